@@ -1,0 +1,111 @@
+# mlod: multi-layer level of detail for skinned characters.
+#
+#   make                  library, runtime and tools (build/bin)
+#   make test             unit + CLI + validator tests, then the unit tests under ASan/UBSan
+#   make test-extended    also uses ../shared/data when it is present
+#   make bench            benchmarks against the peers (bench/RESULTS.md)
+#   make demo             the main job on the bundled sample
+#   make install          PREFIX=/usr/local DESTDIR= MANDIR=$(PREFIX)/share/man
+#   make config=debug|release|sanitize
+#
+# Link order matters: -ltinygltf must come before -ldraco (see docs).
+
+config ?= release
+PREFIX ?= /usr/local
+MANDIR ?= $(PREFIX)/share/man
+DESTDIR ?=
+
+CC ?= cc
+CXX ?= c++
+WARN := -Wall -Wextra -Wpedantic
+CPPFLAGS += -Ilib
+CFLAGS_release := -O2 -g
+CFLAGS_debug := -O0 -g3
+CFLAGS_sanitize := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+CFLAGS += -std=c11 $(WARN) $(CFLAGS_$(config))
+CXXFLAGS += -std=c++14 -Wall -Wextra $(CFLAGS_$(config))
+LDFLAGS_sanitize := -fsanitize=address,undefined
+LDFLAGS += $(LDFLAGS_$(config))
+LDLIBS := -ltinygltf -lstdc++ -lm
+
+B := build/$(config)
+BIN := $(B)/bin
+
+LIB_C := $(sort $(wildcard lib/*.c))
+LIB_CXX := $(sort $(wildcard lib/*.cpp))
+LIB_OBJ := $(LIB_C:%.c=$(B)/%.o) $(LIB_CXX:%.cpp=$(B)/%.o)
+RT_C := $(sort $(wildcard lib/rt/*.c))
+RT_OBJ := $(RT_C:%.c=$(B)/%.o)
+TOOL_NAMES := $(notdir $(basename $(sort $(wildcard tools/mlod-*.c))))
+TOOL_COMMON_OBJ := $(B)/tools/common.o
+TOOLS := $(TOOL_NAMES:%=$(BIN)/%)
+UNIT_SRC := $(sort $(wildcard tests/unit/test_*.c))
+UNIT := $(UNIT_SRC:tests/unit/%.c=$(B)/tests/%)
+HELPERS := $(patsubst tests/helpers/%.c,$(B)/tests/helpers/%,$(wildcard tests/helpers/*.c))
+
+.PHONY: all lib tools unit test test-extended test-unit test-sanitize bench demo install clean samples
+
+all: $(B)/libmlod.a $(if $(RT_OBJ),$(B)/libmlodrt.a) $(TOOLS)
+
+$(B)/libmlod.a: $(LIB_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+
+$(B)/libmlodrt.a: $(RT_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+
+$(B)/%.o: %.c
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(B)/%.o: %.cpp
+	@mkdir -p $(@D)
+	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@
+
+$(BIN)/%: $(B)/tools/%.o $(TOOL_COMMON_OBJ) $(B)/libmlod.a
+	@mkdir -p $(@D)
+	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+
+$(B)/tests/%: $(B)/tests/unit/%.o $(B)/libmlod.a
+	@mkdir -p $(@D)
+	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+
+$(B)/tests/helpers/%: $(B)/tests/helpers/%.o $(B)/libmlod.a
+	@mkdir -p $(@D)
+	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+
+unit: $(UNIT) $(HELPERS)
+
+# The whole suite: unit, CLI and validator tests on the release build, then
+# the unit tests again under AddressSanitizer and UBSan.
+test: all unit
+	@$(MAKE) --no-print-directory config=sanitize unit
+	@tests/run.sh --build $(B) --sanitize-build build/sanitize
+
+test-extended: all unit
+	@$(MAKE) --no-print-directory config=sanitize unit
+	@tests/run.sh --build $(B) --sanitize-build build/sanitize --extended
+
+bench: all
+	@bench/run.sh $(B)
+
+demo: all
+	@scripts/demo $(BIN)
+
+# Regenerates the procedural sample character.
+samples: all $(HELPERS)
+	@scripts/gen-sample $(B)
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man5
+	install -m 755 $(TOOLS) $(DESTDIR)$(PREFIX)/bin
+	install -m 644 $(B)/libmlod.a $(DESTDIR)$(PREFIX)/lib
+	install -m 644 lib/mlod.h $(DESTDIR)$(PREFIX)/include
+	install -m 644 man/man1/*.1 $(DESTDIR)$(MANDIR)/man1
+	if ls man/man5/*.5 >/dev/null 2>&1; then install -m 644 man/man5/*.5 $(DESTDIR)$(MANDIR)/man5; fi
+
+clean:
+	rm -rf build
+
+-include $(shell find build -name '*.d' 2>/dev/null)

@@ -1,0 +1,479 @@
+/*
+ * mlod.h: the public interface of libmlod, the bake library of mlod.
+ *
+ * mlod implements "Multi-Layer Level of Detail for Character Animation"
+ * (Savoye & Meyer, VRIPHYS 2008). This header is the whole public API of
+ * the bake side; the runtime has its own header (lib/rt/mlodrt.h) and does
+ * not include this one.
+ *
+ * Conventions
+ * - Every fallible call returns an mlod_result and, when err is not NULL,
+ *   fills *err with the code and a human-readable message. The library
+ *   never prints and never exits.
+ * - Lengths are in the scene's units (metres for glTF, file units for BVH).
+ *   Angles are radians. Matrices are column-major 4x4 (as in glTF):
+ *   m[col * 4 + row].
+ * - Objects the library allocates are released with the matching *_free
+ *   call, which accepts NULL. Plain buffers it returns are released with
+ *   mlod_free().
+ * - Joints of an mlod_skeleton are ordered so that a parent always comes
+ *   before its children (parent index < child index). Readers establish
+ *   this; everything else relies on it.
+ */
+#ifndef MLOD_H
+#define MLOD_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------ */
+/* Results                                                             */
+/* ------------------------------------------------------------------ */
+
+typedef enum mlod_result {
+	MLOD_OK = 0,
+	MLOD_ERR_INVALID_ARG,  /* a caller error: NULL where not allowed, bad option value */
+	MLOD_ERR_IO,           /* reading or writing a file failed */
+	MLOD_ERR_PARSE,        /* malformed input: truncated, bad syntax, out-of-range index */
+	MLOD_ERR_UNSUPPORTED,  /* well-formed input using a feature mlod does not handle */
+	MLOD_ERR_NOMEM,        /* an allocation failed, or input claims an absurd size */
+	MLOD_ERR_LIMIT         /* a request the data cannot satisfy (e.g. an error bound) */
+} mlod_result;
+
+#define MLOD_ERROR_MESSAGE_SIZE 512
+
+typedef struct mlod_error {
+	mlod_result code;
+	char message[MLOD_ERROR_MESSAGE_SIZE]; /* says what went wrong, without a trailing newline */
+} mlod_error;
+
+/* A short static description of a result code ("malformed input", ...). */
+const char *mlod_strerror(mlod_result code);
+
+/* Fills err (if not NULL) with code and a printf-style message; returns code.
+ * Used by the library itself and available to tools. */
+mlod_result mlod_fail(mlod_error *err, mlod_result code, const char *fmt, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 3, 4)))
+#endif
+	;
+
+/* Releases a buffer returned by the library (glb bytes, JSON text, ...). */
+void mlod_free(void *p);
+
+/* ------------------------------------------------------------------ */
+/* Math                                                                */
+/* ------------------------------------------------------------------ */
+
+typedef struct mlod_v3 { float x, y, z; } mlod_v3;
+typedef struct mlod_quat { float x, y, z, w; } mlod_quat;  /* glTF order */
+typedef struct mlod_mat4 { float m[16]; } mlod_mat4;         /* column-major */
+
+/* A local transform: translation, rotation, scale (glTF's TRS). */
+typedef struct mlod_trs {
+	mlod_v3 t;
+	mlod_quat r;
+	mlod_v3 s;
+} mlod_trs;
+
+/* Euler orders. MLOD_EULER_ZXY means the rotation matrix is Rz * Rx * Ry:
+ * the order in which BVH lists "Zrotation Xrotation Yrotation". */
+typedef enum mlod_euler_order {
+	MLOD_EULER_XYZ,
+	MLOD_EULER_XZY,
+	MLOD_EULER_YXZ,
+	MLOD_EULER_YZX,
+	MLOD_EULER_ZXY,
+	MLOD_EULER_ZYX
+} mlod_euler_order;
+
+mlod_v3 mlod_v3_add(mlod_v3 a, mlod_v3 b);
+mlod_v3 mlod_v3_sub(mlod_v3 a, mlod_v3 b);
+mlod_v3 mlod_v3_scale(mlod_v3 a, float s);
+float mlod_v3_dot(mlod_v3 a, mlod_v3 b);
+mlod_v3 mlod_v3_cross(mlod_v3 a, mlod_v3 b);
+float mlod_v3_length(mlod_v3 a);
+
+mlod_quat mlod_quat_identity(void);
+mlod_quat mlod_quat_mul(mlod_quat a, mlod_quat b);         /* a then applied after b: a*b */
+mlod_quat mlod_quat_normalize(mlod_quat q);
+mlod_quat mlod_quat_conjugate(mlod_quat q);
+mlod_v3 mlod_quat_rotate(mlod_quat q, mlod_v3 v);
+mlod_quat mlod_quat_axis_angle(mlod_v3 axis, float angle); /* axis need not be unit */
+mlod_quat mlod_quat_slerp(mlod_quat a, mlod_quat b, float t); /* shortest path */
+mlod_quat mlod_quat_nlerp(mlod_quat a, mlod_quat b, float t); /* shortest path */
+/* Angle in [0, pi] between the rotations a and b; q and -q are the same rotation. */
+float mlod_quat_angle(mlod_quat a, mlod_quat b);
+
+/* angles[0..2] are the rotations about x, y, z (radians), whatever the order. */
+mlod_quat mlod_quat_from_euler(mlod_euler_order order, const float angles[3]);
+void mlod_quat_to_euler(mlod_euler_order order, mlod_quat q, float angles[3]);
+/* Parses "XYZ", "zxy", ... ; returns 0 on success, -1 when not an order. */
+int mlod_euler_order_parse(const char *s, mlod_euler_order *out);
+const char *mlod_euler_order_name(mlod_euler_order order);
+
+mlod_mat4 mlod_mat4_identity(void);
+mlod_mat4 mlod_mat4_mul(const mlod_mat4 *a, const mlod_mat4 *b); /* a*b */
+mlod_mat4 mlod_mat4_from_trs(const mlod_trs *trs);
+/* Decomposes an affine matrix. Returns 0 when it is exactly a TRS (no shear,
+ * within tol relative), 1 when it has shear the TRS cannot express (the
+ * result is then the closest TRS), -1 when singular. */
+int mlod_mat4_to_trs(const mlod_mat4 *m, mlod_trs *out, float tol);
+/* General inverse; returns 0 on success, -1 when singular. */
+int mlod_mat4_invert(const mlod_mat4 *m, mlod_mat4 *out);
+mlod_v3 mlod_mat4_point(const mlod_mat4 *m, mlod_v3 p);  /* m * (p, 1) */
+mlod_v3 mlod_mat4_vector(const mlod_mat4 *m, mlod_v3 v); /* m * (v, 0) */
+mlod_trs mlod_trs_identity(void);
+
+/* ------------------------------------------------------------------ */
+/* Character model                                                     */
+/* ------------------------------------------------------------------ */
+
+/* BVH channel codes, in the order a BVH file lists them. */
+typedef enum mlod_bvh_channel {
+	MLOD_BVH_XPOS, MLOD_BVH_YPOS, MLOD_BVH_ZPOS,
+	MLOD_BVH_XROT, MLOD_BVH_YROT, MLOD_BVH_ZROT
+} mlod_bvh_channel;
+
+typedef struct mlod_joint {
+	char *name;               /* never NULL; may be "" */
+	int parent;               /* joint index, or -1 for a root */
+	mlod_trs rest;            /* local rest transform (glTF node TRS, or BVH OFFSET) */
+	mlod_mat4 base;           /* roots only: world transform of the non-joint ancestors; identity otherwise */
+	int node;                 /* glTF node index, or -1 (BVH) */
+	/* BVH layout, kept so a BVH round-trips. channel_count is 0 for glTF joints. */
+	int channel_count;        /* 0, 3 or 6 */
+	unsigned char channels[6];/* mlod_bvh_channel codes in file order */
+	mlod_euler_order euler;   /* rotation order implied by the channels (XYZ when none) */
+	int has_end_site;         /* BVH "End Site" below this joint */
+	mlod_v3 end_site;         /* its OFFSET */
+} mlod_joint;
+
+/* A glTF skin: a list of joints with their inverse bind matrices.
+ * Vertex joint indices in primitives skinned by it index this list. */
+typedef struct mlod_skin {
+	char *name;
+	int joint_count;
+	int *joints;              /* indices into mlod_skeleton.joints */
+	mlod_mat4 *inverse_bind;  /* joint_count matrices */
+	int gltf_index;           /* glTF skin index, or -1 */
+} mlod_skin;
+
+typedef struct mlod_skeleton {
+	int joint_count;
+	mlod_joint *joints;
+	int skin_count;
+	mlod_skin *skins;
+} mlod_skeleton;
+
+#define MLOD_MAX_SETS 8
+
+typedef struct mlod_morph_target {
+	float *positions;  /* 3 * vertex_count deltas, or NULL */
+	float *normals;    /* 3 * vertex_count deltas, or NULL */
+	float *tangents;   /* 3 * vertex_count deltas, or NULL */
+} mlod_morph_target;
+
+/* One glTF primitive with its attributes decoded to floats. */
+typedef struct mlod_primitive {
+	int vertex_count;
+	float *positions;                 /* 3 * vertex_count */
+	float *normals;                   /* 3 * vertex_count, or NULL */
+	float *tangents;                  /* 4 * vertex_count, or NULL */
+	int uv_set_count;
+	float *uvs[MLOD_MAX_SETS];        /* 2 * vertex_count each */
+	int color_set_count;
+	float *colors[MLOD_MAX_SETS];     /* 4 * vertex_count each (RGB gets alpha 1) */
+	int weight_set_count;             /* sets of 4 influences (JOINTS_n/WEIGHTS_n) */
+	uint16_t *joints[MLOD_MAX_SETS];  /* 4 * vertex_count each; skin-local indices */
+	float *weights[MLOD_MAX_SETS];    /* 4 * vertex_count each */
+	int index_count;                  /* 0 when not indexed */
+	uint32_t *indices;
+	int mode;                         /* glTF mode: 4 = triangles */
+	int material;                     /* glTF material index, or -1 */
+	int target_count;
+	mlod_morph_target *targets;
+} mlod_primitive;
+
+typedef struct mlod_mesh {
+	char *name;
+	int primitive_count;
+	mlod_primitive *primitives;
+	int gltf_index;                   /* glTF mesh index, or -1 */
+} mlod_mesh;
+
+/* A mesh placed in the scene by a node. A skinned instance follows its
+ * skin; a rigid one follows the joint it hangs under (joint >= 0), with
+ * offset its rest transform relative to that joint; otherwise offset is
+ * its world transform. */
+typedef struct mlod_instance {
+	int mesh;                 /* index into mlod_character.meshes */
+	int node;                 /* glTF node index, or -1 */
+	int skin;                 /* index into skeleton.skins, or -1 */
+	int joint;                /* rigid attachment joint, or -1 */
+	mlod_mat4 offset;
+} mlod_instance;
+
+typedef enum mlod_path { MLOD_PATH_TRANSLATION, MLOD_PATH_ROTATION, MLOD_PATH_SCALE } mlod_path;
+typedef enum mlod_interp { MLOD_INTERP_LINEAR, MLOD_INTERP_STEP, MLOD_INTERP_CUBICSPLINE } mlod_interp;
+
+/* One animated property of one joint. values holds comps floats per key
+ * (3 for translation and scale, 4 for a rotation quaternion); for
+ * CUBICSPLINE it holds 3 * comps per key: in-tangent, value, out-tangent. */
+typedef struct mlod_channel {
+	int joint;
+	mlod_path path;
+	mlod_interp interp;
+	int key_count;
+	float *times;     /* key_count, strictly increasing, seconds */
+	float *values;
+} mlod_channel;
+
+typedef struct mlod_clip {
+	char *name;
+	float duration;   /* seconds: the largest key time */
+	float frame_time; /* > 0 for uniformly sampled clips (BVH); 0 otherwise */
+	int frame_count;  /* frames of a uniformly sampled clip, else 0 */
+	int channel_count;
+	mlod_channel *channels;
+	int gltf_index;   /* glTF animation index, or -1 */
+} mlod_clip;
+
+typedef struct mlod_character {
+	mlod_skeleton skeleton;
+	int mesh_count;
+	mlod_mesh *meshes;
+	int instance_count;
+	mlod_instance *instances;
+	int clip_count;
+	mlod_clip *clips;
+	/* What a reader could not represent and skipped, for the report
+	 * (e.g. "2 joint nodes outside any skin"). May be NULL. */
+	char *notes;
+} mlod_character;
+
+/* Releases everything the character owns and zeroes it. */
+void mlod_character_free(mlod_character *c);
+
+/* Checks the invariants (parent order, index ranges, finite values,
+ * increasing key times, weights in range). Returns MLOD_ERR_PARSE with a
+ * message naming the first problem. */
+mlod_result mlod_character_validate(const mlod_character *c, mlod_error *err);
+
+/* Height of the skeleton: the extent of the rest-pose joint positions
+ * along its largest axis (never 0 for a non-empty skeleton). */
+float mlod_skeleton_size(const mlod_skeleton *s);
+
+/* ------------------------------------------------------------------ */
+/* Pose evaluation and skinning                                        */
+/* ------------------------------------------------------------------ */
+
+/* local[i] = rest transform of joint i. */
+void mlod_pose_rest(const mlod_skeleton *s, mlod_trs *local);
+
+/* Samples clip at time t (clamped to [0, duration]) into local, which must
+ * hold the pose the clip does not animate (usually the rest pose). */
+void mlod_clip_sample(const mlod_clip *clip, float t, mlod_trs *local);
+
+/* world[i] = world transform of joint i for the given local pose
+ * (roots are prefixed by their base). */
+void mlod_pose_world(const mlod_skeleton *s, const mlod_trs *local, mlod_mat4 *world);
+
+/* out[k] = world[skin->joints[k]] * skin->inverse_bind[k]. */
+void mlod_skin_matrices(const mlod_skin *skin, const mlod_mat4 *world, mlod_mat4 *out);
+
+/* Linear blend skinning of a primitive's positions (3 * vertex_count floats
+ * into out) and, when out_normals is not NULL and the primitive has
+ * normals, of its normals. Vertices whose weights sum to 0 stay at their
+ * bind position. */
+void mlod_skin_primitive(const mlod_primitive *p, const mlod_mat4 *skin_mats,
+                         float *out_positions, float *out_normals);
+
+/* A character posed as one triangle soup, for measuring. */
+typedef struct mlod_posed {
+	int vertex_count;
+	float *positions;     /* 3 * vertex_count */
+	int triangle_count;
+	uint32_t *indices;    /* 3 * triangle_count */
+} mlod_posed;
+
+/* Poses every triangle instance of the character (skinned or rigid) with
+ * the world matrices of one pose into out. out is reused between calls:
+ * initialise it to {0} and free it with mlod_posed_free. */
+mlod_result mlod_pose_character(const mlod_character *c, const mlod_mat4 *world,
+                                mlod_posed *out, mlod_error *err);
+void mlod_posed_free(mlod_posed *p);
+
+/* Surface deviation between two posed meshes: each vertex and triangle
+ * centroid of either mesh is projected to the nearest point of the other
+ * surface. mean and max are percentages of the bounding-box diagonal of a. */
+typedef struct mlod_deviation {
+	double mean;
+	double max;
+} mlod_deviation;
+
+mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
+                                   mlod_deviation *out, mlod_error *err);
+
+/* ------------------------------------------------------------------ */
+/* glTF (through a C shim over tinygltf)                               */
+/* ------------------------------------------------------------------ */
+
+/* An opaque glTF document. Everything mlod does not change (materials,
+ * textures, cameras, extras, extensions, names, animations, skins) is kept
+ * as read and written back unchanged. */
+typedef struct mlod_gltf mlod_gltf;
+
+/* Parses .glb or .gltf bytes. base_dir resolves external URIs of a .gltf
+ * (may be NULL: only data: URIs are then allowed). Draco- or
+ * meshopt-compressed input is MLOD_ERR_UNSUPPORTED. */
+mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir,
+                           mlod_gltf **out, mlod_error *err);
+void mlod_gltf_free(mlod_gltf *doc);
+
+/* Serialises the document: binary != 0 gives .glb, else .gltf JSON with
+ * embedded buffers. *data is released with mlod_free. */
+mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data,
+                            size_t *size, mlod_error *err);
+
+/* Builds the character model from the document's skins, meshes and
+ * animations. Joint nodes are the union of all skins' joints plus the nodes
+ * that connect them. */
+mlod_result mlod_gltf_to_character(const mlod_gltf *doc, mlod_character *out,
+                                   mlod_error *err);
+
+/* Builds a new document from a character: nodes for joints (and End Sites
+ * as child nodes marked extras.mlod.end_site), meshes, skins, instances and
+ * one animation per clip. A BVH read this way gives a glb. */
+mlod_result mlod_gltf_from_character(const mlod_character *c, mlod_gltf **out,
+                                     mlod_error *err);
+
+typedef enum mlod_gltf_kind {
+	MLOD_GLTF_NODE,
+	MLOD_GLTF_SKIN,
+	MLOD_GLTF_SCENE,  /* index -1: the default scene */
+	MLOD_GLTF_MESH,
+	MLOD_GLTF_ANIMATION,
+	MLOD_GLTF_ASSET   /* index ignored */
+} mlod_gltf_kind;
+
+int mlod_gltf_count(const mlod_gltf *doc, mlod_gltf_kind kind);
+
+/* Sets extras[key] of an object to the JSON value in json (an object,
+ * array, string, number, ...), replacing any previous value of that key
+ * and keeping the other keys. */
+mlod_result mlod_gltf_set_extra(mlod_gltf *doc, mlod_gltf_kind kind, int index,
+                                const char *key, const char *json, mlod_error *err);
+
+/* Reads extras[key] as JSON text into *json (release with mlod_free).
+ * Returns MLOD_OK with *json = NULL when the key is absent. */
+mlod_result mlod_gltf_get_extra(const mlod_gltf *doc, mlod_gltf_kind kind, int index,
+                                const char *key, char **json, mlod_error *err);
+
+/* Appends a mesh built from m's primitives (new accessors in a new buffer
+ * view range of buffer 0; material indices kept). */
+mlod_result mlod_gltf_add_mesh(mlod_gltf *doc, const mlod_mesh *m, int *out_index,
+                               mlod_error *err);
+
+/* Appends a node. parent -1 puts it in the default scene's roots.
+ * mesh and skin may be -1. */
+mlod_result mlod_gltf_add_node(mlod_gltf *doc, const char *name, int parent,
+                               int mesh, int skin, const mlod_trs *trs,
+                               int *out_index, mlod_error *err);
+
+/* Appends a skin whose joints are the glTF nodes of the given skeleton
+ * joints (skin->joints index s->joints; each must have a node). */
+mlod_result mlod_gltf_add_skin(mlod_gltf *doc, const mlod_skeleton *s,
+                               const mlod_skin *skin, int *out_index, mlod_error *err);
+
+/* Appends an animation with the clip's channels, targeting the joints'
+ * nodes. */
+mlod_result mlod_gltf_add_animation(mlod_gltf *doc, const mlod_skeleton *s,
+                                    const mlod_clip *clip, int *out_index,
+                                    mlod_error *err);
+
+/* Adds MSFT_lod to node (lod_nodes are its coarser levels, finest first)
+ * and MSFT_screencoverage to its extras (lod_count + 1 values, decreasing),
+ * and declares MSFT_lod in extensionsUsed. */
+mlod_result mlod_gltf_set_lod(mlod_gltf *doc, int node, const int *lod_nodes,
+                              int lod_count, const float *coverage, mlod_error *err);
+
+/* ------------------------------------------------------------------ */
+/* BVH                                                                 */
+/* ------------------------------------------------------------------ */
+
+/* Parses BVH text. Joints get their channel layout, rest = OFFSET (with
+ * identity rotation), and one clip "bvh" with a uniformly sampled
+ * translation and rotation channel per animated joint. Errors name the line. */
+mlod_result mlod_bvh_read(const void *data, size_t size, mlod_character *out,
+                          mlod_error *err);
+
+/* Writes the character's skeleton and one clip as BVH text, sampled at
+ * frame_time (0: the clip's own frame time, else 1/30 s). Joints without a
+ * BVH layout get "Xposition Yposition Zposition" on roots and
+ * "Zrotation Xrotation Yrotation" elsewhere. *text is released with mlod_free. */
+mlod_result mlod_bvh_write(const mlod_character *c, int clip, float frame_time,
+                           char **text, size_t *size, mlod_error *err);
+
+/* ------------------------------------------------------------------ */
+/* Input                                                               */
+/* ------------------------------------------------------------------ */
+
+typedef enum mlod_format { MLOD_FORMAT_UNKNOWN, MLOD_FORMAT_GLB, MLOD_FORMAT_GLTF, MLOD_FORMAT_BVH } mlod_format;
+
+/* Guesses the format from the first bytes. */
+mlod_format mlod_detect_format(const void *data, size_t size);
+
+/* Loads glb, glTF or BVH bytes into a document and a character. BVH gets a
+ * document made with mlod_gltf_from_character, so every tool writes glb.
+ * doc may be NULL when only the character is wanted. On failure nothing
+ * is allocated. */
+mlod_result mlod_load(const void *data, size_t size, const char *base_dir,
+                      mlod_gltf **doc, mlod_character *c, mlod_format *format,
+                      mlod_error *err);
+
+/* ------------------------------------------------------------------ */
+/* Skeleton labeling and joint energy (paper 4.1.1, 4.1.2)             */
+/* ------------------------------------------------------------------ */
+
+typedef enum mlod_label {
+	MLOD_LABEL_ROOT,         /* zeta */
+	MLOD_LABEL_END_EFFECTOR, /* chi */
+	MLOD_LABEL_MAJOR,        /* psi */
+	MLOD_LABEL_EXTREME,      /* mu */
+	MLOD_LABEL_MINOR         /* kappa: the only removable joints */
+} mlod_label;
+
+const char *mlod_label_name(mlod_label l);   /* "root", "end-effector", ... */
+const char *mlod_label_symbol(mlod_label l); /* UTF-8 Greek letter */
+/* Parses a label name; returns 0 on success, -1 otherwise. */
+int mlod_label_parse(const char *s, mlod_label *out);
+
+typedef struct mlod_label_options {
+	double hub_factor;   /* 0 means 1.9, the paper's value */
+	double max_angle;    /* rotation range per Euler axis for energy normalisation; 0 means pi */
+} mlod_label_options;
+
+typedef struct mlod_joint_info {
+	int depth;           /* edges to the joint's root */
+	int children;
+	int neighbors;       /* children + 1 if the joint has a parent */
+	mlod_label label;
+	double weight;       /* (h - depth) / h, h = tree height (max depth + 1) */
+	double energy;       /* max over clips of the joint energy */
+} mlod_joint_info;
+
+/* Labels every joint and computes its energy from the character's clips
+ * (0 when there are none). info holds skeleton.joint_count entries. */
+mlod_result mlod_label_skeleton(const mlod_character *c, const mlod_label_options *opt,
+                                mlod_joint_info *info, mlod_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MLOD_H */

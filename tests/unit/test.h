@@ -1,0 +1,101 @@
+/*
+ * test.h: a minimal unit test harness for mlod.
+ *
+ * Each tests/unit/test_*.c is one program. It defines test functions with
+ * TEST(name) and runs them from main with RUN(name). Each test prints one
+ * line, "PASS name" or "FAIL name: file:line: what", which tests/run.sh
+ * counts. A failing CHECK stops only its own test.
+ *
+ * Tests that need sample files find them through test_path("samples/x"),
+ * relative to the repository root (the runner's working directory).
+ */
+#ifndef MLOD_TEST_H
+#define MLOD_TEST_H
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mlod.h"
+
+static int test_failed_;
+static char test_msg_[1024];
+static int test_total_fail_;
+
+#define TEST(name) static void test_##name(void)
+
+#define RUN(name)                                                              \
+	do {                                                                   \
+		test_failed_ = 0;                                              \
+		test_##name();                                                 \
+		if (test_failed_) {                                            \
+			printf("FAIL %s: %s\n", #name, test_msg_);             \
+			test_total_fail_++;                                    \
+		} else {                                                       \
+			printf("PASS %s\n", #name);                            \
+		}                                                              \
+		fflush(stdout);                                                \
+	} while (0)
+
+#define TEST_EXIT() return test_total_fail_ ? 1 : 0
+
+#define CHECK_MSG(cond, ...)                                                   \
+	do {                                                                   \
+		if (!(cond)) {                                                 \
+			int n_ = snprintf(test_msg_, sizeof test_msg_, "%s:%d: ", __FILE__, __LINE__); \
+			snprintf(test_msg_ + n_, sizeof test_msg_ - (size_t)n_, __VA_ARGS__); \
+			test_failed_ = 1;                                      \
+			return;                                                \
+		}                                                              \
+	} while (0)
+
+#define CHECK(cond) CHECK_MSG(cond, "%s", #cond)
+
+#define CHECK_NEAR(a, b, tol)                                                  \
+	do {                                                                   \
+		double a_ = (double)(a), b_ = (double)(b);                     \
+		CHECK_MSG(fabs(a_ - b_) <= (tol), "%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, (double)(tol)); \
+	} while (0)
+
+/* Checks an mlod call returned MLOD_OK; prints the library's message otherwise. */
+/* Pass &terr as the call's error argument so the message can be shown. */
+static mlod_error terr;
+#define CHECK_OK(call)                                                         \
+	do {                                                                   \
+		memset(&terr, 0, sizeof terr);                                 \
+		mlod_result r_ = (call);                                       \
+		CHECK_MSG(r_ == MLOD_OK, "%s returned %d: %s", #call, (int)r_, terr.message); \
+	} while (0)
+
+/* Reads a whole file; returns NULL if it cannot. *size gets its length. */
+static inline void *test_read_file(const char *path, size_t *size)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	size_t cap = 1 << 16, n = 0;
+	char *buf = malloc(cap);
+	for (;;) {
+		if (n == cap) {
+			cap *= 2;
+			buf = realloc(buf, cap);
+		}
+		size_t got = fread(buf + n, 1, cap - n, f);
+		if (got == 0)
+			break;
+		n += got;
+	}
+	fclose(f);
+	*size = n;
+	return buf;
+}
+
+/* Is the development data in ../shared/data present (make test-extended)? */
+static inline int test_have_shared(void)
+{
+	const char *e = getenv("MLOD_SHARED_DATA");
+	return e && *e;
+}
+
+#endif
