@@ -1,0 +1,1 @@
+"$BIN/mlod-label" --frobnicate x.glb

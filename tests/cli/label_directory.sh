@@ -1,0 +1,2 @@
+mkdir -p somedir
+"$BIN/mlod-label" somedir

@@ -1,0 +1,2 @@
+: > empty.glb
+"$BIN/mlod-label" empty.glb

@@ -1,0 +1,1 @@
+"$BIN/mlod-label" "$ROOT/tests/data/bad/missing_brace.bvh"

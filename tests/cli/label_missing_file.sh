@@ -1,0 +1,1 @@
+"$BIN/mlod-label" no-such-file.glb

@@ -1,0 +1,2 @@
+printf 'hello, world\n' > text.txt
+"$BIN/mlod-label" text.txt

@@ -1,0 +1,230 @@
+/* common.c: input, output and error handling shared by the mlod-* tools. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "common.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+const char *tool_name = "mlod";
+
+/* Inputs larger than this are refused rather than read into memory. */
+#define MAX_INPUT_SIZE ((size_t)2 << 30)
+
+void tool_die(int code, const char *what, const char *fmt, ...)
+{
+	va_list ap;
+	fprintf(stderr, "%s: ", tool_name);
+	if (what)
+		fprintf(stderr, "%s: ", what);
+	va_start(ap, fmt);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fputc('\n', stderr);
+	exit(code);
+}
+
+void tool_usage_error(const char *fmt, ...)
+{
+	va_list ap;
+	fprintf(stderr, "%s: ", tool_name);
+	va_start(ap, fmt);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fprintf(stderr, "\nTry '%s --help' for more information.\n", tool_name);
+	exit(EXIT_USAGE);
+}
+
+int tool_exit_code(mlod_result r)
+{
+	switch (r) {
+	case MLOD_OK: return 0;
+	case MLOD_ERR_INVALID_ARG: return EXIT_USAGE;
+	case MLOD_ERR_UNSUPPORTED: return EXIT_UNSUPPORTED;
+	case MLOD_ERR_IO:
+	case MLOD_ERR_PARSE:
+	case MLOD_ERR_NOMEM:
+	case MLOD_ERR_LIMIT: return EXIT_INPUT;
+	}
+	return EXIT_INPUT;
+}
+
+static int is_stdio(const char *path)
+{
+	return path == NULL || strcmp(path, "-") == 0;
+}
+
+const char *tool_input_label(const char *path)
+{
+	return is_stdio(path) ? "<stdin>" : path;
+}
+
+void *tool_read_input(const char *path, size_t *size)
+{
+	const char *label = tool_input_label(path);
+	FILE *f = stdin;
+	if (!is_stdio(path)) {
+		struct stat st;
+		if (stat(path, &st) != 0)
+			tool_die(EXIT_INPUT, label, "%s", strerror(errno));
+		if (S_ISDIR(st.st_mode))
+			tool_die(EXIT_INPUT, label, "is a directory");
+		f = fopen(path, "rb");
+		if (!f)
+			tool_die(EXIT_INPUT, label, "%s", strerror(errno));
+	} else if (isatty(fileno(stdin))) {
+		tool_usage_error("no input: give a file, or pipe a glb, glTF or BVH into stdin");
+	}
+	size_t cap = 1 << 16, n = 0;
+	char *buf = malloc(cap);
+	if (!buf)
+		tool_die(EXIT_INPUT, label, "out of memory");
+	for (;;) {
+		if (n == cap) {
+			if (cap >= MAX_INPUT_SIZE)
+				tool_die(EXIT_INPUT, label, "input larger than %zu bytes", MAX_INPUT_SIZE);
+			char *grown = realloc(buf, cap * 2);
+			if (!grown)
+				tool_die(EXIT_INPUT, label, "out of memory");
+			buf = grown;
+			cap *= 2;
+		}
+		size_t got = fread(buf + n, 1, cap - n, f);
+		if (got == 0)
+			break;
+		n += got;
+	}
+	if (ferror(f))
+		tool_die(EXIT_INPUT, label, "read error: %s", strerror(errno));
+	if (f != stdin)
+		fclose(f);
+	*size = n;
+	return buf;
+}
+
+/* The directory part of path, for resolving a .gltf's external URIs. */
+static char *dir_of(const char *path)
+{
+	if (is_stdio(path))
+		return NULL;
+	const char *slash = strrchr(path, '/');
+	if (!slash)
+		return strdup(".");
+	size_t n = (size_t)(slash - path);
+	char *d = malloc(n + 2);
+	if (!d)
+		return NULL;
+	memcpy(d, path, n ? n : 1);
+	d[n ? n : 1] = '\0';
+	return d;
+}
+
+void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format)
+{
+	size_t size;
+	void *data = tool_read_input(path, &size);
+	char *dir = dir_of(path);
+	mlod_error err = {0};
+	mlod_result r = mlod_load(data, size, dir, doc, c, format, &err);
+	free(dir);
+	free(data);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
+}
+
+void tool_write_output(const char *path, const void *data, size_t size, int binary)
+{
+	if (is_stdio(path)) {
+		if (binary && isatty(fileno(stdout)))
+			tool_die(EXIT_USAGE, NULL, "refusing to write binary output to a terminal; redirect stdout or use -o FILE");
+		if (fwrite(data, 1, size, stdout) != size || fflush(stdout) != 0)
+			tool_die(EXIT_OUTPUT, "<stdout>", "write error: %s", strerror(errno));
+		return;
+	}
+	size_t n = strlen(path) + 32;
+	char *tmp = malloc(n);
+	if (!tmp)
+		tool_die(EXIT_OUTPUT, path, "out of memory");
+	snprintf(tmp, n, "%s.tmp.%ld", path, (long)getpid());
+	FILE *f = fopen(tmp, "wb");
+	if (!f) {
+		int e = errno;
+		free(tmp);
+		tool_die(EXIT_OUTPUT, path, "cannot create: %s", strerror(e));
+	}
+	int ok = fwrite(data, 1, size, f) == size;
+	ok = (fflush(f) == 0) && ok;
+	ok = (fsync(fileno(f)) == 0 || errno == EINVAL) && ok;
+	int e = errno;
+	ok = (fclose(f) == 0) && ok;
+	if (!ok || rename(tmp, path) != 0) {
+		if (ok)
+			e = errno;
+		remove(tmp);
+		free(tmp);
+		tool_die(EXIT_OUTPUT, path, "write failed: %s", strerror(e));
+	}
+	free(tmp);
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+	size_t a = strlen(s), b = strlen(suffix);
+	return a >= b && strcmp(s + a - b, suffix) == 0;
+}
+
+void tool_write_gltf(const char *path, const mlod_gltf *doc)
+{
+	int binary = is_stdio(path) || !ends_with(path, ".gltf");
+	void *data = NULL;
+	size_t size = 0;
+	mlod_error err = {0};
+	if (mlod_gltf_write(doc, binary, &data, &size, &err) != MLOD_OK)
+		tool_die(EXIT_OUTPUT, is_stdio(path) ? "<stdout>" : path, "%s", err.message);
+	tool_write_output(path, data, size, binary);
+	mlod_free(data);
+}
+
+double tool_parse_double(const char *option, const char *value, double lo, double hi)
+{
+	char *end = NULL;
+	errno = 0;
+	double v = strtod(value, &end);
+	if (end == value || *end != '\0' || errno == ERANGE || !isfinite(v))
+		tool_usage_error("%s: '%s' is not a number", option, value);
+	if (v < lo || v > hi)
+		tool_usage_error("%s: %s is out of range [%g, %g]", option, value, lo, hi);
+	return v;
+}
+
+void tool_json_string(FILE *f, const char *s)
+{
+	fputc('"', f);
+	for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+		switch (*p) {
+		case '"': fputs("\\\"", f); break;
+		case '\\': fputs("\\\\", f); break;
+		case '\n': fputs("\\n", f); break;
+		case '\t': fputs("\\t", f); break;
+		case '\r': fputs("\\r", f); break;
+		default:
+			if (*p < 0x20)
+				fprintf(f, "\\u%04x", *p);
+			else
+				fputc(*p, f);
+		}
+	}
+	fputc('"', f);
+}
+
+void tool_version(void)
+{
+	printf("%s (mlod) %s\n", tool_name, MLOD_VERSION);
+	exit(0);
+}

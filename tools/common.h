@@ -1,0 +1,79 @@
+/*
+ * common.h: what every mlod-* tool shares: error reporting with the exit
+ * codes of the pipeline, reading the input, and writing the output
+ * atomically. Only the public API of libmlod is used.
+ *
+ * Exit codes: 0 success, 1 usage, 2 bad input, 3 unsupported input,
+ * 4 output failure.
+ */
+#ifndef MLOD_TOOLS_COMMON_H
+#define MLOD_TOOLS_COMMON_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "mlod.h"
+
+enum {
+	EXIT_USAGE = 1,
+	EXIT_INPUT = 2,
+	EXIT_UNSUPPORTED = 3,
+	EXIT_OUTPUT = 4
+};
+
+/* The tool's name for messages ("mlod-label"). Set once in main. */
+extern const char *tool_name;
+
+/* Prints "tool: what: message" to stderr and exits with code. what may be
+ * NULL (then "tool: message"). */
+void tool_die(int code, const char *what, const char *fmt, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 3, 4), noreturn))
+#endif
+	;
+
+/* Prints "tool: message" and a hint to run --help, then exits 1. */
+void tool_usage_error(const char *fmt, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 1, 2), noreturn))
+#endif
+	;
+
+/* The exit code for a library result met while reading input. */
+int tool_exit_code(mlod_result r);
+
+/* The name to use in messages for an input path (NULL or "-" is "<stdin>"). */
+const char *tool_input_label(const char *path);
+
+/* Reads a whole file, or stdin when path is NULL or "-". Exits 2 with a
+ * clear message when it cannot (missing, a directory, unreadable, too big). */
+void *tool_read_input(const char *path, size_t *size);
+
+/* Reads and loads a glb, glTF or BVH input; exits on failure. doc may be
+ * NULL. */
+void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format);
+
+/* Writes bytes to path atomically (a temporary file in the same directory,
+ * then rename), or to stdout when path is NULL or "-". Binary output is
+ * refused when stdout is a terminal. Exits 4 on failure. */
+void tool_write_output(const char *path, const void *data, size_t size, int binary);
+
+/* Serialises doc as glb (or .gltf when path ends in ".gltf") to path or
+ * stdout. Exits 4 on failure. */
+void tool_write_gltf(const char *path, const mlod_gltf *doc);
+
+/* Parses a double from an option value; exits 1 with a message naming the
+ * option when it is not a finite number within [lo, hi]. */
+double tool_parse_double(const char *option, const char *value, double lo, double hi);
+
+/* Writes s as a JSON string literal (quoted, escaped) to f. */
+void tool_json_string(FILE *f, const char *s);
+
+/* Prints "tool (mlod) VERSION" to stdout and exits 0. */
+void tool_version(void)
+#if defined(__GNUC__)
+	__attribute__((noreturn))
+#endif
+	;
+
+#endif
