@@ -474,6 +474,82 @@ typedef struct mlod_joint_info {
 mlod_result mlod_label_skeleton(const mlod_character *c, const mlod_label_options *opt,
                                 mlod_joint_info *info, mlod_error *err);
 
+
+/* ------------------------------------------------------------------ */
+/* Multiresolution Skeletal Graph and skeleton levels (paper 4.1.3)    */
+/* ------------------------------------------------------------------ */
+
+/* An edge of the transitive closure of a kinematic sub-chain: from an
+ * ancestor a to a descendant b, weighted by the bone length along the
+ * chain between them. */
+typedef struct mlod_skelgraph_edge {
+	int a, b;
+	float length;
+} mlod_skelgraph_edge;
+
+/* The graph: each kinematic sub-chain is a connected set of joints whose
+ * interior joints are minor and whose ends are non-minor; chains meet only
+ * at non-minor joints. A chain may branch where a minor joint has several
+ * children. */
+typedef struct mlod_skelgraph {
+	int joint_count;
+	int *joint_parent;            /* joint_count: the skeleton's parents */
+	int chain_count;
+	int *chain_start;             /* chain_count + 1 offsets into chain_joints */
+	int *chain_joints;            /* each chain's joints, its top joint first, parents before children */
+	int edge_count;
+	mlod_skelgraph_edge *edges;   /* the closure of every chain, sorted by (length, a, b) */
+} mlod_skelgraph;
+
+/* Builds the graph from the skeleton and its labels. A skeleton whose
+ * closure would exceed a few million edges is MLOD_ERR_LIMIT. */
+mlod_result mlod_skelgraph_build(const mlod_skeleton *s, const mlod_joint_info *info,
+                                 mlod_skelgraph *out, mlod_error *err);
+void mlod_skelgraph_free(mlod_skelgraph *g);
+
+/* One skeleton level. */
+typedef struct mlod_skel_level {
+	double threshold;        /* minor joints with energy below it are removed */
+	int joint_count;         /* of the full skeleton */
+	int kept_count;
+	unsigned char *kept;     /* joint_count flags */
+	int *parent;             /* joint_count: a kept joint's parent in the level (-1 for a root or a removed joint) */
+	int *remap;              /* joint_count: the kept joint that stands in for each joint (itself when kept) */
+} mlod_skel_level;
+
+/* Extracts the level at threshold: disables the minor joints whose energy
+ * is below it, then takes the minimum spanning tree of the enabled joints
+ * over the closure edges, oriented from the roots. Levels extracted at
+ * increasing thresholds are nested. */
+mlod_result mlod_skelgraph_extract(const mlod_skelgraph *g, const mlod_joint_info *info,
+                                   double threshold, mlod_skel_level *out, mlod_error *err);
+void mlod_skel_level_free(mlod_skel_level *l);
+
+/* The threshold that removes the `removed` lowest-energy minor joints
+ * (ties broken by joint index are kept together: the result may remove a
+ * few more). Returns 0 when removed <= 0. */
+double mlod_skel_threshold_for(const mlod_skeleton *s, const mlod_joint_info *info, int removed);
+
+typedef struct mlod_fold_stats {
+	int shear_samples;       /* composed transforms that had shear TRS cannot express */
+	int weight_merges;       /* vertices whose influences were merged */
+} mlod_fold_stats;
+
+/* Applies a level to a character, giving a standalone character whose
+ * skeleton holds only the kept joints (in the same relative order):
+ * - motion folding: a kept joint whose parent was removed gets the local
+ *   transform L'_c = L_j ... L_c composed over its removed ancestors, at
+ *   the union of their key times (or every frame of a sampled clip), so
+ *   every kept joint's world transform is unchanged there;
+ * - skin transfer: each vertex's weight on a removed joint moves to its
+ *   stand-in; duplicates merge and the weights are renormalised;
+ * - skins list the kept joints they used plus any stand-in they need, with
+ *   inverse bind matrices from the full skeleton;
+ * - rigid instances on a removed joint follow its stand-in.
+ * out->joints[k].node keeps the original node index. stats may be NULL. */
+mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level *l,
+                                  mlod_character *out, mlod_fold_stats *stats, mlod_error *err);
+
 #ifdef __cplusplus
 }
 #endif

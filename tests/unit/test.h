@@ -12,6 +12,10 @@
 #ifndef MLOD_TEST_H
 #define MLOD_TEST_H
 
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L /* strdup, mkstemp in tests */
+#endif
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
