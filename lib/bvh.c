@@ -721,9 +721,9 @@ typedef struct joint_anim {
 
 static mlod_result read_motion(reader *r, mlod_character *c)
 {
-	long frames;
-	double ft;
-	int time_line;
+	long frames = 0;
+	double ft = 0.0;
+	int time_line = 0;
 	token t;
 	char b[64];
 	TRY(read_motion_header(r, &frames, &ft, &time_line));
