@@ -476,6 +476,34 @@ mlod_result mlod_label_skeleton(const mlod_character *c, const mlod_label_option
 
 
 /* ------------------------------------------------------------------ */
+/* Comparing a level against the full character                       */
+/* ------------------------------------------------------------------ */
+
+/* The times at which a clip is measured: every frame of a sampled clip, or
+ * the union of its key times, thinned evenly to at most max_samples (0: no
+ * limit) and always keeping the first and last. *times is released with
+ * mlod_free. Returns the count, or -1 when out of memory. */
+int mlod_clip_times(const mlod_clip *clip, int max_samples, float **times);
+
+/* Skinned-vertex deviation: a and b have the same meshes, instances and
+ * clips (b is a level of a that changed only skeleton, weights or keys).
+ * At each measured time of each clip (up to max_samples per clip), every
+ * posed vertex of b is compared with the same vertex of a. mean and max
+ * are percentages of the bounding-box diagonal of a in its rest pose. A
+ * character without clips is measured in the rest pose. */
+mlod_result mlod_vertex_deviation(const mlod_character *a, const mlod_character *b, int max_samples,
+                                  mlod_deviation *out, mlod_error *err);
+
+/* Joint position deviation, in scene units: the world position of every
+ * joint j of a (and of its End Site) against the same point carried by b.
+ * stand_in[j] is the joint of a whose counterpart in b carries j rigidly,
+ * with their relative transform from a's rest pose (NULL: j itself);
+ * a_to_b[k] is the joint of b that is a's joint k (NULL: the same index).
+ * For a skeleton level these are the level's remap and the renumbering. */
+mlod_result mlod_joint_deviation(const mlod_character *a, const mlod_character *b, const int *stand_in,
+                                 const int *a_to_b, int max_samples, mlod_deviation *out, mlod_error *err);
+
+/* ------------------------------------------------------------------ */
 /* Multiresolution Skeletal Graph and skeleton levels (paper 4.1.3)    */
 /* ------------------------------------------------------------------ */
 
