@@ -647,7 +647,8 @@ static mlod_result read_hierarchy(reader *r)
 }
 
 /* Reads "Frames: n" and "Frame Time: t". */
-static mlod_result read_motion_header(reader *r, long *frames, double *frame_time, int *time_line)
+static mlod_result read_motion_header(reader *r, long *frames, int *frames_line, double *frame_time,
+                                      int *time_line)
 {
 	token t;
 	char b[64];
@@ -657,6 +658,7 @@ static mlod_result read_motion_header(reader *r, long *frames, double *frame_tim
 		                 show(&t, b));
 	if (t.len == 0)
 		TRY(next(r, &t));
+	*frames_line = t.line;
 	if (t.len > 0 && t.s[0] == '-')
 		return mlod_fail(r->err, MLOD_ERR_PARSE, "line %d: negative frame count %s", t.line, show(&t, b));
 	long n = 0;
@@ -723,10 +725,10 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 {
 	long frames = 0;
 	double ft = 0.0;
-	int time_line = 0;
+	int frames_line = 0, time_line = 0;
 	token t;
 	char b[64];
-	TRY(read_motion_header(r, &frames, &ft, &time_line));
+	TRY(read_motion_header(r, &frames, &frames_line, &ft, &time_line));
 
 	int n = r->count;
 	long vpf = 0;
@@ -751,7 +753,7 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 	if (need > avail / 2 + 1)
 		return mlod_fail(r->err, MLOD_ERR_PARSE,
 		                 "line %d: 'Frames: %ld' needs %llu values of %ld per frame but only %llu bytes follow (truncated file?)",
-		                 time_line, frames, (unsigned long long)need, vpf, (unsigned long long)avail);
+		                 frames_line, frames, (unsigned long long)need, vpf, (unsigned long long)avail);
 	/* Key times must stay distinct in single precision. */
 	float last = (float)((double)(frames - 1) * ft), before = (float)((double)(frames - 2) * ft);
 	if (!isfinite(last) || (frames > 1 && !(last > before)))
