@@ -1,0 +1,417 @@
+/*
+ * deviation.c: symmetric surface deviation between two triangle meshes.
+ *
+ * Samples of each mesh (the vertices its triangles use, and its triangle
+ * centroids) are projected to the nearest point of the other surface.
+ * Nearest points come from a bounding volume hierarchy over the target's
+ * triangles (object-median splits on the longest axis, so the depth is
+ * logarithmic), searched nearer child first and pruned by box distance,
+ * each query seeded with the previous sample's triangle. Point-triangle
+ * distance is the Voronoi-region method of Ericson, "Real-Time Collision
+ * Detection" (2005), 5.1.5; degenerate triangles are measured as their
+ * three edges. Single-threaded and in a fixed order, so deterministic.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mlod.h"
+
+#define LEAF_SIZE 4
+#define MAX_DEPTH 64 /* object-median splits of < 2^31 triangles stay far below */
+
+typedef struct node {
+	float lo[3], hi[3];
+	int first; /* leaf: first triangle; inner: index of the left child (right is next) */
+	int count; /* leaf: triangle count; inner: 0 */
+} node;
+
+typedef struct tri {
+	double a[3], b[3], c[3];
+	int degenerate;
+} tri;
+
+typedef struct bvh {
+	node *nodes;
+	int node_count;
+	tri *tris;  /* in leaf order */
+} bvh;
+
+/* ---------------------------------------------------------------- */
+/* Point-triangle distance                                           */
+/* ---------------------------------------------------------------- */
+
+static double dot3(const double *u, const double *v)
+{
+	return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+}
+
+static void sub3(const double *u, const double *v, double *out)
+{
+	out[0] = u[0] - v[0], out[1] = u[1] - v[1], out[2] = u[2] - v[2];
+}
+
+static double dist2_to(const double *p, const double *q)
+{
+	double d[3];
+	sub3(p, q, d);
+	return dot3(d, d);
+}
+
+/* Squared distance from p to the segment a + s (b - a), s in [0, 1]. */
+static double segment_dist2(const double *p, const double *a, const double *b)
+{
+	double ab[3], ap[3], q[3];
+	sub3(b, a, ab);
+	sub3(p, a, ap);
+	double len2 = dot3(ab, ab), s = len2 > 0.0 ? dot3(ap, ab) / len2 : 0.0;
+	s = s < 0.0 ? 0.0 : s > 1.0 ? 1.0 : s;
+	for (int i = 0; i < 3; i++)
+		q[i] = a[i] + s * ab[i];
+	return dist2_to(p, q);
+}
+
+/* Squared distance from p to the triangle (Ericson, 5.1.5). */
+static double triangle_dist2(const double *p, const tri *t)
+{
+	const double *a = t->a, *b = t->b, *c = t->c;
+	if (t->degenerate) {
+		double d = segment_dist2(p, a, b), e = segment_dist2(p, b, c), f = segment_dist2(p, c, a);
+		return fmin(d, fmin(e, f));
+	}
+	double ab[3], ac[3], ap[3], bp[3], cp[3], q[3];
+	sub3(b, a, ab);
+	sub3(c, a, ac);
+	sub3(p, a, ap);
+	double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+	if (d1 <= 0.0 && d2 <= 0.0)
+		return dist2_to(p, a); /* vertex region a */
+	sub3(p, b, bp);
+	double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+	if (d3 >= 0.0 && d4 <= d3)
+		return dist2_to(p, b); /* vertex region b */
+	double vc = d1 * d4 - d3 * d2;
+	if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) { /* edge ab */
+		double v = d1 / (d1 - d3);
+		for (int i = 0; i < 3; i++)
+			q[i] = a[i] + v * ab[i];
+		return dist2_to(p, q);
+	}
+	sub3(p, c, cp);
+	double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+	if (d6 >= 0.0 && d5 <= d6)
+		return dist2_to(p, c); /* vertex region c */
+	double vb = d5 * d2 - d1 * d6;
+	if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { /* edge ac */
+		double w = d2 / (d2 - d6);
+		for (int i = 0; i < 3; i++)
+			q[i] = a[i] + w * ac[i];
+		return dist2_to(p, q);
+	}
+	double va = d3 * d6 - d5 * d4;
+	if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) { /* edge bc */
+		double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+		for (int i = 0; i < 3; i++)
+			q[i] = b[i] + w * (c[i] - b[i]);
+		return dist2_to(p, q);
+	}
+	double denom = 1.0 / (va + vb + vc), v = vb * denom, w = vc * denom; /* face */
+	for (int i = 0; i < 3; i++)
+		q[i] = a[i] + ab[i] * v + ac[i] * w;
+	return dist2_to(p, q);
+}
+
+/* A triangle is degenerate when its area is negligible against its edges:
+ * then the face formula would divide by (nearly) zero. */
+static int is_degenerate(const tri *t)
+{
+	double ab[3], ac[3];
+	sub3(t->b, t->a, ab);
+	sub3(t->c, t->a, ac);
+	double n[3] = { ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0] };
+	return dot3(n, n) <= 1e-12 * dot3(ab, ab) * dot3(ac, ac);
+}
+
+/* ---------------------------------------------------------------- */
+/* Hierarchy                                                         */
+/* ---------------------------------------------------------------- */
+
+typedef struct builder {
+	bvh *out;
+	const mlod_posed *mesh;
+	int *order;       /* triangle indices, permuted into leaf order */
+	float *centroids; /* 3 per triangle */
+} builder;
+
+static float centroid_of(const builder *b, int t, int axis)
+{
+	return b->centroids[3 * t + axis];
+}
+
+/* Rearranges order[lo, hi) so that order[nth] has the nth smallest centroid
+ * along axis and no smaller one comes after it (quickselect). */
+static void select_nth(const builder *b, int lo, int hi, int nth, int axis)
+{
+	int *o = b->order;
+	while (hi - lo > 1) {
+		float pivot = centroid_of(b, o[lo + (hi - lo) / 2], axis);
+		int i = lo, j = hi - 1;
+		while (i <= j) {
+			while (centroid_of(b, o[i], axis) < pivot)
+				i++;
+			while (centroid_of(b, o[j], axis) > pivot)
+				j--;
+			if (i <= j) {
+				int tmp = o[i];
+				o[i] = o[j], o[j] = tmp;
+				i++, j--;
+			}
+		}
+		/* now [lo, j] <= pivot <= [i, hi) and (j, i) == pivot */
+		if (nth <= j)
+			hi = j + 1;
+		else if (nth >= i)
+			lo = i;
+		else
+			return;
+	}
+}
+
+/* Builds the subtree of order[lo, hi) at nodes[index]: a leaf for a few
+ * triangles, else two children split at the median centroid along the
+ * axis where centroids spread most. Boxes are merged bottom-up. */
+static void build_node(builder *b, int index, int lo, int hi)
+{
+	node *n = &b->out->nodes[index];
+	float lo3[3] = { INFINITY, INFINITY, INFINITY }, hi3[3] = { -INFINITY, -INFINITY, -INFINITY };
+	if (hi - lo <= LEAF_SIZE) {
+		for (int k = lo; k < hi; k++) {
+			const uint32_t *ix = b->mesh->indices + 3 * (size_t)b->order[k];
+			for (int v = 0; v < 3; v++)
+				for (int a = 0; a < 3; a++) {
+					float x = b->mesh->positions[3 * (size_t)ix[v] + a];
+					lo3[a] = x < lo3[a] ? x : lo3[a];
+					hi3[a] = x > hi3[a] ? x : hi3[a];
+				}
+		}
+		memcpy(n->lo, lo3, sizeof lo3);
+		memcpy(n->hi, hi3, sizeof hi3);
+		n->first = lo;
+		n->count = hi - lo;
+		return;
+	}
+	for (int k = lo; k < hi; k++)
+		for (int a = 0; a < 3; a++) {
+			float x = centroid_of(b, b->order[k], a);
+			lo3[a] = x < lo3[a] ? x : lo3[a];
+			hi3[a] = x > hi3[a] ? x : hi3[a];
+		}
+	int axis = 0;
+	for (int a = 1; a < 3; a++)
+		if (hi3[a] - lo3[a] > hi3[axis] - lo3[axis])
+			axis = a;
+	int mid = lo + (hi - lo) / 2;
+	select_nth(b, lo, hi, mid, axis);
+	int left = b->out->node_count;
+	b->out->node_count += 2;
+	build_node(b, left, lo, mid);
+	build_node(b, left + 1, mid, hi);
+	n = &b->out->nodes[index];
+	const node *l = &b->out->nodes[left], *r = &b->out->nodes[left + 1];
+	for (int a = 0; a < 3; a++) {
+		n->lo[a] = l->lo[a] < r->lo[a] ? l->lo[a] : r->lo[a];
+		n->hi[a] = l->hi[a] > r->hi[a] ? l->hi[a] : r->hi[a];
+	}
+	n->first = left;
+	n->count = 0;
+}
+
+static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
+{
+	int n = m->triangle_count;
+	builder b = { out, m, malloc((size_t)n * sizeof(int)), malloc((size_t)n * 3 * sizeof(float)) };
+	out->nodes = malloc((size_t)2 * n * sizeof *out->nodes);
+	out->tris = malloc((size_t)n * sizeof *out->tris);
+	out->node_count = 1;
+	if (!b.order || !b.centroids || !out->nodes || !out->tris) {
+		free(b.order);
+		free(b.centroids);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", n);
+	}
+	for (int t = 0; t < n; t++) {
+		const uint32_t *ix = m->indices + 3 * (size_t)t;
+		b.order[t] = t;
+		for (int a = 0; a < 3; a++)
+			b.centroids[3 * t + a] = (m->positions[3 * (size_t)ix[0] + a] + m->positions[3 * (size_t)ix[1] + a] +
+			                          m->positions[3 * (size_t)ix[2] + a]) / 3.0f;
+	}
+	build_node(&b, 0, 0, n);
+	for (int k = 0; k < n; k++) {
+		const uint32_t *ix = m->indices + 3 * (size_t)b.order[k];
+		tri *t = &out->tris[k];
+		for (int a = 0; a < 3; a++) {
+			t->a[a] = m->positions[3 * (size_t)ix[0] + a];
+			t->b[a] = m->positions[3 * (size_t)ix[1] + a];
+			t->c[a] = m->positions[3 * (size_t)ix[2] + a];
+		}
+		t->degenerate = is_degenerate(t);
+	}
+	free(b.order);
+	free(b.centroids);
+	return MLOD_OK;
+}
+
+static void bvh_free(bvh *b)
+{
+	free(b->nodes);
+	free(b->tris);
+}
+
+static double box_dist2(const double *p, const node *n)
+{
+	double d2 = 0.0;
+	for (int a = 0; a < 3; a++) {
+		double below = n->lo[a] - p[a], above = p[a] - n->hi[a];
+		double d = below > above ? below : above;
+		d = d > 0.0 ? d : 0.0;
+		d2 += d * d;
+	}
+	return d2;
+}
+
+/* Squared distance from p to the nearest triangle. *hint is a triangle to
+ * start from (updated to the nearest one), which makes neighbouring
+ * queries cheap. */
+static double bvh_nearest2(const bvh *b, const double *p, int *hint)
+{
+	double best = triangle_dist2(p, &b->tris[*hint]);
+	struct { int node; double d2; } stack[MAX_DEPTH + 1];
+	int top = 0;
+	stack[top].node = 0, stack[top++].d2 = box_dist2(p, &b->nodes[0]);
+	while (top > 0) {
+		--top;
+		if (stack[top].d2 >= best)
+			continue;
+		const node *n = &b->nodes[stack[top].node];
+		if (n->count > 0) {
+			for (int k = n->first; k < n->first + n->count; k++) {
+				double d = triangle_dist2(p, &b->tris[k]);
+				if (d < best)
+					best = d, *hint = k;
+			}
+			continue;
+		}
+		/* push the farther child first, so the nearer one is searched first */
+		int l = n->first, r = n->first + 1;
+		double dl = box_dist2(p, &b->nodes[l]), dr = box_dist2(p, &b->nodes[r]);
+		if (dl > dr) {
+			int ti = l;
+			double td = dl;
+			l = r, dl = dr;
+			r = ti, dr = td;
+		}
+		if (dr < best)
+			stack[top].node = r, stack[top++].d2 = dr;
+		if (dl < best)
+			stack[top].node = l, stack[top++].d2 = dl;
+	}
+	return best;
+}
+
+/* ---------------------------------------------------------------- */
+/* Measuring                                                         */
+/* ---------------------------------------------------------------- */
+
+static mlod_result check_mesh(const mlod_posed *m, const char *which, mlod_error *err)
+{
+	if (!m || m->vertex_count <= 0 || m->triangle_count <= 0 || !m->positions || !m->indices)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh %s is empty", which);
+	for (long i = 0; i < 3L * m->triangle_count; i++) {
+		uint32_t v = m->indices[i];
+		if (v >= (uint32_t)m->vertex_count)
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh %s: index %ld is %u, out of range (%d vertices)",
+			                 which, i, v, m->vertex_count);
+		for (int a = 0; a < 3; a++)
+			if (!isfinite(m->positions[3 * (size_t)v + a]))
+				return mlod_fail(err, MLOD_ERR_PARSE, "deviation: mesh %s: vertex %u is not finite", which, v);
+	}
+	return MLOD_OK;
+}
+
+/* Adds the distances of from's samples to the surface in to. */
+static mlod_result measure(const mlod_posed *from, const bvh *to, double *sum, double *max, long *count,
+                           mlod_error *err)
+{
+	unsigned char *used = calloc((size_t)from->vertex_count, 1);
+	if (!used)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %d vertex flags", from->vertex_count);
+	int hint = 0;
+	for (long i = 0; i < 3L * from->triangle_count; i++)
+		used[from->indices[i]] = 1;
+	/* only vertices on the surface count: unreferenced ones are not part of it */
+	for (int v = 0; v < from->vertex_count; v++) {
+		if (!used[v])
+			continue;
+		const double p[3] = { from->positions[3 * (size_t)v], from->positions[3 * (size_t)v + 1],
+		                      from->positions[3 * (size_t)v + 2] };
+		double d = sqrt(bvh_nearest2(to, p, &hint));
+		*sum += d;
+		*max = fmax(*max, d);
+		++*count;
+	}
+	for (int t = 0; t < from->triangle_count; t++) {
+		const uint32_t *ix = from->indices + 3 * (size_t)t;
+		double p[3];
+		for (int a = 0; a < 3; a++)
+			p[a] = ((double)from->positions[3 * (size_t)ix[0] + a] + from->positions[3 * (size_t)ix[1] + a] +
+			        from->positions[3 * (size_t)ix[2] + a]) / 3.0;
+		double d = sqrt(bvh_nearest2(to, p, &hint));
+		*sum += d;
+		*max = fmax(*max, d);
+		++*count;
+	}
+	free(used);
+	return MLOD_OK;
+}
+
+/* Diagonal of the bounding box of the vertices a's triangles use. */
+static double diagonal(const mlod_posed *m)
+{
+	double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+	for (long i = 0; i < 3L * m->triangle_count; i++)
+		for (int a = 0; a < 3; a++) {
+			double x = m->positions[3 * (size_t)m->indices[i] + a];
+			lo[a] = fmin(lo[a], x);
+			hi[a] = fmax(hi[a], x);
+		}
+	return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+	            (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
+                                   mlod_deviation *out, mlod_error *err)
+{
+	mlod_result r;
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: no output");
+	if ((r = check_mesh(a, "a", err)) || (r = check_mesh(b, "b", err)))
+		return r;
+	double diag = diagonal(a);
+	if (!(diag > 0.0))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
+
+	bvh ba = { 0 }, bb = { 0 };
+	double sum = 0.0, max = 0.0;
+	long count = 0;
+	if (!(r = bvh_build(a, &ba, err)) && !(r = bvh_build(b, &bb, err)) &&
+	    !(r = measure(a, &bb, &sum, &max, &count, err)))
+		r = measure(b, &ba, &sum, &max, &count, err);
+	bvh_free(&ba);
+	bvh_free(&bb);
+	if (r)
+		return r;
+	out->mean = 100.0 * sum / (double)count / diag;
+	out->max = 100.0 * max / diag;
+	out->scale = diag;
+	return MLOD_OK;
+}

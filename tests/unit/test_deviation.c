@@ -1,0 +1,311 @@
+/* test_deviation.c: surface deviation against hand results and brute force. */
+#include "test.h"
+
+#define PI 3.14159265358979323846
+
+static unsigned rng_state = 777u;
+static double rnd(double lo, double hi)
+{
+	rng_state = rng_state * 1664525u + 1013904223u;
+	return lo + (hi - lo) * (double)(rng_state >> 8) / (double)(1u << 24);
+}
+
+static mlod_posed alloc_mesh(int vertices, int triangles)
+{
+	mlod_posed m = { vertices, malloc((size_t)vertices * 3 * sizeof(float)), triangles,
+	                 malloc((size_t)triangles * 3 * sizeof(uint32_t)) };
+	return m;
+}
+
+/* An n x n grid of quads on z = 0 covering [0, size]^2. */
+static mlod_posed grid(int n, float size)
+{
+	mlod_posed m = alloc_mesh((n + 1) * (n + 1), 2 * n * n);
+	for (int y = 0; y <= n; y++)
+		for (int x = 0; x <= n; x++) {
+			float *p = m.positions + 3 * (y * (n + 1) + x);
+			p[0] = size * x / n, p[1] = size * y / n, p[2] = 0.0f;
+		}
+	uint32_t *ix = m.indices;
+	for (int y = 0; y < n; y++)
+		for (int x = 0; x < n; x++) {
+			uint32_t v = (uint32_t)(y * (n + 1) + x), w = (uint32_t)(n + 1);
+			*ix++ = v, *ix++ = v + 1, *ix++ = v + w + 1;
+			*ix++ = v, *ix++ = v + w + 1, *ix++ = v + w;
+		}
+	return m;
+}
+
+/* A UV sphere of radius r, rings x segments, with each vertex pushed
+ * radially by up to noise. */
+static mlod_posed sphere(int rings, int segs, double r, double noise)
+{
+	mlod_posed m = alloc_mesh((rings + 1) * segs, 2 * rings * segs);
+	for (int i = 0; i <= rings; i++)
+		for (int j = 0; j < segs; j++) {
+			double th = PI * i / rings, ph = 2 * PI * j / segs, rr = r + rnd(-noise, noise);
+			float *p = m.positions + 3 * (i * segs + j);
+			p[0] = (float)(rr * sin(th) * cos(ph)), p[1] = (float)(rr * sin(th) * sin(ph)), p[2] = (float)(rr * cos(th));
+		}
+	uint32_t *ix = m.indices;
+	for (int i = 0; i < rings; i++)
+		for (int j = 0; j < segs; j++) {
+			uint32_t a = (uint32_t)(i * segs + j), b = (uint32_t)(i * segs + (j + 1) % segs);
+			uint32_t c = a + (uint32_t)segs, d = b + (uint32_t)segs;
+			*ix++ = a, *ix++ = c, *ix++ = d; /* at the poles some are degenerate */
+			*ix++ = a, *ix++ = d, *ix++ = b;
+		}
+	return m;
+}
+
+static mlod_posed copy_translated(const mlod_posed *m, float dx, float dy, float dz)
+{
+	mlod_posed c = alloc_mesh(m->vertex_count, m->triangle_count);
+	memcpy(c.indices, m->indices, (size_t)m->triangle_count * 3 * sizeof(uint32_t));
+	for (int v = 0; v < m->vertex_count; v++) {
+		c.positions[3 * v] = m->positions[3 * v] + dx;
+		c.positions[3 * v + 1] = m->positions[3 * v + 1] + dy;
+		c.positions[3 * v + 2] = m->positions[3 * v + 2] + dz;
+	}
+	return c;
+}
+
+/* ---------------------------------------------------------------- */
+/* Brute force: an independent point-triangle distance               */
+/* ---------------------------------------------------------------- */
+
+typedef struct { double x, y, z; } d3;
+static d3 dsub(d3 a, d3 b) { d3 r = { a.x - b.x, a.y - b.y, a.z - b.z }; return r; }
+static double ddot(d3 a, d3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static d3 dcross(d3 a, d3 b) { d3 r = { a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x }; return r; }
+
+static double seg_dist(d3 p, d3 a, d3 b)
+{
+	d3 ab = dsub(b, a);
+	double l = ddot(ab, ab), s = l > 0 ? ddot(dsub(p, a), ab) / l : 0;
+	s = fmin(1, fmax(0, s));
+	d3 q = { a.x + s * ab.x, a.y + s * ab.y, a.z + s * ab.z };
+	d3 d = dsub(p, q);
+	return sqrt(ddot(d, d));
+}
+
+/* Project onto the plane; inside (all edge tests agree) gives the plane
+ * distance, outside the nearest edge. */
+static double tri_dist(d3 p, d3 a, d3 b, d3 c)
+{
+	d3 n = dcross(dsub(b, a), dsub(c, a));
+	double nn = ddot(n, n);
+	double e = fmin(seg_dist(p, a, b), fmin(seg_dist(p, b, c), seg_dist(p, c, a)));
+	if (nn <= 1e-20)
+		return e;
+	double h = ddot(dsub(p, a), n) / nn;
+	d3 q = { p.x - h * n.x, p.y - h * n.y, p.z - h * n.z };
+	if (ddot(dcross(dsub(b, a), dsub(q, a)), n) >= 0 && ddot(dcross(dsub(c, b), dsub(q, b)), n) >= 0 &&
+	    ddot(dcross(dsub(a, c), dsub(q, c)), n) >= 0)
+		return fabs(h) * sqrt(nn);
+	return e;
+}
+
+static d3 vert(const mlod_posed *m, uint32_t v)
+{
+	d3 r = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] };
+	return r;
+}
+
+static double surface_dist(d3 p, const mlod_posed *m)
+{
+	double best = INFINITY;
+	for (int t = 0; t < m->triangle_count; t++) {
+		const uint32_t *ix = m->indices + 3 * t;
+		best = fmin(best, tri_dist(p, vert(m, ix[0]), vert(m, ix[1]), vert(m, ix[2])));
+	}
+	return best;
+}
+
+static void brute_side(const mlod_posed *from, const mlod_posed *to, double *sum, double *max, long *n)
+{
+	char *used = calloc((size_t)from->vertex_count, 1);
+	for (int i = 0; i < 3 * from->triangle_count; i++)
+		used[from->indices[i]] = 1;
+	for (int v = 0; v < from->vertex_count; v++)
+		if (used[v]) {
+			double d = surface_dist(vert(from, (uint32_t)v), to);
+			*sum += d, *max = fmax(*max, d), ++*n;
+		}
+	for (int t = 0; t < from->triangle_count; t++) {
+		d3 a = vert(from, from->indices[3 * t]), b = vert(from, from->indices[3 * t + 1]),
+		   c = vert(from, from->indices[3 * t + 2]);
+		d3 g = { (a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3, (a.z + b.z + c.z) / 3 };
+		double d = surface_dist(g, to);
+		*sum += d, *max = fmax(*max, d), ++*n;
+	}
+	free(used);
+}
+
+/* Diagonal of the bounding box of the vertices m's triangles use. */
+static double diag_of(const mlod_posed *m)
+{
+	double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+	for (int i = 0; i < 3 * m->triangle_count; i++)
+		for (int k = 0; k < 3; k++) {
+			lo[k] = fmin(lo[k], m->positions[3 * m->indices[i] + k]);
+			hi[k] = fmax(hi[k], m->positions[3 * m->indices[i] + k]);
+		}
+	return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+static mlod_deviation brute(const mlod_posed *a, const mlod_posed *b)
+{
+	double sum = 0, max = 0, diag = diag_of(a);
+	long n = 0;
+	brute_side(a, b, &sum, &max, &n);
+	brute_side(b, a, &sum, &max, &n);
+	mlod_deviation d;
+	d.mean = 100 * sum / n / diag;
+	d.max = 100 * max / diag;
+	d.scale = diag;
+	return d;
+}
+
+/* ---------------------------------------------------------------- */
+/* Tests                                                             */
+/* ---------------------------------------------------------------- */
+
+TEST(identical_meshes)
+{
+	mlod_posed s = sphere(12, 16, 1.0, 0.05);
+	mlod_deviation d;
+	CHECK_OK(mlod_surface_deviation(&s, &s, &d, &terr));
+	CHECK_NEAR(d.mean, 0, 1e-6);
+	CHECK_NEAR(d.max, 0, 1e-6);
+	mlod_posed_free(&s);
+}
+
+TEST(plane_offset_along_normal)
+{
+	/* every sample is exactly 0.3 from the other plane; the diagonal is 2 sqrt 2 */
+	mlod_posed a = grid(10, 2.0f), b = copy_translated(&a, 0, 0, 0.3f);
+	mlod_deviation d;
+	CHECK_OK(mlod_surface_deviation(&a, &b, &d, &terr));
+	double want = 100 * 0.3 / sqrt(8.0);
+	CHECK_NEAR(d.mean, want, 1e-4);
+	CHECK_NEAR(d.max, want, 1e-4);
+	CHECK_NEAR(d.scale, sqrt(8.0), 1e-6); /* the percentages are of a's diagonal */
+	mlod_posed_free(&a);
+	mlod_posed_free(&b);
+}
+
+TEST(plane_offset_within_plane)
+{
+	/* shifted sideways by 0.5: the overlapping samples are at distance 0,
+	 * the ones hanging over the edge at their distance to it */
+	mlod_posed a = grid(4, 2.0f), b = copy_translated(&a, 0.5f, 0, 0);
+	mlod_deviation d, w = brute(&a, &b);
+	CHECK_OK(mlod_surface_deviation(&a, &b, &d, &terr));
+	CHECK_NEAR(d.max, 100 * 0.5 / sqrt(8.0), 1e-4);
+	CHECK_NEAR(d.mean, w.mean, 1e-5);
+	mlod_posed_free(&a);
+	mlod_posed_free(&b);
+}
+
+TEST(translated_sphere_matches_brute_force)
+{
+	mlod_posed a = sphere(10, 14, 1.0, 0.0), b = copy_translated(&a, 0.1f, -0.05f, 0.2f);
+	double t = sqrt(0.1 * 0.1 + 0.05 * 0.05 + 0.2 * 0.2);
+	mlod_deviation d, w = brute(&a, &b);
+	CHECK_OK(mlod_surface_deviation(&a, &b, &d, &terr));
+	CHECK_NEAR(d.mean, w.mean, 1e-4);
+	CHECK_NEAR(d.max, w.max, 1e-4);
+	/* no sample is farther than the translation; the farthest nearly is */
+	double pct = 100.0 * t / diag_of(&a); /* the translation in % */
+	CHECK(d.max <= pct + 1e-4);
+	CHECK(d.max >= 0.8 * pct);
+	CHECK(d.mean > 0.2 * pct);
+	mlod_posed_free(&a);
+	mlod_posed_free(&b);
+}
+
+TEST(random_meshes_match_brute_force)
+{
+	for (int round = 0; round < 4; round++) {
+		/* a noisy sphere against a triangle soup with degenerate triangles */
+		mlod_posed a = sphere(8 + round, 12, 1.0, 0.1);
+		mlod_posed b = alloc_mesh(300, 400);
+		for (int i = 0; i < 3 * b.vertex_count; i++)
+			b.positions[i] = (float)rnd(-1.3, 1.3);
+		for (int i = 0; i < 3 * b.triangle_count; i++)
+			b.indices[i] = (uint32_t)rnd(0, b.vertex_count - 1e-9);
+		for (int t = 0; t < 20; t++) {
+			uint32_t *ix = b.indices + 3 * t;
+			if (t % 2) {
+				ix[2] = ix[1]; /* two corners the same */
+			} else {        /* three collinear corners */
+				float *p0 = b.positions + 3 * ix[0], *p1 = b.positions + 3 * ix[1], *p2 = b.positions + 3 * ix[2];
+				for (int k = 0; k < 3; k++)
+					p2[k] = p0[k] + 2.0f * (p1[k] - p0[k]);
+			}
+		}
+		b.indices[60] = b.indices[61] = b.indices[62] = 7; /* a point */
+		mlod_deviation d, w = brute(&a, &b);
+		CHECK_OK(mlod_surface_deviation(&a, &b, &d, &terr));
+		CHECK_MSG(fabs(d.mean - w.mean) < 1e-4, "round %d mean %g vs %g", round, d.mean, w.mean);
+		CHECK_MSG(fabs(d.max - w.max) < 1e-4, "round %d max %g vs %g", round, d.max, w.max);
+		CHECK(d.mean > 0 && d.max >= d.mean);
+		/* deterministic, bit for bit */
+		mlod_deviation again;
+		CHECK_OK(mlod_surface_deviation(&a, &b, &again, &terr));
+		CHECK(d.mean == again.mean && d.max == again.max && d.scale == again.scale);
+		mlod_posed_free(&a);
+		mlod_posed_free(&b);
+	}
+}
+
+TEST(unused_vertices_do_not_count)
+{
+	mlod_posed a = grid(3, 1.0f), b = copy_translated(&a, 0, 0, 0);
+	mlod_deviation d;
+	/* a stray vertex far away that no triangle uses */
+	b.positions[3 * 5 + 2] = 100.0f;
+	for (int i = 0; i < 3 * b.triangle_count; i++)
+		if (b.indices[i] == 5)
+			b.indices[i] = 4;
+	CHECK_OK(mlod_surface_deviation(&a, &b, &d, &terr));
+	CHECK(d.max < 100.0);
+	mlod_posed_free(&a);
+	mlod_posed_free(&b);
+}
+
+TEST(bad_input)
+{
+	mlod_posed a = grid(2, 1.0f), b = grid(2, 1.0f), empty = { 0 };
+	mlod_deviation d;
+	mlod_error e;
+	CHECK(mlod_surface_deviation(&a, &empty, &d, &e) == MLOD_ERR_INVALID_ARG);
+	CHECK(mlod_surface_deviation(&empty, &a, &d, &e) == MLOD_ERR_INVALID_ARG);
+	CHECK(mlod_surface_deviation(NULL, &a, &d, &e) == MLOD_ERR_INVALID_ARG);
+	CHECK(mlod_surface_deviation(&a, &b, NULL, &e) == MLOD_ERR_INVALID_ARG);
+	b.positions[4] = NAN;
+	CHECK(mlod_surface_deviation(&a, &b, &d, &e) == MLOD_ERR_PARSE);
+	CHECK(strstr(e.message, "vertex 1") != NULL);
+	b.positions[4] = 0.0f;
+	b.indices[5] = 99;
+	CHECK(mlod_surface_deviation(&a, &b, &d, &e) == MLOD_ERR_INVALID_ARG);
+	b.indices[5] = 0;
+	for (int i = 0; i < 3 * a.vertex_count; i++)
+		a.positions[i] = 1.0f; /* all of a at one point: no scale */
+	CHECK(mlod_surface_deviation(&a, &b, &d, &e) == MLOD_ERR_INVALID_ARG);
+	mlod_posed_free(&a);
+	mlod_posed_free(&b);
+}
+
+int main(void)
+{
+	RUN(identical_meshes);
+	RUN(plane_offset_along_normal);
+	RUN(plane_offset_within_plane);
+	RUN(translated_sphere_matches_brute_force);
+	RUN(random_meshes_match_brute_force);
+	RUN(unused_vertices_do_not_count);
+	RUN(bad_input);
+	TEST_EXIT();
+}
