@@ -160,6 +160,7 @@ mlod_result mlod_vertex_deviation(const mlod_character *a, const mlod_character 
 	}
 	out->mean = count ? 100.0 * sum / (double)count / diag : 0.0;
 	out->max = 100.0 * out->max / diag;
+	out->scale = diag;
 done:
 	free(times);
 	poser_free(&pa);

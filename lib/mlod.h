@@ -316,6 +316,7 @@ void mlod_posed_free(mlod_posed *p);
 typedef struct mlod_deviation {
 	double mean;
 	double max;
+	double scale; /* the length mean and max are percentages of; 0 when they are in scene units */
 } mlod_deviation;
 
 mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,

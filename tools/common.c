@@ -228,3 +228,128 @@ void tool_version(void)
 	printf("%s (mlod) %s\n", tool_name, MLOD_VERSION);
 	exit(0);
 }
+
+/* A minimal JSON scanner for reading back our own extras. */
+static const char *json_ws(const char *p)
+{
+	while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r')
+		p++;
+	return p;
+}
+
+/* Skips a string starting at its opening quote; returns past the closing
+ * quote, or NULL. Copies the raw contents (escapes kept) into out. */
+static const char *json_string(const char *p, char *out, size_t size)
+{
+	size_t n = 0;
+	if (*p++ != '"')
+		return NULL;
+	while (*p && *p != '"') {
+		if (*p == '\\' && p[1])
+			p++;
+		if (out && n + 1 < size)
+			out[n++] = *p;
+		p++;
+	}
+	if (out && size)
+		out[n] = '\0';
+	return *p == '"' ? p + 1 : NULL;
+}
+
+/* Skips any JSON value; returns past it, or NULL when malformed. */
+static const char *json_skip(const char *p, int depth)
+{
+	p = json_ws(p);
+	if (depth > 64)
+		return NULL;
+	if (*p == '"')
+		return json_string(p, NULL, 0);
+	if (*p == '{' || *p == '[') {
+		char close = *p == '{' ? '}' : ']';
+		p = json_ws(p + 1);
+		if (*p == close)
+			return p + 1;
+		for (;;) {
+			if (close == '}') {
+				if (!(p = json_string(json_ws(p), NULL, 0)))
+					return NULL;
+				p = json_ws(p);
+				if (*p++ != ':')
+					return NULL;
+			}
+			if (!(p = json_skip(p, depth + 1)))
+				return NULL;
+			p = json_ws(p);
+			if (*p == close)
+				return p + 1;
+			if (*p++ != ',')
+				return NULL;
+		}
+	}
+	const char *start = p;
+	while (*p && strchr("+-.0123456789eEtruefalsn", *p))
+		p++;
+	return p > start ? p : NULL;
+}
+
+/* Finds key's value in a top-level object: returns a pointer to it, or
+ * NULL when absent; sets *bad when the text is malformed. */
+static const char *json_find(const char *json, const char *key, int *bad)
+{
+	char name[256];
+	const char *p = json_ws(json);
+	*bad = 0;
+	if (*p++ != '{') {
+		*bad = 1;
+		return NULL;
+	}
+	p = json_ws(p);
+	if (*p == '}')
+		return NULL;
+	for (;;) {
+		if (!(p = json_string(json_ws(p), name, sizeof name)))
+			break;
+		p = json_ws(p);
+		if (*p++ != ':')
+			break;
+		p = json_ws(p);
+		if (strcmp(name, key) == 0)
+			return p;
+		if (!(p = json_skip(p, 1)))
+			break;
+		p = json_ws(p);
+		if (*p == '}')
+			return NULL;
+		if (*p++ != ',')
+			break;
+	}
+	*bad = 1;
+	return NULL;
+}
+
+int tool_json_number(const char *json, const char *key, double *out)
+{
+	int bad;
+	const char *p = json_find(json, key, &bad);
+	if (bad)
+		return -1;
+	if (!p || !(*p == '-' || (*p >= '0' && *p <= '9')))
+		return 0;
+	char *end;
+	double v = strtod(p, &end);
+	if (end == p || !isfinite(v))
+		return -1;
+	*out = v;
+	return 1;
+}
+
+int tool_json_string_value(const char *json, const char *key, char *out, size_t size)
+{
+	int bad;
+	const char *p = json_find(json, key, &bad);
+	if (bad)
+		return -1;
+	if (!p || *p != '"')
+		return 0;
+	return json_string(p, out, size) ? 1 : -1;
+}

@@ -76,4 +76,10 @@ void tool_version(void)
 #endif
 	;
 
+/* Looks up key in the top level of a JSON object text. Returns 1 and
+ * fills *out when the key holds a number (resp. a string, truncated to
+ * size), 0 when absent or of another type, -1 when the text is malformed. */
+int tool_json_number(const char *json, const char *key, double *out);
+int tool_json_string_value(const char *json, const char *key, char *out, size_t size);
+
 #endif

@@ -64,6 +64,9 @@ static int test_total_fail_;
 
 /* Checks an mlod call returned MLOD_OK; prints the library's message otherwise. */
 /* Pass &terr as the call's error argument so the message can be shown. */
+#if defined(__GNUC__)
+__attribute__((unused))
+#endif
 static mlod_error terr;
 #define CHECK_OK(call)                                                         \
 	do {                                                                   \
