@@ -42,6 +42,7 @@ TOOLS := $(TOOL_NAMES:%=$(BIN)/%)
 UNIT_SRC := $(sort $(wildcard tests/unit/test_*.c))
 UNIT := $(UNIT_SRC:tests/unit/%.c=$(B)/tests/%)
 HELPERS := $(patsubst tests/helpers/%.c,$(B)/tests/helpers/%,$(wildcard tests/helpers/*.c))
+BENCH := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
 
 .PHONY: all lib tools unit test test-extended test-unit test-sanitize bench demo install clean samples
 
@@ -75,6 +76,10 @@ $(B)/tests/helpers/%: $(B)/tests/helpers/%.o $(B)/libmlod.a
 	@mkdir -p $(@D)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
+$(B)/bench/%: $(B)/bench/%.o $(B)/libmlod.a
+	@mkdir -p $(@D)
+	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+
 unit: $(UNIT) $(HELPERS)
 
 # The whole suite: unit, CLI and validator tests on the release build, then
@@ -87,7 +92,7 @@ test-extended: all unit
 	@$(MAKE) --no-print-directory config=sanitize unit
 	@tests/run.sh --build $(B) --sanitize-build build/sanitize --extended
 
-bench: all
+bench: all $(BENCH)
 	@bench/run.sh $(B)
 
 demo: all
