@@ -382,7 +382,10 @@ mlod_result mlod_gltf_get_extra(const mlod_gltf *doc, mlod_gltf_kind kind, int i
 mlod_result mlod_gltf_add_mesh(mlod_gltf *doc, const mlod_mesh *m, int *out_index,
                                mlod_error *err);
 
-/* Appends a node. parent -1 puts it in the default scene's roots.
+#define MLOD_GLTF_DETACHED (-2)
+
+/* Appends a node. parent -1 puts it in the default scene's roots;
+ * MLOD_GLTF_DETACHED leaves it out of every scene (e.g. an MSFT_lod level).
  * mesh and skin may be -1. */
 mlod_result mlod_gltf_add_node(mlod_gltf *doc, const char *name, int parent,
                                int mesh, int skin, const mlod_trs *trs,
@@ -398,6 +401,13 @@ mlod_result mlod_gltf_add_skin(mlod_gltf *doc, const mlod_skeleton *s,
 mlod_result mlod_gltf_add_animation(mlod_gltf *doc, const mlod_skeleton *s,
                                     const mlod_clip *clip, int *out_index,
                                     mlod_error *err);
+
+/* Appends a copy of glTF mesh `mesh` whose JOINTS_n and WEIGHTS_n come
+ * from m (same primitives and vertex counts, as made by
+ * mlod_skel_level_apply); every other attribute, the indices and the morph
+ * targets share the original accessors. */
+mlod_result mlod_gltf_add_mesh_reskinned(mlod_gltf *doc, int mesh, const mlod_mesh *m, int *out_index,
+                                         mlod_error *err);
 
 /* Adds MSFT_lod to node (lod_nodes are its coarser levels, finest first)
  * and MSFT_screencoverage to its extras (lod_count + 1 values, decreasing),
@@ -559,6 +569,21 @@ void mlod_skel_level_free(mlod_skel_level *l);
  * few more). Returns 0 when removed <= 0. */
 double mlod_skel_threshold_for(const mlod_skeleton *s, const mlod_joint_info *info, int removed);
 
+/* A level as measured, for mlod_gltf_add_skel_levels. */
+typedef struct mlod_skel_level_record {
+	const mlod_skel_level *level;
+	const mlod_character *character; /* the level applied to the full character */
+	mlod_deviation vertex;           /* skinned-vertex error, % of diagonal; scale 0 without meshes */
+	mlod_deviation joint;            /* joint position error, scene units */
+	double size;                     /* the skeleton height, for the joint error */
+} mlod_skel_level_record;
+
+/* The largest screen coverage (fraction of the screen height covered by
+ * the character) at which an error of error_percent of the character's
+ * size stays within pixel_budget pixels on a screen screen_pixels high;
+ * at most 1, and 0 for no error. */
+double mlod_error_coverage(double error_percent, double screen_pixels, double pixel_budget);
+
 typedef struct mlod_fold_stats {
 	int shear_samples;       /* composed transforms that had shear TRS cannot express */
 	int weight_merges;       /* vertices whose influences were merged */
@@ -578,6 +603,16 @@ typedef struct mlod_fold_stats {
  * out->joints[k].node keeps the original node index. stats may be NULL. */
 mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level *l,
                                   mlod_character *out, mlod_fold_stats *stats, mlod_error *err);
+
+/* Records levels (coarser in order) in the document that full was read
+ * from: per level a glTF skin for each skin, over the kept joints; a copy
+ * of each skinned mesh with the transferred weights, on a node outside the
+ * scene listed in the original node's MSFT_lod (coverage from the
+ * errors); and extras.mlod on the scene (the levels: threshold, kept
+ * nodes, remap as node -> stand-in node, skins, errors) and on each skin
+ * (the skins of its levels). */
+mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full,
+                                      const mlod_skel_level_record *levels, int count, mlod_error *err);
 
 #ifdef __cplusplus
 }
