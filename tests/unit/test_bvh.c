@@ -992,6 +992,119 @@ TEST(write_angles)
 	mlod_character_free(&c);
 }
 
+/* ---------------------------------------------------------------- */
+/* Format detection and loading                                      */
+/* ---------------------------------------------------------------- */
+
+TEST(detect_format)
+{
+	static const struct {
+		const char *bytes;
+		size_t size;
+		mlod_format want;
+	} cases[] = {
+		{ "glTF\x02\0\0\0", 8, MLOD_FORMAT_GLB },
+		{ "{\"asset\":{\"version\":\"2.0\"}}", 28, MLOD_FORMAT_GLTF },
+		{ " \r\n\t{", 5, MLOD_FORMAT_GLTF },
+		{ "\xEF\xBB\xBF{", 4, MLOD_FORMAT_GLTF },
+		{ "HIERARCHY\nROOT", 15, MLOD_FORMAT_BVH },
+		{ "\xEF\xBB\xBF\r\n hierarchy ", 16, MLOD_FORMAT_BVH },
+		{ "HIERARCHY", 9, MLOD_FORMAT_BVH },
+		{ "HIERARCHYX", 10, MLOD_FORMAT_UNKNOWN },
+		{ "HIERARC", 7, MLOD_FORMAT_UNKNOWN },
+		{ "glT", 3, MLOD_FORMAT_UNKNOWN },
+		{ "hello, world\n", 13, MLOD_FORMAT_UNKNOWN },
+		{ "\xEF\xBB\xBF", 3, MLOD_FORMAT_UNKNOWN },
+		{ "", 0, MLOD_FORMAT_UNKNOWN },
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+		CHECK_MSG(mlod_detect_format(cases[i].bytes, cases[i].size) == cases[i].want, "case %zu", i);
+	CHECK(mlod_detect_format(NULL, 10) == MLOD_FORMAT_UNKNOWN);
+}
+
+TEST(load_bvh)
+{
+	size_t size = 0;
+	char *data = test_read_file("samples/cmu_12_01_walk.bvh", &size);
+	CHECK(data);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format f = MLOD_FORMAT_UNKNOWN;
+	mlod_result r = mlod_load(data, size, NULL, &doc, &c, &f, &terr);
+	free(data);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	CHECK(f == MLOD_FORMAT_BVH && doc);
+	CHECK(c.skeleton.joint_count == 31 && c.clip_count == 1 && c.clips[0].frame_count == 524);
+	CHECK(mlod_gltf_count(doc, MLOD_GLTF_NODE) >= 31);
+	void *glb = NULL;
+	size_t glb_size = 0;
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &glb_size, &terr));
+	CHECK(glb_size > 12 && mlod_detect_format(glb, glb_size) == MLOD_FORMAT_GLB);
+	mlod_free(glb);
+	mlod_gltf_free(doc);
+	mlod_character_free(&c);
+
+	/* Without a document. */
+	data = test_read_file("tests/data/mixed_channels.bvh", &size);
+	r = mlod_load(data, size, NULL, NULL, &c, NULL, &terr);
+	free(data);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	CHECK(c.skeleton.joint_count == 8);
+	mlod_character_free(&c);
+}
+
+TEST(load_glb)
+{
+	size_t size = 0;
+	char *data = test_read_file("samples/RobotExpressive.glb", &size);
+	CHECK(data);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format f = MLOD_FORMAT_UNKNOWN;
+	mlod_result r = mlod_load(data, size, "samples", &doc, &c, &f, &terr);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	CHECK(f == MLOD_FORMAT_GLB && doc);
+	CHECK(c.skeleton.joint_count > 0 && c.clip_count > 0 && c.mesh_count > 0);
+	mlod_gltf_free(doc);
+	mlod_character_free(&c);
+
+	/* Truncated: an error, and nothing left allocated. */
+	doc = (mlod_gltf *)&c;
+	r = mlod_load(data, size / 2, NULL, &doc, &c, NULL, &terr);
+	free(data);
+	CHECK(r != MLOD_OK && doc == NULL);
+	CHECK(c.skeleton.joints == NULL && c.meshes == NULL && c.clips == NULL);
+}
+
+TEST(load_errors)
+{
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format f;
+	CHECK(mlod_load("", 0, NULL, &doc, &c, &f, &terr) == MLOD_ERR_PARSE);
+	CHECK(strcmp(terr.message, "empty input") == 0 && !doc);
+	CHECK(mlod_load(" \n\t\r\n", 5, NULL, &doc, &c, &f, &terr) == MLOD_ERR_PARSE);
+	CHECK(strcmp(terr.message, "empty input") == 0);
+	CHECK(mlod_load("hello, world\n", 13, NULL, &doc, &c, &f, &terr) == MLOD_ERR_UNSUPPORTED);
+	CHECK(strcmp(terr.message, "not a glTF, glb or BVH file") == 0 && !doc && f == MLOD_FORMAT_UNKNOWN);
+	CHECK(mlod_load("\x00\x01\x02\x03", 4, NULL, &doc, &c, &f, &terr) == MLOD_ERR_UNSUPPORTED);
+	CHECK(mlod_load(NULL, 4, NULL, &doc, &c, &f, &terr) == MLOD_ERR_INVALID_ARG);
+	CHECK(mlod_load("HIERARCHY", 9, NULL, &doc, NULL, &f, &terr) == MLOD_ERR_INVALID_ARG);
+
+	size_t size = 0;
+	char *data = test_read_file("tests/data/bad/missing_brace.bvh", &size);
+	CHECK(data);
+	memset(&c, 0x5a, sizeof c);
+	mlod_result r = mlod_load(data, size, NULL, &doc, &c, &f, &terr);
+	free(data);
+	CHECK(r == MLOD_ERR_PARSE && f == MLOD_FORMAT_BVH && !doc);
+	CHECK_MSG(strncmp(terr.message, "line 15: ", 9) == 0, "%s", terr.message);
+	CHECK(c.skeleton.joints == NULL && c.clips == NULL && c.skeleton.joint_count == 0);
+
+	CHECK(mlod_load("{\"asset\":", 10, NULL, &doc, &c, &f, &terr) != MLOD_OK);
+	CHECK(f == MLOD_FORMAT_GLTF && !doc && c.skeleton.joints == NULL);
+}
+
 int main(void)
 {
 	RUN(cmu_walk);
@@ -1009,5 +1122,9 @@ int main(void)
 	RUN(write_gltf_like);
 	RUN(write_rest_and_arguments);
 	RUN(write_angles);
+	RUN(detect_format);
+	RUN(load_bvh);
+	RUN(load_glb);
+	RUN(load_errors);
 	TEST_EXIT();
 }
