@@ -18,8 +18,9 @@
  * bone, v along it) with duplicated seam and pole vertices, as real assets
  * have. Everything goes into one mesh with one primitive and a plain
  * material, skinned by one skin over all joints whose inverse bind matrices
- * invert the rest pose; the BVH clip becomes the animation "walk". The output is deterministic and is
- * written atomically (out.glb.tmp.PID, then renamed).
+ * invert the rest pose; the BVH clip becomes the animation "walk". The
+ * output is deterministic (byte-identical on every run) and is written
+ * atomically (out.glb.tmp.PID, then renamed).
  *
  * --segments is the number of vertices around each ring (default 12), and
  * --rings the number of rings along each bone's straight part, both ends
@@ -302,7 +303,7 @@ static void emit_tube(builder *bd, const tube_shape *sh, const bone *bn, latitud
 	tube_latitudes(sh, bn->length, bn->radius, lat);
 	double blend = 0.25 * bn->length;
 
-	/* Proximal pole copies, then the rings, then distal pole copies. */
+	/* The copies of the proximal pole, then of the distal one, then the rings. */
 	int first = bd->vertices;
 	for (int pole = 0; pole < 2; pole++) {
 		double s = pole ? bn->length + bn->radius : -bn->radius;
