@@ -1033,7 +1033,8 @@ static size_t utoa(unsigned long long v, char *buf)
 
 /* Formats v with at most dec decimals, trailing zeros trimmed, "-0" as
  * "0", without the C library (so without its locale). Values too large for
- * fixed notation get an exponent. buf holds at least 48 bytes. */
+ * fixed notation, and tiny ones asked for many decimals, get an exponent.
+ * buf holds at least 48 bytes. */
 static void format_number(double v, int dec, char *buf)
 {
 	size_t k = 0;
@@ -1044,17 +1045,23 @@ static void format_number(double v, int dec, char *buf)
 	while (dec > 0 && fabs(v) * pow10_exact(dec) >= 9.0e15)
 		dec--;
 	double a = fabs(v);
-	if (a >= 9.0e15) {
+	if (a >= 9.0e15 || (a > 0.0 && a < 1e-9 && dec > 9)) {
+		/* Scientific: 9 significant digits. */
 		int e = (int)floor(log10(a));
 		double m = a / pow(10.0, e);
 		if (m >= 10.0) {
 			m /= 10.0;
 			e++;
+		} else if (m < 1.0) {
+			m *= 10.0;
+			e--;
 		}
 		format_number(v < 0 ? -m : m, 8, buf);
 		k = strlen(buf);
 		buf[k++] = 'e';
-		k += utoa((unsigned long long)e, buf + k);
+		if (e < 0)
+			buf[k++] = '-';
+		k += utoa((unsigned long long)(e < 0 ? -e : e), buf + k);
 		buf[k] = 0;
 		return;
 	}

@@ -381,6 +381,34 @@ TEST(lenient_syntax)
 	mlod_character_free(&c);
 }
 
+/* Huge and tiny numbers are written so that they read back as the same
+ * floats. */
+TEST(extreme_values)
+{
+	const char *text = "HIERARCHY\nROOT A\n{\nOFFSET 1e30 -3.4e38 1e-30\n"
+	                   "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+	                   "End Site\n{\nOFFSET 123456789 0.000001 -1e-7\n}\n}\n"
+	                   "MOTION\nFrames: 2\nFrame Time: 1e-3\n3e38 -1e20 1e-38 1000 -720 3600\n1 2 3 4 5 6\n";
+	mlod_character a, b;
+	CHECK_MSG(read_text(text, &a) == MLOD_OK, "%s", terr.message);
+	char *out = NULL;
+	CHECK_OK(mlod_bvh_write(&a, 0, 0.0f, &out, NULL, &terr));
+	CHECK(strstr(out, "Frame Time: 0.001\n"));
+	CHECK_MSG(read_text(out, &b) == MLOD_OK, "%s\n%s", terr.message, out);
+	mlod_free(out);
+	const mlod_joint *ja = &a.skeleton.joints[0], *jb = &b.skeleton.joints[0];
+	CHECK(memcmp(&ja->rest.t, &jb->rest.t, sizeof ja->rest.t) == 0);
+	CHECK(memcmp(&ja->end_site, &jb->end_site, sizeof ja->end_site) == 0);
+	const mlod_channel *ca = find_channel(&a.clips[0], 0, MLOD_PATH_TRANSLATION);
+	const mlod_channel *cb = find_channel(&b.clips[0], 0, MLOD_PATH_TRANSLATION);
+	CHECK(ca && cb && memcmp(ca->values, cb->values, 6 * sizeof(float)) == 0);
+	ca = find_channel(&a.clips[0], 0, MLOD_PATH_ROTATION);
+	cb = find_channel(&b.clips[0], 0, MLOD_PATH_ROTATION);
+	CHECK(ca && cb && mlod_quat_angle(key_quat(ca, 0), key_quat(cb, 0)) < 1e-5);
+	mlod_character_free(&a);
+	mlod_character_free(&b);
+}
+
 /* ---------------------------------------------------------------- */
 /* Malformed input                                                   */
 /* ---------------------------------------------------------------- */
@@ -1111,6 +1139,7 @@ int main(void)
 	RUN(mixed_channel_orders);
 	RUN(several_roots);
 	RUN(lenient_syntax);
+	RUN(extreme_values);
 	RUN(malformed);
 	RUN(deep_nesting);
 	RUN(truncation);
