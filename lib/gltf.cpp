@@ -1,0 +1,2130 @@
+/*
+ * gltf.cpp: the glTF half of libmlod, a C shim over tinygltf 2.7 (the only
+ * C++ in the library). It implements every mlod_gltf_* function of mlod.h.
+ *
+ * Reading. mlod_gltf_read checks what tinygltf does not before handing it
+ * the bytes: the glb container's length fields, the JSON syntax and nesting
+ * depth, required extensions mlod cannot decode (Draco, meshopt), and the
+ * URIs of external buffers. tinygltf then parses the document, keeping
+ * images as their encoded bytes (no decoding). Finally every cross-reference
+ * is checked (node hierarchy, accessors inside buffer views inside buffers),
+ * so the rest of this file can index the model without re-checking.
+ *
+ * Writing. tinygltf 2.7 serialises the model, but it drops data (empty
+ * objects inside extras, accessor and buffer extensions, ...) and writes
+ * defaults the input left out. The JSON it writes is therefore reconciled
+ * with the JSON as read: objects that came from the input keep exactly
+ * their keys, plus those mlod adds, and extras come from an exact copy.
+ * Buffer 0 becomes the glb's BIN chunk; other buffers and images that were
+ * not in a buffer view are embedded as data: URIs, bytes unchanged.
+ *
+ * Character model. mlod_gltf_to_character decodes skins, meshes (every
+ * accessor layout: normalised integers, strides, sparse) and animations
+ * into the structures of mlod.h; mlod_gltf_from_character and the
+ * mlod_gltf_add_* functions build glTF from them.
+ *
+ * No C++ exception crosses into C: errors are thrown as Failure and turned
+ * into mlod_result codes by guard(), as are std::bad_alloc and anything
+ * tinygltf or nlohmann::json throw.
+ */
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <tiny_gltf.h>
+
+#include "mlod.h"
+
+using json = nlohmann::json;
+using tinygltf::Model;
+using tinygltf::Value;
+
+struct mlod_gltf {
+	Model model;
+	/* The JSON as read (without URIs), to write back what tinygltf drops;
+	 * null for documents mlod built. */
+	json original;
+	/* Exact extras by JSON pointer ("/nodes/3/extras"): those read from
+	 * the input and those set through mlod_gltf_set_extra. They win over
+	 * the tinygltf::Value of the object, which cannot hold all of JSON. */
+	std::map<std::string, json> extras;
+};
+
+namespace {
+
+/* ------------------------------------------------------------------ */
+/* Errors                                                              */
+/* ------------------------------------------------------------------ */
+
+struct Failure {
+	mlod_result code;
+	std::string message;
+};
+
+[[noreturn]] void fail(mlod_result code, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+void fail(mlod_result code, const char *fmt, ...)
+{
+	char message[MLOD_ERROR_MESSAGE_SIZE];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(message, sizeof message, fmt, ap);
+	va_end(ap);
+	throw Failure{code, message};
+}
+
+/* Runs body, turning whatever it throws into a result code and message. */
+template <class F> mlod_result guard(mlod_error *err, F &&body)
+{
+	try {
+		body();
+		return MLOD_OK;
+	} catch (const Failure &f) {
+		return mlod_fail(err, f.code, "%s", f.message.c_str());
+	} catch (const std::bad_alloc &) {
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	} catch (const std::length_error &) {
+		return mlod_fail(err, MLOD_ERR_NOMEM, "glTF data too large");
+	} catch (const std::exception &e) {
+		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: %s", e.what());
+	} catch (...) {
+		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: unknown error");
+	}
+}
+
+/* ------------------------------------------------------------------ */
+/* Small helpers: C allocation, strings, JSON                          */
+/* ------------------------------------------------------------------ */
+
+/* A zeroed C array of n elements, released with free(); NULL when n == 0. */
+template <class T> T *c_array(size_t n)
+{
+	if (n == 0)
+		return nullptr;
+	void *p = calloc(n, sizeof(T));
+	if (!p)
+		throw std::bad_alloc();
+	return static_cast<T *>(p);
+}
+
+template <class T> T *c_copy(const std::vector<T> &v)
+{
+	T *p = c_array<T>(v.size());
+	if (p)
+		memcpy(p, v.data(), v.size() * sizeof(T));
+	return p;
+}
+
+char *c_string(const std::string &s)
+{
+	char *p = static_cast<char *>(malloc(s.size() + 1));
+	if (!p)
+		throw std::bad_alloc();
+	memcpy(p, s.c_str(), s.size() + 1);
+	return p;
+}
+
+/* s with invalid UTF-8 replaced by U+FFFD: JSON text must be UTF-8, and
+ * names from BVH files or callers may be Latin-1. */
+std::string utf8(const char *s)
+{
+	std::string out;
+	const unsigned char *p = reinterpret_cast<const unsigned char *>(s ? s : "");
+	while (*p) {
+		unsigned c = *p;
+		int n = c < 0x80 ? 0 : c >= 0xC2 && c <= 0xDF ? 1 : c >= 0xE0 && c <= 0xEF ? 2 : c >= 0xF0 && c <= 0xF4 ? 3 : -1;
+		bool ok = n >= 0;
+		for (int k = 1; ok && k <= n; k++) {
+			unsigned lo = 0x80, hi = 0xBF;
+			if (k == 1 && c == 0xE0) lo = 0xA0;
+			if (k == 1 && c == 0xED) hi = 0x9F;
+			if (k == 1 && c == 0xF0) lo = 0x90;
+			if (k == 1 && c == 0xF4) hi = 0x8F;
+			ok = p[k] >= lo && p[k] <= hi;
+		}
+		if (ok) {
+			out.append(reinterpret_cast<const char *>(p), size_t(n) + 1);
+			p += n + 1;
+		} else {
+			out += "\xEF\xBF\xBD";
+			p++;
+		}
+	}
+	return out;
+}
+
+/* The double whose shortest decimal form reads back as f: 0.1f is written
+ * 0.1 rather than 0.10000000149011612. */
+double tidy(float f)
+{
+	char buf[32];
+	for (int digits = 6; digits < 9; digits++) {
+		snprintf(buf, sizeof buf, "%.*g", digits, double(f));
+		double d = strtod(buf, nullptr);
+		if (float(d) == f)
+			return d;
+	}
+	return double(f);
+}
+
+/* Deeper JSON is refused: tinygltf converts it recursively. */
+const int max_json_depth = 100;
+
+json parse_json(const char *text, size_t size)
+{
+	json::parser_callback_t limit = [](int depth, json::parse_event_t, json &) {
+		if (depth > max_json_depth)
+			fail(MLOD_ERR_PARSE, "JSON nested deeper than %d levels", max_json_depth);
+		return true;
+	};
+	return json::parse(text, text + size, limit);
+}
+
+std::string pointer_token(const std::string &key)
+{
+	std::string t;
+	for (char ch : key)
+		t += ch == '~' ? "~0" : ch == '/' ? "~1" : std::string(1, ch);
+	return t;
+}
+
+json to_json(const Value &v)
+{
+	switch (v.Type()) {
+	case tinygltf::BOOL_TYPE:
+		return v.Get<bool>();
+	case tinygltf::INT_TYPE:
+		return v.Get<int>();
+	case tinygltf::REAL_TYPE:
+		return v.Get<double>();
+	case tinygltf::STRING_TYPE:
+		return v.Get<std::string>();
+	case tinygltf::ARRAY_TYPE: {
+		json a = json::array();
+		for (size_t i = 0; i < v.ArrayLen(); i++)
+			a.push_back(to_json(v.Get(int(i))));
+		return a;
+	}
+	case tinygltf::OBJECT_TYPE: {
+		json o = json::object();
+		for (const auto &kv : v.Get<Value::Object>())
+			o[kv.first] = to_json(kv.second);
+		return o;
+	}
+	default:
+		return nullptr;
+	}
+}
+
+Value to_value(const json &j)
+{
+	switch (j.type()) {
+	case json::value_t::boolean:
+		return Value(j.get<bool>());
+	case json::value_t::number_integer: {
+		int64_t i = j.get<int64_t>();
+		return i >= INT_MIN && i <= INT_MAX ? Value(int(i)) : Value(double(i));
+	}
+	case json::value_t::number_unsigned: {
+		uint64_t u = j.get<uint64_t>();
+		return u <= uint64_t(INT_MAX) ? Value(int(u)) : Value(double(u));
+	}
+	case json::value_t::number_float:
+		return Value(j.get<double>());
+	case json::value_t::string:
+		return Value(j.get<std::string>());
+	case json::value_t::array: {
+		Value::Array a;
+		for (const auto &e : j)
+			a.push_back(to_value(e));
+		return Value(std::move(a));
+	}
+	case json::value_t::object: {
+		Value::Object o;
+		for (auto it = j.begin(); it != j.end(); ++it)
+			o[it.key()] = to_value(*it);
+		return Value(std::move(o));
+	}
+	default:
+		return Value();
+	}
+}
+
+/* ------------------------------------------------------------------ */
+/* Reading: checks before tinygltf                                     */
+/* ------------------------------------------------------------------ */
+
+const uint32_t glb_magic = 0x46546C67, chunk_json = 0x4E4F534A, chunk_bin = 0x004E4942;
+
+uint32_t le32(const unsigned char *p)
+{
+	return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+
+/* Checks the glb container (tinygltf reads 8 bytes past a BIN chunk that
+ * claims to end at the end of the file) and returns its JSON chunk. */
+std::string glb_json(const unsigned char *d, size_t size)
+{
+	if (size < 20)
+		fail(MLOD_ERR_PARSE, "glb: truncated: %zu bytes, less than a header and a chunk header", size);
+	uint32_t version = le32(d + 4), length = le32(d + 8);
+	if (version != 2)
+		fail(MLOD_ERR_UNSUPPORTED, "glb: container version %u (only 2 is supported)", version);
+	if (length > size)
+		fail(MLOD_ERR_PARSE, "glb: truncated: the header says %u bytes, the input has %zu", length, size);
+	if (length < 20)
+		fail(MLOD_ERR_PARSE, "glb: the header says %u bytes, too short for a JSON chunk", length);
+	uint32_t json_length = le32(d + 12);
+	if (le32(d + 16) != chunk_json)
+		fail(MLOD_ERR_PARSE, "glb: the first chunk is not JSON");
+	if (json_length > length - 20)
+		fail(MLOD_ERR_PARSE, "glb: the JSON chunk (%u bytes) extends past the end of the file (%u bytes)",
+		     json_length, length);
+	size_t at = 20 + size_t(json_length);
+	if (at < length) {
+		if (length - at < 8)
+			fail(MLOD_ERR_PARSE, "glb: truncated chunk header at byte %zu", at);
+		uint32_t bin_length = le32(d + at);
+		if (le32(d + at + 4) == chunk_bin && bin_length > length - at - 8)
+			fail(MLOD_ERR_PARSE, "glb: the BIN chunk (%u bytes) extends past the end of the file (%u bytes)",
+			     bin_length, length);
+	}
+	return std::string(reinterpret_cast<const char *>(d) + 20, json_length);
+}
+
+/* Required extensions that only touch what mlod passes through unchanged
+ * (materials, textures, lights) or that the accessor decoder handles. */
+bool extension_supported(const std::string &name)
+{
+	static const char *const prefixes[] = {"KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_punctual",
+	                                       "KHR_mesh_quantization", "MSFT_texture_dds"};
+	for (const char *p : prefixes)
+		if (name.compare(0, strlen(p), p) == 0)
+			return true;
+	return false;
+}
+
+void check_required_extensions(const json &doc)
+{
+	auto it = doc.find("extensionsRequired");
+	if (it == doc.end() || !it->is_array())
+		return;
+	for (const auto &e : *it) {
+		if (!e.is_string())
+			continue;
+		std::string name = e.get<std::string>();
+		if (name == "KHR_draco_mesh_compression")
+			fail(MLOD_ERR_UNSUPPORTED, "the file requires KHR_draco_mesh_compression: Draco-compressed meshes "
+			                           "cannot be decoded (decompress it first, e.g. with gltf-transform)");
+		if (name == "EXT_meshopt_compression" || name == "KHR_meshopt_compression")
+			fail(MLOD_ERR_UNSUPPORTED, "the file requires %s: meshopt-compressed buffers cannot be decoded "
+			                           "(decompress it first, e.g. with gltf-transform)", name.c_str());
+		if (!extension_supported(name))
+			fail(MLOD_ERR_UNSUPPORTED, "the file requires the extension %s, which mlod does not support", name.c_str());
+	}
+}
+
+/* %XX decoding, as tinygltf does before opening a URI. */
+std::string url_decode(const std::string &s)
+{
+	std::string out;
+	for (size_t i = 0; i < s.size(); i++) {
+		if (s[i] == '%' && i + 2 < s.size() && isxdigit((unsigned char)s[i + 1]) && isxdigit((unsigned char)s[i + 2])) {
+			out += char(std::stoi(s.substr(i + 1, 2), nullptr, 16));
+			i += 2;
+		} else {
+			out += s[i];
+		}
+	}
+	return out;
+}
+
+/* Is path a plain relative path that stays below the base directory (no
+ * scheme, not absolute, no ".." segment)? Other URIs are not opened, so a
+ * hostile file cannot make mlod embed arbitrary local files. */
+bool stays_inside(const std::string &path)
+{
+	if (path.empty() || path[0] == '/' || path[0] == '\\' || path.find(':') != std::string::npos)
+		return false;
+	size_t start = 0;
+	for (;;) {
+		size_t end = path.find_first_of("/\\", start);
+		if (path.compare(start, end == std::string::npos ? std::string::npos : end - start, "..") == 0)
+			return false;
+		if (end == std::string::npos)
+			return true;
+		start = end + 1;
+	}
+}
+
+std::string join_path(const std::string &dir, const std::string &file)
+{
+	if (dir.empty())
+		return file;
+	return dir.back() == '/' ? dir + file : dir + "/" + file;
+}
+
+/* External buffers must be readable files under base_dir; data: URIs must
+ * be of a type tinygltf decodes. Images are not checked: one that cannot
+ * be read keeps its URI. */
+void check_buffer_uris(const json &doc, const char *base_dir)
+{
+	auto buffers = doc.find("buffers");
+	if (buffers == doc.end() || !buffers->is_array())
+		return;
+	for (size_t i = 0; i < buffers->size(); i++) {
+		const json &b = (*buffers)[i];
+		if (!b.is_object() || !b.contains("uri") || !b["uri"].is_string())
+			continue;
+		std::string uri = b["uri"].get<std::string>();
+		if (uri.compare(0, 5, "data:") == 0) {
+			if (!tinygltf::IsDataURI(uri))
+				fail(MLOD_ERR_UNSUPPORTED, "buffer %zu: unsupported data URI \"%.40s...\"", i, uri.c_str());
+			continue;
+		}
+		if (!base_dir)
+			fail(MLOD_ERR_IO, "buffer %zu: external file \"%s\" but no base directory to find it in", i, uri.c_str());
+		std::string rel = url_decode(uri);
+		if (!stays_inside(rel))
+			fail(MLOD_ERR_UNSUPPORTED, "buffer %zu: URI \"%s\" is not a file below the base directory", i, uri.c_str());
+		std::string path = join_path(base_dir, rel);
+		struct stat st;
+		if (stat(path.c_str(), &st) != 0)
+			fail(MLOD_ERR_IO, "buffer %zu: cannot read \"%s\": %s", i, path.c_str(), strerror(errno));
+	}
+}
+
+/* ------------------------------------------------------------------ */
+/* Reading: tinygltf callbacks                                         */
+/* ------------------------------------------------------------------ */
+
+/* Where external files may be read from: nowhere when there is no base
+ * directory. */
+struct FileAccess {
+	bool allowed;
+	std::string prefix; /* the base directory, ending in '/' unless empty */
+};
+
+bool file_exists(const std::string &path, void *user)
+{
+	const FileAccess *fa = static_cast<const FileAccess *>(user);
+	if (!fa->allowed || path.compare(0, fa->prefix.size(), fa->prefix) != 0 ||
+	    !stays_inside(path.substr(fa->prefix.size())))
+		return false;
+	struct stat st;
+	return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* tinygltf's default runs wordexp() on the path; mlod takes it as it is. */
+std::string expand_path(const std::string &path, void *)
+{
+	return path;
+}
+
+bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
+{
+	if (!file_exists(path, user)) {
+		*err = "not readable";
+		return false;
+	}
+	std::ifstream f(path, std::ios::binary | std::ios::ate);
+	std::streamoff size = f.tellg();
+	if (!f || size < 0 || uint64_t(size) > UINT32_MAX) {
+		*err = f ? "larger than 4 GiB" : "cannot open";
+		return false;
+	}
+	out->resize(size_t(size));
+	f.seekg(0);
+	if (size > 0 && !f.read(reinterpret_cast<char *>(out->data()), size)) {
+		*err = "read error";
+		return false;
+	}
+	return true;
+}
+
+bool refuse_write(std::string *err, const std::string &, const std::vector<unsigned char> &, void *)
+{
+	*err = "mlod does not write files through tinygltf";
+	return false;
+}
+
+/* tinygltf's image loader: keeps the encoded bytes instead of decoding
+ * them. Bytes of a bufferView image stay in the buffer; tinygltf computes
+ * their address without checking the view against the buffer, so that is
+ * checked here (user is the model being loaded). */
+bool keep_image_bytes(tinygltf::Image *image, const int index, std::string *err, std::string *, int, int,
+                      const unsigned char *bytes, int size, void *user)
+{
+	if (image->bufferView >= 0) {
+		const Model &m = *static_cast<const Model *>(user);
+		const tinygltf::BufferView &v = m.bufferViews[size_t(image->bufferView)];
+		size_t have = m.buffers[size_t(v.buffer)].data.size();
+		if (v.byteOffset > have || v.byteLength > have - v.byteOffset) {
+			*err += "image " + std::to_string(index) + ": buffer view " + std::to_string(image->bufferView) +
+			        " extends past the end of buffer " + std::to_string(v.buffer);
+			return false;
+		}
+		return true;
+	}
+	image->image.assign(bytes, bytes + size);
+	image->as_is = true;
+	return true;
+}
+
+/* ------------------------------------------------------------------ */
+/* Accessors                                                           */
+/* ------------------------------------------------------------------ */
+
+size_t component_size(int component_type)
+{
+	switch (component_type) {
+	case TINYGLTF_COMPONENT_TYPE_BYTE:
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+		return 1;
+	case TINYGLTF_COMPONENT_TYPE_SHORT:
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+		return 2;
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+	case TINYGLTF_COMPONENT_TYPE_FLOAT:
+		return 4;
+	default:
+		return 0;
+	}
+}
+
+const char *type_name(int type)
+{
+	switch (type) {
+	case TINYGLTF_TYPE_SCALAR: return "SCALAR";
+	case TINYGLTF_TYPE_VEC2: return "VEC2";
+	case TINYGLTF_TYPE_VEC3: return "VEC3";
+	case TINYGLTF_TYPE_VEC4: return "VEC4";
+	case TINYGLTF_TYPE_MAT2: return "MAT2";
+	case TINYGLTF_TYPE_MAT3: return "MAT3";
+	case TINYGLTF_TYPE_MAT4: return "MAT4";
+	default: return "unknown";
+	}
+}
+
+/* How an accessor's elements are laid out. Matrix columns start on 4-byte
+ * boundaries, which pads MAT2 and MAT3 of 1- and 2-byte components. */
+struct Layout {
+	int components;      /* per element */
+	int rows;            /* of a matrix column; 0 for scalars and vectors */
+	size_t size;         /* bytes per component */
+	size_t column_bytes; /* matrices only */
+	size_t element;      /* bytes per element */
+
+	size_t offset(int c) const { return rows ? size_t(c / rows) * column_bytes + size_t(c % rows) * size : size_t(c) * size; }
+};
+
+Layout layout_of(const tinygltf::Accessor &a)
+{
+	Layout l{0, 0, component_size(a.componentType), 0, 0};
+	switch (a.type) {
+	case TINYGLTF_TYPE_SCALAR: l.components = 1; break;
+	case TINYGLTF_TYPE_VEC2: l.components = 2; break;
+	case TINYGLTF_TYPE_VEC3: l.components = 3; break;
+	case TINYGLTF_TYPE_VEC4: l.components = 4; break;
+	case TINYGLTF_TYPE_MAT2: l.rows = 2; break;
+	case TINYGLTF_TYPE_MAT3: l.rows = 3; break;
+	case TINYGLTF_TYPE_MAT4: l.rows = 4; break;
+	default: break;
+	}
+	if (l.rows) {
+		l.components = l.rows * l.rows;
+		l.column_bytes = (size_t(l.rows) * l.size + 3) / 4 * 4;
+		l.element = size_t(l.rows) * l.column_bytes;
+	} else {
+		l.element = size_t(l.components) * l.size;
+	}
+	return l;
+}
+
+/* Do count elements of elem bytes, stride bytes apart from offset, fit in
+ * length bytes? (Overflow-safe; stride >= elem > 0.) */
+bool fits(size_t offset, size_t stride, size_t count, size_t elem, size_t length)
+{
+	if (count == 0)
+		return offset <= length;
+	if (offset > length || elem > length - offset)
+		return false;
+	return count - 1 <= (length - offset - elem) / stride;
+}
+
+/* Decoded arrays are limited to this many values: a hostile count cannot
+ * make mlod allocate without bound. */
+const size_t max_values = size_t(1) << 28;
+
+void check_view(const Model &m, size_t v)
+{
+	const tinygltf::BufferView &bv = m.bufferViews[v];
+	if (bv.buffer < 0 || size_t(bv.buffer) >= m.buffers.size())
+		fail(MLOD_ERR_PARSE, "buffer view %zu: buffer %d does not exist", v, bv.buffer);
+	size_t have = m.buffers[size_t(bv.buffer)].data.size();
+	if (!fits(bv.byteOffset, 1, bv.byteLength, 1, have))
+		fail(MLOD_ERR_PARSE, "buffer view %zu: extends past the end of buffer %d (%zu bytes at offset %zu, the buffer has %zu)",
+		     v, bv.buffer, bv.byteLength, bv.byteOffset, have);
+}
+
+/* The sparse index k of accessor a (after check_accessor). */
+uint32_t sparse_index(const Model &m, const tinygltf::Accessor &a, size_t k)
+{
+	const auto &s = a.sparse.indices;
+	const tinygltf::BufferView &v = m.bufferViews[size_t(s.bufferView)];
+	size_t cs = component_size(s.componentType);
+	const unsigned char *p = m.buffers[size_t(v.buffer)].data.data() + v.byteOffset + size_t(s.byteOffset) + k * cs;
+	return cs == 1 ? p[0] : cs == 2 ? uint32_t(p[0] | p[1] << 8) : le32(p);
+}
+
+/* Checks that accessor i is readable: known types, inside its buffer view
+ * (checked against its buffer before), sparse parts likewise, sparse
+ * indices increasing and in range. */
+void check_accessor(const Model &m, size_t i)
+{
+	const tinygltf::Accessor &a = m.accessors[i];
+	Layout l = layout_of(a);
+	if (!l.size)
+		fail(MLOD_ERR_PARSE, "accessor %zu: unsupported component type %d", i, a.componentType);
+	if (!l.components)
+		fail(MLOD_ERR_PARSE, "accessor %zu: unsupported type %d", i, a.type);
+	if (a.count > max_values / size_t(l.components))
+		fail(MLOD_ERR_NOMEM, "accessor %zu: %zu elements is more than mlod handles", i, a.count);
+	if (a.bufferView >= 0) {
+		if (size_t(a.bufferView) >= m.bufferViews.size())
+			fail(MLOD_ERR_PARSE, "accessor %zu: buffer view %d does not exist", i, a.bufferView);
+		const tinygltf::BufferView &v = m.bufferViews[size_t(a.bufferView)];
+		size_t stride = v.byteStride ? v.byteStride : l.element;
+		if (stride < l.element)
+			fail(MLOD_ERR_PARSE, "accessor %zu: buffer view %d has a stride of %zu bytes, less than an element (%zu)",
+			     i, a.bufferView, stride, l.element);
+		if (!fits(a.byteOffset, stride, a.count, l.element, v.byteLength))
+			fail(MLOD_ERR_PARSE, "accessor %zu: extends past the end of buffer view %d", i, a.bufferView);
+	} else if (a.bufferView != -1) {
+		fail(MLOD_ERR_PARSE, "accessor %zu: buffer view %d does not exist", i, a.bufferView);
+	}
+	if (!a.sparse.isSparse)
+		return;
+	const auto &s = a.sparse;
+	if (s.count < 1 || size_t(s.count) > a.count)
+		fail(MLOD_ERR_PARSE, "accessor %zu: sparse count %d out of range (the accessor has %zu elements)", i, s.count, a.count);
+	size_t cs = component_size(s.indices.componentType);
+	if (s.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE || s.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
+	    s.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || !cs)
+		fail(MLOD_ERR_PARSE, "accessor %zu: sparse indices of component type %d", i, s.indices.componentType);
+	struct Part {
+		const char *what;
+		int view, offset;
+		size_t elem;
+	} parts[2] = {{"indices", s.indices.bufferView, s.indices.byteOffset, cs},
+	              {"values", s.values.bufferView, s.values.byteOffset, l.element}};
+	for (const Part &p : parts) {
+		if (p.view < 0 || size_t(p.view) >= m.bufferViews.size())
+			fail(MLOD_ERR_PARSE, "accessor %zu: sparse %s buffer view %d does not exist", i, p.what, p.view);
+		if (p.offset < 0 || !fits(size_t(p.offset), p.elem, size_t(s.count), p.elem, m.bufferViews[size_t(p.view)].byteLength))
+			fail(MLOD_ERR_PARSE, "accessor %zu: sparse %s extend past the end of buffer view %d", i, p.what, p.view);
+	}
+	for (size_t k = 0; k < size_t(s.count); k++) {
+		uint32_t index = sparse_index(m, a, k);
+		if (index >= a.count || (k > 0 && index <= sparse_index(m, a, k - 1)))
+			fail(MLOD_ERR_PARSE, "accessor %zu: sparse index %zu is %u: out of range or not increasing", i, k, index);
+	}
+}
+
+/* One component at p, as glTF defines its value (normalised integers map
+ * to [0, 1] or [-1, 1]). */
+double component(const unsigned char *p, int type, bool normalized)
+{
+	switch (type) {
+	case TINYGLTF_COMPONENT_TYPE_BYTE: {
+		double v = int8_t(p[0]);
+		return normalized ? std::max(v / 127.0, -1.0) : v;
+	}
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+		return normalized ? p[0] / 255.0 : p[0];
+	case TINYGLTF_COMPONENT_TYPE_SHORT: {
+		double v = int16_t(uint16_t(p[0] | p[1] << 8));
+		return normalized ? std::max(v / 32767.0, -1.0) : v;
+	}
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+		double v = uint16_t(p[0] | p[1] << 8);
+		return normalized ? v / 65535.0 : v;
+	}
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+		return le32(p);
+	default: {
+		uint32_t bits = le32(p);
+		float f;
+		memcpy(&f, &bits, 4);
+		return f;
+	}
+	}
+}
+
+/* All values of accessor i (count * components), the sparse substitution
+ * applied; an accessor without buffer view starts from zeros. */
+template <class T> std::vector<T> decode(const Model &m, int i)
+{
+	const tinygltf::Accessor &a = m.accessors[size_t(i)];
+	Layout l = layout_of(a);
+	size_t n = size_t(l.components);
+	std::vector<T> out(a.count * n);
+	auto read_element = [&](const unsigned char *p, size_t e) {
+		for (size_t c = 0; c < n; c++)
+			out[e * n + c] = T(component(p + l.offset(int(c)), a.componentType, a.normalized));
+	};
+	if (a.bufferView >= 0) {
+		const tinygltf::BufferView &v = m.bufferViews[size_t(a.bufferView)];
+		const unsigned char *base = m.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
+		size_t stride = v.byteStride ? v.byteStride : l.element;
+		for (size_t e = 0; e < a.count; e++)
+			read_element(base + e * stride, e);
+	}
+	if (a.sparse.isSparse) {
+		const tinygltf::BufferView &v = m.bufferViews[size_t(a.sparse.values.bufferView)];
+		const unsigned char *base = m.buffers[size_t(v.buffer)].data.data() + v.byteOffset + size_t(a.sparse.values.byteOffset);
+		for (size_t k = 0; k < size_t(a.sparse.count); k++)
+			read_element(base + k * l.element, sparse_index(m, a, k));
+	}
+	return out;
+}
+
+/* Accessor i, which must exist and have one of the given types, as floats.
+ * what names its use in messages ("mesh 2 primitive 0 NORMAL"). */
+std::vector<float> read_floats(const Model &m, int i, const std::string &what, int type, int other_type = -1)
+{
+	if (i < 0 || size_t(i) >= m.accessors.size())
+		fail(MLOD_ERR_PARSE, "%s: accessor %d does not exist", what.c_str(), i);
+	int t = m.accessors[size_t(i)].type;
+	if (t != type && t != other_type)
+		fail(MLOD_ERR_PARSE, "%s: accessor %d is %s, not %s", what.c_str(), i, type_name(t), type_name(type));
+	return decode<float>(m, i);
+}
+
+/* Accessor i as unsigned integers: it must have an unsigned integer type. */
+std::vector<uint32_t> read_uints(const Model &m, int i, const std::string &what, int type)
+{
+	if (i < 0 || size_t(i) >= m.accessors.size())
+		fail(MLOD_ERR_PARSE, "%s: accessor %d does not exist", what.c_str(), i);
+	const tinygltf::Accessor &a = m.accessors[size_t(i)];
+	if (a.type != type)
+		fail(MLOD_ERR_PARSE, "%s: accessor %d is %s, not %s", what.c_str(), i, type_name(a.type), type_name(type));
+	if (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+	    a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+		fail(MLOD_ERR_PARSE, "%s: accessor %d has component type %d, not an unsigned integer", what.c_str(), i, a.componentType);
+	return decode<uint32_t>(m, i);
+}
+
+/* ------------------------------------------------------------------ */
+/* Document checks                                                     */
+/* ------------------------------------------------------------------ */
+
+void check_ref(int index, size_t count, const char *fmt_owner, size_t owner, const char *what)
+{
+	if (index < -1 || (index >= 0 && size_t(index) >= count)) {
+		char who[96];
+		snprintf(who, sizeof who, fmt_owner, owner);
+		fail(MLOD_ERR_PARSE, "%s: %s %d does not exist", who, what, index);
+	}
+}
+
+/* parent[n] of every node, or -1. A node listed as the child of two nodes
+ * (or twice), a child that does not exist, or a cycle is an error. */
+std::vector<int> node_parents(const Model &m)
+{
+	size_t n = m.nodes.size();
+	std::vector<int> parent(n, -1);
+	for (size_t p = 0; p < n; p++) {
+		for (int c : m.nodes[p].children) {
+			if (c < 0 || size_t(c) >= n)
+				fail(MLOD_ERR_PARSE, "node %zu: child node %d does not exist", p, c);
+			if (parent[size_t(c)] == int(p))
+				fail(MLOD_ERR_PARSE, "node %zu: lists child node %d twice", p, c);
+			if (parent[size_t(c)] >= 0)
+				fail(MLOD_ERR_PARSE, "node %d has two parents (nodes %d and %zu)", c, parent[size_t(c)], p);
+			parent[size_t(c)] = int(p);
+		}
+	}
+	/* With one parent each, a cycle is a parent chain that never ends. */
+	std::vector<char> state(n, 0); /* 0 unseen, 1 on the current chain, 2 ends at a root */
+	for (size_t start = 0; start < n; start++) {
+		int k = int(start);
+		while (k >= 0 && state[size_t(k)] == 0) {
+			state[size_t(k)] = 1;
+			k = parent[size_t(k)];
+		}
+		if (k >= 0 && state[size_t(k)] == 1)
+			fail(MLOD_ERR_PARSE, "the node hierarchy has a cycle through node %d", k);
+		for (k = int(start); k >= 0 && state[size_t(k)] == 1; k = parent[size_t(k)])
+			state[size_t(k)] = 2;
+	}
+	return parent;
+}
+
+/* Checks every reference mlod may follow, so later code can index freely. */
+void check_document(const Model &m)
+{
+	for (size_t v = 0; v < m.bufferViews.size(); v++)
+		check_view(m, v);
+	for (size_t a = 0; a < m.accessors.size(); a++)
+		check_accessor(m, a);
+	size_t accessors = m.accessors.size();
+	for (size_t i = 0; i < m.meshes.size(); i++) {
+		for (const tinygltf::Primitive &p : m.meshes[i].primitives) {
+			for (const auto &kv : p.attributes)
+				check_ref(kv.second, accessors, "mesh %zu", i, ("attribute " + kv.first + " accessor").c_str());
+			for (const auto &target : p.targets)
+				for (const auto &kv : target)
+					check_ref(kv.second, accessors, "mesh %zu", i, ("morph target " + kv.first + " accessor").c_str());
+			check_ref(p.indices, accessors, "mesh %zu", i, "indices accessor");
+			check_ref(p.material, m.materials.size(), "mesh %zu", i, "material");
+		}
+	}
+	for (size_t i = 0; i < m.nodes.size(); i++) {
+		const tinygltf::Node &n = m.nodes[i];
+		check_ref(n.mesh, m.meshes.size(), "node %zu", i, "mesh");
+		check_ref(n.skin, m.skins.size(), "node %zu", i, "skin");
+		check_ref(n.camera, m.cameras.size(), "node %zu", i, "camera");
+		if ((!n.translation.empty() && n.translation.size() != 3) || (!n.rotation.empty() && n.rotation.size() != 4) ||
+		    (!n.scale.empty() && n.scale.size() != 3) || (!n.matrix.empty() && n.matrix.size() != 16))
+			fail(MLOD_ERR_PARSE, "node %zu: a transform property has the wrong number of values", i);
+	}
+	node_parents(m);
+	for (size_t i = 0; i < m.skins.size(); i++) {
+		for (int j : m.skins[i].joints) {
+			if (j < 0)
+				fail(MLOD_ERR_PARSE, "skin %zu: joint node %d does not exist", i, j);
+			check_ref(j, m.nodes.size(), "skin %zu", i, "joint node");
+		}
+		check_ref(m.skins[i].skeleton, m.nodes.size(), "skin %zu", i, "skeleton node");
+		check_ref(m.skins[i].inverseBindMatrices, accessors, "skin %zu", i, "inverseBindMatrices accessor");
+	}
+	for (size_t i = 0; i < m.scenes.size(); i++)
+		for (int n : m.scenes[i].nodes) {
+			if (n < 0)
+				fail(MLOD_ERR_PARSE, "scene %zu: node %d does not exist", i, n);
+			check_ref(n, m.nodes.size(), "scene %zu", i, "node");
+		}
+	if (m.defaultScene >= int(m.scenes.size()))
+		fail(MLOD_ERR_PARSE, "the default scene %d does not exist", m.defaultScene);
+	for (size_t i = 0; i < m.animations.size(); i++) {
+		const tinygltf::Animation &a = m.animations[i];
+		for (const tinygltf::AnimationChannel &c : a.channels) {
+			if (c.sampler < 0)
+				fail(MLOD_ERR_PARSE, "animation %zu: sampler %d does not exist", i, c.sampler);
+			check_ref(c.sampler, a.samplers.size(), "animation %zu", i, "sampler");
+			check_ref(c.target_node, m.nodes.size(), "animation %zu", i, "target node");
+		}
+		for (const tinygltf::AnimationSampler &s : a.samplers) {
+			if (s.input < 0 || s.output < 0)
+				fail(MLOD_ERR_PARSE, "animation %zu: a sampler has no input or output accessor", i);
+			check_ref(s.input, accessors, "animation %zu", i, "sampler input accessor");
+			check_ref(s.output, accessors, "animation %zu", i, "sampler output accessor");
+		}
+	}
+}
+
+/* Records every "extras" of the JSON by pointer, outside other extras. */
+void collect_extras(const json &j, const std::string &at, std::map<std::string, json> &out)
+{
+	if (j.is_object()) {
+		for (auto it = j.begin(); it != j.end(); ++it) {
+			std::string p = at + "/" + pointer_token(it.key());
+			if (it.key() == "extras")
+				out[p] = *it;
+			else
+				collect_extras(*it, p, out);
+		}
+	} else if (j.is_array()) {
+		for (size_t i = 0; i < j.size(); i++)
+			collect_extras(j[i], at + "/" + std::to_string(i), out);
+	}
+}
+
+void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const char *base_dir)
+{
+	if (size == 0)
+		fail(MLOD_ERR_PARSE, "empty input: not glTF");
+	if (size > UINT32_MAX)
+		fail(MLOD_ERR_NOMEM, "input of %zu bytes: glTF is limited to 4 GiB", size);
+	bool binary = size >= 4 && le32(data) == glb_magic;
+	json j;
+	try {
+		if (binary) {
+			std::string text = glb_json(data, size);
+			j = parse_json(text.data(), text.size());
+		} else {
+			j = parse_json(reinterpret_cast<const char *>(data), size);
+		}
+	} catch (const json::exception &e) {
+		fail(MLOD_ERR_PARSE, "%s: %s", binary ? "glb JSON chunk" : "not glTF (neither glb nor JSON)", e.what());
+	}
+	if (!j.is_object())
+		fail(MLOD_ERR_PARSE, "not glTF: the JSON is not an object");
+	check_required_extensions(j);
+	check_buffer_uris(j, base_dir);
+
+	tinygltf::TinyGLTF loader;
+	FileAccess access{base_dir != nullptr, base_dir ? join_path(base_dir, "") : ""};
+	loader.SetFsCallbacks(tinygltf::FsCallbacks{&file_exists, &expand_path, &read_whole_file, &refuse_write, &access});
+	loader.SetImageLoader(&keep_image_bytes, &doc.model);
+	std::string error, warning;
+	std::string base = base_dir ? base_dir : "";
+	bool ok = binary ? loader.LoadBinaryFromMemory(&doc.model, &error, &warning, data, unsigned(size), base)
+	                 : loader.LoadASCIIFromString(&doc.model, &error, &warning, reinterpret_cast<const char *>(data),
+	                                              unsigned(size), base);
+	if (!ok) {
+		while (!error.empty() && (error.back() == '\n' || error.back() == ' '))
+			error.pop_back();
+		for (char &ch : error)
+			if (ch == '\n')
+				ch = ';';
+		fail(MLOD_ERR_PARSE, "glTF: %s", error.empty() ? "tinygltf could not load the document" : error.c_str());
+	}
+	const tinygltf::Asset &asset = doc.model.asset;
+	if (asset.version.compare(0, 2, "2.") != 0 || (!asset.minVersion.empty() && asset.minVersion != "2.0"))
+		fail(MLOD_ERR_UNSUPPORTED, "glTF version %s (minimum %s) is not supported: mlod reads glTF 2.0",
+		     asset.version.c_str(), asset.minVersion.empty() ? "none" : asset.minVersion.c_str());
+	check_document(doc.model);
+
+	/* The data is in memory now: the document no longer refers to files. */
+	for (tinygltf::Buffer &b : doc.model.buffers)
+		b.uri.clear();
+	for (const char *list : {"buffers", "images"})
+		if (j.contains(list) && j[list].is_array())
+			for (json &o : j[list])
+				if (o.is_object())
+					o.erase("uri");
+	collect_extras(j, "", doc.extras);
+	doc.original = std::move(j);
+}
+
+/* ------------------------------------------------------------------ */
+/* Writing                                                             */
+/* ------------------------------------------------------------------ */
+
+std::string base64(const std::vector<unsigned char> &in)
+{
+	static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+	std::string out;
+	out.reserve((in.size() + 2) / 3 * 4);
+	for (size_t i = 0; i < in.size(); i += 3) {
+		uint32_t v = uint32_t(in[i]) << 16;
+		if (i + 1 < in.size()) v |= uint32_t(in[i + 1]) << 8;
+		if (i + 2 < in.size()) v |= in[i + 2];
+		out += digits[v >> 18 & 63];
+		out += digits[v >> 12 & 63];
+		out += i + 1 < in.size() ? digits[v >> 6 & 63] : '=';
+		out += i + 2 < in.size() ? digits[v & 63] : '=';
+	}
+	return out;
+}
+
+/* The media type of encoded image bytes, "" when unknown. */
+std::string sniff_image_type(const std::vector<unsigned char> &b)
+{
+	auto starts = [&](const char *magic, size_t n, size_t at) { return b.size() >= at + n && memcmp(b.data() + at, magic, n) == 0; };
+	if (starts("\x89PNG", 4, 0)) return "image/png";
+	if (starts("\xFF\xD8\xFF", 3, 0)) return "image/jpeg";
+	if (starts("RIFF", 4, 0) && starts("WEBP", 4, 8)) return "image/webp";
+	if (starts("\xABKTX 20\xBB", 8, 0)) return "image/ktx2";
+	return "";
+}
+
+/* tinygltf's image writer: embeds the bytes as they were read in a data:
+ * URI. Images that were never loaded (an external file that was missing)
+ * keep their URI. Not called for images in a buffer view. */
+bool embed_image(const std::string *, const std::string *, const tinygltf::Image *image, bool, std::string *uri, void *)
+{
+	if (image->image.empty())
+		return false;
+	std::string type = image->mimeType.empty() ? sniff_image_type(image->image) : image->mimeType;
+	if (type.empty())
+		return false;
+	*uri = "data:" + type + ";base64," + base64(image->image);
+	return true;
+}
+
+/* Keys mlod may add to an object that came from the input. */
+bool added_by_mlod(const std::string &key)
+{
+	return key == "children" || key == "nodes" || key == "extensions" || key == "extras" || key == "uri";
+}
+
+/* Makes out (written by tinygltf) hold what orig (read) held: keys tinygltf
+ * dropped come back, keys it added (defaults, buffer view targets) go,
+ * except those mlod adds. Arrays are matched element by element; mlod only
+ * appends to them, so a shorter one is one tinygltf dropped elements of and
+ * is left alone. Extras are restored separately, from the exact copies. */
+void reconcile(json &out, const json &orig, bool root, bool in_extension)
+{
+	if (out.is_object() && orig.is_object()) {
+		for (auto it = orig.begin(); it != orig.end(); ++it)
+			if (it.key() != "uri" && it.key() != "extras" && !out.contains(it.key()))
+				out[it.key()] = *it;
+		if (!root && !in_extension)
+			for (auto it = out.begin(); it != out.end();)
+				it = orig.contains(it.key()) || added_by_mlod(it.key()) ? std::next(it) : out.erase(it);
+		for (auto it = out.begin(); it != out.end(); ++it)
+			if (it.key() != "extras" && orig.contains(it.key()))
+				reconcile(*it, orig[it.key()], false, in_extension || it.key() == "extensions");
+	} else if (out.is_array() && orig.is_array() && out.size() >= orig.size()) {
+		for (size_t i = 0; i < orig.size(); i++)
+			reconcile(out[i], orig[i], false, in_extension);
+	}
+}
+
+/* The document as .glb or pretty-printed .gltf bytes. */
+std::string serialize(const mlod_gltf &doc, bool binary)
+{
+	tinygltf::TinyGLTF writer;
+	writer.SetImageWriter(&embed_image, nullptr);
+	std::ostringstream stream;
+	if (!writer.WriteGltfSceneToStream(&doc.model, stream, !binary, binary) || !stream)
+		fail(MLOD_ERR_IO, "tinygltf could not serialise the document");
+	std::string written = stream.str();
+	json j;
+	std::string bin_chunk; /* with its chunk header and padding */
+	if (binary) {
+		size_t json_length = le32(reinterpret_cast<const unsigned char *>(written.data()) + 12);
+		j = json::parse(written.begin() + 20, written.begin() + 20 + long(json_length));
+		bin_chunk = written.substr(20 + json_length);
+	} else {
+		j = json::parse(written);
+	}
+	if (!doc.original.is_null())
+		reconcile(j, doc.original, true, false);
+	/* tinygltf skips animations without channels, which shifts indices. */
+	bool animations_shifted = j.contains("animations") && j["animations"].size() != doc.model.animations.size();
+	for (const auto &kv : doc.extras) {
+		json::json_pointer p(kv.first);
+		if (animations_shifted && kv.first.compare(0, 12, "/animations/") == 0)
+			continue;
+		if (j.contains(p.parent_pointer()) && j[p.parent_pointer()].is_object())
+			j[p] = kv.second;
+	}
+	if (!binary)
+		return j.dump(2) + "\n";
+
+	std::string text = j.dump();
+	text.append((4 - text.size() % 4) % 4, ' ');
+	uint64_t total = 20 + uint64_t(text.size()) + bin_chunk.size();
+	if (total > UINT32_MAX)
+		fail(MLOD_ERR_LIMIT, "the glb would be larger than 4 GiB");
+	std::string out;
+	out.reserve(size_t(total));
+	for (uint32_t v : {glb_magic, uint32_t(2), uint32_t(total), uint32_t(text.size()), chunk_json})
+		for (int k = 0; k < 4; k++)
+			out += char(v >> (8 * k) & 0xFF);
+	out += text;
+	out += bin_chunk;
+	return out;
+}
+
+/* ------------------------------------------------------------------ */
+/* Transforms                                                          */
+/* ------------------------------------------------------------------ */
+
+mlod_trs node_trs(const tinygltf::Node &n)
+{
+	mlod_trs t = mlod_trs_identity();
+	if (n.translation.size() == 3)
+		t.t = mlod_v3{float(n.translation[0]), float(n.translation[1]), float(n.translation[2])};
+	if (n.rotation.size() == 4)
+		t.r = mlod_quat{float(n.rotation[0]), float(n.rotation[1]), float(n.rotation[2]), float(n.rotation[3])};
+	if (n.scale.size() == 3)
+		t.s = mlod_v3{float(n.scale[0]), float(n.scale[1]), float(n.scale[2])};
+	return t;
+}
+
+mlod_mat4 node_matrix(const tinygltf::Node &n)
+{
+	if (n.matrix.size() == 16) {
+		mlod_mat4 m;
+		for (int i = 0; i < 16; i++)
+			m.m[i] = float(n.matrix[size_t(i)]);
+		return m;
+	}
+	mlod_trs t = node_trs(n);
+	return mlod_mat4_from_trs(&t);
+}
+
+bool is_identity(const mlod_mat4 &m)
+{
+	mlod_mat4 id = mlod_mat4_identity();
+	return memcmp(&m, &id, sizeof m) == 0;
+}
+
+/* Sets a node's TRS, leaving out identity parts; rotations are normalised
+ * (the validator wants unit quaternions). */
+void set_trs(tinygltf::Node &n, const mlod_trs &t)
+{
+	n.translation.clear();
+	n.rotation.clear();
+	n.scale.clear();
+	n.matrix.clear();
+	mlod_quat q = mlod_quat_normalize(t.r);
+	if (t.t.x != 0 || t.t.y != 0 || t.t.z != 0)
+		n.translation = {tidy(t.t.x), tidy(t.t.y), tidy(t.t.z)};
+	if (q.x != 0 || q.y != 0 || q.z != 0 || q.w != 1)
+		n.rotation = {tidy(q.x), tidy(q.y), tidy(q.z), tidy(q.w)};
+	if (t.s.x != 1 || t.s.y != 1 || t.s.z != 1)
+		n.scale = {tidy(t.s.x), tidy(t.s.y), tidy(t.s.z)};
+}
+
+/* Sets a node's transform from a matrix: TRS when it is one, else the matrix. */
+void set_transform(tinygltf::Node &n, const mlod_mat4 &m)
+{
+	mlod_trs t;
+	if (mlod_mat4_to_trs(&m, &t, 1e-5f) == 0) {
+		set_trs(n, t);
+	} else {
+		set_trs(n, mlod_trs_identity());
+		n.matrix.assign(m.m, m.m + 16);
+	}
+}
+
+/* ------------------------------------------------------------------ */
+/* glTF -> character                                                   */
+/* ------------------------------------------------------------------ */
+
+/* Builds an mlod_character from a document; every method may throw. */
+class CharacterReader {
+public:
+	CharacterReader(const mlod_gltf &doc, mlod_character &c) : doc_(doc), m_(doc.model), c_(c) {}
+
+	void read()
+	{
+		graph();
+		skeleton();
+		skins();
+		meshes();
+		instances();
+		clips();
+		notes();
+	}
+
+private:
+	const mlod_gltf &doc_;
+	const Model &m_;
+	mlod_character &c_;
+	std::vector<int> parent_;       /* per node */
+	std::vector<int> order_;        /* nodes, parents first */
+	std::vector<mlod_mat4> local_;  /* per node */
+	std::vector<mlod_mat4> world_;  /* per node, at rest */
+	std::vector<int> joint_of_;     /* per node: joint index or -1 */
+	std::vector<char> in_skin_;     /* per node */
+	std::vector<char> animated_;    /* per node: a TRS channel targets it */
+	std::vector<std::string> notes_;
+
+	void note(const char *fmt, ...) __attribute__((format(printf, 2, 3)))
+	{
+		char buf[MLOD_ERROR_MESSAGE_SIZE];
+		va_list ap;
+		va_start(ap, fmt);
+		vsnprintf(buf, sizeof buf, fmt, ap);
+		va_end(ap);
+		notes_.push_back(buf);
+	}
+
+	const char *node_name(int n) const { return m_.nodes[size_t(n)].name.c_str(); }
+
+	/* Parents, a parents-first order (depth-first from the roots, in file
+	 * order) and rest transforms. */
+	void graph()
+	{
+		size_t n = m_.nodes.size();
+		parent_ = node_parents(m_);
+		std::vector<int> stack;
+		for (size_t i = n; i-- > 0;)
+			if (parent_[i] < 0)
+				stack.push_back(int(i));
+		while (!stack.empty()) {
+			int k = stack.back();
+			stack.pop_back();
+			order_.push_back(k);
+			const std::vector<int> &ch = m_.nodes[size_t(k)].children;
+			for (size_t i = ch.size(); i-- > 0;)
+				stack.push_back(ch[i]);
+		}
+		local_.resize(n);
+		world_.resize(n);
+		for (int k : order_) {
+			local_[size_t(k)] = node_matrix(m_.nodes[size_t(k)]);
+			world_[size_t(k)] = parent_[size_t(k)] < 0 ? local_[size_t(k)]
+			                                           : mlod_mat4_mul(&world_[size_t(parent_[size_t(k)])], &local_[size_t(k)]);
+		}
+	}
+
+	bool is_end_site(int n) const
+	{
+		std::string at = "/nodes/" + std::to_string(n) + "/extras";
+		auto it = doc_.extras.find(at);
+		json e = it != doc_.extras.end() ? it->second : to_json(m_.nodes[size_t(n)].extras);
+		return e.is_object() && e.contains("mlod") && e["mlod"].is_object() && e["mlod"].value("end_site", false) == true;
+	}
+
+	/* Joints: skin joints and the nodes between a joint and its nearest
+	 * joint ancestor, in parents-first order. Leaves marked as End Sites
+	 * below a joint become that joint's End Site. */
+	void skeleton()
+	{
+		size_t n = m_.nodes.size();
+		in_skin_.assign(n, 0);
+		for (const tinygltf::Skin &s : m_.skins)
+			for (int j : s.joints)
+				in_skin_[size_t(j)] = 1;
+		std::vector<char> is_joint(in_skin_);
+		for (size_t j = 0; j < n; j++) {
+			if (!in_skin_[j])
+				continue;
+			std::vector<int> between;
+			int k = parent_[j];
+			while (k >= 0 && !is_joint[size_t(k)]) {
+				between.push_back(k);
+				k = parent_[size_t(k)];
+			}
+			if (k >= 0)
+				for (int b : between)
+					is_joint[size_t(b)] = 1;
+		}
+		joint_of_.assign(n, -1);
+		int count = 0;
+		for (int k : order_)
+			if (is_joint[size_t(k)])
+				joint_of_[size_t(k)] = count++;
+		mlod_skeleton &s = c_.skeleton;
+		s.joints = c_array<mlod_joint>(size_t(count));
+		s.joint_count = count;
+		int sheared = 0;
+		for (int k : order_) {
+			int i = joint_of_[size_t(k)];
+			if (i < 0)
+				continue;
+			mlod_joint &j = s.joints[i];
+			const tinygltf::Node &node = m_.nodes[size_t(k)];
+			j.name = c_string(node.name);
+			j.node = k;
+			j.euler = MLOD_EULER_XYZ;
+			int p = parent_[size_t(k)];
+			j.parent = p >= 0 ? joint_of_[size_t(p)] : -1;
+			j.base = j.parent < 0 && p >= 0 ? world_[size_t(p)] : mlod_mat4_identity();
+			if (node.matrix.size() == 16)
+				sheared += mlod_mat4_to_trs(&local_[size_t(k)], &j.rest, 1e-4f) != 0;
+			else
+				j.rest = node_trs(node);
+		}
+		if (sheared)
+			note("%d joint nodes have a matrix that is not a TRS (shear or singular); their rest pose is approximated",
+			     sheared);
+		for (size_t k = 0; k < n; k++) {
+			int p = parent_[k];
+			if (is_joint[k] || p < 0 || !is_joint[size_t(p)] || !m_.nodes[k].children.empty() || !is_end_site(int(k)))
+				continue;
+			mlod_joint &j = s.joints[joint_of_[size_t(p)]];
+			if (j.has_end_site) {
+				note("joint \"%s\" has more than one End Site node; node %zu is ignored", j.name, k);
+				continue;
+			}
+			j.has_end_site = 1;
+			j.end_site = node_trs(m_.nodes[k]).t;
+		}
+	}
+
+	void skins()
+	{
+		mlod_skeleton &s = c_.skeleton;
+		s.skins = c_array<mlod_skin>(m_.skins.size());
+		s.skin_count = int(m_.skins.size());
+		for (size_t i = 0; i < m_.skins.size(); i++) {
+			const tinygltf::Skin &src = m_.skins[i];
+			mlod_skin &k = s.skins[i];
+			size_t n = src.joints.size();
+			k.name = c_string(src.name);
+			k.gltf_index = int(i);
+			k.joints = c_array<int>(n);
+			k.inverse_bind = c_array<mlod_mat4>(n);
+			k.joint_count = int(n);
+			std::vector<float> ibm;
+			if (src.inverseBindMatrices >= 0) {
+				ibm = read_floats(m_, src.inverseBindMatrices, "skin " + std::to_string(i) + " inverseBindMatrices",
+				                  TINYGLTF_TYPE_MAT4);
+				if (ibm.size() < 16 * n)
+					fail(MLOD_ERR_PARSE, "skin %zu: %zu inverse bind matrices for %zu joints", i, ibm.size() / 16, n);
+			}
+			std::vector<int> roots;
+			for (size_t j = 0; j < n; j++) {
+				k.joints[j] = joint_of_[size_t(src.joints[j])];
+				k.inverse_bind[j] = mlod_mat4_identity();
+				if (!ibm.empty())
+					memcpy(k.inverse_bind[j].m, &ibm[16 * j], sizeof(float[16]));
+				int r = k.joints[j];
+				while (s.joints[r].parent >= 0)
+					r = s.joints[r].parent;
+				if (std::find(roots.begin(), roots.end(), r) == roots.end())
+					roots.push_back(r);
+			}
+			if (roots.size() > 1)
+				note("skin %zu \"%s\": its joints have no common root (%zu separate hierarchies)", i, k.name, roots.size());
+		}
+	}
+
+	/* Index of set n in an attribute name like "TEXCOORD_3", or -1. */
+	static int set_index(const std::string &name, const char *prefix)
+	{
+		size_t len = strlen(prefix);
+		if (name.compare(0, len, prefix) != 0 || name.size() == len || name.size() > len + 3)
+			return -1;
+		for (size_t i = len; i < name.size(); i++)
+			if (!isdigit((unsigned char)name[i]))
+				return -1;
+		return atoi(name.c_str() + len);
+	}
+
+	void primitive(size_t mi, size_t pi, mlod_primitive &out)
+	{
+		const tinygltf::Primitive &p = m_.meshes[mi].primitives[pi];
+		std::string who = "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi);
+		auto find = [&](const std::map<std::string, int> &attrs, const std::string &name) {
+			auto it = attrs.find(name);
+			return it == attrs.end() ? -1 : it->second;
+		};
+		int position = find(p.attributes, "POSITION");
+		if (position < 0)
+			fail(MLOD_ERR_PARSE, "%s: no POSITION attribute", who.c_str());
+		std::vector<float> pos = read_floats(m_, position, who + " POSITION", TINYGLTF_TYPE_VEC3);
+		size_t n = pos.size() / 3;
+		if (n > size_t(INT_MAX))
+			fail(MLOD_ERR_NOMEM, "%s: too many vertices", who.c_str());
+		out.vertex_count = int(n);
+		out.positions = c_copy(pos);
+		out.mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+		out.material = p.material;
+
+		/* Reads an attribute of the expected element count as floats with
+		 * comps components (a VEC3 color gets alpha 1). */
+		auto floats = [&](int accessor, const std::string &name, int type, int comps, int other_type = -1) {
+			std::vector<float> v = read_floats(m_, accessor, who + " " + name, type, other_type);
+			size_t have = int(m_.accessors[size_t(accessor)].type) == TINYGLTF_TYPE_VEC3 && comps == 4 ? 3 : size_t(comps);
+			if (v.size() / have != n)
+				fail(MLOD_ERR_PARSE, "%s: %s has %zu elements, POSITION has %zu", who.c_str(), name.c_str(), v.size() / have, n);
+			if (have == 3 && comps == 4) {
+				std::vector<float> rgba(4 * n, 1.0f);
+				for (size_t i = 0; i < n; i++)
+					memcpy(&rgba[4 * i], &v[3 * i], 3 * sizeof(float));
+				v.swap(rgba);
+			}
+			return c_copy(v);
+		};
+		int normal = find(p.attributes, "NORMAL"), tangent = find(p.attributes, "TANGENT");
+		if (normal >= 0)
+			out.normals = floats(normal, "NORMAL", TINYGLTF_TYPE_VEC3, 3);
+		if (tangent >= 0)
+			out.tangents = floats(tangent, "TANGENT", TINYGLTF_TYPE_VEC4, 4);
+		for (int k = 0; k < MLOD_MAX_SETS; k++) {
+			int a = find(p.attributes, "TEXCOORD_" + std::to_string(k));
+			if (a < 0)
+				break;
+			out.uvs[k] = floats(a, "TEXCOORD_" + std::to_string(k), TINYGLTF_TYPE_VEC2, 2);
+			out.uv_set_count = k + 1;
+		}
+		for (int k = 0; k < MLOD_MAX_SETS; k++) {
+			int a = find(p.attributes, "COLOR_" + std::to_string(k));
+			if (a < 0)
+				break;
+			out.colors[k] = floats(a, "COLOR_" + std::to_string(k), TINYGLTF_TYPE_VEC4, 4, TINYGLTF_TYPE_VEC3);
+			out.color_set_count = k + 1;
+		}
+		for (int k = 0; k < MLOD_MAX_SETS; k++) {
+			std::string jn = "JOINTS_" + std::to_string(k), wn = "WEIGHTS_" + std::to_string(k);
+			int ja = find(p.attributes, jn), wa = find(p.attributes, wn);
+			if (ja < 0 || wa < 0)
+				break;
+			std::vector<uint32_t> joints = read_uints(m_, ja, who + " " + jn, TINYGLTF_TYPE_VEC4);
+			if (joints.size() / 4 != n)
+				fail(MLOD_ERR_PARSE, "%s: %s has %zu elements, POSITION has %zu", who.c_str(), jn.c_str(), joints.size() / 4, n);
+			std::vector<uint16_t> narrow(joints.size());
+			for (size_t i = 0; i < joints.size(); i++) {
+				if (joints[i] > 0xFFFF)
+					fail(MLOD_ERR_PARSE, "%s: %s of vertex %zu is %u, out of range", who.c_str(), jn.c_str(), i / 4, joints[i]);
+				narrow[i] = uint16_t(joints[i]);
+			}
+			out.joints[k] = c_copy(narrow);
+			out.weights[k] = floats(wa, wn, TINYGLTF_TYPE_VEC4, 4);
+			out.weight_set_count = k + 1;
+		}
+		static const char *const prefixes[] = {"TEXCOORD_", "COLOR_", "JOINTS_", "WEIGHTS_"};
+		const int used[] = {out.uv_set_count, out.color_set_count, out.weight_set_count, out.weight_set_count};
+		for (const auto &kv : p.attributes)
+			for (int s = 0; s < 4; s++)
+				if (set_index(kv.first, prefixes[s]) >= used[s])
+					note("%s: attribute %s is not decoded (sets are numbered from 0, JOINTS_n with WEIGHTS_n, "
+					     "at most %d)", who.c_str(), kv.first.c_str(), MLOD_MAX_SETS);
+		if (p.indices >= 0) {
+			std::vector<uint32_t> idx = read_uints(m_, p.indices, who + " indices", TINYGLTF_TYPE_SCALAR);
+			for (size_t i = 0; i < idx.size(); i++)
+				if (idx[i] >= n)
+					fail(MLOD_ERR_PARSE, "%s: index %zu is %u, out of range (%zu vertices)", who.c_str(), i, idx[i], n);
+			if (idx.size() > size_t(INT_MAX))
+				fail(MLOD_ERR_NOMEM, "%s: too many indices", who.c_str());
+			out.indices = c_copy(idx);
+			out.index_count = int(idx.size());
+		}
+		out.targets = c_array<mlod_morph_target>(p.targets.size());
+		out.target_count = int(p.targets.size());
+		for (size_t t = 0; t < p.targets.size(); t++) {
+			std::string tn = "morph target " + std::to_string(t) + " ";
+			int a;
+			if ((a = find(p.targets[t], "POSITION")) >= 0)
+				out.targets[t].positions = floats(a, tn + "POSITION", TINYGLTF_TYPE_VEC3, 3);
+			if ((a = find(p.targets[t], "NORMAL")) >= 0)
+				out.targets[t].normals = floats(a, tn + "NORMAL", TINYGLTF_TYPE_VEC3, 3);
+			if ((a = find(p.targets[t], "TANGENT")) >= 0)
+				out.targets[t].tangents = floats(a, tn + "TANGENT", TINYGLTF_TYPE_VEC3, 3);
+		}
+	}
+
+	void meshes()
+	{
+		c_.meshes = c_array<mlod_mesh>(m_.meshes.size());
+		c_.mesh_count = int(m_.meshes.size());
+		for (size_t i = 0; i < m_.meshes.size(); i++) {
+			mlod_mesh &mesh = c_.meshes[i];
+			mesh.name = c_string(m_.meshes[i].name);
+			mesh.gltf_index = int(i);
+			mesh.primitives = c_array<mlod_primitive>(m_.meshes[i].primitives.size());
+			mesh.primitive_count = int(m_.meshes[i].primitives.size());
+			for (size_t p = 0; p < m_.meshes[i].primitives.size(); p++)
+				primitive(i, p, mesh.primitives[p]);
+		}
+	}
+
+	/* Skinned vertices must name joints of the skin (where they have weight). */
+	void check_skinning(size_t node, const mlod_mesh &mesh, const mlod_skin &skin) const
+	{
+		for (int p = 0; p < mesh.primitive_count; p++) {
+			const mlod_primitive &pr = mesh.primitives[p];
+			for (int s = 0; s < pr.weight_set_count; s++)
+				for (size_t i = 0; i < 4 * size_t(pr.vertex_count); i++)
+					if (pr.weights[s][i] > 0 && pr.joints[s][i] >= skin.joint_count)
+						fail(MLOD_ERR_PARSE, "node %zu: mesh %d primitive %d vertex %zu uses joint %u, but skin %d has %d joints",
+						     node, mesh.gltf_index, p, i / 4, pr.joints[s][i], skin.gltf_index, skin.joint_count);
+		}
+	}
+
+	/* One instance per node with a mesh, in node order. */
+	void instances()
+	{
+		std::vector<mlod_instance> list;
+		for (size_t k = 0; k < m_.nodes.size(); k++) {
+			const tinygltf::Node &node = m_.nodes[k];
+			if (node.mesh < 0)
+				continue;
+			mlod_instance in;
+			in.mesh = node.mesh;
+			in.node = int(k);
+			in.skin = node.skin;
+			in.joint = -1;
+			in.offset = mlod_mat4_identity();
+			if (in.skin >= 0) {
+				check_skinning(k, c_.meshes[in.mesh], c_.skeleton.skins[in.skin]);
+			} else {
+				/* Hang it under its nearest joint, or place it in the world. */
+				mlod_mat4 offset = mlod_mat4_identity();
+				int a = int(k);
+				while (a >= 0 && joint_of_[size_t(a)] < 0) {
+					offset = mlod_mat4_mul(&local_[size_t(a)], &offset);
+					a = parent_[size_t(a)];
+				}
+				in.joint = a >= 0 ? joint_of_[size_t(a)] : -1;
+				in.offset = offset;
+			}
+			list.push_back(in);
+		}
+		c_.instances = c_copy(list);
+		c_.instance_count = int(list.size());
+	}
+
+	void clips()
+	{
+		c_.clips = c_array<mlod_clip>(m_.animations.size());
+		c_.clip_count = int(m_.animations.size());
+		animated_.assign(m_.nodes.size(), 0);
+		int not_joint = 0, weights = 0;
+		for (size_t a = 0; a < m_.animations.size(); a++) {
+			const tinygltf::Animation &anim = m_.animations[a];
+			mlod_clip &clip = c_.clips[a];
+			clip.name = c_string(anim.name);
+			clip.gltf_index = int(a);
+			std::vector<const tinygltf::AnimationChannel *> kept;
+			for (const tinygltf::AnimationChannel &ch : anim.channels) {
+				bool trs = ch.target_path == "translation" || ch.target_path == "rotation" || ch.target_path == "scale";
+				if (ch.target_node >= 0 && trs)
+					animated_[size_t(ch.target_node)] = 1;
+				if (ch.target_path == "weights")
+					weights++;
+				else if (!trs || ch.target_node < 0 || joint_of_[size_t(ch.target_node)] < 0)
+					not_joint++;
+				else
+					kept.push_back(&ch);
+			}
+			clip.channels = c_array<mlod_channel>(kept.size());
+			clip.channel_count = int(kept.size());
+			for (size_t i = 0; i < kept.size(); i++) {
+				channel(a, *kept[i], clip.channels[i]);
+				clip.duration = std::max(clip.duration, clip.channels[i].times[clip.channels[i].key_count - 1]);
+			}
+		}
+		if (not_joint)
+			note("%d animation channels target nodes that are not joints (kept in the document, not in the clips)",
+			     not_joint);
+		if (weights)
+			note("%d animation channels animate morph target weights (kept in the document, not in the clips)",
+			     weights);
+	}
+
+	void channel(size_t a, const tinygltf::AnimationChannel &src, mlod_channel &ch)
+	{
+		const tinygltf::AnimationSampler &s = m_.animations[a].samplers[size_t(src.sampler)];
+		std::string who = "animation " + std::to_string(a) + " sampler " + std::to_string(src.sampler);
+		ch.joint = joint_of_[size_t(src.target_node)];
+		ch.path = src.target_path == "translation" ? MLOD_PATH_TRANSLATION
+		          : src.target_path == "rotation"  ? MLOD_PATH_ROTATION
+		                                           : MLOD_PATH_SCALE;
+		if (s.interpolation.empty() || s.interpolation == "LINEAR")
+			ch.interp = MLOD_INTERP_LINEAR;
+		else if (s.interpolation == "STEP")
+			ch.interp = MLOD_INTERP_STEP;
+		else if (s.interpolation == "CUBICSPLINE")
+			ch.interp = MLOD_INTERP_CUBICSPLINE;
+		else
+			fail(MLOD_ERR_PARSE, "%s: unknown interpolation \"%s\"", who.c_str(), s.interpolation.c_str());
+		std::vector<float> times = read_floats(m_, s.input, who + " input", TINYGLTF_TYPE_SCALAR);
+		if (times.empty())
+			fail(MLOD_ERR_PARSE, "%s: no keys", who.c_str());
+		if (times.size() > size_t(INT_MAX))
+			fail(MLOD_ERR_NOMEM, "%s: too many keys", who.c_str());
+		for (size_t k = 1; k < times.size(); k++)
+			if (!(times[k] > times[k - 1]))
+				fail(MLOD_ERR_PARSE, "%s: key times do not increase (key %zu at %g s follows %g s)", who.c_str(), k,
+				     double(times[k]), double(times[k - 1]));
+		int comps = ch.path == MLOD_PATH_ROTATION ? 4 : 3;
+		std::vector<float> values =
+		    read_floats(m_, s.output, who + " output", ch.path == MLOD_PATH_ROTATION ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3);
+		size_t per_key = size_t(comps) * (ch.interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
+		if (values.size() != per_key * times.size())
+			fail(MLOD_ERR_PARSE, "%s: output has %zu elements for %zu keys", who.c_str(), values.size() / size_t(comps),
+			     times.size());
+		ch.times = c_copy(times);
+		ch.values = c_copy(values);
+		ch.key_count = int(times.size());
+	}
+
+	void notes()
+	{
+		std::string outside;
+		int count = 0, moving = 0;
+		for (size_t k = 0; k < m_.nodes.size(); k++) {
+			if (joint_of_[k] < 0 || in_skin_[k])
+				continue;
+			if (count++ < 8)
+				outside += std::string(count > 1 ? ", " : "") + "\"" + m_.nodes[k].name + "\"";
+			moving += animated_[k];
+		}
+		if (count)
+			note("%d joint nodes are in no skin (they connect skin joints: %s%s), %d of them animated", count,
+			     outside.c_str(), count > 8 ? ", ..." : "", moving);
+		if (notes_.empty())
+			return;
+		std::string all;
+		for (const std::string &n : notes_)
+			all += (all.empty() ? "" : "\n") + n;
+		c_.notes = c_string(all);
+	}
+};
+
+/* ------------------------------------------------------------------ */
+/* Character -> glTF                                                   */
+/* ------------------------------------------------------------------ */
+
+/* Appends bytes to buffer 0 (made if there is none) at a 4-byte aligned
+ * offset, as a new buffer view; returns the view. */
+int append_view(Model &m, const void *data, size_t size, int target)
+{
+	if (m.buffers.empty())
+		m.buffers.emplace_back();
+	std::vector<unsigned char> &b = m.buffers[0].data;
+	b.resize((b.size() + 3) / 4 * 4, 0);
+	tinygltf::BufferView v;
+	v.buffer = 0;
+	v.byteOffset = b.size();
+	v.byteLength = size;
+	v.target = target;
+	const unsigned char *p = static_cast<const unsigned char *>(data);
+	b.insert(b.end(), p, p + size);
+	m.bufferViews.push_back(v);
+	return int(m.bufferViews.size() - 1);
+}
+
+/* Appends an accessor over count elements of comps components at data.
+ * With min_max, records the per-component bounds (floats only). */
+int append_accessor(Model &m, const void *data, size_t count, int component_type, int type, int comps, int target,
+                    bool min_max)
+{
+	size_t bytes = count * size_t(comps) * component_size(component_type);
+	tinygltf::Accessor a;
+	a.bufferView = append_view(m, data, bytes, target);
+	a.byteOffset = 0;
+	a.componentType = component_type;
+	a.count = count;
+	a.type = type;
+	a.normalized = false;
+	if (min_max) {
+		const float *v = static_cast<const float *>(data);
+		a.minValues.assign(size_t(comps), INFINITY);
+		a.maxValues.assign(size_t(comps), -INFINITY);
+		for (size_t i = 0; i < count; i++)
+			for (size_t c = 0; c < size_t(comps); c++) {
+				a.minValues[c] = std::min(a.minValues[c], double(v[i * size_t(comps) + c]));
+				a.maxValues[c] = std::max(a.maxValues[c], double(v[i * size_t(comps) + c]));
+			}
+	}
+	m.accessors.push_back(a);
+	return int(m.accessors.size() - 1);
+}
+
+int append_floats(Model &m, const float *v, size_t count, int comps, int target, bool min_max = false)
+{
+	static const int types[] = {0, TINYGLTF_TYPE_SCALAR, TINYGLTF_TYPE_VEC2, TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4};
+	int type = comps == 16 ? TINYGLTF_TYPE_MAT4 : types[comps];
+	return append_accessor(m, v, count, TINYGLTF_COMPONENT_TYPE_FLOAT, type, comps, target, min_max);
+}
+
+void check_finite(const float *v, size_t n, const char *what)
+{
+	for (size_t i = 0; i < n; i++)
+		if (!std::isfinite(v[i]))
+			fail(MLOD_ERR_INVALID_ARG, "%s: value %zu is not finite", what, i);
+}
+
+tinygltf::Primitive make_primitive(Model &m, const mlod_primitive &p, int mesh_index, int index)
+{
+	char who[64];
+	snprintf(who, sizeof who, "mesh %d primitive %d", mesh_index, index);
+	if (p.vertex_count <= 0 || !p.positions)
+		fail(MLOD_ERR_INVALID_ARG, "%s: no vertices", who);
+	if (p.material < -1 || p.material >= int(m.materials.size()))
+		fail(MLOD_ERR_INVALID_ARG, "%s: material %d does not exist in the document", who, p.material);
+	size_t n = size_t(p.vertex_count);
+	check_finite(p.positions, 3 * n, who);
+	tinygltf::Primitive out;
+	out.mode = p.mode;
+	out.material = p.material;
+	auto attribute = [&](const char *name, int k, const float *v, int comps, bool min_max = false) {
+		if (v)
+			out.attributes[k < 0 ? name : name + std::to_string(k)] =
+			    append_floats(m, v, n, comps, TINYGLTF_TARGET_ARRAY_BUFFER, min_max);
+	};
+	attribute("POSITION", -1, p.positions, 3, true);
+	attribute("NORMAL", -1, p.normals, 3);
+	attribute("TANGENT", -1, p.tangents, 4);
+	for (int k = 0; k < p.uv_set_count && k < MLOD_MAX_SETS; k++)
+		attribute("TEXCOORD_", k, p.uvs[k], 2);
+	for (int k = 0; k < p.color_set_count && k < MLOD_MAX_SETS; k++)
+		attribute("COLOR_", k, p.colors[k], 4);
+	for (int k = 0; k < p.weight_set_count && k < MLOD_MAX_SETS; k++) {
+		if (!p.joints[k] || !p.weights[k])
+			continue;
+		out.attributes["JOINTS_" + std::to_string(k)] = append_accessor(
+		    m, p.joints[k], n, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, 4, TINYGLTF_TARGET_ARRAY_BUFFER, false);
+		attribute("WEIGHTS_", k, p.weights[k], 4);
+	}
+	if (p.index_count > 0 && p.indices) {
+		size_t count = size_t(p.index_count);
+		for (size_t i = 0; i < count; i++)
+			if (p.indices[i] >= n)
+				fail(MLOD_ERR_INVALID_ARG, "%s: index %zu is %u, out of range (%zu vertices)", who, i, p.indices[i], n);
+		if (n <= 0xFFFF) { /* 65535 is the primitive restart value */
+			std::vector<uint16_t> narrow(p.indices, p.indices + count);
+			out.indices = append_accessor(m, narrow.data(), count, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+			                              TINYGLTF_TYPE_SCALAR, 1, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, false);
+		} else {
+			out.indices = append_accessor(m, p.indices, count, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+			                              1, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, false);
+		}
+	}
+	for (int t = 0; t < p.target_count && p.targets; t++) {
+		std::map<std::string, int> target;
+		const mlod_morph_target &mt = p.targets[t];
+		const float *parts[] = {mt.positions, mt.normals, mt.tangents};
+		const char *names[] = {"POSITION", "NORMAL", "TANGENT"};
+		for (int k = 0; k < 3; k++)
+			if (parts[k])
+				target[names[k]] = append_floats(m, parts[k], n, 3, TINYGLTF_TARGET_ARRAY_BUFFER, k == 0);
+		out.targets.push_back(target);
+	}
+	return out;
+}
+
+int add_mesh(Model &m, const mlod_mesh &mesh)
+{
+	if (mesh.primitive_count <= 0 || !mesh.primitives)
+		fail(MLOD_ERR_INVALID_ARG, "mesh \"%s\": no primitives", mesh.name ? mesh.name : "");
+	tinygltf::Mesh out;
+	out.name = utf8(mesh.name);
+	int index = int(m.meshes.size());
+	for (int p = 0; p < mesh.primitive_count; p++)
+		out.primitives.push_back(make_primitive(m, mesh.primitives[p], index, p));
+	m.meshes.push_back(std::move(out));
+	return index;
+}
+
+/* Appends a skin whose joint k is node nodes[skin.joints[k]]. */
+int add_skin(Model &m, const mlod_skin &skin, const std::vector<int> &nodes)
+{
+	if (skin.joint_count <= 0 || !skin.joints)
+		fail(MLOD_ERR_INVALID_ARG, "skin \"%s\": no joints", skin.name ? skin.name : "");
+	tinygltf::Skin out;
+	out.name = utf8(skin.name);
+	for (int k = 0; k < skin.joint_count; k++) {
+		int j = skin.joints[k];
+		if (j < 0 || size_t(j) >= nodes.size() || nodes[size_t(j)] < 0 || size_t(nodes[size_t(j)]) >= m.nodes.size())
+			fail(MLOD_ERR_INVALID_ARG, "skin \"%s\": joint %d (%d) has no node in the document", out.name.c_str(), k, j);
+		out.joints.push_back(nodes[size_t(j)]);
+	}
+	std::vector<float> ibm(16 * size_t(skin.joint_count));
+	for (int k = 0; k < skin.joint_count; k++) {
+		mlod_mat4 id = mlod_mat4_identity();
+		memcpy(&ibm[16 * size_t(k)], skin.inverse_bind ? skin.inverse_bind[k].m : id.m, sizeof(float[16]));
+	}
+	check_finite(ibm.data(), ibm.size(), "inverse bind matrices");
+	out.inverseBindMatrices = append_floats(m, ibm.data(), size_t(skin.joint_count), 16, 0);
+	m.skins.push_back(std::move(out));
+	return int(m.skins.size() - 1);
+}
+
+/* Appends an animation whose channels target nodes[channel.joint]; key
+ * times shared by several channels are stored once. */
+int add_animation(Model &m, const mlod_clip &clip, const std::vector<int> &nodes)
+{
+	if (clip.channel_count <= 0 || !clip.channels)
+		fail(MLOD_ERR_INVALID_ARG, "clip \"%s\": no channels (a glTF animation needs one)", clip.name ? clip.name : "");
+	tinygltf::Animation out;
+	out.name = utf8(clip.name);
+	std::map<std::vector<float>, int> inputs;
+	static const char *const paths[] = {"translation", "rotation", "scale"};
+	static const char *const interps[] = {"LINEAR", "STEP", "CUBICSPLINE"};
+	for (int i = 0; i < clip.channel_count; i++) {
+		const mlod_channel &ch = clip.channels[i];
+		if (ch.joint < 0 || size_t(ch.joint) >= nodes.size() || nodes[size_t(ch.joint)] < 0 ||
+		    size_t(nodes[size_t(ch.joint)]) >= m.nodes.size())
+			fail(MLOD_ERR_INVALID_ARG, "clip \"%s\" channel %d: joint %d has no node in the document", out.name.c_str(), i, ch.joint);
+		if (ch.key_count <= 0 || !ch.times || !ch.values || unsigned(ch.path) > MLOD_PATH_SCALE ||
+		    unsigned(ch.interp) > MLOD_INTERP_CUBICSPLINE)
+			fail(MLOD_ERR_INVALID_ARG, "clip \"%s\" channel %d: no keys, or a bad path or interpolation", out.name.c_str(), i);
+		size_t keys = size_t(ch.key_count), comps = ch.path == MLOD_PATH_ROTATION ? 4 : 3;
+		size_t per_key = comps * (ch.interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
+		std::vector<float> times(ch.times, ch.times + keys), values(ch.values, ch.values + keys * per_key);
+		check_finite(times.data(), keys, "key times");
+		check_finite(values.data(), values.size(), "key values");
+		for (size_t k = 1; k < keys; k++)
+			if (!(times[k] > times[k - 1]))
+				fail(MLOD_ERR_INVALID_ARG, "clip \"%s\" channel %d: key times do not increase", out.name.c_str(), i);
+		if (ch.path == MLOD_PATH_ROTATION) { /* unit quaternions; cubic tangents stay as they are */
+			size_t first = ch.interp == MLOD_INTERP_CUBICSPLINE ? 4 : 0;
+			for (size_t k = 0; k < keys; k++) {
+				float *q = &values[k * per_key + first];
+				mlod_quat n = mlod_quat_normalize(mlod_quat{q[0], q[1], q[2], q[3]});
+				q[0] = n.x, q[1] = n.y, q[2] = n.z, q[3] = n.w;
+			}
+		}
+		auto in = inputs.find(times);
+		if (in == inputs.end())
+			in = inputs.emplace(times, append_floats(m, times.data(), keys, 1, 0, true)).first;
+		tinygltf::AnimationSampler s;
+		s.input = in->second;
+		s.output = append_floats(m, values.data(), values.size() / comps, int(comps), 0);
+		s.interpolation = interps[ch.interp];
+		out.samplers.push_back(s);
+		tinygltf::AnimationChannel c;
+		c.sampler = int(out.samplers.size() - 1);
+		c.target_node = nodes[size_t(ch.joint)];
+		c.target_path = paths[ch.path];
+		out.channels.push_back(c);
+	}
+	m.animations.push_back(std::move(out));
+	return int(m.animations.size() - 1);
+}
+
+/* The scene parentless nodes join: the default one, made if needed. */
+tinygltf::Scene &default_scene(Model &m)
+{
+	if (m.scenes.empty())
+		m.scenes.emplace_back();
+	if (m.defaultScene < 0)
+		m.defaultScene = 0;
+	return m.scenes[size_t(m.defaultScene)];
+}
+
+void build_document(Model &m, const mlod_character &c)
+{
+	m.asset.version = "2.0";
+	m.asset.generator = "mlod";
+	const mlod_skeleton &s = c.skeleton;
+	std::vector<int> roots, joint_nodes;
+	m.nodes.resize(size_t(s.joint_count));
+	for (int i = 0; i < s.joint_count; i++) {
+		const mlod_joint &j = s.joints[i];
+		joint_nodes.push_back(i);
+		m.nodes[size_t(i)].name = utf8(j.name);
+		set_trs(m.nodes[size_t(i)], j.rest);
+	}
+	for (int i = 0; i < s.joint_count; i++) {
+		const mlod_joint &j = s.joints[i];
+		if (j.parent >= 0) {
+			m.nodes[size_t(j.parent)].children.push_back(i);
+		} else if (is_identity(j.base)) {
+			roots.push_back(i);
+		} else { /* the world transform above a root: a node of its own */
+			tinygltf::Node base;
+			base.name = utf8(j.name) + "_base";
+			set_transform(base, j.base);
+			base.children.push_back(i);
+			m.nodes.push_back(base);
+			roots.push_back(int(m.nodes.size() - 1));
+		}
+		if (j.has_end_site) {
+			tinygltf::Node end;
+			end.name = utf8(j.name) + "_end";
+			set_trs(end, mlod_trs{j.end_site, mlod_quat_identity(), mlod_v3{1, 1, 1}});
+			end.extras = Value(Value::Object{{"mlod", Value(Value::Object{{"end_site", Value(true)}})}});
+			m.nodes.push_back(end);
+			m.nodes[size_t(i)].children.push_back(int(m.nodes.size() - 1));
+		}
+	}
+	for (int i = 0; i < c.mesh_count; i++) {
+		mlod_mesh mesh = c.meshes[i];
+		/* A new document has no materials. */
+		std::vector<mlod_primitive> prims(mesh.primitives, mesh.primitives + mesh.primitive_count);
+		for (mlod_primitive &p : prims)
+			p.material = -1;
+		mesh.primitives = prims.data();
+		add_mesh(m, mesh);
+	}
+	for (int i = 0; i < s.skin_count; i++)
+		add_skin(m, s.skins[i], joint_nodes);
+	for (int i = 0; i < c.instance_count; i++) {
+		const mlod_instance &in = c.instances[i];
+		tinygltf::Node node;
+		node.name = utf8(c.meshes[in.mesh].name);
+		node.mesh = in.mesh;
+		node.skin = in.skin;
+		if (in.skin < 0)
+			set_transform(node, in.offset);
+		m.nodes.push_back(node);
+		int k = int(m.nodes.size() - 1);
+		if (in.skin < 0 && in.joint >= 0)
+			m.nodes[size_t(in.joint)].children.push_back(k);
+		else
+			roots.push_back(k);
+	}
+	for (int i = 0; i < c.clip_count; i++)
+		if (c.clips[i].channel_count > 0)
+			add_animation(m, c.clips[i], joint_nodes);
+	default_scene(m).nodes = roots;
+}
+
+/* ------------------------------------------------------------------ */
+/* Extras                                                              */
+/* ------------------------------------------------------------------ */
+
+/* The extras Value of an object and its JSON pointer. Doc is mlod_gltf or
+ * const mlod_gltf. */
+template <class Doc> auto extras_slot(Doc &doc, mlod_gltf_kind kind, int index, std::string *pointer)
+    -> decltype(&doc.model.asset.extras)
+{
+	auto &m = doc.model;
+	auto pick = [&](auto &list, const char *name, const char *what) {
+		if (index < 0 || size_t(index) >= list.size())
+			fail(MLOD_ERR_INVALID_ARG, "%s %d does not exist (the document has %zu)", what, index, list.size());
+		*pointer = std::string("/") + name + "/" + std::to_string(index) + "/extras";
+		return &list[size_t(index)].extras;
+	};
+	switch (kind) {
+	case MLOD_GLTF_NODE: return pick(m.nodes, "nodes", "node");
+	case MLOD_GLTF_SKIN: return pick(m.skins, "skins", "skin");
+	case MLOD_GLTF_MESH: return pick(m.meshes, "meshes", "mesh");
+	case MLOD_GLTF_ANIMATION: return pick(m.animations, "animations", "animation");
+	case MLOD_GLTF_SCENE:
+		if (index == -1) {
+			if (m.scenes.empty())
+				fail(MLOD_ERR_INVALID_ARG, "the document has no scene");
+			index = m.defaultScene >= 0 ? m.defaultScene : 0;
+		}
+		return pick(m.scenes, "scenes", "scene");
+	case MLOD_GLTF_ASSET:
+		*pointer = "/asset/extras";
+		return &m.asset.extras;
+	}
+	fail(MLOD_ERR_INVALID_ARG, "unknown glTF object kind %d", int(kind));
+}
+
+json current_extras(const mlod_gltf &doc, const std::string &pointer, const Value &value)
+{
+	auto it = doc.extras.find(pointer);
+	return it != doc.extras.end() ? it->second : to_json(value);
+}
+
+/* Sets extras[key] of an object, keeping its other keys. */
+void set_extra(mlod_gltf &doc, mlod_gltf_kind kind, int index, const std::string &key, const json &v)
+{
+	std::string pointer;
+	Value *value = extras_slot(doc, kind, index, &pointer);
+	json e = current_extras(doc, pointer, *value);
+	if (e.is_null())
+		e = json::object();
+	if (!e.is_object())
+		fail(MLOD_ERR_UNSUPPORTED, "%s is not a JSON object: mlod does not add keys to it", pointer.c_str());
+	e[key] = v;
+	*value = to_value(e);
+	doc.extras[pointer] = std::move(e);
+}
+
+/* The glTF node of every joint of s (-1 when it has none). */
+std::vector<int> joint_nodes(const mlod_skeleton *s)
+{
+	std::vector<int> nodes;
+	for (int i = 0; i < s->joint_count; i++)
+		nodes.push_back(s->joints[i].node);
+	return nodes;
+}
+
+/* Checks the arguments common to the calls that take a document. */
+void need(bool ok, const char *what)
+{
+	if (!ok)
+		fail(MLOD_ERR_INVALID_ARG, "%s", what);
+}
+
+} /* namespace */
+
+/* ------------------------------------------------------------------ */
+/* Public API                                                          */
+/* ------------------------------------------------------------------ */
+
+mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir, mlod_gltf **out, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(out != nullptr, "mlod_gltf_read: out is NULL");
+		*out = nullptr;
+		need(data != nullptr || size == 0, "mlod_gltf_read: data is NULL");
+		std::unique_ptr<mlod_gltf> doc(new mlod_gltf);
+		read_document(*doc, static_cast<const unsigned char *>(data), size, base_dir);
+		*out = doc.release();
+	});
+}
+
+void mlod_gltf_free(mlod_gltf *doc)
+{
+	delete doc;
+}
+
+mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data, size_t *size, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && data && size, "mlod_gltf_write: doc, data and size must not be NULL");
+		*data = nullptr;
+		*size = 0;
+		std::string bytes = serialize(*doc, binary != 0);
+		void *p = malloc(bytes.size());
+		if (!p)
+			throw std::bad_alloc();
+		memcpy(p, bytes.data(), bytes.size());
+		*data = p;
+		*size = bytes.size();
+	});
+}
+
+mlod_result mlod_gltf_to_character(const mlod_gltf *doc, mlod_character *out, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && out, "mlod_gltf_to_character: doc and out must not be NULL");
+		memset(out, 0, sizeof *out);
+		mlod_character c;
+		memset(&c, 0, sizeof c);
+		try {
+			CharacterReader(*doc, c).read();
+		} catch (...) {
+			mlod_character_free(&c);
+			throw;
+		}
+		*out = c;
+	});
+}
+
+mlod_result mlod_gltf_from_character(const mlod_character *c, mlod_gltf **out, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(c && out, "mlod_gltf_from_character: c and out must not be NULL");
+		*out = nullptr;
+		mlod_error verr;
+		if (mlod_character_validate(c, &verr) != MLOD_OK)
+			fail(MLOD_ERR_INVALID_ARG, "invalid character: %s", verr.message);
+		std::unique_ptr<mlod_gltf> doc(new mlod_gltf);
+		build_document(doc->model, *c);
+		*out = doc.release();
+	});
+}
+
+int mlod_gltf_count(const mlod_gltf *doc, mlod_gltf_kind kind)
+{
+	if (!doc)
+		return 0;
+	const Model &m = doc->model;
+	switch (kind) {
+	case MLOD_GLTF_NODE: return int(m.nodes.size());
+	case MLOD_GLTF_SKIN: return int(m.skins.size());
+	case MLOD_GLTF_SCENE: return int(m.scenes.size());
+	case MLOD_GLTF_MESH: return int(m.meshes.size());
+	case MLOD_GLTF_ANIMATION: return int(m.animations.size());
+	case MLOD_GLTF_ASSET: return 1;
+	}
+	return 0;
+}
+
+mlod_result mlod_gltf_set_extra(mlod_gltf *doc, mlod_gltf_kind kind, int index, const char *key, const char *text,
+                                mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && key && text, "mlod_gltf_set_extra: doc, key and json must not be NULL");
+		need(utf8(key) == key, "mlod_gltf_set_extra: the key is not UTF-8");
+		json v;
+		try {
+			v = parse_json(text, strlen(text));
+		} catch (const json::exception &e) {
+			fail(MLOD_ERR_INVALID_ARG, "extras \"%s\": not JSON: %s", key, e.what());
+		} catch (const Failure &f) {
+			fail(MLOD_ERR_INVALID_ARG, "extras \"%s\": %s", key, f.message.c_str());
+		}
+		set_extra(*doc, kind, index, key, v);
+	});
+}
+
+mlod_result mlod_gltf_get_extra(const mlod_gltf *doc, mlod_gltf_kind kind, int index, const char *key, char **text,
+                                mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && key && text, "mlod_gltf_get_extra: doc, key and json must not be NULL");
+		*text = nullptr;
+		std::string pointer;
+		const Value *value = extras_slot(*doc, kind, index, &pointer);
+		json e = current_extras(*doc, pointer, *value);
+		if (e.is_object() && e.contains(key))
+			*text = c_string(e[key].dump());
+	});
+}
+
+mlod_result mlod_gltf_add_mesh(mlod_gltf *doc, const mlod_mesh *m, int *out_index, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && m, "mlod_gltf_add_mesh: doc and mesh must not be NULL");
+		int index = add_mesh(doc->model, *m);
+		if (out_index)
+			*out_index = index;
+	});
+}
+
+mlod_result mlod_gltf_add_node(mlod_gltf *doc, const char *name, int parent, int mesh, int skin, const mlod_trs *trs,
+                               int *out_index, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_add_node: doc is NULL");
+		Model &m = doc->model;
+		if (parent < -1 || parent >= int(m.nodes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "parent node %d does not exist", parent);
+		if (mesh < -1 || mesh >= int(m.meshes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "mesh %d does not exist", mesh);
+		if (skin < -1 || skin >= int(m.skins.size()))
+			fail(MLOD_ERR_INVALID_ARG, "skin %d does not exist", skin);
+		tinygltf::Node node;
+		node.name = utf8(name);
+		node.mesh = mesh;
+		node.skin = skin;
+		if (trs)
+			set_trs(node, *trs);
+		int index = int(m.nodes.size());
+		if (parent >= 0)
+			m.nodes[size_t(parent)].children.push_back(index);
+		else
+			default_scene(m).nodes.push_back(index);
+		m.nodes.push_back(std::move(node));
+		if (out_index)
+			*out_index = index;
+	});
+}
+
+mlod_result mlod_gltf_add_skin(mlod_gltf *doc, const mlod_skeleton *s, const mlod_skin *skin, int *out_index,
+                               mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && s && skin, "mlod_gltf_add_skin: doc, skeleton and skin must not be NULL");
+		int index = add_skin(doc->model, *skin, joint_nodes(s));
+		if (out_index)
+			*out_index = index;
+	});
+}
+
+mlod_result mlod_gltf_add_animation(mlod_gltf *doc, const mlod_skeleton *s, const mlod_clip *clip, int *out_index,
+                                    mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && s && clip, "mlod_gltf_add_animation: doc, skeleton and clip must not be NULL");
+		int index = add_animation(doc->model, *clip, joint_nodes(s));
+		if (out_index)
+			*out_index = index;
+	});
+}
+
+mlod_result mlod_gltf_set_lod(mlod_gltf *doc, int node, const int *lod_nodes, int lod_count, const float *coverage,
+                              mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && lod_nodes && coverage && lod_count > 0,
+		     "mlod_gltf_set_lod: doc, lod_nodes and coverage must not be NULL, lod_count must be positive");
+		Model &m = doc->model;
+		if (node < 0 || node >= int(m.nodes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+		Value::Array ids;
+		for (int i = 0; i < lod_count; i++) {
+			if (lod_nodes[i] < 0 || lod_nodes[i] >= int(m.nodes.size()) || lod_nodes[i] == node)
+				fail(MLOD_ERR_INVALID_ARG, "LOD node %d of node %d does not exist or is the node itself", lod_nodes[i], node);
+			ids.push_back(Value(lod_nodes[i]));
+		}
+		json cov = json::array();
+		for (int i = 0; i <= lod_count; i++) {
+			if (!std::isfinite(coverage[i]) || coverage[i] < 0 || (i > 0 && coverage[i] > coverage[i - 1]))
+				fail(MLOD_ERR_INVALID_ARG, "screen coverage %d (%g) is negative or larger than the one before", i,
+				     double(coverage[i]));
+			cov.push_back(tidy(coverage[i]));
+		}
+		set_extra(*doc, MLOD_GLTF_NODE, node, "MSFT_screencoverage", cov);
+		m.nodes[size_t(node)].extensions["MSFT_lod"] = Value(Value::Object{{"ids", Value(ids)}});
+		if (std::find(m.extensionsUsed.begin(), m.extensionsUsed.end(), "MSFT_lod") == m.extensionsUsed.end())
+			m.extensionsUsed.push_back("MSFT_lod");
+	});
+}
