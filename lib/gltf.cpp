@@ -1130,6 +1130,7 @@ private:
 	std::vector<int> joint_of_;     /* per node: joint index or -1 */
 	std::vector<char> in_skin_;     /* per node */
 	std::vector<char> animated_;    /* per node: a TRS channel targets it */
+	std::vector<char> shown_;       /* per node: in the default scene */
 	std::vector<std::string> notes_;
 
 	void note(const char *fmt, ...) __attribute__((format(printf, 2, 3)))
@@ -1145,7 +1146,8 @@ private:
 	const char *node_name(int n) const { return m_.nodes[size_t(n)].name.c_str(); }
 
 	/* Parents, a parents-first order (depth-first from the roots, in file
-	 * order) and rest transforms. */
+	 * order), rest transforms, the nodes the default scene shows (all of
+	 * them without scenes) and the nodes TRS channels animate. */
 	void graph()
 	{
 		size_t n = m_.nodes.size();
@@ -1169,6 +1171,23 @@ private:
 			world_[size_t(k)] = parent_[size_t(k)] < 0 ? local_[size_t(k)]
 			                                           : mlod_mat4_mul(&world_[size_t(parent_[size_t(k)])], &local_[size_t(k)]);
 		}
+		shown_.assign(n, m_.scenes.empty());
+		if (!m_.scenes.empty())
+			for (int root : m_.scenes[size_t(std::max(m_.defaultScene, 0))].nodes)
+				shown_[size_t(root)] = 1;
+		for (int k : order_)
+			if (parent_[size_t(k)] >= 0 && shown_[size_t(parent_[size_t(k)])])
+				shown_[size_t(k)] = 1;
+		animated_.assign(n, 0);
+		for (const tinygltf::Animation &a : m_.animations)
+			for (const tinygltf::AnimationChannel &ch : a.channels)
+				if (ch.target_node >= 0 && is_trs(ch.target_path))
+					animated_[size_t(ch.target_node)] = 1;
+	}
+
+	static bool is_trs(const std::string &path)
+	{
+		return path == "translation" || path == "rotation" || path == "scale";
 	}
 
 	bool is_end_site(int n) const
@@ -1180,8 +1199,10 @@ private:
 	}
 
 	/* Joints: skin joints and the nodes between a joint and its nearest
-	 * joint ancestor, in parents-first order. Leaves marked as End Sites
-	 * below a joint become that joint's End Site. */
+	 * joint ancestor, in parents-first order. A document without skins (a
+	 * BVH converted to glTF, a node-animated rig) has its animated nodes
+	 * instead of skin joints. Leaves marked as End Sites below a joint
+	 * become that joint's End Site. */
 	void skeleton()
 	{
 		size_t n = m_.nodes.size();
@@ -1189,9 +1210,10 @@ private:
 		for (const tinygltf::Skin &s : m_.skins)
 			for (int j : s.joints)
 				in_skin_[size_t(j)] = 1;
-		std::vector<char> is_joint(in_skin_);
+		const std::vector<char> &seeds = m_.skins.empty() ? animated_ : in_skin_;
+		std::vector<char> is_joint(seeds);
 		for (size_t j = 0; j < n; j++) {
-			if (!in_skin_[j])
+			if (!seeds[j])
 				continue;
 			std::vector<int> between;
 			int k = parent_[j];
@@ -1229,6 +1251,8 @@ private:
 			else
 				j.rest = node_trs(node);
 		}
+		if (m_.skins.empty() && count > 0)
+			note("the document has no skins: the skeleton is its %d animated nodes and the nodes between them", count);
 		if (sheared)
 			note("%d joint nodes have a matrix that is not a TRS (shear or singular); their rest pose is approximated",
 			     sheared);
@@ -1316,14 +1340,14 @@ private:
 		out.mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
 		out.material = p.material;
 
-		/* Reads an attribute of the expected element count as floats with
-		 * comps components (a VEC3 color gets alpha 1). */
+		/* Reads an attribute with n elements as floats with comps
+		 * components (an RGB color, other_type VEC3, gets alpha 1). */
 		auto floats = [&](int accessor, const std::string &name, int type, int comps, int other_type = -1) {
 			std::vector<float> v = read_floats(m_, accessor, who + " " + name, type, other_type);
-			size_t have = int(m_.accessors[size_t(accessor)].type) == TINYGLTF_TYPE_VEC3 && comps == 4 ? 3 : size_t(comps);
+			size_t have = size_t(layout_of(m_.accessors[size_t(accessor)]).components);
 			if (v.size() / have != n)
 				fail(MLOD_ERR_PARSE, "%s: %s has %zu elements, POSITION has %zu", who.c_str(), name.c_str(), v.size() / have, n);
-			if (have == 3 && comps == 4) {
+			if (have < size_t(comps)) {
 				std::vector<float> rgba(4 * n, 1.0f);
 				for (size_t i = 0; i < n; i++)
 					memcpy(&rgba[4 * i], &v[3 * i], 3 * sizeof(float));
@@ -1427,14 +1451,20 @@ private:
 		}
 	}
 
-	/* One instance per node with a mesh, in node order. */
+	/* One instance per node with a mesh that the default scene shows, in
+	 * node order. Nodes outside it (MSFT_lod levels, say) are not drawn. */
 	void instances()
 	{
 		std::vector<mlod_instance> list;
+		int hidden = 0;
 		for (size_t k = 0; k < m_.nodes.size(); k++) {
 			const tinygltf::Node &node = m_.nodes[k];
 			if (node.mesh < 0)
 				continue;
+			if (!shown_[k]) {
+				hidden++;
+				continue;
+			}
 			mlod_instance in;
 			in.mesh = node.mesh;
 			in.node = int(k);
@@ -1458,13 +1488,15 @@ private:
 		}
 		c_.instances = c_copy(list);
 		c_.instance_count = int(list.size());
+		if (hidden)
+			note("%d nodes with a mesh are not in the default scene (MSFT_lod levels, say): they are not instances",
+			     hidden);
 	}
 
 	void clips()
 	{
 		c_.clips = c_array<mlod_clip>(m_.animations.size());
 		c_.clip_count = int(m_.animations.size());
-		animated_.assign(m_.nodes.size(), 0);
 		int not_joint = 0, weights = 0;
 		for (size_t a = 0; a < m_.animations.size(); a++) {
 			const tinygltf::Animation &anim = m_.animations[a];
@@ -1473,12 +1505,9 @@ private:
 			clip.gltf_index = int(a);
 			std::vector<const tinygltf::AnimationChannel *> kept;
 			for (const tinygltf::AnimationChannel &ch : anim.channels) {
-				bool trs = ch.target_path == "translation" || ch.target_path == "rotation" || ch.target_path == "scale";
-				if (ch.target_node >= 0 && trs)
-					animated_[size_t(ch.target_node)] = 1;
 				if (ch.target_path == "weights")
 					weights++;
-				else if (!trs || ch.target_node < 0 || joint_of_[size_t(ch.target_node)] < 0)
+				else if (!is_trs(ch.target_path) || ch.target_node < 0 || joint_of_[size_t(ch.target_node)] < 0)
 					not_joint++;
 				else
 					kept.push_back(&ch);
@@ -1539,7 +1568,7 @@ private:
 	{
 		std::string outside;
 		int count = 0, moving = 0;
-		for (size_t k = 0; k < m_.nodes.size(); k++) {
+		for (size_t k = 0; k < m_.nodes.size() && !m_.skins.empty(); k++) {
 			if (joint_of_[k] < 0 || in_skin_[k])
 				continue;
 			if (count++ < 8)
@@ -1622,6 +1651,20 @@ void check_finite(const float *v, size_t n, const char *what)
 			fail(MLOD_ERR_INVALID_ARG, "%s: value %zu is not finite", what, i);
 }
 
+/* Adds JOINTS_n (unsigned short) and WEIGHTS_n (float) of p to attributes. */
+void add_skinning(Model &m, const mlod_primitive &p, std::map<std::string, int> &attributes)
+{
+	size_t n = size_t(p.vertex_count);
+	for (int k = 0; k < p.weight_set_count && k < MLOD_MAX_SETS; k++) {
+		if (!p.joints[k] || !p.weights[k])
+			continue;
+		check_finite(p.weights[k], 4 * n, "weights");
+		attributes["JOINTS_" + std::to_string(k)] = append_accessor(
+		    m, p.joints[k], n, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, 4, TINYGLTF_TARGET_ARRAY_BUFFER, false);
+		attributes["WEIGHTS_" + std::to_string(k)] = append_floats(m, p.weights[k], n, 4, TINYGLTF_TARGET_ARRAY_BUFFER);
+	}
+}
+
 tinygltf::Primitive make_primitive(Model &m, const mlod_primitive &p, int mesh_index, int index)
 {
 	char who[64];
@@ -1647,13 +1690,7 @@ tinygltf::Primitive make_primitive(Model &m, const mlod_primitive &p, int mesh_i
 		attribute("TEXCOORD_", k, p.uvs[k], 2);
 	for (int k = 0; k < p.color_set_count && k < MLOD_MAX_SETS; k++)
 		attribute("COLOR_", k, p.colors[k], 4);
-	for (int k = 0; k < p.weight_set_count && k < MLOD_MAX_SETS; k++) {
-		if (!p.joints[k] || !p.weights[k])
-			continue;
-		out.attributes["JOINTS_" + std::to_string(k)] = append_accessor(
-		    m, p.joints[k], n, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, 4, TINYGLTF_TARGET_ARRAY_BUFFER, false);
-		attribute("WEIGHTS_", k, p.weights[k], 4);
-	}
+	add_skinning(m, p, out.attributes);
 	if (p.index_count > 0 && p.indices) {
 		size_t count = size_t(p.index_count);
 		for (size_t i = 0; i < count; i++)
@@ -1691,6 +1728,39 @@ int add_mesh(Model &m, const mlod_mesh &mesh)
 	for (int p = 0; p < mesh.primitive_count; p++)
 		out.primitives.push_back(make_primitive(m, mesh.primitives[p], index, p));
 	m.meshes.push_back(std::move(out));
+	return index;
+}
+
+/* Appends a copy of mesh `mesh` with JOINTS_n/WEIGHTS_n from m; the rest
+ * shares the original accessors, and extras are copied exactly. */
+int add_mesh_reskinned(mlod_gltf &doc, int mesh, const mlod_mesh &m)
+{
+	Model &model = doc.model;
+	if (mesh < 0 || size_t(mesh) >= model.meshes.size())
+		fail(MLOD_ERR_INVALID_ARG, "mesh %d does not exist", mesh);
+	tinygltf::Mesh copy = model.meshes[size_t(mesh)];
+	if (m.primitive_count != int(copy.primitives.size()) || !m.primitives)
+		fail(MLOD_ERR_INVALID_ARG, "mesh %d has %zu primitives, the new skinning %d", mesh, copy.primitives.size(),
+		     m.primitive_count);
+	for (size_t p = 0; p < copy.primitives.size(); p++) {
+		std::map<std::string, int> &attributes = copy.primitives[p].attributes;
+		auto position = attributes.find("POSITION");
+		const mlod_primitive &mp = m.primitives[p];
+		if (position == attributes.end() || model.accessors[size_t(position->second)].count != size_t(mp.vertex_count))
+			fail(MLOD_ERR_INVALID_ARG, "mesh %d primitive %zu: the new skinning has %d vertices, not as many as POSITION",
+			     mesh, p, mp.vertex_count);
+		for (auto it = attributes.begin(); it != attributes.end();)
+			it = it->first.compare(0, 7, "JOINTS_") == 0 || it->first.compare(0, 8, "WEIGHTS_") == 0 ? attributes.erase(it)
+			                                                                                       : std::next(it);
+		add_skinning(model, mp, attributes);
+	}
+	int index = int(model.meshes.size());
+	model.meshes.push_back(std::move(copy));
+	std::string from = "/meshes/" + std::to_string(mesh) + "/", to = "/meshes/" + std::to_string(index) + "/";
+	std::map<std::string, json> copied;
+	for (auto it = doc.extras.lower_bound(from); it != doc.extras.end() && it->first.compare(0, from.size(), from) == 0; ++it)
+		copied[to + it->first.substr(from.size())] = it->second;
+	doc.extras.insert(copied.begin(), copied.end());
 	return index;
 }
 
@@ -2049,13 +2119,24 @@ mlod_result mlod_gltf_add_mesh(mlod_gltf *doc, const mlod_mesh *m, int *out_inde
 	});
 }
 
+mlod_result mlod_gltf_add_mesh_reskinned(mlod_gltf *doc, int mesh, const mlod_mesh *m, int *out_index,
+                                         mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && m, "mlod_gltf_add_mesh_reskinned: doc and mesh must not be NULL");
+		int index = add_mesh_reskinned(*doc, mesh, *m);
+		if (out_index)
+			*out_index = index;
+	});
+}
+
 mlod_result mlod_gltf_add_node(mlod_gltf *doc, const char *name, int parent, int mesh, int skin, const mlod_trs *trs,
                                int *out_index, mlod_error *err)
 {
 	return guard(err, [&] {
 		need(doc != nullptr, "mlod_gltf_add_node: doc is NULL");
 		Model &m = doc->model;
-		if (parent < -1 || parent >= int(m.nodes.size()))
+		if (parent < MLOD_GLTF_DETACHED || parent >= int(m.nodes.size()))
 			fail(MLOD_ERR_INVALID_ARG, "parent node %d does not exist", parent);
 		if (mesh < -1 || mesh >= int(m.meshes.size()))
 			fail(MLOD_ERR_INVALID_ARG, "mesh %d does not exist", mesh);
@@ -2070,7 +2151,7 @@ mlod_result mlod_gltf_add_node(mlod_gltf *doc, const char *name, int parent, int
 		int index = int(m.nodes.size());
 		if (parent >= 0)
 			m.nodes[size_t(parent)].children.push_back(index);
-		else
+		else if (parent == -1)
 			default_scene(m).nodes.push_back(index);
 		m.nodes.push_back(std::move(node));
 		if (out_index)

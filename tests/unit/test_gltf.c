@@ -392,8 +392,8 @@ TEST(add_objects)
 	trs.t.x = 0.5f;
 	mlod_result r = mlod_gltf_add_mesh(doc, &c.meshes[in->mesh], &mesh, &terr);
 	if (!r) r = mlod_gltf_add_skin(doc, &c.skeleton, &c.skeleton.skins[in->skin], &skin, &terr);
-	if (!r) r = mlod_gltf_add_node(doc, "lod1", -1, mesh, skin, NULL, &lod1, &terr);
-	if (!r) r = mlod_gltf_add_node(doc, "lod2", -1, mesh, skin, NULL, &lod2, &terr);
+	if (!r) r = mlod_gltf_add_node(doc, "lod1", MLOD_GLTF_DETACHED, mesh, skin, NULL, &lod1, &terr);
+	if (!r) r = mlod_gltf_add_node(doc, "lod2", MLOD_GLTF_DETACHED, mesh, skin, NULL, &lod2, &terr);
 	if (!r) r = mlod_gltf_add_node(doc, "child", 0, -1, -1, &trs, &base, &terr);
 	if (!r) r = mlod_gltf_add_animation(doc, &c.skeleton, &c.clips[0], &anim, &terr);
 	const int lods[2] = { lod1, lod2 };
@@ -421,10 +421,13 @@ TEST(add_objects)
 	const char *d = NULL;
 	if (rc == MLOD_OK) {
 		/* The new mesh decodes to the one it was made from; the new
-		 * clip to the first clip. */
+		 * clip to the first clip; the LOD nodes are out of the scene, so
+		 * not instances. */
 		d = primitive_diff(&c.meshes[in->mesh].primitives[0], &c2.meshes[mesh].primitives[0], 0.0f);
 		if (!d && (c2.clip_count != 15 || c2.clips[14].channel_count != c.clips[0].channel_count))
 			d = "the added animation differs";
+		if (!d && (c2.instance_count != c.instance_count || !c2.notes || !strstr(c2.notes, "not in the default scene")))
+			d = "the detached LOD nodes became instances, or the child node did not";
 	}
 	mlod_character_free(&c);
 	mlod_character_free(&c2);
@@ -432,6 +435,49 @@ TEST(add_objects)
 	CHECK(lod_ext);
 	CHECK(cov_ok);
 	CHECK_MSG(rc == MLOD_OK, "%s", terr.message);
+	CHECK_MSG(d == NULL, "%s", d);
+}
+
+/* A reskinned copy of a mesh: new joints and weights, the rest shared. */
+TEST(reskinned_mesh)
+{
+	mlod_gltf *doc = read_robot(), *again = NULL;
+	CHECK_MSG(doc != NULL, "%s", terr.message);
+	mlod_character c = {0}, c2 = {0};
+	CHECK_OK(mlod_gltf_to_character(doc, &c, &terr));
+	int m = -1;
+	for (int i = 0; i < c.instance_count && m < 0; i++)
+		if (c.instances[i].skin >= 0)
+			m = c.instances[i].mesh;
+	mlod_primitive *p = &c.meshes[m].primitives[0];
+	for (int i = 0; i < p->vertex_count; i++) {
+		memset(&p->joints[0][4 * i], 0, 4 * sizeof(uint16_t));
+		p->weights[0][4 * i] = 1;
+		memset(&p->weights[0][4 * i + 1], 0, 3 * sizeof(float));
+	}
+	char *before = gltf_text(doc), *after = NULL;
+	int index = -1;
+	mlod_result r = mlod_gltf_add_mesh_reskinned(doc, c.meshes[m].gltf_index, &c.meshes[m], &index, &terr);
+	if (r == MLOD_OK) {
+		after = gltf_text(doc);
+		r = reread(doc, &again);
+	}
+	if (r == MLOD_OK)
+		r = mlod_gltf_to_character(again, &c2, &terr);
+	mlod_gltf_free(doc);
+	mlod_gltf_free(again);
+	/* Two new accessors: JOINTS_0 and WEIGHTS_0 of its one primitive. */
+	int shared = before && after && count_of(after, "\"componentType\"") == count_of(before, "\"componentType\"") + 2;
+	free(before);
+	free(after);
+	const char *d = NULL;
+	if (r == MLOD_OK)
+		d = index != 19 || c2.mesh_count != 20 ? "not appended" : primitive_diff(p, &c2.meshes[index].primitives[0], 0.0f);
+	CHECK(mlod_gltf_add_mesh_reskinned(NULL, 0, &c.meshes[m], NULL, &terr) == MLOD_ERR_INVALID_ARG);
+	mlod_character_free(&c);
+	mlod_character_free(&c2);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	CHECK(shared);
 	CHECK_MSG(d == NULL, "%s", d);
 }
 
@@ -612,6 +658,36 @@ TEST(from_character)
 	CHECK(notes);
 }
 
+/* A BVH skeleton in glTF (no skins) comes back from its animated nodes,
+ * End Sites included. */
+TEST(bvh_via_gltf)
+{
+	size_t size;
+	void *text = test_read_file("samples/cmu_12_01_walk.bvh", &size);
+	CHECK(text != NULL);
+	mlod_character c = {0}, back = {0};
+	mlod_gltf *doc = NULL, *again = NULL;
+	mlod_result r = mlod_bvh_read(text, size, &c, &terr);
+	free(text);
+	if (r == MLOD_OK)
+		r = mlod_gltf_from_character(&c, &doc, &terr);
+	if (r == MLOD_OK)
+		r = reread(doc, &again);
+	if (r == MLOD_OK)
+		r = mlod_gltf_to_character(again, &back, &terr);
+	int ends = 0;
+	for (int i = 0; r == MLOD_OK && i < back.skeleton.joint_count; i++)
+		ends += back.skeleton.joints[i].has_end_site;
+	const char *d = r == MLOD_OK ? character_diff(&c, &back, 0, 1e-6f) : NULL; /* quaternions are renormalised */
+	mlod_gltf_free(doc);
+	mlod_gltf_free(again);
+	mlod_character_free(&c);
+	mlod_character_free(&back);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	CHECK_MSG(d == NULL, "%s", d);
+	CHECK(ends == 7); /* the End Sites of the file: toes, head, fingers and thumbs */
+}
+
 /* The sample through from_character comes back as the same character. */
 TEST(robot_via_character)
 {
@@ -633,6 +709,185 @@ TEST(robot_via_character)
 	mlod_character_free(&back);
 	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
 	CHECK_MSG(d == NULL, "%s", d);
+}
+
+/* ---------------------------------------------------------------- */
+/* Decoding                                                          */
+/* ---------------------------------------------------------------- */
+
+static void put32(unsigned char *p, uint32_t v)
+{
+	for (int k = 0; k < 4; k++)
+		p[k] = (unsigned char)(v >> (8 * k));
+}
+
+static void put_floats(unsigned char *p, const float *v, int n)
+{
+	memcpy(p, v, (size_t)n * sizeof(float));
+}
+
+/* A glb of json and bin (padded as the format wants); free() it. */
+static unsigned char *make_glb(const char *json, const unsigned char *bin, size_t bin_size, size_t *size)
+{
+	size_t jn = (strlen(json) + 3) / 4 * 4, bn = (bin_size + 3) / 4 * 4;
+	*size = 12 + 8 + jn + (bn ? 8 + bn : 0);
+	unsigned char *g = calloc(1, *size);
+	memcpy(g, "glTF", 4);
+	put32(g + 4, 2);
+	put32(g + 8, (uint32_t)*size);
+	put32(g + 12, (uint32_t)jn);
+	put32(g + 16, 0x4E4F534A);
+	memset(g + 20, ' ', jn);
+	memcpy(g + 20, json, strlen(json));
+	if (bn) {
+		put32(g + 20 + jn, (uint32_t)bn);
+		put32(g + 24 + jn, 0x004E4942);
+		memcpy(g + 28 + jn, bin, bin_size);
+	}
+	return g;
+}
+
+/* Interleaved positions and normals (stride 24), normalised ushort UVs,
+ * normalised ubyte RGB colors (stride 4), ubyte joints, normalised ubyte
+ * weights, ubyte indices, a sparse morph target without buffer view, a
+ * sparse UV set over a buffer view, a quantised rotation track. Node 1
+ * sits between the skin joints 0 and 2; node 5 is an End Site; node 4 a
+ * rigid part; node 6 a non-joint parent of the root. */
+static const char decode_json[] =
+	"{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_mesh_quantization\"],"
+	"\"buffers\":[{\"byteLength\":232}],"
+	"\"bufferViews\":["
+	"{\"buffer\":0,\"byteOffset\":0,\"byteLength\":72,\"byteStride\":24},"
+	"{\"buffer\":0,\"byteOffset\":72,\"byteLength\":12},"
+	"{\"buffer\":0,\"byteOffset\":84,\"byteLength\":12,\"byteStride\":4},"
+	"{\"buffer\":0,\"byteOffset\":96,\"byteLength\":12},"
+	"{\"buffer\":0,\"byteOffset\":108,\"byteLength\":12},"
+	"{\"buffer\":0,\"byteOffset\":120,\"byteLength\":3},"
+	"{\"buffer\":0,\"byteOffset\":124,\"byteLength\":2},"
+	"{\"buffer\":0,\"byteOffset\":128,\"byteLength\":12},"
+	"{\"buffer\":0,\"byteOffset\":140,\"byteLength\":24},"
+	"{\"buffer\":0,\"byteOffset\":164,\"byteLength\":1},"
+	"{\"buffer\":0,\"byteOffset\":168,\"byteLength\":8},"
+	"{\"buffer\":0,\"byteOffset\":176,\"byteLength\":8},"
+	"{\"buffer\":0,\"byteOffset\":184,\"byteLength\":16},"
+	"{\"buffer\":0,\"byteOffset\":200,\"byteLength\":24},"
+	"{\"buffer\":0,\"byteOffset\":224,\"byteLength\":8}],"
+	"\"accessors\":["
+	"{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},"
+	"{\"bufferView\":0,\"byteOffset\":12,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+	"{\"bufferView\":1,\"componentType\":5123,\"normalized\":true,\"count\":3,\"type\":\"VEC2\"},"
+	"{\"bufferView\":2,\"componentType\":5121,\"normalized\":true,\"count\":3,\"type\":\"VEC3\"},"
+	"{\"bufferView\":3,\"componentType\":5121,\"count\":3,\"type\":\"VEC4\"},"
+	"{\"bufferView\":4,\"componentType\":5121,\"normalized\":true,\"count\":3,\"type\":\"VEC4\"},"
+	"{\"bufferView\":5,\"componentType\":5121,\"count\":3,\"type\":\"SCALAR\"},"
+	"{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[0,0,1],\"sparse\":{\"count\":1,"
+	"\"indices\":{\"bufferView\":6,\"componentType\":5123},\"values\":{\"bufferView\":7}}},"
+	"{\"bufferView\":8,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\",\"sparse\":{\"count\":1,"
+	"\"indices\":{\"bufferView\":9,\"componentType\":5121},\"values\":{\"bufferView\":10}}},"
+	"{\"bufferView\":11,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},"
+	"{\"bufferView\":12,\"componentType\":5122,\"normalized\":true,\"count\":2,\"type\":\"VEC4\"},"
+	"{\"bufferView\":13,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"},"
+	"{\"bufferView\":14,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"}],"
+	"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2,\"TEXCOORD_1\":8,"
+	"\"COLOR_0\":3,\"JOINTS_0\":4,\"WEIGHTS_0\":5},\"indices\":6,\"targets\":[{\"POSITION\":7}]}],\"weights\":[0]}],"
+	"\"nodes\":[{\"name\":\"root\",\"children\":[1]},{\"name\":\"link\",\"children\":[2],\"translation\":[0,1,0]},"
+	"{\"name\":\"tip\",\"children\":[4,5],\"translation\":[0,1,0]},{\"name\":\"body\",\"mesh\":0,\"skin\":0},"
+	"{\"name\":\"prop\",\"mesh\":0,\"translation\":[1,0,0]},"
+	"{\"name\":\"tip_end\",\"translation\":[0,0.5,0],\"extras\":{\"mlod\":{\"end_site\":true}}},"
+	"{\"name\":\"world\",\"translation\":[0,0,5],\"children\":[0]}],"
+	"\"scenes\":[{\"nodes\":[6,3]}],\"scene\":0,\"skins\":[{\"joints\":[0,2]}],"
+	"\"animations\":[{\"name\":\"a\",\"samplers\":[{\"input\":9,\"output\":10},"
+	"{\"input\":9,\"output\":11,\"interpolation\":\"STEP\"},{\"input\":9,\"output\":12}],"
+	"\"channels\":[{\"sampler\":0,\"target\":{\"node\":2,\"path\":\"rotation\"}},"
+	"{\"sampler\":1,\"target\":{\"node\":4,\"path\":\"translation\"}},"
+	"{\"sampler\":2,\"target\":{\"node\":3,\"path\":\"weights\"}}]}]}";
+
+static void decode_bin(unsigned char bin[232])
+{
+	memset(bin, 0, 232);
+	const float vertices[18] = { 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 1 };
+	put_floats(bin, vertices, 18);
+	const uint16_t uv[6] = { 0, 0, 65535, 0, 0, 65535 };
+	memcpy(bin + 72, uv, sizeof uv);
+	const unsigned char rgb[12] = { 255, 0, 0, 9, 0, 255, 0, 9, 0, 0, 255, 9 };
+	memcpy(bin + 84, rgb, 12);
+	const unsigned char joints[12] = { 0, 1, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0 };
+	memcpy(bin + 96, joints, 12);
+	const unsigned char weights[12] = { 255, 0, 0, 0, 128, 127, 0, 0, 255, 0, 0, 0 };
+	memcpy(bin + 108, weights, 12);
+	const unsigned char idx[3] = { 0, 1, 2 };
+	memcpy(bin + 120, idx, 3);
+	const uint16_t sparse_index = 2;
+	memcpy(bin + 124, &sparse_index, 2);
+	const float delta[3] = { 0, 0, 1 };
+	put_floats(bin + 128, delta, 3);
+	const float uv1[6] = { 0.1f, 0.1f, 0.2f, 0.2f, 0.3f, 0.3f };
+	put_floats(bin + 140, uv1, 6);
+	bin[164] = 0;
+	const float uv1_new[2] = { 0.25f, 0.75f };
+	put_floats(bin + 168, uv1_new, 2);
+	const float times[2] = { 0, 1 };
+	put_floats(bin + 176, times, 2);
+	const int16_t rot[8] = { 0, 0, 0, 32767, 0, 0, 32767, 0 };
+	memcpy(bin + 184, rot, sizeof rot);
+}
+
+TEST(decode_layouts)
+{
+	unsigned char bin[232];
+	decode_bin(bin);
+	size_t size;
+	unsigned char *glb = make_glb(decode_json, bin, sizeof bin, &size);
+	mlod_gltf *doc = NULL;
+	mlod_character c = {0};
+	mlod_result r = mlod_gltf_read(glb, size, NULL, &doc, &terr);
+	free(glb);
+	if (r == MLOD_OK)
+		r = mlod_gltf_to_character(doc, &c, &terr);
+	mlod_gltf_free(doc);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	mlod_result valid = mlod_character_validate(&c, &terr);
+	const mlod_skeleton *s = &c.skeleton;
+	int skeleton = s->joint_count == 3 && strcmp(s->joints[0].name, "root") == 0 &&
+	               strcmp(s->joints[1].name, "link") == 0 && strcmp(s->joints[2].name, "tip") == 0 &&
+	               s->joints[0].parent == -1 && s->joints[1].parent == 0 && s->joints[2].parent == 1 &&
+	               s->joints[0].base.m[14] == 5 && s->joints[1].base.m[14] == 0 &&
+	               s->joints[2].has_end_site && s->joints[2].end_site.y == 0.5f && !s->joints[0].has_end_site;
+	int skin = s->skin_count == 1 && s->skins[0].joint_count == 2 && s->skins[0].joints[0] == 0 &&
+	           s->skins[0].joints[1] == 2 && s->skins[0].inverse_bind[1].m[0] == 1;
+	const mlod_primitive *p = c.mesh_count == 1 ? &c.meshes[0].primitives[0] : NULL;
+	int interleaved = p && p->vertex_count == 3 && p->positions[3] == 1 && p->positions[7] == 1 &&
+	                  p->normals[2] == 1 && p->normals[8] == 1;
+	int uvs = p && p->uv_set_count == 2 && p->uvs[0][2] == 1 && p->uvs[0][5] == 1 && p->uvs[0][0] == 0 &&
+	          p->uvs[1][0] == 0.25f && p->uvs[1][1] == 0.75f && p->uvs[1][2] == 0.2f;
+	int colors = p && p->color_set_count == 1 && p->colors[0][0] == 1 && p->colors[0][3] == 1 &&
+	             p->colors[0][5] == 1 && p->colors[0][7] == 1 && p->colors[0][4] == 0;
+	int skinning = p && p->weight_set_count == 1 && p->joints[0][1] == 1 && p->joints[0][4] == 1 &&
+	               fabsf(p->weights[0][4] - 128.0f / 255) < 1e-7f && p->weights[0][0] == 1;
+	int indexed = p && p->index_count == 3 && p->indices[2] == 2 && p->mode == 4;
+	int morph = p && p->target_count == 1 && p->targets[0].positions[8] == 1 && p->targets[0].positions[5] == 0;
+	int instances = c.instance_count == 2 && c.instances[0].skin == 0 && c.instances[0].joint == -1 &&
+	                c.instances[1].skin == -1 && c.instances[1].joint == 2 && c.instances[1].offset.m[12] == 1;
+	const mlod_clip *k = c.clip_count == 1 ? &c.clips[0] : NULL;
+	int clip = k && k->channel_count == 1 && k->duration == 1 && k->channels[0].joint == 2 &&
+	           k->channels[0].path == MLOD_PATH_ROTATION && k->channels[0].values[3] == 1 && k->channels[0].values[6] == 1;
+	const char *notes = c.notes ? c.notes : "";
+	int noted = strstr(notes, "1 joint nodes are in no skin") && strstr(notes, "\"link\"") &&
+	            strstr(notes, "1 animation channels target nodes that are not joints") &&
+	            strstr(notes, "1 animation channels animate morph target weights");
+	mlod_character_free(&c);
+	CHECK_MSG(valid == MLOD_OK, "%s", terr.message);
+	CHECK(skeleton);
+	CHECK(skin);
+	CHECK(interleaved);
+	CHECK(uvs);
+	CHECK(colors);
+	CHECK(skinning);
+	CHECK(indexed);
+	CHECK(morph);
+	CHECK(instances);
+	CHECK(clip);
+	CHECK_MSG(noted, "notes: %s", notes);
 }
 
 /* ---------------------------------------------------------------- */
@@ -693,12 +948,6 @@ TEST(empty_and_garbage)
 		deep[n++] = ']';
 	deep[n++] = '}';
 	CHECK(try_read(deep, n) == MLOD_ERR_PARSE);
-}
-
-static void put32(unsigned char *p, uint32_t v)
-{
-	for (int k = 0; k < 4; k++)
-		p[k] = (unsigned char)(v >> (8 * k));
 }
 
 TEST(truncated_glb)
@@ -914,6 +1163,9 @@ int main(void)
 	RUN(add_objects);
 	RUN(from_character);
 	RUN(robot_via_character);
+	RUN(bvh_via_gltf);
+	RUN(reskinned_mesh);
+	RUN(decode_layouts);
 	RUN(empty_and_garbage);
 	RUN(truncated_glb);
 	RUN(mutated_glb);
