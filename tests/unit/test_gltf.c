@@ -754,7 +754,7 @@ static unsigned char *make_glb(const char *json, const unsigned char *bin, size_
  * sits between the skin joints 0 and 2; node 5 is an End Site; node 4 a
  * rigid part; node 6 a non-joint parent of the root. */
 static const char decode_json[] =
-	"{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_mesh_quantization\"],"
+	"{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_quantization\"],"
 	"\"buffers\":[{\"byteLength\":232}],"
 	"\"bufferViews\":["
 	"{\"buffer\":0,\"byteOffset\":0,\"byteLength\":72,\"byteStride\":24},"
