@@ -96,17 +96,17 @@ static double dist(mlod_v3 a, mlod_v3 b)
 	return mlod_v3_length(mlod_v3_sub(a, b));
 }
 
-/* Writes a's clip 0 (its own frame time) as BVH, reads it back into b and
- * checks that every joint (matched by name), and every End Site when
- * end_sites is set, is where it was in every frame, within 1e-4 of the
- * skeleton's size. a's clip must be uniformly sampled or frame_time given. */
-static void check_round_trip(const mlod_character *a, float frame_time, int end_sites, const char *what)
+/* Writes clip k of a (or its rest pose when it has no clip) as BVH, reads
+ * it back into b and checks that every joint (matched by name), and every
+ * End Site when end_sites is set, is where it was in every frame, within
+ * 1e-4 of the skeleton's size. */
+static void check_clip_round_trip(const mlod_character *a, int k, float frame_time, int end_sites, const char *what)
 {
 	char *text = NULL;
 	size_t size = 0;
 	mlod_character b;
 	memset(&b, 0, sizeof b);
-	CHECK_OK(mlod_bvh_write(a, a->clip_count ? 0 : -1, frame_time, &text, &size, &terr));
+	CHECK_OK(mlod_bvh_write(a, a->clip_count ? k : -1, frame_time, &text, &size, &terr));
 	CHECK_MSG(text && size == strlen(text), "%s: bad text", what);
 	CHECK_MSG(!strchr(text, ','), "%s: a comma in the BVH text", what);
 	mlod_result r = mlod_bvh_read(text, size, &b, &terr);
@@ -138,10 +138,10 @@ static void check_round_trip(const mlod_character *a, float frame_time, int end_
 		float t = (float)(f * (double)ft);
 		for (int pass = 0; pass < (end_sites ? 2 : 1); pass++) {
 			if (pass == 0) {
-				world_positions(a, a->clip_count ? 0 : -1, t, pa);
+				world_positions(a, a->clip_count ? k : -1, t, pa);
 				world_positions(&b, b.clip_count ? 0 : -1, t, pb);
 			} else {
-				end_positions(a, a->clip_count ? 0 : -1, t, pa);
+				end_positions(a, a->clip_count ? k : -1, t, pa);
 				end_positions(&b, b.clip_count ? 0 : -1, t, pb);
 			}
 			for (int j = 0; j < n; j++) {
@@ -163,16 +163,21 @@ static void check_round_trip(const mlod_character *a, float frame_time, int end_
 	          worst_end ? "End Site of" : "joint", a->skeleton.joints[worst_joint].name, worst, worst_frame, tol);
 }
 
+static void check_round_trip(const mlod_character *a, float frame_time, int end_sites, const char *what)
+{
+	check_clip_round_trip(a, 0, frame_time, end_sites, what);
+}
+
 /* Round trip of a BVH file. */
 static void check_file_round_trip(const char *path)
 {
 	size_t size = 0;
 	char *data = test_read_file(path, &size);
-	CHECK_MSG(data, "cannot read %s", path);
+	CHECK_MSG(data, "cannot read %.300s", path);
 	mlod_character a;
 	mlod_result r = mlod_bvh_read(data, size, &a, &terr);
 	free(data);
-	CHECK_MSG(r == MLOD_OK, "%s: %s", path, terr.message);
+	CHECK_MSG(r == MLOD_OK, "%.300s: %.300s", path, terr.message);
 	CHECK_OK(mlod_character_validate(&a, &terr));
 	check_round_trip(&a, 0.0f, 1, path);
 	mlod_character_free(&a);
@@ -756,7 +761,25 @@ TEST(round_trip_files)
 	mlod_character_free(&c);
 }
 
-/* Round trips of every .bvh in a directory, if it exists. */
+/* Round trips of every clip of a glb as BVH. */
+static void check_glb_round_trip(const char *path)
+{
+	size_t size = 0;
+	char *data = test_read_file(path, &size);
+	CHECK_MSG(data, "cannot read %.300s", path);
+	mlod_character c;
+	mlod_result r = mlod_load(data, size, NULL, NULL, &c, NULL, &terr);
+	free(data);
+	CHECK_MSG(r == MLOD_OK, "%.300s: %.300s", path, terr.message);
+	for (int k = 0; k < (c.clip_count ? c.clip_count : 1) && !test_failed_; k++) {
+		char what[600];
+		snprintf(what, sizeof what, "%.500s clip %d", path, k);
+		check_clip_round_trip(&c, k, 0.0f, 1, what);
+	}
+	mlod_character_free(&c);
+}
+
+/* Round trips of every .bvh and .glb in a directory, if it exists. */
 static void round_trip_dir(const char *dir, int *count)
 {
 	DIR *d = opendir(dir);
@@ -766,10 +789,13 @@ static void round_trip_dir(const char *dir, int *count)
 	char path[1024];
 	while ((e = readdir(d))) {
 		size_t n = strlen(e->d_name);
-		if (n < 4 || (strcmp(e->d_name + n - 4, ".bvh") != 0 && strcmp(e->d_name + n - 4, ".BVH") != 0))
-			continue;
 		snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-		check_file_round_trip(path);
+		if (n >= 4 && strcmp(e->d_name + n - 4, ".glb") == 0)
+			check_glb_round_trip(path);
+		else if (n >= 4 && (strcmp(e->d_name + n - 4, ".bvh") == 0 || strcmp(e->d_name + n - 4, ".BVH") == 0))
+			check_file_round_trip(path);
+		else
+			continue;
 		(*count)++;
 		if (test_failed_)
 			break;
@@ -1094,7 +1120,17 @@ TEST(load_glb)
 	CHECK(f == MLOD_FORMAT_GLB && doc);
 	CHECK(c.skeleton.joint_count > 0 && c.clip_count > 0 && c.mesh_count > 0);
 	mlod_gltf_free(doc);
+	/* Its clips as BVH: rest rotations folded into the channels. */
+	for (int k = 0; k < c.clip_count && !test_failed_; k++) {
+		char what[160];
+		snprintf(what, sizeof what, "RobotExpressive.glb clip %d (%.100s)", k, c.clips[k].name);
+		check_clip_round_trip(&c, k, 0.0f, 1, what);
+	}
 	mlod_character_free(&c);
+	if (test_failed_) {
+		free(data);
+		return;
+	}
 
 	/* Truncated: an error, and nothing left allocated. */
 	doc = (mlod_gltf *)&c;
