@@ -265,6 +265,14 @@ Value to_value(const json &j)
 	}
 }
 
+/* The extras of an object: the exact copy at pointer if there is one,
+ * else its Value. */
+json current_extras(const mlod_gltf &doc, const std::string &pointer, const Value &value)
+{
+	auto it = doc.extras.find(pointer);
+	return it != doc.extras.end() ? it->second : to_json(value);
+}
+
 /* ------------------------------------------------------------------ */
 /* Reading: checks before tinygltf                                     */
 /* ------------------------------------------------------------------ */
@@ -1143,8 +1151,6 @@ private:
 		notes_.push_back(buf);
 	}
 
-	const char *node_name(int n) const { return m_.nodes[size_t(n)].name.c_str(); }
-
 	/* Parents, a parents-first order (depth-first from the roots, in file
 	 * order), rest transforms, the nodes the default scene shows (all of
 	 * them without scenes) and the nodes TRS channels animate. */
@@ -1190,12 +1196,13 @@ private:
 		return path == "translation" || path == "rotation" || path == "scale";
 	}
 
+	/* Is node n marked extras.mlod.end_site = true? */
 	bool is_end_site(int n) const
 	{
-		std::string at = "/nodes/" + std::to_string(n) + "/extras";
-		auto it = doc_.extras.find(at);
-		json e = it != doc_.extras.end() ? it->second : to_json(m_.nodes[size_t(n)].extras);
-		return e.is_object() && e.contains("mlod") && e["mlod"].is_object() && e["mlod"].value("end_site", false) == true;
+		const json e = current_extras(doc_, "/nodes/" + std::to_string(n) + "/extras", m_.nodes[size_t(n)].extras);
+		const json none;
+		const json &mlod = e.is_object() && e.contains("mlod") ? e["mlod"] : none;
+		return mlod.is_object() && mlod.contains("end_site") && mlod["end_site"] == true;
 	}
 
 	/* Joints: skin joints and the nodes between a joint and its nearest
@@ -1252,7 +1259,7 @@ private:
 				j.rest = node_trs(node);
 		}
 		if (m_.skins.empty() && count > 0)
-			note("the document has no skins: the skeleton is its %d animated nodes and the nodes between them", count);
+			note("the document has no skins: its %d joints are the animated nodes and the nodes between them", count);
 		if (sheared)
 			note("%d joint nodes have a matrix that is not a TRS (shear or singular); their rest pose is approximated",
 			     sheared);
@@ -1637,6 +1644,7 @@ int append_accessor(Model &m, const void *data, size_t count, int component_type
 	return int(m.accessors.size() - 1);
 }
 
+/* append_accessor for floats: comps 1 to 4 are SCALAR to VEC4, 16 is MAT4. */
 int append_floats(Model &m, const float *v, size_t count, int comps, int target, bool min_max = false)
 {
 	static const int types[] = {0, TINYGLTF_TYPE_SCALAR, TINYGLTF_TYPE_VEC2, TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4};
@@ -1644,6 +1652,7 @@ int append_floats(Model &m, const float *v, size_t count, int comps, int target,
 	return append_accessor(m, v, count, TINYGLTF_COMPONENT_TYPE_FLOAT, type, comps, target, min_max);
 }
 
+/* Callers' data must be finite: JSON cannot hold NaN in min/max. */
 void check_finite(const float *v, size_t n, const char *what)
 {
 	for (size_t i = 0; i < n; i++)
@@ -1665,6 +1674,8 @@ void add_skinning(Model &m, const mlod_primitive &p, std::map<std::string, int> 
 	}
 }
 
+/* A glTF primitive with new accessors for every attribute of p (POSITION
+ * with min and max, 16-bit indices when the vertices allow). */
 tinygltf::Primitive make_primitive(Model &m, const mlod_primitive &p, int mesh_index, int index)
 {
 	char who[64];
@@ -1718,6 +1729,7 @@ tinygltf::Primitive make_primitive(Model &m, const mlod_primitive &p, int mesh_i
 	return out;
 }
 
+/* Appends a mesh with mesh's primitives; returns its index. */
 int add_mesh(Model &m, const mlod_mesh &mesh)
 {
 	if (mesh.primitive_count <= 0 || !mesh.primitives)
@@ -1851,16 +1863,20 @@ tinygltf::Scene &default_scene(Model &m)
 	return m.scenes[size_t(m.defaultScene)];
 }
 
+/* Fills an empty model from a character: joint nodes first (node i is
+ * joint i), a node above each root whose base is not the identity, End
+ * Site nodes, meshes, skins, instance nodes (rigid ones under their joint)
+ * and one animation per clip with channels. */
 void build_document(Model &m, const mlod_character &c)
 {
 	m.asset.version = "2.0";
 	m.asset.generator = "mlod";
 	const mlod_skeleton &s = c.skeleton;
-	std::vector<int> roots, joint_nodes;
+	std::vector<int> roots, node_of_joint; /* joint i is node i */
 	m.nodes.resize(size_t(s.joint_count));
 	for (int i = 0; i < s.joint_count; i++) {
 		const mlod_joint &j = s.joints[i];
-		joint_nodes.push_back(i);
+		node_of_joint.push_back(i);
 		m.nodes[size_t(i)].name = utf8(j.name);
 		set_trs(m.nodes[size_t(i)], j.rest);
 	}
@@ -1897,7 +1913,7 @@ void build_document(Model &m, const mlod_character &c)
 		add_mesh(m, mesh);
 	}
 	for (int i = 0; i < s.skin_count; i++)
-		add_skin(m, s.skins[i], joint_nodes);
+		add_skin(m, s.skins[i], node_of_joint);
 	for (int i = 0; i < c.instance_count; i++) {
 		const mlod_instance &in = c.instances[i];
 		tinygltf::Node node;
@@ -1915,7 +1931,7 @@ void build_document(Model &m, const mlod_character &c)
 	}
 	for (int i = 0; i < c.clip_count; i++)
 		if (c.clips[i].channel_count > 0)
-			add_animation(m, c.clips[i], joint_nodes);
+			add_animation(m, c.clips[i], node_of_joint);
 	default_scene(m).nodes = roots;
 }
 
@@ -1952,12 +1968,6 @@ template <class Doc> auto extras_slot(Doc &doc, mlod_gltf_kind kind, int index, 
 		return &m.asset.extras;
 	}
 	fail(MLOD_ERR_INVALID_ARG, "unknown glTF object kind %d", int(kind));
-}
-
-json current_extras(const mlod_gltf &doc, const std::string &pointer, const Value &value)
-{
-	auto it = doc.extras.find(pointer);
-	return it != doc.extras.end() ? it->second : to_json(value);
 }
 
 /* Sets extras[key] of an object, keeping its other keys. */
