@@ -1226,26 +1226,42 @@ static void euler_pick(const layout *l, mlod_quat q, const double *prev, double 
 			out[a] = 0.0;
 }
 
-/* Per-frame state of the writer. */
+/* The writer's state: the layouts and rest values, and one posed frame. */
 typedef struct writer {
 	const mlod_character *c;
 	const mlod_clip *clip;
 	int n;
+	double ft;           /* seconds per frame */
+	long frames;
+	layout *lay;
+	mlod_v3 *offset;     /* BVH OFFSETs */
+	mlod_v3 *end;        /* End Site OFFSETs */
+	double pos_tol;      /* a translation this far from its OFFSET needs channels */
+	int *base_rigid;     /* roots: base is a rigid transform */
+	mlod_quat *base_q;   /* roots: rotation of the base */
+	/* The current pose. */
 	mlod_trs *local;
 	mlod_mat4 *world;
-	int *rigid;        /* the joint's world transform is rigid (unit scales above and at it) */
-	int *have_frame;   /* fw_q / fw_p computed for this pose */
-	mlod_quat *fw_q;   /* rotation of the world matrix */
-	mlod_v3 *fw_p;     /* position of the world matrix */
-	mlod_v3 *t;        /* BVH local translation */
-	mlod_quat *q;      /* BVH local rotation */
-	int *base_rigid;   /* roots: base is a rigid transform */
-	mlod_quat *base_q;
+	int *rigid;          /* the joint's world transform is rigid (unit scales above and at it) */
+	int *have_frame;     /* fw_q / fw_p computed for this pose */
+	mlod_quat *fw_q;     /* rotation of the world matrix */
+	mlod_v3 *fw_p;       /* position of the world matrix */
+	mlod_v3 *t;          /* BVH local translation */
+	mlod_quat *q;        /* BVH local rotation */
+	/* Output. */
+	int *order;          /* joints in file order (depth first) */
+	double *prev;        /* last frame's Euler angles, 3 per joint */
+	strbuf b;
 } writer;
 
 static int unit_scale(mlod_v3 s)
 {
 	return fabsf(s.x - 1.0f) <= 1e-6f && fabsf(s.y - 1.0f) <= 1e-6f && fabsf(s.z - 1.0f) <= 1e-6f;
+}
+
+static int finite_v3(mlod_v3 v)
+{
+	return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
 }
 
 /* The rigid frame (rotation, position) of joint j's world matrix. */
@@ -1272,7 +1288,8 @@ static void world_frame(writer *w, int j)
 	w->have_frame[j] = 1;
 }
 
-/* Computes the BVH local transforms (w->t, w->q) of the pose in w->local. */
+/* Computes the BVH local transforms (w->t, w->q) of the pose in w->local.
+ * A joint's BVH frame is the rigid part of its world transform. */
 static void bvh_locals(writer *w)
 {
 	const mlod_skeleton *s = &w->c->skeleton;
@@ -1311,21 +1328,43 @@ static void bvh_locals(writer *w)
 }
 
 /* Poses frame f (or the rest pose when f < 0) and computes its BVH locals. */
-static void pose_frame(writer *w, long f, double ft)
+static void pose_frame(writer *w, long f)
 {
 	mlod_pose_rest(&w->c->skeleton, w->local);
 	if (f >= 0 && w->clip)
-		mlod_clip_sample(w->clip, (float)((double)f * ft), w->local);
+		mlod_clip_sample(w->clip, (float)((double)f * w->ft), w->local);
 	bvh_locals(w);
 }
 
-static int finite_v3(mlod_v3 v)
+static int writer_alloc(writer *w)
 {
-	return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
+	size_t n = (size_t)w->n;
+	w->lay = calloc(n, sizeof *w->lay);
+	w->offset = malloc(n * sizeof *w->offset);
+	w->end = malloc(n * sizeof *w->end);
+	w->base_rigid = calloc(n, sizeof *w->base_rigid);
+	w->base_q = malloc(n * sizeof *w->base_q);
+	w->local = malloc(n * sizeof *w->local);
+	w->world = malloc(n * sizeof *w->world);
+	w->rigid = malloc(n * sizeof *w->rigid);
+	w->have_frame = malloc(n * sizeof *w->have_frame);
+	w->fw_q = malloc(n * sizeof *w->fw_q);
+	w->fw_p = malloc(n * sizeof *w->fw_p);
+	w->t = malloc(n * sizeof *w->t);
+	w->q = malloc(n * sizeof *w->q);
+	w->order = malloc(n * sizeof *w->order);
+	w->prev = malloc(n * 3 * sizeof *w->prev);
+	return w->lay && w->offset && w->end && w->base_rigid && w->base_q && w->local && w->world && w->rigid &&
+	       w->have_frame && w->fw_q && w->fw_p && w->t && w->q && w->order && w->prev;
 }
 
 static void writer_free(writer *w)
 {
+	free(w->lay);
+	free(w->offset);
+	free(w->end);
+	free(w->base_rigid);
+	free(w->base_q);
 	free(w->local);
 	free(w->world);
 	free(w->rigid);
@@ -1334,8 +1373,111 @@ static void writer_free(writer *w)
 	free(w->fw_p);
 	free(w->t);
 	free(w->q);
-	free(w->base_rigid);
-	free(w->base_q);
+	free(w->order);
+	free(w->prev);
+	free(w->b.s);
+}
+
+/* Each joint's layout as the character gives it (or the default), and the
+ * bases of roots. */
+static mlod_result writer_layouts(writer *w, mlod_error *err)
+{
+	static const unsigned char root6[6] = { MLOD_BVH_XPOS, MLOD_BVH_YPOS, MLOD_BVH_ZPOS,
+	                                        MLOD_BVH_ZROT, MLOD_BVH_XROT, MLOD_BVH_YROT };
+	for (int j = 0; j < w->n; j++) {
+		const mlod_joint *jt = &w->c->skeleton.joints[j];
+		layout *l = &w->lay[j];
+		if (jt->channel_count < 0 || jt->channel_count > 6)
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has %d BVH channels", jt->name,
+			                 jt->channel_count);
+		if (jt->channel_count > 0) {
+			int seen = 0;
+			for (int k = 0; k < jt->channel_count; k++) {
+				int code = jt->channels[k];
+				if (code > MLOD_BVH_ZROT || (seen & (1 << code)))
+					return mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has an invalid BVH channel layout",
+					                 jt->name);
+				seen |= 1 << code;
+				l->ch[l->n++] = (unsigned char)code;
+			}
+			mlod_euler_order fb = (int)jt->euler >= 0 && (int)jt->euler < 6 ? jt->euler : MLOD_EULER_ZXY;
+			l->euler = layout_euler(l->ch, l->n, fb);
+		} else {
+			/* No layout: positions and ZXY on roots, ZXY elsewhere. */
+			l->n = jt->parent < 0 ? 6 : 3;
+			memcpy(l->ch, jt->parent < 0 ? root6 : root6 + 3, (size_t)l->n);
+			l->euler = MLOD_EULER_ZXY;
+		}
+		layout_masks(l);
+		w->base_q[j] = mlod_quat_identity();
+		if (jt->parent < 0) {
+			mlod_trs bt;
+			if (mlod_mat4_to_trs(&jt->base, &bt, 1e-5f) == 0 && unit_scale(bt.s)) {
+				w->base_rigid[j] = 1;
+				w->base_q[j] = mlod_quat_normalize(bt.r);
+			}
+		}
+	}
+	return MLOD_OK;
+}
+
+/* The rest pose gives the OFFSETs, the End Sites and the skeleton's size. */
+static mlod_result writer_rest(writer *w, mlod_error *err)
+{
+	pose_frame(w, -1);
+	mlod_v3 lo = { HUGE_VALF, HUGE_VALF, HUGE_VALF }, hi = { -HUGE_VALF, -HUGE_VALF, -HUGE_VALF };
+	for (int j = 0; j < w->n; j++) {
+		const mlod_joint *jt = &w->c->skeleton.joints[j];
+		w->offset[j] = w->t[j];
+		w->end[j] = jt->end_site;
+		if (jt->has_end_site && !w->rigid[j]) {
+			/* Scaled: the End Site's place in the joint's rigid frame. */
+			world_frame(w, j);
+			mlod_v3 e = mlod_mat4_point(&w->world[j], jt->end_site);
+			w->end[j] = mlod_quat_rotate(mlod_quat_conjugate(w->fw_q[j]), mlod_v3_sub(e, w->fw_p[j]));
+		}
+		if (!finite_v3(w->offset[j]) || !finite_v3(w->end[j]))
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has a non-finite rest transform", jt->name);
+		mlod_v3 p = { w->world[j].m[12], w->world[j].m[13], w->world[j].m[14] };
+		lo.x = fminf(lo.x, p.x), lo.y = fminf(lo.y, p.y), lo.z = fminf(lo.z, p.z);
+		hi.x = fmaxf(hi.x, p.x), hi.y = fmaxf(hi.y, p.y), hi.z = fmaxf(hi.z, p.z);
+	}
+	double extent = fmax(hi.x - lo.x, fmax(hi.y - lo.y, hi.z - lo.z));
+	if (!(extent > 0.0) || !isfinite(extent))
+		extent = 1.0;
+	w->pos_tol = 1e-6 * extent;
+	return MLOD_OK;
+}
+
+/* Pass 1 over the frames: a joint whose translation leaves its OFFSET on
+ * an axis it has no position channel for, or that turns about an axis it
+ * has no rotation channel for, gets the missing channels. */
+static mlod_result writer_widen(writer *w, mlod_error *err)
+{
+	for (long f = 0; f < w->frames; f++) {
+		pose_frame(w, f);
+		for (int j = 0; j < w->n; j++) {
+			layout *l = &w->lay[j];
+			mlod_quat q = w->q[j];
+			if (!finite_v3(w->t[j]) || !isfinite(q.x) || !isfinite(q.y) || !isfinite(q.z) || !isfinite(q.w))
+				return mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has a non-finite transform in frame %ld",
+				                 w->c->skeleton.joints[j].name, f + 1);
+			float d[3] = { w->t[j].x - w->offset[j].x, w->t[j].y - w->offset[j].y, w->t[j].z - w->offset[j].z };
+			for (int a = 0; a < 3; a++)
+				if (!(l->pos_mask & (1 << a)) && fabs(d[a]) > w->pos_tol)
+					l->need_pos = 1;
+			if (l->rot_mask != 7 && !l->need_rot) {
+				double sol[2][3];
+				euler_solutions(l, q, sol);
+				if (!fits_layout(l, sol[0]) && !fits_layout(l, sol[1]))
+					l->need_rot = 1;
+			}
+		}
+	}
+	for (int j = 0; j < w->n; j++)
+		if (w->lay[j].need_pos || w->lay[j].need_rot)
+			layout_complete(&w->lay[j]);
+	return MLOD_OK;
 }
 
 /* A joint name safe for BVH: no blanks, braces or control bytes. */
@@ -1360,14 +1502,154 @@ static void put_indent(strbuf *b, int depth)
 		sb_char(b, '\t');
 }
 
-static void put_v3(strbuf *b, mlod_v3 v)
+static void put_offset(strbuf *b, int depth, mlod_v3 v)
 {
 	char num[64];
 	float c[3] = { v.x, v.y, v.z };
+	put_indent(b, depth);
+	sb_puts(b, "OFFSET");
 	for (int i = 0; i < 3; i++) {
 		format_float_exact(c[i], num);
 		sb_char(b, ' ');
 		sb_puts(b, num);
+	}
+	sb_char(b, '\n');
+}
+
+/* Opens joint j at the given depth: name, brace, OFFSET, CHANNELS. */
+static void put_joint_head(writer *w, int j, int depth)
+{
+	const mlod_joint *jt = &w->c->skeleton.joints[j];
+	const layout *l = &w->lay[j];
+	strbuf *b = &w->b;
+	put_indent(b, depth);
+	sb_puts(b, jt->parent < 0 ? "ROOT " : "JOINT ");
+	put_name(b, jt->name, j);
+	sb_char(b, '\n');
+	put_indent(b, depth);
+	sb_puts(b, "{\n");
+	put_offset(b, depth + 1, w->offset[j]);
+	put_indent(b, depth + 1);
+	sb_puts(b, "CHANNELS ");
+	sb_char(b, (char)('0' + l->n));
+	for (int k = 0; k < l->n; k++) {
+		sb_char(b, ' ');
+		sb_puts(b, channel_names[l->ch[k]]);
+	}
+	sb_char(b, '\n');
+}
+
+/* Closes joint j: its End Site, then the brace. */
+static void put_joint_tail(writer *w, int j, int depth)
+{
+	strbuf *b = &w->b;
+	if (w->c->skeleton.joints[j].has_end_site) {
+		put_indent(b, depth + 1);
+		sb_puts(b, "End Site\n");
+		put_indent(b, depth + 1);
+		sb_puts(b, "{\n");
+		put_offset(b, depth + 2, w->end[j]);
+		put_indent(b, depth + 1);
+		sb_puts(b, "}\n");
+	}
+	put_indent(b, depth);
+	sb_puts(b, "}\n");
+}
+
+/* The HIERARCHY, depth first without recursion; fills w->order. */
+static mlod_result write_hierarchy(writer *w, mlod_error *err)
+{
+	const mlod_skeleton *s = &w->c->skeleton;
+	size_t n = (size_t)w->n;
+	int *first_child = malloc(n * sizeof(int)), *next_sib = malloc(n * sizeof(int));
+	int *stack = malloc(n * sizeof(int)), *cursor = malloc(n * sizeof(int));
+	if (!first_child || !next_sib || !stack || !cursor) {
+		free(first_child);
+		free(next_sib);
+		free(stack);
+		free(cursor);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	/* Children lists in index order. */
+	for (int j = 0; j < w->n; j++)
+		first_child[j] = next_sib[j] = -1;
+	for (int j = w->n - 1; j >= 0; j--) {
+		int p = s->joints[j].parent;
+		if (p >= 0) {
+			next_sib[j] = first_child[p];
+			first_child[p] = j;
+		}
+	}
+	sb_puts(&w->b, "HIERARCHY\n");
+	int count = 0;
+	for (int root = 0; root < w->n; root++) {
+		if (s->joints[root].parent >= 0)
+			continue;
+		int depth = 1;
+		stack[0] = root;
+		w->order[count++] = root;
+		put_joint_head(w, root, 0);
+		cursor[root] = first_child[root];
+		while (depth > 0) {
+			int j = stack[depth - 1];
+			if (cursor[j] >= 0) {
+				int ch = cursor[j];
+				cursor[j] = next_sib[ch];
+				w->order[count++] = ch;
+				put_joint_head(w, ch, depth);
+				cursor[ch] = first_child[ch];
+				stack[depth++] = ch;
+			} else {
+				depth--;
+				put_joint_tail(w, j, depth);
+			}
+		}
+	}
+	free(first_child);
+	free(next_sib);
+	free(stack);
+	free(cursor);
+	return MLOD_OK;
+}
+
+/* Pass 2 over the frames: the MOTION. Positions are written as the
+ * shortest decimal of their float, angles to 1e-5 degree (2e-7 radian). */
+static void write_motion(writer *w)
+{
+	strbuf *b = &w->b;
+	char num[64];
+	sb_puts(b, "MOTION\nFrames: ");
+	num[utoa((unsigned long long)w->frames, num)] = 0;
+	sb_puts(b, num);
+	sb_puts(b, "\nFrame Time: ");
+	format_float_exact((float)w->ft, num);
+	sb_puts(b, num);
+	sb_char(b, '\n');
+	for (long f = 0; f < w->frames && !b->oom; f++) {
+		pose_frame(w, f);
+		int sep = 0;
+		for (int i = 0; i < w->n; i++) {
+			int j = w->order[i];
+			const layout *l = &w->lay[j];
+			double ang[3] = { 0.0, 0.0, 0.0 };
+			if (l->rot_mask) {
+				euler_pick(l, w->q[j], f > 0 ? w->prev + 3 * j : NULL, ang);
+				memcpy(w->prev + 3 * j, ang, sizeof ang);
+			}
+			float pos[3] = { w->t[j].x, w->t[j].y, w->t[j].z };
+			for (int k = 0; k < l->n; k++) {
+				int code = l->ch[k];
+				if (code < MLOD_BVH_XROT)
+					format_float_exact(pos[code], num);
+				else
+					format_number(ang[code - MLOD_BVH_XROT] * (180.0 / PI), 5, num);
+				if (sep)
+					sb_char(b, ' ');
+				sep = 1;
+				sb_puts(b, num);
+			}
+		}
+		sb_char(b, '\n');
 	}
 }
 
@@ -1399,6 +1681,7 @@ mlod_result mlod_bvh_write(const mlod_character *c, int clip, float frame_time, 
 	else if (clip >= 0 && !(clip == 0 && c->clip_count == 0))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "no clip %d (the character has %d)", clip, c->clip_count);
 
+	/* Frames at ft from 0 until the frame that reaches the clip's end. */
 	double ft = frame_time > 0.0f ? frame_time : cl && cl->frame_time > 0.0f ? cl->frame_time : 1.0 / 30.0;
 	long frames = 1;
 	if (cl && frame_time == 0.0f && cl->frame_time > 0.0f && cl->frame_count > 0) {
@@ -1419,253 +1702,29 @@ mlod_result mlod_bvh_write(const mlod_character *c, int clip, float frame_time, 
 	w.c = c;
 	w.clip = cl;
 	w.n = n;
-	size_t un = (size_t)n;
-	w.local = malloc(un * sizeof *w.local);
-	w.world = malloc(un * sizeof *w.world);
-	w.rigid = malloc(un * sizeof *w.rigid);
-	w.have_frame = malloc(un * sizeof *w.have_frame);
-	w.fw_q = malloc(un * sizeof *w.fw_q);
-	w.fw_p = malloc(un * sizeof *w.fw_p);
-	w.t = malloc(un * sizeof *w.t);
-	w.q = malloc(un * sizeof *w.q);
-	w.base_rigid = calloc(un, sizeof *w.base_rigid);
-	w.base_q = malloc(un * sizeof *w.base_q);
-	layout *lay = calloc(un, sizeof *lay);
-	mlod_v3 *offset = malloc(un * sizeof *offset);
-	mlod_v3 *end = malloc(un * sizeof *end);
-	double *prev = malloc(un * 3 * sizeof *prev);
-	int *first_child = malloc(un * sizeof(int)), *next_sib = malloc(un * sizeof(int));
-	int *stack = malloc(un * sizeof(int)), *cursor = malloc(un * sizeof(int)), *order = malloc(un * sizeof(int));
-	strbuf b = { NULL, 0, 0, 0 };
+	w.ft = ft;
+	w.frames = frames;
 	mlod_result res = MLOD_OK;
-	if (!w.local || !w.world || !w.rigid || !w.have_frame || !w.fw_q || !w.fw_p || !w.t || !w.q ||
-	    !w.base_rigid || !w.base_q || !lay || !offset || !end || !prev || !first_child || !next_sib ||
-	    !stack || !cursor || !order) {
+	if (!writer_alloc(&w))
 		res = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-		goto done;
-	}
-
-	/* Layouts, and the bases of roots. */
-	for (int j = 0; j < n; j++) {
-		const mlod_joint *jt = &s->joints[j];
-		layout *l = &lay[j];
-		if (jt->channel_count < 0 || jt->channel_count > 6) {
-			res = mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has %d BVH channels", jt->name,
-			                jt->channel_count);
-			goto done;
-		}
-		if (jt->channel_count > 0) {
-			int seen = 0;
-			for (int k = 0; k < jt->channel_count; k++) {
-				int code = jt->channels[k];
-				if (code > MLOD_BVH_ZROT || (seen & (1 << code))) {
-					res = mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has an invalid BVH channel layout",
-					                jt->name);
-					goto done;
-				}
-				seen |= 1 << code;
-				l->ch[l->n++] = (unsigned char)code;
-			}
-			mlod_euler_order fb = (int)jt->euler >= 0 && (int)jt->euler < 6 ? jt->euler : MLOD_EULER_ZXY;
-			l->euler = layout_euler(l->ch, l->n, fb);
-		} else {
-			static const unsigned char root6[6] = { MLOD_BVH_XPOS, MLOD_BVH_YPOS, MLOD_BVH_ZPOS,
-			                                        MLOD_BVH_ZROT, MLOD_BVH_XROT, MLOD_BVH_YROT };
-			l->n = jt->parent < 0 ? 6 : 3;
-			memcpy(l->ch, jt->parent < 0 ? root6 : root6 + 3, (size_t)l->n);
-			l->euler = MLOD_EULER_ZXY;
-		}
-		layout_masks(l);
-		w.base_q[j] = mlod_quat_identity();
-		if (jt->parent < 0) {
-			mlod_trs bt;
-			if (mlod_mat4_to_trs(&jt->base, &bt, 1e-5f) == 0 && unit_scale(bt.s)) {
-				w.base_rigid[j] = 1;
-				w.base_q[j] = mlod_quat_normalize(bt.r);
-			}
-		}
-	}
-
-	/* The rest pose gives the OFFSETs, the End Sites and the size. */
-	pose_frame(&w, -1, ft);
-	mlod_v3 lo = { HUGE_VALF, HUGE_VALF, HUGE_VALF }, hi = { -HUGE_VALF, -HUGE_VALF, -HUGE_VALF };
-	for (int j = 0; j < n; j++) {
-		const mlod_joint *jt = &s->joints[j];
-		offset[j] = w.t[j];
-		end[j] = jt->end_site;
-		if (jt->has_end_site && !w.rigid[j]) {
-			world_frame(&w, j);
-			mlod_v3 e = mlod_mat4_point(&w.world[j], jt->end_site);
-			end[j] = mlod_quat_rotate(mlod_quat_conjugate(w.fw_q[j]), mlod_v3_sub(e, w.fw_p[j]));
-		}
-		if (!finite_v3(offset[j]) || !finite_v3(end[j])) {
-			res = mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has a non-finite rest transform", jt->name);
-			goto done;
-		}
-		mlod_v3 p = { w.world[j].m[12], w.world[j].m[13], w.world[j].m[14] };
-		lo.x = fminf(lo.x, p.x), lo.y = fminf(lo.y, p.y), lo.z = fminf(lo.z, p.z);
-		hi.x = fmaxf(hi.x, p.x), hi.y = fmaxf(hi.y, p.y), hi.z = fmaxf(hi.z, p.z);
-	}
-	double extent = fmax(hi.x - lo.x, fmax(hi.y - lo.y, hi.z - lo.z));
-	if (!(extent > 0.0) || !isfinite(extent))
-		extent = 1.0;
-	double pos_tol = 1e-6 * extent;
-	/* Positions are written as the shortest decimal of their float, angles
-	 * to 1e-5 degree (about 2e-7 radian). */
-	const int ang_dec = 5;
-
-	/* Pass 1: which joints need channels their layout lacks. */
-	for (long f = 0; f < frames; f++) {
-		pose_frame(&w, f, ft);
-		for (int j = 0; j < n; j++) {
-			layout *l = &lay[j];
-			if (!finite_v3(w.t[j]) || !isfinite(w.q[j].x) || !isfinite(w.q[j].y) || !isfinite(w.q[j].z) ||
-			    !isfinite(w.q[j].w)) {
-				res = mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has a non-finite transform in frame %ld",
-				                s->joints[j].name, f + 1);
-				goto done;
-			}
-			float d[3] = { w.t[j].x - offset[j].x, w.t[j].y - offset[j].y, w.t[j].z - offset[j].z };
-			for (int a = 0; a < 3; a++)
-				if (!(l->pos_mask & (1 << a)) && fabs(d[a]) > pos_tol)
-					l->need_pos = 1;
-			if (l->rot_mask != 7 && !l->need_rot) {
-				double sol[2][3];
-				euler_solutions(l, w.q[j], sol);
-				if (!fits_layout(l, sol[0]) && !fits_layout(l, sol[1]))
-					l->need_rot = 1;
-			}
-		}
-	}
-	for (int j = 0; j < n; j++)
-		if (lay[j].need_pos || lay[j].need_rot)
-			layout_complete(&lay[j]);
-
-	/* The hierarchy, depth first; order[] is the file's joint order. */
-	for (int j = n - 1; j >= 0; j--) {
-		first_child[j] = -1;
-		next_sib[j] = -1;
-	}
-	for (int j = n - 1; j >= 0; j--) {
-		int p = s->joints[j].parent;
-		if (p >= 0) {
-			next_sib[j] = first_child[p];
-			first_child[p] = j;
-		}
-	}
-	sb_puts(&b, "HIERARCHY\n");
-	int count = 0;
-	for (int root = 0; root < n; root++) {
-		if (s->joints[root].parent >= 0)
-			continue;
-		int depth = 0;
-		stack[depth++] = root;
-		cursor[root] = -2; /* not opened yet */
-		while (depth > 0) {
-			int j = stack[depth - 1];
-			const mlod_joint *jt = &s->joints[j];
-			if (cursor[j] == -2) {
-				order[count++] = j;
-				put_indent(&b, depth - 1);
-				sb_puts(&b, jt->parent < 0 ? "ROOT " : "JOINT ");
-				put_name(&b, jt->name, j);
-				sb_char(&b, '\n');
-				put_indent(&b, depth - 1);
-				sb_puts(&b, "{\n");
-				put_indent(&b, depth);
-				sb_puts(&b, "OFFSET");
-				put_v3(&b, offset[j]);
-				sb_char(&b, '\n');
-				put_indent(&b, depth);
-				sb_puts(&b, "CHANNELS ");
-				sb_char(&b, (char)('0' + lay[j].n));
-				for (int k = 0; k < lay[j].n; k++) {
-					sb_char(&b, ' ');
-					sb_puts(&b, channel_names[lay[j].ch[k]]);
-				}
-				sb_char(&b, '\n');
-				cursor[j] = first_child[j];
-			}
-			if (cursor[j] >= 0) {
-				int ch = cursor[j];
-				cursor[j] = next_sib[ch];
-				cursor[ch] = -2;
-				stack[depth++] = ch;
-				continue;
-			}
-			if (jt->has_end_site) {
-				put_indent(&b, depth);
-				sb_puts(&b, "End Site\n");
-				put_indent(&b, depth);
-				sb_puts(&b, "{\n");
-				put_indent(&b, depth + 1);
-				sb_puts(&b, "OFFSET");
-				put_v3(&b, end[j]);
-				sb_char(&b, '\n');
-				put_indent(&b, depth);
-				sb_puts(&b, "}\n");
-			}
-			put_indent(&b, depth - 1);
-			sb_puts(&b, "}\n");
-			depth--;
-		}
-	}
-
-	/* Pass 2: the motion. */
-	char num[64];
-	sb_puts(&b, "MOTION\nFrames: ");
-	num[utoa((unsigned long long)frames, num)] = 0;
-	sb_puts(&b, num);
-	sb_puts(&b, "\nFrame Time: ");
-	format_float_exact((float)ft, num);
-	sb_puts(&b, num);
-	sb_char(&b, '\n');
-	for (long f = 0; f < frames && !b.oom; f++) {
-		pose_frame(&w, f, ft);
-		int sep = 0;
-		for (int i = 0; i < count; i++) {
-			int j = order[i];
-			const layout *l = &lay[j];
-			double ang[3] = { 0.0, 0.0, 0.0 };
-			if (l->rot_mask) {
-				euler_pick(l, w.q[j], f > 0 ? prev + 3 * j : NULL, ang);
-				memcpy(prev + 3 * j, ang, sizeof ang);
-			}
-			float pos[3] = { w.t[j].x, w.t[j].y, w.t[j].z };
-			for (int k = 0; k < l->n; k++) {
-				int code = l->ch[k];
-				if (code < MLOD_BVH_XROT)
-					format_float_exact(pos[code], num);
-				else
-					format_number(ang[code - MLOD_BVH_XROT] * (180.0 / PI), ang_dec, num);
-				if (sep)
-					sb_char(&b, ' ');
-				sep = 1;
-				sb_puts(&b, num);
-			}
-		}
-		sb_char(&b, '\n');
-	}
-	if (b.oom) {
+	if (res == MLOD_OK)
+		res = writer_layouts(&w, err);
+	if (res == MLOD_OK)
+		res = writer_rest(&w, err);
+	if (res == MLOD_OK)
+		res = writer_widen(&w, err);
+	if (res == MLOD_OK)
+		res = write_hierarchy(&w, err);
+	if (res == MLOD_OK)
+		write_motion(&w);
+	if (res == MLOD_OK && w.b.oom)
 		res = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing BVH");
-		goto done;
+	if (res == MLOD_OK) {
+		*text = w.b.s;
+		if (size)
+			*size = w.b.len;
+		w.b.s = NULL;
 	}
-	*text = b.s;
-	if (size)
-		*size = b.len;
-	b.s = NULL;
-
-done:
-	free(b.s);
 	writer_free(&w);
-	free(lay);
-	free(offset);
-	free(end);
-	free(prev);
-	free(first_child);
-	free(next_sib);
-	free(stack);
-	free(cursor);
-	free(order);
 	return res;
 }
