@@ -7,12 +7,19 @@
  * every joint with rotation channels (quaternions from the Euler angles,
  * kept sign-continuous from frame to frame) and a LINEAR translation channel
  * for every joint with position channels (the channel values replace the
- * matching OFFSET components; the others keep the OFFSET).
+ * matching OFFSET components; the others keep the OFFSET). Key i is at
+ * i * frame time. A partial layout ("CHANNELS 2 Zrotation Xrotation") is
+ * read as such and then completed to 3 or 6 channels, as the character
+ * model keeps them. Frames: 0, or no channels at all, gives no clip.
  *
- * The reader trusts nothing: every error names its line, sizes claimed by
- * the file are checked against the bytes actually present before anything
- * is allocated, and the hierarchy is parsed without recursion. Numbers are
- * parsed by hand, so the result does not depend on the C locale.
+ * The reader trusts nothing: every error names its line (frames are
+ * counted from 1 in messages), sizes claimed by the file are checked
+ * against the bytes actually present before anything is allocated, and
+ * the hierarchy is parsed without recursion. It accepts CR LF, LF or CR
+ * line ends, a UTF-8 byte order mark, keywords in any case, names with
+ * spaces, and braces on the line of what they open. Numbers are parsed by
+ * hand, so the result does not depend on the C locale; NaN and infinities
+ * are refused.
  *
  * Writing samples one clip at a uniform frame time. Each joint's BVH frame
  * is its rigid world frame: where the skeleton is rigid (unit scales) the
@@ -21,8 +28,11 @@
  * derived from the world matrices, so joint positions are reproduced even
  * under scale. A joint whose layout cannot express its motion (a translation
  * that differs from its OFFSET without position channels, a rotation about
- * an axis it has no channel for) is given the missing channels. Numbers are
- * formatted by hand as well.
+ * an axis it has no channel for) is given the missing channels. Euler
+ * angles continue across +-180 degrees from frame to frame. Positions are
+ * written as the shortest decimal that reads back as the same float,
+ * angles to 1e-5 degree; numbers are formatted by hand, without the
+ * locale. Joint names get '_' for blanks and braces.
  */
 #include <float.h>
 #include <math.h>
