@@ -968,6 +968,18 @@ bool embed_image(const std::string *, const std::string *, const tinygltf::Image
 	return true;
 }
 
+/* tinygltf 2.7 writes an object with only default properties (a scene
+ * without nodes, an unnamed node at the origin, {} inside extras) as
+ * null, which it never means: such nulls become {}. */
+void fill_empty_objects(json &j)
+{
+	if (j.is_null())
+		j = json::object();
+	else if (j.is_structured())
+		for (json &e : j)
+			fill_empty_objects(e);
+}
+
 /* Keys mlod may add to an object that came from the input. */
 bool added_by_mlod(const std::string &key)
 {
@@ -1015,6 +1027,7 @@ std::string serialize(const mlod_gltf &doc, bool binary)
 	} else {
 		j = json::parse(written);
 	}
+	fill_empty_objects(j);
 	if (!doc.original.is_null())
 		reconcile(j, doc.original, true, false);
 	/* tinygltf skips animations without channels, which shifts indices. */

@@ -658,6 +658,37 @@ TEST(from_character)
 	CHECK(notes);
 }
 
+/* Objects with only default properties (an empty scene, an unnamed joint
+ * at the origin) are written as {}, not null. */
+TEST(empty_objects)
+{
+	mlod_character c = {0};
+	mlod_gltf *doc = NULL, *again = NULL;
+	CHECK_OK(mlod_gltf_from_character(&c, &doc, &terr));
+	char *empty = gltf_text(doc);
+	mlod_gltf_free(doc);
+	c.skeleton.joint_count = 1;
+	c.skeleton.joints = calloc(1, sizeof(mlod_joint));
+	c.skeleton.joints[0].name = dup("");
+	c.skeleton.joints[0].parent = -1;
+	c.skeleton.joints[0].rest = mlod_trs_identity();
+	c.skeleton.joints[0].base = mlod_mat4_identity();
+	mlod_result r = mlod_gltf_from_character(&c, &doc, &terr);
+	mlod_character_free(&c);
+	char *one = r == MLOD_OK ? gltf_text(doc) : NULL;
+	if (r == MLOD_OK)
+		r = reread(doc, &again);
+	int nodes = mlod_gltf_count(again, MLOD_GLTF_NODE);
+	mlod_gltf_free(doc);
+	mlod_gltf_free(again);
+	int no_null = empty && one && !strstr(empty, "null") && !strstr(one, "null");
+	free(empty);
+	free(one);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	CHECK(no_null);
+	CHECK(nodes == 1);
+}
+
 /* A BVH skeleton in glTF (no skins) comes back from its animated nodes,
  * End Sites included. */
 TEST(bvh_via_gltf)
@@ -1164,6 +1195,7 @@ int main(void)
 	RUN(from_character);
 	RUN(robot_via_character);
 	RUN(bvh_via_gltf);
+	RUN(empty_objects);
 	RUN(reskinned_mesh);
 	RUN(decode_layouts);
 	RUN(empty_and_garbage);
