@@ -66,11 +66,16 @@ static int build_levels(const mlod_character *c, mlod_joint_info *info, mlod_ske
 	    mlod_skelgraph_build(&c->skeleton, info, g, &err) != MLOD_OK)
 		return -1;
 	static const double fractions[] = {0.13, 0.26, 0.39};
+	int *order = malloc(sizeof(int) * (size_t)n);
+	int minors = mlod_skel_removal_order(&c->skeleton, info, order);
 	for (int k = 0; k < 3; k++) {
-		double t = mlod_skel_threshold_for(&c->skeleton, info, (int)lround(fractions[k] * n));
-		if (mlod_skelgraph_extract(g, info, t, &levels[k], &err) != MLOD_OK)
+		int removed = (int)lround(fractions[k] * n);
+		if (mlod_skelgraph_extract_first(g, info, order, removed < minors ? removed : minors, &levels[k], &err) != MLOD_OK) {
+			free(order);
 			return -1;
+		}
 	}
+	free(order);
 	return 0;
 }
 
@@ -93,11 +98,15 @@ static int bench_graph(int argc, char **argv)
 			double t0 = now();
 			mlod_label_skeleton(&c, NULL, info, &err);
 			double t1 = now();
+			int *order = malloc(sizeof(int) * (size_t)n);
+			int minors = mlod_skel_removal_order(&c.skeleton, info, order);
 			mlod_skelgraph_build(&c.skeleton, info, &g, &err);
-			for (int k = 0; k < 3; k++)
-				mlod_skelgraph_extract(&g, info, mlod_skel_threshold_for(&c.skeleton, info, (int)lround(0.13 * (k + 1) * n)),
-				                       &levels[k], &err);
+			for (int k = 0; k < 3; k++) {
+				int removed = (int)lround(0.13 * (k + 1) * n);
+				mlod_skelgraph_extract_first(&g, info, order, removed < minors ? removed : minors, &levels[k], &err);
+			}
 			double t2 = now();
+			free(order);
 			tl[r] = t1 - t0;
 			tg[r] = t2 - t1;
 			edges = g.edge_count;

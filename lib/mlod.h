@@ -567,10 +567,19 @@ mlod_result mlod_skelgraph_extract(const mlod_skelgraph *g, const mlod_joint_inf
                                    double threshold, mlod_skel_level *out, mlod_error *err);
 void mlod_skel_level_free(mlod_skel_level *l);
 
-/* The threshold that removes the `removed` lowest-energy minor joints
- * (ties broken by joint index are kept together: the result may remove a
- * few more). Returns 0 when removed <= 0. */
-double mlod_skel_threshold_for(const mlod_skeleton *s, const mlod_joint_info *info, int removed);
+/* The paper's decimation order: the minor joints sorted by energy, lowest
+ * first; equal energies (joints that never move relative to their parent)
+ * go deepest first, then by index. Writes the minor joints to order
+ * (joint_count entries suffice) and returns how many there are. */
+int mlod_skel_removal_order(const mlod_skeleton *s, const mlod_joint_info *info, int *order);
+
+/* Extracts the level that removes the first `removed` joints of order, as
+ * mlod_skelgraph_extract does for a threshold. Levels with increasing
+ * counts are nested. out->threshold is the energy of the last removed
+ * joint (0 when none). */
+mlod_result mlod_skelgraph_extract_first(const mlod_skelgraph *g, const mlod_joint_info *info,
+                                         const int *order, int removed, mlod_skel_level *out,
+                                         mlod_error *err);
 
 /* A level as measured, for mlod_gltf_add_skel_levels. */
 typedef struct mlod_skel_level_record {

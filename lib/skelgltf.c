@@ -136,8 +136,7 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
 		for (int k = 1; k <= count; k++)
 			if (coverage[k] > coverage[k - 1])
 				coverage[k] = coverage[k - 1];
-		r = mlod_gltf_set_lod(doc, in->node, lod_nodes, count, coverage, err);
-		if (r != MLOD_OK)
+		if (count > 0 && (r = mlod_gltf_set_lod(doc, in->node, lod_nodes, count, coverage, err)) != MLOD_OK)
 			goto done;
 	}
 

@@ -190,24 +190,20 @@ static int find(int *uf, int x)
 	return x;
 }
 
-mlod_result mlod_skelgraph_extract(const mlod_skelgraph *g, const mlod_joint_info *info,
-                                   double threshold, mlod_skel_level *out, mlod_error *err)
+/* The minimum spanning tree of the joints with out->kept set. */
+static mlod_result extract(const mlod_skelgraph *g, mlod_skel_level *out, mlod_error *err)
 {
 	int n = g->joint_count;
-	memset(out, 0, sizeof *out);
-	out->threshold = threshold;
-	out->joint_count = n;
-	out->kept = calloc((size_t)n, 1);
 	out->parent = malloc(sizeof(int) * (size_t)n);
 	out->remap = malloc(sizeof(int) * (size_t)n);
 	int *uf = malloc(sizeof(int) * (size_t)n);
-	if (!out->kept || !out->parent || !out->remap || !uf) {
+	if (!out->parent || !out->remap || !uf) {
 		free(uf);
 		mlod_skel_level_free(out);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory extracting a skeleton level");
 	}
+	out->kept_count = 0;
 	for (int j = 0; j < n; j++) {
-		out->kept[j] = !is_minor(info, j) || info[j].energy >= threshold;
 		out->kept_count += out->kept[j];
 		out->parent[j] = -1;
 		uf[j] = j;
@@ -241,37 +237,67 @@ mlod_result mlod_skelgraph_extract(const mlod_skelgraph *g, const mlod_joint_inf
 	return MLOD_OK;
 }
 
-double mlod_skel_threshold_for(const mlod_skeleton *s, const mlod_joint_info *info, int removed)
+static mlod_result level_init(const mlod_skelgraph *g, mlod_skel_level *out, mlod_error *err)
 {
-	if (removed <= 0)
-		return 0.0;
-	double below = -1.0, above = -1.0;
-	int n = s->joint_count, minors = 0;
-	double *e = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1));
-	if (!e)
-		return 0.0;
-	for (int j = 0; j < n; j++)
+	memset(out, 0, sizeof *out);
+	out->joint_count = g->joint_count;
+	out->kept = calloc((size_t)(g->joint_count > 0 ? g->joint_count : 1), 1);
+	if (!out->kept)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory extracting a skeleton level");
+	return MLOD_OK;
+}
+
+mlod_result mlod_skelgraph_extract(const mlod_skelgraph *g, const mlod_joint_info *info,
+                                   double threshold, mlod_skel_level *out, mlod_error *err)
+{
+	mlod_result r = level_init(g, out, err);
+	if (r != MLOD_OK)
+		return r;
+	out->threshold = threshold;
+	for (int j = 0; j < g->joint_count; j++)
+		out->kept[j] = !is_minor(info, j) || info[j].energy >= threshold;
+	return extract(g, out, err);
+}
+
+mlod_result mlod_skelgraph_extract_first(const mlod_skelgraph *g, const mlod_joint_info *info,
+                                         const int *order, int removed, mlod_skel_level *out,
+                                         mlod_error *err)
+{
+	mlod_result r = level_init(g, out, err);
+	if (r != MLOD_OK)
+		return r;
+	memset(out->kept, 1, (size_t)g->joint_count);
+	for (int i = 0; i < removed; i++) {
+		int j = order[i];
+		if (j < 0 || j >= g->joint_count || !is_minor(info, j)) {
+			mlod_skel_level_free(out);
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "removal order entry %d (joint %d) is not a minor joint", i, j);
+		}
+		out->kept[j] = 0;
+		out->threshold = info[j].energy;
+	}
+	return extract(g, out, err);
+}
+
+/* Sort key of the removal order. */
+static int removal_order_cmp(const void *pa, const void *pb)
+{
+	int a = *(const int *)pa, b = *(const int *)pb;
+	if (sort_info[a].energy != sort_info[b].energy)
+		return sort_info[a].energy < sort_info[b].energy ? -1 : 1;
+	if (sort_info[a].depth != sort_info[b].depth)
+		return sort_info[a].depth > sort_info[b].depth ? -1 : 1;
+	return (a > b) - (a < b);
+}
+
+int mlod_skel_removal_order(const mlod_skeleton *s, const mlod_joint_info *info, int *order)
+{
+	int n = 0;
+	for (int j = 0; j < s->joint_count; j++)
 		if (is_minor(info, j))
-			e[minors++] = info[j].energy;
-	/* Insertion sort: skeletons have at most a few hundred joints. */
-	for (int i = 1; i < minors; i++) {
-		double v = e[i];
-		int k = i;
-		for (; k > 0 && e[k - 1] > v; k--)
-			e[k] = e[k - 1];
-		e[k] = v;
-	}
-	if (minors == 0) {
-		free(e);
-		return 0.0;
-	}
-	if (removed > minors)
-		removed = minors;
-	below = e[removed - 1];
-	for (int i = removed; i < minors && above < 0.0; i++)
-		if (e[i] > below)
-			above = e[i];
-	free(e);
-	/* Everything at or below `below` goes; the next distinct energy stays. */
-	return above < 0.0 ? below * 2.0 + 1.0 : 0.5 * (below + above);
+			order[n++] = j;
+	sort_info = info;
+	qsort(order, (size_t)n, sizeof *order, removal_order_cmp);
+	sort_info = NULL;
+	return n;
 }

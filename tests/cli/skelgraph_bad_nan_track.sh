@@ -1,0 +1,1 @@
+"$BIN/mlod-skelgraph" --report "$ROOT/tests/data/bad/nan_track.gltf"

@@ -1,0 +1,405 @@
+/* test_skelgraph.c: the Multiresolution Skeletal Graph, level extraction,
+ * motion folding and skin transfer. */
+#include "test.h"
+
+/* A skeleton from a parent array, bones of length 1 along y. */
+static mlod_character make_skeleton(int n, const int *parent)
+{
+	mlod_character c = {0};
+	c.skeleton.joint_count = n;
+	c.skeleton.joints = calloc((size_t)n, sizeof(mlod_joint));
+	for (int j = 0; j < n; j++) {
+		mlod_joint *jt = &c.skeleton.joints[j];
+		char name[16];
+		snprintf(name, sizeof name, "j%d", j);
+		jt->name = strdup(name);
+		jt->parent = parent[j];
+		jt->rest = mlod_trs_identity();
+		jt->rest.t.y = parent[j] >= 0 ? 1.0f : 0.0f;
+		jt->base = mlod_mat4_identity();
+		jt->node = -1;
+	}
+	return c;
+}
+
+static int load_sample(const char *path, mlod_character *c)
+{
+	size_t size;
+	void *data = test_read_file(path, &size);
+	if (!data)
+		return -1;
+	mlod_error e = {0};
+	mlod_result r = mlod_load(data, size, "samples", NULL, c, NULL, &e);
+	free(data);
+	if (r != MLOD_OK)
+		fprintf(stderr, "%s: %s\n", path, e.message);
+	return r == MLOD_OK ? 0 : -1;
+}
+
+TEST(chain_closure)
+{
+	/* root 0 - 1 - 2 - 3 - leaf 4: one chain, 4 + 3 + 2 + 1 edges. */
+	int parent[] = {-1, 0, 1, 2, 3};
+	mlod_character c = make_skeleton(5, parent);
+	mlod_joint_info info[5];
+	mlod_skelgraph g;
+	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
+	CHECK_OK(mlod_skelgraph_build(&c.skeleton, info, &g, &terr));
+	CHECK(g.chain_count == 1);
+	CHECK(g.chain_start[1] - g.chain_start[0] == 5);
+	CHECK(g.edge_count == 10);
+	for (int e = 0; e < g.edge_count; e++) {
+		const mlod_skelgraph_edge *edge = &g.edges[e];
+		CHECK_NEAR(edge->length, (double)(edge->b - edge->a), 1e-6);
+	}
+	/* Remove everything minor: the leaf hangs from the root. */
+	mlod_skel_level l;
+	CHECK_OK(mlod_skelgraph_extract(&g, info, 1e30, &l, &terr));
+	CHECK(l.kept_count == 2);
+	CHECK(l.parent[4] == 0);
+	CHECK(l.remap[2] == 0 && l.remap[4] == 4);
+	mlod_skel_level_free(&l);
+	mlod_skelgraph_free(&g);
+	mlod_character_free(&c);
+}
+
+TEST(star_has_one_chain_per_bone)
+{
+	int parent[] = {-1, 0, 0, 0, 0};
+	mlod_character c = make_skeleton(5, parent);
+	mlod_joint_info info[5];
+	mlod_skelgraph g;
+	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
+	CHECK_OK(mlod_skelgraph_build(&c.skeleton, info, &g, &terr));
+	CHECK(g.chain_count == 4);
+	CHECK(g.edge_count == 4);
+	mlod_skelgraph_free(&g);
+	mlod_character_free(&c);
+}
+
+TEST(two_roots)
+{
+	int parent[] = {-1, 0, 1, -1, 3, 4};
+	mlod_character c = make_skeleton(6, parent);
+	mlod_joint_info info[6];
+	mlod_skelgraph g;
+	mlod_skel_level l;
+	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
+	CHECK_OK(mlod_skelgraph_build(&c.skeleton, info, &g, &terr));
+	CHECK(g.chain_count == 2);
+	CHECK_OK(mlod_skelgraph_extract(&g, info, 1.0, &l, &terr));
+	CHECK(l.kept_count == 4);
+	CHECK(l.parent[2] == 0 && l.parent[5] == 3 && l.parent[3] == -1);
+	mlod_skel_level_free(&l);
+	mlod_skelgraph_free(&g);
+	mlod_character_free(&c);
+}
+
+/* Zero-length bones make equal closure lengths: the tie goes to the deeper
+ * ancestor, so the level still reconnects to the nearest kept ancestor. */
+TEST(zero_length_bones)
+{
+	int parent[] = {-1, 0, 1, 2, 3};
+	mlod_character c = make_skeleton(5, parent);
+	c.skeleton.joints[1].rest.t.y = 0.0f;
+	c.skeleton.joints[2].rest.t.y = 0.0f;
+	mlod_joint_info info[5];
+	mlod_skelgraph g;
+	mlod_skel_level l;
+	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
+	info[1].energy = 1.0;
+	info[2].energy = 1.0;
+	info[3].energy = 0.0;
+	CHECK_OK(mlod_skelgraph_build(&c.skeleton, info, &g, &terr));
+	CHECK_OK(mlod_skelgraph_extract(&g, info, 0.5, &l, &terr));
+	CHECK(l.parent[1] == 0 && l.parent[2] == 1 && l.parent[4] == 2);
+	mlod_skel_level_free(&l);
+	mlod_skelgraph_free(&g);
+	mlod_character_free(&c);
+}
+
+/* Oracle: the MST extraction equals nearest-kept-ancestor reconnection, the
+ * levels nest, and every threshold between two energies is tried. */
+static void check_oracle(const mlod_character *c)
+{
+	int n = c->skeleton.joint_count;
+	mlod_joint_info *info = calloc((size_t)n, sizeof *info);
+	mlod_skelgraph g;
+	CHECK_OK(mlod_label_skeleton(c, NULL, info, &terr));
+	CHECK_OK(mlod_skelgraph_build(&c->skeleton, info, &g, &terr));
+	unsigned char *prev = calloc((size_t)n, 1);
+	memset(prev, 1, (size_t)n);
+	int *order = malloc(sizeof(int) * (size_t)n);
+	int minors = mlod_skel_removal_order(&c->skeleton, info, order);
+	for (int removed = 0; removed <= minors; removed++) {
+		mlod_skel_level l;
+		CHECK_OK(mlod_skelgraph_extract_first(&g, info, order, removed, &l, &terr));
+		CHECK(l.kept_count == n - removed);
+		/* The same level by threshold when the energies do not tie. */
+		if (removed > 0 && (removed == minors || info[order[removed]].energy > info[order[removed - 1]].energy)) {
+			mlod_skel_level lt;
+			double th = removed == minors ? 1e300 : 0.5 * (info[order[removed]].energy + info[order[removed - 1]].energy);
+			CHECK_OK(mlod_skelgraph_extract(&g, info, th, &lt, &terr));
+			CHECK(memcmp(lt.kept, l.kept, (size_t)n) == 0);
+			mlod_skel_level_free(&lt);
+		}
+		double t = l.threshold;
+		for (int j = 0; j < n; j++) {
+			CHECK_MSG(!l.kept[j] || prev[j], "level at %g keeps %s removed earlier", t, c->skeleton.joints[j].name);
+			if (!l.kept[j])
+				continue;
+			int a = c->skeleton.joints[j].parent;
+			while (a >= 0 && !l.kept[a])
+				a = c->skeleton.joints[a].parent;
+			CHECK_MSG(l.parent[j] == a, "joint %s: MST parent %d, nearest kept ancestor %d",
+			          c->skeleton.joints[j].name, l.parent[j], a);
+		}
+		memcpy(prev, l.kept, (size_t)n);
+		mlod_skel_level_free(&l);
+	}
+	free(prev);
+	free(order);
+	free(info);
+	mlod_skelgraph_free(&g);
+}
+
+TEST(mst_equals_nearest_kept_ancestor)
+{
+	const char *samples[] = {"samples/cmu_12_01_walk.bvh", "samples/RobotExpressive.glb", "samples/tubeman.glb",
+	                         "tests/data/mixed_channels.bvh", "tests/data/two_roots.bvh"};
+	for (size_t i = 0; i < sizeof samples / sizeof *samples; i++) {
+		mlod_character c = {0};
+		CHECK_MSG(load_sample(samples[i], &c) == 0, "cannot load %s", samples[i]);
+		check_oracle(&c);
+		mlod_character_free(&c);
+		if (test_failed_)
+			return;
+	}
+}
+
+/* The world transform of every kept joint at every key time or frame
+ * matches the full skeleton within 1e-5 of the skeleton size. */
+static void check_folding(const mlod_character *c, double fraction)
+{
+	const mlod_skeleton *s = &c->skeleton;
+	int n = s->joint_count;
+	mlod_joint_info *info = calloc((size_t)n, sizeof *info);
+	mlod_skelgraph g;
+	mlod_skel_level l;
+	mlod_character r = {0};
+	mlod_fold_stats st;
+	CHECK_OK(mlod_label_skeleton(c, NULL, info, &terr));
+	CHECK_OK(mlod_skelgraph_build(s, info, &g, &terr));
+	int *order = malloc(sizeof(int) * (size_t)n);
+	int minors = mlod_skel_removal_order(s, info, order);
+	int removed = (int)(fraction * n) < minors ? (int)(fraction * n) : minors;
+	CHECK_OK(mlod_skelgraph_extract_first(&g, info, order, removed, &l, &terr));
+	free(order);
+	CHECK_OK(mlod_skel_level_apply(c, &l, &r, &st, &terr));
+	CHECK_OK(mlod_character_validate(&r, &terr));
+	CHECK(r.skeleton.joint_count == l.kept_count);
+	CHECK(st.shear_samples == 0);
+	double size = mlod_skeleton_size(s);
+	mlod_trs *pa = malloc(sizeof *pa * (size_t)n), *pb = malloc(sizeof *pb * (size_t)n);
+	mlod_mat4 *wa = malloc(sizeof *wa * (size_t)n), *wb = malloc(sizeof *wb * (size_t)n);
+	for (int k = 0; k < c->clip_count; k++) {
+		const mlod_clip *clip = &c->clips[k];
+		/* Every frame of a sampled clip, or every key time of every channel. */
+		int frames = clip->frame_count;
+		for (int i = 0; i < clip->channel_count && clip->frame_count <= 0; i++)
+			frames += clip->channels[i].key_count;
+		for (int f = 0, ci = 0, key = 0; f < frames; f++) {
+			float t;
+			if (clip->frame_count > 0) {
+				t = (float)f * clip->frame_time;
+			} else {
+				while (key >= clip->channels[ci].key_count)
+					ci++, key = 0;
+				t = clip->channels[ci].times[key++];
+			}
+			mlod_pose_rest(s, pa);
+			mlod_clip_sample(clip, t, pa);
+			mlod_pose_world(s, pa, wa);
+			mlod_pose_rest(&r.skeleton, pb);
+			mlod_clip_sample(&r.clips[k], t, pb);
+			mlod_pose_world(&r.skeleton, pb, wb);
+			for (int j = 0, nj = 0; j < n; j++) {
+				if (!l.kept[j])
+					continue;
+				for (int e = 0; e < 16; e++) {
+					/* relative to the column's length (world matrices carry
+					 * the armature's scale) or to the skeleton size */
+					const float *col = &wa[j].m[4 * (e / 4)];
+					double norm = sqrt((double)col[0] * col[0] + (double)col[1] * col[1] + (double)col[2] * col[2]);
+					double tol = 1e-5 * (e >= 12 ? size : norm);
+					CHECK_MSG(fabs(wa[j].m[e] - wb[nj].m[e]) <= tol,
+					          "clip %d t=%g joint %s m[%d]: %g vs %g", k, t, s->joints[j].name, e,
+					          wa[j].m[e], wb[nj].m[e]);
+				}
+				nj++;
+			}
+		}
+	}
+	/* Weights: sum 1, at most 4 per set, indices inside the reduced skin. */
+	for (int m = 0; m < r.mesh_count; m++) {
+		for (int p = 0; p < r.meshes[m].primitive_count; p++) {
+			const mlod_primitive *q = &r.meshes[m].primitives[p];
+			int skin = -1;
+			for (int i = 0; i < r.instance_count; i++)
+				if (r.instances[i].mesh == m && r.instances[i].skin >= 0)
+					skin = r.instances[i].skin;
+			if (skin < 0 || q->weight_set_count == 0)
+				continue;
+			for (int v = 0; v < q->vertex_count; v++) {
+				double sum = 0;
+				for (int ws = 0; ws < q->weight_set_count; ws++) {
+					for (int i = 0; i < 4; i++) {
+						sum += q->weights[ws][4 * v + i];
+						CHECK(q->joints[ws][4 * v + i] < r.skeleton.skins[skin].joint_count);
+					}
+				}
+				CHECK_MSG(fabs(sum - 1.0) <= 1e-6 || sum == 0.0, "mesh %d vertex %d: weights sum to %.9g", m, v, sum);
+			}
+		}
+	}
+	free(pa), free(pb), free(wa), free(wb), free(info);
+	mlod_character_free(&r);
+	mlod_skel_level_free(&l);
+	mlod_skelgraph_free(&g);
+}
+
+TEST(folding_is_exact)
+{
+	const char *samples[] = {"samples/cmu_12_01_walk.bvh", "samples/RobotExpressive.glb", "samples/tubeman.glb",
+	                         "tests/data/mixed_channels.bvh"};
+	for (size_t i = 0; i < sizeof samples / sizeof *samples; i++) {
+		mlod_character c = {0};
+		CHECK_MSG(load_sample(samples[i], &c) == 0, "cannot load %s", samples[i]);
+		check_folding(&c, 0.39);
+		check_folding(&c, 0.2);
+		mlod_character_free(&c);
+		if (test_failed_)
+			return;
+	}
+}
+
+/* A removed joint with non-uniform scale under a rotated child shears:
+ * the fold reports it. */
+TEST(shear_is_detected)
+{
+	int parent[] = {-1, 0, 1, 2};
+	mlod_character c = make_skeleton(4, parent);
+	c.skeleton.joints[1].rest.s = (mlod_v3){1.0f, 3.0f, 1.0f};
+	mlod_v3 z = {0, 0, 1};
+	c.skeleton.joints[2].rest.r = mlod_quat_axis_angle(z, 0.7f);
+	mlod_joint_info info[4];
+	mlod_skelgraph g;
+	mlod_skel_level l;
+	mlod_character r;
+	mlod_fold_stats st;
+	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
+	CHECK_OK(mlod_skelgraph_build(&c.skeleton, info, &g, &terr));
+	info[1].energy = 0.0;
+	info[2].energy = 1.0;
+	CHECK_OK(mlod_skelgraph_extract(&g, info, 0.5, &l, &terr));
+	CHECK(!l.kept[1] && l.kept[2]);
+	CHECK_OK(mlod_skel_level_apply(&c, &l, &r, &st, &terr));
+	CHECK(st.shear_samples > 0);
+	mlod_character_free(&r);
+	mlod_skel_level_free(&l);
+	mlod_skelgraph_free(&g);
+	mlod_character_free(&c);
+}
+
+/* Weight on a removed joint moves to its stand-in and merges. */
+TEST(skin_transfer_merges)
+{
+	int parent[] = {-1, 0, 1, 2};
+	mlod_character c = make_skeleton(4, parent);
+	c.skeleton.skin_count = 1;
+	c.skeleton.skins = calloc(1, sizeof(mlod_skin));
+	mlod_skin *sk = &c.skeleton.skins[0];
+	sk->name = strdup("skin");
+	sk->joint_count = 3;
+	sk->joints = malloc(3 * sizeof(int));
+	sk->inverse_bind = malloc(3 * sizeof(mlod_mat4));
+	int joints[] = {0, 1, 2}; /* joint 3 (the leaf) is not in the skin */
+	for (int k = 0; k < 3; k++) {
+		sk->joints[k] = joints[k];
+		mlod_mat4 m = mlod_mat4_identity();
+		m.m[13] = -(float)joints[k];
+		sk->inverse_bind[k] = m;
+	}
+	c.mesh_count = 1;
+	c.meshes = calloc(1, sizeof(mlod_mesh));
+	c.meshes[0].name = strdup("m");
+	c.meshes[0].primitive_count = 1;
+	c.meshes[0].primitives = calloc(1, sizeof(mlod_primitive));
+	mlod_primitive *p = &c.meshes[0].primitives[0];
+	p->vertex_count = 3;
+	p->mode = 4;
+	p->material = -1;
+	p->positions = calloc(9, sizeof(float));
+	p->positions[4] = 1.5f;
+	p->index_count = 3;
+	p->indices = malloc(3 * sizeof(uint32_t));
+	for (int i = 0; i < 3; i++)
+		p->indices[i] = (uint32_t)i;
+	p->weight_set_count = 1;
+	p->joints[0] = calloc(12, sizeof(uint16_t));
+	p->weights[0] = calloc(12, sizeof(float));
+	/* vertex 1: half on joint 0, half on joint 1 (to be removed) */
+	p->joints[0][4] = 0, p->weights[0][4] = 0.5f;
+	p->joints[0][5] = 1, p->weights[0][5] = 0.5f;
+	p->weights[0][0] = 1.0f;
+	p->joints[0][8] = 2, p->weights[0][8] = 1.0f;
+	c.instance_count = 1;
+	c.instances = calloc(1, sizeof(mlod_instance));
+	c.instances[0] = (mlod_instance){0, -1, 0, -1, mlod_mat4_identity()};
+
+	mlod_joint_info info[4];
+	mlod_skelgraph g;
+	mlod_skel_level l;
+	mlod_character r;
+	mlod_fold_stats st;
+	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
+	info[1].energy = 0.0;
+	info[2].energy = 1.0;
+	CHECK_OK(mlod_skelgraph_build(&c.skeleton, info, &g, &terr));
+	CHECK_OK(mlod_skelgraph_extract(&g, info, 0.5, &l, &terr));
+	CHECK_OK(mlod_skel_level_apply(&c, &l, &r, &st, &terr));
+	CHECK(st.weight_merges == 1);
+	const mlod_skin *rs = &r.skeleton.skins[0];
+	CHECK(rs->joint_count == 2);
+	const mlod_primitive *q = &r.meshes[0].primitives[0];
+	CHECK(rs->joints[q->joints[0][4]] == 0);
+	CHECK_NEAR(q->weights[0][4], 1.0, 1e-7);
+	CHECK_NEAR(q->weights[0][5], 0.0, 0.0);
+	/* The rest pose still skins to the bind positions. */
+	mlod_trs pose[3];
+	mlod_mat4 world[3], mats[2];
+	float out[9];
+	mlod_pose_rest(&r.skeleton, pose);
+	mlod_pose_world(&r.skeleton, pose, world);
+	mlod_skin_matrices(rs, world, mats);
+	mlod_skin_primitive(q, mats, out, NULL);
+	for (int i = 0; i < 9; i++)
+		CHECK_NEAR(out[i], p->positions[i], 1e-6);
+	mlod_character_free(&r);
+	mlod_skel_level_free(&l);
+	mlod_skelgraph_free(&g);
+	mlod_character_free(&c);
+}
+
+int main(void)
+{
+	RUN(chain_closure);
+	RUN(star_has_one_chain_per_bone);
+	RUN(two_roots);
+	RUN(zero_length_bones);
+	RUN(mst_equals_nearest_kept_ancestor);
+	RUN(folding_is_exact);
+	RUN(shear_is_detected);
+	RUN(skin_transfer_merges);
+	TEST_EXIT();
+}

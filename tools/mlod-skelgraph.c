@@ -1,0 +1,455 @@
+/*
+ * mlod-skelgraph: builds the Multiresolution Skeletal Graph and extracts
+ * nested skeleton levels (paper 4.1.3), with folded motion, transferred
+ * skin weights and the measured error of each level.
+ *
+ * Output: a glb where each level is recorded in extras.mlod of the skins
+ * and the scene, and becomes a real glTF skin over the kept joints (plus a
+ * mesh with the transferred weights); or, with --level K, a BVH of level K;
+ * or a report.
+ */
+#define _GNU_SOURCE /* getopt_long */
+
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common.h"
+
+#define MAX_LEVELS 32
+#define DEFAULT_MAX_ERROR 2.0 /* percent of the skeleton height */
+#define MEASURE_SAMPLES 120   /* measured times per clip */
+
+static const char usage_text[] =
+	"usage: mlod-skelgraph [options] [input]\n"
+	"\n"
+	"Builds the Multiresolution Skeletal Graph of a character and extracts nested\n"
+	"skeleton levels by joint energy. Input is glb, glTF or BVH (labels come from\n"
+	"mlod-label's extras when present). Output is a glb with the levels.\n"
+	"\n"
+	"options:\n"
+	"  -o, --output FILE       write to FILE instead of stdout; a .bvh name writes\n"
+	"                          the level chosen by --level as BVH\n"
+	"  -r, --report[=FORMAT]   print the levels instead; FORMAT is table or json\n"
+	"  -t, --thresholds LIST   levels at these energy thresholds (E1,E2,...)\n"
+	"  -j, --joints LIST       levels keeping these fractions of the joints (0.8,0.6)\n"
+	"  -e, --max-error PCT     default levels stop before the error exceeds PCT\n"
+	"                          percent of the skeleton height (default 2)\n"
+	"  -l, --level K           with a .bvh output: the level to write (0 = full)\n"
+	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
+	"      --hub-factor F      labels' hub factor when they are computed (1.9)\n"
+	"  -h, --help              show this help\n"
+	"  -V, --version           show the version\n"
+	"\n"
+	"Default levels remove 13%, 26% and 39% of the joints (the paper's figure),\n"
+	"stopping at the last level within --max-error.\n"
+	"\n"
+	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
+	"4 output failure.\n";
+
+enum report { REPORT_NONE, REPORT_TABLE, REPORT_JSON };
+
+struct level {
+	mlod_skel_level skel;
+	mlod_character c;        /* the level as a standalone character */
+	mlod_fold_stats stats;
+	int has_mesh_error;
+	mlod_deviation vertex;   /* % of the bounding diagonal */
+	mlod_deviation joint;    /* scene units */
+	double bound_error;      /* the error compared with --max-error, % of height */
+};
+
+struct job {
+	const char *input;
+	mlod_character c;
+	mlod_joint_info *info;
+	int labels_from_extras;
+	mlod_skelgraph graph;
+	int *order;              /* the removal order of the minor joints */
+	int minor_count;
+	double height;
+	int has_mesh;
+	int level_count;
+	struct level levels[MAX_LEVELS];
+};
+
+static int parse_list(const char *option, const char *value, double *out, double lo, double hi)
+{
+	int n = 0;
+	char *copy = strdup(value);
+	if (!copy)
+		tool_die(EXIT_USAGE, NULL, "out of memory");
+	for (char *tok = strtok(copy, ","); tok; tok = strtok(NULL, ",")) {
+		if (n == MAX_LEVELS)
+			tool_usage_error("%s: at most %d levels", option, MAX_LEVELS);
+		out[n++] = tool_parse_double(option, tok, lo, hi);
+	}
+	free(copy);
+	if (n == 0)
+		tool_usage_error("%s: empty list", option);
+	return n;
+}
+
+/* Takes labels and energies from mlod-label's extras when every joint
+ * node has them; returns 1 when it did. */
+static int labels_from_extras(mlod_gltf *doc, const mlod_character *c, mlod_joint_info *info)
+{
+	const mlod_skeleton *s = &c->skeleton;
+	if (!doc)
+		return 0;
+	for (int j = 0; j < s->joint_count; j++) {
+		char *json = NULL, label[32];
+		double energy, depth;
+		mlod_error err = {0};
+		if (s->joints[j].node < 0 ||
+		    mlod_gltf_get_extra(doc, MLOD_GLTF_NODE, s->joints[j].node, "mlod", &json, &err) != MLOD_OK || !json)
+			return 0;
+		int ok = tool_json_string_value(json, "label", label, sizeof label) == 1 &&
+		         tool_json_number(json, "energy", &energy) == 1 && tool_json_number(json, "depth", &depth) == 1 &&
+		         mlod_label_parse(label, &info[j].label) == 0 && energy >= 0.0;
+		mlod_free(json);
+		if (!ok)
+			return 0;
+		info[j].energy = energy;
+	}
+	return 1;
+}
+
+static void measure(struct job *job, struct level *lv)
+{
+	mlod_error err = {0};
+	mlod_result r;
+	/* a_to_b: the renumbering of kept joints. */
+	int *newidx = malloc(sizeof(int) * (size_t)job->c.skeleton.joint_count);
+	if (!newidx)
+		tool_die(EXIT_INPUT, NULL, "out of memory");
+	for (int j = 0, k = 0; j < job->c.skeleton.joint_count; j++)
+		newidx[j] = lv->skel.kept[j] ? k++ : -1;
+	r = mlod_joint_deviation(&job->c, &lv->c, lv->skel.remap, newidx, MEASURE_SAMPLES, &lv->joint, &err);
+	free(newidx);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), tool_input_label(job->input), "%s", err.message);
+	lv->bound_error = 100.0 * lv->joint.max / job->height;
+	if (job->has_mesh) {
+		r = mlod_vertex_deviation(&job->c, &lv->c, MEASURE_SAMPLES, &lv->vertex, &err);
+		if (r != MLOD_OK)
+			tool_die(tool_exit_code(r), tool_input_label(job->input), "%s", err.message);
+		lv->has_mesh_error = 1;
+		lv->bound_error = lv->vertex.max * lv->vertex.scale / job->height;
+	}
+}
+
+/* Extracts, applies and measures the level at threshold t, or (t < 0) the
+ * level that removes the first `removed` joints of the removal order. */
+static void make_level(struct job *job, struct level *lv, double t, int removed)
+{
+	mlod_error err = {0};
+	mlod_result r;
+	if (t >= 0.0)
+		r = mlod_skelgraph_extract(&job->graph, job->info, t, &lv->skel, &err);
+	else
+		r = mlod_skelgraph_extract_first(&job->graph, job->info, job->order,
+		                                 removed < job->minor_count ? removed : job->minor_count, &lv->skel, &err);
+	if (r == MLOD_OK)
+		r = mlod_skel_level_apply(&job->c, &lv->skel, &lv->c, &lv->stats, &err);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), tool_input_label(job->input), "%s", err.message);
+	measure(job, lv);
+}
+
+static void free_level(struct level *lv)
+{
+	mlod_skel_level_free(&lv->skel);
+	mlod_character_free(&lv->c);
+}
+
+/* The default chain: 13%, 26% and 39% of the joints removed in the
+ * removal order, each only while the error stays within the bound; past
+ * it, the largest removal within the bound is found by bisection and the
+ * chain ends there. */
+static void default_levels(struct job *job, double max_error)
+{
+	static const double fractions[] = {0.13, 0.26, 0.39};
+	int n = job->c.skeleton.joint_count, accepted = 0;
+	for (size_t i = 0; i < sizeof fractions / sizeof *fractions; i++) {
+		int removed = (int)lround(fractions[i] * n);
+		if (removed > job->minor_count)
+			removed = job->minor_count;
+		if (removed <= accepted)
+			break;
+		struct level *lv = &job->levels[job->level_count];
+		make_level(job, lv, -1.0, removed);
+		if (lv->bound_error <= max_error) {
+			accepted = removed;
+			job->level_count++;
+			continue;
+		}
+		free_level(lv);
+		int lo = accepted, hi = removed;
+		struct level best = {0};
+		while (hi - lo > 1) {
+			int mid = (lo + hi) / 2;
+			struct level trial = {0};
+			make_level(job, &trial, -1.0, mid);
+			if (trial.bound_error <= max_error) {
+				if (lo > accepted)
+					free_level(&best);
+				best = trial;
+				lo = mid;
+			} else {
+				free_level(&trial);
+				hi = mid;
+			}
+		}
+		if (lo > accepted)
+			job->levels[job->level_count++] = best;
+		break;
+	}
+}
+
+static void removed_names(FILE *f, const struct job *job, const struct level *lv, int json)
+{
+	const mlod_skeleton *s = &job->c.skeleton;
+	int first = 1;
+	for (int j = 0; j < s->joint_count; j++) {
+		if (lv->skel.kept[j])
+			continue;
+		if (json) {
+			fputs(first ? "" : ", ", f);
+			tool_json_string(f, s->joints[j].name);
+		} else {
+			fprintf(f, "%s%s", first ? "" : " ", s->joints[j].name);
+		}
+		first = 0;
+	}
+}
+
+static void report_table(const struct job *job)
+{
+	const mlod_skeleton *s = &job->c.skeleton;
+	int minors = 0;
+	for (int j = 0; j < s->joint_count; j++)
+		minors += job->info[j].label == MLOD_LABEL_MINOR;
+	printf("# %s: %d joints (%d minor) in %d sub-chains, %d closure edges; height %.4g; %d clips; labels %s\n",
+	       job->input, s->joint_count, minors, job->graph.chain_count, job->graph.edge_count, job->height,
+	       job->c.clip_count, job->labels_from_extras ? "from extras" : "computed");
+	printf("%5s  %12s  %6s  %7s  %10s  %10s  %10s  %10s  %6s\n", "level", "threshold", "joints", "removed",
+	       "vtx max%", "vtx mean%", "jnt max%", "jnt mean%", "shear");
+	printf("%5d  %12s  %6d  %7s  %10s  %10s  %10s  %10s  %6s\n", 0, "-", s->joint_count, "0%", "0", "0", "0",
+	       "0", "0");
+	for (int k = 0; k < job->level_count; k++) {
+		const struct level *lv = &job->levels[k];
+		char vmax[32] = "-", vmean[32] = "-", removed[16];
+		if (lv->has_mesh_error) {
+			snprintf(vmax, sizeof vmax, "%.4f", lv->vertex.max);
+			snprintf(vmean, sizeof vmean, "%.4f", lv->vertex.mean);
+		}
+		snprintf(removed, sizeof removed, "%.0f%%",
+		         100.0 * (s->joint_count - lv->skel.kept_count) / s->joint_count);
+		printf("%5d  %12.6g  %6d  %7s  %10s  %10s  %10.4f  %10.4f  %6d\n", k + 1, lv->skel.threshold,
+		       lv->skel.kept_count, removed, vmax, vmean, 100.0 * lv->joint.max / job->height,
+		       100.0 * lv->joint.mean / job->height, lv->stats.shear_samples);
+	}
+	for (int k = 0; k < job->level_count; k++) {
+		printf("# level %d removes: ", k + 1);
+		removed_names(stdout, job, &job->levels[k], 0);
+		putchar('\n');
+	}
+	printf("# vtx: skinned-vertex deviation over the clips, %% of the bounding diagonal;"
+	       " jnt: removed joints following their stand-ins, %% of the height\n");
+	if (job->c.notes && *job->c.notes)
+		printf("# note: %s\n", job->c.notes);
+}
+
+static void report_json(const struct job *job)
+{
+	const mlod_skeleton *s = &job->c.skeleton;
+	printf("{\n  \"input\": ");
+	tool_json_string(stdout, job->input);
+	printf(",\n  \"joints\": %d,\n  \"chains\": %d,\n  \"closure_edges\": %d,\n  \"height\": %.9g,\n",
+	       s->joint_count, job->graph.chain_count, job->graph.edge_count, job->height);
+	printf("  \"labels\": \"%s\",\n  \"levels\": [\n", job->labels_from_extras ? "extras" : "computed");
+	for (int k = 0; k < job->level_count; k++) {
+		const struct level *lv = &job->levels[k];
+		printf("    {\"level\": %d, \"threshold\": %.9g, \"kept\": %d, \"removed\": [", k + 1,
+		       lv->skel.threshold, lv->skel.kept_count);
+		removed_names(stdout, job, lv, 1);
+		printf("],\n     \"joint_error\": {\"max\": %.9g, \"mean\": %.9g, \"max_percent_height\": %.9g},\n",
+		       lv->joint.max, lv->joint.mean, 100.0 * lv->joint.max / job->height);
+		if (lv->has_mesh_error)
+			printf("     \"vertex_error\": {\"max_percent_diagonal\": %.9g, \"mean_percent_diagonal\": %.9g},\n",
+			       lv->vertex.max, lv->vertex.mean);
+		printf("     \"shear_samples\": %d, \"weight_merges\": %d}%s\n", lv->stats.shear_samples,
+		       lv->stats.weight_merges, k + 1 < job->level_count ? "," : "");
+	}
+	printf("  ]\n}\n");
+}
+
+static void write_bvh(const struct job *job, const char *output, int level, int clip)
+{
+	const mlod_character *c = level == 0 ? &job->c : &job->levels[level - 1].c;
+	char *text = NULL;
+	size_t size = 0;
+	mlod_error err = {0};
+	if (clip >= c->clip_count)
+		tool_die(EXIT_USAGE, NULL, "--clip %d: the input has %d clips", clip, c->clip_count);
+	mlod_result r = mlod_bvh_write(c, clip, 0.0f, &text, &size, &err);
+	if (r != MLOD_OK)
+		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_OUTPUT, output, "%s", err.message);
+	tool_write_output(output, text, size, 0);
+	mlod_free(text);
+}
+
+/* Records the levels in the document and writes it. */
+static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
+{
+	mlod_skel_level_record records[MAX_LEVELS];
+	mlod_error err = {0};
+	for (int k = 0; k < job->level_count; k++) {
+		const struct level *lv = &job->levels[k];
+		records[k] = (mlod_skel_level_record){&lv->skel, &lv->c, lv->vertex, lv->joint, job->height};
+		if (!lv->has_mesh_error)
+			records[k].vertex.scale = 0.0;
+	}
+	if (mlod_gltf_add_skel_levels(doc, &job->c, records, job->level_count, &err) != MLOD_OK)
+		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+	tool_write_gltf(output, doc);
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+	size_t a = strlen(s), b = strlen(suffix);
+	return a >= b && strcmp(s + a - b, suffix) == 0;
+}
+
+int main(int argc, char **argv)
+{
+	static const struct option longopts[] = {
+		{"output", required_argument, NULL, 'o'},
+		{"report", optional_argument, NULL, 'r'},
+		{"thresholds", required_argument, NULL, 't'},
+		{"joints", required_argument, NULL, 'j'},
+		{"max-error", required_argument, NULL, 'e'},
+		{"level", required_argument, NULL, 'l'},
+		{"clip", required_argument, NULL, 'c'},
+		{"hub-factor", required_argument, NULL, 'H'},
+		{"help", no_argument, NULL, 'h'},
+		{"version", no_argument, NULL, 'V'},
+		{NULL, 0, NULL, 0},
+	};
+	const char *output = NULL;
+	enum report report = REPORT_NONE;
+	double thresholds[MAX_LEVELS], fractions[MAX_LEVELS];
+	int threshold_count = 0, fraction_count = 0, level = -1, clip = 0;
+	double max_error = DEFAULT_MAX_ERROR;
+	mlod_label_options lopt = {0};
+	int ch;
+
+	tool_name = "mlod-skelgraph";
+	opterr = 0;
+	while ((ch = getopt_long(argc, argv, ":o:r::t:j:e:l:c:hV", longopts, NULL)) != -1) {
+		switch (ch) {
+		case 'o': output = optarg; break;
+		case 'r':
+			if (!optarg || strcmp(optarg, "table") == 0)
+				report = REPORT_TABLE;
+			else if (strcmp(optarg, "json") == 0)
+				report = REPORT_JSON;
+			else
+				tool_usage_error("--report: unknown format '%s' (table or json)", optarg);
+			break;
+		case 't': threshold_count = parse_list("--thresholds", optarg, thresholds, 0.0, 1e9); break;
+		case 'j': fraction_count = parse_list("--joints", optarg, fractions, 0.0, 1.0); break;
+		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 1e6); break;
+		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
+		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
+		case 'H': lopt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
+		case 'h': fputs(usage_text, stdout); return 0;
+		case 'V': tool_version();
+		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
+		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (argc - optind > 1)
+		tool_usage_error("too many inputs: one file, or stdin");
+	if (threshold_count && fraction_count)
+		tool_usage_error("--thresholds and --joints do not go together");
+	int bvh_out = output && ends_with(output, ".bvh");
+	if (level >= 0 && !bvh_out)
+		tool_usage_error("--level needs a .bvh output (-o out.bvh)");
+	if (report != REPORT_NONE && output)
+		tool_usage_error("--report and --output do not go together");
+
+	struct job job = {0};
+	mlod_gltf *doc = NULL;
+	mlod_error err = {0};
+	job.input = tool_input_label(optind < argc ? argv[optind] : NULL);
+	tool_load(optind < argc ? argv[optind] : NULL, &doc, &job.c, NULL);
+	int n = job.c.skeleton.joint_count;
+	job.info = calloc((size_t)n + 1, sizeof *job.info);
+	if (!job.info)
+		tool_die(EXIT_INPUT, job.input, "out of memory");
+	mlod_result r = mlod_label_skeleton(&job.c, &lopt, job.info, &err);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), job.input, "%s", err.message);
+	job.labels_from_extras = labels_from_extras(doc, &job.c, job.info);
+	if ((r = mlod_skelgraph_build(&job.c.skeleton, job.info, &job.graph, &err)) != MLOD_OK)
+		tool_die(tool_exit_code(r), job.input, "%s", err.message);
+	job.height = mlod_skeleton_size(&job.c.skeleton);
+	job.order = malloc(sizeof(int) * ((size_t)n + 1));
+	if (!job.order)
+		tool_die(EXIT_INPUT, job.input, "out of memory");
+	job.minor_count = mlod_skel_removal_order(&job.c.skeleton, job.info, job.order);
+	job.has_mesh = job.c.instance_count > 0;
+
+	if (threshold_count) {
+		for (int k = 0; k < threshold_count; k++)
+			make_level(&job, &job.levels[job.level_count++], thresholds[k], 0);
+	} else if (fraction_count) {
+		for (int k = 0; k < fraction_count; k++) {
+			make_level(&job, &job.levels[job.level_count++], -1.0, (int)lround((1.0 - fractions[k]) * n));
+		}
+	} else {
+		default_levels(&job, max_error);
+		if (job.level_count == 0 && job.minor_count > 0) {
+			struct level first = {0};
+			make_level(&job, &first, -1.0, 1);
+			fprintf(stderr, "%s: %s: no skeleton level within --max-error %g%%: removing %s alone costs %.3g%%\n",
+			        tool_name, job.input, max_error, job.c.skeleton.joints[job.order[0]].name, first.bound_error);
+			free_level(&first);
+		}
+	}
+	/* Levels are nested: finest first. */
+	for (int a = 1; a < job.level_count; a++)
+		for (int b = a; b > 0 && job.levels[b].skel.kept_count > job.levels[b - 1].skel.kept_count; b--) {
+			struct level t = job.levels[b];
+			job.levels[b] = job.levels[b - 1];
+			job.levels[b - 1] = t;
+		}
+
+	if (report == REPORT_TABLE)
+		report_table(&job);
+	else if (report == REPORT_JSON)
+		report_json(&job);
+	else if (bvh_out) {
+		if (level < 0)
+			level = job.level_count;
+		if (level > job.level_count)
+			tool_die(EXIT_USAGE, NULL, "--level %d: there are %d levels", level, job.level_count);
+		write_bvh(&job, output, level, clip);
+	} else
+		write_glb(&job, doc, output);
+
+	if (fflush(stdout) != 0)
+		tool_die(EXIT_OUTPUT, "<stdout>", "write error");
+	for (int k = 0; k < job.level_count; k++)
+		free_level(&job.levels[k]);
+	free(job.info);
+	free(job.order);
+	mlod_skelgraph_free(&job.graph);
+	mlod_character_free(&job.c);
+	mlod_gltf_free(doc);
+	return 0;
+}
