@@ -73,6 +73,9 @@ mlod_result mlod_load(const void *data, size_t size, const char *base_dir, mlod_
 			r = mlod_character_validate(c, err);
 		if (r == MLOD_OK && doc)
 			r = mlod_gltf_from_character(c, &d, err);
+		/* mlod_gltf_from_character makes joint i node i. */
+		for (int i = 0; r == MLOD_OK && d && i < c->skeleton.joint_count; i++)
+			c->skeleton.joints[i].node = i;
 		break;
 	case MLOD_FORMAT_GLB:
 	case MLOD_FORMAT_GLTF:

@@ -352,9 +352,9 @@ mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data,
 mlod_result mlod_gltf_to_character(const mlod_gltf *doc, mlod_character *out,
                                    mlod_error *err);
 
-/* Builds a new document from a character: nodes for joints (and End Sites
- * as child nodes marked extras.mlod.end_site), meshes, skins, instances and
- * one animation per clip. A BVH read this way gives a glb. */
+/* Builds a new document from a character: nodes for joints (joint i is
+ * node i; End Sites become child nodes marked extras.mlod.end_site),
+ * meshes, skins, instances and one animation per clip. A BVH read this way gives a glb. */
 mlod_result mlod_gltf_from_character(const mlod_character *c, mlod_gltf **out,
                                      mlod_error *err);
 
