@@ -20,11 +20,8 @@ if [ -d "$shared" ]; then
 fi
 for f in /usr/share/assimp/models/BVH/*.bvh; do [ -f "$f" ] && inputs="$inputs $f"; done
 
-echo "## Skeleton layer: graph and levels (paper: under 1 ms)"
-echo
-# shellcheck disable=SC2086
-"$build/bench/bench_skeleton" graph $inputs
-echo
-echo "## Skeleton layer: crowd pose cost (paper Figure 15: 2x at 50 skeletons)"
-echo
-"$build/bench/bench_skeleton" crowd samples/cmu_12_01_walk.bvh
+# Each layer's benchmarks live in bench/<layer>.sh and print their sections.
+export BUILD="$build" INPUTS="$inputs"
+for section in bench/skeleton.sh bench/mesh.sh bench/motion.sh; do
+	[ -f "$section" ] && sh "$section"
+done

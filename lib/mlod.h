@@ -626,6 +626,14 @@ mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level
 mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full,
                                       const mlod_skel_level_record *levels, int count, mlod_error *err);
 
+/* ------------------------------------------------------------------ */
+/* Mesh layer: BindGraphMesh, triangle collapse, Power Skinning (4.2)  */
+/* ------------------------------------------------------------------ */
+
+/* ------------------------------------------------------------------ */
+/* Motion layer: the multiresolution motion tree (paper 4.3)           */
+/* ------------------------------------------------------------------ */
+
 #ifdef __cplusplus
 }
 #endif
