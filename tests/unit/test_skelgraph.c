@@ -163,6 +163,34 @@ static void check_oracle(const mlod_character *c)
 	mlod_skelgraph_free(&g);
 }
 
+/* The oracle and the folding check on every file of ../shared/data too,
+ * under make test-extended. */
+static void for_shared(void (*check)(const mlod_character *))
+{
+	static const char *files[] = {"Ely.glb", "RobotExpressive.glb", "bvh_test3.bvh", "cmu_12_01_walk.bvh"};
+	if (!test_have_shared())
+		return;
+	for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
+		char path[1024];
+		mlod_character c = {0};
+		snprintf(path, sizeof path, "%.900s/%s", getenv("MLOD_SHARED_DATA"), files[i]);
+		CHECK_MSG(load_sample(path, &c) == 0, "cannot load %s", path);
+		check(&c);
+		mlod_character_free(&c);
+		if (test_failed_)
+			return;
+	}
+}
+
+static void check_folding_39(const mlod_character *c);
+
+TEST(shared_data)
+{
+	for_shared(check_oracle);
+	if (!test_failed_)
+		for_shared(check_folding_39);
+}
+
 TEST(mst_equals_nearest_kept_ancestor)
 {
 	const char *samples[] = {"samples/cmu_12_01_walk.bvh", "samples/RobotExpressive.glb", "samples/tubeman.glb",
@@ -266,6 +294,11 @@ static void check_folding(const mlod_character *c, double fraction)
 	mlod_character_free(&r);
 	mlod_skel_level_free(&l);
 	mlod_skelgraph_free(&g);
+}
+
+static void check_folding_39(const mlod_character *c)
+{
+	check_folding(c, 0.39);
 }
 
 TEST(folding_is_exact)
@@ -401,5 +434,6 @@ int main(void)
 	RUN(folding_is_exact);
 	RUN(shear_is_detected);
 	RUN(skin_transfer_merges);
+	RUN(shared_data);
 	TEST_EXIT();
 }
