@@ -174,7 +174,7 @@ static void for_shared(void (*check)(const mlod_character *))
 		char path[1024];
 		mlod_character c = {0};
 		snprintf(path, sizeof path, "%.900s/%s", getenv("MLOD_SHARED_DATA"), files[i]);
-		CHECK_MSG(load_sample(path, &c) == 0, "cannot load %s", path);
+		CHECK_MSG(load_sample(path, &c) == 0, "cannot load %.300s", path);
 		check(&c);
 		mlod_character_free(&c);
 		if (test_failed_)
