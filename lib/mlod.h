@@ -634,6 +634,122 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
 /* Motion layer: the multiresolution motion tree (paper 4.3)           */
 /* ------------------------------------------------------------------ */
 
+/* Levels of one clip. Level 0 is the clip as read; level k + 1 is coarser
+ * than level k (fewer keys, a larger bound). Frame distances, thresholds
+ * and the tree follow the paper; per-channel key reduction goes beyond it.
+ * Error is the world-space joint position error (mlod_joint_deviation:
+ * joints and End Sites) against the clip as read, in scene units. */
+
+typedef enum mlod_motion_method {
+	MLOD_MOTION_FRAMES,  /* the paper's multiresolution motion tree: whole frames go */
+	MLOD_MOTION_KEYS     /* per-channel key reduction under a hierarchical error bound */
+} mlod_motion_method;
+
+/* How the tree merges two neighbouring frames. */
+typedef enum mlod_motion_merge {
+	MLOD_MOTION_REMOVE,  /* keep one of the two as it is; the other is interpolated at play time */
+	MLOD_MOTION_AVERAGE  /* one frame at their mean time with their mean pose (weighted by the frames each stands for) */
+} mlod_motion_merge;
+
+/* How a level's size is chosen. */
+typedef enum mlod_motion_target {
+	MLOD_MOTION_THRESHOLD, /* frames method only: merge neighbours closer than this frame distance */
+	MLOD_MOTION_FRACTION,  /* keep at most this fraction (0..1] of the clip's keys */
+	MLOD_MOTION_MAX_ERROR  /* the coarsest level whose joint position error is at most this (scene units) */
+} mlod_motion_target;
+
+/* Zero-initialised options are the defaults. */
+typedef struct mlod_motion_options {
+	mlod_motion_merge merge;  /* frames method; MLOD_MOTION_REMOVE (the default) measured better */
+	double cubic_rate;        /* CUBICSPLINE clips are resampled at least this often (1/s); 0 means 60 */
+	double point_distance;    /* keys method: radius of the points carried by each joint (scene
+	                             units); 0 means the skeleton height / 18 (10 cm on a 1.8 m person) */
+} mlod_motion_options;
+
+/* How a clip was put on a common timeline: every channel keyed at every
+ * frame. A clip whose channels share their key times and are LINEAR or
+ * STEP keeps its keys; otherwise the frames are the union of all key
+ * times, and intervals longer than 1/cubic_rate get evenly spaced frames
+ * when a channel is CUBICSPLINE (which becomes LINEAR). */
+typedef struct mlod_motion_timeline {
+	int frames;               /* frames of the common timeline */
+	int resampled;            /* 0 when the clip's own keys were kept */
+	int cubic_channels;       /* CUBICSPLINE channels, sampled as LINEAR */
+	int mismatched_channels;  /* channels whose key times were not the common ones */
+} mlod_motion_timeline;
+
+/* Frame distance (paper 4.3): the energy to move every joint from local
+ * pose a to local pose b, each joint weighted by the energy weight
+ * (h - depth) / h of 4.1.2: the sum over joints of the weight times
+ * (|change of each Euler angle| / pi, in the joint's Euler order, wrapped
+ * into (-pi, pi], taking the nearer of the two Euler triples that give
+ * the rotation, so q and -q and 179 -> -179 degrees are no motion) plus,
+ * beyond the paper, |change of translation| / skeleton height and
+ * |change of scale|, so root motion counts. */
+double mlod_motion_frame_distance(const mlod_skeleton *s, const mlod_trs *a, const mlod_trs *b);
+
+/* Puts clip on its common timeline (see mlod_motion_timeline): out gets
+ * one channel per channel of clip, every one keyed at every frame, LINEAR
+ * or STEP, rotations normalised and sign-continuous. Release out with
+ * mlod_clip_free. Bad clips (no channels, no keys, times not finite or
+ * negative or not increasing, values not finite, zero quaternions) are
+ * MLOD_ERR_PARSE; too many frames is MLOD_ERR_LIMIT. info may be NULL. */
+mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_options *opt,
+                                    mlod_clip *out, mlod_motion_timeline *info, mlod_error *err);
+
+/* Releases what a clip made by the library owns and zeroes it. */
+void mlod_clip_free(mlod_clip *clip);
+
+/* Keys in a clip (all channels), and the bytes glTF stores for them as
+ * floats: values (three per key for CUBICSPLINE) plus key times, where
+ * channels with identical times share one input accessor. */
+long mlod_clip_key_count(const mlod_clip *clip);
+long mlod_clip_key_bytes(const mlod_clip *clip);
+
+/* The levels of one clip under construction; it keeps pointers to c. */
+typedef struct mlod_motion mlod_motion;
+
+mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_motion_options *opt,
+                               mlod_motion **out, mlod_error *err);
+void mlod_motion_free(mlod_motion *m);
+/* The clip's common timeline. */
+const mlod_motion_timeline *mlod_motion_timeline_info(const mlod_motion *m);
+
+/* One level of a clip. */
+typedef struct mlod_motion_level {
+	mlod_clip clip;           /* kept keys only, LINEAR or STEP (STEP where the source was); same
+	                             name, duration, first and last key times as the source */
+	mlod_motion_method method;
+	double threshold;         /* frames: the frame distance threshold; keys: the error budget used */
+	long keys;                /* mlod_clip_key_count(&clip) */
+	long bytes;               /* mlod_clip_key_bytes(&clip) */
+	mlod_deviation error;     /* joint position error against the source clip, scene units */
+} mlod_motion_level;
+
+/* Builds the next level of a method: each level is made from the previous
+ * level of the same method (nested: the frames method's levels are the
+ * lines of the motion tree, the keys method's keep subsets of the previous
+ * keys). target and value choose its size; with MLOD_MOTION_MAX_ERROR the
+ * measured error is at most value, or MLOD_ERR_LIMIT says why not (a
+ * resampled clip that already deviates more). Release with
+ * mlod_motion_level_free. */
+mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
+                                   double value, mlod_motion_level *out, mlod_error *err);
+void mlod_motion_level_free(mlod_motion_level *l);
+
+/* Per-channel key reduction under a hierarchical error bound (beyond the
+ * paper; the metric of ozz-animation's optimizer and ACL's virtual
+ * vertices). common is original on its common timeline
+ * (mlod_motion_common_clip). kept holds channel_count * frames flags
+ * (channel-major): on entry the keys that may stay (each channel keeps its
+ * first frame, and its last unless it is a single key), on return those
+ * kept. A key goes only if, at every frame, every joint's world origin
+ * stays within bound of the original, and so does every point within
+ * point_distance of it (and its End Site); tracks that then fit a
+ * constant collapse to one key. */
+mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common,
+                           double bound, double point_distance, unsigned char *kept, mlod_error *err);
+
 #ifdef __cplusplus
 }
 #endif

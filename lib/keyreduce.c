@@ -1,0 +1,409 @@
+/*
+ * keyreduce.c: per-channel key reduction under a hierarchical error bound.
+ *
+ * Beyond the paper (whose motion layer, 4.3, removes whole frames; see
+ * motion.c): each animated channel of each joint keeps only the keys it
+ * needs, in the manner of ozz-animation's keyframe optimizer and of ACL's
+ * "virtual vertex" error (Frechette, "Animation Compression Library").
+ * The error of a joint at a frame is
+ *
+ *     |o' - o| + r * sigma_max(A' - A)
+ *
+ * where o, A are the origin and the 3x3 linear part of the joint's world
+ * matrix as read, o', A' those of the reduced clip, and r the larger of
+ * point_distance and the joint's End Site offset: it bounds how far any
+ * point within r of the joint moves (for a pure rotation error of angle
+ * t it is 2 r sin(t/2), the exact displacement of the farthest point).
+ * A key may go only if, at every frame of the common timeline, this error
+ * stays within the bound for the joint and every descendant, given every
+ * other channel as it currently is; the check is exact (the same
+ * sampling and float forward kinematics as mlod_clip_sample and
+ * mlod_pose_world), so the bound holds for the final clip at every frame.
+ *
+ * Search: per channel, from a kept key, the farthest key the segment can
+ * reach is found by galloping (2, 3, 5, 9, ... keys ahead) then bisection,
+ * and the keys in between go. Channels are swept root first, in rounds
+ * whose budget grows (a quarter of the bound, a half, ...), so no channel
+ * spends the whole budget before the others had a share (4 rounds, root
+ * first, measured best of 1/2/4/8 rounds and root or leaves first on the
+ * samples). Last, a channel whose last value equals its first and that
+ * fits that constant collapses to one key; the first and last frames of
+ * every channel are thus kept exactly.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mlod.h"
+
+#define MAX_FRAME_JOINTS 1000000L /* frames * joints the caches may hold */
+#define ROUNDS 4
+
+typedef struct reducer {
+	const mlod_skeleton *s;
+	const mlod_clip *common;
+	int F, J;
+	const float *times;
+	double *radius;          /* per joint */
+	int *sub_start, *sub;    /* per joint: the joint and its descendants, parents first */
+	mlod_mat4 *w0;           /* F * J: world matrices as read */
+	mlod_trs *lc;            /* F * J: current local transforms */
+	mlod_mat4 *lm;           /* F * J: their matrices */
+	mlod_mat4 *wc;           /* F * J: current world matrices */
+	mlod_mat4 *tmp;          /* J */
+	unsigned char *kept;
+} reducer;
+
+static int comps_of(const mlod_channel *ch)
+{
+	return ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+}
+
+/* Sets one path of a local transform from comps values, as mlod_clip_sample does. */
+static void set_path(mlod_trs *l, mlod_path path, const float *v)
+{
+	switch (path) {
+	case MLOD_PATH_TRANSLATION: l->t.x = v[0], l->t.y = v[1], l->t.z = v[2]; break;
+	case MLOD_PATH_SCALE: l->s.x = v[0], l->s.y = v[1], l->s.z = v[2]; break;
+	case MLOD_PATH_ROTATION: l->r = mlod_quat_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+	}
+}
+
+/* The value at frame f of a channel keyed at frames a < b (f strictly
+ * between them), as mlod_clip_sample computes it from those two keys. */
+static void segment_value(const reducer *R, const mlod_channel *ch, int a, int b, int f, float *out)
+{
+	int comps = comps_of(ch);
+	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
+	if (ch->interp == MLOD_INTERP_STEP) {
+		memcpy(out, va, sizeof(float) * (size_t)comps);
+		return;
+	}
+	const float t0 = R->times[a], t1 = R->times[b], dt = t1 - t0;
+	const float u = (R->times[f] - t0) / dt;
+	if (comps == 4) {
+		mlod_quat q = mlod_quat_slerp((mlod_quat){ va[0], va[1], va[2], va[3] }, (mlod_quat){ vb[0], vb[1], vb[2], vb[3] }, u);
+		out[0] = q.x, out[1] = q.y, out[2] = q.z, out[3] = q.w;
+	} else {
+		for (int c = 0; c < 3; c++)
+			out[c] = va[c] + (vb[c] - va[c]) * u;
+	}
+}
+
+/* The value at frame f of a channel keyed where row is set. */
+static void kept_value(const reducer *R, const mlod_channel *ch, const unsigned char *row, int f, float *out)
+{
+	int comps = comps_of(ch), first = -1, last = -1;
+	for (int k = 0; k < R->F; k++)
+		if (row[k]) {
+			first = k;
+			break;
+		}
+	for (int k = R->F - 1; k >= 0; k--)
+		if (row[k]) {
+			last = k;
+			break;
+		}
+	if (first == last || f <= first || f >= last) {
+		int k = f >= last && first != last ? last : first;
+		memcpy(out, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
+		return;
+	}
+	int a = f, b = f + 1;
+	while (!row[a])
+		a--;
+	while (!row[b])
+		b++;
+	segment_value(R, ch, a, b, f, out);
+}
+
+/* Largest singular value of a 3x3 matrix given by columns (m[c * 4 + r]). */
+static double sigma_max(const double a[9])
+{
+	/* B = A^T A, symmetric positive semi-definite. */
+	double b[3][3];
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++)
+			b[i][j] = a[0 * 3 + i] * a[0 * 3 + j] + a[1 * 3 + i] * a[1 * 3 + j] + a[2 * 3 + i] * a[2 * 3 + j];
+	double p1 = b[0][1] * b[0][1] + b[0][2] * b[0][2] + b[1][2] * b[1][2];
+	double q = (b[0][0] + b[1][1] + b[2][2]) / 3.0, lambda;
+	if (p1 <= 1e-30 * (q * q + 1e-300)) {
+		lambda = fmax(b[0][0], fmax(b[1][1], b[2][2]));
+	} else {
+		double p2 = (b[0][0] - q) * (b[0][0] - q) + (b[1][1] - q) * (b[1][1] - q) + (b[2][2] - q) * (b[2][2] - q) +
+		            2.0 * p1;
+		double p = sqrt(p2 / 6.0), c[3][3];
+		for (int i = 0; i < 3; i++)
+			for (int j = 0; j < 3; j++)
+				c[i][j] = (b[i][j] - (i == j ? q : 0.0)) / p;
+		double det = c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0]) +
+		             c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]);
+		double r = det / 2.0;
+		r = r < -1.0 ? -1.0 : r > 1.0 ? 1.0 : r;
+		lambda = q + 2.0 * p * cos(acos(r) / 3.0);
+		/* Rounding: never below the largest diagonal entry. */
+		lambda = fmax(lambda, fmax(b[0][0], fmax(b[1][1], b[2][2])));
+	}
+	return lambda > 0.0 ? sqrt(lambda) * (1.0 + 1e-9) : 0.0;
+}
+
+/* Does the joint's world matrix w stay within budget of w0? */
+static int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget)
+{
+	double dx = (double)w->m[12] - w0->m[12], dy = (double)w->m[13] - w0->m[13], dz = (double)w->m[14] - w0->m[14];
+	double dp = sqrt(dx * dx + dy * dy + dz * dz);
+	if (!(dp <= budget))
+		return 0;
+	double a[9], frob = 0.0;
+	for (int c = 0; c < 3; c++)
+		for (int r = 0; r < 3; r++) {
+			a[c * 3 + r] = (double)w->m[c * 4 + r] - w0->m[c * 4 + r];
+			frob += a[c * 3 + r] * a[c * 3 + r];
+		}
+	double room = budget - dp, rad = R->radius[j];
+	if (rad * rad * frob <= room * room)
+		return 1; /* sigma_max <= Frobenius norm */
+	return rad * sigma_max(a) <= room;
+}
+
+/* Checks (commit = 0) or applies (commit = 1) channel ch taking the value
+ * val_of(f) at frames lo..hi (inclusive): val_a, val_b are the keys of a
+ * segment, or const_value for a constant. */
+static int sweep(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget,
+                 int commit)
+{
+	const mlod_skeleton *s = R->s;
+	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch);
+	const int *sub = R->sub + R->sub_start[j];
+	int nsub = R->sub_start[j + 1] - R->sub_start[j];
+	for (int f = lo; f <= hi; f++) {
+		float v[4];
+		if (constant)
+			memcpy(v, ch->values + (size_t)a * (size_t)comps, sizeof(float) * (size_t)comps);
+		else
+			segment_value(R, ch, a, b, f, v);
+		size_t base = (size_t)f * (size_t)R->J;
+		mlod_trs l = R->lc[base + (size_t)j];
+		set_path(&l, ch->path, v);
+		mlod_mat4 lm = mlod_mat4_from_trs(&l);
+		mlod_mat4 *w = commit ? R->wc + base : R->tmp;
+		w[j] = mlod_mat4_mul(p < 0 ? &s->joints[j].base : &R->wc[base + (size_t)p], &lm);
+		if (!commit && !within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
+			return 0;
+		for (int k = 1; k < nsub; k++) {
+			int d = sub[k], dp = s->joints[d].parent;
+			w[d] = mlod_mat4_mul(&w[dp], &R->lm[base + (size_t)d]);
+			if (!commit && !within(R, d, &w[d], &R->w0[base + (size_t)d], budget))
+				return 0;
+		}
+		if (commit) {
+			R->lc[base + (size_t)j] = l;
+			R->lm[base + (size_t)j] = lm;
+		}
+	}
+	return 1;
+}
+
+/* Removes what keys it can from one channel at one budget. */
+static void reduce_channel(reducer *R, int c, double budget, int *K)
+{
+	const mlod_channel *ch = &R->common->channels[c];
+	unsigned char *row = R->kept + (size_t)c * (size_t)R->F;
+	int nk = 0;
+	for (int f = 0; f < R->F; f++)
+		if (row[f])
+			K[nk++] = f;
+	for (int i = 0; i + 2 < nk + 0 && i < nk - 1;) {
+		int ok = i + 1, fail = nk, step = 1, probe = i + 2;
+		while (probe < nk) {
+			if (sweep(R, ch, K[i], K[probe], K[i] + 1, K[probe] - 1, 0, budget, 0)) {
+				ok = probe;
+				step *= 2;
+				probe = i + 1 + step;
+			} else {
+				fail = probe;
+				break;
+			}
+		}
+		if (fail == nk && ok < nk - 1) {
+			if (sweep(R, ch, K[i], K[nk - 1], K[i] + 1, K[nk - 1] - 1, 0, budget, 0))
+				ok = nk - 1;
+			else
+				fail = nk - 1;
+		}
+		while (fail - ok > 1) {
+			int mid = ok + (fail - ok) / 2;
+			if (sweep(R, ch, K[i], K[mid], K[i] + 1, K[mid] - 1, 0, budget, 0))
+				ok = mid;
+			else
+				fail = mid;
+		}
+		if (ok > i + 1) {
+			sweep(R, ch, K[i], K[ok], K[i] + 1, K[ok] - 1, 0, budget, 1);
+			for (int k = i + 1; k < ok; k++)
+				row[K[k]] = 0;
+		}
+		i = ok;
+	}
+}
+
+/* Collapses a channel to its first key when that constant fits. */
+static void collapse_channel(reducer *R, int c, double budget)
+{
+	const mlod_channel *ch = &R->common->channels[c];
+	unsigned char *row = R->kept + (size_t)c * (size_t)R->F;
+	int first = -1, count = 0;
+	for (int f = 0; f < R->F; f++)
+		if (row[f]) {
+			if (first < 0)
+				first = f;
+			count++;
+		}
+	if (count < 2 || first != 0)
+		return;
+	/* The last frame must stay exact: only a channel that ends where it
+	 * starts can become its first key. */
+	int comps = comps_of(ch);
+	if (memcmp(ch->values, ch->values + (size_t)(R->F - 1) * (size_t)comps, sizeof(float) * (size_t)comps) != 0)
+		return;
+	if (!sweep(R, ch, 0, 0, 1, R->F - 1, 1, budget, 0))
+		return;
+	sweep(R, ch, 0, 0, 1, R->F - 1, 1, budget, 1);
+	memset(row + 1, 0, (size_t)R->F - 1);
+}
+
+static void reducer_free(reducer *R)
+{
+	free(R->radius);
+	free(R->sub_start);
+	free(R->sub);
+	free(R->w0);
+	free(R->lc);
+	free(R->lm);
+	free(R->wc);
+	free(R->tmp);
+}
+
+static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
+                              double point_distance, const unsigned char *kept, mlod_error *err)
+{
+	if (!s || !original || !common || !kept)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: NULL argument");
+	if (!(bound >= 0.0) || !isfinite(bound) || !(point_distance >= 0.0) || !isfinite(point_distance))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: bad bound %g or point distance %g", bound,
+		                 point_distance);
+	if (s->joint_count <= 0 || common->channel_count <= 0 || !common->channels)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: no joints or no channels");
+	const mlod_channel *c0 = &common->channels[0];
+	int F = c0->key_count;
+	if (F <= 0)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: no frames");
+	if ((double)F * s->joint_count > (double)MAX_FRAME_JOINTS)
+		return mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": %d frames of %d joints is more than the keys method holds (%ld); split the clip",
+		                 common->name ? common->name : "", F, s->joint_count, MAX_FRAME_JOINTS);
+	for (int c = 0; c < common->channel_count; c++) {
+		const mlod_channel *ch = &common->channels[c];
+		const unsigned char *row = kept + (size_t)c * (size_t)F;
+		if (ch->key_count != F || !ch->times || !ch->values ||
+		    memcmp(ch->times, c0->times, sizeof(float) * (size_t)F) != 0)
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: channel %d is not on the common timeline", c);
+		if (ch->joint < 0 || ch->joint >= s->joint_count || (unsigned)ch->path > MLOD_PATH_SCALE ||
+		    (ch->interp != MLOD_INTERP_LINEAR && ch->interp != MLOD_INTERP_STEP))
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: channel %d: bad joint, path or interpolation", c);
+		if (!row[0])
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: channel %d does not keep its first frame", c);
+	}
+	for (int j = 0; j < s->joint_count; j++)
+		if (s->joints[j].parent >= j)
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: joint %d comes before its parent", j);
+	return MLOD_OK;
+}
+
+mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
+                           double point_distance, unsigned char *kept, mlod_error *err)
+{
+	mlod_result r = check_args(s, original, common, bound, point_distance, kept, err);
+	if (r != MLOD_OK)
+		return r;
+	reducer R;
+	memset(&R, 0, sizeof R);
+	R.s = s;
+	R.common = common;
+	R.F = common->channels[0].key_count;
+	R.J = s->joint_count;
+	R.times = common->channels[0].times;
+	R.kept = kept;
+	size_t FJ = (size_t)R.F * (size_t)R.J;
+	R.radius = malloc(sizeof(double) * (size_t)R.J);
+	R.sub_start = calloc((size_t)R.J + 1, sizeof(int));
+	R.w0 = malloc(sizeof(mlod_mat4) * FJ);
+	R.lc = malloc(sizeof(mlod_trs) * FJ);
+	R.lm = malloc(sizeof(mlod_mat4) * FJ);
+	R.wc = malloc(sizeof(mlod_mat4) * FJ);
+	R.tmp = malloc(sizeof(mlod_mat4) * (size_t)R.J);
+	int *depth = malloc(sizeof(int) * (size_t)R.J);
+	int *K = malloc(sizeof(int) * (size_t)R.F);
+	int *fill = NULL;
+	if (!R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.tmp || !depth || !K) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	/* Subtrees: joint j's descendants d (parents before children) are
+	 * listed after j; sizes first. */
+	long total = 0;
+	for (int j = 0; j < R.J; j++) {
+		const mlod_joint *jt = &s->joints[j];
+		double es = jt->has_end_site ? mlod_v3_length(jt->end_site) : 0.0;
+		R.radius[j] = es > point_distance ? es : point_distance;
+		depth[j] = jt->parent < 0 ? 0 : depth[jt->parent] + 1;
+		total += depth[j] + 1;
+	}
+	R.sub = malloc(sizeof(int) * (size_t)total);
+	fill = calloc((size_t)R.J, sizeof(int));
+	if (!R.sub || !fill) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	for (int d = 0; d < R.J; d++)
+		for (int a = d; a >= 0; a = s->joints[a].parent)
+			R.sub_start[a + 1]++;
+	for (int j = 0; j < R.J; j++)
+		R.sub_start[j + 1] += R.sub_start[j];
+	for (int d = 0; d < R.J; d++) /* d in index order: parents first in every list */
+		for (int a = d; a >= 0; a = s->joints[a].parent)
+			R.sub[R.sub_start[a] + fill[a]++] = d;
+
+	/* The clip as read, and as currently kept. */
+	for (int f = 0; f < R.F; f++) {
+		size_t base = (size_t)f * (size_t)R.J;
+		mlod_trs *l = R.lc + base;
+		mlod_pose_rest(s, l);
+		mlod_clip_sample(original, R.times[f], l);
+		mlod_pose_world(s, l, R.w0 + base);
+		mlod_pose_rest(s, l);
+		for (int c = 0; c < common->channel_count; c++) {
+			const mlod_channel *ch = &common->channels[c];
+			float v[4];
+			kept_value(&R, ch, kept + (size_t)c * (size_t)R.F, f, v);
+			set_path(&l[ch->joint], ch->path, v);
+		}
+		for (int j = 0; j < R.J; j++)
+			R.lm[base + (size_t)j] = mlod_mat4_from_trs(&l[j]);
+		for (int j = 0; j < R.J; j++) {
+			int p = s->joints[j].parent;
+			R.wc[base + (size_t)j] = mlod_mat4_mul(p < 0 ? &s->joints[j].base : &R.wc[base + (size_t)p], &R.lm[base + (size_t)j]);
+		}
+	}
+
+	for (int round = 1; round <= ROUNDS; round++)
+		for (int c = 0; c < common->channel_count; c++)
+			reduce_channel(&R, c, bound * round / ROUNDS, K);
+	for (int c = 0; c < common->channel_count; c++)
+		collapse_channel(&R, c, bound);
+done:
+	free(depth);
+	free(K);
+	free(fill);
+	reducer_free(&R);
+	return r;
+}

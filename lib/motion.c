@@ -1,0 +1,1216 @@
+/*
+ * motion.c: the multiresolution motion tree and motion levels (paper 4.3,
+ * with the energy weight of 4.1.2).
+ *
+ * Savoye & Meyer merge "nearby postures": two neighbouring frames fuse
+ * when the distance between them, "the energy needed to move all joints
+ * from one frame to the other", is below a threshold, by "removing a frame
+ * from among the two or by merging the two into a single frame, preserving
+ * the duration". We read it so (docs: paper-notes.md, 4.3):
+ *
+ * - Common timeline. A clip is first put on frames shared by all its
+ *   channels: its own keys when they agree, else the union of the key
+ *   times (exact for LINEAR and STEP), with CUBICSPLINE intervals
+ *   subdivided to at least cubic_rate frames per second.
+ * - Frame distance. For each joint, the energy weight (h - depth) / h
+ *   (h = tree height, max depth + 1, as in label.c) times the total
+ *   absolute change of its three Euler angles divided by pi (the axis
+ *   range Max(R) without joint limits). Angles are taken in the joint's
+ *   own order, differences wrapped into (-pi, pi] and the nearer of the
+ *   two Euler triples of the rotation used, so q against -q and 179
+ *   against -179 degrees is no motion. Beyond the paper, translation
+ *   change over the skeleton height and scale change are added, so root
+ *   motion counts.
+ * - The tree. Line 0 is every frame. One pass scans neighbouring pairs
+ *   left to right and fuses each disjoint pair closer than the threshold,
+ *   giving the next line; a level at threshold T is the line reached when
+ *   no neighbouring pair is closer than T any more (passes repeat). A
+ *   level is built from the previous one, so levels are nested. Removal
+ *   keeps the frame of the pair that linear interpolation of its
+ *   neighbours reproduces worse; averaging puts one frame at the pair's
+ *   mean time (frames weighted by how many original frames they stand
+ *   for). The first and last frames are pinned: a pair holding one
+ *   keeps it as it is, so the duration is kept.
+ * - Levels are chosen by threshold, by the fraction of keys kept
+ *   (bisection on the threshold), or by an error bound (bisection on the
+ *   threshold, accepting only thresholds whose level measures within the
+ *   bound at every frame of the common timeline). Removal measured better
+ *   than averaging (bench/results-motion.md) and is the default.
+ * - The keys method (keyreduce.c) is driven from here the same way, with
+ *   the error budget in place of the threshold.
+ *
+ * Error is the world position error of every joint and End Site at every
+ * frame of the common timeline, computed with the same sampling and
+ * forward kinematics as mlod_joint_deviation, so a bound met here is met
+ * there; the reported error is mlod_joint_deviation's.
+ */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mlod.h"
+
+#define PI 3.14159265358979323846
+#define DEFAULT_CUBIC_RATE 60.0
+#define MAX_FRAMES 10000000
+#define MAX_VALUES 200000000.0 /* floats of a common clip */
+#define SEARCH_STEPS 40
+#define KEYS_RETRIES 6
+
+/* Axes of each Euler order, outermost first (as in math.c). */
+static const int euler_axes[6][3] = {
+	{ 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 }
+};
+
+static int comps_of(const mlod_channel *ch)
+{
+	return ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+}
+
+/* ---------------------------------------------------------------- */
+/* Clips                                                             */
+/* ---------------------------------------------------------------- */
+
+void mlod_clip_free(mlod_clip *clip)
+{
+	if (!clip)
+		return;
+	for (int i = 0; clip->channels && i < clip->channel_count; i++) {
+		free(clip->channels[i].times);
+		free(clip->channels[i].values);
+	}
+	free(clip->channels);
+	free(clip->name);
+	memset(clip, 0, sizeof *clip);
+}
+
+long mlod_clip_key_count(const mlod_clip *clip)
+{
+	long n = 0;
+	for (int i = 0; clip && i < clip->channel_count; i++)
+		n += clip->channels[i].key_count;
+	return n;
+}
+
+long mlod_clip_key_bytes(const mlod_clip *clip)
+{
+	long bytes = 0;
+	if (!clip)
+		return 0;
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		long per_key = comps_of(ch) * (ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
+		bytes += (long)ch->key_count * per_key * 4;
+		int shared = 0;
+		for (int k = 0; k < i && !shared; k++) {
+			const mlod_channel *o = &clip->channels[k];
+			shared = o->key_count == ch->key_count &&
+			         memcmp(o->times, ch->times, sizeof(float) * (size_t)ch->key_count) == 0;
+		}
+		if (!shared)
+			bytes += (long)ch->key_count * 4;
+	}
+	return bytes;
+}
+
+static char *dup_string(const char *s)
+{
+	size_t n = strlen(s ? s : "") + 1;
+	char *d = malloc(n);
+	if (d)
+		memcpy(d, s ? s : "", n);
+	return d;
+}
+
+static mlod_result check_clip(const mlod_clip *clip, mlod_error *err)
+{
+	const char *name = clip->name ? clip->name : "";
+	if (clip->channel_count <= 0 || !clip->channels)
+		return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\": no channels to reduce", name);
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		if ((unsigned)ch->path > MLOD_PATH_SCALE || (unsigned)ch->interp > MLOD_INTERP_CUBICSPLINE)
+			return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: bad path or interpolation", name, i);
+		if (ch->key_count <= 0 || !ch->times || !ch->values)
+			return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: no keys", name, i);
+		int comps = comps_of(ch), stride = comps * (ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
+		for (int k = 0; k < ch->key_count; k++) {
+			float t = ch->times[k];
+			if (!isfinite(t))
+				return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: key %d time is not finite", name, i, k);
+			if (k == 0 && t < 0.0f)
+				return mlod_fail(err, MLOD_ERR_PARSE,
+				                 "clip \"%s\" channel %d: first key time %g is negative (glTF needs times >= 0)",
+				                 name, i, (double)t);
+			if (k > 0 && !(t > ch->times[k - 1]))
+				return mlod_fail(err, MLOD_ERR_PARSE,
+				                 "clip \"%s\" channel %d: key %d time %g does not follow %g (times must increase)",
+				                 name, i, k, (double)t, (double)ch->times[k - 1]);
+			const float *v = ch->values + (size_t)k * (size_t)stride;
+			double len2 = 0.0;
+			for (int c = 0; c < stride; c++)
+				if (!isfinite(v[c]))
+					return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: key %d value is not finite", name,
+					                 i, k);
+			if (comps == 4) {
+				const float *q = v + (ch->interp == MLOD_INTERP_CUBICSPLINE ? 4 : 0);
+				for (int c = 0; c < 4; c++)
+					len2 += (double)q[c] * q[c];
+				if (!(len2 > 1e-12))
+					return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: key %d rotation is a zero quaternion",
+					                 name, i, k);
+			}
+		}
+	}
+	return MLOD_OK;
+}
+
+static int float_order(const void *a, const void *b)
+{
+	float x = *(const float *)a, y = *(const float *)b;
+	return (x > y) - (x < y);
+}
+
+/* Samples one channel of clip at t into out (comps floats), exactly as
+ * mlod_clip_sample does. */
+static void sample_one(const mlod_clip *clip, const mlod_channel *ch, float t, float *out)
+{
+	mlod_channel one = *ch;
+	mlod_clip tmp;
+	memset(&tmp, 0, sizeof tmp);
+	one.joint = 0;
+	tmp.duration = clip->duration;
+	tmp.channel_count = 1;
+	tmp.channels = &one;
+	mlod_trs local = mlod_trs_identity();
+	mlod_clip_sample(&tmp, t, &local);
+	switch (ch->path) {
+	case MLOD_PATH_TRANSLATION: out[0] = local.t.x, out[1] = local.t.y, out[2] = local.t.z; break;
+	case MLOD_PATH_SCALE: out[0] = local.s.x, out[1] = local.s.y, out[2] = local.s.z; break;
+	case MLOD_PATH_ROTATION: out[0] = local.r.x, out[1] = local.r.y, out[2] = local.r.z, out[3] = local.r.w; break;
+	}
+}
+
+mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_options *opt, mlod_clip *out,
+                                    mlod_motion_timeline *info, mlod_error *err)
+{
+	mlod_motion_timeline inf;
+	memset(&inf, 0, sizeof inf);
+	if (!clip || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_common_clip: NULL argument");
+	memset(out, 0, sizeof *out);
+	mlod_result r = check_clip(clip, err);
+	if (r != MLOD_OK)
+		return r;
+	double rate = opt && opt->cubic_rate > 0.0 ? opt->cubic_rate : DEFAULT_CUBIC_RATE;
+	const mlod_channel *c0 = &clip->channels[0];
+	int same = 1;
+	long total = 0;
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		total += ch->key_count;
+		if (ch->interp == MLOD_INTERP_CUBICSPLINE)
+			inf.cubic_channels++;
+		if (ch->key_count != c0->key_count ||
+		    memcmp(ch->times, c0->times, sizeof(float) * (size_t)ch->key_count) != 0)
+			same = 0;
+	}
+
+	/* The frames. */
+	float *times = NULL;
+	long n = 0;
+	if (same && inf.cubic_channels == 0) {
+		n = c0->key_count;
+		times = malloc(sizeof(float) * (size_t)n);
+		if (!times)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		memcpy(times, c0->times, sizeof(float) * (size_t)n);
+	} else {
+		float *u = malloc(sizeof(float) * (size_t)total);
+		if (!u)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		long m = 0;
+		for (int i = 0; i < clip->channel_count; i++) {
+			memcpy(u + m, clip->channels[i].times, sizeof(float) * (size_t)clip->channels[i].key_count);
+			m += clip->channels[i].key_count;
+		}
+		qsort(u, (size_t)m, sizeof *u, float_order);
+		long k = 0;
+		for (long i = 0; i < m; i++)
+			if (k == 0 || u[i] != u[k - 1])
+				u[k++] = u[i];
+		/* CUBICSPLINE: evenly spaced frames in intervals longer than 1/rate. */
+		double extra = 0.0;
+		for (long i = 0; inf.cubic_channels && i + 1 < k; i++)
+			extra += ceil(((double)u[i + 1] - u[i]) * rate - 1e-6) - 1.0;
+		if (k + extra > MAX_FRAMES) {
+			free(u);
+			return mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": resampling needs %.0f frames (at most %d)",
+			                 clip->name ? clip->name : "", k + extra, MAX_FRAMES);
+		}
+		n = k + (long)extra;
+		times = malloc(sizeof(float) * (size_t)n);
+		if (!times) {
+			free(u);
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		}
+		long f = 0;
+		for (long i = 0; i < k; i++) {
+			times[f++] = u[i];
+			if (!inf.cubic_channels || i + 1 == k)
+				continue;
+			long sub = (long)(ceil(((double)u[i + 1] - u[i]) * rate - 1e-6));
+			for (long s = 1; s < sub; s++) {
+				float t = (float)((double)u[i] + ((double)u[i + 1] - u[i]) * (double)s / (double)sub);
+				if (t > times[f - 1] && t < u[i + 1])
+					times[f++] = t;
+			}
+		}
+		n = f;
+		free(u);
+		inf.resampled = 1;
+		for (int i = 0; i < clip->channel_count; i++) {
+			const mlod_channel *ch = &clip->channels[i];
+			if (ch->key_count != n || memcmp(ch->times, times, sizeof(float) * (size_t)n) != 0)
+				inf.mismatched_channels++;
+		}
+	}
+	double values = 0.0;
+	for (int i = 0; i < clip->channel_count; i++)
+		values += (double)n * (comps_of(&clip->channels[i]) + 1);
+	if (n > MAX_FRAMES || values > MAX_VALUES) {
+		free(times);
+		return mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": %ld frames of %d channels is too much motion",
+		                 clip->name ? clip->name : "", n, clip->channel_count);
+	}
+	inf.frames = (int)n;
+
+	/* The channels. */
+	out->name = dup_string(clip->name);
+	out->channels = calloc((size_t)clip->channel_count, sizeof *out->channels);
+	out->channel_count = clip->channel_count;
+	out->duration = clip->duration;
+	out->frame_time = clip->frame_time;
+	out->frame_count = clip->frame_count;
+	out->gltf_index = clip->gltf_index;
+	int ok = out->name && out->channels;
+	for (int i = 0; ok && i < clip->channel_count; i++) {
+		const mlod_channel *src = &clip->channels[i];
+		mlod_channel *ch = &out->channels[i];
+		int comps = comps_of(src);
+		ch->joint = src->joint;
+		ch->path = src->path;
+		ch->interp = src->interp == MLOD_INTERP_STEP ? MLOD_INTERP_STEP : MLOD_INTERP_LINEAR;
+		ch->key_count = (int)n;
+		ch->times = malloc(sizeof(float) * (size_t)n);
+		ch->values = malloc(sizeof(float) * (size_t)n * (size_t)comps);
+		if (!ch->times || !ch->values) {
+			ok = 0;
+			break;
+		}
+		memcpy(ch->times, times, sizeof(float) * (size_t)n);
+		int own = !inf.resampled;
+		for (long f = 0; f < n; f++) {
+			float *v = ch->values + f * comps;
+			if (own)
+				memcpy(v, src->values + f * comps, sizeof(float) * (size_t)comps);
+			else
+				sample_one(clip, src, times[f], v);
+			/* Sign-continuous rotations: -q is q. */
+			if (comps == 4 && f > 0) {
+				const float *p = v - 4;
+				if ((double)p[0] * v[0] + (double)p[1] * v[1] + (double)p[2] * v[2] + (double)p[3] * v[3] < 0.0)
+					v[0] = -v[0], v[1] = -v[1], v[2] = -v[2], v[3] = -v[3];
+			}
+		}
+	}
+	free(times);
+	if (!ok) {
+		mlod_clip_free(out);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	if (info)
+		*info = inf;
+	return MLOD_OK;
+}
+
+/* ---------------------------------------------------------------- */
+/* Frame distance                                                    */
+/* ---------------------------------------------------------------- */
+
+static double wrap_angle(double a)
+{
+	a = fmod(a + PI, 2.0 * PI);
+	if (a <= 0.0)
+		a += 2.0 * PI;
+	return a - PI;
+}
+
+/* Sum of |wrapped differences| between two Euler triples of one order,
+ * the nearer of the two triples of b: (A, B, C) and (A + pi, pi - B, C + pi)
+ * over the order's axes, outermost first. */
+static double euler_change(mlod_euler_order order, const float *ea, const float *eb)
+{
+	const int *ax = euler_axes[(unsigned)order < 6 ? order : 0];
+	double d1 = 0.0, d2 = 0.0;
+	for (int a = 0; a < 3; a++)
+		d1 += fabs(wrap_angle((double)eb[a] - ea[a]));
+	double alt[3];
+	alt[ax[0]] = eb[ax[0]] + PI;
+	alt[ax[1]] = PI - eb[ax[1]];
+	alt[ax[2]] = eb[ax[2]] + PI;
+	for (int a = 0; a < 3; a++)
+		d2 += fabs(wrap_angle(alt[a] - ea[a]));
+	return d1 < d2 ? d1 : d2;
+}
+
+/* Energy weights (h - depth) / h, h = max depth + 1 (label.c's weight). */
+static void joint_weights(const mlod_skeleton *s, double *w)
+{
+	int *depth = malloc(sizeof(int) * (size_t)(s->joint_count > 0 ? s->joint_count : 1));
+	int max_depth = 0;
+	for (int j = 0; j < s->joint_count; j++) {
+		int p = s->joints[j].parent;
+		int d = p >= 0 && p < j && depth ? depth[p] + 1 : 0;
+		if (depth)
+			depth[j] = d;
+		if (d > max_depth)
+			max_depth = d;
+		w[j] = d; /* for now */
+	}
+	double h = max_depth + 1.0;
+	for (int j = 0; j < s->joint_count; j++)
+		w[j] = (h - w[j]) / h;
+	free(depth);
+}
+
+static double v3_dist(mlod_v3 a, mlod_v3 b)
+{
+	double dx = (double)a.x - b.x, dy = (double)a.y - b.y, dz = (double)a.z - b.z;
+	return sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+double mlod_motion_frame_distance(const mlod_skeleton *s, const mlod_trs *a, const mlod_trs *b)
+{
+	if (!s || !a || !b || s->joint_count <= 0)
+		return 0.0;
+	double *w = malloc(sizeof(double) * (size_t)s->joint_count);
+	if (!w)
+		return HUGE_VAL;
+	joint_weights(s, w);
+	double height = mlod_skeleton_size(s), d = 0.0;
+	for (int j = 0; j < s->joint_count; j++) {
+		float ea[3], eb[3];
+		mlod_quat_to_euler(s->joints[j].euler, a[j].r, ea);
+		mlod_quat_to_euler(s->joints[j].euler, b[j].r, eb);
+		d += w[j] * (euler_change(s->joints[j].euler, ea, eb) / PI + v3_dist(a[j].t, b[j].t) / height +
+		             v3_dist(a[j].s, b[j].s));
+	}
+	free(w);
+	return d;
+}
+
+/* ---------------------------------------------------------------- */
+/* The motion context                                                */
+/* ---------------------------------------------------------------- */
+
+/* A frame of a line of the tree: its time, the channel values (V floats,
+ * laid out by channel) and the Euler angles of its rotation channels. */
+typedef struct fnode {
+	double time;
+	int leaves;      /* original frames it stands for */
+	int frame;       /* the common frame it is (removal), or -1 (averaged) */
+	float *values;   /* V floats, then 3 * rotation channels Euler angles */
+} fnode;
+
+typedef struct line {
+	int n;
+	fnode *v;
+} line;
+
+struct mlod_motion {
+	const mlod_character *c;
+	const mlod_skeleton *s;
+	const mlod_clip *orig;
+	mlod_motion_options opt;
+	mlod_clip common;
+	mlod_motion_timeline info;
+	int frames;
+	double height;
+	double *weight;        /* per joint */
+	int value_count;       /* V */
+	int rot_count;
+	int *offset;           /* per channel: first value in a node */
+	int *euler_slot;       /* per channel: Euler slot of a rotation channel, else -1 */
+	unsigned char *constant; /* per channel: the same value at every frame */
+	/* The measured points (joints, then End Sites) at every frame. */
+	int point_count;
+	int *point_joint;
+	mlod_v3 *point_offset;
+	mlod_v3 *p0;           /* frames * point_count */
+	mlod_trs *local;
+	mlod_mat4 *world;
+	/* State of each method: the last line of the tree, the keys kept. */
+	line tree;
+	unsigned char *kept;   /* channel_count * frames */
+};
+
+static void line_free(line *l)
+{
+	for (int i = 0; l->v && i < l->n; i++)
+		free(l->v[i].values);
+	free(l->v);
+	l->v = NULL;
+	l->n = 0;
+}
+
+void mlod_motion_free(mlod_motion *m)
+{
+	if (!m)
+		return;
+	mlod_clip_free(&m->common);
+	free(m->weight);
+	free(m->offset);
+	free(m->euler_slot);
+	free(m->constant);
+	free(m->point_joint);
+	free(m->point_offset);
+	free(m->p0);
+	free(m->local);
+	free(m->world);
+	line_free(&m->tree);
+	free(m->kept);
+	free(m);
+}
+
+const mlod_motion_timeline *mlod_motion_timeline_info(const mlod_motion *m)
+{
+	return m ? &m->info : NULL;
+}
+
+/* Poses the skeleton with clip at t into m->world. */
+static void pose_at(mlod_motion *m, const mlod_clip *clip, float t)
+{
+	mlod_pose_rest(m->s, m->local);
+	mlod_clip_sample(clip, t, m->local);
+	mlod_pose_world(m->s, m->local, m->world);
+}
+
+static mlod_v3 point_at(const mlod_motion *m, int p)
+{
+	return mlod_mat4_point(&m->world[m->point_joint[p]], m->point_offset[p]);
+}
+
+/* Fills node values from common frame f, and its Euler angles. */
+static void node_euler(const mlod_motion *m, fnode *nd)
+{
+	for (int i = 0; i < m->common.channel_count; i++) {
+		int slot = m->euler_slot[i];
+		if (slot < 0)
+			continue;
+		const float *q = nd->values + m->offset[i];
+		mlod_quat r = { q[0], q[1], q[2], q[3] };
+		mlod_quat_to_euler(m->s->joints[m->common.channels[i].joint].euler, r, nd->values + m->value_count + 3 * slot);
+	}
+}
+
+static int node_from_frame(const mlod_motion *m, int f, fnode *nd)
+{
+	nd->values = malloc(sizeof(float) * (size_t)(m->value_count + 3 * m->rot_count + 1));
+	if (!nd->values)
+		return -1;
+	nd->time = m->common.channels[0].times[f];
+	nd->leaves = 1;
+	nd->frame = f;
+	for (int i = 0; i < m->common.channel_count; i++) {
+		const mlod_channel *ch = &m->common.channels[i];
+		int comps = comps_of(ch);
+		memcpy(nd->values + m->offset[i], ch->values + (size_t)f * (size_t)comps, sizeof(float) * (size_t)comps);
+	}
+	node_euler(m, nd);
+	return 0;
+}
+
+mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_motion_options *opt,
+                               mlod_motion **out, mlod_error *err)
+{
+	if (out)
+		*out = NULL;
+	if (!c || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_create: NULL argument");
+	if (clip < 0 || clip >= c->clip_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "no clip %d (the character has %d)", clip, c->clip_count);
+	const mlod_skeleton *s = &c->skeleton;
+	if (s->joint_count <= 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "the skeleton has no joints");
+	const mlod_clip *src = &c->clips[clip];
+	for (int i = 0; i < src->channel_count; i++)
+		if (src->channels && (src->channels[i].joint < 0 || src->channels[i].joint >= s->joint_count))
+			return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: joint %d out of range",
+			                 src->name ? src->name : "", i, src->channels[i].joint);
+	mlod_motion *m = calloc(1, sizeof *m);
+	if (!m)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	m->c = c;
+	m->s = s;
+	m->orig = src;
+	if (opt)
+		m->opt = *opt;
+	mlod_result r = mlod_motion_common_clip(src, opt, &m->common, &m->info, err);
+	if (r != MLOD_OK) {
+		mlod_motion_free(m);
+		return r;
+	}
+	int n = s->joint_count, nch = m->common.channel_count, F = m->info.frames;
+	m->frames = F;
+	m->height = mlod_skeleton_size(s);
+	if (!(m->height > 0.0))
+		m->height = 1.0;
+	m->weight = malloc(sizeof(double) * (size_t)n);
+	m->offset = malloc(sizeof(int) * (size_t)nch);
+	m->euler_slot = malloc(sizeof(int) * (size_t)nch);
+	m->constant = malloc((size_t)nch);
+	m->local = malloc(sizeof *m->local * (size_t)n);
+	m->world = malloc(sizeof *m->world * (size_t)n);
+	int ends = 0;
+	for (int j = 0; j < n; j++)
+		ends += s->joints[j].has_end_site != 0;
+	m->point_count = n + ends;
+	m->point_joint = malloc(sizeof(int) * (size_t)m->point_count);
+	m->point_offset = malloc(sizeof(mlod_v3) * (size_t)m->point_count);
+	m->p0 = malloc(sizeof(mlod_v3) * (size_t)m->point_count * (size_t)F);
+	if (!m->weight || !m->offset || !m->euler_slot || !m->constant || !m->local || !m->world || !m->point_joint ||
+	    !m->point_offset || !m->p0) {
+		mlod_motion_free(m);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	joint_weights(s, m->weight);
+	for (int i = 0; i < nch; i++) {
+		const mlod_channel *ch = &m->common.channels[i];
+		int comps = comps_of(ch);
+		m->offset[i] = m->value_count;
+		m->value_count += comps;
+		m->euler_slot[i] = comps == 4 ? m->rot_count++ : -1;
+		m->constant[i] = 1;
+		for (int f = 1; f < F && m->constant[i]; f++)
+			m->constant[i] = memcmp(ch->values, ch->values + (size_t)f * (size_t)comps, sizeof(float) * (size_t)comps) == 0;
+	}
+	for (int j = 0, e = n; j < n; j++) {
+		m->point_joint[j] = j;
+		m->point_offset[j] = (mlod_v3){ 0, 0, 0 };
+		if (s->joints[j].has_end_site) {
+			m->point_joint[e] = j;
+			m->point_offset[e++] = s->joints[j].end_site;
+		}
+	}
+	for (int f = 0; f < F; f++) {
+		pose_at(m, src, m->common.channels[0].times[f]);
+		for (int p = 0; p < m->point_count; p++)
+			m->p0[(size_t)f * (size_t)m->point_count + (size_t)p] = point_at(m, p);
+	}
+	/* Level 0 of each method: every frame, every key. */
+	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
+	m->kept = malloc((size_t)nch * (size_t)F);
+	if (!m->tree.v || !m->kept) {
+		mlod_motion_free(m);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	for (int f = 0; f < F; f++) {
+		if (node_from_frame(m, f, &m->tree.v[f]) != 0) {
+			mlod_motion_free(m);
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		}
+		m->tree.n = f + 1;
+	}
+	memset(m->kept, 1, (size_t)nch * (size_t)F);
+	*out = m;
+	return MLOD_OK;
+}
+
+/* ---------------------------------------------------------------- */
+/* Levels as clips, and their error                                   */
+/* ---------------------------------------------------------------- */
+
+/* Starts a level clip like the source: name, duration, frame rate. */
+static int level_clip_init(const mlod_motion *m, mlod_clip *clip)
+{
+	memset(clip, 0, sizeof *clip);
+	clip->name = dup_string(m->orig->name);
+	clip->duration = m->orig->duration;
+	clip->frame_time = m->orig->frame_time;
+	clip->frame_count = m->orig->frame_count;
+	clip->gltf_index = m->orig->gltf_index;
+	clip->channel_count = m->common.channel_count;
+	clip->channels = calloc((size_t)clip->channel_count, sizeof *clip->channels);
+	return clip->name && clip->channels ? 0 : -1;
+}
+
+/* The clip must reach the last frame: a channel with a single key gets a
+ * second, equal key there when no channel does. */
+static int keep_duration(const mlod_motion *m, mlod_clip *clip)
+{
+	float end = m->common.channels[0].times[m->frames - 1];
+	int single = -1;
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		if (ch->times[ch->key_count - 1] == end)
+			return 0;
+		if (ch->key_count == 1 && single < 0)
+			single = i;
+	}
+	if (single < 0)
+		return 0;
+	mlod_channel *ch = &clip->channels[single];
+	int comps = comps_of(ch);
+	float *t = realloc(ch->times, 2 * sizeof(float)), *v;
+	if (!t)
+		return -1;
+	ch->times = t;
+	v = realloc(ch->values, 2 * (size_t)comps * sizeof(float));
+	if (!v)
+		return -1;
+	ch->values = v;
+	t[1] = end;
+	memcpy(v + comps, v, (size_t)comps * sizeof(float));
+	ch->key_count = 2;
+	return 0;
+}
+
+/* The level clip of a line of the tree; exactly constant channels keep
+ * one key. */
+static int clip_from_line(const mlod_motion *m, const line *l, mlod_clip *clip)
+{
+	if (level_clip_init(m, clip) != 0)
+		return -1;
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *src = &m->common.channels[i];
+		mlod_channel *ch = &clip->channels[i];
+		int comps = comps_of(src), keys = m->constant[i] ? 1 : l->n;
+		ch->joint = src->joint;
+		ch->path = src->path;
+		ch->interp = src->interp;
+		ch->key_count = keys;
+		ch->times = malloc(sizeof(float) * (size_t)keys);
+		ch->values = malloc(sizeof(float) * (size_t)keys * (size_t)comps);
+		if (!ch->times || !ch->values)
+			return -1;
+		float prev = -FLT_MAX;
+		for (int k = 0; k < keys; k++) {
+			float t = (float)l->v[k].time;
+			if (!(t > prev))
+				t = nextafterf(prev, FLT_MAX);
+			ch->times[k] = prev = t;
+			memcpy(ch->values + (size_t)k * (size_t)comps, l->v[k].values + m->offset[i], sizeof(float) * (size_t)comps);
+		}
+	}
+	return keep_duration(m, clip);
+}
+
+/* The level clip of a key selection. */
+static int clip_from_kept(const mlod_motion *m, const unsigned char *kept, mlod_clip *clip)
+{
+	if (level_clip_init(m, clip) != 0)
+		return -1;
+	int F = m->frames;
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *src = &m->common.channels[i];
+		mlod_channel *ch = &clip->channels[i];
+		const unsigned char *k = kept + (size_t)i * (size_t)F;
+		int comps = comps_of(src), keys = 0;
+		for (int f = 0; f < F; f++)
+			keys += k[f] != 0;
+		ch->joint = src->joint;
+		ch->path = src->path;
+		ch->interp = src->interp;
+		ch->key_count = keys;
+		ch->times = malloc(sizeof(float) * (size_t)(keys > 0 ? keys : 1));
+		ch->values = malloc(sizeof(float) * (size_t)(keys > 0 ? keys : 1) * (size_t)comps);
+		if (!ch->times || !ch->values || keys == 0)
+			return -1;
+		for (int f = 0, n = 0; f < F; f++) {
+			if (!k[f])
+				continue;
+			ch->times[n] = src->times[f];
+			memcpy(ch->values + (size_t)n * (size_t)comps, src->values + (size_t)f * (size_t)comps,
+			       sizeof(float) * (size_t)comps);
+			n++;
+		}
+	}
+	return keep_duration(m, clip);
+}
+
+/* Largest joint (and End Site) position error of a level clip over every
+ * frame of the common timeline, in scene units. */
+static double level_max_error(mlod_motion *m, const mlod_clip *clip)
+{
+	double worst = 0.0;
+	for (int f = 0; f < m->frames; f++) {
+		pose_at(m, clip, m->common.channels[0].times[f]);
+		const mlod_v3 *p0 = m->p0 + (size_t)f * (size_t)m->point_count;
+		for (int p = 0; p < m->point_count; p++) {
+			mlod_v3 d = mlod_v3_sub(point_at(m, p), p0[p]);
+			double e = mlod_v3_length(d);
+			if (!(e <= worst))
+				worst = e; /* NaN counts as the worst */
+		}
+	}
+	return worst;
+}
+
+void mlod_motion_level_free(mlod_motion_level *l)
+{
+	if (!l)
+		return;
+	mlod_clip_free(&l->clip);
+	memset(l, 0, sizeof *l);
+}
+
+/* Fills the level's counts and its error as mlod_joint_deviation measures it. */
+static mlod_result level_finish(const mlod_motion *m, mlod_motion_level *out, mlod_error *err)
+{
+	out->keys = mlod_clip_key_count(&out->clip);
+	out->bytes = mlod_clip_key_bytes(&out->clip);
+	mlod_character a, b;
+	memset(&a, 0, sizeof a);
+	a.skeleton = m->s[0];
+	a.clip_count = 1;
+	b = a;
+	a.clips = (mlod_clip *)m->orig;
+	b.clips = &out->clip;
+	return mlod_joint_deviation(&a, &b, NULL, NULL, 0, &out->error, err);
+}
+
+/* ---------------------------------------------------------------- */
+/* The multiresolution motion tree                                   */
+/* ---------------------------------------------------------------- */
+
+static double node_distance(const mlod_motion *m, const fnode *a, const fnode *b)
+{
+	double d = 0.0;
+	for (int i = 0; i < m->common.channel_count; i++) {
+		if (m->constant[i])
+			continue;
+		const mlod_channel *ch = &m->common.channels[i];
+		const float *va = a->values + m->offset[i], *vb = b->values + m->offset[i];
+		double w = m->weight[ch->joint], term;
+		if (ch->path == MLOD_PATH_ROTATION) {
+			int slot = m->value_count + 3 * m->euler_slot[i];
+			term = euler_change(m->s->joints[ch->joint].euler, a->values + slot, b->values + slot) / PI;
+		} else {
+			double dx = (double)vb[0] - va[0], dy = (double)vb[1] - va[1], dz = (double)vb[2] - va[2];
+			term = sqrt(dx * dx + dy * dy + dz * dz);
+			if (ch->path == MLOD_PATH_TRANSLATION)
+				term /= m->height;
+		}
+		d += w * term;
+	}
+	return d;
+}
+
+static int pinned(const mlod_motion *m, const fnode *nd)
+{
+	return nd->frame == 0 || nd->frame == m->frames - 1;
+}
+
+/* How badly interpolating p and q reproduces x: the frame distance from x
+ * to the interpolated frame, or -1 when out of memory. */
+static double residual(const mlod_motion *m, const fnode *p, const fnode *x, const fnode *q)
+{
+	fnode tmp;
+	tmp.values = malloc(sizeof(float) * (size_t)(m->value_count + 3 * m->rot_count + 1));
+	if (!tmp.values)
+		return -1.0;
+	float u = (float)((x->time - p->time) / (q->time - p->time));
+	for (int i = 0; i < m->common.channel_count; i++) {
+		const mlod_channel *ch = &m->common.channels[i];
+		const float *a = p->values + m->offset[i], *b = q->values + m->offset[i];
+		float *o = tmp.values + m->offset[i];
+		if (ch->interp == MLOD_INTERP_STEP) {
+			memcpy(o, a, sizeof(float) * (size_t)comps_of(ch));
+		} else if (ch->path == MLOD_PATH_ROTATION) {
+			mlod_quat r = mlod_quat_normalize(mlod_quat_slerp((mlod_quat){ a[0], a[1], a[2], a[3] },
+			                                                  (mlod_quat){ b[0], b[1], b[2], b[3] }, u));
+			o[0] = r.x, o[1] = r.y, o[2] = r.z, o[3] = r.w;
+		} else {
+			for (int c = 0; c < 3; c++)
+				o[c] = a[c] + (b[c] - a[c]) * u;
+		}
+	}
+	node_euler(m, &tmp);
+	double d = node_distance(m, x, &tmp);
+	free(tmp.values);
+	return d;
+}
+
+/* Fuses a and b into *o (which owns new values). */
+static int fuse(const mlod_motion *m, const line *l, int i, fnode *o)
+{
+	const fnode *a = &l->v[i], *b = &l->v[i + 1];
+	size_t size = sizeof(float) * (size_t)(m->value_count + 3 * m->rot_count + 1);
+	const fnode *keep = NULL;
+	if (pinned(m, a))
+		keep = a;
+	else if (pinned(m, b))
+		keep = b;
+	else if (m->opt.merge == MLOD_MOTION_REMOVE) {
+		/* Neighbours exist: neither a nor b is an end. */
+		double ra = residual(m, &l->v[i - 1], a, b), rb = residual(m, a, b, &l->v[i + 2]);
+		if (ra < 0.0 || rb < 0.0)
+			return -1;
+		keep = ra >= rb ? a : b; /* drop the one interpolation reproduces better */
+	}
+	o->values = malloc(size);
+	if (!o->values)
+		return -1;
+	if (keep) {
+		memcpy(o->values, keep->values, size);
+		o->time = keep->time;
+		o->frame = keep->frame;
+		o->leaves = a->leaves + b->leaves;
+		return 0;
+	}
+	double wa = a->leaves, wb = b->leaves, sum = wa + wb;
+	o->time = (wa * a->time + wb * b->time) / sum;
+	o->frame = -1;
+	o->leaves = a->leaves + b->leaves;
+	for (int c = 0; c < m->common.channel_count; c++) {
+		const mlod_channel *ch = &m->common.channels[c];
+		const float *x = a->values + m->offset[c], *y = b->values + m->offset[c];
+		float *v = o->values + m->offset[c];
+		if (ch->path == MLOD_PATH_ROTATION) {
+			double dot = (double)x[0] * y[0] + (double)x[1] * y[1] + (double)x[2] * y[2] + (double)x[3] * y[3];
+			double sb = dot < 0.0 ? -wb : wb, q[4], n = 0.0;
+			for (int k = 0; k < 4; k++) {
+				q[k] = wa * x[k] + sb * y[k];
+				n += q[k] * q[k];
+			}
+			n = sqrt(n);
+			for (int k = 0; k < 4; k++)
+				v[k] = n > 0.0 ? (float)(q[k] / n) : x[k];
+		} else {
+			for (int k = 0; k < 3; k++)
+				v[k] = (float)((wa * x[k] + wb * y[k]) / sum);
+		}
+	}
+	node_euler(m, o);
+	return 0;
+}
+
+/* One pass of the tree: fuses disjoint neighbouring pairs closer than T.
+ * Returns the number of fusions, or -1 when out of memory. */
+static int tree_pass(const mlod_motion *m, const line *in, double T, line *out)
+{
+	out->v = calloc((size_t)(in->n > 0 ? in->n : 1), sizeof *out->v);
+	out->n = 0;
+	if (!out->v)
+		return -1;
+	int fused = 0;
+	for (int i = 0; i < in->n;) {
+		fnode *o = &out->v[out->n];
+		if (i + 1 < in->n && !(pinned(m, &in->v[i]) && pinned(m, &in->v[i + 1])) &&
+		    node_distance(m, &in->v[i], &in->v[i + 1]) < T) {
+			if (fuse(m, in, i, o) != 0)
+				return -1;
+			out->n++;
+			fused++;
+			i += 2;
+		} else {
+			size_t size = sizeof(float) * (size_t)(m->value_count + 3 * m->rot_count + 1);
+			*o = in->v[i];
+			o->values = malloc(size);
+			if (!o->values)
+				return -1;
+			memcpy(o->values, in->v[i].values, size);
+			out->n++;
+			i++;
+		}
+	}
+	return fused;
+}
+
+/* The line reached from in when no neighbouring pair is closer than T. */
+static int tree_level(const mlod_motion *m, const line *in, double T, line *out)
+{
+	line cur = { 0, NULL };
+	int first = 1;
+	for (;;) {
+		line next = { 0, NULL };
+		int fused = tree_pass(m, first ? in : &cur, T, &next);
+		if (fused < 0) {
+			line_free(&next);
+			line_free(&cur);
+			return -1;
+		}
+		if (!first)
+			line_free(&cur);
+		cur = next;
+		first = 0;
+		if (fused == 0)
+			break;
+	}
+	*out = cur;
+	return 0;
+}
+
+/* The sum of the distances between neighbours of a line: fusing frames
+ * only brings frames of the line together, so every pair fuses below
+ * about that. */
+static double total_neighbour_distance(const mlod_motion *m, const line *l)
+{
+	double d = 0.0;
+	for (int i = 0; i + 1 < l->n; i++)
+		d += node_distance(m, &l->v[i], &l->v[i + 1]);
+	return d;
+}
+
+static long line_keys(const mlod_motion *m, const line *l)
+{
+	long keys = 0;
+	for (int i = 0; i < m->common.channel_count; i++)
+		keys += m->constant[i] ? 1 : l->n;
+	return keys;
+}
+
+/* The frames method: the next line of the tree. */
+static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
+                                mlod_error *err)
+{
+	line best = { 0, NULL };
+	double T = 0.0;
+	const char *name = m->orig->name ? m->orig->name : "";
+	if (target == MLOD_MOTION_THRESHOLD) {
+		T = value;
+		if (tree_level(m, &m->tree, T, &best) != 0)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	} else {
+		/* Bisection on T: lo is acceptable, hi is not (or is the top). */
+		double hi = 2.0 * total_neighbour_distance(m, &m->tree) + 1e-9, lo = 0.0;
+		long budget = target == MLOD_MOTION_FRACTION ? (long)floor(value * (double)mlod_clip_key_count(m->orig)) : 0;
+		for (int step = 0; step <= SEARCH_STEPS; step++) {
+			double t = step == 0 ? hi : 0.5 * (lo + hi);
+			line l = { 0, NULL };
+			if (tree_level(m, &m->tree, t, &l) != 0)
+				return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+			int ok;
+			if (target == MLOD_MOTION_FRACTION) {
+				ok = line_keys(m, &l) <= budget; /* here "ok" means small enough: search the smallest T */
+			} else {
+				mlod_clip c;
+				if (clip_from_line(m, &l, &c) != 0) {
+					mlod_clip_free(&c);
+					line_free(&l);
+					line_free(&best);
+					return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+				}
+				ok = level_max_error(m, &c) <= value;
+				mlod_clip_free(&c);
+			}
+			if (target == MLOD_MOTION_FRACTION) {
+				if (ok) {
+					line_free(&best);
+					best = l;
+					T = t;
+					hi = t;
+				} else {
+					line_free(&l);
+					lo = t;
+				}
+				if (step == 0 && !ok)
+					break; /* even merging everything keeps too many: take the coarsest */
+			} else {
+				if (ok) {
+					line_free(&best);
+					best = l;
+					T = t;
+					lo = t;
+					if (step == 0)
+						break;
+				} else {
+					line_free(&l);
+					hi = t;
+				}
+			}
+		}
+		if (!best.v) {
+			/* Fraction: even the top is too many keys, so take it; error: T = 0,
+			 * the previous line, whose error must be within the bound. */
+			T = target == MLOD_MOTION_FRACTION ? hi : 0.0;
+			if (tree_level(m, &m->tree, T, &best) != 0)
+				return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+			if (target == MLOD_MOTION_MAX_ERROR) {
+				mlod_clip c;
+				int bad = clip_from_line(m, &best, &c) != 0;
+				double e = bad ? 0.0 : level_max_error(m, &c);
+				mlod_clip_free(&c);
+				if (bad) {
+					line_free(&best);
+					return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+				}
+				if (!(e <= value)) {
+					line_free(&best);
+					return mlod_fail(err, MLOD_ERR_LIMIT,
+					                 "clip \"%s\": no frames level within %g: the %s already deviates by %g", name,
+					                 value, m->info.resampled ? "resampled clip" : "previous level", e);
+				}
+			}
+		}
+	}
+	memset(out, 0, sizeof *out);
+	out->method = MLOD_MOTION_FRAMES;
+	out->threshold = T;
+	if (clip_from_line(m, &best, &out->clip) != 0) {
+		line_free(&best);
+		mlod_motion_level_free(out);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	line_free(&m->tree);
+	m->tree = best;
+	mlod_result r = level_finish(m, out, err);
+	if (r != MLOD_OK)
+		mlod_motion_level_free(out);
+	return r;
+}
+
+/* ---------------------------------------------------------------- */
+/* The keys method                                                   */
+/* ---------------------------------------------------------------- */
+
+static double point_distance(const mlod_motion *m)
+{
+	return m->opt.point_distance > 0.0 ? m->opt.point_distance : m->height / 18.0;
+}
+
+/* Runs the key reduction with budget from the current keys into kept;
+ * returns the clip's largest error, or -1 with err set. */
+static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_clip *clip, mlod_error *err)
+{
+	size_t size = (size_t)m->common.channel_count * (size_t)m->frames;
+	memcpy(kept, m->kept, size);
+	memset(clip, 0, sizeof *clip);
+	if (mlod_keyreduce(m->s, m->orig, &m->common, budget, point_distance(m), kept, err) != MLOD_OK)
+		return -1.0;
+	if (clip_from_kept(m, kept, clip) != 0) {
+		mlod_clip_free(clip);
+		mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		return -1.0;
+	}
+	return level_max_error(m, clip);
+}
+
+static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
+                              mlod_error *err)
+{
+	const char *name = m->orig->name ? m->orig->name : "";
+	if (target == MLOD_MOTION_THRESHOLD)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "thresholds are frame distances: they need the frames method");
+	size_t size = (size_t)m->common.channel_count * (size_t)m->frames;
+	unsigned char *kept = malloc(size), *best = malloc(size);
+	mlod_clip clip, best_clip;
+	double best_budget = -1.0;
+	memset(&best_clip, 0, sizeof best_clip);
+	mlod_result r = MLOD_OK;
+	if (!kept || !best) {
+		free(kept);
+		free(best);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	if (target == MLOD_MOTION_MAX_ERROR) {
+		/* The budget bounds a stricter metric; retry smaller if float
+		 * rounding lets the measured error pass the bound. */
+		double budget = value * (1.0 - 1e-5);
+		for (int t = 0; t < KEYS_RETRIES && best_budget < 0.0; t++, budget *= 0.9) {
+			double e = keys_try(m, budget, kept, &clip, err);
+			if (e < 0.0) {
+				r = err ? err->code : MLOD_ERR_NOMEM;
+				break;
+			}
+			if (e <= value) {
+				memcpy(best, kept, size);
+				best_clip = clip;
+				best_budget = budget;
+			} else {
+				mlod_clip_free(&clip);
+			}
+		}
+		if (r == MLOD_OK && best_budget < 0.0) {
+			mlod_clip c0;
+			double e = keys_try(m, 0.0, kept, &c0, err);
+			mlod_clip_free(&c0);
+			r = mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": no keys level within %g: the %s already deviates by %g",
+			              name, value, m->info.resampled ? "resampled clip" : "previous level", e);
+		}
+	} else {
+		long target_keys = (long)floor(value * (double)mlod_clip_key_count(m->orig));
+		double lo = 0.0, hi = m->height;
+		/* Grow hi until it reaches the target (or everything is constant). */
+		for (int g = 0; g < 12 && r == MLOD_OK; g++) {
+			double e = keys_try(m, hi, kept, &clip, err);
+			if (e < 0.0) {
+				r = err ? err->code : MLOD_ERR_NOMEM;
+				break;
+			}
+			long keys = mlod_clip_key_count(&clip);
+			mlod_clip_free(&best_clip);
+			memcpy(best, kept, size);
+			best_clip = clip;
+			best_budget = hi;
+			if (keys <= target_keys)
+				break;
+			lo = hi;
+			hi *= 4.0;
+		}
+		for (int step = 0; step < SEARCH_STEPS / 2 && r == MLOD_OK && mlod_clip_key_count(&best_clip) <= target_keys;
+		     step++) {
+			double mid = 0.5 * (lo + hi);
+			double e = keys_try(m, mid, kept, &clip, err);
+			if (e < 0.0) {
+				r = err ? err->code : MLOD_ERR_NOMEM;
+				break;
+			}
+			if (mlod_clip_key_count(&clip) <= target_keys) {
+				mlod_clip_free(&best_clip);
+				memcpy(best, kept, size);
+				best_clip = clip;
+				best_budget = mid;
+				hi = mid;
+			} else {
+				mlod_clip_free(&clip);
+				lo = mid;
+			}
+		}
+	}
+	free(kept);
+	if (r != MLOD_OK) {
+		free(best);
+		mlod_clip_free(&best_clip);
+		return r;
+	}
+	memset(out, 0, sizeof *out);
+	out->method = MLOD_MOTION_KEYS;
+	out->threshold = best_budget;
+	out->clip = best_clip;
+	free(m->kept);
+	m->kept = best;
+	r = level_finish(m, out, err);
+	if (r != MLOD_OK)
+		mlod_motion_level_free(out);
+	return r;
+}
+
+mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
+                                   double value, mlod_motion_level *out, mlod_error *err)
+{
+	if (!m || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_next_level: NULL argument");
+	memset(out, 0, sizeof *out);
+	if (!(value >= 0.0) || !isfinite(value) || (target == MLOD_MOTION_FRACTION && value > 1.0))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad level value %g", value);
+	if ((unsigned)target > MLOD_MOTION_MAX_ERROR)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad level target %d", (int)target);
+	switch (method) {
+	case MLOD_MOTION_FRAMES: return frames_level(m, target, value, out, err);
+	case MLOD_MOTION_KEYS: return keys_level(m, target, value, out, err);
+	}
+	return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad method %d", (int)method);
+}

@@ -1,0 +1,595 @@
+/* test_motion.c: the motion layer: common timelines, frame distance, the
+ * multiresolution motion tree and per-channel key reduction. */
+#include "test.h"
+
+#define PI_F 3.14159265358979323846f
+
+/* A chain of n joints, bones of length 1 along y, and one clip of F
+ * frames at 30 fps with a LINEAR rotation channel per joint (values
+ * zeroed: the caller fills them). */
+static mlod_character make_chain(int n, int F)
+{
+	mlod_character c = {0};
+	c.skeleton.joint_count = n;
+	c.skeleton.joints = calloc((size_t)n, sizeof(mlod_joint));
+	for (int j = 0; j < n; j++) {
+		mlod_joint *jt = &c.skeleton.joints[j];
+		char name[16];
+		snprintf(name, sizeof name, "j%d", j);
+		jt->name = strdup(name);
+		jt->parent = j - 1;
+		jt->rest = mlod_trs_identity();
+		jt->rest.t.y = j > 0 ? 1.0f : 0.0f;
+		jt->base = mlod_mat4_identity();
+		jt->node = -1;
+	}
+	c.clip_count = 1;
+	c.clips = calloc(1, sizeof(mlod_clip));
+	mlod_clip *cl = &c.clips[0];
+	cl->name = strdup("test");
+	cl->gltf_index = -1;
+	cl->channel_count = n;
+	cl->channels = calloc((size_t)n, sizeof(mlod_channel));
+	cl->duration = (float)(F - 1) / 30.0f;
+	for (int j = 0; j < n; j++) {
+		mlod_channel *ch = &cl->channels[j];
+		ch->joint = j;
+		ch->path = MLOD_PATH_ROTATION;
+		ch->interp = MLOD_INTERP_LINEAR;
+		ch->key_count = F;
+		ch->times = calloc((size_t)F, sizeof(float));
+		ch->values = calloc((size_t)F * 4, sizeof(float));
+		for (int f = 0; f < F; f++) {
+			ch->times[f] = (float)f / 30.0f;
+			ch->values[4 * f + 3] = 1.0f;
+		}
+	}
+	return c;
+}
+
+static void set_rot(mlod_channel *ch, int f, mlod_quat q)
+{
+	float *v = ch->values + 4 * f;
+	v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
+}
+
+static int load_sample(const char *path, mlod_character *c)
+{
+	size_t size;
+	void *data = test_read_file(path, &size);
+	if (!data)
+		return -1;
+	mlod_error e = {0};
+	mlod_result r = mlod_load(data, size, "samples", NULL, c, NULL, &e);
+	free(data);
+	if (r != MLOD_OK)
+		fprintf(stderr, "%s: %s\n", path, e.message);
+	return r == MLOD_OK ? 0 : -1;
+}
+
+/* World positions of every joint of c posed by clip at t. */
+static void positions(const mlod_character *c, const mlod_clip *clip, float t, mlod_v3 *out)
+{
+	int n = c->skeleton.joint_count;
+	mlod_trs *l = malloc(sizeof *l * (size_t)n);
+	mlod_mat4 *w = malloc(sizeof *w * (size_t)n);
+	mlod_pose_rest(&c->skeleton, l);
+	mlod_clip_sample(clip, t, l);
+	mlod_pose_world(&c->skeleton, l, w);
+	for (int j = 0; j < n; j++)
+		out[j] = mlod_mat4_point(&w[j], (mlod_v3){0, 0, 0});
+	free(l);
+	free(w);
+}
+
+/* First and last key times over a clip's channels. */
+static void clip_span(const mlod_clip *clip, float *first, float *last)
+{
+	*first = 1e30f, *last = -1e30f;
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		if (ch->times[0] < *first)
+			*first = ch->times[0];
+		if (ch->times[ch->key_count - 1] > *last)
+			*last = ch->times[ch->key_count - 1];
+	}
+}
+
+/* Levels under bounds of 0.2%, 1% and 3% of the height, for one method:
+ * each within its bound, ordered, keeping duration and end frames. */
+static int check_levels(const mlod_character *c, int k, mlod_motion_method method, char *why, size_t size)
+{
+	double h = mlod_skeleton_size(&c->skeleton), pct[3] = {0.2, 1.0, 3.0};
+	mlod_motion *m = NULL;
+	mlod_error e = {0};
+	mlod_motion_options opt = {0};
+	const mlod_clip *src = &c->clips[k];
+	long prev = mlod_clip_key_count(src);
+	float f0, f1;
+	clip_span(src, &f0, &f1);
+	int n = c->skeleton.joint_count, bad = 0;
+	mlod_v3 *a = malloc(sizeof *a * (size_t)n), *b = malloc(sizeof *b * (size_t)n);
+	if (mlod_motion_create(c, k, &opt, &m, &e) != MLOD_OK) {
+		snprintf(why, size, "create: %.400s", e.message);
+		bad = 1;
+	}
+	for (int l = 0; l < 3 && !bad; l++) {
+		mlod_motion_level lv;
+		double bound = pct[l] * h / 100.0;
+		if (mlod_motion_next_level(m, method, MLOD_MOTION_MAX_ERROR, bound, &lv, &e) != MLOD_OK) {
+			snprintf(why, size, "clip %d level %d: %.400s", k, l + 1, e.message);
+			bad = 1;
+			break;
+		}
+		float g0, g1;
+		clip_span(&lv.clip, &g0, &g1);
+		if (!(lv.error.max <= bound))
+			snprintf(why, size, "clip %d level %d: error %g over bound %g", k, l + 1, lv.error.max, bound), bad = 1;
+		else if (lv.keys > prev)
+			snprintf(why, size, "clip %d level %d: %ld keys after %ld", k, l + 1, lv.keys, prev), bad = 1;
+		else if (g0 != f0 || g1 != f1 || lv.clip.duration != src->duration)
+			snprintf(why, size, "clip %d level %d: span %g..%g (duration %g) for %g..%g (%g)", k, l + 1, g0, g1,
+			         lv.clip.duration, f0, f1, src->duration), bad = 1;
+		/* The first and last frames are kept exactly. */
+		for (int end = 0; end < 2 && !bad; end++) {
+			float t = end ? f1 : f0;
+			positions(c, src, t, a);
+			positions(c, &lv.clip, t, b);
+			for (int j = 0; j < n && !bad; j++)
+				if (mlod_v3_length(mlod_v3_sub(a[j], b[j])) > 1e-6 * h)
+					snprintf(why, size, "clip %d level %d: joint %d moved at t = %g", k, l + 1, j, t), bad = 1;
+		}
+		prev = lv.keys;
+		mlod_motion_level_free(&lv);
+	}
+	mlod_motion_free(m);
+	free(a);
+	free(b);
+	return bad;
+}
+
+TEST(levels_within_bounds_cmu)
+{
+	mlod_character c;
+	char why[512] = "";
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	CHECK_MSG(!check_levels(&c, 0, MLOD_MOTION_FRAMES, why, sizeof why), "frames: %s", why);
+	CHECK_MSG(!check_levels(&c, 0, MLOD_MOTION_KEYS, why, sizeof why), "keys: %s", why);
+	mlod_character_free(&c);
+}
+
+TEST(levels_within_bounds_robot)
+{
+	mlod_character c;
+	char why[512] = "";
+	CHECK(load_sample("samples/RobotExpressive.glb", &c) == 0);
+	for (int k = 0; k < c.clip_count; k++) {
+		CHECK_MSG(!check_levels(&c, k, MLOD_MOTION_FRAMES, why, sizeof why), "frames: %s", why);
+		CHECK_MSG(!check_levels(&c, k, MLOD_MOTION_KEYS, why, sizeof why), "keys: %s", why);
+	}
+	mlod_character_free(&c);
+}
+
+TEST(keys_method_beats_frames_on_cmu)
+{
+	/* The measurement behind the default: at 1% of the height. */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double bound = 0.01 * mlod_skeleton_size(&c.skeleton);
+	long bytes[2];
+	for (int method = 0; method < 2; method++) {
+		mlod_motion *m;
+		mlod_motion_level lv;
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+		CHECK_OK(mlod_motion_next_level(m, (mlod_motion_method)method, MLOD_MOTION_MAX_ERROR, bound, &lv, &terr));
+		bytes[method] = lv.bytes;
+		CHECK(lv.bytes == mlod_clip_key_bytes(&lv.clip) && lv.keys == mlod_clip_key_count(&lv.clip));
+		mlod_motion_level_free(&lv);
+		mlod_motion_free(m);
+	}
+	CHECK_MSG(bytes[MLOD_MOTION_KEYS] < bytes[MLOD_MOTION_FRAMES], "keys %ld bytes, frames %ld", bytes[1], bytes[0]);
+	mlod_character_free(&c);
+}
+
+TEST(fraction_of_keys)
+{
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	long total = mlod_clip_key_count(&c.clips[0]);
+	for (int method = 0; method < 2; method++) {
+		mlod_motion *m;
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+		double fr[2] = {0.5, 0.1};
+		for (int i = 0; i < 2; i++) {
+			mlod_motion_level lv;
+			CHECK_OK(mlod_motion_next_level(m, (mlod_motion_method)method, MLOD_MOTION_FRACTION, fr[i], &lv, &terr));
+			CHECK_MSG(lv.keys <= (long)(fr[i] * (double)total), "method %d: %ld keys for %g of %ld", method, lv.keys,
+			          fr[i], total);
+			/* Not absurdly fewer: within 40% of the target. */
+			CHECK_MSG(lv.keys >= (long)(0.6 * fr[i] * (double)total), "method %d: only %ld keys for %g of %ld", method,
+			          lv.keys, fr[i], total);
+			mlod_motion_level_free(&lv);
+		}
+		mlod_motion_free(m);
+	}
+	mlod_character_free(&c);
+}
+
+TEST(tree_levels_are_nested)
+{
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	mlod_motion *m;
+	CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+	double T[3] = {0.1, 0.2, 0.5};
+	mlod_motion_level prev = {0};
+	for (int i = 0; i < 3; i++) {
+		mlod_motion_level lv;
+		CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_FRAMES, MLOD_MOTION_THRESHOLD, T[i], &lv, &terr));
+		CHECK(lv.threshold == T[i]);
+		/* Removal keeps original frames: each level's times are among the previous level's. */
+		const mlod_channel *ch = &lv.clip.channels[0];
+		const mlod_channel *pc = i ? &prev.clip.channels[0] : &c.clips[0].channels[0];
+		CHECK(ch->key_count < pc->key_count);
+		for (int k = 0, p = 0; k < ch->key_count; k++) {
+			while (p < pc->key_count && pc->times[p] != ch->times[k])
+				p++;
+			CHECK_MSG(p < pc->key_count, "level %d: time %g is not in the previous level", i + 1, ch->times[k]);
+		}
+		mlod_motion_level_free(&prev);
+		prev = lv;
+	}
+	mlod_motion_level_free(&prev);
+	mlod_motion_free(m);
+	CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+	mlod_motion_level lv;
+	CHECK(mlod_motion_next_level(m, MLOD_MOTION_KEYS, MLOD_MOTION_THRESHOLD, 0.1, &lv, &terr) == MLOD_ERR_INVALID_ARG);
+	CHECK(mlod_motion_next_level(m, MLOD_MOTION_KEYS, MLOD_MOTION_FRACTION, 1.5, &lv, &terr) == MLOD_ERR_INVALID_ARG);
+	mlod_motion_free(m);
+	mlod_character_free(&c);
+}
+
+TEST(average_merge_keeps_ends)
+{
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	mlod_motion *m;
+	mlod_motion_options opt = {0};
+	opt.merge = MLOD_MOTION_AVERAGE;
+	CHECK_OK(mlod_motion_create(&c, 0, &opt, &m, &terr));
+	mlod_motion_level lv;
+	CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_FRAMES, MLOD_MOTION_THRESHOLD, 0.05, &lv, &terr));
+	const mlod_channel *ch = &lv.clip.channels[0], *src = &c.clips[0].channels[0];
+	CHECK(ch->key_count < src->key_count);
+	CHECK(ch->times[0] == src->times[0] && ch->times[ch->key_count - 1] == src->times[src->key_count - 1]);
+	CHECK(memcmp(ch->values, src->values, 3 * sizeof(float)) == 0);
+	/* Averaged frames sit at times that no original frame has. */
+	int off_grid = 0;
+	for (int k = 0; k < ch->key_count; k++) {
+		double f = ch->times[k] / c.clips[0].frame_time;
+		off_grid += fabs(f - floor(f + 0.5)) > 1e-3;
+	}
+	CHECK(off_grid > 0);
+	mlod_motion_level_free(&lv);
+	mlod_motion_free(m);
+	mlod_character_free(&c);
+}
+
+TEST(sign_flips_are_not_motion)
+{
+	/* One joint holding the same rotation, stored as q and -q in turn. */
+	mlod_character c = make_chain(2, 20);
+	mlod_quat q = mlod_quat_axis_angle((mlod_v3){0.3f, 1, 0.2f}, 1.1f);
+	mlod_quat nq = {-q.x, -q.y, -q.z, -q.w};
+	for (int f = 0; f < 20; f++)
+		set_rot(&c.clips[0].channels[0], f, f % 2 ? nq : q);
+	mlod_trs a[2], b[2];
+	mlod_pose_rest(&c.skeleton, a);
+	mlod_pose_rest(&c.skeleton, b);
+	a[0].r = q;
+	b[0].r = nq;
+	CHECK(mlod_motion_frame_distance(&c.skeleton, a, b) < 1e-6);
+	for (int method = 0; method < 2; method++) {
+		mlod_motion *m;
+		mlod_motion_level lv;
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+		if (method == MLOD_MOTION_FRAMES)
+			CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_FRAMES, MLOD_MOTION_THRESHOLD, 1e-6, &lv, &terr));
+		else
+			CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_KEYS, MLOD_MOTION_MAX_ERROR, 1e-6, &lv, &terr));
+		/* Nothing moves: one key per channel, and one more to keep the duration. */
+		CHECK_MSG(lv.keys <= 3, "method %d: %ld keys", method, lv.keys);
+		CHECK(lv.clip.duration == c.clips[0].duration);
+		mlod_motion_level_free(&lv);
+		mlod_motion_free(m);
+	}
+	mlod_character_free(&c);
+}
+
+TEST(angle_wrap_is_not_motion)
+{
+	/* A BVH-like joint turning 170, 179, -179, -170 degrees about z: the
+	 * steps are 9, 2 and 9 degrees, not 358. */
+	mlod_character c = make_chain(2, 4);
+	c.skeleton.joints[0].euler = MLOD_EULER_ZXY;
+	float deg[4] = {170, 179, -179, -170};
+	mlod_trs p[4][2];
+	for (int f = 0; f < 4; f++) {
+		float e[3] = {0, 0, deg[f] * PI_F / 180.0f};
+		mlod_pose_rest(&c.skeleton, p[f]);
+		p[f][0].r = mlod_quat_from_euler(MLOD_EULER_ZXY, e);
+	}
+	double d01 = mlod_motion_frame_distance(&c.skeleton, p[0], p[1]);
+	double d12 = mlod_motion_frame_distance(&c.skeleton, p[1], p[2]);
+	double d23 = mlod_motion_frame_distance(&c.skeleton, p[2], p[3]);
+	/* Weight of the root: (h - 0) / h = 1; distance = angle / pi. */
+	CHECK_NEAR(d12, 2.0 / 180.0, 1e-5);
+	CHECK_NEAR(d01, 9.0 / 180.0, 1e-5);
+	CHECK_NEAR(d23, d01, 1e-5);
+	/* A joint one level down weighs (2 - 1) / 2. */
+	mlod_trs q0[2], q1[2];
+	mlod_pose_rest(&c.skeleton, q0);
+	mlod_pose_rest(&c.skeleton, q1);
+	q0[1].r = p[1][0].r;
+	q1[1].r = p[2][0].r;
+	CHECK_NEAR(mlod_motion_frame_distance(&c.skeleton, q0, q1), 0.5 * 2.0 / 180.0, 1e-5);
+	/* Near gimbal lock the two Euler triples of a rotation are both valid:
+	 * the distance between a pose and itself through either is 0. */
+	float g[3] = {0.4f, PI_F / 2 - 1e-4f, -0.7f};
+	mlod_trs r0[2], r1[2];
+	mlod_pose_rest(&c.skeleton, r0);
+	mlod_pose_rest(&c.skeleton, r1);
+	r0[0].r = mlod_quat_from_euler(MLOD_EULER_XYZ, g);
+	float g2[3] = {g[0] + PI_F, PI_F - g[1], g[2] + PI_F};
+	r1[0].r = mlod_quat_from_euler(MLOD_EULER_XYZ, g2);
+	CHECK(mlod_quat_angle(r0[0].r, r1[0].r) < 1e-3f);
+	CHECK(mlod_motion_frame_distance(&c.skeleton, r0, r1) < 1e-2);
+	mlod_character_free(&c);
+}
+
+TEST(points_out_from_leaves_are_kept)
+{
+	/* Only the leaf turns: no joint position moves, so the frames method
+	 * (joint positions) drops every frame, while the keys method keeps the
+	 * leaf's rotation within the bound at point_distance. */
+	int F = 61;
+	mlod_character c = make_chain(3, F);
+	for (int f = 0; f < F; f++)
+		set_rot(&c.clips[0].channels[2], f, mlod_quat_axis_angle((mlod_v3){1, 0, 0}, 0.8f * sinf(0.3f * (float)f)));
+	double bound = 0.01, r = 0.1;
+	mlod_motion_options opt = {0};
+	opt.point_distance = r;
+	mlod_motion *m;
+	mlod_motion_level lv;
+	CHECK_OK(mlod_motion_create(&c, 0, &opt, &m, &terr));
+	CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_FRAMES, MLOD_MOTION_MAX_ERROR, bound, &lv, &terr));
+	CHECK_MSG(lv.clip.channels[2].key_count == 2, "%d %d %d keys, error %g", lv.clip.channels[0].key_count, lv.clip.channels[1].key_count, lv.clip.channels[2].key_count, lv.error.max);
+	CHECK(lv.error.max <= bound);
+	mlod_motion_level_free(&lv);
+	mlod_motion_free(m);
+
+	CHECK_OK(mlod_motion_create(&c, 0, &opt, &m, &terr));
+	CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_KEYS, MLOD_MOTION_MAX_ERROR, bound, &lv, &terr));
+	const mlod_channel *ch = &lv.clip.channels[2];
+	CHECK(ch->key_count > 2 && ch->key_count < F);
+	/* Constant channels collapse to one key. */
+	CHECK(lv.clip.channels[0].key_count <= 2 && lv.clip.channels[1].key_count <= 2);
+	double max_angle = 2.0 * asin(bound / (2.0 * r)), worst = 0.0;
+	for (int f = 0; f < 10 * (F - 1); f++) {
+		float t = (float)f / 300.0f;
+		mlod_trs a[3], b[3];
+		mlod_pose_rest(&c.skeleton, a);
+		mlod_pose_rest(&c.skeleton, b);
+		mlod_clip_sample(&c.clips[0], t, a);
+		mlod_clip_sample(&lv.clip, t, b);
+		if (f % 10 == 0 && mlod_quat_angle(a[2].r, b[2].r) > worst)
+			worst = mlod_quat_angle(a[2].r, b[2].r);
+	}
+	CHECK_MSG(worst <= max_angle * 1.0001, "leaf rotation error %g rad over %g", worst, max_angle);
+	mlod_motion_level_free(&lv);
+	mlod_motion_free(m);
+	mlod_character_free(&c);
+}
+
+TEST(hierarchy_error_is_bounded)
+{
+	/* The root's rotation swings a long chain: removing root keys moves the
+	 * far joints most. Every joint stays within the bound at every frame. */
+	int F = 90, n = 6;
+	mlod_character c = make_chain(n, F);
+	for (int j = 0; j < n; j++)
+		for (int f = 0; f < F; f++)
+			set_rot(&c.clips[0].channels[j], f,
+			        mlod_quat_axis_angle((mlod_v3){0, 0, 1}, 0.3f * sinf(0.1f * (float)(f + 7 * j))));
+	double bound = 0.05;
+	mlod_motion *m;
+	mlod_motion_level lv;
+	CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+	CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_KEYS, MLOD_MOTION_MAX_ERROR, bound, &lv, &terr));
+	CHECK(lv.keys < mlod_clip_key_count(&c.clips[0]));
+	mlod_v3 a[6], b[6];
+	for (int f = 0; f < F; f++) {
+		positions(&c, &c.clips[0], c.clips[0].channels[0].times[f], a);
+		positions(&c, &lv.clip, c.clips[0].channels[0].times[f], b);
+		for (int j = 0; j < n; j++)
+			CHECK_MSG(mlod_v3_length(mlod_v3_sub(a[j], b[j])) <= bound, "frame %d joint %d: %g", f, j,
+			          mlod_v3_length(mlod_v3_sub(a[j], b[j])));
+	}
+	/* The root, which moves everything, keeps more keys than a leaf-side joint. */
+	CHECK(lv.clip.channels[0].key_count >= lv.clip.channels[n - 2].key_count);
+	mlod_motion_level_free(&lv);
+	mlod_motion_free(m);
+	mlod_character_free(&c);
+}
+
+TEST(common_timeline)
+{
+	/* Two channels on different times: the union, exact at every key. */
+	mlod_character c = make_chain(2, 5);
+	mlod_channel *a = &c.clips[0].channels[0], *b = &c.clips[0].channels[1];
+	for (int f = 0; f < 5; f++) {
+		set_rot(a, f, mlod_quat_axis_angle((mlod_v3){0, 0, 1}, 0.2f * (float)f));
+		set_rot(b, f, mlod_quat_axis_angle((mlod_v3){1, 0, 0}, 0.1f * (float)(f * f)));
+		b->times[f] = (float)f / 30.0f + 0.01f;
+	}
+	c.clips[0].duration = b->times[4];
+	mlod_clip common;
+	mlod_motion_timeline info;
+	CHECK_OK(mlod_motion_common_clip(&c.clips[0], NULL, &common, &info, &terr));
+	CHECK(info.resampled == 1 && info.mismatched_channels == 2 && info.frames == 10 && info.cubic_channels == 0);
+	CHECK(common.channels[0].key_count == 10 && common.channels[1].key_count == 10);
+	for (int k = 0; k < 10; k++) {
+		mlod_trs x[2], y[2];
+		float t = common.channels[0].times[k];
+		mlod_pose_rest(&c.skeleton, x);
+		mlod_pose_rest(&c.skeleton, y);
+		mlod_clip_sample(&c.clips[0], t, x);
+		mlod_clip_sample(&common, t, y);
+		CHECK(mlod_quat_angle(x[0].r, y[0].r) < 1e-5f && mlod_quat_angle(x[1].r, y[1].r) < 1e-5f);
+	}
+	mlod_clip_free(&common);
+
+	/* Shared times and LINEAR: kept as they are. */
+	for (int f = 0; f < 5; f++)
+		b->times[f] = a->times[f];
+	c.clips[0].duration = a->times[4];
+	CHECK_OK(mlod_motion_common_clip(&c.clips[0], NULL, &common, &info, &terr));
+	CHECK(info.resampled == 0 && info.frames == 5);
+	mlod_clip_free(&common);
+
+	/* CUBICSPLINE: resampled at the rate given, and LINEAR afterwards. */
+	mlod_channel cubic = *a;
+	float *cv = calloc(5 * 12, sizeof(float));
+	for (int f = 0; f < 5; f++)
+		memcpy(cv + 12 * f + 4, a->values + 4 * f, 4 * sizeof(float));
+	float *saved = a->values;
+	a->values = cv;
+	a->interp = MLOD_INTERP_CUBICSPLINE;
+	mlod_motion_options opt = {0};
+	opt.cubic_rate = 120.0;
+	CHECK_OK(mlod_motion_common_clip(&c.clips[0], &opt, &common, &info, &terr));
+	CHECK(info.resampled == 1 && info.cubic_channels == 1);
+	CHECK_MSG(info.frames == 17, "%d frames", info.frames); /* 4 intervals of 1/30 s at 120/s */
+	CHECK(common.channels[0].interp == MLOD_INTERP_LINEAR);
+	mlod_clip_free(&common);
+	a->values = saved;
+	a->interp = MLOD_INTERP_LINEAR;
+	(void)cubic;
+	free(cv);
+	mlod_character_free(&c);
+}
+
+TEST(bad_clips)
+{
+	mlod_character c = make_chain(2, 4);
+	mlod_clip common;
+	mlod_channel *ch = &c.clips[0].channels[1];
+	/* Decreasing key times. */
+	ch->times[2] = ch->times[1] - 0.01f;
+	CHECK(mlod_motion_common_clip(&c.clips[0], NULL, &common, NULL, &terr) == MLOD_ERR_PARSE);
+	CHECK(strstr(terr.message, "times must increase") != NULL);
+	ch->times[2] = 2.0f / 30.0f;
+	/* NaN and infinity in a track. */
+	ch->values[5] = NAN;
+	CHECK(mlod_motion_common_clip(&c.clips[0], NULL, &common, NULL, &terr) == MLOD_ERR_PARSE);
+	CHECK(strstr(terr.message, "not finite") != NULL);
+	ch->values[5] = INFINITY;
+	CHECK(mlod_motion_common_clip(&c.clips[0], NULL, &common, NULL, &terr) == MLOD_ERR_PARSE);
+	ch->values[5] = 0.0f;
+	/* A zero quaternion. */
+	ch->values[7] = 0.0f;
+	CHECK(mlod_motion_common_clip(&c.clips[0], NULL, &common, NULL, &terr) == MLOD_ERR_PARSE);
+	CHECK(strstr(terr.message, "zero quaternion") != NULL);
+	ch->values[7] = 1.0f;
+	/* A negative first time. */
+	ch->times[0] = -0.5f;
+	CHECK(mlod_motion_common_clip(&c.clips[0], NULL, &common, NULL, &terr) == MLOD_ERR_PARSE);
+	ch->times[0] = 0.0f;
+	/* No keys. */
+	ch->key_count = 0;
+	CHECK(mlod_motion_common_clip(&c.clips[0], NULL, &common, NULL, &terr) == MLOD_ERR_PARSE);
+	ch->key_count = 4;
+	CHECK_OK(mlod_motion_common_clip(&c.clips[0], NULL, &common, NULL, &terr));
+	mlod_clip_free(&common);
+	/* No clip at all (a BVH with "Frames: 0" has none). */
+	mlod_motion *m = NULL;
+	CHECK(mlod_motion_create(&c, 1, NULL, &m, &terr) == MLOD_ERR_INVALID_ARG && m == NULL);
+	mlod_motion_free(NULL);
+	mlod_clip_free(NULL);
+	mlod_motion_level_free(NULL);
+	mlod_character_free(&c);
+}
+
+TEST(one_frame_clip)
+{
+	/* Nothing to reduce: every level is the single frame. */
+	mlod_character c = make_chain(3, 1);
+	c.clips[0].duration = 0.0f;
+	for (int method = 0; method < 2; method++) {
+		mlod_motion *m;
+		mlod_motion_level lv;
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+		CHECK(mlod_motion_timeline_info(m)->frames == 1);
+		CHECK_OK(mlod_motion_next_level(m, (mlod_motion_method)method, MLOD_MOTION_MAX_ERROR, 0.1, &lv, &terr));
+		CHECK(lv.keys == 3 && lv.error.max == 0.0);
+		mlod_motion_level_free(&lv);
+		CHECK_OK(mlod_motion_next_level(m, (mlod_motion_method)method, MLOD_MOTION_FRACTION, 0.1, &lv, &terr));
+		CHECK(lv.keys == 3);
+		mlod_motion_level_free(&lv);
+		mlod_motion_free(m);
+	}
+	mlod_character_free(&c);
+}
+
+TEST(step_channels_stay_step)
+{
+	mlod_character c = make_chain(2, 30);
+	mlod_channel *ch = &c.clips[0].channels[1];
+	ch->interp = MLOD_INTERP_STEP;
+	for (int f = 0; f < 30; f++)
+		set_rot(ch, f, mlod_quat_axis_angle((mlod_v3){0, 0, 1}, (float)(f / 10)));
+	for (int method = 0; method < 2; method++) {
+		mlod_motion *m;
+		mlod_motion_level lv;
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+		CHECK_OK(mlod_motion_next_level(m, (mlod_motion_method)method, MLOD_MOTION_MAX_ERROR, 1e-4, &lv, &terr));
+		CHECK(lv.clip.channels[1].interp == MLOD_INTERP_STEP);
+		CHECK(lv.error.max <= 1e-4);
+		if (method == MLOD_MOTION_KEYS) /* the three steps, the last frame */
+			CHECK_MSG(lv.clip.channels[1].key_count == 4, "%d keys", lv.clip.channels[1].key_count);
+		mlod_motion_level_free(&lv);
+		mlod_motion_free(m);
+	}
+	mlod_character_free(&c);
+}
+
+TEST(key_bytes)
+{
+	mlod_character c = make_chain(2, 10);
+	/* Two channels sharing times: 2 * 10 * 16 value bytes + 10 * 4 time bytes. */
+	CHECK(mlod_clip_key_bytes(&c.clips[0]) == 2 * 10 * 16 + 40);
+	CHECK(mlod_clip_key_count(&c.clips[0]) == 20);
+	c.clips[0].channels[1].times[9] += 0.01f;
+	CHECK(mlod_clip_key_bytes(&c.clips[0]) == 2 * 10 * 16 + 80);
+	mlod_character_free(&c);
+}
+
+int main(void)
+{
+	RUN(levels_within_bounds_cmu);
+	RUN(levels_within_bounds_robot);
+	RUN(keys_method_beats_frames_on_cmu);
+	RUN(fraction_of_keys);
+	RUN(tree_levels_are_nested);
+	RUN(average_merge_keeps_ends);
+	RUN(sign_flips_are_not_motion);
+	RUN(angle_wrap_is_not_motion);
+	RUN(points_out_from_leaves_are_kept);
+	RUN(hierarchy_error_is_bounded);
+	RUN(common_timeline);
+	RUN(bad_clips);
+	RUN(one_frame_clip);
+	RUN(step_channels_stay_step);
+	RUN(key_bytes);
+	TEST_EXIT();
+}
