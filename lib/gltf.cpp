@@ -1218,6 +1218,40 @@ private:
 		return mlod.is_object() && mlod.contains("end_site") && mlod["end_site"] == true;
 	}
 
+	/* A joint read from a BVH keeps its channel layout in
+	 * extras.mlod_bvh.channels, so that its Euler order survives the glb. */
+	void bvh_layout(int n, mlod_joint &j) const
+	{
+		static const char *const names[6] = {"Xposition", "Yposition", "Zposition",
+		                                     "Xrotation", "Yrotation", "Zrotation"};
+		const json e = current_extras(doc_, "/nodes/" + std::to_string(n) + "/extras", m_.nodes[size_t(n)].extras);
+		if (!e.is_object() || !e.contains("mlod_bvh") || !e["mlod_bvh"].is_object())
+			return;
+		const json &ch = e["mlod_bvh"].contains("channels") ? e["mlod_bvh"]["channels"] : json();
+		if (!ch.is_array() || (ch.size() != 3 && ch.size() != 6))
+			return;
+		unsigned char codes[6];
+		char axes[4] = {0};
+		int rotations = 0;
+		for (size_t i = 0; i < ch.size(); i++) {
+			int code = -1;
+			for (int k = 0; k < 6 && ch[i].is_string(); k++)
+				if (ch[i].get<std::string>() == names[k])
+					code = k;
+			if (code < 0)
+				return; /* not ours: ignore it */
+			codes[i] = (unsigned char)code;
+			if (code >= MLOD_BVH_XROT && rotations < 3)
+				axes[rotations++] = char('X' + (code - MLOD_BVH_XROT));
+		}
+		mlod_euler_order order;
+		if (rotations != 3 || mlod_euler_order_parse(axes, &order) != 0)
+			return;
+		j.channel_count = int(ch.size());
+		memcpy(j.channels, codes, ch.size());
+		j.euler = order;
+	}
+
 	/* Joints: skin joints and the nodes between a joint and its nearest
 	 * joint ancestor, in parents-first order. A document without skins (a
 	 * BVH converted to glTF, a node-animated rig) has its animated nodes
@@ -1263,6 +1297,7 @@ private:
 			j.name = c_string(node.name);
 			j.node = k;
 			j.euler = MLOD_EULER_XYZ;
+			bvh_layout(k, j);
 			int p = parent_[size_t(k)];
 			j.parent = p >= 0 ? joint_of_[size_t(p)] : -1;
 			j.base = j.parent < 0 && p >= 0 ? world_[size_t(p)] : mlod_mat4_identity();
@@ -1892,6 +1927,16 @@ void build_document(Model &m, const mlod_character &c)
 		node_of_joint.push_back(i);
 		m.nodes[size_t(i)].name = utf8(j.name);
 		set_trs(m.nodes[size_t(i)], j.rest);
+		if (j.channel_count > 0) {
+			static const char *const names[6] = {"Xposition", "Yposition", "Zposition",
+			                                     "Xrotation", "Yrotation", "Zrotation"};
+			Value::Array channels;
+			for (int k = 0; k < j.channel_count && k < 6; k++)
+				if (j.channels[k] < 6)
+					channels.push_back(Value(std::string(names[j.channels[k]])));
+			m.nodes[size_t(i)].extras =
+				Value(Value::Object{{"mlod_bvh", Value(Value::Object{{"channels", Value(channels)}})}});
+		}
 	}
 	for (int i = 0; i < s.joint_count; i++) {
 		const mlod_joint &j = s.joints[i];

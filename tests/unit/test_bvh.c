@@ -684,7 +684,8 @@ TEST(data_files)
 	char path[512];
 	while ((e = readdir(d))) {
 		size_t n = strlen(e->d_name);
-		if (n < 4 || strcmp(e->d_name + n - 4, ".bvh") != 0)
+		/* motion_* files are bad for the motion layer, not for the parser. */
+		if (n < 4 || strcmp(e->d_name + n - 4, ".bvh") != 0 || strncmp(e->d_name, "motion_", 7) == 0)
 			continue;
 		snprintf(path, sizeof path, "tests/data/bad/%s", e->d_name);
 		size_t size = 0;

@@ -201,6 +201,40 @@ TEST(names)
 	CHECK(strcmp(mlod_label_name(MLOD_LABEL_END_EFFECTOR), "end-effector") == 0);
 }
 
+/* A BVH converted to glb keeps each joint's Euler order (extras.mlod_bvh),
+ * so its energies do not change. */
+TEST(bvh_energy_survives_glb)
+{
+	size_t size;
+	void *data = test_read_file("samples/cmu_12_01_walk.bvh", &size);
+	CHECK(data != NULL);
+	mlod_character a = {0}, b = {0};
+	mlod_gltf *doc = NULL, *back = NULL;
+	void *glb = NULL;
+	size_t glb_size = 0;
+	CHECK_OK(mlod_load(data, size, NULL, &doc, &a, NULL, &terr));
+	free(data);
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &glb_size, &terr));
+	CHECK_OK(mlod_load(glb, glb_size, NULL, &back, &b, NULL, &terr));
+	CHECK(a.skeleton.joint_count == b.skeleton.joint_count);
+	mlod_joint_info *ia = calloc((size_t)a.skeleton.joint_count, sizeof *ia);
+	mlod_joint_info *ib = calloc((size_t)b.skeleton.joint_count, sizeof *ib);
+	CHECK_OK(mlod_label_skeleton(&a, NULL, ia, &terr));
+	CHECK_OK(mlod_label_skeleton(&b, NULL, ib, &terr));
+	for (int j = 0; j < a.skeleton.joint_count; j++) {
+		CHECK(a.skeleton.joints[j].euler == b.skeleton.joints[j].euler);
+		CHECK(ia[j].label == ib[j].label);
+		CHECK_NEAR(ia[j].energy, ib[j].energy, 1e-4 * (1.0 + ia[j].energy));
+	}
+	free(ia);
+	free(ib);
+	mlod_free(glb);
+	mlod_gltf_free(doc);
+	mlod_gltf_free(back);
+	mlod_character_free(&a);
+	mlod_character_free(&b);
+}
+
 int main(void)
 {
 	RUN(single_chain);
@@ -212,5 +246,6 @@ int main(void)
 	RUN(energy_max_over_clips);
 	RUN(names);
 	RUN(bad_skeleton);
+	RUN(bvh_energy_survives_glb);
 	TEST_EXIT();
 }
