@@ -103,6 +103,18 @@ else
 	for f in $inputs; do
 		[ -f "$f" ] || continue
 		base=$(basename "$f")
+		# The shim itself: read and write back, and rebuild from the character.
+		for mode in "" --via-character; do
+			out="$work/validate-roundtrip$mode-$base.glb"
+			case $f in *.bvh) continue ;; esac
+			if ! "$HELPERS/roundtrip" $mode "$f" "$out" 2> "$work/stderr"; then
+				fail "validate/roundtrip$mode/$base" "$(head -c 300 "$work/stderr")"
+			elif msg=$($validator "$out" 2>&1); then
+				pass "validate/roundtrip$mode/$base"
+			else
+				fail "validate/roundtrip$mode/$base" "$(echo "$msg" | head -n 8 | tr '\n' ' ')"
+			fi
+		done
 		for tool in $glb_tools; do
 			[ -x "$BIN/$tool" ] || continue
 			out="$work/validate-$tool-$base.glb"
