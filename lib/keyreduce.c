@@ -147,7 +147,19 @@ static double sigma_max(const double a[9])
 	return lambda > 0.0 ? sqrt(lambda) * (1.0 + 1e-9) : 0.0;
 }
 
-/* Does the joint's world matrix w stay within budget of w0? */
+double mlod_motion_point_error(const mlod_mat4 *a, const mlod_mat4 *b, double radius)
+{
+	double d[3], m[9];
+	for (int r = 0; r < 3; r++)
+		d[r] = (double)a->m[12 + r] - b->m[12 + r];
+	for (int c = 0; c < 3; c++)
+		for (int r = 0; r < 3; r++)
+			m[c * 3 + r] = (double)a->m[c * 4 + r] - b->m[c * 4 + r];
+	return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + radius * sigma_max(m);
+}
+
+/* Does the joint's world matrix w stay within budget of w0? The same
+ * error as mlod_motion_point_error, with early exits. */
 static int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget)
 {
 	double dx = (double)w->m[12] - w0->m[12], dy = (double)w->m[13] - w0->m[13], dz = (double)w->m[14] - w0->m[14];

@@ -637,8 +637,16 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
 /* Levels of one clip. Level 0 is the clip as read; level k + 1 is coarser
  * than level k (fewer keys, a larger bound). Frame distances, thresholds
  * and the tree follow the paper; per-channel key reduction goes beyond it.
- * Error is the world-space joint position error (mlod_joint_deviation:
- * joints and End Sites) against the clip as read, in scene units. */
+ * Error bounds apply to the point error (mlod_motion_point_error) of every
+ * joint at every frame of the clip's common timeline, which bounds the
+ * world-space joint and End Site position error (mlod_joint_deviation)
+ * against the clip as read, in scene units. */
+
+/* How far any point within radius of a joint moves between world matrices
+ * a and b: |origin(a) - origin(b)| + radius * sigma_max(A - B), A and B
+ * their 3x3 parts (for a rotation error of angle t alone, 2 radius sin(t/2),
+ * exact for the farthest point). */
+double mlod_motion_point_error(const mlod_mat4 *a, const mlod_mat4 *b, double radius);
 
 typedef enum mlod_motion_method {
 	MLOD_MOTION_FRAMES,  /* the paper's multiresolution motion tree: whole frames go */
@@ -662,8 +670,9 @@ typedef enum mlod_motion_target {
 typedef struct mlod_motion_options {
 	mlod_motion_merge merge;  /* frames method; MLOD_MOTION_REMOVE (the default) measured better */
 	double cubic_rate;        /* CUBICSPLINE clips are resampled at least this often (1/s); 0 means 60 */
-	double point_distance;    /* keys method: radius of the points carried by each joint (scene
-	                             units); 0 means the skeleton height / 18 (10 cm on a 1.8 m person) */
+	double point_distance;    /* radius of the points carried by each joint for the point error
+	                             (scene units); 0 means the skeleton height / 18 (10 cm on a 1.8 m
+	                             person) */
 } mlod_motion_options;
 
 /* How a clip was put on a common timeline: every channel keyed at every
@@ -724,15 +733,16 @@ typedef struct mlod_motion_level {
 	long keys;                /* mlod_clip_key_count(&clip) */
 	long bytes;               /* mlod_clip_key_bytes(&clip) */
 	mlod_deviation error;     /* joint position error against the source clip, scene units */
+	double point_error;       /* the largest point error over joints and common frames, scene units */
 } mlod_motion_level;
 
 /* Builds the next level of a method: each level is made from the previous
  * level of the same method (nested: the frames method's levels are the
  * lines of the motion tree, the keys method's keep subsets of the previous
  * keys). target and value choose its size; with MLOD_MOTION_MAX_ERROR the
- * measured error is at most value, or MLOD_ERR_LIMIT says why not (a
- * resampled clip that already deviates more). Release with
- * mlod_motion_level_free. */
+ * point error (so the joint position error too) is at most value, or
+ * MLOD_ERR_LIMIT says why not (a resampled clip that already deviates
+ * more). Release with mlod_motion_level_free. */
 mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                    double value, mlod_motion_level *out, mlod_error *err);
 void mlod_motion_level_free(mlod_motion_level *l);

@@ -39,10 +39,13 @@
  * - The keys method (keyreduce.c) is driven from here the same way, with
  *   the error budget in place of the threshold.
  *
- * Error is the world position error of every joint and End Site at every
- * frame of the common timeline, computed with the same sampling and
- * forward kinematics as mlod_joint_deviation, so a bound met here is met
- * there; the reported error is mlod_joint_deviation's.
+ * Error bounds are checked on the point error of every joint at every
+ * frame of the common timeline (mlod_motion_point_error: the joint's
+ * origin and every point within point_distance of it, or within its End
+ * Site), computed with the same sampling and forward kinematics as
+ * mlod_joint_deviation, so a bound met here is met there for joint and
+ * End Site positions; both methods answer to the same bound, so they can
+ * be compared at it. The reported error is mlod_joint_deviation's.
  */
 #include <float.h>
 #include <math.h>
@@ -444,13 +447,9 @@ struct mlod_motion {
 	int *offset;           /* per channel: first value in a node */
 	int *euler_slot;       /* per channel: Euler slot of a rotation channel, else -1 */
 	unsigned char *constant; /* per channel: the same value at every frame */
-	/* The measured points (joints, then End Sites) at every frame. */
-	int point_count;
-	int *point_joint;
-	mlod_v3 *point_offset;
-	mlod_v3 *p0;           /* frames * point_count */
+	double *radius;        /* per joint: the point distance, or its End Site's if farther */
 	mlod_trs *local;
-	mlod_mat4 *world;
+	mlod_mat4 *world, *world0;
 	/* State of each method: the last line of the tree, the keys kept. */
 	line tree;
 	unsigned char *kept;   /* channel_count * frames */
@@ -474,11 +473,10 @@ void mlod_motion_free(mlod_motion *m)
 	free(m->offset);
 	free(m->euler_slot);
 	free(m->constant);
-	free(m->point_joint);
-	free(m->point_offset);
-	free(m->p0);
+	free(m->radius);
 	free(m->local);
 	free(m->world);
+	free(m->world0);
 	line_free(&m->tree);
 	free(m->kept);
 	free(m);
@@ -489,17 +487,12 @@ const mlod_motion_timeline *mlod_motion_timeline_info(const mlod_motion *m)
 	return m ? &m->info : NULL;
 }
 
-/* Poses the skeleton with clip at t into m->world. */
-static void pose_at(mlod_motion *m, const mlod_clip *clip, float t)
+/* Poses the skeleton with clip at t into world. */
+static void pose_at(mlod_motion *m, const mlod_clip *clip, float t, mlod_mat4 *world)
 {
 	mlod_pose_rest(m->s, m->local);
 	mlod_clip_sample(clip, t, m->local);
-	mlod_pose_world(m->s, m->local, m->world);
-}
-
-static mlod_v3 point_at(const mlod_motion *m, int p)
-{
-	return mlod_mat4_point(&m->world[m->point_joint[p]], m->point_offset[p]);
+	mlod_pose_world(m->s, m->local, world);
 }
 
 /* Fills node values from common frame f, and its Euler angles. */
@@ -573,15 +566,10 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	m->constant = malloc((size_t)nch);
 	m->local = malloc(sizeof *m->local * (size_t)n);
 	m->world = malloc(sizeof *m->world * (size_t)n);
-	int ends = 0;
-	for (int j = 0; j < n; j++)
-		ends += s->joints[j].has_end_site != 0;
-	m->point_count = n + ends;
-	m->point_joint = malloc(sizeof(int) * (size_t)m->point_count);
-	m->point_offset = malloc(sizeof(mlod_v3) * (size_t)m->point_count);
-	m->p0 = malloc(sizeof(mlod_v3) * (size_t)m->point_count * (size_t)F);
-	if (!m->weight || !m->offset || !m->euler_slot || !m->constant || !m->local || !m->world || !m->point_joint ||
-	    !m->point_offset || !m->p0) {
+	m->world0 = malloc(sizeof *m->world0 * (size_t)n);
+	m->radius = malloc(sizeof(double) * (size_t)n);
+	if (!m->weight || !m->offset || !m->euler_slot || !m->constant || !m->local || !m->world || !m->world0 ||
+	    !m->radius) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
@@ -596,18 +584,10 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 		for (int f = 1; f < F && m->constant[i]; f++)
 			m->constant[i] = memcmp(ch->values, ch->values + (size_t)f * (size_t)comps, sizeof(float) * (size_t)comps) == 0;
 	}
-	for (int j = 0, e = n; j < n; j++) {
-		m->point_joint[j] = j;
-		m->point_offset[j] = (mlod_v3){ 0, 0, 0 };
-		if (s->joints[j].has_end_site) {
-			m->point_joint[e] = j;
-			m->point_offset[e++] = s->joints[j].end_site;
-		}
-	}
-	for (int f = 0; f < F; f++) {
-		pose_at(m, src, m->common.channels[0].times[f]);
-		for (int p = 0; p < m->point_count; p++)
-			m->p0[(size_t)f * (size_t)m->point_count + (size_t)p] = point_at(m, p);
+	double pd = opt && opt->point_distance > 0.0 ? opt->point_distance : m->height / 18.0;
+	for (int j = 0; j < n; j++) {
+		double es = s->joints[j].has_end_site ? mlod_v3_length(s->joints[j].end_site) : 0.0;
+		m->radius[j] = es > pd ? es : pd;
 	}
 	/* Level 0 of each method: every frame, every key. */
 	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
@@ -740,17 +720,18 @@ static int clip_from_kept(const mlod_motion *m, const unsigned char *kept, mlod_
 	return keep_duration(m, clip);
 }
 
-/* Largest joint (and End Site) position error of a level clip over every
- * frame of the common timeline, in scene units. */
+/* Largest point error (mlod_motion_point_error) of a level clip over
+ * every joint and every frame of the common timeline, in scene units. It
+ * bounds the joint and End Site position error. */
 static double level_max_error(mlod_motion *m, const mlod_clip *clip)
 {
 	double worst = 0.0;
 	for (int f = 0; f < m->frames; f++) {
-		pose_at(m, clip, m->common.channels[0].times[f]);
-		const mlod_v3 *p0 = m->p0 + (size_t)f * (size_t)m->point_count;
-		for (int p = 0; p < m->point_count; p++) {
-			mlod_v3 d = mlod_v3_sub(point_at(m, p), p0[p]);
-			double e = mlod_v3_length(d);
+		float t = m->common.channels[0].times[f];
+		pose_at(m, m->orig, t, m->world0);
+		pose_at(m, clip, t, m->world);
+		for (int j = 0; j < m->s->joint_count; j++) {
+			double e = mlod_motion_point_error(&m->world[j], &m->world0[j], m->radius[j]);
 			if (!(e <= worst))
 				worst = e; /* NaN counts as the worst */
 		}
@@ -767,8 +748,9 @@ void mlod_motion_level_free(mlod_motion_level *l)
 }
 
 /* Fills the level's counts and its error as mlod_joint_deviation measures it. */
-static mlod_result level_finish(const mlod_motion *m, mlod_motion_level *out, mlod_error *err)
+static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, mlod_error *err)
 {
+	out->point_error = level_max_error(m, &out->clip);
 	out->keys = mlod_clip_key_count(&out->clip);
 	out->bytes = mlod_clip_key_bytes(&out->clip);
 	mlod_character a, b;

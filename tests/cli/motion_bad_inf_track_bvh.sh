@@ -1,0 +1,1 @@
+"$BIN/mlod-motion" < "$ROOT/tests/data/bad/motion_inf_track.bvh" > /dev/null

@@ -1,0 +1,1 @@
+"$BIN/mlod-motion" --frobnicate x.glb

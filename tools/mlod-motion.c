@@ -1,0 +1,568 @@
+/*
+ * mlod-motion: motion levels of detail (paper 4.3): the multiresolution
+ * motion tree, which drops whole frames, and per-channel key reduction
+ * under a hierarchical error bound, which goes beyond the paper.
+ *
+ * Output: a glb where each clip gets its levels as extra animations
+ * "<clip>@lod<k>" (originals untouched, extras.mlod on each level); or,
+ * with --level K -o out.bvh, a BVH of level K at the clip's frame rate; or
+ * a report.
+ */
+#define _GNU_SOURCE /* getopt_long, strdup */
+
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common.h"
+
+#define MAX_LEVELS 32
+#define DEFAULT_MAX_ERROR "0.2%,1%,3%"
+#define VERTEX_SAMPLES 60   /* measured times per clip for the skinned-vertex error */
+#define GLTF_POINT_DISTANCE 0.1 /* 10 cm in glTF's metres */
+
+static const char usage_text[] =
+	"usage: mlod-motion [options] [input]\n"
+	"\n"
+	"Builds motion levels of detail for every clip of a character: the paper's\n"
+	"multiresolution motion tree (whole frames merge) or per-channel key reduction\n"
+	"under a hierarchical error bound. Input is glb, glTF or BVH. Output is a glb\n"
+	"where each clip gets its levels as animations named <clip>@lod<k>.\n"
+	"\n"
+	"options:\n"
+	"  -o, --output FILE       write to FILE instead of stdout; a .bvh name writes\n"
+	"                          the level chosen by --level as BVH\n"
+	"  -r, --report[=FORMAT]   print the levels instead; FORMAT is table or json\n"
+	"  -m, --method METHOD     frames (the paper's tree), keys (per-channel key\n"
+	"                          reduction) or auto: per level the one with fewer\n"
+	"                          bytes within the same bound (default auto)\n"
+	"  -e, --max-error LIST    one level per bound on the world joint position\n"
+	"                          error: E in scene units or E% of the skeleton height\n"
+	"                          (default " DEFAULT_MAX_ERROR ")\n"
+	"  -t, --thresholds LIST   one level per frame distance threshold (frames method)\n"
+	"  -k, --keys LIST         one level per fraction of the keys kept (0.5,0.2)\n"
+	"      --merge MODE        frames method: remove (default) or average\n"
+	"      --point-distance D  keys method: radius of the points carried by each\n"
+	"                          joint (default 0.1 for glTF, height/18 for BVH)\n"
+	"      --cubic-rate R      resample CUBICSPLINE clips at R frames/s (default 60)\n"
+	"  -l, --level K           with a .bvh output: the level to write (0 = as read)\n"
+	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
+	"  -h, --help              show this help\n"
+	"  -V, --version           show the version\n"
+	"\n"
+	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
+	"4 output failure.\n";
+
+enum report { REPORT_NONE, REPORT_TABLE, REPORT_JSON };
+enum method { METHOD_AUTO = -1 };
+
+struct spec {
+	mlod_motion_target target;
+	double value;    /* as given */
+	int percent;     /* max error given in % of the height */
+};
+
+struct level {
+	int ok;          /* 0 when no level met the bound */
+	double bound;    /* scene units, for max-error levels */
+	mlod_motion_level l;
+	int has_vertex;
+	mlod_deviation vertex; /* % of the diagonal; scale is the diagonal */
+};
+
+struct clip {
+	int index;
+	int frames;
+	mlod_motion_timeline timeline;
+	long keys, bytes;
+	int level_count;
+	struct level levels[MAX_LEVELS];
+};
+
+struct job {
+	const char *input;
+	mlod_format format;
+	mlod_character c;
+	double height;
+	double point_distance;
+	int method;       /* mlod_motion_method or METHOD_AUTO */
+	mlod_motion_options opt;
+	int spec_count;
+	struct spec specs[MAX_LEVELS];
+	int clip_count;
+	struct clip *clips;
+};
+
+static const char *method_name(mlod_motion_method m)
+{
+	return m == MLOD_MOTION_KEYS ? "keys" : "frames";
+}
+
+static const char *target_name(mlod_motion_target t)
+{
+	return t == MLOD_MOTION_THRESHOLD ? "threshold" : t == MLOD_MOTION_FRACTION ? "keys" : "max_error";
+}
+
+/* Parses a comma-separated list; "E%" is allowed when percent is not NULL. */
+static int parse_list(const char *option, const char *value, struct spec *out, mlod_motion_target target,
+                      double lo, double hi)
+{
+	int n = 0;
+	char *copy = strdup(value);
+	if (!copy)
+		tool_die(EXIT_USAGE, NULL, "out of memory");
+	for (char *tok = strtok(copy, ","); tok; tok = strtok(NULL, ",")) {
+		if (n == MAX_LEVELS)
+			tool_usage_error("%s: at most %d levels", option, MAX_LEVELS);
+		size_t len = strlen(tok);
+		out[n].target = target;
+		out[n].percent = 0;
+		if (target == MLOD_MOTION_MAX_ERROR && len > 0 && tok[len - 1] == '%') {
+			tok[len - 1] = '\0';
+			out[n].percent = 1;
+		}
+		out[n].value = tool_parse_double(option, tok, lo, hi);
+		if (target == MLOD_MOTION_FRACTION && !(out[n].value > 0.0))
+			tool_usage_error("%s: a fraction of keys must be above 0", option);
+		n++;
+	}
+	free(copy);
+	if (n == 0)
+		tool_usage_error("%s: empty list", option);
+	return n;
+}
+
+static int spec_order(const void *a, const void *b)
+{
+	const struct spec *x = a, *y = b;
+	/* Coarser last: larger bounds and thresholds, smaller fractions. */
+	double u = x->target == MLOD_MOTION_FRACTION ? -x->value : x->value;
+	double v = y->target == MLOD_MOTION_FRACTION ? -y->value : y->value;
+	return (u > v) - (u < v);
+}
+
+/* A shallow character: c's skeleton and meshes with one clip. */
+static mlod_character with_clip(const mlod_character *c, const mlod_clip *clip)
+{
+	mlod_character s = *c;
+	s.clip_count = 1;
+	s.clips = (mlod_clip *)clip;
+	s.notes = NULL;
+	return s;
+}
+
+static void measure_vertex(struct job *job, struct clip *cl, struct level *lv)
+{
+	if (job->c.instance_count == 0)
+		return;
+	mlod_character a = with_clip(&job->c, &job->c.clips[cl->index]), b = with_clip(&job->c, &lv->l.clip);
+	mlod_error err = {0};
+	mlod_result r = mlod_vertex_deviation(&a, &b, VERTEX_SAMPLES, &lv->vertex, &err);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), job->input, "clip \"%s\": %s", job->c.clips[cl->index].name, err.message);
+	lv->has_vertex = 1;
+}
+
+/* Builds the levels of one clip. */
+static void clip_levels(struct job *job, struct clip *cl)
+{
+	const mlod_clip *src = &job->c.clips[cl->index];
+	mlod_error err = {0};
+	mlod_motion *m[2] = {NULL, NULL};
+	int methods[2], method_count = 0;
+	if (job->method == METHOD_AUTO) {
+		methods[method_count++] = MLOD_MOTION_FRAMES;
+		methods[method_count++] = MLOD_MOTION_KEYS;
+	} else {
+		methods[method_count++] = job->method;
+	}
+	cl->keys = mlod_clip_key_count(src);
+	cl->bytes = mlod_clip_key_bytes(src);
+	for (int i = 0; i < method_count; i++) {
+		mlod_result r = mlod_motion_create(&job->c, cl->index, &job->opt, &m[i], &err);
+		if (r != MLOD_OK)
+			tool_die(tool_exit_code(r), job->input, "%s", err.message);
+	}
+	cl->timeline = *mlod_motion_timeline_info(m[0]);
+	cl->frames = cl->timeline.frames;
+	if (cl->frames < 3) {
+		fprintf(stderr, "%s: %s: clip \"%s\" has %d frame%s: nothing to reduce, no levels\n", tool_name, job->input,
+		        src->name, cl->frames, cl->frames == 1 ? "" : "s");
+		for (int i = 0; i < method_count; i++)
+			mlod_motion_free(m[i]);
+		return;
+	}
+	for (int s = 0; s < job->spec_count; s++) {
+		const struct spec *sp = &job->specs[s];
+		struct level *lv = &cl->levels[cl->level_count++];
+		double value = sp->percent ? sp->value * job->height / 100.0 : sp->value;
+		lv->bound = sp->target == MLOD_MOTION_MAX_ERROR ? value : -1.0;
+		char why[2][MLOD_ERROR_MESSAGE_SIZE] = {"", ""};
+		for (int i = 0; i < method_count; i++) {
+			if (methods[i] == MLOD_MOTION_KEYS && sp->target == MLOD_MOTION_THRESHOLD)
+				continue;
+			mlod_motion_level l;
+			mlod_result r = mlod_motion_next_level(m[i], (mlod_motion_method)methods[i], sp->target, value, &l, &err);
+			if (r == MLOD_ERR_LIMIT) {
+				snprintf(why[i], sizeof why[i], "%s", err.message);
+				continue;
+			}
+			if (r != MLOD_OK)
+				tool_die(tool_exit_code(r), job->input, "%s", err.message);
+			/* Fewer bytes wins; on a tie, the smaller error. */
+			if (!lv->ok || l.bytes < lv->l.bytes || (l.bytes == lv->l.bytes && l.error.max < lv->l.error.max)) {
+				if (lv->ok)
+					mlod_motion_level_free(&lv->l);
+				lv->l = l;
+				lv->ok = 1;
+			} else {
+				mlod_motion_level_free(&l);
+			}
+		}
+		if (!lv->ok)
+			fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, why[0][0] ? why[0] : why[1]);
+		else
+			measure_vertex(job, cl, lv);
+	}
+	for (int i = 0; i < method_count; i++)
+		mlod_motion_free(m[i]);
+}
+
+static void timeline_note(char *buf, size_t size, const struct clip *cl)
+{
+	if (!cl->timeline.resampled)
+		snprintf(buf, size, "own keys");
+	else
+		snprintf(buf, size, "resampled to %d common frames (%d channels on other times, %d CUBICSPLINE)",
+		         cl->frames, cl->timeline.mismatched_channels, cl->timeline.cubic_channels);
+}
+
+static void report_table(const struct job *job)
+{
+	printf("# %s: %d joints, height %.4g, %d clips; point distance %.4g\n", job->input, job->c.skeleton.joint_count,
+	       job->height, job->c.clip_count, job->point_distance);
+	printf("%-16s %5s %6s %10s %7s %7s %8s %10s %8s %10s %8s %10s %8s\n", "clip", "level", "method", "threshold",
+	       "keys", "keys%", "bytes", "jnt max", "max%", "jnt mean", "mean%", "pt max", "vtx max%");
+	for (int k = 0; k < job->clip_count; k++) {
+		const struct clip *cl = &job->clips[k];
+		const char *name = job->c.clips[cl->index].name;
+		printf("%-16s %5d %6s %10s %7ld %6.1f%% %8ld %10s %8s %10s %8s %10s %8s\n", name, 0, "-", "-", cl->keys, 100.0,
+		       cl->bytes, "0", "0", "0", "0", "0", job->c.instance_count ? "0" : "-");
+		for (int i = 0; i < cl->level_count; i++) {
+			const struct level *lv = &cl->levels[i];
+			if (!lv->ok) {
+				printf("%-16s %5d %6s (no level within %.4g)\n", name, i + 1, "-", lv->bound);
+				continue;
+			}
+			char vtx[32] = "-";
+			if (lv->has_vertex)
+				snprintf(vtx, sizeof vtx, "%.4f", lv->vertex.max);
+			printf("%-16s %5d %6s %10.4g %7ld %6.1f%% %8ld %10.4g %8.4f %10.4g %8.4f %10.4g %8s\n", name, i + 1,
+			       method_name(lv->l.method), lv->l.threshold, lv->l.keys, 100.0 * (double)lv->l.keys / (double)cl->keys,
+			       lv->l.bytes, lv->l.error.max, 100.0 * lv->l.error.max / job->height, lv->l.error.mean,
+			       100.0 * lv->l.error.mean / job->height, lv->l.point_error, vtx);
+		}
+	}
+	for (int k = 0; k < job->clip_count; k++) {
+		const struct clip *cl = &job->clips[k];
+		if (cl->timeline.resampled) {
+			char note[256];
+			timeline_note(note, sizeof note, cl);
+			printf("# clip %s: %s\n", job->c.clips[cl->index].name, note);
+		}
+	}
+	printf("# threshold: frame distance (frames) or error budget in scene units (keys); jnt: world joint\n"
+	       "# position error against the clip as read, scene units and %% of the height; pt: point error (joint\n"
+	       "# origins and points within the point distance), scene units; vtx: skinned-vertex error, %% of the\n"
+	       "# bounding diagonal\n");
+	if (job->c.notes && *job->c.notes)
+		printf("# note: %s\n", job->c.notes);
+}
+
+static void report_json(const struct job *job)
+{
+	printf("{\n  \"input\": ");
+	tool_json_string(stdout, job->input);
+	printf(",\n  \"joints\": %d,\n  \"height\": %.9g,\n  \"point_distance\": %.9g,\n  \"clips\": [\n",
+	       job->c.skeleton.joint_count, job->height, job->point_distance);
+	for (int k = 0; k < job->clip_count; k++) {
+		const struct clip *cl = &job->clips[k];
+		printf("    {\"name\": ");
+		tool_json_string(stdout, job->c.clips[cl->index].name);
+		printf(", \"index\": %d, \"duration\": %.9g, \"frames\": %d, \"resampled\": %s, "
+		       "\"mismatched_channels\": %d, \"cubic_channels\": %d, \"keys\": %ld, \"bytes\": %ld,\n     \"levels\": [",
+		       cl->index, (double)job->c.clips[cl->index].duration, cl->frames, cl->timeline.resampled ? "true" : "false",
+		       cl->timeline.mismatched_channels, cl->timeline.cubic_channels, cl->keys, cl->bytes);
+		for (int i = 0; i < cl->level_count; i++) {
+			const struct level *lv = &cl->levels[i];
+			const struct spec *sp = &job->specs[i];
+			printf("%s\n       {\"level\": %d, \"target\": \"%s\", \"value\": %.9g, ", i ? "," : "", i + 1,
+			       target_name(sp->target), sp->percent ? sp->value * job->height / 100.0 : sp->value);
+			if (lv->bound >= 0.0)
+				printf("\"bound\": %.9g, \"bound_percent_height\": %.9g, ", lv->bound, 100.0 * lv->bound / job->height);
+			if (!lv->ok) {
+				printf("\"ok\": false}");
+				continue;
+			}
+			printf("\"ok\": true, \"method\": \"%s\", \"threshold\": %.9g, \"keys\": %ld, \"keys_percent\": %.6g, "
+			       "\"bytes\": %ld,\n        \"joint_error\": {\"max\": %.9g, \"mean\": %.9g, \"max_percent_height\": %.9g, "
+			       "\"mean_percent_height\": %.9g},\n        \"point_error\": %.9g",
+			       method_name(lv->l.method), lv->l.threshold, lv->l.keys, 100.0 * (double)lv->l.keys / (double)cl->keys,
+			       lv->l.bytes, lv->l.error.max, lv->l.error.mean, 100.0 * lv->l.error.max / job->height,
+			       100.0 * lv->l.error.mean / job->height, lv->l.point_error);
+			if (lv->has_vertex)
+				printf(",\n        \"vertex_error\": {\"max\": %.9g, \"max_percent_diagonal\": %.9g, "
+				       "\"mean_percent_diagonal\": %.9g}",
+				       lv->vertex.max * lv->vertex.scale / 100.0, lv->vertex.max, lv->vertex.mean);
+			printf("}");
+		}
+		printf("]}%s\n", k + 1 < job->clip_count ? "," : "");
+	}
+	printf("  ]\n}\n");
+}
+
+/* The frame time a BVH of the clip plays at: its own, else the mean
+ * spacing of its common timeline. */
+static float bvh_frame_time(const mlod_clip *src, const struct clip *cl)
+{
+	if (src->frame_time > 0.0f)
+		return 0.0f; /* the clip's own */
+	int frames = cl->frames;
+	float *times = NULL;
+	if (frames == 0) { /* level 0 alone: the clip's key times */
+		frames = mlod_clip_times(src, 0, &times);
+		mlod_free(times);
+	}
+	if (frames > 1 && src->duration > 0.0f)
+		return src->duration / (float)(frames - 1);
+	return 0.0f;
+}
+
+static void write_bvh(const struct job *job, const char *output, int level, int clip)
+{
+	const struct clip *cl = &job->clips[0];
+	const mlod_clip *src = &job->c.clips[clip];
+	const mlod_clip *use = src;
+	if (level > 0) {
+		if (level > cl->level_count)
+			tool_die(EXIT_USAGE, NULL, "--level %d: clip %d has %d levels", level, clip, cl->level_count);
+		if (!cl->levels[level - 1].ok)
+			tool_die(EXIT_INPUT, job->input, "--level %d: no level within its bound", level);
+		use = &cl->levels[level - 1].l.clip;
+	}
+	mlod_character c = with_clip(&job->c, use);
+	char *text = NULL;
+	size_t size = 0;
+	mlod_error err = {0};
+	mlod_result r = mlod_bvh_write(&c, 0, bvh_frame_time(src, cl), &text, &size, &err);
+	if (r != MLOD_OK)
+		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_OUTPUT, output, "%s", err.message);
+	tool_write_output(output, text, size, 0);
+	mlod_free(text);
+}
+
+/* Adds the levels as animations "<clip>@lod<k>" with extras.mlod. */
+static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
+{
+	mlod_error err = {0};
+	for (int k = 0; k < job->clip_count; k++) {
+		struct clip *cl = &job->clips[k];
+		const mlod_clip *src = &job->c.clips[cl->index];
+		for (int i = 0; i < cl->level_count; i++) {
+			struct level *lv = &cl->levels[i];
+			if (!lv->ok)
+				continue;
+			const char *base = src->name ? src->name : "";
+			char *name = malloc(strlen(base) + 32);
+			if (!name)
+				tool_die(EXIT_OUTPUT, NULL, "out of memory");
+			sprintf(name, "%s@lod%d", base, i + 1);
+			free(lv->l.clip.name);
+			lv->l.clip.name = name;
+			int index;
+			if (mlod_gltf_add_animation(doc, &job->c.skeleton, &lv->l.clip, &index, &err) != MLOD_OK)
+				tool_die(EXIT_OUTPUT, NULL, "clip \"%s\": %s", base, err.message);
+			char json[1024];
+			int n = snprintf(json, sizeof json,
+			                 "{\"motion_level\": %d, \"source_animation\": %d, \"method\": \"%s\", \"threshold\": %.9g, ",
+			                 i + 1, src->gltf_index >= 0 ? src->gltf_index : cl->index, method_name(lv->l.method),
+			                 lv->l.threshold);
+			if (lv->bound >= 0.0)
+				n += snprintf(json + n, sizeof json - (size_t)n, "\"bound\": %.9g, ", lv->bound);
+			n += snprintf(json + n, sizeof json - (size_t)n,
+			              "\"keys\": %ld, \"source_keys\": %ld, \"bytes\": %ld, \"joint_error\": {\"max\": %.9g, "
+			              "\"mean\": %.9g, \"max_percent_height\": %.9g}, \"point_error\": %.9g",
+			              lv->l.keys, cl->keys, lv->l.bytes, lv->l.error.max, lv->l.error.mean,
+			              100.0 * lv->l.error.max / job->height, lv->l.point_error);
+			if (lv->has_vertex)
+				n += snprintf(json + n, sizeof json - (size_t)n, ", \"vertex_error_percent_diagonal\": %.9g",
+				              lv->vertex.max);
+			snprintf(json + n, sizeof json - (size_t)n, "}");
+			if (mlod_gltf_set_extra(doc, MLOD_GLTF_ANIMATION, index, "mlod", json, &err) != MLOD_OK)
+				tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+		}
+	}
+	tool_write_gltf(output, doc);
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+	size_t a = strlen(s), b = strlen(suffix);
+	return a >= b && strcmp(s + a - b, suffix) == 0;
+}
+
+int main(int argc, char **argv)
+{
+	static const struct option longopts[] = {
+		{"output", required_argument, NULL, 'o'},
+		{"report", optional_argument, NULL, 'r'},
+		{"method", required_argument, NULL, 'm'},
+		{"max-error", required_argument, NULL, 'e'},
+		{"thresholds", required_argument, NULL, 't'},
+		{"keys", required_argument, NULL, 'k'},
+		{"merge", required_argument, NULL, 'M'},
+		{"point-distance", required_argument, NULL, 'P'},
+		{"cubic-rate", required_argument, NULL, 'C'},
+		{"level", required_argument, NULL, 'l'},
+		{"clip", required_argument, NULL, 'c'},
+		{"help", no_argument, NULL, 'h'},
+		{"version", no_argument, NULL, 'V'},
+		{NULL, 0, NULL, 0},
+	};
+	const char *output = NULL;
+	enum report report = REPORT_NONE;
+	struct job job;
+	int level = -1, clip = 0, ch, kinds = 0, method_given = 0;
+	double point_distance = 0.0;
+	memset(&job, 0, sizeof job);
+	job.method = METHOD_AUTO;
+
+	tool_name = "mlod-motion";
+	opterr = 0;
+	while ((ch = getopt_long(argc, argv, ":o:r::m:e:t:k:l:c:hV", longopts, NULL)) != -1) {
+		switch (ch) {
+		case 'o': output = optarg; break;
+		case 'r':
+			if (!optarg || strcmp(optarg, "table") == 0)
+				report = REPORT_TABLE;
+			else if (strcmp(optarg, "json") == 0)
+				report = REPORT_JSON;
+			else
+				tool_usage_error("--report: unknown format '%s' (table or json)", optarg);
+			break;
+		case 'm':
+			method_given = 1;
+			if (strcmp(optarg, "frames") == 0)
+				job.method = MLOD_MOTION_FRAMES;
+			else if (strcmp(optarg, "keys") == 0)
+				job.method = MLOD_MOTION_KEYS;
+			else if (strcmp(optarg, "auto") == 0)
+				job.method = METHOD_AUTO;
+			else
+				tool_usage_error("--method: unknown method '%s' (frames, keys or auto)", optarg);
+			break;
+		case 'e':
+			job.spec_count = parse_list("--max-error", optarg, job.specs, MLOD_MOTION_MAX_ERROR, 0.0, 1e12);
+			kinds++;
+			break;
+		case 't':
+			job.spec_count = parse_list("--thresholds", optarg, job.specs, MLOD_MOTION_THRESHOLD, 0.0, 1e12);
+			kinds++;
+			break;
+		case 'k':
+			job.spec_count = parse_list("--keys", optarg, job.specs, MLOD_MOTION_FRACTION, 0.0, 1.0);
+			kinds++;
+			break;
+		case 'M':
+			if (strcmp(optarg, "remove") == 0)
+				job.opt.merge = MLOD_MOTION_REMOVE;
+			else if (strcmp(optarg, "average") == 0)
+				job.opt.merge = MLOD_MOTION_AVERAGE;
+			else
+				tool_usage_error("--merge: unknown mode '%s' (remove or average)", optarg);
+			break;
+		case 'P': point_distance = tool_parse_double("--point-distance", optarg, 1e-12, 1e12); break;
+		case 'C': job.opt.cubic_rate = tool_parse_double("--cubic-rate", optarg, 1.0, 1e4); break;
+		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
+		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
+		case 'h': fputs(usage_text, stdout); return 0;
+		case 'V': tool_version();
+		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
+		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		}
+	}
+	if (argc - optind > 1)
+		tool_usage_error("too many inputs: one file, or stdin");
+	if (kinds > 1)
+		tool_usage_error("--max-error, --thresholds and --keys do not go together");
+	if (job.spec_count && job.specs[0].target == MLOD_MOTION_THRESHOLD) {
+		if (method_given && job.method == MLOD_MOTION_KEYS)
+			tool_usage_error("--thresholds are frame distances: they need --method frames");
+		job.method = MLOD_MOTION_FRAMES;
+	}
+	if (job.spec_count == 0)
+		job.spec_count = parse_list("--max-error", DEFAULT_MAX_ERROR, job.specs, MLOD_MOTION_MAX_ERROR, 0.0, 1e12);
+	qsort(job.specs, (size_t)job.spec_count, sizeof *job.specs, spec_order);
+	int bvh_out = output && ends_with(output, ".bvh");
+	if (level >= 0 && !bvh_out)
+		tool_usage_error("--level needs a .bvh output (-o out.bvh)");
+	if (report != REPORT_NONE && output)
+		tool_usage_error("--report and --output do not go together");
+
+	mlod_gltf *doc = NULL;
+	job.input = tool_input_label(optind < argc ? argv[optind] : NULL);
+	tool_load(optind < argc ? argv[optind] : NULL, bvh_out || report != REPORT_NONE ? NULL : &doc, &job.c,
+	          &job.format);
+	if (job.c.clip_count == 0)
+		tool_die(EXIT_INPUT, job.input, "no animation to reduce (a BVH with 'Frames: 0' has none)");
+	job.height = mlod_skeleton_size(&job.c.skeleton);
+	/* 10 cm: glTF is in metres; a BVH's unit is its own, so a person 1.8 units tall gets 0.1. */
+	job.point_distance = point_distance > 0.0                 ? point_distance
+	                     : job.format == MLOD_FORMAT_BVH ? job.height / 18.0
+	                                                          : GLTF_POINT_DISTANCE;
+	job.opt.point_distance = job.point_distance;
+	for (int s = 0; s < job.spec_count; s++)
+		if (job.specs[s].percent && !(job.height > 0.0))
+			tool_die(EXIT_INPUT, job.input, "--max-error in %%: the skeleton has no height");
+
+	if (bvh_out && clip >= job.c.clip_count)
+		tool_die(EXIT_USAGE, NULL, "--clip %d: the input has %d clips", clip, job.c.clip_count);
+	job.clip_count = bvh_out ? 1 : job.c.clip_count;
+	job.clips = calloc((size_t)job.clip_count, sizeof *job.clips);
+	if (!job.clips)
+		tool_die(EXIT_INPUT, job.input, "out of memory");
+	for (int k = 0; k < job.clip_count; k++) {
+		job.clips[k].index = bvh_out ? clip : k;
+		if (!(bvh_out && level == 0))
+			clip_levels(&job, &job.clips[k]);
+	}
+	for (int k = 0; k < job.clip_count && report == REPORT_NONE; k++)
+		if (job.clips[k].timeline.resampled) {
+			char note[256];
+			timeline_note(note, sizeof note, &job.clips[k]);
+			fprintf(stderr, "%s: %s: clip \"%s\": %s\n", tool_name, job.input, job.c.clips[job.clips[k].index].name,
+			        note);
+		}
+
+	if (report == REPORT_TABLE)
+		report_table(&job);
+	else if (report == REPORT_JSON)
+		report_json(&job);
+	else if (bvh_out)
+		write_bvh(&job, output, level < 0 ? job.clips[0].level_count : level, clip);
+	else
+		write_glb(&job, doc, output);
+
+	if (fflush(stdout) != 0)
+		tool_die(EXIT_OUTPUT, "<stdout>", "write error");
+	for (int k = 0; k < job.clip_count; k++)
+		for (int i = 0; i < job.clips[k].level_count; i++)
+			if (job.clips[k].levels[i].ok)
+				mlod_motion_level_free(&job.clips[k].levels[i].l);
+	free(job.clips);
+	mlod_character_free(&job.c);
+	mlod_gltf_free(doc);
+	return 0;
+}
