@@ -37,6 +37,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -912,11 +913,40 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 	if (res != MLOD_OK)
 		return res;
 
+	/* Whole frames past the declared count (real files have them: one of
+	 * Debian's assimp test files says 3069 frames and holds 3070) are
+	 * ignored with a note, as common readers do; anything else is an error. */
 	skip_space(&r->lx, 1);
 	if (r->lx.p < r->lx.end) {
-		TRY(next(r, &t));
-		return mlod_fail(r->err, MLOD_ERR_PARSE, "line %d: extra data %s after the last of %ld frames", t.line,
-		                 show(&t, b), frames);
+		lexer start = r->lx;
+		long values = 0;
+		int first_line = 0, ok = 1;
+		double v;
+		for (;;) {
+			TRY(next(r, &t));
+			if (t.len == 0)
+				break;
+			if (!first_line)
+				first_line = t.line;
+			if (parse_number(t.s, t.len, &v) != NUM_OK) {
+				ok = 0;
+				break;
+			}
+			values++;
+		}
+		if (!ok || values % vpf != 0) {
+			r->lx = start;
+			TRY(next(r, &t));
+			return mlod_fail(r->err, MLOD_ERR_PARSE, "line %d: extra data %s after the last of %ld frames",
+			                 t.line, show(&t, b), frames);
+		}
+		char note[160];
+		snprintf(note, sizeof note, "%ld %s after the %ld that 'Frames:' announces (from line %d) ignored",
+		         values / vpf, values / vpf == 1 ? "frame" : "frames", frames, first_line);
+		c->notes = malloc(strlen(note) + 1);
+		if (!c->notes)
+			return mlod_fail(r->err, MLOD_ERR_NOMEM, "out of memory");
+		memcpy(c->notes, note, strlen(note) + 1);
 	}
 	return MLOD_OK;
 }
