@@ -105,4 +105,45 @@ static inline int test_have_shared(void)
 	return e && *e;
 }
 
+
+/* A skeleton from a parent array (parents before children), joints named
+ * j0, j1, ..., bones of length 1 along y. Free with mlod_character_free. */
+static inline mlod_character test_skeleton(int n, const int *parent)
+{
+	mlod_character c = {0};
+	c.skeleton.joint_count = n;
+	c.skeleton.joints = calloc((size_t)n, sizeof(mlod_joint));
+	for (int j = 0; j < n; j++) {
+		mlod_joint *jt = &c.skeleton.joints[j];
+		char name[16];
+		snprintf(name, sizeof name, "j%d", j);
+		jt->name = strdup(name);
+		jt->parent = parent[j];
+		jt->rest = mlod_trs_identity();
+		jt->rest.t.y = parent[j] >= 0 ? 1.0f : 0.0f;
+		jt->base = mlod_mat4_identity();
+		jt->node = -1;
+		jt->euler = MLOD_EULER_XYZ;
+	}
+	return c;
+}
+
+/* Loads a glb, glTF or BVH file into c; returns 0, or -1 after printing
+ * why to stderr. */
+static inline int test_load(const char *path, mlod_character *c)
+{
+	size_t size;
+	void *data = test_read_file(path, &size);
+	if (!data) {
+		fprintf(stderr, "%s: cannot read\n", path);
+		return -1;
+	}
+	mlod_error e = {0};
+	mlod_result r = mlod_load(data, size, NULL, NULL, c, NULL, &e);
+	free(data);
+	if (r != MLOD_OK)
+		fprintf(stderr, "%s: %s\n", path, e.message);
+	return r == MLOD_OK ? 0 : -1;
+}
+
 #endif

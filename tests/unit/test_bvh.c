@@ -1,4 +1,5 @@
 /* test_bvh.c: the BVH reader and writer: layouts, motion, round trips, malformed input. */
+#define _POSIX_C_SOURCE 200809L /* strdup, opendir */
 #include "test.h"
 
 #include <dirent.h>

@@ -3,27 +3,6 @@
 
 #define PI 3.14159265358979323846
 
-/* A skeleton from a parent array (parents before children). */
-static mlod_character make_skeleton(int n, const int *parent)
-{
-	mlod_character c = {0};
-	c.skeleton.joint_count = n;
-	c.skeleton.joints = calloc((size_t)n, sizeof(mlod_joint));
-	for (int j = 0; j < n; j++) {
-		mlod_joint *jt = &c.skeleton.joints[j];
-		char name[16];
-		snprintf(name, sizeof name, "j%d", j);
-		jt->name = strdup(name);
-		jt->parent = parent[j];
-		jt->rest = mlod_trs_identity();
-		jt->rest.t.y = parent[j] >= 0 ? 1.0f : 0.0f;
-		jt->base = mlod_mat4_identity();
-		jt->node = -1;
-		jt->euler = MLOD_EULER_XYZ;
-	}
-	return c;
-}
-
 /* Adds a clip rotating joint j about x through the given angles (degrees),
  * one key per angle at 1/30 s. */
 static void add_x_rotation_clip(mlod_character *c, int j, const float *deg, int keys)
@@ -54,7 +33,7 @@ static void add_x_rotation_clip(mlod_character *c, int j, const float *deg, int 
 TEST(single_chain)
 {
 	int parent[] = {-1, 0, 1, 2, 3};
-	mlod_character c = make_skeleton(5, parent);
+	mlod_character c = test_skeleton(5, parent);
 	mlod_joint_info info[5];
 	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
 	CHECK(info[0].label == MLOD_LABEL_ROOT);
@@ -79,7 +58,7 @@ TEST(humanoid_hubs)
 	/* 0 pelvis; 1-2 left leg; 3-4 right leg; 5 spine; 6 chest; 7 neck 8 head;
 	 * 9-10 left arm; 11-12 right arm */
 	int parent[] = {-1, 0, 1, 0, 3, 0, 5, 6, 7, 6, 9, 6, 11};
-	mlod_character c = make_skeleton(13, parent);
+	mlod_character c = test_skeleton(13, parent);
 	mlod_joint_info info[13];
 	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
 	CHECK(info[0].label == MLOD_LABEL_ROOT);
@@ -105,7 +84,7 @@ TEST(hub_at_average_depth_is_minor)
 	 * root. depths 0 1 2 3 3 3 1 -> average 13/7; make it exactly 2 by
 	 * adding leaf 7 at depth 3: 0+1+2+3+3+3+1+3 = 16/8 = 2. */
 	int parent[] = {-1, 0, 1, 2, 2, 2, 0, 2};
-	mlod_character c = make_skeleton(8, parent);
+	mlod_character c = test_skeleton(8, parent);
 	mlod_joint_info info[8];
 	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
 	CHECK(info[2].depth == 2);
@@ -117,7 +96,7 @@ TEST(hub_at_average_depth_is_minor)
 TEST(star_and_two_roots)
 {
 	int star[] = {-1, 0, 0, 0, 0, 0};
-	mlod_character c = make_skeleton(6, star);
+	mlod_character c = test_skeleton(6, star);
 	mlod_joint_info info[8];
 	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
 	CHECK(info[0].label == MLOD_LABEL_ROOT);
@@ -126,7 +105,7 @@ TEST(star_and_two_roots)
 	mlod_character_free(&c);
 
 	int two[] = {-1, 0, 1, -1, 3, 4};
-	c = make_skeleton(6, two);
+	c = test_skeleton(6, two);
 	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
 	CHECK(info[0].label == MLOD_LABEL_ROOT && info[3].label == MLOD_LABEL_ROOT);
 	CHECK(info[4].depth == 1 && info[5].depth == 2);
@@ -138,7 +117,7 @@ TEST(star_and_two_roots)
 TEST(energy_total_variation)
 {
 	int parent[] = {-1, 0, 1};
-	mlod_character c = make_skeleton(3, parent);
+	mlod_character c = test_skeleton(3, parent);
 	float there_and_back[] = {0, 45, 90, 45, 0};
 	add_x_rotation_clip(&c, 1, there_and_back, 5);
 	mlod_joint_info info[3];
@@ -157,7 +136,7 @@ TEST(energy_total_variation)
 TEST(energy_unwraps_angles)
 {
 	int parent[] = {-1, 0, 1};
-	mlod_character c = make_skeleton(3, parent);
+	mlod_character c = test_skeleton(3, parent);
 	float wrap[] = {170, 179, -179, -170};
 	add_x_rotation_clip(&c, 1, wrap, 4);
 	mlod_joint_info info[3];
@@ -170,7 +149,7 @@ TEST(energy_unwraps_angles)
 TEST(energy_max_over_clips)
 {
 	int parent[] = {-1, 0, 1};
-	mlod_character c = make_skeleton(3, parent);
+	mlod_character c = test_skeleton(3, parent);
 	float small[] = {0, 10}, big[] = {0, 60, 0};
 	add_x_rotation_clip(&c, 1, small, 2);
 	add_x_rotation_clip(&c, 1, big, 3);
@@ -183,7 +162,7 @@ TEST(energy_max_over_clips)
 TEST(bad_skeleton)
 {
 	int parent[] = {-1, 2, 0};
-	mlod_character c = make_skeleton(3, parent);
+	mlod_character c = test_skeleton(3, parent);
 	mlod_joint_info info[3];
 	CHECK(mlod_label_skeleton(&c, NULL, info, &terr) == MLOD_ERR_PARSE);
 	CHECK(strstr(terr.message, "j1") != NULL);

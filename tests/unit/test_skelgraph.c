@@ -2,45 +2,11 @@
  * motion folding and skin transfer. */
 #include "test.h"
 
-/* A skeleton from a parent array, bones of length 1 along y. */
-static mlod_character make_skeleton(int n, const int *parent)
-{
-	mlod_character c = {0};
-	c.skeleton.joint_count = n;
-	c.skeleton.joints = calloc((size_t)n, sizeof(mlod_joint));
-	for (int j = 0; j < n; j++) {
-		mlod_joint *jt = &c.skeleton.joints[j];
-		char name[16];
-		snprintf(name, sizeof name, "j%d", j);
-		jt->name = strdup(name);
-		jt->parent = parent[j];
-		jt->rest = mlod_trs_identity();
-		jt->rest.t.y = parent[j] >= 0 ? 1.0f : 0.0f;
-		jt->base = mlod_mat4_identity();
-		jt->node = -1;
-	}
-	return c;
-}
-
-static int load_sample(const char *path, mlod_character *c)
-{
-	size_t size;
-	void *data = test_read_file(path, &size);
-	if (!data)
-		return -1;
-	mlod_error e = {0};
-	mlod_result r = mlod_load(data, size, "samples", NULL, c, NULL, &e);
-	free(data);
-	if (r != MLOD_OK)
-		fprintf(stderr, "%s: %s\n", path, e.message);
-	return r == MLOD_OK ? 0 : -1;
-}
-
 TEST(chain_closure)
 {
 	/* root 0 - 1 - 2 - 3 - leaf 4: one chain, 4 + 3 + 2 + 1 edges. */
 	int parent[] = {-1, 0, 1, 2, 3};
-	mlod_character c = make_skeleton(5, parent);
+	mlod_character c = test_skeleton(5, parent);
 	mlod_joint_info info[5];
 	mlod_skelgraph g;
 	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
@@ -66,7 +32,7 @@ TEST(chain_closure)
 TEST(star_has_one_chain_per_bone)
 {
 	int parent[] = {-1, 0, 0, 0, 0};
-	mlod_character c = make_skeleton(5, parent);
+	mlod_character c = test_skeleton(5, parent);
 	mlod_joint_info info[5];
 	mlod_skelgraph g;
 	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
@@ -80,7 +46,7 @@ TEST(star_has_one_chain_per_bone)
 TEST(two_roots)
 {
 	int parent[] = {-1, 0, 1, -1, 3, 4};
-	mlod_character c = make_skeleton(6, parent);
+	mlod_character c = test_skeleton(6, parent);
 	mlod_joint_info info[6];
 	mlod_skelgraph g;
 	mlod_skel_level l;
@@ -100,7 +66,7 @@ TEST(two_roots)
 TEST(zero_length_bones)
 {
 	int parent[] = {-1, 0, 1, 2, 3};
-	mlod_character c = make_skeleton(5, parent);
+	mlod_character c = test_skeleton(5, parent);
 	c.skeleton.joints[1].rest.t.y = 0.0f;
 	c.skeleton.joints[2].rest.t.y = 0.0f;
 	mlod_joint_info info[5];
@@ -174,7 +140,7 @@ static void for_shared(void (*check)(const mlod_character *))
 		char path[1024];
 		mlod_character c = {0};
 		snprintf(path, sizeof path, "%.900s/%s", getenv("MLOD_SHARED_DATA"), files[i]);
-		CHECK_MSG(load_sample(path, &c) == 0, "cannot load %.300s", path);
+		CHECK_MSG(test_load(path, &c) == 0, "cannot load %.300s", path);
 		check(&c);
 		mlod_character_free(&c);
 		if (test_failed_)
@@ -197,7 +163,7 @@ TEST(mst_equals_nearest_kept_ancestor)
 	                         "tests/data/mixed_channels.bvh", "tests/data/two_roots.bvh"};
 	for (size_t i = 0; i < sizeof samples / sizeof *samples; i++) {
 		mlod_character c = {0};
-		CHECK_MSG(load_sample(samples[i], &c) == 0, "cannot load %s", samples[i]);
+		CHECK_MSG(test_load(samples[i], &c) == 0, "cannot load %s", samples[i]);
 		check_oracle(&c);
 		mlod_character_free(&c);
 		if (test_failed_)
@@ -307,7 +273,7 @@ TEST(folding_is_exact)
 	                         "tests/data/mixed_channels.bvh"};
 	for (size_t i = 0; i < sizeof samples / sizeof *samples; i++) {
 		mlod_character c = {0};
-		CHECK_MSG(load_sample(samples[i], &c) == 0, "cannot load %s", samples[i]);
+		CHECK_MSG(test_load(samples[i], &c) == 0, "cannot load %s", samples[i]);
 		check_folding(&c, 0.39);
 		check_folding(&c, 0.2);
 		mlod_character_free(&c);
@@ -321,7 +287,7 @@ TEST(folding_is_exact)
 TEST(shear_is_detected)
 {
 	int parent[] = {-1, 0, 1, 2};
-	mlod_character c = make_skeleton(4, parent);
+	mlod_character c = test_skeleton(4, parent);
 	c.skeleton.joints[1].rest.s = (mlod_v3){1.0f, 3.0f, 1.0f};
 	mlod_v3 z = {0, 0, 1};
 	c.skeleton.joints[2].rest.r = mlod_quat_axis_angle(z, 0.7f);
@@ -348,7 +314,7 @@ TEST(shear_is_detected)
 TEST(skin_transfer_merges)
 {
 	int parent[] = {-1, 0, 1, 2};
-	mlod_character c = make_skeleton(4, parent);
+	mlod_character c = test_skeleton(4, parent);
 	c.skeleton.skin_count = 1;
 	c.skeleton.skins = calloc(1, sizeof(mlod_skin));
 	mlod_skin *sk = &c.skeleton.skins[0];

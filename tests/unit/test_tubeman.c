@@ -7,6 +7,7 @@
  * per BVH frame, skin to a plausible body, and be byte-identical to what
  * tests/helpers/gen_tubeman (next to this program, in helpers/) makes now.
  */
+#define _POSIX_C_SOURCE 200809L /* strdup, opendir */
 #include <stdint.h>
 
 #include "test.h"
