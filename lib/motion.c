@@ -58,7 +58,8 @@
 #define DEFAULT_CUBIC_RATE 60.0
 #define MAX_FRAMES 10000000
 #define MAX_VALUES 200000000.0 /* floats of a common clip */
-#define SEARCH_STEPS 40
+#define SEARCH_STEPS 24 /* bisection steps: the threshold to 2^-24 of its range */
+#define MAX_CACHED 1000000L /* frames * joints whose world matrices as read are cached */
 #define KEYS_RETRIES 6
 
 /* Axes of each Euler order, outermost first (as in math.c). */
@@ -450,6 +451,7 @@ struct mlod_motion {
 	double *radius;        /* per joint: the point distance, or its End Site's if farther */
 	mlod_trs *local;
 	mlod_mat4 *world, *world0;
+	mlod_mat4 *cache0;     /* frames * joints world matrices as read, or NULL */
 	/* State of each method: the last line of the tree, the keys kept. */
 	line tree;
 	unsigned char *kept;   /* channel_count * frames */
@@ -477,6 +479,7 @@ void mlod_motion_free(mlod_motion *m)
 	free(m->local);
 	free(m->world);
 	free(m->world0);
+	free(m->cache0);
 	line_free(&m->tree);
 	free(m->kept);
 	free(m);
@@ -589,6 +592,9 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 		double es = s->joints[j].has_end_site ? mlod_v3_length(s->joints[j].end_site) : 0.0;
 		m->radius[j] = es > pd ? es : pd;
 	}
+	if ((double)F * n <= (double)MAX_CACHED && (m->cache0 = malloc(sizeof(mlod_mat4) * (size_t)F * (size_t)n)) != NULL)
+		for (int f = 0; f < F; f++)
+			pose_at(m, src, m->common.channels[0].times[f], m->cache0 + (size_t)f * (size_t)n);
 	/* Level 0 of each method: every frame, every key. */
 	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
 	m->kept = malloc((size_t)nch * (size_t)F);
@@ -728,10 +734,14 @@ static double level_max_error(mlod_motion *m, const mlod_clip *clip)
 	double worst = 0.0;
 	for (int f = 0; f < m->frames; f++) {
 		float t = m->common.channels[0].times[f];
-		pose_at(m, m->orig, t, m->world0);
+		const mlod_mat4 *w0 = m->world0;
+		if (m->cache0)
+			w0 = m->cache0 + (size_t)f * (size_t)m->s->joint_count;
+		else
+			pose_at(m, m->orig, t, m->world0);
 		pose_at(m, clip, t, m->world);
 		for (int j = 0; j < m->s->joint_count; j++) {
-			double e = mlod_motion_point_error(&m->world[j], &m->world0[j], m->radius[j]);
+			double e = mlod_motion_point_error(&m->world[j], &w0[j], m->radius[j]);
 			if (!(e <= worst))
 				worst = e; /* NaN counts as the worst */
 		}
@@ -880,8 +890,9 @@ static int fuse(const mlod_motion *m, const line *l, int i, fnode *o)
 }
 
 /* One pass of the tree: fuses disjoint neighbouring pairs closer than T.
+ * With steal, frames that stay are moved from in rather than copied.
  * Returns the number of fusions, or -1 when out of memory. */
-static int tree_pass(const mlod_motion *m, const line *in, double T, line *out)
+static int tree_pass(const mlod_motion *m, line *in, double T, line *out, int steal)
 {
 	out->v = calloc((size_t)(in->n > 0 ? in->n : 1), sizeof *out->v);
 	out->n = 0;
@@ -900,25 +911,33 @@ static int tree_pass(const mlod_motion *m, const line *in, double T, line *out)
 		} else {
 			size_t size = sizeof(float) * (size_t)(m->value_count + 3 * m->rot_count + 1);
 			*o = in->v[i];
-			o->values = malloc(size);
-			if (!o->values)
-				return -1;
-			memcpy(o->values, in->v[i].values, size);
+			if (steal) {
+				/* in->v[i] still serves as a neighbour below: forget it after the pass. */
+				in->v[i].frame = -2;
+			} else {
+				o->values = malloc(size);
+				if (!o->values)
+					return -1;
+				memcpy(o->values, in->v[i].values, size);
+			}
 			out->n++;
 			i++;
 		}
 	}
+	for (int i = 0; steal && i < in->n; i++)
+		if (in->v[i].frame == -2)
+			in->v[i].values = NULL; /* now owned by out */
 	return fused;
 }
 
 /* The line reached from in when no neighbouring pair is closer than T. */
-static int tree_level(const mlod_motion *m, const line *in, double T, line *out)
+static int tree_level(const mlod_motion *m, line *in, double T, line *out)
 {
 	line cur = { 0, NULL };
 	int first = 1;
 	for (;;) {
 		line next = { 0, NULL };
-		int fused = tree_pass(m, first ? in : &cur, T, &next);
+		int fused = tree_pass(m, first ? in : &cur, T, &next, !first);
 		if (fused < 0) {
 			line_free(&next);
 			line_free(&cur);

@@ -1,0 +1,488 @@
+/*
+ * bench_motion.c: motion layer benchmarks.
+ *
+ *   bench_motion convert IN OUT.glb      writes IN (BVH, glTF) as glb
+ *   bench_motion peers ORIG LABEL=FILE...
+ *                                        compares other tools' outputs of ORIG
+ *                                        (gltfpack) with mlod's levels at the
+ *                                        same error: per output, the keys, key
+ *                                        bytes raw and compressed (gzip -9,
+ *                                        zstd -19 on the same layout), and the
+ *                                        max joint position error measured by
+ *                                        mlod_joint_deviation; mlod's levels use
+ *                                        per clip the peer's own error as bound
+ *   bench_motion methods FILE...         both methods (and both merges of the
+ *                                        tree) at 0.2%, 1% and 3% of the height
+ *   bench_motion speed FILE...           time to build the default levels
+ *                                        (0.2%, 1%, 3%): clips/s and frames/s
+ *
+ * Prints Markdown tables. Times are medians of repeated runs. Clips and
+ * joints of a peer's output are matched to the original by name.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "mlod.h"
+
+#define MAX_PEERS 8
+#define SPEED_RUNS 5
+
+static double now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+	qsort(v, (size_t)n, sizeof *v, cmp_double);
+	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static void *read_all(const char *path, size_t *size)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	fseek(f, 0, SEEK_END);
+	long n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	void *data = malloc((size_t)(n > 0 ? n : 1));
+	*size = data ? fread(data, 1, (size_t)n, f) : 0;
+	fclose(f);
+	return data;
+}
+
+static int load(const char *path, mlod_character *c, mlod_gltf **doc)
+{
+	size_t size = 0;
+	void *data = read_all(path, &size);
+	if (!data) {
+		fprintf(stderr, "bench_motion: %s: cannot read\n", path);
+		return -1;
+	}
+	mlod_error err = {0};
+	mlod_result r = mlod_load(data, size, ".", doc, c, NULL, &err);
+	free(data);
+	if (r != MLOD_OK)
+		fprintf(stderr, "bench_motion: %s: %s\n", path, err.message);
+	return r == MLOD_OK ? 0 : -1;
+}
+
+static const char *base_name(const char *path)
+{
+	const char *s = strrchr(path, '/');
+	return s ? s + 1 : path;
+}
+
+/* ---------------------------------------------------------------- */
+/* Key data: raw layout and compressed sizes                         */
+/* ---------------------------------------------------------------- */
+
+/* Appends a clip's key data as glTF holds it (times shared by channels
+ * written once, then values) to f. */
+static void write_keys(FILE *f, const mlod_clip *clip)
+{
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		int shared = 0;
+		for (int k = 0; k < i && !shared; k++)
+			shared = clip->channels[k].key_count == ch->key_count &&
+			         memcmp(clip->channels[k].times, ch->times, sizeof(float) * (size_t)ch->key_count) == 0;
+		if (!shared)
+			fwrite(ch->times, sizeof(float), (size_t)ch->key_count, f);
+	}
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		size_t per = (ch->path == MLOD_PATH_ROTATION ? 4 : 3) * (ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
+		fwrite(ch->values, sizeof(float), per * (size_t)ch->key_count, f);
+	}
+}
+
+/* Compressed size of a file by a command ("gzip -9 -c"), or -1. */
+static long compressed(const char *cmd, const char *path)
+{
+	char line[1024];
+	snprintf(line, sizeof line, "%s < '%s' 2>/dev/null | wc -c", cmd, path);
+	FILE *p = popen(line, "r");
+	long n = -1;
+	if (!p)
+		return -1;
+	if (fscanf(p, "%ld", &n) != 1)
+		n = -1;
+	if (pclose(p) != 0)
+		n = -1;
+	return n;
+}
+
+typedef struct sizes {
+	long keys, raw, gz, zst;
+} sizes;
+
+static sizes clip_sizes(const mlod_clip *const *clips, int n)
+{
+	/* NULL entries are clips a peer lacks. */
+	sizes s = {0, 0, -1, -1};
+	char path[] = "/tmp/bench_motion.XXXXXX";
+	int fd = mkstemp(path);
+	FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+	for (int k = 0; k < n; k++) {
+		if (!clips[k])
+			continue;
+		s.keys += mlod_clip_key_count(clips[k]);
+		s.raw += mlod_clip_key_bytes(clips[k]);
+		if (f)
+			write_keys(f, clips[k]);
+	}
+	if (f) {
+		fclose(f);
+		s.gz = compressed("gzip -9 -c", path);
+		s.zst = compressed("zstd -19 -c -q", path);
+		unlink(path);
+	}
+	return s;
+}
+
+/* ---------------------------------------------------------------- */
+/* Error of a peer's clip against the original, joints by name        */
+/* ---------------------------------------------------------------- */
+
+static int find_clip(const mlod_character *c, const char *name)
+{
+	for (int k = 0; k < c->clip_count; k++)
+		if (strcmp(c->clips[k].name, name) == 0)
+			return k;
+	return -1;
+}
+
+static int *joint_map(const mlod_character *a, const mlod_character *b)
+{
+	int *map = malloc(sizeof(int) * (size_t)a->skeleton.joint_count);
+	for (int j = 0; map && j < a->skeleton.joint_count; j++) {
+		map[j] = -1;
+		for (int k = 0; k < b->skeleton.joint_count && map[j] < 0; k++)
+			if (strcmp(a->skeleton.joints[j].name, b->skeleton.joints[k].name) == 0)
+				map[j] = k;
+	}
+	return map;
+}
+
+/* Max joint position error of clip kb of b against clip ka of a. */
+static double clip_error(const mlod_character *a, int ka, const mlod_character *b, int kb, const int *map)
+{
+	mlod_character x = *a, y = *b;
+	x.clip_count = y.clip_count = 1;
+	x.clips = &a->clips[ka];
+	y.clips = &b->clips[kb];
+	mlod_deviation d;
+	mlod_error err = {0};
+	if (mlod_joint_deviation(&x, &y, NULL, map, 0, &d, &err) != MLOD_OK) {
+		fprintf(stderr, "bench_motion: %s\n", err.message);
+		return NAN;
+	}
+	return d.max;
+}
+
+/* Max and mean joint position error of clips (one per clip of a, in a's
+ * order; NULL entries are a's own) carried by skeleton b (map: a's joint
+ * -> b's; NULL when b is a). */
+static mlod_deviation all_error(const mlod_character *a, const mlod_character *b, const mlod_clip *const *clips,
+                                const int *map)
+{
+	mlod_character y = *b;
+	mlod_clip *copy = malloc(sizeof *copy * (size_t)a->clip_count);
+	mlod_deviation d = {NAN, NAN, 0};
+	for (int k = 0; k < a->clip_count; k++)
+		copy[k] = clips[k] ? *clips[k] : a->clips[k];
+	y.clip_count = a->clip_count;
+	y.clips = copy;
+	mlod_error err = {0};
+	if (mlod_joint_deviation(a, &y, NULL, map, 0, &d, &err) != MLOD_OK)
+		fprintf(stderr, "bench_motion: %s\n", err.message);
+	free(copy);
+	return d;
+}
+
+/* mlod's level of clip k within bound, by method (-1: auto). */
+static int our_level(const mlod_character *c, int k, int method, double bound, double point_distance,
+                     mlod_motion_level *out)
+{
+	mlod_motion_options opt = {0};
+	opt.point_distance = point_distance;
+	int have = 0;
+	for (int m = 0; m < 2; m++) {
+		if (method >= 0 && m != method)
+			continue;
+		mlod_motion *mo;
+		mlod_motion_level l;
+		mlod_error err = {0};
+		if (mlod_motion_create(c, k, &opt, &mo, &err) != MLOD_OK)
+			return -1;
+		mlod_result r = mlod_motion_next_level(mo, (mlod_motion_method)m, MLOD_MOTION_MAX_ERROR, bound, &l, &err);
+		mlod_motion_free(mo);
+		if (r != MLOD_OK)
+			continue;
+		if (!have || l.bytes < out->bytes) {
+			if (have)
+				mlod_motion_level_free(out);
+			*out = l;
+			have = 1;
+		} else {
+			mlod_motion_level_free(&l);
+		}
+	}
+	return have ? 0 : -1;
+}
+
+static void row(const char *label, sizes s, mlod_deviation e, double h, const sizes *ref, double ref_err)
+{
+	double err_pct = 100.0 * e.max / h;
+	printf("| %s | %ld | %ld | %ld | %ld | %.4f | %.4f |", label, s.keys, s.raw, s.gz, s.zst, err_pct, 100.0 * e.mean / h);
+	if (ref)
+		printf(" %.2fx | %.2fx | %.2fx | %s |\n", (double)s.raw / (double)ref->raw, (double)s.gz / (double)ref->gz,
+		       (double)s.zst / (double)ref->zst, err_pct <= ref_err + 1e-9 ? "yes" : "no");
+	else
+		printf(" | | | |\n");
+}
+
+static int cmd_peers(int argc, char **argv)
+{
+	mlod_character a;
+	if (argc < 2 || load(argv[0], &a, NULL) != 0)
+		return 1;
+	double h = mlod_skeleton_size(&a.skeleton);
+	int bvh = strstr(argv[0], ".bvh") != NULL;
+	double pd = bvh ? h / 18.0 : 0.1;
+	const mlod_clip **clips = malloc(sizeof *clips * (size_t)a.clip_count);
+	for (int k = 0; k < a.clip_count; k++)
+		clips[k] = &a.clips[k];
+	sizes s0 = clip_sizes(clips, a.clip_count);
+	printf("%s: %d clips, %d joints, height %.4g. Key data in bytes (float32, as glTF stores it); "
+	       "error: max world joint position error over all clips, %% of the height, measured by mlod.\n\n",
+	       base_name(argv[0]), a.clip_count, a.skeleton.joint_count, h);
+	printf("| output | keys | raw | gzip -9 | zstd -19 | max error %% | mean error %% | raw vs peer | gzip vs peer | zstd vs peer | max error <= peer |\n");
+	printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
+	mlod_deviation zero = {0, 0, 0};
+	row("input", s0, zero, h, NULL, 0.0);
+	for (int p = 1; p < argc; p++) {
+		char label[256];
+		const char *eq = strchr(argv[p], '=');
+		if (!eq)
+			continue;
+		snprintf(label, sizeof label, "%.*s", (int)(eq - argv[p]), argv[p]);
+		mlod_character b;
+		if (load(eq + 1, &b, NULL) != 0)
+			continue;
+		int *map = joint_map(&a, &b);
+		const mlod_clip **pc = calloc((size_t)a.clip_count, sizeof *pc);
+		double *bound = malloc(sizeof(double) * (size_t)a.clip_count);
+		for (int k = 0; k < a.clip_count; k++) {
+			int kb = find_clip(&b, a.clips[k].name);
+			bound[k] = -1.0;
+			if (kb < 0) {
+				fprintf(stderr, "bench_motion: %s has no clip \"%s\"\n", label, a.clips[k].name);
+				continue;
+			}
+			pc[k] = &b.clips[kb];
+			bound[k] = clip_error(&a, k, &b, kb, map);
+		}
+		sizes sp = clip_sizes(pc, a.clip_count);
+		mlod_deviation pe = all_error(&a, &b, pc, map);
+		row(label, sp, pe, h, NULL, 0.0);
+		/* mlod at the peer's own max error, clip by clip, then at fixed bounds. */
+		static const char *const names[] = {"mlod auto", "mlod frames", "mlod keys"};
+		static const double fixed[] = {-1.0, 0.01, 0.002};
+		for (int f = 0; f < 3; f++)
+			for (int method = -1; method < 2; method++) {
+				if (f > 0 && method >= 0)
+					continue;
+				mlod_motion_level *lv = calloc((size_t)a.clip_count, sizeof *lv);
+				const mlod_clip **oc = calloc((size_t)a.clip_count, sizeof *oc);
+				for (int k = 0; k < a.clip_count; k++) {
+					double bk = fixed[f] > 0.0 ? fixed[f] * h : bound[k];
+					if (bk >= 0.0 && our_level(&a, k, method, bk, pd, &lv[k]) == 0)
+						oc[k] = &lv[k].clip;
+					else
+						oc[k] = &a.clips[k]; /* no level: the clip as read */
+				}
+				char l2[320];
+				if (f == 0)
+					snprintf(l2, sizeof l2, "%s within %s's error", names[method + 1], label);
+				else
+					snprintf(l2, sizeof l2, "%s within %g%% of the height", names[method + 1], 100.0 * fixed[f]);
+				row(l2, clip_sizes(oc, a.clip_count), all_error(&a, &a, oc, NULL), h, &sp, 100.0 * pe.max / h);
+				for (int k = 0; k < a.clip_count; k++)
+					mlod_motion_level_free(&lv[k]);
+				free(lv);
+				free(oc);
+			}
+		free(map);
+		free(pc);
+		free(bound);
+		mlod_character_free(&b);
+	}
+	printf("\n");
+	free(clips);
+	mlod_character_free(&a);
+	return 0;
+}
+
+/* ---------------------------------------------------------------- */
+/* Methods at fixed bounds                                           */
+/* ---------------------------------------------------------------- */
+
+static int cmd_methods(int argc, char **argv)
+{
+	static const double pct[3] = {0.2, 1.0, 3.0};
+	printf("| character | clips | keys | method | keys at 0.2%% | bytes | keys at 1%% | bytes | keys at 3%% | bytes | vs tree (remove) at 1%% |\n");
+	printf("|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
+	for (int i = 0; i < argc; i++) {
+		mlod_character c;
+		if (load(argv[i], &c, NULL) != 0)
+			continue;
+		double h = mlod_skeleton_size(&c.skeleton);
+		double pd = strstr(argv[i], ".bvh") ? h / 18.0 : 0.1;
+		long keys0 = 0, ref = 0;
+		for (int k = 0; k < c.clip_count; k++)
+			keys0 += mlod_clip_key_count(&c.clips[k]);
+		static const char *const names[] = {"tree, remove", "tree, average", "keys"};
+		for (int v = 0; v < 3; v++) {
+			long keys[3] = {0}, bytes[3] = {0};
+			for (int k = 0; k < c.clip_count; k++) {
+				mlod_motion_options opt = {0};
+				opt.point_distance = pd;
+				opt.merge = v == 1 ? MLOD_MOTION_AVERAGE : MLOD_MOTION_REMOVE;
+				mlod_motion *m;
+				mlod_error err = {0};
+				if (mlod_motion_create(&c, k, &opt, &m, &err) != MLOD_OK)
+					continue;
+				for (int l = 0; l < 3; l++) {
+					mlod_motion_level lv;
+					if (mlod_motion_next_level(m, v == 2 ? MLOD_MOTION_KEYS : MLOD_MOTION_FRAMES, MLOD_MOTION_MAX_ERROR,
+					                           pct[l] * h / 100.0, &lv, &err) != MLOD_OK)
+						continue;
+					keys[l] += lv.keys;
+					bytes[l] += lv.bytes;
+					mlod_motion_level_free(&lv);
+				}
+				mlod_motion_free(m);
+			}
+			if (v == 0)
+				ref = bytes[1];
+			printf("| %s | %d | %ld | %s | %ld | %ld | %ld | %ld | %ld | %ld | %.2fx |\n", base_name(argv[i]),
+			       c.clip_count, keys0, names[v], keys[0], bytes[0], keys[1], bytes[1], keys[2], bytes[2],
+			       (double)bytes[1] / (double)ref);
+		}
+		mlod_character_free(&c);
+	}
+	printf("\n");
+	return 0;
+}
+
+/* ---------------------------------------------------------------- */
+/* Speed                                                             */
+/* ---------------------------------------------------------------- */
+
+static int cmd_speed(int argc, char **argv)
+{
+	static const double pct[3] = {0.2, 1.0, 3.0};
+	printf("| file | clips | frames | joints | method | ms per clip (3 levels) | clips/s | input frames/s |\n");
+	printf("|---|---:|---:|---:|---|---:|---:|---:|\n");
+	for (int i = 0; i < argc; i++) {
+		mlod_character c;
+		if (load(argv[i], &c, NULL) != 0)
+			continue;
+		double h = mlod_skeleton_size(&c.skeleton);
+		long frames = 0;
+		for (int k = 0; k < c.clip_count; k++) {
+			float *t = NULL;
+			int n = mlod_clip_times(&c.clips[k], 0, &t);
+			mlod_free(t);
+			frames += n > 0 ? n : 0;
+		}
+		static const char *const names[] = {"frames", "keys", "auto (both)"};
+		for (int v = 0; v < 3; v++) {
+			double runs[SPEED_RUNS];
+			for (int r = 0; r < SPEED_RUNS; r++) {
+				double t0 = now();
+				for (int k = 0; k < c.clip_count; k++)
+					for (int m = 0; m < 2; m++) {
+						if (v < 2 && m != v)
+							continue;
+						mlod_motion_options opt = {0};
+						opt.point_distance = strstr(argv[i], ".bvh") ? h / 18.0 : 0.1;
+						mlod_motion *mo;
+						mlod_error err = {0};
+						if (mlod_motion_create(&c, k, &opt, &mo, &err) != MLOD_OK)
+							continue;
+						for (int l = 0; l < 3; l++) {
+							mlod_motion_level lv;
+							if (mlod_motion_next_level(mo, (mlod_motion_method)m, MLOD_MOTION_MAX_ERROR, pct[l] * h / 100.0,
+							                           &lv, &err) == MLOD_OK)
+								mlod_motion_level_free(&lv);
+						}
+						mlod_motion_free(mo);
+					}
+				runs[r] = now() - t0;
+			}
+			double t = median(runs, SPEED_RUNS);
+			printf("| %s | %d | %ld | %d | %s | %.1f | %.1f | %.0f |\n", base_name(argv[i]), c.clip_count, frames,
+			       c.skeleton.joint_count, names[v], 1000.0 * t / c.clip_count, c.clip_count / t, (double)frames / t);
+		}
+		mlod_character_free(&c);
+	}
+	printf("\n");
+	return 0;
+}
+
+static int cmd_convert(int argc, char **argv)
+{
+	mlod_character c;
+	mlod_gltf *doc = NULL;
+	if (argc != 2 || load(argv[0], &c, &doc) != 0)
+		return 1;
+	void *data = NULL;
+	size_t size = 0;
+	mlod_error err = {0};
+	int rc = 1;
+	if (mlod_gltf_write(doc, 1, &data, &size, &err) == MLOD_OK) {
+		FILE *f = fopen(argv[1], "wb");
+		if (f && fwrite(data, 1, size, f) == size)
+			rc = 0;
+		if (f)
+			fclose(f);
+	}
+	if (rc)
+		fprintf(stderr, "bench_motion: %s: cannot write\n", argv[1]);
+	mlod_free(data);
+	mlod_gltf_free(doc);
+	mlod_character_free(&c);
+	return rc;
+}
+
+int main(int argc, char **argv)
+{
+	if (argc >= 2 && strcmp(argv[1], "convert") == 0)
+		return cmd_convert(argc - 2, argv + 2);
+	if (argc >= 2 && strcmp(argv[1], "peers") == 0)
+		return cmd_peers(argc - 2, argv + 2);
+	if (argc >= 2 && strcmp(argv[1], "methods") == 0)
+		return cmd_methods(argc - 2, argv + 2);
+	if (argc >= 2 && strcmp(argv[1], "speed") == 0)
+		return cmd_speed(argc - 2, argv + 2);
+	fprintf(stderr, "usage: bench_motion convert IN OUT.glb | peers ORIG LABEL=FILE... | methods FILE... | speed FILE...\n");
+	return 1;
+}
