@@ -1,0 +1,136 @@
+/*
+ * bgm.h: the BindGraphMesh as the mesh layer's files share it (bgm.c
+ * builds it, quadric.c gives its posed quadrics, collapse.c simplifies
+ * it, bgmlevel.c turns prefixes into primitives). Internal: not installed,
+ * not for tools.
+ *
+ * Storage is append-only, so that every prefix of the collapse sequence
+ * can be rebuilt: a collapse kills faces (death = its record number + 1)
+ * and appends faces, wedges and one node; a face is live after prefix k
+ * when birth <= k < death.
+ */
+#ifndef MLOD_BGM_H
+#define MLOD_BGM_H
+
+#include <limits.h>
+
+#include "mlod.h"
+
+#define BGM_ALIVE INT_MAX
+
+/* Node flags. */
+enum {
+	BGM_BORDER = 1,    /* on an edge with one face */
+	BGM_LOCKED = 2,    /* never collapses: non-manifold or otherwise unsafe */
+	BGM_ELIGIBLE = 4,  /* 4.2.2 allows it to disappear */
+	BGM_DEAD = 8       /* collapsed into a newer node */
+};
+
+typedef struct bgm_face {
+	int w[3];   /* corner wedges, in winding order */
+	int n[3];   /* their nodes */
+	int adj[3]; /* dual graph: the face across edge (n[e], n[(e + 1) % 3]), or -1 */
+	int birth;  /* 0 for input faces, else the record number + 1 that made it */
+	int death;  /* BGM_ALIVE, or the record number + 1 that removed it */
+} bgm_face;
+
+typedef struct bgm_node {
+	double p[3];        /* bind position (mesh space for rigid meshes) */
+	int flags;
+	int inc_first;      /* incident live faces: inc[inc_first .. +inc_count] */
+	int inc_count;
+	int inc_cap;
+} bgm_node;
+
+/* Wedge attribute layout, in floats (offsets are -1 when absent). */
+typedef struct bgm_layout {
+	int normal;         /* 3 */
+	int tangent;        /* 4 */
+	int uv[MLOD_MAX_SETS];    /* 2 each */
+	int color[MLOD_MAX_SETS]; /* 4 each */
+	int target_normal;  /* 3 per target, target t at target_normal + 3 t */
+	int target_tangent; /* 3 per target */
+	int stride;
+	int morph_stride;   /* node floats: 3 per target with positions, else 0 */
+} bgm_layout;
+
+struct mlod_bgm {
+	/* The input. */
+	const mlod_primitive *prim;
+	int skinned;            /* weights come from the primitive */
+	int rigid;              /* one joint with weight 1 (a rigid mesh under a joint) */
+	int joint_count;        /* influence ids: skin joints, 1 when rigid, 0 when static */
+	int *joint_map;         /* influence id -> skeleton joint */
+	mlod_bgm_options opt;   /* with defaults filled in */
+	double tau;
+	double *eta;            /* per skeleton joint */
+	int skeleton_joints;
+	double diagonal;        /* of the bind positions */
+	bgm_layout lay;
+
+	/* Nodes, wedges, faces (append-only). */
+	int node_count, node_cap;
+	int node_aux_cap;       /* capacity of inf, morph and quadric */
+	bgm_node *nodes;
+	mlod_influences *inf;   /* per node */
+	float *morph;           /* per node, lay.morph_stride floats */
+	int wedge_count, wedge_cap;
+	int *wedge_node;
+	int *wedge_source;      /* input vertex, or -1 for a new wedge */
+	float *wedge_attr;      /* lay.stride floats per wedge */
+	int face_count, face_cap;
+	bgm_face *faces;
+	int *inc;               /* the incidence pool */
+	int inc_len, inc_cap;
+	int live_triangles;
+
+	/* The sequence. */
+	int record_count, record_cap;
+	mlod_vsplit *records;
+	int *removed;
+	int removed_len, removed_cap;
+
+	/* Posed quadrics (quadric.c): pose_count poses; per node and pose 10
+	 * doubles; per pose and influence id a 3x4 skin matrix (row-major). */
+	int pose_count;
+	double *quadric;
+	float *skin;
+
+	/* Statistics. */
+	int input_vertices, input_triangles, dropped, border_edges, nonmanifold_edges;
+	int seam_nodes, locked_nodes, eligible_nodes;
+	int caps, snaps, refused;
+	double build_seconds, collapse_seconds;
+
+	/* Collapse state (collapse.c). */
+	struct bgm_heap *heap;
+	unsigned char *blocked; /* per face: refused when last looked at */
+	int blocked_cap;
+};
+
+/* bgm.c */
+int bgm_grow(void **p, int *cap, int need, size_t size);
+int bgm_add_node(mlod_bgm *g);
+int bgm_add_wedge(mlod_bgm *g, int node);
+int bgm_add_face(mlod_bgm *g, const int *w, int birth);
+int bgm_inc_add(mlod_bgm *g, int node, int face);
+void bgm_inc_remove(mlod_bgm *g, int node, int face);
+double bgm_seconds(void);
+int bgm_link_ok(const int *from, const int *to, int m, int path_ok);
+double bgm_compactness(const double *a, const double *b, const double *c);
+int bgm_node_eligible(const mlod_bgm *g, const mlod_influences *inf);
+
+/* collapse.c */
+void bgm_heap_free(struct bgm_heap *h);
+
+/* quadric.c */
+mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err);
+/* The error of a node at bind position p with influences inf against
+ * the quadrics q (pose_count x 10): sum over poses. */
+double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *p);
+/* The bind position minimising that error with inf fixed (directions the
+ * quadric leaves free stay at x0); returns 0 and fills out, or -1. */
+int bgm_quadric_optimum(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x0,
+                        double *out);
+
+#endif

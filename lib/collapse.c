@@ -1,0 +1,798 @@
+/*
+ * collapse.c: triangle decimation on the BindGraphMesh (Savoye & Meyer
+ * 2008, 4.2.3), recorded as a progressive sequence.
+ *
+ * A triangle collapse contracts t = (a, b, c) into one new vertex v-bar:
+ * t and the faces sharing an edge with it go (up to four), and the rest
+ * of the mesh patch (the faces sharing a vertex with t) is re-meshed
+ * around v-bar. Candidates wait in a priority queue: by compactness
+ * 4 sqrt(3) area / (l1^2 + l2^2 + l3^2), lowest first (the paper), or by
+ * the posed quadric error of quadric.c (beyond the paper, compactness
+ * breaking ties); the faces a collapse creates join the queue.
+ *
+ * The paper does not check validity; a collapse is refused when
+ * - a vertex of t is locked, not eligible (4.2.2), or on a border
+ *   (unless borders are allowed);
+ * - the re-meshed patch would not be one fan around v-bar (the link
+ *   condition generalised to a triangle: this also refuses duplicate
+ *   faces and the closing of tunnels);
+ * - a re-meshed face would flip in the bind pose, or be degenerate;
+ * - the attribute wedges of the patch cannot be carried over: at a seam
+ *   (a vertex with several wedges) or an allowed border, v-bar snaps onto
+ *   one such vertex s, and every wedge group (wedges joined through the
+ *   removed faces) must hold exactly one wedge of s and at most one of
+ *   each other vertex; seam-free patches give v-bar one wedge
+ *   interpolated inside t. So seams neither tear nor smear.
+ * v-bar goes to t's barycenter (the paper) or to the posed quadric's
+ * optimum (or the barycenter when that is cheaper); Power Skinning
+ * (powerskin.c) gives its weights, the same barycentric weights as its
+ * attributes give its morph target offsets.
+ *
+ * Each collapse appends one vertex-split record (the faces it removed
+ * and the faces it added), so any prefix of the sequence is a valid mesh
+ * and can be rebuilt, undone or redone.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bgm.h"
+
+#define MAX_PATCH 128       /* faces around a, b and c */
+#define MAX_WEDGES 64       /* distinct wedges of a, b and c in the patch */
+#define MAX_CANDIDATES 5
+#define FLIP_COS 0.2        /* a re-meshed face may turn by less than ~78 degrees */
+#define DEGENERATE 1e-3     /* compactness under which a new face counts as degenerate */
+#define TIE_WEIGHT 1e-5     /* compactness tie-break of the posed cost */
+
+typedef struct heap_entry {
+	double key;
+	int face;
+} heap_entry;
+
+struct bgm_heap {
+	int count, cap;
+	heap_entry *e;
+};
+
+void bgm_heap_free(struct bgm_heap *h)
+{
+	if (h)
+		free(h->e);
+	free(h);
+}
+
+static int entry_less(const heap_entry *a, const heap_entry *b)
+{
+	return a->key < b->key || (a->key == b->key && a->face < b->face);
+}
+
+static int heap_push(struct bgm_heap *h, double key, int face)
+{
+	if (bgm_grow((void **)&h->e, &h->cap, h->count + 1, sizeof *h->e))
+		return -1;
+	int i = h->count++;
+	heap_entry x = {key, face};
+	while (i > 0) {
+		int p = (i - 1) / 2;
+		if (!entry_less(&x, &h->e[p]))
+			break;
+		h->e[i] = h->e[p];
+		i = p;
+	}
+	h->e[i] = x;
+	return 0;
+}
+
+static heap_entry heap_pop(struct bgm_heap *h)
+{
+	heap_entry top = h->e[0], x = h->e[--h->count];
+	int i = 0;
+	for (;;) {
+		int l = 2 * i + 1, r = l + 1, m = i;
+		const heap_entry *best = &x;
+		if (l < h->count && entry_less(&h->e[l], best))
+			m = l, best = &h->e[l];
+		if (r < h->count && entry_less(&h->e[r], best))
+			m = r;
+		if (m == i)
+			break;
+		h->e[i] = h->e[m];
+		i = m;
+	}
+	if (h->count > 0)
+		h->e[i] = x;
+	return top;
+}
+
+/* Everything a collapse needs, worked out by plan() and applied by
+ * apply(). */
+struct plan {
+	int t;
+	int v[3];                   /* a, b, c */
+	int nf, faces[MAX_PATCH];   /* the patch */
+	int nr, removed[MAX_PATCH]; /* faces with two or more of a, b, c */
+	int nk, kept[MAX_PATCH];    /* the others, re-meshed around v-bar */
+	int corner[MAX_PATCH];      /* the corner of kept[i] that becomes v-bar */
+	int nw, wedges[MAX_WEDGES], group[MAX_WEDGES], ngroups;
+	/* The chosen placement. */
+	double pos[3];
+	int snap;                   /* 0..2: v-bar at v[snap]; -1: free */
+	int hard[3];                /* a, b, c have hard normal edges */
+	double lambda[3];           /* attribute and morph weights of a, b, c */
+	mlod_influences inf;
+	int capped;
+	double cost;
+};
+
+static int find(int *parent, int i)
+{
+	while (parent[i] != i)
+		i = parent[i] = parent[parent[i]];
+	return i;
+}
+
+static int wedge_slot(const struct plan *pl, int w)
+{
+	for (int i = 0; i < pl->nw; i++)
+		if (pl->wedges[i] == w)
+			return i;
+	return -1;
+}
+
+static void face_normal(const double *a, const double *b, const double *c, double *n)
+{
+	double u[3], v[3];
+	for (int i = 0; i < 3; i++)
+		u[i] = b[i] - a[i], v[i] = c[i] - a[i];
+	n[0] = u[1] * v[2] - u[2] * v[1];
+	n[1] = u[2] * v[0] - u[0] * v[2];
+	n[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+static int is_normal_float(const bgm_layout *L, int k, int targets)
+{
+	return (L->normal >= 0 && k >= L->normal && k < L->normal + 3) ||
+	       (L->target_normal >= 0 && k >= L->target_normal && k < L->target_normal + 3 * targets);
+}
+
+/* What differs between the wedges of node v: *texture when anything but
+ * the normals does (a UV, colour or tangent seam), *hard when the normals
+ * do (a hard edge, as on faceted meshes). */
+static void node_seams(const mlod_bgm *g, int v, int *texture, int *hard)
+{
+	const bgm_node *n = &g->nodes[v];
+	const bgm_layout *L = &g->lay;
+	int first = -1, T = g->prim->target_count;
+	*texture = *hard = 0;
+	for (int i = 0; i < n->inc_count; i++) {
+		const bgm_face *f = &g->faces[g->inc[n->inc_first + i]];
+		int w = f->w[f->n[0] == v ? 0 : f->n[1] == v ? 1 : 2];
+		if (first < 0) {
+			first = w;
+			continue;
+		}
+		if (w == first)
+			continue;
+		const float *a = g->wedge_attr + (size_t)first * (size_t)L->stride, *b = g->wedge_attr + (size_t)w * (size_t)L->stride;
+		for (int k = 0; k < L->stride; k++)
+			if (a[k] != b[k]) {
+				if (is_normal_float(L, k, T))
+					*hard = 1;
+				else
+					*texture = 1;
+			}
+	}
+}
+
+/* The barycentric coordinates of x projected onto triangle (a, b, c),
+ * clamped into it. */
+static void barycentric(const double *a, const double *b, const double *c, const double *x, double *l)
+{
+	double v0[3], v1[3], v2[3];
+	for (int i = 0; i < 3; i++)
+		v0[i] = b[i] - a[i], v1[i] = c[i] - a[i], v2[i] = x[i] - a[i];
+	double d00 = v0[0] * v0[0] + v0[1] * v0[1] + v0[2] * v0[2];
+	double d01 = v0[0] * v1[0] + v0[1] * v1[1] + v0[2] * v1[2];
+	double d11 = v1[0] * v1[0] + v1[1] * v1[1] + v1[2] * v1[2];
+	double d20 = v2[0] * v0[0] + v2[1] * v0[1] + v2[2] * v0[2];
+	double d21 = v2[0] * v1[0] + v2[1] * v1[1] + v2[2] * v1[2];
+	double den = d00 * d11 - d01 * d01;
+	if (!(fabs(den) > 0.0)) {
+		l[0] = l[1] = l[2] = 1.0 / 3.0;
+		return;
+	}
+	double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
+	l[0] = 1.0 - v - w, l[1] = v, l[2] = w;
+	double sum = 0.0;
+	for (int i = 0; i < 3; i++) {
+		l[i] = l[i] > 0.0 ? l[i] : 0.0;
+		sum += l[i];
+	}
+	for (int i = 0; i < 3; i++)
+		l[i] = sum > 0.0 ? l[i] / sum : 1.0 / 3.0;
+}
+
+/* Checks the re-meshed faces for flips and degeneracy with v-bar at x. */
+static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x)
+{
+	for (int i = 0; i < pl->nk; i++) {
+		const bgm_face *f = &g->faces[pl->kept[i]];
+		const double *p[3], *q[3];
+		for (int k = 0; k < 3; k++)
+			p[k] = q[k] = g->nodes[f->n[k]].p;
+		q[pl->corner[i]] = x;
+		double no[3], nn[3];
+		face_normal(p[0], p[1], p[2], no);
+		face_normal(q[0], q[1], q[2], nn);
+		double lo = sqrt(no[0] * no[0] + no[1] * no[1] + no[2] * no[2]);
+		double ln = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+		double cn = bgm_compactness(q[0], q[1], q[2]);
+		if (!(ln > 0.0) || cn < DEGENERATE)
+			return 0;
+		if (lo > 0.0 && bgm_compactness(p[0], p[1], p[2]) >= DEGENERATE &&
+		    !(no[0] * nn[0] + no[1] * nn[1] + no[2] * nn[2] > FLIP_COS * lo * ln))
+			return 0;
+	}
+	return 1;
+}
+
+/* Works out the collapse of face t; returns 1 when it is valid (pl holds
+ * the cheapest valid placement), else 0. */
+static int plan(mlod_bgm *g, int t, struct plan *pl)
+{
+	const bgm_face *T = &g->faces[t];
+	int allow_border = g->opt.allow_border;
+	if (T->death != BGM_ALIVE)
+		return 0;
+	pl->t = t;
+	for (int i = 0; i < 3; i++) {
+		int v = pl->v[i] = T->n[i];
+		int fl = g->nodes[v].flags;
+		if ((fl & (BGM_LOCKED | BGM_DEAD)) || !(fl & BGM_ELIGIBLE) || (!allow_border && (fl & BGM_BORDER)))
+			return 0;
+	}
+	int a = pl->v[0], b = pl->v[1], c = pl->v[2];
+
+	/* The patch. */
+	pl->nf = pl->nr = pl->nk = 0;
+	for (int i = 0; i < 3; i++) {
+		const bgm_node *n = &g->nodes[pl->v[i]];
+		for (int k = 0; k < n->inc_count; k++) {
+			int f = g->inc[n->inc_first + k], seen = 0;
+			for (int j = 0; j < pl->nf && !seen; j++)
+				seen = pl->faces[j] == f;
+			if (seen)
+				continue;
+			if (pl->nf == MAX_PATCH)
+				return 0;
+			pl->faces[pl->nf++] = f;
+		}
+	}
+	int from[MAX_PATCH], to[MAX_PATCH], all3 = 0;
+	for (int j = 0; j < pl->nf; j++) {
+		const bgm_face *f = &g->faces[pl->faces[j]];
+		int in = 0, corner = -1;
+		for (int k = 0; k < 3; k++)
+			if (f->n[k] == a || f->n[k] == b || f->n[k] == c)
+				in++, corner = k;
+		if (in == 3)
+			all3++;
+		if (in >= 2) {
+			pl->removed[pl->nr++] = pl->faces[j];
+			continue;
+		}
+		pl->corner[pl->nk] = corner;
+		from[pl->nk] = f->n[(corner + 1) % 3];
+		to[pl->nk] = f->n[(corner + 2) % 3];
+		pl->kept[pl->nk++] = pl->faces[j];
+	}
+	if (all3 != 1 || pl->nk == 0)
+		return 0;
+	/* Each edge of t has one face across at most (two faces in all). */
+	for (int e = 0; e < 3; e++) {
+		int x = pl->v[e], y = pl->v[(e + 1) % 3], count = 0;
+		for (int j = 0; j < pl->nr; j++) {
+			const bgm_face *f = &g->faces[pl->removed[j]];
+			int hx = f->n[0] == x || f->n[1] == x || f->n[2] == x;
+			int hy = f->n[0] == y || f->n[1] == y || f->n[2] == y;
+			count += hx && hy;
+		}
+		if (count > 2)
+			return 0;
+	}
+	int border = 0, special[3];
+	for (int i = 0; i < 3; i++) {
+		int fb = (g->nodes[pl->v[i]].flags & BGM_BORDER) != 0, texture;
+		node_seams(g, pl->v[i], &texture, &pl->hard[i]);
+		border |= fb;
+		special[i] = fb || texture;
+	}
+	/* The link condition: the re-meshed faces form one fan around v-bar. */
+	if (!bgm_link_ok(from, to, pl->nk, border))
+		return 0;
+
+	/* Wedge groups: wedges of a, b and c joined through removed faces. */
+	int parent[MAX_WEDGES], owner[MAX_WEDGES];
+	pl->nw = 0;
+	for (int j = 0; j < pl->nf; j++) {
+		const bgm_face *f = &g->faces[pl->faces[j]];
+		for (int k = 0; k < 3; k++) {
+			int o = f->n[k] == a ? 0 : f->n[k] == b ? 1 : f->n[k] == c ? 2 : -1;
+			if (o < 0 || wedge_slot(pl, f->w[k]) >= 0)
+				continue;
+			if (pl->nw == MAX_WEDGES)
+				return 0;
+			owner[pl->nw] = o;
+			parent[pl->nw] = pl->nw;
+			pl->wedges[pl->nw++] = f->w[k];
+		}
+	}
+	for (int j = 0; j < pl->nr; j++) {
+		const bgm_face *f = &g->faces[pl->removed[j]];
+		int first = -1;
+		for (int k = 0; k < 3; k++) {
+			int s = wedge_slot(pl, f->w[k]);
+			if (s < 0)
+				continue;
+			if (first < 0)
+				first = s;
+			else
+				parent[find(parent, s)] = find(parent, first);
+		}
+	}
+	pl->ngroups = 0;
+	int root_group[MAX_WEDGES];
+	for (int i = 0; i < pl->nw; i++)
+		root_group[i] = -1;
+	for (int i = 0; i < pl->nw; i++) {
+		int r = find(parent, i);
+		if (root_group[r] < 0)
+			root_group[r] = pl->ngroups++;
+		pl->group[i] = root_group[r];
+	}
+	/* Per group, how many wedges each of a, b, c has there. */
+	int per[MAX_WEDGES][3];
+	memset(per, 0, sizeof per);
+	for (int i = 0; i < pl->nw; i++)
+		per[pl->group[i]][owner[i]]++;
+
+	/* Candidate placements. */
+	double cand[MAX_CANDIDATES][3];
+	int cand_snap[MAX_CANDIDATES], nc = 0;
+	const double *P[3] = {g->nodes[a].p, g->nodes[b].p, g->nodes[c].p};
+	double bary[3];
+	for (int i = 0; i < 3; i++)
+		bary[i] = (P[0][i] + P[1][i] + P[2][i]) / 3.0;
+	mlod_v3 V[3];
+	for (int i = 0; i < 3; i++)
+		V[i] = (mlod_v3){(float)P[i][0], (float)P[i][1], (float)P[i][2]};
+	mlod_influences in3[3] = {g->inf[a], g->inf[b], g->inf[c]};
+	if (special[0] || special[1] || special[2]) {
+		/* Snap onto a seam (or border) vertex that keeps every wedge group
+		 * whole. Border vertices must stay on the border. */
+		for (int s = 0; s < 3; s++) {
+			if (!special[s] || (border && !(g->nodes[pl->v[s]].flags & BGM_BORDER)))
+				continue;
+			int ok = 1;
+			for (int k = 0; k < pl->ngroups && ok; k++)
+				for (int o = 0; o < 3; o++)
+					if ((o == s && per[k][o] != 1) || per[k][o] > 1)
+						ok = 0;
+			if (!ok)
+				continue;
+			memcpy(cand[nc], P[s], sizeof cand[nc]);
+			cand_snap[nc++] = s;
+		}
+	} else {
+		if (g->opt.placement == MLOD_PLACE_OPTIMAL && g->pose_count > 0) {
+			mlod_influences w;
+			double q[10 * 64], opt[3];
+			double *Q = g->pose_count <= 64 ? q : malloc(sizeof(double) * 10 * (size_t)g->pose_count);
+			if (Q) {
+				for (int k = 0; k < 10 * g->pose_count; k++)
+					Q[k] = g->quadric[((size_t)a * (size_t)g->pose_count) * 10 + (size_t)k] +
+					       g->quadric[((size_t)b * (size_t)g->pose_count) * 10 + (size_t)k] +
+					       g->quadric[((size_t)c * (size_t)g->pose_count) * 10 + (size_t)k];
+				mlod_power_skin(V, in3, 3, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
+				if (bgm_quadric_optimum(g, Q, &w, bary, opt) == 0) {
+					/* Stay near t: at most its longest edge from the barycenter. */
+					double lmax = 0.0, d = 0.0;
+					for (int e = 0; e < 3; e++) {
+						double l = 0.0;
+						for (int i = 0; i < 3; i++)
+							l += (P[e][i] - P[(e + 1) % 3][i]) * (P[e][i] - P[(e + 1) % 3][i]);
+						lmax = fmax(lmax, l);
+					}
+					for (int i = 0; i < 3; i++)
+						d += (opt[i] - bary[i]) * (opt[i] - bary[i]);
+					if (d <= lmax) {
+						memcpy(cand[nc], opt, sizeof cand[nc]);
+						cand_snap[nc++] = -1;
+					}
+				}
+				if (Q != q)
+					free(Q);
+			}
+		}
+		memcpy(cand[nc], bary, sizeof cand[nc]);
+		cand_snap[nc++] = -1;
+	}
+
+	/* The cheapest valid candidate; with the compactness cost (the same
+	 * for every placement), the one nearest the barycenter. */
+	int best = -1;
+	double area2 = 0.0, comp = bgm_compactness(P[0], P[1], P[2]), best_d = 0.0;
+	{
+		double n[3];
+		face_normal(P[0], P[1], P[2], n);
+		area2 = 0.25 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+	}
+	for (int k = 0; k < nc; k++) {
+		if (!geometry_ok(g, pl, cand[k]))
+			continue;
+		mlod_influences w;
+		int capped = mlod_power_skin(V, in3, 3, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+		if (g->joint_count > 0 && w.count == 0)
+			continue;
+		double cost, d = 0.0;
+		for (int i = 0; i < 3; i++)
+			d += (cand[k][i] - bary[i]) * (cand[k][i] - bary[i]);
+		if (g->opt.cost == MLOD_COST_POSED) {
+			/* Area-normalised (a mean squared distance), so small
+			 * features count as much as large ones. */
+			double e = 0.0, wsum = 0.0;
+			for (int i = 0; i < 3; i++) {
+				const double *q = g->quadric + (size_t)pl->v[i] * (size_t)g->pose_count * 10;
+				e += bgm_quadric_error(g, q, &w, cand[k]);
+				for (int p = 0; p < g->pose_count; p++)
+					wsum += q[10 * p] + q[10 * p + 4] + q[10 * p + 7];
+			}
+			cost = (wsum > 0.0 ? e / wsum : 0.0) + TIE_WEIGHT * sqrt(area2) * (1.0 - comp);
+			if (best >= 0 && !(cost < pl->cost))
+				continue;
+		} else {
+			cost = comp;
+			if (best >= 0 && !(d < best_d))
+				continue;
+		}
+		best = k;
+		best_d = d;
+		pl->cost = cost;
+		pl->inf = w;
+		pl->capped = capped;
+	}
+	if (best < 0)
+		return 0;
+	memcpy(pl->pos, cand[best], sizeof pl->pos);
+	pl->snap = cand_snap[best];
+	if (pl->snap >= 0) {
+		pl->lambda[0] = pl->lambda[1] = pl->lambda[2] = 0.0;
+		pl->lambda[pl->snap] = 1.0;
+	} else {
+		barycentric(P[0], P[1], P[2], pl->pos, pl->lambda);
+	}
+	return 1;
+}
+
+/* Interpolates wedge attributes: out = sum_i l[i] * attr(w[i]), with unit
+ * normals and tangents. */
+static void interpolate_wedge(mlod_bgm *g, int out, const int *w, const double *l)
+{
+	const bgm_layout *L = &g->lay;
+	int S = L->stride;
+	if (S == 0)
+		return;
+	float *o = g->wedge_attr + (size_t)out * (size_t)S;
+	const float *x[3];
+	for (int i = 0; i < 3; i++)
+		x[i] = g->wedge_attr + (size_t)w[i] * (size_t)S;
+	for (int k = 0; k < S; k++)
+		o[k] = (float)(l[0] * x[0][k] + l[1] * x[1][k] + l[2] * x[2][k]);
+	if (L->normal >= 0) {
+		float *n = o + L->normal;
+		double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+		int m = l[0] >= l[1] && l[0] >= l[2] ? 0 : l[1] >= l[2] ? 1 : 2;
+		if (len > 1e-6)
+			for (int i = 0; i < 3; i++)
+				n[i] = (float)(n[i] / len);
+		else
+			memcpy(n, x[m] + L->normal, 3 * sizeof(float));
+	}
+	if (L->tangent >= 0) {
+		float *tg = o + L->tangent;
+		double len = sqrt((double)tg[0] * tg[0] + (double)tg[1] * tg[1] + (double)tg[2] * tg[2]);
+		int m = l[0] >= l[1] && l[0] >= l[2] ? 0 : l[1] >= l[2] ? 1 : 2;
+		if (len > 1e-6)
+			for (int i = 0; i < 3; i++)
+				tg[i] = (float)(tg[i] / len);
+		else
+			memcpy(tg, x[m] + L->tangent, 3 * sizeof(float));
+		tg[3] = x[m][L->tangent + 3] < 0.0f ? -1.0f : 1.0f;
+	}
+}
+
+static int grow_face_arrays(mlod_bgm *g)
+{
+	if (g->blocked_cap < g->face_cap) {
+		unsigned char *b = realloc(g->blocked, (size_t)g->face_cap);
+		if (!b)
+			return -1;
+		memset(b + g->blocked_cap, 0, (size_t)(g->face_cap - g->blocked_cap));
+		g->blocked = b;
+		g->blocked_cap = g->face_cap;
+	}
+	return 0;
+}
+
+/* Queues face f (new, or back from being blocked). */
+static int push_face(mlod_bgm *g, int f, struct plan *scratch)
+{
+	const bgm_face *F = &g->faces[f];
+	for (int i = 0; i < 3; i++) {
+		int fl = g->nodes[F->n[i]].flags;
+		if ((fl & BGM_LOCKED) || !(fl & BGM_ELIGIBLE) || (!g->opt.allow_border && (fl & BGM_BORDER)))
+			return 0; /* never collapsible while these nodes live */
+	}
+	double key;
+	if (g->opt.cost == MLOD_COST_POSED) {
+		if (!plan(g, f, scratch)) {
+			g->blocked[f] = 1;
+			return 0;
+		}
+		key = scratch->cost;
+	} else {
+		key = bgm_compactness(g->nodes[F->n[0]].p, g->nodes[F->n[1]].p, g->nodes[F->n[2]].p);
+	}
+	return heap_push(g->heap, key, f);
+}
+
+/* Applies a planned collapse; returns 0, or -1 when out of memory. */
+static int apply(mlod_bgm *g, struct plan *pl)
+{
+	int rec = g->record_count, stamp = rec + 1;
+	if (bgm_grow((void **)&g->records, &g->record_cap, rec + 1, sizeof *g->records) ||
+	    bgm_grow((void **)&g->removed, &g->removed_cap, g->removed_len + pl->nf, sizeof *g->removed))
+		return -1;
+	int v = bgm_add_node(g);
+	if (v < 0)
+		return -1;
+	bgm_node *N = &g->nodes[v];
+	for (int i = 0; i < 3; i++)
+		N->p[i] = pl->pos[i];
+	g->inf[v] = pl->inf;
+	int fl = 0;
+	for (int i = 0; i < 3; i++)
+		fl |= g->nodes[pl->v[i]].flags & BGM_BORDER;
+	if (bgm_node_eligible(g, &pl->inf))
+		fl |= BGM_ELIGIBLE;
+	N->flags = fl;
+	if (g->lay.morph_stride > 0) {
+		float *m = g->morph + (size_t)v * (size_t)g->lay.morph_stride;
+		for (int k = 0; k < g->lay.morph_stride; k++) {
+			double x = 0.0;
+			for (int i = 0; i < 3; i++)
+				x += pl->lambda[i] * g->morph[(size_t)pl->v[i] * (size_t)g->lay.morph_stride + (size_t)k];
+			m[k] = (float)x;
+		}
+	}
+	if (g->pose_count > 0) {
+		double *q = g->quadric + (size_t)v * (size_t)g->pose_count * 10;
+		for (int k = 0; k < 10 * g->pose_count; k++) {
+			double x = 0.0;
+			for (int i = 0; i < 3; i++)
+				x += g->quadric[(size_t)pl->v[i] * (size_t)g->pose_count * 10 + (size_t)k];
+			q[k] = x;
+		}
+	}
+
+	/* New wedges. Snapped: one per wedge group, a copy of the snap vertex's
+	 * wedge there. Free (no texture seam at a, b, c): the attributes
+	 * interpolated inside t, except that corners of a vertex with hard
+	 * normal edges keep their own normals (so faceted meshes stay
+	 * faceted); equal results share a wedge. */
+	int gw[MAX_WEDGES], cw[MAX_PATCH];
+	int S = g->lay.stride;
+	if (pl->snap >= 0) {
+		for (int k = 0; k < pl->ngroups; k++) {
+			if ((gw[k] = bgm_add_wedge(g, v)) < 0)
+				return -1;
+			for (int i = 0; i < pl->nw; i++)
+				if (pl->group[i] == k && g->wedge_node[pl->wedges[i]] == pl->v[pl->snap] && S > 0)
+					memcpy(g->wedge_attr + (size_t)gw[k] * (size_t)S, g->wedge_attr + (size_t)pl->wedges[i] * (size_t)S,
+					       sizeof(float) * (size_t)S);
+		}
+		for (int j = 0; j < pl->nk; j++)
+			cw[j] = gw[pl->group[wedge_slot(pl, g->faces[pl->kept[j]].w[pl->corner[j]])]];
+	} else {
+		int base = bgm_add_wedge(g, v), T = g->prim->target_count;
+		if (base < 0)
+			return -1;
+		int tw[3] = {g->faces[pl->t].w[0], g->faces[pl->t].w[1], g->faces[pl->t].w[2]};
+		interpolate_wedge(g, base, tw, pl->lambda);
+		for (int j = 0; j < pl->nk; j++) {
+			int w = g->faces[pl->kept[j]].w[pl->corner[j]], x = g->wedge_node[w];
+			int o = x == pl->v[0] ? 0 : x == pl->v[1] ? 1 : 2;
+			cw[j] = base;
+			if (!pl->hard[o] || S == 0)
+				continue;
+			/* The interpolated wedge with this corner's own normals. */
+			int nw = bgm_add_wedge(g, v);
+			if (nw < 0)
+				return -1;
+			float *dst = g->wedge_attr + (size_t)nw * (size_t)S;
+			const float *own = g->wedge_attr + (size_t)w * (size_t)S;
+			memcpy(dst, g->wedge_attr + (size_t)base * (size_t)S, sizeof(float) * (size_t)S);
+			for (int k = 0; k < S; k++)
+				if (is_normal_float(&g->lay, k, T))
+					dst[k] = own[k];
+			cw[j] = nw;
+			for (int prev = base; prev < nw; prev++) /* this collapse's wedges are contiguous */
+				if (memcmp(g->wedge_attr + (size_t)prev * (size_t)S, dst, sizeof(float) * (size_t)S) == 0) {
+					cw[j] = prev;
+					g->wedge_count--; /* drop the duplicate just made (the last) */
+					break;
+				}
+		}
+	}
+
+	/* Remove the patch. */
+	for (int j = 0; j < pl->nf; j++) {
+		bgm_face *f = &g->faces[pl->faces[j]];
+		f->death = stamp;
+		for (int k = 0; k < 3; k++)
+			bgm_inc_remove(g, f->n[k], pl->faces[j]);
+		g->removed[g->removed_len + j] = pl->faces[j];
+	}
+	for (int i = 0; i < 3; i++)
+		g->nodes[pl->v[i]].flags |= BGM_DEAD;
+	g->live_triangles -= pl->nf;
+
+	/* Re-mesh it around v-bar. */
+	int first = g->face_count;
+	for (int j = 0; j < pl->nk; j++) {
+		const bgm_face *old = &g->faces[pl->kept[j]];
+		int w[3];
+		for (int k = 0; k < 3; k++)
+			w[k] = old->w[k];
+		w[pl->corner[j]] = cw[j];
+		int f = bgm_add_face(g, w, stamp);
+		if (f < 0)
+			return -1;
+		for (int k = 0; k < 3; k++)
+			if (bgm_inc_add(g, g->faces[f].n[k], f))
+				return -1;
+	}
+	g->live_triangles += pl->nk;
+	/* The dual graph of the new faces. */
+	for (int j = 0; j < pl->nk; j++) {
+		int f = first + j, ci = pl->corner[j];
+		bgm_face *F = &g->faces[f];
+		const bgm_face *old = &g->faces[pl->kept[j]];
+		int p = F->n[(ci + 1) % 3], q = F->n[(ci + 2) % 3];
+		/* (p, q): the face that was across it, or its replacement. */
+		int across = old->adj[(ci + 1) % 3];
+		int repl = -1;
+		for (int k = 0; k < pl->nk && across >= 0; k++)
+			if (pl->kept[k] == across)
+				repl = first + k;
+		if (repl >= 0) {
+			F->adj[(ci + 1) % 3] = repl;
+		} else if (across >= 0) {
+			F->adj[(ci + 1) % 3] = across;
+			bgm_face *A = &g->faces[across];
+			for (int k = 0; k < 3; k++)
+				if (A->adj[k] == pl->kept[j])
+					A->adj[k] = f;
+		}
+		/* (v-bar, p) and (q, v-bar): the new faces whose links end at p
+		 * and start at q. */
+		for (int k = 0; k < pl->nk; k++) {
+			const bgm_face *G = &g->faces[first + k];
+			int ck = pl->corner[k];
+			if (G->n[(ck + 2) % 3] == p)
+				F->adj[ci] = first + k;
+			if (G->n[(ck + 1) % 3] == q)
+				F->adj[(ci + 2) % 3] = first + k;
+		}
+	}
+
+	mlod_vsplit *r = &g->records[g->record_count++];
+	memset(r, 0, sizeof *r);
+	for (int i = 0; i < 3; i++)
+		r->parents[i] = pl->v[i];
+	r->node = v;
+	r->snapped = pl->snap;
+	r->removed_first = g->removed_len;
+	r->removed_count = pl->nf;
+	r->added_first = first;
+	r->added_count = pl->nk;
+	r->triangles = g->live_triangles;
+	r->capped = pl->capped;
+	r->cost = pl->cost;
+	g->removed_len += pl->nf;
+	g->caps += pl->capped;
+	g->snaps += pl->snap >= 0;
+	return grow_face_arrays(g);
+}
+
+mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_error *err)
+{
+	if (!g)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_bgm_simplify: NULL");
+	double t0 = bgm_seconds();
+	mlod_result r = MLOD_OK;
+	struct plan *pl = malloc(sizeof *pl), *scratch = malloc(sizeof *scratch);
+	if (!pl || !scratch || grow_face_arrays(g)) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+		goto done;
+	}
+	if (!g->heap) {
+		if (!(g->heap = calloc(1, sizeof *g->heap))) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+			goto done;
+		}
+		for (int f = 0; f < g->face_count; f++)
+			if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+				goto done;
+			}
+	}
+	int done_count = 0;
+	while (g->heap->count > 0 && (target <= 0 || g->live_triangles > target) &&
+	       (max_collapses <= 0 || done_count < max_collapses)) {
+		heap_entry e = heap_pop(g->heap);
+		if (g->faces[e.face].death != BGM_ALIVE)
+			continue;
+		if (!plan(g, e.face, pl)) {
+			g->refused++;
+			g->blocked[e.face] = 1;
+			continue;
+		}
+		if (g->opt.cost == MLOD_COST_POSED && pl->cost > e.key * (1.0 + 1e-9) + 1e-300) {
+			if (heap_push(g->heap, pl->cost, e.face)) {
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+				goto done;
+			}
+			continue;
+		}
+		int first = g->face_count;
+		if (apply(g, pl)) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+			goto done;
+		}
+		done_count++;
+		/* Queue the new faces, and give blocked faces around the patch
+		 * another chance: their neighbourhood changed. */
+		for (int f = first; f < g->face_count; f++)
+			if (push_face(g, f, scratch)) {
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+				goto done;
+			}
+		int v = g->node_count - 1;
+		const bgm_node *N = &g->nodes[v];
+		for (int k = 0; k < N->inc_count; k++) {
+			const bgm_face *F = &g->faces[g->inc[N->inc_first + k]];
+			for (int i = 0; i < 3; i++) {
+				if (F->n[i] == v)
+					continue;
+				const bgm_node *L = &g->nodes[F->n[i]];
+				for (int m = 0; m < L->inc_count; m++) {
+					int h = g->inc[L->inc_first + m];
+					if (h < first && g->blocked[h]) {
+						g->blocked[h] = 0;
+						if (push_face(g, h, scratch)) {
+							r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+							goto done;
+						}
+					}
+				}
+			}
+		}
+	}
+done:
+	free(pl);
+	free(scratch);
+	g->collapse_seconds += bgm_seconds() - t0;
+	return r;
+}

@@ -1,0 +1,149 @@
+/*
+ * posederror.c: how far a mesh level strays from the full character where
+ * it matters, posed (the measure of Savoye & Meyer 2008, 4.2, "simplifying
+ * deforming meshes using a standard algorithm is error prone", made
+ * quantitative).
+ *
+ * A pose set holds joint world matrices for the rest pose, evenly spaced
+ * times of each clip, and random poses: each joint's rest rotation turned
+ * about a random axis by a random angle up to a bound (SplitMix64, so a
+ * seed gives the same poses on every machine). At each pose both
+ * characters are skinned and compared with mlod_surface_deviation
+ * (symmetric point-to-surface, % of the full character's diagonal).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mlod.h"
+
+static uint64_t splitmix(uint64_t *s)
+{
+	uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+	z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+	z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+	return z ^ (z >> 31);
+}
+
+/* Uniform in [0, 1). */
+static double uniform(uint64_t *s)
+{
+	return (double)(splitmix(s) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+mlod_result mlod_pose_set_make(const mlod_character *c, int bind, int per_clip, int random, uint64_t seed,
+                               float max_angle, mlod_pose_set *out, mlod_error *err)
+{
+	if (!c || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pose_set_make: NULL argument");
+	memset(out, 0, sizeof *out);
+	if (per_clip < 0 || random < 0 || random > 100000 || !isfinite(max_angle))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pose_set_make: bad counts or angle");
+	const mlod_skeleton *s = &c->skeleton;
+	int J = s->joint_count;
+	long total = (bind ? 1 : 0) + random;
+	float **times = calloc((size_t)c->clip_count + 1, sizeof *times);
+	int *counts = calloc((size_t)c->clip_count + 1, sizeof *counts);
+	mlod_trs *rest = malloc(sizeof *rest * ((size_t)J + 1)), *local = malloc(sizeof *local * ((size_t)J + 1));
+	mlod_result r = MLOD_OK;
+	if (!times || !counts || !rest || !local) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory making poses");
+		goto done;
+	}
+	for (int k = 0; per_clip > 0 && k < c->clip_count; k++) {
+		counts[k] = mlod_clip_times(&c->clips[k], per_clip, &times[k]);
+		if (counts[k] < 0) {
+			counts[k] = 0;
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory making poses");
+			goto done;
+		}
+		total += counts[k];
+	}
+	if ((size_t)total * (size_t)(J > 0 ? J : 1) > ((size_t)1 << 26)) {
+		r = mlod_fail(err, MLOD_ERR_LIMIT, "%ld poses of %d joints is too many", total, J);
+		goto done;
+	}
+	out->world = malloc(sizeof *out->world * (size_t)(total > 0 ? total : 1) * (size_t)(J > 0 ? J : 1));
+	if (!out->world) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory making poses");
+		goto done;
+	}
+	out->joint_count = J;
+	mlod_pose_rest(s, rest);
+	int n = 0;
+	if (bind)
+		mlod_pose_world(s, rest, out->world + (size_t)n++ * (size_t)J);
+	for (int k = 0; k < c->clip_count; k++)
+		for (int i = 0; i < counts[k]; i++) {
+			memcpy(local, rest, sizeof *local * (size_t)J);
+			mlod_clip_sample(&c->clips[k], times[k][i], local);
+			mlod_pose_world(s, local, out->world + (size_t)n++ * (size_t)J);
+		}
+	uint64_t state = seed;
+	for (int i = 0; i < random; i++) {
+		memcpy(local, rest, sizeof *local * (size_t)J);
+		for (int j = 0; j < J; j++) {
+			mlod_v3 axis;
+			double len2;
+			do {
+				axis.x = (float)(2.0 * uniform(&state) - 1.0);
+				axis.y = (float)(2.0 * uniform(&state) - 1.0);
+				axis.z = (float)(2.0 * uniform(&state) - 1.0);
+				len2 = (double)axis.x * axis.x + (double)axis.y * axis.y + (double)axis.z * axis.z;
+			} while (len2 > 1.0 || len2 < 1e-6);
+			float angle = (float)((2.0 * uniform(&state) - 1.0) * max_angle);
+			local[j].r = mlod_quat_normalize(mlod_quat_mul(local[j].r, mlod_quat_axis_angle(axis, angle)));
+		}
+		mlod_pose_world(s, local, out->world + (size_t)n++ * (size_t)J);
+	}
+	out->count = n;
+done:
+	for (int k = 0; times && k < c->clip_count; k++)
+		free(times[k]);
+	free(times);
+	free(counts);
+	free(rest);
+	free(local);
+	if (r != MLOD_OK)
+		mlod_pose_set_free(out);
+	return r;
+}
+
+void mlod_pose_set_free(mlod_pose_set *s)
+{
+	if (!s)
+		return;
+	free(s->world);
+	memset(s, 0, sizeof *s);
+}
+
+mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *level, const mlod_pose_set *poses,
+                             mlod_deviation *out, mlod_error *err)
+{
+	if (!full || !level || !poses || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_posed_error: NULL argument");
+	memset(out, 0, sizeof *out);
+	if (poses->joint_count != full->skeleton.joint_count || level->skeleton.joint_count != full->skeleton.joint_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_posed_error: poses of %d joints for %d and %d joints",
+		                 poses->joint_count, full->skeleton.joint_count, level->skeleton.joint_count);
+	mlod_posed a = {0}, b = {0};
+	mlod_result r = MLOD_OK;
+	double sum = 0.0;
+	for (int k = 0; k < poses->count; k++) {
+		const mlod_mat4 *world = poses->world + (size_t)k * (size_t)poses->joint_count;
+		mlod_deviation d;
+		if ((r = mlod_pose_character(full, world, &a, err)) != MLOD_OK ||
+		    (r = mlod_pose_character(level, world, &b, err)) != MLOD_OK ||
+		    (r = mlod_surface_deviation(&a, &b, &d, err)) != MLOD_OK)
+			break;
+		sum += d.mean;
+		if (d.max > out->max)
+			out->max = d.max;
+		out->scale = d.scale;
+	}
+	if (r == MLOD_OK && poses->count > 0)
+		out->mean = sum / poses->count;
+	mlod_posed_free(&a);
+	mlod_posed_free(&b);
+	return r;
+}

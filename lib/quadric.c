@@ -1,0 +1,272 @@
+/*
+ * quadric.c: posed quadrics, the skin-aware cost of the mesh layer
+ * (beyond Savoye & Meyer 2008, whose 4.2.3 orders collapses by triangle
+ * compactness only).
+ *
+ * Garland & Heckbert's quadric error metric ("Surface simplification
+ * using quadric error metrics", SIGGRAPH 1997), summed over poses: at
+ * each pose p the input faces are skinned, and each node accumulates the
+ * area-weighted plane quadrics Q_p of its faces (a new node v-bar sums
+ * its parents'). A candidate v-bar with bind position x and influences w
+ * costs sum_p q_p(M_p(w) x), where M_p(w) = sum_j w_j S_j,p blends the
+ * skinning matrices: the error the collapse makes where the character is
+ * actually seen, including what Power Skinning does to its weights. With
+ * w fixed the cost is a quadric in x (sum_p M_p^T Q_p M_p), whose minimum
+ * is the optimal placement.
+ *
+ * Pose 0 is the bind pose (the rest pose for a rigid mesh); the others
+ * come from mlod_bgm_options.poses (clip frames and random poses).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bgm.h"
+
+#define FEATURE_COS 0.5     /* creases sharper than 60 degrees are features */
+#define FEATURE_WEIGHT 1.0  /* of a feature plane, times the squared edge length */
+
+/* out = a * b for affine matrices; out as 3x4 row-major floats. */
+static void to_rows(const mlod_mat4 *m, float *out)
+{
+	for (int r = 0; r < 3; r++)
+		for (int c = 0; c < 4; c++)
+			out[4 * r + c] = m->m[c * 4 + r];
+}
+
+static void plane_quadric(const double *a, const double *b, const double *c, double *q)
+{
+	double u[3], v[3], n[3];
+	for (int i = 0; i < 3; i++)
+		u[i] = b[i] - a[i], v[i] = c[i] - a[i];
+	n[0] = u[1] * v[2] - u[2] * v[1];
+	n[1] = u[2] * v[0] - u[0] * v[2];
+	n[2] = u[0] * v[1] - u[1] * v[0];
+	double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+	if (!(len > 0.0))
+		return;
+	double area = 0.5 * len;
+	for (int i = 0; i < 3; i++)
+		n[i] /= len;
+	double d = -(n[0] * a[0] + n[1] * a[1] + n[2] * a[2]);
+	double P[4] = {n[0], n[1], n[2], d};
+	int k = 0;
+	for (int i = 0; i < 4; i++)
+		for (int j = i; j < 4; j++)
+			q[k++] += area * P[i] * P[j];
+}
+
+static double dot3(const double *a, const double *b)
+{
+	return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void face_normal3(const double *a, const double *b, const double *c, double *n)
+{
+	double u[3], v[3];
+	for (int i = 0; i < 3; i++)
+		u[i] = b[i] - a[i], v[i] = c[i] - a[i];
+	n[0] = u[1] * v[2] - u[2] * v[1];
+	n[1] = u[2] * v[0] - u[0] * v[2];
+	n[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+/* The plane through edge (a, b) perpendicular to a face of normal n,
+ * weighted by the squared edge length. */
+static void edge_quadric(const double *a, const double *b, const double *n, double *q)
+{
+	double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, m[3];
+	m[0] = e[1] * n[2] - e[2] * n[1];
+	m[1] = e[2] * n[0] - e[0] * n[2];
+	m[2] = e[0] * n[1] - e[1] * n[0];
+	double len = sqrt(dot3(m, m)), l2 = dot3(e, e);
+	if (!(len > 0.0))
+		return;
+	for (int i = 0; i < 3; i++)
+		m[i] /= len;
+	double P[4] = {m[0], m[1], m[2], -dot3(m, a)};
+	int k = 0;
+	for (int i = 0; i < 4; i++)
+		for (int j = i; j < 4; j++)
+			q[k++] += FEATURE_WEIGHT * l2 * P[i] * P[j];
+}
+
+/* The blended 3x4 matrix of pose p for influences inf. */
+static void blend(const mlod_bgm *g, int p, const mlod_influences *inf, double *M)
+{
+	const float *S = g->skin + (size_t)p * (size_t)(g->joint_count > 0 ? g->joint_count : 1) * 12;
+	if (g->joint_count == 0 || inf->count == 0) {
+		for (int i = 0; i < 12; i++)
+			M[i] = g->joint_count == 0 ? S[i] : (i % 5 == 0 ? 1.0 : 0.0);
+		return;
+	}
+	memset(M, 0, 12 * sizeof *M);
+	for (int k = 0; k < inf->count; k++) {
+		const float *s = S + 12 * (size_t)inf->joints[k];
+		double w = inf->weights[k];
+		for (int i = 0; i < 12; i++)
+			M[i] += w * s[i];
+	}
+}
+
+static void apply(const double *M, const double *x, double *y)
+{
+	for (int r = 0; r < 3; r++)
+		y[r] = M[4 * r] * x[0] + M[4 * r + 1] * x[1] + M[4 * r + 2] * x[2] + M[4 * r + 3];
+}
+
+static double eval(const double *q, const double *x)
+{
+	return q[0] * x[0] * x[0] + 2 * q[1] * x[0] * x[1] + 2 * q[2] * x[0] * x[2] + 2 * q[3] * x[0] +
+	       q[4] * x[1] * x[1] + 2 * q[5] * x[1] * x[2] + 2 * q[6] * x[1] + q[7] * x[2] * x[2] + 2 * q[8] * x[2] + q[9];
+}
+
+mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err)
+{
+	const mlod_skeleton *s = &c->skeleton;
+	const mlod_pose_set *ps = g->opt.poses;
+	int extra = ps && ps->count > 0 && ps->joint_count == s->joint_count && g->joint_count > 0 ? ps->count : 0;
+	int P = 1 + extra, J = g->joint_count > 0 ? g->joint_count : 1;
+	mlod_result r = MLOD_OK;
+	mlod_mat4 *mats = malloc(sizeof *mats * (size_t)J);
+	mlod_mat4 *rest = malloc(sizeof *rest * ((size_t)s->joint_count + 1));
+	mlod_trs *local = malloc(sizeof *local * ((size_t)s->joint_count + 1));
+	double *posed = malloc(sizeof(double) * 3 * (size_t)g->node_count + 1);
+	g->skin = malloc(sizeof(float) * 12 * (size_t)J * (size_t)P);
+	g->quadric = calloc((size_t)g->node_cap * (size_t)P * 10, sizeof *g->quadric);
+	if (!mats || !rest || !local || !posed || !g->skin || !g->quadric) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+		goto done;
+	}
+	g->pose_count = P;
+	mlod_pose_rest(s, local);
+	mlod_pose_world(s, local, rest);
+	for (int p = 0; p < P; p++) {
+		float *S = g->skin + (size_t)p * (size_t)J * 12;
+		const mlod_mat4 *world = p == 0 ? rest : ps->world + (size_t)(p - 1) * (size_t)s->joint_count;
+		if (g->skinned) {
+			if (p == 0) {
+				mlod_mat4 id = mlod_mat4_identity();
+				for (int k = 0; k < J; k++)
+					to_rows(&id, S + 12 * k);
+			} else {
+				mlod_skin_matrices(&s->skins[in->skin], world, mats);
+				for (int k = 0; k < J; k++)
+					to_rows(&mats[k], S + 12 * k);
+			}
+		} else if (g->rigid) {
+			mlod_mat4 m = mlod_mat4_mul(&world[in->joint], &in->offset);
+			to_rows(&m, S);
+		} else {
+			to_rows(&in->offset, S);
+		}
+	}
+	/* Per pose: skin the nodes, then add each face's plane to its nodes. */
+	for (int p = 0; p < P; p++) {
+		double M[12];
+		for (int v = 0; v < g->node_count; v++) {
+			blend(g, p, &g->inf[v], M);
+			apply(M, g->nodes[v].p, posed + 3 * v);
+		}
+		for (int f = 0; f < g->face_count; f++) {
+			const bgm_face *F = &g->faces[f];
+			double q[10] = {0};
+			plane_quadric(posed + 3 * F->n[0], posed + 3 * F->n[1], posed + 3 * F->n[2], q);
+			for (int i = 0; i < 3; i++) {
+				double *Q = g->quadric + ((size_t)F->n[i] * (size_t)P + (size_t)p) * 10;
+				for (int k = 0; k < 10; k++)
+					Q[k] += q[k];
+			}
+			/* Feature edges (borders, creases sharper than FEATURE_COS):
+			 * a plane through the edge, perpendicular to the face, keeps
+			 * collapses from sliding along the surface and cutting the
+			 * feature short (the tip of a thin blade, a rim). */
+			for (int e = 0; e < 3; e++) {
+				int h = F->adj[e];
+				if (h >= 0 && h < f)
+					continue; /* each interior edge once */
+				const double *a = posed + 3 * F->n[e], *b = posed + 3 * F->n[(e + 1) % 3];
+				const double *o = posed + 3 * F->n[(e + 2) % 3];
+				double n1[3], n2[3];
+				face_normal3(a, b, o, n1);
+				if (h >= 0) {
+					const bgm_face *H = &g->faces[h];
+					face_normal3(posed + 3 * H->n[0], posed + 3 * H->n[1], posed + 3 * H->n[2], n2);
+					double l1 = sqrt(dot3(n1, n1)), l2 = sqrt(dot3(n2, n2));
+					if (!(l1 > 0.0) || !(l2 > 0.0) || dot3(n1, n2) > FEATURE_COS * l1 * l2)
+						continue;
+				}
+				double q2[10] = {0};
+				edge_quadric(a, b, n1, q2);
+				if (h >= 0) {
+					const bgm_face *H = &g->faces[h];
+					face_normal3(posed + 3 * H->n[0], posed + 3 * H->n[1], posed + 3 * H->n[2], n2);
+					edge_quadric(a, b, n2, q2);
+				}
+				int ends[2] = {F->n[e], F->n[(e + 1) % 3]};
+				for (int i = 0; i < 2; i++) {
+					double *Q = g->quadric + ((size_t)ends[i] * (size_t)P + (size_t)p) * 10;
+					for (int k = 0; k < 10; k++)
+						Q[k] += q2[k];
+				}
+			}
+		}
+	}
+done:
+	free(mats);
+	free(rest);
+	free(local);
+	free(posed);
+	return r;
+}
+
+double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x)
+{
+	double M[12], y[3], e = 0.0;
+	for (int p = 0; p < g->pose_count; p++) {
+		blend(g, p, inf, M);
+		apply(M, x, y);
+		double v = eval(q + 10 * p, y);
+		e += v > 0.0 ? v : 0.0;
+	}
+	return e;
+}
+
+int bgm_quadric_optimum(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x0, double *out)
+{
+	double H[4][4] = {{0}};
+	for (int p = 0; p < g->pose_count; p++) {
+		double M[12], Q[4][4], T[4][4];
+		const double *a = q + 10 * p;
+		blend(g, p, inf, M);
+		int k = 0;
+		for (int i = 0; i < 4; i++)
+			for (int j = i; j < 4; j++)
+				Q[i][j] = Q[j][i] = a[k++];
+		/* T = Q * [M; 0 0 0 1], H += [M; 0 0 0 1]^T * T. */
+		for (int i = 0; i < 4; i++)
+			for (int j = 0; j < 4; j++)
+				T[i][j] = Q[i][0] * M[j] + Q[i][1] * M[4 + j] + Q[i][2] * M[8 + j] + (j == 3 ? Q[i][3] : 0.0);
+		for (int i = 0; i < 4; i++)
+			for (int j = 0; j < 4; j++) {
+				double mi0 = M[i], mi1 = M[4 + i], mi2 = M[8 + i], mi3 = i == 3 ? 1.0 : 0.0;
+				H[i][j] += mi0 * T[0][j] + mi1 * T[1][j] + mi2 * T[2][j] + mi3 * T[3][j];
+			}
+	}
+	/* Solve (H[0..2][0..2] + mu I) x = -H[0..2][3] + mu x0 by Cramer's
+	 * rule: the small mu pins the directions the quadric leaves free
+	 * (flat regions, creases) at x0 instead of leaving them singular. */
+	double tr = H[0][0] + H[1][1] + H[2][2];
+	if (!(tr > 0.0) || !isfinite(tr))
+		return -1;
+	double mu = 1e-5 * tr;
+	double a = H[0][0] + mu, b = H[0][1], c = H[0][2], d = H[1][1] + mu, e = H[1][2], f = H[2][2] + mu;
+	double det = a * (d * f - e * e) - b * (b * f - c * e) + c * (b * e - c * d);
+	if (!(fabs(det) > 0.0))
+		return -1;
+	double r0 = -H[0][3] + mu * x0[0], r1 = -H[1][3] + mu * x0[1], r2 = -H[2][3] + mu * x0[2];
+	out[0] = (r0 * (d * f - e * e) - b * (r1 * f - e * r2) + c * (r1 * e - d * r2)) / det;
+	out[1] = (a * (r1 * f - e * r2) - r0 * (b * f - c * e) + c * (b * r2 - r1 * c)) / det;
+	out[2] = (a * (d * r2 - r1 * e) - b * (b * r2 - r1 * c) + r0 * (b * e - c * d)) / det;
+	return isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2]) ? 0 : -1;
+}

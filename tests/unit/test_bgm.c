@@ -1,0 +1,705 @@
+/* test_bgm.c: the mesh layer: Power Skinning, eligibility, the
+ * BindGraphMesh weld, triangle collapses and their recorded sequence,
+ * level extraction, posed error. White-box where it must be: the seam
+ * tests read the BGM's wedges through lib/bgm.h. */
+#include "test.h"
+
+#include "bgm.h"
+
+#define DEG40 0.6981317f
+
+/* ---------------------------------------------------------------- */
+/* A position-welded look at a primitive                             */
+/* ---------------------------------------------------------------- */
+
+struct mesh_stats {
+	int triangles;
+	int degenerate;     /* two corners at one position, or zero area */
+	int border_edges;   /* edges with one face */
+	int complex_edges;  /* edges with more than two faces */
+	int flipped_edges;  /* two faces that use the edge in the same direction */
+};
+
+struct wedge_edge {
+	uint32_t a, b;      /* welded ids, a < b */
+	int forward;
+};
+
+static int edge_cmp(const void *x, const void *y)
+{
+	const struct wedge_edge *p = x, *q = y;
+	if (p->a != q->a)
+		return p->a < q->a ? -1 : 1;
+	if (p->b != q->b)
+		return p->b < q->b ? -1 : 1;
+	return p->forward - q->forward;
+}
+
+static int pos_cmp(const void *x, const void *y, const float *pos)
+{
+	const float *p = pos + 3 * *(const uint32_t *)x, *q = pos + 3 * *(const uint32_t *)y;
+	for (int i = 0; i < 3; i++)
+		if (p[i] != q[i])
+			return p[i] < q[i] ? -1 : 1;
+	return 0;
+}
+
+static const float *sort_positions;
+static int pos_cmp_global(const void *x, const void *y)
+{
+	return pos_cmp(x, y, sort_positions);
+}
+
+/* weld[v]: the smallest vertex index at v's position. */
+static uint32_t *weld_positions(const mlod_primitive *p)
+{
+	uint32_t n = (uint32_t)p->vertex_count, *order = malloc(sizeof(uint32_t) * (n + 1)),
+	         *weld = malloc(sizeof(uint32_t) * (n + 1));
+	for (uint32_t i = 0; i < n; i++)
+		order[i] = i;
+	sort_positions = p->positions;
+	qsort(order, n, sizeof *order, pos_cmp_global);
+	for (uint32_t i = 0; i < n;) {
+		uint32_t j = i, rep = order[i];
+		while (j < n && pos_cmp(&order[i], &order[j], p->positions) == 0) {
+			if (order[j] < rep)
+				rep = order[j];
+			j++;
+		}
+		for (uint32_t k = i; k < j; k++)
+			weld[order[k]] = rep;
+		i = j;
+	}
+	free(order);
+	return weld;
+}
+
+static struct mesh_stats mesh_stats(const mlod_primitive *p)
+{
+	struct mesh_stats s = {0};
+	uint32_t *weld = weld_positions(p);
+	int nt = p->index_count / 3;
+	struct wedge_edge *e = malloc(sizeof *e * (size_t)(3 * nt + 1));
+	int ne = 0;
+	s.triangles = nt;
+	for (int t = 0; t < nt; t++) {
+		uint32_t v[3];
+		for (int k = 0; k < 3; k++)
+			v[k] = weld[p->indices[3 * t + k]];
+		const float *a = p->positions + 3 * v[0], *b = p->positions + 3 * v[1], *c = p->positions + 3 * v[2];
+		double u[3], w[3], n[3];
+		for (int i = 0; i < 3; i++)
+			u[i] = b[i] - a[i], w[i] = c[i] - a[i];
+		n[0] = u[1] * w[2] - u[2] * w[1];
+		n[1] = u[2] * w[0] - u[0] * w[2];
+		n[2] = u[0] * w[1] - u[1] * w[0];
+		if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2] || n[0] * n[0] + n[1] * n[1] + n[2] * n[2] == 0.0) {
+			s.degenerate++;
+			continue;
+		}
+		for (int k = 0; k < 3; k++) {
+			uint32_t x = v[k], y = v[(k + 1) % 3];
+			e[ne++] = (struct wedge_edge){x < y ? x : y, x < y ? y : x, x < y};
+		}
+	}
+	qsort(e, (size_t)ne, sizeof *e, edge_cmp);
+	for (int i = 0; i < ne;) {
+		int j = i, fw = 0;
+		while (j < ne && e[j].a == e[i].a && e[j].b == e[i].b)
+			fw += e[j++].forward;
+		int count = j - i;
+		s.border_edges += count == 1;
+		s.complex_edges += count > 2;
+		s.flipped_edges += count == 2 && fw != 1;
+		i = j;
+	}
+	free(e);
+	free(weld);
+	return s;
+}
+
+/* ---------------------------------------------------------------- */
+/* Power Skinning                                                    */
+/* ---------------------------------------------------------------- */
+
+TEST(power_weights_equilateral)
+{
+	/* The barycenter of an equilateral triangle is equidistant: 1/3 each. */
+	mlod_v3 v[3] = {{0, 0, 0}, {1, 0, 0}, {0.5f, 0.8660254f, 0}};
+	mlod_v3 bar = {0.5f, 0.28867513f, 0};
+	double W[3];
+	mlod_power_weights(v, 3, bar, W);
+	for (int i = 0; i < 3; i++)
+		CHECK_NEAR(W[i], 1.0 / 3.0, 1e-6);
+}
+
+TEST(power_weights_coincident)
+{
+	/* D = 0: every vertex at v-bar gets 1/k. */
+	for (int k = 2; k <= 5; k++) {
+		mlod_v3 v[5];
+		double W[5];
+		for (int i = 0; i < k; i++)
+			v[i] = (mlod_v3){1.5f, -2.0f, 0.25f};
+		mlod_power_weights(v, k, v[0], W);
+		for (int i = 0; i < k; i++)
+			CHECK_NEAR(W[i], 1.0 / k, 1e-12);
+	}
+}
+
+TEST(power_weights_formula)
+{
+	/* d = (1, 2, 3): D = 6, W_i = (6 - d_i) / 12 = 5/12, 4/12, 3/12. */
+	mlod_v3 v[3] = {{1, 0, 0}, {0, 2, 0}, {0, 0, -3}};
+	double W[3];
+	mlod_power_weights(v, 3, (mlod_v3){0, 0, 0}, W);
+	CHECK_NEAR(W[0], 5.0 / 12.0, 1e-12);
+	CHECK_NEAR(W[1], 4.0 / 12.0, 1e-12);
+	CHECK_NEAR(W[2], 3.0 / 12.0, 1e-12);
+	/* Snapped onto v[0] (d_0 = 0): W_0 = 1/(k-1) = 1/2. */
+	mlod_power_weights(v, 3, v[0], W);
+	CHECK_NEAR(W[0], 0.5, 1e-12);
+	CHECK_NEAR(W[0] + W[1] + W[2], 1.0, 1e-12);
+}
+
+TEST(power_skin_blends_and_caps)
+{
+	mlod_v3 v[3] = {{0, 0, 0}, {1, 0, 0}, {0.5f, 0.8660254f, 0}};
+	mlod_v3 bar = {0.5f, 0.28867513f, 0};
+	mlod_influences in[3] = {{0}}, out;
+	/* Two joints: w(0) = (1 + 0.5 + 0) / 3, w(1) = (0 + 0.5 + 1) / 3. */
+	in[0].count = 1, in[0].joints[0] = 0, in[0].weights[0] = 1.0f;
+	in[1].count = 2, in[1].joints[0] = 0, in[1].weights[0] = 0.5f, in[1].joints[1] = 1, in[1].weights[1] = 0.5f;
+	in[2].count = 1, in[2].joints[0] = 1, in[2].weights[0] = 1.0f;
+	CHECK(mlod_power_skin(v, in, 3, bar, &out) == 0);
+	CHECK(out.count == 2);
+	CHECK_NEAR(out.weights[0], 0.5, 1e-6);
+	CHECK_NEAR(out.weights[1], 0.5, 1e-6);
+	/* Twelve joints in all: capped to the largest 4, renormalised. */
+	for (int i = 0; i < 3; i++) {
+		in[i].count = 4;
+		for (int k = 0; k < 4; k++) {
+			in[i].joints[k] = (uint16_t)(4 * i + k);
+			in[i].weights[k] = k == 0 ? 0.7f : 0.1f;
+		}
+	}
+	CHECK(mlod_power_skin(v, in, 3, bar, &out) == 1);
+	CHECK(out.count == 4);
+	double sum = 0.0;
+	for (int k = 0; k < 4; k++) {
+		sum += out.weights[k];
+		CHECK(k == 0 || out.weights[k] <= out.weights[k - 1]);
+	}
+	CHECK_NEAR(sum, 1.0, 1e-6);
+	/* The three 0.7 joints survive: 0.7/3 each before renormalising. */
+	CHECK(out.joints[0] == 0 && out.joints[1] == 4 && out.joints[2] == 8);
+	CHECK_NEAR(out.weights[0], (0.7 / 3) / (3 * 0.7 / 3 + 0.1 / 3), 1e-6);
+}
+
+TEST(eligibility_rules)
+{
+	int map[3] = {0, 1, 2};
+	double eta[3] = {0.8, 0.8, 1.0};
+	mlod_influences dominated = {0}, split = {0}, rigid = {0}, none = {0};
+	dominated.count = 2, dominated.joints[0] = 0, dominated.weights[0] = 0.9f, dominated.joints[1] = 1,
+	dominated.weights[1] = 0.1f;
+	split.count = 2, split.joints[0] = 0, split.weights[0] = 0.5f, split.joints[1] = 1, split.weights[1] = 0.5f;
+	rigid.count = 1, rigid.joints[0] = 2, rigid.weights[0] = 1.0f;
+	/* The paper's rule frees split weights and protects dominated ones. */
+	CHECK(!mlod_vertex_eligible(MLOD_ELIGIBLE_LITERAL, 1.0, &dominated, map, eta));
+	CHECK(mlod_vertex_eligible(MLOD_ELIGIBLE_LITERAL, 1.0, &split, map, eta));
+	CHECK(!mlod_vertex_eligible(MLOD_ELIGIBLE_LITERAL, 1.0, &rigid, map, eta));
+	CHECK(mlod_vertex_eligible(MLOD_ELIGIBLE_LITERAL, 2.0, &rigid, map, eta));
+	/* The bend rule protects the bend instead. */
+	CHECK(mlod_vertex_eligible(MLOD_ELIGIBLE_BEND, 1.0, &dominated, map, eta));
+	CHECK(!mlod_vertex_eligible(MLOD_ELIGIBLE_BEND, 1.0, &split, map, eta));
+	CHECK(mlod_vertex_eligible(MLOD_ELIGIBLE_BEND, 1.0, &rigid, map, eta));
+	CHECK(mlod_vertex_eligible(MLOD_ELIGIBLE_BEND, 0.5, &split, map, eta));
+	CHECK(mlod_vertex_eligible(MLOD_ELIGIBLE_ALL, 1.0, &split, map, eta));
+	CHECK(mlod_vertex_eligible(MLOD_ELIGIBLE_LITERAL, 1.0, &none, map, eta));
+	CHECK(mlod_vertex_eligible(MLOD_ELIGIBLE_BEND, 1.0, &none, map, eta));
+}
+
+TEST(weight_average)
+{
+	mlod_character c;
+	CHECK(test_load("samples/RobotExpressive.glb", &c) == 0);
+	double *eta = calloc((size_t)c.skeleton.joint_count, sizeof *eta);
+	CHECK_OK(mlod_joint_weight_average(&c, eta, &terr));
+	/* Rigid parts weigh 1 on their joint; every average is in (0, 1]. */
+	for (int j = 0; j < c.skeleton.joint_count; j++)
+		CHECK(eta[j] >= 0.0 && eta[j] <= 1.0 + 1e-6);
+	CHECK_NEAR(eta[c.instances[0].joint], 1.0, 1e-9);
+	free(eta);
+	mlod_character_free(&c);
+}
+
+TEST(compactness)
+{
+	double a[3] = {0, 0, 0}, b[3] = {1, 0, 0}, c[3] = {0.5, sqrt(3.0) / 2, 0}, d[3] = {2, 0, 0};
+	CHECK_NEAR(bgm_compactness(a, b, c), 1.0, 1e-12);
+	CHECK_NEAR(bgm_compactness(a, b, d), 0.0, 1e-12);
+	CHECK_NEAR(bgm_compactness(a, a, a), 0.0, 0.0);
+}
+
+/* ---------------------------------------------------------------- */
+/* The BGM on the samples                                            */
+/* ---------------------------------------------------------------- */
+
+/* The level of a character whose instance i uses level[i] (a view:
+ * free only the arrays it allocated). */
+static mlod_character level_view(const mlod_character *c, mlod_mesh *level)
+{
+	mlod_character v = *c;
+	v.meshes = level;
+	v.mesh_count = c->instance_count;
+	v.instances = malloc(sizeof *v.instances * (size_t)c->instance_count);
+	for (int i = 0; i < c->instance_count; i++) {
+		v.instances[i] = c->instances[i];
+		v.instances[i].mesh = i;
+	}
+	return v;
+}
+
+TEST(weld_keeps_seams_closed)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	const mlod_primitive *p = &c.meshes[0].primitives[0];
+	mlod_bgm *g;
+	CHECK_OK(mlod_bgm_build(&c, 0, 0, NULL, &g, &terr));
+	mlod_bgm_info info;
+	mlod_bgm_get_info(g, &info);
+	struct mesh_stats in = mesh_stats(p);
+	/* UV seams split glTF vertices; welded they are not borders. */
+	CHECK(info.vertices == p->vertex_count);
+	CHECK(info.nodes < info.vertices);
+	CHECK(info.seam_nodes > 0);
+	CHECK(info.border_edges == in.border_edges);
+	CHECK(info.nonmanifold_edges == in.complex_edges);
+	CHECK(info.triangles == in.triangles - in.degenerate);
+	CHECK_OK(mlod_bgm_check(g, &terr));
+	/* Levels add no border. */
+	CHECK_OK(mlod_bgm_simplify(g, info.triangles / 10, 0, &terr));
+	CHECK_OK(mlod_bgm_check(g, &terr));
+	int prefixes[3] = {mlod_bgm_prefix_for(g, info.triangles / 2), mlod_bgm_prefix_for(g, info.triangles / 4),
+	                   mlod_bgm_prefix_for(g, info.triangles / 10)};
+	for (int k = 0; k < 3; k++) {
+		mlod_primitive q;
+		CHECK_OK(mlod_bgm_extract(g, prefixes[k], 0, &q, &terr));
+		struct mesh_stats s = mesh_stats(&q);
+		int ok = s.border_edges <= in.border_edges && s.complex_edges <= in.complex_edges && s.degenerate == 0 &&
+		         s.flipped_edges <= in.flipped_edges;
+		mlod_primitive_free(&q);
+		CHECK_MSG(ok, "level %d: %d border, %d complex, %d degenerate, %d flipped", k, s.border_edges, s.complex_edges,
+		          s.degenerate, s.flipped_edges);
+	}
+	mlod_bgm_free(g);
+	mlod_character_free(&c);
+}
+
+/* Every wedge a collapse made: a free v-bar's parents had one texture
+ * value each and the wedge's UV lies in their range; a snapped v-bar
+ * reproduces a UV of the vertex it snapped onto exactly. */
+TEST(seam_wedges)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	mlod_bgm *g;
+	CHECK_OK(mlod_bgm_build(&c, 0, 0, NULL, &g, &terr));
+	CHECK_OK(mlod_bgm_simplify(g, 0, 0, &terr));
+	int count, snapped = 0, free_ = 0;
+	const mlod_vsplit *seq = mlod_bgm_sequence(g, &count);
+	CHECK(count > 100);
+	CHECK(g->lay.uv[0] >= 0);
+	int S = g->lay.stride, uv = g->lay.uv[0];
+	for (int r = 0; r < count; r++) {
+		const mlod_vsplit *rec = &seq[r];
+		float lo[2] = {1e30f, 1e30f}, hi[2] = {-1e30f, -1e30f};
+		for (int w = 0; w < g->wedge_count; w++) {
+			int n = g->wedge_node[w];
+			if (n != rec->parents[0] && n != rec->parents[1] && n != rec->parents[2])
+				continue;
+			for (int i = 0; i < 2; i++) {
+				float x = g->wedge_attr[(size_t)w * (size_t)S + (size_t)uv + (size_t)i];
+				lo[i] = fminf(lo[i], x);
+				hi[i] = fmaxf(hi[i], x);
+			}
+		}
+		for (int w = 0; w < g->wedge_count; w++) {
+			if (g->wedge_node[w] != rec->node)
+				continue;
+			const float *x = g->wedge_attr + (size_t)w * (size_t)S + uv;
+			if (rec->snapped < 0) {
+				free_++;
+				for (int i = 0; i < 2; i++)
+					CHECK_MSG(x[i] >= lo[i] - 1e-6f && x[i] <= hi[i] + 1e-6f, "record %d: UV outside its wedges' range", r);
+				/* No texture seam among the parents: one UV per parent. */
+				for (int pi = 0; pi < 3; pi++) {
+					int first = -1;
+					for (int v = 0; v < g->wedge_count; v++) {
+						if (g->wedge_node[v] != rec->parents[pi])
+							continue;
+						const float *y = g->wedge_attr + (size_t)v * (size_t)S + uv;
+						if (first < 0)
+							first = v;
+						else
+							CHECK_MSG(memcmp(y, g->wedge_attr + (size_t)first * (size_t)S + uv, 2 * sizeof(float)) == 0,
+							          "record %d: a free v-bar across a UV seam", r);
+					}
+				}
+			} else {
+				snapped++;
+				int found = 0;
+				for (int v = 0; v < g->wedge_count && !found; v++)
+					found = g->wedge_node[v] == rec->parents[rec->snapped] &&
+					        memcmp(g->wedge_attr + (size_t)v * (size_t)S + uv, x, 2 * sizeof(float)) == 0;
+				CHECK_MSG(found, "record %d: snapped wedge UV is not one of its vertex's", r);
+			}
+		}
+	}
+	CHECK(snapped > 0 && free_ > 0);
+	mlod_bgm_free(g);
+	mlod_character_free(&c);
+}
+
+/* Sampled prefixes of the whole sequence are valid meshes. */
+static void check_prefixes(const mlod_character *c, int instance, const mlod_bgm_options *opt)
+{
+	const mlod_primitive *p = &c->meshes[c->instances[instance].mesh].primitives[0];
+	struct mesh_stats in = mesh_stats(p);
+	mlod_bgm *g;
+	CHECK_OK(mlod_bgm_build(c, instance, 0, opt, &g, &terr));
+	CHECK_OK(mlod_bgm_simplify(g, 0, 0, &terr));
+	CHECK_OK(mlod_bgm_check(g, &terr));
+	int count;
+	const mlod_vsplit *seq = mlod_bgm_sequence(g, &count);
+	for (int r = 1; r < count; r++)
+		CHECK(seq[r].triangles < seq[r - 1].triangles);
+	for (int s = 0; s <= 8; s++) {
+		int k = count * s / 8;
+		mlod_primitive q;
+		CHECK_OK(mlod_bgm_extract(g, k, 1, &q, &terr));
+		CHECK(q.index_count / 3 == mlod_bgm_triangles(g, k));
+		struct mesh_stats st = mesh_stats(&q);
+		int bad = st.border_edges > in.border_edges || st.complex_edges > in.complex_edges ||
+		          st.flipped_edges > in.flipped_edges || st.degenerate > 0;
+		/* Weights: at most 4 influences per set, new vertices sum to 1. */
+		int weights_bad = -1;
+		for (int v = 0; v < q.vertex_count && weights_bad < 0; v++) {
+			double sum = 0.0;
+			for (int set = 0; set < q.weight_set_count; set++)
+				for (int i = 0; i < 4; i++)
+					sum += q.weights[set][4 * v + i];
+			if (q.weight_set_count > 0 && fabs(sum - 1.0) > 1e-6)
+				weights_bad = v;
+		}
+		mlod_primitive_free(&q);
+		CHECK_MSG(!bad, "prefix %d of %d: %d border (input %d), %d complex (%d), %d flipped (%d), %d degenerate", k,
+		          count, st.border_edges, in.border_edges, st.complex_edges, in.complex_edges, st.flipped_edges,
+		          in.flipped_edges, st.degenerate);
+		CHECK_MSG(weights_bad < 0, "prefix %d: vertex %d weights do not sum to 1", k, weights_bad);
+	}
+	mlod_bgm_free(g);
+}
+
+TEST(prefixes_tubeman)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	mlod_pose_set poses;
+	CHECK_OK(mlod_pose_set_make(&c, 0, 4, 4, 1, DEG40, &poses, &terr));
+	mlod_bgm_options opt = {0};
+	opt.poses = &poses;
+	check_prefixes(&c, 0, &opt);
+	if (!test_failed_) {
+		opt.cost = MLOD_COST_COMPACTNESS;
+		opt.placement = MLOD_PLACE_BARYCENTER;
+		check_prefixes(&c, 0, &opt);
+	}
+	mlod_pose_set_free(&poses);
+	mlod_character_free(&c);
+}
+
+TEST(prefixes_robot)
+{
+	/* Faceted, non-manifold parts, rigid parts and morph targets. */
+	mlod_character c;
+	CHECK(test_load("samples/RobotExpressive.glb", &c) == 0);
+	for (int i = 0; i < c.instance_count && !test_failed_; i++)
+		check_prefixes(&c, i, NULL);
+	mlod_character_free(&c);
+}
+
+TEST(prefixes_allow_border)
+{
+	mlod_character c;
+	CHECK(test_load("samples/RobotExpressive.glb", &c) == 0);
+	mlod_bgm_options opt = {0};
+	opt.allow_border = 1;
+	for (int i = 0; i < c.instance_count && !test_failed_; i++) {
+		/* Borders may now move, but no new complex edge may appear. */
+		const mlod_primitive *p = &c.meshes[c.instances[i].mesh].primitives[0];
+		struct mesh_stats in = mesh_stats(p);
+		mlod_bgm *g;
+		CHECK_OK(mlod_bgm_build(&c, i, 0, &opt, &g, &terr));
+		CHECK_OK(mlod_bgm_simplify(g, 0, 0, &terr));
+		CHECK_OK(mlod_bgm_check(g, &terr));
+		mlod_primitive q;
+		CHECK_OK(mlod_bgm_extract(g, mlod_bgm_prefix_for(g, 0), 0, &q, &terr));
+		struct mesh_stats st = mesh_stats(&q);
+		mlod_primitive_free(&q);
+		mlod_bgm_free(g);
+		CHECK_MSG(st.complex_edges <= in.complex_edges && st.degenerate == 0 && st.flipped_edges <= in.flipped_edges,
+		          "instance %d: %d complex, %d degenerate, %d flipped", i, st.complex_edges, st.degenerate,
+		          st.flipped_edges);
+	}
+	mlod_character_free(&c);
+}
+
+TEST(rigid_and_morph)
+{
+	mlod_character c;
+	CHECK(test_load("samples/RobotExpressive.glb", &c) == 0);
+	/* Instance 4: a rigid part of the head with morph targets. */
+	int inst = -1;
+	for (int i = 0; i < c.instance_count && inst < 0; i++)
+		if (c.instances[i].skin < 0 && c.instances[i].joint >= 0 && c.meshes[c.instances[i].mesh].primitives[0].target_count > 0)
+			inst = i;
+	CHECK(inst >= 0);
+	const mlod_primitive *p = &c.meshes[c.instances[inst].mesh].primitives[0];
+	mlod_bgm *g;
+	CHECK_OK(mlod_bgm_build(&c, inst, 0, NULL, &g, &terr));
+	CHECK_OK(mlod_bgm_simplify(g, 0, 0, &terr));
+	int count;
+	const mlod_vsplit *seq = mlod_bgm_sequence(g, &count);
+	CHECK(count > 0);
+	/* A new node's morph offsets are a convex combination of its parents'. */
+	int M = g->lay.morph_stride;
+	CHECK(M == 3 * p->target_count);
+	for (int r = 0; r < count; r++)
+		for (int k = 0; k < M; k++) {
+			float lo = 1e30f, hi = -1e30f;
+			for (int i = 0; i < 3; i++) {
+				float x = g->morph[(size_t)seq[r].parents[i] * (size_t)M + (size_t)k];
+				lo = fminf(lo, x);
+				hi = fmaxf(hi, x);
+			}
+			float y = g->morph[(size_t)seq[r].node * (size_t)M + (size_t)k];
+			CHECK_MSG(y >= lo - 1e-6f && y <= hi + 1e-6f, "record %d: morph offset outside its parents'", r);
+		}
+	mlod_primitive q;
+	CHECK_OK(mlod_bgm_extract(g, count, 1, &q, &terr));
+	CHECK(q.target_count == p->target_count && q.targets && q.targets[0].positions);
+	/* Rigid: one weight set, joint 0 weight 1. */
+	CHECK(q.weight_set_count == 1);
+	for (int v = 0; v < q.vertex_count; v++)
+		CHECK(q.joints[0][4 * v] == 0 && q.weights[0][4 * v] == 1.0f && q.weights[0][4 * v + 1] == 0.0f);
+	mlod_primitive_free(&q);
+	mlod_bgm_free(g);
+	mlod_character_free(&c);
+}
+
+TEST(deterministic)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	mlod_pose_set poses;
+	CHECK_OK(mlod_pose_set_make(&c, 0, 2, 3, 7, DEG40, &poses, &terr));
+	mlod_bgm_options opt = {0};
+	opt.poses = &poses;
+	mlod_bgm *g1, *g2;
+	CHECK_OK(mlod_bgm_build(&c, 0, 0, &opt, &g1, &terr));
+	CHECK_OK(mlod_bgm_build(&c, 0, 0, &opt, &g2, &terr));
+	CHECK_OK(mlod_bgm_simplify(g1, 2000, 0, &terr));
+	/* In two steps: the same sequence. */
+	CHECK_OK(mlod_bgm_simplify(g2, 4000, 0, &terr));
+	CHECK_OK(mlod_bgm_simplify(g2, 2000, 0, &terr));
+	int n1, n2;
+	const mlod_vsplit *s1 = mlod_bgm_sequence(g1, &n1), *s2 = mlod_bgm_sequence(g2, &n2);
+	CHECK(n1 == n2);
+	for (int r = 0; r < n1; r++)
+		CHECK(memcmp(s1[r].parents, s2[r].parents, sizeof s1[r].parents) == 0 && s1[r].cost == s2[r].cost);
+	mlod_bgm_free(g1);
+	mlod_bgm_free(g2);
+	mlod_pose_set_free(&poses);
+	mlod_character_free(&c);
+}
+
+/* Level errors as mlod_posed_error reports them, recomputed pose by pose;
+ * the levels are ordered. */
+TEST(level_errors_ordered)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	mlod_pose_set train, measure;
+	CHECK_OK(mlod_pose_set_make(&c, 0, 4, 4, 1, DEG40, &train, &terr));
+	CHECK_OK(mlod_pose_set_make(&c, 1, 3, 4, 2008, DEG40, &measure, &terr));
+	mlod_bgm_options opt = {0};
+	opt.poses = &train;
+	mlod_bgm *g;
+	CHECK_OK(mlod_bgm_build(&c, 0, 0, &opt, &g, &terr));
+	mlod_bgm_info info;
+	mlod_bgm_get_info(g, &info);
+	CHECK_OK(mlod_bgm_simplify(g, info.triangles / 10, 0, &terr));
+	double ratios[3] = {0.5, 0.25, 0.1}, prev_mean = 0.0, prev_max = 0.0;
+	int prev_tris = info.triangles;
+	for (int k = 0; k < 3; k++) {
+		mlod_mesh mesh = {0};
+		mlod_primitive q;
+		CHECK_OK(mlod_bgm_extract(g, mlod_bgm_prefix_for(g, (int)(ratios[k] * info.triangles)), 0, &q, &terr));
+		mesh.primitive_count = 1;
+		mesh.primitives = &q;
+		mlod_character v = level_view(&c, &mesh);
+		mlod_deviation rep;
+		mlod_result r = mlod_posed_error(&c, &v, &measure, &rep, &terr);
+		double max = 0.0, mean = 0.0;
+		mlod_posed a = {0}, b = {0};
+		for (int i = 0; r == MLOD_OK && i < measure.count; i++) {
+			mlod_deviation d;
+			const mlod_mat4 *w = measure.world + (size_t)i * (size_t)measure.joint_count;
+			if (mlod_pose_character(&c, w, &a, NULL) || mlod_pose_character(&v, w, &b, NULL) ||
+			    mlod_surface_deviation(&a, &b, &d, NULL))
+				r = MLOD_ERR_INVALID_ARG;
+			max = fmax(max, d.max);
+			mean += d.mean / measure.count;
+		}
+		mlod_posed_free(&a);
+		mlod_posed_free(&b);
+		int tris = q.index_count / 3;
+		mlod_primitive_free(&q);
+		free(v.instances);
+		CHECK(r == MLOD_OK);
+		CHECK_MSG(max <= rep.max + 1e-9 && mean <= rep.mean + 1e-9, "level %d: measured %g/%g, reported %g/%g", k,
+		          mean, max, rep.mean, rep.max);
+		CHECK_MSG(tris < prev_tris && rep.mean > prev_mean && rep.max >= prev_max,
+		          "level %d: %d triangles, mean %g max %g after %d, %g, %g", k, tris, rep.mean, rep.max, prev_tris,
+		          prev_mean, prev_max);
+		prev_tris = tris, prev_mean = rep.mean, prev_max = rep.max;
+	}
+	CHECK(prev_max < 5.0); /* 10% of the triangles stay within 5% of the diagonal */
+	mlod_bgm_free(g);
+	mlod_pose_set_free(&train);
+	mlod_pose_set_free(&measure);
+	mlod_character_free(&c);
+}
+
+TEST(pose_sets)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	mlod_pose_set a, b;
+	CHECK_OK(mlod_pose_set_make(&c, 1, 5, 8, 42, DEG40, &a, &terr));
+	CHECK_OK(mlod_pose_set_make(&c, 1, 5, 8, 42, DEG40, &b, &terr));
+	CHECK(a.count == 1 + 5 + 8 && a.joint_count == c.skeleton.joint_count);
+	CHECK(memcmp(a.world, b.world, sizeof *a.world * (size_t)a.count * (size_t)a.joint_count) == 0);
+	mlod_pose_set_free(&b);
+	CHECK_OK(mlod_pose_set_make(&c, 1, 5, 8, 43, DEG40, &b, &terr));
+	CHECK(memcmp(a.world, b.world, sizeof *a.world * (size_t)a.count * (size_t)a.joint_count) != 0);
+	/* The rest pose first. */
+	mlod_trs *local = malloc(sizeof *local * (size_t)c.skeleton.joint_count);
+	mlod_mat4 *world = malloc(sizeof *world * (size_t)c.skeleton.joint_count);
+	mlod_pose_rest(&c.skeleton, local);
+	mlod_pose_world(&c.skeleton, local, world);
+	CHECK(memcmp(world, a.world, sizeof *world * (size_t)c.skeleton.joint_count) == 0);
+	free(local);
+	free(world);
+	mlod_pose_set_free(&a);
+	mlod_pose_set_free(&b);
+	mlod_character_free(&c);
+}
+
+TEST(remap_joints)
+{
+	uint16_t joints[8] = {0, 1, 2, 3, 2, 0, 0, 0};
+	float weights[8] = {0.4f, 0.3f, 0.2f, 0.1f, 1.0f, 0, 0, 0};
+	float pos[6] = {0};
+	mlod_primitive p = {0};
+	p.vertex_count = 2;
+	p.positions = pos;
+	p.weight_set_count = 1;
+	p.joints[0] = joints;
+	p.weights[0] = weights;
+	int map[4] = {0, 0, 5, 1};
+	CHECK_OK(mlod_primitive_remap_joints(&p, map, 4, &terr));
+	/* 0.4 + 0.3 on joint 0, 0.2 on 5, 0.1 on 1. */
+	CHECK(joints[0] == 0 && joints[1] == 5 && joints[2] == 1);
+	CHECK_NEAR(weights[0], 0.7, 1e-6);
+	CHECK_NEAR(weights[3], 0.0, 0.0);
+	CHECK(joints[4] == 5 && weights[4] == 1.0f);
+	int bad[2] = {0, -1};
+	CHECK(mlod_primitive_remap_joints(&p, bad, 2, NULL) == MLOD_ERR_INVALID_ARG);
+}
+
+TEST(hostile_input)
+{
+	float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+	uint32_t idx[3] = {0, 1, 7};
+	mlod_primitive p = {0};
+	p.vertex_count = 3;
+	p.positions = pos;
+	p.mode = 1; /* lines */
+	mlod_mesh m = {0};
+	m.primitive_count = 1;
+	m.primitives = &p;
+	mlod_instance in = {0};
+	in.mesh = 0, in.skin = -1, in.joint = -1, in.offset = mlod_mat4_identity();
+	mlod_character c = {0};
+	c.mesh_count = 1, c.meshes = &m, c.instance_count = 1, c.instances = &in;
+	mlod_bgm *g = NULL;
+	CHECK(mlod_bgm_build(&c, 0, 0, NULL, &g, NULL) == MLOD_ERR_UNSUPPORTED && !g);
+	p.mode = 4;
+	p.index_count = 3;
+	p.indices = idx;
+	CHECK(mlod_bgm_build(&c, 0, 0, NULL, &g, NULL) == MLOD_ERR_PARSE && !g);
+	idx[2] = 2;
+	pos[4] = NAN;
+	CHECK(mlod_bgm_build(&c, 0, 0, NULL, &g, NULL) == MLOD_ERR_PARSE && !g);
+	pos[4] = 0.0f;
+	CHECK(mlod_bgm_build(&c, 1, 0, NULL, &g, NULL) == MLOD_ERR_INVALID_ARG);
+	/* One static triangle: nothing to collapse (all border). */
+	CHECK_OK(mlod_bgm_build(&c, 0, 0, NULL, &g, &terr));
+	CHECK_OK(mlod_bgm_simplify(g, 0, 0, &terr));
+	mlod_bgm_info info;
+	mlod_bgm_get_info(g, &info);
+	CHECK(info.collapses == 0 && info.live_triangles == 1 && info.border_edges == 3);
+	mlod_bgm_free(g);
+	mlod_bgm_free(NULL);
+}
+
+TEST(shared_data)
+{
+	/* Ely (make test-extended): welds, simplifies and stays valid. */
+	if (!test_have_shared())
+		return;
+	char path[4096];
+	snprintf(path, sizeof path, "%s/Ely.glb", getenv("MLOD_SHARED_DATA"));
+	mlod_character c;
+	CHECK(test_load(path, &c) == 0);
+	check_prefixes(&c, 0, NULL);
+	mlod_character_free(&c);
+}
+
+int main(void)
+{
+	RUN(power_weights_equilateral);
+	RUN(power_weights_coincident);
+	RUN(power_weights_formula);
+	RUN(power_skin_blends_and_caps);
+	RUN(eligibility_rules);
+	RUN(weight_average);
+	RUN(compactness);
+	RUN(weld_keeps_seams_closed);
+	RUN(seam_wedges);
+	RUN(prefixes_tubeman);
+	RUN(prefixes_robot);
+	RUN(prefixes_allow_border);
+	RUN(rigid_and_morph);
+	RUN(deterministic);
+	RUN(level_errors_ordered);
+	RUN(pose_sets);
+	RUN(remap_joints);
+	RUN(hostile_input);
+	RUN(shared_data);
+	TEST_EXIT();
+}
