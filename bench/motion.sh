@@ -33,10 +33,7 @@ for f in $INPUTS; do case $f in samples/*) samples="$samples $f" ;; esac; done
 long=
 for f in /usr/share/assimp/models/BVH/01_01.bvh /usr/share/assimp/models/BVH/Boxing_Toes.bvh; do
 	[ -f "$f" ] || continue
-	# Boxing_Toes holds data past its announced frames, which mlod refuses:
-	# keep the frames it announces.
-	awk 'done { next } /^Frames:/ { n = $2 } { print } /^Frame Time:/ { t = 1; next } t && ++c == n { done = 1 }' "$f" > "$tmp/$(basename "$f")"
-	long="$long $tmp/$(basename "$f")"
+	long="$long $f" # Boxing_Toes holds one frame past its announced 3069: mlod ignores it with a note
 done
 # shellcheck disable=SC2086
 "$bench" methods $samples $long
