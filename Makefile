@@ -113,4 +113,25 @@ install: all
 clean:
 	rm -rf build
 
+# --- Mesh layer (issue 4) ---------------------------------------------
+# tests/openmesh/test_openmesh.cpp checks every mesh level of every sample
+# with OpenMesh (headers from libopenmesh-dev, or unpacked into build/deps
+# by scripts/install-deps; the library from libopenmesh1). It is part of
+# `unit` for the release and debug builds, not under the sanitizers.
+# (-Wno-maybe-uninitialized: a false positive inside OpenMesh's
+# PropertyT::push_back.) bench/bench_mesh compares with meshoptimizer,
+# linked there only.
+OPENMESH_HDR := $(firstword $(wildcard /usr/include/OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh build/deps/usr/include/OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh))
+OPENMESH_INC := $(patsubst %/OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh,%,$(OPENMESH_HDR))
+OPENMESH_LIB ?= -l:libOpenMeshCore.so.9.0
+ifneq ($(config),sanitize)
+unit: $(B)/tests/test_openmesh
+endif
+$(B)/tests/test_openmesh: tests/openmesh/test_openmesh.cpp lib/mlod.h $(B)/libmlod.a
+	@mkdir -p $(@D)
+	@if [ -z "$(OPENMESH_INC)" ]; then echo "OpenMesh headers are missing: run scripts/install-deps" >&2; exit 1; fi
+	$(CXX) $(CPPFLAGS) -isystem $(OPENMESH_INC) $(CXXFLAGS) -Wno-maybe-uninitialized $< $(B)/libmlod.a $(OPENMESH_LIB) $(LDFLAGS) $(LDLIBS) -o $@
+$(B)/bench/bench_mesh: LDLIBS += -lmeshoptimizer
+# ----------------------------------------------------------------------
+
 -include $(shell find build -name '*.d' 2>/dev/null)

@@ -762,6 +762,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			goto done;
 		}
 		done_count++;
+		g->records[g->record_count - 1].seconds = g->collapse_seconds + (bgm_seconds() - t0);
 		/* Queue the new faces, and give blocked faces around the patch
 		 * another chance: their neighbourhood changed. */
 		for (int f = first; f < g->face_count; f++)

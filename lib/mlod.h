@@ -786,6 +786,7 @@ typedef struct mlod_vsplit {
 	int triangles;      /* live triangles after it */
 	int capped;         /* v-bar's influences were capped to 4 */
 	double cost;
+	double seconds;     /* collapse time spent on this BGM up to and including it */
 } mlod_vsplit;
 
 /* The sequence so far (valid until the next mlod_bgm_simplify), and the

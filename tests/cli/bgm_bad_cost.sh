@@ -1,0 +1,1 @@
+"$BIN/mlod-bgm" --cost qem "$ROOT/samples/tubeman.glb"

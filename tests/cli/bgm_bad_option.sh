@@ -1,0 +1,1 @@
+"$BIN/mlod-bgm" --frobnicate x.glb

@@ -1,0 +1,1 @@
+"$BIN/mlod-bgm" no-such-file.glb
