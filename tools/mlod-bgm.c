@@ -573,10 +573,13 @@ static int skin_of_gltf(const mlod_skeleton *s, int gltf)
 	return -1;
 }
 
-/* Remaps a level primitive of a skinned instance to skeleton level k's
- * skin; returns that skin's glTF index, or -1 (then nothing changed). */
-static int remap_to_skeleton_level(struct job *job, const struct skel_levels *sl, int k, int skin,
-                                   mlod_primitive *p)
+/* Remaps the level mesh of a skinned instance to skeleton level k's skin:
+ * every primitive must be one the level made (an unsimplified primitive
+ * shares the input's accessors) and every weighted joint must have a
+ * stand-in in that skin. Returns the skin's glTF index, or -1 when that
+ * is not so (then nothing changed). */
+static int remap_to_skeleton_level(struct job *job, const struct skel_levels *sl, int k, int skin, mlod_mesh *m,
+                                   const unsigned char *owned)
 {
 	const mlod_skeleton *s = &job->c.skeleton;
 	int target = sl->skins[k * s->skin_count + skin], ts = skin_of_gltf(s, target);
@@ -594,17 +597,22 @@ static int remap_to_skeleton_level(struct job *job, const struct skel_levels *sl
 			if (s->joints[to->joints[t]].node == stand)
 				map[j] = t;
 	}
-	/* Check first, so a failure leaves p as it was. */
-	for (int set = 0; set < p->weight_set_count; set++)
-		for (long v = 0; v < 4L * p->vertex_count; v++)
-			if (p->weights[set][v] > 0.0f && (p->joints[set][v] >= from->joint_count || map[p->joints[set][v]] < 0)) {
-				free(map);
-				return -1;
-			}
-	mlod_error err = {0};
-	mlod_result r = mlod_primitive_remap_joints(p, map, from->joint_count, &err);
+	/* Check everything first, so a failure leaves the mesh as it was. */
+	int ok = 1;
+	for (int p = 0; ok && p < m->primitive_count; p++) {
+		const mlod_primitive *q = &m->primitives[p];
+		ok = owned[p] != 0;
+		for (int set = 0; ok && set < q->weight_set_count; set++)
+			for (long v = 0; ok && v < 4L * q->vertex_count; v++)
+				ok = !(q->weights[set][v] > 0.0f) || (q->joints[set][v] < from->joint_count && map[q->joints[set][v]] >= 0);
+	}
+	for (int p = 0; ok && p < m->primitive_count; p++) {
+		mlod_error err = {0};
+		if (mlod_primitive_remap_joints(&m->primitives[p], map, from->joint_count, &err) != MLOD_OK)
+			tool_die(EXIT_OUTPUT, NULL, "%s", err.message); /* cannot happen after the check */
+	}
 	free(map);
-	return r == MLOD_OK ? target : -1;
+	return ok ? target : -1;
 }
 
 /* A skin of one joint for a rigid instance: world = W_joint * offset * p.
@@ -680,7 +688,7 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 			any |= job->parts[i][p].bgm != NULL;
 		if (!any || in->node < 0)
 			continue;
-		int lod_nodes[MAX_LEVELS];
+		int lod_nodes[MAX_LEVELS], rigid_joint = -1, rigid_index = -1;
 		for (int k = 0; k < job->level_count; k++) {
 			struct level *lv = &job->levels[k];
 			int sk = sl.count > 0 ? (k < sl.count ? k : sl.count - 1) : -1; /* the matching skeleton level */
@@ -688,28 +696,19 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 			if (in->skin >= 0) {
 				skin = c->skeleton.skins[in->skin].gltf_index;
 				if (sk >= 0) {
-					/* Try every primitive; fall back to the full skin for all
-					 * of them if one cannot be remapped. */
-					int ok = 1, target = -1;
-					for (int p = 0; ok && p < lv->meshes[i].primitive_count; p++) {
-						if (!lv->owned[i][p]) {
-							ok = 0; /* an unsimplified primitive shares the original accessors */
-							break;
-						}
-						int t = remap_to_skeleton_level(job, &sl, sk, in->skin, &lv->meshes[i].primitives[p]);
-						ok = t >= 0 && (target < 0 || t == target);
-						target = t;
-					}
-					if (ok && target >= 0)
+					int target = remap_to_skeleton_level(job, &sl, sk, in->skin, &lv->meshes[i], lv->owned[i]);
+					if (target >= 0)
 						skin = target;
 					else
 						fallback++;
-					if (!ok && target >= 0)
-						tool_die(EXIT_OUTPUT, NULL, "node %d: skeleton level %d: cannot remap every primitive", in->node,
-						         sk + 1);
 				}
 			} else {
-				skin = rigid_skin(job, doc, in, stand_in_joint(job, &sl, sk, in->joint));
+				int joint = stand_in_joint(job, &sl, sk, in->joint);
+				if (joint != rigid_joint) {
+					rigid_joint = joint;
+					rigid_index = rigid_skin(job, doc, in, joint);
+				}
+				skin = rigid_index;
 			}
 			if (mlod_gltf_add_mesh(doc, &lv->meshes[i], &mesh, &err) != MLOD_OK)
 				tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
@@ -1031,9 +1030,9 @@ int main(int argc, char **argv)
 			}
 		}
 		if (report == REPORT_NONE) {
-			write_glb(&job, doc, output);
-			if (split)
+			if (split) /* first: write_glb remaps level joints to skeleton levels */
 				write_split(&job, split, input_path);
+			write_glb(&job, doc, output);
 		} else {
 			if (split)
 				write_split(&job, split, input_path);

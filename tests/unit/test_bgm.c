@@ -667,6 +667,62 @@ TEST(hostile_input)
 	mlod_bgm_free(NULL);
 }
 
+/* A bumpy grid of n x n quads scaled by s, as a static instance. */
+TEST(extreme_scales)
+{
+	enum { N = 12 };
+	static float pos[3 * (N + 1) * (N + 1)];
+	static uint32_t idx[6 * N * N];
+	const double scales[] = {1e-18, 1.0, 1e18};
+	for (int si = 0; si < 3; si++) {
+		for (int y = 0; y <= N; y++)
+			for (int x = 0; x <= N; x++) {
+				float *p = pos + 3 * (y * (N + 1) + x);
+				p[0] = (float)(scales[si] * x);
+				p[1] = (float)(scales[si] * y);
+				p[2] = (float)(scales[si] * 0.3 * sin(x * 0.9) * cos(y * 0.7));
+			}
+		int k = 0;
+		for (int y = 0; y < N; y++)
+			for (int x = 0; x < N; x++) {
+				uint32_t a = (uint32_t)(y * (N + 1) + x), b = a + 1, c = a + N + 1, d = c + 1;
+				idx[k++] = a, idx[k++] = b, idx[k++] = d, idx[k++] = a, idx[k++] = d, idx[k++] = c;
+			}
+		mlod_primitive p = {0};
+		p.vertex_count = (N + 1) * (N + 1);
+		p.positions = pos;
+		p.index_count = k;
+		p.indices = idx;
+		p.mode = 4;
+		mlod_mesh m = {0};
+		m.primitive_count = 1;
+		m.primitives = &p;
+		mlod_instance in = {0};
+		in.skin = -1, in.joint = -1, in.offset = mlod_mat4_identity();
+		mlod_character c = {0};
+		c.mesh_count = 1, c.meshes = &m, c.instance_count = 1, c.instances = &in;
+		for (int cost = 0; cost < 2; cost++) {
+			mlod_bgm_options opt = {0};
+			opt.cost = cost ? MLOD_COST_COMPACTNESS : MLOD_COST_POSED;
+			mlod_bgm *g;
+			CHECK_OK(mlod_bgm_build(&c, 0, 0, &opt, &g, &terr));
+			CHECK_OK(mlod_bgm_simplify(g, 0, 0, &terr));
+			mlod_bgm_info info;
+			mlod_bgm_get_info(g, &info);
+			mlod_primitive q;
+			mlod_result r = mlod_bgm_check(g, &terr);
+			CHECK_OK(mlod_bgm_extract(g, info.collapses, 0, &q, &terr));
+			int finite = 1;
+			for (int i = 0; i < 3 * q.vertex_count; i++)
+				finite &= isfinite(q.positions[i]);
+			mlod_primitive_free(&q);
+			mlod_bgm_free(g);
+			CHECK_MSG(r == MLOD_OK, "scale %g: %s", scales[si], terr.message);
+			CHECK_MSG(finite && info.collapses > 10, "scale %g: %d collapses, finite %d", scales[si], info.collapses, finite);
+		}
+	}
+}
+
 TEST(shared_data)
 {
 	/* Ely (make test-extended): welds, simplifies and stays valid. */
@@ -700,6 +756,7 @@ int main(void)
 	RUN(pose_sets);
 	RUN(remap_joints);
 	RUN(hostile_input);
+	RUN(extreme_scales);
 	RUN(shared_data);
 	TEST_EXIT();
 }
