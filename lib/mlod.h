@@ -715,7 +715,7 @@ typedef enum mlod_mesh_cost {
 /* Where v-bar goes. Next to a seam or an allowed border it always snaps
  * to a seam (border) vertex, so that textures neither tear nor smear. */
 typedef enum mlod_placement {
-	MLOD_PLACE_DEFAULT = 0, /* the measured default: MLOD_PLACE_OPTIMAL */
+	MLOD_PLACE_DEFAULT = 0, /* OPTIMAL with the posed cost (measured), BARYCENTER with compactness (the paper) */
 	MLOD_PLACE_BARYCENTER,  /* the paper: the triangle's barycenter */
 	MLOD_PLACE_OPTIMAL      /* beyond the paper: the minimum of the posed quadric (or the barycenter when lower) */
 } mlod_placement;
@@ -815,13 +815,16 @@ int mlod_bgm_triangles(const mlod_bgm *g, int prefix);
  * MLOD_ERR_PARSE names the first problem. For tests. */
 mlod_result mlod_bgm_check(const mlod_bgm *g, mlod_error *err);
 
+/* Releases the arrays of a primitive made by mlod_bgm_extract and zeroes
+ * it. */
 void mlod_primitive_free(mlod_primitive *p);
 
 /* Maps a primitive's joint indices through map (map_count entries; old
  * joint -> new joint), merging influences that land on the same joint
- * and renormalising; at most 4 influences in set 0 for vertices that
- * change. Returns MLOD_ERR_INVALID_ARG when a weighted joint is outside
- * map. */
+ * (weights add up, so sums are unchanged) and writing them back into the
+ * same weight sets, largest first. Returns MLOD_ERR_INVALID_ARG when a
+ * weighted joint is outside map (the vertices before it are already
+ * remapped: check first when that matters). */
 mlod_result mlod_primitive_remap_joints(mlod_primitive *p, const int *map, int map_count, mlod_error *err);
 
 
