@@ -682,7 +682,7 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 		g->opt.cost = MLOD_COST_POSED;
 	if (g->opt.placement == MLOD_PLACE_DEFAULT)
 		g->opt.placement = g->opt.cost == MLOD_COST_POSED ? MLOD_PLACE_OPTIMAL : MLOD_PLACE_BARYCENTER;
-	if (g->opt.eligibility == MLOD_ELIGIBLE_DEFAULT) /* as measured: see bench/results-mesh.md */
+	if (g->opt.eligibility == MLOD_ELIGIBLE_DEFAULT) /* as measured: see bench/RESULTS.md */
 		g->opt.eligibility = g->opt.cost == MLOD_COST_POSED ? MLOD_ELIGIBLE_ALL : MLOD_ELIGIBLE_BEND;
 	if ((unsigned)g->opt.cost > MLOD_COST_POSED || (unsigned)g->opt.placement > MLOD_PLACE_OPTIMAL ||
 	    (unsigned)g->opt.eligibility > MLOD_ELIGIBLE_ALL || !(g->opt.tau >= 0.0) || !isfinite(g->opt.tau)) {

@@ -35,7 +35,7 @@
  *   (bisection on the threshold), or by an error bound (bisection on the
  *   threshold, accepting only thresholds whose level measures within the
  *   bound at every frame of the common timeline). Removal measured better
- *   than averaging (bench/results-motion.md) and is the default.
+ *   than averaging (bench/RESULTS.md) and is the default.
  * - The keys method (keyreduce.c) is driven from here the same way, with
  *   the error budget in place of the threshold.
  *
