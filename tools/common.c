@@ -173,15 +173,24 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 	free(tmp);
 }
 
-static int ends_with(const char *s, const char *suffix)
+int tool_ends_with(const char *s, const char *suffix)
 {
 	size_t a = strlen(s), b = strlen(suffix);
 	return a >= b && strcmp(s + a - b, suffix) == 0;
 }
 
+enum tool_report tool_parse_report(const char *format)
+{
+	if (!format || strcmp(format, "table") == 0)
+		return REPORT_TABLE;
+	if (strcmp(format, "json") == 0)
+		return REPORT_JSON;
+	tool_usage_error("--report: unknown format '%s' (table or json)", format);
+}
+
 void tool_write_gltf(const char *path, const mlod_gltf *doc)
 {
-	int binary = is_stdio(path) || !ends_with(path, ".gltf");
+	int binary = is_stdio(path) || !tool_ends_with(path, ".gltf");
 	void *data = NULL;
 	size_t size = 0;
 	mlod_error err = {0};

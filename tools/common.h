@@ -82,4 +82,14 @@ void tool_version(void)
 int tool_json_number(const char *json, const char *key, double *out);
 int tool_json_string_value(const char *json, const char *key, char *out, size_t size);
 
+/* What --report[=FORMAT] asked for. */
+enum tool_report { REPORT_NONE, REPORT_TABLE, REPORT_JSON };
+
+/* Parses the optional FORMAT of --report (NULL means table); exits 1 on an
+ * unknown format. */
+enum tool_report tool_parse_report(const char *format);
+
+/* Does s end with suffix? */
+int tool_ends_with(const char *s, const char *suffix);
+
 #endif

@@ -61,8 +61,6 @@ static const char usage_text[] =
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
 	"4 output failure.\n";
 
-enum report { REPORT_NONE, REPORT_TABLE, REPORT_JSON };
-
 /* One primitive of one instance. */
 struct part {
 	mlod_bgm *bgm;          /* NULL: left as it is */
@@ -932,7 +930,7 @@ int main(int argc, char **argv)
 	static const char *const placements[] = {"barycenter", "optimal"};
 	static const char *const rules[] = {"literal", "bend", "all"};
 	const char *output = NULL, *split = NULL;
-	enum report report = REPORT_NONE;
+	enum tool_report report = REPORT_NONE;
 	double ratios[MAX_LEVELS] = {0.5, 0.25, 0.1}, max_error = -1.0;
 	int ratio_count = 3, ratios_given = 0, ch;
 	struct job job;
@@ -943,14 +941,7 @@ int main(int argc, char **argv)
 	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:p:E:t:bs:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
-		case 'r':
-			if (!optarg || strcmp(optarg, "table") == 0)
-				report = REPORT_TABLE;
-			else if (strcmp(optarg, "json") == 0)
-				report = REPORT_JSON;
-			else
-				tool_usage_error("--report: unknown format '%s' (table or json)", optarg);
-			break;
+		case 'r': report = tool_parse_report(optarg); break;
 		case 'R':
 			ratio_count = parse_list("--ratios", optarg, ratios, 1e-6, 1.0);
 			ratios_given = 1;

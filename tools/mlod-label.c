@@ -39,8 +39,6 @@ static const char usage_text[] =
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
 	"4 output failure.\n";
 
-enum report { REPORT_NONE, REPORT_TABLE, REPORT_JSON };
-
 struct stats {
 	double avg_neighbors, avg_depth;
 	int count[5];
@@ -153,7 +151,7 @@ int main(int argc, char **argv)
 		{NULL, 0, NULL, 0},
 	};
 	const char *output = NULL;
-	enum report report = REPORT_NONE;
+	enum tool_report report = REPORT_NONE;
 	mlod_label_options opt = {1.9, PI};
 	int ch;
 
@@ -162,14 +160,7 @@ int main(int argc, char **argv)
 	while ((ch = getopt_long(argc, argv, ":o:r::hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
-		case 'r':
-			if (!optarg || strcmp(optarg, "table") == 0)
-				report = REPORT_TABLE;
-			else if (strcmp(optarg, "json") == 0)
-				report = REPORT_JSON;
-			else
-				tool_usage_error("--report: unknown format '%s' (table or json)", optarg);
-			break;
+		case 'r': report = tool_parse_report(optarg); break;
 		case 'H': opt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
 		case 'A': opt.max_angle = tool_parse_double("--max-angle", optarg, 1e-3, 1e6) * PI / 180.0; break;
 		case 'h': fputs(usage_text, stdout); return 0;

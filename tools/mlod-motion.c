@@ -55,7 +55,6 @@ static const char usage_text[] =
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
 	"4 output failure.\n";
 
-enum report { REPORT_NONE, REPORT_TABLE, REPORT_JSON };
 enum method { METHOD_AUTO = -1 };
 
 struct spec {
@@ -407,12 +406,6 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	tool_write_gltf(output, doc);
 }
 
-static int ends_with(const char *s, const char *suffix)
-{
-	size_t a = strlen(s), b = strlen(suffix);
-	return a >= b && strcmp(s + a - b, suffix) == 0;
-}
-
 int main(int argc, char **argv)
 {
 	static const struct option longopts[] = {
@@ -432,7 +425,7 @@ int main(int argc, char **argv)
 		{NULL, 0, NULL, 0},
 	};
 	const char *output = NULL;
-	enum report report = REPORT_NONE;
+	enum tool_report report = REPORT_NONE;
 	struct job job;
 	int level = -1, clip = 0, ch, kinds = 0, method_given = 0;
 	double point_distance = 0.0;
@@ -444,14 +437,7 @@ int main(int argc, char **argv)
 	while ((ch = getopt_long(argc, argv, ":o:r::m:e:t:k:l:c:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
-		case 'r':
-			if (!optarg || strcmp(optarg, "table") == 0)
-				report = REPORT_TABLE;
-			else if (strcmp(optarg, "json") == 0)
-				report = REPORT_JSON;
-			else
-				tool_usage_error("--report: unknown format '%s' (table or json)", optarg);
-			break;
+		case 'r': report = tool_parse_report(optarg); break;
 		case 'm':
 			method_given = 1;
 			if (strcmp(optarg, "frames") == 0)
@@ -505,7 +491,7 @@ int main(int argc, char **argv)
 	if (job.spec_count == 0)
 		job.spec_count = parse_list("--max-error", DEFAULT_MAX_ERROR, job.specs, MLOD_MOTION_MAX_ERROR, 0.0, 1e12);
 	qsort(job.specs, (size_t)job.spec_count, sizeof *job.specs, spec_order);
-	int bvh_out = output && ends_with(output, ".bvh");
+	int bvh_out = output && tool_ends_with(output, ".bvh");
 	if (level >= 0 && !bvh_out)
 		tool_usage_error("--level needs a .bvh output (-o out.bvh)");
 	if (report != REPORT_NONE && output)

@@ -49,8 +49,6 @@ static const char usage_text[] =
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
 	"4 output failure.\n";
 
-enum report { REPORT_NONE, REPORT_TABLE, REPORT_JSON };
-
 struct level {
 	mlod_skel_level skel;
 	mlod_character c;        /* the level as a standalone character */
@@ -318,12 +316,6 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	tool_write_gltf(output, doc);
 }
 
-static int ends_with(const char *s, const char *suffix)
-{
-	size_t a = strlen(s), b = strlen(suffix);
-	return a >= b && strcmp(s + a - b, suffix) == 0;
-}
-
 int main(int argc, char **argv)
 {
 	static const struct option longopts[] = {
@@ -340,7 +332,7 @@ int main(int argc, char **argv)
 		{NULL, 0, NULL, 0},
 	};
 	const char *output = NULL;
-	enum report report = REPORT_NONE;
+	enum tool_report report = REPORT_NONE;
 	double thresholds[MAX_LEVELS], fractions[MAX_LEVELS];
 	int threshold_count = 0, fraction_count = 0, level = -1, clip = 0;
 	double max_error = DEFAULT_MAX_ERROR;
@@ -352,14 +344,7 @@ int main(int argc, char **argv)
 	while ((ch = getopt_long(argc, argv, ":o:r::t:j:e:l:c:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
-		case 'r':
-			if (!optarg || strcmp(optarg, "table") == 0)
-				report = REPORT_TABLE;
-			else if (strcmp(optarg, "json") == 0)
-				report = REPORT_JSON;
-			else
-				tool_usage_error("--report: unknown format '%s' (table or json)", optarg);
-			break;
+		case 'r': report = tool_parse_report(optarg); break;
 		case 't': threshold_count = parse_list("--thresholds", optarg, thresholds, 0.0, 1e9); break;
 		case 'j': fraction_count = parse_list("--joints", optarg, fractions, 0.0, 1.0); break;
 		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 1e6); break;
@@ -376,7 +361,7 @@ int main(int argc, char **argv)
 		tool_usage_error("too many inputs: one file, or stdin");
 	if (threshold_count && fraction_count)
 		tool_usage_error("--thresholds and --joints do not go together");
-	int bvh_out = output && ends_with(output, ".bvh");
+	int bvh_out = output && tool_ends_with(output, ".bvh");
 	if (level >= 0 && !bvh_out)
 		tool_usage_error("--level needs a .bvh output (-o out.bvh)");
 	if (report != REPORT_NONE && output)
