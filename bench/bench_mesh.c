@@ -26,31 +26,13 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench.h"
 #include "mlod.h"
 
 #define DEG40 0.69813170f
 #define RUNS 5
 
 static const double ratios[3] = {0.5, 0.25, 0.1};
-
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-	qsort(v, (size_t)n, sizeof *v, cmp_double);
-	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 static const char *base_name(const char *path)
 {
@@ -170,7 +152,7 @@ struct mlod_stats {
 static double mlod_levels(const mlod_character *c, const mlod_bgm_options *base, struct levelset *L,
                           struct mlod_stats *st)
 {
-	double t0 = now();
+	double t0 = bench_now();
 	mlod_pose_set train = {0};
 	mlod_bgm_options opt = *base;
 	if (!(opt.cost == MLOD_COST_COMPACTNESS && opt.placement == MLOD_PLACE_BARYCENTER)) {
@@ -210,14 +192,14 @@ static double mlod_levels(const mlod_character *c, const mlod_bgm_options *base,
 	free(eta);
 	mlod_pose_set_free(&train);
 	levelset_count(L);
-	return now() - t0;
+	return bench_now() - t0;
 }
 
 /* meshopt_simplify on each primitive, each level from the full mesh (as
  * gltfpack does), no error limit so the triangle target decides. */
 static double meshopt_levels(const mlod_character *c, struct levelset *L)
 {
-	double t0 = now();
+	double t0 = bench_now();
 	for (int i = 0; i < L->instances; i++) {
 		if (c->instances[i].skin < 0 && c->instances[i].joint < 0)
 			continue;
@@ -247,7 +229,7 @@ static double meshopt_levels(const mlod_character *c, struct levelset *L)
 		}
 	}
 	levelset_count(L);
-	return now() - t0;
+	return bench_now() - t0;
 }
 
 /* ---------------------------------------------------------------- */
@@ -341,7 +323,7 @@ static void table1(int argc, char **argv)
 				collapses = st.collapses;
 			}
 			printf("| %s | %d | %s | %.2f | %.3f | %d | %s | %s |\n", base_name(argv[a]), T,
-			       cost ? "compactness (paper)" : "posed (default)", median(build, RUNS), median(decim, RUNS), collapses,
+			       cost ? "compactness (paper)" : "posed (default)", bench_median(build, RUNS), bench_median(decim, RUNS), collapses,
 			       "142 ms (982 tris), 7.7-8.8 s (7186), 11.6 s (6656)", "1-12 ms");
 		}
 		mlod_character_free(&c);
@@ -379,7 +361,7 @@ static void speed(int argc, char **argv)
 				levelset_free(&L);
 			}
 		}
-		double tp = median(t[0], RUNS), tc = median(t[1], RUNS), tm = median(t[2], RUNS);
+		double tp = bench_median(t[0], RUNS), tc = bench_median(t[1], RUNS), tm = bench_median(t[2], RUNS);
 		printf("| %s | %d | %.1f | %.1f | %.2f | %.0fx | %.0fx |\n", base_name(argv[a]), T, tp, tc, tm, tp / tm, tc / tm);
 		mlod_character_free(&c);
 	}

@@ -28,29 +28,11 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench.h"
 #include "mlod.h"
 
 #define MAX_PEERS 8
 #define SPEED_RUNS 5
-
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-	qsort(v, (size_t)n, sizeof *v, cmp_double);
-	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 static void *read_all(const char *path, size_t *size)
 {
@@ -417,7 +399,7 @@ static int cmd_speed(int argc, char **argv)
 		for (int v = 0; v < 3; v++) {
 			double runs[SPEED_RUNS];
 			for (int r = 0; r < SPEED_RUNS; r++) {
-				double t0 = now();
+				double t0 = bench_now();
 				for (int k = 0; k < c.clip_count; k++)
 					for (int m = 0; m < 2; m++) {
 						if (v < 2 && m != v)
@@ -436,9 +418,9 @@ static int cmd_speed(int argc, char **argv)
 						}
 						mlod_motion_free(mo);
 					}
-				runs[r] = now() - t0;
+				runs[r] = bench_now() - t0;
 			}
-			double t = median(runs, SPEED_RUNS);
+			double t = bench_median(runs, SPEED_RUNS);
 			printf("| %s | %d | %ld | %d | %s | %.1f | %.1f | %.0f |\n", base_name(argv[i]), c.clip_count, frames,
 			       c.skeleton.joint_count, names[v], 1000.0 * t / c.clip_count, c.clip_count / t, (double)frames / t);
 		}

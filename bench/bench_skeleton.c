@@ -17,26 +17,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench.h"
 #include "mlod.h"
-
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-	qsort(v, (size_t)n, sizeof *v, cmp_double);
-	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 static int load(const char *path, mlod_character *c)
 {
@@ -95,9 +77,9 @@ static int bench_graph(int argc, char **argv)
 			mlod_skelgraph g;
 			mlod_skel_level levels[3];
 			mlod_error err = {0};
-			double t0 = now();
+			double t0 = bench_now();
 			mlod_label_skeleton(&c, NULL, info, &err);
-			double t1 = now();
+			double t1 = bench_now();
 			int *order = malloc(sizeof(int) * (size_t)n);
 			int minors = mlod_skel_removal_order(&c.skeleton, info, order);
 			mlod_skelgraph_build(&c.skeleton, info, &g, &err);
@@ -105,7 +87,7 @@ static int bench_graph(int argc, char **argv)
 				int removed = (int)lround(0.13 * (k + 1) * n);
 				mlod_skelgraph_extract_first(&g, info, order, removed < minors ? removed : minors, &levels[k], &err);
 			}
-			double t2 = now();
+			double t2 = bench_now();
 			free(order);
 			tl[r] = t1 - t0;
 			tg[r] = t2 - t1;
@@ -116,7 +98,7 @@ static int bench_graph(int argc, char **argv)
 		}
 		const char *name = strrchr(argv[i], '/');
 		printf("| %s | %d | %d | %.3f | %.4f | %d |\n", name ? name + 1 : argv[i], n, c.clip_count,
-		       1e3 * median(tl, reps), 1e3 * median(tg, reps), edges);
+		       1e3 * bench_median(tl, reps), 1e3 * bench_median(tg, reps), edges);
 		free(info);
 		mlod_character_free(&c);
 	}
@@ -150,7 +132,7 @@ static double crowd_frame(const mlod_character *c, int count, int frames)
 	mlod_mat4 *palette = malloc(sizeof *palette * (size_t)n);
 	volatile float sink = 0.0f;
 	inverse_binds(c, ibm);
-	double t0 = now();
+	double t0 = bench_now();
 	for (int f = 0; f < frames; f++) {
 		for (int i = 0; i < count; i++) {
 			float t = fmodf((float)f / 60.0f + 0.37f * (float)i, clip->duration > 0 ? clip->duration : 1.0f);
@@ -162,7 +144,7 @@ static double crowd_frame(const mlod_character *c, int count, int frames)
 			sink += palette[n - 1].m[12];
 		}
 	}
-	double dt = (now() - t0) / frames;
+	double dt = (bench_now() - t0) / frames;
 	(void)sink;
 	free(local);
 	free(world);
@@ -198,7 +180,7 @@ static int bench_crowd(const char *path)
 			full[r] = crowd_frame(&c, count, frames);
 			lvl[r] = crowd_frame(&lod, count, frames);
 		}
-		double a = median(full, 5), b = median(lvl, 5);
+		double a = bench_median(full, 5), b = bench_median(lvl, 5);
 		printf("| %d | %.4f | %.4f | %.2fx |\n", count, 1e3 * a, 1e3 * b, a / b);
 	}
 	for (int k = 0; k < 3; k++)
