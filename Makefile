@@ -44,6 +44,9 @@ UNIT := $(UNIT_SRC:tests/unit/%.c=$(B)/tests/%)
 HELPERS := $(patsubst tests/helpers/%.c,$(B)/tests/helpers/%,$(wildcard tests/helpers/*.c))
 BENCH := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
 
+# Keep object files that pattern chains would treat as intermediate.
+.SECONDARY:
+
 .PHONY: all lib tools unit test test-extended test-unit test-sanitize bench demo install clean samples
 
 all: $(B)/libmlod.a $(if $(RT_OBJ),$(B)/libmlodrt.a) $(TOOLS)
