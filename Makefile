@@ -47,7 +47,7 @@ BENCH := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
 # Keep object files that pattern chains would treat as intermediate.
 .SECONDARY:
 
-.PHONY: all lib tools unit test test-extended test-unit test-sanitize bench demo install clean samples
+.PHONY: all unit test test-extended bench demo install clean samples
 
 all: $(B)/libmlod.a $(if $(RT_OBJ),$(B)/libmlodrt.a) $(TOOLS)
 
