@@ -16,29 +16,6 @@
 
 #include "bgm.h"
 
-void mlod_primitive_free(mlod_primitive *p)
-{
-	if (!p)
-		return;
-	free(p->positions);
-	free(p->normals);
-	free(p->tangents);
-	for (int i = 0; i < MLOD_MAX_SETS; i++) {
-		free(p->uvs[i]);
-		free(p->colors[i]);
-		free(p->joints[i]);
-		free(p->weights[i]);
-	}
-	free(p->indices);
-	for (int t = 0; p->targets && t < p->target_count; t++) {
-		free(p->targets[t].positions);
-		free(p->targets[t].normals);
-		free(p->targets[t].tangents);
-	}
-	free(p->targets);
-	memset(p, 0, sizeof *p);
-}
-
 static int live_at(const bgm_face *f, int prefix)
 {
 	return f->birth <= prefix && f->death > prefix;

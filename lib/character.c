@@ -13,8 +13,10 @@
 
 #include "mlod.h"
 
-static void primitive_free(mlod_primitive *p)
+void mlod_primitive_free(mlod_primitive *p)
 {
+	if (!p)
+		return;
 	free(p->positions);
 	free(p->normals);
 	free(p->tangents);
@@ -31,6 +33,7 @@ static void primitive_free(mlod_primitive *p)
 		free(p->targets[t].tangents);
 	}
 	free(p->targets);
+	memset(p, 0, sizeof *p);
 }
 
 void mlod_character_free(mlod_character *c)
@@ -49,7 +52,7 @@ void mlod_character_free(mlod_character *c)
 	free(s->skins);
 	for (int m = 0; c->meshes && m < c->mesh_count; m++) {
 		for (int p = 0; c->meshes[m].primitives && p < c->meshes[m].primitive_count; p++)
-			primitive_free(&c->meshes[m].primitives[p]);
+			mlod_primitive_free(&c->meshes[m].primitives[p]);
 		free(c->meshes[m].primitives);
 		free(c->meshes[m].name);
 	}

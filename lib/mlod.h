@@ -261,6 +261,9 @@ typedef struct mlod_character {
 /* Releases everything the character owns and zeroes it. */
 void mlod_character_free(mlod_character *c);
 
+/* Releases a primitive's arrays and zeroes it (NULL is allowed). */
+void mlod_primitive_free(mlod_primitive *p);
+
 /* Checks the invariants (parent order, index ranges, finite values,
  * increasing key times, weights in range). Returns MLOD_ERR_PARSE with a
  * message naming the first problem. */
@@ -814,10 +817,6 @@ int mlod_bgm_triangles(const mlod_bgm *g, int prefix);
  * incidence lists, manifold fans at every node that was not locked);
  * MLOD_ERR_PARSE names the first problem. For tests. */
 mlod_result mlod_bgm_check(const mlod_bgm *g, mlod_error *err);
-
-/* Releases the arrays of a primitive made by mlod_bgm_extract and zeroes
- * it. */
-void mlod_primitive_free(mlod_primitive *p);
 
 /* Maps a primitive's joint indices through map (map_count entries; old
  * joint -> new joint), merging influences that land on the same joint

@@ -362,3 +362,21 @@ int tool_json_string_value(const char *json, const char *key, char *out, size_t 
 		return 0;
 	return json_string(p, out, size) ? 1 : -1;
 }
+
+int tool_parse_list(const char *option, const char *value, double *out, int max, double lo, double hi)
+{
+	int n = 0;
+	char *copy = malloc(strlen(value) + 1);
+	if (!copy)
+		tool_die(EXIT_USAGE, NULL, "out of memory");
+	strcpy(copy, value);
+	for (char *tok = strtok(copy, ","); tok; tok = strtok(NULL, ",")) {
+		if (n == max)
+			tool_usage_error("%s: at most %d values", option, max);
+		out[n++] = tool_parse_double(option, tok, lo, hi);
+	}
+	free(copy);
+	if (n == 0)
+		tool_usage_error("%s: empty list", option);
+	return n;
+}

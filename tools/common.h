@@ -92,4 +92,9 @@ enum tool_report tool_parse_report(const char *format);
 /* Does s end with suffix? */
 int tool_ends_with(const char *s, const char *suffix);
 
+/* Parses a comma-separated list of at most max numbers within [lo, hi]
+ * into out; exits 1 naming the option when it is empty, too long or holds
+ * something else. Returns the count. */
+int tool_parse_list(const char *option, const char *value, double *out, int max, double lo, double hi);
+
 #endif

@@ -113,23 +113,6 @@ static void note(struct job *job, const char *fmt, ...)
 	va_end(ap);
 }
 
-static int parse_list(const char *option, const char *value, double *out, double lo, double hi)
-{
-	int n = 0;
-	char *copy = strdup(value);
-	if (!copy)
-		tool_die(EXIT_USAGE, NULL, "out of memory");
-	for (char *tok = strtok(copy, ","); tok; tok = strtok(NULL, ",")) {
-		if (n == MAX_LEVELS)
-			tool_usage_error("%s: at most %d levels", option, MAX_LEVELS);
-		out[n++] = tool_parse_double(option, tok, lo, hi);
-	}
-	free(copy);
-	if (n == 0)
-		tool_usage_error("%s: empty list", option);
-	return n;
-}
-
 static int double_desc(const void *a, const void *b)
 {
 	double x = *(const double *)a, y = *(const double *)b;
@@ -943,7 +926,7 @@ int main(int argc, char **argv)
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
 		case 'R':
-			ratio_count = parse_list("--ratios", optarg, ratios, 1e-6, 1.0);
+			ratio_count = tool_parse_list("--ratios", optarg, ratios, MAX_LEVELS, 1e-6, 1.0);
 			ratios_given = 1;
 			break;
 		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;

@@ -73,23 +73,6 @@ struct job {
 	struct level levels[MAX_LEVELS];
 };
 
-static int parse_list(const char *option, const char *value, double *out, double lo, double hi)
-{
-	int n = 0;
-	char *copy = strdup(value);
-	if (!copy)
-		tool_die(EXIT_USAGE, NULL, "out of memory");
-	for (char *tok = strtok(copy, ","); tok; tok = strtok(NULL, ",")) {
-		if (n == MAX_LEVELS)
-			tool_usage_error("%s: at most %d levels", option, MAX_LEVELS);
-		out[n++] = tool_parse_double(option, tok, lo, hi);
-	}
-	free(copy);
-	if (n == 0)
-		tool_usage_error("%s: empty list", option);
-	return n;
-}
-
 /* Takes labels and energies from mlod-label's extras when every joint
  * node has them; returns 1 when it did. */
 static int labels_from_extras(mlod_gltf *doc, const mlod_character *c, mlod_joint_info *info)
@@ -345,8 +328,8 @@ int main(int argc, char **argv)
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
-		case 't': threshold_count = parse_list("--thresholds", optarg, thresholds, 0.0, 1e9); break;
-		case 'j': fraction_count = parse_list("--joints", optarg, fractions, 0.0, 1.0); break;
+		case 't': threshold_count = tool_parse_list("--thresholds", optarg, thresholds, MAX_LEVELS, 0.0, 1e9); break;
+		case 'j': fraction_count = tool_parse_list("--joints", optarg, fractions, MAX_LEVELS, 0.0, 1.0); break;
 		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 1e6); break;
 		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
 		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
