@@ -323,7 +323,7 @@ static void table1(int argc, char **argv)
 				collapses = st.collapses;
 			}
 			printf("| %s | %d | %s | %.2f | %.3f | %d | %s | %s |\n", base_name(argv[a]), T,
-			       cost ? "compactness (paper)" : "posed (default)", bench_median(build, RUNS), bench_median(decim, RUNS), collapses,
+			       cost ? "compactness, triangle (paper)" : "posed, edge (default)", bench_median(build, RUNS), bench_median(decim, RUNS), collapses,
 			       "142 ms (982 tris), 7.7-8.8 s (7186), 11.6 s (6656)", "1-12 ms");
 		}
 		mlod_character_free(&c);
@@ -384,10 +384,12 @@ static void quality(int argc, char **argv)
 		return;
 	const char *name = base_name(argv[0]);
 	struct method methods[] = {
-		{"mlod posed, optimal, all (default)", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .eligibility = MLOD_ELIGIBLE_ALL}},
-		{"mlod posed, optimal, bend", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .eligibility = MLOD_ELIGIBLE_BEND}},
-		{"mlod posed, optimal, literal", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .eligibility = MLOD_ELIGIBLE_LITERAL}},
-		{"mlod posed, barycenter, all", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_BARYCENTER, .eligibility = MLOD_ELIGIBLE_ALL}},
+		{"mlod posed, optimal, all, edge (default)", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_ALL}},
+		{"mlod posed, optimal, all, mixed", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .op = MLOD_OP_MIXED, .eligibility = MLOD_ELIGIBLE_ALL}},
+		{"mlod posed, optimal, all, triangle", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .op = MLOD_OP_TRIANGLE, .eligibility = MLOD_ELIGIBLE_ALL}},
+		{"mlod posed, optimal, bend, edge", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_BEND}},
+		{"mlod posed, optimal, literal, edge", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_LITERAL}},
+		{"mlod posed, barycenter, all, edge", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_BARYCENTER, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_ALL}},
 		{"mlod compactness, barycenter, bend (paper)", 0, {.cost = MLOD_COST_COMPACTNESS, .placement = MLOD_PLACE_BARYCENTER, .eligibility = MLOD_ELIGIBLE_BEND}},
 		{"mlod compactness, barycenter, literal", 0, {.cost = MLOD_COST_COMPACTNESS, .placement = MLOD_PLACE_BARYCENTER, .eligibility = MLOD_ELIGIBLE_LITERAL}},
 		{"mlod compactness, barycenter, all", 0, {.cost = MLOD_COST_COMPACTNESS, .placement = MLOD_PLACE_BARYCENTER, .eligibility = MLOD_ELIGIBLE_ALL}},

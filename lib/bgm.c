@@ -684,8 +684,15 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 		g->opt.placement = g->opt.cost == MLOD_COST_POSED ? MLOD_PLACE_OPTIMAL : MLOD_PLACE_BARYCENTER;
 	if (g->opt.eligibility == MLOD_ELIGIBLE_DEFAULT) /* as measured: see bench/RESULTS.md */
 		g->opt.eligibility = g->opt.cost == MLOD_COST_POSED ? MLOD_ELIGIBLE_ALL : MLOD_ELIGIBLE_BEND;
+	if (g->opt.op == MLOD_OP_DEFAULT)
+		g->opt.op = g->opt.cost == MLOD_COST_POSED ? MLOD_OP_EDGE : MLOD_OP_TRIANGLE;
+	if (g->opt.op != MLOD_OP_TRIANGLE && g->opt.cost != MLOD_COST_POSED) {
+		free(g);
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "edge collapses need the posed cost");
+	}
 	if ((unsigned)g->opt.cost > MLOD_COST_POSED || (unsigned)g->opt.placement > MLOD_PLACE_OPTIMAL ||
-	    (unsigned)g->opt.eligibility > MLOD_ELIGIBLE_ALL || !(g->opt.tau >= 0.0) || !isfinite(g->opt.tau)) {
+	    (unsigned)g->opt.op > MLOD_OP_MIXED || (unsigned)g->opt.eligibility > MLOD_ELIGIBLE_ALL ||
+	    !(g->opt.tau >= 0.0) || !isfinite(g->opt.tau)) {
 		free(g);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_bgm_build: bad options");
 	}
@@ -753,8 +760,9 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->records);
 	free(g->removed);
 	free(g->quadric);
+	free(g->qsum);
 	free(g->skin);
-	free(g->blocked);
+	free(g->opstate);
 	bgm_heap_free(g->heap);
 	free(g);
 }

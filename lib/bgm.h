@@ -95,6 +95,7 @@ struct mlod_bgm {
 	int pose_count;
 	double *quadric;
 	float *skin;
+	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
 
 	/* Statistics. */
 	int input_vertices, input_triangles, dropped, border_edges, nonmanifold_edges;
@@ -104,8 +105,8 @@ struct mlod_bgm {
 
 	/* Collapse state (collapse.c). */
 	struct bgm_heap *heap;
-	unsigned char *blocked; /* per face: refused when last looked at */
-	int blocked_cap;
+	unsigned char *opstate; /* per face and op (collapse.c): refused when last looked at, queued */
+	int opstate_cap;
 };
 
 /* bgm.c */

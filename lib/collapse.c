@@ -45,9 +45,16 @@
 #define DEGENERATE 1e-3     /* compactness under which a new face counts as degenerate */
 #define TIE_WEIGHT 1e-5     /* compactness tie-break of the posed cost */
 
+/* An operation on a face: collapse the triangle, or one of its edges. */
+#define OP_TRIANGLE 3       /* ops 0..2: the edge (n[op], n[(op + 1) % 3]) */
+#define BLOCKED(op) (1u << (op))       /* opstate: refused when last planned */
+#define QUEUED(op) (16u << (op))       /* opstate: has an entry in the heap */
+#define ALL_BLOCKED 15u
+
 typedef struct heap_entry {
 	double key;
 	int face;
+	int op;
 } heap_entry;
 
 struct bgm_heap {
@@ -64,15 +71,16 @@ void bgm_heap_free(struct bgm_heap *h)
 
 static int entry_less(const heap_entry *a, const heap_entry *b)
 {
-	return a->key < b->key || (a->key == b->key && a->face < b->face);
+	return a->key < b->key ||
+	       (a->key == b->key && (a->face < b->face || (a->face == b->face && a->op < b->op)));
 }
 
-static int heap_push(struct bgm_heap *h, double key, int face)
+static int heap_push(struct bgm_heap *h, double key, int face, int op)
 {
 	if (bgm_grow((void **)&h->e, &h->cap, h->count + 1, sizeof *h->e))
 		return -1;
 	int i = h->count++;
-	heap_entry x = {key, face};
+	heap_entry x = {key, face, op};
 	while (i > 0) {
 		int p = (i - 1) / 2;
 		if (!entry_less(&x, &h->e[p]))
@@ -108,8 +116,9 @@ static heap_entry heap_pop(struct bgm_heap *h)
 /* Everything a collapse needs, worked out by plan() and applied by
  * apply(). */
 struct plan {
-	int t;
-	int v[3];                   /* a, b, c */
+	int t, op;                  /* face t, OP_TRIANGLE or the edge */
+	int k;                      /* 3 (a, b, c) or 2 (the edge a, b) */
+	int v[3];                   /* a, b, c (v[2] = -1 for an edge) */
 	int nf, faces[MAX_PATCH];   /* the patch */
 	int nr, removed[MAX_PATCH]; /* faces with two or more of a, b, c */
 	int nk, kept[MAX_PATCH];    /* the others, re-meshed around v-bar */
@@ -130,6 +139,15 @@ static int find(int *parent, int i)
 	while (parent[i] != i)
 		i = parent[i] = parent[parent[i]];
 	return i;
+}
+
+/* Which of the collapsed vertices node n is (0 .. k-1), or -1. */
+static int owner_of(const struct plan *pl, int n)
+{
+	for (int i = 0; i < pl->k; i++)
+		if (pl->v[i] == n)
+			return i;
+	return -1;
 }
 
 static int wedge_slot(const struct plan *pl, int w)
@@ -237,26 +255,51 @@ static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x
 	return 1;
 }
 
-/* Works out the collapse of face t; returns 1 when it is valid (pl holds
+/* The weights of x projected onto segment (a, b), clamped into it. */
+static void segment_weights(const double *a, const double *b, const double *x, double *l)
+{
+	double d = 0.0, len2 = 0.0;
+	for (int i = 0; i < 3; i++) {
+		d += (x[i] - a[i]) * (b[i] - a[i]);
+		len2 += (b[i] - a[i]) * (b[i] - a[i]);
+	}
+	double s = len2 > 0.0 ? d / len2 : 0.5;
+	s = s < 0.0 ? 0.0 : s > 1.0 ? 1.0 : s;
+	l[0] = 1.0 - s, l[1] = s, l[2] = 0.0;
+}
+
+/* Half the squared norm of the normal: the squared area of (a, b, c). */
+static double area_sq(const double *a, const double *b, const double *c)
+{
+	double n[3];
+	face_normal(a, b, c, n);
+	return 0.25 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+/* Works out operation op on face t (its triangle collapse, or the
+ * collapse of one of its edges); returns 1 when it is valid (pl holds
  * the cheapest valid placement), else 0. */
-static int plan(mlod_bgm *g, int t, struct plan *pl)
+static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
 {
 	const bgm_face *T = &g->faces[t];
 	int allow_border = g->opt.allow_border;
 	if (T->death != BGM_ALIVE)
 		return 0;
 	pl->t = t;
-	for (int i = 0; i < 3; i++) {
-		int v = pl->v[i] = T->n[i];
+	pl->op = op;
+	pl->k = op == OP_TRIANGLE ? 3 : 2;
+	pl->v[2] = -1;
+	for (int i = 0; i < pl->k; i++) {
+		int v = pl->v[i] = T->n[op == OP_TRIANGLE ? i : (op + i) % 3];
 		int fl = g->nodes[v].flags;
 		if ((fl & (BGM_LOCKED | BGM_DEAD)) || !(fl & BGM_ELIGIBLE) || (!allow_border && (fl & BGM_BORDER)))
 			return 0;
 	}
-	int a = pl->v[0], b = pl->v[1], c = pl->v[2];
+	int K = pl->k;
 
 	/* The patch. */
 	pl->nf = pl->nr = pl->nk = 0;
-	for (int i = 0; i < 3; i++) {
+	for (int i = 0; i < K; i++) {
 		const bgm_node *n = &g->nodes[pl->v[i]];
 		for (int k = 0; k < n->inc_count; k++) {
 			int f = g->inc[n->inc_first + k], seen = 0;
@@ -274,7 +317,7 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 		const bgm_face *f = &g->faces[pl->faces[j]];
 		int in = 0, corner = -1;
 		for (int k = 0; k < 3; k++)
-			if (f->n[k] == a || f->n[k] == b || f->n[k] == c)
+			if (owner_of(pl, f->n[k]) >= 0)
 				in++, corner = k;
 		if (in == 3)
 			all3++;
@@ -287,11 +330,11 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 		to[pl->nk] = f->n[(corner + 2) % 3];
 		pl->kept[pl->nk++] = pl->faces[j];
 	}
-	if (all3 != 1 || pl->nk == 0)
+	if ((K == 3 && all3 != 1) || pl->nk == 0)
 		return 0;
-	/* Each edge of t has one face across at most (two faces in all). */
-	for (int e = 0; e < 3; e++) {
-		int x = pl->v[e], y = pl->v[(e + 1) % 3], count = 0;
+	/* Each collapsed edge has at most two faces (t and one across). */
+	for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
+		int x = pl->v[e], y = pl->v[(e + 1) % K], count = 0;
 		for (int j = 0; j < pl->nr; j++) {
 			const bgm_face *f = &g->faces[pl->removed[j]];
 			int hx = f->n[0] == x || f->n[1] == x || f->n[2] == x;
@@ -301,8 +344,8 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 		if (count > 2)
 			return 0;
 	}
-	int border = 0, special[3];
-	for (int i = 0; i < 3; i++) {
+	int border = 0, special[3] = {0, 0, 0};
+	for (int i = 0; i < K; i++) {
 		int fb = (g->nodes[pl->v[i]].flags & BGM_BORDER) != 0, texture;
 		node_seams(g, pl->v[i], &texture, &pl->hard[i]);
 		border |= fb;
@@ -312,13 +355,14 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 	if (!bgm_link_ok(from, to, pl->nk, border))
 		return 0;
 
-	/* Wedge groups: wedges of a, b and c joined through removed faces. */
+	/* Wedge groups: wedges of the collapsed vertices joined through
+	 * removed faces. */
 	int parent[MAX_WEDGES], owner[MAX_WEDGES];
 	pl->nw = 0;
 	for (int j = 0; j < pl->nf; j++) {
 		const bgm_face *f = &g->faces[pl->faces[j]];
 		for (int k = 0; k < 3; k++) {
-			int o = f->n[k] == a ? 0 : f->n[k] == b ? 1 : f->n[k] == c ? 2 : -1;
+			int o = owner_of(pl, f->n[k]);
 			if (o < 0 || wedge_slot(pl, f->w[k]) >= 0)
 				continue;
 			if (pl->nw == MAX_WEDGES)
@@ -351,7 +395,7 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 			root_group[r] = pl->ngroups++;
 		pl->group[i] = root_group[r];
 	}
-	/* Per group, how many wedges each of a, b, c has there. */
+	/* Per group, how many wedges each collapsed vertex has there. */
 	int per[MAX_WEDGES][3];
 	memset(per, 0, sizeof per);
 	for (int i = 0; i < pl->nw; i++)
@@ -360,23 +404,40 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 	/* Candidate placements. */
 	double cand[MAX_CANDIDATES][3];
 	int cand_snap[MAX_CANDIDATES], nc = 0;
-	const double *P[3] = {g->nodes[a].p, g->nodes[b].p, g->nodes[c].p};
+	const double *P[3] = {g->nodes[pl->v[0]].p, g->nodes[pl->v[1]].p, K == 3 ? g->nodes[pl->v[2]].p : NULL};
 	double bary[3];
-	for (int i = 0; i < 3; i++)
-		bary[i] = (P[0][i] + P[1][i] + P[2][i]) / 3.0;
+	for (int i = 0; i < 3; i++) {
+		bary[i] = 0.0;
+		for (int j = 0; j < K; j++)
+			bary[i] += P[j][i] / K;
+	}
 	mlod_v3 V[3];
-	for (int i = 0; i < 3; i++)
-		V[i] = (mlod_v3){(float)P[i][0], (float)P[i][1], (float)P[i][2]};
-	mlod_influences in3[3] = {g->inf[a], g->inf[b], g->inf[c]};
+	mlod_influences in3[3];
+	for (int j = 0; j < K; j++) {
+		V[j] = (mlod_v3){(float)P[j][0], (float)P[j][1], (float)P[j][2]};
+		in3[j] = g->inf[pl->v[j]];
+	}
+	/* The summed posed quadrics of the collapsed vertices, and their area
+	 * (the normaliser of the posed cost). */
+	double *Q = g->qsum, wsum = 0.0;
+	if (g->pose_count > 0) {
+		for (int k = 0; k < 10 * g->pose_count; k++) {
+			Q[k] = 0.0;
+			for (int j = 0; j < K; j++)
+				Q[k] += g->quadric[((size_t)pl->v[j] * (size_t)g->pose_count) * 10 + (size_t)k];
+		}
+		for (int p = 0; p < g->pose_count; p++)
+			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+	}
 	if (special[0] || special[1] || special[2]) {
 		/* Snap onto a seam (or border) vertex that keeps every wedge group
 		 * whole. Border vertices must stay on the border. */
-		for (int s = 0; s < 3; s++) {
+		for (int s = 0; s < K; s++) {
 			if (!special[s] || (border && !(g->nodes[pl->v[s]].flags & BGM_BORDER)))
 				continue;
 			int ok = 1;
 			for (int k = 0; k < pl->ngroups && ok; k++)
-				for (int o = 0; o < 3; o++)
+				for (int o = 0; o < K; o++)
 					if ((o == s && per[k][o] != 1) || per[k][o] > 1)
 						ok = 0;
 			if (!ok)
@@ -387,21 +448,17 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 	} else {
 		if (g->opt.placement == MLOD_PLACE_OPTIMAL && g->pose_count > 0) {
 			mlod_influences w;
-			double q[10 * 64], opt[3];
-			double *Q = g->pose_count <= 64 ? q : malloc(sizeof(double) * 10 * (size_t)g->pose_count);
-			if (Q) {
-				for (int k = 0; k < 10 * g->pose_count; k++)
-					Q[k] = g->quadric[((size_t)a * (size_t)g->pose_count) * 10 + (size_t)k] +
-					       g->quadric[((size_t)b * (size_t)g->pose_count) * 10 + (size_t)k] +
-					       g->quadric[((size_t)c * (size_t)g->pose_count) * 10 + (size_t)k];
-				mlod_power_skin(V, in3, 3, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
+			double opt[3];
+			{
+				mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
 				if (bgm_quadric_optimum(g, Q, &w, bary, opt) == 0) {
-					/* Stay near t: at most its longest edge from the barycenter. */
+					/* Stay near the collapsed vertices: at most their
+					 * longest edge from the barycenter. */
 					double lmax = 0.0, d = 0.0;
-					for (int e = 0; e < 3; e++) {
+					for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
 						double l = 0.0;
 						for (int i = 0; i < 3; i++)
-							l += (P[e][i] - P[(e + 1) % 3][i]) * (P[e][i] - P[(e + 1) % 3][i]);
+							l += (P[e][i] - P[(e + 1) % K][i]) * (P[e][i] - P[(e + 1) % K][i]);
 						lmax = fmax(lmax, l);
 					}
 					for (int i = 0; i < 3; i++)
@@ -411,8 +468,12 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 						cand_snap[nc++] = -1;
 					}
 				}
-				if (Q != q)
-					free(Q);
+			}
+			/* An edge may also go to either end (a half-edge collapse),
+			 * with that end's attributes. */
+			for (int s = 0; s < K && K == 2; s++) {
+				memcpy(cand[nc], P[s], sizeof cand[nc]);
+				cand_snap[nc++] = -1;
 			}
 		}
 		memcpy(cand[nc], bary, sizeof cand[nc]);
@@ -420,19 +481,25 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 	}
 
 	/* The cheapest valid candidate; with the compactness cost (the same
-	 * for every placement), the one nearest the barycenter. */
+	 * for every placement), the one nearest the barycenter. The
+	 * compactness tie-break of the posed cost is t's own for a triangle,
+	 * the mean over the removed faces for an edge. */
 	int best = -1;
-	double area2 = 0.0, comp = bgm_compactness(P[0], P[1], P[2]), best_d = 0.0;
-	{
-		double n[3];
-		face_normal(P[0], P[1], P[2], n);
-		area2 = 0.25 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+	double best_d = 0.0, tie = 0.0;
+	if (K == 3) {
+		tie = sqrt(area_sq(P[0], P[1], P[2])) * (1.0 - bgm_compactness(P[0], P[1], P[2]));
+	} else {
+		for (int j = 0; j < pl->nr; j++) {
+			const bgm_face *f = &g->faces[pl->removed[j]];
+			const double *a = g->nodes[f->n[0]].p, *b = g->nodes[f->n[1]].p, *c = g->nodes[f->n[2]].p;
+			tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / pl->nr;
+		}
 	}
 	for (int k = 0; k < nc; k++) {
 		if (!geometry_ok(g, pl, cand[k]))
 			continue;
 		mlod_influences w;
-		int capped = mlod_power_skin(V, in3, 3, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+		int capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double cost, d = 0.0;
@@ -441,18 +508,14 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 		if (g->opt.cost == MLOD_COST_POSED) {
 			/* Area-normalised (a mean squared distance), so small
 			 * features count as much as large ones. */
-			double e = 0.0, wsum = 0.0;
-			for (int i = 0; i < 3; i++) {
-				const double *q = g->quadric + (size_t)pl->v[i] * (size_t)g->pose_count * 10;
-				e += bgm_quadric_error(g, q, &w, cand[k]);
-				for (int p = 0; p < g->pose_count; p++)
-					wsum += q[10 * p] + q[10 * p + 4] + q[10 * p + 7];
-			}
-			cost = (wsum > 0.0 ? e / wsum : 0.0) + TIE_WEIGHT * sqrt(area2) * (1.0 - comp);
+			double e = g->pose_count > 0 ? bgm_quadric_error(g, Q, &w, cand[k]) : 0.0;
+			cost = (wsum > 0.0 ? e / wsum : 0.0) + TIE_WEIGHT * tie;
+			if (g->opt.op == MLOD_OP_MIXED) /* per removed face: triangles and edges compete */
+				cost /= pl->nr;
 			if (best >= 0 && !(cost < pl->cost))
 				continue;
 		} else {
-			cost = comp;
+			cost = bgm_compactness(P[0], P[1], P[2]);
 			if (best >= 0 && !(d < best_d))
 				continue;
 		}
@@ -469,8 +532,10 @@ static int plan(mlod_bgm *g, int t, struct plan *pl)
 	if (pl->snap >= 0) {
 		pl->lambda[0] = pl->lambda[1] = pl->lambda[2] = 0.0;
 		pl->lambda[pl->snap] = 1.0;
-	} else {
+	} else if (K == 3) {
 		barycentric(P[0], P[1], P[2], pl->pos, pl->lambda);
+	} else {
+		segment_weights(P[0], P[1], pl->pos, pl->lambda);
 	}
 	return 1;
 }
@@ -514,37 +579,65 @@ static void interpolate_wedge(mlod_bgm *g, int out, const int *w, const double *
 
 static int grow_face_arrays(mlod_bgm *g)
 {
-	if (g->blocked_cap < g->face_cap) {
-		unsigned char *b = realloc(g->blocked, (size_t)g->face_cap);
+	if (g->opstate_cap < g->face_cap) {
+		unsigned char *b = realloc(g->opstate, (size_t)g->face_cap);
 		if (!b)
 			return -1;
-		memset(b + g->blocked_cap, 0, (size_t)(g->face_cap - g->blocked_cap));
-		g->blocked = b;
-		g->blocked_cap = g->face_cap;
+		memset(b + g->opstate_cap, 0, (size_t)(g->face_cap - g->opstate_cap));
+		g->opstate = b;
+		g->opstate_cap = g->face_cap;
 	}
 	return 0;
 }
 
-/* Queues face f (new, or back from being blocked). */
-static int push_face(mlod_bgm *g, int f, struct plan *scratch)
+/* Queues operation op on face f (new, or back from being blocked). */
+static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 {
 	const bgm_face *F = &g->faces[f];
 	for (int i = 0; i < 3; i++) {
+		if (op != OP_TRIANGLE && i != op && i != (op + 1) % 3)
+			continue;
 		int fl = g->nodes[F->n[i]].flags;
 		if ((fl & BGM_LOCKED) || !(fl & BGM_ELIGIBLE) || (!g->opt.allow_border && (fl & BGM_BORDER)))
 			return 0; /* never collapsible while these nodes live */
 	}
 	double key;
 	if (g->opt.cost == MLOD_COST_POSED) {
-		if (!plan(g, f, scratch)) {
-			g->blocked[f] = 1;
+		if (!plan(g, f, op, scratch)) {
+			g->opstate[f] |= (unsigned char)BLOCKED(op);
 			return 0;
 		}
 		key = scratch->cost;
 	} else {
 		key = bgm_compactness(g->nodes[F->n[0]].p, g->nodes[F->n[1]].p, g->nodes[F->n[2]].p);
 	}
-	return heap_push(g->heap, key, f);
+	g->opstate[f] |= (unsigned char)QUEUED(op);
+	return heap_push(g->heap, key, f, op);
+}
+
+/* Queues face f's triangle collapse and its edges, as the option asks.
+ * An edge has two faces: it is not queued again when the face across
+ * holds an entry for it (an edge keeps its cost while its two nodes
+ * live; its validity is checked again when it leaves the queue). */
+static int push_face(mlod_bgm *g, int f, struct plan *scratch)
+{
+	if (g->opt.op != MLOD_OP_EDGE && push_op(g, f, OP_TRIANGLE, scratch))
+		return -1;
+	if (g->opt.op == MLOD_OP_TRIANGLE)
+		return 0;
+	const bgm_face *F = &g->faces[f];
+	for (int e = 0; e < 3; e++) {
+		int across = F->adj[e], queued = 0;
+		if (across >= 0)
+			for (int k = 0; k < 3 && !queued; k++) {
+				const bgm_face *A = &g->faces[across];
+				queued = A->n[k] == F->n[(e + 1) % 3] && A->n[(k + 1) % 3] == F->n[e] &&
+				         (g->opstate[across] & QUEUED(k));
+			}
+		if (!queued && push_op(g, f, e, scratch))
+			return -1;
+	}
+	return 0;
 }
 
 /* Applies a planned collapse; returns 0, or -1 when out of memory. */
@@ -561,8 +654,8 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	for (int i = 0; i < 3; i++)
 		N->p[i] = pl->pos[i];
 	g->inf[v] = pl->inf;
-	int fl = 0;
-	for (int i = 0; i < 3; i++)
+	int fl = 0, K = pl->k;
+	for (int i = 0; i < K; i++)
 		fl |= g->nodes[pl->v[i]].flags & BGM_BORDER;
 	if (bgm_node_eligible(g, &pl->inf))
 		fl |= BGM_ELIGIBLE;
@@ -571,7 +664,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 		float *m = g->morph + (size_t)v * (size_t)g->lay.morph_stride;
 		for (int k = 0; k < g->lay.morph_stride; k++) {
 			double x = 0.0;
-			for (int i = 0; i < 3; i++)
+			for (int i = 0; i < K; i++)
 				x += pl->lambda[i] * g->morph[(size_t)pl->v[i] * (size_t)g->lay.morph_stride + (size_t)k];
 			m[k] = (float)x;
 		}
@@ -580,7 +673,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 		double *q = g->quadric + (size_t)v * (size_t)g->pose_count * 10;
 		for (int k = 0; k < 10 * g->pose_count; k++) {
 			double x = 0.0;
-			for (int i = 0; i < 3; i++)
+			for (int i = 0; i < K; i++)
 				x += g->quadric[(size_t)pl->v[i] * (size_t)g->pose_count * 10 + (size_t)k];
 			q[k] = x;
 		}
@@ -608,7 +701,11 @@ static int apply(mlod_bgm *g, struct plan *pl)
 		int base = bgm_add_wedge(g, v), T = g->prim->target_count;
 		if (base < 0)
 			return -1;
-		int tw[3] = {g->faces[pl->t].w[0], g->faces[pl->t].w[1], g->faces[pl->t].w[2]};
+		/* The collapsed vertices' wedges in t (an edge: its two ends). */
+		const bgm_face *TF = &g->faces[pl->t];
+		int tw[3] = {TF->w[0], TF->w[1], TF->w[2]};
+		if (K == 2)
+			tw[0] = TF->w[pl->op], tw[1] = TF->w[(pl->op + 1) % 3], tw[2] = tw[0];
 		interpolate_wedge(g, base, tw, pl->lambda);
 		for (int j = 0; j < pl->nk; j++) {
 			int w = g->faces[pl->kept[j]].w[pl->corner[j]], x = g->wedge_node[w];
@@ -644,7 +741,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 			bgm_inc_remove(g, f->n[k], pl->faces[j]);
 		g->removed[g->removed_len + j] = pl->faces[j];
 	}
-	for (int i = 0; i < 3; i++)
+	for (int i = 0; i < K; i++)
 		g->nodes[pl->v[i]].flags |= BGM_DEAD;
 	g->live_triangles -= pl->nf;
 
@@ -701,6 +798,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	memset(r, 0, sizeof *r);
 	for (int i = 0; i < 3; i++)
 		r->parents[i] = pl->v[i];
+	r->parent_count = K;
 	r->node = v;
 	r->snapped = pl->snap;
 	r->removed_first = g->removed_len;
@@ -723,7 +821,9 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 	double t0 = bgm_seconds();
 	mlod_result r = MLOD_OK;
 	struct plan *pl = malloc(sizeof *pl), *scratch = malloc(sizeof *scratch);
-	if (!pl || !scratch || grow_face_arrays(g)) {
+	if (!g->qsum && g->pose_count > 0)
+		g->qsum = malloc(sizeof(double) * 10 * (size_t)g->pose_count);
+	if (!pl || !scratch || grow_face_arrays(g) || (g->pose_count > 0 && !g->qsum)) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 		goto done;
 	}
@@ -744,13 +844,15 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 		heap_entry e = heap_pop(g->heap);
 		if (g->faces[e.face].death != BGM_ALIVE)
 			continue;
-		if (!plan(g, e.face, pl)) {
+		g->opstate[e.face] &= (unsigned char)~QUEUED(e.op);
+		if (!plan(g, e.face, e.op, pl)) {
 			g->refused++;
-			g->blocked[e.face] = 1;
+			g->opstate[e.face] |= (unsigned char)BLOCKED(e.op);
 			continue;
 		}
 		if (g->opt.cost == MLOD_COST_POSED && pl->cost > e.key * (1.0 + 1e-9) + 1e-300) {
-			if (heap_push(g->heap, pl->cost, e.face)) {
+			g->opstate[e.face] |= (unsigned char)QUEUED(e.op);
+			if (heap_push(g->heap, pl->cost, e.face, e.op)) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 				goto done;
 			}
@@ -777,16 +879,26 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			for (int i = 0; i < 3; i++) {
 				if (F->n[i] == v)
 					continue;
-				const bgm_node *L = &g->nodes[F->n[i]];
+				int ring = F->n[i];
+				const bgm_node *L = &g->nodes[ring];
 				for (int m = 0; m < L->inc_count; m++) {
 					int h = g->inc[L->inc_first + m];
-					if (h < first && g->blocked[h]) {
-						g->blocked[h] = 0;
-						if (push_face(g, h, scratch)) {
+					if (h >= first || !(g->opstate[h] & ALL_BLOCKED))
+						continue;
+					/* Its triangle, and its edges that end at the ring
+					 * vertex (the others' patches did not change). */
+					const bgm_face *H = &g->faces[h];
+					unsigned retry = BLOCKED(OP_TRIANGLE);
+					for (int e = 0; e < 3; e++)
+						if (H->n[e] == ring || H->n[(e + 1) % 3] == ring)
+							retry |= BLOCKED(e);
+					unsigned bits = g->opstate[h] & retry;
+					g->opstate[h] &= (unsigned char)~retry;
+					for (int op = 0; op <= OP_TRIANGLE; op++)
+						if ((bits >> op & 1u) && push_op(g, h, op, scratch)) {
 							r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 							goto done;
 						}
-					}
 				}
 			}
 		}

@@ -723,10 +723,20 @@ typedef enum mlod_placement {
 	MLOD_PLACE_OPTIMAL      /* beyond the paper: the minimum of the posed quadric (or the barycenter when lower) */
 } mlod_placement;
 
+/* Which collapses run. */
+typedef enum mlod_collapse_op {
+	MLOD_OP_DEFAULT = 0,    /* the measured default: EDGE with the posed cost, TRIANGLE with compactness */
+	MLOD_OP_TRIANGLE,       /* the paper (4.2.3): triangle collapses only */
+	MLOD_OP_EDGE,           /* beyond the paper: edge collapses only (the posed cost only: compactness
+	                         * does not rank an edge) */
+	MLOD_OP_MIXED           /* triangle and edge collapses in one queue, cheapest first (posed cost only) */
+} mlod_collapse_op;
+
 /* Zero-initialised options are the defaults. */
 typedef struct mlod_bgm_options {
 	mlod_mesh_cost cost;
 	mlod_placement placement;
+	mlod_collapse_op op;
 	mlod_eligibility eligibility;
 	double tau;                  /* 0 means 1 */
 	int allow_border;            /* let collapses move and remove border vertices */
@@ -779,7 +789,8 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
  * removes faces added_first .. added_first + added_count - 1 and brings
  * back the faces it removed. */
 typedef struct mlod_vsplit {
-	int parents[3];     /* the collapsed nodes */
+	int parents[3];     /* the collapsed nodes (parents[2] is -1 for an edge) */
+	int parent_count;   /* 3: a triangle collapse; 2: an edge collapse */
 	int node;           /* v-bar */
 	int snapped;        /* v-bar is at parents[snapped], or -1 */
 	int removed_first;  /* into mlod_bgm_removed_faces */

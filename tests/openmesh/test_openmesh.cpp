@@ -3,7 +3,8 @@
 //
 // For every sample (and ../shared/data with make test-extended), every
 // triangle primitive of every mesh node is simplified as mlod-bgm does by
-// default (and with the paper's compactness cost), and each level (50%,
+// default (triangle and edge collapses, posed cost), with triangle
+// collapses only, and with the paper's compactness cost; each level (50%,
 // 25%, 10% of the triangles) is loaded into an OpenMesh TriMesh after
 // welding by position (else UV seams would count as borders). A level
 // passes when, compared with the input primitive loaded the same way:
@@ -108,8 +109,9 @@ void report(const std::string &name, const std::string &problem)
 void check_sample(const char *path, const char *label)
 {
 	const double ratios[] = {0.5, 0.25, 0.1};
-	const mlod_mesh_cost costs[] = {MLOD_COST_POSED, MLOD_COST_COMPACTNESS};
-	const char *cost_names[] = {"posed", "compactness"};
+	const mlod_mesh_cost costs[] = {MLOD_COST_POSED, MLOD_COST_POSED, MLOD_COST_COMPACTNESS};
+	const mlod_collapse_op ops[] = {MLOD_OP_MIXED, MLOD_OP_TRIANGLE, MLOD_OP_TRIANGLE};
+	const char *cost_names[] = {"posed", "posed-triangle", "compactness"};
 	size_t size = 0;
 	void *data = read_file(path, &size);
 	mlod_character c;
@@ -128,7 +130,7 @@ void check_sample(const char *path, const char *label)
 		mlod_character_free(&c);
 		return;
 	}
-	for (int ci = 0; ci < 2; ci++) {
+	for (int ci = 0; ci < 3; ci++) {
 		std::string problems[3];
 		int primitives = 0, collapsed[3] = {0, 0, 0};
 		for (int i = 0; i < c.instance_count; i++) {
@@ -143,6 +145,7 @@ void check_sample(const char *path, const char *label)
 				mlod_bgm_options opt;
 				memset(&opt, 0, sizeof opt);
 				opt.cost = costs[ci];
+				opt.op = ops[ci];
 				opt.poses = &poses;
 				mlod_bgm *g = nullptr;
 				if (mlod_bgm_build(&c, i, pi, &opt, &g, &err) != MLOD_OK ||

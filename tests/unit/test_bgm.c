@@ -318,7 +318,7 @@ TEST(seam_wedges)
 		float lo[2] = {1e30f, 1e30f}, hi[2] = {-1e30f, -1e30f};
 		for (int w = 0; w < g->wedge_count; w++) {
 			int n = g->wedge_node[w];
-			if (n != rec->parents[0] && n != rec->parents[1] && n != rec->parents[2])
+			if (n < 0 || (n != rec->parents[0] && n != rec->parents[1] && n != rec->parents[2]))
 				continue;
 			for (int i = 0; i < 2; i++) {
 				float x = g->wedge_attr[(size_t)w * (size_t)S + (size_t)uv + (size_t)i];
@@ -335,7 +335,7 @@ TEST(seam_wedges)
 				for (int i = 0; i < 2; i++)
 					CHECK_MSG(x[i] >= lo[i] - 1e-6f && x[i] <= hi[i] + 1e-6f, "record %d: UV outside its wedges' range", r);
 				/* No texture seam among the parents: one UV per parent. */
-				for (int pi = 0; pi < 3; pi++) {
+				for (int pi = 0; pi < rec->parent_count; pi++) {
 					int first = -1;
 					for (int v = 0; v < g->wedge_count; v++) {
 						if (g->wedge_node[v] != rec->parents[pi])
@@ -413,11 +413,84 @@ TEST(prefixes_tubeman)
 	opt.poses = &poses;
 	check_prefixes(&c, 0, &opt);
 	if (!test_failed_) {
+		opt.op = MLOD_OP_TRIANGLE;
+		check_prefixes(&c, 0, &opt);
+	}
+	if (!test_failed_) {
+		opt.op = MLOD_OP_MIXED;
+		check_prefixes(&c, 0, &opt);
+	}
+	if (!test_failed_) {
 		opt.cost = MLOD_COST_COMPACTNESS;
+		opt.op = MLOD_OP_DEFAULT;
 		opt.placement = MLOD_PLACE_BARYCENTER;
 		check_prefixes(&c, 0, &opt);
 	}
 	mlod_pose_set_free(&poses);
+	mlod_character_free(&c);
+}
+
+/* The default (posed cost) collapses edges: an edge record has two
+ * parents, and its v-bar's influences are Power Skinning of those two.
+ * MLOD_OP_MIXED lets triangles and edges compete, MLOD_OP_TRIANGLE is the
+ * paper's triangle collapse only; edges need the posed cost. */
+static void count_ops(const mlod_character *c, const mlod_bgm_options *opt, int *edges, int *triangles)
+{
+	mlod_bgm *g;
+	*edges = *triangles = 0;
+	CHECK_OK(mlod_bgm_build(c, 0, 0, opt, &g, &terr));
+	if (!g)
+		return;
+	CHECK_OK(mlod_bgm_simplify(g, 0, 0, &terr));
+	int count;
+	const mlod_vsplit *seq = mlod_bgm_sequence(g, &count);
+	CHECK(count > 100);
+	for (int r = 0; r < count; r++) {
+		const mlod_vsplit *rec = &seq[r];
+		CHECK(rec->parent_count == 2 || rec->parent_count == 3);
+		if (rec->parent_count == 3) {
+			(*triangles)++;
+			continue;
+		}
+		(*edges)++;
+		CHECK(rec->parents[2] == -1);
+		/* An edge removes its two faces (one on a border). */
+		CHECK(rec->removed_count - rec->added_count == 2 || rec->removed_count - rec->added_count == 1);
+		mlod_v3 v[2];
+		mlod_influences in[2], want;
+		for (int i = 0; i < 2; i++) {
+			const double *p = g->nodes[rec->parents[i]].p;
+			v[i] = (mlod_v3){(float)p[0], (float)p[1], (float)p[2]};
+			in[i] = g->inf[rec->parents[i]];
+		}
+		const double *x = g->nodes[rec->node].p;
+		mlod_power_skin(v, in, 2, (mlod_v3){(float)x[0], (float)x[1], (float)x[2]}, &want);
+		const mlod_influences *got = &g->inf[rec->node];
+		CHECK(got->count == want.count);
+		for (int i = 0; i < want.count && i < got->count; i++)
+			CHECK(got->joints[i] == want.joints[i] && fabsf(got->weights[i] - want.weights[i]) < 1e-6f);
+	}
+	mlod_bgm_free(g);
+}
+
+TEST(collapse_ops)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	int edges, triangles;
+	count_ops(&c, NULL, &edges, &triangles);
+	CHECK_MSG(edges > 0 && triangles == 0, "default: %d edge and %d triangle collapses", edges, triangles);
+	mlod_bgm_options opt = {0};
+	opt.op = MLOD_OP_MIXED;
+	count_ops(&c, &opt, &edges, &triangles);
+	CHECK_MSG(edges > 0 && triangles > 0, "mixed: %d edge and %d triangle collapses", edges, triangles);
+	opt.op = MLOD_OP_TRIANGLE;
+	count_ops(&c, &opt, &edges, &triangles);
+	CHECK_MSG(edges == 0 && triangles > 0, "triangle: %d edge and %d triangle collapses", edges, triangles);
+	opt.op = MLOD_OP_EDGE;
+	opt.cost = MLOD_COST_COMPACTNESS;
+	mlod_bgm *g = NULL;
+	CHECK(mlod_bgm_build(&c, 0, 0, &opt, &g, &terr) == MLOD_ERR_INVALID_ARG && !g);
 	mlod_character_free(&c);
 }
 
@@ -480,7 +553,7 @@ TEST(rigid_and_morph)
 	for (int r = 0; r < count; r++)
 		for (int k = 0; k < M; k++) {
 			float lo = 1e30f, hi = -1e30f;
-			for (int i = 0; i < 3; i++) {
+			for (int i = 0; i < seq[r].parent_count; i++) {
 				float x = g->morph[(size_t)seq[r].parents[i] * (size_t)M + (size_t)k];
 				lo = fminf(lo, x);
 				hi = fmaxf(hi, x);
@@ -748,6 +821,7 @@ int main(void)
 	RUN(weld_keeps_seams_closed);
 	RUN(seam_wedges);
 	RUN(prefixes_tubeman);
+	RUN(collapse_ops);
 	RUN(prefixes_robot);
 	RUN(prefixes_allow_border);
 	RUN(rigid_and_morph);
