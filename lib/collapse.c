@@ -10,8 +10,17 @@
  * the posed quadric error of quadric.c (beyond the paper, compactness
  * breaking ties); the faces a collapse creates join the queue.
  *
+ * Beyond the paper, with the posed cost, the same machinery collapses an
+ * edge (a, b) into v-bar: its two faces go and the rest of the patch is
+ * re-meshed. A triangle collapse always merges three vertices into one
+ * point, which costs something on any curved surface; an edge collapse
+ * along a flat or straight direction costs nothing. Measured (bench/
+ * RESULTS.md), edges alone give the lowest posed error, so they are the
+ * posed cost's default; MLOD_OP_MIXED queues both, by cost per removed
+ * face.
+ *
  * The paper does not check validity; a collapse is refused when
- * - a vertex of t is locked, not eligible (4.2.2), or on a border
+ * - a collapsed vertex is locked, not eligible (4.2.2), or on a border
  *   (unless borders are allowed);
  * - the re-meshed patch would not be one fan around v-bar (the link
  *   condition generalised to a triangle: this also refuses duplicate
@@ -22,9 +31,11 @@
  *   one such vertex s, and every wedge group (wedges joined through the
  *   removed faces) must hold exactly one wedge of s and at most one of
  *   each other vertex; seam-free patches give v-bar one wedge
- *   interpolated inside t. So seams neither tear nor smear.
+ *   interpolated inside t (along the edge). So seams neither tear nor
+ *   smear.
  * v-bar goes to t's barycenter (the paper) or to the posed quadric's
- * optimum (or the barycenter when that is cheaper); Power Skinning
+ * optimum (or the barycenter, or for an edge either end, when that is
+ * cheaper); Power Skinning
  * (powerskin.c) gives its weights, the same barycentric weights as its
  * attributes give its morph target offsets.
  *

@@ -638,8 +638,9 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
  * topology) with one attribute "wedge" per seam side (each glTF vertex),
  * its dual graph (face adjacency) and each node's joint influences. Rigid
  * meshes hanging under a joint are skinned to it with weight 1. Triangle
- * collapses into a new vertex v-bar are recorded in order, so that every
- * prefix of the sequence is a valid mesh: a level is a prefix. */
+ * (the paper) or edge collapses into a new vertex v-bar are recorded in
+ * order, so that every prefix of the sequence is a valid mesh: a level is
+ * a prefix. */
 
 /* Up to this many joint influences per vertex (every weight set). */
 #define MLOD_MAX_INFLUENCES (4 * MLOD_MAX_SETS)
