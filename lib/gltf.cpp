@@ -2143,8 +2143,11 @@ template <class T> void keep_only(std::vector<T> &v, const std::vector<bool> &ke
 {
 	size_t n = 0;
 	for (size_t i = 0; i < v.size(); i++)
-		if (keep[i])
-			v[n++] = std::move(v[i]);
+		if (keep[i]) {
+			if (n != i) /* never move an element onto itself */
+				v[n] = std::move(v[i]);
+			n++;
+		}
 	v.resize(n);
 }
 
@@ -2278,6 +2281,79 @@ int copy_morph_animation(Model &m, int from, int to)
 			}
 	}
 	return added;
+}
+
+/* Removes MSFT_lod from node and MSFT_screencoverage from its extras; its
+ * former level nodes lose their mesh and skin (they stay, empty, so that
+ * node indices hold). MSFT_lod leaves extensionsUsed when no node uses it
+ * any more. The JSON as read follows. */
+void clear_lod(mlod_gltf &doc, int node)
+{
+	Model &m = doc.model;
+	if (node < 0 || size_t(node) >= m.nodes.size())
+		fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+	tinygltf::Node &n = m.nodes[size_t(node)];
+	auto lod = n.extensions.find("MSFT_lod");
+	if (lod == n.extensions.end())
+		return;
+	const Value ids = lod->second.Get("ids"); /* a copy: the extension goes below */
+	for (size_t i = 0; ids.IsArray() && i < ids.ArrayLen(); i++) {
+		int id = ids.Get(int(i)).IsInt() ? ids.Get(int(i)).Get<int>() : -1;
+		if (id >= 0 && size_t(id) < m.nodes.size() && id != node) {
+			m.nodes[size_t(id)].mesh = -1;
+			m.nodes[size_t(id)].skin = -1;
+		}
+	}
+	n.extensions.erase(lod);
+	std::string pointer = "/nodes/" + std::to_string(node) + "/extras";
+	json e = current_extras(doc, pointer, n.extras);
+	if (e.is_object() && e.contains("MSFT_screencoverage")) {
+		e.erase("MSFT_screencoverage");
+		n.extras = e.empty() ? Value() : to_value(e);
+		if (e.empty())
+			doc.extras.erase(pointer);
+		else
+			doc.extras[pointer] = e;
+	}
+	bool used = false;
+	for (const tinygltf::Node &other : m.nodes)
+		used = used || other.extensions.count("MSFT_lod") > 0;
+	if (!used)
+		m.extensionsUsed.erase(std::remove(m.extensionsUsed.begin(), m.extensionsUsed.end(), "MSFT_lod"),
+		                       m.extensionsUsed.end());
+
+	json &orig = doc.original;
+	if (!orig.is_object())
+		return;
+	if (orig.contains("nodes") && orig["nodes"].is_array()) {
+		json &nodes = orig["nodes"];
+		if (ids.IsArray())
+			for (size_t i = 0; i < ids.ArrayLen(); i++) {
+				int id = ids.Get(int(i)).IsInt() ? ids.Get(int(i)).Get<int>() : -1;
+				if (id >= 0 && size_t(id) < nodes.size() && nodes[size_t(id)].is_object()) {
+					nodes[size_t(id)].erase("mesh");
+					nodes[size_t(id)].erase("skin");
+				}
+			}
+		if (size_t(node) < nodes.size() && nodes[size_t(node)].is_object()) {
+			json &o = nodes[size_t(node)];
+			if (o.contains("extensions") && o["extensions"].is_object()) {
+				o["extensions"].erase("MSFT_lod");
+				if (o["extensions"].empty())
+					o.erase("extensions");
+			}
+		}
+	}
+	if (!used && orig.contains("extensionsUsed") && orig["extensionsUsed"].is_array()) {
+		json kept = json::array();
+		for (const json &e2 : orig["extensionsUsed"])
+			if (e2 != "MSFT_lod")
+				kept.push_back(e2);
+		if (kept.empty())
+			orig.erase("extensionsUsed");
+		else
+			orig["extensionsUsed"] = kept;
+	}
 }
 
 /* Checks the arguments common to the calls that take a document. */
@@ -2588,5 +2664,13 @@ mlod_result mlod_gltf_copy_morph_animation(mlod_gltf *doc, int from, int to, int
 		int n = copy_morph_animation(doc->model, from, to);
 		if (added)
 			*added = n;
+	});
+}
+
+mlod_result mlod_gltf_clear_lod(mlod_gltf *doc, int node, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_clear_lod: doc is NULL");
+		clear_lod(*doc, node);
 	});
 }

@@ -449,6 +449,12 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
  * MSFT_lod family) is MLOD_ERR_UNSUPPORTED and left unchanged. */
 mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err);
 
+/* Removes MSFT_lod from node (and MSFT_screencoverage from its extras):
+ * its former level nodes stay, without mesh or skin, so that node indices
+ * hold. MSFT_lod leaves extensionsUsed when no node uses it any more. A
+ * node without MSFT_lod is left as it is. */
+mlod_result mlod_gltf_clear_lod(mlod_gltf *doc, int node, mlod_error *err);
+
 /* Makes node `to` morph like node `from`: it gets from's default morph
  * weights and, in every animation, a channel animating its weights with
  * the sampler of each channel animating from's (to's mesh must keep the

@@ -877,7 +877,10 @@ static void write_split(struct job *job, const mlod_gltf *input, const char *dir
 			m.primitives = prims;
 			int mesh = add_level_mesh(job, doc, i, &m);
 			free(prims);
-			if (mlod_gltf_set_node_mesh(doc, in->node, mesh, lv->skins[i], &err) != MLOD_OK)
+			/* A level file holds one level: the node's earlier levels (the
+			 * skeleton levels' nodes, say) go. */
+			if (mlod_gltf_clear_lod(doc, in->node, &err) != MLOD_OK ||
+			    mlod_gltf_set_node_mesh(doc, in->node, mesh, lv->skins[i], &err) != MLOD_OK)
 				tool_die(EXIT_OUTPUT, dir, "level %d: %s", k + 1, err.message);
 		}
 		char json[512];
