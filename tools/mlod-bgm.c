@@ -51,6 +51,10 @@ static const char usage_text[] =
 	"                           whose posed error stays within PCT percent of the\n"
 	"                           bounding diagonal\n"
 	"  -c, --cost NAME          collapse order: posed (default) or compactness\n"
+	"  -B, --budget NAME        a level's triangles: character (shared by all\n"
+	"                           primitives, cheapest collapses first; the default\n"
+	"                           with the posed cost) or primitive (each keeps the\n"
+	"                           ratio; the default with compactness)\n"
 	"  -p, --placement NAME     new vertex: optimal (default) or barycenter\n"
 	"  -E, --eligibility NAME   vertices that may go: all, bend or literal\n"
 	"                           (default: all with the posed cost, bend otherwise)\n"
@@ -69,7 +73,10 @@ struct part {
 	mlod_bgm *bgm;          /* NULL: left as it is */
 	int triangles;
 	int prefix[MAX_LEVELS];
+	int k;                  /* the level being made: its prefix */
 };
+
+enum budget { BUDGET_DEFAULT, BUDGET_CHARACTER, BUDGET_PRIMITIVE };
 
 struct level {
 	double ratio;           /* requested, or found under --max-error */
@@ -86,6 +93,7 @@ struct job {
 	const char *input;
 	mlod_character c;
 	mlod_bgm_options opt;
+	enum budget budget;
 	double *eta;
 	mlod_pose_set train, measure;
 	struct part **parts;    /* per instance, per primitive */
@@ -362,6 +370,11 @@ static void build_all(struct job *job, double target_ratio)
 			caps_total += info.caps;
 		}
 	}
+	/* A character budget may take any primitive further than the ratio. */
+	for (int i = 0; job->budget == BUDGET_CHARACTER && target_ratio > 0.0 && i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
+			if (job->parts[i][p].bgm && (r = mlod_bgm_simplify(job->parts[i][p].bgm, 0, 0, &err)) != MLOD_OK)
+				tool_die(tool_exit_code(r), job->input, "%s", err.message);
 	if (job->statics)
 		note(job, "%d primitive(s) of static meshes (no joint, no skin) simplified in world space", job->statics);
 	if (unsupported)
@@ -371,8 +384,47 @@ static void build_all(struct job *job, double target_ratio)
 	(void)caps_total;
 }
 
-/* Extracts level lv at ratio (per primitive, the shortest prefix within
- * ratio of its triangles) and measures it. */
+/* The character budget: ratio of all simplified triangles, reached by
+ * taking, over every primitive's recorded sequence, the next collapse of
+ * lowest cost first (the posed costs are errors in one unit: comparable
+ * across primitives). Sets each part's k. */
+static void character_prefixes(struct job *job, double ratio)
+{
+	const mlod_character *c = &job->c;
+	long total = 0, live = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
+			struct part *pt = &job->parts[i][p];
+			pt->k = 0;
+			if (pt->bgm) {
+				total += pt->triangles;
+				live += mlod_bgm_triangles(pt->bgm, 0);
+			}
+		}
+	long target = (long)ceil(ratio * (double)total);
+	while (live > target) {
+		struct part *best = NULL;
+		double cost = 0.0;
+		for (int i = 0; i < c->instance_count; i++)
+			for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
+				struct part *pt = &job->parts[i][p];
+				int count = 0;
+				const mlod_vsplit *seq = pt->bgm ? mlod_bgm_sequence(pt->bgm, &count) : NULL;
+				if (pt->k < count && (!best || seq[pt->k].cost < cost)) {
+					best = pt;
+					cost = seq[pt->k].cost;
+				}
+			}
+		if (!best)
+			break; /* nothing more comes off */
+		live -= mlod_bgm_triangles(best->bgm, best->k);
+		live += mlod_bgm_triangles(best->bgm, ++best->k);
+	}
+}
+
+/* Extracts level lv at ratio (with the primitive budget, per primitive
+ * the shortest prefix within ratio of its triangles; with the character
+ * budget, character_prefixes) and measures it. */
 static void make_level(struct job *job, struct level *lv, double ratio)
 {
 	mlod_error err = {0};
@@ -384,6 +436,8 @@ static void make_level(struct job *job, struct level *lv, double ratio)
 	if (!lv->meshes || !lv->owned || !lv->skins)
 		tool_die(EXIT_INPUT, job->input, "out of memory");
 	double seconds = 0.0;
+	if (job->budget == BUDGET_CHARACTER)
+		character_prefixes(job, ratio);
 	for (int i = 0; i < c->instance_count; i++) {
 		const mlod_mesh *m = &c->meshes[c->instances[i].mesh];
 		mlod_mesh *lm = &lv->meshes[i];
@@ -402,7 +456,7 @@ static void make_level(struct job *job, struct level *lv, double ratio)
 				lv->vertices += m->primitives[p].vertex_count;
 				continue;
 			}
-			int k = mlod_bgm_prefix_for(pt->bgm, (int)ceil(ratio * pt->triangles));
+			int k = job->budget == BUDGET_CHARACTER ? pt->k : mlod_bgm_prefix_for(pt->bgm, (int)ceil(ratio * pt->triangles));
 			mlod_result r = mlod_bgm_extract(pt->bgm, k, c->instances[i].skin < 0, &lm->primitives[p], &err);
 			if (r != MLOD_OK)
 				tool_die(tool_exit_code(r), job->input, "%s", err.message);
@@ -913,6 +967,11 @@ static const char *cost_name(mlod_mesh_cost c)
 	return c == MLOD_COST_COMPACTNESS ? "compactness" : "posed";
 }
 
+static const char *budget_name(enum budget b)
+{
+	return b == BUDGET_PRIMITIVE ? "primitive" : "character";
+}
+
 static const char *placement_name(mlod_placement p)
 {
 	return p == MLOD_PLACE_BARYCENTER ? "barycenter" : "optimal";
@@ -956,11 +1015,11 @@ static void report_table(const struct job *job)
 	       "%d border and %d non-manifold edges; %d primitives simplified; build %.1f ms\n",
 	       job->input, job->triangles, job->vertices, t.nodes, t.seam_nodes, t.eligible_nodes, t.locked_nodes,
 	       t.border_edges, t.nonmanifold_edges, job->simplified, 1e3 * job->build_seconds);
-	printf("# cost %s, placement %s, eligibility %s (tau %g)%s; error over %d poses (rest, clip frames, %d random "
+	printf("# cost %s, budget per %s, placement %s, eligibility %s (tau %g)%s; error over %d poses (rest, clip frames, %d random "
 	       "up to 40 degrees)\n",
-	       cost_name(job->opt.cost), placement_name(job->opt.placement), eligibility_name(&job->opt),
-	       job->opt.tau > 0 ? job->opt.tau : 1.0, job->opt.allow_border ? ", borders allowed" : "",
-	       job->measure.count, RANDOM_POSES);
+	       cost_name(job->opt.cost), budget_name(job->budget), placement_name(job->opt.placement),
+	       eligibility_name(&job->opt), job->opt.tau > 0 ? job->opt.tau : 1.0,
+	       job->opt.allow_border ? ", borders allowed" : "", job->measure.count, RANDOM_POSES);
 	printf("%5s  %6s  %9s  %8s  %10s  %10s  %5s  %9s  %11s\n", "level", "ratio", "triangles", "vertices", "mean%",
 	       "max%", "caps", "build ms", "collapse ms");
 	printf("%5d  %6s  %9d  %8d  %10s  %10s  %5s  %9s  %11s\n", 0, "1", job->triangles, job->vertices, "0", "0", "-",
@@ -991,9 +1050,9 @@ static void report_json(const struct job *job)
 	       t.border_edges, t.nonmanifold_edges, t.locked_nodes, t.eligible_nodes);
 	printf("  \"simplified_primitives\": %d,\n  \"static_primitives\": %d,\n  \"build_ms\": %.6g,\n", job->simplified,
 	       job->statics, 1e3 * job->build_seconds);
-	printf("  \"options\": {\"cost\": \"%s\", \"placement\": \"%s\", \"eligibility\": \"%s\", \"tau\": %g, "
-	       "\"allow_border\": %s},\n",
-	       cost_name(job->opt.cost), placement_name(job->opt.placement), eligibility_name(&job->opt),
+	printf("  \"options\": {\"cost\": \"%s\", \"budget\": \"%s\", \"placement\": \"%s\", \"eligibility\": \"%s\", "
+	       "\"tau\": %g, \"allow_border\": %s},\n",
+	       cost_name(job->opt.cost), budget_name(job->budget), placement_name(job->opt.placement), eligibility_name(&job->opt),
 	       job->opt.tau > 0 ? job->opt.tau : 1.0, job->opt.allow_border ? "true" : "false");
 	printf("  \"measured_poses\": %d,\n  \"levels\": [\n", job->measure.count);
 	for (int k = 0; k < job->level_count; k++) {
@@ -1025,6 +1084,7 @@ int main(int argc, char **argv)
 		{"ratios", required_argument, NULL, 'R'},
 		{"max-error", required_argument, NULL, 'e'},
 		{"cost", required_argument, NULL, 'c'},
+		{"budget", required_argument, NULL, 'B'},
 		{"placement", required_argument, NULL, 'p'},
 		{"eligibility", required_argument, NULL, 'E'},
 		{"tau", required_argument, NULL, 't'},
@@ -1035,6 +1095,7 @@ int main(int argc, char **argv)
 		{NULL, 0, NULL, 0},
 	};
 	static const char *const costs[] = {"compactness", "posed"};
+	static const char *const budgets[] = {"character", "primitive"};
 	static const char *const placements[] = {"barycenter", "optimal"};
 	static const char *const rules[] = {"literal", "bend", "all"};
 	const char *output = NULL, *split = NULL;
@@ -1046,7 +1107,7 @@ int main(int argc, char **argv)
 
 	tool_name = "mlod-bgm";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:p:E:t:bs:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:B:p:E:t:bs:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -1056,6 +1117,7 @@ int main(int argc, char **argv)
 			break;
 		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
 		case 'c': job.opt.cost = (mlod_mesh_cost)(MLOD_COST_COMPACTNESS + parse_enum("--cost", optarg, costs, 2)); break;
+		case 'B': job.budget = (enum budget)(BUDGET_CHARACTER + parse_enum("--budget", optarg, budgets, 2)); break;
 		case 'p':
 			job.opt.placement = (mlod_placement)(MLOD_PLACE_BARYCENTER + parse_enum("--placement", optarg, placements, 2));
 			break;
@@ -1079,6 +1141,8 @@ int main(int argc, char **argv)
 		tool_usage_error("--report and --output do not go together");
 	if (job.opt.cost == MLOD_COST_DEFAULT)
 		job.opt.cost = MLOD_COST_POSED;
+	if (job.budget == BUDGET_DEFAULT) /* measured: see the man page */
+		job.budget = job.opt.cost == MLOD_COST_POSED ? BUDGET_CHARACTER : BUDGET_PRIMITIVE;
 	if (job.opt.placement == MLOD_PLACE_DEFAULT)
 		job.opt.placement = job.opt.cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_OPTIMAL;
 	qsort(ratios, (size_t)ratio_count, sizeof *ratios, double_desc);

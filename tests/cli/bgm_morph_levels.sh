@@ -3,7 +3,7 @@
 # nodes too (RobotExpressive: 3 heads, 42 weight channels), with the same
 # sampler; the glb validates.
 set -e
-"$BIN/mlod-bgm" -o out.glb "$ROOT/samples/RobotExpressive.glb"
+"$BIN/mlod-bgm" -R 0.5,0.35,0.3 -o out.glb "$ROOT/samples/RobotExpressive.glb"
 node "$ROOT/tests/validate.mjs" out.glb > /dev/null
 node - "$ROOT/samples/RobotExpressive.glb" <<'JS'
 const fs = require('fs');

@@ -12,7 +12,7 @@ node -e 'const r = JSON.parse(require("fs").readFileSync("r.json")); if (r.trian
 "$BIN/mlod-bgm" -s again -R 0.5,0.2 -o out2.glb "$ROOT/samples/tubeman.glb"
 cmp lods/tubeman.lod1.glb again/tubeman.lod1.glb && cmp lods/tubeman.lod2.glb again/tubeman.lod2.glb
 
-"$BIN/mlod-bgm" -s lods --report=json "$ROOT/samples/RobotExpressive.glb" > robot.json
+"$BIN/mlod-bgm" -s lods -R 0.5,0.35,0.3 --report=json "$ROOT/samples/RobotExpressive.glb" > robot.json
 node "$ROOT/tests/validate.mjs" lods/RobotExpressive.lod1.glb lods/RobotExpressive.lod2.glb lods/RobotExpressive.lod3.glb > /dev/null
 node - "$ROOT/samples/RobotExpressive.glb" robot.json lods/RobotExpressive.lod*.glb <<'JS'
 const fs = require('fs');
