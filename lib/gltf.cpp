@@ -2052,6 +2052,310 @@ std::vector<int> joint_nodes(const mlod_skeleton *s)
 	return nodes;
 }
 
+/* ------------------------------------------------------------------ */
+/* Editing a read document: level meshes in place, pruning             */
+/* ------------------------------------------------------------------ */
+
+/* Appends a mesh with mesh's primitives that takes the name, default
+ * morph weights, extensions and extras of glTF mesh `like` (and of its
+ * primitives, by position); returns its index. */
+int add_mesh_like(mlod_gltf &doc, int like, const mlod_mesh &mesh)
+{
+	Model &m = doc.model;
+	if (like < 0 || size_t(like) >= m.meshes.size())
+		fail(MLOD_ERR_INVALID_ARG, "mesh %d does not exist", like);
+	int index = add_mesh(m, mesh);
+	const tinygltf::Mesh &src = m.meshes[size_t(like)];
+	tinygltf::Mesh &dst = m.meshes[size_t(index)];
+	size_t prims = std::min(src.primitives.size(), dst.primitives.size());
+	bool same_targets = true;
+	for (size_t p = 0; p < dst.primitives.size(); p++)
+		same_targets = same_targets && dst.primitives[p].targets.size() == src.weights.size();
+	dst.name = src.name;
+	if (same_targets)
+		dst.weights = src.weights;
+	dst.extensions = src.extensions;
+	dst.extras = src.extras;
+	for (size_t p = 0; p < prims; p++) {
+		dst.primitives[p].extensions = src.primitives[p].extensions;
+		dst.primitives[p].extras = src.primitives[p].extras;
+	}
+	std::string from = "/meshes/" + std::to_string(like) + "/", to = "/meshes/" + std::to_string(index) + "/";
+	std::map<std::string, json> copied;
+	for (auto it = doc.extras.lower_bound(from); it != doc.extras.end() && it->first.compare(0, from.size(), from) == 0;
+	     ++it) {
+		std::string rest = it->first.substr(from.size());
+		unsigned long p = 0;
+		if (rest == "extras" || (sscanf(rest.c_str(), "primitives/%lu/extras", &p) == 1 && p < prims &&
+		                         rest == "primitives/" + std::to_string(p) + "/extras"))
+			copied[to + rest] = it->second;
+	}
+	doc.extras.insert(copied.begin(), copied.end());
+	return index;
+}
+
+/* Extensions that refer to no mesh, accessor or buffer view, so that
+ * pruning (which renumbers those) leaves them right. */
+bool prune_safe(const std::string &name)
+{
+	static const char *const prefixes[] = {"KHR_materials_", "KHR_texture_", "KHR_lights_punctual",
+	                                       "KHR_mesh_quantization", "KHR_xmp", "EXT_texture_", "MSFT_lod",
+	                                       "MSFT_texture_dds"};
+	for (const char *p : prefixes)
+		if (name.compare(0, strlen(p), p) == 0)
+			return true;
+	return false;
+}
+
+/* Drops the elements of array `name` that keep says go, from the JSON as
+ * read and from the exact extras (later ones renumbered). Returns the
+ * old -> new index map (-1: dropped). The caller drops them from the model. */
+std::vector<int> renumber(mlod_gltf &doc, const std::string &name, const std::vector<bool> &keep)
+{
+	std::vector<int> map(keep.size(), -1);
+	int n = 0;
+	for (size_t i = 0; i < keep.size(); i++)
+		if (keep[i])
+			map[i] = n++;
+	if (doc.original.is_object() && doc.original.contains(name) && doc.original[name].is_array()) {
+		json kept = json::array();
+		const json &a = doc.original[name];
+		for (size_t i = 0; i < a.size(); i++)
+			if (i >= keep.size() || keep[i])
+				kept.push_back(a[i]);
+		doc.original[name] = std::move(kept);
+	}
+	std::string prefix = "/" + name + "/";
+	std::map<std::string, json> moved;
+	for (auto it = doc.extras.lower_bound(prefix);
+	     it != doc.extras.end() && it->first.compare(0, prefix.size(), prefix) == 0;) {
+		size_t slash = it->first.find('/', prefix.size());
+		size_t i = size_t(std::stoul(it->first.substr(prefix.size(), slash - prefix.size())));
+		if (i < map.size() && map[i] >= 0)
+			moved[prefix + std::to_string(map[i]) + it->first.substr(slash)] = std::move(it->second);
+		it = doc.extras.erase(it);
+	}
+	doc.extras.insert(moved.begin(), moved.end());
+	return map;
+}
+
+template <class T> void keep_only(std::vector<T> &v, const std::vector<bool> &keep)
+{
+	size_t n = 0;
+	for (size_t i = 0; i < v.size(); i++)
+		if (keep[i]) {
+			if (n != i) /* never move an element onto itself */
+				v[n] = std::move(v[i]);
+			n++;
+		}
+	v.resize(n);
+}
+
+/* Drops the meshes no node uses, then the accessors and buffer views
+ * nothing uses, and packs the buffers' bytes again. */
+void prune(mlod_gltf &doc)
+{
+	Model &m = doc.model;
+	for (const std::string &e : m.extensionsUsed)
+		if (!prune_safe(e))
+			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not pruned",
+			     e.c_str());
+	auto mark = [](std::vector<bool> &used, int i) {
+		if (i >= 0 && size_t(i) < used.size())
+			used[size_t(i)] = true;
+	};
+	auto apply = [](const std::vector<int> &map, int &i) {
+		if (i >= 0)
+			i = size_t(i) < map.size() ? map[size_t(i)] : -1;
+	};
+
+	std::vector<bool> used(m.meshes.size());
+	for (const tinygltf::Node &n : m.nodes)
+		mark(used, n.mesh);
+	std::vector<int> map = renumber(doc, "meshes", used);
+	keep_only(m.meshes, used);
+	for (tinygltf::Node &n : m.nodes)
+		apply(map, n.mesh);
+
+	used.assign(m.accessors.size(), false);
+	for (const tinygltf::Mesh &mesh : m.meshes)
+		for (const tinygltf::Primitive &p : mesh.primitives) {
+			mark(used, p.indices);
+			for (const auto &kv : p.attributes)
+				mark(used, kv.second);
+			for (const auto &t : p.targets)
+				for (const auto &kv : t)
+					mark(used, kv.second);
+		}
+	for (const tinygltf::Skin &s : m.skins)
+		mark(used, s.inverseBindMatrices);
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationSampler &s : a.samplers) {
+			mark(used, s.input);
+			mark(used, s.output);
+		}
+	map = renumber(doc, "accessors", used);
+	keep_only(m.accessors, used);
+	for (tinygltf::Mesh &mesh : m.meshes)
+		for (tinygltf::Primitive &p : mesh.primitives) {
+			apply(map, p.indices);
+			for (auto &kv : p.attributes)
+				apply(map, kv.second);
+			for (auto &t : p.targets)
+				for (auto &kv : t)
+					apply(map, kv.second);
+		}
+	for (tinygltf::Skin &s : m.skins)
+		apply(map, s.inverseBindMatrices);
+	for (tinygltf::Animation &a : m.animations)
+		for (tinygltf::AnimationSampler &s : a.samplers) {
+			apply(map, s.input);
+			apply(map, s.output);
+		}
+
+	used.assign(m.bufferViews.size(), false);
+	for (const tinygltf::Accessor &a : m.accessors) {
+		mark(used, a.bufferView);
+		if (a.sparse.isSparse) {
+			mark(used, a.sparse.indices.bufferView);
+			mark(used, a.sparse.values.bufferView);
+		}
+	}
+	for (const tinygltf::Image &i : m.images)
+		mark(used, i.bufferView);
+	map = renumber(doc, "bufferViews", used);
+	keep_only(m.bufferViews, used);
+	for (tinygltf::Accessor &a : m.accessors) {
+		apply(map, a.bufferView);
+		if (a.sparse.isSparse) {
+			apply(map, a.sparse.indices.bufferView);
+			apply(map, a.sparse.values.bufferView);
+		}
+	}
+	for (tinygltf::Image &i : m.images)
+		apply(map, i.bufferView);
+
+	/* Each buffer keeps its views' bytes only, in view order, 4-byte aligned. */
+	for (size_t b = 0; b < m.buffers.size(); b++) {
+		std::vector<unsigned char> packed;
+		for (tinygltf::BufferView &v : m.bufferViews) {
+			if (v.buffer != int(b))
+				continue;
+			const std::vector<unsigned char> &data = m.buffers[b].data;
+			if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset)
+				fail(MLOD_ERR_PARSE, "a buffer view lies outside buffer %zu", b);
+			packed.resize((packed.size() + 3) / 4 * 4, 0);
+			size_t at = packed.size();
+			packed.insert(packed.end(), data.begin() + long(v.byteOffset), data.begin() + long(v.byteOffset + v.byteLength));
+			v.byteOffset = at;
+		}
+		m.buffers[b].data = std::move(packed);
+	}
+	/* The JSON as read follows: it brings back what tinygltf leaves out
+	 * (a zero byteOffset) and drops what it lacks. */
+	if (doc.original.is_object() && doc.original.contains("bufferViews") && doc.original["bufferViews"].is_array()) {
+		json &views = doc.original["bufferViews"];
+		for (size_t i = 0; i < views.size() && i < m.bufferViews.size(); i++)
+			if (views[i].is_object())
+				views[i]["byteOffset"] = m.bufferViews[i].byteOffset;
+	}
+}
+
+/* Gives node `to` the default morph weights of node `from` and, in every
+ * animation, a copy of each channel animating from's weights. Returns the
+ * channels added. */
+int copy_morph_animation(Model &m, int from, int to)
+{
+	if (from < 0 || size_t(from) >= m.nodes.size() || to < 0 || size_t(to) >= m.nodes.size())
+		fail(MLOD_ERR_INVALID_ARG, "node %d or %d does not exist", from, to);
+	m.nodes[size_t(to)].weights = m.nodes[size_t(from)].weights;
+	int added = 0;
+	for (tinygltf::Animation &a : m.animations) {
+		size_t n = a.channels.size();
+		for (size_t c = 0; c < n; c++)
+			if (a.channels[c].target_node == from && a.channels[c].target_path == "weights") {
+				tinygltf::AnimationChannel copy = a.channels[c];
+				copy.target_node = to;
+				a.channels.push_back(copy);
+				added++;
+			}
+	}
+	return added;
+}
+
+/* Removes MSFT_lod from node and MSFT_screencoverage from its extras; its
+ * former level nodes lose their mesh and skin (they stay, empty, so that
+ * node indices hold). MSFT_lod leaves extensionsUsed when no node uses it
+ * any more. The JSON as read follows. */
+void clear_lod(mlod_gltf &doc, int node)
+{
+	Model &m = doc.model;
+	if (node < 0 || size_t(node) >= m.nodes.size())
+		fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+	tinygltf::Node &n = m.nodes[size_t(node)];
+	auto lod = n.extensions.find("MSFT_lod");
+	if (lod == n.extensions.end())
+		return;
+	const Value ids = lod->second.Get("ids"); /* a copy: the extension goes below */
+	for (size_t i = 0; ids.IsArray() && i < ids.ArrayLen(); i++) {
+		int id = ids.Get(int(i)).IsInt() ? ids.Get(int(i)).Get<int>() : -1;
+		if (id >= 0 && size_t(id) < m.nodes.size() && id != node) {
+			m.nodes[size_t(id)].mesh = -1;
+			m.nodes[size_t(id)].skin = -1;
+		}
+	}
+	n.extensions.erase(lod);
+	std::string pointer = "/nodes/" + std::to_string(node) + "/extras";
+	json e = current_extras(doc, pointer, n.extras);
+	if (e.is_object() && e.contains("MSFT_screencoverage")) {
+		e.erase("MSFT_screencoverage");
+		n.extras = e.empty() ? Value() : to_value(e);
+		if (e.empty())
+			doc.extras.erase(pointer);
+		else
+			doc.extras[pointer] = e;
+	}
+	bool used = false;
+	for (const tinygltf::Node &other : m.nodes)
+		used = used || other.extensions.count("MSFT_lod") > 0;
+	if (!used)
+		m.extensionsUsed.erase(std::remove(m.extensionsUsed.begin(), m.extensionsUsed.end(), "MSFT_lod"),
+		                       m.extensionsUsed.end());
+
+	json &orig = doc.original;
+	if (!orig.is_object())
+		return;
+	if (orig.contains("nodes") && orig["nodes"].is_array()) {
+		json &nodes = orig["nodes"];
+		if (ids.IsArray())
+			for (size_t i = 0; i < ids.ArrayLen(); i++) {
+				int id = ids.Get(int(i)).IsInt() ? ids.Get(int(i)).Get<int>() : -1;
+				if (id >= 0 && size_t(id) < nodes.size() && nodes[size_t(id)].is_object()) {
+					nodes[size_t(id)].erase("mesh");
+					nodes[size_t(id)].erase("skin");
+				}
+			}
+		if (size_t(node) < nodes.size() && nodes[size_t(node)].is_object()) {
+			json &o = nodes[size_t(node)];
+			if (o.contains("extensions") && o["extensions"].is_object()) {
+				o["extensions"].erase("MSFT_lod");
+				if (o["extensions"].empty())
+					o.erase("extensions");
+			}
+		}
+	}
+	if (!used && orig.contains("extensionsUsed") && orig["extensionsUsed"].is_array()) {
+		json kept = json::array();
+		for (const json &e2 : orig["extensionsUsed"])
+			if (e2 != "MSFT_lod")
+				kept.push_back(e2);
+		if (kept.empty())
+			orig.erase("extensionsUsed");
+		else
+			orig["extensionsUsed"] = kept;
+	}
+}
+
 /* Checks the arguments common to the calls that take a document. */
 void need(bool ok, const char *what)
 {
@@ -2275,5 +2579,98 @@ mlod_result mlod_gltf_set_lod(mlod_gltf *doc, int node, const int *lod_nodes, in
 		m.nodes[size_t(node)].extensions["MSFT_lod"] = Value(Value::Object{{"ids", Value(ids)}});
 		if (std::find(m.extensionsUsed.begin(), m.extensionsUsed.end(), "MSFT_lod") == m.extensionsUsed.end())
 			m.extensionsUsed.push_back("MSFT_lod");
+	});
+}
+
+mlod_result mlod_gltf_copy(const mlod_gltf *doc, mlod_gltf **out, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && out, "mlod_gltf_copy: doc and out must not be NULL");
+		*out = nullptr;
+		*out = new mlod_gltf(*doc);
+	});
+}
+
+mlod_result mlod_gltf_add_mesh_like(mlod_gltf *doc, int like, const mlod_mesh *m, int *out_index, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && m, "mlod_gltf_add_mesh_like: doc and mesh must not be NULL");
+		int index = add_mesh_like(*doc, like, *m);
+		if (out_index)
+			*out_index = index;
+	});
+}
+
+mlod_result mlod_gltf_set_node_mesh(mlod_gltf *doc, int node, int mesh, int skin, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_set_node_mesh: doc is NULL");
+		Model &m = doc->model;
+		if (node < 0 || node >= int(m.nodes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+		if (mesh < -1 || mesh >= int(m.meshes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "mesh %d does not exist", mesh);
+		if (skin < -1 || skin >= int(m.skins.size()))
+			fail(MLOD_ERR_INVALID_ARG, "skin %d does not exist", skin);
+		tinygltf::Node &n = m.nodes[size_t(node)];
+		n.mesh = mesh;
+		n.skin = skin;
+		/* The JSON as read follows, so that serialising neither brings back
+		 * what the node no longer has nor drops what it gained. */
+		json &orig = doc->original;
+		if (orig.is_object() && orig.contains("nodes") && orig["nodes"].is_array() && size_t(node) < orig["nodes"].size() &&
+		    orig["nodes"][size_t(node)].is_object()) {
+			json &o = orig["nodes"][size_t(node)];
+			for (auto kv : {std::make_pair("mesh", mesh), std::make_pair("skin", skin)}) {
+				if (kv.second < 0)
+					o.erase(kv.first);
+				else
+					o[kv.first] = kv.second;
+			}
+		}
+	});
+}
+
+mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && out, "mlod_gltf_get_node_trs: doc and out must not be NULL");
+		const Model &m = doc->model;
+		if (node < 0 || node >= int(m.nodes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+		const tinygltf::Node &n = m.nodes[size_t(node)];
+		if (n.matrix.size() == 16) {
+			mlod_mat4 mat = node_matrix(n);
+			if (mlod_mat4_to_trs(&mat, out, 1e-5f) != 0)
+				fail(MLOD_ERR_UNSUPPORTED, "node %d: its matrix is not a translation, rotation and scale", node);
+		} else {
+			*out = node_trs(n);
+		}
+	});
+}
+
+mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_prune: doc is NULL");
+		prune(*doc);
+	});
+}
+
+mlod_result mlod_gltf_copy_morph_animation(mlod_gltf *doc, int from, int to, int *added, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_copy_morph_animation: doc is NULL");
+		int n = copy_morph_animation(doc->model, from, to);
+		if (added)
+			*added = n;
+	});
+}
+
+mlod_result mlod_gltf_clear_lod(mlod_gltf *doc, int node, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_clear_lod: doc is NULL");
+		clear_lod(*doc, node);
 	});
 }

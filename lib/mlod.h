@@ -421,6 +421,47 @@ mlod_result mlod_gltf_add_mesh_reskinned(mlod_gltf *doc, int mesh, const mlod_me
 mlod_result mlod_gltf_set_lod(mlod_gltf *doc, int node, const int *lod_nodes,
                               int lod_count, const float *coverage, mlod_error *err);
 
+/* Editing a document that was read: these keep everything else as it
+ * was (materials, textures, names, extras, animations, skins). */
+
+/* A deep copy of doc (release it with mlod_gltf_free). */
+mlod_result mlod_gltf_copy(const mlod_gltf *doc, mlod_gltf **out, mlod_error *err);
+
+/* Appends a mesh built from m's primitives, like mlod_gltf_add_mesh, that
+ * takes the name, default morph weights (when every primitive keeps that
+ * many targets), extensions and extras of glTF mesh `like`, and those of
+ * its primitives by position. */
+mlod_result mlod_gltf_add_mesh_like(mlod_gltf *doc, int like, const mlod_mesh *m, int *out_index,
+                                    mlod_error *err);
+
+/* Points node at mesh and skin (either may be -1: none). */
+mlod_result mlod_gltf_set_node_mesh(mlod_gltf *doc, int node, int mesh, int skin, mlod_error *err);
+
+/* The node's local transform. A matrix that is not a translation,
+ * rotation and scale is MLOD_ERR_UNSUPPORTED. */
+mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out, mlod_error *err);
+
+/* Removes the meshes no node uses, then the accessors and buffer views
+ * nothing uses, and packs the buffers again: indices of meshes, accessors
+ * and buffer views change, every other index stays. A document using an
+ * extension that may refer to those (beyond the KHR_materials_*,
+ * KHR_texture_*, KHR_lights_punctual, KHR_mesh_quantization, EXT_texture_*,
+ * MSFT_lod family) is MLOD_ERR_UNSUPPORTED and left unchanged. */
+mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err);
+
+/* Removes MSFT_lod from node (and MSFT_screencoverage from its extras):
+ * its former level nodes stay, without mesh or skin, so that node indices
+ * hold. MSFT_lod leaves extensionsUsed when no node uses it any more. A
+ * node without MSFT_lod is left as it is. */
+mlod_result mlod_gltf_clear_lod(mlod_gltf *doc, int node, mlod_error *err);
+
+/* Makes node `to` morph like node `from`: it gets from's default morph
+ * weights and, in every animation, a channel animating its weights with
+ * the sampler of each channel animating from's (to's mesh must keep the
+ * number of targets). *added (may be NULL) is the number of channels
+ * added. */
+mlod_result mlod_gltf_copy_morph_animation(mlod_gltf *doc, int from, int to, int *added, mlod_error *err);
+
 /* ------------------------------------------------------------------ */
 /* BVH                                                                 */
 /* ------------------------------------------------------------------ */

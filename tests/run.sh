@@ -118,13 +118,27 @@ else
 		for tool in $glb_tools; do
 			[ -x "$BIN/$tool" ] || continue
 			out="$work/validate-$tool-$base.glb"
-			if ! "$BIN/$tool" "$f" > "$out" 2> "$work/stderr"; then
+			split=
+			# mlod-bgm also writes one glb per level (--split): each must validate.
+			if [ $tool = mlod-bgm ]; then
+				split="$work/split-$base"
+				mkdir -p "$split"
+			fi
+			if ! "$BIN/$tool" ${split:+--split "$split"} "$f" > "$out" 2> "$work/stderr"; then
 				fail "validate/$tool/$base" "$tool failed: $(head -c 300 "$work/stderr")"
 			elif msg=$($validator "$out" 2>&1); then
 				pass "validate/$tool/$base"
 			else
 				fail "validate/$tool/$base" "$(echo "$msg" | head -n 8 | tr '\n' ' ')"
 			fi
+			for lod in ${split:+"$split"/*.glb}; do
+				[ -f "$lod" ] || continue
+				if msg=$($validator "$lod" 2>&1); then
+					pass "validate/$tool-split/$(basename "$lod")"
+				else
+					fail "validate/$tool-split/$(basename "$lod")" "$(echo "$msg" | head -n 8 | tr '\n' ' ')"
+				fi
+			done
 		done
 	done
 fi

@@ -9,8 +9,10 @@
  * in MSFT_lod (with MSFT_screencoverage from each level's measured error);
  * level nodes use the node's skin, or the matching skeleton level's skin
  * when mlod-skelgraph ran before; rigid meshes under a joint become meshes
- * skinned to it with weight 1. Or a report, or (--split) one glb per
- * level.
+ * skinned to it with weight 1; static meshes (no joint, no skin) keep the
+ * node's transform; level nodes that keep morph targets get copies of the
+ * node's weight animation channels. Or a report. --split also writes one
+ * glb per level: the input document with that level's meshes in place.
  */
 #define _GNU_SOURCE /* getopt_long */
 
@@ -49,12 +51,17 @@ static const char usage_text[] =
 	"                           whose posed error stays within PCT percent of the\n"
 	"                           bounding diagonal\n"
 	"  -c, --cost NAME          collapse order: posed (default) or compactness\n"
+	"  -B, --budget NAME        a level's triangles: character (shared by all\n"
+	"                           primitives, cheapest collapses first; the default\n"
+	"                           with the posed cost) or primitive (each keeps the\n"
+	"                           ratio; the default with compactness)\n"
 	"  -p, --placement NAME     new vertex: optimal (default) or barycenter\n"
 	"  -E, --eligibility NAME   vertices that may go: all, bend or literal\n"
 	"                           (default: all with the posed cost, bend otherwise)\n"
 	"  -t, --tau T              eligibility threshold factor (default 1)\n"
 	"  -b, --allow-border       let collapses move and remove border vertices\n"
-	"  -s, --split DIR          also write one glb per level into DIR\n"
+	"  -s, --split DIR          also write one glb per level into DIR: the input\n"
+	"                           with that level's meshes in place\n"
 	"  -h, --help               show this help\n"
 	"  -V, --version            show the version\n"
 	"\n"
@@ -66,12 +73,16 @@ struct part {
 	mlod_bgm *bgm;          /* NULL: left as it is */
 	int triangles;
 	int prefix[MAX_LEVELS];
+	int k;                  /* the level being made: its prefix */
 };
+
+enum budget { BUDGET_DEFAULT, BUDGET_CHARACTER, BUDGET_PRIMITIVE };
 
 struct level {
 	double ratio;           /* requested, or found under --max-error */
 	mlod_mesh *meshes;      /* one per instance */
 	unsigned char **owned;  /* per instance and primitive: extracted (else the original's) */
+	int *skins;             /* per instance: the glTF skin of a skinned level mesh (level_skins) */
 	mlod_character view;    /* the character with these meshes */
 	int triangles, vertices, caps, collapses;
 	double collapse_seconds;
@@ -82,10 +93,12 @@ struct job {
 	const char *input;
 	mlod_character c;
 	mlod_bgm_options opt;
+	enum budget budget;
 	double *eta;
 	mlod_pose_set train, measure;
 	struct part **parts;    /* per instance, per primitive */
 	int simplified;         /* primitives with a BGM */
+	int statics;            /* of them, on no joint and no skin */
 	int triangles, vertices;
 	double build_seconds;
 	int level_count;
@@ -314,7 +327,7 @@ static void build_all(struct job *job, double target_ratio)
 {
 	mlod_error err = {0};
 	mlod_character *c = &job->c;
-	int statics = 0, unsupported = 0, morphs = 0, caps_total = 0;
+	int unsupported = 0, morphs = 0, caps_total = 0;
 	job->eta = calloc((size_t)c->skeleton.joint_count + 1, sizeof *job->eta);
 	job->parts = calloc((size_t)c->instance_count + 1, sizeof *job->parts);
 	if (!job->eta || !job->parts)
@@ -336,13 +349,7 @@ static void build_all(struct job *job, double target_ratio)
 			pt->triangles = primitive_triangles(pr);
 			job->triangles += pt->triangles;
 			job->vertices += pr->vertex_count;
-			if (pt->triangles < 4)
-				continue;
-			if (in->skin < 0 && in->joint < 0) {
-				statics++;
-				continue;
-			}
-			if (in->node < 0)
+			if (pt->triangles < 4 || in->node < 0)
 				continue;
 			r = mlod_bgm_build(c, i, p, &job->opt, &pt->bgm, &err);
 			if (r == MLOD_ERR_UNSUPPORTED) {
@@ -358,12 +365,18 @@ static void build_all(struct job *job, double target_ratio)
 			mlod_bgm_get_info(pt->bgm, &info);
 			job->build_seconds += info.build_seconds;
 			job->simplified++;
+			job->statics += in->skin < 0 && in->joint < 0;
 			morphs += pr->target_count > 0;
 			caps_total += info.caps;
 		}
 	}
-	if (statics)
-		note(job, "%d primitive(s) of meshes on no joint and no skin left as they are", statics);
+	/* A character budget may take any primitive further than the ratio. */
+	for (int i = 0; job->budget == BUDGET_CHARACTER && target_ratio > 0.0 && i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
+			if (job->parts[i][p].bgm && (r = mlod_bgm_simplify(job->parts[i][p].bgm, 0, 0, &err)) != MLOD_OK)
+				tool_die(tool_exit_code(r), job->input, "%s", err.message);
+	if (job->statics)
+		note(job, "%d primitive(s) of static meshes (no joint, no skin) simplified in world space", job->statics);
 	if (unsupported)
 		note(job, "%d primitive(s) that are not triangles left as they are", unsupported);
 	if (morphs)
@@ -371,8 +384,47 @@ static void build_all(struct job *job, double target_ratio)
 	(void)caps_total;
 }
 
-/* Extracts level lv at ratio (per primitive, the shortest prefix within
- * ratio of its triangles) and measures it. */
+/* The character budget: ratio of all simplified triangles, reached by
+ * taking, over every primitive's recorded sequence, the next collapse of
+ * lowest cost first (the posed costs are errors in one unit: comparable
+ * across primitives). Sets each part's k. */
+static void character_prefixes(struct job *job, double ratio)
+{
+	const mlod_character *c = &job->c;
+	long total = 0, live = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
+			struct part *pt = &job->parts[i][p];
+			pt->k = 0;
+			if (pt->bgm) {
+				total += pt->triangles;
+				live += mlod_bgm_triangles(pt->bgm, 0);
+			}
+		}
+	long target = (long)ceil(ratio * (double)total);
+	while (live > target) {
+		struct part *best = NULL;
+		double cost = 0.0;
+		for (int i = 0; i < c->instance_count; i++)
+			for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
+				struct part *pt = &job->parts[i][p];
+				int count = 0;
+				const mlod_vsplit *seq = pt->bgm ? mlod_bgm_sequence(pt->bgm, &count) : NULL;
+				if (pt->k < count && (!best || seq[pt->k].cost < cost)) {
+					best = pt;
+					cost = seq[pt->k].cost;
+				}
+			}
+		if (!best)
+			break; /* nothing more comes off */
+		live -= mlod_bgm_triangles(best->bgm, best->k);
+		live += mlod_bgm_triangles(best->bgm, ++best->k);
+	}
+}
+
+/* Extracts level lv at ratio (with the primitive budget, per primitive
+ * the shortest prefix within ratio of its triangles; with the character
+ * budget, character_prefixes) and measures it. */
 static void make_level(struct job *job, struct level *lv, double ratio)
 {
 	mlod_error err = {0};
@@ -380,9 +432,12 @@ static void make_level(struct job *job, struct level *lv, double ratio)
 	lv->ratio = ratio;
 	lv->meshes = calloc((size_t)c->instance_count + 1, sizeof *lv->meshes);
 	lv->owned = calloc((size_t)c->instance_count + 1, sizeof *lv->owned);
-	if (!lv->meshes || !lv->owned)
+	lv->skins = calloc((size_t)c->instance_count + 1, sizeof *lv->skins);
+	if (!lv->meshes || !lv->owned || !lv->skins)
 		tool_die(EXIT_INPUT, job->input, "out of memory");
 	double seconds = 0.0;
+	if (job->budget == BUDGET_CHARACTER)
+		character_prefixes(job, ratio);
 	for (int i = 0; i < c->instance_count; i++) {
 		const mlod_mesh *m = &c->meshes[c->instances[i].mesh];
 		mlod_mesh *lm = &lv->meshes[i];
@@ -401,7 +456,7 @@ static void make_level(struct job *job, struct level *lv, double ratio)
 				lv->vertices += m->primitives[p].vertex_count;
 				continue;
 			}
-			int k = mlod_bgm_prefix_for(pt->bgm, (int)ceil(ratio * pt->triangles));
+			int k = job->budget == BUDGET_CHARACTER ? pt->k : mlod_bgm_prefix_for(pt->bgm, (int)ceil(ratio * pt->triangles));
 			mlod_result r = mlod_bgm_extract(pt->bgm, k, c->instances[i].skin < 0, &lm->primitives[p], &err);
 			if (r != MLOD_OK)
 				tool_die(tool_exit_code(r), job->input, "%s", err.message);
@@ -444,6 +499,7 @@ static void free_level(struct job *job, struct level *lv)
 	}
 	free(lv->meshes);
 	free(lv->owned);
+	free(lv->skins);
 	free(lv->view.instances);
 	memset(lv, 0, sizeof *lv);
 }
@@ -646,14 +702,121 @@ static int stand_in_joint(const struct job *job, const struct skel_levels *sl, i
 	return j;
 }
 
-static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
+/* Does instance i get levels (a node, and a primitive with a BGM)? */
+static int has_levels(const struct job *job, int i)
+{
+	const mlod_instance *in = &job->c.instances[i];
+	if (in->node < 0)
+		return 0;
+	for (int p = 0; p < job->c.meshes[in->mesh].primitive_count; p++)
+		if (job->parts[i][p].bgm)
+			return 1;
+	return 0;
+}
+
+/* The skeleton level matching mesh level k, or -1 without any. */
+static int skeleton_level(const struct skel_levels *sl, int k)
+{
+	return sl->count > 0 ? (k < sl->count ? k : sl->count - 1) : -1;
+}
+
+/* The glTF skin of each skinned level mesh: the instance's own, or the
+ * matching skeleton level's when mlod-skelgraph ran before (the level
+ * mesh's joints are then remapped to it, once for every output). */
+static void level_skins(struct job *job, const struct skel_levels *sl)
+{
+	const mlod_character *c = &job->c;
+	int fallback = 0;
+	for (int k = 0; k < job->level_count; k++) {
+		struct level *lv = &job->levels[k];
+		int sk = skeleton_level(sl, k);
+		for (int i = 0; i < c->instance_count; i++) {
+			const mlod_instance *in = &c->instances[i];
+			lv->skins[i] = -1;
+			if (in->skin < 0 || !has_levels(job, i))
+				continue;
+			lv->skins[i] = c->skeleton.skins[in->skin].gltf_index;
+			if (sk < 0)
+				continue;
+			int target = remap_to_skeleton_level(job, sl, sk, in->skin, &lv->meshes[i], lv->owned[i]);
+			if (target >= 0)
+				lv->skins[i] = target;
+			else
+				fallback++;
+		}
+	}
+	if (sl->count > 0)
+		note(job, "skeleton levels found: mesh level k uses skeleton level k's skins%s",
+		     fallback ? " (some fell back to the full skin)" : "");
+}
+
+/* Sets extras.mlod[key] of the default scene to value (JSON), next to the
+ * keys already there (the skeleton levels, say). */
+static void set_scene_mlod(mlod_gltf *doc, const char *key, const char *value)
+{
+	mlod_error err = {0};
+	if (mlod_gltf_count(doc, MLOD_GLTF_SCENE) == 0)
+		return;
+	char *old = NULL;
+	if (mlod_gltf_get_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", &old, &err) != MLOD_OK)
+		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+	size_t len = old ? strlen(old) : 0, size = len + strlen(key) + strlen(value) + 64;
+	char *json = malloc(size);
+	if (!json)
+		tool_die(EXIT_OUTPUT, NULL, "out of memory");
+	jv parsed;
+	int parsed_ok = old && parse_value(old, &parsed, 0), object = parsed_ok && parsed.type == 'o';
+	const jv *prev = object ? member(&parsed, key) : NULL;
+	if (prev) /* from an earlier run: replaced */
+		snprintf(json, size, "%.*s%s%s", (int)(prev->start - old), old, value, prev->end);
+	else if (object && parsed.count > 0)
+		snprintf(json, size, "%.*s,\"%s\":%s}", (int)(parsed.end - 1 - old), old, key, value);
+	else
+		snprintf(json, size, "{\"%s\":%s}", key, value);
+	if (parsed_ok)
+		jv_free(&parsed);
+	mlod_free(old);
+	if (mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", json, &err) != MLOD_OK)
+		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+	free(json);
+}
+
+/* A level's summary as JSON into buf. */
+static void level_json(const struct level *lv, int k, char *buf, size_t size)
+{
+	snprintf(buf, size,
+	         "{\"level\":%d,\"ratio\":%.6g,\"triangles\":%d,\"vertices\":%d,"
+	         "\"error_percent\":{\"mean\":%.9g,\"max\":%.9g}}",
+	         k + 1, lv->ratio, lv->triangles, lv->vertices, lv->error.mean, lv->error.max);
+}
+
+static int has_targets(const mlod_mesh *m)
+{
+	for (int p = 0; p < m->primitive_count; p++)
+		if (m->primitives[p].target_count > 0)
+			return 1;
+	return 0;
+}
+
+/* Adds level mesh m of instance i like its glTF mesh (name, morph weights,
+ * extras); returns its index. */
+static int add_level_mesh(const struct job *job, mlod_gltf *doc, int i, const mlod_mesh *m)
+{
+	mlod_error err = {0};
+	int like = job->c.meshes[job->c.instances[i].mesh].gltf_index, mesh = -1;
+	mlod_result r = like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH)
+	                    ? mlod_gltf_add_mesh_like(doc, like, m, &mesh, &err)
+	                    : mlod_gltf_add_mesh(doc, m, &mesh, &err);
+	if (r != MLOD_OK)
+		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+	return mesh;
+}
+
+static void write_glb(struct job *job, mlod_gltf *doc, const char *output, const struct skel_levels *sl)
 {
 	mlod_error err = {0};
 	mlod_character *c = &job->c;
-	struct skel_levels sl;
-	read_skeleton_levels(job, doc, &sl);
-	job->skeleton_levels = sl.count;
-	int fallback = 0;
+	int morph_channels = 0, untransformable = 0;
 	float coverage[MAX_LEVELS + 1];
 	for (int k = 0; k < job->level_count; k++)
 		coverage[k] = (float)mlod_error_coverage(job->levels[k].error.max, 1080.0, 1.0);
@@ -664,39 +827,40 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 
 	for (int i = 0; job->level_count > 0 && i < c->instance_count; i++) {
 		const mlod_instance *in = &c->instances[i];
-		int any = 0;
-		for (int p = 0; p < c->meshes[in->mesh].primitive_count; p++)
-			any |= job->parts[i][p].bgm != NULL;
-		if (!any || in->node < 0)
+		if (!has_levels(job, i))
 			continue;
+		/* A static level node stands where the node stands: same local transform. */
+		mlod_trs local, *trs = NULL;
+		if (in->skin < 0 && in->joint < 0) {
+			if (mlod_gltf_get_node_trs(doc, in->node, &local, &err) != MLOD_OK) {
+				untransformable++;
+				continue;
+			}
+			trs = &local;
+		}
 		int lod_nodes[MAX_LEVELS], rigid_joint = -1, rigid_index = -1;
 		for (int k = 0; k < job->level_count; k++) {
 			struct level *lv = &job->levels[k];
-			int sk = sl.count > 0 ? (k < sl.count ? k : sl.count - 1) : -1; /* the matching skeleton level */
-			int skin = -1, mesh = -1, node = -1;
-			if (in->skin >= 0) {
-				skin = c->skeleton.skins[in->skin].gltf_index;
-				if (sk >= 0) {
-					int target = remap_to_skeleton_level(job, &sl, sk, in->skin, &lv->meshes[i], lv->owned[i]);
-					if (target >= 0)
-						skin = target;
-					else
-						fallback++;
-				}
-			} else {
-				int joint = stand_in_joint(job, &sl, sk, in->joint);
+			int sk = skeleton_level(sl, k), skin = lv->skins[i], node = -1;
+			if (in->skin < 0 && in->joint >= 0) { /* rigid: skinned to its joint's stand-in */
+				int joint = stand_in_joint(job, sl, sk, in->joint);
 				if (joint != rigid_joint) {
 					rigid_joint = joint;
 					rigid_index = rigid_skin(job, doc, in, joint);
 				}
 				skin = rigid_index;
 			}
-			if (mlod_gltf_add_mesh(doc, &lv->meshes[i], &mesh, &err) != MLOD_OK)
-				tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+			int mesh = add_level_mesh(job, doc, i, &lv->meshes[i]);
 			char name[96];
 			snprintf(name, sizeof name, "mlod mesh level %d of node %d", k + 1, in->node);
-			if (mlod_gltf_add_node(doc, name, MLOD_GLTF_DETACHED, mesh, skin, NULL, &node, &err) != MLOD_OK)
+			if (mlod_gltf_add_node(doc, name, MLOD_GLTF_DETACHED, mesh, skin, trs, &node, &err) != MLOD_OK)
 				tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+			if (has_targets(&lv->meshes[i])) {
+				int added = 0;
+				if (mlod_gltf_copy_morph_animation(doc, in->node, node, &added, &err) != MLOD_OK)
+					tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+				morph_channels += added;
+			}
 			char json[256];
 			snprintf(json, sizeof json,
 			         "{\"mesh_level\":%d,\"ratio\":%.6g,\"error_percent\":{\"mean\":%.9g,\"max\":%.9g}%s}", k + 1,
@@ -708,52 +872,30 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 		if (mlod_gltf_set_lod(doc, in->node, lod_nodes, job->level_count, coverage, &err) != MLOD_OK)
 			tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
 	}
-	if (sl.count > 0)
-		note(job, "skeleton levels found: mesh level k uses skeleton level k's skins%s",
-		     fallback ? " (some fell back to the full skin)" : "");
+	if (morph_channels)
+		note(job, "%d morph weight channel(s) copied to the level nodes", morph_channels);
+	if (untransformable)
+		note(job, "%d static mesh node(s) with a sheared matrix: no MSFT_lod", untransformable);
 
 	/* extras.mlod.mesh_levels on the scene, next to what is there. */
-	if (job->level_count > 0 && mlod_gltf_count(doc, MLOD_GLTF_SCENE) > 0) {
-		char *old = NULL, levels[4096];
-		size_t n = 0;
-		n += (size_t)snprintf(levels + n, sizeof levels - n, "[");
-		for (int k = 0; k < job->level_count && n < sizeof levels - 256; k++)
-			n += (size_t)snprintf(levels + n, sizeof levels - n,
-			                      "%s{\"level\":%d,\"ratio\":%.6g,\"triangles\":%d,\"vertices\":%d,"
-			                      "\"error_percent\":{\"mean\":%.9g,\"max\":%.9g}}",
-			                      k ? "," : "", k + 1, job->levels[k].ratio, job->levels[k].triangles,
-			                      job->levels[k].vertices, job->levels[k].error.mean, job->levels[k].error.max);
+	if (job->level_count > 0) {
+		char levels[4096];
+		size_t n = (size_t)snprintf(levels, sizeof levels, "[");
+		for (int k = 0; k < job->level_count && n < sizeof levels - 256; k++) {
+			n += (size_t)snprintf(levels + n, sizeof levels - n, "%s", k ? "," : "");
+			level_json(&job->levels[k], k, levels + n, sizeof levels - n);
+			n = strlen(levels);
+		}
 		snprintf(levels + n, sizeof levels - n, "]");
-		if (mlod_gltf_get_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", &old, &err) != MLOD_OK)
-			tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
-		size_t len = old ? strlen(old) : 0, size = len + strlen(levels) + 64;
-		char *json = malloc(size);
-		if (!json)
-			tool_die(EXIT_OUTPUT, NULL, "out of memory");
-		jv parsed;
-		int parsed_ok = old && parse_value(old, &parsed, 0), object = parsed_ok && parsed.type == 'o';
-		const jv *prev = object ? member(&parsed, "mesh_levels") : NULL;
-		if (prev) /* from an earlier run: replaced */
-			snprintf(json, size, "%.*s%s%s", (int)(prev->start - old), old, levels, prev->end);
-		else if (object && parsed.count > 0) /* next to the skeleton levels, say */
-			snprintf(json, size, "%.*s,\"mesh_levels\":%s}", (int)(parsed.end - 1 - old), old, levels);
-		else
-			snprintf(json, size, "{\"mesh_levels\":%s}", levels);
-		if (parsed_ok)
-			jv_free(&parsed);
-		mlod_free(old);
-		if (mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", json, &err) != MLOD_OK)
-			tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
-		free(json);
+		set_scene_mlod(doc, "mesh_levels", levels);
 	}
-	free(sl.skins);
-	free(sl.remap);
 	tool_write_gltf(output, doc);
 }
 
-/* One glb per level: the level as a character of its own (a new document:
- * the materials of the input are not carried over). */
-static void write_split(struct job *job, const char *dir, const char *input_path)
+/* One glb per level: the input document with each simplified node's mesh
+ * replaced by its level (skinned ones on the matching skeleton level's
+ * skin, rigid and static ones where they hang), the full meshes pruned. */
+static void write_split(struct job *job, const mlod_gltf *input, const char *dir, const char *input_path)
 {
 	struct stat st;
 	if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
@@ -764,10 +906,44 @@ static void write_split(struct job *job, const char *dir, const char *input_path
 	const char *dot = strrchr(base, '.');
 	if (dot && dot != base)
 		blen = (size_t)(dot - base);
+	const mlod_character *c = &job->c;
+	int unpruned = 0;
 	for (int k = 0; k < job->level_count; k++) {
+		struct level *lv = &job->levels[k];
 		mlod_gltf *doc = NULL;
 		mlod_error err = {0};
-		if (mlod_gltf_from_character(&job->levels[k].view, &doc, &err) != MLOD_OK)
+		if (mlod_gltf_copy(input, &doc, &err) != MLOD_OK)
+			tool_die(EXIT_OUTPUT, dir, "level %d: %s", k + 1, err.message);
+		for (int i = 0; i < c->instance_count; i++) {
+			const mlod_instance *in = &c->instances[i];
+			if (!has_levels(job, i))
+				continue;
+			/* A rigid part stays under its joint: without the weights its level was given. */
+			mlod_mesh m = lv->meshes[i];
+			mlod_primitive *prims = malloc(sizeof *prims * ((size_t)m.primitive_count + 1));
+			if (!prims)
+				tool_die(EXIT_OUTPUT, dir, "out of memory");
+			for (int p = 0; p < m.primitive_count; p++) {
+				prims[p] = m.primitives[p];
+				if (in->skin < 0 && lv->owned[i][p])
+					prims[p].weight_set_count = 0;
+			}
+			m.primitives = prims;
+			int mesh = add_level_mesh(job, doc, i, &m);
+			free(prims);
+			/* A level file holds one level: the node's earlier levels (the
+			 * skeleton levels' nodes, say) go. */
+			if (mlod_gltf_clear_lod(doc, in->node, &err) != MLOD_OK ||
+			    mlod_gltf_set_node_mesh(doc, in->node, mesh, lv->skins[i], &err) != MLOD_OK)
+				tool_die(EXIT_OUTPUT, dir, "level %d: %s", k + 1, err.message);
+		}
+		char json[512];
+		level_json(lv, k, json, sizeof json);
+		set_scene_mlod(doc, "mesh_level", json);
+		mlod_result r = mlod_gltf_prune(doc, &err);
+		if (r == MLOD_ERR_UNSUPPORTED)
+			unpruned = 1;
+		else if (r != MLOD_OK)
 			tool_die(EXIT_OUTPUT, dir, "level %d: %s", k + 1, err.message);
 		size_t n = strlen(dir) + blen + 32;
 		char *path = malloc(n);
@@ -778,6 +954,8 @@ static void write_split(struct job *job, const char *dir, const char *input_path
 		free(path);
 		mlod_gltf_free(doc);
 	}
+	if (unpruned)
+		note(job, "the split glb keep the full meshes too: an extension may refer to them");
 }
 
 /* ---------------------------------------------------------------- */
@@ -787,6 +965,11 @@ static void write_split(struct job *job, const char *dir, const char *input_path
 static const char *cost_name(mlod_mesh_cost c)
 {
 	return c == MLOD_COST_COMPACTNESS ? "compactness" : "posed";
+}
+
+static const char *budget_name(enum budget b)
+{
+	return b == BUDGET_PRIMITIVE ? "primitive" : "character";
 }
 
 static const char *placement_name(mlod_placement p)
@@ -832,11 +1015,11 @@ static void report_table(const struct job *job)
 	       "%d border and %d non-manifold edges; %d primitives simplified; build %.1f ms\n",
 	       job->input, job->triangles, job->vertices, t.nodes, t.seam_nodes, t.eligible_nodes, t.locked_nodes,
 	       t.border_edges, t.nonmanifold_edges, job->simplified, 1e3 * job->build_seconds);
-	printf("# cost %s, placement %s, eligibility %s (tau %g)%s; error over %d poses (rest, clip frames, %d random "
+	printf("# cost %s, budget per %s, placement %s, eligibility %s (tau %g)%s; error over %d poses (rest, clip frames, %d random "
 	       "up to 40 degrees)\n",
-	       cost_name(job->opt.cost), placement_name(job->opt.placement), eligibility_name(&job->opt),
-	       job->opt.tau > 0 ? job->opt.tau : 1.0, job->opt.allow_border ? ", borders allowed" : "",
-	       job->measure.count, RANDOM_POSES);
+	       cost_name(job->opt.cost), budget_name(job->budget), placement_name(job->opt.placement),
+	       eligibility_name(&job->opt), job->opt.tau > 0 ? job->opt.tau : 1.0,
+	       job->opt.allow_border ? ", borders allowed" : "", job->measure.count, RANDOM_POSES);
 	printf("%5s  %6s  %9s  %8s  %10s  %10s  %5s  %9s  %11s\n", "level", "ratio", "triangles", "vertices", "mean%",
 	       "max%", "caps", "build ms", "collapse ms");
 	printf("%5d  %6s  %9d  %8d  %10s  %10s  %5s  %9s  %11s\n", 0, "1", job->triangles, job->vertices, "0", "0", "-",
@@ -865,10 +1048,11 @@ static void report_json(const struct job *job)
 	       job->vertices, t.nodes, t.seam_nodes);
 	printf("  \"border_edges\": %d,\n  \"nonmanifold_edges\": %d,\n  \"locked_nodes\": %d,\n  \"eligible_nodes\": %d,\n",
 	       t.border_edges, t.nonmanifold_edges, t.locked_nodes, t.eligible_nodes);
-	printf("  \"simplified_primitives\": %d,\n  \"build_ms\": %.6g,\n", job->simplified, 1e3 * job->build_seconds);
-	printf("  \"options\": {\"cost\": \"%s\", \"placement\": \"%s\", \"eligibility\": \"%s\", \"tau\": %g, "
-	       "\"allow_border\": %s},\n",
-	       cost_name(job->opt.cost), placement_name(job->opt.placement), eligibility_name(&job->opt),
+	printf("  \"simplified_primitives\": %d,\n  \"static_primitives\": %d,\n  \"build_ms\": %.6g,\n", job->simplified,
+	       job->statics, 1e3 * job->build_seconds);
+	printf("  \"options\": {\"cost\": \"%s\", \"budget\": \"%s\", \"placement\": \"%s\", \"eligibility\": \"%s\", "
+	       "\"tau\": %g, \"allow_border\": %s},\n",
+	       cost_name(job->opt.cost), budget_name(job->budget), placement_name(job->opt.placement), eligibility_name(&job->opt),
 	       job->opt.tau > 0 ? job->opt.tau : 1.0, job->opt.allow_border ? "true" : "false");
 	printf("  \"measured_poses\": %d,\n  \"levels\": [\n", job->measure.count);
 	for (int k = 0; k < job->level_count; k++) {
@@ -900,6 +1084,7 @@ int main(int argc, char **argv)
 		{"ratios", required_argument, NULL, 'R'},
 		{"max-error", required_argument, NULL, 'e'},
 		{"cost", required_argument, NULL, 'c'},
+		{"budget", required_argument, NULL, 'B'},
 		{"placement", required_argument, NULL, 'p'},
 		{"eligibility", required_argument, NULL, 'E'},
 		{"tau", required_argument, NULL, 't'},
@@ -910,6 +1095,7 @@ int main(int argc, char **argv)
 		{NULL, 0, NULL, 0},
 	};
 	static const char *const costs[] = {"compactness", "posed"};
+	static const char *const budgets[] = {"character", "primitive"};
 	static const char *const placements[] = {"barycenter", "optimal"};
 	static const char *const rules[] = {"literal", "bend", "all"};
 	const char *output = NULL, *split = NULL;
@@ -921,7 +1107,7 @@ int main(int argc, char **argv)
 
 	tool_name = "mlod-bgm";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:p:E:t:bs:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:B:p:E:t:bs:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -931,6 +1117,7 @@ int main(int argc, char **argv)
 			break;
 		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
 		case 'c': job.opt.cost = (mlod_mesh_cost)(MLOD_COST_COMPACTNESS + parse_enum("--cost", optarg, costs, 2)); break;
+		case 'B': job.budget = (enum budget)(BUDGET_CHARACTER + parse_enum("--budget", optarg, budgets, 2)); break;
 		case 'p':
 			job.opt.placement = (mlod_placement)(MLOD_PLACE_BARYCENTER + parse_enum("--placement", optarg, placements, 2));
 			break;
@@ -954,6 +1141,8 @@ int main(int argc, char **argv)
 		tool_usage_error("--report and --output do not go together");
 	if (job.opt.cost == MLOD_COST_DEFAULT)
 		job.opt.cost = MLOD_COST_POSED;
+	if (job.budget == BUDGET_DEFAULT) /* measured: see the man page */
+		job.budget = job.opt.cost == MLOD_COST_POSED ? BUDGET_CHARACTER : BUDGET_PRIMITIVE;
 	if (job.opt.placement == MLOD_PLACE_DEFAULT)
 		job.opt.placement = job.opt.cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_OPTIMAL;
 	qsort(ratios, (size_t)ratio_count, sizeof *ratios, double_desc);
@@ -1003,18 +1192,22 @@ int main(int argc, char **argv)
 				job.levels[job.level_count++] = lv;
 			}
 		}
+		struct skel_levels sl;
+		read_skeleton_levels(&job, doc, &sl);
+		job.skeleton_levels = sl.count;
+		level_skins(&job, &sl);
+		if (split) /* first: write_glb changes doc */
+			write_split(&job, doc, split, input_path);
 		if (report == REPORT_NONE) {
-			if (split) /* first: write_glb remaps level joints to skeleton levels */
-				write_split(&job, split, input_path);
-			write_glb(&job, doc, output);
+			write_glb(&job, doc, output, &sl);
 		} else {
-			if (split)
-				write_split(&job, split, input_path);
 			if (report == REPORT_TABLE)
 				report_table(&job);
 			else
 				report_json(&job);
 		}
+		free(sl.skins);
+		free(sl.remap);
 	}
 	if (fflush(stdout) != 0)
 		tool_die(EXIT_OUTPUT, "<stdout>", "write error");

@@ -2,7 +2,7 @@
 # MSFT_lod with one node per level and decreasing screen coverage; rigid
 # parts are skinned to their joint; the glb validates.
 set -e
-"$BIN/mlod-bgm" -o out.glb "$ROOT/samples/RobotExpressive.glb"
+"$BIN/mlod-bgm" -R 0.5,0.35,0.3 -o out.glb "$ROOT/samples/RobotExpressive.glb"
 node "$ROOT/tests/validate.mjs" out.glb > /dev/null
 node -e '
 const b = require("fs").readFileSync("out.glb");

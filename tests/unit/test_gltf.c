@@ -630,6 +630,91 @@ static void build_character(mlod_character *c)
 	}
 }
 
+/* A level in place: a copy of the document with one node's mesh replaced
+ * by a coarser one, pruned: the full mesh and its accessors go, the rest
+ * (other meshes, materials, the original document) stays as it was. */
+TEST(level_in_place)
+{
+	mlod_gltf *doc = read_robot(), *copy = NULL, *again = NULL;
+	CHECK_MSG(doc != NULL, "%s", terr.message);
+	mlod_character c = {0}, c2 = {0};
+	CHECK_OK(mlod_gltf_to_character(doc, &c, &terr));
+	char *before = gltf_text(doc);
+	const mlod_instance *in = &c.instances[1];
+	mlod_mesh m = c.meshes[in->mesh];
+	mlod_primitive half = m.primitives[0];
+	half.index_count = half.index_count / 6 * 3;
+	m.primitives = &half;
+	int mesh = -1, meshes = mlod_gltf_count(doc, MLOD_GLTF_MESH);
+	mlod_result r = mlod_gltf_copy(doc, &copy, &terr);
+	if (r == MLOD_OK)
+		r = mlod_gltf_add_mesh_like(copy, m.gltf_index, &m, &mesh, &terr);
+	if (r == MLOD_OK)
+		r = mlod_gltf_set_node_mesh(copy, in->node, mesh, -1, &terr);
+	if (r == MLOD_OK)
+		r = mlod_gltf_prune(copy, &terr);
+	int pruned = mlod_gltf_count(copy, MLOD_GLTF_MESH);
+	if (r == MLOD_OK)
+		r = reread(copy, &again);
+	if (r == MLOD_OK)
+		r = mlod_gltf_to_character(again, &c2, &terr);
+	char *after = gltf_text(doc), *text = gltf_text(copy);
+	int same_original = before && after && strcmp(before, after) == 0;
+	int materials = text && count_of(text, "\"pbrMetallicRoughness\"") == count_of(before, "\"pbrMetallicRoughness\"");
+	free(before);
+	free(after);
+	free(text);
+	CHECK(mlod_gltf_set_node_mesh(copy, in->node, meshes + 5, -1, &terr) == MLOD_ERR_INVALID_ARG);
+	CHECK(mlod_gltf_clear_lod(copy, in->node, &terr) == MLOD_OK); /* no MSFT_lod: nothing to do */
+	mlod_gltf_free(copy);
+	mlod_gltf_free(again);
+	mlod_gltf_free(doc);
+	const char *d = "not read back";
+	if (r == MLOD_OK && c2.instance_count == c.instance_count) {
+		const mlod_mesh *m1 = &c2.meshes[c2.instances[1].mesh], *m0 = &c2.meshes[c2.instances[0].mesh];
+		d = m1->primitives[0].index_count != half.index_count ? "the level is not in place"
+		    : primitive_diff(&c.meshes[c.instances[0].mesh].primitives[0], &m0->primitives[0], 0.0f);
+	}
+	mlod_character_free(&c);
+	mlod_character_free(&c2);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	CHECK(same_original);
+	CHECK(materials);
+	CHECK_MSG(pruned == meshes, "%d meshes after pruning, %d before", pruned, meshes);
+	CHECK_MSG(d == NULL, "%s", d);
+}
+
+/* Level nodes morph like their node; pruning refuses unknown extensions;
+ * a static node's transform. */
+TEST(morph_channels_and_transforms)
+{
+	mlod_gltf *doc = read_robot();
+	CHECK_MSG(doc != NULL, "%s", terr.message);
+	int node = -1, added = -1;
+	mlod_trs t;
+	mlod_result r = mlod_gltf_add_node(doc, "level", MLOD_GLTF_DETACHED, 3, -1, NULL, &node, &terr);
+	if (r == MLOD_OK) /* node 6 (Head_2) has 14 weight channels over the clips */
+		r = mlod_gltf_copy_morph_animation(doc, 6, node, &added, &terr);
+	char *text = r == MLOD_OK ? gltf_text(doc) : NULL;
+	int weights = text ? count_of(text, "\"path\": \"weights\"") : -1;
+	free(text);
+	mlod_result bad = mlod_gltf_copy_morph_animation(doc, 6, node + 1, NULL, &terr);
+	mlod_result trs = mlod_gltf_get_node_trs(doc, 6, &t, &terr);
+	mlod_result bad_trs = mlod_gltf_get_node_trs(doc, -1, &t, &terr);
+	mlod_gltf_free(doc);
+	mlod_gltf *ext = NULL;
+	mlod_result with_ext = read_text("{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\"]}",
+	                                 &ext, &terr);
+	mlod_result pruned = with_ext == MLOD_OK ? mlod_gltf_prune(ext, &terr) : with_ext;
+	mlod_gltf_free(ext);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	CHECK_MSG(added == 14, "%d channels added", added);
+	CHECK_MSG(weights == 42 + 14, "%d weight channels", weights);
+	CHECK(bad == MLOD_ERR_INVALID_ARG);
+	CHECK(trs == MLOD_OK && bad_trs == MLOD_ERR_INVALID_ARG);
+	CHECK(pruned == MLOD_ERR_UNSUPPORTED);
+}
+
 TEST(from_character)
 {
 	mlod_character c, back = {0};
@@ -1197,6 +1282,8 @@ int main(void)
 	RUN(bvh_via_gltf);
 	RUN(empty_objects);
 	RUN(reskinned_mesh);
+	RUN(level_in_place);
+	RUN(morph_channels_and_transforms);
 	RUN(decode_layouts);
 	RUN(empty_and_garbage);
 	RUN(truncated_glb);
