@@ -37,8 +37,8 @@
 static const char usage_text[] =
 	"usage: mlod-bgm [options] [input]\n"
 	"\n"
-	"Simplifies the meshes of a character with the BindGraphMesh, triangle\n"
-	"collapses and Power Skinning (Savoye & Meyer 2008, 4.2). Input is glb or\n"
+	"Simplifies the meshes of a character with the BindGraphMesh, triangle (or\n"
+	"edge) collapses and Power Skinning (Savoye & Meyer 2008, 4.2). Input is glb or\n"
 	"glTF (BVH has no mesh and passes through). Output is a glb whose mesh nodes\n"
 	"carry their levels in MSFT_lod.\n"
 	"\n"
@@ -51,6 +51,9 @@ static const char usage_text[] =
 	"                           whose posed error stays within PCT percent of the\n"
 	"                           bounding diagonal\n"
 	"  -c, --cost NAME          collapse order: posed (default) or compactness\n"
+	"  -C, --collapse NAME      what collapses: edge (the default with the posed\n"
+	"                           cost), triangle (the paper; the only one with\n"
+	"                           compactness) or mixed (both, by cost per face)\n"
 	"  -B, --budget NAME        a level's triangles: character (shared by all\n"
 	"                           primitives, cheapest collapses first; the default\n"
 	"                           with the posed cost) or primitive (each keeps the\n"
@@ -972,6 +975,14 @@ static const char *budget_name(enum budget b)
 	return b == BUDGET_PRIMITIVE ? "primitive" : "character";
 }
 
+static const char *collapse_name(const mlod_bgm_options *o)
+{
+	mlod_collapse_op op = o->op;
+	if (op == MLOD_OP_DEFAULT)
+		op = o->cost == MLOD_COST_COMPACTNESS ? MLOD_OP_TRIANGLE : MLOD_OP_EDGE;
+	return op == MLOD_OP_TRIANGLE ? "triangle" : op == MLOD_OP_EDGE ? "edge" : "mixed";
+}
+
 static const char *placement_name(mlod_placement p)
 {
 	return p == MLOD_PLACE_BARYCENTER ? "barycenter" : "optimal";
@@ -1015,9 +1026,9 @@ static void report_table(const struct job *job)
 	       "%d border and %d non-manifold edges; %d primitives simplified; build %.1f ms\n",
 	       job->input, job->triangles, job->vertices, t.nodes, t.seam_nodes, t.eligible_nodes, t.locked_nodes,
 	       t.border_edges, t.nonmanifold_edges, job->simplified, 1e3 * job->build_seconds);
-	printf("# cost %s, budget per %s, placement %s, eligibility %s (tau %g)%s; error over %d poses (rest, clip frames, %d random "
-	       "up to 40 degrees)\n",
-	       cost_name(job->opt.cost), budget_name(job->budget), placement_name(job->opt.placement),
+	printf("# cost %s, %s collapses, budget per %s, placement %s, eligibility %s (tau %g)%s; error over %d poses (rest, clip "
+	       "frames, %d random up to 40 degrees)\n",
+	       cost_name(job->opt.cost), collapse_name(&job->opt), budget_name(job->budget), placement_name(job->opt.placement),
 	       eligibility_name(&job->opt), job->opt.tau > 0 ? job->opt.tau : 1.0,
 	       job->opt.allow_border ? ", borders allowed" : "", job->measure.count, RANDOM_POSES);
 	printf("%5s  %6s  %9s  %8s  %10s  %10s  %5s  %9s  %11s\n", "level", "ratio", "triangles", "vertices", "mean%",
@@ -1050,9 +1061,9 @@ static void report_json(const struct job *job)
 	       t.border_edges, t.nonmanifold_edges, t.locked_nodes, t.eligible_nodes);
 	printf("  \"simplified_primitives\": %d,\n  \"static_primitives\": %d,\n  \"build_ms\": %.6g,\n", job->simplified,
 	       job->statics, 1e3 * job->build_seconds);
-	printf("  \"options\": {\"cost\": \"%s\", \"budget\": \"%s\", \"placement\": \"%s\", \"eligibility\": \"%s\", "
-	       "\"tau\": %g, \"allow_border\": %s},\n",
-	       cost_name(job->opt.cost), budget_name(job->budget), placement_name(job->opt.placement), eligibility_name(&job->opt),
+	printf("  \"options\": {\"cost\": \"%s\", \"collapse\": \"%s\", \"budget\": \"%s\", \"placement\": \"%s\", "
+	       "\"eligibility\": \"%s\", \"tau\": %g, \"allow_border\": %s},\n",
+	       cost_name(job->opt.cost), collapse_name(&job->opt), budget_name(job->budget), placement_name(job->opt.placement), eligibility_name(&job->opt),
 	       job->opt.tau > 0 ? job->opt.tau : 1.0, job->opt.allow_border ? "true" : "false");
 	printf("  \"measured_poses\": %d,\n  \"levels\": [\n", job->measure.count);
 	for (int k = 0; k < job->level_count; k++) {
@@ -1084,6 +1095,7 @@ int main(int argc, char **argv)
 		{"ratios", required_argument, NULL, 'R'},
 		{"max-error", required_argument, NULL, 'e'},
 		{"cost", required_argument, NULL, 'c'},
+		{"collapse", required_argument, NULL, 'C'},
 		{"budget", required_argument, NULL, 'B'},
 		{"placement", required_argument, NULL, 'p'},
 		{"eligibility", required_argument, NULL, 'E'},
@@ -1095,6 +1107,7 @@ int main(int argc, char **argv)
 		{NULL, 0, NULL, 0},
 	};
 	static const char *const costs[] = {"compactness", "posed"};
+	static const char *const ops[] = {"triangle", "edge", "mixed"};
 	static const char *const budgets[] = {"character", "primitive"};
 	static const char *const placements[] = {"barycenter", "optimal"};
 	static const char *const rules[] = {"literal", "bend", "all"};
@@ -1107,7 +1120,7 @@ int main(int argc, char **argv)
 
 	tool_name = "mlod-bgm";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:B:p:E:t:bs:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:C:B:p:E:t:bs:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -1117,6 +1130,7 @@ int main(int argc, char **argv)
 			break;
 		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
 		case 'c': job.opt.cost = (mlod_mesh_cost)(MLOD_COST_COMPACTNESS + parse_enum("--cost", optarg, costs, 2)); break;
+		case 'C': job.opt.op = (mlod_collapse_op)(MLOD_OP_TRIANGLE + parse_enum("--collapse", optarg, ops, 3)); break;
 		case 'B': job.budget = (enum budget)(BUDGET_CHARACTER + parse_enum("--budget", optarg, budgets, 2)); break;
 		case 'p':
 			job.opt.placement = (mlod_placement)(MLOD_PLACE_BARYCENTER + parse_enum("--placement", optarg, placements, 2));
@@ -1141,6 +1155,8 @@ int main(int argc, char **argv)
 		tool_usage_error("--report and --output do not go together");
 	if (job.opt.cost == MLOD_COST_DEFAULT)
 		job.opt.cost = MLOD_COST_POSED;
+	if (job.opt.cost == MLOD_COST_COMPACTNESS && job.opt.op != MLOD_OP_DEFAULT && job.opt.op != MLOD_OP_TRIANGLE)
+		tool_usage_error("--collapse %s needs --cost posed: compactness ranks triangles only", collapse_name(&job.opt));
 	if (job.budget == BUDGET_DEFAULT) /* measured: see the man page */
 		job.budget = job.opt.cost == MLOD_COST_POSED ? BUDGET_CHARACTER : BUDGET_PRIMITIVE;
 	if (job.opt.placement == MLOD_PLACE_DEFAULT)

@@ -1,0 +1,1 @@
+"$BIN/mlod-bgm" --cost compactness --collapse edge "$ROOT/samples/tubeman.glb"
