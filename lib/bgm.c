@@ -835,6 +835,31 @@ int mlod_bgm_prefix_for(const mlod_bgm *g, int target)
 /* Consistency check (tests)                                         */
 /* ---------------------------------------------------------------- */
 
+long mlod_bgm_share_budget(mlod_bgm *const *bgms, int n, long target, int *prefix)
+{
+	long live = 0;
+	for (int i = 0; i < n; i++) {
+		prefix[i] = 0;
+		live += bgms[i] ? bgms[i]->input_triangles : 0;
+	}
+	while (live > target) {
+		int best = -1;
+		for (int i = 0; i < n; i++) {
+			const mlod_bgm *g = bgms[i];
+			if (g && prefix[i] < g->record_count &&
+			    (best < 0 || g->records[prefix[i]].cost < bgms[best]->records[prefix[best]].cost))
+				best = i;
+		}
+		if (best < 0)
+			break; /* nothing more comes off */
+		const mlod_bgm *g = bgms[best];
+		live = live - (prefix[best] ? g->records[prefix[best] - 1].triangles : g->input_triangles) +
+		       g->records[prefix[best]].triangles;
+		prefix[best]++;
+	}
+	return live;
+}
+
 mlod_result mlod_bgm_check(const mlod_bgm *g, mlod_error *err)
 {
 	if (!g)

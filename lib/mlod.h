@@ -854,6 +854,14 @@ const int *mlod_bgm_removed_faces(const mlod_bgm *g);
  * triangles, or the whole sequence when none does. */
 int mlod_bgm_prefix_for(const mlod_bgm *g, int target);
 
+/* A budget shared by several primitives (beyond the paper): the prefixes
+ * of n simplified BGMs (NULL entries are skipped, prefix 0) that bring
+ * their live triangles down to at most target in all, taking over every
+ * sequence the next collapse of lowest cost first. Meaningful with the
+ * posed cost, whose costs are errors in one unit across primitives.
+ * Returns the triangles left (more than target when the sequences end). */
+long mlod_bgm_share_budget(mlod_bgm *const *bgms, int n, long target, int *prefix);
+
 /* The mesh after the first `prefix` collapses as a primitive (release it
  * with mlod_primitive_free): original vertices keep their attributes;
  * new ones get interpolated attributes (per wedge), morph target offsets,

@@ -387,42 +387,33 @@ static void build_all(struct job *job, double target_ratio)
 	(void)caps_total;
 }
 
-/* The character budget: ratio of all simplified triangles, reached by
- * taking, over every primitive's recorded sequence, the next collapse of
- * lowest cost first (the posed costs are errors in one unit: comparable
- * across primitives). Sets each part's k. */
+/* The character budget: ratio of all simplified triangles, shared among
+ * the primitives by posed cost (mlod_bgm_share_budget). Sets each part's
+ * k. */
 static void character_prefixes(struct job *job, double ratio)
 {
 	const mlod_character *c = &job->c;
-	long total = 0, live = 0;
+	int n = 0, at = 0;
+	long total = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		n += c->meshes[c->instances[i].mesh].primitive_count;
+	mlod_bgm **bgms = calloc((size_t)n + 1, sizeof *bgms);
+	int *prefix = calloc((size_t)n + 1, sizeof *prefix);
+	if (!bgms || !prefix)
+		tool_die(EXIT_INPUT, job->input, "out of memory");
 	for (int i = 0; i < c->instance_count; i++)
 		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
 			struct part *pt = &job->parts[i][p];
-			pt->k = 0;
-			if (pt->bgm) {
-				total += pt->triangles;
-				live += mlod_bgm_triangles(pt->bgm, 0);
-			}
+			bgms[at++] = pt->bgm;
+			total += pt->bgm ? pt->triangles : 0;
 		}
-	long target = (long)ceil(ratio * (double)total);
-	while (live > target) {
-		struct part *best = NULL;
-		double cost = 0.0;
-		for (int i = 0; i < c->instance_count; i++)
-			for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
-				struct part *pt = &job->parts[i][p];
-				int count = 0;
-				const mlod_vsplit *seq = pt->bgm ? mlod_bgm_sequence(pt->bgm, &count) : NULL;
-				if (pt->k < count && (!best || seq[pt->k].cost < cost)) {
-					best = pt;
-					cost = seq[pt->k].cost;
-				}
-			}
-		if (!best)
-			break; /* nothing more comes off */
-		live -= mlod_bgm_triangles(best->bgm, best->k);
-		live += mlod_bgm_triangles(best->bgm, ++best->k);
-	}
+	mlod_bgm_share_budget(bgms, n, (long)ceil(ratio * (double)total), prefix);
+	at = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
+			job->parts[i][p].k = prefix[at++];
+	free(bgms);
+	free(prefix);
 }
 
 /* Extracts level lv at ratio (with the primitive budget, per primitive
