@@ -233,6 +233,8 @@ typedef struct mlod_channel {
 	int key_count;
 	float *times;     /* key_count, strictly increasing, seconds */
 	float *values;
+	int short_values; /* rotation, not CUBICSPLINE: every value is n / 32767 for an integer n
+	                     (|n| <= 32767), so glTF writes them as normalised shorts; 0: floats */
 } mlod_channel;
 
 typedef struct mlod_clip {
@@ -863,11 +865,16 @@ typedef enum mlod_motion_target {
 	MLOD_MOTION_MAX_ERROR  /* the coarsest level whose joint position error is at most this (scene units) */
 } mlod_motion_target;
 
-/* How a level stores its key values. Both keep float32 (plain glTF). */
+/* How a level stores its key values (plain glTF in every case). */
 typedef enum mlod_motion_precision {
-	MLOD_MOTION_PRECISION_AUTO, /* values rounded to the coarsest power-of-two grids that keep the
-	                               level within its bound (the low mantissa bits become zeros) */
-	MLOD_MOTION_PRECISION_FULL  /* values as read */
+	MLOD_MOTION_PRECISION_AUTO,  /* rotations on the lattice of normalised shorts (n / 32767, core
+	                                glTF, 8 bytes a key), translations and scales float32 rounded to
+	                                power-of-two grids: the coarsest that keep the level within its
+	                                bound. First and last keys: translations and scales exact,
+	                                rotations on the finest lattice (1/65534 per component). */
+	MLOD_MOTION_PRECISION_FLOAT, /* every value float32 rounded to power-of-two grids (the low
+	                                mantissa bits become zeros); first and last keys exact */
+	MLOD_MOTION_PRECISION_FULL   /* values as read */
 } mlod_motion_precision;
 
 /* Zero-initialised options are the defaults. */

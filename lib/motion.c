@@ -38,15 +38,17 @@
  *   than averaging (bench/RESULTS.md) and is the default.
  * - The keys method (keyreduce.c) is driven from here the same way, with
  *   the error budget in place of the threshold.
- * - Value precision (beyond the paper; auto by default). A level's key
- *   values stay float32 but are rounded to power-of-two grids, so their
- *   low mantissa bits are zeros and gzip/zstd compress them well: keys go
- *   within (1 - share) of the bound, then the coarsest level grid whose
- *   measured error stays within the bound is bisected (translations on
- *   it, rotations and scales finer by their joint's reach), then each
- *   channel takes coarser grids while the bound holds. A rotation's
- *   largest component is recomputed from the three rounded ones, so it
- *   stays unit; every channel's first and last keys stay exact.
+ * - Value precision (beyond the paper). Keys go within (1 - share) of
+ *   the bound; the values are then rounded, so that few bits vary and
+ *   gzip/zstd compress them well: the coarsest level grid whose measured
+ *   error stays within the bound is bisected (translations on it,
+ *   rotations and scales finer by their joint's reach), then each channel
+ *   takes coarser grids while the bound holds. A rotation's three smaller
+ *   components are rounded and its largest recomputed from them, so it
+ *   stays (about) unit. By default (auto) rotations go on the lattice of
+ *   normalised shorts, as gltfpack stores them (core glTF), and
+ *   translations and scales stay float32 on power-of-two grids; float
+ *   keeps every value float32, with the first and last keys exact.
  *
  * Error bounds are checked on the point error of every joint at every
  * frame of the common timeline (mlod_motion_point_error: the joint's
@@ -116,7 +118,7 @@ long mlod_clip_key_bytes(const mlod_clip *clip)
 	for (int i = 0; i < clip->channel_count; i++) {
 		const mlod_channel *ch = &clip->channels[i];
 		long per_key = comps_of(ch) * (ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
-		bytes += (long)ch->key_count * per_key * 4;
+		bytes += (long)ch->key_count * per_key * (ch->short_values ? 2 : 4);
 		int shared = 0;
 		for (int k = 0; k < i && !shared; k++) {
 			const mlod_channel *o = &clip->channels[k];
@@ -818,11 +820,23 @@ void mlod_motion_level_free(mlod_motion_level *l)
 	memset(l, 0, sizeof *l);
 }
 
+/* The part of a max-error bound the keys (or frames) may spend: with auto
+ * precision, the rest is left to rounding the values. */
+static double removal_bound(const mlod_motion *m, double bound)
+{
+	if (m->opt.precision == MLOD_MOTION_PRECISION_FULL)
+		return bound;
+	double share = m->opt.precision_share > 0.0 && m->opt.precision_share < 1.0 ? m->opt.precision_share
+	                                                                            : DEFAULT_PRECISION_SHARE;
+	return bound * (1.0 - share);
+}
+
 /* ---------------------------------------------------------------- */
 /* Value precision                                                   */
 /* ---------------------------------------------------------------- */
 
 #define NO_ROUNDING INT_MIN
+#define SHORTS(m) ((m)->opt.precision == MLOD_MOTION_PRECISION_AUTO)
 #define GRID_RANGE 48     /* grids tried: from 2^48 times finer than the bound up to it */
 #define CHANNEL_COARSER 8 /* per channel, up to this many doublings beyond the level's grid */
 
@@ -858,12 +872,56 @@ static void round_quat(float *q, int e)
 /* dst, laid out as src, gets src's values rounded: channel i to the grid
  * 2^e[i] (NO_ROUNDING: as they are). The first and last key of every
  * channel stay exact. */
-static void round_channel(const mlod_channel *a, mlod_channel *b, int e)
+/* The lattice of normalised shorts: n / 32767 as glTF readers decode it. */
+static float short_value(long n)
+{
+	return (float)((double)n / 32767.0);
+}
+
+/* Rounds a unit quaternion onto the lattice of normalised shorts: its three
+ * smaller components to multiples of 2^a / 32767, the largest to the
+ * nearest lattice value that makes it unit. */
+static void round_quat_short(float *q, int a)
+{
+	int big = 0;
+	for (int c = 1; c < 4; c++)
+		if (fabsf(q[c]) > fabsf(q[big]))
+			big = c;
+	double step = ldexp(1.0, a), sum = 0.0;
+	long n[4];
+	for (int c = 0; c < 4; c++)
+		if (c != big) {
+			n[c] = lrint(rint((double)q[c] * 32767.0 / step) * step);
+			n[c] = n[c] > 32767 ? 32767 : n[c] < -32767 ? -32767 : n[c];
+			sum += (double)short_value(n[c]) * short_value(n[c]);
+		}
+	if (!(sum < 1.0)) /* a grid too coarse for this key: the finest lattice */
+		for (int c = 0; c < 4; c++)
+			n[c] = lrint((double)q[c] * 32767.0);
+	else
+		n[big] = lrint(copysign(sqrt(1.0 - sum), (double)q[big]) * 32767.0);
+	for (int c = 0; c < 4; c++)
+		q[c] = short_value(n[c]);
+}
+
+/* b gets a's values rounded to the grid 2^e (NO_ROUNDING: as they are),
+ * the first and last keys exact; with shorts, a rotation goes on the
+ * lattice of normalised shorts instead, every key (the ends on the finest
+ * lattice). */
+static void round_channel(const mlod_channel *a, mlod_channel *b, int e, int shorts)
 {
 	int comps = comps_of(a), n = a->key_count;
 	memcpy(b->values, a->values, sizeof(float) * (size_t)n * (size_t)comps);
+	b->short_values = 0;
 	if (e == NO_ROUNDING)
 		return;
+	if (shorts && comps == 4 && a->interp != MLOD_INTERP_CUBICSPLINE) {
+		int lattice = e + 15 > 0 ? e + 15 : 0; /* 2^e is about 2^(e + 15) / 32767 */
+		for (int k = 0; k < n; k++)
+			round_quat_short(b->values + (size_t)k * 4u, k == 0 || k == n - 1 ? 0 : lattice);
+		b->short_values = 1;
+		return;
+	}
 	for (int k = 1; k + 1 < n; k++) {
 		float *v = b->values + (size_t)k * (size_t)comps;
 		if (comps == 4)
@@ -874,10 +932,10 @@ static void round_channel(const mlod_channel *a, mlod_channel *b, int e)
 	}
 }
 
-static void round_clip(const mlod_clip *src, mlod_clip *dst, const int *e)
+static void round_clip(const mlod_clip *src, mlod_clip *dst, const int *e, int shorts)
 {
 	for (int i = 0; i < src->channel_count; i++)
-		round_channel(&src->channels[i], &dst->channels[i], e[i]);
+		round_channel(&src->channels[i], &dst->channels[i], e[i], shorts);
 }
 
 /* A deep copy of a level clip, or -1 when out of memory. */
@@ -922,7 +980,7 @@ static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int
                       double bound)
 {
 	channel_exps(m, src, g, adj, e);
-	round_clip(src, clip, e);
+	round_clip(src, clip, e, SHORTS(m));
 	return level_error_upto(m, clip, bound) <= bound;
 }
 
@@ -957,7 +1015,7 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	int *sub = malloc(sizeof(int) * (size_t)J);
 	const float *times = m->common.channels[0].times;
 	channel_exps(m, src, g, adj, e);
-	round_clip(src, clip, e);
+	round_clip(src, clip, e, SHORTS(m));
 	if (!L || !W || !w || !sub) {
 		free(L), free(W), free(w), free(sub);
 		return -1;
@@ -982,7 +1040,7 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 		while (adj[i] < CHANNEL_COARSER) {
 			adj[i]++;
 			channel_exps(m, src, g, adj, e);
-			round_channel(&src->channels[i], ch, e[i]);
+			round_channel(&src->channels[i], ch, e[i], SHORTS(m));
 			int ok = 1;
 			for (int pass = 0; pass < 2 && ok; pass++) /* check, then commit */
 				for (int f = 0; f < F && ok; f++) {
@@ -1005,7 +1063,7 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 			if (!ok) {
 				adj[i]--;
 				channel_exps(m, src, g, adj, e);
-				round_channel(&src->channels[i], ch, e[i]);
+				round_channel(&src->channels[i], ch, e[i], SHORTS(m));
 				break;
 			}
 		}
@@ -1038,7 +1096,7 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 	if (!round_fits(m, &src, clip, lo, adj, e, bound)) {
 		for (int i = 0; i < n; i++)
 			e[i] = NO_ROUNDING;
-		round_clip(&src, clip, e);
+		round_clip(&src, clip, e, SHORTS(m));
 	} else {
 		if (round_fits(m, &src, clip, hi, adj, e, bound))
 			lo = hi;
@@ -1066,13 +1124,17 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 }
 
 /* Fills the level's counts and its error as mlod_joint_deviation measures
- * it, after rounding its values (auto precision) within bound (< 0: within
- * the error the level already has). */
+ * it, after rounding its values within bound (< 0: a level chosen by
+ * threshold or fraction, whose error e may grow to e / (1 - share), the
+ * share a bound leaves to rounding). */
 static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double bound, mlod_error *err)
 {
-	if (m->opt.precision == MLOD_MOTION_PRECISION_AUTO &&
-	    level_round(m, &out->clip, bound >= 0.0 ? bound : level_max_error(m, &out->clip), &out->grid) != 0)
-		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	if (m->opt.precision != MLOD_MOTION_PRECISION_FULL) {
+		if (bound < 0.0)
+			bound = level_max_error(m, &out->clip) / removal_bound(m, 1.0);
+		if (level_round(m, &out->clip, bound, &out->grid) != 0)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
 	out->point_error = level_max_error(m, &out->clip);
 	out->keys = mlod_clip_key_count(&out->clip);
 	out->bytes = mlod_clip_key_bytes(&out->clip);
@@ -1284,17 +1346,6 @@ static long line_keys(const mlod_motion *m, const line *l)
 	for (int i = 0; i < m->common.channel_count; i++)
 		keys += m->constant[i] ? 1 : l->n;
 	return keys;
-}
-
-/* The part of a max-error bound the keys (or frames) may spend: with auto
- * precision, the rest is left to rounding the values. */
-static double removal_bound(const mlod_motion *m, double bound)
-{
-	if (m->opt.precision != MLOD_MOTION_PRECISION_AUTO)
-		return bound;
-	double share = m->opt.precision_share > 0.0 && m->opt.precision_share < 1.0 ? m->opt.precision_share
-	                                                                            : DEFAULT_PRECISION_SHARE;
-	return bound * (1.0 - share);
 }
 
 /* The frames method: the next line of the tree. */

@@ -46,12 +46,14 @@ static const char usage_text[] =
 	"      --merge MODE        frames method: remove (default) or average\n"
 	"      --point-distance D  keys method: radius of the points carried by each\n"
 	"                          joint (default 0.1 for glTF, height/18 for BVH)\n"
-	"      --precision MODE    auto: round each level's key values (float32) to the\n"
-	"                          coarsest power-of-two grids that keep its bound, so\n"
-	"                          their low bits are zeros and compress well; full:\n"
+	"      --precision MODE    how level key values are stored, rounded within each\n"
+	"                          bound so they compress well: auto stores rotations as\n"
+	"                          normalised shorts (core glTF) and the rest as floats on\n"
+	"                          power-of-two grids; float keeps every value float32 on\n"
+	"                          such grids, first and last keys exact; full keeps the\n"
 	"                          values as read (default auto)\n"
-	"      --precision-share F auto precision: the share of each bound left to\n"
-	"                          rounding, the rest to removing keys (default 0.1)\n"
+	"      --precision-share F the share of each bound left to rounding, the rest to\n"
+	"                          removing keys (default 0.1)\n"
 	"      --cubic-rate R      resample CUBICSPLINE clips at R frames/s (default 60)\n"
 	"  -l, --level K           with a .bvh output: the level to write (0 = as read)\n"
 	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
@@ -282,8 +284,9 @@ static void report_table(const struct job *job)
 	       "# position error against the clip as read, scene units and %% of the height; pt: point error (joint\n"
 	       "# origins and points within the point distance), scene units; vtx: skinned-vertex error, %% of the\n"
 	       "# bounding diagonal\n");
-	if (job->opt.precision == MLOD_MOTION_PRECISION_AUTO)
-		printf("# key values rounded to power-of-two grids within each level's bound (--precision auto)\n");
+	if (job->opt.precision != MLOD_MOTION_PRECISION_FULL)
+		printf("# key values rounded within each level's bound (--precision %s)\n",
+		       job->opt.precision == MLOD_MOTION_PRECISION_AUTO ? "auto" : "float");
 	if (job->c.notes && *job->c.notes)
 		printf("# note: %s\n", job->c.notes);
 }
@@ -484,10 +487,12 @@ int main(int argc, char **argv)
 		case 'p':
 			if (strcmp(optarg, "auto") == 0)
 				job.opt.precision = MLOD_MOTION_PRECISION_AUTO;
+			else if (strcmp(optarg, "float") == 0)
+				job.opt.precision = MLOD_MOTION_PRECISION_FLOAT;
 			else if (strcmp(optarg, "full") == 0)
 				job.opt.precision = MLOD_MOTION_PRECISION_FULL;
 			else
-				tool_usage_error("--precision: unknown mode '%s' (auto or full)", optarg);
+				tool_usage_error("--precision: unknown mode '%s' (auto, float or full)", optarg);
 			break;
 		case 'S':
 			job.opt.precision_share = tool_parse_double("--precision-share", optarg, 0.0, 1.0);
