@@ -189,9 +189,9 @@ static int float_order(const void *a, const void *b)
 	return (x > y) - (x < y);
 }
 
-/* Samples one channel of clip at t into out (comps floats), exactly as
- * mlod_clip_sample does. */
-static void sample_one(const mlod_clip *clip, const mlod_channel *ch, float t, float *out)
+/* Sets the path of l that channel ch of clip animates to its value at t,
+ * as mlod_clip_sample does. */
+static void sample_into(const mlod_clip *clip, const mlod_channel *ch, float t, mlod_trs *l)
 {
 	mlod_channel one = *ch;
 	mlod_clip tmp;
@@ -200,8 +200,15 @@ static void sample_one(const mlod_clip *clip, const mlod_channel *ch, float t, f
 	tmp.duration = clip->duration;
 	tmp.channel_count = 1;
 	tmp.channels = &one;
+	mlod_clip_sample(&tmp, t, l);
+}
+
+/* Samples one channel of clip at t into out (comps floats), exactly as
+ * mlod_clip_sample does. */
+static void sample_one(const mlod_clip *clip, const mlod_channel *ch, float t, float *out)
+{
 	mlod_trs local = mlod_trs_identity();
-	mlod_clip_sample(&tmp, t, &local);
+	sample_into(clip, ch, t, &local);
 	switch (ch->path) {
 	case MLOD_PATH_TRANSLATION: out[0] = local.t.x, out[1] = local.t.y, out[2] = local.t.z; break;
 	case MLOD_PATH_SCALE: out[0] = local.s.x, out[1] = local.s.y, out[2] = local.s.z; break;
@@ -982,20 +989,6 @@ static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
 	return level_error_upto(m, clip, bound) <= bound;
-}
-
-/* Sets the path of l that channel ch of clip animates to its value at t,
- * as mlod_clip_sample does. */
-static void sample_into(const mlod_clip *clip, const mlod_channel *ch, float t, mlod_trs *l)
-{
-	mlod_channel one = *ch;
-	mlod_clip tmp;
-	memset(&tmp, 0, sizeof tmp);
-	one.joint = 0;
-	tmp.duration = clip->duration;
-	tmp.channel_count = 1;
-	tmp.channels = &one;
-	mlod_clip_sample(&tmp, t, l);
 }
 
 /* Per-channel refinement: each channel in turn goes to coarser grids
