@@ -2,15 +2,20 @@
  * bench_motion.c: motion layer benchmarks.
  *
  *   bench_motion convert IN OUT.glb      writes IN (BVH, glTF) as glb
- *   bench_motion peers ORIG LABEL=FILE...
+ *   bench_motion peers ORIG LABEL=FILE[@KEYS]...
  *                                        compares other tools' outputs of ORIG
  *                                        (gltfpack) with mlod's levels at the
  *                                        same error: per output, the keys, key
  *                                        bytes raw and compressed (gzip -9,
- *                                        zstd -19 on the same layout), and the
- *                                        max joint position error measured by
+ *                                        zstd -19 on the same layout: times,
+ *                                        then values as stored), and the max
+ *                                        joint position error measured by
  *                                        mlod_joint_deviation; mlod's levels use
- *                                        per clip the peer's own error as bound
+ *                                        per clip the peer's own error as bound.
+ *                                        KEYS: the peer's key data as its file
+ *                                        stores it (bench/anim-keys.mjs)
+ *   bench_motion precision FILE...       the value precision modes and shares
+ *                                        of the bound at 1% and 0.2%
  *   bench_motion methods FILE...         both methods (and both merges of the
  *                                        tree) at 0.2%, 1% and 3% of the height
  *   bench_motion speed FILE...           time to build the default levels
@@ -64,6 +69,17 @@ static int load(const char *path, mlod_character *c, mlod_gltf **doc)
 	return r == MLOD_OK ? 0 : -1;
 }
 
+/* load, plus the skeleton height and the point distance mlod-motion uses
+ * (height / 18 for BVH, 10 cm for glTF). */
+static int load_sized(const char *path, mlod_character *c, double *h, double *pd)
+{
+	if (load(path, c, NULL) != 0)
+		return -1;
+	*h = mlod_skeleton_size(&c->skeleton);
+	*pd = strstr(path, ".bvh") ? *h / 18.0 : 0.1;
+	return 0;
+}
+
 static const char *base_name(const char *path)
 {
 	const char *s = strrchr(path, '/');
@@ -90,7 +106,14 @@ static void write_keys(FILE *f, const mlod_clip *clip)
 	for (int i = 0; i < clip->channel_count; i++) {
 		const mlod_channel *ch = &clip->channels[i];
 		size_t per = (ch->path == MLOD_PATH_ROTATION ? 4 : 3) * (ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
-		fwrite(ch->values, sizeof(float), per * (size_t)ch->key_count, f);
+		for (size_t k = 0; ch->short_values && k < per * (size_t)ch->key_count; k++) {
+			/* normalised shorts, little-endian, as the glTF writer stores them */
+			long n = lrint((double)ch->values[k] * 32767.0);
+			unsigned char b[2] = {(unsigned char)(n & 0xff), (unsigned char)((unsigned long)n >> 8 & 0xff)};
+			fwrite(b, 1, 2, f);
+		}
+		if (!ch->short_values)
+			fwrite(ch->values, sizeof(float), per * (size_t)ch->key_count, f);
 	}
 }
 
@@ -198,12 +221,29 @@ static mlod_deviation all_error(const mlod_character *a, const mlod_character *b
 	return d;
 }
 
+/* Sizes of key data stored in a file (a peer's, as bench/anim-keys.mjs
+ * extracts it from its glb); keys as counted in clips. */
+static sizes file_sizes(const char *path, long keys)
+{
+	sizes s = {keys, -1, -1, -1};
+	FILE *f = fopen(path, "rb");
+	if (f) {
+		fseek(f, 0, SEEK_END);
+		s.raw = ftell(f);
+		fclose(f);
+		s.gz = compressed("gzip -9 -c", path);
+		s.zst = compressed("zstd -19 -c -q", path);
+	}
+	return s;
+}
+
 /* mlod's level of clip k within bound, by method (-1: auto). */
-static int our_level(const mlod_character *c, int k, int method, double bound, double point_distance,
-                     mlod_motion_level *out)
+static int our_level(const mlod_character *c, int k, int method, mlod_motion_precision precision, double bound,
+                     double point_distance, mlod_motion_level *out)
 {
 	mlod_motion_options opt = {0};
 	opt.point_distance = point_distance;
+	opt.precision = precision;
 	int have = 0;
 	for (int m = 0; m < 2; m++) {
 		if (method >= 0 && m != method)
@@ -252,7 +292,7 @@ static int cmd_peers(int argc, char **argv)
 	for (int k = 0; k < a.clip_count; k++)
 		clips[k] = &a.clips[k];
 	sizes s0 = clip_sizes(clips, a.clip_count);
-	printf("%s: %d clips, %d joints, height %.4g. Key data in bytes (float32, as glTF stores it); "
+	printf("%s: %d clips, %d joints, height %.4g. Key data in bytes as each file stores it; "
 	       "error: max world joint position error over all clips, %% of the height, measured by mlod.\n\n",
 	       base_name(argv[0]), a.clip_count, a.skeleton.joint_count, h);
 	printf("| output | keys | raw | gzip -9 | zstd -19 | max error %% | mean error %% | raw vs peer | gzip vs peer | zstd vs peer | max error <= peer |\n");
@@ -260,13 +300,14 @@ static int cmd_peers(int argc, char **argv)
 	mlod_deviation zero = {0, 0, 0};
 	row("input", s0, zero, h, NULL, 0.0);
 	for (int p = 1; p < argc; p++) {
-		char label[256];
-		const char *eq = strchr(argv[p], '=');
+		char label[256], file[1024];
+		const char *eq = strchr(argv[p], '='), *at = eq ? strchr(eq, '@') : NULL;
 		if (!eq)
 			continue;
 		snprintf(label, sizeof label, "%.*s", (int)(eq - argv[p]), argv[p]);
+		snprintf(file, sizeof file, "%.*s", (int)(at ? at - eq - 1 : (long)strlen(eq + 1)), eq + 1);
 		mlod_character b;
-		if (load(eq + 1, &b, NULL) != 0)
+		if (load(file, &b, NULL) != 0)
 			continue;
 		int *map = joint_map(&a, &b);
 		const mlod_clip **pc = calloc((size_t)a.clip_count, sizeof *pc);
@@ -282,29 +323,42 @@ static int cmd_peers(int argc, char **argv)
 			bound[k] = clip_error(&a, k, &b, kb, map);
 		}
 		sizes sp = clip_sizes(pc, a.clip_count);
+		if (at) /* the bytes the peer stores (gltfpack keeps rotations as normalised shorts) */
+			sp = file_sizes(at + 1, sp.keys);
 		mlod_deviation pe = all_error(&a, &b, pc, map);
 		row(label, sp, pe, h, NULL, 0.0);
-		/* mlod at the peer's own max error, clip by clip, then at fixed bounds. */
-		static const char *const names[] = {"mlod auto", "mlod frames", "mlod keys"};
+		/* mlod at the peer's own max error, clip by clip, then at fixed bounds:
+		 * the default (auto method, auto precision), then variants. */
+		static const struct {
+			const char *name;
+			int method;
+			mlod_motion_precision precision;
+		} runs[] = {
+			{"mlod", -1, MLOD_MOTION_PRECISION_AUTO},
+			{"mlod --precision float", -1, MLOD_MOTION_PRECISION_FLOAT},
+			{"mlod --precision full", -1, MLOD_MOTION_PRECISION_FULL},
+			{"mlod -m frames", MLOD_MOTION_FRAMES, MLOD_MOTION_PRECISION_AUTO},
+			{"mlod -m keys", MLOD_MOTION_KEYS, MLOD_MOTION_PRECISION_AUTO},
+		};
 		static const double fixed[] = {-1.0, 0.01, 0.002};
 		for (int f = 0; f < 3; f++)
-			for (int method = -1; method < 2; method++) {
-				if (f > 0 && method >= 0)
+			for (int v = 0; v < (int)(sizeof runs / sizeof runs[0]); v++) {
+				if (f > 0 && v > 1)
 					continue;
 				mlod_motion_level *lv = calloc((size_t)a.clip_count, sizeof *lv);
 				const mlod_clip **oc = calloc((size_t)a.clip_count, sizeof *oc);
 				for (int k = 0; k < a.clip_count; k++) {
 					double bk = fixed[f] > 0.0 ? fixed[f] * h : bound[k];
-					if (bk >= 0.0 && our_level(&a, k, method, bk, pd, &lv[k]) == 0)
+					if (bk >= 0.0 && our_level(&a, k, runs[v].method, runs[v].precision, bk, pd, &lv[k]) == 0)
 						oc[k] = &lv[k].clip;
 					else
 						oc[k] = &a.clips[k]; /* no level: the clip as read */
 				}
 				char l2[320];
 				if (f == 0)
-					snprintf(l2, sizeof l2, "%s within %s's error", names[method + 1], label);
+					snprintf(l2, sizeof l2, "%s within %s's error", runs[v].name, label);
 				else
-					snprintf(l2, sizeof l2, "%s within %g%% of the height", names[method + 1], 100.0 * fixed[f]);
+					snprintf(l2, sizeof l2, "%s within %g%% of the height", runs[v].name, 100.0 * fixed[f]);
 				row(l2, clip_sizes(oc, a.clip_count), all_error(&a, &a, oc, NULL), h, &sp, 100.0 * pe.max / h);
 				for (int k = 0; k < a.clip_count; k++)
 					mlod_motion_level_free(&lv[k]);
@@ -323,6 +377,68 @@ static int cmd_peers(int argc, char **argv)
 }
 
 /* ---------------------------------------------------------------- */
+/* Value precision: modes and the share of the bound left to rounding */
+/* ---------------------------------------------------------------- */
+
+static int cmd_precision(int argc, char **argv)
+{
+	static const double pct[2] = {1.0, 0.2};
+	static const struct {
+		mlod_motion_precision precision;
+		double share;
+	} runs[] = {
+		{MLOD_MOTION_PRECISION_FULL, 0.0},   {MLOD_MOTION_PRECISION_FLOAT, 0.05}, {MLOD_MOTION_PRECISION_FLOAT, 0.1},
+		{MLOD_MOTION_PRECISION_FLOAT, 0.2},  {MLOD_MOTION_PRECISION_FLOAT, 0.3},  {MLOD_MOTION_PRECISION_FLOAT, 0.5},
+		{MLOD_MOTION_PRECISION_AUTO, 0.05},  {MLOD_MOTION_PRECISION_AUTO, 0.1},   {MLOD_MOTION_PRECISION_AUTO, 0.2},
+		{MLOD_MOTION_PRECISION_AUTO, 0.3},   {MLOD_MOTION_PRECISION_AUTO, 0.5},
+	};
+	static const char *const names[] = {"auto", "float", "full"};
+	printf("| character | precision | share | keys at 1%% | raw | gzip -9 | zstd -19 | keys at 0.2%% | raw | gzip -9 | zstd -19 |\n");
+	printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+	for (int i = 0; i < argc; i++) {
+		mlod_character c;
+		double h, pd;
+		if (load_sized(argv[i], &c, &h, &pd) != 0)
+			continue;
+		for (int v = 0; v < (int)(sizeof runs / sizeof runs[0]); v++) {
+			printf("| %s | %s | %s", base_name(argv[i]), names[runs[v].precision], runs[v].share > 0.0 ? "" : "-");
+			if (runs[v].share > 0.0)
+				printf("%g", runs[v].share);
+			printf(" |");
+			for (int b = 0; b < 2; b++) {
+				mlod_motion_level *lv = calloc((size_t)c.clip_count, sizeof *lv);
+				const mlod_clip **oc = calloc((size_t)c.clip_count, sizeof *oc);
+				for (int k = 0; k < c.clip_count; k++) {
+					mlod_motion_options opt = {0};
+					opt.point_distance = pd;
+					opt.precision = runs[v].precision;
+					opt.precision_share = runs[v].share;
+					mlod_motion *m;
+					mlod_error err = {0};
+					oc[k] = &c.clips[k];
+					if (mlod_motion_create(&c, k, &opt, &m, &err) != MLOD_OK)
+						continue;
+					if (mlod_motion_next_level(m, MLOD_MOTION_KEYS, MLOD_MOTION_MAX_ERROR, pct[b] * h / 100.0, &lv[k],
+					                           &err) == MLOD_OK)
+						oc[k] = &lv[k].clip;
+					mlod_motion_free(m);
+				}
+				sizes sz = clip_sizes(oc, c.clip_count);
+				printf(" %ld | %ld | %ld | %ld |", sz.keys, sz.raw, sz.gz, sz.zst);
+				for (int k = 0; k < c.clip_count; k++)
+					mlod_motion_level_free(&lv[k]);
+				free(lv);
+				free(oc);
+			}
+			printf("\n");
+		}
+		mlod_character_free(&c);
+	}
+	printf("\n");
+	return 0;
+}
+
+/* ---------------------------------------------------------------- */
 /* Methods at fixed bounds                                           */
 /* ---------------------------------------------------------------- */
 
@@ -333,10 +449,9 @@ static int cmd_methods(int argc, char **argv)
 	printf("|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
 	for (int i = 0; i < argc; i++) {
 		mlod_character c;
-		if (load(argv[i], &c, NULL) != 0)
+		double h, pd;
+		if (load_sized(argv[i], &c, &h, &pd) != 0)
 			continue;
-		double h = mlod_skeleton_size(&c.skeleton);
-		double pd = strstr(argv[i], ".bvh") ? h / 18.0 : 0.1;
 		long keys0 = 0, ref = 0;
 		for (int k = 0; k < c.clip_count; k++)
 			keys0 += mlod_clip_key_count(&c.clips[k]);
@@ -461,10 +576,13 @@ int main(int argc, char **argv)
 		return cmd_convert(argc - 2, argv + 2);
 	if (argc >= 2 && strcmp(argv[1], "peers") == 0)
 		return cmd_peers(argc - 2, argv + 2);
+	if (argc >= 2 && strcmp(argv[1], "precision") == 0)
+		return cmd_precision(argc - 2, argv + 2);
 	if (argc >= 2 && strcmp(argv[1], "methods") == 0)
 		return cmd_methods(argc - 2, argv + 2);
 	if (argc >= 2 && strcmp(argv[1], "speed") == 0)
 		return cmd_speed(argc - 2, argv + 2);
-	fprintf(stderr, "usage: bench_motion convert IN OUT.glb | peers ORIG LABEL=FILE... | methods FILE... | speed FILE...\n");
+	fprintf(stderr, "usage: bench_motion convert IN OUT.glb | peers ORIG LABEL=FILE[@KEYS]... | precision FILE... | "
+	                "methods FILE... | speed FILE...\n");
 	return 1;
 }

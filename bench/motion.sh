@@ -10,19 +10,28 @@ gltfpack="node tests/node/node_modules/gltfpack/cli.js"
 echo "## Motion layer: against gltfpack (same error function, same codecs)"
 echo
 if [ -f tests/node/node_modules/gltfpack/cli.js ]; then
-	echo "gltfpack $($gltfpack -v 2>&1 | head -n 1 | sed 's/^gltfpack //'), with -noq (float keys), at its defaults (30 Hz resampling) and with -af 15."
+	echo "gltfpack $($gltfpack -v 2>&1 | head -n 1 | sed 's/^gltfpack //'), with -noq at its defaults (30 Hz resampling) and with -af 15, and without -noq (quantised) at its defaults."
+	echo "gltfpack's bytes are those its glb stores (bench/anim-keys.mjs): rotations as normalised shorts, even with -noq."
 	echo
 	"$bench" convert samples/cmu_12_01_walk.bvh "$tmp/cmu_12_01_walk.glb"
 	for f in samples/RobotExpressive.glb "$tmp/cmu_12_01_walk.glb"; do
 		b=$(basename "$f" .glb)
-		$gltfpack -i "$f" -o "$tmp/$b-gltfpack.glb" -noq > /dev/null
-		$gltfpack -i "$f" -o "$tmp/$b-gltfpack-af15.glb" -noq -af 15 > /dev/null
-		"$bench" peers "$f" "gltfpack=$tmp/$b-gltfpack.glb" "gltfpack -af 15=$tmp/$b-gltfpack-af15.glb"
+		$gltfpack -i "$f" -o "$tmp/$b-noq.glb" -noq > /dev/null
+		$gltfpack -i "$f" -o "$tmp/$b-noq-af15.glb" -noq -af 15 > /dev/null
+		$gltfpack -i "$f" -o "$tmp/$b-q.glb" > /dev/null
+		for g in noq noq-af15 q; do node bench/anim-keys.mjs "$tmp/$b-$g.glb" "$tmp/$b-$g.keys"; done
+		"$bench" peers "$f" "gltfpack -noq=$tmp/$b-noq.glb@$tmp/$b-noq.keys" \
+			"gltfpack -noq -af 15=$tmp/$b-noq-af15.glb@$tmp/$b-noq-af15.keys" "gltfpack=$tmp/$b-q.glb@$tmp/$b-q.keys"
 	done
 else
 	echo "gltfpack is not installed (scripts/install-deps): skipped."
 	echo
 fi
+
+echo "## Motion layer: value precision (keys method; the share of each bound left to rounding)"
+echo
+# shellcheck disable=SC2086
+"$bench" precision samples/RobotExpressive.glb samples/cmu_12_01_walk.bvh
 
 echo "## Motion layer: the paper's tree (removal, averaging) against key reduction"
 echo

@@ -1883,12 +1883,30 @@ int add_animation(Model &m, const mlod_clip &clip, const std::vector<int> &nodes
 				q[0] = n.x, q[1] = n.y, q[2] = n.z, q[3] = n.w;
 			}
 		}
+		/* Rotations on the lattice of normalised shorts are written as such
+		 * (as given: the lattice is as unit as it gets). */
+		std::vector<int16_t> shorts;
+		if (ch.short_values && ch.path == MLOD_PATH_ROTATION && ch.interp != MLOD_INTERP_CUBICSPLINE)
+			for (size_t k = 0; k < keys * per_key; k++) {
+				long n = lrint(double(ch.values[k]) * 32767.0);
+				if (n < -32767 || n > 32767 || float(n / 32767.0) != ch.values[k]) {
+					shorts.clear();
+					break;
+				}
+				shorts.push_back(int16_t(n));
+			}
 		auto in = inputs.find(times);
 		if (in == inputs.end())
 			in = inputs.emplace(times, append_floats(m, times.data(), keys, 1, 0, true)).first;
 		tinygltf::AnimationSampler s;
 		s.input = in->second;
-		s.output = append_floats(m, values.data(), values.size() / comps, int(comps), 0);
+		if (!shorts.empty()) {
+			s.output = append_accessor(m, shorts.data(), keys, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC4, 4, 0,
+			                           false);
+			m.accessors.back().normalized = true;
+		} else {
+			s.output = append_floats(m, values.data(), values.size() / comps, int(comps), 0);
+		}
 		s.interpolation = interps[ch.interp];
 		out.samplers.push_back(s);
 		tinygltf::AnimationChannel c;

@@ -233,6 +233,8 @@ typedef struct mlod_channel {
 	int key_count;
 	float *times;     /* key_count, strictly increasing, seconds */
 	float *values;
+	int short_values; /* rotation, not CUBICSPLINE: every value is n / 32767 for an integer n
+	                     (|n| <= 32767), so glTF writes them as normalised shorts; 0: floats */
 } mlod_channel;
 
 typedef struct mlod_clip {
@@ -924,6 +926,18 @@ typedef enum mlod_motion_target {
 	MLOD_MOTION_MAX_ERROR  /* the coarsest level whose joint position error is at most this (scene units) */
 } mlod_motion_target;
 
+/* How a level stores its key values (plain glTF in every case). */
+typedef enum mlod_motion_precision {
+	MLOD_MOTION_PRECISION_AUTO,  /* rotations on the lattice of normalised shorts (n / 32767, core
+	                                glTF, 8 bytes a key), translations and scales float32 rounded to
+	                                power-of-two grids: the coarsest that keep the level within its
+	                                bound. First and last keys: translations and scales exact,
+	                                rotations on the finest lattice (1/65534 per component). */
+	MLOD_MOTION_PRECISION_FLOAT, /* every value float32 rounded to power-of-two grids (the low
+	                                mantissa bits become zeros); first and last keys exact */
+	MLOD_MOTION_PRECISION_FULL   /* values as read */
+} mlod_motion_precision;
+
 /* Zero-initialised options are the defaults. */
 typedef struct mlod_motion_options {
 	mlod_motion_merge merge;  /* frames method; MLOD_MOTION_REMOVE (the default) measured better */
@@ -931,6 +945,9 @@ typedef struct mlod_motion_options {
 	double point_distance;    /* radius of the points carried by each joint for the point error
 	                             (scene units); 0 means the skeleton height / 18 (10 cm on a 1.8 m
 	                             person) */
+	mlod_motion_precision precision; /* how a level's key values are stored (default auto) */
+	double precision_share;   /* auto precision: the share of a max-error bound left to rounding,
+	                             (0, 1); 0 means the default */
 } mlod_motion_options;
 
 /* How a clip was put on a common timeline: every channel keyed at every
@@ -992,6 +1009,8 @@ typedef struct mlod_motion_level {
 	long bytes;               /* mlod_clip_key_bytes(&clip) */
 	mlod_deviation error;     /* joint position error against the source clip, scene units */
 	double point_error;       /* the largest point error over joints and common frames, scene units */
+	double grid;              /* auto precision: the grid translations were rounded to (rotations
+	                             and scales finer by their joint's reach), scene units; 0: none */
 } mlod_motion_level;
 
 /* Builds the next level of a method: each level is made from the previous
@@ -1000,7 +1019,9 @@ typedef struct mlod_motion_level {
  * keys). target and value choose its size; with MLOD_MOTION_MAX_ERROR the
  * point error (so the joint position error too) is at most value, or
  * MLOD_ERR_LIMIT says why not (a resampled clip that already deviates
- * more). Release with mlod_motion_level_free. */
+ * more). With auto precision the values are rounded within value (for
+ * the other targets, within the error the level has before rounding) and
+ * the errors are those after rounding. Release with mlod_motion_level_free. */
 mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                    double value, mlod_motion_level *out, mlod_error *err);
 void mlod_motion_level_free(mlod_motion_level *l);

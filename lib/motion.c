@@ -38,6 +38,17 @@
  *   than averaging (bench/RESULTS.md) and is the default.
  * - The keys method (keyreduce.c) is driven from here the same way, with
  *   the error budget in place of the threshold.
+ * - Value precision (beyond the paper). Keys go within (1 - share) of
+ *   the bound; the values are then rounded, so that few bits vary and
+ *   gzip/zstd compress them well: the coarsest level grid whose measured
+ *   error stays within the bound is bisected (translations on it,
+ *   rotations and scales finer by their joint's reach), then each channel
+ *   takes coarser grids while the bound holds. A rotation's three smaller
+ *   components are rounded and its largest recomputed from them, so it
+ *   stays (about) unit. By default (auto) rotations go on the lattice of
+ *   normalised shorts, as gltfpack stores them (core glTF), and
+ *   translations and scales stay float32 on power-of-two grids; float
+ *   keeps every value float32, with the first and last keys exact.
  *
  * Error bounds are checked on the point error of every joint at every
  * frame of the common timeline (mlod_motion_point_error: the joint's
@@ -48,6 +59,7 @@
  * be compared at it. The reported error is mlod_joint_deviation's.
  */
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,6 +73,7 @@
 #define SEARCH_STEPS 24 /* bisection steps: the threshold to 2^-24 of its range */
 #define MAX_CACHED 1000000L /* frames * joints whose world matrices as read are cached */
 #define KEYS_RETRIES 6
+#define DEFAULT_PRECISION_SHARE 0.1 /* of a max-error bound left to rounding (bench/RESULTS.md) */
 
 /* Axes of each Euler order, outermost first (as in math.c). */
 static const int euler_axes[6][3] = {
@@ -105,7 +118,7 @@ long mlod_clip_key_bytes(const mlod_clip *clip)
 	for (int i = 0; i < clip->channel_count; i++) {
 		const mlod_channel *ch = &clip->channels[i];
 		long per_key = comps_of(ch) * (ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
-		bytes += (long)ch->key_count * per_key * 4;
+		bytes += (long)ch->key_count * per_key * (ch->short_values ? 2 : 4);
 		int shared = 0;
 		for (int k = 0; k < i && !shared; k++) {
 			const mlod_channel *o = &clip->channels[k];
@@ -176,9 +189,9 @@ static int float_order(const void *a, const void *b)
 	return (x > y) - (x < y);
 }
 
-/* Samples one channel of clip at t into out (comps floats), exactly as
- * mlod_clip_sample does. */
-static void sample_one(const mlod_clip *clip, const mlod_channel *ch, float t, float *out)
+/* Sets the path of l that channel ch of clip animates to its value at t,
+ * as mlod_clip_sample does. */
+static void sample_into(const mlod_clip *clip, const mlod_channel *ch, float t, mlod_trs *l)
 {
 	mlod_channel one = *ch;
 	mlod_clip tmp;
@@ -187,8 +200,15 @@ static void sample_one(const mlod_clip *clip, const mlod_channel *ch, float t, f
 	tmp.duration = clip->duration;
 	tmp.channel_count = 1;
 	tmp.channels = &one;
+	mlod_clip_sample(&tmp, t, l);
+}
+
+/* Samples one channel of clip at t into out (comps floats), exactly as
+ * mlod_clip_sample does. */
+static void sample_one(const mlod_clip *clip, const mlod_channel *ch, float t, float *out)
+{
 	mlod_trs local = mlod_trs_identity();
-	mlod_clip_sample(&tmp, t, &local);
+	sample_into(clip, ch, t, &local);
 	switch (ch->path) {
 	case MLOD_PATH_TRANSLATION: out[0] = local.t.x, out[1] = local.t.y, out[2] = local.t.z; break;
 	case MLOD_PATH_SCALE: out[0] = local.s.x, out[1] = local.s.y, out[2] = local.s.z; break;
@@ -449,6 +469,7 @@ struct mlod_motion {
 	int *euler_slot;       /* per channel: Euler slot of a rotation channel, else -1 */
 	unsigned char *constant; /* per channel: the same value at every frame */
 	double *radius;        /* per joint: the point distance, or its End Site's if farther */
+	int *reach_exp;        /* per joint: -ceil(log2(2 reach)), reach the farthest point it carries */
 	mlod_trs *local;
 	mlod_mat4 *world, *world0;
 	mlod_mat4 *cache0;     /* frames * joints world matrices as read, or NULL */
@@ -476,6 +497,7 @@ void mlod_motion_free(mlod_motion *m)
 	free(m->euler_slot);
 	free(m->constant);
 	free(m->radius);
+	free(m->reach_exp);
 	free(m->local);
 	free(m->world);
 	free(m->world0);
@@ -525,6 +547,40 @@ static int node_from_frame(const mlod_motion *m, int f, fnode *nd)
 		memcpy(nd->values + m->offset[i], ch->values + (size_t)f * (size_t)comps, sizeof(float) * (size_t)comps);
 	}
 	node_euler(m, nd);
+	return 0;
+}
+
+/* Per joint, how far the points it carries reach in the rest pose: the
+ * farthest descendant origin plus that joint's radius. Rounding a
+ * rotation or scale by d moves them by about 2 reach d. */
+static int reach_exps(mlod_motion *m)
+{
+	const mlod_skeleton *s = m->s;
+	int n = s->joint_count;
+	double *reach = malloc(sizeof(double) * (size_t)n);
+	m->reach_exp = malloc(sizeof(int) * (size_t)n);
+	if (!reach || !m->reach_exp) {
+		free(reach);
+		return -1;
+	}
+	mlod_pose_rest(s, m->local);
+	mlod_pose_world(s, m->local, m->world);
+	for (int j = 0; j < n; j++)
+		reach[j] = m->radius[j];
+	for (int d = 0; d < n; d++) {
+		mlod_v3 pd = mlod_mat4_point(&m->world[d], (mlod_v3){0, 0, 0});
+		for (int a = s->joints[d].parent; a >= 0; a = s->joints[a].parent) {
+			mlod_v3 pa = mlod_mat4_point(&m->world[a], (mlod_v3){0, 0, 0});
+			double r = mlod_v3_length(mlod_v3_sub(pd, pa)) + m->radius[d];
+			if (r > reach[a])
+				reach[a] = r;
+		}
+	}
+	for (int j = 0; j < n; j++) {
+		double r = 2.0 * reach[j];
+		m->reach_exp[j] = r > 0.0 && isfinite(r) ? -(int)ceil(log2(r)) : 0;
+	}
+	free(reach);
 	return 0;
 }
 
@@ -591,6 +647,10 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	for (int j = 0; j < n; j++) {
 		double es = s->joints[j].has_end_site ? mlod_v3_length(s->joints[j].end_site) : 0.0;
 		m->radius[j] = es > pd ? es : pd;
+	}
+	if (reach_exps(m) != 0) {
+		mlod_motion_free(m);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
 	if ((double)F * n <= (double)MAX_CACHED && (m->cache0 = malloc(sizeof(mlod_mat4) * (size_t)F * (size_t)n)) != NULL)
 		for (int f = 0; f < F; f++)
@@ -729,7 +789,15 @@ static int clip_from_kept(const mlod_motion *m, const unsigned char *kept, mlod_
 /* Largest point error (mlod_motion_point_error) of a level clip over
  * every joint and every frame of the common timeline, in scene units. It
  * bounds the joint and End Site position error. */
+static double level_error_upto(mlod_motion *m, const mlod_clip *clip, double stop);
+
 static double level_max_error(mlod_motion *m, const mlod_clip *clip)
+{
+	return level_error_upto(m, clip, HUGE_VAL);
+}
+
+/* level_max_error, but it may stop early with any error above stop. */
+static double level_error_upto(mlod_motion *m, const mlod_clip *clip, double stop)
 {
 	double worst = 0.0;
 	for (int f = 0; f < m->frames; f++) {
@@ -745,6 +813,8 @@ static double level_max_error(mlod_motion *m, const mlod_clip *clip)
 			if (!(e <= worst))
 				worst = e; /* NaN counts as the worst */
 		}
+		if (!(worst <= stop))
+			break;
 	}
 	return worst;
 }
@@ -757,9 +827,307 @@ void mlod_motion_level_free(mlod_motion_level *l)
 	memset(l, 0, sizeof *l);
 }
 
-/* Fills the level's counts and its error as mlod_joint_deviation measures it. */
-static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, mlod_error *err)
+/* The part of a max-error bound the keys (or frames) may spend: with auto
+ * precision, the rest is left to rounding the values. */
+static double removal_bound(const mlod_motion *m, double bound)
 {
+	if (m->opt.precision == MLOD_MOTION_PRECISION_FULL)
+		return bound;
+	double share = m->opt.precision_share > 0.0 && m->opt.precision_share < 1.0 ? m->opt.precision_share
+	                                                                            : DEFAULT_PRECISION_SHARE;
+	return bound * (1.0 - share);
+}
+
+/* ---------------------------------------------------------------- */
+/* Value precision                                                   */
+/* ---------------------------------------------------------------- */
+
+#define NO_ROUNDING INT_MIN
+#define SHORTS(m) ((m)->opt.precision == MLOD_MOTION_PRECISION_AUTO)
+#define GRID_RANGE 48     /* grids tried: from 2^48 times finer than the bound up to it */
+#define CHANNEL_COARSER 8 /* per channel, up to this many doublings beyond the level's grid */
+
+/* v rounded to the nearest multiple of 2^e. */
+static float grid_round(float v, int e)
+{
+	return (float)ldexp(rint(ldexp((double)v, -e)), e);
+}
+
+/* Rounds a unit quaternion: its three smaller components to the grid 2^e,
+ * the largest recomputed from them, so it stays unit (and the glTF
+ * writer's normalisation leaves it as it is). */
+static void round_quat(float *q, int e)
+{
+	int big = 0;
+	for (int c = 1; c < 4; c++)
+		if (fabsf(q[c]) > fabsf(q[big]))
+			big = c;
+	float r[4];
+	double sum = 0.0;
+	for (int c = 0; c < 4; c++)
+		if (c != big) {
+			r[c] = grid_round(q[c], e);
+			sum += (double)r[c] * r[c];
+		}
+	if (!(sum < 1.0))
+		return; /* a grid too coarse for this key: it stays as it is */
+	r[big] = copysignf((float)sqrt(1.0 - sum), q[big]);
+	mlod_quat n = mlod_quat_normalize((mlod_quat){ r[0], r[1], r[2], r[3] });
+	q[0] = n.x, q[1] = n.y, q[2] = n.z, q[3] = n.w;
+}
+
+/* dst, laid out as src, gets src's values rounded: channel i to the grid
+ * 2^e[i] (NO_ROUNDING: as they are). The first and last key of every
+ * channel stay exact. */
+/* The lattice of normalised shorts: n / 32767 as glTF readers decode it. */
+static float short_value(long n)
+{
+	return (float)((double)n / 32767.0);
+}
+
+/* Rounds a unit quaternion onto the lattice of normalised shorts: its three
+ * smaller components to multiples of 2^a / 32767, the largest to the
+ * nearest lattice value that makes it unit. */
+static void round_quat_short(float *q, int a)
+{
+	int big = 0;
+	for (int c = 1; c < 4; c++)
+		if (fabsf(q[c]) > fabsf(q[big]))
+			big = c;
+	double step = ldexp(1.0, a), sum = 0.0;
+	long n[4];
+	for (int c = 0; c < 4; c++)
+		if (c != big) {
+			n[c] = lrint(rint((double)q[c] * 32767.0 / step) * step);
+			n[c] = n[c] > 32767 ? 32767 : n[c] < -32767 ? -32767 : n[c];
+			sum += (double)short_value(n[c]) * short_value(n[c]);
+		}
+	if (!(sum < 1.0)) /* a grid too coarse for this key: the finest lattice */
+		for (int c = 0; c < 4; c++)
+			n[c] = lrint((double)q[c] * 32767.0);
+	else
+		n[big] = lrint(copysign(sqrt(1.0 - sum), (double)q[big]) * 32767.0);
+	for (int c = 0; c < 4; c++)
+		q[c] = short_value(n[c]);
+}
+
+/* b gets a's values rounded to the grid 2^e (NO_ROUNDING: as they are),
+ * the first and last keys exact; with shorts, a rotation goes on the
+ * lattice of normalised shorts instead, every key (the ends on the finest
+ * lattice). */
+static void round_channel(const mlod_channel *a, mlod_channel *b, int e, int shorts)
+{
+	int comps = comps_of(a), n = a->key_count;
+	memcpy(b->values, a->values, sizeof(float) * (size_t)n * (size_t)comps);
+	b->short_values = 0;
+	if (e == NO_ROUNDING)
+		return;
+	if (shorts && comps == 4 && a->interp != MLOD_INTERP_CUBICSPLINE) {
+		int lattice = e + 15 > 0 ? e + 15 : 0; /* 2^e is about 2^(e + 15) / 32767 */
+		for (int k = 0; k < n; k++)
+			round_quat_short(b->values + (size_t)k * 4u, k == 0 || k == n - 1 ? 0 : lattice);
+		b->short_values = 1;
+		return;
+	}
+	for (int k = 1; k + 1 < n; k++) {
+		float *v = b->values + (size_t)k * (size_t)comps;
+		if (comps == 4)
+			round_quat(v, e);
+		else
+			for (int c = 0; c < 3; c++)
+				v[c] = grid_round(v[c], e);
+	}
+}
+
+static void round_clip(const mlod_clip *src, mlod_clip *dst, const int *e, int shorts)
+{
+	for (int i = 0; i < src->channel_count; i++)
+		round_channel(&src->channels[i], &dst->channels[i], e[i], shorts);
+}
+
+/* A deep copy of a level clip, or -1 when out of memory. */
+static int clip_copy(const mlod_clip *src, mlod_clip *dst)
+{
+	*dst = *src;
+	dst->name = dup_string(src->name);
+	dst->channels = calloc((size_t)src->channel_count, sizeof *dst->channels);
+	if (!dst->name || !dst->channels) {
+		dst->channel_count = 0;
+		return -1;
+	}
+	for (int i = 0; i < src->channel_count; i++) {
+		const mlod_channel *a = &src->channels[i];
+		mlod_channel *b = &dst->channels[i];
+		size_t n = (size_t)a->key_count;
+		*b = *a;
+		b->values = NULL;
+		b->times = malloc(sizeof(float) * n);
+		b->values = malloc(sizeof(float) * n * (size_t)comps_of(a));
+		if (!b->times || !b->values)
+			return -1;
+		memcpy(b->times, a->times, sizeof(float) * n);
+		memcpy(b->values, a->values, sizeof(float) * n * (size_t)comps_of(a));
+	}
+	return 0;
+}
+
+/* The grid exponent of each channel for the level grid 2^g: translations
+ * on 2^g, rotations and scales finer by their joint's reach; plus adj. */
+static void channel_exps(const mlod_motion *m, const mlod_clip *clip, int g, const int *adj, int *e)
+{
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		e[i] = g + adj[i] + (ch->path == MLOD_PATH_TRANSLATION ? 0 : m->reach_exp[ch->joint]);
+	}
+}
+
+/* Rounds src's values into clip with level grid g and adjustments adj;
+ * is the error within bound? */
+static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int g, const int *adj, int *e,
+                      double bound)
+{
+	channel_exps(m, src, g, adj, e);
+	round_clip(src, clip, e, SHORTS(m));
+	return level_error_upto(m, clip, bound) <= bound;
+}
+
+/* Per-channel refinement: each channel in turn goes to coarser grids
+ * (adj[i] + 1, + 2, ...) while the bound holds. The rounded clip's local
+ * transforms and world matrices are kept at every common frame, so a try
+ * recomputes only the channel's joint and its descendants, with the same
+ * operations as mlod_pose_world. Needs m->cache0. Returns -1 when out of
+ * memory; clip is then rounded with adj as it was. */
+static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int g, int *adj, int *e,
+                           double bound)
+{
+	const mlod_skeleton *s = m->s;
+	int F = m->frames, J = s->joint_count, n = clip->channel_count;
+	size_t FJ = (size_t)F * (size_t)J;
+	mlod_trs *L = malloc(sizeof *L * FJ);
+	mlod_mat4 *W = malloc(sizeof *W * FJ), *w = malloc(sizeof *w * (size_t)J);
+	int *sub = malloc(sizeof(int) * (size_t)J);
+	const float *times = m->common.channels[0].times;
+	channel_exps(m, src, g, adj, e);
+	round_clip(src, clip, e, SHORTS(m));
+	if (!L || !W || !w || !sub) {
+		free(L), free(W), free(w), free(sub);
+		return -1;
+	}
+	for (int f = 0; f < F; f++) {
+		mlod_pose_rest(s, L + (size_t)f * (size_t)J);
+		mlod_clip_sample(clip, times[f], L + (size_t)f * (size_t)J);
+		mlod_pose_world(s, L + (size_t)f * (size_t)J, W + (size_t)f * (size_t)J);
+	}
+	for (int i = 0; i < n; i++) {
+		mlod_channel *ch = &clip->channels[i];
+		int j = ch->joint, ns = 0;
+		if (ch->key_count < 3)
+			continue; /* its first and last keys stay exact: nothing to round */
+		for (int d = j; d < J; d++) { /* j and its descendants, parents first */
+			int a = d;
+			while (a > j)
+				a = s->joints[a].parent;
+			if (a == j)
+				sub[ns++] = d;
+		}
+		while (adj[i] < CHANNEL_COARSER) {
+			adj[i]++;
+			channel_exps(m, src, g, adj, e);
+			round_channel(&src->channels[i], ch, e[i], SHORTS(m));
+			int ok = 1;
+			for (int pass = 0; pass < 2 && ok; pass++) /* check, then commit */
+				for (int f = 0; f < F && ok; f++) {
+					mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
+					mlod_mat4 *wf = W + (size_t)f * (size_t)J;
+					const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J;
+					sample_into(clip, ch, times[f], &l);
+					for (int k = 0; k < ns && ok; k++) {
+						int d = sub[k], p = s->joints[d].parent;
+						mlod_mat4 lm = mlod_mat4_from_trs(d == j ? &l : &lf[d]);
+						w[d] = mlod_mat4_mul(p < 0 ? &s->joints[d].base : d == j ? &wf[p] : &w[p], &lm);
+						ok = mlod_motion_point_error(&w[d], &w0[d], m->radius[d]) <= bound;
+					}
+					if (pass == 1) {
+						lf[j] = l;
+						for (int k = 0; k < ns; k++)
+							wf[sub[k]] = w[sub[k]];
+					}
+				}
+			if (!ok) {
+				adj[i]--;
+				channel_exps(m, src, g, adj, e);
+				round_channel(&src->channels[i], ch, e[i], SHORTS(m));
+				break;
+			}
+		}
+	}
+	free(L), free(W), free(w), free(sub);
+	return 0;
+}
+
+/* Rounds the level's values to the coarsest grids that keep its point
+ * error within bound: first one level grid (bisection on its exponent),
+ * then each channel coarser while the bound holds. Sets *grid to the
+ * level grid (0 when nothing was rounded). Returns -1 when out of memory. */
+static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *grid)
+{
+	int n = clip->channel_count;
+	*grid = 0.0;
+	if (!(bound > 0.0) || !isfinite(bound) || !(level_max_error(m, clip) <= bound))
+		return 0;
+	mlod_clip src;
+	memset(&src, 0, sizeof src);
+	int *adj = calloc((size_t)n, sizeof(int)), *e = malloc(sizeof(int) * (size_t)n);
+	int bad = !adj || !e || clip_copy(clip, &src) != 0;
+	if (bad) {
+		free(adj);
+		free(e);
+		mlod_clip_free(&src);
+		return -1;
+	}
+	int hi = (int)ceil(log2(bound)) + 1, lo = hi - GRID_RANGE;
+	if (!round_fits(m, &src, clip, lo, adj, e, bound)) {
+		for (int i = 0; i < n; i++)
+			e[i] = NO_ROUNDING;
+		round_clip(&src, clip, e, SHORTS(m));
+	} else {
+		if (round_fits(m, &src, clip, hi, adj, e, bound))
+			lo = hi;
+		while (hi - lo > 1) {
+			int mid = lo + (hi - lo) / 2;
+			if (round_fits(m, &src, clip, mid, adj, e, bound))
+				lo = mid;
+			else
+				hi = mid;
+		}
+		/* Channels in their order (measured as good as round robin or
+		 * leaves first); the result is measured again as a whole. */
+		if (m->cache0 && refine_channels(m, &src, clip, lo, adj, e, bound) != 0)
+			bad = 1;
+		if (!round_fits(m, &src, clip, lo, adj, e, bound)) {
+			memset(adj, 0, sizeof(int) * (size_t)n); /* fitted in the bisection */
+			round_fits(m, &src, clip, lo, adj, e, bound);
+		}
+		*grid = ldexp(1.0, lo);
+	}
+	free(adj);
+	free(e);
+	mlod_clip_free(&src);
+	return bad ? -1 : 0;
+}
+
+/* Fills the level's counts and its error as mlod_joint_deviation measures
+ * it, after rounding its values within bound (< 0: a level chosen by
+ * threshold or fraction, whose error e may grow to e / (1 - share), the
+ * share a bound leaves to rounding). */
+static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double bound, mlod_error *err)
+{
+	if (m->opt.precision != MLOD_MOTION_PRECISION_FULL) {
+		if (bound < 0.0)
+			bound = level_max_error(m, &out->clip) / removal_bound(m, 1.0);
+		if (level_round(m, &out->clip, bound, &out->grid) != 0)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
 	out->point_error = level_max_error(m, &out->clip);
 	out->keys = mlod_clip_key_count(&out->clip);
 	out->bytes = mlod_clip_key_bytes(&out->clip);
@@ -1004,7 +1372,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 					line_free(&best);
 					return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 				}
-				ok = level_max_error(m, &c) <= value;
+				ok = level_max_error(m, &c) <= removal_bound(m, value);
 				mlod_clip_free(&c);
 			}
 			if (target == MLOD_MOTION_FRACTION) {
@@ -1067,7 +1435,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 	}
 	line_free(&m->tree);
 	m->tree = best;
-	mlod_result r = level_finish(m, out, err);
+	mlod_result r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, err);
 	if (r != MLOD_OK)
 		mlod_motion_level_free(out);
 	return r;
@@ -1119,7 +1487,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 	if (target == MLOD_MOTION_MAX_ERROR) {
 		/* The budget bounds a stricter metric; retry smaller if float
 		 * rounding lets the measured error pass the bound. */
-		double budget = value * (1.0 - 1e-5);
+		double budget = removal_bound(m, value) * (1.0 - 1e-5);
 		for (int t = 0; t < KEYS_RETRIES && best_budget < 0.0; t++, budget *= 0.9) {
 			double e = keys_try(m, budget, kept, &clip, err);
 			if (e < 0.0) {
@@ -1193,7 +1561,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 	out->clip = best_clip;
 	free(m->kept);
 	m->kept = best;
-	r = level_finish(m, out, err);
+	r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, err);
 	if (r != MLOD_OK)
 		mlod_motion_level_free(out);
 	return r;

@@ -46,6 +46,14 @@ static const char usage_text[] =
 	"      --merge MODE        frames method: remove (default) or average\n"
 	"      --point-distance D  keys method: radius of the points carried by each\n"
 	"                          joint (default 0.1 for glTF, height/18 for BVH)\n"
+	"      --precision MODE    how level key values are stored, rounded within each\n"
+	"                          bound so they compress well: auto stores rotations as\n"
+	"                          normalised shorts (core glTF) and the rest as floats on\n"
+	"                          power-of-two grids; float keeps every value float32 on\n"
+	"                          such grids, first and last keys exact; full keeps the\n"
+	"                          values as read (default auto)\n"
+	"      --precision-share F the share of each bound left to rounding, the rest to\n"
+	"                          removing keys (default 0.1)\n"
 	"      --cubic-rate R      resample CUBICSPLINE clips at R frames/s (default 60)\n"
 	"  -l, --level K           with a .bvh output: the level to write (0 = as read)\n"
 	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
@@ -276,6 +284,9 @@ static void report_table(const struct job *job)
 	       "# position error against the clip as read, scene units and %% of the height; pt: point error (joint\n"
 	       "# origins and points within the point distance), scene units; vtx: skinned-vertex error, %% of the\n"
 	       "# bounding diagonal\n");
+	if (job->opt.precision != MLOD_MOTION_PRECISION_FULL)
+		printf("# key values rounded within each level's bound (--precision %s)\n",
+		       job->opt.precision == MLOD_MOTION_PRECISION_AUTO ? "auto" : "float");
 	if (job->c.notes && *job->c.notes)
 		printf("# note: %s\n", job->c.notes);
 }
@@ -307,10 +318,10 @@ static void report_json(const struct job *job)
 			}
 			printf("\"ok\": true, \"method\": \"%s\", \"threshold\": %.9g, \"keys\": %ld, \"keys_percent\": %.6g, "
 			       "\"bytes\": %ld,\n        \"joint_error\": {\"max\": %.9g, \"mean\": %.9g, \"max_percent_height\": %.9g, "
-			       "\"mean_percent_height\": %.9g},\n        \"point_error\": %.9g",
+			       "\"mean_percent_height\": %.9g},\n        \"point_error\": %.9g, \"grid\": %.9g",
 			       method_name(lv->l.method), lv->l.threshold, lv->l.keys, 100.0 * (double)lv->l.keys / (double)cl->keys,
 			       lv->l.bytes, lv->l.error.max, lv->l.error.mean, 100.0 * lv->l.error.max / job->height,
-			       100.0 * lv->l.error.mean / job->height, lv->l.point_error);
+			       100.0 * lv->l.error.mean / job->height, lv->l.point_error, lv->l.grid);
 			if (lv->has_vertex)
 				printf(",\n        \"vertex_error\": {\"max\": %.9g, \"max_percent_diagonal\": %.9g, "
 				       "\"mean_percent_diagonal\": %.9g}",
@@ -392,9 +403,9 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 				n += snprintf(json + n, sizeof json - (size_t)n, "\"bound\": %.9g, ", lv->bound);
 			n += snprintf(json + n, sizeof json - (size_t)n,
 			              "\"keys\": %ld, \"source_keys\": %ld, \"bytes\": %ld, \"joint_error\": {\"max\": %.9g, "
-			              "\"mean\": %.9g, \"max_percent_height\": %.9g}, \"point_error\": %.9g",
+			              "\"mean\": %.9g, \"max_percent_height\": %.9g}, \"point_error\": %.9g, \"grid\": %.9g",
 			              lv->l.keys, cl->keys, lv->l.bytes, lv->l.error.max, lv->l.error.mean,
-			              100.0 * lv->l.error.max / job->height, lv->l.point_error);
+			              100.0 * lv->l.error.max / job->height, lv->l.point_error, lv->l.grid);
 			if (lv->has_vertex)
 				n += snprintf(json + n, sizeof json - (size_t)n, ", \"vertex_error_percent_diagonal\": %.9g",
 				              lv->vertex.max);
@@ -418,6 +429,8 @@ int main(int argc, char **argv)
 		{"merge", required_argument, NULL, 'M'},
 		{"point-distance", required_argument, NULL, 'P'},
 		{"cubic-rate", required_argument, NULL, 'C'},
+		{"precision", required_argument, NULL, 'p'},
+		{"precision-share", required_argument, NULL, 'S'},
 		{"level", required_argument, NULL, 'l'},
 		{"clip", required_argument, NULL, 'c'},
 		{"help", no_argument, NULL, 'h'},
@@ -471,6 +484,21 @@ int main(int argc, char **argv)
 			break;
 		case 'P': point_distance = tool_parse_double("--point-distance", optarg, 1e-12, 1e12); break;
 		case 'C': job.opt.cubic_rate = tool_parse_double("--cubic-rate", optarg, 1.0, 1e4); break;
+		case 'p':
+			if (strcmp(optarg, "auto") == 0)
+				job.opt.precision = MLOD_MOTION_PRECISION_AUTO;
+			else if (strcmp(optarg, "float") == 0)
+				job.opt.precision = MLOD_MOTION_PRECISION_FLOAT;
+			else if (strcmp(optarg, "full") == 0)
+				job.opt.precision = MLOD_MOTION_PRECISION_FULL;
+			else
+				tool_usage_error("--precision: unknown mode '%s' (auto, float or full)", optarg);
+			break;
+		case 'S':
+			job.opt.precision_share = tool_parse_double("--precision-share", optarg, 0.0, 1.0);
+			if (!(job.opt.precision_share > 0.0 && job.opt.precision_share < 1.0))
+				tool_usage_error("--precision-share: %s is not between 0 and 1", optarg);
+			break;
 		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
 		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
 		case 'h': fputs(usage_text, stdout); return 0;

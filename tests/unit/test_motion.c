@@ -97,12 +97,17 @@ static void clip_span(const mlod_clip *clip, float *first, float *last)
 
 /* Levels under bounds of 0.2%, 1% and 3% of the height, for one method:
  * each within its bound, ordered, keeping duration and end frames. */
-static int check_levels(const mlod_character *c, int k, mlod_motion_method method, char *why, size_t size)
+static int check_levels(const mlod_character *c, int k, mlod_motion_method method, mlod_motion_precision precision,
+                        char *why, size_t size)
 {
 	double h = mlod_skeleton_size(&c->skeleton), pct[3] = {0.2, 1.0, 3.0};
+	/* Exact, but for rotations on the lattice of normalised shorts (auto
+	 * precision), within 1/65534 per component: a few 1e-5 of the height. */
+	double end_tol = precision == MLOD_MOTION_PRECISION_AUTO ? 2e-4 : 1e-6;
 	mlod_motion *m = NULL;
 	mlod_error e = {0};
 	mlod_motion_options opt = {0};
+	opt.precision = precision;
 	const mlod_clip *src = &c->clips[k];
 	long prev = mlod_clip_key_count(src);
 	float f0, f1;
@@ -136,8 +141,9 @@ static int check_levels(const mlod_character *c, int k, mlod_motion_method metho
 			positions(c, src, t, a);
 			positions(c, &lv.clip, t, b);
 			for (int j = 0; j < n && !bad; j++)
-				if (mlod_v3_length(mlod_v3_sub(a[j], b[j])) > 1e-6 * h)
-					snprintf(why, size, "clip %d level %d: joint %d moved at t = %g", k, l + 1, j, t), bad = 1;
+				if (mlod_v3_length(mlod_v3_sub(a[j], b[j])) > end_tol * h)
+					snprintf(why, size, "clip %d level %d: joint %d moved by %g at t = %g", k, l + 1, j,
+					         mlod_v3_length(mlod_v3_sub(a[j], b[j])), t), bad = 1;
 		}
 		prev = lv.keys;
 		mlod_motion_level_free(&lv);
@@ -153,8 +159,10 @@ TEST(levels_within_bounds_cmu)
 	mlod_character c;
 	char why[512] = "";
 	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
-	CHECK_MSG(!check_levels(&c, 0, MLOD_MOTION_FRAMES, why, sizeof why), "frames: %s", why);
-	CHECK_MSG(!check_levels(&c, 0, MLOD_MOTION_KEYS, why, sizeof why), "keys: %s", why);
+	for (int p = 0; p <= MLOD_MOTION_PRECISION_FULL; p++) {
+		CHECK_MSG(!check_levels(&c, 0, MLOD_MOTION_FRAMES, (mlod_motion_precision)p, why, sizeof why), "frames: %s", why);
+		CHECK_MSG(!check_levels(&c, 0, MLOD_MOTION_KEYS, (mlod_motion_precision)p, why, sizeof why), "keys: %s", why);
+	}
 	mlod_character_free(&c);
 }
 
@@ -163,10 +171,12 @@ TEST(levels_within_bounds_robot)
 	mlod_character c;
 	char why[512] = "";
 	CHECK(load_sample("samples/RobotExpressive.glb", &c) == 0);
-	for (int k = 0; k < c.clip_count; k++) {
-		CHECK_MSG(!check_levels(&c, k, MLOD_MOTION_FRAMES, why, sizeof why), "frames: %s", why);
-		CHECK_MSG(!check_levels(&c, k, MLOD_MOTION_KEYS, why, sizeof why), "keys: %s", why);
-	}
+	for (int k = 0; k < c.clip_count; k++)
+		for (int p = 0; p <= MLOD_MOTION_PRECISION_FULL; p++) {
+			mlod_motion_precision pr = (mlod_motion_precision)p;
+			CHECK_MSG(!check_levels(&c, k, MLOD_MOTION_FRAMES, pr, why, sizeof why), "frames, precision %d: %s", p, why);
+			CHECK_MSG(!check_levels(&c, k, MLOD_MOTION_KEYS, pr, why, sizeof why), "keys, precision %d: %s", p, why);
+		}
 	mlod_character_free(&c);
 }
 
@@ -570,6 +580,199 @@ TEST(key_bytes)
 	mlod_character_free(&c);
 }
 
+/* Trailing zero bits of a float's mantissa (23 for 0 and powers of two). */
+static int zero_bits(float v)
+{
+	uint32_t u;
+	memcpy(&u, &v, sizeof u);
+	u &= 0x7fffffu;
+	int z = 0;
+	if (!u)
+		return 23;
+	while (!(u & 1u))
+		u >>= 1, z++;
+	return z;
+}
+
+/* The keys levels of every robot clip at 1% of the height, with the given
+ * precision; returns the values with at least 8 trailing zero bits. */
+static long robot_levels(const mlod_character *c, mlod_motion_precision precision, mlod_motion_level *out)
+{
+	mlod_motion_options opt = {0};
+	opt.precision = precision;
+	double bound = 0.01 * mlod_skeleton_size(&c->skeleton);
+	long zeros = 0;
+	for (int k = 0; k < c->clip_count; k++) {
+		mlod_motion *m;
+		if (mlod_motion_create(c, k, &opt, &m, &terr) != MLOD_OK)
+			return -1;
+		mlod_result r = mlod_motion_next_level(m, MLOD_MOTION_KEYS, MLOD_MOTION_MAX_ERROR, bound, &out[k], &terr);
+		mlod_motion_free(m);
+		if (r != MLOD_OK)
+			return -1;
+		const mlod_clip *cl = &out[k].clip;
+		for (int i = 0; i < cl->channel_count; i++) {
+			const mlod_channel *ch = &cl->channels[i];
+			int comps = ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+			for (int v = 0; v < ch->key_count * comps; v++)
+				zeros += zero_bits(ch->values[v]) >= 8;
+		}
+	}
+	return zeros;
+}
+
+/* Is v the value of channel i of clip (its own keys, not resampled) at
+ * key time t, bit for bit (a rotation's sign aside: levels keep their
+ * quaternions on one hemisphere)? */
+static int value_at(const mlod_clip *clip, int i, float t, const float *v)
+{
+	const mlod_channel *ch = &clip->channels[i];
+	int comps = ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+	for (int k = 0; k < ch->key_count; k++)
+		if (ch->times[k] == t) {
+			const float *w = ch->values + (size_t)k * (size_t)comps;
+			int same = 1, neg = comps == 4;
+			for (int c = 0; c < comps; c++) {
+				same = same && w[c] == v[c];
+				neg = neg && w[c] == -v[c];
+			}
+			return same || neg;
+		}
+	return 0;
+}
+
+TEST(precision_float_and_full)
+{
+	mlod_character c;
+	CHECK(load_sample("samples/RobotExpressive.glb", &c) == 0);
+	int n = c.clip_count;
+	double bound = 0.01 * mlod_skeleton_size(&c.skeleton);
+	mlod_motion_level *full = calloc((size_t)n, sizeof *full), *a = calloc((size_t)n, sizeof *a),
+	                  *b = calloc((size_t)n, sizeof *b);
+	long zeros_full = robot_levels(&c, MLOD_MOTION_PRECISION_FULL, full);
+	long zeros_auto = robot_levels(&c, MLOD_MOTION_PRECISION_FLOAT, a);
+	robot_levels(&c, MLOD_MOTION_PRECISION_FLOAT, b);
+	CHECK(zeros_full >= 0 && zeros_auto >= 0);
+	/* Rounding zeroes low bits: many more values end in a zero byte. */
+	CHECK_MSG(zeros_auto > 4 * zeros_full, "values with 8 zero bits: auto %ld, full %ld", zeros_auto, zeros_full);
+	for (int k = 0; k < n; k++) {
+		const mlod_clip *src = &c.clips[k];
+		/* Full precision: every kept key as read, bit for bit. */
+		for (int i = 0; i < full[k].clip.channel_count; i++) {
+			const mlod_channel *ch = &full[k].clip.channels[i];
+			int comps = ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+			for (int key = 0; key < ch->key_count; key++) {
+				CHECK_MSG(value_at(src, i, ch->times[key], ch->values + key * comps),
+				          "clip %d channel %d key %d changed at full precision", k, i, key);
+			}
+		}
+		CHECK(full[k].grid == 0.0);
+		/* Float: within the bound, measured after rounding, and rounded. */
+		CHECK_MSG(a[k].error.max <= bound && a[k].point_error <= bound, "clip %d: error %g, point %g, bound %g", k,
+		          a[k].error.max, a[k].point_error, bound);
+		CHECK(a[k].grid > 0.0 && a[k].grid <= 2.0 * bound);
+		for (int i = 0; i < a[k].clip.channel_count; i++) {
+			const mlod_channel *ch = &a[k].clip.channels[i];
+			int comps = ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+			/* Deterministic: a second run gives the same values, bit for bit. */
+			CHECK(b[k].clip.channels[i].key_count == ch->key_count &&
+			      memcmp(b[k].clip.channels[i].values, ch->values, sizeof(float) * (size_t)(ch->key_count * comps)) == 0);
+			/* The first and last keys stay exact. */
+			for (int end = 0; end < 2; end++) {
+				int key = end ? ch->key_count - 1 : 0;
+				CHECK(value_at(src, i, ch->times[key], ch->values + key * comps));
+			}
+			CHECK(!ch->short_values);
+			/* Rotations stay unit: the glTF writer's normalisation keeps them bit for bit. */
+			for (int key = 0; comps == 4 && key < ch->key_count; key++) {
+				const float *q = ch->values + 4 * key;
+				mlod_quat u = mlod_quat_normalize((mlod_quat){q[0], q[1], q[2], q[3]});
+				double len = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
+				CHECK_MSG(fabs(len - 1.0) < 1e-6, "clip %d channel %d key %d: |q| = %.9g", k, i, key, len);
+				if (key > 0 && key + 1 < ch->key_count)
+					CHECK_MSG(u.x == q[0] && u.y == q[1] && u.z == q[2] && u.w == q[3],
+					          "clip %d channel %d key %d: normalising changes it", k, i, key);
+			}
+		}
+		mlod_motion_level_free(&full[k]);
+		mlod_motion_level_free(&a[k]);
+		mlod_motion_level_free(&b[k]);
+	}
+	free(full);
+	free(a);
+	free(b);
+	mlod_character_free(&c);
+}
+
+TEST(precision_auto_shorts)
+{
+	/* Auto: rotations on the lattice of normalised shorts, about unit; the
+	 * bound holds after rounding; the same values from run to run. */
+	mlod_character c;
+	CHECK(load_sample("samples/RobotExpressive.glb", &c) == 0);
+	int n = c.clip_count;
+	double bound = 0.01 * mlod_skeleton_size(&c.skeleton);
+	mlod_motion_level *a = calloc((size_t)n, sizeof *a), *b = calloc((size_t)n, sizeof *b);
+	CHECK(robot_levels(&c, MLOD_MOTION_PRECISION_AUTO, a) >= 0);
+	CHECK(robot_levels(&c, MLOD_MOTION_PRECISION_AUTO, b) >= 0);
+	long rot_keys = 0;
+	for (int k = 0; k < n; k++) {
+		CHECK_MSG(a[k].error.max <= bound && a[k].point_error <= bound, "clip %d: error %g, point %g, bound %g", k,
+		          a[k].error.max, a[k].point_error, bound);
+		CHECK(a[k].bytes == mlod_clip_key_bytes(&a[k].clip));
+		for (int i = 0; i < a[k].clip.channel_count; i++) {
+			const mlod_channel *ch = &a[k].clip.channels[i];
+			int comps = ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+			CHECK(b[k].clip.channels[i].key_count == ch->key_count &&
+			      memcmp(b[k].clip.channels[i].values, ch->values, sizeof(float) * (size_t)(ch->key_count * comps)) == 0);
+			CHECK(ch->short_values == (comps == 4));
+			for (int key = 0; comps == 4 && key < ch->key_count; key++, rot_keys++) {
+				const float *q = ch->values + 4 * key;
+				double len = 0.0;
+				for (int x = 0; x < 4; x++) {
+					long s16 = lrint((double)q[x] * 32767.0);
+					CHECK_MSG((float)((double)s16 / 32767.0) == q[x], "clip %d channel %d key %d: off the lattice", k, i, key);
+					len += (double)q[x] * q[x];
+				}
+				/* The validator allows 0.00769; the lattice gets within a few 1e-5. */
+				CHECK_MSG(fabs(sqrt(len) - 1.0) < 1e-4, "clip %d channel %d key %d: |q| = %.9g", k, i, key, sqrt(len));
+			}
+		}
+		mlod_motion_level_free(&a[k]);
+		mlod_motion_level_free(&b[k]);
+	}
+	CHECK(rot_keys > 1000);
+	/* A rotation key stores 8 bytes: the level's bytes count them so. */
+	free(a);
+	free(b);
+	mlod_character_free(&c);
+}
+
+TEST(precision_rounds_within_own_error)
+{
+	/* --keys levels have no bound: rounding may add to the error the level
+	 * has before rounding what a bound leaves it (share 0.1: e / 0.9). */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double pe[3];
+	for (int p = 0; p <= MLOD_MOTION_PRECISION_FULL; p++) {
+		mlod_motion_options opt = {0};
+		opt.precision = (mlod_motion_precision)p;
+		mlod_motion *m;
+		mlod_motion_level lv;
+		CHECK_OK(mlod_motion_create(&c, 0, &opt, &m, &terr));
+		CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_KEYS, MLOD_MOTION_FRACTION, 0.1, &lv, &terr));
+		pe[p] = lv.point_error;
+		CHECK_MSG(p == MLOD_MOTION_PRECISION_FULL ? lv.grid == 0.0 : lv.grid > 0.0, "precision %d: grid %g", p, lv.grid);
+		mlod_motion_level_free(&lv);
+		mlod_motion_free(m);
+	}
+	for (int p = 0; p < MLOD_MOTION_PRECISION_FULL; p++)
+		CHECK_MSG(pe[p] <= pe[MLOD_MOTION_PRECISION_FULL] / 0.9, "precision %d: rounded %g, full %g", p, pe[p],
+		          pe[MLOD_MOTION_PRECISION_FULL]);
+	mlod_character_free(&c);
+}
+
 int main(void)
 {
 	RUN(levels_within_bounds_cmu);
@@ -587,5 +790,8 @@ int main(void)
 	RUN(one_frame_clip);
 	RUN(step_channels_stay_step);
 	RUN(key_bytes);
+	RUN(precision_float_and_full);
+	RUN(precision_auto_shorts);
+	RUN(precision_rounds_within_own_error);
 	TEST_EXIT();
 }

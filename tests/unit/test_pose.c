@@ -203,7 +203,7 @@ TEST(skeleton_size)
 
 static mlod_channel channel(int joint, mlod_path path, mlod_interp interp, int keys, float *times, float *values)
 {
-	mlod_channel ch = { joint, path, interp, keys, times, values };
+	mlod_channel ch = { joint, path, interp, keys, times, values, 0 };
 	return ch;
 }
 

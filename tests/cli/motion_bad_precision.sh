@@ -1,0 +1,1 @@
+"$BIN/mlod-motion" --precision half x.glb
