@@ -386,9 +386,11 @@ static void speed(int argc, char **argv)
 		printf("| %s | %d | %.1f | %.1f | %.2f | %.0fx | %.0fx |\n", base_name(argv[a]), T, tp, tc, tm, tp / tm, tc / tm);
 		mlod_character_free(&c);
 	}
-	printf("\nThe whole chain of three levels (50%%, 25%%, 10%% of each primitive's triangles): mlod makes its poses, "
-	       "builds the BGMs, collapses down to 10%% once and extracts the three prefixes; meshopt_simplify "
-	       "simplifies each level from the full mesh, positions only. Medians of %d runs.\n",
+	printf("\nThe whole chain of three levels (50%%, 25%%, 10%% of the triangles): mlod makes its poses, builds "
+	       "the BGMs, collapses once (as far as it goes with the posed cost, whose character budget then shares "
+	       "each level among the primitives; to 10%% of each primitive with compactness) and extracts the three "
+	       "prefixes; meshopt_simplify simplifies each primitive's level from the full mesh, positions only. "
+	       "Medians of %d runs.\n",
 	       RUNS);
 }
 

@@ -41,7 +41,8 @@ for f in $glbs; do
 	"$BUILD/bench/bench_mesh" quality "$f" $files 2> "$tmp/stderr" || cat "$tmp/stderr" >&2
 	echo
 done
-echo "mlod rows are the library with each cost, placement and eligibility rule; levels keep 50/25/10% of each"
-echo "primitive's triangles (gltfpack and the paper's rules may stop short: see the tris columns). The default"
-echo "row's ratios against the peers are given where the triangle counts match within 1%."
+echo "mlod rows are the library with each cost, collapse, placement and eligibility rule; levels keep 50/25/10%"
+echo "of the triangles (posed cost: of the whole character, shared by cost as mlod-bgm does; compactness: of each"
+echo "primitive). gltfpack and the paper's rules may stop short: see the tris columns. The default row's ratios"
+echo "against the peers are given where the triangle counts match within 1%."
 echo
