@@ -562,6 +562,10 @@ mlod_result mlod_vertex_deviation(const mlod_character *a, const mlod_character 
  * For a skeleton level these are the level's remap and the renumbering. */
 mlod_result mlod_joint_deviation(const mlod_character *a, const mlod_character *b, const int *stand_in,
                                  const int *a_to_b, int max_samples, mlod_deviation *out, mlod_error *err);
+/* The same (joints matched by index) at the count given times of every
+ * clip instead of the clips' own times. */
+mlod_result mlod_joint_deviation_at(const mlod_character *a, const mlod_character *b, const float *times, int count,
+                                    mlod_deviation *out, mlod_error *err);
 
 /* ------------------------------------------------------------------ */
 /* Multiresolution Skeletal Graph and skeleton levels (paper 4.1.3)    */
@@ -898,9 +902,10 @@ mlod_result mlod_primitive_remap_joints(mlod_primitive *p, const int *map, int m
  * than level k (fewer keys, a larger bound). Frame distances, thresholds
  * and the tree follow the paper; per-channel key reduction goes beyond it.
  * Error bounds apply to the point error (mlod_motion_point_error) of every
- * joint at every frame of the clip's common timeline, which bounds the
- * world-space joint and End Site position error (mlod_joint_deviation)
- * against the clip as read, in scene units. */
+ * joint at every sample of the clip's common timeline (its frames and, by
+ * default, the midpoints between them: mlod_motion_options.subdivide),
+ * which bounds the world-space joint and End Site position error
+ * (mlod_joint_deviation_at) against the clip as read, in scene units. */
 
 /* How far any point within radius of a joint moves between world matrices
  * a and b: |origin(a) - origin(b)| + radius * sigma_max(A - B), A and B
@@ -948,7 +953,18 @@ typedef struct mlod_motion_options {
 	mlod_motion_precision precision; /* how a level's key values are stored (default auto) */
 	double precision_share;   /* auto precision: the share of a max-error bound left to rounding,
 	                             (0, 1); 0 means the default */
+	int subdivide;            /* errors are checked at the frames of the common timeline and at
+	                             subdivide - 1 evenly spaced times inside each interval between
+	                             them (1: frames only; 0 means the default, 2: midpoints too) */
 } mlod_motion_options;
+
+#define MLOD_DEFAULT_SUBDIVIDE 2
+#define MLOD_MAX_SUBDIVIDE 64
+
+/* The sample times of a timeline of `frames` increasing times: frame f is
+ * sample f * subdivide, with subdivide - 1 evenly spaced times after it
+ * (before the next frame). out holds (frames - 1) * subdivide + 1 floats. */
+void mlod_motion_sample_times(const float *times, int frames, int subdivide, float *out);
 
 /* How a clip was put on a common timeline: every channel keyed at every
  * frame. A clip whose channels share their key times and are LINEAR or
@@ -1007,8 +1023,9 @@ typedef struct mlod_motion_level {
 	double threshold;         /* frames: the frame distance threshold; keys: the error budget used */
 	long keys;                /* mlod_clip_key_count(&clip) */
 	long bytes;               /* mlod_clip_key_bytes(&clip) */
-	mlod_deviation error;     /* joint position error against the source clip, scene units */
-	double point_error;       /* the largest point error over joints and common frames, scene units */
+	mlod_deviation error;     /* joint position error against the source clip at the samples
+	                             (frames and the times between them), scene units */
+	double point_error;       /* the largest point error over joints and samples, scene units */
 	double grid;              /* auto precision: the grid translations were rounded to (rotations
 	                             and scales finer by their joint's reach), scene units; 0: none */
 } mlod_motion_level;
@@ -1032,12 +1049,14 @@ void mlod_motion_level_free(mlod_motion_level *l);
  * (mlod_motion_common_clip). kept holds channel_count * frames flags
  * (channel-major): on entry the keys that may stay (each channel keeps its
  * first frame, and its last unless it is a single key), on return those
- * kept. A key goes only if, at every frame, every joint's world origin
- * stays within bound of the original, and so does every point within
- * point_distance of it (and its End Site); tracks that then fit a
- * constant collapse to one key. */
+ * kept. A key goes only if, at every sample (mlod_motion_sample_times:
+ * the frames and subdivide - 1 times between each two, 1 to
+ * MLOD_MAX_SUBDIVIDE), every joint's world origin stays within bound of
+ * the original, and so does every point within point_distance of it (and
+ * its End Site); tracks that then fit a constant collapse to one key. */
 mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common,
-                           double bound, double point_distance, unsigned char *kept, mlod_error *err);
+                           double bound, double point_distance, int subdivide, unsigned char *kept,
+                           mlod_error *err);
 
 #ifdef __cplusplus
 }

@@ -55,6 +55,9 @@ static const char usage_text[] =
 	"      --precision-share F the share of each bound left to rounding, the rest to\n"
 	"                          removing keys (default 0.1)\n"
 	"      --cubic-rate R      resample CUBICSPLINE clips at R frames/s (default 60)\n"
+	"      --subdivide N       check the error bound at the frames and at N-1 evenly\n"
+	"                          spaced times between each two (1: frames only;\n"
+	"                          default 2, the midpoints too)\n"
 	"  -l, --level K           with a .bvh output: the level to write (0 = as read)\n"
 	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
 	"  -h, --help              show this help\n"
@@ -246,6 +249,12 @@ static void timeline_note(char *buf, size_t size, const struct clip *cl)
 		         cl->frames, cl->timeline.mismatched_channels, cl->timeline.cubic_channels);
 }
 
+/* Samples per frame interval at which the bounds are checked. */
+static int subdivide(const struct job *job)
+{
+	return job->opt.subdivide > 0 ? job->opt.subdivide : MLOD_DEFAULT_SUBDIVIDE;
+}
+
 static void report_table(const struct job *job)
 {
 	printf("# %s: %d joints, height %.4g, %d clips; point distance %.4g\n", job->input, job->c.skeleton.joint_count,
@@ -284,6 +293,12 @@ static void report_table(const struct job *job)
 	       "# position error against the clip as read, scene units and %% of the height; pt: point error (joint\n"
 	       "# origins and points within the point distance), scene units; vtx: skinned-vertex error, %% of the\n"
 	       "# bounding diagonal\n");
+	int sub = subdivide(job);
+	if (sub == 1)
+		printf("# jnt and pt measured at the frames of each clip's common timeline (--subdivide 1)\n");
+	else
+		printf("# jnt and pt measured at the frames of each clip's common timeline and %d time%s between each two "
+		       "(--subdivide %d)\n", sub - 1, sub == 2 ? "" : "s", sub);
 	if (job->opt.precision != MLOD_MOTION_PRECISION_FULL)
 		printf("# key values rounded within each level's bound (--precision %s)\n",
 		       job->opt.precision == MLOD_MOTION_PRECISION_AUTO ? "auto" : "float");
@@ -295,8 +310,8 @@ static void report_json(const struct job *job)
 {
 	printf("{\n  \"input\": ");
 	tool_json_string(stdout, job->input);
-	printf(",\n  \"joints\": %d,\n  \"height\": %.9g,\n  \"point_distance\": %.9g,\n  \"clips\": [\n",
-	       job->c.skeleton.joint_count, job->height, job->point_distance);
+	printf(",\n  \"joints\": %d,\n  \"height\": %.9g,\n  \"point_distance\": %.9g,\n  \"subdivide\": %d,\n  \"clips\": [\n",
+	       job->c.skeleton.joint_count, job->height, job->point_distance, subdivide(job));
 	for (int k = 0; k < job->clip_count; k++) {
 		const struct clip *cl = &job->clips[k];
 		printf("    {\"name\": ");
@@ -403,9 +418,10 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 				n += snprintf(json + n, sizeof json - (size_t)n, "\"bound\": %.9g, ", lv->bound);
 			n += snprintf(json + n, sizeof json - (size_t)n,
 			              "\"keys\": %ld, \"source_keys\": %ld, \"bytes\": %ld, \"joint_error\": {\"max\": %.9g, "
-			              "\"mean\": %.9g, \"max_percent_height\": %.9g}, \"point_error\": %.9g, \"grid\": %.9g",
+			              "\"mean\": %.9g, \"max_percent_height\": %.9g}, \"point_error\": %.9g, \"grid\": %.9g, "
+			              "\"subdivide\": %d",
 			              lv->l.keys, cl->keys, lv->l.bytes, lv->l.error.max, lv->l.error.mean,
-			              100.0 * lv->l.error.max / job->height, lv->l.point_error, lv->l.grid);
+			              100.0 * lv->l.error.max / job->height, lv->l.point_error, lv->l.grid, subdivide(job));
 			if (lv->has_vertex)
 				n += snprintf(json + n, sizeof json - (size_t)n, ", \"vertex_error_percent_diagonal\": %.9g",
 				              lv->vertex.max);
@@ -431,6 +447,7 @@ int main(int argc, char **argv)
 		{"cubic-rate", required_argument, NULL, 'C'},
 		{"precision", required_argument, NULL, 'p'},
 		{"precision-share", required_argument, NULL, 'S'},
+		{"subdivide", required_argument, NULL, 'D'},
 		{"level", required_argument, NULL, 'l'},
 		{"clip", required_argument, NULL, 'c'},
 		{"help", no_argument, NULL, 'h'},
@@ -499,6 +516,13 @@ int main(int argc, char **argv)
 			if (!(job.opt.precision_share > 0.0 && job.opt.precision_share < 1.0))
 				tool_usage_error("--precision-share: %s is not between 0 and 1", optarg);
 			break;
+		case 'D': {
+			double v = tool_parse_double("--subdivide", optarg, 1, MLOD_MAX_SUBDIVIDE);
+			if (v != floor(v))
+				tool_usage_error("--subdivide: %s is not a whole number", optarg);
+			job.opt.subdivide = (int)v;
+			break;
+		}
 		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
 		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
 		case 'h': fputs(usage_text, stdout); return 0;
