@@ -464,6 +464,28 @@ mlod_result mlod_gltf_clear_lod(mlod_gltf *doc, int node, mlod_error *err);
  * added. */
 mlod_result mlod_gltf_copy_morph_animation(mlod_gltf *doc, int from, int to, int *added, mlod_error *err);
 
+/* A channel animating the morph target weights of a node (not part of the
+ * character's clips). */
+typedef struct mlod_weight_track {
+	int node;            /* glTF node */
+	int targets;         /* weights per key */
+	mlod_interp interp;
+	int key_count;
+	float *times;        /* key_count, increasing */
+	float *values;       /* targets per key (3 * targets for CUBICSPLINE: in-tangents, values, out-tangents) */
+} mlod_weight_track;
+
+/* The weights channels of glTF animation `animation`, in channel order;
+ * *tracks is NULL when there are none. Release with mlod_weight_tracks_free. */
+mlod_result mlod_gltf_weight_tracks(const mlod_gltf *doc, int animation, mlod_weight_track **tracks, int *count,
+                                    mlod_error *err);
+void mlod_weight_tracks_free(mlod_weight_track *tracks, int count);
+
+/* Appends the tracks to glTF animation `animation` as weights channels
+ * (key times shared by several tracks are stored once). */
+mlod_result mlod_gltf_add_weight_tracks(mlod_gltf *doc, int animation, const mlod_weight_track *tracks, int count,
+                                        mlod_error *err);
+
 /* ------------------------------------------------------------------ */
 /* BVH                                                                 */
 /* ------------------------------------------------------------------ */
@@ -1042,6 +1064,33 @@ typedef struct mlod_motion_level {
 mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                    double value, mlod_motion_level *out, mlod_error *err);
 void mlod_motion_level_free(mlod_motion_level *l);
+
+/* Morph target weights of a level (beyond the paper). A weight error dw on
+ * a target moves a vertex by dw times that target's offset there, so a
+ * track's error at a time is the sum over its targets of |dw| times the
+ * target's reach: its largest vertex offset, in scene units, on the node's
+ * mesh as placed (rigidly or skinned) in the rest pose. */
+
+/* The reach of each of the `targets` morph targets of the mesh instance on
+ * glTF node `node` into out. MLOD_ERR_INVALID_ARG when no instance of c is
+ * on that node or its mesh has another number of targets. */
+mlod_result mlod_morph_target_reach(const mlod_character *c, int node, int targets, double *out, mlod_error *err);
+
+/* Reduces a LINEAR or STEP weight track: out gets the keys it needs so
+ * that, at every key time of in and subdivide - 1 evenly spaced times
+ * between each two, the error (above) is at most bound; the first and last
+ * keys stay (one key for a track that comes down to a constant), and kept
+ * keys keep their values. *error gets the largest
+ * error at those times. CUBICSPLINE tracks are MLOD_ERR_UNSUPPORTED.
+ * out's times and values are released with free(). */
+mlod_result mlod_weight_track_reduce(const mlod_weight_track *in, const double *reach, double bound, int subdivide,
+                                     mlod_weight_track *out, double *error, mlod_error *err);
+
+/* Keys and glTF bytes of weight tracks: each key stores targets floats
+ * (three times as many for CUBICSPLINE) and a time, which tracks with
+ * identical times share. */
+long mlod_weight_tracks_keys(const mlod_weight_track *tracks, int count);
+long mlod_weight_tracks_bytes(const mlod_weight_track *tracks, int count);
 
 /* Per-channel key reduction under a hierarchical error bound (beyond the
  * paper; the metric of ozz-animation's optimizer and ACL's virtual

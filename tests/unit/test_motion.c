@@ -528,6 +528,86 @@ TEST(bound_holds_between_frames)
 	mlod_character_free(&c);
 }
 
+TEST(morph_weights_reduced_within_bound)
+{
+	/* Two targets over 11 keys: target 0 ramps 0 -> 1 (a line: its inner
+	 * keys go), target 1 has a bump of h at key 5 with reach 2, so it
+	 * costs 2 h there: it stays under a bound below 2 h and goes above. */
+	const float h = 0.05f;
+	mlod_weight_track t = {0};
+	t.node = 3;
+	t.targets = 2;
+	t.interp = MLOD_INTERP_LINEAR;
+	t.key_count = 11;
+	t.times = malloc(sizeof(float) * 11);
+	t.values = calloc(22, sizeof(float));
+	for (int k = 0; k < 11; k++) {
+		t.times[k] = (float)k / 10.0f;
+		t.values[2 * k] = (float)k / 10.0f;
+	}
+	t.values[2 * 5 + 1] = h;
+	const double reach[2] = {1.0, 2.0};
+	mlod_weight_track out;
+	double e;
+	CHECK_OK(mlod_weight_track_reduce(&t, reach, 1.5 * h, 2, &out, &e, &terr));
+	CHECK_MSG(out.key_count >= 3 && out.key_count < 11 && e <= 1.5 * h, "keys %d error %g", out.key_count, e);
+	int has5 = 0;
+	for (int k = 0; k < out.key_count; k++)
+		has5 |= out.times[k] == t.times[5];
+	CHECK(has5 && out.times[0] == t.times[0] && out.times[out.key_count - 1] == t.times[10]);
+	free(out.times), free(out.values);
+	CHECK_OK(mlod_weight_track_reduce(&t, reach, 2.5 * h, 2, &out, &e, &terr));
+	CHECK_MSG(out.key_count == 2 && e <= 2.5 * h && e >= 1.9 * h, "keys %d error %g", out.key_count, e);
+	free(out.times), free(out.values);
+	/* A constant track keeps one key. */
+	for (int k = 0; k < 22; k++)
+		t.values[k] = 0.25f;
+	CHECK_OK(mlod_weight_track_reduce(&t, reach, 0.0, 2, &out, &e, &terr));
+	CHECK(out.key_count == 1 && out.values[0] == 0.25f && e == 0.0);
+	free(out.times), free(out.values);
+	t.interp = MLOD_INTERP_CUBICSPLINE;
+	CHECK(mlod_weight_track_reduce(&t, reach, 0.1, 2, &out, &e, &terr) == MLOD_ERR_UNSUPPORTED);
+	free(t.times), free(t.values);
+}
+
+TEST(morph_target_reach_in_scene_units)
+{
+	/* One rigid mesh on node 4, scaled by 2 in the scene: its target moves
+	 * vertices by 0.1 and 0.3, so 0.6 in scene units. */
+	mlod_character c = make_chain(1, 3);
+	c.mesh_count = 1;
+	c.meshes = calloc(1, sizeof(mlod_mesh));
+	c.meshes[0].name = strdup("face");
+	c.meshes[0].gltf_index = -1;
+	c.meshes[0].primitive_count = 1;
+	c.meshes[0].primitives = calloc(1, sizeof(mlod_primitive));
+	mlod_primitive *p = &c.meshes[0].primitives[0];
+	p->vertex_count = 2;
+	p->positions = calloc(6, sizeof(float));
+	p->mode = 4;
+	p->material = -1;
+	p->target_count = 1;
+	p->targets = calloc(1, sizeof(mlod_morph_target));
+	p->targets[0].positions = calloc(6, sizeof(float));
+	p->targets[0].positions[0] = 0.1f;
+	p->targets[0].positions[4] = 0.3f;
+	c.instance_count = 1;
+	c.instances = calloc(1, sizeof(mlod_instance));
+	c.instances[0].mesh = 0;
+	c.instances[0].node = 4;
+	c.instances[0].skin = -1;
+	c.instances[0].joint = -1;
+	mlod_trs tr = mlod_trs_identity();
+	tr.s = (mlod_v3){2, 2, 2};
+	c.instances[0].offset = mlod_mat4_from_trs(&tr);
+	double reach[2];
+	CHECK_OK(mlod_morph_target_reach(&c, 4, 1, reach, &terr));
+	CHECK_MSG(fabs(reach[0] - 0.6) < 1e-6, "reach %g", reach[0]);
+	CHECK(mlod_morph_target_reach(&c, 5, 1, reach, &terr) == MLOD_ERR_INVALID_ARG);
+	CHECK(mlod_morph_target_reach(&c, 4, 2, reach, &terr) == MLOD_ERR_INVALID_ARG);
+	mlod_character_free(&c);
+}
+
 TEST(common_timeline)
 {
 	/* Two channels on different times: the union, exact at every key. */
@@ -886,6 +966,8 @@ int main(void)
 	RUN(points_out_from_leaves_are_kept);
 	RUN(hierarchy_error_is_bounded);
 	RUN(bound_holds_between_frames);
+	RUN(morph_weights_reduced_within_bound);
+	RUN(morph_target_reach_in_scene_units);
 	RUN(common_timeline);
 	RUN(bad_clips);
 	RUN(one_frame_clip);
