@@ -545,6 +545,112 @@ static int cmd_speed(int argc, char **argv)
 	return 0;
 }
 
+/* ---------------------------------------------------------------- */
+/* Between frames                                                     */
+/* ---------------------------------------------------------------- */
+
+#define DENSE 16 /* samples per frame interval of the dense error */
+
+/* Max joint position error of a level of clip k of c, DENSE samples per
+ * interval of the clip's own key times. */
+static double dense_error(const mlod_character *c, int k, const mlod_clip *level)
+{
+	float *t = NULL, *st;
+	int n = mlod_clip_times(&c->clips[k], 0, &t);
+	if (n <= 0)
+		return NAN;
+	st = malloc(sizeof(float) * ((size_t)(n - 1) * DENSE + 1));
+	mlod_motion_sample_times(t, n, DENSE, st);
+	mlod_character a = *c, b = *c;
+	a.clip_count = b.clip_count = 1;
+	a.clips = &c->clips[k];
+	b.clips = (mlod_clip *)level;
+	mlod_deviation d = {NAN, NAN, 0};
+	mlod_error err = {0};
+	if (mlod_joint_deviation_at(&a, &b, st, (n - 1) * DENSE + 1, &d, &err) != MLOD_OK)
+		fprintf(stderr, "bench_motion: %s\n", err.message);
+	mlod_free(t);
+	free(st);
+	return d.max;
+}
+
+/* Levels (auto: the method with fewer bytes) checked at the frames only
+ * and with samples between them: keys, bytes, time, and the error found
+ * between frames (DENSE samples per interval) against the bound. */
+static int cmd_between(int argc, char **argv)
+{
+	static const double pct[3] = {0.2, 1.0, 3.0};
+	static const int subs[3] = {1, 2, 4};
+	printf("Default levels (0.2%%, 1%%, 3%% of the height; auto method) with the bound checked at the frames only "
+	       "(subdivide 1), also at the midpoints (2) or at 3 times between frames (4). Dense error: the largest joint "
+	       "position error at %d samples per frame interval, over the bound; levels over: how many of the levels "
+	       "exceed their bound there.\n\n", DENSE);
+	printf("| file | clips | subdivide | keys | bytes | ms (3 levels, all clips) | dense error / bound, worst | levels over |\n");
+	printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
+	for (int i = 0; i < argc; i++) {
+		mlod_character c;
+		double h, pd;
+		if (load_sized(argv[i], &c, &h, &pd) != 0)
+			continue;
+		for (int v = 0; v < 3; v++) {
+			long keys = 0, bytes = 0;
+			int over = 0, levels = 0;
+			double worst = 0.0, ms = 0.0;
+			for (int k = 0; k < c.clip_count; k++) {
+				mlod_motion_options opt = {0};
+				opt.point_distance = pd;
+				opt.subdivide = subs[v];
+				mlod_motion *mo[2];
+				mlod_error err = {0};
+				double t0 = bench_now();
+				if (mlod_motion_create(&c, k, &opt, &mo[0], &err) != MLOD_OK)
+					continue;
+				if (mlod_motion_create(&c, k, &opt, &mo[1], &err) != MLOD_OK) {
+					mlod_motion_free(mo[0]);
+					continue;
+				}
+				mlod_motion_level best[3];
+				int have[3] = {0, 0, 0};
+				for (int l = 0; l < 3; l++)
+					for (int m = 0; m < 2; m++) {
+						mlod_motion_level lv;
+						if (mlod_motion_next_level(mo[m], (mlod_motion_method)m, MLOD_MOTION_MAX_ERROR, pct[l] * h / 100.0,
+						                           &lv, &err) != MLOD_OK)
+							continue;
+						if (!have[l] || lv.bytes < best[l].bytes) {
+							if (have[l])
+								mlod_motion_level_free(&best[l]);
+							best[l] = lv;
+							have[l] = 1;
+						} else {
+							mlod_motion_level_free(&lv);
+						}
+					}
+				ms += 1000.0 * (bench_now() - t0);
+				for (int l = 0; l < 3; l++) {
+					if (!have[l])
+						continue;
+					double e = dense_error(&c, k, &best[l].clip) / (pct[l] * h / 100.0);
+					keys += best[l].keys;
+					bytes += best[l].bytes;
+					levels++;
+					over += e > 1.0;
+					if (!(e <= worst))
+						worst = e;
+					mlod_motion_level_free(&best[l]);
+				}
+				mlod_motion_free(mo[0]);
+				mlod_motion_free(mo[1]);
+			}
+			printf("| %s | %d | %d | %ld | %ld | %.0f | %.4f | %d of %d |\n", base_name(argv[i]), c.clip_count, subs[v],
+			       keys, bytes, ms, worst, over, levels);
+		}
+		mlod_character_free(&c);
+	}
+	printf("\n");
+	return 0;
+}
+
 static int cmd_convert(int argc, char **argv)
 {
 	mlod_character c;
@@ -582,7 +688,9 @@ int main(int argc, char **argv)
 		return cmd_methods(argc - 2, argv + 2);
 	if (argc >= 2 && strcmp(argv[1], "speed") == 0)
 		return cmd_speed(argc - 2, argv + 2);
+	if (argc >= 2 && strcmp(argv[1], "between") == 0)
+		return cmd_between(argc - 2, argv + 2);
 	fprintf(stderr, "usage: bench_motion convert IN OUT.glb | peers ORIG LABEL=FILE[@KEYS]... | precision FILE... | "
-	                "methods FILE... | speed FILE...\n");
+	                "methods FILE... | speed FILE... | between FILE...\n");
 	return 1;
 }

@@ -47,6 +47,11 @@ done
 # shellcheck disable=SC2086
 "$bench" methods $samples $long
 
+echo "## Motion layer: the bound between frames (--subdivide)"
+echo
+# shellcheck disable=SC2086
+"$bench" between $samples $long
+
 echo "## Motion layer: speed (default levels: 0.2%, 1%, 3% of the height)"
 echo
 if [ -z "$long" ]; then

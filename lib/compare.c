@@ -168,8 +168,11 @@ done:
 	return r;
 }
 
-mlod_result mlod_joint_deviation(const mlod_character *a, const mlod_character *b, const int *stand_in,
-                                 const int *a_to_b, int max_samples, mlod_deviation *out, mlod_error *err)
+/* mlod_joint_deviation at the times of each clip (mlod_clip_times), or at
+ * the at_count times `at` when at is not NULL. */
+static mlod_result joint_deviation(const mlod_character *a, const mlod_character *b, const int *stand_in,
+                                   const int *a_to_b, int max_samples, const float *at, int at_count,
+                                   mlod_deviation *out, mlod_error *err)
 {
 	const mlod_skeleton *s = &a->skeleton;
 	int n = s->joint_count;
@@ -204,14 +207,15 @@ mlod_result mlod_joint_deviation(const mlod_character *a, const mlod_character *
 	double sum = 0.0;
 	long count = 0;
 	for (int k = 0; k < a->clip_count; k++) {
-		int nt = mlod_clip_times(&a->clips[k], max_samples, &times);
+		int nt = at ? at_count : mlod_clip_times(&a->clips[k], max_samples, &times);
+		const float *tk = at ? at : times;
 		if (nt < 0) {
 			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory measuring deviation");
 			goto done;
 		}
 		for (int i = 0; i < nt; i++) {
-			poser_world(&pa, k, times[i]);
-			poser_world(&pb, k, times[i]);
+			poser_world(&pa, k, tk[i]);
+			poser_world(&pb, k, tk[i]);
 			for (int j = 0; j < n; j++) {
 				if (carrier[j] < 0)
 					continue;
@@ -240,4 +244,20 @@ done:
 	poser_free(&pa);
 	poser_free(&pb);
 	return r;
+}
+
+mlod_result mlod_joint_deviation(const mlod_character *a, const mlod_character *b, const int *stand_in,
+                                 const int *a_to_b, int max_samples, mlod_deviation *out, mlod_error *err)
+{
+	return joint_deviation(a, b, stand_in, a_to_b, max_samples, NULL, 0, out, err);
+}
+
+mlod_result mlod_joint_deviation_at(const mlod_character *a, const mlod_character *b, const float *times, int count,
+                                    mlod_deviation *out, mlod_error *err)
+{
+	if (!times || count <= 0) {
+		memset(out, 0, sizeof *out);
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_joint_deviation_at: no times");
+	}
+	return joint_deviation(a, b, NULL, NULL, 0, times, count, out, err);
 }

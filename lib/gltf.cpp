@@ -2685,6 +2685,116 @@ mlod_result mlod_gltf_copy_morph_animation(mlod_gltf *doc, int from, int to, int
 	});
 }
 
+mlod_result mlod_gltf_weight_tracks(const mlod_gltf *doc, int animation, mlod_weight_track **tracks, int *count,
+                                    mlod_error *err)
+{
+	if (tracks)
+		*tracks = nullptr;
+	if (count)
+		*count = 0;
+	std::vector<mlod_weight_track> out;
+	mlod_result r = guard(err, [&] {
+		need(doc && tracks && count, "mlod_gltf_weight_tracks: doc, tracks and count must not be NULL");
+		const Model &m = doc->model;
+		if (animation < 0 || size_t(animation) >= m.animations.size())
+			fail(MLOD_ERR_INVALID_ARG, "animation %d does not exist", animation);
+		const tinygltf::Animation &a = m.animations[size_t(animation)];
+		for (const tinygltf::AnimationChannel &ch : a.channels) {
+			if (ch.target_path != "weights")
+				continue;
+			std::string who = "animation " + std::to_string(animation) + " sampler " + std::to_string(ch.sampler);
+			if (ch.sampler < 0 || size_t(ch.sampler) >= a.samplers.size())
+				fail(MLOD_ERR_PARSE, "%s does not exist", who.c_str());
+			const tinygltf::AnimationSampler &s = a.samplers[size_t(ch.sampler)];
+			mlod_weight_track t;
+			memset(&t, 0, sizeof t);
+			t.node = ch.target_node;
+			t.interp = s.interpolation == "STEP"          ? MLOD_INTERP_STEP
+			           : s.interpolation == "CUBICSPLINE" ? MLOD_INTERP_CUBICSPLINE
+			                                              : MLOD_INTERP_LINEAR;
+			std::vector<float> times = read_floats(m, s.input, who + " input", TINYGLTF_TYPE_SCALAR);
+			std::vector<float> values = read_floats(m, s.output, who + " output", TINYGLTF_TYPE_SCALAR);
+			size_t per = t.interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
+			if (times.empty() || times.size() > size_t(INT_MAX) || values.size() % (per * times.size()) != 0 ||
+			    values.empty())
+				fail(MLOD_ERR_PARSE, "%s: %zu weights for %zu keys", who.c_str(), values.size(), times.size());
+			for (size_t k = 1; k < times.size(); k++)
+				if (!(times[k] > times[k - 1]))
+					fail(MLOD_ERR_PARSE, "%s: key times do not increase", who.c_str());
+			check_finite(times.data(), times.size(), "key times");
+			check_finite(values.data(), values.size(), "weights");
+			t.targets = int(values.size() / (per * times.size()));
+			t.key_count = int(times.size());
+			out.push_back(t);
+			out.back().times = c_copy(times);
+			out.back().values = c_copy(values);
+		}
+	});
+	if (r != MLOD_OK) {
+		for (mlod_weight_track &t : out)
+			free(t.times), free(t.values);
+		return r;
+	}
+	if (!out.empty()) {
+		*tracks = static_cast<mlod_weight_track *>(malloc(sizeof(mlod_weight_track) * out.size()));
+		if (!*tracks) {
+			for (mlod_weight_track &t : out)
+				free(t.times), free(t.values);
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		}
+		memcpy(*tracks, out.data(), sizeof(mlod_weight_track) * out.size());
+		*count = int(out.size());
+	}
+	return MLOD_OK;
+}
+
+void mlod_weight_tracks_free(mlod_weight_track *tracks, int count)
+{
+	for (int i = 0; tracks && i < count; i++)
+		free(tracks[i].times), free(tracks[i].values);
+	free(tracks);
+}
+
+mlod_result mlod_gltf_add_weight_tracks(mlod_gltf *doc, int animation, const mlod_weight_track *tracks, int count,
+                                        mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && (tracks || count == 0), "mlod_gltf_add_weight_tracks: doc and tracks must not be NULL");
+		Model &m = doc->model;
+		if (animation < 0 || size_t(animation) >= m.animations.size())
+			fail(MLOD_ERR_INVALID_ARG, "animation %d does not exist", animation);
+		static const char *const interps[] = {"LINEAR", "STEP", "CUBICSPLINE"};
+		std::map<std::vector<float>, int> inputs;
+		for (int i = 0; i < count; i++) {
+			const mlod_weight_track &t = tracks[i];
+			size_t per = t.interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1, keys = size_t(t.key_count);
+			if (t.node < 0 || size_t(t.node) >= m.nodes.size() || t.key_count <= 0 || t.targets <= 0 || !t.times ||
+			    !t.values || unsigned(t.interp) > MLOD_INTERP_CUBICSPLINE)
+				fail(MLOD_ERR_INVALID_ARG, "weight track %d: no node, no keys or a bad interpolation", i);
+			std::vector<float> times(t.times, t.times + keys);
+			check_finite(times.data(), keys, "key times");
+			check_finite(t.values, keys * per * size_t(t.targets), "weights");
+			for (size_t k = 1; k < keys; k++)
+				if (!(times[k] > times[k - 1]))
+					fail(MLOD_ERR_INVALID_ARG, "weight track %d: key times do not increase", i);
+			auto in = inputs.find(times);
+			if (in == inputs.end())
+				in = inputs.emplace(times, append_floats(m, times.data(), keys, 1, 0, true)).first;
+			tinygltf::AnimationSampler s;
+			s.input = in->second;
+			s.output = append_floats(m, t.values, keys * per * size_t(t.targets), 1, 0);
+			s.interpolation = interps[t.interp];
+			tinygltf::Animation &a = m.animations[size_t(animation)];
+			a.samplers.push_back(s);
+			tinygltf::AnimationChannel c;
+			c.sampler = int(a.samplers.size() - 1);
+			c.target_node = t.node;
+			c.target_path = "weights";
+			a.channels.push_back(c);
+		}
+	});
+}
+
 mlod_result mlod_gltf_clear_lod(mlod_gltf *doc, int node, mlod_error *err)
 {
 	return guard(err, [&] {

@@ -14,11 +14,12 @@
  * point_distance and the joint's End Site offset: it bounds how far any
  * point within r of the joint moves (for a pure rotation error of angle
  * t it is 2 r sin(t/2), the exact displacement of the farthest point).
- * A key may go only if, at every frame of the common timeline, this error
+ * A key may go only if, at every sample of the common timeline (its
+ * frames and the `subdivide - 1` times between each two), this error
  * stays within the bound for the joint and every descendant, given every
  * other channel as it currently is; the check is exact (the same
  * sampling and float forward kinematics as mlod_clip_sample and
- * mlod_pose_world), so the bound holds for the final clip at every frame.
+ * mlod_pose_world), so the bound holds for the final clip at every sample.
  *
  * Search: per channel, from a kept key, the farthest key the segment can
  * reach is found by galloping (2, 3, 5, 9, ... keys ahead) then bisection,
@@ -43,13 +44,15 @@ typedef struct reducer {
 	const mlod_skeleton *s;
 	const mlod_clip *common;
 	int F, J;
-	const float *times;
+	int per;                 /* samples per frame interval: frame f is sample f * per */
+	int S;                   /* samples: (F - 1) * per + 1 */
+	float *times;            /* S sample times */
 	double *radius;          /* per joint */
 	int *sub_start, *sub;    /* per joint: the joint and its descendants, parents first */
-	mlod_mat4 *w0;           /* F * J: world matrices as read */
-	mlod_trs *lc;            /* F * J: current local transforms */
-	mlod_mat4 *lm;           /* F * J: their matrices */
-	mlod_mat4 *wc;           /* F * J: current world matrices */
+	mlod_mat4 *w0;           /* S * J: world matrices as read */
+	mlod_trs *lc;            /* S * J: current local transforms */
+	mlod_mat4 *lm;           /* S * J: their matrices */
+	mlod_mat4 *wc;           /* S * J: current world matrices */
 	mlod_mat4 *tmp;          /* J */
 	unsigned char *kept;
 } reducer;
@@ -69,7 +72,7 @@ static void set_path(mlod_trs *l, mlod_path path, const float *v)
 	}
 }
 
-/* The value at frame f of a channel keyed at frames a < b (f strictly
+/* The value at sample f of a channel keyed at frames a < b (f strictly
  * between them), as mlod_clip_sample computes it from those two keys. */
 static void segment_value(const reducer *R, const mlod_channel *ch, int a, int b, int f, float *out)
 {
@@ -79,7 +82,7 @@ static void segment_value(const reducer *R, const mlod_channel *ch, int a, int b
 		memcpy(out, va, sizeof(float) * (size_t)comps);
 		return;
 	}
-	const float t0 = R->times[a], t1 = R->times[b], dt = t1 - t0;
+	const float t0 = R->times[a * R->per], t1 = R->times[b * R->per], dt = t1 - t0;
 	const float u = (R->times[f] - t0) / dt;
 	if (comps == 4) {
 		mlod_quat q = mlod_quat_slerp((mlod_quat){ va[0], va[1], va[2], va[3] }, (mlod_quat){ vb[0], vb[1], vb[2], vb[3] }, u);
@@ -90,7 +93,7 @@ static void segment_value(const reducer *R, const mlod_channel *ch, int a, int b
 	}
 }
 
-/* The value at frame f of a channel keyed where row is set. */
+/* The value at sample f of a channel keyed (at frames) where row is set. */
 static void kept_value(const reducer *R, const mlod_channel *ch, const unsigned char *row, int f, float *out)
 {
 	int comps = comps_of(ch), first = -1, last = -1;
@@ -104,12 +107,12 @@ static void kept_value(const reducer *R, const mlod_channel *ch, const unsigned 
 			last = k;
 			break;
 		}
-	if (first == last || f <= first || f >= last) {
-		int k = f >= last && first != last ? last : first;
+	if (first == last || f <= first * R->per || f >= last * R->per) {
+		int k = f >= last * R->per && first != last ? last : first;
 		memcpy(out, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
 		return;
 	}
-	int a = f, b = f + 1;
+	int a = f / R->per, b = a + 1;
 	while (!row[a])
 		a--;
 	while (!row[b])
@@ -222,13 +225,14 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 	const mlod_channel *ch = &R->common->channels[c];
 	unsigned char *row = R->kept + (size_t)c * (size_t)R->F;
 	int nk = 0;
+	const int q = R->per;
 	for (int f = 0; f < R->F; f++)
 		if (row[f])
 			K[nk++] = f;
 	for (int i = 0; i + 2 < nk + 0 && i < nk - 1;) {
 		int ok = i + 1, fail = nk, step = 1, probe = i + 2;
 		while (probe < nk) {
-			if (sweep(R, ch, K[i], K[probe], K[i] + 1, K[probe] - 1, 0, budget, 0)) {
+			if (sweep(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget, 0)) {
 				ok = probe;
 				step *= 2;
 				probe = i + 1 + step;
@@ -238,20 +242,20 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 			}
 		}
 		if (fail == nk && ok < nk - 1) {
-			if (sweep(R, ch, K[i], K[nk - 1], K[i] + 1, K[nk - 1] - 1, 0, budget, 0))
+			if (sweep(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget, 0))
 				ok = nk - 1;
 			else
 				fail = nk - 1;
 		}
 		while (fail - ok > 1) {
 			int mid = ok + (fail - ok) / 2;
-			if (sweep(R, ch, K[i], K[mid], K[i] + 1, K[mid] - 1, 0, budget, 0))
+			if (sweep(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget, 0))
 				ok = mid;
 			else
 				fail = mid;
 		}
 		if (ok > i + 1) {
-			sweep(R, ch, K[i], K[ok], K[i] + 1, K[ok] - 1, 0, budget, 1);
+			sweep(R, ch, K[i], K[ok], K[i] * q + 1, K[ok] * q - 1, 0, budget, 1);
 			for (int k = i + 1; k < ok; k++)
 				row[K[k]] = 0;
 		}
@@ -278,14 +282,15 @@ static void collapse_channel(reducer *R, int c, double budget)
 	int comps = comps_of(ch);
 	if (memcmp(ch->values, ch->values + (size_t)(R->F - 1) * (size_t)comps, sizeof(float) * (size_t)comps) != 0)
 		return;
-	if (!sweep(R, ch, 0, 0, 1, R->F - 1, 1, budget, 0))
+	if (!sweep(R, ch, 0, 0, 1, R->S - 1, 1, budget, 0))
 		return;
-	sweep(R, ch, 0, 0, 1, R->F - 1, 1, budget, 1);
+	sweep(R, ch, 0, 0, 1, R->S - 1, 1, budget, 1);
 	memset(row + 1, 0, (size_t)R->F - 1);
 }
 
 static void reducer_free(reducer *R)
 {
+	free(R->times);
 	free(R->radius);
 	free(R->sub_start);
 	free(R->sub);
@@ -297,22 +302,26 @@ static void reducer_free(reducer *R)
 }
 
 static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
-                              double point_distance, const unsigned char *kept, mlod_error *err)
+                              double point_distance, int subdivide, const unsigned char *kept, mlod_error *err)
 {
 	if (!s || !original || !common || !kept)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: NULL argument");
 	if (!(bound >= 0.0) || !isfinite(bound) || !(point_distance >= 0.0) || !isfinite(point_distance))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: bad bound %g or point distance %g", bound,
 		                 point_distance);
+	if (subdivide < 1 || subdivide > MLOD_MAX_SUBDIVIDE)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: subdivide %d is not 1 to %d", subdivide,
+		                 MLOD_MAX_SUBDIVIDE);
 	if (s->joint_count <= 0 || common->channel_count <= 0 || !common->channels)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: no joints or no channels");
 	const mlod_channel *c0 = &common->channels[0];
 	int F = c0->key_count;
 	if (F <= 0)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: no frames");
-	if ((double)F * s->joint_count > (double)MAX_FRAME_JOINTS)
-		return mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": %d frames of %d joints is more than the keys method holds (%ld); split the clip",
-		                 common->name ? common->name : "", F, s->joint_count, MAX_FRAME_JOINTS);
+	if (((double)F - 1.0) * subdivide * s->joint_count > (double)MAX_FRAME_JOINTS)
+		return mlod_fail(err, MLOD_ERR_LIMIT,
+		                 "clip \"%s\": %d frames (%d samples each) of %d joints is more than the keys method holds (%ld); split the clip",
+		                 common->name ? common->name : "", F, subdivide, s->joint_count, MAX_FRAME_JOINTS);
 	for (int c = 0; c < common->channel_count; c++) {
 		const mlod_channel *ch = &common->channels[c];
 		const unsigned char *row = kept + (size_t)c * (size_t)F;
@@ -332,9 +341,9 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 }
 
 mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
-                           double point_distance, unsigned char *kept, mlod_error *err)
+                           double point_distance, int subdivide, unsigned char *kept, mlod_error *err)
 {
-	mlod_result r = check_args(s, original, common, bound, point_distance, kept, err);
+	mlod_result r = check_args(s, original, common, bound, point_distance, subdivide, kept, err);
 	if (r != MLOD_OK)
 		return r;
 	reducer R;
@@ -343,9 +352,11 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 	R.common = common;
 	R.F = common->channels[0].key_count;
 	R.J = s->joint_count;
-	R.times = common->channels[0].times;
+	R.per = subdivide;
+	R.S = (R.F - 1) * R.per + 1;
 	R.kept = kept;
-	size_t FJ = (size_t)R.F * (size_t)R.J;
+	size_t FJ = (size_t)R.S * (size_t)R.J;
+	R.times = malloc(sizeof(float) * (size_t)R.S);
 	R.radius = malloc(sizeof(double) * (size_t)R.J);
 	R.sub_start = calloc((size_t)R.J + 1, sizeof(int));
 	R.w0 = malloc(sizeof(mlod_mat4) * FJ);
@@ -356,7 +367,7 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 	int *depth = malloc(sizeof(int) * (size_t)R.J);
 	int *K = malloc(sizeof(int) * (size_t)R.F);
 	int *fill = NULL;
-	if (!R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.tmp || !depth || !K) {
+	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.tmp || !depth || !K) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
@@ -385,8 +396,9 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 		for (int a = d; a >= 0; a = s->joints[a].parent)
 			R.sub[R.sub_start[a] + fill[a]++] = d;
 
+	mlod_motion_sample_times(common->channels[0].times, R.F, R.per, R.times);
 	/* The clip as read, and as currently kept. */
-	for (int f = 0; f < R.F; f++) {
+	for (int f = 0; f < R.S; f++) {
 		size_t base = (size_t)f * (size_t)R.J;
 		mlod_trs *l = R.lc + base;
 		mlod_pose_rest(s, l);

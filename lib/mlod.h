@@ -464,6 +464,28 @@ mlod_result mlod_gltf_clear_lod(mlod_gltf *doc, int node, mlod_error *err);
  * added. */
 mlod_result mlod_gltf_copy_morph_animation(mlod_gltf *doc, int from, int to, int *added, mlod_error *err);
 
+/* A channel animating the morph target weights of a node (not part of the
+ * character's clips). */
+typedef struct mlod_weight_track {
+	int node;            /* glTF node */
+	int targets;         /* weights per key */
+	mlod_interp interp;
+	int key_count;
+	float *times;        /* key_count, increasing */
+	float *values;       /* targets per key (3 * targets for CUBICSPLINE: in-tangents, values, out-tangents) */
+} mlod_weight_track;
+
+/* The weights channels of glTF animation `animation`, in channel order;
+ * *tracks is NULL when there are none. Release with mlod_weight_tracks_free. */
+mlod_result mlod_gltf_weight_tracks(const mlod_gltf *doc, int animation, mlod_weight_track **tracks, int *count,
+                                    mlod_error *err);
+void mlod_weight_tracks_free(mlod_weight_track *tracks, int count);
+
+/* Appends the tracks to glTF animation `animation` as weights channels
+ * (key times shared by several tracks are stored once). */
+mlod_result mlod_gltf_add_weight_tracks(mlod_gltf *doc, int animation, const mlod_weight_track *tracks, int count,
+                                        mlod_error *err);
+
 /* ------------------------------------------------------------------ */
 /* BVH                                                                 */
 /* ------------------------------------------------------------------ */
@@ -562,6 +584,10 @@ mlod_result mlod_vertex_deviation(const mlod_character *a, const mlod_character 
  * For a skeleton level these are the level's remap and the renumbering. */
 mlod_result mlod_joint_deviation(const mlod_character *a, const mlod_character *b, const int *stand_in,
                                  const int *a_to_b, int max_samples, mlod_deviation *out, mlod_error *err);
+/* The same (joints matched by index) at the count given times of every
+ * clip instead of the clips' own times. */
+mlod_result mlod_joint_deviation_at(const mlod_character *a, const mlod_character *b, const float *times, int count,
+                                    mlod_deviation *out, mlod_error *err);
 
 /* ------------------------------------------------------------------ */
 /* Multiresolution Skeletal Graph and skeleton levels (paper 4.1.3)    */
@@ -898,9 +924,10 @@ mlod_result mlod_primitive_remap_joints(mlod_primitive *p, const int *map, int m
  * than level k (fewer keys, a larger bound). Frame distances, thresholds
  * and the tree follow the paper; per-channel key reduction goes beyond it.
  * Error bounds apply to the point error (mlod_motion_point_error) of every
- * joint at every frame of the clip's common timeline, which bounds the
- * world-space joint and End Site position error (mlod_joint_deviation)
- * against the clip as read, in scene units. */
+ * joint at every sample of the clip's common timeline (its frames and, by
+ * default, the midpoints between them: mlod_motion_options.subdivide),
+ * which bounds the world-space joint and End Site position error
+ * (mlod_joint_deviation_at) against the clip as read, in scene units. */
 
 /* How far any point within radius of a joint moves between world matrices
  * a and b: |origin(a) - origin(b)| + radius * sigma_max(A - B), A and B
@@ -948,7 +975,18 @@ typedef struct mlod_motion_options {
 	mlod_motion_precision precision; /* how a level's key values are stored (default auto) */
 	double precision_share;   /* auto precision: the share of a max-error bound left to rounding,
 	                             (0, 1); 0 means the default */
+	int subdivide;            /* errors are checked at the frames of the common timeline and at
+	                             subdivide - 1 evenly spaced times inside each interval between
+	                             them (1: frames only; 0 means the default, 2: midpoints too) */
 } mlod_motion_options;
+
+#define MLOD_DEFAULT_SUBDIVIDE 2
+#define MLOD_MAX_SUBDIVIDE 64
+
+/* The sample times of a timeline of `frames` increasing times: frame f is
+ * sample f * subdivide, with subdivide - 1 evenly spaced times after it
+ * (before the next frame). out holds (frames - 1) * subdivide + 1 floats. */
+void mlod_motion_sample_times(const float *times, int frames, int subdivide, float *out);
 
 /* How a clip was put on a common timeline: every channel keyed at every
  * frame. A clip whose channels share their key times and are LINEAR or
@@ -1007,8 +1045,9 @@ typedef struct mlod_motion_level {
 	double threshold;         /* frames: the frame distance threshold; keys: the error budget used */
 	long keys;                /* mlod_clip_key_count(&clip) */
 	long bytes;               /* mlod_clip_key_bytes(&clip) */
-	mlod_deviation error;     /* joint position error against the source clip, scene units */
-	double point_error;       /* the largest point error over joints and common frames, scene units */
+	mlod_deviation error;     /* joint position error against the source clip at the samples
+	                             (frames and the times between them), scene units */
+	double point_error;       /* the largest point error over joints and samples, scene units */
 	double grid;              /* auto precision: the grid translations were rounded to (rotations
 	                             and scales finer by their joint's reach), scene units; 0: none */
 } mlod_motion_level;
@@ -1026,18 +1065,47 @@ mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, ml
                                    double value, mlod_motion_level *out, mlod_error *err);
 void mlod_motion_level_free(mlod_motion_level *l);
 
+/* Morph target weights of a level (beyond the paper). A weight error dw on
+ * a target moves a vertex by dw times that target's offset there, so a
+ * track's error at a time is the sum over its targets of |dw| times the
+ * target's reach: its largest vertex offset, in scene units, on the node's
+ * mesh as placed (rigidly or skinned) in the rest pose. */
+
+/* The reach of each of the `targets` morph targets of the mesh instance on
+ * glTF node `node` into out. MLOD_ERR_INVALID_ARG when no instance of c is
+ * on that node or its mesh has another number of targets. */
+mlod_result mlod_morph_target_reach(const mlod_character *c, int node, int targets, double *out, mlod_error *err);
+
+/* Reduces a LINEAR or STEP weight track: out gets the keys it needs so
+ * that, at every key time of in and subdivide - 1 evenly spaced times
+ * between each two, the error (above) is at most bound; the first and last
+ * keys stay (one key for a track that comes down to a constant), and kept
+ * keys keep their values. *error gets the largest
+ * error at those times. CUBICSPLINE tracks are MLOD_ERR_UNSUPPORTED.
+ * out's times and values are released with free(). */
+mlod_result mlod_weight_track_reduce(const mlod_weight_track *in, const double *reach, double bound, int subdivide,
+                                     mlod_weight_track *out, double *error, mlod_error *err);
+
+/* Keys and glTF bytes of weight tracks: each key stores targets floats
+ * (three times as many for CUBICSPLINE) and a time, which tracks with
+ * identical times share. */
+long mlod_weight_tracks_keys(const mlod_weight_track *tracks, int count);
+long mlod_weight_tracks_bytes(const mlod_weight_track *tracks, int count);
+
 /* Per-channel key reduction under a hierarchical error bound (beyond the
  * paper; the metric of ozz-animation's optimizer and ACL's virtual
  * vertices). common is original on its common timeline
  * (mlod_motion_common_clip). kept holds channel_count * frames flags
  * (channel-major): on entry the keys that may stay (each channel keeps its
  * first frame, and its last unless it is a single key), on return those
- * kept. A key goes only if, at every frame, every joint's world origin
- * stays within bound of the original, and so does every point within
- * point_distance of it (and its End Site); tracks that then fit a
- * constant collapse to one key. */
+ * kept. A key goes only if, at every sample (mlod_motion_sample_times:
+ * the frames and subdivide - 1 times between each two, 1 to
+ * MLOD_MAX_SUBDIVIDE), every joint's world origin stays within bound of
+ * the original, and so does every point within point_distance of it (and
+ * its End Site); tracks that then fit a constant collapse to one key. */
 mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common,
-                           double bound, double point_distance, unsigned char *kept, mlod_error *err);
+                           double bound, double point_distance, int subdivide, unsigned char *kept,
+                           mlod_error *err);
 
 #ifdef __cplusplus
 }

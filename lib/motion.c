@@ -51,12 +51,16 @@
  *   keeps every value float32, with the first and last keys exact.
  *
  * Error bounds are checked on the point error of every joint at every
- * frame of the common timeline (mlod_motion_point_error: the joint's
+ * sample of the common timeline (mlod_motion_point_error: the joint's
  * origin and every point within point_distance of it, or within its End
  * Site), computed with the same sampling and forward kinematics as
  * mlod_joint_deviation, so a bound met here is met there for joint and
  * End Site positions; both methods answer to the same bound, so they can
- * be compared at it. The reported error is mlod_joint_deviation's.
+ * be compared at it. The samples are the frames and, by default, the
+ * midpoints between them (options.subdivide): a level and its source
+ * each interpolate their own keys, and between two frames they can differ
+ * more than at either (bench/RESULTS.md, test bound_holds_between_frames).
+ * The reported error is mlod_joint_deviation_at's at the same samples.
  */
 #include <float.h>
 #include <limits.h>
@@ -129,6 +133,20 @@ long mlod_clip_key_bytes(const mlod_clip *clip)
 			bytes += (long)ch->key_count * 4;
 	}
 	return bytes;
+}
+
+void mlod_motion_sample_times(const float *times, int frames, int subdivide, float *out)
+{
+	int sub = subdivide > 0 ? subdivide : 1;
+	for (int f = 0; f < frames; f++) {
+		out[(size_t)f * (size_t)sub] = times[f];
+		for (int i = 1; f + 1 < frames && i < sub; i++) {
+			double t0 = times[f], t1 = times[f + 1];
+			float t = (float)(t0 + (t1 - t0) * (double)i / (double)sub);
+			/* Inside the interval (or on its start when it is too short). */
+			out[(size_t)f * (size_t)sub + (size_t)i] = t > times[f] && t < times[f + 1] ? t : times[f];
+		}
+	}
 }
 
 static char *dup_string(const char *s)
@@ -461,6 +479,9 @@ struct mlod_motion {
 	mlod_clip common;
 	mlod_motion_timeline info;
 	int frames;
+	int sub;               /* samples per frame interval (mlod_motion_options.subdivide) */
+	int samples;           /* (frames - 1) * sub + 1 */
+	float *st;             /* sample times: frame f is sample f * sub */
 	double height;
 	double *weight;        /* per joint */
 	int value_count;       /* V */
@@ -472,7 +493,7 @@ struct mlod_motion {
 	int *reach_exp;        /* per joint: -ceil(log2(2 reach)), reach the farthest point it carries */
 	mlod_trs *local;
 	mlod_mat4 *world, *world0;
-	mlod_mat4 *cache0;     /* frames * joints world matrices as read, or NULL */
+	mlod_mat4 *cache0;     /* samples * joints world matrices as read, or NULL */
 	/* State of each method: the last line of the tree, the keys kept. */
 	line tree;
 	unsigned char *kept;   /* channel_count * frames */
@@ -492,6 +513,7 @@ void mlod_motion_free(mlod_motion *m)
 	if (!m)
 		return;
 	mlod_clip_free(&m->common);
+	free(m->st);
 	free(m->weight);
 	free(m->offset);
 	free(m->euler_slot);
@@ -616,6 +638,13 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	}
 	int n = s->joint_count, nch = m->common.channel_count, F = m->info.frames;
 	m->frames = F;
+	m->sub = opt && opt->subdivide > 0 ? opt->subdivide : MLOD_DEFAULT_SUBDIVIDE;
+	if (m->sub > MLOD_MAX_SUBDIVIDE) {
+		mlod_motion_free(m);
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "subdivide %d is more than %d", opt->subdivide, MLOD_MAX_SUBDIVIDE);
+	}
+	m->samples = (F - 1) * m->sub + 1;
+	m->st = malloc(sizeof(float) * (size_t)m->samples);
 	m->height = mlod_skeleton_size(s);
 	if (!(m->height > 0.0))
 		m->height = 1.0;
@@ -627,12 +656,13 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	m->world = malloc(sizeof *m->world * (size_t)n);
 	m->world0 = malloc(sizeof *m->world0 * (size_t)n);
 	m->radius = malloc(sizeof(double) * (size_t)n);
-	if (!m->weight || !m->offset || !m->euler_slot || !m->constant || !m->local || !m->world || !m->world0 ||
+	if (!m->st || !m->weight || !m->offset || !m->euler_slot || !m->constant || !m->local || !m->world || !m->world0 ||
 	    !m->radius) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
 	joint_weights(s, m->weight);
+	mlod_motion_sample_times(m->common.channels[0].times, F, m->sub, m->st);
 	for (int i = 0; i < nch; i++) {
 		const mlod_channel *ch = &m->common.channels[i];
 		int comps = comps_of(ch);
@@ -652,9 +682,10 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
-	if ((double)F * n <= (double)MAX_CACHED && (m->cache0 = malloc(sizeof(mlod_mat4) * (size_t)F * (size_t)n)) != NULL)
-		for (int f = 0; f < F; f++)
-			pose_at(m, src, m->common.channels[0].times[f], m->cache0 + (size_t)f * (size_t)n);
+	if ((double)m->samples * n <= (double)MAX_CACHED &&
+	    (m->cache0 = malloc(sizeof(mlod_mat4) * (size_t)m->samples * (size_t)n)) != NULL)
+		for (int f = 0; f < m->samples; f++)
+			pose_at(m, src, m->st[f], m->cache0 + (size_t)f * (size_t)n);
 	/* Level 0 of each method: every frame, every key. */
 	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
 	m->kept = malloc((size_t)nch * (size_t)F);
@@ -787,8 +818,9 @@ static int clip_from_kept(const mlod_motion *m, const unsigned char *kept, mlod_
 }
 
 /* Largest point error (mlod_motion_point_error) of a level clip over
- * every joint and every frame of the common timeline, in scene units. It
- * bounds the joint and End Site position error. */
+ * every joint and every sample of the common timeline (frames and the
+ * times between them), in scene units. It bounds the joint and End Site
+ * position error. */
 static double level_error_upto(mlod_motion *m, const mlod_clip *clip, double stop);
 
 static double level_max_error(mlod_motion *m, const mlod_clip *clip)
@@ -800,8 +832,8 @@ static double level_max_error(mlod_motion *m, const mlod_clip *clip)
 static double level_error_upto(mlod_motion *m, const mlod_clip *clip, double stop)
 {
 	double worst = 0.0;
-	for (int f = 0; f < m->frames; f++) {
-		float t = m->common.channels[0].times[f];
+	for (int f = 0; f < m->samples; f++) {
+		float t = m->st[f];
 		const mlod_mat4 *w0 = m->world0;
 		if (m->cache0)
 			w0 = m->cache0 + (size_t)f * (size_t)m->s->joint_count;
@@ -1001,12 +1033,12 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
                            double bound)
 {
 	const mlod_skeleton *s = m->s;
-	int F = m->frames, J = s->joint_count, n = clip->channel_count;
+	int F = m->samples, J = s->joint_count, n = clip->channel_count;
 	size_t FJ = (size_t)F * (size_t)J;
 	mlod_trs *L = malloc(sizeof *L * FJ);
 	mlod_mat4 *W = malloc(sizeof *W * FJ), *w = malloc(sizeof *w * (size_t)J);
 	int *sub = malloc(sizeof(int) * (size_t)J);
-	const float *times = m->common.channels[0].times;
+	const float *times = m->st;
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
 	if (!L || !W || !w || !sub) {
@@ -1138,7 +1170,7 @@ static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double b
 	b = a;
 	a.clips = (mlod_clip *)m->orig;
 	b.clips = &out->clip;
-	return mlod_joint_deviation(&a, &b, NULL, NULL, 0, &out->error, err);
+	return mlod_joint_deviation_at(&a, &b, m->st, m->samples, &out->error, err);
 }
 
 /* ---------------------------------------------------------------- */
@@ -1457,7 +1489,7 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	size_t size = (size_t)m->common.channel_count * (size_t)m->frames;
 	memcpy(kept, m->kept, size);
 	memset(clip, 0, sizeof *clip);
-	if (mlod_keyreduce(m->s, m->orig, &m->common, budget, point_distance(m), kept, err) != MLOD_OK)
+	if (mlod_keyreduce(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, err) != MLOD_OK)
 		return -1.0;
 	if (clip_from_kept(m, kept, clip) != 0) {
 		mlod_clip_free(clip);

@@ -29,7 +29,8 @@ static const char usage_text[] =
 	"Builds motion levels of detail for every clip of a character: the paper's\n"
 	"multiresolution motion tree (whole frames merge) or per-channel key reduction\n"
 	"under a hierarchical error bound. Input is glb, glTF or BVH. Output is a glb\n"
-	"where each clip gets its levels as animations named <clip>@lod<k>.\n"
+	"where each clip gets its levels as animations named <clip>@lod<k>, morph\n"
+	"target weights channels reduced within the same bounds.\n"
 	"\n"
 	"options:\n"
 	"  -o, --output FILE       write to FILE instead of stdout; a .bvh name writes\n"
@@ -55,6 +56,9 @@ static const char usage_text[] =
 	"      --precision-share F the share of each bound left to rounding, the rest to\n"
 	"                          removing keys (default 0.1)\n"
 	"      --cubic-rate R      resample CUBICSPLINE clips at R frames/s (default 60)\n"
+	"      --subdivide N       check the error bound at the frames and at N-1 evenly\n"
+	"                          spaced times between each two (1: frames only;\n"
+	"                          default 2, the midpoints too)\n"
 	"  -l, --level K           with a .bvh output: the level to write (0 = as read)\n"
 	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
 	"  -h, --help              show this help\n"
@@ -77,19 +81,30 @@ struct level {
 	mlod_motion_level l;
 	int has_vertex;
 	mlod_deviation vertex; /* % of the diagonal; scale is the diagonal */
+	/* Morph weights channels of the level (glTF input with such channels). */
+	mlod_weight_track *w;
+	int w_count;
+	int w_copied;    /* tracks kept as they are (CUBICSPLINE, or no mesh to measure) */
+	double w_bound;  /* scene units: the level's bound, or its joint error without one */
+	double w_error;  /* the largest vertex displacement bound of the reduced tracks */
+	long w_keys, w_bytes;
 };
 
 struct clip {
 	int index;
 	int frames;
 	mlod_motion_timeline timeline;
-	long keys, bytes;
+	long keys, bytes;   /* joint channels and morph weights */
+	mlod_weight_track *w; /* the source's morph weights channels */
+	int w_count;
+	long w_keys;
 	int level_count;
 	struct level levels[MAX_LEVELS];
 };
 
 struct job {
 	const char *input;
+	const mlod_gltf *doc; /* glTF input, else NULL */
 	mlod_format format;
 	mlod_character c;
 	double height;
@@ -172,6 +187,56 @@ static void measure_vertex(struct job *job, struct clip *cl, struct level *lv)
 	lv->has_vertex = 1;
 }
 
+/* A copy of a weight track. */
+static void copy_track(const mlod_weight_track *in, mlod_weight_track *out)
+{
+	size_t n = (size_t)in->key_count, v = n * (size_t)in->targets * (in->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
+	*out = *in;
+	out->times = malloc(sizeof(float) * n);
+	out->values = malloc(sizeof(float) * v);
+	if (!out->times || !out->values)
+		tool_die(EXIT_INPUT, NULL, "out of memory");
+	memcpy(out->times, in->times, sizeof(float) * n);
+	memcpy(out->values, in->values, sizeof(float) * v);
+}
+
+/* The level's morph weights: each track reduced within the level's bound
+ * (or, for a level chosen by keys or threshold, its joint error). */
+static void level_weights(struct job *job, struct clip *cl, struct level *lv)
+{
+	if (cl->w_count == 0)
+		return;
+	lv->w = calloc((size_t)cl->w_count, sizeof *lv->w);
+	if (!lv->w)
+		tool_die(EXIT_INPUT, NULL, "out of memory");
+	lv->w_count = cl->w_count;
+	lv->w_bound = lv->bound >= 0.0 ? lv->bound : lv->l.error.max;
+	int sub = job->opt.subdivide > 0 ? job->opt.subdivide : MLOD_DEFAULT_SUBDIVIDE;
+	for (int i = 0; i < cl->w_count; i++) {
+		const mlod_weight_track *t = &cl->w[i];
+		double *reach = malloc(sizeof(double) * (size_t)t->targets), e = 0.0;
+		mlod_error err = {0};
+		if (!reach)
+			tool_die(EXIT_INPUT, NULL, "out of memory");
+		mlod_result r = t->interp == MLOD_INTERP_CUBICSPLINE
+		                    ? MLOD_ERR_UNSUPPORTED
+		                    : mlod_morph_target_reach(&job->c, t->node, t->targets, reach, &err);
+		if (r == MLOD_OK)
+			r = mlod_weight_track_reduce(t, reach, lv->w_bound, sub, &lv->w[i], &e, &err);
+		free(reach);
+		if (r == MLOD_ERR_NOMEM)
+			tool_die(EXIT_INPUT, job->input, "%s", err.message);
+		if (r != MLOD_OK) {
+			copy_track(t, &lv->w[i]);
+			lv->w_copied++;
+		} else if (e > lv->w_error) {
+			lv->w_error = e;
+		}
+	}
+	lv->w_keys = mlod_weight_tracks_keys(lv->w, lv->w_count);
+	lv->w_bytes = mlod_weight_tracks_bytes(lv->w, lv->w_count);
+}
+
 /* Builds the levels of one clip. */
 static void clip_levels(struct job *job, struct clip *cl)
 {
@@ -187,6 +252,13 @@ static void clip_levels(struct job *job, struct clip *cl)
 	}
 	cl->keys = mlod_clip_key_count(src);
 	cl->bytes = mlod_clip_key_bytes(src);
+	if (job->doc && src->gltf_index >= 0) {
+		if (mlod_gltf_weight_tracks(job->doc, src->gltf_index, &cl->w, &cl->w_count, &err) != MLOD_OK)
+			tool_die(EXIT_INPUT, job->input, "%s", err.message);
+		cl->w_keys = mlod_weight_tracks_keys(cl->w, cl->w_count);
+		cl->keys += cl->w_keys;
+		cl->bytes += mlod_weight_tracks_bytes(cl->w, cl->w_count);
+	}
 	for (int i = 0; i < method_count; i++) {
 		mlod_result r = mlod_motion_create(&job->c, cl->index, &job->opt, &m[i], &err);
 		if (r != MLOD_OK)
@@ -228,13 +300,25 @@ static void clip_levels(struct job *job, struct clip *cl)
 				mlod_motion_level_free(&l);
 			}
 		}
-		if (!lv->ok)
+		if (!lv->ok) {
 			fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, why[0][0] ? why[0] : why[1]);
-		else
+		} else {
 			measure_vertex(job, cl, lv);
+			level_weights(job, cl, lv);
+		}
 	}
 	for (int i = 0; i < method_count; i++)
 		mlod_motion_free(m[i]);
+}
+
+/* What was done to a level's morph weights, as a JSON object. */
+static void weights_json(char *buf, size_t size, const struct clip *cl, const struct level *lv)
+{
+	snprintf(buf, size,
+	         "{\"channels\": %d, \"keys\": %ld, \"source_keys\": %ld, \"bytes\": %ld, \"bound\": %.9g, "
+	         "\"error\": %.9g, \"copied\": %d, \"error_measure\": \"sum over targets of |weight error| times the "
+	         "target's largest vertex offset in the rest pose, scene units\"}",
+	         lv->w_count, lv->w_keys, cl->w_keys, lv->w_bytes, lv->w_bound, lv->w_error, lv->w_copied);
 }
 
 static void timeline_note(char *buf, size_t size, const struct clip *cl)
@@ -244,6 +328,12 @@ static void timeline_note(char *buf, size_t size, const struct clip *cl)
 	else
 		snprintf(buf, size, "resampled to %d common frames (%d channels on other times, %d CUBICSPLINE)",
 		         cl->frames, cl->timeline.mismatched_channels, cl->timeline.cubic_channels);
+}
+
+/* Samples per frame interval at which the bounds are checked. */
+static int subdivide(const struct job *job)
+{
+	return job->opt.subdivide > 0 ? job->opt.subdivide : MLOD_DEFAULT_SUBDIVIDE;
 }
 
 static void report_table(const struct job *job)
@@ -266,9 +356,10 @@ static void report_table(const struct job *job)
 			char vtx[32] = "-";
 			if (lv->has_vertex)
 				snprintf(vtx, sizeof vtx, "%.4f", lv->vertex.max);
+			long keys = lv->l.keys + lv->w_keys;
 			printf("%-16s %5d %6s %10.4g %7ld %6.1f%% %8ld %10.4g %8.4f %10.4g %8.4f %10.4g %8s\n", name, i + 1,
-			       method_name(lv->l.method), lv->l.threshold, lv->l.keys, 100.0 * (double)lv->l.keys / (double)cl->keys,
-			       lv->l.bytes, lv->l.error.max, 100.0 * lv->l.error.max / job->height, lv->l.error.mean,
+			       method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
+			       lv->l.bytes + lv->w_bytes, lv->l.error.max, 100.0 * lv->l.error.max / job->height, lv->l.error.mean,
 			       100.0 * lv->l.error.mean / job->height, lv->l.point_error, vtx);
 		}
 	}
@@ -280,10 +371,28 @@ static void report_table(const struct job *job)
 			printf("# clip %s: %s\n", job->c.clips[cl->index].name, note);
 		}
 	}
+	for (int k = 0; k < job->clip_count; k++) {
+		const struct clip *cl = &job->clips[k];
+		if (cl->w_count == 0)
+			continue;
+		printf("# clip %s: %d morph weights channels, %ld keys; per level kept keys (vertex error bound, scene units):",
+		       job->c.clips[cl->index].name, cl->w_count, cl->w_keys);
+		for (int i = 0; i < cl->level_count; i++)
+			if (cl->levels[i].ok)
+				printf(" %d: %ld (%.4g%s)", i + 1, cl->levels[i].w_keys, cl->levels[i].w_error,
+				       cl->levels[i].w_copied ? ", some copied" : "");
+		printf("\n");
+	}
 	printf("# threshold: frame distance (frames) or error budget in scene units (keys); jnt: world joint\n"
 	       "# position error against the clip as read, scene units and %% of the height; pt: point error (joint\n"
 	       "# origins and points within the point distance), scene units; vtx: skinned-vertex error, %% of the\n"
 	       "# bounding diagonal\n");
+	int sub = subdivide(job);
+	if (sub == 1)
+		printf("# jnt and pt measured at the frames of each clip's common timeline (--subdivide 1)\n");
+	else
+		printf("# jnt and pt measured at the frames of each clip's common timeline and %d time%s between each two "
+		       "(--subdivide %d)\n", sub - 1, sub == 2 ? "" : "s", sub);
 	if (job->opt.precision != MLOD_MOTION_PRECISION_FULL)
 		printf("# key values rounded within each level's bound (--precision %s)\n",
 		       job->opt.precision == MLOD_MOTION_PRECISION_AUTO ? "auto" : "float");
@@ -295,8 +404,8 @@ static void report_json(const struct job *job)
 {
 	printf("{\n  \"input\": ");
 	tool_json_string(stdout, job->input);
-	printf(",\n  \"joints\": %d,\n  \"height\": %.9g,\n  \"point_distance\": %.9g,\n  \"clips\": [\n",
-	       job->c.skeleton.joint_count, job->height, job->point_distance);
+	printf(",\n  \"joints\": %d,\n  \"height\": %.9g,\n  \"point_distance\": %.9g,\n  \"subdivide\": %d,\n  \"clips\": [\n",
+	       job->c.skeleton.joint_count, job->height, job->point_distance, subdivide(job));
 	for (int k = 0; k < job->clip_count; k++) {
 		const struct clip *cl = &job->clips[k];
 		printf("    {\"name\": ");
@@ -316,16 +425,22 @@ static void report_json(const struct job *job)
 				printf("\"ok\": false}");
 				continue;
 			}
+			long keys = lv->l.keys + lv->w_keys;
 			printf("\"ok\": true, \"method\": \"%s\", \"threshold\": %.9g, \"keys\": %ld, \"keys_percent\": %.6g, "
 			       "\"bytes\": %ld,\n        \"joint_error\": {\"max\": %.9g, \"mean\": %.9g, \"max_percent_height\": %.9g, "
 			       "\"mean_percent_height\": %.9g},\n        \"point_error\": %.9g, \"grid\": %.9g",
-			       method_name(lv->l.method), lv->l.threshold, lv->l.keys, 100.0 * (double)lv->l.keys / (double)cl->keys,
-			       lv->l.bytes, lv->l.error.max, lv->l.error.mean, 100.0 * lv->l.error.max / job->height,
+			       method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
+			       lv->l.bytes + lv->w_bytes, lv->l.error.max, lv->l.error.mean, 100.0 * lv->l.error.max / job->height,
 			       100.0 * lv->l.error.mean / job->height, lv->l.point_error, lv->l.grid);
 			if (lv->has_vertex)
 				printf(",\n        \"vertex_error\": {\"max\": %.9g, \"max_percent_diagonal\": %.9g, "
 				       "\"mean_percent_diagonal\": %.9g}",
 				       lv->vertex.max * lv->vertex.scale / 100.0, lv->vertex.max, lv->vertex.mean);
+			if (lv->w_count) {
+				char w[512];
+				weights_json(w, sizeof w, cl, lv);
+				printf(",\n        \"morph_weights\": %s", w);
+			}
 			printf("}");
 		}
 		printf("]}%s\n", k + 1 < job->clip_count ? "," : "");
@@ -394,7 +509,7 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 			int index;
 			if (mlod_gltf_add_animation(doc, &job->c.skeleton, &lv->l.clip, &index, &err) != MLOD_OK)
 				tool_die(EXIT_OUTPUT, NULL, "clip \"%s\": %s", base, err.message);
-			char json[1024];
+			char json[2048];
 			int n = snprintf(json, sizeof json,
 			                 "{\"motion_level\": %d, \"source_animation\": %d, \"method\": \"%s\", \"threshold\": %.9g, ",
 			                 i + 1, src->gltf_index >= 0 ? src->gltf_index : cl->index, method_name(lv->l.method),
@@ -403,12 +518,20 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 				n += snprintf(json + n, sizeof json - (size_t)n, "\"bound\": %.9g, ", lv->bound);
 			n += snprintf(json + n, sizeof json - (size_t)n,
 			              "\"keys\": %ld, \"source_keys\": %ld, \"bytes\": %ld, \"joint_error\": {\"max\": %.9g, "
-			              "\"mean\": %.9g, \"max_percent_height\": %.9g}, \"point_error\": %.9g, \"grid\": %.9g",
-			              lv->l.keys, cl->keys, lv->l.bytes, lv->l.error.max, lv->l.error.mean,
-			              100.0 * lv->l.error.max / job->height, lv->l.point_error, lv->l.grid);
+			              "\"mean\": %.9g, \"max_percent_height\": %.9g}, \"point_error\": %.9g, \"grid\": %.9g, "
+			              "\"subdivide\": %d",
+			              lv->l.keys + lv->w_keys, cl->keys, lv->l.bytes + lv->w_bytes, lv->l.error.max, lv->l.error.mean,
+			              100.0 * lv->l.error.max / job->height, lv->l.point_error, lv->l.grid, subdivide(job));
 			if (lv->has_vertex)
 				n += snprintf(json + n, sizeof json - (size_t)n, ", \"vertex_error_percent_diagonal\": %.9g",
 				              lv->vertex.max);
+			if (lv->w_count) {
+				char w[512];
+				weights_json(w, sizeof w, cl, lv);
+				n += snprintf(json + n, sizeof json - (size_t)n, ", \"morph_weights\": %s", w);
+				if (mlod_gltf_add_weight_tracks(doc, index, lv->w, lv->w_count, &err) != MLOD_OK)
+					tool_die(EXIT_OUTPUT, NULL, "clip \"%s\": %s", base, err.message);
+			}
 			snprintf(json + n, sizeof json - (size_t)n, "}");
 			if (mlod_gltf_set_extra(doc, MLOD_GLTF_ANIMATION, index, "mlod", json, &err) != MLOD_OK)
 				tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
@@ -431,6 +554,7 @@ int main(int argc, char **argv)
 		{"cubic-rate", required_argument, NULL, 'C'},
 		{"precision", required_argument, NULL, 'p'},
 		{"precision-share", required_argument, NULL, 'S'},
+		{"subdivide", required_argument, NULL, 'D'},
 		{"level", required_argument, NULL, 'l'},
 		{"clip", required_argument, NULL, 'c'},
 		{"help", no_argument, NULL, 'h'},
@@ -499,6 +623,13 @@ int main(int argc, char **argv)
 			if (!(job.opt.precision_share > 0.0 && job.opt.precision_share < 1.0))
 				tool_usage_error("--precision-share: %s is not between 0 and 1", optarg);
 			break;
+		case 'D': {
+			double v = tool_parse_double("--subdivide", optarg, 1, MLOD_MAX_SUBDIVIDE);
+			if (v != floor(v))
+				tool_usage_error("--subdivide: %s is not a whole number", optarg);
+			job.opt.subdivide = (int)v;
+			break;
+		}
 		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
 		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
 		case 'h': fputs(usage_text, stdout); return 0;
@@ -527,8 +658,8 @@ int main(int argc, char **argv)
 
 	mlod_gltf *doc = NULL;
 	job.input = tool_input_label(optind < argc ? argv[optind] : NULL);
-	tool_load(optind < argc ? argv[optind] : NULL, bvh_out || report != REPORT_NONE ? NULL : &doc, &job.c,
-	          &job.format);
+	tool_load(optind < argc ? argv[optind] : NULL, bvh_out ? NULL : &doc, &job.c, &job.format);
+	job.doc = doc;
 	if (job.c.clip_count == 0)
 		tool_die(EXIT_INPUT, job.input, "no animation to reduce (a BVH with 'Frames: 0' has none)");
 	job.height = mlod_skeleton_size(&job.c.skeleton);
@@ -571,10 +702,14 @@ int main(int argc, char **argv)
 
 	if (fflush(stdout) != 0)
 		tool_die(EXIT_OUTPUT, "<stdout>", "write error");
-	for (int k = 0; k < job.clip_count; k++)
+	for (int k = 0; k < job.clip_count; k++) {
 		for (int i = 0; i < job.clips[k].level_count; i++)
-			if (job.clips[k].levels[i].ok)
+			if (job.clips[k].levels[i].ok) {
 				mlod_motion_level_free(&job.clips[k].levels[i].l);
+				mlod_weight_tracks_free(job.clips[k].levels[i].w, job.clips[k].levels[i].w_count);
+			}
+		mlod_weight_tracks_free(job.clips[k].w, job.clips[k].w_count);
+	}
 	free(job.clips);
 	mlod_character_free(&job.c);
 	mlod_gltf_free(doc);

@@ -428,6 +428,186 @@ TEST(hierarchy_error_is_bounded)
 	mlod_character_free(&c);
 }
 
+/* Largest joint position error of level against clip 0 of c at 16
+ * samples per frame interval. */
+static double dense_error(const mlod_character *c, const mlod_clip *level)
+{
+	const mlod_channel *ch = &c->clips[0].channels[0];
+	int n = (ch->key_count - 1) * 16 + 1;
+	float *st = malloc(sizeof(float) * (size_t)n);
+	mlod_motion_sample_times(ch->times, ch->key_count, 16, st);
+	mlod_character a = *c, b = *c;
+	b.clips = (mlod_clip *)level;
+	mlod_deviation d = {0, 0, 0};
+	mlod_result r = mlod_joint_deviation_at(&a, &b, st, n, &d, &terr);
+	free(st);
+	return r == MLOD_OK ? d.max : HUGE_VAL;
+}
+
+TEST(bound_holds_between_frames)
+{
+	/* A root A with a rotation and a translation, and a child C carried
+	 * 1 out along x by its own translation. A holds -90 degrees about z,
+	 * sweeps to +90 between frames 1 and 2 and holds. Both translations
+	 * step out by d at frames 1 and 2 and back. Dropping the two
+	 * translation keys leaves C off by d sqrt 2 at frames 1 and 2 (the two
+	 * errors at right angles) but by 2 d halfway between them, where A's
+	 * rotation lines them up: within a bound of 1.6 d at the frames, over
+	 * it between them. */
+	const float d = 0.01f;
+	const double bound = 1.6 * d;
+	mlod_character c = {0};
+	c.skeleton.joint_count = 2;
+	c.skeleton.joints = calloc(2, sizeof(mlod_joint));
+	for (int j = 0; j < 2; j++) {
+		mlod_joint *jt = &c.skeleton.joints[j];
+		jt->name = strdup(j ? "C" : "A");
+		jt->parent = j - 1;
+		jt->rest = mlod_trs_identity();
+		jt->rest.t.x = j ? 1.0f : 0.0f;
+		jt->base = mlod_mat4_identity();
+		jt->node = -1;
+	}
+	c.clip_count = 1;
+	c.clips = calloc(1, sizeof(mlod_clip));
+	mlod_clip *cl = &c.clips[0];
+	cl->name = strdup("sweep");
+	cl->gltf_index = -1;
+	cl->channel_count = 3;
+	cl->channels = calloc(3, sizeof(mlod_channel));
+	cl->duration = 3.0f / 30.0f;
+	static const float angle[4] = {-90.0f, -90.0f, 90.0f, 90.0f};
+	for (int i = 0; i < 3; i++) {
+		mlod_channel *ch = &cl->channels[i];
+		int comps = i == 0 ? 4 : 3;
+		ch->joint = i == 2 ? 1 : 0;
+		ch->path = i == 0 ? MLOD_PATH_ROTATION : MLOD_PATH_TRANSLATION;
+		ch->interp = MLOD_INTERP_LINEAR;
+		ch->key_count = 4;
+		ch->times = calloc(4, sizeof(float));
+		ch->values = calloc(4 * (size_t)comps, sizeof(float));
+		for (int f = 0; f < 4; f++) {
+			float *v = ch->values + comps * f, out = f == 1 || f == 2 ? d : 0.0f;
+			ch->times[f] = (float)f / 30.0f;
+			if (i == 0)
+				set_rot(ch, f, mlod_quat_axis_angle((mlod_v3){0, 0, 1}, angle[f] * PI_F / 180.0f));
+			else
+				v[0] = (i == 2 ? 1.0f : 0.0f) + out;
+		}
+	}
+	mlod_motion_options opt = {0};
+	opt.precision = MLOD_MOTION_PRECISION_FULL;
+	opt.point_distance = 1e-3;
+	for (int sub = 1; sub <= 2; sub++) {
+		mlod_motion *m;
+		mlod_motion_level lv;
+		opt.subdivide = sub == 1 ? 1 : 0; /* frames only; the default (midpoints) */
+		CHECK_OK(mlod_motion_create(&c, 0, &opt, &m, &terr));
+		CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_KEYS, MLOD_MOTION_MAX_ERROR, bound, &lv, &terr));
+		double dense = dense_error(&c, &lv.clip);
+		if (sub == 1) {
+			/* Checked at the frames only: the level passes there, not between. */
+			CHECK_MSG(lv.clip.channels[2].key_count == 1, "C keys %d", lv.clip.channels[2].key_count);
+			CHECK_MSG(lv.error.max <= bound && dense > 1.2 * bound, "frames %g, between %g", lv.error.max, dense);
+		} else {
+			/* Checked at the midpoints too: C keeps keys, the bound holds. */
+			CHECK_MSG(lv.clip.channels[2].key_count > 2, "C keys %d", lv.clip.channels[2].key_count);
+			CHECK_MSG(lv.clip.channels[1].key_count == 1, "A translation keys %d", lv.clip.channels[1].key_count);
+			CHECK_MSG(dense <= bound && lv.error.max <= bound && lv.point_error <= bound, "between %g, reported %g",
+			          dense, lv.error.max);
+		}
+		mlod_motion_level_free(&lv);
+		mlod_motion_free(m);
+		/* The frames method drops nothing here (the sweep needs every frame). */
+		CHECK_OK(mlod_motion_create(&c, 0, &opt, &m, &terr));
+		CHECK_OK(mlod_motion_next_level(m, MLOD_MOTION_FRAMES, MLOD_MOTION_MAX_ERROR, bound, &lv, &terr));
+		CHECK(dense_error(&c, &lv.clip) <= bound);
+		mlod_motion_level_free(&lv);
+		mlod_motion_free(m);
+	}
+	mlod_character_free(&c);
+}
+
+TEST(morph_weights_reduced_within_bound)
+{
+	/* Two targets over 11 keys: target 0 ramps 0 -> 1 (a line: its inner
+	 * keys go), target 1 has a bump of h at key 5 with reach 2, so it
+	 * costs 2 h there: it stays under a bound below 2 h and goes above. */
+	const float h = 0.05f;
+	mlod_weight_track t = {0};
+	t.node = 3;
+	t.targets = 2;
+	t.interp = MLOD_INTERP_LINEAR;
+	t.key_count = 11;
+	t.times = malloc(sizeof(float) * 11);
+	t.values = calloc(22, sizeof(float));
+	for (int k = 0; k < 11; k++) {
+		t.times[k] = (float)k / 10.0f;
+		t.values[2 * k] = (float)k / 10.0f;
+	}
+	t.values[2 * 5 + 1] = h;
+	const double reach[2] = {1.0, 2.0};
+	mlod_weight_track out;
+	double e;
+	CHECK_OK(mlod_weight_track_reduce(&t, reach, 1.5 * h, 2, &out, &e, &terr));
+	CHECK_MSG(out.key_count >= 3 && out.key_count < 11 && e <= 1.5 * h, "keys %d error %g", out.key_count, e);
+	int has5 = 0;
+	for (int k = 0; k < out.key_count; k++)
+		has5 |= out.times[k] == t.times[5];
+	CHECK(has5 && out.times[0] == t.times[0] && out.times[out.key_count - 1] == t.times[10]);
+	free(out.times), free(out.values);
+	CHECK_OK(mlod_weight_track_reduce(&t, reach, 2.5 * h, 2, &out, &e, &terr));
+	CHECK_MSG(out.key_count == 2 && e <= 2.5 * h && e >= 1.9 * h, "keys %d error %g", out.key_count, e);
+	free(out.times), free(out.values);
+	/* A constant track keeps one key. */
+	for (int k = 0; k < 22; k++)
+		t.values[k] = 0.25f;
+	CHECK_OK(mlod_weight_track_reduce(&t, reach, 0.0, 2, &out, &e, &terr));
+	CHECK(out.key_count == 1 && out.values[0] == 0.25f && e == 0.0);
+	free(out.times), free(out.values);
+	t.interp = MLOD_INTERP_CUBICSPLINE;
+	CHECK(mlod_weight_track_reduce(&t, reach, 0.1, 2, &out, &e, &terr) == MLOD_ERR_UNSUPPORTED);
+	free(t.times), free(t.values);
+}
+
+TEST(morph_target_reach_in_scene_units)
+{
+	/* One rigid mesh on node 4, scaled by 2 in the scene: its target moves
+	 * vertices by 0.1 and 0.3, so 0.6 in scene units. */
+	mlod_character c = make_chain(1, 3);
+	c.mesh_count = 1;
+	c.meshes = calloc(1, sizeof(mlod_mesh));
+	c.meshes[0].name = strdup("face");
+	c.meshes[0].gltf_index = -1;
+	c.meshes[0].primitive_count = 1;
+	c.meshes[0].primitives = calloc(1, sizeof(mlod_primitive));
+	mlod_primitive *p = &c.meshes[0].primitives[0];
+	p->vertex_count = 2;
+	p->positions = calloc(6, sizeof(float));
+	p->mode = 4;
+	p->material = -1;
+	p->target_count = 1;
+	p->targets = calloc(1, sizeof(mlod_morph_target));
+	p->targets[0].positions = calloc(6, sizeof(float));
+	p->targets[0].positions[0] = 0.1f;
+	p->targets[0].positions[4] = 0.3f;
+	c.instance_count = 1;
+	c.instances = calloc(1, sizeof(mlod_instance));
+	c.instances[0].mesh = 0;
+	c.instances[0].node = 4;
+	c.instances[0].skin = -1;
+	c.instances[0].joint = -1;
+	mlod_trs tr = mlod_trs_identity();
+	tr.s = (mlod_v3){2, 2, 2};
+	c.instances[0].offset = mlod_mat4_from_trs(&tr);
+	double reach[2];
+	CHECK_OK(mlod_morph_target_reach(&c, 4, 1, reach, &terr));
+	CHECK_MSG(fabs(reach[0] - 0.6) < 1e-6, "reach %g", reach[0]);
+	CHECK(mlod_morph_target_reach(&c, 5, 1, reach, &terr) == MLOD_ERR_INVALID_ARG);
+	CHECK(mlod_morph_target_reach(&c, 4, 2, reach, &terr) == MLOD_ERR_INVALID_ARG);
+	mlod_character_free(&c);
+}
+
 TEST(common_timeline)
 {
 	/* Two channels on different times: the union, exact at every key. */
@@ -785,6 +965,9 @@ int main(void)
 	RUN(angle_wrap_is_not_motion);
 	RUN(points_out_from_leaves_are_kept);
 	RUN(hierarchy_error_is_bounded);
+	RUN(bound_holds_between_frames);
+	RUN(morph_weights_reduced_within_bound);
+	RUN(morph_target_reach_in_scene_units);
 	RUN(common_timeline);
 	RUN(bad_clips);
 	RUN(one_frame_clip);

@@ -1,0 +1,1 @@
+"$BIN/mlod-motion" --subdivide 0 x.glb
