@@ -1578,7 +1578,7 @@ private:
 			note("%d animation channels target nodes that are not joints (kept in the document, not in the clips)",
 			     not_joint);
 		if (weights)
-			note("%d animation channels animate morph target weights (kept in the document, not in the clips)",
+			note("%d animation channels animate morph target weights (kept in the document, outside the joint clips)",
 			     weights);
 	}
 
