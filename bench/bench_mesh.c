@@ -184,7 +184,7 @@ static double mlod_levels(const mlod_character *c, const mlod_bgm_options *base,
 			mlod_bgm_simplify(g, shared ? 0 : (int)ceil(ratios[2] * T), 0, NULL);
 			bgms[n] = g;
 			where[n][0] = i, where[n][1] = p;
-			total += T;
+			total += mlod_bgm_triangles(g, 0);
 			n++;
 		}
 	}

@@ -626,28 +626,36 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 	return heap_push(g->heap, key, f, op);
 }
 
-/* Queues face f's triangle collapse and its edges, as the option asks.
- * An edge has two faces: it is not queued again when the face across
- * holds an entry for it (an edge keeps its cost while its two nodes
- * live; its validity is checked again when it leaves the queue). */
+/* 1 when the face across edge e of face f holds a queue entry for that
+ * edge. An edge has two faces and is queued from one of them. */
+static int queued_across(const mlod_bgm *g, int f, int e)
+{
+	const bgm_face *F = &g->faces[f];
+	int across = F->adj[e];
+	if (across < 0)
+		return 0;
+	const bgm_face *A = &g->faces[across];
+	for (int k = 0; k < 3; k++)
+		if (A->n[k] == F->n[(e + 1) % 3] && A->n[(k + 1) % 3] == F->n[e])
+			return (g->opstate[across] & QUEUED(k)) != 0;
+	return 0;
+}
+
+/* Queues face f's triangle collapse and its edges, as the option asks,
+ * except edges the face across has queued. The queue is lazy: a popped
+ * entry is planned again and goes back with its new cost when that rose;
+ * one whose cost fell (its neighbourhood changed which placements are
+ * valid) waits at its old key, an approximation that saves re-planning
+ * every operation around each collapse. */
 static int push_face(mlod_bgm *g, int f, struct plan *scratch)
 {
 	if (g->opt.op != MLOD_OP_EDGE && push_op(g, f, OP_TRIANGLE, scratch))
 		return -1;
 	if (g->opt.op == MLOD_OP_TRIANGLE)
 		return 0;
-	const bgm_face *F = &g->faces[f];
-	for (int e = 0; e < 3; e++) {
-		int across = F->adj[e], queued = 0;
-		if (across >= 0)
-			for (int k = 0; k < 3 && !queued; k++) {
-				const bgm_face *A = &g->faces[across];
-				queued = A->n[k] == F->n[(e + 1) % 3] && A->n[(k + 1) % 3] == F->n[e] &&
-				         (g->opstate[across] & QUEUED(k));
-			}
-		if (!queued && push_op(g, f, e, scratch))
+	for (int e = 0; e < 3; e++)
+		if (!queued_across(g, f, e) && push_op(g, f, e, scratch))
 			return -1;
-	}
 	return 0;
 }
 
@@ -906,7 +914,8 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 					unsigned bits = g->opstate[h] & retry;
 					g->opstate[h] &= (unsigned char)~retry;
 					for (int op = 0; op <= OP_TRIANGLE; op++)
-						if ((bits >> op & 1u) && push_op(g, h, op, scratch)) {
+						if ((bits >> op & 1u) && (op == OP_TRIANGLE || !queued_across(g, h, op)) &&
+						    push_op(g, h, op, scratch)) {
 							r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 							goto done;
 						}

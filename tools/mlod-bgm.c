@@ -55,9 +55,9 @@ static const char usage_text[] =
 	"                           cost), triangle (the paper; the only one with\n"
 	"                           compactness) or mixed (both, by cost per face)\n"
 	"  -B, --budget NAME        a level's triangles: character (shared by all\n"
-	"                           primitives, cheapest collapses first; the default\n"
-	"                           with the posed cost) or primitive (each keeps the\n"
-	"                           ratio; the default with compactness)\n"
+	"                           primitives, cheapest collapses first; the posed\n"
+	"                           cost only, its default) or primitive (each keeps\n"
+	"                           the ratio; the default with compactness)\n"
 	"  -p, --placement NAME     new vertex: optimal (default) or barycenter\n"
 	"  -E, --eligibility NAME   vertices that may go: all, bend or literal\n"
 	"                           (default: all with the posed cost, bend otherwise)\n"
@@ -405,7 +405,7 @@ static void character_prefixes(struct job *job, double ratio)
 		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
 			struct part *pt = &job->parts[i][p];
 			bgms[at++] = pt->bgm;
-			total += pt->bgm ? pt->triangles : 0;
+			total += mlod_bgm_triangles(pt->bgm, 0); /* 0 without a BGM; degenerate faces dropped */
 		}
 	mlod_bgm_share_budget(bgms, n, (long)ceil(ratio * (double)total), prefix);
 	at = 0;
@@ -1148,6 +1148,8 @@ int main(int argc, char **argv)
 		job.opt.cost = MLOD_COST_POSED;
 	if (job.opt.cost == MLOD_COST_COMPACTNESS && job.opt.op != MLOD_OP_DEFAULT && job.opt.op != MLOD_OP_TRIANGLE)
 		tool_usage_error("--collapse %s needs --cost posed: compactness ranks triangles only", collapse_name(&job.opt));
+	if (job.opt.cost == MLOD_COST_COMPACTNESS && job.budget == BUDGET_CHARACTER)
+		tool_usage_error("--budget character needs --cost posed: compactness costs do not compare across primitives");
 	if (job.budget == BUDGET_DEFAULT) /* measured: see the man page */
 		job.budget = job.opt.cost == MLOD_COST_POSED ? BUDGET_CHARACTER : BUDGET_PRIMITIVE;
 	if (job.opt.placement == MLOD_PLACE_DEFAULT)

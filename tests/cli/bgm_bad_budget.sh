@@ -1,0 +1,1 @@
+"$BIN/mlod-bgm" --cost compactness --budget character "$ROOT/samples/tubeman.glb"
