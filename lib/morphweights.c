@@ -17,6 +17,7 @@
  * The first and last keys stay, except that a track that comes down to
  * two equal keys (a constant) keeps one.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -143,6 +144,9 @@ mlod_result mlod_weight_track_reduce(const mlod_weight_track *in, const double *
 	if (in->key_count <= 0 || in->targets <= 0 || !in->times || !in->values || !(bound >= 0.0) || subdivide < 1 ||
 	    subdivide > MLOD_MAX_SUBDIVIDE)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_weight_track_reduce: no keys, or a bad bound or subdivide");
+	if ((double)(in->key_count - 1) * subdivide + 1.0 > (double)INT_MAX / 16)
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "node %d: %d keys at %d samples each are too many", in->node,
+		                 in->key_count, subdivide);
 	int n = in->key_count, sub = subdivide, S = (n - 1) * sub + 1;
 	float *st = malloc(sizeof(float) * (size_t)S);
 	unsigned char *keep = calloc((size_t)n, 1);
@@ -153,9 +157,25 @@ mlod_result mlod_weight_track_reduce(const mlod_weight_track *in, const double *
 	mlod_motion_sample_times(in->times, n, sub, st);
 	keep[0] = keep[n - 1] = 1;
 	for (int a = 0; a < n - 1;) {
-		int b = a + 1;
-		while (b + 1 < n && segment_error(in, reach, st, sub, a, b + 1, a * sub, (b + 1) * sub) <= bound)
-			b++;
+		/* The farthest b whose segment stays within the bound: gallop,
+		 * then bisect (a segment of one interval is the track itself). */
+		int b = a + 1, fail = -1;
+		for (int step = 1; b < n - 1; step *= 2) {
+			int t = b + step < n - 1 ? b + step : n - 1;
+			if (segment_error(in, reach, st, sub, a, t, a * sub, t * sub) <= bound) {
+				b = t;
+			} else {
+				fail = t;
+				break;
+			}
+		}
+		while (fail > b + 1) {
+			int mid = b + (fail - b) / 2;
+			if (segment_error(in, reach, st, sub, a, mid, a * sub, mid * sub) <= bound)
+				b = mid;
+			else
+				fail = mid;
+		}
 		keep[b] = 1;
 		double e = segment_error(in, reach, st, sub, a, b, a * sub, b * sub);
 		if (!(e <= *error))

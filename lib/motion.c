@@ -639,9 +639,17 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	int n = s->joint_count, nch = m->common.channel_count, F = m->info.frames;
 	m->frames = F;
 	m->sub = opt && opt->subdivide > 0 ? opt->subdivide : MLOD_DEFAULT_SUBDIVIDE;
-	if (m->sub > MLOD_MAX_SUBDIVIDE) {
+	if (m->sub > MLOD_MAX_SUBDIVIDE || (opt && opt->subdivide < 0)) {
 		mlod_motion_free(m);
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "subdivide %d is more than %d", opt->subdivide, MLOD_MAX_SUBDIVIDE);
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "subdivide %d is not in 0..%d", opt->subdivide, MLOD_MAX_SUBDIVIDE);
+	}
+	if ((unsigned)m->opt.precision > MLOD_MOTION_PRECISION_FULL) {
+		mlod_motion_free(m);
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "unknown precision %d", (int)m->opt.precision);
+	}
+	if ((double)(F - 1) * m->sub + 1.0 > (double)INT_MAX / 16) {
+		mlod_motion_free(m);
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%d frames at %d samples each are too many", F, m->sub);
 	}
 	m->samples = (F - 1) * m->sub + 1;
 	m->st = malloc(sizeof(float) * (size_t)m->samples);
