@@ -2095,7 +2095,10 @@ int add_mesh_like(mlod_gltf &doc, int like, const mlod_mesh &mesh)
 	dst.extensions = src.extensions;
 	dst.extras = src.extras;
 	for (size_t p = 0; p < prims; p++) {
+		/* Not Draco's: it points at the full mesh's compressed data (a
+		 * file that lists Draco as used but not required gets here). */
 		dst.primitives[p].extensions = src.primitives[p].extensions;
+		dst.primitives[p].extensions.erase("KHR_draco_mesh_compression");
 		dst.primitives[p].extras = src.primitives[p].extras;
 	}
 	std::string from = "/meshes/" + std::to_string(like) + "/", to = "/meshes/" + std::to_string(index) + "/";
