@@ -313,19 +313,27 @@ static int posed_error(const mlod_character *full, const mlod_character *level, 
 /* Commands                                                          */
 /* ---------------------------------------------------------------- */
 
+/* Loads a character with triangles: returns their count, or 0 (nothing
+ * loaded) when it cannot be read or has none. */
+static int load_meshed(const char *path, mlod_character *c)
+{
+	if (load(path, c) != 0)
+		return 0;
+	int T = character_triangles(c);
+	if (T == 0)
+		mlod_character_free(c);
+	return T;
+}
+
 static void table1(int argc, char **argv)
 {
 	printf("| character | triangles | cost | t_initBGM (ms) | t_10*decim (ms) | collapses | paper t_initBGM | "
 	       "paper t_10*decim |\n|---|---:|---|---:|---:|---:|---:|---:|\n");
 	for (int a = 0; a < argc; a++) {
 		mlod_character c;
-		if (load(argv[a], &c) != 0)
+		int T = load_meshed(argv[a], &c);
+		if (T == 0)
 			continue;
-		int T = character_triangles(&c);
-		if (T == 0) {
-			mlod_character_free(&c);
-			continue;
-		}
 		for (int cost = 0; cost < 2; cost++) {
 			mlod_bgm_options opt = {0};
 			opt.cost = cost ? MLOD_COST_COMPACTNESS : MLOD_COST_POSED;
@@ -361,13 +369,9 @@ static void speed(int argc, char **argv)
 	       "compactness / meshopt |\n|---|---:|---:|---:|---:|---:|---:|\n");
 	for (int a = 0; a < argc; a++) {
 		mlod_character c;
-		if (load(argv[a], &c) != 0)
+		int T = load_meshed(argv[a], &c);
+		if (T == 0)
 			continue;
-		int T = character_triangles(&c);
-		if (T == 0) {
-			mlod_character_free(&c);
-			continue;
-		}
 		double t[3][RUNS];
 		for (int run = 0; run < RUNS; run++) {
 			for (int m = 0; m < 3; m++) {
