@@ -18,7 +18,10 @@ DESTDIR ?=
 CC ?= cc
 CXX ?= c++
 WARN := -Wall -Wextra -Wpedantic
-CPPFLAGS += -Ilib
+# The bake side sees lib/ (parts are included as "part/mlod_part.h") and the
+# core; the runtime (lib/rt) sees only the core and its own folder.
+CPPFLAGS += -Ilib -Ilib/core
+RT_CPPFLAGS := -Ilib/core -Ilib/rt
 CFLAGS_release := -O2 -g
 CFLAGS_debug := -O0 -g3
 CFLAGS_sanitize := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
@@ -31,8 +34,9 @@ LDLIBS := -ltinygltf -lstdc++ -lm
 B := build/$(config)
 BIN := $(B)/bin
 
-LIB_C := $(sort $(wildcard lib/*.c))
-LIB_CXX := $(sort $(wildcard lib/*.cpp))
+LIB_PARTS := core model io measure skeleton mesh motion
+LIB_C := $(sort $(foreach p,$(LIB_PARTS),$(wildcard lib/$(p)/*.c)))
+LIB_CXX := $(sort $(foreach p,$(LIB_PARTS),$(wildcard lib/$(p)/*.cpp)))
 LIB_OBJ := $(LIB_C:%.c=$(B)/%.o) $(LIB_CXX:%.cpp=$(B)/%.o)
 RT_C := $(sort $(wildcard lib/rt/*.c))
 RT_OBJ := $(RT_C:%.c=$(B)/%.o)
@@ -49,15 +53,36 @@ BENCH := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
 
 .PHONY: all unit test test-extended bench demo install clean samples
 
-all: $(B)/libmlod.a $(if $(RT_OBJ),$(B)/libmlodrt.a) $(TOOLS)
+all: $(B)/libmlod.a $(B)/libmlodrt.a $(TOOLS)
 
 $(B)/libmlod.a: $(LIB_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^
 
-$(B)/libmlodrt.a: $(RT_OBJ)
+# The runtime library: lib/rt plus the core, nothing from the bake side.
+CORE_OBJ := $(patsubst %.c,$(B)/%.o,$(sort $(wildcard lib/core/*.c)))
+$(B)/libmlodrt.a: $(RT_OBJ) $(CORE_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^
+
+# The core and the runtime compile with only the core and lib/rt on the
+# include path, so neither can include a bake-side header; C only.
+$(B)/lib/core/%.o: lib/core/%.c
+	@mkdir -p $(@D)
+	$(CC) $(RT_CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(B)/lib/rt/%.o: lib/rt/%.c
+	@mkdir -p $(@D)
+	$(CC) $(RT_CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
+
+# Runtime test programs link libmlodrt.a alone: no tinygltf, no C++, no
+# libmlod. A bake-side symbol in the runtime fails this link.
+RT_TEST_SRC := $(sort $(wildcard tests/rt/*.c))
+RT_TESTS := $(RT_TEST_SRC:tests/rt/%.c=$(B)/tests/rt/%)
+RT_LDLIBS := -lm
+$(B)/tests/rt/%: tests/rt/%.c $(B)/libmlodrt.a
+	@mkdir -p $(@D)
+	$(CC) $(RT_CPPFLAGS) $(CFLAGS) $(LDFLAGS) $^ $(RT_LDLIBS) -o $@
 
 $(B)/%.o: %.c
 	@mkdir -p $(@D)
@@ -83,7 +108,7 @@ $(B)/bench/%: $(B)/bench/%.o $(B)/libmlod.a
 	@mkdir -p $(@D)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
-unit: $(UNIT) $(HELPERS)
+unit: $(UNIT) $(HELPERS) $(RT_TESTS)
 
 # The whole suite: unit, CLI and validator tests on the release build, then
 # the unit tests again under AddressSanitizer and UBSan.

@@ -1,10 +1,10 @@
 /* test_bgm.c: the mesh layer: Power Skinning, eligibility, the
  * BindGraphMesh weld, triangle collapses and their recorded sequence,
  * level extraction, posed error. White-box where it must be: the seam
- * tests read the BGM's wedges through lib/bgm.h. */
+ * tests read the BGM's wedges through lib/mesh/bgm.h. */
 #include "test.h"
 
-#include "bgm.h"
+#include "mesh/bgm.h"
 
 #define DEG40 0.6981317f
 

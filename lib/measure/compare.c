@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "measure/mlod_measure.h"
 
 static int float_order(const void *a, const void *b)
 {

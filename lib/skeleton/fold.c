@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "skeleton/mlod_skeleton.h"
 
 /* Duplicates n bytes, or returns NULL for a NULL or empty source. */
 static void *dup_bytes(const void *src, size_t n, int *failed)

@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "measure/mlod_measure.h"
 
 static uint64_t splitmix(uint64_t *s)
 {

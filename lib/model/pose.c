@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "model/mlod_model.h"
 
 void mlod_pose_rest(const mlod_skeleton *s, mlod_trs *local)
 {

@@ -11,7 +11,7 @@
  */
 #include <string.h>
 
-#include "mlod.h"
+#include "io/mlod_io.h"
 
 /* Skips a UTF-8 byte order mark and blanks; returns the offset reached. */
 static size_t skip_bom_and_blanks(const unsigned char *p, size_t size)

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "model/mlod_model.h"
 
 void mlod_primitive_free(mlod_primitive *p)
 {

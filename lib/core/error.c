@@ -3,7 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "mlod.h"
+#include "mlod_core.h"
 
 const char *mlod_strerror(mlod_result code)
 {

@@ -41,7 +41,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "io/mlod_io.h"
 
 #define BVH_MAX_FRAMES 10000000       /* more frames than this is absurd */
 #define BVH_MAX_DEPTH 1000            /* deeper nesting than this is nonsense */

@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "measure/mlod_measure.h"
 
 #define LEAF_SIZE 4
 #define MAX_DEPTH 64 /* object-median splits of < 2^31 triangles stay far below */

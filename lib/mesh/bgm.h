@@ -14,7 +14,7 @@
 
 #include <limits.h>
 
-#include "mlod.h"
+#include "mesh/mlod_mesh.h"
 
 #define BGM_ALIVE INT_MAX
 

@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "mesh/mlod_mesh.h"
 
 mlod_result mlod_joint_weight_average(const mlod_character *c, double *eta, mlod_error *err)
 {

@@ -68,7 +68,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "motion/mlod_motion.h"
 
 #define PI 3.14159265358979323846
 #define DEFAULT_CUBIC_RATE 60.0

@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "skeleton/mlod_skeleton.h"
 
 /* A growing string for JSON. */
 struct text {

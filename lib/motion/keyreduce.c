@@ -35,7 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "motion/mlod_motion.h"
 
 #define MAX_FRAME_JOINTS 1000000L /* frames * joints the caches may hold */
 #define ROUNDS 4

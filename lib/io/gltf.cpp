@@ -48,7 +48,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
-#include "mlod.h"
+#include "io/mlod_io.h"
 
 using json = nlohmann::json;
 using tinygltf::Model;

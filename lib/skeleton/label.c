@@ -26,7 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "skeleton/mlod_skeleton.h"
 
 #define DEFAULT_HUB_FACTOR 1.9
 #define ENERGY_RATE 30.0

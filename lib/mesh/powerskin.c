@@ -17,7 +17,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "mesh/mlod_mesh.h"
 
 void mlod_power_weights(const mlod_v3 *v, int k, mlod_v3 vbar, double *W)
 {

@@ -14,7 +14,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "mlod.h"
+#include "mlod_core.h"
 
 /* ---------------------------------------------------------------- */
 /* Vectors                                                           */

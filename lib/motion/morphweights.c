@@ -22,7 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "motion/mlod_motion.h"
 
 /* How far offset d moves once placed by m (its 3x3 part). */
 static double moved(const mlod_mat4 *m, const float *d)

@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod.h"
+#include "skeleton/mlod_skeleton.h"
 
 /* The closure of a real skeleton has a few thousand edges; this bounds
  * hostile input (one chain of n joints has n(n-1)/2). */

@@ -1,0 +1,132 @@
+/*
+ * mlod_core.h: the common core of mlod, shared by the bake library and the
+ * runtime (lib/rt): result codes and their messages, and the small math
+ * (vectors, quaternions, 4x4 matrices, TRS, Euler angles) both sides use.
+ * It depends on nothing but the C library, and nothing in it allocates
+ * but mlod_free's counterpart.
+ *
+ * Conventions (every part of mlod follows them)
+ * - Every fallible call returns an mlod_result and, when err is not NULL,
+ *   fills *err with the code and a human-readable message. The library
+ *   never prints and never exits.
+ * - Lengths are in the scene's units (metres for glTF, file units for BVH).
+ *   Angles are radians. Matrices are column-major 4x4 (as in glTF):
+ *   m[col * 4 + row].
+ */
+#ifndef MLOD_CORE_H
+#define MLOD_CORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MLOD_VERSION "0.1.0"
+
+/* ------------------------------------------------------------------ */
+/* Results                                                             */
+/* ------------------------------------------------------------------ */
+
+typedef enum mlod_result {
+	MLOD_OK = 0,
+	MLOD_ERR_INVALID_ARG,  /* a caller error: NULL where not allowed, bad option value */
+	MLOD_ERR_IO,           /* reading or writing a file failed */
+	MLOD_ERR_PARSE,        /* malformed input: truncated, bad syntax, out-of-range index */
+	MLOD_ERR_UNSUPPORTED,  /* well-formed input using a feature mlod does not handle */
+	MLOD_ERR_NOMEM,        /* an allocation failed, or input claims an absurd size */
+	MLOD_ERR_LIMIT         /* a request the data cannot satisfy (e.g. an error bound) */
+} mlod_result;
+
+#define MLOD_ERROR_MESSAGE_SIZE 512
+
+typedef struct mlod_error {
+	mlod_result code;
+	char message[MLOD_ERROR_MESSAGE_SIZE]; /* says what went wrong, without a trailing newline */
+} mlod_error;
+
+/* A short static description of a result code ("malformed input", ...). */
+const char *mlod_strerror(mlod_result code);
+
+/* Fills err (if not NULL) with code and a printf-style message; returns code.
+ * Used by the library itself and available to tools. */
+mlod_result mlod_fail(mlod_error *err, mlod_result code, const char *fmt, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 3, 4)))
+#endif
+	;
+
+/* Releases a buffer returned by the library (glb bytes, JSON text, ...). */
+void mlod_free(void *p);
+
+/* ------------------------------------------------------------------ */
+/* Math                                                                */
+/* ------------------------------------------------------------------ */
+
+typedef struct mlod_v3 { float x, y, z; } mlod_v3;
+typedef struct mlod_quat { float x, y, z, w; } mlod_quat;  /* glTF order */
+typedef struct mlod_mat4 { float m[16]; } mlod_mat4;         /* column-major */
+
+/* A local transform: translation, rotation, scale (glTF's TRS). */
+typedef struct mlod_trs {
+	mlod_v3 t;
+	mlod_quat r;
+	mlod_v3 s;
+} mlod_trs;
+
+/* Euler orders. MLOD_EULER_ZXY means the rotation matrix is Rz * Rx * Ry:
+ * the order in which BVH lists "Zrotation Xrotation Yrotation". */
+typedef enum mlod_euler_order {
+	MLOD_EULER_XYZ,
+	MLOD_EULER_XZY,
+	MLOD_EULER_YXZ,
+	MLOD_EULER_YZX,
+	MLOD_EULER_ZXY,
+	MLOD_EULER_ZYX
+} mlod_euler_order;
+
+mlod_v3 mlod_v3_add(mlod_v3 a, mlod_v3 b);
+mlod_v3 mlod_v3_sub(mlod_v3 a, mlod_v3 b);
+mlod_v3 mlod_v3_scale(mlod_v3 a, float s);
+float mlod_v3_dot(mlod_v3 a, mlod_v3 b);
+mlod_v3 mlod_v3_cross(mlod_v3 a, mlod_v3 b);
+float mlod_v3_length(mlod_v3 a);
+
+mlod_quat mlod_quat_identity(void);
+mlod_quat mlod_quat_mul(mlod_quat a, mlod_quat b);         /* a then applied after b: a*b */
+mlod_quat mlod_quat_normalize(mlod_quat q);
+mlod_quat mlod_quat_conjugate(mlod_quat q);
+mlod_v3 mlod_quat_rotate(mlod_quat q, mlod_v3 v);
+mlod_quat mlod_quat_axis_angle(mlod_v3 axis, float angle); /* axis need not be unit */
+mlod_quat mlod_quat_slerp(mlod_quat a, mlod_quat b, float t); /* shortest path */
+mlod_quat mlod_quat_nlerp(mlod_quat a, mlod_quat b, float t); /* shortest path */
+/* Angle in [0, pi] between the rotations a and b; q and -q are the same rotation. */
+float mlod_quat_angle(mlod_quat a, mlod_quat b);
+
+/* angles[0..2] are the rotations about x, y, z (radians), whatever the order. */
+mlod_quat mlod_quat_from_euler(mlod_euler_order order, const float angles[3]);
+void mlod_quat_to_euler(mlod_euler_order order, mlod_quat q, float angles[3]);
+/* Parses "XYZ", "zxy", ... ; returns 0 on success, -1 when not an order. */
+int mlod_euler_order_parse(const char *s, mlod_euler_order *out);
+const char *mlod_euler_order_name(mlod_euler_order order);
+
+mlod_mat4 mlod_mat4_identity(void);
+mlod_mat4 mlod_mat4_mul(const mlod_mat4 *a, const mlod_mat4 *b); /* a*b */
+mlod_mat4 mlod_mat4_from_trs(const mlod_trs *trs);
+/* Decomposes an affine matrix. Returns 0 when it is exactly a TRS (no shear,
+ * within tol relative), 1 when it has shear the TRS cannot express (the
+ * result is then the closest TRS), -1 when singular. */
+int mlod_mat4_to_trs(const mlod_mat4 *m, mlod_trs *out, float tol);
+/* General inverse; returns 0 on success, -1 when singular. */
+int mlod_mat4_invert(const mlod_mat4 *m, mlod_mat4 *out);
+mlod_v3 mlod_mat4_point(const mlod_mat4 *m, mlod_v3 p);  /* m * (p, 1) */
+mlod_v3 mlod_mat4_vector(const mlod_mat4 *m, mlod_v3 v); /* m * (v, 0) */
+mlod_trs mlod_trs_identity(void);
+
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MLOD_CORE_H */

@@ -1,0 +1,212 @@
+/*
+ * mlod_io.h: input and output: glTF through a C shim over tinygltf (the only
+ * C++ of the bake side), BVH read and write, and format detection.
+ */
+#ifndef MLOD_IO_H
+#define MLOD_IO_H
+
+#include "model/mlod_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------ */
+/* glTF (through a C shim over tinygltf)                               */
+/* ------------------------------------------------------------------ */
+
+/* An opaque glTF document. Everything mlod does not change (materials,
+ * textures, cameras, extras, extensions, names, animations, skins) is kept
+ * as read and written back unchanged. */
+typedef struct mlod_gltf mlod_gltf;
+
+/* Parses .glb or .gltf bytes. base_dir resolves external URIs of a .gltf
+ * (may be NULL: only data: URIs are then allowed). Draco- or
+ * meshopt-compressed input is MLOD_ERR_UNSUPPORTED. */
+mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir,
+                           mlod_gltf **out, mlod_error *err);
+void mlod_gltf_free(mlod_gltf *doc);
+
+/* Serialises the document: binary != 0 gives .glb, else .gltf JSON with
+ * embedded buffers. *data is released with mlod_free. */
+mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data,
+                            size_t *size, mlod_error *err);
+
+/* Builds the character model from the document's skins, meshes and
+ * animations. Joint nodes are the union of all skins' joints plus the nodes
+ * that connect them; a document without skins (such as a BVH converted by
+ * mlod_gltf_from_character) uses its animated nodes instead of skin joints.
+ * Instances are the nodes with a mesh that the default scene shows (every
+ * node when there is no scene). What is skipped is listed in out->notes. */
+mlod_result mlod_gltf_to_character(const mlod_gltf *doc, mlod_character *out,
+                                   mlod_error *err);
+
+/* Builds a new document from a character: nodes for joints (joint i is
+ * node i; End Sites become child nodes marked extras.mlod.end_site),
+ * meshes, skins, instances and one animation per clip. A BVH read this way gives a glb. */
+mlod_result mlod_gltf_from_character(const mlod_character *c, mlod_gltf **out,
+                                     mlod_error *err);
+
+typedef enum mlod_gltf_kind {
+	MLOD_GLTF_NODE,
+	MLOD_GLTF_SKIN,
+	MLOD_GLTF_SCENE,  /* index -1: the default scene */
+	MLOD_GLTF_MESH,
+	MLOD_GLTF_ANIMATION,
+	MLOD_GLTF_ASSET   /* index ignored */
+} mlod_gltf_kind;
+
+int mlod_gltf_count(const mlod_gltf *doc, mlod_gltf_kind kind);
+
+/* Sets extras[key] of an object to the JSON value in json (an object,
+ * array, string, number, ...), replacing any previous value of that key
+ * and keeping the other keys. */
+mlod_result mlod_gltf_set_extra(mlod_gltf *doc, mlod_gltf_kind kind, int index,
+                                const char *key, const char *json, mlod_error *err);
+
+/* Reads extras[key] as JSON text into *json (release with mlod_free).
+ * Returns MLOD_OK with *json = NULL when the key is absent. */
+mlod_result mlod_gltf_get_extra(const mlod_gltf *doc, mlod_gltf_kind kind, int index,
+                                const char *key, char **json, mlod_error *err);
+
+/* Appends a mesh built from m's primitives (new accessors in a new buffer
+ * view range of buffer 0; material indices kept). */
+mlod_result mlod_gltf_add_mesh(mlod_gltf *doc, const mlod_mesh *m, int *out_index,
+                               mlod_error *err);
+
+#define MLOD_GLTF_DETACHED (-2)
+
+/* Appends a node. parent -1 puts it in the default scene's roots;
+ * MLOD_GLTF_DETACHED leaves it out of every scene (e.g. an MSFT_lod level).
+ * mesh and skin may be -1. */
+mlod_result mlod_gltf_add_node(mlod_gltf *doc, const char *name, int parent,
+                               int mesh, int skin, const mlod_trs *trs,
+                               int *out_index, mlod_error *err);
+
+/* Appends a skin whose joints are the glTF nodes of the given skeleton
+ * joints (skin->joints index s->joints; each must have a node). */
+mlod_result mlod_gltf_add_skin(mlod_gltf *doc, const mlod_skeleton *s,
+                               const mlod_skin *skin, int *out_index, mlod_error *err);
+
+/* Appends an animation with the clip's channels, targeting the joints'
+ * nodes. */
+mlod_result mlod_gltf_add_animation(mlod_gltf *doc, const mlod_skeleton *s,
+                                    const mlod_clip *clip, int *out_index,
+                                    mlod_error *err);
+
+/* Appends a copy of glTF mesh `mesh` whose JOINTS_n and WEIGHTS_n come
+ * from m (same primitives and vertex counts, as made by
+ * mlod_skel_level_apply); every other attribute, the indices and the morph
+ * targets share the original accessors. */
+mlod_result mlod_gltf_add_mesh_reskinned(mlod_gltf *doc, int mesh, const mlod_mesh *m, int *out_index,
+                                         mlod_error *err);
+
+/* Adds MSFT_lod to node (lod_nodes are its coarser levels, finest first)
+ * and MSFT_screencoverage to its extras (lod_count + 1 values, decreasing),
+ * and declares MSFT_lod in extensionsUsed. */
+mlod_result mlod_gltf_set_lod(mlod_gltf *doc, int node, const int *lod_nodes,
+                              int lod_count, const float *coverage, mlod_error *err);
+
+/* Editing a document that was read: these keep everything else as it
+ * was (materials, textures, names, extras, animations, skins). */
+
+/* A deep copy of doc (release it with mlod_gltf_free). */
+mlod_result mlod_gltf_copy(const mlod_gltf *doc, mlod_gltf **out, mlod_error *err);
+
+/* Appends a mesh built from m's primitives, like mlod_gltf_add_mesh, that
+ * takes the name, default morph weights (when every primitive keeps that
+ * many targets), extensions and extras of glTF mesh `like`, and those of
+ * its primitives by position. */
+mlod_result mlod_gltf_add_mesh_like(mlod_gltf *doc, int like, const mlod_mesh *m, int *out_index,
+                                    mlod_error *err);
+
+/* Points node at mesh and skin (either may be -1: none). */
+mlod_result mlod_gltf_set_node_mesh(mlod_gltf *doc, int node, int mesh, int skin, mlod_error *err);
+
+/* The node's local transform. A matrix that is not a translation,
+ * rotation and scale is MLOD_ERR_UNSUPPORTED. */
+mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out, mlod_error *err);
+
+/* Removes the meshes no node uses, then the accessors and buffer views
+ * nothing uses, and packs the buffers again: indices of meshes, accessors
+ * and buffer views change, every other index stays. A document using an
+ * extension that may refer to those (beyond the KHR_materials_*,
+ * KHR_texture_*, KHR_lights_punctual, KHR_mesh_quantization, EXT_texture_*,
+ * MSFT_lod family) is MLOD_ERR_UNSUPPORTED and left unchanged. */
+mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err);
+
+/* Removes MSFT_lod from node (and MSFT_screencoverage from its extras):
+ * its former level nodes stay, without mesh or skin, so that node indices
+ * hold. MSFT_lod leaves extensionsUsed when no node uses it any more. A
+ * node without MSFT_lod is left as it is. */
+mlod_result mlod_gltf_clear_lod(mlod_gltf *doc, int node, mlod_error *err);
+
+/* Makes node `to` morph like node `from`: it gets from's default morph
+ * weights and, in every animation, a channel animating its weights with
+ * the sampler of each channel animating from's (to's mesh must keep the
+ * number of targets). *added (may be NULL) is the number of channels
+ * added. */
+mlod_result mlod_gltf_copy_morph_animation(mlod_gltf *doc, int from, int to, int *added, mlod_error *err);
+
+/* A channel animating the morph target weights of a node (not part of the
+ * character's clips). */
+typedef struct mlod_weight_track {
+	int node;            /* glTF node */
+	int targets;         /* weights per key */
+	mlod_interp interp;
+	int key_count;
+	float *times;        /* key_count, increasing */
+	float *values;       /* targets per key (3 * targets for CUBICSPLINE: in-tangents, values, out-tangents) */
+} mlod_weight_track;
+
+/* The weights channels of glTF animation `animation`, in channel order;
+ * *tracks is NULL when there are none. Release with mlod_weight_tracks_free. */
+mlod_result mlod_gltf_weight_tracks(const mlod_gltf *doc, int animation, mlod_weight_track **tracks, int *count,
+                                    mlod_error *err);
+void mlod_weight_tracks_free(mlod_weight_track *tracks, int count);
+
+/* Appends the tracks to glTF animation `animation` as weights channels
+ * (key times shared by several tracks are stored once). */
+mlod_result mlod_gltf_add_weight_tracks(mlod_gltf *doc, int animation, const mlod_weight_track *tracks, int count,
+                                        mlod_error *err);
+
+/* ------------------------------------------------------------------ */
+/* BVH                                                                 */
+/* ------------------------------------------------------------------ */
+
+/* Parses BVH text. Joints get their channel layout, rest = OFFSET (with
+ * identity rotation), and one clip "bvh" with a uniformly sampled
+ * translation and rotation channel per animated joint. Errors name the line. */
+mlod_result mlod_bvh_read(const void *data, size_t size, mlod_character *out,
+                          mlod_error *err);
+
+/* Writes the character's skeleton and one clip as BVH text, sampled at
+ * frame_time (0: the clip's own frame time, else 1/30 s). Joints without a
+ * BVH layout get "Xposition Yposition Zposition" on roots and
+ * "Zrotation Xrotation Yrotation" elsewhere. *text is released with mlod_free. */
+mlod_result mlod_bvh_write(const mlod_character *c, int clip, float frame_time,
+                           char **text, size_t *size, mlod_error *err);
+
+/* ------------------------------------------------------------------ */
+/* Input                                                               */
+/* ------------------------------------------------------------------ */
+
+typedef enum mlod_format { MLOD_FORMAT_UNKNOWN, MLOD_FORMAT_GLB, MLOD_FORMAT_GLTF, MLOD_FORMAT_BVH } mlod_format;
+
+/* Guesses the format from the first bytes. */
+mlod_format mlod_detect_format(const void *data, size_t size);
+
+/* Loads glb, glTF or BVH bytes into a document and a character. BVH gets a
+ * document made with mlod_gltf_from_character, so every tool writes glb.
+ * doc may be NULL when only the character is wanted. On failure nothing
+ * is allocated. */
+mlod_result mlod_load(const void *data, size_t size, const char *base_dir,
+                      mlod_gltf **doc, mlod_character *c, mlod_format *format,
+                      mlod_error *err);
+
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MLOD_IO_H */

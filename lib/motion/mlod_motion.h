@@ -1,0 +1,213 @@
+/*
+ * mlod_motion.h: the motion layer (paper 4.3): the multiresolution motion tree,
+ * per-channel key reduction under a hierarchical error bound, and morph
+ * target weight tracks.
+ */
+#ifndef MLOD_MOTION_H
+#define MLOD_MOTION_H
+
+#include "model/mlod_model.h"
+#include "io/mlod_io.h"
+#include "measure/mlod_measure.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------ */
+/* Motion layer: the multiresolution motion tree (paper 4.3)           */
+/* ------------------------------------------------------------------ */
+
+/* Levels of one clip. Level 0 is the clip as read; level k + 1 is coarser
+ * than level k (fewer keys, a larger bound). Frame distances, thresholds
+ * and the tree follow the paper; per-channel key reduction goes beyond it.
+ * Error bounds apply to the point error (mlod_motion_point_error) of every
+ * joint at every sample of the clip's common timeline (its frames and, by
+ * default, the midpoints between them: mlod_motion_options.subdivide),
+ * which bounds the world-space joint and End Site position error
+ * (mlod_joint_deviation_at) against the clip as read, in scene units. */
+
+/* How far any point within radius of a joint moves between world matrices
+ * a and b: |origin(a) - origin(b)| + radius * sigma_max(A - B), A and B
+ * their 3x3 parts (for a rotation error of angle t alone, 2 radius sin(t/2),
+ * exact for the farthest point). */
+double mlod_motion_point_error(const mlod_mat4 *a, const mlod_mat4 *b, double radius);
+
+typedef enum mlod_motion_method {
+	MLOD_MOTION_FRAMES,  /* the paper's multiresolution motion tree: whole frames go */
+	MLOD_MOTION_KEYS     /* per-channel key reduction under a hierarchical error bound */
+} mlod_motion_method;
+
+/* How the tree merges two neighbouring frames. */
+typedef enum mlod_motion_merge {
+	MLOD_MOTION_REMOVE,  /* keep one of the two as it is; the other is interpolated at play time */
+	MLOD_MOTION_AVERAGE  /* one frame at their mean time with their mean pose (weighted by the frames each stands for) */
+} mlod_motion_merge;
+
+/* How a level's size is chosen. */
+typedef enum mlod_motion_target {
+	MLOD_MOTION_THRESHOLD, /* frames method only: merge neighbours closer than this frame distance */
+	MLOD_MOTION_FRACTION,  /* keep at most this fraction (0..1] of the clip's keys */
+	MLOD_MOTION_MAX_ERROR  /* the coarsest level whose joint position error is at most this (scene units) */
+} mlod_motion_target;
+
+/* How a level stores its key values (plain glTF in every case). */
+typedef enum mlod_motion_precision {
+	MLOD_MOTION_PRECISION_AUTO,  /* rotations on the lattice of normalised shorts (n / 32767, core
+	                                glTF, 8 bytes a key), translations and scales float32 rounded to
+	                                power-of-two grids: the coarsest that keep the level within its
+	                                bound. First and last keys: translations and scales exact,
+	                                rotations on the finest lattice (1/65534 per component). */
+	MLOD_MOTION_PRECISION_FLOAT, /* every value float32 rounded to power-of-two grids (the low
+	                                mantissa bits become zeros); first and last keys exact */
+	MLOD_MOTION_PRECISION_FULL   /* values as read */
+} mlod_motion_precision;
+
+/* Zero-initialised options are the defaults. */
+typedef struct mlod_motion_options {
+	mlod_motion_merge merge;  /* frames method; MLOD_MOTION_REMOVE (the default) measured better */
+	double cubic_rate;        /* CUBICSPLINE clips are resampled at least this often (1/s); 0 means 60 */
+	double point_distance;    /* radius of the points carried by each joint for the point error
+	                             (scene units); 0 means the skeleton height / 18 (10 cm on a 1.8 m
+	                             person) */
+	mlod_motion_precision precision; /* how a level's key values are stored (default auto) */
+	double precision_share;   /* auto precision: the share of a max-error bound left to rounding,
+	                             (0, 1); 0 means the default */
+	int subdivide;            /* errors are checked at the frames of the common timeline and at
+	                             subdivide - 1 evenly spaced times inside each interval between
+	                             them (1: frames only; 0 means the default, 2: midpoints too) */
+} mlod_motion_options;
+
+#define MLOD_DEFAULT_SUBDIVIDE 2
+#define MLOD_MAX_SUBDIVIDE 64
+
+/* The sample times of a timeline of `frames` increasing times: frame f is
+ * sample f * subdivide, with subdivide - 1 evenly spaced times after it
+ * (before the next frame). out holds (frames - 1) * subdivide + 1 floats. */
+void mlod_motion_sample_times(const float *times, int frames, int subdivide, float *out);
+
+/* How a clip was put on a common timeline: every channel keyed at every
+ * frame. A clip whose channels share their key times and are LINEAR or
+ * STEP keeps its keys; otherwise the frames are the union of all key
+ * times, and intervals longer than 1/cubic_rate get evenly spaced frames
+ * when a channel is CUBICSPLINE (which becomes LINEAR). */
+typedef struct mlod_motion_timeline {
+	int frames;               /* frames of the common timeline */
+	int resampled;            /* 0 when the clip's own keys were kept */
+	int cubic_channels;       /* CUBICSPLINE channels, sampled as LINEAR */
+	int mismatched_channels;  /* channels whose key times were not the common ones */
+} mlod_motion_timeline;
+
+/* Frame distance (paper 4.3): the energy to move every joint from local
+ * pose a to local pose b, each joint weighted by the energy weight
+ * (h - depth) / h of 4.1.2: the sum over joints of the weight times
+ * (|change of each Euler angle| / pi, in the joint's Euler order, wrapped
+ * into (-pi, pi], taking the nearer of the two Euler triples that give
+ * the rotation, so q and -q and 179 -> -179 degrees are no motion) plus,
+ * beyond the paper, |change of translation| / skeleton height and
+ * |change of scale|, so root motion counts. */
+double mlod_motion_frame_distance(const mlod_skeleton *s, const mlod_trs *a, const mlod_trs *b);
+
+/* Puts clip on its common timeline (see mlod_motion_timeline): out gets
+ * one channel per channel of clip, every one keyed at every frame, LINEAR
+ * or STEP, rotations normalised and sign-continuous. Release out with
+ * mlod_clip_free. Bad clips (no channels, no keys, times not finite or
+ * negative or not increasing, values not finite, zero quaternions) are
+ * MLOD_ERR_PARSE; too many frames is MLOD_ERR_LIMIT. info may be NULL. */
+mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_options *opt,
+                                    mlod_clip *out, mlod_motion_timeline *info, mlod_error *err);
+
+/* Releases what a clip made by the library owns and zeroes it. */
+void mlod_clip_free(mlod_clip *clip);
+
+/* Keys in a clip (all channels), and the bytes glTF stores for them as
+ * floats: values (three per key for CUBICSPLINE) plus key times, where
+ * channels with identical times share one input accessor. */
+long mlod_clip_key_count(const mlod_clip *clip);
+long mlod_clip_key_bytes(const mlod_clip *clip);
+
+/* The levels of one clip under construction; it keeps pointers to c. */
+typedef struct mlod_motion mlod_motion;
+
+mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_motion_options *opt,
+                               mlod_motion **out, mlod_error *err);
+void mlod_motion_free(mlod_motion *m);
+/* The clip's common timeline. */
+const mlod_motion_timeline *mlod_motion_timeline_info(const mlod_motion *m);
+
+/* One level of a clip. */
+typedef struct mlod_motion_level {
+	mlod_clip clip;           /* kept keys only, LINEAR or STEP (STEP where the source was); same
+	                             name, duration, first and last key times as the source */
+	mlod_motion_method method;
+	double threshold;         /* frames: the frame distance threshold; keys: the error budget used */
+	long keys;                /* mlod_clip_key_count(&clip) */
+	long bytes;               /* mlod_clip_key_bytes(&clip) */
+	mlod_deviation error;     /* joint position error against the source clip at the samples
+	                             (frames and the times between them), scene units */
+	double point_error;       /* the largest point error over joints and samples, scene units */
+	double grid;              /* auto precision: the grid translations were rounded to (rotations
+	                             and scales finer by their joint's reach), scene units; 0: none */
+} mlod_motion_level;
+
+/* Builds the next level of a method: each level is made from the previous
+ * level of the same method (nested: the frames method's levels are the
+ * lines of the motion tree, the keys method's keep subsets of the previous
+ * keys). target and value choose its size; with MLOD_MOTION_MAX_ERROR the
+ * point error (so the joint position error too) is at most value, or
+ * MLOD_ERR_LIMIT says why not (a resampled clip that already deviates
+ * more). With auto precision the values are rounded within value (for
+ * the other targets, within the error the level has before rounding) and
+ * the errors are those after rounding. Release with mlod_motion_level_free. */
+mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
+                                   double value, mlod_motion_level *out, mlod_error *err);
+void mlod_motion_level_free(mlod_motion_level *l);
+
+/* Morph target weights of a level (beyond the paper). A weight error dw on
+ * a target moves a vertex by dw times that target's offset there, so a
+ * track's error at a time is the sum over its targets of |dw| times the
+ * target's reach: its largest vertex offset, in scene units, on the node's
+ * mesh as placed (rigidly or skinned) in the rest pose. */
+
+/* The reach of each of the `targets` morph targets of the mesh instance on
+ * glTF node `node` into out. MLOD_ERR_INVALID_ARG when no instance of c is
+ * on that node or its mesh has another number of targets. */
+mlod_result mlod_morph_target_reach(const mlod_character *c, int node, int targets, double *out, mlod_error *err);
+
+/* Reduces a LINEAR or STEP weight track: out gets the keys it needs so
+ * that, at every key time of in and subdivide - 1 evenly spaced times
+ * between each two, the error (above) is at most bound; the first and last
+ * keys stay (one key for a track that comes down to a constant), and kept
+ * keys keep their values. *error gets the largest
+ * error at those times. CUBICSPLINE tracks are MLOD_ERR_UNSUPPORTED.
+ * out's times and values are released with free(). */
+mlod_result mlod_weight_track_reduce(const mlod_weight_track *in, const double *reach, double bound, int subdivide,
+                                     mlod_weight_track *out, double *error, mlod_error *err);
+
+/* Keys and glTF bytes of weight tracks: each key stores targets floats
+ * (three times as many for CUBICSPLINE) and a time, which tracks with
+ * identical times share. */
+long mlod_weight_tracks_keys(const mlod_weight_track *tracks, int count);
+long mlod_weight_tracks_bytes(const mlod_weight_track *tracks, int count);
+
+/* Per-channel key reduction under a hierarchical error bound (beyond the
+ * paper; the metric of ozz-animation's optimizer and ACL's virtual
+ * vertices). common is original on its common timeline
+ * (mlod_motion_common_clip). kept holds channel_count * frames flags
+ * (channel-major): on entry the keys that may stay (each channel keeps its
+ * first frame, and its last unless it is a single key), on return those
+ * kept. A key goes only if, at every sample (mlod_motion_sample_times:
+ * the frames and subdivide - 1 times between each two, 1 to
+ * MLOD_MAX_SUBDIVIDE), every joint's world origin stays within bound of
+ * the original, and so does every point within point_distance of it (and
+ * its End Site); tracks that then fit a constant collapse to one key. */
+mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common,
+                           double bound, double point_distance, int subdivide, unsigned char *kept,
+                           mlod_error *err);
+
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MLOD_MOTION_H */
