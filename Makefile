@@ -34,7 +34,7 @@ LDLIBS := -ltinygltf -lstdc++ -lm
 B := build/$(config)
 BIN := $(B)/bin
 
-LIB_PARTS := core model io measure skeleton mesh motion
+LIB_PARTS := core model io measure skeleton mesh motion record
 LIB_C := $(sort $(foreach p,$(LIB_PARTS),$(wildcard lib/$(p)/*.c)))
 LIB_CXX := $(sort $(foreach p,$(LIB_PARTS),$(wildcard lib/$(p)/*.cpp)))
 LIB_OBJ := $(LIB_C:%.c=$(B)/%.o) $(LIB_CXX:%.cpp=$(B)/%.o)

@@ -13,6 +13,7 @@
  *   skeleton/mlod_skeleton.h  labels, energy, MSG, skeleton levels (4.1)
  *   mesh/mlod_mesh.h          BindGraphMesh, collapses, Power Skinning (4.2)
  *   motion/mlod_motion.h      motion tree, key reduction, weight tracks (4.3)
+ *   record/mlod_record.h      the stage record, extras.mlod (mlod-record(5))
  *
  * The runtime (lib/rt, header mlod_rt.h) builds from core alone and does
  * not include this header.
@@ -27,5 +28,6 @@
 #include "skeleton/mlod_skeleton.h"
 #include "mesh/mlod_mesh.h"
 #include "motion/mlod_motion.h"
+#include "record/mlod_record.h"
 
 #endif /* MLOD_H */

@@ -4,8 +4,8 @@
  *
  * Reads glb, glTF or BVH from a file or stdin. By default writes a glb to
  * stdout (or -o FILE) with each joint node's extras.mlod holding its depth,
- * neighbours, children, label, weight and energy; --report prints a table
- * (or JSON) instead.
+ * neighbours, children, label, weight and energy (the stage record,
+ * lib/record); --report prints a table (or JSON) instead.
  */
 #define _GNU_SOURCE /* getopt_long */
 
@@ -18,6 +18,7 @@
 
 #define PI 3.14159265358979323846
 
+/* A printf format: the defaults come from the library. */
 static const char usage_text[] =
 	"usage: mlod-label [options] [input]\n"
 	"\n"
@@ -30,9 +31,9 @@ static const char usage_text[] =
 	"  -r, --report[=FORMAT]  print a report instead of a glb; FORMAT is table\n"
 	"                         (default) or json\n"
 	"      --hub-factor F     a joint is a hub when its neighbours exceed F times\n"
-	"                         the average (default 1.9)\n"
+	"                         the average (default %g)\n"
 	"      --max-angle DEG    rotation range per Euler axis that normalises the\n"
-	"                         energy (default 180)\n"
+	"                         energy (default %g)\n"
 	"  -h, --help             show this help\n"
 	"  -V, --version          show the version\n"
 	"\n"
@@ -120,25 +121,6 @@ static void report_json(const char *input, const mlod_character *c, const mlod_j
 	printf("  ]\n}\n");
 }
 
-/* Stores each joint's results in its node's extras.mlod. */
-static void annotate(mlod_gltf *doc, const mlod_character *c, const mlod_joint_info *info)
-{
-	const mlod_skeleton *s = &c->skeleton;
-	for (int j = 0; j < s->joint_count; j++) {
-		char json[256];
-		mlod_error err = {0};
-		if (s->joints[j].node < 0)
-			continue;
-		snprintf(json, sizeof json,
-		         "{\"label\":\"%s\",\"depth\":%d,\"children\":%d,\"neighbors\":%d,"
-		         "\"weight\":%.9g,\"energy\":%.9g}",
-		         mlod_label_name(info[j].label), info[j].depth, info[j].children, info[j].neighbors,
-		         info[j].weight, info[j].energy);
-		if (mlod_gltf_set_extra(doc, MLOD_GLTF_NODE, s->joints[j].node, "mlod", json, &err) != MLOD_OK)
-			tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
-	}
-}
-
 int main(int argc, char **argv)
 {
 	static const struct option longopts[] = {
@@ -152,7 +134,7 @@ int main(int argc, char **argv)
 	};
 	const char *output = NULL;
 	enum tool_report report = REPORT_NONE;
-	mlod_label_options opt = {1.9, PI};
+	mlod_label_options opt = {MLOD_LABEL_HUB_FACTOR_DEFAULT, MLOD_LABEL_MAX_ANGLE_DEFAULT * PI / 180.0};
 	int ch;
 
 	tool_name = "mlod-label";
@@ -163,7 +145,7 @@ int main(int argc, char **argv)
 		case 'r': report = tool_parse_report(optarg); break;
 		case 'H': opt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
 		case 'A': opt.max_angle = tool_parse_double("--max-angle", optarg, 1e-3, 1e6) * PI / 180.0; break;
-		case 'h': fputs(usage_text, stdout); return 0;
+		case 'h': printf(usage_text, MLOD_LABEL_HUB_FACTOR_DEFAULT, MLOD_LABEL_MAX_ANGLE_DEFAULT); return 0;
 		case 'V': tool_version();
 		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
 		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
@@ -192,7 +174,8 @@ int main(int argc, char **argv)
 	} else if (report == REPORT_JSON) {
 		report_json(tool_input_label(input), &c, info, &opt);
 	} else {
-		annotate(doc, &c, info);
+		if ((r = mlod_record_write_joints(doc, &c, info, &err)) != MLOD_OK)
+			tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
 		tool_write_gltf(output, doc);
 	}
 	if (fflush(stdout) != 0)

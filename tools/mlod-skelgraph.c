@@ -18,10 +18,6 @@
 
 #include "common.h"
 
-#define MAX_LEVELS 32
-#define DEFAULT_MAX_ERROR 2.0 /* percent of the skeleton height */
-#define MEASURE_SAMPLES 120   /* measured times per clip */
-
 static const char usage_text[] =
 	"usage: mlod-skelgraph [options] [input]\n"
 	"\n"
@@ -49,148 +45,15 @@ static const char usage_text[] =
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
 	"4 output failure.\n";
 
-struct level {
-	mlod_skel_level skel;
-	mlod_character c;        /* the level as a standalone character */
-	mlod_fold_stats stats;
-	int has_mesh_error;
-	mlod_deviation vertex;   /* % of the bounding diagonal */
-	mlod_deviation joint;    /* scene units */
-	double bound_error;      /* the error compared with --max-error, % of height */
-};
-
 struct job {
 	const char *input;
 	mlod_character c;
 	mlod_joint_info *info;
 	int labels_from_extras;
-	mlod_skelgraph graph;
-	int *order;              /* the removal order of the minor joints */
-	int minor_count;
-	double height;
-	int has_mesh;
-	int level_count;
-	struct level levels[MAX_LEVELS];
+	mlod_skel_levels L;
 };
 
-/* Takes labels and energies from mlod-label's extras when every joint
- * node has them; returns 1 when it did. */
-static int labels_from_extras(mlod_gltf *doc, const mlod_character *c, mlod_joint_info *info)
-{
-	const mlod_skeleton *s = &c->skeleton;
-	if (!doc)
-		return 0;
-	for (int j = 0; j < s->joint_count; j++) {
-		char *json = NULL, label[32];
-		double energy, depth;
-		mlod_error err = {0};
-		if (s->joints[j].node < 0 ||
-		    mlod_gltf_get_extra(doc, MLOD_GLTF_NODE, s->joints[j].node, "mlod", &json, &err) != MLOD_OK || !json)
-			return 0;
-		int ok = tool_json_string_value(json, "label", label, sizeof label) == 1 &&
-		         tool_json_number(json, "energy", &energy) == 1 && tool_json_number(json, "depth", &depth) == 1 &&
-		         mlod_label_parse(label, &info[j].label) == 0 && energy >= 0.0;
-		mlod_free(json);
-		if (!ok)
-			return 0;
-		info[j].energy = energy;
-	}
-	return 1;
-}
-
-static void measure(struct job *job, struct level *lv)
-{
-	mlod_error err = {0};
-	mlod_result r;
-	/* a_to_b: the renumbering of kept joints. */
-	int *newidx = malloc(sizeof(int) * (size_t)job->c.skeleton.joint_count);
-	if (!newidx)
-		tool_die(EXIT_INPUT, NULL, "out of memory");
-	for (int j = 0, k = 0; j < job->c.skeleton.joint_count; j++)
-		newidx[j] = lv->skel.kept[j] ? k++ : -1;
-	r = mlod_joint_deviation(&job->c, &lv->c, lv->skel.remap, newidx, MEASURE_SAMPLES, &lv->joint, &err);
-	free(newidx);
-	if (r != MLOD_OK)
-		tool_die(tool_exit_code(r), tool_input_label(job->input), "%s", err.message);
-	lv->bound_error = 100.0 * lv->joint.max / job->height;
-	if (job->has_mesh) {
-		r = mlod_vertex_deviation(&job->c, &lv->c, MEASURE_SAMPLES, &lv->vertex, &err);
-		if (r != MLOD_OK)
-			tool_die(tool_exit_code(r), tool_input_label(job->input), "%s", err.message);
-		lv->has_mesh_error = 1;
-		lv->bound_error = lv->vertex.max * lv->vertex.scale / job->height;
-	}
-}
-
-/* Extracts, applies and measures the level at threshold t, or (t < 0) the
- * level that removes the first `removed` joints of the removal order. */
-static void make_level(struct job *job, struct level *lv, double t, int removed)
-{
-	mlod_error err = {0};
-	mlod_result r;
-	if (t >= 0.0)
-		r = mlod_skelgraph_extract(&job->graph, job->info, t, &lv->skel, &err);
-	else
-		r = mlod_skelgraph_extract_first(&job->graph, job->info, job->order,
-		                                 removed < job->minor_count ? removed : job->minor_count, &lv->skel, &err);
-	if (r == MLOD_OK)
-		r = mlod_skel_level_apply(&job->c, &lv->skel, &lv->c, &lv->stats, &err);
-	if (r != MLOD_OK)
-		tool_die(tool_exit_code(r), tool_input_label(job->input), "%s", err.message);
-	measure(job, lv);
-}
-
-static void free_level(struct level *lv)
-{
-	mlod_skel_level_free(&lv->skel);
-	mlod_character_free(&lv->c);
-}
-
-/* The default chain: 13%, 26% and 39% of the joints removed in the
- * removal order, each only while the error stays within the bound; past
- * it, the largest removal within the bound is found by bisection and the
- * chain ends there. */
-static void default_levels(struct job *job, double max_error)
-{
-	static const double fractions[] = {0.13, 0.26, 0.39};
-	int n = job->c.skeleton.joint_count, accepted = 0;
-	for (size_t i = 0; i < sizeof fractions / sizeof *fractions; i++) {
-		int removed = (int)lround(fractions[i] * n);
-		if (removed > job->minor_count)
-			removed = job->minor_count;
-		if (removed <= accepted)
-			break;
-		struct level *lv = &job->levels[job->level_count];
-		make_level(job, lv, -1.0, removed);
-		if (lv->bound_error <= max_error) {
-			accepted = removed;
-			job->level_count++;
-			continue;
-		}
-		free_level(lv);
-		int lo = accepted, hi = removed;
-		struct level best = {0};
-		while (hi - lo > 1) {
-			int mid = (lo + hi) / 2;
-			struct level trial = {0};
-			make_level(job, &trial, -1.0, mid);
-			if (trial.bound_error <= max_error) {
-				if (lo > accepted)
-					free_level(&best);
-				best = trial;
-				lo = mid;
-			} else {
-				free_level(&trial);
-				hi = mid;
-			}
-		}
-		if (lo > accepted)
-			job->levels[job->level_count++] = best;
-		break;
-	}
-}
-
-static void removed_names(FILE *f, const struct job *job, const struct level *lv, int json)
+static void removed_names(FILE *f, const struct job *job, const mlod_skel_built *lv, int json)
 {
 	const mlod_skeleton *s = &job->c.skeleton;
 	int first = 1;
@@ -214,14 +77,14 @@ static void report_table(const struct job *job)
 	for (int j = 0; j < s->joint_count; j++)
 		minors += job->info[j].label == MLOD_LABEL_MINOR;
 	printf("# %s: %d joints (%d minor) in %d sub-chains, %d closure edges; height %.4g; %d clips; labels %s\n",
-	       job->input, s->joint_count, minors, job->graph.chain_count, job->graph.edge_count, job->height,
+	       job->input, s->joint_count, minors, job->L.graph.chain_count, job->L.graph.edge_count, job->L.height,
 	       job->c.clip_count, job->labels_from_extras ? "from extras" : "computed");
 	printf("%5s  %12s  %6s  %7s  %10s  %10s  %10s  %10s  %6s\n", "level", "threshold", "joints", "removed",
 	       "vtx max%", "vtx mean%", "jnt max%", "jnt mean%", "shear");
 	printf("%5d  %12s  %6d  %7s  %10s  %10s  %10s  %10s  %6s\n", 0, "-", s->joint_count, "0%", "0", "0", "0",
 	       "0", "0");
-	for (int k = 0; k < job->level_count; k++) {
-		const struct level *lv = &job->levels[k];
+	for (int k = 0; k < job->L.count; k++) {
+		const mlod_skel_built *lv = &job->L.levels[k];
 		char vmax[32] = "-", vmean[32] = "-", removed[16];
 		if (lv->has_mesh_error) {
 			snprintf(vmax, sizeof vmax, "%.4f", lv->vertex.max);
@@ -230,12 +93,12 @@ static void report_table(const struct job *job)
 		snprintf(removed, sizeof removed, "%.0f%%",
 		         100.0 * (s->joint_count - lv->skel.kept_count) / s->joint_count);
 		printf("%5d  %12.6g  %6d  %7s  %10s  %10s  %10.4f  %10.4f  %6d\n", k + 1, lv->skel.threshold,
-		       lv->skel.kept_count, removed, vmax, vmean, 100.0 * lv->joint.max / job->height,
-		       100.0 * lv->joint.mean / job->height, lv->stats.shear_samples);
+		       lv->skel.kept_count, removed, vmax, vmean, 100.0 * lv->joint.max / job->L.height,
+		       100.0 * lv->joint.mean / job->L.height, lv->stats.shear_samples);
 	}
-	for (int k = 0; k < job->level_count; k++) {
+	for (int k = 0; k < job->L.count; k++) {
 		printf("# level %d removes: ", k + 1);
-		removed_names(stdout, job, &job->levels[k], 0);
+		removed_names(stdout, job, &job->L.levels[k], 0);
 		putchar('\n');
 	}
 	printf("# vtx: skinned-vertex deviation over the clips, %% of the bounding diagonal;"
@@ -250,27 +113,27 @@ static void report_json(const struct job *job)
 	printf("{\n  \"input\": ");
 	tool_json_string(stdout, job->input);
 	printf(",\n  \"joints\": %d,\n  \"chains\": %d,\n  \"closure_edges\": %d,\n  \"height\": %.9g,\n",
-	       s->joint_count, job->graph.chain_count, job->graph.edge_count, job->height);
+	       s->joint_count, job->L.graph.chain_count, job->L.graph.edge_count, job->L.height);
 	printf("  \"labels\": \"%s\",\n  \"levels\": [\n", job->labels_from_extras ? "extras" : "computed");
-	for (int k = 0; k < job->level_count; k++) {
-		const struct level *lv = &job->levels[k];
+	for (int k = 0; k < job->L.count; k++) {
+		const mlod_skel_built *lv = &job->L.levels[k];
 		printf("    {\"level\": %d, \"threshold\": %.9g, \"kept\": %d, \"removed\": [", k + 1,
 		       lv->skel.threshold, lv->skel.kept_count);
 		removed_names(stdout, job, lv, 1);
 		printf("],\n     \"joint_error\": {\"max\": %.9g, \"mean\": %.9g, \"max_percent_height\": %.9g},\n",
-		       lv->joint.max, lv->joint.mean, 100.0 * lv->joint.max / job->height);
+		       lv->joint.max, lv->joint.mean, 100.0 * lv->joint.max / job->L.height);
 		if (lv->has_mesh_error)
 			printf("     \"vertex_error\": {\"max_percent_diagonal\": %.9g, \"mean_percent_diagonal\": %.9g},\n",
 			       lv->vertex.max, lv->vertex.mean);
 		printf("     \"shear_samples\": %d, \"weight_merges\": %d}%s\n", lv->stats.shear_samples,
-		       lv->stats.weight_merges, k + 1 < job->level_count ? "," : "");
+		       lv->stats.weight_merges, k + 1 < job->L.count ? "," : "");
 	}
 	printf("  ]\n}\n");
 }
 
 static void write_bvh(const struct job *job, const char *output, int level, int clip)
 {
-	const mlod_character *c = level == 0 ? &job->c : &job->levels[level - 1].c;
+	const mlod_character *c = level == 0 ? &job->c : &job->L.levels[level - 1].c;
 	char *text = NULL;
 	size_t size = 0;
 	mlod_error err = {0};
@@ -283,18 +146,29 @@ static void write_bvh(const struct job *job, const char *output, int level, int 
 	mlod_free(text);
 }
 
-/* Records the levels in the document and writes it. */
+/* Adds the levels and their record to the document and writes it. */
 static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 {
-	mlod_skel_level_record records[MAX_LEVELS];
+	const mlod_skeleton *s = &job->c.skeleton;
+	int n = job->L.count, sc = s->skin_count;
+	mlod_skel_level_record records[MLOD_SKEL_MAX_LEVELS];
+	mlod_record_skel_level rec[MLOD_SKEL_MAX_LEVELS];
+	int *skins = malloc(sizeof(int) * ((size_t)n * (size_t)sc + 1)), *full = malloc(sizeof(int) * ((size_t)sc + 1));
 	mlod_error err = {0};
-	for (int k = 0; k < job->level_count; k++) {
-		const struct level *lv = &job->levels[k];
-		records[k] = (mlod_skel_level_record){&lv->skel, &lv->c, lv->vertex, lv->joint, job->height};
-		if (!lv->has_mesh_error)
-			records[k].vertex.scale = 0.0;
-	}
-	if (mlod_gltf_add_skel_levels(doc, &job->c, records, job->level_count, &err) != MLOD_OK)
+	if (!skins || !full)
+		tool_die(EXIT_OUTPUT, NULL, "out of memory");
+	for (int i = 0; i < sc; i++)
+		full[i] = s->skins[i].gltf_index;
+	mlod_skel_levels_records(&job->L, records);
+	if (mlod_gltf_add_skel_levels(doc, &job->c, records, n, skins, &err) != MLOD_OK ||
+	    mlod_record_skel_levels_make(&job->c, records, n, skins, rec, &err) != MLOD_OK)
+		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+	mlod_result r = mlod_record_write_skeleton(doc, rec, n, full, sc, &err);
+	for (int k = 0; k < n; k++)
+		mlod_record_skel_level_free(&rec[k]);
+	free(skins);
+	free(full);
+	if (r != MLOD_OK)
 		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
 	tool_write_gltf(output, doc);
 }
@@ -316,9 +190,9 @@ int main(int argc, char **argv)
 	};
 	const char *output = NULL;
 	enum tool_report report = REPORT_NONE;
-	double thresholds[MAX_LEVELS], fractions[MAX_LEVELS];
+	double thresholds[MLOD_SKEL_MAX_LEVELS], fractions[MLOD_SKEL_MAX_LEVELS];
 	int threshold_count = 0, fraction_count = 0, level = -1, clip = 0;
-	double max_error = DEFAULT_MAX_ERROR;
+	double max_error = MLOD_SKEL_MAX_ERROR_DEFAULT;
 	mlod_label_options lopt = {0};
 	int ch;
 
@@ -328,10 +202,10 @@ int main(int argc, char **argv)
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
-		case 't': threshold_count = tool_parse_list("--thresholds", optarg, thresholds, MAX_LEVELS, 0.0, 1e9); break;
-		case 'j': fraction_count = tool_parse_list("--joints", optarg, fractions, MAX_LEVELS, 0.0, 1.0); break;
+		case 't': threshold_count = tool_parse_list("--thresholds", optarg, thresholds, MLOD_SKEL_MAX_LEVELS, 0.0, 1e9); break;
+		case 'j': fraction_count = tool_parse_list("--joints", optarg, fractions, MLOD_SKEL_MAX_LEVELS, 0.0, 1.0); break;
 		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 1e6); break;
-		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
+		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MLOD_SKEL_MAX_LEVELS); break;
 		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
 		case 'H': lopt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
 		case 'h': fputs(usage_text, stdout); return 0;
@@ -355,47 +229,33 @@ int main(int argc, char **argv)
 	mlod_error err = {0};
 	job.input = tool_input_label(optind < argc ? argv[optind] : NULL);
 	tool_load(optind < argc ? argv[optind] : NULL, &doc, &job.c, NULL);
-	int n = job.c.skeleton.joint_count;
-	job.info = calloc((size_t)n + 1, sizeof *job.info);
+	job.info = calloc((size_t)job.c.skeleton.joint_count + 1, sizeof *job.info);
 	if (!job.info)
 		tool_die(EXIT_INPUT, job.input, "out of memory");
 	mlod_result r = mlod_label_skeleton(&job.c, &lopt, job.info, &err);
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), job.input, "%s", err.message);
-	job.labels_from_extras = labels_from_extras(doc, &job.c, job.info);
-	if ((r = mlod_skelgraph_build(&job.c.skeleton, job.info, &job.graph, &err)) != MLOD_OK)
+	if ((r = mlod_record_read_joints(doc, &job.c, job.info, &job.labels_from_extras, &err)) != MLOD_OK)
 		tool_die(tool_exit_code(r), job.input, "%s", err.message);
-	job.height = mlod_skeleton_size(&job.c.skeleton);
-	job.order = malloc(sizeof(int) * ((size_t)n + 1));
-	if (!job.order)
-		tool_die(EXIT_INPUT, job.input, "out of memory");
-	job.minor_count = mlod_skel_removal_order(&job.c.skeleton, job.info, job.order);
-	job.has_mesh = job.c.instance_count > 0;
+	if ((r = mlod_skel_levels_init(&job.L, &job.c, job.info, &err)) != MLOD_OK)
+		tool_die(tool_exit_code(r), job.input, "%s", err.message);
 
-	if (threshold_count) {
-		for (int k = 0; k < threshold_count; k++)
-			make_level(&job, &job.levels[job.level_count++], thresholds[k], 0);
-	} else if (fraction_count) {
-		for (int k = 0; k < fraction_count; k++) {
-			make_level(&job, &job.levels[job.level_count++], -1.0, (int)lround((1.0 - fractions[k]) * n));
-		}
-	} else {
-		default_levels(&job, max_error);
-		if (job.level_count == 0 && job.minor_count > 0) {
-			struct level first = {0};
-			make_level(&job, &first, -1.0, 1);
-			fprintf(stderr, "%s: %s: no skeleton level within --max-error %g%%: removing %s alone costs %.3g%%\n",
-			        tool_name, job.input, max_error, job.c.skeleton.joints[job.order[0]].name, first.bound_error);
-			free_level(&first);
-		}
+	if (threshold_count)
+		r = mlod_skel_levels_thresholds(&job.L, thresholds, threshold_count, &err);
+	else if (fraction_count)
+		r = mlod_skel_levels_fractions(&job.L, fractions, fraction_count, &err);
+	else
+		r = mlod_skel_levels_default(&job.L, max_error, &err);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), job.input, "%s", err.message);
+	if (!threshold_count && !fraction_count && job.L.count == 0 && job.L.minor_count > 0) {
+		mlod_skel_built first;
+		if ((r = mlod_skel_levels_make(&job.L, -1.0, 1, &first, &err)) != MLOD_OK)
+			tool_die(tool_exit_code(r), job.input, "%s", err.message);
+		fprintf(stderr, "%s: %s: no skeleton level within --max-error %g%%: removing %s alone costs %.3g%%\n",
+		        tool_name, job.input, max_error, job.c.skeleton.joints[job.L.order[0]].name, first.bound_error);
+		mlod_skel_built_free(&first);
 	}
-	/* Levels are nested: finest first. */
-	for (int a = 1; a < job.level_count; a++)
-		for (int b = a; b > 0 && job.levels[b].skel.kept_count > job.levels[b - 1].skel.kept_count; b--) {
-			struct level t = job.levels[b];
-			job.levels[b] = job.levels[b - 1];
-			job.levels[b - 1] = t;
-		}
 
 	if (report == REPORT_TABLE)
 		report_table(&job);
@@ -403,20 +263,17 @@ int main(int argc, char **argv)
 		report_json(&job);
 	else if (bvh_out) {
 		if (level < 0)
-			level = job.level_count;
-		if (level > job.level_count)
-			tool_die(EXIT_USAGE, NULL, "--level %d: there are %d levels", level, job.level_count);
+			level = job.L.count;
+		if (level > job.L.count)
+			tool_die(EXIT_USAGE, NULL, "--level %d: there are %d levels", level, job.L.count);
 		write_bvh(&job, output, level, clip);
 	} else
 		write_glb(&job, doc, output);
 
 	if (fflush(stdout) != 0)
 		tool_die(EXIT_OUTPUT, "<stdout>", "write error");
-	for (int k = 0; k < job.level_count; k++)
-		free_level(&job.levels[k]);
+	mlod_skel_levels_free(&job.L);
 	free(job.info);
-	free(job.order);
-	mlod_skelgraph_free(&job.graph);
 	mlod_character_free(&job.c);
 	mlod_gltf_free(doc);
 	return 0;

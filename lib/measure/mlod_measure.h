@@ -81,6 +81,53 @@ mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *l
                              mlod_deviation *out, mlod_error *err);
 
 
+/* ------------------------------------------------------------------ */
+/* Levels within an error bound (bound.c)                              */
+/* ------------------------------------------------------------------ */
+
+/* Screen coverage: a level shows while its error stays within
+ * MLOD_COVERAGE_PIXELS pixels on a screen MLOD_COVERAGE_LINES high. */
+#define MLOD_COVERAGE_LINES 1080.0
+#define MLOD_COVERAGE_PIXELS 1.0
+
+/* The largest screen coverage (fraction of the screen height covered by
+ * the character) at which an error of error_percent of the character's
+ * size stays within pixel_budget pixels on a screen screen_pixels high;
+ * at most 1, and 0 for no error. */
+double mlod_error_coverage(double error_percent, double screen_pixels, double pixel_budget);
+
+/* MSFT_screencoverage for count levels of errors error_percent (finest
+ * first): count + 1 values, the full mesh's first, made non-increasing,
+ * the last 0. */
+void mlod_lod_coverage(const double *error_percent, int count, float *coverage);
+
+/* The search both the skeleton and the mesh layer use for levels within a
+ * bound: the candidate parameters are tried in order, coarser and
+ * coarser, each level kept while its error stays within the bound; at the
+ * first one beyond it, the parameter is bisected between it and the last
+ * one kept (at first `start`), and the coarsest level within the bound
+ * found there ends the chain. */
+typedef struct mlod_level_search {
+	const double *candidates;
+	int count;
+	double start;        /* the parameter of the level before the first (the full one) */
+	int whole;           /* bisect over whole numbers until they are neighbours; else `bisections` halvings */
+	int bisections;
+	double bound;
+	void *ctx;
+	/* Makes the level at x: MLOD_OK with its error in *error, or an
+	 * error. For a candidate of the chain (chain set) it may instead
+	 * return 1, without a level, when that brings nothing over the last
+	 * level kept: the chain then ends. */
+	mlod_result (*make)(void *ctx, double x, int chain, void **level, double *error, mlod_error *err);
+	/* Keeps a level: 1, or 0 when it refuses it (and drops it itself);
+	 * the chain ends on a refusal. */
+	int (*keep)(void *ctx, void *level);
+	void (*drop)(void *ctx, void *level);
+} mlod_level_search;
+
+mlod_result mlod_level_search_run(const mlod_level_search *s, mlod_error *err);
+
 #ifdef __cplusplus
 }
 #endif

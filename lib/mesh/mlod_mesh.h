@@ -6,6 +6,7 @@
 #define MLOD_MESH_H
 
 #include "model/mlod_model.h"
+#include "io/mlod_io.h"
 #include "measure/mlod_measure.h"
 
 #ifdef __cplusplus
@@ -204,6 +205,145 @@ mlod_result mlod_bgm_check(const mlod_bgm *g, mlod_error *err);
  * weighted joint is outside map (the vertices before it are already
  * remapped: check first when that matters). */
 mlod_result mlod_primitive_remap_joints(mlod_primitive *p, const int *map, int map_count, mlod_error *err);
+
+
+/* ------------------------------------------------------------------ */
+/* Mesh levels: the policy (levels.c) and their glTF output (lodgltf.c) */
+/* ------------------------------------------------------------------ */
+
+/* The defaults of mlod-bgm: levels keeping these fractions of the
+ * triangles; under a --max-error, levels halving the triangles down to
+ * MLOD_MESH_MIN_RATIO, the last found by MLOD_MESH_BISECTIONS halvings.
+ * The posed cost trains on clip frames and MLOD_MESH_RANDOM_POSES random
+ * poses (seed MLOD_MESH_TRAIN_SEED, joints turned up to
+ * MLOD_MESH_RANDOM_ANGLE radians); the error is measured on the rest pose,
+ * clip frames and as many other random poses (seed
+ * MLOD_MESH_MEASURE_SEED). */
+#define MLOD_MESH_RATIOS_DEFAULT "0.5,0.25,0.1"
+#define MLOD_MESH_MAX_LEVELS 16
+#define MLOD_MESH_MIN_RATIO (1.0 / 256)
+#define MLOD_MESH_BISECTIONS 6
+#define MLOD_MESH_RANDOM_POSES 8
+#define MLOD_MESH_RANDOM_ANGLE 0.69813170f /* 40 degrees */
+#define MLOD_MESH_TRAIN_SEED 1
+#define MLOD_MESH_MEASURE_SEED 2008
+
+/* Whose triangles a level's ratio counts. */
+typedef enum mlod_mesh_budget {
+	MLOD_BUDGET_DEFAULT = 0, /* CHARACTER with the posed cost (measured), PRIMITIVE with compactness */
+	MLOD_BUDGET_CHARACTER,   /* all simplified primitives together, cheapest collapses first (posed cost only) */
+	MLOD_BUDGET_PRIMITIVE    /* each primitive keeps the ratio */
+} mlod_mesh_budget;
+
+/* Names as the tools spell them ("posed", "edge", "character", ...). */
+const char *mlod_mesh_cost_name(mlod_mesh_cost c);
+const char *mlod_mesh_op_name(mlod_collapse_op op);
+const char *mlod_mesh_budget_name(mlod_mesh_budget b);
+const char *mlod_mesh_placement_name(mlod_placement p);
+const char *mlod_mesh_eligibility_name(mlod_eligibility e);
+
+/* Replaces the DEFAULT values with what they stand for (the cost first:
+ * posed), as the BGM and the levels use them. */
+void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget);
+
+/* The triangle primitives (mode 4) of the character's instances. */
+int mlod_mesh_triangle_primitives(const mlod_character *c);
+
+/* One level of the whole character. */
+typedef struct mlod_mesh_level {
+	double ratio;            /* requested, or found under a bound */
+	mlod_mesh *meshes;       /* one per instance */
+	unsigned char **owned;   /* per instance and primitive: extracted (else the input's) */
+	int *skins;              /* per instance: the glTF skin of its skinned level mesh (mlod_mesh_levels_follow) */
+	mlod_character view;     /* the character with these meshes */
+	int triangles, vertices, caps, collapses;
+	double collapse_seconds;
+	mlod_deviation error;    /* posed error, % of the bounding diagonal */
+} mlod_mesh_level;
+
+/* What a mesh level follows of skeleton level k (from the stage record:
+ * mlod_record_mesh_skeleton). */
+typedef struct mlod_mesh_skeleton {
+	int skin_count;
+	const int *skins;        /* the glTF skin standing for each skin of the character, -1: none */
+	int remap_count;
+	const int *remap_from;   /* a removed joint's node ... */
+	const int *remap_to;     /* ... and its stand-in's node */
+} mlod_mesh_skeleton;
+
+typedef struct mlod_mesh_part mlod_mesh_part;
+
+/* The levels of one character, finest first. */
+typedef struct mlod_mesh_levels {
+	const mlod_character *c;
+	mlod_bgm_options opt;    /* resolved (mlod_mesh_resolve) */
+	mlod_mesh_budget budget;
+	mlod_pose_set train, measure;
+	double *eta;
+	mlod_mesh_part **parts;  /* per instance, per primitive */
+	int simplified;          /* primitives with a BGM */
+	int statics;             /* of them, on no joint and no skin */
+	int triangles, vertices; /* of the input */
+	double build_seconds;
+	int count;
+	mlod_mesh_level levels[MLOD_MESH_MAX_LEVELS];
+	const mlod_mesh_skeleton *skeleton; /* followed skeleton levels (mlod_mesh_levels_follow) */
+	int skeleton_count;
+	char notes[2048];        /* what was done, "; "-separated, for reports */
+} mlod_mesh_levels;
+
+/* Builds the BGM of every triangle primitive of c (which must outlive L)
+ * and records its collapses down to min_ratio of its triangles (0: as far
+ * as they go). */
+mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, const mlod_bgm_options *opt,
+                                  mlod_mesh_budget budget, double min_ratio, mlod_error *err);
+void mlod_mesh_levels_free(mlod_mesh_levels *L);
+
+/* Levels at these ratios (decreasing); a ratio that removes nothing more
+ * is dropped with a note. */
+mlod_result mlod_mesh_levels_by_ratio(mlod_mesh_levels *L, const double *ratios, int n, mlod_error *err);
+
+/* Levels halving the triangles while the posed error stays within bound
+ * (% of the diagonal); past it, the coarsest ratio within it
+ * (mlod_level_search_run) ends the chain. */
+mlod_result mlod_mesh_levels_by_error(mlod_mesh_levels *L, double bound, mlod_error *err);
+
+/* Sums of the BGMs' figures (nodes, seams, borders, ...). */
+void mlod_mesh_levels_totals(const mlod_mesh_levels *L, mlod_bgm_info *sum);
+
+/* Mesh level k follows skeleton level min(k, count - 1): the level meshes
+ * of skinned instances are remapped to its skin where every weighted
+ * joint has a stand-in there, and rigid parts follow their joint's
+ * stand-in. skeleton must outlive L. */
+mlod_result mlod_mesh_levels_follow(mlod_mesh_levels *L, const mlod_mesh_skeleton *skeleton, int count,
+                                    mlod_error *err);
+
+/* The level nodes mlod_mesh_levels_write added. */
+typedef struct mlod_mesh_lod {
+	int count;
+	int *node;               /* glTF node */
+	int *level;              /* its mesh level, 0 for the finest */
+	unsigned char *skeleton_level; /* its skin is a skeleton level's */
+} mlod_mesh_lod;
+void mlod_mesh_lod_free(mlod_mesh_lod *lod);
+
+/* Writes the levels into doc, the document c was read from: each
+ * simplified mesh node lists one node per level in MSFT_lod (coverage
+ * from the errors: mlod_lod_coverage); level nodes use the node's skin or
+ * the followed skeleton level's; rigid meshes become meshes skinned to
+ * their joint with weight 1; static meshes keep the node's transform;
+ * level nodes that keep morph targets get copies of the node's weight
+ * animation channels. */
+mlod_result mlod_mesh_levels_write(mlod_mesh_levels *L, mlod_gltf *doc, mlod_mesh_lod *out, mlod_error *err);
+
+/* Level k on its own: a copy of input with each simplified node's mesh
+ * replaced by the level's (skinned ones on the followed skeleton level's
+ * skin, rigid and static ones where they hang), without the nodes'
+ * MSFT_lod, the unused meshes pruned. *unpruned (0 at first, passed to
+ * every call) is set, and a note added, when an extension kept the full
+ * meshes. */
+mlod_result mlod_mesh_levels_split(mlod_mesh_levels *L, const mlod_gltf *input, int k, mlod_gltf **out,
+                                   int *unpruned, mlod_error *err);
 
 
 

@@ -31,9 +31,14 @@ const char *mlod_label_symbol(mlod_label l); /* UTF-8 Greek letter */
 /* Parses a label name; returns 0 on success, -1 otherwise. */
 int mlod_label_parse(const char *s, mlod_label *out);
 
+/* The defaults: the paper's hub factor, and a half turn per Euler axis. */
+#define MLOD_LABEL_HUB_FACTOR_DEFAULT 1.9
+#define MLOD_LABEL_MAX_ANGLE_DEFAULT 180.0 /* degrees */
+
 typedef struct mlod_label_options {
-	double hub_factor;   /* 0 means 1.9, the paper's value */
-	double max_angle;    /* rotation range per Euler axis for energy normalisation; 0 means pi */
+	double hub_factor;   /* 0 means MLOD_LABEL_HUB_FACTOR_DEFAULT */
+	double max_angle;    /* radians: rotation range per Euler axis for energy normalisation; 0 means
+	                      * MLOD_LABEL_MAX_ANGLE_DEFAULT degrees */
 } mlod_label_options;
 
 typedef struct mlod_joint_info {
@@ -124,12 +129,6 @@ typedef struct mlod_skel_level_record {
 	double size;                     /* the skeleton height, for the joint error */
 } mlod_skel_level_record;
 
-/* The largest screen coverage (fraction of the screen height covered by
- * the character) at which an error of error_percent of the character's
- * size stays within pixel_budget pixels on a screen screen_pixels high;
- * at most 1, and 0 for no error. */
-double mlod_error_coverage(double error_percent, double screen_pixels, double pixel_budget);
-
 typedef struct mlod_fold_stats {
 	int shear_samples;       /* composed transforms that had shear TRS cannot express */
 	int weight_merges;       /* vertices whose influences were merged */
@@ -150,15 +149,77 @@ typedef struct mlod_fold_stats {
 mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level *l,
                                   mlod_character *out, mlod_fold_stats *stats, mlod_error *err);
 
-/* Records levels (coarser in order) in the document that full was read
+/* Adds levels (coarser in order) to the document that full was read
  * from: per level a glTF skin for each skin, over the kept joints; a copy
  * of each skinned mesh with the transferred weights, on a node outside the
  * scene listed in the original node's MSFT_lod (coverage from the
- * errors); and extras.mlod on the scene (the levels: threshold, kept
- * nodes, remap as node -> stand-in node, skins, errors) and on each skin
- * (the skins of its levels). */
+ * errors). skins (count * skin_count entries, may be NULL) receives level
+ * k's glTF skin for skin s at k * skin_count + s: what the stage record
+ * (mlod_record_write_skeleton) lists. */
 mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full,
-                                      const mlod_skel_level_record *levels, int count, mlod_error *err);
+                                      const mlod_skel_level_record *levels, int count, int *skins,
+                                      mlod_error *err);
+
+/* ------------------------------------------------------------------ */
+/* The skeleton level policy (levels.c)                                */
+/* ------------------------------------------------------------------ */
+
+/* The defaults of mlod-skelgraph: levels removing these fractions of the
+ * joints (the paper's figure), within MLOD_SKEL_MAX_ERROR_DEFAULT percent
+ * of the skeleton size; errors measured at up to MLOD_SKEL_SAMPLES times
+ * per clip. */
+#define MLOD_SKEL_REMOVED_DEFAULT 0.13, 0.26, 0.39
+#define MLOD_SKEL_MAX_ERROR_DEFAULT 2.0
+#define MLOD_SKEL_SAMPLES 120
+#define MLOD_SKEL_MAX_LEVELS 32
+
+/* A level made and measured. */
+typedef struct mlod_skel_built {
+	mlod_skel_level skel;
+	mlod_character c;        /* the level as a standalone character */
+	mlod_fold_stats stats;
+	int has_mesh_error;
+	mlod_deviation vertex;   /* skinned-vertex error, % of the bounding diagonal */
+	mlod_deviation joint;    /* joint position error, scene units */
+	double bound_error;      /* what a bound is compared with: the vertex error with meshes, else the
+	                          * joint error, in % of the skeleton size */
+} mlod_skel_built;
+
+/* The levels of one character, finest first. */
+typedef struct mlod_skel_levels {
+	const mlod_character *c;
+	const mlod_joint_info *info;
+	mlod_skelgraph graph;
+	int *order;              /* the removal order of the minor joints */
+	int minor_count;
+	double height;           /* mlod_skeleton_size */
+	int has_mesh;
+	int count;
+	mlod_skel_built levels[MLOD_SKEL_MAX_LEVELS];
+} mlod_skel_levels;
+
+/* Builds the graph and the removal order (c and info must outlive L). */
+mlod_result mlod_skel_levels_init(mlod_skel_levels *L, const mlod_character *c, const mlod_joint_info *info,
+                                  mlod_error *err);
+void mlod_skel_levels_free(mlod_skel_levels *L);
+
+/* Makes and measures one level: at an energy threshold (threshold >= 0),
+ * else removing the first `removed` joints of the order. */
+mlod_result mlod_skel_levels_make(const mlod_skel_levels *L, double threshold, int removed, mlod_skel_built *out,
+                                  mlod_error *err);
+void mlod_skel_built_free(mlod_skel_built *b);
+
+/* Adds levels at energy thresholds, or keeping fractions of the joints. */
+mlod_result mlod_skel_levels_thresholds(mlod_skel_levels *L, const double *thresholds, int n, mlod_error *err);
+mlod_result mlod_skel_levels_fractions(mlod_skel_levels *L, const double *kept, int n, mlod_error *err);
+
+/* The default chain: MLOD_SKEL_REMOVED_DEFAULT of the joints removed,
+ * each only while bound_error stays within max_error; past it, the
+ * largest removal within it (mlod_level_search_run) ends the chain. */
+mlod_result mlod_skel_levels_default(mlod_skel_levels *L, double max_error, mlod_error *err);
+
+/* The levels as records for mlod_gltf_add_skel_levels (L->count). */
+void mlod_skel_levels_records(const mlod_skel_levels *L, mlod_skel_level_record *out);
 
 
 #ifdef __cplusplus

@@ -1,0 +1,428 @@
+/*
+ * levels.c: the mesh level policy (mlod_mesh.h): the BGM of every triangle
+ * primitive of a character, levels by triangle ratio (each primitive's,
+ * or the whole character's budget shared by posed cost) or down to a
+ * posed error bound, each measured against the full character.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "levels.h"
+
+/* One primitive of one instance. */
+struct mlod_mesh_part {
+	mlod_bgm *bgm;          /* NULL: left as it is */
+	int triangles;
+	int k;                  /* the level being made: its prefix */
+};
+
+const char *mlod_mesh_cost_name(mlod_mesh_cost c)
+{
+	return c == MLOD_COST_COMPACTNESS ? "compactness" : "posed";
+}
+
+const char *mlod_mesh_op_name(mlod_collapse_op op)
+{
+	return op == MLOD_OP_TRIANGLE ? "triangle" : op == MLOD_OP_EDGE ? "edge" : op == MLOD_OP_MIXED ? "mixed" : "default";
+}
+
+const char *mlod_mesh_budget_name(mlod_mesh_budget b)
+{
+	return b == MLOD_BUDGET_PRIMITIVE ? "primitive" : "character";
+}
+
+const char *mlod_mesh_placement_name(mlod_placement p)
+{
+	return p == MLOD_PLACE_BARYCENTER ? "barycenter" : "optimal";
+}
+
+const char *mlod_mesh_eligibility_name(mlod_eligibility e)
+{
+	return e == MLOD_ELIGIBLE_LITERAL ? "literal" : e == MLOD_ELIGIBLE_BEND ? "bend" : "all";
+}
+
+void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget)
+{
+	if (opt->cost == MLOD_COST_DEFAULT)
+		opt->cost = MLOD_COST_POSED;
+	if (budget && *budget == MLOD_BUDGET_DEFAULT) /* measured: see mlod-bgm(1) */
+		*budget = opt->cost == MLOD_COST_POSED ? MLOD_BUDGET_CHARACTER : MLOD_BUDGET_PRIMITIVE;
+	if (opt->placement == MLOD_PLACE_DEFAULT)
+		opt->placement = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_OPTIMAL;
+}
+
+static int primitive_triangles(const mlod_primitive *p)
+{
+	if (p->mode != 4)
+		return 0;
+	return (p->index_count > 0 ? p->index_count : p->vertex_count) / 3;
+}
+
+int mlod_mesh_triangle_primitives(const mlod_character *c)
+{
+	int n = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
+			n += primitive_triangles(&c->meshes[c->instances[i].mesh].primitives[p]) > 0;
+	return n;
+}
+
+static void note(mlod_mesh_levels *L, const char *fmt, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 2, 3)))
+#endif
+	;
+
+static void note(mlod_mesh_levels *L, const char *fmt, ...)
+{
+	size_t n = strlen(L->notes);
+	if (n + 4 >= sizeof L->notes)
+		return;
+	if (n)
+		n += (size_t)snprintf(L->notes + n, sizeof L->notes - n, "; ");
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(L->notes + n, sizeof L->notes - n, fmt, ap);
+	va_end(ap);
+}
+
+void mlod_mesh_note_(mlod_mesh_levels *L, const char *text)
+{
+	note(L, "%s", text);
+}
+
+static mlod_result nomem(mlod_error *err)
+{
+	return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+}
+
+static mlod_result make_poses(mlod_mesh_levels *L, mlod_error *err)
+{
+	int clips = L->c->clip_count > 0 ? L->c->clip_count : 1;
+	int per_train = 24 / clips, per_measure = 16 / clips;
+	per_train = per_train < 2 ? 2 : per_train > 8 ? 8 : per_train;
+	per_measure = per_measure < 2 ? 2 : per_measure > 4 ? 4 : per_measure; /* mlod_clip_times: 1 means all */
+	mlod_result r = mlod_pose_set_make(L->c, 0, per_train, MLOD_MESH_RANDOM_POSES, MLOD_MESH_TRAIN_SEED,
+	                                   MLOD_MESH_RANDOM_ANGLE, &L->train, err);
+	if (r == MLOD_OK)
+		r = mlod_pose_set_make(L->c, 1, per_measure, MLOD_MESH_RANDOM_POSES, MLOD_MESH_MEASURE_SEED,
+		                       MLOD_MESH_RANDOM_ANGLE, &L->measure, err);
+	return r;
+}
+
+mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, const mlod_bgm_options *opt,
+                                  mlod_mesh_budget budget, double min_ratio, mlod_error *err)
+{
+	memset(L, 0, sizeof *L);
+	L->c = c;
+	L->opt = *opt;
+	L->budget = budget;
+	mlod_mesh_resolve(&L->opt, &L->budget);
+	int unsupported = 0, morphs = 0;
+	mlod_result r = make_poses(L, err);
+	if (r != MLOD_OK)
+		return r;
+	L->eta = calloc((size_t)c->skeleton.joint_count + 1, sizeof *L->eta);
+	L->parts = calloc((size_t)c->instance_count + 1, sizeof *L->parts);
+	if (!L->eta || !L->parts)
+		return nomem(err);
+	if ((r = mlod_joint_weight_average(c, L->eta, err)) != MLOD_OK)
+		return r;
+	L->opt.eta = L->eta;
+	L->opt.poses = &L->train;
+	for (int i = 0; i < c->instance_count; i++) {
+		const mlod_instance *in = &c->instances[i];
+		const mlod_mesh *m = &c->meshes[in->mesh];
+		L->parts[i] = calloc((size_t)m->primitive_count + 1, sizeof **L->parts);
+		if (!L->parts[i])
+			return nomem(err);
+		for (int p = 0; p < m->primitive_count; p++) {
+			const mlod_primitive *pr = &m->primitives[p];
+			mlod_mesh_part *pt = &L->parts[i][p];
+			pt->triangles = primitive_triangles(pr);
+			L->triangles += pt->triangles;
+			L->vertices += pr->vertex_count;
+			if (pt->triangles < 4 || in->node < 0)
+				continue;
+			r = mlod_bgm_build(c, i, p, &L->opt, &pt->bgm, err);
+			if (r == MLOD_ERR_UNSUPPORTED) {
+				unsupported++;
+				continue;
+			}
+			if (r != MLOD_OK)
+				return r;
+			int target = min_ratio > 0.0 ? (int)ceil(min_ratio * pt->triangles) : 0;
+			if ((r = mlod_bgm_simplify(pt->bgm, target, 0, err)) != MLOD_OK)
+				return r;
+			mlod_bgm_info info;
+			mlod_bgm_get_info(pt->bgm, &info);
+			L->build_seconds += info.build_seconds;
+			L->simplified++;
+			L->statics += in->skin < 0 && in->joint < 0;
+			morphs += pr->target_count > 0;
+		}
+	}
+	/* A character budget may take any primitive further than the ratio. */
+	for (int i = 0; L->budget == MLOD_BUDGET_CHARACTER && min_ratio > 0.0 && i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
+			if (L->parts[i][p].bgm && (r = mlod_bgm_simplify(L->parts[i][p].bgm, 0, 0, err)) != MLOD_OK)
+				return r;
+	if (L->statics)
+		note(L, "%d primitive(s) of static meshes (no joint, no skin) simplified in world space", L->statics);
+	if (unsupported)
+		note(L, "%d primitive(s) that are not triangles left as they are", unsupported);
+	if (morphs)
+		note(L, "%d primitive(s) with morph targets: offsets interpolated like positions", morphs);
+	return MLOD_OK;
+}
+
+/* The character budget: ratio of all simplified triangles, shared among
+ * the primitives by posed cost (mlod_bgm_share_budget). Sets each part's
+ * k. */
+static mlod_result character_prefixes(mlod_mesh_levels *L, double ratio, mlod_error *err)
+{
+	const mlod_character *c = L->c;
+	int n = 0, at = 0;
+	long total = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		n += c->meshes[c->instances[i].mesh].primitive_count;
+	mlod_bgm **bgms = calloc((size_t)n + 1, sizeof *bgms);
+	int *prefix = calloc((size_t)n + 1, sizeof *prefix);
+	if (!bgms || !prefix) {
+		free(bgms);
+		free(prefix);
+		return nomem(err);
+	}
+	for (int i = 0; i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
+			mlod_mesh_part *pt = &L->parts[i][p];
+			bgms[at++] = pt->bgm;
+			total += mlod_bgm_triangles(pt->bgm, 0); /* 0 without a BGM; degenerate faces dropped */
+		}
+	mlod_bgm_share_budget(bgms, n, (long)ceil(ratio * (double)total), prefix);
+	at = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
+			L->parts[i][p].k = prefix[at++];
+	free(bgms);
+	free(prefix);
+	return MLOD_OK;
+}
+
+static void free_level(const mlod_mesh_levels *L, mlod_mesh_level *lv)
+{
+	for (int i = 0; lv->meshes && i < L->c->instance_count; i++) {
+		for (int p = 0; lv->owned && lv->owned[i] && p < lv->meshes[i].primitive_count; p++)
+			if (lv->owned[i][p])
+				mlod_primitive_free(&lv->meshes[i].primitives[p]);
+		free(lv->meshes[i].primitives);
+		if (lv->owned)
+			free(lv->owned[i]);
+	}
+	free(lv->meshes);
+	free(lv->owned);
+	free(lv->skins);
+	free(lv->view.instances);
+	memset(lv, 0, sizeof *lv);
+}
+
+/* Extracts the level at ratio (with the primitive budget, per primitive
+ * the shortest prefix within ratio of its triangles; with the character
+ * budget, character_prefixes) and measures it. */
+static mlod_result make_level(mlod_mesh_levels *L, mlod_mesh_level *lv, double ratio, mlod_error *err)
+{
+	const mlod_character *c = L->c;
+	mlod_result r = MLOD_OK;
+	memset(lv, 0, sizeof *lv);
+	lv->ratio = ratio;
+	lv->meshes = calloc((size_t)c->instance_count + 1, sizeof *lv->meshes);
+	lv->owned = calloc((size_t)c->instance_count + 1, sizeof *lv->owned);
+	lv->skins = calloc((size_t)c->instance_count + 1, sizeof *lv->skins);
+	if (!lv->meshes || !lv->owned || !lv->skins) {
+		free_level(L, lv);
+		return nomem(err);
+	}
+	double seconds = 0.0;
+	if (L->budget == MLOD_BUDGET_CHARACTER && (r = character_prefixes(L, ratio, err)) != MLOD_OK) {
+		free_level(L, lv);
+		return r;
+	}
+	for (int i = 0; r == MLOD_OK && i < c->instance_count; i++) {
+		const mlod_mesh *m = &c->meshes[c->instances[i].mesh];
+		mlod_mesh *lm = &lv->meshes[i];
+		lm->name = m->name;
+		lm->gltf_index = m->gltf_index;
+		lm->primitives = calloc((size_t)m->primitive_count + 1, sizeof *lm->primitives);
+		lv->owned[i] = calloc((size_t)m->primitive_count + 1, 1);
+		if (!lm->primitives || !lv->owned[i]) {
+			r = nomem(err);
+			break;
+		}
+		lm->primitive_count = m->primitive_count;
+		for (int p = 0; p < m->primitive_count; p++) {
+			mlod_mesh_part *pt = &L->parts[i][p];
+			if (!pt->bgm) {
+				lm->primitives[p] = m->primitives[p];
+				lv->triangles += pt->triangles;
+				lv->vertices += m->primitives[p].vertex_count;
+				continue;
+			}
+			int k = L->budget == MLOD_BUDGET_CHARACTER ? pt->k
+			                                             : mlod_bgm_prefix_for(pt->bgm, (int)ceil(ratio * pt->triangles));
+			if ((r = mlod_bgm_extract(pt->bgm, k, c->instances[i].skin < 0, &lm->primitives[p], err)) != MLOD_OK)
+				break;
+			lv->owned[i][p] = 1;
+			lv->triangles += lm->primitives[p].index_count / 3;
+			lv->vertices += lm->primitives[p].vertex_count;
+			int count;
+			const mlod_vsplit *seq = mlod_bgm_sequence(pt->bgm, &count);
+			for (int s = 0; s < k; s++)
+				lv->caps += seq[s].capped;
+			lv->collapses += k;
+			if (k > 0)
+				seconds += seq[k - 1].seconds;
+		}
+	}
+	lv->collapse_seconds = seconds;
+	lv->view = *c;
+	lv->view.meshes = lv->meshes;
+	lv->view.mesh_count = c->instance_count;
+	lv->view.instances = NULL;
+	if (r == MLOD_OK && !(lv->view.instances = malloc(sizeof *lv->view.instances * ((size_t)c->instance_count + 1))))
+		r = nomem(err);
+	if (r == MLOD_OK) {
+		for (int i = 0; i < c->instance_count; i++) {
+			lv->view.instances[i] = c->instances[i];
+			lv->view.instances[i].mesh = i;
+		}
+		r = mlod_posed_error(c, &lv->view, &L->measure, &lv->error, err);
+	}
+	if (r != MLOD_OK)
+		free_level(L, lv);
+	return r;
+}
+
+void mlod_mesh_levels_free(mlod_mesh_levels *L)
+{
+	for (int k = 0; k < L->count; k++)
+		free_level(L, &L->levels[k]);
+	for (int i = 0; L->parts && i < L->c->instance_count; i++) {
+		for (int p = 0; L->parts[i] && p < L->c->meshes[L->c->instances[i].mesh].primitive_count; p++)
+			mlod_bgm_free(L->parts[i][p].bgm);
+		free(L->parts[i]);
+	}
+	free(L->parts);
+	free(L->eta);
+	mlod_pose_set_free(&L->train);
+	mlod_pose_set_free(&L->measure);
+	memset(L, 0, sizeof *L);
+}
+
+mlod_result mlod_mesh_levels_by_ratio(mlod_mesh_levels *L, const double *ratios, int n, mlod_error *err)
+{
+	for (int k = 0; k < n && L->count < MLOD_MESH_MAX_LEVELS; k++) {
+		mlod_mesh_level lv;
+		mlod_result r = make_level(L, &lv, ratios[k], err);
+		if (r != MLOD_OK)
+			return r;
+		if (L->count > 0 && lv.triangles >= L->levels[L->count - 1].triangles) {
+			note(L, "ratio %g gives no fewer triangles than %g: dropped", ratios[k], L->levels[L->count - 1].ratio);
+			free_level(L, &lv);
+			continue;
+		}
+		if (L->count == 0 && lv.triangles >= L->triangles) {
+			note(L, "ratio %g removes nothing: dropped", ratios[k]);
+			free_level(L, &lv);
+			continue;
+		}
+		L->levels[L->count++] = lv;
+	}
+	return MLOD_OK;
+}
+
+/* By error, through mlod_level_search_run: the parameter is the ratio. */
+static mlod_result search_make(void *ctx, double x, int chain, void **level, double *error, mlod_error *err)
+{
+	mlod_mesh_levels *L = ctx;
+	mlod_mesh_level *lv = malloc(sizeof *lv);
+	if (!lv)
+		return nomem(err);
+	mlod_result r = make_level(L, lv, x, err);
+	if (r != MLOD_OK) {
+		free(lv);
+		return r;
+	}
+	if (chain && L->count > 0 && lv->triangles >= L->levels[L->count - 1].triangles) {
+		free_level(L, lv); /* nothing more comes off */
+		free(lv);
+		return (mlod_result)1;
+	}
+	*level = lv;
+	*error = lv->error.max;
+	return MLOD_OK;
+}
+
+static void search_drop(void *ctx, void *level)
+{
+	free_level(ctx, level);
+	free(level);
+}
+
+static int search_keep(void *ctx, void *level)
+{
+	mlod_mesh_levels *L = ctx;
+	mlod_mesh_level *lv = level;
+	if (L->count >= MLOD_MESH_MAX_LEVELS || (L->count > 0 && lv->triangles >= L->levels[L->count - 1].triangles)) {
+		search_drop(ctx, level);
+		return 0;
+	}
+	L->levels[L->count++] = *lv;
+	free(lv);
+	return 1;
+}
+
+mlod_result mlod_mesh_levels_by_error(mlod_mesh_levels *L, double bound, mlod_error *err)
+{
+	double ratios[MLOD_MESH_MAX_LEVELS];
+	int n = 0;
+	for (double ratio = 0.5; ratio >= MLOD_MESH_MIN_RATIO && n < MLOD_MESH_MAX_LEVELS; ratio /= 2)
+		ratios[n++] = ratio;
+	mlod_level_search s = {ratios, n, 1.0, 0, MLOD_MESH_BISECTIONS, bound, L, search_make, search_keep, search_drop};
+	return mlod_level_search_run(&s, err);
+}
+
+void mlod_mesh_levels_totals(const mlod_mesh_levels *L, mlod_bgm_info *sum)
+{
+	memset(sum, 0, sizeof *sum);
+	for (int i = 0; L->parts && i < L->c->instance_count; i++)
+		for (int p = 0; p < L->c->meshes[L->c->instances[i].mesh].primitive_count; p++) {
+			const mlod_bgm *g = L->parts[i][p].bgm;
+			if (!g)
+				continue;
+			mlod_bgm_info in;
+			mlod_bgm_get_info(g, &in);
+			sum->nodes += in.nodes;
+			sum->seam_nodes += in.seam_nodes;
+			sum->border_edges += in.border_edges;
+			sum->nonmanifold_edges += in.nonmanifold_edges;
+			sum->locked_nodes += in.locked_nodes;
+			sum->eligible_nodes += in.eligible_nodes;
+			sum->dropped += in.dropped;
+			sum->refused += in.refused;
+			sum->snaps += in.snaps;
+		}
+}
+
+int mlod_mesh_has_levels_(const mlod_mesh_levels *L, int i)
+{
+	const mlod_instance *in = &L->c->instances[i];
+	if (in->node < 0)
+		return 0;
+	for (int p = 0; p < L->c->meshes[in->mesh].primitive_count; p++)
+		if (L->parts[i][p].bgm)
+			return 1;
+	return 0;
+}
