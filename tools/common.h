@@ -1,7 +1,8 @@
 /*
  * common.h: what every mlod-* tool shares: error reporting with the exit
  * codes of the pipeline, reading the input, and writing the output
- * atomically. Only the public API of libmlod is used.
+ * atomically. Only the public API of libmlod is used; no tool parses
+ * JSON (the stage record is read through lib/record).
  *
  * Exit codes: 0 success, 1 usage, 2 bad input, 3 unsupported input,
  * 4 output failure.
@@ -75,12 +76,6 @@ void tool_version(void)
 	__attribute__((noreturn))
 #endif
 	;
-
-/* Looks up key in the top level of a JSON object text. Returns 1 and
- * fills *out when the key holds a number (resp. a string, truncated to
- * size), 0 when absent or of another type, -1 when the text is malformed. */
-int tool_json_number(const char *json, const char *key, double *out);
-int tool_json_string_value(const char *json, const char *key, char *out, size_t size);
 
 /* What --report[=FORMAT] asked for. */
 enum tool_report { REPORT_NONE, REPORT_TABLE, REPORT_JSON };

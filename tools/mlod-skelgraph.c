@@ -18,6 +18,7 @@
 
 #include "common.h"
 
+/* A printf format: the default comes from the library. */
 static const char usage_text[] =
 	"usage: mlod-skelgraph [options] [input]\n"
 	"\n"
@@ -32,14 +33,14 @@ static const char usage_text[] =
 	"  -t, --thresholds LIST   levels at these energy thresholds (E1,E2,...)\n"
 	"  -j, --joints LIST       levels keeping these fractions of the joints (0.8,0.6)\n"
 	"  -e, --max-error PCT     default levels stop before the error exceeds PCT\n"
-	"                          percent of the skeleton height (default 2)\n"
+	"                          percent of the skeleton height (default %g)\n"
 	"  -l, --level K           with a .bvh output: the level to write (0 = full)\n"
 	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
 	"      --hub-factor F      labels' hub factor when they are computed (1.9)\n"
 	"  -h, --help              show this help\n"
 	"  -V, --version           show the version\n"
 	"\n"
-	"Default levels remove 13%, 26% and 39% of the joints (the paper's figure),\n"
+	"Default levels remove 13%%, 26%% and 39%% of the joints (the paper's figure),\n"
 	"stopping at the last level within --max-error.\n"
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
@@ -208,7 +209,7 @@ int main(int argc, char **argv)
 		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MLOD_SKEL_MAX_LEVELS); break;
 		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
 		case 'H': lopt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
-		case 'h': fputs(usage_text, stdout); return 0;
+		case 'h': printf(usage_text, MLOD_SKEL_MAX_ERROR_DEFAULT); return 0;
 		case 'V': tool_version();
 		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
 		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);

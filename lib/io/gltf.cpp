@@ -182,6 +182,15 @@ double tidy(float f)
 	return double(f);
 }
 
+/* The glTF reader's own keys of the stage record (mlod-record(5)): a BVH
+ * turned into glTF marks its End Site nodes extras.mlod.end_site = true
+ * and keeps each joint's channel layout in extras.mlod_bvh.channels. The
+ * reader below (is_end_site, bvh_layout) is their one reader and
+ * build_document their one writer; the rest of extras.mlod belongs to
+ * lib/record, above this file. */
+const char *const record_key = "mlod", *const record_end_site = "end_site";
+const char *const bvh_key = "mlod_bvh", *const bvh_channels = "channels";
+
 /* Deeper JSON is refused: tinygltf converts it recursively. */
 const int max_json_depth = 100;
 
@@ -1214,8 +1223,8 @@ private:
 	{
 		const json e = current_extras(doc_, "/nodes/" + std::to_string(n) + "/extras", m_.nodes[size_t(n)].extras);
 		const json none;
-		const json &mlod = e.is_object() && e.contains("mlod") ? e["mlod"] : none;
-		return mlod.is_object() && mlod.contains("end_site") && mlod["end_site"] == true;
+		const json &mlod = e.is_object() && e.contains(record_key) ? e[record_key] : none;
+		return mlod.is_object() && mlod.contains(record_end_site) && mlod[record_end_site] == true;
 	}
 
 	/* A joint read from a BVH keeps its channel layout in
@@ -1225,9 +1234,9 @@ private:
 		static const char *const names[6] = {"Xposition", "Yposition", "Zposition",
 		                                     "Xrotation", "Yrotation", "Zrotation"};
 		const json e = current_extras(doc_, "/nodes/" + std::to_string(n) + "/extras", m_.nodes[size_t(n)].extras);
-		if (!e.is_object() || !e.contains("mlod_bvh") || !e["mlod_bvh"].is_object())
+		if (!e.is_object() || !e.contains(bvh_key) || !e[bvh_key].is_object())
 			return;
-		const json &ch = e["mlod_bvh"].contains("channels") ? e["mlod_bvh"]["channels"] : json();
+		const json &ch = e[bvh_key].contains(bvh_channels) ? e[bvh_key][bvh_channels] : json();
 		if (!ch.is_array() || (ch.size() != 3 && ch.size() != 6))
 			return;
 		unsigned char codes[6];
@@ -1953,7 +1962,7 @@ void build_document(Model &m, const mlod_character &c)
 				if (j.channels[k] < 6)
 					channels.push_back(Value(std::string(names[j.channels[k]])));
 			m.nodes[size_t(i)].extras =
-				Value(Value::Object{{"mlod_bvh", Value(Value::Object{{"channels", Value(channels)}})}});
+				Value(Value::Object{{bvh_key, Value(Value::Object{{bvh_channels, Value(channels)}})}});
 		}
 	}
 	for (int i = 0; i < s.joint_count; i++) {
@@ -1974,7 +1983,7 @@ void build_document(Model &m, const mlod_character &c)
 			tinygltf::Node end;
 			end.name = utf8(j.name) + "_end";
 			set_trs(end, mlod_trs{j.end_site, mlod_quat_identity(), mlod_v3{1, 1, 1}});
-			end.extras = Value(Value::Object{{"mlod", Value(Value::Object{{"end_site", Value(true)}})}});
+			end.extras = Value(Value::Object{{record_key, Value(Value::Object{{record_end_site, Value(true)}})}});
 			m.nodes.push_back(end);
 			m.nodes[size_t(i)].children.push_back(int(m.nodes.size() - 1));
 		}

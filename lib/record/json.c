@@ -497,6 +497,10 @@ static void put_string(struct out *o, const char *s)
 			esc[0] = '\\';
 			esc[1] = (char)*p;
 			put(o, esc, 2);
+		} else if (*p == '\n' || *p == '\t' || *p == '\r' || *p == '\b' || *p == '\f') {
+			esc[0] = '\\';
+			esc[1] = *p == '\n' ? 'n' : *p == '\t' ? 't' : *p == '\r' ? 'r' : *p == '\b' ? 'b' : 'f';
+			put(o, esc, 2);
 		} else if (*p < 0x20) {
 			snprintf(esc, sizeof esc, "\\u%04x", *p);
 			put(o, esc, 6);

@@ -1,0 +1,348 @@
+/*
+ * test_record.c: the stage record (lib/record): its strict JSON, each
+ * stage's reader and writer, merging, the version, and clear errors on
+ * malformed or hostile records.
+ */
+#include "test.h"
+
+#include "record/json.h"
+
+/* ---------------------------------------------------------------- */
+/* JSON                                                              */
+/* ---------------------------------------------------------------- */
+
+static int parses(const char *text)
+{
+	mj v;
+	char why[128];
+	int rc = mj_parse(text, strlen(text), &v, why, sizeof why);
+	mj_free(&v);
+	return rc == 0;
+}
+
+TEST(json_strict)
+{
+	static const char *const good[] = {
+		"{}", "[]", "0", "-0.5e+3", "\"a\\u00e9\\ud83d\\ude00\"", "{\"a\":[1,true,false,null,{\"b\":\"\"}]}",
+		" \t\n{ \"x\" : 1 } ",
+	};
+	static const char *const bad[] = {
+		"", "{", "[1,]", "{\"a\":1,}", "01", "1.", ".5", "1e", "+1", "{'a':1}", "{\"a\" 1}", "[1 2]",
+		"\"\\x\"", "\"\\ud800\"", "\"\\udc00x\"", "\"\\u12\"", "\"\\u0000\"", "\"a\nb\"", "tru", "nul", "1 2",
+		"{\"a\":1,\"a\":2}", "1e999", "\"unterminated", "[\"\\", "{\"a\":}", "NaN", "[1]]",
+	};
+	for (size_t i = 0; i < sizeof good / sizeof *good; i++)
+		CHECK_MSG(parses(good[i]), "refused %s", good[i]);
+	for (size_t i = 0; i < sizeof bad / sizeof *bad; i++)
+		CHECK_MSG(!parses(bad[i]), "accepted %s", bad[i]);
+}
+
+TEST(json_depth_and_roundtrip)
+{
+	/* Nesting: 64 levels parse, 65 do not, 100000 do not crash. */
+	char deep[200001];
+	for (int depth = 64; depth <= 65; depth++) {
+		memset(deep, '[', (size_t)depth);
+		memset(deep + depth, ']', (size_t)depth);
+		deep[2 * depth] = '\0';
+		CHECK(parses(deep) == (depth == 64));
+	}
+	memset(deep, '[', 100000);
+	memset(deep + 100000, ']', 100000);
+	deep[200000] = '\0';
+	CHECK(!parses(deep));
+
+	/* Written back, numbers keep their digits and strings their bytes. */
+	const char *text = "{\"n\":[0.100000001,12345678901,-3e-7],\"s\":\"caf\xc3\xa9 \\\"q\\\" \\n\",\"t\":true}";
+	mj v;
+	char *out = NULL, why[128];
+	CHECK(mj_parse(text, strlen(text), &v, why, sizeof why) == 0);
+	CHECK(mj_write(&v, &out) == 0);
+	CHECK_MSG(strcmp(out, text) == 0, "wrote %s", out);
+	free(out);
+	mj_free(&v);
+}
+
+/* Mutations of a valid record never crash (the sanitizer build checks
+ * memory), and a rejected text always says why. */
+TEST(json_hostile)
+{
+	const char *base = "{\"skeleton_levels\":[{\"level\":1,\"threshold\":0.5,\"kept\":[0,1],\"remap\":{\"2\":1},"
+	                   "\"joint_error\":{\"max\":1,\"mean\":0.5}}],\"s\":\"\\u00e9\"}";
+	size_t n = strlen(base);
+	char buf[512];
+	unsigned state = 12345u;
+	for (int round = 0; round < 20000; round++) {
+		memcpy(buf, base, n + 1);
+		size_t len = n;
+		for (int m = 0; m < 1 + round % 4; m++) {
+			state = state * 1103515245u + 12345u;
+			size_t at = (state >> 8) % len;
+			switch ((state >> 4) % 3) {
+			case 0: buf[at] = (char)(state >> 16); break;            /* change a byte */
+			case 1: len = at; break;                                  /* truncate */
+			case 2: memmove(buf + at, buf + at + 1, len - at); len--; break; /* drop one */
+			}
+			if (len == 0)
+				len = 1;
+		}
+		mj v;
+		char why[128] = "";
+		if (mj_parse(buf, len, &v, why, sizeof why) != 0)
+			CHECK_MSG(why[0] != '\0', "no message for a rejected text");
+		mj_free(&v);
+	}
+}
+
+/* ---------------------------------------------------------------- */
+/* Records in a document                                             */
+/* ---------------------------------------------------------------- */
+
+static int load(const char *path, mlod_gltf **doc, mlod_character *c)
+{
+	size_t size;
+	void *data = test_read_file(path, &size);
+	if (!data)
+		return -1;
+	mlod_result r = mlod_load(data, size, "samples", doc, c, NULL, &terr);
+	free(data);
+	return r == MLOD_OK ? 0 : -1;
+}
+
+/* Two skeleton levels of the tubeman as records. */
+static mlod_record_skel_level skel_level(int level, int kept_node, int from, int to, int skin)
+{
+	static int kept[2][1], rf[2][1], rt[2][1], skins[2][1];
+	int k = level - 1;
+	kept[k][0] = kept_node;
+	rf[k][0] = from;
+	rt[k][0] = to;
+	skins[k][0] = skin;
+	mlod_record_skel_level l = {0};
+	l.level = level;
+	l.threshold = 0.25 * level;
+	l.joints = 1;
+	l.kept_count = 1;
+	l.kept = kept[k];
+	l.remap_count = 1;
+	l.remap_from = rf[k];
+	l.remap_to = rt[k];
+	l.skin_count = 1;
+	l.skins = skins[k];
+	l.joint_error = (mlod_deviation){.max = 0.125, .mean = 0.5};
+	l.has_vertex_error = level == 2;
+	l.vertex_error = (mlod_deviation){.max = 0.01, .mean = 0.02};
+	return l;
+}
+
+TEST(stages_merge_and_version)
+{
+	mlod_gltf *doc = NULL;
+	mlod_character c = {0};
+	CHECK(load("samples/tubeman.glb", &doc, &c) == 0);
+	CHECK(c.skeleton.skin_count == 1);
+	int full = c.skeleton.skins[0].gltf_index;
+
+	/* Labels: written, read back, and found only when every joint has one. */
+	mlod_joint_info *info = calloc((size_t)c.skeleton.joint_count, sizeof *info), *back;
+	back = calloc((size_t)c.skeleton.joint_count, sizeof *back);
+	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
+	int found = -1;
+	CHECK_OK(mlod_record_read_joints(doc, &c, back, &found, &terr));
+	CHECK(found == 0);
+	CHECK_OK(mlod_record_write_joints(doc, &c, info, &terr));
+	CHECK_OK(mlod_record_read_joints(doc, &c, back, &found, &terr));
+	CHECK(found == 1);
+	for (int j = 0; j < c.skeleton.joint_count; j++) {
+		CHECK(back[j].label == info[j].label);
+		CHECK_NEAR(back[j].energy, info[j].energy, 1e-8 * (1 + info[j].energy));
+	}
+
+	/* Mesh levels, then skeleton levels: both stay (the merge fix), and
+	 * the version is stamped. */
+	mlod_record_mesh_level mesh[2] = {{1, 0.5, 100, 80, {0.1, 1.5, 0}, 0}, {2, 0.25, 50, 40, {0.3, 3.0, 0}, 0}};
+	CHECK_OK(mlod_record_write_mesh_levels(doc, mesh, 2, &terr));
+	mlod_record_skel_level skel[2] = {skel_level(1, 0, 2, 1, full), skel_level(2, 0, 3, 0, full)};
+	int fulls[1] = {full};
+	CHECK_OK(mlod_record_write_skeleton(doc, skel, 2, fulls, 1, &terr));
+	mlod_record rec;
+	CHECK_OK(mlod_record_read(doc, &rec, &terr));
+	CHECK(rec.version == MLOD_RECORD_VERSION);
+	CHECK(rec.mesh_level_count == 2 && rec.skel_level_count == 2);
+	CHECK(rec.mesh_levels[1].triangles == 50 && rec.mesh_levels[1].vertices == 40);
+	CHECK_NEAR(rec.mesh_levels[0].error.max, 1.5, 0);
+	/* Coverage as MSFT_screencoverage: 100 / (1.5 * 1080), then less. */
+	CHECK_NEAR(rec.mesh_levels[0].coverage, (float)(100.0 / (1.5 * 1080.0)), 1e-7);
+	CHECK(rec.mesh_levels[1].coverage <= rec.mesh_levels[0].coverage);
+	CHECK(rec.skel_levels[1].remap_from[0] == 3 && rec.skel_levels[1].remap_to[0] == 0);
+	CHECK(rec.skel_levels[0].skins[0] == full && !rec.skel_levels[0].has_vertex_error);
+	CHECK(rec.skel_levels[1].has_vertex_error);
+	CHECK_NEAR(rec.skel_levels[1].vertex_error.mean, 0.02, 0);
+	CHECK(rec.skin_count == 1 && rec.skins[0].skin == full && rec.skins[0].level_count == 2);
+	mlod_record_free(&rec);
+
+	/* The other order, and labels again: nothing is lost. */
+	CHECK_OK(mlod_record_write_mesh_levels(doc, mesh, 1, &terr));
+	CHECK_OK(mlod_record_write_joints(doc, &c, info, &terr));
+	CHECK_OK(mlod_record_read(doc, &rec, &terr));
+	CHECK(rec.mesh_level_count == 1 && rec.skel_level_count == 2);
+	mlod_record_free(&rec);
+	CHECK_OK(mlod_record_read_joints(doc, &c, back, &found, &terr));
+	CHECK(found == 1);
+
+	/* A split file's one level sits beside the rest. */
+	CHECK_OK(mlod_record_write_mesh_split(doc, &mesh[1], &terr));
+	CHECK_OK(mlod_record_read(doc, &rec, &terr));
+	CHECK(rec.has_mesh_level && rec.mesh_level.level == 2 && rec.skel_level_count == 2);
+	mlod_record_free(&rec);
+
+	free(info);
+	free(back);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+}
+
+TEST(motion_and_node_records)
+{
+	mlod_gltf *doc = NULL;
+	mlod_character c = {0};
+	CHECK(load("samples/tubeman.glb", &doc, &c) == 0);
+	CHECK(mlod_gltf_count(doc, MLOD_GLTF_ANIMATION) >= 1);
+	mlod_record_motion_level m = {0}, back;
+	m.level = 2;
+	m.source_animation = 0;
+	m.method = MLOD_MOTION_KEYS;
+	m.threshold = 0.01;
+	m.has_bound = 1;
+	m.bound = 0.02;
+	m.keys = 1000;
+	m.source_keys = 5000;
+	m.bytes = 12345;
+	m.joint_error = (mlod_deviation){.max = 0.019, .mean = 0.004};
+	m.joint_error_max_percent_height = 0.9;
+	m.point_error = 0.0195;
+	m.grid = 0.001;
+	m.subdivide = 2;
+	m.has_morph_weights = 1;
+	m.morph_weights = (mlod_record_morph_weights){2, 30, 90, 360, 0.02, 0.015, 1};
+	int found = 0;
+	CHECK_OK(mlod_record_read_motion(doc, 0, &back, &found, &terr));
+	CHECK(found == 0);
+	CHECK_OK(mlod_record_write_motion(doc, 0, &m, &terr));
+	CHECK_OK(mlod_record_read_motion(doc, 0, &back, &found, &terr));
+	CHECK(found == 1);
+	CHECK(back.level == 2 && back.method == MLOD_MOTION_KEYS && back.has_bound && back.keys == 1000);
+	CHECK(back.source_keys == 5000 && back.bytes == 12345 && back.subdivide == 2 && !back.has_vertex_error);
+	CHECK_NEAR(back.joint_error.max, 0.019, 0);
+	CHECK(back.has_morph_weights && back.morph_weights.channels == 2 && back.morph_weights.copied == 1);
+	mlod_record rec;
+	CHECK_OK(mlod_record_read(doc, &rec, &terr));
+	CHECK(rec.version == MLOD_RECORD_VERSION);
+	mlod_record_free(&rec);
+
+	/* A level node's record. */
+	mlod_record_mesh_node node;
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_NODE, 1, "mlod",
+	                             "{\"mesh_level\":1,\"ratio\":0.5,\"error_percent\":{\"mean\":0.1,\"max\":1},"
+	                             "\"skeleton_level\":true}",
+	                             &terr));
+	CHECK_OK(mlod_record_read_mesh_node(doc, 1, &node, &found, &terr));
+	CHECK(found && node.level == 1 && node.skeleton_level);
+	CHECK_NEAR(node.error.max, 1.0, 0);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+}
+
+/* Sets the scene's record to text and reads it: the result, and the
+ * message in err. */
+static mlod_result read_scene(mlod_gltf *doc, const char *text, mlod_error *err)
+{
+	mlod_record rec;
+	memset(err, 0, sizeof *err);
+	if (mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", text, err) != MLOD_OK)
+		return MLOD_ERR_INVALID_ARG;
+	mlod_result r = mlod_record_read(doc, &rec, err);
+	if (r == MLOD_OK)
+		mlod_record_free(&rec);
+	return r;
+}
+
+TEST(old_new_and_malformed)
+{
+	mlod_gltf *doc = NULL;
+	mlod_character c = {0};
+	mlod_error e;
+	CHECK(load("samples/tubeman.glb", &doc, &c) == 0);
+	/* Without a version: what mlod wrote before it had one (version 1). */
+	CHECK(read_scene(doc,
+	                 "{\"skeleton_levels\":[{\"level\":1,\"threshold\":0.5,\"joints\":3,\"kept\":[0,1,2],"
+	                 "\"remap\":{\"3\":2},\"skins\":[0],\"joint_error\":{\"max\":0.1,\"mean\":0.01}}]}",
+	                 &e) == MLOD_OK);
+	CHECK(read_scene(doc, "{\"version\":1}", &e) == MLOD_OK);
+	CHECK(read_scene(doc, "{\"version\":2}", &e) == MLOD_ERR_UNSUPPORTED);
+	CHECK_MSG(strstr(e.message, "version 2") && strstr(e.message, "up to version 1"), "%s", e.message);
+	static const struct {
+		const char *text, *says;
+	} bad[] = {
+		{"[1]", "the scene's extras.mlod: not an object"},
+		{"{\"version\":\"1\"}", "extras.mlod.version: not a number"},
+		{"{\"version\":1.5}", "extras.mlod.version: not a whole number"},
+		{"{\"skeleton_levels\":{}}", "extras.mlod.skeleton_levels: not an array"},
+		{"{\"skeleton_levels\":[{\"level\":1}]}", "skeleton_levels[0].threshold: missing"},
+		{"{\"skeleton_levels\":[{\"level\":1,\"threshold\":0,\"joints\":1,\"kept\":[99999],\"skins\":[0],"
+		 "\"joint_error\":{\"max\":0,\"mean\":0},\"remap\":{}}]}",
+		 "skeleton_levels[0].kept: holds something other than an index in range"},
+		{"{\"skeleton_levels\":[{\"level\":1,\"threshold\":0,\"joints\":1,\"kept\":[0],\"skins\":[0],"
+		 "\"joint_error\":{\"max\":0,\"mean\":0},\"remap\":{\"x\":1}}]}",
+		 "skeleton_levels[0].remap: holds something other than node -> node"},
+		{"{\"skeleton_levels\":[{\"level\":1,\"threshold\":0,\"joints\":1,\"kept\":[0],\"skins\":[5],"
+		 "\"joint_error\":{\"max\":0,\"mean\":0},\"remap\":{}}]}",
+		 "skeleton_levels[0].skins: holds something"},
+		{"{\"mesh_levels\":[{\"level\":1,\"ratio\":0.5,\"triangles\":-1,\"vertices\":3,\"error_percent\":{}}]}",
+		 "mesh_levels[0].triangles: not a whole number in range"},
+		{"{\"mesh_levels\":[{\"level\":1,\"ratio\":0.5,\"triangles\":1,\"vertices\":3,\"error_percent\":{}}]}",
+		 "mesh_levels[0].error_percent.max: missing"},
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+		mlod_result r = read_scene(doc, bad[i].text, &e);
+		CHECK_MSG(r == MLOD_ERR_PARSE, "%s: result %d", bad[i].text, (int)r);
+		CHECK_MSG(strstr(e.message, bad[i].says), "%s: says \"%s\"", bad[i].text, e.message);
+	}
+	/* A writer does not add to a record that is not an object. */
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", "\"text\"", &terr));
+	mlod_record_mesh_level m = {1, 0.5, 1, 3, {0, 0, 0}, 0};
+	CHECK(mlod_record_write_mesh_levels(doc, &m, 1, &e) == MLOD_ERR_UNSUPPORTED);
+	CHECK_MSG(strstr(e.message, "not a JSON object"), "%s", e.message);
+
+	/* Labels: a malformed one is an error naming its node. */
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", "{}", &terr));
+	mlod_joint_info *info = calloc((size_t)c.skeleton.joint_count, sizeof *info);
+	int found;
+	CHECK_OK(mlod_label_skeleton(&c, NULL, info, &terr));
+	CHECK_OK(mlod_record_write_joints(doc, &c, info, &terr));
+	int node = c.skeleton.joints[0].node;
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_NODE, node, "mlod", "{\"label\":\"chief\",\"depth\":0,\"energy\":1}",
+	                             &terr));
+	CHECK(mlod_record_read_joints(doc, &c, info, &found, &e) == MLOD_ERR_PARSE);
+	char want[64];
+	snprintf(want, sizeof want, "node %d: extras.mlod.label: not a joint label", node);
+	CHECK_MSG(strstr(e.message, want), "%s", e.message);
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_NODE, node, "mlod", "{\"label\":\"root\",\"depth\":0,\"energy\":-1}",
+	                             &terr));
+	CHECK(mlod_record_read_joints(doc, &c, info, &found, &e) == MLOD_ERR_PARSE);
+	CHECK_MSG(strstr(e.message, "energy: negative"), "%s", e.message);
+	free(info);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+}
+
+int main(void)
+{
+	RUN(json_strict);
+	RUN(json_depth_and_roundtrip);
+	RUN(json_hostile);
+	RUN(stages_merge_and_version);
+	RUN(motion_and_node_records);
+	RUN(old_new_and_malformed);
+	TEST_EXIT();
+}
