@@ -9,7 +9,7 @@
  *   core/mlod_core.h          results, errors, math (shared with the runtime)
  *   model/mlod_model.h        the character model, pose, skinning
  *   io/mlod_io.h              glTF (C shim over tinygltf), BVH, format detection
- *   measure/mlod_measure.h    surface, posed, vertex and joint deviation
+ *   measure/mlod_measure.h    surface, posed, vertex and joint deviation, bound search
  *   skeleton/mlod_skeleton.h  labels, energy, MSG, skeleton levels (4.1)
  *   mesh/mlod_mesh.h          BindGraphMesh, collapses, Power Skinning (4.2)
  *   motion/mlod_motion.h      motion tree, key reduction, weight tracks (4.3)

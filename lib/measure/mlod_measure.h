@@ -1,7 +1,9 @@
 /*
  * mlod_measure.h: measurement: surface deviation between posed meshes, posed error
  * of a level over a pose set, and skinned-vertex and joint deviation of a
- * level against the full character over its clips.
+ * level against the full character over its clips; the search for levels
+ * within an error bound and the screen coverage an error allows, which the
+ * skeleton and mesh layers share.
  */
 #ifndef MLOD_MEASURE_H
 #define MLOD_MEASURE_H

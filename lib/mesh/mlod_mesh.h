@@ -1,6 +1,9 @@
 /*
  * mlod_mesh.h: the mesh layer (paper 4.2): the BindGraphMesh, triangle and edge
- * collapses, Power Skinning, progressive levels.
+ * collapses, Power Skinning, progressive levels, and the level policy of
+ * mlod-bgm: levels by ratio or down to an error bound, following the
+ * skeleton levels, written under MSFT_lod or one document per level. The
+ * stage record they leave is lib/record's.
  */
 #ifndef MLOD_MESH_H
 #define MLOD_MESH_H

@@ -1,7 +1,9 @@
 /*
  * mlod_skeleton.h: the skeleton layer (paper 4.1): joint labels and energy, the
  * Multiresolution Skeletal Graph, nested skeleton levels with folded motion
- * and transferred weights, and their glTF output.
+ * and transferred weights, their glTF output, and the level policy of
+ * mlod-skelgraph (default levels within an error bound, levels by threshold
+ * or joint fraction). The stage record they leave is lib/record's.
  */
 #ifndef MLOD_SKELETON_H
 #define MLOD_SKELETON_H
