@@ -29,10 +29,9 @@
 #include "bench.h"
 #include "mlod.h"
 
-#define DEG40 0.69813170f
 #define RUNS 5
 
-static const double ratios[3] = {0.5, 0.25, 0.1};
+static const double ratios[3] = {MLOD_MESH_RATIOS_DEFAULT};
 
 static const char *base_name(const char *path)
 {
@@ -80,7 +79,7 @@ static void train_poses(const mlod_character *c, mlod_pose_set *out)
 {
 	int clips = c->clip_count > 0 ? c->clip_count : 1, per = 24 / clips;
 	per = per < 2 ? 2 : per > 8 ? 8 : per;
-	mlod_pose_set_make(c, 0, per, 8, 1, DEG40, out, NULL);
+	mlod_pose_set_make(c, 0, per, MLOD_MESH_RANDOM_POSES, MLOD_MESH_TRAIN_SEED, MLOD_MESH_RANDOM_ANGLE, out, NULL);
 }
 
 /* ---------------------------------------------------------------- */
@@ -426,7 +425,7 @@ static void quality(int argc, char **argv)
 	int nm = (int)(sizeof methods / sizeof *methods);
 	mlod_pose_set clip = {0}, random = {0};
 	mlod_pose_set_make(&c, 0, 16, 0, 0, 0.0f, &clip, NULL);
-	mlod_pose_set_make(&c, 0, 0, 8, 2008, DEG40, &random, NULL);
+	mlod_pose_set_make(&c, 0, 0, MLOD_MESH_RANDOM_POSES, MLOD_MESH_MEASURE_SEED, MLOD_MESH_RANDOM_ANGLE, &random, NULL);
 	int T = character_triangles(&c);
 	/* results[method][pose set][level] */
 	mlod_deviation res[16][2][3];

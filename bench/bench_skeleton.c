@@ -47,7 +47,7 @@ static int build_levels(const mlod_character *c, mlod_joint_info *info, mlod_ske
 	if (mlod_label_skeleton(c, NULL, info, &err) != MLOD_OK ||
 	    mlod_skelgraph_build(&c->skeleton, info, g, &err) != MLOD_OK)
 		return -1;
-	static const double fractions[] = {0.13, 0.26, 0.39};
+	static const double fractions[] = {MLOD_SKEL_REMOVED_DEFAULT};
 	int *order = malloc(sizeof(int) * (size_t)n);
 	int minors = mlod_skel_removal_order(&c->skeleton, info, order);
 	for (int k = 0; k < 3; k++) {
@@ -83,8 +83,9 @@ static int bench_graph(int argc, char **argv)
 			int *order = malloc(sizeof(int) * (size_t)n);
 			int minors = mlod_skel_removal_order(&c.skeleton, info, order);
 			mlod_skelgraph_build(&c.skeleton, info, &g, &err);
+			static const double removal[] = {MLOD_SKEL_REMOVED_DEFAULT};
 			for (int k = 0; k < 3; k++) {
-				int removed = (int)lround(0.13 * (k + 1) * n);
+				int removed = (int)lround(removal[k] * n);
 				mlod_skelgraph_extract_first(&g, info, order, removed < minors ? removed : minors, &levels[k], &err);
 			}
 			double t2 = bench_now();

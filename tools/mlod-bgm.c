@@ -235,6 +235,7 @@ int main(int argc, char **argv)
 	static const char *const budgets[] = {"character", "primitive"};
 	static const char *const placements[] = {"barycenter", "optimal"};
 	static const char *const rules[] = {"literal", "bend", "all"};
+	static const double defaults[] = {MLOD_MESH_RATIOS_DEFAULT};
 	const char *output = NULL, *split = NULL;
 	enum tool_report report = REPORT_NONE;
 	double ratios[MLOD_MESH_MAX_LEVELS], max_error = -1.0;
@@ -264,7 +265,13 @@ int main(int argc, char **argv)
 		case 't': opt.tau = tool_parse_double("--tau", optarg, 1e-6, 1e6); break;
 		case 'b': opt.allow_border = 1; break;
 		case 's': split = optarg; break;
-		case 'h': printf(usage_text, MLOD_MESH_RATIOS_DEFAULT); return 0;
+		case 'h': {
+			char list[64] = "";
+			for (size_t i = 0, n = 0; i < sizeof defaults / sizeof *defaults; i++)
+				n += (size_t)snprintf(list + n, sizeof list - n, "%s%g", i ? "," : "", defaults[i]);
+			printf(usage_text, list);
+			return 0;
+		}
 		case 'V': tool_version();
 		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
 		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
@@ -282,7 +289,8 @@ int main(int argc, char **argv)
 		tool_usage_error("--budget character needs --cost posed: compactness costs do not compare across primitives");
 	mlod_mesh_resolve(&opt, &budget);
 	if (!ratio_count)
-		ratio_count = tool_parse_list("--ratios", MLOD_MESH_RATIOS_DEFAULT, ratios, MLOD_MESH_MAX_LEVELS, 1e-6, 1.0);
+		for (size_t i = 0; i < sizeof defaults / sizeof *defaults; i++)
+			ratios[ratio_count++] = defaults[i];
 	qsort(ratios, (size_t)ratio_count, sizeof *ratios, double_desc);
 
 	mlod_gltf *doc = NULL;
