@@ -315,12 +315,11 @@ int main(int argc, char **argv)
 		}
 	} else {
 		mlod_record rec;
-		mlod_mesh_skeleton sk[MLOD_SKEL_MAX_LEVELS];
 		if ((r = mlod_record_read(doc, &rec, &err)) != MLOD_OK)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
-		if (rec.skel_level_count > MLOD_SKEL_MAX_LEVELS)
-			tool_die(EXIT_INPUT, job.input, "the scene's extras.mlod lists %d skeleton levels (at most %d)",
-			         rec.skel_level_count, MLOD_SKEL_MAX_LEVELS);
+		mlod_mesh_skeleton *sk = calloc((size_t)rec.skel_level_count + 1, sizeof *sk);
+		if (!sk)
+			tool_die(EXIT_INPUT, job.input, "out of memory");
 		r = mlod_mesh_levels_init(&job.L, &job.c, &opt, budget, max_error >= 0.0 ? 0.0 : ratios[ratio_count - 1], &err);
 		if (r == MLOD_OK)
 			r = max_error >= 0.0 ? mlod_mesh_levels_by_error(&job.L, max_error, &err)
@@ -339,6 +338,7 @@ int main(int argc, char **argv)
 		else
 			write_glb(&job, doc, output);
 		mlod_record_free(&rec);
+		free(sk);
 	}
 	if (fflush(stdout) != 0)
 		tool_die(EXIT_OUTPUT, "<stdout>", "write error");

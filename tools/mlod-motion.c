@@ -509,31 +509,32 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 			int index;
 			if (mlod_gltf_add_animation(doc, &job->c.skeleton, &lv->l.clip, &index, &err) != MLOD_OK)
 				tool_die(EXIT_OUTPUT, NULL, "clip \"%s\": %s", base, err.message);
-			char json[2048];
-			int n = snprintf(json, sizeof json,
-			                 "{\"motion_level\": %d, \"source_animation\": %d, \"method\": \"%s\", \"threshold\": %.9g, ",
-			                 i + 1, src->gltf_index >= 0 ? src->gltf_index : cl->index, method_name(lv->l.method),
-			                 lv->l.threshold);
-			if (lv->bound >= 0.0)
-				n += snprintf(json + n, sizeof json - (size_t)n, "\"bound\": %.9g, ", lv->bound);
-			n += snprintf(json + n, sizeof json - (size_t)n,
-			              "\"keys\": %ld, \"source_keys\": %ld, \"bytes\": %ld, \"joint_error\": {\"max\": %.9g, "
-			              "\"mean\": %.9g, \"max_percent_height\": %.9g}, \"point_error\": %.9g, \"grid\": %.9g, "
-			              "\"subdivide\": %d",
-			              lv->l.keys + lv->w_keys, cl->keys, lv->l.bytes + lv->w_bytes, lv->l.error.max, lv->l.error.mean,
-			              100.0 * lv->l.error.max / job->height, lv->l.point_error, lv->l.grid, subdivide(job));
-			if (lv->has_vertex)
-				n += snprintf(json + n, sizeof json - (size_t)n, ", \"vertex_error_percent_diagonal\": %.9g",
-				              lv->vertex.max);
+			/* The level's stage record (mlod-record(5)). */
+			mlod_record_motion_level rec = {0};
+			rec.level = i + 1;
+			rec.source_animation = src->gltf_index >= 0 ? src->gltf_index : cl->index;
+			rec.method = lv->l.method;
+			rec.threshold = lv->l.threshold;
+			rec.has_bound = lv->bound >= 0.0;
+			rec.bound = lv->bound;
+			rec.keys = lv->l.keys + lv->w_keys;
+			rec.source_keys = cl->keys;
+			rec.bytes = lv->l.bytes + lv->w_bytes;
+			rec.joint_error = lv->l.error;
+			rec.joint_error_max_percent_height = 100.0 * lv->l.error.max / job->height;
+			rec.point_error = lv->l.point_error;
+			rec.grid = lv->l.grid;
+			rec.subdivide = subdivide(job);
+			rec.has_vertex_error = lv->has_vertex;
+			rec.vertex_error_percent_diagonal = lv->vertex.max;
 			if (lv->w_count) {
-				char w[512];
-				weights_json(w, sizeof w, cl, lv);
-				n += snprintf(json + n, sizeof json - (size_t)n, ", \"morph_weights\": %s", w);
+				rec.has_morph_weights = 1;
+				rec.morph_weights = (mlod_record_morph_weights){lv->w_count, lv->w_keys, cl->w_keys, lv->w_bytes,
+				                                                lv->w_bound, lv->w_error, lv->w_copied};
 				if (mlod_gltf_add_weight_tracks(doc, index, lv->w, lv->w_count, &err) != MLOD_OK)
 					tool_die(EXIT_OUTPUT, NULL, "clip \"%s\": %s", base, err.message);
 			}
-			snprintf(json + n, sizeof json - (size_t)n, "}");
-			if (mlod_gltf_set_extra(doc, MLOD_GLTF_ANIMATION, index, "mlod", json, &err) != MLOD_OK)
+			if (mlod_record_write_motion(doc, index, &rec, &err) != MLOD_OK)
 				tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
 		}
 	}
