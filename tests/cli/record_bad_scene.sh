@@ -1,16 +1,5 @@
 # A malformed stage record on the scene is an error naming the key (exit 2),
-# not silently ignored; mlod-skelgraph and mlod-bgm both read it.
-node - "$ROOT/samples/tubeman.glb" bad.glb <<'JS'
-const fs = require('fs');
-const [src, dst] = process.argv.slice(2);
-const b = fs.readFileSync(src), jl = b.readUInt32LE(12);
-const j = JSON.parse(b.subarray(20, 20 + jl).toString());
-j.scenes[0].extras = { mlod: { skeleton_levels: 'three' } };
-let text = Buffer.from(JSON.stringify(j));
-text = Buffer.concat([text, Buffer.alloc((4 - text.length % 4) % 4, 0x20)]);
-const bin = b.subarray(20 + jl), head = Buffer.alloc(20);
-head.writeUInt32LE(0x46546c67, 0); head.writeUInt32LE(2, 4); head.writeUInt32LE(20 + text.length + bin.length, 8);
-head.writeUInt32LE(text.length, 12); head.writeUInt32LE(0x4e4f534a, 16);
-fs.writeFileSync(dst, Buffer.concat([head, text, bin]));
-JS
+# not silently ignored.
+node "$ROOT/tests/glb-edit.mjs" "$ROOT/samples/tubeman.glb" bad.glb \
+	'j.scenes[0].extras = { mlod: { skeleton_levels: "three" } }'
 "$BIN/mlod-bgm" bad.glb > out.glb
