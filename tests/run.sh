@@ -1,16 +1,26 @@
 #!/bin/sh
-# tests/run.sh: runs mlod's whole test suite and ends with "N passed, N failed".
+# tests/run.sh: runs mlod's whole test suite and ends with the line
+# "N passed, N failed, N skipped".
 #
 #   tests/run.sh --build build/release [--sanitize-build build/sanitize] [--extended]
 #
 # Stages:
-#   unit       every build/<config>/tests/test_* program (one PASS/FAIL line
-#              per test); every tests/unit/test_*.c must be built
+#   unit       every build/<config>/tests/test_* program (one PASS/FAIL/SKIP
+#              line per test); every tests/unit/test_*.c must be built
 #   cli        tests/cli/NAME.sh, checked against NAME.exit and NAME.stderr
 #              or NAME.stderr.re (below)
 #   validate   glb written by the tools, checked by the Khronos glTF validator
 #   sanitize   the unit tests again, built with ASan and UBSan
-# --extended also feeds ../shared/data (when present) to every stage.
+# --extended also feeds ../shared/data (when present) to every stage: its
+# absolute path is exported as MLOD_SHARED_DATA. A MLOD_SHARED_DATA already
+# set names another directory instead (relative to the repository root); a
+# missing one counts as absent (MLOD_SHARED_DATA=/nonexistent shows the SKIPs).
+#
+# SKIP: a test that needs ../shared/data and does not have it says so
+# instead of passing. A unit test prints "SKIP name: reason" (NEED_SHARED()
+# in tests/unit/test.h); a CLI script exits 77 (as automake's tests do) with
+# the reason as the last line of its stderr. Skipping is only for absent
+# data: a SKIP while MLOD_SHARED_DATA is set counts as a failure.
 #
 # CLI expectations: NAME.exit holds the expected exit code (0 without it).
 # NAME.stderr is the exact stderr expected. NAME.stderr.re holds one
@@ -36,9 +46,16 @@ done
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root" || exit 1
 export LC_ALL=C
-if [ $extended = 1 ] && [ -d ../shared/data ]; then
-	MLOD_SHARED_DATA=$(cd ../shared/data && pwd)
-	export MLOD_SHARED_DATA
+if [ $extended = 1 ]; then
+	shared=${MLOD_SHARED_DATA:-../shared/data}
+	if [ -d "$shared" ]; then
+		MLOD_SHARED_DATA=$(cd "$shared" && pwd)
+		export MLOD_SHARED_DATA
+		echo "== shared data: $MLOD_SHARED_DATA"
+	else
+		echo "== shared data: $shared is absent: the tests that need it SKIP"
+		unset MLOD_SHARED_DATA
+	fi
 else
 	unset MLOD_SHARED_DATA
 fi
@@ -50,11 +67,26 @@ trap 'exit 130' INT
 trap 'exit 143' TERM
 passed=0
 failed=0
+skipped=0
 failures=
+skips=
 
 pass() { passed=$((passed + 1)); echo "PASS $1"; }
 fail() { failed=$((failed + 1)); failures="$failures
   $1"; echo "FAIL $1${2:+: $2}"; }
+# A test that could not run: only for absent ../shared/data, with a reason.
+skip() {
+	if [ -z "$2" ]; then
+		fail "$1" "skipped without a reason"
+	elif [ -n "${MLOD_SHARED_DATA:-}" ]; then
+		fail "$1" "skipped, but ../shared/data is present ($MLOD_SHARED_DATA): $2"
+	else
+		skipped=$((skipped + 1))
+		skips="$skips
+  $1: $2"
+		echo "SKIP $1: $2"
+	fi
+}
 
 # Checks stderr ($2) line by line against the whole-line extended regular
 # expressions of $1; prints the first mismatch.
@@ -72,7 +104,7 @@ stderr_matches() {
 	}' "$1" "$2"
 }
 
-# Runs the unit test programs in dir; counts their PASS/FAIL lines.
+# Runs the unit test programs in dir; counts their PASS/FAIL/SKIP lines.
 run_unit() {
 	stage=$1 dir=$2
 	# A test program that was not built must not go unnoticed.
@@ -86,11 +118,13 @@ run_unit() {
 		name=$(basename "$t")
 		out=$("$t" 2>"$work/stderr"; echo "rc=$?")
 		rc=${out##*rc=}
-		echo "$out" | grep -E '^(PASS|FAIL) ' > "$work/lines"
+		echo "$out" | grep -E '^(PASS|FAIL|SKIP) ' > "$work/lines"
 		while IFS= read -r line; do
 			case $line in
 			PASS\ *) pass "$stage/$name/${line#PASS }" ;;
 			FAIL\ *) l=${line#FAIL }; fail "$stage/$name/${l%%:*}" "${l#*: }" ;;
+			SKIP\ *:\ *) l=${line#SKIP }; skip "$stage/$name/${l%%:*}" "${l#*: }" ;;
+			SKIP\ *) skip "$stage/$name/${line#SKIP }" "" ;;
 			esac
 		done < "$work/lines"
 		if [ "$rc" != 0 ] && ! grep -q '^FAIL ' "$work/lines"; then
@@ -98,7 +132,7 @@ run_unit() {
 		elif [ "$rc" = 0 ] && grep -q '^FAIL ' "$work/lines"; then
 			fail "$stage/$name" "reported FAIL but exited 0"
 		elif [ "$rc" = 0 ] && [ ! -s "$work/lines" ]; then
-			fail "$stage/$name" "exited 0 without a PASS or FAIL line"
+			fail "$stage/$name" "exited 0 without a PASS, FAIL or SKIP line"
 		fi
 	done
 }
@@ -120,7 +154,9 @@ for t in tests/cli/*.sh; do
 	mkdir -p "$out"
 	( cd "$out" && ROOT=$root sh "$root/$t" ) > "$out/.stdout" 2> "$out/.stderr" < /dev/null
 	rc=$?
-	if [ "$rc" != "$expect_rc" ]; then
+	if [ "$rc" = 77 ] && [ "$expect_rc" != 77 ]; then
+		skip "cli/$name" "$(tail -n 1 "$out/.stderr")"
+	elif [ "$rc" != "$expect_rc" ]; then
 		fail "cli/$name" "exit $rc, expected $expect_rc; stderr: $(head -c 400 "$out/.stderr")"
 	elif [ -f "$exp.stderr" ] && [ -f "$exp.stderr.re" ]; then
 		fail "cli/$name" "both $name.stderr and $name.stderr.re: keep one"
@@ -237,8 +273,11 @@ if [ -n "$san" ]; then
 	run_unit sanitize "$san"
 fi
 
+if [ $skipped -gt 0 ]; then
+	printf '\nSkipped:%s\n' "$skips"
+fi
 if [ $failed -gt 0 ]; then
 	printf '\nFailures:%s\n' "$failures"
 fi
-echo "$passed passed, $failed failed"
+echo "$passed passed, $failed failed, $skipped skipped"
 [ $failed = 0 ]
