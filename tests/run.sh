@@ -11,10 +11,11 @@
 #              or NAME.stderr.re (below)
 #   validate   glb written by the tools, checked by the Khronos glTF validator
 #   sanitize   the unit tests again, built with ASan and UBSan
-# --extended also feeds ../shared/data (when present) to every stage: its
-# absolute path is exported as MLOD_SHARED_DATA. A MLOD_SHARED_DATA already
-# set names another directory instead (relative to the repository root); a
-# missing one counts as absent (MLOD_SHARED_DATA=/nonexistent shows the SKIPs).
+# The unit tests that need ../shared/data get it whenever it is present;
+# --extended also feeds it to every CLI stage. Its absolute path is exported
+# as MLOD_SHARED_DATA. A MLOD_SHARED_DATA already set names another directory
+# instead (relative to the repository root); a missing one counts as absent
+# (MLOD_SHARED_DATA=/nonexistent shows the SKIPs).
 #
 # SKIP: a test that needs ../shared/data and does not have it says so
 # instead of passing. A unit test prints "SKIP name: reason" (NEED_SHARED()
@@ -46,17 +47,16 @@ done
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root" || exit 1
 export LC_ALL=C
-if [ $extended = 1 ]; then
-	shared=${MLOD_SHARED_DATA:-../shared/data}
-	if [ -d "$shared" ]; then
-		MLOD_SHARED_DATA=$(cd "$shared" && pwd)
-		export MLOD_SHARED_DATA
-		echo "== shared data: $MLOD_SHARED_DATA"
-	else
-		echo "== shared data: $shared is absent: the tests that need it SKIP"
-		unset MLOD_SHARED_DATA
-	fi
+# The unit tests that need ../shared/data run whenever it is present (and
+# SKIP, with the reason, where it is absent); --extended also feeds it to
+# every CLI stage.
+shared=${MLOD_SHARED_DATA:-../shared/data}
+if [ -d "$shared" ]; then
+	MLOD_SHARED_DATA=$(cd "$shared" && pwd)
+	export MLOD_SHARED_DATA
+	echo "== shared data: $MLOD_SHARED_DATA"
 else
+	echo "== shared data: $shared is absent: the tests that need it SKIP"
 	unset MLOD_SHARED_DATA
 fi
 
@@ -193,7 +193,7 @@ validator="node tests/validate.mjs"
 # The tools whose default output is a glb.
 glb_tools="mlod-label mlod-skelgraph mlod-bgm mlod-motion"
 inputs="samples/*.glb samples/*.bvh"
-[ -n "${MLOD_SHARED_DATA:-}" ] && inputs="$inputs $MLOD_SHARED_DATA/*.glb $MLOD_SHARED_DATA/*.bvh"
+[ $extended = 1 ] && [ -n "${MLOD_SHARED_DATA:-}" ] && inputs="$inputs $MLOD_SHARED_DATA/*.glb $MLOD_SHARED_DATA/*.bvh"
 if [ ! -d tests/node/node_modules/gltf-validator ]; then
 	fail "validate" "gltf-validator is not installed (run scripts/install-deps)"
 else
