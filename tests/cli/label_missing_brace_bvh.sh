@@ -1,1 +1,1 @@
-"$BIN/mlod-label" "$ROOT/tests/data/bad/missing_brace.bvh"
+cd "$ROOT" && "$BIN/mlod-label" tests/data/bad/missing_brace.bvh

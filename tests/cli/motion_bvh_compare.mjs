@@ -15,6 +15,7 @@ function parse(path) {
 	let i = 0;
 	const joints = [], stack = [];
 	while (tok[i] !== 'MOTION') {
+		if (i >= tok.length) throw new Error(`${path}: no MOTION section`);
 		const t = tok[i++];
 		if (t === 'ROOT' || t === 'JOINT') {
 			const parent = stack.length ? stack[stack.length - 1] : -1;

@@ -1,1 +1,1 @@
-"$BIN/mlod-skelgraph" --report "$ROOT/tests/data/bad/missing_target.gltf"
+cd "$ROOT" && "$BIN/mlod-skelgraph" --report tests/data/bad/missing_target.gltf

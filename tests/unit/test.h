@@ -3,8 +3,11 @@
  *
  * Each tests/unit/test_*.c is one program. It defines test functions with
  * TEST(name) and runs them from main with RUN(name). Each test prints one
- * line, "PASS name" or "FAIL name: file:line: what", which tests/run.sh
- * counts. A failing CHECK stops only its own test.
+ * line, "PASS name", "FAIL name: file:line: what" or "SKIP name: why",
+ * which tests/run.sh counts. A failing CHECK stops only its own test.
+ * A test that needs ../shared/data starts with NEED_SHARED(): without the
+ * data it is reported as SKIP with the reason, not as PASS (tests/run.sh
+ * counts a SKIP as a failure when the data is there).
  *
  * Tests that need sample files find them through test_path("samples/x"),
  * relative to the repository root (the runner's working directory).
@@ -20,10 +23,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "mlod.h"
 
 static int test_failed_;
+static int test_skipped_;
 static char test_msg_[1024];
 static int test_total_fail_;
 
@@ -32,10 +37,13 @@ static int test_total_fail_;
 #define RUN(name)                                                              \
 	do {                                                                   \
 		test_failed_ = 0;                                              \
+		test_skipped_ = 0;                                             \
 		test_##name();                                                 \
 		if (test_failed_) {                                            \
 			printf("FAIL %s: %s\n", #name, test_msg_);             \
 			test_total_fail_++;                                    \
+		} else if (test_skipped_) {                                    \
+			printf("SKIP %s: %s\n", #name, test_msg_);             \
 		} else {                                                       \
 			printf("PASS %s\n", #name);                            \
 		}                                                              \
@@ -98,12 +106,42 @@ static inline void *test_read_file(const char *path, size_t *size)
 	return buf;
 }
 
-/* Is the development data in ../shared/data present (make test-extended)? */
-static inline int test_have_shared(void)
+/* Ends the current test as SKIP with a reason (printf-like): it could not
+ * run. Only for absent ../shared/data (see NEED_SHARED). */
+#define SKIP(...)                                                              \
+	do {                                                                   \
+		snprintf(test_msg_, sizeof test_msg_, __VA_ARGS__);            \
+		test_skipped_ = 1;                                             \
+		return;                                                        \
+	} while (0)
+
+/* The development data in ../shared/data, as tests/run.sh --extended
+ * (make test-extended) names it in MLOD_SHARED_DATA: its directory, or
+ * NULL when it is absent, with the reason in why. */
+static inline const char *test_shared_dir(char *why, size_t size)
 {
 	const char *e = getenv("MLOD_SHARED_DATA");
-	return e && *e;
+	struct stat st;
+	if (!e || !*e) {
+		snprintf(why, size, "needs ../shared/data: MLOD_SHARED_DATA is not set "
+		                    "(make test-extended sets it when ../shared/data exists)");
+		return NULL;
+	}
+	if (stat(e, &st) != 0 || !S_ISDIR(st.st_mode)) {
+		snprintf(why, size, "needs ../shared/data: MLOD_SHARED_DATA=%.900s is not a directory", e);
+		return NULL;
+	}
+	return e;
 }
+
+/* Skips the current test when ../shared/data is absent. */
+#define NEED_SHARED()                                                          \
+	do {                                                                   \
+		if (!test_shared_dir(test_msg_, sizeof test_msg_)) {          \
+			test_skipped_ = 1;                                     \
+			return;                                                \
+		}                                                              \
+	} while (0)
 
 
 /* A skeleton from a parent array (parents before children), joints named

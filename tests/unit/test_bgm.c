@@ -799,8 +799,7 @@ TEST(extreme_scales)
 TEST(shared_data)
 {
 	/* Ely (make test-extended): welds, simplifies and stays valid. */
-	if (!test_have_shared())
-		return;
+	NEED_SHARED();
 	char path[4096];
 	snprintf(path, sizeof path, "%s/Ely.glb", getenv("MLOD_SHARED_DATA"));
 	mlod_character c;

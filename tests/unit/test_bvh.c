@@ -807,8 +807,7 @@ static void round_trip_dir(const char *dir, int *count)
 
 TEST(round_trip_shared)
 {
-	if (!test_have_shared())
-		return;
+	NEED_SHARED();
 	int count = 0;
 	round_trip_dir(getenv("MLOD_SHARED_DATA"), &count);
 	if (test_failed_)

@@ -1246,8 +1246,7 @@ TEST(external_buffer)
 
 TEST(shared_data)
 {
-	if (!test_have_shared())
-		return;
+	NEED_SHARED();
 	const char *dir = getenv("MLOD_SHARED_DATA");
 	DIR *d = opendir(dir);
 	CHECK_MSG(d != NULL, "cannot open %s", dir);
