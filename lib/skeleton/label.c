@@ -28,7 +28,7 @@
 
 #include "skeleton/mlod_skeleton.h"
 
-#define DEFAULT_HUB_FACTOR 1.9
+#define DEFAULT_HUB_FACTOR MLOD_LABEL_HUB_FACTOR_DEFAULT
 #define ENERGY_RATE 30.0
 #define PI 3.14159265358979323846
 
