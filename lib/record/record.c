@@ -6,6 +6,7 @@
  * %.6g, counts as integers), so that records read and written again stay
  * the same to the digit.
  */
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -205,7 +206,6 @@ static void rd_at(struct rd *c, const char *fmt, ...)
 #endif
 	;
 
-#include <stdarg.h>
 static void rd_at(struct rd *c, const char *fmt, ...)
 {
 	va_list ap;
