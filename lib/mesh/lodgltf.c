@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "levels.h"
+#include "meshlevels.h"
 
 static mlod_result nomem(mlod_error *err)
 {

@@ -211,7 +211,7 @@ mlod_result mlod_primitive_remap_joints(mlod_primitive *p, const int *map, int m
 
 
 /* ------------------------------------------------------------------ */
-/* Mesh levels: the policy (levels.c) and their glTF output (lodgltf.c) */
+/* Mesh levels: the policy (meshlevels.c) and their glTF output (lodgltf.c) */
 /* ------------------------------------------------------------------ */
 
 /* The defaults of mlod-bgm: levels keeping these fractions of the

@@ -163,7 +163,7 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
                                       mlod_error *err);
 
 /* ------------------------------------------------------------------ */
-/* The skeleton level policy (levels.c)                                */
+/* The skeleton level policy (skellevels.c)                                */
 /* ------------------------------------------------------------------ */
 
 /* The defaults of mlod-skelgraph: levels removing these fractions of the

@@ -1,5 +1,5 @@
 /*
- * levels.c: the mesh level policy (mlod_mesh.h): the BGM of every triangle
+ * meshlevels.c: the mesh level policy (mlod_mesh.h): the BGM of every triangle
  * primitive of a character, levels by triangle ratio (each primitive's,
  * or the whole character's budget shared by posed cost) or down to a
  * posed error bound, each measured against the full character.
@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "levels.h"
+#include "meshlevels.h"
 
 /* One primitive of one instance. */
 struct mlod_mesh_part {

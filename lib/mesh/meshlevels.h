@@ -1,4 +1,4 @@
-/* levels.h: what levels.c shares with lodgltf.c (internal to lib/mesh). */
+/* meshlevels.h: what meshlevels.c shares with lodgltf.c (internal to lib/mesh). */
 #ifndef MLOD_MESH_LEVELS_H
 #define MLOD_MESH_LEVELS_H
 

@@ -1,5 +1,5 @@
 /*
- * levels.c: the skeleton level policy (mlod_skeleton.h): levels at given
+ * skellevels.c: the skeleton level policy (mlod_skeleton.h): levels at given
  * energy thresholds or joint fractions, and the default chain (13%, 26%
  * and 39% of the joints removed in the paper's order, within an error
  * bound, the last found by bisection), each level applied to the
