@@ -29,12 +29,13 @@ CFLAGS += -std=c11 $(WARN) $(CFLAGS_$(config))
 CXXFLAGS += -std=c++14 -Wall -Wextra $(CFLAGS_$(config))
 LDFLAGS_sanitize := -fsanitize=address,undefined
 LDFLAGS += $(LDFLAGS_$(config))
-LDLIBS := -ltinygltf -lstdc++ -lm
+# meshoptimizer's codecs: the pack writer's encoder and the runtime's decoder.
+LDLIBS := -ltinygltf -lmeshoptimizer -lstdc++ -lm
 
 B := build/$(config)
 BIN := $(B)/bin
 
-LIB_PARTS := core model io measure skeleton mesh motion record
+LIB_PARTS := core model io measure skeleton mesh motion record pack
 LIB_C := $(sort $(foreach p,$(LIB_PARTS),$(wildcard lib/$(p)/*.c)))
 LIB_CXX := $(sort $(foreach p,$(LIB_PARTS),$(wildcard lib/$(p)/*.cpp)))
 LIB_OBJ := $(LIB_C:%.c=$(B)/%.o) $(LIB_CXX:%.cpp=$(B)/%.o)
@@ -79,7 +80,7 @@ $(B)/lib/rt/%.o: lib/rt/%.c
 # libmlod. A bake-side symbol in the runtime fails this link.
 RT_TEST_SRC := $(sort $(wildcard tests/rt/*.c))
 RT_TESTS := $(RT_TEST_SRC:tests/rt/%.c=$(B)/tests/rt/%)
-RT_LDLIBS := -lm
+RT_LDLIBS := -lmeshoptimizer -lm
 $(B)/tests/rt/%: tests/rt/%.c $(B)/libmlodrt.a
 	@mkdir -p $(@D)
 	$(CC) $(RT_CPPFLAGS) $(CFLAGS) $(LDFLAGS) $^ $(RT_LDLIBS) -o $@
@@ -92,19 +93,19 @@ $(B)/%.o: %.cpp
 	@mkdir -p $(@D)
 	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@
 
-$(BIN)/%: $(B)/tools/%.o $(TOOL_COMMON_OBJ) $(B)/libmlod.a
+$(BIN)/%: $(B)/tools/%.o $(TOOL_COMMON_OBJ) $(B)/libmlod.a $(B)/libmlodrt.a
 	@mkdir -p $(@D)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
-$(B)/tests/%: $(B)/tests/unit/%.o $(B)/libmlod.a
+$(B)/tests/%: $(B)/tests/unit/%.o $(B)/libmlod.a $(B)/libmlodrt.a
 	@mkdir -p $(@D)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
-$(B)/tests/helpers/%: $(B)/tests/helpers/%.o $(B)/libmlod.a
+$(B)/tests/helpers/%: $(B)/tests/helpers/%.o $(B)/libmlod.a $(B)/libmlodrt.a
 	@mkdir -p $(@D)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
-$(B)/bench/%: $(B)/bench/%.o $(B)/libmlod.a
+$(B)/bench/%: $(B)/bench/%.o $(B)/libmlod.a $(B)/libmlodrt.a
 	@mkdir -p $(@D)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
@@ -159,7 +160,6 @@ $(B)/tests/test_openmesh: tests/openmesh/test_openmesh.cpp lib/mlod.h $(B)/libml
 	@mkdir -p $(@D)
 	@if [ -z "$(OPENMESH_INC)" ]; then echo "OpenMesh headers are missing: run scripts/install-deps" >&2; exit 1; fi
 	$(CXX) $(CPPFLAGS) -isystem $(OPENMESH_INC) $(CXXFLAGS) -Wno-maybe-uninitialized $< $(B)/libmlod.a $(OPENMESH_LIB) $(LDFLAGS) $(LDLIBS) -o $@
-$(B)/bench/bench_mesh: LDLIBS += -lmeshoptimizer
 # ----------------------------------------------------------------------
 
 -include $(shell find build -name '*.d' 2>/dev/null)

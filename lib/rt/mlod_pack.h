@@ -1,0 +1,435 @@
+/*
+ * mlod_pack.h: the .mlod pack format (mlod(5)) and its one reader.
+ *
+ * This header owns the format: every constant, every byte layout and the
+ * decoded view of each chunk. The bake side's writer (lib/pack) includes
+ * it to write what this reader reads; the runtime (mlod_rt.h), mlod-pack
+ * --info and -x read through it. It is C11, depends only on the core and
+ * meshoptimizer's decoder, and never prints or exits.
+ *
+ * ------------------------------------------------------------------
+ * File layout (format 1.0). Everything is little-endian.
+ *
+ *   header      32 bytes at offset 0
+ *   TOC         chunk_count entries of 48 bytes, right after the header
+ *   chunks      each starts on a 16-byte boundary (zero padding between),
+ *               in TOC order, coarse to fine (below)
+ *
+ * Header:
+ *   0  u8[4]  magic "MLOD"
+ *   4  u16    major version (MLOD_PACK_MAJOR); a reader refuses a newer one
+ *   6  u16    minor version; a newer minor only adds what older readers skip
+ *   8  u32    flags (0; a reader ignores bits it does not know)
+ *  12  u32    chunk_count (at most MLOD_PACK_MAX_CHUNKS)
+ *  16  u64    file_size: the whole file, header to the last chunk's end
+ *  24  u32    CRC32 of the TOC bytes
+ *  28  u32    CRC32 of header bytes 0..27
+ *
+ * TOC entry (48 bytes):
+ *   0  u32    type (MLOD_CHUNK_*); a reader skips types it does not know
+ *   4  u8     layer (MLOD_LAYER_*)
+ *   5  u8     codec (MLOD_CODEC_*): the codec of the chunk's streams
+ *   6  u16    level: 0 the finest (the input as read), larger is coarser
+ *   8  u16    item: the clip for MOTION chunks, else 0
+ *  10  u16    flags (0)
+ *  12  u32    reserved (0)
+ *  16  u64    offset of the chunk from the start of the file (16-aligned)
+ *  24  u32    stored size in bytes
+ *  28  u32    raw size: the chunk's size with every stream decoded
+ *  32  u32    CRC32 (IEEE 802.3, as zlib's crc32) of the stored bytes
+ *  36  f32    error: the level's measured error in scene units (0 for
+ *             level 0 and for chunks that are not levels)
+ *  40  f32    switch distance: the camera distance (scene units) from which
+ *             this level is fine enough, at MLOD_PACK_FOV_Y and
+ *             MLOD_PACK_LINES (the error projects to at most
+ *             MLOD_PACK_PIXELS pixels); 0 for level 0
+ *  44  u32    reserved (0)
+ *
+ * Chunk order: INFO, SKELETON, the skeleton levels coarsest first, then per
+ * level from the coarsest to the finest: that mesh level and that motion
+ * level of every clip; DOC last. A reader holding a prefix of the file has
+ * every chunk whose end lies inside it, and so the coarse levels first;
+ * mlod-pack --info says how many bytes the first drawable level needs.
+ *
+ * Chunk payload: a stream container.
+ *   u32 stream_count (at most MLOD_PACK_MAX_STREAMS)
+ *   stream_count stream headers of 16 bytes:
+ *     0 u32  tag (MLOD_STREAM_*, a fourcc)
+ *     4 u32  element count
+ *     8 u16  element size in bytes (1..256; a multiple of 4 for the meshopt
+ *            vertex codec, 2 or 4 for the index codec)
+ *    10 u8   stream codec (MLOD_SCODEC_*)
+ *    11 u8   reserved (0)
+ *    12 u32  stored byte size
+ *   then the streams' bytes in order, each padded with zeros to 4 bytes.
+ * A stream's decoded size is count * element size. raw size in the TOC is
+ * 4 + 16 * stream_count + the decoded sizes, each padded to 4.
+ *
+ * The chunk types and their streams, in this order:
+ *
+ * INFO (layer none, once): stream 'INFO', one element of
+ *   sizeof(mlod_pack_info_rec) bytes; stream 'NAME', the string table
+ *   (u8, NUL-separated, UTF-8): the character's and the clips' names.
+ *
+ * SKELETON (layer skeleton, level 0, once): the full skeleton.
+ *   'JNTS' joint records (mlod_pack_joint_rec), parents before children
+ *   'NAME' the string table of joint names
+ *   'SKIN' skin records (mlod_pack_skin_rec)
+ *   'SKJT' u32 per skin joint, all skins in order: joint indices
+ *   'IBMS' 16 f32 per skin joint: inverse bind matrices, column-major
+ *
+ * SKELETON level k >= 1: a nested level of the skeleton.
+ *   'KEPT' u32 per kept joint, increasing: the full skeleton's joints it
+ *          keeps (every root is kept). A kept joint's parent at this level
+ *          is its nearest kept ancestor; its local transform folds the
+ *          removed joints between them (mlod(5), SKELETON LEVELS).
+ *   'PALJ' u32 per skin joint (all skins in order, as 'SKJT'): the kept
+ *          joint (full index) whose world matrix a vertex weighted to that
+ *          skin joint follows at this level (the joint itself when kept,
+ *          else its stand-in, the nearest kept ancestor)
+ *   'PALB' 16 f32 per skin joint: the bind matrix to use with it (the
+ *          joint's own inverse bind when kept; else the stand-in's, or
+ *          R(stand-in -> joint) * IBM(joint) when the stand-in is not in
+ *          that skin), so that skinning with (PALJ, PALB) equals skinning
+ *          the level's transferred weights
+ *
+ * MESH level k (layer mesh; level 0 is the input's meshes): one part per
+ *   instance and triangle primitive, in instance then primitive order.
+ *   'PART' part records (mlod_pack_part_rec)
+ *   then per part, the streams its flags name, in this order:
+ *   'POSQ' u16[4] per vertex: position = min + q * scale (q[3] is 0)
+ *   'NRMQ' i16[2] per vertex: octahedral unit normal, snorm16
+ *   'TANQ' i16[4] per vertex: octahedral unit tangent (snorm16), then the
+ *          handedness w as -32767 or 32767, then 0
+ *   'UVQ0'.. u16[2] per vertex per UV set: uv = uv_min + q * uv_scale
+ *   'COLQ' u8[4] per vertex: colour set 0, unorm8 RGBA
+ *   'JNT8' u8[4] or 'JN16' u16[4] per vertex: joints of the part's skin
+ *          (indices into that skin's joint list of the full skeleton)
+ *   'WGT8' u8[4] per vertex: weights, unorm8, summing exactly to 255
+ *   'IDX ' u32 (or u16, element size 2) per index: triangles
+ *   'MTPQ' per morph target: i16[4] per vertex position delta
+ *          = q * target_scale[t] (q[3] is 0); 'MTSC' f32 per target before
+ *          them: the targets' scales
+ *
+ * MOTION level k of clip c (layer motion, item c; level 0 is the clip as
+ *   read, every key): the channels of one clip on the full skeleton.
+ *   'CHAN' channel records (mlod_pack_channel_rec)
+ *   then per channel: 'TIME' f32 per key (seconds), and
+ *   'ROTQ' i16[4] per key (normalised: value = q / 32767) for a rotation
+ *          whose every value sits on that lattice, else 'ROTF' f32[4];
+ *          'VEC3' f32[3] per key for translation and scale;
+ *          CUBICSPLINE channels store 3 values per key (in-tangent, value,
+ *          out-tangent), in 'ROTF' or 'VEC3'.
+ *
+ * DOC (layer none, once, last): stream 'GLB ': the input glb without the
+ *   meshes' geometry and the joint clips, which the levels hold: materials,
+ *   textures, images, samplers, names, extras, extensions, the node tree,
+ *   skins and everything else the input carried. The runtime skips it;
+ *   mlod-pack -x rebuilds a glb from it and the levels.
+ */
+#ifndef MLOD_PACK_H
+#define MLOD_PACK_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "mlod_core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MLOD_PACK_MAGIC "MLOD"
+#define MLOD_PACK_MAJOR 1
+#define MLOD_PACK_MINOR 0
+#define MLOD_PACK_HEADER_SIZE 32
+#define MLOD_PACK_TOC_ENTRY_SIZE 48
+#define MLOD_PACK_ALIGN 16
+#define MLOD_PACK_MAX_CHUNKS 65536
+#define MLOD_PACK_MAX_STREAMS 65536
+#define MLOD_PACK_MAX_UV 4
+
+/* The switch distance's view: a level switches in where its error spans
+ * MLOD_PACK_PIXELS pixels on a screen of MLOD_PACK_LINES lines with a
+ * vertical field of view of MLOD_PACK_FOV_Y degrees. */
+#define MLOD_PACK_FOV_Y 60.0
+#define MLOD_PACK_LINES 1080.0
+#define MLOD_PACK_PIXELS 1.0
+
+#define MLOD_FOURCC(a, b, c, d) \
+	((uint32_t)(uint8_t)(a) | (uint32_t)(uint8_t)(b) << 8 | (uint32_t)(uint8_t)(c) << 16 | (uint32_t)(uint8_t)(d) << 24)
+
+/* Chunk types. */
+#define MLOD_CHUNK_INFO MLOD_FOURCC('I', 'N', 'F', 'O')
+#define MLOD_CHUNK_SKELETON MLOD_FOURCC('S', 'K', 'E', 'L')
+#define MLOD_CHUNK_MESH MLOD_FOURCC('M', 'E', 'S', 'H')
+#define MLOD_CHUNK_MOTION MLOD_FOURCC('A', 'N', 'I', 'M')
+#define MLOD_CHUNK_DOC MLOD_FOURCC('D', 'O', 'C', ' ')
+
+typedef enum mlod_pack_layer {
+	MLOD_LAYER_NONE = 0,
+	MLOD_LAYER_SKELETON = 1,
+	MLOD_LAYER_MESH = 2,
+	MLOD_LAYER_MOTION = 3
+} mlod_pack_layer;
+
+/* A chunk's codec (TOC), naming what its streams use. */
+typedef enum mlod_pack_codec {
+	MLOD_CODEC_NONE = 0,    /* every stream raw */
+	MLOD_CODEC_MESHOPT = 1, /* meshoptimizer's vertex and index codecs */
+	MLOD_CODEC_DRACO = 2    /* Draco's mesh codec (mesh chunks) */
+} mlod_pack_codec;
+
+/* A stream's codec. */
+#define MLOD_SCODEC_RAW 0
+#define MLOD_SCODEC_MESHOPT_VERTEX 1 /* meshopt_decodeVertexBuffer */
+#define MLOD_SCODEC_MESHOPT_INDEX 2  /* meshopt_decodeIndexBuffer */
+
+/* Stream tags. */
+#define MLOD_STREAM_INFO MLOD_FOURCC('I', 'N', 'F', 'O')
+#define MLOD_STREAM_NAME MLOD_FOURCC('N', 'A', 'M', 'E')
+#define MLOD_STREAM_JNTS MLOD_FOURCC('J', 'N', 'T', 'S')
+#define MLOD_STREAM_SKIN MLOD_FOURCC('S', 'K', 'I', 'N')
+#define MLOD_STREAM_SKJT MLOD_FOURCC('S', 'K', 'J', 'T')
+#define MLOD_STREAM_IBMS MLOD_FOURCC('I', 'B', 'M', 'S')
+#define MLOD_STREAM_KEPT MLOD_FOURCC('K', 'E', 'P', 'T')
+#define MLOD_STREAM_PALJ MLOD_FOURCC('P', 'A', 'L', 'J')
+#define MLOD_STREAM_PALB MLOD_FOURCC('P', 'A', 'L', 'B')
+#define MLOD_STREAM_PART MLOD_FOURCC('P', 'A', 'R', 'T')
+#define MLOD_STREAM_POSQ MLOD_FOURCC('P', 'O', 'S', 'Q')
+#define MLOD_STREAM_NRMQ MLOD_FOURCC('N', 'R', 'M', 'Q')
+#define MLOD_STREAM_TANQ MLOD_FOURCC('T', 'A', 'N', 'Q')
+#define MLOD_STREAM_UVQ0 MLOD_FOURCC('U', 'V', 'Q', '0') /* set s: 'U','V','Q','0' + s */
+#define MLOD_STREAM_COLQ MLOD_FOURCC('C', 'O', 'L', 'Q')
+#define MLOD_STREAM_JNT8 MLOD_FOURCC('J', 'N', 'T', '8')
+#define MLOD_STREAM_JN16 MLOD_FOURCC('J', 'N', '1', '6')
+#define MLOD_STREAM_WGT8 MLOD_FOURCC('W', 'G', 'T', '8')
+#define MLOD_STREAM_IDX MLOD_FOURCC('I', 'D', 'X', ' ')
+#define MLOD_STREAM_MTSC MLOD_FOURCC('M', 'T', 'S', 'C')
+#define MLOD_STREAM_MTPQ MLOD_FOURCC('M', 'T', 'P', 'Q')
+#define MLOD_STREAM_CHAN MLOD_FOURCC('C', 'H', 'A', 'N')
+#define MLOD_STREAM_TIME MLOD_FOURCC('T', 'I', 'M', 'E')
+#define MLOD_STREAM_ROTQ MLOD_FOURCC('R', 'O', 'T', 'Q')
+#define MLOD_STREAM_ROTF MLOD_FOURCC('R', 'O', 'T', 'F')
+#define MLOD_STREAM_VEC3 MLOD_FOURCC('V', 'E', 'C', '3')
+#define MLOD_STREAM_GLB MLOD_FOURCC('G', 'L', 'B', ' ')
+
+/* ------------------------------------------------------------------ */
+/* Fixed records (little-endian, no padding: every field is 4 bytes)   */
+/* ------------------------------------------------------------------ */
+
+/* INFO: the whole character. */
+typedef struct mlod_pack_info_rec {
+	uint32_t joint_count;
+	uint32_t skin_count;
+	uint32_t skeleton_levels;  /* counting level 0 */
+	uint32_t mesh_levels;      /* counting level 0; 0 without meshes */
+	uint32_t clip_count;
+	uint32_t motion_levels;    /* per clip, counting level 0; 0 without clips */
+	uint32_t instance_count;   /* parts of mesh level 0 */
+	uint32_t name;             /* the character's name: offset in 'NAME' */
+	float bounds_min[3];       /* rest pose of level 0, scene units */
+	float bounds_max[3];
+	float height;              /* the skeleton height (mlod(5)) */
+	float diagonal;            /* of the bounds */
+	uint32_t first_drawable;   /* bytes of the file that hold the coarsest
+	                            * skeleton, mesh and motion levels */
+	uint32_t reserved[3];
+} mlod_pack_info_rec;
+
+/* SKELETON 'JNTS'. */
+typedef struct mlod_pack_joint_rec {
+	int32_t parent;            /* -1 for a root */
+	uint32_t name;             /* offset in 'NAME' */
+	float t[3], r[4], s[3];    /* rest TRS, r as x, y, z, w */
+	float base[16];            /* roots: the non-joint ancestors' world transform; identity otherwise */
+	int32_t node;              /* glTF node of the input, or -1 */
+} mlod_pack_joint_rec;
+
+/* SKELETON 'SKIN'. */
+typedef struct mlod_pack_skin_rec {
+	uint32_t joint_count;      /* entries in 'SKJT' and 'IBMS' */
+	uint32_t name;             /* offset in 'NAME' */
+	int32_t gltf_index;        /* the input's glTF skin, or -1 */
+} mlod_pack_skin_rec;
+
+/* MESH 'PART' flags. */
+#define MLOD_PART_NORMALS 0x1u
+#define MLOD_PART_TANGENTS 0x2u
+#define MLOD_PART_COLORS 0x4u
+#define MLOD_PART_SKINNED 0x8u    /* joints and weights */
+#define MLOD_PART_JOINTS16 0x10u  /* 'JN16' instead of 'JNT8' */
+#define MLOD_PART_INDEX16 0x20u   /* 'IDX ' elements are u16 */
+
+typedef struct mlod_pack_part_rec {
+	uint32_t instance;         /* the character's instance */
+	int32_t node;              /* its glTF node, or -1 */
+	int32_t mesh;              /* its glTF mesh, or -1 */
+	uint32_t primitive;        /* the primitive within that mesh */
+	int32_t skin;              /* skin index (SKELETON), or -1 */
+	int32_t joint;             /* rigid attachment joint, or -1 */
+	int32_t material;          /* glTF material of the input, or -1 */
+	uint32_t flags;            /* MLOD_PART_* */
+	uint32_t vertex_count;
+	uint32_t index_count;      /* a multiple of 3 */
+	uint32_t uv_sets;          /* 0..MLOD_PACK_MAX_UV */
+	uint32_t target_count;     /* morph targets (positions only) */
+	float offset[16];          /* mlod_instance.offset */
+	float pos_min[3], pos_scale[3];
+	float uv_min[MLOD_PACK_MAX_UV][2], uv_scale[MLOD_PACK_MAX_UV][2];
+} mlod_pack_part_rec;
+
+/* MOTION 'CHAN'. */
+typedef struct mlod_pack_channel_rec {
+	uint32_t joint;            /* full skeleton joint */
+	uint32_t path;             /* 0 translation, 1 rotation, 2 scale (mlod_path) */
+	uint32_t interp;           /* 0 linear, 1 step, 2 cubic spline (mlod_interp) */
+	uint32_t key_count;
+} mlod_pack_channel_rec;
+
+/* The MOTION chunk's clip: INFO 'NAME' holds the clip names, after the
+ * character's, in clip order; each clip's duration is its largest key
+ * time. */
+
+/* ------------------------------------------------------------------ */
+/* The reader                                                          */
+/* ------------------------------------------------------------------ */
+
+/* One TOC entry, as read. */
+typedef struct mlod_pack_chunk {
+	uint32_t type;
+	uint8_t layer, codec;
+	uint16_t level, item, flags;
+	uint64_t offset;
+	uint32_t stored_size, raw_size, crc;
+	float error, distance;
+} mlod_pack_chunk;
+
+/* An opened pack: the header and the TOC, checked (sizes, offsets,
+ * alignment, order, CRCs of header and TOC; chunk CRCs are checked when a
+ * chunk is decoded). Chunks of unknown types are kept in the TOC and
+ * skipped by everything else. */
+typedef struct mlod_pack {
+	uint16_t major, minor;
+	uint32_t flags;
+	uint64_t file_size;
+	uint32_t chunk_count;
+	mlod_pack_chunk *chunks;
+} mlod_pack;
+
+/* Parses and checks the header and TOC from the first bytes of a file
+ * (size >= 32 + 48 * chunk_count; the chunks need not be there).
+ * MLOD_ERR_PARSE with a message for anything malformed,
+ * MLOD_ERR_UNSUPPORTED for a newer major version. Release with
+ * mlod_pack_close. */
+mlod_result mlod_pack_open(const void *data, size_t size, mlod_pack *out, mlod_error *err);
+void mlod_pack_close(mlod_pack *p);
+
+/* The CRC32 the format uses. */
+uint32_t mlod_pack_crc32(uint32_t crc, const void *data, size_t size);
+
+/* Decoded chunks. Each decode checks the chunk's CRC and every size,
+ * count and index, and fails with MLOD_ERR_PARSE naming the chunk
+ * ("MESH level 2: ...") rather than read out of bounds. Everything a
+ * decoded chunk points to lives in one allocation owned by it; release
+ * with the matching *_free (which accepts a zeroed struct). */
+
+typedef struct mlod_pack_info {
+	mlod_pack_info_rec rec;
+	const char *name;          /* the character's */
+	const char **clip_names;   /* clip_count */
+	void *block;
+} mlod_pack_info;
+
+typedef struct mlod_pack_skeleton {
+	uint32_t joint_count;
+	const mlod_pack_joint_rec *joints;
+	const char **joint_names;
+	uint32_t skin_count;
+	const mlod_pack_skin_rec *skins;
+	const char **skin_names;
+	const uint32_t **skin_joints;   /* per skin: joint_count joint indices */
+	const float **inverse_bind;     /* per skin: 16 * joint_count */
+	void *block;
+} mlod_pack_skeleton;
+
+typedef struct mlod_pack_skel_level {
+	uint32_t kept_count;
+	const uint32_t *kept;
+	uint32_t palette_size;          /* skin joints over all skins */
+	const uint32_t *palette_joint;
+	const float *palette_bind;      /* 16 per palette entry */
+	void *block;
+} mlod_pack_skel_level;
+
+/* A decoded part: attributes dequantised to floats. */
+typedef struct mlod_pack_part {
+	mlod_pack_part_rec rec;
+	float *positions;               /* 3 per vertex */
+	float *normals;                 /* 3 per vertex, or NULL */
+	float *tangents;                /* 4 per vertex, or NULL */
+	float *uvs[MLOD_PACK_MAX_UV];   /* 2 per vertex */
+	float *colors;                  /* 4 per vertex, or NULL */
+	uint16_t *joints;               /* 4 per vertex, or NULL */
+	float *weights;                 /* 4 per vertex, summing to 1, or NULL */
+	uint32_t *indices;
+	float **targets;                /* target_count arrays of 3 per vertex */
+} mlod_pack_part;
+
+typedef struct mlod_pack_mesh {
+	uint32_t part_count;
+	mlod_pack_part *parts;
+	void *block;
+} mlod_pack_mesh;
+
+typedef struct mlod_pack_channel {
+	mlod_pack_channel_rec rec;
+	const float *times;             /* key_count */
+	float *values;                  /* 3 or 4 per key (x3 for cubic spline), dequantised */
+} mlod_pack_channel;
+
+typedef struct mlod_pack_motion {
+	uint32_t channel_count;
+	mlod_pack_channel *channels;
+	float duration;
+	void *block;
+} mlod_pack_motion;
+
+/* data holds at least the chunk's bytes at its offset (a whole file, or
+ * the prefix that ends at or after the chunk). */
+mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t size, mlod_pack_info *out,
+                                  mlod_error *err);
+mlod_result mlod_pack_decode_skeleton(const mlod_pack *p, const void *data, size_t size,
+                                      mlod_pack_skeleton *out, mlod_error *err);
+/* skel is the decoded full skeleton the level refers to. */
+mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                        const mlod_pack_skeleton *skel, mlod_pack_skel_level *out,
+                                        mlod_error *err);
+mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                  const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err);
+mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                    const mlod_pack_skeleton *skel, mlod_pack_motion *out, mlod_error *err);
+/* The DOC chunk's glb bytes (*glb points into data after the CRC check;
+ * the stream is stored raw). */
+mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, const void **glb, size_t *glb_size,
+                          mlod_error *err);
+
+void mlod_pack_info_free(mlod_pack_info *x);
+void mlod_pack_skeleton_free(mlod_pack_skeleton *x);
+void mlod_pack_skel_level_free(mlod_pack_skel_level *x);
+void mlod_pack_mesh_free(mlod_pack_mesh *x);
+void mlod_pack_motion_free(mlod_pack_motion *x);
+
+/* The index of the chunk of this type, layer, level and item, or -1. */
+int mlod_pack_find(const mlod_pack *p, uint32_t type, unsigned level, unsigned item);
+
+/* "INFO", "SKEL", ...; "none", "meshopt", "draco"; "none", "skeleton",
+ * "mesh", "motion". */
+const char *mlod_pack_codec_name(unsigned codec);
+const char *mlod_pack_layer_name(unsigned layer);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MLOD_PACK_H */
