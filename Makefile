@@ -29,8 +29,9 @@ CFLAGS += -std=c11 $(WARN) $(CFLAGS_$(config))
 CXXFLAGS += -std=c++14 -Wall -Wextra $(CFLAGS_$(config))
 LDFLAGS_sanitize := -fsanitize=address,undefined
 LDFLAGS += $(LDFLAGS_$(config))
-# meshoptimizer's codecs: the pack writer's encoder and the runtime's decoder.
-LDLIBS := -ltinygltf -lmeshoptimizer -lstdc++ -lm
+# meshoptimizer's codecs (the pack writer's encoder, the runtime's decoder) and
+# Draco's core mesh codec (lib/pack/draco.cpp); -ltinygltf before -ldraco.
+LDLIBS := -ltinygltf -lmeshoptimizer -ldraco -lstdc++ -lm
 
 B := build/$(config)
 BIN := $(B)/bin

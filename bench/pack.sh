@@ -24,6 +24,15 @@ sizes() { # sizes FILE: raw gzip zstd
 }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.2fx", a / b; else printf "-" }'; }
 
+echo "## Pack: mesh codecs on the same quantised data (meshoptimizer 0.18, Draco 1.5)"
+echo
+glbs=
+for f in $INPUTS; do
+	case $f in *.glb) glbs="$glbs $f" ;; esac
+done
+# shellcheck disable=SC2086
+[ -z "$glbs" ] || "$BUILD/bench/bench_codec" $glbs
+echo
 echo "## Pack: every level in one file, against gltfpack 1.3"
 echo
 echo "| input | file | raw | gzip -9 | zstd -19 | raw, no textures | pack / file (gzip) |"
