@@ -6,7 +6,8 @@
  * Nearest points come from a bounding volume hierarchy over the target's
  * triangles (object-median splits on the longest axis, so the depth is
  * logarithmic), searched nearer child first and pruned by box distance,
- * each query seeded with the previous sample's triangle. Point-triangle
+ * each query seeded with the previous sample's triangle; a leaf's
+ * triangle is skipped when its plane is already farther than the best. Point-triangle
  * distance is the Voronoi-region method of Ericson, "Real-Time Collision
  * Detection" (2005), 5.1.5; degenerate triangles are measured as their
  * three edges. Single-threaded and in a fixed order, so deterministic.
@@ -28,6 +29,7 @@ typedef struct node {
 
 typedef struct tri {
 	double a[3], b[3], c[3];
+	double n[3];    /* unit normal (0 for a degenerate triangle) */
 	int degenerate;
 } tri;
 
@@ -255,6 +257,13 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 			t->c[a] = m->positions[3 * (size_t)ix[2] + a];
 		}
 		t->degenerate = is_degenerate(t);
+		double ab[3], ac[3];
+		sub3(t->b, t->a, ab);
+		sub3(t->c, t->a, ac);
+		double nn[3] = { ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0] };
+		double len = sqrt(dot3(nn, nn));
+		for (int a = 0; a < 3; a++)
+			t->n[a] = t->degenerate || !(len > 0.0) ? 0.0 : nn[a] / len;
 	}
 	free(b.order);
 	free(b.centroids);
@@ -279,6 +288,19 @@ static double box_dist2(const double *p, const node *n)
 	return d2;
 }
 
+/* A lower bound of triangle_dist2: the squared distance to the
+ * triangle's plane, less a slack (1e-12 of |p - a|, a thousand times the
+ * rounding of the dot product) so that rounding can never make it exceed
+ * the distance triangle_dist2 computes: a triangle skipped by it could
+ * not have been nearer, and the result is the same as without it. */
+static double plane_dist2(const double *p, const tri *t)
+{
+	double u[3] = { p[0] - t->a[0], p[1] - t->a[1], p[2] - t->a[2] };
+	double d = fabs(u[0] * t->n[0] + u[1] * t->n[1] + u[2] * t->n[2]);
+	d -= 1e-12 * (fabs(u[0]) + fabs(u[1]) + fabs(u[2]));
+	return d > 0.0 ? d * d : 0.0;
+}
+
 /* Squared distance from p to the nearest triangle. *hint is a triangle to
  * start from (updated to the nearest one), which makes neighbouring
  * queries cheap. */
@@ -295,6 +317,8 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 		const node *n = &b->nodes[stack[top].node];
 		if (n->count > 0) {
 			for (int k = n->first; k < n->first + n->count; k++) {
+				if (plane_dist2(p, &b->tris[k]) >= best)
+					continue; /* its plane is already farther than the best */
 				double d = triangle_dist2(p, &b->tris[k]);
 				if (d < best)
 					best = d, *hint = k;
