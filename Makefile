@@ -25,10 +25,10 @@ RT_CPPFLAGS := -Ilib/core -Ilib/rt
 CFLAGS_release := -O2 -g
 CFLAGS_debug := -O0 -g3
 CFLAGS_sanitize := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
-CFLAGS += -std=c11 $(WARN) $(CFLAGS_$(config))
-CXXFLAGS += -std=c++14 -Wall -Wextra $(CFLAGS_$(config))
+CFLAGS += -std=c11 -pthread $(WARN) $(CFLAGS_$(config))
+CXXFLAGS += -std=c++14 -pthread -Wall -Wextra $(CFLAGS_$(config))
 LDFLAGS_sanitize := -fsanitize=address,undefined
-LDFLAGS += $(LDFLAGS_$(config))
+LDFLAGS += -pthread $(LDFLAGS_$(config))
 # meshoptimizer's codecs (the pack writer's encoder, the runtime's decoder) and
 # Draco's core mesh codec (lib/pack/draco.cpp); -ltinygltf before -ldraco.
 LDLIBS := -ltinygltf -lmeshoptimizer -ldraco -lstdc++ -lm

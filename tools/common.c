@@ -212,6 +212,14 @@ double tool_parse_double(const char *option, const char *value, double lo, doubl
 	return v;
 }
 
+int tool_parse_threads(const char *value)
+{
+	double v = tool_parse_double("--threads", value, 1, MLOD_MAX_THREADS);
+	if (v != (int)v)
+		tool_usage_error("--threads: '%s' is not a whole number", value);
+	return (int)v;
+}
+
 void tool_json_string(FILE *f, const char *s)
 {
 	fputc('"', f);

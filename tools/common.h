@@ -92,4 +92,8 @@ int tool_ends_with(const char *s, const char *suffix);
  * something else. Returns the count. */
 int tool_parse_list(const char *option, const char *value, double *out, int max, double lo, double hi);
 
+/* Parses -j/--threads: a whole number from 1 to MLOD_MAX_THREADS; exits 1
+ * naming the option otherwise. The tools default to mlod_thread_count(). */
+int tool_parse_threads(const char *value);
+
 #endif

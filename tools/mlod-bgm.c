@@ -55,6 +55,8 @@ static const char usage_text[] =
 	"  -b, --allow-border       let collapses move and remove border vertices\n"
 	"  -s, --split DIR          also write one glb per level into DIR: the input\n"
 	"                           with that level's meshes in place\n"
+	"  -j, --threads N          work on N threads (default: the processors online);\n"
+	"                           the output is the same at any N\n"
 	"  -h, --help               show this help\n"
 	"  -V, --version            show the version\n"
 	"\n"
@@ -226,6 +228,7 @@ int main(int argc, char **argv)
 		{"tau", required_argument, NULL, 't'},
 		{"allow-border", no_argument, NULL, 'b'},
 		{"split", required_argument, NULL, 's'},
+		{"threads", required_argument, NULL, 'j'},
 		{"help", no_argument, NULL, 'h'},
 		{"version", no_argument, NULL, 'V'},
 		{NULL, 0, NULL, 0},
@@ -241,13 +244,14 @@ int main(int argc, char **argv)
 	double ratios[MLOD_MESH_MAX_LEVELS], max_error = -1.0;
 	int ratio_count = 0, ch;
 	mlod_bgm_options opt = {0};
+	opt.threads = mlod_thread_count();
 	mlod_mesh_budget budget = MLOD_BUDGET_DEFAULT;
 	struct job job;
 	memset(&job, 0, sizeof job);
 
 	tool_name = "mlod-bgm";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:C:B:p:E:t:bs:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:C:B:p:E:t:bs:j:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -265,6 +269,7 @@ int main(int argc, char **argv)
 		case 't': opt.tau = tool_parse_double("--tau", optarg, 1e-6, 1e6); break;
 		case 'b': opt.allow_border = 1; break;
 		case 's': split = optarg; break;
+		case 'j': opt.threads = tool_parse_threads(optarg); break;
 		case 'h': {
 			char list[64] = "";
 			for (size_t i = 0, n = 0; i < sizeof defaults / sizeof *defaults; i++)

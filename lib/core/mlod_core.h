@@ -2,8 +2,9 @@
  * mlod_core.h: the common core of mlod, shared by the bake library and the
  * runtime (lib/rt): result codes and their messages, and the small math
  * (vectors, quaternions, 4x4 matrices, TRS, Euler angles) both sides use.
- * It depends on nothing but the C library, and nothing in it allocates
- * but mlod_free's counterpart.
+ * It depends on nothing but the C library and POSIX threads (for
+ * mlod_parallel_for), and nothing in it allocates but mlod_free's
+ * counterpart.
  *
  * Conventions (every part of mlod follows them)
  * - Every fallible call returns an mlod_result and, when err is not NULL,
@@ -59,6 +60,25 @@ mlod_result mlod_fail(mlod_error *err, mlod_result code, const char *fmt, ...)
 
 /* Releases a buffer returned by the library (glb bytes, JSON text, ...). */
 void mlod_free(void *p);
+
+/* ------------------------------------------------------------------ */
+/* Threads                                                             */
+/* ------------------------------------------------------------------ */
+
+#define MLOD_MAX_THREADS 64
+
+/* The number of processors online (1 when unknown), at most
+ * MLOD_MAX_THREADS: the tools' default for -j. */
+int mlod_thread_count(void);
+
+/* One work item: fills only item i's own results. */
+typedef mlod_result (*mlod_parallel_fn)(void *ctx, int i);
+
+/* Runs fn(ctx, i) for i in [0, n) on up to `threads` threads (the caller's
+ * among them; 0 or 1: a plain loop on the caller's thread). Returns the
+ * result of the first failing item in index order (items after it may not
+ * run), else MLOD_OK. Results do not depend on the thread count. */
+mlod_result mlod_parallel_for(int n, int threads, mlod_parallel_fn fn, void *ctx);
 
 /* ------------------------------------------------------------------ */
 /* Math                                                                */

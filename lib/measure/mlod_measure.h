@@ -64,6 +64,8 @@ typedef struct mlod_pose_set {
 	int count;
 	int joint_count;
 	mlod_mat4 *world;
+	int threads;      /* mlod_posed_error measures poses on this many threads
+	                   * (0 or 1: the caller's only); the same result at any count */
 } mlod_pose_set;
 
 /* Builds a pose set: the rest pose when bind is set, up to per_clip

@@ -117,6 +117,28 @@ void mlod_pose_set_free(mlod_pose_set *s)
 	memset(s, 0, sizeof *s);
 }
 
+/* One pose of mlod_posed_error: both characters posed and compared. */
+typedef struct posed_job {
+	const mlod_character *full, *level;
+	const mlod_pose_set *poses;
+	mlod_deviation *d;      /* per pose */
+	mlod_error *errs;       /* per pose */
+} posed_job;
+
+static mlod_result posed_one(void *ctx, int k)
+{
+	posed_job *j = ctx;
+	const mlod_mat4 *world = j->poses->world + (size_t)k * (size_t)j->poses->joint_count;
+	mlod_posed a = {0}, b = {0};
+	mlod_result r;
+	if ((r = mlod_pose_character(j->full, world, &a, &j->errs[k])) == MLOD_OK &&
+	    (r = mlod_pose_character(j->level, world, &b, &j->errs[k])) == MLOD_OK)
+		r = mlod_surface_deviation(&a, &b, &j->d[k], &j->errs[k]);
+	mlod_posed_free(&a);
+	mlod_posed_free(&b);
+	return r;
+}
+
 mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *level, const mlod_pose_set *poses,
                              mlod_deviation *out, mlod_error *err)
 {
@@ -126,24 +148,35 @@ mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *l
 	if (poses->joint_count != full->skeleton.joint_count || level->skeleton.joint_count != full->skeleton.joint_count)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_posed_error: poses of %d joints for %d and %d joints",
 		                 poses->joint_count, full->skeleton.joint_count, level->skeleton.joint_count);
-	mlod_posed a = {0}, b = {0};
-	mlod_result r = MLOD_OK;
-	double sum = 0.0;
-	for (int k = 0; k < poses->count; k++) {
-		const mlod_mat4 *world = poses->world + (size_t)k * (size_t)poses->joint_count;
-		mlod_deviation d;
-		if ((r = mlod_pose_character(full, world, &a, err)) != MLOD_OK ||
-		    (r = mlod_pose_character(level, world, &b, err)) != MLOD_OK ||
-		    (r = mlod_surface_deviation(&a, &b, &d, err)) != MLOD_OK)
-			break;
-		sum += d.mean;
-		if (d.max > out->max)
-			out->max = d.max;
-		out->scale = d.scale;
+	if (poses->count <= 0)
+		return MLOD_OK;
+	posed_job j = { full, level, poses, calloc((size_t)poses->count, sizeof *j.d),
+	                calloc((size_t)poses->count, sizeof *j.errs) };
+	if (!j.d || !j.errs) {
+		free(j.d);
+		free(j.errs);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "mlod_posed_error: out of memory for %d poses", poses->count);
 	}
-	if (r == MLOD_OK && poses->count > 0)
+	mlod_result r = mlod_parallel_for(poses->count, poses->threads, posed_one, &j);
+	if (r != MLOD_OK) {
+		for (int k = 0; k < poses->count; k++)
+			if (j.errs[k].code != MLOD_OK) {
+				if (err)
+					*err = j.errs[k];
+				break;
+			}
+	} else {
+		/* summed in pose order, so the thread count cannot change a bit */
+		double sum = 0.0;
+		for (int k = 0; k < poses->count; k++) {
+			sum += j.d[k].mean;
+			if (j.d[k].max > out->max)
+				out->max = j.d[k].max;
+			out->scale = j.d[k].scale;
+		}
 		out->mean = sum / poses->count;
-	mlod_posed_free(&a);
-	mlod_posed_free(&b);
+	}
+	free(j.d);
+	free(j.errs);
 	return r;
 }

@@ -119,6 +119,52 @@ static mlod_result make_poses(mlod_mesh_levels *L, mlod_error *err)
 	return r;
 }
 
+/* The primitives of mlod_mesh_levels_init, built and simplified one per
+ * work item (part[2k], part[2k + 1]: its instance and primitive). */
+typedef struct part_job {
+	mlod_mesh_levels *L;
+	double min_ratio;
+	int *part;
+	mlod_error *errs;
+	mlod_result *result;
+} part_job;
+
+static void part_job_free(part_job *j)
+{
+	free(j->part);
+	free(j->errs);
+	free(j->result);
+}
+
+static mlod_result part_one(void *ctx, int k)
+{
+	part_job *j = ctx;
+	mlod_mesh_levels *L = j->L;
+	int i = j->part[2 * k], p = j->part[2 * k + 1];
+	const mlod_instance *in = &L->c->instances[i];
+	mlod_mesh_part *pt = &L->parts[i][p];
+	if (pt->triangles < 4 || in->node < 0)
+		return MLOD_OK;
+	mlod_result r = mlod_bgm_build(L->c, i, p, &L->opt, &pt->bgm, &j->errs[k]);
+	if (r == MLOD_OK) {
+		int target = j->min_ratio > 0.0 ? (int)ceil(j->min_ratio * pt->triangles) : 0;
+		r = mlod_bgm_simplify(pt->bgm, target, 0, &j->errs[k]);
+	}
+	/* an unsupported primitive is skipped, not an error of the whole */
+	j->result[k] = r;
+	return MLOD_OK;
+}
+
+/* A part simplified as far as it goes (the character budget). */
+static mlod_result part_further(void *ctx, int k)
+{
+	part_job *j = ctx;
+	mlod_mesh_part *pt = &j->L->parts[j->part[2 * k]][j->part[2 * k + 1]];
+	if (pt->bgm)
+		j->result[k] = mlod_bgm_simplify(pt->bgm, 0, 0, &j->errs[k]);
+	return MLOD_OK;
+}
+
 mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, const mlod_bgm_options *opt,
                                   mlod_mesh_budget budget, double min_ratio, mlod_error *err)
 {
@@ -139,43 +185,77 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 		return r;
 	L->opt.eta = L->eta;
 	L->opt.poses = &L->train;
-	for (int i = 0; i < c->instance_count; i++) {
+	L->measure.threads = L->opt.threads;
+	int n = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		n += c->meshes[c->instances[i].mesh].primitive_count;
+	part_job j = { L, min_ratio, calloc(2 * (size_t)n + 1, sizeof *j.part), calloc((size_t)n + 1, sizeof *j.errs),
+	               calloc((size_t)n + 1, sizeof *j.result) };
+	if (!j.part || !j.errs || !j.result) {
+		part_job_free(&j);
+		return nomem(err);
+	}
+	for (int i = 0, at = 0; i < c->instance_count; i++) {
 		const mlod_instance *in = &c->instances[i];
 		const mlod_mesh *m = &c->meshes[in->mesh];
 		L->parts[i] = calloc((size_t)m->primitive_count + 1, sizeof **L->parts);
-		if (!L->parts[i])
+		if (!L->parts[i]) {
+			part_job_free(&j);
 			return nomem(err);
+		}
 		for (int p = 0; p < m->primitive_count; p++) {
 			const mlod_primitive *pr = &m->primitives[p];
 			mlod_mesh_part *pt = &L->parts[i][p];
 			pt->triangles = primitive_triangles(pr);
 			L->triangles += pt->triangles;
 			L->vertices += pr->vertex_count;
-			if (pt->triangles < 4 || in->node < 0)
-				continue;
-			r = mlod_bgm_build(c, i, p, &L->opt, &pt->bgm, err);
-			if (r == MLOD_ERR_UNSUPPORTED) {
-				unsupported++;
-				continue;
-			}
-			if (r != MLOD_OK)
-				return r;
-			int target = min_ratio > 0.0 ? (int)ceil(min_ratio * pt->triangles) : 0;
-			if ((r = mlod_bgm_simplify(pt->bgm, target, 0, err)) != MLOD_OK)
-				return r;
-			mlod_bgm_info info;
-			mlod_bgm_get_info(pt->bgm, &info);
-			L->build_seconds += info.build_seconds;
-			L->simplified++;
-			L->statics += in->skin < 0 && in->joint < 0;
-			morphs += pr->target_count > 0;
+			j.part[2 * at] = i, j.part[2 * at + 1] = p, at++;
 		}
 	}
+	/* Each primitive's BGM is built and simplified on its own: in
+	 * parallel, with the results gathered in primitive order. */
+	mlod_parallel_for(n, L->opt.threads, part_one, &j);
+	for (int k = 0; k < n; k++) {
+		int i = j.part[2 * k], p = j.part[2 * k + 1];
+		const mlod_instance *in = &c->instances[i];
+		const mlod_primitive *pr = &c->meshes[in->mesh].primitives[p];
+		mlod_mesh_part *pt = &L->parts[i][p];
+		if (j.result[k] == MLOD_ERR_UNSUPPORTED) {
+			unsupported++;
+			continue;
+		}
+		if (j.result[k] != MLOD_OK) {
+			if (err)
+				*err = j.errs[k];
+			r = j.result[k];
+			part_job_free(&j);
+			return r;
+		}
+		if (!pt->bgm)
+			continue;
+		mlod_bgm_info info;
+		mlod_bgm_get_info(pt->bgm, &info);
+		L->build_seconds += info.build_seconds;
+		L->simplified++;
+		L->statics += in->skin < 0 && in->joint < 0;
+		morphs += pr->target_count > 0;
+	}
 	/* A character budget may take any primitive further than the ratio. */
-	for (int i = 0; L->budget == MLOD_BUDGET_CHARACTER && min_ratio > 0.0 && i < c->instance_count; i++)
-		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
-			if (L->parts[i][p].bgm && (r = mlod_bgm_simplify(L->parts[i][p].bgm, 0, 0, err)) != MLOD_OK)
+	if (L->budget == MLOD_BUDGET_CHARACTER && min_ratio > 0.0) {
+		j.min_ratio = 0.0;
+		for (int k = 0; k < n; k++)
+			j.result[k] = MLOD_OK;
+		mlod_parallel_for(n, L->opt.threads, part_further, &j);
+		for (int k = 0; k < n; k++)
+			if (j.result[k] != MLOD_OK) {
+				if (err)
+					*err = j.errs[k];
+				r = j.result[k];
+				part_job_free(&j);
 				return r;
+			}
+	}
+	part_job_free(&j);
 	if (L->statics)
 		note(L, "%d primitive(s) of static meshes (no joint, no skin) simplified in world space", L->statics);
 	if (unsupported)

@@ -106,6 +106,8 @@ typedef struct mlod_bgm_options {
 	int allow_border;            /* let collapses move and remove border vertices */
 	const mlod_pose_set *poses;  /* the posed cost's poses; NULL: the bind pose only */
 	const double *eta;           /* per joint (mlod_joint_weight_average); NULL: computed */
+	int threads;                 /* mlod_mesh_levels: primitives and measured poses on this many
+	                              * threads (0 or 1: the caller's); the same levels at any count */
 } mlod_bgm_options;
 
 typedef struct mlod_bgm mlod_bgm;

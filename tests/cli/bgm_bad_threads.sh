@@ -1,0 +1,1 @@
+"$BIN/mlod-bgm" -j 0 "$ROOT/samples/tubeman.glb"

@@ -1,0 +1,1 @@
+"$BIN/mlod-bgm" -j 1.5 "$ROOT/samples/tubeman.glb"
