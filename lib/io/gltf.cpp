@@ -2679,6 +2679,47 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
 	});
 }
 
+mlod_result mlod_gltf_node_refs(const mlod_gltf *doc, int node, int *mesh, int *skin, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && mesh && skin, "mlod_gltf_node_refs: doc, mesh and skin must not be NULL");
+		const Model &m = doc->model;
+		if (node < 0 || node >= int(m.nodes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+		*mesh = m.nodes[size_t(node)].mesh;
+		*skin = m.nodes[size_t(node)].skin;
+	});
+}
+
+mlod_result mlod_gltf_node_lod(const mlod_gltf *doc, int node, int *ids, int max, int *count, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && count && (ids || max == 0), "mlod_gltf_node_lod: doc, ids and count must not be NULL");
+		const Model &m = doc->model;
+		if (node < 0 || node >= int(m.nodes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+		*count = 0;
+		const tinygltf::Node &n = m.nodes[size_t(node)];
+		auto it = n.extensions.find("MSFT_lod");
+		if (it == n.extensions.end() || !it->second.IsObject() || !it->second.Has("ids"))
+			return;
+		const tinygltf::Value &v = it->second.Get("ids");
+		if (!v.IsArray())
+			fail(MLOD_ERR_PARSE, "node %d: MSFT_lod.ids is not an array", node);
+		for (size_t i = 0; i < v.ArrayLen(); i++) {
+			const tinygltf::Value &e = v.Get(int(i));
+			if (!e.IsNumber() && !e.IsInt())
+				fail(MLOD_ERR_PARSE, "node %d: MSFT_lod.ids[%zu] is not a node", node, i);
+			int id = e.IsInt() ? e.Get<int>() : int(e.GetNumberAsDouble());
+			if (id < 0 || id >= int(m.nodes.size()))
+				fail(MLOD_ERR_PARSE, "node %d: MSFT_lod.ids[%zu] = %d is not a node", node, i, id);
+			if (*count < max)
+				ids[*count] = id;
+			++*count;
+		}
+	});
+}
+
 mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err)
 {
 	return guard(err, [&] {
