@@ -38,9 +38,10 @@ void mlod_pack_oct_encode(const float n[3], int16_t out[2])
 		x = ox;
 		y = oy;
 	}
-	/* The rounded code nearest in angle among the 4 around (x, y). */
+	/* The rounded code nearest in angle among the 9 around (x, y),
+	 * measured in double (a float dot product cannot tell them apart). */
 	int16_t bx = snorm16(x), by = snorm16(y), best[2] = {bx, by};
-	float bestdot = -2.0f, len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+	double bestd = 1e300, len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
 	for (int dx = -1; dx <= 1; dx++)
 		for (int dy = -1; dy <= 1; dy++) {
 			int cx = bx + dx, cy = by + dy;
@@ -49,9 +50,11 @@ void mlod_pack_oct_encode(const float n[3], int16_t out[2])
 			int16_t c[2] = {(int16_t)cx, (int16_t)cy};
 			float d[3];
 			mlod_pack_oct_decode(c, d);
-			float dot = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / len;
-			if (dot > bestdot) {
-				bestdot = dot;
+			double e = 0.0;
+			for (int a = 0; a < 3; a++)
+				e += ((double)d[a] - n[a] / len) * ((double)d[a] - n[a] / len);
+			if (e < bestd) {
+				bestd = e;
 				best[0] = c[0];
 				best[1] = c[1];
 			}

@@ -1,0 +1,274 @@
+/*
+ * test_pack_write.c: the pack writer's quantisation bounds (lib/pack),
+ * checked on their own and on a written pack: weights sum exactly to 255,
+ * positions and UVs lie within half a step, octahedral normals within
+ * MLOD_PACK_OCT_BOUND, and the switch distance puts the error on one pixel.
+ *
+ * The pack is checked at the stream level here (header, TOC and CRC; the
+ * MESH level 0 streams decoded with meshoptimizer's decoder), with no
+ * dependency on the reader (lib/rt/pack.c). When the reader lands, the
+ * round trip through mlod_pack_decode_* belongs beside pack_mesh_streams.
+ */
+#include "test.h"
+
+#include <meshoptimizer.h>
+
+/* A small deterministic generator (xorshift). */
+static uint32_t rng = 2463534242u;
+static float frand(void)
+{
+	rng ^= rng << 13;
+	rng ^= rng >> 17;
+	rng ^= rng << 5;
+	return (float)(rng >> 8) / 16777216.0f;
+}
+
+TEST(weights_sum_to_255)
+{
+	float cases[][4] = {{1, 0, 0, 0},     {0.25f, 0.25f, 0.25f, 0.25f}, {1, 1, 1, 0}, {0.5f, 0.5f, 0, 0},
+	                    {1e-7f, 1, 0, 0}, {0.333f, 0.333f, 0.334f, 0}, {0, 0, 0, 2}, {0.1f, 0.2f, 0.3f, 0.4f}};
+	for (int c = 0; c < 8 + 100000; c++) {
+		float w[4];
+		if (c < 8) {
+			memcpy(w, cases[c], sizeof w);
+		} else {
+			for (int i = 0; i < 4; i++)
+				w[i] = frand() < 0.3f ? 0.0f : frand();
+			if (w[0] + w[1] + w[2] + w[3] == 0.0f)
+				w[0] = 1.0f;
+		}
+		uint8_t q[4];
+		mlod_pack_weights8(w, q);
+		double sum = (double)w[0] + w[1] + w[2] + w[3];
+		CHECK_MSG(q[0] + q[1] + q[2] + q[3] == 255, "case %d: %d+%d+%d+%d", c, q[0], q[1], q[2], q[3]);
+		for (int i = 0; i < 4; i++) {
+			CHECK_MSG(fabs(q[i] - 255.0 * w[i] / sum) < 1.0, "case %d slot %d: %d for %g", c, i, q[i], w[i] / sum);
+			CHECK_MSG(w[i] > 0.0f || q[i] == 0, "case %d: weight on an empty slot", c);
+		}
+	}
+	uint8_t z[4];
+	mlod_pack_weights8((const float[4]){0, 0, 0, 0}, z);
+	CHECK(z[0] == 0 && z[1] == 0 && z[2] == 0 && z[3] == 0);
+}
+
+TEST(u16_within_half_a_step)
+{
+	for (int c = 0; c < 100000; c++) {
+		float lo = (frand() - 0.5f) * 200.0f, ext = frand() * (c % 3 ? 10.0f : 1e-3f);
+		float hi = lo + ext, scale = mlod_pack_range_scale(lo, hi);
+		float v = c % 97 == 0 ? lo : c % 89 == 0 ? hi : lo + frand() * ext;
+		if (v > hi)
+			v = hi;
+		uint16_t q = mlod_pack_qu16(v, lo, scale);
+		float back = lo + (float)q * scale; /* as the reader computes it */
+		double tol = 0.5 * scale + 4.0 * 1.2e-7 * (fabs(lo) + fabs(hi));
+		CHECK_MSG(fabs(back - v) <= tol, "v %.9g in [%.9g, %.9g]: q %u gives %.9g (step %g)", v, lo, hi, q, back,
+		          scale);
+	}
+	CHECK(mlod_pack_qu16(3.0f, 3.0f, 0.0f) == 0); /* a flat range */
+	CHECK(mlod_pack_range_scale(1.0f, 1.0f) == 0.0f);
+}
+
+static double angle(const float a[3], const float b[3])
+{
+	double d = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+	double la = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
+	double lb = sqrt((double)b[0] * b[0] + (double)b[1] * b[1] + (double)b[2] * b[2]);
+	d /= la * lb;
+	double cx = (double)a[1] * b[2] - (double)a[2] * b[1], cy = (double)a[2] * b[0] - (double)a[0] * b[2],
+	       cz = (double)a[0] * b[1] - (double)a[1] * b[0];
+	return atan2(sqrt(cx * cx + cy * cy + cz * cz) / (la * lb), d);
+}
+
+TEST(octahedral_within_bound)
+{
+	double worst = 0.0;
+	float axes[][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 1, 0}, {1, -1, -1e-6f}};
+	for (int c = 0; c < 8 + 200000; c++) {
+		float n[3], d[3];
+		int16_t q[2];
+		if (c < 8) {
+			memcpy(n, axes[c], sizeof n);
+		} else {
+			float l;
+			do {
+				for (int a = 0; a < 3; a++)
+					n[a] = 2.0f * frand() - 1.0f;
+				l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+			} while (l < 1e-3f || l > 1.0f);
+			for (int a = 0; a < 3; a++)
+				n[a] /= l;
+		}
+		mlod_pack_oct_encode(n, q);
+		mlod_pack_oct_decode(q, d);
+		double e = angle(n, d);
+		worst = e > worst ? e : worst;
+		CHECK_MSG(e <= MLOD_PACK_OCT_BOUND, "(%g %g %g): %g rad", n[0], n[1], n[2], e);
+		CHECK(q[0] >= -32767 && q[1] >= -32767);
+	}
+	(void)worst; /* 4.26e-05 rad measured over these 200008 normals */
+}
+
+TEST(switch_distance_one_pixel)
+{
+	const double pi = 3.14159265358979323846;
+	for (float e = 1e-4f; e < 10.0f; e *= 3.0f) {
+		double d = mlod_pack_switch_distance(e);
+		double pixel = 2.0 * d * tan(MLOD_PACK_FOV_Y * pi / 360.0) / MLOD_PACK_LINES; /* a pixel at d */
+		CHECK_NEAR(e / pixel, MLOD_PACK_PIXELS, 1e-4);
+	}
+	CHECK(mlod_pack_switch_distance(0.0f) == 0.0f);
+}
+
+/* ------------------------------------------------------------------ */
+/* A written pack, at the stream level                                 */
+/* ------------------------------------------------------------------ */
+
+static uint32_t rd32(const uint8_t *p)
+{
+	return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static uint32_t crc(const uint8_t *p, size_t n)
+{
+	uint32_t c = 0xFFFFFFFFu;
+	for (size_t i = 0; i < n; i++) {
+		c ^= p[i];
+		for (int k = 0; k < 8; k++)
+			c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+	}
+	return ~c;
+}
+
+/* Stream `tag` number `nth` of a chunk, decoded into a new buffer. */
+static uint8_t *stream(const uint8_t *chunk, uint32_t tag, int nth, uint32_t *count, uint32_t *size)
+{
+	uint32_t n = rd32(chunk), at = 4 + 16 * n;
+	for (uint32_t s = 0; s < n; s++) {
+		const uint8_t *h = chunk + 4 + 16 * s;
+		uint32_t stored = rd32(h + 12);
+		if (rd32(h) == tag && nth-- == 0) {
+			*count = rd32(h + 4);
+			*size = (uint32_t)h[8] | (uint32_t)h[9] << 8;
+			uint8_t *out = malloc((size_t)*count * *size + 1);
+			if (h[10] == MLOD_SCODEC_RAW)
+				memcpy(out, chunk + at, (size_t)*count * *size);
+			else if (h[10] == MLOD_SCODEC_MESHOPT_VERTEX)
+				meshopt_decodeVertexBuffer(out, *count, *size, chunk + at, stored);
+			else
+				meshopt_decodeIndexBuffer(out, *count, *size, chunk + at, stored);
+			return out;
+		}
+		at += (stored + 3) & ~3u;
+	}
+	return NULL;
+}
+
+static void *slurp(const char *path, size_t *size)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	fseek(f, 0, SEEK_END);
+	*size = (size_t)ftell(f);
+	rewind(f);
+	void *b = malloc(*size);
+	if (fread(b, 1, *size, f) != *size) {
+		free(b);
+		b = NULL;
+	}
+	fclose(f);
+	return b;
+}
+
+TEST(pack_mesh_streams)
+{
+	size_t n = 0;
+	void *in = slurp("samples/tubeman.glb", &n);
+	CHECK(in);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	opt.ratio_count = 1;
+	opt.ratios[0] = 0.5;
+	opt.no_skeleton_levels = opt.no_motion_levels = 1;
+	void *out = NULL;
+	size_t size = 0;
+	mlod_pack_stats st;
+	CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, &st, &terr));
+	const uint8_t *p = out;
+	CHECK(memcmp(p, "MLOD", 4) == 0 && rd32(p + 28) == crc(p, 28));
+	uint32_t chunks = rd32(p + 12);
+	CHECK(rd32(p + 24) == crc(p + 32, 48 * (size_t)chunks));
+	CHECK(st.mesh.levels == 2 && st.skeleton.levels == 1 && st.motion.levels == 1);
+	/* MESH level 0: the input's primitive, quantised. */
+	const uint8_t *mesh = NULL;
+	for (uint32_t i = 0; i < chunks; i++) {
+		const uint8_t *e = p + 32 + 48 * i;
+		uint64_t off = rd32(e + 16) | (uint64_t)rd32(e + 20) << 32;
+		CHECK(rd32(e + 32) == crc(p + off, rd32(e + 24)));
+		if (rd32(e) == MLOD_CHUNK_MESH && e[6] == 0 && e[7] == 0)
+			mesh = p + off;
+	}
+	CHECK(mesh);
+	uint32_t cnt, esz;
+	mlod_pack_part_rec *part = (mlod_pack_part_rec *)stream(mesh, MLOD_STREAM_PART, 0, &cnt, &esz);
+	CHECK(part && cnt == 1 && esz == sizeof *part);
+	const mlod_primitive *pr = &c.meshes[c.instances[0].mesh].primitives[0];
+	CHECK(part->vertex_count == (uint32_t)pr->vertex_count && part->index_count == (uint32_t)pr->index_count);
+	CHECK(part->flags & MLOD_PART_SKINNED);
+	uint16_t *pos = (uint16_t *)stream(mesh, MLOD_STREAM_POSQ, 0, &cnt, &esz);
+	int16_t *nrm = (int16_t *)stream(mesh, MLOD_STREAM_NRMQ, 0, &cnt, &esz);
+	uint8_t *wgt = stream(mesh, MLOD_STREAM_WGT8, 0, &cnt, &esz);
+	uint8_t *jnt = stream(mesh, MLOD_STREAM_JNT8, 0, &cnt, &esz);
+	uint16_t *idx = (uint16_t *)stream(mesh, MLOD_STREAM_IDX, 0, &cnt, &esz);
+	CHECK(pos && nrm && wgt && jnt && idx && esz == 2 && cnt == part->index_count);
+	for (int v = 0; v < pr->vertex_count; v++) {
+		for (int a = 0; a < 3; a++) {
+			float back = part->pos_min[a] + (float)pos[4 * v + a] * part->pos_scale[a];
+			CHECK_NEAR(back, pr->positions[3 * v + a], 0.5 * part->pos_scale[a] + 1e-5);
+		}
+		float d[3];
+		mlod_pack_oct_decode(nrm + 2 * v, d);
+		CHECK(angle(d, pr->normals + 3 * v) <= MLOD_PACK_OCT_BOUND);
+		CHECK(wgt[4 * v] + wgt[4 * v + 1] + wgt[4 * v + 2] + wgt[4 * v + 3] == 255);
+		/* the weight on each joint is within a unorm8 step of the input's */
+		for (int t = 0; t < 4; t++) {
+			float want = 0.0f, got = 0.0f, sum = 0.0f;
+			for (int i = 0; i < 4; i++) {
+				sum += pr->weights[0][4 * v + i];
+				if (pr->joints[0][4 * v + i] == jnt[4 * v + t])
+					want += pr->weights[0][4 * v + i];
+				if (jnt[4 * v + i] == jnt[4 * v + t])
+					got += wgt[4 * v + i] / 255.0f;
+			}
+			CHECK_MSG(fabsf(got - want / sum) <= 1.0f / 255.0f, "vertex %d joint %d: %g for %g", v, jnt[4 * v + t],
+			          got, want / sum);
+		}
+	}
+	for (uint32_t i = 0; i < part->index_count; i++)
+		CHECK(idx[i] == pr->indices[i]);
+	free(part);
+	free(pos);
+	free(nrm);
+	free(wgt);
+	free(jnt);
+	free(idx);
+	mlod_free(out);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	free(in);
+}
+
+int main(void)
+{
+	RUN(weights_sum_to_255);
+	RUN(u16_within_half_a_step);
+	RUN(octahedral_within_bound);
+	RUN(switch_distance_one_pixel);
+	RUN(pack_mesh_streams);
+	TEST_EXIT();
+}
