@@ -28,9 +28,10 @@
  * mlod_pack_q* helpers below.
  *
  * The output is deterministic: the same input and options give the same
- * bytes. The DOC chunk holds the input glb as read (a glTF or BVH input is
- * written as glb first); stripping the geometry and clips the levels hold
- * from it is not done yet.
+ * bytes. The DOC chunk holds the input document without what the levels
+ * hold (mlod_gltf_strip_levels: geometry, joint channels, MSFT_lod), as
+ * glb; when it cannot be stripped (an extension that may refer to
+ * accessors) or with doc_whole, the input glb as read, with a note.
  */
 #ifndef MLOD_PACK_WRITE_H
 #define MLOD_PACK_WRITE_H
@@ -70,6 +71,7 @@ typedef struct mlod_pack_options {
 	double point_distance;       /* 0: 0.1 for glTF, height / 18 for BVH (as mlod-motion) */
 	/* each layer can be left at level 0 alone */
 	int no_skeleton_levels, no_mesh_levels, no_motion_levels;
+	int doc_whole;               /* DOC: the input glb whole, not stripped */
 } mlod_pack_options;
 
 void mlod_pack_options_default(mlod_pack_options *opt);
@@ -86,6 +88,7 @@ typedef struct mlod_pack_layer_stats {
 typedef struct mlod_pack_stats {
 	mlod_pack_layer_stats skeleton, mesh, motion;
 	uint64_t info_bytes, doc_bytes, total;
+	int doc_stripped;            /* DOC holds the stripped document (else the input whole) */
 	uint32_t chunks, first_drawable;
 	int joints, skins, parts, clips;
 	float height, diagonal;

@@ -1476,21 +1476,41 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		}
 		x.st->motion.seconds += now_seconds() - t0;
 	}
-	/* DOC: the input glb as read (a glTF or BVH input as glb). */
+	/* DOC: the input without what the levels hold (mlod_gltf_strip_levels),
+	 * or as read when it cannot be stripped. */
 	{
 		chunkb cb = {0};
 		void *glb = NULL;
 		size_t glb_size = 0;
-		if (format == MLOD_FORMAT_GLB && input) {
+		mlod_gltf *copy = NULL;
+		mlod_error serr = {0};
+		mlod_result sr = doc ? mlod_gltf_copy(doc, &copy, &serr) : MLOD_ERR_INVALID_ARG;
+		if (sr == MLOD_OK && !opt->doc_whole)
+			sr = mlod_gltf_strip_levels(copy, &serr);
+		if (sr == MLOD_OK)
+			sr = mlod_gltf_write(copy, 1, &glb, &glb_size, &serr);
+		mlod_gltf_free(copy);
+		if (sr == MLOD_OK) {
+			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
+			x.st->doc_stripped = !opt->doc_whole;
+		} else if (format == MLOD_FORMAT_GLB && input) {
+			char text[MLOD_ERROR_MESSAGE_SIZE + 64];
+			snprintf(text, sizeof text, "the document chunk holds the input whole: %s", serr.message);
+			note(&x, text);
 			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)input_size, 1, input, 0);
 		} else if (doc) {
+			mlod_free(glb);
+			glb = NULL;
 			if ((r = mlod_gltf_write(doc, 1, &glb, &glb_size, err)) != MLOD_OK)
 				goto done;
+			char text[MLOD_ERROR_MESSAGE_SIZE + 64];
+			snprintf(text, sizeof text, "the document chunk holds the input whole: %s", serr.message);
+			note(&x, text);
 			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
-			mlod_free(glb);
 		} else {
 			cb_add(&cb, MLOD_STREAM_GLB, 0, 1, NULL, 0);
 		}
+		mlod_free(glb);
 		if ((r = cb_finish(&cb, MLOD_CODEC_NONE, &body, MLOD_CHUNK_DOC, MLOD_LAYER_NONE, 0, 0, 0.0f, err)) != MLOD_OK)
 			goto done;
 	}

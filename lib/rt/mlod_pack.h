@@ -134,7 +134,15 @@
  *   meshes' geometry and the joint clips, which the levels hold: materials,
  *   textures, images, samplers, names, extras, extensions, the node tree,
  *   skins and everything else the input carried. The runtime skips it;
- *   mlod-pack -x rebuilds a glb from it and the levels.
+ *   mlod-pack -x rebuilds a glb from it and the levels. (Writer's note:
+ *   as mlod_gltf_strip_levels makes it: primitives keep mode, material,
+ *   extensions and extras with empty attributes, no indices, no targets;
+ *   animations keep their morph weights channels (those left empty go:
+ *   animation indices change); MSFT_lod goes, its level nodes stay
+ *   without mesh or skin; node, mesh, skin and material indices hold, so
+ *   'PART' node, mesh and material and 'SKIN' gltf_index refer to it. A
+ *   document with an extension that may refer to accessors is stored as
+ *   read, whole.)
  */
 #ifndef MLOD_PACK_H
 #define MLOD_PACK_H

@@ -3,11 +3,12 @@
 // stream containers, INFO), independently of the C reader, and prints a
 // summary as JSON for the tests to check. Exits 1 naming the first problem.
 //
-//   node tests/cli/pack_check.mjs FILE.mlod
+//   node tests/cli/pack_check.mjs FILE.mlod [--doc OUT.glb]
 //
+// --doc writes the DOC chunk's glb to OUT.glb.
 // It does not decode streams: the round trip through the reader
 // (lib/rt/pack.c) is for the tests that come with it.
-import { readFileSync } from 'node:fs';
+import { readFileSync, writeFileSync } from 'node:fs';
 import { crc32 } from 'node:zlib';
 
 const file = process.argv[2];
@@ -110,5 +111,10 @@ if (out.first_drawable > b.length || out.first_drawable < chunks[1].offset + chu
 for (const c of chunks) {
 	const coarsest = c.type === 'MESH' ? out.mesh_levels - 1 : c.type === 'ANIM' ? out.motion_levels - 1 : c.type === 'SKEL' ? out.skeleton_levels - 1 : -1;
 	if (c.level === coarsest && c.offset + c.stored > out.first_drawable) die(`${c.type} level ${c.level} past first_drawable`);
+}
+if (process.argv[3] === '--doc') {
+	const d = chunks[n - 1], s = d.streams[0];
+	if (s.tag !== 'GLB ' || s.codec !== 0) die('DOC stream');
+	writeFileSync(process.argv[4], b.subarray(d.offset + s.at, d.offset + s.at + s.count));
 }
 console.log(JSON.stringify(out));
