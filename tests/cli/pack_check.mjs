@@ -101,6 +101,7 @@ const out = {
 	stream_codecs: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.codec)))].sort(),
 	tags: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.tag)))].sort(),
 	doc: chunks[n - 1].streams[0].count,
+	toc: chunks.map((c) => `${c.type.trim()} ${c.level}/${c.item} ${c.crc.toString(16)}`),
 };
 for (const c of chunks) out.count[c.type.trim()] = (out.count[c.type.trim()] || 0) + 1;
 if (out.count.SKEL !== out.skeleton_levels) die('SKEL chunks and INFO skeleton_levels');
