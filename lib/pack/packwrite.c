@@ -368,7 +368,7 @@ static int mesh_of_gltf(const mlod_character *c, int g)
 
 /* The level nodes of instance node `node`, by mesh level (1-based) into
  * nodes[]; returns the largest level found. */
-static mlod_result level_nodes(struct ctx *x, int node, int *nodes, int *max_level)
+static mlod_result level_nodes(struct ctx *x, int node, int *nodes, int *max_level, double *errors)
 {
 	int ids[64], count = 0;
 	*max_level = 0;
@@ -382,6 +382,8 @@ static mlod_result level_nodes(struct ctx *x, int node, int *nodes, int *max_lev
 			continue;
 		if (mn.level >= 1 && mn.level <= MLOD_MESH_MAX_LEVELS) {
 			nodes[mn.level - 1] = ids[i];
+			if (errors && mn.error.max > errors[mn.level - 1])
+				errors[mn.level - 1] = mn.error.max;
 			*max_level = mn.level > *max_level ? mn.level : *max_level;
 		}
 	}
@@ -415,7 +417,7 @@ static mlod_result make_view(struct ctx *x)
 		}
 	for (int i = 0; i < c->instance_count; i++) {
 		int nodes[MLOD_MESH_MAX_LEVELS], max = 0;
-		if ((r = level_nodes(x, c->instances[i].node, nodes, &max)) != MLOD_OK) {
+		if ((r = level_nodes(x, c->instances[i].node, nodes, &max, NULL)) != MLOD_OK) {
 			free(level_skin);
 			return r;
 		}
@@ -773,9 +775,10 @@ static mlod_result mesh_levels(struct ctx *x)
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 	for (size_t i = 0; i < MLOD_MESH_MAX_LEVELS * ((size_t)c->instance_count + 1); i++)
 		nodes[i] = -1;
+	double node_error[MLOD_MESH_MAX_LEVELS] = {0};
 	for (int i = 0; r == MLOD_OK && i < c->instance_count; i++) {
 		int m = 0;
-		r = level_nodes(x, c->instances[i].node, nodes + MLOD_MESH_MAX_LEVELS * i, &m);
+		r = level_nodes(x, c->instances[i].node, nodes + MLOD_MESH_MAX_LEVELS * i, &m, node_error);
 		max = m > max ? m : max;
 	}
 	if (r == MLOD_OK && max > 0) {
@@ -789,7 +792,8 @@ static mlod_result mesh_levels(struct ctx *x)
 			x->mesh_count = k + 1;
 			for (int i = 0; i < c->instance_count; i++)
 				x->level_node[k][i] = nodes[MLOD_MESH_MAX_LEVELS * i + k];
-			x->mesh_error[k] = 0.0f;
+			/* The scene's record, else the largest of the level nodes'. */
+			x->mesh_error[k] = (float)(node_error[k] * x->diag / 100.0);
 			for (int q = 0; q < x->rec.mesh_level_count; q++)
 				if (x->rec.mesh_levels[q].level == k + 1)
 					x->mesh_error[k] = (float)(x->rec.mesh_levels[q].error.max * x->diag / 100.0);
