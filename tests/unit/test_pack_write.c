@@ -263,6 +263,229 @@ TEST(pack_mesh_streams)
 	free(in);
 }
 
+
+/* The chunk of this type and level; NULL when there is none. */
+static const uint8_t *find_chunk(const uint8_t *p, uint32_t type, int level)
+{
+	uint32_t chunks = rd32(p + 12);
+	for (uint32_t i = 0; i < chunks; i++) {
+		const uint8_t *e = p + 32 + 48 * i;
+		if (rd32(e) == type && (e[6] | e[7] << 8) == level)
+			return p + (rd32(e + 16) | (uint64_t)rd32(e + 20) << 32);
+	}
+	return NULL;
+}
+
+/* Drops the entry of joint `joint` from skin 0 (vertices on it move to
+ * entry 0), so that a stand-in can be missing from the skin. */
+static void drop_skin_joint(mlod_character *c, int joint)
+{
+	mlod_skin *sk = &c->skeleton.skins[0];
+	int r = -1;
+	for (int q = 0; q < sk->joint_count; q++)
+		if (sk->joints[q] == joint)
+			r = q;
+	if (r < 0)
+		return;
+	for (int q = r; q + 1 < sk->joint_count; q++) {
+		sk->joints[q] = sk->joints[q + 1];
+		sk->inverse_bind[q] = sk->inverse_bind[q + 1];
+	}
+	sk->joint_count--;
+	for (int i = 0; i < c->instance_count; i++) {
+		if (c->instances[i].skin != 0)
+			continue;
+		mlod_mesh *m = &c->meshes[c->instances[i].mesh];
+		for (int p = 0; p < m->primitive_count; p++)
+			for (int s = 0; s < m->primitives[p].weight_set_count; s++)
+				for (int v = 0; v < 4 * m->primitives[p].vertex_count; v++) {
+					uint16_t *jt = &m->primitives[p].joints[s][v];
+					*jt = *jt == r ? 0 : *jt > r ? (uint16_t)(*jt - 1) : *jt;
+				}
+	}
+}
+
+/* The skeleton levels' palettes reproduce fold.c's skin transfer: for
+ * every skin joint, the level skin that mlod_skel_level_apply makes holds
+ * the joint PALJ names with the bind matrix PALB gives, and KEPT lists
+ * the level's kept joints. Twice: on tubeman, whose skin has every joint
+ * (a stand-in's own bind), and with a stand-in dropped from the skin
+ * (R(stand-in -> joint) * IBM(joint)). */
+TEST(pack_palette_is_fold)
+{
+	size_t n = 0;
+	void *in = slurp("samples/tubeman.glb", &n);
+	CHECK(in);
+	int outside_total = 0;
+	for (int variant = 0; variant < 2; variant++) {
+		mlod_gltf *doc = NULL;
+		mlod_character c;
+		mlod_format fmt;
+		CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+		mlod_joint_info *info = calloc((size_t)c.skeleton.joint_count, sizeof *info);
+		mlod_label_options lopt = {0};
+		mlod_skel_levels L;
+		memset(&L, 0, sizeof L);
+		CHECK_OK(mlod_label_skeleton(&c, &lopt, info, &terr));
+		if (variant == 1) {
+			/* the stand-in of the first joint the first level removes */
+			CHECK_OK(mlod_skel_levels_init(&L, &c, info, &terr));
+			CHECK_OK(mlod_skel_levels_default(&L, MLOD_SKEL_MAX_ERROR_DEFAULT, &terr));
+			int stand = -1;
+			for (int k = 0; k < L.count && stand < 0; k++)
+				for (int j = 0; j < c.skeleton.joint_count && stand < 0; j++)
+					if (!L.levels[k].skel.kept[j] && L.levels[k].skel.remap[j] != c.skeleton.skins[0].joints[0])
+						stand = L.levels[k].skel.remap[j];
+			mlod_skel_levels_free(&L);
+			memset(&L, 0, sizeof L);
+			CHECK(stand >= 0);
+			drop_skin_joint(&c, stand);
+		}
+		/* The levels mlod-pack computes: mlod-skelgraph's defaults. */
+		CHECK_OK(mlod_skel_levels_init(&L, &c, info, &terr));
+		CHECK_OK(mlod_skel_levels_default(&L, MLOD_SKEL_MAX_ERROR_DEFAULT, &terr));
+		CHECK(L.count >= 2);
+		mlod_pack_options opt;
+		mlod_pack_options_default(&opt);
+		opt.no_mesh_levels = opt.no_motion_levels = 1;
+		opt.codec = MLOD_CODEC_NONE;
+		void *out = NULL;
+		size_t size = 0;
+		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, NULL, &terr));
+		const mlod_skin *sk = &c.skeleton.skins[0];
+		CHECK(c.skeleton.skin_count == 1);
+		int removed_in_skin = 0;
+		for (int k = 0; k < L.count; k++) {
+			const mlod_skel_built *b = &L.levels[k];
+			const uint8_t *ch = find_chunk(out, MLOD_CHUNK_SKELETON, k + 1);
+			CHECK_MSG(ch, "no SKEL level %d", k + 1);
+			uint32_t kc, pc, bc, es;
+			uint32_t *kept = (uint32_t *)stream(ch, MLOD_STREAM_KEPT, 0, &kc, &es);
+			uint32_t *palj = (uint32_t *)stream(ch, MLOD_STREAM_PALJ, 0, &pc, &es);
+			float *palb = (float *)stream(ch, MLOD_STREAM_PALB, 0, &bc, &es);
+			CHECK(kept && palj && palb && es == 64);
+			CHECK(kc == (uint32_t)b->skel.kept_count && pc == (uint32_t)sk->joint_count && bc == pc);
+			for (uint32_t i = 0; i < kc; i++)
+				CHECK(b->skel.kept[kept[i]] && (i == 0 || kept[i] > kept[i - 1]));
+			const mlod_skin *lsk = &b->c.skeleton.skins[0];
+			for (int q = 0; q < sk->joint_count; q++) {
+				int j = sk->joints[q], in_skin = 0;
+				CHECK(palj[q] == (uint32_t)b->skel.remap[j]);
+				removed_in_skin += !b->skel.kept[j];
+				for (int t = 0; t < sk->joint_count; t++)
+					in_skin |= sk->joints[t] == (int)palj[q];
+				outside_total += !in_skin;
+				/* the level skin's entry for that joint, by node */
+				int found = 0;
+				for (int t = 0; t < lsk->joint_count && !found; t++) {
+					if (b->c.skeleton.joints[lsk->joints[t]].node != c.skeleton.joints[palj[q]].node)
+						continue;
+					found = 1;
+					for (int e = 0; e < 16; e++)
+						CHECK_MSG(fabsf(lsk->inverse_bind[t].m[e] - palb[16 * q + e]) <=
+						              1e-6f * (1.0f + fabsf(palb[16 * q + e])),
+						          "variant %d level %d, skin joint %d: PALB[%d] %g, fold.c %g", variant, k + 1, q, e,
+						          palb[16 * q + e], lsk->inverse_bind[t].m[e]);
+				}
+				CHECK_MSG(found, "level %d: skin joint %d's stand-in is not in the level skin", k + 1, q);
+			}
+			free(kept);
+			free(palj);
+			free(palb);
+		}
+		CHECK(removed_in_skin > 0); /* the rule for removed joints was exercised */
+		mlod_free(out);
+		mlod_skel_levels_free(&L);
+		free(info);
+		mlod_character_free(&c);
+		mlod_gltf_free(doc);
+	}
+	CHECK(outside_total > 0); /* and the one for a stand-in outside the skin */
+	free(in);
+}
+
+/* A skin of more than 256 joints stores u16 joints ('JN16'), and a
+ * character built in memory packs without a document. */
+TEST(pack_joints16)
+{
+	enum { N = 300 };
+	static mlod_joint joints[N];
+	static int skin_joints[N];
+	static mlod_mat4 ibm[N];
+	for (int i = 0; i < N; i++) {
+		memset(&joints[i], 0, sizeof joints[i]);
+		joints[i].name = "j";
+		joints[i].parent = i - 1;
+		joints[i].rest = mlod_trs_identity();
+		joints[i].rest.t.y = 0.01f;
+		joints[i].base = mlod_mat4_identity();
+		joints[i].node = -1;
+		skin_joints[i] = i;
+		ibm[i] = mlod_mat4_identity();
+	}
+	mlod_skin skin = {"skin", N, skin_joints, ibm, -1};
+	float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+	uint16_t jv[12] = {299, 5, 0, 0, 299, 5, 0, 0, 7, 0, 0, 0};
+	float wv[12] = {0.5f, 0.5f, 0, 0, 0.25f, 0.75f, 0, 0, 1, 0, 0, 0};
+	uint32_t idx[3] = {0, 1, 2};
+	mlod_primitive prim;
+	memset(&prim, 0, sizeof prim);
+	prim.vertex_count = 3;
+	prim.positions = pos;
+	prim.weight_set_count = 1;
+	prim.joints[0] = jv;
+	prim.weights[0] = wv;
+	prim.index_count = 3;
+	prim.indices = idx;
+	prim.mode = 4;
+	prim.material = -1;
+	mlod_mesh mesh = {"m", 1, &prim, -1};
+	mlod_instance inst = {0, -1, 0, -1, mlod_mat4_identity()};
+	mlod_character c;
+	memset(&c, 0, sizeof c);
+	c.skeleton.joint_count = N;
+	c.skeleton.joints = joints;
+	c.skeleton.skin_count = 1;
+	c.skeleton.skins = &skin;
+	c.mesh_count = 1;
+	c.meshes = &mesh;
+	c.instance_count = 1;
+	c.instances = &inst;
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	opt.no_skeleton_levels = opt.no_mesh_levels = opt.no_motion_levels = 1;
+	void *out = NULL;
+	size_t size = 0;
+	mlod_pack_stats st;
+	CHECK_OK(mlod_pack_write(NULL, &c, MLOD_FORMAT_UNKNOWN, NULL, 0, &opt, &out, &size, &st, &terr));
+	CHECK(st.joints == N && st.parts == 1 && st.mesh.levels == 1 && st.motion.levels == 0);
+	const uint8_t *mesh0 = find_chunk(out, MLOD_CHUNK_MESH, 0);
+	CHECK(mesh0);
+	uint32_t cnt, esz;
+	mlod_pack_part_rec *part = (mlod_pack_part_rec *)stream(mesh0, MLOD_STREAM_PART, 0, &cnt, &esz);
+	uint16_t *j16 = (uint16_t *)stream(mesh0, MLOD_STREAM_JN16, 0, &cnt, &esz);
+	uint8_t *w8 = stream(mesh0, MLOD_STREAM_WGT8, 0, &cnt, &esz);
+	CHECK(part && j16 && w8 && !stream(mesh0, MLOD_STREAM_JNT8, 0, &cnt, &esz));
+	CHECK((part->flags & (MLOD_PART_SKINNED | MLOD_PART_JOINTS16)) == (MLOD_PART_SKINNED | MLOD_PART_JOINTS16));
+	for (int v = 0; v < 3; v++) {
+		CHECK(w8[4 * v] + w8[4 * v + 1] + w8[4 * v + 2] + w8[4 * v + 3] == 255);
+		for (int t = 0; t < 4; t++) {
+			float got = w8[4 * v + t] / 255.0f;
+			float want = 0.0f;
+			for (int i = 0; i < 4; i++)
+				if (jv[4 * v + i] == j16[4 * v + t])
+					want += wv[4 * v + i];
+			CHECK_MSG(got == 0.0f || fabsf(got - want) <= 1.0f / 255.0f, "vertex %d: joint %d %g for %g", v,
+			          j16[4 * v + t], got, want);
+		}
+	}
+	CHECK(j16[0] == 299 || j16[1] == 299);
+	free(part);
+	free(j16);
+	free(w8);
+	mlod_free(out);
+}
+
 int main(void)
 {
 	RUN(weights_sum_to_255);
@@ -270,5 +493,7 @@ int main(void)
 	RUN(octahedral_within_bound);
 	RUN(switch_distance_one_pixel);
 	RUN(pack_mesh_streams);
+	RUN(pack_palette_is_fold);
+	RUN(pack_joints16);
 	TEST_EXIT();
 }
