@@ -486,6 +486,110 @@ TEST(pack_joints16)
 	mlod_free(out);
 }
 
+/* The lossless fields are exact: SKEL level 0 holds the input's joints
+ * and inverse binds, ANIM level 0 every key of the clip bit for bit
+ * (rotations on the short lattice as 'ROTQ', q / 32767 giving the value
+ * back), with the meshopt codec. */
+TEST(pack_lossless_fields)
+{
+	const char *files[] = {"samples/RobotExpressive.glb", "samples/cmu_12_01_walk.bvh"};
+	int rotq = 0, rotf = 0;
+	for (int f = 0; f < 2; f++) {
+		size_t n = 0;
+		void *in = slurp(files[f], &n);
+		CHECK(in);
+		mlod_gltf *doc = NULL;
+		mlod_character c;
+		mlod_format fmt;
+		CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+		mlod_pack_options opt;
+		mlod_pack_options_default(&opt);
+		opt.no_skeleton_levels = opt.no_mesh_levels = opt.no_motion_levels = 1;
+		void *out = NULL;
+		size_t size = 0;
+		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, NULL, &terr));
+		const uint8_t *sk = find_chunk(out, MLOD_CHUNK_SKELETON, 0);
+		CHECK(sk);
+		uint32_t cnt, esz;
+		mlod_pack_joint_rec *jr = (mlod_pack_joint_rec *)stream(sk, MLOD_STREAM_JNTS, 0, &cnt, &esz);
+		CHECK(jr && cnt == (uint32_t)c.skeleton.joint_count && esz == sizeof *jr);
+		for (int j = 0; j < c.skeleton.joint_count; j++) {
+			const mlod_joint *q = &c.skeleton.joints[j];
+			CHECK(jr[j].parent == q->parent && jr[j].node == q->node);
+			CHECK(memcmp(jr[j].t, &q->rest.t, 12) == 0 && memcmp(jr[j].r, &q->rest.r, 16) == 0 &&
+			      memcmp(jr[j].s, &q->rest.s, 12) == 0 && memcmp(jr[j].base, q->base.m, 64) == 0);
+		}
+		free(jr);
+		float *ib = (float *)stream(sk, MLOD_STREAM_IBMS, 0, &cnt, &esz);
+		CHECK(ib);
+		for (int i = 0, e = 0; i < c.skeleton.skin_count; i++)
+			for (int q = 0; q < c.skeleton.skins[i].joint_count; q++, e++)
+				CHECK(memcmp(ib + 16 * e, c.skeleton.skins[i].inverse_bind[q].m, 64) == 0);
+		free(ib);
+		/* every clip's level 0 */
+		uint32_t chunks = rd32((const uint8_t *)out + 12);
+		int clips = 0;
+		for (uint32_t i = 0; i < chunks; i++) {
+			const uint8_t *e = (const uint8_t *)out + 32 + 48 * i;
+			if (rd32(e) != MLOD_CHUNK_MOTION || (e[6] | e[7] << 8) != 0)
+				continue;
+			const mlod_clip *clip = &c.clips[e[8] | e[9] << 8];
+			const uint8_t *ch = (const uint8_t *)out + rd32(e + 16);
+			mlod_pack_channel_rec *cr = (mlod_pack_channel_rec *)stream(ch, MLOD_STREAM_CHAN, 0, &cnt, &esz);
+			CHECK(cr && cnt == (uint32_t)clip->channel_count);
+			int nrotq = 0, nrotf = 0, nvec = 0;
+			for (int k = 0; k < clip->channel_count; k++) {
+				const mlod_channel *cc = &clip->channels[k];
+				int per = cc->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1, comps = cc->path == MLOD_PATH_ROTATION ? 4 : 3;
+				CHECK(cr[k].joint == (uint32_t)cc->joint && cr[k].path == (uint32_t)cc->path &&
+				      cr[k].interp == (uint32_t)cc->interp && cr[k].key_count == (uint32_t)cc->key_count);
+				float *t = (float *)stream(ch, MLOD_STREAM_TIME, k, &cnt, &esz);
+				CHECK(t && cnt == (uint32_t)cc->key_count && memcmp(t, cc->times, 4 * cnt) == 0);
+				free(t);
+				size_t values = (size_t)cc->key_count * per * comps;
+				if (comps == 3) {
+					float *v = (float *)stream(ch, MLOD_STREAM_VEC3, nvec++, &cnt, &esz);
+					CHECK(v && memcmp(v, cc->values, 4 * values) == 0);
+					free(v);
+					continue;
+				}
+				/* which of ROTQ or ROTF this channel used: the k-th rotation */
+				uint32_t n0 = rd32(ch);
+				int rot = 0, tag = 0;
+				for (uint32_t s = 0; s < n0; s++) {
+					uint32_t tg = rd32(ch + 4 + 16 * s);
+					if (tg == MLOD_STREAM_ROTQ || tg == MLOD_STREAM_ROTF) {
+						if (rot == nrotq + nrotf)
+							tag = (int)tg;
+						rot++;
+					}
+				}
+				if ((uint32_t)tag == MLOD_STREAM_ROTQ) {
+					int16_t *q = (int16_t *)stream(ch, MLOD_STREAM_ROTQ, nrotq++, &cnt, &esz);
+					CHECK(q && cnt == (uint32_t)cc->key_count);
+					for (size_t v = 0; v < values; v++)
+						CHECK_MSG((float)q[v] / 32767.0f == cc->values[v], "ROTQ %d/32767 for %.9g", q[v], cc->values[v]);
+					free(q);
+					rotq++;
+				} else {
+					float *v = (float *)stream(ch, MLOD_STREAM_ROTF, nrotf++, &cnt, &esz);
+					CHECK(v && memcmp(v, cc->values, 4 * values) == 0);
+					free(v);
+					rotf++;
+				}
+			}
+			free(cr);
+			clips++;
+		}
+		CHECK(clips == c.clip_count);
+		mlod_free(out);
+		mlod_character_free(&c);
+		mlod_gltf_free(doc);
+		free(in);
+	}
+	CHECK(rotq > 0 && rotf > 0); /* both rotation forms were met */
+}
+
 int main(void)
 {
 	RUN(weights_sum_to_255);
@@ -495,5 +599,6 @@ int main(void)
 	RUN(pack_mesh_streams);
 	RUN(pack_palette_is_fold);
 	RUN(pack_joints16);
+	RUN(pack_lossless_fields);
 	TEST_EXIT();
 }
