@@ -40,14 +40,16 @@ echo "|---|---|---|---|---|---|---|"
 for f in $INPUTS; do
 	name=$(basename "$f"); name=${name%.*}
 	case $f in
-	*.bvh) glb=$tmp/$name.glb; "$bin/mlod-label" -o "$glb" "$f" ;;
+	*.bvh) glb=$tmp/$name.glb; "$bin/mlod-label" -o "$glb" "$f" 2> /dev/null ;;
 	*) glb=$f ;;
 	esac
 	images=$(node bench/glb-image-bytes.mjs "$glb")
 	start=$(date +%s.%N)
-	"$bin/mlod-pack" -o "$tmp/$name.mlod" "$f"
+	"$bin/mlod-pack" -o "$tmp/$name.mlod" "$f" 2> /dev/null
 	end=$(date +%s.%N)
-	"$bin/mlod-label" < "$f" | "$bin/mlod-skelgraph" | "$bin/mlod-bgm" | "$bin/mlod-motion" > "$tmp/$name.pipe.glb"
+	"$bin/mlod-pack" --codec none -o "$tmp/$name.none.mlod" "$f" 2> /dev/null
+	"$bin/mlod-label" < "$f" 2> /dev/null | "$bin/mlod-skelgraph" 2> /dev/null | "$bin/mlod-bgm" 2> /dev/null |
+		"$bin/mlod-motion" > "$tmp/$name.pipe.glb" 2> /dev/null
 	$gltfpack -i "$glb" -o "$tmp/$name.gp.glb" -cc > /dev/null 2>&1 || continue
 	cp "$tmp/$name.gp.glb" "$tmp/$name.gpl.bin"
 	for r in $ratios; do
@@ -55,7 +57,7 @@ for f in $INPUTS; do
 		cat "$tmp/$name.gp$r.glb" >> "$tmp/$name.gpl.bin"
 	done
 	set -- $(sizes "$tmp/$name.mlod"); pr=$1 pg=$2 pz=$3
-	for row in "pack:$tmp/$name.mlod:1" "gltfpack -cc:$tmp/$name.gp.glb:1" "gltfpack -cc, per level:$tmp/$name.gpl.bin:4" "pipeline glb:$tmp/$name.pipe.glb:1"; do
+	for row in "pack:$tmp/$name.mlod:1" "pack --codec none:$tmp/$name.none.mlod:1" "gltfpack -cc:$tmp/$name.gp.glb:1" "gltfpack -cc, per level:$tmp/$name.gpl.bin:4" "pipeline glb:$tmp/$name.pipe.glb:1"; do
 		label=${row%%:*}; rest=${row#*:}; file=${rest%:*}; copies=${rest##*:}
 		set -- $(sizes "$file")
 		echo "| $name | $label | $1 | $2 | $3 | $(( $1 - images * copies )) | $(ratio "$pg" "$2") |"

@@ -14,6 +14,7 @@
  *   mesh/mlod_mesh.h          BindGraphMesh, collapses, Power Skinning (4.2)
  *   motion/mlod_motion.h      motion tree, key reduction, weight tracks (4.3)
  *   record/mlod_record.h      the stage record, extras.mlod (mlod-record(5))
+ *   pack/mlod_pack_write.h    the .mlod pack writer (mlod(5); layout in rt/mlod_pack.h)
  *
  * The runtime (lib/rt, header mlod_rt.h) builds from core alone and does
  * not include this header.
@@ -29,5 +30,6 @@
 #include "mesh/mlod_mesh.h"
 #include "motion/mlod_motion.h"
 #include "record/mlod_record.h"
+#include "pack/mlod_pack_write.h"
 
 #endif /* MLOD_H */

@@ -138,6 +138,18 @@ void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format
 		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
 }
 
+void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format, size_t *size)
+{
+	void *data = tool_read_input(path, size);
+	char *dir = dir_of(path);
+	mlod_error err = {0};
+	mlod_result r = mlod_load(data, *size, dir, doc, c, format, &err);
+	free(dir);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
+	return data;
+}
+
 void tool_write_output(const char *path, const void *data, size_t size, int binary)
 {
 	if (is_stdio(path)) {

@@ -54,6 +54,10 @@ void *tool_read_input(const char *path, size_t *size);
  * NULL. */
 void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format);
 
+/* tool_load that also returns the input's bytes (*size of them; release
+ * with free). */
+void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format, size_t *size);
+
 /* Writes bytes to path atomically (a temporary file in the same directory,
  * then rename), or to stdout when path is NULL or "-". Binary output is
  * refused when stdout is a terminal. Exits 4 on failure. */

@@ -161,6 +161,14 @@ int main(int argc, char **argv)
 	mlod_character c = {0};
 	tool_load(input, report == REPORT_NONE ? &doc : NULL, &c, NULL);
 
+	if (c.skeleton.joint_count == 0 && report == REPORT_NONE) {
+		/* A static prop: nothing to label; pass it through. */
+		fprintf(stderr, "%s: %s: no joints: nothing to label; written unchanged\n", tool_name, tool_input_label(input));
+		tool_write_gltf(output, doc);
+		mlod_character_free(&c);
+		mlod_gltf_free(doc);
+		return 0;
+	}
 	mlod_joint_info *info = calloc((size_t)c.skeleton.joint_count + 1, sizeof *info);
 	mlod_error err = {0};
 	if (!info)

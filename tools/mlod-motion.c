@@ -661,8 +661,20 @@ int main(int argc, char **argv)
 	job.input = tool_input_label(optind < argc ? argv[optind] : NULL);
 	tool_load(optind < argc ? argv[optind] : NULL, bvh_out ? NULL : &doc, &job.c, &job.format);
 	job.doc = doc;
-	if (job.c.clip_count == 0)
-		tool_die(EXIT_INPUT, job.input, "no animation to reduce (a BVH with 'Frames: 0' has none)");
+	if (job.c.clip_count == 0) {
+		/* Nothing to reduce (a static prop, a character without clips):
+		 * pass it through, so that a pipeline over many assets goes on. */
+		const char *why = job.format == MLOD_FORMAT_BVH ? "no animation (the BVH has 'Frames: 0')" : "no animation";
+		if (bvh_out)
+			tool_die(EXIT_INPUT, job.input, "%s: no clip to write as BVH", why);
+		if (report == REPORT_NONE) {
+			fprintf(stderr, "%s: %s: %s: nothing to reduce; written unchanged\n", tool_name, job.input, why);
+			tool_write_gltf(output, doc);
+			mlod_character_free(&job.c);
+			mlod_gltf_free(doc);
+			return 0;
+		}
+	}
 	job.height = mlod_skeleton_size(&job.c.skeleton);
 	/* 10 cm: glTF is in metres; a BVH's unit is its own, so a person 1.8 units tall gets 0.1. */
 	job.point_distance = point_distance > 0.0                 ? point_distance
@@ -670,13 +682,13 @@ int main(int argc, char **argv)
 	                                                          : GLTF_POINT_DISTANCE;
 	job.opt.point_distance = job.point_distance;
 	for (int s = 0; s < job.spec_count; s++)
-		if (job.specs[s].percent && !(job.height > 0.0))
+		if (job.specs[s].percent && !(job.height > 0.0) && job.c.clip_count > 0)
 			tool_die(EXIT_INPUT, job.input, "--max-error in %%: the skeleton has no height");
 
 	if (bvh_out && clip >= job.c.clip_count)
 		tool_die(EXIT_USAGE, NULL, "--clip %d: the input has %d clips", clip, job.c.clip_count);
 	job.clip_count = bvh_out ? 1 : job.c.clip_count;
-	job.clips = calloc((size_t)job.clip_count, sizeof *job.clips);
+	job.clips = calloc((size_t)job.clip_count + 1, sizeof *job.clips);
 	if (!job.clips)
 		tool_die(EXIT_INPUT, job.input, "out of memory");
 	for (int k = 0; k < job.clip_count; k++) {

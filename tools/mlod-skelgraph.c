@@ -230,6 +230,14 @@ int main(int argc, char **argv)
 	mlod_error err = {0};
 	job.input = tool_input_label(optind < argc ? argv[optind] : NULL);
 	tool_load(optind < argc ? argv[optind] : NULL, &doc, &job.c, NULL);
+	if (job.c.skeleton.joint_count == 0 && report == REPORT_NONE && !bvh_out) {
+		/* A static prop: no skeleton to reduce; pass it through. */
+		fprintf(stderr, "%s: %s: no joints: no skeleton levels; written unchanged\n", tool_name, job.input);
+		tool_write_gltf(output, doc);
+		mlod_character_free(&job.c);
+		mlod_gltf_free(doc);
+		return 0;
+	}
 	job.info = calloc((size_t)job.c.skeleton.joint_count + 1, sizeof *job.info);
 	if (!job.info)
 		tool_die(EXIT_INPUT, job.input, "out of memory");

@@ -2183,7 +2183,7 @@ template <class T> void keep_only(std::vector<T> &v, const std::vector<bool> &ke
 
 /* Drops the meshes no node uses, then the accessors and buffer views
  * nothing uses, and packs the buffers' bytes again. */
-void prune(mlod_gltf &doc)
+void prune(mlod_gltf &doc, bool meshes = true)
 {
 	Model &m = doc.model;
 	for (const std::string &e : m.extensionsUsed)
@@ -2199,13 +2199,17 @@ void prune(mlod_gltf &doc)
 			i = size_t(i) < map.size() ? map[size_t(i)] : -1;
 	};
 
-	std::vector<bool> used(m.meshes.size());
-	for (const tinygltf::Node &n : m.nodes)
-		mark(used, n.mesh);
-	std::vector<int> map = renumber(doc, "meshes", used);
-	keep_only(m.meshes, used);
-	for (tinygltf::Node &n : m.nodes)
-		apply(map, n.mesh);
+	std::vector<bool> used(m.meshes.size(), true);
+	std::vector<int> map;
+	if (meshes) {
+		used.assign(m.meshes.size(), false);
+		for (const tinygltf::Node &n : m.nodes)
+			mark(used, n.mesh);
+		map = renumber(doc, "meshes", used);
+		keep_only(m.meshes, used);
+		for (tinygltf::Node &n : m.nodes)
+			apply(map, n.mesh);
+	}
 
 	used.assign(m.accessors.size(), false);
 	for (const tinygltf::Mesh &mesh : m.meshes)
@@ -2384,6 +2388,85 @@ void clear_lod(mlod_gltf &doc, int node)
 		else
 			orig["extensionsUsed"] = kept;
 	}
+}
+
+/* What a pack's levels hold goes (mlod_gltf_strip_levels). */
+void strip_levels(mlod_gltf &doc)
+{
+	Model &m = doc.model;
+	for (const std::string &e : m.extensionsUsed)
+		if (!prune_safe(e))
+			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not stripped",
+			     e.c_str());
+	json &orig = doc.original;
+	auto orig_array = [&](const char *name) -> json * {
+		return orig.is_object() && orig.contains(name) && orig[name].is_array() ? &orig[name] : nullptr;
+	};
+	/* MSFT_lod: the level nodes stay, without mesh or skin. */
+	for (size_t n = 0; n < m.nodes.size(); n++)
+		if (m.nodes[n].extensions.count("MSFT_lod"))
+			clear_lod(doc, int(n));
+	/* Every primitive keeps its mode, material, extensions and extras. */
+	json *meshes = orig_array("meshes");
+	for (size_t i = 0; i < m.meshes.size(); i++)
+		for (size_t p = 0; p < m.meshes[i].primitives.size(); p++) {
+			tinygltf::Primitive &pr = m.meshes[i].primitives[p];
+			pr.attributes.clear();
+			pr.indices = -1;
+			pr.targets.clear();
+			if (meshes && i < meshes->size() && (*meshes)[i].is_object() && (*meshes)[i].contains("primitives") &&
+			    (*meshes)[i]["primitives"].is_array() && p < (*meshes)[i]["primitives"].size() &&
+			    (*meshes)[i]["primitives"][p].is_object()) {
+				json &o = (*meshes)[i]["primitives"][p];
+				o["attributes"] = json::object();
+				o.erase("indices");
+				o.erase("targets");
+			}
+		}
+	/* Animations keep their morph weights channels only. */
+	json *anims = orig_array("animations");
+	std::vector<bool> keep(m.animations.size(), true);
+	for (size_t a = 0; a < m.animations.size(); a++) {
+		tinygltf::Animation &an = m.animations[a];
+		json *oa = anims && a < anims->size() && (*anims)[a].is_object() ? &(*anims)[a] : nullptr;
+		std::vector<tinygltf::AnimationChannel> channels;
+		std::vector<int> sampler_map(an.samplers.size(), -1);
+		std::vector<tinygltf::AnimationSampler> samplers;
+		json ochannels = json::array(), osamplers = json::array();
+		for (size_t c = 0; c < an.channels.size(); c++) {
+			tinygltf::AnimationChannel ch = an.channels[c];
+			/* (weights of a node left without mesh: a level node's copy) */
+			if (ch.target_path != "weights" || ch.sampler < 0 || size_t(ch.sampler) >= an.samplers.size() ||
+			    ch.target_node < 0 || size_t(ch.target_node) >= m.nodes.size() ||
+			    m.nodes[size_t(ch.target_node)].mesh < 0)
+				continue;
+			if (sampler_map[size_t(ch.sampler)] < 0) {
+				sampler_map[size_t(ch.sampler)] = int(samplers.size());
+				samplers.push_back(an.samplers[size_t(ch.sampler)]);
+				if (oa && oa->contains("samplers") && (*oa)["samplers"].is_array() &&
+				    size_t(ch.sampler) < (*oa)["samplers"].size())
+					osamplers.push_back((*oa)["samplers"][size_t(ch.sampler)]);
+			}
+			if (oa && oa->contains("channels") && (*oa)["channels"].is_array() && c < (*oa)["channels"].size()) {
+				json oc = (*oa)["channels"][c];
+				oc["sampler"] = sampler_map[size_t(ch.sampler)];
+				ochannels.push_back(oc);
+			}
+			ch.sampler = sampler_map[size_t(ch.sampler)];
+			channels.push_back(ch);
+		}
+		an.channels = std::move(channels);
+		an.samplers = std::move(samplers);
+		if (oa) {
+			(*oa)["channels"] = std::move(ochannels);
+			(*oa)["samplers"] = std::move(osamplers);
+		}
+		keep[a] = !an.channels.empty();
+	}
+	renumber(doc, "animations", keep);
+	keep_only(m.animations, keep);
+	/* The accessors, views and bytes nothing uses any more go. */
+	prune(doc, false);
 }
 
 /* Checks the arguments common to the calls that take a document. */
@@ -2675,6 +2758,55 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
 				fail(MLOD_ERR_UNSUPPORTED, "node %d: its matrix is not a translation, rotation and scale", node);
 		} else {
 			*out = node_trs(n);
+		}
+	});
+}
+
+mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_strip_levels: doc is NULL");
+		strip_levels(*doc);
+	});
+}
+
+mlod_result mlod_gltf_node_refs(const mlod_gltf *doc, int node, int *mesh, int *skin, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && mesh && skin, "mlod_gltf_node_refs: doc, mesh and skin must not be NULL");
+		const Model &m = doc->model;
+		if (node < 0 || node >= int(m.nodes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+		*mesh = m.nodes[size_t(node)].mesh;
+		*skin = m.nodes[size_t(node)].skin;
+	});
+}
+
+mlod_result mlod_gltf_node_lod(const mlod_gltf *doc, int node, int *ids, int max, int *count, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && count && (ids || max == 0), "mlod_gltf_node_lod: doc, ids and count must not be NULL");
+		const Model &m = doc->model;
+		if (node < 0 || node >= int(m.nodes.size()))
+			fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+		*count = 0;
+		const tinygltf::Node &n = m.nodes[size_t(node)];
+		auto it = n.extensions.find("MSFT_lod");
+		if (it == n.extensions.end() || !it->second.IsObject() || !it->second.Has("ids"))
+			return;
+		const tinygltf::Value &v = it->second.Get("ids");
+		if (!v.IsArray())
+			fail(MLOD_ERR_PARSE, "node %d: MSFT_lod.ids is not an array", node);
+		for (size_t i = 0; i < v.ArrayLen(); i++) {
+			const tinygltf::Value &e = v.Get(int(i));
+			if (!e.IsNumber() && !e.IsInt())
+				fail(MLOD_ERR_PARSE, "node %d: MSFT_lod.ids[%zu] is not a node", node, i);
+			int id = e.IsInt() ? e.Get<int>() : int(e.GetNumberAsDouble());
+			if (id < 0 || id >= int(m.nodes.size()))
+				fail(MLOD_ERR_PARSE, "node %d: MSFT_lod.ids[%zu] = %d is not a node", node, i, id);
+			if (*count < max)
+				ids[*count] = id;
+			++*count;
 		}
 	});
 }

@@ -127,6 +127,28 @@ mlod_result mlod_gltf_set_node_mesh(mlod_gltf *doc, int node, int mesh, int skin
  * rotation and scale is MLOD_ERR_UNSUPPORTED. */
 mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out, mlod_error *err);
 
+/* Removes what a pack's levels hold (mlod(5), the DOC chunk): every
+ * primitive's attributes, indices and morph targets (each keeps its mode,
+ * material, extensions and extras), every animation channel but morph
+ * weights ones of nodes that keep a mesh (animations left without
+ * channels go), MSFT_lod (level
+ * nodes stay, without mesh or skin), then the accessors, buffer views and
+ * bytes nothing uses. Node, mesh, skin, material, texture and image
+ * indices hold; animation, accessor and buffer view indices change. The
+ * result is not a valid glTF on its own (primitives without POSITION):
+ * mlod-pack -x puts the levels back. A document using an extension that
+ * may refer to accessors (as mlod_gltf_prune) is MLOD_ERR_UNSUPPORTED and
+ * may be partly stripped: strip a copy. */
+mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, mlod_error *err);
+
+/* The glTF mesh and skin a node points at (-1: none). */
+mlod_result mlod_gltf_node_refs(const mlod_gltf *doc, int node, int *mesh, int *skin, mlod_error *err);
+
+/* The nodes a node's MSFT_lod lists (its coarser levels, finest first):
+ * the first max into ids, their number into *count (0 without MSFT_lod).
+ * An ids entry that is not a node is MLOD_ERR_PARSE. */
+mlod_result mlod_gltf_node_lod(const mlod_gltf *doc, int node, int *ids, int max, int *count, mlod_error *err);
+
 /* Removes the meshes no node uses, then the accessors and buffer views
  * nothing uses, and packs the buffers again: indices of meshes, accessors
  * and buffer views change, every other index stays. A document using an

@@ -91,7 +91,10 @@
  *          joint's own inverse bind when kept; else the stand-in's, or
  *          R(stand-in -> joint) * IBM(joint) when the stand-in is not in
  *          that skin), so that skinning with (PALJ, PALB) equals skinning
- *          the level's transferred weights
+ *          the level's transferred weights. (Writer's note: when several
+ *          removed joints of one skin share a stand-in that skin lacks,
+ *          all take the R * IBM of the first of them in skin order, as
+ *          fold.c's skin transfer does; R is in the rest pose.)
  *
  * MESH level k (layer mesh; level 0 is the input's meshes): one part per
  *   instance and triangle primitive, in instance then primitive order.
@@ -110,9 +113,15 @@
  *   'MTPQ' per morph target: i16[4] per vertex position delta
  *          = q * target_scale[t] (q[3] is 0); 'MTSC' f32 per target before
  *          them: the targets' scales
+ *   (Writer's notes: every level has the same parts, in the same order; a
+ *   rigid part (joint >= 0, skin -1) has no joints or weights and follows
+ *   its joint through offset; a vertex's 4 largest influences over all
+ *   its glTF weight sets are kept; 'PART' comes first but is filled last.)
  *
  * MOTION level k of clip c (layer motion, item c; level 0 is the clip as
- *   read, every key): the channels of one clip on the full skeleton.
+ *   read, every key): the channels of one clip on the full skeleton. Every
+ *   clip has INFO motion_levels levels: a clip with fewer (too few frames,
+ *   no level within a bound) repeats its coarsest one.
  *   'CHAN' channel records (mlod_pack_channel_rec)
  *   then per channel: 'TIME' f32 per key (seconds), and
  *   'ROTQ' i16[4] per key (normalised: value = q / 32767) for a rotation
@@ -125,7 +134,15 @@
  *   meshes' geometry and the joint clips, which the levels hold: materials,
  *   textures, images, samplers, names, extras, extensions, the node tree,
  *   skins and everything else the input carried. The runtime skips it;
- *   mlod-pack -x rebuilds a glb from it and the levels.
+ *   mlod-pack -x rebuilds a glb from it and the levels. (Writer's note:
+ *   as mlod_gltf_strip_levels makes it: primitives keep mode, material,
+ *   extensions and extras with empty attributes, no indices, no targets;
+ *   animations keep their morph weights channels (those left empty go:
+ *   animation indices change); MSFT_lod goes, its level nodes stay
+ *   without mesh or skin; node, mesh, skin and material indices hold, so
+ *   'PART' node, mesh and material and 'SKIN' gltf_index refer to it. A
+ *   document with an extension that may refer to accessors is stored as
+ *   read, whole.)
  *
  * Precisions the reader (lib/rt/pack.c) checks, added with it; they make
  * explicit what the text above implies and change no layout:
@@ -257,7 +274,9 @@ typedef struct mlod_pack_info_rec {
 	float height;              /* the skeleton height (mlod(5)) */
 	float diagonal;            /* of the bounds */
 	uint32_t first_drawable;   /* bytes of the file that hold the coarsest
-	                            * skeleton, mesh and motion levels */
+	                            * skeleton, mesh and motion levels (INFO,
+	                            * SKELETON, and the coarsest level of each
+	                            * layer, of every clip for motion) */
 	uint32_t reserved[3];
 } mlod_pack_info_rec;
 

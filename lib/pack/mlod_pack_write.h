@@ -1,0 +1,136 @@
+/*
+ * mlod_pack_write.h: the bake side of the .mlod pack (mlod(5), whose
+ * layout rt/mlod_pack.h owns): gathers every level of every layer of a
+ * loaded character and writes the pack bytes.
+ *
+ * Levels come from the stage record when the input has them (mlod-label,
+ * mlod-skelgraph, mlod-bgm and mlod-motion ran before), and are computed
+ * with each layer's defaults (or the options below) when it has not:
+ *
+ *   skeleton  the record's skeleton_levels (kept joints and remap, glTF
+ *             nodes); else labels (the record's, or mlod_label_skeleton)
+ *             and mlod_skel_levels_default within skel_max_error
+ *   mesh      the MSFT_lod level nodes with a mesh level record; else
+ *             mlod_mesh_levels_by_ratio (ratios) or _by_error (max_error),
+ *             not following the skeleton levels: a mesh level's joints are
+ *             the full skin's, and a skeleton level's palette (PALJ, PALB)
+ *             does the transfer at run time
+ *   motion    the "<clip>@lod<k>" animations with a motion level record;
+ *             else per clip and bound the frames and the keys methods of
+ *             lib/motion, the one with fewer bytes (mlod-motion's auto)
+ *
+ * A piped document holds the level skins and level animations beside the
+ * full ones: the writer packs the character's full skins (those no record
+ * or level node names as a level's) and full clips (those without a motion
+ * level record) only.
+ *
+ * Quantisation (the bounds tests/unit/test_pack_write.c checks): see the
+ * mlod_pack_q* helpers below.
+ *
+ * The output is deterministic: the same input and options give the same
+ * bytes. The DOC chunk holds the input document without what the levels
+ * hold (mlod_gltf_strip_levels: geometry, joint channels, MSFT_lod), as
+ * glb; when it cannot be stripped (an extension that may refer to
+ * accessors) or with doc_whole, the input glb as read, with a note.
+ */
+#ifndef MLOD_PACK_WRITE_H
+#define MLOD_PACK_WRITE_H
+
+#include "rt/mlod_pack.h"
+#include "io/mlod_io.h"
+#include "mesh/mlod_mesh.h"
+#include "motion/mlod_motion.h"
+#include "skeleton/mlod_skeleton.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MLOD_PACK_MAX_MOTION_LEVELS 32
+/* mlod-motion's default bounds: 0.2%, 1% and 3% of the skeleton height. */
+#define MLOD_PACK_MOTION_BOUNDS_DEFAULT 0.2, 1.0, 3.0
+
+/* Zero-initialised options are not the defaults: start from
+ * mlod_pack_options_default. */
+typedef struct mlod_pack_options {
+	mlod_pack_codec codec;       /* NONE or MESHOPT (DRACO: MLOD_ERR_UNSUPPORTED) */
+	const char *name;            /* the character's name in INFO; NULL: "" */
+	/* skeleton, when computed */
+	double skel_max_error;       /* % of the skeleton height (MLOD_SKEL_MAX_ERROR_DEFAULT) */
+	mlod_label_options label;
+	/* mesh, when computed */
+	int ratio_count;             /* levels at these ratios (decreasing) ... */
+	double ratios[MLOD_MESH_MAX_LEVELS];
+	double mesh_max_error;       /* ... or, when >= 0, down to this % of the diagonal */
+	mlod_bgm_options bgm;
+	mlod_mesh_budget budget;
+	/* motion, when computed */
+	int motion_bound_count;      /* one level per bound on the joint position error */
+	double motion_bounds[MLOD_PACK_MAX_MOTION_LEVELS];
+	unsigned char motion_percent[MLOD_PACK_MAX_MOTION_LEVELS]; /* bound in % of the height, else scene units */
+	double point_distance;       /* 0: 0.1 for glTF, height / 18 for BVH (as mlod-motion) */
+	/* each layer can be left at level 0 alone */
+	int no_skeleton_levels, no_mesh_levels, no_motion_levels;
+	int doc_whole;               /* DOC: the input glb whole, not stripped */
+} mlod_pack_options;
+
+void mlod_pack_options_default(mlod_pack_options *opt);
+
+/* What one layer got. */
+typedef struct mlod_pack_layer_stats {
+	int levels;                  /* counting level 0 (0: the layer is empty) */
+	int from_input;              /* the levels were the input's (1) or computed (0) */
+	uint64_t stored, raw;        /* bytes of its chunks */
+	double seconds;              /* computing its levels and encoding them */
+	float errors[MLOD_PACK_MAX_MOTION_LEVELS + MLOD_MESH_MAX_LEVELS]; /* per level, scene units (largest over clips) */
+} mlod_pack_layer_stats;
+
+typedef struct mlod_pack_stats {
+	mlod_pack_layer_stats skeleton, mesh, motion;
+	uint64_t info_bytes, doc_bytes, total;
+	int doc_stripped;            /* DOC holds the stripped document (else the input whole) */
+	uint32_t chunks, first_drawable;
+	int joints, skins, parts, clips;
+	float height, diagonal;
+	char notes[1024];            /* what was done or skipped, "; "-separated */
+} mlod_pack_stats;
+
+/* Packs the character c read from doc (mlod_load of input, input_size
+ * bytes, in format). *out (release with mlod_free) gets the pack. stats
+ * may be NULL. Errors: MLOD_ERR_UNSUPPORTED for the draco codec,
+ * MLOD_ERR_PARSE for a malformed record, what the layers return. */
+mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_format format, const void *input,
+                            size_t input_size, const mlod_pack_options *opt, void **out, size_t *out_size,
+                            mlod_pack_stats *stats, mlod_error *err);
+
+/* ------------------------------------------------------------------ */
+/* Quantisation, as the writer does it (the reader undoes it)          */
+/* ------------------------------------------------------------------ */
+
+/* Unit vector to octahedral snorm16 (x, y), and back (normalised). The
+ * angle between n and its round trip is below MLOD_PACK_OCT_BOUND. */
+#define MLOD_PACK_OCT_BOUND 1e-4 /* radians (4.3e-5 measured over 200000 random normals) */
+void mlod_pack_oct_encode(const float n[3], int16_t out[2]);
+void mlod_pack_oct_decode(const int16_t in[2], float n[3]);
+
+/* A value within [min, min + 65535 * scale] to u16: q = round((v - min) /
+ * scale) (0 when scale is 0); |min + q * scale - v| <= scale / 2. The
+ * scale for a range: (max - min) / 65535. */
+uint16_t mlod_pack_qu16(float v, float min, float scale);
+float mlod_pack_range_scale(float min, float max);
+
+/* Up to 4 weights (>= 0, any sum > 0) to unorm8 summing exactly to 255
+ * by largest-remainder rounding: each differs from 255 w / sum by less
+ * than 1. A zero sum gives all zeros. */
+void mlod_pack_weights8(const float w[4], uint8_t out[4]);
+
+/* The switch distance of an error (scene units) at MLOD_PACK_FOV_Y,
+ * MLOD_PACK_LINES and MLOD_PACK_PIXELS: error * lines / (2 tan(fov / 2)
+ * pixels). */
+float mlod_pack_switch_distance(float error);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MLOD_PACK_WRITE_H */

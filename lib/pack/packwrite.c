@@ -1,0 +1,1650 @@
+/*
+ * packwrite.c: gathers the levels of every layer and writes the .mlod
+ * pack (mlod_pack_write.h; the layout is rt/mlod_pack.h's).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <meshoptimizer.h>
+
+#include "pack/mlod_pack_write.h"
+#include "record/mlod_record.h"
+
+/* ------------------------------------------------------------------ */
+/* Bytes                                                               */
+/* ------------------------------------------------------------------ */
+
+typedef struct buf {
+	uint8_t *p;
+	size_t n, cap;
+	int fail;
+} buf;
+
+static void buf_reserve(buf *b, size_t extra)
+{
+	if (b->fail || b->n + extra <= b->cap)
+		return;
+	size_t cap = b->cap ? b->cap : 256;
+	while (cap < b->n + extra)
+		cap *= 2;
+	uint8_t *p = realloc(b->p, cap);
+	if (!p) {
+		b->fail = 1;
+		return;
+	}
+	b->p = p;
+	b->cap = cap;
+}
+
+static void buf_put(buf *b, const void *d, size_t n)
+{
+	buf_reserve(b, n);
+	if (b->fail || n == 0)
+		return;
+	memcpy(b->p + b->n, d, n);
+	b->n += n;
+}
+
+static void buf_zeros(buf *b, size_t n)
+{
+	buf_reserve(b, n);
+	if (b->fail)
+		return;
+	memset(b->p + b->n, 0, n);
+	b->n += n;
+}
+
+static void buf_pad(buf *b, size_t align)
+{
+	if (b->n % align)
+		buf_zeros(b, align - b->n % align);
+}
+
+static void put_u16(uint8_t *p, uint16_t v)
+{
+	p[0] = (uint8_t)v;
+	p[1] = (uint8_t)(v >> 8);
+}
+
+static void put_u32(uint8_t *p, uint32_t v)
+{
+	for (int i = 0; i < 4; i++)
+		p[i] = (uint8_t)(v >> (8 * i));
+}
+
+static void put_u64(uint8_t *p, uint64_t v)
+{
+	for (int i = 0; i < 8; i++)
+		p[i] = (uint8_t)(v >> (8 * i));
+}
+
+static void put_f32(uint8_t *p, float f)
+{
+	uint32_t u;
+	memcpy(&u, &f, 4);
+	put_u32(p, u);
+}
+
+static double now_seconds(void)
+{
+	struct timespec ts;
+	timespec_get(&ts, TIME_UTC);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ------------------------------------------------------------------ */
+/* Chunks and their streams                                            */
+/* ------------------------------------------------------------------ */
+
+typedef struct stream {
+	uint32_t tag, count;
+	uint16_t size;
+	int index;       /* an index stream (the index codec may apply) */
+	uint8_t *data;   /* count * size bytes, owned */
+} stream;
+
+typedef struct chunkb {
+	stream *s;
+	int n, cap;
+	int fail;
+} chunkb;
+
+static void cb_add(chunkb *cb, uint32_t tag, uint32_t count, uint16_t size, const void *data, int index)
+{
+	if (cb->fail)
+		return;
+	if (cb->n == cb->cap) {
+		int cap = cb->cap ? 2 * cb->cap : 16;
+		stream *s = realloc(cb->s, sizeof *s * (size_t)cap);
+		if (!s) {
+			cb->fail = 1;
+			return;
+		}
+		cb->s = s;
+		cb->cap = cap;
+	}
+	size_t bytes = (size_t)count * size;
+	uint8_t *copy = malloc(bytes ? bytes : 1);
+	if (!copy) {
+		cb->fail = 1;
+		return;
+	}
+	if (bytes)
+		memcpy(copy, data, bytes);
+	cb->s[cb->n++] = (stream){tag, count, size, index, copy};
+}
+
+static void cb_free(chunkb *cb)
+{
+	for (int i = 0; i < cb->n; i++)
+		free(cb->s[i].data);
+	free(cb->s);
+	memset(cb, 0, sizeof *cb);
+}
+
+typedef struct chunk {
+	uint32_t type;
+	uint8_t layer, codec;
+	uint16_t level, item;
+	float error, distance;
+	uint8_t *data;
+	size_t size;
+	uint32_t raw;
+	uint64_t offset;
+} chunk;
+
+typedef struct chunks {
+	chunk *c;
+	int n, cap;
+} chunks;
+
+/* Encodes the streams of cb into a chunk (the stream container). */
+static mlod_result cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uint32_t type, int layer, int level,
+                             int item, float error, mlod_error *err)
+{
+	buf b = {0};
+	uint8_t word[4];
+	uint32_t raw = 4 + 16 * (uint32_t)cb->n;
+	if (cb->fail)
+		goto nomem;
+	put_u32(word, (uint32_t)cb->n);
+	buf_put(&b, word, 4);
+	size_t headers = b.n;
+	buf_zeros(&b, 16 * (size_t)cb->n);
+	for (int i = 0; i < cb->n; i++) {
+		stream *s = &cb->s[i];
+		size_t bytes = (size_t)s->count * s->size;
+		uint8_t scodec = MLOD_SCODEC_RAW;
+		uint8_t *enc = NULL;
+		size_t enc_size = 0;
+		raw += (uint32_t)((bytes + 3) & ~(size_t)3);
+		if (codec == MLOD_CODEC_MESHOPT && s->count > 0) {
+			if (s->index && s->count % 3 == 0 && (s->size == 2 || s->size == 4)) {
+				unsigned int *idx = malloc(sizeof *idx * s->count), maxv = 0;
+				if (!idx)
+					goto nomem;
+				for (uint32_t k = 0; k < s->count; k++) {
+					if (s->size == 2) {
+						uint16_t v;
+						memcpy(&v, s->data + 2 * k, 2);
+						idx[k] = v;
+					} else {
+						memcpy(&idx[k], s->data + 4 * k, 4);
+					}
+					maxv = idx[k] > maxv ? idx[k] : maxv;
+				}
+				size_t bound = meshopt_encodeIndexBufferBound(s->count, (size_t)maxv + 1);
+				enc = malloc(bound);
+				if (!enc) {
+					free(idx);
+					goto nomem;
+				}
+				enc_size = meshopt_encodeIndexBuffer(enc, bound, idx, s->count);
+				free(idx);
+				if (enc_size > 0)
+					scodec = MLOD_SCODEC_MESHOPT_INDEX;
+			} else if (!s->index && s->size % 4 == 0 && s->size <= 256) {
+				size_t bound = meshopt_encodeVertexBufferBound(s->count, s->size);
+				enc = malloc(bound);
+				if (!enc)
+					goto nomem;
+				enc_size = meshopt_encodeVertexBuffer(enc, bound, s->data, s->count, s->size);
+				if (enc_size > 0 && enc_size < bytes)
+					scodec = MLOD_SCODEC_MESHOPT_VERTEX;
+			}
+		}
+		const uint8_t *data = scodec == MLOD_SCODEC_RAW ? s->data : enc;
+		size_t stored = scodec == MLOD_SCODEC_RAW ? bytes : enc_size;
+		uint8_t h[16] = {0};
+		put_u32(h, s->tag);
+		put_u32(h + 4, s->count);
+		put_u16(h + 8, s->size);
+		h[10] = scodec;
+		put_u32(h + 12, (uint32_t)stored);
+		if (!b.fail)
+			memcpy(b.p + headers + 16 * (size_t)i, h, 16);
+		buf_put(&b, data, stored);
+		buf_pad(&b, 4);
+		free(enc);
+	}
+	if (b.fail)
+		goto nomem;
+	if (out->n == out->cap) {
+		int cap = out->cap ? 2 * out->cap : 32;
+		chunk *c = realloc(out->c, sizeof *c * (size_t)cap);
+		if (!c)
+			goto nomem;
+		out->c = c;
+		out->cap = cap;
+	}
+	chunk *c = &out->c[out->n++];
+	memset(c, 0, sizeof *c);
+	c->type = type;
+	c->layer = (uint8_t)layer;
+	c->codec = type == MLOD_CHUNK_INFO || type == MLOD_CHUNK_DOC ? MLOD_CODEC_NONE : (uint8_t)codec;
+	c->level = (uint16_t)level;
+	c->item = (uint16_t)item;
+	c->error = level > 0 ? error : 0.0f;
+	c->distance = level > 0 ? mlod_pack_switch_distance(error) : 0.0f;
+	c->data = b.p;
+	c->size = b.n;
+	c->raw = raw;
+	cb_free(cb);
+	return MLOD_OK;
+nomem:
+	free(b.p);
+	cb_free(cb);
+	return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+}
+
+/* A string table. */
+typedef struct strtab {
+	buf b;
+} strtab;
+
+static uint32_t str_add(strtab *t, const char *s)
+{
+	uint32_t off = (uint32_t)t->b.n;
+	buf_put(&t->b, s ? s : "", strlen(s ? s : "") + 1);
+	return off;
+}
+
+/* ------------------------------------------------------------------ */
+/* The character as packed                                             */
+/* ------------------------------------------------------------------ */
+
+struct clip_levels {
+	int count;                 /* levels >= 1 */
+	const mlod_clip *clip[MLOD_PACK_MAX_MOTION_LEVELS];
+	float error[MLOD_PACK_MAX_MOTION_LEVELS];
+};
+
+struct ctx {
+	const mlod_gltf *doc;
+	const mlod_character *in;
+	mlod_format format;
+	const mlod_pack_options *opt;
+	mlod_pack_stats *st;
+	mlod_error *err;
+	mlod_record rec;
+	/* The view: the full skins and clips of in. */
+	mlod_character v;
+	int *view_skin;            /* input skin -> view skin, -1 for a level's */
+	mlod_mat4 *world;          /* rest world matrices */
+	float bmin[3], bmax[3], diag, height;
+	/* skeleton levels >= 1, finest first */
+	int skel_count;
+	unsigned char *kept[MLOD_SKEL_MAX_LEVELS];
+	int *remap[MLOD_SKEL_MAX_LEVELS];
+	float skel_error[MLOD_SKEL_MAX_LEVELS];
+	/* mesh levels >= 1 */
+	int mesh_count;
+	const mlod_mesh *level_mesh[MLOD_MESH_MAX_LEVELS]; /* per instance (computed) */
+	int *level_node[MLOD_MESH_MAX_LEVELS];             /* per instance (from input), -1 none */
+	float mesh_error[MLOD_MESH_MAX_LEVELS];
+	mlod_mesh_levels ML;
+	int has_ML;
+	/* motion */
+	struct clip_levels *clips;
+	mlod_motion_level *owned_levels;
+	int owned_count;
+	int motion_count;          /* levels >= 1, over all clips */
+};
+
+static void note(struct ctx *x, const char *text)
+{
+	char *n = x->st->notes;
+	size_t len = strlen(n);
+	if (len + strlen(text) + 3 < sizeof x->st->notes)
+		snprintf(n + len, sizeof x->st->notes - len, "%s%s", len ? "; " : "", text);
+}
+
+static int joint_of_node(const mlod_skeleton *s, int node)
+{
+	for (int j = 0; j < s->joint_count; j++)
+		if (s->joints[j].node == node)
+			return j;
+	return -1;
+}
+
+static int skin_of_gltf(const mlod_skeleton *s, int g)
+{
+	for (int i = 0; g >= 0 && i < s->skin_count; i++)
+		if (s->skins[i].gltf_index == g)
+			return i;
+	return -1;
+}
+
+static int mesh_of_gltf(const mlod_character *c, int g)
+{
+	for (int i = 0; g >= 0 && i < c->mesh_count; i++)
+		if (c->meshes[i].gltf_index == g)
+			return i;
+	return -1;
+}
+
+/* The level nodes of instance node `node`, by mesh level (1-based) into
+ * nodes[]; returns the largest level found. */
+static mlod_result level_nodes(struct ctx *x, int node, int *nodes, int *max_level, double *errors)
+{
+	int ids[64], count = 0;
+	*max_level = 0;
+	if (node < 0 || !x->doc)
+		return MLOD_OK;
+	mlod_result r = mlod_gltf_node_lod(x->doc, node, ids, 64, &count, x->err);
+	for (int i = 0; r == MLOD_OK && i < count && i < 64; i++) {
+		mlod_record_mesh_node mn;
+		int found = 0;
+		if ((r = mlod_record_read_mesh_node(x->doc, ids[i], &mn, &found, x->err)) != MLOD_OK || !found)
+			continue;
+		if (mn.level >= 1 && mn.level <= MLOD_MESH_MAX_LEVELS) {
+			nodes[mn.level - 1] = ids[i];
+			if (errors && mn.error.max > errors[mn.level - 1])
+				errors[mn.level - 1] = mn.error.max;
+			*max_level = mn.level > *max_level ? mn.level : *max_level;
+		}
+	}
+	return r;
+}
+
+/* Builds the view: skins that are not a level's, clips that are not a
+ * motion level. */
+static mlod_result make_view(struct ctx *x)
+{
+	const mlod_character *c = x->in;
+	const mlod_skeleton *s = &c->skeleton;
+	mlod_result r;
+	unsigned char *level_skin = calloc((size_t)s->skin_count + 1, 1);
+	x->view_skin = malloc(sizeof(int) * ((size_t)s->skin_count + 1));
+	if (!level_skin || !x->view_skin) {
+		free(level_skin);
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	for (int i = 0; i < x->rec.skin_count; i++)
+		for (int k = 0; k < x->rec.skins[i].level_count; k++) {
+			int sk = skin_of_gltf(s, x->rec.skins[i].levels[k]);
+			if (sk >= 0)
+				level_skin[sk] = 1;
+		}
+	for (int k = 0; k < x->rec.skel_level_count; k++)
+		for (int i = 0; i < x->rec.skel_levels[k].skin_count; i++) {
+			int sk = skin_of_gltf(s, x->rec.skel_levels[k].skins[i]);
+			if (sk >= 0)
+				level_skin[sk] = 1;
+		}
+	for (int i = 0; i < c->instance_count; i++) {
+		int nodes[MLOD_MESH_MAX_LEVELS], max = 0;
+		if ((r = level_nodes(x, c->instances[i].node, nodes, &max, NULL)) != MLOD_OK) {
+			free(level_skin);
+			return r;
+		}
+		for (int k = 0; k < max; k++) {
+			int mesh = -1, skin = -1;
+			mlod_error ignored;
+			if (mlod_gltf_node_refs(x->doc, nodes[k], &mesh, &skin, &ignored) == MLOD_OK && skin >= 0) {
+				int sk = skin_of_gltf(s, skin);
+				if (sk >= 0 && sk != c->instances[i].skin)
+					level_skin[sk] = 1;
+			}
+		}
+	}
+	x->v = *c;
+	x->v.notes = NULL;
+	x->v.skeleton.skins = malloc(sizeof(mlod_skin) * ((size_t)s->skin_count + 1));
+	x->v.instances = malloc(sizeof(mlod_instance) * ((size_t)c->instance_count + 1));
+	x->v.clips = malloc(sizeof(mlod_clip) * ((size_t)c->clip_count + 1));
+	if (!x->v.skeleton.skins || !x->v.instances || !x->v.clips) {
+		free(level_skin);
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	x->v.skeleton.skin_count = 0;
+	for (int i = 0; i < s->skin_count; i++) {
+		x->view_skin[i] = level_skin[i] ? -1 : x->v.skeleton.skin_count;
+		if (!level_skin[i])
+			x->v.skeleton.skins[x->v.skeleton.skin_count++] = s->skins[i];
+	}
+	free(level_skin);
+	for (int i = 0; i < c->instance_count; i++) {
+		x->v.instances[i] = c->instances[i];
+		if (c->instances[i].skin >= 0)
+			x->v.instances[i].skin = x->view_skin[c->instances[i].skin];
+	}
+	x->v.clip_count = 0;
+	for (int i = 0; i < c->clip_count; i++) {
+		int found = 0;
+		mlod_record_motion_level ml;
+		if (x->doc && c->clips[i].gltf_index >= 0 &&
+		    (r = mlod_record_read_motion(x->doc, c->clips[i].gltf_index, &ml, &found, x->err)) != MLOD_OK)
+			return r;
+		if (!found)
+			x->v.clips[x->v.clip_count++] = c->clips[i];
+	}
+	if (x->v.skeleton.skin_count < s->skin_count || x->v.clip_count < c->clip_count) {
+		char text[160];
+		snprintf(text, sizeof text, "the input's level skins (%d) and level animations (%d) are packed as levels",
+		         s->skin_count - x->v.skeleton.skin_count, c->clip_count - x->v.clip_count);
+		note(x, text);
+	}
+	return MLOD_OK;
+}
+
+/* Rest world matrices, bounds, height and diagonal. */
+static mlod_result measure(struct ctx *x)
+{
+	const mlod_skeleton *s = &x->v.skeleton;
+	x->world = malloc(sizeof(mlod_mat4) * ((size_t)s->joint_count + 1));
+	mlod_trs *local = malloc(sizeof(mlod_trs) * ((size_t)s->joint_count + 1));
+	if (!x->world || !local) {
+		free(local);
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	mlod_pose_rest(s, local);
+	mlod_pose_world(s, local, x->world);
+	free(local);
+	int any = 0;
+	for (int a = 0; a < 3; a++) {
+		x->bmin[a] = 0.0f;
+		x->bmax[a] = 0.0f;
+	}
+	mlod_posed posed = {0};
+	if (x->v.instance_count > 0) {
+		mlod_result r = mlod_pose_character(&x->v, x->world, &posed, x->err);
+		if (r != MLOD_OK) {
+			mlod_posed_free(&posed);
+			return r;
+		}
+	}
+	for (int i = 0; i < posed.vertex_count; i++)
+		for (int a = 0; a < 3; a++) {
+			float p = posed.positions[3 * i + a];
+			if (!any || p < x->bmin[a])
+				x->bmin[a] = p;
+			if (!any || p > x->bmax[a])
+				x->bmax[a] = p;
+			any |= a == 2;
+		}
+	mlod_posed_free(&posed);
+	if (!any)
+		for (int j = 0; j < s->joint_count; j++) {
+			float p[3] = {x->world[j].m[12], x->world[j].m[13], x->world[j].m[14]};
+			for (int a = 0; a < 3; a++) {
+				if (!any || p[a] < x->bmin[a])
+					x->bmin[a] = p[a];
+				if (!any || p[a] > x->bmax[a])
+					x->bmax[a] = p[a];
+			}
+			any = 1;
+		}
+	float d[3] = {x->bmax[0] - x->bmin[0], x->bmax[1] - x->bmin[1], x->bmax[2] - x->bmin[2]};
+	x->diag = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+	x->height = s->joint_count > 0 ? mlod_skeleton_size(s) : 0.0f;
+	return MLOD_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* Skeleton                                                            */
+/* ------------------------------------------------------------------ */
+
+static mlod_result skeleton_levels(struct ctx *x)
+{
+	const mlod_skeleton *s = &x->v.skeleton;
+	int n = s->joint_count;
+	mlod_result r = MLOD_OK;
+	if (n == 0 || x->opt->no_skeleton_levels)
+		return MLOD_OK;
+	if (x->rec.skel_level_count > 0) {
+		x->st->skeleton.from_input = 1;
+		for (int k = 0; k < x->rec.skel_level_count && k < MLOD_SKEL_MAX_LEVELS; k++) {
+			const mlod_record_skel_level *l = &x->rec.skel_levels[k];
+			unsigned char *kept = calloc((size_t)n, 1);
+			int *remap = malloc(sizeof(int) * (size_t)n);
+			if (!kept || !remap) {
+				free(kept);
+				free(remap);
+				return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+			}
+			x->kept[k] = kept;
+			x->remap[k] = remap;
+			x->skel_count = k + 1;
+			for (int i = 0; i < l->kept_count; i++) {
+				int j = joint_of_node(s, l->kept[i]);
+				if (j < 0)
+					return mlod_fail(x->err, MLOD_ERR_PARSE,
+					                 "skeleton level %d: kept node %d is not a joint", k + 1, l->kept[i]);
+				kept[j] = 1;
+			}
+			for (int j = 0; j < n; j++)
+				if (s->joints[j].parent < 0)
+					kept[j] = 1; /* every root is kept */
+			for (int j = 0; j < n; j++)
+				remap[j] = kept[j] ? j : -1;
+			for (int i = 0; i < l->remap_count; i++) {
+				int a = joint_of_node(s, l->remap_from[i]), b = joint_of_node(s, l->remap_to[i]);
+				if (a < 0 || b < 0 || !kept[b])
+					return mlod_fail(x->err, MLOD_ERR_PARSE, "skeleton level %d: remap %d -> %d is not a kept joint",
+					                 k + 1, l->remap_from[i], l->remap_to[i]);
+				if (!kept[a])
+					remap[a] = b;
+			}
+			for (int j = 0; j < n; j++) /* parents first: the nearest kept ancestor */
+				if (remap[j] < 0)
+					remap[j] = remap[s->joints[j].parent];
+			x->skel_error[k] = (float)(l->has_vertex_error ? l->vertex_error.max * x->diag / 100.0
+			                                                : l->joint_error.max);
+		}
+		return MLOD_OK;
+	}
+	/* Computed: labels (the record's when there), then the default chain. */
+	mlod_joint_info *info = calloc((size_t)n, sizeof *info);
+	mlod_skel_levels L;
+	int found = 0;
+	memset(&L, 0, sizeof L);
+	if (!info)
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	r = mlod_label_skeleton(&x->v, &x->opt->label, info, x->err);
+	if (r == MLOD_OK && x->doc)
+		r = mlod_record_read_joints(x->doc, &x->v, info, &found, x->err);
+	if (r == MLOD_OK)
+		r = mlod_skel_levels_init(&L, &x->v, info, x->err);
+	if (r == MLOD_OK)
+		r = mlod_skel_levels_default(&L, x->opt->skel_max_error, x->err);
+	for (int k = 0; r == MLOD_OK && k < L.count; k++) {
+		const mlod_skel_built *b = &L.levels[k];
+		x->kept[k] = malloc((size_t)n);
+		x->remap[k] = malloc(sizeof(int) * (size_t)n);
+		x->skel_count = k + 1;
+		if (!x->kept[k] || !x->remap[k]) {
+			r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+			break;
+		}
+		memcpy(x->kept[k], b->skel.kept, (size_t)n);
+		memcpy(x->remap[k], b->skel.remap, sizeof(int) * (size_t)n);
+		x->skel_error[k] = (float)(b->has_mesh_error ? b->vertex.max * x->diag / 100.0 : b->joint.max);
+	}
+	if (r == MLOD_OK && L.count == 0 && L.minor_count > 0)
+		note(x, "no skeleton level within the skeleton's max error");
+	mlod_skel_levels_free(&L);
+	free(info);
+	return r;
+}
+
+static mlod_result skeleton_chunk(struct ctx *x, chunks *out)
+{
+	const mlod_skeleton *s = &x->v.skeleton;
+	chunkb cb = {0};
+	strtab names = {0};
+	int n = s->joint_count;
+	mlod_pack_joint_rec *j = calloc((size_t)n + 1, sizeof *j);
+	mlod_pack_skin_rec *sk = calloc((size_t)s->skin_count + 1, sizeof *sk);
+	size_t pal = 0;
+	for (int i = 0; i < s->skin_count; i++)
+		pal += (size_t)s->skins[i].joint_count;
+	uint32_t *skjt = malloc(sizeof(uint32_t) * (pal + 1));
+	float *ibms = malloc(sizeof(float) * 16 * (pal + 1));
+	mlod_result r = MLOD_OK;
+	if (!j || !sk || !skjt || !ibms) {
+		r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	for (int i = 0; i < n; i++) {
+		const mlod_joint *q = &s->joints[i];
+		j[i].parent = q->parent;
+		j[i].name = str_add(&names, q->name);
+		j[i].t[0] = q->rest.t.x, j[i].t[1] = q->rest.t.y, j[i].t[2] = q->rest.t.z;
+		j[i].r[0] = q->rest.r.x, j[i].r[1] = q->rest.r.y, j[i].r[2] = q->rest.r.z, j[i].r[3] = q->rest.r.w;
+		j[i].s[0] = q->rest.s.x, j[i].s[1] = q->rest.s.y, j[i].s[2] = q->rest.s.z;
+		memcpy(j[i].base, q->base.m, sizeof j[i].base);
+		j[i].node = q->node;
+	}
+	size_t e = 0;
+	for (int i = 0; i < s->skin_count; i++) {
+		const mlod_skin *k = &s->skins[i];
+		sk[i].joint_count = (uint32_t)k->joint_count;
+		sk[i].name = str_add(&names, k->name);
+		sk[i].gltf_index = k->gltf_index;
+		for (int q = 0; q < k->joint_count; q++, e++) {
+			skjt[e] = (uint32_t)k->joints[q];
+			memcpy(ibms + 16 * e, k->inverse_bind[q].m, 64);
+		}
+	}
+	if (names.b.fail) {
+		r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	cb_add(&cb, MLOD_STREAM_JNTS, (uint32_t)n, sizeof *j, j, 0);
+	cb_add(&cb, MLOD_STREAM_NAME, (uint32_t)names.b.n, 1, names.b.p, 0);
+	cb_add(&cb, MLOD_STREAM_SKIN, (uint32_t)s->skin_count, sizeof *sk, sk, 0);
+	cb_add(&cb, MLOD_STREAM_SKJT, (uint32_t)pal, 4, skjt, 0);
+	cb_add(&cb, MLOD_STREAM_IBMS, (uint32_t)pal, 64, ibms, 0);
+	r = cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_SKELETON, MLOD_LAYER_SKELETON, 0, 0, 0.0f, x->err);
+done:
+	cb_free(&cb);
+	free(names.b.p);
+	free(j);
+	free(sk);
+	free(skjt);
+	free(ibms);
+	return r;
+}
+
+/* Skeleton level k (1-based): KEPT, and the palette as fold.c's skin
+ * transfer makes it (reduce_skin): a kept skin joint keeps its bind; a
+ * removed one uses its stand-in's entry in the level skin: the stand-in's
+ * own bind when the skin has it, else R(stand-in -> joint) * IBM(joint)
+ * of the first removed joint of the skin that brought it in. */
+static mlod_result skel_level_chunk(struct ctx *x, int k, chunks *out)
+{
+	const mlod_skeleton *s = &x->v.skeleton;
+	const unsigned char *kept = x->kept[k - 1];
+	const int *remap = x->remap[k - 1];
+	int n = s->joint_count;
+	size_t pal = 0, e = 0;
+	int maxsk = 0;
+	for (int i = 0; i < s->skin_count; i++) {
+		pal += (size_t)s->skins[i].joint_count;
+		maxsk = s->skins[i].joint_count > maxsk ? s->skins[i].joint_count : maxsk;
+	}
+	uint32_t *keptv = malloc(sizeof(uint32_t) * ((size_t)n + 1)), kc = 0;
+	uint32_t *palj = malloc(sizeof(uint32_t) * (pal + 1));
+	float *palb = malloc(sizeof(float) * 16 * (pal + 1));
+	int *lj = malloc(sizeof(int) * ((size_t)maxsk + 1));          /* the level skin's joints */
+	mlod_mat4 *lb = malloc(sizeof(mlod_mat4) * ((size_t)maxsk + 1)); /* and binds */
+	chunkb cb = {0};
+	mlod_result r = MLOD_OK;
+	if (!keptv || !palj || !palb || !lj || !lb) {
+		r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	for (int j = 0; j < n; j++)
+		if (kept[j])
+			keptv[kc++] = (uint32_t)j;
+	for (int i = 0; i < s->skin_count; i++) {
+		const mlod_skin *sk = &s->skins[i];
+		int ln = 0;
+		for (int q = 0; q < sk->joint_count; q++)
+			if (kept[sk->joints[q]]) {
+				lj[ln] = sk->joints[q];
+				lb[ln++] = sk->inverse_bind[q];
+			}
+		for (int q = 0; q < sk->joint_count; q++, e++) {
+			int j = sk->joints[q];
+			mlod_mat4 bind = sk->inverse_bind[q];
+			int pj = j;
+			if (!kept[j]) {
+				int stand = remap[j], at = -1;
+				pj = stand;
+				for (int t = 0; t < ln; t++)
+					if (lj[t] == stand)
+						at = t;
+				if (at < 0) {
+					mlod_mat4 inv, rel;
+					if (mlod_mat4_invert(&x->world[stand], &inv) != 0) {
+						r = mlod_fail(x->err, MLOD_ERR_PARSE, "joint \"%s\" has a singular rest transform",
+						              s->joints[stand].name);
+						goto done;
+					}
+					rel = mlod_mat4_mul(&inv, &x->world[j]);
+					lj[ln] = stand;
+					lb[ln] = mlod_mat4_mul(&rel, &sk->inverse_bind[q]);
+					at = ln++;
+				}
+				bind = lb[at];
+			}
+			palj[e] = (uint32_t)pj;
+			memcpy(palb + 16 * e, bind.m, 64);
+		}
+	}
+	cb_add(&cb, MLOD_STREAM_KEPT, kc, 4, keptv, 0);
+	cb_add(&cb, MLOD_STREAM_PALJ, (uint32_t)pal, 4, palj, 0);
+	cb_add(&cb, MLOD_STREAM_PALB, (uint32_t)pal, 64, palb, 0);
+	r = cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_SKELETON, MLOD_LAYER_SKELETON, k, 0, x->skel_error[k - 1],
+	              x->err);
+done:
+	cb_free(&cb);
+	free(keptv);
+	free(palj);
+	free(palb);
+	free(lj);
+	free(lb);
+	return r;
+}
+
+/* ------------------------------------------------------------------ */
+/* Mesh                                                                */
+/* ------------------------------------------------------------------ */
+
+static int ratio_desc(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x < y) - (x > y);
+}
+
+static mlod_result mesh_levels(struct ctx *x)
+{
+	const mlod_character *c = &x->v;
+	mlod_result r = MLOD_OK;
+	if (x->opt->no_mesh_levels || mlod_mesh_triangle_primitives(c) == 0)
+		return MLOD_OK;
+	/* The input's levels: MSFT_lod level nodes with a mesh level record. */
+	int max = 0;
+	int *nodes = malloc(sizeof(int) * MLOD_MESH_MAX_LEVELS * ((size_t)c->instance_count + 1));
+	if (!nodes)
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	for (size_t i = 0; i < MLOD_MESH_MAX_LEVELS * ((size_t)c->instance_count + 1); i++)
+		nodes[i] = -1;
+	double node_error[MLOD_MESH_MAX_LEVELS] = {0};
+	for (int i = 0; r == MLOD_OK && i < c->instance_count; i++) {
+		int m = 0;
+		r = level_nodes(x, c->instances[i].node, nodes + MLOD_MESH_MAX_LEVELS * i, &m, node_error);
+		max = m > max ? m : max;
+	}
+	if (r == MLOD_OK && max > 0) {
+		x->st->mesh.from_input = 1;
+		for (int k = 0; k < max; k++) {
+			x->level_node[k] = malloc(sizeof(int) * ((size_t)c->instance_count + 1));
+			if (!x->level_node[k]) {
+				r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+				break;
+			}
+			x->mesh_count = k + 1;
+			for (int i = 0; i < c->instance_count; i++)
+				x->level_node[k][i] = nodes[MLOD_MESH_MAX_LEVELS * i + k];
+			/* The scene's record, else the largest of the level nodes'. */
+			x->mesh_error[k] = (float)(node_error[k] * x->diag / 100.0);
+			for (int q = 0; q < x->rec.mesh_level_count; q++)
+				if (x->rec.mesh_levels[q].level == k + 1)
+					x->mesh_error[k] = (float)(x->rec.mesh_levels[q].error.max * x->diag / 100.0);
+		}
+		free(nodes);
+		return r;
+	}
+	free(nodes);
+	if (r != MLOD_OK)
+		return r;
+	/* Computed, as mlod-bgm does with the same options. */
+	double ratios[MLOD_MESH_MAX_LEVELS];
+	int n = x->opt->ratio_count;
+	memcpy(ratios, x->opt->ratios, sizeof ratios);
+	qsort(ratios, (size_t)n, sizeof *ratios, ratio_desc);
+	mlod_bgm_options bo = x->opt->bgm;
+	mlod_mesh_budget budget = x->opt->budget;
+	mlod_mesh_resolve(&bo, &budget);
+	int by_error = x->opt->mesh_max_error >= 0.0;
+	r = mlod_mesh_levels_init(&x->ML, c, &bo, budget, by_error || n == 0 ? 0.0 : ratios[n - 1], x->err);
+	x->has_ML = 1;
+	if (r == MLOD_OK)
+		r = by_error ? mlod_mesh_levels_by_error(&x->ML, x->opt->mesh_max_error, x->err)
+		             : mlod_mesh_levels_by_ratio(&x->ML, ratios, n, x->err);
+	if (r != MLOD_OK)
+		return r;
+	if (by_error && x->ML.count == 0)
+		note(x, "no mesh level within the mesh's max error");
+	for (int k = 0; k < x->ML.count; k++) {
+		x->level_mesh[k] = x->ML.levels[k].meshes;
+		x->mesh_error[k] = (float)(x->ML.levels[k].error.max * x->diag / 100.0);
+	}
+	x->mesh_count = x->ML.count;
+	return MLOD_OK;
+}
+
+/* One part: a triangle primitive of an instance at one level. jmap maps
+ * the primitive's joint indices to the full skin's (NULL: as they are). */
+struct part {
+	mlod_pack_part_rec rec;
+	const mlod_primitive *p;
+	const int *jmap;
+	int jmap_count;
+};
+
+static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
+{
+	const mlod_primitive *p = pt->p;
+	mlod_pack_part_rec *rec = &pt->rec;
+	uint32_t nv = (uint32_t)p->vertex_count;
+	size_t cap = (size_t)nv + 1;
+	void *tmp = malloc(16 * cap > (size_t)p->index_count * 4 + 4 ? 16 * cap : (size_t)p->index_count * 4 + 4);
+	if (!tmp) {
+		cb->fail = 1;
+		return;
+	}
+	/* Positions. */
+	float mn[3] = {0, 0, 0}, mx[3] = {0, 0, 0};
+	for (uint32_t v = 0; v < nv; v++)
+		for (int a = 0; a < 3; a++) {
+			float f = p->positions[3 * v + a];
+			if (v == 0 || f < mn[a])
+				mn[a] = f;
+			if (v == 0 || f > mx[a])
+				mx[a] = f;
+		}
+	for (int a = 0; a < 3; a++) {
+		rec->pos_min[a] = mn[a];
+		rec->pos_scale[a] = mlod_pack_range_scale(mn[a], mx[a]);
+	}
+	uint16_t *q16 = tmp;
+	for (uint32_t v = 0; v < nv; v++) {
+		for (int a = 0; a < 3; a++)
+			q16[4 * v + a] = mlod_pack_qu16(p->positions[3 * v + a], mn[a], rec->pos_scale[a]);
+		q16[4 * v + 3] = 0;
+	}
+	cb_add(cb, MLOD_STREAM_POSQ, nv, 8, tmp, 0);
+	int16_t *s16 = tmp;
+	if (p->normals) {
+		rec->flags |= MLOD_PART_NORMALS;
+		for (uint32_t v = 0; v < nv; v++)
+			mlod_pack_oct_encode(p->normals + 3 * v, s16 + 2 * v);
+		cb_add(cb, MLOD_STREAM_NRMQ, nv, 4, tmp, 0);
+	}
+	if (p->tangents) {
+		rec->flags |= MLOD_PART_TANGENTS;
+		for (uint32_t v = 0; v < nv; v++) {
+			mlod_pack_oct_encode(p->tangents + 4 * v, s16 + 4 * v);
+			s16[4 * v + 2] = p->tangents[4 * v + 3] < 0.0f ? -32767 : 32767;
+			s16[4 * v + 3] = 0;
+		}
+		cb_add(cb, MLOD_STREAM_TANQ, nv, 8, tmp, 0);
+	}
+	int sets = p->uv_set_count < MLOD_PACK_MAX_UV ? p->uv_set_count : MLOD_PACK_MAX_UV;
+	rec->uv_sets = (uint32_t)sets;
+	for (int s = 0; s < sets; s++) {
+		float umn[2] = {0, 0}, umx[2] = {0, 0};
+		for (uint32_t v = 0; v < nv; v++)
+			for (int a = 0; a < 2; a++) {
+				float f = p->uvs[s][2 * v + a];
+				if (v == 0 || f < umn[a])
+					umn[a] = f;
+				if (v == 0 || f > umx[a])
+					umx[a] = f;
+			}
+		for (int a = 0; a < 2; a++) {
+			rec->uv_min[s][a] = umn[a];
+			rec->uv_scale[s][a] = mlod_pack_range_scale(umn[a], umx[a]);
+		}
+		for (uint32_t v = 0; v < nv; v++)
+			for (int a = 0; a < 2; a++)
+				q16[2 * v + a] = mlod_pack_qu16(p->uvs[s][2 * v + a], umn[a], rec->uv_scale[s][a]);
+		cb_add(cb, MLOD_STREAM_UVQ0 + ((uint32_t)s << 24), nv, 4, tmp, 0);
+	}
+	if (p->color_set_count > 0) {
+		uint8_t *u8 = tmp;
+		rec->flags |= MLOD_PART_COLORS;
+		for (uint32_t v = 0; v < 4 * nv; v++) {
+			float f = p->colors[0][v];
+			f = f > 0.0f ? (f < 1.0f ? f : 1.0f) : 0.0f;
+			u8[v] = (uint8_t)lrintf(f * 255.0f);
+		}
+		cb_add(cb, MLOD_STREAM_COLQ, nv, 4, tmp, 0);
+	}
+	if (rec->skin >= 0 && p->weight_set_count > 0) {
+		const mlod_skin *sk = &x->v.skeleton.skins[rec->skin];
+		int wide = sk->joint_count > 256;
+		uint16_t *jj = malloc(sizeof(uint16_t) * 4 * cap);
+		uint8_t *ww = malloc(4 * cap);
+		if (!jj || !ww) {
+			free(jj);
+			free(ww);
+			free(tmp);
+			cb->fail = 1;
+			return;
+		}
+		rec->flags |= MLOD_PART_SKINNED | (wide ? MLOD_PART_JOINTS16 : 0);
+		for (uint32_t v = 0; v < nv; v++) {
+			/* The 4 largest influences over every set (ties: the lower slot). */
+			int bj[4] = {0, 0, 0, 0};
+			float bw[4] = {0, 0, 0, 0};
+			for (int s = 0; s < p->weight_set_count; s++)
+				for (int i = 0; i < 4; i++) {
+					float w = p->weights[s][4 * v + i];
+					int jt = p->joints[s][4 * v + i];
+					if (!(w > 0.0f))
+						continue;
+					if (pt->jmap)
+						jt = jt < pt->jmap_count ? pt->jmap[jt] : 0;
+					/* merge a joint met twice */
+					int at = -1;
+					for (int t = 0; t < 4; t++)
+						if (bw[t] > 0.0f && bj[t] == jt)
+							at = t;
+					if (at >= 0) {
+						bw[at] += w;
+					} else {
+						int low = 0;
+						for (int t = 1; t < 4; t++)
+							if (bw[t] < bw[low])
+								low = t;
+						if (w > bw[low]) {
+							bw[low] = w;
+							bj[low] = jt;
+						}
+					}
+				}
+			uint8_t q[4];
+			mlod_pack_weights8(bw, q);
+			for (int t = 0; t < 4; t++) {
+				int jt = q[t] ? bj[t] : 0;
+				if (jt < 0 || jt >= sk->joint_count)
+					jt = 0;
+				jj[4 * v + t] = (uint16_t)jt;
+				ww[4 * v + t] = q[t];
+			}
+		}
+		if (wide) {
+			cb_add(cb, MLOD_STREAM_JN16, nv, 8, jj, 0);
+		} else {
+			uint8_t *j8 = tmp;
+			for (uint32_t i = 0; i < 4 * nv; i++)
+				j8[i] = (uint8_t)jj[i];
+			cb_add(cb, MLOD_STREAM_JNT8, nv, 4, j8, 0);
+		}
+		cb_add(cb, MLOD_STREAM_WGT8, nv, 4, ww, 0);
+		free(jj);
+		free(ww);
+	}
+	/* Indices (a primitive without them gets 0, 1, 2, ...). */
+	uint32_t ni = p->index_count > 0 ? (uint32_t)p->index_count : nv;
+	ni -= ni % 3;
+	rec->index_count = ni;
+	uint32_t *i32 = malloc(sizeof(uint32_t) * ((size_t)ni + 1));
+	if (!i32) {
+		free(tmp);
+		cb->fail = 1;
+		return;
+	}
+	for (uint32_t i = 0; i < ni; i++)
+		i32[i] = p->index_count > 0 ? p->indices[i] : i;
+	if (nv <= 65536) {
+		uint16_t *i16 = (uint16_t *)i32; /* in place, front to back */
+		rec->flags |= MLOD_PART_INDEX16;
+		for (uint32_t i = 0; i < ni; i++)
+			i16[i] = (uint16_t)i32[i];
+		cb_add(cb, MLOD_STREAM_IDX, ni, 2, i16, 1);
+	} else {
+		cb_add(cb, MLOD_STREAM_IDX, ni, 4, i32, 1);
+	}
+	free(i32);
+	/* Morph target positions. */
+	int nt = p->target_count;
+	rec->target_count = (uint32_t)nt;
+	if (nt > 0) {
+		float *scale = malloc(sizeof(float) * (size_t)nt);
+		if (!scale) {
+			free(tmp);
+			cb->fail = 1;
+			return;
+		}
+		for (int t = 0; t < nt; t++) {
+			float m = 0.0f;
+			const float *d = p->targets[t].positions;
+			for (uint32_t i = 0; d && i < 3 * nv; i++)
+				m = fabsf(d[i]) > m ? fabsf(d[i]) : m;
+			scale[t] = m > 0.0f ? m / 32767.0f : 0.0f;
+		}
+		cb_add(cb, MLOD_STREAM_MTSC, (uint32_t)nt, 4, scale, 0);
+		for (int t = 0; t < nt; t++) {
+			const float *d = p->targets[t].positions;
+			for (uint32_t v = 0; v < nv; v++) {
+				for (int a = 0; a < 3; a++) {
+					float f = d && scale[t] > 0.0f ? d[3 * v + a] / scale[t] : 0.0f;
+					f = f > 32767.0f ? 32767.0f : f < -32767.0f ? -32767.0f : f;
+					s16[4 * v + a] = (int16_t)lrintf(f);
+				}
+				s16[4 * v + 3] = 0;
+			}
+			cb_add(cb, MLOD_STREAM_MTPQ, nv, 8, tmp, 0);
+		}
+		free(scale);
+	}
+	free(tmp);
+}
+
+/* Maps the joints of a level skin (input skin `lsk`) to the full skin
+ * `fsk`: the same joint, else the first joint of the full skin that the
+ * level joint stands in for (its nearest ancestor in the level skin). */
+static int *level_joint_map(const mlod_skeleton *s, const mlod_skin *lsk, const mlod_skin *fsk)
+{
+	int *map = malloc(sizeof(int) * ((size_t)lsk->joint_count + 1));
+	if (!map)
+		return NULL;
+	for (int q = 0; q < lsk->joint_count; q++) {
+		int j = lsk->joints[q], at = -1;
+		for (int t = 0; t < fsk->joint_count && at < 0; t++)
+			if (fsk->joints[t] == j)
+				at = t;
+		for (int t = 0; t < fsk->joint_count && at < 0; t++) {
+			int a = fsk->joints[t];
+			int in_level = 0;
+			for (int u = 0; u < lsk->joint_count; u++)
+				in_level |= lsk->joints[u] == a;
+			if (in_level)
+				continue;
+			while (a >= 0 && a != j) {
+				int p = s->joints[a].parent, in = 0;
+				for (int u = 0; p >= 0 && u < lsk->joint_count; u++)
+					in |= lsk->joints[u] == p;
+				a = p;
+				if (in && p != j)
+					a = -1; /* a nearer level joint stands in for it */
+			}
+			if (a == j)
+				at = t;
+		}
+		map[q] = at >= 0 ? at : 0;
+	}
+	return map;
+}
+
+static mlod_result mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count)
+{
+	const mlod_character *c = &x->v;
+	chunkb cb = {0};
+	struct part *parts = NULL;
+	int np = 0, cap = 0;
+	int **maps = calloc((size_t)c->instance_count + 1, sizeof *maps);
+	mlod_result r = MLOD_OK;
+	if (!maps)
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	for (int i = 0; i < c->instance_count; i++) {
+		const mlod_instance *in = &c->instances[i];
+		const mlod_mesh *m = &c->meshes[in->mesh];
+		const mlod_mesh *lm = m;
+		int lmap_count = 0;
+		if (k > 0 && x->level_mesh[k - 1]) {
+			lm = &x->level_mesh[k - 1][i];
+		} else if (k > 0 && x->level_node[k - 1] && x->level_node[k - 1][i] >= 0) {
+			int gm = -1, gs = -1;
+			if ((r = mlod_gltf_node_refs(x->doc, x->level_node[k - 1][i], &gm, &gs, x->err)) != MLOD_OK)
+				goto done;
+			int mi = mesh_of_gltf(x->in, gm);
+			if (mi < 0) {
+				r = mlod_fail(x->err, MLOD_ERR_PARSE, "mesh level %d of node %d: its mesh %d was not read", k,
+				              in->node, gm);
+				goto done;
+			}
+			lm = &x->in->meshes[mi];
+			int ls = skin_of_gltf(&x->in->skeleton, gs);
+			if (in->skin >= 0 && ls >= 0 && x->view_skin[ls] != in->skin) {
+				maps[i] = level_joint_map(&c->skeleton, &x->in->skeleton.skins[ls], &c->skeleton.skins[in->skin]);
+				if (!maps[i]) {
+					r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+					goto done;
+				}
+				lmap_count = x->in->skeleton.skins[ls].joint_count;
+			}
+		}
+		for (int p = 0; p < lm->primitive_count && p < m->primitive_count; p++) {
+			const mlod_primitive *pr = &lm->primitives[p];
+			if (m->primitives[p].mode != 4 || pr->mode != 4 || pr->vertex_count <= 0)
+				continue;
+			if (np == cap) {
+				cap = cap ? 2 * cap : 16;
+				struct part *q = realloc(parts, sizeof *q * (size_t)cap);
+				if (!q) {
+					r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+					goto done;
+				}
+				parts = q;
+			}
+			struct part *pt = &parts[np++];
+			memset(pt, 0, sizeof *pt);
+			pt->p = pr;
+			pt->jmap = maps[i];
+			pt->jmap_count = lmap_count;
+			pt->rec.instance = (uint32_t)i;
+			pt->rec.node = in->node;
+			pt->rec.mesh = m->gltf_index;
+			pt->rec.primitive = (uint32_t)p;
+			pt->rec.skin = in->skin;
+			pt->rec.joint = in->joint;
+			pt->rec.material = m->primitives[p].material;
+			pt->rec.vertex_count = (uint32_t)pr->vertex_count;
+			memcpy(pt->rec.offset, in->offset.m, sizeof pt->rec.offset);
+		}
+	}
+	/* PART first: its records are complete once the streams are made. */
+	cb_add(&cb, MLOD_STREAM_PART, 0, sizeof(mlod_pack_part_rec), NULL, 0);
+	for (int i = 0; i < np; i++)
+		add_part_streams(x, &cb, &parts[i]);
+	if (!cb.fail) {
+		mlod_pack_part_rec *recs = malloc(sizeof *recs * ((size_t)np + 1));
+		if (!recs) {
+			cb.fail = 1;
+		} else {
+			for (int i = 0; i < np; i++)
+				recs[i] = parts[i].rec;
+			free(cb.s[0].data);
+			cb.s[0].data = (uint8_t *)recs;
+			cb.s[0].count = (uint32_t)np;
+		}
+	}
+	*part_count = np;
+	r = cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MESH, MLOD_LAYER_MESH, k, 0, k > 0 ? x->mesh_error[k - 1] : 0.0f,
+	              x->err);
+done:
+	cb_free(&cb);
+	for (int i = 0; i < c->instance_count; i++)
+		free(maps[i]);
+	free(maps);
+	free(parts);
+	return r;
+}
+
+/* ------------------------------------------------------------------ */
+/* Motion                                                              */
+/* ------------------------------------------------------------------ */
+
+static int double_asc(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+static mlod_result motion_levels(struct ctx *x)
+{
+	const mlod_character *c = &x->v;
+	mlod_result r = MLOD_OK;
+	x->clips = calloc((size_t)c->clip_count + 1, sizeof *x->clips);
+	if (!x->clips)
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	if (c->clip_count == 0 || x->opt->no_motion_levels)
+		return MLOD_OK;
+	/* The input's levels: "<clip>@lod<k>" animations with a record. */
+	int from_input = 0;
+	for (int i = 0; r == MLOD_OK && x->doc && i < x->in->clip_count; i++) {
+		mlod_record_motion_level ml;
+		int found = 0;
+		if (x->in->clips[i].gltf_index < 0)
+			continue;
+		if ((r = mlod_record_read_motion(x->doc, x->in->clips[i].gltf_index, &ml, &found, x->err)) != MLOD_OK ||
+		    !found)
+			continue;
+		for (int q = 0; q < c->clip_count; q++)
+			if (c->clips[q].gltf_index == ml.source_animation && ml.level >= 1 &&
+			    ml.level <= MLOD_PACK_MAX_MOTION_LEVELS) {
+				struct clip_levels *cl = &x->clips[q];
+				cl->clip[ml.level - 1] = &x->in->clips[i];
+				cl->error[ml.level - 1] = (float)ml.joint_error.max;
+				cl->count = ml.level > cl->count ? ml.level : cl->count;
+				from_input = 1;
+			}
+	}
+	if (r != MLOD_OK)
+		return r;
+	if (from_input) {
+		x->st->motion.from_input = 1;
+		for (int q = 0; q < c->clip_count; q++) /* a gap repeats the finer level */
+			for (int k = 0; k < x->clips[q].count; k++)
+				if (!x->clips[q].clip[k]) {
+					x->clips[q].clip[k] = k ? x->clips[q].clip[k - 1] : &c->clips[q];
+					x->clips[q].error[k] = k ? x->clips[q].error[k - 1] : 0.0f;
+				}
+		return MLOD_OK;
+	}
+	/* Computed: per bound, the frames and keys methods; fewer bytes wins. */
+	int nb = x->opt->motion_bound_count;
+	double bounds[MLOD_PACK_MAX_MOTION_LEVELS];
+	for (int b = 0; b < nb; b++)
+		bounds[b] = x->opt->motion_percent[b] ? x->opt->motion_bounds[b] * x->height / 100.0 : x->opt->motion_bounds[b];
+	qsort(bounds, (size_t)nb, sizeof *bounds, double_asc);
+	mlod_motion_options mo = {0};
+	mo.point_distance = x->opt->point_distance > 0.0             ? x->opt->point_distance
+	                    : x->format == MLOD_FORMAT_BVH ? x->height / 18.0
+	                                                         : 0.1;
+	x->owned_levels = calloc((size_t)c->clip_count * (size_t)(nb > 0 ? nb : 1), sizeof *x->owned_levels);
+	if (!x->owned_levels)
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	int short_clips = 0, missed = 0;
+	for (int q = 0; r == MLOD_OK && q < c->clip_count; q++) {
+		mlod_motion *m[2] = {NULL, NULL};
+		for (int i = 0; r == MLOD_OK && i < 2; i++)
+			r = mlod_motion_create(c, q, &mo, &m[i], x->err);
+		if (r == MLOD_OK && mlod_motion_timeline_info(m[0])->frames < 3)
+			short_clips++;
+		else
+			for (int b = 0; r == MLOD_OK && b < nb; b++) {
+				mlod_motion_level best, l;
+				int ok = 0;
+				for (int i = 0; i < 2; i++) {
+					mlod_result e = mlod_motion_next_level(m[i], i ? MLOD_MOTION_KEYS : MLOD_MOTION_FRAMES,
+					                                       MLOD_MOTION_MAX_ERROR, bounds[b], &l, x->err);
+					if (e == MLOD_ERR_LIMIT)
+						continue;
+					if (e != MLOD_OK) {
+						r = e;
+						break;
+					}
+					if (!ok || l.bytes < best.bytes || (l.bytes == best.bytes && l.error.max < best.error.max)) {
+						if (ok)
+							mlod_motion_level_free(&best);
+						best = l;
+						ok = 1;
+					} else {
+						mlod_motion_level_free(&l);
+					}
+				}
+				if (r != MLOD_OK) {
+					if (ok)
+						mlod_motion_level_free(&best);
+					break;
+				}
+				if (!ok) {
+					missed++;
+					continue;
+				}
+				struct clip_levels *cl = &x->clips[q];
+				x->owned_levels[x->owned_count] = best;
+				cl->clip[cl->count] = &x->owned_levels[x->owned_count++].clip;
+				cl->error[cl->count++] = (float)best.error.max;
+			}
+		for (int i = 0; i < 2; i++)
+			mlod_motion_free(m[i]);
+	}
+	if (short_clips) {
+		char text[96];
+		snprintf(text, sizeof text, "%d clip(s) with fewer than 3 frames: no motion levels", short_clips);
+		note(x, text);
+	}
+	if (missed) {
+		char text[96];
+		snprintf(text, sizeof text, "%d motion level(s) met no bound", missed);
+		note(x, text);
+	}
+	return r;
+}
+
+/* 1 when every value of a rotation channel is q / 32767 for an integer q. */
+static int on_lattice(const mlod_channel *ch)
+{
+	if (ch->path != MLOD_PATH_ROTATION || ch->interp == MLOD_INTERP_CUBICSPLINE)
+		return 0;
+	for (int i = 0; i < 4 * ch->key_count; i++) {
+		float v = ch->values[i];
+		if (!(fabsf(v) <= 1.0f))
+			return 0;
+		long q = lrintf(v * 32767.0f);
+		if ((float)q / 32767.0f != v)
+			return 0;
+	}
+	return 1;
+}
+
+static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int item, float error, chunks *out)
+{
+	chunkb cb = {0};
+	int n = clip->channel_count;
+	mlod_pack_channel_rec *recs = calloc((size_t)n + 1, sizeof *recs);
+	if (!recs)
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	for (int i = 0; i < n; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		recs[i] = (mlod_pack_channel_rec){(uint32_t)ch->joint, (uint32_t)ch->path, (uint32_t)ch->interp,
+		                                  (uint32_t)ch->key_count};
+	}
+	cb_add(&cb, MLOD_STREAM_CHAN, (uint32_t)n, sizeof *recs, recs, 0);
+	free(recs);
+	for (int i = 0; i < n && !cb.fail; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		uint32_t keys = (uint32_t)ch->key_count, per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
+		cb_add(&cb, MLOD_STREAM_TIME, keys, 4, ch->times, 0);
+		if (ch->path == MLOD_PATH_ROTATION && (ch->short_values || on_lattice(ch)) && on_lattice(ch)) {
+			int16_t *q = malloc(sizeof(int16_t) * 4 * ((size_t)keys + 1));
+			if (!q) {
+				cb.fail = 1;
+				break;
+			}
+			for (uint32_t v = 0; v < 4 * keys; v++)
+				q[v] = (int16_t)lrintf(ch->values[v] * 32767.0f);
+			cb_add(&cb, MLOD_STREAM_ROTQ, keys, 8, q, 0);
+			free(q);
+		} else if (ch->path == MLOD_PATH_ROTATION) {
+			cb_add(&cb, MLOD_STREAM_ROTF, keys * per, 16, ch->values, 0);
+		} else {
+			cb_add(&cb, MLOD_STREAM_VEC3, keys * per, 12, ch->values, 0);
+		}
+	}
+	return cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, k, item, error, x->err);
+}
+
+/* ------------------------------------------------------------------ */
+/* The pack                                                            */
+/* ------------------------------------------------------------------ */
+
+void mlod_pack_options_default(mlod_pack_options *opt)
+{
+	static const double ratios[] = {MLOD_MESH_RATIOS_DEFAULT}, bounds[] = {MLOD_PACK_MOTION_BOUNDS_DEFAULT};
+	memset(opt, 0, sizeof *opt);
+	opt->codec = MLOD_CODEC_MESHOPT;
+	opt->skel_max_error = MLOD_SKEL_MAX_ERROR_DEFAULT;
+	opt->ratio_count = (int)(sizeof ratios / sizeof *ratios);
+	memcpy(opt->ratios, ratios, sizeof ratios);
+	opt->mesh_max_error = -1.0;
+	opt->motion_bound_count = (int)(sizeof bounds / sizeof *bounds);
+	for (int i = 0; i < opt->motion_bound_count; i++) {
+		opt->motion_bounds[i] = bounds[i];
+		opt->motion_percent[i] = 1;
+	}
+}
+
+static void ctx_free(struct ctx *x)
+{
+	for (int k = 0; k < MLOD_SKEL_MAX_LEVELS; k++) {
+		free(x->kept[k]);
+		free(x->remap[k]);
+	}
+	for (int k = 0; k < MLOD_MESH_MAX_LEVELS; k++)
+		free(x->level_node[k]);
+	if (x->has_ML)
+		mlod_mesh_levels_free(&x->ML);
+	for (int i = 0; i < x->owned_count; i++)
+		mlod_motion_level_free(&x->owned_levels[i]);
+	free(x->owned_levels);
+	free(x->clips);
+	free(x->world);
+	free(x->view_skin);
+	free(x->v.skeleton.skins);
+	free(x->v.instances);
+	free(x->v.clips);
+	mlod_record_free(&x->rec);
+}
+
+static uint64_t layer_bytes(const chunks *ch, int layer, int raw)
+{
+	uint64_t n = 0;
+	for (int i = 0; i < ch->n; i++)
+		if (ch->c[i].layer == layer)
+			n += raw ? ch->c[i].raw : ch->c[i].size;
+	return n;
+}
+
+mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_format format, const void *input,
+                            size_t input_size, const mlod_pack_options *opt, void **out, size_t *out_size,
+                            mlod_pack_stats *stats, mlod_error *err)
+{
+	struct ctx x;
+	mlod_pack_stats local_stats;
+	chunks body = {0}, head = {0};
+	mlod_result r;
+	double t0;
+	if (!c || !opt || !out || !out_size)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_write: c, opt, out and out_size must not be NULL");
+	*out = NULL;
+	*out_size = 0;
+	if (opt->codec == MLOD_CODEC_DRACO)
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "the draco codec is not built yet");
+	if (opt->codec != MLOD_CODEC_NONE && opt->codec != MLOD_CODEC_MESHOPT)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "unknown codec %d", (int)opt->codec);
+	memset(&x, 0, sizeof x);
+	x.doc = doc;
+	x.in = c;
+	x.format = format;
+	x.opt = opt;
+	x.st = stats ? stats : &local_stats;
+	x.err = err;
+	memset(x.st, 0, sizeof *x.st);
+	if (doc && (r = mlod_record_read(doc, &x.rec, err)) != MLOD_OK)
+		return r;
+	if ((r = make_view(&x)) != MLOD_OK || (r = measure(&x)) != MLOD_OK)
+		goto done;
+
+	/* The levels of each layer. */
+	t0 = now_seconds();
+	if ((r = skeleton_levels(&x)) != MLOD_OK)
+		goto done;
+	x.st->skeleton.seconds = now_seconds() - t0;
+	t0 = now_seconds();
+	if ((r = mesh_levels(&x)) != MLOD_OK)
+		goto done;
+	x.st->mesh.seconds = now_seconds() - t0;
+	t0 = now_seconds();
+	if ((r = motion_levels(&x)) != MLOD_OK)
+		goto done;
+	int A = 0; /* motion levels counting level 0 */
+	for (int q = 0; q < x.v.clip_count; q++)
+		A = x.clips[q].count + 1 > A ? x.clips[q].count + 1 : A;
+	for (int q = 0; q < x.v.clip_count; q++) /* a clip with fewer levels repeats its coarsest */
+		for (int k = x.clips[q].count; k < A - 1; k++) {
+			x.clips[q].clip[k] = k ? x.clips[q].clip[k - 1] : &x.v.clips[q];
+			x.clips[q].error[k] = k ? x.clips[q].error[k - 1] : 0.0f;
+		}
+	x.st->motion.seconds = now_seconds() - t0;
+
+	/* The chunks after INFO, in file order. */
+	int S = 1 + x.skel_count;
+	int M = mlod_mesh_triangle_primitives(&x.v) > 0 ? 1 + x.mesh_count : 0;
+	int parts0 = 0;
+	t0 = now_seconds();
+	if ((r = skeleton_chunk(&x, &body)) != MLOD_OK)
+		goto done;
+	for (int k = S - 1; k >= 1; k--)
+		if ((r = skel_level_chunk(&x, k, &body)) != MLOD_OK)
+			goto done;
+	x.st->skeleton.seconds += now_seconds() - t0;
+	int top = (M > A ? M : A) - 1;
+	for (int k = top; k >= 0; k--) {
+		t0 = now_seconds();
+		if (k < M) {
+			int np = 0;
+			if ((r = mesh_chunk(&x, k, &body, &np)) != MLOD_OK)
+				goto done;
+			if (k == 0)
+				parts0 = np;
+		}
+		x.st->mesh.seconds += now_seconds() - t0;
+		t0 = now_seconds();
+		for (int q = 0; k < A && q < x.v.clip_count; q++) {
+			const mlod_clip *cl = k == 0 ? &x.v.clips[q] : x.clips[q].clip[k - 1];
+			if ((r = motion_chunk(&x, cl, k, q, k == 0 ? 0.0f : x.clips[q].error[k - 1], &body)) != MLOD_OK)
+				goto done;
+		}
+		x.st->motion.seconds += now_seconds() - t0;
+	}
+	/* DOC: the input without what the levels hold (mlod_gltf_strip_levels),
+	 * or as read when it cannot be stripped. */
+	{
+		chunkb cb = {0};
+		void *glb = NULL;
+		size_t glb_size = 0;
+		mlod_gltf *copy = NULL;
+		mlod_error serr = {0};
+		mlod_result sr = doc ? mlod_gltf_copy(doc, &copy, &serr) : MLOD_ERR_INVALID_ARG;
+		if (sr == MLOD_OK && !opt->doc_whole)
+			sr = mlod_gltf_strip_levels(copy, &serr);
+		if (sr == MLOD_OK)
+			sr = mlod_gltf_write(copy, 1, &glb, &glb_size, &serr);
+		mlod_gltf_free(copy);
+		if (sr == MLOD_OK) {
+			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
+			x.st->doc_stripped = !opt->doc_whole;
+		} else if (format == MLOD_FORMAT_GLB && input) {
+			char text[MLOD_ERROR_MESSAGE_SIZE + 64];
+			snprintf(text, sizeof text, "the document chunk holds the input whole: %s", serr.message);
+			note(&x, text);
+			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)input_size, 1, input, 0);
+		} else if (doc) {
+			mlod_free(glb);
+			glb = NULL;
+			if ((r = mlod_gltf_write(doc, 1, &glb, &glb_size, err)) != MLOD_OK)
+				goto done;
+			char text[MLOD_ERROR_MESSAGE_SIZE + 64];
+			snprintf(text, sizeof text, "the document chunk holds the input whole: %s", serr.message);
+			note(&x, text);
+			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
+		} else {
+			cb_add(&cb, MLOD_STREAM_GLB, 0, 1, NULL, 0);
+		}
+		mlod_free(glb);
+		if ((r = cb_finish(&cb, MLOD_CODEC_NONE, &body, MLOD_CHUNK_DOC, MLOD_LAYER_NONE, 0, 0, 0.0f, err)) != MLOD_OK)
+			goto done;
+	}
+
+	/* INFO: its size does not depend on its values (its streams are raw). */
+	strtab names = {0};
+	mlod_pack_info_rec info;
+	memset(&info, 0, sizeof info);
+	info.name = str_add(&names, opt->name ? opt->name : "");
+	for (int q = 0; q < x.v.clip_count; q++)
+		str_add(&names, x.v.clips[q].name);
+	if (names.b.fail) {
+		free(names.b.p);
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	info.joint_count = (uint32_t)x.v.skeleton.joint_count;
+	info.skin_count = (uint32_t)x.v.skeleton.skin_count;
+	info.skeleton_levels = (uint32_t)S;
+	info.mesh_levels = (uint32_t)M;
+	info.clip_count = (uint32_t)x.v.clip_count;
+	info.motion_levels = (uint32_t)A;
+	info.instance_count = (uint32_t)parts0;
+	for (int a = 0; a < 3; a++) {
+		info.bounds_min[a] = x.bmin[a];
+		info.bounds_max[a] = x.bmax[a];
+	}
+	info.height = x.height;
+	info.diagonal = x.diag;
+	size_t info_size = 4 + 2 * 16 + ((sizeof info + 3) & ~(size_t)3) + ((names.b.n + 3) & ~(size_t)3);
+	/* Offsets. */
+	uint64_t off = MLOD_PACK_HEADER_SIZE + (uint64_t)MLOD_PACK_TOC_ENTRY_SIZE * (uint64_t)(body.n + 1);
+	off = (off + 15) & ~(uint64_t)15;
+	uint64_t info_off = off;
+	off += info_size;
+	uint64_t first = off;
+	for (int i = 0; i < body.n; i++) {
+		off = (off + 15) & ~(uint64_t)15;
+		body.c[i].offset = off;
+		off += body.c[i].size;
+		chunk *ch = &body.c[i];
+		int needed = ch->type == MLOD_CHUNK_SKELETON ? ch->level == 0 || ch->level == S - 1
+		             : ch->type == MLOD_CHUNK_MESH    ? ch->level == M - 1
+		             : ch->type == MLOD_CHUNK_MOTION  ? ch->level == A - 1
+		                                              : 0;
+		if (needed && off > first)
+			first = off;
+	}
+	uint64_t file_size = off;
+	if (file_size > UINT32_MAX || body.n + 1 > MLOD_PACK_MAX_CHUNKS) {
+		free(names.b.p);
+		r = mlod_fail(err, MLOD_ERR_LIMIT, "the pack would be larger than 4 GiB");
+		goto done;
+	}
+	info.first_drawable = (uint32_t)first;
+	{
+		chunkb cb = {0};
+		cb_add(&cb, MLOD_STREAM_INFO, 1, sizeof info, &info, 0);
+		cb_add(&cb, MLOD_STREAM_NAME, (uint32_t)names.b.n, 1, names.b.p, 0);
+		free(names.b.p);
+		if ((r = cb_finish(&cb, MLOD_CODEC_NONE, &head, MLOD_CHUNK_INFO, MLOD_LAYER_NONE, 0, 0, 0.0f, err)) != MLOD_OK)
+			goto done;
+		head.c[0].offset = info_off;
+	}
+
+	/* Header, TOC, chunks. */
+	{
+		buf f = {0};
+		int n = body.n + 1;
+		buf_zeros(&f, MLOD_PACK_HEADER_SIZE + (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)n);
+		if (f.fail) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+			goto done;
+		}
+		for (int i = 0; i < n; i++) {
+			chunk *ch = i == 0 ? &head.c[0] : &body.c[i - 1];
+			buf_pad(&f, MLOD_PACK_ALIGN);
+			if (f.fail || f.n != ch->offset)
+				break;
+			uint8_t *e = f.p + MLOD_PACK_HEADER_SIZE + (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)i;
+			put_u32(e, ch->type);
+			e[4] = ch->layer;
+			e[5] = ch->codec;
+			put_u16(e + 6, ch->level);
+			put_u16(e + 8, ch->item);
+			put_u64(e + 16, ch->offset);
+			put_u32(e + 24, (uint32_t)ch->size);
+			put_u32(e + 28, ch->raw);
+			put_u32(e + 32, mlod_pack_crc32(0, ch->data, ch->size));
+			put_f32(e + 36, ch->error);
+			put_f32(e + 40, ch->distance);
+			buf_put(&f, ch->data, ch->size);
+		}
+		if (f.fail || f.n != file_size) {
+			free(f.p);
+			r = mlod_fail(err, f.fail ? MLOD_ERR_NOMEM : MLOD_ERR_INVALID_ARG, "writing the pack: layout mismatch");
+			goto done;
+		}
+		memcpy(f.p, MLOD_PACK_MAGIC, 4);
+		put_u16(f.p + 4, MLOD_PACK_MAJOR);
+		put_u16(f.p + 6, MLOD_PACK_MINOR);
+		put_u32(f.p + 8, 0);
+		put_u32(f.p + 12, (uint32_t)n);
+		put_u64(f.p + 16, file_size);
+		put_u32(f.p + 24, mlod_pack_crc32(0, f.p + MLOD_PACK_HEADER_SIZE, (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)n));
+		put_u32(f.p + 28, mlod_pack_crc32(0, f.p, 28));
+		*out = f.p;
+		*out_size = f.n;
+	}
+
+	/* Stats. */
+	{
+		mlod_pack_stats *st = x.st;
+		st->skeleton.levels = S;
+		st->mesh.levels = M;
+		st->motion.levels = A;
+		for (int k = 1; k < S; k++)
+			st->skeleton.errors[k] = x.skel_error[k - 1];
+		for (int k = 1; k < M; k++)
+			st->mesh.errors[k] = x.mesh_error[k - 1];
+		for (int k = 1; k < A; k++)
+			for (int q = 0; q < x.v.clip_count; q++)
+				st->motion.errors[k] = x.clips[q].error[k - 1] > st->motion.errors[k] ? x.clips[q].error[k - 1]
+				                                                                      : st->motion.errors[k];
+		st->skeleton.stored = layer_bytes(&body, MLOD_LAYER_SKELETON, 0);
+		st->skeleton.raw = layer_bytes(&body, MLOD_LAYER_SKELETON, 1);
+		st->mesh.stored = layer_bytes(&body, MLOD_LAYER_MESH, 0);
+		st->mesh.raw = layer_bytes(&body, MLOD_LAYER_MESH, 1);
+		st->motion.stored = layer_bytes(&body, MLOD_LAYER_MOTION, 0);
+		st->motion.raw = layer_bytes(&body, MLOD_LAYER_MOTION, 1);
+		st->info_bytes = head.c[0].size;
+		st->doc_bytes = body.c[body.n - 1].size;
+		st->total = file_size;
+		st->chunks = (uint32_t)(body.n + 1);
+		st->first_drawable = info.first_drawable;
+		st->joints = x.v.skeleton.joint_count;
+		st->skins = x.v.skeleton.skin_count;
+		st->parts = parts0;
+		st->clips = x.v.clip_count;
+		st->height = x.height;
+		st->diagonal = x.diag;
+	}
+	r = MLOD_OK;
+done:
+	for (int i = 0; i < body.n; i++)
+		free(body.c[i].data);
+	free(body.c);
+	for (int i = 0; i < head.n; i++)
+		free(head.c[i].data);
+	free(head.c);
+	ctx_free(&x);
+	return r;
+}

@@ -1,0 +1,1 @@
+"$BIN/mlod-pack" --codec zip "$ROOT/samples/tubeman.glb"

@@ -1,0 +1,1 @@
+"$BIN/mlod-pack" --frobnicate x.glb

@@ -1,0 +1,124 @@
+// pack_check.mjs: checks the container of a .mlod pack as mlod(5) and
+// lib/rt/mlod_pack.h lay it out (header, TOC, CRCs, alignment, order,
+// stream containers, INFO), independently of the C reader, and prints a
+// summary as JSON for the tests to check. Exits 1 naming the first problem.
+//
+//   node tests/cli/pack_check.mjs FILE.mlod [--doc OUT.glb]
+//
+// --doc writes the DOC chunk's glb to OUT.glb.
+// It does not decode streams: the round trip through the reader
+// (lib/rt/pack.c) is for the tests that come with it.
+import { readFileSync, writeFileSync } from 'node:fs';
+import { crc32 } from 'node:zlib';
+
+const file = process.argv[2];
+const b = readFileSync(file);
+const die = (m) => { console.error(`pack_check: ${file}: ${m}`); process.exit(1); };
+const fourcc = (u) => String.fromCharCode(u & 255, (u >> 8) & 255, (u >> 16) & 255, u >>> 24);
+
+if (b.length < 32 || b.subarray(0, 4).toString('latin1') !== 'MLOD') die('no MLOD magic');
+const major = b.readUInt16LE(4), minor = b.readUInt16LE(6), flags = b.readUInt32LE(8), n = b.readUInt32LE(12);
+const size = Number(b.readBigUInt64LE(16));
+if (major !== 1 || minor !== 0) die(`version ${major}.${minor}`);
+if (flags !== 0) die('flags');
+if (size !== b.length) die(`file_size ${size}, file ${b.length}`);
+if (crc32(b.subarray(0, 28)) !== b.readUInt32LE(28)) die('header CRC');
+if (32 + 48 * n > b.length) die('TOC past the end');
+if (crc32(b.subarray(32, 32 + 48 * n)) !== b.readUInt32LE(24)) die('TOC CRC');
+
+const chunks = [];
+let end = 32 + 48 * n;
+for (let i = 0; i < n; i++) {
+	const e = b.subarray(32 + 48 * i, 80 + 48 * i);
+	const c = {
+		type: fourcc(e.readUInt32LE(0)), layer: e[4], codec: e[5], level: e.readUInt16LE(6), item: e.readUInt16LE(8),
+		offset: Number(e.readBigUInt64LE(16)), stored: e.readUInt32LE(24), raw: e.readUInt32LE(28),
+		crc: e.readUInt32LE(32), error: e.readFloatLE(36), distance: e.readFloatLE(40),
+	};
+	if (e.readUInt16LE(10) || e.readUInt32LE(12) || e.readUInt32LE(44)) die(`chunk ${i}: reserved bytes`);
+	if (c.offset % 16) die(`chunk ${i}: offset ${c.offset} not 16-aligned`);
+	if (c.offset < end) die(`chunk ${i}: overlaps`);
+	if (b.subarray(end, c.offset).some((x) => x !== 0)) die(`chunk ${i}: padding not zero`);
+	if (c.offset + c.stored > b.length) die(`chunk ${i}: past the end`);
+	end = c.offset + c.stored;
+	const d = b.subarray(c.offset, end);
+	if (crc32(d) !== c.crc) die(`chunk ${i} (${c.type}): CRC`);
+	if (c.level === 0 && (c.error !== 0 || c.distance !== 0)) die(`chunk ${i}: error or distance at level 0`);
+	if (!(c.error >= 0) || (c.error > 0) !== (c.distance > 0)) die(`chunk ${i}: error ${c.error}, distance ${c.distance}`);
+	// distance = error * lines / (2 tan(fov / 2) pixels)
+	const want = c.error * 1080 / (2 * Math.tan(Math.PI / 6));
+	if (Math.abs(c.distance - want) > 1e-5 * want) die(`chunk ${i}: distance ${c.distance} for error ${c.error}`);
+	// The stream container.
+	const sc = d.readUInt32LE(0);
+	let p = 4 + 16 * sc, raw = 4 + 16 * sc;
+	c.streams = [];
+	for (let s = 0; s < sc; s++) {
+		const h = d.subarray(4 + 16 * s, 20 + 16 * s);
+		const st = { tag: fourcc(h.readUInt32LE(0)), count: h.readUInt32LE(4), size: h.readUInt16LE(8), codec: h[10], stored: h.readUInt32LE(12) };
+		if (h[11]) die(`chunk ${i}: stream ${s}: reserved`);
+		if (st.size < 1 || st.size > 256) die(`chunk ${i}: stream ${st.tag}: element size ${st.size}`);
+		if (st.codec === 0 && st.stored !== st.count * st.size) die(`chunk ${i}: raw stream ${st.tag}: stored ${st.stored}`);
+		if (st.codec === 1 && st.size % 4) die(`chunk ${i}: vertex codec on element size ${st.size}`);
+		if (st.codec === 2 && (st.size !== 2 && st.size !== 4 || st.count % 3)) die(`chunk ${i}: index codec on ${st.tag}`);
+		if (st.codec > 2) die(`chunk ${i}: stream codec ${st.codec}`);
+		st.at = p;
+		p += (st.stored + 3) & ~3;
+		raw += (st.count * st.size + 3) & ~3;
+		c.streams.push(st);
+	}
+	if (p !== d.length) die(`chunk ${i} (${c.type}): streams end at ${p}, chunk at ${d.length}`);
+	if (raw !== c.raw) die(`chunk ${i} (${c.type}): raw size ${c.raw}, streams say ${raw}`);
+	chunks.push(c);
+}
+if (end !== b.length) die('bytes after the last chunk');
+
+// Order: INFO, SKEL 0, skeleton levels coarsest first, then per level
+// coarse to fine mesh and motion, DOC last.
+const types = chunks.map((c) => c.type);
+if (types[0] !== 'INFO' || types[1] !== 'SKEL' || chunks[1].level !== 0 || types[n - 1] !== 'DOC ') die(`order: ${types.join(',')}`);
+let i = 2, last = Infinity;
+for (; i < n && types[i] === 'SKEL'; i++) {
+	if (!(chunks[i].level < last) || chunks[i].level === 0) die('skeleton levels not coarsest first');
+	last = chunks[i].level;
+}
+last = Infinity;
+for (; i < n - 1; i++) {
+	if (types[i] !== 'MESH' && types[i] !== 'ANIM') die(`chunk ${i}: ${types[i]} among the levels`);
+	if (chunks[i].level > last) die(`chunk ${i}: level ${chunks[i].level} after ${last}`);
+	last = chunks[i].level;
+}
+
+// INFO.
+const info = chunks[0], is = info.streams;
+if (is[0].tag !== 'INFO' || is[0].count !== 1 || is[0].size !== 80 || is[1].tag !== 'NAME') die('INFO streams');
+const r = b.subarray(info.offset + is[0].at, info.offset + is[0].at + 80);
+const u = (k) => r.readUInt32LE(4 * k), f = (k) => r.readFloatLE(4 * k);
+const names = b.subarray(info.offset + is[1].at, info.offset + is[1].at + is[1].count).toString('utf8').split('\0');
+const out = {
+	chunks: n, size: b.length,
+	joints: u(0), skins: u(1), skeleton_levels: u(2), mesh_levels: u(3), clips: u(4), motion_levels: u(5), parts: u(6),
+	name: names[0], clip_names: names.slice(1, 1 + u(4)),
+	bounds_min: [f(8), f(9), f(10)], bounds_max: [f(11), f(12), f(13)], height: f(14), diagonal: f(15), first_drawable: u(16),
+	count: {},
+	codecs: [...new Set(chunks.map((c) => c.codec))].sort(),
+	stream_codecs: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.codec)))].sort(),
+	tags: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.tag)))].sort(),
+	doc: chunks[n - 1].streams[0].count,
+	toc: chunks.map((c) => `${c.type.trim()} ${c.level}/${c.item} ${c.crc.toString(16)}`),
+};
+for (const c of chunks) out.count[c.type.trim()] = (out.count[c.type.trim()] || 0) + 1;
+if (out.count.SKEL !== out.skeleton_levels) die('SKEL chunks and INFO skeleton_levels');
+if ((out.count.MESH || 0) !== out.mesh_levels) die('MESH chunks and INFO mesh_levels');
+if ((out.count.ANIM || 0) !== out.clips * out.motion_levels) die('ANIM chunks and INFO clips x motion_levels');
+if (out.first_drawable > b.length || out.first_drawable < chunks[1].offset + chunks[1].stored) die('first_drawable');
+// Every coarsest level lies within first_drawable.
+for (const c of chunks) {
+	const coarsest = c.type === 'MESH' ? out.mesh_levels - 1 : c.type === 'ANIM' ? out.motion_levels - 1 : c.type === 'SKEL' ? out.skeleton_levels - 1 : -1;
+	if (c.level === coarsest && c.offset + c.stored > out.first_drawable) die(`${c.type} level ${c.level} past first_drawable`);
+}
+if (process.argv[3] === '--doc') {
+	const d = chunks[n - 1], s = d.streams[0];
+	if (s.tag !== 'GLB ' || s.codec !== 0) die('DOC stream');
+	writeFileSync(process.argv[4], b.subarray(d.offset + s.at, d.offset + s.at + s.count));
+}
+console.log(JSON.stringify(out));

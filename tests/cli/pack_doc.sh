@@ -1,0 +1,21 @@
+# The DOC chunk: the input document without what the levels hold. Node,
+# mesh, skin and material counts are the input's; primitives keep their
+# material but no attributes or indices; no MSFT_lod; animations keep
+# only morph weights channels (RobotExpressive has 3 per clip); far
+# smaller than the input.
+set -e
+"$BIN/mlod-label" < "$ROOT/samples/RobotExpressive.glb" | "$BIN/mlod-bgm" -R 0.5 > piped.glb
+"$BIN/mlod-pack" --no-motion-levels piped.glb -o robot.mlod
+node "$ROOT/tests/cli/pack_check.mjs" robot.mlod --doc doc.glb > /dev/null
+node - "$ROOT/samples/RobotExpressive.glb" <<'JS'
+const fs = require('fs');
+const glb = (f) => { const b = fs.readFileSync(f); return JSON.parse(b.subarray(20, 20 + b.readUInt32LE(12)).toString()); };
+const d = glb('doc.glb'), p = glb('piped.glb'), i = glb(process.argv[2]);
+for (const k of ['nodes', 'meshes', 'skins', 'materials']) if (d[k].length !== p[k].length) throw new Error(k);
+for (const m of d.meshes) for (const q of m.primitives) if (Object.keys(q.attributes).length || q.indices !== undefined || q.targets) throw new Error('geometry left');
+i.meshes.forEach((m, k) => m.primitives.forEach((q, t) => { if (d.meshes[k].primitives[t].material !== q.material) throw new Error('material of mesh ' + k); }));
+if (JSON.stringify(d).includes('MSFT_lod')) throw new Error('MSFT_lod left');
+if (d.animations.length !== i.animations.length) throw new Error('animations');
+for (const a of d.animations) if (a.channels.length !== 3 || a.channels.some((c) => c.target.path !== 'weights')) throw new Error('channels of ' + a.name);
+if (!(fs.statSync('doc.glb').size * 4 < fs.statSync(process.argv[2]).size)) throw new Error('doc size ' + fs.statSync('doc.glb').size);
+JS

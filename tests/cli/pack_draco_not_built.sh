@@ -1,0 +1,1 @@
+"$BIN/mlod-pack" --codec draco -o x.mlod "$ROOT/samples/tubeman.glb"

@@ -1,0 +1,4 @@
+set -e
+"$BIN/mlod-pack" --help | grep -q "^usage: mlod-pack"
+"$BIN/mlod-pack" --help | grep -q -- "--motion-max-error"
+"$BIN/mlod-pack" --version | grep -q "^mlod-pack (mlod) "

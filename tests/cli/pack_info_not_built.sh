@@ -1,0 +1,2 @@
+printf MLOD > x.mlod
+"$BIN/mlod-pack" --info x.mlod

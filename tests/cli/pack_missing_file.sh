@@ -1,0 +1,1 @@
+"$BIN/mlod-pack" no-such-file.glb

@@ -1,0 +1,604 @@
+/*
+ * test_pack_write.c: the pack writer's quantisation bounds (lib/pack),
+ * checked on their own and on a written pack: weights sum exactly to 255,
+ * positions and UVs lie within half a step, octahedral normals within
+ * MLOD_PACK_OCT_BOUND, and the switch distance puts the error on one pixel.
+ *
+ * The pack is checked at the stream level here (header, TOC and CRC; the
+ * MESH level 0 streams decoded with meshoptimizer's decoder), with no
+ * dependency on the reader (lib/rt/pack.c). When the reader lands, the
+ * round trip through mlod_pack_decode_* belongs beside pack_mesh_streams.
+ */
+#include "test.h"
+
+#include <meshoptimizer.h>
+
+/* A small deterministic generator (xorshift). */
+static uint32_t rng = 2463534242u;
+static float frand(void)
+{
+	rng ^= rng << 13;
+	rng ^= rng >> 17;
+	rng ^= rng << 5;
+	return (float)(rng >> 8) / 16777216.0f;
+}
+
+TEST(weights_sum_to_255)
+{
+	float cases[][4] = {{1, 0, 0, 0},     {0.25f, 0.25f, 0.25f, 0.25f}, {1, 1, 1, 0}, {0.5f, 0.5f, 0, 0},
+	                    {1e-7f, 1, 0, 0}, {0.333f, 0.333f, 0.334f, 0}, {0, 0, 0, 2}, {0.1f, 0.2f, 0.3f, 0.4f}};
+	for (int c = 0; c < 8 + 100000; c++) {
+		float w[4];
+		if (c < 8) {
+			memcpy(w, cases[c], sizeof w);
+		} else {
+			for (int i = 0; i < 4; i++)
+				w[i] = frand() < 0.3f ? 0.0f : frand();
+			if (w[0] + w[1] + w[2] + w[3] == 0.0f)
+				w[0] = 1.0f;
+		}
+		uint8_t q[4];
+		mlod_pack_weights8(w, q);
+		double sum = (double)w[0] + w[1] + w[2] + w[3];
+		CHECK_MSG(q[0] + q[1] + q[2] + q[3] == 255, "case %d: %d+%d+%d+%d", c, q[0], q[1], q[2], q[3]);
+		for (int i = 0; i < 4; i++) {
+			CHECK_MSG(fabs(q[i] - 255.0 * w[i] / sum) < 1.0, "case %d slot %d: %d for %g", c, i, q[i], w[i] / sum);
+			CHECK_MSG(w[i] > 0.0f || q[i] == 0, "case %d: weight on an empty slot", c);
+		}
+	}
+	uint8_t z[4];
+	mlod_pack_weights8((const float[4]){0, 0, 0, 0}, z);
+	CHECK(z[0] == 0 && z[1] == 0 && z[2] == 0 && z[3] == 0);
+}
+
+TEST(u16_within_half_a_step)
+{
+	for (int c = 0; c < 100000; c++) {
+		float lo = (frand() - 0.5f) * 200.0f, ext = frand() * (c % 3 ? 10.0f : 1e-3f);
+		float hi = lo + ext, scale = mlod_pack_range_scale(lo, hi);
+		float v = c % 97 == 0 ? lo : c % 89 == 0 ? hi : lo + frand() * ext;
+		if (v > hi)
+			v = hi;
+		uint16_t q = mlod_pack_qu16(v, lo, scale);
+		float back = lo + (float)q * scale; /* as the reader computes it */
+		double tol = 0.5 * scale + 4.0 * 1.2e-7 * (fabs(lo) + fabs(hi));
+		CHECK_MSG(fabs(back - v) <= tol, "v %.9g in [%.9g, %.9g]: q %u gives %.9g (step %g)", v, lo, hi, q, back,
+		          scale);
+	}
+	CHECK(mlod_pack_qu16(3.0f, 3.0f, 0.0f) == 0); /* a flat range */
+	CHECK(mlod_pack_range_scale(1.0f, 1.0f) == 0.0f);
+}
+
+static double angle(const float a[3], const float b[3])
+{
+	double d = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+	double la = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
+	double lb = sqrt((double)b[0] * b[0] + (double)b[1] * b[1] + (double)b[2] * b[2]);
+	d /= la * lb;
+	double cx = (double)a[1] * b[2] - (double)a[2] * b[1], cy = (double)a[2] * b[0] - (double)a[0] * b[2],
+	       cz = (double)a[0] * b[1] - (double)a[1] * b[0];
+	return atan2(sqrt(cx * cx + cy * cy + cz * cz) / (la * lb), d);
+}
+
+TEST(octahedral_within_bound)
+{
+	double worst = 0.0;
+	float axes[][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 1, 0}, {1, -1, -1e-6f}};
+	for (int c = 0; c < 8 + 200000; c++) {
+		float n[3], d[3];
+		int16_t q[2];
+		if (c < 8) {
+			memcpy(n, axes[c], sizeof n);
+		} else {
+			float l;
+			do {
+				for (int a = 0; a < 3; a++)
+					n[a] = 2.0f * frand() - 1.0f;
+				l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+			} while (l < 1e-3f || l > 1.0f);
+			for (int a = 0; a < 3; a++)
+				n[a] /= l;
+		}
+		mlod_pack_oct_encode(n, q);
+		mlod_pack_oct_decode(q, d);
+		double e = angle(n, d);
+		worst = e > worst ? e : worst;
+		CHECK_MSG(e <= MLOD_PACK_OCT_BOUND, "(%g %g %g): %g rad", n[0], n[1], n[2], e);
+		CHECK(q[0] >= -32767 && q[1] >= -32767);
+	}
+	(void)worst; /* 4.26e-05 rad measured over these 200008 normals */
+}
+
+TEST(switch_distance_one_pixel)
+{
+	const double pi = 3.14159265358979323846;
+	for (float e = 1e-4f; e < 10.0f; e *= 3.0f) {
+		double d = mlod_pack_switch_distance(e);
+		double pixel = 2.0 * d * tan(MLOD_PACK_FOV_Y * pi / 360.0) / MLOD_PACK_LINES; /* a pixel at d */
+		CHECK_NEAR(e / pixel, MLOD_PACK_PIXELS, 1e-4);
+	}
+	CHECK(mlod_pack_switch_distance(0.0f) == 0.0f);
+}
+
+/* ------------------------------------------------------------------ */
+/* A written pack, at the stream level                                 */
+/* ------------------------------------------------------------------ */
+
+static uint32_t rd32(const uint8_t *p)
+{
+	return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static uint32_t crc(const uint8_t *p, size_t n)
+{
+	uint32_t c = 0xFFFFFFFFu;
+	for (size_t i = 0; i < n; i++) {
+		c ^= p[i];
+		for (int k = 0; k < 8; k++)
+			c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+	}
+	return ~c;
+}
+
+/* Stream `tag` number `nth` of a chunk, decoded into a new buffer. */
+static uint8_t *stream(const uint8_t *chunk, uint32_t tag, int nth, uint32_t *count, uint32_t *size)
+{
+	uint32_t n = rd32(chunk), at = 4 + 16 * n;
+	for (uint32_t s = 0; s < n; s++) {
+		const uint8_t *h = chunk + 4 + 16 * s;
+		uint32_t stored = rd32(h + 12);
+		if (rd32(h) == tag && nth-- == 0) {
+			*count = rd32(h + 4);
+			*size = (uint32_t)h[8] | (uint32_t)h[9] << 8;
+			uint8_t *out = malloc((size_t)*count * *size + 1);
+			if (h[10] == MLOD_SCODEC_RAW)
+				memcpy(out, chunk + at, (size_t)*count * *size);
+			else if (h[10] == MLOD_SCODEC_MESHOPT_VERTEX)
+				meshopt_decodeVertexBuffer(out, *count, *size, chunk + at, stored);
+			else
+				meshopt_decodeIndexBuffer(out, *count, *size, chunk + at, stored);
+			return out;
+		}
+		at += (stored + 3) & ~3u;
+	}
+	return NULL;
+}
+
+static void *slurp(const char *path, size_t *size)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	fseek(f, 0, SEEK_END);
+	*size = (size_t)ftell(f);
+	rewind(f);
+	void *b = malloc(*size);
+	if (fread(b, 1, *size, f) != *size) {
+		free(b);
+		b = NULL;
+	}
+	fclose(f);
+	return b;
+}
+
+TEST(pack_mesh_streams)
+{
+	size_t n = 0;
+	void *in = slurp("samples/tubeman.glb", &n);
+	CHECK(in);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	opt.ratio_count = 1;
+	opt.ratios[0] = 0.5;
+	opt.no_skeleton_levels = opt.no_motion_levels = 1;
+	void *out = NULL;
+	size_t size = 0;
+	mlod_pack_stats st;
+	CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, &st, &terr));
+	const uint8_t *p = out;
+	CHECK(memcmp(p, "MLOD", 4) == 0 && rd32(p + 28) == crc(p, 28));
+	uint32_t chunks = rd32(p + 12);
+	CHECK(rd32(p + 24) == crc(p + 32, 48 * (size_t)chunks));
+	CHECK(st.mesh.levels == 2 && st.skeleton.levels == 1 && st.motion.levels == 1);
+	/* MESH level 0: the input's primitive, quantised. */
+	const uint8_t *mesh = NULL;
+	for (uint32_t i = 0; i < chunks; i++) {
+		const uint8_t *e = p + 32 + 48 * i;
+		uint64_t off = rd32(e + 16) | (uint64_t)rd32(e + 20) << 32;
+		CHECK(rd32(e + 32) == crc(p + off, rd32(e + 24)));
+		if (rd32(e) == MLOD_CHUNK_MESH && e[6] == 0 && e[7] == 0)
+			mesh = p + off;
+	}
+	CHECK(mesh);
+	uint32_t cnt, esz;
+	mlod_pack_part_rec *part = (mlod_pack_part_rec *)stream(mesh, MLOD_STREAM_PART, 0, &cnt, &esz);
+	CHECK(part && cnt == 1 && esz == sizeof *part);
+	const mlod_primitive *pr = &c.meshes[c.instances[0].mesh].primitives[0];
+	CHECK(part->vertex_count == (uint32_t)pr->vertex_count && part->index_count == (uint32_t)pr->index_count);
+	CHECK(part->flags & MLOD_PART_SKINNED);
+	uint16_t *pos = (uint16_t *)stream(mesh, MLOD_STREAM_POSQ, 0, &cnt, &esz);
+	int16_t *nrm = (int16_t *)stream(mesh, MLOD_STREAM_NRMQ, 0, &cnt, &esz);
+	uint8_t *wgt = stream(mesh, MLOD_STREAM_WGT8, 0, &cnt, &esz);
+	uint8_t *jnt = stream(mesh, MLOD_STREAM_JNT8, 0, &cnt, &esz);
+	uint16_t *idx = (uint16_t *)stream(mesh, MLOD_STREAM_IDX, 0, &cnt, &esz);
+	CHECK(pos && nrm && wgt && jnt && idx && esz == 2 && cnt == part->index_count);
+	for (int v = 0; v < pr->vertex_count; v++) {
+		for (int a = 0; a < 3; a++) {
+			float back = part->pos_min[a] + (float)pos[4 * v + a] * part->pos_scale[a];
+			CHECK_NEAR(back, pr->positions[3 * v + a], 0.5 * part->pos_scale[a] + 1e-5);
+		}
+		float d[3];
+		mlod_pack_oct_decode(nrm + 2 * v, d);
+		CHECK(angle(d, pr->normals + 3 * v) <= MLOD_PACK_OCT_BOUND);
+		CHECK(wgt[4 * v] + wgt[4 * v + 1] + wgt[4 * v + 2] + wgt[4 * v + 3] == 255);
+		/* the weight on each joint is within a unorm8 step of the input's */
+		for (int t = 0; t < 4; t++) {
+			float want = 0.0f, got = 0.0f, sum = 0.0f;
+			for (int i = 0; i < 4; i++) {
+				sum += pr->weights[0][4 * v + i];
+				if (pr->joints[0][4 * v + i] == jnt[4 * v + t])
+					want += pr->weights[0][4 * v + i];
+				if (jnt[4 * v + i] == jnt[4 * v + t])
+					got += wgt[4 * v + i] / 255.0f;
+			}
+			CHECK_MSG(fabsf(got - want / sum) <= 1.0f / 255.0f, "vertex %d joint %d: %g for %g", v, jnt[4 * v + t],
+			          got, want / sum);
+		}
+	}
+	for (uint32_t i = 0; i < part->index_count; i++)
+		CHECK(idx[i] == pr->indices[i]);
+	free(part);
+	free(pos);
+	free(nrm);
+	free(wgt);
+	free(jnt);
+	free(idx);
+	mlod_free(out);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	free(in);
+}
+
+
+/* The chunk of this type and level; NULL when there is none. */
+static const uint8_t *find_chunk(const uint8_t *p, uint32_t type, int level)
+{
+	uint32_t chunks = rd32(p + 12);
+	for (uint32_t i = 0; i < chunks; i++) {
+		const uint8_t *e = p + 32 + 48 * i;
+		if (rd32(e) == type && (e[6] | e[7] << 8) == level)
+			return p + (rd32(e + 16) | (uint64_t)rd32(e + 20) << 32);
+	}
+	return NULL;
+}
+
+/* Drops the entry of joint `joint` from skin 0 (vertices on it move to
+ * entry 0), so that a stand-in can be missing from the skin. */
+static void drop_skin_joint(mlod_character *c, int joint)
+{
+	mlod_skin *sk = &c->skeleton.skins[0];
+	int r = -1;
+	for (int q = 0; q < sk->joint_count; q++)
+		if (sk->joints[q] == joint)
+			r = q;
+	if (r < 0)
+		return;
+	for (int q = r; q + 1 < sk->joint_count; q++) {
+		sk->joints[q] = sk->joints[q + 1];
+		sk->inverse_bind[q] = sk->inverse_bind[q + 1];
+	}
+	sk->joint_count--;
+	for (int i = 0; i < c->instance_count; i++) {
+		if (c->instances[i].skin != 0)
+			continue;
+		mlod_mesh *m = &c->meshes[c->instances[i].mesh];
+		for (int p = 0; p < m->primitive_count; p++)
+			for (int s = 0; s < m->primitives[p].weight_set_count; s++)
+				for (int v = 0; v < 4 * m->primitives[p].vertex_count; v++) {
+					uint16_t *jt = &m->primitives[p].joints[s][v];
+					*jt = *jt == r ? 0 : *jt > r ? (uint16_t)(*jt - 1) : *jt;
+				}
+	}
+}
+
+/* The skeleton levels' palettes reproduce fold.c's skin transfer: for
+ * every skin joint, the level skin that mlod_skel_level_apply makes holds
+ * the joint PALJ names with the bind matrix PALB gives, and KEPT lists
+ * the level's kept joints. Twice: on tubeman, whose skin has every joint
+ * (a stand-in's own bind), and with a stand-in dropped from the skin
+ * (R(stand-in -> joint) * IBM(joint)). */
+TEST(pack_palette_is_fold)
+{
+	size_t n = 0;
+	void *in = slurp("samples/tubeman.glb", &n);
+	CHECK(in);
+	int outside_total = 0;
+	for (int variant = 0; variant < 2; variant++) {
+		mlod_gltf *doc = NULL;
+		mlod_character c;
+		mlod_format fmt;
+		CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+		mlod_joint_info *info = calloc((size_t)c.skeleton.joint_count, sizeof *info);
+		mlod_label_options lopt = {0};
+		mlod_skel_levels L;
+		memset(&L, 0, sizeof L);
+		CHECK_OK(mlod_label_skeleton(&c, &lopt, info, &terr));
+		if (variant == 1) {
+			/* the stand-in of the first joint the first level removes */
+			CHECK_OK(mlod_skel_levels_init(&L, &c, info, &terr));
+			CHECK_OK(mlod_skel_levels_default(&L, MLOD_SKEL_MAX_ERROR_DEFAULT, &terr));
+			int stand = -1;
+			for (int k = 0; k < L.count && stand < 0; k++)
+				for (int j = 0; j < c.skeleton.joint_count && stand < 0; j++)
+					if (!L.levels[k].skel.kept[j] && L.levels[k].skel.remap[j] != c.skeleton.skins[0].joints[0])
+						stand = L.levels[k].skel.remap[j];
+			mlod_skel_levels_free(&L);
+			memset(&L, 0, sizeof L);
+			CHECK(stand >= 0);
+			drop_skin_joint(&c, stand);
+		}
+		/* The levels mlod-pack computes: mlod-skelgraph's defaults. */
+		CHECK_OK(mlod_skel_levels_init(&L, &c, info, &terr));
+		CHECK_OK(mlod_skel_levels_default(&L, MLOD_SKEL_MAX_ERROR_DEFAULT, &terr));
+		CHECK(L.count >= 2);
+		mlod_pack_options opt;
+		mlod_pack_options_default(&opt);
+		opt.no_mesh_levels = opt.no_motion_levels = 1;
+		opt.codec = MLOD_CODEC_NONE;
+		void *out = NULL;
+		size_t size = 0;
+		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, NULL, &terr));
+		const mlod_skin *sk = &c.skeleton.skins[0];
+		CHECK(c.skeleton.skin_count == 1);
+		int removed_in_skin = 0;
+		for (int k = 0; k < L.count; k++) {
+			const mlod_skel_built *b = &L.levels[k];
+			const uint8_t *ch = find_chunk(out, MLOD_CHUNK_SKELETON, k + 1);
+			CHECK_MSG(ch, "no SKEL level %d", k + 1);
+			uint32_t kc, pc, bc, es;
+			uint32_t *kept = (uint32_t *)stream(ch, MLOD_STREAM_KEPT, 0, &kc, &es);
+			uint32_t *palj = (uint32_t *)stream(ch, MLOD_STREAM_PALJ, 0, &pc, &es);
+			float *palb = (float *)stream(ch, MLOD_STREAM_PALB, 0, &bc, &es);
+			CHECK(kept && palj && palb && es == 64);
+			CHECK(kc == (uint32_t)b->skel.kept_count && pc == (uint32_t)sk->joint_count && bc == pc);
+			for (uint32_t i = 0; i < kc; i++)
+				CHECK(b->skel.kept[kept[i]] && (i == 0 || kept[i] > kept[i - 1]));
+			const mlod_skin *lsk = &b->c.skeleton.skins[0];
+			for (int q = 0; q < sk->joint_count; q++) {
+				int j = sk->joints[q], in_skin = 0;
+				CHECK(palj[q] == (uint32_t)b->skel.remap[j]);
+				removed_in_skin += !b->skel.kept[j];
+				for (int t = 0; t < sk->joint_count; t++)
+					in_skin |= sk->joints[t] == (int)palj[q];
+				outside_total += !in_skin;
+				/* the level skin's entry for that joint, by node */
+				int found = 0;
+				for (int t = 0; t < lsk->joint_count && !found; t++) {
+					if (b->c.skeleton.joints[lsk->joints[t]].node != c.skeleton.joints[palj[q]].node)
+						continue;
+					found = 1;
+					for (int e = 0; e < 16; e++)
+						CHECK_MSG(fabsf(lsk->inverse_bind[t].m[e] - palb[16 * q + e]) <=
+						              1e-6f * (1.0f + fabsf(palb[16 * q + e])),
+						          "variant %d level %d, skin joint %d: PALB[%d] %g, fold.c %g", variant, k + 1, q, e,
+						          palb[16 * q + e], lsk->inverse_bind[t].m[e]);
+				}
+				CHECK_MSG(found, "level %d: skin joint %d's stand-in is not in the level skin", k + 1, q);
+			}
+			free(kept);
+			free(palj);
+			free(palb);
+		}
+		CHECK(removed_in_skin > 0); /* the rule for removed joints was exercised */
+		mlod_free(out);
+		mlod_skel_levels_free(&L);
+		free(info);
+		mlod_character_free(&c);
+		mlod_gltf_free(doc);
+	}
+	CHECK(outside_total > 0); /* and the one for a stand-in outside the skin */
+	free(in);
+}
+
+/* A skin of more than 256 joints stores u16 joints ('JN16'), and a
+ * character built in memory packs without a document. */
+TEST(pack_joints16)
+{
+	enum { N = 300 };
+	static mlod_joint joints[N];
+	static int skin_joints[N];
+	static mlod_mat4 ibm[N];
+	for (int i = 0; i < N; i++) {
+		memset(&joints[i], 0, sizeof joints[i]);
+		joints[i].name = "j";
+		joints[i].parent = i - 1;
+		joints[i].rest = mlod_trs_identity();
+		joints[i].rest.t.y = 0.01f;
+		joints[i].base = mlod_mat4_identity();
+		joints[i].node = -1;
+		skin_joints[i] = i;
+		ibm[i] = mlod_mat4_identity();
+	}
+	mlod_skin skin = {"skin", N, skin_joints, ibm, -1};
+	float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+	uint16_t jv[12] = {299, 5, 0, 0, 299, 5, 0, 0, 7, 0, 0, 0};
+	float wv[12] = {0.5f, 0.5f, 0, 0, 0.25f, 0.75f, 0, 0, 1, 0, 0, 0};
+	uint32_t idx[3] = {0, 1, 2};
+	mlod_primitive prim;
+	memset(&prim, 0, sizeof prim);
+	prim.vertex_count = 3;
+	prim.positions = pos;
+	prim.weight_set_count = 1;
+	prim.joints[0] = jv;
+	prim.weights[0] = wv;
+	prim.index_count = 3;
+	prim.indices = idx;
+	prim.mode = 4;
+	prim.material = -1;
+	mlod_mesh mesh = {"m", 1, &prim, -1};
+	mlod_instance inst = {0, -1, 0, -1, mlod_mat4_identity()};
+	mlod_character c;
+	memset(&c, 0, sizeof c);
+	c.skeleton.joint_count = N;
+	c.skeleton.joints = joints;
+	c.skeleton.skin_count = 1;
+	c.skeleton.skins = &skin;
+	c.mesh_count = 1;
+	c.meshes = &mesh;
+	c.instance_count = 1;
+	c.instances = &inst;
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	opt.no_skeleton_levels = opt.no_mesh_levels = opt.no_motion_levels = 1;
+	void *out = NULL;
+	size_t size = 0;
+	mlod_pack_stats st;
+	CHECK_OK(mlod_pack_write(NULL, &c, MLOD_FORMAT_UNKNOWN, NULL, 0, &opt, &out, &size, &st, &terr));
+	CHECK(st.joints == N && st.parts == 1 && st.mesh.levels == 1 && st.motion.levels == 0);
+	const uint8_t *mesh0 = find_chunk(out, MLOD_CHUNK_MESH, 0);
+	CHECK(mesh0);
+	uint32_t cnt, esz;
+	mlod_pack_part_rec *part = (mlod_pack_part_rec *)stream(mesh0, MLOD_STREAM_PART, 0, &cnt, &esz);
+	uint16_t *j16 = (uint16_t *)stream(mesh0, MLOD_STREAM_JN16, 0, &cnt, &esz);
+	uint8_t *w8 = stream(mesh0, MLOD_STREAM_WGT8, 0, &cnt, &esz);
+	CHECK(part && j16 && w8 && !stream(mesh0, MLOD_STREAM_JNT8, 0, &cnt, &esz));
+	CHECK((part->flags & (MLOD_PART_SKINNED | MLOD_PART_JOINTS16)) == (MLOD_PART_SKINNED | MLOD_PART_JOINTS16));
+	for (int v = 0; v < 3; v++) {
+		CHECK(w8[4 * v] + w8[4 * v + 1] + w8[4 * v + 2] + w8[4 * v + 3] == 255);
+		for (int t = 0; t < 4; t++) {
+			float got = w8[4 * v + t] / 255.0f;
+			float want = 0.0f;
+			for (int i = 0; i < 4; i++)
+				if (jv[4 * v + i] == j16[4 * v + t])
+					want += wv[4 * v + i];
+			CHECK_MSG(got == 0.0f || fabsf(got - want) <= 1.0f / 255.0f, "vertex %d: joint %d %g for %g", v,
+			          j16[4 * v + t], got, want);
+		}
+	}
+	CHECK(j16[0] == 299 || j16[1] == 299);
+	free(part);
+	free(j16);
+	free(w8);
+	mlod_free(out);
+}
+
+/* The lossless fields are exact: SKEL level 0 holds the input's joints
+ * and inverse binds, ANIM level 0 every key of the clip bit for bit
+ * (rotations on the short lattice as 'ROTQ', q / 32767 giving the value
+ * back), with the meshopt codec. */
+TEST(pack_lossless_fields)
+{
+	const char *files[] = {"samples/RobotExpressive.glb", "samples/cmu_12_01_walk.bvh"};
+	int rotq = 0, rotf = 0;
+	for (int f = 0; f < 2; f++) {
+		size_t n = 0;
+		void *in = slurp(files[f], &n);
+		CHECK(in);
+		mlod_gltf *doc = NULL;
+		mlod_character c;
+		mlod_format fmt;
+		CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+		mlod_pack_options opt;
+		mlod_pack_options_default(&opt);
+		opt.no_skeleton_levels = opt.no_mesh_levels = opt.no_motion_levels = 1;
+		void *out = NULL;
+		size_t size = 0;
+		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, NULL, &terr));
+		const uint8_t *sk = find_chunk(out, MLOD_CHUNK_SKELETON, 0);
+		CHECK(sk);
+		uint32_t cnt, esz;
+		mlod_pack_joint_rec *jr = (mlod_pack_joint_rec *)stream(sk, MLOD_STREAM_JNTS, 0, &cnt, &esz);
+		CHECK(jr && cnt == (uint32_t)c.skeleton.joint_count && esz == sizeof *jr);
+		for (int j = 0; j < c.skeleton.joint_count; j++) {
+			const mlod_joint *q = &c.skeleton.joints[j];
+			CHECK(jr[j].parent == q->parent && jr[j].node == q->node);
+			CHECK(memcmp(jr[j].t, &q->rest.t, 12) == 0 && memcmp(jr[j].r, &q->rest.r, 16) == 0 &&
+			      memcmp(jr[j].s, &q->rest.s, 12) == 0 && memcmp(jr[j].base, q->base.m, 64) == 0);
+		}
+		free(jr);
+		float *ib = (float *)stream(sk, MLOD_STREAM_IBMS, 0, &cnt, &esz);
+		CHECK(ib);
+		for (int i = 0, e = 0; i < c.skeleton.skin_count; i++)
+			for (int q = 0; q < c.skeleton.skins[i].joint_count; q++, e++)
+				CHECK(memcmp(ib + 16 * e, c.skeleton.skins[i].inverse_bind[q].m, 64) == 0);
+		free(ib);
+		/* every clip's level 0 */
+		uint32_t chunks = rd32((const uint8_t *)out + 12);
+		int clips = 0;
+		for (uint32_t i = 0; i < chunks; i++) {
+			const uint8_t *e = (const uint8_t *)out + 32 + 48 * i;
+			if (rd32(e) != MLOD_CHUNK_MOTION || (e[6] | e[7] << 8) != 0)
+				continue;
+			const mlod_clip *clip = &c.clips[e[8] | e[9] << 8];
+			const uint8_t *ch = (const uint8_t *)out + rd32(e + 16);
+			mlod_pack_channel_rec *cr = (mlod_pack_channel_rec *)stream(ch, MLOD_STREAM_CHAN, 0, &cnt, &esz);
+			CHECK(cr && cnt == (uint32_t)clip->channel_count);
+			int nrotq = 0, nrotf = 0, nvec = 0;
+			for (int k = 0; k < clip->channel_count; k++) {
+				const mlod_channel *cc = &clip->channels[k];
+				int per = cc->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1, comps = cc->path == MLOD_PATH_ROTATION ? 4 : 3;
+				CHECK(cr[k].joint == (uint32_t)cc->joint && cr[k].path == (uint32_t)cc->path &&
+				      cr[k].interp == (uint32_t)cc->interp && cr[k].key_count == (uint32_t)cc->key_count);
+				float *t = (float *)stream(ch, MLOD_STREAM_TIME, k, &cnt, &esz);
+				CHECK(t && cnt == (uint32_t)cc->key_count && memcmp(t, cc->times, 4 * cnt) == 0);
+				free(t);
+				size_t values = (size_t)cc->key_count * per * comps;
+				if (comps == 3) {
+					float *v = (float *)stream(ch, MLOD_STREAM_VEC3, nvec++, &cnt, &esz);
+					CHECK(v && memcmp(v, cc->values, 4 * values) == 0);
+					free(v);
+					continue;
+				}
+				/* which of ROTQ or ROTF this channel used: the k-th rotation */
+				uint32_t n0 = rd32(ch);
+				int rot = 0, tag = 0;
+				for (uint32_t s = 0; s < n0; s++) {
+					uint32_t tg = rd32(ch + 4 + 16 * s);
+					if (tg == MLOD_STREAM_ROTQ || tg == MLOD_STREAM_ROTF) {
+						if (rot == nrotq + nrotf)
+							tag = (int)tg;
+						rot++;
+					}
+				}
+				if ((uint32_t)tag == MLOD_STREAM_ROTQ) {
+					int16_t *q = (int16_t *)stream(ch, MLOD_STREAM_ROTQ, nrotq++, &cnt, &esz);
+					CHECK(q && cnt == (uint32_t)cc->key_count);
+					for (size_t v = 0; v < values; v++)
+						CHECK_MSG((float)q[v] / 32767.0f == cc->values[v], "ROTQ %d/32767 for %.9g", q[v], cc->values[v]);
+					free(q);
+					rotq++;
+				} else {
+					float *v = (float *)stream(ch, MLOD_STREAM_ROTF, nrotf++, &cnt, &esz);
+					CHECK(v && memcmp(v, cc->values, 4 * values) == 0);
+					free(v);
+					rotf++;
+				}
+			}
+			free(cr);
+			clips++;
+		}
+		CHECK(clips == c.clip_count);
+		mlod_free(out);
+		mlod_character_free(&c);
+		mlod_gltf_free(doc);
+		free(in);
+	}
+	CHECK(rotq > 0 && rotf > 0); /* both rotation forms were met */
+}
+
+int main(void)
+{
+	RUN(weights_sum_to_255);
+	RUN(u16_within_half_a_step);
+	RUN(octahedral_within_bound);
+	RUN(switch_distance_one_pixel);
+	RUN(pack_mesh_streams);
+	RUN(pack_palette_is_fold);
+	RUN(pack_joints16);
+	RUN(pack_lossless_fields);
+	TEST_EXIT();
+}
