@@ -126,6 +126,28 @@
  *   textures, images, samplers, names, extras, extensions, the node tree,
  *   skins and everything else the input carried. The runtime skips it;
  *   mlod-pack -x rebuilds a glb from it and the levels.
+ *
+ * Precisions the reader (lib/rt/pack.c) checks, added with it; they make
+ * explicit what the text above implies and change no layout:
+ * - file_size is exactly the last chunk's end (the TOC's end without
+ *   chunks): no bytes after the last chunk.
+ * - The known chunk types appear in the order above, each (type, level,
+ *   item) at most once: INFO, DOC and every SKELETON and MESH have item 0,
+ *   INFO and DOC level 0; only MESH chunks may use the Draco codec. Chunks
+ *   of unknown types may stand anywhere. INFO's level counts match the TOC.
+ * - A chunk of codec none has only raw streams; a chunk's stored size is
+ *   exactly 4 + 16 * stream_count + its streams' stored sizes, each padded
+ *   to 4 (and its raw size as said above).
+ * - INFO 'NAME': the clips' names follow the character's name (at
+ *   rec.name), one after the other, in clip order.
+ * - MESH: 'POSQ' and 'IDX ' are always there (possibly with 0 elements);
+ *   'MTSC' and the 'MTPQ' streams only when target_count > 0. Normals and
+ *   tangents use the octahedral map: x = q0 / 32767, y = q1 / 32767 (each
+ *   clamped to -1), z = 1 - |x| - |y|; where z < 0, (x, y) becomes
+ *   ((1 - |y|) * sign x, (1 - |x|) * sign y) with sign 0 = +1; then the
+ *   vector is normalised. 'TANQ' w is exactly -32767 or 32767.
+ * - MOTION: key times are finite and strictly increasing; a joint has at
+ *   most one channel per path; 'ROTQ' only for non-cubic channels.
  */
 #ifndef MLOD_PACK_H
 #define MLOD_PACK_H
@@ -288,8 +310,8 @@ typedef struct mlod_pack_channel_rec {
 } mlod_pack_channel_rec;
 
 /* The MOTION chunk's clip: INFO 'NAME' holds the clip names, after the
- * character's, in clip order; each clip's duration is its largest key
- * time. */
+ * character's (the strings that follow the one at rec.name, one per clip),
+ * in clip order; each clip's duration is its largest key time. */
 
 /* ------------------------------------------------------------------ */
 /* The reader                                                          */
@@ -401,7 +423,9 @@ mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t s
                                   mlod_error *err);
 mlod_result mlod_pack_decode_skeleton(const mlod_pack *p, const void *data, size_t size,
                                       mlod_pack_skeleton *out, mlod_error *err);
-/* skel is the decoded full skeleton the level refers to. */
+/* skel is the decoded full skeleton the level refers to (required for a
+ * skeleton level; for a mesh or motion level, NULL stands for a character
+ * without joints and skins, and any reference to one then fails). */
 mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
                                         const mlod_pack_skeleton *skel, mlod_pack_skel_level *out,
                                         mlod_error *err);
@@ -423,8 +447,11 @@ void mlod_pack_motion_free(mlod_pack_motion *x);
 /* The index of the chunk of this type, layer, level and item, or -1. */
 int mlod_pack_find(const mlod_pack *p, uint32_t type, unsigned level, unsigned item);
 
-/* "INFO", "SKEL", ...; "none", "meshopt", "draco"; "none", "skeleton",
- * "mesh", "motion". */
+/* "INFO", "SKEL", "MESH", "ANIM", "DOC" (a chunk type's fourcc, without
+ * the trailing space; "unknown" for others); "none", "meshopt", "draco";
+ * "none", "skeleton", "mesh", "motion". mlod_pack_type_name was added with
+ * the reader: the comment named it, no declaration did. */
+const char *mlod_pack_type_name(uint32_t type);
 const char *mlod_pack_codec_name(unsigned codec);
 const char *mlod_pack_layer_name(unsigned layer);
 

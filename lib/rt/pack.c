@@ -1,0 +1,1414 @@
+/*
+ * pack.c: the one reader of the .mlod pack format (mlod_pack.h, mlod(5)).
+ *
+ * Everything read from the file is checked before it is used: the header
+ * and TOC by mlod_pack_open, each chunk's CRC, stream container, stream
+ * sizes, record counts and indices by its decode. Sizes are computed in
+ * uint64_t, so no product or sum can wrap. A decode sizes its one
+ * allocation (the block) from the stream headers, whose decoded sizes add
+ * up to the TOC's raw size, and refuses one above PACK_MAX_BLOCK before
+ * allocating. Meshopt-coded streams are decoded into a temporary buffer
+ * (freed before the decode returns); raw streams are read in place.
+ *
+ * Byte order: the format is little-endian, and so must the host be (the
+ * index codec's output and the records are read with memcpy); the
+ * preprocessor check below refuses a big-endian target where the compiler
+ * tells. Fields are read with memcpy, so the data needs no alignment.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <meshoptimizer.h>
+
+#include "mlod_pack.h"
+
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "mlod's pack reader assumes a little-endian host"
+#endif
+
+_Static_assert(sizeof(float) == 4, "f32 is float");
+_Static_assert(sizeof(mlod_pack_info_rec) == 80, "INFO record is 80 bytes");
+_Static_assert(sizeof(mlod_pack_joint_rec) == 116, "joint record is 116 bytes");
+_Static_assert(sizeof(mlod_pack_skin_rec) == 12, "skin record is 12 bytes");
+_Static_assert(sizeof(mlod_pack_part_rec) == 200, "part record is 200 bytes");
+_Static_assert(sizeof(mlod_pack_channel_rec) == 16, "channel record is 16 bytes");
+
+/* The largest block (and temporary buffer) a decode allocates. */
+#define PACK_MAX_BLOCK ((uint64_t)1 << 30)
+
+static const uint32_t crc_table[256] = {
+	0x00000000u, 0x77073096u, 0xee0e612cu, 0x990951bau, 0x076dc419u, 0x706af48fu,
+	0xe963a535u, 0x9e6495a3u, 0x0edb8832u, 0x79dcb8a4u, 0xe0d5e91eu, 0x97d2d988u,
+	0x09b64c2bu, 0x7eb17cbdu, 0xe7b82d07u, 0x90bf1d91u, 0x1db71064u, 0x6ab020f2u,
+	0xf3b97148u, 0x84be41deu, 0x1adad47du, 0x6ddde4ebu, 0xf4d4b551u, 0x83d385c7u,
+	0x136c9856u, 0x646ba8c0u, 0xfd62f97au, 0x8a65c9ecu, 0x14015c4fu, 0x63066cd9u,
+	0xfa0f3d63u, 0x8d080df5u, 0x3b6e20c8u, 0x4c69105eu, 0xd56041e4u, 0xa2677172u,
+	0x3c03e4d1u, 0x4b04d447u, 0xd20d85fdu, 0xa50ab56bu, 0x35b5a8fau, 0x42b2986cu,
+	0xdbbbc9d6u, 0xacbcf940u, 0x32d86ce3u, 0x45df5c75u, 0xdcd60dcfu, 0xabd13d59u,
+	0x26d930acu, 0x51de003au, 0xc8d75180u, 0xbfd06116u, 0x21b4f4b5u, 0x56b3c423u,
+	0xcfba9599u, 0xb8bda50fu, 0x2802b89eu, 0x5f058808u, 0xc60cd9b2u, 0xb10be924u,
+	0x2f6f7c87u, 0x58684c11u, 0xc1611dabu, 0xb6662d3du, 0x76dc4190u, 0x01db7106u,
+	0x98d220bcu, 0xefd5102au, 0x71b18589u, 0x06b6b51fu, 0x9fbfe4a5u, 0xe8b8d433u,
+	0x7807c9a2u, 0x0f00f934u, 0x9609a88eu, 0xe10e9818u, 0x7f6a0dbbu, 0x086d3d2du,
+	0x91646c97u, 0xe6635c01u, 0x6b6b51f4u, 0x1c6c6162u, 0x856530d8u, 0xf262004eu,
+	0x6c0695edu, 0x1b01a57bu, 0x8208f4c1u, 0xf50fc457u, 0x65b0d9c6u, 0x12b7e950u,
+	0x8bbeb8eau, 0xfcb9887cu, 0x62dd1ddfu, 0x15da2d49u, 0x8cd37cf3u, 0xfbd44c65u,
+	0x4db26158u, 0x3ab551ceu, 0xa3bc0074u, 0xd4bb30e2u, 0x4adfa541u, 0x3dd895d7u,
+	0xa4d1c46du, 0xd3d6f4fbu, 0x4369e96au, 0x346ed9fcu, 0xad678846u, 0xda60b8d0u,
+	0x44042d73u, 0x33031de5u, 0xaa0a4c5fu, 0xdd0d7cc9u, 0x5005713cu, 0x270241aau,
+	0xbe0b1010u, 0xc90c2086u, 0x5768b525u, 0x206f85b3u, 0xb966d409u, 0xce61e49fu,
+	0x5edef90eu, 0x29d9c998u, 0xb0d09822u, 0xc7d7a8b4u, 0x59b33d17u, 0x2eb40d81u,
+	0xb7bd5c3bu, 0xc0ba6cadu, 0xedb88320u, 0x9abfb3b6u, 0x03b6e20cu, 0x74b1d29au,
+	0xead54739u, 0x9dd277afu, 0x04db2615u, 0x73dc1683u, 0xe3630b12u, 0x94643b84u,
+	0x0d6d6a3eu, 0x7a6a5aa8u, 0xe40ecf0bu, 0x9309ff9du, 0x0a00ae27u, 0x7d079eb1u,
+	0xf00f9344u, 0x8708a3d2u, 0x1e01f268u, 0x6906c2feu, 0xf762575du, 0x806567cbu,
+	0x196c3671u, 0x6e6b06e7u, 0xfed41b76u, 0x89d32be0u, 0x10da7a5au, 0x67dd4accu,
+	0xf9b9df6fu, 0x8ebeeff9u, 0x17b7be43u, 0x60b08ed5u, 0xd6d6a3e8u, 0xa1d1937eu,
+	0x38d8c2c4u, 0x4fdff252u, 0xd1bb67f1u, 0xa6bc5767u, 0x3fb506ddu, 0x48b2364bu,
+	0xd80d2bdau, 0xaf0a1b4cu, 0x36034af6u, 0x41047a60u, 0xdf60efc3u, 0xa867df55u,
+	0x316e8eefu, 0x4669be79u, 0xcb61b38cu, 0xbc66831au, 0x256fd2a0u, 0x5268e236u,
+	0xcc0c7795u, 0xbb0b4703u, 0x220216b9u, 0x5505262fu, 0xc5ba3bbeu, 0xb2bd0b28u,
+	0x2bb45a92u, 0x5cb36a04u, 0xc2d7ffa7u, 0xb5d0cf31u, 0x2cd99e8bu, 0x5bdeae1du,
+	0x9b64c2b0u, 0xec63f226u, 0x756aa39cu, 0x026d930au, 0x9c0906a9u, 0xeb0e363fu,
+	0x72076785u, 0x05005713u, 0x95bf4a82u, 0xe2b87a14u, 0x7bb12baeu, 0x0cb61b38u,
+	0x92d28e9bu, 0xe5d5be0du, 0x7cdcefb7u, 0x0bdbdf21u, 0x86d3d2d4u, 0xf1d4e242u,
+	0x68ddb3f8u, 0x1fda836eu, 0x81be16cdu, 0xf6b9265bu, 0x6fb077e1u, 0x18b74777u,
+	0x88085ae6u, 0xff0f6a70u, 0x66063bcau, 0x11010b5cu, 0x8f659effu, 0xf862ae69u,
+	0x616bffd3u, 0x166ccf45u, 0xa00ae278u, 0xd70dd2eeu, 0x4e048354u, 0x3903b3c2u,
+	0xa7672661u, 0xd06016f7u, 0x4969474du, 0x3e6e77dbu, 0xaed16a4au, 0xd9d65adcu,
+	0x40df0b66u, 0x37d83bf0u, 0xa9bcae53u, 0xdebb9ec5u, 0x47b2cf7fu, 0x30b5ffe9u,
+	0xbdbdf21cu, 0xcabac28au, 0x53b39330u, 0x24b4a3a6u, 0xbad03605u, 0xcdd70693u,
+	0x54de5729u, 0x23d967bfu, 0xb3667a2eu, 0xc4614ab8u, 0x5d681b02u, 0x2a6f2b94u,
+	0xb40bbe37u, 0xc30c8ea1u, 0x5a05df1bu, 0x2d02ef8du,
+};
+
+uint32_t mlod_pack_crc32(uint32_t crc, const void *data, size_t size)
+{
+	const uint8_t *p = data;
+	crc = ~crc;
+	for (size_t i = 0; i < size; i++)
+		crc = crc_table[(crc ^ p[i]) & 0xffu] ^ (crc >> 8);
+	return ~crc;
+}
+
+/* ------------------------------------------------------------------ */
+/* Small helpers                                                       */
+/* ------------------------------------------------------------------ */
+
+static uint16_t rd16(const uint8_t *p)
+{
+	return (uint16_t)(p[0] | p[1] << 8);
+}
+
+static uint32_t rd32(const uint8_t *p)
+{
+	return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static uint64_t rd64(const uint8_t *p)
+{
+	return (uint64_t)rd32(p) | (uint64_t)rd32(p + 4) << 32;
+}
+
+static float rdf(const uint8_t *p)
+{
+	uint32_t u = rd32(p);
+	float f;
+	memcpy(&f, &u, 4);
+	return f;
+}
+
+static int16_t rdi16(const uint8_t *p)
+{
+	uint16_t u = rd16(p);
+	return u < 0x8000u ? (int16_t)u : (int16_t)((int32_t)u - 65536);
+}
+
+static uint64_t pad4(uint64_t n)
+{
+	return (n + 3) & ~(uint64_t)3;
+}
+
+static uint64_t round8(uint64_t n)
+{
+	return (n + 7) & ~(uint64_t)7;
+}
+
+static int all_finite(const float *v, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		if (!isfinite(v[i]))
+			return 0;
+	return 1;
+}
+
+/* A fourcc as printable text. */
+typedef struct tagname {
+	char s[5];
+} tagname;
+
+static tagname tagn(uint32_t tag)
+{
+	tagname t;
+	for (int i = 0; i < 4; i++) {
+		unsigned char ch = (unsigned char)(tag >> (8 * i));
+		t.s[i] = ch >= 0x20 && ch < 0x7f ? (char)ch : '?';
+	}
+	t.s[4] = 0;
+	return t;
+}
+
+/* The chunk's name in messages: "MESH level 2", "MOTION level 1 of clip 0". */
+static void chunk_label(uint32_t type, unsigned level, unsigned item, char *buf, size_t n)
+{
+	switch (type) {
+	case MLOD_CHUNK_INFO: snprintf(buf, n, "INFO"); break;
+	case MLOD_CHUNK_SKELETON:
+		if (level == 0)
+			snprintf(buf, n, "SKELETON");
+		else
+			snprintf(buf, n, "SKELETON level %u", level);
+		break;
+	case MLOD_CHUNK_MESH: snprintf(buf, n, "MESH level %u", level); break;
+	case MLOD_CHUNK_MOTION: snprintf(buf, n, "MOTION level %u of clip %u", level, item); break;
+	case MLOD_CHUNK_DOC: snprintf(buf, n, "DOC"); break;
+	default: snprintf(buf, n, "chunk of unknown type '%s'", tagn(type).s); break;
+	}
+}
+
+static int known_type(uint32_t type)
+{
+	return type == MLOD_CHUNK_INFO || type == MLOD_CHUNK_SKELETON || type == MLOD_CHUNK_MESH ||
+	       type == MLOD_CHUNK_MOTION || type == MLOD_CHUNK_DOC;
+}
+
+/* The position of a known chunk in the format's order (strictly increasing
+ * along the TOC): INFO, SKELETON, skeleton levels coarsest first, then per
+ * level coarsest first the mesh level and the motion levels by clip, DOC. */
+static uint64_t order_key(const mlod_pack_chunk *c)
+{
+	uint64_t inv = 65535u - c->level;
+	switch (c->type) {
+	case MLOD_CHUNK_INFO: return 0;
+	case MLOD_CHUNK_SKELETON: return c->level == 0 ? (uint64_t)1 << 40 : (uint64_t)2 << 40 | inv << 24;
+	case MLOD_CHUNK_MESH: return (uint64_t)3 << 40 | inv << 24;
+	case MLOD_CHUNK_MOTION: return (uint64_t)3 << 40 | inv << 24 | (uint64_t)1 << 16 | c->item;
+	default: return (uint64_t)4 << 40;
+	}
+}
+
+/* ------------------------------------------------------------------ */
+/* Header and TOC                                                      */
+/* ------------------------------------------------------------------ */
+
+mlod_result mlod_pack_open(const void *data, size_t size, mlod_pack *out, mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_open: out is NULL");
+	memset(out, 0, sizeof *out);
+	if (!data && size)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_open: data is NULL");
+	const uint8_t *d = data;
+	if (size < 4 || memcmp(d, MLOD_PACK_MAGIC, 4) != 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "not an mlod pack: it does not start with \"MLOD\"");
+	if (size < MLOD_PACK_HEADER_SIZE)
+		return mlod_fail(err, MLOD_ERR_PARSE, "truncated pack: %zu bytes, shorter than the %d-byte header", size,
+		                 MLOD_PACK_HEADER_SIZE);
+	unsigned major = rd16(d + 4), minor = rd16(d + 6);
+	if (major > MLOD_PACK_MAJOR)
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "pack format %u.%u is newer than this reader's %d.x", major,
+		                 minor, MLOD_PACK_MAJOR);
+	if (major == 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "pack format %u.%u does not exist (the first is 1.0)", major, minor);
+	uint32_t hcrc = mlod_pack_crc32(0, d, 28);
+	if (hcrc != rd32(d + 28))
+		return mlod_fail(err, MLOD_ERR_PARSE, "pack header: CRC mismatch (stored 0x%08x, computed 0x%08x)",
+		                 rd32(d + 28), hcrc);
+	uint32_t flags = rd32(d + 8), n = rd32(d + 12);
+	uint64_t file_size = rd64(d + 16);
+	if (n > MLOD_PACK_MAX_CHUNKS)
+		return mlod_fail(err, MLOD_ERR_PARSE, "pack header: %u chunks, more than the format's %d", n,
+		                 MLOD_PACK_MAX_CHUNKS);
+	uint64_t toc_end = MLOD_PACK_HEADER_SIZE + (uint64_t)n * MLOD_PACK_TOC_ENTRY_SIZE;
+	if (size < toc_end)
+		return mlod_fail(err, MLOD_ERR_PARSE, "truncated pack: the TOC of %u chunks ends at byte %llu, the data has %zu",
+		                 n, (unsigned long long)toc_end, size);
+	uint32_t tcrc = mlod_pack_crc32(0, d + MLOD_PACK_HEADER_SIZE, (size_t)(toc_end - MLOD_PACK_HEADER_SIZE));
+	if (tcrc != rd32(d + 24))
+		return mlod_fail(err, MLOD_ERR_PARSE, "pack TOC: CRC mismatch (stored 0x%08x, computed 0x%08x)", rd32(d + 24),
+		                 tcrc);
+	if (file_size < toc_end)
+		return mlod_fail(err, MLOD_ERR_PARSE, "pack header: file size %llu is less than the header and TOC (%llu bytes)",
+		                 (unsigned long long)file_size, (unsigned long long)toc_end);
+
+	mlod_pack_chunk *chunks = NULL;
+	if (n > 0) {
+		chunks = calloc(n, sizeof *chunks);
+		if (!chunks)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "pack TOC: out of memory for %u entries", n);
+	}
+	uint64_t prev_end = toc_end, prev_key = 0;
+	int have_prev = 0;
+	mlod_result r = MLOD_OK;
+	char label[64];
+	for (uint32_t i = 0; i < n && r == MLOD_OK; i++) {
+		const uint8_t *e = d + MLOD_PACK_HEADER_SIZE + (size_t)i * MLOD_PACK_TOC_ENTRY_SIZE;
+		mlod_pack_chunk *c = &chunks[i];
+		c->type = rd32(e);
+		c->layer = e[4];
+		c->codec = e[5];
+		c->level = rd16(e + 6);
+		c->item = rd16(e + 8);
+		c->flags = rd16(e + 10);
+		c->offset = rd64(e + 16);
+		c->stored_size = rd32(e + 24);
+		c->raw_size = rd32(e + 28);
+		c->crc = rd32(e + 32);
+		c->error = rdf(e + 36);
+		c->distance = rdf(e + 40);
+		chunk_label(c->type, c->level, c->item, label, sizeof label);
+		if (c->offset % MLOD_PACK_ALIGN != 0) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): offset %llu is not %d-aligned", i, label,
+			              (unsigned long long)c->offset, MLOD_PACK_ALIGN);
+		} else if (c->offset < prev_end) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): offset %llu overlaps the %s, which ends at %llu", i,
+			              label, (unsigned long long)c->offset, i == 0 ? "header and TOC" : "previous chunk",
+			              (unsigned long long)prev_end);
+		} else if (c->offset > file_size || c->stored_size > file_size - c->offset) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): bytes %llu to %llu lie outside the file (%llu bytes)",
+			              i, label, (unsigned long long)c->offset,
+			              (unsigned long long)c->offset + c->stored_size, (unsigned long long)file_size);
+		} else if (!isfinite(c->error) || c->error < 0 || !isfinite(c->distance) || c->distance < 0) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): error %g and switch distance %g must be finite and >= 0",
+			              i, label, (double)c->error, (double)c->distance);
+		} else if (known_type(c->type)) {
+			unsigned want_layer = c->type == MLOD_CHUNK_SKELETON ? MLOD_LAYER_SKELETON
+			                      : c->type == MLOD_CHUNK_MESH   ? MLOD_LAYER_MESH
+			                      : c->type == MLOD_CHUNK_MOTION ? MLOD_LAYER_MOTION
+			                                                     : MLOD_LAYER_NONE;
+			uint64_t key = order_key(c);
+			if (c->layer != want_layer)
+				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): layer %u, expected %u (%s)", i, label,
+				              c->layer, want_layer, mlod_pack_layer_name(want_layer));
+			else if ((c->type == MLOD_CHUNK_INFO || c->type == MLOD_CHUNK_DOC) && c->level != 0)
+				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): level %u, expected 0", i, label, c->level);
+			else if (c->type != MLOD_CHUNK_MOTION && c->item != 0)
+				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): item %u, expected 0", i, label, c->item);
+			else if (c->codec == MLOD_CODEC_DRACO && c->type != MLOD_CHUNK_MESH)
+				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the Draco codec is for MESH chunks only", i,
+				              label);
+			else if (have_prev && key == prev_key)
+				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): a second chunk of that type, level and item", i,
+				              label);
+			else if (have_prev && key < prev_key)
+				r = mlod_fail(err, MLOD_ERR_PARSE,
+				              "TOC entry %u (%s) is out of order: chunks go INFO, SKELETON, skeleton levels, then mesh "
+				              "and motion levels coarsest first, DOC last",
+				              i, label);
+			prev_key = key;
+			have_prev = 1;
+		}
+		prev_end = c->offset + c->stored_size;
+	}
+	if (r == MLOD_OK && file_size != prev_end)
+		r = mlod_fail(err, MLOD_ERR_PARSE, "pack header: file size %llu, but the %s ends at byte %llu",
+		              (unsigned long long)file_size, n ? "last chunk" : "TOC", (unsigned long long)prev_end);
+	if (r != MLOD_OK) {
+		free(chunks);
+		return r;
+	}
+	out->major = (uint16_t)major;
+	out->minor = (uint16_t)minor;
+	out->flags = flags;
+	out->file_size = file_size;
+	out->chunk_count = n;
+	out->chunks = chunks;
+	return MLOD_OK;
+}
+
+void mlod_pack_close(mlod_pack *p)
+{
+	if (!p)
+		return;
+	free(p->chunks);
+	memset(p, 0, sizeof *p);
+}
+
+int mlod_pack_find(const mlod_pack *p, uint32_t type, unsigned level, unsigned item)
+{
+	if (!p)
+		return -1;
+	for (uint32_t i = 0; i < p->chunk_count; i++) {
+		const mlod_pack_chunk *c = &p->chunks[i];
+		if (c->type == type && c->level == level && c->item == item)
+			return (int)i;
+	}
+	return -1;
+}
+
+const char *mlod_pack_type_name(uint32_t type)
+{
+	switch (type) {
+	case MLOD_CHUNK_INFO: return "INFO";
+	case MLOD_CHUNK_SKELETON: return "SKEL";
+	case MLOD_CHUNK_MESH: return "MESH";
+	case MLOD_CHUNK_MOTION: return "ANIM";
+	case MLOD_CHUNK_DOC: return "DOC";
+	}
+	return "unknown";
+}
+
+const char *mlod_pack_codec_name(unsigned codec)
+{
+	switch (codec) {
+	case MLOD_CODEC_NONE: return "none";
+	case MLOD_CODEC_MESHOPT: return "meshopt";
+	case MLOD_CODEC_DRACO: return "draco";
+	}
+	return "unknown";
+}
+
+const char *mlod_pack_layer_name(unsigned layer)
+{
+	switch (layer) {
+	case MLOD_LAYER_NONE: return "none";
+	case MLOD_LAYER_SKELETON: return "skeleton";
+	case MLOD_LAYER_MESH: return "mesh";
+	case MLOD_LAYER_MOTION: return "motion";
+	}
+	return "unknown";
+}
+
+/* ------------------------------------------------------------------ */
+/* A chunk's stream container                                          */
+/* ------------------------------------------------------------------ */
+
+typedef struct stream {
+	uint32_t index, tag, count, elsize, codec, stored;
+	const uint8_t *src; /* the stored bytes */
+} stream;
+
+typedef struct cx {
+	const mlod_pack_chunk *c;
+	char label[64];
+	const uint8_t *base; /* the chunk's stored bytes */
+	uint32_t nstreams, next;
+	uint64_t cursor;      /* offset in the chunk of stream next's bytes */
+	uint64_t max_decoded; /* the largest meshopt-coded stream, decoded */
+	uint8_t *temp;        /* aux bytes, then the decode buffer */
+	uint64_t aux;
+} cx;
+
+/* Checks the chunk (type, codec, bounds, CRC) and its stream container
+ * (sizes add up to the stored and the raw size). */
+static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, const void *data, size_t size, cx *x,
+                            mlod_error *err)
+{
+	memset(x, 0, sizeof *x);
+	if (!p || (!data && size))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: the pack or the data is NULL");
+	if (index >= p->chunk_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: chunk %u does not exist (the pack has %u)", index,
+		                 p->chunk_count);
+	const mlod_pack_chunk *c = &p->chunks[index];
+	x->c = c;
+	chunk_label(c->type, c->level, c->item, x->label, sizeof x->label);
+	if (c->type != type) {
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: chunk %u is %s, not a %s chunk", index, x->label,
+		                 mlod_pack_type_name(type));
+	}
+	if (c->codec == MLOD_CODEC_DRACO)
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: Draco chunks need the Draco decoder, not built in", x->label);
+	if (c->codec != MLOD_CODEC_NONE && c->codec != MLOD_CODEC_MESHOPT)
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: unknown chunk codec %u", x->label, c->codec);
+	if (c->offset > size || c->stored_size > size - c->offset)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: truncated: the chunk ends at byte %llu, the data has %zu", x->label,
+		                 (unsigned long long)(c->offset + c->stored_size), size);
+	x->base = (const uint8_t *)data + c->offset;
+	uint32_t crc = mlod_pack_crc32(0, x->base, c->stored_size);
+	if (crc != c->crc)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: CRC mismatch (stored 0x%08x, computed 0x%08x)", x->label, c->crc,
+		                 crc);
+	if (c->stored_size < 4)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %u bytes, too short for its stream count", x->label,
+		                 c->stored_size);
+	uint32_t n = rd32(x->base);
+	if (n > MLOD_PACK_MAX_STREAMS)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %u streams, more than the format's %d", x->label, n,
+		                 MLOD_PACK_MAX_STREAMS);
+	uint64_t cursor = 4 + 16 * (uint64_t)n, raw = cursor;
+	if (cursor > c->stored_size)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %u stream headers do not fit in its %u bytes", x->label, n,
+		                 c->stored_size);
+	for (uint32_t i = 0; i < n; i++) {
+		const uint8_t *h = x->base + 4 + 16 * (size_t)i;
+		uint32_t tag = rd32(h), count = rd32(h + 4), elsize = rd16(h + 8), codec = h[10], stored = rd32(h + 12);
+		uint64_t decoded = (uint64_t)count * elsize;
+		if (elsize < 1 || elsize > 256)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': element size %u is not 1 to 256", x->label, i,
+			                 tagn(tag).s, elsize);
+		if (codec > MLOD_SCODEC_MESHOPT_INDEX)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': unknown stream codec %u", x->label, i,
+			                 tagn(tag).s, codec);
+		if (codec != MLOD_SCODEC_RAW && c->codec == MLOD_CODEC_NONE)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s' is meshopt-coded in a chunk of codec none",
+			                 x->label, i, tagn(tag).s);
+		if (codec == MLOD_SCODEC_MESHOPT_VERTEX && elsize % 4 != 0)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': the meshopt vertex codec needs an element size that is a multiple of "
+			                 "4, not %u",
+			                 x->label, i, tagn(tag).s, elsize);
+		if (codec == MLOD_SCODEC_MESHOPT_INDEX && elsize != 2 && elsize != 4)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': the meshopt index codec needs an element size of 2 or 4, not %u",
+			                 x->label, i, tagn(tag).s, elsize);
+		if (codec == MLOD_SCODEC_MESHOPT_INDEX && count % 3 != 0)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': the meshopt index codec needs a multiple of 3 elements, not %u",
+			                 x->label, i, tagn(tag).s, count);
+		if (codec == MLOD_SCODEC_RAW && stored != decoded)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': %u bytes stored for %u elements of %u bytes",
+			                 x->label, i, tagn(tag).s, stored, count, elsize);
+		if (pad4(stored) > c->stored_size - cursor)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s' (%u bytes at %llu) runs past the chunk's %u bytes",
+			                 x->label, i, tagn(tag).s, stored, (unsigned long long)cursor, c->stored_size);
+		cursor += pad4(stored);
+		raw += pad4(decoded);
+		if (codec != MLOD_SCODEC_RAW && decoded > x->max_decoded)
+			x->max_decoded = decoded;
+	}
+	if (cursor != c->stored_size)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: its streams end at byte %llu of its %u", x->label,
+		                 (unsigned long long)cursor, c->stored_size);
+	if (raw != c->raw_size)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: raw size %u in the TOC, but its streams decode to %llu bytes",
+		                 x->label, c->raw_size, (unsigned long long)raw);
+	x->nstreams = n;
+	x->next = 0;
+	x->cursor = 4 + 16 * (uint64_t)n;
+	return MLOD_OK;
+}
+
+static void cx_rewind(cx *x)
+{
+	x->next = 0;
+	x->cursor = 4 + 16 * (uint64_t)x->nstreams;
+}
+
+/* The next stream's header; 0 when there is none. */
+static int cx_next(cx *x, stream *s)
+{
+	if (x->next >= x->nstreams)
+		return 0;
+	const uint8_t *h = x->base + 4 + 16 * (size_t)x->next;
+	s->index = x->next;
+	s->tag = rd32(h);
+	s->count = rd32(h + 4);
+	s->elsize = rd16(h + 8);
+	s->codec = h[10];
+	s->stored = rd32(h + 12);
+	s->src = x->base + x->cursor;
+	x->cursor += pad4(s->stored);
+	x->next++;
+	return 1;
+}
+
+/* The next stream, which must have this tag, element size and count
+ * (count UINT64_MAX: any). what says where ("part 3"), count_what what
+ * the count is. */
+static mlod_result cx_expect(cx *x, stream *s, uint32_t tag, uint32_t elsize, uint64_t count, const char *what,
+                             const char *count_what, mlod_error *err)
+{
+	const char *sep = *what ? ": " : "";
+	if (!cx_next(x, s))
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %s%smissing stream '%s' (the chunk has %u streams)", x->label, what,
+		                 sep, tagn(tag).s, x->nstreams);
+	if (s->tag != tag)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %s%sstream %u is '%s', expected '%s'", x->label, what, sep, s->index,
+		                 tagn(s->tag).s, tagn(tag).s);
+	if (s->elsize != elsize)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %s%sstream %u '%s' has elements of %u bytes, expected %u", x->label,
+		                 what, sep, s->index, tagn(tag).s, s->elsize, elsize);
+	if (count != UINT64_MAX && s->count != count)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %s%sstream %u '%s' has %u elements, expected %llu (%s)", x->label,
+		                 what, sep, s->index, tagn(tag).s, s->count, (unsigned long long)count, count_what);
+	return MLOD_OK;
+}
+
+static mlod_result cx_end(cx *x, mlod_error *err)
+{
+	if (x->next != x->nstreams)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %u unexpected streams after the last one it needs (stream %u '%s')",
+		                 x->label, x->nstreams - x->next, x->next, tagn(rd32(x->base + 4 + 16 * (size_t)x->next)).s);
+	return MLOD_OK;
+}
+
+/* Allocates the temporary buffer: aux bytes for the decode's own checks,
+ * then room for the largest meshopt-coded stream. */
+static mlod_result cx_temp(cx *x, uint64_t aux, mlod_error *err)
+{
+	uint64_t total = round8(aux) + x->max_decoded;
+	x->aux = round8(aux);
+	if (total == 0)
+		return MLOD_OK;
+	if (total > PACK_MAX_BLOCK)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: decoding needs %llu bytes of scratch, more than the reader's limit",
+		                 x->label, (unsigned long long)total);
+	x->temp = calloc(1, (size_t)total);
+	if (!x->temp)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for %llu bytes of scratch", x->label,
+		                 (unsigned long long)total);
+	return MLOD_OK;
+}
+
+static void cx_done(cx *x)
+{
+	free(x->temp);
+	x->temp = NULL;
+}
+
+/* The stream's decoded bytes: in place for raw streams, else decoded into
+ * the temporary buffer (valid until the next load). */
+static mlod_result cx_load(cx *x, const stream *s, const uint8_t **out, mlod_error *err)
+{
+	if (s->codec == MLOD_SCODEC_RAW) {
+		*out = s->src;
+		return MLOD_OK;
+	}
+	static unsigned char dummy[256];
+	unsigned char *dst = x->temp && x->max_decoded ? x->temp + x->aux : dummy;
+	int rc;
+	if (s->codec == MLOD_SCODEC_MESHOPT_VERTEX)
+		rc = meshopt_decodeVertexBuffer(dst, s->count, s->elsize, s->src, s->stored);
+	else
+		rc = meshopt_decodeIndexBuffer(dst, s->count, s->elsize, s->src, s->stored);
+	if (rc != 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': the meshopt %s codec failed (%d)", x->label,
+		                 s->index, tagn(s->tag).s,
+		                 s->codec == MLOD_SCODEC_MESHOPT_VERTEX ? "vertex" : "index", rc);
+	*out = dst;
+	return MLOD_OK;
+}
+
+/* The block: one allocation carved into 8-aligned arrays. */
+typedef struct bump {
+	uint8_t *base;
+	uint64_t used, cap;
+} bump;
+
+static mlod_result bump_alloc(bump *b, cx *x, uint64_t total, mlod_error *err)
+{
+	memset(b, 0, sizeof *b);
+	if (total > PACK_MAX_BLOCK)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: decoded, it needs %llu bytes, more than the reader's limit",
+		                 x->label, (unsigned long long)total);
+	b->base = calloc(1, (size_t)(total ? total : 8));
+	if (!b->base)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for %llu bytes", x->label,
+		                 (unsigned long long)total);
+	b->cap = total;
+	return MLOD_OK;
+}
+
+static void *bump_take(bump *b, uint64_t bytes)
+{
+	if (round8(bytes) > b->cap - b->used)
+		return NULL;
+	void *p = b->base + b->used;
+	b->used += round8(bytes);
+	return p;
+}
+
+/* A string table: the stream's bytes with a NUL after them; every string
+ * offset must be inside and the table must end with a NUL. */
+static mlod_result load_names(cx *x, bump *b, const stream *s, char **out, mlod_error *err)
+{
+	const uint8_t *src;
+	mlod_result r = cx_load(x, s, &src, err);
+	if (r != MLOD_OK)
+		return r;
+	char *t = bump_take(b, (uint64_t)s->count + 1);
+	if (!t)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: internal block size mismatch", x->label);
+	if (s->count)
+		memcpy(t, src, s->count);
+	t[s->count] = 0;
+	if (s->count && t[s->count - 1] != 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the string table 'NAME' does not end with a NUL", x->label);
+	*out = t;
+	return MLOD_OK;
+}
+
+static mlod_result name_at(cx *x, const char *table, uint32_t table_size, uint32_t off, const char **out,
+                           const char *what, mlod_error *err)
+{
+	if (off >= table_size)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %s: name offset %u is outside the string table (%u bytes)", x->label,
+		                 what, off, table_size);
+	*out = table + off;
+	return MLOD_OK;
+}
+
+#define TAKE(ptr, bytes)                                                                                        \
+	do {                                                                                                    \
+		(ptr) = bump_take(&b, (bytes));                                                                  \
+		if (!(ptr)) {                                                                                   \
+			r = mlod_fail(err, MLOD_ERR_PARSE, "%s: internal block size mismatch", x.label);          \
+			goto fail;                                                                              \
+		}                                                                                               \
+	} while (0)
+
+#define TRY(call)                                                                                               \
+	do {                                                                                                    \
+		r = (call);                                                                                     \
+		if (r != MLOD_OK)                                                                               \
+			goto fail;                                                                              \
+	} while (0)
+
+#define FAIL(...)                                                                                               \
+	do {                                                                                                    \
+		r = mlod_fail(err, MLOD_ERR_PARSE, __VA_ARGS__);                                                 \
+		goto fail;                                                                                      \
+	} while (0)
+
+/* ------------------------------------------------------------------ */
+/* INFO                                                                */
+/* ------------------------------------------------------------------ */
+
+mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t size, mlod_pack_info *out,
+                                  mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_info: out is NULL");
+	memset(out, 0, sizeof *out);
+	int ci = mlod_pack_find(p, MLOD_CHUNK_INFO, 0, 0);
+	if (ci < 0)
+		return mlod_fail(err, p ? MLOD_ERR_PARSE : MLOD_ERR_INVALID_ARG, "the pack has no INFO chunk");
+	cx x;
+	bump b = {0};
+	stream s_info, s_name;
+	const uint8_t *src;
+	mlod_result r = cx_begin(p, (uint32_t)ci, MLOD_CHUNK_INFO, data, size, &x, err);
+	if (r != MLOD_OK)
+		return r;
+	TRY(cx_expect(&x, &s_info, MLOD_STREAM_INFO, sizeof(mlod_pack_info_rec), 1, "", "one record", err));
+	TRY(cx_expect(&x, &s_name, MLOD_STREAM_NAME, 1, UINT64_MAX, "", "", err));
+	TRY(cx_end(&x, err));
+	TRY(cx_temp(&x, 0, err));
+	TRY(cx_load(&x, &s_info, &src, err));
+	mlod_pack_info_rec rec;
+	memcpy(&rec, src, sizeof rec);
+	if (!all_finite(rec.bounds_min, 3) || !all_finite(rec.bounds_max, 3) || !isfinite(rec.height) ||
+	    !isfinite(rec.diagonal))
+		FAIL("%s: the bounds, height and diagonal must be finite", x.label);
+	if ((rec.mesh_levels == 0) != (rec.instance_count == 0))
+		FAIL("%s: %u mesh levels with %u instances (0 mesh levels means no instances)", x.label, rec.mesh_levels,
+		     rec.instance_count);
+	if ((rec.motion_levels == 0) != (rec.clip_count == 0))
+		FAIL("%s: %u motion levels with %u clips (0 motion levels means no clips)", x.label, rec.motion_levels,
+		     rec.clip_count);
+	if (rec.first_drawable > p->file_size)
+		FAIL("%s: first_drawable %u is past the file's end (%llu)", x.label, rec.first_drawable,
+		     (unsigned long long)p->file_size);
+	/* The TOC holds exactly the levels INFO counts (open made them unique). */
+	uint64_t nskel = 0, nmesh = 0, nmotion = 0;
+	for (uint32_t i = 0; i < p->chunk_count; i++) {
+		const mlod_pack_chunk *c = &p->chunks[i];
+		char label[64];
+		chunk_label(c->type, c->level, c->item, label, sizeof label);
+		if (c->type == MLOD_CHUNK_SKELETON) {
+			if (c->level >= rec.skeleton_levels)
+				FAIL("%s: the TOC has %s, but INFO counts %u skeleton levels", x.label, label, rec.skeleton_levels);
+			nskel++;
+		} else if (c->type == MLOD_CHUNK_MESH) {
+			if (c->level >= rec.mesh_levels)
+				FAIL("%s: the TOC has %s, but INFO counts %u mesh levels", x.label, label, rec.mesh_levels);
+			nmesh++;
+		} else if (c->type == MLOD_CHUNK_MOTION) {
+			if (c->level >= rec.motion_levels || c->item >= rec.clip_count)
+				FAIL("%s: the TOC has %s, but INFO counts %u motion levels of %u clips", x.label, label,
+				     rec.motion_levels, rec.clip_count);
+			nmotion++;
+		}
+	}
+	if (nskel != rec.skeleton_levels || nmesh != rec.mesh_levels ||
+	    nmotion != (uint64_t)rec.motion_levels * rec.clip_count)
+		FAIL("%s: it counts %u skeleton, %u mesh and %u motion levels of %u clips, but the TOC has %llu SKELETON, "
+		     "%llu MESH and %llu MOTION chunks",
+		     x.label, rec.skeleton_levels, rec.mesh_levels, rec.motion_levels, rec.clip_count,
+		     (unsigned long long)nskel, (unsigned long long)nmesh, (unsigned long long)nmotion);
+	/* Every clip name takes at least its NUL. */
+	if (rec.clip_count > s_name.count)
+		FAIL("%s: %u clips, but the string table 'NAME' has only %u bytes", x.label, rec.clip_count, s_name.count);
+	TRY(bump_alloc(&b, &x, round8((uint64_t)rec.clip_count * sizeof(char *)) + round8((uint64_t)s_name.count + 1),
+	               err));
+	const char **clip_names;
+	char *names;
+	TAKE(clip_names, (uint64_t)rec.clip_count * sizeof(char *));
+	TRY(load_names(&x, &b, &s_name, &names, err));
+	const char *name = NULL;
+	TRY(name_at(&x, names, s_name.count, rec.name, &name, "the character", err));
+	/* The clips' names follow the character's, one after the other. */
+	size_t pos = (size_t)rec.name + strlen(name) + 1;
+	for (uint32_t c = 0; c < rec.clip_count; c++) {
+		if (pos >= s_name.count)
+			FAIL("%s: the string table 'NAME' ends before clip %u's name", x.label, c);
+		clip_names[c] = names + pos;
+		pos += strlen(names + pos) + 1;
+	}
+	cx_done(&x);
+	out->rec = rec;
+	out->name = name;
+	out->clip_names = clip_names;
+	out->block = b.base;
+	return MLOD_OK;
+fail:
+	cx_done(&x);
+	free(b.base);
+	return r;
+}
+
+void mlod_pack_info_free(mlod_pack_info *x)
+{
+	if (!x)
+		return;
+	free(x->block);
+	memset(x, 0, sizeof *x);
+}
+
+/* ------------------------------------------------------------------ */
+/* SKELETON                                                            */
+/* ------------------------------------------------------------------ */
+
+mlod_result mlod_pack_decode_skeleton(const mlod_pack *p, const void *data, size_t size, mlod_pack_skeleton *out,
+                                      mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_skeleton: out is NULL");
+	memset(out, 0, sizeof *out);
+	int ci = mlod_pack_find(p, MLOD_CHUNK_SKELETON, 0, 0);
+	if (ci < 0)
+		return mlod_fail(err, p ? MLOD_ERR_PARSE : MLOD_ERR_INVALID_ARG, "the pack has no SKELETON chunk");
+	cx x;
+	bump b = {0};
+	stream sj, sn, ss, sk, si;
+	const uint8_t *src;
+	mlod_result r = cx_begin(p, (uint32_t)ci, MLOD_CHUNK_SKELETON, data, size, &x, err);
+	if (r != MLOD_OK)
+		return r;
+	TRY(cx_expect(&x, &sj, MLOD_STREAM_JNTS, sizeof(mlod_pack_joint_rec), UINT64_MAX, "", "", err));
+	TRY(cx_expect(&x, &sn, MLOD_STREAM_NAME, 1, UINT64_MAX, "", "", err));
+	TRY(cx_expect(&x, &ss, MLOD_STREAM_SKIN, sizeof(mlod_pack_skin_rec), UINT64_MAX, "", "", err));
+	TRY(cx_expect(&x, &sk, MLOD_STREAM_SKJT, 4, UINT64_MAX, "", "", err));
+	TRY(cx_expect(&x, &si, MLOD_STREAM_IBMS, 64, sk.count, "", "one per skin joint in 'SKJT'", err));
+	TRY(cx_end(&x, err));
+	uint64_t J = sj.count, N = sn.count, S = ss.count, K = sk.count;
+	TRY(cx_temp(&x, 0, err));
+	TRY(bump_alloc(&b, &x,
+	               round8(J * sizeof(mlod_pack_joint_rec)) + round8(J * sizeof(char *)) + round8(N + 1) +
+	                       round8(S * sizeof(mlod_pack_skin_rec)) + 3 * round8(S * sizeof(void *)) + round8(K * 4) +
+	                       round8(K * 64),
+	               err));
+	mlod_pack_joint_rec *joints;
+	const char **joint_names, **skin_names;
+	mlod_pack_skin_rec *skins;
+	const uint32_t **skin_joints;
+	const float **inverse_bind;
+	uint32_t *skjt;
+	float *ibms;
+	char *names;
+	TAKE(joints, J * sizeof *joints);
+	TAKE(joint_names, J * sizeof *joint_names);
+	TAKE(skins, S * sizeof *skins);
+	TAKE(skin_names, S * sizeof *skin_names);
+	TAKE(skin_joints, S * sizeof *skin_joints);
+	TAKE(inverse_bind, S * sizeof *inverse_bind);
+	TAKE(skjt, K * 4);
+	TAKE(ibms, K * 64);
+	TRY(cx_load(&x, &sj, &src, err));
+	if (J)
+		memcpy(joints, src, J * sizeof *joints);
+	TRY(load_names(&x, &b, &sn, &names, err));
+	for (uint32_t j = 0; j < J; j++) {
+		const mlod_pack_joint_rec *jt = &joints[j];
+		char what[48];
+		snprintf(what, sizeof what, "joint %u", j);
+		if (jt->parent < -1 || jt->parent >= (int32_t)j)
+			FAIL("%s: joint %u: parent %d is not -1 or an earlier joint", x.label, j, jt->parent);
+		if (!all_finite(jt->t, 3) || !all_finite(jt->r, 4) || !all_finite(jt->s, 3) || !all_finite(jt->base, 16))
+			FAIL("%s: joint %u: a rest transform or base value is not finite", x.label, j);
+		if (jt->node < -1)
+			FAIL("%s: joint %u: node %d is not -1 or a node", x.label, j, jt->node);
+		TRY(name_at(&x, names, sn.count, jt->name, &joint_names[j], what, err));
+	}
+	TRY(cx_load(&x, &ss, &src, err));
+	if (S)
+		memcpy(skins, src, S * sizeof *skins);
+	uint64_t sum = 0;
+	for (uint32_t k = 0; k < S; k++) {
+		char what[48];
+		snprintf(what, sizeof what, "skin %u", k);
+		if (skins[k].gltf_index < -1)
+			FAIL("%s: skin %u: glTF skin %d is not -1 or a skin", x.label, k, skins[k].gltf_index);
+		TRY(name_at(&x, names, sn.count, skins[k].name, &skin_names[k], what, err));
+		skin_joints[k] = skjt + sum;
+		inverse_bind[k] = ibms + 16 * sum;
+		sum += skins[k].joint_count;
+		if (sum > K)
+			FAIL("%s: skin %u: its joints run past the %llu in 'SKJT'", x.label, k, (unsigned long long)K);
+	}
+	if (sum != K)
+		FAIL("%s: the skins have %llu joints, but 'SKJT' has %llu", x.label, (unsigned long long)sum,
+		     (unsigned long long)K);
+	TRY(cx_load(&x, &sk, &src, err));
+	if (K)
+		memcpy(skjt, src, K * 4);
+	for (uint32_t k = 0, i = 0; k < S; k++)
+		for (uint32_t m = 0; m < skins[k].joint_count; m++, i++)
+			if (skjt[i] >= J)
+				FAIL("%s: skin %u: joint %u is %u, not below the joint count %llu", x.label, k, m, skjt[i],
+				     (unsigned long long)J);
+	TRY(cx_load(&x, &si, &src, err));
+	if (K)
+		memcpy(ibms, src, K * 64);
+	if (!all_finite(ibms, (size_t)K * 16))
+		FAIL("%s: an inverse bind matrix is not finite", x.label);
+	cx_done(&x);
+	out->joint_count = (uint32_t)J;
+	out->joints = joints;
+	out->joint_names = joint_names;
+	out->skin_count = (uint32_t)S;
+	out->skins = skins;
+	out->skin_names = skin_names;
+	out->skin_joints = skin_joints;
+	out->inverse_bind = inverse_bind;
+	out->block = b.base;
+	return MLOD_OK;
+fail:
+	cx_done(&x);
+	free(b.base);
+	return r;
+}
+
+void mlod_pack_skeleton_free(mlod_pack_skeleton *x)
+{
+	if (!x)
+		return;
+	free(x->block);
+	memset(x, 0, sizeof *x);
+}
+
+/* ------------------------------------------------------------------ */
+/* SKELETON level k                                                    */
+/* ------------------------------------------------------------------ */
+
+mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                        const mlod_pack_skeleton *skel, mlod_pack_skel_level *out, mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_skel_level: out is NULL");
+	memset(out, 0, sizeof *out);
+	if (!skel)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_skel_level: the full skeleton is NULL");
+	cx x;
+	bump b = {0};
+	stream sk, sj, sb;
+	const uint8_t *src;
+	mlod_result r = cx_begin(p, chunk, MLOD_CHUNK_SKELETON, data, size, &x, err);
+	if (r != MLOD_OK)
+		return r;
+	if (x.c->level == 0)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG,
+		                 "pack decode: chunk %u is the full SKELETON: use mlod_pack_decode_skeleton", chunk);
+	uint64_t J = skel->joint_count, P = 0;
+	for (uint32_t k = 0; k < skel->skin_count; k++)
+		P += skel->skins[k].joint_count;
+	TRY(cx_expect(&x, &sk, MLOD_STREAM_KEPT, 4, UINT64_MAX, "", "", err));
+	TRY(cx_expect(&x, &sj, MLOD_STREAM_PALJ, 4, P, "", "the skins' joints", err));
+	TRY(cx_expect(&x, &sb, MLOD_STREAM_PALB, 64, P, "", "the skins' joints", err));
+	TRY(cx_end(&x, err));
+	uint64_t Kc = sk.count;
+	if (Kc > J)
+		FAIL("%s: %llu kept joints of a skeleton of %llu", x.label, (unsigned long long)Kc, (unsigned long long)J);
+	/* aux: each joint's nearest kept ancestor (or itself). */
+	TRY(cx_temp(&x, J * 4, err));
+	TRY(bump_alloc(&b, &x, round8(Kc * 4) + round8(P * 4) + round8(P * 64), err));
+	uint32_t *kept, *palj, *nearest = (uint32_t *)x.temp;
+	float *palb;
+	TAKE(kept, Kc * 4);
+	TAKE(palj, P * 4);
+	TAKE(palb, P * 64);
+	TRY(cx_load(&x, &sk, &src, err));
+	if (Kc)
+		memcpy(kept, src, Kc * 4);
+	for (uint64_t i = 0; i < Kc; i++) {
+		if (kept[i] >= J)
+			FAIL("%s: kept joint %llu is %u, not below the joint count %llu", x.label, (unsigned long long)i, kept[i],
+			     (unsigned long long)J);
+		if (i > 0 && kept[i] <= kept[i - 1])
+			FAIL("%s: kept joints are not increasing (%u after %u)", x.label, kept[i], kept[i - 1]);
+	}
+	for (uint32_t j = 0, ki = 0; j < J; j++) {
+		int is_kept = ki < Kc && kept[ki] == j;
+		if (is_kept)
+			ki++;
+		int32_t parent = skel->joints[j].parent;
+		if (parent < 0 && !is_kept)
+			FAIL("%s: root joint %u is not kept (every root is)", x.label, j);
+		nearest[j] = is_kept ? j : nearest[parent];
+	}
+	TRY(cx_load(&x, &sj, &src, err));
+	if (P)
+		memcpy(palj, src, P * 4);
+	for (uint32_t k = 0, i = 0; k < skel->skin_count; k++)
+		for (uint32_t m = 0; m < skel->skins[k].joint_count; m++, i++) {
+			uint32_t joint = skel->skin_joints[k][m], v = palj[i];
+			if (joint >= J)
+				FAIL("%s: the given skeleton's skin %u joint %u is %u, not below its joint count", x.label, k, m,
+				     joint);
+			if (v >= J || nearest[v] != v)
+				FAIL("%s: palette entry %u (skin %u joint %u): joint %u is not a kept joint", x.label, i, k, m, v);
+			if (v != nearest[joint])
+				FAIL("%s: palette entry %u (skin %u joint %u): joint %u, but the nearest kept ancestor of joint %u "
+				     "is %u",
+				     x.label, i, k, m, v, joint, nearest[joint]);
+		}
+	TRY(cx_load(&x, &sb, &src, err));
+	if (P)
+		memcpy(palb, src, P * 64);
+	if (!all_finite(palb, (size_t)P * 16))
+		FAIL("%s: a palette bind matrix is not finite", x.label);
+	cx_done(&x);
+	out->kept_count = (uint32_t)Kc;
+	out->kept = kept;
+	out->palette_size = (uint32_t)P;
+	out->palette_joint = palj;
+	out->palette_bind = palb;
+	out->block = b.base;
+	return MLOD_OK;
+fail:
+	cx_done(&x);
+	free(b.base);
+	return r;
+}
+
+void mlod_pack_skel_level_free(mlod_pack_skel_level *x)
+{
+	if (!x)
+		return;
+	free(x->block);
+	memset(x, 0, sizeof *x);
+}
+
+/* ------------------------------------------------------------------ */
+/* MESH level k                                                        */
+/* ------------------------------------------------------------------ */
+
+/* Octahedral unit vector from two snorm16 values, normalised. */
+static void oct_decode(int16_t qx, int16_t qy, float *out)
+{
+	float x = qx / 32767.0f, y = qy / 32767.0f;
+	x = x < -1.0f ? -1.0f : x;
+	y = y < -1.0f ? -1.0f : y;
+	float z = 1.0f - fabsf(x) - fabsf(y);
+	if (z < 0) {
+		float ox = x;
+		x = (1.0f - fabsf(y)) * (ox >= 0 ? 1.0f : -1.0f);
+		y = (1.0f - fabsf(ox)) * (y >= 0 ? 1.0f : -1.0f);
+	}
+	float len = sqrtf(x * x + y * y + z * z); /* >= 1/sqrt(3): |x|+|y|+|z| = 1 */
+	out[0] = x / len;
+	out[1] = y / len;
+	out[2] = z / len;
+}
+
+/* The decoded bytes per element of a mesh stream (0: not a mesh stream). */
+static uint64_t mesh_out_size(uint32_t tag)
+{
+	switch (tag) {
+	case MLOD_STREAM_POSQ: return 12;
+	case MLOD_STREAM_NRMQ: return 12;
+	case MLOD_STREAM_TANQ: return 16;
+	case MLOD_STREAM_COLQ: return 16;
+	case MLOD_STREAM_JNT8: return 8;
+	case MLOD_STREAM_JN16: return 8;
+	case MLOD_STREAM_WGT8: return 16;
+	case MLOD_STREAM_IDX: return 4;
+	case MLOD_STREAM_MTSC: return 0; /* sized apart */
+	case MLOD_STREAM_MTPQ: return 12;
+	}
+	for (uint32_t s = 0; s < MLOD_PACK_MAX_UV; s++)
+		if (tag == MLOD_STREAM_UVQ0 + (s << 24))
+			return 8;
+	return 0;
+}
+
+#define PART_KNOWN_FLAGS                                                                                        \
+	(MLOD_PART_NORMALS | MLOD_PART_TANGENTS | MLOD_PART_COLORS | MLOD_PART_SKINNED | MLOD_PART_JOINTS16 |    \
+	 MLOD_PART_INDEX16)
+
+mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                  const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_mesh: out is NULL");
+	memset(out, 0, sizeof *out);
+	cx x;
+	bump b = {0};
+	stream s;
+	const uint8_t *src;
+	mlod_result r = cx_begin(p, chunk, MLOD_CHUNK_MESH, data, size, &x, err);
+	if (r != MLOD_OK)
+		return r;
+	uint32_t J = skel ? skel->joint_count : 0, S = skel ? skel->skin_count : 0;
+	/* Size the block from the stream headers. */
+	stream sp;
+	TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), UINT64_MAX, "", "", err));
+	uint64_t P = sp.count, total = round8(P * sizeof(mlod_pack_part));
+	while (cx_next(&x, &s)) {
+		uint64_t per = mesh_out_size(s.tag);
+		if (s.tag == MLOD_STREAM_MTSC)
+			total += round8((uint64_t)s.count * sizeof(float *)) + round8((uint64_t)s.count * 4);
+		else if (per)
+			total += round8(per * s.count);
+		else
+			FAIL("%s: stream %u is '%s', not a mesh stream", x.label, s.index, tagn(s.tag).s);
+	}
+	cx_rewind(&x);
+	TRY(cx_temp(&x, 0, err));
+	TRY(bump_alloc(&b, &x, total, err));
+	mlod_pack_part *parts;
+	TAKE(parts, P * sizeof *parts);
+	TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), UINT64_MAX, "", "", err));
+	TRY(cx_load(&x, &sp, &src, err));
+	for (uint64_t i = 0; i < P; i++)
+		memcpy(&parts[i].rec, src + i * sizeof(mlod_pack_part_rec), sizeof(mlod_pack_part_rec));
+	for (uint32_t i = 0; i < P; i++) {
+		mlod_pack_part *pt = &parts[i];
+		const mlod_pack_part_rec *rc = &pt->rec;
+		char what[32];
+		snprintf(what, sizeof what, "part %u", i);
+		uint32_t V = rc->vertex_count, f = rc->flags;
+		if (f & ~PART_KNOWN_FLAGS)
+			FAIL("%s: part %u: unknown flags 0x%x", x.label, i, f & ~PART_KNOWN_FLAGS);
+		if ((f & MLOD_PART_JOINTS16) && !(f & MLOD_PART_SKINNED))
+			FAIL("%s: part %u: JOINTS16 without SKINNED", x.label, i);
+		if (rc->index_count % 3 != 0)
+			FAIL("%s: part %u: index count %u is not a multiple of 3", x.label, i, rc->index_count);
+		if (rc->uv_sets > MLOD_PACK_MAX_UV)
+			FAIL("%s: part %u: %u UV sets, more than %d", x.label, i, rc->uv_sets, MLOD_PACK_MAX_UV);
+		if (rc->skin < -1 || rc->skin >= (int64_t)S)
+			FAIL("%s: part %u: skin %d is not -1 or below the skeleton's %u skins", x.label, i, rc->skin, S);
+		if ((f & MLOD_PART_SKINNED) && rc->skin < 0)
+			FAIL("%s: part %u: skinned, but without a skin", x.label, i);
+		if (rc->joint < -1 || rc->joint >= (int64_t)J)
+			FAIL("%s: part %u: joint %d is not -1 or below the skeleton's %u joints", x.label, i, rc->joint, J);
+		if (rc->node < -1 || rc->mesh < -1 || rc->material < -1)
+			FAIL("%s: part %u: node %d, mesh %d, material %d: each must be -1 or an index", x.label, i, rc->node,
+			     rc->mesh, rc->material);
+		if (!all_finite(rc->offset, 16))
+			FAIL("%s: part %u: its offset matrix is not finite", x.label, i);
+		for (int a = 0; a < 3; a++)
+			if (!isfinite(rc->pos_min[a]) || !(rc->pos_scale[a] >= 0) ||
+			    !isfinite(rc->pos_min[a] + 65535.0f * rc->pos_scale[a]))
+				FAIL("%s: part %u: position range %g + q * %g is not finite and increasing", x.label, i,
+				     (double)rc->pos_min[a], (double)rc->pos_scale[a]);
+		for (uint32_t t = 0; t < rc->uv_sets; t++)
+			for (int a = 0; a < 2; a++)
+				if (!isfinite(rc->uv_min[t][a]) || !isfinite(rc->uv_scale[t][a]) ||
+				    !isfinite(rc->uv_min[t][a] + 65535.0f * rc->uv_scale[t][a]))
+					FAIL("%s: part %u: UV set %u range %g + q * %g is not finite", x.label, i, t,
+					     (double)rc->uv_min[t][a], (double)rc->uv_scale[t][a]);
+
+		/* Positions. */
+		TRY(cx_expect(&x, &s, MLOD_STREAM_POSQ, 8, V, what, "vertex count", err));
+		TRY(cx_load(&x, &s, &src, err));
+		TAKE(pt->positions, (uint64_t)V * 12);
+		for (uint32_t v = 0; v < V; v++)
+			for (int a = 0; a < 3; a++)
+				pt->positions[3 * v + a] = rc->pos_min[a] + rd16(src + 8 * (size_t)v + 2 * a) * rc->pos_scale[a];
+		if (f & MLOD_PART_NORMALS) {
+			TRY(cx_expect(&x, &s, MLOD_STREAM_NRMQ, 4, V, what, "vertex count", err));
+			TRY(cx_load(&x, &s, &src, err));
+			TAKE(pt->normals, (uint64_t)V * 12);
+			for (uint32_t v = 0; v < V; v++)
+				oct_decode(rdi16(src + 4 * (size_t)v), rdi16(src + 4 * (size_t)v + 2), pt->normals + 3 * (size_t)v);
+		}
+		if (f & MLOD_PART_TANGENTS) {
+			TRY(cx_expect(&x, &s, MLOD_STREAM_TANQ, 8, V, what, "vertex count", err));
+			TRY(cx_load(&x, &s, &src, err));
+			TAKE(pt->tangents, (uint64_t)V * 16);
+			for (uint32_t v = 0; v < V; v++) {
+				const uint8_t *e = src + 8 * (size_t)v;
+				int16_t w = rdi16(e + 4);
+				if (w != 32767 && w != -32767)
+					FAIL("%s: part %u: vertex %u: tangent handedness %d is not -32767 or 32767", x.label, i, v, w);
+				oct_decode(rdi16(e), rdi16(e + 2), pt->tangents + 4 * (size_t)v);
+				pt->tangents[4 * (size_t)v + 3] = w > 0 ? 1.0f : -1.0f;
+			}
+		}
+		for (uint32_t t = 0; t < rc->uv_sets; t++) {
+			TRY(cx_expect(&x, &s, MLOD_STREAM_UVQ0 + (t << 24), 4, V, what, "vertex count", err));
+			TRY(cx_load(&x, &s, &src, err));
+			TAKE(pt->uvs[t], (uint64_t)V * 8);
+			for (uint32_t v = 0; v < V; v++)
+				for (int a = 0; a < 2; a++)
+					pt->uvs[t][2 * (size_t)v + a] =
+					        rc->uv_min[t][a] + rd16(src + 4 * (size_t)v + 2 * a) * rc->uv_scale[t][a];
+		}
+		if (f & MLOD_PART_COLORS) {
+			TRY(cx_expect(&x, &s, MLOD_STREAM_COLQ, 4, V, what, "vertex count", err));
+			TRY(cx_load(&x, &s, &src, err));
+			TAKE(pt->colors, (uint64_t)V * 16);
+			for (size_t k = 0; k < (size_t)V * 4; k++)
+				pt->colors[k] = src[k] / 255.0f;
+		}
+		if (f & MLOD_PART_SKINNED) {
+			int j16 = (f & MLOD_PART_JOINTS16) != 0;
+			uint32_t skin_joints = skel->skins[rc->skin].joint_count;
+			TRY(cx_expect(&x, &s, j16 ? MLOD_STREAM_JN16 : MLOD_STREAM_JNT8, j16 ? 8 : 4, V, what, "vertex count",
+			              err));
+			TRY(cx_load(&x, &s, &src, err));
+			TAKE(pt->joints, (uint64_t)V * 8);
+			for (size_t k = 0; k < (size_t)V * 4; k++) {
+				uint16_t jv = j16 ? rd16(src + 2 * k) : src[k];
+				if (jv >= skin_joints)
+					FAIL("%s: part %u: vertex %zu: joint %u is not below skin %d's %u joints", x.label, i, k / 4,
+					     jv, rc->skin, skin_joints);
+				pt->joints[k] = jv;
+			}
+			TRY(cx_expect(&x, &s, MLOD_STREAM_WGT8, 4, V, what, "vertex count", err));
+			TRY(cx_load(&x, &s, &src, err));
+			TAKE(pt->weights, (uint64_t)V * 16);
+			for (uint32_t v = 0; v < V; v++) {
+				const uint8_t *e = src + 4 * (size_t)v;
+				unsigned sum = (unsigned)e[0] + e[1] + e[2] + e[3];
+				if (sum != 255)
+					FAIL("%s: part %u: vertex %u: weights sum to %u, not 255", x.label, i, v, sum);
+				for (int a = 0; a < 4; a++)
+					pt->weights[4 * (size_t)v + a] = e[a] / 255.0f;
+			}
+		}
+		int i16 = (f & MLOD_PART_INDEX16) != 0;
+		TRY(cx_expect(&x, &s, MLOD_STREAM_IDX, i16 ? 2 : 4, rc->index_count, what, "index count", err));
+		TRY(cx_load(&x, &s, &src, err));
+		TAKE(pt->indices, (uint64_t)rc->index_count * 4);
+		for (uint32_t k = 0; k < rc->index_count; k++) {
+			uint32_t iv;
+			if (i16) {
+				uint16_t v16;
+				memcpy(&v16, src + 2 * (size_t)k, 2);
+				iv = v16;
+			} else {
+				memcpy(&iv, src + 4 * (size_t)k, 4);
+			}
+			if (iv >= V)
+				FAIL("%s: part %u: index %u >= vertex count %u (at position %u)", x.label, i, iv, V, k);
+			pt->indices[k] = iv;
+		}
+		if (rc->target_count > 0) {
+			uint32_t T = rc->target_count;
+			float *scales;
+			TRY(cx_expect(&x, &s, MLOD_STREAM_MTSC, 4, T, what, "target count", err));
+			TRY(cx_load(&x, &s, &src, err));
+			TAKE(pt->targets, (uint64_t)T * sizeof(float *));
+			TAKE(scales, (uint64_t)T * 4);
+			memcpy(scales, src, (size_t)T * 4);
+			for (uint32_t t = 0; t < T; t++)
+				if (!(scales[t] >= 0) || !isfinite(scales[t] * 32768.0f))
+					FAIL("%s: part %u: morph target %u: scale %g is not finite and >= 0", x.label, i, t,
+					     (double)scales[t]);
+			for (uint32_t t = 0; t < T; t++) {
+				char twhat[64];
+				snprintf(twhat, sizeof twhat, "part %u target %u", i, t);
+				TRY(cx_expect(&x, &s, MLOD_STREAM_MTPQ, 8, V, twhat, "vertex count", err));
+				TRY(cx_load(&x, &s, &src, err));
+				TAKE(pt->targets[t], (uint64_t)V * 12);
+				for (uint32_t v = 0; v < V; v++)
+					for (int a = 0; a < 3; a++)
+						pt->targets[t][3 * (size_t)v + a] = rdi16(src + 8 * (size_t)v + 2 * a) * scales[t];
+			}
+		}
+	}
+	TRY(cx_end(&x, err));
+	cx_done(&x);
+	out->part_count = (uint32_t)P;
+	out->parts = parts;
+	out->block = b.base;
+	return MLOD_OK;
+fail:
+	cx_done(&x);
+	free(b.base);
+	return r;
+}
+
+void mlod_pack_mesh_free(mlod_pack_mesh *x)
+{
+	if (!x)
+		return;
+	free(x->block);
+	memset(x, 0, sizeof *x);
+}
+
+/* ------------------------------------------------------------------ */
+/* MOTION level k of clip c                                            */
+/* ------------------------------------------------------------------ */
+
+mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                    const mlod_pack_skeleton *skel, mlod_pack_motion *out, mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_motion: out is NULL");
+	memset(out, 0, sizeof *out);
+	cx x;
+	bump b = {0};
+	stream s;
+	const uint8_t *src;
+	mlod_result r = cx_begin(p, chunk, MLOD_CHUNK_MOTION, data, size, &x, err);
+	if (r != MLOD_OK)
+		return r;
+	uint32_t J = skel ? skel->joint_count : 0;
+	stream sc;
+	TRY(cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
+	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel));
+	while (cx_next(&x, &s)) {
+		uint64_t per = s.tag == MLOD_STREAM_TIME ? 4
+		               : s.tag == MLOD_STREAM_ROTQ || s.tag == MLOD_STREAM_ROTF ? 16
+		               : s.tag == MLOD_STREAM_VEC3                                ? 12
+		                                                                          : 0;
+		if (!per)
+			FAIL("%s: stream %u is '%s', not a motion stream", x.label, s.index, tagn(s.tag).s);
+		total += round8(per * s.count);
+	}
+	cx_rewind(&x);
+	/* aux: one byte per joint and path, to find a second channel. */
+	TRY(cx_temp(&x, (uint64_t)J * 3, err));
+	TRY(bump_alloc(&b, &x, total, err));
+	uint8_t *seen = x.temp;
+	mlod_pack_channel *chans;
+	TAKE(chans, C * sizeof *chans);
+	TRY(cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
+	TRY(cx_load(&x, &sc, &src, err));
+	for (uint64_t i = 0; i < C; i++)
+		memcpy(&chans[i].rec, src + i * sizeof(mlod_pack_channel_rec), sizeof(mlod_pack_channel_rec));
+	float duration = 0;
+	static const char *const path_names[3] = {"translation", "rotation", "scale"};
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		const mlod_pack_channel_rec *rc = &ch->rec;
+		char what[32];
+		snprintf(what, sizeof what, "channel %u", i);
+		uint32_t K = rc->key_count;
+		if (rc->joint >= J)
+			FAIL("%s: channel %u: joint %u is not below the skeleton's %u joints", x.label, i, rc->joint, J);
+		if (rc->path > 2)
+			FAIL("%s: channel %u: path %u is not 0, 1 or 2", x.label, i, rc->path);
+		if (rc->interp > 2)
+			FAIL("%s: channel %u: interpolation %u is not 0, 1 or 2", x.label, i, rc->interp);
+		if (K == 0)
+			FAIL("%s: channel %u: no keys", x.label, i);
+		if (seen[3 * (size_t)rc->joint + rc->path])
+			FAIL("%s: channel %u: a second %s channel of joint %u", x.label, i, path_names[rc->path], rc->joint);
+		seen[3 * (size_t)rc->joint + rc->path] = 1;
+		float *times;
+		TRY(cx_expect(&x, &s, MLOD_STREAM_TIME, 4, K, what, "key count", err));
+		TRY(cx_load(&x, &s, &src, err));
+		TAKE(times, (uint64_t)K * 4);
+		memcpy(times, src, (size_t)K * 4);
+		for (uint32_t k = 0; k < K; k++) {
+			if (!isfinite(times[k]))
+				FAIL("%s: channel %u: key %u: time is not finite", x.label, i, k);
+			if (k > 0 && !(times[k] > times[k - 1]))
+				FAIL("%s: channel %u: key %u: time %g is not after %g", x.label, i, k, (double)times[k],
+				     (double)times[k - 1]);
+		}
+		if (times[K - 1] > duration)
+			duration = times[K - 1];
+		ch->times = times;
+		uint64_t m = rc->interp == 2 ? 3 : 1, values = m * K;
+		if (rc->path == 1) {
+			/* ROTQ, or ROTF (always for cubic splines). */
+			if (!cx_next(&x, &s))
+				FAIL("%s: channel %u: missing its rotation stream", x.label, i);
+			if (s.tag == MLOD_STREAM_ROTQ && m == 1) {
+				x.next--;
+				x.cursor -= pad4(s.stored);
+				TRY(cx_expect(&x, &s, MLOD_STREAM_ROTQ, 8, values, what, "key count", err));
+				TRY(cx_load(&x, &s, &src, err));
+				TAKE(ch->values, values * 16);
+				for (size_t k = 0; k < values * 4; k++)
+					ch->values[k] = rdi16(src + 2 * k) / 32767.0f;
+			} else {
+				x.next--;
+				x.cursor -= pad4(s.stored);
+				TRY(cx_expect(&x, &s, MLOD_STREAM_ROTF, 16, values, what,
+				              m == 3 ? "3 values per key" : "key count", err));
+				TRY(cx_load(&x, &s, &src, err));
+				TAKE(ch->values, values * 16);
+				memcpy(ch->values, src, values * 16);
+				if (!all_finite(ch->values, values * 4))
+					FAIL("%s: channel %u: a rotation value is not finite", x.label, i);
+			}
+		} else {
+			TRY(cx_expect(&x, &s, MLOD_STREAM_VEC3, 12, values, what, m == 3 ? "3 values per key" : "key count",
+			              err));
+			TRY(cx_load(&x, &s, &src, err));
+			TAKE(ch->values, values * 12);
+			memcpy(ch->values, src, values * 12);
+			if (!all_finite(ch->values, values * 3))
+				FAIL("%s: channel %u: a %s value is not finite", x.label, i, path_names[rc->path]);
+		}
+	}
+	TRY(cx_end(&x, err));
+	cx_done(&x);
+	out->channel_count = (uint32_t)C;
+	out->channels = chans;
+	out->duration = duration;
+	out->block = b.base;
+	return MLOD_OK;
+fail:
+	cx_done(&x);
+	free(b.base);
+	return r;
+}
+
+void mlod_pack_motion_free(mlod_pack_motion *x)
+{
+	if (!x)
+		return;
+	free(x->block);
+	memset(x, 0, sizeof *x);
+}
+
+/* ------------------------------------------------------------------ */
+/* DOC                                                                 */
+/* ------------------------------------------------------------------ */
+
+mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, const void **glb, size_t *glb_size,
+                          mlod_error *err)
+{
+	if (!glb || !glb_size)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_doc: glb or glb_size is NULL");
+	*glb = NULL;
+	*glb_size = 0;
+	int ci = mlod_pack_find(p, MLOD_CHUNK_DOC, 0, 0);
+	if (ci < 0)
+		return mlod_fail(err, p ? MLOD_ERR_PARSE : MLOD_ERR_INVALID_ARG, "the pack has no DOC chunk");
+	cx x;
+	stream s;
+	mlod_result r = cx_begin(p, (uint32_t)ci, MLOD_CHUNK_DOC, data, size, &x, err);
+	if (r != MLOD_OK)
+		return r;
+	r = cx_expect(&x, &s, MLOD_STREAM_GLB, 1, UINT64_MAX, "", "", err);
+	if (r == MLOD_OK)
+		r = cx_end(&x, err);
+	if (r != MLOD_OK)
+		return r;
+	if (s.codec != MLOD_SCODEC_RAW)
+		return mlod_fail(err, MLOD_ERR_PARSE, "DOC: the 'GLB ' stream must be stored raw");
+	*glb = s.src;
+	*glb_size = s.count;
+	return MLOD_OK;
+}
