@@ -496,7 +496,6 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 	ctx->free_head = 0;
 
 	/* The coarse levels, pinned. */
-	ctx->resident_bytes += ctx->skel_owned ? sizeof *s + (size_t)J * sizeof *s->joints : 0;
 	for (uint32_t i = 0; i < ctx->unit_count; i++) {
 		rt_unit *u = &ctx->units[i];
 		u->coarse = u->level + 1u == ctx->levels[u->layer];
