@@ -5,7 +5,7 @@
 #   tests/run.sh --build build/release [--sanitize-build build/sanitize] [--extended]
 #
 # Stages:
-#   unit       every build/<config>/tests/test_* program (one PASS/FAIL/SKIP
+#   unit       every build/<config>/tests/test_* and tests/rt/* program (one PASS/FAIL/SKIP
 #              line per test); every tests/unit/test_*.c must be built
 #   cli        tests/cli/NAME.sh, checked against NAME.exit and NAME.stderr
 #              or NAME.stderr.re (below)
@@ -113,9 +113,15 @@ run_unit() {
 		name=$(basename "$src" .c)
 		[ -x "$dir/tests/$name" ] || fail "$stage/$name" "$dir/tests/$name was not built"
 	done
-	for t in "$dir"/tests/test_*; do
-		[ -x "$t" ] || continue
-		name=$(basename "$t")
+	# The runtime's tests (tests/rt/*.c, linked with libmlodrt.a alone).
+	for src in tests/rt/*.c; do
+		[ -f "$src" ] || continue
+		name=rt/$(basename "$src" .c)
+		[ -x "$dir/tests/$name" ] || fail "$stage/$name" "$dir/tests/$name was not built"
+	done
+	for t in "$dir"/tests/test_* "$dir"/tests/rt/*; do
+		[ -f "$t" ] && [ -x "$t" ] || continue
+		case $t in */tests/rt/*) name=rt/$(basename "$t") ;; *) name=$(basename "$t") ;; esac
 		out=$("$t" 2>"$work/stderr"; echo "rc=$?")
 		rc=${out##*rc=}
 		echo "$out" | grep -E '^(PASS|FAIL|SKIP) ' > "$work/lines"

@@ -289,8 +289,9 @@ mlod_result mlod_rt_open_path(const char *path, const mlod_rt_config *config, ml
 		/* say which file */
 		if (err) {
 			char m[MLOD_ERROR_MESSAGE_SIZE];
-			snprintf(m, sizeof m, "%s: %s", path, err->message);
-			memcpy(err->message, m, sizeof m);
+			memcpy(m, err->message, sizeof m);
+			m[300] = '\0';
+			mlod_fail(err, r, "%.200s: %s", path, m);
 		}
 		return r;
 	}

@@ -117,25 +117,25 @@ static mlod_pack_motion fx_mo[2][3];
 static mlod_rt_view_level fx_vskel[3], fx_vmesh[3], fx_vmotion[6];
 static mlod_rt_views fx_views;
 
-static void fx_identity(float *m)
+static inline void fx_identity(float *m)
 {
 	memset(m, 0, 16 * sizeof *m);
 	m[0] = m[5] = m[10] = m[15] = 1;
 }
 
-static void fx_quat_z(float deg, float *q)
+static inline void fx_quat_z(float deg, float *q)
 {
 	double a = deg * 3.14159265358979323846 / 360.0;
 	q[0] = 0, q[1] = 0, q[2] = (float)sin(a), q[3] = (float)cos(a);
 }
 
-static void fx_quat_x(float deg, float *q)
+static inline void fx_quat_x(float deg, float *q)
 {
 	double a = deg * 3.14159265358979323846 / 360.0;
 	q[0] = (float)sin(a), q[1] = 0, q[2] = 0, q[3] = (float)cos(a);
 }
 
-static void fx_part(mlod_pack_part *p, float *pos, float *nrm, uint16_t *jnt, float *wgt, uint32_t n, int skin,
+static inline void fx_part(mlod_pack_part *p, float *pos, float *nrm, uint16_t *jnt, float *wgt, uint32_t n, int skin,
                     int joint, const float *offset)
 {
 	memset(p, 0, sizeof *p);
@@ -158,7 +158,7 @@ static void fx_part(mlod_pack_part *p, float *pos, float *nrm, uint16_t *jnt, fl
 	p->indices = fx_idx;
 }
 
-static void fx_channel(mlod_pack_channel *c, uint32_t joint, uint32_t path, uint32_t interp, uint32_t keys,
+static inline void fx_channel(mlod_pack_channel *c, uint32_t joint, uint32_t path, uint32_t interp, uint32_t keys,
                        const float *times, float *values)
 {
 	c->rec.joint = joint;
@@ -169,7 +169,7 @@ static void fx_channel(mlod_pack_channel *c, uint32_t joint, uint32_t path, uint
 	c->values = values;
 }
 
-static void fx_motion(mlod_pack_motion *m, mlod_pack_channel *c, uint32_t n, float duration)
+static inline void fx_motion(mlod_pack_motion *m, mlod_pack_channel *c, uint32_t n, float duration)
 {
 	m->channel_count = n;
 	m->channels = c;
@@ -178,7 +178,7 @@ static void fx_motion(mlod_pack_motion *m, mlod_pack_channel *c, uint32_t n, flo
 
 /* Builds everything; bytes != 0 gives each level a fixed byte cost:
  * skeleton 1000/500, mesh 4000/2000/1000, motion 3000/1500/700. */
-static void fx_build(int bytes)
+static inline void fx_build(int bytes)
 {
 	static const float base[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0.5f, 1 };
 	static const float off[FX_J][3] = { { 0, 0, 0 }, { 0, 1, 0 }, { 0, 1, 0 }, { 0, 1, 0 }, { 1, 0, 0 } };
@@ -272,7 +272,7 @@ static void fx_build(int bytes)
 }
 
 /* Loads every level (unlimited budget). */
-static int fx_load_all(mlod_rt_ctx *ctx)
+static inline int fx_load_all(mlod_rt_ctx *ctx)
 {
 	for (int layer = 0; layer < MLOD_RT_LAYERS; layer++)
 		for (uint32_t l = 0; l < mlod_rt_level_count(ctx, (mlod_rt_layer)layer); l++)
@@ -283,7 +283,7 @@ static int fx_load_all(mlod_rt_ctx *ctx)
 }
 
 /* 4x4 column-major helpers for expectations. */
-static void fx_mul(const float *a, const float *b, float *out)
+static inline void fx_mul(const float *a, const float *b, float *out)
 {
 	float r[16];
 	for (int c = 0; c < 4; c++)
@@ -296,7 +296,7 @@ static void fx_mul(const float *a, const float *b, float *out)
 	memcpy(out, r, sizeof r);
 }
 
-static double fx_maxdiff(const float *a, const float *b, int n)
+static inline double fx_maxdiff(const float *a, const float *b, int n)
 {
 	double d = 0;
 	for (int i = 0; i < n; i++)
