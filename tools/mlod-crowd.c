@@ -47,6 +47,7 @@ static const char usage_text[] =
 	"                        none)\n"
 	"      --near D, --far D the distance range in scene units (default 2, 200)\n"
 	"      --mode MODE       alpha (the paper's, default), pixels or toc\n"
+	"      --interval TS,TE  the alpha interval of every layer (default 0,1)\n"
 	"      --hysteresis H    relative hysteresis (default 0.1)\n"
 	"      --no-skin-bench   skip the kernel measurement\n"
 	"  -h, --help            show this help\n"
@@ -345,7 +346,7 @@ int main(int argc, char **argv)
 {
 	const char *counts = "1,10,50,250,1000,10000";
 	double seconds = 2, fps = 30, max_wall = 10, hyst = 0.1;
-	float near = 2, far = 200;
+	float near = 2, far = 200, ts = 0, te = 1;
 	size_t budget = 0;
 	int bench = 1;
 	mlod_rt_select_mode mode = MLOD_RT_SELECT_ALPHA;
@@ -355,6 +356,7 @@ int main(int argc, char **argv)
 		{ "budget", required_argument, NULL, 'b' },   { "near", required_argument, NULL, 'N' },
 		{ "far", required_argument, NULL, 'F' },      { "mode", required_argument, NULL, 'm' },
 		{ "hysteresis", required_argument, NULL, 'H' }, { "no-skin-bench", no_argument, NULL, 'k' },
+		{ "interval", required_argument, NULL, 'I' },
 		{ "help", no_argument, NULL, 'h' },           { NULL, 0, NULL, 0 },
 	};
 	int ch;
@@ -370,6 +372,10 @@ int main(int argc, char **argv)
 		case 'F': far = (float)parse_num(optarg, "--far"); break;
 		case 'H': hyst = parse_num(optarg, "--hysteresis"); break;
 		case 'k': bench = 0; break;
+		case 'I':
+			if (sscanf(optarg, "%f,%f", &ts, &te) != 2 || !(ts >= 0) || !(te <= 1))
+				die(1, "bad --interval '%s' (TS,TE within 0..1)", optarg);
+			break;
 		case 'm':
 			if (!strcmp(optarg, "alpha"))
 				mode = MLOD_RT_SELECT_ALPHA;
@@ -429,9 +435,10 @@ int main(int argc, char **argv)
 	mlod_rt_stats_get(c.ctx, &st);
 	printf("%s: %u joints, %u clips; levels: skeleton %u, mesh %u, motion %u; open %.1f ms, %zu bytes resident\n",
 	       path, mlod_rt_joint_count(c.ctx), clips, L[0], L[1], L[2], open_ms, st.resident_bytes);
-	printf("budget %s%zu, distances %g..%g, mode %s, hysteresis %g, %g s at %g fps per measurement\n",
+	printf("budget %s%zu, distances %g..%g, mode %s (alpha interval %g,%g), hysteresis %g, %g s at %g fps per "
+	       "measurement\n",
 	       budget ? "" : "none ", budget, near, far,
-	       mode == MLOD_RT_SELECT_ALPHA ? "alpha" : mode == MLOD_RT_SELECT_PIXELS ? "pixels" : "toc", hyst,
+	       mode == MLOD_RT_SELECT_ALPHA ? "alpha" : mode == MLOD_RT_SELECT_PIXELS ? "pixels" : "toc", ts, te, hyst,
 	       seconds, fps);
 	if (bench)
 		skin_bench(path);
@@ -443,6 +450,8 @@ int main(int argc, char **argv)
 	lod.mode = mode;
 	lod.d_near = near, lod.d_far = far;
 	lod.hysteresis = (float)hyst;
+	for (int l = 0; l < MLOD_RT_LAYERS; l++)
+		lod.t_start[l] = ts, lod.t_end[l] = te;
 
 	printf("\n%7s %12s %12s %8s  %-s\n", "N", "full ms/fr", "LoD ms/fr", "speedup",
 	       "LoD instances per level (skeleton | mesh | motion), resident bytes");
