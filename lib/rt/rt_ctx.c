@@ -356,24 +356,29 @@ static size_t evictable_bytes(const mlod_rt_ctx *ctx)
 	return b;
 }
 
-/* A guess of a unit's resident size before loading it, to skip a level
- * that cannot fit without decoding it: views know it; for packs the
- * stored size is a lower bound (decoded data is never smaller). */
+/* An upper bound of a unit's resident size before loading it, so that
+ * room is made before decoding and resident bytes never pass the budget,
+ * not even while a level decodes. Views know their size. For packs:
+ * dequantising at most quadruples a stream (unorm8 weights and colours
+ * become floats; positions and normals grow less), the decoded structs at
+ * most double their records, and the alignment of each stream costs less
+ * than 4 times its 16-byte header; plus the skeleton level's tables. */
 static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 {
+	size_t plan = u->layer == MLOD_RT_SKELETON ? (size_t)ctx->joint_count * (4 + 1 + 4 + 64) : 0;
 	if (!ctx->load) {
 		const mlod_rt_view_level *v = u->view;
 		if (v && v->bytes)
-			return v->bytes;
+			return v->bytes + plan;
 		if (v && v->data)
 			switch (u->layer) {
-			case MLOD_RT_SKELETON: return rt_bytes_skel_level(v->data);
+			case MLOD_RT_SKELETON: return rt_bytes_skel_level(v->data) + plan;
 			case MLOD_RT_MESH: return rt_bytes_mesh(v->data);
 			default: return rt_bytes_motion(v->data);
 			}
 		return 0;
 	}
-	return u->stored_size;
+	return 4 * (size_t)u->raw_size + 256 + plan;
 }
 
 /* ---------------------------------------------------------------- */

@@ -29,7 +29,7 @@ typedef struct rt_unit {
 	uint8_t owned;            /* decoded by the runtime (pack source) */
 	uint16_t level, item;
 	int32_t chunk;            /* TOC index, -1 for views */
-	uint32_t stored_size;
+	uint32_t stored_size, raw_size;
 	float error, distance;
 	size_t bytes;             /* counted while resident */
 	uint64_t last_wanted;     /* the update stamp */

@@ -202,6 +202,7 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 			                 u->level, u->layer == MLOD_RT_MOTION ? " for a clip" : "");
 		u->chunk = c;
 		u->stored_size = ctx->pack.chunks[c].stored_size;
+		u->raw_size = ctx->pack.chunks[c].raw_size;
 		u->error = ctx->pack.chunks[c].error;
 		u->distance = ctx->pack.chunks[c].distance;
 	}

@@ -521,6 +521,37 @@ TEST(mutations)
 	CHECK(opened > 0, "no mutated pack opened: the CRC-fixed half should reach the decoders");
 }
 
+TEST(pack_budget)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_memory(pack.d, pack.n, NULL, &ctx, &e), e);
+	mlod_rt_stats s;
+	mlod_rt_stats_get(ctx, &s);
+	const size_t coarse = s.resident_bytes;
+	mlod_rt_close(ctx);
+	for (size_t extra = 0; extra <= 20000; extra += 500) {
+		mlod_rt_config cfg = { coarse + extra, 16, NULL };
+		CHECK_OK(mlod_rt_open_memory(pack.d, pack.n, &cfg, &ctx, &e), e);
+		mlod_rt_select sel;
+		mlod_rt_select_default(&sel);
+		uint32_t ids[8];
+		float d[8];
+		for (int i = 0; i < 8; i++)
+			CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)i % 2, 0, MLOD_RT_LOOP, &ids[i], &e), e);
+		for (int f = 0; f < 50; f++) {
+			for (int i = 0; i < 8; i++)
+				d[i] = (float)((i * 31 + f * 7) % 200);
+			CHECK_OK(mlod_rt_update(ctx, &sel, ids, d, 8, 0.05f, &e), e);
+			CHECK_OK(mlod_rt_stream(ctx, 4096, NULL, &e), e);
+			mlod_rt_stats_get(ctx, &s);
+			CHECK(s.peak_resident_bytes <= coarse + extra, "budget %zu: peak %zu", coarse + extra,
+			      s.peak_resident_bytes);
+		}
+		mlod_rt_close(ctx);
+	}
+}
+
 int main(void)
 {
 	fx_build(0);
@@ -530,6 +561,7 @@ int main(void)
 	build_pack(&pack);
 	printf("# pack of %zu bytes, %d chunks\n", pack.n, nchunks);
 	RUN(pack_equals_views);
+	RUN(pack_budget);
 	RUN(truncated_prefixes);
 	RUN(mutations);
 	free(pack.d);
