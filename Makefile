@@ -4,6 +4,7 @@
 #   make test             unit + CLI + validator tests, then the unit tests under ASan/UBSan
 #   make test-extended    also uses ../shared/data when it is present
 #   make bench            benchmarks against the peers (bench/RESULTS.md)
+#   make fuzz             libFuzzer on the pack reader (clang; not in make test)
 #   make demo             the main job on the bundled sample
 #   make install          PREFIX=/usr/local DESTDIR= MANDIR=$(PREFIX)/share/man
 #   make config=debug|release|sanitize
@@ -163,6 +164,26 @@ $(B)/tests/test_openmesh: tests/openmesh/test_openmesh.cpp lib/mlod.h $(B)/libml
 	@mkdir -p $(@D)
 	@if [ -z "$(OPENMESH_INC)" ]; then echo "OpenMesh headers are missing: run scripts/install-deps" >&2; exit 1; fi
 	$(CXX) $(CPPFLAGS) -isystem $(OPENMESH_INC) $(CXXFLAGS) -Wno-maybe-uninitialized $< $(B)/libmlod.a $(OPENMESH_LIB) $(LDFLAGS) $(LDLIBS) -o $@
+# ----------------------------------------------------------------------
+
+# --- Pack reader fuzzing ----------------------------------------------
+# make fuzz: libFuzzer on the pack reader (tests/fuzz/fuzz_pack.c), built
+# with clang (Debian: clang, libclang-rt-dev) under ASan and UBSan from the
+# runtime's sources alone. Not part of `make test`. The corpus starts with
+# the test character's pack (test_pack_reader --write-seed) and grows in
+# build/fuzz/corpus. FUZZ_TIME=seconds (default 60); FUZZ_ARGS passes more.
+FUZZ_CC ?= clang
+FUZZ_TIME ?= 60
+FUZZ_ARGS ?=
+.PHONY: fuzz
+fuzz: build/fuzz/fuzz_pack $(B)/tests/rt/test_pack_reader
+	@mkdir -p build/fuzz/corpus
+	$(B)/tests/rt/test_pack_reader --write-seed build/fuzz/corpus/seed.mlod
+	build/fuzz/fuzz_pack -max_total_time=$(FUZZ_TIME) -max_len=65536 $(FUZZ_ARGS) build/fuzz/corpus
+build/fuzz/fuzz_pack: tests/fuzz/fuzz_pack.c $(RT_C) lib/rt/mlod_pack.h $(sort $(wildcard lib/core/*.c)) lib/core/mlod_core.h
+	@mkdir -p $(@D)
+	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { echo "make fuzz needs clang with libFuzzer (Debian: clang libclang-rt-dev)" >&2; exit 1; }
+	$(FUZZ_CC) -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined $(RT_CPPFLAGS) tests/fuzz/fuzz_pack.c $(RT_C) $(sort $(wildcard lib/core/*.c)) -lmeshoptimizer -lm -o $@
 # ----------------------------------------------------------------------
 
 -include $(shell find build -name '*.d' 2>/dev/null)

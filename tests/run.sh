@@ -5,12 +5,14 @@
 #   tests/run.sh --build build/release [--sanitize-build build/sanitize] [--extended]
 #
 # Stages:
-#   unit       every build/<config>/tests/test_* and tests/rt/* program (one PASS/FAIL/SKIP
-#              line per test); every tests/unit/test_*.c must be built
+#   unit       every build/<config>/tests/test_* program and every runtime
+#              test program build/<config>/tests/rt/* (one PASS/FAIL/SKIP
+#              line per test); every tests/unit/test_*.c and tests/rt/*.c
+#              must be built
 #   cli        tests/cli/NAME.sh, checked against NAME.exit and NAME.stderr
 #              or NAME.stderr.re (below)
 #   validate   glb written by the tools, checked by the Khronos glTF validator
-#   sanitize   the unit tests again, built with ASan and UBSan
+#   sanitize   the unit and runtime tests again, built with ASan and UBSan
 # The unit tests that need ../shared/data get it whenever it is present;
 # --extended also feeds it to every CLI stage. Its absolute path is exported
 # as MLOD_SHARED_DATA. A MLOD_SHARED_DATA already set names another directory
@@ -113,15 +115,17 @@ run_unit() {
 		name=$(basename "$src" .c)
 		[ -x "$dir/tests/$name" ] || fail "$stage/$name" "$dir/tests/$name was not built"
 	done
-	# The runtime's tests (tests/rt/*.c, linked with libmlodrt.a alone).
 	for src in tests/rt/*.c; do
 		[ -f "$src" ] || continue
-		name=rt/$(basename "$src" .c)
-		[ -x "$dir/tests/$name" ] || fail "$stage/$name" "$dir/tests/$name was not built"
+		name=$(basename "$src" .c)
+		[ -x "$dir/tests/rt/$name" ] || fail "$stage/rt/$name" "$dir/tests/rt/$name was not built"
 	done
 	for t in "$dir"/tests/test_* "$dir"/tests/rt/*; do
 		[ -f "$t" ] && [ -x "$t" ] || continue
-		case $t in */tests/rt/*) name=rt/$(basename "$t") ;; *) name=$(basename "$t") ;; esac
+		case $t in
+		*/tests/rt/*) name=rt/$(basename "$t") ;;
+		*) name=$(basename "$t") ;;
+		esac
 		out=$("$t" 2>"$work/stderr"; echo "rc=$?")
 		rc=${out##*rc=}
 		echo "$out" | grep -E '^(PASS|FAIL|SKIP) ' > "$work/lines"

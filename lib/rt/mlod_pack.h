@@ -141,7 +141,9 @@
  * - INFO 'NAME': the clips' names follow the character's name (at
  *   rec.name), one after the other, in clip order.
  * - MESH: 'POSQ' and 'IDX ' are always there (possibly with 0 elements);
- *   'MTSC' and the 'MTPQ' streams only when target_count > 0. Normals and
+ *   'MTSC' and the 'MTPQ' streams only when target_count > 0. pos_scale
+ *   and the target scales are >= 0, and every range (min + 65535 * scale)
+ *   finite; unknown part flags are refused. Normals and
  *   tangents use the octahedral map: x = q0 / 32767, y = q1 / 32767 (each
  *   clamped to -1), z = 1 - |x| - |y|; where z < 0, (x, y) becomes
  *   ((1 - |y|) * sign x, (1 - |x|) * sign y) with sign 0 = +1; then the

@@ -683,9 +683,11 @@ mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t s
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_info: out is NULL");
 	memset(out, 0, sizeof *out);
+	if (!p)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_info: the pack is NULL");
 	int ci = mlod_pack_find(p, MLOD_CHUNK_INFO, 0, 0);
 	if (ci < 0)
-		return mlod_fail(err, p ? MLOD_ERR_PARSE : MLOD_ERR_INVALID_ARG, "the pack has no INFO chunk");
+		return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no INFO chunk");
 	cx x;
 	bump b = {0};
 	stream s_info, s_name;
@@ -788,9 +790,11 @@ mlod_result mlod_pack_decode_skeleton(const mlod_pack *p, const void *data, size
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_skeleton: out is NULL");
 	memset(out, 0, sizeof *out);
+	if (!p)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_skeleton: the pack is NULL");
 	int ci = mlod_pack_find(p, MLOD_CHUNK_SKELETON, 0, 0);
 	if (ci < 0)
-		return mlod_fail(err, p ? MLOD_ERR_PARSE : MLOD_ERR_INVALID_ARG, "the pack has no SKELETON chunk");
+		return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no SKELETON chunk");
 	cx x;
 	bump b = {0};
 	stream sj, sn, ss, sk, si;
@@ -955,6 +959,8 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 		if (is_kept)
 			ki++;
 		int32_t parent = skel->joints[j].parent;
+		if (parent >= (int32_t)j)
+			FAIL("%s: the given skeleton's joint %u has parent %d, not an earlier joint", x.label, j, parent);
 		if (parent < 0 && !is_kept)
 			FAIL("%s: root joint %u is not kept (every root is)", x.label, j);
 		nearest[j] = is_kept ? j : nearest[parent];
@@ -1393,9 +1399,11 @@ mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, con
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_doc: glb or glb_size is NULL");
 	*glb = NULL;
 	*glb_size = 0;
+	if (!p)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_doc: the pack is NULL");
 	int ci = mlod_pack_find(p, MLOD_CHUNK_DOC, 0, 0);
 	if (ci < 0)
-		return mlod_fail(err, p ? MLOD_ERR_PARSE : MLOD_ERR_INVALID_ARG, "the pack has no DOC chunk");
+		return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no DOC chunk");
 	cx x;
 	stream s;
 	mlod_result r = cx_begin(p, (uint32_t)ci, MLOD_CHUNK_DOC, data, size, &x, err);

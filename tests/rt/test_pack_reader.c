@@ -1,0 +1,1633 @@
+/*
+ * test_pack_reader.c: the pack reader (lib/rt/pack.c) against packs built
+ * here, byte by byte, by a small test-local encoder (the writer, lib/pack,
+ * is another part). Links libmlodrt.a alone (+ meshoptimizer for the
+ * codecs and libm), which also proves the runtime boundary.
+ *
+ * One line per test, "PASS name" or "FAIL name: file:line: what", as
+ * tests/unit/test.h prints (which this program cannot include: it sees
+ * only lib/core and lib/rt).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <meshoptimizer.h>
+
+#include "mlod_pack.h"
+
+/* ------------------------------------------------------------------ */
+/* Harness (as tests/unit/test.h)                                      */
+/* ------------------------------------------------------------------ */
+
+static int test_failed_;
+static char test_msg_[1024];
+static int test_total_fail_;
+
+#define TEST(name) static void test_##name(void)
+#define RUN(name)                                                                                               \
+	do {                                                                                                    \
+		test_failed_ = 0;                                                                               \
+		test_##name();                                                                                  \
+		if (test_failed_) {                                                                             \
+			printf("FAIL %s: %s\n", #name, test_msg_);                                               \
+			test_total_fail_++;                                                                     \
+		} else {                                                                                        \
+			printf("PASS %s\n", #name);                                                              \
+		}                                                                                               \
+		fflush(stdout);                                                                                 \
+	} while (0)
+#define CHECK_MSG(cond, ...)                                                                                    \
+	do {                                                                                                    \
+		if (!(cond)) {                                                                                  \
+			int n_ = snprintf(test_msg_, sizeof test_msg_, "%s:%d: ", __FILE__, __LINE__);           \
+			snprintf(test_msg_ + n_, sizeof test_msg_ - (size_t)n_, __VA_ARGS__);                   \
+			test_failed_ = 1;                                                                       \
+			return;                                                                                 \
+		}                                                                                               \
+	} while (0)
+#define CHECK(cond) CHECK_MSG(cond, "%s", #cond)
+#define CHECK_NEAR(a, b, tol)                                                                                   \
+	do {                                                                                                    \
+		double a_ = (double)(a), b_ = (double)(b);                                                      \
+		CHECK_MSG(fabs(a_ - b_) <= (tol), "%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_,      \
+		          (double)(tol));                                                                       \
+	} while (0)
+static mlod_error terr;
+#define CHECK_OK(call)                                                                                          \
+	do {                                                                                                    \
+		memset(&terr, 0, sizeof terr);                                                                  \
+		mlod_result r_ = (call);                                                                        \
+		CHECK_MSG(r_ == MLOD_OK, "%s returned %d: %s", #call, (int)r_, terr.message);                   \
+	} while (0)
+/* The call fails with code and a message containing text. */
+#define CHECK_ERR(call, code, text)                                                                             \
+	do {                                                                                                    \
+		memset(&terr, 0, sizeof terr);                                                                  \
+		mlod_result r_ = (call);                                                                        \
+		CHECK_MSG(r_ == (code), "%s returned %d (%s), expected %d", #call, (int)r_, terr.message, (int)(code)); \
+		CHECK_MSG(strstr(terr.message, (text)) != NULL, "%s: message \"%s\" lacks \"%s\"", #call, terr.message, \
+		          (text));                                                                              \
+	} while (0)
+
+/* ------------------------------------------------------------------ */
+/* A deterministic random source                                       */
+/* ------------------------------------------------------------------ */
+
+static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
+static uint32_t rnd(void)
+{
+	uint64_t x = rng_state;
+	x ^= x << 13;
+	x ^= x >> 7;
+	x ^= x << 17;
+	rng_state = x;
+	return (uint32_t)(x >> 16);
+}
+static float rndf(float lo, float hi)
+{
+	return lo + (hi - lo) * (float)(rnd() & 0xffffff) / (float)0xffffff;
+}
+
+/* ------------------------------------------------------------------ */
+/* The test-local encoder                                              */
+/* ------------------------------------------------------------------ */
+
+typedef struct buf {
+	uint8_t *p;
+	size_t n, cap;
+} buf;
+
+static void put(buf *b, const void *src, size_t n)
+{
+	if (b->n + n > b->cap) {
+		b->cap = (b->n + n) * 2 + 64;
+		b->p = realloc(b->p, b->cap);
+	}
+	if (n)
+		memcpy(b->p + b->n, src, n);
+	b->n += n;
+}
+static void put8(buf *b, uint8_t v) { put(b, &v, 1); }
+static void put16(buf *b, uint16_t v) { uint8_t e[2] = {(uint8_t)v, (uint8_t)(v >> 8)}; put(b, e, 2); }
+static void put32(buf *b, uint32_t v)
+{
+	uint8_t e[4] = {(uint8_t)v, (uint8_t)(v >> 8), (uint8_t)(v >> 16), (uint8_t)(v >> 24)};
+	put(b, e, 4);
+}
+static void put64(buf *b, uint64_t v) { put32(b, (uint32_t)v); put32(b, (uint32_t)(v >> 32)); }
+static void putf(buf *b, float f) { uint32_t u; memcpy(&u, &f, 4); put32(b, u); }
+static void pad_to(buf *b, size_t align) { while (b->n % align) put8(b, 0); }
+static void wr32(uint8_t *p, uint32_t v) { p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24); }
+static uint32_t get32(const uint8_t *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
+static uint64_t get64(const uint8_t *p) { return get32(p) | (uint64_t)get32(p + 4) << 32; }
+
+#define MAXS 64
+typedef struct wstream {
+	uint32_t tag, count;
+	uint16_t elsize;
+	uint8_t codec;
+	buf data; /* decoded bytes */
+} wstream;
+
+typedef struct wchunk {
+	uint32_t type;
+	uint8_t layer, codec;
+	uint16_t level, item;
+	float error, distance;
+	int ns;
+	wstream s[MAXS];
+	/* A raw payload instead of streams (unknown chunk types). */
+	buf payload;
+} wchunk;
+
+static wstream *add_stream(wchunk *c, uint32_t tag, uint16_t elsize, uint8_t codec)
+{
+	wstream *s = &c->s[c->ns++];
+	memset(s, 0, sizeof *s);
+	s->tag = tag;
+	s->elsize = elsize;
+	s->codec = codec;
+	return s;
+}
+/* Drops stream i of a chunk. */
+static void wchunk_free_stream(wchunk *c, int i)
+{
+	free(c->s[i].data.p);
+	memmove(&c->s[i], &c->s[i + 1], sizeof(wstream) * (size_t)(c->ns - i - 1));
+	c->ns--;
+}
+static void wchunk_free(wchunk *c)
+{
+	for (int i = 0; i < c->ns; i++)
+		free(c->s[i].data.p);
+	free(c->payload.p);
+	memset(c, 0, sizeof *c);
+}
+
+/* The chunk's stored bytes and raw size. */
+static buf chunk_bytes(const wchunk *c, uint32_t *raw)
+{
+	buf out = {0};
+	if (c->payload.n || c->ns == 0) {
+		put(&out, c->payload.p, c->payload.n);
+		*raw = (uint32_t)out.n;
+		return out;
+	}
+	buf enc[MAXS] = {{0}};
+	uint64_t r = 4 + 16 * (uint64_t)c->ns;
+	for (int i = 0; i < c->ns; i++) {
+		const wstream *s = &c->s[i];
+		uint32_t count = s->count;
+		if (s->codec == MLOD_SCODEC_MESHOPT_VERTEX) {
+			size_t bound = meshopt_encodeVertexBufferBound(count, s->elsize);
+			enc[i].p = malloc(bound);
+			enc[i].n = meshopt_encodeVertexBuffer(enc[i].p, bound, s->data.p, count, s->elsize);
+		} else if (s->codec == MLOD_SCODEC_MESHOPT_INDEX) {
+			unsigned *idx = malloc(sizeof(unsigned) * (count ? count : 1));
+			unsigned maxv = 0;
+			for (uint32_t k = 0; k < count; k++) {
+				if (s->elsize == 2) {
+					uint16_t v;
+					memcpy(&v, s->data.p + 2 * k, 2);
+					idx[k] = v;
+				} else {
+					memcpy(&idx[k], s->data.p + 4 * k, 4);
+				}
+				if (idx[k] > maxv)
+					maxv = idx[k];
+			}
+			size_t bound = meshopt_encodeIndexBufferBound(count, maxv + 1);
+			enc[i].p = malloc(bound);
+			enc[i].n = meshopt_encodeIndexBuffer(enc[i].p, bound, idx, count);
+			free(idx);
+		} else {
+			put(&enc[i], s->data.p, s->data.n);
+		}
+		r += ((uint64_t)count * s->elsize + 3) & ~(uint64_t)3;
+	}
+	put32(&out, (uint32_t)c->ns);
+	for (int i = 0; i < c->ns; i++) {
+		const wstream *s = &c->s[i];
+		put32(&out, s->tag);
+		put32(&out, s->count);
+		put16(&out, s->elsize);
+		put8(&out, s->codec);
+		put8(&out, 0);
+		put32(&out, (uint32_t)enc[i].n);
+	}
+	for (int i = 0; i < c->ns; i++) {
+		put(&out, enc[i].p, enc[i].n);
+		pad_to(&out, 4);
+		free(enc[i].p);
+	}
+	*raw = (uint32_t)r;
+	return out;
+}
+
+/* Re-stamps every CRC: each chunk's (where the TOC entry lies inside the
+ * data), the TOC's and the header's. */
+static void restamp(uint8_t *d, size_t n)
+{
+	if (n < 32)
+		return;
+	uint32_t count = get32(d + 12);
+	uint64_t toc_end = 32 + 48 * (uint64_t)count;
+	if (toc_end > n) {
+		wr32(d + 28, mlod_pack_crc32(0, d, 28));
+		return;
+	}
+	for (uint32_t i = 0; i < count; i++) {
+		uint8_t *e = d + 32 + 48 * (size_t)i;
+		uint64_t off = get64(e + 16), size = get32(e + 24);
+		if (off <= n && size <= n - off)
+			wr32(e + 32, mlod_pack_crc32(0, d + off, (size_t)size));
+	}
+	wr32(d + 24, mlod_pack_crc32(0, d + 32, (size_t)(toc_end - 32)));
+	wr32(d + 28, mlod_pack_crc32(0, d, 28));
+}
+
+/* The file: header, TOC, chunks on 16-byte boundaries. */
+static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
+{
+	buf chunks[64];
+	uint32_t raw[64];
+	uint64_t off[64];
+	uint64_t at = 32 + 48 * (uint64_t)nc;
+	for (int i = 0; i < nc; i++) {
+		at = (at + 15) & ~(uint64_t)15;
+		chunks[i] = chunk_bytes(&c[i], &raw[i]);
+		off[i] = at;
+		at += chunks[i].n;
+	}
+	buf out = {0};
+	put(&out, "MLOD", 4);
+	put16(&out, major);
+	put16(&out, minor);
+	put32(&out, 0);
+	put32(&out, (uint32_t)nc);
+	put64(&out, at);
+	put32(&out, 0);
+	put32(&out, 0);
+	for (int i = 0; i < nc; i++) {
+		put32(&out, c[i].type);
+		put8(&out, c[i].layer);
+		put8(&out, c[i].codec);
+		put16(&out, c[i].level);
+		put16(&out, c[i].item);
+		put16(&out, 0);
+		put32(&out, 0);
+		put64(&out, off[i]);
+		put32(&out, (uint32_t)chunks[i].n);
+		put32(&out, raw[i]);
+		put32(&out, 0);
+		putf(&out, c[i].error);
+		putf(&out, c[i].distance);
+		put32(&out, 0);
+	}
+	for (int i = 0; i < nc; i++) {
+		pad_to(&out, 16);
+		put(&out, chunks[i].p, chunks[i].n);
+		free(chunks[i].p);
+	}
+	restamp(out.p, out.n);
+	return out;
+}
+
+/* ------------------------------------------------------------------ */
+/* The character: what the encoder writes, kept to compare with        */
+/* ------------------------------------------------------------------ */
+
+#define NJ 4
+#define NV0 40 /* part 0 vertices */
+#define NV1 24 /* part 1 vertices */
+#define NI0 60
+#define NI1 36
+#define NK 5 /* keys */
+
+typedef struct part_truth {
+	uint32_t flags, V, I, uv_sets, T;
+	int32_t skin, joint;
+	float pos[NV0][3], nrm[NV0][3], tan[NV0][4], uv[2][NV0][2], col[NV0][4], wgt[NV0][4], morph[NV0][3];
+	uint16_t jnt[NV0][4];
+	uint8_t wq[NV0][4], cq[NV0][4];
+	uint32_t idx[NI0];
+	float pos_min[3], pos_scale[3], uv_min[2][2], uv_scale[2][2], mscale;
+} part_truth;
+
+static part_truth parts_truth[3]; /* level 0: parts 0, 1; level 1: part 2 */
+static float ibm_truth[NJ][16];
+static float time_truth[NK];
+static float vec_truth[NK * 3][3];
+static float rot_truth[NK * 3][4];
+static int16_t rotq_truth[NK][4];
+
+static const int32_t parents[NJ] = {-1, 0, 1, 1};
+
+static void oct_encode(const float n[3], int16_t *qx, int16_t *qy)
+{
+	float s = fabsf(n[0]) + fabsf(n[1]) + fabsf(n[2]);
+	float x = n[0] / s, y = n[1] / s;
+	if (n[2] < 0) {
+		float ox = x;
+		x = (1 - fabsf(y)) * (ox >= 0 ? 1.0f : -1.0f);
+		y = (1 - fabsf(ox)) * (y >= 0 ? 1.0f : -1.0f);
+	}
+	*qx = (int16_t)lrintf(x * 32767.0f);
+	*qy = (int16_t)lrintf(y * 32767.0f);
+}
+
+static void rnd_unit(float *v)
+{
+	float l;
+	do {
+		v[0] = rndf(-1, 1), v[1] = rndf(-1, 1), v[2] = rndf(-1, 1);
+		l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+	} while (l < 0.1f || l > 1);
+	v[0] /= l, v[1] /= l, v[2] /= l;
+}
+
+/* Weights quantised to unorm8 summing to 255 (largest remainder). */
+static void quant_weights(const float *w, uint8_t *q)
+{
+	int sum = 0;
+	float frac[4];
+	for (int a = 0; a < 4; a++) {
+		float f = w[a] * 255.0f;
+		q[a] = (uint8_t)floorf(f);
+		frac[a] = f - floorf(f);
+		sum += q[a];
+	}
+	while (sum < 255) {
+		int best = 0;
+		for (int a = 1; a < 4; a++)
+			if (frac[a] > frac[best])
+				best = a;
+		q[best]++;
+		frac[best] = -1;
+		sum++;
+	}
+}
+
+static void make_part(part_truth *t, uint32_t flags, uint32_t V, uint32_t I, uint32_t uv_sets, uint32_t T, int32_t skin,
+                      int32_t joint)
+{
+	memset(t, 0, sizeof *t);
+	t->flags = flags, t->V = V, t->I = I, t->uv_sets = uv_sets, t->T = T, t->skin = skin, t->joint = joint;
+	float lo[3] = {-0.5f, 0.0f, -0.25f}, hi[3] = {0.5f, 1.8f, 0.25f};
+	for (int a = 0; a < 3; a++) {
+		t->pos_min[a] = lo[a];
+		t->pos_scale[a] = (hi[a] - lo[a]) / 65535.0f;
+	}
+	for (uint32_t s = 0; s < uv_sets; s++)
+		for (int a = 0; a < 2; a++) {
+			t->uv_min[s][a] = -1.0f + (float)s;
+			t->uv_scale[s][a] = 2.0f / 65535.0f;
+		}
+	t->mscale = 0.1f / 32767.0f;
+	for (uint32_t v = 0; v < V; v++) {
+		for (int a = 0; a < 3; a++)
+			t->pos[v][a] = rndf(lo[a], hi[a]);
+		rnd_unit(t->nrm[v]);
+		rnd_unit(t->tan[v]);
+		t->tan[v][3] = (rnd() & 1) ? 1.0f : -1.0f;
+		for (uint32_t s = 0; s < uv_sets; s++)
+			for (int a = 0; a < 2; a++)
+				t->uv[s][v][a] = rndf(t->uv_min[s][a], t->uv_min[s][a] + 2.0f);
+		for (int a = 0; a < 4; a++) {
+			t->cq[v][a] = (uint8_t)(rnd() & 0xff);
+			t->col[v][a] = t->cq[v][a] / 255.0f;
+		}
+		float sum = 0;
+		for (int a = 0; a < 4; a++) {
+			t->wgt[v][a] = a < 2 || (rnd() & 1) ? rndf(0.05f, 1) : 0;
+			sum += t->wgt[v][a];
+			t->jnt[v][a] = (uint16_t)(rnd() % NJ);
+		}
+		for (int a = 0; a < 4; a++)
+			t->wgt[v][a] /= sum;
+		quant_weights(t->wgt[v], t->wq[v]);
+		for (int a = 0; a < 3; a++)
+			t->morph[v][a] = rndf(-0.1f, 0.1f);
+	}
+	for (uint32_t k = 0; k < I; k++)
+		t->idx[k] = rnd() % V;
+}
+
+static void part_rec(const part_truth *t, uint32_t instance, buf *b)
+{
+	mlod_pack_part_rec r;
+	memset(&r, 0, sizeof r);
+	r.instance = instance;
+	r.node = (int32_t)instance + 1;
+	r.mesh = 0;
+	r.primitive = instance;
+	r.skin = t->skin;
+	r.joint = t->joint;
+	r.material = -1;
+	r.flags = t->flags;
+	r.vertex_count = t->V;
+	r.index_count = t->I;
+	r.uv_sets = t->uv_sets;
+	r.target_count = t->T;
+	for (int k = 0; k < 16; k++)
+		r.offset[k] = k % 5 == 0 ? 1.0f : 0.0f;
+	memcpy(r.pos_min, t->pos_min, sizeof r.pos_min);
+	memcpy(r.pos_scale, t->pos_scale, sizeof r.pos_scale);
+	memcpy(r.uv_min, t->uv_min, sizeof t->uv_min);
+	memcpy(r.uv_scale, t->uv_scale, sizeof t->uv_scale);
+	put(b, &r, sizeof r);
+}
+
+/* Appends a part's streams; vc/ic: the codecs of vertex and index streams. */
+static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
+{
+	wstream *s = add_stream(c, MLOD_STREAM_POSQ, 8, vc);
+	s->count = t->V;
+	for (uint32_t v = 0; v < t->V; v++) {
+		for (int a = 0; a < 3; a++)
+			put16(&s->data, (uint16_t)lrintf((t->pos[v][a] - t->pos_min[a]) / t->pos_scale[a]));
+		put16(&s->data, 0);
+	}
+	if (t->flags & MLOD_PART_NORMALS) {
+		s = add_stream(c, MLOD_STREAM_NRMQ, 4, vc);
+		s->count = t->V;
+		for (uint32_t v = 0; v < t->V; v++) {
+			int16_t qx, qy;
+			oct_encode(t->nrm[v], &qx, &qy);
+			put16(&s->data, (uint16_t)qx);
+			put16(&s->data, (uint16_t)qy);
+		}
+	}
+	if (t->flags & MLOD_PART_TANGENTS) {
+		s = add_stream(c, MLOD_STREAM_TANQ, 8, vc);
+		s->count = t->V;
+		for (uint32_t v = 0; v < t->V; v++) {
+			int16_t qx, qy;
+			oct_encode(t->tan[v], &qx, &qy);
+			put16(&s->data, (uint16_t)qx);
+			put16(&s->data, (uint16_t)qy);
+			put16(&s->data, (uint16_t)(t->tan[v][3] > 0 ? 32767 : -32767));
+			put16(&s->data, 0);
+		}
+	}
+	for (uint32_t u = 0; u < t->uv_sets; u++) {
+		s = add_stream(c, MLOD_STREAM_UVQ0 + (u << 24), 4, vc);
+		s->count = t->V;
+		for (uint32_t v = 0; v < t->V; v++)
+			for (int a = 0; a < 2; a++)
+				put16(&s->data, (uint16_t)lrintf((t->uv[u][v][a] - t->uv_min[u][a]) / t->uv_scale[u][a]));
+	}
+	if (t->flags & MLOD_PART_COLORS) {
+		s = add_stream(c, MLOD_STREAM_COLQ, 4, vc);
+		s->count = t->V;
+		put(&s->data, t->cq, 4 * (size_t)t->V);
+	}
+	if (t->flags & MLOD_PART_SKINNED) {
+		int j16 = (t->flags & MLOD_PART_JOINTS16) != 0;
+		s = add_stream(c, j16 ? MLOD_STREAM_JN16 : MLOD_STREAM_JNT8, j16 ? 8 : 4, vc);
+		s->count = t->V;
+		for (uint32_t v = 0; v < t->V; v++)
+			for (int a = 0; a < 4; a++) {
+				if (j16)
+					put16(&s->data, t->jnt[v][a]);
+				else
+					put8(&s->data, (uint8_t)t->jnt[v][a]);
+			}
+		s = add_stream(c, MLOD_STREAM_WGT8, 4, vc);
+		s->count = t->V;
+		put(&s->data, t->wq, 4 * (size_t)t->V);
+	}
+	int i16 = (t->flags & MLOD_PART_INDEX16) != 0;
+	s = add_stream(c, MLOD_STREAM_IDX, i16 ? 2 : 4, ic);
+	s->count = t->I;
+	for (uint32_t k = 0; k < t->I; k++) {
+		if (i16)
+			put16(&s->data, (uint16_t)t->idx[k]);
+		else
+			put32(&s->data, t->idx[k]);
+	}
+	if (t->T) {
+		s = add_stream(c, MLOD_STREAM_MTSC, 4, MLOD_SCODEC_RAW);
+		s->count = t->T;
+		for (uint32_t k = 0; k < t->T; k++)
+			putf(&s->data, t->mscale);
+		for (uint32_t k = 0; k < t->T; k++) {
+			s = add_stream(c, MLOD_STREAM_MTPQ, 8, vc);
+			s->count = t->V;
+			for (uint32_t v = 0; v < t->V; v++) {
+				for (int a = 0; a < 3; a++)
+					put16(&s->data, (uint16_t)(int16_t)lrintf(t->morph[v][a] / t->mscale));
+				put16(&s->data, 0);
+			}
+		}
+	}
+}
+
+/* The chunks of the test character, in the format's order:
+ * INFO, SKELETON, SKELETON 1, MESH 1, MOTION 1/0, MESH 0, MOTION 0/0, DOC.
+ * with_unknown adds an 'XTRA' chunk after INFO. */
+enum { C_INFO, C_SKEL, C_SKEL1, C_MESH1, C_MOT1, C_MESH0, C_MOT0, C_DOC, C_COUNT };
+
+static int make_chunks(wchunk *c, int with_unknown)
+{
+	rng_state = 0x9e3779b97f4a7c15ull;
+	memset(c, 0, sizeof(wchunk) * (C_COUNT + 1));
+	wstream *s;
+	/* INFO */
+	wchunk *ch = &c[C_INFO];
+	ch->type = MLOD_CHUNK_INFO;
+	mlod_pack_info_rec info;
+	memset(&info, 0, sizeof info);
+	info.joint_count = NJ;
+	info.skin_count = 1;
+	info.skeleton_levels = 2;
+	info.mesh_levels = 2;
+	info.clip_count = 1;
+	info.motion_levels = 2;
+	info.instance_count = 2;
+	info.name = 0;
+	info.bounds_min[0] = -0.5f, info.bounds_max[0] = 0.5f, info.bounds_max[1] = 1.8f;
+	info.height = 1.8f;
+	info.diagonal = 1.9f;
+	info.first_drawable = 0;
+	s = add_stream(ch, MLOD_STREAM_INFO, sizeof info, MLOD_SCODEC_RAW);
+	s->count = 1;
+	put(&s->data, &info, sizeof info);
+	s = add_stream(ch, MLOD_STREAM_NAME, 1, MLOD_SCODEC_RAW);
+	put(&s->data, "hero\0walk\0", 10);
+	s->count = 10;
+
+	/* SKELETON */
+	ch = &c[C_SKEL];
+	ch->type = MLOD_CHUNK_SKELETON, ch->layer = MLOD_LAYER_SKELETON;
+	s = add_stream(ch, MLOD_STREAM_JNTS, sizeof(mlod_pack_joint_rec), MLOD_SCODEC_RAW);
+	s->count = NJ;
+	static const char jnames[] = "root\0hip\0leg_l\0leg_r\0skin\0";
+	static const uint32_t jname_off[NJ] = {0, 5, 9, 15};
+	for (int j = 0; j < NJ; j++) {
+		mlod_pack_joint_rec r;
+		memset(&r, 0, sizeof r);
+		r.parent = parents[j];
+		r.name = jname_off[j];
+		r.t[1] = j ? 0.5f : 0.0f;
+		r.t[0] = 0.125f * (float)j;
+		r.r[3] = 1;
+		r.s[0] = r.s[1] = r.s[2] = 1;
+		for (int k = 0; k < 16; k++)
+			r.base[k] = k % 5 == 0 ? 1.0f : 0.0f;
+		r.node = j + 10;
+		put(&s->data, &r, sizeof r);
+	}
+	s = add_stream(ch, MLOD_STREAM_NAME, 1, MLOD_SCODEC_RAW);
+	put(&s->data, jnames, sizeof jnames - 1);
+	s->count = sizeof jnames - 1;
+	s = add_stream(ch, MLOD_STREAM_SKIN, sizeof(mlod_pack_skin_rec), MLOD_SCODEC_RAW);
+	s->count = 1;
+	mlod_pack_skin_rec sk = {NJ, 21, 0};
+	put(&s->data, &sk, sizeof sk);
+	s = add_stream(ch, MLOD_STREAM_SKJT, 4, MLOD_SCODEC_RAW);
+	s->count = NJ;
+	for (int j = 0; j < NJ; j++)
+		put32(&s->data, (uint32_t)j);
+	s = add_stream(ch, MLOD_STREAM_IBMS, 64, MLOD_SCODEC_RAW);
+	s->count = NJ;
+	for (int j = 0; j < NJ; j++)
+		for (int k = 0; k < 16; k++) {
+			ibm_truth[j][k] = k % 5 == 0 ? 1.0f : (k == 13 ? -0.5f * (float)j : 0.0f);
+			putf(&s->data, ibm_truth[j][k]);
+		}
+
+	/* SKELETON level 1: keeps root and hip; the legs follow the hip. */
+	ch = &c[C_SKEL1];
+	ch->type = MLOD_CHUNK_SKELETON, ch->layer = MLOD_LAYER_SKELETON, ch->level = 1;
+	ch->error = 0.02f, ch->distance = 10.0f;
+	s = add_stream(ch, MLOD_STREAM_KEPT, 4, MLOD_SCODEC_RAW);
+	s->count = 2;
+	put32(&s->data, 0);
+	put32(&s->data, 1);
+	s = add_stream(ch, MLOD_STREAM_PALJ, 4, MLOD_SCODEC_RAW);
+	s->count = NJ;
+	static const uint32_t palj[NJ] = {0, 1, 1, 1};
+	for (int j = 0; j < NJ; j++)
+		put32(&s->data, palj[j]);
+	s = add_stream(ch, MLOD_STREAM_PALB, 64, MLOD_SCODEC_RAW);
+	s->count = NJ;
+	for (int j = 0; j < NJ; j++)
+		for (int k = 0; k < 16; k++)
+			putf(&s->data, ibm_truth[palj[j]][k]);
+
+	/* MESH level 1: one raw part, JNT8, u16 indices. */
+	ch = &c[C_MESH1];
+	ch->type = MLOD_CHUNK_MESH, ch->layer = MLOD_LAYER_MESH, ch->level = 1;
+	ch->error = 0.01f, ch->distance = 9.35f;
+	make_part(&parts_truth[2], MLOD_PART_NORMALS | MLOD_PART_SKINNED | MLOD_PART_INDEX16, 12, 18, 1, 0, 0, -1);
+	s = add_stream(ch, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), MLOD_SCODEC_RAW);
+	s->count = 1;
+	part_rec(&parts_truth[2], 0, &s->data);
+	part_streams(ch, &parts_truth[2], MLOD_SCODEC_RAW, MLOD_SCODEC_RAW);
+
+	/* MOTION level 1 of clip 0: one raw channel. */
+	ch = &c[C_MOT1];
+	ch->type = MLOD_CHUNK_MOTION, ch->layer = MLOD_LAYER_MOTION, ch->level = 1;
+	ch->error = 0.01f, ch->distance = 9.35f;
+	for (int k = 0; k < NK; k++)
+		time_truth[k] = 0.25f * (float)k;
+	s = add_stream(ch, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), MLOD_SCODEC_RAW);
+	s->count = 1;
+	mlod_pack_channel_rec cr = {0, 0, 0, 2};
+	put(&s->data, &cr, sizeof cr);
+	s = add_stream(ch, MLOD_STREAM_TIME, 4, MLOD_SCODEC_RAW);
+	s->count = 2;
+	putf(&s->data, 0.0f);
+	putf(&s->data, 1.0f);
+	s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_RAW);
+	s->count = 2;
+	for (int k = 0; k < 6; k++)
+		putf(&s->data, (float)k);
+
+	/* MESH level 0: two meshopt-coded parts. */
+	ch = &c[C_MESH0];
+	ch->type = MLOD_CHUNK_MESH, ch->layer = MLOD_LAYER_MESH, ch->codec = MLOD_CODEC_MESHOPT;
+	make_part(&parts_truth[0],
+	          MLOD_PART_NORMALS | MLOD_PART_TANGENTS | MLOD_PART_COLORS | MLOD_PART_SKINNED, NV0, NI0, 2, 1, 0, -1);
+	make_part(&parts_truth[1], MLOD_PART_SKINNED | MLOD_PART_JOINTS16 | MLOD_PART_INDEX16, NV1, NI1, 0, 0, 0, 2);
+	s = add_stream(ch, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), MLOD_SCODEC_MESHOPT_VERTEX);
+	s->count = 2;
+	part_rec(&parts_truth[0], 0, &s->data);
+	part_rec(&parts_truth[1], 1, &s->data);
+	part_streams(ch, &parts_truth[0], MLOD_SCODEC_MESHOPT_VERTEX, MLOD_SCODEC_MESHOPT_INDEX);
+	part_streams(ch, &parts_truth[1], MLOD_SCODEC_MESHOPT_VERTEX, MLOD_SCODEC_MESHOPT_INDEX);
+
+	/* MOTION level 0 of clip 0: translation (linear), rotation (ROTQ),
+	 * rotation (cubic, ROTF), scale (step). */
+	ch = &c[C_MOT0];
+	ch->type = MLOD_CHUNK_MOTION, ch->layer = MLOD_LAYER_MOTION, ch->codec = MLOD_CODEC_MESHOPT;
+	s = add_stream(ch, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), MLOD_SCODEC_RAW);
+	s->count = 4;
+	mlod_pack_channel_rec chans[4] = {{0, 0, 0, NK}, {1, 1, 0, NK}, {2, 1, 2, NK}, {3, 2, 1, NK}};
+	put(&s->data, chans, sizeof chans);
+	for (int k = 0; k < NK * 3; k++) {
+		for (int a = 0; a < 3; a++)
+			vec_truth[k][a] = rndf(-2, 2);
+		float q[4], l = 0;
+		for (int a = 0; a < 4; a++)
+			q[a] = rndf(-1, 1), l += q[a] * q[a];
+		for (int a = 0; a < 4; a++)
+			rot_truth[k][a] = q[a] / sqrtf(l);
+	}
+	for (int k = 0; k < NK; k++)
+		for (int a = 0; a < 4; a++)
+			rotq_truth[k][a] = (int16_t)lrintf(rot_truth[k][a] * 32767.0f);
+	for (int cidx = 0; cidx < 4; cidx++) {
+		s = add_stream(ch, MLOD_STREAM_TIME, 4, cidx == 1 ? MLOD_SCODEC_MESHOPT_VERTEX : MLOD_SCODEC_RAW);
+		s->count = NK;
+		for (int k = 0; k < NK; k++)
+			putf(&s->data, time_truth[k]);
+		if (cidx == 0 || cidx == 3) {
+			s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_MESHOPT_VERTEX);
+			s->count = NK;
+			for (int k = 0; k < NK; k++)
+				for (int a = 0; a < 3; a++)
+					putf(&s->data, vec_truth[k][a]);
+		} else if (cidx == 1) {
+			s = add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_MESHOPT_VERTEX);
+			s->count = NK;
+			for (int k = 0; k < NK; k++)
+				for (int a = 0; a < 4; a++)
+					put16(&s->data, (uint16_t)rotq_truth[k][a]);
+		} else {
+			s = add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
+			s->count = NK * 3;
+			for (int k = 0; k < NK * 3; k++)
+				for (int a = 0; a < 4; a++)
+					putf(&s->data, rot_truth[k][a]);
+		}
+	}
+
+	/* DOC */
+	ch = &c[C_DOC];
+	ch->type = MLOD_CHUNK_DOC;
+	s = add_stream(ch, MLOD_STREAM_GLB, 1, MLOD_SCODEC_RAW);
+	put(&s->data, "glTF\x02\0\0\0(a glb without geometry)", 32);
+	s->count = 32;
+
+	int n = C_COUNT;
+	if (with_unknown) {
+		memmove(&c[2], &c[1], sizeof(wchunk) * (C_COUNT - 1));
+		memset(&c[1], 0, sizeof c[1]);
+		c[1].type = MLOD_FOURCC('X', 'T', 'R', 'A');
+		c[1].layer = 7;
+		c[1].codec = 9;
+		put(&c[1].payload, "anything at all, not even streams", 33);
+		n++;
+	}
+	return n;
+}
+
+static void free_chunks(wchunk *c, int n)
+{
+	for (int i = 0; i < n; i++)
+		wchunk_free(&c[i]);
+}
+
+static buf make_pack(int with_unknown)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, with_unknown);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, MLOD_PACK_MINOR);
+	free_chunks(c, n);
+	return b;
+}
+
+/* Opens and decodes every chunk; the count of chunks decoded, or -1 when
+ * open fails. Checks the guarantees of whatever decodes. */
+static int decode_all(const uint8_t *d, size_t n, const mlod_pack_skeleton *given_skel, int *bad)
+{
+	mlod_pack p;
+	mlod_error e;
+	if (mlod_pack_open(d, n, &p, &e) != MLOD_OK) {
+		if (!e.message[0])
+			*bad = 1;
+		return -1;
+	}
+	int ok = 0;
+	mlod_pack_info info;
+	if (mlod_pack_decode_info(&p, d, n, &info, &e) == MLOD_OK) {
+		ok++;
+		if (!info.name)
+			*bad = 1;
+		for (uint32_t c = 0; c < info.rec.clip_count; c++)
+			if (!info.clip_names[c])
+				*bad = 1;
+	} else if (!e.message[0]) {
+		*bad = 1;
+	}
+	mlod_pack_info_free(&info);
+	mlod_pack_skeleton skel;
+	const mlod_pack_skeleton *sk = given_skel;
+	if (mlod_pack_decode_skeleton(&p, d, n, &skel, &e) == MLOD_OK) {
+		ok++;
+		for (uint32_t j = 0; j < skel.joint_count; j++)
+			if (skel.joints[j].parent >= (int32_t)j || !skel.joint_names[j])
+				*bad = 1;
+		if (!given_skel)
+			sk = &skel;
+	}
+	for (uint32_t i = 0; i < p.chunk_count; i++) {
+		const mlod_pack_chunk *c = &p.chunks[i];
+		mlod_result r = MLOD_OK;
+		e.message[0] = 0;
+		if (c->type == MLOD_CHUNK_SKELETON && c->level > 0 && sk) {
+			mlod_pack_skel_level l;
+			r = mlod_pack_decode_skel_level(&p, i, d, n, sk, &l, &e);
+			if (r == MLOD_OK)
+				for (uint32_t k = 0; k < l.palette_size; k++)
+					if (l.palette_joint[k] >= sk->joint_count)
+						*bad = 1;
+			mlod_pack_skel_level_free(&l);
+		} else if (c->type == MLOD_CHUNK_MESH) {
+			mlod_pack_mesh m;
+			r = mlod_pack_decode_mesh(&p, i, d, n, sk, &m, &e);
+			for (uint32_t k = 0; r == MLOD_OK && k < m.part_count; k++) {
+				const mlod_pack_part *pt = &m.parts[k];
+				for (uint32_t x = 0; x < pt->rec.index_count; x++)
+					if (pt->indices[x] >= pt->rec.vertex_count)
+						*bad = 1;
+				for (uint32_t v = 0; v < pt->rec.vertex_count; v++) {
+					for (int a = 0; a < 3; a++)
+						if (!isfinite(pt->positions[3 * v + a]))
+							*bad = 1;
+					if (pt->weights) {
+						float s = 0;
+						for (int a = 0; a < 4; a++)
+							s += pt->weights[4 * v + a];
+						if (fabsf(s - 1) > 1e-5f)
+							*bad = 1;
+					}
+					if (pt->normals) {
+						const float *nn = pt->normals + 3 * v;
+						if (fabsf(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2] - 1) > 1e-5f)
+							*bad = 1;
+					}
+				}
+			}
+			mlod_pack_mesh_free(&m);
+		} else if (c->type == MLOD_CHUNK_MOTION) {
+			mlod_pack_motion m;
+			r = mlod_pack_decode_motion(&p, i, d, n, sk, &m, &e);
+			for (uint32_t k = 0; r == MLOD_OK && k < m.channel_count; k++)
+				if (!sk || m.channels[k].rec.joint >= sk->joint_count)
+					*bad = 1;
+			mlod_pack_motion_free(&m);
+		} else if (c->type == MLOD_CHUNK_DOC) {
+			const void *g;
+			size_t gs;
+			r = mlod_pack_doc(&p, d, n, &g, &gs, &e);
+			if (r == MLOD_OK && ((const uint8_t *)g < d || (const uint8_t *)g + gs > d + n))
+				*bad = 1;
+		} else {
+			continue;
+		}
+		if (r == MLOD_OK)
+			ok++;
+		else if (!e.message[0])
+			*bad = 1;
+	}
+	mlod_pack_skeleton_free(&skel);
+	mlod_pack_close(&p);
+	return ok;
+}
+
+/* ------------------------------------------------------------------ */
+/* Tests                                                               */
+/* ------------------------------------------------------------------ */
+
+TEST(crc_known_vectors)
+{
+	CHECK(mlod_pack_crc32(0, "123456789", 9) == 0xCBF43926u);
+	CHECK(mlod_pack_crc32(0, "", 0) == 0);
+	CHECK(mlod_pack_crc32(0, "The quick brown fox jumps over the lazy dog", 43) == 0x414FA339u);
+	CHECK(mlod_pack_crc32(0, "a", 1) == 0xE8B7BE43u);
+	/* Incremental, as zlib's crc32. */
+	CHECK(mlod_pack_crc32(mlod_pack_crc32(0, "12345", 5), "6789", 4) == 0xCBF43926u);
+}
+
+TEST(open_reads_header_and_toc)
+{
+	buf b = make_pack(0);
+	mlod_pack p;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	int ok = p.major == 1 && p.minor == 0 && p.chunk_count == C_COUNT && p.file_size == b.n &&
+	         p.chunks[C_MESH0].type == MLOD_CHUNK_MESH && p.chunks[C_MESH0].codec == MLOD_CODEC_MESHOPT &&
+	         p.chunks[C_MESH1].level == 1 && p.chunks[C_MESH1].error == 0.01f &&
+	         p.chunks[C_MESH1].distance == 9.35f && p.chunks[C_MESH1].offset % 16 == 0;
+	int f1 = mlod_pack_find(&p, MLOD_CHUNK_MESH, 1, 0), f2 = mlod_pack_find(&p, MLOD_CHUNK_MOTION, 0, 0),
+	    f3 = mlod_pack_find(&p, MLOD_CHUNK_MOTION, 0, 1), f4 = mlod_pack_find(&p, MLOD_CHUNK_DOC, 0, 0);
+	mlod_pack_close(&p);
+	static const mlod_pack zero_pack;
+	int zeroed = memcmp(&p, &zero_pack, sizeof p) == 0;
+	free(b.p);
+	CHECK(ok);
+	CHECK(f1 == C_MESH1 && f2 == C_MOT0 && f3 == -1 && f4 == C_DOC);
+	CHECK(zeroed);
+}
+
+TEST(names)
+{
+	CHECK(strcmp(mlod_pack_type_name(MLOD_CHUNK_INFO), "INFO") == 0);
+	CHECK(strcmp(mlod_pack_type_name(MLOD_CHUNK_SKELETON), "SKEL") == 0);
+	CHECK(strcmp(mlod_pack_type_name(MLOD_CHUNK_MESH), "MESH") == 0);
+	CHECK(strcmp(mlod_pack_type_name(MLOD_CHUNK_MOTION), "ANIM") == 0);
+	CHECK(strcmp(mlod_pack_type_name(MLOD_CHUNK_DOC), "DOC") == 0);
+	CHECK(strcmp(mlod_pack_type_name(MLOD_FOURCC('X', 'X', 'X', 'X')), "unknown") == 0);
+	CHECK(strcmp(mlod_pack_codec_name(0), "none") == 0 && strcmp(mlod_pack_codec_name(1), "meshopt") == 0 &&
+	      strcmp(mlod_pack_codec_name(2), "draco") == 0 && strcmp(mlod_pack_codec_name(3), "unknown") == 0);
+	CHECK(strcmp(mlod_pack_layer_name(0), "none") == 0 && strcmp(mlod_pack_layer_name(1), "skeleton") == 0 &&
+	      strcmp(mlod_pack_layer_name(2), "mesh") == 0 && strcmp(mlod_pack_layer_name(3), "motion") == 0 &&
+	      strcmp(mlod_pack_layer_name(4), "unknown") == 0);
+}
+
+TEST(decode_info)
+{
+	buf b = make_pack(0);
+	mlod_pack p = {0};
+	mlod_pack_info info = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_info(&p, b.p, b.n, &info, &terr);
+	int ok = r == MLOD_OK && info.rec.joint_count == NJ && info.rec.skin_count == 1 && info.rec.clip_count == 1 &&
+	         info.rec.mesh_levels == 2 && info.rec.height == 1.8f && strcmp(info.name, "hero") == 0 &&
+	         strcmp(info.clip_names[0], "walk") == 0 && info.block != NULL;
+	mlod_pack_info_free(&info);
+	static const mlod_pack_info zero_info;
+	int zeroed = memcmp(&info, &zero_info, sizeof info) == 0;
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	CHECK(ok);
+	CHECK(zeroed);
+}
+
+TEST(decode_skeleton_and_level)
+{
+	buf b = make_pack(0);
+	mlod_pack p = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_skel_level l = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &s, &terr));
+	CHECK_OK(mlod_pack_decode_skel_level(&p, C_SKEL1, b.p, b.n, &s, &l, &terr));
+	int ok = s.joint_count == NJ && s.skin_count == 1 && strcmp(s.joint_names[2], "leg_l") == 0 &&
+	         strcmp(s.skin_names[0], "skin") == 0 && s.joints[3].parent == 1 && s.joints[2].t[0] == 0.25f &&
+	         s.joints[3].node == 13 && s.skins[0].joint_count == NJ && s.skin_joints[0][3] == 3 &&
+	         memcmp(s.inverse_bind[0], ibm_truth, sizeof ibm_truth) == 0;
+	int lok = l.kept_count == 2 && l.kept[1] == 1 && l.palette_size == NJ && l.palette_joint[0] == 0 &&
+	          l.palette_joint[3] == 1 && memcmp(l.palette_bind + 16 * 2, ibm_truth[1], 64) == 0;
+	/* The level's chunk is not the full skeleton, and vice versa. */
+	mlod_pack_skel_level l2;
+	mlod_result r1 = mlod_pack_decode_skel_level(&p, C_SKEL, b.p, b.n, &s, &l2, &terr);
+	mlod_result r2 = mlod_pack_decode_skel_level(&p, C_MESH1, b.p, b.n, &s, &l2, &terr);
+	mlod_pack_mesh m2;
+	mlod_result r3 = mlod_pack_decode_mesh(&p, 99, b.p, b.n, &s, &m2, &terr);
+	mlod_pack_skel_level_free(&l);
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK(ok);
+	CHECK(lok);
+	CHECK(r1 == MLOD_ERR_INVALID_ARG && r2 == MLOD_ERR_INVALID_ARG && r3 == MLOD_ERR_INVALID_ARG);
+}
+
+/* The angle between two unit vectors (float), in double. */
+static double angle3(const float *a, const float *b)
+{
+	double c0 = (double)a[1] * b[2] - (double)a[2] * b[1], c1 = (double)a[2] * b[0] - (double)a[0] * b[2],
+	       c2 = (double)a[0] * b[1] - (double)a[1] * b[0];
+	return atan2(sqrt(c0 * c0 + c1 * c1 + c2 * c2), (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2]);
+}
+
+/* Compares a decoded part with what was encoded. */
+static int check_part(const mlod_pack_part *pt, const part_truth *t, char *why, size_t n)
+{
+	if (pt->rec.vertex_count != t->V || pt->rec.index_count != t->I || pt->rec.flags != t->flags ||
+	    pt->rec.uv_sets != t->uv_sets || pt->rec.target_count != t->T || pt->rec.skin != t->skin ||
+	    pt->rec.joint != t->joint)
+		return snprintf(why, n, "record differs"), 0;
+	/* Octahedral snorm16: at most 3 * sqrt(2) / 2 / 32767 = 6.4742e-5 rad
+	 * (at a face's centre, mlod(5)); 1e-6 more for float rounding. */
+	const double oct_bound = 3.0 * sqrt(2.0) / 2.0 / 32767.0 + 1e-6;
+	for (uint32_t v = 0; v < t->V; v++) {
+		for (int a = 0; a < 3; a++)
+			if (fabs(pt->positions[3 * v + a] - t->pos[v][a]) > 0.5 * t->pos_scale[a] + 1e-6)
+				return snprintf(why, n, "vertex %u position %d: %g vs %g", v, a, pt->positions[3 * v + a],
+				                t->pos[v][a]), 0;
+		if (t->flags & MLOD_PART_NORMALS) {
+			double ang = angle3(pt->normals + 3 * v, t->nrm[v]);
+			if (ang > oct_bound)
+				return snprintf(why, n, "vertex %u normal off by %g rad", v, ang), 0;
+		} else if (pt->normals) {
+			return snprintf(why, n, "normals without the flag"), 0;
+		}
+		if (t->flags & MLOD_PART_TANGENTS) {
+			const float *d = pt->tangents + 4 * v;
+			double ang = angle3(d, t->tan[v]);
+			if (ang > oct_bound || d[3] != t->tan[v][3])
+				return snprintf(why, n, "vertex %u tangent off by %g rad, w %g", v, ang, d[3]), 0;
+		}
+		for (uint32_t s = 0; s < t->uv_sets; s++)
+			for (int a = 0; a < 2; a++)
+				if (fabs(pt->uvs[s][2 * v + a] - t->uv[s][v][a]) > 0.5 * t->uv_scale[s][a] + 1e-6)
+					return snprintf(why, n, "vertex %u uv %u", v, s), 0;
+		if (t->flags & MLOD_PART_COLORS)
+			for (int a = 0; a < 4; a++)
+				if (pt->colors[4 * v + a] != t->col[v][a])
+					return snprintf(why, n, "vertex %u colour", v), 0;
+		if (t->flags & MLOD_PART_SKINNED) {
+			float sum = 0;
+			for (int a = 0; a < 4; a++) {
+				if (pt->joints[4 * v + a] != t->jnt[v][a])
+					return snprintf(why, n, "vertex %u joint %d", v, a), 0;
+				if (pt->weights[4 * v + a] != t->wq[v][a] / 255.0f)
+					return snprintf(why, n, "vertex %u weight %d", v, a), 0;
+				/* Largest remainder: within 3/4 of a step of the input. */
+				if (fabs(pt->weights[4 * v + a] - t->wgt[v][a]) > 0.75 / 255 + 1e-6)
+					return snprintf(why, n, "vertex %u weight %d off the input", v, a), 0;
+				sum += pt->weights[4 * v + a];
+			}
+			if (fabsf(sum - 1) > 1e-5f)
+				return snprintf(why, n, "vertex %u weights sum to %g", v, sum), 0;
+		}
+		for (uint32_t k = 0; k < t->T; k++)
+			for (int a = 0; a < 3; a++)
+				if (fabs(pt->targets[k][3 * v + a] - t->morph[v][a]) > 0.5 * t->mscale + 1e-7)
+					return snprintf(why, n, "vertex %u morph %u", v, k), 0;
+	}
+	/* The index codec keeps the triangles' order and winding but may
+	 * rotate each triangle's corners. */
+	for (uint32_t k = 0; k < t->I; k += 3) {
+		const uint32_t *a = pt->indices + k, *e = t->idx + k;
+		int same = 0;
+		for (int r = 0; r < 3; r++)
+			same |= a[0] == e[r] && a[1] == e[(r + 1) % 3] && a[2] == e[(r + 2) % 3];
+		if (!same)
+			return snprintf(why, n, "triangle %u: %u %u %u vs %u %u %u", k / 3, a[0], a[1], a[2], e[0], e[1], e[2]),
+			       0;
+	}
+	return 1;
+}
+
+TEST(decode_mesh_meshopt_and_raw)
+{
+	buf b = make_pack(0);
+	mlod_pack p = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_mesh m0 = {0}, m1 = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &s, &terr));
+	CHECK_OK(mlod_pack_decode_mesh(&p, C_MESH0, b.p, b.n, &s, &m0, &terr));
+	CHECK_OK(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &s, &m1, &terr));
+	char why[256] = "";
+	int ok = m0.part_count == 2 && m1.part_count == 1 && check_part(&m0.parts[0], &parts_truth[0], why, sizeof why) &&
+	         check_part(&m0.parts[1], &parts_truth[1], why, sizeof why) &&
+	         check_part(&m1.parts[0], &parts_truth[2], why, sizeof why) && m0.parts[1].rec.instance == 1 &&
+	         m0.parts[1].normals == NULL && m0.parts[1].uvs[0] == NULL && m0.parts[1].targets == NULL;
+	mlod_pack_mesh_free(&m0);
+	mlod_pack_mesh_free(&m1);
+	mlod_pack_mesh_free(&m1); /* twice: the struct is zeroed */
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK_MSG(ok, "%s", why);
+}
+
+TEST(decode_motion)
+{
+	buf b = make_pack(0);
+	mlod_pack p = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_motion m = {0}, m1 = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &s, &terr));
+	CHECK_OK(mlod_pack_decode_motion(&p, C_MOT0, b.p, b.n, &s, &m, &terr));
+	CHECK_OK(mlod_pack_decode_motion(&p, C_MOT1, b.p, b.n, &s, &m1, &terr));
+	int ok = m.channel_count == 4 && m.duration == time_truth[NK - 1] && m1.duration == 1.0f &&
+	         m1.channels[0].values[5] == 5.0f;
+	for (int k = 0; ok && k < NK; k++) {
+		ok = m.channels[1].times[k] == time_truth[k];
+		for (int a = 0; ok && a < 3; a++)
+			ok = m.channels[0].values[3 * k + a] == vec_truth[k][a] && m.channels[3].values[3 * k + a] == vec_truth[k][a];
+		for (int a = 0; ok && a < 4; a++)
+			ok = m.channels[1].values[4 * k + a] == rotq_truth[k][a] / 32767.0f &&
+			     fabsf(m.channels[1].values[4 * k + a] - rot_truth[k][a]) <= 0.5f / 32767 + 1e-7f;
+	}
+	for (int k = 0; ok && k < 3 * NK; k++)
+		for (int a = 0; ok && a < 4; a++)
+			ok = m.channels[2].values[4 * k + a] == rot_truth[k][a];
+	ok = ok && m.channels[2].rec.interp == 2 && m.channels[3].rec.path == 2;
+	mlod_pack_motion_free(&m);
+	mlod_pack_motion_free(&m1);
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK(ok);
+}
+
+TEST(doc_points_into_the_data)
+{
+	buf b = make_pack(0);
+	mlod_pack p = {0};
+	const void *glb = NULL;
+	size_t gs = 0;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_doc(&p, b.p, b.n, &glb, &gs, &terr));
+	size_t at = (size_t)((const uint8_t *)glb - b.p);
+	int ok = gs == 32 && memcmp(glb, "glTF\x02", 5) == 0 && at > 0 && at + gs <= b.n;
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK(ok);
+}
+
+TEST(free_accepts_zeroed)
+{
+	mlod_pack p = {0};
+	mlod_pack_info i = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_skel_level l = {0};
+	mlod_pack_mesh m = {0};
+	mlod_pack_motion a = {0};
+	mlod_pack_close(&p);
+	mlod_pack_info_free(&i);
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_skel_level_free(&l);
+	mlod_pack_mesh_free(&m);
+	mlod_pack_motion_free(&a);
+	mlod_pack_close(NULL);
+	mlod_pack_mesh_free(NULL);
+	CHECK(1);
+}
+
+TEST(unknown_chunks_are_skipped)
+{
+	buf b = make_pack(1);
+	mlod_pack p = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	int unknown = p.chunk_count == C_COUNT + 1 && p.chunks[1].type == MLOD_FOURCC('X', 'T', 'R', 'A');
+	int mesh = mlod_pack_find(&p, MLOD_CHUNK_MESH, 0, 0);
+	mlod_pack_close(&p);
+	int bad = 0;
+	int ok = decode_all(b.p, b.n, NULL, &bad);
+	free(b.p);
+	CHECK(unknown);
+	CHECK(mesh == C_MESH0 + 1);
+	/* INFO, SKELETON, the skeleton level, 2 meshes, 2 motions, DOC. */
+	CHECK_MSG(ok == 8 && !bad, "%d chunks decoded, bad %d", ok, bad);
+}
+
+TEST(newer_major_is_refused)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, 2, 0);
+	buf m = build_pack(c, n, 1, 7); /* a newer minor reads */
+	free_chunks(c, n);
+	mlod_pack p = {0};
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_open(b.p, b.n, &p, &terr);
+	char msg[sizeof terr.message];
+	memcpy(msg, terr.message, sizeof msg);
+	mlod_result r2 = mlod_pack_open(m.p, m.n, &p, &terr);
+	int minor = p.minor;
+	mlod_pack_close(&p);
+	free(b.p);
+	free(m.p);
+	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
+	CHECK_MSG(strcmp(msg, "pack format 2.0 is newer than this reader's 1.x") == 0, "message: %s", msg);
+	CHECK(r2 == MLOD_OK && minor == 7);
+}
+
+TEST(draco_chunks_are_unsupported)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	c[C_MESH1].codec = MLOD_CODEC_DRACO;
+	buf b = build_pack(c, n, 1, 0);
+	free_chunks(c, n);
+	mlod_pack p = {0};
+	mlod_pack_mesh m = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, NULL, &m, &terr);
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK(r == MLOD_ERR_UNSUPPORTED);
+	CHECK_MSG(strcmp(terr.message, "MESH level 1: Draco chunks need the Draco decoder, not built in") == 0, "%s",
+	          terr.message);
+}
+
+/* A prefix of the pack: open fails until the TOC is in, and then each chunk
+ * decodes exactly when its end lies inside the prefix. */
+TEST(every_prefix)
+{
+	buf b = make_pack(0);
+	mlod_pack full = {0};
+	mlod_pack_skeleton skel = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &full, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&full, b.p, b.n, &skel, &terr));
+	size_t toc_end = 32 + 48 * (size_t)full.chunk_count;
+	char why[800] = "";
+	for (size_t len = 0; len < b.n && !why[0]; len++) {
+		/* A copy of exactly len bytes, so that ASan sees any read past it. */
+		uint8_t *d = malloc(len ? len : 1);
+		memcpy(d, b.p, len);
+		mlod_pack p;
+		mlod_error e = {0};
+		mlod_result r = mlod_pack_open(d, len, &p, &e);
+		if ((r == MLOD_OK) != (len >= toc_end) || (r != MLOD_OK && !e.message[0])) {
+			snprintf(why, sizeof why, "prefix %zu: open returned %d: %s", len, (int)r, e.message);
+		} else if (r == MLOD_OK) {
+			int bad = 0;
+			int got = decode_all(d, len, &skel, &bad);
+			int want = 0;
+			for (uint32_t i = 0; i < full.chunk_count; i++)
+				if (full.chunks[i].offset + full.chunks[i].stored_size <= len)
+					want++;
+			if (got != want || bad)
+				snprintf(why, sizeof why, "prefix %zu: %d chunks decoded, expected %d (bad %d)", len, got, want,
+				         bad);
+			mlod_pack_close(&p);
+		}
+		free(d);
+	}
+	mlod_pack_skeleton_free(&skel);
+	mlod_pack_close(&full);
+	free(b.p);
+	CHECK_MSG(!why[0], "%s", why);
+}
+
+/* Random mutations, plain (the CRCs catch them) and with every CRC
+ * re-stamped (the structural checks must). Nothing may crash or read out
+ * of bounds (the sanitize build runs this too), and whatever decodes keeps
+ * the reader's guarantees. */
+static void mutate(uint8_t *d, size_t n)
+{
+	int kind = (int)(rnd() % 6);
+	int times = kind == 0 ? 1 : 1 + (int)(rnd() % 8);
+	for (int t = 0; t < times; t++) {
+		size_t at = rnd() % n;
+		switch (kind) {
+		case 0:
+		case 1: d[at] ^= (uint8_t)(1u << (rnd() % 8)); break;
+		case 2: d[at] = (uint8_t)rnd(); break;
+		case 3: d[at] = (rnd() & 1) ? 0xff : 0; break;
+		case 4: /* a 32-bit field around here to an edge value */
+		{
+			static const uint32_t edges[] = {0, 1, 2, 3, 4, 255, 256, 0x7fffffffu, 0x80000000u, 0xffffffffu,
+			                                 0xfffffffeu, 65535, 65536};
+			at &= ~(size_t)3;
+			if (at + 4 <= n)
+				wr32(d + at, edges[rnd() % (sizeof edges / sizeof *edges)]);
+			break;
+		}
+		default: /* a small int32 nudge */
+			at &= ~(size_t)3;
+			if (at + 4 <= n)
+				wr32(d + at, get32(d + at) + (uint32_t)((int)(rnd() % 5) - 2));
+			break;
+		}
+	}
+}
+
+static void run_mutations(int restamped, int iterations, int *opened, int *decoded, int *bad_out, char *why,
+                          size_t whysize)
+{
+	buf b = make_pack(0);
+	uint8_t *d = malloc(b.n);
+	for (int it = 0; it < iterations; it++) {
+		memcpy(d, b.p, b.n);
+		mutate(d, b.n);
+		if (restamped)
+			restamp(d, b.n);
+		int bad = 0;
+		int got = decode_all(d, b.n, NULL, &bad);
+		if (got >= 0)
+			(*opened)++;
+		if (got > 0)
+			*decoded += got;
+		if (bad && !*bad_out) {
+			*bad_out = 1;
+			snprintf(why, whysize, "iteration %d: a decode broke a guarantee or failed without a message", it);
+		}
+	}
+	free(d);
+	free(b.p);
+}
+
+TEST(mutations_plain)
+{
+	rng_state = 12345;
+	int opened = 0, decoded = 0, bad = 0;
+	char why[200] = "";
+	run_mutations(0, 10000, &opened, &decoded, &bad, why, sizeof why);
+	CHECK_MSG(!bad, "%s", why);
+	/* Mutations in the chunks leave the header and TOC intact. */
+	CHECK_MSG(opened > 1000, "only %d of 10000 opened", opened);
+}
+
+TEST(mutations_restamped)
+{
+	rng_state = 67890;
+	int opened = 0, decoded = 0, bad = 0;
+	char why[200] = "";
+	run_mutations(1, 10000, &opened, &decoded, &bad, why, sizeof why);
+	CHECK_MSG(!bad, "%s", why);
+	CHECK_MSG(opened > 3000 && decoded > 10000, "%d opened, %d chunks decoded", opened, decoded);
+}
+
+/* A pack with one change to the character, for the targeted checks. */
+typedef void (*edit_fn)(wchunk *c);
+static buf edited_pack(edit_fn edit)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	edit(c);
+	buf b = build_pack(c, n, 1, 0);
+	free_chunks(c, n);
+	return b;
+}
+
+static uint8_t *stream_data(wchunk *c, int chunk, uint32_t tag, int nth)
+{
+	for (int i = 0; i < c[chunk].ns; i++)
+		if (c[chunk].s[i].tag == tag && nth-- == 0)
+			return c[chunk].s[i].data.p;
+	return NULL;
+}
+
+static void e_index(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_IDX, 0) + 4 * 7, NV0 + 3); }
+static void e_parent(wchunk *c) { wr32(stream_data(c, C_SKEL, MLOD_STREAM_JNTS, 0) + 116 * 2, 3); }
+static void e_palj(wchunk *c) { wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALJ, 0) + 4 * 3, 2); }
+static void e_weights(wchunk *c) { stream_data(c, C_MESH1, MLOD_STREAM_WGT8, 0)[4 * 5] ^= 1; }
+static void e_skin_joint(wchunk *c) { stream_data(c, C_MESH1, MLOD_STREAM_JNT8, 0)[4 * 2 + 1] = NJ; }
+static void e_uv_sets(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 40, 5); }
+static void e_stream_order(wchunk *c)
+{
+	wstream t = c[C_MESH1].s[2];
+	c[C_MESH1].s[2] = c[C_MESH1].s[3];
+	c[C_MESH1].s[3] = t;
+}
+static void e_vertex_count(wchunk *c) { c[C_MESH1].s[2].count--, c[C_MESH1].s[2].data.n -= 4; }
+static void e_nan(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_VEC3, 0) + 8, 0x7fc00000u); }
+static void e_time(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_TIME, 0) + 4, 0); }
+static void e_chan_joint(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0), NJ); }
+static void e_kept_root(wchunk *c)
+{
+	wr32(stream_data(c, C_SKEL1, MLOD_STREAM_KEPT, 0), 1);
+	wr32(stream_data(c, C_SKEL1, MLOD_STREAM_KEPT, 0) + 4, 2);
+}
+static void e_skjt(wchunk *c) { wr32(stream_data(c, C_SKEL, MLOD_STREAM_SKJT, 0) + 4, 99); }
+static void e_vertex_elsize(wchunk *c)
+{
+	/* A meshopt vertex stream of 6-byte elements. */
+	wstream *s = &c[C_MESH0].s[1];
+	s->codec = MLOD_SCODEC_RAW;
+	s->elsize = 6;
+	s->count = (uint32_t)(s->data.n / 6);
+	s->data.n = (size_t)s->count * 6;
+	c[C_MESH0].codec = MLOD_CODEC_MESHOPT;
+}
+static void e_info_levels(wchunk *c) { wr32(stream_data(c, C_INFO, MLOD_STREAM_INFO, 0) + 8, 1); }
+static void e_clip_names(wchunk *c) { c[C_INFO].s[1].count = 5, c[C_INFO].s[1].data.n = 5; }
+static void e_extra_stream(wchunk *c)
+{
+	wstream *s = add_stream(&c[C_MOT1], MLOD_STREAM_TIME, 4, MLOD_SCODEC_RAW);
+	s->count = 1;
+	putf(&s->data, 2.0f);
+}
+static void e_dup_channel(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 16 * 2, 1); }
+static void e_missing_rotation(wchunk *c)
+{
+	wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1);
+	wchunk_free_stream(&c[C_MOT1], 2);
+}
+static void e_morph_scale(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_MTSC, 0), 0xbf800000u); }
+static void e_no_skin(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 16, 0xffffffffu); }
+static void e_rotq_cubic(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 16 + 8, 2); }
+static void e_part_flags(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x48); }
+
+TEST(structural_checks_name_the_chunk)
+{
+	struct {
+		edit_fn edit;
+		int chunk;
+		mlod_result code;
+		const char *text;
+	} cases[] = {
+		{e_index, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: index 43 >= vertex count 40 (at position 7)"},
+		{e_parent, C_SKEL, MLOD_ERR_PARSE, "SKELETON: joint 2: parent 3 is not -1 or an earlier joint"},
+		{e_palj, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: palette entry 3 (skin 0 joint 3): joint 2 is not a kept joint"},
+		{e_weights, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: vertex 5: weights sum to"},
+		{e_skin_joint, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: vertex 2: joint 4 is not below skin 0's 4 joints"},
+		{e_uv_sets, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: 5 UV sets, more than 4"},
+		{e_stream_order, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: stream 2 is 'UVQ0', expected 'NRMQ'"},
+		{e_vertex_count, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: stream 2 'NRMQ' has 11 elements, expected 12 (vertex count)"},
+		{e_nan, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: a translation value is not finite"},
+		{e_time, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: key 1: time 0 is not after 0"},
+		{e_chan_joint, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: joint 4 is not below the skeleton's 4 joints"},
+		{e_kept_root, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: root joint 0 is not kept"},
+		{e_skjt, C_SKEL, MLOD_ERR_PARSE, "SKELETON: skin 0: joint 1 is 99, not below the joint count 4"},
+		{e_vertex_elsize, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: stream 1 'POSQ' has elements of 6 bytes, expected 8"},
+		{e_info_levels, C_INFO, MLOD_ERR_PARSE, "INFO: the TOC has SKELETON level 1, but INFO counts"},
+		{e_clip_names, C_INFO, MLOD_ERR_PARSE, "INFO: the string table 'NAME' ends before clip 0's name"},
+		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 3 'TIME')"},
+		{e_dup_channel, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 2: a second rotation channel of joint 1"},
+		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: missing its rotation stream"},
+		{e_morph_scale, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: morph target 0: scale -1 is not finite and >= 0"},
+		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
+		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: stream 4 is 'ROTQ', expected 'ROTF'"},
+		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x40"},
+	};
+	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+		buf b = edited_pack(cases[k].edit);
+		/* The edited chunk may be shorter now: rebuilt, the TOC fits. */
+		mlod_pack p = {0};
+		mlod_pack_skeleton s = {0};
+		/* The unedited skeleton, from a clean pack. */
+		buf clean = make_pack(0);
+		mlod_pack cp = {0};
+		mlod_error e = {0};
+		mlod_result r = mlod_pack_open(clean.p, clean.n, &cp, &e);
+		if (r == MLOD_OK)
+			r = mlod_pack_decode_skeleton(&cp, clean.p, clean.n, &s, &e);
+		mlod_pack_close(&cp);
+		free(clean.p);
+		if (r == MLOD_OK)
+			r = mlod_pack_open(b.p, b.n, &p, &e);
+		if (r == MLOD_OK) {
+			memset(&e, 0, sizeof e);
+			uint32_t i = (uint32_t)cases[k].chunk;
+			if (i == C_INFO) {
+				mlod_pack_info x;
+				r = mlod_pack_decode_info(&p, b.p, b.n, &x, &e);
+				mlod_pack_info_free(&x);
+			} else if (i == C_SKEL) {
+				mlod_pack_skeleton x;
+				r = mlod_pack_decode_skeleton(&p, b.p, b.n, &x, &e);
+				mlod_pack_skeleton_free(&x);
+			} else if (i == C_SKEL1) {
+				mlod_pack_skel_level x;
+				r = mlod_pack_decode_skel_level(&p, i, b.p, b.n, &s, &x, &e);
+				mlod_pack_skel_level_free(&x);
+			} else if (i == C_MESH0 || i == C_MESH1) {
+				mlod_pack_mesh x;
+				r = mlod_pack_decode_mesh(&p, i, b.p, b.n, &s, &x, &e);
+				mlod_pack_mesh_free(&x);
+			} else {
+				mlod_pack_motion x;
+				r = mlod_pack_decode_motion(&p, i, b.p, b.n, &s, &x, &e);
+				mlod_pack_motion_free(&x);
+			}
+		}
+		mlod_pack_close(&p);
+		mlod_pack_skeleton_free(&s);
+		free(b.p);
+		CHECK_MSG(r == cases[k].code, "case %zu: returned %d: %s", k, (int)r, e.message);
+		CHECK_MSG(strstr(e.message, cases[k].text) != NULL, "case %zu: \"%s\" lacks \"%s\"", k, e.message,
+		          cases[k].text);
+	}
+}
+
+/* TOC and header damage, each with the CRCs re-stamped. */
+TEST(toc_checks)
+{
+	buf b = make_pack(0);
+	uint8_t *d = malloc(b.n);
+	mlod_pack p;
+	uint8_t *mesh1 = d + 32 + 48 * C_MESH1;
+#define DAMAGE(stmt, code, text)                                                                                \
+	do {                                                                                                    \
+		memcpy(d, b.p, b.n);                                                                            \
+		stmt;                                                                                           \
+		restamp(d, b.n);                                                                                \
+		CHECK_ERR(mlod_pack_open(d, b.n, &p, &terr), code, text);                                       \
+	} while (0)
+	DAMAGE(d[0] = 'X', MLOD_ERR_PARSE, "not an mlod pack");
+	DAMAGE(wr32(mesh1 + 16, get32(mesh1 + 16) + 4), MLOD_ERR_PARSE, "TOC entry 3 (MESH level 1): offset");
+	DAMAGE(wr32(mesh1 + 16, get32(mesh1 + 16) - 16), MLOD_ERR_PARSE, "overlaps the previous chunk");
+	DAMAGE(wr32(d + 16, get32(d + 16) + 16), MLOD_ERR_PARSE, "pack header: file size");
+	DAMAGE(wr32(d + 16, 40), MLOD_ERR_PARSE, "is less than the header and TOC");
+	DAMAGE(wr32(d + 12, 70000), MLOD_ERR_PARSE, "70000 chunks, more than the format's 65536");
+	DAMAGE(wr32(d + 12, 60000), MLOD_ERR_PARSE, "truncated pack: the TOC of 60000 chunks");
+	DAMAGE(wr32(mesh1 + 24, 0x7fffffff), MLOD_ERR_PARSE, "lie outside the file");
+	DAMAGE(mesh1[4] = MLOD_LAYER_MOTION, MLOD_ERR_PARSE, "TOC entry 3 (MESH level 1): layer 3, expected 2 (mesh)");
+	DAMAGE(mesh1[6] = 0, MLOD_ERR_PARSE, "TOC entry 4 (MOTION level 1 of clip 0) is out of order");
+	DAMAGE((wr32(d + 32 + 48 * C_MOT0, MLOD_CHUNK_MESH), d[32 + 48 * C_MOT0 + 4] = MLOD_LAYER_MESH), MLOD_ERR_PARSE,
+	       "TOC entry 6 (MESH level 0): a second chunk of that type, level and item");
+	DAMAGE(wr32(d + 32 + 48 * C_MOT1 + 36, 0xff800000u), MLOD_ERR_PARSE, "must be finite");
+	DAMAGE(d[32 + 48 * C_SKEL1 + 8] = 1, MLOD_ERR_PARSE, "TOC entry 2 (SKELETON level 1): item 1, expected 0");
+	DAMAGE(d[32 + 48 * C_DOC + 6] = 1, MLOD_ERR_PARSE, "TOC entry 7 (DOC): level 1, expected 0");
+	/* DOC before the levels. */
+	DAMAGE(wr32(d + 32 + 48 * C_MOT0, MLOD_CHUNK_DOC), MLOD_ERR_PARSE, "layer 3, expected 0");
+	/* Unstamped damage: the CRCs. */
+	memcpy(d, b.p, b.n);
+	d[33] ^= 1;
+	CHECK_ERR(mlod_pack_open(d, b.n, &p, &terr), MLOD_ERR_PARSE, "pack TOC: CRC mismatch");
+	memcpy(d, b.p, b.n);
+	d[9] ^= 1;
+	CHECK_ERR(mlod_pack_open(d, b.n, &p, &terr), MLOD_ERR_PARSE, "pack header: CRC mismatch");
+	memcpy(d, b.p, b.n);
+	d[b.n - 1] ^= 1;
+	CHECK_OK(mlod_pack_open(d, b.n, &p, &terr));
+	const void *g;
+	size_t gs;
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_doc(&p, d, b.n, &g, &gs, &terr);
+	mlod_pack_close(&p);
+	free(d);
+	free(b.p);
+	CHECK(r == MLOD_ERR_PARSE && strstr(terr.message, "DOC: CRC mismatch") != NULL);
+#undef DAMAGE
+}
+
+/* A chunk whose headers claim huge streams fails before allocating them. */
+TEST(absurd_sizes)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	/* A meshopt stream of 16 M part records (3.4 GB decoded, raw size
+	 * consistent): NOMEM before any allocation. */
+	wchunk *m = &c[C_MESH0];
+	for (int i = 0; i < m->ns; i++)
+		free(m->s[i].data.p);
+	m->ns = 0;
+	wstream *s = add_stream(m, MLOD_STREAM_PART, 200, MLOD_SCODEC_MESHOPT_VERTEX);
+	s->count = 0;
+	buf b = build_pack(c, n, 1, 0);
+	/* Patch the stream header and the raw size in place. */
+	mlod_pack p;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	uint8_t *ch = b.p + p.chunks[C_MESH0].offset;
+	mlod_pack_close(&p);
+	wr32(ch + 4 + 4, 0x01000000u);
+	uint64_t raw = 4 + 16 + (uint64_t)0x01000000 * 200;
+	wr32(b.p + 32 + 48 * C_MESH0 + 28, (uint32_t)raw);
+	restamp(b.p, b.n);
+	mlod_pack_mesh mesh;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	memset(&terr, 0, sizeof terr);
+	mlod_result r1 = mlod_pack_decode_mesh(&p, C_MESH0, b.p, b.n, NULL, &mesh, &terr);
+	char m1[sizeof terr.message];
+	memcpy(m1, terr.message, sizeof m1);
+	/* The same with a raw size that does not match: PARSE. */
+	wr32(b.p + 32 + 48 * C_MESH0 + 28, 1000);
+	restamp(b.p, b.n);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	memset(&terr, 0, sizeof terr);
+	mlod_result r2 = mlod_pack_decode_mesh(&p, C_MESH0, b.p, b.n, NULL, &mesh, &terr);
+	mlod_pack_close(&p);
+	free(b.p);
+	free_chunks(c, n);
+	CHECK_MSG(r1 == MLOD_ERR_NOMEM && strstr(m1, "MESH level 0:"), "returned %d: %s", (int)r1, m1);
+	CHECK_MSG(r2 == MLOD_ERR_PARSE && strstr(terr.message, "raw size 1000 in the TOC"), "returned %d: %s", (int)r2,
+	          terr.message);
+}
+
+/* The meshopt codecs' constraints, and a damaged meshopt stream. */
+TEST(meshopt_streams)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	c[C_MESH1].codec = MLOD_CODEC_MESHOPT;
+	c[C_MESH1].s[0].codec = MLOD_SCODEC_MESHOPT_VERTEX;
+	buf b = build_pack(c, n, 1, 0);
+	free_chunks(c, n);
+	mlod_pack p;
+	mlod_pack_mesh m;
+	mlod_pack_skeleton sk;
+	char why[256] = "";
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &sk, &terr));
+	CHECK_OK(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &m, &terr));
+	int ok = check_part(&m.parts[0], &parts_truth[2], why, sizeof why);
+	mlod_pack_mesh_free(&m);
+	mlod_pack_skeleton_free(&sk);
+	CHECK_MSG(ok, "%s", why);
+	uint8_t *ch = b.p + p.chunks[C_MESH1].offset;
+	uint32_t ns = get32(ch);
+	uint8_t *h0 = ch + 4;
+	uint8_t save[16];
+	memcpy(save, h0, 16);
+	/* Element size 200 -> 202: not a multiple of 4. */
+	h0[8] = 202;
+	restamp(b.p, b.n);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, NULL, &m, &terr), MLOD_ERR_PARSE,
+	          "stream 0 'PART': the meshopt vertex codec needs an element size that is a multiple of 4");
+	memcpy(h0, save, 16);
+	/* The index codec on the part records. */
+	h0[10] = MLOD_SCODEC_MESHOPT_INDEX;
+	restamp(b.p, b.n);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, NULL, &m, &terr), MLOD_ERR_PARSE,
+	          "the meshopt index codec needs an element size of 2 or 4");
+	memcpy(h0, save, 16);
+	/* Damaged encoded bytes: the decoder's return code. */
+	uint8_t *data = ch + 4 + 16 * ns;
+	uint8_t first = data[0];
+	data[0] = 0x00;
+	restamp(b.p, b.n);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, NULL, &m, &terr), MLOD_ERR_PARSE,
+	          "MESH level 1: stream 0 'PART': the meshopt vertex codec failed");
+	data[0] = first;
+	restamp(b.p, b.n);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	/* Skinned part without a skeleton. */
+	CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, NULL, &m, &terr), MLOD_ERR_PARSE,
+	          "MESH level 1: part 0: skin 0 is not -1 or below the skeleton's 0 skins");
+	mlod_pack_close(&p);
+	free(b.p);
+}
+
+/* test_pack_reader --write-seed FILE writes the test character's pack
+ * (make fuzz starts its corpus with it). */
+int main(int argc, char **argv)
+{
+	if (argc == 3 && strcmp(argv[1], "--write-seed") == 0) {
+		buf b = make_pack(0);
+		FILE *f = fopen(argv[2], "wb");
+		int ok = f && fwrite(b.p, 1, b.n, f) == b.n;
+		if (f && fclose(f) != 0)
+			ok = 0;
+		free(b.p);
+		if (!ok)
+			fprintf(stderr, "test_pack_reader: cannot write %s\n", argv[2]);
+		return ok ? 0 : 1;
+	}
+	RUN(crc_known_vectors);
+	RUN(open_reads_header_and_toc);
+	RUN(names);
+	RUN(decode_info);
+	RUN(decode_skeleton_and_level);
+	RUN(decode_mesh_meshopt_and_raw);
+	RUN(decode_motion);
+	RUN(doc_points_into_the_data);
+	RUN(free_accepts_zeroed);
+	RUN(unknown_chunks_are_skipped);
+	RUN(newer_major_is_refused);
+	RUN(draco_chunks_are_unsupported);
+	RUN(every_prefix);
+	RUN(structural_checks_name_the_chunk);
+	RUN(toc_checks);
+	RUN(absurd_sizes);
+	RUN(meshopt_streams);
+	RUN(mutations_plain);
+	RUN(mutations_restamped);
+	return test_total_fail_ ? 1 : 0;
+}
