@@ -433,13 +433,50 @@ int main(int argc, char **argv)
 		L[l] = mlod_rt_level_count(c.ctx, (mlod_rt_layer)l);
 	mlod_rt_stats st;
 	mlod_rt_stats_get(c.ctx, &st);
-	printf("%s: %u joints, %u clips; levels: skeleton %u, mesh %u, motion %u; open %.1f ms, %zu bytes resident\n",
+	printf("%s: %u joints, %u clips; levels: skeleton %u, mesh %u, motion %u; open %.2f ms CPU, %zu bytes resident\n",
 	       path, mlod_rt_joint_count(c.ctx), clips, L[0], L[1], L[2], open_ms, st.resident_bytes);
 	printf("budget %s%zu, distances %g..%g, mode %s (alpha interval %g,%g), hysteresis %g, %g s at %g fps per "
 	       "measurement\n",
 	       budget ? "" : "none ", budget, near, far,
 	       mode == MLOD_RT_SELECT_ALPHA ? "alpha" : mode == MLOD_RT_SELECT_PIXELS ? "pixels" : "toc", ts, te, hyst,
 	       seconds, fps);
+	/* Open to the first frame (one instance, the coarse levels open gave),
+	 * then the decoding of every other level. */
+	{
+		uint32_t id, nv = 0;
+		float d = 0;
+		mlod_rt_select sel;
+		mlod_rt_select_default(&sel);
+		t0 = cpu_seconds();
+		if (mlod_rt_instance_create(c.ctx, 0, 0, 0, &id, &e) != MLOD_OK ||
+		    mlod_rt_update(c.ctx, &sel, &id, &d, 1, 0, &e) != MLOD_OK ||
+		    mlod_rt_skin(c.ctx, c.scratch, id, c.buf, 12, c.buf + 3 * (size_t)c.cap, 12, c.cap, &nv, &e) != MLOD_OK)
+			die(2, "%s", e.message);
+		double first_ms = open_ms + 1000 * (cpu_seconds() - t0);
+		mlod_rt_instance_destroy(c.ctx, id);
+		size_t before = st.resident_bytes;
+		uint64_t stored = 0;
+		for (int l = 0; l < MLOD_RT_LAYERS; l++)
+			for (uint32_t k = 0; k < L[l]; k++)
+				for (uint32_t item = 0; item < (l == MLOD_RT_MOTION ? clips : 1u); item++) {
+					mlod_rt_level_info li;
+					mlod_rt_level_info_get(c.ctx, (mlod_rt_layer)l, k, item, &li, NULL);
+					if (!li.resident && mlod_rt_request(c.ctx, (mlod_rt_layer)l, k, item, NULL) == MLOD_OK)
+						stored += li.stored_size;
+				}
+		uint32_t loaded = 0;
+		t0 = cpu_seconds();
+		r = mlod_rt_stream(c.ctx, SIZE_MAX, &loaded, &e);
+		double dec = cpu_seconds() - t0;
+		if (r != MLOD_OK)
+			fprintf(stderr, "%s: warning: %s\n", tool, e.message);
+		grow(&c);
+		mlod_rt_stats_get(c.ctx, &st);
+		printf("open to first frame (coarse levels, %u vertices): %.2f ms CPU; decoding the other %u levels: "
+		       "%llu stored bytes to %zu resident in %.2f ms CPU (%.0f MB/s stored)\n",
+		       nv, first_ms, loaded, (unsigned long long)stored, st.resident_bytes - before, 1000 * dec,
+		       dec > 0 ? (double)stored / dec / 1e6 : 0.0);
+	}
 	if (bench)
 		skin_bench(path);
 
