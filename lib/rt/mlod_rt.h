@@ -279,7 +279,8 @@ mlod_result mlod_rt_request(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t leve
 /* Loads wanted levels, decoding on the caller's thread, most wanted first
  * (ties: coarser first), until the stored bytes of the levels loaded in
  * this call reach byte_budget (a first level larger than byte_budget is
- * still loaded alone, so that every level can load; 0 loads nothing),
+ * still loaded alone, so that every level can load; 0 loads nothing;
+ * views have no stored size and count 1 byte each),
  * evicting as described above. Then re-resolves the instances (fallback
  * levels change to the better resident ones, and away from evicted ones).
  * *loaded (may be NULL) gets the number of levels loaded. Returns MLOD_OK,
