@@ -272,6 +272,25 @@ uint32_t mlod_rt_mesh_vertex_count(const mlod_rt_ctx *ctx, uint32_t level);
 uint32_t mlod_rt_max_vertex_count(const mlod_rt_ctx *ctx);
 void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out);
 
+/* A part of a resident mesh level, for drawing what mlod_rt_skin wrote:
+ * its vertices are first_vertex .. first_vertex + vertex_count - 1 of the
+ * skinned output, its triangles index_count indices local to the part
+ * (add first_vertex), pointing into the resident level: valid until that
+ * level is evicted (mlod_rt_stream) or the context closes. */
+typedef struct mlod_rt_part_info {
+	uint32_t first_vertex, vertex_count;
+	uint32_t index_count;
+	const uint32_t *indices;
+	int32_t material;     /* the input's glTF material, or -1 */
+	int32_t skin, joint;  /* skinned, rigid (joint >= 0) or static */
+} mlod_rt_part_info;
+
+/* Parts of a mesh level when resident, else 0. */
+uint32_t mlod_rt_mesh_part_count(const mlod_rt_ctx *ctx, uint32_t level);
+/* MLOD_ERR_INVALID_ARG for a level not resident or a part out of range. */
+mlod_result mlod_rt_mesh_part(const mlod_rt_ctx *ctx, uint32_t level, uint32_t part, mlod_rt_part_info *out,
+                              mlod_error *err);
+
 /* Asks for a level as if an instance wanted it at the last update (until
  * the next update). No decoding here. */
 mlod_result mlod_rt_request(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item, mlod_error *err);

@@ -149,6 +149,12 @@ static mlod_result check_mesh(const mlod_rt_ctx *ctx, const mlod_pack_mesh *m, u
 					                 "mesh level %u part %u: vertex joint %u outside its skin of %u", level, i,
 					                 (unsigned)p->joints[k], sj);
 		}
+		if (p->rec.index_count % 3 || (p->rec.index_count && !p->indices))
+			return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u part %u: %u indices", level, i, p->rec.index_count);
+		for (uint32_t k = 0; k < p->rec.index_count; k++)
+			if (p->indices[k] >= n)
+				return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u part %u: index %u of %u vertices", level, i,
+				                 p->indices[k], n);
 		total += n;
 		if (total > UINT32_MAX / 2)
 			return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u: too many vertices", level);
@@ -644,6 +650,33 @@ uint32_t mlod_rt_mesh_vertex_count(const mlod_rt_ctx *ctx, uint32_t level)
 {
 	const rt_unit *u = ctx ? rt_unit_get(ctx, MLOD_RT_MESH, level, 0) : NULL;
 	return u && u->state == RT_UNIT_RESIDENT ? u->vertex_count : 0;
+}
+
+uint32_t mlod_rt_mesh_part_count(const mlod_rt_ctx *ctx, uint32_t level)
+{
+	const rt_unit *u = ctx ? rt_unit_get(ctx, MLOD_RT_MESH, level, 0) : NULL;
+	return u && u->state == RT_UNIT_RESIDENT ? u->mesh->part_count : 0;
+}
+
+mlod_result mlod_rt_mesh_part(const mlod_rt_ctx *ctx, uint32_t level, uint32_t part, mlod_rt_part_info *out,
+                              mlod_error *err)
+{
+	const rt_unit *u = ctx && out ? rt_unit_get(ctx, MLOD_RT_MESH, level, 0) : NULL;
+	if (!u || u->state != RT_UNIT_RESIDENT || part >= u->mesh->part_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mesh level %u part %u: not resident or out of range", level,
+		                 part);
+	uint32_t first = 0;
+	for (uint32_t i = 0; i < part; i++)
+		first += u->mesh->parts[i].rec.vertex_count;
+	const mlod_pack_part *p = &u->mesh->parts[part];
+	out->first_vertex = first;
+	out->vertex_count = p->rec.vertex_count;
+	out->index_count = p->indices ? p->rec.index_count : 0;
+	out->indices = p->indices;
+	out->material = p->rec.material;
+	out->skin = p->rec.skin;
+	out->joint = p->rec.joint;
+	return MLOD_OK;
 }
 
 void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out)

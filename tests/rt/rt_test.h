@@ -140,7 +140,7 @@ static inline void fx_part(mlod_pack_part *p, float *pos, float *nrm, uint16_t *
 {
 	memset(p, 0, sizeof *p);
 	p->rec.vertex_count = n;
-	p->rec.index_count = 3;
+	p->rec.index_count = n >= 3 ? 3 : 0;
 	p->rec.skin = skin;
 	p->rec.joint = joint;
 	p->rec.node = -1;

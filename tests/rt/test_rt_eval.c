@@ -249,6 +249,15 @@ TEST(skin_hand_lbs)
 	CHECK_OK(mlod_rt_skin(ctx, s, id, buf, 12, NULL, 0, 7, &n, &e), e);
 	CHECK(fx_maxdiff(buf + 12, (const float[]){ 2.0f, 2.0f, 2.0f }, 3) <= 1e-5, "rigid on stand-in: %g %g %g",
 	      buf[12], buf[13], buf[14]);
+	/* The parts, for drawing: vertex ranges and local indices. */
+	CHECK(mlod_rt_mesh_part_count(ctx, 0) == 3 && mlod_rt_mesh_part_count(ctx, 2) == 1, "part counts");
+	mlod_rt_part_info pi;
+	CHECK_OK(mlod_rt_mesh_part(ctx, 0, 1, &pi, &e), e);
+	CHECK(pi.first_vertex == 4 && pi.vertex_count == 2 && pi.joint == 4 && pi.skin == -1 && pi.index_count == 0,
+	      "part 1: first %u count %u joint %d", pi.first_vertex, pi.vertex_count, pi.joint);
+	CHECK_OK(mlod_rt_mesh_part(ctx, 0, 0, &pi, &e), e);
+	CHECK(pi.first_vertex == 0 && pi.index_count == 3 && pi.indices[2] == 2 && pi.skin == 0, "part 0");
+	CHECK(mlod_rt_mesh_part(ctx, 0, 3, &pi, &e) == MLOD_ERR_INVALID_ARG, "part 3 of 3");
 	mlod_rt_instance_destroy(ctx, id);
 	mlod_rt_scratch_destroy(ctx, s);
 	mlod_rt_close(ctx);
