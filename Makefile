@@ -134,11 +134,14 @@ samples: all $(HELPERS)
 	@scripts/gen-sample $(B)
 
 install: all
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man5
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man3 $(DESTDIR)$(MANDIR)/man5
 	install -m 755 $(TOOLS) $(DESTDIR)$(PREFIX)/bin
-	install -m 644 $(B)/libmlod.a $(DESTDIR)$(PREFIX)/lib
+	install -m 644 $(B)/libmlod.a $(B)/libmlodrt.a $(DESTDIR)$(PREFIX)/lib
 	install -m 644 lib/mlod.h $(DESTDIR)$(PREFIX)/include
+	# the runtime's headers: mlod_rt.h includes mlod_pack.h and mlod_core.h
+	install -m 644 lib/rt/mlod_rt.h lib/rt/mlod_pack.h lib/core/mlod_core.h $(DESTDIR)$(PREFIX)/include
 	install -m 644 man/man1/*.1 $(DESTDIR)$(MANDIR)/man1
+	if ls man/man3/*.3 >/dev/null 2>&1; then install -m 644 man/man3/*.3 $(DESTDIR)$(MANDIR)/man3; fi
 	if ls man/man5/*.5 >/dev/null 2>&1; then install -m 644 man/man5/*.5 $(DESTDIR)$(MANDIR)/man5; fi
 
 clean:

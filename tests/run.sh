@@ -267,7 +267,7 @@ for src in tools/mlod-*.c; do
 		fail "man/$t" "$(echo "$msg" | head -n 3 | tr '\n' ' ')"
 	fi
 done
-for page in man/man5/*.5; do
+for page in man/man3/*.3 man/man5/*.5; do
 	[ -f "$page" ] || continue
 	if msg=$(mandoc -T lint -W warning "$page" 2>&1) && [ -z "$msg" ]; then
 		pass "man/$(basename "$page")"

@@ -151,6 +151,13 @@ static wstream *add_stream(wchunk *c, uint32_t tag, uint16_t elsize, uint8_t cod
 	s->codec = codec;
 	return s;
 }
+/* Drops stream i of a chunk. */
+static void wchunk_free_stream(wchunk *c, int i)
+{
+	free(c->s[i].data.p);
+	memmove(&c->s[i], &c->s[i + 1], sizeof(wstream) * (size_t)(c->ns - i - 1));
+	c->ns--;
+}
 static void wchunk_free(wchunk *c)
 {
 	for (int i = 0; i < c->ns; i++)
@@ -922,13 +929,15 @@ TEST(decode_skeleton_and_level)
 	mlod_pack_skel_level l2;
 	mlod_result r1 = mlod_pack_decode_skel_level(&p, C_SKEL, b.p, b.n, &s, &l2, &terr);
 	mlod_result r2 = mlod_pack_decode_skel_level(&p, C_MESH1, b.p, b.n, &s, &l2, &terr);
+	mlod_pack_mesh m2;
+	mlod_result r3 = mlod_pack_decode_mesh(&p, 99, b.p, b.n, &s, &m2, &terr);
 	mlod_pack_skel_level_free(&l);
 	mlod_pack_skeleton_free(&s);
 	mlod_pack_close(&p);
 	free(b.p);
 	CHECK(ok);
 	CHECK(lok);
-	CHECK(r1 == MLOD_ERR_INVALID_ARG && r2 == MLOD_ERR_INVALID_ARG);
+	CHECK(r1 == MLOD_ERR_INVALID_ARG && r2 == MLOD_ERR_INVALID_ARG && r3 == MLOD_ERR_INVALID_ARG);
 }
 
 /* The angle between two unit vectors (float), in double. */
@@ -1330,6 +1339,22 @@ static void e_vertex_elsize(wchunk *c)
 }
 static void e_info_levels(wchunk *c) { wr32(stream_data(c, C_INFO, MLOD_STREAM_INFO, 0) + 8, 1); }
 static void e_clip_names(wchunk *c) { c[C_INFO].s[1].count = 5, c[C_INFO].s[1].data.n = 5; }
+static void e_extra_stream(wchunk *c)
+{
+	wstream *s = add_stream(&c[C_MOT1], MLOD_STREAM_TIME, 4, MLOD_SCODEC_RAW);
+	s->count = 1;
+	putf(&s->data, 2.0f);
+}
+static void e_dup_channel(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 16 * 2, 1); }
+static void e_missing_rotation(wchunk *c)
+{
+	wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1);
+	wchunk_free_stream(&c[C_MOT1], 2);
+}
+static void e_morph_scale(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_MTSC, 0), 0xbf800000u); }
+static void e_no_skin(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 16, 0xffffffffu); }
+static void e_rotq_cubic(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 16 + 8, 2); }
+static void e_part_flags(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x48); }
 
 TEST(structural_checks_name_the_chunk)
 {
@@ -1355,6 +1380,13 @@ TEST(structural_checks_name_the_chunk)
 		{e_vertex_elsize, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: stream 1 'POSQ' has elements of 6 bytes, expected 8"},
 		{e_info_levels, C_INFO, MLOD_ERR_PARSE, "INFO: the TOC has SKELETON level 1, but INFO counts"},
 		{e_clip_names, C_INFO, MLOD_ERR_PARSE, "INFO: the string table 'NAME' ends before clip 0's name"},
+		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 3 'TIME')"},
+		{e_dup_channel, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 2: a second rotation channel of joint 1"},
+		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: missing its rotation stream"},
+		{e_morph_scale, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: morph target 0: scale -1 is not finite and >= 0"},
+		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
+		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: stream 4 is 'ROTQ', expected 'ROTF'"},
+		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x40"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
 		buf b = edited_pack(cases[k].edit);

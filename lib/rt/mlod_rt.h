@@ -1,0 +1,438 @@
+/*
+ * mlod_rt.h: the mlod runtime. Streams a .mlod pack (mlod(5)), picks
+ * skeleton, mesh and motion levels per character by distance, samples the
+ * motion, builds the pose and the skinning palette and linear-blend-skins
+ * the mesh level into the caller's buffers. C11; depends only on the core
+ * (mlod_core.h), the pack reader (mlod_pack.h) and meshoptimizer's decoder.
+ * It never prints or exits. See mlod_rt(3) and the pages it names.
+ *
+ * ------------------------------------------------------------------
+ * Objects and ownership
+ *
+ *   mlod_rt_ctx      one opened character (a pack, or decoded views the
+ *                    caller built): its levels, the resident-level cache
+ *                    and a pool of instances. Created by mlod_rt_open_*,
+ *                    released by mlod_rt_close (which releases everything
+ *                    the context allocated, including its instances).
+ *   instance         one character in the world, an id (uint32_t) from the
+ *                    context's pool (sized at open: config.max_instances).
+ *   mlod_rt_scratch  per-thread working memory for evaluation (local
+ *                    transforms, world matrices, palette), sized at
+ *                    creation for the context; released by
+ *                    mlod_rt_scratch_destroy before mlod_rt_close.
+ *
+ * Pointers the runtime returns (world matrices, palettes, state) point into
+ * the context or the scratch and stay valid until the next call that
+ * writes there (the next mlod_rt_pose on that scratch, the next update).
+ *
+ * Allocation. Every allocation of the runtime goes through the
+ * configuration's allocator (malloc/free when NULL), except the decoded
+ * chunks themselves, which the pack reader allocates with malloc. Memory is
+ * allocated only by mlod_rt_open_*, mlod_rt_scratch_create and
+ * mlod_rt_stream when it loads a level. mlod_rt_update, mlod_rt_request,
+ * mlod_rt_pose, mlod_rt_palette, mlod_rt_skin, instance creation and
+ * destruction (from the pool) allocate nothing.
+ *
+ * Threading. A context is not locked. Decoding happens only inside
+ * mlod_rt_stream, on the caller's thread; nothing runs in the background.
+ * mlod_rt_pose, mlod_rt_palette and mlod_rt_skin only read the context, so
+ * several threads may evaluate different instances at once, each with its
+ * own scratch, as long as no thread calls mlod_rt_update, mlod_rt_stream,
+ * mlod_rt_request or creates, destroys or changes an instance meanwhile.
+ *
+ * Errors. Fallible calls return an mlod_result and fill *err (when not
+ * NULL) with the code and a message (mlod_core.h). A corrupt chunk met by
+ * mlod_rt_stream fails that level only: it is marked failed, is never
+ * tried again, and the instances keep showing coarser levels.
+ *
+ * ------------------------------------------------------------------
+ * Levels
+ *
+ * Three layers (mlod_rt_layer): skeleton, mesh, motion. Level 0 is the
+ * finest; larger is coarser; the coarsest is count - 1. Motion levels are
+ * per clip (one chunk per clip and level). Each level has the pack TOC's
+ * measured error (scene units) and switch distance (mlod(5)). Skeleton
+ * level 0 is the full skeleton (the SKELETON chunk).
+ *
+ * Resident-level cache. Open decodes INFO, SKELETON and the coarsest level
+ * of each layer (of each clip for motion); these stay resident until close.
+ * Every other level is loaded when some instance wants it (or
+ * mlod_rt_request asks for it) and decoded only inside
+ * mlod_rt_stream(ctx, byte_budget). Resident bytes (the decoded levels plus
+ * the runtime's per-level tables, counted from their arrays) never exceed
+ * the budget, not even while a level decodes: before decoding, stream
+ * makes room for an upper bound of the level's size (its size for views;
+ * 4 x the TOC's raw size plus the runtime's tables for packs), evicting
+ * resident levels that no instance wanted at the last update, least
+ * recently wanted first; it never evicts a level that was wanted at the
+ * last update nor a coarsest level. A level that cannot fit stays unloaded
+ * and is tried again when room appears. (The reader's own scratch while
+ * one chunk decodes is not counted.)
+ *
+ * Fallback. An instance shows, per layer, the wanted level when resident,
+ * else the finest resident level coarser than the wanted one (the coarsest
+ * is always resident, so there always is one), and flags the layer in
+ * mlod_rt_state.fallback.
+ *
+ * ------------------------------------------------------------------
+ * Selection (mlod_rt_select)
+ *
+ * Every mode reduces to switch distances D_1 < ... per layer (D_0 = 0): the
+ * level wanted at distance d without hysteresis is the largest l with
+ * D_l <= d (the coarsest level fine enough).
+ *
+ * MLOD_RT_SELECT_ALPHA (the paper's): alpha = (d - d_near) / (d_far -
+ * d_near) clamped to [0, 1]; per layer with L levels and interval
+ * [t_s, t_e]: u = (alpha - t_s) / (t_e - t_s) clamped to [0, 1] (when
+ * t_e <= t_s, u = 0 for alpha < t_s and 1 otherwise), and
+ *     level = floor(u * (L - 1) + 0.5)     (rounded), clamped to [0, L - 1].
+ * Hence D_l = d_near + (t_s + (l - 0.5) / (L - 1) * (t_e - t_s)) *
+ * (d_far - d_near).
+ *
+ * MLOD_RT_SELECT_PIXELS: the coarsest level whose error e projects to at
+ * most max_pixels pixels: e * lines / (2 d tan(fov_y / 2)) <= max_pixels,
+ * so D_l = e_l * lines / (2 tan(fov_y / 2) * max_pixels). Motion levels
+ * use their own clip's errors.
+ *
+ * MLOD_RT_SELECT_TOC: D_l is the TOC's switch distance (the pixel rule at
+ * MLOD_PACK_FOV_Y, MLOD_PACK_LINES, MLOD_PACK_PIXELS, as baked).
+ *
+ * Any mode may be scaled: D_l is multiplied by distance_scale (1 when
+ * <= 0). D_l values need not increase with l; the rule stays "the largest
+ * l with D_l <= d".
+ *
+ * Hysteresis h >= 0 (relative). With c the level wanted at the last update:
+ * switching finer happens at the threshold (go to the raw level l < c when
+ * d < D_c); switching coarser needs the distance to pass the threshold
+ * times (1 + h): the new level is the largest l > c with D_l * (1 + h) <=
+ * d, or stays c. Inside [D_l, D_l (1 + h)) the level does not change,
+ * whichever way the camera moves, so a character sitting at a switch
+ * distance does not flicker.
+ *
+ * ------------------------------------------------------------------
+ * Evaluation
+ *
+ * Sampling follows the bake side's mlod_clip_sample (lib/model/pose.c)
+ * exactly: time clamped to [0, duration] (after wrapping into it when the
+ * instance loops); outside the keys, or with one key, the end key's value;
+ * STEP holds the key; LINEAR lerps translation and scale and slerps
+ * rotation (mlod_quat_slerp: shortest arc); CUBICSPLINE is glTF's Hermite
+ * with tangents scaled by the key interval; rotations are normalised after
+ * sampling. Joints without a channel keep their rest TRS.
+ *
+ * Skeleton levels, folded at run time: a kept joint c whose parent chain
+ * j1 (its parent) ... jk was removed gets the local transform
+ * L'_c = L_jk ... L_j1 L_c relative to its nearest kept ancestor. The
+ * runtime samples those removed ancestors' channels too and composes the
+ * product on the way down from the kept ancestor (shared between kept
+ * siblings), so every kept joint's world matrix equals the full skeleton's.
+ * Removed joints with no kept descendant are neither sampled nor posed:
+ * that is the skeleton level's saving. Roots get their base matrix:
+ * W_root = base * L_root.
+ *
+ * Palette (per skin joint, all skins in order, as the pack's 'SKJT'):
+ * level 0: W[skin joint] * IBM; level k: W[PALJ] * PALB.
+ *
+ * Skinning writes every part of the instance's mesh level, in part order,
+ * vertices concatenated: skinned parts by linear blend skinning of 4
+ * influences (positions by the blended matrix, normals by its 3x3 part,
+ * renormalised); rigid parts (joint >= 0) by W[joint] * offset, or for a
+ * joint the skeleton level removed, W[stand-in] * R * offset with R the
+ * rest transform from the stand-in (nearest kept ancestor) to the joint, as
+ * the bake side's fold does; static parts by offset. Morph targets are not
+ * applied.
+ */
+#ifndef MLOD_RT_H
+#define MLOD_RT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "mlod_core.h"
+#include "mlod_pack.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct mlod_rt_ctx mlod_rt_ctx;
+typedef struct mlod_rt_scratch mlod_rt_scratch;
+
+typedef enum mlod_rt_layer {
+	MLOD_RT_SKELETON = 0,
+	MLOD_RT_MESH = 1,
+	MLOD_RT_MOTION = 2,
+	MLOD_RT_LAYERS = 3
+} mlod_rt_layer;
+
+/* ------------------------------------------------------------------ */
+/* Opening (mlod_rt_open(3))                                           */
+/* ------------------------------------------------------------------ */
+
+/* User allocator: malloc(user, size) returns NULL on failure; free(user,
+ * NULL) must be harmless. Both or neither. */
+typedef struct mlod_rt_allocator {
+	void *(*malloc)(void *user, size_t size);
+	void (*free)(void *user, void *p);
+	void *user;
+} mlod_rt_allocator;
+
+typedef struct mlod_rt_config {
+	size_t budget_bytes;      /* resident bytes allowed; 0: no limit */
+	uint32_t max_instances;   /* the instance pool's size (0: 1024) */
+	const mlod_rt_allocator *allocator; /* NULL: malloc and free; copied */
+} mlod_rt_config;
+
+/* Reads size bytes at offset of the pack into dst; returns 0 on success,
+ * anything else for an error. Called only inside mlod_rt_open_read and
+ * mlod_rt_stream, on the caller's thread. */
+typedef int (*mlod_rt_read_fn)(void *user, uint64_t offset, size_t size, void *dst);
+
+/* Opens a pack held in memory. The memory is borrowed: it must stay valid
+ * and unchanged until mlod_rt_close. config may be NULL (defaults).
+ * Errors: MLOD_ERR_INVALID_ARG, MLOD_ERR_PARSE / MLOD_ERR_UNSUPPORTED from
+ * the reader (malformed or newer pack, a corrupt coarse chunk),
+ * MLOD_ERR_LIMIT when the coarse levels alone exceed the budget,
+ * MLOD_ERR_NOMEM. */
+mlod_result mlod_rt_open_memory(const void *data, size_t size, const mlod_rt_config *config, mlod_rt_ctx **out,
+                                mlod_error *err);
+/* Opens a pack file; the file stays open until mlod_rt_close and is read
+ * only by open and mlod_rt_stream. Adds MLOD_ERR_IO. */
+mlod_result mlod_rt_open_path(const char *path, const mlod_rt_config *config, mlod_rt_ctx **out, mlod_error *err);
+/* Opens a pack of file_size bytes read through read(user, ...). user must
+ * stay valid until mlod_rt_close. Adds MLOD_ERR_IO when read fails. */
+mlod_result mlod_rt_open_read(mlod_rt_read_fn read, void *user, uint64_t file_size, const mlod_rt_config *config,
+                              mlod_rt_ctx **out, mlod_error *err);
+
+/* Decoded views built by the caller (tests, or a host that decodes
+ * itself). Everything is borrowed and must outlive the context. The levels
+ * still go through the cache: only the coarsest of each layer is resident
+ * after open; the others "load" in mlod_rt_stream (no decoding), costing
+ * bytes (given, or counted from the arrays when 0). The runtime checks
+ * every index in them when it loads a level (MLOD_ERR_PARSE). */
+typedef struct mlod_rt_view_level {
+	const void *data;  /* mlod_pack_skel_level, mlod_pack_mesh or mlod_pack_motion */
+	float error;       /* scene units */
+	float distance;    /* switch distance (MLOD_RT_SELECT_TOC) */
+	size_t bytes;      /* decoded size to count; 0: counted from the arrays */
+} mlod_rt_view_level;
+
+typedef struct mlod_rt_views {
+	const mlod_pack_skeleton *skeleton;  /* required */
+	uint32_t skel_levels;                /* counting level 0 (>= 1) */
+	const mlod_rt_view_level *skel;      /* skel_levels; [0].data is ignored (the full skeleton) */
+	uint32_t mesh_levels;                /* 0: no mesh */
+	const mlod_rt_view_level *mesh;
+	uint32_t clip_count, motion_levels;  /* 0: no motion */
+	const mlod_rt_view_level *motion;    /* clip_count * motion_levels, [clip * motion_levels + level] */
+} mlod_rt_views;
+
+mlod_result mlod_rt_open_views(const mlod_rt_views *views, const mlod_rt_config *config, mlod_rt_ctx **out,
+                               mlod_error *err);
+
+/* Releases the context, its instances, its resident levels and, for
+ * mlod_rt_open_path, closes the file. NULL is harmless. */
+void mlod_rt_close(mlod_rt_ctx *ctx);
+
+/* ------------------------------------------------------------------ */
+/* Levels and streaming (mlod_rt_stream(3))                            */
+/* ------------------------------------------------------------------ */
+
+typedef struct mlod_rt_level_info {
+	float error;          /* scene units */
+	float distance;       /* the TOC's switch distance */
+	uint32_t stored_size; /* bytes in the pack (0 for views) */
+	size_t bytes;         /* resident bytes, 0 when not resident */
+	int resident;         /* 1 when resident */
+	int failed;           /* 1 when loading it failed */
+	uint32_t users;       /* instances showing it at the last update */
+} mlod_rt_level_info;
+
+typedef struct mlod_rt_stats {
+	size_t resident_bytes, budget_bytes, peak_resident_bytes;
+	uint32_t resident_levels, pending_levels; /* pending: wanted, not resident, not failed */
+	uint64_t loads, evictions, failures;
+} mlod_rt_stats;
+
+/* Levels of a layer, counting level 0 (motion: per clip). */
+uint32_t mlod_rt_level_count(const mlod_rt_ctx *ctx, mlod_rt_layer layer);
+uint32_t mlod_rt_clip_count(const mlod_rt_ctx *ctx);
+uint32_t mlod_rt_joint_count(const mlod_rt_ctx *ctx);
+/* Palette entries: the skin joints of every skin. */
+uint32_t mlod_rt_palette_size(const mlod_rt_ctx *ctx);
+/* The clip's duration in seconds (its coarsest level's). */
+float mlod_rt_clip_duration(const mlod_rt_ctx *ctx, uint32_t clip);
+/* item is the clip for the motion layer, else ignored. MLOD_ERR_INVALID_ARG
+ * out of range. */
+mlod_result mlod_rt_level_info_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item,
+                                   mlod_rt_level_info *out, mlod_error *err);
+/* Vertices the mesh level writes (all parts) when resident, else 0; and
+ * the largest count of any mesh level resident so far. */
+uint32_t mlod_rt_mesh_vertex_count(const mlod_rt_ctx *ctx, uint32_t level);
+uint32_t mlod_rt_max_vertex_count(const mlod_rt_ctx *ctx);
+void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out);
+
+/* A part of a resident mesh level, for drawing what mlod_rt_skin wrote:
+ * its vertices are first_vertex .. first_vertex + vertex_count - 1 of the
+ * skinned output, its triangles index_count indices local to the part
+ * (add first_vertex), pointing into the resident level: valid until that
+ * level is evicted (mlod_rt_stream) or the context closes. */
+typedef struct mlod_rt_part_info {
+	uint32_t first_vertex, vertex_count;
+	uint32_t index_count;
+	const uint32_t *indices;
+	int32_t material;     /* the input's glTF material, or -1 */
+	int32_t skin, joint;  /* skinned, rigid (joint >= 0) or static */
+} mlod_rt_part_info;
+
+/* Parts of a mesh level when resident, else 0. */
+uint32_t mlod_rt_mesh_part_count(const mlod_rt_ctx *ctx, uint32_t level);
+/* MLOD_ERR_INVALID_ARG for a level not resident or a part out of range. */
+mlod_result mlod_rt_mesh_part(const mlod_rt_ctx *ctx, uint32_t level, uint32_t part, mlod_rt_part_info *out,
+                              mlod_error *err);
+
+/* Asks for a level as if an instance wanted it at the last update (until
+ * the next update). No decoding here. */
+mlod_result mlod_rt_request(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item, mlod_error *err);
+
+/* Loads wanted levels, decoding on the caller's thread, most wanted first
+ * (ties: coarser first), until the stored bytes of the levels loaded in
+ * this call reach byte_budget (a first level larger than byte_budget is
+ * still loaded alone, so that every level can load; 0 loads nothing;
+ * views have no stored size and count 1 byte each),
+ * evicting as described above. Then re-resolves the instances (fallback
+ * levels change to the better resident ones, and away from evicted ones).
+ * *loaded (may be NULL) gets the number of levels loaded. Returns MLOD_OK,
+ * or the error of a level that failed to load (the call still went on
+ * with the others; the context stays usable). */
+mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loaded, mlod_error *err);
+
+/* ------------------------------------------------------------------ */
+/* Instances and selection (mlod_rt_instance(3))                       */
+/* ------------------------------------------------------------------ */
+
+#define MLOD_RT_LOOP 0x1u  /* instance flag: time wraps over the clip's duration */
+
+/* What an instance shows: per layer (mlod_rt_layer) the wanted level and
+ * the resident level shown; fallback has bit (1 << layer) set when they
+ * differ. */
+typedef struct mlod_rt_state {
+	uint32_t clip;
+	uint32_t flags;           /* MLOD_RT_LOOP */
+	float time;               /* seconds, before wrapping or clamping */
+	float distance;           /* at the last update */
+	float alpha;              /* the paper's alpha at the last update (alpha mode) */
+	uint16_t wanted[MLOD_RT_LAYERS];
+	uint16_t level[MLOD_RT_LAYERS];
+	uint32_t fallback;
+	int alive;
+} mlod_rt_state;
+
+/* Takes an instance from the pool, showing clip (ignored without clips)
+ * from time, at the coarsest levels until the first update.
+ * MLOD_ERR_LIMIT when the pool is full, MLOD_ERR_INVALID_ARG for a clip out
+ * of range. */
+mlod_result mlod_rt_instance_create(mlod_rt_ctx *ctx, uint32_t clip, float time, uint32_t flags, uint32_t *id,
+                                    mlod_error *err);
+/* Returns the instance to the pool; an id not alive is ignored. */
+void mlod_rt_instance_destroy(mlod_rt_ctx *ctx, uint32_t id);
+mlod_result mlod_rt_instance_set(mlod_rt_ctx *ctx, uint32_t id, uint32_t clip, float time, uint32_t flags,
+                                 mlod_error *err);
+/* The instance's state, or NULL for an id not alive. */
+const mlod_rt_state *mlod_rt_instance_state(const mlod_rt_ctx *ctx, uint32_t id);
+
+typedef enum mlod_rt_select_mode {
+	MLOD_RT_SELECT_ALPHA = 0,
+	MLOD_RT_SELECT_PIXELS = 1,
+	MLOD_RT_SELECT_TOC = 2
+} mlod_rt_select_mode;
+
+/* Selection parameters (see "Selection" above). mlod_rt_select_default
+ * fills: ALPHA mode, d_near 2, d_far 200 (scene units), every layer's
+ * interval [0, 1], fov_y 60 degrees (in radians), 1080 lines, 1 pixel,
+ * hysteresis 0.1, distance_scale 1, force_level -1. */
+typedef struct mlod_rt_select {
+	mlod_rt_select_mode mode;
+	float d_near, d_far;
+	float t_start[MLOD_RT_LAYERS], t_end[MLOD_RT_LAYERS];
+	float fov_y;        /* radians */
+	float lines;        /* screen height in pixels */
+	float max_pixels;
+	float hysteresis;   /* h >= 0 */
+	float distance_scale;
+	int force_level;    /* >= 0: every layer wants this level (clamped), no selection */
+} mlod_rt_select;
+
+void mlod_rt_select_default(mlod_rt_select *sel);
+
+/* One frame for n instances: each instance's time advances by dt, its
+ * levels are selected at distances[i] (scene units, >= 0), and wanted
+ * levels are recorded for mlod_rt_stream; shown levels are resolved.
+ * Ids not alive are skipped. No allocation. */
+mlod_result mlod_rt_update(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const uint32_t *ids,
+                           const float *distances, size_t n, float dt, mlod_error *err);
+/* The same with the distance from camera[3] to positions[3 * i]. */
+mlod_result mlod_rt_update_positions(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const float camera[3],
+                                     const uint32_t *ids, const float *positions, size_t n, float dt,
+                                     mlod_error *err);
+/* The level wanted at distance d by sel, for a layer, with the previous
+ * wanted level prev (or -1 for none: no hysteresis), the motion layer for
+ * clip item. The rule mlod_rt_update applies. */
+uint32_t mlod_rt_select_level(const mlod_rt_ctx *ctx, const mlod_rt_select *sel, mlod_rt_layer layer,
+                              uint32_t item, float d, int prev);
+
+/* ------------------------------------------------------------------ */
+/* Evaluation (mlod_rt_eval(3))                                        */
+/* ------------------------------------------------------------------ */
+
+/* Working memory for one thread (sized for the context). NULL when out of
+ * memory. Destroy before closing the context. */
+mlod_rt_scratch *mlod_rt_scratch_create(mlod_rt_ctx *ctx);
+void mlod_rt_scratch_destroy(mlod_rt_ctx *ctx, mlod_rt_scratch *s);
+
+/* Samples the instance's motion level at its time and poses its skeleton
+ * level: *world (may be NULL) points to joint_count column-major 4x4
+ * matrices in the scratch, valid at the level's posed joints (the kept
+ * joints and their removed ancestors; *joints and *joint_count (may be NULL)
+ * list the kept ones). Without clips the rest pose. */
+mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const float **world,
+                         const uint32_t **joints, uint32_t *joint_count, mlod_error *err);
+/* The skinning palette of the pose last computed in s (mlod_rt_pose):
+ * palette_size column-major 4x4 matrices (see "Palette"), for GPU
+ * skinning. */
+mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const float **palette, uint32_t *count,
+                            mlod_error *err);
+/* Poses the instance (as mlod_rt_pose) and skins its mesh level into the
+ * caller's buffers: 3 floats per vertex at positions + i * pos_stride bytes
+ * and, when normals is not NULL, at normals + i * nrm_stride (strides >= 12
+ * and multiples of 4); parts without normals get (0, 0, 0). capacity is
+ * the vertices the buffers hold: MLOD_ERR_LIMIT when the level needs more
+ * (mlod_rt_mesh_vertex_count). *vertex_count (may be NULL) gets the
+ * vertices written. */
+mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float *positions,
+                         size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
+                         uint32_t *vertex_count, mlod_error *err);
+
+/* The skinning kernels, for callers with their own data and for the
+ * benchmark: n vertices, positions and normals 3 floats each (normals may
+ * be NULL, then out_nrm is not written), joints 4 palette indices each
+ * (the caller guarantees them in range), weights 4 each (summing to 1:
+ * no renormalisation), palette 16 floats per matrix (column-major 4x4, as
+ * mlod_rt_palette gives); output 3 floats per vertex with byte strides.
+ * The first is the runtime's loop (fixed 4 influences, restrict pointers,
+ * blends written so the compiler vectorises them), the second a plain
+ * scalar loop (per-influence accumulation, vectorisation disabled where
+ * the compiler allows it), kept as the benchmark's reference. Same results
+ * to rounding. */
+void mlod_rt_skin_lbs(size_t n, const float *positions, const float *normals, const uint16_t *joints,
+                      const float *weights, const float *palette, float *out_pos, size_t pos_stride,
+                      float *out_nrm, size_t nrm_stride);
+void mlod_rt_skin_lbs_scalar(size_t n, const float *positions, const float *normals, const uint16_t *joints,
+                             const float *weights, const float *palette, float *out_pos, size_t pos_stride,
+                             float *out_nrm, size_t nrm_stride);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MLOD_RT_H */

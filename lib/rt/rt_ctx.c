@@ -1,0 +1,888 @@
+/*
+ * rt_ctx.c: the runtime context: allocation, levels and the resident-level
+ * cache (loading, LRU eviction under the budget, streaming), instances and
+ * the fallback rule. The pack source lives in rt_pack.c; views open here.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rt_internal.h"
+
+static void *default_malloc(void *user, size_t size)
+{
+	(void)user;
+	return malloc(size);
+}
+
+static void default_free(void *user, void *p)
+{
+	(void)user;
+	free(p);
+}
+
+void *rt_alloc(const mlod_rt_ctx *ctx, size_t size)
+{
+	return ctx->alloc.malloc(ctx->alloc.user, size ? size : 1);
+}
+
+void rt_free(const mlod_rt_ctx *ctx, void *p)
+{
+	if (p)
+		ctx->alloc.free(ctx->alloc.user, p);
+}
+
+static void *rt_calloc(const mlod_rt_ctx *ctx, size_t n, size_t size)
+{
+	if (size && n > SIZE_MAX / size)
+		return NULL;
+	void *p = rt_alloc(ctx, n * size);
+	if (p)
+		memset(p, 0, n * size);
+	return p;
+}
+
+mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config)
+{
+	mlod_rt_allocator a = { default_malloc, default_free, NULL };
+	if (config && config->allocator && config->allocator->malloc && config->allocator->free)
+		a = *config->allocator;
+	mlod_rt_ctx *ctx = a.malloc(a.user, sizeof *ctx);
+	if (!ctx)
+		return NULL;
+	memset(ctx, 0, sizeof *ctx);
+	ctx->alloc = a;
+	ctx->budget = config && config->budget_bytes ? config->budget_bytes : SIZE_MAX;
+	ctx->max_instances = config && config->max_instances ? config->max_instances : 1024;
+	return ctx;
+}
+
+rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item)
+{
+	if ((unsigned)layer >= MLOD_RT_LAYERS || level >= ctx->levels[layer])
+		return NULL;
+	if (layer == MLOD_RT_MOTION) {
+		if (item >= ctx->clip_count)
+			return NULL;
+		return &ctx->units[ctx->unit_base[layer] + item * ctx->levels[layer] + level];
+	}
+	return &ctx->units[ctx->unit_base[layer] + level];
+}
+
+/* ---------------------------------------------------------------- */
+/* Byte counts                                                       */
+/* ---------------------------------------------------------------- */
+
+size_t rt_bytes_skel_level(const mlod_pack_skel_level *l)
+{
+	return sizeof *l + (size_t)l->kept_count * 4 + (size_t)l->palette_size * (4 + 64);
+}
+
+size_t rt_bytes_mesh(const mlod_pack_mesh *m)
+{
+	size_t b = sizeof *m;
+	for (uint32_t i = 0; i < m->part_count; i++) {
+		const mlod_pack_part *p = &m->parts[i];
+		size_t v = p->rec.vertex_count, per = 12;
+		if (p->normals)
+			per += 12;
+		if (p->tangents)
+			per += 16;
+		for (int s = 0; s < MLOD_PACK_MAX_UV; s++)
+			if (p->uvs[s])
+				per += 8;
+		if (p->colors)
+			per += 16;
+		if (p->joints)
+			per += 8;
+		if (p->weights)
+			per += 16;
+		b += sizeof *p + v * per + (size_t)p->rec.index_count * 4;
+		if (p->targets)
+			b += (size_t)p->rec.target_count * (sizeof(float *) + v * 12);
+	}
+	return b;
+}
+
+size_t rt_bytes_motion(const mlod_pack_motion *m)
+{
+	size_t b = sizeof *m;
+	for (uint32_t i = 0; i < m->channel_count; i++) {
+		const mlod_pack_channel *c = &m->channels[i];
+		size_t comps = c->rec.path == 1 ? 4 : 3;
+		if (c->rec.interp == 2)
+			comps *= 3;
+		b += sizeof *c + (size_t)c->rec.key_count * (4 + 4 * comps);
+	}
+	return b;
+}
+
+/* ---------------------------------------------------------------- */
+/* Checking and preparing a loaded unit                              */
+/* ---------------------------------------------------------------- */
+
+static mlod_result check_mesh(const mlod_rt_ctx *ctx, const mlod_pack_mesh *m, uint32_t level, uint32_t *vertices,
+                              mlod_error *err)
+{
+	uint64_t total = 0;
+	if (m->part_count && !m->parts)
+		return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u: no parts", level);
+	for (uint32_t i = 0; i < m->part_count; i++) {
+		const mlod_pack_part *p = &m->parts[i];
+		const uint32_t n = p->rec.vertex_count;
+		if (n && !p->positions)
+			return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u part %u: no positions", level, i);
+		if (p->rec.joint >= 0 && (uint32_t)p->rec.joint >= ctx->joint_count)
+			return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u part %u: joint %d out of range", level, i,
+			                 (int)p->rec.joint);
+		if (p->rec.skin >= 0) {
+			if ((uint32_t)p->rec.skin >= ctx->skin_count)
+				return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u part %u: skin %d out of range", level, i,
+				                 (int)p->rec.skin);
+			if (n && (!p->joints || !p->weights))
+				return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u part %u: skinned without weights", level,
+				                 i);
+			const uint32_t sj = ctx->skel->skins[p->rec.skin].joint_count;
+			for (size_t k = 0; k < 4 * (size_t)n; k++)
+				if (p->joints[k] >= sj)
+					return mlod_fail(err, MLOD_ERR_PARSE,
+					                 "mesh level %u part %u: vertex joint %u outside its skin of %u", level, i,
+					                 (unsigned)p->joints[k], sj);
+		}
+		if (p->rec.index_count % 3 || (p->rec.index_count && !p->indices))
+			return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u part %u: %u indices", level, i, p->rec.index_count);
+		for (uint32_t k = 0; k < p->rec.index_count; k++)
+			if (p->indices[k] >= n)
+				return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u part %u: index %u of %u vertices", level, i,
+				                 p->indices[k], n);
+		total += n;
+		if (total > UINT32_MAX / 2)
+			return mlod_fail(err, MLOD_ERR_PARSE, "mesh level %u: too many vertices", level);
+	}
+	*vertices = (uint32_t)total;
+	return MLOD_OK;
+}
+
+static mlod_result check_motion(const mlod_rt_ctx *ctx, const mlod_pack_motion *m, uint32_t level, uint32_t clip,
+                                mlod_error *err)
+{
+	if (m->channel_count && !m->channels)
+		return mlod_fail(err, MLOD_ERR_PARSE, "motion level %u of clip %u: no channels", level, clip);
+	for (uint32_t i = 0; i < m->channel_count; i++) {
+		const mlod_pack_channel_rec *c = &m->channels[i].rec;
+		if (c->joint >= ctx->joint_count || c->path > 2 || c->interp > 2 ||
+		    (c->key_count && (!m->channels[i].times || !m->channels[i].values)))
+			return mlod_fail(err, MLOD_ERR_PARSE, "motion level %u of clip %u: channel %u is malformed", level,
+			                 clip, i);
+	}
+	return MLOD_OK;
+}
+
+static void mat_identity(float *m)
+{
+	memset(m, 0, 16 * sizeof *m);
+	m[0] = m[5] = m[10] = m[15] = 1.0f;
+}
+
+/* Builds the plan of a skeleton level (level >= 1) into one block. */
+static mlod_result prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_skel_level *l, mlod_error *err)
+{
+	const uint32_t J = ctx->joint_count;
+	if (l->kept_count == 0 || l->kept_count > J || !l->kept)
+		return mlod_fail(err, MLOD_ERR_PARSE, "skeleton level %u: %u kept joints of %u", u->level, l->kept_count,
+		                 J);
+	if (l->palette_size != ctx->palette_size || (l->palette_size && (!l->palette_joint || !l->palette_bind)))
+		return mlod_fail(err, MLOD_ERR_PARSE, "skeleton level %u: palette of %u entries, the skins have %u",
+		                 u->level, l->palette_size, ctx->palette_size);
+	size_t bytes = (size_t)J * (4 + 1 + 4 + 64);
+	uint8_t *block = rt_alloc(ctx, bytes);
+	if (!block)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "skeleton level %u: out of memory", u->level);
+	rt_skel_plan *p = &u->plan;
+	p->rel = (float *)block;
+	p->stand = (int32_t *)(block + (size_t)J * 64);
+	p->posed = (uint32_t *)(block + (size_t)J * 68);
+	p->needed = block + (size_t)J * 72;
+	memset(p->needed, 0, J);
+	mlod_result r = MLOD_OK;
+	for (uint32_t i = 0; i < l->kept_count; i++) {
+		if (l->kept[i] >= J || (i && l->kept[i] <= l->kept[i - 1])) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "skeleton level %u: kept joints not increasing inside %u",
+			              u->level, J);
+			goto fail;
+		}
+		p->needed[l->kept[i]] = 2; /* 2: kept */
+	}
+	for (uint32_t j = 0; j < J; j++) {
+		int32_t par = ctx->skel->joints[j].parent;
+		if (par < 0 && p->needed[j] != 2) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "skeleton level %u: root joint %u is not kept", u->level, j);
+			goto fail;
+		}
+		p->stand[j] = p->needed[j] == 2 ? (int32_t)j : p->stand[par];
+	}
+	/* Removed ancestors of kept joints are posed too (folded at run time). */
+	for (uint32_t i = l->kept_count; i-- > 0;) {
+		for (int32_t a = ctx->skel->joints[l->kept[i]].parent; a >= 0 && !p->needed[a]; a = ctx->skel->joints[a].parent)
+			p->needed[a] = 1;
+	}
+	p->posed_count = 0;
+	for (uint32_t j = 0; j < J; j++)
+		if (p->needed[j])
+			p->posed[p->posed_count++] = j;
+	for (uint32_t i = 0; i < l->palette_size; i++)
+		if (l->palette_joint[i] >= J || p->needed[l->palette_joint[i]] != 2) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "skeleton level %u: palette entry %u follows joint %u, not kept",
+			              u->level, i, l->palette_joint[i]);
+			goto fail;
+		}
+	for (uint32_t j = 0; j < J; j++) {
+		float *rel = p->rel + 16 * (size_t)j;
+		if (p->stand[j] == (int32_t)j) {
+			mat_identity(rel);
+			continue;
+		}
+		mlod_mat4 sw, inv;
+		memcpy(sw.m, ctx->rest_world + 16 * (size_t)p->stand[j], sizeof sw.m);
+		if (mlod_mat4_invert(&sw, &inv) != 0) {
+			mat_identity(rel);
+			continue;
+		}
+		rt_mat_mul(inv.m, ctx->rest_world + 16 * (size_t)j, rel);
+	}
+	p->kept_count = l->kept_count;
+	p->kept = l->kept;
+	p->palette_joint = l->palette_joint;
+	p->palette_bind = l->palette_bind;
+	u->plan_block = block;
+	u->bytes += bytes;
+	return MLOD_OK;
+fail:
+	rt_free(ctx, block);
+	memset(p, 0, sizeof *p);
+	return r;
+}
+
+/* ---------------------------------------------------------------- */
+/* Loading and evicting                                              */
+/* ---------------------------------------------------------------- */
+
+static void unit_release(mlod_rt_ctx *ctx, rt_unit *u)
+{
+	if (u->state != RT_UNIT_RESIDENT)
+		return;
+	if (u->owned && ctx->unload)
+		ctx->unload(ctx, u);
+	rt_free(ctx, u->plan_block);
+	u->plan_block = NULL;
+	memset(&u->plan, 0, sizeof u->plan);
+	u->skel = NULL, u->mesh = NULL, u->motion = NULL;
+	ctx->resident_bytes -= u->bytes;
+	u->bytes = 0;
+	u->owned = 0;
+	u->state = RT_UNIT_ABSENT;
+}
+
+/* Loads u (not resident); on success it is resident and counted. */
+static mlod_result unit_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
+{
+	mlod_result r;
+	u->bytes = 0;
+	if (u->layer == MLOD_RT_SKELETON && u->level == 0) {
+		/* The full skeleton: resident with the context. */
+		u->state = RT_UNIT_RESIDENT;
+		return MLOD_OK;
+	}
+	if (ctx->load) {
+		r = ctx->load(ctx, u, err);
+		if (r)
+			return r;
+		u->owned = 1;
+		switch (u->layer) {
+		case MLOD_RT_SKELETON: u->skel = &u->dec.skel, u->bytes = rt_bytes_skel_level(u->skel); break;
+		case MLOD_RT_MESH: u->mesh = &u->dec.mesh, u->bytes = rt_bytes_mesh(u->mesh); break;
+		default: u->motion = &u->dec.motion, u->bytes = rt_bytes_motion(u->motion); break;
+		}
+	} else {
+		const mlod_rt_view_level *v = u->view;
+		if (!v || !v->data)
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s level %u: no data in the views",
+			                 u->layer == MLOD_RT_SKELETON ? "skeleton" : u->layer == MLOD_RT_MESH ? "mesh" : "motion",
+			                 u->level);
+		switch (u->layer) {
+		case MLOD_RT_SKELETON: u->skel = v->data, u->bytes = v->bytes ? v->bytes : rt_bytes_skel_level(u->skel); break;
+		case MLOD_RT_MESH: u->mesh = v->data, u->bytes = v->bytes ? v->bytes : rt_bytes_mesh(u->mesh); break;
+		default: u->motion = v->data, u->bytes = v->bytes ? v->bytes : rt_bytes_motion(u->motion); break;
+		}
+	}
+	u->state = RT_UNIT_RESIDENT; /* for unit_release on failure below */
+	switch (u->layer) {
+	case MLOD_RT_SKELETON: r = prepare_skel(ctx, u, u->skel, err); break;
+	case MLOD_RT_MESH: r = check_mesh(ctx, u->mesh, u->level, &u->vertex_count, err); break;
+	default: r = check_motion(ctx, u->motion, u->level, u->item, err); break;
+	}
+	ctx->resident_bytes += u->bytes;
+	if (r) {
+		unit_release(ctx, u);
+		return r;
+	}
+	if (u->layer == MLOD_RT_MESH && u->vertex_count > ctx->max_vertices)
+		ctx->max_vertices = u->vertex_count;
+	if (ctx->resident_bytes > ctx->peak_bytes)
+		ctx->peak_bytes = ctx->resident_bytes;
+	ctx->loads++;
+	return MLOD_OK;
+}
+
+/* The least recently wanted evictable unit, or NULL. */
+static rt_unit *lru_victim(mlod_rt_ctx *ctx)
+{
+	rt_unit *best = NULL;
+	for (uint32_t i = 0; i < ctx->unit_count; i++) {
+		rt_unit *u = &ctx->units[i];
+		if (u->state != RT_UNIT_RESIDENT || u->coarse || (u->layer == MLOD_RT_SKELETON && u->level == 0) ||
+		    u->want_count > 0)
+			continue;
+		if (!best || u->last_wanted < best->last_wanted)
+			best = u;
+	}
+	return best;
+}
+
+/* Bytes the victims could free. */
+static size_t evictable_bytes(const mlod_rt_ctx *ctx)
+{
+	size_t b = 0;
+	for (uint32_t i = 0; i < ctx->unit_count; i++) {
+		const rt_unit *u = &ctx->units[i];
+		if (u->state == RT_UNIT_RESIDENT && !u->coarse && !(u->layer == MLOD_RT_SKELETON && u->level == 0) &&
+		    u->want_count == 0)
+			b += u->bytes;
+	}
+	return b;
+}
+
+/* An upper bound of a unit's resident size before loading it, so that
+ * room is made before decoding and resident bytes never pass the budget,
+ * not even while a level decodes. Views know their size. For packs:
+ * dequantising at most quadruples a stream (unorm8 weights and colours
+ * become floats; positions and normals grow less), the decoded structs at
+ * most double their records, and the alignment of each stream costs less
+ * than 4 times its 16-byte header; plus the skeleton level's tables. */
+static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
+{
+	size_t plan = u->layer == MLOD_RT_SKELETON ? (size_t)ctx->joint_count * (4 + 1 + 4 + 64) : 0;
+	if (!ctx->load) {
+		const mlod_rt_view_level *v = u->view;
+		if (v && v->bytes)
+			return v->bytes + plan;
+		if (v && v->data)
+			switch (u->layer) {
+			case MLOD_RT_SKELETON: return rt_bytes_skel_level(v->data) + plan;
+			case MLOD_RT_MESH: return rt_bytes_mesh(v->data);
+			default: return rt_bytes_motion(v->data);
+			}
+		return 0;
+	}
+	return 4 * (size_t)u->raw_size + 256 + plan;
+}
+
+/* ---------------------------------------------------------------- */
+/* Fallback                                                          */
+/* ---------------------------------------------------------------- */
+
+static uint16_t resolve_layer(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t item, uint16_t wanted)
+{
+	const uint32_t L = ctx->levels[layer];
+	for (uint32_t l = wanted; l < L; l++) {
+		const rt_unit *u = rt_unit_get(ctx, layer, l, item);
+		if (u && u->state == RT_UNIT_RESIDENT)
+			return (uint16_t)l;
+	}
+	/* Unreachable while the coarsest stays resident; any resident one. */
+	for (uint32_t l = wanted; l-- > 0;) {
+		const rt_unit *u = rt_unit_get(ctx, layer, l, item);
+		if (u && u->state == RT_UNIT_RESIDENT)
+			return (uint16_t)l;
+	}
+	return (uint16_t)(L ? L - 1 : 0);
+}
+
+void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in)
+{
+	mlod_rt_state *st = &in->st;
+	st->fallback = 0;
+	for (int layer = 0; layer < MLOD_RT_LAYERS; layer++) {
+		if (!ctx->levels[layer]) {
+			st->level[layer] = st->wanted[layer] = 0;
+			continue;
+		}
+		uint32_t item = layer == MLOD_RT_MOTION ? st->clip : 0;
+		rt_unit *old = rt_unit_get(ctx, (mlod_rt_layer)layer, st->level[layer], item);
+		uint16_t l = resolve_layer(ctx, (mlod_rt_layer)layer, item, st->wanted[layer]);
+		rt_unit *now = rt_unit_get(ctx, (mlod_rt_layer)layer, l, item);
+		if (old != now) {
+			if (old && old->users)
+				old->users--;
+			if (now)
+				now->users++;
+		}
+		st->level[layer] = l;
+		if (l != st->wanted[layer])
+			st->fallback |= 1u << layer;
+	}
+}
+
+/* Drops the instance's users counts (before destroy or a clip change). */
+static void unuse(mlod_rt_ctx *ctx, rt_instance *in)
+{
+	for (int layer = 0; layer < MLOD_RT_LAYERS; layer++) {
+		if (!ctx->levels[layer])
+			continue;
+		rt_unit *u = rt_unit_get(ctx, (mlod_rt_layer)layer, in->st.level[layer],
+		                         layer == MLOD_RT_MOTION ? in->st.clip : 0);
+		if (u && u->users)
+			u->users--;
+	}
+}
+
+/* ---------------------------------------------------------------- */
+/* Opening: the common part                                          */
+/* ---------------------------------------------------------------- */
+
+void rt_mat_trs(const mlod_trs *t, float *out);
+
+mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
+{
+	const mlod_pack_skeleton *s = ctx->skel;
+	const uint32_t J = s->joint_count;
+	ctx->joint_count = J;
+	ctx->skin_count = s->skin_count;
+	if (J == 0 || !s->joints)
+		return mlod_fail(err, MLOD_ERR_PARSE, "the skeleton has no joints");
+	if (s->skin_count && (!s->skins || !s->skin_joints || !s->inverse_bind))
+		return mlod_fail(err, MLOD_ERR_PARSE, "the skeleton's skins are incomplete");
+	for (uint32_t j = 0; j < J; j++)
+		if (s->joints[j].parent >= (int32_t)j)
+			return mlod_fail(err, MLOD_ERR_PARSE, "joint %u: parent %d does not come first", j,
+			                 (int)s->joints[j].parent);
+	ctx->skin_offset = rt_calloc(ctx, s->skin_count + 1, sizeof *ctx->skin_offset);
+	ctx->rest_world = rt_calloc(ctx, J, 16 * sizeof(float));
+	ctx->rest_local = rt_calloc(ctx, J, sizeof *ctx->rest_local);
+	ctx->all_joints = rt_calloc(ctx, J, sizeof *ctx->all_joints);
+	ctx->all_needed = rt_calloc(ctx, J, 1);
+	ctx->clip_duration = rt_calloc(ctx, ctx->clip_count + 1, sizeof(float));
+	ctx->inst = rt_calloc(ctx, ctx->max_instances, sizeof *ctx->inst);
+	if (!ctx->skin_offset || !ctx->rest_world || !ctx->rest_local || !ctx->all_joints || !ctx->all_needed ||
+	    !ctx->clip_duration || !ctx->inst)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
+	uint64_t pal = 0;
+	for (uint32_t k = 0; k < s->skin_count; k++) {
+		ctx->skin_offset[k] = (uint32_t)pal;
+		if (s->skins[k].joint_count && (!s->skin_joints[k] || !s->inverse_bind[k]))
+			return mlod_fail(err, MLOD_ERR_PARSE, "skin %u: no joints", k);
+		for (uint32_t i = 0; i < s->skins[k].joint_count; i++)
+			if (s->skin_joints[k][i] >= J)
+				return mlod_fail(err, MLOD_ERR_PARSE, "skin %u: joint %u out of range", k, s->skin_joints[k][i]);
+		pal += s->skins[k].joint_count;
+		if (pal > UINT32_MAX / 64)
+			return mlod_fail(err, MLOD_ERR_PARSE, "the skins have too many joints");
+	}
+	ctx->palette_size = (uint32_t)pal;
+	for (uint32_t j = 0; j < J; j++) {
+		const mlod_pack_joint_rec *jr = &s->joints[j];
+		mlod_trs t = { { jr->t[0], jr->t[1], jr->t[2] },
+		               { jr->r[0], jr->r[1], jr->r[2], jr->r[3] },
+		               { jr->s[0], jr->s[1], jr->s[2] } };
+		ctx->rest_local[j] = t;
+		float l[16];
+		rt_mat_trs(&t, l);
+		rt_mat_mul(jr->parent < 0 ? jr->base : ctx->rest_world + 16 * (size_t)jr->parent, l,
+		           ctx->rest_world + 16 * (size_t)j);
+		ctx->all_joints[j] = j;
+		ctx->all_needed[j] = 2;
+	}
+	for (uint32_t i = 0; i < ctx->max_instances; i++)
+		ctx->inst[i].next_free = i + 1;
+	ctx->free_head = 0;
+
+	/* The coarse levels, pinned. */
+	for (uint32_t i = 0; i < ctx->unit_count; i++) {
+		rt_unit *u = &ctx->units[i];
+		u->coarse = u->level + 1u == ctx->levels[u->layer];
+		if (!u->coarse && !(u->layer == MLOD_RT_SKELETON && u->level == 0))
+			continue;
+		mlod_result r = unit_load(ctx, u, err);
+		if (r)
+			return r;
+	}
+	for (uint32_t c = 0; c < ctx->clip_count; c++) {
+		const rt_unit *u = rt_unit_get(ctx, MLOD_RT_MOTION, ctx->levels[MLOD_RT_MOTION] - 1, c);
+		float d = u && u->motion ? u->motion->duration : 0.0f;
+		if (u && u->motion && !(d > 0.0f)) /* views may leave it 0: the largest key time */
+			for (uint32_t k = 0; k < u->motion->channel_count; k++) {
+				const mlod_pack_channel *ch = &u->motion->channels[k];
+				if (ch->rec.key_count && ch->times[ch->rec.key_count - 1] > d)
+					d = ch->times[ch->rec.key_count - 1];
+			}
+		ctx->clip_duration[c] = isfinite(d) && d > 0.0f ? d : 0.0f;
+	}
+	if (ctx->resident_bytes > ctx->budget)
+		return mlod_fail(err, MLOD_ERR_LIMIT,
+		                 "the coarse levels need %zu bytes, more than the budget of %zu bytes",
+		                 ctx->resident_bytes, ctx->budget);
+	ctx->peak_bytes = ctx->resident_bytes;
+	return MLOD_OK;
+}
+
+mlod_result mlod_rt_open_views(const mlod_rt_views *v, const mlod_rt_config *config, mlod_rt_ctx **out,
+                               mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_views: NULL argument");
+	*out = NULL;
+	if (!v || !v->skeleton || v->skel_levels < 1 || !v->skel || (v->mesh_levels && !v->mesh) ||
+	    (v->clip_count && v->motion_levels && !v->motion) || v->skel_levels > 65535 || v->mesh_levels > 65535 ||
+	    v->motion_levels > 65535 || v->clip_count > 65535)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_views: missing or oversized views");
+	mlod_rt_ctx *ctx = rt_ctx_new(config);
+	if (!ctx)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
+	ctx->skel = v->skeleton;
+	ctx->levels[MLOD_RT_SKELETON] = v->skel_levels;
+	ctx->levels[MLOD_RT_MESH] = v->mesh_levels;
+	ctx->clip_count = v->motion_levels ? v->clip_count : 0;
+	ctx->levels[MLOD_RT_MOTION] = ctx->clip_count ? v->motion_levels : 0;
+	ctx->unit_count = ctx->levels[0] + ctx->levels[1] + ctx->clip_count * ctx->levels[2];
+	ctx->unit_base[0] = 0;
+	ctx->unit_base[1] = ctx->levels[0];
+	ctx->unit_base[2] = ctx->levels[0] + ctx->levels[1];
+	ctx->units = rt_calloc(ctx, ctx->unit_count, sizeof *ctx->units);
+	if (!ctx->units) {
+		mlod_rt_close(ctx);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
+	}
+	for (uint32_t i = 0; i < ctx->unit_count; i++) {
+		rt_unit *u = &ctx->units[i];
+		const mlod_rt_view_level *vl;
+		if (i < ctx->unit_base[1])
+			u->layer = MLOD_RT_SKELETON, u->level = (uint16_t)i, vl = &v->skel[i];
+		else if (i < ctx->unit_base[2])
+			u->layer = MLOD_RT_MESH, u->level = (uint16_t)(i - ctx->unit_base[1]), vl = &v->mesh[u->level];
+		else {
+			uint32_t k = i - ctx->unit_base[2];
+			u->layer = MLOD_RT_MOTION;
+			u->item = (uint16_t)(k / ctx->levels[2]);
+			u->level = (uint16_t)(k % ctx->levels[2]);
+			vl = &v->motion[k];
+		}
+		u->chunk = -1;
+		u->view = vl;
+		u->error = u->level ? vl->error : 0.0f;
+		u->distance = u->level ? vl->distance : 0.0f;
+	}
+	mlod_result r = rt_ctx_finish_open(ctx, err);
+	if (r) {
+		mlod_rt_close(ctx);
+		return r;
+	}
+	*out = ctx;
+	return MLOD_OK;
+}
+
+void mlod_rt_close(mlod_rt_ctx *ctx)
+{
+	if (!ctx)
+		return;
+	if (ctx->units)
+		for (uint32_t i = 0; i < ctx->unit_count; i++)
+			unit_release(ctx, &ctx->units[i]);
+	if (ctx->close_source)
+		ctx->close_source(ctx);
+	rt_free(ctx, ctx->units);
+	rt_free(ctx, ctx->skin_offset);
+	rt_free(ctx, ctx->rest_world);
+	rt_free(ctx, ctx->rest_local);
+	rt_free(ctx, ctx->all_joints);
+	rt_free(ctx, ctx->all_needed);
+	rt_free(ctx, ctx->clip_duration);
+	rt_free(ctx, ctx->inst);
+	mlod_rt_allocator a = ctx->alloc;
+	a.free(a.user, ctx);
+}
+
+/* ---------------------------------------------------------------- */
+/* Queries                                                           */
+/* ---------------------------------------------------------------- */
+
+uint32_t mlod_rt_level_count(const mlod_rt_ctx *ctx, mlod_rt_layer layer)
+{
+	return ctx && (unsigned)layer < MLOD_RT_LAYERS ? ctx->levels[layer] : 0;
+}
+
+uint32_t mlod_rt_clip_count(const mlod_rt_ctx *ctx) { return ctx ? ctx->clip_count : 0; }
+uint32_t mlod_rt_joint_count(const mlod_rt_ctx *ctx) { return ctx ? ctx->joint_count : 0; }
+uint32_t mlod_rt_palette_size(const mlod_rt_ctx *ctx) { return ctx ? ctx->palette_size : 0; }
+uint32_t mlod_rt_max_vertex_count(const mlod_rt_ctx *ctx) { return ctx ? ctx->max_vertices : 0; }
+
+float mlod_rt_clip_duration(const mlod_rt_ctx *ctx, uint32_t clip)
+{
+	return ctx && clip < ctx->clip_count ? ctx->clip_duration[clip] : 0.0f;
+}
+
+mlod_result mlod_rt_level_info_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item,
+                                   mlod_rt_level_info *out, mlod_error *err)
+{
+	const rt_unit *u = ctx && out ? rt_unit_get(ctx, layer, level, item) : NULL;
+	if (!u)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "no such level");
+	out->error = u->error;
+	out->distance = u->distance;
+	out->stored_size = u->stored_size;
+	out->bytes = u->state == RT_UNIT_RESIDENT ? u->bytes : 0;
+	out->resident = u->state == RT_UNIT_RESIDENT;
+	out->failed = u->state == RT_UNIT_FAILED;
+	out->users = u->users;
+	return MLOD_OK;
+}
+
+uint32_t mlod_rt_mesh_vertex_count(const mlod_rt_ctx *ctx, uint32_t level)
+{
+	const rt_unit *u = ctx ? rt_unit_get(ctx, MLOD_RT_MESH, level, 0) : NULL;
+	return u && u->state == RT_UNIT_RESIDENT ? u->vertex_count : 0;
+}
+
+uint32_t mlod_rt_mesh_part_count(const mlod_rt_ctx *ctx, uint32_t level)
+{
+	const rt_unit *u = ctx ? rt_unit_get(ctx, MLOD_RT_MESH, level, 0) : NULL;
+	return u && u->state == RT_UNIT_RESIDENT ? u->mesh->part_count : 0;
+}
+
+mlod_result mlod_rt_mesh_part(const mlod_rt_ctx *ctx, uint32_t level, uint32_t part, mlod_rt_part_info *out,
+                              mlod_error *err)
+{
+	const rt_unit *u = ctx && out ? rt_unit_get(ctx, MLOD_RT_MESH, level, 0) : NULL;
+	if (!u || u->state != RT_UNIT_RESIDENT || part >= u->mesh->part_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mesh level %u part %u: not resident or out of range", level,
+		                 part);
+	uint32_t first = 0;
+	for (uint32_t i = 0; i < part; i++)
+		first += u->mesh->parts[i].rec.vertex_count;
+	const mlod_pack_part *p = &u->mesh->parts[part];
+	out->first_vertex = first;
+	out->vertex_count = p->rec.vertex_count;
+	out->index_count = p->indices ? p->rec.index_count : 0;
+	out->indices = p->indices;
+	out->material = p->rec.material;
+	out->skin = p->rec.skin;
+	out->joint = p->rec.joint;
+	return MLOD_OK;
+}
+
+void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out)
+{
+	memset(out, 0, sizeof *out);
+	out->resident_bytes = ctx->resident_bytes;
+	out->budget_bytes = ctx->budget;
+	out->peak_resident_bytes = ctx->peak_bytes;
+	out->loads = ctx->loads;
+	out->evictions = ctx->evictions;
+	out->failures = ctx->failures;
+	for (uint32_t i = 0; i < ctx->unit_count; i++) {
+		const rt_unit *u = &ctx->units[i];
+		out->resident_levels += u->state == RT_UNIT_RESIDENT;
+		out->pending_levels += u->state == RT_UNIT_ABSENT && u->want_count > 0;
+	}
+}
+
+/* ---------------------------------------------------------------- */
+/* Streaming                                                         */
+/* ---------------------------------------------------------------- */
+
+mlod_result mlod_rt_request(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item, mlod_error *err)
+{
+	rt_unit *u = ctx ? rt_unit_get(ctx, layer, level, item) : NULL;
+	if (!u)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_request: no such level");
+	u->want_count++;
+	u->last_wanted = ctx->stamp;
+	return MLOD_OK;
+}
+
+/* The next unit to load: most wanted, then coarser, then lower index. */
+static rt_unit *next_wanted(mlod_rt_ctx *ctx)
+{
+	rt_unit *best = NULL;
+	for (uint32_t i = 0; i < ctx->unit_count; i++) {
+		rt_unit *u = &ctx->units[i];
+		/* the high bit marks a level that cannot fit in this call */
+		if (u->state != RT_UNIT_ABSENT || u->want_count == 0 || (u->want_count & 0x80000000u))
+			continue;
+		if (!best || u->want_count > best->want_count ||
+		    (u->want_count == best->want_count && u->level > best->level))
+			best = u;
+	}
+	return best;
+}
+
+mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loaded, mlod_error *err)
+{
+	if (loaded)
+		*loaded = 0;
+	if (!ctx)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_stream: NULL context");
+	mlod_result first = MLOD_OK;
+	size_t spent = 0;
+	uint32_t n = 0;
+	int changed = 0;
+	while (byte_budget > 0 && spent < byte_budget) {
+		rt_unit *u = NULL;
+		/* Find the best candidate that may fit. */
+		for (;;) {
+			rt_unit *c = next_wanted(ctx);
+			if (!c)
+				break;
+			size_t hint = size_hint(ctx, c);
+			if (ctx->resident_bytes + hint > ctx->budget &&
+			    ctx->resident_bytes - evictable_bytes(ctx) + hint > ctx->budget) {
+				/* cannot fit even after every eviction: skip it in this call */
+				c->want_count |= 0x80000000u;
+				continue;
+			}
+			u = c;
+			break;
+		}
+		if (!u)
+			break;
+		if (spent > 0 && spent + u->stored_size > byte_budget)
+			break;
+		/* Make room for the hint before decoding. */
+		size_t hint = size_hint(ctx, u);
+		while (ctx->resident_bytes + hint > ctx->budget) {
+			rt_unit *v = lru_victim(ctx);
+			if (!v)
+				break;
+			unit_release(ctx, v);
+			ctx->evictions++;
+			changed = 1;
+		}
+		mlod_error e;
+		mlod_result r = unit_load(ctx, u, &e);
+		spent += u->stored_size ? u->stored_size : 1;
+		if (r) {
+			u->state = RT_UNIT_FAILED;
+			ctx->failures++;
+			if (!first) {
+				first = r;
+				if (err)
+					*err = e;
+			}
+			continue;
+		}
+		/* Evict to fit what it really costs. */
+		while (ctx->resident_bytes > ctx->budget) {
+			rt_unit *v = lru_victim(ctx);
+			if (!v)
+				break;
+			unit_release(ctx, v);
+			ctx->evictions++;
+		}
+		if (ctx->resident_bytes > ctx->budget) { /* larger than its hint: give it back */
+			unit_release(ctx, u);
+			u->want_count |= 0x80000000u;
+			changed = 1;
+			continue;
+		}
+		n++;
+		changed = 1;
+	}
+	for (uint32_t i = 0; i < ctx->unit_count; i++)
+		ctx->units[i].want_count &= 0x7fffffffu;
+	if (changed)
+		for (uint32_t i = 0; i < ctx->max_instances; i++)
+			if (ctx->inst[i].st.alive)
+				rt_resolve(ctx, &ctx->inst[i]);
+	if (loaded)
+		*loaded = n;
+	return first;
+}
+
+/* ---------------------------------------------------------------- */
+/* Instances                                                         */
+/* ---------------------------------------------------------------- */
+
+mlod_result mlod_rt_instance_create(mlod_rt_ctx *ctx, uint32_t clip, float time, uint32_t flags, uint32_t *id,
+                                    mlod_error *err)
+{
+	if (!ctx || !id)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_instance_create: NULL argument");
+	if (ctx->clip_count && clip >= ctx->clip_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "clip %u out of range (%u clips)", clip, ctx->clip_count);
+	if (ctx->free_head >= ctx->max_instances)
+		return mlod_fail(err, MLOD_ERR_LIMIT, "the instance pool of %u is full", ctx->max_instances);
+	uint32_t i = ctx->free_head;
+	rt_instance *in = &ctx->inst[i];
+	ctx->free_head = in->next_free;
+	memset(&in->st, 0, sizeof in->st);
+	in->selected = 0;
+	in->st.alive = 1;
+	in->st.clip = ctx->clip_count ? clip : 0;
+	in->st.time = time;
+	in->st.flags = flags;
+	for (int layer = 0; layer < MLOD_RT_LAYERS; layer++) {
+		uint16_t c = (uint16_t)(ctx->levels[layer] ? ctx->levels[layer] - 1 : 0);
+		in->st.wanted[layer] = c;
+		in->st.level[layer] = c;
+		rt_unit *u = ctx->levels[layer] ? rt_unit_get(ctx, (mlod_rt_layer)layer, c,
+		                                              layer == MLOD_RT_MOTION ? in->st.clip : 0)
+		                                : NULL;
+		if (u)
+			u->users++;
+	}
+	ctx->live++;
+	*id = i;
+	return MLOD_OK;
+}
+
+void mlod_rt_instance_destroy(mlod_rt_ctx *ctx, uint32_t id)
+{
+	if (!ctx || id >= ctx->max_instances || !ctx->inst[id].st.alive)
+		return;
+	rt_instance *in = &ctx->inst[id];
+	unuse(ctx, in);
+	in->st.alive = 0;
+	in->next_free = ctx->free_head;
+	ctx->free_head = id;
+	ctx->live--;
+}
+
+mlod_result mlod_rt_instance_set(mlod_rt_ctx *ctx, uint32_t id, uint32_t clip, float time, uint32_t flags,
+                                 mlod_error *err)
+{
+	if (!ctx || id >= ctx->max_instances || !ctx->inst[id].st.alive)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
+	if (ctx->clip_count && clip >= ctx->clip_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "clip %u out of range (%u clips)", clip, ctx->clip_count);
+	rt_instance *in = &ctx->inst[id];
+	unuse(ctx, in);
+	in->st.clip = ctx->clip_count ? clip : 0;
+	in->st.time = time;
+	in->st.flags = flags;
+	/* The shown motion level now counts for the new clip. */
+	for (int layer = 0; layer < MLOD_RT_LAYERS; layer++) {
+		rt_unit *u = ctx->levels[layer] ? rt_unit_get(ctx, (mlod_rt_layer)layer, in->st.level[layer],
+		                                              layer == MLOD_RT_MOTION ? in->st.clip : 0)
+		                                : NULL;
+		if (u)
+			u->users++;
+	}
+	rt_resolve(ctx, in);
+	return MLOD_OK;
+}
+
+const mlod_rt_state *mlod_rt_instance_state(const mlod_rt_ctx *ctx, uint32_t id)
+{
+	if (!ctx || id >= ctx->max_instances || !ctx->inst[id].st.alive)
+		return NULL;
+	return &ctx->inst[id].st;
+}

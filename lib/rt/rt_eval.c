@@ -1,0 +1,350 @@
+/*
+ * rt_eval.c: motion sampling (the bake side's mlod_clip_sample semantics),
+ * the pose of a skeleton level folded at run time, the palette and the
+ * skinning of a mesh level into the caller's buffers (mlod_rt.h,
+ * "Evaluation").
+ */
+#include <math.h>
+#include <string.h>
+
+#include "rt_internal.h"
+
+/* ---------------------------------------------------------------- */
+/* Matrices (column-major, affine)                                   */
+/* ---------------------------------------------------------------- */
+
+/* a * b for affine a and b; the same sums in the same order as
+ * mlod_mat4_mul, so the same floats. */
+void rt_mat_mul(const float *a, const float *b, float *out)
+{
+	float r[16];
+	for (int c = 0; c < 4; c++) {
+		for (int row = 0; row < 3; row++)
+			r[c * 4 + row] = a[row] * b[c * 4] + a[4 + row] * b[c * 4 + 1] + a[8 + row] * b[c * 4 + 2] +
+			                 a[12 + row] * b[c * 4 + 3];
+		r[c * 4 + 3] = c == 3 ? 1.0f : 0.0f;
+	}
+	memcpy(out, r, sizeof r);
+}
+
+void rt_mat_trs(const mlod_trs *t, float *out)
+{
+	mlod_mat4 m = mlod_mat4_from_trs(t);
+	memcpy(out, m.m, sizeof m.m);
+}
+
+/* ---------------------------------------------------------------- */
+/* Sampling (as lib/model/pose.c's sample_channel)                   */
+/* ---------------------------------------------------------------- */
+
+static uint32_t find_key(const float *times, uint32_t n, float t)
+{
+	uint32_t lo = 0, hi = n - 1;
+	while (hi - lo > 1) {
+		uint32_t mid = lo + (hi - lo) / 2;
+		if (times[mid] <= t)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return lo;
+}
+
+static void sample_channel(const mlod_pack_channel *ch, float t, int comps, float *out)
+{
+	const uint32_t n = ch->rec.key_count;
+	const int cubic = ch->rec.interp == 2;
+	const size_t stride = cubic ? 3 * (size_t)comps : (size_t)comps, value = cubic ? (size_t)comps : 0;
+	const float *v = ch->values;
+	const float *times = ch->times;
+	int64_t k;
+	if (n == 1 || !(t > times[0]))
+		k = 0;
+	else if (t >= times[n - 1])
+		k = n - 1;
+	else
+		k = -1;
+	if (k >= 0) {
+		memcpy(out, v + (size_t)k * stride + value, (size_t)comps * sizeof *out);
+		return;
+	}
+	const uint32_t i = find_key(times, n, t);
+	const float t0 = times[i], t1 = times[i + 1], dt = t1 - t0;
+	const float u = (t - t0) / dt;
+	const float *a = v + (size_t)i * stride, *b = v + (size_t)(i + 1) * stride;
+	switch (ch->rec.interp) {
+	case 1: /* STEP */
+		memcpy(out, a, (size_t)comps * sizeof *out);
+		break;
+	case 0: /* LINEAR */
+		if (comps == 4) {
+			mlod_quat qa = { a[0], a[1], a[2], a[3] }, qb = { b[0], b[1], b[2], b[3] };
+			mlod_quat q = mlod_quat_slerp(qa, qb, u);
+			out[0] = q.x, out[1] = q.y, out[2] = q.z, out[3] = q.w;
+		} else {
+			for (int c = 0; c < comps; c++)
+				out[c] = a[c] + (b[c] - a[c]) * u;
+		}
+		break;
+	default: { /* CUBICSPLINE: glTF Appendix C */
+		const float u2 = u * u, u3 = u2 * u;
+		const float h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u;
+		const float h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
+		for (int c = 0; c < comps; c++)
+			out[c] = h00 * a[comps + c] + h10 * dt * a[2 * comps + c] + h01 * b[comps + c] + h11 * dt * b[c];
+		break;
+	}
+	}
+}
+
+/* Samples the channels of the posed joints into local. */
+static void sample_motion(const mlod_pack_motion *m, float t, const uint8_t *needed, mlod_trs *local)
+{
+	for (uint32_t i = 0; i < m->channel_count; i++) {
+		const mlod_pack_channel *ch = &m->channels[i];
+		if (ch->rec.key_count < 1 || !needed[ch->rec.joint])
+			continue;
+		mlod_trs *l = &local[ch->rec.joint];
+		float v[4];
+		switch (ch->rec.path) {
+		case 0:
+			sample_channel(ch, t, 3, v);
+			l->t.x = v[0], l->t.y = v[1], l->t.z = v[2];
+			break;
+		case 2:
+			sample_channel(ch, t, 3, v);
+			l->s.x = v[0], l->s.y = v[1], l->s.z = v[2];
+			break;
+		default: {
+			sample_channel(ch, t, 4, v);
+			mlod_quat q = { v[0], v[1], v[2], v[3] };
+			l->r = mlod_quat_normalize(q);
+			break;
+		}
+		}
+	}
+}
+
+/* ---------------------------------------------------------------- */
+/* Scratch                                                           */
+/* ---------------------------------------------------------------- */
+
+mlod_rt_scratch *mlod_rt_scratch_create(mlod_rt_ctx *ctx)
+{
+	if (!ctx)
+		return NULL;
+	const size_t J = ctx->joint_count, P = ctx->palette_size;
+	size_t bytes = sizeof(mlod_rt_scratch) + J * sizeof(mlod_trs) + 16 * sizeof(float) * (J + P) + 64;
+	mlod_rt_scratch *s = rt_alloc(ctx, bytes);
+	if (!s)
+		return NULL;
+	memset(s, 0, bytes);
+	/* one block: the floats on a 16-byte boundary */
+	uintptr_t a = ((uintptr_t)(s + 1) + 15) & ~(uintptr_t)15;
+	s->world = (float *)a;
+	s->palette = s->world + 16 * J;
+	s->local = (mlod_trs *)(s->palette + 16 * P);
+	return s;
+}
+
+void mlod_rt_scratch_destroy(mlod_rt_ctx *ctx, mlod_rt_scratch *s)
+{
+	if (ctx && s)
+		rt_free(ctx, s);
+}
+
+/* ---------------------------------------------------------------- */
+/* Pose and palette                                                  */
+/* ---------------------------------------------------------------- */
+
+/* The level-0 or level-k posing tables of the instance's skeleton level. */
+static const rt_unit *skel_unit(const mlod_rt_ctx *ctx, const mlod_rt_state *st)
+{
+	const rt_unit *u = rt_unit_get(ctx, MLOD_RT_SKELETON, st->level[MLOD_RT_SKELETON], 0);
+	return u && u->level > 0 && u->state == RT_UNIT_RESIDENT ? u : NULL;
+}
+
+static float sample_time(const mlod_rt_ctx *ctx, const mlod_rt_state *st)
+{
+	const float dur = ctx->clip_duration[st->clip];
+	float t = st->time;
+	if ((st->flags & MLOD_RT_LOOP) && dur > 0.0f && (t >= dur || t < 0.0f)) {
+		t = fmodf(t, dur);
+		if (t < 0.0f)
+			t += dur;
+	}
+	if (!(t > 0.0f))
+		t = 0.0f; /* also NaN */
+	if (t > dur)
+		t = dur;
+	return t;
+}
+
+mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const float **world,
+                         const uint32_t **joints, uint32_t *joint_count, mlod_error *err)
+{
+	if (!ctx || !s)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_pose: NULL argument");
+	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
+	const mlod_rt_state *st = &ctx->inst[id].st;
+	const rt_unit *su = skel_unit(ctx, st);
+	const uint32_t *posed = su ? su->plan.posed : ctx->all_joints;
+	const uint32_t npose = su ? su->plan.posed_count : ctx->joint_count;
+	const uint8_t *needed = su ? su->plan.needed : ctx->all_needed;
+	const mlod_pack_joint_rec *jr = ctx->skel->joints;
+	mlod_trs *local = s->local;
+	float *W = s->world;
+
+	for (uint32_t i = 0; i < npose; i++)
+		local[posed[i]] = ctx->rest_local[posed[i]];
+	if (ctx->clip_count) {
+		const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MOTION, st->level[MLOD_RT_MOTION], st->clip);
+		if (mu && mu->state == RT_UNIT_RESIDENT)
+			sample_motion(mu->motion, sample_time(ctx, st), needed, local);
+	}
+	for (uint32_t i = 0; i < npose; i++) {
+		const uint32_t j = posed[i];
+		float l[16];
+		rt_mat_trs(&local[j], l);
+		rt_mat_mul(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, l, W + 16 * (size_t)j);
+	}
+	s->skel_unit = su;
+	s->posed = 1;
+	s->paletted = 0;
+	if (world)
+		*world = W;
+	if (joints)
+		*joints = su ? su->plan.kept : ctx->all_joints;
+	if (joint_count)
+		*joint_count = su ? su->plan.kept_count : ctx->joint_count;
+	return MLOD_OK;
+}
+
+static void build_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s)
+{
+	const rt_unit *su = s->skel_unit;
+	const float *W = s->world;
+	if (su) {
+		for (uint32_t e = 0; e < ctx->palette_size; e++)
+			rt_mat_mul(W + 16 * (size_t)su->plan.palette_joint[e], su->plan.palette_bind + 16 * (size_t)e,
+			           s->palette + 16 * (size_t)e);
+	} else {
+		for (uint32_t k = 0; k < ctx->skin_count; k++) {
+			const uint32_t off = ctx->skin_offset[k];
+			for (uint32_t i = 0; i < ctx->skel->skins[k].joint_count; i++)
+				rt_mat_mul(W + 16 * (size_t)ctx->skel->skin_joints[k][i], ctx->skel->inverse_bind[k] + 16 * (size_t)i,
+				           s->palette + 16 * (size_t)(off + i));
+		}
+	}
+	s->paletted = 1;
+}
+
+mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const float **palette, uint32_t *count,
+                            mlod_error *err)
+{
+	if (!ctx || !s)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_palette: NULL argument");
+	if (!s->posed)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_palette: no pose in the scratch (call mlod_rt_pose)");
+	if (!s->paletted)
+		build_palette(ctx, s);
+	if (palette)
+		*palette = s->palette;
+	if (count)
+		*count = ctx->palette_size;
+	return MLOD_OK;
+}
+
+/* ---------------------------------------------------------------- */
+/* Skinning                                                          */
+/* ---------------------------------------------------------------- */
+
+static void transform_part(const mlod_pack_part *p, const float *M, float *out_pos, size_t ps, float *out_nrm,
+                           size_t ns)
+{
+	const uint32_t n = p->rec.vertex_count;
+	for (uint32_t v = 0; v < n; v++) {
+		const float *q = p->positions + 3 * (size_t)v;
+		float *o = (float *)((char *)out_pos + (size_t)v * ps);
+		for (int r = 0; r < 3; r++)
+			o[r] = M[r] * q[0] + M[4 + r] * q[1] + M[8 + r] * q[2] + M[12 + r];
+		if (out_nrm) {
+			float *on = (float *)((char *)out_nrm + (size_t)v * ns);
+			if (!p->normals) {
+				on[0] = on[1] = on[2] = 0.0f;
+				continue;
+			}
+			const float *nn = p->normals + 3 * (size_t)v;
+			float len2 = 0.0f;
+			for (int r = 0; r < 3; r++) {
+				on[r] = M[r] * nn[0] + M[4 + r] * nn[1] + M[8 + r] * nn[2];
+				len2 += on[r] * on[r];
+			}
+			const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
+			for (int r = 0; r < 3; r++)
+				on[r] *= il;
+		}
+	}
+}
+
+mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float *positions,
+                         size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
+                         uint32_t *vertex_count, mlod_error *err)
+{
+	if (vertex_count)
+		*vertex_count = 0;
+	if (!ctx || !s || !positions)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: NULL argument");
+	if (pos_stride < 12 || pos_stride % 4 || (normals && (nrm_stride < 12 || nrm_stride % 4)))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: strides must be multiples of 4, at least 12");
+	if (ctx->levels[MLOD_RT_MESH] == 0)
+		return MLOD_OK;
+	mlod_result r = mlod_rt_pose(ctx, s, id, NULL, NULL, NULL, err);
+	if (r)
+		return r;
+	const mlod_rt_state *st = &ctx->inst[id].st;
+	const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MESH, st->level[MLOD_RT_MESH], 0);
+	if (!mu || mu->state != RT_UNIT_RESIDENT)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u shows no resident mesh level", id);
+	if (mu->vertex_count > capacity)
+		return mlod_fail(err, MLOD_ERR_LIMIT, "mesh level %u has %u vertices, the buffers hold %u", mu->level,
+		                 mu->vertex_count, capacity);
+	build_palette(ctx, s);
+	const rt_unit *su = s->skel_unit;
+	const float *W = s->world;
+	size_t base = 0;
+	for (uint32_t i = 0; i < mu->mesh->part_count; i++) {
+		const mlod_pack_part *p = &mu->mesh->parts[i];
+		const uint32_t n = p->rec.vertex_count;
+		float *op = (float *)((char *)positions + base * pos_stride);
+		float *on = normals ? (float *)((char *)normals + base * nrm_stride) : NULL;
+		if (p->rec.skin >= 0 && n) {
+			const float *pal = s->palette + 16 * (size_t)ctx->skin_offset[p->rec.skin];
+			mlod_rt_skin_lbs(n, p->positions, on ? p->normals : NULL, p->joints, p->weights, pal, op, pos_stride, on,
+			                 nrm_stride);
+			if (on && !p->normals)
+				for (uint32_t v = 0; v < n; v++) {
+					float *x = (float *)((char *)on + (size_t)v * nrm_stride);
+					x[0] = x[1] = x[2] = 0.0f;
+				}
+		} else if (p->rec.joint >= 0) {
+			const uint32_t j = (uint32_t)p->rec.joint;
+			float M[16];
+			if (su && su->plan.stand[j] != (int32_t)j) {
+				float t[16];
+				rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
+				rt_mat_mul(t, p->rec.offset, M);
+			} else {
+				rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
+			}
+			transform_part(p, M, op, pos_stride, on, nrm_stride);
+		} else {
+			transform_part(p, p->rec.offset, op, pos_stride, on, nrm_stride);
+		}
+		base += n;
+	}
+	if (vertex_count)
+		*vertex_count = (uint32_t)base;
+	return MLOD_OK;
+}

@@ -1,0 +1,139 @@
+/*
+ * rt_internal.h: the runtime's private structures (lib/rt only).
+ */
+#ifndef MLOD_RT_INTERNAL_H
+#define MLOD_RT_INTERNAL_H
+
+#include "mlod_rt.h"
+
+/* A loaded skeleton level's tables (level >= 1), built at load. */
+typedef struct rt_skel_plan {
+	uint32_t posed_count;     /* kept joints and their removed ancestors, increasing */
+	uint32_t *posed;
+	uint8_t *needed;          /* joint_count flags: 1 when posed */
+	uint32_t kept_count;
+	const uint32_t *kept;
+	int32_t *stand;           /* joint_count: nearest kept ancestor-or-self */
+	float *rel;               /* 16 per joint: rest transform stand-in -> joint (identity when kept) */
+	const uint32_t *palette_joint;
+	const float *palette_bind;
+} rt_skel_plan;
+
+enum { RT_UNIT_ABSENT = 0, RT_UNIT_RESIDENT = 1, RT_UNIT_FAILED = 2 };
+
+/* One level of one layer (and clip for motion): the cache's unit. */
+typedef struct rt_unit {
+	uint8_t layer;            /* mlod_rt_layer */
+	uint8_t state;            /* RT_UNIT_* */
+	uint8_t coarse;           /* pinned: the coarsest level */
+	uint8_t owned;            /* decoded by the runtime (pack source) */
+	uint16_t level, item;
+	int32_t chunk;            /* TOC index, -1 for views */
+	uint32_t stored_size, raw_size;
+	float error, distance;
+	size_t bytes;             /* counted while resident */
+	uint64_t last_wanted;     /* the update stamp */
+	uint32_t want_count;      /* instances wanting it at the last update */
+	uint32_t users;           /* instances showing it */
+	uint32_t vertex_count;    /* mesh levels: vertices over all parts */
+	/* Resident data. */
+	const void *view;         /* views: the caller's struct */
+	union {
+		mlod_pack_skel_level skel;
+		mlod_pack_mesh mesh;
+		mlod_pack_motion motion;
+	} dec;                    /* pack source: decoded here */
+	const mlod_pack_skel_level *skel;
+	const mlod_pack_mesh *mesh;
+	const mlod_pack_motion *motion;
+	rt_skel_plan plan;        /* skeleton levels >= 1 */
+	void *plan_block;
+} rt_unit;
+
+struct mlod_rt_ctx;
+/* The source: decodes a unit into u->dec (pack source, rt_pack.c), frees
+ * it, and closes the source. NULL for views. */
+typedef mlod_result (*rt_load_fn)(struct mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err);
+typedef void (*rt_unload_fn)(struct mlod_rt_ctx *ctx, rt_unit *u);
+typedef void (*rt_close_fn)(struct mlod_rt_ctx *ctx);
+
+typedef struct rt_instance {
+	mlod_rt_state st;
+	uint32_t next_free;
+	int selected;             /* 0 until the first update: no hysteresis then */
+} rt_instance;
+
+struct mlod_rt_ctx {
+	mlod_rt_allocator alloc;
+	size_t budget;
+	rt_load_fn load;
+	rt_unload_fn unload;
+	rt_close_fn close_source;
+	/* Source. */
+	int source;               /* 0 views, 1 memory, 2 read callback (path uses 2) */
+	const uint8_t *data;
+	size_t size;
+	mlod_rt_read_fn read;
+	void *read_user;
+	void *file;               /* FILE * for open_path */
+	uint64_t file_size;
+	mlod_pack pack;
+	int pack_open;
+	mlod_pack_chunk *shadow;  /* a copy of the TOC for decoding from the staging buffer */
+	uint8_t *staging;
+	size_t staging_size;
+	mlod_pack_info info;
+	mlod_pack_skeleton skel_dec;
+	int skel_owned, info_owned;
+	/* The character. */
+	const mlod_pack_skeleton *skel;
+	uint32_t joint_count, skin_count, palette_size;
+	uint32_t *skin_offset;    /* skin_count: first palette entry of each skin */
+	float *rest_world;        /* 16 per joint */
+	mlod_trs *rest_local;     /* joint_count */
+	uint32_t *all_joints;     /* 0..joint_count-1: level 0's posed and kept list */
+	uint8_t *all_needed;      /* joint_count ones */
+	uint32_t levels[MLOD_RT_LAYERS];
+	uint32_t clip_count;
+	float *clip_duration;
+	/* Units: skeleton levels, mesh levels, then motion clip-major. */
+	rt_unit *units;
+	uint32_t unit_count;
+	uint32_t unit_base[MLOD_RT_LAYERS];
+	/* Cache. */
+	size_t resident_bytes, peak_bytes;
+	uint64_t stamp;
+	uint64_t loads, evictions, failures;
+	uint32_t max_vertices;
+	/* Instances. */
+	rt_instance *inst;
+	uint32_t max_instances, free_head, live;
+};
+
+struct mlod_rt_scratch {
+	mlod_trs *local;          /* joint_count */
+	float *world;             /* 16 per joint */
+	float *palette;           /* 16 per palette entry */
+	const rt_unit *skel_unit; /* the pose's skeleton level (NULL: level 0) */
+	int posed, paletted;
+};
+
+/* rt_ctx.c */
+void *rt_alloc(const mlod_rt_ctx *ctx, size_t size);
+void rt_free(const mlod_rt_ctx *ctx, void *p);
+rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item);
+void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in);
+mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err);
+mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
+
+
+/* Byte counts of decoded views (from their arrays). */
+size_t rt_bytes_skel_level(const mlod_pack_skel_level *l);
+size_t rt_bytes_mesh(const mlod_pack_mesh *m);
+size_t rt_bytes_motion(const mlod_pack_motion *m);
+
+/* rt_eval.c: the 3x4 affine helpers. */
+void rt_mat_mul(const float *a, const float *b, float *out); /* 4x4 column-major, affine */
+void rt_mat_trs(const mlod_trs *t, float *out);
+
+#endif

@@ -1,0 +1,301 @@
+/*
+ * rt_pack.c: the pack source of the runtime: mlod_rt_open_memory, _path
+ * and _read, and the loader that decodes one level through the pack reader
+ * (lib/rt/pack.c) inside mlod_rt_stream. Sources other than memory read a
+ * chunk into a staging buffer (allocated at open, the size of the largest
+ * chunk) and decode it through a copy of the TOC whose entry for that
+ * chunk says offset 0.
+ */
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rt_internal.h"
+
+enum { SRC_VIEWS = 0, SRC_MEMORY = 1, SRC_READ = 2 };
+
+/* The chunk's bytes as (data, size) for the reader, and the pack to pass. */
+static mlod_result chunk_bytes(mlod_rt_ctx *ctx, uint32_t chunk, const mlod_pack **pack, const void **data,
+                               size_t *size, mlod_pack *shadow, mlod_error *err)
+{
+	const mlod_pack_chunk *c = &ctx->pack.chunks[chunk];
+	if (ctx->source == SRC_MEMORY) {
+		*pack = &ctx->pack;
+		*data = ctx->data;
+		*size = ctx->size;
+		return MLOD_OK;
+	}
+	if (c->stored_size > ctx->staging_size)
+		return mlod_fail(err, MLOD_ERR_PARSE, "chunk %u: %u bytes, larger than the staging buffer", chunk,
+		                 c->stored_size);
+	if (ctx->read(ctx->read_user, c->offset, c->stored_size, ctx->staging) != 0)
+		return mlod_fail(err, MLOD_ERR_IO, "chunk %u: reading %u bytes at offset %llu failed", chunk, c->stored_size,
+		                 (unsigned long long)c->offset);
+	*shadow = ctx->pack;
+	memcpy(ctx->shadow, ctx->pack.chunks, sizeof *ctx->shadow * ctx->pack.chunk_count);
+	ctx->shadow[chunk].offset = 0;
+	shadow->chunks = ctx->shadow;
+	*pack = shadow;
+	*data = ctx->staging;
+	*size = c->stored_size;
+	return MLOD_OK;
+}
+
+static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
+{
+	const mlod_pack *p;
+	const void *data;
+	size_t size;
+	mlod_pack shadow;
+	mlod_result r = chunk_bytes(ctx, (uint32_t)u->chunk, &p, &data, &size, &shadow, err);
+	if (r)
+		return r;
+	memset(&u->dec, 0, sizeof u->dec);
+	switch (u->layer) {
+	case MLOD_RT_SKELETON:
+		return mlod_pack_decode_skel_level(p, (uint32_t)u->chunk, data, size, ctx->skel, &u->dec.skel, err);
+	case MLOD_RT_MESH:
+		return mlod_pack_decode_mesh(p, (uint32_t)u->chunk, data, size, ctx->skel, &u->dec.mesh, err);
+	default:
+		return mlod_pack_decode_motion(p, (uint32_t)u->chunk, data, size, ctx->skel, &u->dec.motion, err);
+	}
+}
+
+static void pack_unload(mlod_rt_ctx *ctx, rt_unit *u)
+{
+	(void)ctx;
+	switch (u->layer) {
+	case MLOD_RT_SKELETON: mlod_pack_skel_level_free(&u->dec.skel); break;
+	case MLOD_RT_MESH: mlod_pack_mesh_free(&u->dec.mesh); break;
+	default: mlod_pack_motion_free(&u->dec.motion); break;
+	}
+}
+
+static void pack_close(mlod_rt_ctx *ctx)
+{
+	if (ctx->skel_owned)
+		mlod_pack_skeleton_free(&ctx->skel_dec);
+	if (ctx->info_owned)
+		mlod_pack_info_free(&ctx->info);
+	if (ctx->pack_open)
+		mlod_pack_close(&ctx->pack);
+	rt_free(ctx, ctx->shadow);
+	rt_free(ctx, ctx->staging);
+	if (ctx->file)
+		fclose(ctx->file);
+	ctx->file = NULL;
+}
+
+static size_t skeleton_bytes(const mlod_pack_skeleton *s)
+{
+	size_t b = sizeof *s + (size_t)s->joint_count * (sizeof *s->joints + sizeof(char *) + 16);
+	for (uint32_t k = 0; k < s->skin_count; k++)
+		b += sizeof *s->skins + 2 * sizeof(void *) + (size_t)s->skins[k].joint_count * (4 + 64);
+	return b;
+}
+
+/* Reads the header and TOC, decodes INFO and SKELETON, builds the units. */
+static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
+{
+	mlod_result r;
+	ctx->load = pack_load;
+	ctx->unload = pack_unload;
+	ctx->close_source = pack_close;
+	if (ctx->source == SRC_MEMORY) {
+		r = mlod_pack_open(ctx->data, ctx->size, &ctx->pack, err);
+	} else {
+		uint8_t head[MLOD_PACK_HEADER_SIZE];
+		if (ctx->file_size < MLOD_PACK_HEADER_SIZE)
+			return mlod_fail(err, MLOD_ERR_PARSE, "the pack has %llu bytes, less than its header",
+			                 (unsigned long long)ctx->file_size);
+		if (ctx->read(ctx->read_user, 0, sizeof head, head) != 0)
+			return mlod_fail(err, MLOD_ERR_IO, "reading the pack's header failed");
+		uint32_t n = (uint32_t)head[12] | (uint32_t)head[13] << 8 | (uint32_t)head[14] << 16 |
+		             (uint32_t)head[15] << 24;
+		if (n > MLOD_PACK_MAX_CHUNKS)
+			n = MLOD_PACK_MAX_CHUNKS + 1u; /* the reader says what is wrong */
+		uint64_t want = MLOD_PACK_HEADER_SIZE + (uint64_t)MLOD_PACK_TOC_ENTRY_SIZE * n;
+		if (want > ctx->file_size)
+			want = ctx->file_size;
+		uint8_t *toc = rt_alloc(ctx, (size_t)want);
+		if (!toc)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory for the TOC");
+		if (ctx->read(ctx->read_user, 0, (size_t)want, toc) != 0) {
+			rt_free(ctx, toc);
+			return mlod_fail(err, MLOD_ERR_IO, "reading the pack's TOC failed");
+		}
+		r = mlod_pack_open(toc, (size_t)want, &ctx->pack, err);
+		rt_free(ctx, toc);
+	}
+	if (r)
+		return r;
+	ctx->pack_open = 1;
+	if (ctx->pack.file_size != (ctx->source == SRC_MEMORY ? (uint64_t)ctx->size : ctx->file_size))
+		return mlod_fail(err, MLOD_ERR_PARSE, "the pack says %llu bytes, the source has %llu",
+		                 (unsigned long long)ctx->pack.file_size,
+		                 (unsigned long long)(ctx->source == SRC_MEMORY ? (uint64_t)ctx->size : ctx->file_size));
+	if (ctx->source != SRC_MEMORY) {
+		size_t big = 0;
+		for (uint32_t i = 0; i < ctx->pack.chunk_count; i++)
+			if (ctx->pack.chunks[i].type != MLOD_CHUNK_DOC && ctx->pack.chunks[i].stored_size > big)
+				big = ctx->pack.chunks[i].stored_size;
+		ctx->staging_size = big;
+		ctx->staging = rt_alloc(ctx, big);
+		ctx->shadow = rt_alloc(ctx, sizeof *ctx->shadow * (ctx->pack.chunk_count + 1));
+		if (!ctx->staging || !ctx->shadow)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory for a %zu-byte staging buffer", big);
+		ctx->resident_bytes += big + sizeof *ctx->shadow * ctx->pack.chunk_count;
+	}
+	/* INFO and SKELETON. */
+	const mlod_pack *p;
+	const void *data;
+	size_t size;
+	mlod_pack shadow;
+	int ci = mlod_pack_find(&ctx->pack, MLOD_CHUNK_INFO, 0, 0);
+	int cs = mlod_pack_find(&ctx->pack, MLOD_CHUNK_SKELETON, 0, 0);
+	if (ci < 0 || cs < 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no %s chunk", ci < 0 ? "INFO" : "SKELETON");
+	if ((r = chunk_bytes(ctx, (uint32_t)ci, &p, &data, &size, &shadow, err)) ||
+	    (r = mlod_pack_decode_info(p, data, size, &ctx->info, err)))
+		return r;
+	ctx->info_owned = 1;
+	if ((r = chunk_bytes(ctx, (uint32_t)cs, &p, &data, &size, &shadow, err)) ||
+	    (r = mlod_pack_decode_skeleton(p, data, size, &ctx->skel_dec, err)))
+		return r;
+	ctx->skel_owned = 1;
+	ctx->skel = &ctx->skel_dec;
+	ctx->resident_bytes += sizeof ctx->info + skeleton_bytes(ctx->skel);
+	const mlod_pack_info_rec *rec = &ctx->info.rec;
+	if (rec->skeleton_levels < 1 || rec->skeleton_levels > 65535 || rec->mesh_levels > 65535 ||
+	    rec->motion_levels > 65535 || rec->clip_count > 65535)
+		return mlod_fail(err, MLOD_ERR_PARSE, "INFO: level counts out of range");
+	ctx->levels[MLOD_RT_SKELETON] = rec->skeleton_levels;
+	ctx->levels[MLOD_RT_MESH] = rec->mesh_levels;
+	ctx->clip_count = rec->motion_levels ? rec->clip_count : 0;
+	ctx->levels[MLOD_RT_MOTION] = ctx->clip_count ? rec->motion_levels : 0;
+	ctx->unit_count = ctx->levels[0] + ctx->levels[1] + ctx->clip_count * ctx->levels[2];
+	ctx->unit_base[0] = 0;
+	ctx->unit_base[1] = ctx->levels[0];
+	ctx->unit_base[2] = ctx->levels[0] + ctx->levels[1];
+	ctx->units = rt_alloc(ctx, sizeof *ctx->units * ctx->unit_count);
+	if (!ctx->units)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
+	memset(ctx->units, 0, sizeof *ctx->units * ctx->unit_count);
+	for (uint32_t i = 0; i < ctx->unit_count; i++) {
+		rt_unit *u = &ctx->units[i];
+		uint32_t type;
+		if (i < ctx->unit_base[1])
+			u->layer = MLOD_RT_SKELETON, u->level = (uint16_t)i, type = MLOD_CHUNK_SKELETON;
+		else if (i < ctx->unit_base[2])
+			u->layer = MLOD_RT_MESH, u->level = (uint16_t)(i - ctx->unit_base[1]), type = MLOD_CHUNK_MESH;
+		else {
+			uint32_t k = i - ctx->unit_base[2];
+			u->layer = MLOD_RT_MOTION;
+			u->item = (uint16_t)(k / ctx->levels[2]);
+			u->level = (uint16_t)(k % ctx->levels[2]);
+			type = MLOD_CHUNK_MOTION;
+		}
+		int c = mlod_pack_find(&ctx->pack, type, u->level, u->item);
+		if (c < 0)
+			return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no %s level %u%s", mlod_pack_type_name(type),
+			                 u->level, u->layer == MLOD_RT_MOTION ? " for a clip" : "");
+		u->chunk = c;
+		u->stored_size = ctx->pack.chunks[c].stored_size;
+		u->raw_size = ctx->pack.chunks[c].raw_size;
+		u->error = ctx->pack.chunks[c].error;
+		u->distance = ctx->pack.chunks[c].distance;
+	}
+	return rt_ctx_finish_open(ctx, err);
+}
+
+static mlod_result finish(mlod_rt_ctx *ctx, mlod_rt_ctx **out, mlod_error *err)
+{
+	mlod_result r = pack_open(ctx, err);
+	if (r) {
+		mlod_rt_close(ctx);
+		return r;
+	}
+	*out = ctx;
+	return MLOD_OK;
+}
+
+mlod_result mlod_rt_open_memory(const void *data, size_t size, const mlod_rt_config *config, mlod_rt_ctx **out,
+                                mlod_error *err)
+{
+	if (!out || (!data && size))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_memory: NULL argument");
+	*out = NULL;
+	mlod_rt_ctx *ctx = rt_ctx_new(config);
+	if (!ctx)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
+	ctx->source = SRC_MEMORY;
+	ctx->data = data;
+	ctx->size = size;
+	return finish(ctx, out, err);
+}
+
+mlod_result mlod_rt_open_read(mlod_rt_read_fn read, void *user, uint64_t file_size, const mlod_rt_config *config,
+                              mlod_rt_ctx **out, mlod_error *err)
+{
+	if (!out || !read)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_read: NULL argument");
+	*out = NULL;
+	mlod_rt_ctx *ctx = rt_ctx_new(config);
+	if (!ctx)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
+	ctx->source = SRC_READ;
+	ctx->read = read;
+	ctx->read_user = user;
+	ctx->file_size = file_size;
+	return finish(ctx, out, err);
+}
+
+static int file_read(void *user, uint64_t offset, size_t size, void *dst)
+{
+	FILE *f = user;
+	if (offset > (uint64_t)LONG_MAX || fseek(f, (long)offset, SEEK_SET) != 0)
+		return -1;
+	return fread(dst, 1, size, f) == size ? 0 : -1;
+}
+
+mlod_result mlod_rt_open_path(const char *path, const mlod_rt_config *config, mlod_rt_ctx **out, mlod_error *err)
+{
+	if (!out || !path)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_path: NULL argument");
+	*out = NULL;
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return mlod_fail(err, MLOD_ERR_IO, "%s: cannot open", path);
+	long end = -1;
+	if (fseek(f, 0, SEEK_END) == 0)
+		end = ftell(f);
+	if (end < 0) {
+		fclose(f);
+		return mlod_fail(err, MLOD_ERR_IO, "%s: cannot tell its size", path);
+	}
+	mlod_rt_ctx *ctx = rt_ctx_new(config);
+	if (!ctx) {
+		fclose(f);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
+	}
+	ctx->source = SRC_READ;
+	ctx->read = file_read;
+	ctx->read_user = f;
+	ctx->file = f;
+	ctx->file_size = (uint64_t)end;
+	mlod_result r = pack_open(ctx, err);
+	if (r) {
+		mlod_rt_close(ctx);
+		/* say which file */
+		if (err) {
+			char m[MLOD_ERROR_MESSAGE_SIZE];
+			memcpy(m, err->message, sizeof m);
+			m[300] = '\0';
+			mlod_fail(err, r, "%.200s: %s", path, m);
+		}
+		return r;
+	}
+	*out = ctx;
+	return MLOD_OK;
+}

@@ -1,0 +1,366 @@
+/*
+ * test_rt_eval.c: sampling against hand-computed values (LINEAR lerp and
+ * slerp, STEP, CUBICSPLINE, loop and clamp), folding at run time (skeleton
+ * levels give the full skeleton's world matrices at their kept joints),
+ * skinning against a hand-computed LBS (skinned, rigid, static parts;
+ * strides), the vectorised kernel against the scalar one, and no
+ * allocation per frame (counting allocator).
+ */
+#include "rt_test.h"
+
+static mlod_rt_ctx *open_all(mlod_rt_config *cfg, mlod_error *e)
+{
+	mlod_rt_ctx *ctx = NULL;
+	if (mlod_rt_open_views(&fx_views, cfg, &ctx, e) != MLOD_OK)
+		return NULL;
+	if (fx_load_all(ctx) != 0) {
+		mlod_rt_close(ctx);
+		return NULL;
+	}
+	return ctx;
+}
+
+/* Updates one instance with every layer forced to level. */
+static mlod_result force(mlod_rt_ctx *ctx, uint32_t id, int level, mlod_error *e)
+{
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	sel.force_level = level;
+	float d = 1;
+	return mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0f, e);
+}
+
+/* The local transform of joint j: inverse(world[parent]) * world[j]. */
+static void local_of(const float *W, int parent, int j, float *out)
+{
+	mlod_mat4 p, inv, w;
+	memcpy(p.m, W + 16 * parent, sizeof p.m);
+	memcpy(w.m, W + 16 * j, sizeof w.m);
+	mlod_mat4_invert(&p, &inv);
+	fx_mul(inv.m, w.m, out);
+}
+
+TEST(sample_hand_values)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_all(NULL, &e);
+	CHECK(ctx, "open: %s", e.message);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	uint32_t id;
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.25f, 0, &id, &e), e);
+	CHECK_OK(force(ctx, id, 0, &e), e);
+	const float *W;
+	CHECK_OK(mlod_rt_pose(ctx, s, id, &W, NULL, NULL, &e), e);
+	/* joint 0: lerp (0,0,0) -> (2,4,6) at 0.25, after base z + 0.5 */
+	CHECK(NEAR(W[12], 0.5, 1e-6) && NEAR(W[13], 1.0, 1e-6) && NEAR(W[14], 2.0, 1e-6), "W0 t = %g %g %g", W[12],
+	      W[13], W[14]);
+	/* joint 1: slerp identity -> Rz(90) at 0.25: Rz(22.5) */
+	const double c = cos(22.5 * M_PI / 180), sn = sin(22.5 * M_PI / 180);
+	const float *W1 = W + 16;
+	CHECK(NEAR(W1[0], c, 1e-6) && NEAR(W1[1], sn, 1e-6) && NEAR(W1[4], -sn, 1e-6) && NEAR(W1[5], c, 1e-6),
+	      "W1 rotation %g %g %g %g", W1[0], W1[1], W1[4], W1[5]);
+	CHECK(NEAR(W1[12], 0.5, 1e-6) && NEAR(W1[13], 2.0, 1e-6) && NEAR(W1[14], 2.0, 1e-6), "W1 t");
+	/* joint 2: STEP holds identity before 0.5 */
+	const float *W2 = W + 32;
+	CHECK(NEAR(W2[12], 0.5 - sn, 1e-6) && NEAR(W2[13], 2.0 + c, 1e-6) && NEAR(W2[0], c, 1e-6), "W2");
+	/* joint 3: CUBICSPLINE at u = 0.125, dt = 2 */
+	float L[16];
+	local_of(W, 2, 3, L);
+	CHECK(NEAR(L[12], 0.19140625, 1e-5) && NEAR(L[13], 1.0859375, 1e-5) && NEAR(L[14], -0.0546875, 1e-5),
+	      "L3 t = %.7g %.7g %.7g", L[12], L[13], L[14]);
+	/* joint 4: scale lerp 1 -> 3 over [0, 2] at 0.25: 1.25 */
+	local_of(W, 1, 4, L);
+	CHECK(NEAR(L[0], 1.25, 1e-5) && NEAR(L[5], 1.25, 1e-5) && NEAR(L[10], 1.25, 1e-5), "L4 scale %g", L[0]);
+
+	/* t = 0.75: STEP switched to Rx(90); slerp Rz(67.5) */
+	CHECK_OK(mlod_rt_instance_set(ctx, id, 0, 0.75f, 0, &e), e);
+	CHECK_OK(mlod_rt_pose(ctx, s, id, &W, NULL, NULL, &e), e);
+	local_of(W, 1, 2, L);
+	CHECK(NEAR(L[5], 0, 1e-6) && NEAR(L[6], 1, 1e-6) && NEAR(L[9], -1, 1e-6), "L2 is not Rx(90)");
+	local_of(W, 0, 1, L);
+	CHECK(NEAR(L[0], cos(67.5 * M_PI / 180), 1e-6) && NEAR(L[1], sin(67.5 * M_PI / 180), 1e-6), "L1 not Rz(67.5)");
+	/* t = 1.5: between Rz(90) and Rz(180): Rz(135) */
+	CHECK_OK(mlod_rt_instance_set(ctx, id, 0, 1.5f, 0, &e), e);
+	CHECK_OK(mlod_rt_pose(ctx, s, id, &W, NULL, NULL, &e), e);
+	local_of(W, 0, 1, L);
+	CHECK(NEAR(L[0], cos(135 * M_PI / 180), 1e-6) && NEAR(L[1], sin(135 * M_PI / 180), 1e-6), "L1 not Rz(135)");
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+}
+
+TEST(sample_loop_and_clamp)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_all(NULL, &e);
+	CHECK(ctx, "open: %s", e.message);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	/* clip 1: joint 0 x from 0 to 4 over [0, 4] */
+	static const struct { float time; uint32_t flags; float x; } cases[] = {
+		{ 1.0f, 0, 1.0f }, { 5.0f, 0, 4.0f }, { -1.0f, 0, 0.0f },
+		{ 5.0f, MLOD_RT_LOOP, 1.0f }, { -1.0f, MLOD_RT_LOOP, 3.0f }, { 9.5f, MLOD_RT_LOOP, 1.5f },
+	};
+	CHECK(NEAR(mlod_rt_clip_duration(ctx, 1), 4.0, 0), "clip 1 lasts %g", mlod_rt_clip_duration(ctx, 1));
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		uint32_t id;
+		const float *W;
+		CHECK_OK(mlod_rt_instance_create(ctx, 1, cases[i].time, cases[i].flags, &id, &e), e);
+		CHECK_OK(force(ctx, id, 0, &e), e);
+		CHECK_OK(mlod_rt_pose(ctx, s, id, &W, NULL, NULL, &e), e);
+		CHECK(NEAR(W[12], cases[i].x, 1e-5), "time %g flags %u: x = %g, expected %g", cases[i].time,
+		      cases[i].flags, W[12], cases[i].x);
+		mlod_rt_instance_destroy(ctx, id);
+	}
+	/* Time advances by dt in update; looping wraps it. */
+	uint32_t id;
+	CHECK_OK(mlod_rt_instance_create(ctx, 1, 3.5f, MLOD_RT_LOOP, &id, &e), e);
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	sel.force_level = 0;
+	float d = 1;
+	CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f, &e), e);
+	CHECK(NEAR(mlod_rt_instance_state(ctx, id)->time, 0.5, 1e-6), "time %g after wrap",
+	      mlod_rt_instance_state(ctx, id)->time);
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+}
+
+TEST(fold_matches_full_skeleton)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_all(NULL, &e);
+	CHECK(ctx, "open: %s", e.message);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	sel.d_near = 0, sel.d_far = 100, sel.hysteresis = 0;
+	sel.t_start[MLOD_RT_MOTION] = sel.t_end[MLOD_RT_MOTION] = 1; /* motion level 0 below alpha 1 */
+	static const float times[] = { 0.0f, 0.3f, 0.77f, 1.4f, 1.99f };
+	for (size_t k = 0; k < sizeof times / sizeof times[0]; k++) {
+		uint32_t ids[3];
+		float d[3] = { 0, 50, 99 }; /* skeleton levels 0, 1 (alpha 0.5), 2 (alpha 0.99) */
+		for (int i = 0; i < 3; i++)
+			CHECK_OK(mlod_rt_instance_create(ctx, 0, times[k], 0, &ids[i], &e), e);
+		CHECK_OK(mlod_rt_update(ctx, &sel, ids, d, 3, 0.0f, &e), e);
+		float full[16 * FX_J];
+		const float *W;
+		const uint32_t *kept;
+		uint32_t nk;
+		for (int i = 0; i < 3; i++) {
+			const mlod_rt_state *st = mlod_rt_instance_state(ctx, ids[i]);
+			CHECK(st->level[MLOD_RT_SKELETON] == i && st->level[MLOD_RT_MOTION] == 0, "instance %d: levels %u %u",
+			      i, st->level[MLOD_RT_SKELETON], st->level[MLOD_RT_MOTION]);
+			CHECK_OK(mlod_rt_pose(ctx, s, ids[i], &W, &kept, &nk, &e), e);
+			if (i == 0) {
+				memcpy(full, W, sizeof full);
+				CHECK(nk == FX_J, "level 0 keeps %u", nk);
+				continue;
+			}
+			CHECK(nk == (i == 1 ? 3u : 1u), "level %d keeps %u", i, nk);
+			for (uint32_t q = 0; q < nk; q++) {
+				double dd = fx_maxdiff(W + 16 * kept[q], full + 16 * kept[q], 16);
+				CHECK(dd <= 1e-6, "t %g level %d joint %u: differs by %g from the full skeleton", times[k], i,
+				      kept[q], dd);
+			}
+		}
+		for (int i = 0; i < 3; i++)
+			mlod_rt_instance_destroy(ctx, ids[i]);
+	}
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+}
+
+/* Expected LBS of one vertex from the pose's world matrices. */
+static void lbs_expect(const float *W, const float *ibm, const uint16_t *j, const float *w, const float *p,
+                       float *out)
+{
+	out[0] = out[1] = out[2] = 0;
+	for (int k = 0; k < 4; k++) {
+		if (w[k] == 0)
+			continue;
+		float M[16];
+		fx_mul(W + 16 * j[k], ibm + 16 * j[k], M);
+		for (int r = 0; r < 3; r++)
+			out[r] += w[k] * (M[r] * p[0] + M[4 + r] * p[1] + M[8 + r] * p[2] + M[12 + r]);
+	}
+}
+
+TEST(skin_hand_lbs)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_all(NULL, &e);
+	CHECK(ctx, "open: %s", e.message);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	CHECK(mlod_rt_max_vertex_count(ctx) == 7, "max vertices %u", mlod_rt_max_vertex_count(ctx));
+	float buf[8 * 7];
+	uint32_t n, id;
+	/* Rest pose (clip 1 at 0): skinned vertices stay, rigid follows joint 4, static its offset. */
+	CHECK_OK(mlod_rt_instance_create(ctx, 1, 0.0f, 0, &id, &e), e);
+	CHECK_OK(force(ctx, id, 0, &e), e);
+	CHECK(mlod_rt_skin(ctx, s, id, buf, 32, buf + 3, 32, 6, &n, &e) == MLOD_ERR_LIMIT, "capacity not checked");
+	CHECK_OK(mlod_rt_skin(ctx, s, id, buf, 32, buf + 3, 32, 7, &n, &e), e);
+	CHECK(n == 7, "%u vertices", n);
+	static const float rest[7][3] = { { 0, 0.5f, 0 }, { 0, 1.5f, 0 }, { 0, 2.5f, 0 }, { 1, 1, 0 },
+	                                  { 1.5f, 1, 0.5f }, { 1.75f, 1, 0.5f }, { 1, 2, 2 } };
+	for (int v = 0; v < 7; v++)
+		CHECK(fx_maxdiff(buf + 8 * v, rest[v], 3) <= 1e-6, "rest vertex %d: %g %g %g", v, buf[8 * v],
+		      buf[8 * v + 1], buf[8 * v + 2]);
+	CHECK(fx_maxdiff(buf + 8 * 3 + 3, (const float[]){ 0.6f, 0.8f, 0 }, 3) <= 1e-6, "rest normal 3");
+	CHECK(fx_maxdiff(buf + 8 * 6 + 3, (const float[]){ 0, 0, 0 }, 3) == 0, "a part without normals gets zeros");
+	/* Translated root (clip 1 at 2: x + 2): all but the static part move. */
+	CHECK_OK(mlod_rt_instance_set(ctx, id, 1, 2.0f, 0, &e), e);
+	CHECK_OK(mlod_rt_skin(ctx, s, id, buf, 32, buf + 3, 32, 7, &n, &e), e);
+	for (int v = 0; v < 7; v++) {
+		float x[3] = { rest[v][0] + (v < 6 ? 2.0f : 0.0f), rest[v][1], rest[v][2] };
+		CHECK(fx_maxdiff(buf + 8 * v, x, 3) <= 1e-6, "moved vertex %d: %g %g %g", v, buf[8 * v], buf[8 * v + 1],
+		      buf[8 * v + 2]);
+	}
+	/* A bent pose (clip 0 at 0.25): LBS by hand from the world matrices. */
+	CHECK_OK(mlod_rt_instance_set(ctx, id, 0, 0.25f, 0, &e), e);
+	CHECK_OK(mlod_rt_skin(ctx, s, id, buf, 12, NULL, 0, 7, &n, &e), e);
+	const float *W;
+	CHECK_OK(mlod_rt_pose(ctx, s, id, &W, NULL, NULL, &e), e);
+	for (int v = 0; v < 4; v++) {
+		float x[3];
+		lbs_expect(W, fx_ibm_0, fx_m0_jnt0 + 4 * v, fx_m0_wgt0 + 4 * v, fx_m0_pos0 + 3 * v, x);
+		CHECK(fx_maxdiff(buf + 3 * v, x, 3) <= 1e-5, "bent vertex %d: %g %g %g, expected %g %g %g", v, buf[3 * v],
+		      buf[3 * v + 1], buf[3 * v + 2], x[0], x[1], x[2]);
+	}
+	float R[16], x[3];
+	fx_mul(W + 64, fx_m0_parts[1].rec.offset, R);
+	x[0] = R[12] + 0.25f * R[0], x[1] = R[13] + 0.25f * R[1], x[2] = R[14] + 0.25f * R[2];
+	CHECK(fx_maxdiff(buf + 15, x, 3) <= 1e-5, "rigid vertex 5");
+	/* The palette is W * IBM. */
+	const float *P;
+	uint32_t pn;
+	CHECK_OK(mlod_rt_palette(ctx, s, &P, &pn, &e), e);
+	CHECK(pn == FX_J, "palette of %u", pn);
+	fx_mul(W + 32, fx_ibm_0 + 32, R);
+	CHECK(fx_maxdiff(P + 32, R, 16) <= 1e-6, "palette entry 2");
+	/* Skeleton level 1 removes joint 4: the rigid part follows the stand-in 0
+	 * with the rest offset from 0 to 4, (1, 1, 0). */
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	sel.d_near = 0, sel.d_far = 100, sel.hysteresis = 0;
+	sel.t_start[MLOD_RT_MOTION] = sel.t_end[MLOD_RT_MOTION] = 1;
+	sel.t_start[MLOD_RT_MESH] = sel.t_end[MLOD_RT_MESH] = 1;
+	float d = 50;
+	CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0f, &e), e);
+	CHECK(mlod_rt_instance_state(ctx, id)->level[MLOD_RT_SKELETON] == 1, "not skeleton level 1");
+	CHECK_OK(mlod_rt_skin(ctx, s, id, buf, 12, NULL, 0, 7, &n, &e), e);
+	CHECK(fx_maxdiff(buf + 12, (const float[]){ 2.0f, 2.0f, 2.0f }, 3) <= 1e-5, "rigid on stand-in: %g %g %g",
+	      buf[12], buf[13], buf[14]);
+	/* The parts, for drawing: vertex ranges and local indices. */
+	CHECK(mlod_rt_mesh_part_count(ctx, 0) == 3 && mlod_rt_mesh_part_count(ctx, 2) == 1, "part counts");
+	mlod_rt_part_info pi;
+	CHECK_OK(mlod_rt_mesh_part(ctx, 0, 1, &pi, &e), e);
+	CHECK(pi.first_vertex == 4 && pi.vertex_count == 2 && pi.joint == 4 && pi.skin == -1 && pi.index_count == 0,
+	      "part 1: first %u count %u joint %d", pi.first_vertex, pi.vertex_count, pi.joint);
+	CHECK_OK(mlod_rt_mesh_part(ctx, 0, 0, &pi, &e), e);
+	CHECK(pi.first_vertex == 0 && pi.index_count == 3 && pi.indices[2] == 2 && pi.skin == 0, "part 0");
+	CHECK(mlod_rt_mesh_part(ctx, 0, 3, &pi, &e) == MLOD_ERR_INVALID_ARG, "part 3 of 3");
+	mlod_rt_instance_destroy(ctx, id);
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+}
+
+static unsigned rng_state = 12345;
+static float frand(void)
+{
+	rng_state = rng_state * 1103515245u + 12345u;
+	return (float)((rng_state >> 8) & 0xffff) / 65535.0f;
+}
+
+TEST(kernel_matches_scalar)
+{
+	enum { N = 1000, P = 8 };
+	static float pos[3 * N], nrm[3 * N], wgt[4 * N], pal[16 * P], a[3 * N], b[3 * N], an[3 * N], bn[3 * N];
+	static uint16_t jnt[4 * N];
+	for (int m = 0; m < P; m++) {
+		mlod_trs t = { { frand(), frand(), frand() },
+		               mlod_quat_normalize((mlod_quat){ frand() - 0.5f, frand() - 0.5f, frand() - 0.5f, 1 }),
+		               { 1, 1, 1 } };
+		mlod_mat4 M = mlod_mat4_from_trs(&t);
+		memcpy(pal + 16 * m, M.m, sizeof M.m);
+	}
+	for (int v = 0; v < N; v++) {
+		float s = 0;
+		for (int k = 0; k < 3; k++)
+			pos[3 * v + k] = frand() * 2 - 1, nrm[3 * v + k] = frand() - 0.5f;
+		for (int k = 0; k < 4; k++)
+			jnt[4 * v + k] = (uint16_t)(frand() * (P - 1) + 0.5f), wgt[4 * v + k] = frand(), s += wgt[4 * v + k];
+		for (int k = 0; k < 4; k++)
+			wgt[4 * v + k] /= s;
+	}
+	mlod_rt_skin_lbs(N, pos, nrm, jnt, wgt, pal, a, 12, an, 12);
+	mlod_rt_skin_lbs_scalar(N, pos, nrm, jnt, wgt, pal, b, 12, bn, 12);
+	double d = fx_maxdiff(a, b, 3 * N), dn = fx_maxdiff(an, bn, 3 * N);
+	CHECK(d <= 1e-5 && dn <= 1e-5, "kernel and scalar differ: %g (positions), %g (normals)", d, dn);
+}
+
+/* The counting allocator. */
+static size_t n_alloc, n_free;
+static void *count_malloc(void *user, size_t size)
+{
+	(void)user;
+	n_alloc++;
+	return malloc(size);
+}
+static void count_free(void *user, void *p)
+{
+	(void)user;
+	if (p)
+		n_free++;
+	free(p);
+}
+
+TEST(no_allocation_per_frame)
+{
+	mlod_rt_allocator a = { count_malloc, count_free, NULL };
+	mlod_rt_config cfg = { 0, 64, &a };
+	mlod_error e;
+	n_alloc = n_free = 0;
+	mlod_rt_ctx *ctx = open_all(&cfg, &e);
+	CHECK(ctx, "open: %s", e.message);
+	CHECK(n_alloc > 0, "the allocator hooks were not used");
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	uint32_t ids[50];
+	for (int i = 0; i < 50; i++)
+		CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)i % 2, 0.1f * (float)i, MLOD_RT_LOOP, &ids[i], &e), e);
+	const size_t before = n_alloc, freed = n_free;
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	float d[50], buf[3 * 7], nb[3 * 7];
+	for (int f = 0; f < 500; f++) {
+		for (int i = 0; i < 50; i++)
+			d[i] = 2.0f + (float)((i * 37 + f * 3) % 200);
+		sel.mode = (mlod_rt_select_mode)(f % 3);
+		CHECK_OK(mlod_rt_update(ctx, &sel, ids, d, 50, 1.0f / 60, &e), e);
+		CHECK_OK(mlod_rt_stream(ctx, 1 << 20, NULL, &e), e);
+		for (int i = 0; i < 50; i++) {
+			uint32_t n;
+			const float *P;
+			CHECK_OK(mlod_rt_skin(ctx, s, ids[i], buf, 12, nb, 12, 7, &n, &e), e);
+			CHECK_OK(mlod_rt_palette(ctx, s, &P, NULL, &e), e);
+		}
+		/* the pool: destroy and create again */
+		mlod_rt_instance_destroy(ctx, ids[f % 50]);
+		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, 0, &ids[f % 50], &e), e);
+	}
+	CHECK(n_alloc == before && n_free == freed, "%zu allocations and %zu frees in 500 frames", n_alloc - before,
+	      n_free - freed);
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+	CHECK(n_alloc == n_free, "%zu allocations, %zu frees: a leak", n_alloc, n_free);
+}
+
+int main(void)
+{
+	fx_build(0);
+	RUN(sample_hand_values);
+	RUN(sample_loop_and_clamp);
+	RUN(fold_matches_full_skeleton);
+	RUN(skin_hand_lbs);
+	RUN(kernel_matches_scalar);
+	RUN(no_allocation_per_frame);
+	TEST_EXIT();
+}

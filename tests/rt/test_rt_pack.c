@@ -1,0 +1,569 @@
+/*
+ * test_rt_pack.c: the runtime on a real .mlod pack, written here byte by
+ * byte from the format (mlod_pack.h; raw streams) from the hand-built
+ * character of rt_test.h: three skeleton, three mesh and three motion
+ * levels of two clips. Opened from memory, from a file and through read
+ * callbacks, it must pose exactly as the views and skin within the
+ * quantisation of positions, normals and weights. Then every truncated prefix and
+ * 10,000 mutations (half with every CRC fixed, so that the decoders' own
+ * checks are reached) go through open, streaming and one frame of
+ * evaluation: an error is fine, a crash or a sanitizer report is not.
+ */
+#define _POSIX_C_SOURCE 200809L /* mkstemp */
+#include <unistd.h>
+
+#include "rt_test.h"
+
+/* ---------------------------------------------------------------- */
+/* Writing a pack                                                    */
+/* ---------------------------------------------------------------- */
+
+typedef struct bytes {
+	uint8_t *d;
+	size_t n, cap;
+} bytes;
+
+static void put(bytes *b, const void *p, size_t n)
+{
+	if (b->n + n > b->cap) {
+		b->cap = (b->n + n) * 2 + 256;
+		b->d = realloc(b->d, b->cap);
+	}
+	if (n)
+		memcpy(b->d + b->n, p, n);
+	b->n += n;
+}
+static void put32(bytes *b, uint32_t v)
+{
+	uint8_t x[4] = { (uint8_t)v, (uint8_t)(v >> 8), (uint8_t)(v >> 16), (uint8_t)(v >> 24) };
+	put(b, x, 4);
+}
+static void put16(bytes *b, uint16_t v)
+{
+	uint8_t x[2] = { (uint8_t)v, (uint8_t)(v >> 8) };
+	put(b, x, 2);
+}
+static void put64(bytes *b, uint64_t v)
+{
+	put32(b, (uint32_t)v);
+	put32(b, (uint32_t)(v >> 32));
+}
+static void putf(bytes *b, float f)
+{
+	uint32_t v;
+	memcpy(&v, &f, 4);
+	put32(b, v);
+}
+static void pad(bytes *b, size_t a)
+{
+	static const uint8_t z[16] = { 0 };
+	put(b, z, (a - b->n % a) % a);
+}
+
+/* A chunk under construction: its streams. */
+#define MAXS 64
+typedef struct chunk {
+	uint32_t type, layer, level, item;
+	float error, distance;
+	int ns;
+	uint32_t tag[MAXS], count[MAXS], elsize[MAXS];
+	bytes data[MAXS];
+} chunk;
+
+static bytes *stream(chunk *c, uint32_t tag, uint32_t elsize)
+{
+	c->tag[c->ns] = tag;
+	c->elsize[c->ns] = elsize;
+	c->count[c->ns] = 0;
+	memset(&c->data[c->ns], 0, sizeof(bytes));
+	return &c->data[c->ns++];
+}
+static void stream_end(chunk *c)
+{
+	c->count[c->ns - 1] = (uint32_t)(c->data[c->ns - 1].n / c->elsize[c->ns - 1]);
+}
+
+static void chunk_bytes(chunk *c, bytes *out)
+{
+	put32(out, (uint32_t)c->ns);
+	for (int i = 0; i < c->ns; i++) {
+		put32(out, c->tag[i]);
+		put32(out, c->count[i]);
+		put16(out, (uint16_t)c->elsize[i]);
+		uint8_t z[2] = { 0, 0 };
+		put(out, z, 2);
+		put32(out, (uint32_t)c->data[i].n);
+	}
+	for (int i = 0; i < c->ns; i++) {
+		put(out, c->data[i].d, c->data[i].n);
+		pad(out, 4);
+		free(c->data[i].d);
+	}
+}
+
+static chunk chunks[32];
+static int nchunks;
+
+static chunk *new_chunk(uint32_t type, uint32_t layer, uint32_t level, uint32_t item, float error, float distance)
+{
+	chunk *c = &chunks[nchunks++];
+	memset(c, 0, sizeof *c);
+	c->type = type, c->layer = layer, c->level = level, c->item = item, c->error = error, c->distance = distance;
+	return c;
+}
+
+/* The CRCs of every chunk, the TOC and the header, from the bytes. */
+static void fix_crcs(uint8_t *d, size_t size)
+{
+	uint32_t n = (uint32_t)d[12] | (uint32_t)d[13] << 8 | (uint32_t)d[14] << 16 | (uint32_t)d[15] << 24;
+	if (32 + (uint64_t)n * 48 > size)
+		return;
+	for (uint32_t i = 0; i < n; i++) {
+		uint8_t *e = d + 32 + 48 * i;
+		uint64_t off = 0;
+		uint32_t st = 0;
+		for (int k = 7; k >= 0; k--)
+			off = off << 8 | e[16 + k];
+		for (int k = 3; k >= 0; k--)
+			st = st << 8 | e[24 + k];
+		if (off <= size && st <= size - off) {
+			uint32_t crc = mlod_pack_crc32(0, d + off, st);
+			for (int k = 0; k < 4; k++)
+				e[32 + k] = (uint8_t)(crc >> (8 * k));
+		}
+	}
+	uint32_t t = mlod_pack_crc32(0, d + 32, (size_t)n * 48);
+	for (int k = 0; k < 4; k++)
+		d[24 + k] = (uint8_t)(t >> (8 * k));
+	uint32_t h = mlod_pack_crc32(0, d, 28);
+	for (int k = 0; k < 4; k++)
+		d[28 + k] = (uint8_t)(h >> (8 * k));
+}
+
+static void write_pack(bytes *out)
+{
+	bytes body[32];
+	for (int i = 0; i < nchunks; i++) {
+		memset(&body[i], 0, sizeof body[i]);
+		chunk_bytes(&chunks[i], &body[i]);
+	}
+	uint64_t off = 32 + 48 * (uint64_t)nchunks, offs[32];
+	for (int i = 0; i < nchunks; i++) {
+		off = (off + 15) / 16 * 16;
+		offs[i] = off;
+		off += body[i].n;
+	}
+	memset(out, 0, sizeof *out);
+	put(out, "MLOD", 4);
+	put16(out, 1), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
+	put32(out, 0), put32(out, 0); /* CRCs below */
+	for (int i = 0; i < nchunks; i++) {
+		chunk *c = &chunks[i];
+		put32(out, c->type);
+		uint8_t lc[2] = { (uint8_t)c->layer, 0 };
+		put(out, lc, 2);
+		put16(out, (uint16_t)c->level), put16(out, (uint16_t)c->item), put16(out, 0), put32(out, 0);
+		put64(out, offs[i]);
+		put32(out, (uint32_t)body[i].n), put32(out, (uint32_t)body[i].n), put32(out, 0);
+		putf(out, c->error), putf(out, c->distance), put32(out, 0);
+	}
+	for (int i = 0; i < nchunks; i++) {
+		pad(out, 16);
+		put(out, body[i].d, body[i].n);
+		free(body[i].d);
+	}
+	fix_crcs(out->d, out->n);
+}
+
+static void put_mat(bytes *b, const float *m)
+{
+	for (int i = 0; i < 16; i++)
+		putf(b, m[i]);
+}
+
+static void oct(const float *n, int16_t *q)
+{
+	float x = n[0], y = n[1], z = n[2], s = fabsf(x) + fabsf(y) + fabsf(z);
+	x /= s, y /= s, z /= s;
+	if (z < 0) {
+		float ox = (1 - fabsf(y)) * (x >= 0 ? 1 : -1), oy = (1 - fabsf(x)) * (y >= 0 ? 1 : -1);
+		x = ox, y = oy;
+	}
+	q[0] = (int16_t)lrintf(x * 32767), q[1] = (int16_t)lrintf(y * 32767);
+}
+
+static void mesh_chunk(const mlod_pack_mesh *m, uint32_t level)
+{
+	chunk *c = new_chunk(MLOD_CHUNK_MESH, MLOD_LAYER_MESH, level, 0, fx_vmesh[level].error, fx_vmesh[level].distance);
+	bytes *b = stream(c, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec));
+	for (uint32_t i = 0; i < m->part_count; i++) {
+		const mlod_pack_part *p = &m->parts[i];
+		mlod_pack_part_rec r = p->rec;
+		r.index_count = r.vertex_count >= 3 ? 3 : 0;
+		for (int a = 0; a < 3; a++) {
+			float lo = 1e30f, hi = -1e30f;
+			for (uint32_t v = 0; v < r.vertex_count; v++) {
+				float x = p->positions[3 * v + a];
+				lo = x < lo ? x : lo, hi = x > hi ? x : hi;
+			}
+			r.pos_min[a] = lo;
+			r.pos_scale[a] = (hi - lo) / 65535.0f;
+		}
+		put(b, &r, sizeof r);
+	}
+	stream_end(c);
+	for (uint32_t i = 0; i < m->part_count; i++) {
+		const mlod_pack_part *p = &m->parts[i];
+		const mlod_pack_part_rec *r = (const mlod_pack_part_rec *)c->data[0].d + i;
+		b = stream(c, MLOD_STREAM_POSQ, 8);
+		for (uint32_t v = 0; v < r->vertex_count; v++) {
+			for (int a = 0; a < 3; a++)
+				put16(b, (uint16_t)(r->pos_scale[a] > 0 ? lrintf((p->positions[3 * v + a] - r->pos_min[a]) / r->pos_scale[a]) : 0));
+			put16(b, 0);
+		}
+		stream_end(c);
+		if (r->flags & MLOD_PART_NORMALS) {
+			b = stream(c, MLOD_STREAM_NRMQ, 4);
+			for (uint32_t v = 0; v < r->vertex_count; v++) {
+				int16_t q[2];
+				oct(p->normals + 3 * v, q);
+				put16(b, (uint16_t)q[0]), put16(b, (uint16_t)q[1]);
+			}
+			stream_end(c);
+		}
+		if (r->flags & MLOD_PART_SKINNED) {
+			b = stream(c, MLOD_STREAM_JNT8, 4);
+			for (uint32_t k = 0; k < 4 * r->vertex_count; k++) {
+				uint8_t j = (uint8_t)p->joints[k];
+				put(b, &j, 1);
+			}
+			stream_end(c);
+			b = stream(c, MLOD_STREAM_WGT8, 4);
+			for (uint32_t v = 0; v < r->vertex_count; v++) {
+				uint8_t w[4];
+				int sum = 0, big = 0;
+				for (int k = 0; k < 4; k++) {
+					w[k] = (uint8_t)lrintf(p->weights[4 * v + k] * 255);
+					sum += w[k];
+					big = w[k] > w[big] ? k : big;
+				}
+				w[big] = (uint8_t)(w[big] + 255 - sum);
+				put(b, w, 4);
+			}
+			stream_end(c);
+		}
+		b = stream(c, MLOD_STREAM_IDX, 4);
+		for (uint32_t k = 0; k < r->index_count; k++)
+			put32(b, k);
+		stream_end(c);
+	}
+}
+
+static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t clip)
+{
+	const mlod_rt_view_level *vl = &fx_vmotion[clip * 3 + level];
+	chunk *c = new_chunk(MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, level, clip, vl->error, vl->distance);
+	bytes *b = stream(c, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec));
+	for (uint32_t i = 0; i < m->channel_count; i++)
+		put(b, &m->channels[i].rec, sizeof m->channels[i].rec);
+	stream_end(c);
+	for (uint32_t i = 0; i < m->channel_count; i++) {
+		const mlod_pack_channel *ch = &m->channels[i];
+		const uint32_t K = ch->rec.key_count, comps = ch->rec.path == 1 ? 4 : 3, per = ch->rec.interp == 2 ? 3 : 1;
+		b = stream(c, MLOD_STREAM_TIME, 4);
+		for (uint32_t k = 0; k < K; k++)
+			putf(b, ch->times[k]);
+		stream_end(c);
+		b = stream(c, comps == 4 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3, 4 * comps);
+		for (uint32_t k = 0; k < K * per * comps; k++)
+			putf(b, ch->values[k]);
+		stream_end(c);
+	}
+}
+
+static void build_pack(bytes *out)
+{
+	nchunks = 0;
+	chunk *c = new_chunk(MLOD_CHUNK_INFO, MLOD_LAYER_NONE, 0, 0, 0, 0);
+	mlod_pack_info_rec info;
+	memset(&info, 0, sizeof info);
+	info.joint_count = FX_J, info.skin_count = 1, info.skeleton_levels = 3, info.mesh_levels = 3;
+	info.clip_count = 2, info.motion_levels = 3, info.instance_count = 3;
+	info.bounds_max[0] = info.bounds_max[1] = info.bounds_max[2] = 3, info.height = 3, info.diagonal = 5.2f;
+	put(stream(c, MLOD_STREAM_INFO, sizeof info), &info, sizeof info);
+	stream_end(c);
+	put(stream(c, MLOD_STREAM_NAME, 1), "fx\0walk\0run", 12);
+	stream_end(c);
+
+	c = new_chunk(MLOD_CHUNK_SKELETON, MLOD_LAYER_SKELETON, 0, 0, 0, 0);
+	bytes *b = stream(c, MLOD_STREAM_JNTS, sizeof(mlod_pack_joint_rec));
+	static const uint32_t name_off[FX_J] = { 0, 5, 11, 17, 22 }; /* "root spine chest head arm" */
+	for (int j = 0; j < FX_J; j++) {
+		mlod_pack_joint_rec r = fx_joints[j];
+		r.name = name_off[j];
+		r.node = -1;
+		put(b, &r, sizeof r);
+	}
+	stream_end(c);
+	put(stream(c, MLOD_STREAM_NAME, 1), "root\0spine\0chest\0head\0arm\0skin", 31);
+	stream_end(c);
+	mlod_pack_skin_rec sk = { FX_J, 26, -1 };
+	put(stream(c, MLOD_STREAM_SKIN, sizeof sk), &sk, sizeof sk);
+	stream_end(c);
+	b = stream(c, MLOD_STREAM_SKJT, 4);
+	for (int j = 0; j < FX_J; j++)
+		put32(b, fx_skin_joints_0[j]);
+	stream_end(c);
+	b = stream(c, MLOD_STREAM_IBMS, 64);
+	for (int j = 0; j < FX_J; j++)
+		put_mat(b, fx_ibm_0 + 16 * j);
+	stream_end(c);
+	const mlod_pack_skel_level *sl[3] = { NULL, &fx_sl1, &fx_sl2 };
+	for (int l = 2; l >= 1; l--) {
+		c = new_chunk(MLOD_CHUNK_SKELETON, MLOD_LAYER_SKELETON, (uint32_t)l, 0, fx_vskel[l].error,
+		              fx_vskel[l].distance);
+		b = stream(c, MLOD_STREAM_KEPT, 4);
+		for (uint32_t i = 0; i < sl[l]->kept_count; i++)
+			put32(b, sl[l]->kept[i]);
+		stream_end(c);
+		b = stream(c, MLOD_STREAM_PALJ, 4);
+		for (uint32_t i = 0; i < FX_J; i++)
+			put32(b, sl[l]->palette_joint[i]);
+		stream_end(c);
+		b = stream(c, MLOD_STREAM_PALB, 64);
+		for (uint32_t i = 0; i < FX_J; i++)
+			put_mat(b, sl[l]->palette_bind + 16 * i);
+		stream_end(c);
+	}
+	const mlod_pack_mesh *ml[3] = { &fx_mesh0, &fx_mesh1, &fx_mesh2 };
+	for (int l = 2; l >= 0; l--) {
+		mesh_chunk(ml[l], (uint32_t)l);
+		for (uint32_t clip = 0; clip < 2; clip++)
+			motion_chunk(&fx_mo[clip][l], (uint32_t)l, clip);
+	}
+	write_pack(out);
+}
+
+/* ---------------------------------------------------------------- */
+/* Tests                                                             */
+/* ---------------------------------------------------------------- */
+
+static bytes pack;
+static int reads;
+
+static int mem_read(void *user, uint64_t offset, size_t size, void *dst)
+{
+	const bytes *b = user;
+	reads++;
+	if (offset > b->n || size > b->n - offset)
+		return -1;
+	memcpy(dst, b->d + offset, size);
+	return 0;
+}
+
+/* Poses and skins instance id of a and b at the same levels; the largest
+ * differences. */
+static void compare(mlod_rt_ctx *a, mlod_rt_ctx *b, double *dw, double *dp, double *dn, mlod_error *e)
+{
+	mlod_rt_scratch *sa = mlod_rt_scratch_create(a), *sb = mlod_rt_scratch_create(b);
+	float pa[21], pb[21], na[21], nb[21];
+	*dw = *dp = *dn = 0;
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	sel.hysteresis = 0;
+	for (int k = 0; k < 40; k++) {
+		uint32_t ia, ib, n1, n2;
+		float d = (float)(k % 10) * 22.0f, t = 0.13f * (float)k;
+		mlod_rt_instance_create(a, (uint32_t)k % 2, t, MLOD_RT_LOOP, &ia, e);
+		mlod_rt_instance_create(b, (uint32_t)k % 2, t, MLOD_RT_LOOP, &ib, e);
+		mlod_rt_update(a, &sel, &ia, &d, 1, 0, e);
+		mlod_rt_update(b, &sel, &ib, &d, 1, 0, e);
+		const float *wa, *wb;
+		if (mlod_rt_pose(a, sa, ia, &wa, NULL, NULL, e) || mlod_rt_pose(b, sb, ib, &wb, NULL, NULL, e) ||
+		    memcmp(mlod_rt_instance_state(a, ia)->level, mlod_rt_instance_state(b, ib)->level, 6) != 0) {
+			*dw = 1e9;
+			break;
+		}
+		for (int j = 0; j < FX_J; j++) {
+			double x = fx_maxdiff(wa + 16 * j, wb + 16 * j, 16);
+			*dw = x > *dw ? x : *dw;
+		}
+		if (mlod_rt_skin(a, sa, ia, pa, 12, na, 12, 7, &n1, e) || mlod_rt_skin(b, sb, ib, pb, 12, nb, 12, 7, &n2, e) ||
+		    n1 != n2) {
+			*dp = 1e9;
+			break;
+		}
+		double x = fx_maxdiff(pa, pb, 3 * (int)n1), y = fx_maxdiff(na, nb, 3 * (int)n1);
+		*dp = x > *dp ? x : *dp;
+		*dn = y > *dn ? y : *dn;
+		mlod_rt_instance_destroy(a, ia);
+		mlod_rt_instance_destroy(b, ib);
+	}
+	mlod_rt_scratch_destroy(a, sa);
+	mlod_rt_scratch_destroy(b, sb);
+}
+
+TEST(pack_equals_views)
+{
+	mlod_error e;
+	mlod_rt_ctx *v = NULL, *m = NULL, *p = NULL, *r = NULL;
+	CHECK_OK(mlod_rt_open_views(&fx_views, NULL, &v, &e), e);
+	CHECK_OK(mlod_rt_open_memory(pack.d, pack.n, NULL, &m, &e), e);
+	char path[] = "/tmp/mlod-rt-test-XXXXXX";
+	int fd = mkstemp(path);
+	CHECK(fd >= 0, "mkstemp");
+	CHECK(write(fd, pack.d, pack.n) == (ssize_t)pack.n, "write");
+	close(fd);
+	mlod_result res = mlod_rt_open_path(path, NULL, &p, &e);
+	remove(path);
+	CHECK(res == MLOD_OK, "open_path: %s", e.message);
+	reads = 0;
+	CHECK_OK(mlod_rt_open_read(mem_read, &pack, pack.n, NULL, &r, &e), e);
+	CHECK(reads > 0, "no read through the callback");
+	CHECK(mlod_rt_level_count(m, MLOD_RT_SKELETON) == 3 && mlod_rt_level_count(m, MLOD_RT_MESH) == 3 &&
+	          mlod_rt_level_count(m, MLOD_RT_MOTION) == 3 && mlod_rt_clip_count(m) == 2,
+	      "level counts from the pack");
+	mlod_rt_level_info li;
+	CHECK_OK(mlod_rt_level_info_get(m, MLOD_RT_MESH, 1, 0, &li, &e), e);
+	CHECK(NEAR(li.error, 0.01, 1e-7) && !li.resident && li.stored_size > 0, "mesh level 1 from the TOC");
+	CHECK(fx_load_all(v) == 0 && fx_load_all(m) == 0 && fx_load_all(p) == 0 && fx_load_all(r) == 0,
+	      "streaming every level failed");
+	mlod_rt_ctx *ctxs[3] = { m, p, r };
+	for (int i = 0; i < 3; i++) {
+		double dw, dp, dn;
+		compare(v, ctxs[i], &dw, &dp, &dn, &e);
+		/* positions quantised to 1/65535 of a part's extent (<= 3), normals to
+		 * 1/32767, and weights to 1/255 (0.75 becomes 191/255: about 1e-3
+		 * of the 2 units between the blended joints) */
+		CHECK(dw <= 1e-6 && dp <= 5e-3 && dn <= 5e-3, "source %d: pose %g, positions %g, normals %g", i, dw, dp, dn);
+	}
+	mlod_rt_stats s;
+	mlod_rt_stats_get(r, &s); /* 4 coarse levels at open, then 7 (skeleton level 0 comes with SKELETON) */
+	CHECK(s.loads == 11 && s.failures == 0, "%llu loads, %llu failures", (unsigned long long)s.loads,
+	      (unsigned long long)s.failures);
+	mlod_rt_close(v), mlod_rt_close(m), mlod_rt_close(p), mlod_rt_close(r);
+	CHECK(mlod_rt_open_path("/nonexistent/x.mlod", NULL, &p, &e) == MLOD_ERR_IO && !p, "missing file");
+}
+
+/* Open plus one frame: everything wanted streamed, every instance posed and skinned. */
+static int one_frame(const void *data, size_t size, int through_read)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = NULL;
+	mlod_rt_config cfg = { 0, 8, NULL };
+	bytes view = { (uint8_t *)data, size, size };
+	mlod_result r = through_read ? mlod_rt_open_read(mem_read, &view, size, &cfg, &ctx, &e)
+	                             : mlod_rt_open_memory(data, size, &cfg, &ctx, &e);
+	if (r != MLOD_OK)
+		return 0;
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	uint32_t ids[4];
+	float d[4] = { 0, 30, 90, 500 };
+	int n = 0;
+	for (int i = 0; i < 4; i++)
+		if (mlod_rt_instance_create(ctx, mlod_rt_clip_count(ctx) ? (uint32_t)i % mlod_rt_clip_count(ctx) : 0,
+		                            0.4f * (float)i, MLOD_RT_LOOP, &ids[n], &e) == MLOD_OK)
+			n++;
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	mlod_rt_update(ctx, &sel, ids, d, (size_t)n, 0.1f, &e);
+	mlod_rt_stream(ctx, SIZE_MAX, NULL, &e);
+	const uint32_t cap = mlod_rt_max_vertex_count(ctx);
+	float *buf = malloc(24 * (size_t)cap + 24);
+	for (int i = 0; i < n && s && buf; i++) {
+		uint32_t nv;
+		const float *P;
+		mlod_rt_skin(ctx, s, ids[i], buf, 12, buf + 3 * (size_t)cap, 12, cap, &nv, &e);
+		mlod_rt_palette(ctx, s, &P, NULL, &e);
+	}
+	free(buf);
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+	return 1;
+}
+
+TEST(truncated_prefixes)
+{
+	int opened = 0;
+	for (size_t k = 0; k < pack.n; k++) {
+		opened += one_frame(pack.d, k, 0);
+		opened += one_frame(pack.d, k, 1);
+	}
+	CHECK(opened == 0, "%d truncated packs opened", opened);
+	CHECK(one_frame(pack.d, pack.n, 0) && one_frame(pack.d, pack.n, 1), "the whole pack does not open");
+}
+
+TEST(mutations)
+{
+	uint8_t *m = malloc(pack.n);
+	unsigned seed = 99;
+	int opened = 0;
+	for (int i = 0; i < 10000; i++) {
+		memcpy(m, pack.d, pack.n);
+		seed = seed * 1103515245u + 12345u;
+		int flips = 1 + (int)((seed >> 16) % 4);
+		for (int f = 0; f < flips; f++) {
+			seed = seed * 1103515245u + 12345u;
+			size_t at = (seed >> 8) % pack.n;
+			seed = seed * 1103515245u + 12345u;
+			switch ((seed >> 12) % 3) {
+			case 0: m[at] ^= (uint8_t)(1u << ((seed >> 20) % 8)); break;
+			case 1: m[at] = (uint8_t)(seed >> 24); break;
+			default: m[at] = (seed >> 24) & 1 ? 0xff : 0; break;
+			}
+		}
+		if (i % 2)
+			fix_crcs(m, pack.n);
+		opened += one_frame(m, pack.n, i % 4 == 1);
+	}
+	free(m);
+	printf("# mutations: %d of 10000 opened and ran a frame\n", opened);
+	CHECK(opened > 0, "no mutated pack opened: the CRC-fixed half should reach the decoders");
+}
+
+TEST(pack_budget)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_memory(pack.d, pack.n, NULL, &ctx, &e), e);
+	mlod_rt_stats s;
+	mlod_rt_stats_get(ctx, &s);
+	const size_t coarse = s.resident_bytes;
+	mlod_rt_close(ctx);
+	for (size_t extra = 0; extra <= 20000; extra += 500) {
+		mlod_rt_config cfg = { coarse + extra, 16, NULL };
+		CHECK_OK(mlod_rt_open_memory(pack.d, pack.n, &cfg, &ctx, &e), e);
+		mlod_rt_select sel;
+		mlod_rt_select_default(&sel);
+		uint32_t ids[8];
+		float d[8];
+		for (int i = 0; i < 8; i++)
+			CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)i % 2, 0, MLOD_RT_LOOP, &ids[i], &e), e);
+		for (int f = 0; f < 50; f++) {
+			for (int i = 0; i < 8; i++)
+				d[i] = (float)((i * 31 + f * 7) % 200);
+			CHECK_OK(mlod_rt_update(ctx, &sel, ids, d, 8, 0.05f, &e), e);
+			CHECK_OK(mlod_rt_stream(ctx, 4096, NULL, &e), e);
+			mlod_rt_stats_get(ctx, &s);
+			CHECK(s.peak_resident_bytes <= coarse + extra, "budget %zu: peak %zu", coarse + extra,
+			      s.peak_resident_bytes);
+		}
+		mlod_rt_close(ctx);
+	}
+}
+
+int main(void)
+{
+	fx_build(0);
+	/* the pack's clip durations are their coarsest level's largest key time */
+	for (int l = 0; l < 3; l++)
+		fx_mo[0][l].duration = 1;
+	build_pack(&pack);
+	printf("# pack of %zu bytes, %d chunks\n", pack.n, nchunks);
+	RUN(pack_equals_views);
+	RUN(pack_budget);
+	RUN(truncated_prefixes);
+	RUN(mutations);
+	free(pack.d);
+	TEST_EXIT();
+}

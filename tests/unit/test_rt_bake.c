@@ -1,0 +1,240 @@
+/*
+ * test_rt_bake.c: the runtime (libmlodrt) against the bake library
+ * (libmlod) on the committed samples: the same character handed to the
+ * runtime as decoded views (level 0 of every layer) must give the bake
+ * side's pose (mlod_clip_sample + mlod_pose_world) and skinning
+ * (mlod_skin_matrices + mlod_skin_primitive; rigid and static parts as
+ * mlod_pose_character places them) within 1e-5 of the diagonal, at many
+ * times of every clip. Primitives with more than one weight set are
+ * outside the runtime's 4 influences and are counted, not compared.
+ */
+#include "test.h"
+
+#include "rt/mlod_rt.h"
+
+/* The runtime's views of a bake-side character (level 0 only). */
+typedef struct conv {
+	mlod_pack_skeleton skel;
+	mlod_pack_joint_rec *joints;
+	const char **names;
+	mlod_pack_skin_rec *skins;
+	const char **skin_names;
+	uint32_t **skin_joints;
+	const float **ibm;
+	mlod_pack_part *parts;
+	const mlod_primitive **prims;
+	mlod_pack_mesh mesh;
+	mlod_pack_channel *chans;
+	mlod_pack_motion *motions;
+	mlod_rt_view_level skel_v, mesh_v, *mot_v;
+	mlod_rt_views views;
+	int skipped;
+} conv;
+
+static void conv_build(const mlod_character *c, conv *v)
+{
+	memset(v, 0, sizeof *v);
+	const mlod_skeleton *s = &c->skeleton;
+	v->joints = calloc((size_t)s->joint_count + 1, sizeof *v->joints);
+	v->names = calloc((size_t)s->joint_count + 1, sizeof *v->names);
+	for (int j = 0; j < s->joint_count; j++) {
+		const mlod_joint *jt = &s->joints[j];
+		mlod_pack_joint_rec *r = &v->joints[j];
+		r->parent = jt->parent;
+		r->t[0] = jt->rest.t.x, r->t[1] = jt->rest.t.y, r->t[2] = jt->rest.t.z;
+		r->r[0] = jt->rest.r.x, r->r[1] = jt->rest.r.y, r->r[2] = jt->rest.r.z, r->r[3] = jt->rest.r.w;
+		r->s[0] = jt->rest.s.x, r->s[1] = jt->rest.s.y, r->s[2] = jt->rest.s.z;
+		memcpy(r->base, jt->base.m, sizeof r->base);
+		r->node = jt->node;
+		v->names[j] = jt->name;
+	}
+	v->skins = calloc((size_t)s->skin_count + 1, sizeof *v->skins);
+	v->skin_names = calloc((size_t)s->skin_count + 1, sizeof *v->skin_names);
+	v->skin_joints = calloc((size_t)s->skin_count + 1, sizeof *v->skin_joints);
+	v->ibm = calloc((size_t)s->skin_count + 1, sizeof *v->ibm);
+	for (int k = 0; k < s->skin_count; k++) {
+		v->skins[k].joint_count = (uint32_t)s->skins[k].joint_count;
+		v->skins[k].gltf_index = -1;
+		v->skin_names[k] = s->skins[k].name;
+		v->skin_joints[k] = calloc((size_t)s->skins[k].joint_count + 1, sizeof(uint32_t));
+		for (int i = 0; i < s->skins[k].joint_count; i++)
+			v->skin_joints[k][i] = (uint32_t)s->skins[k].joints[i];
+		v->ibm[k] = s->skins[k].inverse_bind[0].m;
+	}
+	v->skel = (mlod_pack_skeleton){ (uint32_t)s->joint_count, v->joints, v->names, (uint32_t)s->skin_count,
+	                                v->skins, v->skin_names, (const uint32_t **)v->skin_joints, v->ibm, NULL };
+	/* Parts: instance then primitive order, triangles only. */
+	int np = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		np += c->meshes[c->instances[i].mesh].primitive_count;
+	v->parts = calloc((size_t)np + 1, sizeof *v->parts);
+	v->prims = calloc((size_t)np + 1, sizeof *v->prims);
+	for (int i = 0; i < c->instance_count; i++) {
+		const mlod_instance *in = &c->instances[i];
+		const mlod_mesh *m = &c->meshes[in->mesh];
+		for (int p = 0; p < m->primitive_count; p++) {
+			const mlod_primitive *q = &m->primitives[p];
+			if (q->mode != 4 || q->vertex_count <= 0)
+				continue;
+			if (in->skin >= 0 && q->weight_set_count != 1) {
+				v->skipped++;
+				continue;
+			}
+			mlod_pack_part *t = &v->parts[v->mesh.part_count];
+			v->prims[v->mesh.part_count++] = q;
+			t->rec.instance = (uint32_t)i;
+			t->rec.skin = in->skin;
+			t->rec.joint = in->skin >= 0 ? -1 : in->joint;
+			memcpy(t->rec.offset, in->offset.m, sizeof t->rec.offset);
+			t->rec.vertex_count = (uint32_t)q->vertex_count;
+			t->positions = q->positions;
+			t->normals = q->normals;
+			if (in->skin >= 0)
+				t->joints = q->joints[0], t->weights = q->weights[0];
+		}
+	}
+	v->mesh.parts = v->parts;
+	int nch = 0;
+	for (int k = 0; k < c->clip_count; k++)
+		nch += c->clips[k].channel_count;
+	v->chans = calloc((size_t)nch + 1, sizeof *v->chans);
+	v->motions = calloc((size_t)c->clip_count + 1, sizeof *v->motions);
+	v->mot_v = calloc((size_t)c->clip_count + 1, sizeof *v->mot_v);
+	nch = 0;
+	for (int k = 0; k < c->clip_count; k++) {
+		const mlod_clip *cl = &c->clips[k];
+		v->motions[k].channels = v->chans + nch;
+		v->motions[k].channel_count = (uint32_t)cl->channel_count;
+		v->motions[k].duration = cl->duration;
+		for (int i = 0; i < cl->channel_count; i++, nch++) {
+			const mlod_channel *ch = &cl->channels[i];
+			v->chans[nch].rec = (mlod_pack_channel_rec){ (uint32_t)ch->joint, (uint32_t)ch->path,
+			                                             (uint32_t)ch->interp, (uint32_t)ch->key_count };
+			v->chans[nch].times = ch->times;
+			v->chans[nch].values = ch->values;
+		}
+		v->mot_v[k].data = &v->motions[k];
+	}
+	v->skel_v.data = NULL;
+	v->mesh_v.data = &v->mesh;
+	v->views = (mlod_rt_views){ &v->skel, 1, &v->skel_v, 1, &v->mesh_v, (uint32_t)c->clip_count,
+	                            c->clip_count ? 1u : 0u, v->mot_v };
+}
+
+static void conv_free(conv *v)
+{
+	for (uint32_t k = 0; k < v->skel.skin_count; k++)
+		free(v->skin_joints[k]);
+	free(v->joints), free(v->names), free(v->skins), free(v->skin_names), free(v->skin_joints), free(v->ibm);
+	free(v->parts), free(v->prims), free(v->chans), free(v->motions), free(v->mot_v);
+}
+
+static void compare_sample(const char *path)
+{
+	size_t size;
+	void *data = test_read_file(path, &size);
+	CHECK_MSG(data, "cannot read %s", path);
+	mlod_character c;
+	CHECK_OK(mlod_load(data, size, "samples", NULL, &c, NULL, &terr));
+	free(data);
+	const mlod_skeleton *s = &c.skeleton;
+	conv v;
+	conv_build(&c, &v);
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_views(&v.views, NULL, &ctx, &terr));
+	mlod_rt_scratch *sc = mlod_rt_scratch_create(ctx);
+	CHECK(sc != NULL);
+	const uint32_t nv = mlod_rt_max_vertex_count(ctx);
+	float *rp = malloc((size_t)nv * 12 + 12), *rn = malloc((size_t)nv * 12 + 12);
+	float *bp = malloc((size_t)nv * 12 + 12), *bn = malloc((size_t)nv * 12 + 12);
+	mlod_trs *local = malloc(sizeof *local * (size_t)s->joint_count);
+	mlod_mat4 *world = malloc(sizeof *world * (size_t)s->joint_count);
+	int maxskin = 1;
+	for (int k = 0; k < s->skin_count; k++)
+		maxskin = s->skins[k].joint_count > maxskin ? s->skins[k].joint_count : maxskin;
+	mlod_mat4 *sm = malloc(sizeof *sm * (size_t)maxskin);
+	/* the diagonal of the rest bounds */
+	float lo[3] = { 1e30f, 1e30f, 1e30f }, hi[3] = { -1e30f, -1e30f, -1e30f };
+	for (uint32_t p = 0; p < v.mesh.part_count; p++)
+		for (uint32_t i = 0; i < v.parts[p].rec.vertex_count; i++)
+			for (int k = 0; k < 3; k++) {
+				float x = v.parts[p].positions[3 * i + k];
+				lo[k] = x < lo[k] ? x : lo[k], hi[k] = x > hi[k] ? x : hi[k];
+			}
+	const double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+	                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
+	double worst_pose = 0, worst_skin = 0, worst_nrm = 0;
+	const int clips = c.clip_count ? c.clip_count : 1;
+	for (int k = 0; k < clips; k++) {
+		const float dur = c.clip_count ? c.clips[k].duration : 0;
+		for (int step = 0; step <= 12; step++) {
+			const float t = dur * (float)step / 11.0f - 0.01f; /* also before 0 and after the end */
+			uint32_t id;
+			CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)k, t, 0, &id, &terr));
+			const float *W;
+			CHECK_OK(mlod_rt_pose(ctx, sc, id, &W, NULL, NULL, &terr));
+			mlod_pose_rest(s, local);
+			if (c.clip_count)
+				mlod_clip_sample(&c.clips[k], t, local);
+			mlod_pose_world(s, local, world);
+			for (int j = 0; j < s->joint_count; j++)
+				for (int q = 0; q < 16; q++) {
+					double d = fabs((double)W[16 * j + q] - world[j].m[q]) / (q >= 12 ? diag : 1.0);
+					worst_pose = d > worst_pose ? d : worst_pose;
+				}
+			uint32_t n;
+			CHECK_OK(mlod_rt_skin(ctx, sc, id, rp, 12, rn, 12, nv, &n, &terr));
+			size_t base = 0;
+			for (uint32_t p = 0; p < v.mesh.part_count; p++) {
+				const mlod_pack_part *pt = &v.parts[p];
+				const mlod_primitive *q = v.prims[p];
+				const size_t m = pt->rec.vertex_count;
+				if (pt->rec.skin >= 0) {
+					mlod_skin_matrices(&s->skins[pt->rec.skin], world, sm);
+					mlod_skin_primitive(q, sm, bp, q->normals ? bn : NULL);
+				} else {
+					mlod_mat4 off, R;
+					memcpy(off.m, pt->rec.offset, sizeof off.m);
+					R = pt->rec.joint >= 0 ? mlod_mat4_mul(&world[pt->rec.joint], &off) : off;
+					for (size_t i = 0; i < m; i++) {
+						mlod_v3 x = mlod_mat4_point(&R, (mlod_v3){ q->positions[3 * i], q->positions[3 * i + 1],
+						                                          q->positions[3 * i + 2] });
+						bp[3 * i] = x.x, bp[3 * i + 1] = x.y, bp[3 * i + 2] = x.z;
+					}
+				}
+				for (size_t i = 0; i < 3 * m; i++) {
+					double d = fabs((double)rp[3 * base + i] - bp[i]) / diag;
+					worst_skin = d > worst_skin ? d : worst_skin;
+					if (pt->rec.skin >= 0 && q->normals) {
+						d = fabs((double)rn[3 * base + i] - bn[i]);
+						worst_nrm = d > worst_nrm ? d : worst_nrm;
+					}
+				}
+				base += m;
+			}
+			CHECK_MSG(base == n, "%zu vertices compared, the runtime wrote %u", base, n);
+			mlod_rt_instance_destroy(ctx, id);
+		}
+	}
+	printf("# %s: %u parts (%d skipped: several weight sets), %u vertices; worst: pose %.3g, positions %.3g "
+	       "of the diagonal, normals %.3g\n",
+	       path, v.mesh.part_count, v.skipped, nv, worst_pose, worst_skin, worst_nrm);
+	CHECK_MSG(worst_pose <= 1e-5, "%s: pose differs by %g", path, worst_pose);
+	CHECK_MSG(worst_skin <= 1e-5, "%s: skinned positions differ by %g of the diagonal", path, worst_skin);
+	CHECK_MSG(worst_nrm <= 1e-4, "%s: skinned normals differ by %g", path, worst_nrm);
+	free(rp), free(rn), free(bp), free(bn), free(local), free(world), free(sm);
+	mlod_rt_scratch_destroy(ctx, sc);
+	mlod_rt_close(ctx);
+	conv_free(&v);
+	mlod_character_free(&c);
+}
+
+TEST(rt_equals_bake_tubeman) { compare_sample("samples/tubeman.glb"); }
+TEST(rt_equals_bake_robot) { compare_sample("samples/RobotExpressive.glb"); }
+
+int main(void)
+{
+	RUN(rt_equals_bake_tubeman);
+	RUN(rt_equals_bake_robot);
+	TEST_EXIT();
+}
