@@ -75,7 +75,7 @@ static int load_sized(const char *path, mlod_character *c, double *h, double *pd
 {
 	if (load(path, c, NULL) != 0)
 		return -1;
-	*h = mlod_skeleton_size(&c->skeleton);
+	*h = mlod_skeleton_height(&c->skeleton);
 	*pd = strstr(path, ".bvh") ? *h / 18.0 : 0.1;
 	return 0;
 }
@@ -285,7 +285,7 @@ static int cmd_peers(int argc, char **argv)
 	mlod_character a;
 	if (argc < 2 || load(argv[0], &a, NULL) != 0)
 		return 1;
-	double h = mlod_skeleton_size(&a.skeleton);
+	double h = mlod_skeleton_height(&a.skeleton);
 	int bvh = strstr(argv[0], ".bvh") != NULL;
 	double pd = bvh ? h / 18.0 : 0.1;
 	const mlod_clip **clips = malloc(sizeof *clips * (size_t)a.clip_count);
@@ -502,7 +502,7 @@ static int cmd_speed(int argc, char **argv)
 		mlod_character c;
 		if (load(argv[i], &c, NULL) != 0)
 			continue;
-		double h = mlod_skeleton_size(&c.skeleton);
+		double h = mlod_skeleton_height(&c.skeleton);
 		long frames = 0;
 		for (int k = 0; k < c.clip_count; k++) {
 			float *t = NULL;

@@ -41,6 +41,7 @@ static const char usage_text[] =
 	"                          bytes within the same bound (default auto)\n"
 	"  -e, --max-error LIST    one level per bound on the world joint position\n"
 	"                          error: E in scene units or E% of the skeleton height\n"
+	"                          (the rest-pose joints' extent along +Y)\n"
 	"                          (default " DEFAULT_MAX_ERROR ")\n"
 	"  -t, --thresholds LIST   one level per frame distance threshold (frames method)\n"
 	"  -k, --keys LIST         one level per fraction of the keys kept (0.5,0.2)\n"
@@ -663,7 +664,7 @@ int main(int argc, char **argv)
 	job.doc = doc;
 	if (job.c.clip_count == 0)
 		tool_die(EXIT_INPUT, job.input, "no animation to reduce (a BVH with 'Frames: 0' has none)");
-	job.height = mlod_skeleton_size(&job.c.skeleton);
+	job.height = mlod_skeleton_height(&job.c.skeleton);
 	/* 10 cm: glTF is in metres; a BVH's unit is its own, so a person 1.8 units tall gets 0.1. */
 	job.point_distance = point_distance > 0.0                 ? point_distance
 	                     : job.format == MLOD_FORMAT_BVH ? job.height / 18.0

@@ -1461,11 +1461,10 @@ static mlod_result writer_layouts(writer *w, mlod_error *err)
 	return MLOD_OK;
 }
 
-/* The rest pose gives the OFFSETs, the End Sites and the skeleton's size. */
+/* The rest pose gives the OFFSETs, the End Sites and the skeleton's extent. */
 static mlod_result writer_rest(writer *w, mlod_error *err)
 {
 	pose_frame(w, -1);
-	mlod_v3 lo = { HUGE_VALF, HUGE_VALF, HUGE_VALF }, hi = { -HUGE_VALF, -HUGE_VALF, -HUGE_VALF };
 	for (int j = 0; j < w->n; j++) {
 		const mlod_joint *jt = &w->c->skeleton.joints[j];
 		w->offset[j] = w->t[j];
@@ -1478,11 +1477,9 @@ static mlod_result writer_rest(writer *w, mlod_error *err)
 		}
 		if (!finite_v3(w->offset[j]) || !finite_v3(w->end[j]))
 			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has a non-finite rest transform", jt->name);
-		mlod_v3 p = { w->world[j].m[12], w->world[j].m[13], w->world[j].m[14] };
-		lo.x = fminf(lo.x, p.x), lo.y = fminf(lo.y, p.y), lo.z = fminf(lo.z, p.z);
-		hi.x = fmaxf(hi.x, p.x), hi.y = fmaxf(hi.y, p.y), hi.z = fmaxf(hi.z, p.z);
 	}
-	double extent = fmax(hi.x - lo.x, fmax(hi.y - lo.y, hi.z - lo.z));
+	/* A numeric tolerance: the largest extent, not the height. */
+	double extent = mlod_skeleton_extent(&w->c->skeleton);
 	if (!(extent > 0.0) || !isfinite(extent))
 		extent = 1.0;
 	w->pos_tol = 1e-6 * extent;

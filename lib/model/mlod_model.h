@@ -159,9 +159,24 @@ void mlod_primitive_free(mlod_primitive *p);
  * message naming the first problem. */
 mlod_result mlod_character_validate(const mlod_character *c, mlod_error *err);
 
-/* Height of the skeleton: the extent of the rest-pose joint positions
- * along its largest axis (never 0 for a non-empty skeleton). */
-float mlod_skeleton_size(const mlod_skeleton *s);
+/* Height of the skeleton, the scale of every "% of the height" mlod reads
+ * or reports (motion bounds, skeleton level errors, the stage record): the
+ * extent along +Y, glTF's up axis (BVH files such as CMU's are Y-up too),
+ * of the rest-pose joint origins in world space, roots with their base
+ * transforms. Joints only: the mesh above the head joint is not counted.
+ * The rule for degenerate skeletons: when the Y extent is under
+ * MLOD_HEIGHT_MIN_UP of the largest extent (a character lying down or
+ * modelled Z-up, a snake, a single joint), the height is the largest
+ * extent (mlod_skeleton_extent). Never 0 for a non-empty skeleton; 0 for
+ * NULL or no joints. */
+#define MLOD_HEIGHT_MIN_UP 0.25f
+float mlod_skeleton_height(const mlod_skeleton *s);
+
+/* The largest extent of the rest-pose joint origins along x, y or z (1 for
+ * a single point; 0 for NULL or no joints). Not a height (on a T-posed
+ * character it is the arm span): a scale for numeric tolerances and for
+ * the test character's proportions, never shown as a percentage. */
+float mlod_skeleton_extent(const mlod_skeleton *s);
 
 /* ------------------------------------------------------------------ */
 /* Pose evaluation and skinning                                        */

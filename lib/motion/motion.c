@@ -441,7 +441,7 @@ double mlod_motion_frame_distance(const mlod_skeleton *s, const mlod_trs *a, con
 	if (!w)
 		return HUGE_VAL;
 	joint_weights(s, w);
-	double height = mlod_skeleton_size(s), d = 0.0;
+	double height = mlod_skeleton_height(s), d = 0.0;
 	for (int j = 0; j < s->joint_count; j++) {
 		float ea[3], eb[3];
 		mlod_quat_to_euler(s->joints[j].euler, a[j].r, ea);
@@ -653,7 +653,7 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	}
 	m->samples = (F - 1) * m->sub + 1;
 	m->st = malloc(sizeof(float) * (size_t)m->samples);
-	m->height = mlod_skeleton_size(s);
+	m->height = mlod_skeleton_height(s);
 	if (!(m->height > 0.0))
 		m->height = 1.0;
 	m->weight = malloc(sizeof(double) * (size_t)n);

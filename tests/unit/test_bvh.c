@@ -129,7 +129,7 @@ static void check_clip_round_trip(const mlod_character *a, int k, float frame_ti
 			CHECK_MSG(0, "%s: End Site of %s lost", what, a->skeleton.joints[j].name);
 		}
 	}
-	double tol = 1e-4 * mlod_skeleton_size(&a->skeleton);
+	double tol = 1e-4 * mlod_skeleton_height(&a->skeleton);
 	int frames = b.clip_count ? b.clips[0].frame_count : 1;
 	float ft = b.clip_count ? b.clips[0].frame_time : 0.0f;
 	mlod_v3 *pa = malloc((size_t)n * sizeof *pa), *pb = malloc((size_t)n * sizeof *pb);
