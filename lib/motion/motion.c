@@ -6,7 +6,8 @@
  * when the distance between them, "the energy needed to move all joints
  * from one frame to the other", is below a threshold, by "removing a frame
  * from among the two or by merging the two into a single frame, preserving
- * the duration". We read it so (docs: paper-notes.md, 4.3):
+ * the duration". We read it so (mlod-motion(1), Common timeline, Frame
+ * distance, The multiresolution motion tree):
  *
  * - Common timeline. A clip is first put on frames shared by all its
  *   channels: its own keys when they agree, else the union of the key

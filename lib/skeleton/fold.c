@@ -1,6 +1,7 @@
 /*
- * fold.c: applies a skeleton level to a character (paper 4.1.3, as read in
- * paper-notes.md): motion folding, skin transfer and the joint remap.
+ * fold.c: applies a skeleton level to a character (paper 4.1.3, which does
+ * not say what removal does to motion and skin; mlod-skelgraph(1), Levels,
+ * documents this reading): motion folding, skin transfer and the joint remap.
  *
  * Motion folding. A kept joint c whose parent chain j1 (its parent), ...,
  * jk was removed gets the local transform

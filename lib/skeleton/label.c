@@ -8,7 +8,7 @@
  *   4. neighbours > f * avg(neighbours), depth > avg(depth) -> extreme (mu)
  *   5. otherwise                                         -> minor (kappa)
  * A hub whose depth equals the average exactly falls through to minor, as
- * the rules are written (docs: paper-notes.md).
+ * the rules are written (mlod-label(1), Labels).
  *
  * Energy. The paper's sum over frames of R(b+1) - R(b) telescopes to the
  * net displacement, so we read it as the total variation of each unwrapped
