@@ -70,13 +70,13 @@ static int load(const char *path, mlod_character *c, mlod_gltf **doc)
 }
 
 /* load, plus the skeleton height and the point distance mlod-motion uses
- * (height / 18 for BVH, 10 cm for glTF). */
+ * (mlod_motion_point_distance: height / 18 for BVH, 10 cm for glTF). */
 static int load_sized(const char *path, mlod_character *c, double *h, double *pd)
 {
 	if (load(path, c, NULL) != 0)
 		return -1;
 	*h = mlod_skeleton_height(&c->skeleton);
-	*pd = strstr(path, ".bvh") ? *h / 18.0 : 0.1;
+	*pd = mlod_motion_point_distance(&c->skeleton, !strstr(path, ".bvh"));
 	return 0;
 }
 
@@ -286,8 +286,7 @@ static int cmd_peers(int argc, char **argv)
 	if (argc < 2 || load(argv[0], &a, NULL) != 0)
 		return 1;
 	double h = mlod_skeleton_height(&a.skeleton);
-	int bvh = strstr(argv[0], ".bvh") != NULL;
-	double pd = bvh ? h / 18.0 : 0.1;
+	double pd = mlod_motion_point_distance(&a.skeleton, !strstr(argv[0], ".bvh"));
 	const mlod_clip **clips = malloc(sizeof *clips * (size_t)a.clip_count);
 	for (int k = 0; k < a.clip_count; k++)
 		clips[k] = &a.clips[k];
@@ -520,7 +519,7 @@ static int cmd_speed(int argc, char **argv)
 						if (v < 2 && m != v)
 							continue;
 						mlod_motion_options opt = {0};
-						opt.point_distance = strstr(argv[i], ".bvh") ? h / 18.0 : 0.1;
+						opt.point_distance = mlod_motion_point_distance(&c.skeleton, !strstr(argv[i], ".bvh"));
 						mlod_motion *mo;
 						mlod_error err = {0};
 						if (mlod_motion_create(&c, k, &opt, &mo, &err) != MLOD_OK)

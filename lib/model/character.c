@@ -257,6 +257,15 @@ mlod_result mlod_character_validate(const mlod_character *c, mlod_error *err)
 	return MLOD_OK;
 }
 
+char *mlod_strdup(const char *s)
+{
+	size_t n = strlen(s ? s : "") + 1;
+	char *d = malloc(n);
+	if (d)
+		memcpy(d, s ? s : "", n);
+	return d;
+}
+
 /* ---------------------------------------------------------------- */
 /* Height                                                            */
 /* ---------------------------------------------------------------- */
