@@ -171,7 +171,7 @@ TEST(mst_equals_nearest_kept_ancestor)
 }
 
 /* The world transform of every kept joint at every key time or frame
- * matches the full skeleton within 1e-5 of the skeleton size. */
+ * matches the full skeleton within 1e-5 of the skeleton height. */
 static void check_folding(const mlod_character *c, double fraction)
 {
 	const mlod_skeleton *s = &c->skeleton;
