@@ -327,7 +327,7 @@ static int cmd_peers(int argc, char **argv)
 		mlod_deviation pe = all_error(&a, &b, pc, map);
 		row(label, sp, pe, h, NULL, 0.0);
 		/* mlod at the peer's own max error, clip by clip, then at fixed bounds:
-		 * the default (auto method, auto precision), then variants. */
+		 * mlod-motion's default method and precision (auto, auto), then variants. */
 		static const struct {
 			const char *name;
 			int method;
@@ -354,10 +354,12 @@ static int cmd_peers(int argc, char **argv)
 						oc[k] = &a.clips[k]; /* no level: the clip as read */
 				}
 				char l2[320];
+				/* Say the options: -e per clip (the peer's max error on it, not
+				 * a default level) or a fixed -e in % of the height. */
 				if (f == 0)
-					snprintf(l2, sizeof l2, "%s within %s's error", runs[v].name, label);
+					snprintf(l2, sizeof l2, "%s -e (%s's max error on each clip)", runs[v].name, label);
 				else
-					snprintf(l2, sizeof l2, "%s within %g%% of the height", runs[v].name, 100.0 * fixed[f]);
+					snprintf(l2, sizeof l2, "%s -e %g%%", runs[v].name, 100.0 * fixed[f]);
 				row(l2, clip_sizes(oc, a.clip_count), all_error(&a, &a, oc, NULL), h, &sp, 100.0 * pe.max / h);
 				for (int k = 0; k < a.clip_count; k++)
 					mlod_motion_level_free(&lv[k]);
