@@ -9,7 +9,8 @@
 #   make install          PREFIX=/usr/local DESTDIR= MANDIR=$(PREFIX)/share/man
 #   make config=debug|release|sanitize
 #
-# Link order matters: -ltinygltf must come before -ldraco (see docs).
+# Link order matters: -ltinygltf must come before -ldraco, which exports an
+# older copy of tinygltf's symbols (scripts/check-deps probes it so).
 
 config ?= release
 PREFIX ?= /usr/local

@@ -70,13 +70,13 @@ static int load(const char *path, mlod_character *c, mlod_gltf **doc)
 }
 
 /* load, plus the skeleton height and the point distance mlod-motion uses
- * (height / 18 for BVH, 10 cm for glTF). */
+ * (mlod_motion_point_distance: height / 18 for BVH, 10 cm for glTF). */
 static int load_sized(const char *path, mlod_character *c, double *h, double *pd)
 {
 	if (load(path, c, NULL) != 0)
 		return -1;
-	*h = mlod_skeleton_size(&c->skeleton);
-	*pd = strstr(path, ".bvh") ? *h / 18.0 : 0.1;
+	*h = mlod_skeleton_height(&c->skeleton);
+	*pd = mlod_motion_point_distance(&c->skeleton, !strstr(path, ".bvh"));
 	return 0;
 }
 
@@ -285,9 +285,8 @@ static int cmd_peers(int argc, char **argv)
 	mlod_character a;
 	if (argc < 2 || load(argv[0], &a, NULL) != 0)
 		return 1;
-	double h = mlod_skeleton_size(&a.skeleton);
-	int bvh = strstr(argv[0], ".bvh") != NULL;
-	double pd = bvh ? h / 18.0 : 0.1;
+	double h = mlod_skeleton_height(&a.skeleton);
+	double pd = mlod_motion_point_distance(&a.skeleton, !strstr(argv[0], ".bvh"));
 	const mlod_clip **clips = malloc(sizeof *clips * (size_t)a.clip_count);
 	for (int k = 0; k < a.clip_count; k++)
 		clips[k] = &a.clips[k];
@@ -328,7 +327,7 @@ static int cmd_peers(int argc, char **argv)
 		mlod_deviation pe = all_error(&a, &b, pc, map);
 		row(label, sp, pe, h, NULL, 0.0);
 		/* mlod at the peer's own max error, clip by clip, then at fixed bounds:
-		 * the default (auto method, auto precision), then variants. */
+		 * mlod-motion's default method and precision (auto, auto), then variants. */
 		static const struct {
 			const char *name;
 			int method;
@@ -355,10 +354,12 @@ static int cmd_peers(int argc, char **argv)
 						oc[k] = &a.clips[k]; /* no level: the clip as read */
 				}
 				char l2[320];
+				/* Say the options: -e per clip (the peer's max error on it, not
+				 * a default level) or a fixed -e in % of the height. */
 				if (f == 0)
-					snprintf(l2, sizeof l2, "%s within %s's error", runs[v].name, label);
+					snprintf(l2, sizeof l2, "%s -e (%s's max error on each clip)", runs[v].name, label);
 				else
-					snprintf(l2, sizeof l2, "%s within %g%% of the height", runs[v].name, 100.0 * fixed[f]);
+					snprintf(l2, sizeof l2, "%s -e %g%%", runs[v].name, 100.0 * fixed[f]);
 				row(l2, clip_sizes(oc, a.clip_count), all_error(&a, &a, oc, NULL), h, &sp, 100.0 * pe.max / h);
 				for (int k = 0; k < a.clip_count; k++)
 					mlod_motion_level_free(&lv[k]);
@@ -502,7 +503,7 @@ static int cmd_speed(int argc, char **argv)
 		mlod_character c;
 		if (load(argv[i], &c, NULL) != 0)
 			continue;
-		double h = mlod_skeleton_size(&c.skeleton);
+		double h = mlod_skeleton_height(&c.skeleton);
 		long frames = 0;
 		for (int k = 0; k < c.clip_count; k++) {
 			float *t = NULL;
@@ -520,7 +521,7 @@ static int cmd_speed(int argc, char **argv)
 						if (v < 2 && m != v)
 							continue;
 						mlod_motion_options opt = {0};
-						opt.point_distance = strstr(argv[i], ".bvh") ? h / 18.0 : 0.1;
+						opt.point_distance = mlod_motion_point_distance(&c.skeleton, !strstr(argv[i], ".bvh"));
 						mlod_motion *mo;
 						mlod_error err = {0};
 						if (mlod_motion_create(&c, k, &opt, &mo, &err) != MLOD_OK)

@@ -260,6 +260,12 @@ void tool_version(void)
 
 int tool_parse_list(const char *option, const char *value, double *out, int max, double lo, double hi)
 {
+	return tool_parse_list_percent(option, value, out, NULL, max, lo, hi);
+}
+
+int tool_parse_list_percent(const char *option, const char *value, double *out, int *percent, int max, double lo,
+                            double hi)
+{
 	int n = 0;
 	char *copy = malloc(strlen(value) + 1);
 	if (!copy)
@@ -268,6 +274,11 @@ int tool_parse_list(const char *option, const char *value, double *out, int max,
 	for (char *tok = strtok(copy, ","); tok; tok = strtok(NULL, ",")) {
 		if (n == max)
 			tool_usage_error("%s: at most %d values", option, max);
+		size_t len = strlen(tok);
+		if (percent)
+			percent[n] = len > 0 && tok[len - 1] == '%';
+		if (percent && percent[n])
+			tok[len - 1] = '\0';
 		out[n++] = tool_parse_double(option, tok, lo, hi);
 	}
 	free(copy);

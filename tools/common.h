@@ -95,6 +95,9 @@ int tool_ends_with(const char *s, const char *suffix);
  * into out; exits 1 naming the option when it is empty, too long or holds
  * something else. Returns the count. */
 int tool_parse_list(const char *option, const char *value, double *out, int max, double lo, double hi);
+/* The same, where a value may end in '%': percent[i] says whether value i did. */
+int tool_parse_list_percent(const char *option, const char *value, double *out, int *percent, int max, double lo,
+                            double hi);
 
 /* Parses -j/--threads: a whole number from 1 to MLOD_MAX_THREADS; exits 1
  * naming the option otherwise. The tools default to mlod_thread_count(). */

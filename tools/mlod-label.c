@@ -16,7 +16,6 @@
 
 #include "common.h"
 
-#define PI 3.14159265358979323846
 
 /* A printf format: the defaults come from the library. */
 static const char usage_text[] =
@@ -134,7 +133,7 @@ int main(int argc, char **argv)
 	};
 	const char *output = NULL;
 	enum tool_report report = REPORT_NONE;
-	mlod_label_options opt = {MLOD_LABEL_HUB_FACTOR_DEFAULT, MLOD_LABEL_MAX_ANGLE_DEFAULT * PI / 180.0};
+	mlod_label_options opt = {MLOD_LABEL_HUB_FACTOR_DEFAULT, MLOD_LABEL_MAX_ANGLE_DEFAULT * MLOD_PI / 180.0};
 	int ch;
 
 	tool_name = "mlod-label";
@@ -144,7 +143,7 @@ int main(int argc, char **argv)
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
 		case 'H': opt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
-		case 'A': opt.max_angle = tool_parse_double("--max-angle", optarg, 1e-3, 1e6) * PI / 180.0; break;
+		case 'A': opt.max_angle = tool_parse_double("--max-angle", optarg, 1e-3, 1e6) * MLOD_PI / 180.0; break;
 		case 'h': printf(usage_text, MLOD_LABEL_HUB_FACTOR_DEFAULT, MLOD_LABEL_MAX_ANGLE_DEFAULT); return 0;
 		case 'V': tool_version();
 		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);

@@ -8,7 +8,7 @@
  * with --level K -o out.bvh, a BVH of level K at the clip's frame rate; or
  * a report.
  */
-#define _GNU_SOURCE /* getopt_long, strdup */
+#define _GNU_SOURCE /* getopt_long */
 
 #include <getopt.h>
 #include <math.h>
@@ -21,7 +21,6 @@
 #define MAX_LEVELS 32
 #define DEFAULT_MAX_ERROR "0.2%,1%,3%"
 #define VERTEX_SAMPLES 60   /* measured times per clip for the skinned-vertex error */
-#define GLTF_POINT_DISTANCE 0.1 /* 10 cm in glTF's metres */
 
 static const char usage_text[] =
 	"usage: mlod-motion [options] [input]\n"
@@ -41,6 +40,7 @@ static const char usage_text[] =
 	"                          bytes within the same bound (default auto)\n"
 	"  -e, --max-error LIST    one level per bound on the world joint position\n"
 	"                          error: E in scene units or E% of the skeleton height\n"
+	"                          (the rest-pose joints' extent along +Y)\n"
 	"                          (default " DEFAULT_MAX_ERROR ")\n"
 	"  -t, --thresholds LIST   one level per frame distance threshold (frames method)\n"
 	"  -k, --keys LIST         one level per fraction of the keys kept (0.5,0.2)\n"
@@ -127,32 +127,22 @@ static const char *target_name(mlod_motion_target t)
 	return t == MLOD_MOTION_THRESHOLD ? "threshold" : t == MLOD_MOTION_FRACTION ? "keys" : "max_error";
 }
 
-/* Parses a comma-separated list; "E%" is allowed when percent is not NULL. */
+/* Parses a comma-separated list (tool_parse_list); "E%" is allowed for
+ * error bounds. */
 static int parse_list(const char *option, const char *value, struct spec *out, mlod_motion_target target,
                       double lo, double hi)
 {
-	int n = 0;
-	char *copy = strdup(value);
-	if (!copy)
-		tool_die(EXIT_USAGE, NULL, "out of memory");
-	for (char *tok = strtok(copy, ","); tok; tok = strtok(NULL, ",")) {
-		if (n == MAX_LEVELS)
-			tool_usage_error("%s: at most %d levels", option, MAX_LEVELS);
-		size_t len = strlen(tok);
-		out[n].target = target;
-		out[n].percent = 0;
-		if (target == MLOD_MOTION_MAX_ERROR && len > 0 && tok[len - 1] == '%') {
-			tok[len - 1] = '\0';
-			out[n].percent = 1;
-		}
-		out[n].value = tool_parse_double(option, tok, lo, hi);
-		if (target == MLOD_MOTION_FRACTION && !(out[n].value > 0.0))
+	double v[MAX_LEVELS];
+	int pct[MAX_LEVELS] = {0};
+	int n = target == MLOD_MOTION_MAX_ERROR ? tool_parse_list_percent(option, value, v, pct, MAX_LEVELS, lo, hi)
+	                                        : tool_parse_list(option, value, v, MAX_LEVELS, lo, hi);
+	for (int i = 0; i < n; i++) {
+		out[i].target = target;
+		out[i].percent = target == MLOD_MOTION_MAX_ERROR && pct[i];
+		out[i].value = v[i];
+		if (target == MLOD_MOTION_FRACTION && !(v[i] > 0.0))
 			tool_usage_error("%s: a fraction of keys must be above 0", option);
-		n++;
 	}
-	free(copy);
-	if (n == 0)
-		tool_usage_error("%s: empty list", option);
 	return n;
 }
 
@@ -675,11 +665,10 @@ int main(int argc, char **argv)
 			return 0;
 		}
 	}
-	job.height = mlod_skeleton_size(&job.c.skeleton);
-	/* 10 cm: glTF is in metres; a BVH's unit is its own, so a person 1.8 units tall gets 0.1. */
-	job.point_distance = point_distance > 0.0                 ? point_distance
-	                     : job.format == MLOD_FORMAT_BVH ? job.height / 18.0
-	                                                          : GLTF_POINT_DISTANCE;
+	job.height = mlod_skeleton_height(&job.c.skeleton);
+	/* 10 cm: glTF is in metres; a BVH's unit is its own. */
+	job.point_distance = point_distance > 0.0 ? point_distance
+	                                          : mlod_motion_point_distance(&job.c.skeleton, job.format != MLOD_FORMAT_BVH);
 	job.opt.point_distance = job.point_distance;
 	for (int s = 0; s < job.spec_count; s++)
 		if (job.specs[s].percent && !(job.height > 0.0) && job.c.clip_count > 0)

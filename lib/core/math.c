@@ -16,6 +16,14 @@
 
 #include "mlod_core.h"
 
+double mlod_wrap_angle(double a)
+{
+	a = fmod(a + MLOD_PI, 2.0 * MLOD_PI);
+	if (a <= 0.0)
+		a += 2.0 * MLOD_PI;
+	return a - MLOD_PI;
+}
+
 /* ---------------------------------------------------------------- */
 /* Vectors                                                           */
 /* ---------------------------------------------------------------- */
@@ -236,6 +244,11 @@ int mlod_euler_order_parse(const char *s, mlod_euler_order *out)
 const char *mlod_euler_order_name(mlod_euler_order order)
 {
 	return euler_valid(order) ? euler_names[order] : "?";
+}
+
+const int *mlod_euler_axes(mlod_euler_order order)
+{
+	return euler_axes[euler_valid(order) ? order : MLOD_EULER_XYZ];
 }
 
 /* ---------------------------------------------------------------- */

@@ -84,6 +84,11 @@ mlod_result mlod_parallel_for(int n, int threads, mlod_parallel_fn fn, void *ctx
 /* Math                                                                */
 /* ------------------------------------------------------------------ */
 
+#define MLOD_PI 3.14159265358979323846
+
+/* a wrapped into (-pi, pi]: an angle difference taken the short way. */
+double mlod_wrap_angle(double a);
+
 typedef struct mlod_v3 { float x, y, z; } mlod_v3;
 typedef struct mlod_quat { float x, y, z, w; } mlod_quat;  /* glTF order */
 typedef struct mlod_mat4 { float m[16]; } mlod_mat4;         /* column-major */
@@ -130,6 +135,9 @@ void mlod_quat_to_euler(mlod_euler_order order, mlod_quat q, float angles[3]);
 /* Parses "XYZ", "zxy", ... ; returns 0 on success, -1 when not an order. */
 int mlod_euler_order_parse(const char *s, mlod_euler_order *out);
 const char *mlod_euler_order_name(mlod_euler_order order);
+/* The axes (0 x, 1 y, 2 z) of an order, outermost first: order ABC is
+ * RA * RB * RC. An invalid order gives XYZ's. */
+const int *mlod_euler_axes(mlod_euler_order order);
 
 mlod_mat4 mlod_mat4_identity(void);
 mlod_mat4 mlod_mat4_mul(const mlod_mat4 *a, const mlod_mat4 *b); /* a*b */

@@ -48,13 +48,6 @@
 #define BVH_MAX_JOINTS (1 << 20)
 #define BVH_MAX_WRITE_VALUES 200000000 /* values a written BVH may hold */
 
-static const double PI = 3.14159265358979323846;
-
-/* Axes of each Euler order, outermost first (ZXY is Rz * Rx * Ry). */
-static const int euler_axes[6][3] = {
-	{ 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 }
-};
-
 static const char *const channel_names[6] = {
 	"Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation"
 };
@@ -62,9 +55,11 @@ static const char *const channel_names[6] = {
 /* The Euler order whose axes are a, b, c. */
 static mlod_euler_order euler_from_axes(int a, int b, int c)
 {
-	for (int o = 0; o < 6; o++)
-		if (euler_axes[o][0] == a && euler_axes[o][1] == b && euler_axes[o][2] == c)
+	for (int o = 0; o < 6; o++) {
+		const int *ax = mlod_euler_axes((mlod_euler_order)o);
+		if (ax[0] == a && ax[1] == b && ax[2] == c)
 			return (mlod_euler_order)o;
+	}
 	return MLOD_EULER_XYZ;
 }
 
@@ -885,7 +880,7 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 				if (code < MLOD_BVH_XROT)
 					pos[code] = v[k];
 				else
-					ang[code - MLOD_BVH_XROT] = (float)(v[k] * (PI / 180.0));
+					ang[code - MLOD_BVH_XROT] = (float)(v[k] * (MLOD_PI / 180.0));
 			}
 			if (anim[j].tv)
 				memcpy(anim[j].tv + 3 * f, pos, sizeof pos);
@@ -943,10 +938,9 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 		char note[160];
 		snprintf(note, sizeof note, "%ld %s after the %ld that 'Frames:' announces (from line %d) ignored",
 		         values / vpf, values / vpf == 1 ? "frame" : "frames", frames, first_line);
-		c->notes = malloc(strlen(note) + 1);
+		c->notes = mlod_strdup(note);
 		if (!c->notes)
 			return mlod_fail(r->err, MLOD_ERR_NOMEM, "out of memory");
-		memcpy(c->notes, note, strlen(note) + 1);
 	}
 	return MLOD_OK;
 }
@@ -979,7 +973,7 @@ static void complete_layouts(mlod_skeleton *s)
 		}
 		if (rot)
 			for (int a = 0; a < 3; a++)
-				ch[n++] = (unsigned char)(MLOD_BVH_XROT + euler_axes[j->euler][a]);
+				ch[n++] = (unsigned char)(MLOD_BVH_XROT + mlod_euler_axes(j->euler)[a]);
 		memcpy(j->channels, ch, (size_t)n);
 		j->channel_count = n;
 	}
@@ -1176,7 +1170,7 @@ static void layout_complete(layout *l)
 	}
 	if (o.need_rot) {
 		for (int a = 0; a < 3; a++)
-			l->ch[l->n++] = (unsigned char)(MLOD_BVH_XROT + euler_axes[l->euler][a]);
+			l->ch[l->n++] = (unsigned char)(MLOD_BVH_XROT + mlod_euler_axes(l->euler)[a]);
 	} else {
 		for (int i = 0; i < o.n; i++)
 			if (o.ch[i] >= MLOD_BVH_XROT)
@@ -1185,28 +1179,18 @@ static void layout_complete(layout *l)
 	layout_masks(l);
 }
 
-static double wrap_angle(double a)
-{
-	a = fmod(a, 2.0 * PI);
-	if (a > PI)
-		a -= 2.0 * PI;
-	else if (a <= -PI)
-		a += 2.0 * PI;
-	return a;
-}
-
 /* The two Euler solutions of q in the layout's order: the principal one
  * and (a + pi, pi - b, c + pi). */
 static void euler_solutions(const layout *l, mlod_quat q, double sol[2][3])
 {
 	float a[3];
 	mlod_quat_to_euler(l->euler, q, a);
-	const int *ax = euler_axes[l->euler];
+	const int *ax = mlod_euler_axes(l->euler);
 	for (int i = 0; i < 3; i++)
 		sol[0][i] = a[i];
-	sol[1][ax[0]] = wrap_angle(a[ax[0]] + PI);
-	sol[1][ax[1]] = wrap_angle(PI - a[ax[1]]);
-	sol[1][ax[2]] = wrap_angle(a[ax[2]] + PI);
+	sol[1][ax[0]] = mlod_wrap_angle(a[ax[0]] + MLOD_PI);
+	sol[1][ax[1]] = mlod_wrap_angle(MLOD_PI - a[ax[1]]);
+	sol[1][ax[2]] = mlod_wrap_angle(a[ax[2]] + MLOD_PI);
 }
 
 #define ANGLE_TOL 1e-5
@@ -1215,7 +1199,7 @@ static void euler_solutions(const layout *l, mlod_quat q, double sol[2][3])
 static int fits_layout(const layout *l, const double s[3])
 {
 	for (int a = 0; a < 3; a++)
-		if (!(l->rot_mask & (1 << a)) && fabs(wrap_angle(s[a])) > ANGLE_TOL)
+		if (!(l->rot_mask & (1 << a)) && fabs(mlod_wrap_angle(s[a])) > ANGLE_TOL)
 			return 0;
 	return 1;
 }
@@ -1248,7 +1232,7 @@ static void euler_pick(const layout *l, mlod_quat q, const double *prev, double 
 			/* The 2 pi turn of the angle nearest to the previous frame. */
 			double bestd = HUGE_VAL;
 			for (int k = -1; k <= 1; k++) {
-				double x = sol[s][a] + k * 2.0 * PI, dd = fabs(x - prev[a]);
+				double x = sol[s][a] + k * 2.0 * MLOD_PI, dd = fabs(x - prev[a]);
 				if (dd < bestd) {
 					bestd = dd;
 					cand[a] = x;
@@ -1461,11 +1445,10 @@ static mlod_result writer_layouts(writer *w, mlod_error *err)
 	return MLOD_OK;
 }
 
-/* The rest pose gives the OFFSETs, the End Sites and the skeleton's size. */
+/* The rest pose gives the OFFSETs, the End Sites and the skeleton's extent. */
 static mlod_result writer_rest(writer *w, mlod_error *err)
 {
 	pose_frame(w, -1);
-	mlod_v3 lo = { HUGE_VALF, HUGE_VALF, HUGE_VALF }, hi = { -HUGE_VALF, -HUGE_VALF, -HUGE_VALF };
 	for (int j = 0; j < w->n; j++) {
 		const mlod_joint *jt = &w->c->skeleton.joints[j];
 		w->offset[j] = w->t[j];
@@ -1478,11 +1461,9 @@ static mlod_result writer_rest(writer *w, mlod_error *err)
 		}
 		if (!finite_v3(w->offset[j]) || !finite_v3(w->end[j]))
 			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint '%s' has a non-finite rest transform", jt->name);
-		mlod_v3 p = { w->world[j].m[12], w->world[j].m[13], w->world[j].m[14] };
-		lo.x = fminf(lo.x, p.x), lo.y = fminf(lo.y, p.y), lo.z = fminf(lo.z, p.z);
-		hi.x = fmaxf(hi.x, p.x), hi.y = fmaxf(hi.y, p.y), hi.z = fmaxf(hi.z, p.z);
 	}
-	double extent = fmax(hi.x - lo.x, fmax(hi.y - lo.y, hi.z - lo.z));
+	/* A numeric tolerance: the largest extent, not the height. */
+	double extent = mlod_skeleton_extent(&w->c->skeleton);
 	if (!(extent > 0.0) || !isfinite(extent))
 		extent = 1.0;
 	w->pos_tol = 1e-6 * extent;
@@ -1682,7 +1663,7 @@ static void write_motion(writer *w)
 				if (code < MLOD_BVH_XROT)
 					format_float_exact(pos[code], num);
 				else
-					format_number(ang[code - MLOD_BVH_XROT] * (180.0 / PI), 5, num);
+					format_number(ang[code - MLOD_BVH_XROT] * (180.0 / MLOD_PI), 5, num);
 				if (sep)
 					sb_char(b, ' ');
 				sep = 1;

@@ -10,41 +10,26 @@
 
 #include "measure/mlod_measure.h"
 
-static int float_order(const void *a, const void *b)
-{
-	float x = *(const float *)a, y = *(const float *)b;
-	return (x > y) - (x < y);
-}
-
 int mlod_clip_times(const mlod_clip *clip, int max_samples, float **times)
 {
-	int n = 0;
+	/* The frames, or the key times (mlod_clip_key_times) and time 0. */
 	float *t = NULL;
-	if (clip->frame_time > 0.0f && clip->frame_count > 0) {
-		n = clip->frame_count;
-		t = malloc(sizeof(float) * (size_t)n);
-		if (!t)
+	int n = mlod_clip_key_times(clip, NULL, 1, &t, NULL);
+	if (n < 0)
+		return -1;
+	int at = 0;
+	while (at < n && t[at] < 0.0f)
+		at++;
+	if (at == n || t[at] != 0.0f) {
+		float *g = realloc(t, sizeof(float) * ((size_t)n + 1));
+		if (!g) {
+			free(t);
 			return -1;
-		for (int i = 0; i < n; i++)
-			t[i] = (float)i * clip->frame_time;
-	} else {
-		long total = 1;
-		for (int i = 0; i < clip->channel_count; i++)
-			total += clip->channels[i].key_count;
-		t = malloc(sizeof(float) * (size_t)total);
-		if (!t)
-			return -1;
-		t[n++] = 0.0f;
-		for (int i = 0; i < clip->channel_count; i++) {
-			memcpy(t + n, clip->channels[i].times, sizeof(float) * (size_t)clip->channels[i].key_count);
-			n += clip->channels[i].key_count;
 		}
-		qsort(t, (size_t)n, sizeof *t, float_order);
-		int m = 0;
-		for (int i = 0; i < n; i++)
-			if (m == 0 || t[i] != t[m - 1])
-				t[m++] = t[i];
-		n = m;
+		t = g;
+		memmove(t + at + 1, t + at, sizeof(float) * (size_t)(n - at));
+		t[at] = 0.0f;
+		n++;
 	}
 	if (max_samples > 1 && n > max_samples) {
 		/* Evenly spaced picks, first and last included. */

@@ -763,7 +763,7 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->qsum);
 	free(g->skin);
 	free(g->opstate);
-	bgm_heap_free(g->heap);
+	free(g->heap.e);
 	free(g);
 }
 

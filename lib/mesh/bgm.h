@@ -103,8 +103,13 @@ struct mlod_bgm {
 	int caps, snaps, refused;
 	double build_seconds, collapse_seconds;
 
-	/* Collapse state (collapse.c). */
-	struct bgm_heap *heap;
+	/* Collapse state (collapse.c): the queue of candidate collapses, a
+	 * binary heap of entries whose layout only collapse.c knows. */
+	struct bgm_heap {
+		int ready;                 /* every live face was queued */
+		int count, cap;
+		struct bgm_heap_entry *e;  /* released with free() by mlod_bgm_free */
+	} heap;
 	unsigned char *opstate; /* per face and op (collapse.c): refused when last looked at, queued */
 	int opstate_cap;
 };
@@ -121,10 +126,9 @@ int bgm_link_ok(const int *from, const int *to, int m, int path_ok);
 double bgm_compactness(const double *a, const double *b, const double *c);
 int bgm_node_eligible(const mlod_bgm *g, const mlod_influences *inf);
 
-/* collapse.c */
-void bgm_heap_free(struct bgm_heap *h);
-
 /* quadric.c */
+/* n = (b - a) x (c - a): the face's normal times twice its area. */
+void bgm_face_normal(const double *a, const double *b, const double *c, double *n);
 mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err);
 /* The error of a node at bind position p with influences inf against
  * the quadrics q (pose_count x 10): sum over poses. */

@@ -62,23 +62,11 @@
 #define QUEUED(op) (16u << (op))       /* opstate: has an entry in the heap */
 #define ALL_BLOCKED 15u
 
-typedef struct heap_entry {
+typedef struct bgm_heap_entry {
 	double key;
 	int face;
 	int op;
 } heap_entry;
-
-struct bgm_heap {
-	int count, cap;
-	heap_entry *e;
-};
-
-void bgm_heap_free(struct bgm_heap *h)
-{
-	if (h)
-		free(h->e);
-	free(h);
-}
 
 static int entry_less(const heap_entry *a, const heap_entry *b)
 {
@@ -169,16 +157,6 @@ static int wedge_slot(const struct plan *pl, int w)
 	return -1;
 }
 
-static void face_normal(const double *a, const double *b, const double *c, double *n)
-{
-	double u[3], v[3];
-	for (int i = 0; i < 3; i++)
-		u[i] = b[i] - a[i], v[i] = c[i] - a[i];
-	n[0] = u[1] * v[2] - u[2] * v[1];
-	n[1] = u[2] * v[0] - u[0] * v[2];
-	n[2] = u[0] * v[1] - u[1] * v[0];
-}
-
 static int is_normal_float(const bgm_layout *L, int k, int targets)
 {
 	return (L->normal >= 0 && k >= L->normal && k < L->normal + 3) ||
@@ -252,8 +230,8 @@ static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x
 			p[k] = q[k] = g->nodes[f->n[k]].p;
 		q[pl->corner[i]] = x;
 		double no[3], nn[3];
-		face_normal(p[0], p[1], p[2], no);
-		face_normal(q[0], q[1], q[2], nn);
+		bgm_face_normal(p[0], p[1], p[2], no);
+		bgm_face_normal(q[0], q[1], q[2], nn);
 		double lo = sqrt(no[0] * no[0] + no[1] * no[1] + no[2] * no[2]);
 		double ln = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
 		double cn = bgm_compactness(q[0], q[1], q[2]);
@@ -283,7 +261,7 @@ static void segment_weights(const double *a, const double *b, const double *x, d
 static double area_sq(const double *a, const double *b, const double *c)
 {
 	double n[3];
-	face_normal(a, b, c, n);
+	bgm_face_normal(a, b, c, n);
 	return 0.25 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 }
 
@@ -623,7 +601,7 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 		key = bgm_compactness(g->nodes[F->n[0]].p, g->nodes[F->n[1]].p, g->nodes[F->n[2]].p);
 	}
 	g->opstate[f] |= (unsigned char)QUEUED(op);
-	return heap_push(g->heap, key, f, op);
+	return heap_push(&g->heap, key, f, op);
 }
 
 /* 1 when the face across edge e of face f holds a queue entry for that
@@ -846,11 +824,8 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 		goto done;
 	}
-	if (!g->heap) {
-		if (!(g->heap = calloc(1, sizeof *g->heap))) {
-			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
-			goto done;
-		}
+	if (!g->heap.ready) {
+		g->heap.ready = 1;
 		for (int f = 0; f < g->face_count; f++)
 			if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
@@ -858,9 +833,9 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			}
 	}
 	int done_count = 0;
-	while (g->heap->count > 0 && (target <= 0 || g->live_triangles > target) &&
+	while (g->heap.count > 0 && (target <= 0 || g->live_triangles > target) &&
 	       (max_collapses <= 0 || done_count < max_collapses)) {
-		heap_entry e = heap_pop(g->heap);
+		heap_entry e = heap_pop(&g->heap);
 		if (g->faces[e.face].death != BGM_ALIVE)
 			continue;
 		g->opstate[e.face] &= (unsigned char)~QUEUED(e.op);
@@ -871,7 +846,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 		}
 		if (g->opt.cost == MLOD_COST_POSED && pl->cost > e.key * (1.0 + 1e-9) + 1e-300) {
 			g->opstate[e.face] |= (unsigned char)QUEUED(e.op);
-			if (heap_push(g->heap, pl->cost, e.face, e.op)) {
+			if (heap_push(&g->heap, pl->cost, e.face, e.op)) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 				goto done;
 			}

@@ -8,7 +8,8 @@
  * tau * eta(j) for every joint j. Read literally it protects the vertices
  * one joint dominates (the middle of a bone segment) and frees the ones
  * whose weight is split (the bends), the opposite of the stated intent
- * ("preserve high-detail regions around joints"; see paper-notes 4.2.2).
+ * ("preserve high-detail regions around joints"; mlod-bgm(1), Eligible
+ * vertices).
  * MLOD_ELIGIBLE_BEND protects the bends instead: v may disappear only when
  * its largest weight w(j, v) reaches tau * eta(j) for that joint, i.e.
  * when one joint dominates it at least as much as that joint usually

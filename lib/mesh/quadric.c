@@ -61,7 +61,7 @@ static double dot3(const double *a, const double *b)
 	return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-static void face_normal3(const double *a, const double *b, const double *c, double *n)
+void bgm_face_normal(const double *a, const double *b, const double *c, double *n)
 {
 	double u[3], v[3];
 	for (int i = 0; i < 3; i++)
@@ -188,10 +188,10 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 				const double *a = posed + 3 * F->n[e], *b = posed + 3 * F->n[(e + 1) % 3];
 				const double *o = posed + 3 * F->n[(e + 2) % 3];
 				double n1[3], n2[3];
-				face_normal3(a, b, o, n1);
+				bgm_face_normal(a, b, o, n1);
 				if (h >= 0) {
 					const bgm_face *H = &g->faces[h];
-					face_normal3(posed + 3 * H->n[0], posed + 3 * H->n[1], posed + 3 * H->n[2], n2);
+					bgm_face_normal(posed + 3 * H->n[0], posed + 3 * H->n[1], posed + 3 * H->n[2], n2);
 					double l1 = sqrt(dot3(n1, n1)), l2 = sqrt(dot3(n2, n2));
 					if (!(l1 > 0.0) || !(l2 > 0.0) || dot3(n1, n2) > FEATURE_COS * l1 * l2)
 						continue;
@@ -200,7 +200,7 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 				edge_quadric(a, b, n1, q2);
 				if (h >= 0) {
 					const bgm_face *H = &g->faces[h];
-					face_normal3(posed + 3 * H->n[0], posed + 3 * H->n[1], posed + 3 * H->n[2], n2);
+					bgm_face_normal(posed + 3 * H->n[0], posed + 3 * H->n[1], posed + 3 * H->n[2], n2);
 					edge_quadric(a, b, n2, q2);
 				}
 				int ends[2] = {F->n[e], F->n[(e + 1) % 3]};

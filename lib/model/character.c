@@ -5,7 +5,8 @@
  * mlod_character_validate checks what the rest of the library relies on
  * (parents before children, every index in range, finite numbers,
  * increasing key times, non-negative weights) and names the first problem;
- * mlod_skeleton_size gives the scale that relative tolerances use.
+ * mlod_skeleton_height gives the scale of every "% of the height",
+ * mlod_skeleton_extent the scale of numeric tolerances.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -256,17 +257,29 @@ mlod_result mlod_character_validate(const mlod_character *c, mlod_error *err)
 	return MLOD_OK;
 }
 
+char *mlod_strdup(const char *s)
+{
+	size_t n = strlen(s ? s : "") + 1;
+	char *d = malloc(n);
+	if (d)
+		memcpy(d, s ? s : "", n);
+	return d;
+}
+
 /* ---------------------------------------------------------------- */
-/* Size                                                              */
+/* Height                                                            */
 /* ---------------------------------------------------------------- */
 
-float mlod_skeleton_size(const mlod_skeleton *s)
+/* The box of the rest-pose joint origins in world space: each origin
+ * carried up through its ancestors' rest transforms and its root's base.
+ * Returns 0 without joints. */
+static int rest_box(const mlod_skeleton *s, float lo[3], float hi[3])
 {
 	if (!s || s->joint_count <= 0)
-		return 0.0f;
-	float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+		return 0;
+	for (int a = 0; a < 3; a++)
+		lo[a] = INFINITY, hi[a] = -INFINITY;
 	for (int i = 0; i < s->joint_count; i++) {
-		/* The joint's origin, carried up through its ancestors' rest transforms. */
 		mlod_v3 p = { 0, 0, 0 };
 		int j = i, root = i;
 		for (; j >= 0; j = s->joints[j].parent) {
@@ -281,6 +294,24 @@ float mlod_skeleton_size(const mlod_skeleton *s)
 			hi[a] = fmaxf(hi[a], v[a]);
 		}
 	}
+	return 1;
+}
+
+float mlod_skeleton_extent(const mlod_skeleton *s)
+{
+	float lo[3], hi[3];
+	if (!rest_box(s, lo, hi))
+		return 0.0f;
 	float size = fmaxf(hi[0] - lo[0], fmaxf(hi[1] - lo[1], hi[2] - lo[2]));
 	return size > 0.0f && isfinite(size) ? size : 1.0f; /* a single point: unit scale */
+}
+
+float mlod_skeleton_height(const mlod_skeleton *s)
+{
+	float lo[3], hi[3];
+	if (!rest_box(s, lo, hi))
+		return 0.0f;
+	float extent = mlod_skeleton_extent(s), up = hi[1] - lo[1];
+	/* Lying down, modelled Z-up, a snake, one joint: the largest extent. */
+	return up >= MLOD_HEIGHT_MIN_UP * extent && isfinite(up) ? up : extent;
 }

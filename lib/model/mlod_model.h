@@ -1,7 +1,8 @@
 /*
  * mlod_model.h: the character model: skeleton, skins, meshes, instances and
  * clips as every reader produces them and every layer consumes them, with
- * pose evaluation and linear blend skinning.
+ * pose evaluation and linear blend skinning (pose.c), lifetime, invariants
+ * and the skeleton height (character.c), and clip timelines (keytimes.c).
  *
  * - Objects the library allocates are released with the matching *_free
  *   call, which accepts NULL. Plain buffers it returns are released with
@@ -159,9 +160,36 @@ void mlod_primitive_free(mlod_primitive *p);
  * message naming the first problem. */
 mlod_result mlod_character_validate(const mlod_character *c, mlod_error *err);
 
-/* Height of the skeleton: the extent of the rest-pose joint positions
- * along its largest axis (never 0 for a non-empty skeleton). */
-float mlod_skeleton_size(const mlod_skeleton *s);
+/* Height of the skeleton, the scale of every "% of the height" mlod reads
+ * or reports (motion bounds, skeleton level errors, the stage record): the
+ * extent along +Y, glTF's up axis (BVH files such as CMU's are Y-up too),
+ * of the rest-pose joint origins in world space, roots with their base
+ * transforms. Joints only: the mesh above the head joint is not counted.
+ * The rule for degenerate skeletons: when the Y extent is under
+ * MLOD_HEIGHT_MIN_UP of the largest extent (a character lying down or
+ * modelled Z-up, a snake, a single joint), the height is the largest
+ * extent (mlod_skeleton_extent). Never 0 for a non-empty skeleton; 0 for
+ * NULL or no joints. */
+#define MLOD_HEIGHT_MIN_UP 0.25f
+float mlod_skeleton_height(const mlod_skeleton *s);
+
+/* The largest extent of the rest-pose joint origins along x, y or z (1 for
+ * a single point; 0 for NULL or no joints). Not a height (on a T-posed
+ * character it is the arm span): a scale for numeric tolerances and for
+ * the test character's proportions, never shown as a percentage. */
+float mlod_skeleton_extent(const mlod_skeleton *s);
+
+/* A malloc'ed copy of s ("" for NULL), or NULL when out of memory. */
+char *mlod_strdup(const char *s);
+
+/* The timeline of a clip (keytimes.c): with frames set and a sampled clip
+ * (frame_time > 0, frame_count > 0), its frames i * frame_time; otherwise
+ * the key times of the channels that use selects (use[i] != 0 for channel
+ * i; every channel when use is NULL), merged, sorted and each once.
+ * *times is malloc'ed (NULL when the count is 0). Returns the count, or -1
+ * when out of memory. *shared (may be NULL) is set to 1 when the selected
+ * channels all have the same key times, else 0. */
+int mlod_clip_key_times(const mlod_clip *clip, const unsigned char *use, int frames, float **times, int *shared);
 
 /* ------------------------------------------------------------------ */
 /* Pose evaluation and skinning                                        */
@@ -173,6 +201,10 @@ void mlod_pose_rest(const mlod_skeleton *s, mlod_trs *local);
 /* Samples clip at time t (clamped to [0, duration]) into local, which must
  * hold the pose the clip does not animate (usually the rest pose). */
 void mlod_clip_sample(const mlod_clip *clip, float t, mlod_trs *local);
+
+/* Sets the path of l that one channel animates to its value at time t
+ * (clamped to [0, duration]), as mlod_clip_sample does for each channel. */
+void mlod_channel_sample(const mlod_channel *ch, float duration, float t, mlod_trs *l);
 
 /* world[i] = world transform of joint i for the given local pose
  * (roots are prefixed by their base). */

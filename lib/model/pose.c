@@ -89,35 +89,37 @@ static void sample_channel(const mlod_channel *ch, float t, int comps, float *ou
 	}
 }
 
-void mlod_clip_sample(const mlod_clip *clip, float t, mlod_trs *local)
+void mlod_channel_sample(const mlod_channel *ch, float duration, float t, mlod_trs *l)
 {
 	if (!(t > 0.0f))
 		t = 0.0f; /* also NaN */
-	if (t > clip->duration)
-		t = clip->duration;
-	for (int i = 0; i < clip->channel_count; i++) {
-		const mlod_channel *ch = &clip->channels[i];
-		mlod_trs *l = &local[ch->joint];
-		float v[4];
-		if (ch->key_count < 1)
-			continue;
-		switch (ch->path) {
-		case MLOD_PATH_TRANSLATION:
-			sample_channel(ch, t, 3, v);
-			l->t.x = v[0], l->t.y = v[1], l->t.z = v[2];
-			break;
-		case MLOD_PATH_SCALE:
-			sample_channel(ch, t, 3, v);
-			l->s.x = v[0], l->s.y = v[1], l->s.z = v[2];
-			break;
-		case MLOD_PATH_ROTATION: {
-			sample_channel(ch, t, 4, v);
-			mlod_quat q = { v[0], v[1], v[2], v[3] };
-			l->r = mlod_quat_normalize(q);
-			break;
-		}
-		}
+	if (t > duration)
+		t = duration;
+	float v[4];
+	if (ch->key_count < 1)
+		return;
+	switch (ch->path) {
+	case MLOD_PATH_TRANSLATION:
+		sample_channel(ch, t, 3, v);
+		l->t.x = v[0], l->t.y = v[1], l->t.z = v[2];
+		break;
+	case MLOD_PATH_SCALE:
+		sample_channel(ch, t, 3, v);
+		l->s.x = v[0], l->s.y = v[1], l->s.z = v[2];
+		break;
+	case MLOD_PATH_ROTATION: {
+		sample_channel(ch, t, 4, v);
+		mlod_quat q = { v[0], v[1], v[2], v[3] };
+		l->r = mlod_quat_normalize(q);
+		break;
 	}
+	}
+}
+
+void mlod_clip_sample(const mlod_clip *clip, float t, mlod_trs *local)
+{
+	for (int i = 0; i < clip->channel_count; i++)
+		mlod_channel_sample(&clip->channels[i], clip->duration, t, &local[clip->channels[i].joint]);
 }
 
 /* ---------------------------------------------------------------- */

@@ -5,7 +5,7 @@
  * motion.c): each animated channel of each joint keeps only the keys it
  * needs, in the manner of ozz-animation's keyframe optimizer and of ACL's
  * "virtual vertex" error (Frechette, "Animation Compression Library").
- * The error of a joint at a frame is
+ * The error of a joint at a frame is the point error (pointerror.c)
  *
  *     |o' - o| + r * sigma_max(A' - A)
  *
@@ -120,67 +120,6 @@ static void kept_value(const reducer *R, const mlod_channel *ch, const unsigned 
 	segment_value(R, ch, a, b, f, out);
 }
 
-/* Largest singular value of a 3x3 matrix given by columns (m[c * 4 + r]). */
-static double sigma_max(const double a[9])
-{
-	/* B = A^T A, symmetric positive semi-definite. */
-	double b[3][3];
-	for (int i = 0; i < 3; i++)
-		for (int j = 0; j < 3; j++)
-			b[i][j] = a[0 * 3 + i] * a[0 * 3 + j] + a[1 * 3 + i] * a[1 * 3 + j] + a[2 * 3 + i] * a[2 * 3 + j];
-	double p1 = b[0][1] * b[0][1] + b[0][2] * b[0][2] + b[1][2] * b[1][2];
-	double q = (b[0][0] + b[1][1] + b[2][2]) / 3.0, lambda;
-	if (p1 <= 1e-30 * (q * q + 1e-300)) {
-		lambda = fmax(b[0][0], fmax(b[1][1], b[2][2]));
-	} else {
-		double p2 = (b[0][0] - q) * (b[0][0] - q) + (b[1][1] - q) * (b[1][1] - q) + (b[2][2] - q) * (b[2][2] - q) +
-		            2.0 * p1;
-		double p = sqrt(p2 / 6.0), c[3][3];
-		for (int i = 0; i < 3; i++)
-			for (int j = 0; j < 3; j++)
-				c[i][j] = (b[i][j] - (i == j ? q : 0.0)) / p;
-		double det = c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0]) +
-		             c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]);
-		double r = det / 2.0;
-		r = r < -1.0 ? -1.0 : r > 1.0 ? 1.0 : r;
-		lambda = q + 2.0 * p * cos(acos(r) / 3.0);
-		/* Rounding: never below the largest diagonal entry. */
-		lambda = fmax(lambda, fmax(b[0][0], fmax(b[1][1], b[2][2])));
-	}
-	return lambda > 0.0 ? sqrt(lambda) * (1.0 + 1e-9) : 0.0;
-}
-
-double mlod_motion_point_error(const mlod_mat4 *a, const mlod_mat4 *b, double radius)
-{
-	double d[3], m[9];
-	for (int r = 0; r < 3; r++)
-		d[r] = (double)a->m[12 + r] - b->m[12 + r];
-	for (int c = 0; c < 3; c++)
-		for (int r = 0; r < 3; r++)
-			m[c * 3 + r] = (double)a->m[c * 4 + r] - b->m[c * 4 + r];
-	return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + radius * sigma_max(m);
-}
-
-/* Does the joint's world matrix w stay within budget of w0? The same
- * error as mlod_motion_point_error, with early exits. */
-static int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget)
-{
-	double dx = (double)w->m[12] - w0->m[12], dy = (double)w->m[13] - w0->m[13], dz = (double)w->m[14] - w0->m[14];
-	double dp = sqrt(dx * dx + dy * dy + dz * dz);
-	if (!(dp <= budget))
-		return 0;
-	double a[9], frob = 0.0;
-	for (int c = 0; c < 3; c++)
-		for (int r = 0; r < 3; r++) {
-			a[c * 3 + r] = (double)w->m[c * 4 + r] - w0->m[c * 4 + r];
-			frob += a[c * 3 + r] * a[c * 3 + r];
-		}
-	double room = budget - dp, rad = R->radius[j];
-	if (rad * rad * frob <= room * room)
-		return 1; /* sigma_max <= Frobenius norm */
-	return rad * sigma_max(a) <= room;
-}
-
 /* Checks (commit = 0) or applies (commit = 1) channel ch taking the value
  * val_of(f) at frames lo..hi (inclusive): val_a, val_b are the keys of a
  * segment, or const_value for a constant. */
@@ -203,12 +142,12 @@ static int sweep(reducer *R, const mlod_channel *ch, int a, int b, int lo, int h
 		mlod_mat4 lm = mlod_mat4_from_trs(&l);
 		mlod_mat4 *w = commit ? R->wc + base : R->tmp;
 		w[j] = mlod_mat4_mul(p < 0 ? &s->joints[j].base : &R->wc[base + (size_t)p], &lm);
-		if (!commit && !within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
+		if (!commit && !mlod_motion_point_within(&w[j], &R->w0[base + (size_t)j], R->radius[j], budget))
 			return 0;
 		for (int k = 1; k < nsub; k++) {
 			int d = sub[k], dp = s->joints[d].parent;
 			w[d] = mlod_mat4_mul(&w[dp], &R->lm[base + (size_t)d]);
-			if (!commit && !within(R, d, &w[d], &R->w0[base + (size_t)d], budget))
+			if (!commit && !mlod_motion_point_within(&w[d], &R->w0[base + (size_t)d], R->radius[d], budget))
 				return 0;
 		}
 		if (commit) {

@@ -1,7 +1,10 @@
 /*
- * mlod_motion.h: the motion layer (paper 4.3): the multiresolution motion tree,
- * per-channel key reduction under a hierarchical error bound, and morph
- * target weight tracks.
+ * mlod_motion.h: the motion layer (paper 4.3): the common timeline
+ * (timeline.c), the point error both methods answer to (pointerror.c), the
+ * multiresolution motion tree and the levels (motion.c), per-channel key
+ * reduction under a hierarchical error bound (keyreduce.c), and morph
+ * target weight tracks (morphweights.c). Files call one way: motion.c
+ * calls keyreduce.c, both call pointerror.c and timeline.c.
  */
 #ifndef MLOD_MOTION_H
 #define MLOD_MOTION_H
@@ -33,6 +36,9 @@ extern "C" {
  * exact for the farthest point). */
 double mlod_motion_point_error(const mlod_mat4 *a, const mlod_mat4 *b, double radius);
 
+/* mlod_motion_point_error(w, w0, radius) <= budget, with early exits. */
+int mlod_motion_point_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double budget);
+
 typedef enum mlod_motion_method {
 	MLOD_MOTION_FRAMES,  /* the paper's multiresolution motion tree: whole frames go */
 	MLOD_MOTION_KEYS     /* per-channel key reduction under a hierarchical error bound */
@@ -63,13 +69,20 @@ typedef enum mlod_motion_precision {
 	MLOD_MOTION_PRECISION_FULL   /* values as read */
 } mlod_motion_precision;
 
+/* The default point distance: 10 cm in metres (glTF's unit) when metres
+ * is set; otherwise, for a file in units of its own such as BVH, the
+ * skeleton height / 18 (10 cm on a person 1.8 units tall; 1/18 for a
+ * skeleton without joints). mlod-motion's default, and the benchmarks'. */
+#define MLOD_POINT_DISTANCE_METRES 0.1
+double mlod_motion_point_distance(const mlod_skeleton *s, int metres);
+
 /* Zero-initialised options are the defaults. */
 typedef struct mlod_motion_options {
 	mlod_motion_merge merge;  /* frames method; MLOD_MOTION_REMOVE (the default) measured better */
 	double cubic_rate;        /* CUBICSPLINE clips are resampled at least this often (1/s); 0 means 60 */
 	double point_distance;    /* radius of the points carried by each joint for the point error
-	                             (scene units); 0 means the skeleton height / 18 (10 cm on a 1.8 m
-	                             person) */
+	                             (scene units); 0 means mlod_motion_point_distance(s, 0): the
+	                             skeleton height / 18 */
 	mlod_motion_precision precision; /* how a level's key values are stored (default auto) */
 	double precision_share;   /* auto precision: the share of a max-error bound left to rounding,
 	                             (0, 1); 0 means the default */

@@ -6,9 +6,10 @@
  * when the distance between them, "the energy needed to move all joints
  * from one frame to the other", is below a threshold, by "removing a frame
  * from among the two or by merging the two into a single frame, preserving
- * the duration". We read it so (docs: paper-notes.md, 4.3):
+ * the duration". We read it so (mlod-motion(1), Common timeline, Frame
+ * distance, The multiresolution motion tree):
  *
- * - Common timeline. A clip is first put on frames shared by all its
+ * - Common timeline (timeline.c). A clip is first put on frames shared by all its
  *   channels: its own keys when they agree, else the union of the key
  *   times (exact for LINEAR and STEP), with CUBICSPLINE intervals
  *   subdivided to at least cubic_rate frames per second.
@@ -70,340 +71,43 @@
 
 #include "motion/mlod_motion.h"
 
-#define PI 3.14159265358979323846
-#define DEFAULT_CUBIC_RATE 60.0
-#define MAX_FRAMES 10000000
-#define MAX_VALUES 200000000.0 /* floats of a common clip */
 #define SEARCH_STEPS 24 /* bisection steps: the threshold to 2^-24 of its range */
 #define MAX_CACHED 1000000L /* frames * joints whose world matrices as read are cached */
 #define KEYS_RETRIES 6
 #define DEFAULT_PRECISION_SHARE 0.1 /* of a max-error bound left to rounding (bench/RESULTS.md) */
-
-/* Axes of each Euler order, outermost first (as in math.c). */
-static const int euler_axes[6][3] = {
-	{ 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 }
-};
 
 static int comps_of(const mlod_channel *ch)
 {
 	return ch->path == MLOD_PATH_ROTATION ? 4 : 3;
 }
 
-/* ---------------------------------------------------------------- */
-/* Clips                                                             */
-/* ---------------------------------------------------------------- */
-
-void mlod_clip_free(mlod_clip *clip)
+double mlod_motion_point_distance(const mlod_skeleton *s, int metres)
 {
-	if (!clip)
-		return;
-	for (int i = 0; clip->channels && i < clip->channel_count; i++) {
-		free(clip->channels[i].times);
-		free(clip->channels[i].values);
-	}
-	free(clip->channels);
-	free(clip->name);
-	memset(clip, 0, sizeof *clip);
-}
-
-long mlod_clip_key_count(const mlod_clip *clip)
-{
-	long n = 0;
-	for (int i = 0; clip && i < clip->channel_count; i++)
-		n += clip->channels[i].key_count;
-	return n;
-}
-
-long mlod_clip_key_bytes(const mlod_clip *clip)
-{
-	long bytes = 0;
-	if (!clip)
-		return 0;
-	for (int i = 0; i < clip->channel_count; i++) {
-		const mlod_channel *ch = &clip->channels[i];
-		long per_key = comps_of(ch) * (ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
-		bytes += (long)ch->key_count * per_key * (ch->short_values ? 2 : 4);
-		int shared = 0;
-		for (int k = 0; k < i && !shared; k++) {
-			const mlod_channel *o = &clip->channels[k];
-			shared = o->key_count == ch->key_count &&
-			         memcmp(o->times, ch->times, sizeof(float) * (size_t)ch->key_count) == 0;
-		}
-		if (!shared)
-			bytes += (long)ch->key_count * 4;
-	}
-	return bytes;
-}
-
-void mlod_motion_sample_times(const float *times, int frames, int subdivide, float *out)
-{
-	int sub = subdivide > 0 ? subdivide : 1;
-	for (int f = 0; f < frames; f++) {
-		out[(size_t)f * (size_t)sub] = times[f];
-		for (int i = 1; f + 1 < frames && i < sub; i++) {
-			double t0 = times[f], t1 = times[f + 1];
-			float t = (float)(t0 + (t1 - t0) * (double)i / (double)sub);
-			/* Inside the interval (or on its start when it is too short). */
-			out[(size_t)f * (size_t)sub + (size_t)i] = t > times[f] && t < times[f + 1] ? t : times[f];
-		}
-	}
-}
-
-static char *dup_string(const char *s)
-{
-	size_t n = strlen(s ? s : "") + 1;
-	char *d = malloc(n);
-	if (d)
-		memcpy(d, s ? s : "", n);
-	return d;
-}
-
-static mlod_result check_clip(const mlod_clip *clip, mlod_error *err)
-{
-	const char *name = clip->name ? clip->name : "";
-	if (clip->channel_count <= 0 || !clip->channels)
-		return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\": no channels to reduce", name);
-	for (int i = 0; i < clip->channel_count; i++) {
-		const mlod_channel *ch = &clip->channels[i];
-		if ((unsigned)ch->path > MLOD_PATH_SCALE || (unsigned)ch->interp > MLOD_INTERP_CUBICSPLINE)
-			return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: bad path or interpolation", name, i);
-		if (ch->key_count <= 0 || !ch->times || !ch->values)
-			return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: no keys", name, i);
-		int comps = comps_of(ch), stride = comps * (ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
-		for (int k = 0; k < ch->key_count; k++) {
-			float t = ch->times[k];
-			if (!isfinite(t))
-				return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: key %d time is not finite", name, i, k);
-			if (k == 0 && t < 0.0f)
-				return mlod_fail(err, MLOD_ERR_PARSE,
-				                 "clip \"%s\" channel %d: first key time %g is negative (glTF needs times >= 0)",
-				                 name, i, (double)t);
-			if (k > 0 && !(t > ch->times[k - 1]))
-				return mlod_fail(err, MLOD_ERR_PARSE,
-				                 "clip \"%s\" channel %d: key %d time %g does not follow %g (times must increase)",
-				                 name, i, k, (double)t, (double)ch->times[k - 1]);
-			const float *v = ch->values + (size_t)k * (size_t)stride;
-			double len2 = 0.0;
-			for (int c = 0; c < stride; c++)
-				if (!isfinite(v[c]))
-					return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: key %d value is not finite", name,
-					                 i, k);
-			if (comps == 4) {
-				const float *q = v + (ch->interp == MLOD_INTERP_CUBICSPLINE ? 4 : 0);
-				for (int c = 0; c < 4; c++)
-					len2 += (double)q[c] * q[c];
-				if (!(len2 > 1e-12))
-					return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: key %d rotation is a zero quaternion",
-					                 name, i, k);
-			}
-		}
-	}
-	return MLOD_OK;
-}
-
-static int float_order(const void *a, const void *b)
-{
-	float x = *(const float *)a, y = *(const float *)b;
-	return (x > y) - (x < y);
-}
-
-/* Sets the path of l that channel ch of clip animates to its value at t,
- * as mlod_clip_sample does. */
-static void sample_into(const mlod_clip *clip, const mlod_channel *ch, float t, mlod_trs *l)
-{
-	mlod_channel one = *ch;
-	mlod_clip tmp;
-	memset(&tmp, 0, sizeof tmp);
-	one.joint = 0;
-	tmp.duration = clip->duration;
-	tmp.channel_count = 1;
-	tmp.channels = &one;
-	mlod_clip_sample(&tmp, t, l);
-}
-
-/* Samples one channel of clip at t into out (comps floats), exactly as
- * mlod_clip_sample does. */
-static void sample_one(const mlod_clip *clip, const mlod_channel *ch, float t, float *out)
-{
-	mlod_trs local = mlod_trs_identity();
-	sample_into(clip, ch, t, &local);
-	switch (ch->path) {
-	case MLOD_PATH_TRANSLATION: out[0] = local.t.x, out[1] = local.t.y, out[2] = local.t.z; break;
-	case MLOD_PATH_SCALE: out[0] = local.s.x, out[1] = local.s.y, out[2] = local.s.z; break;
-	case MLOD_PATH_ROTATION: out[0] = local.r.x, out[1] = local.r.y, out[2] = local.r.z, out[3] = local.r.w; break;
-	}
-}
-
-mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_options *opt, mlod_clip *out,
-                                    mlod_motion_timeline *info, mlod_error *err)
-{
-	mlod_motion_timeline inf;
-	memset(&inf, 0, sizeof inf);
-	if (!clip || !out)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_common_clip: NULL argument");
-	memset(out, 0, sizeof *out);
-	mlod_result r = check_clip(clip, err);
-	if (r != MLOD_OK)
-		return r;
-	double rate = opt && opt->cubic_rate > 0.0 ? opt->cubic_rate : DEFAULT_CUBIC_RATE;
-	const mlod_channel *c0 = &clip->channels[0];
-	int same = 1;
-	long total = 0;
-	for (int i = 0; i < clip->channel_count; i++) {
-		const mlod_channel *ch = &clip->channels[i];
-		total += ch->key_count;
-		if (ch->interp == MLOD_INTERP_CUBICSPLINE)
-			inf.cubic_channels++;
-		if (ch->key_count != c0->key_count ||
-		    memcmp(ch->times, c0->times, sizeof(float) * (size_t)ch->key_count) != 0)
-			same = 0;
-	}
-
-	/* The frames. */
-	float *times = NULL;
-	long n = 0;
-	if (same && inf.cubic_channels == 0) {
-		n = c0->key_count;
-		times = malloc(sizeof(float) * (size_t)n);
-		if (!times)
-			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-		memcpy(times, c0->times, sizeof(float) * (size_t)n);
-	} else {
-		float *u = malloc(sizeof(float) * (size_t)total);
-		if (!u)
-			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-		long m = 0;
-		for (int i = 0; i < clip->channel_count; i++) {
-			memcpy(u + m, clip->channels[i].times, sizeof(float) * (size_t)clip->channels[i].key_count);
-			m += clip->channels[i].key_count;
-		}
-		qsort(u, (size_t)m, sizeof *u, float_order);
-		long k = 0;
-		for (long i = 0; i < m; i++)
-			if (k == 0 || u[i] != u[k - 1])
-				u[k++] = u[i];
-		/* CUBICSPLINE: evenly spaced frames in intervals longer than 1/rate. */
-		double extra = 0.0;
-		for (long i = 0; inf.cubic_channels && i + 1 < k; i++)
-			extra += ceil(((double)u[i + 1] - u[i]) * rate - 1e-6) - 1.0;
-		if (k + extra > MAX_FRAMES) {
-			free(u);
-			return mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": resampling needs %.0f frames (at most %d)",
-			                 clip->name ? clip->name : "", k + extra, MAX_FRAMES);
-		}
-		n = k + (long)extra;
-		times = malloc(sizeof(float) * (size_t)n);
-		if (!times) {
-			free(u);
-			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-		}
-		long f = 0;
-		for (long i = 0; i < k; i++) {
-			times[f++] = u[i];
-			if (!inf.cubic_channels || i + 1 == k)
-				continue;
-			long sub = (long)(ceil(((double)u[i + 1] - u[i]) * rate - 1e-6));
-			for (long s = 1; s < sub; s++) {
-				float t = (float)((double)u[i] + ((double)u[i + 1] - u[i]) * (double)s / (double)sub);
-				if (t > times[f - 1] && t < u[i + 1])
-					times[f++] = t;
-			}
-		}
-		n = f;
-		free(u);
-		inf.resampled = 1;
-		for (int i = 0; i < clip->channel_count; i++) {
-			const mlod_channel *ch = &clip->channels[i];
-			if (ch->key_count != n || memcmp(ch->times, times, sizeof(float) * (size_t)n) != 0)
-				inf.mismatched_channels++;
-		}
-	}
-	double values = 0.0;
-	for (int i = 0; i < clip->channel_count; i++)
-		values += (double)n * (comps_of(&clip->channels[i]) + 1);
-	if (n > MAX_FRAMES || values > MAX_VALUES) {
-		free(times);
-		return mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": %ld frames of %d channels is too much motion",
-		                 clip->name ? clip->name : "", n, clip->channel_count);
-	}
-	inf.frames = (int)n;
-
-	/* The channels. */
-	out->name = dup_string(clip->name);
-	out->channels = calloc((size_t)clip->channel_count, sizeof *out->channels);
-	out->channel_count = clip->channel_count;
-	out->duration = clip->duration;
-	out->frame_time = clip->frame_time;
-	out->frame_count = clip->frame_count;
-	out->gltf_index = clip->gltf_index;
-	int ok = out->name && out->channels;
-	for (int i = 0; ok && i < clip->channel_count; i++) {
-		const mlod_channel *src = &clip->channels[i];
-		mlod_channel *ch = &out->channels[i];
-		int comps = comps_of(src);
-		ch->joint = src->joint;
-		ch->path = src->path;
-		ch->interp = src->interp == MLOD_INTERP_STEP ? MLOD_INTERP_STEP : MLOD_INTERP_LINEAR;
-		ch->key_count = (int)n;
-		ch->times = malloc(sizeof(float) * (size_t)n);
-		ch->values = malloc(sizeof(float) * (size_t)n * (size_t)comps);
-		if (!ch->times || !ch->values) {
-			ok = 0;
-			break;
-		}
-		memcpy(ch->times, times, sizeof(float) * (size_t)n);
-		int own = !inf.resampled;
-		for (long f = 0; f < n; f++) {
-			float *v = ch->values + f * comps;
-			if (own)
-				memcpy(v, src->values + f * comps, sizeof(float) * (size_t)comps);
-			else
-				sample_one(clip, src, times[f], v);
-			/* Sign-continuous rotations: -q is q. */
-			if (comps == 4 && f > 0) {
-				const float *p = v - 4;
-				if ((double)p[0] * v[0] + (double)p[1] * v[1] + (double)p[2] * v[2] + (double)p[3] * v[3] < 0.0)
-					v[0] = -v[0], v[1] = -v[1], v[2] = -v[2], v[3] = -v[3];
-			}
-		}
-	}
-	free(times);
-	if (!ok) {
-		mlod_clip_free(out);
-		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-	}
-	if (info)
-		*info = inf;
-	return MLOD_OK;
+	if (metres)
+		return MLOD_POINT_DISTANCE_METRES;
+	double h = mlod_skeleton_height(s);
+	return (h > 0.0 ? h : 1.0) / 18.0;
 }
 
 /* ---------------------------------------------------------------- */
 /* Frame distance                                                    */
 /* ---------------------------------------------------------------- */
 
-static double wrap_angle(double a)
-{
-	a = fmod(a + PI, 2.0 * PI);
-	if (a <= 0.0)
-		a += 2.0 * PI;
-	return a - PI;
-}
-
 /* Sum of |wrapped differences| between two Euler triples of one order,
  * the nearer of the two triples of b: (A, B, C) and (A + pi, pi - B, C + pi)
  * over the order's axes, outermost first. */
 static double euler_change(mlod_euler_order order, const float *ea, const float *eb)
 {
-	const int *ax = euler_axes[(unsigned)order < 6 ? order : 0];
+	const int *ax = mlod_euler_axes(order);
 	double d1 = 0.0, d2 = 0.0;
 	for (int a = 0; a < 3; a++)
-		d1 += fabs(wrap_angle((double)eb[a] - ea[a]));
+		d1 += fabs(mlod_wrap_angle((double)eb[a] - ea[a]));
 	double alt[3];
-	alt[ax[0]] = eb[ax[0]] + PI;
-	alt[ax[1]] = PI - eb[ax[1]];
-	alt[ax[2]] = eb[ax[2]] + PI;
+	alt[ax[0]] = eb[ax[0]] + MLOD_PI;
+	alt[ax[1]] = MLOD_PI - eb[ax[1]];
+	alt[ax[2]] = eb[ax[2]] + MLOD_PI;
 	for (int a = 0; a < 3; a++)
-		d2 += fabs(wrap_angle(alt[a] - ea[a]));
+		d2 += fabs(mlod_wrap_angle(alt[a] - ea[a]));
 	return d1 < d2 ? d1 : d2;
 }
 
@@ -441,12 +145,12 @@ double mlod_motion_frame_distance(const mlod_skeleton *s, const mlod_trs *a, con
 	if (!w)
 		return HUGE_VAL;
 	joint_weights(s, w);
-	double height = mlod_skeleton_size(s), d = 0.0;
+	double height = mlod_skeleton_height(s), d = 0.0;
 	for (int j = 0; j < s->joint_count; j++) {
 		float ea[3], eb[3];
 		mlod_quat_to_euler(s->joints[j].euler, a[j].r, ea);
 		mlod_quat_to_euler(s->joints[j].euler, b[j].r, eb);
-		d += w[j] * (euler_change(s->joints[j].euler, ea, eb) / PI + v3_dist(a[j].t, b[j].t) / height +
+		d += w[j] * (euler_change(s->joints[j].euler, ea, eb) / MLOD_PI + v3_dist(a[j].t, b[j].t) / height +
 		             v3_dist(a[j].s, b[j].s));
 	}
 	free(w);
@@ -653,7 +357,7 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	}
 	m->samples = (F - 1) * m->sub + 1;
 	m->st = malloc(sizeof(float) * (size_t)m->samples);
-	m->height = mlod_skeleton_size(s);
+	m->height = mlod_skeleton_height(s);
 	if (!(m->height > 0.0))
 		m->height = 1.0;
 	m->weight = malloc(sizeof(double) * (size_t)n);
@@ -681,7 +385,7 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 		for (int f = 1; f < F && m->constant[i]; f++)
 			m->constant[i] = memcmp(ch->values, ch->values + (size_t)f * (size_t)comps, sizeof(float) * (size_t)comps) == 0;
 	}
-	double pd = opt && opt->point_distance > 0.0 ? opt->point_distance : m->height / 18.0;
+	double pd = opt && opt->point_distance > 0.0 ? opt->point_distance : mlod_motion_point_distance(s, 0);
 	for (int j = 0; j < n; j++) {
 		double es = s->joints[j].has_end_site ? mlod_v3_length(s->joints[j].end_site) : 0.0;
 		m->radius[j] = es > pd ? es : pd;
@@ -721,7 +425,7 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 static int level_clip_init(const mlod_motion *m, mlod_clip *clip)
 {
 	memset(clip, 0, sizeof *clip);
-	clip->name = dup_string(m->orig->name);
+	clip->name = mlod_strdup(m->orig->name);
 	clip->duration = m->orig->duration;
 	clip->frame_time = m->orig->frame_time;
 	clip->frame_count = m->orig->frame_count;
@@ -989,7 +693,7 @@ static void round_clip(const mlod_clip *src, mlod_clip *dst, const int *e, int s
 static int clip_copy(const mlod_clip *src, mlod_clip *dst)
 {
 	*dst = *src;
-	dst->name = dup_string(src->name);
+	dst->name = mlod_strdup(src->name);
 	dst->channels = calloc((size_t)src->channel_count, sizeof *dst->channels);
 	if (!dst->name || !dst->channels) {
 		dst->channel_count = 0;
@@ -1080,7 +784,7 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 					mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
 					mlod_mat4 *wf = W + (size_t)f * (size_t)J;
 					const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J;
-					sample_into(clip, ch, times[f], &l);
+					mlod_channel_sample(ch, clip->duration, times[f], &l);
 					for (int k = 0; k < ns && ok; k++) {
 						int d = sub[k], p = s->joints[d].parent;
 						mlod_mat4 lm = mlod_mat4_from_trs(d == j ? &l : &lf[d]);
@@ -1196,7 +900,7 @@ static double node_distance(const mlod_motion *m, const fnode *a, const fnode *b
 		double w = m->weight[ch->joint], term;
 		if (ch->path == MLOD_PATH_ROTATION) {
 			int slot = m->value_count + 3 * m->euler_slot[i];
-			term = euler_change(m->s->joints[ch->joint].euler, a->values + slot, b->values + slot) / PI;
+			term = euler_change(m->s->joints[ch->joint].euler, a->values + slot, b->values + slot) / MLOD_PI;
 		} else {
 			double dx = (double)vb[0] - va[0], dy = (double)vb[1] - va[1], dz = (double)vb[2] - va[2];
 			term = sqrt(dx * dx + dy * dy + dz * dz);
@@ -1487,7 +1191,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 
 static double point_distance(const mlod_motion *m)
 {
-	return m->opt.point_distance > 0.0 ? m->opt.point_distance : m->height / 18.0;
+	return m->opt.point_distance > 0.0 ? m->opt.point_distance : mlod_motion_point_distance(m->s, 0);
 }
 
 /* Runs the key reduction with budget from the current keys into kept;

@@ -500,7 +500,7 @@ static mlod_result measure(struct ctx *x)
 		}
 	float d[3] = {x->bmax[0] - x->bmin[0], x->bmax[1] - x->bmin[1], x->bmax[2] - x->bmin[2]};
 	x->diag = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-	x->height = s->joint_count > 0 ? mlod_skeleton_size(s) : 0.0f;
+	x->height = s->joint_count > 0 ? mlod_skeleton_height(s) : 0.0f;
 	return MLOD_OK;
 }
 

@@ -41,8 +41,10 @@
 extern "C" {
 #endif
 
-/* The version this mlod writes and the newest it reads. */
-#define MLOD_RECORD_VERSION 1
+/* The version this mlod writes and the newest it reads. Version 2:
+ * joint_error.max_percent_height is of mlod_skeleton_height (version 1:
+ * of the largest extent of the rest pose). */
+#define MLOD_RECORD_VERSION 2
 
 /* ------------------------------------------------------------------ */
 /* Joint nodes: labels and energy (mlod-label)                         */

@@ -1,6 +1,7 @@
 /*
- * fold.c: applies a skeleton level to a character (paper 4.1.3, as read in
- * paper-notes.md): motion folding, skin transfer and the joint remap.
+ * fold.c: applies a skeleton level to a character (paper 4.1.3, which does
+ * not say what removal does to motion and skin; mlod-skelgraph(1), Levels,
+ * documents this reading): motion folding, skin transfer and the joint remap.
  *
  * Motion folding. A kept joint c whose parent chain j1 (its parent), ...,
  * jk was removed gets the local transform
@@ -36,9 +37,13 @@ static void *dup_bytes(const void *src, size_t n, int *failed)
 	return p;
 }
 
-static char *dup_string(const char *s, int *failed)
+/* mlod_strdup, noting a failure in *failed. */
+static char *copy_name(const char *s, int *failed)
 {
-	return dup_bytes(s ? s : "", strlen(s ? s : "") + 1, failed);
+	char *d = mlod_strdup(s);
+	if (!d)
+		*failed = 1;
+	return d;
 }
 
 static void copy_primitive(const mlod_primitive *p, mlod_primitive *q, int *failed)
@@ -99,46 +104,20 @@ static mlod_mat4 chain_product(const mlod_skeleton *s, const mlod_trs *local, in
 	return m;
 }
 
-/* Appends to *times the key times of joint j's channels; returns 0 or -1. */
-static int collect_times(const mlod_clip *clip, int j, float **times, int *count, int *cap, int *step_only,
-                         int *animated)
+/* Marks in use the channels of joint j; returns 1 when there is one. */
+static int mark_channels(const mlod_clip *clip, int j, unsigned char *use, int *step_only)
 {
+	int animated = 0;
 	for (int i = 0; i < clip->channel_count; i++) {
 		const mlod_channel *ch = &clip->channels[i];
 		if (ch->joint != j)
 			continue;
-		*animated = 1;
+		use[i] = 1;
+		animated = 1;
 		if (ch->interp != MLOD_INTERP_STEP)
 			*step_only = 0;
-		if (*count + ch->key_count > *cap) {
-			int grown = (*count + ch->key_count) * 2;
-			float *t = realloc(*times, sizeof(float) * (size_t)grown);
-			if (!t)
-				return -1;
-			*times = t;
-			*cap = grown;
-		}
-		memcpy(*times + *count, ch->times, sizeof(float) * (size_t)ch->key_count);
-		*count += ch->key_count;
 	}
-	return 0;
-}
-
-static int float_order(const void *a, const void *b)
-{
-	float x = *(const float *)a, y = *(const float *)b;
-	return (x > y) - (x < y);
-}
-
-/* Sorts and removes duplicates; returns the new count. */
-static int unique_times(float *t, int n)
-{
-	qsort(t, (size_t)n, sizeof *t, float_order);
-	int m = 0;
-	for (int i = 0; i < n; i++)
-		if (m == 0 || t[i] != t[m - 1])
-			t[m++] = t[i];
-	return m;
+	return animated;
 }
 
 /* Allocates channel storage; returns 0 or -1. */
@@ -170,25 +149,23 @@ static mlod_result fold_clip_joint(struct folder *f, const mlod_clip *clip, int 
 	int top = f->level->parent[j];
 	int nj = f->newidx[j];
 	float *times = NULL;
-	int count = 0, cap = 0, step_only = 1, animated = 0;
+	int count = 0, step_only = 1, animated = 0;
 	mlod_result r = MLOD_OK;
 
+	/* The keys of j and its removed ancestors, or the frames of a sampled clip. */
+	unsigned char *use = calloc((size_t)clip->channel_count + 1, 1);
+	if (!use)
+		goto nomem;
 	for (int a = j; a != top; a = s->joints[a].parent)
-		if (collect_times(clip, a, &times, &count, &cap, &step_only, &animated) != 0)
-			goto nomem;
-	if (!animated)
+		animated |= mark_channels(clip, a, use, &step_only);
+	if (!animated) {
+		free(use);
 		return MLOD_OK; /* the folded rest transform covers it */
-	if (clip->frame_time > 0.0f && clip->frame_count > 0) {
-		free(times);
-		count = clip->frame_count;
-		times = malloc(sizeof(float) * (size_t)count);
-		if (!times)
-			goto nomem;
-		for (int i = 0; i < count; i++)
-			times[i] = (float)i * clip->frame_time;
-	} else {
-		count = unique_times(times, count);
 	}
+	count = mlod_clip_key_times(clip, use, 1, &times, NULL);
+	free(use);
+	if (count < 0)
+		goto nomem;
 
 	mlod_trs *pose = malloc(sizeof *pose * (size_t)s->joint_count);
 	mlod_channel tc = {0}, rc = {0}, sc = {0};
@@ -243,7 +220,7 @@ static mlod_result fold_clip(struct folder *f, const mlod_clip *clip, mlod_clip 
 	*out = *clip;
 	out->channels = NULL;
 	out->channel_count = 0;
-	out->name = dup_string(clip->name, &failed);
+	out->name = copy_name(clip->name, &failed);
 	/* At most 3 channels per kept joint besides the copied ones. */
 	out->channels = calloc((size_t)clip->channel_count + 3 * (size_t)l->kept_count + 1, sizeof(mlod_channel));
 	if (failed || !out->channels)
@@ -283,7 +260,7 @@ static mlod_result reduce_skin(struct folder *f, const mlod_skin *sk, const mlod
 	const mlod_skeleton *s = &f->c->skeleton;
 	int failed = 0;
 	memset(out, 0, sizeof *out);
-	out->name = dup_string(sk->name, &failed);
+	out->name = copy_name(sk->name, &failed);
 	out->gltf_index = sk->gltf_index;
 	out->joints = malloc(sizeof(int) * (size_t)(sk->joint_count ? sk->joint_count : 1));
 	out->inverse_bind = malloc(sizeof(mlod_mat4) * (size_t)(sk->joint_count ? sk->joint_count : 1));
@@ -393,7 +370,7 @@ mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level
 			continue;
 		mlod_joint *nj = &out->skeleton.joints[out->skeleton.joint_count];
 		*nj = s->joints[j];
-		nj->name = dup_string(s->joints[j].name, &failed);
+		nj->name = copy_name(s->joints[j].name, &failed);
 		newidx[j] = out->skeleton.joint_count++;
 		nj->parent = l->parent[j] >= 0 ? newidx[l->parent[j]] : -1;
 		if (s->joints[j].parent >= 0 && !l->kept[s->joints[j].parent]) {
@@ -451,7 +428,7 @@ mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level
 			skin = in->skin;
 		}
 		*dst = *src;
-		dst->name = dup_string(src->name, &failed);
+		dst->name = copy_name(src->name, &failed);
 		dst->primitives = calloc((size_t)src->primitive_count + 1, sizeof(mlod_primitive));
 		if (failed || !dst->primitives) {
 			dst->primitive_count = 0;
@@ -501,7 +478,7 @@ mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level
 			goto fail;
 	}
 	if (c->notes) {
-		out->notes = dup_string(c->notes, &failed);
+		out->notes = copy_name(c->notes, &failed);
 		if (failed)
 			goto nomem;
 	}

@@ -8,7 +8,7 @@
  *   4. neighbours > f * avg(neighbours), depth > avg(depth) -> extreme (mu)
  *   5. otherwise                                         -> minor (kappa)
  * A hub whose depth equals the average exactly falls through to minor, as
- * the rules are written (docs: paper-notes.md).
+ * the rules are written (mlod-label(1), Labels).
  *
  * Energy. The paper's sum over frames of R(b+1) - R(b) telescopes to the
  * net displacement, so we read it as the total variation of each unwrapped
@@ -30,7 +30,6 @@
 
 #define DEFAULT_HUB_FACTOR MLOD_LABEL_HUB_FACTOR_DEFAULT
 #define ENERGY_RATE 30.0
-#define PI 3.14159265358979323846
 
 static const char *const label_names[] = {"root", "end-effector", "major", "extreme", "minor"};
 static const char *const label_symbols[] = {"\xce\xb6", "\xcf\x87", "\xcf\x88", "\xce\xbc", "\xce\xba"};
@@ -56,54 +55,36 @@ int mlod_label_parse(const char *s, mlod_label *out)
 	return -1;
 }
 
-/* Wraps an angle difference into (-pi, pi]. */
-static double wrap_angle(double a)
-{
-	a = fmod(a + PI, 2.0 * PI);
-	if (a <= 0.0)
-		a += 2.0 * PI;
-	return a - PI;
-}
-
 /* The times at which a clip is sampled for energy; returns the count and
  * sets *times (malloc'ed), or -1 when out of memory. */
 static int energy_times(const mlod_clip *clip, float **times)
 {
-	int n = 0;
-	const mlod_channel *shared = NULL;
-	int uniform_keys = clip->frame_time <= 0.0f;
-	for (int i = 0; i < clip->channel_count && uniform_keys; i++) {
-		const mlod_channel *ch = &clip->channels[i];
-		if (ch->path != MLOD_PATH_ROTATION)
-			continue;
-		if (!shared) {
-			shared = ch;
-		} else if (ch->key_count != shared->key_count ||
-		           memcmp(ch->times, shared->times, sizeof(float) * (size_t)ch->key_count) != 0) {
-			uniform_keys = 0;
-		}
+	*times = NULL;
+	/* A sampled clip: its frames. */
+	if (clip->frame_time > 0.0f && clip->frame_count > 0)
+		return mlod_clip_key_times(clip, NULL, 1, times, NULL);
+	/* Rotation channels that share their key times: those. */
+	if (clip->frame_time <= 0.0f) {
+		unsigned char *rot = malloc((size_t)clip->channel_count + 1);
+		if (!rot)
+			return -1;
+		for (int i = 0; i < clip->channel_count; i++)
+			rot[i] = clip->channels[i].path == MLOD_PATH_ROTATION;
+		int shared = 0, n = mlod_clip_key_times(clip, rot, 0, times, &shared);
+		free(rot);
+		if (n < 0 || (n > 0 && shared))
+			return n;
+		free(*times);
+		*times = NULL;
 	}
-	if (clip->frame_time > 0.0f && clip->frame_count > 0) {
-		n = clip->frame_count;
-	} else if (uniform_keys && shared) {
-		n = shared->key_count;
-	} else {
-		double frames = floor((double)clip->duration * ENERGY_RATE) + 1.0;
-		n = frames > 1e7 ? 10000000 : (int)frames;
-	}
-	if (n < 1)
-		n = 1;
+	/* Otherwise ENERGY_RATE frames per second. */
+	double frames = floor((double)clip->duration * ENERGY_RATE) + 1.0;
+	int n = frames > 1e7 ? 10000000 : frames < 1.0 ? 1 : (int)frames;
 	*times = malloc(sizeof(float) * (size_t)n);
 	if (!*times)
 		return -1;
-	for (int i = 0; i < n; i++) {
-		if (clip->frame_time > 0.0f && clip->frame_count > 0)
-			(*times)[i] = (float)i * clip->frame_time;
-		else if (uniform_keys && shared)
-			(*times)[i] = shared->times[i];
-		else
-			(*times)[i] = (float)(i / ENERGY_RATE);
-	}
+	for (int i = 0; i < n; i++)
+		(*times)[i] = (float)(i / ENERGY_RATE);
 	return n;
 }
 
@@ -132,7 +113,7 @@ static mlod_result clip_variation(const mlod_skeleton *s, const mlod_clip *clip,
 			mlod_quat_to_euler(s->joints[j].euler, pose[j].r, e);
 			for (int a = 0; a < 3; a++) {
 				if (f > 0)
-					variation[j] += fabs(wrap_angle((double)e[a] - prev[3 * j + a]));
+					variation[j] += fabs(mlod_wrap_angle((double)e[a] - prev[3 * j + a]));
 				prev[3 * j + a] = e[a];
 			}
 		}
@@ -153,7 +134,7 @@ mlod_result mlod_label_skeleton(const mlod_character *c, const mlod_label_option
 	if (n <= 0)
 		return mlod_fail(err, MLOD_ERR_PARSE, "the skeleton has no joints");
 	double hub = opt && opt->hub_factor > 0.0 ? opt->hub_factor : DEFAULT_HUB_FACTOR;
-	double range = opt && opt->max_angle > 0.0 ? opt->max_angle : PI;
+	double range = opt && opt->max_angle > 0.0 ? opt->max_angle : MLOD_PI;
 
 	/* Topology: parents come before children, so one pass gives depths. */
 	memset(info, 0, sizeof *info * (size_t)n);

@@ -128,7 +128,7 @@ typedef struct mlod_skel_level_record {
 	const mlod_character *character; /* the level applied to the full character */
 	mlod_deviation vertex;           /* skinned-vertex error, % of diagonal; scale 0 without meshes */
 	mlod_deviation joint;            /* joint position error, scene units */
-	double size;                     /* the skeleton height, for the joint error */
+	double height;                   /* mlod_skeleton_height, for the joint error */
 } mlod_skel_level_record;
 
 typedef struct mlod_fold_stats {
@@ -168,7 +168,7 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
 
 /* The defaults of mlod-skelgraph: levels removing these fractions of the
  * joints (the paper's figure), within MLOD_SKEL_MAX_ERROR_DEFAULT percent
- * of the skeleton size; errors measured at up to MLOD_SKEL_SAMPLES times
+ * of the skeleton height; errors measured at up to MLOD_SKEL_SAMPLES times
  * per clip. */
 #define MLOD_SKEL_REMOVED_DEFAULT 0.13, 0.26, 0.39
 #define MLOD_SKEL_MAX_ERROR_DEFAULT 2.0
@@ -184,7 +184,7 @@ typedef struct mlod_skel_built {
 	mlod_deviation vertex;   /* skinned-vertex error, % of the bounding diagonal */
 	mlod_deviation joint;    /* joint position error, scene units */
 	double bound_error;      /* what a bound is compared with: the vertex error with meshes, else the
-	                          * joint error, in % of the skeleton size */
+	                          * joint error, in % of the skeleton height */
 } mlod_skel_built;
 
 /* The levels of one character, finest first. */
@@ -194,7 +194,7 @@ typedef struct mlod_skel_levels {
 	mlod_skelgraph graph;
 	int *order;              /* the removal order of the minor joints */
 	int minor_count;
-	double height;           /* mlod_skeleton_size */
+	double height;           /* mlod_skeleton_height */
 	int has_mesh;
 	int count;
 	mlod_skel_built levels[MLOD_SKEL_MAX_LEVELS];

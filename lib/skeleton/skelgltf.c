@@ -22,12 +22,12 @@
 #include "skeleton/mlod_skeleton.h"
 
 /* The error that decides when a level may be shown, in percent of the
- * character's size. */
+ * skeleton height (mlod_skeleton_height). */
 static double level_error(const mlod_skel_level_record *r)
 {
 	if (r->vertex.scale > 0.0)
 		return r->vertex.max;
-	return r->size > 0.0 ? 100.0 * r->joint.max / r->size : 0.0;
+	return r->height > 0.0 ? 100.0 * r->joint.max / r->height : 0.0;
 }
 
 mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full,

@@ -20,7 +20,7 @@ mlod_result mlod_skel_levels_init(mlod_skel_levels *L, const mlod_character *c, 
 	mlod_result r = mlod_skelgraph_build(&c->skeleton, info, &L->graph, err);
 	if (r != MLOD_OK)
 		return r;
-	L->height = mlod_skeleton_size(&c->skeleton);
+	L->height = mlod_skeleton_height(&c->skeleton);
 	L->order = malloc(sizeof(int) * ((size_t)c->skeleton.joint_count + 1));
 	if (!L->order) {
 		mlod_skelgraph_free(&L->graph);

@@ -1,10 +1,18 @@
-# A failing run leaves an existing output untouched and no temporary file.
+# A failing run leaves an existing output untouched and no temporary file
+# (the temporary name is OUTPUT.tmp.PID).
 set -e
 printf 'keep me' > out.glb
 : > empty.bvh
 if "$BIN/mlod-label" -o out.glb empty.bvh 2>/dev/null; then exit 1; fi
 test "$(cat out.glb)" = "keep me"
-test "$(ls | grep -c tmp)" -eq 0
+test "$(ls -A | grep -c '\.tmp\.')" -eq 0
+# A failure after the temporary file was written (the output is a
+# directory, so the rename fails) leaves no temporary file either.
+mkdir -p taken/inside
+if "$BIN/mlod-label" -o taken "$ROOT/samples/cmu_12_01_walk.bvh" 2> err.txt; then exit 1; fi
+grep -qx 'mlod-label: taken: write failed: .*' err.txt
+test -d taken/inside
+test "$(ls -A | grep -c '\.tmp\.')" -eq 0
 # A good run replaces it.
 "$BIN/mlod-label" -o out.glb "$ROOT/samples/cmu_12_01_walk.bvh"
 test "$(head -c 4 out.glb)" = glTF

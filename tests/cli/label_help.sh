@@ -1,3 +1,9 @@
+# --help and --version print on stdout and exit 0, with nothing on stderr
+# (a pipe into grep would hide a failing exit code).
 set -e
-"$BIN/mlod-label" --help | grep -q '^usage: mlod-label'
-"$BIN/mlod-label" --version | grep -q '^mlod-label (mlod) '
+"$BIN/mlod-label" --help > help.txt 2> help.err
+grep -q '^usage: mlod-label' help.txt
+test ! -s help.err
+"$BIN/mlod-label" --version > version.txt 2> version.err
+grep -qx 'mlod-label (mlod) [0-9][0-9.]*' version.txt
+test ! -s version.err

@@ -1,3 +1,9 @@
+# --help and --version print on stdout and exit 0, with nothing on stderr
+# (a pipe into grep would hide a failing exit code).
 set -e
-"$BIN/mlod-motion" --help | grep -q "^usage: mlod-motion"
-"$BIN/mlod-motion" --version | grep -q "^mlod-motion (mlod) "
+"$BIN/mlod-motion" --help > help.txt 2> help.err
+grep -q '^usage: mlod-motion' help.txt
+test ! -s help.err
+"$BIN/mlod-motion" --version > version.txt 2> version.err
+grep -qx 'mlod-motion (mlod) [0-9][0-9.]*' version.txt
+test ! -s version.err

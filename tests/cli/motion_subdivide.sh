@@ -6,7 +6,8 @@ set -e
 cd "$ROOT"
 "$BIN/mlod-motion" --report=json samples/cmu_12_01_walk.bvh > "$OLDPWD/def.json"
 "$BIN/mlod-motion" --report=json --subdivide 1 samples/cmu_12_01_walk.bvh > "$OLDPWD/one.json"
-"$BIN/mlod-motion" --report samples/cmu_12_01_walk.bvh | grep -q '1 time between each two (--subdivide 2)'
+"$BIN/mlod-motion" --report samples/cmu_12_01_walk.bvh > "$OLDPWD/def.txt"
+grep -q '1 time between each two (--subdivide 2)' "$OLDPWD/def.txt"
 "$BIN/mlod-motion" -e 1% -o "$OLDPWD/out.glb" samples/RobotExpressive.glb
 cd "$OLDPWD"
 node -e '

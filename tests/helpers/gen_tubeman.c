@@ -57,7 +57,7 @@ typedef struct bone {
 typedef struct part_rule {
 	const char *const *keys; /* name substrings, lower case; NULL: the default */
 	double k;                /* radius = k * bone length ... */
-	double lo, hi;           /* ... clamped to [lo, hi] * skeleton size */
+	double lo, hi;           /* ... clamped to [lo, hi] * skeleton extent */
 } part_rule;
 
 static const char *const extremity_keys[] = { "finger", "thumb", "index", "middle", "ring",
@@ -385,7 +385,9 @@ static mlod_result build_tubeman(mlod_character *c, const tube_shape *sh, int *o
 	mlod_pose_rest(s, local);
 	mlod_pose_world(s, local, world);
 
-	double size = mlod_skeleton_size(s);
+	/* Proportions against the largest extent (the arm span of the T-pose),
+	 * which the committed sample was generated with. */
+	double size = mlod_skeleton_extent(s);
 	int nbones = collect_bones(s, world, size, bones);
 	if (nbones == 0) {
 		rc = mlod_fail(err, MLOD_ERR_UNSUPPORTED, "the skeleton has no bone of non-zero length");

@@ -100,7 +100,7 @@ static void clip_span(const mlod_clip *clip, float *first, float *last)
 static int check_levels(const mlod_character *c, int k, mlod_motion_method method, mlod_motion_precision precision,
                         char *why, size_t size)
 {
-	double h = mlod_skeleton_size(&c->skeleton), pct[3] = {0.2, 1.0, 3.0};
+	double h = mlod_skeleton_height(&c->skeleton), pct[3] = {0.2, 1.0, 3.0};
 	/* Exact, but for rotations on the lattice of normalised shorts (auto
 	 * precision), within 1/65534 per component: a few 1e-5 of the height. */
 	double end_tol = precision == MLOD_MOTION_PRECISION_AUTO ? 2e-4 : 1e-6;
@@ -185,7 +185,7 @@ TEST(keys_method_beats_frames_on_cmu)
 	/* The measurement behind the default: at 1% of the height. */
 	mlod_character c;
 	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
-	double bound = 0.01 * mlod_skeleton_size(&c.skeleton);
+	double bound = 0.01 * mlod_skeleton_height(&c.skeleton);
 	long bytes[2];
 	for (int method = 0; method < 2; method++) {
 		mlod_motion *m;
@@ -780,7 +780,7 @@ static long robot_levels(const mlod_character *c, mlod_motion_precision precisio
 {
 	mlod_motion_options opt = {0};
 	opt.precision = precision;
-	double bound = 0.01 * mlod_skeleton_size(&c->skeleton);
+	double bound = 0.01 * mlod_skeleton_height(&c->skeleton);
 	long zeros = 0;
 	for (int k = 0; k < c->clip_count; k++) {
 		mlod_motion *m;
@@ -826,7 +826,7 @@ TEST(precision_float_and_full)
 	mlod_character c;
 	CHECK(load_sample("samples/RobotExpressive.glb", &c) == 0);
 	int n = c.clip_count;
-	double bound = 0.01 * mlod_skeleton_size(&c.skeleton);
+	double bound = 0.01 * mlod_skeleton_height(&c.skeleton);
 	mlod_motion_level *full = calloc((size_t)n, sizeof *full), *a = calloc((size_t)n, sizeof *a),
 	                  *b = calloc((size_t)n, sizeof *b);
 	long zeros_full = robot_levels(&c, MLOD_MOTION_PRECISION_FULL, full);
@@ -891,7 +891,7 @@ TEST(precision_auto_shorts)
 	mlod_character c;
 	CHECK(load_sample("samples/RobotExpressive.glb", &c) == 0);
 	int n = c.clip_count;
-	double bound = 0.01 * mlod_skeleton_size(&c.skeleton);
+	double bound = 0.01 * mlod_skeleton_height(&c.skeleton);
 	mlod_motion_level *a = calloc((size_t)n, sizeof *a), *b = calloc((size_t)n, sizeof *b);
 	CHECK(robot_levels(&c, MLOD_MOTION_PRECISION_AUTO, a) >= 0);
 	CHECK(robot_levels(&c, MLOD_MOTION_PRECISION_AUTO, b) >= 0);

@@ -184,15 +184,38 @@ TEST(validate_names_first_problem)
 	mlod_character_free(&c);
 }
 
-TEST(skeleton_size)
+TEST(skeleton_height)
 {
 	mlod_character c;
 	build_chain(&c);
-	CHECK_NEAR(mlod_skeleton_size(&c.skeleton), 2.0, 1e-6);
-	c.skeleton.joints[2].rest.t = v3(0, 0, 5); /* B is now 5 out along z */
-	CHECK_NEAR(mlod_skeleton_size(&c.skeleton), 5.0, 1e-6);
+	/* Root (10, 0, 0), A (10, 1, 0), B (10, 2, 0): 2 tall. */
+	CHECK_NEAR(mlod_skeleton_height(&c.skeleton), 2.0, 1e-6);
+	CHECK_NEAR(mlod_skeleton_extent(&c.skeleton), 2.0, 1e-6);
+	/* An arm: B 3 out along x from A. The height is along +Y (1), not the
+	 * span (3), while Y is at least a quarter of the largest extent. */
+	c.skeleton.joints[2].rest.t = v3(3, 0, 0);
+	CHECK_NEAR(mlod_skeleton_height(&c.skeleton), 1.0, 1e-6);
+	CHECK_NEAR(mlod_skeleton_extent(&c.skeleton), 3.0, 1e-6);
+	/* Lying down: B 5 out along z, Y (1) under a quarter of 5: the
+	 * largest extent. */
+	c.skeleton.joints[2].rest.t = v3(0, 0, 5);
+	CHECK_NEAR(mlod_skeleton_height(&c.skeleton), 5.0, 1e-6);
+	/* Modelled Z-up under a node turning it Y-up (-90 degrees about x):
+	 * the root's base counts. A 1 up z, B 1.5 out along x. */
+	c.skeleton.joints[1].rest.t = v3(0, 0, 1);
+	c.skeleton.joints[2].rest.t = v3(1.5f, 0, 0);
+	CHECK_NEAR(mlod_skeleton_height(&c.skeleton), 1.5, 1e-6); /* flat without the base */
+	mlod_trs up = mlod_trs_identity();
+	up.r = mlod_quat_axis_angle(v3(1, 0, 0), -1.5707963f);
+	up.t = v3(10, 0, 0);
+	c.skeleton.joints[0].base = mlod_mat4_from_trs(&up);
+	CHECK_NEAR(mlod_skeleton_height(&c.skeleton), 1.0, 1e-5);
+	CHECK_NEAR(mlod_skeleton_extent(&c.skeleton), 1.5, 1e-5);
 	c.skeleton.joint_count = 1; /* one point: still a usable scale */
-	CHECK(mlod_skeleton_size(&c.skeleton) > 0.0f);
+	CHECK(mlod_skeleton_height(&c.skeleton) > 0.0f);
+	CHECK(mlod_skeleton_extent(&c.skeleton) > 0.0f);
+	c.skeleton.joint_count = 0; /* nothing to measure */
+	CHECK(mlod_skeleton_height(&c.skeleton) == 0.0f);
 	c.skeleton.joint_count = 3;
 	mlod_character_free(&c);
 }
@@ -479,7 +502,7 @@ int main(void)
 {
 	RUN(validate_accepts_and_free_zeroes);
 	RUN(validate_names_first_problem);
-	RUN(skeleton_size);
+	RUN(skeleton_height);
 	RUN(linear_and_step);
 	RUN(rotation_interpolation);
 	RUN(single_key_is_constant);

@@ -171,7 +171,7 @@ TEST(mst_equals_nearest_kept_ancestor)
 }
 
 /* The world transform of every kept joint at every key time or frame
- * matches the full skeleton within 1e-5 of the skeleton size. */
+ * matches the full skeleton within 1e-5 of the skeleton height. */
 static void check_folding(const mlod_character *c, double fraction)
 {
 	const mlod_skeleton *s = &c->skeleton;
@@ -192,7 +192,7 @@ static void check_folding(const mlod_character *c, double fraction)
 	CHECK_OK(mlod_character_validate(&r, &terr));
 	CHECK(r.skeleton.joint_count == l.kept_count);
 	CHECK(st.shear_samples == 0);
-	double size = mlod_skeleton_size(s);
+	double size = mlod_skeleton_height(s);
 	mlod_trs *pa = malloc(sizeof *pa * (size_t)n), *pb = malloc(sizeof *pb * (size_t)n);
 	mlod_mat4 *wa = malloc(sizeof *wa * (size_t)n), *wb = malloc(sizeof *wb * (size_t)n);
 	for (int k = 0; k < c->clip_count; k++) {

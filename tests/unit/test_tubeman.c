@@ -212,7 +212,7 @@ TEST(closed_manifold)
 		rep[order[i]] = i > 0 && cmp_position(&order[i - 1], &order[i]) == 0
 					? rep[order[i - 1]] : order[i];
 
-	double size = mlod_skeleton_size(&bvh.skeleton);
+	double size = mlod_skeleton_height(&bvh.skeleton);
 	double volume = 0.0;
 	int bad_triangle = -1, ne = 0;
 	for (int t = 0; t < nt && bad_triangle < 0; t++) {
@@ -332,7 +332,7 @@ static void check_skinned_at(float t, const char *when)
 
 	double jlo[3], jhi[3];
 	bvh_joint_box(t, jlo, jhi);
-	double size = mlod_skeleton_size(&bvh.skeleton);
+	double size = mlod_skeleton_height(&bvh.skeleton);
 	double mesh_extent = 0.0, joint_extent = 0.0;
 	for (int c = 0; c < 3; c++) {
 		/* Tubes surround the bones: the mesh box holds the joints, and

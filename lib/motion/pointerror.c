@@ -1,0 +1,74 @@
+/*
+ * pointerror.c: the point error, the bound both motion methods answer to
+ * (the frames method of motion.c and the key reduction of keyreduce.c):
+ *
+ *     |o' - o| + r * sigma_max(A' - A)
+ *
+ * where o, A are the origin and the 3x3 linear part of a joint's world
+ * matrix as read, o', A' those of a level, and r the joint's point
+ * distance. It bounds how far any point within r of the joint moves (for
+ * a pure rotation error of angle t it is 2 r sin(t/2), the exact
+ * displacement of the farthest point).
+ */
+#include <math.h>
+
+#include "motion/mlod_motion.h"
+
+/* Largest singular value of a 3x3 matrix given by columns (a[c * 3 + r]). */
+static double sigma_max(const double a[9])
+{
+	/* B = A^T A, symmetric positive semi-definite. */
+	double b[3][3];
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++)
+			b[i][j] = a[0 * 3 + i] * a[0 * 3 + j] + a[1 * 3 + i] * a[1 * 3 + j] + a[2 * 3 + i] * a[2 * 3 + j];
+	double p1 = b[0][1] * b[0][1] + b[0][2] * b[0][2] + b[1][2] * b[1][2];
+	double q = (b[0][0] + b[1][1] + b[2][2]) / 3.0, lambda;
+	if (p1 <= 1e-30 * (q * q + 1e-300)) {
+		lambda = fmax(b[0][0], fmax(b[1][1], b[2][2]));
+	} else {
+		double p2 = (b[0][0] - q) * (b[0][0] - q) + (b[1][1] - q) * (b[1][1] - q) + (b[2][2] - q) * (b[2][2] - q) +
+		            2.0 * p1;
+		double p = sqrt(p2 / 6.0), c[3][3];
+		for (int i = 0; i < 3; i++)
+			for (int j = 0; j < 3; j++)
+				c[i][j] = (b[i][j] - (i == j ? q : 0.0)) / p;
+		double det = c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0]) +
+		             c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]);
+		double r = det / 2.0;
+		r = r < -1.0 ? -1.0 : r > 1.0 ? 1.0 : r;
+		lambda = q + 2.0 * p * cos(acos(r) / 3.0);
+		/* Rounding: never below the largest diagonal entry. */
+		lambda = fmax(lambda, fmax(b[0][0], fmax(b[1][1], b[2][2])));
+	}
+	return lambda > 0.0 ? sqrt(lambda) * (1.0 + 1e-9) : 0.0;
+}
+
+double mlod_motion_point_error(const mlod_mat4 *a, const mlod_mat4 *b, double radius)
+{
+	double d[3], m[9];
+	for (int r = 0; r < 3; r++)
+		d[r] = (double)a->m[12 + r] - b->m[12 + r];
+	for (int c = 0; c < 3; c++)
+		for (int r = 0; r < 3; r++)
+			m[c * 3 + r] = (double)a->m[c * 4 + r] - b->m[c * 4 + r];
+	return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + radius * sigma_max(m);
+}
+
+int mlod_motion_point_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double budget)
+{
+	double dx = (double)w->m[12] - w0->m[12], dy = (double)w->m[13] - w0->m[13], dz = (double)w->m[14] - w0->m[14];
+	double dp = sqrt(dx * dx + dy * dy + dz * dz);
+	if (!(dp <= budget))
+		return 0;
+	double a[9], frob = 0.0;
+	for (int c = 0; c < 3; c++)
+		for (int r = 0; r < 3; r++) {
+			a[c * 3 + r] = (double)w->m[c * 4 + r] - w0->m[c * 4 + r];
+			frob += a[c * 3 + r] * a[c * 3 + r];
+		}
+	double room = budget - dp, rad = radius;
+	if (rad * rad * frob <= room * room)
+		return 1; /* sigma_max <= Frobenius norm */
+	return rad * sigma_max(a) <= room;
+}
