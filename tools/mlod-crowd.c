@@ -3,7 +3,7 @@
  * and 16) on any .mlod pack.
  *
  * For each N (1, 10, 50, 250, 1000, 10000 by default) it places N
- * instances at distances spread over [near, far] (2 to 200 m), each with
+ * instances at distances in [near, far] (2 to 200 m), each with
  * its own clip and time offset, walking towards or away from the camera,
  * and runs a few simulated seconds twice in one run: every instance at
  * full detail (level 0 of every layer), then with LoD by distance. It
@@ -13,6 +13,13 @@
  * measured time (its cost is printed apart). It prints per N: ms per frame
  * in each mode, the speed-up, the instances per mesh level (and skeleton
  * and motion level) at the last frame, and the resident bytes.
+ *
+ * Spread: by default the instances stand evenly over the ground around
+ * the camera, the ring between near and far (so the density of distances
+ * grows with the distance, as in a crowd filling a square: instance i of n
+ * at d = sqrt(near^2 + (i + 1/2)/n (far^2 - near^2))); --spread line puts
+ * them evenly along one line instead (d = near + (i + 1/2)/n (far - near)),
+ * which gives the near levels many more instances.
  *
  * It also measures the runtime's skinning kernel against the plain scalar
  * loop, in vertices per second on one core, on the pack's finest mesh.
@@ -46,6 +53,8 @@ static const char usage_text[] =
 	"  -b, --budget BYTES    the runtime's memory budget (K, M suffixes; default\n"
 	"                        none)\n"
 	"      --near D, --far D the distance range in scene units (default 2, 200)\n"
+	"      --spread HOW      ground (default: evenly over the ground between\n"
+	"                        near and far) or line (evenly over the distances)\n"
 	"      --mode MODE       alpha (the paper's, default), pixels or toc\n"
 	"      --interval TS,TE  the alpha interval of every layer (default 0,1)\n"
 	"      --hysteresis H    relative hysteresis (default 0.1)\n"
@@ -348,7 +357,7 @@ int main(int argc, char **argv)
 	double seconds = 2, fps = 30, max_wall = 10, hyst = 0.1;
 	float near = 2, far = 200, ts = 0, te = 1;
 	size_t budget = 0;
-	int bench = 1;
+	int bench = 1, line = 0;
 	mlod_rt_select_mode mode = MLOD_RT_SELECT_ALPHA;
 	static const struct option longopts[] = {
 		{ "counts", required_argument, NULL, 'n' },   { "seconds", required_argument, NULL, 's' },
@@ -356,7 +365,7 @@ int main(int argc, char **argv)
 		{ "budget", required_argument, NULL, 'b' },   { "near", required_argument, NULL, 'N' },
 		{ "far", required_argument, NULL, 'F' },      { "mode", required_argument, NULL, 'm' },
 		{ "hysteresis", required_argument, NULL, 'H' }, { "no-skin-bench", no_argument, NULL, 'k' },
-		{ "interval", required_argument, NULL, 'I' },
+		{ "interval", required_argument, NULL, 'I' }, { "spread", required_argument, NULL, 'S' },
 		{ "help", no_argument, NULL, 'h' },           { NULL, 0, NULL, 0 },
 	};
 	int ch;
@@ -372,6 +381,12 @@ int main(int argc, char **argv)
 		case 'F': far = (float)parse_num(optarg, "--far"); break;
 		case 'H': hyst = parse_num(optarg, "--hysteresis"); break;
 		case 'k': bench = 0; break;
+		case 'S':
+			if (!strcmp(optarg, "ground") || !strcmp(optarg, "line"))
+				line = !strcmp(optarg, "line");
+			else
+				die(1, "unknown spread '%s' (ground or line)", optarg);
+			break;
 		case 'I':
 			if (sscanf(optarg, "%f,%f", &ts, &te) != 2 || !(ts >= 0) || !(te <= 1))
 				die(1, "bad --interval '%s' (TS,TE within 0..1)", optarg);
@@ -435,9 +450,9 @@ int main(int argc, char **argv)
 	mlod_rt_stats_get(c.ctx, &st);
 	printf("%s: %u joints, %u clips; levels: skeleton %u, mesh %u, motion %u; open %.2f ms CPU, %zu bytes resident\n",
 	       path, mlod_rt_joint_count(c.ctx), clips, L[0], L[1], L[2], open_ms, st.resident_bytes);
-	printf("budget %s%zu, distances %g..%g, mode %s (alpha interval %g,%g), hysteresis %g, %g s at %g fps per "
+	printf("budget %s%zu, distances %g..%g spread %s, mode %s (alpha interval %g,%g), hysteresis %g, %g s at %g fps per "
 	       "measurement\n",
-	       budget ? "" : "none ", budget, near, far,
+	       budget ? "" : "none ", budget, near, far, line ? "along a line" : "over the ground",
 	       mode == MLOD_RT_SELECT_ALPHA ? "alpha" : mode == MLOD_RT_SELECT_PIXELS ? "pixels" : "toc", ts, te, hyst,
 	       seconds, fps);
 	/* Open to the first frame (one instance, the coarse levels open gave),
@@ -499,7 +514,8 @@ int main(int argc, char **argv)
 			float t = frand() * 10;
 			if (mlod_rt_instance_create(c.ctx, clips ? i % clips : 0, t, MLOD_RT_LOOP, &c.ids[i], &e) != MLOD_OK)
 				die(2, "%s", e.message);
-			c.dist[i] = near + (far - near) * ((float)i + 0.5f) / (float)n; /* spread over the range */
+			float u = ((float)i + 0.5f) / (float)n;
+			c.dist[i] = line ? near + (far - near) * u : sqrtf(near * near + u * (far * far - near * near));
 			c.speed[i] = (frand() < 0.5f ? -1.0f : 1.0f) * (0.8f + 1.2f * frand()); /* walking, m/s */
 		}
 		c.n = n;

@@ -450,8 +450,6 @@ static void unuse(mlod_rt_ctx *ctx, rt_instance *in)
 /* Opening: the common part                                          */
 /* ---------------------------------------------------------------- */
 
-void rt_mat_trs(const mlod_trs *t, float *out);
-
 mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 {
 	const mlod_pack_skeleton *s = ctx->skel;
