@@ -5,9 +5,11 @@
 //   node motion_bvh_compare.mjs a.bvh b.bvh TOL
 //
 // Joints and End Sites are matched by order; TOL is a fraction of the
-// skeleton size (the largest extent of the rest-pose positions). Prints
-// the largest difference as that fraction; exits 1 when it is over TOL or
-// the files differ in joints or frames.
+// skeleton height as mlod-motion(1) defines it (the extent along +Y of the
+// rest-pose joint origins, End Sites left out; the largest extent when
+// that is under a quarter of it), computed here independently. Prints the
+// largest difference as that fraction; exits 1 when it is over TOL or the
+// files differ in joints or frames.
 import { readFileSync } from 'node:fs';
 
 function parse(path) {
@@ -59,7 +61,7 @@ function rot(axis, deg) {
 	m[p * 4 + p] = c; m[q * 4 + q] = c; m[p * 4 + q] = s; m[q * 4 + p] = -s;
 	return m;
 }
-function points(b, f) {
+function points(b, f, origins = null) {
 	const out = [], world = [];
 	let v = f * b.per;
 	for (const j of b.joints) {
@@ -74,6 +76,7 @@ function points(b, f) {
 		const w = j.parent < 0 ? r : mul(world[j.parent], r);
 		world.push(w);
 		out.push([w[12], w[13], w[14]]);
+		if (origins) origins.push([w[12], w[13], w[14]]);
 		if (j.end) {
 			const e = j.end;
 			out.push([0, 1, 2].map((k) => w[k] * e[0] + w[4 + k] * e[1] + w[8 + k] * e[2] + w[12 + k]));
@@ -88,9 +91,11 @@ if (a.joints.length !== b.joints.length || a.frames !== b.frames) {
 	console.log(`joints ${a.joints.length}/${b.joints.length}, frames ${a.frames}/${b.frames}`);
 	process.exit(1);
 }
-const rest = points(a, -1);
-let size = 0;
-for (let k = 0; k < 3; k++) size = Math.max(size, Math.max(...rest.map((p) => p[k])) - Math.min(...rest.map((p) => p[k])));
+const origins = [];
+points(a, -1, origins);
+const extent = (k) => Math.max(...origins.map((p) => p[k])) - Math.min(...origins.map((p) => p[k]));
+const largest = Math.max(extent(0), extent(1), extent(2));
+const size = extent(1) >= 0.25 * largest ? extent(1) : largest > 0 ? largest : 1;
 let worst = 0;
 for (let f = 0; f < a.frames; f++) {
 	const x = points(a, f), y = points(b, f);

@@ -1,5 +1,5 @@
 # --level 0 writes the clip as read: re-read, its joint positions are the
-# input's within 1e-4 of the skeleton size, at every frame. Level 1 stays
+# input's within 1e-4 of the skeleton height, at every frame. Level 1 stays
 # near the input (its bound is 0.2% of the height), level 3 does not.
 set -e
 "$BIN/mlod-motion" --level 0 -o l0.bvh "$ROOT/samples/cmu_12_01_walk.bvh"

@@ -100,7 +100,7 @@ static double dist(mlod_v3 a, mlod_v3 b)
 /* Writes clip k of a (or its rest pose when it has no clip) as BVH, reads
  * it back into b and checks that every joint (matched by name), and every
  * End Site when end_sites is set, is where it was in every frame, within
- * 1e-4 of the skeleton's size. */
+ * 1e-4 of the skeleton height. */
 static void check_clip_round_trip(const mlod_character *a, int k, float frame_time, int end_sites, const char *what)
 {
 	char *text = NULL;

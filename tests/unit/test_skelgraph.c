@@ -221,7 +221,7 @@ static void check_folding(const mlod_character *c, double fraction)
 					continue;
 				for (int e = 0; e < 16; e++) {
 					/* relative to the column's length (world matrices carry
-					 * the armature's scale) or to the skeleton size */
+					 * the armature's scale) or to the skeleton height */
 					const float *col = &wa[j].m[4 * (e / 4)];
 					double norm = sqrt((double)col[0] * col[0] + (double)col[1] * col[1] + (double)col[2] * col[2]);
 					double tol = 1e-5 * (e >= 12 ? size : norm);
