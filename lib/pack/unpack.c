@@ -617,7 +617,15 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		}
 	}
 
-	/* Motion: level 0 as the clip, coarser levels as <clip>@lod<k>. */
+	/* Motion: level 0 as the clip, coarser levels as <clip>@lod<k>. A
+	 * clip whose animation the DOC kept (for its morph weights channels)
+	 * goes back into it. */
+	int doc_anims = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
+	unsigned char *used = calloc((size_t)doc_anims + 1, 1);
+	if (!used) {
+		r = nomem(err);
+		goto done;
+	}
 	for (uint32_t c = 0; have_skel && c < info.rec.clip_count; c++) {
 		for (uint32_t k = 0; k < info.rec.motion_levels; k++) {
 			int ch = mlod_pack_find(&p, MLOD_CHUNK_MOTION, k, c);
@@ -636,10 +644,27 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 				snprintf(name, sizeof name, "%s@lod%u", info.clip_names[c], k);
 			r = add_clip(doc, &s, &mo, name, err);
 			mlod_pack_motion_free(&mo);
-			if (r != MLOD_OK)
+			int into = -1;
+			for (int a = 0; k == 0 && r == MLOD_OK && a < doc_anims; a++) {
+				a = mlod_gltf_find_animation(doc, name, a);
+				if (a < 0 || a >= doc_anims)
+					break;
+				if (!used[a]) {
+					into = a;
+					used[a] = 1;
+					break;
+				}
+			}
+			if (r == MLOD_OK && into >= 0)
+				r = mlod_gltf_merge_animation(doc, into, err);
+			if (r != MLOD_OK) {
+				free(used);
 				goto done;
+			}
 		}
 	}
+
+	free(used);
 
 	/* The DOC's emptied meshes go. */
 	{
