@@ -15,7 +15,8 @@
 
 static const char usage_text[] =
 	"usage: mlod-pack [options] [input]\n"
-	"       mlod-pack --info FILE | -x FILE -o out.glb   (need the pack reader)\n"
+	"       mlod-pack --info FILE [--json]\n"
+	"       mlod-pack -x FILE [-o out.glb]\n"
 	"\n"
 	"Bakes the skeleton, mesh and motion levels of a character into one .mlod\n"
 	"pack (mlod(5)), coarse levels first. Input is glb, glTF or BVH; levels left\n"
@@ -42,6 +43,12 @@ static const char usage_text[] =
 	"                             of the skeleton height (default 0.2%%,1%%,3%%)\n"
 	"      --no-skeleton-levels, --no-mesh-levels, --no-motion-levels\n"
 	"                             pack that layer at level 0 only\n"
+	"      --info FILE            print the pack's chunks (layer, level, clip,\n"
+	"                             codec, sizes, error, switch distance) and totals;\n"
+	"                             every chunk is decoded and checked\n"
+	"      --json                 with --info: as JSON (= --report=json)\n"
+	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels,\n"
+	"                             skeleton-level skins, <clip>@lod<k> animations\n"
 	"  -h, --help                 show this help\n"
 	"  -V, --version              show the version\n"
 	"\n"
