@@ -503,8 +503,10 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			goto done;
 	}
 	if (mesh_levels > 0) {
-		uint32_t n = meshes[0].part_count;
-		parts = malloc(sizeof(int) * ((size_t)n + 1));
+		uint32_t n = meshes[0].part_count, most = 0;
+		for (uint32_t k = 0; k < mesh_levels; k++) /* node_parts' room at any level */
+			most = meshes[k].part_count > most ? meshes[k].part_count : most;
+		parts = malloc(sizeof(int) * ((size_t)most + 1));
 		nodes = malloc(sizeof(int) * ((size_t)n + 1));
 		mesh_map = malloc(sizeof(int) * ((size_t)mlod_gltf_count(doc, MLOD_GLTF_MESH) + 1));
 		lod_nodes = malloc(sizeof(int) * ((size_t)mesh_levels + 1));
