@@ -435,6 +435,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	int *parts = NULL, *nodes = NULL, *mesh_map = NULL, *lod_nodes = NULL;
 	mlod_mat4 *world = NULL;
 	mlod_trs *local = NULL;
+	unsigned char *used = NULL;
 	uint32_t mesh_levels = 0, skel_levels = 0;
 	int have_skel = 0, node_count = 0;
 	memset(&info, 0, sizeof info);
@@ -623,7 +624,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	 * clip whose animation the DOC kept (for its morph weights channels)
 	 * goes back into it. */
 	int doc_anims = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
-	unsigned char *used = calloc((size_t)doc_anims + 1, 1);
+	used = calloc((size_t)doc_anims + 1, 1);
 	if (!used) {
 		r = nomem(err);
 		goto done;
@@ -659,14 +660,10 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			}
 			if (r == MLOD_OK && into >= 0)
 				r = mlod_gltf_merge_animation(doc, into, err);
-			if (r != MLOD_OK) {
-				free(used);
+			if (r != MLOD_OK)
 				goto done;
-			}
 		}
 	}
-
-	free(used);
 
 	/* The DOC's emptied meshes go. */
 	{
@@ -692,6 +689,7 @@ done:
 	free(lod_nodes);
 	free(world);
 	free(local);
+	free(used);
 	skeleton_free(&s);
 	mlod_gltf_free(doc);
 	mlod_pack_skeleton_free(&skel);
