@@ -1,5 +1,6 @@
 # The pack round trip on ../shared/data/Ely.glb (make test-extended): pack,
-# -x, and the unpacked glb validates with zero errors.
+# -x, and the unpacked glb validates with zero errors and keeps the
+# lossless fields (pack_unpack_lossless.mjs).
 set -e
 if [ -z "${MLOD_SHARED_DATA:-}" ] || [ ! -f "$MLOD_SHARED_DATA/Ely.glb" ]; then
 	echo "needs ../shared/data/Ely.glb (make test-extended)" >&2
@@ -10,3 +11,4 @@ fi
 grep -q '^# total ' info.txt
 "$BIN/mlod-pack" -x ely.mlod -o ely.x.glb
 node "$ROOT/tests/validate.mjs" ely.x.glb >&2
+node "$ROOT/tests/cli/pack_unpack_lossless.mjs" "$MLOD_SHARED_DATA/Ely.glb" ely.x.glb

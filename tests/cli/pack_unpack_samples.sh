@@ -1,7 +1,8 @@
 # mlod-pack -x on every sample: pack, unpack, and the unpacked glb passes
 # the Khronos validator with zero errors; it holds MSFT_lod level nodes
 # (glb samples), "<clip>@lod<k>" animations and, for tubeman, the
-# skeleton-level skins ("<skin>@lod<k>"). tests/unit/test_unpack.c
+# skeleton-level skins ("<skin>@lod<k>"); the glb samples' lossless
+# fields come back exactly (pack_unpack_lossless.mjs). tests/unit/test_unpack.c
 # measures the geometry and the clips against the input.
 set -e
 for s in tubeman.glb RobotExpressive.glb cmu_12_01_walk.bvh; do
@@ -27,4 +28,7 @@ if (sample.endsWith('.glb')) {
 if (sample === 'tubeman.glb' && !json.skins.some(s => /@lod1$/.test(s.name || '')))
 	throw new Error('tubeman: no skeleton-level skin');
 JS
+	case $s in
+	*.glb) node "$ROOT/tests/cli/pack_unpack_lossless.mjs" "$ROOT/samples/$s" "$n.x.glb" ;;
+	esac
 done
