@@ -15,7 +15,8 @@
 
 static const char usage_text[] =
 	"usage: mlod-pack [options] [input]\n"
-	"       mlod-pack --info FILE | -x FILE -o out.glb   (need the pack reader)\n"
+	"       mlod-pack --info FILE [--json]\n"
+	"       mlod-pack -x FILE [-o out.glb]\n"
 	"\n"
 	"Bakes the skeleton, mesh and motion levels of a character into one .mlod\n"
 	"pack (mlod(5)), coarse levels first. Input is glb, glTF or BVH; levels left\n"
@@ -42,6 +43,12 @@ static const char usage_text[] =
 	"                             of the skeleton height (default 0.2%%,1%%,3%%)\n"
 	"      --no-skeleton-levels, --no-mesh-levels, --no-motion-levels\n"
 	"                             pack that layer at level 0 only\n"
+	"      --info FILE            print the pack's chunks (layer, level, clip,\n"
+	"                             codec, sizes, error, switch distance) and totals;\n"
+	"                             every chunk is decoded and checked\n"
+	"      --json                 with --info: as JSON (= --report=json)\n"
+	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels,\n"
+	"                             skeleton-level skins, <clip>@lod<k> animations\n"
 	"  -h, --help                 show this help\n"
 	"  -V, --version              show the version\n"
 	"\n"
@@ -135,9 +142,176 @@ static void report_json(FILE *rf, const char *input, const mlod_pack_stats *st, 
 	fprintf(rf, "\n}\n");
 }
 
+/* --info: every chunk decoded through the reader (lib/rt), so that a CRC
+ * or a bound that does not hold exits 2 with the reader's message. */
+typedef struct pack_totals {
+	uint64_t stored[4], raw[4];
+	uint32_t chunks[4];
+} pack_totals;
+
+static void check_chunks(const mlod_pack *p, const void *data, size_t size, const char *label)
+{
+	mlod_error err = {0};
+	mlod_pack_skeleton skel;
+	memset(&skel, 0, sizeof skel);
+	int have_skel = 0;
+	mlod_result r = MLOD_OK;
+	for (uint32_t i = 0; r == MLOD_OK && i < p->chunk_count; i++) {
+		const mlod_pack_chunk *c = &p->chunks[i];
+		if (c->type == MLOD_CHUNK_INFO) {
+			mlod_pack_info x;
+			memset(&x, 0, sizeof x);
+			r = mlod_pack_decode_info(p, data, size, &x, &err);
+			mlod_pack_info_free(&x);
+		} else if (c->type == MLOD_CHUNK_SKELETON && c->level == 0) {
+			r = mlod_pack_decode_skeleton(p, data, size, &skel, &err);
+			have_skel = r == MLOD_OK;
+		} else if (c->type == MLOD_CHUNK_SKELETON) {
+			mlod_pack_skel_level x;
+			memset(&x, 0, sizeof x);
+			r = mlod_pack_decode_skel_level(p, i, data, size, have_skel ? &skel : NULL, &x, &err);
+			mlod_pack_skel_level_free(&x);
+		} else if (c->type == MLOD_CHUNK_MESH) {
+			mlod_pack_mesh x;
+			memset(&x, 0, sizeof x);
+			r = mlod_pack_decode_mesh(p, i, data, size, have_skel ? &skel : NULL, &x, &err);
+			mlod_pack_mesh_free(&x);
+		} else if (c->type == MLOD_CHUNK_MOTION) {
+			mlod_pack_motion x;
+			memset(&x, 0, sizeof x);
+			r = mlod_pack_decode_motion(p, i, data, size, have_skel ? &skel : NULL, &x, &err);
+			mlod_pack_motion_free(&x);
+		} else if (c->type == MLOD_CHUNK_DOC) {
+			const void *glb;
+			size_t n;
+			r = mlod_pack_doc(p, data, size, &glb, &n, &err);
+		}
+	}
+	mlod_pack_skeleton_free(&skel);
+	if (r != MLOD_OK)
+		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
+}
+
+static int pack_info(const char *path, enum tool_report report)
+{
+	const char *label = tool_input_label(path);
+	size_t size = 0;
+	void *data = tool_read_input(path, &size);
+	mlod_pack p;
+	mlod_pack_info info;
+	mlod_error err = {0};
+	memset(&info, 0, sizeof info);
+	mlod_result r = mlod_pack_open(data, size, &p, &err);
+	if (r != MLOD_OK)
+		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
+	check_chunks(&p, data, size, label);
+	if (p.file_size != size)
+		tool_die(EXIT_INPUT, label, "the header says %llu bytes, the file has %zu", (unsigned long long)p.file_size,
+		         size);
+	if ((r = mlod_pack_decode_info(&p, data, size, &info, &err)) != MLOD_OK)
+		tool_die(tool_exit_code(r), label, "%s", err.message);
+	const mlod_pack_info_rec *ir = &info.rec;
+	pack_totals t;
+	memset(&t, 0, sizeof t);
+	for (uint32_t i = 0; i < p.chunk_count; i++) {
+		unsigned l = p.chunks[i].layer < 4 ? p.chunks[i].layer : 0;
+		t.stored[l] += p.chunks[i].stored_size;
+		t.raw[l] += p.chunks[i].raw_size;
+		t.chunks[l]++;
+	}
+	uint64_t stored = t.stored[0] + t.stored[1] + t.stored[2] + t.stored[3];
+	uint64_t raw = t.raw[0] + t.raw[1] + t.raw[2] + t.raw[3];
+	uint64_t overhead = p.file_size - stored; /* header, TOC, padding */
+	FILE *f = stdout;
+	if (report == REPORT_JSON) {
+		fprintf(f, "{\n  \"file\": ");
+		tool_json_string(f, label);
+		fprintf(f, ",\n  \"version\": \"%u.%u\",\n  \"size\": %llu,\n  \"flags\": %u,\n  \"name\": ", p.major, p.minor,
+		        (unsigned long long)p.file_size, p.flags);
+		tool_json_string(f, info.name);
+		fprintf(f, ",\n  \"joints\": %u,\n  \"skins\": %u,\n  \"parts\": %u,\n  \"clips\": %u,\n", ir->joint_count,
+		        ir->skin_count, ir->instance_count, ir->clip_count);
+		fprintf(f, "  \"skeleton_levels\": %u,\n  \"mesh_levels\": %u,\n  \"motion_levels\": %u,\n",
+		        ir->skeleton_levels, ir->mesh_levels, ir->motion_levels);
+		fprintf(f, "  \"height\": %.9g,\n  \"diagonal\": %.9g,\n  \"chunks\": [\n", ir->height, ir->diagonal);
+		for (uint32_t i = 0; i < p.chunk_count; i++) {
+			const mlod_pack_chunk *c = &p.chunks[i];
+			double ref = c->layer == MLOD_LAYER_MESH ? ir->diagonal : ir->height;
+			fprintf(f, "    {\"type\": \"%s\", \"layer\": \"%s\", \"level\": %u, \"item\": %u, \"clip\": ",
+			        mlod_pack_type_name(c->type), mlod_pack_layer_name(c->layer), c->level, c->item);
+			if (c->type == MLOD_CHUNK_MOTION && c->item < ir->clip_count)
+				tool_json_string(f, info.clip_names[c->item]);
+			else
+				fputs("null", f);
+			fprintf(f, ", \"codec\": \"%s\", \"offset\": %llu, \"stored\": %u, \"raw\": %u, \"crc\": %u, "
+			        "\"error\": %.9g, \"error_percent\": %.9g, \"distance\": %.9g}%s\n",
+			        mlod_pack_codec_name(c->codec), (unsigned long long)c->offset, c->stored_size, c->raw_size, c->crc,
+			        c->error, ref > 0.0 ? 100.0 * c->error / ref : 0.0, c->distance, i + 1 < p.chunk_count ? "," : "");
+		}
+		fprintf(f, "  ],\n  \"layers\": {\n");
+		for (unsigned l = 0; l < 4; l++)
+			fprintf(f, "    \"%s\": {\"chunks\": %u, \"stored\": %llu, \"raw\": %llu}%s\n", mlod_pack_layer_name(l),
+			        t.chunks[l], (unsigned long long)t.stored[l], (unsigned long long)t.raw[l], l < 3 ? "," : "");
+		fprintf(f, "  },\n  \"stored\": %llu,\n  \"raw\": %llu,\n  \"overhead\": %llu,\n  \"total\": %llu,\n",
+		        (unsigned long long)stored, (unsigned long long)raw, (unsigned long long)overhead,
+		        (unsigned long long)(stored + overhead));
+		fprintf(f, "  \"first_drawable\": %u\n}\n", ir->first_drawable);
+	} else {
+		fprintf(f, "# %s: mlod %u.%u, %llu bytes, %u chunks\n", label, p.major, p.minor,
+		        (unsigned long long)p.file_size, p.chunk_count);
+		fprintf(f, "# character '%s': %u joints, %u skins, %u parts, %u clips; levels: skeleton %u, mesh %u, motion %u; "
+		        "height %.4g, diagonal %.4g\n", info.name, ir->joint_count, ir->skin_count, ir->instance_count,
+		        ir->clip_count, ir->skeleton_levels, ir->mesh_levels, ir->motion_levels, ir->height, ir->diagonal);
+		fprintf(f, "%-5s %-8s %5s  %-20s %-7s %10s %10s %11s %9s %11s\n", "type", "layer", "level", "item", "codec",
+		        "stored", "raw", "error", "error%", "distance");
+		for (uint32_t i = 0; i < p.chunk_count; i++) {
+			const mlod_pack_chunk *c = &p.chunks[i];
+			double ref = c->layer == MLOD_LAYER_MESH ? ir->diagonal : ir->height;
+			char item[64];
+			if (c->type == MLOD_CHUNK_MOTION && c->item < ir->clip_count)
+				snprintf(item, sizeof item, "%s", info.clip_names[c->item]);
+			else
+				snprintf(item, sizeof item, "-");
+			fprintf(f, "%-5s %-8s %5u  %-20s %-7s %10u %10u %11.4g %8.4g%% %11.4g\n", mlod_pack_type_name(c->type),
+			        mlod_pack_layer_name(c->layer), c->level, item, mlod_pack_codec_name(c->codec), c->stored_size,
+			        c->raw_size, c->error, ref > 0.0 ? 100.0 * c->error / ref : 0.0, c->distance);
+		}
+		for (unsigned l = 0; l < 4; l++)
+			fprintf(f, "# total %-8s %4u chunks, stored %10llu, raw %10llu\n", mlod_pack_layer_name(l), t.chunks[l],
+			        (unsigned long long)t.stored[l], (unsigned long long)t.raw[l]);
+		fprintf(f, "# total %llu bytes: %llu stored in chunks (raw %llu), %llu header, TOC and padding\n",
+		        (unsigned long long)(stored + overhead), (unsigned long long)stored, (unsigned long long)raw,
+		        (unsigned long long)overhead);
+		fprintf(f, "# first drawable level: %u bytes\n", ir->first_drawable);
+	}
+	mlod_pack_info_free(&info);
+	mlod_pack_close(&p);
+	free(data);
+	if (fflush(stdout) != 0)
+		tool_die(EXIT_OUTPUT, "<stdout>", "write error");
+	return 0;
+}
+
+/* -x: the pack back to a glb (lib/pack/unpack.c). */
+static int pack_extract(const char *path, const char *output)
+{
+	const char *label = tool_input_label(path);
+	size_t size = 0;
+	void *data = tool_read_input(path, &size);
+	mlod_gltf *doc = NULL;
+	mlod_error err = {0};
+	mlod_result r = mlod_pack_unpack(data, size, &doc, &err);
+	free(data);
+	if (r != MLOD_OK)
+		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
+	tool_write_gltf(output, doc);
+	mlod_gltf_free(doc);
+	return 0;
+}
+
 int main(int argc, char **argv)
 {
-	enum { OPT_CODEC = 256, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH, OPT_NO_MOTION, OPT_INFO };
+	enum { OPT_CODEC = 256, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH, OPT_NO_MOTION, OPT_INFO, OPT_JSON };
 	static const struct option longopts[] = {
 		{"output", required_argument, NULL, 'o'},
 		{"report", optional_argument, NULL, 'r'},
@@ -151,6 +325,7 @@ int main(int argc, char **argv)
 		{"no-mesh-levels", no_argument, NULL, OPT_NO_MESH},
 		{"no-motion-levels", no_argument, NULL, OPT_NO_MOTION},
 		{"info", required_argument, NULL, OPT_INFO},
+		{"json", no_argument, NULL, OPT_JSON},
 		{"extract", required_argument, NULL, 'x'},
 		{"help", no_argument, NULL, 'h'},
 		{"version", no_argument, NULL, 'V'},
@@ -160,7 +335,7 @@ int main(int argc, char **argv)
 	mlod_pack_options_default(&opt);
 	const char *output = NULL, *name = NULL, *info = NULL, *extract = NULL, *codec = "meshopt";
 	enum tool_report report = REPORT_NONE;
-	int ratios_given = 0, ch;
+	int ratios_given = 0, json = 0, ch;
 
 	tool_name = "mlod-pack";
 	opterr = 0;
@@ -192,6 +367,7 @@ int main(int argc, char **argv)
 		case OPT_NO_MOTION: opt.no_motion_levels = 1; break;
 		case OPT_INFO: info = optarg; break;
 		case 'x': extract = optarg; break;
+		case OPT_JSON: json = 1; break;
 		case 'h': {
 			static const double defaults[] = {MLOD_MESH_RATIOS_DEFAULT};
 			char list[64] = "";
@@ -211,12 +387,16 @@ int main(int argc, char **argv)
 		tool_usage_error("--ratios and --max-error do not go together");
 	if (info && extract)
 		tool_usage_error("--info and -x do not go together");
+	if (json && !info)
+		tool_usage_error("--json goes with --info (else use --report=json)");
 	if (info || extract) {
-		/* Hooks for the pack reader (lib/rt/pack.c), which is not merged yet. */
 		if (optind < argc)
 			tool_usage_error("%s takes its pack as the option's value", info ? "--info" : "-x");
-		tool_die(EXIT_UNSUPPORTED, info ? info : extract, "%s needs the pack reader, which is not built yet",
-		         info ? "--info" : "-x");
+		if (info)
+			return pack_info(info, json ? REPORT_JSON : report);
+		if (report != REPORT_NONE)
+			tool_usage_error("-x and --report do not go together");
+		return pack_extract(extract, output);
 	}
 	if (opt.codec == MLOD_CODEC_DRACO)
 		tool_die(EXIT_UNSUPPORTED, NULL, "--codec draco: not built yet (use meshopt or none)");

@@ -2946,3 +2946,34 @@ mlod_result mlod_gltf_clear_lod(mlod_gltf *doc, int node, mlod_error *err)
 		clear_lod(*doc, node);
 	});
 }
+
+int mlod_gltf_find_animation(const mlod_gltf *doc, const char *name, int from)
+{
+	if (!doc || !name)
+		return -1;
+	const Model &m = doc->model;
+	for (size_t i = size_t(from < 0 ? 0 : from); i < m.animations.size(); i++)
+		if (m.animations[i].name == name)
+			return int(i);
+	return -1;
+}
+
+mlod_result mlod_gltf_merge_animation(mlod_gltf *doc, int into, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_merge_animation: doc is NULL");
+		Model &m = doc->model;
+		if (m.animations.empty() || into < 0 || size_t(into) + 1 >= m.animations.size())
+			fail(MLOD_ERR_INVALID_ARG, "animation %d is not before the last one", into);
+		tinygltf::Animation from = m.animations.back();
+		m.animations.pop_back();
+		tinygltf::Animation &a = m.animations[size_t(into)];
+		int base = int(a.samplers.size());
+		for (const tinygltf::AnimationSampler &s : from.samplers)
+			a.samplers.push_back(s);
+		for (tinygltf::AnimationChannel c : from.channels) {
+			c.sampler += base;
+			a.channels.push_back(c);
+		}
+	});
+}

@@ -192,6 +192,15 @@ void mlod_weight_tracks_free(mlod_weight_track *tracks, int count);
 mlod_result mlod_gltf_add_weight_tracks(mlod_gltf *doc, int animation, const mlod_weight_track *tracks, int count,
                                         mlod_error *err);
 
+/* The first animation at index from or later named name, or -1. */
+int mlod_gltf_find_animation(const mlod_gltf *doc, const char *name, int from);
+
+/* Moves the last animation's samplers and channels to the end of
+ * animation `into` (an earlier one, which keeps its name, extras and
+ * extensions) and removes the last animation: mlod-pack -x puts a clip's
+ * joint channels back beside the morph weights channels the DOC kept. */
+mlod_result mlod_gltf_merge_animation(mlod_gltf *doc, int into, mlod_error *err);
+
 /* ------------------------------------------------------------------ */
 /* BVH                                                                 */
 /* ------------------------------------------------------------------ */

@@ -129,6 +129,14 @@ void mlod_pack_weights8(const float w[4], uint8_t out[4]);
  * pixels). */
 float mlod_pack_switch_distance(float error);
 
+/* Unpacks a pack (read through rt/mlod_pack.h) to a glTF document
+ * (lib/pack/unpack.c): the DOC chunk with level 0 back in its nodes'
+ * meshes and clips, MSFT_lod level nodes for the coarser mesh levels,
+ * a skin per skeleton level and skin, "<clip>@lod<k>" animations.
+ * MLOD_ERR_PARSE (the reader's message, naming the chunk) for a corrupt
+ * pack. Release *out with mlod_gltf_free. */
+mlod_result mlod_pack_unpack(const void *pack, size_t size, mlod_gltf **out, mlod_error *err);
+
 #ifdef __cplusplus
 }
 #endif

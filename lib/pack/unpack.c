@@ -1,0 +1,699 @@
+/*
+ * unpack.c: a .mlod pack back to a glTF document (mlod-pack -x), read
+ * through the one reader (rt/mlod_pack.h) and written through the glTF
+ * shim (io/mlod_io.h).
+ *
+ * The document starts from the DOC chunk (the input without the levels'
+ * data). Level 0 goes back where it came from: each instance node gets a
+ * mesh built from its level 0 parts (like the DOC mesh it named: name,
+ * extras, primitives' material and extensions), and each clip's level 0
+ * becomes an animation named after the clip. Coarser levels are added as
+ * mlod-skelgraph, mlod-bgm and mlod-motion write them: a skin per skeleton
+ * level and skin, an MSFT_lod level node per mesh level and instance
+ * (with MSFT_screencoverage; skinned level k follows skeleton level k's
+ * skin, or the coarsest), and "<clip>@lod<k>" animations. The DOC's
+ * emptied meshes go (mlod_gltf_prune).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mlod_pack_write.h"
+#include "measure/mlod_measure.h"
+
+static mlod_result nomem(mlod_error *err)
+{
+	return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory unpacking");
+}
+
+/* The pack's full skeleton as an mlod_skeleton (names and arrays point
+ * into k or into allocations freed by skeleton_free). */
+static mlod_result build_skeleton(const mlod_pack_skeleton *k, mlod_skeleton *s, mlod_error *err)
+{
+	memset(s, 0, sizeof *s);
+	if (!k)
+		return MLOD_OK;
+	s->joints = calloc((size_t)k->joint_count + 1, sizeof *s->joints);
+	s->skins = calloc((size_t)k->skin_count + 1, sizeof *s->skins);
+	if (!s->joints || !s->skins)
+		return nomem(err);
+	s->joint_count = (int)k->joint_count;
+	for (uint32_t j = 0; j < k->joint_count; j++) {
+		const mlod_pack_joint_rec *r = &k->joints[j];
+		mlod_joint *o = &s->joints[j];
+		o->name = (char *)k->joint_names[j];
+		o->parent = r->parent;
+		o->rest.t = (mlod_v3){r->t[0], r->t[1], r->t[2]};
+		o->rest.r = (mlod_quat){r->r[0], r->r[1], r->r[2], r->r[3]};
+		o->rest.s = (mlod_v3){r->s[0], r->s[1], r->s[2]};
+		memcpy(o->base.m, r->base, sizeof o->base.m);
+		o->node = r->node;
+	}
+	s->skin_count = (int)k->skin_count;
+	for (uint32_t i = 0; i < k->skin_count; i++) {
+		mlod_skin *o = &s->skins[i];
+		uint32_t n = k->skins[i].joint_count;
+		o->name = (char *)k->skin_names[i];
+		o->joint_count = (int)n;
+		o->joints = malloc(sizeof(int) * ((size_t)n + 1));
+		o->inverse_bind = malloc(sizeof(mlod_mat4) * ((size_t)n + 1));
+		if (!o->joints || !o->inverse_bind)
+			return nomem(err);
+		for (uint32_t j = 0; j < n; j++) {
+			o->joints[j] = (int)k->skin_joints[i][j];
+			memcpy(o->inverse_bind[j].m, k->inverse_bind[i] + 16 * (size_t)j, sizeof(mlod_mat4));
+		}
+		o->gltf_index = k->skins[i].gltf_index;
+	}
+	return MLOD_OK;
+}
+
+static void skeleton_free(mlod_skeleton *s)
+{
+	for (int i = 0; s->skins && i < s->skin_count; i++) {
+		free(s->skins[i].joints);
+		free(s->skins[i].inverse_bind);
+	}
+	free(s->skins);
+	free(s->joints);
+	memset(s, 0, sizeof *s);
+}
+
+/* One skeleton level's skins: per skin, the distinct stand-ins of its
+ * joints in skin order (each with the bind of the first skin joint that
+ * maps to it: the writer gives every skin joint of one stand-in the same
+ * bind) and the map from a skin joint to its position in that list. */
+typedef struct level_skins {
+	int *gltf;      /* per skin: the glTF skin added, or -1 */
+	int **map;      /* per skin: skin joint -> level skin joint */
+	int *stand;     /* per full joint: its stand-in at this level */
+} level_skins;
+
+static void level_skins_free(level_skins *l, int skins)
+{
+	for (int i = 0; l->map && i < skins; i++)
+		free(l->map[i]);
+	free(l->map);
+	free(l->gltf);
+	free(l->stand);
+	memset(l, 0, sizeof *l);
+}
+
+static mlod_result add_level_skins(mlod_gltf *doc, const mlod_skeleton *s, const mlod_pack_skel_level *lv,
+                                   int level, level_skins *out, mlod_error *err)
+{
+	memset(out, 0, sizeof *out);
+	out->gltf = malloc(sizeof(int) * ((size_t)s->skin_count + 1));
+	out->map = calloc((size_t)s->skin_count + 1, sizeof(int *));
+	out->stand = malloc(sizeof(int) * ((size_t)s->joint_count + 1));
+	if (!out->gltf || !out->map || !out->stand)
+		return nomem(err);
+	/* Stand-ins: a joint's nearest kept ancestor (itself when kept). */
+	unsigned char *kept = calloc((size_t)s->joint_count + 1, 1);
+	if (!kept)
+		return nomem(err);
+	for (uint32_t i = 0; i < lv->kept_count; i++)
+		kept[lv->kept[i]] = 1;
+	for (int j = 0; j < s->joint_count; j++) { /* parents come before children */
+		int a = j;
+		while (a >= 0 && !kept[a])
+			a = s->joints[a].parent;
+		out->stand[j] = a >= 0 ? a : j;
+	}
+	free(kept);
+	size_t base = 0;
+	mlod_result r = MLOD_OK;
+	for (int i = 0; r == MLOD_OK && i < s->skin_count; i++) {
+		const mlod_skin *full = &s->skins[i];
+		int n = full->joint_count, m = 0;
+		int *joints = malloc(sizeof(int) * ((size_t)n + 1));
+		mlod_mat4 *bind = malloc(sizeof(mlod_mat4) * ((size_t)n + 1));
+		out->map[i] = malloc(sizeof(int) * ((size_t)n + 1));
+		if (!joints || !bind || !out->map[i]) {
+			free(joints);
+			free(bind);
+			return nomem(err);
+		}
+		for (int j = 0; j < n; j++) {
+			int pj = (int)lv->palette_joint[base + (size_t)j], t = 0;
+			while (t < m && joints[t] != pj)
+				t++;
+			if (t == m) {
+				joints[m] = pj;
+				memcpy(bind[m].m, lv->palette_bind + 16 * (base + (size_t)j), sizeof(mlod_mat4));
+				m++;
+			}
+			out->map[i][j] = t;
+		}
+		base += (size_t)n;
+		char name[160];
+		snprintf(name, sizeof name, "%s@lod%d", full->name ? full->name : "", level);
+		mlod_skin skin = {0};
+		skin.name = name;
+		skin.joint_count = m;
+		skin.joints = joints;
+		skin.inverse_bind = bind;
+		skin.gltf_index = -1;
+		out->gltf[i] = -1;
+		r = mlod_gltf_add_skin(doc, s, &skin, &out->gltf[i], err);
+		free(joints);
+		free(bind);
+	}
+	return r;
+}
+
+/* The primitive of a decoded part (pointing into it). */
+static void part_primitive(const mlod_pack_part *q, mlod_primitive *p, mlod_morph_target *targets)
+{
+	memset(p, 0, sizeof *p);
+	p->vertex_count = (int)q->rec.vertex_count;
+	p->positions = q->positions;
+	p->normals = q->normals;
+	p->tangents = q->tangents;
+	p->uv_set_count = (int)q->rec.uv_sets;
+	for (uint32_t s = 0; s < q->rec.uv_sets; s++)
+		p->uvs[s] = q->uvs[s];
+	if (q->colors) {
+		p->color_set_count = 1;
+		p->colors[0] = q->colors;
+	}
+	if (q->joints && q->weights) {
+		p->weight_set_count = 1;
+		p->joints[0] = q->joints;
+		p->weights[0] = q->weights;
+	}
+	p->index_count = (int)q->rec.index_count;
+	p->indices = q->indices;
+	p->mode = 4;
+	p->material = q->rec.material;
+	p->target_count = (int)q->rec.target_count;
+	p->targets = targets;
+	for (uint32_t t = 0; t < q->rec.target_count; t++) {
+		memset(&targets[t], 0, sizeof targets[t]);
+		targets[t].positions = q->targets[t];
+	}
+}
+
+/* Remaps a skinned primitive's joints through map (skin joint -> level
+ * skin joint), merging the weights of influences that land on one joint
+ * (glTF wants a vertex's joints with weight distinct). Allocates new
+ * joints and weights arrays into *joints and *weights. */
+static mlod_result remap_primitive(mlod_primitive *p, const int *map, int map_count, uint16_t **joints,
+                                   float **weights, mlod_error *err)
+{
+	size_t n = 4 * (size_t)p->vertex_count;
+	*joints = malloc(sizeof(uint16_t) * (n + 1));
+	*weights = malloc(sizeof(float) * (n + 1));
+	if (!*joints || !*weights)
+		return nomem(err);
+	for (int v = 0; v < p->vertex_count; v++) {
+		const uint16_t *js = p->joints[0] + 4 * (size_t)v;
+		const float *ws = p->weights[0] + 4 * (size_t)v;
+		uint16_t *oj = *joints + 4 * (size_t)v;
+		float *ow = *weights + 4 * (size_t)v;
+		int m = 0;
+		for (int i = 0; i < 4; i++) {
+			if (!(ws[i] > 0.0f))
+				continue;
+			int t = js[i] < map_count ? map[js[i]] : 0, k = 0;
+			while (k < m && oj[k] != t)
+				k++;
+			if (k == m) {
+				oj[m] = (uint16_t)t;
+				ow[m++] = 0.0f;
+			}
+			ow[k] += ws[i];
+		}
+		for (; m < 4; m++) {
+			oj[m] = 0;
+			ow[m] = 0.0f;
+		}
+	}
+	p->joints[0] = *joints;
+	p->weights[0] = *weights;
+	return MLOD_OK;
+}
+
+/* The parts of a mesh level that belong to node (in part order). */
+static int node_parts(const mlod_pack_mesh *m, int node, int *out)
+{
+	int n = 0;
+	for (uint32_t i = 0; i < m->part_count; i++)
+		if (m->parts[i].rec.node == node)
+			out[n++] = (int)i;
+	return n;
+}
+
+/* Adds the mesh of node's parts at one level (like glTF mesh `like`).
+ * map (per skin, may be NULL) remaps skinned parts' joints. */
+static mlod_result add_parts_mesh(mlod_gltf *doc, const mlod_pack_mesh *m, const int *parts, int count, int like,
+                                  int **map, int rigid, const mlod_skeleton *s, int *out, mlod_error *err)
+{
+	mlod_primitive *prims = calloc((size_t)count + 1, sizeof *prims);
+	mlod_morph_target **targets = calloc((size_t)count + 1, sizeof *targets);
+	uint16_t **js = calloc((size_t)count + 1, sizeof *js);
+	float **ws = calloc((size_t)count + 1, sizeof *ws);
+	mlod_result r = MLOD_OK;
+	if (!prims || !targets || !js || !ws)
+		r = nomem(err);
+	for (int i = 0; r == MLOD_OK && i < count; i++) {
+		const mlod_pack_part *q = &m->parts[parts[i]];
+		targets[i] = calloc((size_t)q->rec.target_count + 1, sizeof **targets);
+		if (!targets[i]) {
+			r = nomem(err);
+			break;
+		}
+		part_primitive(q, &prims[i], targets[i]);
+		int sk = q->rec.skin;
+		if (map && sk >= 0 && sk < s->skin_count && prims[i].weight_set_count)
+			r = remap_primitive(&prims[i], map[sk], s->skins[sk].joint_count, &js[i], &ws[i], err);
+		if (rigid && !prims[i].weight_set_count) {
+			/* A rigid part's level follows its one-joint skin: joint 0, weight 1. */
+			size_t nv = (size_t)prims[i].vertex_count;
+			js[i] = calloc(4 * nv + 1, sizeof **js);
+			ws[i] = calloc(4 * nv + 1, sizeof **ws);
+			if (!js[i] || !ws[i]) {
+				r = nomem(err);
+				break;
+			}
+			for (size_t v = 0; v < nv; v++)
+				ws[i][4 * v] = 1.0f;
+			prims[i].weight_set_count = 1;
+			prims[i].joints[0] = js[i];
+			prims[i].weights[0] = ws[i];
+		}
+	}
+	if (r == MLOD_OK) {
+		mlod_mesh mesh = {0};
+		mesh.primitive_count = count;
+		mesh.primitives = prims;
+		mesh.gltf_index = like;
+		*out = -1;
+		r = like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) ? mlod_gltf_add_mesh_like(doc, like, &mesh, out, err)
+		                                                               : mlod_gltf_add_mesh(doc, &mesh, out, err);
+	}
+	for (int i = 0; i < count; i++) {
+		if (targets)
+			free(targets[i]);
+		if (js)
+			free(js[i]);
+		if (ws)
+			free(ws[i]);
+	}
+	free(targets);
+	free(js);
+	free(ws);
+	free(prims);
+	return r;
+}
+
+/* A skin of one joint for a rigid part: world = W(stand) * bind * p, bind
+ * = W(stand)^-1 W(joint) offset in the rest pose (offset itself when
+ * stand is the joint). */
+typedef struct world_cache {
+	mlod_mat4 *world;
+} world_cache;
+
+static mlod_result rigid_skin(mlod_gltf *doc, const mlod_skeleton *s, const world_cache *wc, int joint,
+                              int stand, const float *offset, int *index, mlod_error *err)
+{
+	mlod_mat4 ibm, inv;
+	memcpy(ibm.m, offset, sizeof ibm.m);
+	if (stand != joint && wc && wc->world && mlod_mat4_invert(&wc->world[stand], &inv)) {
+		mlod_mat4 rel = mlod_mat4_mul(&inv, &wc->world[joint]);
+		ibm = mlod_mat4_mul(&rel, &ibm);
+	} else {
+		stand = joint;
+	}
+	int joints[1] = {stand};
+	mlod_skin skin = {0};
+	skin.name = "mlod rigid part";
+	skin.joint_count = 1;
+	skin.joints = joints;
+	skin.inverse_bind = &ibm;
+	skin.gltf_index = -1;
+	*index = -1;
+	return mlod_gltf_add_skin(doc, s, &skin, index, err);
+}
+
+/* A decoded motion level as a clip (pointing into it). */
+static mlod_result add_clip(mlod_gltf *doc, const mlod_skeleton *s, const mlod_pack_motion *mo, const char *name,
+                            mlod_error *err)
+{
+	mlod_clip clip = {0};
+	clip.name = (char *)name;
+	clip.duration = mo->duration;
+	clip.channel_count = (int)mo->channel_count;
+	clip.channels = calloc((size_t)mo->channel_count + 1, sizeof *clip.channels);
+	clip.gltf_index = -1;
+	if (!clip.channels)
+		return nomem(err);
+	for (uint32_t i = 0; i < mo->channel_count; i++) {
+		const mlod_pack_channel *c = &mo->channels[i];
+		mlod_channel *o = &clip.channels[i];
+		o->joint = (int)c->rec.joint;
+		o->path = (mlod_path)c->rec.path;
+		o->interp = (mlod_interp)c->rec.interp;
+		o->key_count = (int)c->rec.key_count;
+		o->times = (float *)c->times;
+		o->values = c->values;
+		/* Rotations on the int16 lattice go back as normalised shorts. */
+		if (o->path == MLOD_PATH_ROTATION && o->interp != MLOD_INTERP_CUBICSPLINE) {
+			int lattice = 1;
+			for (size_t v = 0; lattice && v < 4 * (size_t)o->key_count; v++) {
+				float q = o->values[v] * 32767.0f;
+				lattice = q == rintf(q) && fabsf(q) <= 32767.0f;
+			}
+			o->short_values = lattice;
+		}
+	}
+	int index = -1;
+	mlod_result r = mlod_gltf_add_animation(doc, s, &clip, &index, err);
+	free(clip.channels);
+	return r;
+}
+
+static uint32_t le32(const unsigned char *b)
+{
+	return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+}
+
+static void put32(unsigned char *b, uint32_t v)
+{
+	b[0] = (unsigned char)v;
+	b[1] = (unsigned char)(v >> 8);
+	b[2] = (unsigned char)(v >> 16);
+	b[3] = (unsigned char)(v >> 24);
+}
+
+/* Reads the DOC's glb. A stripped document without any geometry left (a
+ * BVH's, say) is a glb with a JSON chunk alone whose buffer 0 has no
+ * bytes, which tinygltf refuses: it gets an empty BIN chunk (4 zero
+ * bytes) first, and its empty buffer those 4 bytes. */
+static mlod_result read_doc(const void *glb, size_t size, mlod_gltf **doc, mlod_error *err)
+{
+	const unsigned char *b = glb;
+	unsigned char *copy = NULL;
+	if (size >= 20 && memcmp(b, "glTF", 4) == 0 && le32(b + 8) == size && (size_t)le32(b + 12) + 20 == size) {
+		copy = malloc(size + 12);
+		if (!copy)
+			return nomem(err);
+		memcpy(copy, b, size);
+		/* The writer's empty buffer gets the chunk's 4 bytes (the same
+		 * JSON length). */
+		char *json = (char *)copy + 20, *end = json + le32(b + 12);
+		for (char *c = json; c + 16 <= end; c++)
+			if (memcmp(c, "{\"byteLength\":0}", 16) == 0) {
+				c[14] = '4';
+				break;
+			}
+		put32(copy + 8, (uint32_t)size + 12);
+		put32(copy + size, 4);
+		memcpy(copy + size + 4, "BIN\0", 4);
+		memset(copy + size + 8, 0, 4);
+		glb = copy;
+		size += 12;
+	}
+	mlod_error derr = {0};
+	mlod_result r = mlod_gltf_read(glb, size, NULL, doc, &derr);
+	free(copy);
+	if (r != MLOD_OK)
+		return mlod_fail(err, r == MLOD_ERR_NOMEM ? r : MLOD_ERR_PARSE, "DOC: %s", derr.message);
+	return MLOD_OK;
+}
+
+mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlod_error *err)
+{
+	mlod_pack p;
+	mlod_pack_info info;
+	mlod_pack_skeleton skel;
+	mlod_pack_mesh *meshes = NULL;
+	mlod_skeleton s;
+	level_skins *ls = NULL;
+	mlod_gltf *doc = NULL;
+	int *parts = NULL, *nodes = NULL, *mesh_map = NULL, *lod_nodes = NULL;
+	mlod_mat4 *world = NULL;
+	mlod_trs *local = NULL;
+	unsigned char *used = NULL;
+	uint32_t mesh_levels = 0, skel_levels = 0;
+	int have_skel = 0, node_count = 0;
+	memset(&info, 0, sizeof info);
+	memset(&skel, 0, sizeof skel);
+	memset(&s, 0, sizeof s);
+	*out = NULL;
+
+	mlod_result r = mlod_pack_open(data, size, &p, err);
+	if (r != MLOD_OK)
+		return r;
+	if ((r = mlod_pack_decode_info(&p, data, size, &info, err)) != MLOD_OK)
+		goto done;
+	if (mlod_pack_find(&p, MLOD_CHUNK_SKELETON, 0, 0) >= 0) {
+		if ((r = mlod_pack_decode_skeleton(&p, data, size, &skel, err)) != MLOD_OK)
+			goto done;
+		have_skel = 1;
+	}
+	const void *glb;
+	size_t glb_size;
+	if ((r = mlod_pack_doc(&p, data, size, &glb, &glb_size, err)) != MLOD_OK)
+		goto done;
+	if ((r = read_doc(glb, glb_size, &doc, err)) != MLOD_OK)
+		goto done;
+	if ((r = build_skeleton(have_skel ? &skel : NULL, &s, err)) != MLOD_OK)
+		goto done;
+	node_count = mlod_gltf_count(doc, MLOD_GLTF_NODE);
+
+	/* Skeleton levels: their skins. */
+	skel_levels = have_skel ? info.rec.skeleton_levels : 0;
+	ls = calloc((size_t)skel_levels + 1, sizeof *ls);
+	if (!ls) {
+		r = nomem(err);
+		goto done;
+	}
+	for (uint32_t k = 1; k < skel_levels; k++) {
+		int c = mlod_pack_find(&p, MLOD_CHUNK_SKELETON, k, 0);
+		mlod_pack_skel_level lv;
+		memset(&lv, 0, sizeof lv);
+		if (c < 0) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "SKEL level %u: missing", k);
+			goto done;
+		}
+		if ((r = mlod_pack_decode_skel_level(&p, (uint32_t)c, data, size, &skel, &lv, err)) != MLOD_OK)
+			goto done;
+		r = add_level_skins(doc, &s, &lv, (int)k, &ls[k], err);
+		mlod_pack_skel_level_free(&lv);
+		if (r != MLOD_OK)
+			goto done;
+	}
+
+	/* Mesh levels. */
+	mesh_levels = info.rec.mesh_levels;
+	meshes = calloc((size_t)mesh_levels + 1, sizeof *meshes);
+	if (!meshes) {
+		r = nomem(err);
+		goto done;
+	}
+	for (uint32_t k = 0; k < mesh_levels; k++) {
+		int c = mlod_pack_find(&p, MLOD_CHUNK_MESH, k, 0);
+		if (c < 0) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "MESH level %u: missing", k);
+			goto done;
+		}
+		if ((r = mlod_pack_decode_mesh(&p, (uint32_t)c, data, size, have_skel ? &skel : NULL, &meshes[k], err)) !=
+		    MLOD_OK)
+			goto done;
+	}
+	if (mesh_levels > 0) {
+		uint32_t n = meshes[0].part_count, most = 0;
+		for (uint32_t k = 0; k < mesh_levels; k++) /* node_parts' room at any level */
+			most = meshes[k].part_count > most ? meshes[k].part_count : most;
+		parts = malloc(sizeof(int) * ((size_t)most + 1));
+		nodes = malloc(sizeof(int) * ((size_t)n + 1));
+		mesh_map = malloc(sizeof(int) * ((size_t)mlod_gltf_count(doc, MLOD_GLTF_MESH) + 1));
+		lod_nodes = malloc(sizeof(int) * ((size_t)mesh_levels + 1));
+		if (!parts || !nodes || !mesh_map || !lod_nodes) {
+			r = nomem(err);
+			goto done;
+		}
+		for (int i = 0; i < mlod_gltf_count(doc, MLOD_GLTF_MESH); i++)
+			mesh_map[i] = -1;
+		/* The rest pose's world matrices (rigid parts under a stand-in). */
+		if (s.joint_count > 0) {
+			local = malloc(sizeof *local * (size_t)s.joint_count);
+			world = malloc(sizeof *world * (size_t)s.joint_count);
+			if (!local || !world) {
+				r = nomem(err);
+				goto done;
+			}
+			mlod_pose_rest(&s, local);
+			mlod_pose_world(&s, local, world);
+		}
+		world_cache wc = {world};
+		/* The instance nodes, in part order. */
+		int nn = 0;
+		for (uint32_t i = 0; i < n; i++) {
+			int node = meshes[0].parts[i].rec.node, seen = 0;
+			for (int j = 0; j < nn; j++)
+				seen |= nodes[j] == node;
+			if (!seen)
+				nodes[nn++] = node;
+		}
+		double errors[MLOD_MESH_MAX_LEVELS + 64];
+		float coverage[MLOD_MESH_MAX_LEVELS + 65];
+		int lods = (int)mesh_levels - 1;
+		if (lods > MLOD_MESH_MAX_LEVELS + 63)
+			lods = MLOD_MESH_MAX_LEVELS + 63;
+		for (int k = 1; k <= lods; k++) {
+			int c = mlod_pack_find(&p, MLOD_CHUNK_MESH, (unsigned)k, 0);
+			float e = p.chunks[c].error;
+			errors[k - 1] = info.rec.diagonal > 0.0f ? 100.0 * e / info.rec.diagonal : 0.0;
+		}
+		if (lods > 0)
+			mlod_lod_coverage(errors, lods, coverage);
+		for (int j = 0; j < nn; j++) {
+			int node = nodes[j];
+			if (node < 0 || node >= node_count)
+				continue; /* an instance the DOC has no node for */
+			int count = node_parts(&meshes[0], node, parts);
+			const mlod_pack_part_rec *q0 = &meshes[0].parts[parts[0]].rec;
+			int like = q0->mesh, old_mesh = -1, old_skin = -1, mesh = -1;
+			if ((r = mlod_gltf_node_refs(doc, node, &old_mesh, &old_skin, err)) != MLOD_OK)
+				goto done;
+			/* Level 0: the node's own mesh again. */
+			if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) && mesh_map[like] >= 0) {
+				mesh = mesh_map[like];
+			} else {
+				if ((r = add_parts_mesh(doc, &meshes[0], parts, count, like, NULL, 0, &s, &mesh, err)) != MLOD_OK)
+					goto done;
+				if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH))
+					mesh_map[like] = mesh;
+			}
+			int skin0 = old_skin;
+			if (q0->skin >= 0 && q0->skin < s.skin_count && s.skins[q0->skin].gltf_index >= 0)
+				skin0 = s.skins[q0->skin].gltf_index;
+			if ((r = mlod_gltf_set_node_mesh(doc, node, mesh, skin0, err)) != MLOD_OK)
+				goto done;
+			/* Coarser levels: detached level nodes. */
+			mlod_trs trs, *tp = NULL;
+			if (q0->skin < 0 && q0->joint < 0) {
+				mlod_error ignored = {0};
+				if (mlod_gltf_get_node_trs(doc, node, &trs, &ignored) != MLOD_OK)
+					continue; /* a sheared matrix: no MSFT_lod (as mlod-bgm) */
+				tp = &trs;
+			}
+			int rigid_stand = -1, rigid_index = -1;
+			for (int k = 1; k <= lods; k++) {
+				int ck = node_parts(&meshes[k], node, parts), sl = k < (int)skel_levels ? k : (int)skel_levels - 1;
+				if (ck != count) {
+					r = mlod_fail(err, MLOD_ERR_PARSE, "MESH level %d: node %d has %d parts, level 0 %d", k, node, ck,
+					              count);
+					goto done;
+				}
+				int skin = skin0, lmesh = -1, lnode = -1;
+				int **map = NULL;
+				if (q0->skin >= 0 && sl >= 1 && ls[sl].gltf && ls[sl].gltf[q0->skin] >= 0) {
+					map = ls[sl].map;
+					skin = ls[sl].gltf[q0->skin];
+				} else if (q0->skin < 0 && q0->joint >= 0 && q0->joint < s.joint_count) {
+					int stand = sl >= 1 && ls[sl].stand ? ls[sl].stand[q0->joint] : q0->joint;
+					if (stand != rigid_stand) {
+						rigid_stand = stand;
+						if ((r = rigid_skin(doc, &s, &wc, q0->joint, stand, q0->offset, &rigid_index, err)) !=
+						    MLOD_OK)
+							goto done;
+					}
+					skin = rigid_index;
+				}
+				if ((r = add_parts_mesh(doc, &meshes[k], parts, count, like, map, q0->skin < 0 && q0->joint >= 0, &s, &lmesh, err)) != MLOD_OK)
+					goto done;
+				char name[96];
+				snprintf(name, sizeof name, "mlod mesh level %d of node %d", k, node);
+				if ((r = mlod_gltf_add_node(doc, name, MLOD_GLTF_DETACHED, lmesh, skin, tp, &lnode, err)) != MLOD_OK)
+					goto done;
+				if (meshes[k].parts[parts[0]].rec.target_count > 0 &&
+				    (r = mlod_gltf_copy_morph_animation(doc, node, lnode, NULL, err)) != MLOD_OK)
+					goto done;
+				lod_nodes[k - 1] = lnode;
+			}
+			if (lods > 0 && (r = mlod_gltf_set_lod(doc, node, lod_nodes, lods, coverage, err)) != MLOD_OK)
+				goto done;
+		}
+	}
+
+	/* Motion: level 0 as the clip, coarser levels as <clip>@lod<k>. A
+	 * clip whose animation the DOC kept (for its morph weights channels)
+	 * goes back into it. */
+	int doc_anims = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
+	used = calloc((size_t)doc_anims + 1, 1);
+	if (!used) {
+		r = nomem(err);
+		goto done;
+	}
+	for (uint32_t c = 0; have_skel && c < info.rec.clip_count; c++) {
+		for (uint32_t k = 0; k < info.rec.motion_levels; k++) {
+			int ch = mlod_pack_find(&p, MLOD_CHUNK_MOTION, k, c);
+			if (ch < 0) {
+				r = mlod_fail(err, MLOD_ERR_PARSE, "ANIM level %u of clip %u: missing", k, c);
+				goto done;
+			}
+			mlod_pack_motion mo;
+			memset(&mo, 0, sizeof mo);
+			if ((r = mlod_pack_decode_motion(&p, (uint32_t)ch, data, size, &skel, &mo, err)) != MLOD_OK)
+				goto done;
+			char name[512];
+			if (k == 0)
+				snprintf(name, sizeof name, "%s", info.clip_names[c]);
+			else
+				snprintf(name, sizeof name, "%s@lod%u", info.clip_names[c], k);
+			r = add_clip(doc, &s, &mo, name, err);
+			mlod_pack_motion_free(&mo);
+			int into = -1;
+			for (int a = 0; k == 0 && r == MLOD_OK && a < doc_anims; a++) {
+				a = mlod_gltf_find_animation(doc, name, a);
+				if (a < 0 || a >= doc_anims)
+					break;
+				if (!used[a]) {
+					into = a;
+					used[a] = 1;
+					break;
+				}
+			}
+			if (r == MLOD_OK && into >= 0)
+				r = mlod_gltf_merge_animation(doc, into, err);
+			if (r != MLOD_OK)
+				goto done;
+		}
+	}
+
+	/* The DOC's emptied meshes go. */
+	{
+		mlod_error perr = {0};
+		mlod_result pr = mlod_gltf_prune(doc, &perr);
+		if (pr != MLOD_OK && pr != MLOD_ERR_UNSUPPORTED) {
+			r = mlod_fail(err, pr, "%s", perr.message);
+			goto done;
+		}
+	}
+	*out = doc;
+	doc = NULL;
+done:
+	for (uint32_t k = 0; meshes && k < mesh_levels; k++)
+		mlod_pack_mesh_free(&meshes[k]);
+	free(meshes);
+	for (uint32_t k = 0; ls && k <= skel_levels; k++)
+		level_skins_free(&ls[k], s.skin_count);
+	free(ls);
+	free(parts);
+	free(nodes);
+	free(mesh_map);
+	free(lod_nodes);
+	free(world);
+	free(local);
+	free(used);
+	skeleton_free(&s);
+	mlod_gltf_free(doc);
+	mlod_pack_skeleton_free(&skel);
+	mlod_pack_info_free(&info);
+	mlod_pack_close(&p);
+	return r;
+}

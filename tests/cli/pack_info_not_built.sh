@@ -1,2 +1,0 @@
-printf MLOD > x.mlod
-"$BIN/mlod-pack" --info x.mlod

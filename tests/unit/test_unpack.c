@@ -1,0 +1,339 @@
+/*
+ * test_unpack.c: pack then unpack (mlod_pack_write, mlod_pack_unpack) on
+ * every sample, measured independently of both: the input and the
+ * unpacked glb are loaded with the bake library (mlod_load) and compared.
+ *
+ *   lossless   joint names, parents and rest TRS, skins' joints and
+ *              inverse binds, materials of the primitives, clip key times
+ *              and values (the reader's ROTQ values are exact: the writer
+ *              uses it only for values on the int16 lattice), index lists
+ *   quantised  (mlod(5)) positions within half a step of 16 bits of the
+ *              part's box per axis, normals within MLOD_PACK_OCT_BOUND
+ *              radians, UVs within half a step of 16 bits of their box,
+ *              weights (the 4 largest influences, renormalised) within
+ *              1/255 each
+ *
+ * The writer keeps the vertex order, so vertices are compared in order.
+ * The largest position error relative to its bound is printed on stderr.
+ */
+#include "test.h"
+
+static double worst_pos_ratio, worst_pos_err, worst_nrm, worst_uv_ratio, worst_w;
+
+static const mlod_instance *instance_of_node(const mlod_character *c, int node)
+{
+	for (int i = 0; i < c->instance_count; i++)
+		if (c->instances[i].node == node)
+			return &c->instances[i];
+	return NULL;
+}
+
+static const mlod_clip *clip_named(const mlod_character *c, const char *name)
+{
+	for (int i = 0; i < c->clip_count; i++)
+		if (strcmp(c->clips[i].name, name) == 0)
+			return &c->clips[i];
+	return NULL;
+}
+
+static const mlod_channel *channel_of(const mlod_clip *k, int joint, mlod_path path)
+{
+	for (int i = 0; i < k->channel_count; i++)
+		if (k->channels[i].joint == joint && k->channels[i].path == path)
+			return &k->channels[i];
+	return NULL;
+}
+
+/* Checks one primitive; returns a message or NULL. */
+static const char *compare_primitive(const mlod_primitive *a, const mlod_primitive *b, char *msg, size_t cap)
+{
+	if (a->vertex_count != b->vertex_count) {
+		snprintf(msg, cap, "vertex count %d, unpacked %d", a->vertex_count, b->vertex_count);
+		return msg;
+	}
+	if (a->material != b->material) {
+		snprintf(msg, cap, "material %d, unpacked %d", a->material, b->material);
+		return msg;
+	}
+	int n = a->vertex_count;
+	/* Indices: the same triangles (an unindexed input gets 0..n-1). */
+	int ia = a->index_count ? a->index_count : n;
+	if (ia != b->index_count) {
+		snprintf(msg, cap, "index count %d, unpacked %d", ia, b->index_count);
+		return msg;
+	}
+	/* The same triangles in the same order; meshopt's index codec may
+	 * rotate a triangle's corners. */
+	for (int t = 0; t + 2 < ia; t += 3) {
+		uint32_t x[3], y[3];
+		for (int k = 0; k < 3; k++) {
+			x[k] = a->index_count ? a->indices[t + k] : (uint32_t)(t + k);
+			y[k] = b->indices[t + k];
+		}
+		int same = 0;
+		for (int r = 0; r < 3; r++)
+			same |= x[0] == y[r] && x[1] == y[(r + 1) % 3] && x[2] == y[(r + 2) % 3];
+		if (!same) {
+			snprintf(msg, cap, "triangle %d differs", t / 3);
+			return msg;
+		}
+	}
+	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+	for (int v = 0; v < n; v++)
+		for (int d = 0; d < 3; d++) {
+			lo[d] = fminf(lo[d], a->positions[3 * v + d]);
+			hi[d] = fmaxf(hi[d], a->positions[3 * v + d]);
+		}
+	for (int d = 0; d < 3; d++) {
+		double bound = (double)mlod_pack_range_scale(lo[d], hi[d]) / 2 * (1 + 1e-4) + 1e-6 * (fabs(lo[d]) + fabs(hi[d]));
+		for (int v = 0; v < n; v++) {
+			double e = fabs((double)a->positions[3 * v + d] - b->positions[3 * v + d]);
+			if (e > worst_pos_err)
+				worst_pos_err = e;
+			if (bound > 0 && e / bound > worst_pos_ratio)
+				worst_pos_ratio = e / bound;
+			if (e > bound) {
+				snprintf(msg, cap, "vertex %d axis %d: position off by %g, bound %g", v, d, e, bound);
+				return msg;
+			}
+		}
+	}
+	if ((a->normals != NULL) != (b->normals != NULL)) {
+		snprintf(msg, cap, "normals present %d, unpacked %d", a->normals != NULL, b->normals != NULL);
+		return msg;
+	}
+	for (int v = 0; a->normals && v < n; v++) {
+		const float *x = a->normals + 3 * v, *y = b->normals + 3 * v;
+		double X[3] = {x[0], x[1], x[2]}, Y[3] = {y[0], y[1], y[2]};
+		double lx = sqrt(X[0] * X[0] + X[1] * X[1] + X[2] * X[2]);
+		if (!(lx > 0.5))
+			continue; /* not a unit normal in the input */
+		double dot = X[0] * Y[0] + X[1] * Y[1] + X[2] * Y[2];
+		double cr[3] = {X[1] * Y[2] - X[2] * Y[1], X[2] * Y[0] - X[0] * Y[2], X[0] * Y[1] - X[1] * Y[0]};
+		double ang = atan2(sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]), dot);
+		if (ang > worst_nrm)
+			worst_nrm = ang;
+		if (ang > MLOD_PACK_OCT_BOUND + 1e-6) {
+			snprintf(msg, cap, "vertex %d: normal off by %g rad (%.9g %.9g %.9g, unpacked %.9g %.9g %.9g)", v, ang, x[0], x[1], x[2], y[0], y[1], y[2]);
+			return msg;
+		}
+	}
+	int sets = a->uv_set_count < MLOD_PACK_MAX_UV ? a->uv_set_count : MLOD_PACK_MAX_UV;
+	if (b->uv_set_count != sets) {
+		snprintf(msg, cap, "uv sets %d, unpacked %d", a->uv_set_count, b->uv_set_count);
+		return msg;
+	}
+	for (int s = 0; s < sets; s++)
+		for (int d = 0; d < 2; d++) {
+			float ul = INFINITY, uh = -INFINITY;
+			for (int v = 0; v < n; v++) {
+				ul = fminf(ul, a->uvs[s][2 * v + d]);
+				uh = fmaxf(uh, a->uvs[s][2 * v + d]);
+			}
+			double bound = (double)mlod_pack_range_scale(ul, uh) / 2 * (1 + 1e-4) + 1e-6 * (fabs(ul) + fabs(uh));
+			for (int v = 0; v < n; v++) {
+				double e = fabs((double)a->uvs[s][2 * v + d] - b->uvs[s][2 * v + d]);
+				if (bound > 0 && e / bound > worst_uv_ratio)
+					worst_uv_ratio = e / bound;
+				if (e > bound) {
+					snprintf(msg, cap, "vertex %d uv %d.%d off by %g, bound %g", v, s, d, e, bound);
+					return msg;
+				}
+			}
+		}
+	if ((a->weight_set_count > 0) != (b->weight_set_count > 0)) {
+		snprintf(msg, cap, "weights present %d, unpacked %d", a->weight_set_count, b->weight_set_count);
+		return msg;
+	}
+	for (int v = 0; a->weight_set_count && v < n; v++) {
+		/* The input's 4 largest influences, renormalised. */
+		int jt[4 * MLOD_MAX_SETS];
+		float wt[4 * MLOD_MAX_SETS];
+		int m = 0;
+		for (int s = 0; s < a->weight_set_count; s++)
+			for (int i = 0; i < 4; i++)
+				if (a->weights[s][4 * v + i] > 0) {
+					jt[m] = a->joints[s][4 * v + i];
+					wt[m++] = a->weights[s][4 * v + i];
+				}
+		for (int i = 0; i < m; i++) /* sort by weight, decreasing */
+			for (int j = i + 1; j < m; j++)
+				if (wt[j] > wt[i]) {
+					float tw = wt[i];
+					int tj = jt[i];
+					wt[i] = wt[j];
+					jt[i] = jt[j];
+					wt[j] = tw;
+					jt[j] = tj;
+				}
+		if (m > 4)
+			m = 4;
+		double sum = 0;
+		for (int i = 0; i < m; i++)
+			sum += wt[i];
+		for (int i = 0; i < m; i++) {
+			double w = 0;
+			for (int s = 0; s < b->weight_set_count; s++)
+				for (int k = 0; k < 4; k++)
+					if (b->joints[s][4 * v + k] == jt[i])
+						w += b->weights[s][4 * v + k];
+			double e = fabs(w - wt[i] / sum);
+			if (e > worst_w)
+				worst_w = e;
+			if (e > 1.0 / 255 + 1e-6) {
+				snprintf(msg, cap, "vertex %d joint %d: weight %g, input %g", v, jt[i], w, wt[i] / sum);
+				return msg;
+			}
+		}
+	}
+	return NULL;
+}
+
+/* Packs path with opt, unpacks, writes and reloads the glb, compares. */
+static const char *round_trip(const char *path, const mlod_pack_options *opt, char *msg, size_t cap)
+{
+	size_t n = 0;
+	void *in = test_read_file(path, &n);
+	if (!in) {
+		snprintf(msg, cap, "cannot read %s", path);
+		return msg;
+	}
+	mlod_gltf *doc = NULL, *un = NULL, *doc2 = NULL;
+	mlod_character c, c2;
+	mlod_format fmt, fmt2;
+	mlod_error err = {0};
+	void *pack = NULL, *glb = NULL;
+	size_t pack_size = 0, glb_size = 0;
+	const char *fail = NULL;
+	memset(&c, 0, sizeof c);
+	memset(&c2, 0, sizeof c2);
+#define STEP(call)                                                                                 \
+	do {                                                                                       \
+		if ((call) != MLOD_OK) {                                                           \
+			snprintf(msg, cap, "%s: %s", #call, err.message);                          \
+			fail = msg;                                                                \
+			goto done;                                                                 \
+		}                                                                                  \
+	} while (0)
+#define FAIL(...)                                                                                  \
+	do {                                                                                       \
+		snprintf(msg, cap, __VA_ARGS__);                                                   \
+		fail = msg;                                                                        \
+		goto done;                                                                         \
+	} while (0)
+	STEP(mlod_load(in, n, NULL, &doc, &c, &fmt, &err));
+	mlod_pack_stats st;
+	STEP(mlod_pack_write(doc, &c, fmt, in, n, opt, &pack, &pack_size, &st, &err));
+	STEP(mlod_pack_unpack(pack, pack_size, &un, &err));
+	STEP(mlod_gltf_write(un, 1, &glb, &glb_size, &err));
+	STEP(mlod_load(glb, glb_size, NULL, &doc2, &c2, &fmt2, &err));
+	fprintf(stderr, "%s: pack %zu bytes, unpacked glb %zu bytes; levels: skeleton %d, mesh %d, motion %d\n", path,
+	        pack_size, glb_size, st.skeleton.levels, st.mesh.levels, st.motion.levels);
+
+	/* Skeleton: names, parents, rest exact. */
+	if (c.skeleton.joint_count != c2.skeleton.joint_count)
+		FAIL("%d joints, unpacked %d", c.skeleton.joint_count, c2.skeleton.joint_count);
+	for (int j = 0; j < c.skeleton.joint_count; j++) {
+		const mlod_joint *a = &c.skeleton.joints[j], *b = &c2.skeleton.joints[j];
+		if (strcmp(a->name, b->name) || a->parent != b->parent || memcmp(&a->rest, &b->rest, sizeof a->rest))
+			FAIL("joint %d (%s): name, parent or rest differs", j, a->name);
+	}
+	/* Skins: the input's skins come back first, exact. */
+	for (int s = 0; s < c.skeleton.skin_count; s++) {
+		const mlod_skin *a = &c.skeleton.skins[s], *b = NULL;
+		for (int t = 0; t < c2.skeleton.skin_count; t++)
+			if (c2.skeleton.skins[t].gltf_index == a->gltf_index)
+				b = &c2.skeleton.skins[t];
+		if (!b || a->joint_count != b->joint_count ||
+		    memcmp(a->joints, b->joints, sizeof(int) * (size_t)a->joint_count) ||
+		    memcmp(a->inverse_bind, b->inverse_bind, sizeof(mlod_mat4) * (size_t)a->joint_count))
+			FAIL("skin %d differs", s);
+	}
+	/* Meshes, per instance node. */
+	if (c.instance_count != c2.instance_count)
+		FAIL("%d instances, unpacked %d", c.instance_count, c2.instance_count);
+	for (int i = 0; i < c.instance_count; i++) {
+		const mlod_instance *a = &c.instances[i], *b = instance_of_node(&c2, a->node);
+		if (!b)
+			FAIL("instance of node %d missing", a->node);
+		const mlod_mesh *ma = &c.meshes[a->mesh], *mb = &c2.meshes[b->mesh];
+		int pb = 0;
+		for (int p = 0; p < ma->primitive_count; p++) {
+			if (ma->primitives[p].mode != 4)
+				continue; /* the pack holds triangle primitives */
+			if (pb >= mb->primitive_count)
+				FAIL("node %d: primitive %d missing", a->node, p);
+			char sub[512];
+			const char *why = compare_primitive(&ma->primitives[p], &mb->primitives[pb++], sub, sizeof sub);
+			if (why)
+				FAIL("node %d primitive %d: %s", a->node, p, why);
+		}
+	}
+	/* Clips: level 0 under the clip's name, exact. */
+	for (int k = 0; k < c.clip_count; k++) {
+		const mlod_clip *a = &c.clips[k], *b = clip_named(&c2, a->name);
+		if (!b)
+			FAIL("clip '%s' missing", a->name);
+		for (int ch = 0; ch < a->channel_count; ch++) {
+			const mlod_channel *x = &a->channels[ch], *y = channel_of(b, x->joint, x->path);
+			if (!y || y->key_count != x->key_count || y->interp != x->interp)
+				FAIL("clip '%s' channel %d: missing or different keys", a->name, ch);
+			int comps = (x->path == MLOD_PATH_ROTATION ? 4 : 3) * (x->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
+			if (memcmp(x->times, y->times, sizeof(float) * (size_t)x->key_count))
+				FAIL("clip '%s' channel %d: key times differ", a->name, ch);
+			for (int v = 0; v < comps * x->key_count; v++)
+				if (fabsf(x->values[v] - y->values[v]) > 0.5f / 32767.0f)
+					FAIL("clip '%s' channel %d value %d: %.9g, unpacked %.9g", a->name, ch, v, x->values[v],
+					     y->values[v]);
+		}
+		/* Coarser levels are there too. */
+		char name[300];
+		snprintf(name, sizeof name, "%s@lod1", a->name);
+		if (st.motion.levels > 1 && !clip_named(&c2, name))
+			FAIL("clip '%s' missing", name);
+	}
+done:
+	mlod_character_free(&c);
+	mlod_character_free(&c2);
+	mlod_gltf_free(doc);
+	mlod_gltf_free(doc2);
+	mlod_gltf_free(un);
+	mlod_free(pack);
+	mlod_free(glb);
+	free(in);
+	return fail;
+}
+
+static void sample(const char *path)
+{
+	char msg[1024];
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	worst_pos_ratio = worst_pos_err = worst_nrm = worst_uv_ratio = worst_w = 0;
+	const char *why = round_trip(path, &opt, msg, sizeof msg - 64);
+	fprintf(stderr, "%s: max position error %.3g (%.3f of the half-step bound), normal %.3g rad, uv %.3f of bound, "
+	        "weight %.4f\n", path, worst_pos_err, worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w);
+	CHECK_MSG(!why, "%s: %s", path, why);
+}
+
+TEST(round_trip_tubeman) { sample("samples/tubeman.glb"); }
+TEST(round_trip_robot) { sample("samples/RobotExpressive.glb"); }
+TEST(round_trip_bvh) { sample("samples/cmu_12_01_walk.bvh"); }
+
+TEST(round_trip_shared_ely)
+{
+	NEED_SHARED();
+	const char *dir = getenv("MLOD_SHARED_DATA");
+	char path[1024];
+	snprintf(path, sizeof path, "%s/Ely.glb", dir);
+	sample(path);
+}
+
+int main(void)
+{
+	RUN(round_trip_tubeman);
+	RUN(round_trip_robot);
+	RUN(round_trip_bvh);
+	RUN(round_trip_shared_ely);
+	TEST_EXIT();
+}
