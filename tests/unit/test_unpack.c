@@ -313,7 +313,7 @@ static void sample(const char *path)
 	const char *why = round_trip(path, &opt, msg, sizeof msg - 64);
 	fprintf(stderr, "%s: max position error %.3g (%.3f of the half-step bound), normal %.3g rad, uv %.3f of bound, "
 	        "weight %.4f\n", path, worst_pos_err, worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w);
-	CHECK_MSG(!why, "%s: %s", path, why);
+	CHECK_MSG(!why, "%.200s: %.700s", path, why);
 }
 
 TEST(round_trip_tubeman) { sample("samples/tubeman.glb"); }
