@@ -69,6 +69,7 @@
 #include <string.h>
 
 #include "motion/mlod_motion.h"
+#include "motion/motion_eval.h"
 
 #define PI 3.14159265358979323846
 #define DEFAULT_CUBIC_RATE 60.0
@@ -494,6 +495,8 @@ struct mlod_motion {
 	mlod_trs *local;
 	mlod_mat4 *world, *world0;
 	mlod_mat4 *cache0;     /* samples * joints world matrices as read, or NULL */
+	eval_seg *walk_segs;   /* per channel: sampling level clips (level_walk) */
+	mlod_trs *walk_local;  /* per joint */
 	/* State of each method: the last line of the tree, the keys kept. */
 	line tree;
 	unsigned char *kept;   /* channel_count * frames */
@@ -524,6 +527,8 @@ void mlod_motion_free(mlod_motion *m)
 	free(m->world);
 	free(m->world0);
 	free(m->cache0);
+	free(m->walk_segs);
+	free(m->walk_local);
 	line_free(&m->tree);
 	free(m->kept);
 	free(m);
@@ -664,8 +669,10 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	m->world = malloc(sizeof *m->world * (size_t)n);
 	m->world0 = malloc(sizeof *m->world0 * (size_t)n);
 	m->radius = malloc(sizeof(double) * (size_t)n);
+	m->walk_segs = malloc(sizeof *m->walk_segs * (size_t)nch);
+	m->walk_local = malloc(sizeof *m->walk_local * (size_t)n);
 	if (!m->st || !m->weight || !m->offset || !m->euler_slot || !m->constant || !m->local || !m->world || !m->world0 ||
-	    !m->radius) {
+	    !m->radius || !m->walk_segs || !m->walk_local) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
@@ -825,38 +832,89 @@ static int clip_from_kept(const mlod_motion *m, const unsigned char *kept, mlod_
 	return keep_duration(m, clip);
 }
 
+/* Walks the samples of a level clip: its pose at each sample into
+ * world, with the fast sampling of motion_eval.h (the clip's channels are
+ * LINEAR or STEP) or mlod_clip_sample. */
+typedef struct level_walk {
+	const mlod_clip *clip;
+	int fast;
+	eval_seg *segs;   /* per channel */
+	mlod_trs *local;  /* per joint: the rest pose with the animated paths set */
+} level_walk;
+
+/* Level clips have the common clip's channels: m's buffers serve. */
+static void walk_begin(mlod_motion *m, const mlod_clip *clip, level_walk *w)
+{
+	w->clip = clip;
+	w->fast = clip->channel_count <= m->common.channel_count && eval_clip_ok(clip);
+	w->segs = m->walk_segs;
+	w->local = m->walk_local;
+	for (int i = 0; w->fast && i < clip->channel_count; i++)
+		w->segs[i].k = -1, w->segs[i].ready = 0;
+	mlod_pose_rest(m->s, w->local);
+}
+
+/* The clip as read at sample f (cached or posed into m->world0). */
+static const mlod_mat4 *orig_world(mlod_motion *m, int f)
+{
+	if (m->cache0)
+		return m->cache0 + (size_t)f * (size_t)m->s->joint_count;
+	pose_at(m, m->orig, m->st[f], m->world0);
+	return m->world0;
+}
+
+/* The level at sample f (samples in increasing order) into m->world. */
+static void walk_pose(mlod_motion *m, level_walk *w, int f)
+{
+	if (w->fast) {
+		/* Every sample sets the same paths: the rest of local stays rest. */
+		eval_sample(w->clip, w->segs, m->st[f], w->local);
+		eval_pose_world(m->s, w->local, m->world);
+	} else {
+		pose_at(m, w->clip, m->st[f], m->world);
+	}
+}
+
 /* Largest point error (mlod_motion_point_error) of a level clip over
  * every joint and every sample of the common timeline (frames and the
  * times between them), in scene units. It bounds the joint and End Site
- * position error. */
-static double level_error_upto(mlod_motion *m, const mlod_clip *clip, double stop);
-
+ * position error. A NaN error counts as the worst and ends the walk.
+ */
 static double level_max_error(mlod_motion *m, const mlod_clip *clip)
 {
-	return level_error_upto(m, clip, HUGE_VAL);
-}
-
-/* level_max_error, but it may stop early with any error above stop. */
-static double level_error_upto(mlod_motion *m, const mlod_clip *clip, double stop)
-{
+	level_walk w;
+	walk_begin(m, clip, &w);
 	double worst = 0.0;
 	for (int f = 0; f < m->samples; f++) {
-		float t = m->st[f];
-		const mlod_mat4 *w0 = m->world0;
-		if (m->cache0)
-			w0 = m->cache0 + (size_t)f * (size_t)m->s->joint_count;
-		else
-			pose_at(m, m->orig, t, m->world0);
-		pose_at(m, clip, t, m->world);
+		const mlod_mat4 *w0 = orig_world(m, f);
+		walk_pose(m, &w, f);
 		for (int j = 0; j < m->s->joint_count; j++) {
-			double e = mlod_motion_point_error(&m->world[j], &w0[j], m->radius[j]);
-			if (!(e <= worst))
+			double e = eval_error_over(&m->world[j], &w0[j], m->radius[j], worst);
+			if (e >= 0.0 && !(e <= worst))
+				worst = e;
+			else if (e != e)
 				worst = e; /* NaN counts as the worst */
 		}
-		if (!(worst <= stop))
+		if (!(worst <= HUGE_VAL))
 			break;
 	}
 	return worst;
+}
+
+/* Is level_max_error(m, clip) <= bound? It stops at the first error
+ * above. */
+static int level_within(mlod_motion *m, const mlod_clip *clip, double bound)
+{
+	level_walk w;
+	walk_begin(m, clip, &w);
+	int ok = 1;
+	for (int f = 0; f < m->samples && ok; f++) {
+		const mlod_mat4 *w0 = orig_world(m, f);
+		walk_pose(m, &w, f);
+		for (int j = 0; j < m->s->joint_count && ok; j++)
+			ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
+	}
+	return ok;
 }
 
 void mlod_motion_level_free(mlod_motion_level *l)
@@ -1028,7 +1086,7 @@ static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int
 {
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
-	return level_error_upto(m, clip, bound) <= bound;
+	return level_within(m, clip, bound);
 }
 
 /* Per-channel refinement: each channel in turn goes to coarser grids
@@ -1113,7 +1171,7 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 {
 	int n = clip->channel_count;
 	*grid = 0.0;
-	if (!(bound > 0.0) || !isfinite(bound) || !(level_max_error(m, clip) <= bound))
+	if (!(bound > 0.0) || !isfinite(bound) || !level_within(m, clip, bound))
 		return 0;
 	mlod_clip src;
 	memset(&src, 0, sizeof src);
@@ -1412,7 +1470,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 					line_free(&best);
 					return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 				}
-				ok = level_max_error(m, &c) <= removal_bound(m, value);
+				ok = level_within(m, &c, removal_bound(m, value));
 				mlod_clip_free(&c);
 			}
 			if (target == MLOD_MOTION_FRACTION) {
