@@ -1101,24 +1101,33 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	const mlod_skeleton *s = m->s;
 	int F = m->samples, J = s->joint_count, n = clip->channel_count;
 	size_t FJ = (size_t)F * (size_t)J;
-	mlod_trs *L = malloc(sizeof *L * FJ);
-	mlod_mat4 *W = malloc(sizeof *W * FJ), *w = malloc(sizeof *w * (size_t)J);
-	int *sub = malloc(sizeof(int) * (size_t)J);
+	mlod_trs *L = malloc(sizeof *L * FJ), *Lj = malloc(sizeof *Lj * (size_t)F);
+	mlod_mat4 *W = malloc(sizeof *W * FJ), *T = malloc(sizeof *T * FJ);
+	int *sub = malloc(sizeof(int) * (size_t)J), *pos = malloc(sizeof(int) * (size_t)J);
 	const float *times = m->st;
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
-	if (!L || !W || !w || !sub) {
-		free(L), free(W), free(w), free(sub);
+	if (!L || !Lj || !W || !T || !sub || !pos) {
+		free(L), free(Lj), free(W), free(T), free(sub), free(pos);
 		return -1;
 	}
+	level_walk walk;
+	walk_begin(m, clip, &walk);
 	for (int f = 0; f < F; f++) {
-		mlod_pose_rest(s, L + (size_t)f * (size_t)J);
-		mlod_clip_sample(clip, times[f], L + (size_t)f * (size_t)J);
-		mlod_pose_world(s, L + (size_t)f * (size_t)J, W + (size_t)f * (size_t)J);
+		mlod_trs *lf = L + (size_t)f * (size_t)J;
+		if (walk.fast) {
+			eval_sample(clip, walk.segs, times[f], walk.local);
+			memcpy(lf, walk.local, sizeof *lf * (size_t)J);
+			eval_pose_world(s, lf, W + (size_t)f * (size_t)J);
+		} else {
+			mlod_pose_rest(s, lf);
+			mlod_clip_sample(clip, times[f], lf);
+			mlod_pose_world(s, lf, W + (size_t)f * (size_t)J);
+		}
 	}
 	for (int i = 0; i < n; i++) {
 		mlod_channel *ch = &clip->channels[i];
-		int j = ch->joint, ns = 0;
+		int j = ch->joint, ns = 0, fast = ch->interp != MLOD_INTERP_CUBICSPLINE;
 		if (ch->key_count < 3)
 			continue; /* its first and last keys stay exact: nothing to round */
 		for (int d = j; d < J; d++) { /* j and its descendants, parents first */
@@ -1126,40 +1135,61 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 			while (a > j)
 				a = s->joints[a].parent;
 			if (a == j)
-				sub[ns++] = d;
+				pos[d] = ns, sub[ns++] = d;
 		}
 		while (adj[i] < CHANNEL_COARSER) {
 			adj[i]++;
 			channel_exps(m, src, g, adj, e);
 			round_channel(&src->channels[i], ch, e[i], SHORTS(m));
+			/* The try's local transform of j and world matrices of its
+			 * subtree go to Lj and T (ns per sample); kept if it fits. */
 			int ok = 1;
-			for (int pass = 0; pass < 2 && ok; pass++) /* check, then commit */
-				for (int f = 0; f < F && ok; f++) {
-					mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
-					mlod_mat4 *wf = W + (size_t)f * (size_t)J;
-					const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J;
+			eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+			for (int f = 0; f < F && ok; f++) {
+				mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
+				const mlod_mat4 *wf = W + (size_t)f * (size_t)J;
+				mlod_mat4 *w = T + (size_t)f * (size_t)ns;
+				const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J;
+				if (fast) {
+					float t = times[f], v[4];
+					if (!(t > 0.0f))
+						t = 0.0f;
+					if (t > clip->duration)
+						t = clip->duration;
+					eval_channel(ch, &seg, t, v);
+					switch (ch->path) {
+					case MLOD_PATH_TRANSLATION: l.t.x = v[0], l.t.y = v[1], l.t.z = v[2]; break;
+					case MLOD_PATH_SCALE: l.s.x = v[0], l.s.y = v[1], l.s.z = v[2]; break;
+					case MLOD_PATH_ROTATION: l.r = mlod_quat_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+					}
+				} else {
 					sample_into(clip, ch, times[f], &l);
-					for (int k = 0; k < ns && ok; k++) {
-						int d = sub[k], p = s->joints[d].parent;
-						mlod_mat4 lm = mlod_mat4_from_trs(d == j ? &l : &lf[d]);
-						w[d] = mlod_mat4_mul(p < 0 ? &s->joints[d].base : d == j ? &wf[p] : &w[p], &lm);
-						ok = mlod_motion_point_error(&w[d], &w0[d], m->radius[d]) <= bound;
-					}
-					if (pass == 1) {
-						lf[j] = l;
-						for (int k = 0; k < ns; k++)
-							wf[sub[k]] = w[sub[k]];
-					}
 				}
+				Lj[f] = l;
+				for (int k = 0; k < ns && ok; k++) {
+					int d = sub[k], p = s->joints[d].parent;
+					mlod_mat4 lm = mlod_mat4_from_trs(d == j ? &l : &lf[d]);
+					/* Below j, the parent is in the subtree, before d. */
+					const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
+					w[k] = p < 0 ? mlod_mat4_mul(&s->joints[d].base, &lm) : eval_mul_affine(pw, &lm);
+					ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
+				}
+			}
 			if (!ok) {
 				adj[i]--;
 				channel_exps(m, src, g, adj, e);
 				round_channel(&src->channels[i], ch, e[i], SHORTS(m));
 				break;
 			}
+			for (int f = 0; f < F; f++) {
+				mlod_mat4 *wf = W + (size_t)f * (size_t)J;
+				L[(size_t)f * (size_t)J + (size_t)j] = Lj[f];
+				for (int k = 0; k < ns; k++)
+					wf[sub[k]] = T[(size_t)f * (size_t)ns + (size_t)k];
+			}
 		}
 	}
-	free(L), free(W), free(w), free(sub);
+	free(L), free(Lj), free(W), free(T), free(sub), free(pos);
 	return 0;
 }
 
