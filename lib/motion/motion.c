@@ -458,6 +458,77 @@ double mlod_motion_frame_distance(const mlod_skeleton *s, const mlod_trs *a, con
 /* The motion context                                                */
 /* ---------------------------------------------------------------- */
 
+/* Memo of the tree's frame distances and residuals between frames of the
+ * common timeline: they depend only on the frames (a node that is frame f
+ * has its values), and the bisection on the threshold rebuilds the tree
+ * from the same line many times. Keys (a, b, -1) for a distance, (p, x, q)
+ * for a residual. */
+typedef struct memo_slot {
+	int a, b, c; /* a = -1: empty */
+	double v;
+} memo_slot;
+
+typedef struct memo {
+	memo_slot *slot;
+	size_t cap, n; /* cap a power of two */
+} memo;
+
+#define MEMO_MAX ((size_t)1 << 21) /* slots at most */
+
+static size_t memo_hash(int a, int b, int c)
+{
+	unsigned long long h = (unsigned)a * 0x9E3779B97F4A7C15ull;
+	h ^= (unsigned)b * 0xC2B2AE3D27D4EB4Full + (h >> 29);
+	h ^= (unsigned)c * 0x165667B19E3779F9ull + (h >> 31);
+	return (size_t)(h ^ (h >> 32));
+}
+
+static int memo_get(const memo *mo, int a, int b, int c, double *v)
+{
+	if (!mo->slot)
+		return 0;
+	for (size_t i = memo_hash(a, b, c) & (mo->cap - 1);; i = (i + 1) & (mo->cap - 1)) {
+		const memo_slot *e = &mo->slot[i];
+		if (e->a < 0)
+			return 0;
+		if (e->a == a && e->b == b && e->c == c) {
+			*v = e->v;
+			return 1;
+		}
+	}
+}
+
+static void memo_put(memo *mo, int a, int b, int c, double v)
+{
+	if (2 * (mo->n + 1) > mo->cap) { /* at most half full */
+		size_t cap = mo->cap ? 2 * mo->cap : 4096;
+		if (cap > MEMO_MAX)
+			return;
+		memo_slot *slot = malloc(sizeof *slot * cap);
+		if (!slot)
+			return;
+		for (size_t i = 0; i < cap; i++)
+			slot[i].a = -1;
+		for (size_t k = 0; k < mo->cap; k++) {
+			const memo_slot *e = &mo->slot[k];
+			if (e->a < 0)
+				continue;
+			size_t i = memo_hash(e->a, e->b, e->c) & (cap - 1);
+			while (slot[i].a >= 0)
+				i = (i + 1) & (cap - 1);
+			slot[i] = *e;
+		}
+		free(mo->slot);
+		mo->slot = slot;
+		mo->cap = cap;
+	}
+	size_t i = memo_hash(a, b, c) & (mo->cap - 1);
+	while (mo->slot[i].a >= 0)
+		i = (i + 1) & (mo->cap - 1);
+	mo->slot[i] = (memo_slot){ a, b, c, v };
+	mo->n++;
+}
+
 /* A frame of a line of the tree: its time, the channel values (V floats,
  * laid out by channel) and the Euler angles of its rotation channels. */
 typedef struct fnode {
@@ -500,6 +571,7 @@ struct mlod_motion {
 	/* State of each method: the last line of the tree, the keys kept. */
 	line tree;
 	unsigned char *kept;   /* channel_count * frames */
+	memo *memo;            /* the tree's distances and residuals */
 };
 
 static void line_free(line *l)
@@ -531,6 +603,9 @@ void mlod_motion_free(mlod_motion *m)
 	free(m->walk_local);
 	line_free(&m->tree);
 	free(m->kept);
+	if (m->memo)
+		free(m->memo->slot);
+	free(m->memo);
 	free(m);
 }
 
@@ -704,7 +779,8 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	/* Level 0 of each method: every frame, every key. */
 	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
 	m->kept = malloc((size_t)nch * (size_t)F);
-	if (!m->tree.v || !m->kept) {
+	m->memo = calloc(1, sizeof *m->memo);
+	if (!m->tree.v || !m->kept || !m->memo) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
@@ -1301,9 +1377,37 @@ static int pinned(const mlod_motion *m, const fnode *nd)
 	return nd->frame == 0 || nd->frame == m->frames - 1;
 }
 
+/* node_distance through the memo when both nodes are frames. */
+static double frame_distance(const mlod_motion *m, const fnode *a, const fnode *b)
+{
+	double d;
+	if (a->frame < 0 || b->frame < 0)
+		return node_distance(m, a, b);
+	if (memo_get(m->memo, a->frame, b->frame, -1, &d))
+		return d;
+	d = node_distance(m, a, b);
+	memo_put(m->memo, a->frame, b->frame, -1, d);
+	return d;
+}
+
+static double residual_of(const mlod_motion *m, const fnode *p, const fnode *x, const fnode *q);
+
 /* How badly interpolating p and q reproduces x: the frame distance from x
  * to the interpolated frame, or -1 when out of memory. */
 static double residual(const mlod_motion *m, const fnode *p, const fnode *x, const fnode *q)
+{
+	double d;
+	if (p->frame < 0 || x->frame < 0 || q->frame < 0)
+		return residual_of(m, p, x, q);
+	if (memo_get(m->memo, p->frame, x->frame, q->frame, &d))
+		return d;
+	d = residual_of(m, p, x, q);
+	if (d >= 0.0)
+		memo_put(m->memo, p->frame, x->frame, q->frame, d);
+	return d;
+}
+
+static double residual_of(const mlod_motion *m, const fnode *p, const fnode *x, const fnode *q)
 {
 	fnode tmp;
 	tmp.values = malloc(sizeof(float) * (size_t)(m->value_count + 3 * m->rot_count + 1));
@@ -1392,15 +1496,22 @@ static int tree_pass(const mlod_motion *m, line *in, double T, line *out, int st
 {
 	out->v = calloc((size_t)(in->n > 0 ? in->n : 1), sizeof *out->v);
 	out->n = 0;
-	if (!out->v)
+	/* in's frames moved to out (steal): they still serve as neighbours
+	 * below, with their frame numbers (the memo's keys). */
+	unsigned char *moved = steal ? calloc((size_t)(in->n > 0 ? in->n : 1), 1) : NULL;
+	if (!out->v || (steal && !moved)) {
+		free(moved);
 		return -1;
+	}
 	int fused = 0;
 	for (int i = 0; i < in->n;) {
 		fnode *o = &out->v[out->n];
 		if (i + 1 < in->n && !(pinned(m, &in->v[i]) && pinned(m, &in->v[i + 1])) &&
-		    node_distance(m, &in->v[i], &in->v[i + 1]) < T) {
-			if (fuse(m, in, i, o) != 0)
+		    frame_distance(m, &in->v[i], &in->v[i + 1]) < T) {
+			if (fuse(m, in, i, o) != 0) {
+				free(moved);
 				return -1;
+			}
 			out->n++;
 			fused++;
 			i += 2;
@@ -1409,7 +1520,7 @@ static int tree_pass(const mlod_motion *m, line *in, double T, line *out, int st
 			*o = in->v[i];
 			if (steal) {
 				/* in->v[i] still serves as a neighbour below: forget it after the pass. */
-				in->v[i].frame = -2;
+				moved[i] = 1;
 			} else {
 				o->values = malloc(size);
 				if (!o->values)
@@ -1421,8 +1532,9 @@ static int tree_pass(const mlod_motion *m, line *in, double T, line *out, int st
 		}
 	}
 	for (int i = 0; steal && i < in->n; i++)
-		if (in->v[i].frame == -2)
+		if (moved[i])
 			in->v[i].values = NULL; /* now owned by out */
+	free(moved);
 	return fused;
 }
 
