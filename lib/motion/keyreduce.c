@@ -36,6 +36,7 @@
 #include <string.h>
 
 #include "motion/mlod_motion.h"
+#include "motion/motion_eval.h"
 
 #define MAX_FRAME_JOINTS 1000000L /* frames * joints the caches may hold */
 #define ROUNDS 4
@@ -191,23 +192,35 @@ static int sweep(reducer *R, const mlod_channel *ch, int a, int b, int lo, int h
 	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch);
 	const int *sub = R->sub + R->sub_start[j];
 	int nsub = R->sub_start[j + 1] - R->sub_start[j];
+	/* segment_value's slerp, with what depends only on the keys computed once. */
+	eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
+	const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
 	for (int f = lo; f <= hi; f++) {
 		float v[4];
-		if (constant)
-			memcpy(v, ch->values + (size_t)a * (size_t)comps, sizeof(float) * (size_t)comps);
-		else
-			segment_value(R, ch, a, b, f, v);
+		if (constant || ch->interp == MLOD_INTERP_STEP) {
+			memcpy(v, va, sizeof(float) * (size_t)comps);
+		} else {
+			const float u = (R->times[f] - t0) / dt;
+			if (comps == 4) {
+				mlod_quat q = eval_slerp(&seg, va, vb, u);
+				v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
+			} else {
+				for (int c = 0; c < 3; c++)
+					v[c] = va[c] + (vb[c] - va[c]) * u;
+			}
+		}
 		size_t base = (size_t)f * (size_t)R->J;
 		mlod_trs l = R->lc[base + (size_t)j];
 		set_path(&l, ch->path, v);
 		mlod_mat4 lm = mlod_mat4_from_trs(&l);
 		mlod_mat4 *w = commit ? R->wc + base : R->tmp;
-		w[j] = mlod_mat4_mul(p < 0 ? &s->joints[j].base : &R->wc[base + (size_t)p], &lm);
+		w[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &lm) : eval_mul_affine(&R->wc[base + (size_t)p], &lm);
 		if (!commit && !within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
 			return 0;
 		for (int k = 1; k < nsub; k++) {
 			int d = sub[k], dp = s->joints[d].parent;
-			w[d] = mlod_mat4_mul(&w[dp], &R->lm[base + (size_t)d]);
+			w[d] = eval_mul_affine(&w[dp], &R->lm[base + (size_t)d]);
 			if (!commit && !within(R, d, &w[d], &R->w0[base + (size_t)d], budget))
 				return 0;
 		}
