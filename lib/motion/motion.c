@@ -1324,8 +1324,26 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
  * it, after rounding its values within bound (< 0: a level chosen by
  * threshold or fraction, whose error e may grow to e / (1 - share), the
  * share a bound leaves to rounding). */
-static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double bound, mlod_error *err)
+static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double bound, long max_bytes,
+                                mlod_error *err)
 {
+	out->keys = mlod_clip_key_count(&out->clip);
+	out->bytes = mlod_clip_key_bytes(&out->clip);
+	if (max_bytes >= 0) {
+		/* Rounding keeps the keys; at most, auto precision stores every
+		 * rotation as shorts (8 bytes a key instead of 16). */
+		long least = out->bytes;
+		for (int i = 0; SHORTS(m) && i < out->clip.channel_count; i++) {
+			const mlod_channel *ch = &out->clip.channels[i];
+			if (ch->path == MLOD_PATH_ROTATION && ch->interp != MLOD_INTERP_CUBICSPLINE && !ch->short_values)
+				least -= 8L * ch->key_count;
+		}
+		if (least > max_bytes) {
+			out->bytes = least;
+			out->unfinished = 1;
+			return MLOD_OK;
+		}
+	}
 	if (m->opt.precision != MLOD_MOTION_PRECISION_FULL) {
 		if (bound < 0.0)
 			bound = level_max_error(m, &out->clip) / removal_bound(m, 1.0);
@@ -1582,8 +1600,8 @@ static long line_keys(const mlod_motion *m, const line *l)
 }
 
 /* The frames method: the next line of the tree. */
-static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
-                                mlod_error *err)
+static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
+                                mlod_motion_level *out, mlod_error *err)
 {
 	line best = { 0, NULL };
 	double T = 0.0;
@@ -1675,7 +1693,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 	}
 	line_free(&m->tree);
 	m->tree = best;
-	mlod_result r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, err);
+	mlod_result r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, err);
 	if (r != MLOD_OK)
 		mlod_motion_level_free(out);
 	return r;
@@ -1707,8 +1725,8 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	return level_max_error(m, clip);
 }
 
-static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
-                              mlod_error *err)
+static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
+                              mlod_motion_level *out, mlod_error *err)
 {
 	const char *name = m->orig->name ? m->orig->name : "";
 	if (target == MLOD_MOTION_THRESHOLD)
@@ -1801,7 +1819,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 	out->clip = best_clip;
 	free(m->kept);
 	m->kept = best;
-	r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, err);
+	r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, err);
 	if (r != MLOD_OK)
 		mlod_motion_level_free(out);
 	return r;
@@ -1809,6 +1827,12 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 
 mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                    double value, mlod_motion_level *out, mlod_error *err)
+{
+	return mlod_motion_next_level_under(m, method, target, value, -1, out, err);
+}
+
+mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
+                                         double value, long max_bytes, mlod_motion_level *out, mlod_error *err)
 {
 	if (!m || !out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_next_level: NULL argument");
@@ -1818,8 +1842,8 @@ mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, ml
 	if ((unsigned)target > MLOD_MOTION_MAX_ERROR)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad level target %d", (int)target);
 	switch (method) {
-	case MLOD_MOTION_FRAMES: return frames_level(m, target, value, out, err);
-	case MLOD_MOTION_KEYS: return keys_level(m, target, value, out, err);
+	case MLOD_MOTION_FRAMES: return frames_level(m, target, value, max_bytes, out, err);
+	case MLOD_MOTION_KEYS: return keys_level(m, target, value, max_bytes, out, err);
 	}
 	return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad method %d", (int)method);
 }
