@@ -54,7 +54,12 @@ typedef struct reducer {
 	mlod_trs *lc;            /* S * J: current local transforms */
 	mlod_mat4 *lm;           /* S * J: their matrices */
 	mlod_mat4 *wc;           /* S * J: current world matrices */
-	mlod_mat4 *tmp;          /* J */
+	mlod_mat4 *wb[2];        /* S * J: world matrices of a check (the subtree's) */
+	mlod_trs *lb[2];         /* S: the channel's joint's local transform in a check */
+	mlod_mat4 *lmb[2];       /* S: its matrix */
+	int good;                /* which buffers hold the last check that fitted */
+	const mlod_channel *good_ch; /* and of what: channel, samples */
+	int good_lo, good_hi;
 	unsigned char *kept;
 } reducer;
 
@@ -182,54 +187,86 @@ static int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *
 	return rad * sigma_max(a) <= room;
 }
 
-/* Checks (commit = 0) or applies (commit = 1) channel ch taking the value
- * val_of(f) at frames lo..hi (inclusive): val_a, val_b are the keys of a
- * segment, or const_value for a constant. */
-static int sweep(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget,
-                 int commit)
+/* The channel's value at sample f and the subtree's world matrices with
+ * it, into the spare buffers; is every joint within budget? */
+static int sample_check(reducer *R, const mlod_channel *ch, const float *va, const float *vb, float t0, float dt,
+                        eval_seg *seg, int constant, int f, double budget)
 {
 	const mlod_skeleton *s = R->s;
-	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch);
+	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch), spare = 1 - R->good;
 	const int *sub = R->sub + R->sub_start[j];
 	int nsub = R->sub_start[j + 1] - R->sub_start[j];
-	/* segment_value's slerp, with what depends only on the keys computed once. */
+	float v[4];
+	if (constant || ch->interp == MLOD_INTERP_STEP) {
+		memcpy(v, va, sizeof(float) * (size_t)comps);
+	} else {
+		/* segment_value, with the slerp's per-segment part done once. */
+		const float u = (R->times[f] - t0) / dt;
+		if (comps == 4) {
+			mlod_quat q = eval_slerp(seg, va, vb, u);
+			v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
+		} else {
+			for (int c = 0; c < 3; c++)
+				v[c] = va[c] + (vb[c] - va[c]) * u;
+		}
+	}
+	size_t base = (size_t)f * (size_t)R->J;
+	mlod_trs *l = &R->lb[spare][f];
+	mlod_mat4 *lm = &R->lmb[spare][f], *w = R->wb[spare] + base;
+	*l = R->lc[base + (size_t)j];
+	set_path(l, ch->path, v);
+	*lm = mlod_mat4_from_trs(l);
+	w[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, lm) : eval_mul_affine(&R->wc[base + (size_t)p], lm);
+	if (!within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
+		return 0;
+	for (int k = 1; k < nsub; k++) {
+		int d = sub[k], dp = s->joints[d].parent;
+		w[d] = eval_mul_affine(&w[dp], &R->lm[base + (size_t)d]);
+		if (!within(R, d, &w[d], &R->w0[base + (size_t)d], budget))
+			return 0;
+	}
+	return 1;
+}
+
+/* Checks channel ch taking, at samples lo..hi (inclusive), the values of
+ * the segment between its keys at frames a and b (or a's value, constant).
+ * The samples are independent (each needs only the current matrices at
+ * that sample), so they are visited every SWEEP_STRIDE-th first: a
+ * failing check usually stops sooner. When every sample fits, the results
+ * become the good buffers, which sweep_commit applies. */
+#define SWEEP_STRIDE 8
+static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget)
+{
+	int comps = comps_of(ch);
 	eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
 	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
 	const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
-	for (int f = lo; f <= hi; f++) {
-		float v[4];
-		if (constant || ch->interp == MLOD_INTERP_STEP) {
-			memcpy(v, va, sizeof(float) * (size_t)comps);
-		} else {
-			const float u = (R->times[f] - t0) / dt;
-			if (comps == 4) {
-				mlod_quat q = eval_slerp(&seg, va, vb, u);
-				v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
-			} else {
-				for (int c = 0; c < 3; c++)
-					v[c] = va[c] + (vb[c] - va[c]) * u;
-			}
-		}
-		size_t base = (size_t)f * (size_t)R->J;
-		mlod_trs l = R->lc[base + (size_t)j];
-		set_path(&l, ch->path, v);
-		mlod_mat4 lm = mlod_mat4_from_trs(&l);
-		mlod_mat4 *w = commit ? R->wc + base : R->tmp;
-		w[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &lm) : eval_mul_affine(&R->wc[base + (size_t)p], &lm);
-		if (!commit && !within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
-			return 0;
-		for (int k = 1; k < nsub; k++) {
-			int d = sub[k], dp = s->joints[d].parent;
-			w[d] = eval_mul_affine(&w[dp], &R->lm[base + (size_t)d]);
-			if (!commit && !within(R, d, &w[d], &R->w0[base + (size_t)d], budget))
+	int stride = hi - lo + 1 >= 4 * SWEEP_STRIDE ? SWEEP_STRIDE : 1;
+	for (int phase = 0; phase < stride; phase++)
+		for (int f = lo + phase; f <= hi; f += stride)
+			if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
 				return 0;
-		}
-		if (commit) {
-			R->lc[base + (size_t)j] = l;
-			R->lm[base + (size_t)j] = lm;
-		}
-	}
+	R->good = 1 - R->good;
+	R->good_ch = ch, R->good_lo = lo, R->good_hi = hi;
 	return 1;
+}
+
+/* Applies the last check that fitted (channel ch at samples lo..hi). */
+static void sweep_commit(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant)
+{
+	if (R->good_ch != ch || R->good_lo != lo || R->good_hi != hi)
+		sweep_check(R, ch, a, b, lo, hi, constant, HUGE_VAL); /* not reached: the last fit is the one applied */
+	int j = ch->joint, g = R->good;
+	const int *sub = R->sub + R->sub_start[j];
+	int nsub = R->sub_start[j + 1] - R->sub_start[j];
+	for (int f = lo; f <= hi; f++) {
+		size_t base = (size_t)f * (size_t)R->J;
+		R->lc[base + (size_t)j] = R->lb[g][f];
+		R->lm[base + (size_t)j] = R->lmb[g][f];
+		for (int k = 0; k < nsub; k++)
+			R->wc[base + (size_t)sub[k]] = R->wb[g][base + (size_t)sub[k]];
+	}
+	R->good_ch = NULL;
 }
 
 /* Removes what keys it can from one channel at one budget. */
@@ -245,7 +282,7 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 	for (int i = 0; i + 2 < nk + 0 && i < nk - 1;) {
 		int ok = i + 1, fail = nk, step = 1, probe = i + 2;
 		while (probe < nk) {
-			if (sweep(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget, 0)) {
+			if (sweep_check(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget)) {
 				ok = probe;
 				step *= 2;
 				probe = i + 1 + step;
@@ -255,20 +292,20 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 			}
 		}
 		if (fail == nk && ok < nk - 1) {
-			if (sweep(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget, 0))
+			if (sweep_check(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget))
 				ok = nk - 1;
 			else
 				fail = nk - 1;
 		}
 		while (fail - ok > 1) {
 			int mid = ok + (fail - ok) / 2;
-			if (sweep(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget, 0))
+			if (sweep_check(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget))
 				ok = mid;
 			else
 				fail = mid;
 		}
 		if (ok > i + 1) {
-			sweep(R, ch, K[i], K[ok], K[i] * q + 1, K[ok] * q - 1, 0, budget, 1);
+			sweep_commit(R, ch, K[i], K[ok], K[i] * q + 1, K[ok] * q - 1, 0);
 			for (int k = i + 1; k < ok; k++)
 				row[K[k]] = 0;
 		}
@@ -295,9 +332,9 @@ static void collapse_channel(reducer *R, int c, double budget)
 	int comps = comps_of(ch);
 	if (memcmp(ch->values, ch->values + (size_t)(R->F - 1) * (size_t)comps, sizeof(float) * (size_t)comps) != 0)
 		return;
-	if (!sweep(R, ch, 0, 0, 1, R->S - 1, 1, budget, 0))
+	if (!sweep_check(R, ch, 0, 0, 1, R->S - 1, 1, budget))
 		return;
-	sweep(R, ch, 0, 0, 1, R->S - 1, 1, budget, 1);
+	sweep_commit(R, ch, 0, 0, 1, R->S - 1, 1);
 	memset(row + 1, 0, (size_t)R->F - 1);
 }
 
@@ -311,7 +348,11 @@ static void reducer_free(reducer *R)
 	free(R->lc);
 	free(R->lm);
 	free(R->wc);
-	free(R->tmp);
+	for (int i = 0; i < 2; i++) {
+		free(R->wb[i]);
+		free(R->lb[i]);
+		free(R->lmb[i]);
+	}
 }
 
 static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
@@ -376,11 +417,16 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 	R.lc = malloc(sizeof(mlod_trs) * FJ);
 	R.lm = malloc(sizeof(mlod_mat4) * FJ);
 	R.wc = malloc(sizeof(mlod_mat4) * FJ);
-	R.tmp = malloc(sizeof(mlod_mat4) * (size_t)R.J);
+	for (int i = 0; i < 2; i++) {
+		R.wb[i] = malloc(sizeof(mlod_mat4) * FJ);
+		R.lb[i] = malloc(sizeof(mlod_trs) * (size_t)R.S);
+		R.lmb[i] = malloc(sizeof(mlod_mat4) * (size_t)R.S);
+	}
 	int *depth = malloc(sizeof(int) * (size_t)R.J);
 	int *K = malloc(sizeof(int) * (size_t)R.F);
 	int *fill = NULL;
-	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.tmp || !depth || !K) {
+	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.wb[0] || !R.wb[1] || !R.lb[0] ||
+	    !R.lb[1] || !R.lmb[0] || !R.lmb[1] || !depth || !K) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
