@@ -572,6 +572,7 @@ struct mlod_motion {
 	line tree;
 	unsigned char *kept;   /* channel_count * frames */
 	memo *memo;            /* the tree's distances and residuals */
+	memo *segmemo;         /* frames level under way: segments of lines within its bound */
 };
 
 static void line_free(line *l)
@@ -606,6 +607,9 @@ void mlod_motion_free(mlod_motion *m)
 	if (m->memo)
 		free(m->memo->slot);
 	free(m->memo);
+	if (m->segmemo)
+		free(m->segmemo->slot);
+	free(m->segmemo);
 	free(m);
 }
 
@@ -780,7 +784,8 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
 	m->kept = malloc((size_t)nch * (size_t)F);
 	m->memo = calloc(1, sizeof *m->memo);
-	if (!m->tree.v || !m->kept || !m->memo) {
+	m->segmemo = calloc(1, sizeof *m->segmemo);
+	if (!m->tree.v || !m->kept || !m->memo || !m->segmemo) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
@@ -991,6 +996,54 @@ static int level_within(mlod_motion *m, const mlod_clip *clip, double bound)
 			ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
 	}
 	return ok;
+}
+
+
+/* level_within over samples lo..hi only. */
+static int level_within_range(mlod_motion *m, const mlod_clip *clip, double bound, int lo, int hi)
+{
+	level_walk w;
+	walk_begin(m, clip, &w);
+	int ok = 1;
+	for (int f = lo; f <= hi && ok; f++) {
+		const mlod_mat4 *w0 = orig_world(m, f);
+		walk_pose(m, &w, f);
+		for (int j = 0; j < m->s->joint_count && ok; j++)
+			ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
+	}
+	return ok;
+}
+
+/* level_within for the clip c of line l (clip_from_line), through the
+ * segment memo: every channel of c is keyed at the line's frames (or
+ * constant), so its pose at the samples from frame p up to the next frame
+ * q of the line (the last sample too when q is the last frame) depends on
+ * p and q alone. The bisection on the threshold tries lines that share
+ * most of their segments. The memo holds one bound: frames_level clears
+ * it. */
+static int line_within(mlod_motion *m, const line *l, const mlod_clip *c, double bound)
+{
+	int usable = m->sub > 0 && c->duration >= m->common.channels[0].times[m->frames - 1] && l->n >= 2 &&
+	             l->v[0].frame == 0 && l->v[l->n - 1].frame == m->frames - 1;
+	for (int k = 0; usable && k < l->n; k++)
+		usable = l->v[k].frame >= 0 && (k == 0 || l->v[k].frame > l->v[k - 1].frame);
+	if (!usable)
+		return level_within(m, c, bound);
+	for (int k = 0; k + 1 < l->n; k++) {
+		int p = l->v[k].frame, q = l->v[k + 1].frame;
+		double v;
+		if (memo_get(m->segmemo, p, q, -3, &v)) {
+			if (v == 0.0)
+				return 0;
+			continue;
+		}
+		int hi = q == m->frames - 1 ? m->samples - 1 : q * m->sub - 1;
+		int ok = level_within_range(m, c, bound, p * m->sub, hi);
+		memo_put(m->segmemo, p, q, -3, ok);
+		if (!ok)
+			return 0;
+	}
+	return 1;
 }
 
 void mlod_motion_level_free(mlod_motion_level *l)
@@ -1606,6 +1659,8 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 	line best = { 0, NULL };
 	double T = 0.0;
 	const char *name = m->orig->name ? m->orig->name : "";
+	free(m->segmemo->slot);
+	memset(m->segmemo, 0, sizeof *m->segmemo);
 	if (target == MLOD_MOTION_THRESHOLD) {
 		T = value;
 		if (tree_level(m, &m->tree, T, &best) != 0)
@@ -1630,7 +1685,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 					line_free(&best);
 					return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 				}
-				ok = level_within(m, &c, removal_bound(m, value));
+				ok = line_within(m, &l, &c, removal_bound(m, value));
 				mlod_clip_free(&c);
 			}
 			if (target == MLOD_MOTION_FRACTION) {
