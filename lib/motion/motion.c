@@ -982,6 +982,50 @@ static double level_max_error(mlod_motion *m, const mlod_clip *clip)
 	return worst;
 }
 
+/* A level's measures in one walk: *point_error gets level_max_error's
+ * value and *dev mlod_joint_deviation_at's at the same samples (the same
+ * sums in the same order, from the same world matrices: the level's from
+ * the same float operations, and the clip as read from its cache).
+ * Returns 0 when it could not (no cache, or a NaN error): the caller then
+ * measures as those functions do. */
+static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_error, mlod_deviation *dev)
+{
+	if (!m->cache0)
+		return 0;
+	const mlod_skeleton *s = m->s;
+	level_walk w;
+	walk_begin(m, clip, &w);
+	double worst = 0.0, sum = 0.0, max = 0.0;
+	long count = 0;
+	for (int f = 0; f < m->samples; f++) {
+		const mlod_mat4 *w0 = orig_world(m, f);
+		walk_pose(m, &w, f);
+		for (int j = 0; j < s->joint_count; j++) {
+			double e = eval_error_over(&m->world[j], &w0[j], m->radius[j], worst);
+			if (e >= 0.0 && !(e <= worst))
+				worst = e;
+			else if (e != e)
+				return 0;
+			for (int k = 0; k < 1 + (s->joints[j].has_end_site != 0); k++) {
+				mlod_v3 o = { 0, 0, 0 };
+				if (k == 1)
+					o = s->joints[j].end_site;
+				mlod_v3 x = mlod_mat4_point(&w0[j], o), y = mlod_mat4_point(&m->world[j], o);
+				double d = mlod_v3_length(mlod_v3_sub(x, y));
+				sum += d;
+				count++;
+				if (d > max)
+					max = d;
+			}
+		}
+	}
+	*point_error = worst;
+	memset(dev, 0, sizeof *dev);
+	dev->max = max;
+	dev->mean = count ? sum / (double)count : 0.0;
+	return 1;
+}
+
 /* Is level_max_error(m, clip) <= bound? It stops at the first error
  * above. */
 static int level_within(mlod_motion *m, const mlod_clip *clip, double bound)
@@ -1326,11 +1370,19 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
  * error within bound: first one level grid (bisection on its exponent),
  * then each channel coarser while the bound holds. Sets *grid to the
  * level grid (0 when nothing was rounded). Returns -1 when out of memory. */
-static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *grid)
+typedef struct level_meas {
+	int valid;            /* the level as it now is was measured */
+	double point_error;
+	mlod_deviation dev;
+} level_meas;
+
+static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *grid, double known, level_meas *meas)
 {
 	int n = clip->channel_count;
 	*grid = 0.0;
-	if (!(bound > 0.0) || !isfinite(bound) || !level_within(m, clip, bound))
+	meas->valid = 0;
+	/* known: the clip's level_max_error when the caller measured it, or < 0. */
+	if (!(bound > 0.0) || !isfinite(bound) || !(known >= 0.0 ? known <= bound : level_within(m, clip, bound)))
 		return 0;
 	mlod_clip src;
 	memset(&src, 0, sizeof src);
@@ -1361,7 +1413,11 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 		 * leaves first); the result is measured again as a whole. */
 		if (m->cache0 && refine_channels(m, &src, clip, lo, adj, e, bound) != 0)
 			bad = 1;
-		if (!round_fits(m, &src, clip, lo, adj, e, bound)) {
+		/* round_fits, measuring the level at the same time. */
+		channel_exps(m, &src, lo, adj, e);
+		round_clip(&src, clip, e, SHORTS(m));
+		meas->valid = level_measure(m, clip, &meas->point_error, &meas->dev) && meas->point_error <= bound;
+		if (!meas->valid && !level_within(m, clip, bound)) {
 			memset(adj, 0, sizeof(int) * (size_t)n); /* fitted in the bisection */
 			round_fits(m, &src, clip, lo, adj, e, bound);
 		}
@@ -1377,9 +1433,10 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
  * it, after rounding its values within bound (< 0: a level chosen by
  * threshold or fraction, whose error e may grow to e / (1 - share), the
  * share a bound leaves to rounding). */
-static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double bound, long max_bytes,
+static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double bound, long max_bytes, double known,
                                 mlod_error *err)
 {
+	level_meas meas = { 0, 0.0, { 0.0, 0.0, 0.0 } };
 	out->keys = mlod_clip_key_count(&out->clip);
 	out->bytes = mlod_clip_key_bytes(&out->clip);
 	if (max_bytes >= 0) {
@@ -1399,13 +1456,18 @@ static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double b
 	}
 	if (m->opt.precision != MLOD_MOTION_PRECISION_FULL) {
 		if (bound < 0.0)
-			bound = level_max_error(m, &out->clip) / removal_bound(m, 1.0);
-		if (level_round(m, &out->clip, bound, &out->grid) != 0)
+			bound = (known >= 0.0 ? known : level_max_error(m, &out->clip)) / removal_bound(m, 1.0);
+		if (level_round(m, &out->clip, bound, &out->grid, known, &meas) != 0)
 			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
-	out->point_error = level_max_error(m, &out->clip);
 	out->keys = mlod_clip_key_count(&out->clip);
 	out->bytes = mlod_clip_key_bytes(&out->clip);
+	if (meas.valid || level_measure(m, &out->clip, &meas.point_error, &meas.dev)) {
+		out->point_error = meas.point_error;
+		out->error = meas.dev;
+		return MLOD_OK;
+	}
+	out->point_error = level_max_error(m, &out->clip);
 	mlod_character a, b;
 	memset(&a, 0, sizeof a);
 	a.skeleton = m->s[0];
@@ -1748,7 +1810,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 	}
 	line_free(&m->tree);
 	m->tree = best;
-	mlod_result r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, err);
+	mlod_result r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, -1.0, err);
 	if (r != MLOD_OK)
 		mlod_motion_level_free(out);
 	return r;
@@ -1789,7 +1851,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 	size_t size = (size_t)m->common.channel_count * (size_t)m->frames;
 	unsigned char *kept = malloc(size), *best = malloc(size);
 	mlod_clip clip, best_clip;
-	double best_budget = -1.0;
+	double best_budget = -1.0, best_error = -1.0; /* best_clip's level_max_error */
 	memset(&best_clip, 0, sizeof best_clip);
 	mlod_result r = MLOD_OK;
 	if (!kept || !best) {
@@ -1811,6 +1873,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 				memcpy(best, kept, size);
 				best_clip = clip;
 				best_budget = budget;
+				best_error = e;
 			} else {
 				mlod_clip_free(&clip);
 			}
@@ -1837,6 +1900,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 			memcpy(best, kept, size);
 			best_clip = clip;
 			best_budget = hi;
+			best_error = e;
 			if (keys <= target_keys)
 				break;
 			lo = hi;
@@ -1855,6 +1919,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 				memcpy(best, kept, size);
 				best_clip = clip;
 				best_budget = mid;
+				best_error = e;
 				hi = mid;
 			} else {
 				mlod_clip_free(&clip);
@@ -1874,7 +1939,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 	out->clip = best_clip;
 	free(m->kept);
 	m->kept = best;
-	r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, err);
+	r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, best_error, err);
 	if (r != MLOD_OK)
 		mlod_motion_level_free(out);
 	return r;
