@@ -215,7 +215,7 @@ static int sample_check(reducer *R, const mlod_channel *ch, const float *va, con
 	mlod_mat4 *lm = &R->lmb[spare][f], *w = R->wb[spare] + base;
 	*l = R->lc[base + (size_t)j];
 	set_path(l, ch->path, v);
-	*lm = mlod_mat4_from_trs(l);
+	*lm = eval_from_trs(l);
 	w[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, lm) : eval_mul_affine(&R->wc[base + (size_t)p], lm);
 	if (!within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
 		return 0;

@@ -1341,7 +1341,7 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 				Lj[f] = l;
 				for (int k = 0; k < ns && ok; k++) {
 					int d = sub[k], p = s->joints[d].parent;
-					mlod_mat4 lm = mlod_mat4_from_trs(d == j ? &l : &lf[d]);
+					mlod_mat4 lm = eval_from_trs(d == j ? &l : &lf[d]);
 					/* Below j, the parent is in the subtree, before d. */
 					const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
 					w[k] = p < 0 ? mlod_mat4_mul(&s->joints[d].base, &lm) : eval_mul_affine(pw, &lm);

@@ -32,10 +32,30 @@
 
 /* parent * local, local affine with last row (0, 0, 0, 1) as
  * mlod_mat4_from_trs makes it: rows 0 to 2 as mlod_mat4_mul computes
- * them (same products, same order of the sums); the last row (0, 0, 0, 1). */
+ * them (same products, same order of the sums, lane by lane when GCC's
+ * vector extension computes a column at once); the last row (0, 0, 0, 1). */
+#if defined(__GNUC__)
+typedef float eval_v4 __attribute__((vector_size(16)));
+#endif
+
 static inline mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 {
 	mlod_mat4 r;
+#if defined(__GNUC__)
+	eval_v4 a0, a1, a2, a3;
+	memcpy(&a0, a->m, sizeof a0);
+	memcpy(&a1, a->m + 4, sizeof a1);
+	memcpy(&a2, a->m + 8, sizeof a2);
+	memcpy(&a3, a->m + 12, sizeof a3);
+	for (int c = 0; c < 4; c++) {
+		eval_v4 s = a0 * b->m[c * 4];
+		s = s + a1 * b->m[c * 4 + 1];
+		s = s + a2 * b->m[c * 4 + 2];
+		if (c == 3)
+			s = s + a3;
+		memcpy(r.m + c * 4, &s, sizeof s);
+	}
+#else
 	for (int c = 0; c < 4; c++) {
 		const float b0 = b->m[c * 4], b1 = b->m[c * 4 + 1], b2 = b->m[c * 4 + 2];
 		for (int row = 0; row < 3; row++) {
@@ -47,9 +67,34 @@ static inline mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 			r.m[c * 4 + row] = s;
 		}
 	}
+#endif
 	r.m[3] = r.m[7] = r.m[11] = 0.0f;
 	r.m[15] = 1.0f;
 	return r;
+}
+
+/* mlod_mat4_from_trs, the same operations, inline. */
+static inline mlod_mat4 eval_from_trs(const mlod_trs *trs)
+{
+	double x = trs->r.x, y = trs->r.y, z = trs->r.z, w = trs->r.w;
+	double n = x * x + y * y + z * z + w * w;
+	double s = n > 0.0 ? 2.0 / n : 0.0;
+	double r[3][3];
+	r[0][0] = 1 - s * (y * y + z * z); r[0][1] = s * (x * y - w * z);     r[0][2] = s * (x * z + w * y);
+	r[1][0] = s * (x * y + w * z);     r[1][1] = 1 - s * (x * x + z * z); r[1][2] = s * (y * z - w * x);
+	r[2][0] = s * (x * z - w * y);     r[2][1] = s * (y * z + w * x);     r[2][2] = 1 - s * (x * x + y * y);
+	const float sc[3] = { trs->s.x, trs->s.y, trs->s.z };
+	mlod_mat4 m;
+	for (int c = 0; c < 3; c++) {
+		for (int row = 0; row < 3; row++)
+			m.m[c * 4 + row] = (float)(r[row][c] * sc[c]);
+		m.m[c * 4 + 3] = 0.0f;
+	}
+	m.m[12] = trs->t.x;
+	m.m[13] = trs->t.y;
+	m.m[14] = trs->t.z;
+	m.m[15] = 1.0f;
+	return m;
 }
 
 /* Is mlod_motion_point_error(w, w0, radius) <= limit? Exactly that
@@ -220,7 +265,7 @@ static inline void eval_pose_world(const mlod_skeleton *s, const mlod_trs *local
 {
 	for (int i = 0; i < s->joint_count; i++) {
 		const mlod_joint *j = &s->joints[i];
-		mlod_mat4 l = mlod_mat4_from_trs(&local[i]);
+		mlod_mat4 l = eval_from_trs(&local[i]);
 		world[i] = j->parent < 0 ? mlod_mat4_mul(&j->base, &l) : eval_mul_affine(&world[j->parent], &l);
 	}
 }
