@@ -97,11 +97,44 @@ static inline mlod_mat4 eval_from_trs(const mlod_trs *trs)
 	return m;
 }
 
+/* An upper bound of mlod_motion_point_error(w, w0, radius) from float
+ * arithmetic: each difference of two floats is their exact difference
+ * within a relative 2^-24, the sums of squares and square roots add a few
+ * more such roundings, and underflowed squares lose less than 1e-18 in
+ * the roots: the factor 1 + 1e-5 and that absolute term cover them (and
+ * sigma_max <= Frobenius norm). Lane 3 of each column (the last row) only
+ * adds. Inf or NaN when the matrices hold them. */
+static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, double radius)
+{
+#if defined(__GNUC__)
+	eval_v4 d[4];
+	for (int c = 0; c < 4; c++) {
+		eval_v4 x, y;
+		memcpy(&x, w->m + 4 * c, sizeof x);
+		memcpy(&y, w0->m + 4 * c, sizeof y);
+		d[c] = x - y;
+	}
+	eval_v4 f = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], t = d[3] * d[3];
+	float frob = (f[0] + f[1]) + (f[2] + f[3]), dp2 = (t[0] + t[1]) + (t[2] + t[3]);
+#else
+	float frob = 0.0f, dp2 = 0.0f;
+	for (int i = 0; i < 16; i++) {
+		float x = w->m[i] - w0->m[i];
+		if (i < 12)
+			frob += x * x;
+		else
+			dp2 += x * x;
+	}
+#endif
+	return ((double)sqrtf(dp2) + radius * (double)sqrtf(frob)) * (1.0 + 1e-5) + 1e-18 * (1.0 + radius);
+}
+
 /* Is mlod_motion_point_error(w, w0, radius) <= limit? Exactly that
- * answer; the exact error is computed only when the cheap bound cannot
- * tell. */
+ * answer; the exact error is computed only when the bounds cannot tell. */
 static inline int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
 {
+	if (eval_error_bound(w, w0, radius) <= limit)
+		return 1;
 	double dx = (double)w->m[12] - w0->m[12], dy = (double)w->m[13] - w0->m[13], dz = (double)w->m[14] - w0->m[14];
 	double dp = sqrt(dx * dx + dy * dy + dz * dz), frob = 0.0;
 	for (int c = 0; c < 3; c++)
@@ -114,10 +147,12 @@ static inline int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double ra
 	return mlod_motion_point_error(w, w0, radius) <= limit;
 }
 
-/* mlod_motion_point_error(w, w0, radius), or -1 when the cheap bound
- * shows that it is at most limit. */
+/* mlod_motion_point_error(w, w0, radius), or -1 when a bound shows that
+ * it is at most limit. */
 static inline double eval_error_over(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
 {
+	if (eval_error_bound(w, w0, radius) <= limit)
+		return -1.0;
 	double dx = (double)w->m[12] - w0->m[12], dy = (double)w->m[13] - w0->m[13], dz = (double)w->m[14] - w0->m[14];
 	double dp = sqrt(dx * dx + dy * dy + dz * dz), frob = 0.0;
 	for (int c = 0; c < 3; c++)
