@@ -1117,6 +1117,7 @@ static double removal_bound(const mlod_motion *m, double bound)
 #define SHORTS(m) ((m)->opt.precision == MLOD_MOTION_PRECISION_AUTO)
 #define GRID_RANGE 48     /* grids tried: from 2^48 times finer than the bound up to it */
 #define CHANNEL_COARSER 8 /* per channel, up to this many doublings beyond the level's grid */
+#define REFINE_STRIDE 8
 
 /* v rounded to the nearest multiple of 2^e. */
 static float grid_round(float v, int e)
@@ -1276,12 +1277,13 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	size_t FJ = (size_t)F * (size_t)J;
 	mlod_trs *L = malloc(sizeof *L * FJ), *Lj = malloc(sizeof *Lj * (size_t)F);
 	mlod_mat4 *W = malloc(sizeof *W * FJ), *T = malloc(sizeof *T * FJ);
+	mlod_mat4 *LM = malloc(sizeof *LM * FJ), *LMj = malloc(sizeof *LMj * (size_t)F);
 	int *sub = malloc(sizeof(int) * (size_t)J), *pos = malloc(sizeof(int) * (size_t)J);
 	const float *times = m->st;
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
-	if (!L || !Lj || !W || !T || !sub || !pos) {
-		free(L), free(Lj), free(W), free(T), free(sub), free(pos);
+	if (!L || !Lj || !W || !T || !LM || !LMj || !sub || !pos) {
+		free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
 		return -1;
 	}
 	level_walk walk;
@@ -1297,7 +1299,12 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 			mlod_clip_sample(clip, times[f], lf);
 			mlod_pose_world(s, lf, W + (size_t)f * (size_t)J);
 		}
+		for (int j = 0; j < J; j++)
+			LM[(size_t)f * (size_t)J + (size_t)j] = eval_from_trs(&lf[j]);
 	}
+	/* Samples every REFINE_STRIDE-th first: they are independent, and a
+	 * try that fails usually fails sooner. */
+	const int stride = F >= 4 * REFINE_STRIDE ? REFINE_STRIDE : 1;
 	for (int i = 0; i < n; i++) {
 		mlod_channel *ch = &clip->channels[i];
 		int j = ch->joint, ns = 0, fast = ch->interp != MLOD_INTERP_CUBICSPLINE;
@@ -1315,39 +1322,41 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 			channel_exps(m, src, g, adj, e);
 			round_channel(&src->channels[i], ch, e[i], SHORTS(m));
 			/* The try's local transform of j and world matrices of its
-			 * subtree go to Lj and T (ns per sample); kept if it fits. */
+			 * subtree go to Lj, LMj and T (ns per sample); kept if it fits. */
 			int ok = 1;
 			eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
-			for (int f = 0; f < F && ok; f++) {
-				mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
-				const mlod_mat4 *wf = W + (size_t)f * (size_t)J;
-				mlod_mat4 *w = T + (size_t)f * (size_t)ns;
-				const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J;
-				if (fast) {
-					float t = times[f], v[4];
-					if (!(t > 0.0f))
-						t = 0.0f;
-					if (t > clip->duration)
-						t = clip->duration;
-					eval_channel(ch, &seg, t, v);
-					switch (ch->path) {
-					case MLOD_PATH_TRANSLATION: l.t.x = v[0], l.t.y = v[1], l.t.z = v[2]; break;
-					case MLOD_PATH_SCALE: l.s.x = v[0], l.s.y = v[1], l.s.z = v[2]; break;
-					case MLOD_PATH_ROTATION: l.r = mlod_quat_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+			for (int phase = 0; phase < stride && ok; phase++)
+				for (int f = phase; f < F && ok; f += stride) {
+					mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
+					const mlod_mat4 *wf = W + (size_t)f * (size_t)J, *lmf = LM + (size_t)f * (size_t)J;
+					mlod_mat4 *w = T + (size_t)f * (size_t)ns;
+					const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J;
+					if (fast) {
+						float t = times[f], v[4];
+						if (!(t > 0.0f))
+							t = 0.0f;
+						if (t > clip->duration)
+							t = clip->duration;
+						eval_channel(ch, &seg, t, v);
+						switch (ch->path) {
+						case MLOD_PATH_TRANSLATION: l.t.x = v[0], l.t.y = v[1], l.t.z = v[2]; break;
+						case MLOD_PATH_SCALE: l.s.x = v[0], l.s.y = v[1], l.s.z = v[2]; break;
+						case MLOD_PATH_ROTATION: l.r = mlod_quat_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+						}
+					} else {
+						sample_into(clip, ch, times[f], &l);
 					}
-				} else {
-					sample_into(clip, ch, times[f], &l);
+					Lj[f] = l;
+					LMj[f] = eval_from_trs(&l);
+					for (int k = 0; k < ns && ok; k++) {
+						int d = sub[k], p = s->joints[d].parent;
+						const mlod_mat4 *lm = d == j ? &LMj[f] : &lmf[d];
+						/* Below j, the parent is in the subtree, before d. */
+						const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
+						w[k] = p < 0 ? mlod_mat4_mul(&s->joints[d].base, lm) : eval_mul_affine(pw, lm);
+						ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
+					}
 				}
-				Lj[f] = l;
-				for (int k = 0; k < ns && ok; k++) {
-					int d = sub[k], p = s->joints[d].parent;
-					mlod_mat4 lm = eval_from_trs(d == j ? &l : &lf[d]);
-					/* Below j, the parent is in the subtree, before d. */
-					const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
-					w[k] = p < 0 ? mlod_mat4_mul(&s->joints[d].base, &lm) : eval_mul_affine(pw, &lm);
-					ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
-				}
-			}
 			if (!ok) {
 				adj[i]--;
 				channel_exps(m, src, g, adj, e);
@@ -1357,12 +1366,13 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 			for (int f = 0; f < F; f++) {
 				mlod_mat4 *wf = W + (size_t)f * (size_t)J;
 				L[(size_t)f * (size_t)J + (size_t)j] = Lj[f];
+				LM[(size_t)f * (size_t)J + (size_t)j] = LMj[f];
 				for (int k = 0; k < ns; k++)
 					wf[sub[k]] = T[(size_t)f * (size_t)ns + (size_t)k];
 			}
 		}
 	}
-	free(L), free(Lj), free(W), free(T), free(sub), free(pos);
+	free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
 	return 0;
 }
 
