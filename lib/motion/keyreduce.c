@@ -51,6 +51,7 @@ typedef struct reducer {
 	double *radius;          /* per joint */
 	int *sub_start, *sub;    /* per joint: the joint and its descendants, parents first */
 	mlod_mat4 *w0;           /* S * J: world matrices as read */
+	int own_w0;              /* 0: the caller's */
 	mlod_trs *lc;            /* S * J: current local transforms */
 	mlod_mat4 *lm;           /* S * J: their matrices */
 	mlod_mat4 *wc;           /* S * J: current world matrices */
@@ -346,7 +347,8 @@ static void reducer_free(reducer *R)
 	free(R->radius);
 	free(R->sub_start);
 	free(R->sub);
-	free(R->w0);
+	if (R->own_w0)
+		free(R->w0);
 	free(R->lc);
 	free(R->lm);
 	free(R->wc);
@@ -399,6 +401,15 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                            double point_distance, int subdivide, unsigned char *kept, mlod_error *err)
 {
+	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, err);
+}
+
+mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
+                          double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
+                          double *max_error, mlod_error *err)
+{
+	if (max_error)
+		*max_error = -1.0;
 	mlod_result r = check_args(s, original, common, bound, point_distance, subdivide, kept, err);
 	if (r != MLOD_OK)
 		return r;
@@ -415,7 +426,8 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 	R.times = malloc(sizeof(float) * (size_t)R.S);
 	R.radius = malloc(sizeof(double) * (size_t)R.J);
 	R.sub_start = calloc((size_t)R.J + 1, sizeof(int));
-	R.w0 = malloc(sizeof(mlod_mat4) * FJ);
+	R.own_w0 = !w0;
+	R.w0 = w0 ? (mlod_mat4 *)w0 : malloc(sizeof(mlod_mat4) * FJ); /* not written when given */
 	R.lc = malloc(sizeof(mlod_trs) * FJ);
 	R.lm = malloc(sizeof(mlod_mat4) * FJ);
 	R.wc = malloc(sizeof(mlod_mat4) * FJ);
@@ -462,9 +474,11 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 	for (int f = 0; f < R.S; f++) {
 		size_t base = (size_t)f * (size_t)R.J;
 		mlod_trs *l = R.lc + base;
-		mlod_pose_rest(s, l);
-		mlod_clip_sample(original, R.times[f], l);
-		mlod_pose_world(s, l, R.w0 + base);
+		if (R.own_w0) {
+			mlod_pose_rest(s, l);
+			mlod_clip_sample(original, R.times[f], l);
+			mlod_pose_world(s, l, R.w0 + base);
+		}
 		mlod_pose_rest(s, l);
 		for (int c = 0; c < common->channel_count; c++) {
 			const mlod_channel *ch = &common->channels[c];
@@ -485,6 +499,27 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 			reduce_channel(&R, c, bound * round / ROUNDS, K);
 	for (int c = 0; c < common->channel_count; c++)
 		collapse_channel(&R, c, bound);
+	/* The largest point error of the result, as motion.c's
+	 * level_max_error measures the level clip of these keys: the same
+	 * sampling (kept_value and segment_value are mlod_clip_sample's on
+	 * those keys) and kinematics, when no sample time is past the clip's
+	 * duration (mlod_clip_sample would clamp it). */
+	if (max_error && R.times[R.S - 1] <= common->duration) {
+		double worst = 0.0;
+		for (int f = 0; f < R.S; f++) {
+			size_t base = (size_t)f * (size_t)R.J;
+			for (int j = 0; j < R.J; j++) {
+				double e = eval_error_over(&R.wc[base + (size_t)j], &R.w0[base + (size_t)j], R.radius[j], worst);
+				if (e >= 0.0 && !(e <= worst))
+					worst = e;
+				else if (e != e)
+					worst = e; /* NaN counts as the worst */
+			}
+			if (!(worst <= HUGE_VAL))
+				break;
+		}
+		*max_error = worst != worst ? -1.0 : worst;
+	}
 done:
 	free(depth);
 	free(K);

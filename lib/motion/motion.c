@@ -567,6 +567,7 @@ struct mlod_motion {
 	mlod_mat4 *world, *world0;
 	mlod_mat4 *cache0;     /* samples * joints world matrices as read, or NULL */
 	eval_seg *walk_segs;   /* per channel: sampling level clips (level_walk) */
+	int clip_end_ok;       /* no sample time past the clip's duration (level clips are not clamped) */
 	mlod_trs *walk_local;  /* per joint */
 	/* State of each method: the last line of the tree, the keys kept. */
 	line tree;
@@ -757,6 +758,7 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	}
 	joint_weights(s, m->weight);
 	mlod_motion_sample_times(m->common.channels[0].times, F, m->sub, m->st);
+	m->clip_end_ok = m->st[m->samples - 1] <= src->duration;
 	for (int i = 0; i < nch; i++) {
 		const mlod_channel *ch = &m->common.channels[i];
 		int comps = comps_of(ch);
@@ -1842,14 +1844,18 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	size_t size = (size_t)m->common.channel_count * (size_t)m->frames;
 	memcpy(kept, m->kept, size);
 	memset(clip, 0, sizeof *clip);
-	if (mlod_keyreduce(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, err) != MLOD_OK)
+	double e = -1.0;
+	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, err) !=
+	    MLOD_OK)
 		return -1.0;
 	if (clip_from_kept(m, kept, clip) != 0) {
 		mlod_clip_free(clip);
 		mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		return -1.0;
 	}
-	return level_max_error(m, clip);
+	/* keyreduce measured the clip as level_max_error does, unless it
+	 * could not. */
+	return e >= 0.0 && m->clip_end_ok ? e : level_max_error(m, clip);
 }
 
 static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,

@@ -305,4 +305,13 @@ static inline void eval_pose_world(const mlod_skeleton *s, const mlod_trs *local
 	}
 }
 
+/* mlod_keyreduce, with the clip as read at the samples given (w0, samples
+ * * joints world matrices as mlod_pose_world makes them; NULL: computed),
+ * and *max_error (if not NULL) the largest point error of the result as
+ * motion.c's level_max_error measures its level clip, or -1 when not
+ * measured (a NaN, or samples past the clip's duration). */
+mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
+                          double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
+                          double *max_error, mlod_error *err);
+
 #endif /* MLOD_MOTION_EVAL_H */
