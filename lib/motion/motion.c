@@ -779,9 +779,23 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
 	if ((double)m->samples * n <= (double)MAX_CACHED &&
-	    (m->cache0 = malloc(sizeof(mlod_mat4) * (size_t)m->samples * (size_t)n)) != NULL)
-		for (int f = 0; f < m->samples; f++)
-			pose_at(m, src, m->st[f], m->cache0 + (size_t)f * (size_t)n);
+	    (m->cache0 = malloc(sizeof(mlod_mat4) * (size_t)m->samples * (size_t)n)) != NULL) {
+		/* mlod_clip_sample and mlod_pose_world, faster (motion_eval.h)
+		 * when the clip is LINEAR or STEP. */
+		int fast = eval_clip_ok(src) && src->channel_count <= nch;
+		for (int i = 0; fast && i < src->channel_count; i++)
+			m->walk_segs[i].k = -1, m->walk_segs[i].ready = 0;
+		mlod_pose_rest(s, m->walk_local);
+		for (int f = 0; f < m->samples; f++) {
+			mlod_mat4 *w = m->cache0 + (size_t)f * (size_t)n;
+			if (fast) {
+				eval_sample(src, m->walk_segs, m->st[f], m->walk_local);
+				eval_pose_world(s, m->walk_local, w);
+			} else {
+				pose_at(m, src, m->st[f], w);
+			}
+		}
+	}
 	/* Level 0 of each method: every frame, every key. */
 	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
 	m->kept = malloc((size_t)nch * (size_t)F);
