@@ -75,7 +75,7 @@ static void set_path(mlod_trs *l, mlod_path path, const float *v)
 	switch (path) {
 	case MLOD_PATH_TRANSLATION: l->t.x = v[0], l->t.y = v[1], l->t.z = v[2]; break;
 	case MLOD_PATH_SCALE: l->s.x = v[0], l->s.y = v[1], l->s.z = v[2]; break;
-	case MLOD_PATH_ROTATION: l->r = mlod_quat_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+	case MLOD_PATH_ROTATION: l->r = eval_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
 	}
 }
 

@@ -1357,7 +1357,7 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 						switch (ch->path) {
 						case MLOD_PATH_TRANSLATION: l.t.x = v[0], l.t.y = v[1], l.t.z = v[2]; break;
 						case MLOD_PATH_SCALE: l.s.x = v[0], l.s.y = v[1], l.s.z = v[2]; break;
-						case MLOD_PATH_ROTATION: l.r = mlod_quat_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+						case MLOD_PATH_ROTATION: l.r = eval_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
 						}
 					} else {
 						sample_into(clip, ch, times[f], &l);

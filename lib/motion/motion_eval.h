@@ -174,6 +174,34 @@ typedef struct eval_seg {
 	double sign, theta, s;
 } eval_seg;
 
+#if defined(__GNUC__)
+typedef double eval_v2d __attribute__((vector_size(16)));
+#endif
+
+/* (float)(x / n) ... for the four components: two lanes at a time where
+ * GCC's vector extension is there (each lane the same IEEE division). */
+static inline mlod_quat eval_div4(double x, double y, double z, double w, double n)
+{
+#if defined(__GNUC__)
+	eval_v2d a = { x, y }, b = { z, w }, d = { n, n };
+	a = a / d;
+	b = b / d;
+	mlod_quat r = { (float)a[0], (float)a[1], (float)b[0], (float)b[1] };
+#else
+	mlod_quat r = { (float)(x / n), (float)(y / n), (float)(z / n), (float)(w / n) };
+#endif
+	return r;
+}
+
+/* mlod_quat_normalize, the same operations, inline. */
+static inline mlod_quat eval_normalize(mlod_quat q)
+{
+	double n = sqrt((double)q.x * q.x + (double)q.y * q.y + (double)q.z * q.z + (double)q.w * q.w);
+	if (!(n > 0.0) || !isfinite(n))
+		return mlod_quat_identity();
+	return eval_div4(q.x, q.y, q.z, q.w, n);
+}
+
 static inline mlod_quat eval_blend(mlod_quat a, double wa, mlod_quat b, double wb)
 {
 	double x = wa * a.x + wb * b.x, y = wa * a.y + wb * b.y;
@@ -181,8 +209,7 @@ static inline mlod_quat eval_blend(mlod_quat a, double wa, mlod_quat b, double w
 	double n = sqrt(x * x + y * y + z * z + w * w);
 	if (!(n > 0.0))
 		return mlod_quat_identity();
-	mlod_quat r = { (float)(x / n), (float)(y / n), (float)(z / n), (float)(w / n) };
-	return r;
+	return eval_div4(x, y, z, w, n);
 }
 
 /* mlod_quat_slerp(ka, kb, u) with the segment's keys ka, kb (float[4]). */
@@ -290,7 +317,7 @@ static inline void eval_sample(const mlod_clip *clip, eval_seg *segs, float t, m
 		switch (ch->path) {
 		case MLOD_PATH_TRANSLATION: l->t.x = v[0], l->t.y = v[1], l->t.z = v[2]; break;
 		case MLOD_PATH_SCALE: l->s.x = v[0], l->s.y = v[1], l->s.z = v[2]; break;
-		case MLOD_PATH_ROTATION: l->r = mlod_quat_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+		case MLOD_PATH_ROTATION: l->r = eval_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
 		}
 	}
 }

@@ -1038,6 +1038,16 @@ TEST(fast_checks_match_exact)
 					wrong_mul++;
 	}
 	CHECK_MSG(wrong_trs == 0, "eval_from_trs differs from mlod_mat4_from_trs %ld times", wrong_trs);
+	long wrong_norm = 0;
+	for (int i = 0; i < 100000; i++) {
+		double k = i % 3 == 0 ? 1.0 : i % 3 == 1 ? 1e-3 : 37.0;
+		mlod_quat q = { (float)((urand() - 0.5) * k), (float)((urand() - 0.5) * k), (float)((urand() - 0.5) * k),
+		                (float)((urand() - 0.5) * k) };
+		mlod_quat a = mlod_quat_normalize(q), b = eval_normalize(q);
+		if (memcmp(&a, &b, sizeof a) != 0)
+			wrong_norm++;
+	}
+	CHECK_MSG(wrong_norm == 0, "eval_normalize differs from mlod_quat_normalize %ld times", wrong_norm);
 	CHECK_MSG(wrong_mul == 0, "eval_mul_affine differs from mlod_mat4_mul in %ld entries", wrong_mul);
 
 	/* Cursor sampling: a chain clip with random keys, LINEAR and STEP,
