@@ -100,33 +100,6 @@ static void segment_value(const reducer *R, const mlod_channel *ch, int a, int b
 	}
 }
 
-/* The value at sample f of a channel keyed (at frames) where row is set. */
-static void kept_value(const reducer *R, const mlod_channel *ch, const unsigned char *row, int f, float *out)
-{
-	int comps = comps_of(ch), first = -1, last = -1;
-	for (int k = 0; k < R->F; k++)
-		if (row[k]) {
-			first = k;
-			break;
-		}
-	for (int k = R->F - 1; k >= 0; k--)
-		if (row[k]) {
-			last = k;
-			break;
-		}
-	if (first == last || f <= first * R->per || f >= last * R->per) {
-		int k = f >= last * R->per && first != last ? last : first;
-		memcpy(out, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
-		return;
-	}
-	int a = f / R->per, b = a + 1;
-	while (!row[a])
-		a--;
-	while (!row[b])
-		b++;
-	segment_value(R, ch, a, b, f, out);
-}
-
 /* Largest singular value of a 3x3 matrix given by columns (m[c * 4 + r]). */
 static double sigma_max(const double a[9])
 {
@@ -234,8 +207,8 @@ static int sample_check(reducer *R, const mlod_channel *ch, const float *va, con
 /* Checks channel ch taking, at samples lo..hi (inclusive), the values of
  * the segment between its keys at frames a and b (or a's value, constant).
  * The samples are independent (each needs only the current matrices at
- * that sample), so they are visited every SWEEP_STRIDE-th first: a
- * failing check usually stops sooner. When every sample fits, the results
+ * that sample), so every SWEEP_STRIDE-th goes first, then the others in
+ * order: a failing check usually stops sooner. When every sample fits, the results
  * become the good buffers, which sweep_commit applies. */
 #define SWEEP_STRIDE 8
 static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget)
@@ -245,10 +218,12 @@ static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo,
 	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
 	const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
 	int stride = hi - lo + 1 >= 4 * SWEEP_STRIDE ? SWEEP_STRIDE : 1;
-	for (int phase = 0; phase < stride; phase++)
-		for (int f = lo + phase; f <= hi; f += stride)
-			if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
-				return 0;
+	for (int f = lo; f <= hi && stride > 1; f += stride)
+		if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+			return 0;
+	for (int f = lo; f <= hi; f++) /* the rest in order (memory order) */
+		if ((stride == 1 || (f - lo) % stride != 0) && !sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+			return 0;
 	R->good = 1 - R->good;
 	R->good_ch = ch, R->good_lo = lo, R->good_hi = hi;
 	return 1;
@@ -438,9 +413,10 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	}
 	int *depth = malloc(sizeof(int) * (size_t)R.J);
 	int *K = malloc(sizeof(int) * (size_t)R.F);
+	int *prevk = malloc(sizeof(int) * (size_t)R.F), *nextk = malloc(sizeof(int) * (size_t)R.F);
 	int *fill = NULL;
 	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.wb[0] || !R.wb[1] || !R.lb[0] ||
-	    !R.lb[1] || !R.lmb[0] || !R.lmb[1] || !depth || !K) {
+	    !R.lb[1] || !R.lmb[0] || !R.lmb[1] || !depth || !K || !prevk || !nextk) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
@@ -480,12 +456,42 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 			mlod_pose_world(s, l, R.w0 + base);
 		}
 		mlod_pose_rest(s, l);
-		for (int c = 0; c < common->channel_count; c++) {
-			const mlod_channel *ch = &common->channels[c];
-			float v[4];
-			kept_value(&R, ch, kept + (size_t)c * (size_t)R.F, f, v);
-			set_path(&l[ch->joint], ch->path, v);
+	}
+	/* The kept keys' values (those of mlod_clip_sample on the kept keys,
+	 * each sample's kept neighbours looked up), channel by channel in
+	 * order, as mlod_clip_sample sets them. */
+	for (int c = 0; c < common->channel_count; c++) {
+		const mlod_channel *ch = &common->channels[c];
+		const unsigned char *row = kept + (size_t)c * (size_t)R.F;
+		int first = -1, last = -1;
+		for (int k = 0; k < R.F; k++)
+			if (row[k]) {
+				if (first < 0)
+					first = k;
+				last = k;
+			}
+		for (int k = 0, p = -1; k < R.F; k++) /* prevk: the last kept at or before k */
+			prevk[k] = p = row[k] ? k : p;
+		for (int k = R.F - 1, n = -1; k >= 0; k--) { /* nextk: the first kept after k */
+			nextk[k] = n;
+			if (row[k])
+				n = k;
 		}
+		for (int f = 0; f < R.S; f++) {
+			float v[4];
+			int comps = comps_of(ch);
+			if (first == last || f <= first * R.per || f >= last * R.per) {
+				int k = f >= last * R.per && first != last ? last : first;
+				memcpy(v, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
+			} else {
+				segment_value(&R, ch, prevk[f / R.per], nextk[f / R.per], f, v);
+			}
+			set_path(&R.lc[(size_t)f * (size_t)R.J + (size_t)ch->joint], ch->path, v);
+		}
+	}
+	for (int f = 0; f < R.S; f++) {
+		size_t base = (size_t)f * (size_t)R.J;
+		mlod_trs *l = R.lc + base;
 		for (int j = 0; j < R.J; j++)
 			R.lm[base + (size_t)j] = mlod_mat4_from_trs(&l[j]);
 		for (int j = 0; j < R.J; j++) {
@@ -501,7 +507,7 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		collapse_channel(&R, c, bound);
 	/* The largest point error of the result, as motion.c's
 	 * level_max_error measures the level clip of these keys: the same
-	 * sampling (kept_value and segment_value are mlod_clip_sample's on
+	 * sampling (the kept values and segment_value are mlod_clip_sample's on
 	 * those keys) and kinematics, when no sample time is past the clip's
 	 * duration (mlod_clip_sample would clamp it). */
 	if (max_error && R.times[R.S - 1] <= common->duration) {
@@ -523,6 +529,8 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 done:
 	free(depth);
 	free(K);
+	free(prevk);
+	free(nextk);
 	free(fill);
 	reducer_free(&R);
 	return r;
