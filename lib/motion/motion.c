@@ -1318,8 +1318,8 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 		for (int j = 0; j < J; j++)
 			LM[(size_t)f * (size_t)J + (size_t)j] = eval_from_trs(&lf[j]);
 	}
-	/* Samples every REFINE_STRIDE-th first: they are independent, and a
-	 * try that fails usually fails sooner. */
+	/* Samples every REFINE_STRIDE-th first (they are independent, and a
+	 * try that fails usually fails sooner), then the others in order. */
 	const int stride = F >= 4 * REFINE_STRIDE ? REFINE_STRIDE : 1;
 	for (int i = 0; i < n; i++) {
 		mlod_channel *ch = &clip->channels[i];
@@ -1341,8 +1341,11 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 			 * subtree go to Lj, LMj and T (ns per sample); kept if it fits. */
 			int ok = 1;
 			eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
-			for (int phase = 0; phase < stride && ok; phase++)
-				for (int f = phase; f < F && ok; f += stride) {
+			/* Every stride-th sample first, then the rest in order. */
+			for (int pass = stride > 1 ? 0 : 1; pass < 2 && ok; pass++)
+				for (int f = 0; f < F && ok; f += pass ? 1 : stride) {
+					if (pass == 1 && stride > 1 && f % stride == 0)
+						continue;
 					mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
 					const mlod_mat4 *wf = W + (size_t)f * (size_t)J, *lmf = LM + (size_t)f * (size_t)J;
 					mlod_mat4 *w = T + (size_t)f * (size_t)ns;
