@@ -269,19 +269,23 @@ static void clip_levels(struct job *job, struct clip *cl)
 		double value = sp->percent ? sp->value * job->height / 100.0 : sp->value;
 		lv->bound = sp->target == MLOD_MOTION_MAX_ERROR ? value : -1.0;
 		char why[2][MLOD_ERROR_MESSAGE_SIZE] = {"", ""};
-		for (int i = 0; i < method_count; i++) {
+		/* Fewer bytes wins; on a tie, the smaller error, then the method
+		 * listed first. The last method runs first, so that the others
+		 * can skip rounding and measuring a level that cannot win. */
+		for (int i = method_count - 1; i >= 0; i--) {
 			if (methods[i] == MLOD_MOTION_KEYS && sp->target == MLOD_MOTION_THRESHOLD)
 				continue;
 			mlod_motion_level l;
-			mlod_result r = mlod_motion_next_level(m[i], (mlod_motion_method)methods[i], sp->target, value, &l, &err);
+			mlod_result r = mlod_motion_next_level_under(m[i], (mlod_motion_method)methods[i], sp->target, value,
+			                                             lv->ok ? lv->l.bytes : -1, &l, &err);
 			if (r == MLOD_ERR_LIMIT) {
 				snprintf(why[i], sizeof why[i], "%s", err.message);
 				continue;
 			}
 			if (r != MLOD_OK)
 				tool_die(tool_exit_code(r), job->input, "%s", err.message);
-			/* Fewer bytes wins; on a tie, the smaller error. */
-			if (!lv->ok || l.bytes < lv->l.bytes || (l.bytes == lv->l.bytes && l.error.max < lv->l.error.max)) {
+			if (!l.unfinished &&
+			    (!lv->ok || l.bytes < lv->l.bytes || (l.bytes == lv->l.bytes && !(lv->l.error.max < l.error.max)))) {
 				if (lv->ok)
 					mlod_motion_level_free(&lv->l);
 				lv->l = l;

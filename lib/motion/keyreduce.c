@@ -36,6 +36,7 @@
 #include <string.h>
 
 #include "motion/mlod_motion.h"
+#include "motion/motion_eval.h"
 
 #define MAX_FRAME_JOINTS 1000000L /* frames * joints the caches may hold */
 #define ROUNDS 4
@@ -50,10 +51,16 @@ typedef struct reducer {
 	double *radius;          /* per joint */
 	int *sub_start, *sub;    /* per joint: the joint and its descendants, parents first */
 	mlod_mat4 *w0;           /* S * J: world matrices as read */
+	int own_w0;              /* 0: the caller's */
 	mlod_trs *lc;            /* S * J: current local transforms */
 	mlod_mat4 *lm;           /* S * J: their matrices */
 	mlod_mat4 *wc;           /* S * J: current world matrices */
-	mlod_mat4 *tmp;          /* J */
+	mlod_mat4 *wb[2];        /* S * J: world matrices of a check (the subtree's) */
+	mlod_trs *lb[2];         /* S: the channel's joint's local transform in a check */
+	mlod_mat4 *lmb[2];       /* S: its matrix */
+	int good;                /* which buffers hold the last check that fitted */
+	const mlod_channel *good_ch; /* and of what: channel, samples */
+	int good_lo, good_hi;
 	unsigned char *kept;
 } reducer;
 
@@ -68,7 +75,7 @@ static void set_path(mlod_trs *l, mlod_path path, const float *v)
 	switch (path) {
 	case MLOD_PATH_TRANSLATION: l->t.x = v[0], l->t.y = v[1], l->t.z = v[2]; break;
 	case MLOD_PATH_SCALE: l->s.x = v[0], l->s.y = v[1], l->s.z = v[2]; break;
-	case MLOD_PATH_ROTATION: l->r = mlod_quat_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+	case MLOD_PATH_ROTATION: l->r = eval_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
 	}
 }
 
@@ -93,69 +100,98 @@ static void segment_value(const reducer *R, const mlod_channel *ch, int a, int b
 	}
 }
 
-/* The value at sample f of a channel keyed (at frames) where row is set. */
-static void kept_value(const reducer *R, const mlod_channel *ch, const unsigned char *row, int f, float *out)
+/* Does the joint's world matrix w stay within budget of w0? A float
+ * bound of the point error decides first (the same answer); only when it
+ * cannot, mlod_motion_point_within with its early exits. */
+static int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget)
 {
-	int comps = comps_of(ch), first = -1, last = -1;
-	for (int k = 0; k < R->F; k++)
-		if (row[k]) {
-			first = k;
-			break;
-		}
-	for (int k = R->F - 1; k >= 0; k--)
-		if (row[k]) {
-			last = k;
-			break;
-		}
-	if (first == last || f <= first * R->per || f >= last * R->per) {
-		int k = f >= last * R->per && first != last ? last : first;
-		memcpy(out, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
-		return;
-	}
-	int a = f / R->per, b = a + 1;
-	while (!row[a])
-		a--;
-	while (!row[b])
-		b++;
-	segment_value(R, ch, a, b, f, out);
+	if (eval_error_bound(w, w0, R->radius[j]) <= budget)
+		return 1; /* the same answer as below, from a float bound */
+	return mlod_motion_point_within(w, w0, R->radius[j], budget);
 }
 
-/* Checks (commit = 0) or applies (commit = 1) channel ch taking the value
- * val_of(f) at frames lo..hi (inclusive): val_a, val_b are the keys of a
- * segment, or const_value for a constant. */
-static int sweep(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget,
-                 int commit)
+/* The channel's value at sample f and the subtree's world matrices with
+ * it, into the spare buffers; is every joint within budget? */
+static int sample_check(reducer *R, const mlod_channel *ch, const float *va, const float *vb, float t0, float dt,
+                        eval_seg *seg, int constant, int f, double budget)
 {
 	const mlod_skeleton *s = R->s;
-	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch);
+	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch), spare = 1 - R->good;
+	const int *sub = R->sub + R->sub_start[j];
+	int nsub = R->sub_start[j + 1] - R->sub_start[j];
+	float v[4];
+	if (constant || ch->interp == MLOD_INTERP_STEP) {
+		memcpy(v, va, sizeof(float) * (size_t)comps);
+	} else {
+		/* segment_value, with the slerp's per-segment part done once. */
+		const float u = (R->times[f] - t0) / dt;
+		if (comps == 4) {
+			mlod_quat q = eval_slerp(seg, va, vb, u);
+			v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
+		} else {
+			for (int c = 0; c < 3; c++)
+				v[c] = va[c] + (vb[c] - va[c]) * u;
+		}
+	}
+	size_t base = (size_t)f * (size_t)R->J;
+	mlod_trs *l = &R->lb[spare][f];
+	mlod_mat4 *lm = &R->lmb[spare][f], *w = R->wb[spare] + base;
+	*l = R->lc[base + (size_t)j];
+	set_path(l, ch->path, v);
+	*lm = eval_from_trs(l);
+	w[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, lm) : eval_mul_affine(&R->wc[base + (size_t)p], lm);
+	if (!within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
+		return 0;
+	for (int k = 1; k < nsub; k++) {
+		int d = sub[k], dp = s->joints[d].parent;
+		w[d] = eval_mul_affine(&w[dp], &R->lm[base + (size_t)d]);
+		if (!within(R, d, &w[d], &R->w0[base + (size_t)d], budget))
+			return 0;
+	}
+	return 1;
+}
+
+/* Checks channel ch taking, at samples lo..hi (inclusive), the values of
+ * the segment between its keys at frames a and b (or a's value, constant).
+ * The samples are independent (each needs only the current matrices at
+ * that sample), so every SWEEP_STRIDE-th goes first, then the others in
+ * order: a failing check usually stops sooner. When every sample fits, the results
+ * become the good buffers, which sweep_commit applies. */
+#define SWEEP_STRIDE 8
+static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget)
+{
+	int comps = comps_of(ch);
+	eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
+	const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
+	int stride = hi - lo + 1 >= 4 * SWEEP_STRIDE ? SWEEP_STRIDE : 1;
+	for (int f = lo; f <= hi && stride > 1; f += stride)
+		if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+			return 0;
+	for (int f = lo; f <= hi; f++) /* the rest in order (memory order) */
+		if ((stride == 1 || (f - lo) % stride != 0) && !sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+			return 0;
+	R->good = 1 - R->good;
+	R->good_ch = ch, R->good_lo = lo, R->good_hi = hi;
+	return 1;
+}
+
+/* Applies the last check that fitted (channel ch at samples lo..hi). */
+static void sweep_commit(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant)
+{
+	if (R->good_ch != ch || R->good_lo != lo || R->good_hi != hi)
+		sweep_check(R, ch, a, b, lo, hi, constant, HUGE_VAL); /* not reached: the last fit is the one applied */
+	int j = ch->joint, g = R->good;
 	const int *sub = R->sub + R->sub_start[j];
 	int nsub = R->sub_start[j + 1] - R->sub_start[j];
 	for (int f = lo; f <= hi; f++) {
-		float v[4];
-		if (constant)
-			memcpy(v, ch->values + (size_t)a * (size_t)comps, sizeof(float) * (size_t)comps);
-		else
-			segment_value(R, ch, a, b, f, v);
 		size_t base = (size_t)f * (size_t)R->J;
-		mlod_trs l = R->lc[base + (size_t)j];
-		set_path(&l, ch->path, v);
-		mlod_mat4 lm = mlod_mat4_from_trs(&l);
-		mlod_mat4 *w = commit ? R->wc + base : R->tmp;
-		w[j] = mlod_mat4_mul(p < 0 ? &s->joints[j].base : &R->wc[base + (size_t)p], &lm);
-		if (!commit && !mlod_motion_point_within(&w[j], &R->w0[base + (size_t)j], R->radius[j], budget))
-			return 0;
-		for (int k = 1; k < nsub; k++) {
-			int d = sub[k], dp = s->joints[d].parent;
-			w[d] = mlod_mat4_mul(&w[dp], &R->lm[base + (size_t)d]);
-			if (!commit && !mlod_motion_point_within(&w[d], &R->w0[base + (size_t)d], R->radius[d], budget))
-				return 0;
-		}
-		if (commit) {
-			R->lc[base + (size_t)j] = l;
-			R->lm[base + (size_t)j] = lm;
-		}
+		R->lc[base + (size_t)j] = R->lb[g][f];
+		R->lm[base + (size_t)j] = R->lmb[g][f];
+		for (int k = 0; k < nsub; k++)
+			R->wc[base + (size_t)sub[k]] = R->wb[g][base + (size_t)sub[k]];
 	}
-	return 1;
+	R->good_ch = NULL;
 }
 
 /* Removes what keys it can from one channel at one budget. */
@@ -171,7 +207,7 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 	for (int i = 0; i + 2 < nk + 0 && i < nk - 1;) {
 		int ok = i + 1, fail = nk, step = 1, probe = i + 2;
 		while (probe < nk) {
-			if (sweep(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget, 0)) {
+			if (sweep_check(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget)) {
 				ok = probe;
 				step *= 2;
 				probe = i + 1 + step;
@@ -181,20 +217,20 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 			}
 		}
 		if (fail == nk && ok < nk - 1) {
-			if (sweep(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget, 0))
+			if (sweep_check(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget))
 				ok = nk - 1;
 			else
 				fail = nk - 1;
 		}
 		while (fail - ok > 1) {
 			int mid = ok + (fail - ok) / 2;
-			if (sweep(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget, 0))
+			if (sweep_check(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget))
 				ok = mid;
 			else
 				fail = mid;
 		}
 		if (ok > i + 1) {
-			sweep(R, ch, K[i], K[ok], K[i] * q + 1, K[ok] * q - 1, 0, budget, 1);
+			sweep_commit(R, ch, K[i], K[ok], K[i] * q + 1, K[ok] * q - 1, 0);
 			for (int k = i + 1; k < ok; k++)
 				row[K[k]] = 0;
 		}
@@ -221,9 +257,9 @@ static void collapse_channel(reducer *R, int c, double budget)
 	int comps = comps_of(ch);
 	if (memcmp(ch->values, ch->values + (size_t)(R->F - 1) * (size_t)comps, sizeof(float) * (size_t)comps) != 0)
 		return;
-	if (!sweep(R, ch, 0, 0, 1, R->S - 1, 1, budget, 0))
+	if (!sweep_check(R, ch, 0, 0, 1, R->S - 1, 1, budget))
 		return;
-	sweep(R, ch, 0, 0, 1, R->S - 1, 1, budget, 1);
+	sweep_commit(R, ch, 0, 0, 1, R->S - 1, 1);
 	memset(row + 1, 0, (size_t)R->F - 1);
 }
 
@@ -233,11 +269,16 @@ static void reducer_free(reducer *R)
 	free(R->radius);
 	free(R->sub_start);
 	free(R->sub);
-	free(R->w0);
+	if (R->own_w0)
+		free(R->w0);
 	free(R->lc);
 	free(R->lm);
 	free(R->wc);
-	free(R->tmp);
+	for (int i = 0; i < 2; i++) {
+		free(R->wb[i]);
+		free(R->lb[i]);
+		free(R->lmb[i]);
+	}
 }
 
 static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
@@ -282,6 +323,15 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                            double point_distance, int subdivide, unsigned char *kept, mlod_error *err)
 {
+	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, err);
+}
+
+mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
+                          double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
+                          double *max_error, mlod_error *err)
+{
+	if (max_error)
+		*max_error = -1.0;
 	mlod_result r = check_args(s, original, common, bound, point_distance, subdivide, kept, err);
 	if (r != MLOD_OK)
 		return r;
@@ -298,15 +348,22 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 	R.times = malloc(sizeof(float) * (size_t)R.S);
 	R.radius = malloc(sizeof(double) * (size_t)R.J);
 	R.sub_start = calloc((size_t)R.J + 1, sizeof(int));
-	R.w0 = malloc(sizeof(mlod_mat4) * FJ);
+	R.own_w0 = !w0;
+	R.w0 = w0 ? (mlod_mat4 *)w0 : malloc(sizeof(mlod_mat4) * FJ); /* not written when given */
 	R.lc = malloc(sizeof(mlod_trs) * FJ);
 	R.lm = malloc(sizeof(mlod_mat4) * FJ);
 	R.wc = malloc(sizeof(mlod_mat4) * FJ);
-	R.tmp = malloc(sizeof(mlod_mat4) * (size_t)R.J);
+	for (int i = 0; i < 2; i++) {
+		R.wb[i] = malloc(sizeof(mlod_mat4) * FJ);
+		R.lb[i] = malloc(sizeof(mlod_trs) * (size_t)R.S);
+		R.lmb[i] = malloc(sizeof(mlod_mat4) * (size_t)R.S);
+	}
 	int *depth = malloc(sizeof(int) * (size_t)R.J);
 	int *K = malloc(sizeof(int) * (size_t)R.F);
+	int *prevk = malloc(sizeof(int) * (size_t)R.F), *nextk = malloc(sizeof(int) * (size_t)R.F);
 	int *fill = NULL;
-	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.tmp || !depth || !K) {
+	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.wb[0] || !R.wb[1] || !R.lb[0] ||
+	    !R.lb[1] || !R.lmb[0] || !R.lmb[1] || !depth || !K || !prevk || !nextk) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
@@ -340,16 +397,48 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 	for (int f = 0; f < R.S; f++) {
 		size_t base = (size_t)f * (size_t)R.J;
 		mlod_trs *l = R.lc + base;
-		mlod_pose_rest(s, l);
-		mlod_clip_sample(original, R.times[f], l);
-		mlod_pose_world(s, l, R.w0 + base);
-		mlod_pose_rest(s, l);
-		for (int c = 0; c < common->channel_count; c++) {
-			const mlod_channel *ch = &common->channels[c];
-			float v[4];
-			kept_value(&R, ch, kept + (size_t)c * (size_t)R.F, f, v);
-			set_path(&l[ch->joint], ch->path, v);
+		if (R.own_w0) {
+			mlod_pose_rest(s, l);
+			mlod_clip_sample(original, R.times[f], l);
+			mlod_pose_world(s, l, R.w0 + base);
 		}
+		mlod_pose_rest(s, l);
+	}
+	/* The kept keys' values (those of mlod_clip_sample on the kept keys,
+	 * each sample's kept neighbours looked up), channel by channel in
+	 * order, as mlod_clip_sample sets them. */
+	for (int c = 0; c < common->channel_count; c++) {
+		const mlod_channel *ch = &common->channels[c];
+		const unsigned char *row = kept + (size_t)c * (size_t)R.F;
+		int first = -1, last = -1;
+		for (int k = 0; k < R.F; k++)
+			if (row[k]) {
+				if (first < 0)
+					first = k;
+				last = k;
+			}
+		for (int k = 0, p = -1; k < R.F; k++) /* prevk: the last kept at or before k */
+			prevk[k] = p = row[k] ? k : p;
+		for (int k = R.F - 1, n = -1; k >= 0; k--) { /* nextk: the first kept after k */
+			nextk[k] = n;
+			if (row[k])
+				n = k;
+		}
+		for (int f = 0; f < R.S; f++) {
+			float v[4];
+			int comps = comps_of(ch);
+			if (first == last || f <= first * R.per || f >= last * R.per) {
+				int k = f >= last * R.per && first != last ? last : first;
+				memcpy(v, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
+			} else {
+				segment_value(&R, ch, prevk[f / R.per], nextk[f / R.per], f, v);
+			}
+			set_path(&R.lc[(size_t)f * (size_t)R.J + (size_t)ch->joint], ch->path, v);
+		}
+	}
+	for (int f = 0; f < R.S; f++) {
+		size_t base = (size_t)f * (size_t)R.J;
+		mlod_trs *l = R.lc + base;
 		for (int j = 0; j < R.J; j++)
 			R.lm[base + (size_t)j] = mlod_mat4_from_trs(&l[j]);
 		for (int j = 0; j < R.J; j++) {
@@ -363,9 +452,32 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 			reduce_channel(&R, c, bound * round / ROUNDS, K);
 	for (int c = 0; c < common->channel_count; c++)
 		collapse_channel(&R, c, bound);
+	/* The largest point error of the result, as motion.c's
+	 * level_max_error measures the level clip of these keys: the same
+	 * sampling (the kept values and segment_value are mlod_clip_sample's on
+	 * those keys) and kinematics, when no sample time is past the clip's
+	 * duration (mlod_clip_sample would clamp it). */
+	if (max_error && R.times[R.S - 1] <= common->duration) {
+		double worst = 0.0;
+		for (int f = 0; f < R.S; f++) {
+			size_t base = (size_t)f * (size_t)R.J;
+			for (int j = 0; j < R.J; j++) {
+				double e = eval_error_over(&R.wc[base + (size_t)j], &R.w0[base + (size_t)j], R.radius[j], worst);
+				if (e >= 0.0 && !(e <= worst))
+					worst = e;
+				else if (e != e)
+					worst = e; /* NaN counts as the worst */
+			}
+			if (!(worst <= HUGE_VAL))
+				break;
+		}
+		*max_error = worst != worst ? -1.0 : worst;
+	}
 done:
 	free(depth);
 	free(K);
+	free(prevk);
+	free(nextk);
 	free(fill);
 	reducer_free(&R);
 	return r;

@@ -4,7 +4,9 @@
  * multiresolution motion tree and the levels (motion.c), per-channel key
  * reduction under a hierarchical error bound (keyreduce.c), and morph
  * target weight tracks (morphweights.c). Files call one way: motion.c
- * calls keyreduce.c, both call pointerror.c and timeline.c.
+ * calls keyreduce.c, both call pointerror.c and timeline.c. motion_eval.h
+ * (internal) holds the inline fast forms of sampling, kinematics and the
+ * point error check that motion.c and keyreduce.c measure with.
  */
 #ifndef MLOD_MOTION_H
 #define MLOD_MOTION_H
@@ -161,6 +163,9 @@ typedef struct mlod_motion_level {
 	double point_error;       /* the largest point error over joints and samples, scene units */
 	double grid;              /* auto precision: the grid translations were rounded to (rotations
 	                             and scales finer by their joint's reach), scene units; 0: none */
+	int unfinished;           /* mlod_motion_next_level_under only: more bytes than its limit
+	                             whatever the rounding; clip holds the kept keys unrounded,
+	                             bytes the fewest it could store, errors are not measured */
 } mlod_motion_level;
 
 /* Builds the next level of a method: each level is made from the previous
@@ -175,6 +180,15 @@ typedef struct mlod_motion_level {
 mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                    double value, mlod_motion_level *out, mlod_error *err);
 void mlod_motion_level_free(mlod_motion_level *l);
+
+/* mlod_motion_next_level for a caller that keeps a level only if it has
+ * fewer bytes than another (max_bytes; < 0: no limit): the keys are
+ * chosen as there, and the method's next level builds on them, but a
+ * level that would store more than max_bytes however its values are
+ * rounded is left unfinished (mlod_motion_level.unfinished), which saves
+ * the rounding and measuring. */
+mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
+                                         double value, long max_bytes, mlod_motion_level *out, mlod_error *err);
 
 /* Morph target weights of a level (beyond the paper). A weight error dw on
  * a target moves a vertex by dw times that target's offset there, so a

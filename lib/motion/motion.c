@@ -70,6 +70,7 @@
 #include <string.h>
 
 #include "motion/mlod_motion.h"
+#include "motion/motion_eval.h"
 
 #define SEARCH_STEPS 24 /* bisection steps: the threshold to 2^-24 of its range */
 #define MAX_CACHED 1000000L /* frames * joints whose world matrices as read are cached */
@@ -161,6 +162,77 @@ double mlod_motion_frame_distance(const mlod_skeleton *s, const mlod_trs *a, con
 /* The motion context                                                */
 /* ---------------------------------------------------------------- */
 
+/* Memo of the tree's frame distances and residuals between frames of the
+ * common timeline: they depend only on the frames (a node that is frame f
+ * has its values), and the bisection on the threshold rebuilds the tree
+ * from the same line many times. Keys (a, b, -1) for a distance, (p, x, q)
+ * for a residual. */
+typedef struct memo_slot {
+	int a, b, c; /* a = -1: empty */
+	double v;
+} memo_slot;
+
+typedef struct memo {
+	memo_slot *slot;
+	size_t cap, n; /* cap a power of two */
+} memo;
+
+#define MEMO_MAX ((size_t)1 << 21) /* slots at most */
+
+static size_t memo_hash(int a, int b, int c)
+{
+	unsigned long long h = (unsigned)a * 0x9E3779B97F4A7C15ull;
+	h ^= (unsigned)b * 0xC2B2AE3D27D4EB4Full + (h >> 29);
+	h ^= (unsigned)c * 0x165667B19E3779F9ull + (h >> 31);
+	return (size_t)(h ^ (h >> 32));
+}
+
+static int memo_get(const memo *mo, int a, int b, int c, double *v)
+{
+	if (!mo->slot)
+		return 0;
+	for (size_t i = memo_hash(a, b, c) & (mo->cap - 1);; i = (i + 1) & (mo->cap - 1)) {
+		const memo_slot *e = &mo->slot[i];
+		if (e->a < 0)
+			return 0;
+		if (e->a == a && e->b == b && e->c == c) {
+			*v = e->v;
+			return 1;
+		}
+	}
+}
+
+static void memo_put(memo *mo, int a, int b, int c, double v)
+{
+	if (2 * (mo->n + 1) > mo->cap) { /* at most half full */
+		size_t cap = mo->cap ? 2 * mo->cap : 4096;
+		if (cap > MEMO_MAX)
+			return;
+		memo_slot *slot = malloc(sizeof *slot * cap);
+		if (!slot)
+			return;
+		for (size_t i = 0; i < cap; i++)
+			slot[i].a = -1;
+		for (size_t k = 0; k < mo->cap; k++) {
+			const memo_slot *e = &mo->slot[k];
+			if (e->a < 0)
+				continue;
+			size_t i = memo_hash(e->a, e->b, e->c) & (cap - 1);
+			while (slot[i].a >= 0)
+				i = (i + 1) & (cap - 1);
+			slot[i] = *e;
+		}
+		free(mo->slot);
+		mo->slot = slot;
+		mo->cap = cap;
+	}
+	size_t i = memo_hash(a, b, c) & (mo->cap - 1);
+	while (mo->slot[i].a >= 0)
+		i = (i + 1) & (mo->cap - 1);
+	mo->slot[i] = (memo_slot){ a, b, c, v };
+	mo->n++;
+}
+
 /* A frame of a line of the tree: its time, the channel values (V floats,
  * laid out by channel) and the Euler angles of its rotation channels. */
 typedef struct fnode {
@@ -198,9 +270,14 @@ struct mlod_motion {
 	mlod_trs *local;
 	mlod_mat4 *world, *world0;
 	mlod_mat4 *cache0;     /* samples * joints world matrices as read, or NULL */
+	eval_seg *walk_segs;   /* per channel: sampling level clips (level_walk) */
+	int clip_end_ok;       /* no sample time past the clip's duration (level clips are not clamped) */
+	mlod_trs *walk_local;  /* per joint */
 	/* State of each method: the last line of the tree, the keys kept. */
 	line tree;
 	unsigned char *kept;   /* channel_count * frames */
+	memo *memo;            /* the tree's distances and residuals */
+	memo *segmemo;         /* frames level under way: segments of lines within its bound */
 };
 
 static void line_free(line *l)
@@ -228,8 +305,16 @@ void mlod_motion_free(mlod_motion *m)
 	free(m->world);
 	free(m->world0);
 	free(m->cache0);
+	free(m->walk_segs);
+	free(m->walk_local);
 	line_free(&m->tree);
 	free(m->kept);
+	if (m->memo)
+		free(m->memo->slot);
+	free(m->memo);
+	if (m->segmemo)
+		free(m->segmemo->slot);
+	free(m->segmemo);
 	free(m);
 }
 
@@ -368,13 +453,16 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	m->world = malloc(sizeof *m->world * (size_t)n);
 	m->world0 = malloc(sizeof *m->world0 * (size_t)n);
 	m->radius = malloc(sizeof(double) * (size_t)n);
+	m->walk_segs = malloc(sizeof *m->walk_segs * (size_t)nch);
+	m->walk_local = malloc(sizeof *m->walk_local * (size_t)n);
 	if (!m->st || !m->weight || !m->offset || !m->euler_slot || !m->constant || !m->local || !m->world || !m->world0 ||
-	    !m->radius) {
+	    !m->radius || !m->walk_segs || !m->walk_local) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
 	joint_weights(s, m->weight);
 	mlod_motion_sample_times(m->common.channels[0].times, F, m->sub, m->st);
+	m->clip_end_ok = m->st[m->samples - 1] <= src->duration;
 	for (int i = 0; i < nch; i++) {
 		const mlod_channel *ch = &m->common.channels[i];
 		int comps = comps_of(ch);
@@ -395,13 +483,29 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
 	if ((double)m->samples * n <= (double)MAX_CACHED &&
-	    (m->cache0 = malloc(sizeof(mlod_mat4) * (size_t)m->samples * (size_t)n)) != NULL)
-		for (int f = 0; f < m->samples; f++)
-			pose_at(m, src, m->st[f], m->cache0 + (size_t)f * (size_t)n);
+	    (m->cache0 = malloc(sizeof(mlod_mat4) * (size_t)m->samples * (size_t)n)) != NULL) {
+		/* mlod_clip_sample and mlod_pose_world, faster (motion_eval.h)
+		 * when the clip is LINEAR or STEP. */
+		int fast = eval_clip_ok(src) && src->channel_count <= nch;
+		for (int i = 0; fast && i < src->channel_count; i++)
+			m->walk_segs[i].k = -1, m->walk_segs[i].ready = 0;
+		mlod_pose_rest(s, m->walk_local);
+		for (int f = 0; f < m->samples; f++) {
+			mlod_mat4 *w = m->cache0 + (size_t)f * (size_t)n;
+			if (fast) {
+				eval_sample(src, m->walk_segs, m->st[f], m->walk_local);
+				eval_pose_world(s, m->walk_local, w);
+			} else {
+				pose_at(m, src, m->st[f], w);
+			}
+		}
+	}
 	/* Level 0 of each method: every frame, every key. */
 	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
 	m->kept = malloc((size_t)nch * (size_t)F);
-	if (!m->tree.v || !m->kept) {
+	m->memo = calloc(1, sizeof *m->memo);
+	m->segmemo = calloc(1, sizeof *m->segmemo);
+	if (!m->tree.v || !m->kept || !m->memo || !m->segmemo) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
@@ -529,38 +633,181 @@ static int clip_from_kept(const mlod_motion *m, const unsigned char *kept, mlod_
 	return keep_duration(m, clip);
 }
 
+/* Walks the samples of a level clip: its pose at each sample into
+ * world, with the fast sampling of motion_eval.h (the clip's channels are
+ * LINEAR or STEP) or mlod_clip_sample. */
+typedef struct level_walk {
+	const mlod_clip *clip;
+	int fast;
+	eval_seg *segs;   /* per channel */
+	mlod_trs *local;  /* per joint: the rest pose with the animated paths set */
+} level_walk;
+
+/* Level clips have the common clip's channels: m's buffers serve. */
+static void walk_begin(mlod_motion *m, const mlod_clip *clip, level_walk *w)
+{
+	w->clip = clip;
+	w->fast = clip->channel_count <= m->common.channel_count && eval_clip_ok(clip);
+	w->segs = m->walk_segs;
+	w->local = m->walk_local;
+	for (int i = 0; w->fast && i < clip->channel_count; i++)
+		w->segs[i].k = -1, w->segs[i].ready = 0;
+	mlod_pose_rest(m->s, w->local);
+}
+
+/* The clip as read at sample f (cached or posed into m->world0). */
+static const mlod_mat4 *orig_world(mlod_motion *m, int f)
+{
+	if (m->cache0)
+		return m->cache0 + (size_t)f * (size_t)m->s->joint_count;
+	pose_at(m, m->orig, m->st[f], m->world0);
+	return m->world0;
+}
+
+/* The level at sample f (samples in increasing order) into m->world. */
+static void walk_pose(mlod_motion *m, level_walk *w, int f)
+{
+	if (w->fast) {
+		/* Every sample sets the same paths: the rest of local stays rest. */
+		eval_sample(w->clip, w->segs, m->st[f], w->local);
+		eval_pose_world(m->s, w->local, m->world);
+	} else {
+		pose_at(m, w->clip, m->st[f], m->world);
+	}
+}
+
 /* Largest point error (mlod_motion_point_error) of a level clip over
  * every joint and every sample of the common timeline (frames and the
  * times between them), in scene units. It bounds the joint and End Site
- * position error. */
-static double level_error_upto(mlod_motion *m, const mlod_clip *clip, double stop);
-
+ * position error. A NaN error counts as the worst and ends the walk.
+ */
 static double level_max_error(mlod_motion *m, const mlod_clip *clip)
 {
-	return level_error_upto(m, clip, HUGE_VAL);
-}
-
-/* level_max_error, but it may stop early with any error above stop. */
-static double level_error_upto(mlod_motion *m, const mlod_clip *clip, double stop)
-{
+	level_walk w;
+	walk_begin(m, clip, &w);
 	double worst = 0.0;
 	for (int f = 0; f < m->samples; f++) {
-		float t = m->st[f];
-		const mlod_mat4 *w0 = m->world0;
-		if (m->cache0)
-			w0 = m->cache0 + (size_t)f * (size_t)m->s->joint_count;
-		else
-			pose_at(m, m->orig, t, m->world0);
-		pose_at(m, clip, t, m->world);
+		const mlod_mat4 *w0 = orig_world(m, f);
+		walk_pose(m, &w, f);
 		for (int j = 0; j < m->s->joint_count; j++) {
-			double e = mlod_motion_point_error(&m->world[j], &w0[j], m->radius[j]);
-			if (!(e <= worst))
+			double e = eval_error_over(&m->world[j], &w0[j], m->radius[j], worst);
+			if (e >= 0.0 && !(e <= worst))
+				worst = e;
+			else if (e != e)
 				worst = e; /* NaN counts as the worst */
 		}
-		if (!(worst <= stop))
+		if (!(worst <= HUGE_VAL))
 			break;
 	}
 	return worst;
+}
+
+/* A level's measures in one walk: *point_error gets level_max_error's
+ * value and *dev mlod_joint_deviation_at's at the same samples (the same
+ * sums in the same order, from the same world matrices: the level's from
+ * the same float operations, and the clip as read from its cache).
+ * Returns 0 when it could not (no cache, or a NaN error): the caller then
+ * measures as those functions do. */
+static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_error, mlod_deviation *dev)
+{
+	if (!m->cache0)
+		return 0;
+	const mlod_skeleton *s = m->s;
+	level_walk w;
+	walk_begin(m, clip, &w);
+	double worst = 0.0, sum = 0.0, max = 0.0;
+	long count = 0;
+	for (int f = 0; f < m->samples; f++) {
+		const mlod_mat4 *w0 = orig_world(m, f);
+		walk_pose(m, &w, f);
+		for (int j = 0; j < s->joint_count; j++) {
+			double e = eval_error_over(&m->world[j], &w0[j], m->radius[j], worst);
+			if (e >= 0.0 && !(e <= worst))
+				worst = e;
+			else if (e != e)
+				return 0;
+			for (int k = 0; k < 1 + (s->joints[j].has_end_site != 0); k++) {
+				mlod_v3 o = { 0, 0, 0 };
+				if (k == 1)
+					o = s->joints[j].end_site;
+				mlod_v3 x = mlod_mat4_point(&w0[j], o), y = mlod_mat4_point(&m->world[j], o);
+				double d = mlod_v3_length(mlod_v3_sub(x, y));
+				sum += d;
+				count++;
+				if (d > max)
+					max = d;
+			}
+		}
+	}
+	*point_error = worst;
+	memset(dev, 0, sizeof *dev);
+	dev->max = max;
+	dev->mean = count ? sum / (double)count : 0.0;
+	return 1;
+}
+
+/* Is level_max_error(m, clip) <= bound? It stops at the first error
+ * above. */
+static int level_within(mlod_motion *m, const mlod_clip *clip, double bound)
+{
+	level_walk w;
+	walk_begin(m, clip, &w);
+	int ok = 1;
+	for (int f = 0; f < m->samples && ok; f++) {
+		const mlod_mat4 *w0 = orig_world(m, f);
+		walk_pose(m, &w, f);
+		for (int j = 0; j < m->s->joint_count && ok; j++)
+			ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
+	}
+	return ok;
+}
+
+
+/* level_within over samples lo..hi only. */
+static int level_within_range(mlod_motion *m, const mlod_clip *clip, double bound, int lo, int hi)
+{
+	level_walk w;
+	walk_begin(m, clip, &w);
+	int ok = 1;
+	for (int f = lo; f <= hi && ok; f++) {
+		const mlod_mat4 *w0 = orig_world(m, f);
+		walk_pose(m, &w, f);
+		for (int j = 0; j < m->s->joint_count && ok; j++)
+			ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
+	}
+	return ok;
+}
+
+/* level_within for the clip c of line l (clip_from_line), through the
+ * segment memo: every channel of c is keyed at the line's frames (or
+ * constant), so its pose at the samples from frame p up to the next frame
+ * q of the line (the last sample too when q is the last frame) depends on
+ * p and q alone. The bisection on the threshold tries lines that share
+ * most of their segments. The memo holds one bound: frames_level clears
+ * it. */
+static int line_within(mlod_motion *m, const line *l, const mlod_clip *c, double bound)
+{
+	int usable = m->sub > 0 && c->duration >= m->common.channels[0].times[m->frames - 1] && l->n >= 2 &&
+	             l->v[0].frame == 0 && l->v[l->n - 1].frame == m->frames - 1;
+	for (int k = 0; usable && k < l->n; k++)
+		usable = l->v[k].frame >= 0 && (k == 0 || l->v[k].frame > l->v[k - 1].frame);
+	if (!usable)
+		return level_within(m, c, bound);
+	for (int k = 0; k + 1 < l->n; k++) {
+		int p = l->v[k].frame, q = l->v[k + 1].frame;
+		double v;
+		if (memo_get(m->segmemo, p, q, -3, &v)) {
+			if (v == 0.0)
+				return 0;
+			continue;
+		}
+		int hi = q == m->frames - 1 ? m->samples - 1 : q * m->sub - 1;
+		int ok = level_within_range(m, c, bound, p * m->sub, hi);
+		memo_put(m->segmemo, p, q, -3, ok);
+		if (!ok)
+			return 0;
+	}
+	return 1;
 }
 
 void mlod_motion_level_free(mlod_motion_level *l)
@@ -590,6 +837,7 @@ static double removal_bound(const mlod_motion *m, double bound)
 #define SHORTS(m) ((m)->opt.precision == MLOD_MOTION_PRECISION_AUTO)
 #define GRID_RANGE 48     /* grids tried: from 2^48 times finer than the bound up to it */
 #define CHANNEL_COARSER 8 /* per channel, up to this many doublings beyond the level's grid */
+#define REFINE_STRIDE 8
 
 /* v rounded to the nearest multiple of 2^e. */
 static float grid_round(float v, int e)
@@ -732,7 +980,7 @@ static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int
 {
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
-	return level_error_upto(m, clip, bound) <= bound;
+	return level_within(m, clip, bound);
 }
 
 /* Per-channel refinement: each channel in turn goes to coarser grids
@@ -747,24 +995,39 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	const mlod_skeleton *s = m->s;
 	int F = m->samples, J = s->joint_count, n = clip->channel_count;
 	size_t FJ = (size_t)F * (size_t)J;
-	mlod_trs *L = malloc(sizeof *L * FJ);
-	mlod_mat4 *W = malloc(sizeof *W * FJ), *w = malloc(sizeof *w * (size_t)J);
-	int *sub = malloc(sizeof(int) * (size_t)J);
+	mlod_trs *L = malloc(sizeof *L * FJ), *Lj = malloc(sizeof *Lj * (size_t)F);
+	mlod_mat4 *W = malloc(sizeof *W * FJ), *T = malloc(sizeof *T * FJ);
+	mlod_mat4 *LM = malloc(sizeof *LM * FJ), *LMj = malloc(sizeof *LMj * (size_t)F);
+	int *sub = malloc(sizeof(int) * (size_t)J), *pos = malloc(sizeof(int) * (size_t)J);
 	const float *times = m->st;
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
-	if (!L || !W || !w || !sub) {
-		free(L), free(W), free(w), free(sub);
+	if (!L || !Lj || !W || !T || !LM || !LMj || !sub || !pos) {
+		free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
 		return -1;
 	}
+	level_walk walk;
+	walk_begin(m, clip, &walk);
 	for (int f = 0; f < F; f++) {
-		mlod_pose_rest(s, L + (size_t)f * (size_t)J);
-		mlod_clip_sample(clip, times[f], L + (size_t)f * (size_t)J);
-		mlod_pose_world(s, L + (size_t)f * (size_t)J, W + (size_t)f * (size_t)J);
+		mlod_trs *lf = L + (size_t)f * (size_t)J;
+		if (walk.fast) {
+			eval_sample(clip, walk.segs, times[f], walk.local);
+			memcpy(lf, walk.local, sizeof *lf * (size_t)J);
+			eval_pose_world(s, lf, W + (size_t)f * (size_t)J);
+		} else {
+			mlod_pose_rest(s, lf);
+			mlod_clip_sample(clip, times[f], lf);
+			mlod_pose_world(s, lf, W + (size_t)f * (size_t)J);
+		}
+		for (int j = 0; j < J; j++)
+			LM[(size_t)f * (size_t)J + (size_t)j] = eval_from_trs(&lf[j]);
 	}
+	/* Samples every REFINE_STRIDE-th first (they are independent, and a
+	 * try that fails usually fails sooner), then the others in order. */
+	const int stride = F >= 4 * REFINE_STRIDE ? REFINE_STRIDE : 1;
 	for (int i = 0; i < n; i++) {
 		mlod_channel *ch = &clip->channels[i];
-		int j = ch->joint, ns = 0;
+		int j = ch->joint, ns = 0, fast = ch->interp != MLOD_INTERP_CUBICSPLINE;
 		if (ch->key_count < 3)
 			continue; /* its first and last keys stay exact: nothing to round */
 		for (int d = j; d < J; d++) { /* j and its descendants, parents first */
@@ -772,29 +1035,49 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 			while (a > j)
 				a = s->joints[a].parent;
 			if (a == j)
-				sub[ns++] = d;
+				pos[d] = ns, sub[ns++] = d;
 		}
 		while (adj[i] < CHANNEL_COARSER) {
 			adj[i]++;
 			channel_exps(m, src, g, adj, e);
 			round_channel(&src->channels[i], ch, e[i], SHORTS(m));
+			/* The try's local transform of j and world matrices of its
+			 * subtree go to Lj, LMj and T (ns per sample); kept if it fits. */
 			int ok = 1;
-			for (int pass = 0; pass < 2 && ok; pass++) /* check, then commit */
-				for (int f = 0; f < F && ok; f++) {
+			eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+			/* Every stride-th sample first, then the rest in order. */
+			for (int pass = stride > 1 ? 0 : 1; pass < 2 && ok; pass++)
+				for (int f = 0; f < F && ok; f += pass ? 1 : stride) {
+					if (pass == 1 && stride > 1 && f % stride == 0)
+						continue;
 					mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
-					mlod_mat4 *wf = W + (size_t)f * (size_t)J;
+					const mlod_mat4 *wf = W + (size_t)f * (size_t)J, *lmf = LM + (size_t)f * (size_t)J;
+					mlod_mat4 *w = T + (size_t)f * (size_t)ns;
 					const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J;
-					mlod_channel_sample(ch, clip->duration, times[f], &l);
+					if (fast) {
+						float t = times[f], v[4];
+						if (!(t > 0.0f))
+							t = 0.0f;
+						if (t > clip->duration)
+							t = clip->duration;
+						eval_channel(ch, &seg, t, v);
+						switch (ch->path) {
+						case MLOD_PATH_TRANSLATION: l.t.x = v[0], l.t.y = v[1], l.t.z = v[2]; break;
+						case MLOD_PATH_SCALE: l.s.x = v[0], l.s.y = v[1], l.s.z = v[2]; break;
+						case MLOD_PATH_ROTATION: l.r = eval_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+						}
+					} else {
+						mlod_channel_sample(ch, clip->duration, times[f], &l);
+					}
+					Lj[f] = l;
+					LMj[f] = eval_from_trs(&l);
 					for (int k = 0; k < ns && ok; k++) {
 						int d = sub[k], p = s->joints[d].parent;
-						mlod_mat4 lm = mlod_mat4_from_trs(d == j ? &l : &lf[d]);
-						w[d] = mlod_mat4_mul(p < 0 ? &s->joints[d].base : d == j ? &wf[p] : &w[p], &lm);
-						ok = mlod_motion_point_error(&w[d], &w0[d], m->radius[d]) <= bound;
-					}
-					if (pass == 1) {
-						lf[j] = l;
-						for (int k = 0; k < ns; k++)
-							wf[sub[k]] = w[sub[k]];
+						const mlod_mat4 *lm = d == j ? &LMj[f] : &lmf[d];
+						/* Below j, the parent is in the subtree, before d. */
+						const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
+						w[k] = p < 0 ? mlod_mat4_mul(&s->joints[d].base, lm) : eval_mul_affine(pw, lm);
+						ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
 					}
 				}
 			if (!ok) {
@@ -803,9 +1086,16 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 				round_channel(&src->channels[i], ch, e[i], SHORTS(m));
 				break;
 			}
+			for (int f = 0; f < F; f++) {
+				mlod_mat4 *wf = W + (size_t)f * (size_t)J;
+				L[(size_t)f * (size_t)J + (size_t)j] = Lj[f];
+				LM[(size_t)f * (size_t)J + (size_t)j] = LMj[f];
+				for (int k = 0; k < ns; k++)
+					wf[sub[k]] = T[(size_t)f * (size_t)ns + (size_t)k];
+			}
 		}
 	}
-	free(L), free(W), free(w), free(sub);
+	free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
 	return 0;
 }
 
@@ -813,11 +1103,19 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
  * error within bound: first one level grid (bisection on its exponent),
  * then each channel coarser while the bound holds. Sets *grid to the
  * level grid (0 when nothing was rounded). Returns -1 when out of memory. */
-static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *grid)
+typedef struct level_meas {
+	int valid;            /* the level as it now is was measured */
+	double point_error;
+	mlod_deviation dev;
+} level_meas;
+
+static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *grid, double known, level_meas *meas)
 {
 	int n = clip->channel_count;
 	*grid = 0.0;
-	if (!(bound > 0.0) || !isfinite(bound) || !(level_max_error(m, clip) <= bound))
+	meas->valid = 0;
+	/* known: the clip's level_max_error when the caller measured it, or < 0. */
+	if (!(bound > 0.0) || !isfinite(bound) || !(known >= 0.0 ? known <= bound : level_within(m, clip, bound)))
 		return 0;
 	mlod_clip src;
 	memset(&src, 0, sizeof src);
@@ -848,7 +1146,11 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 		 * leaves first); the result is measured again as a whole. */
 		if (m->cache0 && refine_channels(m, &src, clip, lo, adj, e, bound) != 0)
 			bad = 1;
-		if (!round_fits(m, &src, clip, lo, adj, e, bound)) {
+		/* round_fits, measuring the level at the same time. */
+		channel_exps(m, &src, lo, adj, e);
+		round_clip(&src, clip, e, SHORTS(m));
+		meas->valid = level_measure(m, clip, &meas->point_error, &meas->dev) && meas->point_error <= bound;
+		if (!meas->valid && !level_within(m, clip, bound)) {
 			memset(adj, 0, sizeof(int) * (size_t)n); /* fitted in the bisection */
 			round_fits(m, &src, clip, lo, adj, e, bound);
 		}
@@ -864,17 +1166,41 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
  * it, after rounding its values within bound (< 0: a level chosen by
  * threshold or fraction, whose error e may grow to e / (1 - share), the
  * share a bound leaves to rounding). */
-static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double bound, mlod_error *err)
+static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double bound, long max_bytes, double known,
+                                mlod_error *err)
 {
-	if (m->opt.precision != MLOD_MOTION_PRECISION_FULL) {
-		if (bound < 0.0)
-			bound = level_max_error(m, &out->clip) / removal_bound(m, 1.0);
-		if (level_round(m, &out->clip, bound, &out->grid) != 0)
-			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-	}
-	out->point_error = level_max_error(m, &out->clip);
+	level_meas meas = { 0, 0.0, { 0.0, 0.0, 0.0 } };
 	out->keys = mlod_clip_key_count(&out->clip);
 	out->bytes = mlod_clip_key_bytes(&out->clip);
+	if (max_bytes >= 0) {
+		/* Rounding keeps the keys; at most, auto precision stores every
+		 * rotation as shorts (8 bytes a key instead of 16). */
+		long least = out->bytes;
+		for (int i = 0; SHORTS(m) && i < out->clip.channel_count; i++) {
+			const mlod_channel *ch = &out->clip.channels[i];
+			if (ch->path == MLOD_PATH_ROTATION && ch->interp != MLOD_INTERP_CUBICSPLINE && !ch->short_values)
+				least -= 8L * ch->key_count;
+		}
+		if (least > max_bytes) {
+			out->bytes = least;
+			out->unfinished = 1;
+			return MLOD_OK;
+		}
+	}
+	if (m->opt.precision != MLOD_MOTION_PRECISION_FULL) {
+		if (bound < 0.0)
+			bound = (known >= 0.0 ? known : level_max_error(m, &out->clip)) / removal_bound(m, 1.0);
+		if (level_round(m, &out->clip, bound, &out->grid, known, &meas) != 0)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	out->keys = mlod_clip_key_count(&out->clip);
+	out->bytes = mlod_clip_key_bytes(&out->clip);
+	if (meas.valid || level_measure(m, &out->clip, &meas.point_error, &meas.dev)) {
+		out->point_error = meas.point_error;
+		out->error = meas.dev;
+		return MLOD_OK;
+	}
+	out->point_error = level_max_error(m, &out->clip);
 	mlod_character a, b;
 	memset(&a, 0, sizeof a);
 	a.skeleton = m->s[0];
@@ -917,9 +1243,37 @@ static int pinned(const mlod_motion *m, const fnode *nd)
 	return nd->frame == 0 || nd->frame == m->frames - 1;
 }
 
+/* node_distance through the memo when both nodes are frames. */
+static double frame_distance(const mlod_motion *m, const fnode *a, const fnode *b)
+{
+	double d;
+	if (a->frame < 0 || b->frame < 0)
+		return node_distance(m, a, b);
+	if (memo_get(m->memo, a->frame, b->frame, -1, &d))
+		return d;
+	d = node_distance(m, a, b);
+	memo_put(m->memo, a->frame, b->frame, -1, d);
+	return d;
+}
+
+static double residual_of(const mlod_motion *m, const fnode *p, const fnode *x, const fnode *q);
+
 /* How badly interpolating p and q reproduces x: the frame distance from x
  * to the interpolated frame, or -1 when out of memory. */
 static double residual(const mlod_motion *m, const fnode *p, const fnode *x, const fnode *q)
+{
+	double d;
+	if (p->frame < 0 || x->frame < 0 || q->frame < 0)
+		return residual_of(m, p, x, q);
+	if (memo_get(m->memo, p->frame, x->frame, q->frame, &d))
+		return d;
+	d = residual_of(m, p, x, q);
+	if (d >= 0.0)
+		memo_put(m->memo, p->frame, x->frame, q->frame, d);
+	return d;
+}
+
+static double residual_of(const mlod_motion *m, const fnode *p, const fnode *x, const fnode *q)
 {
 	fnode tmp;
 	tmp.values = malloc(sizeof(float) * (size_t)(m->value_count + 3 * m->rot_count + 1));
@@ -1008,15 +1362,22 @@ static int tree_pass(const mlod_motion *m, line *in, double T, line *out, int st
 {
 	out->v = calloc((size_t)(in->n > 0 ? in->n : 1), sizeof *out->v);
 	out->n = 0;
-	if (!out->v)
+	/* in's frames moved to out (steal): they still serve as neighbours
+	 * below, with their frame numbers (the memo's keys). */
+	unsigned char *moved = steal ? calloc((size_t)(in->n > 0 ? in->n : 1), 1) : NULL;
+	if (!out->v || (steal && !moved)) {
+		free(moved);
 		return -1;
+	}
 	int fused = 0;
 	for (int i = 0; i < in->n;) {
 		fnode *o = &out->v[out->n];
 		if (i + 1 < in->n && !(pinned(m, &in->v[i]) && pinned(m, &in->v[i + 1])) &&
-		    node_distance(m, &in->v[i], &in->v[i + 1]) < T) {
-			if (fuse(m, in, i, o) != 0)
+		    frame_distance(m, &in->v[i], &in->v[i + 1]) < T) {
+			if (fuse(m, in, i, o) != 0) {
+				free(moved);
 				return -1;
+			}
 			out->n++;
 			fused++;
 			i += 2;
@@ -1025,7 +1386,7 @@ static int tree_pass(const mlod_motion *m, line *in, double T, line *out, int st
 			*o = in->v[i];
 			if (steal) {
 				/* in->v[i] still serves as a neighbour below: forget it after the pass. */
-				in->v[i].frame = -2;
+				moved[i] = 1;
 			} else {
 				o->values = malloc(size);
 				if (!o->values)
@@ -1037,8 +1398,9 @@ static int tree_pass(const mlod_motion *m, line *in, double T, line *out, int st
 		}
 	}
 	for (int i = 0; steal && i < in->n; i++)
-		if (in->v[i].frame == -2)
+		if (moved[i])
 			in->v[i].values = NULL; /* now owned by out */
+	free(moved);
 	return fused;
 }
 
@@ -1086,12 +1448,14 @@ static long line_keys(const mlod_motion *m, const line *l)
 }
 
 /* The frames method: the next line of the tree. */
-static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
-                                mlod_error *err)
+static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
+                                mlod_motion_level *out, mlod_error *err)
 {
 	line best = { 0, NULL };
 	double T = 0.0;
 	const char *name = m->orig->name ? m->orig->name : "";
+	free(m->segmemo->slot);
+	memset(m->segmemo, 0, sizeof *m->segmemo);
 	if (target == MLOD_MOTION_THRESHOLD) {
 		T = value;
 		if (tree_level(m, &m->tree, T, &best) != 0)
@@ -1116,7 +1480,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 					line_free(&best);
 					return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 				}
-				ok = level_max_error(m, &c) <= removal_bound(m, value);
+				ok = line_within(m, &l, &c, removal_bound(m, value));
 				mlod_clip_free(&c);
 			}
 			if (target == MLOD_MOTION_FRACTION) {
@@ -1179,7 +1543,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 	}
 	line_free(&m->tree);
 	m->tree = best;
-	mlod_result r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, err);
+	mlod_result r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, -1.0, err);
 	if (r != MLOD_OK)
 		mlod_motion_level_free(out);
 	return r;
@@ -1201,18 +1565,22 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	size_t size = (size_t)m->common.channel_count * (size_t)m->frames;
 	memcpy(kept, m->kept, size);
 	memset(clip, 0, sizeof *clip);
-	if (mlod_keyreduce(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, err) != MLOD_OK)
+	double e = -1.0;
+	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, err) !=
+	    MLOD_OK)
 		return -1.0;
 	if (clip_from_kept(m, kept, clip) != 0) {
 		mlod_clip_free(clip);
 		mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		return -1.0;
 	}
-	return level_max_error(m, clip);
+	/* keyreduce measured the clip as level_max_error does, unless it
+	 * could not. */
+	return e >= 0.0 && m->clip_end_ok ? e : level_max_error(m, clip);
 }
 
-static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
-                              mlod_error *err)
+static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
+                              mlod_motion_level *out, mlod_error *err)
 {
 	const char *name = m->orig->name ? m->orig->name : "";
 	if (target == MLOD_MOTION_THRESHOLD)
@@ -1220,7 +1588,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 	size_t size = (size_t)m->common.channel_count * (size_t)m->frames;
 	unsigned char *kept = malloc(size), *best = malloc(size);
 	mlod_clip clip, best_clip;
-	double best_budget = -1.0;
+	double best_budget = -1.0, best_error = -1.0; /* best_clip's level_max_error */
 	memset(&best_clip, 0, sizeof best_clip);
 	mlod_result r = MLOD_OK;
 	if (!kept || !best) {
@@ -1242,6 +1610,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 				memcpy(best, kept, size);
 				best_clip = clip;
 				best_budget = budget;
+				best_error = e;
 			} else {
 				mlod_clip_free(&clip);
 			}
@@ -1268,6 +1637,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 			memcpy(best, kept, size);
 			best_clip = clip;
 			best_budget = hi;
+			best_error = e;
 			if (keys <= target_keys)
 				break;
 			lo = hi;
@@ -1286,6 +1656,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 				memcpy(best, kept, size);
 				best_clip = clip;
 				best_budget = mid;
+				best_error = e;
 				hi = mid;
 			} else {
 				mlod_clip_free(&clip);
@@ -1305,7 +1676,7 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 	out->clip = best_clip;
 	free(m->kept);
 	m->kept = best;
-	r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, err);
+	r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, best_error, err);
 	if (r != MLOD_OK)
 		mlod_motion_level_free(out);
 	return r;
@@ -1313,6 +1684,12 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 
 mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                    double value, mlod_motion_level *out, mlod_error *err)
+{
+	return mlod_motion_next_level_under(m, method, target, value, -1, out, err);
+}
+
+mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
+                                         double value, long max_bytes, mlod_motion_level *out, mlod_error *err)
 {
 	if (!m || !out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_next_level: NULL argument");
@@ -1322,8 +1699,8 @@ mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, ml
 	if ((unsigned)target > MLOD_MOTION_MAX_ERROR)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad level target %d", (int)target);
 	switch (method) {
-	case MLOD_MOTION_FRAMES: return frames_level(m, target, value, out, err);
-	case MLOD_MOTION_KEYS: return keys_level(m, target, value, out, err);
+	case MLOD_MOTION_FRAMES: return frames_level(m, target, value, max_bytes, out, err);
+	case MLOD_MOTION_KEYS: return keys_level(m, target, value, max_bytes, out, err);
 	}
 	return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad method %d", (int)method);
 }

@@ -1,6 +1,7 @@
 /* test_motion.c: the motion layer: common timelines, frame distance, the
  * multiresolution motion tree and per-channel key reduction. */
 #include "test.h"
+#include "motion/motion_eval.h"
 
 #define PI_F 3.14159265358979323846f
 
@@ -967,6 +968,130 @@ TEST(precision_rounds_within_own_error)
 	mlod_character_free(&c);
 }
 
+/* motion_eval.h's fast forms give the library's answers: the point error
+ * checks accept and reject as the exact error does (random matrix pairs,
+ * limits at, just above and just below the error), the float bound is
+ * never below it, and the affine product, the local matrix and the
+ * cursor sampling are bit for bit the library's. */
+static unsigned long long rng_state = 88172645463325252ull;
+static double urand(void)
+{
+	rng_state ^= rng_state << 13, rng_state ^= rng_state >> 7, rng_state ^= rng_state << 17;
+	return (double)(rng_state >> 11) / 9007199254740992.0;
+}
+
+static mlod_trs random_trs(int scaled)
+{
+	mlod_trs l = mlod_trs_identity();
+	mlod_v3 axis = { (float)(urand() - 0.5), (float)(urand() - 0.5), (float)(urand() - 0.5) };
+	l.r = mlod_quat_axis_angle(axis, (float)(urand() * 6.0 - 3.0));
+	l.t = (mlod_v3){ (float)(urand() * 100 - 50), (float)(urand() * 100 - 50), (float)(urand() * 100 - 50) };
+	if (scaled)
+		l.s = (mlod_v3){ (float)(0.5 + urand() * 1.5), (float)(0.5 + urand() * 1.5), (float)(0.5 + urand() * 1.5) };
+	return l;
+}
+
+TEST(fast_checks_match_exact)
+{
+	long wrong_within = 0, wrong_over = 0, low_bound = 0, pairs = 0;
+	for (int i = 0; i < 200000; i++) {
+		mlod_trs a = random_trs(i % 4 == 0), b = a;
+		double size = i % 3 == 0 ? 1e-6 : i % 3 == 1 ? 1e-3 : 0.1;
+		if (i % 7) {
+			mlod_v3 axis = { (float)(urand() - 0.5), (float)(urand() - 0.5), (float)(urand() - 0.5) };
+			b.r = mlod_quat_normalize(mlod_quat_mul(a.r, mlod_quat_axis_angle(axis, (float)(urand() * size))));
+			b.t.x += (float)((urand() - 0.5) * size);
+			b.t.z += (float)((urand() - 0.5) * size);
+		}
+		mlod_mat4 parent = mlod_mat4_from_trs(&(mlod_trs){ random_trs(0).t, random_trs(0).r, { 1, 1, 1 } });
+		mlod_mat4 la = mlod_mat4_from_trs(&a), lb = mlod_mat4_from_trs(&b);
+		mlod_mat4 w0 = mlod_mat4_mul(&parent, &la), w = mlod_mat4_mul(&parent, &lb);
+		double r = urand() * 3.0, e = mlod_motion_point_error(&w, &w0, r);
+		if (eval_error_bound(&w, &w0, r) < e)
+			low_bound++;
+		double limits[7] = { e, nextafter(e, HUGE_VAL), nextafter(e, -HUGE_VAL), e * (1 + 1e-7), e * (1 - 1e-7),
+		                     e * 2.0, urand() * 0.2 };
+		for (int k = 0; k < 7; k++) {
+			int exact = e <= limits[k];
+			pairs++;
+			if (eval_within(&w, &w0, r, limits[k]) != exact)
+				wrong_within++;
+			double o = eval_error_over(&w, &w0, r, limits[k]);
+			if (o < 0.0 ? !exact : memcmp(&o, &e, sizeof o) != 0)
+				wrong_over++;
+		}
+	}
+	CHECK_MSG(low_bound == 0, "float bound below the exact error %ld times", low_bound);
+	CHECK_MSG(wrong_within == 0, "eval_within differs from the exact check %ld times in %ld", wrong_within, pairs);
+	CHECK_MSG(wrong_over == 0, "eval_error_over differs from the exact error %ld times in %ld", wrong_over, pairs);
+
+	long wrong_mul = 0, wrong_trs = 0;
+	for (int i = 0; i < 100000; i++) {
+		mlod_trs pa = random_trs(i % 2), lo = random_trs(i % 3 == 0);
+		mlod_mat4 p = mlod_mat4_from_trs(&pa), l = mlod_mat4_from_trs(&lo), l2 = eval_from_trs(&lo);
+		if (memcmp(&l, &l2, sizeof l) != 0)
+			wrong_trs++;
+		mlod_mat4 x = mlod_mat4_mul(&p, &l), y = eval_mul_affine(&p, &l);
+		for (int c = 0; c < 4; c++)
+			for (int row = 0; row < 3; row++)
+				if (!(x.m[c * 4 + row] == y.m[c * 4 + row]))
+					wrong_mul++;
+	}
+	CHECK_MSG(wrong_trs == 0, "eval_from_trs differs from mlod_mat4_from_trs %ld times", wrong_trs);
+	long wrong_norm = 0;
+	for (int i = 0; i < 100000; i++) {
+		double k = i % 3 == 0 ? 1.0 : i % 3 == 1 ? 1e-3 : 37.0;
+		mlod_quat q = { (float)((urand() - 0.5) * k), (float)((urand() - 0.5) * k), (float)((urand() - 0.5) * k),
+		                (float)((urand() - 0.5) * k) };
+		mlod_quat a = mlod_quat_normalize(q), b = eval_normalize(q);
+		if (memcmp(&a, &b, sizeof a) != 0)
+			wrong_norm++;
+	}
+	CHECK_MSG(wrong_norm == 0, "eval_normalize differs from mlod_quat_normalize %ld times", wrong_norm);
+	CHECK_MSG(wrong_mul == 0, "eval_mul_affine differs from mlod_mat4_mul in %ld entries", wrong_mul);
+
+	/* Cursor sampling: a chain clip with random keys, LINEAR and STEP,
+	 * rotations and a translation, at increasing times (key times, times
+	 * between, outside the clip) and a few jumps back. */
+	mlod_character c = make_chain(5, 40);
+	mlod_clip *clip = &c.clips[0];
+	for (int j = 0; j < 5; j++)
+		for (int f = 0; f < 40; f++)
+			set_rot(&clip->channels[j], f, random_trs(0).r);
+	clip->channels[3].interp = MLOD_INTERP_STEP;
+	mlod_channel *t = &clip->channels[1];
+	t->path = MLOD_PATH_TRANSLATION;
+	for (int f = 0; f < 40; f++)
+		for (int k = 0; k < 3; k++)
+			t->values[3 * f + k] = (float)(urand() * 4 - 2);
+	eval_seg segs[5];
+	for (int j = 0; j < 5; j++)
+		segs[j].k = -1, segs[j].ready = 0;
+	mlod_trs *l1 = malloc(sizeof *l1 * 5), *l2 = malloc(sizeof *l2 * 5);
+	mlod_pose_rest(&c.skeleton, l2);
+	long wrong_sample = 0;
+	float time = -0.1f;
+	for (int i = 0; i < 3000; i++) {
+		if (i % 5 == 0)
+			time = clip->channels[0].times[(i / 5) % 40]; /* on a key */
+		else if (i % 97 == 0)
+			time -= 0.3f; /* back */
+		else
+			time += (float)(urand() * 0.01);
+		if (time > clip->duration + 0.2f)
+			time = -0.05f;
+		mlod_pose_rest(&c.skeleton, l1);
+		mlod_clip_sample(clip, time, l1);
+		eval_sample(clip, segs, time, l2);
+		if (memcmp(l1, l2, sizeof *l1 * 5) != 0)
+			wrong_sample++;
+	}
+	CHECK_MSG(wrong_sample == 0, "eval_sample differs from mlod_clip_sample %ld times", wrong_sample);
+	free(l1);
+	free(l2);
+	mlod_character_free(&c);
+}
+
 int main(void)
 {
 	RUN(levels_within_bounds_cmu);
@@ -990,5 +1115,6 @@ int main(void)
 	RUN(precision_float_and_full);
 	RUN(precision_auto_shorts);
 	RUN(precision_rounds_within_own_error);
+	RUN(fast_checks_match_exact);
 	TEST_EXIT();
 }

@@ -1,0 +1,344 @@
+/*
+ * motion_eval.h: internal to lib/motion. Fast forms of the sampling,
+ * forward kinematics and point error the motion layer measures with, each
+ * giving bit for bit the result of the library function it stands for
+ * (mlod_clip_sample, mlod_mat4_mul on an affine local matrix,
+ * mlod_motion_point_error compared with a limit), so the levels and their
+ * errors are the same as with the plain functions, only faster.
+ *
+ * - Sampling walks increasing times with a cursor per channel instead of
+ *   a binary search, and keeps per segment what mlod_quat_slerp computes
+ *   from the two keys alone (the normalised keys, their angle and its
+ *   sine); per sample it then does the rest of mlod_quat_slerp's
+ *   operations, in its order.
+ * - A local matrix from mlod_mat4_from_trs has the last row (0, 0, 0, 1),
+ *   so in parent * local the terms mlod_mat4_mul adds for it are exact
+ *   zeros (or the parent's translation times 1): they are left out.
+ * - sigma_max(A) <= |A|_F: a joint whose origin error plus radius times
+ *   the Frobenius norm (with a margin far above rounding) is within the
+ *   limit is within it; only the others take the exact sigma_max.
+ */
+#ifndef MLOD_MOTION_EVAL_H
+#define MLOD_MOTION_EVAL_H
+
+#include <math.h>
+#include <string.h>
+
+#include "motion/mlod_motion.h"
+
+/* Margin on the Frobenius bound: the computed sigma_max is the exact one
+ * times (1 + 1e-9) plus rounding far below 1e-12 relative. */
+#define EVAL_FROB_MARGIN (1.0 + 1e-6)
+
+/* parent * local, local affine with last row (0, 0, 0, 1) as
+ * mlod_mat4_from_trs makes it: rows 0 to 2 as mlod_mat4_mul computes
+ * them (same products, same order of the sums, lane by lane when GCC's
+ * vector extension computes a column at once); the last row (0, 0, 0, 1). */
+#if defined(__GNUC__)
+typedef float eval_v4 __attribute__((vector_size(16)));
+#endif
+
+static inline mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
+{
+	mlod_mat4 r;
+#if defined(__GNUC__)
+	eval_v4 a0, a1, a2, a3;
+	memcpy(&a0, a->m, sizeof a0);
+	memcpy(&a1, a->m + 4, sizeof a1);
+	memcpy(&a2, a->m + 8, sizeof a2);
+	memcpy(&a3, a->m + 12, sizeof a3);
+	for (int c = 0; c < 4; c++) {
+		eval_v4 s = a0 * b->m[c * 4];
+		s = s + a1 * b->m[c * 4 + 1];
+		s = s + a2 * b->m[c * 4 + 2];
+		if (c == 3)
+			s = s + a3;
+		memcpy(r.m + c * 4, &s, sizeof s);
+	}
+#else
+	for (int c = 0; c < 4; c++) {
+		const float b0 = b->m[c * 4], b1 = b->m[c * 4 + 1], b2 = b->m[c * 4 + 2];
+		for (int row = 0; row < 3; row++) {
+			float s = a->m[row] * b0;
+			s += a->m[4 + row] * b1;
+			s += a->m[8 + row] * b2;
+			if (c == 3)
+				s += a->m[12 + row];
+			r.m[c * 4 + row] = s;
+		}
+	}
+#endif
+	r.m[3] = r.m[7] = r.m[11] = 0.0f;
+	r.m[15] = 1.0f;
+	return r;
+}
+
+/* mlod_mat4_from_trs, the same operations, inline. */
+static inline mlod_mat4 eval_from_trs(const mlod_trs *trs)
+{
+	double x = trs->r.x, y = trs->r.y, z = trs->r.z, w = trs->r.w;
+	double n = x * x + y * y + z * z + w * w;
+	double s = n > 0.0 ? 2.0 / n : 0.0;
+	double r[3][3];
+	r[0][0] = 1 - s * (y * y + z * z); r[0][1] = s * (x * y - w * z);     r[0][2] = s * (x * z + w * y);
+	r[1][0] = s * (x * y + w * z);     r[1][1] = 1 - s * (x * x + z * z); r[1][2] = s * (y * z - w * x);
+	r[2][0] = s * (x * z - w * y);     r[2][1] = s * (y * z + w * x);     r[2][2] = 1 - s * (x * x + y * y);
+	const float sc[3] = { trs->s.x, trs->s.y, trs->s.z };
+	mlod_mat4 m;
+	for (int c = 0; c < 3; c++) {
+		for (int row = 0; row < 3; row++)
+			m.m[c * 4 + row] = (float)(r[row][c] * sc[c]);
+		m.m[c * 4 + 3] = 0.0f;
+	}
+	m.m[12] = trs->t.x;
+	m.m[13] = trs->t.y;
+	m.m[14] = trs->t.z;
+	m.m[15] = 1.0f;
+	return m;
+}
+
+/* An upper bound of mlod_motion_point_error(w, w0, radius) from float
+ * arithmetic: each difference of two floats is their exact difference
+ * within a relative 2^-24, the sums of squares and square roots add a few
+ * more such roundings, and underflowed squares lose less than 1e-18 in
+ * the roots: the factor 1 + 1e-5 and that absolute term cover them (and
+ * sigma_max <= Frobenius norm). Lane 3 of each column (the last row) only
+ * adds. Inf or NaN when the matrices hold them. */
+static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, double radius)
+{
+#if defined(__GNUC__)
+	eval_v4 d[4];
+	for (int c = 0; c < 4; c++) {
+		eval_v4 x, y;
+		memcpy(&x, w->m + 4 * c, sizeof x);
+		memcpy(&y, w0->m + 4 * c, sizeof y);
+		d[c] = x - y;
+	}
+	eval_v4 f = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], t = d[3] * d[3];
+	float frob = (f[0] + f[1]) + (f[2] + f[3]), dp2 = (t[0] + t[1]) + (t[2] + t[3]);
+#else
+	float frob = 0.0f, dp2 = 0.0f;
+	for (int i = 0; i < 16; i++) {
+		float x = w->m[i] - w0->m[i];
+		if (i < 12)
+			frob += x * x;
+		else
+			dp2 += x * x;
+	}
+#endif
+	return ((double)sqrtf(dp2) + radius * (double)sqrtf(frob)) * (1.0 + 1e-5) + 1e-18 * (1.0 + radius);
+}
+
+/* Is mlod_motion_point_error(w, w0, radius) <= limit? Exactly that
+ * answer; the exact error is computed only when the bounds cannot tell. */
+static inline int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
+{
+	if (eval_error_bound(w, w0, radius) <= limit)
+		return 1;
+	double dx = (double)w->m[12] - w0->m[12], dy = (double)w->m[13] - w0->m[13], dz = (double)w->m[14] - w0->m[14];
+	double dp = sqrt(dx * dx + dy * dy + dz * dz), frob = 0.0;
+	for (int c = 0; c < 3; c++)
+		for (int r = 0; r < 3; r++) {
+			double a = (double)w->m[c * 4 + r] - w0->m[c * 4 + r];
+			frob += a * a;
+		}
+	if (dp + radius * (sqrt(frob) * EVAL_FROB_MARGIN) <= limit)
+		return 1;
+	return mlod_motion_point_error(w, w0, radius) <= limit;
+}
+
+/* mlod_motion_point_error(w, w0, radius), or -1 when a bound shows that
+ * it is at most limit. */
+static inline double eval_error_over(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
+{
+	if (eval_error_bound(w, w0, radius) <= limit)
+		return -1.0;
+	double dx = (double)w->m[12] - w0->m[12], dy = (double)w->m[13] - w0->m[13], dz = (double)w->m[14] - w0->m[14];
+	double dp = sqrt(dx * dx + dy * dy + dz * dz), frob = 0.0;
+	for (int c = 0; c < 3; c++)
+		for (int r = 0; r < 3; r++) {
+			double a = (double)w->m[c * 4 + r] - w0->m[c * 4 + r];
+			frob += a * a;
+		}
+	if (dp + radius * (sqrt(frob) * EVAL_FROB_MARGIN) <= limit)
+		return -1.0;
+	return mlod_motion_point_error(w, w0, radius);
+}
+
+/* Per channel: the segment a cursor is in and what slerp needs of it. */
+typedef struct eval_seg {
+	int k;               /* first key of the segment, -1: none yet */
+	int ready;           /* rotation data below filled for k */
+	int near;            /* |dot| > 0.9995: slerp blends linearly */
+	mlod_quat a, b;      /* the keys, normalised */
+	double sign, theta, s;
+} eval_seg;
+
+#if defined(__GNUC__)
+typedef double eval_v2d __attribute__((vector_size(16)));
+#endif
+
+/* (float)(x / n) ... for the four components: two lanes at a time where
+ * GCC's vector extension is there (each lane the same IEEE division). */
+static inline mlod_quat eval_div4(double x, double y, double z, double w, double n)
+{
+#if defined(__GNUC__)
+	eval_v2d a = { x, y }, b = { z, w }, d = { n, n };
+	a = a / d;
+	b = b / d;
+	mlod_quat r = { (float)a[0], (float)a[1], (float)b[0], (float)b[1] };
+#else
+	mlod_quat r = { (float)(x / n), (float)(y / n), (float)(z / n), (float)(w / n) };
+#endif
+	return r;
+}
+
+/* mlod_quat_normalize, the same operations, inline. */
+static inline mlod_quat eval_normalize(mlod_quat q)
+{
+	double n = sqrt((double)q.x * q.x + (double)q.y * q.y + (double)q.z * q.z + (double)q.w * q.w);
+	if (!(n > 0.0) || !isfinite(n))
+		return mlod_quat_identity();
+	return eval_div4(q.x, q.y, q.z, q.w, n);
+}
+
+static inline mlod_quat eval_blend(mlod_quat a, double wa, mlod_quat b, double wb)
+{
+	double x = wa * a.x + wb * b.x, y = wa * a.y + wb * b.y;
+	double z = wa * a.z + wb * b.z, w = wa * a.w + wb * b.w;
+	double n = sqrt(x * x + y * y + z * z + w * w);
+	if (!(n > 0.0))
+		return mlod_quat_identity();
+	return eval_div4(x, y, z, w, n);
+}
+
+/* mlod_quat_slerp(ka, kb, u) with the segment's keys ka, kb (float[4]). */
+static inline mlod_quat eval_slerp(eval_seg *sg, const float *ka, const float *kb, float u)
+{
+	if (!sg->ready) {
+		sg->a = mlod_quat_normalize((mlod_quat){ ka[0], ka[1], ka[2], ka[3] });
+		sg->b = mlod_quat_normalize((mlod_quat){ kb[0], kb[1], kb[2], kb[3] });
+		double d = (double)sg->a.x * sg->b.x + (double)sg->a.y * sg->b.y + (double)sg->a.z * sg->b.z +
+		           (double)sg->a.w * sg->b.w;
+		sg->sign = d < 0.0 ? -1.0 : 1.0;
+		d = fabs(d);
+		sg->near = d > 0.9995;
+		if (!sg->near) {
+			sg->theta = acos(d);
+			sg->s = sin(sg->theta);
+		}
+		sg->ready = 1;
+	}
+	if (sg->near)
+		return eval_blend(sg->a, 1.0 - u, sg->b, sg->sign * u);
+	return eval_blend(sg->a, sin((1.0 - u) * sg->theta) / sg->s, sg->b, sg->sign * sin(u * sg->theta) / sg->s);
+}
+
+/* The key k with times[k] <= t < times[k + 1] (times[0] < t < times[n - 1]),
+ * from the cursor's segment forward (or by bisection when t went back). */
+static inline int eval_find(const float *times, int n, int k, float t)
+{
+	if (k < 0 || k >= n - 1 || times[k] > t) {
+		int lo = 0, hi = n - 1;
+		while (hi - lo > 1) {
+			int mid = lo + (hi - lo) / 2;
+			if (times[mid] <= t)
+				lo = mid;
+			else
+				hi = mid;
+		}
+		return lo;
+	}
+	while (times[k + 1] <= t)
+		k++;
+	return k;
+}
+
+/* One channel (LINEAR or STEP) at t (already clamped as mlod_clip_sample
+ * clamps it) into out, comps floats, as mlod_clip_sample's sampling;
+ * rotations come out as the slerp (not yet normalised). */
+static inline void eval_channel(const mlod_channel *ch, eval_seg *sg, float t, float *out)
+{
+	const int n = ch->key_count, comps = ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+	const float *v = ch->values;
+	if (n == 1 || !(t > ch->times[0])) {
+		memcpy(out, v, (size_t)comps * sizeof *out);
+		return;
+	}
+	if (t >= ch->times[n - 1]) {
+		memcpy(out, v + (size_t)(n - 1) * (size_t)comps, (size_t)comps * sizeof *out);
+		return;
+	}
+	int k = eval_find(ch->times, n, sg->k, t);
+	if (k != sg->k) {
+		sg->k = k;
+		sg->ready = 0;
+	}
+	const float *a = v + (size_t)k * (size_t)comps, *b = a + comps;
+	if (ch->interp == MLOD_INTERP_STEP) {
+		memcpy(out, a, (size_t)comps * sizeof *out);
+		return;
+	}
+	const float t0 = ch->times[k], t1 = ch->times[k + 1], dt = t1 - t0;
+	const float u = (t - t0) / dt;
+	if (comps == 4) {
+		mlod_quat q = eval_slerp(sg, a, b, u);
+		out[0] = q.x, out[1] = q.y, out[2] = q.z, out[3] = q.w;
+	} else {
+		for (int c = 0; c < 3; c++)
+			out[c] = a[c] + (b[c] - a[c]) * u;
+	}
+}
+
+/* Can eval_sample sample this clip (LINEAR and STEP channels only)? */
+static inline int eval_clip_ok(const mlod_clip *clip)
+{
+	for (int i = 0; i < clip->channel_count; i++)
+		if (clip->channels[i].interp == MLOD_INTERP_CUBICSPLINE)
+			return 0;
+	return 1;
+}
+
+/* mlod_clip_sample(clip, t, local) for a clip eval_clip_ok accepts, with
+ * one eval_seg per channel (k = -1 at first). */
+static inline void eval_sample(const mlod_clip *clip, eval_seg *segs, float t, mlod_trs *local)
+{
+	if (!(t > 0.0f))
+		t = 0.0f;
+	if (t > clip->duration)
+		t = clip->duration;
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		mlod_trs *l = &local[ch->joint];
+		float v[4];
+		if (ch->key_count < 1)
+			continue;
+		eval_channel(ch, &segs[i], t, v);
+		switch (ch->path) {
+		case MLOD_PATH_TRANSLATION: l->t.x = v[0], l->t.y = v[1], l->t.z = v[2]; break;
+		case MLOD_PATH_SCALE: l->s.x = v[0], l->s.y = v[1], l->s.z = v[2]; break;
+		case MLOD_PATH_ROTATION: l->r = eval_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+		}
+	}
+}
+
+/* mlod_pose_world with eval_mul_affine. */
+static inline void eval_pose_world(const mlod_skeleton *s, const mlod_trs *local, mlod_mat4 *world)
+{
+	for (int i = 0; i < s->joint_count; i++) {
+		const mlod_joint *j = &s->joints[i];
+		mlod_mat4 l = eval_from_trs(&local[i]);
+		world[i] = j->parent < 0 ? mlod_mat4_mul(&j->base, &l) : eval_mul_affine(&world[j->parent], &l);
+	}
+}
+
+/* mlod_keyreduce, with the clip as read at the samples given (w0, samples
+ * * joints world matrices as mlod_pose_world makes them; NULL: computed),
+ * and *max_error (if not NULL) the largest point error of the result as
+ * motion.c's level_max_error measures its level clip, or -1 when not
+ * measured (a NaN, or samples past the clip's duration). */
+mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
+                          double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
+                          double *max_error, mlod_error *err);
+
+#endif /* MLOD_MOTION_EVAL_H */
