@@ -111,6 +111,13 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
  * angle between n and its round trip is below MLOD_PACK_OCT_BOUND. */
 #define MLOD_PACK_OCT_BOUND 1e-4 /* radians (4.3e-5 measured over 200000 random normals) */
 void mlod_pack_oct_encode(const float n[3], int16_t out[2]);
+
+/* 'ROTQ' rotations: each component of a unit quaternion (up to the sign
+ * the writer picks for continuity) is within half a step, 1/65534, of the
+ * input; the 4-vector error is then at most 1/32767 and the rotation
+ * angle between input and decoded (normalised) at most 2 asin(1/32767). */
+#define MLOD_PACK_ROTQ_BOUND (1.0 / 65534.0)
+#define MLOD_PACK_ROTQ_ANGLE 6.1037e-5 /* radians, 2 asin(1/32767) rounded up; 0.0035 degrees */
 void mlod_pack_oct_decode(const int16_t in[2], float n[3]);
 
 /* A value within [min, min + 65535 * scale] to u16: q = round((v - min) /

@@ -1274,20 +1274,57 @@ static mlod_result motion_levels(struct ctx *x)
 	return r;
 }
 
-/* 1 when every value of a rotation channel is q / 32767 for an integer q. */
-static int on_lattice(const mlod_channel *ch)
+/* 1 when a non-cubic channel's keys all hold one value (bit for bit). */
+static int constant_channel(const mlod_channel *ch)
 {
-	if (ch->path != MLOD_PATH_ROTATION || ch->interp == MLOD_INTERP_CUBICSPLINE)
+	if (ch->interp == MLOD_INTERP_CUBICSPLINE || ch->key_count < 2)
 		return 0;
-	for (int i = 0; i < 4 * ch->key_count; i++) {
-		float v = ch->values[i];
-		if (!(fabsf(v) <= 1.0f))
+	int comps = ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+	for (int k = 1; k < ch->key_count; k++)
+		if (memcmp(ch->values + (size_t)comps * k, ch->values, sizeof(float) * (size_t)comps) != 0)
 			return 0;
-		long q = lrintf(v * 32767.0f);
-		if ((float)q / 32767.0f != v)
-			return 0;
-	}
 	return 1;
+}
+
+/* 1 when every time of the arrays is (float)(tick * step) for a tick in
+ * 0..UINT32_MAX; *max_tick is the largest. */
+static int ticks_fit(const float *const *arr, const int *cnt, int n, double step, uint32_t *max_tick)
+{
+	uint32_t mx = 0;
+	if (!(step > 0) || !isfinite(step))
+		return 0;
+	for (int a = 0; a < n; a++)
+		for (int k = 0; k < cnt[a]; k++) {
+			double q = floor((double)arr[a][k] / step + 0.5);
+			if (!(q >= 0 && q <= 4294967295.0) || (float)(q * step) != arr[a][k])
+				return 0;
+			mx = (uint32_t)q > mx ? (uint32_t)q : mx;
+		}
+	*max_tick = mx;
+	return 1;
+}
+
+/* The time step of a chunk's key-time arrays, or 0 to keep them f32: the
+ * smallest key interval, or 1 / the nearest whole frame rate to it. */
+static double time_step(const float *const *arr, const int *cnt, int n, uint32_t *max_tick)
+{
+	double d = 0;
+	for (int a = 0; a < n; a++)
+		for (int k = 1; k < cnt[a]; k++) {
+			double e = (double)arr[a][k] - (double)arr[a][k - 1];
+			if (e > 0 && (d == 0 || e < d))
+				d = e;
+		}
+	if (d == 0)
+		return 0;
+	double fps = floor(1.0 / d + 0.5);
+	if (fps >= 1 && fps <= 100000 && ticks_fit(arr, cnt, n, 1.0 / fps, max_tick))
+		return 1.0 / fps;
+	if (ticks_fit(arr, cnt, n, d, max_tick))
+		return d;
+	if (ticks_fit(arr, cnt, n, (double)(float)d, max_tick))
+		return (double)(float)d;
+	return 0;
 }
 
 static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int item, float error, chunks *out)
@@ -1295,27 +1332,81 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 	chunkb cb = {0};
 	int n = clip->channel_count;
 	mlod_pack_channel_rec *recs = calloc((size_t)n + 1, sizeof *recs);
-	if (!recs)
+	const float **arr = calloc((size_t)n + 1, sizeof *arr);
+	int *cnt = calloc((size_t)n + 1, sizeof *cnt), na = 0;
+	if (!recs || !arr || !cnt) {
+		free(recs), free(arr), free(cnt);
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	/* The distinct time arrays, in first-use order. */
 	for (int i = 0; i < n; i++) {
 		const mlod_channel *ch = &clip->channels[i];
+		int konst = constant_channel(ch), keys = konst ? 1 : ch->key_count;
+		const float *t = konst ? ch->times + ch->key_count - 1 : ch->times;
+		int a = 0;
+		while (a < na && !(cnt[a] == keys && memcmp(arr[a], t, sizeof(float) * (size_t)keys) == 0))
+			a++;
+		if (a == na)
+			arr[na] = t, cnt[na++] = keys;
 		recs[i] = (mlod_pack_channel_rec){(uint32_t)ch->joint, (uint32_t)ch->path, (uint32_t)ch->interp,
-		                                  (uint32_t)ch->key_count};
+		                                  (uint32_t)keys, (uint32_t)a};
 	}
 	cb_add(&cb, MLOD_STREAM_CHAN, (uint32_t)n, sizeof *recs, recs, 0);
 	free(recs);
+	uint32_t max_tick = 0;
+	double step = time_step(arr, cnt, na, &max_tick);
+	cb_add(&cb, MLOD_STREAM_STEP, 1, 8, &step, 0);
+	for (int a = 0; a < na && !cb.fail; a++) {
+		if (step == 0) {
+			cb_add(&cb, MLOD_STREAM_TIME, (uint32_t)cnt[a], 4, arr[a], 0);
+			continue;
+		}
+		/* u16 ticks raw; u32 where they do not fit or the vertex codec
+		 * (a multiple of 4 bytes) applies. */
+		int wide = max_tick > 65535 || x->opt->codec == MLOD_CODEC_MESHOPT;
+		uint8_t *tk = malloc(4 * ((size_t)cnt[a] + 1));
+		if (!tk) {
+			cb.fail = 1;
+			break;
+		}
+		for (int q = 0; q < cnt[a]; q++) {
+			uint32_t v = (uint32_t)floor((double)arr[a][q] / step + 0.5);
+			if (wide)
+				put_u32(tk + 4 * q, v);
+			else
+				put_u16(tk + 2 * q, (uint16_t)v);
+		}
+		cb_add(&cb, MLOD_STREAM_TICK, (uint32_t)cnt[a], wide ? 4 : 2, tk, 0);
+		free(tk);
+	}
+	free(arr);
+	free(cnt);
 	for (int i = 0; i < n && !cb.fail; i++) {
 		const mlod_channel *ch = &clip->channels[i];
-		uint32_t keys = (uint32_t)ch->key_count, per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
-		cb_add(&cb, MLOD_STREAM_TIME, keys, 4, ch->times, 0);
-		if (ch->path == MLOD_PATH_ROTATION && (ch->short_values || on_lattice(ch)) && on_lattice(ch)) {
+		int konst = constant_channel(ch);
+		uint32_t keys = konst ? 1 : (uint32_t)ch->key_count, per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
+		if (ch->path == MLOD_PATH_ROTATION && per == 1) {
+			/* Nearest lattice point, each key's sign continuing the last. */
 			int16_t *q = malloc(sizeof(int16_t) * 4 * ((size_t)keys + 1));
 			if (!q) {
 				cb.fail = 1;
 				break;
 			}
-			for (uint32_t v = 0; v < 4 * keys; v++)
-				q[v] = (int16_t)lrintf(ch->values[v] * 32767.0f);
+			for (uint32_t v = 0; v < keys; v++) {
+				const float *r = ch->values + 4 * (size_t)v;
+				double sign = 1;
+				if (v > 0) {
+					double dot = 0;
+					for (int c = 0; c < 4; c++)
+						dot += (double)r[c] * q[4 * (v - 1) + c];
+					sign = dot < 0 ? -1 : 1;
+				}
+				for (int c = 0; c < 4; c++) {
+					double e = sign * r[c];
+					e = e > 1 ? 1 : e < -1 ? -1 : e;
+					q[4 * v + c] = (int16_t)lrint(e * 32767.0);
+				}
+			}
 			cb_add(&cb, MLOD_STREAM_ROTQ, keys, 8, q, 0);
 			free(q);
 		} else if (ch->path == MLOD_PATH_ROTATION) {

@@ -123,12 +123,27 @@
  *   clip has INFO motion_levels levels: a clip with fewer (too few frames,
  *   no level within a bound) repeats its coarsest one.
  *   'CHAN' channel records (mlod_pack_channel_rec)
- *   then per channel: 'TIME' f32 per key (seconds), and
- *   'ROTQ' i16[4] per key (normalised: value = q / 32767) for a rotation
- *          whose every value sits on that lattice, else 'ROTF' f32[4];
- *          'VEC3' f32[3] per key for translation and scale;
- *          CUBICSPLINE channels store 3 values per key (in-tangent, value,
- *          out-tangent), in 'ROTF' or 'VEC3'.
+ *   'STEP' one f64: the clip's time step in seconds (0 when no 'TICK')
+ *   then the chunk's distinct key-time arrays, in the order the channels
+ *   first refer to them (channel rec.time: its array's index; channel 0
+ *   refers to array 0, and each later channel to an earlier array or the
+ *   next one), each one stream of key_count elements:
+ *   'TIME' f32 per key (seconds), or
+ *   'TICK' u16 (element size 2) or u32 (element size 4) per key:
+ *          time = (float)((double)tick * step), exactly the key time read
+ *   then per channel, its values:
+ *   'ROTQ' i16[4] per key (value = q / 32767) for every non-cubic
+ *          rotation: the rotation rounded to the nearest lattice point,
+ *          each key's sign chosen for continuity with the key before
+ *          (q and -q are one rotation);
+ *   'ROTF' f32[4] per key (cubic-spline rotations);
+ *   'VEC3' f32[3] per key for translation and scale;
+ *   CUBICSPLINE channels store 3 values per key (in-tangent, value,
+ *   out-tangent), in 'ROTF' or 'VEC3'.
+ *   (Writer's notes: a non-cubic channel whose keys all hold one value is
+ *   stored as one key at its last time, which keeps the clip's duration;
+ *   key times go as ticks when every one is a multiple of one step within
+ *   float precision, as sampled clips' are.)
  *
  * DOC (layer none, once, last): stream 'GLB ': the input glb without the
  *   meshes' geometry and the joint clips, which the levels hold: materials,
@@ -166,7 +181,10 @@
  *   ((1 - |y|) * sign x, (1 - |x|) * sign y) with sign 0 = +1; then the
  *   vector is normalised. 'TANQ' w is exactly -32767 or 32767.
  * - MOTION: key times are finite and strictly increasing; a joint has at
- *   most one channel per path; 'ROTQ' only for non-cubic channels.
+ *   most one channel per path; 'ROTQ' only for non-cubic channels, 'ROTF'
+ *   only for cubic ones; a channel's key count equals its time array's
+ *   element count; every time array is referred to; 'STEP' is finite and
+ *   >= 0, and > 0 when there is a 'TICK'.
  */
 #ifndef MLOD_PACK_H
 #define MLOD_PACK_H
@@ -249,7 +267,9 @@ typedef enum mlod_pack_codec {
 #define MLOD_STREAM_MTSC MLOD_FOURCC('M', 'T', 'S', 'C')
 #define MLOD_STREAM_MTPQ MLOD_FOURCC('M', 'T', 'P', 'Q')
 #define MLOD_STREAM_CHAN MLOD_FOURCC('C', 'H', 'A', 'N')
+#define MLOD_STREAM_STEP MLOD_FOURCC('S', 'T', 'E', 'P')
 #define MLOD_STREAM_TIME MLOD_FOURCC('T', 'I', 'M', 'E')
+#define MLOD_STREAM_TICK MLOD_FOURCC('T', 'I', 'C', 'K')
 #define MLOD_STREAM_ROTQ MLOD_FOURCC('R', 'O', 'T', 'Q')
 #define MLOD_STREAM_ROTF MLOD_FOURCC('R', 'O', 'T', 'F')
 #define MLOD_STREAM_VEC3 MLOD_FOURCC('V', 'E', 'C', '3')
@@ -328,6 +348,7 @@ typedef struct mlod_pack_channel_rec {
 	uint32_t path;             /* 0 translation, 1 rotation, 2 scale (mlod_path) */
 	uint32_t interp;           /* 0 linear, 1 step, 2 cubic spline (mlod_interp) */
 	uint32_t key_count;
+	uint32_t time;             /* its key-time array: index among the chunk's 'TIME'/'TICK' streams */
 } mlod_pack_channel_rec;
 
 /* The MOTION chunk's clip: INFO 'NAME' holds the clip names, after the
@@ -427,7 +448,7 @@ typedef struct mlod_pack_mesh {
 
 typedef struct mlod_pack_channel {
 	mlod_pack_channel_rec rec;
-	const float *times;             /* key_count */
+	const float *times;             /* key_count (shared by channels with one time array) */
 	float *values;                  /* 3 or 4 per key (x3 for cubic spline), dequantised */
 } mlod_pack_channel;
 

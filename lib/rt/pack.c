@@ -33,7 +33,7 @@ _Static_assert(sizeof(mlod_pack_info_rec) == 80, "INFO record is 80 bytes");
 _Static_assert(sizeof(mlod_pack_joint_rec) == 116, "joint record is 116 bytes");
 _Static_assert(sizeof(mlod_pack_skin_rec) == 12, "skin record is 12 bytes");
 _Static_assert(sizeof(mlod_pack_part_rec) == 200, "part record is 200 bytes");
-_Static_assert(sizeof(mlod_pack_channel_rec) == 16, "channel record is 16 bytes");
+_Static_assert(sizeof(mlod_pack_channel_rec) == 20, "channel record is 20 bytes");
 
 /* The largest block (and temporary buffer) a decode allocates. */
 #define PACK_MAX_BLOCK ((uint64_t)1 << 30)
@@ -1276,31 +1276,92 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	if (r != MLOD_OK)
 		return r;
 	uint32_t J = skel ? skel->joint_count : 0;
-	stream sc;
+	stream sc, sstep;
 	TRY(cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
+	TRY(cx_expect(&x, &sstep, MLOD_STREAM_STEP, 8, 1, "", "one step", err));
 	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel));
+	uint64_t T = 0; /* time arrays */
+	int in_times = 1;
 	while (cx_next(&x, &s)) {
-		uint64_t per = s.tag == MLOD_STREAM_TIME ? 4
+		int is_time = s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK;
+		uint64_t per = is_time ? 4
 		               : s.tag == MLOD_STREAM_ROTQ || s.tag == MLOD_STREAM_ROTF ? 16
 		               : s.tag == MLOD_STREAM_VEC3                                ? 12
 		                                                                          : 0;
 		if (!per)
 			FAIL("%s: stream %u is '%s', not a motion stream", x.label, s.index, tagn(s.tag).s);
+		if (is_time && !in_times)
+			FAIL("%s: stream %u '%s' after the first value stream", x.label, s.index, tagn(s.tag).s);
+		if (is_time)
+			T++;
+		else
+			in_times = 0;
 		total += round8(per * s.count);
 	}
+	total += round8(T * sizeof(float *)) + round8(T * 4);
 	cx_rewind(&x);
 	/* aux: one byte per joint and path, to find a second channel. */
 	TRY(cx_temp(&x, (uint64_t)J * 3, err));
 	TRY(bump_alloc(&b, &x, total, err));
 	uint8_t *seen = x.temp;
 	mlod_pack_channel *chans;
+	const float **tarr;
+	uint32_t *tcount;
 	TAKE(chans, C * sizeof *chans);
+	TAKE(tarr, T * sizeof *tarr);
 	TRY(cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
 	TRY(cx_load(&x, &sc, &src, err));
 	for (uint64_t i = 0; i < C; i++)
 		memcpy(&chans[i].rec, src + i * sizeof(mlod_pack_channel_rec), sizeof(mlod_pack_channel_rec));
+	TRY(cx_expect(&x, &sstep, MLOD_STREAM_STEP, 8, 1, "", "one step", err));
+	TRY(cx_load(&x, &sstep, &src, err));
+	double step;
+	{
+		uint64_t bits = rd64(src);
+		memcpy(&step, &bits, 8);
+	}
+	if (!isfinite(step) || !(step >= 0))
+		FAIL("%s: step %g is not finite and >= 0", x.label, step);
+	/* The time arrays, with their counts (checked against the channels'). */
+	TAKE(tcount, T * sizeof *tcount);
+	for (uint64_t t = 0; t < T; t++) {
+		char what[32];
+		snprintf(what, sizeof what, "time array %u", (unsigned)t);
+		if (!cx_next(&x, &s))
+			FAIL("%s: missing time array %u", x.label, (unsigned)t);
+		float *times;
+		TAKE(times, (uint64_t)s.count * 4);
+		if (s.tag == MLOD_STREAM_TIME) {
+			if (s.elsize != 4)
+				FAIL("%s: %s: stream %u 'TIME' has elements of %u bytes, expected 4", x.label, what, s.index, s.elsize);
+			TRY(cx_load(&x, &s, &src, err));
+			memcpy(times, src, (size_t)s.count * 4);
+		} else {
+			if (s.elsize != 2 && s.elsize != 4)
+				FAIL("%s: %s: stream %u 'TICK' has elements of %u bytes, expected 2 or 4", x.label, what, s.index,
+				     s.elsize);
+			if (!(step > 0))
+				FAIL("%s: %s: ticks with step 0", x.label, what);
+			TRY(cx_load(&x, &s, &src, err));
+			for (uint32_t k = 0; k < s.count; k++)
+				times[k] = (float)((double)(s.elsize == 2 ? rd16(src + 2 * (size_t)k) : rd32(src + 4 * (size_t)k)) *
+				                   step);
+		}
+		if (s.count == 0)
+			FAIL("%s: %s: no keys", x.label, what);
+		for (uint32_t k = 0; k < s.count; k++) {
+			if (!isfinite(times[k]))
+				FAIL("%s: %s: key %u: time is not finite", x.label, what, k);
+			if (k > 0 && !(times[k] > times[k - 1]))
+				FAIL("%s: %s: key %u: time %g is not after %g", x.label, what, k, (double)times[k],
+				     (double)times[k - 1]);
+		}
+		tarr[t] = times;
+		tcount[t] = s.count;
+	}
 	float duration = 0;
 	static const char *const path_names[3] = {"translation", "rotation", "scale"};
+	uint64_t next_time = 0;
 	for (uint32_t i = 0; i < C; i++) {
 		mlod_pack_channel *ch = &chans[i];
 		const mlod_pack_channel_rec *rc = &ch->rec;
@@ -1318,39 +1379,28 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 		if (seen[3 * (size_t)rc->joint + rc->path])
 			FAIL("%s: channel %u: a second %s channel of joint %u", x.label, i, path_names[rc->path], rc->joint);
 		seen[3 * (size_t)rc->joint + rc->path] = 1;
-		float *times;
-		TRY(cx_expect(&x, &s, MLOD_STREAM_TIME, 4, K, what, "key count", err));
-		TRY(cx_load(&x, &s, &src, err));
-		TAKE(times, (uint64_t)K * 4);
-		memcpy(times, src, (size_t)K * 4);
-		for (uint32_t k = 0; k < K; k++) {
-			if (!isfinite(times[k]))
-				FAIL("%s: channel %u: key %u: time is not finite", x.label, i, k);
-			if (k > 0 && !(times[k] > times[k - 1]))
-				FAIL("%s: channel %u: key %u: time %g is not after %g", x.label, i, k, (double)times[k],
-				     (double)times[k - 1]);
-		}
+		if (rc->time > next_time || rc->time >= T)
+			FAIL("%s: channel %u: time array %u is not below %llu (the arrays go in first-use order)", x.label, i,
+			     rc->time, (unsigned long long)(next_time < T ? next_time + 1 : T));
+		if (rc->time == next_time)
+			next_time++;
+		if (tcount[rc->time] != K)
+			FAIL("%s: channel %u: %u keys, but time array %u has %u", x.label, i, K, rc->time, tcount[rc->time]);
+		const float *times = tarr[rc->time];
 		if (times[K - 1] > duration)
 			duration = times[K - 1];
 		ch->times = times;
 		uint64_t m = rc->interp == 2 ? 3 : 1, values = m * K;
 		if (rc->path == 1) {
-			/* ROTQ, or ROTF (always for cubic splines). */
-			if (!cx_next(&x, &s))
-				FAIL("%s: channel %u: missing its rotation stream", x.label, i);
-			if (s.tag == MLOD_STREAM_ROTQ && m == 1) {
-				x.next--;
-				x.cursor -= pad4(s.stored);
+			/* ROTQ, or ROTF for cubic splines. */
+			if (m == 1) {
 				TRY(cx_expect(&x, &s, MLOD_STREAM_ROTQ, 8, values, what, "key count", err));
 				TRY(cx_load(&x, &s, &src, err));
 				TAKE(ch->values, values * 16);
 				for (size_t k = 0; k < values * 4; k++)
 					ch->values[k] = rdi16(src + 2 * k) / 32767.0f;
 			} else {
-				x.next--;
-				x.cursor -= pad4(s.stored);
-				TRY(cx_expect(&x, &s, MLOD_STREAM_ROTF, 16, values, what,
-				              m == 3 ? "3 values per key" : "key count", err));
+				TRY(cx_expect(&x, &s, MLOD_STREAM_ROTF, 16, values, what, "3 values per key", err));
 				TRY(cx_load(&x, &s, &src, err));
 				TAKE(ch->values, values * 16);
 				memcpy(ch->values, src, values * 16);
@@ -1367,6 +1417,8 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 				FAIL("%s: channel %u: a %s value is not finite", x.label, i, path_names[rc->path]);
 		}
 	}
+	if (next_time != T)
+		FAIL("%s: time array %llu is not used by any channel", x.label, (unsigned long long)next_time);
 	TRY(cx_end(&x, err));
 	cx_done(&x);
 	out->channel_count = (uint32_t)C;

@@ -263,20 +263,39 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 {
 	const mlod_rt_view_level *vl = &fx_vmotion[clip * 3 + level];
 	chunk *c = new_chunk(MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, level, clip, vl->error, vl->distance);
+	/* one f32 time array per channel (channel i refers to array i) */
 	bytes *b = stream(c, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec));
-	for (uint32_t i = 0; i < m->channel_count; i++)
-		put(b, &m->channels[i].rec, sizeof m->channels[i].rec);
+	for (uint32_t i = 0; i < m->channel_count; i++) {
+		mlod_pack_channel_rec rec = m->channels[i].rec;
+		rec.time = i;
+		put(b, &rec, sizeof rec);
+	}
+	stream_end(c);
+	b = stream(c, MLOD_STREAM_STEP, 8);
+	double no_step = 0;
+	put(b, &no_step, 8);
 	stream_end(c);
 	for (uint32_t i = 0; i < m->channel_count; i++) {
 		const mlod_pack_channel *ch = &m->channels[i];
-		const uint32_t K = ch->rec.key_count, comps = ch->rec.path == 1 ? 4 : 3, per = ch->rec.interp == 2 ? 3 : 1;
 		b = stream(c, MLOD_STREAM_TIME, 4);
-		for (uint32_t k = 0; k < K; k++)
+		for (uint32_t k = 0; k < ch->rec.key_count; k++)
 			putf(b, ch->times[k]);
 		stream_end(c);
-		b = stream(c, comps == 4 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3, 4 * comps);
-		for (uint32_t k = 0; k < K * per * comps; k++)
-			putf(b, ch->values[k]);
+	}
+	for (uint32_t i = 0; i < m->channel_count; i++) {
+		const mlod_pack_channel *ch = &m->channels[i];
+		const uint32_t K = ch->rec.key_count, comps = ch->rec.path == 1 ? 4 : 3, per = ch->rec.interp == 2 ? 3 : 1;
+		if (comps == 4 && per == 1) {
+			b = stream(c, MLOD_STREAM_ROTQ, 8);
+			for (uint32_t k = 0; k < K * 4; k++) {
+				int16_t q = (int16_t)lrintf(ch->values[k] * 32767.0f);
+				put(b, &q, 2);
+			}
+		} else {
+			b = stream(c, comps == 4 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3, 4 * comps);
+			for (uint32_t k = 0; k < K * per * comps; k++)
+				putf(b, ch->values[k]);
+		}
 		stream_end(c);
 	}
 }
