@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mlod_pack.h"
+#include "rt/mlod_pack.h"
 
 #define MAXTAGS 64
 typedef struct { uint32_t tag; unsigned long long stored, raw, n; } tagsum;

@@ -130,7 +130,8 @@
  *   next one), each one stream of key_count elements:
  *   'TIME' f32 per key (seconds), or
  *   'TICK' u16 (element size 2) or u32 (element size 4) per key:
- *          time = (float)((double)tick * step), exactly the key time read
+ *          time = (float)((double)tick * step): the key time read, or
+ *          within 2^-20 * max(|t|, step) of it (mlod(5), QUANTISATION)
  *   then per channel, its values:
  *   'ROTQ' i16[4] per key (value = q / 32767) for every non-cubic
  *          rotation: the rotation rounded to the nearest lattice point,
@@ -143,7 +144,7 @@
  *   (Writer's notes: a non-cubic channel whose keys all hold one value is
  *   stored as one key at its last time, which keeps the clip's duration;
  *   key times go as ticks when every one is a multiple of one step within
- *   float precision, as sampled clips' are.)
+ *   that tolerance, as sampled clips' are, an exact step preferred.)
  *
  * DOC (layer none, once, last): stream 'GLB ': the input glb without the
  *   meshes' geometry and the joint clips, which the levels hold: materials,
