@@ -1482,40 +1482,61 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 	}
 	free(arr);
 	free(cnt);
+	/* The values: 'ROTQ' (non-cubic rotations), 'ROTF' (cubic rotations),
+	 * 'VEC3' (translations and scales), each one stream of its channels'
+	 * keys in channel order. */
+	size_t nq = 0, nf = 0, nv = 0;
+	for (int i = 0; i < n; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		size_t keys = constant_channel(ch) ? 1 : (size_t)ch->key_count;
+		size_t per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
+		if (ch->path == MLOD_PATH_ROTATION && per == 1)
+			nq += keys;
+		else if (ch->path == MLOD_PATH_ROTATION)
+			nf += 3 * keys;
+		else
+			nv += per * keys;
+	}
+	int16_t *q = malloc(sizeof(int16_t) * 4 * (nq + 1));
+	float *rf = malloc(sizeof(float) * 4 * (nf + 1)), *v3 = malloc(sizeof(float) * 3 * (nv + 1));
+	if (!q || !rf || !v3)
+		cb.fail = 1;
+	size_t at_q = 0, at_f = 0, at_v = 0;
 	for (int i = 0; i < n && !cb.fail; i++) {
 		const mlod_channel *ch = &clip->channels[i];
 		int konst = constant_channel(ch);
 		uint32_t keys = konst ? 1 : (uint32_t)ch->key_count, per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
 		if (ch->path == MLOD_PATH_ROTATION && per == 1) {
 			/* Nearest lattice point, each key's sign continuing the last. */
-			int16_t *q = malloc(sizeof(int16_t) * 4 * ((size_t)keys + 1));
-			if (!q) {
-				cb.fail = 1;
-				break;
-			}
-			for (uint32_t v = 0; v < keys; v++) {
+			for (uint32_t v = 0; v < keys; v++, at_q++) {
 				const float *r = ch->values + 4 * (size_t)v;
 				double sign = 1;
 				if (v > 0) {
 					double dot = 0;
 					for (int c = 0; c < 4; c++)
-						dot += (double)r[c] * q[4 * (v - 1) + c];
+						dot += (double)r[c] * q[4 * (at_q - 1) + c];
 					sign = dot < 0 ? -1 : 1;
 				}
 				for (int c = 0; c < 4; c++) {
 					double e = sign * r[c];
 					e = e > 1 ? 1 : e < -1 ? -1 : e;
-					q[4 * v + c] = (int16_t)lrint(e * 32767.0);
+					q[4 * at_q + c] = (int16_t)lrint(e * 32767.0);
 				}
 			}
-			cb_add(&cb, MLOD_STREAM_ROTQ, keys, 8, q, 0);
-			free(q);
 		} else if (ch->path == MLOD_PATH_ROTATION) {
-			cb_add(&cb, MLOD_STREAM_ROTF, keys * per, 16, ch->values, 0);
+			memcpy(rf + 4 * at_f, ch->values, sizeof(float) * 4 * 3 * keys);
+			at_f += 3 * (size_t)keys;
 		} else {
-			cb_add(&cb, MLOD_STREAM_VEC3, keys * per, 12, ch->values, 0);
+			memcpy(v3 + 3 * at_v, ch->values, sizeof(float) * 3 * per * keys);
+			at_v += (size_t)per * keys;
 		}
 	}
+	cb_add(&cb, MLOD_STREAM_ROTQ, (uint32_t)nq, 8, q, 0);
+	cb_add(&cb, MLOD_STREAM_ROTF, (uint32_t)nf, 16, rf, 0);
+	cb_add(&cb, MLOD_STREAM_VEC3, (uint32_t)nv, 12, v3, 0);
+	free(q);
+	free(rf);
+	free(v3);
 	return cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, k, item, error, x->err);
 }
 

@@ -132,15 +132,17 @@
  *   'TICK' u16 (element size 2) or u32 (element size 4) per key:
  *          time = (float)((double)tick * step): the key time read, or
  *          within 2^-20 * max(|t|, step) of it (mlod(5), QUANTISATION)
- *   then per channel, its values:
- *   'ROTQ' i16[4] per key (value = q / 32767) for every non-cubic
- *          rotation: the rotation rounded to the nearest lattice point,
- *          each key's sign chosen for continuity with the key before
- *          (q and -q are one rotation);
- *   'ROTF' f32[4] per key (cubic-spline rotations);
- *   'VEC3' f32[3] per key for translation and scale;
- *   CUBICSPLINE channels store 3 values per key (in-tangent, value,
- *   out-tangent), in 'ROTF' or 'VEC3'.
+ *   then the values, three streams, each holding the keys of its
+ *   channels one channel after the other in channel order (possibly 0
+ *   elements):
+ *   'ROTQ' i16[4] per key of every non-cubic rotation (value = q / 32767):
+ *          the rotation rounded to the nearest lattice point, each key's
+ *          sign chosen for continuity with the key before (q and -q are
+ *          one rotation);
+ *   'ROTF' f32[4], 3 per key (in-tangent, value, out-tangent), of every
+ *          cubic-spline rotation;
+ *   'VEC3' f32[3] per key (3 per key for cubic splines) of every
+ *          translation and scale.
  *   (Writer's notes: a non-cubic channel whose keys all hold one value is
  *   stored as one key at its last time, which keeps the clip's duration;
  *   key times go as ticks when every one is a multiple of one step within
@@ -182,8 +184,8 @@
  *   ((1 - |y|) * sign x, (1 - |x|) * sign y) with sign 0 = +1; then the
  *   vector is normalised. 'TANQ' w is exactly -32767 or 32767.
  * - MOTION: key times are finite and strictly increasing; a joint has at
- *   most one channel per path; 'ROTQ' only for non-cubic channels, 'ROTF'
- *   only for cubic ones; a channel's key count equals its time array's
+ *   most one channel per path; each value stream's count is its
+ *   channels' keys (x3 for cubic); a channel's key count equals its time array's
  *   element count; every time array is referred to; 'STEP' is finite and
  *   >= 0, and > 0 when there is a 'TICK'.
  */

@@ -1279,7 +1279,9 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	stream sc, sstep;
 	TRY(cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
 	TRY(cx_expect(&x, &sstep, MLOD_STREAM_STEP, 8, 1, "", "one step", err));
-	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel));
+	/* each channel's values are taken on their own: up to 8 bytes of
+	 * rounding each */
+	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel)) + 8 * C;
 	uint64_t T = 0; /* time arrays */
 	int in_times = 1;
 	while (cx_next(&x, &s)) {
@@ -1361,7 +1363,7 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	}
 	float duration = 0;
 	static const char *const path_names[3] = {"translation", "rotation", "scale"};
-	uint64_t next_time = 0;
+	uint64_t next_time = 0, nq = 0, nf = 0, nv = 0;
 	for (uint32_t i = 0; i < C; i++) {
 		mlod_pack_channel *ch = &chans[i];
 		const mlod_pack_channel_rec *rc = &ch->rec;
@@ -1390,35 +1392,56 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 		if (times[K - 1] > duration)
 			duration = times[K - 1];
 		ch->times = times;
-		uint64_t m = rc->interp == 2 ? 3 : 1, values = m * K;
-		if (rc->path == 1) {
-			/* ROTQ, or ROTF for cubic splines. */
-			if (m == 1) {
-				TRY(cx_expect(&x, &s, MLOD_STREAM_ROTQ, 8, values, what, "key count", err));
-				TRY(cx_load(&x, &s, &src, err));
-				TAKE(ch->values, values * 16);
-				for (size_t k = 0; k < values * 4; k++)
-					ch->values[k] = rdi16(src + 2 * k) / 32767.0f;
-			} else {
-				TRY(cx_expect(&x, &s, MLOD_STREAM_ROTF, 16, values, what, "3 values per key", err));
-				TRY(cx_load(&x, &s, &src, err));
-				TAKE(ch->values, values * 16);
-				memcpy(ch->values, src, values * 16);
-				if (!all_finite(ch->values, values * 4))
-					FAIL("%s: channel %u: a rotation value is not finite", x.label, i);
-			}
-		} else {
-			TRY(cx_expect(&x, &s, MLOD_STREAM_VEC3, 12, values, what, m == 3 ? "3 values per key" : "key count",
-			              err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(ch->values, values * 12);
-			memcpy(ch->values, src, values * 12);
-			if (!all_finite(ch->values, values * 3))
-				FAIL("%s: channel %u: a %s value is not finite", x.label, i, path_names[rc->path]);
-		}
+		uint64_t m = rc->interp == 2 ? 3 : 1;
+		if (rc->path == 1 && m == 1)
+			nq += K;
+		else if (rc->path == 1)
+			nf += 3 * (uint64_t)K;
+		else
+			nv += m * K;
 	}
 	if (next_time != T)
 		FAIL("%s: time array %llu is not used by any channel", x.label, (unsigned long long)next_time);
+	/* The values: 'ROTQ', 'ROTF', 'VEC3', each the keys of its channels
+	 * one channel after the other, in channel order. */
+	TRY(cx_expect(&x, &s, MLOD_STREAM_ROTQ, 8, nq, "", "keys of the non-cubic rotations", err));
+	TRY(cx_load(&x, &s, &src, err));
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path != 1 || ch->rec.interp == 2)
+			continue;
+		uint64_t values = ch->rec.key_count;
+		TAKE(ch->values, values * 16);
+		for (size_t k = 0; k < values * 4; k++)
+			ch->values[k] = rdi16(src + 2 * k) / 32767.0f;
+		src += values * 8;
+	}
+	TRY(cx_expect(&x, &s, MLOD_STREAM_ROTF, 16, nf, "", "3 values per key of the cubic rotations", err));
+	TRY(cx_load(&x, &s, &src, err));
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path != 1 || ch->rec.interp != 2)
+			continue;
+		uint64_t values = 3 * (uint64_t)ch->rec.key_count;
+		TAKE(ch->values, values * 16);
+		memcpy(ch->values, src, values * 16);
+		src += values * 16;
+		if (!all_finite(ch->values, values * 4))
+			FAIL("%s: channel %u: a rotation value is not finite", x.label, i);
+	}
+	TRY(cx_expect(&x, &s, MLOD_STREAM_VEC3, 12, nv, "", "keys of the translations and scales", err));
+	TRY(cx_load(&x, &s, &src, err));
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path == 1)
+			continue;
+		uint64_t values = (ch->rec.interp == 2 ? 3 : 1) * (uint64_t)ch->rec.key_count;
+		TAKE(ch->values, values * 12);
+		memcpy(ch->values, src, values * 12);
+		src += values * 12;
+		if (!all_finite(ch->values, values * 3))
+			FAIL("%s: channel %u: a %s value is not finite", x.label, i, path_names[ch->rec.path]);
+	}
 	TRY(cx_end(&x, err));
 	cx_done(&x);
 	out->channel_count = (uint32_t)C;

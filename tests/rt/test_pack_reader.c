@@ -646,6 +646,8 @@ static int make_chunks(wchunk *c, int with_unknown)
 	s->count = 2;
 	putf(&s->data, 0.0f);
 	putf(&s->data, 1.0f);
+	add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_RAW);
+	add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
 	s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_RAW);
 	s->count = 2;
 	for (int k = 0; k < 6; k++)
@@ -698,27 +700,23 @@ static int make_chunks(wchunk *c, int with_unknown)
 	s->count = NK;
 	for (int k = 0; k < NK; k++)
 		putf(&s->data, time_truth[k]);
-	for (int cidx = 0; cidx < 4; cidx++) {
-		if (cidx == 0 || cidx == 3) {
-			s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_MESHOPT_VERTEX);
-			s->count = NK;
-			for (int k = 0; k < NK; k++)
-				for (int a = 0; a < 3; a++)
-					putf(&s->data, vec_truth[k][a]);
-		} else if (cidx == 1) {
-			s = add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_MESHOPT_VERTEX);
-			s->count = NK;
-			for (int k = 0; k < NK; k++)
-				for (int a = 0; a < 4; a++)
-					put16(&s->data, (uint16_t)rotq_truth[k][a]);
-		} else {
-			s = add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
-			s->count = NK * 3;
-			for (int k = 0; k < NK * 3; k++)
-				for (int a = 0; a < 4; a++)
-					putf(&s->data, rot_truth[k][a]);
-		}
-	}
+	/* the values: ROTQ (channel 1), ROTF (channel 2), VEC3 (channels 0, 3) */
+	s = add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_MESHOPT_VERTEX);
+	s->count = NK;
+	for (int k = 0; k < NK; k++)
+		for (int a = 0; a < 4; a++)
+			put16(&s->data, (uint16_t)rotq_truth[k][a]);
+	s = add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
+	s->count = NK * 3;
+	for (int k = 0; k < NK * 3; k++)
+		for (int a = 0; a < 4; a++)
+			putf(&s->data, rot_truth[k][a]);
+	s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_MESHOPT_VERTEX);
+	s->count = 2 * NK;
+	for (int cidx = 0; cidx < 2; cidx++)
+		for (int k = 0; k < NK; k++)
+			for (int a = 0; a < 3; a++)
+				putf(&s->data, vec_truth[k][a]);
 
 	/* DOC */
 	ch = &c[C_DOC];
@@ -1370,11 +1368,8 @@ static void e_time_after_values(wchunk *c)
 	putf(&s->data, 2.0f);
 }
 static void e_dup_channel(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 2, 1); }
-static void e_missing_rotation(wchunk *c)
-{
-	wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1);
-	wchunk_free_stream(&c[C_MOT1], 3);
-}
+static void e_no_vec3(wchunk *c) { wchunk_free_stream(&c[C_MOT1], 5); }
+static void e_missing_rotation(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1); }
 static void e_time_order(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 3 + 16, 2); }
 static void e_time_unused(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 3 + 16, 0); }
 static void e_time_keys(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 12, 3); }
@@ -1421,8 +1416,8 @@ TEST(structural_checks_name_the_chunk)
 		{e_vertex_elsize, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: stream 1 'POSQ' has elements of 6 bytes, expected 8"},
 		{e_info_levels, C_INFO, MLOD_ERR_PARSE, "INFO: the TOC has SKELETON level 1, but INFO counts"},
 		{e_clip_names, C_INFO, MLOD_ERR_PARSE, "INFO: the string table 'NAME' ends before clip 0's name"},
-		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 4 'VEC3')"},
-		{e_time_after_values, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 4 'TIME' after the first value stream"},
+		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 6 'VEC3')"},
+		{e_time_after_values, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 6 'TIME' after the first value stream"},
 		{e_time_order, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 3: time array 2 is not below 2 (the arrays go in first-use order)"},
 		{e_time_unused, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: time array 1 is not used by any channel"},
 		{e_time_keys, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: 3 keys, but time array 0 has 2"},
@@ -1430,10 +1425,11 @@ TEST(structural_checks_name_the_chunk)
 		{e_step_nan, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: step nan is not finite and >= 0"},
 		{e_tick_elsize, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: time array 0: stream 2 'TICK' has elements of 1 bytes, expected 2 or 4"},
 		{e_dup_channel, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 2: a second rotation channel of joint 1"},
-		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: missing stream 'ROTQ' (the chunk has 3 streams)"},
+		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 3 'ROTQ' has 0 elements, expected 2 (keys of the non-cubic rotations)"},
+		{e_no_vec3, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: missing stream 'VEC3' (the chunk has 5 streams)"},
 		{e_morph_scale, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: morph target 0: scale -1 is not finite and >= 0"},
 		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
-		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: stream 5 is 'ROTQ', expected 'ROTF'"},
+		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 4 'ROTQ' has 5 elements, expected 0 (keys of the non-cubic rotations)"},
 		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x40"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {

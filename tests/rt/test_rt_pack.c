@@ -282,19 +282,24 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 			putf(b, ch->times[k]);
 		stream_end(c);
 	}
-	for (uint32_t i = 0; i < m->channel_count; i++) {
-		const mlod_pack_channel *ch = &m->channels[i];
-		const uint32_t K = ch->rec.key_count, comps = ch->rec.path == 1 ? 4 : 3, per = ch->rec.interp == 2 ? 3 : 1;
-		if (comps == 4 && per == 1) {
-			b = stream(c, MLOD_STREAM_ROTQ, 8);
-			for (uint32_t k = 0; k < K * 4; k++) {
-				int16_t q = (int16_t)lrintf(ch->values[k] * 32767.0f);
-				put(b, &q, 2);
+	/* the values: ROTQ, ROTF, VEC3, each its channels' keys in order */
+	for (int kind = 0; kind < 3; kind++) {
+		b = stream(c, kind == 0 ? MLOD_STREAM_ROTQ : kind == 1 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3,
+		           kind == 0 ? 8 : kind == 1 ? 16 : 12);
+		for (uint32_t i = 0; i < m->channel_count; i++) {
+			const mlod_pack_channel *ch = &m->channels[i];
+			const uint32_t K = ch->rec.key_count, per = ch->rec.interp == 2 ? 3 : 1;
+			int is = ch->rec.path == 1 ? (per == 1 ? 0 : 1) : 2;
+			if (is != kind)
+				continue;
+			for (uint32_t k = 0; k < K * per * (kind == 2 ? 3 : 4); k++) {
+				if (kind == 0) {
+					int16_t q = (int16_t)lrintf(ch->values[k] * 32767.0f);
+					put(b, &q, 2);
+				} else {
+					putf(b, ch->values[k]);
+				}
 			}
-		} else {
-			b = stream(c, comps == 4 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3, 4 * comps);
-			for (uint32_t k = 0; k < K * per * comps; k++)
-				putf(b, ch->values[k]);
 		}
 		stream_end(c);
 	}
