@@ -1457,27 +1457,34 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 	uint32_t max_tick = 0;
 	double step = time_step(arr, cnt, na, &max_tick);
 	cb_add(&cb, MLOD_STREAM_STEP, 1, 8, &step, 0);
-	for (int a = 0; a < na && !cb.fail; a++) {
-		if (step == 0) {
-			cb_add(&cb, MLOD_STREAM_TIME, (uint32_t)cnt[a], 4, arr[a], 0);
-			continue;
-		}
-		/* u16 ticks raw; u32 where they do not fit or the vertex codec
-		 * (a multiple of 4 bytes) applies. */
-		int wide = max_tick > 65535 || x->opt->codec == MLOD_CODEC_MESHOPT;
-		uint8_t *tk = malloc(4 * ((size_t)cnt[a] + 1));
-		if (!tk) {
-			cb.fail = 1;
-			break;
-		}
-		for (int q = 0; q < cnt[a]; q++) {
-			uint32_t v = (uint32_t)floor((double)arr[a][q] / step + 0.5);
-			if (wide)
-				put_u32(tk + 4 * q, v);
-			else
-				put_u16(tk + 2 * q, (uint16_t)v);
-		}
-		cb_add(&cb, MLOD_STREAM_TICK, (uint32_t)cnt[a], wide ? 4 : 2, tk, 0);
+	/* The key times: one stream, the arrays one after the other; f32, or
+	 * u16 ticks raw, u32 where they do not fit or the vertex codec (a
+	 * multiple of 4 bytes) applies. */
+	size_t nt = 0;
+	for (int a = 0; a < na; a++)
+		nt += (size_t)cnt[a];
+	int wide = max_tick > 65535 || x->opt->codec == MLOD_CODEC_MESHOPT;
+	uint8_t *tk = malloc(4 * (nt + 1));
+	if (!tk) {
+		cb.fail = 1;
+	} else {
+		size_t at = 0;
+		for (int a = 0; a < na; a++)
+			for (int q = 0; q < cnt[a]; q++, at++) {
+				if (step == 0) {
+					memcpy(tk + 4 * at, &arr[a][q], 4);
+					continue;
+				}
+				uint32_t v = (uint32_t)floor((double)arr[a][q] / step + 0.5);
+				if (wide)
+					put_u32(tk + 4 * at, v);
+				else
+					put_u16(tk + 2 * at, (uint16_t)v);
+			}
+		if (step == 0)
+			cb_add(&cb, MLOD_STREAM_TIME, (uint32_t)nt, 4, tk, 0);
+		else
+			cb_add(&cb, MLOD_STREAM_TICK, (uint32_t)nt, wide ? 4 : 2, tk, 0);
 		free(tk);
 	}
 	free(arr);

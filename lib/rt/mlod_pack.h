@@ -123,15 +123,17 @@
  *   clip has INFO motion_levels levels: a clip with fewer (too few frames,
  *   no level within a bound) repeats its coarsest one.
  *   'CHAN' channel records (mlod_pack_channel_rec)
- *   'STEP' one f64: the clip's time step in seconds (0 when no 'TICK')
- *   then the chunk's distinct key-time arrays, in the order the channels
- *   first refer to them (channel rec.time: its array's index; channel 0
- *   refers to array 0, and each later channel to an earlier array or the
- *   next one), each one stream of key_count elements:
- *   'TIME' f32 per key (seconds), or
- *   'TICK' u16 (element size 2) or u32 (element size 4) per key:
- *          time = (float)((double)tick * step): the key time read, or
- *          within 2^-20 * max(|t|, step) of it (mlod(5), QUANTISATION)
+ *   'STEP' one f64: the chunk's time step in seconds, 0 for f32 times
+ *   then the key times, one stream: the chunk's distinct key-time arrays
+ *   one after the other, in the order the channels first refer to them
+ *   (channel rec.time: its array's index; channel 0 refers to array 0,
+ *   each later channel to an earlier array or the next one; an array's
+ *   length is the key_count of the channels referring to it):
+ *   'TIME' f32 per key (seconds), when step is 0, or
+ *   'TICK' u16 (element size 2) or u32 (element size 4) per key, when
+ *          step > 0: time = (float)((double)tick * step): the key time
+ *          read, or within 2^-20 * max(|t|, step) of it (mlod(5),
+ *          QUANTISATION)
  *   then the values, three streams, each holding the keys of its
  *   channels one channel after the other in channel order (possibly 0
  *   elements):
@@ -185,9 +187,9 @@
  *   vector is normalised. 'TANQ' w is exactly -32767 or 32767.
  * - MOTION: key times are finite and strictly increasing; a joint has at
  *   most one channel per path; each value stream's count is its
- *   channels' keys (x3 for cubic); a channel's key count equals its time array's
- *   element count; every time array is referred to; 'STEP' is finite and
- *   >= 0, and > 0 when there is a 'TICK'.
+ *   channels' keys (x3 for cubic), the time stream's the arrays' keys;
+ *   every channel referring to an array has its key count; 'STEP' is
+ *   finite and >= 0.
  */
 #ifndef MLOD_PACK_H
 #define MLOD_PACK_H

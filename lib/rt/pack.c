@@ -1282,25 +1282,18 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	/* each channel's values are taken on their own: up to 8 bytes of
 	 * rounding each */
 	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel)) + 8 * C;
-	uint64_t T = 0; /* time arrays */
-	int in_times = 1;
 	while (cx_next(&x, &s)) {
-		int is_time = s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK;
-		uint64_t per = is_time ? 4
+		uint64_t per = s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK ? 4
 		               : s.tag == MLOD_STREAM_ROTQ || s.tag == MLOD_STREAM_ROTF ? 16
 		               : s.tag == MLOD_STREAM_VEC3                                ? 12
 		                                                                          : 0;
 		if (!per)
 			FAIL("%s: stream %u is '%s', not a motion stream", x.label, s.index, tagn(s.tag).s);
-		if (is_time && !in_times)
-			FAIL("%s: stream %u '%s' after the first value stream", x.label, s.index, tagn(s.tag).s);
-		if (is_time)
-			T++;
-		else
-			in_times = 0;
 		total += round8(per * s.count);
 	}
-	total += round8(T * sizeof(float *)) + round8(T * 4);
+	/* the time arrays: a pointer and a count per array, at most one per
+	 * channel */
+	total += round8(C * sizeof(float *)) + round8(C * 4);
 	cx_rewind(&x);
 	/* aux: one byte per joint and path, to find a second channel. */
 	TRY(cx_temp(&x, (uint64_t)J * 3, err));
@@ -1310,7 +1303,8 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	const float **tarr;
 	uint32_t *tcount;
 	TAKE(chans, C * sizeof *chans);
-	TAKE(tarr, T * sizeof *tarr);
+	TAKE(tarr, C * sizeof *tarr);
+	TAKE(tcount, C * sizeof *tcount);
 	TRY(cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
 	TRY(cx_load(&x, &sc, &src, err));
 	for (uint64_t i = 0; i < C; i++)
@@ -1324,51 +1318,12 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	}
 	if (!isfinite(step) || !(step >= 0))
 		FAIL("%s: step %g is not finite and >= 0", x.label, step);
-	/* The time arrays, with their counts (checked against the channels'). */
-	TAKE(tcount, T * sizeof *tcount);
-	for (uint64_t t = 0; t < T; t++) {
-		char what[32];
-		snprintf(what, sizeof what, "time array %u", (unsigned)t);
-		if (!cx_next(&x, &s))
-			FAIL("%s: missing time array %u", x.label, (unsigned)t);
-		float *times;
-		TAKE(times, (uint64_t)s.count * 4);
-		if (s.tag == MLOD_STREAM_TIME) {
-			if (s.elsize != 4)
-				FAIL("%s: %s: stream %u 'TIME' has elements of %u bytes, expected 4", x.label, what, s.index, s.elsize);
-			TRY(cx_load(&x, &s, &src, err));
-			memcpy(times, src, (size_t)s.count * 4);
-		} else {
-			if (s.elsize != 2 && s.elsize != 4)
-				FAIL("%s: %s: stream %u 'TICK' has elements of %u bytes, expected 2 or 4", x.label, what, s.index,
-				     s.elsize);
-			if (!(step > 0))
-				FAIL("%s: %s: ticks with step 0", x.label, what);
-			TRY(cx_load(&x, &s, &src, err));
-			for (uint32_t k = 0; k < s.count; k++)
-				times[k] = (float)((double)(s.elsize == 2 ? rd16(src + 2 * (size_t)k) : rd32(src + 4 * (size_t)k)) *
-				                   step);
-		}
-		if (s.count == 0)
-			FAIL("%s: %s: no keys", x.label, what);
-		for (uint32_t k = 0; k < s.count; k++) {
-			if (!isfinite(times[k]))
-				FAIL("%s: %s: key %u: time is not finite", x.label, what, k);
-			if (k > 0 && !(times[k] > times[k - 1]))
-				FAIL("%s: %s: key %u: time %g is not after %g", x.label, what, k, (double)times[k],
-				     (double)times[k - 1]);
-		}
-		tarr[t] = times;
-		tcount[t] = s.count;
-	}
 	float duration = 0;
 	static const char *const path_names[3] = {"translation", "rotation", "scale"};
-	uint64_t next_time = 0, nq = 0, nf = 0, nv = 0;
+	/* The channels; the time arrays' counts, in first-use order. */
+	uint64_t T = 0, nt = 0, nq = 0, nf = 0, nv = 0;
 	for (uint32_t i = 0; i < C; i++) {
-		mlod_pack_channel *ch = &chans[i];
-		const mlod_pack_channel_rec *rc = &ch->rec;
-		char what[32];
-		snprintf(what, sizeof what, "channel %u", i);
+		const mlod_pack_channel_rec *rc = &chans[i].rec;
 		uint32_t K = rc->key_count;
 		if (rc->joint >= J)
 			FAIL("%s: channel %u: joint %u is not below the skeleton's %u joints", x.label, i, rc->joint, J);
@@ -1381,17 +1336,15 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 		if (seen[3 * (size_t)rc->joint + rc->path])
 			FAIL("%s: channel %u: a second %s channel of joint %u", x.label, i, path_names[rc->path], rc->joint);
 		seen[3 * (size_t)rc->joint + rc->path] = 1;
-		if (rc->time > next_time || rc->time >= T)
+		if (rc->time > T)
 			FAIL("%s: channel %u: time array %u is not below %llu (the arrays go in first-use order)", x.label, i,
-			     rc->time, (unsigned long long)(next_time < T ? next_time + 1 : T));
-		if (rc->time == next_time)
-			next_time++;
-		if (tcount[rc->time] != K)
+			     rc->time, (unsigned long long)T + 1);
+		if (rc->time == T) {
+			tcount[T++] = K;
+			nt += K;
+		} else if (tcount[rc->time] != K) {
 			FAIL("%s: channel %u: %u keys, but time array %u has %u", x.label, i, K, rc->time, tcount[rc->time]);
-		const float *times = tarr[rc->time];
-		if (times[K - 1] > duration)
-			duration = times[K - 1];
-		ch->times = times;
+		}
 		uint64_t m = rc->interp == 2 ? 3 : 1;
 		if (rc->path == 1 && m == 1)
 			nq += K;
@@ -1400,8 +1353,46 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 		else
 			nv += m * K;
 	}
-	if (next_time != T)
-		FAIL("%s: time array %llu is not used by any channel", x.label, (unsigned long long)next_time);
+	/* The key times: one stream, the arrays one after the other. */
+	if (!cx_next(&x, &s))
+		FAIL("%s: missing its key times", x.label);
+	if (s.tag != (step > 0 ? MLOD_STREAM_TICK : MLOD_STREAM_TIME))
+		FAIL("%s: stream %u is '%s', expected '%s' (step %g)", x.label, s.index, tagn(s.tag).s,
+		     step > 0 ? "TICK" : "TIME", step);
+	if (s.tag == MLOD_STREAM_TICK ? s.elsize != 2 && s.elsize != 4 : s.elsize != 4)
+		FAIL("%s: stream %u '%s' has elements of %u bytes, expected %s", x.label, s.index, tagn(s.tag).s, s.elsize,
+		     s.tag == MLOD_STREAM_TICK ? "2 or 4" : "4");
+	if (s.count != nt)
+		FAIL("%s: stream %u '%s' has %u elements, expected %llu (the time arrays' keys)", x.label, s.index,
+		     tagn(s.tag).s, s.count, (unsigned long long)nt);
+	TRY(cx_load(&x, &s, &src, err));
+	float *all;
+	TAKE(all, nt * 4);
+	if (s.tag == MLOD_STREAM_TIME)
+		memcpy(all, src, (size_t)nt * 4);
+	else
+		for (uint64_t k = 0; k < nt; k++)
+			all[k] = (float)((double)(s.elsize == 2 ? rd16(src + 2 * k) : rd32(src + 4 * k)) * step);
+	for (uint64_t t = 0, at = 0; t < T; at += tcount[t++]) {
+		const float *times = all + at;
+		for (uint32_t k = 0; k < tcount[t]; k++) {
+			if (!isfinite(times[k]))
+				FAIL("%s: time array %u: key %u: time is not finite", x.label, (unsigned)t, k);
+			if (k > 0 && !(times[k] > times[k - 1]))
+				FAIL("%s: time array %u: key %u: time %g is not after %g", x.label, (unsigned)t, k,
+				     (double)times[k], (double)times[k - 1]);
+		}
+		tarr[t] = times;
+	}
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		const mlod_pack_channel_rec *rc = &ch->rec;
+		uint32_t K = rc->key_count;
+		const float *times = tarr[rc->time];
+		if (times[K - 1] > duration)
+			duration = times[K - 1];
+		ch->times = times;
+	}
 	/* The values: 'ROTQ', 'ROTF', 'VEC3', each the keys of its channels
 	 * one channel after the other, in channel order. */
 	TRY(cx_expect(&x, &s, MLOD_STREAM_ROTQ, 8, nq, "", "keys of the non-cubic rotations", err));

@@ -668,8 +668,8 @@ static int make_chunks(wchunk *c, int with_unknown)
 
 	/* MOTION level 0 of clip 0: translation (linear), rotation (ROTQ),
 	 * rotation (cubic, ROTF), scale (step); the first three share time
-	 * array 0 (ticks of 0.25 s, meshopt-coded), the scale has array 1
-	 * (the same times as f32). */
+	 * array 0, the scale has array 1 (the same times): ticks of 0.25 s,
+	 * meshopt-coded. */
 	ch = &c[C_MOT0];
 	ch->type = MLOD_CHUNK_MOTION, ch->layer = MLOD_LAYER_MOTION, ch->codec = MLOD_CODEC_MESHOPT;
 	s = add_stream(ch, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), MLOD_SCODEC_RAW);
@@ -692,14 +692,12 @@ static int make_chunks(wchunk *c, int with_unknown)
 	for (int k = 0; k < NK; k++)
 		for (int a = 0; a < 4; a++)
 			rotq_truth[k][a] = (int16_t)lrintf(rot_truth[k][a] * 32767.0f);
+	/* the two time arrays, one after the other, as ticks */
 	s = add_stream(ch, MLOD_STREAM_TICK, 4, MLOD_SCODEC_MESHOPT_VERTEX);
-	s->count = NK;
-	for (int k = 0; k < NK; k++)
-		put32(&s->data, (uint32_t)k);
-	s = add_stream(ch, MLOD_STREAM_TIME, 4, MLOD_SCODEC_RAW);
-	s->count = NK;
-	for (int k = 0; k < NK; k++)
-		putf(&s->data, time_truth[k]);
+	s->count = 2 * NK;
+	for (int a = 0; a < 2; a++)
+		for (int k = 0; k < NK; k++)
+			put32(&s->data, (uint32_t)k);
 	/* the values: ROTQ (channel 1), ROTF (channel 2), VEC3 (channels 0, 3) */
 	s = add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_MESHOPT_VERTEX);
 	s->count = NK;
@@ -1361,18 +1359,12 @@ static void e_extra_stream(wchunk *c)
 	for (int a = 0; a < 3; a++)
 		putf(&s->data, 2.0f);
 }
-static void e_time_after_values(wchunk *c)
-{
-	wstream *s = add_stream(&c[C_MOT1], MLOD_STREAM_TIME, 4, MLOD_SCODEC_RAW);
-	s->count = 1;
-	putf(&s->data, 2.0f);
-}
 static void e_dup_channel(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 2, 1); }
 static void e_no_vec3(wchunk *c) { wchunk_free_stream(&c[C_MOT1], 5); }
 static void e_missing_rotation(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1); }
 static void e_time_order(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 3 + 16, 2); }
-static void e_time_unused(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 3 + 16, 0); }
 static void e_time_keys(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 12, 3); }
+static void e_time_shared_keys(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 + 12, NK + 1); }
 static void e_step_zero(wchunk *c) { memset(stream_data(c, C_MOT0, MLOD_STREAM_STEP, 0), 0, 8); }
 static void e_step_nan(wchunk *c)
 {
@@ -1417,19 +1409,18 @@ TEST(structural_checks_name_the_chunk)
 		{e_info_levels, C_INFO, MLOD_ERR_PARSE, "INFO: the TOC has SKELETON level 1, but INFO counts"},
 		{e_clip_names, C_INFO, MLOD_ERR_PARSE, "INFO: the string table 'NAME' ends before clip 0's name"},
 		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 6 'VEC3')"},
-		{e_time_after_values, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 6 'TIME' after the first value stream"},
 		{e_time_order, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 3: time array 2 is not below 2 (the arrays go in first-use order)"},
-		{e_time_unused, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: time array 1 is not used by any channel"},
-		{e_time_keys, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: 3 keys, but time array 0 has 2"},
-		{e_step_zero, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: time array 0: ticks with step 0"},
+		{e_time_keys, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 2 'TIME' has 2 elements, expected 3 (the time arrays' keys)"},
+		{e_time_shared_keys, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: 6 keys, but time array 0 has 5"},
+		{e_step_zero, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 is 'TICK', expected 'TIME' (step 0)"},
 		{e_step_nan, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: step nan is not finite and >= 0"},
-		{e_tick_elsize, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: time array 0: stream 2 'TICK' has elements of 1 bytes, expected 2 or 4"},
+		{e_tick_elsize, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 'TICK' has elements of 1 bytes, expected 2 or 4"},
 		{e_dup_channel, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 2: a second rotation channel of joint 1"},
 		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 3 'ROTQ' has 0 elements, expected 2 (keys of the non-cubic rotations)"},
 		{e_no_vec3, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: missing stream 'VEC3' (the chunk has 5 streams)"},
 		{e_morph_scale, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: morph target 0: scale -1 is not finite and >= 0"},
 		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
-		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 4 'ROTQ' has 5 elements, expected 0 (keys of the non-cubic rotations)"},
+		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (keys of the non-cubic rotations)"},
 		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x40"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {

@@ -263,7 +263,8 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 {
 	const mlod_rt_view_level *vl = &fx_vmotion[clip * 3 + level];
 	chunk *c = new_chunk(MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, level, clip, vl->error, vl->distance);
-	/* one f32 time array per channel (channel i refers to array i) */
+	/* one f32 time array per channel (channel i refers to array i), in
+	 * one 'TIME' stream */
 	bytes *b = stream(c, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec));
 	for (uint32_t i = 0; i < m->channel_count; i++) {
 		mlod_pack_channel_rec rec = m->channels[i].rec;
@@ -275,13 +276,13 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 	double no_step = 0;
 	put(b, &no_step, 8);
 	stream_end(c);
+	b = stream(c, MLOD_STREAM_TIME, 4);
 	for (uint32_t i = 0; i < m->channel_count; i++) {
 		const mlod_pack_channel *ch = &m->channels[i];
-		b = stream(c, MLOD_STREAM_TIME, 4);
 		for (uint32_t k = 0; k < ch->rec.key_count; k++)
 			putf(b, ch->times[k]);
-		stream_end(c);
 	}
+	stream_end(c);
 	/* the values: ROTQ, ROTF, VEC3, each its channels' keys in order */
 	for (int kind = 0; kind < 3; kind++) {
 		b = stream(c, kind == 0 ? MLOD_STREAM_ROTQ : kind == 1 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3,
