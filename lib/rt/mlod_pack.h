@@ -353,7 +353,7 @@ typedef struct mlod_pack_channel_rec {
 	uint32_t path;             /* 0 translation, 1 rotation, 2 scale (mlod_path) */
 	uint32_t interp;           /* 0 linear, 1 step, 2 cubic spline (mlod_interp) */
 	uint32_t key_count;
-	uint32_t time;             /* its key-time array: index among the chunk's 'TIME'/'TICK' streams */
+	uint32_t time;             /* its key-time array: index in first-use order (mlod(5)) */
 } mlod_pack_channel_rec;
 
 /* The MOTION chunk's clip: INFO 'NAME' holds the clip names, after the
