@@ -119,7 +119,8 @@
  *   its glTF weight sets are kept; 'PART' comes first but is filled last.)
  *
  * MOTION level k of clip c (layer motion, item c; level 0 is the clip as
- *   read, every key): the channels of one clip on the full skeleton. Every
+ *   read, every key, a constant channel as one): the channels of one clip
+ *   on the full skeleton. Every
  *   clip has INFO motion_levels levels: a clip with fewer (too few frames,
  *   no level within a bound) repeats its coarsest one.
  *   'CHAN' channel records (mlod_pack_channel_rec)
