@@ -111,6 +111,17 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
  * angle between n and its round trip is below MLOD_PACK_OCT_BOUND. */
 #define MLOD_PACK_OCT_BOUND 1e-4 /* radians (4.3e-5 measured over 200000 random normals) */
 void mlod_pack_oct_encode(const float n[3], int16_t out[2]);
+
+/* 'ROTQ' rotations: each component of a unit quaternion (up to the sign
+ * the writer picks for continuity) is within half a step, 1/65534, of the
+ * input; the 4-vector error is then at most 1/32767 and the rotation
+ * angle between input and decoded (normalised) at most 2 asin(1/32767). */
+#define MLOD_PACK_ROTQ_BOUND (1.0 / 65534.0)
+/* Key times as 'TICK': each decoded time is the time given, or within
+ * MLOD_PACK_TICK_TOLERANCE * max(|t|, step) of it (about 8 f32 ulps:
+ * 4.8 microseconds at t = 5 s); the writer prefers a step that is exact. */
+#define MLOD_PACK_TICK_TOLERANCE (1.0 / 1048576.0)
+#define MLOD_PACK_ROTQ_ANGLE 6.1037e-5 /* radians, 2 asin(1/32767) rounded up; 0.0035 degrees */
 void mlod_pack_oct_decode(const int16_t in[2], float n[3]);
 
 /* A value within [min, min + 65535 * scale] to u16: q = round((v - min) /
@@ -123,6 +134,22 @@ float mlod_pack_range_scale(float min, float max);
  * by largest-remainder rounding: each differs from 255 w / sum by less
  * than 1. A zero sum gives all zeros. */
 void mlod_pack_weights8(const float w[4], uint8_t out[4]);
+
+/* The orders a part may be stored in (the writer keeps whichever codes
+ * to the fewest bytes, input order on a tie and with codec none):
+ *   0 as input;
+ *   1 the triangles reordered for the vertex cache
+ *     (meshopt_optimizeVertexCache), vertices as input;
+ *   2 as 1, then the vertices in the order those triangles first use them
+ *     (meshopt_optimizeVertexFetchRemap), vertices no triangle uses after
+ *     them in input order.
+ * remap[old] = new (nv entries), out[ni] the triangles in new vertex
+ * indices. ni is a multiple of 3 and every index below nv, else the order
+ * is left as it is (identity remap, out = indices). 0, or -1 when out of
+ * memory. */
+#define MLOD_PACK_ORDERS 3
+int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, uint32_t *remap,
+                           uint32_t *out);
 
 /* The switch distance of an error (scene units) at MLOD_PACK_FOV_Y,
  * MLOD_PACK_LINES and MLOD_PACK_PIXELS: error * lines / (2 tan(fov / 2)

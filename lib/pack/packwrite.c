@@ -819,17 +819,43 @@ struct part {
 	int jmap_count;
 };
 
-static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
+/* Adds a per-vertex stream in the part's stored order (remap[old] = new). */
+static void cb_add_vertices(chunkb *cb, uint32_t tag, uint32_t nv, uint16_t size, const void *data,
+                            const uint32_t *remap, void *scratch)
+{
+	if (nv)
+		meshopt_remapVertexBuffer(scratch, data, nv, size, remap);
+	cb_add(cb, tag, nv, size, scratch, 0);
+}
+
+static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt, int order)
 {
 	const mlod_primitive *p = pt->p;
 	mlod_pack_part_rec *rec = &pt->rec;
 	uint32_t nv = (uint32_t)p->vertex_count;
 	size_t cap = (size_t)nv + 1;
 	void *tmp = malloc(16 * cap > (size_t)p->index_count * 4 + 4 ? 16 * cap : (size_t)p->index_count * 4 + 4);
-	if (!tmp) {
+	void *perm = malloc(16 * cap);
+	uint32_t *remap = malloc(sizeof *remap * cap);
+	/* Indices (a primitive without them gets 0, 1, 2, ...), and the
+	 * stored order (mlod_pack_vertex_order). */
+	uint32_t ni = p->index_count > 0 ? (uint32_t)p->index_count : nv;
+	ni -= ni % 3;
+	uint32_t *i32 = malloc(sizeof(uint32_t) * ((size_t)ni + 1));
+	uint32_t *in32 = malloc(sizeof(uint32_t) * ((size_t)ni + 1));
+	if (!tmp || !perm || !remap || !i32 || !in32) {
+		free(tmp), free(perm), free(remap), free(i32), free(in32);
 		cb->fail = 1;
 		return;
 	}
+	for (uint32_t i = 0; i < ni; i++)
+		in32[i] = p->index_count > 0 ? p->indices[i] : i;
+	if (mlod_pack_vertex_order(order, in32, ni, nv, remap, i32) != 0) {
+		free(tmp), free(perm), free(remap), free(i32), free(in32);
+		cb->fail = 1;
+		return;
+	}
+	free(in32);
 	/* Positions. */
 	float mn[3] = {0, 0, 0}, mx[3] = {0, 0, 0};
 	for (uint32_t v = 0; v < nv; v++)
@@ -850,13 +876,13 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
 			q16[4 * v + a] = mlod_pack_qu16(p->positions[3 * v + a], mn[a], rec->pos_scale[a]);
 		q16[4 * v + 3] = 0;
 	}
-	cb_add(cb, MLOD_STREAM_POSQ, nv, 8, tmp, 0);
+	cb_add_vertices(cb, MLOD_STREAM_POSQ, nv, 8, tmp, remap, perm);
 	int16_t *s16 = tmp;
 	if (p->normals) {
 		rec->flags |= MLOD_PART_NORMALS;
 		for (uint32_t v = 0; v < nv; v++)
 			mlod_pack_oct_encode(p->normals + 3 * v, s16 + 2 * v);
-		cb_add(cb, MLOD_STREAM_NRMQ, nv, 4, tmp, 0);
+		cb_add_vertices(cb, MLOD_STREAM_NRMQ, nv, 4, tmp, remap, perm);
 	}
 	if (p->tangents) {
 		rec->flags |= MLOD_PART_TANGENTS;
@@ -865,7 +891,7 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
 			s16[4 * v + 2] = p->tangents[4 * v + 3] < 0.0f ? -32767 : 32767;
 			s16[4 * v + 3] = 0;
 		}
-		cb_add(cb, MLOD_STREAM_TANQ, nv, 8, tmp, 0);
+		cb_add_vertices(cb, MLOD_STREAM_TANQ, nv, 8, tmp, remap, perm);
 	}
 	int sets = p->uv_set_count < MLOD_PACK_MAX_UV ? p->uv_set_count : MLOD_PACK_MAX_UV;
 	rec->uv_sets = (uint32_t)sets;
@@ -886,7 +912,7 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
 		for (uint32_t v = 0; v < nv; v++)
 			for (int a = 0; a < 2; a++)
 				q16[2 * v + a] = mlod_pack_qu16(p->uvs[s][2 * v + a], umn[a], rec->uv_scale[s][a]);
-		cb_add(cb, MLOD_STREAM_UVQ0 + ((uint32_t)s << 24), nv, 4, tmp, 0);
+		cb_add_vertices(cb, MLOD_STREAM_UVQ0 + ((uint32_t)s << 24), nv, 4, tmp, remap, perm);
 	}
 	if (p->color_set_count > 0) {
 		uint8_t *u8 = tmp;
@@ -896,7 +922,7 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
 			f = f > 0.0f ? (f < 1.0f ? f : 1.0f) : 0.0f;
 			u8[v] = (uint8_t)lrintf(f * 255.0f);
 		}
-		cb_add(cb, MLOD_STREAM_COLQ, nv, 4, tmp, 0);
+		cb_add_vertices(cb, MLOD_STREAM_COLQ, nv, 4, tmp, remap, perm);
 	}
 	if (rec->skin >= 0 && p->weight_set_count > 0) {
 		const mlod_skin *sk = &x->v.skeleton.skins[rec->skin];
@@ -906,7 +932,7 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
 		if (!jj || !ww) {
 			free(jj);
 			free(ww);
-			free(tmp);
+			free(tmp), free(perm), free(remap), free(i32);
 			cb->fail = 1;
 			return;
 		}
@@ -952,29 +978,18 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
 			}
 		}
 		if (wide) {
-			cb_add(cb, MLOD_STREAM_JN16, nv, 8, jj, 0);
+			cb_add_vertices(cb, MLOD_STREAM_JN16, nv, 8, jj, remap, perm);
 		} else {
 			uint8_t *j8 = tmp;
 			for (uint32_t i = 0; i < 4 * nv; i++)
 				j8[i] = (uint8_t)jj[i];
-			cb_add(cb, MLOD_STREAM_JNT8, nv, 4, j8, 0);
+			cb_add_vertices(cb, MLOD_STREAM_JNT8, nv, 4, j8, remap, perm);
 		}
-		cb_add(cb, MLOD_STREAM_WGT8, nv, 4, ww, 0);
+		cb_add_vertices(cb, MLOD_STREAM_WGT8, nv, 4, ww, remap, perm);
 		free(jj);
 		free(ww);
 	}
-	/* Indices (a primitive without them gets 0, 1, 2, ...). */
-	uint32_t ni = p->index_count > 0 ? (uint32_t)p->index_count : nv;
-	ni -= ni % 3;
 	rec->index_count = ni;
-	uint32_t *i32 = malloc(sizeof(uint32_t) * ((size_t)ni + 1));
-	if (!i32) {
-		free(tmp);
-		cb->fail = 1;
-		return;
-	}
-	for (uint32_t i = 0; i < ni; i++)
-		i32[i] = p->index_count > 0 ? p->indices[i] : i;
 	if (nv <= 65536) {
 		uint16_t *i16 = (uint16_t *)i32; /* in place, front to back */
 		rec->flags |= MLOD_PART_INDEX16;
@@ -991,7 +1006,7 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
 	if (nt > 0) {
 		float *scale = malloc(sizeof(float) * (size_t)nt);
 		if (!scale) {
-			free(tmp);
+			free(tmp), free(perm), free(remap);
 			cb->fail = 1;
 			return;
 		}
@@ -1013,11 +1028,80 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt)
 				}
 				s16[4 * v + 3] = 0;
 			}
-			cb_add(cb, MLOD_STREAM_MTPQ, nv, 8, tmp, 0);
+			cb_add_vertices(cb, MLOD_STREAM_MTPQ, nv, 8, tmp, remap, perm);
 		}
 		free(scale);
 	}
 	free(tmp);
+	free(perm);
+	free(remap);
+}
+
+/* The meshopt-coded bytes of the streams from `from` on. */
+static size_t cb_coded_bytes(const chunkb *cb, int from)
+{
+	size_t total = 0;
+	for (int i = from; i < cb->n; i++) {
+		const stream *s = &cb->s[i];
+		size_t bytes = (size_t)s->count * s->size, got = bytes;
+		unsigned char *enc = NULL;
+		if (s->count == 0)
+			continue;
+		if (s->index && s->count % 3 == 0 && (s->size == 2 || s->size == 4)) {
+			unsigned int *idx = malloc(sizeof *idx * s->count), maxv = 0;
+			if (idx) {
+				for (uint32_t k = 0; k < s->count; k++) {
+					if (s->size == 2) {
+						uint16_t v;
+						memcpy(&v, s->data + 2 * k, 2);
+						idx[k] = v;
+					} else {
+						memcpy(&idx[k], s->data + 4 * k, 4);
+					}
+					maxv = idx[k] > maxv ? idx[k] : maxv;
+				}
+				size_t bound = meshopt_encodeIndexBufferBound(s->count, (size_t)maxv + 1);
+				if ((enc = malloc(bound)) != NULL) {
+					size_t e = meshopt_encodeIndexBuffer(enc, bound, idx, s->count);
+					got = e > 0 ? e : bytes;
+				}
+			}
+			free(idx);
+		} else if (!s->index && s->size % 4 == 0) {
+			size_t bound = meshopt_encodeVertexBufferBound(s->count, s->size);
+			if ((enc = malloc(bound)) != NULL) {
+				size_t e = meshopt_encodeVertexBuffer(enc, bound, s->data, s->count, s->size);
+				got = e > 0 && e < bytes ? e : bytes;
+			}
+		}
+		free(enc);
+		total += (got + 3) & ~(size_t)3;
+	}
+	return total;
+}
+
+/* A part's streams in the order (mlod_pack_vertex_order) that codes to
+ * the fewest bytes; input order with codec none. */
+static void add_part(struct ctx *x, chunkb *cb, struct part *pt)
+{
+	if (x->opt->codec != MLOD_CODEC_MESHOPT) {
+		add_part_streams(x, cb, pt, 0);
+		return;
+	}
+	int best = 0, from = cb->n;
+	size_t best_bytes = 0;
+	mlod_pack_part_rec rec0 = pt->rec;
+	for (int o = 0; o < MLOD_PACK_ORDERS && !cb->fail; o++) {
+		pt->rec = rec0;
+		add_part_streams(x, cb, pt, o);
+		size_t b = cb->fail ? 0 : cb_coded_bytes(cb, from);
+		if (o == 0 || b < best_bytes)
+			best = o, best_bytes = b;
+		while (cb->n > from)
+			free(cb->s[--cb->n].data);
+	}
+	pt->rec = rec0;
+	add_part_streams(x, cb, pt, best);
 }
 
 /* Maps the joints of a level skin (input skin `lsk`) to the full skin
@@ -1126,7 +1210,7 @@ static mlod_result mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count
 	/* PART first: its records are complete once the streams are made. */
 	cb_add(&cb, MLOD_STREAM_PART, 0, sizeof(mlod_pack_part_rec), NULL, 0);
 	for (int i = 0; i < np; i++)
-		add_part_streams(x, &cb, &parts[i]);
+		add_part(x, &cb, &parts[i]);
 	if (!cb.fail) {
 		mlod_pack_part_rec *recs = malloc(sizeof *recs * ((size_t)np + 1));
 		if (!recs) {
@@ -1274,20 +1358,74 @@ static mlod_result motion_levels(struct ctx *x)
 	return r;
 }
 
-/* 1 when every value of a rotation channel is q / 32767 for an integer q. */
-static int on_lattice(const mlod_channel *ch)
+/* 1 when a non-cubic channel's keys all hold one value (bit for bit). */
+static int constant_channel(const mlod_channel *ch)
 {
-	if (ch->path != MLOD_PATH_ROTATION || ch->interp == MLOD_INTERP_CUBICSPLINE)
+	if (ch->interp == MLOD_INTERP_CUBICSPLINE || ch->key_count < 2)
 		return 0;
-	for (int i = 0; i < 4 * ch->key_count; i++) {
-		float v = ch->values[i];
-		if (!(fabsf(v) <= 1.0f))
+	int comps = ch->path == MLOD_PATH_ROTATION ? 4 : 3;
+	for (int k = 1; k < ch->key_count; k++)
+		if (memcmp(ch->values + (size_t)comps * k, ch->values, sizeof(float) * (size_t)comps) != 0)
 			return 0;
-		long q = lrintf(v * 32767.0f);
-		if ((float)q / 32767.0f != v)
-			return 0;
-	}
 	return 1;
+}
+
+/* 1 when every time t of the arrays is within tol * max(|t|, step) of
+ * (float)(tick * step) for a tick in 0..UINT32_MAX (tol 0: exactly), and
+ * the ticks and their times increase strictly; *max_tick is the largest. */
+static int ticks_fit(const float *const *arr, const int *cnt, int n, double step, double tol, uint32_t *max_tick)
+{
+	uint32_t mx = 0;
+	if (!(step > 0) || !isfinite(step))
+		return 0;
+	for (int a = 0; a < n; a++) {
+		float prev = 0;
+		for (int k = 0; k < cnt[a]; k++) {
+			double q = floor((double)arr[a][k] / step + 0.5);
+			if (!(q >= 0 && q <= 4294967295.0))
+				return 0;
+			float t = (float)(q * step);
+			double lim = tol * (fabs((double)arr[a][k]) > step ? fabs((double)arr[a][k]) : step);
+			if (tol == 0 ? t != arr[a][k] : !(fabs((double)t - arr[a][k]) <= lim))
+				return 0;
+			if (k > 0 && !(t > prev))
+				return 0;
+			prev = t;
+			mx = (uint32_t)q > mx ? (uint32_t)q : mx;
+		}
+	}
+	*max_tick = mx;
+	return 1;
+}
+
+/* The time step of a chunk's key-time arrays, or 0 to keep them f32. The
+ * candidates: 1 / the nearest whole frame rate to the smallest key
+ * interval d; the smallest positive key time (a clip sampled as
+ * (float)(k * step)); the largest time over its whole number of d; d.
+ * The first that gives every time back exactly wins; else the first
+ * within MLOD_PACK_TICK_TOLERANCE (times summed frame by frame in f32). */
+static double time_step(const float *const *arr, const int *cnt, int n, uint32_t *max_tick)
+{
+	double d = 0, first = 0, last = 0;
+	for (int a = 0; a < n; a++)
+		for (int k = 0; k < cnt[a]; k++) {
+			double t = arr[a][k], e = k > 0 ? t - (double)arr[a][k - 1] : 0;
+			if (e > 0 && (d == 0 || e < d))
+				d = e;
+			if (t > 0 && (first == 0 || t < first))
+				first = t;
+			last = t > last ? t : last;
+		}
+	if (d == 0)
+		return 0;
+	double fps = floor(1.0 / d + 0.5), frames = floor(last / d + 0.5);
+	double cand[5] = {fps >= 1 && fps <= 100000 ? 1.0 / fps : 0, first, frames >= 1 ? last / frames : 0,
+	                  frames >= 1 ? (double)(float)(last / frames) : 0, d};
+	for (int pass = 0; pass < 2; pass++)
+		for (int i = 0; i < 5; i++)
+			if (cand[i] > 0 && ticks_fit(arr, cnt, n, cand[i], pass ? MLOD_PACK_TICK_TOLERANCE : 0, max_tick))
+				return cand[i];
+	return 0;
 }
 
 static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int item, float error, chunks *out)
@@ -1295,35 +1433,117 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 	chunkb cb = {0};
 	int n = clip->channel_count;
 	mlod_pack_channel_rec *recs = calloc((size_t)n + 1, sizeof *recs);
-	if (!recs)
+	const float **arr = calloc((size_t)n + 1, sizeof *arr);
+	int *cnt = calloc((size_t)n + 1, sizeof *cnt), na = 0;
+	if (!recs || !arr || !cnt) {
+		free(recs), free(arr), free(cnt);
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	/* The distinct time arrays, in first-use order. */
 	for (int i = 0; i < n; i++) {
 		const mlod_channel *ch = &clip->channels[i];
+		int konst = constant_channel(ch), keys = konst ? 1 : ch->key_count;
+		const float *t = konst ? ch->times + ch->key_count - 1 : ch->times;
+		int a = 0;
+		while (a < na && !(cnt[a] == keys && memcmp(arr[a], t, sizeof(float) * (size_t)keys) == 0))
+			a++;
+		if (a == na)
+			arr[na] = t, cnt[na++] = keys;
 		recs[i] = (mlod_pack_channel_rec){(uint32_t)ch->joint, (uint32_t)ch->path, (uint32_t)ch->interp,
-		                                  (uint32_t)ch->key_count};
+		                                  (uint32_t)keys, (uint32_t)a};
 	}
 	cb_add(&cb, MLOD_STREAM_CHAN, (uint32_t)n, sizeof *recs, recs, 0);
 	free(recs);
+	uint32_t max_tick = 0;
+	double step = time_step(arr, cnt, na, &max_tick);
+	cb_add(&cb, MLOD_STREAM_STEP, 1, 8, &step, 0);
+	/* The key times: one stream, the arrays one after the other; f32, or
+	 * u16 ticks raw, u32 where they do not fit or the vertex codec (a
+	 * multiple of 4 bytes) applies. */
+	size_t nt = 0;
+	for (int a = 0; a < na; a++)
+		nt += (size_t)cnt[a];
+	int wide = max_tick > 65535 || x->opt->codec == MLOD_CODEC_MESHOPT;
+	uint8_t *tk = malloc(4 * (nt + 1));
+	if (!tk) {
+		cb.fail = 1;
+	} else {
+		size_t at = 0;
+		for (int a = 0; a < na; a++)
+			for (int q = 0; q < cnt[a]; q++, at++) {
+				if (step == 0) {
+					memcpy(tk + 4 * at, &arr[a][q], 4);
+					continue;
+				}
+				uint32_t v = (uint32_t)floor((double)arr[a][q] / step + 0.5);
+				if (wide)
+					put_u32(tk + 4 * at, v);
+				else
+					put_u16(tk + 2 * at, (uint16_t)v);
+			}
+		if (step == 0)
+			cb_add(&cb, MLOD_STREAM_TIME, (uint32_t)nt, 4, tk, 0);
+		else
+			cb_add(&cb, MLOD_STREAM_TICK, (uint32_t)nt, wide ? 4 : 2, tk, 0);
+		free(tk);
+	}
+	free(arr);
+	free(cnt);
+	/* The values: 'ROTQ' (non-cubic rotations), 'ROTF' (cubic rotations),
+	 * 'VEC3' (translations and scales), each one stream of its channels'
+	 * keys in channel order. */
+	size_t nq = 0, nf = 0, nv = 0;
+	for (int i = 0; i < n; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		size_t keys = constant_channel(ch) ? 1 : (size_t)ch->key_count;
+		size_t per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
+		if (ch->path == MLOD_PATH_ROTATION && per == 1)
+			nq += keys;
+		else if (ch->path == MLOD_PATH_ROTATION)
+			nf += 3 * keys;
+		else
+			nv += per * keys;
+	}
+	int16_t *q = malloc(sizeof(int16_t) * 4 * (nq + 1));
+	float *rf = malloc(sizeof(float) * 4 * (nf + 1)), *v3 = malloc(sizeof(float) * 3 * (nv + 1));
+	if (!q || !rf || !v3)
+		cb.fail = 1;
+	size_t at_q = 0, at_f = 0, at_v = 0;
 	for (int i = 0; i < n && !cb.fail; i++) {
 		const mlod_channel *ch = &clip->channels[i];
-		uint32_t keys = (uint32_t)ch->key_count, per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
-		cb_add(&cb, MLOD_STREAM_TIME, keys, 4, ch->times, 0);
-		if (ch->path == MLOD_PATH_ROTATION && (ch->short_values || on_lattice(ch)) && on_lattice(ch)) {
-			int16_t *q = malloc(sizeof(int16_t) * 4 * ((size_t)keys + 1));
-			if (!q) {
-				cb.fail = 1;
-				break;
+		int konst = constant_channel(ch);
+		uint32_t keys = konst ? 1 : (uint32_t)ch->key_count, per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
+		if (ch->path == MLOD_PATH_ROTATION && per == 1) {
+			/* Nearest lattice point, each key's sign continuing the last. */
+			for (uint32_t v = 0; v < keys; v++, at_q++) {
+				const float *r = ch->values + 4 * (size_t)v;
+				double sign = 1;
+				if (v > 0) {
+					double dot = 0;
+					for (int c = 0; c < 4; c++)
+						dot += (double)r[c] * q[4 * (at_q - 1) + c];
+					sign = dot < 0 ? -1 : 1;
+				}
+				for (int c = 0; c < 4; c++) {
+					double e = sign * r[c];
+					e = e > 1 ? 1 : e < -1 ? -1 : e;
+					q[4 * at_q + c] = (int16_t)lrint(e * 32767.0);
+				}
 			}
-			for (uint32_t v = 0; v < 4 * keys; v++)
-				q[v] = (int16_t)lrintf(ch->values[v] * 32767.0f);
-			cb_add(&cb, MLOD_STREAM_ROTQ, keys, 8, q, 0);
-			free(q);
 		} else if (ch->path == MLOD_PATH_ROTATION) {
-			cb_add(&cb, MLOD_STREAM_ROTF, keys * per, 16, ch->values, 0);
+			memcpy(rf + 4 * at_f, ch->values, sizeof(float) * 4 * 3 * keys);
+			at_f += 3 * (size_t)keys;
 		} else {
-			cb_add(&cb, MLOD_STREAM_VEC3, keys * per, 12, ch->values, 0);
+			memcpy(v3 + 3 * at_v, ch->values, sizeof(float) * 3 * per * keys);
+			at_v += (size_t)per * keys;
 		}
 	}
+	cb_add(&cb, MLOD_STREAM_ROTQ, (uint32_t)nq, 8, q, 0);
+	cb_add(&cb, MLOD_STREAM_ROTF, (uint32_t)nf, 16, rf, 0);
+	cb_add(&cb, MLOD_STREAM_VEC3, (uint32_t)nv, 12, v3, 0);
+	free(q);
+	free(rf);
+	free(v3);
 	return cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, k, item, error, x->err);
 }
 

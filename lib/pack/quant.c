@@ -6,6 +6,10 @@
 
 #include "pack/mlod_pack_write.h"
 
+#include <meshoptimizer.h>
+#include <stdlib.h>
+#include <string.h>
+
 static float sign_not_zero(float v)
 {
 	return v < 0.0f ? -1.0f : 1.0f;
@@ -129,4 +133,37 @@ float mlod_pack_switch_distance(float error)
 	if (!(error > 0.0f))
 		return 0.0f;
 	return (float)((double)error * MLOD_PACK_LINES / (2.0 * tan(MLOD_PACK_FOV_Y * pi / 360.0) * MLOD_PACK_PIXELS));
+}
+
+int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, uint32_t *remap,
+                           uint32_t *out)
+{
+	int ok = ni % 3 == 0 && order > 0;
+	for (uint32_t i = 0; ok && i < ni; i++)
+		ok = indices[i] < nv;
+	if (!ok || nv == 0) {
+		for (uint32_t v = 0; v < nv; v++)
+			remap[v] = v;
+		if (ni)
+			memmove(out, indices, sizeof *out * ni);
+		return 0;
+	}
+	unsigned int *cache = malloc(sizeof *cache * ((size_t)ni + 1));
+	if (!cache)
+		return -1;
+	meshopt_optimizeVertexCache(cache, indices, ni, nv);
+	if (order == 1) {
+		for (uint32_t v = 0; v < nv; v++)
+			remap[v] = v;
+		memcpy(out, cache, sizeof *out * ni);
+		free(cache);
+		return 0;
+	}
+	size_t used = meshopt_optimizeVertexFetchRemap(remap, cache, ni, nv);
+	for (uint32_t v = 0; v < nv; v++)
+		if (remap[v] == ~0u)
+			remap[v] = (uint32_t)used++;
+	meshopt_remapIndexBuffer(out, cache, ni, remap);
+	free(cache);
+	return 0;
 }

@@ -119,16 +119,37 @@
  *   its glTF weight sets are kept; 'PART' comes first but is filled last.)
  *
  * MOTION level k of clip c (layer motion, item c; level 0 is the clip as
- *   read, every key): the channels of one clip on the full skeleton. Every
+ *   read, every key, a constant channel as one): the channels of one clip
+ *   on the full skeleton. Every
  *   clip has INFO motion_levels levels: a clip with fewer (too few frames,
  *   no level within a bound) repeats its coarsest one.
  *   'CHAN' channel records (mlod_pack_channel_rec)
- *   then per channel: 'TIME' f32 per key (seconds), and
- *   'ROTQ' i16[4] per key (normalised: value = q / 32767) for a rotation
- *          whose every value sits on that lattice, else 'ROTF' f32[4];
- *          'VEC3' f32[3] per key for translation and scale;
- *          CUBICSPLINE channels store 3 values per key (in-tangent, value,
- *          out-tangent), in 'ROTF' or 'VEC3'.
+ *   'STEP' one f64: the chunk's time step in seconds, 0 for f32 times
+ *   then the key times, one stream: the chunk's distinct key-time arrays
+ *   one after the other, in the order the channels first refer to them
+ *   (channel rec.time: its array's index; channel 0 refers to array 0,
+ *   each later channel to an earlier array or the next one; an array's
+ *   length is the key_count of the channels referring to it):
+ *   'TIME' f32 per key (seconds), when step is 0, or
+ *   'TICK' u16 (element size 2) or u32 (element size 4) per key, when
+ *          step > 0: time = (float)((double)tick * step): the key time
+ *          read, or within 2^-20 * max(|t|, step) of it (mlod(5),
+ *          QUANTISATION)
+ *   then the values, three streams, each holding the keys of its
+ *   channels one channel after the other in channel order (possibly 0
+ *   elements):
+ *   'ROTQ' i16[4] per key of every non-cubic rotation (value = q / 32767):
+ *          the rotation rounded to the nearest lattice point, each key's
+ *          sign chosen for continuity with the key before (q and -q are
+ *          one rotation);
+ *   'ROTF' f32[4], 3 per key (in-tangent, value, out-tangent), of every
+ *          cubic-spline rotation;
+ *   'VEC3' f32[3] per key (3 per key for cubic splines) of every
+ *          translation and scale.
+ *   (Writer's notes: a non-cubic channel whose keys all hold one value is
+ *   stored as one key at its last time, which keeps the clip's duration;
+ *   key times go as ticks when every one is a multiple of one step within
+ *   that tolerance, as sampled clips' are, an exact step preferred.)
  *
  * DOC (layer none, once, last): stream 'GLB ': the input glb without the
  *   meshes' geometry and the joint clips, which the levels hold: materials,
@@ -166,7 +187,10 @@
  *   ((1 - |y|) * sign x, (1 - |x|) * sign y) with sign 0 = +1; then the
  *   vector is normalised. 'TANQ' w is exactly -32767 or 32767.
  * - MOTION: key times are finite and strictly increasing; a joint has at
- *   most one channel per path; 'ROTQ' only for non-cubic channels.
+ *   most one channel per path; each value stream's count is its
+ *   channels' keys (x3 for cubic), the time stream's the arrays' keys;
+ *   every channel referring to an array has its key count; 'STEP' is
+ *   finite and >= 0.
  */
 #ifndef MLOD_PACK_H
 #define MLOD_PACK_H
@@ -249,7 +273,9 @@ typedef enum mlod_pack_codec {
 #define MLOD_STREAM_MTSC MLOD_FOURCC('M', 'T', 'S', 'C')
 #define MLOD_STREAM_MTPQ MLOD_FOURCC('M', 'T', 'P', 'Q')
 #define MLOD_STREAM_CHAN MLOD_FOURCC('C', 'H', 'A', 'N')
+#define MLOD_STREAM_STEP MLOD_FOURCC('S', 'T', 'E', 'P')
 #define MLOD_STREAM_TIME MLOD_FOURCC('T', 'I', 'M', 'E')
+#define MLOD_STREAM_TICK MLOD_FOURCC('T', 'I', 'C', 'K')
 #define MLOD_STREAM_ROTQ MLOD_FOURCC('R', 'O', 'T', 'Q')
 #define MLOD_STREAM_ROTF MLOD_FOURCC('R', 'O', 'T', 'F')
 #define MLOD_STREAM_VEC3 MLOD_FOURCC('V', 'E', 'C', '3')
@@ -328,6 +354,7 @@ typedef struct mlod_pack_channel_rec {
 	uint32_t path;             /* 0 translation, 1 rotation, 2 scale (mlod_path) */
 	uint32_t interp;           /* 0 linear, 1 step, 2 cubic spline (mlod_interp) */
 	uint32_t key_count;
+	uint32_t time;             /* its key-time array: index in first-use order (mlod(5)) */
 } mlod_pack_channel_rec;
 
 /* The MOTION chunk's clip: INFO 'NAME' holds the clip names, after the
@@ -427,7 +454,7 @@ typedef struct mlod_pack_mesh {
 
 typedef struct mlod_pack_channel {
 	mlod_pack_channel_rec rec;
-	const float *times;             /* key_count */
+	const float *times;             /* key_count (shared by channels with one time array) */
 	float *values;                  /* 3 or 4 per key (x3 for cubic spline), dequantised */
 } mlod_pack_channel;
 

@@ -33,7 +33,7 @@ _Static_assert(sizeof(mlod_pack_info_rec) == 80, "INFO record is 80 bytes");
 _Static_assert(sizeof(mlod_pack_joint_rec) == 116, "joint record is 116 bytes");
 _Static_assert(sizeof(mlod_pack_skin_rec) == 12, "skin record is 12 bytes");
 _Static_assert(sizeof(mlod_pack_part_rec) == 200, "part record is 200 bytes");
-_Static_assert(sizeof(mlod_pack_channel_rec) == 16, "channel record is 16 bytes");
+_Static_assert(sizeof(mlod_pack_channel_rec) == 20, "channel record is 20 bytes");
 
 /* The largest block (and temporary buffer) a decode allocates. */
 #define PACK_MAX_BLOCK ((uint64_t)1 << 30)
@@ -1276,11 +1276,14 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	if (r != MLOD_OK)
 		return r;
 	uint32_t J = skel ? skel->joint_count : 0;
-	stream sc;
+	stream sc, sstep;
 	TRY(cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
-	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel));
+	TRY(cx_expect(&x, &sstep, MLOD_STREAM_STEP, 8, 1, "", "one step", err));
+	/* each channel's values are taken on their own: up to 8 bytes of
+	 * rounding each */
+	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel)) + 8 * C;
 	while (cx_next(&x, &s)) {
-		uint64_t per = s.tag == MLOD_STREAM_TIME ? 4
+		uint64_t per = s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK ? 4
 		               : s.tag == MLOD_STREAM_ROTQ || s.tag == MLOD_STREAM_ROTF ? 16
 		               : s.tag == MLOD_STREAM_VEC3                                ? 12
 		                                                                          : 0;
@@ -1288,24 +1291,39 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 			FAIL("%s: stream %u is '%s', not a motion stream", x.label, s.index, tagn(s.tag).s);
 		total += round8(per * s.count);
 	}
+	/* the time arrays: a pointer and a count per array, at most one per
+	 * channel */
+	total += round8(C * sizeof(float *)) + round8(C * 4);
 	cx_rewind(&x);
 	/* aux: one byte per joint and path, to find a second channel. */
 	TRY(cx_temp(&x, (uint64_t)J * 3, err));
 	TRY(bump_alloc(&b, &x, total, err));
 	uint8_t *seen = x.temp;
 	mlod_pack_channel *chans;
+	const float **tarr;
+	uint32_t *tcount;
 	TAKE(chans, C * sizeof *chans);
+	TAKE(tarr, C * sizeof *tarr);
+	TAKE(tcount, C * sizeof *tcount);
 	TRY(cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
 	TRY(cx_load(&x, &sc, &src, err));
 	for (uint64_t i = 0; i < C; i++)
 		memcpy(&chans[i].rec, src + i * sizeof(mlod_pack_channel_rec), sizeof(mlod_pack_channel_rec));
+	TRY(cx_expect(&x, &sstep, MLOD_STREAM_STEP, 8, 1, "", "one step", err));
+	TRY(cx_load(&x, &sstep, &src, err));
+	double step;
+	{
+		uint64_t bits = rd64(src);
+		memcpy(&step, &bits, 8);
+	}
+	if (!isfinite(step) || !(step >= 0))
+		FAIL("%s: step %g is not finite and >= 0", x.label, step);
 	float duration = 0;
 	static const char *const path_names[3] = {"translation", "rotation", "scale"};
+	/* The channels; the time arrays' counts, in first-use order. */
+	uint64_t T = 0, nt = 0, nq = 0, nf = 0, nv = 0;
 	for (uint32_t i = 0; i < C; i++) {
-		mlod_pack_channel *ch = &chans[i];
-		const mlod_pack_channel_rec *rc = &ch->rec;
-		char what[32];
-		snprintf(what, sizeof what, "channel %u", i);
+		const mlod_pack_channel_rec *rc = &chans[i].rec;
 		uint32_t K = rc->key_count;
 		if (rc->joint >= J)
 			FAIL("%s: channel %u: joint %u is not below the skeleton's %u joints", x.label, i, rc->joint, J);
@@ -1318,54 +1336,102 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 		if (seen[3 * (size_t)rc->joint + rc->path])
 			FAIL("%s: channel %u: a second %s channel of joint %u", x.label, i, path_names[rc->path], rc->joint);
 		seen[3 * (size_t)rc->joint + rc->path] = 1;
-		float *times;
-		TRY(cx_expect(&x, &s, MLOD_STREAM_TIME, 4, K, what, "key count", err));
-		TRY(cx_load(&x, &s, &src, err));
-		TAKE(times, (uint64_t)K * 4);
-		memcpy(times, src, (size_t)K * 4);
-		for (uint32_t k = 0; k < K; k++) {
-			if (!isfinite(times[k]))
-				FAIL("%s: channel %u: key %u: time is not finite", x.label, i, k);
-			if (k > 0 && !(times[k] > times[k - 1]))
-				FAIL("%s: channel %u: key %u: time %g is not after %g", x.label, i, k, (double)times[k],
-				     (double)times[k - 1]);
+		if (rc->time > T)
+			FAIL("%s: channel %u: time array %u is not below %llu (the arrays go in first-use order)", x.label, i,
+			     rc->time, (unsigned long long)T + 1);
+		if (rc->time == T) {
+			tcount[T++] = K;
+			nt += K;
+		} else if (tcount[rc->time] != K) {
+			FAIL("%s: channel %u: %u keys, but time array %u has %u", x.label, i, K, rc->time, tcount[rc->time]);
 		}
+		uint64_t m = rc->interp == 2 ? 3 : 1;
+		if (rc->path == 1 && m == 1)
+			nq += K;
+		else if (rc->path == 1)
+			nf += 3 * (uint64_t)K;
+		else
+			nv += m * K;
+	}
+	/* The key times: one stream, the arrays one after the other. */
+	if (!cx_next(&x, &s))
+		FAIL("%s: missing its key times", x.label);
+	if (s.tag != (step > 0 ? MLOD_STREAM_TICK : MLOD_STREAM_TIME))
+		FAIL("%s: stream %u is '%s', expected '%s' (step %g)", x.label, s.index, tagn(s.tag).s,
+		     step > 0 ? "TICK" : "TIME", step);
+	if (s.tag == MLOD_STREAM_TICK ? s.elsize != 2 && s.elsize != 4 : s.elsize != 4)
+		FAIL("%s: stream %u '%s' has elements of %u bytes, expected %s", x.label, s.index, tagn(s.tag).s, s.elsize,
+		     s.tag == MLOD_STREAM_TICK ? "2 or 4" : "4");
+	if (s.count != nt)
+		FAIL("%s: stream %u '%s' has %u elements, expected %llu (the time arrays' keys)", x.label, s.index,
+		     tagn(s.tag).s, s.count, (unsigned long long)nt);
+	TRY(cx_load(&x, &s, &src, err));
+	float *all;
+	TAKE(all, nt * 4);
+	if (s.tag == MLOD_STREAM_TIME)
+		memcpy(all, src, (size_t)nt * 4);
+	else
+		for (uint64_t k = 0; k < nt; k++)
+			all[k] = (float)((double)(s.elsize == 2 ? rd16(src + 2 * k) : rd32(src + 4 * k)) * step);
+	for (uint64_t t = 0, at = 0; t < T; at += tcount[t++]) {
+		const float *times = all + at;
+		for (uint32_t k = 0; k < tcount[t]; k++) {
+			if (!isfinite(times[k]))
+				FAIL("%s: time array %u: key %u: time is not finite", x.label, (unsigned)t, k);
+			if (k > 0 && !(times[k] > times[k - 1]))
+				FAIL("%s: time array %u: key %u: time %g is not after %g", x.label, (unsigned)t, k,
+				     (double)times[k], (double)times[k - 1]);
+		}
+		tarr[t] = times;
+	}
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		const mlod_pack_channel_rec *rc = &ch->rec;
+		uint32_t K = rc->key_count;
+		const float *times = tarr[rc->time];
 		if (times[K - 1] > duration)
 			duration = times[K - 1];
 		ch->times = times;
-		uint64_t m = rc->interp == 2 ? 3 : 1, values = m * K;
-		if (rc->path == 1) {
-			/* ROTQ, or ROTF (always for cubic splines). */
-			if (!cx_next(&x, &s))
-				FAIL("%s: channel %u: missing its rotation stream", x.label, i);
-			if (s.tag == MLOD_STREAM_ROTQ && m == 1) {
-				x.next--;
-				x.cursor -= pad4(s.stored);
-				TRY(cx_expect(&x, &s, MLOD_STREAM_ROTQ, 8, values, what, "key count", err));
-				TRY(cx_load(&x, &s, &src, err));
-				TAKE(ch->values, values * 16);
-				for (size_t k = 0; k < values * 4; k++)
-					ch->values[k] = rdi16(src + 2 * k) / 32767.0f;
-			} else {
-				x.next--;
-				x.cursor -= pad4(s.stored);
-				TRY(cx_expect(&x, &s, MLOD_STREAM_ROTF, 16, values, what,
-				              m == 3 ? "3 values per key" : "key count", err));
-				TRY(cx_load(&x, &s, &src, err));
-				TAKE(ch->values, values * 16);
-				memcpy(ch->values, src, values * 16);
-				if (!all_finite(ch->values, values * 4))
-					FAIL("%s: channel %u: a rotation value is not finite", x.label, i);
-			}
-		} else {
-			TRY(cx_expect(&x, &s, MLOD_STREAM_VEC3, 12, values, what, m == 3 ? "3 values per key" : "key count",
-			              err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(ch->values, values * 12);
-			memcpy(ch->values, src, values * 12);
-			if (!all_finite(ch->values, values * 3))
-				FAIL("%s: channel %u: a %s value is not finite", x.label, i, path_names[rc->path]);
-		}
+	}
+	/* The values: 'ROTQ', 'ROTF', 'VEC3', each the keys of its channels
+	 * one channel after the other, in channel order. */
+	TRY(cx_expect(&x, &s, MLOD_STREAM_ROTQ, 8, nq, "", "keys of the non-cubic rotations", err));
+	TRY(cx_load(&x, &s, &src, err));
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path != 1 || ch->rec.interp == 2)
+			continue;
+		uint64_t values = ch->rec.key_count;
+		TAKE(ch->values, values * 16);
+		for (size_t k = 0; k < values * 4; k++)
+			ch->values[k] = rdi16(src + 2 * k) / 32767.0f;
+		src += values * 8;
+	}
+	TRY(cx_expect(&x, &s, MLOD_STREAM_ROTF, 16, nf, "", "3 values per key of the cubic rotations", err));
+	TRY(cx_load(&x, &s, &src, err));
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path != 1 || ch->rec.interp != 2)
+			continue;
+		uint64_t values = 3 * (uint64_t)ch->rec.key_count;
+		TAKE(ch->values, values * 16);
+		memcpy(ch->values, src, values * 16);
+		src += values * 16;
+		if (!all_finite(ch->values, values * 4))
+			FAIL("%s: channel %u: a rotation value is not finite", x.label, i);
+	}
+	TRY(cx_expect(&x, &s, MLOD_STREAM_VEC3, 12, nv, "", "keys of the translations and scales", err));
+	TRY(cx_load(&x, &s, &src, err));
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path == 1)
+			continue;
+		uint64_t values = (ch->rec.interp == 2 ? 3 : 1) * (uint64_t)ch->rec.key_count;
+		TAKE(ch->values, values * 12);
+		memcpy(ch->values, src, values * 12);
+		src += values * 12;
+		if (!all_finite(ch->values, values * 3))
+			FAIL("%s: channel %u: a %s value is not finite", x.label, i, path_names[ch->rec.path]);
 	}
 	TRY(cx_end(&x, err));
 	cx_done(&x);

@@ -636,12 +636,18 @@ static int make_chunks(wchunk *c, int with_unknown)
 		time_truth[k] = 0.25f * (float)k;
 	s = add_stream(ch, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), MLOD_SCODEC_RAW);
 	s->count = 1;
-	mlod_pack_channel_rec cr = {0, 0, 0, 2};
+	mlod_pack_channel_rec cr = {0, 0, 0, 2, 0};
 	put(&s->data, &cr, sizeof cr);
+	s = add_stream(ch, MLOD_STREAM_STEP, 8, MLOD_SCODEC_RAW);
+	s->count = 1;
+	double no_step = 0;
+	put(&s->data, &no_step, 8);
 	s = add_stream(ch, MLOD_STREAM_TIME, 4, MLOD_SCODEC_RAW);
 	s->count = 2;
 	putf(&s->data, 0.0f);
 	putf(&s->data, 1.0f);
+	add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_RAW);
+	add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
 	s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_RAW);
 	s->count = 2;
 	for (int k = 0; k < 6; k++)
@@ -661,13 +667,19 @@ static int make_chunks(wchunk *c, int with_unknown)
 	part_streams(ch, &parts_truth[1], MLOD_SCODEC_MESHOPT_VERTEX, MLOD_SCODEC_MESHOPT_INDEX);
 
 	/* MOTION level 0 of clip 0: translation (linear), rotation (ROTQ),
-	 * rotation (cubic, ROTF), scale (step). */
+	 * rotation (cubic, ROTF), scale (step); the first three share time
+	 * array 0, the scale has array 1 (the same times): ticks of 0.25 s,
+	 * meshopt-coded. */
 	ch = &c[C_MOT0];
 	ch->type = MLOD_CHUNK_MOTION, ch->layer = MLOD_LAYER_MOTION, ch->codec = MLOD_CODEC_MESHOPT;
 	s = add_stream(ch, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), MLOD_SCODEC_RAW);
 	s->count = 4;
-	mlod_pack_channel_rec chans[4] = {{0, 0, 0, NK}, {1, 1, 0, NK}, {2, 1, 2, NK}, {3, 2, 1, NK}};
+	mlod_pack_channel_rec chans[4] = {{0, 0, 0, NK, 0}, {1, 1, 0, NK, 0}, {2, 1, 2, NK, 0}, {3, 2, 1, NK, 1}};
 	put(&s->data, chans, sizeof chans);
+	s = add_stream(ch, MLOD_STREAM_STEP, 8, MLOD_SCODEC_RAW);
+	s->count = 1;
+	double step = 0.25;
+	put(&s->data, &step, 8);
 	for (int k = 0; k < NK * 3; k++) {
 		for (int a = 0; a < 3; a++)
 			vec_truth[k][a] = rndf(-2, 2);
@@ -680,31 +692,29 @@ static int make_chunks(wchunk *c, int with_unknown)
 	for (int k = 0; k < NK; k++)
 		for (int a = 0; a < 4; a++)
 			rotq_truth[k][a] = (int16_t)lrintf(rot_truth[k][a] * 32767.0f);
-	for (int cidx = 0; cidx < 4; cidx++) {
-		s = add_stream(ch, MLOD_STREAM_TIME, 4, cidx == 1 ? MLOD_SCODEC_MESHOPT_VERTEX : MLOD_SCODEC_RAW);
-		s->count = NK;
+	/* the two time arrays, one after the other, as ticks */
+	s = add_stream(ch, MLOD_STREAM_TICK, 4, MLOD_SCODEC_MESHOPT_VERTEX);
+	s->count = 2 * NK;
+	for (int a = 0; a < 2; a++)
 		for (int k = 0; k < NK; k++)
-			putf(&s->data, time_truth[k]);
-		if (cidx == 0 || cidx == 3) {
-			s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_MESHOPT_VERTEX);
-			s->count = NK;
-			for (int k = 0; k < NK; k++)
-				for (int a = 0; a < 3; a++)
-					putf(&s->data, vec_truth[k][a]);
-		} else if (cidx == 1) {
-			s = add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_MESHOPT_VERTEX);
-			s->count = NK;
-			for (int k = 0; k < NK; k++)
-				for (int a = 0; a < 4; a++)
-					put16(&s->data, (uint16_t)rotq_truth[k][a]);
-		} else {
-			s = add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
-			s->count = NK * 3;
-			for (int k = 0; k < NK * 3; k++)
-				for (int a = 0; a < 4; a++)
-					putf(&s->data, rot_truth[k][a]);
-		}
-	}
+			put32(&s->data, (uint32_t)k);
+	/* the values: ROTQ (channel 1), ROTF (channel 2), VEC3 (channels 0, 3) */
+	s = add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_MESHOPT_VERTEX);
+	s->count = NK;
+	for (int k = 0; k < NK; k++)
+		for (int a = 0; a < 4; a++)
+			put16(&s->data, (uint16_t)rotq_truth[k][a]);
+	s = add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
+	s->count = NK * 3;
+	for (int k = 0; k < NK * 3; k++)
+		for (int a = 0; a < 4; a++)
+			putf(&s->data, rot_truth[k][a]);
+	s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_MESHOPT_VERTEX);
+	s->count = 2 * NK;
+	for (int cidx = 0; cidx < 2; cidx++)
+		for (int k = 0; k < NK; k++)
+			for (int a = 0; a < 3; a++)
+				putf(&s->data, vec_truth[k][a]);
 
 	/* DOC */
 	ch = &c[C_DOC];
@@ -1055,7 +1065,7 @@ TEST(decode_motion)
 	int ok = m.channel_count == 4 && m.duration == time_truth[NK - 1] && m1.duration == 1.0f &&
 	         m1.channels[0].values[5] == 5.0f;
 	for (int k = 0; ok && k < NK; k++) {
-		ok = m.channels[1].times[k] == time_truth[k];
+		ok = m.channels[1].times[k] == time_truth[k] && m.channels[3].times[k] == time_truth[k];
 		for (int a = 0; ok && a < 3; a++)
 			ok = m.channels[0].values[3 * k + a] == vec_truth[k][a] && m.channels[3].values[3 * k + a] == vec_truth[k][a];
 		for (int a = 0; ok && a < 4; a++)
@@ -1066,6 +1076,9 @@ TEST(decode_motion)
 		for (int a = 0; ok && a < 4; a++)
 			ok = m.channels[2].values[4 * k + a] == rot_truth[k][a];
 	ok = ok && m.channels[2].rec.interp == 2 && m.channels[3].rec.path == 2;
+	/* one time array for channels 0 to 2, another for channel 3 */
+	ok = ok && m.channels[0].times == m.channels[1].times && m.channels[1].times == m.channels[2].times &&
+	     m.channels[3].times != m.channels[0].times;
 	mlod_pack_motion_free(&m);
 	mlod_pack_motion_free(&m1);
 	mlod_pack_skeleton_free(&s);
@@ -1341,19 +1354,34 @@ static void e_info_levels(wchunk *c) { wr32(stream_data(c, C_INFO, MLOD_STREAM_I
 static void e_clip_names(wchunk *c) { c[C_INFO].s[1].count = 5, c[C_INFO].s[1].data.n = 5; }
 static void e_extra_stream(wchunk *c)
 {
-	wstream *s = add_stream(&c[C_MOT1], MLOD_STREAM_TIME, 4, MLOD_SCODEC_RAW);
+	wstream *s = add_stream(&c[C_MOT1], MLOD_STREAM_VEC3, 12, MLOD_SCODEC_RAW);
 	s->count = 1;
-	putf(&s->data, 2.0f);
+	for (int a = 0; a < 3; a++)
+		putf(&s->data, 2.0f);
 }
-static void e_dup_channel(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 16 * 2, 1); }
-static void e_missing_rotation(wchunk *c)
+static void e_dup_channel(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 2, 1); }
+static void e_no_vec3(wchunk *c) { wchunk_free_stream(&c[C_MOT1], 5); }
+static void e_missing_rotation(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1); }
+static void e_time_order(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 3 + 16, 2); }
+static void e_time_keys(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 12, 3); }
+static void e_time_shared_keys(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 + 12, NK + 1); }
+static void e_step_zero(wchunk *c) { memset(stream_data(c, C_MOT0, MLOD_STREAM_STEP, 0), 0, 8); }
+static void e_step_nan(wchunk *c)
 {
-	wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1);
-	wchunk_free_stream(&c[C_MOT1], 2);
+	double nan = NAN;
+	memcpy(stream_data(c, C_MOT1, MLOD_STREAM_STEP, 0), &nan, 8);
+}
+static void e_tick_elsize(wchunk *c)
+{
+	/* a TICK stream of 1-byte elements */
+	wstream *s = &c[C_MOT0].s[2];
+	s->codec = MLOD_SCODEC_RAW;
+	s->elsize = 1;
+	s->data.n = s->count;
 }
 static void e_morph_scale(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_MTSC, 0), 0xbf800000u); }
 static void e_no_skin(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 16, 0xffffffffu); }
-static void e_rotq_cubic(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 16 + 8, 2); }
+static void e_rotq_cubic(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 + 8, 2); }
 static void e_part_flags(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x48); }
 
 TEST(structural_checks_name_the_chunk)
@@ -1373,19 +1401,26 @@ TEST(structural_checks_name_the_chunk)
 		{e_stream_order, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: stream 2 is 'UVQ0', expected 'NRMQ'"},
 		{e_vertex_count, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: stream 2 'NRMQ' has 11 elements, expected 12 (vertex count)"},
 		{e_nan, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: a translation value is not finite"},
-		{e_time, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: key 1: time 0 is not after 0"},
+		{e_time, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: time array 0: key 1: time 0 is not after 0"},
 		{e_chan_joint, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: joint 4 is not below the skeleton's 4 joints"},
 		{e_kept_root, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: root joint 0 is not kept"},
 		{e_skjt, C_SKEL, MLOD_ERR_PARSE, "SKELETON: skin 0: joint 1 is 99, not below the joint count 4"},
 		{e_vertex_elsize, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: stream 1 'POSQ' has elements of 6 bytes, expected 8"},
 		{e_info_levels, C_INFO, MLOD_ERR_PARSE, "INFO: the TOC has SKELETON level 1, but INFO counts"},
 		{e_clip_names, C_INFO, MLOD_ERR_PARSE, "INFO: the string table 'NAME' ends before clip 0's name"},
-		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 3 'TIME')"},
+		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 6 'VEC3')"},
+		{e_time_order, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 3: time array 2 is not below 2 (the arrays go in first-use order)"},
+		{e_time_keys, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 2 'TIME' has 2 elements, expected 3 (the time arrays' keys)"},
+		{e_time_shared_keys, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: 6 keys, but time array 0 has 5"},
+		{e_step_zero, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 is 'TICK', expected 'TIME' (step 0)"},
+		{e_step_nan, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: step nan is not finite and >= 0"},
+		{e_tick_elsize, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 'TICK' has elements of 1 bytes, expected 2 or 4"},
 		{e_dup_channel, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 2: a second rotation channel of joint 1"},
-		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: missing its rotation stream"},
+		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 3 'ROTQ' has 0 elements, expected 2 (keys of the non-cubic rotations)"},
+		{e_no_vec3, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: missing stream 'VEC3' (the chunk has 5 streams)"},
 		{e_morph_scale, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: morph target 0: scale -1 is not finite and >= 0"},
 		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
-		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: stream 4 is 'ROTQ', expected 'ROTF'"},
+		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (keys of the non-cubic rotations)"},
 		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x40"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {

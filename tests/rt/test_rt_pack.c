@@ -263,20 +263,45 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 {
 	const mlod_rt_view_level *vl = &fx_vmotion[clip * 3 + level];
 	chunk *c = new_chunk(MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, level, clip, vl->error, vl->distance);
+	/* one f32 time array per channel (channel i refers to array i), in
+	 * one 'TIME' stream */
 	bytes *b = stream(c, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec));
-	for (uint32_t i = 0; i < m->channel_count; i++)
-		put(b, &m->channels[i].rec, sizeof m->channels[i].rec);
+	for (uint32_t i = 0; i < m->channel_count; i++) {
+		mlod_pack_channel_rec rec = m->channels[i].rec;
+		rec.time = i;
+		put(b, &rec, sizeof rec);
+	}
 	stream_end(c);
+	b = stream(c, MLOD_STREAM_STEP, 8);
+	double no_step = 0;
+	put(b, &no_step, 8);
+	stream_end(c);
+	b = stream(c, MLOD_STREAM_TIME, 4);
 	for (uint32_t i = 0; i < m->channel_count; i++) {
 		const mlod_pack_channel *ch = &m->channels[i];
-		const uint32_t K = ch->rec.key_count, comps = ch->rec.path == 1 ? 4 : 3, per = ch->rec.interp == 2 ? 3 : 1;
-		b = stream(c, MLOD_STREAM_TIME, 4);
-		for (uint32_t k = 0; k < K; k++)
+		for (uint32_t k = 0; k < ch->rec.key_count; k++)
 			putf(b, ch->times[k]);
-		stream_end(c);
-		b = stream(c, comps == 4 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3, 4 * comps);
-		for (uint32_t k = 0; k < K * per * comps; k++)
-			putf(b, ch->values[k]);
+	}
+	stream_end(c);
+	/* the values: ROTQ, ROTF, VEC3, each its channels' keys in order */
+	for (int kind = 0; kind < 3; kind++) {
+		b = stream(c, kind == 0 ? MLOD_STREAM_ROTQ : kind == 1 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3,
+		           kind == 0 ? 8 : kind == 1 ? 16 : 12);
+		for (uint32_t i = 0; i < m->channel_count; i++) {
+			const mlod_pack_channel *ch = &m->channels[i];
+			const uint32_t K = ch->rec.key_count, per = ch->rec.interp == 2 ? 3 : 1;
+			int is = ch->rec.path == 1 ? (per == 1 ? 0 : 1) : 2;
+			if (is != kind)
+				continue;
+			for (uint32_t k = 0; k < K * per * (kind == 2 ? 3 : 4); k++) {
+				if (kind == 0) {
+					int16_t q = (int16_t)lrintf(ch->values[k] * 32767.0f);
+					put(b, &q, 2);
+				} else {
+					putf(b, ch->values[k]);
+				}
+			}
+		}
 		stream_end(c);
 	}
 }

@@ -226,22 +226,46 @@ TEST(pack_mesh_streams)
 	uint8_t *jnt = stream(mesh, MLOD_STREAM_JNT8, 0, &cnt, &esz);
 	uint16_t *idx = (uint16_t *)stream(mesh, MLOD_STREAM_IDX, 0, &cnt, &esz);
 	CHECK(pos && nrm && wgt && jnt && idx && esz == 2 && cnt == part->index_count);
-	for (int v = 0; v < pr->vertex_count; v++) {
+	/* The stored order is one of mlod_pack_vertex_order's: find the one
+	 * whose triangles (each up to a rotation of its corners, which the
+	 * index codec may make) are the stored ones, and check every vertex
+	 * through its remap. */
+	uint32_t nv = (uint32_t)pr->vertex_count, ni = part->index_count;
+	uint32_t *remap = malloc(sizeof *remap * nv), *want_idx = malloc(sizeof *want_idx * ni);
+	int order = -1;
+	for (int o = 0; o < MLOD_PACK_ORDERS && order < 0; o++) {
+		CHECK(mlod_pack_vertex_order(o, (const uint32_t *)pr->indices, ni, nv, remap, want_idx) == 0);
+		int same = 1;
+		for (uint32_t t = 0; same && t < ni; t += 3) {
+			int rot = 0;
+			for (int r = 0; r < 3; r++)
+				if (idx[t] == want_idx[t + r] && idx[t + 1] == want_idx[t + (r + 1) % 3] &&
+				    idx[t + 2] == want_idx[t + (r + 2) % 3])
+					rot = 1;
+			same = rot;
+		}
+		if (same)
+			order = o;
+	}
+	CHECK_MSG(order >= 0, "the stored triangles are none of the orders'");
+	printf("# MESH level 0 stored in order %d\n", order);
+	for (int u = 0; order >= 0 && u < pr->vertex_count; u++) {
+		int v = (int)remap[u]; /* stored index of input vertex u */
 		for (int a = 0; a < 3; a++) {
 			float back = part->pos_min[a] + (float)pos[4 * v + a] * part->pos_scale[a];
-			CHECK_NEAR(back, pr->positions[3 * v + a], 0.5 * part->pos_scale[a] + 1e-5);
+			CHECK_NEAR(back, pr->positions[3 * u + a], 0.5 * part->pos_scale[a] + 1e-5);
 		}
 		float d[3];
 		mlod_pack_oct_decode(nrm + 2 * v, d);
-		CHECK(angle(d, pr->normals + 3 * v) <= MLOD_PACK_OCT_BOUND);
+		CHECK(angle(d, pr->normals + 3 * u) <= MLOD_PACK_OCT_BOUND);
 		CHECK(wgt[4 * v] + wgt[4 * v + 1] + wgt[4 * v + 2] + wgt[4 * v + 3] == 255);
 		/* the weight on each joint is within a unorm8 step of the input's */
 		for (int t = 0; t < 4; t++) {
 			float want = 0.0f, got = 0.0f, sum = 0.0f;
 			for (int i = 0; i < 4; i++) {
-				sum += pr->weights[0][4 * v + i];
-				if (pr->joints[0][4 * v + i] == jnt[4 * v + t])
-					want += pr->weights[0][4 * v + i];
+				sum += pr->weights[0][4 * u + i];
+				if (pr->joints[0][4 * u + i] == jnt[4 * v + t])
+					want += pr->weights[0][4 * u + i];
 				if (jnt[4 * v + i] == jnt[4 * v + t])
 					got += wgt[4 * v + i] / 255.0f;
 			}
@@ -249,8 +273,8 @@ TEST(pack_mesh_streams)
 			          got, want / sum);
 		}
 	}
-	for (uint32_t i = 0; i < part->index_count; i++)
-		CHECK(idx[i] == pr->indices[i]);
+	free(remap);
+	free(want_idx);
 	free(part);
 	free(pos);
 	free(nrm);
@@ -487,13 +511,18 @@ TEST(pack_joints16)
 }
 
 /* The lossless fields are exact: SKEL level 0 holds the input's joints
- * and inverse binds, ANIM level 0 every key of the clip bit for bit
- * (rotations on the short lattice as 'ROTQ', q / 32767 giving the value
- * back), with the meshopt codec. */
+ * and inverse binds, ANIM level 0 (read back through the reader) every
+ * key time bit for bit, or within MLOD_PACK_TICK_TOLERANCE as ticks (time
+ * arrays shared, ticks for sampled clips), and
+ * every translation, scale and cubic value bit for bit; non-cubic
+ * rotations ('ROTQ') within MLOD_PACK_ROTQ_BOUND per component up to the
+ * sign and MLOD_PACK_ROTQ_ANGLE in angle; a constant channel as one key
+ * at its last time holding every key's value; with the meshopt codec. */
 TEST(pack_lossless_fields)
 {
 	const char *files[] = {"samples/RobotExpressive.glb", "samples/cmu_12_01_walk.bvh"};
-	int rotq = 0, rotf = 0;
+	int rotq = 0, ticks = 0, constant = 0;
+	double rot_max = 0, ang_max = 0, time_max = 0;
 	for (int f = 0; f < 2; f++) {
 		size_t n = 0;
 		void *in = slurp(files[f], &n);
@@ -526,68 +555,112 @@ TEST(pack_lossless_fields)
 			for (int q = 0; q < c.skeleton.skins[i].joint_count; q++, e++)
 				CHECK(memcmp(ib + 16 * e, c.skeleton.skins[i].inverse_bind[q].m, 64) == 0);
 		free(ib);
-		/* every clip's level 0 */
-		uint32_t chunks = rd32((const uint8_t *)out + 12);
+		/* every clip's level 0, through the reader */
+		mlod_pack pk;
+		mlod_pack_skeleton skel = {0};
+		CHECK_OK(mlod_pack_open(out, size, &pk, &terr));
+		CHECK_OK(mlod_pack_decode_skeleton(&pk, out, size, &skel, &terr));
 		int clips = 0;
-		for (uint32_t i = 0; i < chunks; i++) {
-			const uint8_t *e = (const uint8_t *)out + 32 + 48 * i;
-			if (rd32(e) != MLOD_CHUNK_MOTION || (e[6] | e[7] << 8) != 0)
+		for (int q = 0; q < c.clip_count; q++) {
+			const mlod_clip *clip = &c.clips[q];
+			int ci = mlod_pack_find(&pk, MLOD_CHUNK_MOTION, 0, (unsigned)q);
+			CHECK(ci >= 0);
+			if (ci < 0)
 				continue;
-			const mlod_clip *clip = &c.clips[e[8] | e[9] << 8];
-			const uint8_t *ch = (const uint8_t *)out + rd32(e + 16);
-			mlod_pack_channel_rec *cr = (mlod_pack_channel_rec *)stream(ch, MLOD_STREAM_CHAN, 0, &cnt, &esz);
-			CHECK(cr && cnt == (uint32_t)clip->channel_count);
-			int nrotq = 0, nrotf = 0, nvec = 0;
-			for (int k = 0; k < clip->channel_count; k++) {
+			/* the chunk's streams: time arrays shared, ticks for sampled clips */
+			const uint8_t *ch = (const uint8_t *)out + pk.chunks[ci].offset;
+			uint32_t n0 = rd32(ch), ntime = 0, time_keys = 0, keys = 0;
+			for (uint32_t s = 0; s < n0; s++) {
+				uint32_t tg = rd32(ch + 4 + 16 * s);
+				if (tg == MLOD_STREAM_TIME || tg == MLOD_STREAM_TICK)
+					ntime++, time_keys += rd32(ch + 4 + 16 * s + 4);
+				ticks += tg == MLOD_STREAM_TICK;
+			}
+			for (int k = 0; k < clip->channel_count; k++)
+				keys += (uint32_t)clip->channels[k].key_count;
+			CHECK(ntime == 1 && time_keys < keys); /* one stream, arrays shared */
+			double *stp = (double *)stream(ch, MLOD_STREAM_STEP, 0, &cnt, &esz);
+			CHECK(stp && cnt == 1 && esz == 8);
+			double step = stp ? *stp : 0;
+			free(stp);
+			/* a key time back: exact as 'TIME', within the tolerance as 'TICK' */
+#define TIME_OK(got, want)                                                                                         \
+	((got) == (want) || (step > 0 && fabs((double)(got) - (want)) <=                                               \
+	                                      MLOD_PACK_TICK_TOLERANCE * (fabs((double)(want)) > step ? fabs((double)(want)) : step)))
+			mlod_pack_motion m = {0};
+			CHECK_OK(mlod_pack_decode_motion(&pk, (uint32_t)ci, out, size, &skel, &m, &terr));
+			CHECK(m.channel_count == (uint32_t)clip->channel_count);
+			for (uint32_t k = 0; k < m.channel_count && k < (uint32_t)clip->channel_count; k++) {
 				const mlod_channel *cc = &clip->channels[k];
+				const mlod_pack_channel *pc = &m.channels[k];
+				const mlod_pack_channel_rec *cr = &pc->rec;
 				int per = cc->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1, comps = cc->path == MLOD_PATH_ROTATION ? 4 : 3;
-				CHECK(cr[k].joint == (uint32_t)cc->joint && cr[k].path == (uint32_t)cc->path &&
-				      cr[k].interp == (uint32_t)cc->interp && cr[k].key_count == (uint32_t)cc->key_count);
-				float *t = (float *)stream(ch, MLOD_STREAM_TIME, k, &cnt, &esz);
-				CHECK(t && cnt == (uint32_t)cc->key_count && memcmp(t, cc->times, 4 * cnt) == 0);
-				free(t);
-				size_t values = (size_t)cc->key_count * per * comps;
-				if (comps == 3) {
-					float *v = (float *)stream(ch, MLOD_STREAM_VEC3, nvec++, &cnt, &esz);
-					CHECK(v && memcmp(v, cc->values, 4 * values) == 0);
-					free(v);
-					continue;
-				}
-				/* which of ROTQ or ROTF this channel used: the k-th rotation */
-				uint32_t n0 = rd32(ch);
-				int rot = 0, tag = 0;
-				for (uint32_t s = 0; s < n0; s++) {
-					uint32_t tg = rd32(ch + 4 + 16 * s);
-					if (tg == MLOD_STREAM_ROTQ || tg == MLOD_STREAM_ROTF) {
-						if (rot == nrotq + nrotf)
-							tag = (int)tg;
-						rot++;
+				CHECK(cr->joint == (uint32_t)cc->joint && cr->path == (uint32_t)cc->path &&
+				      cr->interp == (uint32_t)cc->interp);
+				int konst = cr->key_count == 1 && cc->key_count > 1;
+				CHECK(konst || cr->key_count == (uint32_t)cc->key_count);
+				if (konst) {
+					/* a constant channel: one key at the last time */
+					CHECK(per == 1 && TIME_OK(pc->times[0], cc->times[cc->key_count - 1]));
+					constant++;
+				} else {
+					for (int key = 0; key < cc->key_count; key++) {
+						CHECK_MSG(TIME_OK(pc->times[key], cc->times[key]), "key %d: time %.9g for %.9g", key,
+						          (double)pc->times[key], (double)cc->times[key]);
+						double e = fabs((double)pc->times[key] - cc->times[key]);
+						time_max = e > time_max ? e : time_max;
 					}
 				}
-				if ((uint32_t)tag == MLOD_STREAM_ROTQ) {
-					int16_t *q = (int16_t *)stream(ch, MLOD_STREAM_ROTQ, nrotq++, &cnt, &esz);
-					CHECK(q && cnt == (uint32_t)cc->key_count);
-					for (size_t v = 0; v < values; v++)
-						CHECK_MSG((float)q[v] / 32767.0f == cc->values[v], "ROTQ %d/32767 for %.9g", q[v], cc->values[v]);
-					free(q);
+				for (int key = 0; key < cc->key_count; key++) {
+					const float *want = cc->values + (size_t)comps * per * key;
+					const float *got = pc->values + (size_t)comps * per * (konst ? 0 : key);
+					if (comps == 3 || per == 3) { /* f32: exact */
+						CHECK(memcmp(got, want, 4 * (size_t)comps * per) == 0);
+						continue;
+					}
+					/* ROTQ: within half a step per component, up to the sign */
+					double dot = 0, e = 0;
+					for (int a = 0; a < 4; a++)
+						dot += (double)got[a] * want[a];
+					for (int a = 0; a < 4; a++) {
+						double d = fabs((dot < 0 ? -got[a] : got[a]) - want[a]);
+						e = d > e ? d : e;
+					}
+					float ang = mlod_quat_angle((mlod_quat){got[0], got[1], got[2], got[3]},
+					                            (mlod_quat){want[0], want[1], want[2], want[3]});
+					CHECK_MSG(e <= MLOD_PACK_ROTQ_BOUND + 1e-7 && ang <= MLOD_PACK_ROTQ_ANGLE,
+					          "ROTQ error %.9g (bound %.9g), angle %.9g (bound %.9g)", e, MLOD_PACK_ROTQ_BOUND,
+					          (double)ang, MLOD_PACK_ROTQ_ANGLE);
+					rot_max = e > rot_max ? e : rot_max;
+					ang_max = ang > ang_max ? ang : ang_max;
+				}
+				if (comps == 4 && per == 1) {
 					rotq++;
-				} else {
-					float *v = (float *)stream(ch, MLOD_STREAM_ROTF, nrotf++, &cnt, &esz);
-					CHECK(v && memcmp(v, cc->values, 4 * values) == 0);
-					free(v);
-					rotf++;
+					/* continuity: no key's sign flips against the one before */
+					for (uint32_t key = 1; key < cr->key_count; key++) {
+						double d = 0;
+						for (int a = 0; a < 4; a++)
+							d += (double)pc->values[4 * key + a] * pc->values[4 * (key - 1) + a];
+						CHECK(d >= -1e-3);
+					}
 				}
 			}
-			free(cr);
+			mlod_pack_motion_free(&m);
 			clips++;
 		}
+		mlod_pack_skeleton_free(&skel);
+		mlod_pack_close(&pk);
 		CHECK(clips == c.clip_count);
 		mlod_free(out);
 		mlod_character_free(&c);
 		mlod_gltf_free(doc);
 		free(in);
 	}
-	CHECK(rotq > 0 && rotf > 0); /* both rotation forms were met */
+	/* every form was met */
+	CHECK(rotq > 0 && ticks > 0 && constant > 0);
+	printf("# key times: max error %.3g s\n", time_max);
+	printf("# ROTQ: max component error %.3g (bound %.3g), max angle %.3g rad (bound %.3g)\n", rot_max,
+	       MLOD_PACK_ROTQ_BOUND, ang_max, MLOD_PACK_ROTQ_ANGLE);
 }
 
 int main(void)

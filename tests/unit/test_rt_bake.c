@@ -109,7 +109,7 @@ static void conv_build(const mlod_character *c, conv *v)
 		for (int i = 0; i < cl->channel_count; i++, nch++) {
 			const mlod_channel *ch = &cl->channels[i];
 			v->chans[nch].rec = (mlod_pack_channel_rec){ (uint32_t)ch->joint, (uint32_t)ch->path,
-			                                             (uint32_t)ch->interp, (uint32_t)ch->key_count };
+			                                             (uint32_t)ch->interp, (uint32_t)ch->key_count, 0 };
 			v->chans[nch].times = ch->times;
 			v->chans[nch].values = ch->values;
 		}
