@@ -45,6 +45,158 @@ static const mlod_channel *channel_of(const mlod_clip *k, int joint, mlod_path p
 }
 
 /* Checks one primitive; returns a message or NULL. */
+/* Positions quantised on the writer's grid for a part (its box, 16 bits). */
+typedef struct qgrid {
+	float lo[3], scale[3];
+} qgrid;
+
+static void qgrid_make(qgrid *g, const mlod_primitive *a)
+{
+	float hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+	for (int d = 0; d < 3; d++)
+		g->lo[d] = INFINITY;
+	for (int v = 0; v < a->vertex_count; v++)
+		for (int d = 0; d < 3; d++) {
+			g->lo[d] = fminf(g->lo[d], a->positions[3 * v + d]);
+			hi[d] = fmaxf(hi[d], a->positions[3 * v + d]);
+		}
+	for (int d = 0; d < 3; d++)
+		g->scale[d] = mlod_pack_range_scale(g->lo[d], hi[d]);
+}
+
+static void qpos(const qgrid *g, const float *p, long *out)
+{
+	for (int d = 0; d < 3; d++)
+		out[d] = mlod_pack_qu16(p[d], g->lo[d], g->scale[d]); /* the writer's rounding */
+}
+
+static int cmp_long3(const long *x, const long *y)
+{
+	for (int d = 0; d < 3; d++)
+		if (x[d] != y[d])
+			return x[d] < y[d] ? -1 : 1;
+	return 0;
+}
+
+static int cmp_tri(const void *x, const void *y)
+{
+	const long *a = x, *b = y;
+	for (int d = 0; d < 9; d++)
+		if (a[d] != b[d])
+			return a[d] < b[d] ? -1 : 1;
+	return 0;
+}
+
+/* Each triangle as 9 quantised coordinates, in the rotation that sorts
+ * first (winding kept), the list sorted. */
+static long *tri_keys(const qgrid *g, const mlod_primitive *p, int count)
+{
+	long *k = malloc(sizeof *k * 9 * (size_t)(count / 3 + 1));
+	if (!k)
+		return NULL;
+	for (int t = 0; t + 2 < count; t += 3) {
+		long c[3][3];
+		for (int i = 0; i < 3; i++) {
+			uint32_t v = p->index_count ? p->indices[t + i] : (uint32_t)(t + i);
+			qpos(g, p->positions + 3 * (size_t)v, c[i]);
+		}
+		/* the smallest of the three rotations (two equal corners tie) */
+		long rot[3][9];
+		int r = 0;
+		for (int o = 0; o < 3; o++) {
+			for (int i = 0; i < 3; i++)
+				memcpy(rot[o] + 3 * i, c[(o + i) % 3], sizeof c[0]);
+			if (o > 0 && cmp_tri(rot[o], rot[r]) < 0)
+				r = o;
+		}
+		memcpy(k + 9 * (size_t)(t / 3), rot[r], sizeof rot[r]);
+	}
+	qsort(k, (size_t)(count / 3), sizeof *k * 9, cmp_tri);
+	return k;
+}
+
+static double attr_distance(const mlod_primitive *a, int u, const mlod_primitive *b, int v)
+{
+	double d = 0;
+	for (int i = 0; a->normals && b->normals && i < 3; i++)
+		d += fabs((double)a->normals[3 * u + i] - b->normals[3 * v + i]);
+	for (int s = 0; s < a->uv_set_count && s < b->uv_set_count && s < MLOD_PACK_MAX_UV; s++)
+		for (int i = 0; i < 2; i++)
+			d += fabs((double)a->uvs[s][2 * u + i] - b->uvs[s][2 * v + i]);
+	for (int i = 0; a->weight_set_count && b->weight_set_count && i < 4; i++)
+		d += fabs((double)a->weights[0][4 * u + i] - b->weights[0][4 * v + i]) +
+		     (a->joints[0][4 * u + i] != b->joints[0][4 * v + i]);
+	return d;
+}
+
+static void permuted_free(mlod_primitive *p)
+{
+	free(p->positions);
+	free(p->normals);
+	for (int s = 0; s < MLOD_MAX_SETS; s++) {
+		free(p->uvs[s]);
+		free(p->joints[s]);
+		free(p->weights[s]);
+	}
+	memset(p, 0, sizeof *p);
+}
+
+/* out: a copy of a's vertex attributes in b's vertex order, each unpacked
+ * vertex given the input vertex at its quantised position that is nearest
+ * in its other attributes. 0 when some vertex has none. */
+static int permuted(const qgrid *g, const mlod_primitive *a, const mlod_primitive *b, mlod_primitive *out)
+{
+	int n = b->vertex_count, ok = 1;
+	memset(out, 0, sizeof *out);
+	out->vertex_count = n;
+	out->uv_set_count = a->uv_set_count;
+	out->weight_set_count = a->weight_set_count;
+	out->material = a->material;
+	long *qa = malloc(sizeof *qa * 3 * (size_t)a->vertex_count + 1);
+	out->positions = malloc(sizeof(float) * 3 * (size_t)n + 1);
+	if (a->normals)
+		out->normals = malloc(sizeof(float) * 3 * (size_t)n + 1);
+	for (int s = 0; s < a->uv_set_count && s < MLOD_MAX_SETS; s++)
+		out->uvs[s] = malloc(sizeof(float) * 2 * (size_t)n + 1);
+	for (int s = 0; s < a->weight_set_count; s++) {
+		out->joints[s] = malloc(sizeof(uint16_t) * 4 * (size_t)n + 1);
+		out->weights[s] = malloc(sizeof(float) * 4 * (size_t)n + 1);
+	}
+	if (!qa || !out->positions)
+		ok = 0;
+	for (int u = 0; ok && u < a->vertex_count; u++)
+		qpos(g, a->positions + 3 * (size_t)u, qa + 3 * (size_t)u);
+	for (int v = 0; ok && v < n; v++) {
+		long q[3];
+		qpos(g, b->positions + 3 * (size_t)v, q);
+		int best = -1;
+		double bd = INFINITY;
+		for (int u = 0; u < a->vertex_count; u++)
+			if (cmp_long3(qa + 3 * (size_t)u, q) == 0) {
+				double d = attr_distance(a, u, b, v);
+				if (d < bd)
+					bd = d, best = u;
+			}
+		if (best < 0) {
+			ok = 0;
+			break;
+		}
+		memcpy(out->positions + 3 * (size_t)v, a->positions + 3 * (size_t)best, sizeof(float) * 3);
+		if (a->normals)
+			memcpy(out->normals + 3 * (size_t)v, a->normals + 3 * (size_t)best, sizeof(float) * 3);
+		for (int s = 0; s < a->uv_set_count && s < MLOD_MAX_SETS; s++)
+			memcpy(out->uvs[s] + 2 * (size_t)v, a->uvs[s] + 2 * (size_t)best, sizeof(float) * 2);
+		for (int s = 0; s < a->weight_set_count; s++) {
+			memcpy(out->joints[s] + 4 * (size_t)v, a->joints[s] + 4 * (size_t)best, sizeof(uint16_t) * 4);
+			memcpy(out->weights[s] + 4 * (size_t)v, a->weights[s] + 4 * (size_t)best, sizeof(float) * 4);
+		}
+	}
+	free(qa);
+	if (!ok)
+		permuted_free(out);
+	return ok;
+}
+
 static const char *compare_primitive(const mlod_primitive *a, const mlod_primitive *b, char *msg, size_t cap)
 {
 	if (a->vertex_count != b->vertex_count) {
@@ -62,22 +214,29 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 		snprintf(msg, cap, "index count %d, unpacked %d", ia, b->index_count);
 		return msg;
 	}
-	/* The same triangles in the same order; meshopt's index codec may
-	 * rotate a triangle's corners. */
-	for (int t = 0; t + 2 < ia; t += 3) {
-		uint32_t x[3], y[3];
-		for (int k = 0; k < 3; k++) {
-			x[k] = a->index_count ? a->indices[t + k] : (uint32_t)(t + k);
-			y[k] = b->indices[t + k];
-		}
-		int same = 0;
-		for (int r = 0; r < 3; r++)
-			same |= x[0] == y[r] && x[1] == y[(r + 1) % 3] && x[2] == y[(r + 2) % 3];
-		if (!same) {
-			snprintf(msg, cap, "triangle %d differs", t / 3);
-			return msg;
-		}
+	/* The writer may reorder a part's vertices and triangles (the codecs
+	 * gain from it), and meshopt's index codec may rotate a triangle's
+	 * corners: the same triangles as a multiset, compared by their
+	 * corners' quantised positions, winding kept. Then each unpacked
+	 * vertex is matched with an input vertex at the same quantised
+	 * position (the one nearest in normal, UV and weights), and the
+	 * attribute bounds below are checked against that one. */
+	qgrid g;
+	qgrid_make(&g, a);
+	long *ka = tri_keys(&g, a, ia), *kb = tri_keys(&g, b, ia);
+	int tri_ok = ka && kb && memcmp(ka, kb, sizeof *ka * 9 * (size_t)(ia / 3)) == 0;
+	free(ka);
+	free(kb);
+	if (!tri_ok) {
+		snprintf(msg, cap, "the triangles differ (compared by quantised corner positions)");
+		return msg;
 	}
+	mlod_primitive pa;
+	if (!permuted(&g, a, b, &pa)) {
+		snprintf(msg, cap, "an unpacked vertex has no input vertex at its quantised position");
+		return msg;
+	}
+	a = &pa;
 	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
 	for (int v = 0; v < n; v++)
 		for (int d = 0; d < 3; d++) {
@@ -94,13 +253,13 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 				worst_pos_ratio = e / bound;
 			if (e > bound) {
 				snprintf(msg, cap, "vertex %d axis %d: position off by %g, bound %g", v, d, e, bound);
-				return msg;
+				return permuted_free(&pa), msg;
 			}
 		}
 	}
 	if ((a->normals != NULL) != (b->normals != NULL)) {
 		snprintf(msg, cap, "normals present %d, unpacked %d", a->normals != NULL, b->normals != NULL);
-		return msg;
+		return permuted_free(&pa), msg;
 	}
 	for (int v = 0; a->normals && v < n; v++) {
 		const float *x = a->normals + 3 * v, *y = b->normals + 3 * v;
@@ -115,13 +274,13 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 			worst_nrm = ang;
 		if (ang > MLOD_PACK_OCT_BOUND + 1e-6) {
 			snprintf(msg, cap, "vertex %d: normal off by %g rad (%.9g %.9g %.9g, unpacked %.9g %.9g %.9g)", v, ang, x[0], x[1], x[2], y[0], y[1], y[2]);
-			return msg;
+			return permuted_free(&pa), msg;
 		}
 	}
 	int sets = a->uv_set_count < MLOD_PACK_MAX_UV ? a->uv_set_count : MLOD_PACK_MAX_UV;
 	if (b->uv_set_count != sets) {
 		snprintf(msg, cap, "uv sets %d, unpacked %d", a->uv_set_count, b->uv_set_count);
-		return msg;
+		return permuted_free(&pa), msg;
 	}
 	for (int s = 0; s < sets; s++)
 		for (int d = 0; d < 2; d++) {
@@ -137,13 +296,13 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 					worst_uv_ratio = e / bound;
 				if (e > bound) {
 					snprintf(msg, cap, "vertex %d uv %d.%d off by %g, bound %g", v, s, d, e, bound);
-					return msg;
+					return permuted_free(&pa), msg;
 				}
 			}
 		}
 	if ((a->weight_set_count > 0) != (b->weight_set_count > 0)) {
 		snprintf(msg, cap, "weights present %d, unpacked %d", a->weight_set_count, b->weight_set_count);
-		return msg;
+		return permuted_free(&pa), msg;
 	}
 	for (int v = 0; a->weight_set_count && v < n; v++) {
 		/* The input's 4 largest influences, renormalised. */
@@ -182,10 +341,11 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 				worst_w = e;
 			if (e > 1.0 / 255 + 1e-6) {
 				snprintf(msg, cap, "vertex %d joint %d: weight %g, input %g", v, jt[i], w, wt[i] / sum);
-				return msg;
+				return permuted_free(&pa), msg;
 			}
 		}
 	}
+	permuted_free(&pa);
 	return NULL;
 }
 
@@ -269,22 +429,41 @@ static const char *round_trip(const char *path, const mlod_pack_options *opt, ch
 				FAIL("node %d primitive %d: %s", a->node, p, why);
 		}
 	}
-	/* Clips: level 0 under the clip's name, exact. */
+	/* Clips: level 0 under the clip's name, within mlod(5)'s bounds: key
+	 * times exact or within MLOD_PACK_TICK_TOLERANCE of the clip's span,
+	 * int16 rotations within MLOD_PACK_ROTQ_BOUND per component (q and -q
+	 * are one rotation: the writer keeps signs continuous), other values
+	 * exact; a channel whose keys are all equal may come back as one key
+	 * at its last time. */
 	for (int k = 0; k < c.clip_count; k++) {
 		const mlod_clip *a = &c.clips[k], *b = clip_named(&c2, a->name);
 		if (!b)
 			FAIL("clip '%s' missing", a->name);
 		for (int ch = 0; ch < a->channel_count; ch++) {
 			const mlod_channel *x = &a->channels[ch], *y = channel_of(b, x->joint, x->path);
-			if (!y || y->key_count != x->key_count || y->interp != x->interp)
+			if (!y || y->interp != x->interp || (y->key_count != x->key_count && y->key_count != 1))
 				FAIL("clip '%s' channel %d: missing or different keys", a->name, ch);
+			int rot = x->path == MLOD_PATH_ROTATION && x->interp != MLOD_INTERP_CUBICSPLINE;
 			int comps = (x->path == MLOD_PATH_ROTATION ? 4 : 3) * (x->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
-			if (memcmp(x->times, y->times, sizeof(float) * (size_t)x->key_count))
-				FAIL("clip '%s' channel %d: key times differ", a->name, ch);
-			for (int v = 0; v < comps * x->key_count; v++)
-				if (fabsf(x->values[v] - y->values[v]) > 0.5f / 32767.0f)
-					FAIL("clip '%s' channel %d value %d: %.9g, unpacked %.9g", a->name, ch, v, x->values[v],
-					     y->values[v]);
+			double span = fmax(fabs(x->times[x->key_count - 1]), fabs(x->times[0]));
+			double ttol = MLOD_PACK_TICK_TOLERANCE * span + 1e-9;
+			double vtol = rot ? MLOD_PACK_ROTQ_BOUND + 1e-7 : 0.0;
+			for (int i = 0; i < x->key_count; i++) {
+				int j = y->key_count == 1 ? 0 : i;
+				if (y->key_count == x->key_count || i == x->key_count - 1)
+					if (fabs((double)x->times[i] - y->times[j]) > ttol)
+						FAIL("clip '%s' channel %d key %d: time %.9g, unpacked %.9g", a->name, ch, i, x->times[i],
+						     y->times[j]);
+				const float *xv = x->values + (size_t)comps * (size_t)i, *yv = y->values + (size_t)comps * (size_t)j;
+				double e_pos = 0, e_neg = 0;
+				for (int v = 0; v < comps; v++) {
+					e_pos = fmax(e_pos, fabs((double)xv[v] - yv[v]));
+					e_neg = fmax(e_neg, fabs((double)xv[v] + yv[v]));
+				}
+				double e = rot ? fmin(e_pos, e_neg) : e_pos;
+				if (e > vtol)
+					FAIL("clip '%s' channel %d key %d: values off by %.3g (bound %.3g)", a->name, ch, i, e, vtol);
+			}
 		}
 		/* Coarser levels are there too. */
 		char name[300];
