@@ -1,5 +1,6 @@
 # A pack with one byte flipped inside a chunk: --info and -x exit 2 with
-# the reader's CRC message naming the chunk.
+# the reader's CRC message naming the chunk (whichever level chunk the
+# byte falls in as the format's sizes change).
 "$BIN/mlod-pack" "$ROOT/samples/tubeman.glb" -o t.mlod 2> /dev/null || exit 9
 cp t.mlod bad.mlod
 printf '\377' | dd of=bad.mlod bs=1 seek=100000 conv=notrunc 2> /dev/null
