@@ -41,23 +41,7 @@ static const char *base_name(const char *path)
 
 static int load(const char *path, mlod_character *c)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		fprintf(stderr, "bench_mesh: %s: cannot open\n", path);
-		return -1;
-	}
-	fseek(f, 0, SEEK_END);
-	long size = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	void *data = malloc((size_t)size + 1);
-	size_t got = data ? fread(data, 1, (size_t)size, f) : 0;
-	fclose(f);
-	mlod_error err = {0};
-	mlod_result r = mlod_load(data, got, ".", NULL, c, NULL, &err);
-	free(data);
-	if (r != MLOD_OK)
-		fprintf(stderr, "bench_mesh: %s: %s\n", path, err.message);
-	return r == MLOD_OK ? 0 : -1;
+	return bench_load("bench_mesh", path, c, NULL);
 }
 
 static int triangles(const mlod_primitive *p)

@@ -39,34 +39,9 @@
 #define MAX_PEERS 8
 #define SPEED_RUNS 5
 
-static void *read_all(const char *path, size_t *size)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return NULL;
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	void *data = malloc((size_t)(n > 0 ? n : 1));
-	*size = data ? fread(data, 1, (size_t)n, f) : 0;
-	fclose(f);
-	return data;
-}
-
 static int load(const char *path, mlod_character *c, mlod_gltf **doc)
 {
-	size_t size = 0;
-	void *data = read_all(path, &size);
-	if (!data) {
-		fprintf(stderr, "bench_motion: %s: cannot read\n", path);
-		return -1;
-	}
-	mlod_error err = {0};
-	mlod_result r = mlod_load(data, size, ".", doc, c, NULL, &err);
-	free(data);
-	if (r != MLOD_OK)
-		fprintf(stderr, "bench_motion: %s: %s\n", path, err.message);
-	return r == MLOD_OK ? 0 : -1;
+	return bench_load("bench_motion", path, c, doc);
 }
 
 /* load, plus the skeleton height and the point distance mlod-motion uses

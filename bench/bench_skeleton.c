@@ -22,21 +22,7 @@
 
 static int load(const char *path, mlod_character *c)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return -1;
-	fseek(f, 0, SEEK_END);
-	long size = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	void *data = malloc((size_t)size);
-	size_t got = fread(data, 1, (size_t)size, f);
-	fclose(f);
-	mlod_error err = {0};
-	mlod_result r = mlod_load(data, got, ".", NULL, c, NULL, &err);
-	free(data);
-	if (r != MLOD_OK)
-		fprintf(stderr, "bench_skeleton: %s: %s\n", path, err.message);
-	return r == MLOD_OK ? 0 : -1;
+	return bench_load("bench_skeleton", path, c, NULL);
 }
 
 /* Levels at 13%, 26% and 39% of the joints removed. */
