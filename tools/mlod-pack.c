@@ -49,6 +49,8 @@ static const char usage_text[] =
 	"      --json                 with --info: as JSON (= --report=json)\n"
 	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels,\n"
 	"                             skeleton-level skins, <clip>@lod<k> animations\n"
+	"  -j, --threads N            compute mesh levels on N threads (default: the\n"
+	"                             processors online); the same pack at any N\n"
 	"  -h, --help                 show this help\n"
 	"  -V, --version              show the version\n"
 	"\n"
@@ -327,19 +329,21 @@ int main(int argc, char **argv)
 		{"info", required_argument, NULL, OPT_INFO},
 		{"json", no_argument, NULL, OPT_JSON},
 		{"extract", required_argument, NULL, 'x'},
+		{"threads", required_argument, NULL, 'j'},
 		{"help", no_argument, NULL, 'h'},
 		{"version", no_argument, NULL, 'V'},
 		{NULL, 0, NULL, 0},
 	};
 	mlod_pack_options opt;
 	mlod_pack_options_default(&opt);
+	opt.bgm.threads = mlod_thread_count();
 	const char *output = NULL, *name = NULL, *info = NULL, *extract = NULL, *codec = "meshopt";
 	enum tool_report report = REPORT_NONE;
 	int ratios_given = 0, json = 0, ch;
 
 	tool_name = "mlod-pack";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:x:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, ":o:r::R:e:x:j:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -367,6 +371,7 @@ int main(int argc, char **argv)
 		case OPT_NO_MOTION: opt.no_motion_levels = 1; break;
 		case OPT_INFO: info = optarg; break;
 		case 'x': extract = optarg; break;
+		case 'j': opt.bgm.threads = tool_parse_threads(optarg); break;
 		case OPT_JSON: json = 1; break;
 		case 'h': {
 			static const double defaults[] = {MLOD_MESH_RATIOS_DEFAULT};
