@@ -233,12 +233,13 @@ static void clip_levels(struct job *job, struct clip *cl)
 	const mlod_clip *src = &job->c.clips[cl->index];
 	mlod_error err = {0};
 	mlod_motion *m[2] = {NULL, NULL};
-	int methods[2], method_count = 0;
+	mlod_motion_method methods[2];
+	int method_count = 0;
 	if (job->method == METHOD_AUTO) {
 		methods[method_count++] = MLOD_MOTION_FRAMES;
 		methods[method_count++] = MLOD_MOTION_KEYS;
 	} else {
-		methods[method_count++] = job->method;
+		methods[method_count++] = (mlod_motion_method)job->method;
 	}
 	cl->keys = mlod_clip_key_count(src);
 	cl->bytes = mlod_clip_key_bytes(src);
@@ -268,34 +269,12 @@ static void clip_levels(struct job *job, struct clip *cl)
 		struct level *lv = &cl->levels[cl->level_count++];
 		double value = sp->percent ? sp->value * job->height / 100.0 : sp->value;
 		lv->bound = sp->target == MLOD_MOTION_MAX_ERROR ? value : -1.0;
-		char why[2][MLOD_ERROR_MESSAGE_SIZE] = {"", ""};
-		/* Fewer bytes wins; on a tie, the smaller error, then the method
-		 * listed first. The last method runs first, so that the others
-		 * can skip rounding and measuring a level that cannot win. */
-		for (int i = method_count - 1; i >= 0; i--) {
-			if (methods[i] == MLOD_MOTION_KEYS && sp->target == MLOD_MOTION_THRESHOLD)
-				continue;
-			mlod_motion_level l;
-			mlod_result r = mlod_motion_next_level_under(m[i], (mlod_motion_method)methods[i], sp->target, value,
-			                                             lv->ok ? lv->l.bytes : -1, &l, &err);
-			if (r == MLOD_ERR_LIMIT) {
-				snprintf(why[i], sizeof why[i], "%s", err.message);
-				continue;
-			}
-			if (r != MLOD_OK)
-				tool_die(tool_exit_code(r), job->input, "%s", err.message);
-			if (!l.unfinished &&
-			    (!lv->ok || l.bytes < lv->l.bytes || (l.bytes == lv->l.bytes && !(lv->l.error.max < l.error.max)))) {
-				if (lv->ok)
-					mlod_motion_level_free(&lv->l);
-				lv->l = l;
-				lv->ok = 1;
-			} else {
-				mlod_motion_level_free(&l);
-			}
-		}
+		mlod_result r = mlod_motion_next_level_best(m, methods, method_count, sp->target, value, &lv->l, &err);
+		if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
+			tool_die(tool_exit_code(r), job->input, "%s", err.message);
+		lv->ok = r == MLOD_OK;
 		if (!lv->ok) {
-			fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, why[0][0] ? why[0] : why[1]);
+			fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, err.message);
 		} else {
 			measure_vertex(job, cl, lv);
 			level_weights(job, cl, lv);

@@ -190,6 +190,17 @@ void mlod_motion_level_free(mlod_motion_level *l);
 mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                          double value, long max_bytes, mlod_motion_level *out, mlod_error *err);
 
+/* The auto method's next level: the next level of each of the n motions
+ * (one clip, methods[i] for m[i]; the keys method is skipped for a
+ * MLOD_MOTION_THRESHOLD target) for the same target and value; the one
+ * with fewer bytes wins, on a tie the smaller error, then the earlier
+ * motion. The last runs first, so that the others stop early where they
+ * cannot win (mlod_motion_next_level_under). When no method meets the
+ * target: MLOD_ERR_LIMIT with the first method's reason. */
+mlod_result mlod_motion_next_level_best(mlod_motion *const *m, const mlod_motion_method *methods, int n,
+                                        mlod_motion_target target, double value, mlod_motion_level *out,
+                                        mlod_error *err);
+
 /* Morph target weights of a level (beyond the paper). A weight error dw on
  * a target moves a vertex by dw times that target's offset there, so a
  * track's error at a time is the sum over its targets of |dw| times the

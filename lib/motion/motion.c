@@ -1704,3 +1704,47 @@ mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method meth
 	}
 	return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad method %d", (int)method);
 }
+
+mlod_result mlod_motion_next_level_best(mlod_motion *const *m, const mlod_motion_method *methods, int n,
+                                        mlod_motion_target target, double value, mlod_motion_level *out,
+                                        mlod_error *err)
+{
+	if (!m || !methods || !out || n < 1)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_next_level_best: bad arguments");
+	memset(out, 0, sizeof *out);
+	int ok = 0, limited = -1;
+	mlod_error why = {0};
+	for (int i = n - 1; i >= 0; i--) {
+		if (methods[i] == MLOD_MOTION_KEYS && target == MLOD_MOTION_THRESHOLD)
+			continue;
+		mlod_motion_level l;
+		mlod_error e = {0};
+		mlod_result r = mlod_motion_next_level_under(m[i], methods[i], target, value, ok ? out->bytes : -1, &l, &e);
+		if (r == MLOD_ERR_LIMIT) {
+			why = e, limited = i; /* ends with the earliest method's reason */
+			continue;
+		}
+		if (r != MLOD_OK) {
+			if (ok)
+				mlod_motion_level_free(out);
+			if (err)
+				*err = e;
+			return r;
+		}
+		if (!l.unfinished && (!ok || l.bytes < out->bytes || (l.bytes == out->bytes && !(out->error.max < l.error.max)))) {
+			if (ok)
+				mlod_motion_level_free(out);
+			*out = l;
+			ok = 1;
+		} else {
+			mlod_motion_level_free(&l);
+		}
+	}
+	if (ok)
+		return MLOD_OK;
+	if (limited < 0)
+		return mlod_fail(err, MLOD_ERR_LIMIT, "no method makes a level for this target");
+	if (err)
+		*err = why;
+	return MLOD_ERR_LIMIT;
+}

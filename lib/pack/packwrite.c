@@ -1293,9 +1293,8 @@ static mlod_result motion_levels(struct ctx *x)
 		bounds[b] = x->opt->motion_percent[b] ? x->opt->motion_bounds[b] * x->height / 100.0 : x->opt->motion_bounds[b];
 	qsort(bounds, (size_t)nb, sizeof *bounds, double_asc);
 	mlod_motion_options mo = {0};
-	mo.point_distance = x->opt->point_distance > 0.0             ? x->opt->point_distance
-	                    : x->format == MLOD_FORMAT_BVH ? x->height / 18.0
-	                                                         : 0.1;
+	mo.point_distance = x->opt->point_distance > 0.0 ? x->opt->point_distance
+	                                                 : mlod_motion_point_distance(&c->skeleton, x->format != MLOD_FORMAT_BVH);
 	x->owned_levels = calloc((size_t)c->clip_count * (size_t)(nb > 0 ? nb : 1), sizeof *x->owned_levels);
 	if (!x->owned_levels)
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
@@ -1308,34 +1307,19 @@ static mlod_result motion_levels(struct ctx *x)
 			short_clips++;
 		else
 			for (int b = 0; r == MLOD_OK && b < nb; b++) {
-				mlod_motion_level best, l;
-				int ok = 0;
-				for (int i = 0; i < 2; i++) {
-					mlod_result e = mlod_motion_next_level(m[i], i ? MLOD_MOTION_KEYS : MLOD_MOTION_FRAMES,
-					                                       MLOD_MOTION_MAX_ERROR, bounds[b], &l, x->err);
-					if (e == MLOD_ERR_LIMIT)
-						continue;
-					if (e != MLOD_OK) {
-						r = e;
-						break;
-					}
-					if (!ok || l.bytes < best.bytes || (l.bytes == best.bytes && l.error.max < best.error.max)) {
-						if (ok)
-							mlod_motion_level_free(&best);
-						best = l;
-						ok = 1;
-					} else {
-						mlod_motion_level_free(&l);
-					}
-				}
-				if (r != MLOD_OK) {
-					if (ok)
-						mlod_motion_level_free(&best);
-					break;
-				}
-				if (!ok) {
+				static const mlod_motion_method methods[2] = {MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS};
+				mlod_motion_level best;
+				mlod_error why = {0};
+				mlod_result e = mlod_motion_next_level_best(m, methods, 2, MLOD_MOTION_MAX_ERROR, bounds[b], &best, &why);
+				if (e == MLOD_ERR_LIMIT) {
 					missed++;
 					continue;
+				}
+				if (e != MLOD_OK) {
+					if (x->err)
+						*x->err = why;
+					r = e;
+					break;
 				}
 				struct clip_levels *cl = &x->clips[q];
 				x->owned_levels[x->owned_count] = best;
