@@ -127,8 +127,8 @@ test-extended: all unit
 bench: all $(BENCH)
 	@bench/run.sh $(B)
 
-demo: all
-	@scripts/demo $(BIN)
+demo: all $(B)/bench/crowd
+	@scripts/demo $(BIN) $(B)/bench/crowd
 
 # Regenerates the procedural sample character.
 samples: all $(HELPERS)

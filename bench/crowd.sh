@@ -1,22 +1,22 @@
 #!/bin/sh
 # bench/crowd.sh: the runtime's crowd (paper Figures 15 and 16; run by
 # bench/run.sh, which sets BUILD and INPUTS): each glb input packed with
-# mlod-pack's defaults, then mlod-crowd with N = 1 .. 10,000 instances at
+# mlod-pack's defaults, then bench/crowd with N = 1 .. 10,000 instances at
 # 2..200 m spread over the ground, full detail against LoD by distance, one
 # core; the skinning kernel against a plain scalar loop.
 set -eu
 bin=$BUILD/bin
-[ -x "$bin/mlod-crowd" ] || exit 0
+[ -x "$BUILD/bench/crowd" ] || exit 0
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/mlod-bench-crowd.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT INT TERM
-echo "## Runtime: crowds with and without LoD (mlod-crowd)"
+echo "## Runtime: crowds with and without LoD (bench/crowd)"
 echo
 for f in $INPUTS; do
 	case $f in *.glb) ;; *) continue ;; esac
 	name=$(basename "$f" .glb)
 	"$bin/mlod-pack" -o "$tmp/$name.mlod" "$f" 2> /dev/null
 	echo '```'
-	"$bin/mlod-crowd" -n 1,10,50,250,1000,10000 -s 1 --max-wall 3 "$tmp/$name.mlod"
+	"$BUILD/bench/crowd" -n 1,10,50,250,1000,10000 -s 1 --max-wall 3 "$tmp/$name.mlod"
 	echo '```'
 	echo
 done

@@ -1,5 +1,6 @@
 /*
- * mlod-crowd: the crowd benchmark of the runtime (paper 4.4, Figures 15
+ * bench/crowd (built as build/<config>/bench/crowd; `make demo` and
+ * bench/crowd.sh run it): the crowd benchmark of the runtime (paper 4.4, Figures 15
  * and 16) on any .mlod pack.
  *
  * For each N (1, 10, 50, 250, 1000, 10000 by default) it places N
@@ -38,7 +39,7 @@
 #include "rt/mlod_rt.h"
 
 static const char usage_text[] =
-	"usage: mlod-crowd [options] PACK\n"
+	"usage: crowd [options] PACK\n"
 	"\n"
 	"Runs crowds of N instances of the character in PACK (.mlod) at full detail\n"
 	"and with level of detail by distance, and prints the CPU frame time of\n"
@@ -63,7 +64,7 @@ static const char usage_text[] =
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input\n";
 
-static const char *tool = "mlod-crowd";
+static const char *tool = "crowd";
 
 static _Noreturn void die(int code, const char *fmt, const char *msg)
 {
