@@ -111,16 +111,18 @@ $(B)/tests/helpers/%: $(B)/tests/helpers/%.o $(B)/libmlod.a $(B)/libmlodrt.a
 $(B)/bench/%: $(B)/bench/%.o $(B)/libmlod.a $(B)/libmlodrt.a
 	@mkdir -p $(@D)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+# bench/crowd writes its picture with libpng (libpng-dev), linked there only.
+$(B)/bench/crowd: LDLIBS += -lpng
 
 unit: $(UNIT) $(HELPERS) $(RT_TESTS)
 
 # The whole suite: unit, CLI and validator tests on the release build, then
 # the unit tests again under AddressSanitizer and UBSan.
-test: all unit
+test: all unit $(B)/bench/crowd
 	@$(MAKE) --no-print-directory config=sanitize unit
 	@tests/run.sh --build $(B) --sanitize-build build/sanitize
 
-test-extended: all unit
+test-extended: all unit $(B)/bench/crowd
 	@$(MAKE) --no-print-directory config=sanitize unit
 	@tests/run.sh --build $(B) --sanitize-build build/sanitize --extended
 

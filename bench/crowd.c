@@ -3,34 +3,64 @@
  * bench/crowd.sh run it): the crowd benchmark of the runtime (paper 4.4, Figures 15
  * and 16) on any .mlod pack.
  *
+ * Metres. The character is taken as --height metres tall (default 1.8):
+ * the scale is the pack's height (INFO, the skeleton height of mlod(5))
+ * over --height, in scene units per metre, so --near and --far (2 and 200
+ * m) and the walking speeds mean the same for every pack; --height 0 keeps
+ * scene units. The header line prints the scale.
+ *
  * For each N (1, 10, 50, 250, 1000, 10000 by default) it places N
- * instances at distances in [near, far] (2 to 200 m), each with
- * its own clip and time offset, walking towards or away from the camera,
- * and runs a few simulated seconds twice in one run: every instance at
- * full detail (level 0 of every layer), then with LoD by distance. It
- * measures the CPU time of one frame: the update (selection), motion
- * sampling, pose and linear blend skinning of every instance into one
- * buffer, on one core. Streaming happens between frames, outside the
- * measured time (its cost is printed apart). It prints per N: ms per frame
- * in each mode, the speed-up, the instances per mesh level (and skeleton
- * and motion level) at the last frame, and the resident bytes.
+ * instances at distances in [near, far], each with its own clip and time
+ * offset, walking at 0.8 to 2 m/s towards or away from the camera, and
+ * runs a few simulated seconds several times in one run, on the same walk:
+ * every instance at full detail (level 0 of every layer), then with LoD
+ * by each selection rule of --mode: alpha (the paper's alpha =
+ * (d - near) / (far - near), every layer over [0, 1]), pixels (the
+ * runtime's projected error: the coarsest level whose measured error
+ * projects to at most --pixels pixels, default 1, at 1080 lines and 60
+ * degrees of vertical field of view) and toc (the pack's baked switch
+ * distances); all (the default) is alpha and pixels. It measures the CPU
+ * time of one frame: the update (selection), motion sampling, pose and
+ * linear blend skinning of every instance into one buffer, on one core.
+ * Streaming happens between frames, outside the measured time (its cost
+ * is printed apart). It prints per N one line per mode: ms per frame, the
+ * speed-up over full detail, the instances per skeleton, mesh and motion
+ * level at the last measured frame, and the resident bytes.
  *
  * Spread: by default the instances stand evenly over the ground around
  * the camera, the ring between near and far (so the density of distances
  * grows with the distance, as in a crowd filling a square: instance i of n
- * at d = sqrt(near^2 + (i + 1/2)/n (far^2 - near^2))); --spread line puts
- * them evenly along one line instead (d = near + (i + 1/2)/n (far - near)),
- * which gives the near levels many more instances.
+ * at d = sqrt(near^2 + (i + 1/2)/n (far^2 - near^2)), azimuth i times the
+ * golden angle); --spread line puts them evenly along one line instead
+ * (d = near + (i + 1/2)/n (far - near)), which gives the near levels many
+ * more instances.
+ *
+ * The picture (--png FILE): the last measured frame of one N (the largest,
+ * or --png-count) under one rule (the first measured, or --png-mode),
+ * drawn after that frame outside the measured time by a small software
+ * rasteriser: the runtime skins each instance in view again from the same
+ * state into a buffer (the levels and poses measured), and the triangles
+ * of its shown mesh level are z-buffered with two-sided Lambert shading
+ * from the skinned normals, coloured by mesh level (0, the finest, red;
+ * then orange, yellow, green, light blue, blue, purple; a legend strip at
+ * the bottom left), 2x2 supersampled. The camera stands at the crowd's
+ * centre at eye height (0.9 of the character's height), 60 degrees of
+ * vertical field of view, pitched 8 degrees down; the ground is a checker
+ * of 5 m tiles (thin dark rings at near and far) fading into haze. libpng
+ * writes the file.
  *
  * It also measures the runtime's skinning kernel against the plain scalar
  * loop, in vertices per second on one core, on the pack's finest mesh.
  *
- * Uses only the runtime (mlod_rt.h) and its pack reader (mlod_pack.h).
+ * Uses only the runtime (mlod_rt.h), its pack reader (mlod_pack.h) and
+ * libpng.
  */
 #define _GNU_SOURCE /* getopt_long, clock_gettime */
 
 #include <getopt.h>
 #include <math.h>
+#include <png.h>
+#include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,8 +72,9 @@ static const char usage_text[] =
 	"usage: crowd [options] PACK\n"
 	"\n"
 	"Runs crowds of N instances of the character in PACK (.mlod) at full detail\n"
-	"and with level of detail by distance, and prints the CPU frame time of\n"
-	"motion sampling, pose and skinning for each, on one core.\n"
+	"and with level of detail by each selection rule, and prints the CPU frame\n"
+	"time of motion sampling, pose and skinning for each, on one core, the\n"
+	"speed-up and the instances per level.\n"
 	"\n"
 	"options:\n"
 	"  -n, --counts LIST     crowd sizes (default 1,10,50,250,1000,10000)\n"
@@ -53,16 +84,32 @@ static const char usage_text[] =
 	"                        keeping the frames done (default 10)\n"
 	"  -b, --budget BYTES    the runtime's memory budget (K, M suffixes; default\n"
 	"                        none)\n"
-	"      --near D, --far D the distance range in scene units (default 2, 200)\n"
+	"      --height H        the character is H metres tall (default 1.8): scale =\n"
+	"                        the pack's height / H scene units per metre; 0 keeps\n"
+	"                        scene units\n"
+	"      --near D, --far D the distance range in metres (scene units with\n"
+	"                        --height 0; default 2, 200)\n"
 	"      --spread HOW      ground (default: evenly over the ground between\n"
 	"                        near and far) or line (evenly over the distances)\n"
-	"      --mode MODE       alpha (the paper's, default), pixels or toc\n"
+	"      --mode MODE       the LoD rules measured against full detail: alpha\n"
+	"                        (the paper's), pixels (projected error), toc (the\n"
+	"                        pack's switch distances), a comma list of them, or\n"
+	"                        all (default: alpha and pixels)\n"
+	"      --pixels P        pixels mode: the largest projected error in pixels\n"
+	"                        (default 1, at 1080 lines and 60 degrees)\n"
 	"      --interval TS,TE  the alpha interval of every layer (default 0,1)\n"
 	"      --hysteresis H    relative hysteresis (default 0.1)\n"
+	"      --png FILE        writes a picture of the last measured frame, each\n"
+	"                        character coloured by its mesh level\n"
+	"      --png-count N     the crowd size pictured (one of --counts; default the\n"
+	"                        largest)\n"
+	"      --png-mode MODE   the rule pictured (default the first measured)\n"
+	"      --png-size WxH    the picture's size (default 960x540)\n"
 	"      --no-skin-bench   skip the kernel measurement\n"
 	"  -h, --help            show this help\n"
 	"\n"
-	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input\n";
+	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
+	"4 the picture could not be written\n";
 
 static const char *tool = "crowd";
 
@@ -126,21 +173,50 @@ static double parse_num(const char *s, const char *what)
 /* Skinning kernel vs scalar                                         */
 /* ---------------------------------------------------------------- */
 
-static void skin_bench(const char *path)
+/* The whole file, or NULL (with *size 0) when it cannot be read. */
+static void *read_file(const char *path, size_t *size)
 {
+	*size = 0;
 	FILE *f = fopen(path, "rb");
 	if (!f)
-		return;
-	fseek(f, 0, SEEK_END);
-	long size = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	void *data = malloc((size_t)size);
-	if (!data || fread(data, 1, (size_t)size, f) != (size_t)size) {
-		fclose(f);
+		return NULL;
+	void *data = NULL;
+	long n = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+	if (n > 0 && fseek(f, 0, SEEK_SET) == 0 && (data = malloc((size_t)n)) != NULL &&
+	    fread(data, 1, (size_t)n, f) != (size_t)n) {
 		free(data);
-		return;
+		data = NULL;
 	}
 	fclose(f);
+	if (data)
+		*size = (size_t)n;
+	return data;
+}
+
+/* The pack's INFO record (the character's height and rest bounds); 0 when
+ * it cannot be read (the runtime's open then says why). */
+static int read_info(const void *data, size_t size, mlod_pack_info_rec *out)
+{
+	mlod_pack p;
+	mlod_pack_info info = { 0 };
+	mlod_error e;
+	int ok = 0;
+	memset(out, 0, sizeof *out);
+	if (data && mlod_pack_open(data, size, &p, &e) == MLOD_OK) {
+		if (mlod_pack_decode_info(&p, data, size, &info, &e) == MLOD_OK) {
+			*out = info.rec;
+			ok = 1;
+		}
+		mlod_pack_info_free(&info);
+		mlod_pack_close(&p);
+	}
+	return ok;
+}
+
+static void skin_bench(const void *data, size_t size)
+{
+	if (!data)
+		return;
 	mlod_pack p;
 	mlod_pack_skeleton sk = { 0 };
 	mlod_pack_mesh m = { 0 };
@@ -218,7 +294,6 @@ static void skin_bench(const char *path)
 	}
 	mlod_pack_mesh_free(&m);
 	mlod_pack_skeleton_free(&sk);
-	free(data);
 }
 
 /* ---------------------------------------------------------------- */
@@ -229,7 +304,7 @@ typedef struct crowd {
 	mlod_rt_ctx *ctx;
 	mlod_rt_scratch *scratch;
 	uint32_t *ids;
-	float *dist, *speed;
+	float *dist, *speed, *azimuth; /* scene units, scene units per second, radians */
 	float *buf;
 	uint32_t cap;
 	uint32_t n;
@@ -245,6 +320,12 @@ static void grow(crowd *c)
 	if (!c->buf)
 		die(2, "%s", "out of memory");
 	c->cap = need;
+}
+
+/* Skins instance id into c->buf (positions, then normals at c->buf + 3 cap). */
+static mlod_result skin_one(crowd *c, uint32_t id, uint32_t *nv, mlod_error *e)
+{
+	return mlod_rt_skin(c->ctx, c->scratch, id, c->buf, 12, c->buf + 3 * (size_t)c->cap, 12, c->cap, nv, e);
 }
 
 static void walk(crowd *c, float dt, float near, float far)
@@ -267,14 +348,12 @@ static double frame(crowd *c, const mlod_rt_select *sel, float dt, uint64_t *ver
 		die(2, "%s", e.message);
 	for (uint32_t i = 0; i < c->n; i++) {
 		uint32_t nv = 0;
-		mlod_result r = mlod_rt_skin(c->ctx, c->scratch, c->ids[i], c->buf, 12, c->buf + 3 * (size_t)c->cap, 12,
-		                             c->cap, &nv, &e);
+		mlod_result r = skin_one(c, c->ids[i], &nv, &e);
 		if (r == MLOD_ERR_LIMIT) { /* a larger level arrived: not in the measured time */
 			t0 -= cpu_seconds();
 			grow(c);
 			t0 += cpu_seconds();
-			r = mlod_rt_skin(c->ctx, c->scratch, c->ids[i], c->buf, 12, c->buf + 3 * (size_t)c->cap, 12, c->cap,
-			                 &nv, &e);
+			r = skin_one(c, c->ids[i], &nv, &e);
 		}
 		if (r != MLOD_OK)
 			die(2, "%s", e.message);
@@ -304,6 +383,330 @@ static double settle(crowd *c, const mlod_rt_select *sel)
 	return t;
 }
 
+/* ---------------------------------------------------------------- */
+/* The picture: a small software rasteriser                          */
+/* ---------------------------------------------------------------- */
+
+/* The camera stands at the centre of the crowd at eye height (0.9 of the
+ * character's height), looks along -z, pitched down by PITCH so that the
+ * horizon sits above the middle; 60 degrees of vertical field of view.
+ * The world is y up (glTF); instance i stands at distance d and azimuth a
+ * (from the view direction) at (d sin a, 0, -d cos a), facing the way it
+ * walks (its model +z along the radius, out or in). */
+#define PITCH_DEG 8.0
+#define FOV_Y_DEG 60.0
+#define SS 2 /* supersampling per axis */
+
+typedef struct picture {
+	const char *path;
+	uint32_t count;          /* the crowd size pictured */
+	int mode;                /* the selection mode pictured (index in modes[]) */
+	int width, height;       /* the PNG's */
+	float scale;             /* scene units per metre */
+	float char_height;       /* scene units */
+	float center[3], radius; /* the rest bounds' centre (x, z), floor (y), bounding radius */
+	float near, far;         /* scene units */
+	uint32_t mesh_levels;
+	int done;
+	uint32_t drawn, triangles; /* instances drawn, triangles rasterised */
+	uint32_t drawn_level[16];
+} picture;
+
+typedef struct raster {
+	int w, h;          /* supersampled size */
+	float *rgb;        /* 3 per pixel */
+	float *inv_z;      /* 1 / view depth, 0 = nothing */
+	float f;           /* focal length in pixels */
+	float eye[3], right[3], up[3], fwd[3];
+} raster;
+
+static const float level_rgb[8][3] = {
+	{ 0.86f, 0.20f, 0.18f }, /* 0: finest, red */
+	{ 0.96f, 0.58f, 0.12f }, /* 1: orange */
+	{ 0.93f, 0.86f, 0.20f }, /* 2: yellow */
+	{ 0.30f, 0.72f, 0.30f }, /* 3: green */
+	{ 0.20f, 0.62f, 0.88f }, /* 4: light blue */
+	{ 0.33f, 0.33f, 0.90f }, /* 5: blue */
+	{ 0.66f, 0.34f, 0.86f }, /* 6: purple */
+	{ 0.55f, 0.55f, 0.55f }, /* 7 and coarser: grey */
+};
+
+static const float *level_colour(uint32_t l)
+{
+	return level_rgb[l < 7 ? l : 7];
+}
+
+static float dot3(const float *a, const float *b)
+{
+	return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* Sky above the horizon, a checkered ground of 5 m tiles below it, fading
+ * into haze with the distance. */
+static void draw_background(raster *R, const picture *P)
+{
+	const float haze[3] = { 0.78f, 0.82f, 0.86f }, sky[3] = { 0.42f, 0.60f, 0.85f };
+	const float tile = 5.0f * P->scale, fog = 1.5f * P->far;
+	for (int y = 0; y < R->h; y++)
+		for (int x = 0; x < R->w; x++) {
+			/* the ray through the pixel's centre */
+			float u = ((float)x + 0.5f - 0.5f * (float)R->w) / R->f, v = (0.5f * (float)R->h - (float)y - 0.5f) / R->f;
+			float d[3];
+			for (int k = 0; k < 3; k++)
+				d[k] = R->fwd[k] + u * R->right[k] + v * R->up[k];
+			float *px = R->rgb + 3 * ((size_t)y * R->w + x);
+			if (d[1] >= -1e-6f) {
+				float t = d[1] / sqrtf(dot3(d, d));
+				t = t > 1 ? 1 : t < 0 ? 0 : sqrtf(t);
+				for (int k = 0; k < 3; k++)
+					px[k] = haze[k] + (sky[k] - haze[k]) * t;
+				continue;
+			}
+			float s = -R->eye[1] / d[1]; /* to y = 0 */
+			float gx = R->eye[0] + s * d[0], gz = R->eye[2] + s * d[2];
+			float dist = sqrtf(gx * gx + gz * gz);
+			int check = ((int)floorf(gx / tile) + (int)floorf(gz / tile)) & 1;
+			float g[3] = { check ? 0.50f : 0.44f, check ? 0.52f : 0.46f, check ? 0.47f : 0.41f };
+			/* the near and far rings of the crowd, as thin dark lines */
+			float ring = fabsf(dist - P->near) < 0.05f * P->scale || fabsf(dist - P->far) < 0.4f * P->scale;
+			float t = 1.0f - expf(-dist / fog);
+			for (int k = 0; k < 3; k++)
+				px[k] = (ring ? 0.25f : g[k]) * (1 - t) + haze[k] * t;
+		}
+}
+
+/* One triangle in screen space (x, y in pixels, iz = 1 / depth, c the
+ * shade), z-buffered, colours interpolated affinely. */
+static void draw_triangle(raster *R, float s[3][3], const float shade[3], const float *rgb)
+{
+	float area = (s[1][0] - s[0][0]) * (s[2][1] - s[0][1]) - (s[2][0] - s[0][0]) * (s[1][1] - s[0][1]);
+	if (fabsf(area) < 1e-12f)
+		return;
+	float minx = fminf(s[0][0], fminf(s[1][0], s[2][0])), maxx = fmaxf(s[0][0], fmaxf(s[1][0], s[2][0]));
+	float miny = fminf(s[0][1], fminf(s[1][1], s[2][1])), maxy = fmaxf(s[0][1], fmaxf(s[1][1], s[2][1]));
+	int x0 = minx < 0 ? 0 : (int)minx, x1 = maxx >= (float)R->w - 1 ? R->w - 1 : (int)maxx;
+	int y0 = miny < 0 ? 0 : (int)miny, y1 = maxy >= (float)R->h - 1 ? R->h - 1 : (int)maxy;
+	const float inv = 1.0f / area;
+	for (int y = y0; y <= y1; y++)
+		for (int x = x0; x <= x1; x++) {
+			float px = (float)x + 0.5f, py = (float)y + 0.5f;
+			float w0 = ((s[1][0] - px) * (s[2][1] - py) - (s[2][0] - px) * (s[1][1] - py)) * inv;
+			float w1 = ((s[2][0] - px) * (s[0][1] - py) - (s[0][0] - px) * (s[2][1] - py)) * inv;
+			float w2 = 1.0f - w0 - w1;
+			if (w0 < 0 || w1 < 0 || w2 < 0)
+				continue;
+			float iz = w0 * s[0][2] + w1 * s[1][2] + w2 * s[2][2];
+			size_t o = (size_t)y * R->w + x;
+			if (iz <= R->inv_z[o])
+				continue;
+			R->inv_z[o] = iz;
+			float k = w0 * shade[0] + w1 * shade[1] + w2 * shade[2];
+			for (int j = 0; j < 3; j++)
+				R->rgb[3 * o + j] = rgb[j] * k;
+		}
+}
+
+/* Draws every instance in view at the levels it showed in the last
+ * measured frame, skinned again by the runtime from the same state. */
+static void draw_crowd(crowd *c, raster *R, picture *P)
+{
+	const float light[3] = { 0.40f, 0.80f, 0.45f }; /* towards the light (normalised below) */
+	float L[3], ln = sqrtf(dot3(light, light));
+	for (int k = 0; k < 3; k++)
+		L[k] = light[k] / ln;
+	const float tx = 0.5f * (float)R->w / R->f, ty = 0.5f * (float)R->h / R->f;
+	const float sx = sqrtf(1 + tx * tx), sy = sqrtf(1 + ty * ty), znear = 0.05f * P->scale;
+	mlod_error e;
+	for (uint32_t i = 0; i < c->n; i++) {
+		const mlod_rt_state *st = mlod_rt_instance_state(c->ctx, c->ids[i]);
+		float sa = sinf(c->azimuth[i]), ca = cosf(c->azimuth[i]);
+		float pos[3] = { c->dist[i] * sa, 0, -c->dist[i] * ca };
+		/* facing: model +z along the walk (out when the distance grows) */
+		float dir = c->speed[i] >= 0 ? 1.0f : -1.0f;
+		float fz[3] = { dir * sa, 0, -dir * ca }, fx[3] = { fz[2], 0, -fz[0] }; /* model x, z in the world */
+		/* cull by a bounding sphere around the body */
+		float ctr[3] = { pos[0], 0.5f * P->radius, pos[2] }, q[3];
+		for (int k = 0; k < 3; k++)
+			q[k] = ctr[k] - R->eye[k];
+		float xv = dot3(q, R->right), yv = dot3(q, R->up), zv = dot3(q, R->fwd), r = P->radius;
+		if (zv + r < znear || fabsf(xv) - r * sx > zv * tx || fabsf(yv) - r * sy > zv * ty)
+			continue;
+		uint32_t nv = 0;
+		mlod_result res = skin_one(c, c->ids[i], &nv, &e);
+		if (res == MLOD_ERR_LIMIT) {
+			grow(c);
+			res = skin_one(c, c->ids[i], &nv, &e);
+		}
+		if (res != MLOD_OK)
+			die(2, "%s", e.message);
+		const uint32_t level = st->level[MLOD_RT_MESH];
+		const float *rgb = level_colour(level);
+		const float *vp = c->buf, *vn = c->buf + 3 * (size_t)c->cap;
+		const uint32_t parts = mlod_rt_mesh_part_count(c->ctx, level);
+		uint32_t tris = 0;
+		for (uint32_t p = 0; p < parts; p++) {
+			mlod_rt_part_info pi;
+			if (mlod_rt_mesh_part(c->ctx, level, p, &pi, &e) != MLOD_OK)
+				die(2, "%s", e.message);
+			for (uint32_t t = 0; t + 2 < pi.index_count; t += 3) {
+				float s[3][3], shade[3], nrm[3][3];
+				int ok = 1;
+				for (int k = 0; k < 3 && ok; k++) {
+					uint32_t v = pi.first_vertex + pi.indices[t + k];
+					if (v >= nv) {
+						ok = 0;
+						break;
+					}
+					const float *a = vp + 3 * (size_t)v, *n = vn + 3 * (size_t)v;
+					float m[3] = { a[0] - P->center[0], a[1] - P->center[1], a[2] - P->center[2] };
+					float w[3], d[3];
+					for (int j = 0; j < 3; j++) {
+						w[j] = pos[j] + m[0] * fx[j] + m[2] * fz[j] + (j == 1 ? m[1] : 0);
+						nrm[k][j] = n[0] * fx[j] + n[2] * fz[j] + (j == 1 ? n[1] : 0);
+						d[j] = w[j] - R->eye[j];
+					}
+					float z = dot3(d, R->fwd);
+					if (z < znear) {
+						ok = 0;
+						break;
+					}
+					s[k][0] = 0.5f * (float)R->w + R->f * dot3(d, R->right) / z;
+					s[k][1] = 0.5f * (float)R->h - R->f * dot3(d, R->up) / z;
+					s[k][2] = 1.0f / z;
+				}
+				if (!ok)
+					continue;
+				/* two-sided Lambert: the normal turned towards the eye */
+				float fn[3], tocam[3];
+				for (int j = 0; j < 3; j++) {
+					fn[j] = nrm[0][j] + nrm[1][j] + nrm[2][j];
+					tocam[j] = R->eye[j] - pos[j];
+				}
+				for (int k = 0; k < 3; k++) {
+					float *n = nrm[k];
+					if (dot3(n, n) < 1e-12f) /* a part without normals: the face's */
+						n = fn;
+					float nl = sqrtf(dot3(n, n)), ndl = nl > 0 ? dot3(n, L) / nl : 0;
+					if (nl > 0 && dot3(n, tocam) < 0)
+						ndl = -ndl;
+					shade[k] = 0.35f + 0.65f * (ndl > 0 ? ndl : 0);
+				}
+				draw_triangle(R, s, shade, rgb);
+				tris++;
+			}
+		}
+		P->drawn++;
+		P->drawn_level[level < 15 ? level : 15]++;
+		P->triangles += tris;
+	}
+}
+
+/* 3x5 digit glyphs, one row per 3 bits (top row first), for the legend. */
+static const unsigned short digit_glyph[10] = {
+	075557, 026227, 071747, 071717, 055711, 074717, 074757, 071111, 075757, 075717,
+};
+
+static void put(unsigned char *img, int w, int h, int x, int y, const unsigned char rgb[3])
+{
+	if (x >= 0 && y >= 0 && x < w && y < h)
+		memcpy(img + 3 * ((size_t)y * w + x), rgb, 3);
+}
+
+/* The legend: one swatch per mesh level, with its number, bottom left. */
+static void draw_legend(unsigned char *img, int w, int h, uint32_t levels)
+{
+	const int sw = 28, sh = 18, pad = 6, z = 2; /* swatch size, gap, glyph zoom */
+	const unsigned char frame[3] = { 20, 20, 20 };
+	for (uint32_t l = 0; l < levels && l < 16; l++) {
+		int x0 = pad + (int)l * (sw + pad), y0 = h - pad - sh;
+		unsigned char col[3];
+		for (int k = 0; k < 3; k++)
+			col[k] = (unsigned char)(255.0f * level_colour(l)[k] + 0.5f);
+		for (int y = -1; y <= sh; y++)
+			for (int x = -1; x <= sw; x++)
+				put(img, w, h, x0 + x, y0 + y, x < 0 || y < 0 || x == sw || y == sh ? frame : col);
+		/* the level's number, centred (one or two digits) */
+		int nd = l >= 10 ? 2 : 1, gx = x0 + (sw - (nd * 4 - 1) * z) / 2, gy = y0 + (sh - 5 * z) / 2;
+		for (int d = 0; d < nd; d++) {
+			unsigned g = digit_glyph[nd == 2 ? (d ? l % 10 : l / 10) : l];
+			for (int row = 0; row < 5; row++)
+				for (int col3 = 0; col3 < 3; col3++)
+					if (g >> (3 * (4 - row) + (2 - col3)) & 1)
+						for (int a = 0; a < z; a++)
+							for (int b = 0; b < z; b++)
+								put(img, w, h, gx + (d * 4 + col3) * z + b, gy + row * z + a, frame);
+		}
+	}
+}
+
+static void write_png(const char *path, const unsigned char *img, int w, int h)
+{
+	FILE *f = fopen(path, "wb");
+	if (!f)
+		die(4, "%s: cannot open for writing", path);
+	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+	png_infop info = png ? png_create_info_struct(png) : NULL;
+	if (!png || !info) {
+		fclose(f);
+		die(4, "%s: libpng could not start", path);
+	}
+	if (setjmp(png_jmpbuf(png))) {
+		png_destroy_write_struct(&png, &info);
+		fclose(f);
+		remove(path);
+		die(4, "%s: writing the PNG failed", path);
+	}
+	png_init_io(png, f);
+	png_set_compression_level(png, 9);
+	png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+	             PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+	png_write_info(png, info);
+	for (int y = 0; y < h; y++)
+		png_write_row(png, (png_const_bytep)(img + 3 * (size_t)y * w));
+	png_write_end(png, NULL);
+	png_destroy_write_struct(&png, &info);
+	if (fclose(f) != 0)
+		die(4, "%s: writing the PNG failed", path);
+}
+
+static void render(crowd *c, picture *P)
+{
+	raster R;
+	memset(&R, 0, sizeof R);
+	R.w = P->width * SS, R.h = P->height * SS;
+	R.rgb = malloc((size_t)R.w * R.h * 3 * sizeof(float));
+	R.inv_z = calloc((size_t)R.w * R.h, sizeof(float));
+	unsigned char *img = malloc((size_t)P->width * P->height * 3);
+	if (!R.rgb || !R.inv_z || !img)
+		die(2, "%s", "out of memory");
+	const double pitch = PITCH_DEG * 3.14159265358979323846 / 180.0;
+	R.f = 0.5f * (float)R.h / tanf((float)(0.5 * FOV_Y_DEG * 3.14159265358979323846 / 180.0));
+	R.eye[1] = 0.9f * P->char_height;
+	R.fwd[1] = -(float)sin(pitch), R.fwd[2] = -(float)cos(pitch);
+	R.up[1] = (float)cos(pitch), R.up[2] = -(float)sin(pitch);
+	R.right[0] = 1;
+	draw_background(&R, P);
+	draw_crowd(c, &R, P);
+	for (int y = 0; y < P->height; y++)
+		for (int x = 0; x < P->width; x++)
+			for (int k = 0; k < 3; k++) {
+				float s = 0;
+				for (int a = 0; a < SS; a++)
+					for (int b = 0; b < SS; b++)
+						s += R.rgb[3 * ((size_t)(SS * y + a) * R.w + SS * x + b) + k];
+				s /= SS * SS;
+				img[3 * ((size_t)y * P->width + x) + k] = (unsigned char)(s <= 0 ? 0 : s >= 1 ? 255 : 255.0f * s + 0.5f);
+			}
+	draw_legend(img, P->width, P->height, P->mesh_levels);
+	write_png(P->path, img, P->width, P->height);
+	free(R.rgb), free(R.inv_z), free(img);
+	P->done = 1;
+}
+
+/* ---------------------------------------------------------------- */
+/* Measuring                                                         */
+/* ---------------------------------------------------------------- */
+
 typedef struct result {
 	double ms;
 	int frames;
@@ -313,8 +716,11 @@ typedef struct result {
 	size_t resident;
 } result;
 
+/* Runs the walk under sel; the histogram is the last measured frame's, and
+ * so is the picture when pic is not NULL (drawn outside the measured time,
+ * before any more streaming). */
 static result run_mode(crowd *c, const mlod_rt_select *sel, double seconds, double fps, double max_wall, float near,
-                       float far)
+                       float far, picture *pic)
 {
 	result res;
 	memset(&res, 0, sizeof res);
@@ -326,11 +732,11 @@ static result run_mode(crowd *c, const mlod_rt_select *sel, double seconds, doub
 		walk(c, dt, near, far);
 		total += frame(c, sel, dt, &res.vertices);
 		res.frames++;
+		if (f + 1 == frames || total > max_wall)
+			break;
 		/* streaming between frames, not measured */
 		mlod_rt_stream(c->ctx, 256 * 1024, NULL, NULL);
 		grow(c);
-		if (total > max_wall)
-			break;
 	}
 	res.ms = 1000.0 * total / res.frames;
 	for (uint32_t i = 0; i < c->n; i++) {
@@ -342,24 +748,52 @@ static result run_mode(crowd *c, const mlod_rt_select *sel, double seconds, doub
 	mlod_rt_stats s;
 	mlod_rt_stats_get(c->ctx, &s);
 	res.resident = s.resident_bytes;
+	if (pic)
+		render(c, pic);
 	return res;
 }
 
-static void print_hist(const char *name, const uint32_t *h, uint32_t levels)
+static void print_hist(const uint32_t *h, uint32_t levels)
 {
-	printf("  %s", name);
 	for (uint32_t l = 0; l < levels && l < 16; l++)
 		printf(" %u", h[l]);
 }
 
+/* The LoD modes measured besides full detail. */
+static const char *const mode_name[3] = { "alpha", "pixels", "toc" };
+
+/* "alpha", "pixels", "toc", a comma list of them, or "all" (alpha and
+ * pixels): a bit per mlod_rt_select_mode. */
+static unsigned parse_modes(const char *s)
+{
+	if (!strcmp(s, "all"))
+		return 1u << MLOD_RT_SELECT_ALPHA | 1u << MLOD_RT_SELECT_PIXELS;
+	unsigned m = 0;
+	for (const char *p = s; *p;) {
+		size_t n = strcspn(p, ",");
+		int k;
+		for (k = 0; k < 3; k++)
+			if (strlen(mode_name[k]) == n && !strncmp(p, mode_name[k], n))
+				break;
+		if (k == 3 || n == 0)
+			die(1, "unknown --mode '%s' (alpha, pixels, toc, a comma list of them, or all)", s);
+		m |= 1u << k;
+		p += n;
+		if (*p == ',' && *++p == '\0')
+			die(1, "unknown --mode '%s' (alpha, pixels, toc, a comma list of them, or all)", s);
+	}
+	return m;
+}
+
 int main(int argc, char **argv)
 {
-	const char *counts = "1,10,50,250,1000,10000";
-	double seconds = 2, fps = 30, max_wall = 10, hyst = 0.1;
+	const char *counts = "1,10,50,250,1000,10000", *png_path = NULL;
+	double seconds = 2, fps = 30, max_wall = 10, hyst = 0.1, height = 1.8, pixels = -1;
 	float near = 2, far = 200, ts = 0, te = 1;
 	size_t budget = 0;
-	int bench = 1, line = 0;
-	mlod_rt_select_mode mode = MLOD_RT_SELECT_ALPHA;
+	int bench = 1, line = 0, png_w = 960, png_h = 540, png_mode = -1;
+	unsigned long png_count = 0;
+	unsigned modes = 1u << MLOD_RT_SELECT_ALPHA | 1u << MLOD_RT_SELECT_PIXELS;
 	static const struct option longopts[] = {
 		{ "counts", required_argument, NULL, 'n' },   { "seconds", required_argument, NULL, 's' },
 		{ "fps", required_argument, NULL, 'f' },      { "max-wall", required_argument, NULL, 'w' },
@@ -367,6 +801,9 @@ int main(int argc, char **argv)
 		{ "far", required_argument, NULL, 'F' },      { "mode", required_argument, NULL, 'm' },
 		{ "hysteresis", required_argument, NULL, 'H' }, { "no-skin-bench", no_argument, NULL, 'k' },
 		{ "interval", required_argument, NULL, 'I' }, { "spread", required_argument, NULL, 'S' },
+		{ "height", required_argument, NULL, 'E' },   { "pixels", required_argument, NULL, 'P' },
+		{ "png", required_argument, NULL, 'G' },      { "png-count", required_argument, NULL, 'C' },
+		{ "png-size", required_argument, NULL, 'Z' }, { "png-mode", required_argument, NULL, 'M' },
 		{ "help", no_argument, NULL, 'h' },           { NULL, 0, NULL, 0 },
 	};
 	int ch;
@@ -382,6 +819,42 @@ int main(int argc, char **argv)
 		case 'F': far = (float)parse_num(optarg, "--far"); break;
 		case 'H': hyst = parse_num(optarg, "--hysteresis"); break;
 		case 'k': bench = 0; break;
+		case 'E': {
+			char *end;
+			height = strtod(optarg, &end);
+			if (end == optarg || *end || !isfinite(height) || height < 0)
+				die(1, "bad --height '%s' (the character's height in metres, or 0 for scene units)", optarg);
+			break;
+		}
+		case 'P': {
+			char *end;
+			pixels = strtod(optarg, &end);
+			if (end == optarg || *end || !isfinite(pixels) || !(pixels > 0))
+				die(1, "bad --pixels '%s' (a projected error in pixels, > 0)", optarg);
+			break;
+		}
+		case 'G': png_path = optarg; break;
+		case 'C': {
+			char *end;
+			png_count = strtoul(optarg, &end, 10);
+			if (end == optarg || *end || png_count == 0)
+				die(1, "bad --png-count '%s'", optarg);
+			break;
+		}
+		case 'Z':
+			if (sscanf(optarg, "%dx%d", &png_w, &png_h) != 2 || png_w < 16 || png_h < 16 || png_w > 8192 ||
+			    png_h > 8192)
+				die(1, "bad --png-size '%s' (WxH, 16..8192 each)", optarg);
+			break;
+		case 'M': {
+			int k;
+			for (k = 0; k < 3 && strcmp(optarg, mode_name[k]); k++)
+				;
+			if (k == 3)
+				die(1, "unknown --png-mode '%s' (alpha, pixels or toc)", optarg);
+			png_mode = k;
+			break;
+		}
 		case 'S':
 			if (!strcmp(optarg, "ground") || !strcmp(optarg, "line"))
 				line = !strcmp(optarg, "line");
@@ -392,16 +865,7 @@ int main(int argc, char **argv)
 			if (sscanf(optarg, "%f,%f", &ts, &te) != 2 || !(ts >= 0) || !(te <= 1))
 				die(1, "bad --interval '%s' (TS,TE within 0..1)", optarg);
 			break;
-		case 'm':
-			if (!strcmp(optarg, "alpha"))
-				mode = MLOD_RT_SELECT_ALPHA;
-			else if (!strcmp(optarg, "pixels"))
-				mode = MLOD_RT_SELECT_PIXELS;
-			else if (!strcmp(optarg, "toc"))
-				mode = MLOD_RT_SELECT_TOC;
-			else
-				die(1, "unknown mode '%s' (alpha, pixels or toc)", optarg);
-			break;
+		case 'm': modes = parse_modes(optarg); break;
 		case 'h': fputs(usage_text, stdout); return 0;
 		case ':': die(1, "option '%s' needs a value", argv[optind - 1]);
 		default: die(1, "unknown option '%s' (see --help)", argv[optind - 1]);
@@ -411,6 +875,11 @@ int main(int argc, char **argv)
 		die(1, "%s", "one PACK is needed (see --help)");
 	if (!(seconds > 0) || !(fps > 0) || !(far > near) || near < 0 || hyst < 0)
 		die(1, "%s", "bad --seconds, --fps, --near/--far or --hysteresis");
+	if (png_mode >= 0 && !(modes >> png_mode & 1))
+		die(1, "--png-mode %s is not among the measured --mode", mode_name[png_mode]);
+	if (png_mode < 0)
+		for (png_mode = 0; !(modes >> png_mode & 1); png_mode++)
+			;
 	const char *path = argv[optind];
 
 	/* The crowd sizes. */
@@ -425,6 +894,14 @@ int main(int argc, char **argv)
 			maxn = (uint32_t)v;
 		s = *end ? end + 1 : end;
 	}
+	if (png_count) {
+		uint32_t k = 0;
+		while (k < nsizes && sizes[k] != png_count)
+			k++;
+		if (k == nsizes)
+			die(1, "--png-count is not one of the --counts '%s'", counts);
+	} else
+		png_count = maxn;
 
 	mlod_rt_config cfg = { budget, maxn, NULL };
 	mlod_error e;
@@ -435,11 +912,25 @@ int main(int argc, char **argv)
 	if (r != MLOD_OK)
 		die(exit_code(r), "%s", e.message);
 	double open_ms = 1000 * (cpu_seconds() - t0);
+	size_t file_size = 0;
+	void *file = read_file(path, &file_size);
+	mlod_pack_info_rec info;
+	if (!read_info(file, file_size, &info))
+		die(2, "%s: cannot read the pack's INFO", path);
+	/* Metres: the character is --height metres tall. */
+	float scale = 1.0f;
+	if (height > 0) {
+		if (!(info.height > 0))
+			die(2, "%s: the pack gives no character height: use --height 0 (scene units)", path);
+		scale = info.height / (float)height;
+	}
+	const float near_u = near * scale, far_u = far * scale;
 	c.scratch = mlod_rt_scratch_create(c.ctx);
 	c.ids = malloc(sizeof *c.ids * maxn);
 	c.dist = malloc(sizeof *c.dist * maxn);
 	c.speed = malloc(sizeof *c.speed * maxn);
-	if (!c.scratch || !c.ids || !c.dist || !c.speed)
+	c.azimuth = malloc(sizeof *c.azimuth * maxn);
+	if (!c.scratch || !c.ids || !c.dist || !c.speed || !c.azimuth)
 		die(2, "%s", "out of memory");
 	grow(&c);
 
@@ -449,15 +940,35 @@ int main(int argc, char **argv)
 		L[l] = mlod_rt_level_count(c.ctx, (mlod_rt_layer)l);
 	mlod_rt_stats st;
 	mlod_rt_stats_get(c.ctx, &st);
+	mlod_rt_select lod;
+	mlod_rt_select_default(&lod);
+	if (pixels > 0)
+		lod.max_pixels = (float)pixels;
 	printf("%s: %u joints, %u clips; levels: skeleton %u, mesh %u, motion %u; open %.2f ms CPU, %zu bytes resident\n",
 	       path, mlod_rt_joint_count(c.ctx), clips, L[0], L[1], L[2], open_ms, st.resident_bytes);
-	printf("budget %s%zu, distances %g..%g spread %s, mode %s (alpha interval %g,%g), hysteresis %g, %g s at %g fps per "
-	       "measurement\n",
-	       budget ? "" : "none ", budget, near, far, line ? "along a line" : "over the ground",
-	       mode == MLOD_RT_SELECT_ALPHA ? "alpha" : mode == MLOD_RT_SELECT_PIXELS ? "pixels" : "toc", ts, te, hyst,
-	       seconds, fps);
+	const char *unit = height > 0 ? " m" : " scene units";
+	if (height > 0)
+		printf("scale %.4g scene units per metre (the character, %.4g units in the pack, taken as %g m tall); ", scale,
+		       info.height, height);
+	else
+		printf("scale 1 (scene units; the character is %.4g units tall); ", info.height);
+	printf("distances %g..%g%s spread %s\n", near, far, unit, line ? "along a line" : "over the ground");
+	printf("budget %s%zu, hysteresis %g, %g s at %g fps per measurement; modes: full",
+	       budget ? "" : "none ", budget, hyst, seconds, fps);
+	for (int k = 0; k < 3; k++)
+		if (modes >> k & 1) {
+			if (k == MLOD_RT_SELECT_ALPHA)
+				printf(", alpha (interval %g,%g)", ts, te);
+			else if (k == MLOD_RT_SELECT_PIXELS)
+				printf(", pixels (%g px at %g lines, fov %g deg)", lod.max_pixels, lod.lines,
+				       lod.fov_y * 180.0 / 3.14159265358979323846);
+			else
+				printf(", toc (the pack's switch distances)");
+		}
+	printf("\n");
 	/* Open to the first frame (one instance, the coarse levels open gave),
 	 * then the decoding of every other level. */
+	float bmin[3], bmax[3];
 	{
 		uint32_t id, nv = 0;
 		float d = 0;
@@ -465,11 +976,17 @@ int main(int argc, char **argv)
 		mlod_rt_select_default(&sel);
 		t0 = cpu_seconds();
 		if (mlod_rt_instance_create(c.ctx, 0, 0, 0, &id, &e) != MLOD_OK ||
-		    mlod_rt_update(c.ctx, &sel, &id, &d, 1, 0, &e) != MLOD_OK ||
-		    mlod_rt_skin(c.ctx, c.scratch, id, c.buf, 12, c.buf + 3 * (size_t)c.cap, 12, c.cap, &nv, &e) != MLOD_OK)
+		    mlod_rt_update(c.ctx, &sel, &id, &d, 1, 0, &e) != MLOD_OK || skin_one(&c, id, &nv, &e) != MLOD_OK)
 			die(2, "%s", e.message);
 		double first_ms = open_ms + 1000 * (cpu_seconds() - t0);
 		mlod_rt_instance_destroy(c.ctx, id);
+		/* The picture stands the characters on the ground by this frame's
+		 * skinned bounds (clip 0 at time 0). */
+		for (int k = 0; k < 3; k++)
+			bmin[k] = nv ? INFINITY : 0, bmax[k] = nv ? -INFINITY : 0;
+		for (uint32_t v = 0; v < nv; v++)
+			for (int k = 0; k < 3; k++)
+				bmin[k] = fminf(bmin[k], c.buf[3 * v + k]), bmax[k] = fmaxf(bmax[k], c.buf[3 * v + k]);
 		size_t before = st.resident_bytes;
 		uint64_t stored = 0;
 		for (int l = 0; l < MLOD_RT_LAYERS; l++)
@@ -494,20 +1011,33 @@ int main(int argc, char **argv)
 		       dec > 0 ? (double)stored / dec / 1e6 : 0.0);
 	}
 	if (bench)
-		skin_bench(path);
+		skin_bench(file, file_size);
 
-	mlod_rt_select full, lod;
+	mlod_rt_select full, sel[3];
 	mlod_rt_select_default(&full);
 	full.force_level = 0;
-	mlod_rt_select_default(&lod);
-	lod.mode = mode;
-	lod.d_near = near, lod.d_far = far;
+	lod.d_near = near_u, lod.d_far = far_u;
 	lod.hysteresis = (float)hyst;
 	for (int l = 0; l < MLOD_RT_LAYERS; l++)
 		lod.t_start[l] = ts, lod.t_end[l] = te;
+	for (int k = 0; k < 3; k++)
+		sel[k] = lod, sel[k].mode = (mlod_rt_select_mode)k;
 
-	printf("\n%7s %12s %12s %8s  %-s\n", "N", "full ms/fr", "LoD ms/fr", "speedup",
-	       "LoD instances per level (skeleton | mesh | motion), resident bytes");
+	picture pic;
+	memset(&pic, 0, sizeof pic);
+	pic.path = png_path, pic.count = (uint32_t)png_count, pic.mode = png_mode;
+	pic.width = png_w, pic.height = png_h, pic.scale = scale;
+	pic.char_height = info.height > 0 ? info.height : bmax[1] - bmin[1];
+	pic.center[0] = 0.5f * (bmin[0] + bmax[0]);
+	pic.center[1] = bmin[1];
+	pic.center[2] = 0.5f * (bmin[2] + bmax[2]);
+	/* room for the limbs' motion */
+	pic.radius = 0.75f * sqrtf((bmax[0] - bmin[0]) * (bmax[0] - bmin[0]) + (bmax[1] - bmin[1]) * (bmax[1] - bmin[1]) +
+	                           (bmax[2] - bmin[2]) * (bmax[2] - bmin[2]));
+	pic.near = near_u, pic.far = far_u, pic.mesh_levels = L[MLOD_RT_MESH];
+
+	printf("\n%7s %-7s %11s %8s %8s  %-s\n", "N", "mode", "ms/frame", "speedup", "Mvert/s",
+	       "instances per level (skeleton | mesh | motion), resident bytes");
 	for (uint32_t k = 0; k < nsizes; k++) {
 		const uint32_t n = sizes[k];
 		rng = 2463534242u;
@@ -516,32 +1046,50 @@ int main(int argc, char **argv)
 			if (mlod_rt_instance_create(c.ctx, clips ? i % clips : 0, t, MLOD_RT_LOOP, &c.ids[i], &e) != MLOD_OK)
 				die(2, "%s", e.message);
 			float u = ((float)i + 0.5f) / (float)n;
-			c.dist[i] = line ? near + (far - near) * u : sqrtf(near * near + u * (far * far - near * near));
-			c.speed[i] = (frand() < 0.5f ? -1.0f : 1.0f) * (0.8f + 1.2f * frand()); /* walking, m/s */
+			c.dist[i] = line ? near_u + (far_u - near_u) * u
+			                 : sqrtf(near_u * near_u + u * (far_u * far_u - near_u * near_u));
+			/* walking at 0.8..2 m/s, towards or away from the camera */
+			c.speed[i] = (frand() < 0.5f ? -1.0f : 1.0f) * (0.8f + 1.2f * frand()) * scale;
+			c.azimuth[i] = 2.39996323f * (float)i; /* the golden angle: even over the ring */
 		}
 		c.n = n;
 		float *d0 = malloc(sizeof *d0 * n), *s0 = malloc(sizeof *s0 * n);
 		memcpy(d0, c.dist, sizeof *d0 * n);
 		memcpy(s0, c.speed, sizeof *s0 * n);
-		result a = run_mode(&c, &full, seconds, fps, max_wall, near, far);
-		memcpy(c.dist, d0, sizeof *d0 * n); /* the same walk for both modes */
-		memcpy(c.speed, s0, sizeof *s0 * n);
-		result b = run_mode(&c, &lod, seconds, fps, max_wall, near, far);
+		result res[4];
+		res[3] = run_mode(&c, &full, seconds, fps, max_wall, near_u, far_u, NULL);
+		for (int m = 0; m < 3; m++) {
+			if (!(modes >> m & 1))
+				continue;
+			memcpy(c.dist, d0, sizeof *d0 * n); /* the same walk for every mode */
+			memcpy(c.speed, s0, sizeof *s0 * n);
+			res[m] = run_mode(&c, &sel[m], seconds, fps, max_wall, near_u, far_u,
+			                  png_path && n == png_count && m == png_mode && !pic.done ? &pic : NULL);
+		}
 		free(d0), free(s0);
-		printf("%7u %12.3f %12.3f %7.2fx ", n, a.ms, b.ms, a.ms / b.ms);
-		print_hist("", b.hist[0], L[0]);
-		printf(" |");
-		print_hist("", b.hist[1], L[1]);
-		printf(" |");
-		print_hist("", b.hist[2], L[2]);
-		printf("  %zu B", b.resident);
-		if (b.fallbacks || a.fallbacks)
-			printf("  (fallbacks: full %u, LoD %u)", a.fallbacks, b.fallbacks);
-		if (a.frames < (int)(seconds * fps + 0.5) || b.frames < (int)(seconds * fps + 0.5))
-			printf("  (frames: full %d, LoD %d)", a.frames, b.frames);
-		printf("\n");
-		printf("%7s %12.1f %12.1f %8s  Mvertices skinned per second\n", "", a.vertices / (a.ms * a.frames) / 1e3,
-		       b.vertices / (b.ms * b.frames) / 1e3, "");
+		const int want = (int)(seconds * fps + 0.5);
+		for (int mm = 0; mm < 4; mm++) { /* full, then alpha, pixels, toc */
+			const int m = (mm + 3) % 4;
+			if (m < 3 && !(modes >> m & 1))
+				continue;
+			const result *b = &res[m];
+			if (m == 3)
+				printf("%7u %-7s %11.3f %8s", n, "full", b->ms, "");
+			else
+				printf("%7s %-7s %11.3f %7.2fx", "", mode_name[m], b->ms, res[3].ms / b->ms);
+			printf(" %8.1f ", b->vertices / (b->ms * b->frames) / 1e3);
+			print_hist(b->hist[0], L[0]);
+			printf(" |");
+			print_hist(b->hist[1], L[1]);
+			printf(" |");
+			print_hist(b->hist[2], L[2]);
+			printf("  %zu B", b->resident);
+			if (b->fallbacks)
+				printf("  (fallbacks %u)", b->fallbacks);
+			if (b->frames < want)
+				printf("  (frames %d of %d)", b->frames, want);
+			printf("\n");
+		}
 		for (uint32_t i = 0; i < n; i++)
 			mlod_rt_instance_destroy(c.ctx, c.ids[i]);
 		fflush(stdout);
@@ -550,8 +1098,14 @@ int main(int argc, char **argv)
 	printf("\nstreaming: %llu loads, %llu evictions, %llu failures; peak resident %zu bytes\n",
 	       (unsigned long long)st.loads, (unsigned long long)st.evictions, (unsigned long long)st.failures,
 	       st.peak_resident_bytes);
+	if (png_path) {
+		printf("picture: %s, %dx%d, N = %u, mode %s, the last measured frame: %u instances drawn (mesh levels",
+		       png_path, png_w, png_h, pic.count, mode_name[pic.mode], pic.drawn);
+		print_hist(pic.drawn_level, L[MLOD_RT_MESH]);
+		printf("), %u triangles\n", pic.triangles);
+	}
 	mlod_rt_scratch_destroy(c.ctx, c.scratch);
 	mlod_rt_close(c.ctx);
-	free(c.ids), free(c.dist), free(c.speed), free(c.buf);
+	free(c.ids), free(c.dist), free(c.speed), free(c.azimuth), free(c.buf), free(file);
 	return 0;
 }
