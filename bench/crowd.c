@@ -484,6 +484,8 @@ static void draw_triangle(raster *R, float s[3][3], const float shade[3], const 
 		return;
 	float minx = fminf(s[0][0], fminf(s[1][0], s[2][0])), maxx = fmaxf(s[0][0], fmaxf(s[1][0], s[2][0]));
 	float miny = fminf(s[0][1], fminf(s[1][1], s[2][1])), maxy = fmaxf(s[0][1], fmaxf(s[1][1], s[2][1]));
+	if (!(maxx >= 0 && minx < (float)R->w && maxy >= 0 && miny < (float)R->h))
+		return; /* off screen (or not a number) */
 	int x0 = minx < 0 ? 0 : (int)minx, x1 = maxx >= (float)R->w - 1 ? R->w - 1 : (int)maxx;
 	int y0 = miny < 0 ? 0 : (int)miny, y1 = maxy >= (float)R->h - 1 ? R->h - 1 : (int)maxy;
 	const float inv = 1.0f / area;
@@ -1009,6 +1011,10 @@ int main(int argc, char **argv)
 		       "%llu stored bytes to %zu resident in %.2f ms CPU (%.0f MB/s stored)\n",
 		       nv, first_ms, loaded, (unsigned long long)stored, st.resident_bytes - before, 1000 * dec,
 		       dec > 0 ? (double)stored / dec / 1e6 : 0.0);
+		printf("vertices skinned per mesh level:");
+		for (uint32_t k = 0; k < L[MLOD_RT_MESH]; k++)
+			printf(" %u", mlod_rt_mesh_vertex_count(c.ctx, k));
+		printf("\n");
 	}
 	if (bench)
 		skin_bench(file, file_size);
