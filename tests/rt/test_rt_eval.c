@@ -270,10 +270,15 @@ static float frand(void)
 	return (float)((rng_state >> 8) & 0xffff) / 65535.0f;
 }
 
+/* The kernel against the scalar loop: 1 to 4 influences in every pattern
+ * (zero weights first, between and last), lengths around the kernel's runs
+ * of 64, zero normals, no normals, and positions and normals interleaved
+ * in one buffer with a gap the kernel must not touch. */
 TEST(kernel_matches_scalar)
 {
-	enum { N = 1000, P = 8 };
+	enum { N = 1000, P = 8, S = 8 }; /* S floats per interleaved vertex */
 	static float pos[3 * N], nrm[3 * N], wgt[4 * N], pal[16 * P], a[3 * N], b[3 * N], an[3 * N], bn[3 * N];
+	static float ia[S * N], ib[S * N];
 	static uint16_t jnt[4 * N];
 	for (int m = 0; m < P; m++) {
 		mlod_trs t = { { frand(), frand(), frand() },
@@ -282,19 +287,58 @@ TEST(kernel_matches_scalar)
 		mlod_mat4 M = mlod_mat4_from_trs(&t);
 		memcpy(pal + 16 * m, M.m, sizeof M.m);
 	}
+	int pattern_seen[16] = { 0 };
 	for (int v = 0; v < N; v++) {
 		float s = 0;
 		for (int k = 0; k < 3; k++)
-			pos[3 * v + k] = frand() * 2 - 1, nrm[3 * v + k] = frand() - 0.5f;
-		for (int k = 0; k < 4; k++)
-			jnt[4 * v + k] = (uint16_t)(frand() * (P - 1) + 0.5f), wgt[4 * v + k] = frand(), s += wgt[4 * v + k];
+			pos[3 * v + k] = frand() * 2 - 1, nrm[3 * v + k] = v % 97 == 5 ? 0.0f : frand() - 0.5f;
+		/* Which influences are non-zero: every pattern but none; runs of
+		 * one pattern (as meshes have) and mixed stretches. */
+		int mask = v < N / 2 ? (v / 40) % 15 + 1 : (int)(frand() * 14.99f) + 1;
+		pattern_seen[mask] = 1;
+		for (int k = 0; k < 4; k++) {
+			jnt[4 * v + k] = (uint16_t)(frand() * (P - 1) + 0.5f);
+			wgt[4 * v + k] = mask >> k & 1 ? frand() + 0.01f : 0.0f;
+			s += wgt[4 * v + k];
+		}
 		for (int k = 0; k < 4; k++)
 			wgt[4 * v + k] /= s;
 	}
-	mlod_rt_skin_lbs(N, pos, nrm, jnt, wgt, pal, a, 12, an, 12);
-	mlod_rt_skin_lbs_scalar(N, pos, nrm, jnt, wgt, pal, b, 12, bn, 12);
-	double d = fx_maxdiff(a, b, 3 * N), dn = fx_maxdiff(an, bn, 3 * N);
-	CHECK(d <= 1e-5 && dn <= 1e-5, "kernel and scalar differ: %g (positions), %g (normals)", d, dn);
+	for (int m = 1; m < 16; m++)
+		CHECK(pattern_seen[m], "influence pattern %d not covered", m);
+	static const int lengths[] = { 0, 1, 3, 63, 64, 65, 127, 129, 200, N };
+	for (size_t l = 0; l < sizeof lengths / sizeof lengths[0]; l++) {
+		const int n = lengths[l];
+		const int off = l % 2 ? 0 : 37; /* also an unaligned start */
+		if (off + n > N)
+			continue;
+		memset(a, 0, sizeof a), memset(b, 0, sizeof b), memset(an, 0, sizeof an), memset(bn, 0, sizeof bn);
+		mlod_rt_skin_lbs((size_t)n, pos + 3 * off, nrm + 3 * off, jnt + 4 * off, wgt + 4 * off, pal, a, 12, an, 12);
+		mlod_rt_skin_lbs_scalar((size_t)n, pos + 3 * off, nrm + 3 * off, jnt + 4 * off, wgt + 4 * off, pal, b, 12,
+		                        bn, 12);
+		double d = fx_maxdiff(a, b, 3 * N), dn = fx_maxdiff(an, bn, 3 * N);
+		CHECK(d <= 1e-5 && dn <= 1e-5, "n %d: kernel and scalar differ: %g (positions), %g (normals)", n, d, dn);
+		/* Without normals: same positions, the normal buffer untouched. */
+		memset(a, 0, sizeof a), memset(an, 0, sizeof an);
+		mlod_rt_skin_lbs((size_t)n, pos + 3 * off, NULL, jnt + 4 * off, wgt + 4 * off, pal, a, 12, an, 12);
+		d = fx_maxdiff(a, b, 3 * N);
+		CHECK(d <= 1e-5, "n %d, no normals: positions differ by %g", n, d);
+		for (int i = 0; i < 3 * N; i++)
+			CHECK(an[i] == 0.0f, "n %d: normals written without normals", n);
+		/* Interleaved: position at 0, normal at 4, floats 3 and 7 a gap. */
+		for (int i = 0; i < S * N; i++)
+			ia[i] = ib[i] = -7.0f;
+		mlod_rt_skin_lbs((size_t)n, pos + 3 * off, nrm + 3 * off, jnt + 4 * off, wgt + 4 * off, pal, ia, 4 * S,
+		                 ia + 4, 4 * S);
+		mlod_rt_skin_lbs_scalar((size_t)n, pos + 3 * off, nrm + 3 * off, jnt + 4 * off, wgt + 4 * off, pal, ib,
+		                        4 * S, ib + 4, 4 * S);
+		d = fx_maxdiff(ia, ib, S * N);
+		CHECK(d <= 1e-5, "n %d, interleaved: kernel and scalar differ by %g", n, d);
+		for (int i = 0; i < S * N; i++)
+			CHECK(i >= S * n || (i % S != 3 && i % S != 7) ? 1 : ia[i] == -7.0f, "n %d: gap %d written", n, i);
+		for (int i = S * n; i < S * N; i++)
+			CHECK(ia[i] == -7.0f, "n %d: wrote past the last vertex (float %d)", n, i);
+	}
 }
 
 /* The counting allocator. */
