@@ -26,8 +26,10 @@
  * writes there (the next mlod_rt_pose on that scratch, the next update).
  *
  * Allocation. Every allocation of the runtime goes through the
- * configuration's allocator (malloc/free when NULL), except the decoded
- * chunks themselves, which the pack reader allocates with malloc. Memory is
+ * configuration's allocator (malloc/free when NULL), the pack reader's too
+ * (the TOC, the decoded chunks and their decoding scratch: the runtime
+ * hands it the allocator, mlod_pack_open_alloc). The one exception is the
+ * C library's FILE that mlod_rt_open_path opens with fopen. Memory is
  * allocated only by mlod_rt_open_*, mlod_rt_scratch_create and
  * mlod_rt_stream when it loads a level. mlod_rt_update, mlod_rt_request,
  * mlod_rt_pose, mlod_rt_palette, mlod_rt_skin, instance creation and
@@ -175,7 +177,7 @@ typedef struct mlod_rt_allocator {
 	void *(*malloc)(void *user, size_t size);
 	void (*free)(void *user, void *p);
 	void *user;
-} mlod_rt_allocator;
+} mlod_rt_allocator; /* the same callbacks as mlod_pack_alloc */
 
 typedef struct mlod_rt_config {
 	size_t budget_bytes;      /* resident bytes allowed; 0: no limit */
