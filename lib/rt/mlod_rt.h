@@ -141,8 +141,11 @@
  * renormalised); rigid parts (joint >= 0) by W[joint] * offset, or for a
  * joint the skeleton level removed, W[stand-in] * R * offset with R the
  * rest transform from the stand-in (nearest kept ancestor) to the joint, as
- * the bake side's fold does; static parts by offset. Morph targets are not
- * applied.
+ * the bake side's fold does; static parts by offset. Before that, a part
+ * with morph targets gets the instance's weights for it
+ * (mlod_rt_instance_set_morph_weights; 0 by default): position = position
+ * + sum of weight[t] * delta[t]. Normals are not morphed (the pack keeps
+ * position deltas only).
  */
 #ifndef MLOD_RT_H
 #define MLOD_RT_H
@@ -285,6 +288,9 @@ typedef struct mlod_rt_part_info {
 	const uint32_t *indices;
 	int32_t material;     /* the input's glTF material, or -1 */
 	int32_t skin, joint;  /* skinned, rigid (joint >= 0) or static */
+	uint32_t instance;    /* the character's mesh instance the part belongs to */
+	int32_t node;         /* its glTF node, or -1 */
+	uint32_t target_count; /* morph targets (mlod_rt_morph_target_count) */
 } mlod_rt_part_info;
 
 /* Parts of a mesh level when resident, else 0. */
@@ -342,6 +348,22 @@ mlod_result mlod_rt_instance_set(mlod_rt_ctx *ctx, uint32_t id, uint32_t clip, f
                                  mlod_error *err);
 /* The instance's state, or NULL for an id not alive. */
 const mlod_rt_state *mlod_rt_instance_state(const mlod_rt_ctx *ctx, uint32_t id);
+
+/* Morph targets. A pack's mesh levels have the same parts, in the same
+ * order (mlod_rt_mesh_part's index); mlod_rt_morph_target_count gives a
+ * part's morph targets as the coarsest level has them (views: the most
+ * any level has), 0 for a part out of range. glTF gives one weight vector per mesh: set it on each part of
+ * that mesh instance (mlod_rt_part_info.instance or .node).
+ * mlod_rt_instance_set_morph_weights sets the instance's weights of one
+ * part: count (at most the part's targets) weights, the others 0; they
+ * stay until set again or the instance is destroyed (a new instance has
+ * all weights 0: no morph). mlod_rt_skin applies them to every mesh level
+ * (up to the targets that level's part has). MLOD_ERR_INVALID_ARG for an
+ * id not alive, too many weights or a weight not finite. No allocation;
+ * like mlod_rt_update, not while other threads evaluate the context. */
+uint32_t mlod_rt_morph_target_count(const mlod_rt_ctx *ctx, uint32_t part);
+mlod_result mlod_rt_instance_set_morph_weights(mlod_rt_ctx *ctx, uint32_t id, uint32_t part, const float *weights,
+                                               uint32_t count, mlod_error *err);
 
 typedef enum mlod_rt_select_mode {
 	MLOD_RT_SELECT_ALPHA = 0,

@@ -7,6 +7,9 @@
  * mlod_pose_character places them) within 1e-5 of the diagonal, at many
  * times of every clip. Primitives with more than one weight set are
  * outside the runtime's 4 influences and are counted, not compared.
+ * With morph weights set per instance (mlod_rt_instance_set_morph_weights),
+ * the runtime's output must equal the bake side's skinning of the
+ * primitive whose positions carry the weighted morph target deltas.
  */
 #include "test.h"
 
@@ -23,6 +26,7 @@ typedef struct conv {
 	const float **ibm;
 	mlod_pack_part *parts;
 	const mlod_primitive **prims;
+	float ***targets; /* per part: its targets' position deltas */
 	mlod_pack_mesh mesh;
 	mlod_pack_channel *chans;
 	mlod_pack_motion *motions;
@@ -69,6 +73,7 @@ static void conv_build(const mlod_character *c, conv *v)
 		np += c->meshes[c->instances[i].mesh].primitive_count;
 	v->parts = calloc((size_t)np + 1, sizeof *v->parts);
 	v->prims = calloc((size_t)np + 1, sizeof *v->prims);
+	v->targets = calloc((size_t)np + 1, sizeof *v->targets);
 	for (int i = 0; i < c->instance_count; i++) {
 		const mlod_instance *in = &c->instances[i];
 		const mlod_mesh *m = &c->meshes[in->mesh];
@@ -91,6 +96,13 @@ static void conv_build(const mlod_character *c, conv *v)
 			t->normals = q->normals;
 			if (in->skin >= 0)
 				t->joints = q->joints[0], t->weights = q->weights[0];
+			if (q->target_count > 0) {
+				float **d = v->targets[v->mesh.part_count - 1] = calloc((size_t)q->target_count, sizeof *d);
+				for (int k = 0; k < q->target_count; k++)
+					d[k] = q->targets[k].positions;
+				t->targets = d;
+				t->rec.target_count = (uint32_t)q->target_count;
+			}
 		}
 	}
 	v->mesh.parts = v->parts;
@@ -126,10 +138,21 @@ static void conv_free(conv *v)
 	for (uint32_t k = 0; k < v->skel.skin_count; k++)
 		free(v->skin_joints[k]);
 	free(v->joints), free(v->names), free(v->skins), free(v->skin_names), free(v->skin_joints), free(v->ibm);
-	free(v->parts), free(v->prims), free(v->chans), free(v->motions), free(v->mot_v);
+	for (uint32_t p = 0; p < v->mesh.part_count; p++)
+		free(v->targets[p]);
+	free(v->parts), free(v->prims), free(v->targets), free(v->chans), free(v->motions), free(v->mot_v);
 }
 
-static void compare_sample(const char *path)
+/* The morph weight of target k at step of the comparison: every target
+ * of a mesh instance gets a different one, some negative, some above 1. */
+static float morph_weight(uint32_t instance, int k, int step)
+{
+	return (float)((int)(instance * 7 + (unsigned)k * 3 + (unsigned)step * 5) % 11 - 3) / 6.0f;
+}
+
+/* morph: set morph weights on every instance and compare with the bake
+ * side's skinning of the morphed primitives. */
+static void compare_sample(const char *path, int morph)
 {
 	size_t size;
 	void *data = test_read_file(path, &size);
@@ -147,6 +170,9 @@ static void compare_sample(const char *path)
 	const uint32_t nv = mlod_rt_max_vertex_count(ctx);
 	float *rp = malloc((size_t)nv * 12 + 12), *rn = malloc((size_t)nv * 12 + 12);
 	float *bp = malloc((size_t)nv * 12 + 12), *bn = malloc((size_t)nv * 12 + 12);
+	float *mp = malloc((size_t)nv * 12 + 12); /* a primitive's morphed positions */
+	double worst_shift = 0;                   /* the largest morph displacement, of the diagonal */
+	uint32_t morphed_parts = 0;
 	mlod_trs *local = malloc(sizeof *local * (size_t)s->joint_count);
 	mlod_mat4 *world = malloc(sizeof *world * (size_t)s->joint_count);
 	int maxskin = 1;
@@ -171,6 +197,16 @@ static void compare_sample(const char *path)
 			const float t = dur * (float)step / 11.0f - 0.01f; /* also before 0 and after the end */
 			uint32_t id;
 			CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)k, t, 0, &id, &terr));
+			for (uint32_t p = 0; morph && p < v.mesh.part_count; p++) {
+				const uint32_t nt = mlod_rt_morph_target_count(ctx, p);
+				CHECK_MSG(nt == v.parts[p].rec.target_count, "part %u: %u morph targets, the primitive has %u", p,
+				          nt, v.parts[p].rec.target_count);
+				float w[64];
+				CHECK(nt <= 64);
+				for (uint32_t i = 0; i < nt; i++)
+					w[i] = morph_weight(v.parts[p].rec.instance, (int)i, step);
+				CHECK_OK(mlod_rt_instance_set_morph_weights(ctx, id, p, w, nt, &terr));
+			}
 			const float *W;
 			CHECK_OK(mlod_rt_pose(ctx, sc, id, &W, NULL, NULL, &terr));
 			mlod_pose_rest(s, local);
@@ -187,8 +223,27 @@ static void compare_sample(const char *path)
 			size_t base = 0;
 			for (uint32_t p = 0; p < v.mesh.part_count; p++) {
 				const mlod_pack_part *pt = &v.parts[p];
-				const mlod_primitive *q = v.prims[p];
+				const mlod_primitive *q0 = v.prims[p];
 				const size_t m = pt->rec.vertex_count;
+				/* The bake side's primitive, morphed: a copy whose positions
+				 * carry the weighted deltas. */
+				mlod_primitive qm = *q0;
+				if (morph && q0->target_count > 0) {
+					memcpy(mp, q0->positions, 12 * m);
+					for (int k2 = 0; k2 < q0->target_count; k2++) {
+						const float wk = morph_weight(pt->rec.instance, k2, step);
+						const float *d = q0->targets[k2].positions;
+						for (size_t i = 0; d && wk != 0.0f && i < 3 * m; i++)
+							mp[i] += wk * d[i];
+					}
+					for (size_t i = 0; i < 3 * m; i++) {
+						double d = fabs((double)mp[i] - q0->positions[i]) / diag;
+						worst_shift = d > worst_shift ? d : worst_shift;
+					}
+					qm.positions = mp;
+					morphed_parts += step == 0 && k == 0;
+				}
+				const mlod_primitive *q = &qm;
 				if (pt->rec.skin >= 0) {
 					mlod_skin_matrices(&s->skins[pt->rec.skin], world, sm);
 					mlod_skin_primitive(q, sm, bp, q->normals ? bn : NULL);
@@ -222,19 +277,29 @@ static void compare_sample(const char *path)
 	CHECK_MSG(worst_pose <= 1e-5, "%s: pose differs by %g", path, worst_pose);
 	CHECK_MSG(worst_skin <= 1e-5, "%s: skinned positions differ by %g of the diagonal", path, worst_skin);
 	CHECK_MSG(worst_nrm <= 1e-4, "%s: skinned normals differ by %g", path, worst_nrm);
-	free(rp), free(rn), free(bp), free(bn), free(local), free(world), free(sm);
+	if (morph) {
+		/* The comparison means something only if the morph moves vertices
+		 * well beyond the tolerance. */
+		printf("# %s: %u parts with morph targets, the weights move vertices up to %.3g of the diagonal\n", path,
+		       morphed_parts, worst_shift);
+		CHECK_MSG(morphed_parts > 0 && worst_shift > 1e-3, "%s: no morph to compare (%u parts, %g)", path,
+		          morphed_parts, worst_shift);
+	}
+	free(rp), free(rn), free(bp), free(bn), free(mp), free(local), free(world), free(sm);
 	mlod_rt_scratch_destroy(ctx, sc);
 	mlod_rt_close(ctx);
 	conv_free(&v);
 	mlod_character_free(&c);
 }
 
-TEST(rt_equals_bake_tubeman) { compare_sample("samples/tubeman.glb"); }
-TEST(rt_equals_bake_robot) { compare_sample("samples/RobotExpressive.glb"); }
+TEST(rt_equals_bake_tubeman) { compare_sample("samples/tubeman.glb", 0); }
+TEST(rt_equals_bake_robot) { compare_sample("samples/RobotExpressive.glb", 0); }
+TEST(rt_morph_equals_bake_robot) { compare_sample("samples/RobotExpressive.glb", 1); }
 
 int main(void)
 {
 	RUN(rt_equals_bake_tubeman);
 	RUN(rt_equals_bake_robot);
+	RUN(rt_morph_equals_bake_robot);
 	TEST_EXIT();
 }
