@@ -375,6 +375,15 @@ typedef struct mlod_pack_chunk {
 	float error, distance;
 } mlod_pack_chunk;
 
+/* The reader's allocator (the runtime passes its own, mlod_rt_allocator's
+ * callbacks): malloc(user, size) returns NULL on failure, free(user, p)
+ * takes what it returned. Either NULL (a zeroed struct): malloc and free. */
+typedef struct mlod_pack_alloc {
+	void *(*malloc)(void *user, size_t size);
+	void (*free)(void *user, void *p);
+	void *user;
+} mlod_pack_alloc;
+
 /* An opened pack: the header and the TOC, checked (sizes, offsets,
  * alignment, order, CRCs of header and TOC; chunk CRCs are checked when a
  * chunk is decoded). Chunks of unknown types are kept in the TOC and
@@ -385,14 +394,18 @@ typedef struct mlod_pack {
 	uint64_t file_size;
 	uint32_t chunk_count;
 	mlod_pack_chunk *chunks;
+	mlod_pack_alloc alloc;     /* the TOC's, and every decode's from this pack */
 } mlod_pack;
 
 /* Parses and checks the header and TOC from the first bytes of a file
  * (size >= 32 + 48 * chunk_count; the chunks need not be there).
  * MLOD_ERR_PARSE with a message for anything malformed,
  * MLOD_ERR_UNSUPPORTED for a newer major version. Release with
- * mlod_pack_close. */
+ * mlod_pack_close. mlod_pack_open_alloc allocates the TOC, and every
+ * chunk decoded from the pack later, with alloc (NULL: malloc and free). */
 mlod_result mlod_pack_open(const void *data, size_t size, mlod_pack *out, mlod_error *err);
+mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_alloc *alloc, mlod_pack *out,
+                                 mlod_error *err);
 void mlod_pack_close(mlod_pack *p);
 
 /* The CRC32 the format uses. */
@@ -401,8 +414,10 @@ uint32_t mlod_pack_crc32(uint32_t crc, const void *data, size_t size);
 /* Decoded chunks. Each decode checks the chunk's CRC and every size,
  * count and index, and fails with MLOD_ERR_PARSE naming the chunk
  * ("MESH level 2: ...") rather than read out of bounds. Everything a
- * decoded chunk points to lives in one allocation owned by it; release
- * with the matching *_free (which accepts a zeroed struct). */
+ * decoded chunk points to lives in one allocation owned by it (block),
+ * made with the pack's allocator, which the block records; release with
+ * the matching *_free (which accepts a zeroed struct), which frees it with
+ * that allocator. */
 
 typedef struct mlod_pack_info {
 	mlod_pack_info_rec rec;

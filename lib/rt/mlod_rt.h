@@ -26,8 +26,10 @@
  * writes there (the next mlod_rt_pose on that scratch, the next update).
  *
  * Allocation. Every allocation of the runtime goes through the
- * configuration's allocator (malloc/free when NULL), except the decoded
- * chunks themselves, which the pack reader allocates with malloc. Memory is
+ * configuration's allocator (malloc/free when NULL), the pack reader's too
+ * (the TOC, the decoded chunks and their decoding scratch: the runtime
+ * hands it the allocator, mlod_pack_open_alloc). The one exception is the
+ * C library's FILE that mlod_rt_open_path opens with fopen. Memory is
  * allocated only by mlod_rt_open_*, mlod_rt_scratch_create and
  * mlod_rt_stream when it loads a level. mlod_rt_update, mlod_rt_request,
  * mlod_rt_pose, mlod_rt_palette, mlod_rt_skin, instance creation and
@@ -139,8 +141,11 @@
  * renormalised); rigid parts (joint >= 0) by W[joint] * offset, or for a
  * joint the skeleton level removed, W[stand-in] * R * offset with R the
  * rest transform from the stand-in (nearest kept ancestor) to the joint, as
- * the bake side's fold does; static parts by offset. Morph targets are not
- * applied.
+ * the bake side's fold does; static parts by offset. Before that, a part
+ * with morph targets gets the instance's weights for it
+ * (mlod_rt_instance_set_morph_weights; 0 by default): position = position
+ * + sum of weight[t] * delta[t]. Normals are not morphed (the pack keeps
+ * position deltas only).
  */
 #ifndef MLOD_RT_H
 #define MLOD_RT_H
@@ -175,7 +180,7 @@ typedef struct mlod_rt_allocator {
 	void *(*malloc)(void *user, size_t size);
 	void (*free)(void *user, void *p);
 	void *user;
-} mlod_rt_allocator;
+} mlod_rt_allocator; /* the same callbacks as mlod_pack_alloc */
 
 typedef struct mlod_rt_config {
 	size_t budget_bytes;      /* resident bytes allowed; 0: no limit */
@@ -283,6 +288,9 @@ typedef struct mlod_rt_part_info {
 	const uint32_t *indices;
 	int32_t material;     /* the input's glTF material, or -1 */
 	int32_t skin, joint;  /* skinned, rigid (joint >= 0) or static */
+	uint32_t instance;    /* the character's mesh instance the part belongs to */
+	int32_t node;         /* its glTF node, or -1 */
+	uint32_t target_count; /* morph targets (mlod_rt_morph_target_count) */
 } mlod_rt_part_info;
 
 /* Parts of a mesh level when resident, else 0. */
@@ -340,6 +348,22 @@ mlod_result mlod_rt_instance_set(mlod_rt_ctx *ctx, uint32_t id, uint32_t clip, f
                                  mlod_error *err);
 /* The instance's state, or NULL for an id not alive. */
 const mlod_rt_state *mlod_rt_instance_state(const mlod_rt_ctx *ctx, uint32_t id);
+
+/* Morph targets. A pack's mesh levels have the same parts, in the same
+ * order (mlod_rt_mesh_part's index); mlod_rt_morph_target_count gives a
+ * part's morph targets as the coarsest level has them (views: the most
+ * any level has), 0 for a part out of range. glTF gives one weight vector per mesh: set it on each part of
+ * that mesh instance (mlod_rt_part_info.instance or .node).
+ * mlod_rt_instance_set_morph_weights sets the instance's weights of one
+ * part: count (at most the part's targets) weights, the others 0; they
+ * stay until set again or the instance is destroyed (a new instance has
+ * all weights 0: no morph). mlod_rt_skin applies them to every mesh level
+ * (up to the targets that level's part has). MLOD_ERR_INVALID_ARG for an
+ * id not alive, too many weights or a weight not finite. No allocation;
+ * like mlod_rt_update, not while other threads evaluate the context. */
+uint32_t mlod_rt_morph_target_count(const mlod_rt_ctx *ctx, uint32_t part);
+mlod_result mlod_rt_instance_set_morph_weights(mlod_rt_ctx *ctx, uint32_t id, uint32_t part, const float *weights,
+                                               uint32_t count, mlod_error *err);
 
 typedef enum mlod_rt_select_mode {
 	MLOD_RT_SELECT_ALPHA = 0,
@@ -419,11 +443,14 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
  * (the caller guarantees them in range), weights 4 each (summing to 1:
  * no renormalisation), palette 16 floats per matrix (column-major 4x4, as
  * mlod_rt_palette gives); output 3 floats per vertex with byte strides.
- * The first is the runtime's loop (fixed 4 influences, restrict pointers,
- * blends written so the compiler vectorises them), the second a plain
- * scalar loop (per-influence accumulation, vectorisation disabled where
- * the compiler allows it), kept as the benchmark's reference. Same results
- * to rounding. */
+ * The first is the runtime's loop (vertices bucketed by their count of
+ * influences up to the last non-zero weight, one loop per count, 4-lane
+ * blends; see rt_skin.c), the second a plain scalar loop (per-influence
+ * accumulation skipping zero weights, vectorisation disabled where the
+ * compiler allows it), kept as the benchmark's reference. Same results to
+ * rounding (bit for bit on x86-64 with GCC). Neither allocates; the first
+ * uses about 1.3 KB of stack. Only the 3 floats of each output vertex are
+ * written, so positions and normals may be interleaved in one buffer. */
 void mlod_rt_skin_lbs(size_t n, const float *positions, const float *normals, const uint16_t *joints,
                       const float *weights, const float *palette, float *out_pos, size_t pos_stride,
                       float *out_nrm, size_t nrm_stride);

@@ -9,6 +9,8 @@
  * up to the TOC's raw size, and refuses one above PACK_MAX_BLOCK before
  * allocating. Meshopt-coded streams are decoded into a temporary buffer
  * (freed before the decode returns); raw streams are read in place.
+ * Every allocation is the pack's allocator's (mlod_pack_open_alloc; malloc
+ * by default), and a block starts with that allocator, for *_free.
  *
  * Byte order: the format is little-endian, and so must the host be (the
  * index codec's output and the records are read with memcpy); the
@@ -23,6 +25,28 @@
 #include <meshoptimizer.h>
 
 #include "mlod_pack.h"
+
+/* The reader's allocations, all through the pack's allocator: zeroed. */
+static void *pk_calloc(const mlod_pack_alloc *a, size_t n, size_t size)
+{
+	if (size && n > SIZE_MAX / size)
+		return NULL;
+	size_t bytes = n * size > 0 ? n * size : 1;
+	void *p = a && a->malloc && a->free ? a->malloc(a->user, bytes) : malloc(bytes);
+	if (p)
+		memset(p, 0, bytes);
+	return p;
+}
+
+static void pk_free(const mlod_pack_alloc *a, void *p)
+{
+	if (!p)
+		return;
+	if (a && a->malloc && a->free)
+		a->free(a->user, p);
+	else
+		free(p);
+}
 
 #if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
 #error "mlod's pack reader assumes a little-endian host"
@@ -205,6 +229,12 @@ static uint64_t order_key(const mlod_pack_chunk *c)
 
 mlod_result mlod_pack_open(const void *data, size_t size, mlod_pack *out, mlod_error *err)
 {
+	return mlod_pack_open_alloc(data, size, NULL, out, err);
+}
+
+mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_alloc *alloc, mlod_pack *out,
+                                 mlod_error *err)
+{
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_open: out is NULL");
 	memset(out, 0, sizeof *out);
@@ -245,7 +275,7 @@ mlod_result mlod_pack_open(const void *data, size_t size, mlod_pack *out, mlod_e
 
 	mlod_pack_chunk *chunks = NULL;
 	if (n > 0) {
-		chunks = calloc(n, sizeof *chunks);
+		chunks = pk_calloc(alloc, n, sizeof *chunks);
 		if (!chunks)
 			return mlod_fail(err, MLOD_ERR_NOMEM, "pack TOC: out of memory for %u entries", n);
 	}
@@ -316,7 +346,7 @@ mlod_result mlod_pack_open(const void *data, size_t size, mlod_pack *out, mlod_e
 		r = mlod_fail(err, MLOD_ERR_PARSE, "pack header: file size %llu, but the %s ends at byte %llu",
 		              (unsigned long long)file_size, n ? "last chunk" : "TOC", (unsigned long long)prev_end);
 	if (r != MLOD_OK) {
-		free(chunks);
+		pk_free(alloc, chunks);
 		return r;
 	}
 	out->major = (uint16_t)major;
@@ -325,6 +355,10 @@ mlod_result mlod_pack_open(const void *data, size_t size, mlod_pack *out, mlod_e
 	out->file_size = file_size;
 	out->chunk_count = n;
 	out->chunks = chunks;
+	if (alloc && alloc->malloc && alloc->free)
+		out->alloc = *alloc;
+	else
+		memset(&out->alloc, 0, sizeof out->alloc);
 	return MLOD_OK;
 }
 
@@ -332,7 +366,7 @@ void mlod_pack_close(mlod_pack *p)
 {
 	if (!p)
 		return;
-	free(p->chunks);
+	pk_free(&p->alloc, p->chunks);
 	memset(p, 0, sizeof *p);
 }
 
@@ -399,6 +433,7 @@ typedef struct cx {
 	uint64_t max_decoded; /* the largest meshopt-coded stream, decoded */
 	uint8_t *temp;        /* aux bytes, then the decode buffer */
 	uint64_t aux;
+	mlod_pack_alloc alloc; /* the pack's */
 } cx;
 
 /* Checks the chunk (type, codec, bounds, CRC) and its stream container
@@ -414,6 +449,7 @@ static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, c
 		                 p->chunk_count);
 	const mlod_pack_chunk *c = &p->chunks[index];
 	x->c = c;
+	x->alloc = p->alloc;
 	chunk_label(c->type, c->level, c->item, x->label, sizeof x->label);
 	if (c->type != type) {
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: chunk %u is %s, not a %s chunk", index, x->label,
@@ -556,7 +592,7 @@ static mlod_result cx_temp(cx *x, uint64_t aux, mlod_error *err)
 	if (total > PACK_MAX_BLOCK)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: decoding needs %llu bytes of scratch, more than the reader's limit",
 		                 x->label, (unsigned long long)total);
-	x->temp = calloc(1, (size_t)total);
+	x->temp = pk_calloc(&x->alloc, 1, (size_t)total);
 	if (!x->temp)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for %llu bytes of scratch", x->label,
 		                 (unsigned long long)total);
@@ -565,7 +601,7 @@ static mlod_result cx_temp(cx *x, uint64_t aux, mlod_error *err)
 
 static void cx_done(cx *x)
 {
-	free(x->temp);
+	pk_free(&x->alloc, x->temp);
 	x->temp = NULL;
 }
 
@@ -592,7 +628,20 @@ static mlod_result cx_load(cx *x, const stream *s, const uint8_t **out, mlod_err
 	return MLOD_OK;
 }
 
-/* The block: one allocation carved into 8-aligned arrays. */
+/* The block: one allocation carved into 8-aligned arrays, after a head
+ * that records the allocator that made it (for the *_free calls). */
+enum { BLOCK_HEAD = 32 };
+_Static_assert(sizeof(mlod_pack_alloc) <= BLOCK_HEAD, "the block's head holds its allocator");
+
+static void block_free(void *block)
+{
+	if (!block)
+		return;
+	mlod_pack_alloc a;
+	memcpy(&a, block, sizeof a);
+	pk_free(&a, block);
+}
+
 typedef struct bump {
 	uint8_t *base;
 	uint64_t used, cap;
@@ -604,11 +653,13 @@ static mlod_result bump_alloc(bump *b, cx *x, uint64_t total, mlod_error *err)
 	if (total > PACK_MAX_BLOCK)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: decoded, it needs %llu bytes, more than the reader's limit",
 		                 x->label, (unsigned long long)total);
-	b->base = calloc(1, (size_t)(total ? total : 8));
+	b->base = pk_calloc(&x->alloc, 1, (size_t)(BLOCK_HEAD + total));
 	if (!b->base)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for %llu bytes", x->label,
 		                 (unsigned long long)total);
-	b->cap = total;
+	memcpy(b->base, &x->alloc, sizeof x->alloc);
+	b->used = BLOCK_HEAD;
+	b->cap = BLOCK_HEAD + total;
 	return MLOD_OK;
 }
 
@@ -768,7 +819,7 @@ mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t s
 	return MLOD_OK;
 fail:
 	cx_done(&x);
-	free(b.base);
+	pk_free(&x.alloc, b.base);
 	return r;
 }
 
@@ -776,7 +827,7 @@ void mlod_pack_info_free(mlod_pack_info *x)
 {
 	if (!x)
 		return;
-	free(x->block);
+	block_free(x->block);
 	memset(x, 0, sizeof *x);
 }
 
@@ -892,7 +943,7 @@ mlod_result mlod_pack_decode_skeleton(const mlod_pack *p, const void *data, size
 	return MLOD_OK;
 fail:
 	cx_done(&x);
-	free(b.base);
+	pk_free(&x.alloc, b.base);
 	return r;
 }
 
@@ -900,7 +951,7 @@ void mlod_pack_skeleton_free(mlod_pack_skeleton *x)
 {
 	if (!x)
 		return;
-	free(x->block);
+	block_free(x->block);
 	memset(x, 0, sizeof *x);
 }
 
@@ -996,7 +1047,7 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	return MLOD_OK;
 fail:
 	cx_done(&x);
-	free(b.base);
+	pk_free(&x.alloc, b.base);
 	return r;
 }
 
@@ -1004,7 +1055,7 @@ void mlod_pack_skel_level_free(mlod_pack_skel_level *x)
 {
 	if (!x)
 		return;
-	free(x->block);
+	block_free(x->block);
 	memset(x, 0, sizeof *x);
 }
 
@@ -1246,7 +1297,7 @@ mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void
 	return MLOD_OK;
 fail:
 	cx_done(&x);
-	free(b.base);
+	pk_free(&x.alloc, b.base);
 	return r;
 }
 
@@ -1254,7 +1305,7 @@ void mlod_pack_mesh_free(mlod_pack_mesh *x)
 {
 	if (!x)
 		return;
-	free(x->block);
+	block_free(x->block);
 	memset(x, 0, sizeof *x);
 }
 
@@ -1442,7 +1493,7 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	return MLOD_OK;
 fail:
 	cx_done(&x);
-	free(b.base);
+	pk_free(&x.alloc, b.base);
 	return r;
 }
 
@@ -1450,7 +1501,7 @@ void mlod_pack_motion_free(mlod_pack_motion *x)
 {
 	if (!x)
 		return;
-	free(x->block);
+	block_free(x->block);
 	memset(x, 0, sizeof *x);
 }
 

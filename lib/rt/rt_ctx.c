@@ -450,6 +450,65 @@ static void unuse(mlod_rt_ctx *ctx, rt_instance *in)
 /* Opening: the common part                                          */
 /* ---------------------------------------------------------------- */
 
+/* A mesh level's data for morph_setup: resident, or (views) the caller's. */
+static const mlod_pack_mesh *mesh_of(const mlod_rt_ctx *ctx, const rt_unit *u)
+{
+	if (!u)
+		return NULL;
+	if (u->state == RT_UNIT_RESIDENT)
+		return u->mesh;
+	if (!ctx->load && u->view)
+		return ((const mlod_rt_view_level *)u->view)->data;
+	return NULL;
+}
+
+/* The morph weights' layout and their storage for the whole instance
+ * pool, all 0. A pack's levels have the same parts (mlod(5)): the
+ * coarsest level, resident at open, gives them. Views are all there:
+ * every level counts (the most parts, the most targets per part). */
+static mlod_result morph_setup(mlod_rt_ctx *ctx, mlod_error *err)
+{
+	const uint32_t L = ctx->levels[MLOD_RT_MESH];
+	uint32_t parts = 0;
+	for (uint32_t l = L ? (ctx->load ? L - 1 : 0) : 0; l < L; l++) {
+		const mlod_pack_mesh *m = mesh_of(ctx, rt_unit_get(ctx, MLOD_RT_MESH, l, 0));
+		if (m && m->part_count > parts)
+			parts = m->part_count;
+	}
+	if (!parts)
+		return MLOD_OK;
+	ctx->morph_offset = rt_calloc(ctx, (size_t)parts + 1, sizeof *ctx->morph_offset);
+	if (!ctx->morph_offset)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory for the morph weights");
+	/* morph_offset[i + 1]: part i's targets, then summed in place. */
+	for (uint32_t l = ctx->load ? L - 1 : 0; l < L; l++) {
+		const mlod_pack_mesh *m = mesh_of(ctx, rt_unit_get(ctx, MLOD_RT_MESH, l, 0));
+		for (uint32_t i = 0; m && i < m->part_count; i++) {
+			const uint32_t k = m->parts[i].targets ? m->parts[i].rec.target_count : 0;
+			if (k > ctx->morph_offset[i + 1])
+				ctx->morph_offset[i + 1] = k;
+		}
+	}
+	uint64_t total = 0;
+	for (uint32_t i = 0; i < parts; i++) {
+		total += ctx->morph_offset[i + 1];
+		if (total > UINT32_MAX / 4)
+			return mlod_fail(err, MLOD_ERR_LIMIT, "too many morph targets");
+		ctx->morph_offset[i + 1] = (uint32_t)total;
+	}
+	if (total == 0)
+		return MLOD_OK; /* no weights: morph_parts stays 0 */
+	if (total > SIZE_MAX / sizeof(float) / 2 / ctx->max_instances)
+		return mlod_fail(err, MLOD_ERR_LIMIT, "%llu morph targets: too many for %u instances",
+		                 (unsigned long long)total, ctx->max_instances);
+	ctx->morph_weights = rt_calloc(ctx, (size_t)total * ctx->max_instances, sizeof(float));
+	if (!ctx->morph_weights)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory for the morph weights");
+	ctx->morph_parts = parts;
+	ctx->morph_total = (uint32_t)total;
+	return MLOD_OK;
+}
+
 mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 {
 	const mlod_pack_skeleton *s = ctx->skel;
@@ -525,6 +584,9 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 			}
 		ctx->clip_duration[c] = isfinite(d) && d > 0.0f ? d : 0.0f;
 	}
+	mlod_result mr = morph_setup(ctx, err);
+	if (mr)
+		return mr;
 	if (ctx->resident_bytes > ctx->budget)
 		return mlod_fail(err, MLOD_ERR_LIMIT,
 		                 "the coarse levels need %zu bytes, more than the budget of %zu bytes",
@@ -605,6 +667,8 @@ void mlod_rt_close(mlod_rt_ctx *ctx)
 	rt_free(ctx, ctx->all_needed);
 	rt_free(ctx, ctx->clip_duration);
 	rt_free(ctx, ctx->inst);
+	rt_free(ctx, ctx->morph_offset);
+	rt_free(ctx, ctx->morph_weights);
 	mlod_rt_allocator a = ctx->alloc;
 	a.free(a.user, ctx);
 }
@@ -674,6 +738,9 @@ mlod_result mlod_rt_mesh_part(const mlod_rt_ctx *ctx, uint32_t level, uint32_t p
 	out->material = p->rec.material;
 	out->skin = p->rec.skin;
 	out->joint = p->rec.joint;
+	out->instance = p->rec.instance;
+	out->node = p->rec.node;
+	out->target_count = mlod_rt_morph_target_count(ctx, part);
 	return MLOD_OK;
 }
 
@@ -827,6 +894,8 @@ mlod_result mlod_rt_instance_create(mlod_rt_ctx *ctx, uint32_t clip, float time,
 	in->st.clip = ctx->clip_count ? clip : 0;
 	in->st.time = time;
 	in->st.flags = flags;
+	if (ctx->morph_total)
+		memset(ctx->morph_weights + (size_t)i * ctx->morph_total, 0, sizeof(float) * ctx->morph_total);
 	for (int layer = 0; layer < MLOD_RT_LAYERS; layer++) {
 		uint16_t c = (uint16_t)(ctx->levels[layer] ? ctx->levels[layer] - 1 : 0);
 		in->st.wanted[layer] = c;
@@ -875,6 +944,35 @@ mlod_result mlod_rt_instance_set(mlod_rt_ctx *ctx, uint32_t id, uint32_t clip, f
 			u->users++;
 	}
 	rt_resolve(ctx, in);
+	return MLOD_OK;
+}
+
+uint32_t mlod_rt_morph_target_count(const mlod_rt_ctx *ctx, uint32_t part)
+{
+	if (!ctx || part >= ctx->morph_parts)
+		return 0;
+	return ctx->morph_offset[part + 1] - ctx->morph_offset[part];
+}
+
+mlod_result mlod_rt_instance_set_morph_weights(mlod_rt_ctx *ctx, uint32_t id, uint32_t part, const float *weights,
+                                               uint32_t count, mlod_error *err)
+{
+	if (!ctx || (!weights && count))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_instance_set_morph_weights: NULL argument");
+	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
+	const uint32_t targets = mlod_rt_morph_target_count(ctx, part);
+	if (count > targets)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "part %u has %u morph targets, %u weights given", part, targets,
+		                 count);
+	for (uint32_t t = 0; t < count; t++)
+		if (!isfinite(weights[t]))
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "part %u: morph weight %u is not finite", part, t);
+	if (!targets)
+		return MLOD_OK;
+	float *w = ctx->morph_weights + (size_t)id * ctx->morph_total + ctx->morph_offset[part];
+	for (uint32_t t = 0; t < targets; t++)
+		w[t] = t < count ? weights[t] : 0.0f;
 	return MLOD_OK;
 }
 

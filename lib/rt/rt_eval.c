@@ -236,22 +236,22 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
 /* Skinning                                                          */
 /* ---------------------------------------------------------------- */
 
-static void transform_part(const mlod_pack_part *p, const float *M, float *out_pos, size_t ps, float *out_nrm,
-                           size_t ns)
+/* Vertices of a rigid or static part (or a stretch of them) by M. */
+static void transform_range(size_t n, const float *pos, const float *nrm, const float *M, float *out_pos, size_t ps,
+                            float *out_nrm, size_t ns)
 {
-	const uint32_t n = p->rec.vertex_count;
-	for (uint32_t v = 0; v < n; v++) {
-		const float *q = p->positions + 3 * (size_t)v;
-		float *o = (float *)((char *)out_pos + (size_t)v * ps);
+	for (size_t v = 0; v < n; v++) {
+		const float *q = pos + 3 * v;
+		float *o = (float *)((char *)out_pos + v * ps);
 		for (int r = 0; r < 3; r++)
 			o[r] = M[r] * q[0] + M[4 + r] * q[1] + M[8 + r] * q[2] + M[12 + r];
 		if (out_nrm) {
-			float *on = (float *)((char *)out_nrm + (size_t)v * ns);
-			if (!p->normals) {
+			float *on = (float *)((char *)out_nrm + v * ns);
+			if (!nrm) {
 				on[0] = on[1] = on[2] = 0.0f;
 				continue;
 			}
-			const float *nn = p->normals + 3 * (size_t)v;
+			const float *nn = nrm + 3 * v;
 			float len2 = 0.0f;
 			for (int r = 0; r < 3; r++) {
 				on[r] = M[r] * nn[0] + M[4 + r] * nn[1] + M[8 + r] * nn[2];
@@ -261,6 +261,45 @@ static void transform_part(const mlod_pack_part *p, const float *M, float *out_p
 			for (int r = 0; r < 3; r++)
 				on[r] *= il;
 		}
+	}
+}
+
+/* Morphing goes through a buffer on the stack, this many vertices at a
+ * time: no allocation. */
+enum { RT_MORPH_RUN = 128 };
+
+/* The instance's morph weights for part i of a level and the targets to
+ * apply (*nt), or NULL when every weight is 0 (nothing to do). */
+static const float *part_morph(const mlod_rt_ctx *ctx, uint32_t id, uint32_t i, const mlod_pack_part *p,
+                               uint32_t *nt)
+{
+	if (i >= ctx->morph_parts || !p->targets)
+		return NULL;
+	uint32_t k = ctx->morph_offset[i + 1] - ctx->morph_offset[i];
+	if (p->rec.target_count < k)
+		k = p->rec.target_count;
+	const float *w = ctx->morph_weights + (size_t)id * ctx->morph_total + ctx->morph_offset[i];
+	for (uint32_t t = 0; t < k; t++)
+		if (w[t] != 0.0f && p->targets[t]) {
+			*nt = k;
+			return w;
+		}
+	return NULL;
+}
+
+/* Positions v0 .. v0 + n - 1 of p morphed into out: the position plus
+ * each target's delta times its weight, targets in order. */
+static void morph_range(const mlod_pack_part *p, const float *w, uint32_t nt, size_t v0, size_t n,
+                        float *restrict out)
+{
+	memcpy(out, p->positions + 3 * v0, 3 * n * sizeof(float));
+	for (uint32_t t = 0; t < nt; t++) {
+		if (w[t] == 0.0f || !p->targets[t])
+			continue;
+		const float wt = w[t];
+		const float *restrict d = p->targets[t] + 3 * v0;
+		for (size_t k = 0; k < 3 * n; k++)
+			out[k] += wt * d[k];
 	}
 }
 
@@ -290,23 +329,17 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	const rt_unit *su = s->skel_unit;
 	const float *W = s->world;
 	size_t base = 0;
+	float morphed[3 * RT_MORPH_RUN];
 	for (uint32_t i = 0; i < mu->mesh->part_count; i++) {
 		const mlod_pack_part *p = &mu->mesh->parts[i];
 		const uint32_t n = p->rec.vertex_count;
 		float *op = (float *)((char *)positions + base * pos_stride);
 		float *on = normals ? (float *)((char *)normals + base * nrm_stride) : NULL;
-		if (p->rec.skin >= 0 && n) {
-			const float *pal = s->palette + 16 * (size_t)ctx->skin_offset[p->rec.skin];
-			mlod_rt_skin_lbs(n, p->positions, on ? p->normals : NULL, p->joints, p->weights, pal, op, pos_stride, on,
-			                 nrm_stride);
-			if (on && !p->normals)
-				for (uint32_t v = 0; v < n; v++) {
-					float *x = (float *)((char *)on + (size_t)v * nrm_stride);
-					x[0] = x[1] = x[2] = 0.0f;
-				}
-		} else if (p->rec.joint >= 0) {
+		const int skinned = p->rec.skin >= 0;
+		const float *pal = skinned ? s->palette + 16 * (size_t)ctx->skin_offset[p->rec.skin] : NULL;
+		float M[16];
+		if (!skinned && p->rec.joint >= 0) {
 			const uint32_t j = (uint32_t)p->rec.joint;
-			float M[16];
 			if (su && su->plan.stand[j] != (int32_t)j) {
 				float t[16];
 				rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
@@ -314,9 +347,34 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 			} else {
 				rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
 			}
-			transform_part(p, M, op, pos_stride, on, nrm_stride);
-		} else {
-			transform_part(p, p->rec.offset, op, pos_stride, on, nrm_stride);
+		} else if (!skinned) {
+			memcpy(M, p->rec.offset, sizeof M);
+		}
+		uint32_t nt = 0;
+		const float *mw = part_morph(ctx, id, i, p, &nt);
+		/* The whole part at once, or runs of RT_MORPH_RUN when morphed. */
+		for (size_t v0 = 0; v0 < n;) {
+			const size_t m = mw && n - v0 > RT_MORPH_RUN ? RT_MORPH_RUN : n - v0;
+			const float *pos = p->positions + 3 * v0;
+			if (mw) {
+				morph_range(p, mw, nt, v0, m, morphed);
+				pos = morphed;
+			}
+			const float *nrm = p->normals ? p->normals + 3 * v0 : NULL;
+			float *o = (float *)((char *)op + v0 * pos_stride);
+			float *onr = on ? (float *)((char *)on + v0 * nrm_stride) : NULL;
+			if (skinned) {
+				mlod_rt_skin_lbs(m, pos, onr ? nrm : NULL, p->joints + 4 * v0, p->weights + 4 * v0, pal, o,
+				                 pos_stride, onr, nrm_stride);
+				if (onr && !nrm)
+					for (size_t v = 0; v < m; v++) {
+						float *x = (float *)((char *)onr + v * nrm_stride);
+						x[0] = x[1] = x[2] = 0.0f;
+					}
+			} else {
+				transform_range(m, pos, nrm, M, o, pos_stride, onr, nrm_stride);
+			}
+			v0 += m;
 		}
 		base += n;
 	}

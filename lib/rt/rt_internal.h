@@ -108,6 +108,12 @@ struct mlod_rt_ctx {
 	/* Instances. */
 	rt_instance *inst;
 	uint32_t max_instances, free_head, live;
+	/* Morph target weights (morph_setup): per part its targets' weights,
+	 * morph_total per instance, the instance's at morph_weights + id *
+	 * morph_total; morph_parts 0 when no part has targets. */
+	uint32_t morph_parts, morph_total;
+	uint32_t *morph_offset;   /* morph_parts + 1: first weight of each part */
+	float *morph_weights;     /* max_instances * morph_total, or NULL */
 };
 
 struct mlod_rt_scratch {

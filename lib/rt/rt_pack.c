@@ -4,7 +4,9 @@
  * (lib/rt/pack.c) inside mlod_rt_stream. Sources other than memory read a
  * chunk into a staging buffer (allocated at open, the size of the largest
  * chunk) and decode it through a copy of the TOC whose entry for that
- * chunk says offset 0.
+ * chunk says offset 0. The reader allocates through the context's
+ * allocator (mlod_pack_open_alloc), so every allocation of a context is
+ * its allocator's.
  */
 #include <limits.h>
 #include <stdio.h>
@@ -102,8 +104,11 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 	ctx->load = pack_load;
 	ctx->unload = pack_unload;
 	ctx->close_source = pack_close;
+	/* The reader allocates the TOC and every decoded chunk (and its
+	 * scratch) with the context's allocator. */
+	const mlod_pack_alloc pa = { ctx->alloc.malloc, ctx->alloc.free, ctx->alloc.user };
 	if (ctx->source == SRC_MEMORY) {
-		r = mlod_pack_open(ctx->data, ctx->size, &ctx->pack, err);
+		r = mlod_pack_open_alloc(ctx->data, ctx->size, &pa, &ctx->pack, err);
 	} else {
 		uint8_t head[MLOD_PACK_HEADER_SIZE];
 		if (ctx->file_size < MLOD_PACK_HEADER_SIZE)
@@ -125,7 +130,7 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 			rt_free(ctx, toc);
 			return mlod_fail(err, MLOD_ERR_IO, "reading the pack's TOC failed");
 		}
-		r = mlod_pack_open(toc, (size_t)want, &ctx->pack, err);
+		r = mlod_pack_open_alloc(toc, (size_t)want, &pa, &ctx->pack, err);
 		rt_free(ctx, toc);
 	}
 	if (r)

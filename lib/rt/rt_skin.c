@@ -1,16 +1,23 @@
 /*
  * rt_skin.c: the linear blend skinning kernels (mlod_rt.h).
  *
- * mlod_rt_skin_lbs blends, per vertex, the palette matrices (16 floats
- * each, column-major) 4 lanes at a time, one matrix column per vector; the
- * point and the normal are then one 4-lane multiply-add chain each. With
- * GCC or Clang it is written with their vector extension and works in
- * runs of 32 vertices, each with a loop specialised for the run's largest
- * count of non-zero influences (1 to 4; a zero weight adds nothing, so the
- * results do not change), the normals normalised after the run. Other
- * compilers (or -DMLOD_RT_NO_VECTOR_EXT) get fixed-length restrict loops
- * that the auto-vectoriser handles. mlod_rt_skin_lbs_scalar is the plain
- * loop they are measured against.
+ * mlod_rt_skin_lbs works in runs of 64 vertices. A run's vertices are
+ * first bucketed by how many influences they use (up to the last non-zero
+ * weight: a zero weight adds nothing, so skipping it changes no result),
+ * then each bucket goes through a loop specialised for its count, 1 to 4,
+ * with no branch per influence. The loops blend the palette matrices
+ * (16 floats each, column-major) 4 lanes at a time, one matrix column per
+ * vector, in the scalar loop's order of operations (so the results are
+ * the scalar loop's, bit for bit, where the compiler does not contract
+ * to fused multiply-adds); the point and the normal are then one 4-lane
+ * multiply-add chain each. The run's normals are normalised after it, 4
+ * at a time (SSE2: one square root and one division per 4 vertices).
+ * It is written with the GCC/Clang vector extension; SSE2 intrinsics (the
+ * x86-64 baseline) only for the bucketing mask and the normalisation, each
+ * with a plain C fallback (forced with -DMLOD_RT_NO_SSE2). Other compilers
+ * (or -DMLOD_RT_NO_VECTOR_EXT) get fixed-length restrict loops that the
+ * auto-vectoriser handles. mlod_rt_skin_lbs_scalar is the plain loop they
+ * are measured against (as bench/crowd does).
  */
 #include <math.h>
 #include <string.h>
@@ -19,9 +26,16 @@
 
 #if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
 /* GCC and Clang: 4-lane vectors (SSE, NEON), one matrix column per vector,
- * written with the compilers' vector extension; the same arithmetic as
- * the portable loop below. */
+ * written with the compilers' vector extension; the same arithmetic, in
+ * the same order, as the scalar loop. */
 typedef float rt_v4 __attribute__((vector_size(16)));
+
+#if defined(__SSE2__) && !defined(MLOD_RT_NO_SSE2)
+#define RT_SSE2 1
+#include <emmintrin.h>
+#endif
+
+#define RT_RUN 64 /* vertices per run */
 
 static inline rt_v4 ld4(const float *p)
 {
@@ -30,59 +44,110 @@ static inline rt_v4 ld4(const float *p)
 	return v;
 }
 
-/* The loop for K influences (the others are 0 in this run of vertices):
- * zero weights add nothing, so skipping them changes no result. */
-static inline __attribute__((always_inline)) void lbs_k(const int K, size_t v0, size_t v1,
-                                                      const float *restrict positions,
-                                                      const float *restrict normals,
-                                                      const uint16_t *restrict joints,
-                                                      const float *restrict weights,
-                                                      const float *restrict palette, float *restrict out_pos,
-                                                      size_t pos_stride, float *restrict out_nrm,
-                                                      size_t nrm_stride, float *restrict nx, float *restrict ny,
-                                                      float *restrict nz)
+/* The influences of a vertex the kernel blends: up to the last non-zero
+ * weight (at least 1); a zero weight adds nothing, so skipping it changes
+ * no result. */
+static const uint8_t rt_kcount[16] = { 1, 1, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4 };
+
+static inline unsigned influences(const float *w)
 {
-	for (size_t v = v0; v < v1; v++) {
-		const uint16_t *j = joints + 4 * v;
-		const float *w = weights + 4 * v;
-		rt_v4 c[4];
-		const float *m0 = palette + 16 * (size_t)j[0];
-		for (int k = 0; k < 4; k++)
-			c[k] = w[0] * ld4(m0 + 4 * k);
-		for (int i = 1; i < K; i++) {
-			const float *m = palette + 16 * (size_t)j[i];
-			const float wi = w[i];
-			for (int k = 0; k < 4; k++)
-				c[k] += wi * ld4(m + 4 * k);
-		}
-		const float *p = positions + 3 * v;
-		const rt_v4 o = c[0] * p[0] + c[1] * p[1] + c[2] * p[2] + c[3];
-		float *restrict op = (float *)((char *)out_pos + v * pos_stride);
-		op[0] = o[0], op[1] = o[1], op[2] = o[2];
-		if (normals) { /* unnormalised, in SoA for normalise_block */
-			const float *q = normals + 3 * v;
-			const rt_v4 t = c[0] * q[0] + c[1] * q[1] + c[2] * q[2];
-			nx[v - v0] = t[0], ny[v - v0] = t[1], nz[v - v0] = t[2];
-		}
-	}
-	(void)out_nrm, (void)nrm_stride;
+#if defined(RT_SSE2)
+	const unsigned bits = (unsigned)_mm_movemask_ps(_mm_cmpneq_ps(_mm_loadu_ps(w), _mm_setzero_ps()));
+#else
+	const unsigned bits = (unsigned)(w[0] != 0.0f) | (unsigned)(w[1] != 0.0f) << 1 |
+	                      (unsigned)(w[2] != 0.0f) << 2 | (unsigned)(w[3] != 0.0f) << 3;
+#endif
+	return rt_kcount[bits];
 }
 
-/* Normalises m normals held as SoA and stores them, apart from the blend
- * loop so that the square roots and divisions of a run overlap. (GCC
- * vectorises this loop only with -fno-math-errno.) */
-static void normalise_block(size_t m, const float *restrict nx, const float *restrict ny, const float *restrict nz,
-                            float *restrict out, size_t stride)
+/* Skins the vertices v0 + list[0..m) of a run, each with K influences:
+ * positions stored, normals (when N) left unnormalised in tn[i]. */
+static inline __attribute__((always_inline)) void lbs_list(const int K, const int N, const uint8_t *restrict list,
+                                                         size_t m, size_t v0, const float *restrict positions,
+                                                         const float *restrict normals,
+                                                         const uint16_t *restrict joints,
+                                                         const float *restrict weights,
+                                                         const float *restrict palette, float *restrict out_pos,
+                                                         size_t pos_stride, rt_v4 *restrict tn)
 {
-	float il[32];
-	for (size_t i = 0; i < m; i++) {
-		const float l2 = nx[i] * nx[i] + ny[i] * ny[i] + nz[i] * nz[i];
-		il[i] = l2 > 0.0f ? 1.0f / sqrtf(l2) : 0.0f;
+	for (size_t t = 0; t < m; t++) {
+		const size_t i = list[t], v = v0 + i;
+		const uint16_t *j = joints + 4 * v;
+		const float *w = weights + 4 * v;
+		const float *a = palette + 16 * (size_t)j[0];
+		rt_v4 c0 = w[0] * ld4(a), c1 = w[0] * ld4(a + 4), c2 = w[0] * ld4(a + 8), c3 = w[0] * ld4(a + 12);
+		for (int k = 1; k < K; k++) {
+			const float *b = palette + 16 * (size_t)j[k];
+			const float wk = w[k];
+			c0 += wk * ld4(b), c1 += wk * ld4(b + 4), c2 += wk * ld4(b + 8), c3 += wk * ld4(b + 12);
+		}
+		const float *p = positions + 3 * v;
+		const rt_v4 o = c0 * p[0] + c1 * p[1] + c2 * p[2] + c3;
+		float *restrict op = (float *)((char *)out_pos + v * pos_stride);
+		op[0] = o[0], op[1] = o[1], op[2] = o[2];
+		if (N) {
+			const float *q = normals + 3 * v;
+			tn[i] = c0 * q[0] + c1 * q[1] + c2 * q[2];
+		}
 	}
-	for (size_t i = 0; i < m; i++) {
-		float *restrict on = (float *)((char *)out + i * stride);
-		on[0] = nx[i] * il[i], on[1] = ny[i] * il[i], on[2] = nz[i] * il[i];
+}
+
+/* Normalises the run's m blended normals and stores them at out. */
+static void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out, size_t stride)
+{
+	for (size_t i = m; i % 4; i++)
+		tn[i] = (rt_v4){ 0, 0, 0, 0 };
+	for (size_t i0 = 0; i0 < m; i0 += 4) {
+		float il[4];
+#if defined(RT_SSE2)
+		/* Four vertices at a time: squares transposed, one square root. */
+		__m128 s0 = (__m128)(tn[i0] * tn[i0]), s1 = (__m128)(tn[i0 + 1] * tn[i0 + 1]),
+		       s2 = (__m128)(tn[i0 + 2] * tn[i0 + 2]), s3 = (__m128)(tn[i0 + 3] * tn[i0 + 3]);
+		_MM_TRANSPOSE4_PS(s0, s1, s2, s3);
+		const __m128 l2 = _mm_add_ps(_mm_add_ps(s0, s1), s2);
+		const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(l2));
+		_mm_storeu_ps(il, _mm_and_ps(_mm_cmpgt_ps(l2, _mm_setzero_ps()), inv));
+#else
+		for (int k = 0; k < 4; k++) {
+			const rt_v4 t = tn[i0 + k];
+			const float l2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+			il[k] = l2 > 0.0f ? 1.0f / sqrtf(l2) : 0.0f;
+		}
+#endif
+		const size_t e = m - i0 < 4 ? m - i0 : 4;
+		for (size_t k = 0; k < e; k++) {
+			const rt_v4 r = tn[i0 + k] * il[k];
+			float *restrict on = (float *)((char *)out + (i0 + k) * stride);
+			on[0] = r[0], on[1] = r[1], on[2] = r[2];
+		}
 	}
+}
+
+static inline __attribute__((always_inline)) void lbs_run(const int N, size_t v0, size_t v1,
+                                                        const float *restrict positions,
+                                                        const float *restrict normals,
+                                                        const uint16_t *restrict joints,
+                                                        const float *restrict weights,
+                                                        const float *restrict palette, float *restrict out_pos,
+                                                        size_t pos_stride, float *restrict out_nrm,
+                                                        size_t nrm_stride)
+{
+	/* The run's vertices bucketed by influence count, in order. */
+	uint8_t list[4][RT_RUN];
+	uint64_t packed = 0; /* the four counts, 16 bits each: no store in the chain */
+	for (size_t v = v0; v < v1; v++) {
+		const unsigned sh = 16 * (influences(weights + 4 * v) - 1);
+		list[sh / 16][(packed >> sh) & 0xffff] = (uint8_t)(v - v0);
+		packed += (uint64_t)1 << sh;
+	}
+	const size_t count[4] = { packed & 0xffff, packed >> 16 & 0xffff, packed >> 32 & 0xffff, packed >> 48 };
+	rt_v4 tn[RT_RUN];
+	lbs_list(1, N, list[0], count[0], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(2, N, list[1], count[1], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(3, N, list[2], count[2], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(4, N, list[3], count[3], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	if (N)
+		normalise_run(v1 - v0, tn, (float *)((char *)out_nrm + v0 * nrm_stride), nrm_stride);
 }
 
 void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const float *restrict normals,
@@ -90,24 +155,12 @@ void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const float *re
                       const float *restrict palette, float *restrict out_pos, size_t pos_stride,
                       float *restrict out_nrm, size_t nrm_stride)
 {
-	/* Runs of 32 vertices, each with the loop for its largest count of
-	 * non-zero influences. */
-	for (size_t v0 = 0; v0 < n; v0 += 32) {
-		const size_t v1 = n - v0 < 32 ? n : v0 + 32;
-		int used[4] = { 0, 0, 0, 0 };
-		for (size_t v = v0; v < v1; v++)
-			for (int k = 1; k < 4; k++)
-				used[k] |= weights[4 * v + k] != 0.0f;
-		const int K = used[3] ? 4 : used[2] ? 3 : used[1] ? 2 : 1;
-		float nx[32], ny[32], nz[32];
-		switch (K) {
-		case 1: lbs_k(1, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride, nx, ny, nz); break;
-		case 2: lbs_k(2, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride, nx, ny, nz); break;
-		case 3: lbs_k(3, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride, nx, ny, nz); break;
-		default: lbs_k(4, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride, nx, ny, nz); break;
-		}
+	for (size_t v0 = 0; v0 < n; v0 += RT_RUN) {
+		const size_t v1 = n - v0 < RT_RUN ? n : v0 + RT_RUN;
 		if (normals)
-			normalise_block(v1 - v0, nx, ny, nz, (float *)((char *)out_nrm + v0 * nrm_stride), nrm_stride);
+			lbs_run(1, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride);
+		else
+			lbs_run(0, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride);
 	}
 }
 #else

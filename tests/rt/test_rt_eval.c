@@ -4,7 +4,11 @@
  * levels give the full skeleton's world matrices at their kept joints),
  * skinning against a hand-computed LBS (skinned, rigid, static parts;
  * strides), the vectorised kernel against the scalar one, and no
- * allocation per frame (counting allocator).
+ * allocation per frame (counting allocator). Morph targets: the runtime's
+ * morphed output equals its output for the same character with the
+ * deltas added to the positions by hand, at every mesh level and kind of
+ * part; the weights' rules (count, finite, reset on create); no
+ * allocation.
  */
 #include "rt_test.h"
 
@@ -270,10 +274,15 @@ static float frand(void)
 	return (float)((rng_state >> 8) & 0xffff) / 65535.0f;
 }
 
+/* The kernel against the scalar loop: 1 to 4 influences in every pattern
+ * (zero weights first, between and last), lengths around the kernel's runs
+ * of 64, zero normals, no normals, and positions and normals interleaved
+ * in one buffer with a gap the kernel must not touch. */
 TEST(kernel_matches_scalar)
 {
-	enum { N = 1000, P = 8 };
+	enum { N = 1000, P = 8, S = 8 }; /* S floats per interleaved vertex */
 	static float pos[3 * N], nrm[3 * N], wgt[4 * N], pal[16 * P], a[3 * N], b[3 * N], an[3 * N], bn[3 * N];
+	static float ia[S * N], ib[S * N];
 	static uint16_t jnt[4 * N];
 	for (int m = 0; m < P; m++) {
 		mlod_trs t = { { frand(), frand(), frand() },
@@ -282,19 +291,58 @@ TEST(kernel_matches_scalar)
 		mlod_mat4 M = mlod_mat4_from_trs(&t);
 		memcpy(pal + 16 * m, M.m, sizeof M.m);
 	}
+	int pattern_seen[16] = { 0 };
 	for (int v = 0; v < N; v++) {
 		float s = 0;
 		for (int k = 0; k < 3; k++)
-			pos[3 * v + k] = frand() * 2 - 1, nrm[3 * v + k] = frand() - 0.5f;
-		for (int k = 0; k < 4; k++)
-			jnt[4 * v + k] = (uint16_t)(frand() * (P - 1) + 0.5f), wgt[4 * v + k] = frand(), s += wgt[4 * v + k];
+			pos[3 * v + k] = frand() * 2 - 1, nrm[3 * v + k] = v % 97 == 5 ? 0.0f : frand() - 0.5f;
+		/* Which influences are non-zero: every pattern but none; runs of
+		 * one pattern (as meshes have) and mixed stretches. */
+		int mask = v < N / 2 ? (v / 40) % 15 + 1 : (int)(frand() * 14.99f) + 1;
+		pattern_seen[mask] = 1;
+		for (int k = 0; k < 4; k++) {
+			jnt[4 * v + k] = (uint16_t)(frand() * (P - 1) + 0.5f);
+			wgt[4 * v + k] = mask >> k & 1 ? frand() + 0.01f : 0.0f;
+			s += wgt[4 * v + k];
+		}
 		for (int k = 0; k < 4; k++)
 			wgt[4 * v + k] /= s;
 	}
-	mlod_rt_skin_lbs(N, pos, nrm, jnt, wgt, pal, a, 12, an, 12);
-	mlod_rt_skin_lbs_scalar(N, pos, nrm, jnt, wgt, pal, b, 12, bn, 12);
-	double d = fx_maxdiff(a, b, 3 * N), dn = fx_maxdiff(an, bn, 3 * N);
-	CHECK(d <= 1e-5 && dn <= 1e-5, "kernel and scalar differ: %g (positions), %g (normals)", d, dn);
+	for (int m = 1; m < 16; m++)
+		CHECK(pattern_seen[m], "influence pattern %d not covered", m);
+	static const int lengths[] = { 0, 1, 3, 63, 64, 65, 127, 129, 200, N };
+	for (size_t l = 0; l < sizeof lengths / sizeof lengths[0]; l++) {
+		const int n = lengths[l];
+		const int off = l % 2 ? 0 : 37; /* also an unaligned start */
+		if (off + n > N)
+			continue;
+		memset(a, 0, sizeof a), memset(b, 0, sizeof b), memset(an, 0, sizeof an), memset(bn, 0, sizeof bn);
+		mlod_rt_skin_lbs((size_t)n, pos + 3 * off, nrm + 3 * off, jnt + 4 * off, wgt + 4 * off, pal, a, 12, an, 12);
+		mlod_rt_skin_lbs_scalar((size_t)n, pos + 3 * off, nrm + 3 * off, jnt + 4 * off, wgt + 4 * off, pal, b, 12,
+		                        bn, 12);
+		double d = fx_maxdiff(a, b, 3 * N), dn = fx_maxdiff(an, bn, 3 * N);
+		CHECK(d <= 1e-5 && dn <= 1e-5, "n %d: kernel and scalar differ: %g (positions), %g (normals)", n, d, dn);
+		/* Without normals: same positions, the normal buffer untouched. */
+		memset(a, 0, sizeof a), memset(an, 0, sizeof an);
+		mlod_rt_skin_lbs((size_t)n, pos + 3 * off, NULL, jnt + 4 * off, wgt + 4 * off, pal, a, 12, an, 12);
+		d = fx_maxdiff(a, b, 3 * N);
+		CHECK(d <= 1e-5, "n %d, no normals: positions differ by %g", n, d);
+		for (int i = 0; i < 3 * N; i++)
+			CHECK(an[i] == 0.0f, "n %d: normals written without normals", n);
+		/* Interleaved: position at 0, normal at 4, floats 3 and 7 a gap. */
+		for (int i = 0; i < S * N; i++)
+			ia[i] = ib[i] = -7.0f;
+		mlod_rt_skin_lbs((size_t)n, pos + 3 * off, nrm + 3 * off, jnt + 4 * off, wgt + 4 * off, pal, ia, 4 * S,
+		                 ia + 4, 4 * S);
+		mlod_rt_skin_lbs_scalar((size_t)n, pos + 3 * off, nrm + 3 * off, jnt + 4 * off, wgt + 4 * off, pal, ib,
+		                        4 * S, ib + 4, 4 * S);
+		d = fx_maxdiff(ia, ib, S * N);
+		CHECK(d <= 1e-5, "n %d, interleaved: kernel and scalar differ by %g", n, d);
+		for (int i = 0; i < S * N; i++)
+			CHECK(i >= S * n || (i % S != 3 && i % S != 7) ? 1 : ia[i] == -7.0f, "n %d: gap %d written", n, i);
+		for (int i = S * n; i < S * N; i++)
+			CHECK(ia[i] == -7.0f, "n %d: wrote past the last vertex (float %d)", n, i);
+	}
 }
 
 /* The counting allocator. */
@@ -353,6 +401,138 @@ TEST(no_allocation_per_frame)
 	CHECK(n_alloc == n_free, "%zu allocations, %zu frees: a leak", n_alloc, n_free);
 }
 
+/* The fixture with morph targets: level 0 part 0 (skinned) 2 targets,
+ * part 2 (static) 1; level 1 part 0 (skinned, level 0's vertices 1..2)
+ * 2 targets; level 1 part 1 (rigid) 1 target, which level 0 part 1 lacks:
+ * views take the most targets of any level. mw (non-NULL) gives the same
+ * character with the weighted deltas added to its positions instead. */
+static float mt_d00[12], mt_d01[12], mt_d1[6], mt_d2[3];
+static float *mt_t0[2] = { mt_d00, mt_d01 }, *mt_t0l1[2] = { mt_d00 + 3, mt_d01 + 3 }, *mt_t1[1] = { mt_d1 },
+             *mt_t2[1] = { mt_d2 };
+static float mt_pos0[12], mt_pos1[6], mt_pos2[3];
+static mlod_pack_part mt_p0[3], mt_p1[2], mt_p2[1];
+static mlod_pack_mesh mt_m[3];
+static mlod_rt_view_level mt_vm[3];
+static mlod_rt_views mt_views;
+
+static void morph_views(const float *mw)
+{
+	for (int i = 0; i < 12; i++)
+		mt_d00[i] = 0.1f * (float)(i % 5) - 0.2f, mt_d01[i] = (i % 3 == 1) ? 0.5f : -0.05f * (float)i;
+	for (int i = 0; i < 6; i++)
+		mt_d1[i] = 0.3f - 0.1f * (float)i;
+	mt_d2[0] = 1, mt_d2[1] = -2, mt_d2[2] = 0.5f;
+	memcpy(mt_p0, fx_m0_parts, sizeof mt_p0);
+	memcpy(mt_p1, fx_m1_parts, sizeof mt_p1);
+	memcpy(mt_p2, fx_m2_parts, sizeof mt_p2);
+	if (mw) { /* weights: part 0 mw[0], mw[1]; part 1 mw[2]; part 2 mw[3] */
+		for (int i = 0; i < 12; i++)
+			mt_pos0[i] = fx_m0_pos0[i] + mw[0] * mt_d00[i] + mw[1] * mt_d01[i];
+		for (int i = 0; i < 6; i++)
+			mt_pos1[i] = fx_m0_pos1[i] + mw[2] * mt_d1[i];
+		for (int i = 0; i < 3; i++)
+			mt_pos2[i] = fx_m0_pos2[i] + mw[3] * mt_d2[i];
+		mt_p0[0].positions = mt_pos0, mt_p0[2].positions = mt_pos2;
+		mt_p1[0].positions = mt_pos0 + 3, mt_p1[1].positions = mt_pos1;
+		mt_p2[0].positions = mt_pos0;
+	} else {
+		mt_p0[0].targets = mt_t0, mt_p0[0].rec.target_count = 2;
+		mt_p0[2].targets = mt_t2, mt_p0[2].rec.target_count = 1;
+		mt_p1[0].targets = mt_t0l1, mt_p1[0].rec.target_count = 2;
+		mt_p1[1].targets = mt_t1, mt_p1[1].rec.target_count = 1;
+		mt_p2[0].targets = mt_t0, mt_p2[0].rec.target_count = 2;
+	}
+	mt_m[0] = (mlod_pack_mesh){ 3, mt_p0, NULL };
+	mt_m[1] = (mlod_pack_mesh){ 2, mt_p1, NULL };
+	mt_m[2] = (mlod_pack_mesh){ 1, mt_p2, NULL };
+	for (int l = 0; l < 3; l++)
+		mt_vm[l] = fx_vmesh[l], mt_vm[l].data = &mt_m[l];
+	mt_views = fx_views;
+	mt_views.mesh = mt_vm;
+}
+
+TEST(morph_targets)
+{
+	mlod_error e;
+	mlod_rt_allocator a = { count_malloc, count_free, NULL };
+	mlod_rt_config cfg = { 0, 8, &a };
+	static const float w[4] = { 0.75f, -1.5f, 2.0f, 0.5f };
+	for (int level = 0; level < 3; level++) {
+		/* the reference: positions morphed by hand, no targets */
+		morph_views(w);
+		mlod_rt_views saved = fx_views;
+		fx_views = mt_views; /* open_all opens fx_views */
+		mlod_rt_ctx *ref = open_all(NULL, &e);
+		fx_views = saved;
+		CHECK(ref, "open: %s", e.message);
+		CHECK(mlod_rt_morph_target_count(ref, 0) == 0, "targets in the reference");
+		mlod_rt_scratch *rs = mlod_rt_scratch_create(ref);
+		uint32_t rid;
+		CHECK_OK(mlod_rt_instance_create(ref, 0, 0.7f, MLOD_RT_LOOP, &rid, &e), e);
+		CHECK_OK(force(ref, rid, level, &e), e);
+		float rp[3 * 7], rn[3 * 7], mp[3 * 7], mn[3 * 7], zp[3 * 7], zn[3 * 7];
+		uint32_t rc, mc, zc;
+		CHECK_OK(mlod_rt_skin(ref, rs, rid, rp, 12, rn, 12, 7, &rc, &e), e);
+		mlod_rt_scratch_destroy(ref, rs);
+		mlod_rt_close(ref);
+
+		morph_views(NULL);
+		fx_views = mt_views;
+		n_alloc = n_free = 0;
+		mlod_rt_ctx *ctx = open_all(&cfg, &e);
+		fx_views = saved;
+		CHECK(ctx, "open: %s", e.message);
+		CHECK(mlod_rt_morph_target_count(ctx, 0) == 2 && mlod_rt_morph_target_count(ctx, 1) == 1 &&
+		          mlod_rt_morph_target_count(ctx, 2) == 1 && mlod_rt_morph_target_count(ctx, 3) == 0,
+		      "target counts %u %u %u %u", mlod_rt_morph_target_count(ctx, 0), mlod_rt_morph_target_count(ctx, 1),
+		      mlod_rt_morph_target_count(ctx, 2), mlod_rt_morph_target_count(ctx, 3));
+		mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+		uint32_t id, other;
+		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.7f, MLOD_RT_LOOP, &id, &e), e);
+		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.7f, MLOD_RT_LOOP, &other, &e), e);
+		CHECK_OK(force(ctx, id, level, &e), e);
+		CHECK_OK(force(ctx, other, level, &e), e);
+		const size_t allocs = n_alloc;
+		/* the rules */
+		const float nan = NAN, three[3] = { 1, 2, 3 };
+		CHECK(mlod_rt_instance_set_morph_weights(ctx, id, 0, three, 3, &e) == MLOD_ERR_INVALID_ARG,
+		      "3 weights for 2 targets accepted");
+		CHECK(mlod_rt_instance_set_morph_weights(ctx, id, 0, &nan, 1, &e) == MLOD_ERR_INVALID_ARG,
+		      "a NaN weight accepted");
+		CHECK(mlod_rt_instance_set_morph_weights(ctx, id, 3, w, 1, &e) == MLOD_ERR_INVALID_ARG,
+		      "a weight for a part without targets accepted");
+		CHECK(mlod_rt_instance_set_morph_weights(ctx, 7, 0, w, 1, &e) == MLOD_ERR_INVALID_ARG,
+		      "weights for an instance not alive accepted");
+		CHECK(mlod_rt_instance_set_morph_weights(ctx, id, 0, NULL, 1, &e) == MLOD_ERR_INVALID_ARG, "NULL accepted");
+		/* other: one weight of part 0 (the second is 0), then cleared by count 0 */
+		CHECK_OK(mlod_rt_instance_set_morph_weights(ctx, other, 0, three, 2, &e), e);
+		CHECK_OK(mlod_rt_instance_set_morph_weights(ctx, other, 0, w, 1, &e), e);
+		CHECK_OK(mlod_rt_instance_set_morph_weights(ctx, other, 0, NULL, 0, &e), e);
+		CHECK_OK(mlod_rt_instance_set_morph_weights(ctx, id, 0, w, 2, &e), e);
+		CHECK_OK(mlod_rt_instance_set_morph_weights(ctx, id, 1, w + 2, 1, &e), e);
+		CHECK_OK(mlod_rt_instance_set_morph_weights(ctx, id, 2, w + 3, 1, &e), e);
+		CHECK_OK(mlod_rt_skin(ctx, s, id, mp, 12, mn, 12, 7, &mc, &e), e);
+		CHECK_OK(mlod_rt_skin(ctx, s, other, zp, 12, zn, 12, 7, &zc, &e), e);
+		CHECK(n_alloc == allocs, "%zu allocations setting weights and skinning", n_alloc - allocs);
+		CHECK(mc == rc && zc == rc, "level %d: %u and %u vertices, the reference %u", level, mc, zc, rc);
+		double d = fx_maxdiff(mp, rp, 3 * (int)rc), dn = fx_maxdiff(mn, rn, 3 * (int)rc);
+		CHECK(d <= 1e-5 && dn <= 1e-6, "level %d: morphed positions differ by %g, normals by %g", level, d, dn);
+		/* other has no weights left: it must differ from the morphed one */
+		CHECK(fx_maxdiff(zp, mp, 3 * (int)rc) > 0.1, "level %d: zero weights morphed anyway", level);
+		/* a new instance in a slot that had weights starts at 0 */
+		mlod_rt_instance_destroy(ctx, id);
+		uint32_t again;
+		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.7f, MLOD_RT_LOOP, &again, &e), e);
+		CHECK(again == id, "the pool gave slot %u, not %u", again, id);
+		CHECK_OK(force(ctx, again, level, &e), e);
+		CHECK_OK(mlod_rt_skin(ctx, s, again, mp, 12, mn, 12, 7, &mc, &e), e);
+		CHECK(fx_maxdiff(zp, mp, 3 * (int)rc) == 0, "level %d: a new instance kept the old weights", level);
+		mlod_rt_scratch_destroy(ctx, s);
+		mlod_rt_close(ctx);
+		CHECK(n_alloc == n_free, "%zu allocations, %zu frees: a leak", n_alloc, n_free);
+	}
+}
+
 int main(void)
 {
 	fx_build(0);
@@ -362,5 +542,6 @@ int main(void)
 	RUN(skin_hand_lbs);
 	RUN(kernel_matches_scalar);
 	RUN(no_allocation_per_frame);
+	RUN(morph_targets);
 	TEST_EXIT();
 }

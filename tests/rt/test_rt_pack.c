@@ -8,9 +8,17 @@
  * 10,000 mutations (half with every CRC fixed, so that the decoders' own
  * checks are reached) go through open, streaming and one frame of
  * evaluation: an error is fine, a crash or a sanitizer report is not.
+ * All of these run under a tracking allocator whose blocks come from a
+ * static arena, not malloc: every block the runtime frees must be one of
+ * its live blocks, none may be left at close, the decoded levels must be
+ * in it, and (glibc, outside ASan) the C library's heap must not grow
+ * from open to close: the runtime allocates only through the hooks.
  */
 #define _POSIX_C_SOURCE 200809L /* mkstemp */
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h> /* mallinfo2: glibc's heap, to see that the runtime never calls malloc itself */
+#endif
 
 #include "rt_test.h"
 
@@ -470,17 +478,164 @@ TEST(pack_equals_views)
 	CHECK(mlod_rt_open_path("/nonexistent/x.mlod", NULL, &p, &e) == MLOD_ERR_IO && !p, "missing file");
 }
 
-/* Open plus one frame: everything wanted streamed, every instance posed and skinned. */
+/* ---------------------------------------------------------------- */
+/* The tracking allocator                                            */
+/* ---------------------------------------------------------------- */
+
+/* Blocks from a static arena (never malloc), each after a 16-byte head:
+ * a tag saying live or freed, and its size. The arena starts over when
+ * nothing is live. */
+enum { ARENA = 8 << 20, HEAD = 16, TAG_LIVE = 0x4c495645, TAG_FREED = 0x46524545 };
+static _Alignas(16) unsigned char arena[ARENA];
+static size_t arena_used, track_live, track_live_bytes, track_calls;
+static int track_bad;   /* a foreign or double free */
+static int track_leaks; /* runs of one_frame that left blocks or freed foreign ones */
+
+static void *track_malloc(void *user, size_t size)
+{
+	(void)user;
+	track_calls++;
+	size_t need = HEAD + (size + 15) / 16 * 16;
+	if (size > ARENA || need > ARENA - arena_used)
+		return NULL;
+	unsigned char *h = arena + arena_used;
+	arena_used += need;
+	uint32_t tag = TAG_LIVE;
+	uint64_t n = size;
+	memcpy(h, &tag, 4);
+	memcpy(h + 8, &n, 8);
+	track_live++;
+	track_live_bytes += size;
+	return h + HEAD;
+}
+
+static void track_free(void *user, void *p)
+{
+	(void)user;
+	if (!p)
+		return;
+	unsigned char *h = (unsigned char *)p - HEAD;
+	uint32_t tag;
+	uint64_t n;
+	if ((unsigned char *)p < arena + HEAD || (unsigned char *)p > arena + arena_used ||
+	    (size_t)(h - arena) % 16 != 0) {
+		track_bad++; /* not ours: something the runtime got elsewhere */
+		return;
+	}
+	memcpy(&tag, h, 4);
+	memcpy(&n, h + 8, 8);
+	if (tag != TAG_LIVE) {
+		track_bad++; /* freed twice, or not a block's start */
+		return;
+	}
+	tag = TAG_FREED;
+	memcpy(h, &tag, 4);
+	track_live--;
+	track_live_bytes -= (size_t)n;
+	if (track_live == 0)
+		arena_used = 0;
+}
+
+static const mlod_rt_allocator tracker = { track_malloc, track_free, NULL };
+
+/* A fresh tracker (a failed test may have left a context open). */
+static void track_reset(void)
+{
+	arena_used = track_live = track_live_bytes = track_calls = 0;
+	track_bad = track_leaks = 0;
+}
+
+/* The C library's heap in use, or 0 where it cannot be told (ASan has
+ * its own heap; other C libraries). */
+static size_t libc_heap(void)
+{
+#if defined(__SANITIZE_ADDRESS__)
+	return 0;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+	return 0;
+#endif
+#endif
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
+	struct mallinfo2 mi = mallinfo2();
+	return mi.uordblks + mi.hblkhd;
+#else
+	return 0;
+#endif
+}
+
+TEST(hooks_only)
+{
+	mlod_error e;
+	/* 0: memory, 1: read callbacks (mlod_rt_open_path's FILE is the C
+	 * library's, opened by fopen: the one allocation not the runtime's) */
+	for (int source = 0; source < 2; source++) {
+		track_reset();
+		const size_t heap0 = libc_heap();
+		mlod_rt_ctx *ctx = NULL;
+		mlod_rt_config cfg = { 0, 16, &tracker };
+		if (source == 0)
+			CHECK_OK(mlod_rt_open_memory(pack.d, pack.n, &cfg, &ctx, &e), e);
+		else
+			CHECK_OK(mlod_rt_open_read(mem_read, &pack, pack.n, &cfg, &ctx, &e), e);
+		CHECK(track_calls > 0, "source %d: the hooks were not called", source);
+		CHECK(fx_load_all(ctx) == 0, "source %d: streaming every level failed", source);
+		mlod_rt_stats st;
+		mlod_rt_stats_get(ctx, &st);
+		/* Every decoded level (and the skeleton) is in the hooks' blocks:
+		 * they hold at least what the runtime counts as resident. */
+		CHECK(st.resident_levels > 0 && track_live_bytes >= st.resident_bytes,
+		      "source %d: %zu bytes live in the hooks, %zu resident: levels decoded elsewhere", source,
+		      track_live_bytes, st.resident_bytes);
+		mlod_rt_scratch *sc = mlod_rt_scratch_create(ctx);
+		CHECK(sc, "source %d: scratch", source);
+		uint32_t ids[4];
+		for (int i = 0; i < 4; i++)
+			CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)i % 2, 0.3f * (float)i, MLOD_RT_LOOP, &ids[i], &e), e);
+		mlod_rt_select sel;
+		mlod_rt_select_default(&sel);
+		static float buf[2 * 3 * 4096];
+		const uint32_t cap = mlod_rt_max_vertex_count(ctx);
+		CHECK(cap <= 4096, "source %d: %u vertices", source, cap);
+		for (int f = 0; f < 20; f++) {
+			float d[4] = { 1.0f + f, 40.0f, 90.0f - f, 300.0f };
+			CHECK_OK(mlod_rt_update(ctx, &sel, ids, d, 4, 0.05f, &e), e);
+			CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
+			for (int i = 0; i < 4; i++)
+				CHECK_OK(mlod_rt_skin(ctx, sc, ids[i], buf, 12, buf + 3 * 4096, 12, cap, NULL, &e), e);
+		}
+		mlod_rt_scratch_destroy(ctx, sc);
+		const size_t heap1 = libc_heap();
+		mlod_rt_close(ctx);
+		const size_t heap2 = libc_heap();
+		CHECK(!track_bad, "source %d: the runtime freed %d blocks the hooks did not give", source, track_bad);
+		CHECK(track_live == 0, "source %d: %zu blocks (%zu bytes) left at close", source, track_live,
+		      track_live_bytes);
+		CHECK(heap1 == heap0 && heap2 == heap0,
+		      "source %d: the C library's heap went from %zu to %zu bytes (%zu after close): malloc called directly",
+		      source, heap0, heap1, heap2);
+		if (source == 0 && heap0 == 0)
+			printf("# hooks_only: the C library's heap cannot be read here (ASan): that check is skipped\n");
+	}
+}
+
+/* Open plus one frame: everything wanted streamed, every instance posed
+ * and skinned, under the tracking allocator (nothing left, nothing
+ * foreign freed, checked by the callers through track_leaks). */
 static int one_frame(const void *data, size_t size, int through_read)
 {
 	mlod_error e;
 	mlod_rt_ctx *ctx = NULL;
-	mlod_rt_config cfg = { 0, 8, NULL };
+	mlod_rt_config cfg = { 0, 8, &tracker };
 	bytes view = { (uint8_t *)data, size, size };
 	mlod_result r = through_read ? mlod_rt_open_read(mem_read, &view, size, &cfg, &ctx, &e)
 	                             : mlod_rt_open_memory(data, size, &cfg, &ctx, &e);
-	if (r != MLOD_OK)
+	if (r != MLOD_OK) {
+		if (track_live || track_bad)
+			track_leaks++;
+		track_bad = 0;
 		return 0;
+	}
 	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
 	uint32_t ids[4];
 	float d[4] = { 0, 30, 90, 500 };
@@ -504,22 +659,29 @@ static int one_frame(const void *data, size_t size, int through_read)
 	free(buf);
 	mlod_rt_scratch_destroy(ctx, s);
 	mlod_rt_close(ctx);
+	if (track_live || track_bad)
+		track_leaks++;
+	track_bad = 0;
 	return 1;
 }
 
 TEST(truncated_prefixes)
 {
+	track_reset();
 	int opened = 0;
 	for (size_t k = 0; k < pack.n; k++) {
 		opened += one_frame(pack.d, k, 0);
 		opened += one_frame(pack.d, k, 1);
 	}
 	CHECK(opened == 0, "%d truncated packs opened", opened);
+	CHECK(track_live == 0 && track_leaks == 0 && !track_bad, "%zu blocks left or foreign frees after a failed open",
+	      track_live);
 	CHECK(one_frame(pack.d, pack.n, 0) && one_frame(pack.d, pack.n, 1), "the whole pack does not open");
 }
 
 TEST(mutations)
 {
+	track_reset();
 	uint8_t *m = malloc(pack.n);
 	unsigned seed = 99;
 	int opened = 0;
@@ -543,6 +705,8 @@ TEST(mutations)
 	}
 	free(m);
 	printf("# mutations: %d of 10000 opened and ran a frame\n", opened);
+	CHECK(track_live == 0 && track_leaks == 0 && !track_bad,
+	      "%d runs left blocks or freed foreign ones (%zu live now)", track_leaks, track_live);
 	CHECK(opened > 0, "no mutated pack opened: the CRC-fixed half should reach the decoders");
 }
 
@@ -587,6 +751,7 @@ int main(void)
 	printf("# pack of %zu bytes, %d chunks\n", pack.n, nchunks);
 	RUN(pack_equals_views);
 	RUN(pack_budget);
+	RUN(hooks_only);
 	RUN(truncated_prefixes);
 	RUN(mutations);
 	free(pack.d);

@@ -7,6 +7,12 @@
  * mlod_pose_character places them) within 1e-5 of the diagonal, at many
  * times of every clip. Primitives with more than one weight set are
  * outside the runtime's 4 influences and are counted, not compared.
+ * With morph weights set per instance (mlod_rt_instance_set_morph_weights),
+ * the runtime's output must equal the bake side's skinning of the
+ * primitive whose positions carry the weighted morph target deltas; and
+ * through a real pack (mlod_pack_write, codec none so level 0 keeps the
+ * input's vertex order), within its quantisation, with the weights'
+ * layout taken from the pack's coarsest level.
  */
 #include "test.h"
 
@@ -23,6 +29,7 @@ typedef struct conv {
 	const float **ibm;
 	mlod_pack_part *parts;
 	const mlod_primitive **prims;
+	float ***targets; /* per part: its targets' position deltas */
 	mlod_pack_mesh mesh;
 	mlod_pack_channel *chans;
 	mlod_pack_motion *motions;
@@ -69,6 +76,7 @@ static void conv_build(const mlod_character *c, conv *v)
 		np += c->meshes[c->instances[i].mesh].primitive_count;
 	v->parts = calloc((size_t)np + 1, sizeof *v->parts);
 	v->prims = calloc((size_t)np + 1, sizeof *v->prims);
+	v->targets = calloc((size_t)np + 1, sizeof *v->targets);
 	for (int i = 0; i < c->instance_count; i++) {
 		const mlod_instance *in = &c->instances[i];
 		const mlod_mesh *m = &c->meshes[in->mesh];
@@ -91,6 +99,13 @@ static void conv_build(const mlod_character *c, conv *v)
 			t->normals = q->normals;
 			if (in->skin >= 0)
 				t->joints = q->joints[0], t->weights = q->weights[0];
+			if (q->target_count > 0) {
+				float **d = v->targets[v->mesh.part_count - 1] = calloc((size_t)q->target_count, sizeof *d);
+				for (int k = 0; k < q->target_count; k++)
+					d[k] = q->targets[k].positions;
+				t->targets = d;
+				t->rec.target_count = (uint32_t)q->target_count;
+			}
 		}
 	}
 	v->mesh.parts = v->parts;
@@ -126,10 +141,57 @@ static void conv_free(conv *v)
 	for (uint32_t k = 0; k < v->skel.skin_count; k++)
 		free(v->skin_joints[k]);
 	free(v->joints), free(v->names), free(v->skins), free(v->skin_names), free(v->skin_joints), free(v->ibm);
-	free(v->parts), free(v->prims), free(v->chans), free(v->motions), free(v->mot_v);
+	for (uint32_t p = 0; p < v->mesh.part_count; p++)
+		free(v->targets[p]);
+	free(v->parts), free(v->prims), free(v->targets), free(v->chans), free(v->motions), free(v->mot_v);
 }
 
-static void compare_sample(const char *path)
+/* The morph weight of target k at step of the comparison: every target
+ * of a mesh instance gets a different one, some negative, some above 1. */
+static float morph_weight(uint32_t instance, int k, int step)
+{
+	return (float)((int)(instance * 7 + (unsigned)k * 3 + (unsigned)step * 5) % 11 - 3) / 6.0f;
+}
+
+/* The bake side's placement of part pt (primitive q, which may carry
+ * morphed positions) at world: skinned, rigid or static. */
+static void bake_part(const mlod_skeleton *s, const mlod_pack_part *pt, const mlod_primitive *q,
+                      const mlod_mat4 *world, mlod_mat4 *sm, float *bp, float *bn)
+{
+	const size_t m = pt->rec.vertex_count;
+	if (pt->rec.skin >= 0) {
+		mlod_skin_matrices(&s->skins[pt->rec.skin], world, sm);
+		mlod_skin_primitive(q, sm, bp, q->normals ? bn : NULL);
+	} else {
+		mlod_mat4 off, R;
+		memcpy(off.m, pt->rec.offset, sizeof off.m);
+		R = pt->rec.joint >= 0 ? mlod_mat4_mul(&world[pt->rec.joint], &off) : off;
+		for (size_t i = 0; i < m; i++) {
+			mlod_v3 x = mlod_mat4_point(&R, (mlod_v3){ q->positions[3 * i], q->positions[3 * i + 1],
+			                                          q->positions[3 * i + 2] });
+			bp[3 * i] = x.x, bp[3 * i + 1] = x.y, bp[3 * i + 2] = x.z;
+		}
+	}
+}
+
+/* q's positions plus its targets' deltas weighted by morph_weight(instance,
+ * k, step), into mp; returns mp. */
+static const float *bake_morph(const mlod_primitive *q, uint32_t instance, int step, float *mp)
+{
+	const size_t m = (size_t)q->vertex_count;
+	memcpy(mp, q->positions, 12 * m);
+	for (int k = 0; k < q->target_count; k++) {
+		const float wk = morph_weight(instance, k, step);
+		const float *d = q->targets[k].positions;
+		for (size_t i = 0; d && wk != 0.0f && i < 3 * m; i++)
+			mp[i] += wk * d[i];
+	}
+	return mp;
+}
+
+/* morph: set morph weights on every instance and compare with the bake
+ * side's skinning of the morphed primitives. */
+static void compare_sample(const char *path, int morph)
 {
 	size_t size;
 	void *data = test_read_file(path, &size);
@@ -147,6 +209,9 @@ static void compare_sample(const char *path)
 	const uint32_t nv = mlod_rt_max_vertex_count(ctx);
 	float *rp = malloc((size_t)nv * 12 + 12), *rn = malloc((size_t)nv * 12 + 12);
 	float *bp = malloc((size_t)nv * 12 + 12), *bn = malloc((size_t)nv * 12 + 12);
+	float *mp = malloc((size_t)nv * 12 + 12); /* a primitive's morphed positions */
+	double worst_shift = 0;                   /* the largest morph displacement, of the diagonal */
+	uint32_t morphed_parts = 0;
 	mlod_trs *local = malloc(sizeof *local * (size_t)s->joint_count);
 	mlod_mat4 *world = malloc(sizeof *world * (size_t)s->joint_count);
 	int maxskin = 1;
@@ -171,6 +236,16 @@ static void compare_sample(const char *path)
 			const float t = dur * (float)step / 11.0f - 0.01f; /* also before 0 and after the end */
 			uint32_t id;
 			CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)k, t, 0, &id, &terr));
+			for (uint32_t p = 0; morph && p < v.mesh.part_count; p++) {
+				const uint32_t nt = mlod_rt_morph_target_count(ctx, p);
+				CHECK_MSG(nt == v.parts[p].rec.target_count, "part %u: %u morph targets, the primitive has %u", p,
+				          nt, v.parts[p].rec.target_count);
+				float w[64];
+				CHECK(nt <= 64);
+				for (uint32_t i = 0; i < nt; i++)
+					w[i] = morph_weight(v.parts[p].rec.instance, (int)i, step);
+				CHECK_OK(mlod_rt_instance_set_morph_weights(ctx, id, p, w, nt, &terr));
+			}
 			const float *W;
 			CHECK_OK(mlod_rt_pose(ctx, sc, id, &W, NULL, NULL, &terr));
 			mlod_pose_rest(s, local);
@@ -187,21 +262,22 @@ static void compare_sample(const char *path)
 			size_t base = 0;
 			for (uint32_t p = 0; p < v.mesh.part_count; p++) {
 				const mlod_pack_part *pt = &v.parts[p];
-				const mlod_primitive *q = v.prims[p];
+				const mlod_primitive *q0 = v.prims[p];
 				const size_t m = pt->rec.vertex_count;
-				if (pt->rec.skin >= 0) {
-					mlod_skin_matrices(&s->skins[pt->rec.skin], world, sm);
-					mlod_skin_primitive(q, sm, bp, q->normals ? bn : NULL);
-				} else {
-					mlod_mat4 off, R;
-					memcpy(off.m, pt->rec.offset, sizeof off.m);
-					R = pt->rec.joint >= 0 ? mlod_mat4_mul(&world[pt->rec.joint], &off) : off;
-					for (size_t i = 0; i < m; i++) {
-						mlod_v3 x = mlod_mat4_point(&R, (mlod_v3){ q->positions[3 * i], q->positions[3 * i + 1],
-						                                          q->positions[3 * i + 2] });
-						bp[3 * i] = x.x, bp[3 * i + 1] = x.y, bp[3 * i + 2] = x.z;
+				/* The bake side's primitive, morphed: a copy whose positions
+				 * carry the weighted deltas. */
+				mlod_primitive qm = *q0;
+				if (morph && q0->target_count > 0) {
+					bake_morph(q0, pt->rec.instance, step, mp);
+					for (size_t i = 0; i < 3 * m; i++) {
+						double d = fabs((double)mp[i] - q0->positions[i]) / diag;
+						worst_shift = d > worst_shift ? d : worst_shift;
 					}
+					qm.positions = mp;
+					morphed_parts += step == 0 && k == 0;
 				}
+				const mlod_primitive *q = &qm;
+				bake_part(s, pt, q, world, sm, bp, bn);
 				for (size_t i = 0; i < 3 * m; i++) {
 					double d = fabs((double)rp[3 * base + i] - bp[i]) / diag;
 					worst_skin = d > worst_skin ? d : worst_skin;
@@ -222,19 +298,163 @@ static void compare_sample(const char *path)
 	CHECK_MSG(worst_pose <= 1e-5, "%s: pose differs by %g", path, worst_pose);
 	CHECK_MSG(worst_skin <= 1e-5, "%s: skinned positions differ by %g of the diagonal", path, worst_skin);
 	CHECK_MSG(worst_nrm <= 1e-4, "%s: skinned normals differ by %g", path, worst_nrm);
-	free(rp), free(rn), free(bp), free(bn), free(local), free(world), free(sm);
+	if (morph) {
+		/* The comparison means something only if the morph moves vertices
+		 * well beyond the tolerance. */
+		printf("# %s: %u parts with morph targets, the weights move vertices up to %.3g of the diagonal\n", path,
+		       morphed_parts, worst_shift);
+		CHECK_MSG(morphed_parts > 0 && worst_shift > 1e-3, "%s: no morph to compare (%u parts, %g)", path,
+		          morphed_parts, worst_shift);
+	}
+	free(rp), free(rn), free(bp), free(bn), free(mp), free(local), free(world), free(sm);
 	mlod_rt_scratch_destroy(ctx, sc);
 	mlod_rt_close(ctx);
 	conv_free(&v);
 	mlod_character_free(&c);
 }
 
-TEST(rt_equals_bake_tubeman) { compare_sample("samples/tubeman.glb"); }
-TEST(rt_equals_bake_robot) { compare_sample("samples/RobotExpressive.glb"); }
+/* Through a pack: mesh level 0 and one coarser level (half the
+ * triangles), the skeleton and clips at level 0. */
+static void morph_pack(const char *path)
+{
+	size_t size;
+	void *data = test_read_file(path, &size);
+	CHECK_MSG(data, "cannot read %s", path);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	CHECK_OK(mlod_load(data, size, "samples", &doc, &c, &fmt, &terr));
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	opt.codec = MLOD_CODEC_NONE; /* level 0 in the input's vertex order */
+	opt.ratio_count = 1;
+	opt.ratios[0] = 0.5;
+	opt.no_skeleton_levels = opt.no_motion_levels = 1;
+	void *pk = NULL;
+	size_t pn = 0;
+	CHECK_OK(mlod_pack_write(doc, &c, fmt, data, size, &opt, &pk, &pn, NULL, &terr));
+	free(data);
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_memory(pk, pn, NULL, &ctx, &terr));
+	CHECK(mlod_rt_level_count(ctx, MLOD_RT_MESH) == 2);
+	for (uint32_t l = 0; l < 2; l++)
+		CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MESH, l, 0, &terr));
+	CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &terr));
+	conv v;
+	conv_build(&c, &v);
+	const mlod_skeleton *s = &c.skeleton;
+	CHECK_MSG(mlod_rt_mesh_part_count(ctx, 0) == v.mesh.part_count && mlod_rt_mesh_part_count(ctx, 1) == v.mesh.part_count,
+	          "the pack has %u and %u parts, the character %u", mlod_rt_mesh_part_count(ctx, 0),
+	          mlod_rt_mesh_part_count(ctx, 1), v.mesh.part_count);
+	uint32_t with_targets = 0;
+	for (uint32_t p = 0; p < v.mesh.part_count; p++) {
+		CHECK_MSG(mlod_rt_morph_target_count(ctx, p) == v.parts[p].rec.target_count,
+		          "part %u: %u morph targets in the pack, %u in the input", p, mlod_rt_morph_target_count(ctx, p),
+		          v.parts[p].rec.target_count);
+		with_targets += v.parts[p].rec.target_count > 0;
+	}
+	CHECK(with_targets > 0);
+	mlod_rt_scratch *sc = mlod_rt_scratch_create(ctx);
+	CHECK(sc != NULL);
+	const uint32_t nv = mlod_rt_max_vertex_count(ctx);
+	float *ra = malloc((size_t)nv * 12 + 12), *rb = malloc((size_t)nv * 12 + 12), *na = malloc((size_t)nv * 12 + 12);
+	float *bp = malloc((size_t)nv * 12 + 12), *bn = malloc((size_t)nv * 12 + 12), *mp = malloc((size_t)nv * 12 + 12);
+	mlod_trs *local = malloc(sizeof *local * (size_t)s->joint_count);
+	mlod_mat4 *world = malloc(sizeof *world * (size_t)s->joint_count);
+	int maxskin = 1;
+	for (int k = 0; k < s->skin_count; k++)
+		maxskin = s->skins[k].joint_count > maxskin ? s->skins[k].joint_count : maxskin;
+	mlod_mat4 *sm = malloc(sizeof *sm * (size_t)maxskin);
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	const float t = c.clip_count ? 0.4f * c.clips[0].duration : 0.0f;
+	double worst[2] = { 0, 0 }, shift[2] = { 0, 0 }, diag = 0; /* [0]: no weights, [1]: weights */
+	for (uint32_t level = 0; level < 2; level++) {
+		uint32_t ids[2];
+		sel.force_level = (int)level;
+		for (int i = 0; i < 2; i++) {
+			CHECK_OK(mlod_rt_instance_create(ctx, 0, t, 0, &ids[i], &terr));
+			float d = 1;
+			CHECK_OK(mlod_rt_update(ctx, &sel, &ids[i], &d, 1, 0.0f, &terr));
+		}
+		for (uint32_t p = 0; p < v.mesh.part_count; p++) {
+			float w[64];
+			const uint32_t nt = mlod_rt_morph_target_count(ctx, p);
+			CHECK(nt <= 64);
+			for (uint32_t k = 0; k < nt; k++)
+				w[k] = morph_weight(v.parts[p].rec.instance, (int)k, 3);
+			CHECK_OK(mlod_rt_instance_set_morph_weights(ctx, ids[0], p, w, nt, &terr));
+		}
+		uint32_t n0, n1;
+		CHECK_OK(mlod_rt_skin(ctx, sc, ids[0], ra, 12, na, 12, nv, &n0, &terr));
+		CHECK_OK(mlod_rt_skin(ctx, sc, ids[1], rb, 12, NULL, 12, nv, &n1, &terr));
+		CHECK(n0 == n1 && n0 == mlod_rt_mesh_vertex_count(ctx, level));
+		/* the morph moves the coarse level too */
+		float lo[3] = { 1e30f, 1e30f, 1e30f }, hi[3] = { -1e30f, -1e30f, -1e30f };
+		for (uint32_t i = 0; i < n1; i++)
+			for (int k = 0; k < 3; k++)
+				lo[k] = rb[3 * i + k] < lo[k] ? rb[3 * i + k] : lo[k], hi[k] = rb[3 * i + k] > hi[k] ? rb[3 * i + k] : hi[k];
+		diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+		            (hi[2] - lo[2]) * (hi[2] - lo[2]));
+		for (uint32_t i = 0; i < 3 * n0; i++) {
+			double d = fabs((double)ra[i] - rb[i]) / diag;
+			shift[level] = d > shift[level] ? d : shift[level];
+		}
+		if (level == 0) { /* against the bake side, vertex by vertex */
+			CHECK(n0 == nv);
+			mlod_pose_rest(s, local);
+			if (c.clip_count)
+				mlod_clip_sample(&c.clips[0], t, local);
+			mlod_pose_world(s, local, world);
+			size_t base = 0;
+			for (uint32_t p = 0; p < v.mesh.part_count; p++) {
+				const mlod_pack_part *pt = &v.parts[p];
+				const mlod_primitive *q0 = v.prims[p];
+				mlod_primitive qm = *q0;
+				for (int morphed = 0; morphed < 2; morphed++) {
+					if (morphed && q0->target_count > 0)
+						qm.positions = (float *)bake_morph(q0, pt->rec.instance, 3, mp);
+					bake_part(s, pt, &qm, world, sm, bp, bn);
+					const float *r = morphed ? ra : rb;
+					for (size_t i = 0; i < 3 * (size_t)pt->rec.vertex_count; i++) {
+						double d = fabs((double)r[3 * base + i] - bp[i]) / diag;
+						worst[morphed] = d > worst[morphed] ? d : worst[morphed];
+					}
+				}
+				base += pt->rec.vertex_count;
+			}
+		}
+		for (int i = 0; i < 2; i++)
+			mlod_rt_instance_destroy(ctx, ids[i]);
+	}
+	printf("# %s through a pack: level 0 against the bake side %.3g of the diagonal without morph, %.3g with; "
+	       "the morph moves level 0 up to %.3g, level 1 up to %.3g\n",
+	       path, worst[0], worst[1], shift[0], shift[1]);
+	/* the pack's quantisation: positions to 1/65535 of a part's extent,
+	 * morph deltas to half a step of their scale */
+	CHECK_MSG(worst[0] <= 2.5e-4 && worst[1] <= 2.5e-4, "%s: the pack's runtime differs by %g (%g with morph)", path,
+	          worst[0], worst[1]);
+	CHECK_MSG(shift[0] > 10 * worst[1] && shift[1] > 10 * worst[1], "%s: the morph moves levels 0 and 1 by %g, %g",
+	          path, shift[0], shift[1]);
+	free(ra), free(rb), free(na), free(bp), free(bn), free(mp), free(local), free(world), free(sm);
+	mlod_rt_scratch_destroy(ctx, sc);
+	mlod_rt_close(ctx);
+	mlod_free(pk);
+	conv_free(&v);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+}
+
+TEST(rt_equals_bake_tubeman) { compare_sample("samples/tubeman.glb", 0); }
+TEST(rt_equals_bake_robot) { compare_sample("samples/RobotExpressive.glb", 0); }
+TEST(rt_morph_equals_bake_robot) { compare_sample("samples/RobotExpressive.glb", 1); }
+TEST(rt_morph_pack_robot) { morph_pack("samples/RobotExpressive.glb"); }
 
 int main(void)
 {
 	RUN(rt_equals_bake_tubeman);
 	RUN(rt_equals_bake_robot);
+	RUN(rt_morph_equals_bake_robot);
+	RUN(rt_morph_pack_robot);
 	TEST_EXIT();
 }
