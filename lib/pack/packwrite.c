@@ -868,7 +868,7 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt, int ord
 		}
 	for (int a = 0; a < 3; a++) {
 		rec->pos_min[a] = mn[a];
-		rec->pos_scale[a] = mlod_pack_range_scale(mn[a], mx[a]);
+		rec->pos_scale[a] = mlod_pack_range_scale_bits(mn[a], mx[a], x->opt->position_bits);
 	}
 	uint16_t *q16 = tmp;
 	for (uint32_t v = 0; v < nv; v++) {
@@ -881,13 +881,13 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt, int ord
 	if (p->normals) {
 		rec->flags |= MLOD_PART_NORMALS;
 		for (uint32_t v = 0; v < nv; v++)
-			mlod_pack_oct_encode(p->normals + 3 * v, s16 + 2 * v);
+			mlod_pack_oct_encode_bits(p->normals + 3 * v, x->opt->normal_bits, s16 + 2 * v);
 		cb_add_vertices(cb, MLOD_STREAM_NRMQ, nv, 4, tmp, remap, perm);
 	}
 	if (p->tangents) {
 		rec->flags |= MLOD_PART_TANGENTS;
 		for (uint32_t v = 0; v < nv; v++) {
-			mlod_pack_oct_encode(p->tangents + 4 * v, s16 + 4 * v);
+			mlod_pack_oct_encode_bits(p->tangents + 4 * v, x->opt->normal_bits, s16 + 4 * v);
 			s16[4 * v + 2] = p->tangents[4 * v + 3] < 0.0f ? -32767 : 32767;
 			s16[4 * v + 3] = 0;
 		}
@@ -907,7 +907,7 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt, int ord
 			}
 		for (int a = 0; a < 2; a++) {
 			rec->uv_min[s][a] = umn[a];
-			rec->uv_scale[s][a] = mlod_pack_range_scale(umn[a], umx[a]);
+			rec->uv_scale[s][a] = mlod_pack_range_scale_bits(umn[a], umx[a], x->opt->uv_bits);
 		}
 		for (uint32_t v = 0; v < nv; v++)
 			for (int a = 0; a < 2; a++)
@@ -1015,7 +1015,7 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt, int ord
 			const float *d = p->targets[t].positions;
 			for (uint32_t i = 0; d && i < 3 * nv; i++)
 				m = fabsf(d[i]) > m ? fabsf(d[i]) : m;
-			scale[t] = m > 0.0f ? m / 32767.0f : 0.0f;
+			scale[t] = m > 0.0f ? (float)(m / (ldexp(1.0, x->opt->position_bits - 1) - 1.0)) : 0.0f;
 		}
 		cb_add(cb, MLOD_STREAM_MTSC, (uint32_t)nt, 4, scale, 0);
 		for (int t = 0; t < nt; t++) {
@@ -1544,6 +1544,9 @@ void mlod_pack_options_default(mlod_pack_options *opt)
 	opt->ratio_count = (int)(sizeof ratios / sizeof *ratios);
 	memcpy(opt->ratios, ratios, sizeof ratios);
 	opt->mesh_max_error = -1.0;
+	opt->position_bits = MLOD_PACK_POSITION_BITS_DEFAULT;
+	opt->normal_bits = MLOD_PACK_NORMAL_BITS_DEFAULT;
+	opt->uv_bits = MLOD_PACK_UV_BITS_DEFAULT;
 	opt->motion_bound_count = (int)(sizeof bounds / sizeof *bounds);
 	for (int i = 0; i < opt->motion_bound_count; i++) {
 		opt->motion_bounds[i] = bounds[i];

@@ -7,9 +7,11 @@
  *              inverse binds, materials of the primitives, clip key times
  *              and values (the reader's ROTQ values are exact: the writer
  *              uses it only for values on the int16 lattice), index lists
- *   quantised  (mlod(5)) positions within half a step of 16 bits of the
- *              part's box per axis, normals within MLOD_PACK_OCT_BOUND
- *              radians, UVs within half a step of 16 bits of their box,
+ *   quantised  (mlod(5)) positions within half a step of position_bits
+ *              of the part's box per axis, normals within
+ *              3 sqrt(2) 2^(15 - normal_bits) / 32767 radians, UVs within
+ *              half a step of uv_bits of their box (the defaults, and
+ *              tubeman at 16 and at the smallest bits too),
  *              weights (the 4 largest influences, renormalised) within
  *              1/255 each
  *
@@ -19,6 +21,20 @@
 #include "test.h"
 
 static double worst_pos_ratio, worst_pos_err, worst_nrm, worst_uv_ratio, worst_w;
+/* The writer's bits (mlod_pack_options) for the pack being checked. */
+static int pos_bits = 16, nrm_bits = 16, uv_bits = 16;
+
+/* mlod(5) QUANTISATION, computed here: half a step of 2^bits - 1 over
+ * [lo, hi], with f32 slack; the octahedral angle at nrm_bits. */
+static double half_step(float lo, float hi, int bits)
+{
+	return ((double)hi - lo) / (ldexp(1.0, bits) - 1.0) / 2 * (1 + 1e-4) + 1e-6 * (fabs(lo) + fabs(hi));
+}
+
+static double oct_bound(void)
+{
+	return 3.0 * sqrt(2.0) * ldexp(1.0, 15 - nrm_bits) / 32767.0 + 2e-6;
+}
 
 static const mlod_instance *instance_of_node(const mlod_character *c, int node)
 {
@@ -45,7 +61,7 @@ static const mlod_channel *channel_of(const mlod_clip *k, int joint, mlod_path p
 }
 
 /* Checks one primitive; returns a message or NULL. */
-/* Positions quantised on the writer's grid for a part (its box, 16 bits). */
+/* Positions quantised on the writer's grid for a part (its box, pos_bits). */
 typedef struct qgrid {
 	float lo[3], scale[3];
 } qgrid;
@@ -61,7 +77,7 @@ static void qgrid_make(qgrid *g, const mlod_primitive *a)
 			hi[d] = fmaxf(hi[d], a->positions[3 * v + d]);
 		}
 	for (int d = 0; d < 3; d++)
-		g->scale[d] = mlod_pack_range_scale(g->lo[d], hi[d]);
+		g->scale[d] = mlod_pack_range_scale_bits(g->lo[d], hi[d], pos_bits);
 }
 
 static void qpos(const qgrid *g, const float *p, long *out)
@@ -244,7 +260,7 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 			hi[d] = fmaxf(hi[d], a->positions[3 * v + d]);
 		}
 	for (int d = 0; d < 3; d++) {
-		double bound = (double)mlod_pack_range_scale(lo[d], hi[d]) / 2 * (1 + 1e-4) + 1e-6 * (fabs(lo[d]) + fabs(hi[d]));
+		double bound = half_step(lo[d], hi[d], pos_bits);
 		for (int v = 0; v < n; v++) {
 			double e = fabs((double)a->positions[3 * v + d] - b->positions[3 * v + d]);
 			if (e > worst_pos_err)
@@ -272,7 +288,7 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 		double ang = atan2(sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]), dot);
 		if (ang > worst_nrm)
 			worst_nrm = ang;
-		if (ang > MLOD_PACK_OCT_BOUND + 1e-6) {
+		if (ang > oct_bound()) {
 			snprintf(msg, cap, "vertex %d: normal off by %g rad (%.9g %.9g %.9g, unpacked %.9g %.9g %.9g)", v, ang, x[0], x[1], x[2], y[0], y[1], y[2]);
 			return permuted_free(&pa), msg;
 		}
@@ -289,7 +305,7 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 				ul = fminf(ul, a->uvs[s][2 * v + d]);
 				uh = fmaxf(uh, a->uvs[s][2 * v + d]);
 			}
-			double bound = (double)mlod_pack_range_scale(ul, uh) / 2 * (1 + 1e-4) + 1e-6 * (fabs(ul) + fabs(uh));
+			double bound = half_step(ul, uh, uv_bits);
 			for (int v = 0; v < n; v++) {
 				double e = fabs((double)a->uvs[s][2 * v + d] - b->uvs[s][2 * v + d]);
 				if (bound > 0 && e / bound > worst_uv_ratio)
@@ -483,19 +499,32 @@ done:
 	return fail;
 }
 
-static void sample(const char *path)
+static void sample_bits(const char *path, int pb, int nb, int ub)
 {
 	char msg[1024];
 	mlod_pack_options opt;
 	mlod_pack_options_default(&opt);
+	if (pb)
+		opt.position_bits = pb, opt.normal_bits = nb, opt.uv_bits = ub;
+	pos_bits = opt.position_bits, nrm_bits = opt.normal_bits, uv_bits = opt.uv_bits;
 	worst_pos_ratio = worst_pos_err = worst_nrm = worst_uv_ratio = worst_w = 0;
 	const char *why = round_trip(path, &opt, msg, sizeof msg - 64);
-	fprintf(stderr, "%s: max position error %.3g (%.3f of the half-step bound), normal %.3g rad, uv %.3f of bound, "
-	        "weight %.4f\n", path, worst_pos_err, worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w);
+	fprintf(stderr, "%s (bits %d %d %d): max position error %.3g (%.3f of the half-step bound), normal %.3g rad, uv %.3f of bound, "
+	        "weight %.4f\n", path, pos_bits, nrm_bits, uv_bits, worst_pos_err, worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w);
 	CHECK_MSG(!why, "%.200s: %.700s", path, why);
 }
 
+static void sample(const char *path)
+{
+	sample_bits(path, 0, 0, 0);
+}
+
 TEST(round_trip_tubeman) { sample("samples/tubeman.glb"); }
+TEST(round_trip_tubeman_16_bits) { sample_bits("samples/tubeman.glb", 16, 16, 16); }
+TEST(round_trip_tubeman_fewest_bits)
+{
+	sample_bits("samples/tubeman.glb", MLOD_PACK_POSITION_BITS_MIN, MLOD_PACK_NORMAL_BITS_MIN, MLOD_PACK_UV_BITS_MIN);
+}
 TEST(round_trip_robot) { sample("samples/RobotExpressive.glb"); }
 TEST(round_trip_bvh) { sample("samples/cmu_12_01_walk.bvh"); }
 
@@ -511,6 +540,8 @@ TEST(round_trip_shared_ely)
 int main(void)
 {
 	RUN(round_trip_tubeman);
+	RUN(round_trip_tubeman_16_bits);
+	RUN(round_trip_tubeman_fewest_bits);
 	RUN(round_trip_robot);
 	RUN(round_trip_bvh);
 	RUN(round_trip_shared_ely);
