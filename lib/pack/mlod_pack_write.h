@@ -28,10 +28,12 @@
  * mlod_pack_q* helpers below.
  *
  * The output is deterministic: the same input and options give the same
- * bytes. The DOC chunk holds the input document without what the levels
- * hold (mlod_gltf_strip_levels: geometry, joint channels, MSFT_lod), as
- * glb; when it cannot be stripped (an extension that may refer to
- * accessors) or with doc_whole, the input glb as read, with a note.
+ * bytes. The DOC chunk holds the input document without what the other
+ * chunks hold (mlod_gltf_strip_levels: geometry, joint channels, MSFT_lod;
+ * then the packed skins' inverse bind matrices, the joint nodes' rest TRS
+ * in one number style, the stages' records: mlod(5) DOC), as glb; when it
+ * cannot be stripped (an extension that may refer to accessors) or with
+ * doc_whole, the input glb as read, with a note.
  */
 #ifndef MLOD_PACK_WRITE_H
 #define MLOD_PACK_WRITE_H

@@ -1535,6 +1535,66 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 /* The pack                                                            */
 /* ------------------------------------------------------------------ */
 
+/* The DOC's asset extras.mlod when joint nodes' TRS went, by mode
+ * (mlod_gltf_drop_node_trs); mlod_pack_unpack reads it back. */
+static const char *const trs_marks[3] = {"{\"doc_trs\":0}", "{\"doc_trs\":1}", "{\"doc_trs\":2}"};
+
+/* A skin's inverse bind matrices are all identities (glTF's default). */
+static int identity_binds(const mlod_skin *sk)
+{
+	mlod_mat4 id = mlod_mat4_identity();
+	for (int j = 0; sk->inverse_bind && j < sk->joint_count; j++)
+		if (memcmp(&sk->inverse_bind[j], &id, sizeof id) != 0)
+			return 0;
+	return 1;
+}
+
+/* The stripped DOC without what the other chunks hold (mlod(5) DOC):
+ * the inverse bind matrices of the packed skins (SKEL holds them; not
+ * identities), the joint nodes' translation, rotation and scale that are
+ * SKEL's rest TRS at f32 (not the defaults), and the stages' records
+ * (extras "mlod", but for a BVH's End Site marks, "end_site", which are
+ * the input's). */
+static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
+{
+	mlod_result r = MLOD_OK;
+	for (int i = 0; r == MLOD_OK && i < x->v.skeleton.skin_count; i++) {
+		const mlod_skin *sk = &x->v.skeleton.skins[i];
+		if (sk->gltf_index >= 0 && x->v.skeleton.joint_count > 0 && !identity_binds(sk))
+			r = mlod_gltf_drop_inverse_binds(copy, sk->gltf_index, err);
+	}
+	/* The joints' nodes' rest TRS (SKEL's JNTS hold it, as f32) when their
+	 * numbers are those of the f32 values (mode 0), their shortest
+	 * decimals (1) or their 15 significant digits (2), whichever more
+	 * parts use (the asset's extras.mlod.doc_trs says which). */
+	int parts[3] = {0, 0, 0}, nodes = mlod_gltf_count(copy, MLOD_GLTF_NODE);
+	for (int mode = 0; mode < 3; mode++)
+		for (int j = 0; r == MLOD_OK && j < x->v.skeleton.joint_count; j++) {
+			const mlod_joint *q = &x->v.skeleton.joints[j];
+			int d = 0;
+			if (q->node >= 0 && q->node < nodes)
+				r = mlod_gltf_drop_node_trs(copy, q->node, &q->rest, mode, 0, &d, err);
+			parts[mode] += (d & 1) + (d >> 1 & 1) + (d >> 2 & 1);
+		}
+	int trs_mode = parts[1] > parts[0] ? 1 : 0;
+	trs_mode = parts[2] > parts[trs_mode] ? 2 : trs_mode;
+	for (int j = 0; r == MLOD_OK && parts[trs_mode] > 0 && j < x->v.skeleton.joint_count; j++) {
+		const mlod_joint *q = &x->v.skeleton.joints[j];
+		if (q->node >= 0 && q->node < nodes)
+			r = mlod_gltf_drop_node_trs(copy, q->node, &q->rest, trs_mode, 1, NULL, err);
+	}
+	static const mlod_gltf_kind kinds[] = {MLOD_GLTF_NODE, MLOD_GLTF_SKIN, MLOD_GLTF_SCENE, MLOD_GLTF_MESH,
+	                                       MLOD_GLTF_ANIMATION};
+	for (size_t k = 0; r == MLOD_OK && k < sizeof kinds / sizeof *kinds; k++)
+		for (int i = 0; r == MLOD_OK && i < mlod_gltf_count(copy, kinds[k]); i++)
+			r = mlod_gltf_remove_extra(copy, kinds[k], i, "mlod", "end_site", err);
+	if (r == MLOD_OK)
+		r = mlod_gltf_remove_extra(copy, MLOD_GLTF_ASSET, 0, "mlod", "end_site", err);
+	if (r == MLOD_OK && parts[trs_mode] > 0)
+		r = mlod_gltf_set_extra(copy, MLOD_GLTF_ASSET, 0, "mlod", trs_marks[trs_mode], err);
+	return r;
+}
+
 void mlod_pack_options_default(mlod_pack_options *opt)
 {
 	static const double ratios[] = {MLOD_MESH_RATIOS_DEFAULT}, bounds[] = {MLOD_PACK_MOTION_BOUNDS_DEFAULT};
@@ -1678,6 +1738,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		mlod_result sr = doc ? mlod_gltf_copy(doc, &copy, &serr) : MLOD_ERR_INVALID_ARG;
 		if (sr == MLOD_OK && !opt->doc_whole)
 			sr = mlod_gltf_strip_levels(copy, &serr);
+		if (sr == MLOD_OK && !opt->doc_whole)
+			sr = doc_dedupe(&x, copy, &serr);
 		if (sr == MLOD_OK)
 			sr = mlod_gltf_write(copy, 1, &glb, &glb_size, &serr);
 		mlod_gltf_free(copy);
