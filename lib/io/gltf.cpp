@@ -2506,6 +2506,59 @@ void remove_extra(mlod_gltf &doc, mlod_gltf_kind kind, int index, const std::str
 		doc.extras[pointer] = e;
 }
 
+/* Drops nodes from `nodes` on, skins from `skins` on, meshes from `meshes`
+ * on, after checking that nothing kept refers to them. */
+void drop_tail(mlod_gltf &doc, int nodes, int skins, int meshes)
+{
+	Model &m = doc.model;
+	nodes = std::max(0, std::min(nodes, int(m.nodes.size())));
+	skins = std::max(0, std::min(skins, int(m.skins.size())));
+	meshes = std::max(0, std::min(meshes, int(m.meshes.size())));
+	auto gone = [](int i, int from) { return i >= from; };
+	for (int n = 0; n < nodes; n++) {
+		const tinygltf::Node &nd = m.nodes[size_t(n)];
+		if (gone(nd.mesh, meshes) || gone(nd.skin, skins))
+			fail(MLOD_ERR_UNSUPPORTED, "node %d uses a mesh or skin that would go", n);
+		for (int c : nd.children)
+			if (gone(c, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "node %d has a child that would go", n);
+		if (nd.extensions.count("MSFT_lod"))
+			fail(MLOD_ERR_UNSUPPORTED, "node %d keeps MSFT_lod", n);
+	}
+	for (int k = 0; k < skins; k++) {
+		const tinygltf::Skin &sk = m.skins[size_t(k)];
+		if (gone(sk.skeleton, nodes))
+			fail(MLOD_ERR_UNSUPPORTED, "skin %d's skeleton would go", k);
+		for (int j : sk.joints)
+			if (gone(j, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "skin %d has a joint that would go", k);
+	}
+	for (const tinygltf::Scene &sc : m.scenes)
+		for (int n : sc.nodes)
+			if (gone(n, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "a scene lists a node that would go");
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationChannel &c : a.channels)
+			if (gone(c.target_node, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "animation \"%s\" targets a node that would go", a.name.c_str());
+	auto tail = [](size_t size, int from) {
+		std::vector<bool> keep(size, true);
+		for (size_t i = size_t(from); i < size; i++)
+			keep[i] = false;
+		return keep;
+	};
+	std::vector<bool> keep = tail(m.nodes.size(), nodes);
+	renumber(doc, "nodes", keep);
+	keep_only(m.nodes, keep);
+	keep = tail(m.skins.size(), skins);
+	renumber(doc, "skins", keep);
+	keep_only(m.skins, keep);
+	keep = tail(m.meshes.size(), meshes);
+	renumber(doc, "meshes", keep);
+	keep_only(m.meshes, keep);
+	prune(doc, false);
+}
+
 /* A node's rest TRS parts that hold the default (identity) values. */
 bool trs_default(const mlod_trs &t, int part)
 {
@@ -2600,6 +2653,19 @@ void fill_node_trs(mlod_gltf &doc, int node, const mlod_trs &rest, int mode)
 		if (json *o = orig_element(doc, "nodes", node))
 			(*o)[trs_keys[part]] = have;
 	}
+}
+
+/* Drops animation a. */
+void drop_animation(mlod_gltf &doc, int a)
+{
+	Model &m = doc.model;
+	if (a < 0 || size_t(a) >= m.animations.size())
+		fail(MLOD_ERR_INVALID_ARG, "animation %d does not exist", a);
+	std::vector<bool> keep(m.animations.size(), true);
+	keep[size_t(a)] = false;
+	renumber(doc, "animations", keep);
+	keep_only(m.animations, keep);
+	prune(doc, false);
 }
 
 /* Drops skin k's inverse bind matrices (their bytes go). */
@@ -2942,6 +3008,14 @@ mlod_result mlod_gltf_remove_extra(mlod_gltf *doc, mlod_gltf_kind kind, int inde
 	});
 }
 
+mlod_result mlod_gltf_drop_tail(mlod_gltf *doc, int nodes, int skins, int meshes, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_drop_tail: doc is NULL");
+		drop_tail(*doc, nodes, skins, meshes);
+	});
+}
+
 mlod_result mlod_gltf_drop_node_trs(mlod_gltf *doc, int node, const mlod_trs *rest, int mode, int apply,
                                     int *dropped, mlod_error *err)
 {
@@ -2958,6 +3032,14 @@ mlod_result mlod_gltf_fill_node_trs(mlod_gltf *doc, int node, const mlod_trs *re
 	return guard(err, [&] {
 		need(doc && rest, "mlod_gltf_fill_node_trs: doc and rest must not be NULL");
 		fill_node_trs(*doc, node, *rest, mode);
+	});
+}
+
+mlod_result mlod_gltf_drop_animation(mlod_gltf *doc, int animation, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_drop_animation: doc is NULL");
+		drop_animation(*doc, animation);
 	});
 }
 

@@ -31,7 +31,8 @@
  * bytes. The DOC chunk holds the input document without what the other
  * chunks hold (mlod_gltf_strip_levels: geometry, joint channels, MSFT_lod;
  * then the packed skins' inverse bind matrices, the joint nodes' rest TRS
- * in one number style, the stages' records: mlod(5) DOC), as glb; when it
+ * in one number style, the stages' records and a piped input's level
+ * nodes, skins, meshes and animations: mlod(5) DOC), as glb; when it
  * cannot be stripped (an extension that may refer to accessors) or with
  * doc_whole, the input glb as read, with a note.
  */

@@ -1549,14 +1549,28 @@ static int identity_binds(const mlod_skin *sk)
 	return 1;
 }
 
+/* Whether glTF index g is among the n in list. */
+static int listed(const int *list, int n, int g)
+{
+	for (int i = 0; i < n; i++)
+		if (list[i] == g)
+			return 1;
+	return 0;
+}
+
 /* The stripped DOC without what the other chunks hold (mlod(5) DOC):
  * the inverse bind matrices of the packed skins (SKEL holds them; not
  * identities), the joint nodes' translation, rotation and scale that are
- * SKEL's rest TRS at f32 (not the defaults), and the stages' records
+ * SKEL's rest TRS at f32 (not the defaults), the stages' records
  * (extras "mlod", but for a BVH's End Site marks, "end_site", which are
- * the input's). */
+ * the input's), and a piped input's levels: its level animations, and
+ * its level nodes (MSFT_lod entries, nodes with a level skin), level
+ * skins and level meshes when they are the last of their kind (as the
+ * stages append them; else they stay, with a note). */
 static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
 {
+	const mlod_character *c = x->in;
+	const mlod_skeleton *s = &c->skeleton;
 	mlod_result r = MLOD_OK;
 	for (int i = 0; r == MLOD_OK && i < x->v.skeleton.skin_count; i++) {
 		const mlod_skin *sk = &x->v.skeleton.skins[i];
@@ -1592,6 +1606,79 @@ static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
 		r = mlod_gltf_remove_extra(copy, MLOD_GLTF_ASSET, 0, "mlod", "end_site", err);
 	if (r == MLOD_OK && parts[trs_mode] > 0)
 		r = mlod_gltf_set_extra(copy, MLOD_GLTF_ASSET, 0, "mlod", trs_marks[trs_mode], err);
+	/* The level animations (those strip_levels left: morph weights). */
+	for (int i = 0; r == MLOD_OK && i < c->clip_count; i++) {
+		int level = 1;
+		for (int q = 0; q < x->v.clip_count; q++)
+			level &= x->v.clips[q].name != c->clips[i].name;
+		int a = level && c->clips[i].name ? mlod_gltf_find_animation(copy, c->clips[i].name, 0) : -1;
+		if (a >= 0)
+			r = mlod_gltf_drop_animation(copy, a, err);
+	}
+	if (r != MLOD_OK || !x->doc)
+		return r;
+	/* The level nodes (every MSFT_lod entry), their meshes, level skins. */
+	int nn = mlod_gltf_count(x->doc, MLOD_GLTF_NODE), ns = mlod_gltf_count(x->doc, MLOD_GLTF_SKIN),
+	    nm = mlod_gltf_count(x->doc, MLOD_GLTF_MESH);
+	int *ln = malloc(sizeof(int) * ((size_t)nn + 1)), *lm = malloc(sizeof(int) * ((size_t)nn + 1));
+	int *ls = malloc(sizeof(int) * ((size_t)s->skin_count + 1)), nln = 0, nlm = 0, nls = 0;
+	if (!ln || !lm || !ls) {
+		free(ln), free(lm), free(ls);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	for (int n = 0; r == MLOD_OK && n < nn; n++) {
+		int ids[64], count = 0;
+		mlod_error ignored = {0};
+		if (mlod_gltf_node_lod(x->doc, n, ids, 64, &count, &ignored) != MLOD_OK)
+			continue;
+		for (int i = 0; i < count && i < 64; i++) {
+			int mesh = -1, skin = -1;
+			if (ids[i] == n || listed(ln, nln, ids[i]))
+				continue;
+			ln[nln++] = ids[i];
+			if (mlod_gltf_node_refs(x->doc, ids[i], &mesh, &skin, &ignored) == MLOD_OK && mesh >= 0 &&
+			    !listed(lm, nlm, mesh))
+				lm[nlm++] = mesh;
+		}
+	}
+	for (int i = 0; i < s->skin_count; i++)
+		if (x->view_skin[i] < 0 && s->skins[i].gltf_index >= 0)
+			ls[nls++] = s->skins[i].gltf_index;
+	/* and the nodes a level skin skins (mlod-skelgraph's skeleton level
+	 * nodes), with their meshes */
+	for (int n = 0; nls > 0 && n < nn; n++) {
+		int mesh = -1, skin = -1;
+		mlod_error ignored = {0};
+		if (mlod_gltf_node_refs(x->doc, n, &mesh, &skin, &ignored) != MLOD_OK || !listed(ls, nls, skin))
+			continue;
+		if (!listed(ln, nln, n))
+			ln[nln++] = n;
+		if (mesh >= 0 && !listed(lm, nlm, mesh))
+			lm[nlm++] = mesh;
+	}
+	/* Each kind from its first level one on, when all of those are. */
+	int from[3] = {nn, ns, nm}, *lists[3] = {ln, ls, lm}, counts[3] = {nln, nls, nlm}, totals[3] = {nn, ns, nm};
+	for (int k = 0; k < 3; k++) {
+		int f = totals[k];
+		while (f > 0 && listed(lists[k], counts[k], f - 1))
+			f--;
+		from[k] = f;
+	}
+	/* a mesh a kept node still uses stays (drop_tail refuses it) */
+	if (from[0] < nn || from[1] < ns || from[2] < nm) {
+		mlod_error derr = {0};
+		mlod_result dr = mlod_gltf_drop_tail(copy, from[0], from[1], from[2], &derr);
+		if (dr == MLOD_ERR_UNSUPPORTED) {
+			char text[MLOD_ERROR_MESSAGE_SIZE + 64];
+			snprintf(text, sizeof text, "the document chunk keeps the input's level nodes: %s", derr.message);
+			note(x, text);
+		} else if (dr != MLOD_OK) {
+			r = mlod_fail(err, dr, "%s", derr.message);
+		}
+	}
+	if (r == MLOD_OK && (nln > 0 && from[0] > nn - nln))
+		note(x, "the document chunk keeps some of the input's level nodes: they are not its last nodes");
+	free(ln), free(lm), free(ls);
 	return r;
 }
 

@@ -1,6 +1,6 @@
 # The DOC chunk: the input document without what the other chunks hold.
-# Node, mesh, skin and material counts are the piped input's (its records
-# go); primitives keep their
+# Node, mesh, skin and material counts are the input's (the piped input's
+# level nodes, level meshes and the records go); primitives keep their
 # material but no attributes or indices; no MSFT_lod; animations keep
 # only morph weights channels (RobotExpressive has 3 per clip); skins
 # without inverse bind matrices and most joint nodes without their rest
@@ -13,7 +13,8 @@ node - "$ROOT/samples/RobotExpressive.glb" <<'JS'
 const fs = require('fs');
 const glb = (f) => { const b = fs.readFileSync(f); return JSON.parse(b.subarray(20, 20 + b.readUInt32LE(12)).toString()); };
 const d = glb('doc.glb'), p = glb('piped.glb'), i = glb(process.argv[2]);
-for (const k of ['nodes', 'meshes', 'skins', 'materials']) if (d[k].length !== p[k].length) throw new Error(k);
+for (const k of ['nodes', 'meshes', 'skins', 'materials']) if (d[k].length !== i[k].length) throw new Error(k);
+if (!(p.nodes.length > i.nodes.length)) throw new Error('the piped input has no level nodes');
 if (d.skins.slice(0, i.skins.length).some((s) => s.inverseBindMatrices !== undefined)) throw new Error('inverse bind matrices left');
 const joints = new Set(d.skins.slice(0, i.skins.length).flatMap((s) => s.joints));
 /* one number style per document: 10 of the 43 joints keep parts written otherwise */
