@@ -519,6 +519,145 @@ static void sample(const char *path)
 	sample_bits(path, 0, 0, 0);
 }
 
+/* Posed positions (mlod(5) QUANTISATION): at each pose, the unpacked
+ * level 0 (mlod_posed_error, which takes the full character's diagonal
+ * in that pose) is within the largest over the input's vertices of
+ *   s |pos_scale| / 2 + (2 d + 4 * 3/1020) r
+ * where s bounds the scale of the vertex's skinning matrices (the
+ * Frobenius norm of their 3x3 part), d is the weight the pack drops past
+ * the 4 largest influences, and r the largest distance between the
+ * vertex carried by two of its joints; computed here, skinning the input
+ * with the pose's matrices. Level 0's own measured error is 0. */
+static double frob3(const mlod_mat4 *m)
+{
+	double f = 0;
+	for (int c = 0; c < 3; c++)
+		for (int r = 0; r < 3; r++)
+			f += (double)m->m[4 * c + r] * m->m[4 * c + r];
+	return sqrt(f);
+}
+
+static double pose_bound(const mlod_character *c, const mlod_mat4 *world, int bits)
+{
+	double bound = 0;
+	const mlod_skeleton *sk = &c->skeleton;
+	for (int i = 0; i < c->instance_count; i++) {
+		const mlod_instance *in = &c->instances[i];
+		const mlod_skin *skin = in->skin >= 0 ? &sk->skins[in->skin] : NULL;
+		mlod_mat4 rigid = in->joint >= 0 ? mlod_mat4_mul(&world[in->joint], &in->offset) : in->offset;
+		const mlod_mesh *m = &c->meshes[in->mesh];
+		for (int q = 0; q < m->primitive_count; q++) {
+			const mlod_primitive *p = &m->primitives[q];
+			if (p->mode != 4 || p->vertex_count <= 0)
+				continue;
+			double hd = 0;
+			for (int a = 0; a < 3; a++) {
+				float lo = INFINITY, hi = -INFINITY;
+				for (int v = 0; v < p->vertex_count; v++)
+					lo = fminf(lo, p->positions[3 * v + a]), hi = fmaxf(hi, p->positions[3 * v + a]);
+				double step = ((double)hi - lo) / (ldexp(1.0, bits) - 1.0);
+				hd += step * step;
+			}
+			hd = sqrt(hd) / 2;
+			for (int v = 0; v < p->vertex_count; v++) {
+				mlod_v3 pos = {p->positions[3 * v], p->positions[3 * v + 1], p->positions[3 * v + 2]};
+				if (!skin || p->weight_set_count == 0) {
+					bound = fmax(bound, frob3(&rigid) * hd);
+					continue;
+				}
+				mlod_v3 carried[4 * MLOD_MAX_SETS];
+				float w[4 * MLOD_MAX_SETS];
+				double s = 0, total = 0;
+				int n = 0;
+				for (int set = 0; set < p->weight_set_count; set++)
+					for (int k = 0; k < 4; k++) {
+						float wt = p->weights[set][4 * v + k];
+						int jt = p->joints[set][4 * v + k];
+						if (!(wt > 0) || jt >= skin->joint_count)
+							continue;
+						mlod_mat4 J = mlod_mat4_mul(&world[skin->joints[jt]], &skin->inverse_bind[jt]);
+						s = fmax(s, frob3(&J));
+						carried[n] = mlod_mat4_point(&J, pos);
+						w[n++] = wt;
+						total += wt;
+					}
+				for (int a = 0; a < n; a++) /* the 4 largest first */
+					for (int b = a + 1; b < n; b++)
+						if (w[b] > w[a]) {
+							float t = w[a];
+							w[a] = w[b], w[b] = t;
+						}
+				double dropped = 0, r = 0;
+				for (int a = 4; a < n; a++)
+					dropped += w[a] / total;
+				for (int a = 0; a < n; a++)
+					for (int b = a + 1; b < n; b++) {
+						double dx = carried[a].x - carried[b].x, dy = carried[a].y - carried[b].y,
+						       dz = carried[a].z - carried[b].z;
+						r = fmax(r, sqrt(dx * dx + dy * dy + dz * dz));
+					}
+				bound = fmax(bound, s * hd + (2 * dropped + 4 * 3.0 / 1020) * r);
+			}
+		}
+	}
+	return bound;
+}
+
+static void posed_level0(const char *path)
+{
+	size_t n = 0, pack_size = 0, glb_size = 0;
+	void *in = test_read_file(path, &n), *pack = NULL, *glb = NULL;
+	mlod_gltf *doc = NULL, *un = NULL, *doc2 = NULL;
+	mlod_character c, c2;
+	mlod_format fmt, fmt2;
+	mlod_pack_options opt;
+	mlod_pose_set poses = {0};
+	memset(&c, 0, sizeof c);
+	memset(&c2, 0, sizeof c2);
+	mlod_pack_options_default(&opt);
+	opt.no_skeleton_levels = opt.no_motion_levels = 1;
+	opt.ratio_count = 1, opt.ratios[0] = 0.5;
+	CHECK(in);
+	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+	CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &pack, &pack_size, NULL, &terr));
+	CHECK_OK(mlod_pack_unpack(pack, pack_size, &un, &terr));
+	CHECK_OK(mlod_gltf_write(un, 1, &glb, &glb_size, &terr));
+	CHECK_OK(mlod_load(glb, glb_size, NULL, &doc2, &c2, &fmt2, &terr));
+	CHECK_OK(mlod_pose_set_make(&c, 1, 8, 4, 7, 0.5f, &poses, &terr));
+	double worst = 0, worst_err = 0;
+	for (int k = 0; k < poses.count; k++) {
+		const mlod_mat4 *world = poses.world + (size_t)k * (size_t)poses.joint_count;
+		mlod_pose_set one = {1, poses.joint_count, (mlod_mat4 *)world, 0};
+		mlod_deviation d;
+		CHECK_OK(mlod_posed_error(&c, &c2, &one, &d, &terr));
+		double got = d.max / 100 * d.scale, bound = pose_bound(&c, world, opt.position_bits);
+		CHECK_MSG(got <= bound + 1e-6 * d.scale, "%s pose %d: posed error %g, bound %g", path, k, got, bound);
+		worst = fmax(worst, bound > 0 ? got / bound : 0);
+		worst_err = fmax(worst_err, d.max);
+	}
+	fprintf(stderr, "%s: level 0 posed, %d poses: max %.5f%% of the diagonal, %.3f of the bound at worst\n", path,
+	        poses.count, worst_err, worst);
+	mlod_pose_set_free(&poses);
+	mlod_character_free(&c);
+	mlod_character_free(&c2);
+	mlod_gltf_free(doc);
+	mlod_gltf_free(doc2);
+	mlod_gltf_free(un);
+	mlod_free(pack);
+	mlod_free(glb);
+	free(in);
+}
+
+TEST(posed_tubeman) { posed_level0("samples/tubeman.glb"); }
+TEST(posed_robot) { posed_level0("samples/RobotExpressive.glb"); }
+TEST(posed_shared_ely)
+{
+	NEED_SHARED();
+	char path[1024];
+	snprintf(path, sizeof path, "%s/Ely.glb", getenv("MLOD_SHARED_DATA"));
+	posed_level0(path);
+}
+
 TEST(round_trip_tubeman) { sample("samples/tubeman.glb"); }
 TEST(round_trip_tubeman_16_bits) { sample_bits("samples/tubeman.glb", 16, 16, 16); }
 TEST(round_trip_tubeman_fewest_bits)
@@ -545,5 +684,8 @@ int main(void)
 	RUN(round_trip_robot);
 	RUN(round_trip_bvh);
 	RUN(round_trip_shared_ely);
+	RUN(posed_tubeman);
+	RUN(posed_robot);
+	RUN(posed_shared_ely);
 	TEST_EXIT();
 }
