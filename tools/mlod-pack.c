@@ -36,6 +36,13 @@ static const char usage_text[] =
 	"                             (default %s)\n"
 	"  -e, --max-error PCT        levels down to the coarsest whose posed error\n"
 	"                             stays within PCT percent of the diagonal\n"
+	"mesh quantisation (mlod(5) QUANTISATION):\n"
+	"      --position-bits N      positions: N bits of the part's box, 8-16\n"
+	"                             (default %d)\n"
+	"      --normal-bits N        normals and tangents: N-bit octahedral, 6-16\n"
+	"                             (default %d)\n"
+	"      --uv-bits N            UVs: N bits of the part's UV box, 8-16\n"
+	"                             (default %d)\n"
 	"skeleton levels (mlod-skelgraph's --max-error):\n"
 	"      --skeleton-max-error PCT  percent of the skeleton height (default %g)\n"
 	"motion levels (mlod-motion's --max-error):\n"
@@ -56,6 +63,15 @@ static const char usage_text[] =
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
 	"4 output failure.\n";
+
+/* A bit count from min to 16. */
+static int parse_bits(const char *option, const char *value, int min)
+{
+	double v = tool_parse_double(option, value, min, 16);
+	if (v != (int)v)
+		tool_usage_error("%s: '%s' is not a whole number of bits", option, value);
+	return (int)v;
+}
 
 static const char *input_name(const char *path, char *buf, size_t size)
 {
@@ -313,7 +329,8 @@ static int pack_extract(const char *path, const char *output)
 
 int main(int argc, char **argv)
 {
-	enum { OPT_CODEC = 256, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH, OPT_NO_MOTION, OPT_INFO, OPT_JSON };
+	enum { OPT_CODEC = 256, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH, OPT_NO_MOTION, OPT_INFO, OPT_JSON,
+	       OPT_POS_BITS, OPT_NRM_BITS, OPT_UV_BITS };
 	static const struct option longopts[] = {
 		{"output", required_argument, NULL, 'o'},
 		{"report", optional_argument, NULL, 'r'},
@@ -323,6 +340,9 @@ int main(int argc, char **argv)
 		{"max-error", required_argument, NULL, 'e'},
 		{"skeleton-max-error", required_argument, NULL, OPT_SKEL_ERR},
 		{"motion-max-error", required_argument, NULL, OPT_MOTION_ERR},
+		{"position-bits", required_argument, NULL, OPT_POS_BITS},
+		{"normal-bits", required_argument, NULL, OPT_NRM_BITS},
+		{"uv-bits", required_argument, NULL, OPT_UV_BITS},
 		{"no-skeleton-levels", no_argument, NULL, OPT_NO_SKEL},
 		{"no-mesh-levels", no_argument, NULL, OPT_NO_MESH},
 		{"no-motion-levels", no_argument, NULL, OPT_NO_MOTION},
@@ -366,6 +386,9 @@ int main(int argc, char **argv)
 		case 'e': opt.mesh_max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
 		case OPT_SKEL_ERR: opt.skel_max_error = tool_parse_double("--skeleton-max-error", optarg, 0.0, 1e6); break;
 		case OPT_MOTION_ERR: opt.motion_bound_count = parse_bounds(optarg, &opt); break;
+		case OPT_POS_BITS: opt.position_bits = parse_bits("--position-bits", optarg, MLOD_PACK_POSITION_BITS_MIN); break;
+		case OPT_NRM_BITS: opt.normal_bits = parse_bits("--normal-bits", optarg, MLOD_PACK_NORMAL_BITS_MIN); break;
+		case OPT_UV_BITS: opt.uv_bits = parse_bits("--uv-bits", optarg, MLOD_PACK_UV_BITS_MIN); break;
 		case OPT_NO_SKEL: opt.no_skeleton_levels = 1; break;
 		case OPT_NO_MESH: opt.no_mesh_levels = 1; break;
 		case OPT_NO_MOTION: opt.no_motion_levels = 1; break;
@@ -378,7 +401,8 @@ int main(int argc, char **argv)
 			char list[64] = "";
 			for (size_t i = 0, n = 0; i < sizeof defaults / sizeof *defaults; i++)
 				n += (size_t)snprintf(list + n, sizeof list - n, "%s%g", i ? "," : "", defaults[i]);
-			printf(usage_text, list, MLOD_SKEL_MAX_ERROR_DEFAULT);
+			printf(usage_text, list, MLOD_PACK_POSITION_BITS_DEFAULT, MLOD_PACK_NORMAL_BITS_DEFAULT,
+			       MLOD_PACK_UV_BITS_DEFAULT, MLOD_SKEL_MAX_ERROR_DEFAULT);
 			return 0;
 		}
 		case 'V': tool_version();

@@ -2469,6 +2469,235 @@ void strip_levels(mlod_gltf &doc)
 	prune(doc, false);
 }
 
+/* The JSON object as read of element i of top-level array name (nullptr
+ * when there is none). */
+json *orig_element(mlod_gltf &doc, const char *name, int i)
+{
+	json &o = doc.original;
+	if (i < 0 || !o.is_object() || !o.contains(name) || !o[name].is_array() || size_t(i) >= o[name].size() ||
+	    !o[name][size_t(i)].is_object())
+		return nullptr;
+	return &o[name][size_t(i)];
+}
+
+/* Removes key from an object's extras (the whole extras when it empties),
+ * but for member `keep` of an object extras[key] (none when empty). */
+void remove_extra(mlod_gltf &doc, mlod_gltf_kind kind, int index, const std::string &key, const std::string &keep)
+{
+	std::string pointer;
+	Value *value = extras_slot(doc, kind, index, &pointer);
+	json e = current_extras(doc, pointer, *value);
+	if (!e.is_object() || !e.contains(key))
+		return;
+	json &v = e[key];
+	if (!keep.empty() && v.is_object() && v.contains(keep)) {
+		if (v.size() == 1)
+			return;
+		json kept = json::object();
+		kept[keep] = v[keep];
+		v = std::move(kept);
+	} else {
+		e.erase(key);
+	}
+	*value = e.empty() ? Value() : to_value(e);
+	if (e.empty())
+		doc.extras.erase(pointer);
+	else
+		doc.extras[pointer] = e;
+}
+
+/* Drops nodes from `nodes` on, skins from `skins` on, meshes from `meshes`
+ * on, after checking that nothing kept refers to them. */
+void drop_tail(mlod_gltf &doc, int nodes, int skins, int meshes)
+{
+	Model &m = doc.model;
+	nodes = std::max(0, std::min(nodes, int(m.nodes.size())));
+	skins = std::max(0, std::min(skins, int(m.skins.size())));
+	meshes = std::max(0, std::min(meshes, int(m.meshes.size())));
+	auto gone = [](int i, int from) { return i >= from; };
+	for (int n = 0; n < nodes; n++) {
+		const tinygltf::Node &nd = m.nodes[size_t(n)];
+		if (gone(nd.mesh, meshes) || gone(nd.skin, skins))
+			fail(MLOD_ERR_UNSUPPORTED, "node %d uses a mesh or skin that would go", n);
+		for (int c : nd.children)
+			if (gone(c, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "node %d has a child that would go", n);
+		if (nd.extensions.count("MSFT_lod"))
+			fail(MLOD_ERR_UNSUPPORTED, "node %d keeps MSFT_lod", n);
+	}
+	for (int k = 0; k < skins; k++) {
+		const tinygltf::Skin &sk = m.skins[size_t(k)];
+		if (gone(sk.skeleton, nodes))
+			fail(MLOD_ERR_UNSUPPORTED, "skin %d's skeleton would go", k);
+		for (int j : sk.joints)
+			if (gone(j, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "skin %d has a joint that would go", k);
+	}
+	for (const tinygltf::Scene &sc : m.scenes)
+		for (int n : sc.nodes)
+			if (gone(n, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "a scene lists a node that would go");
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationChannel &c : a.channels)
+			if (gone(c.target_node, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "animation \"%s\" targets a node that would go", a.name.c_str());
+	auto tail = [](size_t size, int from) {
+		std::vector<bool> keep(size, true);
+		for (size_t i = size_t(from); i < size; i++)
+			keep[i] = false;
+		return keep;
+	};
+	std::vector<bool> keep = tail(m.nodes.size(), nodes);
+	renumber(doc, "nodes", keep);
+	keep_only(m.nodes, keep);
+	keep = tail(m.skins.size(), skins);
+	renumber(doc, "skins", keep);
+	keep_only(m.skins, keep);
+	keep = tail(m.meshes.size(), meshes);
+	renumber(doc, "meshes", keep);
+	keep_only(m.meshes, keep);
+	prune(doc, false);
+}
+
+/* A node's rest TRS parts that hold the default (identity) values. */
+bool trs_default(const mlod_trs &t, int part)
+{
+	if (part == 0)
+		return t.t.x == 0.0f && t.t.y == 0.0f && t.t.z == 0.0f;
+	if (part == 1)
+		return t.r.x == 0.0f && t.r.y == 0.0f && t.r.z == 0.0f && t.r.w == 1.0f;
+	return t.s.x == 1.0f && t.s.y == 1.0f && t.s.z == 1.0f;
+}
+
+/* The double a node's number is for f32 value f: f itself (mode 0), the
+ * shortest decimal that reads as f (mode 1), or f to 15 significant digits
+ * (mode 2, as some exporters write). */
+double trs_number(float f, int mode)
+{
+	if (mode == 0 || !std::isfinite(f))
+		return f;
+	char buf[64];
+	if (mode == 2) {
+		snprintf(buf, sizeof buf, "%.15g", double(f));
+		return strtod(buf, nullptr);
+	}
+	for (int p = 1; p <= 9; p++) {
+		snprintf(buf, sizeof buf, "%.*g", p, double(f));
+		double d = strtod(buf, nullptr);
+		if (float(d) == f)
+			return d;
+	}
+	return f;
+}
+
+void trs_values(const mlod_trs &t, int part, int mode, std::vector<double> &v)
+{
+	if (part == 0)
+		v = {trs_number(t.t.x, mode), trs_number(t.t.y, mode), trs_number(t.t.z, mode)};
+	else if (part == 1)
+		v = {trs_number(t.r.x, mode), trs_number(t.r.y, mode), trs_number(t.r.z, mode), trs_number(t.r.w, mode)};
+	else
+		v = {trs_number(t.s.x, mode), trs_number(t.s.y, mode), trs_number(t.s.z, mode)};
+}
+
+const char *const trs_keys[3] = {"translation", "rotation", "scale"};
+
+std::vector<double> &trs_member(tinygltf::Node &n, int part)
+{
+	return part == 0 ? n.translation : part == 1 ? n.rotation : n.scale;
+}
+
+/* Drops (with apply; else only counts) the translation, rotation and
+ * scale of node `node` that are exactly trs_values of rest in mode and
+ * not the default; returns them as bits 1, 2, 4. A node with a matrix
+ * keeps it. */
+int drop_node_trs(mlod_gltf &doc, int node, const mlod_trs &rest, int mode, bool apply)
+{
+	Model &m = doc.model;
+	if (node < 0 || size_t(node) >= m.nodes.size())
+		fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+	tinygltf::Node &n = m.nodes[size_t(node)];
+	if (!n.matrix.empty())
+		return 0;
+	int dropped = 0;
+	for (int part = 0; part < 3; part++) {
+		std::vector<double> &have = trs_member(n, part), want;
+		trs_values(rest, part, mode, want);
+		if (have != want || trs_default(rest, part))
+			continue;
+		dropped |= 1 << part;
+		if (!apply)
+			continue;
+		have.clear();
+		if (json *o = orig_element(doc, "nodes", node))
+			o->erase(trs_keys[part]);
+	}
+	return dropped;
+}
+
+/* Gives node `node` (without a matrix) each of rest's translation,
+ * rotation and scale it lacks that is not the default. */
+void fill_node_trs(mlod_gltf &doc, int node, const mlod_trs &rest, int mode)
+{
+	Model &m = doc.model;
+	if (node < 0 || size_t(node) >= m.nodes.size())
+		fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+	tinygltf::Node &n = m.nodes[size_t(node)];
+	if (!n.matrix.empty())
+		return;
+	for (int part = 0; part < 3; part++) {
+		std::vector<double> &have = trs_member(n, part);
+		if (!have.empty() || trs_default(rest, part))
+			continue;
+		trs_values(rest, part, mode, have);
+		if (json *o = orig_element(doc, "nodes", node))
+			(*o)[trs_keys[part]] = have;
+	}
+}
+
+/* Drops animation a. */
+void drop_animation(mlod_gltf &doc, int a)
+{
+	Model &m = doc.model;
+	if (a < 0 || size_t(a) >= m.animations.size())
+		fail(MLOD_ERR_INVALID_ARG, "animation %d does not exist", a);
+	std::vector<bool> keep(m.animations.size(), true);
+	keep[size_t(a)] = false;
+	renumber(doc, "animations", keep);
+	keep_only(m.animations, keep);
+	prune(doc, false);
+}
+
+/* Drops skin k's inverse bind matrices (their bytes go). */
+void drop_inverse_binds(mlod_gltf &doc, int k)
+{
+	Model &m = doc.model;
+	if (k < 0 || size_t(k) >= m.skins.size())
+		fail(MLOD_ERR_INVALID_ARG, "skin %d does not exist", k);
+	m.skins[size_t(k)].inverseBindMatrices = -1;
+	if (json *o = orig_element(doc, "skins", k))
+		o->erase("inverseBindMatrices");
+	prune(doc, false);
+}
+
+/* Gives skin k the inverse bind matrices (a new accessor). */
+void set_inverse_binds(mlod_gltf &doc, int k, const mlod_mat4 *ibm, int count)
+{
+	Model &m = doc.model;
+	if (k < 0 || size_t(k) >= m.skins.size())
+		fail(MLOD_ERR_INVALID_ARG, "skin %d does not exist", k);
+	if (count != int(m.skins[size_t(k)].joints.size()))
+		fail(MLOD_ERR_INVALID_ARG, "skin %d has %zu joints, not %d", k, m.skins[size_t(k)].joints.size(), count);
+	std::vector<float> v(16 * size_t(count));
+	for (int j = 0; j < count; j++)
+		memcpy(&v[16 * size_t(j)], ibm[j].m, sizeof(float[16]));
+	check_finite(v.data(), v.size(), "inverse bind matrices");
+	int a = append_floats(m, v.data(), size_t(count), 16, 0);
+	m.skins[size_t(k)].inverseBindMatrices = a;
+	if (json *o = orig_element(doc, "skins", k))
+		(*o)["inverseBindMatrices"] = a;
+}
+
 /* Checks the arguments common to the calls that take a document. */
 void need(bool ok, const char *what)
 {
@@ -2767,6 +2996,66 @@ mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, mlod_error *err)
 	return guard(err, [&] {
 		need(doc != nullptr, "mlod_gltf_strip_levels: doc is NULL");
 		strip_levels(*doc);
+	});
+}
+
+mlod_result mlod_gltf_remove_extra(mlod_gltf *doc, mlod_gltf_kind kind, int index, const char *key,
+                                   const char *keep, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && key, "mlod_gltf_remove_extra: doc and key must not be NULL");
+		remove_extra(*doc, kind, index, key, keep ? keep : "");
+	});
+}
+
+mlod_result mlod_gltf_drop_tail(mlod_gltf *doc, int nodes, int skins, int meshes, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_drop_tail: doc is NULL");
+		drop_tail(*doc, nodes, skins, meshes);
+	});
+}
+
+mlod_result mlod_gltf_drop_node_trs(mlod_gltf *doc, int node, const mlod_trs *rest, int mode, int apply,
+                                    int *dropped, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && rest, "mlod_gltf_drop_node_trs: doc and rest must not be NULL");
+		int d = drop_node_trs(*doc, node, *rest, mode, apply != 0);
+		if (dropped)
+			*dropped = d;
+	});
+}
+
+mlod_result mlod_gltf_fill_node_trs(mlod_gltf *doc, int node, const mlod_trs *rest, int mode, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && rest, "mlod_gltf_fill_node_trs: doc and rest must not be NULL");
+		fill_node_trs(*doc, node, *rest, mode);
+	});
+}
+
+mlod_result mlod_gltf_drop_animation(mlod_gltf *doc, int animation, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_drop_animation: doc is NULL");
+		drop_animation(*doc, animation);
+	});
+}
+
+mlod_result mlod_gltf_drop_inverse_binds(mlod_gltf *doc, int skin, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_drop_inverse_binds: doc is NULL");
+		drop_inverse_binds(*doc, skin);
+	});
+}
+
+mlod_result mlod_gltf_set_inverse_binds(mlod_gltf *doc, int skin, const mlod_mat4 *ibm, int count, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && ibm, "mlod_gltf_set_inverse_binds: doc and ibm must not be NULL");
+		set_inverse_binds(*doc, skin, ibm, count);
 	});
 }
 

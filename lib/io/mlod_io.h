@@ -141,6 +141,39 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
  * may be partly stripped: strip a copy. */
 mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, mlod_error *err);
 
+/* For a pack's DOC chunk (mlod-pack, mlod(5)): */
+/* Removes extras[key] of an object (its extras whole when nothing else is
+ * left in them), but when extras[key] is an object with a member `keep`
+ * (NULL: none), that member stays alone in it; nothing without the key. */
+mlod_result mlod_gltf_remove_extra(mlod_gltf *doc, mlod_gltf_kind kind, int index, const char *key,
+                                   const char *keep, mlod_error *err);
+/* Drops the nodes from index `nodes` on, the skins from `skins` on and
+ * the meshes from `meshes` on (a count at or past the end drops none),
+ * then the accessors, views and bytes nothing uses. Every other index
+ * holds. MLOD_ERR_UNSUPPORTED, the document unchanged, when something
+ * kept (a node's mesh, skin or child, a skin's joint, a scene, an
+ * animation channel, MSFT_lod) refers to one that would go. */
+mlod_result mlod_gltf_drop_tail(mlod_gltf *doc, int nodes, int skins, int meshes, mlod_error *err);
+/* Drops the translation, rotation and scale of a node (without a matrix)
+ * whose numbers are exactly those of rest in `mode` and that are not the
+ * default (identity); *dropped (may be NULL) gets them as bits 1, 2 and 4
+ * (apply 0: counted, not dropped). Mode 0: each number is the f32 value
+ * itself; mode 1: the shortest decimal that reads as the f32 value; mode
+ * 2: the f32 value to 15 significant digits. Then
+ * gives a node (without a matrix) each part of rest it lacks that is not
+ * the default, in the numbers of `mode`: the two give the node back with
+ * the same numbers. */
+mlod_result mlod_gltf_drop_node_trs(mlod_gltf *doc, int node, const mlod_trs *rest, int mode, int apply,
+                                    int *dropped, mlod_error *err);
+mlod_result mlod_gltf_fill_node_trs(mlod_gltf *doc, int node, const mlod_trs *rest, int mode, mlod_error *err);
+/* Drops an animation (later ones move down) and the data only it used. */
+mlod_result mlod_gltf_drop_animation(mlod_gltf *doc, int animation, mlod_error *err);
+/* Drops a skin's inverse bind matrices (the skin then has none, which
+ * glTF reads as identities) and their bytes; and gives a skin count
+ * matrices (one per joint) as a new accessor. */
+mlod_result mlod_gltf_drop_inverse_binds(mlod_gltf *doc, int skin, mlod_error *err);
+mlod_result mlod_gltf_set_inverse_binds(mlod_gltf *doc, int skin, const mlod_mat4 *ibm, int count, mlod_error *err);
+
 /* The glTF mesh and skin a node points at (-1: none). */
 mlod_result mlod_gltf_node_refs(const mlod_gltf *doc, int node, int *mesh, int *skin, mlod_error *err);
 

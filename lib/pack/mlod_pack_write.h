@@ -28,10 +28,13 @@
  * mlod_pack_q* helpers below.
  *
  * The output is deterministic: the same input and options give the same
- * bytes. The DOC chunk holds the input document without what the levels
- * hold (mlod_gltf_strip_levels: geometry, joint channels, MSFT_lod), as
- * glb; when it cannot be stripped (an extension that may refer to
- * accessors) or with doc_whole, the input glb as read, with a note.
+ * bytes. The DOC chunk holds the input document without what the other
+ * chunks hold (mlod_gltf_strip_levels: geometry, joint channels, MSFT_lod;
+ * then the packed skins' inverse bind matrices, the joint nodes' rest TRS
+ * in one number style, the stages' records and a piped input's level
+ * nodes, skins, meshes and animations: mlod(5) DOC), as glb; when it
+ * cannot be stripped (an extension that may refer to accessors) or with
+ * doc_whole, the input glb as read, with a note.
  */
 #ifndef MLOD_PACK_WRITE_H
 #define MLOD_PACK_WRITE_H
@@ -72,6 +75,11 @@ typedef struct mlod_pack_options {
 	/* each layer can be left at level 0 alone */
 	int no_skeleton_levels, no_mesh_levels, no_motion_levels;
 	int doc_whole;               /* DOC: the input glb whole, not stripped */
+	/* mesh quantisation (mlod(5) QUANTISATION; MLOD_PACK_*_BITS_MIN to 16) */
+	int position_bits;           /* positions: 2^bits - 1 steps of the part's box per axis;
+	                              * morph deltas: 2^(bits-1) - 1 steps of their largest |value| */
+	int normal_bits;             /* normals, tangents: octahedral codes on a 2^bits lattice */
+	int uv_bits;                 /* UVs: 2^bits - 1 steps of the part's UV box per axis */
 } mlod_pack_options;
 
 void mlod_pack_options_default(mlod_pack_options *opt);
@@ -112,6 +120,25 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 #define MLOD_PACK_OCT_BOUND 1e-4 /* radians (4.3e-5 measured over 200000 random normals) */
 void mlod_pack_oct_encode(const float n[3], int16_t out[2]);
 
+/* The same at `bits` (MLOD_PACK_NORMAL_BITS_MIN to 16; 16 is
+ * mlod_pack_oct_encode): the code nearest in angle among the multiples of
+ * step = 2^(16 - bits), each coordinate clamped to +-32767, so the reader's
+ * snorm16 decode is unchanged and the low 16 - bits bits of most codes are
+ * zero (meshopt's byte codec then stores them in almost nothing). The
+ * angle is within mlod_pack_oct_bound(bits) = 3 sqrt(2) (step / 2) / 32767
+ * (+ 2e-6 for f32): each coordinate within half a step, the map from the
+ * octahedron to the sphere stretching that at most sqrt(18) times. */
+#define MLOD_PACK_NORMAL_BITS_MIN 6
+void mlod_pack_oct_encode_bits(const float n[3], int bits, int16_t out[2]);
+double mlod_pack_oct_bound(int bits);
+
+/* Defaults and lower limits of the mesh bits (the options above). */
+#define MLOD_PACK_POSITION_BITS_MIN 8
+#define MLOD_PACK_UV_BITS_MIN 8
+#define MLOD_PACK_POSITION_BITS_DEFAULT 14
+#define MLOD_PACK_NORMAL_BITS_DEFAULT 8
+#define MLOD_PACK_UV_BITS_DEFAULT 12
+
 /* 'ROTQ' rotations: each component of a unit quaternion (up to the sign
  * the writer picks for continuity) is within half a step, 1/65534, of the
  * input; the 4-vector error is then at most 1/32767 and the rotation
@@ -129,6 +156,9 @@ void mlod_pack_oct_decode(const int16_t in[2], float n[3]);
  * scale for a range: (max - min) / 65535. */
 uint16_t mlod_pack_qu16(float v, float min, float scale);
 float mlod_pack_range_scale(float min, float max);
+/* The scale at `bits` (1 to 16): (max - min) / (2^bits - 1), so q is
+ * within [0, 2^bits - 1] and |min + q * scale - v| <= scale / 2. */
+float mlod_pack_range_scale_bits(float min, float max, int bits);
 
 /* Up to 4 weights (>= 0, any sum > 0) to unorm8 summing exactly to 255
  * by largest-remainder rounding: each differs from 255 w / sum by less

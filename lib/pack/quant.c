@@ -26,6 +26,22 @@ static int16_t snorm16(float v)
 
 void mlod_pack_oct_encode(const float n[3], int16_t out[2])
 {
+	mlod_pack_oct_encode_bits(n, 16, out);
+}
+
+/* The code of lattice point k (a multiple of step, the ends clamped to
+ * +-32767). */
+static int oct_code(long k, int step)
+{
+	long c = k * step;
+	return (int)(c > 32767 ? 32767 : c < -32767 ? -32767 : c);
+}
+
+void mlod_pack_oct_encode_bits(const float n[3], int bits, int16_t out[2])
+{
+	bits = bits < MLOD_PACK_NORMAL_BITS_MIN ? MLOD_PACK_NORMAL_BITS_MIN : bits > 16 ? 16 : bits;
+	int step = 1 << (16 - bits);
+	long kmax = 1L << (bits - 1); /* k * step for |k| <= kmax, clamped: every code's lattice */
 	float x = n[0], y = n[1], z = n[2];
 	float l1 = fabsf(x) + fabsf(y) + fabsf(z);
 	if (!(l1 > 0.0f)) {
@@ -42,16 +58,17 @@ void mlod_pack_oct_encode(const float n[3], int16_t out[2])
 		x = ox;
 		y = oy;
 	}
-	/* The rounded code nearest in angle among the 9 around (x, y),
+	/* The lattice code nearest in angle among the 9 around (x, y),
 	 * measured in double (a float dot product cannot tell them apart). */
-	int16_t bx = snorm16(x), by = snorm16(y), best[2] = {bx, by};
+	long bx = lrint(snorm16(x) / (double)step), by = lrint(snorm16(y) / (double)step);
+	int16_t best[2] = {(int16_t)oct_code(bx, step), (int16_t)oct_code(by, step)};
 	double bestd = 1e300, len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
 	for (int dx = -1; dx <= 1; dx++)
 		for (int dy = -1; dy <= 1; dy++) {
-			int cx = bx + dx, cy = by + dy;
-			if (cx < -32767 || cx > 32767 || cy < -32767 || cy > 32767)
+			long kx = bx + dx, ky = by + dy;
+			if (kx < -kmax || kx > kmax || ky < -kmax || ky > kmax)
 				continue;
-			int16_t c[2] = {(int16_t)cx, (int16_t)cy};
+			int16_t c[2] = {(int16_t)oct_code(kx, step), (int16_t)oct_code(ky, step)};
 			float d[3];
 			mlod_pack_oct_decode(c, d);
 			double e = 0.0;
@@ -65,6 +82,14 @@ void mlod_pack_oct_encode(const float n[3], int16_t out[2])
 		}
 	out[0] = best[0];
 	out[1] = best[1];
+}
+
+double mlod_pack_oct_bound(int bits)
+{
+	/* half a lattice step per coordinate, stretched at most sqrt(18)
+	 * times; 2e-6 rad for the f32 arithmetic */
+	bits = bits < MLOD_PACK_NORMAL_BITS_MIN ? MLOD_PACK_NORMAL_BITS_MIN : bits > 16 ? 16 : bits;
+	return 3.0 * sqrt(2.0) * ldexp(1.0, 15 - bits) / 32767.0 + 2e-6;
 }
 
 void mlod_pack_oct_decode(const int16_t in[2], float n[3])
@@ -82,7 +107,13 @@ void mlod_pack_oct_decode(const int16_t in[2], float n[3])
 
 float mlod_pack_range_scale(float min, float max)
 {
-	return max > min ? (float)(((double)max - (double)min) / 65535.0) : 0.0f;
+	return mlod_pack_range_scale_bits(min, max, 16);
+}
+
+float mlod_pack_range_scale_bits(float min, float max, int bits)
+{
+	bits = bits < 1 ? 1 : bits > 16 ? 16 : bits;
+	return max > min ? (float)(((double)max - (double)min) / (ldexp(1.0, bits) - 1.0)) : 0.0f;
 }
 
 uint16_t mlod_pack_qu16(float v, float min, float scale)

@@ -4,7 +4,9 @@
  * shim (io/mlod_io.h).
  *
  * The document starts from the DOC chunk (the input without the levels'
- * data). Level 0 goes back where it came from: each instance node gets a
+ * data), its skins given back their inverse bind matrices and its joint
+ * nodes their rest TRS from SKEL (mlod(5) DOC). Level 0 goes back where
+ * it came from: each instance node gets a
  * mesh built from its level 0 parts (like the DOC mesh it named: name,
  * extras, primitives' material and extensions), and each clip's level 0
  * becomes an animation named after the clip. Coarser levels are added as
@@ -462,6 +464,47 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	if ((r = build_skeleton(have_skel ? &skel : NULL, &s, err)) != MLOD_OK)
 		goto done;
 	node_count = mlod_gltf_count(doc, MLOD_GLTF_NODE);
+	/* The joints' nodes get back their rest TRS from SKEL, and the DOC's
+	 * skins the inverse bind matrices SKEL holds (the writer drops both
+	 * from the DOC unless they are the defaults). */
+	char *mark = NULL;
+	mlod_error merr = {0};
+	int trs_mode = -1; /* the writer's asset extras.mlod.doc_trs; none: no TRS dropped */
+	if (mlod_gltf_get_extra(doc, MLOD_GLTF_ASSET, 0, "mlod", &mark, &merr) == MLOD_OK && mark) {
+		for (int m = 0; m < 3; m++) {
+			char want[32];
+			snprintf(want, sizeof want, "{\"doc_trs\":%d}", m);
+			if (strcmp(mark, want) == 0)
+				trs_mode = m;
+		}
+		if (trs_mode >= 0 && (r = mlod_gltf_remove_extra(doc, MLOD_GLTF_ASSET, 0, "mlod", NULL, err)) != MLOD_OK) {
+			mlod_free(mark);
+			goto done;
+		}
+	}
+	mlod_free(mark);
+	for (int j = 0; trs_mode >= 0 && j < s.joint_count; j++) {
+		mlod_error serr = {0};
+		if (s.joints[j].node >= 0 && s.joints[j].node < node_count &&
+		    mlod_gltf_fill_node_trs(doc, s.joints[j].node, &s.joints[j].rest, trs_mode, &serr) != MLOD_OK) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "SKEL joint %d: %s", j, serr.message);
+			goto done;
+		}
+	}
+	for (int i = 0; i < s.skin_count; i++) {
+		const mlod_skin *sk = &s.skins[i];
+		mlod_mat4 id = mlod_mat4_identity();
+		int identity = 1;
+		for (int j = 0; identity && j < sk->joint_count; j++)
+			identity = memcmp(&sk->inverse_bind[j], &id, sizeof id) == 0;
+		if (identity || sk->gltf_index < 0 || sk->gltf_index >= mlod_gltf_count(doc, MLOD_GLTF_SKIN))
+			continue;
+		mlod_error serr = {0};
+		if (mlod_gltf_set_inverse_binds(doc, sk->gltf_index, sk->inverse_bind, sk->joint_count, &serr) != MLOD_OK) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "SKEL skin %d: %s", i, serr.message);
+			goto done;
+		}
+	}
 
 	/* Skeleton levels: their skins. */
 	skel_levels = have_skel ? info.rec.skeleton_levels : 0;

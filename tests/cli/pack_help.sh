@@ -4,3 +4,4 @@ set -e
 "$BIN/mlod-pack" --version | grep -q "^mlod-pack (mlod) "
 "$BIN/mlod-pack" --help | grep -q -- "--info FILE"
 "$BIN/mlod-pack" --help | grep -q -- "-x, --extract FILE"
+"$BIN/mlod-pack" --help | grep -q -- "--normal-bits N"

@@ -2,7 +2,8 @@
 // exactly from mlod-pack -x (the input's glb vs the unpacked glb):
 // materials, textures, samplers, images (their bytes too), the scenes, and
 // for each input node its name, children, transform, skin and extras; each
-// input skin's joints and name; each input animation's name in order.
+// input skin's joints, name and inverse bind matrices (bytes); each input
+// animation's name in order.
 //
 //   node pack_unpack_lossless.mjs input.glb unpacked.glb
 import { readFileSync } from 'node:fs';
@@ -52,5 +53,13 @@ a.json.nodes.forEach((n, i) => {
   same(s.joints, b.json.skins[i].joints, `skin ${i} joints`);
   same(s.name, b.json.skins[i].name, `skin ${i} name`);
   same(s.skeleton, b.json.skins[i].skeleton, `skin ${i} skeleton`);
+  // the inverse bind matrices (the pack's DOC leaves them to SKEL)
+  const ibm = (g, sk) => {
+    if (sk.inverseBindMatrices === undefined) return 'none';
+    const acc = g.json.accessors[sk.inverseBindMatrices], v = g.json.bufferViews[acc.bufferView];
+    const at = (v.byteOffset || 0) + (acc.byteOffset || 0);
+    return g.bin.subarray(at, at + 64 * acc.count).toString('base64');
+  };
+  if (ibm(a, s) !== ibm(b, b.json.skins[i])) throw new Error(`skin ${i} inverse bind matrices`);
 });
 same((a.json.animations || []).map((x) => x.name), (b.json.animations || []).slice(0, (a.json.animations || []).length).map((x) => x.name), 'animation names');

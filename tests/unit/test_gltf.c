@@ -371,6 +371,81 @@ TEST(extras)
 	CHECK(absent);
 }
 
+/* The pack's DOC edits (mlod_gltf_remove_extra, _drop_tail,
+ * _drop/_set_inverse_binds, _drop/_fill_node_trs): each undone gives the
+ * document back. */
+TEST(pack_doc_edits)
+{
+	mlod_gltf *doc = read_robot(), *again = NULL;
+	CHECK_MSG(doc != NULL, "%s", terr.message);
+	char *before = gltf_text(doc), *v = NULL;
+	mlod_character c = {0}, c2 = {0};
+	CHECK_OK(mlod_gltf_to_character(doc, &c, &terr));
+	/* extras: "end_site" stays alone, the rest of "mlod" goes */
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_NODE, 0, "mlod", "{\"end_site\": true, \"label\": \"x\"}", &terr));
+	CHECK_OK(mlod_gltf_remove_extra(doc, MLOD_GLTF_NODE, 0, "mlod", "end_site", &terr));
+	CHECK_OK(mlod_gltf_get_extra(doc, MLOD_GLTF_NODE, 0, "mlod", &v, &terr));
+	CHECK(v && strcmp(v, "{\"end_site\":true}") == 0);
+	mlod_free(v);
+	CHECK_OK(mlod_gltf_remove_extra(doc, MLOD_GLTF_NODE, 0, "mlod", NULL, &terr));
+	CHECK_OK(mlod_gltf_get_extra(doc, MLOD_GLTF_NODE, 0, "mlod", &v, &terr));
+	CHECK(v == NULL);
+	/* a tail: refused while a kept node refers to it, else dropped */
+	int nodes = mlod_gltf_count(doc, MLOD_GLTF_NODE), skins = mlod_gltf_count(doc, MLOD_GLTF_SKIN),
+	    meshes = mlod_gltf_count(doc, MLOD_GLTF_MESH), added = -1;
+	CHECK(mlod_gltf_drop_tail(doc, 1, skins, meshes, &terr) == MLOD_ERR_UNSUPPORTED);
+	CHECK(mlod_gltf_count(doc, MLOD_GLTF_NODE) == nodes);
+	CHECK(mlod_gltf_drop_tail(doc, nodes, skins, meshes - 1, &terr) == MLOD_ERR_UNSUPPORTED);
+	CHECK_OK(mlod_gltf_add_node(doc, "level", MLOD_GLTF_DETACHED, -1, -1, NULL, &added, &terr));
+	CHECK(added == nodes && mlod_gltf_count(doc, MLOD_GLTF_NODE) == nodes + 1);
+	CHECK_OK(mlod_gltf_drop_tail(doc, nodes, skins, meshes, &terr));
+	CHECK(mlod_gltf_count(doc, MLOD_GLTF_NODE) == nodes);
+	/* inverse binds: gone (identities), back (the same matrices) */
+	CHECK_OK(mlod_gltf_drop_inverse_binds(doc, 0, &terr));
+	CHECK_OK(reread(doc, &again));
+	CHECK_OK(mlod_gltf_to_character(again, &c2, &terr));
+	mlod_mat4 id = mlod_mat4_identity();
+	CHECK(memcmp(&c2.skeleton.skins[0].inverse_bind[0], &id, sizeof id) == 0);
+	CHECK(memcmp(&c.skeleton.skins[0].inverse_bind[0], &id, sizeof id) != 0);
+	mlod_character_free(&c2);
+	mlod_gltf_free(again);
+	again = NULL;
+	CHECK_OK(mlod_gltf_set_inverse_binds(doc, 0, c.skeleton.skins[0].inverse_bind, c.skeleton.skins[0].joint_count,
+	                                     &terr));
+	CHECK(mlod_gltf_set_inverse_binds(doc, 0, c.skeleton.skins[0].inverse_bind, 1, &terr) == MLOD_ERR_INVALID_ARG);
+	CHECK_OK(reread(doc, &again));
+	CHECK_OK(mlod_gltf_to_character(again, &c2, &terr));
+	CHECK(memcmp(c2.skeleton.skins[0].inverse_bind, c.skeleton.skins[0].inverse_bind,
+	             sizeof(mlod_mat4) * (size_t)c.skeleton.skins[0].joint_count) == 0);
+	mlod_character_free(&c2);
+	mlod_gltf_free(again);
+	mlod_gltf_free(doc);
+	/* rest TRS: the robot writes 15 digits (style 2); dropped then filled,
+	 * the document's text is the same */
+	doc = read_robot();
+	CHECK(doc != NULL);
+	int dropped_parts = 0, other = 0;
+	for (int j = 0; j < c.skeleton.joint_count; j++) {
+		int d = 0, d0 = 0;
+		CHECK_OK(mlod_gltf_drop_node_trs(doc, c.skeleton.joints[j].node, &c.skeleton.joints[j].rest, 0, 0, &d0, &terr));
+		CHECK_OK(mlod_gltf_drop_node_trs(doc, c.skeleton.joints[j].node, &c.skeleton.joints[j].rest, 2, 1, &d, &terr));
+		dropped_parts += (d & 1) + (d >> 1 & 1) + (d >> 2 & 1);
+		other += (d0 & 1) + (d0 >> 1 & 1) + (d0 >> 2 & 1);
+	}
+	CHECK_MSG(dropped_parts > other, "style 2 drops %d parts, style 0 %d", dropped_parts, other);
+	char *stripped = gltf_text(doc);
+	CHECK(stripped && before && strlen(stripped) < strlen(before));
+	for (int j = 0; j < c.skeleton.joint_count; j++)
+		CHECK_OK(mlod_gltf_fill_node_trs(doc, c.skeleton.joints[j].node, &c.skeleton.joints[j].rest, 2, &terr));
+	char *after = gltf_text(doc);
+	CHECK(after && before && strcmp(after, before) == 0);
+	free(stripped);
+	free(after);
+	free(before);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+}
+
 /* ---------------------------------------------------------------- */
 /* Adding to a document                                              */
 /* ---------------------------------------------------------------- */
@@ -1275,6 +1350,7 @@ int main(void)
 	RUN(gltf_text_roundtrip);
 	RUN(images_kept);
 	RUN(extras);
+	RUN(pack_doc_edits);
 	RUN(add_objects);
 	RUN(from_character);
 	RUN(robot_via_character);

@@ -109,6 +109,69 @@ TEST(octahedral_within_bound)
 	(void)worst; /* 4.26e-05 rad measured over these 200008 normals */
 }
 
+/* mlod(5)'s bound at b bits, computed here from the formula: half a
+ * lattice step, 2^(15 - b) / 32767, stretched sqrt(18) times. */
+static double oct_formula(int b)
+{
+	return 3.0 * sqrt(2.0) * ldexp(1.0, 15 - b) / 32767.0;
+}
+
+TEST(octahedral_bits_within_bound)
+{
+	for (int b = MLOD_PACK_NORMAL_BITS_MIN; b <= 16; b++) {
+		double worst = 0.0, bound = oct_formula(b) + 2e-6;
+		int step = 1 << (16 - b), off_lattice = 0;
+		CHECK_NEAR(mlod_pack_oct_bound(b), bound, 1e-12);
+		for (int c = 0; c < 100000; c++) {
+			float n[3], d[3], l;
+			int16_t q[2];
+			do {
+				for (int a = 0; a < 3; a++)
+					n[a] = 2.0f * frand() - 1.0f;
+				l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+			} while (l < 1e-3f || l > 1.0f);
+			for (int a = 0; a < 3; a++)
+				n[a] /= l;
+			mlod_pack_oct_encode_bits(n, b, q);
+			mlod_pack_oct_decode(q, d);
+			double e = angle(n, d);
+			worst = e > worst ? e : worst;
+			CHECK_MSG(e <= bound, "%d bits: (%g %g %g): %g rad, bound %g", b, n[0], n[1], n[2], e, bound);
+			for (int a = 0; a < 2; a++) /* on the lattice: a multiple of the step, or an end */
+				off_lattice += q[a] % step != 0 && q[a] != 32767 && q[a] != -32767;
+		}
+		printf("# octahedral %d bits: worst %.3g rad, bound %.3g\n", b, worst, bound);
+		CHECK_MSG(off_lattice == 0, "%d bits: %d codes off the lattice", b, off_lattice);
+		/* the bound is not loose: the worst case reaches most of it */
+		CHECK_MSG(worst > 0.5 * oct_formula(b), "%d bits: worst %g of bound %g", b, worst, bound);
+		if (b == 16) {
+			int16_t q16[2], qb[2];
+			float n[3] = {0.3f, -0.5f, 0.81240384f};
+			mlod_pack_oct_encode(n, q16);
+			mlod_pack_oct_encode_bits(n, 16, qb);
+			CHECK(q16[0] == qb[0] && q16[1] == qb[1]);
+		}
+	}
+}
+
+TEST(range_bits_within_half_a_step)
+{
+	for (int b = 8; b <= 16; b++)
+		for (int c = 0; c < 20000; c++) {
+			float lo = (frand() - 0.5f) * 200.0f, ext = frand() * 10.0f, hi = lo + ext;
+			float v = c % 97 == 0 ? lo : c % 89 == 0 ? hi : lo + frand() * ext;
+			v = v > hi ? hi : v;
+			float scale = mlod_pack_range_scale_bits(lo, hi, b);
+			double want = ((double)hi - lo) / (ldexp(1.0, b) - 1.0); /* mlod(5): (max - min) / (2^b - 1) */
+			CHECK_NEAR(scale, want, want * 1e-6);
+			uint16_t q = mlod_pack_qu16(v, lo, scale);
+			CHECK_MSG(q <= (1u << b) - 1, "%d bits: q %u", b, q);
+			float back = lo + (float)q * scale;
+			double tol = 0.5 * want + 4.0 * 1.2e-7 * (fabs(lo) + fabs(hi));
+			CHECK_MSG(fabs(back - v) <= tol, "%d bits: v %.9g: %.9g (step %g)", b, v, back, want);
+		}
+}
+
 TEST(switch_distance_one_pixel)
 {
 	const double pi = 3.14159265358979323846;
@@ -220,6 +283,15 @@ TEST(pack_mesh_streams)
 	const mlod_primitive *pr = &c.meshes[c.instances[0].mesh].primitives[0];
 	CHECK(part->vertex_count == (uint32_t)pr->vertex_count && part->index_count == (uint32_t)pr->index_count);
 	CHECK(part->flags & MLOD_PART_SKINNED);
+	/* the part's box over 2^position_bits - 1 steps (mlod(5)) */
+	for (int a = 0; a < 3; a++) {
+		float lo = INFINITY, hi = -INFINITY;
+		for (int u = 0; u < pr->vertex_count; u++)
+			lo = fminf(lo, pr->positions[3 * u + a]), hi = fmaxf(hi, pr->positions[3 * u + a]);
+		double want = ((double)hi - lo) / (ldexp(1.0, opt.position_bits) - 1.0);
+		CHECK(part->pos_min[a] == lo);
+		CHECK_NEAR(part->pos_scale[a], want, want * 1e-6);
+	}
 	uint16_t *pos = (uint16_t *)stream(mesh, MLOD_STREAM_POSQ, 0, &cnt, &esz);
 	int16_t *nrm = (int16_t *)stream(mesh, MLOD_STREAM_NRMQ, 0, &cnt, &esz);
 	uint8_t *wgt = stream(mesh, MLOD_STREAM_WGT8, 0, &cnt, &esz);
@@ -254,10 +326,11 @@ TEST(pack_mesh_streams)
 		for (int a = 0; a < 3; a++) {
 			float back = part->pos_min[a] + (float)pos[4 * v + a] * part->pos_scale[a];
 			CHECK_NEAR(back, pr->positions[3 * u + a], 0.5 * part->pos_scale[a] + 1e-5);
+			CHECK(pos[4 * v + a] < 1u << opt.position_bits);
 		}
 		float d[3];
 		mlod_pack_oct_decode(nrm + 2 * v, d);
-		CHECK(angle(d, pr->normals + 3 * u) <= MLOD_PACK_OCT_BOUND);
+		CHECK(angle(d, pr->normals + 3 * u) <= oct_formula(opt.normal_bits) + 2e-6);
 		CHECK(wgt[4 * v] + wgt[4 * v + 1] + wgt[4 * v + 2] + wgt[4 * v + 3] == 255);
 		/* the weight on each joint is within a unorm8 step of the input's */
 		for (int t = 0; t < 4; t++) {
@@ -668,6 +741,8 @@ int main(void)
 	RUN(weights_sum_to_255);
 	RUN(u16_within_half_a_step);
 	RUN(octahedral_within_bound);
+	RUN(octahedral_bits_within_bound);
+	RUN(range_bits_within_half_a_step);
 	RUN(switch_distance_one_pixel);
 	RUN(pack_mesh_streams);
 	RUN(pack_palette_is_fold);

@@ -7,9 +7,11 @@
  *              inverse binds, materials of the primitives, clip key times
  *              and values (the reader's ROTQ values are exact: the writer
  *              uses it only for values on the int16 lattice), index lists
- *   quantised  (mlod(5)) positions within half a step of 16 bits of the
- *              part's box per axis, normals within MLOD_PACK_OCT_BOUND
- *              radians, UVs within half a step of 16 bits of their box,
+ *   quantised  (mlod(5)) positions within half a step of position_bits
+ *              of the part's box per axis, normals within
+ *              3 sqrt(2) 2^(15 - normal_bits) / 32767 radians, UVs within
+ *              half a step of uv_bits of their box (the defaults, and
+ *              tubeman at 16 and at the smallest bits too),
  *              weights (the 4 largest influences, renormalised) within
  *              1/255 each
  *
@@ -19,6 +21,20 @@
 #include "test.h"
 
 static double worst_pos_ratio, worst_pos_err, worst_nrm, worst_uv_ratio, worst_w;
+/* The writer's bits (mlod_pack_options) for the pack being checked. */
+static int pos_bits = 16, nrm_bits = 16, uv_bits = 16;
+
+/* mlod(5) QUANTISATION, computed here: half a step of 2^bits - 1 over
+ * [lo, hi], with f32 slack; the octahedral angle at nrm_bits. */
+static double half_step(float lo, float hi, int bits)
+{
+	return ((double)hi - lo) / (ldexp(1.0, bits) - 1.0) / 2 * (1 + 1e-4) + 1e-6 * (fabs(lo) + fabs(hi));
+}
+
+static double oct_bound(void)
+{
+	return 3.0 * sqrt(2.0) * ldexp(1.0, 15 - nrm_bits) / 32767.0 + 2e-6;
+}
 
 static const mlod_instance *instance_of_node(const mlod_character *c, int node)
 {
@@ -45,7 +61,7 @@ static const mlod_channel *channel_of(const mlod_clip *k, int joint, mlod_path p
 }
 
 /* Checks one primitive; returns a message or NULL. */
-/* Positions quantised on the writer's grid for a part (its box, 16 bits). */
+/* Positions quantised on the writer's grid for a part (its box, pos_bits). */
 typedef struct qgrid {
 	float lo[3], scale[3];
 } qgrid;
@@ -61,7 +77,7 @@ static void qgrid_make(qgrid *g, const mlod_primitive *a)
 			hi[d] = fmaxf(hi[d], a->positions[3 * v + d]);
 		}
 	for (int d = 0; d < 3; d++)
-		g->scale[d] = mlod_pack_range_scale(g->lo[d], hi[d]);
+		g->scale[d] = mlod_pack_range_scale_bits(g->lo[d], hi[d], pos_bits);
 }
 
 static void qpos(const qgrid *g, const float *p, long *out)
@@ -244,7 +260,7 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 			hi[d] = fmaxf(hi[d], a->positions[3 * v + d]);
 		}
 	for (int d = 0; d < 3; d++) {
-		double bound = (double)mlod_pack_range_scale(lo[d], hi[d]) / 2 * (1 + 1e-4) + 1e-6 * (fabs(lo[d]) + fabs(hi[d]));
+		double bound = half_step(lo[d], hi[d], pos_bits);
 		for (int v = 0; v < n; v++) {
 			double e = fabs((double)a->positions[3 * v + d] - b->positions[3 * v + d]);
 			if (e > worst_pos_err)
@@ -272,7 +288,7 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 		double ang = atan2(sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]), dot);
 		if (ang > worst_nrm)
 			worst_nrm = ang;
-		if (ang > MLOD_PACK_OCT_BOUND + 1e-6) {
+		if (ang > oct_bound()) {
 			snprintf(msg, cap, "vertex %d: normal off by %g rad (%.9g %.9g %.9g, unpacked %.9g %.9g %.9g)", v, ang, x[0], x[1], x[2], y[0], y[1], y[2]);
 			return permuted_free(&pa), msg;
 		}
@@ -289,7 +305,7 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 				ul = fminf(ul, a->uvs[s][2 * v + d]);
 				uh = fmaxf(uh, a->uvs[s][2 * v + d]);
 			}
-			double bound = (double)mlod_pack_range_scale(ul, uh) / 2 * (1 + 1e-4) + 1e-6 * (fabs(ul) + fabs(uh));
+			double bound = half_step(ul, uh, uv_bits);
 			for (int v = 0; v < n; v++) {
 				double e = fabs((double)a->uvs[s][2 * v + d] - b->uvs[s][2 * v + d]);
 				if (bound > 0 && e / bound > worst_uv_ratio)
@@ -483,19 +499,171 @@ done:
 	return fail;
 }
 
-static void sample(const char *path)
+static void sample_bits(const char *path, int pb, int nb, int ub)
 {
 	char msg[1024];
 	mlod_pack_options opt;
 	mlod_pack_options_default(&opt);
+	if (pb)
+		opt.position_bits = pb, opt.normal_bits = nb, opt.uv_bits = ub;
+	pos_bits = opt.position_bits, nrm_bits = opt.normal_bits, uv_bits = opt.uv_bits;
 	worst_pos_ratio = worst_pos_err = worst_nrm = worst_uv_ratio = worst_w = 0;
 	const char *why = round_trip(path, &opt, msg, sizeof msg - 64);
-	fprintf(stderr, "%s: max position error %.3g (%.3f of the half-step bound), normal %.3g rad, uv %.3f of bound, "
-	        "weight %.4f\n", path, worst_pos_err, worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w);
+	fprintf(stderr, "%s (bits %d %d %d): max position error %.3g (%.3f of the half-step bound), normal %.3g rad, uv %.3f of bound, "
+	        "weight %.4f\n", path, pos_bits, nrm_bits, uv_bits, worst_pos_err, worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w);
 	CHECK_MSG(!why, "%.200s: %.700s", path, why);
 }
 
+static void sample(const char *path)
+{
+	sample_bits(path, 0, 0, 0);
+}
+
+/* Posed positions (mlod(5) QUANTISATION): at each pose, the unpacked
+ * level 0 (mlod_posed_error, which takes the full character's diagonal
+ * in that pose) is within the largest over the input's vertices of
+ *   s |pos_scale| / 2 + (2 d + 4 * 3/1020) r
+ * where s bounds the scale of the vertex's skinning matrices (the
+ * Frobenius norm of their 3x3 part), d is the weight the pack drops past
+ * the 4 largest influences, and r the largest distance between the
+ * vertex carried by two of its joints; computed here, skinning the input
+ * with the pose's matrices. Level 0's own measured error is 0. */
+static double frob3(const mlod_mat4 *m)
+{
+	double f = 0;
+	for (int c = 0; c < 3; c++)
+		for (int r = 0; r < 3; r++)
+			f += (double)m->m[4 * c + r] * m->m[4 * c + r];
+	return sqrt(f);
+}
+
+static double pose_bound(const mlod_character *c, const mlod_mat4 *world, int bits)
+{
+	double bound = 0;
+	const mlod_skeleton *sk = &c->skeleton;
+	for (int i = 0; i < c->instance_count; i++) {
+		const mlod_instance *in = &c->instances[i];
+		const mlod_skin *skin = in->skin >= 0 ? &sk->skins[in->skin] : NULL;
+		mlod_mat4 rigid = in->joint >= 0 ? mlod_mat4_mul(&world[in->joint], &in->offset) : in->offset;
+		const mlod_mesh *m = &c->meshes[in->mesh];
+		for (int q = 0; q < m->primitive_count; q++) {
+			const mlod_primitive *p = &m->primitives[q];
+			if (p->mode != 4 || p->vertex_count <= 0)
+				continue;
+			double hd = 0;
+			for (int a = 0; a < 3; a++) {
+				float lo = INFINITY, hi = -INFINITY;
+				for (int v = 0; v < p->vertex_count; v++)
+					lo = fminf(lo, p->positions[3 * v + a]), hi = fmaxf(hi, p->positions[3 * v + a]);
+				double step = ((double)hi - lo) / (ldexp(1.0, bits) - 1.0);
+				hd += step * step;
+			}
+			hd = sqrt(hd) / 2;
+			for (int v = 0; v < p->vertex_count; v++) {
+				mlod_v3 pos = {p->positions[3 * v], p->positions[3 * v + 1], p->positions[3 * v + 2]};
+				if (!skin || p->weight_set_count == 0) {
+					bound = fmax(bound, frob3(&rigid) * hd);
+					continue;
+				}
+				mlod_v3 carried[4 * MLOD_MAX_SETS];
+				float w[4 * MLOD_MAX_SETS];
+				double s = 0, total = 0;
+				int n = 0;
+				for (int set = 0; set < p->weight_set_count; set++)
+					for (int k = 0; k < 4; k++) {
+						float wt = p->weights[set][4 * v + k];
+						int jt = p->joints[set][4 * v + k];
+						if (!(wt > 0) || jt >= skin->joint_count)
+							continue;
+						mlod_mat4 J = mlod_mat4_mul(&world[skin->joints[jt]], &skin->inverse_bind[jt]);
+						s = fmax(s, frob3(&J));
+						carried[n] = mlod_mat4_point(&J, pos);
+						w[n++] = wt;
+						total += wt;
+					}
+				for (int a = 0; a < n; a++) /* the 4 largest first */
+					for (int b = a + 1; b < n; b++)
+						if (w[b] > w[a]) {
+							float t = w[a];
+							w[a] = w[b], w[b] = t;
+						}
+				double dropped = 0, r = 0;
+				for (int a = 4; a < n; a++)
+					dropped += w[a] / total;
+				for (int a = 0; a < n; a++)
+					for (int b = a + 1; b < n; b++) {
+						double dx = carried[a].x - carried[b].x, dy = carried[a].y - carried[b].y,
+						       dz = carried[a].z - carried[b].z;
+						r = fmax(r, sqrt(dx * dx + dy * dy + dz * dz));
+					}
+				bound = fmax(bound, s * hd + (2 * dropped + 4 * 3.0 / 1020) * r);
+			}
+		}
+	}
+	return bound;
+}
+
+static void posed_level0(const char *path)
+{
+	size_t n = 0, pack_size = 0, glb_size = 0;
+	void *in = test_read_file(path, &n), *pack = NULL, *glb = NULL;
+	mlod_gltf *doc = NULL, *un = NULL, *doc2 = NULL;
+	mlod_character c, c2;
+	mlod_format fmt, fmt2;
+	mlod_pack_options opt;
+	mlod_pose_set poses = {0};
+	memset(&c, 0, sizeof c);
+	memset(&c2, 0, sizeof c2);
+	mlod_pack_options_default(&opt);
+	opt.no_skeleton_levels = opt.no_motion_levels = 1;
+	opt.ratio_count = 1, opt.ratios[0] = 0.5;
+	CHECK(in);
+	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+	CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &pack, &pack_size, NULL, &terr));
+	CHECK_OK(mlod_pack_unpack(pack, pack_size, &un, &terr));
+	CHECK_OK(mlod_gltf_write(un, 1, &glb, &glb_size, &terr));
+	CHECK_OK(mlod_load(glb, glb_size, NULL, &doc2, &c2, &fmt2, &terr));
+	CHECK_OK(mlod_pose_set_make(&c, 1, 8, 4, 7, 0.5f, &poses, &terr));
+	double worst = 0, worst_err = 0;
+	for (int k = 0; k < poses.count; k++) {
+		const mlod_mat4 *world = poses.world + (size_t)k * (size_t)poses.joint_count;
+		mlod_pose_set one = {1, poses.joint_count, (mlod_mat4 *)world, 0};
+		mlod_deviation d;
+		CHECK_OK(mlod_posed_error(&c, &c2, &one, &d, &terr));
+		double got = d.max / 100 * d.scale, bound = pose_bound(&c, world, opt.position_bits);
+		CHECK_MSG(got <= bound + 1e-6 * d.scale, "%s pose %d: posed error %g, bound %g", path, k, got, bound);
+		worst = fmax(worst, bound > 0 ? got / bound : 0);
+		worst_err = fmax(worst_err, d.max);
+	}
+	fprintf(stderr, "%s: level 0 posed, %d poses: max %.5f%% of the diagonal, %.3f of the bound at worst\n", path,
+	        poses.count, worst_err, worst);
+	mlod_pose_set_free(&poses);
+	mlod_character_free(&c);
+	mlod_character_free(&c2);
+	mlod_gltf_free(doc);
+	mlod_gltf_free(doc2);
+	mlod_gltf_free(un);
+	mlod_free(pack);
+	mlod_free(glb);
+	free(in);
+}
+
+TEST(posed_tubeman) { posed_level0("samples/tubeman.glb"); }
+TEST(posed_robot) { posed_level0("samples/RobotExpressive.glb"); }
+TEST(posed_shared_ely)
+{
+	NEED_SHARED();
+	char path[1024];
+	snprintf(path, sizeof path, "%s/Ely.glb", getenv("MLOD_SHARED_DATA"));
+	posed_level0(path);
+}
+
 TEST(round_trip_tubeman) { sample("samples/tubeman.glb"); }
+TEST(round_trip_tubeman_16_bits) { sample_bits("samples/tubeman.glb", 16, 16, 16); }
+TEST(round_trip_tubeman_fewest_bits)
+{
+	sample_bits("samples/tubeman.glb", MLOD_PACK_POSITION_BITS_MIN, MLOD_PACK_NORMAL_BITS_MIN, MLOD_PACK_UV_BITS_MIN);
+}
 TEST(round_trip_robot) { sample("samples/RobotExpressive.glb"); }
 TEST(round_trip_bvh) { sample("samples/cmu_12_01_walk.bvh"); }
 
@@ -511,8 +679,13 @@ TEST(round_trip_shared_ely)
 int main(void)
 {
 	RUN(round_trip_tubeman);
+	RUN(round_trip_tubeman_16_bits);
+	RUN(round_trip_tubeman_fewest_bits);
 	RUN(round_trip_robot);
 	RUN(round_trip_bvh);
 	RUN(round_trip_shared_ely);
+	RUN(posed_tubeman);
+	RUN(posed_robot);
+	RUN(posed_shared_ely);
 	TEST_EXIT();
 }

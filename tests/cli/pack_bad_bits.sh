@@ -1,0 +1,1 @@
+"$BIN/mlod-pack" --normal-bits 5 "$ROOT/samples/tubeman.glb"
