@@ -247,7 +247,7 @@ static mlod_result cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uin
 	c->codec = type == MLOD_CHUNK_INFO || type == MLOD_CHUNK_DOC ? MLOD_CODEC_NONE : (uint8_t)codec;
 	c->level = (uint16_t)level;
 	c->item = (uint16_t)item;
-	c->error = level > 0 ? error : 0.0f;
+	c->error = level > 0 || type == MLOD_CHUNK_MOTION ? error : 0.0f; /* ANIM level 0: against the input clip */
 	c->distance = level > 0 ? mlod_pack_switch_distance(error) : 0.0f;
 	c->data = b.p;
 	c->size = b.n;
