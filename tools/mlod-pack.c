@@ -124,6 +124,8 @@ static void report_table(FILE *rf, const char *input, const mlod_pack_stats *st,
 		        (unsigned long long)ls[i]->stored, (unsigned long long)ls[i]->raw, 1e3 * ls[i]->seconds);
 		for (int k = 1; k < ls[i]->levels; k++)
 			fprintf(rf, " %.4g", ls[i]->errors[k]);
+		if (ls[i]->levels > 0 && ls[i]->errors[0] > 0)
+			fprintf(rf, " (level 0: %.4g)", ls[i]->errors[0]);
 		fputc('\n', rf);
 	}
 	fprintf(rf, "# total %llu bytes in %u chunks (info %llu, doc %llu); first drawable level: %u bytes\n",
@@ -148,7 +150,7 @@ static void report_json(FILE *rf, const char *input, const mlod_pack_stats *st, 
 		        (unsigned long long)ls[i]->raw, 1e3 * ls[i]->seconds);
 		for (int k = 1; k < ls[i]->levels; k++)
 			fprintf(rf, "%s%.9g", k > 1 ? ", " : "", ls[i]->errors[k]);
-		fprintf(rf, "]}%s\n", i < 2 ? "," : "");
+		fprintf(rf, "], \"level0_error\": %.9g}%s\n", ls[i]->errors[0], i < 2 ? "," : "");
 	}
 	fprintf(rf, "  },\n  \"total\": %llu,\n  \"chunks\": %u,\n  \"info_bytes\": %llu,\n  \"doc_bytes\": %llu,\n",
 	        (unsigned long long)st->total, st->chunks, (unsigned long long)st->info_bytes,
