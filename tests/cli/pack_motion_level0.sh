@@ -2,7 +2,8 @@
 # height, its TOC error (the joint position error against the clip as
 # read) above 0 and within the bound, fewer bytes than --lossless-motion
 # (error 0); --motion-level0-error in % and in scene units; the coarser
-# levels the same whatever level 0 gets; piped and direct packs agree
+# levels the same whatever level 0 gets; --report=json's level0_error is
+# the TOC's; piped and direct packs agree
 # with --lossless-motion too. test_unpack measures the unpacked level 0.
 set -e
 w="$ROOT/samples/cmu_12_01_walk.bvh"
@@ -11,6 +12,8 @@ w="$ROOT/samples/cmu_12_01_walk.bvh"
 "$BIN/mlod-pack" --motion-level0-error 0.01% "$w" -o p01.mlod
 "$BIN/mlod-pack" --motion-level0-error 0.1 "$w" -o abs.mlod
 for n in def ll p01 abs; do "$BIN/mlod-pack" --info $n.mlod --json > $n.json; done
+# --report=json states level 0's error as the TOC does
+"$BIN/mlod-pack" --report=json "$w" > report.json
 node - <<'JS'
 const fs = require('fs');
 const j = (n) => JSON.parse(fs.readFileSync(`${n}.json`, 'utf8'));
@@ -24,6 +27,8 @@ if (!(l0(p01).error > 0 && l0(p01).error <= 0.0001 * h)) throw new Error(`0.01%:
 if (!(l0(abs).error > 0 && l0(abs).error <= 0.1)) throw new Error(`0.1: error ${l0(abs).error}`);
 if (!(l0(abs).stored < l0(d).stored && l0(d).stored < l0(p01).stored && l0(p01).stored < l0(ll).stored))
 	throw new Error(`level 0 bytes: ${[abs, d, p01, ll].map((p) => l0(p).stored)}`);
+const rep = JSON.parse(fs.readFileSync('report.json', 'utf8')).layers.motion.level0_error;
+if (Math.abs(rep - l0(d).error) > 1e-6 * h) throw new Error(`report level0_error ${rep}, TOC ${l0(d).error}`);
 for (const p of [ll, p01, abs])
 	if (coarse(p) !== coarse(d)) throw new Error('the coarser levels changed with level 0');
 JS
