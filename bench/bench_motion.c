@@ -30,7 +30,10 @@
  *                                        Sites are not points here. FILE may
  *                                        be a gltfpack output or an unpacked
  *                                        pack (mlod-pack -x), whose level 0
- *                                        carries the clip's own name
+ *                                        carries the clip's own name; with
+ *                                        POINTERR_DEBUG=E in the environment,
+ *                                        each error above E (clip, time,
+ *                                        joint) goes to stderr
  *
  * Prints Markdown tables. Times are medians of repeated runs. Clips and
  * joints of a peer's output are matched to the original by name.
