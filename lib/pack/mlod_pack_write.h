@@ -19,6 +19,11 @@
  *             else per clip and bound the frames and the keys methods of
  *             lib/motion, the one with fewer bytes (mlod-motion's auto)
  *
+ * Motion level 0, piped or not, is each full clip within
+ * motion_level0_error (the same methods, a level of its own: the coarser
+ * levels are made from the clip as read either way), or with
+ * lossless_motion the clip as read.
+ *
  * A piped document holds the level skins and level animations beside the
  * full ones: the writer packs the character's full skins (those no record
  * or level node names as a level's) and full clips (those without a motion
