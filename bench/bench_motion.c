@@ -20,6 +20,20 @@
  *                                        tree) at 0.2%, 1% and 3% of the height
  *   bench_motion speed FILE...           time to build the default levels
  *                                        (0.2%, 1%, 3%): clips/s and frames/s
+ *   bench_motion pointerr ORIG LABEL=FILE...
+ *                                        per clip of ORIG, the point error
+ *                                        (mlod_motion_point_error, radius the
+ *                                        point distance mlod-motion uses) of
+ *                                        FILE's clip of that name against it,
+ *                                        every joint (by name) at ORIG's common
+ *                                        timeline frames and midpoints; End
+ *                                        Sites are not points here. FILE may
+ *                                        be a gltfpack output or an unpacked
+ *                                        pack (mlod-pack -x), whose level 0
+ *                                        carries the clip's own name; with
+ *                                        POINTERR_DEBUG=E in the environment,
+ *                                        each error above E (clip, time,
+ *                                        joint) goes to stderr
  *
  * Prints Markdown tables. Times are medians of repeated runs. Clips and
  * joints of a peer's output are matched to the original by name.
@@ -652,6 +666,95 @@ static int cmd_convert(int argc, char **argv)
 	return rc;
 }
 
+/* ---------------------------------------------------------------- */
+/* Point error of another file's clips, sampled independently         */
+/* ---------------------------------------------------------------- */
+
+static int cmp_double(const void *x, const void *y)
+{
+	double a = *(const double *)x, b = *(const double *)y;
+	return (a > b) - (a < b);
+}
+
+static int cmd_pointerr(int argc, char **argv)
+{
+	mlod_character a;
+	double h, pd;
+	if (argc < 2 || load_sized(argv[0], &a, &h, &pd) != 0)
+		return 1;
+	printf("%s: %d clips, %d joints, height %.4g, point distance %.4g. Point error per clip at the frames and "
+	       "midpoints: max and mean over joints and samples, p99 of each sample's largest; scene units and %% of "
+	       "the height.\n\n",
+	       base_name(argv[0]), a.clip_count, a.skeleton.joint_count, h, pd);
+	printf("| file | clip | samples | max | max %% | p99 %% | mean %% |\n|---|---|---:|---:|---:|---:|---:|\n");
+	int rc = 0;
+	for (int p = 1; p < argc; p++) {
+		const char *eq = strchr(argv[p], '=');
+		mlod_character b;
+		if (!eq || load(eq + 1, &b, NULL) != 0) {
+			rc = 1;
+			continue;
+		}
+		int label_len = (int)(eq - argv[p]);
+		int *map = joint_map(&a, &b);
+		int nj = a.skeleton.joint_count, njb = b.skeleton.joint_count;
+		mlod_trs *la = malloc(sizeof *la * (size_t)nj), *lb = malloc(sizeof *lb * (size_t)njb);
+		mlod_mat4 *wa = malloc(sizeof *wa * (size_t)nj), *wb = malloc(sizeof *wb * (size_t)njb);
+		double all_max = 0;
+		for (int k = 0; k < a.clip_count; k++) {
+			int kb = find_clip(&b, a.clips[k].name);
+			mlod_motion_options mo = {0};
+			mlod_clip common;
+			mlod_error err = {0};
+			if (kb < 0 || mlod_motion_common_clip(&a.clips[k], &mo, &common, NULL, &err) != MLOD_OK) {
+				printf("| %.*s | %s | - | - | - | - | - |\n", label_len, argv[p], a.clips[k].name);
+				rc = 1;
+				continue;
+			}
+			int frames = common.channels[0].key_count, n = (frames - 1) * 2 + 1;
+			float *t = malloc(sizeof *t * (size_t)n);
+			double *peak = malloc(sizeof *peak * (size_t)n), mx = 0, sum = 0;
+			long cnt = 0;
+			mlod_motion_sample_times(common.channels[0].times, frames, 2, t);
+			for (int i = 0; i < n; i++) {
+				mlod_pose_rest(&a.skeleton, la);
+				mlod_clip_sample(&a.clips[k], t[i], la);
+				mlod_pose_world(&a.skeleton, la, wa);
+				mlod_pose_rest(&b.skeleton, lb);
+				mlod_clip_sample(&b.clips[kb], t[i], lb);
+				mlod_pose_world(&b.skeleton, lb, wb);
+				peak[i] = 0;
+				for (int j = 0; j < nj; j++) {
+					if (map[j] < 0)
+						continue;
+					double e = mlod_motion_point_error(&wa[j], &wb[map[j]], pd);
+					if (getenv("POINTERR_DEBUG") && e > atof(getenv("POINTERR_DEBUG")))
+						fprintf(stderr, "clip %s t %.5f joint %s err %g\n", a.clips[k].name, t[i],
+						        a.skeleton.joints[j].name, e);
+					peak[i] = e > peak[i] ? e : peak[i];
+					sum += e;
+					cnt++;
+				}
+				mx = peak[i] > mx ? peak[i] : mx;
+			}
+			qsort(peak, (size_t)n, sizeof *peak, cmp_double);
+			double p99 = peak[(size_t)floor(0.99 * (n - 1))];
+			printf("| %.*s | %s | %d | %.6g | %.4f | %.4f | %.5f |\n", label_len, argv[p], a.clips[k].name, n, mx,
+			       100.0 * mx / h, 100.0 * p99 / h, cnt ? 100.0 * sum / (double)cnt / h : 0.0);
+			all_max = mx > all_max ? mx : all_max;
+			free(t);
+			free(peak);
+			mlod_clip_free(&common);
+		}
+		printf("| %.*s | all | | %.6g | %.4f | | |\n", label_len, argv[p], all_max, 100.0 * all_max / h);
+		free(la), free(lb), free(wa), free(wb), free(map);
+		mlod_character_free(&b);
+	}
+	printf("\n");
+	mlod_character_free(&a);
+	return rc;
+}
+
 int main(int argc, char **argv)
 {
 	if (argc >= 2 && strcmp(argv[1], "convert") == 0)
@@ -666,7 +769,9 @@ int main(int argc, char **argv)
 		return cmd_speed(argc - 2, argv + 2);
 	if (argc >= 2 && strcmp(argv[1], "between") == 0)
 		return cmd_between(argc - 2, argv + 2);
+	if (argc >= 2 && strcmp(argv[1], "pointerr") == 0)
+		return cmd_pointerr(argc - 2, argv + 2);
 	fprintf(stderr, "usage: bench_motion convert IN OUT.glb | peers ORIG LABEL=FILE[@KEYS]... | precision FILE... | "
-	                "methods FILE... | speed FILE... | between FILE...\n");
+	                "methods FILE... | speed FILE... | between FILE... | pointerr ORIG LABEL=FILE...\n");
 	return 1;
 }

@@ -28,6 +28,25 @@ else
 	echo
 fi
 
+echo "## Motion layer: pack level 0 against gltfpack -cc (point error, mlod-pack's --motion-level0-error)"
+echo
+if [ -f tests/node/node_modules/gltfpack/cli.js ] && [ -x "$BUILD/bin/mlod-pack" ]; then
+	echo "gltfpack -cc's output made readable by gltfpack -noq -af 0 (no resampling; it adds its own 16-bit"
+	echo "rounding, shown as 'noise floor': gltfpack -noq -af 0 of the input); mlod: mlod-pack at its default"
+	echo "level-0 bound, unpacked (mlod-pack -x). Both sampled at the input's frames and midpoints."
+	echo
+	for f in samples/tubeman.glb samples/RobotExpressive.glb samples/cmu_12_01_walk.bvh; do
+		b=$(basename "$f"); b=${b%.*}; glb=$f
+		case $f in *.bvh) glb=$tmp/$b.glb; "$BUILD/bin/mlod-label" -o "$glb" "$f" 2> /dev/null ;; esac
+		$gltfpack -i "$glb" -o "$tmp/$b-cc.glb" -cc > /dev/null
+		$gltfpack -i "$tmp/$b-cc.glb" -o "$tmp/$b-ccd.glb" -noq -af 0 > /dev/null 2>&1
+		$gltfpack -i "$glb" -o "$tmp/$b-floor.glb" -noq -af 0 > /dev/null 2>&1
+		"$BUILD/bin/mlod-pack" "$f" -o "$tmp/$b.mlod" 2> /dev/null
+		"$BUILD/bin/mlod-pack" -x "$tmp/$b.mlod" -o "$tmp/$b.x.glb"
+		"$bench" pointerr "$f" "gltfpack -cc=$tmp/$b-ccd.glb" "noise floor=$tmp/$b-floor.glb" "mlod-pack level 0=$tmp/$b.x.glb"
+	done
+fi
+
 echo "## Motion layer: value precision (keys method; the share of each bound left to rounding)"
 echo
 # shellcheck disable=SC2086

@@ -48,6 +48,9 @@ static const char usage_text[] =
 	"motion levels (mlod-motion's --max-error):\n"
 	"      --motion-max-error LIST   one level per bound: E in scene units or E%%\n"
 	"                             of the skeleton height (default 0.2%%,1%%,3%%)\n"
+	"      --motion-level0-error E   level 0: the clips within E (scene units, or\n"
+	"                             E%% of the height; default %g%%), keys reduced\n"
+	"      --lossless-motion      level 0: every key of the clips as read\n"
 	"      --no-skeleton-levels, --no-mesh-levels, --no-motion-levels\n"
 	"                             pack that layer at level 0 only\n"
 	"      --info FILE            print the pack's chunks (layer, level, clip,\n"
@@ -108,6 +111,17 @@ static int parse_bounds(const char *value, mlod_pack_options *opt)
 	return n;
 }
 
+/* "0.05%" or "0.001". */
+static void parse_level0(const char *value, mlod_pack_options *opt)
+{
+	char tok[64];
+	size_t len = strlen(value);
+	int percent = len > 0 && value[len - 1] == '%';
+	snprintf(tok, sizeof tok, "%.*s", (int)(percent ? len - 1 : len), value);
+	opt->motion_level0_error = tool_parse_double("--motion-level0-error", tok, 1e-12, percent ? 100.0 : 1e12);
+	opt->motion_level0_percent = (unsigned char)percent;
+}
+
 static const char *source(const mlod_pack_layer_stats *l)
 {
 	return l->levels <= 1 ? "-" : l->from_input ? "input" : "computed";
@@ -126,6 +140,8 @@ static void report_table(FILE *rf, const char *input, const mlod_pack_stats *st,
 		        (unsigned long long)ls[i]->stored, (unsigned long long)ls[i]->raw, 1e3 * ls[i]->seconds);
 		for (int k = 1; k < ls[i]->levels; k++)
 			fprintf(rf, " %.4g", ls[i]->errors[k]);
+		if (ls[i]->levels > 0 && ls[i]->errors[0] > 0)
+			fprintf(rf, " (level 0: %.4g)", ls[i]->errors[0]);
 		fputc('\n', rf);
 	}
 	fprintf(rf, "# total %llu bytes in %u chunks (info %llu, doc %llu); first drawable level: %u bytes\n",
@@ -150,7 +166,7 @@ static void report_json(FILE *rf, const char *input, const mlod_pack_stats *st, 
 		        (unsigned long long)ls[i]->raw, 1e3 * ls[i]->seconds);
 		for (int k = 1; k < ls[i]->levels; k++)
 			fprintf(rf, "%s%.9g", k > 1 ? ", " : "", ls[i]->errors[k]);
-		fprintf(rf, "]}%s\n", i < 2 ? "," : "");
+		fprintf(rf, "], \"level0_error\": %.9g}%s\n", ls[i]->errors[0], i < 2 ? "," : "");
 	}
 	fprintf(rf, "  },\n  \"total\": %llu,\n  \"chunks\": %u,\n  \"info_bytes\": %llu,\n  \"doc_bytes\": %llu,\n",
 	        (unsigned long long)st->total, st->chunks, (unsigned long long)st->info_bytes,
@@ -330,7 +346,7 @@ static int pack_extract(const char *path, const char *output)
 int main(int argc, char **argv)
 {
 	enum { OPT_CODEC = 256, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH, OPT_NO_MOTION, OPT_INFO, OPT_JSON,
-	       OPT_POS_BITS, OPT_NRM_BITS, OPT_UV_BITS };
+	       OPT_POS_BITS, OPT_NRM_BITS, OPT_UV_BITS, OPT_LEVEL0_ERR, OPT_LOSSLESS_MOTION };
 	static const struct option longopts[] = {
 		{"output", required_argument, NULL, 'o'},
 		{"report", optional_argument, NULL, 'r'},
@@ -346,6 +362,8 @@ int main(int argc, char **argv)
 		{"no-skeleton-levels", no_argument, NULL, OPT_NO_SKEL},
 		{"no-mesh-levels", no_argument, NULL, OPT_NO_MESH},
 		{"no-motion-levels", no_argument, NULL, OPT_NO_MOTION},
+		{"motion-level0-error", required_argument, NULL, OPT_LEVEL0_ERR},
+		{"lossless-motion", no_argument, NULL, OPT_LOSSLESS_MOTION},
 		{"info", required_argument, NULL, OPT_INFO},
 		{"json", no_argument, NULL, OPT_JSON},
 		{"extract", required_argument, NULL, 'x'},
@@ -392,6 +410,8 @@ int main(int argc, char **argv)
 		case OPT_NO_SKEL: opt.no_skeleton_levels = 1; break;
 		case OPT_NO_MESH: opt.no_mesh_levels = 1; break;
 		case OPT_NO_MOTION: opt.no_motion_levels = 1; break;
+		case OPT_LEVEL0_ERR: parse_level0(optarg, &opt); break;
+		case OPT_LOSSLESS_MOTION: opt.lossless_motion = 1; break;
 		case OPT_INFO: info = optarg; break;
 		case 'x': extract = optarg; break;
 		case 'j': opt.bgm.threads = tool_parse_threads(optarg); break;
@@ -402,7 +422,7 @@ int main(int argc, char **argv)
 			for (size_t i = 0, n = 0; i < sizeof defaults / sizeof *defaults; i++)
 				n += (size_t)snprintf(list + n, sizeof list - n, "%s%g", i ? "," : "", defaults[i]);
 			printf(usage_text, list, MLOD_PACK_POSITION_BITS_DEFAULT, MLOD_PACK_NORMAL_BITS_DEFAULT,
-			       MLOD_PACK_UV_BITS_DEFAULT, MLOD_SKEL_MAX_ERROR_DEFAULT);
+			       MLOD_PACK_UV_BITS_DEFAULT, MLOD_SKEL_MAX_ERROR_DEFAULT, MLOD_PACK_MOTION_LEVEL0_DEFAULT);
 			return 0;
 		}
 		case 'V': tool_version();

@@ -19,6 +19,11 @@
  *             else per clip and bound the frames and the keys methods of
  *             lib/motion, the one with fewer bytes (mlod-motion's auto)
  *
+ * Motion level 0, piped or not, is each full clip within
+ * motion_level0_error (the same methods, a level of its own: the coarser
+ * levels are made from the clip as read either way), or with
+ * lossless_motion the clip as read.
+ *
  * A piped document holds the level skins and level animations beside the
  * full ones: the writer packs the character's full skins (those no record
  * or level node names as a level's) and full clips (those without a motion
@@ -52,6 +57,10 @@ extern "C" {
 #define MLOD_PACK_MAX_MOTION_LEVELS 32
 /* mlod-motion's default bounds: 0.2%, 1% and 3% of the skeleton height. */
 #define MLOD_PACK_MOTION_BOUNDS_DEFAULT 0.2, 1.0, 3.0
+/* Motion level 0's default bound, % of the skeleton height: a quarter of
+ * the finest default level's, below gltfpack -cc's own error on every
+ * sample clip (bench_motion pointerr; mlod-pack(1)). */
+#define MLOD_PACK_MOTION_LEVEL0_DEFAULT 0.05
 
 /* Zero-initialised options are not the defaults: start from
  * mlod_pack_options_default. */
@@ -72,6 +81,11 @@ typedef struct mlod_pack_options {
 	double motion_bounds[MLOD_PACK_MAX_MOTION_LEVELS];
 	unsigned char motion_percent[MLOD_PACK_MAX_MOTION_LEVELS]; /* bound in % of the height, else scene units */
 	double point_distance;       /* 0: 0.1 for glTF, height / 18 for BVH (as mlod-motion) */
+	/* motion level 0 (computed or piped alike): the input clip within this
+	 * point error bound (keys reduced, values rounded), or as read */
+	double motion_level0_error;  /* > 0; 0: as read */
+	unsigned char motion_level0_percent; /* in % of the height, else scene units */
+	int lossless_motion;         /* level 0 as read whatever motion_level0_error says */
 	/* each layer can be left at level 0 alone */
 	int no_skeleton_levels, no_mesh_levels, no_motion_levels;
 	int doc_whole;               /* DOC: the input glb whole, not stripped */

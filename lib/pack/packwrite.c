@@ -247,7 +247,7 @@ static mlod_result cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uin
 	c->codec = type == MLOD_CHUNK_INFO || type == MLOD_CHUNK_DOC ? MLOD_CODEC_NONE : (uint8_t)codec;
 	c->level = (uint16_t)level;
 	c->item = (uint16_t)item;
-	c->error = level > 0 ? error : 0.0f;
+	c->error = level > 0 || type == MLOD_CHUNK_MOTION ? error : 0.0f; /* ANIM level 0: against the input clip */
 	c->distance = level > 0 ? mlod_pack_switch_distance(error) : 0.0f;
 	c->data = b.p;
 	c->size = b.n;
@@ -277,6 +277,8 @@ static uint32_t str_add(strtab *t, const char *s)
 /* ------------------------------------------------------------------ */
 
 struct clip_levels {
+	const mlod_clip *level0;   /* the input clip, or its reduction (motion_level0) */
+	float error0;              /* level 0's joint position error against the input clip */
 	int count;                 /* levels >= 1 */
 	const mlod_clip *clip[MLOD_PACK_MAX_MOTION_LEVELS];
 	float error[MLOD_PACK_MAX_MOTION_LEVELS];
@@ -311,6 +313,7 @@ struct ctx {
 	struct clip_levels *clips;
 	mlod_motion_level *owned_levels;
 	int owned_count;
+	mlod_motion_level *level0_owned; /* per clip; clip.channels NULL where level 0 is the input's */
 	int motion_count;          /* levels >= 1, over all clips */
 };
 
@@ -1245,6 +1248,71 @@ static int double_asc(const void *a, const void *b)
 	return (x > y) - (x < y);
 }
 
+static double motion_point_distance(const struct ctx *x)
+{
+	return x->opt->point_distance > 0.0 ? x->opt->point_distance
+	                                    : mlod_motion_point_distance(&x->v.skeleton, x->format != MLOD_FORMAT_BVH);
+}
+
+/* Level 0 of each clip: the clip as read, or (unless lossless_motion or a
+ * zero bound) the level lib/motion builds from it within the level-0
+ * bound, methods and precision as for the coarser levels (fewer bytes
+ * wins). The same for computed and piped levels, which are made from the
+ * clip as read too. A clip keeps its keys as read when it has fewer than 3
+ * frames, when no level meets the bound (a resampled cubic clip that
+ * deviates more) or when the level would not have fewer key bytes. */
+static mlod_result motion_level0(struct ctx *x)
+{
+	const mlod_character *c = &x->v;
+	for (int q = 0; q < c->clip_count; q++)
+		x->clips[q].level0 = &c->clips[q];
+	double e0 = x->opt->motion_level0_percent ? x->opt->motion_level0_error * x->height / 100.0
+	                                          : x->opt->motion_level0_error;
+	if (c->clip_count == 0 || x->opt->lossless_motion || !(e0 > 0.0))
+		return MLOD_OK;
+	x->level0_owned = calloc((size_t)c->clip_count, sizeof *x->level0_owned);
+	if (!x->level0_owned)
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	mlod_motion_options mo = {0};
+	mo.point_distance = motion_point_distance(x);
+	mlod_result r = MLOD_OK;
+	int kept = 0;
+	for (int q = 0; r == MLOD_OK && q < c->clip_count; q++) {
+		mlod_motion *m[2] = {NULL, NULL};
+		for (int i = 0; r == MLOD_OK && i < 2; i++)
+			r = mlod_motion_create(c, q, &mo, &m[i], x->err);
+		if (r == MLOD_OK && mlod_motion_timeline_info(m[0])->frames >= 3) {
+			static const mlod_motion_method methods[2] = {MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS};
+			mlod_motion_level best;
+			mlod_error why = {0};
+			mlod_result e = mlod_motion_next_level_best(m, methods, 2, MLOD_MOTION_MAX_ERROR, e0, &best, &why);
+			if (e == MLOD_OK && best.bytes < mlod_clip_key_bytes(&c->clips[q])) {
+				x->level0_owned[q] = best;
+				x->clips[q].level0 = &x->level0_owned[q].clip;
+				x->clips[q].error0 = (float)best.error.max;
+			} else if (e == MLOD_OK || e == MLOD_ERR_LIMIT) {
+				if (e == MLOD_OK)
+					mlod_motion_level_free(&best);
+				kept++;
+			} else {
+				if (x->err)
+					*x->err = why;
+				r = e;
+			}
+		} else if (r == MLOD_OK) {
+			kept++;
+		}
+		for (int i = 0; i < 2; i++)
+			mlod_motion_free(m[i]);
+	}
+	if (r == MLOD_OK && kept) {
+		char text[96];
+		snprintf(text, sizeof text, "%d clip(s) keep every key at motion level 0", kept);
+		note(x, text);
+	}
+	return r;
+}
+
 static mlod_result motion_levels(struct ctx *x)
 {
 	const mlod_character *c = &x->v;
@@ -1252,6 +1320,8 @@ static mlod_result motion_levels(struct ctx *x)
 	x->clips = calloc((size_t)c->clip_count + 1, sizeof *x->clips);
 	if (!x->clips)
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	if ((r = motion_level0(x)) != MLOD_OK)
+		return r;
 	if (c->clip_count == 0 || x->opt->no_motion_levels)
 		return MLOD_OK;
 	/* The input's levels: "<clip>@lod<k>" animations with a record. */
@@ -1281,8 +1351,8 @@ static mlod_result motion_levels(struct ctx *x)
 		for (int q = 0; q < c->clip_count; q++) /* a gap repeats the finer level */
 			for (int k = 0; k < x->clips[q].count; k++)
 				if (!x->clips[q].clip[k]) {
-					x->clips[q].clip[k] = k ? x->clips[q].clip[k - 1] : &c->clips[q];
-					x->clips[q].error[k] = k ? x->clips[q].error[k - 1] : 0.0f;
+					x->clips[q].clip[k] = k ? x->clips[q].clip[k - 1] : x->clips[q].level0;
+					x->clips[q].error[k] = k ? x->clips[q].error[k - 1] : x->clips[q].error0;
 				}
 		return MLOD_OK;
 	}
@@ -1293,8 +1363,7 @@ static mlod_result motion_levels(struct ctx *x)
 		bounds[b] = x->opt->motion_percent[b] ? x->opt->motion_bounds[b] * x->height / 100.0 : x->opt->motion_bounds[b];
 	qsort(bounds, (size_t)nb, sizeof *bounds, double_asc);
 	mlod_motion_options mo = {0};
-	mo.point_distance = x->opt->point_distance > 0.0 ? x->opt->point_distance
-	                                                 : mlod_motion_point_distance(&c->skeleton, x->format != MLOD_FORMAT_BVH);
+	mo.point_distance = motion_point_distance(x);
 	x->owned_levels = calloc((size_t)c->clip_count * (size_t)(nb > 0 ? nb : 1), sizeof *x->owned_levels);
 	if (!x->owned_levels)
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
@@ -1695,6 +1764,8 @@ void mlod_pack_options_default(mlod_pack_options *opt)
 	opt->normal_bits = MLOD_PACK_NORMAL_BITS_DEFAULT;
 	opt->uv_bits = MLOD_PACK_UV_BITS_DEFAULT;
 	opt->motion_bound_count = (int)(sizeof bounds / sizeof *bounds);
+	opt->motion_level0_error = MLOD_PACK_MOTION_LEVEL0_DEFAULT;
+	opt->motion_level0_percent = 1;
 	for (int i = 0; i < opt->motion_bound_count; i++) {
 		opt->motion_bounds[i] = bounds[i];
 		opt->motion_percent[i] = 1;
@@ -1714,6 +1785,9 @@ static void ctx_free(struct ctx *x)
 	for (int i = 0; i < x->owned_count; i++)
 		mlod_motion_level_free(&x->owned_levels[i]);
 	free(x->owned_levels);
+	for (int q = 0; x->level0_owned && q < x->v.clip_count; q++)
+		mlod_motion_level_free(&x->level0_owned[q]);
+	free(x->level0_owned);
 	free(x->clips);
 	free(x->world);
 	free(x->view_skin);
@@ -1779,8 +1853,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		A = x.clips[q].count + 1 > A ? x.clips[q].count + 1 : A;
 	for (int q = 0; q < x.v.clip_count; q++) /* a clip with fewer levels repeats its coarsest */
 		for (int k = x.clips[q].count; k < A - 1; k++) {
-			x.clips[q].clip[k] = k ? x.clips[q].clip[k - 1] : &x.v.clips[q];
-			x.clips[q].error[k] = k ? x.clips[q].error[k - 1] : 0.0f;
+			x.clips[q].clip[k] = k ? x.clips[q].clip[k - 1] : x.clips[q].level0;
+			x.clips[q].error[k] = k ? x.clips[q].error[k - 1] : x.clips[q].error0;
 		}
 	x.st->motion.seconds = now_seconds() - t0;
 
@@ -1808,8 +1882,9 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		x.st->mesh.seconds += now_seconds() - t0;
 		t0 = now_seconds();
 		for (int q = 0; k < A && q < x.v.clip_count; q++) {
-			const mlod_clip *cl = k == 0 ? &x.v.clips[q] : x.clips[q].clip[k - 1];
-			if ((r = motion_chunk(&x, cl, k, q, k == 0 ? 0.0f : x.clips[q].error[k - 1], &body)) != MLOD_OK)
+			const mlod_clip *cl = k == 0 ? x.clips[q].level0 : x.clips[q].clip[k - 1];
+			if ((r = motion_chunk(&x, cl, k, q, k == 0 ? x.clips[q].error0 : x.clips[q].error[k - 1], &body)) !=
+			    MLOD_OK)
 				goto done;
 		}
 		x.st->motion.seconds += now_seconds() - t0;
@@ -1971,10 +2046,11 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			st->skeleton.errors[k] = x.skel_error[k - 1];
 		for (int k = 1; k < M; k++)
 			st->mesh.errors[k] = x.mesh_error[k - 1];
-		for (int k = 1; k < A; k++)
-			for (int q = 0; q < x.v.clip_count; q++)
-				st->motion.errors[k] = x.clips[q].error[k - 1] > st->motion.errors[k] ? x.clips[q].error[k - 1]
-				                                                                      : st->motion.errors[k];
+		for (int k = 0; k < A; k++)
+			for (int q = 0; q < x.v.clip_count; q++) {
+				float e = k ? x.clips[q].error[k - 1] : x.clips[q].error0;
+				st->motion.errors[k] = e > st->motion.errors[k] ? e : st->motion.errors[k];
+			}
 		st->skeleton.stored = layer_bytes(&body, MLOD_LAYER_SKELETON, 0);
 		st->skeleton.raw = layer_bytes(&body, MLOD_LAYER_SKELETON, 1);
 		st->mesh.stored = layer_bytes(&body, MLOD_LAYER_MESH, 0);

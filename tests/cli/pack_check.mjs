@@ -43,11 +43,12 @@ for (let i = 0; i < n; i++) {
 	end = c.offset + c.stored;
 	const d = b.subarray(c.offset, end);
 	if (crc32(d) !== c.crc) die(`chunk ${i} (${c.type}): CRC`);
-	if (c.level === 0 && (c.error !== 0 || c.distance !== 0)) die(`chunk ${i}: error or distance at level 0`);
-	if (!(c.error >= 0) || (c.error > 0) !== (c.distance > 0)) die(`chunk ${i}: error ${c.error}, distance ${c.distance}`);
+	// ANIM level 0 states its error against the input clip (0 when lossless); its distance is 0
+	if (c.level === 0 && ((c.error !== 0 && c.type !== 'ANIM') || c.distance !== 0)) die(`chunk ${i}: error or distance at level 0`);
+	if (!(c.error >= 0) || (c.level > 0 && (c.error > 0) !== (c.distance > 0))) die(`chunk ${i}: error ${c.error}, distance ${c.distance}`);
 	// distance = error * lines / (2 tan(fov / 2) pixels)
 	const want = c.error * 1080 / (2 * Math.tan(Math.PI / 6));
-	if (Math.abs(c.distance - want) > 1e-5 * want) die(`chunk ${i}: distance ${c.distance} for error ${c.error}`);
+	if (c.level > 0 && Math.abs(c.distance - want) > 1e-5 * want) die(`chunk ${i}: distance ${c.distance} for error ${c.error}`);
 	// The stream container.
 	const sc = d.readUInt32LE(0);
 	let p = 4 + 16 * sc, raw = 4 + 16 * sc;

@@ -590,7 +590,8 @@ TEST(pack_joints16)
  * every translation, scale and cubic value bit for bit; non-cubic
  * rotations ('ROTQ') within MLOD_PACK_ROTQ_BOUND per component up to the
  * sign and MLOD_PACK_ROTQ_ANGLE in angle; a constant channel as one key
- * at its last time holding every key's value; with the meshopt codec. */
+ * at its last time holding every key's value; with the meshopt codec and
+ * lossless_motion (the default level 0 is within a bound: test_unpack). */
 TEST(pack_lossless_fields)
 {
 	const char *files[] = {"samples/RobotExpressive.glb", "samples/cmu_12_01_walk.bvh"};
@@ -607,6 +608,7 @@ TEST(pack_lossless_fields)
 		mlod_pack_options opt;
 		mlod_pack_options_default(&opt);
 		opt.no_skeleton_levels = opt.no_mesh_levels = opt.no_motion_levels = 1;
+		opt.lossless_motion = 1;
 		void *out = NULL;
 		size_t size = 0;
 		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, NULL, &terr));
@@ -736,6 +738,73 @@ TEST(pack_lossless_fields)
 	       MLOD_PACK_ROTQ_BOUND, ang_max, MLOD_PACK_ROTQ_ANGLE);
 }
 
+/* The TOC entry of a chunk (type, level, item 0), or NULL. */
+static const uint8_t *find_entry(const uint8_t *p, uint32_t type, int level)
+{
+	uint32_t chunks = rd32(p + 12);
+	for (uint32_t i = 0; i < chunks; i++) {
+		const uint8_t *e = p + 32 + 48 * i;
+		if (rd32(e) == type && (e[6] | e[7] << 8) == level && (e[8] | e[9] << 8) == 0)
+			return e;
+	}
+	return NULL;
+}
+
+static float entry_error(const uint8_t *e)
+{
+	float f;
+	memcpy(&f, e + 36, 4);
+	return f;
+}
+
+/* Motion level 0 by default: the walk within the level-0 bound (its TOC
+ * error, the joint position error, above 0 and within the bound), fewer
+ * raw bytes than with lossless_motion (TOC error 0), and the coarser
+ * levels byte-identical either way (they are made from the clip as read).
+ * A smaller bound keeps more bytes. */
+TEST(motion_level0_bound)
+{
+	size_t n = 0;
+	void *in = slurp("samples/cmu_12_01_walk.bvh", &n);
+	CHECK(in);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+	void *out[3] = {NULL, NULL, NULL};
+	size_t size[3] = {0, 0, 0};
+	mlod_pack_stats st[3];
+	for (int v = 0; v < 3; v++) {
+		mlod_pack_options opt;
+		mlod_pack_options_default(&opt);
+		opt.no_skeleton_levels = 1;
+		opt.lossless_motion = v == 1;
+		if (v == 2)
+			opt.motion_level0_error = MLOD_PACK_MOTION_LEVEL0_DEFAULT / 4;
+		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out[v], &size[v], &st[v], &terr));
+	}
+	double e0 = MLOD_PACK_MOTION_LEVEL0_DEFAULT * st[0].height / 100.0;
+	const uint8_t *a = find_entry(out[0], MLOD_CHUNK_MOTION, 0), *b = find_entry(out[1], MLOD_CHUNK_MOTION, 0),
+	              *q = find_entry(out[2], MLOD_CHUNK_MOTION, 0);
+	CHECK(a && b && q);
+	if (a && b && q) {
+		CHECK(entry_error(a) > 0 && entry_error(a) <= e0 && entry_error(b) == 0);
+		CHECK(entry_error(q) > 0 && entry_error(q) <= e0 / 4);
+		CHECK(st[0].motion.errors[0] == entry_error(a));
+		CHECK(rd32(a + 28) < rd32(b + 28) && rd32(a + 28) < rd32(q + 28));
+	}
+	CHECK(st[0].motion.levels == 4 && st[1].motion.levels == 4);
+	for (int k = 1; k < 4; k++) {
+		const uint8_t *x = find_entry(out[0], MLOD_CHUNK_MOTION, k), *y = find_entry(out[1], MLOD_CHUNK_MOTION, k);
+		CHECK(x && y && rd32(x + 24) == rd32(y + 24) && rd32(x + 32) == rd32(y + 32));
+	}
+	for (int v = 0; v < 3; v++)
+		mlod_free(out[v]);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	free(in);
+}
+
 int main(void)
 {
 	RUN(weights_sum_to_255);
@@ -748,5 +817,6 @@ int main(void)
 	RUN(pack_palette_is_fold);
 	RUN(pack_joints16);
 	RUN(pack_lossless_fields);
+	RUN(motion_level0_bound);
 	TEST_EXIT();
 }

@@ -4,9 +4,13 @@
  * unpacked glb are loaded with the bake library (mlod_load) and compared.
  *
  *   lossless   joint names, parents and rest TRS, skins' joints and
- *              inverse binds, materials of the primitives, clip key times
- *              and values (the reader's ROTQ values are exact: the writer
- *              uses it only for values on the int16 lattice), index lists
+ *              inverse binds, materials of the primitives, index lists;
+ *              with lossless_motion, clip key times and values (ROTQ
+ *              within its lattice bound)
+ *   bounded    motion level 0 (the default): at the input clip's common
+ *              timeline frames and midpoints, every joint's point error
+ *              within the level-0 bound plus the ROTQ lattice's share,
+ *              both clips sampled and posed with the bake library
  *   quantised  (mlod(5)) positions within half a step of position_bits
  *              of the part's box per axis, normals within
  *              3 sqrt(2) 2^(15 - normal_bits) / 32767 radians, UVs within
@@ -365,6 +369,94 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
 	return NULL;
 }
 
+/* Motion level 0 against the input clip, by the point error
+ * (mlod_motion_point_error, radius pd) of every joint at the input's
+ * common timeline frames and midpoints, each clip sampled and posed by the
+ * bake library (not lib/motion's own evaluator): at most e0 plus the ROTQ
+ * lattice's share (mlod(5): each rotation key within 2 asin(1/32767) rad;
+ * a rotation of the joint or an ancestor g off by that angle moves the
+ * joint's origin by at most the angle times |o_joint - o_g| and turns its
+ * world 3x3 part M by that angle, which the point error weighs by pd
+ * sigma_max(M): RobotExpressive's joints carry a world scale of 100),
+ * plus 1e-6 of the height for the ticks and float sums. *worst gets the
+ * largest error / bound. */
+/* The largest singular value of w's 3x3 part (power iteration on M^T M). */
+static double sigma_max3(const mlod_mat4 *w)
+{
+	double v[3] = {1, 0.7, 0.3}, lam = 0;
+	for (int it = 0; it < 64; it++) {
+		double u[3], x[3], n = 0;
+		for (int r = 0; r < 3; r++)
+			u[r] = w->m[r] * v[0] + w->m[4 + r] * v[1] + w->m[8 + r] * v[2];
+		for (int c = 0; c < 3; c++)
+			x[c] = w->m[4 * c] * u[0] + w->m[4 * c + 1] * u[1] + w->m[4 * c + 2] * u[2];
+		for (int c = 0; c < 3; c++)
+			n += x[c] * x[c];
+		n = sqrt(n);
+		if (!(n > 0))
+			return 0;
+		lam = n / sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+		for (int c = 0; c < 3; c++)
+			v[c] = x[c] / n;
+	}
+	return sqrt(lam);
+}
+
+static const char *level0_within(const mlod_character *c, const mlod_clip *a, const mlod_clip *b, double e0,
+                                 double pd, double height, double *worst, char *msg, size_t cap)
+{
+	mlod_motion_options mo = {0};
+	mlod_clip common;
+	mlod_error err = {0};
+	if (mlod_motion_common_clip(a, &mo, &common, NULL, &err) != MLOD_OK) {
+		snprintf(msg, cap, "clip '%s': %s", a->name, err.message);
+		return msg;
+	}
+	int nj = c->skeleton.joint_count, frames = common.channels[0].key_count, n = 2 * (frames - 1) + 1;
+	float *t = malloc(sizeof *t * (size_t)n);
+	mlod_trs *la = malloc(sizeof *la * (size_t)nj), *lb = malloc(sizeof *lb * (size_t)nj);
+	mlod_mat4 *wa = malloc(sizeof *wa * (size_t)nj), *wb = malloc(sizeof *wb * (size_t)nj);
+	unsigned char *rotq = calloc((size_t)nj, 1);
+	const char *fail = NULL;
+	mlod_motion_sample_times(common.channels[0].times, frames, 2, t);
+	for (int i = 0; i < b->channel_count; i++)
+		if (b->channels[i].path == MLOD_PATH_ROTATION && b->channels[i].interp != MLOD_INTERP_CUBICSPLINE)
+			rotq[b->channels[i].joint] = 1;
+	const double angle = 2.0 * asin(1.0 / 32767.0);
+	for (int i = 0; i < n && !fail; i++) {
+		mlod_pose_rest(&c->skeleton, la);
+		mlod_pose_rest(&c->skeleton, lb);
+		mlod_clip_sample(a, t[i], la);
+		mlod_clip_sample(b, t[i], lb);
+		mlod_pose_world(&c->skeleton, la, wa);
+		mlod_pose_world(&c->skeleton, lb, wb);
+		for (int j = 0; j < nj && !fail; j++) {
+			double lattice = 0, radius = pd * sigma_max3(&wa[j]);
+			for (int g = j; g >= 0; g = c->skeleton.joints[g].parent)
+				if (rotq[g]) {
+					double d = 0;
+					for (int r = 0; r < 3; r++)
+						d += ((double)wa[j].m[12 + r] - wa[g].m[12 + r]) * ((double)wa[j].m[12 + r] - wa[g].m[12 + r]);
+					lattice += angle * (sqrt(d) + radius);
+				}
+			double e = mlod_motion_point_error(&wa[j], &wb[j], pd), bound = e0 + lattice + 1e-6 * height;
+			if (e / bound > *worst)
+				*worst = e / bound;
+			if (e > bound) {
+				snprintf(msg, cap, "clip '%s' joint %d at %.5g s: point error %.6g, bound %.6g (level 0 %.6g + lattice %.6g)",
+				         a->name, j, (double)t[i], e, bound, e0, lattice);
+				fail = msg;
+			}
+		}
+	}
+	free(t), free(la), free(lb), free(wa), free(wb), free(rotq);
+	mlod_clip_free(&common);
+	return fail;
+}
+
+static double worst_level0;
+static int level0_fewer_keys; /* the sample's level 0 must have fewer keys than its input */
+
 /* Packs path with opt, unpacks, writes and reloads the glb, compares. */
 static const char *round_trip(const char *path, const mlod_pack_options *opt, char *msg, size_t cap)
 {
@@ -451,11 +543,24 @@ static const char *round_trip(const char *path, const mlod_pack_options *opt, ch
 	 * are one rotation: the writer keeps signs continuous), other values
 	 * exact; a channel whose keys are all equal may come back as one key
 	 * at its last time. */
+	double e0 = opt->motion_level0_percent ? opt->motion_level0_error * st.height / 100.0 : opt->motion_level0_error;
+	double pd = opt->point_distance > 0 ? opt->point_distance
+	                                    : mlod_motion_point_distance(&c.skeleton, fmt != MLOD_FORMAT_BVH);
 	for (int k = 0; k < c.clip_count; k++) {
 		const mlod_clip *a = &c.clips[k], *b = clip_named(&c2, a->name);
 		if (!b)
 			FAIL("clip '%s' missing", a->name);
-		for (int ch = 0; ch < a->channel_count; ch++) {
+		if (!opt->lossless_motion) {
+			const char *why = level0_within(&c, a, b, e0, pd, st.height, &worst_level0, msg, cap);
+			if (why) {
+				fail = why;
+				goto done;
+			}
+			if (level0_fewer_keys && mlod_clip_key_count(b) >= mlod_clip_key_count(a))
+				FAIL("clip '%s': level 0 keeps %ld of %ld keys", a->name, mlod_clip_key_count(b),
+				     mlod_clip_key_count(a));
+		}
+		for (int ch = 0; opt->lossless_motion && ch < a->channel_count; ch++) {
 			const mlod_channel *x = &a->channels[ch], *y = channel_of(b, x->joint, x->path);
 			if (!y || y->interp != x->interp || (y->key_count != x->key_count && y->key_count != 1))
 				FAIL("clip '%s' channel %d: missing or different keys", a->name, ch);
@@ -499,7 +604,10 @@ done:
 	return fail;
 }
 
-static void sample_bits(const char *path, int pb, int nb, int ub)
+/* The pack at the given bits (0: the defaults) with motion level 0 within
+ * its bound, then, motion only, with lossless_motion (keys exact). fewer:
+ * level 0 must drop keys. */
+static void sample_bits(const char *path, int pb, int nb, int ub, int fewer)
 {
 	char msg[1024];
 	mlod_pack_options opt;
@@ -507,16 +615,22 @@ static void sample_bits(const char *path, int pb, int nb, int ub)
 	if (pb)
 		opt.position_bits = pb, opt.normal_bits = nb, opt.uv_bits = ub;
 	pos_bits = opt.position_bits, nrm_bits = opt.normal_bits, uv_bits = opt.uv_bits;
-	worst_pos_ratio = worst_pos_err = worst_nrm = worst_uv_ratio = worst_w = 0;
+	worst_pos_ratio = worst_pos_err = worst_nrm = worst_uv_ratio = worst_w = worst_level0 = 0;
+	level0_fewer_keys = fewer;
 	const char *why = round_trip(path, &opt, msg, sizeof msg - 64);
 	fprintf(stderr, "%s (bits %d %d %d): max position error %.3g (%.3f of the half-step bound), normal %.3g rad, uv %.3f of bound, "
-	        "weight %.4f\n", path, pos_bits, nrm_bits, uv_bits, worst_pos_err, worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w);
+	        "weight %.4f; motion level 0 point error %.3f of its bound\n", path, pos_bits, nrm_bits, uv_bits, worst_pos_err,
+	        worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w, worst_level0);
 	CHECK_MSG(!why, "%.200s: %.700s", path, why);
+	opt.lossless_motion = 1;
+	opt.no_skeleton_levels = opt.no_mesh_levels = 1;
+	why = round_trip(path, &opt, msg, sizeof msg - 64);
+	CHECK_MSG(!why, "%.200s (lossless motion): %.700s", path, why);
 }
 
-static void sample(const char *path)
+static void sample(const char *path, int fewer)
 {
-	sample_bits(path, 0, 0, 0);
+	sample_bits(path, 0, 0, 0, fewer);
 }
 
 /* Posed positions (mlod(5) QUANTISATION): at each pose, the unpacked
@@ -658,14 +772,14 @@ TEST(posed_shared_ely)
 	posed_level0(path);
 }
 
-TEST(round_trip_tubeman) { sample("samples/tubeman.glb"); }
-TEST(round_trip_tubeman_16_bits) { sample_bits("samples/tubeman.glb", 16, 16, 16); }
+TEST(round_trip_tubeman) { sample("samples/tubeman.glb", 1); }
+TEST(round_trip_tubeman_16_bits) { sample_bits("samples/tubeman.glb", 16, 16, 16, 1); }
 TEST(round_trip_tubeman_fewest_bits)
 {
-	sample_bits("samples/tubeman.glb", MLOD_PACK_POSITION_BITS_MIN, MLOD_PACK_NORMAL_BITS_MIN, MLOD_PACK_UV_BITS_MIN);
+	sample_bits("samples/tubeman.glb", MLOD_PACK_POSITION_BITS_MIN, MLOD_PACK_NORMAL_BITS_MIN, MLOD_PACK_UV_BITS_MIN, 1);
 }
-TEST(round_trip_robot) { sample("samples/RobotExpressive.glb"); }
-TEST(round_trip_bvh) { sample("samples/cmu_12_01_walk.bvh"); }
+TEST(round_trip_robot) { sample("samples/RobotExpressive.glb", 0); }
+TEST(round_trip_bvh) { sample("samples/cmu_12_01_walk.bvh", 1); }
 
 TEST(round_trip_shared_ely)
 {
@@ -673,7 +787,7 @@ TEST(round_trip_shared_ely)
 	const char *dir = getenv("MLOD_SHARED_DATA");
 	char path[1024];
 	snprintf(path, sizeof path, "%s/Ely.glb", dir);
-	sample(path);
+	sample(path, 0);
 }
 
 int main(void)

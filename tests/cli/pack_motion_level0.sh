@@ -1,0 +1,44 @@
+# Motion level 0 (mlod-pack(1)): by default the clip within 0.05% of the
+# height, its TOC error (the joint position error against the clip as
+# read) above 0 and within the bound, fewer bytes than --lossless-motion
+# (error 0); --motion-level0-error in % and in scene units; the coarser
+# levels the same whatever level 0 gets; --report=json's level0_error is
+# the TOC's; piped and direct packs agree
+# with --lossless-motion too. test_unpack measures the unpacked level 0.
+set -e
+w="$ROOT/samples/cmu_12_01_walk.bvh"
+"$BIN/mlod-pack" "$w" -o def.mlod
+"$BIN/mlod-pack" --lossless-motion "$w" -o ll.mlod
+"$BIN/mlod-pack" --motion-level0-error 0.01% "$w" -o p01.mlod
+"$BIN/mlod-pack" --motion-level0-error 0.1 "$w" -o abs.mlod
+for n in def ll p01 abs; do "$BIN/mlod-pack" --info $n.mlod --json > $n.json; done
+# --report=json states level 0's error as the TOC does
+"$BIN/mlod-pack" --report=json "$w" > report.json
+node - <<'JS'
+const fs = require('fs');
+const j = (n) => JSON.parse(fs.readFileSync(`${n}.json`, 'utf8'));
+const l0 = (p) => p.chunks.find((c) => c.type === 'ANIM' && c.level === 0);
+const coarse = (p) => p.chunks.filter((c) => c.type === 'ANIM' && c.level > 0).map((c) => c.crc).join();
+const [d, ll, p01, abs] = ['def', 'll', 'p01', 'abs'].map(j);
+const h = d.height;
+if (!(l0(d).error > 0 && l0(d).error <= 0.0005 * h)) throw new Error(`default: error ${l0(d).error}`);
+if (l0(ll).error !== 0) throw new Error(`lossless: error ${l0(ll).error}`);
+if (!(l0(p01).error > 0 && l0(p01).error <= 0.0001 * h)) throw new Error(`0.01%: error ${l0(p01).error}`);
+if (!(l0(abs).error > 0 && l0(abs).error <= 0.1)) throw new Error(`0.1: error ${l0(abs).error}`);
+if (!(l0(abs).stored < l0(d).stored && l0(d).stored < l0(p01).stored && l0(p01).stored < l0(ll).stored))
+	throw new Error(`level 0 bytes: ${[abs, d, p01, ll].map((p) => l0(p).stored)}`);
+const rep = JSON.parse(fs.readFileSync('report.json', 'utf8')).layers.motion.level0_error;
+if (Math.abs(rep - l0(d).error) > 1e-6 * h) throw new Error(`report level0_error ${rep}, TOC ${l0(d).error}`);
+for (const p of [ll, p01, abs])
+	if (coarse(p) !== coarse(d)) throw new Error('the coarser levels changed with level 0');
+JS
+"$BIN/mlod-label" < "$ROOT/samples/RobotExpressive.glb" | "$BIN/mlod-skelgraph" 2>/dev/null | "$BIN/mlod-bgm" |
+	"$BIN/mlod-motion" | "$BIN/mlod-pack" --lossless-motion -o piped.mlod
+"$BIN/mlod-pack" --lossless-motion "$ROOT/samples/RobotExpressive.glb" -o direct.mlod
+"$BIN/mlod-pack" --info piped.mlod --json > p.json
+"$BIN/mlod-pack" --info direct.mlod --json > d.json
+node - <<'JS'
+const fs = require('fs');
+const anim = (f) => JSON.parse(fs.readFileSync(f, 'utf8')).chunks.filter((c) => c.type === 'ANIM').map((c) => `${c.level}:${c.item}:${c.crc}`).join();
+if (anim('p.json') !== anim('d.json')) throw new Error('piped and direct ANIM chunks differ with --lossless-motion');
+JS
