@@ -1,6 +1,8 @@
 #!/bin/sh
 # bench/pack.sh: the pack against gltfpack (run by bench/run.sh, which sets
-# BUILD and INPUTS). Per input, raw, gzip -9 and zstd -19 bytes of:
+# BUILD and INPUTS). First the mesh codecs (bench_codec) and the mesh level
+# layouts (bench_layout) on the glb inputs. Then per input, raw, gzip -9
+# and zstd -19 bytes of:
 #   pack        mlod-pack of the input: every level of every layer
 #   gltfpack    gltfpack -cc of the input: full detail, one level
 #   gltfpack*L  gltfpack -cc, then -cc -si R for each mesh ratio the pack
@@ -32,6 +34,11 @@ for f in $INPUTS; do
 done
 # shellcheck disable=SC2086
 [ -z "$glbs" ] || "$BUILD/bench/bench_codec" $glbs
+echo
+echo "## Pack: mesh level layouts, (a) per level as stored against (b) one prefix buffer per part"
+echo
+# shellcheck disable=SC2086
+[ -z "$glbs" ] || "$BUILD/bench/bench_layout" $glbs
 echo
 echo "## Pack: every level in one file, against gltfpack 1.3"
 echo
