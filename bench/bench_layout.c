@@ -31,7 +31,8 @@
  *       can decode any), b2 each level's appended block as its own
  *       streams (streamable coarse to fine, as the pack's chunks are).
  *
- * Per input: stream bytes of (a), b1 and b2; unique vertices of (b)
+ * Per input: stream bytes of (a), of (a) quantised on (b)'s grid (what
+ * the grid alone changes), b1 and b2; unique vertices of (b)
  * against the sum of the levels' vertices; the decode of the whole mesh
  * (every level) through meshopt, best of 51 runs in thread CPU time, as
  * microseconds and as MB/s of decoded (quantised) bytes; and per level
@@ -421,7 +422,7 @@ typedef struct job {
 
 typedef struct totals {
 	int levels;
-	size_t a, b1, b2;                  /* stream bytes */
+	size_t a, ag, b1, b2;              /* stream bytes (ag: (a) on (b)'s grid) */
 	long verts_a, unique_b;            /* sum of level vertices; (b)'s buffer */
 	long nv[MAXL], prefix[MAXL], used[MAXL]; /* per level */
 	size_t ia, ib1;                    /* of them, index streams ((b2)'s are (b1)'s) */
@@ -446,12 +447,18 @@ static uint32_t *level_indices(const mlod_primitive *p, uint32_t *ni)
 }
 
 /* (a): one level of one part, the best of the writer's orders. */
-static void layout_a(const mlod_primitive *p, int skin, int wide, totals *T)
+static void layout_a(const mlod_primitive *p, int skin, int wide, const grid *shared, totals *T)
 {
 	layout L = make_layout(p, skin, wide);
 	grid g = {0};
 	g.tscale = xmalloc(sizeof(float) * ((size_t)p->target_count + 1));
 	make_grid(&g, &p, 1);
+	if (shared) { /* (a) on (b)'s grid */
+		memcpy(g.tscale, shared->tscale, sizeof(float) * (size_t)p->target_count);
+		float *keep = g.tscale;
+		g = *shared;
+		g.tscale = keep;
+	}
 	uint32_t nv = (uint32_t)p->vertex_count, ni;
 	uint8_t *V = xmalloc((size_t)nv * (size_t)L.stride), *W = xmalloc((size_t)nv * (size_t)L.stride);
 	quantise(p, &L, &g, skin, wide, V);
@@ -465,16 +472,19 @@ static void layout_a(const mlod_primitive *p, int skin, int wide, totals *T)
 				exit(1);
 			for (uint32_t v = 0; v < nv; v++)
 				memcpy(W + (size_t)remap[v] * (size_t)L.stride, V + (size_t)v * (size_t)L.stride, (size_t)L.stride);
-			blobs *keep = pass ? &T->A : NULL;
+			blobs *keep = pass && !shared ? &T->A : NULL;
 			size_t ib = code_indices(out, ni, nv, keep), b = code_vertices(W, 0, nv, &L, keep) + ib;
-			if (pass)
+			if (pass && !shared)
 				T->ia += ib;
 			if (L.targets)
 				b += code(g.tscale, (uint32_t)L.targets, 4, 0, keep); /* 'MTSC' */
 			if (!pass && (o == 0 || b < best))
 				best = b, best_o = o;
 		}
-	T->a += best;
+	if (shared)
+		T->ag += best;
+	else
+		T->a += best;
 	free(V), free(W), free(in), free(out), free(remap), free(g.tscale);
 }
 
@@ -507,17 +517,10 @@ static uint32_t vset_get(vset *s, uint8_t *G, uint32_t *n, const uint8_t *key, i
 	return *n - 1;
 }
 
-/* (b): every level of one part (lv[0] finest .. lv[n-1] coarsest). */
-static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide, totals *T)
+/* (b)'s grid for every level of a part: level 0's steps from the corner
+ * of the union of the levels' boxes (see the top). */
+static grid shared_grid(const mlod_primitive *const *lv, int n, totals *T)
 {
-	layout L = make_layout(lv[0], skin, wide);
-	for (int k = 1; k < n; k++) {
-		layout Lk = make_layout(lv[k], skin, wide);
-		if (Lk.stride != L.stride) {
-			fprintf(stderr, "bench_layout: a level has other attributes than level 0\n");
-			exit(1);
-		}
-	}
 	grid g = {0}, g0 = {0};
 	g.tscale = xmalloc(sizeof(float) * ((size_t)lv[0]->target_count + 1));
 	g0.tscale = xmalloc(sizeof(float) * ((size_t)lv[0]->target_count + 1));
@@ -542,6 +545,22 @@ static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide,
 	for (int t = 0; t < lv[0]->target_count; t++)
 		if (g0.tscale[t] > 0.0f)
 			g.tscale[t] = g0.tscale[t];
+	free(g0.tscale);
+	return g;
+}
+
+/* (b): every level of one part (lv[0] finest .. lv[n-1] coarsest). */
+static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide, totals *T)
+{
+	layout L = make_layout(lv[0], skin, wide);
+	for (int k = 1; k < n; k++) {
+		layout Lk = make_layout(lv[k], skin, wide);
+		if (Lk.stride != L.stride) {
+			fprintf(stderr, "bench_layout: a level has other attributes than level 0\n");
+			exit(1);
+		}
+	}
+	grid g = shared_grid(lv, n, T);
 	size_t total_nv = 0;
 	uint8_t *V[MAXL];
 	uint32_t *in[MAXL], ni[MAXL], nv[MAXL];
@@ -639,7 +658,7 @@ static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide,
 	T->b1 += best1, T->b2 += best2;
 	for (int k = 0; k < n; k++)
 		free(V[k]), free(in[k]);
-	free(G), free(set.slot), free(g.tscale), free(g0.tscale);
+	free(G), free(set.slot), free(g.tscale);
 }
 
 /* The stream bytes of the MESH chunks mlod_pack_write makes (but 'PART'),
@@ -761,9 +780,9 @@ int main(int argc, char **argv)
 	}
 	static const double ratios_default[] = {MLOD_MESH_RATIOS_DEFAULT};
 	int nr = (int)(sizeof ratios_default / sizeof *ratios_default);
-	printf("| input | levels | parts | (a) per level | (b1) one buffer | (b2) per-level blocks | (b2) / (a) |"
+	printf("| input | levels | parts | (a) per level | (a) on (b)'s grid | (b1) one buffer | (b2) per-level blocks | (b2) / (a) |"
 	       " level vertices | (b) unique | decode (a) | decode (b1) | decode (b2) | expand (b) to (a) |\n");
-	printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+	printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
 	char extra[64][512];
 	int ne = 0;
 	for (int i = 1; i < argc; i++) {
@@ -798,13 +817,18 @@ int main(int argc, char **argv)
 						continue;
 					lv[n++] = &lm->primitives[q];
 				}
+				grid sg = {0};
+				if (n > 0)
+					sg = shared_grid(lv, n, &(totals){0});
 				for (int l = 0; l < n; l++) {
-					layout_a(lv[l], skin, wide, &T);
+					layout_a(lv[l], skin, wide, NULL, &T);
+					layout_a(lv[l], skin, wide, &sg, &T);
 					T.nv[l] += lv[l]->vertex_count;
 					T.verts_a += lv[l]->vertex_count;
 				}
 				if (n > 0)
 					layout_b(lv, n, skin, wide, &T), T.parts++;
+				free(sg.tscale);
 			}
 		}
 		int packed_levels = 0;
@@ -818,9 +842,9 @@ int main(int argc, char **argv)
 		const char *name = strrchr(argv[i], '/') ? strrchr(argv[i], '/') + 1 : argv[i];
 		char r[32];
 		pct(r, sizeof r, (double)T.b2, (double)T.a);
-		printf("| %s | %d | %d | %zu | %zu | %zu | %s | %ld | %ld (%.1f%%) | %.0f us, %.0f MB/s | %.0f us, %.0f MB/s |"
+		printf("| %s | %d | %d | %zu | %zu | %zu | %zu | %s | %ld | %ld (%.1f%%) | %.0f us, %.0f MB/s | %.0f us, %.0f MB/s |"
 		       " %.0f us, %.0f MB/s | %.0f us (%ld vertices) |\n",
-		       name, T.levels, T.parts, T.a, T.b1, T.b2, r, T.verts_a, T.unique_b,
+		       name, T.levels, T.parts, T.a, T.ag, T.b1, T.b2, r, T.verts_a, T.unique_b,
 		       100.0 * (double)T.unique_b / (double)T.verts_a, ua, ma, u1, m1, u2, m2, ux, gathered);
 		if (packed != T.a || packed_levels != T.levels) {
 			fprintf(stderr, "bench_layout: %s: (a) computed %zu bytes over %d levels, the pack's MESH streams %zu over %d\n",
