@@ -789,6 +789,10 @@ int main(int argc, char **argv)
 		mlod_character c = {0};
 		if (bench_load("bench_layout", argv[i], &c, NULL))
 			return 2;
+		if (mlod_mesh_triangle_primitives(&c) == 0) { /* the pack has no mesh levels either */
+			mlod_character_free(&c);
+			continue;
+		}
 		mlod_pack_options opt;
 		mlod_pack_options_default(&opt);
 		mlod_bgm_options bo = opt.bgm;
