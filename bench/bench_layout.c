@@ -24,9 +24,9 @@
  *       levels of a part share one grid: the union of the levels' boxes
  *       (positions, UVs; morph deltas: the largest |delta| of any level).
  *       Within a level's appended block the vertices follow one of the
- *       writer's three orders applied to that level's triangles (the
- *       same order for every level of the part; the best of three is
- *       kept). Coded two ways: b1 the whole buffer as one meshopt vertex
+ *       writer's three orders applied to that level's triangles, chosen
+ *       level by level, coarsest first: the one that codes the block and
+ *       the level's indices to the fewest bytes. Coded two ways: b1 the whole buffer as one meshopt vertex
  *       stream per attribute (a reader must have every level before it
  *       can decode any), b2 each level's appended block as its own
  *       streams (streamable coarse to fine, as the pack's chunks are).
@@ -425,6 +425,7 @@ typedef struct totals {
 	size_t a, ag, b1, b2;              /* stream bytes (ag: (a) on (b)'s grid) */
 	long verts_a, unique_b;            /* sum of level vertices; (b)'s buffer */
 	long nv[MAXL], prefix[MAXL], used[MAXL]; /* per level */
+	size_t la[MAXL], lb2[MAXL];        /* per level: (a)'s bytes, (b2)'s (its block and indices) */
 	size_t ia, ib1;                    /* of them, index streams ((b2)'s are (b1)'s) */
 	int union_wider;                   /* parts whose union box is wider than level 0's */
 	double widest;                     /* the largest union / level 0 extent over axes and parts */
@@ -447,7 +448,7 @@ static uint32_t *level_indices(const mlod_primitive *p, uint32_t *ni)
 }
 
 /* (a): one level of one part, the best of the writer's orders. */
-static void layout_a(const mlod_primitive *p, int skin, int wide, const grid *shared, totals *T)
+static void layout_a(const mlod_primitive *p, int level, int skin, int wide, const grid *shared, totals *T)
 {
 	layout L = make_layout(p, skin, wide);
 	grid g = {0};
@@ -484,7 +485,7 @@ static void layout_a(const mlod_primitive *p, int skin, int wide, const grid *sh
 	if (shared)
 		T->ag += best;
 	else
-		T->a += best;
+		T->a += best, T->la[level] += best;
 	free(V), free(W), free(in), free(out), free(remap), free(g.tscale);
 }
 
@@ -515,6 +516,36 @@ static uint32_t vset_get(vset *s, uint8_t *G, uint32_t *n, const uint8_t *key, i
 	memcpy(G + (size_t)*n * (size_t)stride, key, (size_t)stride);
 	s->slot[i] = ++*n;
 	return *n - 1;
+}
+
+/* Appends level V's vertices not yet in G (ids by set) in order o of the
+ * level's triangles; returns its indices into G, *used the distinct
+ * vertices of G it has. */
+static uint32_t *append_level(vset *set, uint8_t *G, uint32_t *count, const uint8_t *V, const uint32_t *in,
+                              uint32_t ni, uint32_t nv, int o, int stride, uint32_t *used)
+{
+	uint32_t *remap = xmalloc(sizeof *remap * ((size_t)nv + 1));
+	uint32_t *inv = xmalloc(sizeof *inv * ((size_t)nv + 1));
+	uint32_t *out = xmalloc(sizeof *out * ((size_t)ni + 1));
+	uint32_t *gid = xmalloc(sizeof *gid * ((size_t)nv + 1));
+	uint32_t *idx = xmalloc(sizeof *idx * ((size_t)ni + 1));
+	if (mlod_pack_vertex_order(o, in, ni, nv, remap, out) != 0)
+		exit(1);
+	for (uint32_t v = 0; v < nv; v++)
+		inv[remap[v]] = v;
+	for (uint32_t j = 0; j < nv; j++) /* by new local index */
+		gid[j] = vset_get(set, G, count, V + (size_t)inv[j] * (size_t)stride, stride);
+	for (uint32_t t = 0; t < ni; t++)
+		idx[t] = gid[out[t]];
+	unsigned char *seen = calloc((size_t)*count + 1, 1);
+	if (!seen)
+		exit(1);
+	*used = 0;
+	for (uint32_t j = 0; j < nv; j++)
+		if (!seen[gid[j]])
+			seen[gid[j]] = 1, ++*used;
+	free(seen), free(remap), free(inv), free(out), free(gid);
+	return idx;
 }
 
 /* (b)'s grid for every level of a part: level 0's steps from the corner
@@ -583,82 +614,57 @@ static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide,
 	while (set.cap < 2 * total_nv + 2)
 		set.cap *= 2;
 	set.slot = xmalloc(sizeof *set.slot * set.cap);
-	uint32_t *idx[MAXL], prefix[MAXL], used[MAXL];
-	size_t best1 = 0, best2 = 0;
-	int o1 = 0, o2 = 0;
-	for (int pass = 0; pass < 3; pass++) {
-		int lo = pass == 0 ? 0 : pass == 1 ? o1 : o2, hi = pass == 0 ? MLOD_PACK_ORDERS : lo + 1;
-		for (int o = lo; o < hi; o++) {
-			memset(set.slot, 0, sizeof *set.slot * set.cap);
-			uint32_t count = 0;
-			for (int k = n - 1; k >= 0; k--) {
-				uint32_t *remap = xmalloc(sizeof *remap * ((size_t)nv[k] + 1));
-				uint32_t *inv = xmalloc(sizeof *inv * ((size_t)nv[k] + 1));
-				uint32_t *out = xmalloc(sizeof *out * ((size_t)ni[k] + 1));
-				uint32_t *gid = xmalloc(sizeof *gid * ((size_t)nv[k] + 1));
-				if (mlod_pack_vertex_order(o, in[k], ni[k], nv[k], remap, out) != 0)
-					exit(1);
-				for (uint32_t v = 0; v < nv[k]; v++)
-					inv[remap[v]] = v;
-				for (uint32_t j = 0; j < nv[k]; j++) /* gid by new local index */
-					gid[j] = vset_get(&set, G, &count, V[k] + (size_t)inv[j] * (size_t)L.stride, L.stride);
-				idx[k] = xmalloc(sizeof *idx[k] * ((size_t)ni[k] + 1));
-				for (uint32_t t = 0; t < ni[k]; t++)
-					idx[k][t] = gid[out[t]];
-				prefix[k] = count;
-				/* the distinct buffer vertices the level has */
-				unsigned char *seen = calloc(count + 1, 1);
-				used[k] = 0;
-				for (uint32_t j = 0; j < nv[k]; j++)
-					if (!seen[gid[j]])
-						seen[gid[j]] = 1, used[k]++;
-				free(seen), free(remap), free(inv), free(out), free(gid);
+	uint32_t *saved = xmalloc(sizeof *saved * set.cap);
+	memset(set.slot, 0, sizeof *set.slot * set.cap);
+	uint32_t *idx[MAXL], prefix[MAXL], used[MAXL], count = 0;
+	size_t tsc = L.targets ? code(g.tscale, (uint32_t)L.targets, 4, 0, NULL) : 0;
+	/* Coarsest first; each level's block in the order (of the writer's
+	 * three, on that level's triangles) that codes its block and indices
+	 * to the fewest bytes. */
+	for (int k = n - 1; k >= 0; k--) {
+		uint32_t count0 = count;
+		memcpy(saved, set.slot, sizeof *saved * set.cap);
+		size_t best = 0;
+		int bo = 0;
+		for (int t = 0; t <= MLOD_PACK_ORDERS; t++) {
+			int o = t < MLOD_PACK_ORDERS ? t : bo;
+			memcpy(set.slot, saved, sizeof *saved * set.cap);
+			count = count0;
+			uint32_t u;
+			uint32_t *ix = append_level(&set, G, &count, V[k], in[k], ni[k], nv[k], o, L.stride, &u);
+			if (t == MLOD_PACK_ORDERS) {
+				idx[k] = ix, used[k] = u, prefix[k] = count;
+				break;
 			}
-			size_t b1 = 0, b2 = 0, tsc = L.targets ? code(g.tscale, (uint32_t)L.targets, 4, 0, NULL) : 0;
-			blobs *k1 = pass == 1 ? &T->B1 : NULL, *k2 = pass == 2 ? &T->B2 : NULL;
-			if (pass != 2)
-				b1 = code_vertices(G, 0, count, &L, k1) + tsc;
-			if (pass != 1)
-				for (int k = n - 1; k >= 0; k--) {
-					uint32_t first = k == n - 1 ? 0 : prefix[k + 1];
-					b2 += code_vertices(G, first, prefix[k] - first, &L, k2) + tsc;
-				}
-			for (int k = 0; k < n; k++) {
-				size_t ib = code_indices(idx[k], ni[k], prefix[k], pass == 1 ? k1 : pass == 2 ? k2 : NULL);
-				b1 += ib, b2 += ib;
-				if (pass == 1)
-					T->ib1 += ib;
-			}
-			if (pass == 2) {
-				job *q = realloc(T->jobs, sizeof *q * ((size_t)T->njobs + 1));
-				if (!q)
-					exit(1);
-				T->jobs = q;
-				job *J = &T->jobs[T->njobs++];
-				J->G = xmalloc((size_t)count * (size_t)L.stride);
-				memcpy(J->G, G, (size_t)count * (size_t)L.stride);
-				J->stride = L.stride, J->n = n, J->count = count;
-				for (int k = 0; k < n; k++)
-					J->prefix[k] = prefix[k], J->ni[k] = ni[k], J->idx[k] = idx[k];
-			} else {
-				for (int k = 0; k < n; k++)
-					free(idx[k]);
-			}
-			if (pass == 0 && (o == 0 || b1 < best1))
-				best1 = b1, o1 = o;
-			if (pass == 0 && (o == 0 || b2 < best2))
-				best2 = b2, o2 = o;
-			if (pass == 1) { /* per level figures (order o1) */
-				T->unique_b += count;
-				for (int k = 0; k < n; k++)
-					T->prefix[k] += prefix[k], T->used[k] += used[k];
-			}
+			size_t b = code_vertices(G, count0, count - count0, &L, NULL) + code_indices(ix, ni[k], count, NULL);
+			if (t == 0 || b < best)
+				best = b, bo = o;
+			free(ix);
 		}
 	}
-	T->b1 += best1, T->b2 += best2;
+	/* b1: the buffer whole; b2: per level block. Indices the same. */
+	size_t b1 = code_vertices(G, 0, count, &L, &T->B1) + tsc, b2 = 0;
+	for (int k = n - 1; k >= 0; k--) {
+		uint32_t first = k == n - 1 ? 0 : prefix[k + 1];
+		size_t vb = code_vertices(G, first, prefix[k] - first, &L, &T->B2) + tsc;
+		size_t ib = code_indices(idx[k], ni[k], prefix[k], &T->B2);
+		code_indices(idx[k], ni[k], prefix[k], &T->B1);
+		b1 += ib, b2 += vb + ib;
+		T->ib1 += ib, T->lb2[k] += vb + ib;
+		T->prefix[k] += prefix[k], T->used[k] += used[k];
+	}
+	T->b1 += b1, T->b2 += b2, T->unique_b += count;
+	job *q = realloc(T->jobs, sizeof *q * ((size_t)T->njobs + 1));
+	if (!q)
+		exit(1);
+	T->jobs = q;
+	job *J = &T->jobs[T->njobs++];
+	J->G = G, J->stride = L.stride, J->n = n, J->count = count;
+	for (int k = 0; k < n; k++)
+		J->prefix[k] = prefix[k], J->ni[k] = ni[k], J->idx[k] = idx[k];
 	for (int k = 0; k < n; k++)
 		free(V[k]), free(in[k]);
-	free(G), free(set.slot), free(g.tscale);
+	free(set.slot), free(saved), free(g.tscale);
 }
 
 /* The stream bytes of the MESH chunks mlod_pack_write makes (but 'PART'),
@@ -825,8 +831,8 @@ int main(int argc, char **argv)
 				if (n > 0)
 					sg = shared_grid(lv, n, &(totals){0});
 				for (int l = 0; l < n; l++) {
-					layout_a(lv[l], skin, wide, NULL, &T);
-					layout_a(lv[l], skin, wide, &sg, &T);
+					layout_a(lv[l], l, skin, wide, NULL, &T);
+					layout_a(lv[l], l, skin, wide, &sg, &T);
 					T.nv[l] += lv[l]->vertex_count;
 					T.verts_a += lv[l]->vertex_count;
 				}
@@ -861,8 +867,8 @@ int main(int argc, char **argv)
 		for (int l = 0; l < T.levels && at < (int)sizeof extra[ne]; l++) {
 			char e[32];
 			pct(e, sizeof e, (double)(T.prefix[l] - T.used[l]), (double)T.nv[l]);
-			at += snprintf(extra[ne] + at, sizeof extra[ne] - (size_t)at, " %ld / %ld / %ld: +%s |", T.nv[l],
-			               T.prefix[l], T.used[l], e);
+			at += snprintf(extra[ne] + at, sizeof extra[ne] - (size_t)at, " %ld / %ld / %ld: +%s; %zu / %zu B |",
+			               T.nv[l], T.prefix[l], T.used[l], e, T.la[l], T.lb2[l]);
 		}
 		if (T.union_wider)
 			at += snprintf(extra[ne] + at, sizeof extra[ne] - (size_t)at,
@@ -885,7 +891,8 @@ int main(int argc, char **argv)
 		mlod_character_free(&c);
 	}
 	printf("\nPer level (0 finest), vertices (a) / prefix (b) / used of the prefix: + the prefix's vertices the level\n"
-	       "does not use, which a runtime skinning the whole prefix skins beyond (a), as a %% of the level's (a) vertices.\n\n");
+	       "does not use, which a runtime skinning the whole prefix skins beyond (a), as a %% of the level's (a) vertices;\n"
+	       "then the level's bytes in (a) / in (b2) (its appended block and its indices).\n\n");
 	printf("| input | level 0 | level 1 | level 2 | level 3 | (b)'s shared grid | index bytes (a) / (b) |\n"
 	       "|---|---|---|---|---|---|---|\n");
 	for (int e = 0; e < ne; e++)
