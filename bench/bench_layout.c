@@ -2,7 +2,7 @@
  * bench_layout: mesh level layouts of the pack, measured side by side
  * (issue 11: "measure at least two layouts and document the choice").
  *
- *   bench_layout FILE.glb ...
+ *   bench_layout [-c] FILE.glb ...
  *
  * The mesh levels are computed as mlod-pack computes them with its
  * defaults (mlod-bgm's ratios 0.5 0.25 0.1). Each part (a triangle
@@ -41,7 +41,8 @@
  * and the other way for a runtime that wants (a)'s buffers: expanding
  * (b) to per-level buffers at load (gather the vertices each level's
  * indices use from the decoded prefix, rewrite the indices), best of 51
- * in thread CPU time, on top of the decode.
+ * in thread CPU time, on top of the decode. With -c, also (c) estimated:
+ * the coarsest level plus the recorded vertex splits (layout_c says how).
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -432,6 +433,12 @@ typedef struct totals {
 	unsigned maxcode;                  /* (b)'s largest position code */
 	int parts;
 	blobs A, B1, B2;                   /* the best orders' streams, for the decode */
+	/* (c) estimate: parts done, parts whose rebuilt sequence missed the
+	 * pack's coarsest level; coarsest bytes ((a)'s), vertices appended by
+	 * the splits, their coded bytes, the records' bits, the splits */
+	int c_parts, c_missed;
+	size_t c_base, c_vbytes, c_bits;
+	long c_verts, c_splits, c_base_verts;
 	job *jobs;                         /* (b2)'s order, per part */
 	int njobs;
 } totals;
@@ -667,6 +674,104 @@ static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide,
 	free(set.slot), free(saved), free(g.tscale);
 }
 
+/* (c), estimated: rebuilds the part's BGM as mlod_mesh_levels does (same
+ * options, poses and joint weights), takes the prefix that gives the
+ * pack's coarsest level (checked: same vertex and index counts), and
+ * replays its splits coarse to fine. Vertices: every vertex of every
+ * intermediate mesh (mlod_bgm_extract at each prefix) not bit-identical on
+ * (b)'s grid to one already sent, appended in split order and coded with
+ * meshopt's vertex codec like (b)'s blocks. Records, bit-packed, no entropy
+ * coding: the split node (ceil log2 of the part's vertex total), the
+ * counts of faces brought back and taken away (8 bits), 3 vertex
+ * references per face brought back (ceil log2 of the vertex total) and an
+ * id per face taken away (ceil log2 of the faces ever made). */
+static void layout_c(const mlod_mesh_levels *ML, int instance, int primitive, const mlod_primitive *const *lv, int n,
+                     int skin, int wide, size_t coarse_bytes, totals *T)
+{
+	const mlod_character *c = ML->c;
+	const mlod_primitive *p0 = lv[0], *pc = lv[n - 1];
+	int triangles = (p0->index_count > 0 ? p0->index_count : p0->vertex_count) / 3;
+	if (n < 2 || triangles < 4 || c->instances[instance].node < 0)
+		return;
+	mlod_bgm *g = NULL;
+	mlod_error err = {0};
+	if (mlod_bgm_build(c, instance, primitive, &ML->opt, &g, &err) != MLOD_OK ||
+	    mlod_bgm_simplify(g, (int)ceil(0.1 * triangles), 0, &err) != MLOD_OK ||
+	    (ML->budget == MLOD_BUDGET_CHARACTER && mlod_bgm_simplify(g, 0, 0, &err) != MLOD_OK)) {
+		mlod_bgm_free(g);
+		T->c_missed++;
+		return;
+	}
+	int P = mlod_bgm_prefix_for(g, pc->index_count / 3);
+	mlod_primitive e;
+	if (mlod_bgm_extract(g, P, c->instances[instance].skin < 0, &e, &err) != MLOD_OK) {
+		mlod_bgm_free(g);
+		T->c_missed++;
+		return;
+	}
+	int same = e.vertex_count == pc->vertex_count && e.index_count == pc->index_count;
+	mlod_primitive_free(&e);
+	if (!same) {
+		mlod_bgm_free(g);
+		T->c_missed++;
+		return;
+	}
+	grid gr = shared_grid(lv, n, &(totals){0});
+	layout L = make_layout(p0, skin, wide);
+	size_t cap = 1024;
+	uint8_t *C = xmalloc(cap * (size_t)L.stride);
+	vset set = {0};
+	set.cap = 1 << 20;
+	set.slot = calloc(set.cap, sizeof *set.slot);
+	uint32_t count = 0, base = 0;
+	for (int k = P; k >= 0; k--) {
+		if (mlod_bgm_extract(g, k, c->instances[instance].skin < 0, &e, &err) != MLOD_OK)
+			exit(1);
+		uint8_t *V = xmalloc((size_t)e.vertex_count * (size_t)L.stride + 1);
+		quantise(&e, &L, &gr, skin, wide, V);
+		if (count + (size_t)e.vertex_count > cap) {
+			while (count + (size_t)e.vertex_count > cap)
+				cap *= 2;
+			uint8_t *q = realloc(C, cap * (size_t)L.stride);
+			if (!q)
+				exit(1);
+			C = q;
+		}
+		for (int v = 0; v < e.vertex_count; v++)
+			vset_get(&set, C, &count, V + (size_t)v * (size_t)L.stride, L.stride);
+		if (2 * (size_t)count >= set.cap) {
+			fprintf(stderr, "bench_layout: (c): a part with more than %zu vertices\n", set.cap / 2);
+			exit(1);
+		}
+		if (k == P)
+			base = count;
+		free(V);
+		mlod_primitive_free(&e);
+	}
+	int nrec;
+	const mlod_vsplit *seq = mlod_bgm_sequence(g, &nrec);
+	long faces = triangles;
+	for (int r = 0; r < P; r++)
+		faces += seq[r].added_count;
+	int vbits = 1, fbits = 1;
+	while ((1ul << vbits) < count)
+		vbits++;
+	while ((1l << fbits) < faces)
+		fbits++;
+	size_t bits = 0;
+	for (int r = 0; r < P; r++)
+		bits += (size_t)vbits + 8 + 3 * (size_t)vbits * (size_t)seq[r].removed_count + (size_t)fbits * (size_t)seq[r].added_count;
+	T->c_parts++;
+	T->c_base += coarse_bytes;
+	T->c_base_verts += base;
+	T->c_verts += count - base;
+	T->c_vbytes += code_vertices(C, base, count - base, &L, NULL);
+	T->c_bits += bits;
+	T->c_splits += P;
+	free(C), free(set.slot), free(gr.tscale);
+	mlod_bgm_free(g);
+}
+
 /* The stream bytes of the MESH chunks mlod_pack_write makes (but 'PART'),
  * padded as stored: what (a) must come to. */
 static size_t packed_mesh_bytes(const char *path, int *levels)
@@ -781,9 +886,10 @@ static void pct(char *out, size_t n, double part, double whole)
 int main(int argc, char **argv)
 {
 	if (argc < 2) {
-		fprintf(stderr, "usage: bench_layout FILE.glb ...\n");
+		fprintf(stderr, "usage: bench_layout [-c] FILE.glb ...\n");
 		return 1;
 	}
+	int with_c = strcmp(argv[1], "-c") == 0, first = 1 + with_c;
 	static const double ratios_default[] = {MLOD_MESH_RATIOS_DEFAULT};
 	int nr = (int)(sizeof ratios_default / sizeof *ratios_default);
 	printf("| input | levels | parts | (a) per level | (a) on (b)'s grid | (b1) one buffer | (b2) per-level blocks | (b2) / (a) |"
@@ -791,7 +897,9 @@ int main(int argc, char **argv)
 	printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
 	char extra[64][512];
 	int ne = 0;
-	for (int i = 1; i < argc; i++) {
+	char ctab[64][512];
+	int nc = 0;
+	for (int i = first; i < argc; i++) {
 		mlod_character c = {0};
 		if (bench_load("bench_layout", argv[i], &c, NULL))
 			return 2;
@@ -830,6 +938,7 @@ int main(int argc, char **argv)
 				grid sg = {0};
 				if (n > 0)
 					sg = shared_grid(lv, n, &(totals){0});
+				size_t coarse_before = n > 0 ? T.la[n - 1] : 0;
 				for (int l = 0; l < n; l++) {
 					layout_a(lv[l], l, skin, wide, NULL, &T);
 					layout_a(lv[l], l, skin, wide, &sg, &T);
@@ -838,6 +947,8 @@ int main(int argc, char **argv)
 				}
 				if (n > 0)
 					layout_b(lv, n, skin, wide, &T), T.parts++;
+				if (n > 0 && with_c)
+					layout_c(&ML, k, q, lv, n, skin, wide, T.la[n - 1] - coarse_before, &T);
 				free(sg.tscale);
 			}
 		}
@@ -880,6 +991,13 @@ int main(int argc, char **argv)
 			snprintf(extra[ne] + at, sizeof extra[ne] - (size_t)at, " %zu / %zu |", T.ia, T.ib1);
 		if (ne < 63)
 			ne++;
+		if (with_c && nc < 64) {
+			size_t cb = T.c_base + T.c_vbytes + (T.c_bits + 7) / 8;
+			snprintf(ctab[nc++], sizeof ctab[0],
+			         "| %s | %d (%d missed) | %ld | %zu | %ld + %ld | %zu | %zu | %zu | %.1f%% |", name, T.c_parts,
+			         T.c_missed, T.c_splits, T.c_base, T.c_base_verts, T.c_verts, T.c_vbytes, (T.c_bits + 7) / 8, cb,
+			         100.0 * (double)cb / (double)T.a);
+		}
 		blobs_free(&T.A), blobs_free(&T.B1), blobs_free(&T.B2);
 		for (int j = 0; j < T.njobs; j++) {
 			free(T.jobs[j].G);
@@ -897,5 +1015,13 @@ int main(int argc, char **argv)
 	       "|---|---|---|---|---|---|---|\n");
 	for (int e = 0; e < ne; e++)
 		printf("%s\n", extra[e]);
+	if (with_c) {
+		printf("\n(c) estimated (-c): the coarsest level as (a) stores it, then the recorded splits replayed coarse to fine\n"
+		       "(parts with a BGM; 'missed': rebuilt sequence did not give the pack's coarsest level, left out).\n\n");
+		printf("| input | parts | splits | coarsest (a) bytes | vertices coarsest + appended | appended, meshopt |"
+		       " records, bit-packed | (c) total | (c) / (a) |\n|---|---|---|---|---|---|---|---|---|\n");
+		for (int e = 0; e < nc; e++)
+			printf("%s\n", ctab[e]);
+	}
 	return 0;
 }

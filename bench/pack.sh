@@ -38,7 +38,7 @@ echo
 echo "## Pack: mesh level layouts, (a) per level as stored against (b) one prefix buffer per part"
 echo
 # shellcheck disable=SC2086
-[ -z "$glbs" ] || "$BUILD/bench/bench_layout" $glbs || echo "bench_layout failed (exit $?): see its message above"
+[ -z "$glbs" ] || "$BUILD/bench/bench_layout" -c $glbs || echo "bench_layout failed (exit $?): see its message above"
 echo
 echo "## Pack: every level in one file, against gltfpack 1.3"
 echo
