@@ -11,8 +11,35 @@
 /* a * b for affine a and b (bottom rows 0 0 0 1), as a 3x4 product: the
  * same sums in the same order as mlod_mat4_mul less its terms that
  * multiply by the bottom row's zeros, so the same floats (up to the sign
- * of a zero). */
-void rt_mat_mul(const float *restrict a, const float *restrict b, float *out)
+ * of a zero). out may be a or b. */
+#if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
+/* GCC and Clang: a column per 4-lane vector (SSE, NEON). */
+typedef float rt_m4 __attribute__((vector_size(16)));
+
+static inline rt_m4 col(const float *p)
+{
+	rt_m4 v;
+	memcpy(&v, p, sizeof v);
+	return v;
+}
+
+void rt_mat_mul(const float *a, const float *b, float *out)
+{
+	const rt_m4 a0 = col(a), a1 = col(a + 4), a2 = col(a + 8), a3 = col(a + 12);
+	const rt_m4 b0 = col(b), b1 = col(b + 4), b2 = col(b + 8), b3 = col(b + 12);
+	const rt_m4 r0 = a0 * b0[0] + a1 * b0[1] + a2 * b0[2];
+	const rt_m4 r1 = a0 * b1[0] + a1 * b1[1] + a2 * b1[2];
+	const rt_m4 r2 = a0 * b2[0] + a1 * b2[1] + a2 * b2[2];
+	const rt_m4 r3 = a0 * b3[0] + a1 * b3[1] + a2 * b3[2] + a3;
+	memcpy(out, &r0, sizeof r0);
+	memcpy(out + 4, &r1, sizeof r1);
+	memcpy(out + 8, &r2, sizeof r2);
+	memcpy(out + 12, &r3, sizeof r3);
+	out[3] = out[7] = out[11] = 0.0f;
+	out[15] = 1.0f;
+}
+#else
+void rt_mat_mul(const float *a, const float *b, float *out)
 {
 	float r[16];
 	for (int c = 0; c < 3; c++)
@@ -24,6 +51,7 @@ void rt_mat_mul(const float *restrict a, const float *restrict b, float *out)
 	r[15] = 1.0f;
 	memcpy(out, r, sizeof r);
 }
+#endif
 
 /* The local matrix of t as mlod_mat4_from_trs makes it: the rotation's
  * rows in double (its quat_to_rows), times the scale, rounded to float. */
