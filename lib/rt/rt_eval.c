@@ -110,21 +110,14 @@ static inline void quat_slerp(const float *a, const float *b, float t, int unit,
 	quat_blend(a, ct - d * wb, b, sign * wb, out);
 }
 
-/* One channel at the key position p, as lib/model/pose.c's sample_channel
- * followed, for rotations, by sample_motion's normalisation. */
+/* One channel between keys p->i and p->i + 1 (LINEAR or CUBICSPLINE), as
+ * lib/model/pose.c's sample_channel followed, for rotations, by
+ * sample_motion's normalisation. */
 static void sample_channel(const mlod_pack_channel *ch, const rt_key_pos *p, int comps, int unit, float *out)
 {
 	const int cubic = ch->rec.interp == 2;
-	const size_t stride = cubic ? 3 * (size_t)comps : (size_t)comps, value = cubic ? (size_t)comps : 0;
+	const size_t stride = cubic ? 3 * (size_t)comps : (size_t)comps;
 	const float *v = ch->values;
-	if (p->k >= 0 || ch->rec.interp == 1) { /* on a key, or STEP */
-		const float *a = v + (size_t)(p->k >= 0 ? (uint32_t)p->k : p->i) * stride + value;
-		if (comps == 4 && !unit)
-			quat_norm(a, out);
-		else
-			memcpy(out, a, (size_t)comps * sizeof *out);
-		return;
-	}
 	const float u = p->u;
 	const float *a = v + (size_t)p->i * stride, *b = v + (size_t)(p->i + 1) * stride;
 	if (!cubic) { /* LINEAR */
@@ -153,7 +146,9 @@ static void sample_channel(const mlod_pack_channel *ch, const rt_key_pos *p, int
 }
 
 /* Samples the channels of the posed joints into local. flags: the motion
- * unit's channel bits, nbits of them (ctx->chan_bits; NULL: none). */
+ * unit's channel bits, nbits of them (ctx->chan_bits; NULL: none). A
+ * value read from a key (one key, clamped, STEP: a constant channel is
+ * stored as one key) is copied here; sample_channel interpolates. */
 static void sample_motion(const mlod_pack_motion *m, const uint8_t *flags, uint32_t nbits, float t,
                           const uint8_t *needed, mlod_trs *local)
 {
@@ -163,24 +158,35 @@ static void sample_motion(const mlod_pack_motion *m, const uint8_t *flags, uint3
 		const uint32_t n = ch->rec.key_count;
 		if (n < 1 || !needed[ch->rec.joint])
 			continue;
-		if (ch->times != p.times || n != p.n)
-			key_pos(ch->times, n, t, &p);
-		mlod_trs *l = &local[ch->rec.joint];
+		const int rot = ch->rec.path != 0 && ch->rec.path != 2;
+		const int unit = rot && flags && i < nbits ? (flags[i >> 3] >> (i & 7)) & 1 : 0;
+		const int comps = rot ? 4 : 3;
+		const float *key;
 		float v[4];
-		switch (ch->rec.path) {
-		case 0:
-			sample_channel(ch, &p, 3, 0, v);
-			l->t.x = v[0], l->t.y = v[1], l->t.z = v[2];
-			break;
-		case 2:
-			sample_channel(ch, &p, 3, 0, v);
-			l->s.x = v[0], l->s.y = v[1], l->s.z = v[2];
-			break;
-		default:
-			sample_channel(ch, &p, 4, flags && i < nbits ? (flags[i >> 3] >> (i & 7)) & 1 : 0, v);
-			l->r.x = v[0], l->r.y = v[1], l->r.z = v[2], l->r.w = v[3];
-			break;
+		uint32_t k = 0;
+		if (n > 1) {
+			if (ch->times != p.times || n != p.n)
+				key_pos(ch->times, n, t, &p);
+			k = p.k >= 0 ? (uint32_t)p.k : p.i;
 		}
+		if (n == 1 || p.k >= 0 || ch->rec.interp == 1) { /* on a key, or STEP */
+			const int cubic = ch->rec.interp == 2;
+			key = ch->values + (size_t)k * (cubic ? 3 * (size_t)comps : (size_t)comps) + (cubic ? comps : 0);
+			if (rot && !unit) {
+				quat_norm(key, v);
+				key = v;
+			}
+		} else {
+			sample_channel(ch, &p, comps, unit, v);
+			key = v;
+		}
+		mlod_trs *l = &local[ch->rec.joint];
+		if (rot)
+			l->r.x = key[0], l->r.y = key[1], l->r.z = key[2], l->r.w = key[3];
+		else if (ch->rec.path == 0)
+			l->t.x = key[0], l->t.y = key[1], l->t.z = key[2];
+		else
+			l->s.x = key[0], l->s.y = key[1], l->s.z = key[2];
 	}
 }
 
