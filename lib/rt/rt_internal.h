@@ -145,9 +145,8 @@ size_t rt_bytes_skel_level(const mlod_pack_skel_level *l);
 size_t rt_bytes_mesh(const mlod_pack_mesh *m);
 size_t rt_bytes_motion(const mlod_pack_motion *m);
 
-/* rt_math.c: the affine helpers (4x4 column-major, bottom row 0 0 0 1). */
-void rt_mat_mul(const float *a, const float *b, float *out);
-void rt_mat_trs(const mlod_trs *t, float *out);                         /* mlod_mat4_from_trs */
-void rt_mat_mul_trs(const float *parent, const mlod_trs *t, float *out); /* parent * rt_mat_trs(t) */
+/* rt_math.h: the affine helpers rt_mat_mul (a * b), rt_mat_trs
+ * (mlod_mat4_from_trs) and rt_mat_mul_trs (parent * rt_mat_trs(t)). */
+#include "rt_math.h"
 
 #endif

@@ -1,12 +1,15 @@
 /*
- * rt_math.c: the runtime's matrix helpers (rt_internal.h), used both when
- * a pack opens (rt_ctx.c: rest poses) and every frame (rt_eval.c).
+ * rt_math.h: the runtime's affine matrix helpers (4x4 column-major, bottom
+ * row 0 0 0 1), used both when a pack opens (rt_ctx.c: rest poses) and
+ * every frame (rt_eval.c), inline: a pose makes a few per joint.
+ * Included by rt_internal.h.
  */
+#ifndef MLOD_RT_MATH_H
+#define MLOD_RT_MATH_H
+
 #include <string.h>
 
-#include "rt_internal.h"
-
-/* ---------------------------------------------------------------- */
+#include "mlod_core.h"
 
 /* a * b for affine a and b (bottom rows 0 0 0 1), as a 3x4 product: the
  * same sums in the same order as mlod_mat4_mul less its terms that
@@ -16,17 +19,17 @@
 /* GCC and Clang: a column per 4-lane vector (SSE, NEON). */
 typedef float rt_m4 __attribute__((vector_size(16)));
 
-static inline rt_m4 col(const float *p)
+static inline rt_m4 rt_m4_load(const float *p)
 {
 	rt_m4 v;
 	memcpy(&v, p, sizeof v);
 	return v;
 }
 
-void rt_mat_mul(const float *a, const float *b, float *out)
+static inline void rt_mat_mul(const float *a, const float *b, float *out)
 {
-	const rt_m4 a0 = col(a), a1 = col(a + 4), a2 = col(a + 8), a3 = col(a + 12);
-	const rt_m4 b0 = col(b), b1 = col(b + 4), b2 = col(b + 8), b3 = col(b + 12);
+	const rt_m4 a0 = rt_m4_load(a), a1 = rt_m4_load(a + 4), a2 = rt_m4_load(a + 8), a3 = rt_m4_load(a + 12);
+	const rt_m4 b0 = rt_m4_load(b), b1 = rt_m4_load(b + 4), b2 = rt_m4_load(b + 8), b3 = rt_m4_load(b + 12);
 	const rt_m4 r0 = a0 * b0[0] + a1 * b0[1] + a2 * b0[2];
 	const rt_m4 r1 = a0 * b1[0] + a1 * b1[1] + a2 * b1[2];
 	const rt_m4 r2 = a0 * b2[0] + a1 * b2[1] + a2 * b2[2];
@@ -39,7 +42,7 @@ void rt_mat_mul(const float *a, const float *b, float *out)
 	out[15] = 1.0f;
 }
 #else
-void rt_mat_mul(const float *a, const float *b, float *out)
+static inline void rt_mat_mul(const float *a, const float *b, float *out)
 {
 	float r[16];
 	for (int c = 0; c < 3; c++)
@@ -55,7 +58,7 @@ void rt_mat_mul(const float *a, const float *b, float *out)
 
 /* The local matrix of t as mlod_mat4_from_trs makes it: the rotation's
  * rows in double (its quat_to_rows), times the scale, rounded to float. */
-static void trs_cols(const mlod_trs *t, float m[16])
+static inline void rt_trs_cols(const mlod_trs *t, float m[16])
 {
 	const double x = t->r.x, y = t->r.y, z = t->r.z, w = t->r.w;
 	const double n = x * x + y * y + z * z + w * w;
@@ -75,15 +78,17 @@ static void trs_cols(const mlod_trs *t, float m[16])
 	m[15] = 1.0f;
 }
 
-void rt_mat_trs(const mlod_trs *t, float *out)
+static inline void rt_mat_trs(const mlod_trs *t, float *out)
 {
-	trs_cols(t, out);
+	rt_trs_cols(t, out);
 }
 
 /* parent * trs(t): rt_mat_mul(parent, rt_mat_trs(t)) in one go. */
-void rt_mat_mul_trs(const float *restrict parent, const mlod_trs *t, float *restrict out)
+static inline void rt_mat_mul_trs(const float *restrict parent, const mlod_trs *t, float *restrict out)
 {
 	float l[16];
-	trs_cols(t, l);
+	rt_trs_cols(t, l);
 	rt_mat_mul(parent, l, out);
 }
+
+#endif
