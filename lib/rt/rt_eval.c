@@ -14,7 +14,8 @@
 /* ---------------------------------------------------------------- */
 
 /* The key i with times[i] <= t < times[i + 1], for times[0] < t <
- * times[n - 1] and times increasing (the pack reader checks it): the one
+ * times[n - 1] and times increasing (the pack reader checks it; for views
+ * unchecked, but i stays within 0 .. n - 2 whatever the times): the one
  * key a binary search finds, without its branches (a conditional move per
  * halving instead of a mispredicted jump). */
 static uint32_t find_key(const float *times, uint32_t n, float t)
