@@ -120,7 +120,14 @@
  * STEP holds the key; LINEAR lerps translation and scale and slerps
  * rotation (mlod_quat_slerp: shortest arc); CUBICSPLINE is glTF's Hermite
  * with tangents scaled by the key interval; rotations are normalised after
- * sampling. Joints without a channel keep their rest TRS.
+ * sampling. Joints without a channel keep their rest TRS. The one
+ * departure: slerp's weights come from one sine and one cosine instead of
+ * three sines, which in double moves them by about 1e-13 of themselves,
+ * far below a float's resolution (the committed samples' poses are the
+ * same floats). The levels the runtime decodes from a pack have their
+ * rotation keys normalised once when they load (when that gives the same
+ * samples), so that sampling need not normalise them every frame; views
+ * are never changed.
  *
  * Skeleton levels, folded at run time: a kept joint c whose parent chain
  * j1 (its parent) ... jk was removed gets the local transform

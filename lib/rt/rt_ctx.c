@@ -184,6 +184,48 @@ static void mat_identity(float *m)
 	m[0] = m[5] = m[10] = m[15] = 1.0f;
 }
 
+/* Checks a motion level and sets its channel bits (ctx->chan_bits). A
+ * level the runtime decoded (owned) has the keys of a non-cubic rotation
+ * replaced by their normalisation when each of those is its own: sampling
+ * normalises every key it reads (mlod_quat_slerp, and sample_motion after
+ * a key or STEP), so the samples stay the same floats, and the keys need
+ * no normalising per frame. The caller's views are only read. */
+static mlod_result prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_motion *m, mlod_error *err)
+{
+	mlod_result r = check_motion(ctx, m, u->level, u->item, err);
+	if (r || !ctx->chan_bits)
+		return r;
+	uint8_t *bits = ctx->chan_bits + (size_t)(u - &ctx->units[ctx->unit_base[MLOD_RT_MOTION]]) * ctx->chan_bytes;
+	memset(bits, 0, ctx->chan_bytes);
+	for (uint32_t i = 0; i < m->channel_count && i < 8 * ctx->chan_bytes; i++) {
+		const mlod_pack_channel *ch = &m->channels[i];
+		if (ch->rec.path != 1 || ch->rec.interp == 2)
+			continue;
+		/* unit: every key its own normalisation; norm: every key's
+		 * normalisation its own (then an owned level takes them). */
+		int unit = 1, norm = u->owned;
+		for (uint32_t k = 0; k < ch->rec.key_count && (unit || norm); k++) {
+			const float *q = ch->values + 4 * (size_t)k;
+			mlod_quat a = { q[0], q[1], q[2], q[3] };
+			mlod_quat b = mlod_quat_normalize(a), c = mlod_quat_normalize(b);
+			unit &= memcmp(&a, &b, sizeof a) == 0;
+			norm &= memcmp(&b, &c, sizeof b) == 0;
+		}
+		if (!unit && norm) {
+			for (uint32_t k = 0; k < ch->rec.key_count; k++) {
+				float *q = ch->values + 4 * (size_t)k;
+				mlod_quat b = mlod_quat_normalize((mlod_quat){ q[0], q[1], q[2], q[3] });
+				q[0] = b.x, q[1] = b.y, q[2] = b.z, q[3] = b.w;
+			}
+			unit = 1;
+		}
+		if (unit)
+			bits[i >> 3] |= (uint8_t)(1u << (i & 7));
+	}
+	u->chan_flags = bits;
+	return MLOD_OK;
+}
+
 /* Builds the plan of a skeleton level (level >= 1) into one block. */
 static mlod_result prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_skel_level *l, mlod_error *err)
 {
@@ -276,6 +318,7 @@ static void unit_release(mlod_rt_ctx *ctx, rt_unit *u)
 	rt_free(ctx, u->plan_block);
 	u->plan_block = NULL;
 	memset(&u->plan, 0, sizeof u->plan);
+	u->chan_flags = NULL;
 	u->skel = NULL, u->mesh = NULL, u->motion = NULL;
 	ctx->resident_bytes -= u->bytes;
 	u->bytes = 0;
@@ -319,7 +362,7 @@ static mlod_result unit_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 	switch (u->layer) {
 	case MLOD_RT_SKELETON: r = prepare_skel(ctx, u, u->skel, err); break;
 	case MLOD_RT_MESH: r = check_mesh(ctx, u->mesh, u->level, &u->vertex_count, err); break;
-	default: r = check_motion(ctx, u->motion, u->level, u->item, err); break;
+	default: r = prepare_motion(ctx, u, u->motion, err); break;
 	}
 	ctx->resident_bytes += u->bytes;
 	if (r) {
@@ -530,7 +573,10 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 	ctx->all_needed = rt_calloc(ctx, J, 1);
 	ctx->clip_duration = rt_calloc(ctx, ctx->clip_count + 1, sizeof(float));
 	ctx->inst = rt_calloc(ctx, ctx->max_instances, sizeof *ctx->inst);
-	if (!ctx->skin_offset || !ctx->rest_world || !ctx->rest_local || !ctx->all_joints || !ctx->all_needed ||
+	const size_t motion_units = (size_t)ctx->levels[MLOD_RT_MOTION] * ctx->clip_count;
+	ctx->chan_bytes = (3 * J + 7) / 8;
+	ctx->chan_bits = motion_units ? rt_calloc(ctx, motion_units, ctx->chan_bytes) : NULL;
+	if ((motion_units && !ctx->chan_bits) || !ctx->skin_offset || !ctx->rest_world || !ctx->rest_local || !ctx->all_joints || !ctx->all_needed ||
 	    !ctx->clip_duration || !ctx->inst)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
 	uint64_t pal = 0;
@@ -666,6 +712,7 @@ void mlod_rt_close(mlod_rt_ctx *ctx)
 	rt_free(ctx, ctx->all_joints);
 	rt_free(ctx, ctx->all_needed);
 	rt_free(ctx, ctx->clip_duration);
+	rt_free(ctx, ctx->chan_bits);
 	rt_free(ctx, ctx->inst);
 	rt_free(ctx, ctx->morph_offset);
 	rt_free(ctx, ctx->morph_weights);

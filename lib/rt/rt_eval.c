@@ -13,91 +13,181 @@
 /* Sampling (as lib/model/pose.c's sample_channel)                   */
 /* ---------------------------------------------------------------- */
 
+/* The key i with times[i] <= t < times[i + 1], for times[0] < t <
+ * times[n - 1] and times increasing (the pack reader checks it; for views
+ * unchecked, but i stays within 0 .. n - 2 whatever the times): the one
+ * key a binary search finds, without its branches (a conditional move per
+ * halving instead of a mispredicted jump). */
 static uint32_t find_key(const float *times, uint32_t n, float t)
 {
-	uint32_t lo = 0, hi = n - 1;
-	while (hi - lo > 1) {
-		uint32_t mid = lo + (hi - lo) / 2;
-		if (times[mid] <= t)
-			lo = mid;
-		else
-			hi = mid;
+	const float *base = times;
+	uint32_t len = n - 1; /* the key is in [base, base + len) */
+	while (len > 1) {
+		const uint32_t half = len / 2;
+		base = base[half] <= t ? base + half : base;
+		len -= half;
 	}
-	return lo;
+	return (uint32_t)(base - times);
 }
 
-static void sample_channel(const mlod_pack_channel *ch, float t, int comps, float *out)
+/* Where t falls in a channel's key times: on key k (clamped, or one key),
+ * or between keys i and i + 1 at u. Channels sharing a key-time array
+ * (the pack's, mlod(5)) share it, so sample_motion finds it once. */
+typedef struct rt_key_pos {
+	const float *times;
+	uint32_t n;
+	int32_t k; /* >= 0: on key k; -1: between i and i + 1 */
+	uint32_t i;
+	float u, dt;
+} rt_key_pos;
+
+static void key_pos(const float *times, uint32_t n, float t, rt_key_pos *p)
 {
-	const uint32_t n = ch->rec.key_count;
-	const int cubic = ch->rec.interp == 2;
-	const size_t stride = cubic ? 3 * (size_t)comps : (size_t)comps, value = cubic ? (size_t)comps : 0;
-	const float *v = ch->values;
-	const float *times = ch->times;
-	int64_t k;
-	if (n == 1 || !(t > times[0]))
-		k = 0;
-	else if (t >= times[n - 1])
-		k = n - 1;
-	else
-		k = -1;
-	if (k >= 0) {
-		memcpy(out, v + (size_t)k * stride + value, (size_t)comps * sizeof *out);
+	p->times = times, p->n = n;
+	if (n == 1 || !(t > times[0])) {
+		p->k = 0;
+	} else if (t >= times[n - 1]) {
+		p->k = (int32_t)n - 1;
+	} else {
+		p->k = -1;
+		p->i = find_key(times, n, t);
+		const float t0 = times[p->i], t1 = times[p->i + 1];
+		p->dt = t1 - t0;
+		p->u = (t - t0) / p->dt;
+	}
+}
+
+/* mlod_quat_normalize, inline: the same doubles. */
+static inline void quat_norm(const float *q, float *out)
+{
+	const double n = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
+	if (!(n > 0.0) || !isfinite(n)) {
+		out[0] = out[1] = out[2] = 0.0f, out[3] = 1.0f;
 		return;
 	}
-	const uint32_t i = find_key(times, n, t);
-	const float t0 = times[i], t1 = times[i + 1], dt = t1 - t0;
-	const float u = (t - t0) / dt;
-	const float *a = v + (size_t)i * stride, *b = v + (size_t)(i + 1) * stride;
-	switch (ch->rec.interp) {
-	case 1: /* STEP */
-		memcpy(out, a, (size_t)comps * sizeof *out);
-		break;
-	case 0: /* LINEAR */
+	out[0] = (float)(q[0] / n), out[1] = (float)(q[1] / n), out[2] = (float)(q[2] / n), out[3] = (float)(q[3] / n);
+}
+
+/* lib/core/math.c's quat_blend: the same doubles. */
+static inline void quat_blend(const float *a, double wa, const float *b, double wb, float *out)
+{
+	const double x = wa * a[0] + wb * b[0], y = wa * a[1] + wb * b[1];
+	const double z = wa * a[2] + wb * b[2], w = wa * a[3] + wb * b[3];
+	const double n = sqrt(x * x + y * y + z * z + w * w);
+	if (!(n > 0.0)) {
+		out[0] = out[1] = out[2] = 0.0f, out[3] = 1.0f;
+		return;
+	}
+	out[0] = (float)(x / n), out[1] = (float)(y / n), out[2] = (float)(z / n), out[3] = (float)(w / n);
+}
+
+/* mlod_quat_slerp(a, b, t), the same doubles; unit: a and b are their own
+ * normalisation (the channel's bit in ctx->chan_bits), which it then
+ * skips. */
+static inline void quat_slerp(const float *a, const float *b, float t, int unit, float *out)
+{
+	float na[4], nb[4];
+	if (!unit) {
+		quat_norm(a, na), quat_norm(b, nb);
+		a = na, b = nb;
+	}
+	double d = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2] + (double)a[3] * b[3];
+	const double sign = d < 0.0 ? -1.0 : 1.0;
+	d = fabs(d);
+	if (d > 0.9995) { /* nearly parallel: the chord is the arc */
+		quat_blend(a, 1.0 - t, b, sign * t, out);
+		return;
+	}
+	/* The weights sin((1 - t) theta) / sin theta and sin(t theta) / sin
+	 * theta with one sine and one cosine (of t theta) instead of three
+	 * sines: sin theta = sqrt(1 - d^2) and sin((1 - t) theta) = sin theta
+	 * cos(t theta) - d sin(t theta). Both are exact in reals; in double
+	 * they differ from mlod_quat_slerp's by ~1e-13 of the weight (d <=
+	 * 0.9995 keeps 1 - d^2 >= 1e-3), far below a float's 6e-8, so the
+	 * blended floats agree but for a rare last bit. */
+	const double theta = acos(d), s = sqrt(1.0 - d * d);
+	const double st = sin(t * theta), ct = cos(t * theta);
+	const double wb = st / s;
+	quat_blend(a, ct - d * wb, b, sign * wb, out);
+}
+
+/* One channel between keys p->i and p->i + 1 (LINEAR or CUBICSPLINE), as
+ * lib/model/pose.c's sample_channel followed, for rotations, by
+ * sample_motion's normalisation. */
+static void sample_channel(const mlod_pack_channel *ch, const rt_key_pos *p, int comps, int unit, float *out)
+{
+	const int cubic = ch->rec.interp == 2;
+	const size_t stride = cubic ? 3 * (size_t)comps : (size_t)comps;
+	const float *v = ch->values;
+	const float u = p->u;
+	const float *a = v + (size_t)p->i * stride, *b = v + (size_t)(p->i + 1) * stride;
+	if (!cubic) { /* LINEAR */
 		if (comps == 4) {
-			mlod_quat qa = { a[0], a[1], a[2], a[3] }, qb = { b[0], b[1], b[2], b[3] };
-			mlod_quat q = mlod_quat_slerp(qa, qb, u);
-			out[0] = q.x, out[1] = q.y, out[2] = q.z, out[3] = q.w;
+			float q[4];
+			quat_slerp(a, b, u, unit, q);
+			quat_norm(q, out);
 		} else {
 			for (int c = 0; c < comps; c++)
 				out[c] = a[c] + (b[c] - a[c]) * u;
 		}
-		break;
-	default: { /* CUBICSPLINE: glTF Appendix C */
-		const float u2 = u * u, u3 = u2 * u;
-		const float h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u;
-		const float h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
-		for (int c = 0; c < comps; c++)
-			out[c] = h00 * a[comps + c] + h10 * dt * a[2 * comps + c] + h01 * b[comps + c] + h11 * dt * b[c];
-		break;
+		return;
 	}
-	}
+	/* CUBICSPLINE: glTF Appendix C */
+	const float dt = p->dt;
+	const float u2 = u * u, u3 = u2 * u;
+	const float h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u;
+	const float h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
+	float q[4];
+	for (int c = 0; c < comps; c++)
+		q[c] = h00 * a[comps + c] + h10 * dt * a[2 * comps + c] + h01 * b[comps + c] + h11 * dt * b[c];
+	if (comps == 4)
+		quat_norm(q, out);
+	else
+		memcpy(out, q, 3 * sizeof *out);
 }
 
-/* Samples the channels of the posed joints into local. */
-static void sample_motion(const mlod_pack_motion *m, float t, const uint8_t *needed, mlod_trs *local)
+/* Samples the channels of the posed joints into local. flags: the motion
+ * unit's channel bits, nbits of them (ctx->chan_bits; NULL: none). A
+ * value read from a key (one key, clamped, STEP: a constant channel is
+ * stored as one key) is copied here; sample_channel interpolates. */
+static void sample_motion(const mlod_pack_motion *m, const uint8_t *flags, uint32_t nbits, float t,
+                          const uint8_t *needed, mlod_trs *local)
 {
+	rt_key_pos p = { NULL, 0, 0, 0, 0.0f, 0.0f };
 	for (uint32_t i = 0; i < m->channel_count; i++) {
 		const mlod_pack_channel *ch = &m->channels[i];
-		if (ch->rec.key_count < 1 || !needed[ch->rec.joint])
+		const uint32_t n = ch->rec.key_count;
+		if (n < 1 || !needed[ch->rec.joint])
 			continue;
-		mlod_trs *l = &local[ch->rec.joint];
+		const int rot = ch->rec.path != 0 && ch->rec.path != 2;
+		const int unit = rot && flags && i < nbits ? (flags[i >> 3] >> (i & 7)) & 1 : 0;
+		const int comps = rot ? 4 : 3;
+		const float *key;
 		float v[4];
-		switch (ch->rec.path) {
-		case 0:
-			sample_channel(ch, t, 3, v);
-			l->t.x = v[0], l->t.y = v[1], l->t.z = v[2];
-			break;
-		case 2:
-			sample_channel(ch, t, 3, v);
-			l->s.x = v[0], l->s.y = v[1], l->s.z = v[2];
-			break;
-		default: {
-			sample_channel(ch, t, 4, v);
-			mlod_quat q = { v[0], v[1], v[2], v[3] };
-			l->r = mlod_quat_normalize(q);
-			break;
+		uint32_t k = 0;
+		if (n > 1) {
+			if (ch->times != p.times || n != p.n)
+				key_pos(ch->times, n, t, &p);
+			k = p.k >= 0 ? (uint32_t)p.k : p.i;
 		}
+		if (n == 1 || p.k >= 0 || ch->rec.interp == 1) { /* on a key, or STEP */
+			const int cubic = ch->rec.interp == 2;
+			key = ch->values + (size_t)k * (cubic ? 3 * (size_t)comps : (size_t)comps) + (cubic ? comps : 0);
+			if (rot && !unit) {
+				quat_norm(key, v);
+				key = v;
+			}
+		} else {
+			sample_channel(ch, &p, comps, unit, v);
+			key = v;
 		}
+		mlod_trs *l = &local[ch->rec.joint];
+		if (rot)
+			l->r.x = key[0], l->r.y = key[1], l->r.z = key[2], l->r.w = key[3];
+		else if (ch->rec.path == 0)
+			l->t.x = key[0], l->t.y = key[1], l->t.z = key[2];
+		else
+			l->s.x = key[0], l->s.y = key[1], l->s.z = key[2];
 	}
 }
 
@@ -177,13 +267,11 @@ mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	if (ctx->clip_count) {
 		const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MOTION, st->level[MLOD_RT_MOTION], st->clip);
 		if (mu && mu->state == RT_UNIT_RESIDENT)
-			sample_motion(mu->motion, sample_time(ctx, st), needed, local);
+			sample_motion(mu->motion, mu->chan_flags, 8 * ctx->chan_bytes, sample_time(ctx, st), needed, local);
 	}
 	for (uint32_t i = 0; i < npose; i++) {
 		const uint32_t j = posed[i];
-		float l[16];
-		rt_mat_trs(&local[j], l);
-		rt_mat_mul(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, l, W + 16 * (size_t)j);
+		rt_mat_mul_trs(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, &local[j], W + 16 * (size_t)j);
 	}
 	s->skel_unit = su;
 	s->posed = 1;

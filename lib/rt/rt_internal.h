@@ -47,6 +47,7 @@ typedef struct rt_unit {
 	const mlod_pack_mesh *mesh;
 	const mlod_pack_motion *motion;
 	rt_skel_plan plan;        /* skeleton levels >= 1 */
+	uint8_t *chan_flags;      /* resident motion levels: a bit per channel (in ctx->chan_bits) */
 	void *plan_block;
 } rt_unit;
 
@@ -96,6 +97,12 @@ struct mlod_rt_ctx {
 	uint32_t levels[MLOD_RT_LAYERS];
 	uint32_t clip_count;
 	float *clip_duration;
+	/* Per motion unit, a bit per channel (the first 3 x joint_count): set
+	 * when the channel is a non-cubic rotation whose keys are each their
+	 * own mlod_quat_normalize, so sampling need not normalise them.
+	 * Allocated at open, chan_bytes per motion unit. */
+	uint8_t *chan_bits;
+	uint32_t chan_bytes;
 	/* Units: skeleton levels, mesh levels, then motion clip-major. */
 	rt_unit *units;
 	uint32_t unit_count;
@@ -138,8 +145,8 @@ size_t rt_bytes_skel_level(const mlod_pack_skel_level *l);
 size_t rt_bytes_mesh(const mlod_pack_mesh *m);
 size_t rt_bytes_motion(const mlod_pack_motion *m);
 
-/* rt_eval.c: the 3x4 affine helpers. */
-void rt_mat_mul(const float *a, const float *b, float *out); /* 4x4 column-major, affine */
-void rt_mat_trs(const mlod_trs *t, float *out);
+/* rt_math.h: the affine helpers rt_mat_mul (a * b), rt_mat_trs
+ * (mlod_mat4_from_trs) and rt_mat_mul_trs (parent * rt_mat_trs(t)). */
+#include "rt_math.h"
 
 #endif

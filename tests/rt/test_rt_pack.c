@@ -4,7 +4,10 @@
  * character of rt_test.h: three skeleton, three mesh and three motion
  * levels of two clips. Opened from memory, from a file and through read
  * callbacks, it must pose exactly as the views and skin within the
- * quantisation of positions, normals and weights. Then every truncated prefix and
+ * quantisation of positions, normals and weights; and pose to the same
+ * floats as the pack decoded by its reader and handed over as views (the
+ * runtime normalises the rotation keys of the levels it decodes, never the
+ * views'). Then every truncated prefix and
  * 10,000 mutations (half with every CRC fixed, so that the decoders' own
  * checks are reached) go through open, streaming and one frame of
  * evaluation: an error is fine, a crash or a sanitizer report is not.
@@ -478,6 +481,98 @@ TEST(pack_equals_views)
 	CHECK(mlod_rt_open_path("/nonexistent/x.mlod", NULL, &p, &e) == MLOD_ERR_IO && !p, "missing file");
 }
 
+/* The pack decoded by its reader into views: the runtime reads views and
+ * never changes them, while it normalises the rotation keys of the levels
+ * it decodes itself when loading them (and then skips normalising them
+ * each frame). Both must pose to the same floats, at every level, clip
+ * and many times (and so give the same palettes). */
+TEST(pack_poses_as_its_decoded_views)
+{
+	mlod_error e;
+	mlod_pack pk;
+	CHECK_OK(mlod_pack_open(pack.d, pack.n, &pk, &e), e);
+	mlod_pack_skeleton sk;
+	CHECK_OK(mlod_pack_decode_skeleton(&pk, pack.d, pack.n, &sk, &e), e);
+	enum { L = 3, C = 2 };
+	mlod_pack_skel_level sl[L];
+	mlod_pack_mesh ml[L];
+	mlod_pack_motion mo[C * L];
+	mlod_rt_view_level vs[L], vm[L], vo[C * L];
+	memset(vs, 0, sizeof vs), memset(vm, 0, sizeof vm), memset(vo, 0, sizeof vo);
+	int got = 0;
+	for (uint32_t i = 0; i < pk.chunk_count; i++) {
+		const mlod_pack_chunk *c = &pk.chunks[i];
+		if (c->level >= L || c->item >= C)
+			continue;
+		if (c->type == MLOD_CHUNK_SKELETON && c->level > 0) {
+			CHECK_OK(mlod_pack_decode_skel_level(&pk, i, pack.d, pack.n, &sk, &sl[c->level], &e), e);
+			vs[c->level].data = &sl[c->level], got++;
+		} else if (c->type == MLOD_CHUNK_MESH) {
+			CHECK_OK(mlod_pack_decode_mesh(&pk, i, pack.d, pack.n, &sk, &ml[c->level], &e), e);
+			vm[c->level].data = &ml[c->level], got++;
+		} else if (c->type == MLOD_CHUNK_MOTION) {
+			const uint32_t k = c->item * L + c->level;
+			CHECK_OK(mlod_pack_decode_motion(&pk, i, pack.d, pack.n, &sk, &mo[k], &e), e);
+			vo[k].data = &mo[k], got++;
+		}
+	}
+	CHECK(got == (L - 1) + L + C * L, "%d levels decoded", got);
+	const mlod_rt_views views = { &sk, L, vs, L, vm, C, L, vo };
+	mlod_rt_ctx *v = NULL, *m = NULL;
+	CHECK_OK(mlod_rt_open_views(&views, NULL, &v, &e), e);
+	CHECK_OK(mlod_rt_open_memory(pack.d, pack.n, NULL, &m, &e), e);
+	CHECK(fx_load_all(v) == 0 && fx_load_all(m) == 0, "streaming every level failed");
+	mlod_rt_scratch *sv = mlod_rt_scratch_create(v), *sm = mlod_rt_scratch_create(m);
+	double worst = 0;
+	int poses = 0;
+	for (uint32_t clip = 0; clip < C; clip++)
+		for (int level = 0; level < L; level++) {
+			uint32_t iv, im;
+			CHECK_OK(mlod_rt_instance_create(v, clip, 0, MLOD_RT_LOOP, &iv, &e), e);
+			CHECK_OK(mlod_rt_instance_create(m, clip, 0, MLOD_RT_LOOP, &im, &e), e);
+			mlod_rt_select sel;
+			mlod_rt_select_default(&sel);
+			sel.force_level = level;
+			float d = 1;
+			for (int f = 0; f < 97; f++) {
+				const float dt = f ? 0.0371f : 0.0f;
+				CHECK_OK(mlod_rt_update(v, &sel, &iv, &d, 1, dt, &e), e);
+				CHECK_OK(mlod_rt_update(m, &sel, &im, &d, 1, dt, &e), e);
+				const float *wv, *wm, *pv, *pm;
+				uint32_t nv, nm, qv, qm;
+				const uint32_t *jv, *jm;
+				CHECK_OK(mlod_rt_pose(v, sv, iv, &wv, &jv, &nv, &e), e);
+				CHECK_OK(mlod_rt_pose(m, sm, im, &wm, &jm, &nm, &e), e);
+				CHECK(nv == nm && memcmp(jv, jm, nv * sizeof *jv) == 0, "kept joints differ");
+				for (uint32_t j = 0; j < nv; j++) {
+					double x = fx_maxdiff(wv + 16 * jv[j], wm + 16 * jm[j], 16);
+					worst = x > worst ? x : worst;
+				}
+				CHECK_OK(mlod_rt_palette(v, sv, &pv, &qv, &e), e);
+				CHECK_OK(mlod_rt_palette(m, sm, &pm, &qm, &e), e);
+				CHECK(qv == qm, "palettes of %u and %u", qv, qm);
+				double x = fx_maxdiff(pv, pm, 16 * (int)qv);
+				worst = x > worst ? x : worst;
+				poses++;
+			}
+			mlod_rt_instance_destroy(v, iv);
+			mlod_rt_instance_destroy(m, im);
+		}
+	CHECK(worst == 0, "the pack's own decode poses %g away from its decoded views", worst);
+	printf("# %d poses of the pack, decoded by the runtime and as views: equal\n", poses);
+	mlod_rt_scratch_destroy(v, sv), mlod_rt_scratch_destroy(m, sm);
+	mlod_rt_close(v), mlod_rt_close(m);
+	for (int l = 0; l < L; l++) {
+		if (l > 0)
+			mlod_pack_skel_level_free(&sl[l]);
+		mlod_pack_mesh_free(&ml[l]);
+	}
+	for (int k = 0; k < C * L; k++)
+		mlod_pack_motion_free(&mo[k]);
+	mlod_pack_skeleton_free(&sk);
+	mlod_pack_close(&pk);
+}
+
 /* ---------------------------------------------------------------- */
 /* The tracking allocator                                            */
 /* ---------------------------------------------------------------- */
@@ -750,6 +845,7 @@ int main(void)
 	build_pack(&pack);
 	printf("# pack of %zu bytes, %d chunks\n", pack.n, nchunks);
 	RUN(pack_equals_views);
+	RUN(pack_poses_as_its_decoded_views);
 	RUN(pack_budget);
 	RUN(hooks_only);
 	RUN(truncated_prefixes);
