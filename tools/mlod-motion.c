@@ -61,6 +61,8 @@ static const char usage_text[] =
 	"                          default 2, the midpoints too)\n"
 	"  -l, --level K           with a .bvh output: the level to write (0 = as read)\n"
 	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
+	"  -j, --threads N         work on N threads (default: the processors online);\n"
+	"                          the output is the same at any N\n"
 	"  -h, --help              show this help\n"
 	"  -V, --version           show the version\n"
 	"\n"
@@ -113,6 +115,7 @@ struct job {
 	mlod_motion_options opt;
 	int spec_count;
 	struct spec specs[MAX_LEVELS];
+	int threads;
 	int clip_count;
 	struct clip *clips;
 };
@@ -165,59 +168,64 @@ static mlod_character with_clip(const mlod_character *c, const mlod_clip *clip)
 	return s;
 }
 
-static void measure_vertex(struct job *job, struct clip *cl, struct level *lv)
-{
-	if (job->c.instance_count == 0)
-		return;
-	mlod_character a = with_clip(&job->c, &job->c.clips[cl->index]), b = with_clip(&job->c, &lv->l.clip);
-	mlod_error err = {0};
-	mlod_result r = mlod_vertex_deviation(&a, &b, VERTEX_SAMPLES, &lv->vertex, &err);
-	if (r != MLOD_OK)
-		tool_die(tool_exit_code(r), job->input, "clip \"%s\": %s", job->c.clips[cl->index].name, err.message);
-	lv->has_vertex = 1;
-}
-
-/* A copy of a weight track. */
-static void copy_track(const mlod_weight_track *in, mlod_weight_track *out)
+/* A copy of a weight track (NULL values when out of memory). */
+static mlod_result copy_track(const mlod_weight_track *in, mlod_weight_track *out)
 {
 	size_t n = (size_t)in->key_count, v = n * (size_t)in->targets * (in->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
 	*out = *in;
 	out->times = malloc(sizeof(float) * n);
 	out->values = malloc(sizeof(float) * v);
 	if (!out->times || !out->values)
-		tool_die(EXIT_INPUT, NULL, "out of memory");
+		return MLOD_ERR_NOMEM;
 	memcpy(out->times, in->times, sizeof(float) * n);
 	memcpy(out->values, in->values, sizeof(float) * v);
+	return MLOD_OK;
 }
 
-/* The level's morph weights: each track reduced within the level's bound
- * (or, for a level chosen by keys or threshold, its joint error). */
-static void level_weights(struct job *job, struct clip *cl, struct level *lv)
+/* A level's measures: its skinned-vertex error and its morph weights, each
+ * track reduced within the level's bound (or, for a level chosen by keys or
+ * threshold, its joint error). Fills only lv; on failure err says why and
+ * *vertex_failed whether the vertex error failed (the weights not made). */
+static mlod_result level_extras(const struct job *job, const struct clip *cl, struct level *lv, int *vertex_failed,
+                                mlod_error *err)
 {
+	*vertex_failed = 0;
+	if (job->c.instance_count > 0) {
+		mlod_character a = with_clip(&job->c, &job->c.clips[cl->index]), b = with_clip(&job->c, &lv->l.clip);
+		mlod_result r = mlod_vertex_deviation(&a, &b, VERTEX_SAMPLES, &lv->vertex, err);
+		if (r != MLOD_OK) {
+			*vertex_failed = 1;
+			return r;
+		}
+		lv->has_vertex = 1;
+	}
 	if (cl->w_count == 0)
-		return;
+		return MLOD_OK;
 	lv->w = calloc((size_t)cl->w_count, sizeof *lv->w);
 	if (!lv->w)
-		tool_die(EXIT_INPUT, NULL, "out of memory");
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	lv->w_count = cl->w_count;
 	lv->w_bound = lv->bound >= 0.0 ? lv->bound : lv->l.error.max;
 	int sub = job->opt.subdivide > 0 ? job->opt.subdivide : MLOD_DEFAULT_SUBDIVIDE;
 	for (int i = 0; i < cl->w_count; i++) {
 		const mlod_weight_track *t = &cl->w[i];
 		double *reach = malloc(sizeof(double) * (size_t)t->targets), e = 0.0;
-		mlod_error err = {0};
 		if (!reach)
-			tool_die(EXIT_INPUT, NULL, "out of memory");
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		mlod_error why = {0};
 		mlod_result r = t->interp == MLOD_INTERP_CUBICSPLINE
 		                    ? MLOD_ERR_UNSUPPORTED
-		                    : mlod_morph_target_reach(&job->c, t->node, t->targets, reach, &err);
+		                    : mlod_morph_target_reach(&job->c, t->node, t->targets, reach, &why);
 		if (r == MLOD_OK)
-			r = mlod_weight_track_reduce(t, reach, lv->w_bound, sub, &lv->w[i], &e, &err);
+			r = mlod_weight_track_reduce(t, reach, lv->w_bound, sub, &lv->w[i], &e, &why);
 		free(reach);
-		if (r == MLOD_ERR_NOMEM)
-			tool_die(EXIT_INPUT, job->input, "%s", err.message);
+		if (r == MLOD_ERR_NOMEM) {
+			*err = why;
+			return r;
+		}
 		if (r != MLOD_OK) {
-			copy_track(t, &lv->w[i]);
+			if (copy_track(t, &lv->w[i]) != MLOD_OK)
+				return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 			lv->w_copied++;
 		} else if (e > lv->w_error) {
 			lv->w_error = e;
@@ -225,14 +233,71 @@ static void level_weights(struct job *job, struct clip *cl, struct level *lv)
 	}
 	lv->w_keys = mlod_weight_tracks_keys(lv->w, lv->w_count);
 	lv->w_bytes = mlod_weight_tracks_bytes(lv->w, lv->w_count);
+	return MLOD_OK;
 }
 
-/* Builds the levels of one clip. */
-static void clip_levels(struct job *job, struct clip *cl)
+/* What building a clip's levels gave, gathered before anything is said. */
+struct clip_outcome {
+	mlod_result w_result; /* reading its morph weights channels */
+	mlod_error w_error;
+	mlod_motion_clip_levels built;
+	mlod_result *extras;  /* per level: level_extras' result */
+	mlod_error *extras_error;
+	int *vertex_failed;
+};
+
+struct extras_ctx {
+	const struct job *job;
+	struct clip_outcome *out;
+	int *item_clip, *item_level;
+};
+
+static mlod_result extras_item(void *ctx, int i)
+{
+	struct extras_ctx *x = ctx;
+	int k = x->item_clip[i], s = x->item_level[i];
+	struct clip_outcome *o = &x->out[k];
+	struct clip *cl = &x->job->clips[k];
+	o->extras[s] = level_extras(x->job, cl, &cl->levels[s], &o->vertex_failed[s], &o->extras_error[s]);
+	return MLOD_OK;
+}
+
+/* Says what one clip's levels gave, in the order they were asked for:
+ * messages and failures come out as if the clips and levels were built
+ * one after another. */
+static void clip_report(struct job *job, struct clip *cl, const struct clip_outcome *o)
 {
 	const mlod_clip *src = &job->c.clips[cl->index];
-	mlod_error err = {0};
-	mlod_motion *m[2] = {NULL, NULL};
+	if (o->w_result != MLOD_OK)
+		tool_die(EXIT_INPUT, job->input, "%s", o->w_error.message);
+	if (o->built.result != MLOD_OK)
+		tool_die(tool_exit_code(o->built.result), job->input, "%s", o->built.error.message);
+	if (cl->frames < 3) {
+		fprintf(stderr, "%s: %s: clip \"%s\" has %d frame%s: nothing to reduce, no levels\n", tool_name, job->input,
+		        src->name, cl->frames, cl->frames == 1 ? "" : "s");
+		return;
+	}
+	for (int s = 0; s < o->built.level_count; s++) {
+		mlod_result r = o->built.results[s];
+		if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
+			tool_die(tool_exit_code(r), job->input, "%s", o->built.errors[s].message);
+		if (r == MLOD_ERR_LIMIT) {
+			fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, o->built.errors[s].message);
+			continue;
+		}
+		if (o->extras[s] != MLOD_OK) {
+			if (o->vertex_failed[s])
+				tool_die(tool_exit_code(o->extras[s]), job->input, "clip \"%s\": %s", src->name,
+				         o->extras_error[s].message);
+			tool_die(EXIT_INPUT, job->input, "%s", o->extras_error[s].message);
+		}
+	}
+}
+
+/* Builds the levels of every clip of the job, their measures and morph
+ * weights, on job->threads threads. */
+static void build_levels(struct job *job)
+{
 	mlod_motion_method methods[2];
 	int method_count = 0;
 	if (job->method == METHOD_AUTO) {
@@ -241,47 +306,79 @@ static void clip_levels(struct job *job, struct clip *cl)
 	} else {
 		methods[method_count++] = (mlod_motion_method)job->method;
 	}
-	cl->keys = mlod_clip_key_count(src);
-	cl->bytes = mlod_clip_key_bytes(src);
-	if (job->doc && src->gltf_index >= 0) {
-		if (mlod_gltf_weight_tracks(job->doc, src->gltf_index, &cl->w, &cl->w_count, &err) != MLOD_OK)
-			tool_die(EXIT_INPUT, job->input, "%s", err.message);
-		cl->w_keys = mlod_weight_tracks_keys(cl->w, cl->w_count);
-		cl->keys += cl->w_keys;
-		cl->bytes += mlod_weight_tracks_bytes(cl->w, cl->w_count);
-	}
-	for (int i = 0; i < method_count; i++) {
-		mlod_result r = mlod_motion_create(&job->c, cl->index, &job->opt, &m[i], &err);
-		if (r != MLOD_OK)
-			tool_die(tool_exit_code(r), job->input, "%s", err.message);
-	}
-	cl->timeline = *mlod_motion_timeline_info(m[0]);
-	cl->frames = cl->timeline.frames;
-	if (cl->frames < 3) {
-		fprintf(stderr, "%s: %s: clip \"%s\" has %d frame%s: nothing to reduce, no levels\n", tool_name, job->input,
-		        src->name, cl->frames, cl->frames == 1 ? "" : "s");
-		for (int i = 0; i < method_count; i++)
-			mlod_motion_free(m[i]);
-		return;
-	}
+	mlod_motion_spec specs[MAX_LEVELS];
 	for (int s = 0; s < job->spec_count; s++) {
 		const struct spec *sp = &job->specs[s];
-		struct level *lv = &cl->levels[cl->level_count++];
-		double value = sp->percent ? sp->value * job->height / 100.0 : sp->value;
-		lv->bound = sp->target == MLOD_MOTION_MAX_ERROR ? value : -1.0;
-		mlod_result r = mlod_motion_next_level_best(m, methods, method_count, sp->target, value, &lv->l, &err);
-		if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
-			tool_die(tool_exit_code(r), job->input, "%s", err.message);
-		lv->ok = r == MLOD_OK;
-		if (!lv->ok) {
-			fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, err.message);
-		} else {
-			measure_vertex(job, cl, lv);
-			level_weights(job, cl, lv);
+		specs[s].target = sp->target;
+		specs[s].value = sp->percent ? sp->value * job->height / 100.0 : sp->value;
+	}
+	int n = job->clip_count, items = 0;
+	int *clips = malloc(sizeof(int) * (size_t)n);
+	struct clip_outcome *out = calloc((size_t)n, sizeof *out);
+	mlod_motion_clip_levels *built = calloc((size_t)n, sizeof *built);
+	int *item_clip = malloc(sizeof(int) * (size_t)n * MAX_LEVELS), *item_level = malloc(sizeof(int) * (size_t)n * MAX_LEVELS);
+	if (!clips || !out || !built || !item_clip || !item_level)
+		tool_die(EXIT_INPUT, job->input, "out of memory");
+	for (int k = 0; k < n; k++) {
+		struct clip *cl = &job->clips[k];
+		const mlod_clip *src = &job->c.clips[cl->index];
+		clips[k] = cl->index;
+		cl->keys = mlod_clip_key_count(src);
+		cl->bytes = mlod_clip_key_bytes(src);
+		if (job->doc && src->gltf_index >= 0) {
+			out[k].w_result = mlod_gltf_weight_tracks(job->doc, src->gltf_index, &cl->w, &cl->w_count, &out[k].w_error);
+			cl->w_keys = mlod_weight_tracks_keys(cl->w, cl->w_count);
+			cl->keys += cl->w_keys;
+			cl->bytes += mlod_weight_tracks_bytes(cl->w, cl->w_count);
 		}
 	}
-	for (int i = 0; i < method_count; i++)
-		mlod_motion_free(m[i]);
+	mlod_error err = {0};
+	mlod_result r = mlod_motion_build_levels(&job->c, clips, n, &job->opt, methods, method_count, specs,
+	                                         job->spec_count, job->threads, built, &err);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), job->input, "%s", err.message);
+	for (int k = 0; k < n; k++) {
+		struct clip *cl = &job->clips[k];
+		struct clip_outcome *o = &out[k];
+		o->built = built[k];
+		cl->timeline = o->built.timeline;
+		cl->frames = cl->timeline.frames;
+		int count = o->built.level_count;
+		o->extras = calloc((size_t)count + 1, sizeof *o->extras);
+		o->extras_error = calloc((size_t)count + 1, sizeof *o->extras_error);
+		o->vertex_failed = calloc((size_t)count + 1, sizeof *o->vertex_failed);
+		if (!o->extras || !o->extras_error || !o->vertex_failed)
+			tool_die(EXIT_INPUT, job->input, "out of memory");
+		if (o->w_result != MLOD_OK || o->built.result != MLOD_OK)
+			continue;
+		for (int s = 0; s < count; s++) {
+			const struct spec *sp = &job->specs[s];
+			struct level *lv = &cl->levels[cl->level_count++];
+			lv->bound = sp->target == MLOD_MOTION_MAX_ERROR ? specs[s].value : -1.0;
+			lv->ok = o->built.results[s] == MLOD_OK;
+			if (lv->ok) {
+				lv->l = o->built.levels[s];
+				memset(&o->built.levels[s], 0, sizeof o->built.levels[s]);
+				item_clip[items] = k;
+				item_level[items++] = s;
+			}
+		}
+	}
+	struct extras_ctx x = { job, out, item_clip, item_level };
+	mlod_parallel_for(items, job->threads, extras_item, &x);
+	for (int k = 0; k < n; k++)
+		clip_report(job, &job->clips[k], &out[k]);
+	for (int k = 0; k < n; k++) {
+		free(out[k].extras);
+		free(out[k].extras_error);
+		free(out[k].vertex_failed);
+	}
+	mlod_motion_clip_levels_free(built, n);
+	free(built);
+	free(out);
+	free(clips);
+	free(item_clip);
+	free(item_level);
 }
 
 /* What was done to a level's morph weights, as a JSON object. */
@@ -531,6 +628,7 @@ int main(int argc, char **argv)
 		{"subdivide", required_argument, NULL, 'D'},
 		{"level", required_argument, NULL, 'l'},
 		{"clip", required_argument, NULL, 'c'},
+		{"threads", required_argument, NULL, 'j'},
 		{"help", no_argument, NULL, 'h'},
 		{"version", no_argument, NULL, 'V'},
 		{NULL, 0, NULL, 0},
@@ -542,10 +640,11 @@ int main(int argc, char **argv)
 	double point_distance = 0.0;
 	memset(&job, 0, sizeof job);
 	job.method = METHOD_AUTO;
+	job.threads = mlod_thread_count();
 
 	tool_name = "mlod-motion";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::m:e:t:k:l:c:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, ":o:r::m:e:t:k:l:c:j:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -606,6 +705,7 @@ int main(int argc, char **argv)
 		}
 		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
 		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
+		case 'j': job.threads = tool_parse_threads(optarg); break;
 		case 'h': fputs(usage_text, stdout); return 0;
 		case 'V': tool_version();
 		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
@@ -663,11 +763,10 @@ int main(int argc, char **argv)
 	job.clips = calloc((size_t)job.clip_count + 1, sizeof *job.clips);
 	if (!job.clips)
 		tool_die(EXIT_INPUT, job.input, "out of memory");
-	for (int k = 0; k < job.clip_count; k++) {
+	for (int k = 0; k < job.clip_count; k++)
 		job.clips[k].index = bvh_out ? clip : k;
-		if (!(bvh_out && level == 0))
-			clip_levels(&job, &job.clips[k]);
-	}
+	if (!(bvh_out && level == 0))
+		build_levels(&job);
 	for (int k = 0; k < job.clip_count && report == REPORT_NONE; k++)
 		if (job.clips[k].timeline.resampled) {
 			char note[256];

@@ -2,9 +2,10 @@
  * mlod_motion.h: the motion layer (paper 4.3): the common timeline
  * (timeline.c), the point error both methods answer to (pointerror.c), the
  * multiresolution motion tree and the levels (motion.c), per-channel key
- * reduction under a hierarchical error bound (keyreduce.c), and morph
- * target weight tracks (morphweights.c). Files call one way: motion.c
- * calls keyreduce.c, both call pointerror.c and timeline.c. motion_eval.h
+ * reduction under a hierarchical error bound (keyreduce.c), morph
+ * target weight tracks (morphweights.c), and the levels of many clips on
+ * threads (levels.c). Files call one way: levels.c calls motion.c, which
+ * calls keyreduce.c; both call pointerror.c and timeline.c. motion_eval.h
  * (internal) holds the inline fast forms of sampling, kinematics and the
  * point error check that motion.c and keyreduce.c measure with.
  */
@@ -200,6 +201,40 @@ mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method meth
 mlod_result mlod_motion_next_level_best(mlod_motion *const *m, const mlod_motion_method *methods, int n,
                                         mlod_motion_target target, double value, mlod_motion_level *out,
                                         mlod_error *err);
+
+/* One level asked for: its target and value (as mlod_motion_next_level). */
+typedef struct mlod_motion_spec {
+	mlod_motion_target target;
+	double value;
+} mlod_motion_spec;
+
+/* The levels of one clip (mlod_motion_build_levels). */
+typedef struct mlod_motion_clip_levels {
+	mlod_result result;       /* MLOD_OK, or why the clip's motions could not be made (error) */
+	mlod_error error;
+	mlod_motion_timeline timeline;
+	int level_count;          /* levels tried, in spec order: 0 for a clip of fewer than 3 frames
+	                             (nothing to reduce); a failure other than MLOD_ERR_LIMIT ends them */
+	mlod_motion_level *levels; /* level_count; those whose result is MLOD_OK are set */
+	mlod_result *results;     /* per level: MLOD_OK, MLOD_ERR_LIMIT (no method meets the target) or
+	                             the failure that ended the levels */
+	mlod_error *errors;       /* per level: why, when not MLOD_OK */
+} mlod_motion_clip_levels;
+
+/* The levels of clips[0..clip_count) of c, out[k] for clips[k]: for each
+ * clip, mlod_motion_create with opt for each of the method_count (1 or 2)
+ * methods, then for each spec in order the level
+ * mlod_motion_next_level_best makes. Clips, and the methods of a clip,
+ * run on up to `threads` threads; the levels do not depend on the
+ * thread count. Returns MLOD_OK (each clip's outcome is in out[k]) or
+ * MLOD_ERR_NOMEM / MLOD_ERR_INVALID_ARG. Release out with
+ * mlod_motion_clip_levels_free (levels taken over by the caller are to be
+ * zeroed, or their results set to other than MLOD_OK). */
+mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, int clip_count,
+                                     const mlod_motion_options *opt, const mlod_motion_method *methods,
+                                     int method_count, const mlod_motion_spec *specs, int spec_count, int threads,
+                                     mlod_motion_clip_levels *out, mlod_error *err);
+void mlod_motion_clip_levels_free(mlod_motion_clip_levels *out, int count);
 
 /* Morph target weights of a level (beyond the paper). A weight error dw on
  * a target moves a vertex by dw times that target's offset there, so a
