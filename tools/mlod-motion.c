@@ -77,33 +77,6 @@ struct spec {
 	int percent;     /* max error given in % of the height */
 };
 
-struct level {
-	int ok;          /* 0 when no level met the bound */
-	double bound;    /* scene units, for max-error levels */
-	mlod_motion_level l;
-	int has_vertex;
-	mlod_deviation vertex; /* % of the diagonal; scale is the diagonal */
-	/* Morph weights channels of the level (glTF input with such channels). */
-	mlod_weight_track *w;
-	int w_count;
-	int w_copied;    /* tracks kept as they are (CUBICSPLINE, or no mesh to measure) */
-	double w_bound;  /* scene units: the level's bound, or its joint error without one */
-	double w_error;  /* the largest vertex displacement bound of the reduced tracks */
-	long w_keys, w_bytes;
-};
-
-struct clip {
-	int index;
-	int frames;
-	mlod_motion_timeline timeline;
-	long keys, bytes;   /* joint channels and morph weights */
-	mlod_weight_track *w; /* the source's morph weights channels */
-	int w_count;
-	long w_keys;
-	int level_count;
-	struct level levels[MAX_LEVELS];
-};
-
 struct job {
 	const char *input;
 	const mlod_gltf *doc; /* glTF input, else NULL */
@@ -116,19 +89,7 @@ struct job {
 	int spec_count;
 	struct spec specs[MAX_LEVELS];
 	int threads;
-	int clip_count;
-	struct clip *clips;
 };
-
-static const char *method_name(mlod_motion_method m)
-{
-	return m == MLOD_MOTION_KEYS ? "keys" : "frames";
-}
-
-static const char *target_name(mlod_motion_target t)
-{
-	return t == MLOD_MOTION_THRESHOLD ? "threshold" : t == MLOD_MOTION_FRACTION ? "keys" : "max_error";
-}
 
 /* Parses a comma-separated list (tool_parse_list); "E%" is allowed for
  * error bounds. */
@@ -158,388 +119,62 @@ static int spec_order(const void *a, const void *b)
 	return (u > v) - (u < v);
 }
 
-/* A shallow character: c's skeleton and meshes with one clip. */
-static mlod_character with_clip(const mlod_character *c, const mlod_clip *clip)
-{
-	mlod_character s = *c;
-	s.clip_count = 1;
-	s.clips = (mlod_clip *)clip;
-	s.notes = NULL;
-	return s;
-}
-
-/* A copy of a weight track (NULL values when out of memory). */
-static mlod_result copy_track(const mlod_weight_track *in, mlod_weight_track *out)
-{
-	size_t n = (size_t)in->key_count, v = n * (size_t)in->targets * (in->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
-	*out = *in;
-	out->times = malloc(sizeof(float) * n);
-	out->values = malloc(sizeof(float) * v);
-	if (!out->times || !out->values)
-		return MLOD_ERR_NOMEM;
-	memcpy(out->times, in->times, sizeof(float) * n);
-	memcpy(out->values, in->values, sizeof(float) * v);
-	return MLOD_OK;
-}
-
-/* A level's measures: its skinned-vertex error and its morph weights, each
- * track reduced within the level's bound (or, for a level chosen by keys or
- * threshold, its joint error). Fills only lv; on failure err says why and
- * *vertex_failed whether the vertex error failed (the weights not made). */
-static mlod_result level_extras(const struct job *job, const struct clip *cl, struct level *lv, int *vertex_failed,
-                                mlod_error *err)
-{
-	*vertex_failed = 0;
-	if (job->c.instance_count > 0) {
-		mlod_character a = with_clip(&job->c, &job->c.clips[cl->index]), b = with_clip(&job->c, &lv->l.clip);
-		mlod_result r = mlod_vertex_deviation(&a, &b, VERTEX_SAMPLES, &lv->vertex, err);
-		if (r != MLOD_OK) {
-			*vertex_failed = 1;
-			return r;
-		}
-		lv->has_vertex = 1;
-	}
-	if (cl->w_count == 0)
-		return MLOD_OK;
-	lv->w = calloc((size_t)cl->w_count, sizeof *lv->w);
-	if (!lv->w)
-		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-	lv->w_count = cl->w_count;
-	lv->w_bound = lv->bound >= 0.0 ? lv->bound : lv->l.error.max;
-	int sub = job->opt.subdivide > 0 ? job->opt.subdivide : MLOD_DEFAULT_SUBDIVIDE;
-	for (int i = 0; i < cl->w_count; i++) {
-		const mlod_weight_track *t = &cl->w[i];
-		double *reach = malloc(sizeof(double) * (size_t)t->targets), e = 0.0;
-		if (!reach)
-			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-		mlod_error why = {0};
-		mlod_result r = t->interp == MLOD_INTERP_CUBICSPLINE
-		                    ? MLOD_ERR_UNSUPPORTED
-		                    : mlod_morph_target_reach(&job->c, t->node, t->targets, reach, &why);
-		if (r == MLOD_OK)
-			r = mlod_weight_track_reduce(t, reach, lv->w_bound, sub, &lv->w[i], &e, &why);
-		free(reach);
-		if (r == MLOD_ERR_NOMEM) {
-			*err = why;
-			return r;
-		}
-		if (r != MLOD_OK) {
-			if (copy_track(t, &lv->w[i]) != MLOD_OK)
-				return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-			lv->w_copied++;
-		} else if (e > lv->w_error) {
-			lv->w_error = e;
-		}
-	}
-	lv->w_keys = mlod_weight_tracks_keys(lv->w, lv->w_count);
-	lv->w_bytes = mlod_weight_tracks_bytes(lv->w, lv->w_count);
-	return MLOD_OK;
-}
-
-/* What building a clip's levels gave, gathered before anything is said. */
-struct clip_outcome {
-	mlod_result w_result; /* reading its morph weights channels */
-	mlod_error w_error;
-	mlod_motion_clip_levels built;
-	mlod_result *extras;  /* per level: level_extras' result */
-	mlod_error *extras_error;
-	int *vertex_failed;
-};
-
-struct extras_ctx {
-	const struct job *job;
-	struct clip_outcome *out;
-	int *item_clip, *item_level;
-};
-
-static mlod_result extras_item(void *ctx, int i)
-{
-	struct extras_ctx *x = ctx;
-	int k = x->item_clip[i], s = x->item_level[i];
-	struct clip_outcome *o = &x->out[k];
-	struct clip *cl = &x->job->clips[k];
-	o->extras[s] = level_extras(x->job, cl, &cl->levels[s], &o->vertex_failed[s], &o->extras_error[s]);
-	return MLOD_OK;
-}
-
-/* Says what one clip's levels gave, in the order they were asked for:
- * messages and failures come out as if the clips and levels were built
- * one after another. */
-static void clip_report(struct job *job, struct clip *cl, const struct clip_outcome *o)
-{
-	const mlod_clip *src = &job->c.clips[cl->index];
-	if (o->w_result != MLOD_OK)
-		tool_die(EXIT_INPUT, job->input, "%s", o->w_error.message);
-	if (o->built.result != MLOD_OK)
-		tool_die(tool_exit_code(o->built.result), job->input, "%s", o->built.error.message);
-	if (cl->frames < 3) {
-		fprintf(stderr, "%s: %s: clip \"%s\" has %d frame%s: nothing to reduce, no levels\n", tool_name, job->input,
-		        src->name, cl->frames, cl->frames == 1 ? "" : "s");
-		return;
-	}
-	for (int s = 0; s < o->built.level_count; s++) {
-		mlod_result r = o->built.results[s];
-		if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
-			tool_die(tool_exit_code(r), job->input, "%s", o->built.errors[s].message);
-		if (r == MLOD_ERR_LIMIT) {
-			fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, o->built.errors[s].message);
-			continue;
-		}
-		if (o->extras[s] != MLOD_OK) {
-			if (o->vertex_failed[s])
-				tool_die(tool_exit_code(o->extras[s]), job->input, "clip \"%s\": %s", src->name,
-				         o->extras_error[s].message);
-			tool_die(EXIT_INPUT, job->input, "%s", o->extras_error[s].message);
-		}
-	}
-}
-
-/* Builds the levels of every clip of the job, their measures and morph
- * weights, on job->threads threads. */
-static void build_levels(struct job *job)
-{
-	mlod_motion_method methods[2];
-	int method_count = 0;
-	if (job->method == METHOD_AUTO) {
-		methods[method_count++] = MLOD_MOTION_FRAMES;
-		methods[method_count++] = MLOD_MOTION_KEYS;
-	} else {
-		methods[method_count++] = (mlod_motion_method)job->method;
-	}
-	mlod_motion_spec specs[MAX_LEVELS];
-	for (int s = 0; s < job->spec_count; s++) {
-		const struct spec *sp = &job->specs[s];
-		specs[s].target = sp->target;
-		specs[s].value = sp->percent ? sp->value * job->height / 100.0 : sp->value;
-	}
-	int n = job->clip_count, items = 0;
-	int *clips = malloc(sizeof(int) * (size_t)n);
-	struct clip_outcome *out = calloc((size_t)n, sizeof *out);
-	mlod_motion_clip_levels *built = calloc((size_t)n, sizeof *built);
-	int *item_clip = malloc(sizeof(int) * (size_t)n * MAX_LEVELS), *item_level = malloc(sizeof(int) * (size_t)n * MAX_LEVELS);
-	if (!clips || !out || !built || !item_clip || !item_level)
-		tool_die(EXIT_INPUT, job->input, "out of memory");
-	for (int k = 0; k < n; k++) {
-		struct clip *cl = &job->clips[k];
-		const mlod_clip *src = &job->c.clips[cl->index];
-		clips[k] = cl->index;
-		cl->keys = mlod_clip_key_count(src);
-		cl->bytes = mlod_clip_key_bytes(src);
-		if (job->doc && src->gltf_index >= 0) {
-			out[k].w_result = mlod_gltf_weight_tracks(job->doc, src->gltf_index, &cl->w, &cl->w_count, &out[k].w_error);
-			cl->w_keys = mlod_weight_tracks_keys(cl->w, cl->w_count);
-			cl->keys += cl->w_keys;
-			cl->bytes += mlod_weight_tracks_bytes(cl->w, cl->w_count);
-		}
-	}
-	mlod_error err = {0};
-	mlod_result r = mlod_motion_build_levels(&job->c, clips, n, &job->opt, methods, method_count, specs,
-	                                         job->spec_count, job->threads, built, &err);
-	if (r != MLOD_OK)
-		tool_die(tool_exit_code(r), job->input, "%s", err.message);
-	for (int k = 0; k < n; k++) {
-		struct clip *cl = &job->clips[k];
-		struct clip_outcome *o = &out[k];
-		o->built = built[k];
-		cl->timeline = o->built.timeline;
-		cl->frames = cl->timeline.frames;
-		int count = o->built.level_count;
-		o->extras = calloc((size_t)count + 1, sizeof *o->extras);
-		o->extras_error = calloc((size_t)count + 1, sizeof *o->extras_error);
-		o->vertex_failed = calloc((size_t)count + 1, sizeof *o->vertex_failed);
-		if (!o->extras || !o->extras_error || !o->vertex_failed)
-			tool_die(EXIT_INPUT, job->input, "out of memory");
-		if (o->w_result != MLOD_OK || o->built.result != MLOD_OK)
-			continue;
-		for (int s = 0; s < count; s++) {
-			const struct spec *sp = &job->specs[s];
-			struct level *lv = &cl->levels[cl->level_count++];
-			lv->bound = sp->target == MLOD_MOTION_MAX_ERROR ? specs[s].value : -1.0;
-			lv->ok = o->built.results[s] == MLOD_OK;
-			if (lv->ok) {
-				lv->l = o->built.levels[s];
-				memset(&o->built.levels[s], 0, sizeof o->built.levels[s]);
-				item_clip[items] = k;
-				item_level[items++] = s;
-			}
-		}
-	}
-	struct extras_ctx x = { job, out, item_clip, item_level };
-	mlod_parallel_for(items, job->threads, extras_item, &x);
-	for (int k = 0; k < n; k++)
-		clip_report(job, &job->clips[k], &out[k]);
-	for (int k = 0; k < n; k++) {
-		free(out[k].extras);
-		free(out[k].extras_error);
-		free(out[k].vertex_failed);
-	}
-	mlod_motion_clip_levels_free(built, n);
-	free(built);
-	free(out);
-	free(clips);
-	free(item_clip);
-	free(item_level);
-}
-
-/* What was done to a level's morph weights, as a JSON object. */
-static void weights_json(char *buf, size_t size, const struct clip *cl, const struct level *lv)
-{
-	snprintf(buf, size,
-	         "{\"channels\": %d, \"keys\": %ld, \"source_keys\": %ld, \"bytes\": %ld, \"bound\": %.9g, "
-	         "\"error\": %.9g, \"copied\": %d, \"error_measure\": \"sum over targets of |weight error| times the "
-	         "target's largest vertex offset in the rest pose, scene units\"}",
-	         lv->w_count, lv->w_keys, cl->w_keys, lv->w_bytes, lv->w_bound, lv->w_error, lv->w_copied);
-}
-
-static void timeline_note(char *buf, size_t size, const struct clip *cl)
-{
-	if (!cl->timeline.resampled)
-		snprintf(buf, size, "own keys");
-	else
-		snprintf(buf, size, "resampled to %d common frames (%d channels on other times, %d CUBICSPLINE)",
-		         cl->frames, cl->timeline.mismatched_channels, cl->timeline.cubic_channels);
-}
-
 /* Samples per frame interval at which the bounds are checked. */
 static int subdivide(const struct job *job)
 {
 	return job->opt.subdivide > 0 ? job->opt.subdivide : MLOD_DEFAULT_SUBDIVIDE;
 }
 
-static void report_table(const struct job *job)
+/* Builds the levels of the clips (all, or the one a BVH output writes) on
+ * job->threads threads; says the notes, and dies at a failure. */
+static void bake(const struct job *job, const int *clips, int clip_count, mlod_motion_bake *out)
 {
-	printf("# %s: %d joints, height %.4g, %d clips; point distance %.4g\n", job->input, job->c.skeleton.joint_count,
-	       job->height, job->c.clip_count, job->point_distance);
-	printf("%-16s %5s %6s %10s %7s %7s %8s %10s %8s %10s %8s %10s %8s\n", "clip", "level", "method", "threshold",
-	       "keys", "keys%", "bytes", "jnt max", "max%", "jnt mean", "mean%", "pt max", "vtx max%");
-	for (int k = 0; k < job->clip_count; k++) {
-		const struct clip *cl = &job->clips[k];
-		const char *name = job->c.clips[cl->index].name;
-		printf("%-16s %5d %6s %10s %7ld %6.1f%% %8ld %10s %8s %10s %8s %10s %8s\n", name, 0, "-", "-", cl->keys, 100.0,
-		       cl->bytes, "0", "0", "0", "0", "0", job->c.instance_count ? "0" : "-");
-		for (int i = 0; i < cl->level_count; i++) {
-			const struct level *lv = &cl->levels[i];
-			if (!lv->ok) {
-				printf("%-16s %5d %6s (no level within %.4g)\n", name, i + 1, "-", lv->bound);
-				continue;
-			}
-			char vtx[32] = "-";
-			if (lv->has_vertex)
-				snprintf(vtx, sizeof vtx, "%.4f", lv->vertex.max);
-			long keys = lv->l.keys + lv->w_keys;
-			printf("%-16s %5d %6s %10.4g %7ld %6.1f%% %8ld %10.4g %8.4f %10.4g %8.4f %10.4g %8s\n", name, i + 1,
-			       method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
-			       lv->l.bytes + lv->w_bytes, lv->l.error.max, 100.0 * lv->l.error.max / job->height, lv->l.error.mean,
-			       100.0 * lv->l.error.mean / job->height, lv->l.point_error, vtx);
-		}
+	mlod_motion_method methods[2];
+	mlod_motion_spec specs[MAX_LEVELS];
+	mlod_motion_bake_options o;
+	memset(&o, 0, sizeof o);
+	o.motion = job->opt;
+	o.methods = methods;
+	if (job->method == METHOD_AUTO) {
+		methods[o.method_count++] = MLOD_MOTION_FRAMES;
+		methods[o.method_count++] = MLOD_MOTION_KEYS;
+	} else {
+		methods[o.method_count++] = (mlod_motion_method)job->method;
 	}
-	for (int k = 0; k < job->clip_count; k++) {
-		const struct clip *cl = &job->clips[k];
-		if (cl->timeline.resampled) {
-			char note[256];
-			timeline_note(note, sizeof note, cl);
-			printf("# clip %s: %s\n", job->c.clips[cl->index].name, note);
-		}
+	for (int s = 0; s < job->spec_count; s++) {
+		const struct spec *sp = &job->specs[s];
+		specs[s].target = sp->target;
+		specs[s].value = sp->percent ? sp->value * job->height / 100.0 : sp->value;
 	}
-	for (int k = 0; k < job->clip_count; k++) {
-		const struct clip *cl = &job->clips[k];
-		if (cl->w_count == 0)
-			continue;
-		printf("# clip %s: %d morph weights channels, %ld keys; per level kept keys (vertex error bound, scene units):",
-		       job->c.clips[cl->index].name, cl->w_count, cl->w_keys);
-		for (int i = 0; i < cl->level_count; i++)
-			if (cl->levels[i].ok)
-				printf(" %d: %ld (%.4g%s)", i + 1, cl->levels[i].w_keys, cl->levels[i].w_error,
-				       cl->levels[i].w_copied ? ", some copied" : "");
-		printf("\n");
-	}
-	printf("# threshold: frame distance (frames) or error budget in scene units (keys); jnt: world joint\n"
-	       "# position error against the clip as read, scene units and %% of the height; pt: point error (joint\n"
-	       "# origins and points within the point distance), scene units; vtx: skinned-vertex error, %% of the\n"
-	       "# bounding diagonal\n");
-	int sub = subdivide(job);
-	if (sub == 1)
-		printf("# jnt and pt measured at the frames of each clip's common timeline (--subdivide 1)\n");
-	else
-		printf("# jnt and pt measured at the frames of each clip's common timeline and %d time%s between each two "
-		       "(--subdivide %d)\n", sub - 1, sub == 2 ? "" : "s", sub);
-	if (job->opt.precision != MLOD_MOTION_PRECISION_FULL)
-		printf("# key values rounded within each level's bound (--precision %s)\n",
-		       job->opt.precision == MLOD_MOTION_PRECISION_AUTO ? "auto" : "float");
-	if (job->c.notes && *job->c.notes)
-		printf("# note: %s\n", job->c.notes);
+	o.specs = specs;
+	o.spec_count = job->spec_count;
+	o.threads = job->threads;
+	o.vertex_samples = VERTEX_SAMPLES;
+	mlod_error err = {0};
+	mlod_result r = mlod_motion_bake_run(&job->c, job->doc, clips, clip_count, &o, out, &err);
+	for (int i = 0; i < out->note_count; i++)
+		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, out->notes[i]);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), job->input, "%s", err.message);
 }
 
-static void report_json(const struct job *job)
+static void print_report(const struct job *job, const mlod_motion_bake *b, enum tool_report kind)
 {
-	printf("{\n  \"input\": ");
-	tool_json_string(stdout, job->input);
-	printf(",\n  \"joints\": %d,\n  \"height\": %.9g,\n  \"point_distance\": %.9g,\n  \"subdivide\": %d,\n  \"clips\": [\n",
-	       job->c.skeleton.joint_count, job->height, job->point_distance, subdivide(job));
-	for (int k = 0; k < job->clip_count; k++) {
-		const struct clip *cl = &job->clips[k];
-		printf("    {\"name\": ");
-		tool_json_string(stdout, job->c.clips[cl->index].name);
-		printf(", \"index\": %d, \"duration\": %.9g, \"frames\": %d, \"resampled\": %s, "
-		       "\"mismatched_channels\": %d, \"cubic_channels\": %d, \"keys\": %ld, \"bytes\": %ld,\n     \"levels\": [",
-		       cl->index, (double)job->c.clips[cl->index].duration, cl->frames, cl->timeline.resampled ? "true" : "false",
-		       cl->timeline.mismatched_channels, cl->timeline.cubic_channels, cl->keys, cl->bytes);
-		for (int i = 0; i < cl->level_count; i++) {
-			const struct level *lv = &cl->levels[i];
-			const struct spec *sp = &job->specs[i];
-			printf("%s\n       {\"level\": %d, \"target\": \"%s\", \"value\": %.9g, ", i ? "," : "", i + 1,
-			       target_name(sp->target), sp->percent ? sp->value * job->height / 100.0 : sp->value);
-			if (lv->bound >= 0.0)
-				printf("\"bound\": %.9g, \"bound_percent_height\": %.9g, ", lv->bound, 100.0 * lv->bound / job->height);
-			if (!lv->ok) {
-				printf("\"ok\": false}");
-				continue;
-			}
-			long keys = lv->l.keys + lv->w_keys;
-			printf("\"ok\": true, \"method\": \"%s\", \"threshold\": %.9g, \"keys\": %ld, \"keys_percent\": %.6g, "
-			       "\"bytes\": %ld,\n        \"joint_error\": {\"max\": %.9g, \"mean\": %.9g, \"max_percent_height\": %.9g, "
-			       "\"mean_percent_height\": %.9g},\n        \"point_error\": %.9g, \"grid\": %.9g",
-			       method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
-			       lv->l.bytes + lv->w_bytes, lv->l.error.max, lv->l.error.mean, 100.0 * lv->l.error.max / job->height,
-			       100.0 * lv->l.error.mean / job->height, lv->l.point_error, lv->l.grid);
-			if (lv->has_vertex)
-				printf(",\n        \"vertex_error\": {\"max\": %.9g, \"max_percent_diagonal\": %.9g, "
-				       "\"mean_percent_diagonal\": %.9g}",
-				       lv->vertex.max * lv->vertex.scale / 100.0, lv->vertex.max, lv->vertex.mean);
-			if (lv->w_count) {
-				char w[512];
-				weights_json(w, sizeof w, cl, lv);
-				printf(",\n        \"morph_weights\": %s", w);
-			}
-			printf("}");
-		}
-		printf("]}%s\n", k + 1 < job->clip_count ? "," : "");
-	}
-	printf("  ]\n}\n");
+	mlod_motion_report_info info = { job->input, job->height, job->point_distance, subdivide(job), job->opt.precision };
+	char *text = NULL;
+	mlod_error err = {0};
+	mlod_result r = kind == REPORT_JSON ? mlod_motion_bake_json(b, &job->c, &info, &text, &err)
+	                                    : mlod_motion_bake_table(b, &job->c, &info, &text, &err);
+	if (r != MLOD_OK)
+		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+	fputs(text, stdout);
+	free(text);
 }
 
-/* The frame time a BVH of the clip plays at: its own, else the mean
- * spacing of its common timeline. */
-static float bvh_frame_time(const mlod_clip *src, const struct clip *cl)
+static void write_bvh(const struct job *job, const mlod_motion_bake *b, const char *output, int level, int clip)
 {
-	if (src->frame_time > 0.0f)
-		return 0.0f; /* the clip's own */
-	int frames = cl->frames;
-	float *times = NULL;
-	if (frames == 0) { /* level 0 alone: the clip's key times */
-		frames = mlod_clip_times(src, 0, &times);
-		mlod_free(times);
-	}
-	if (frames > 1 && src->duration > 0.0f)
-		return src->duration / (float)(frames - 1);
-	return 0.0f;
-}
-
-static void write_bvh(const struct job *job, const char *output, int level, int clip)
-{
-	const struct clip *cl = &job->clips[0];
-	const mlod_clip *src = &job->c.clips[clip];
-	const mlod_clip *use = src;
+	const mlod_motion_bake_clip *cl = &b->clips[0];
+	const mlod_clip *use = NULL;
 	if (level > 0) {
 		if (level > cl->level_count)
 			tool_die(EXIT_USAGE, NULL, "--level %d: clip %d has %d levels", level, clip, cl->level_count);
@@ -547,68 +182,14 @@ static void write_bvh(const struct job *job, const char *output, int level, int 
 			tool_die(EXIT_INPUT, job->input, "--level %d: no level within its bound", level);
 		use = &cl->levels[level - 1].l.clip;
 	}
-	mlod_character c = with_clip(&job->c, use);
 	char *text = NULL;
 	size_t size = 0;
 	mlod_error err = {0};
-	mlod_result r = mlod_bvh_write(&c, 0, bvh_frame_time(src, cl), &text, &size, &err);
+	mlod_result r = mlod_motion_bvh(&job->c, clip, use, cl->frames, &text, &size, &err);
 	if (r != MLOD_OK)
 		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_OUTPUT, output, "%s", err.message);
 	tool_write_output(output, text, size, 0);
 	mlod_free(text);
-}
-
-/* Adds the levels as animations "<clip>@lod<k>" with extras.mlod. */
-static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
-{
-	mlod_error err = {0};
-	for (int k = 0; k < job->clip_count; k++) {
-		struct clip *cl = &job->clips[k];
-		const mlod_clip *src = &job->c.clips[cl->index];
-		for (int i = 0; i < cl->level_count; i++) {
-			struct level *lv = &cl->levels[i];
-			if (!lv->ok)
-				continue;
-			const char *base = src->name ? src->name : "";
-			char *name = malloc(strlen(base) + 32);
-			if (!name)
-				tool_die(EXIT_OUTPUT, NULL, "out of memory");
-			sprintf(name, "%s@lod%d", base, i + 1);
-			free(lv->l.clip.name);
-			lv->l.clip.name = name;
-			int index;
-			if (mlod_gltf_add_animation(doc, &job->c.skeleton, &lv->l.clip, &index, &err) != MLOD_OK)
-				tool_die(EXIT_OUTPUT, NULL, "clip \"%s\": %s", base, err.message);
-			/* The level's stage record (mlod-record(5)). */
-			mlod_record_motion_level rec = {0};
-			rec.level = i + 1;
-			rec.source_animation = src->gltf_index >= 0 ? src->gltf_index : cl->index;
-			rec.method = lv->l.method;
-			rec.threshold = lv->l.threshold;
-			rec.has_bound = lv->bound >= 0.0;
-			rec.bound = lv->bound;
-			rec.keys = lv->l.keys + lv->w_keys;
-			rec.source_keys = cl->keys;
-			rec.bytes = lv->l.bytes + lv->w_bytes;
-			rec.joint_error = lv->l.error;
-			rec.joint_error_max_percent_height = 100.0 * lv->l.error.max / job->height;
-			rec.point_error = lv->l.point_error;
-			rec.grid = lv->l.grid;
-			rec.subdivide = subdivide(job);
-			rec.has_vertex_error = lv->has_vertex;
-			rec.vertex_error_percent_diagonal = lv->vertex.max;
-			if (lv->w_count) {
-				rec.has_morph_weights = 1;
-				rec.morph_weights = (mlod_record_morph_weights){lv->w_count, lv->w_keys, cl->w_keys, lv->w_bytes,
-				                                                lv->w_bound, lv->w_error, lv->w_copied};
-				if (mlod_gltf_add_weight_tracks(doc, index, lv->w, lv->w_count, &err) != MLOD_OK)
-					tool_die(EXIT_OUTPUT, NULL, "clip \"%s\": %s", base, err.message);
-			}
-			if (mlod_record_write_motion(doc, index, &rec, &err) != MLOD_OK)
-				tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
-		}
-	}
-	tool_write_gltf(output, doc);
 }
 
 int main(int argc, char **argv)
@@ -759,42 +340,46 @@ int main(int argc, char **argv)
 
 	if (bvh_out && clip >= job.c.clip_count)
 		tool_die(EXIT_USAGE, NULL, "--clip %d: the input has %d clips", clip, job.c.clip_count);
-	job.clip_count = bvh_out ? 1 : job.c.clip_count;
-	job.clips = calloc((size_t)job.clip_count + 1, sizeof *job.clips);
-	if (!job.clips)
+	int count = bvh_out ? 1 : job.c.clip_count;
+	int *clips = malloc(sizeof(int) * (size_t)(count + 1));
+	if (!clips)
 		tool_die(EXIT_INPUT, job.input, "out of memory");
-	for (int k = 0; k < job.clip_count; k++)
-		job.clips[k].index = bvh_out ? clip : k;
-	if (!(bvh_out && level == 0))
-		build_levels(&job);
-	for (int k = 0; k < job.clip_count && report == REPORT_NONE; k++)
-		if (job.clips[k].timeline.resampled) {
-			char note[256];
-			timeline_note(note, sizeof note, &job.clips[k]);
-			fprintf(stderr, "%s: %s: clip \"%s\": %s\n", tool_name, job.input, job.c.clips[job.clips[k].index].name,
+	for (int k = 0; k < count; k++)
+		clips[k] = bvh_out ? clip : k;
+	mlod_motion_bake b;
+	mlod_motion_bake_clip as_read; /* --level 0: the clip as read, no levels */
+	memset(&b, 0, sizeof b);
+	memset(&as_read, 0, sizeof as_read);
+	if (!(bvh_out && level == 0)) {
+		bake(&job, clips, count, &b);
+	} else {
+		as_read.index = clip;
+		b.clip_count = 1;
+		b.clips = &as_read;
+	}
+	for (int k = 0; k < b.clip_count && report == REPORT_NONE; k++) {
+		char note[256];
+		if (mlod_motion_bake_timeline_note(&b, k, note, sizeof note))
+			fprintf(stderr, "%s: %s: clip \"%s\": %s\n", tool_name, job.input, job.c.clips[b.clips[k].index].name,
 			        note);
-		}
+	}
 
-	if (report == REPORT_TABLE)
-		report_table(&job);
-	else if (report == REPORT_JSON)
-		report_json(&job);
-	else if (bvh_out)
-		write_bvh(&job, output, level < 0 ? job.clips[0].level_count : level, clip);
-	else
-		write_glb(&job, doc, output);
+	if (report != REPORT_NONE) {
+		print_report(&job, &b, report);
+	} else if (bvh_out) {
+		write_bvh(&job, &b, output, level < 0 ? b.clips[0].level_count : level, clip);
+	} else {
+		mlod_error err = {0};
+		if (mlod_motion_bake_to_gltf(&b, &job.c, doc, job.height, subdivide(&job), &err) != MLOD_OK)
+			tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+		tool_write_gltf(output, doc);
+	}
 
 	if (fflush(stdout) != 0)
 		tool_die(EXIT_OUTPUT, "<stdout>", "write error");
-	for (int k = 0; k < job.clip_count; k++) {
-		for (int i = 0; i < job.clips[k].level_count; i++)
-			if (job.clips[k].levels[i].ok) {
-				mlod_motion_level_free(&job.clips[k].levels[i].l);
-				mlod_weight_tracks_free(job.clips[k].levels[i].w, job.clips[k].levels[i].w_count);
-			}
-		mlod_weight_tracks_free(job.clips[k].w, job.clips[k].w_count);
-	}
-	free(job.clips);
+	if (b.clips != &as_read)
+		mlod_motion_bake_free(&b);
+	free(clips);
 	mlod_character_free(&job.c);
 	mlod_gltf_free(doc);
 	return 0;

@@ -1150,6 +1150,42 @@ TEST(build_levels_same_at_any_thread_count)
 	mlod_character_free(&c);
 }
 
+TEST(bake_report_same_at_any_thread_count)
+{
+	/* mlod_motion_bake_run and its JSON report: the same text at 1 and 3
+	 * threads, every level made, and the notes empty. */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	mlod_motion_method methods[2] = { MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS };
+	mlod_motion_spec specs[2] = { { MLOD_MOTION_MAX_ERROR, 0.005 * h }, { MLOD_MOTION_MAX_ERROR, 0.02 * h } };
+	mlod_motion_bake_options o;
+	memset(&o, 0, sizeof o);
+	o.methods = methods;
+	o.method_count = 2;
+	o.specs = specs;
+	o.spec_count = 2;
+	o.vertex_samples = 10;
+	mlod_motion_report_info info = { "walk", h, mlod_motion_point_distance(&c.skeleton, 0), 2, MLOD_MOTION_PRECISION_AUTO };
+	char *text[2] = { NULL, NULL };
+	int clip = 0;
+	for (int t = 0; t < 2; t++) {
+		mlod_motion_bake b;
+		o.threads = t ? 3 : 1;
+		CHECK_OK(mlod_motion_bake_run(&c, NULL, &clip, 1, &o, &b, &terr));
+		CHECK(b.clip_count == 1 && b.note_count == 0 && b.clips[0].level_count == 2);
+		CHECK(b.clips[0].levels[0].ok && b.clips[0].levels[1].ok && !b.clips[0].levels[0].has_vertex);
+		CHECK(b.clips[0].levels[1].l.point_error <= specs[1].value);
+		CHECK_OK(mlod_motion_bake_json(&b, &c, &info, &text[t], &terr));
+		mlod_motion_bake_free(&b);
+	}
+	CHECK(text[0] && text[1] && strcmp(text[0], text[1]) == 0);
+	CHECK(text[0] && strstr(text[0], "\"ok\": true") != NULL);
+	free(text[0]);
+	free(text[1]);
+	mlod_character_free(&c);
+}
+
 int main(void)
 {
 	RUN(levels_within_bounds_cmu);
@@ -1175,5 +1211,6 @@ int main(void)
 	RUN(precision_rounds_within_own_error);
 	RUN(fast_checks_match_exact);
 	RUN(build_levels_same_at_any_thread_count);
+	RUN(bake_report_same_at_any_thread_count);
 	TEST_EXIT();
 }
