@@ -275,6 +275,7 @@ struct mlod_motion {
 	mlod_trs *walk_local;  /* per joint */
 	/* State of each method: the last line of the tree, the keys kept. */
 	line tree;
+	int tree_started;      /* tree holds line 0 or a later one (tree_start) */
 	unsigned char *kept;   /* channel_count * frames */
 	memo *memo;            /* the tree's distances and residuals */
 	memo *segmemo;         /* frames level under way: segments of lines within its bound */
@@ -500,21 +501,14 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 			}
 		}
 	}
-	/* Level 0 of each method: every frame, every key. */
-	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
+	/* Level 0 of each method: every frame, every key (the tree's line
+	 * is made when the frames method first needs it: tree_start). */
 	m->kept = malloc((size_t)nch * (size_t)F);
 	m->memo = calloc(1, sizeof *m->memo);
 	m->segmemo = calloc(1, sizeof *m->segmemo);
-	if (!m->tree.v || !m->kept || !m->memo || !m->segmemo) {
+	if (!m->kept || !m->memo || !m->segmemo) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-	}
-	for (int f = 0; f < F; f++) {
-		if (node_from_frame(m, f, &m->tree.v[f]) != 0) {
-			mlod_motion_free(m);
-			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-		}
-		m->tree.n = f + 1;
 	}
 	memset(m->kept, 1, (size_t)nch * (size_t)F);
 	*out = m;
@@ -1448,9 +1442,30 @@ static long line_keys(const mlod_motion *m, const line *l)
 }
 
 /* The frames method: the next line of the tree. */
+/* The tree's first line, every frame, unless made: 0, or -1 when out of
+ * memory. */
+static int tree_start(mlod_motion *m)
+{
+	if (m->tree_started)
+		return 0;
+	line_free(&m->tree);
+	m->tree.v = calloc((size_t)m->frames, sizeof *m->tree.v);
+	if (!m->tree.v)
+		return -1;
+	for (int f = 0; f < m->frames; f++) {
+		if (node_from_frame(m, f, &m->tree.v[f]) != 0)
+			return -1;
+		m->tree.n = f + 1;
+	}
+	m->tree_started = 1;
+	return 0;
+}
+
 static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
                                 mlod_motion_level *out, mlod_error *err)
 {
+	if (tree_start(m) != 0)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	line best = { 0, NULL };
 	double T = 0.0;
 	const char *name = m->orig->name ? m->orig->name : "";
