@@ -7,13 +7,16 @@
  *   each level is mlod_motion_next_level_best's, whose methods after the
  *   first stop early where they cannot win;
  * - one item per clip and method (fewer clips than threads): each method
- *   builds its whole chain of levels on its own (a method's next level
- *   depends only on its own previous level), without a byte limit, and
- *   the levels are then chosen as mlod_motion_next_level_best chooses. A
- *   level it would have left unfinished stores more bytes than the
- *   winner whatever its rounding (the limit is a lower bound on its
- *   bytes), so it loses here too.
+ *   builds its whole chain of levels on its own thread (a method's next
+ *   level depends only on its own previous level), and the levels are
+ *   then chosen as mlod_motion_next_level_best chooses. With two methods,
+ *   the second's chain runs first, as there; the first's level k waits
+ *   for the second's level k and takes its bytes as the limit, as there,
+ *   so it stops early where it cannot win; the two chains overlap by a
+ *   level. Items are handed out in index order and the second method's
+ *   item comes first, so the one waited for has always started.
  */
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -35,6 +38,11 @@ typedef struct build_ctx {
 	mlod_result *create_result;  /* [clip][method] */
 	mlod_error *create_error;    /* [clip][method] */
 	mlod_motion_timeline *info;  /* [clip][method] */
+	/* The second method's levels as they come (two methods): published
+	 * levels per clip, under lock; the first method's level waits. */
+	pthread_mutex_t lock;
+	pthread_cond_t more;
+	int *published;              /* [clip] */
 } build_ctx;
 
 #define NOT_BUILT ((mlod_result)-1)
@@ -84,26 +92,60 @@ done:
 	return MLOD_OK;
 }
 
-/* The second way: one method's chain of levels of one clip. */
+/* The second method's chain of clip k has levels 0..s - 1 (all: s is
+ * spec_count). */
+static void publish(build_ctx *b, int k, int s)
+{
+	pthread_mutex_lock(&b->lock);
+	b->published[k] = s;
+	pthread_cond_broadcast(&b->more);
+	pthread_mutex_unlock(&b->lock);
+}
+
+/* The byte limit of the first method's level s of clip k: the second
+ * method's level's bytes when it made one, as in
+ * mlod_motion_next_level_best; waits for it. */
+static long level_limit(build_ctx *b, int k, int s)
+{
+	pthread_mutex_lock(&b->lock);
+	while (b->published[k] <= s)
+		pthread_cond_wait(&b->more, &b->lock);
+	pthread_mutex_unlock(&b->lock);
+	size_t at = ((size_t)k * 2 + 1) * (size_t)b->spec_count + (size_t)s;
+	return b->chain_result[at] == MLOD_OK && !b->chain[at].unfinished ? b->chain[at].bytes : -1;
+}
+
+/* The second way: one method's chain of levels of one clip; with two
+ * methods, item 2k is clip k's second method, 2k + 1 its first. */
 static mlod_result method_item(void *ctx, int item)
 {
 	build_ctx *b = ctx;
-	int n = b->method_count, k = item / n, i = item % n;
+	int n = b->method_count, k = item / n, i = n == 2 ? 1 - item % 2 : 0;
 	size_t ci = (size_t)k * (size_t)n + (size_t)i, base = ci * (size_t)b->spec_count;
 	mlod_motion *m = NULL;
+	int waits = n == 2 && i == 0;
 	b->create_result[ci] = mlod_motion_create(b->c, b->clips[k], b->opt, &m, &b->create_error[ci]);
-	if (b->create_result[ci] != MLOD_OK)
-		return MLOD_OK;
-	b->info[ci] = *mlod_motion_timeline_info(m);
-	for (int s = 0; s < b->spec_count && b->info[ci].frames >= 3; s++) {
-		if (skipped(b->methods[i], b->specs[s].target))
-			continue;
-		mlod_result r = mlod_motion_next_level(m, b->methods[i], b->specs[s].target, b->specs[s].value,
-		                                       &b->chain[base + (size_t)s], &b->chain_error[base + (size_t)s]);
-		b->chain_result[base + (size_t)s] = r;
-		if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
-			break;
+	if (b->create_result[ci] == MLOD_OK) {
+		b->info[ci] = *mlod_motion_timeline_info(m);
+		for (int s = 0; s < b->spec_count && b->info[ci].frames >= 3; s++) {
+			if (!skipped(b->methods[i], b->specs[s].target)) {
+				long limit = waits ? level_limit(b, k, s) : -1;
+				mlod_result r = mlod_motion_next_level_under(m, b->methods[i], b->specs[s].target, b->specs[s].value,
+				                                             limit, &b->chain[base + (size_t)s],
+				                                             &b->chain_error[base + (size_t)s]);
+				b->chain_result[base + (size_t)s] = r;
+				if (r != MLOD_OK && r != MLOD_ERR_LIMIT) {
+					if (n == 2 && i == 1)
+						publish(b, k, b->spec_count);
+					break;
+				}
+			}
+			if (n == 2 && i == 1)
+				publish(b, k, s + 1);
+		}
 	}
+	if (n == 2 && i == 1)
+		publish(b, k, b->spec_count); /* the rest will not come */
 	mlod_motion_free(m);
 	return MLOD_OK;
 }
@@ -133,7 +175,8 @@ static mlod_result choose(build_ctx *b, int k, int s, mlod_motion_level *out, ml
 				*err = b->chain_error[at];
 			return r;
 		}
-		if (!ok || l->bytes < out->bytes || (l->bytes == out->bytes && !(out->error.max < l->error.max))) {
+		if (!l->unfinished &&
+		    (!ok || l->bytes < out->bytes || (l->bytes == out->bytes && !(out->error.max < l->error.max)))) {
 			if (ok)
 				mlod_motion_level_free(out);
 			*out = *l;
@@ -219,8 +262,16 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 	b.create_result = calloc(chains, sizeof *b.create_result);
 	b.create_error = calloc(chains, sizeof *b.create_error);
 	b.info = calloc(chains, sizeof *b.info);
+	b.published = calloc((size_t)clip_count, sizeof *b.published);
 	mlod_result r = MLOD_OK;
-	if (!b.chain || !b.chain_result || !b.chain_error || !b.create_result || !b.create_error || !b.info) {
+	int sync = 0;
+	if (b.published && pthread_mutex_init(&b.lock, NULL) == 0) {
+		if (pthread_cond_init(&b.more, NULL) == 0)
+			sync = 1;
+		else
+			pthread_mutex_destroy(&b.lock);
+	}
+	if (!b.chain || !b.chain_result || !b.chain_error || !b.create_result || !b.create_error || !b.info || !sync) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	} else {
 		for (size_t i = 0; i < levels; i++)
@@ -237,6 +288,11 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 	free(b.create_result);
 	free(b.create_error);
 	free(b.info);
+	free(b.published);
+	if (sync) {
+		pthread_cond_destroy(&b.more);
+		pthread_mutex_destroy(&b.lock);
+	}
 	return r;
 }
 
