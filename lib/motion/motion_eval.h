@@ -224,8 +224,8 @@ static inline mlod_quat eval_blend(mlod_quat a, double wa, mlod_quat b, double w
 static inline mlod_quat eval_slerp(eval_seg *sg, const float *ka, const float *kb, float u)
 {
 	if (!sg->ready) {
-		sg->a = mlod_quat_normalize((mlod_quat){ ka[0], ka[1], ka[2], ka[3] });
-		sg->b = mlod_quat_normalize((mlod_quat){ kb[0], kb[1], kb[2], kb[3] });
+		sg->a = eval_normalize((mlod_quat){ ka[0], ka[1], ka[2], ka[3] });
+		sg->b = eval_normalize((mlod_quat){ kb[0], kb[1], kb[2], kb[3] });
 		double d = (double)sg->a.x * sg->b.x + (double)sg->a.y * sg->b.y + (double)sg->a.z * sg->b.z +
 		           (double)sg->a.w * sg->b.w;
 		sg->sign = d < 0.0 ? -1.0 : 1.0;
