@@ -61,6 +61,8 @@ static const char usage_text[] =
 	"                          default 2, the midpoints too)\n"
 	"  -l, --level K           with a .bvh output: the level to write (0 = as read)\n"
 	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
+	"  -j, --threads N         work on N threads (default: the processors online);\n"
+	"                          the output is the same at any N\n"
 	"  -h, --help              show this help\n"
 	"  -V, --version           show the version\n"
 	"\n"
@@ -75,33 +77,6 @@ struct spec {
 	int percent;     /* max error given in % of the height */
 };
 
-struct level {
-	int ok;          /* 0 when no level met the bound */
-	double bound;    /* scene units, for max-error levels */
-	mlod_motion_level l;
-	int has_vertex;
-	mlod_deviation vertex; /* % of the diagonal; scale is the diagonal */
-	/* Morph weights channels of the level (glTF input with such channels). */
-	mlod_weight_track *w;
-	int w_count;
-	int w_copied;    /* tracks kept as they are (CUBICSPLINE, or no mesh to measure) */
-	double w_bound;  /* scene units: the level's bound, or its joint error without one */
-	double w_error;  /* the largest vertex displacement bound of the reduced tracks */
-	long w_keys, w_bytes;
-};
-
-struct clip {
-	int index;
-	int frames;
-	mlod_motion_timeline timeline;
-	long keys, bytes;   /* joint channels and morph weights */
-	mlod_weight_track *w; /* the source's morph weights channels */
-	int w_count;
-	long w_keys;
-	int level_count;
-	struct level levels[MAX_LEVELS];
-};
-
 struct job {
 	const char *input;
 	const mlod_gltf *doc; /* glTF input, else NULL */
@@ -113,19 +88,8 @@ struct job {
 	mlod_motion_options opt;
 	int spec_count;
 	struct spec specs[MAX_LEVELS];
-	int clip_count;
-	struct clip *clips;
+	int threads;
 };
-
-static const char *method_name(mlod_motion_method m)
-{
-	return m == MLOD_MOTION_KEYS ? "keys" : "frames";
-}
-
-static const char *target_name(mlod_motion_target t)
-{
-	return t == MLOD_MOTION_THRESHOLD ? "threshold" : t == MLOD_MOTION_FRACTION ? "keys" : "max_error";
-}
 
 /* Parses a comma-separated list (tool_parse_list); "E%" is allowed for
  * error bounds. */
@@ -155,294 +119,62 @@ static int spec_order(const void *a, const void *b)
 	return (u > v) - (u < v);
 }
 
-/* A shallow character: c's skeleton and meshes with one clip. */
-static mlod_character with_clip(const mlod_character *c, const mlod_clip *clip)
-{
-	mlod_character s = *c;
-	s.clip_count = 1;
-	s.clips = (mlod_clip *)clip;
-	s.notes = NULL;
-	return s;
-}
-
-static void measure_vertex(struct job *job, struct clip *cl, struct level *lv)
-{
-	if (job->c.instance_count == 0)
-		return;
-	mlod_character a = with_clip(&job->c, &job->c.clips[cl->index]), b = with_clip(&job->c, &lv->l.clip);
-	mlod_error err = {0};
-	mlod_result r = mlod_vertex_deviation(&a, &b, VERTEX_SAMPLES, &lv->vertex, &err);
-	if (r != MLOD_OK)
-		tool_die(tool_exit_code(r), job->input, "clip \"%s\": %s", job->c.clips[cl->index].name, err.message);
-	lv->has_vertex = 1;
-}
-
-/* A copy of a weight track. */
-static void copy_track(const mlod_weight_track *in, mlod_weight_track *out)
-{
-	size_t n = (size_t)in->key_count, v = n * (size_t)in->targets * (in->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
-	*out = *in;
-	out->times = malloc(sizeof(float) * n);
-	out->values = malloc(sizeof(float) * v);
-	if (!out->times || !out->values)
-		tool_die(EXIT_INPUT, NULL, "out of memory");
-	memcpy(out->times, in->times, sizeof(float) * n);
-	memcpy(out->values, in->values, sizeof(float) * v);
-}
-
-/* The level's morph weights: each track reduced within the level's bound
- * (or, for a level chosen by keys or threshold, its joint error). */
-static void level_weights(struct job *job, struct clip *cl, struct level *lv)
-{
-	if (cl->w_count == 0)
-		return;
-	lv->w = calloc((size_t)cl->w_count, sizeof *lv->w);
-	if (!lv->w)
-		tool_die(EXIT_INPUT, NULL, "out of memory");
-	lv->w_count = cl->w_count;
-	lv->w_bound = lv->bound >= 0.0 ? lv->bound : lv->l.error.max;
-	int sub = job->opt.subdivide > 0 ? job->opt.subdivide : MLOD_DEFAULT_SUBDIVIDE;
-	for (int i = 0; i < cl->w_count; i++) {
-		const mlod_weight_track *t = &cl->w[i];
-		double *reach = malloc(sizeof(double) * (size_t)t->targets), e = 0.0;
-		mlod_error err = {0};
-		if (!reach)
-			tool_die(EXIT_INPUT, NULL, "out of memory");
-		mlod_result r = t->interp == MLOD_INTERP_CUBICSPLINE
-		                    ? MLOD_ERR_UNSUPPORTED
-		                    : mlod_morph_target_reach(&job->c, t->node, t->targets, reach, &err);
-		if (r == MLOD_OK)
-			r = mlod_weight_track_reduce(t, reach, lv->w_bound, sub, &lv->w[i], &e, &err);
-		free(reach);
-		if (r == MLOD_ERR_NOMEM)
-			tool_die(EXIT_INPUT, job->input, "%s", err.message);
-		if (r != MLOD_OK) {
-			copy_track(t, &lv->w[i]);
-			lv->w_copied++;
-		} else if (e > lv->w_error) {
-			lv->w_error = e;
-		}
-	}
-	lv->w_keys = mlod_weight_tracks_keys(lv->w, lv->w_count);
-	lv->w_bytes = mlod_weight_tracks_bytes(lv->w, lv->w_count);
-}
-
-/* Builds the levels of one clip. */
-static void clip_levels(struct job *job, struct clip *cl)
-{
-	const mlod_clip *src = &job->c.clips[cl->index];
-	mlod_error err = {0};
-	mlod_motion *m[2] = {NULL, NULL};
-	mlod_motion_method methods[2];
-	int method_count = 0;
-	if (job->method == METHOD_AUTO) {
-		methods[method_count++] = MLOD_MOTION_FRAMES;
-		methods[method_count++] = MLOD_MOTION_KEYS;
-	} else {
-		methods[method_count++] = (mlod_motion_method)job->method;
-	}
-	cl->keys = mlod_clip_key_count(src);
-	cl->bytes = mlod_clip_key_bytes(src);
-	if (job->doc && src->gltf_index >= 0) {
-		if (mlod_gltf_weight_tracks(job->doc, src->gltf_index, &cl->w, &cl->w_count, &err) != MLOD_OK)
-			tool_die(EXIT_INPUT, job->input, "%s", err.message);
-		cl->w_keys = mlod_weight_tracks_keys(cl->w, cl->w_count);
-		cl->keys += cl->w_keys;
-		cl->bytes += mlod_weight_tracks_bytes(cl->w, cl->w_count);
-	}
-	for (int i = 0; i < method_count; i++) {
-		mlod_result r = mlod_motion_create(&job->c, cl->index, &job->opt, &m[i], &err);
-		if (r != MLOD_OK)
-			tool_die(tool_exit_code(r), job->input, "%s", err.message);
-	}
-	cl->timeline = *mlod_motion_timeline_info(m[0]);
-	cl->frames = cl->timeline.frames;
-	if (cl->frames < 3) {
-		fprintf(stderr, "%s: %s: clip \"%s\" has %d frame%s: nothing to reduce, no levels\n", tool_name, job->input,
-		        src->name, cl->frames, cl->frames == 1 ? "" : "s");
-		for (int i = 0; i < method_count; i++)
-			mlod_motion_free(m[i]);
-		return;
-	}
-	for (int s = 0; s < job->spec_count; s++) {
-		const struct spec *sp = &job->specs[s];
-		struct level *lv = &cl->levels[cl->level_count++];
-		double value = sp->percent ? sp->value * job->height / 100.0 : sp->value;
-		lv->bound = sp->target == MLOD_MOTION_MAX_ERROR ? value : -1.0;
-		mlod_result r = mlod_motion_next_level_best(m, methods, method_count, sp->target, value, &lv->l, &err);
-		if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
-			tool_die(tool_exit_code(r), job->input, "%s", err.message);
-		lv->ok = r == MLOD_OK;
-		if (!lv->ok) {
-			fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, err.message);
-		} else {
-			measure_vertex(job, cl, lv);
-			level_weights(job, cl, lv);
-		}
-	}
-	for (int i = 0; i < method_count; i++)
-		mlod_motion_free(m[i]);
-}
-
-/* What was done to a level's morph weights, as a JSON object. */
-static void weights_json(char *buf, size_t size, const struct clip *cl, const struct level *lv)
-{
-	snprintf(buf, size,
-	         "{\"channels\": %d, \"keys\": %ld, \"source_keys\": %ld, \"bytes\": %ld, \"bound\": %.9g, "
-	         "\"error\": %.9g, \"copied\": %d, \"error_measure\": \"sum over targets of |weight error| times the "
-	         "target's largest vertex offset in the rest pose, scene units\"}",
-	         lv->w_count, lv->w_keys, cl->w_keys, lv->w_bytes, lv->w_bound, lv->w_error, lv->w_copied);
-}
-
-static void timeline_note(char *buf, size_t size, const struct clip *cl)
-{
-	if (!cl->timeline.resampled)
-		snprintf(buf, size, "own keys");
-	else
-		snprintf(buf, size, "resampled to %d common frames (%d channels on other times, %d CUBICSPLINE)",
-		         cl->frames, cl->timeline.mismatched_channels, cl->timeline.cubic_channels);
-}
-
 /* Samples per frame interval at which the bounds are checked. */
 static int subdivide(const struct job *job)
 {
 	return job->opt.subdivide > 0 ? job->opt.subdivide : MLOD_DEFAULT_SUBDIVIDE;
 }
 
-static void report_table(const struct job *job)
+/* Builds the levels of the clips (all, or the one a BVH output writes) on
+ * job->threads threads; says the notes, and dies at a failure. */
+static void bake(const struct job *job, const int *clips, int clip_count, mlod_motion_bake *out)
 {
-	printf("# %s: %d joints, height %.4g, %d clips; point distance %.4g\n", job->input, job->c.skeleton.joint_count,
-	       job->height, job->c.clip_count, job->point_distance);
-	printf("%-16s %5s %6s %10s %7s %7s %8s %10s %8s %10s %8s %10s %8s\n", "clip", "level", "method", "threshold",
-	       "keys", "keys%", "bytes", "jnt max", "max%", "jnt mean", "mean%", "pt max", "vtx max%");
-	for (int k = 0; k < job->clip_count; k++) {
-		const struct clip *cl = &job->clips[k];
-		const char *name = job->c.clips[cl->index].name;
-		printf("%-16s %5d %6s %10s %7ld %6.1f%% %8ld %10s %8s %10s %8s %10s %8s\n", name, 0, "-", "-", cl->keys, 100.0,
-		       cl->bytes, "0", "0", "0", "0", "0", job->c.instance_count ? "0" : "-");
-		for (int i = 0; i < cl->level_count; i++) {
-			const struct level *lv = &cl->levels[i];
-			if (!lv->ok) {
-				printf("%-16s %5d %6s (no level within %.4g)\n", name, i + 1, "-", lv->bound);
-				continue;
-			}
-			char vtx[32] = "-";
-			if (lv->has_vertex)
-				snprintf(vtx, sizeof vtx, "%.4f", lv->vertex.max);
-			long keys = lv->l.keys + lv->w_keys;
-			printf("%-16s %5d %6s %10.4g %7ld %6.1f%% %8ld %10.4g %8.4f %10.4g %8.4f %10.4g %8s\n", name, i + 1,
-			       method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
-			       lv->l.bytes + lv->w_bytes, lv->l.error.max, 100.0 * lv->l.error.max / job->height, lv->l.error.mean,
-			       100.0 * lv->l.error.mean / job->height, lv->l.point_error, vtx);
-		}
+	mlod_motion_method methods[2];
+	mlod_motion_spec specs[MAX_LEVELS];
+	mlod_motion_bake_options o;
+	memset(&o, 0, sizeof o);
+	o.motion = job->opt;
+	o.methods = methods;
+	if (job->method == METHOD_AUTO) {
+		methods[o.method_count++] = MLOD_MOTION_FRAMES;
+		methods[o.method_count++] = MLOD_MOTION_KEYS;
+	} else {
+		methods[o.method_count++] = (mlod_motion_method)job->method;
 	}
-	for (int k = 0; k < job->clip_count; k++) {
-		const struct clip *cl = &job->clips[k];
-		if (cl->timeline.resampled) {
-			char note[256];
-			timeline_note(note, sizeof note, cl);
-			printf("# clip %s: %s\n", job->c.clips[cl->index].name, note);
-		}
+	for (int s = 0; s < job->spec_count; s++) {
+		const struct spec *sp = &job->specs[s];
+		specs[s].target = sp->target;
+		specs[s].value = sp->percent ? sp->value * job->height / 100.0 : sp->value;
 	}
-	for (int k = 0; k < job->clip_count; k++) {
-		const struct clip *cl = &job->clips[k];
-		if (cl->w_count == 0)
-			continue;
-		printf("# clip %s: %d morph weights channels, %ld keys; per level kept keys (vertex error bound, scene units):",
-		       job->c.clips[cl->index].name, cl->w_count, cl->w_keys);
-		for (int i = 0; i < cl->level_count; i++)
-			if (cl->levels[i].ok)
-				printf(" %d: %ld (%.4g%s)", i + 1, cl->levels[i].w_keys, cl->levels[i].w_error,
-				       cl->levels[i].w_copied ? ", some copied" : "");
-		printf("\n");
-	}
-	printf("# threshold: frame distance (frames) or error budget in scene units (keys); jnt: world joint\n"
-	       "# position error against the clip as read, scene units and %% of the height; pt: point error (joint\n"
-	       "# origins and points within the point distance), scene units; vtx: skinned-vertex error, %% of the\n"
-	       "# bounding diagonal\n");
-	int sub = subdivide(job);
-	if (sub == 1)
-		printf("# jnt and pt measured at the frames of each clip's common timeline (--subdivide 1)\n");
-	else
-		printf("# jnt and pt measured at the frames of each clip's common timeline and %d time%s between each two "
-		       "(--subdivide %d)\n", sub - 1, sub == 2 ? "" : "s", sub);
-	if (job->opt.precision != MLOD_MOTION_PRECISION_FULL)
-		printf("# key values rounded within each level's bound (--precision %s)\n",
-		       job->opt.precision == MLOD_MOTION_PRECISION_AUTO ? "auto" : "float");
-	if (job->c.notes && *job->c.notes)
-		printf("# note: %s\n", job->c.notes);
+	o.specs = specs;
+	o.spec_count = job->spec_count;
+	o.threads = job->threads;
+	o.vertex_samples = VERTEX_SAMPLES;
+	mlod_error err = {0};
+	mlod_result r = mlod_motion_bake_run(&job->c, job->doc, clips, clip_count, &o, out, &err);
+	for (int i = 0; i < out->note_count; i++)
+		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, out->notes[i]);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), job->input, "%s", err.message);
 }
 
-static void report_json(const struct job *job)
+static void print_report(const struct job *job, const mlod_motion_bake *b, enum tool_report kind)
 {
-	printf("{\n  \"input\": ");
-	tool_json_string(stdout, job->input);
-	printf(",\n  \"joints\": %d,\n  \"height\": %.9g,\n  \"point_distance\": %.9g,\n  \"subdivide\": %d,\n  \"clips\": [\n",
-	       job->c.skeleton.joint_count, job->height, job->point_distance, subdivide(job));
-	for (int k = 0; k < job->clip_count; k++) {
-		const struct clip *cl = &job->clips[k];
-		printf("    {\"name\": ");
-		tool_json_string(stdout, job->c.clips[cl->index].name);
-		printf(", \"index\": %d, \"duration\": %.9g, \"frames\": %d, \"resampled\": %s, "
-		       "\"mismatched_channels\": %d, \"cubic_channels\": %d, \"keys\": %ld, \"bytes\": %ld,\n     \"levels\": [",
-		       cl->index, (double)job->c.clips[cl->index].duration, cl->frames, cl->timeline.resampled ? "true" : "false",
-		       cl->timeline.mismatched_channels, cl->timeline.cubic_channels, cl->keys, cl->bytes);
-		for (int i = 0; i < cl->level_count; i++) {
-			const struct level *lv = &cl->levels[i];
-			const struct spec *sp = &job->specs[i];
-			printf("%s\n       {\"level\": %d, \"target\": \"%s\", \"value\": %.9g, ", i ? "," : "", i + 1,
-			       target_name(sp->target), sp->percent ? sp->value * job->height / 100.0 : sp->value);
-			if (lv->bound >= 0.0)
-				printf("\"bound\": %.9g, \"bound_percent_height\": %.9g, ", lv->bound, 100.0 * lv->bound / job->height);
-			if (!lv->ok) {
-				printf("\"ok\": false}");
-				continue;
-			}
-			long keys = lv->l.keys + lv->w_keys;
-			printf("\"ok\": true, \"method\": \"%s\", \"threshold\": %.9g, \"keys\": %ld, \"keys_percent\": %.6g, "
-			       "\"bytes\": %ld,\n        \"joint_error\": {\"max\": %.9g, \"mean\": %.9g, \"max_percent_height\": %.9g, "
-			       "\"mean_percent_height\": %.9g},\n        \"point_error\": %.9g, \"grid\": %.9g",
-			       method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
-			       lv->l.bytes + lv->w_bytes, lv->l.error.max, lv->l.error.mean, 100.0 * lv->l.error.max / job->height,
-			       100.0 * lv->l.error.mean / job->height, lv->l.point_error, lv->l.grid);
-			if (lv->has_vertex)
-				printf(",\n        \"vertex_error\": {\"max\": %.9g, \"max_percent_diagonal\": %.9g, "
-				       "\"mean_percent_diagonal\": %.9g}",
-				       lv->vertex.max * lv->vertex.scale / 100.0, lv->vertex.max, lv->vertex.mean);
-			if (lv->w_count) {
-				char w[512];
-				weights_json(w, sizeof w, cl, lv);
-				printf(",\n        \"morph_weights\": %s", w);
-			}
-			printf("}");
-		}
-		printf("]}%s\n", k + 1 < job->clip_count ? "," : "");
-	}
-	printf("  ]\n}\n");
+	mlod_motion_report_info info = { job->input, job->height, job->point_distance, subdivide(job), job->opt.precision };
+	char *text = NULL;
+	mlod_error err = {0};
+	mlod_result r = kind == REPORT_JSON ? mlod_motion_bake_json(b, &job->c, &info, &text, &err)
+	                                    : mlod_motion_bake_table(b, &job->c, &info, &text, &err);
+	if (r != MLOD_OK)
+		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+	fputs(text, stdout);
+	free(text);
 }
 
-/* The frame time a BVH of the clip plays at: its own, else the mean
- * spacing of its common timeline. */
-static float bvh_frame_time(const mlod_clip *src, const struct clip *cl)
+static void write_bvh(const struct job *job, const mlod_motion_bake *b, const char *output, int level, int clip)
 {
-	if (src->frame_time > 0.0f)
-		return 0.0f; /* the clip's own */
-	int frames = cl->frames;
-	float *times = NULL;
-	if (frames == 0) { /* level 0 alone: the clip's key times */
-		frames = mlod_clip_times(src, 0, &times);
-		mlod_free(times);
-	}
-	if (frames > 1 && src->duration > 0.0f)
-		return src->duration / (float)(frames - 1);
-	return 0.0f;
-}
-
-static void write_bvh(const struct job *job, const char *output, int level, int clip)
-{
-	const struct clip *cl = &job->clips[0];
-	const mlod_clip *src = &job->c.clips[clip];
-	const mlod_clip *use = src;
+	const mlod_motion_bake_clip *cl = &b->clips[0];
+	const mlod_clip *use = NULL;
 	if (level > 0) {
 		if (level > cl->level_count)
 			tool_die(EXIT_USAGE, NULL, "--level %d: clip %d has %d levels", level, clip, cl->level_count);
@@ -450,68 +182,14 @@ static void write_bvh(const struct job *job, const char *output, int level, int 
 			tool_die(EXIT_INPUT, job->input, "--level %d: no level within its bound", level);
 		use = &cl->levels[level - 1].l.clip;
 	}
-	mlod_character c = with_clip(&job->c, use);
 	char *text = NULL;
 	size_t size = 0;
 	mlod_error err = {0};
-	mlod_result r = mlod_bvh_write(&c, 0, bvh_frame_time(src, cl), &text, &size, &err);
+	mlod_result r = mlod_motion_bvh(&job->c, clip, use, cl->frames, &text, &size, &err);
 	if (r != MLOD_OK)
 		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_OUTPUT, output, "%s", err.message);
 	tool_write_output(output, text, size, 0);
 	mlod_free(text);
-}
-
-/* Adds the levels as animations "<clip>@lod<k>" with extras.mlod. */
-static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
-{
-	mlod_error err = {0};
-	for (int k = 0; k < job->clip_count; k++) {
-		struct clip *cl = &job->clips[k];
-		const mlod_clip *src = &job->c.clips[cl->index];
-		for (int i = 0; i < cl->level_count; i++) {
-			struct level *lv = &cl->levels[i];
-			if (!lv->ok)
-				continue;
-			const char *base = src->name ? src->name : "";
-			char *name = malloc(strlen(base) + 32);
-			if (!name)
-				tool_die(EXIT_OUTPUT, NULL, "out of memory");
-			sprintf(name, "%s@lod%d", base, i + 1);
-			free(lv->l.clip.name);
-			lv->l.clip.name = name;
-			int index;
-			if (mlod_gltf_add_animation(doc, &job->c.skeleton, &lv->l.clip, &index, &err) != MLOD_OK)
-				tool_die(EXIT_OUTPUT, NULL, "clip \"%s\": %s", base, err.message);
-			/* The level's stage record (mlod-record(5)). */
-			mlod_record_motion_level rec = {0};
-			rec.level = i + 1;
-			rec.source_animation = src->gltf_index >= 0 ? src->gltf_index : cl->index;
-			rec.method = lv->l.method;
-			rec.threshold = lv->l.threshold;
-			rec.has_bound = lv->bound >= 0.0;
-			rec.bound = lv->bound;
-			rec.keys = lv->l.keys + lv->w_keys;
-			rec.source_keys = cl->keys;
-			rec.bytes = lv->l.bytes + lv->w_bytes;
-			rec.joint_error = lv->l.error;
-			rec.joint_error_max_percent_height = 100.0 * lv->l.error.max / job->height;
-			rec.point_error = lv->l.point_error;
-			rec.grid = lv->l.grid;
-			rec.subdivide = subdivide(job);
-			rec.has_vertex_error = lv->has_vertex;
-			rec.vertex_error_percent_diagonal = lv->vertex.max;
-			if (lv->w_count) {
-				rec.has_morph_weights = 1;
-				rec.morph_weights = (mlod_record_morph_weights){lv->w_count, lv->w_keys, cl->w_keys, lv->w_bytes,
-				                                                lv->w_bound, lv->w_error, lv->w_copied};
-				if (mlod_gltf_add_weight_tracks(doc, index, lv->w, lv->w_count, &err) != MLOD_OK)
-					tool_die(EXIT_OUTPUT, NULL, "clip \"%s\": %s", base, err.message);
-			}
-			if (mlod_record_write_motion(doc, index, &rec, &err) != MLOD_OK)
-				tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
-		}
-	}
-	tool_write_gltf(output, doc);
 }
 
 int main(int argc, char **argv)
@@ -531,6 +209,7 @@ int main(int argc, char **argv)
 		{"subdivide", required_argument, NULL, 'D'},
 		{"level", required_argument, NULL, 'l'},
 		{"clip", required_argument, NULL, 'c'},
+		{"threads", required_argument, NULL, 'j'},
 		{"help", no_argument, NULL, 'h'},
 		{"version", no_argument, NULL, 'V'},
 		{NULL, 0, NULL, 0},
@@ -542,10 +221,11 @@ int main(int argc, char **argv)
 	double point_distance = 0.0;
 	memset(&job, 0, sizeof job);
 	job.method = METHOD_AUTO;
+	job.threads = mlod_thread_count();
 
 	tool_name = "mlod-motion";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::m:e:t:k:l:c:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, ":o:r::m:e:t:k:l:c:j:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -606,6 +286,7 @@ int main(int argc, char **argv)
 		}
 		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
 		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
+		case 'j': job.threads = tool_parse_threads(optarg); break;
 		case 'h': fputs(usage_text, stdout); return 0;
 		case 'V': tool_version();
 		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
@@ -659,43 +340,46 @@ int main(int argc, char **argv)
 
 	if (bvh_out && clip >= job.c.clip_count)
 		tool_die(EXIT_USAGE, NULL, "--clip %d: the input has %d clips", clip, job.c.clip_count);
-	job.clip_count = bvh_out ? 1 : job.c.clip_count;
-	job.clips = calloc((size_t)job.clip_count + 1, sizeof *job.clips);
-	if (!job.clips)
+	int count = bvh_out ? 1 : job.c.clip_count;
+	int *clips = malloc(sizeof(int) * (size_t)(count + 1));
+	if (!clips)
 		tool_die(EXIT_INPUT, job.input, "out of memory");
-	for (int k = 0; k < job.clip_count; k++) {
-		job.clips[k].index = bvh_out ? clip : k;
-		if (!(bvh_out && level == 0))
-			clip_levels(&job, &job.clips[k]);
+	for (int k = 0; k < count; k++)
+		clips[k] = bvh_out ? clip : k;
+	mlod_motion_bake b;
+	mlod_motion_bake_clip as_read; /* --level 0: the clip as read, no levels */
+	memset(&b, 0, sizeof b);
+	memset(&as_read, 0, sizeof as_read);
+	if (!(bvh_out && level == 0)) {
+		bake(&job, clips, count, &b);
+	} else {
+		as_read.index = clip;
+		b.clip_count = 1;
+		b.clips = &as_read;
 	}
-	for (int k = 0; k < job.clip_count && report == REPORT_NONE; k++)
-		if (job.clips[k].timeline.resampled) {
-			char note[256];
-			timeline_note(note, sizeof note, &job.clips[k]);
-			fprintf(stderr, "%s: %s: clip \"%s\": %s\n", tool_name, job.input, job.c.clips[job.clips[k].index].name,
+	for (int k = 0; k < b.clip_count && report == REPORT_NONE; k++) {
+		char note[256];
+		if (mlod_motion_bake_timeline_note(&b, k, note, sizeof note))
+			fprintf(stderr, "%s: %s: clip \"%s\": %s\n", tool_name, job.input, job.c.clips[b.clips[k].index].name,
 			        note);
-		}
+	}
 
-	if (report == REPORT_TABLE)
-		report_table(&job);
-	else if (report == REPORT_JSON)
-		report_json(&job);
-	else if (bvh_out)
-		write_bvh(&job, output, level < 0 ? job.clips[0].level_count : level, clip);
-	else
-		write_glb(&job, doc, output);
+	if (report != REPORT_NONE) {
+		print_report(&job, &b, report);
+	} else if (bvh_out) {
+		write_bvh(&job, &b, output, level < 0 ? b.clips[0].level_count : level, clip);
+	} else {
+		mlod_error err = {0};
+		if (mlod_motion_bake_to_gltf(&b, &job.c, doc, job.height, subdivide(&job), &err) != MLOD_OK)
+			tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+		tool_write_gltf(output, doc);
+	}
 
 	if (fflush(stdout) != 0)
 		tool_die(EXIT_OUTPUT, "<stdout>", "write error");
-	for (int k = 0; k < job.clip_count; k++) {
-		for (int i = 0; i < job.clips[k].level_count; i++)
-			if (job.clips[k].levels[i].ok) {
-				mlod_motion_level_free(&job.clips[k].levels[i].l);
-				mlod_weight_tracks_free(job.clips[k].levels[i].w, job.clips[k].levels[i].w_count);
-			}
-		mlod_weight_tracks_free(job.clips[k].w, job.clips[k].w_count);
-	}
-	free(job.clips);
+	if (b.clips != &as_read)
+		mlod_motion_bake_free(&b);
+	free(clips);
 	mlod_character_free(&job.c);
 	mlod_gltf_free(doc);
 	return 0;

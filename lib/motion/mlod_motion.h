@@ -2,9 +2,12 @@
  * mlod_motion.h: the motion layer (paper 4.3): the common timeline
  * (timeline.c), the point error both methods answer to (pointerror.c), the
  * multiresolution motion tree and the levels (motion.c), per-channel key
- * reduction under a hierarchical error bound (keyreduce.c), and morph
- * target weight tracks (morphweights.c). Files call one way: motion.c
- * calls keyreduce.c, both call pointerror.c and timeline.c. motion_eval.h
+ * reduction under a hierarchical error bound (keyreduce.c), morph
+ * target weight tracks (morphweights.c), the levels of many clips on
+ * threads (levels.c), and a character's levels as mlod-motion makes and
+ * writes them (bake.c). Files call one way: bake.c calls levels.c and
+ * morphweights.c, levels.c calls motion.c, which calls keyreduce.c; both
+ * call pointerror.c and timeline.c. motion_eval.h
  * (internal) holds the inline fast forms of sampling, kinematics and the
  * point error check that motion.c and keyreduce.c measure with.
  */
@@ -200,6 +203,132 @@ mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method meth
 mlod_result mlod_motion_next_level_best(mlod_motion *const *m, const mlod_motion_method *methods, int n,
                                         mlod_motion_target target, double value, mlod_motion_level *out,
                                         mlod_error *err);
+
+/* One level asked for: its target and value (as mlod_motion_next_level). */
+typedef struct mlod_motion_spec {
+	mlod_motion_target target;
+	double value;
+} mlod_motion_spec;
+
+/* The levels of one clip (mlod_motion_build_levels). */
+typedef struct mlod_motion_clip_levels {
+	mlod_result result;       /* MLOD_OK, or why the clip's motions could not be made (error) */
+	mlod_error error;
+	mlod_motion_timeline timeline;
+	int level_count;          /* levels tried, in spec order: 0 for a clip of fewer than 3 frames
+	                             (nothing to reduce); a failure other than MLOD_ERR_LIMIT ends them */
+	mlod_motion_level *levels; /* level_count; those whose result is MLOD_OK are set */
+	mlod_result *results;     /* per level: MLOD_OK, MLOD_ERR_LIMIT (no method meets the target) or
+	                             the failure that ended the levels */
+	mlod_error *errors;       /* per level: why, when not MLOD_OK */
+} mlod_motion_clip_levels;
+
+/* The levels of clips[0..clip_count) of c, out[k] for clips[k]: for each
+ * clip, mlod_motion_create with opt for each of the method_count (1 or 2)
+ * methods, then for each spec in order the level
+ * mlod_motion_next_level_best makes. Clips, and the methods of a clip,
+ * run on up to `threads` threads; the levels do not depend on the
+ * thread count. Returns MLOD_OK (each clip's outcome is in out[k]) or
+ * MLOD_ERR_NOMEM / MLOD_ERR_INVALID_ARG. Release out with
+ * mlod_motion_clip_levels_free (levels taken over by the caller are to be
+ * zeroed, or their results set to other than MLOD_OK). */
+mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, int clip_count,
+                                     const mlod_motion_options *opt, const mlod_motion_method *methods,
+                                     int method_count, const mlod_motion_spec *specs, int spec_count, int threads,
+                                     mlod_motion_clip_levels *out, mlod_error *err);
+void mlod_motion_clip_levels_free(mlod_motion_clip_levels *out, int count);
+
+/* A character's motion levels as mlod-motion(1) makes them (bake.c). */
+
+/* One level of a clip, with its measures and morph weights channels. */
+typedef struct mlod_motion_bake_level {
+	mlod_motion_target target;
+	double value;             /* as asked (scene units for a max error) */
+	double bound;             /* a max-error level's bound, else -1 */
+	int ok;                   /* 0: no method made it (a note says why) */
+	mlod_motion_level l;
+	int has_vertex;           /* the character has meshes: vertex is set */
+	mlod_deviation vertex;    /* skinned-vertex error (mlod_vertex_deviation): % of the diagonal */
+	mlod_weight_track *w;     /* the level's morph weights channels (w_count) */
+	int w_count;
+	int w_copied;             /* tracks kept as they are (CUBICSPLINE, or no mesh to measure) */
+	double w_bound;           /* scene units: the level's bound, or its joint error without one */
+	double w_error;           /* the largest vertex displacement bound of the reduced tracks */
+	long w_keys, w_bytes;
+} mlod_motion_bake_level;
+
+typedef struct mlod_motion_bake_clip {
+	int index;                /* the character's clip */
+	int frames;               /* of its common timeline */
+	mlod_motion_timeline timeline;
+	long keys, bytes;         /* as read: joint channels and morph weights */
+	mlod_weight_track *w;     /* its morph weights channels as read (glTF input) */
+	int w_count;
+	long w_keys;
+	int level_count;
+	mlod_motion_bake_level *levels;
+} mlod_motion_bake_clip;
+
+typedef struct mlod_motion_bake {
+	int clip_count;
+	mlod_motion_bake_clip *clips;
+	int note_count;
+	char **notes;             /* what to tell the user, in order: clips with nothing to reduce,
+	                             levels no method makes (the caller prints them) */
+} mlod_motion_bake;
+
+typedef struct mlod_motion_bake_options {
+	mlod_motion_options motion;
+	const mlod_motion_method *methods; /* 1 or 2 (mlod_motion_build_levels) */
+	int method_count;
+	const mlod_motion_spec *specs;     /* the levels, finer first */
+	int spec_count;
+	int threads;
+	int vertex_samples;       /* times per clip for the skinned-vertex error */
+} mlod_motion_bake_options;
+
+/* The levels of clips[0..clip_count) of c (mlod_motion_build_levels),
+ * each level's skinned-vertex error (when c has meshes) and, with doc
+ * (the glTF c was read from, or NULL), its morph weights channels reduced
+ * within the level's bound (mlod_weight_track_reduce). Threads as there;
+ * the result does not depend on their number. Returns MLOD_OK, or the
+ * failure a run one clip and level after another meets first, with the
+ * notes before it in out. Release out with mlod_motion_bake_free, in
+ * either case. */
+mlod_result mlod_motion_bake_run(const mlod_character *c, const mlod_gltf *doc, const int *clips, int clip_count,
+                                 const mlod_motion_bake_options *o, mlod_motion_bake *out, mlod_error *err);
+void mlod_motion_bake_free(mlod_motion_bake *b);
+
+/* What the reports say besides the levels. */
+typedef struct mlod_motion_report_info {
+	const char *input;        /* the input's name */
+	double height;            /* the skeleton height */
+	double point_distance;
+	int subdivide;
+	mlod_motion_precision precision;
+} mlod_motion_report_info;
+
+/* The report of a bake of c as a table or as JSON: *text, released with
+ * free(). */
+mlod_result mlod_motion_bake_table(const mlod_motion_bake *b, const mlod_character *c,
+                                   const mlod_motion_report_info *info, char **text, mlod_error *err);
+mlod_result mlod_motion_bake_json(const mlod_motion_bake *b, const mlod_character *c,
+                                  const mlod_motion_report_info *info, char **text, mlod_error *err);
+
+/* For a resampled clip (b->clips[k]): 1 and how, into buf; else 0. */
+int mlod_motion_bake_timeline_note(const mlod_motion_bake *b, int k, char *buf, size_t size);
+
+/* Adds each level to doc as an animation "<clip>@lod<k>" (the level's
+ * clip takes that name) with its morph weights channels and its stage
+ * record (mlod_record_write_motion; height and subdivide as the bake's). */
+mlod_result mlod_motion_bake_to_gltf(mlod_motion_bake *b, const mlod_character *c, mlod_gltf *doc, double height,
+                                     int subdivide, mlod_error *err);
+
+/* A BVH of c's clip `clip` with the keys of use (NULL: the clip itself),
+ * at the clip's own frame time, else at the mean spacing of its `frames`
+ * common frames (0: of its key times). *text released with mlod_free. */
+mlod_result mlod_motion_bvh(const mlod_character *c, int clip, const mlod_clip *use, int frames, char **text,
+                            size_t *size, mlod_error *err);
 
 /* Morph target weights of a level (beyond the paper). A weight error dw on
  * a target moves a vertex by dw times that target's offset there, so a

@@ -97,18 +97,29 @@ double mlod_motion_point_distance(const mlod_skeleton *s, int metres)
 /* Sum of |wrapped differences| between two Euler triples of one order,
  * the nearer of the two triples of b: (A, B, C) and (A + pi, pi - B, C + pi)
  * over the order's axes, outermost first. */
+/* mlod_wrap_angle(a), the same double: for a + pi in (0, 2 pi), fmod(a +
+ * pi, 2 pi) is a + pi itself (fmod is exact, and returns x for 0 <= x <
+ * y), so the call is left out. */
+static inline double wrap_angle(double a)
+{
+	double x = a + MLOD_PI;
+	if (x > 0.0 && x < 2.0 * MLOD_PI)
+		return x - MLOD_PI;
+	return mlod_wrap_angle(a);
+}
+
 static double euler_change(mlod_euler_order order, const float *ea, const float *eb)
 {
 	const int *ax = mlod_euler_axes(order);
 	double d1 = 0.0, d2 = 0.0;
 	for (int a = 0; a < 3; a++)
-		d1 += fabs(mlod_wrap_angle((double)eb[a] - ea[a]));
+		d1 += fabs(wrap_angle((double)eb[a] - ea[a]));
 	double alt[3];
 	alt[ax[0]] = eb[ax[0]] + MLOD_PI;
 	alt[ax[1]] = MLOD_PI - eb[ax[1]];
 	alt[ax[2]] = eb[ax[2]] + MLOD_PI;
 	for (int a = 0; a < 3; a++)
-		d2 += fabs(mlod_wrap_angle(alt[a] - ea[a]));
+		d2 += fabs(wrap_angle(alt[a] - ea[a]));
 	return d1 < d2 ? d1 : d2;
 }
 
@@ -275,6 +286,7 @@ struct mlod_motion {
 	mlod_trs *walk_local;  /* per joint */
 	/* State of each method: the last line of the tree, the keys kept. */
 	line tree;
+	int tree_started;      /* tree holds line 0 or a later one (tree_start) */
 	unsigned char *kept;   /* channel_count * frames */
 	memo *memo;            /* the tree's distances and residuals */
 	memo *segmemo;         /* frames level under way: segments of lines within its bound */
@@ -500,21 +512,14 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 			}
 		}
 	}
-	/* Level 0 of each method: every frame, every key. */
-	m->tree.v = calloc((size_t)F, sizeof *m->tree.v);
+	/* Level 0 of each method: every frame, every key (the tree's line
+	 * is made when the frames method first needs it: tree_start). */
 	m->kept = malloc((size_t)nch * (size_t)F);
 	m->memo = calloc(1, sizeof *m->memo);
 	m->segmemo = calloc(1, sizeof *m->segmemo);
-	if (!m->tree.v || !m->kept || !m->memo || !m->segmemo) {
+	if (!m->kept || !m->memo || !m->segmemo) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-	}
-	for (int f = 0; f < F; f++) {
-		if (node_from_frame(m, f, &m->tree.v[f]) != 0) {
-			mlod_motion_free(m);
-			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-		}
-		m->tree.n = f + 1;
 	}
 	memset(m->kept, 1, (size_t)nch * (size_t)F);
 	*out = m;
@@ -1448,9 +1453,30 @@ static long line_keys(const mlod_motion *m, const line *l)
 }
 
 /* The frames method: the next line of the tree. */
+/* The tree's first line, every frame, unless made: 0, or -1 when out of
+ * memory. */
+static int tree_start(mlod_motion *m)
+{
+	if (m->tree_started)
+		return 0;
+	line_free(&m->tree);
+	m->tree.v = calloc((size_t)m->frames, sizeof *m->tree.v);
+	if (!m->tree.v)
+		return -1;
+	for (int f = 0; f < m->frames; f++) {
+		if (node_from_frame(m, f, &m->tree.v[f]) != 0)
+			return -1;
+		m->tree.n = f + 1;
+	}
+	m->tree_started = 1;
+	return 0;
+}
+
 static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
                                 mlod_motion_level *out, mlod_error *err)
 {
+	if (tree_start(m) != 0)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	line best = { 0, NULL };
 	double T = 0.0;
 	const char *name = m->orig->name ? m->orig->name : "";

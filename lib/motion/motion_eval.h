@@ -21,6 +21,13 @@
 #ifndef MLOD_MOTION_EVAL_H
 #define MLOD_MOTION_EVAL_H
 
+/* The small hot helpers below are inlined where GCC would call them. */
+#if defined(__GNUC__)
+#define EVAL_INLINE static inline __attribute__((always_inline))
+#else
+#define EVAL_INLINE static inline
+#endif
+
 #include <math.h>
 #include <string.h>
 
@@ -38,7 +45,7 @@
 typedef float eval_v4 __attribute__((vector_size(16)));
 #endif
 
-static inline mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
+EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 {
 	mlod_mat4 r;
 #if defined(__GNUC__)
@@ -47,14 +54,15 @@ static inline mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 	memcpy(&a1, a->m + 4, sizeof a1);
 	memcpy(&a2, a->m + 8, sizeof a2);
 	memcpy(&a3, a->m + 12, sizeof a3);
-	for (int c = 0; c < 4; c++) {
-		eval_v4 s = a0 * b->m[c * 4];
-		s = s + a1 * b->m[c * 4 + 1];
-		s = s + a2 * b->m[c * 4 + 2];
-		if (c == 3)
-			s = s + a3;
-		memcpy(r.m + c * 4, &s, sizeof s);
-	}
+	/* Column by column, written out (the loop was not unrolled). */
+	eval_v4 s0 = a0 * b->m[0], s1 = a0 * b->m[4], s2 = a0 * b->m[8], s3 = a0 * b->m[12];
+	s0 = s0 + a1 * b->m[1], s1 = s1 + a1 * b->m[5], s2 = s2 + a1 * b->m[9], s3 = s3 + a1 * b->m[13];
+	s0 = s0 + a2 * b->m[2], s1 = s1 + a2 * b->m[6], s2 = s2 + a2 * b->m[10], s3 = s3 + a2 * b->m[14];
+	s3 = s3 + a3;
+	memcpy(r.m, &s0, sizeof s0);
+	memcpy(r.m + 4, &s1, sizeof s1);
+	memcpy(r.m + 8, &s2, sizeof s2);
+	memcpy(r.m + 12, &s3, sizeof s3);
 #else
 	for (int c = 0; c < 4; c++) {
 		const float b0 = b->m[c * 4], b1 = b->m[c * 4 + 1], b2 = b->m[c * 4 + 2];
@@ -74,7 +82,7 @@ static inline mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 }
 
 /* mlod_mat4_from_trs, the same operations, inline. */
-static inline mlod_mat4 eval_from_trs(const mlod_trs *trs)
+EVAL_INLINE mlod_mat4 eval_from_trs(const mlod_trs *trs)
 {
 	double x = trs->r.x, y = trs->r.y, z = trs->r.z, w = trs->r.w;
 	double n = x * x + y * y + z * z + w * w;
@@ -216,8 +224,8 @@ static inline mlod_quat eval_blend(mlod_quat a, double wa, mlod_quat b, double w
 static inline mlod_quat eval_slerp(eval_seg *sg, const float *ka, const float *kb, float u)
 {
 	if (!sg->ready) {
-		sg->a = mlod_quat_normalize((mlod_quat){ ka[0], ka[1], ka[2], ka[3] });
-		sg->b = mlod_quat_normalize((mlod_quat){ kb[0], kb[1], kb[2], kb[3] });
+		sg->a = eval_normalize((mlod_quat){ ka[0], ka[1], ka[2], ka[3] });
+		sg->b = eval_normalize((mlod_quat){ kb[0], kb[1], kb[2], kb[3] });
 		double d = (double)sg->a.x * sg->b.x + (double)sg->a.y * sg->b.y + (double)sg->a.z * sg->b.z +
 		           (double)sg->a.w * sg->b.w;
 		sg->sign = d < 0.0 ? -1.0 : 1.0;

@@ -1092,6 +1092,100 @@ TEST(fast_checks_match_exact)
 	mlod_character_free(&c);
 }
 
+/* Two levels are the same: method, counts, errors and every key. */
+static int same_level(const mlod_motion_level *a, const mlod_motion_level *b)
+{
+	if (a->method != b->method || a->keys != b->keys || a->bytes != b->bytes || a->threshold != b->threshold ||
+	    a->error.max != b->error.max || a->error.mean != b->error.mean || a->point_error != b->point_error ||
+	    a->grid != b->grid || a->clip.channel_count != b->clip.channel_count)
+		return 0;
+	for (int i = 0; i < a->clip.channel_count; i++) {
+		const mlod_channel *x = &a->clip.channels[i], *y = &b->clip.channels[i];
+		int comps = x->path == MLOD_PATH_ROTATION ? 4 : 3;
+		if (x->key_count != y->key_count || x->interp != y->interp ||
+		    memcmp(x->times, y->times, sizeof(float) * (size_t)x->key_count) != 0 ||
+		    memcmp(x->values, y->values, sizeof(float) * (size_t)x->key_count * (size_t)comps) != 0)
+			return 0;
+	}
+	return 1;
+}
+
+TEST(build_levels_same_at_any_thread_count)
+{
+	/* One clip and two methods (each method's chain on a thread of its
+	 * own), and thresholds (the keys method skipped): the levels are
+	 * mlod_motion_next_level_best's, at 1, 2 and 3 threads. */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	mlod_motion_method methods[2] = { MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS };
+	mlod_motion_spec specs[2][3] = {
+		{ { MLOD_MOTION_MAX_ERROR, 0.002 * h }, { MLOD_MOTION_MAX_ERROR, 0.01 * h }, { MLOD_MOTION_MAX_ERROR, 0.03 * h } },
+		{ { MLOD_MOTION_THRESHOLD, 0.5 }, { MLOD_MOTION_THRESHOLD, 2.0 }, { MLOD_MOTION_THRESHOLD, 8.0 } },
+	};
+	int clip = 0;
+	for (int set = 0; set < 2; set++) {
+		mlod_motion *m[2];
+		mlod_motion_level seq[3];
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m[0], &terr));
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m[1], &terr));
+		for (int s = 0; s < 3; s++)
+			CHECK_OK(mlod_motion_next_level_best(m, methods, 2, specs[set][s].target, specs[set][s].value, &seq[s],
+			                                     &terr));
+		mlod_motion_free(m[0]);
+		mlod_motion_free(m[1]);
+		for (int threads = 1; threads <= 3; threads++) {
+			mlod_motion_clip_levels out;
+			CHECK_OK(mlod_motion_build_levels(&c, &clip, 1, NULL, methods, 2, specs[set], 3, threads, &out, &terr));
+			CHECK(out.result == MLOD_OK && out.level_count == 3);
+			for (int s = 0; s < 3; s++) {
+				CHECK(out.results[s] == MLOD_OK);
+				CHECK_MSG(same_level(&out.levels[s], &seq[s]), "set %d, level %d, %d threads", set, s, threads);
+			}
+			mlod_motion_clip_levels_free(&out, 1);
+		}
+		for (int s = 0; s < 3; s++)
+			mlod_motion_level_free(&seq[s]);
+	}
+	mlod_character_free(&c);
+}
+
+TEST(bake_report_same_at_any_thread_count)
+{
+	/* mlod_motion_bake_run and its JSON report: the same text at 1 and 3
+	 * threads, every level made, and the notes empty. */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	mlod_motion_method methods[2] = { MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS };
+	mlod_motion_spec specs[2] = { { MLOD_MOTION_MAX_ERROR, 0.005 * h }, { MLOD_MOTION_MAX_ERROR, 0.02 * h } };
+	mlod_motion_bake_options o;
+	memset(&o, 0, sizeof o);
+	o.methods = methods;
+	o.method_count = 2;
+	o.specs = specs;
+	o.spec_count = 2;
+	o.vertex_samples = 10;
+	mlod_motion_report_info info = { "walk", h, mlod_motion_point_distance(&c.skeleton, 0), 2, MLOD_MOTION_PRECISION_AUTO };
+	char *text[2] = { NULL, NULL };
+	int clip = 0;
+	for (int t = 0; t < 2; t++) {
+		mlod_motion_bake b;
+		o.threads = t ? 3 : 1;
+		CHECK_OK(mlod_motion_bake_run(&c, NULL, &clip, 1, &o, &b, &terr));
+		CHECK(b.clip_count == 1 && b.note_count == 0 && b.clips[0].level_count == 2);
+		CHECK(b.clips[0].levels[0].ok && b.clips[0].levels[1].ok && !b.clips[0].levels[0].has_vertex);
+		CHECK(b.clips[0].levels[1].l.point_error <= specs[1].value);
+		CHECK_OK(mlod_motion_bake_json(&b, &c, &info, &text[t], &terr));
+		mlod_motion_bake_free(&b);
+	}
+	CHECK(text[0] && text[1] && strcmp(text[0], text[1]) == 0);
+	CHECK(text[0] && strstr(text[0], "\"ok\": true") != NULL);
+	free(text[0]);
+	free(text[1]);
+	mlod_character_free(&c);
+}
+
 int main(void)
 {
 	RUN(levels_within_bounds_cmu);
@@ -1116,5 +1210,7 @@ int main(void)
 	RUN(precision_auto_shorts);
 	RUN(precision_rounds_within_own_error);
 	RUN(fast_checks_match_exact);
+	RUN(build_levels_same_at_any_thread_count);
+	RUN(bake_report_same_at_any_thread_count);
 	TEST_EXIT();
 }

@@ -1,0 +1,310 @@
+/*
+ * levels.c: the levels of several clips at once, on threads
+ * (mlod_motion_build_levels).
+ *
+ * Two ways to share the work, with the same results:
+ * - one item per clip (when there are at least as many clips as threads):
+ *   each level is mlod_motion_next_level_best's, whose methods after the
+ *   first stop early where they cannot win;
+ * - one item per clip and method (fewer clips than threads): each method
+ *   builds its whole chain of levels on its own thread (a method's next
+ *   level depends only on its own previous level), and the levels are
+ *   then chosen as mlod_motion_next_level_best chooses. With two methods,
+ *   the second's chain runs first, as there; the first's level k waits
+ *   for the second's level k and takes its bytes as the limit, as there,
+ *   so it stops early where it cannot win; the two chains overlap by a
+ *   level. Items are handed out in index order and the second method's
+ *   item comes first, so the one waited for has always started.
+ */
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "motion/mlod_motion.h"
+
+typedef struct build_ctx {
+	const mlod_character *c;
+	const int *clips;
+	const mlod_motion_options *opt;
+	const mlod_motion_method *methods;
+	int method_count;
+	const mlod_motion_spec *specs;
+	int spec_count;
+	mlod_motion_clip_levels *out;
+	/* Per clip and method (the second way): the chain of levels. */
+	mlod_motion_level *chain;    /* [clip][method][spec] */
+	mlod_result *chain_result;   /* [clip][method][spec]; -1: not built */
+	mlod_error *chain_error;     /* [clip][method][spec] */
+	mlod_result *create_result;  /* [clip][method] */
+	mlod_error *create_error;    /* [clip][method] */
+	mlod_motion_timeline *info;  /* [clip][method] */
+	/* The second method's levels as they come (two methods): published
+	 * levels per clip, under lock; the first method's level waits. */
+	pthread_mutex_t lock;
+	pthread_cond_t more;
+	int *published;              /* [clip] */
+} build_ctx;
+
+#define NOT_BUILT ((mlod_result)-1)
+
+static int skipped(mlod_motion_method method, mlod_motion_target target)
+{
+	return method == MLOD_MOTION_KEYS && target == MLOD_MOTION_THRESHOLD;
+}
+
+static mlod_result alloc_levels(mlod_motion_clip_levels *o, int n)
+{
+	o->levels = calloc((size_t)n, sizeof *o->levels);
+	o->results = calloc((size_t)n, sizeof *o->results);
+	o->errors = calloc((size_t)n, sizeof *o->errors);
+	return o->levels && o->results && o->errors ? MLOD_OK : MLOD_ERR_NOMEM;
+}
+
+/* The first way: one clip, every level through mlod_motion_next_level_best. */
+static mlod_result clip_item(void *ctx, int k)
+{
+	build_ctx *b = ctx;
+	mlod_motion_clip_levels *o = &b->out[k];
+	mlod_motion *m[2] = { NULL, NULL };
+	int n = b->method_count;
+	for (int i = 0; i < n; i++) {
+		o->result = mlod_motion_create(b->c, b->clips[k], b->opt, &m[i], &o->error);
+		if (o->result != MLOD_OK)
+			goto done;
+	}
+	o->timeline = *mlod_motion_timeline_info(m[0]);
+	if (o->timeline.frames < 3)
+		goto done;
+	if (alloc_levels(o, b->spec_count) != MLOD_OK) {
+		o->result = mlod_fail(&o->error, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	for (int s = 0; s < b->spec_count; s++) {
+		o->level_count = s + 1;
+		o->results[s] = mlod_motion_next_level_best(m, b->methods, n, b->specs[s].target, b->specs[s].value,
+		                                            &o->levels[s], &o->errors[s]);
+		if (o->results[s] != MLOD_OK && o->results[s] != MLOD_ERR_LIMIT)
+			break;
+	}
+done:
+	for (int i = 0; i < n; i++)
+		mlod_motion_free(m[i]);
+	return MLOD_OK;
+}
+
+/* The second method's chain of clip k has levels 0..s - 1 (all: s is
+ * spec_count). */
+static void publish(build_ctx *b, int k, int s)
+{
+	pthread_mutex_lock(&b->lock);
+	b->published[k] = s;
+	pthread_cond_broadcast(&b->more);
+	pthread_mutex_unlock(&b->lock);
+}
+
+/* The byte limit of the first method's level s of clip k: the second
+ * method's level's bytes when it made one, as in
+ * mlod_motion_next_level_best; waits for it. */
+static long level_limit(build_ctx *b, int k, int s)
+{
+	pthread_mutex_lock(&b->lock);
+	while (b->published[k] <= s)
+		pthread_cond_wait(&b->more, &b->lock);
+	pthread_mutex_unlock(&b->lock);
+	size_t at = ((size_t)k * 2 + 1) * (size_t)b->spec_count + (size_t)s;
+	return b->chain_result[at] == MLOD_OK && !b->chain[at].unfinished ? b->chain[at].bytes : -1;
+}
+
+/* The second way: one method's chain of levels of one clip; with two
+ * methods, item 2k is clip k's second method, 2k + 1 its first. */
+static mlod_result method_item(void *ctx, int item)
+{
+	build_ctx *b = ctx;
+	int n = b->method_count, k = item / n, i = n == 2 ? 1 - item % 2 : 0;
+	size_t ci = (size_t)k * (size_t)n + (size_t)i, base = ci * (size_t)b->spec_count;
+	mlod_motion *m = NULL;
+	int waits = n == 2 && i == 0;
+	b->create_result[ci] = mlod_motion_create(b->c, b->clips[k], b->opt, &m, &b->create_error[ci]);
+	if (b->create_result[ci] == MLOD_OK) {
+		b->info[ci] = *mlod_motion_timeline_info(m);
+		for (int s = 0; s < b->spec_count && b->info[ci].frames >= 3; s++) {
+			if (!skipped(b->methods[i], b->specs[s].target)) {
+				long limit = waits ? level_limit(b, k, s) : -1;
+				mlod_result r = mlod_motion_next_level_under(m, b->methods[i], b->specs[s].target, b->specs[s].value,
+				                                             limit, &b->chain[base + (size_t)s],
+				                                             &b->chain_error[base + (size_t)s]);
+				b->chain_result[base + (size_t)s] = r;
+				if (r != MLOD_OK && r != MLOD_ERR_LIMIT) {
+					if (n == 2 && i == 1)
+						publish(b, k, b->spec_count);
+					break;
+				}
+			}
+			if (n == 2 && i == 1)
+				publish(b, k, s + 1);
+		}
+	}
+	if (n == 2 && i == 1)
+		publish(b, k, b->spec_count); /* the rest will not come */
+	mlod_motion_free(m);
+	return MLOD_OK;
+}
+
+/* The level mlod_motion_next_level_best would give from the chains' level
+ * s of clip k (taking it over). */
+static mlod_result choose(build_ctx *b, int k, int s, mlod_motion_level *out, mlod_error *err)
+{
+	int n = b->method_count, ok = 0, limited = -1;
+	size_t base = (size_t)k * (size_t)n;
+	mlod_error why = { 0 };
+	memset(out, 0, sizeof *out);
+	for (int i = n - 1; i >= 0; i--) {
+		if (skipped(b->methods[i], b->specs[s].target))
+			continue;
+		size_t at = (base + (size_t)i) * (size_t)b->spec_count + (size_t)s;
+		mlod_result r = b->chain_result[at];
+		mlod_motion_level *l = &b->chain[at];
+		if (r == MLOD_ERR_LIMIT) {
+			why = b->chain_error[at], limited = i;
+			continue;
+		}
+		if (r != MLOD_OK) {
+			if (ok)
+				mlod_motion_level_free(out);
+			if (err)
+				*err = b->chain_error[at];
+			return r;
+		}
+		if (!l->unfinished &&
+		    (!ok || l->bytes < out->bytes || (l->bytes == out->bytes && !(out->error.max < l->error.max)))) {
+			if (ok)
+				mlod_motion_level_free(out);
+			*out = *l;
+			memset(l, 0, sizeof *l);
+			ok = 1;
+		}
+	}
+	if (ok)
+		return MLOD_OK;
+	if (limited < 0)
+		return mlod_fail(err, MLOD_ERR_LIMIT, "no method makes a level for this target");
+	if (err)
+		*err = why;
+	return MLOD_ERR_LIMIT;
+}
+
+/* Gathers clip k from its chains, in the order the first way meets
+ * results and failures. */
+static void gather(build_ctx *b, int k)
+{
+	mlod_motion_clip_levels *o = &b->out[k];
+	int n = b->method_count;
+	size_t base = (size_t)k * (size_t)n;
+	for (int i = 0; i < n; i++)
+		if (b->create_result[base + (size_t)i] != MLOD_OK) {
+			o->result = b->create_result[base + (size_t)i];
+			o->error = b->create_error[base + (size_t)i];
+			return;
+		}
+	o->timeline = b->info[base];
+	if (o->timeline.frames < 3)
+		return;
+	if (alloc_levels(o, b->spec_count) != MLOD_OK) {
+		o->result = mlod_fail(&o->error, MLOD_ERR_NOMEM, "out of memory");
+		return;
+	}
+	for (int s = 0; s < b->spec_count; s++) {
+		o->level_count = s + 1;
+		for (int i = 0; i < n; i++) {
+			size_t at = (base + (size_t)i) * (size_t)b->spec_count + (size_t)s;
+			if (!skipped(b->methods[i], b->specs[s].target) && b->chain_result[at] == NOT_BUILT) {
+				/* An earlier level of this method failed, which ended
+				 * the list there: not reached. */
+				b->chain_result[at] = MLOD_ERR_NOMEM;
+				mlod_fail(&b->chain_error[at], MLOD_ERR_NOMEM, "out of memory");
+			}
+		}
+		o->results[s] = choose(b, k, s, &o->levels[s], &o->errors[s]);
+		if (o->results[s] != MLOD_OK && o->results[s] != MLOD_ERR_LIMIT)
+			break;
+	}
+}
+
+mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, int clip_count,
+                                     const mlod_motion_options *opt, const mlod_motion_method *methods,
+                                     int method_count, const mlod_motion_spec *specs, int spec_count, int threads,
+                                     mlod_motion_clip_levels *out, mlod_error *err)
+{
+	if (!c || (!clips && clip_count > 0) || clip_count < 0 || !methods || method_count < 1 || method_count > 2 ||
+	    (!specs && spec_count > 0) || spec_count < 0 || (!out && clip_count > 0))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_build_levels: bad arguments");
+	if (clip_count == 0)
+		return MLOD_OK;
+	memset(out, 0, sizeof *out * (size_t)clip_count);
+	build_ctx b;
+	memset(&b, 0, sizeof b);
+	b.c = c;
+	b.clips = clips;
+	b.opt = opt;
+	b.methods = methods;
+	b.method_count = method_count;
+	b.specs = specs;
+	b.spec_count = spec_count;
+	b.out = out;
+	if (threads <= 1 || method_count == 1 || clip_count >= threads) {
+		mlod_parallel_for(clip_count, threads, clip_item, &b);
+		return MLOD_OK;
+	}
+	size_t chains = (size_t)clip_count * (size_t)method_count, levels = chains * (size_t)spec_count;
+	b.chain = calloc(levels + 1, sizeof *b.chain);
+	b.chain_result = malloc(sizeof *b.chain_result * (levels + 1));
+	b.chain_error = calloc(levels + 1, sizeof *b.chain_error);
+	b.create_result = calloc(chains, sizeof *b.create_result);
+	b.create_error = calloc(chains, sizeof *b.create_error);
+	b.info = calloc(chains, sizeof *b.info);
+	b.published = calloc((size_t)clip_count, sizeof *b.published);
+	mlod_result r = MLOD_OK;
+	int sync = 0;
+	if (b.published && pthread_mutex_init(&b.lock, NULL) == 0) {
+		if (pthread_cond_init(&b.more, NULL) == 0)
+			sync = 1;
+		else
+			pthread_mutex_destroy(&b.lock);
+	}
+	if (!b.chain || !b.chain_result || !b.chain_error || !b.create_result || !b.create_error || !b.info || !sync) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	} else {
+		for (size_t i = 0; i < levels; i++)
+			b.chain_result[i] = NOT_BUILT;
+		mlod_parallel_for((int)chains, threads, method_item, &b);
+		for (int k = 0; k < clip_count; k++)
+			gather(&b, k);
+	}
+	for (size_t i = 0; b.chain && i < levels; i++)
+		mlod_motion_level_free(&b.chain[i]);
+	free(b.chain);
+	free(b.chain_result);
+	free(b.chain_error);
+	free(b.create_result);
+	free(b.create_error);
+	free(b.info);
+	free(b.published);
+	if (sync) {
+		pthread_cond_destroy(&b.more);
+		pthread_mutex_destroy(&b.lock);
+	}
+	return r;
+}
+
+void mlod_motion_clip_levels_free(mlod_motion_clip_levels *out, int count)
+{
+	for (int k = 0; out && k < count; k++) {
+		for (int s = 0; out[k].levels && s < out[k].level_count; s++)
+			if (out[k].results[s] == MLOD_OK)
+				mlod_motion_level_free(&out[k].levels[s]);
+		free(out[k].levels);
+		free(out[k].results);
+		free(out[k].errors);
+		memset(&out[k], 0, sizeof out[k]);
+	}
+}
