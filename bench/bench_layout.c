@@ -211,29 +211,9 @@ static void quantise(const mlod_primitive *p, const layout *L, const grid *g, in
 			}
 		}
 		if (skinned(p, skin)) {
-			int bj[4] = {0, 0, 0, 0};
-			float bw[4] = {0, 0, 0, 0};
-			for (int s = 0; s < p->weight_set_count; s++)
-				for (int i = 0; i < 4; i++) {
-					float w = p->weights[s][4 * v + i];
-					int jt = p->joints[s][4 * v + i];
-					if (!(w > 0.0f))
-						continue;
-					int at = -1;
-					for (int t = 0; t < 4; t++)
-						if (bw[t] > 0.0f && bj[t] == jt)
-							at = t;
-					if (at >= 0) {
-						bw[at] += w;
-					} else {
-						int low = 0;
-						for (int t = 1; t < 4; t++)
-							if (bw[t] < bw[low])
-								low = t;
-						if (w > bw[low])
-							bw[low] = w, bj[low] = jt;
-					}
-				}
+			int bj[4];
+			float bw[4];
+			mlod_pack_top4(p, (uint32_t)v, NULL, 0, bj, bw);
 			uint8_t w8[4];
 			mlod_pack_weights8(bw, w8);
 			uint16_t j16[4];

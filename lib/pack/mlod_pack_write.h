@@ -179,6 +179,13 @@ float mlod_pack_range_scale_bits(float min, float max, int bits);
  * than 1. A zero sum gives all zeros. */
 void mlod_pack_weights8(const float w[4], uint8_t out[4]);
 
+/* The 4 largest influences of vertex v over every weight set of p (a
+ * joint met twice merged; ties: the lower slot), each joint mapped
+ * through jmap when it is given (one past jmap_count becomes 0); unused
+ * slots hold joint 0 and weight 0. */
+void mlod_pack_top4(const mlod_primitive *p, uint32_t v, const int *jmap, int jmap_count, int joints[4],
+                    float weights[4]);
+
 /* The orders a part may be stored in (the writer keeps whichever codes
  * to the fewest bytes, input order on a tie and with codec none):
  *   0 as input;

@@ -941,35 +941,9 @@ static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt, int ord
 		}
 		rec->flags |= MLOD_PART_SKINNED | (wide ? MLOD_PART_JOINTS16 : 0);
 		for (uint32_t v = 0; v < nv; v++) {
-			/* The 4 largest influences over every set (ties: the lower slot). */
-			int bj[4] = {0, 0, 0, 0};
-			float bw[4] = {0, 0, 0, 0};
-			for (int s = 0; s < p->weight_set_count; s++)
-				for (int i = 0; i < 4; i++) {
-					float w = p->weights[s][4 * v + i];
-					int jt = p->joints[s][4 * v + i];
-					if (!(w > 0.0f))
-						continue;
-					if (pt->jmap)
-						jt = jt < pt->jmap_count ? pt->jmap[jt] : 0;
-					/* merge a joint met twice */
-					int at = -1;
-					for (int t = 0; t < 4; t++)
-						if (bw[t] > 0.0f && bj[t] == jt)
-							at = t;
-					if (at >= 0) {
-						bw[at] += w;
-					} else {
-						int low = 0;
-						for (int t = 1; t < 4; t++)
-							if (bw[t] < bw[low])
-								low = t;
-						if (w > bw[low]) {
-							bw[low] = w;
-							bj[low] = jt;
-						}
-					}
-				}
+			int bj[4];
+			float bw[4];
+			mlod_pack_top4(p, v, pt->jmap, pt->jmap_count, bj, bw);
 			uint8_t q[4];
 			mlod_pack_weights8(bw, q);
 			for (int t = 0; t < 4; t++) {

@@ -198,3 +198,33 @@ int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint
 	free(cache);
 	return 0;
 }
+
+void mlod_pack_top4(const mlod_primitive *p, uint32_t v, const int *jmap, int jmap_count, int joints[4],
+                    float weights[4])
+{
+	for (int t = 0; t < 4; t++)
+		joints[t] = 0, weights[t] = 0.0f;
+	for (int s = 0; s < p->weight_set_count; s++)
+		for (int i = 0; i < 4; i++) {
+			float w = p->weights[s][4 * (size_t)v + i];
+			int jt = p->joints[s][4 * (size_t)v + i];
+			if (!(w > 0.0f))
+				continue;
+			if (jmap)
+				jt = jt < jmap_count ? jmap[jt] : 0;
+			int at = -1; /* a joint met twice */
+			for (int t = 0; t < 4; t++)
+				if (weights[t] > 0.0f && joints[t] == jt)
+					at = t;
+			if (at >= 0) {
+				weights[at] += w;
+				continue;
+			}
+			int low = 0;
+			for (int t = 1; t < 4; t++)
+				if (weights[t] < weights[low])
+					low = t;
+			if (w > weights[low])
+				weights[low] = w, joints[low] = jt;
+		}
+}
