@@ -49,7 +49,7 @@ typedef struct build_ctx {
 
 static int skipped(mlod_motion_method method, mlod_motion_target target)
 {
-	return method == MLOD_MOTION_KEYS && target == MLOD_MOTION_THRESHOLD;
+	return !mlod_motion_method_applies(method, target);
 }
 
 static mlod_result alloc_levels(mlod_motion_clip_levels *o, int n)
@@ -175,8 +175,7 @@ static mlod_result choose(build_ctx *b, int k, int s, mlod_motion_level *out, ml
 				*err = b->chain_error[at];
 			return r;
 		}
-		if (!l->unfinished &&
-		    (!ok || l->bytes < out->bytes || (l->bytes == out->bytes && !(out->error.max < l->error.max)))) {
+		if (mlod_motion_level_wins(l, out, ok)) {
 			if (ok)
 				mlod_motion_level_free(out);
 			*out = *l;

@@ -193,6 +193,15 @@ void mlod_motion_level_free(mlod_motion_level *l);
 mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                          double value, long max_bytes, mlod_motion_level *out, mlod_error *err);
 
+/* The auto method's rule, in one place for mlod_motion_next_level_best
+ * and the threaded builder: whether the method applies to the target (not
+ * the keys method for MLOD_MOTION_THRESHOLD), and whether a level beats
+ * the best so far (have: whether there is one): finished, and fewer bytes
+ * or, on a tie, no larger error (the later method is met first, so a tie
+ * goes to the earlier one). */
+int mlod_motion_method_applies(mlod_motion_method method, mlod_motion_target target);
+int mlod_motion_level_wins(const mlod_motion_level *l, const mlod_motion_level *best, int have);
+
 /* The auto method's next level: the next level of each of the n motions
  * (one clip, methods[i] for m[i]; the keys method is skipped for a
  * MLOD_MOTION_THRESHOLD target) for the same target and value; the one

@@ -1731,6 +1731,17 @@ mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method meth
 	return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad method %d", (int)method);
 }
 
+int mlod_motion_method_applies(mlod_motion_method method, mlod_motion_target target)
+{
+	return !(method == MLOD_MOTION_KEYS && target == MLOD_MOTION_THRESHOLD);
+}
+
+int mlod_motion_level_wins(const mlod_motion_level *l, const mlod_motion_level *best, int have)
+{
+	return !l->unfinished &&
+	       (!have || l->bytes < best->bytes || (l->bytes == best->bytes && !(best->error.max < l->error.max)));
+}
+
 mlod_result mlod_motion_next_level_best(mlod_motion *const *m, const mlod_motion_method *methods, int n,
                                         mlod_motion_target target, double value, mlod_motion_level *out,
                                         mlod_error *err)
@@ -1741,7 +1752,7 @@ mlod_result mlod_motion_next_level_best(mlod_motion *const *m, const mlod_motion
 	int ok = 0, limited = -1;
 	mlod_error why = {0};
 	for (int i = n - 1; i >= 0; i--) {
-		if (methods[i] == MLOD_MOTION_KEYS && target == MLOD_MOTION_THRESHOLD)
+		if (!mlod_motion_method_applies(methods[i], target))
 			continue;
 		mlod_motion_level l;
 		mlod_error e = {0};
@@ -1757,7 +1768,7 @@ mlod_result mlod_motion_next_level_best(mlod_motion *const *m, const mlod_motion
 				*err = e;
 			return r;
 		}
-		if (!l.unfinished && (!ok || l.bytes < out->bytes || (l.bytes == out->bytes && !(out->error.max < l.error.max)))) {
+		if (mlod_motion_level_wins(&l, out, ok)) {
 			if (ok)
 				mlod_motion_level_free(out);
 			*out = l;
