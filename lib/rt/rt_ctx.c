@@ -305,6 +305,60 @@ fail:
 	return r;
 }
 
+/* Checks a mesh level and lists what skinning it reads (u->pal_used, the
+ * palette entries, and u->rigid, the joints of its rigid parts), so that
+ * mlod_rt_skin poses and multiplies only those. The kernel reads a
+ * vertex's influences up to its last non-zero weight (at least the
+ * first), zero weights before it too: each is listed, so the entries
+ * left out are never read. */
+static mlod_result prepare_mesh(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_mesh *m, mlod_error *err)
+{
+	mlod_result r = check_mesh(ctx, m, u->level, &u->vertex_count, err);
+	if (r)
+		return r;
+	const uint32_t P = ctx->palette_size, J = ctx->joint_count;
+	const size_t bytes = 4 * ((size_t)P + J);
+	uint32_t *block = rt_alloc(ctx, bytes ? bytes : 4);
+	uint8_t *mark = rt_alloc(ctx, (P > J ? P : J) + 1);
+	if (!block || !mark) {
+		rt_free(ctx, block);
+		rt_free(ctx, mark);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "mesh level %u: out of memory", u->level);
+	}
+	memset(mark, 0, (P > J ? P : J) + 1);
+	for (uint32_t i = 0; i < m->part_count; i++) {
+		const mlod_pack_part *p = &m->parts[i];
+		if (p->rec.skin < 0)
+			continue;
+		const uint32_t off = ctx->skin_offset[p->rec.skin];
+		for (size_t v = 0; v < p->rec.vertex_count; v++) {
+			const float *w = p->weights + 4 * v;
+			const int k = w[3] != 0.0f ? 4 : w[2] != 0.0f ? 3 : w[1] != 0.0f ? 2 : 1;
+			for (int q = 0; q < k; q++)
+				mark[off + p->joints[4 * v + q]] = 1;
+		}
+	}
+	u->pal_used = block;
+	u->pal_used_count = 0;
+	for (uint32_t e = 0; e < P; e++)
+		if (mark[e])
+			block[u->pal_used_count++] = e;
+	memset(mark, 0, (P > J ? P : J) + 1);
+	u->rigid = block + P;
+	u->rigid_count = 0;
+	for (uint32_t i = 0; i < m->part_count; i++) {
+		const mlod_pack_part *p = &m->parts[i];
+		if (p->rec.skin < 0 && p->rec.joint >= 0 && !mark[p->rec.joint]) {
+			mark[p->rec.joint] = 1;
+			u->rigid[u->rigid_count++] = (uint32_t)p->rec.joint;
+		}
+	}
+	rt_free(ctx, mark);
+	u->plan_block = block;
+	u->bytes += bytes;
+	return MLOD_OK;
+}
+
 /* ---------------------------------------------------------------- */
 /* Loading and evicting                                              */
 /* ---------------------------------------------------------------- */
@@ -318,6 +372,9 @@ static void unit_release(mlod_rt_ctx *ctx, rt_unit *u)
 	rt_free(ctx, u->plan_block);
 	u->plan_block = NULL;
 	memset(&u->plan, 0, sizeof u->plan);
+	u->pal_used = u->rigid = NULL;
+	u->pal_used_count = u->rigid_count = 0;
+	ctx->unit_gen++;
 	u->chan_flags = NULL;
 	u->skel = NULL, u->mesh = NULL, u->motion = NULL;
 	ctx->resident_bytes -= u->bytes;
@@ -361,7 +418,7 @@ static mlod_result unit_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 	u->state = RT_UNIT_RESIDENT; /* for unit_release on failure below */
 	switch (u->layer) {
 	case MLOD_RT_SKELETON: r = prepare_skel(ctx, u, u->skel, err); break;
-	case MLOD_RT_MESH: r = check_mesh(ctx, u->mesh, u->level, &u->vertex_count, err); break;
+	case MLOD_RT_MESH: r = prepare_mesh(ctx, u, u->mesh, err); break;
 	default: r = prepare_motion(ctx, u, u->motion, err); break;
 	}
 	ctx->resident_bytes += u->bytes;
@@ -374,6 +431,7 @@ static mlod_result unit_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 	if (ctx->resident_bytes > ctx->peak_bytes)
 		ctx->peak_bytes = ctx->resident_bytes;
 	ctx->loads++;
+	ctx->unit_gen++;
 	return MLOD_OK;
 }
 
@@ -411,10 +469,13 @@ static size_t evictable_bytes(const mlod_rt_ctx *ctx)
  * dequantising at most quadruples a stream (unorm8 weights and colours
  * become floats; positions and normals grow less), the decoded structs at
  * most double their records, and the alignment of each stream costs less
- * than 4 times its 16-byte header; plus the skeleton level's tables. */
+ * than 4 times its 16-byte header; plus the skeleton level's tables, or
+ * the mesh level's lists (prepare_mesh). */
 static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 {
-	size_t plan = u->layer == MLOD_RT_SKELETON ? (size_t)ctx->joint_count * (4 + 1 + 4 + 64) : 0;
+	size_t plan = u->layer == MLOD_RT_SKELETON ? (size_t)ctx->joint_count * (4 + 1 + 4 + 64)
+	              : u->layer == MLOD_RT_MESH   ? 4 * ((size_t)ctx->palette_size + ctx->joint_count)
+	                                           : 0;
 	if (!ctx->load) {
 		const mlod_rt_view_level *v = u->view;
 		if (v && v->bytes)
@@ -422,7 +483,7 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 		if (v && v->data)
 			switch (u->layer) {
 			case MLOD_RT_SKELETON: return rt_bytes_skel_level(v->data) + plan;
-			case MLOD_RT_MESH: return rt_bytes_mesh(v->data);
+			case MLOD_RT_MESH: return rt_bytes_mesh(v->data) + plan;
 			default: return rt_bytes_motion(v->data);
 			}
 		return 0;
@@ -592,6 +653,15 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 			return mlod_fail(err, MLOD_ERR_PARSE, "the skins have too many joints");
 	}
 	ctx->palette_size = (uint32_t)pal;
+	ctx->pal_joint0 = rt_calloc(ctx, (size_t)pal + 1, sizeof *ctx->pal_joint0);
+	ctx->pal_bind0 = rt_calloc(ctx, (size_t)pal + 1, sizeof *ctx->pal_bind0);
+	if (!ctx->pal_joint0 || !ctx->pal_bind0)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
+	for (uint32_t k = 0; k < s->skin_count; k++)
+		for (uint32_t i = 0; i < s->skins[k].joint_count; i++) {
+			ctx->pal_joint0[ctx->skin_offset[k] + i] = s->skin_joints[k][i];
+			ctx->pal_bind0[ctx->skin_offset[k] + i] = s->inverse_bind[k] + 16 * (size_t)i;
+		}
 	for (uint32_t j = 0; j < J; j++) {
 		const mlod_pack_joint_rec *jr = &s->joints[j];
 		mlod_trs t = { { jr->t[0], jr->t[1], jr->t[2] },
@@ -711,6 +781,8 @@ void mlod_rt_close(mlod_rt_ctx *ctx)
 	rt_free(ctx, ctx->rest_local);
 	rt_free(ctx, ctx->all_joints);
 	rt_free(ctx, ctx->all_needed);
+	rt_free(ctx, ctx->pal_joint0);
+	rt_free(ctx, ctx->pal_bind0);
 	rt_free(ctx, ctx->clip_duration);
 	rt_free(ctx, ctx->chan_bits);
 	rt_free(ctx, ctx->inst);

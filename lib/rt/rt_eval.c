@@ -200,7 +200,7 @@ mlod_rt_scratch *mlod_rt_scratch_create(mlod_rt_ctx *ctx)
 	if (!ctx)
 		return NULL;
 	const size_t J = ctx->joint_count, P = ctx->palette_size;
-	size_t bytes = sizeof(mlod_rt_scratch) + J * sizeof(mlod_trs) + 16 * sizeof(float) * (J + P) + 64;
+	size_t bytes = sizeof(mlod_rt_scratch) + J * sizeof(mlod_trs) + 16 * sizeof(float) * (J + P) + 64 + J * 5;
 	mlod_rt_scratch *s = rt_alloc(ctx, bytes);
 	if (!s)
 		return NULL;
@@ -210,6 +210,8 @@ mlod_rt_scratch *mlod_rt_scratch_create(mlod_rt_ctx *ctx)
 	s->world = (float *)a;
 	s->palette = s->world + 16 * J;
 	s->local = (mlod_trs *)(s->palette + 16 * P);
+	s->plan_posed = (uint32_t *)(s->local + J);
+	s->plan_need = (uint8_t *)(s->plan_posed + J);
 	return s;
 }
 
@@ -246,22 +248,15 @@ static float sample_time(const mlod_rt_ctx *ctx, const mlod_rt_state *st)
 	return t;
 }
 
-mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const float **world,
-                         const uint32_t **joints, uint32_t *joint_count, mlod_error *err)
+/* Poses the npose joints posed[] (increasing: parents first) of the
+ * instance: the rest pose, the motion level's channels of the joints
+ * needed[] flags, and the world matrices. */
+static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_rt_state *st, const uint32_t *posed,
+                        uint32_t npose, const uint8_t *needed)
 {
-	if (!ctx || !s)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_pose: NULL argument");
-	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
-	const mlod_rt_state *st = &ctx->inst[id].st;
-	const rt_unit *su = skel_unit(ctx, st);
-	const uint32_t *posed = su ? su->plan.posed : ctx->all_joints;
-	const uint32_t npose = su ? su->plan.posed_count : ctx->joint_count;
-	const uint8_t *needed = su ? su->plan.needed : ctx->all_needed;
 	const mlod_pack_joint_rec *jr = ctx->skel->joints;
 	mlod_trs *local = s->local;
 	float *W = s->world;
-
 	for (uint32_t i = 0; i < npose; i++)
 		local[posed[i]] = ctx->rest_local[posed[i]];
 	if (ctx->clip_count) {
@@ -273,11 +268,25 @@ mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		const uint32_t j = posed[i];
 		rt_mat_mul_trs(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, &local[j], W + 16 * (size_t)j);
 	}
+}
+
+mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const float **world,
+                         const uint32_t **joints, uint32_t *joint_count, mlod_error *err)
+{
+	if (!ctx || !s)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_pose: NULL argument");
+	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
+	const mlod_rt_state *st = &ctx->inst[id].st;
+	const rt_unit *su = skel_unit(ctx, st);
+	pose_joints(ctx, s, st, su ? su->plan.posed : ctx->all_joints, su ? su->plan.posed_count : ctx->joint_count,
+	            su ? su->plan.needed : ctx->all_needed);
 	s->skel_unit = su;
+	s->id = id;
 	s->posed = 1;
 	s->paletted = 0;
 	if (world)
-		*world = W;
+		*world = s->world;
 	if (joints)
 		*joints = su ? su->plan.kept : ctx->all_joints;
 	if (joint_count)
@@ -285,22 +294,52 @@ mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	return MLOD_OK;
 }
 
+/* The joint palette entry e follows under the skeleton level su (NULL:
+ * level 0), and its bind matrix. */
+static inline uint32_t entry_joint(const mlod_rt_ctx *ctx, const rt_unit *su, uint32_t e)
+{
+	return su ? su->plan.palette_joint[e] : ctx->pal_joint0[e];
+}
+
+static inline const float *entry_bind(const mlod_rt_ctx *ctx, const rt_unit *su, uint32_t e)
+{
+	return su ? su->plan.palette_bind + 16 * (size_t)e : ctx->pal_bind0[e];
+}
+
+/* The skin plan of mesh level mu under skeleton level su in s: the joints
+ * that its palette entries and rigid parts follow, with their ancestors
+ * (removed ones too: they are folded at run time), flagged and listed in
+ * increasing order. Kept while the same levels are resident (ctx->unit_gen),
+ * so a crowd at the same levels builds it once. */
+static void skin_plan(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const rt_unit *su, const rt_unit *mu)
+{
+	if (s->plan_valid && s->plan_skel == su && s->plan_mesh == mu && s->plan_gen == ctx->unit_gen)
+		return;
+	const uint32_t J = ctx->joint_count;
+	const mlod_pack_joint_rec *jr = ctx->skel->joints;
+	uint8_t *need = s->plan_need;
+	memset(need, 0, J);
+	for (uint32_t k = 0; k < mu->pal_used_count + mu->rigid_count; k++) {
+		int32_t j;
+		if (k < mu->pal_used_count)
+			j = (int32_t)entry_joint(ctx, su, mu->pal_used[k]);
+		else
+			j = (int32_t)mu->rigid[k - mu->pal_used_count], j = su ? su->plan.stand[j] : j;
+		for (; j >= 0 && !need[j]; j = jr[j].parent)
+			need[j] = 1;
+	}
+	s->plan_count = 0;
+	for (uint32_t j = 0; j < J; j++)
+		if (need[j])
+			s->plan_posed[s->plan_count++] = j;
+	s->plan_skel = su, s->plan_mesh = mu, s->plan_gen = ctx->unit_gen, s->plan_valid = 1;
+}
+
 static void build_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s)
 {
 	const rt_unit *su = s->skel_unit;
-	const float *W = s->world;
-	if (su) {
-		for (uint32_t e = 0; e < ctx->palette_size; e++)
-			rt_mat_mul(W + 16 * (size_t)su->plan.palette_joint[e], su->plan.palette_bind + 16 * (size_t)e,
-			           s->palette + 16 * (size_t)e);
-	} else {
-		for (uint32_t k = 0; k < ctx->skin_count; k++) {
-			const uint32_t off = ctx->skin_offset[k];
-			for (uint32_t i = 0; i < ctx->skel->skins[k].joint_count; i++)
-				rt_mat_mul(W + 16 * (size_t)ctx->skel->skin_joints[k][i], ctx->skel->inverse_bind[k] + 16 * (size_t)i,
-				           s->palette + 16 * (size_t)(off + i));
-		}
-	}
+	for (uint32_t e = 0; e < ctx->palette_size; e++)
+		rt_mat_mul(s->world + 16 * (size_t)entry_joint(ctx, su, e), entry_bind(ctx, su, e), s->palette + 16 * (size_t)e);
 	s->paletted = 1;
 }
 
@@ -311,6 +350,11 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_palette: NULL argument");
 	if (!s->posed)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_palette: no pose in the scratch (call mlod_rt_pose)");
+	if (s->posed == 2) { /* mlod_rt_skin posed only what its mesh level reads: the whole pose */
+		mlod_result r = mlod_rt_pose(ctx, s, s->id, NULL, NULL, NULL, err);
+		if (r)
+			return r;
+	}
 	if (!s->paletted)
 		build_palette(ctx, s);
 	if (palette)
@@ -324,7 +368,46 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
 /* Skinning                                                          */
 /* ---------------------------------------------------------------- */
 
-/* Vertices of a rigid or static part (or a stretch of them) by M. */
+/* Vertices of a rigid or static part (or a stretch of them) by M: the
+ * point M p and the normal M n normalised, each coordinate summed in the
+ * order M[r] x + M[4 + r] y + M[8 + r] z (+ M[12 + r]). With the GCC/Clang
+ * vector extension one 4-lane multiply-add chain per point and per normal
+ * (the same operations in the same order per lane: the same floats). */
+#if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
+typedef float rt_tv4 __attribute__((vector_size(16)));
+static inline rt_tv4 tld4(const float *p)
+{
+	rt_tv4 v;
+	memcpy(&v, p, sizeof v);
+	return v;
+}
+
+static void transform_range(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
+                            float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
+{
+	const rt_tv4 c0 = tld4(M), c1 = tld4(M + 4), c2 = tld4(M + 8), c3 = tld4(M + 12);
+	for (size_t v = 0; v < n; v++) {
+		const float *q = pos + 3 * v;
+		const rt_tv4 o = c0 * q[0] + c1 * q[1] + c2 * q[2] + c3;
+		float *restrict op = (float *)((char *)out_pos + v * ps);
+		op[0] = o[0], op[1] = o[1], op[2] = o[2];
+	}
+	if (!out_nrm)
+		return;
+	for (size_t v = 0; v < n; v++) {
+		float *restrict on = (float *)((char *)out_nrm + v * ns);
+		if (!nrm) {
+			on[0] = on[1] = on[2] = 0.0f;
+			continue;
+		}
+		const float *nn = nrm + 3 * v;
+		const rt_tv4 t = c0 * nn[0] + c1 * nn[1] + c2 * nn[2];
+		const float len2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+		const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
+		on[0] = t[0] * il, on[1] = t[1] * il, on[2] = t[2] * il;
+	}
+}
+#else
 static void transform_range(size_t n, const float *pos, const float *nrm, const float *M, float *out_pos, size_t ps,
                             float *out_nrm, size_t ns)
 {
@@ -351,6 +434,7 @@ static void transform_range(size_t n, const float *pos, const float *nrm, const 
 		}
 	}
 }
+#endif
 
 /* Morphing goes through a buffer on the stack, this many vertices at a
  * time: no allocation. */
@@ -403,9 +487,8 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: strides must be multiples of 4, at least 12");
 	if (ctx->levels[MLOD_RT_MESH] == 0)
 		return MLOD_OK;
-	mlod_result r = mlod_rt_pose(ctx, s, id, NULL, NULL, NULL, err);
-	if (r)
-		return r;
+	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	const mlod_rt_state *st = &ctx->inst[id].st;
 	const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MESH, st->level[MLOD_RT_MESH], 0);
 	if (!mu || mu->state != RT_UNIT_RESIDENT)
@@ -413,9 +496,20 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	if (mu->vertex_count > capacity)
 		return mlod_fail(err, MLOD_ERR_LIMIT, "mesh level %u has %u vertices, the buffers hold %u", mu->level,
 		                 mu->vertex_count, capacity);
-	build_palette(ctx, s);
-	const rt_unit *su = s->skel_unit;
+	/* Only what the mesh level reads: the joints its palette entries and
+	 * rigid parts follow (with their ancestors), and those entries. */
+	const rt_unit *su = skel_unit(ctx, st);
+	skin_plan(ctx, s, su, mu);
+	pose_joints(ctx, s, st, s->plan_posed, s->plan_count, s->plan_need);
+	s->skel_unit = su;
+	s->id = id;
+	s->posed = 2;
+	s->paletted = 0;
 	const float *W = s->world;
+	for (uint32_t k = 0; k < mu->pal_used_count; k++) {
+		const uint32_t e = mu->pal_used[k];
+		rt_mat_mul(W + 16 * (size_t)entry_joint(ctx, su, e), entry_bind(ctx, su, e), s->palette + 16 * (size_t)e);
+	}
 	size_t base = 0;
 	float morphed[3 * RT_MORPH_RUN];
 	for (uint32_t i = 0; i < mu->mesh->part_count; i++) {

@@ -47,6 +47,11 @@ typedef struct rt_unit {
 	const mlod_pack_mesh *mesh;
 	const mlod_pack_motion *motion;
 	rt_skel_plan plan;        /* skeleton levels >= 1 */
+	/* Mesh levels (prepare_mesh): the palette entries its skinned vertices
+	 * read (every influence the kernel blends, up to the last non-zero
+	 * weight), increasing, and the joints its rigid parts follow. */
+	uint32_t pal_used_count, rigid_count;
+	uint32_t *pal_used, *rigid;
 	uint8_t *chan_flags;      /* resident motion levels: a bit per channel (in ctx->chan_bits) */
 	void *plan_block;
 } rt_unit;
@@ -94,6 +99,8 @@ struct mlod_rt_ctx {
 	mlod_trs *rest_local;     /* joint_count */
 	uint32_t *all_joints;     /* 0..joint_count-1: level 0's posed and kept list */
 	uint8_t *all_needed;      /* joint_count ones */
+	uint32_t *pal_joint0;     /* palette_size: the joint each entry follows at level 0 */
+	const float **pal_bind0;  /* palette_size: its inverse bind matrix */
 	uint32_t levels[MLOD_RT_LAYERS];
 	uint32_t clip_count;
 	float *clip_duration;
@@ -111,6 +118,7 @@ struct mlod_rt_ctx {
 	size_t resident_bytes, peak_bytes;
 	uint64_t stamp;
 	uint64_t loads, evictions, failures;
+	uint64_t unit_gen;        /* counts loads and releases: keys the scratch's skin plan */
 	uint32_t max_vertices;
 	/* Instances. */
 	rt_instance *inst;
@@ -128,7 +136,17 @@ struct mlod_rt_scratch {
 	float *world;             /* 16 per joint */
 	float *palette;           /* 16 per palette entry */
 	const rt_unit *skel_unit; /* the pose's skeleton level (NULL: level 0) */
-	int posed, paletted;
+	int posed, paletted;      /* posed: 1 in full (mlod_rt_pose), 2 only what a mesh level needs */
+	uint32_t id;              /* the instance posed */
+	/* The skin plan (mlod_rt_skin): the joints that the mesh level mesh
+	 * under the skeleton level skel needs posed (need: a flag per joint;
+	 * posed: their list, increasing), valid while ctx->unit_gen is gen. */
+	const rt_unit *plan_skel, *plan_mesh;
+	uint64_t plan_gen;
+	int plan_valid;
+	uint32_t plan_count;
+	uint32_t *plan_posed;
+	uint8_t *plan_need;
 };
 
 /* rt_ctx.c */

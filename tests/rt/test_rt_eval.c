@@ -8,9 +8,13 @@
  * morphed output equals its output for the same character with the
  * deltas added to the positions by hand, at every mesh level and kind of
  * part; the weights' rules (count, finite, reset on create); no
- * allocation.
+ * allocation. The skin plan: mlod_rt_skin poses and multiplies only what
+ * its mesh level reads, and that gives the very floats of the full pose
+ * and palette, at every pair of skeleton and mesh levels (white box:
+ * rt_internal.h).
  */
 #include "rt_test.h"
+#include "rt_internal.h"
 
 static mlod_rt_ctx *open_all(mlod_rt_config *cfg, mlod_error *e)
 {
@@ -533,6 +537,79 @@ TEST(morph_targets)
 	}
 }
 
+/* mlod_rt_skin poses only the joints its mesh level's palette entries and
+ * rigid parts follow (and their ancestors) and multiplies only those
+ * entries: they, the posed joints' world matrices and the skinned
+ * vertices must be the floats of the full pose (mlod_rt_pose) and palette
+ * (mlod_rt_palette), at every skeleton level with every mesh level, and
+ * mlod_rt_palette after mlod_rt_skin must give the whole palette. */
+TEST(skin_plan_matches_full_pose)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_all(NULL, &e);
+	CHECK(ctx, "open: %s", e.message);
+	mlod_rt_scratch *s1 = mlod_rt_scratch_create(ctx), *s2 = mlod_rt_scratch_create(ctx);
+	CHECK(s1 && s2, "scratch");
+	const uint32_t J = mlod_rt_joint_count(ctx), P = mlod_rt_palette_size(ctx);
+	uint32_t id, fewest = J, checked = 0;
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, MLOD_RT_LOOP, &id, &e), e);
+	float out[3 * 16], nrm[3 * 16], ref[3 * 16], refn[3 * 16];
+	for (uint32_t ls = 0; ls < 3; ls++)
+		for (uint32_t lm = 0; lm < 3; lm++)
+			for (int f = 0; f < 23; f++) {
+				mlod_rt_select sel;
+				mlod_rt_select_default(&sel);
+				sel.force_level = 0;
+				float d = 1;
+				CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0913f, &e), e);
+				mlod_rt_state *st = &ctx->inst[id].st; /* the levels under test */
+				st->level[MLOD_RT_SKELETON] = (uint16_t)ls, st->level[MLOD_RT_MESH] = (uint16_t)lm;
+				st->level[MLOD_RT_MOTION] = (uint16_t)(f % 3);
+				uint32_t n = 0;
+				CHECK_OK(mlod_rt_skin(ctx, s1, id, out, 12, nrm, 12, 16, &n, &e), e);
+				const float *W2, *P2, *P1;
+				CHECK_OK(mlod_rt_pose(ctx, s2, id, &W2, NULL, NULL, &e), e);
+				CHECK_OK(mlod_rt_palette(ctx, s2, &P2, NULL, &e), e);
+				const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MESH, lm, 0);
+				CHECK(s1->plan_mesh == mu && s1->plan_count >= 1 && s1->plan_count <= J, "plan of %u joints",
+				      s1->plan_count);
+				fewest = s1->plan_count < fewest ? s1->plan_count : fewest;
+				for (uint32_t k = 0; k < s1->plan_count; k++) {
+					const uint32_t j = s1->plan_posed[k];
+					CHECK(memcmp(s1->world + 16 * j, W2 + 16 * j, 64) == 0,
+					      "skeleton %u mesh %u frame %d: joint %u's world differs", ls, lm, f, j);
+				}
+				for (uint32_t k = 0; k < mu->pal_used_count; k++) {
+					const uint32_t x = mu->pal_used[k];
+					CHECK(memcmp(s1->palette + 16 * x, P2 + 16 * x, 64) == 0,
+					      "skeleton %u mesh %u frame %d: palette entry %u differs", ls, lm, f, x);
+				}
+				/* the skinned parts again with the full palette */
+				size_t base = 0;
+				for (uint32_t i = 0; i < mu->mesh->part_count; i++) {
+					const mlod_pack_part *p = &mu->mesh->parts[i];
+					if (p->rec.skin >= 0) {
+						mlod_rt_skin_lbs(p->rec.vertex_count, p->positions, p->normals, p->joints, p->weights,
+						                 P2 + 16 * (size_t)ctx->skin_offset[p->rec.skin], ref, 12, refn, 12);
+						CHECK(memcmp(ref, out + 3 * base, 12 * p->rec.vertex_count) == 0 &&
+						          memcmp(refn, nrm + 3 * base, 12 * p->rec.vertex_count) == 0,
+						      "skeleton %u mesh %u frame %d: part %u skins differently", ls, lm, f, i);
+					}
+					base += p->rec.vertex_count;
+				}
+				CHECK(base == n, "%u vertices, %zu in the parts", n, base);
+				CHECK_OK(mlod_rt_palette(ctx, s1, &P1, NULL, &e), e);
+				CHECK(memcmp(P1, P2, 64 * (size_t)P) == 0, "skeleton %u mesh %u: the palette after skinning differs",
+				      ls, lm);
+				checked++;
+			}
+	CHECK(fewest < J, "every plan posed all %u joints: nothing left out", J);
+	printf("# %u skins at 3 x 3 level pairs: the plan's floats are the full pose's; fewest joints posed %u of %u\n",
+	       checked, fewest, J);
+	mlod_rt_scratch_destroy(ctx, s1), mlod_rt_scratch_destroy(ctx, s2);
+	mlod_rt_close(ctx);
+}
+
 int main(void)
 {
 	fx_build(0);
@@ -543,5 +620,6 @@ int main(void)
 	RUN(kernel_matches_scalar);
 	RUN(no_allocation_per_frame);
 	RUN(morph_targets);
+	RUN(skin_plan_matches_full_pose);
 	TEST_EXIT();
 }
