@@ -430,11 +430,13 @@ mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
                          const uint32_t **joints, uint32_t *joint_count, mlod_error *err);
 /* The skinning palette of the pose last computed in s (mlod_rt_pose):
  * palette_size column-major 4x4 matrices (see "Palette"), for GPU
- * skinning. */
+ * skinning. After mlod_rt_skin (which poses only what its mesh level
+ * reads) it poses that instance again in full first. */
 mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const float **palette, uint32_t *count,
                             mlod_error *err);
-/* Poses the instance (as mlod_rt_pose) and skins its mesh level into the
- * caller's buffers: 3 floats per vertex at positions + i * pos_stride bytes
+/* Poses the instance (as mlod_rt_pose, but only the joints that its mesh
+ * level's palette entries and rigid parts follow, with their ancestors:
+ * the same floats) and skins its mesh level into the caller's buffers: 3 floats per vertex at positions + i * pos_stride bytes
  * and, when normals is not NULL, at normals + i * nrm_stride (strides >= 12
  * and multiples of 4); parts without normals get (0, 0, 0). capacity is
  * the vertices the buffers hold: MLOD_ERR_LIMIT when the level needs more

@@ -6,11 +6,14 @@
  * resident level (the best one no finer than wanted) and saying when it
  * falls back, a corrupt level failing alone. Level costs are fixed
  * (rt_test.h, fx_build(1)): coarse levels 500 + 1000 + 2 * 700 = 2900,
- * plus the runtime's table of a skeleton level (73 bytes per joint: 365).
+ * plus the runtime's table of a skeleton level (73 bytes per joint: 365)
+ * and its lists of a mesh level (4 bytes per palette entry and joint: 40,
+ * MESH_PLAN).
  */
 #include "rt_test.h"
 
-#define COARSE (2900u + 365u)
+#define MESH_PLAN 40u
+#define COARSE (2900u + 365u + MESH_PLAN)
 
 static mlod_rt_ctx *open_budget(size_t budget, mlod_error *e)
 {
@@ -152,10 +155,10 @@ static void frame(mlod_rt_ctx *ctx)
 TEST(lru_eviction)
 {
 	mlod_error e;
-	mlod_rt_ctx *ctx = open_budget(COARSE + 3500, &e);
+	mlod_rt_ctx *ctx = open_budget(COARSE + 3500 + MESH_PLAN, &e);
 	CHECK(ctx, "open: %s", e.message);
 	frame(ctx);
-	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MESH, 1, 0, &e), e); /* 2000 */
+	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MESH, 1, 0, &e), e); /* 2000 + MESH_PLAN */
 	CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
 	frame(ctx);
 	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MOTION, 1, 0, &e), e); /* 1500: exactly full */
