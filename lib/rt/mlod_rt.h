@@ -436,9 +436,10 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
                             mlod_error *err);
 /* Poses the instance (as mlod_rt_pose, but only the joints that its mesh
  * level's palette entries and rigid parts follow, with their ancestors:
- * the same floats) and skins its mesh level into the caller's buffers: 3 floats per vertex at positions + i * pos_stride bytes
- * and, when normals is not NULL, at normals + i * nrm_stride (strides >= 12
- * and multiples of 4); parts without normals get (0, 0, 0). capacity is
+ * the same floats) and skins its mesh level into the caller's buffers:
+ * 3 floats per vertex at positions + i * pos_stride bytes and, when
+ * normals is not NULL, at normals + i * nrm_stride (strides >= 12 and
+ * multiples of 4); parts without normals get (0, 0, 0). capacity is
  * the vertices the buffers hold: MLOD_ERR_LIMIT when the level needs more
  * (mlod_rt_mesh_vertex_count). *vertex_count (may be NULL) gets the
  * vertices written. */
