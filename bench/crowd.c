@@ -706,6 +706,208 @@ static void render(crowd *c, picture *P)
 }
 
 /* ---------------------------------------------------------------- */
+/* The figures' plot (--plot FILE)                                   */
+/* ---------------------------------------------------------------- */
+
+/* 3x5 glyphs, one octal digit per row (top first, the high bit left), for
+ * the plot's labels: letters (lower case drawn as upper case), digits and
+ * a little punctuation. */
+static unsigned glyph(int c)
+{
+	static const unsigned short letters[26] = {
+		025755, 065656, 034443, 065556, 074647, 074644, 034553, 055755, 072227, 011152, 055655, 044447, 057755,
+		065555, 025552, 065644, 025563, 065655, 034216, 072222, 055557, 055552, 055775, 055255, 055222, 071247,
+	};
+	if (c >= 'a' && c <= 'z')
+		c -= 'a' - 'A';
+	if (c >= 'A' && c <= 'Z')
+		return letters[c - 'A'];
+	if (c >= '0' && c <= '9')
+		return digit_glyph[c - '0'];
+	switch (c) {
+	case '.': return 000002;
+	case ',': return 000024;
+	case ':': return 002020;
+	case '/': return 011244;
+	case '(': return 012221;
+	case ')': return 042224;
+	case '-': return 000700;
+	case '%': return 051245;
+	case '=': return 007070;
+	case '+': return 002720;
+	default: return 0;
+	}
+}
+
+typedef struct canvas {
+	unsigned char *img;
+	int w, h;
+} canvas;
+
+static void dot(canvas *C, int x, int y, const unsigned char rgb[3])
+{
+	put(C->img, C->w, C->h, x, y, rgb);
+}
+
+/* Text at (x, y) (top left), glyphs zoomed z times; returns its width. */
+static int text(canvas *C, int x, int y, int z, const char *s, const unsigned char rgb[3])
+{
+	int x0 = x;
+	for (; *s; s++, x += 4 * z) {
+		unsigned g = glyph((unsigned char)*s);
+		for (int row = 0; row < 5; row++)
+			for (int col = 0; col < 3; col++)
+				if (g >> (3 * (4 - row) + (2 - col)) & 1)
+					for (int a = 0; a < z; a++)
+						for (int b = 0; b < z; b++)
+							dot(C, x + col * z + b, y + row * z + a, rgb);
+	}
+	return x - x0;
+}
+
+static void rect(canvas *C, int x0, int y0, int x1, int y1, const unsigned char rgb[3])
+{
+	for (int y = y0; y <= y1; y++)
+		for (int x = x0; x <= x1; x++)
+			dot(C, x, y, rgb);
+}
+
+/* A line 2 pixels thick. */
+static void line(canvas *C, double x0, double y0, double x1, double y1, const unsigned char rgb[3])
+{
+	const int n = (int)(fmax(fabs(x1 - x0), fabs(y1 - y0)) + 1);
+	for (int i = 0; i <= n; i++) {
+		const double t = (double)i / n;
+		const int x = (int)floor(x0 + t * (x1 - x0)), y = (int)floor(y0 + t * (y1 - y0));
+		rect(C, x, y, x + 1, y + 1, rgb);
+	}
+}
+
+/* One panel: up to 5 series of n points (x[k], y[k][s]; y <= 0: none),
+ * in the box (bx, by, bw, bh) of the canvas, log or linear axes. */
+typedef struct panel {
+	const char *title, *xlabel, *ylabel;
+	int logx, logy;
+	int n, series;
+	double x[32], y[32][5];
+	const char *name[5];
+	const unsigned char *colour[5];
+	const char *point_label[32]; /* written beside the first series' points, or NULL */
+} panel;
+
+static void fmt_tick(char *buf, size_t n, double v)
+{
+	if (v >= 1e4 && fabs(v - 1e3 * floor(v / 1e3 + 0.5)) < 1e-9 * v)
+		snprintf(buf, n, "%gK", v / 1e3);
+	else
+		snprintf(buf, n, "%g", v);
+}
+
+/* 1, 2 or 5 times a power of 10, at least v (> 0). */
+static double nice_step(double v)
+{
+	if (!(v > 0))
+		return 1;
+	const double p = pow(10, floor(log10(v))), f = v / p;
+	return (f <= 1 ? 1 : f <= 2 ? 2 : f <= 5 ? 5 : 10) * p;
+}
+
+static void draw_panel(canvas *C, const panel *P, int bx, int by, int bw, int bh)
+{
+	static const unsigned char ink[3] = { 30, 30, 30 }, grid[3] = { 222, 222, 222 };
+	const int L = bx + 80, R = bx + bw - 25, T = by + 64, B = by + bh - 45; /* the plot area */
+	text(C, bx + 10, by + 10, 2, P->title, ink);
+	/* the ranges */
+	double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+	for (int k = 0; k < P->n; k++) {
+		x0 = fmin(x0, P->x[k]), x1 = fmax(x1, P->x[k]);
+		for (int s = 0; s < P->series; s++)
+			if (P->y[k][s] > 0)
+				y0 = fmin(y0, P->y[k][s]), y1 = fmax(y1, P->y[k][s]);
+	}
+	if (!(x1 >= x0) || !(y1 >= y0))
+		return;
+	if (P->logx)
+		x0 = log10(x0), x1 = log10(x1);
+	else
+		x0 = 0;
+	/* linear axes from 0 in round steps (1, 2 or 5 times a power of 10) */
+	double xstep = 0, ystep = 0;
+	if (P->logy) {
+		y0 = floor(log10(y0)), y1 = ceil(log10(y1));
+	} else {
+		y0 = 0, ystep = nice_step(y1 / 5), y1 = ystep * ceil(y1 * 1.05 / ystep);
+	}
+	if (!P->logx)
+		xstep = nice_step(x1 / 5), x1 = xstep * ceil(x1 * 1.05 / xstep);
+	if (x1 - x0 < 1e-9)
+		x0 -= 0.5, x1 += 0.5;
+	if (y1 - y0 < 1e-9)
+		y1 = y0 + 1;
+#define PX(v) (L + ((P->logx ? log10(v) : (v)) - x0) / (x1 - x0) * (R - L))
+#define PY(v) (B - ((P->logy ? log10(v) : (v)) - y0) / (y1 - y0) * (B - T))
+	char buf[32];
+	/* y ticks: decades (log) or 5 steps (linear) */
+	const int yt = P->logy ? (int)(y1 - y0) : (int)(y1 / ystep + 0.5);
+	for (int k = 0; k <= yt; k++) {
+		const double v = P->logy ? pow(10, y0 + k) : ystep * k;
+		const int y = (int)PY(v);
+		rect(C, L, y, R, y, grid);
+		fmt_tick(buf, sizeof buf, P->logy ? v : floor(v + 0.5));
+		text(C, L - 8 - 8 * (int)strlen(buf), y - 5, 2, buf, ink);
+	}
+	/* x ticks: at the points (log) or 5 steps (linear) */
+	const int xt = P->logx ? P->n : (int)(x1 / xstep + 0.5);
+	for (int k = 0; k < xt + (P->logx ? 0 : 1); k++) {
+		const double v = P->logx ? P->x[k] : xstep * k;
+		const int x = (int)PX(v);
+		rect(C, x, T, x, B, grid);
+		fmt_tick(buf, sizeof buf, P->logx ? v : floor(v + 0.5));
+		text(C, x - 4 * (int)strlen(buf), B + 8, 2, buf, ink);
+	}
+	rect(C, L, T, L + 1, B, ink), rect(C, L, B, R, B + 1, ink);
+	text(C, (L + R) / 2 - 4 * (int)strlen(P->xlabel), B + 26, 2, P->xlabel, ink);
+	text(C, bx + 10, by + 34, 2, P->ylabel, ink);
+	/* the series: lines between the points, a square on each */
+	for (int s = 0; s < P->series; s++) {
+		double px = 0, py = 0;
+		int have = 0;
+		for (int k = 0; k < P->n; k++) {
+			if (!(P->y[k][s] > 0))
+				continue;
+			const double x = PX(P->x[k]), y = PY(P->y[k][s]);
+			if (have)
+				line(C, px, py, x, y, P->colour[s]);
+			rect(C, (int)x - 3, (int)y - 3, (int)x + 3, (int)y + 3, P->colour[s]);
+			if (s == 0 && P->point_label[k])
+				text(C, (int)x + 6, (int)y - 16, 2, P->point_label[k], ink);
+			px = x, py = y, have = 1;
+		}
+	}
+#undef PX
+#undef PY
+	/* the legend, top right */
+	for (int s = 0; s < P->series && P->series > 1; s++) {
+		const int y = T + 8 + 16 * s, x = R - 150;
+		rect(C, x, y + 3, x + 20, y + 5, P->colour[s]);
+		text(C, x + 28, y, 2, P->name[s], ink);
+	}
+}
+
+static void write_plot(const char *path, const panel *p15, const panel *p16)
+{
+	canvas C = { NULL, 1280, 560 };
+	C.img = malloc((size_t)C.w * C.h * 3);
+	if (!C.img)
+		die(2, "%s", "out of memory");
+	memset(C.img, 255, (size_t)C.w * C.h * 3);
+	draw_panel(&C, p15, 0, 0, C.w / 2, C.h);
+	draw_panel(&C, p16, C.w / 2, 0, C.w / 2, C.h);
+	write_png(path, C.img, C.w, C.h);
+	free(C.img);
+}
+
+/* ---------------------------------------------------------------- */
 /* Measuring                                                         */
 /* ---------------------------------------------------------------- */
 
@@ -761,11 +963,15 @@ static void print_hist(const uint32_t *h, uint32_t levels)
 		printf(" %u", h[l]);
 }
 
-/* The LoD modes measured besides full detail. */
-static const char *const mode_name[3] = { "alpha", "pixels", "toc" };
+/* The LoD modes measured besides full detail: the runtime's rules
+ * (mlod_rt_select_mode), then skeleton (the paper's Figure 15: the alpha
+ * rule on the skeleton layer alone, mesh and motion at level 0). */
+#define MODES 4
+#define MODE_SKELETON 3
+static const char *const mode_name[MODES] = { "alpha", "pixels", "toc", "skeleton" };
 
-/* "alpha", "pixels", "toc", a comma list of them, or "all" (alpha and
- * pixels): a bit per mlod_rt_select_mode. */
+/* "alpha", "pixels", "toc", "skeleton", a comma list of them, or "all"
+ * (alpha and pixels): a bit per mode. */
 static unsigned parse_modes(const char *s)
 {
 	if (!strcmp(s, "all"))
@@ -774,22 +980,133 @@ static unsigned parse_modes(const char *s)
 	for (const char *p = s; *p;) {
 		size_t n = strcspn(p, ",");
 		int k;
-		for (k = 0; k < 3; k++)
+		for (k = 0; k < MODES; k++)
 			if (strlen(mode_name[k]) == n && !strncmp(p, mode_name[k], n))
 				break;
-		if (k == 3 || n == 0)
-			die(1, "unknown --mode '%s' (alpha, pixels, toc, a comma list of them, or all)", s);
+		if (k == MODES || n == 0)
+			die(1, "unknown --mode '%s' (alpha, pixels, toc, skeleton, a comma list of them, or all)", s);
 		m |= 1u << k;
 		p += n;
 		if (*p == ',' && *++p == '\0')
-			die(1, "unknown --mode '%s' (alpha, pixels, toc, a comma list of them, or all)", s);
+			die(1, "unknown --mode '%s' (alpha, pixels, toc, skeleton, a comma list of them, or all)", s);
 	}
 	return m;
 }
 
+/* The paper's Figures 15 and 16 as data (and, with plot_path, as a PNG
+ * plot): Figure 15, the crowd's frame rate against N at full detail and
+ * with LoD (fig15: frames per second per N and mode, full last, from the
+ * runs above); Figure 16, one character at each mesh level with skeleton
+ * and motion at level 0 (the paper's mesh LoD on one character), measured
+ * here: the best of 5 runs of 0.05 s CPU each, one update and one skin
+ * per frame. */
+static void print_figures(crowd *c, const uint32_t *L, float near, float far, const uint32_t *sizes, uint32_t nsizes,
+                          unsigned modes, double fig15[][MODES + 1], const char *plot_path)
+{
+	static const unsigned char colours[MODES + 1][3] = {
+		{ 40, 150, 60 },  /* alpha: green */
+		{ 40, 90, 200 },  /* pixels: blue */
+		{ 150, 60, 170 }, /* toc: purple */
+		{ 235, 140, 20 }, /* skeleton: orange */
+		{ 200, 30, 30 },  /* full: red */
+	};
+	panel p15, p16;
+	memset(&p15, 0, sizeof p15), memset(&p16, 0, sizeof p16);
+	p15.title = "FIG 15: CROWD FRAME RATE, FULL AND LOD";
+	p15.xlabel = "N (INSTANCES)", p15.ylabel = "FRAMES/S (CPU, ONE CORE)";
+	p15.logx = p15.logy = 1;
+	p15.n = nsizes < 32 ? (int)nsizes : 32;
+	int order[MODES + 1], ns = 0;
+	order[ns++] = MODES; /* full first */
+	order[ns++] = MODE_SKELETON;
+	for (int m = 0; m < 3; m++)
+		order[ns++] = m;
+	printf("\nfigure 15 (the crowd's frame rate against N: frames per second of CPU time, one core)\n%7s", "N");
+	for (int i = 0; i < ns; i++)
+		if (order[i] == MODES || (modes >> order[i] & 1)) {
+			p15.name[p15.series] = order[i] == MODES ? "FULL" : mode_name[order[i]];
+			p15.colour[p15.series] = colours[order[i]];
+			for (int k = 0; k < p15.n; k++)
+				p15.y[k][p15.series] = fig15[k][order[i]];
+			p15.series++;
+			printf(" %9s", order[i] == MODES ? "full" : mode_name[order[i]]);
+		}
+	printf("\n");
+	for (int k = 0; k < p15.n; k++) {
+		p15.x[k] = sizes[k];
+		printf("%7u", sizes[k]);
+		for (int i = 0; i < p15.series; i++)
+			printf(" %9.2f", p15.y[k][i]);
+		printf("\n");
+	}
+
+	/* Figure 16 */
+	const uint32_t Lm = L[MLOD_RT_MESH];
+	mlod_error e;
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	sel.d_near = near, sel.d_far = far, sel.hysteresis = 0;
+	for (int l = 0; l < MLOD_RT_LAYERS; l++)
+		sel.t_start[l] = l == MLOD_RT_MESH ? 0.0f : 2.0f, sel.t_end[l] = l == MLOD_RT_MESH ? 1.0f : 2.0f;
+	printf("\nfigure 16 (one character at each mesh level, skeleton and motion at level 0)\n"
+	       "%5s %9s %9s %10s %10s %8s\n", "level", "triangles", "vertices", "us/frame", "frames/s", "speedup");
+	p16.title = "FIG 16: ONE CHARACTER, MESH LEVELS";
+	p16.xlabel = "TRIANGLES", p16.ylabel = "FRAMES/S (CPU, ONE CORE)";
+	p16.series = 1, p16.name[0] = "MESH LOD", p16.colour[0] = colours[MLOD_RT_SELECT_PIXELS];
+	static char labels[32][8];
+	double us0 = 0;
+	for (uint32_t k = 0; k < Lm && k < 32; k++) {
+		uint32_t id;
+		if (mlod_rt_instance_create(c->ctx, 0, 0, MLOD_RT_LOOP, &id, &e) != MLOD_OK)
+			die(2, "%s", e.message);
+		float d = Lm > 1 ? near + (far - near) * (float)k / (float)(Lm - 1) : near;
+		c->ids[0] = id, c->dist[0] = d, c->n = 1;
+		settle(c, &sel);
+		const mlod_rt_state *st = mlod_rt_instance_state(c->ctx, id);
+		double best = INFINITY;
+		for (int rep = 0; rep < 5; rep++) {
+			int frames = 0;
+			double t0 = cpu_seconds(), t1;
+			do {
+				uint32_t nv;
+				if (mlod_rt_update(c->ctx, &sel, &id, &d, 1, 1.0f / 30, &e) != MLOD_OK ||
+				    skin_one(c, id, &nv, &e) != MLOD_OK)
+					die(2, "%s", e.message);
+				frames++;
+				t1 = cpu_seconds();
+			} while (t1 - t0 < 0.05);
+			best = fmin(best, (t1 - t0) / frames);
+		}
+		const uint32_t shown = st->level[MLOD_RT_MESH];
+		uint32_t tris = 0;
+		for (uint32_t p = 0; p < mlod_rt_mesh_part_count(c->ctx, shown); p++) {
+			mlod_rt_part_info pi;
+			if (mlod_rt_mesh_part(c->ctx, shown, p, &pi, &e) == MLOD_OK)
+				tris += pi.index_count / 3;
+		}
+		if (k == 0)
+			us0 = 1e6 * best;
+		printf("%5u %9u %9u %10.2f %10.0f %7.2fx%s\n", shown, tris, mlod_rt_mesh_vertex_count(c->ctx, shown),
+		       1e6 * best, 1.0 / best, us0 / (1e6 * best), shown != k ? "  (not the level asked: not resident)" : "");
+		p16.x[p16.n] = tris;
+		p16.y[p16.n][0] = 1.0 / best;
+		snprintf(labels[p16.n], sizeof labels[p16.n], "L%u", shown);
+		p16.point_label[p16.n] = labels[p16.n];
+		p16.n++;
+		mlod_rt_instance_destroy(c->ctx, id);
+	}
+	c->n = 0;
+	if (plot_path) {
+		write_plot(plot_path, &p15, &p16);
+		printf("plot: %s, 1280x560: figure 15 (frames per second against N, log-log) and figure 16 (frames per "
+		       "second of one character against its mesh level's triangles)\n", plot_path);
+	}
+}
+
 int main(int argc, char **argv)
 {
-	const char *counts = "1,10,50,250,1000,10000", *png_path = NULL;
+	const char *counts = "1,10,50,250,1000,10000", *png_path = NULL, *plot_path = NULL;
+	int figures = 0;
 	double seconds = 2, fps = 30, max_wall = 10, hyst = 0.1, height = 1.8, pixels = -1;
 	float near = 2, far = 200, ts = 0, te = 1;
 	size_t budget = 0;
@@ -806,6 +1123,7 @@ int main(int argc, char **argv)
 		{ "height", required_argument, NULL, 'E' },   { "pixels", required_argument, NULL, 'P' },
 		{ "png", required_argument, NULL, 'G' },      { "png-count", required_argument, NULL, 'C' },
 		{ "png-size", required_argument, NULL, 'Z' }, { "png-mode", required_argument, NULL, 'M' },
+		{ "figures", no_argument, NULL, 'g' },        { "plot", required_argument, NULL, 'p' },
 		{ "help", no_argument, NULL, 'h' },           { NULL, 0, NULL, 0 },
 	};
 	int ch;
@@ -836,6 +1154,8 @@ int main(int argc, char **argv)
 			break;
 		}
 		case 'G': png_path = optarg; break;
+		case 'g': figures = 1; break;
+		case 'p': plot_path = optarg, figures = 1; break;
 		case 'C': {
 			char *end;
 			png_count = strtoul(optarg, &end, 10);
@@ -850,10 +1170,10 @@ int main(int argc, char **argv)
 			break;
 		case 'M': {
 			int k;
-			for (k = 0; k < 3 && strcmp(optarg, mode_name[k]); k++)
+			for (k = 0; k < MODES && strcmp(optarg, mode_name[k]); k++)
 				;
-			if (k == 3)
-				die(1, "unknown --png-mode '%s' (alpha, pixels or toc)", optarg);
+			if (k == MODES)
+				die(1, "unknown --png-mode '%s' (alpha, pixels, toc or skeleton)", optarg);
 			png_mode = k;
 			break;
 		}
@@ -877,6 +1197,8 @@ int main(int argc, char **argv)
 		die(1, "%s", "one PACK is needed (see --help)");
 	if (!(seconds > 0) || !(fps > 0) || !(far > near) || near < 0 || hyst < 0)
 		die(1, "%s", "bad --seconds, --fps, --near/--far or --hysteresis");
+	if (figures)
+		modes |= 1u << MODE_SKELETON;
 	if (png_mode >= 0 && !(modes >> png_mode & 1))
 		die(1, "--png-mode %s is not among the measured --mode", mode_name[png_mode]);
 	if (png_mode < 0)
@@ -957,9 +1279,11 @@ int main(int argc, char **argv)
 	printf("distances %g..%g%s spread %s\n", near, far, unit, line ? "along a line" : "over the ground");
 	printf("budget %s%zu, hysteresis %g, %g s at %g fps per measurement; modes: full",
 	       budget ? "" : "none ", budget, hyst, seconds, fps);
-	for (int k = 0; k < 3; k++)
+	for (int k = 0; k < MODES; k++)
 		if (modes >> k & 1) {
-			if (k == MLOD_RT_SELECT_ALPHA)
+			if (k == MODE_SKELETON)
+				printf(", skeleton (alpha on the skeleton layer alone, interval %g,%g)", ts, te);
+			else if (k == MLOD_RT_SELECT_ALPHA)
 				printf(", alpha (interval %g,%g)", ts, te);
 			else if (k == MLOD_RT_SELECT_PIXELS)
 				printf(", pixels (%g px at %g lines, fov %g deg)", lod.max_pixels, lod.lines,
@@ -1019,7 +1343,7 @@ int main(int argc, char **argv)
 	if (bench)
 		skin_bench(file, file_size);
 
-	mlod_rt_select full, sel[3];
+	mlod_rt_select full, sel[MODES];
 	mlod_rt_select_default(&full);
 	full.force_level = 0;
 	lod.d_near = near_u, lod.d_far = far_u;
@@ -1028,6 +1352,17 @@ int main(int argc, char **argv)
 		lod.t_start[l] = ts, lod.t_end[l] = te;
 	for (int k = 0; k < 3; k++)
 		sel[k] = lod, sel[k].mode = (mlod_rt_select_mode)k;
+	/* skeleton: alpha over the interval for the skeleton layer; an
+	 * interval past 1 keeps mesh and motion at level 0 */
+	sel[MODE_SKELETON] = lod;
+	sel[MODE_SKELETON].mode = MLOD_RT_SELECT_ALPHA;
+	for (int l = 0; l < MLOD_RT_LAYERS; l++)
+		if (l != MLOD_RT_SKELETON)
+			sel[MODE_SKELETON].t_start[l] = sel[MODE_SKELETON].t_end[l] = 2.0f;
+	/* Figure 15's data: frames per second (CPU, one core) per N and mode
+	 * (full last). */
+	double fig15[32][MODES + 1];
+	memset(fig15, 0, sizeof fig15);
 
 	picture pic;
 	memset(&pic, 0, sizeof pic);
@@ -1042,7 +1377,7 @@ int main(int argc, char **argv)
 	                           (bmax[2] - bmin[2]) * (bmax[2] - bmin[2]));
 	pic.near = near_u, pic.far = far_u, pic.mesh_levels = L[MLOD_RT_MESH];
 
-	printf("\n%7s %-7s %11s %8s %8s  %-s\n", "N", "mode", "ms/frame", "speedup", "Mvert/s",
+	printf("\n%7s %-8s %11s %8s %8s  %-s\n", "N", "mode", "ms/frame", "speedup", "Mvert/s",
 	       "instances per level (skeleton | mesh | motion), resident bytes");
 	for (uint32_t k = 0; k < nsizes; k++) {
 		const uint32_t n = sizes[k];
@@ -1062,9 +1397,9 @@ int main(int argc, char **argv)
 		float *d0 = malloc(sizeof *d0 * n), *s0 = malloc(sizeof *s0 * n);
 		memcpy(d0, c.dist, sizeof *d0 * n);
 		memcpy(s0, c.speed, sizeof *s0 * n);
-		result res[4];
-		res[3] = run_mode(&c, &full, seconds, fps, max_wall, near_u, far_u, NULL);
-		for (int m = 0; m < 3; m++) {
+		result res[MODES + 1];
+		res[MODES] = run_mode(&c, &full, seconds, fps, max_wall, near_u, far_u, NULL);
+		for (int m = 0; m < MODES; m++) {
 			if (!(modes >> m & 1))
 				continue;
 			memcpy(c.dist, d0, sizeof *d0 * n); /* the same walk for every mode */
@@ -1074,15 +1409,17 @@ int main(int argc, char **argv)
 		}
 		free(d0), free(s0);
 		const int want = (int)(seconds * fps + 0.5);
-		for (int mm = 0; mm < 4; mm++) { /* full, then alpha, pixels, toc */
-			const int m = (mm + 3) % 4;
-			if (m < 3 && !(modes >> m & 1))
+		for (int mm = 0; mm <= MODES; mm++) { /* full, then alpha, pixels, toc, skeleton */
+			const int m = (mm + MODES) % (MODES + 1);
+			if (m < MODES && !(modes >> m & 1))
 				continue;
 			const result *b = &res[m];
-			if (m == 3)
-				printf("%7u %-7s %11.3f %8s", n, "full", b->ms, "");
+			if (k < 32)
+				fig15[k][m] = 1000.0 / b->ms;
+			if (m == MODES)
+				printf("%7u %-8s %11.3f %8s", n, "full", b->ms, "");
 			else
-				printf("%7s %-7s %11.3f %7.2fx", "", mode_name[m], b->ms, res[3].ms / b->ms);
+				printf("%7s %-8s %11.3f %7.2fx", "", mode_name[m], b->ms, res[MODES].ms / b->ms);
 			printf(" %8.1f ", b->vertices / (b->ms * b->frames) / 1e3);
 			print_hist(b->hist[0], L[0]);
 			printf(" |");
@@ -1104,6 +1441,8 @@ int main(int argc, char **argv)
 	printf("\nstreaming: %llu loads, %llu evictions, %llu failures; peak resident %zu bytes\n",
 	       (unsigned long long)st.loads, (unsigned long long)st.evictions, (unsigned long long)st.failures,
 	       st.peak_resident_bytes);
+	if (figures)
+		print_figures(&c, L, near_u, far_u, sizes, nsizes, modes, fig15, plot_path);
 	if (png_path) {
 		printf("picture: %s, %dx%d, N = %u, mode %s, the last measured frame: %u instances drawn (mesh levels",
 		       png_path, png_w, png_h, pic.count, mode_name[pic.mode], pic.drawn);
