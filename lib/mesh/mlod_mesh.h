@@ -224,7 +224,7 @@ mlod_result mlod_primitive_remap_joints(mlod_primitive *p, const int *map, int m
  * MLOD_MESH_RANDOM_ANGLE radians); the error is measured on the rest pose,
  * clip frames and as many other random poses (seed
  * MLOD_MESH_MEASURE_SEED). */
-#define MLOD_MESH_RATIOS_DEFAULT 0.5, 0.25, 0.1
+#define MLOD_MESH_RATIOS_DEFAULT 0.5, 0.25, 0.1, 0.03
 #define MLOD_MESH_MAX_LEVELS 16
 #define MLOD_MESH_MIN_RATIO (1.0 / 256)
 #define MLOD_MESH_BISECTIONS 6
