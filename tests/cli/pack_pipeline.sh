@@ -10,9 +10,9 @@ const fs = require('fs');
 const c = JSON.parse(fs.readFileSync('c.json')), r = JSON.parse(fs.readFileSync('r.json'));
 // mlod-skelgraph's default chain stops where a level would pass 2% of the
 // height: tubeman keeps 2 coarser levels (3 with the full skeleton).
-const levels = { skeleton: 3, mesh: 4, motion: 4 };
+const levels = { skeleton: 3, mesh: 5, motion: 4 };
 for (const l in levels) if (r.layers[l].source !== 'input' || r.layers[l].levels !== levels[l]) throw new Error(l + ': ' + JSON.stringify(r.layers[l]));
-const want = { joints: 31, skins: 1, skeleton_levels: 3, mesh_levels: 4, clips: 1, motion_levels: 4, parts: 1 };
+const want = { joints: 31, skins: 1, skeleton_levels: 3, mesh_levels: 5, clips: 1, motion_levels: 4, parts: 1 };
 for (const k in want) if (c[k] !== want[k]) throw new Error(`${k}: ${c[k]}`);
 if (JSON.stringify(c.clip_names) !== '["walk"]') throw new Error('clips ' + c.clip_names);
 JS
