@@ -44,7 +44,7 @@ for (const order of process.argv.slice(2)) {
 		made[stage] = parts[stage](j);
 		const found = {
 			L: made.L && made.L.some((x) => x), S: made.S && made.S[0] && made.S[0].length > 0,
-			B: made.B && made.B[0] && made.B[0].length === 3, M: made.M && made.M.some((x) => x && x.motion_level),
+			B: made.B && made.B[0] && made.B[0].length === 4, M: made.M && made.M.some((x) => x && x.motion_level),
 		};
 		if (!found[stage]) throw new Error(`${order}: ${stage} recorded nothing`);
 		for (const [s, was] of Object.entries(made))
