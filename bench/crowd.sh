@@ -5,7 +5,9 @@
 # 2..200 m (every character taken as 1.8 m tall) spread over the ground,
 # full detail against LoD by the paper's alpha and by projected error
 # (1 px at 1080 lines, 60 degrees), one core; the skinning kernel against a
-# plain scalar loop.
+# plain scalar loop; and the paper's Figures 15 and 16 as data (--figures:
+# frames per second against N with skeletal LoD alone too, and one
+# character at each mesh level).
 set -eu
 bin=$BUILD/bin
 [ -x "$BUILD/bench/crowd" ] || exit 0
@@ -18,7 +20,7 @@ for f in $INPUTS; do
 	name=$(basename "$f" .glb)
 	"$bin/mlod-pack" -o "$tmp/$name.mlod" "$f" 2> /dev/null
 	echo '```'
-	"$BUILD/bench/crowd" -n 1,10,50,250,1000,10000 -s 1 --max-wall 3 --mode all "$tmp/$name.mlod"
+	"$BUILD/bench/crowd" -n 1,10,50,250,1000,10000 -s 1 --max-wall 3 --mode all --figures "$tmp/$name.mlod"
 	echo '```'
 	echo
 done
