@@ -18,7 +18,7 @@
 
 #include "measure/mlod_measure.h"
 
-#define LEAF_SIZE 4
+#define LEAF_SIZE 8
 #define MAX_DEPTH 64 /* object-median splits of < 2^31 triangles stay far below */
 
 typedef struct node {
@@ -37,6 +37,7 @@ typedef struct bvh {
 	node *nodes;
 	int node_count;
 	tri *tris;  /* in leaf order */
+	int *order; /* the mesh's triangle at each place of tris */
 } bvh;
 
 /* ---------------------------------------------------------------- */
@@ -265,7 +266,7 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 		for (int a = 0; a < 3; a++)
 			t->n[a] = t->degenerate || !(len > 0.0) ? 0.0 : nn[a] / len;
 	}
-	free(b.order);
+	out->order = b.order;
 	free(b.centroids);
 	return MLOD_OK;
 }
@@ -274,6 +275,7 @@ static void bvh_free(bvh *b)
 {
 	free(b->nodes);
 	free(b->tris);
+	free(b->order);
 }
 
 static double box_dist2(const double *p, const node *n)
@@ -362,39 +364,55 @@ static mlod_result check_mesh(const mlod_posed *m, const char *which, mlod_error
 	return MLOD_OK;
 }
 
-/* Adds the distances of from's samples to the surface in to. */
-static mlod_result measure(const mlod_posed *from, const bvh *to, double *sum, double *max, long *count,
-                           mlod_error *err)
+/* Adds the distances of from's samples to the surface in to. The samples
+ * are visited in the leaf order of from's own hierarchy (each triangle's
+ * vertices, then its centroid), so that neighbouring queries are near one
+ * another and each starts from a close triangle; the distances are then
+ * summed in the mesh's order (used vertices, then triangles), so the sum
+ * does not depend on the visiting order. */
+static mlod_result measure(const mlod_posed *from, const bvh *from_bvh, const bvh *to, double *sum, double *max,
+                           long *count, mlod_error *err)
 {
-	unsigned char *used = calloc((size_t)from->vertex_count, 1);
-	if (!used)
-		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %d vertex flags", from->vertex_count);
+	double *dv = malloc(((size_t)from->vertex_count + (size_t)from->triangle_count) * sizeof *dv);
+	if (!dv)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %d distances",
+		                 from->vertex_count + from->triangle_count);
+	double *dt = dv + from->vertex_count;
+	/* only vertices on the surface count: unreferenced ones are not part of it (-1) */
+	for (int v = 0; v < from->vertex_count; v++)
+		dv[v] = -1.0;
 	int hint = 0;
-	for (long i = 0; i < 3L * from->triangle_count; i++)
-		used[from->indices[i]] = 1;
-	/* only vertices on the surface count: unreferenced ones are not part of it */
-	for (int v = 0; v < from->vertex_count; v++) {
-		if (!used[v])
-			continue;
-		const double p[3] = { from->positions[3 * (size_t)v], from->positions[3 * (size_t)v + 1],
-		                      from->positions[3 * (size_t)v + 2] };
-		double d = sqrt(bvh_nearest2(to, p, &hint));
-		*sum += d;
-		*max = fmax(*max, d);
-		++*count;
-	}
-	for (int t = 0; t < from->triangle_count; t++) {
+	for (int k = 0; k < from->triangle_count; k++) {
+		int t = from_bvh->order[k];
 		const uint32_t *ix = from->indices + 3 * (size_t)t;
+		for (int c = 0; c < 3; c++) {
+			if (dv[ix[c]] >= 0.0)
+				continue;
+			const float *q = from->positions + 3 * (size_t)ix[c];
+			const double p[3] = { q[0], q[1], q[2] };
+			dv[ix[c]] = sqrt(bvh_nearest2(to, p, &hint));
+		}
 		double p[3];
 		for (int a = 0; a < 3; a++)
 			p[a] = ((double)from->positions[3 * (size_t)ix[0] + a] + from->positions[3 * (size_t)ix[1] + a] +
 			        from->positions[3 * (size_t)ix[2] + a]) / 3.0;
-		double d = sqrt(bvh_nearest2(to, p, &hint));
-		*sum += d;
-		*max = fmax(*max, d);
-		++*count;
+		dt[t] = sqrt(bvh_nearest2(to, p, &hint));
 	}
-	free(used);
+	double s = *sum, m = *max;
+	long n = *count;
+	for (int v = 0; v < from->vertex_count; v++)
+		if (dv[v] >= 0.0) {
+			s += dv[v];
+			m = dv[v] > m ? dv[v] : m;
+			n++;
+		}
+	for (int t = 0; t < from->triangle_count; t++) {
+		s += dt[t];
+		m = dt[t] > m ? dt[t] : m;
+		n++;
+	}
+	*sum = s, *max = m, *count = n;
+	free(dv);
 	return MLOD_OK;
 }
 
@@ -428,8 +446,8 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 	double sum = 0.0, max = 0.0;
 	long count = 0;
 	if (!(r = bvh_build(a, &ba, err)) && !(r = bvh_build(b, &bb, err)) &&
-	    !(r = measure(a, &bb, &sum, &max, &count, err)))
-		r = measure(b, &ba, &sum, &max, &count, err);
+	    !(r = measure(a, &ba, &bb, &sum, &max, &count, err)))
+		r = measure(b, &bb, &ba, &sum, &max, &count, err);
 	bvh_free(&ba);
 	bvh_free(&bb);
 	if (r)
