@@ -22,7 +22,7 @@
 #define MAX_DEPTH 64 /* object-median splits of < 2^31 triangles stay far below */
 
 typedef struct node {
-	float lo[3], hi[3];
+	double lo[3], hi[3];
 	int first; /* leaf: first triangle; inner: index of the left child (right is next) */
 	int count; /* leaf: triangle count; inner: 0 */
 } node;
@@ -197,8 +197,8 @@ static void build_node(builder *b, int index, int lo, int hi)
 					hi3[a] = x > hi3[a] ? x : hi3[a];
 				}
 		}
-		memcpy(n->lo, lo3, sizeof lo3);
-		memcpy(n->hi, hi3, sizeof hi3);
+		for (int a = 0; a < 3; a++)
+			n->lo[a] = lo3[a], n->hi[a] = hi3[a];
 		n->first = lo;
 		n->count = hi - lo;
 		return;
@@ -285,7 +285,7 @@ static double box_dist2(const double *p, const node *n)
 		double below = n->lo[a] - p[a], above = p[a] - n->hi[a];
 		double d = below > above ? below : above;
 		d = d > 0.0 ? d : 0.0;
-		d2 += d * d;
+		d2 = d2 + d * d;
 	}
 	return d2;
 }
