@@ -278,14 +278,16 @@ static void bvh_free(bvh *b)
 	free(b->order);
 }
 
-static double box_dist2(const double *p, const node *n)
+/* Squared distance from p to the node's box: p less its clamp to the box
+ * on each axis (so the compiler needs no branch). */
+static inline double box_dist2(const double *p, const node *n)
 {
 	double d2 = 0.0;
 	for (int a = 0; a < 3; a++) {
-		double below = n->lo[a] - p[a], above = p[a] - n->hi[a];
-		double d = below > above ? below : above;
-		d = d > 0.0 ? d : 0.0;
-		d2 = d2 + d * d;
+		double c = p[a] > n->lo[a] ? p[a] : n->lo[a];
+		c = c < n->hi[a] ? c : n->hi[a];
+		double d = p[a] - c;
+		d2 += d * d;
 	}
 	return d2;
 }
