@@ -312,14 +312,22 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 {
 	double best = triangle_dist2(p, &b->tris[*hint]);
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
-	int top = 0;
-	stack[top].node = 0, stack[top++].d2 = box_dist2(p, &b->nodes[0]);
-	while (top > 0) {
-		--top;
-		if (stack[top].d2 >= best)
+	int top = 0, at = 0;
+	double at_d2 = box_dist2(p, &b->nodes[0]);
+	for (;;) {
+		const node *n = &b->nodes[at];
+		if (at_d2 < best && n->count == 0) {
+			/* on into the nearer child; the farther one waits on the stack */
+			int l = n->first, r = n->first + 1;
+			double dl = box_dist2(p, &b->nodes[l]), dr = box_dist2(p, &b->nodes[r]);
+			int near = dl <= dr ? l : r, far = dl <= dr ? r : l;
+			double dnear = dl <= dr ? dl : dr, dfar = dl <= dr ? dr : dl;
+			if (dfar < best)
+				stack[top].node = far, stack[top++].d2 = dfar;
+			at = near, at_d2 = dnear;
 			continue;
-		const node *n = &b->nodes[stack[top].node];
-		if (n->count > 0) {
+		}
+		if (at_d2 < best)
 			for (int k = n->first; k < n->first + n->count; k++) {
 				if (plane_dist2(p, &b->tris[k]) >= best)
 					continue; /* its plane is already farther than the best */
@@ -327,21 +335,10 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 				if (d < best)
 					best = d, *hint = k;
 			}
-			continue;
-		}
-		/* push the farther child first, so the nearer one is searched first */
-		int l = n->first, r = n->first + 1;
-		double dl = box_dist2(p, &b->nodes[l]), dr = box_dist2(p, &b->nodes[r]);
-		if (dl > dr) {
-			int ti = l;
-			double td = dl;
-			l = r, dl = dr;
-			r = ti, dr = td;
-		}
-		if (dr < best)
-			stack[top].node = r, stack[top++].d2 = dr;
-		if (dl < best)
-			stack[top].node = l, stack[top++].d2 = dl;
+		if (top == 0)
+			break;
+		--top;
+		at = stack[top].node, at_d2 = stack[top].d2;
 	}
 	return best;
 }
