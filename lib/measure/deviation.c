@@ -139,33 +139,34 @@ static int is_degenerate(const tri *t)
 /* Hierarchy                                                         */
 /* ---------------------------------------------------------------- */
 
+/* A triangle being placed: its centroid and index, moved together so
+ * that the build reads memory in order. */
+typedef struct item {
+	float c[3];
+	int t;
+} item;
+
 typedef struct builder {
 	bvh *out;
 	const mlod_posed *mesh;
-	int *order;       /* triangle indices, permuted into leaf order */
-	float *centroids; /* 3 per triangle */
+	item *items;      /* permuted into leaf order */
 } builder;
 
-static float centroid_of(const builder *b, int t, int axis)
-{
-	return b->centroids[3 * t + axis];
-}
-
-/* Rearranges order[lo, hi) so that order[nth] has the nth smallest centroid
+/* Rearranges items[lo, hi) so that items[nth] has the nth smallest centroid
  * along axis and no smaller one comes after it (quickselect). */
 static void select_nth(const builder *b, int lo, int hi, int nth, int axis)
 {
-	int *o = b->order;
+	item *o = b->items;
 	while (hi - lo > 1) {
-		float pivot = centroid_of(b, o[lo + (hi - lo) / 2], axis);
+		float pivot = o[lo + (hi - lo) / 2].c[axis];
 		int i = lo, j = hi - 1;
 		while (i <= j) {
-			while (centroid_of(b, o[i], axis) < pivot)
+			while (o[i].c[axis] < pivot)
 				i++;
-			while (centroid_of(b, o[j], axis) > pivot)
+			while (o[j].c[axis] > pivot)
 				j--;
 			if (i <= j) {
-				int tmp = o[i];
+				item tmp = o[i];
 				o[i] = o[j], o[j] = tmp;
 				i++, j--;
 			}
@@ -180,7 +181,7 @@ static void select_nth(const builder *b, int lo, int hi, int nth, int axis)
 	}
 }
 
-/* Builds the subtree of order[lo, hi) at nodes[index]: a leaf for a few
+/* Builds the subtree of items[lo, hi) at nodes[index]: a leaf for a few
  * triangles, else two children split at the median centroid along the
  * axis where centroids spread most. Boxes are merged bottom-up. */
 static void build_node(builder *b, int index, int lo, int hi)
@@ -189,7 +190,7 @@ static void build_node(builder *b, int index, int lo, int hi)
 	float lo3[3] = { INFINITY, INFINITY, INFINITY }, hi3[3] = { -INFINITY, -INFINITY, -INFINITY };
 	if (hi - lo <= LEAF_SIZE) {
 		for (int k = lo; k < hi; k++) {
-			const uint32_t *ix = b->mesh->indices + 3 * (size_t)b->order[k];
+			const uint32_t *ix = b->mesh->indices + 3 * (size_t)b->items[k].t;
 			for (int v = 0; v < 3; v++)
 				for (int a = 0; a < 3; a++) {
 					float x = b->mesh->positions[3 * (size_t)ix[v] + a];
@@ -205,7 +206,7 @@ static void build_node(builder *b, int index, int lo, int hi)
 	}
 	for (int k = lo; k < hi; k++)
 		for (int a = 0; a < 3; a++) {
-			float x = centroid_of(b, b->order[k], a);
+			float x = b->items[k].c[a];
 			lo3[a] = x < lo3[a] ? x : lo3[a];
 			hi3[a] = x > hi3[a] ? x : hi3[a];
 		}
@@ -232,25 +233,26 @@ static void build_node(builder *b, int index, int lo, int hi)
 static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 {
 	int n = m->triangle_count;
-	builder b = { out, m, malloc((size_t)n * sizeof(int)), malloc((size_t)n * 3 * sizeof(float)) };
+	builder b = { out, m, malloc((size_t)n * sizeof *b.items) };
 	out->nodes = malloc((size_t)2 * n * sizeof *out->nodes);
 	out->tris = malloc((size_t)n * sizeof *out->tris);
+	out->order = malloc((size_t)n * sizeof *out->order);
 	out->node_count = 1;
-	if (!b.order || !b.centroids || !out->nodes || !out->tris) {
-		free(b.order);
-		free(b.centroids);
+	if (!b.items || !out->nodes || !out->tris || !out->order) {
+		free(b.items);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", n);
 	}
 	for (int t = 0; t < n; t++) {
 		const uint32_t *ix = m->indices + 3 * (size_t)t;
-		b.order[t] = t;
+		b.items[t].t = t;
 		for (int a = 0; a < 3; a++)
-			b.centroids[3 * t + a] = (m->positions[3 * (size_t)ix[0] + a] + m->positions[3 * (size_t)ix[1] + a] +
-			                          m->positions[3 * (size_t)ix[2] + a]) / 3.0f;
+			b.items[t].c[a] = (m->positions[3 * (size_t)ix[0] + a] + m->positions[3 * (size_t)ix[1] + a] +
+			                   m->positions[3 * (size_t)ix[2] + a]) / 3.0f;
 	}
 	build_node(&b, 0, 0, n);
 	for (int k = 0; k < n; k++) {
-		const uint32_t *ix = m->indices + 3 * (size_t)b.order[k];
+		out->order[k] = b.items[k].t;
+		const uint32_t *ix = m->indices + 3 * (size_t)out->order[k];
 		tri *t = &out->tris[k];
 		for (int a = 0; a < 3; a++) {
 			t->a[a] = m->positions[3 * (size_t)ix[0] + a];
@@ -266,8 +268,7 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 		for (int a = 0; a < 3; a++)
 			t->n[a] = t->degenerate || !(len > 0.0) ? 0.0 : nn[a] / len;
 	}
-	out->order = b.order;
-	free(b.centroids);
+	free(b.items);
 	return MLOD_OK;
 }
 
@@ -422,8 +423,8 @@ static double diagonal(const mlod_posed *m)
 	for (long i = 0; i < 3L * m->triangle_count; i++)
 		for (int a = 0; a < 3; a++) {
 			double x = m->positions[3 * (size_t)m->indices[i] + a];
-			lo[a] = fmin(lo[a], x);
-			hi[a] = fmax(hi[a], x);
+			lo[a] = x < lo[a] ? x : lo[a];
+			hi[a] = x > hi[a] ? x : hi[a];
 		}
 	return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
 	            (hi[2] - lo[2]) * (hi[2] - lo[2]));
