@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "measure/mlod_measure.h"
+#include "measure/surface.h"
 
 #define LEAF_SIZE 8
 #define MAX_DEPTH 64 /* object-median splits of < 2^31 triangles stay far below */
@@ -250,6 +251,9 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 			                   m->positions[3 * (size_t)ix[2] + a]) / 3.0f;
 	}
 	build_node(&b, 0, 0, n);
+	node *fit = realloc(out->nodes, (size_t)out->node_count * sizeof *out->nodes);
+	if (fit)
+		out->nodes = fit;
 	for (int k = 0; k < n; k++) {
 		out->order[k] = b.items[k].t;
 		const uint32_t *ix = m->indices + 3 * (size_t)out->order[k];
@@ -430,6 +434,25 @@ static double diagonal(const mlod_posed *m)
 	            (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
 
+/* Adds both directions between a (with its hierarchy ta) and b. */
+static mlod_result both_ways(const mlod_posed *a, const bvh *ta, const mlod_posed *b, double diag,
+                             mlod_deviation *out, mlod_error *err)
+{
+	bvh tb = { 0 };
+	double sum = 0.0, max = 0.0;
+	long count = 0;
+	mlod_result r;
+	if (!(r = bvh_build(b, &tb, err)) && !(r = measure(a, ta, &tb, &sum, &max, &count, err)))
+		r = measure(b, &tb, ta, &sum, &max, &count, err);
+	bvh_free(&tb);
+	if (r)
+		return r;
+	out->mean = 100.0 * sum / (double)count / diag;
+	out->max = 100.0 * max / diag;
+	out->scale = diag;
+	return MLOD_OK;
+}
+
 mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
                                    mlod_deviation *out, mlod_error *err)
 {
@@ -441,19 +464,74 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 	double diag = diagonal(a);
 	if (!(diag > 0.0))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
+	bvh ta = { 0 };
+	if (!(r = bvh_build(a, &ta, err)))
+		r = both_ways(a, &ta, b, diag, out, err);
+	bvh_free(&ta);
+	return r;
+}
 
-	bvh ba = { 0 }, bb = { 0 };
-	double sum = 0.0, max = 0.0;
-	long count = 0;
-	if (!(r = bvh_build(a, &ba, err)) && !(r = bvh_build(b, &bb, err)) &&
-	    !(r = measure(a, &ba, &bb, &sum, &max, &count, err)))
-		r = measure(b, &bb, &ba, &sum, &max, &count, err);
-	bvh_free(&ba);
-	bvh_free(&bb);
-	if (r)
+/* ---------------------------------------------------------------- */
+/* A posed mesh kept with its hierarchy (surface.h)                  */
+/* ---------------------------------------------------------------- */
+
+struct mlod_surface {
+	mlod_posed mesh;
+	bvh tree;
+	double diag;
+};
+
+mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_error *err)
+{
+	mlod_result r;
+	*out = NULL;
+	if ((r = check_mesh(m, "a", err)))
 		return r;
-	out->mean = 100.0 * sum / (double)count / diag;
-	out->max = 100.0 * max / diag;
-	out->scale = diag;
+	double diag = diagonal(m);
+	if (!(diag > 0.0))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
+	mlod_surface *s = calloc(1, sizeof *s);
+	size_t pos = 3 * (size_t)m->vertex_count * sizeof *m->positions, ind = 3 * (size_t)m->triangle_count * sizeof *m->indices;
+	if (!s || !(s->mesh.positions = malloc(pos)) || !(s->mesh.indices = malloc(ind))) {
+		mlod_surface_free(s);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: out of memory");
+	}
+	memcpy(s->mesh.positions, m->positions, pos);
+	memcpy(s->mesh.indices, m->indices, ind);
+	s->mesh.vertex_count = m->vertex_count;
+	s->mesh.triangle_count = m->triangle_count;
+	s->diag = diag;
+	if ((r = bvh_build(&s->mesh, &s->tree, err))) {
+		mlod_surface_free(s);
+		return r;
+	}
+	*out = s;
 	return MLOD_OK;
+}
+
+void mlod_surface_free(mlod_surface *s)
+{
+	if (!s)
+		return;
+	bvh_free(&s->tree);
+	mlod_posed_free(&s->mesh);
+	free(s);
+}
+
+int mlod_surface_is(const mlod_surface *s, const mlod_posed *m)
+{
+	return s->mesh.vertex_count == m->vertex_count && s->mesh.triangle_count == m->triangle_count &&
+	       !memcmp(s->mesh.positions, m->positions, 3 * (size_t)m->vertex_count * sizeof *m->positions) &&
+	       !memcmp(s->mesh.indices, m->indices, 3 * (size_t)m->triangle_count * sizeof *m->indices);
+}
+
+mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, mlod_deviation *out,
+                                      mlod_error *err)
+{
+	mlod_result r;
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: no output");
+	if ((r = check_mesh(b, "b", err)))
+		return r;
+	return both_ways(&a->mesh, &a->tree, b, a->diag, out, err);
 }
