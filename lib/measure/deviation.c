@@ -5,13 +5,16 @@
  * centroids) are projected to the nearest point of the other surface.
  * Nearest points come from a bounding volume hierarchy over the target's
  * triangles (object-median splits on the longest axis, so the depth is
- * logarithmic), searched nearer child first and pruned by box distance,
- * each query seeded with the previous sample's triangle; a leaf's
- * triangle is skipped when its plane is already farther than the best. Point-triangle
- * distance is the Voronoi-region method of Ericson, "Real-Time Collision
- * Detection" (2005), 5.1.5; degenerate triangles are measured as their
- * three edges. Single-threaded and in a fixed order, so deterministic.
- */
+ * logarithmic; leaves of up to 8), searched nearer child first and pruned
+ * by box distance, each query seeded with the previous sample's triangle;
+ * a leaf's triangle is skipped when its plane is already farther than the
+ * best. The samples are visited in the leaf order of their own mesh's
+ * hierarchy, so consecutive queries are neighbours, and summed in the
+ * mesh's order afterwards. Point-triangle distance is the Voronoi-region
+ * method of Ericson, "Real-Time Collision Detection" (2005), 5.1.5;
+ * degenerate triangles are measured as their three edges. Single-threaded
+ * and in a fixed order, so deterministic. A mesh can be kept with its
+ * hierarchy (mlod_surface, surface.h) and measured against many others. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
