@@ -22,6 +22,6 @@ for f in /usr/share/assimp/models/BVH/*.bvh; do [ -f "$f" ] && inputs="$inputs $
 
 # Each layer's benchmarks live in bench/<layer>.sh and print their sections.
 export BUILD="$build" INPUTS="$inputs"
-for section in bench/skeleton.sh bench/mesh.sh bench/motion.sh bench/pack.sh bench/crowd.sh; do
+for section in bench/skeleton.sh bench/mesh.sh bench/motion.sh bench/pack.sh bench/big.sh bench/crowd.sh; do
 	[ -f "$section" ] && sh "$section"
 done

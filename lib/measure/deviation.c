@@ -5,24 +5,28 @@
  * centroids) are projected to the nearest point of the other surface.
  * Nearest points come from a bounding volume hierarchy over the target's
  * triangles (object-median splits on the longest axis, so the depth is
- * logarithmic), searched nearer child first and pruned by box distance,
- * each query seeded with the previous sample's triangle; a leaf's
- * triangle is skipped when its plane is already farther than the best. Point-triangle
- * distance is the Voronoi-region method of Ericson, "Real-Time Collision
- * Detection" (2005), 5.1.5; degenerate triangles are measured as their
- * three edges. Single-threaded and in a fixed order, so deterministic.
- */
+ * logarithmic; leaves of up to 8), searched nearer child first and pruned
+ * by box distance, each query seeded with the previous sample's triangle;
+ * a leaf's triangle is skipped when its plane is already farther than the
+ * best. The samples are visited in the leaf order of their own mesh's
+ * hierarchy, so consecutive queries are neighbours, and summed in the
+ * mesh's order afterwards. Point-triangle distance is the Voronoi-region
+ * method of Ericson, "Real-Time Collision Detection" (2005), 5.1.5;
+ * degenerate triangles are measured as their three edges. Single-threaded
+ * and in a fixed order, so deterministic. A mesh can be kept with its
+ * hierarchy (mlod_surface, surface.h) and measured against many others. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "measure/mlod_measure.h"
+#include "measure/surface.h"
 
-#define LEAF_SIZE 4
+#define LEAF_SIZE 8
 #define MAX_DEPTH 64 /* object-median splits of < 2^31 triangles stay far below */
 
 typedef struct node {
-	float lo[3], hi[3];
+	double lo[3], hi[3];
 	int first; /* leaf: first triangle; inner: index of the left child (right is next) */
 	int count; /* leaf: triangle count; inner: 0 */
 } node;
@@ -37,6 +41,7 @@ typedef struct bvh {
 	node *nodes;
 	int node_count;
 	tri *tris;  /* in leaf order */
+	int *order; /* the mesh's triangle at each place of tris */
 } bvh;
 
 /* ---------------------------------------------------------------- */
@@ -138,33 +143,34 @@ static int is_degenerate(const tri *t)
 /* Hierarchy                                                         */
 /* ---------------------------------------------------------------- */
 
+/* A triangle being placed: its centroid and index, moved together so
+ * that the build reads memory in order. */
+typedef struct item {
+	float c[3];
+	int t;
+} item;
+
 typedef struct builder {
 	bvh *out;
 	const mlod_posed *mesh;
-	int *order;       /* triangle indices, permuted into leaf order */
-	float *centroids; /* 3 per triangle */
+	item *items;      /* permuted into leaf order */
 } builder;
 
-static float centroid_of(const builder *b, int t, int axis)
-{
-	return b->centroids[3 * t + axis];
-}
-
-/* Rearranges order[lo, hi) so that order[nth] has the nth smallest centroid
+/* Rearranges items[lo, hi) so that items[nth] has the nth smallest centroid
  * along axis and no smaller one comes after it (quickselect). */
 static void select_nth(const builder *b, int lo, int hi, int nth, int axis)
 {
-	int *o = b->order;
+	item *o = b->items;
 	while (hi - lo > 1) {
-		float pivot = centroid_of(b, o[lo + (hi - lo) / 2], axis);
+		float pivot = o[lo + (hi - lo) / 2].c[axis];
 		int i = lo, j = hi - 1;
 		while (i <= j) {
-			while (centroid_of(b, o[i], axis) < pivot)
+			while (o[i].c[axis] < pivot)
 				i++;
-			while (centroid_of(b, o[j], axis) > pivot)
+			while (o[j].c[axis] > pivot)
 				j--;
 			if (i <= j) {
-				int tmp = o[i];
+				item tmp = o[i];
 				o[i] = o[j], o[j] = tmp;
 				i++, j--;
 			}
@@ -179,7 +185,7 @@ static void select_nth(const builder *b, int lo, int hi, int nth, int axis)
 	}
 }
 
-/* Builds the subtree of order[lo, hi) at nodes[index]: a leaf for a few
+/* Builds the subtree of items[lo, hi) at nodes[index]: a leaf for a few
  * triangles, else two children split at the median centroid along the
  * axis where centroids spread most. Boxes are merged bottom-up. */
 static void build_node(builder *b, int index, int lo, int hi)
@@ -188,7 +194,7 @@ static void build_node(builder *b, int index, int lo, int hi)
 	float lo3[3] = { INFINITY, INFINITY, INFINITY }, hi3[3] = { -INFINITY, -INFINITY, -INFINITY };
 	if (hi - lo <= LEAF_SIZE) {
 		for (int k = lo; k < hi; k++) {
-			const uint32_t *ix = b->mesh->indices + 3 * (size_t)b->order[k];
+			const uint32_t *ix = b->mesh->indices + 3 * (size_t)b->items[k].t;
 			for (int v = 0; v < 3; v++)
 				for (int a = 0; a < 3; a++) {
 					float x = b->mesh->positions[3 * (size_t)ix[v] + a];
@@ -196,15 +202,15 @@ static void build_node(builder *b, int index, int lo, int hi)
 					hi3[a] = x > hi3[a] ? x : hi3[a];
 				}
 		}
-		memcpy(n->lo, lo3, sizeof lo3);
-		memcpy(n->hi, hi3, sizeof hi3);
+		for (int a = 0; a < 3; a++)
+			n->lo[a] = lo3[a], n->hi[a] = hi3[a];
 		n->first = lo;
 		n->count = hi - lo;
 		return;
 	}
 	for (int k = lo; k < hi; k++)
 		for (int a = 0; a < 3; a++) {
-			float x = centroid_of(b, b->order[k], a);
+			float x = b->items[k].c[a];
 			lo3[a] = x < lo3[a] ? x : lo3[a];
 			hi3[a] = x > hi3[a] ? x : hi3[a];
 		}
@@ -231,25 +237,29 @@ static void build_node(builder *b, int index, int lo, int hi)
 static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 {
 	int n = m->triangle_count;
-	builder b = { out, m, malloc((size_t)n * sizeof(int)), malloc((size_t)n * 3 * sizeof(float)) };
+	builder b = { out, m, malloc((size_t)n * sizeof *b.items) };
 	out->nodes = malloc((size_t)2 * n * sizeof *out->nodes);
 	out->tris = malloc((size_t)n * sizeof *out->tris);
+	out->order = malloc((size_t)n * sizeof *out->order);
 	out->node_count = 1;
-	if (!b.order || !b.centroids || !out->nodes || !out->tris) {
-		free(b.order);
-		free(b.centroids);
+	if (!b.items || !out->nodes || !out->tris || !out->order) {
+		free(b.items);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", n);
 	}
 	for (int t = 0; t < n; t++) {
 		const uint32_t *ix = m->indices + 3 * (size_t)t;
-		b.order[t] = t;
+		b.items[t].t = t;
 		for (int a = 0; a < 3; a++)
-			b.centroids[3 * t + a] = (m->positions[3 * (size_t)ix[0] + a] + m->positions[3 * (size_t)ix[1] + a] +
-			                          m->positions[3 * (size_t)ix[2] + a]) / 3.0f;
+			b.items[t].c[a] = (m->positions[3 * (size_t)ix[0] + a] + m->positions[3 * (size_t)ix[1] + a] +
+			                   m->positions[3 * (size_t)ix[2] + a]) / 3.0f;
 	}
 	build_node(&b, 0, 0, n);
+	node *fit = realloc(out->nodes, (size_t)out->node_count * sizeof *out->nodes);
+	if (fit)
+		out->nodes = fit;
 	for (int k = 0; k < n; k++) {
-		const uint32_t *ix = m->indices + 3 * (size_t)b.order[k];
+		out->order[k] = b.items[k].t;
+		const uint32_t *ix = m->indices + 3 * (size_t)out->order[k];
 		tri *t = &out->tris[k];
 		for (int a = 0; a < 3; a++) {
 			t->a[a] = m->positions[3 * (size_t)ix[0] + a];
@@ -265,8 +275,7 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 		for (int a = 0; a < 3; a++)
 			t->n[a] = t->degenerate || !(len > 0.0) ? 0.0 : nn[a] / len;
 	}
-	free(b.order);
-	free(b.centroids);
+	free(b.items);
 	return MLOD_OK;
 }
 
@@ -274,15 +283,18 @@ static void bvh_free(bvh *b)
 {
 	free(b->nodes);
 	free(b->tris);
+	free(b->order);
 }
 
-static double box_dist2(const double *p, const node *n)
+/* Squared distance from p to the node's box: p less its clamp to the box
+ * on each axis (so the compiler needs no branch). */
+static inline double box_dist2(const double *p, const node *n)
 {
 	double d2 = 0.0;
 	for (int a = 0; a < 3; a++) {
-		double below = n->lo[a] - p[a], above = p[a] - n->hi[a];
-		double d = below > above ? below : above;
-		d = d > 0.0 ? d : 0.0;
+		double c = p[a] > n->lo[a] ? p[a] : n->lo[a];
+		c = c < n->hi[a] ? c : n->hi[a];
+		double d = p[a] - c;
 		d2 += d * d;
 	}
 	return d2;
@@ -308,14 +320,22 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 {
 	double best = triangle_dist2(p, &b->tris[*hint]);
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
-	int top = 0;
-	stack[top].node = 0, stack[top++].d2 = box_dist2(p, &b->nodes[0]);
-	while (top > 0) {
-		--top;
-		if (stack[top].d2 >= best)
+	int top = 0, at = 0;
+	double at_d2 = box_dist2(p, &b->nodes[0]);
+	for (;;) {
+		const node *n = &b->nodes[at];
+		if (at_d2 < best && n->count == 0) {
+			/* on into the nearer child; the farther one waits on the stack */
+			int l = n->first, r = n->first + 1;
+			double dl = box_dist2(p, &b->nodes[l]), dr = box_dist2(p, &b->nodes[r]);
+			int near = dl <= dr ? l : r, far = dl <= dr ? r : l;
+			double dnear = dl <= dr ? dl : dr, dfar = dl <= dr ? dr : dl;
+			if (dfar < best)
+				stack[top].node = far, stack[top++].d2 = dfar;
+			at = near, at_d2 = dnear;
 			continue;
-		const node *n = &b->nodes[stack[top].node];
-		if (n->count > 0) {
+		}
+		if (at_d2 < best)
 			for (int k = n->first; k < n->first + n->count; k++) {
 				if (plane_dist2(p, &b->tris[k]) >= best)
 					continue; /* its plane is already farther than the best */
@@ -323,21 +343,10 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 				if (d < best)
 					best = d, *hint = k;
 			}
-			continue;
-		}
-		/* push the farther child first, so the nearer one is searched first */
-		int l = n->first, r = n->first + 1;
-		double dl = box_dist2(p, &b->nodes[l]), dr = box_dist2(p, &b->nodes[r]);
-		if (dl > dr) {
-			int ti = l;
-			double td = dl;
-			l = r, dl = dr;
-			r = ti, dr = td;
-		}
-		if (dr < best)
-			stack[top].node = r, stack[top++].d2 = dr;
-		if (dl < best)
-			stack[top].node = l, stack[top++].d2 = dl;
+		if (top == 0)
+			break;
+		--top;
+		at = stack[top].node, at_d2 = stack[top].d2;
 	}
 	return best;
 }
@@ -362,39 +371,55 @@ static mlod_result check_mesh(const mlod_posed *m, const char *which, mlod_error
 	return MLOD_OK;
 }
 
-/* Adds the distances of from's samples to the surface in to. */
-static mlod_result measure(const mlod_posed *from, const bvh *to, double *sum, double *max, long *count,
-                           mlod_error *err)
+/* Adds the distances of from's samples to the surface in to. The samples
+ * are visited in the leaf order of from's own hierarchy (each triangle's
+ * vertices, then its centroid), so that neighbouring queries are near one
+ * another and each starts from a close triangle; the distances are then
+ * summed in the mesh's order (used vertices, then triangles), so the sum
+ * does not depend on the visiting order. */
+static mlod_result measure(const mlod_posed *from, const bvh *from_bvh, const bvh *to, double *sum, double *max,
+                           long *count, mlod_error *err)
 {
-	unsigned char *used = calloc((size_t)from->vertex_count, 1);
-	if (!used)
-		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %d vertex flags", from->vertex_count);
+	double *dv = malloc(((size_t)from->vertex_count + (size_t)from->triangle_count) * sizeof *dv);
+	if (!dv)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %d distances",
+		                 from->vertex_count + from->triangle_count);
+	double *dt = dv + from->vertex_count;
+	/* only vertices on the surface count: unreferenced ones are not part of it (-1) */
+	for (int v = 0; v < from->vertex_count; v++)
+		dv[v] = -1.0;
 	int hint = 0;
-	for (long i = 0; i < 3L * from->triangle_count; i++)
-		used[from->indices[i]] = 1;
-	/* only vertices on the surface count: unreferenced ones are not part of it */
-	for (int v = 0; v < from->vertex_count; v++) {
-		if (!used[v])
-			continue;
-		const double p[3] = { from->positions[3 * (size_t)v], from->positions[3 * (size_t)v + 1],
-		                      from->positions[3 * (size_t)v + 2] };
-		double d = sqrt(bvh_nearest2(to, p, &hint));
-		*sum += d;
-		*max = fmax(*max, d);
-		++*count;
-	}
-	for (int t = 0; t < from->triangle_count; t++) {
+	for (int k = 0; k < from->triangle_count; k++) {
+		int t = from_bvh->order[k];
 		const uint32_t *ix = from->indices + 3 * (size_t)t;
+		for (int c = 0; c < 3; c++) {
+			if (dv[ix[c]] >= 0.0)
+				continue;
+			const float *q = from->positions + 3 * (size_t)ix[c];
+			const double p[3] = { q[0], q[1], q[2] };
+			dv[ix[c]] = sqrt(bvh_nearest2(to, p, &hint));
+		}
 		double p[3];
 		for (int a = 0; a < 3; a++)
 			p[a] = ((double)from->positions[3 * (size_t)ix[0] + a] + from->positions[3 * (size_t)ix[1] + a] +
 			        from->positions[3 * (size_t)ix[2] + a]) / 3.0;
-		double d = sqrt(bvh_nearest2(to, p, &hint));
-		*sum += d;
-		*max = fmax(*max, d);
-		++*count;
+		dt[t] = sqrt(bvh_nearest2(to, p, &hint));
 	}
-	free(used);
+	double s = *sum, m = *max;
+	long n = *count;
+	for (int v = 0; v < from->vertex_count; v++)
+		if (dv[v] >= 0.0) {
+			s += dv[v];
+			m = dv[v] > m ? dv[v] : m;
+			n++;
+		}
+	for (int t = 0; t < from->triangle_count; t++) {
+		s += dt[t];
+		m = dt[t] > m ? dt[t] : m;
+		n++;
+	}
+	*sum = s, *max = m, *count = n;
+	free(dv);
 	return MLOD_OK;
 }
 
@@ -405,11 +430,30 @@ static double diagonal(const mlod_posed *m)
 	for (long i = 0; i < 3L * m->triangle_count; i++)
 		for (int a = 0; a < 3; a++) {
 			double x = m->positions[3 * (size_t)m->indices[i] + a];
-			lo[a] = fmin(lo[a], x);
-			hi[a] = fmax(hi[a], x);
+			lo[a] = x < lo[a] ? x : lo[a];
+			hi[a] = x > hi[a] ? x : hi[a];
 		}
 	return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
 	            (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+/* Adds both directions between a (with its hierarchy ta) and b. */
+static mlod_result both_ways(const mlod_posed *a, const bvh *ta, const mlod_posed *b, double diag,
+                             mlod_deviation *out, mlod_error *err)
+{
+	bvh tb = { 0 };
+	double sum = 0.0, max = 0.0;
+	long count = 0;
+	mlod_result r;
+	if (!(r = bvh_build(b, &tb, err)) && !(r = measure(a, ta, &tb, &sum, &max, &count, err)))
+		r = measure(b, &tb, ta, &sum, &max, &count, err);
+	bvh_free(&tb);
+	if (r)
+		return r;
+	out->mean = 100.0 * sum / (double)count / diag;
+	out->max = 100.0 * max / diag;
+	out->scale = diag;
+	return MLOD_OK;
 }
 
 mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
@@ -423,19 +467,74 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 	double diag = diagonal(a);
 	if (!(diag > 0.0))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
+	bvh ta = { 0 };
+	if (!(r = bvh_build(a, &ta, err)))
+		r = both_ways(a, &ta, b, diag, out, err);
+	bvh_free(&ta);
+	return r;
+}
 
-	bvh ba = { 0 }, bb = { 0 };
-	double sum = 0.0, max = 0.0;
-	long count = 0;
-	if (!(r = bvh_build(a, &ba, err)) && !(r = bvh_build(b, &bb, err)) &&
-	    !(r = measure(a, &bb, &sum, &max, &count, err)))
-		r = measure(b, &ba, &sum, &max, &count, err);
-	bvh_free(&ba);
-	bvh_free(&bb);
-	if (r)
+/* ---------------------------------------------------------------- */
+/* A posed mesh kept with its hierarchy (surface.h)                  */
+/* ---------------------------------------------------------------- */
+
+struct mlod_surface {
+	mlod_posed mesh;
+	bvh tree;
+	double diag;
+};
+
+mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_error *err)
+{
+	mlod_result r;
+	*out = NULL;
+	if ((r = check_mesh(m, "a", err)))
 		return r;
-	out->mean = 100.0 * sum / (double)count / diag;
-	out->max = 100.0 * max / diag;
-	out->scale = diag;
+	double diag = diagonal(m);
+	if (!(diag > 0.0))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
+	mlod_surface *s = calloc(1, sizeof *s);
+	size_t pos = 3 * (size_t)m->vertex_count * sizeof *m->positions, ind = 3 * (size_t)m->triangle_count * sizeof *m->indices;
+	if (!s || !(s->mesh.positions = malloc(pos)) || !(s->mesh.indices = malloc(ind))) {
+		mlod_surface_free(s);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: out of memory");
+	}
+	memcpy(s->mesh.positions, m->positions, pos);
+	memcpy(s->mesh.indices, m->indices, ind);
+	s->mesh.vertex_count = m->vertex_count;
+	s->mesh.triangle_count = m->triangle_count;
+	s->diag = diag;
+	if ((r = bvh_build(&s->mesh, &s->tree, err))) {
+		mlod_surface_free(s);
+		return r;
+	}
+	*out = s;
 	return MLOD_OK;
+}
+
+void mlod_surface_free(mlod_surface *s)
+{
+	if (!s)
+		return;
+	bvh_free(&s->tree);
+	mlod_posed_free(&s->mesh);
+	free(s);
+}
+
+int mlod_surface_is(const mlod_surface *s, const mlod_posed *m)
+{
+	return s->mesh.vertex_count == m->vertex_count && s->mesh.triangle_count == m->triangle_count &&
+	       !memcmp(s->mesh.positions, m->positions, 3 * (size_t)m->vertex_count * sizeof *m->positions) &&
+	       !memcmp(s->mesh.indices, m->indices, 3 * (size_t)m->triangle_count * sizeof *m->indices);
+}
+
+mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, mlod_deviation *out,
+                                      mlod_error *err)
+{
+	mlod_result r;
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: no output");
+	if ((r = check_mesh(b, "b", err)))
+		return r;
+	return both_ways(&a->mesh, &a->tree, b, a->diag, out, err);
 }

@@ -66,6 +66,10 @@ typedef struct mlod_pose_set {
 	mlod_mat4 *world;
 	int threads;      /* mlod_posed_error measures poses on this many threads
 	                   * (0 or 1: the caller's only); the same result at any count */
+	struct mlod_pose_cache *cache; /* made by mlod_pose_set_make (NULL in a set made
+	                   * by hand: nothing is kept); mlod_posed_error keeps the full
+	                   * character posed at each pose with its search hierarchy there,
+	                   * for later calls with the same full character */
 } mlod_pose_set;
 
 /* Builds a pose set: the rest pose when bind is set, up to per_clip
@@ -80,7 +84,12 @@ void mlod_pose_set_free(mlod_pose_set *s);
 /* Posed surface error of a level against the full character: at every
  * pose, mlod_surface_deviation of the posed level against the posed full
  * character; mean is the mean over poses of the mean, max the largest max
- * (Hausdorff), both in % of the full character's diagonal in that pose. */
+ * (Hausdorff), both in % of the full character's diagonal in that pose.
+ * With a pose set from mlod_pose_set_make, the first call keeps the posed
+ * full character of each pose and its hierarchy in the set's cache, and
+ * later calls whose full character poses to the same bytes there reuse
+ * them (the levels of one character): the same results, to the bit. Calls
+ * may run at once on one set. */
 mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *level, const mlod_pose_set *poses,
                              mlod_deviation *out, mlod_error *err);
 

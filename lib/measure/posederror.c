@@ -9,13 +9,20 @@
  * about a random axis by a random angle up to a bound (SplitMix64, so a
  * seed gives the same poses on every machine). At each pose both
  * characters are skinned and compared with mlod_surface_deviation
- * (symmetric point-to-surface, % of the full character's diagonal).
+ * (symmetric point-to-surface, % of the full character's diagonal). A set
+ * made here keeps, per pose, the posed full character with its search
+ * hierarchy (struct mlod_pose_cache): measuring every level of a character
+ * builds that hierarchy once per pose. The full character is still posed
+ * at every call, and the kept one used only when it is the same, byte for
+ * byte.
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "measure/mlod_measure.h"
+#include "measure/surface.h"
 
 static uint64_t splitmix(uint64_t *s)
 {
@@ -29,6 +36,65 @@ static uint64_t splitmix(uint64_t *s)
 static double uniform(uint64_t *s)
 {
 	return (double)(splitmix(s) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* Per pose of a set: the full character posed there with its hierarchy,
+ * made by the first mlod_posed_error that needs it and then kept as it is
+ * (a later call with another full character does without). */
+struct mlod_pose_cache {
+	pthread_mutex_t lock;
+	int count;
+	mlod_surface **full;
+};
+
+static struct mlod_pose_cache *cache_make(int count)
+{
+	struct mlod_pose_cache *c = calloc(1, sizeof *c);
+	if (!c)
+		return NULL;
+	c->full = calloc((size_t)(count > 0 ? count : 1), sizeof *c->full);
+	if (!c->full || pthread_mutex_init(&c->lock, NULL) != 0) {
+		free(c->full);
+		free(c);
+		return NULL;
+	}
+	c->count = count;
+	return c;
+}
+
+static void cache_free(struct mlod_pose_cache *c)
+{
+	if (!c)
+		return;
+	for (int k = 0; k < c->count; k++)
+		mlod_surface_free(c->full[k]);
+	free(c->full);
+	pthread_mutex_destroy(&c->lock);
+	free(c);
+}
+
+/* The kept full character at pose k when it is a, made from a when pose
+ * k has none yet; NULL otherwise, or when it cannot be made (the caller
+ * then measures a itself, and reports why). */
+static const mlod_surface *cache_get(struct mlod_pose_cache *c, int k, const mlod_posed *a)
+{
+	if (!c || k >= c->count)
+		return NULL;
+	pthread_mutex_lock(&c->lock);
+	mlod_surface *s = c->full[k];
+	pthread_mutex_unlock(&c->lock);
+	if (!s) {
+		mlod_surface *made;
+		if (mlod_surface_make(a, &made, NULL) != MLOD_OK)
+			return NULL;
+		pthread_mutex_lock(&c->lock);
+		if (!c->full[k])
+			c->full[k] = made, made = NULL;
+		s = c->full[k];
+		pthread_mutex_unlock(&c->lock);
+		mlod_surface_free(made); /* another call kept its own first */
+	}
+	return mlod_surface_is(s, a) ? s : NULL;
 }
 
 mlod_result mlod_pose_set_make(const mlod_character *c, int bind, int per_clip, int random, uint64_t seed,
@@ -97,6 +163,8 @@ mlod_result mlod_pose_set_make(const mlod_character *c, int bind, int per_clip, 
 		mlod_pose_world(s, local, out->world + (size_t)n++ * (size_t)J);
 	}
 	out->count = n;
+	if (!(out->cache = cache_make(n)))
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory making poses");
 done:
 	for (int k = 0; times && k < c->clip_count; k++)
 		free(times[k]);
@@ -114,6 +182,7 @@ void mlod_pose_set_free(mlod_pose_set *s)
 	if (!s)
 		return;
 	free(s->world);
+	cache_free(s->cache);
 	memset(s, 0, sizeof *s);
 }
 
@@ -132,8 +201,11 @@ static mlod_result posed_one(void *ctx, int k)
 	mlod_posed a = {0}, b = {0};
 	mlod_result r;
 	if ((r = mlod_pose_character(j->full, world, &a, &j->errs[k])) == MLOD_OK &&
-	    (r = mlod_pose_character(j->level, world, &b, &j->errs[k])) == MLOD_OK)
-		r = mlod_surface_deviation(&a, &b, &j->d[k], &j->errs[k]);
+	    (r = mlod_pose_character(j->level, world, &b, &j->errs[k])) == MLOD_OK) {
+		const mlod_surface *kept = cache_get(j->poses->cache, k, &a);
+		r = kept ? mlod_surface_deviation_to(kept, &b, &j->d[k], &j->errs[k])
+		         : mlod_surface_deviation(&a, &b, &j->d[k], &j->errs[k]);
+	}
 	mlod_posed_free(&a);
 	mlod_posed_free(&b);
 	return r;

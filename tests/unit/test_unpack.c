@@ -741,7 +741,7 @@ static void posed_level0(const char *path)
 	double worst = 0, worst_err = 0;
 	for (int k = 0; k < poses.count; k++) {
 		const mlod_mat4 *world = poses.world + (size_t)k * (size_t)poses.joint_count;
-		mlod_pose_set one = {1, poses.joint_count, (mlod_mat4 *)world, 0};
+		mlod_pose_set one = {1, poses.joint_count, (mlod_mat4 *)world, 0, NULL};
 		mlod_deviation d;
 		CHECK_OK(mlod_posed_error(&c, &c2, &one, &d, &terr));
 		double got = d.max / 100 * d.scale, bound = pose_bound(&c, world, opt.position_bits);
