@@ -126,7 +126,7 @@ test-extended: all unit $(B)/bench/crowd
 	@$(MAKE) --no-print-directory config=sanitize unit
 	@tests/run.sh --build $(B) --sanitize-build build/sanitize --extended
 
-bench: all $(BENCH)
+bench: all $(BENCH) $(HELPERS)
 	@bench/run.sh $(B)
 
 demo: all $(B)/bench/crowd
