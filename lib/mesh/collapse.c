@@ -66,6 +66,7 @@ typedef struct bgm_heap_entry {
 	double key;
 	int face;
 	int op;
+	int weak;   /* key is lower_key's bind-pose bound: exact_bound comes next */
 } heap_entry;
 
 static int entry_less(const heap_entry *a, const heap_entry *b)
@@ -74,12 +75,12 @@ static int entry_less(const heap_entry *a, const heap_entry *b)
 	       (a->key == b->key && (a->face < b->face || (a->face == b->face && a->op < b->op)));
 }
 
-static int heap_push(struct bgm_heap *h, double key, int face, int op)
+static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak)
 {
 	if (bgm_grow((void **)&h->e, &h->cap, h->count + 1, sizeof *h->e))
 		return -1;
 	int i = h->count++;
-	heap_entry x = {key, face, op};
+	heap_entry x = {key, face, op, weak};
 	while (i > 0) {
 		int p = (i - 1) / 2;
 		if (!entry_less(&x, &h->e[p]))
@@ -699,7 +700,7 @@ static int same_influences(const mlod_influences *x, const mlod_influences *y)
  * it beyond), where the convex quadric is at least its tangent plane at
  * the barycenter. The fast cost (mlod_bgm_options.fast_cost) is the
  * pulled-back sum for every operation. */
-static double lower_key(mlod_bgm *g, int f, int op)
+static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 {
 	const bgm_face *F = &g->faces[f];
 	int K = op == OP_TRIANGLE ? 3 : 2, v[3];
@@ -764,8 +765,96 @@ static double lower_key(mlod_bgm *g, int f, int op)
 			lb = fmin(lb, t > 0.0 ? t : 0.0);
 		}
 		margin = 1.0 - 1e-9; /* rounding: stay below the exact sum */
+		*weak = 1;
 	}
 	return (wsum > 0.0 ? lb / wsum : 0.0) * margin + TIE_WEIGHT * tie;
+}
+
+/* The collapsed vertices' posed quadrics summed per pose, as plan()
+ * sums them. */
+static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
+{
+	for (int k = 0; k < 10 * g->pose_count; k++) {
+		Q[k] = 0.0;
+		for (int j = 0; j < pl->k; j++)
+			Q[k] += g->quadric[((size_t)pl->v[j] * (size_t)g->pose_count) * 10 + (size_t)k];
+	}
+}
+
+/* A lower bound of plan()'s exact cost for operation op on face f that
+ * is tighter than lower_key's bind-pose bound: the least exact cost over
+ * every placement plan() may try, valid or not, with the arithmetic of
+ * plan(), so that it is the planned cost when that placement is valid.
+ * It skips the patch: operations whose bound rises above the queue's
+ * head go back without being planned, and most die before they return. */
+static double exact_bound(mlod_bgm *g, int f, int op)
+{
+	const bgm_face *F = &g->faces[f];
+	struct plan pv; /* only k and v[] are used */
+	int K = pv.k = op == OP_TRIANGLE ? 3 : 2;
+	double bary[3] = {0, 0, 0}, cand[MAX_CANDIDATES][3], wsum = 0.0, *Q = g->qsum;
+	const double *P[3];
+	mlod_v3 V[3];
+	mlod_influences in3[3];
+	int nc = 0;
+	for (int j = 0; j < K; j++) {
+		pv.v[j] = F->n[op == OP_TRIANGLE ? j : (op + j) % 3];
+		P[j] = g->nodes[pv.v[j]].p;
+	}
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < K; j++)
+			bary[i] += P[j][i] / K;
+	for (int j = 0; j < K; j++) {
+		V[j] = (mlod_v3){(float)P[j][0], (float)P[j][1], (float)P[j][2]};
+		in3[j] = g->inf[pv.v[j]];
+	}
+	sum_quadrics(g, &pv, Q);
+	for (int p = 0; p < g->pose_count; p++)
+		wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+	if (g->opt.placement == MLOD_PLACE_OPTIMAL) {
+		mlod_influences w;
+		double opt[3];
+		mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
+		if (bgm_quadric_optimum(g, Q, &w, bary, opt) == 0) {
+			double lmax = 0.0, d = 0.0;
+			for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
+				double l = 0.0;
+				for (int i = 0; i < 3; i++)
+					l += (P[e][i] - P[(e + 1) % K][i]) * (P[e][i] - P[(e + 1) % K][i]);
+				lmax = fmax(lmax, l);
+			}
+			for (int i = 0; i < 3; i++)
+				d += (opt[i] - bary[i]) * (opt[i] - bary[i]);
+			if (d <= lmax)
+				memcpy(cand[nc++], opt, sizeof cand[0]);
+		}
+	}
+	for (int j = 0; j < K; j++)
+		memcpy(cand[nc++], P[j], sizeof cand[0]);
+	memcpy(cand[nc++], bary, sizeof cand[0]);
+	double best = HUGE_VAL;
+	for (int k = 0; k < nc; k++) {
+		mlod_influences w;
+		mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+		if (g->joint_count > 0 && w.count == 0)
+			continue;
+		double e = bgm_quadric_error(g, Q, &w, cand[k], HUGE_VAL);
+		best = fmin(best, wsum > 0.0 ? e / wsum : 0.0);
+	}
+	if (best == HUGE_VAL)
+		best = 0.0;
+	double tie = 0.0;
+	if (K == 3) {
+		tie = sqrt(area_sq(P[0], P[1], P[2])) * (1.0 - bgm_compactness(P[0], P[1], P[2]));
+	} else {
+		int faces[2] = {f, F->adj[op]}, nr = faces[1] >= 0 ? 2 : 1;
+		for (int j = 0; j < nr; j++) {
+			const bgm_face *h = &g->faces[faces[j]];
+			const double *a = g->nodes[h->n[0]].p, *b = g->nodes[h->n[1]].p, *c = g->nodes[h->n[2]].p;
+			tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / nr;
+		}
+	}
+	return best + TIE_WEIGHT * tie;
 }
 
 /* Queues operation op on face f (new, or back from being blocked). */
@@ -780,8 +869,9 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 			return 0; /* never collapsible while these nodes live */
 	}
 	double key;
+	int weak = 0;
 	if (lazy_keys(g)) {
-		key = lower_key(g, f, op);
+		key = lower_key(g, f, op, &weak);
 	} else if (g->opt.cost == MLOD_COST_POSED) {
 		if (!plan(g, f, op, !g->opt.fast_cost, scratch)) {
 			g->opstate[f] |= (unsigned char)BLOCKED(op);
@@ -792,7 +882,7 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 		key = bgm_compactness(g->nodes[F->n[0]].p, g->nodes[F->n[1]].p, g->nodes[F->n[2]].p);
 	}
 	g->opstate[f] |= (unsigned char)QUEUED(op);
-	return heap_push(&g->heap, key, f, op);
+	return heap_push(&g->heap, key, f, op, weak);
 }
 
 /* 1 when the face across edge e of face f holds a queue entry for that
@@ -1030,6 +1120,16 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 		heap_entry e = heap_pop(&g->heap);
 		if (g->faces[e.face].death != BGM_ALIVE)
 			continue;
+		if (e.weak) {
+			double b = exact_bound(g, e.face, e.op);
+			if (b > e.key * (1.0 + 1e-9) + 1e-300) {
+				if (heap_push(&g->heap, b, e.face, e.op, 0)) {
+					r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+					goto done;
+				}
+				continue;
+			}
+		}
 		g->opstate[e.face] &= (unsigned char)~QUEUED(e.op);
 		if (!plan(g, e.face, e.op, !g->opt.fast_cost, pl)) {
 			g->refused++;
@@ -1038,7 +1138,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 		}
 		if (g->opt.cost == MLOD_COST_POSED && pl->cost > e.key * (1.0 + 1e-9) + 1e-300) {
 			g->opstate[e.face] |= (unsigned char)QUEUED(e.op);
-			if (heap_push(&g->heap, pl->cost, e.face, e.op)) {
+			if (heap_push(&g->heap, pl->cost, e.face, e.op, 0)) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 				goto done;
 			}
