@@ -771,6 +771,7 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->skin);
 	free(g->opstate);
 	free(g->heap.e);
+	free(g->heap.memo);
 	free(g);
 }
 

@@ -114,6 +114,9 @@ struct mlod_bgm {
 		int ready;                 /* every live face was queued */
 		int count, cap;
 		struct bgm_heap_entry *e;  /* released with free() by mlod_bgm_free */
+		struct bgm_memo *memo;     /* queued operations' exact placement costs (collapse.c);
+		                            * released with free() by mlod_bgm_free */
+		int memo_count, memo_cap, memo_free;
 	} heap;
 	unsigned char *opstate; /* per face and op (collapse.c): refused when last looked at, queued */
 	int opstate_cap;

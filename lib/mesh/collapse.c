@@ -67,7 +67,50 @@ typedef struct bgm_heap_entry {
 	int face;
 	int op;
 	int weak;   /* key is lower_key's bind-pose bound: exact_bound comes next */
+	int memo;   /* into heap.memo, or -1 */
 } heap_entry;
+
+/* What the exact posed cost of an operation's placements came to. It
+ * depends only on the collapsed vertices (quadrics, positions and
+ * influences, fixed while the face lives), not on the patch, so an
+ * operation back in the queue keeps it for its next bound or plan.
+ * Placements by role: 0 the optimum, 1 + i vertex i, 4 the barycenter. */
+#define MEMO_ROLES 5
+#define MEMO_WSUM (1u << MEMO_ROLES)
+typedef struct bgm_memo {
+	double opt[3];
+	int opt_state;              /* 0 not worked out, 1 found, 2 none */
+	unsigned known;             /* bit r: e[r] holds role r's full sum; MEMO_WSUM: wsum */
+	double e[MEMO_ROLES];
+	double wsum;
+	int next_free;
+} memo;
+
+static const memo memo_empty = {{0, 0, 0}, 0, 0, {0, 0, 0, 0, 0}, 0.0, -1};
+
+/* A slot holding m; returns its index, or -1 when out of memory. */
+static int memo_add(struct bgm_heap *h, const memo *m)
+{
+	int i = h->memo_free;
+	if (i >= 0) {
+		h->memo_free = h->memo[i].next_free;
+	} else {
+		if (bgm_grow((void **)&h->memo, &h->memo_cap, h->memo_count + 1, sizeof *h->memo))
+			return -1;
+		i = h->memo_count++;
+	}
+	h->memo[i] = *m;
+	h->memo[i].next_free = -1;
+	return i;
+}
+
+static void memo_release(struct bgm_heap *h, int i)
+{
+	if (i < 0)
+		return;
+	h->memo[i].next_free = h->memo_free;
+	h->memo_free = i;
+}
 
 static int entry_less(const heap_entry *a, const heap_entry *b)
 {
@@ -75,12 +118,12 @@ static int entry_less(const heap_entry *a, const heap_entry *b)
 	       (a->key == b->key && (a->face < b->face || (a->face == b->face && a->op < b->op)));
 }
 
-static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak)
+static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak, int memo_slot)
 {
 	if (bgm_grow((void **)&h->e, &h->cap, h->count + 1, sizeof *h->e))
 		return -1;
 	int i = h->count++;
-	heap_entry x = {key, face, op, weak};
+	heap_entry x = {key, face, op, weak, memo_slot};
 	while (i > 0) {
 		int p = (i - 1) / 2;
 		if (!entry_less(&x, &h->e[p]))
@@ -283,10 +326,21 @@ static double area_sq(const double *a, const double *b, const double *c)
 	return 0.25 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 }
 
+/* The collapsed vertices' posed quadrics summed per pose, as plan()
+ * sums them. */
+static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
+{
+	for (int k = 0; k < 10 * g->pose_count; k++) {
+		Q[k] = 0.0;
+		for (int j = 0; j < pl->k; j++)
+			Q[k] += g->quadric[((size_t)pl->v[j] * (size_t)g->pose_count) * 10 + (size_t)k];
+	}
+}
+
 /* Works out operation op on face t (its triangle collapse, or the
  * collapse of one of its edges); returns 1 when it is valid (pl holds
  * the cheapest valid placement), else 0. */
-static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl)
+static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm)
 {
 	const bgm_face *T = &g->faces[t];
 	int allow_border = g->opt.allow_border;
@@ -410,7 +464,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl)
 
 	/* Candidate placements. */
 	double cand[MAX_CANDIDATES][3];
-	int cand_snap[MAX_CANDIDATES], nc = 0;
+	int cand_snap[MAX_CANDIDATES], cand_role[MAX_CANDIDATES], nc = 0;
 	const double *P[3] = {g->nodes[pl->v[0]].p, g->nodes[pl->v[1]].p, K == 3 ? g->nodes[pl->v[2]].p : NULL};
 	double bary[3];
 	for (int i = 0; i < 3; i++) {
@@ -438,6 +492,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl)
 			if (!ok)
 				continue;
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
+			cand_role[nc] = 1 + s;
 			cand_snap[nc++] = s;
 		}
 		if (nc == 0)
@@ -446,7 +501,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl)
 	/* The summed posed quadrics of the collapsed vertices, and their area
 	 * (the normaliser of the posed cost). */
 	double *Q = g->qsum, wsum = 0.0, R[10] = {0};
-	int fast = !exact && g->rquad;
+	int fast = !exact && g->rquad, q_ready = 0;
 	if (g->pose_count > 0 && fast) {
 		for (int j = 0; j < K; j++) {
 			const double *r = bgm_quadric_rest(g, pl->v[j]);
@@ -454,14 +509,17 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl)
 				R[k] += r[k];
 			wsum += r[10];
 		}
+	} else if (g->pose_count > 0 && mm && (mm->known & MEMO_WSUM)) {
+		wsum = mm->wsum; /* Q is summed when needed */
 	} else if (g->pose_count > 0) {
-		for (int k = 0; k < 10 * g->pose_count; k++) {
-			Q[k] = 0.0;
-			for (int j = 0; j < K; j++)
-				Q[k] += g->quadric[((size_t)pl->v[j] * (size_t)g->pose_count) * 10 + (size_t)k];
-		}
+		sum_quadrics(g, pl, Q);
+		q_ready = 1;
 		for (int p = 0; p < g->pose_count; p++)
 			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+		if (mm) {
+			mm->wsum = wsum;
+			mm->known |= MEMO_WSUM;
+		}
 	}
 	if (!(special[0] || special[1] || special[2])) {
 		if (g->opt.placement == MLOD_PLACE_OPTIMAL && g->pose_count > 0) {
@@ -470,9 +528,18 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl)
 			int found;
 			if (fast) {
 				found = bgm_quadric_solve(R, bary, opt) == 0;
+			} else if (mm && mm->opt_state) {
+				found = mm->opt_state == 1;
+				memcpy(opt, mm->opt, sizeof opt);
 			} else {
+				if (!q_ready)
+					sum_quadrics(g, pl, Q), q_ready = 1;
 				mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
 				found = bgm_quadric_optimum(g, Q, &w, bary, opt) == 0;
+				if (mm) {
+					mm->opt_state = found ? 1 : 2;
+					memcpy(mm->opt, opt, sizeof opt);
+				}
 			}
 			{
 				if (found) {
@@ -489,6 +556,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl)
 						d += (opt[i] - bary[i]) * (opt[i] - bary[i]);
 					if (d <= lmax) {
 						memcpy(cand[nc], opt, sizeof cand[nc]);
+						cand_role[nc] = 0;
 						cand_snap[nc++] = -1;
 					}
 				}
@@ -497,10 +565,12 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl)
 			 * with that end's attributes. */
 			for (int s = 0; s < K && K == 2; s++) {
 				memcpy(cand[nc], P[s], sizeof cand[nc]);
+				cand_role[nc] = 1 + s;
 				cand_snap[nc++] = -1;
 			}
 		}
 		memcpy(cand[nc], bary, sizeof cand[nc]);
+		cand_role[nc] = 4;
 		cand_snap[nc++] = -1;
 	}
 
@@ -578,9 +648,20 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl)
 					if (lim > 1e-6 * add)
 						stop = lim * wsum * (1.0 + 1e-9);
 				}
-				e = bgm_quadric_error(g, Q, &w, cand[k], stop);
-				if (e == HUGE_VAL)
-					continue;
+				int role = cand_role[k];
+				if (mm && (mm->known >> role & 1u)) {
+					e = mm->e[role];
+				} else {
+					if (!q_ready)
+						sum_quadrics(g, pl, Q), q_ready = 1;
+					e = bgm_quadric_error(g, Q, &w, cand[k], stop);
+					if (e == HUGE_VAL)
+						continue;
+					if (mm) {
+						mm->e[role] = e;
+						mm->known |= 1u << role;
+					}
+				}
 			}
 			cost = (wsum > 0.0 ? e / wsum : 0.0) + TIE_WEIGHT * tie;
 			if (g->opt.op == MLOD_OP_MIXED) /* per removed face: triangles and edges compete */
@@ -770,24 +851,13 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 	return (wsum > 0.0 ? lb / wsum : 0.0) * margin + TIE_WEIGHT * tie;
 }
 
-/* The collapsed vertices' posed quadrics summed per pose, as plan()
- * sums them. */
-static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
-{
-	for (int k = 0; k < 10 * g->pose_count; k++) {
-		Q[k] = 0.0;
-		for (int j = 0; j < pl->k; j++)
-			Q[k] += g->quadric[((size_t)pl->v[j] * (size_t)g->pose_count) * 10 + (size_t)k];
-	}
-}
-
 /* A lower bound of plan()'s exact cost for operation op on face f that
  * is tighter than lower_key's bind-pose bound: the least exact cost over
  * every placement plan() may try, valid or not, with the arithmetic of
  * plan(), so that it is the planned cost when that placement is valid.
  * It skips the patch: operations whose bound rises above the queue's
  * head go back without being planned, and most die before they return. */
-static double exact_bound(mlod_bgm *g, int f, int op)
+static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 {
 	const bgm_face *F = &g->faces[f];
 	struct plan pv; /* only k and v[] are used */
@@ -808,14 +878,28 @@ static double exact_bound(mlod_bgm *g, int f, int op)
 		V[j] = (mlod_v3){(float)P[j][0], (float)P[j][1], (float)P[j][2]};
 		in3[j] = g->inf[pv.v[j]];
 	}
-	sum_quadrics(g, &pv, Q);
-	for (int p = 0; p < g->pose_count; p++)
-		wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+	int q_ready = 0, role[MAX_CANDIDATES];
+	if (mm->known & MEMO_WSUM) {
+		wsum = mm->wsum;
+	} else {
+		sum_quadrics(g, &pv, Q);
+		q_ready = 1;
+		for (int p = 0; p < g->pose_count; p++)
+			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+		mm->wsum = wsum;
+		mm->known |= MEMO_WSUM;
+	}
 	if (g->opt.placement == MLOD_PLACE_OPTIMAL) {
 		mlod_influences w;
 		double opt[3];
-		mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
-		if (bgm_quadric_optimum(g, Q, &w, bary, opt) == 0) {
+		if (!mm->opt_state) {
+			if (!q_ready)
+				sum_quadrics(g, &pv, Q), q_ready = 1;
+			mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
+			mm->opt_state = bgm_quadric_optimum(g, Q, &w, bary, mm->opt) == 0 ? 1 : 2;
+		}
+		memcpy(opt, mm->opt, sizeof opt);
+		if (mm->opt_state == 1) {
 			double lmax = 0.0, d = 0.0;
 			for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
 				double l = 0.0;
@@ -825,12 +909,17 @@ static double exact_bound(mlod_bgm *g, int f, int op)
 			}
 			for (int i = 0; i < 3; i++)
 				d += (opt[i] - bary[i]) * (opt[i] - bary[i]);
-			if (d <= lmax)
+			if (d <= lmax) {
+				role[nc] = 0;
 				memcpy(cand[nc++], opt, sizeof cand[0]);
+			}
 		}
 	}
-	for (int j = 0; j < K; j++)
+	for (int j = 0; j < K; j++) {
+		role[nc] = 1 + j;
 		memcpy(cand[nc++], P[j], sizeof cand[0]);
+	}
+	role[nc] = 4;
 	memcpy(cand[nc++], bary, sizeof cand[0]);
 	double best = HUGE_VAL;
 	for (int k = 0; k < nc; k++) {
@@ -838,7 +927,16 @@ static double exact_bound(mlod_bgm *g, int f, int op)
 		mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
-		double e = bgm_quadric_error(g, Q, &w, cand[k], HUGE_VAL);
+		double e;
+		if (mm->known >> role[k] & 1u) {
+			e = mm->e[role[k]];
+		} else {
+			if (!q_ready)
+				sum_quadrics(g, &pv, Q), q_ready = 1;
+			e = bgm_quadric_error(g, Q, &w, cand[k], HUGE_VAL);
+			mm->e[role[k]] = e;
+			mm->known |= 1u << role[k];
+		}
 		best = fmin(best, wsum > 0.0 ? e / wsum : 0.0);
 	}
 	if (best == HUGE_VAL)
@@ -873,7 +971,7 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 	if (lazy_keys(g)) {
 		key = lower_key(g, f, op, &weak);
 	} else if (g->opt.cost == MLOD_COST_POSED) {
-		if (!plan(g, f, op, !g->opt.fast_cost, scratch)) {
+		if (!plan(g, f, op, !g->opt.fast_cost, scratch, NULL)) {
 			g->opstate[f] |= (unsigned char)BLOCKED(op);
 			return 0;
 		}
@@ -882,7 +980,7 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 		key = bgm_compactness(g->nodes[F->n[0]].p, g->nodes[F->n[1]].p, g->nodes[F->n[2]].p);
 	}
 	g->opstate[f] |= (unsigned char)QUEUED(op);
-	return heap_push(&g->heap, key, f, op, weak);
+	return heap_push(&g->heap, key, f, op, weak, -1);
 }
 
 /* 1 when the face across edge e of face f holds a queue entry for that
@@ -1108,6 +1206,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 	}
 	if (!g->heap.ready) {
 		g->heap.ready = 1;
+		g->heap.memo_free = -1;
 		for (int f = 0; f < g->face_count; f++)
 			if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
@@ -1118,32 +1217,44 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 	while (g->heap.count > 0 && (target <= 0 || g->live_triangles > target) &&
 	       (max_collapses <= 0 || done_count < max_collapses)) {
 		heap_entry e = heap_pop(&g->heap);
-		if (g->faces[e.face].death != BGM_ALIVE)
+		if (g->faces[e.face].death != BGM_ALIVE) {
+			memo_release(&g->heap, e.memo);
 			continue;
+		}
+		/* An operation going back keeps what its placements cost. */
+		memo local = memo_empty, *mm = e.memo >= 0 ? &g->heap.memo[e.memo] : &local;
+		double back = -1.0;
 		if (e.weak) {
-			double b = exact_bound(g, e.face, e.op);
-			if (b > e.key * (1.0 + 1e-9) + 1e-300) {
-				if (heap_push(&g->heap, b, e.face, e.op, 0)) {
-					r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
-					goto done;
-				}
+			double b = exact_bound(g, e.face, e.op, mm);
+			if (b > e.key * (1.0 + 1e-9) + 1e-300)
+				back = b;
+		}
+		if (back < 0.0) {
+			g->opstate[e.face] &= (unsigned char)~QUEUED(e.op);
+			if (!plan(g, e.face, e.op, !g->opt.fast_cost, pl, g->opt.fast_cost ? NULL : mm)) {
+				memo_release(&g->heap, e.memo);
+				g->refused++;
+				g->opstate[e.face] |= (unsigned char)BLOCKED(e.op);
 				continue;
 			}
+			if (g->opt.cost == MLOD_COST_POSED && pl->cost > e.key * (1.0 + 1e-9) + 1e-300) {
+				g->opstate[e.face] |= (unsigned char)QUEUED(e.op);
+				back = pl->cost;
+			}
 		}
-		g->opstate[e.face] &= (unsigned char)~QUEUED(e.op);
-		if (!plan(g, e.face, e.op, !g->opt.fast_cost, pl)) {
-			g->refused++;
-			g->opstate[e.face] |= (unsigned char)BLOCKED(e.op);
-			continue;
-		}
-		if (g->opt.cost == MLOD_COST_POSED && pl->cost > e.key * (1.0 + 1e-9) + 1e-300) {
-			g->opstate[e.face] |= (unsigned char)QUEUED(e.op);
-			if (heap_push(&g->heap, pl->cost, e.face, e.op, 0)) {
+		if (back >= 0.0) {
+			int slot = e.memo;
+			if (slot < 0 && !g->opt.fast_cost && (slot = memo_add(&g->heap, &local)) < 0) {
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+				goto done;
+			}
+			if (heap_push(&g->heap, back, e.face, e.op, 0, slot)) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 				goto done;
 			}
 			continue;
 		}
+		memo_release(&g->heap, e.memo);
 		int first = g->face_count;
 		if (apply(g, pl)) {
 			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
