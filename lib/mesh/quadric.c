@@ -26,7 +26,7 @@
 #define FEATURE_COS 0.5     /* creases sharper than 60 degrees are features */
 #define FEATURE_WEIGHT 1.0  /* of a feature plane, times the squared edge length */
 
-/* out = a * b for affine matrices; out as 3x4 row-major floats. */
+/* m's top 3x4, row-major. */
 static void to_rows(const mlod_mat4 *m, float *out)
 {
 	for (int r = 0; r < 3; r++)
@@ -278,15 +278,17 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 		for (int i = 0; i < 4; i++)
 			for (int j = i; j < 4; j++)
 				Q[i][j] = Q[j][i] = a[k++];
-		/* T = Q * [M; 0 0 0 1], H += [M; 0 0 0 1]^T * T. */
-		for (int i = 0; i < 4; i++)
-			for (int j = 0; j < 4; j++)
-				T[i][j] = Q[i][0] * M[j] + Q[i][1] * M[4 + j] + Q[i][2] * M[8 + j] + (j == 3 ? Q[i][3] : 0.0);
-		for (int i = 0; i < 4; i++)
-			for (int j = i; j < 4; j++) {
-				double mi0 = M[i], mi1 = M[4 + i], mi2 = M[8 + i], mi3 = i == 3 ? 1.0 : 0.0;
-				H[i][j] += mi0 * T[0][j] + mi1 * T[1][j] + mi2 * T[2][j] + mi3 * T[3][j];
-			}
+		/* T = Q * [M; 0 0 0 1], H += [M; 0 0 0 1]^T * T (the terms of the
+		 * last row's zeros left out). */
+		for (int i = 0; i < 4; i++) {
+			for (int j = 0; j < 3; j++)
+				T[i][j] = Q[i][0] * M[j] + Q[i][1] * M[4 + j] + Q[i][2] * M[8 + j];
+			T[i][3] = Q[i][0] * M[3] + Q[i][1] * M[7] + Q[i][2] * M[11] + Q[i][3];
+		}
+		for (int i = 0; i < 3; i++)
+			for (int j = i; j < 4; j++)
+				H[i][j] += M[i] * T[0][j] + M[4 + i] * T[1][j] + M[8 + i] * T[2][j];
+		H[3][3] += M[3] * T[0][3] + M[7] * T[1][3] + M[11] * T[2][3] + T[3][3];
 	}
 	int k = 0;
 	for (int i = 0; i < 4; i++)
