@@ -1000,10 +1000,11 @@ static int queued_across(const mlod_bgm *g, int f, int e)
 
 /* Queues face f's triangle collapse and its edges, as the option asks,
  * except edges the face across has queued. The queue is lazy: a popped
- * entry is planned again and goes back with its new cost when that rose;
- * one whose cost fell (its neighbourhood changed which placements are
- * valid) waits at its old key, an approximation that saves re-planning
- * every operation around each collapse. */
+ * entry is planned (with the posed cost, queued under lower_key's bound,
+ * for the first time) and goes back with its cost when that is above its
+ * key; one whose cost fell (its neighbourhood changed which placements
+ * are valid) waits at its old key, an approximation that saves
+ * re-planning every operation around each collapse. */
 static int push_face(mlod_bgm *g, int f, struct plan *scratch)
 {
 	if (g->opt.op != MLOD_OP_EDGE && push_op(g, f, OP_TRIANGLE, scratch))
