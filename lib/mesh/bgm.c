@@ -98,6 +98,10 @@ int bgm_add_node(mlod_bgm *g)
 			if (!p)
 				return -1;
 			g->quadric = p;
+			p = realloc(g->rquad, (size_t)g->node_cap * BGM_RQUAD * sizeof *g->rquad);
+			if (!p)
+				return -1;
+			g->rquad = p;
 		}
 		g->node_aux_cap = g->node_cap;
 	}
@@ -106,8 +110,10 @@ int bgm_add_node(mlod_bgm *g)
 	memset(&g->inf[n], 0, sizeof g->inf[n]);
 	if (g->lay.morph_stride > 0)
 		memset(g->morph + (size_t)n * (size_t)g->lay.morph_stride, 0, sizeof(float) * (size_t)g->lay.morph_stride);
-	if (g->pose_count > 0)
+	if (g->pose_count > 0) {
 		memset(g->quadric + (size_t)n * (size_t)g->pose_count * 10, 0, sizeof(double) * 10 * (size_t)g->pose_count);
+		memset(g->rquad + (size_t)n * BGM_RQUAD, 0, sizeof(double) * BGM_RQUAD);
+	}
 	return n;
 }
 
@@ -760,10 +766,12 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->records);
 	free(g->removed);
 	free(g->quadric);
+	free(g->rquad);
 	free(g->qsum);
 	free(g->skin);
 	free(g->opstate);
 	free(g->heap.e);
+	free(g->heap.memo);
 	free(g);
 }
 

@@ -17,6 +17,7 @@
 #include "mesh/mlod_mesh.h"
 
 #define BGM_ALIVE INT_MAX
+#define BGM_RQUAD 11 /* doubles per node in mlod_bgm.rquad */
 
 /* Node flags. */
 enum {
@@ -95,6 +96,10 @@ struct mlod_bgm {
 	int pose_count;
 	double *quadric;
 	float *skin;
+	double *rquad;          /* per node BGM_RQUAD doubles: its posed quadrics pulled back
+	                         * into bind space with its influences (bgm_quadric_pullback;
+	                         * -1 first until bgm_quadric_rest needs them), then the sum
+	                         * over poses of their traces */
 	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
 
 	/* Statistics. */
@@ -109,6 +114,9 @@ struct mlod_bgm {
 		int ready;                 /* every live face was queued */
 		int count, cap;
 		struct bgm_heap_entry *e;  /* released with free() by mlod_bgm_free */
+		struct bgm_memo *memo;     /* queued operations' exact placement costs (collapse.c);
+		                            * released with free() by mlod_bgm_free */
+		int memo_count, memo_cap, memo_free;
 	} heap;
 	unsigned char *opstate; /* per face and op (collapse.c): refused when last looked at, queued */
 	int opstate_cap;
@@ -131,8 +139,24 @@ int bgm_node_eligible(const mlod_bgm *g, const mlod_influences *inf);
 void bgm_face_normal(const double *a, const double *b, const double *c, double *n);
 mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err);
 /* The error of a node at bind position p with influences inf against
- * the quadrics q (pose_count x 10): sum over poses. */
-double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *p);
+ * the quadrics q (pose_count x 10): sum over poses; HUGE_VAL as soon as
+ * the partial sum reaches stop (HUGE_VAL: never). */
+double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *p,
+                         double stop);
+/* h (10 doubles) = sum over poses of M_p^T Q_p M_p, M_p the pose's skin
+ * matrix blended for inf: the posed quadrics q pulled back into bind
+ * space (DeCoro & Rusinkiewicz 2005), exact for a node that keeps inf. */
+void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influences *inf, double *h);
+/* Node v's rquad, its pulled-back quadric computed on first use. */
+const double *bgm_quadric_rest(mlod_bgm *g, int v);
+/* Sets node v's trace sum and marks its pulled-back quadric for
+ * computing (a new node, its quadrics summed). */
+void bgm_quadric_rest_reset(mlod_bgm *g, int v);
+/* A packed quadric's value at x, clamped at 0. */
+double bgm_quadric_eval(const double *h, const double *x);
+/* The minimiser of the packed quadric h (directions it leaves free stay
+ * at x0); returns 0 and fills out, or -1. */
+int bgm_quadric_solve(const double *h, const double *x0, double *out);
 /* The bind position minimising that error with inf fixed (directions the
  * quadric leaves free stay at x0); returns 0 and fills out, or -1. */
 int bgm_quadric_optimum(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x0,

@@ -66,7 +66,51 @@ typedef struct bgm_heap_entry {
 	double key;
 	int face;
 	int op;
+	int weak;   /* key is lower_key's bind-pose bound: exact_bound comes next */
+	int memo;   /* into heap.memo, or -1 */
 } heap_entry;
+
+/* What the exact posed cost of an operation's placements came to. It
+ * depends only on the collapsed vertices (quadrics, positions and
+ * influences, fixed while the face lives), not on the patch, so an
+ * operation back in the queue keeps it for its next bound or plan.
+ * Placements by role: 0 the optimum, 1 + i vertex i, 4 the barycenter. */
+#define MEMO_ROLES 5
+#define MEMO_WSUM (1u << MEMO_ROLES)
+typedef struct bgm_memo {
+	double opt[3];
+	int opt_state;              /* 0 not worked out, 1 found, 2 none */
+	unsigned known;             /* bit r: e[r] holds role r's full sum; MEMO_WSUM: wsum */
+	double e[MEMO_ROLES];
+	double wsum;
+	int next_free;
+} memo;
+
+static const memo memo_empty = {{0, 0, 0}, 0, 0, {0, 0, 0, 0, 0}, 0.0, -1};
+
+/* A slot holding m; returns its index, or -1 when out of memory. */
+static int memo_add(struct bgm_heap *h, const memo *m)
+{
+	int i = h->memo_free;
+	if (i >= 0) {
+		h->memo_free = h->memo[i].next_free;
+	} else {
+		if (bgm_grow((void **)&h->memo, &h->memo_cap, h->memo_count + 1, sizeof *h->memo))
+			return -1;
+		i = h->memo_count++;
+	}
+	h->memo[i] = *m;
+	h->memo[i].next_free = -1;
+	return i;
+}
+
+static void memo_release(struct bgm_heap *h, int i)
+{
+	if (i < 0)
+		return;
+	h->memo[i].next_free = h->memo_free;
+	h->memo_free = i;
+}
 
 static int entry_less(const heap_entry *a, const heap_entry *b)
 {
@@ -74,12 +118,12 @@ static int entry_less(const heap_entry *a, const heap_entry *b)
 	       (a->key == b->key && (a->face < b->face || (a->face == b->face && a->op < b->op)));
 }
 
-static int heap_push(struct bgm_heap *h, double key, int face, int op)
+static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak, int memo_slot)
 {
 	if (bgm_grow((void **)&h->e, &h->cap, h->count + 1, sizeof *h->e))
 		return -1;
 	int i = h->count++;
-	heap_entry x = {key, face, op};
+	heap_entry x = {key, face, op, weak, memo_slot};
 	while (i > 0) {
 		int p = (i - 1) / 2;
 		if (!entry_less(&x, &h->e[p]))
@@ -122,6 +166,8 @@ struct plan {
 	int nr, removed[MAX_PATCH]; /* faces with two or more of a, b, c */
 	int nk, kept[MAX_PATCH];    /* the others, re-meshed around v-bar */
 	int corner[MAX_PATCH];      /* the corner of kept[i] that becomes v-bar */
+	double onormal[MAX_PATCH][4]; /* kept[i]'s normal, then its length */
+	unsigned char oflip[MAX_PATCH]; /* kept[i] is not degenerate: it may not flip */
 	int nw, wedges[MAX_WEDGES], group[MAX_WEDGES], ngroups;
 	/* The chosen placement. */
 	double pos[3];
@@ -220,24 +266,39 @@ static void barycentric(const double *a, const double *b, const double *c, const
 		l[i] = sum > 0.0 ? l[i] / sum : 1.0 / 3.0;
 }
 
+/* bgm_compactness(a, b, c) from len, the length of bgm_face_normal's
+ * normal (the same arithmetic, so the same value). */
+static double compactness_of(const double *a, const double *b, const double *c, double len)
+{
+	double u[3], v[3], w[3];
+	for (int i = 0; i < 3; i++)
+		u[i] = b[i] - a[i], v[i] = c[i] - a[i], w[i] = c[i] - b[i];
+	double area = 0.5 * len;
+	double l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + w[0] * w[0] +
+	            w[1] * w[1] + w[2] * w[2];
+	if (!(l2 > 0.0))
+		return 0.0;
+	return 4.0 * sqrt(3.0) * area / l2;
+}
+
 /* Checks the re-meshed faces for flips and degeneracy with v-bar at x. */
 static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x)
 {
 	for (int i = 0; i < pl->nk; i++) {
 		const bgm_face *f = &g->faces[pl->kept[i]];
-		const double *p[3], *q[3];
+		const double *q[3];
 		for (int k = 0; k < 3; k++)
-			p[k] = q[k] = g->nodes[f->n[k]].p;
+			q[k] = g->nodes[f->n[k]].p;
 		q[pl->corner[i]] = x;
-		double no[3], nn[3];
-		bgm_face_normal(p[0], p[1], p[2], no);
+		const double *no = pl->onormal[i];
+		double nn[3];
 		bgm_face_normal(q[0], q[1], q[2], nn);
-		double lo = sqrt(no[0] * no[0] + no[1] * no[1] + no[2] * no[2]);
+		double lo = no[3];
 		double ln = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-		double cn = bgm_compactness(q[0], q[1], q[2]);
+		double cn = compactness_of(q[0], q[1], q[2], ln);
 		if (!(ln > 0.0) || cn < DEGENERATE)
 			return 0;
-		if (lo > 0.0 && bgm_compactness(p[0], p[1], p[2]) >= DEGENERATE &&
+		if (lo > 0.0 && pl->oflip[i] &&
 		    !(no[0] * nn[0] + no[1] * nn[1] + no[2] * nn[2] > FLIP_COS * lo * ln))
 			return 0;
 	}
@@ -265,10 +326,21 @@ static double area_sq(const double *a, const double *b, const double *c)
 	return 0.25 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 }
 
+/* The collapsed vertices' posed quadrics summed per pose, as plan()
+ * sums them. */
+static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
+{
+	for (int k = 0; k < 10 * g->pose_count; k++) {
+		Q[k] = 0.0;
+		for (int j = 0; j < pl->k; j++)
+			Q[k] += g->quadric[((size_t)pl->v[j] * (size_t)g->pose_count) * 10 + (size_t)k];
+	}
+}
+
 /* Works out operation op on face t (its triangle collapse, or the
  * collapse of one of its edges); returns 1 when it is valid (pl holds
  * the cheapest valid placement), else 0. */
-static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
+static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm)
 {
 	const bgm_face *T = &g->faces[t];
 	int allow_border = g->opt.allow_border;
@@ -392,7 +464,7 @@ static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
 
 	/* Candidate placements. */
 	double cand[MAX_CANDIDATES][3];
-	int cand_snap[MAX_CANDIDATES], nc = 0;
+	int cand_snap[MAX_CANDIDATES], cand_role[MAX_CANDIDATES], nc = 0;
 	const double *P[3] = {g->nodes[pl->v[0]].p, g->nodes[pl->v[1]].p, K == 3 ? g->nodes[pl->v[2]].p : NULL};
 	double bary[3];
 	for (int i = 0; i < 3; i++) {
@@ -405,18 +477,6 @@ static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
 	for (int j = 0; j < K; j++) {
 		V[j] = (mlod_v3){(float)P[j][0], (float)P[j][1], (float)P[j][2]};
 		in3[j] = g->inf[pl->v[j]];
-	}
-	/* The summed posed quadrics of the collapsed vertices, and their area
-	 * (the normaliser of the posed cost). */
-	double *Q = g->qsum, wsum = 0.0;
-	if (g->pose_count > 0) {
-		for (int k = 0; k < 10 * g->pose_count; k++) {
-			Q[k] = 0.0;
-			for (int j = 0; j < K; j++)
-				Q[k] += g->quadric[((size_t)pl->v[j] * (size_t)g->pose_count) * 10 + (size_t)k];
-		}
-		for (int p = 0; p < g->pose_count; p++)
-			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
 	}
 	if (special[0] || special[1] || special[2]) {
 		/* Snap onto a seam (or border) vertex that keeps every wedge group
@@ -432,15 +492,57 @@ static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
 			if (!ok)
 				continue;
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
+			cand_role[nc] = 1 + s;
 			cand_snap[nc++] = s;
 		}
-	} else {
+		if (nc == 0)
+			return 0;
+	}
+	/* The summed posed quadrics of the collapsed vertices, and their area
+	 * (the normaliser of the posed cost). */
+	double *Q = g->qsum, wsum = 0.0, R[10] = {0};
+	int fast = !exact && g->rquad, q_ready = 0;
+	if (g->pose_count > 0 && fast) {
+		for (int j = 0; j < K; j++) {
+			const double *r = bgm_quadric_rest(g, pl->v[j]);
+			for (int k = 0; k < 10; k++)
+				R[k] += r[k];
+			wsum += r[10];
+		}
+	} else if (g->pose_count > 0 && mm && (mm->known & MEMO_WSUM)) {
+		wsum = mm->wsum; /* Q is summed when needed */
+	} else if (g->pose_count > 0) {
+		sum_quadrics(g, pl, Q);
+		q_ready = 1;
+		for (int p = 0; p < g->pose_count; p++)
+			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+		if (mm) {
+			mm->wsum = wsum;
+			mm->known |= MEMO_WSUM;
+		}
+	}
+	if (!(special[0] || special[1] || special[2])) {
 		if (g->opt.placement == MLOD_PLACE_OPTIMAL && g->pose_count > 0) {
 			mlod_influences w;
 			double opt[3];
-			{
+			int found;
+			if (fast) {
+				found = bgm_quadric_solve(R, bary, opt) == 0;
+			} else if (mm && mm->opt_state) {
+				found = mm->opt_state == 1;
+				memcpy(opt, mm->opt, sizeof opt);
+			} else {
+				if (!q_ready)
+					sum_quadrics(g, pl, Q), q_ready = 1;
 				mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
-				if (bgm_quadric_optimum(g, Q, &w, bary, opt) == 0) {
+				found = bgm_quadric_optimum(g, Q, &w, bary, opt) == 0;
+				if (mm) {
+					mm->opt_state = found ? 1 : 2;
+					memcpy(mm->opt, opt, sizeof opt);
+				}
+			}
+			{
+				if (found) {
 					/* Stay near the collapsed vertices: at most their
 					 * longest edge from the barycenter. */
 					double lmax = 0.0, d = 0.0;
@@ -454,6 +556,7 @@ static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
 						d += (opt[i] - bary[i]) * (opt[i] - bary[i]);
 					if (d <= lmax) {
 						memcpy(cand[nc], opt, sizeof cand[nc]);
+						cand_role[nc] = 0;
 						cand_snap[nc++] = -1;
 					}
 				}
@@ -462,13 +565,24 @@ static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
 			 * with that end's attributes. */
 			for (int s = 0; s < K && K == 2; s++) {
 				memcpy(cand[nc], P[s], sizeof cand[nc]);
+				cand_role[nc] = 1 + s;
 				cand_snap[nc++] = -1;
 			}
 		}
 		memcpy(cand[nc], bary, sizeof cand[nc]);
+		cand_role[nc] = 4;
 		cand_snap[nc++] = -1;
 	}
 
+	/* The kept faces as they are, for geometry_ok. */
+	for (int i = 0; i < pl->nk; i++) {
+		const bgm_face *f = &g->faces[pl->kept[i]];
+		const double *a = g->nodes[f->n[0]].p, *b = g->nodes[f->n[1]].p, *c = g->nodes[f->n[2]].p;
+		double *no = pl->onormal[i];
+		bgm_face_normal(a, b, c, no);
+		no[3] = sqrt(no[0] * no[0] + no[1] * no[1] + no[2] * no[2]);
+		pl->oflip[i] = no[3] > 0.0 && bgm_compactness(a, b, c) >= DEGENERATE;
+	}
 	/* The cheapest valid candidate; with the compactness cost (the same
 	 * for every placement), the one nearest the barycenter. The
 	 * compactness tie-break of the posed cost is t's own for a triangle,
@@ -484,7 +598,30 @@ static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
 			tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / pl->nr;
 		}
 	}
+	/* The fast posed cost does not depend on the influences: rank the
+	 * candidates by it, and the first valid one is the choice (the one
+	 * the loop below would make, ties going to the earlier). */
+	int order[MAX_CANDIDATES];
+	double ckey[MAX_CANDIDATES];
+	int ranked = fast && g->opt.cost == MLOD_COST_POSED;
 	for (int k = 0; k < nc; k++) {
+		order[k] = k;
+		if (!ranked)
+			continue;
+		double e = g->pose_count > 0 ? bgm_quadric_eval(R, cand[k]) : 0.0;
+		ckey[k] = (wsum > 0.0 ? e / wsum : 0.0) + TIE_WEIGHT * tie;
+		if (g->opt.op == MLOD_OP_MIXED)
+			ckey[k] /= pl->nr;
+		for (int i = k; i > 0 && ckey[order[i]] < ckey[order[i - 1]]; i--) {
+			int x = order[i];
+			order[i] = order[i - 1];
+			order[i - 1] = x;
+		}
+	}
+	for (int kk = 0; kk < nc; kk++) {
+		int k = order[kk];
+		if (ranked && best >= 0)
+			break;
 		if (!geometry_ok(g, pl, cand[k]))
 			continue;
 		mlod_influences w;
@@ -497,7 +634,35 @@ static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
 		if (g->opt.cost == MLOD_COST_POSED) {
 			/* Area-normalised (a mean squared distance), so small
 			 * features count as much as large ones. */
-			double e = g->pose_count > 0 ? bgm_quadric_error(g, Q, &w, cand[k]) : 0.0;
+			double e = 0.0;
+			if (ranked) {
+				pl->cost = ckey[k];
+				goto take;
+			} else if (g->pose_count > 0) {
+				/* Stop summing once this candidate cannot beat the best:
+				 * with a margin far above rounding, so that the choice is
+				 * the one the full sum makes. */
+				double stop = HUGE_VAL, add = TIE_WEIGHT * tie;
+				if (best >= 0 && wsum > 0.0) {
+					double lim = pl->cost * (g->opt.op == MLOD_OP_MIXED ? pl->nr : 1) - add;
+					if (lim > 1e-6 * add)
+						stop = lim * wsum * (1.0 + 1e-9);
+				}
+				int role = cand_role[k];
+				if (mm && (mm->known >> role & 1u)) {
+					e = mm->e[role];
+				} else {
+					if (!q_ready)
+						sum_quadrics(g, pl, Q), q_ready = 1;
+					e = bgm_quadric_error(g, Q, &w, cand[k], stop);
+					if (e == HUGE_VAL)
+						continue;
+					if (mm) {
+						mm->e[role] = e;
+						mm->known |= 1u << role;
+					}
+				}
+			}
 			cost = (wsum > 0.0 ? e / wsum : 0.0) + TIE_WEIGHT * tie;
 			if (g->opt.op == MLOD_OP_MIXED) /* per removed face: triangles and edges compete */
 				cost /= pl->nr;
@@ -508,9 +673,10 @@ static int plan(mlod_bgm *g, int t, int op, struct plan *pl)
 			if (best >= 0 && !(d < best_d))
 				continue;
 		}
+		pl->cost = cost;
+	take:
 		best = k;
 		best_d = d;
-		pl->cost = cost;
 		pl->inf = w;
 		pl->capped = capped;
 	}
@@ -579,6 +745,216 @@ static int grow_face_arrays(mlod_bgm *g)
 	return 0;
 }
 
+/* 1 when the queue takes lower bounds of the posed cost (lower_key) and
+ * plans an operation only when it is popped. */
+static int lazy_keys(const mlod_bgm *g)
+{
+	return g->opt.cost == MLOD_COST_POSED && g->rquad && g->pose_count > 0 && g->opt.op != MLOD_OP_MIXED;
+}
+
+static int same_influences(const mlod_influences *x, const mlod_influences *y)
+{
+	if (x->count != y->count)
+		return 0;
+	for (int i = 0; i < x->count; i++)
+		if (x->joints[i] != y->joints[i] || x->weights[i] != y->weights[i])
+			return 0;
+	return 1;
+}
+
+/* A lower bound of the cost plan() finds for operation op on face f,
+ * from the quadrics alone (no patch, no validity): the least over every
+ * placement plan() may try, valid or not, plus plan()'s compactness
+ * tie-break (of t, or of the edge's faces). Most queued operations die
+ * with their face before they come up, so they are planned only when
+ * popped, and go back with their cost when it is above the bound.
+ *
+ * The exact posed cost skins each placement with its own (Power
+ * Skinning) influences. When the collapsed vertices share theirs, every
+ * placement has them too, and the exact cost is the sum of the vertices'
+ * posed quadrics pulled back into bind space (bgm_quadric_rest), the
+ * bound being then the cost itself when the cheapest placement is valid.
+ * Otherwise the bound is the bind pose's term alone, which no influence
+ * changes (its skin matrices are the identity, or one rigid matrix),
+ * the other poses' terms not being negative; the optimal placement,
+ * unknown here, lies within sqrt(lmax) of the barycenter (plan() drops
+ * it beyond), where the convex quadric is at least its tangent plane at
+ * the barycenter. The fast cost (mlod_bgm_options.fast_cost) is the
+ * pulled-back sum for every operation. */
+static double lower_key(mlod_bgm *g, int f, int op, int *weak)
+{
+	const bgm_face *F = &g->faces[f];
+	int K = op == OP_TRIANGLE ? 3 : 2, v[3];
+	double Q[10] = {0}, wsum = 0.0, bary[3] = {0, 0, 0}, x[3];
+	const double *P[3];
+	int same = 1;
+	for (int j = 0; j < K; j++) {
+		v[j] = F->n[op == OP_TRIANGLE ? j : (op + j) % 3];
+		P[j] = g->nodes[v[j]].p;
+		for (int i = 0; i < 3; i++)
+			bary[i] += P[j][i] / K;
+		wsum += g->rquad[(size_t)v[j] * BGM_RQUAD + 10];
+		if (j > 0 && same)
+			same = same_influences(&g->inf[v[0]], &g->inf[v[j]]);
+	}
+	double tie = 0.0;
+	if (K == 3) {
+		tie = sqrt(area_sq(P[0], P[1], P[2])) * (1.0 - bgm_compactness(P[0], P[1], P[2]));
+	} else {
+		int faces[2] = {f, F->adj[op]}, nr = faces[1] >= 0 ? 2 : 1;
+		for (int j = 0; j < nr; j++) {
+			const bgm_face *h = &g->faces[faces[j]];
+			const double *a = g->nodes[h->n[0]].p, *b = g->nodes[h->n[1]].p, *c = g->nodes[h->n[2]].p;
+			tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / nr;
+		}
+	}
+	double lb, margin = 1.0;
+	if (same || g->opt.fast_cost) {
+		for (int j = 0; j < K; j++) {
+			const double *r = bgm_quadric_rest(g, v[j]);
+			for (int k = 0; k < 10; k++)
+				Q[k] += r[k];
+		}
+		lb = bgm_quadric_eval(Q, bary);
+		for (int j = 0; j < K; j++)
+			lb = fmin(lb, bgm_quadric_eval(Q, P[j]));
+		if (g->opt.placement == MLOD_PLACE_OPTIMAL && bgm_quadric_solve(Q, bary, x) == 0)
+			lb = fmin(lb, bgm_quadric_eval(Q, x));
+	} else {
+		for (int j = 0; j < K; j++) {
+			const double *q = g->quadric + (size_t)v[j] * (size_t)g->pose_count * 10;
+			for (int k = 0; k < 10; k++)
+				Q[k] += q[k];
+		}
+		lb = bgm_quadric_eval(Q, bary);
+		for (int j = 0; j < K; j++)
+			lb = fmin(lb, bgm_quadric_eval(Q, P[j]));
+		if (g->opt.placement == MLOD_PLACE_OPTIMAL) {
+			double lmax = 0.0, gr[3], gl = 0.0;
+			for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
+				double l = 0.0;
+				for (int i = 0; i < 3; i++)
+					l += (P[e][i] - P[(e + 1) % K][i]) * (P[e][i] - P[(e + 1) % K][i]);
+				lmax = fmax(lmax, l);
+			}
+			gr[0] = Q[0] * bary[0] + Q[1] * bary[1] + Q[2] * bary[2] + Q[3];
+			gr[1] = Q[1] * bary[0] + Q[4] * bary[1] + Q[5] * bary[2] + Q[6];
+			gr[2] = Q[2] * bary[0] + Q[5] * bary[1] + Q[7] * bary[2] + Q[8];
+			for (int i = 0; i < 3; i++)
+				gl += gr[i] * gr[i];
+			double t = bgm_quadric_eval(Q, bary) - 2.0 * sqrt(gl) * sqrt(lmax) * (1.0 + 1e-9);
+			lb = fmin(lb, t > 0.0 ? t : 0.0);
+		}
+		margin = 1.0 - 1e-9; /* rounding: stay below the exact sum */
+		*weak = 1;
+	}
+	return (wsum > 0.0 ? lb / wsum : 0.0) * margin + TIE_WEIGHT * tie;
+}
+
+/* A lower bound of plan()'s exact cost for operation op on face f that
+ * is tighter than lower_key's bind-pose bound: the least exact cost over
+ * every placement plan() may try, valid or not, with the arithmetic of
+ * plan(), so that it is the planned cost when that placement is valid.
+ * It skips the patch: operations whose bound rises above the queue's
+ * head go back without being planned, and most die before they return. */
+static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
+{
+	const bgm_face *F = &g->faces[f];
+	struct plan pv; /* only k and v[] are used */
+	int K = pv.k = op == OP_TRIANGLE ? 3 : 2;
+	double bary[3] = {0, 0, 0}, cand[MAX_CANDIDATES][3], wsum = 0.0, *Q = g->qsum;
+	const double *P[3];
+	mlod_v3 V[3];
+	mlod_influences in3[3];
+	int nc = 0;
+	for (int j = 0; j < K; j++) {
+		pv.v[j] = F->n[op == OP_TRIANGLE ? j : (op + j) % 3];
+		P[j] = g->nodes[pv.v[j]].p;
+	}
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < K; j++)
+			bary[i] += P[j][i] / K;
+	for (int j = 0; j < K; j++) {
+		V[j] = (mlod_v3){(float)P[j][0], (float)P[j][1], (float)P[j][2]};
+		in3[j] = g->inf[pv.v[j]];
+	}
+	int q_ready = 0, role[MAX_CANDIDATES];
+	if (mm->known & MEMO_WSUM) {
+		wsum = mm->wsum;
+	} else {
+		sum_quadrics(g, &pv, Q);
+		q_ready = 1;
+		for (int p = 0; p < g->pose_count; p++)
+			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+		mm->wsum = wsum;
+		mm->known |= MEMO_WSUM;
+	}
+	if (g->opt.placement == MLOD_PLACE_OPTIMAL) {
+		mlod_influences w;
+		double opt[3];
+		if (!mm->opt_state) {
+			if (!q_ready)
+				sum_quadrics(g, &pv, Q), q_ready = 1;
+			mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
+			mm->opt_state = bgm_quadric_optimum(g, Q, &w, bary, mm->opt) == 0 ? 1 : 2;
+		}
+		memcpy(opt, mm->opt, sizeof opt);
+		if (mm->opt_state == 1) {
+			double lmax = 0.0, d = 0.0;
+			for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
+				double l = 0.0;
+				for (int i = 0; i < 3; i++)
+					l += (P[e][i] - P[(e + 1) % K][i]) * (P[e][i] - P[(e + 1) % K][i]);
+				lmax = fmax(lmax, l);
+			}
+			for (int i = 0; i < 3; i++)
+				d += (opt[i] - bary[i]) * (opt[i] - bary[i]);
+			if (d <= lmax) {
+				role[nc] = 0;
+				memcpy(cand[nc++], opt, sizeof cand[0]);
+			}
+		}
+	}
+	for (int j = 0; j < K; j++) {
+		role[nc] = 1 + j;
+		memcpy(cand[nc++], P[j], sizeof cand[0]);
+	}
+	role[nc] = 4;
+	memcpy(cand[nc++], bary, sizeof cand[0]);
+	double best = HUGE_VAL;
+	for (int k = 0; k < nc; k++) {
+		mlod_influences w;
+		mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+		if (g->joint_count > 0 && w.count == 0)
+			continue;
+		double e;
+		if (mm->known >> role[k] & 1u) {
+			e = mm->e[role[k]];
+		} else {
+			if (!q_ready)
+				sum_quadrics(g, &pv, Q), q_ready = 1;
+			e = bgm_quadric_error(g, Q, &w, cand[k], HUGE_VAL);
+			mm->e[role[k]] = e;
+			mm->known |= 1u << role[k];
+		}
+		best = fmin(best, wsum > 0.0 ? e / wsum : 0.0);
+	}
+	if (best == HUGE_VAL)
+		best = 0.0;
+	double tie = 0.0;
+	if (K == 3) {
+		tie = sqrt(area_sq(P[0], P[1], P[2])) * (1.0 - bgm_compactness(P[0], P[1], P[2]));
+	} else {
+		int faces[2] = {f, F->adj[op]}, nr = faces[1] >= 0 ? 2 : 1;
+		for (int j = 0; j < nr; j++) {
+			const bgm_face *h = &g->faces[faces[j]];
+			const double *a = g->nodes[h->n[0]].p, *b = g->nodes[h->n[1]].p, *c = g->nodes[h->n[2]].p;
+			tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / nr;
+		}
+	}
+	return best + TIE_WEIGHT * tie;
+}
+
 /* Queues operation op on face f (new, or back from being blocked). */
 static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 {
@@ -591,8 +967,11 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 			return 0; /* never collapsible while these nodes live */
 	}
 	double key;
-	if (g->opt.cost == MLOD_COST_POSED) {
-		if (!plan(g, f, op, scratch)) {
+	int weak = 0;
+	if (lazy_keys(g)) {
+		key = lower_key(g, f, op, &weak);
+	} else if (g->opt.cost == MLOD_COST_POSED) {
+		if (!plan(g, f, op, !g->opt.fast_cost, scratch, NULL)) {
 			g->opstate[f] |= (unsigned char)BLOCKED(op);
 			return 0;
 		}
@@ -601,7 +980,7 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 		key = bgm_compactness(g->nodes[F->n[0]].p, g->nodes[F->n[1]].p, g->nodes[F->n[2]].p);
 	}
 	g->opstate[f] |= (unsigned char)QUEUED(op);
-	return heap_push(&g->heap, key, f, op);
+	return heap_push(&g->heap, key, f, op, weak, -1);
 }
 
 /* 1 when the face across edge e of face f holds a queue entry for that
@@ -621,10 +1000,11 @@ static int queued_across(const mlod_bgm *g, int f, int e)
 
 /* Queues face f's triangle collapse and its edges, as the option asks,
  * except edges the face across has queued. The queue is lazy: a popped
- * entry is planned again and goes back with its new cost when that rose;
- * one whose cost fell (its neighbourhood changed which placements are
- * valid) waits at its old key, an approximation that saves re-planning
- * every operation around each collapse. */
+ * entry is planned (with the posed cost, queued under lower_key's bound,
+ * for the first time) and goes back with its cost when that is above its
+ * key; one whose cost fell (its neighbourhood changed which placements
+ * are valid) waits at its old key, an approximation that saves
+ * re-planning every operation around each collapse. */
 static int push_face(mlod_bgm *g, int f, struct plan *scratch)
 {
 	if (g->opt.op != MLOD_OP_EDGE && push_op(g, f, OP_TRIANGLE, scratch))
@@ -674,6 +1054,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 				x += g->quadric[(size_t)pl->v[i] * (size_t)g->pose_count * 10 + (size_t)k];
 			q[k] = x;
 		}
+		bgm_quadric_rest_reset(g, v);
 	}
 
 	/* New wedges. Snapped: one per wedge group, a copy of the snap vertex's
@@ -826,6 +1207,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 	}
 	if (!g->heap.ready) {
 		g->heap.ready = 1;
+		g->heap.memo_free = -1;
 		for (int f = 0; f < g->face_count; f++)
 			if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
@@ -836,22 +1218,44 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 	while (g->heap.count > 0 && (target <= 0 || g->live_triangles > target) &&
 	       (max_collapses <= 0 || done_count < max_collapses)) {
 		heap_entry e = heap_pop(&g->heap);
-		if (g->faces[e.face].death != BGM_ALIVE)
-			continue;
-		g->opstate[e.face] &= (unsigned char)~QUEUED(e.op);
-		if (!plan(g, e.face, e.op, pl)) {
-			g->refused++;
-			g->opstate[e.face] |= (unsigned char)BLOCKED(e.op);
+		if (g->faces[e.face].death != BGM_ALIVE) {
+			memo_release(&g->heap, e.memo);
 			continue;
 		}
-		if (g->opt.cost == MLOD_COST_POSED && pl->cost > e.key * (1.0 + 1e-9) + 1e-300) {
-			g->opstate[e.face] |= (unsigned char)QUEUED(e.op);
-			if (heap_push(&g->heap, pl->cost, e.face, e.op)) {
+		/* An operation going back keeps what its placements cost. */
+		memo local = memo_empty, *mm = e.memo >= 0 ? &g->heap.memo[e.memo] : &local;
+		double back = -1.0;
+		if (e.weak) {
+			double b = exact_bound(g, e.face, e.op, mm);
+			if (b > e.key * (1.0 + 1e-9) + 1e-300)
+				back = b;
+		}
+		if (back < 0.0) {
+			g->opstate[e.face] &= (unsigned char)~QUEUED(e.op);
+			if (!plan(g, e.face, e.op, !g->opt.fast_cost, pl, g->opt.fast_cost ? NULL : mm)) {
+				memo_release(&g->heap, e.memo);
+				g->refused++;
+				g->opstate[e.face] |= (unsigned char)BLOCKED(e.op);
+				continue;
+			}
+			if (g->opt.cost == MLOD_COST_POSED && pl->cost > e.key * (1.0 + 1e-9) + 1e-300) {
+				g->opstate[e.face] |= (unsigned char)QUEUED(e.op);
+				back = pl->cost;
+			}
+		}
+		if (back >= 0.0) {
+			int slot = e.memo;
+			if (slot < 0 && !g->opt.fast_cost && (slot = memo_add(&g->heap, &local)) < 0) {
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+				goto done;
+			}
+			if (heap_push(&g->heap, back, e.face, e.op, 0, slot)) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 				goto done;
 			}
 			continue;
 		}
+		memo_release(&g->heap, e.memo);
 		int first = g->face_count;
 		if (apply(g, pl)) {
 			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");

@@ -104,6 +104,10 @@ typedef struct mlod_bgm_options {
 	mlod_eligibility eligibility;
 	double tau;                  /* 0 means 1 */
 	int allow_border;            /* let collapses move and remove border vertices */
+	int fast_cost;               /* posed cost: every pose's quadrics pulled back into bind
+	                              * space with each vertex's own influences (DeCoro &
+	                              * Rusinkiewicz 2005), not skinned with each placement's:
+	                              * faster, at some posed error (bench/RESULTS.md) */
 	const mlod_pose_set *poses;  /* the posed cost's poses; NULL: the bind pose only */
 	const double *eta;           /* per joint (mlod_joint_weight_average); NULL: computed */
 	int threads;                 /* mlod_mesh_levels: primitives and measured poses on this many

@@ -26,7 +26,7 @@
 #define FEATURE_COS 0.5     /* creases sharper than 60 degrees are features */
 #define FEATURE_WEIGHT 1.0  /* of a feature plane, times the squared edge length */
 
-/* out = a * b for affine matrices; out as 3x4 row-major floats. */
+/* m's top 3x4, row-major. */
 static void to_rows(const mlod_mat4 *m, float *out)
 {
 	for (int r = 0; r < 3; r++)
@@ -132,9 +132,13 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	mlod_mat4 *rest = malloc(sizeof *rest * ((size_t)s->joint_count + 1));
 	mlod_trs *local = malloc(sizeof *local * ((size_t)s->joint_count + 1));
 	double *posed = malloc(sizeof(double) * 3 * (size_t)g->node_count + 1);
+	/* Per face, in the pose at hand: bgm_face_normal of its corners in
+	 * order, and that normal's length (computed on first use, -1 before). */
+	double *fn = malloc(sizeof(double) * 4 * (size_t)g->face_count + 1);
 	g->skin = malloc(sizeof(float) * 12 * (size_t)J * (size_t)P);
 	g->quadric = calloc((size_t)g->node_cap * (size_t)P * 10, sizeof *g->quadric);
-	if (!mats || !rest || !local || !posed || !g->skin || !g->quadric) {
+	g->rquad = malloc(sizeof *g->rquad * (size_t)g->node_cap * BGM_RQUAD);
+	if (!mats || !rest || !local || !posed || !fn || !g->skin || !g->quadric || !g->rquad) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
 		goto done;
 	}
@@ -168,6 +172,8 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			blend(g, p, &g->inf[v], M);
 			apply(M, g->nodes[v].p, posed + 3 * v);
 		}
+		for (int f = 0; f < g->face_count; f++)
+			fn[4 * f + 3] = -1.0;
 		for (int f = 0; f < g->face_count; f++) {
 			const bgm_face *F = &g->faces[f];
 			double q[10] = {0};
@@ -187,22 +193,25 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 					continue; /* each interior edge once */
 				const double *a = posed + 3 * F->n[e], *b = posed + 3 * F->n[(e + 1) % 3];
 				const double *o = posed + 3 * F->n[(e + 2) % 3];
-				double n1[3], n2[3];
+				double n1[3];
+				const double *n2 = NULL;
 				bgm_face_normal(a, b, o, n1);
 				if (h >= 0) {
-					const bgm_face *H = &g->faces[h];
-					bgm_face_normal(posed + 3 * H->n[0], posed + 3 * H->n[1], posed + 3 * H->n[2], n2);
-					double l1 = sqrt(dot3(n1, n1)), l2 = sqrt(dot3(n2, n2));
+					double *c = fn + 4 * h;
+					if (c[3] < 0.0) {
+						const bgm_face *H = &g->faces[h];
+						bgm_face_normal(posed + 3 * H->n[0], posed + 3 * H->n[1], posed + 3 * H->n[2], c);
+						c[3] = sqrt(dot3(c, c));
+					}
+					n2 = c;
+					double l1 = sqrt(dot3(n1, n1)), l2 = c[3];
 					if (!(l1 > 0.0) || !(l2 > 0.0) || dot3(n1, n2) > FEATURE_COS * l1 * l2)
 						continue;
 				}
 				double q2[10] = {0};
 				edge_quadric(a, b, n1, q2);
-				if (h >= 0) {
-					const bgm_face *H = &g->faces[h];
-					bgm_face_normal(posed + 3 * H->n[0], posed + 3 * H->n[1], posed + 3 * H->n[2], n2);
+				if (h >= 0)
 					edge_quadric(a, b, n2, q2);
-				}
 				int ends[2] = {F->n[e], F->n[(e + 1) % 3]};
 				for (int i = 0; i < 2; i++) {
 					double *Q = g->quadric + ((size_t)ends[i] * (size_t)P + (size_t)p) * 10;
@@ -212,15 +221,18 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			}
 		}
 	}
+	for (int v = 0; v < g->node_count; v++)
+		bgm_quadric_rest_reset(g, v);
 done:
 	free(mats);
 	free(rest);
 	free(local);
 	free(posed);
+	free(fn);
 	return r;
 }
 
-double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x)
+double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
 {
 	double M[12], y[3], e = 0.0;
 	for (int p = 0; p < g->pose_count; p++) {
@@ -228,11 +240,34 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 		apply(M, x, y);
 		double v = eval(q + 10 * p, y);
 		e += v > 0.0 ? v : 0.0;
+		if (e >= stop)
+			return HUGE_VAL;
 	}
 	return e;
 }
 
-int bgm_quadric_optimum(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x0, double *out)
+void bgm_quadric_rest_reset(mlod_bgm *g, int v)
+{
+	const double *q = g->quadric + (size_t)v * (size_t)g->pose_count * 10;
+	double *r = g->rquad + (size_t)v * BGM_RQUAD, t = 0.0;
+	for (int p = 0; p < g->pose_count; p++)
+		t += q[10 * p] + q[10 * p + 4] + q[10 * p + 7];
+	r[0] = -1.0;
+	r[10] = t;
+}
+
+const double *bgm_quadric_rest(mlod_bgm *g, int v)
+{
+	double *r = g->rquad + (size_t)v * BGM_RQUAD;
+	if (r[0] < 0.0)
+		bgm_quadric_pullback(g, g->quadric + (size_t)v * (size_t)g->pose_count * 10, &g->inf[v], r);
+	return r;
+}
+
+/* h (10 doubles, packed as a quadric) = sum over poses of
+ * [M_p; 0 0 0 1]^T Q_p [M_p; 0 0 0 1], M_p blended for inf: the posed
+ * quadrics q pulled back into bind space. */
+void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influences *inf, double *h)
 {
 	double H[4][4] = {{0}};
 	for (int p = 0; p < g->pose_count; p++) {
@@ -243,30 +278,53 @@ int bgm_quadric_optimum(const mlod_bgm *g, const double *q, const mlod_influence
 		for (int i = 0; i < 4; i++)
 			for (int j = i; j < 4; j++)
 				Q[i][j] = Q[j][i] = a[k++];
-		/* T = Q * [M; 0 0 0 1], H += [M; 0 0 0 1]^T * T. */
-		for (int i = 0; i < 4; i++)
-			for (int j = 0; j < 4; j++)
-				T[i][j] = Q[i][0] * M[j] + Q[i][1] * M[4 + j] + Q[i][2] * M[8 + j] + (j == 3 ? Q[i][3] : 0.0);
-		for (int i = 0; i < 4; i++)
-			for (int j = 0; j < 4; j++) {
-				double mi0 = M[i], mi1 = M[4 + i], mi2 = M[8 + i], mi3 = i == 3 ? 1.0 : 0.0;
-				H[i][j] += mi0 * T[0][j] + mi1 * T[1][j] + mi2 * T[2][j] + mi3 * T[3][j];
-			}
+		/* T = Q * [M; 0 0 0 1], H += [M; 0 0 0 1]^T * T (the terms of the
+		 * last row's zeros left out). */
+		for (int i = 0; i < 4; i++) {
+			for (int j = 0; j < 3; j++)
+				T[i][j] = Q[i][0] * M[j] + Q[i][1] * M[4 + j] + Q[i][2] * M[8 + j];
+			T[i][3] = Q[i][0] * M[3] + Q[i][1] * M[7] + Q[i][2] * M[11] + Q[i][3];
+		}
+		for (int i = 0; i < 3; i++)
+			for (int j = i; j < 4; j++)
+				H[i][j] += M[i] * T[0][j] + M[4 + i] * T[1][j] + M[8 + i] * T[2][j];
+		H[3][3] += M[3] * T[0][3] + M[7] * T[1][3] + M[11] * T[2][3] + T[3][3];
 	}
+	int k = 0;
+	for (int i = 0; i < 4; i++)
+		for (int j = i; j < 4; j++)
+			h[k++] = H[i][j];
+}
+
+double bgm_quadric_eval(const double *h, const double *x)
+{
+	double v = eval(h, x);
+	return v > 0.0 ? v : 0.0;
+}
+
+int bgm_quadric_solve(const double *h, const double *x0, double *out)
+{
 	/* Solve (H[0..2][0..2] + mu I) x = -H[0..2][3] + mu x0 by Cramer's
 	 * rule: the small mu pins the directions the quadric leaves free
 	 * (flat regions, creases) at x0 instead of leaving them singular. */
-	double tr = H[0][0] + H[1][1] + H[2][2];
+	double tr = h[0] + h[4] + h[7];
 	if (!(tr > 0.0) || !isfinite(tr))
 		return -1;
 	double mu = 1e-5 * tr;
-	double a = H[0][0] + mu, b = H[0][1], c = H[0][2], d = H[1][1] + mu, e = H[1][2], f = H[2][2] + mu;
+	double a = h[0] + mu, b = h[1], c = h[2], d = h[4] + mu, e = h[5], f = h[7] + mu;
 	double det = a * (d * f - e * e) - b * (b * f - c * e) + c * (b * e - c * d);
 	if (!(fabs(det) > 0.0))
 		return -1;
-	double r0 = -H[0][3] + mu * x0[0], r1 = -H[1][3] + mu * x0[1], r2 = -H[2][3] + mu * x0[2];
+	double r0 = -h[3] + mu * x0[0], r1 = -h[6] + mu * x0[1], r2 = -h[8] + mu * x0[2];
 	out[0] = (r0 * (d * f - e * e) - b * (r1 * f - e * r2) + c * (r1 * e - d * r2)) / det;
 	out[1] = (a * (r1 * f - e * r2) - r0 * (b * f - c * e) + c * (b * r2 - r1 * c)) / det;
 	out[2] = (a * (d * r2 - r1 * e) - b * (b * r2 - r1 * c) + r0 * (b * e - c * d)) / det;
 	return isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2]) ? 0 : -1;
+}
+
+int bgm_quadric_optimum(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x0, double *out)
+{
+	double h[10];
+	bgm_quadric_pullback(g, q, inf, h);
+	return bgm_quadric_solve(h, x0, out);
 }

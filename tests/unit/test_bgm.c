@@ -504,6 +504,27 @@ TEST(prefixes_robot)
 	mlod_character_free(&c);
 }
 
+TEST(prefixes_fast_cost)
+{
+	/* The pulled-back posed cost: the same checks on every prefix, on the
+	 * robot (rigid, faceted, morphed parts) and on tubeman (skinned),
+	 * with the clip frames as poses. */
+	const char *files[2] = {"samples/RobotExpressive.glb", "samples/tubeman.glb"};
+	for (int k = 0; k < 2 && !test_failed_; k++) {
+		mlod_character c;
+		CHECK(test_load(files[k], &c) == 0);
+		mlod_pose_set poses = {0};
+		CHECK_OK(mlod_pose_set_make(&c, 0, 4, 0, 0, 0.0f, &poses, &terr));
+		mlod_bgm_options opt = {0};
+		opt.fast_cost = 1;
+		opt.poses = &poses;
+		for (int i = 0; i < c.instance_count && !test_failed_; i++)
+			check_prefixes(&c, i, &opt);
+		mlod_pose_set_free(&poses);
+		mlod_character_free(&c);
+	}
+}
+
 TEST(prefixes_allow_border)
 {
 	mlod_character c;
@@ -822,6 +843,7 @@ int main(void)
 	RUN(prefixes_tubeman);
 	RUN(collapse_ops);
 	RUN(prefixes_robot);
+	RUN(prefixes_fast_cost);
 	RUN(prefixes_allow_border);
 	RUN(rigid_and_morph);
 	RUN(deterministic);
