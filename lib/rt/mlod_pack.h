@@ -205,7 +205,7 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 1
+#define MLOD_PACK_MAJOR 2
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32
 #define MLOD_PACK_TOC_ENTRY_SIZE 48
@@ -496,6 +496,15 @@ mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void
                                   const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err);
 mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
                                     const mlod_pack_skeleton *skel, mlod_pack_motion *out, mlod_error *err);
+/* A MESH level needs the blocks of every coarser MESH level (layout b2):
+ * mlod_pack_decode_mesh reads them from data (a prefix that holds the
+ * chunk holds them too). mlod_pack_decode_mesh_fetch reads each chunk
+ * through fetch instead, coarsest first: fetch(user, chunk, &bytes, err)
+ * sets bytes to the chunk's stored_size bytes (valid until the next call)
+ * or fails with a message; the decode checks them like any chunk's. */
+typedef mlod_result (*mlod_pack_fetch_fn)(void *user, uint32_t chunk, const void **bytes, mlod_error *err);
+mlod_result mlod_pack_decode_mesh_fetch(const mlod_pack *p, uint32_t chunk, mlod_pack_fetch_fn fetch, void *user,
+                                        const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err);
 /* The DOC chunk's glb bytes (*glb points into data after the CRC check;
  * the stream is stored raw). */
 mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, const void **glb, size_t *glb_size,
