@@ -1274,6 +1274,11 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 		              "the parts of the coarsest level", err));
 		if (l == 0) {
 			P = sp.count;
+			if (P * (2 * sizeof *recs0 + nlev * sizeof *blk + sizeof(mlod_pack_part)) > PACK_MAX_BLOCK) {
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "%s: %llu parts: decoding them needs more than the reader's limit",
+				              x.label, (unsigned long long)P);
+				goto fail;
+			}
 			recs0 = pk_calloc(al, P + 1, sizeof *recs0);
 			blk = pk_calloc(al, (uint64_t)nlev * P + 1, sizeof *blk);
 			if (!recs0 || !blk) {

@@ -166,7 +166,7 @@ static void write_pack(bytes *out)
 	}
 	memset(out, 0, sizeof *out);
 	put(out, "MLOD", 4);
-	put16(out, 1), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
+	put16(out, MLOD_PACK_MAJOR), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
 	put32(out, 0), put32(out, 0); /* CRCs below */
 	for (int i = 0; i < nchunks; i++) {
 		chunk *c = &chunks[i];
@@ -203,19 +203,39 @@ static void oct(const float *n, int16_t *q)
 	q[0] = (int16_t)lrintf(x * 32767), q[1] = (int16_t)lrintf(y * 32767);
 }
 
+/* The fixture's mesh levels as the pack stores them (layout b2): level
+ * 0's parts at every level (a part a coarser fixture level lacks has no
+ * vertices there), one grid per part (the union of its levels' boxes),
+ * and each level's block holding all its vertices (no vertex shared with a
+ * coarser level: the format allows it) after the coarser levels' blocks;
+ * its indices use every vertex of its block in order, so that the reader's
+ * gathered level is the fixture's, vertex for vertex. */
+static const mlod_pack_mesh *fx_levels[3];
+
+static const mlod_pack_part *level_part(uint32_t level, uint32_t i)
+{
+	return i < fx_levels[level]->part_count ? &fx_levels[level]->parts[i] : NULL;
+}
+
 static void mesh_chunk(const mlod_pack_mesh *m, uint32_t level)
 {
+	(void)m;
+	const mlod_pack_mesh *m0 = fx_levels[0];
 	chunk *c = new_chunk(MLOD_CHUNK_MESH, MLOD_LAYER_MESH, level, 0, fx_vmesh[level].error, fx_vmesh[level].distance);
 	bytes *b = stream(c, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec));
-	for (uint32_t i = 0; i < m->part_count; i++) {
-		const mlod_pack_part *p = &m->parts[i];
-		mlod_pack_part_rec r = p->rec;
-		r.index_count = r.vertex_count >= 3 ? 3 : 0;
+	for (uint32_t i = 0; i < m0->part_count; i++) {
+		mlod_pack_part_rec r = m0->parts[i].rec;
+		const mlod_pack_part *p = level_part(level, i);
+		r.vertex_count = p ? p->rec.vertex_count : 0;
+		r.index_count = (r.vertex_count + 2) / 3 * 3;
 		for (int a = 0; a < 3; a++) {
 			float lo = 1e30f, hi = -1e30f;
-			for (uint32_t v = 0; v < r.vertex_count; v++) {
-				float x = p->positions[3 * v + a];
-				lo = x < lo ? x : lo, hi = x > hi ? x : hi;
+			for (uint32_t l = 0; l < 3; l++) {
+				const mlod_pack_part *q = level_part(l, i);
+				for (uint32_t v = 0; q && v < q->rec.vertex_count; v++) {
+					float x = q->positions[3 * v + a];
+					lo = x < lo ? x : lo, hi = x > hi ? x : hi;
+				}
 			}
 			r.pos_min[a] = lo;
 			r.pos_scale[a] = (hi - lo) / 65535.0f;
@@ -223,9 +243,12 @@ static void mesh_chunk(const mlod_pack_mesh *m, uint32_t level)
 		put(b, &r, sizeof r);
 	}
 	stream_end(c);
-	for (uint32_t i = 0; i < m->part_count; i++) {
-		const mlod_pack_part *p = &m->parts[i];
+	for (uint32_t i = 0; i < m0->part_count; i++) {
+		const mlod_pack_part *p = level_part(level, i);
 		const mlod_pack_part_rec *r = (const mlod_pack_part_rec *)c->data[0].d + i;
+		uint32_t base = 0;
+		for (uint32_t l = level + 1; l < 3; l++)
+			base += level_part(l, i) ? level_part(l, i)->rec.vertex_count : 0;
 		b = stream(c, MLOD_STREAM_POSQ, 8);
 		for (uint32_t v = 0; v < r->vertex_count; v++) {
 			for (int a = 0; a < 3; a++)
@@ -265,7 +288,7 @@ static void mesh_chunk(const mlod_pack_mesh *m, uint32_t level)
 		}
 		b = stream(c, MLOD_STREAM_IDX, 4);
 		for (uint32_t k = 0; k < r->index_count; k++)
-			put32(b, k);
+			put32(b, base + (k < r->vertex_count ? k : r->vertex_count - 1));
 		stream_end(c);
 	}
 }
@@ -372,6 +395,7 @@ static void build_pack(bytes *out)
 		stream_end(c);
 	}
 	const mlod_pack_mesh *ml[3] = { &fx_mesh0, &fx_mesh1, &fx_mesh2 };
+	memcpy(fx_levels, ml, sizeof ml);
 	for (int l = 2; l >= 0; l--) {
 		mesh_chunk(ml[l], (uint32_t)l);
 		for (uint32_t clip = 0; clip < 2; clip++)
