@@ -38,6 +38,15 @@ static void *pk_calloc(const mlod_pack_alloc *a, size_t n, size_t size)
 	return p;
 }
 
+/* As pk_calloc, not zeroed: for scratch written before it is read. */
+static void *pk_malloc(const mlod_pack_alloc *a, size_t n, size_t size)
+{
+	if (size && n > SIZE_MAX / size)
+		return NULL;
+	size_t bytes = n * size > 0 ? n * size : 1;
+	return a && a->malloc && a->free ? a->malloc(a->user, bytes) : malloc(bytes);
+}
+
 static void pk_free(const mlod_pack_alloc *a, void *p)
 {
 	if (!p)
@@ -1251,14 +1260,29 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 	uint64_t P = 0;
 	mlod_pack_part_rec *recs0 = NULL; /* the coarsest level's records */
 	mblock *blk = NULL;               /* nlev * P */
-	uint8_t **lvbuf = NULL;           /* per level: its blocks */
-	uint32_t *idx = NULL, *map = NULL, *used = NULL;
-	uint8_t *gather = NULL;
+	uint8_t *blocks = NULL, *temp = NULL; /* the levels' blocks; meshopt's output */
+	uint64_t blocks_used = 0, sumraw = 0, maxraw = 0;
+	uint32_t *map = NULL, *used = NULL;
+	uint8_t *work = NULL, *gather = NULL;
 	int lev_open = 0;
 	memset(&x, 0, sizeof x);
-	lvbuf = pk_calloc(al, nlev, sizeof *lvbuf);
-	if (!lvbuf)
+	/* The chunks' raw sizes bound what their blocks and streams decode to
+	 * (cx_parse checks them): two allocations for every level. */
+	for (uint32_t l = 0; l < nlev; l++) {
+		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, top - l, 0);
+		uint64_t raw = ci >= 0 ? p->chunks[ci].raw_size : 0;
+		sumraw += raw;
+		maxraw = raw > maxraw ? raw : maxraw;
+	}
+	if (sumraw > PACK_MAX_BLOCK)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "MESH level %u: decoding it and the coarser levels needs %llu bytes, more "
+		                 "than the reader's limit", K, (unsigned long long)sumraw);
+	blocks = pk_malloc(al, 1, (size_t)sumraw + 8);
+	temp = pk_malloc(al, 1, (size_t)maxraw + 8);
+	if (!blocks || !temp) {
+		pk_free(al, blocks), pk_free(al, temp);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "MESH level %u: out of memory", K);
+	}
 	for (uint32_t l = 0; l < nlev; l++) {
 		unsigned L = top - l;
 		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, L, 0);
@@ -1296,16 +1320,11 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			cx_rewind(&x);
 			TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), P, "", "", err));
 		}
-		if (bytes > PACK_MAX_BLOCK)
-			FAIL("%s: its vertex blocks decode to %llu bytes, more than the reader's limit", x.label,
-			     (unsigned long long)bytes);
-		TRY(cx_temp(&x, 0, err));
-		lvbuf[l] = pk_calloc(al, 1, (size_t)bytes + 8);
-		if (!lvbuf[l]) {
-			r = mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for %llu bytes", x.label, (unsigned long long)bytes);
-			goto fail;
-		}
-		uint8_t *at = lvbuf[l];
+		if (bytes > sumraw - blocks_used || x.max_decoded > maxraw)
+			FAIL("%s: internal block size mismatch", x.label);
+		x.temp = temp, x.aux = 0; /* the decode's scratch, shared by the levels (cx_done frees none) */
+		uint8_t *at = blocks + blocks_used;
+		blocks_used += bytes;
 		TRY(cx_load(&x, &sp, &src, err));
 		mlod_pack_part_rec *recs = pk_calloc(al, P + 1, sizeof *recs);
 		if (!recs) {
@@ -1384,13 +1403,14 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 		}
 		if (l + 1 < nlev) {
 			TRY(cx_end(&x, err));
+			x.temp = NULL;
 			cx_done(&x);
 			lev_open = 0;
 			pk_free(al, recs);
 			continue;
 		}
 		/* The finest level read is the one asked for: its output. */
-		uint64_t total = round8(P * sizeof(mlod_pack_part)), big_prefix = 1, big_i = 1, big_v = 1;
+		uint64_t total = round8(P * sizeof(mlod_pack_part)), big_prefix = 1, big_v = 1;
 		for (uint32_t i = 0; i < P; i++) {
 			const mlod_pack_part_rec *rc = &recs[i];
 			uint64_t V = rc->vertex_count, T = rc->target_count;
@@ -1412,7 +1432,6 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 				stride += size[a];
 			stride += 8 * T;
 			big_prefix = mb->first + mb->count > big_prefix ? mb->first + mb->count : big_prefix;
-			big_i = rc->index_count > big_i ? rc->index_count : big_i;
 			big_v = V * stride > big_v ? V * stride : big_v;
 			if (total > PACK_MAX_BLOCK || big_v > PACK_MAX_BLOCK)
 				break;
@@ -1423,11 +1442,13 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			     (unsigned long long)big_prefix);
 		}
 		r = bump_alloc(&b, &x, total, err);
-		idx = pk_calloc(al, big_i, sizeof *idx);
-		map = pk_calloc(al, big_prefix, sizeof *map);
-		used = pk_calloc(al, big_prefix, sizeof *used);
-		gather = pk_calloc(al, 1, (size_t)big_v);
-		if (r == MLOD_OK && (!idx || !map || !used || !gather))
+		work = pk_malloc(al, 1, (size_t)(8 * big_prefix + big_v + 8));
+		if (work) {
+			map = (uint32_t *)work;
+			used = map + big_prefix;
+			gather = (uint8_t *)(used + big_prefix);
+		}
+		if (r == MLOD_OK && !work)
 			r = mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory", x.label);
 		if (r != MLOD_OK) {
 			pk_free(al, recs);
@@ -1517,9 +1538,24 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			for (int a = 0; a < nvs + (int)T; a++) {
 				uint32_t es = a < nvs ? size[a] : 8;
 				uint8_t *dst = gather + aoff;
+				const uint8_t *from[64];
+				uint64_t first[64];
+				for (uint32_t q = 0; q < nlev && q < 64; q++) { /* attribute a of each level's block */
+					const mblock *bb = &blk[(uint64_t)q * P + i];
+					from[q] = bb->base + before * bb->count, first[q] = bb->first;
+				}
 				for (uint32_t v = 0; v < V; v++) {
-					const mblock *bb = &blk[(uint64_t)map[v] * P + i];
-					memcpy(dst + (size_t)v * es, bb->base + before * bb->count + (used[v] - bb->first) * es, es);
+					const uint8_t *sv;
+					if (map[v] < 64) {
+						sv = from[map[v]] + (used[v] - first[map[v]]) * es;
+					} else {
+						const mblock *bb = &blk[(uint64_t)map[v] * P + i];
+						sv = bb->base + before * bb->count + (used[v] - bb->first) * es;
+					}
+					if (es == 4)
+						memcpy(dst + (size_t)v * 4, sv, 4);
+					else
+						memcpy(dst + (size_t)v * 8, sv, 8);
 				}
 				if (a < nvs)
 					g[a] = dst;
@@ -1600,6 +1636,7 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			}
 		}
 		TRY(cx_end(&x, err));
+		x.temp = NULL;
 		cx_done(&x);
 		lev_open = 0;
 		out->part_count = (uint32_t)P;
@@ -1609,18 +1646,16 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 	}
 	r = MLOD_OK;
 fail:
-	if (lev_open)
+	if (lev_open) {
+		x.temp = NULL;
 		cx_done(&x);
+	}
 	pk_free(al, b.base);
-	for (uint32_t l = 0; l < nlev; l++)
-		pk_free(al, lvbuf[l]);
-	pk_free(al, lvbuf);
+	pk_free(al, blocks);
+	pk_free(al, temp);
 	pk_free(al, recs0);
 	pk_free(al, blk);
-	pk_free(al, idx);
-	pk_free(al, map);
-	pk_free(al, used);
-	pk_free(al, gather);
+	pk_free(al, work);
 	return r;
 }
 
