@@ -659,6 +659,24 @@ static mlod_result cx_load(cx *x, const stream *s, const uint8_t **out, mlod_err
 	return MLOD_OK;
 }
 
+/* The stream's decoded bytes written to dst (count * element size bytes):
+ * a copy of a raw stream, or the meshopt decoder's output in place. */
+static mlod_result cx_load_into(cx *x, const stream *s, uint8_t *dst, mlod_error *err)
+{
+	if (s->codec == MLOD_SCODEC_RAW) {
+		if (s->count)
+			memcpy(dst, s->src, (size_t)s->count * s->elsize);
+		return MLOD_OK;
+	}
+	int rc = s->codec == MLOD_SCODEC_MESHOPT_VERTEX
+	                 ? meshopt_decodeVertexBuffer(dst, s->count, s->elsize, s->src, s->stored)
+	                 : meshopt_decodeIndexBuffer(dst, s->count, s->elsize, s->src, s->stored);
+	if (rc != 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': the meshopt %s codec failed (%d)", x->label,
+		                 s->index, tagn(s->tag).s, s->codec == MLOD_SCODEC_MESHOPT_VERTEX ? "vertex" : "index", rc);
+	return MLOD_OK;
+}
+
 /* The block: one allocation carved into 8-aligned arrays, after a head
  * that records the allocator that made it (for the *_free calls). */
 enum { BLOCK_HEAD = 32 };
@@ -1363,11 +1381,8 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 				if (r == MLOD_OK && a == 0)
 					mb->count = s.count;
 				if (r == MLOD_OK)
-					r = cx_load(&x, &s, &src, err);
-				if (r == MLOD_OK && (uint64_t)s.count * size[a] > 0) {
-					memcpy(mb->base + off, src, (size_t)s.count * size[a]);
-					off += (uint64_t)s.count * size[a];
-				}
+					r = cx_load_into(&x, &s, mb->base + off, err);
+				off += (uint64_t)s.count * size[a];
 			}
 			if (r != MLOD_OK)
 				break;
@@ -1380,11 +1395,8 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 				snprintf(twhat, sizeof twhat, "part %u target %u", i, t);
 				r = cx_expect(&x, &s, MLOD_STREAM_MTPQ, 8, mb->count, twhat, "the block's vertex count", err);
 				if (r == MLOD_OK)
-					r = cx_load(&x, &s, &src, err);
-				if (r == MLOD_OK && s.count) {
-					memcpy(mb->base + off, src, (size_t)s.count * 8);
-					off += (uint64_t)s.count * 8;
-				}
+					r = cx_load_into(&x, &s, mb->base + off, err);
+				off += (uint64_t)s.count * 8;
 			}
 			at += round8(off);
 			if (r != MLOD_OK || l + 1 < nlev)
