@@ -829,6 +829,54 @@ TEST(mutations)
 	CHECK(opened > 0, "no mutated pack opened: the CRC-fixed half should reach the decoders");
 }
 
+/* A read source loads a MESH level by reading its chunk and every coarser
+ * MESH chunk again through the callback (layout b2: the level's indices
+ * refer to the coarser levels' vertex blocks), one after the other, and
+ * keeps nothing of them; with a budget, through the callback too, the
+ * resident bytes never pass it. */
+TEST(read_source_rereads_coarser_mesh)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_read(mem_read, &pack, pack.n, NULL, &ctx, &e), e);
+	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MESH, 0, 0, &e), e);
+	int before = reads;
+	uint32_t loaded = 0;
+	CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, &loaded, &e), e);
+	CHECK(loaded == 1 && reads - before == 3, "%u loads, %d reads (MESH levels 2, 1 and 0 expected)", loaded,
+	      reads - before);
+	CHECK(mlod_rt_mesh_vertex_count(ctx, 0) == 7 && mlod_rt_mesh_part_count(ctx, 0) == 3,
+	      "level 0: %u vertices, %u parts", mlod_rt_mesh_vertex_count(ctx, 0), mlod_rt_mesh_part_count(ctx, 0));
+	mlod_rt_close(ctx);
+	mlod_rt_stats s;
+	CHECK_OK(mlod_rt_open_read(mem_read, &pack, pack.n, NULL, &ctx, &e), e);
+	mlod_rt_stats_get(ctx, &s);
+	const size_t at_open = s.resident_bytes; /* the coarse levels and the staging buffer */
+	mlod_rt_close(ctx);
+	for (size_t extra = 0; extra <= 8000; extra += 1000) {
+		mlod_rt_config cfg = { at_open + extra, 16, NULL };
+		CHECK_OK(mlod_rt_open_read(mem_read, &pack, pack.n, &cfg, &ctx, &e), e);
+		mlod_rt_select sel;
+		mlod_rt_select_default(&sel);
+		uint32_t ids[4];
+		float d[4];
+		for (int i = 0; i < 4; i++)
+			CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)i % 2, 0, MLOD_RT_LOOP, &ids[i], &e), e);
+		for (int f = 0; f < 30; f++) {
+			for (int i = 0; i < 4; i++)
+				d[i] = (float)((i * 37 + f * 11) % 200);
+			CHECK_OK(mlod_rt_update(ctx, &sel, ids, d, 4, 0.05f, &e), e);
+			CHECK_OK(mlod_rt_stream(ctx, 4096, NULL, &e), e);
+			mlod_rt_stats_get(ctx, &s);
+			CHECK(s.peak_resident_bytes <= at_open + extra, "budget %zu: peak %zu", at_open + extra,
+			      s.peak_resident_bytes);
+			for (int i = 0; i < 4; i++) /* always some level to show */
+				CHECK(mlod_rt_instance_state(ctx, ids[i])->level[MLOD_RT_MESH] < 3, "instance %d has no mesh level", i);
+		}
+		mlod_rt_close(ctx);
+	}
+}
+
 TEST(pack_budget)
 {
 	mlod_error e;
@@ -870,6 +918,7 @@ int main(void)
 	printf("# pack of %zu bytes, %d chunks\n", pack.n, nchunks);
 	RUN(pack_equals_views);
 	RUN(pack_poses_as_its_decoded_views);
+	RUN(read_source_rereads_coarser_mesh);
 	RUN(pack_budget);
 	RUN(hooks_only);
 	RUN(truncated_prefixes);
