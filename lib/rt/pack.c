@@ -11,6 +11,11 @@
  * (freed before the decode returns); raw streams are read in place.
  * Every allocation is the pack's allocator's (mlod_pack_open_alloc; malloc
  * by default), and a block starts with that allocator, for *_free.
+ * A MESH level (layout b2, mlod(5)) also decodes the vertex blocks of every
+ * coarser MESH chunk, each checked like any chunk, into scratch sized from
+ * their TOC raw sizes (freed before the decode returns), then gathers the
+ * vertices its indices use; its block is sized from its part records,
+ * whose vertex counts the gathering must meet exactly.
  *
  * Byte order: the format is little-endian, and so must the host be (the
  * index codec's output and the records are read with memcpy); the
