@@ -1283,8 +1283,8 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 	uint64_t P = 0;
 	mlod_pack_part_rec *recs0 = NULL; /* the coarsest level's records */
 	mblock *blk = NULL;               /* nlev * P */
-	uint8_t *blocks = NULL, *temp = NULL; /* the levels' blocks; meshopt's output */
-	uint64_t blocks_used = 0, sumraw = 0, maxraw = 0;
+	uint8_t *blocks = NULL, *temp = NULL; /* the levels' blocks; meshopt's output of the other streams */
+	uint64_t blocks_used = 0, sumraw = 0, maxraw = 0, temp_cap = 0;
 	uint32_t *map = NULL, *used = NULL;
 	uint8_t *work = NULL, *gather = NULL;
 	int lev_open = 0;
@@ -1301,11 +1301,8 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 		return mlod_fail(err, MLOD_ERR_NOMEM, "MESH level %u: decoding it and the coarser levels needs %llu bytes, more "
 		                 "than the reader's limit", K, (unsigned long long)sumraw);
 	blocks = pk_malloc(al, 1, (size_t)sumraw + 8);
-	temp = pk_malloc(al, 1, (size_t)maxraw + 8);
-	if (!blocks || !temp) {
-		pk_free(al, blocks), pk_free(al, temp);
+	if (!blocks)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "MESH level %u: out of memory", K);
-	}
 	for (uint32_t l = 0; l < nlev; l++) {
 		unsigned L = top - l;
 		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, L, 0);
@@ -1335,16 +1332,28 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 		}
 		/* Size this level's blocks from the stream headers. */
 		uint64_t bytes = 0;
+		/* meshopt's output of the streams not decoded into a block: 'PART'
+		 * (read above), 'IDX ' and 'MTSC' */
+		uint64_t need = sp.codec != MLOD_SCODEC_RAW ? (uint64_t)sp.count * sp.elsize : 0;
 		{
 			stream t;
 			while (cx_next(&x, &t))
-				if (t.tag != MLOD_STREAM_IDX && t.tag != MLOD_STREAM_MTSC)
+				if (t.tag != MLOD_STREAM_IDX && t.tag != MLOD_STREAM_MTSC && t.tag != MLOD_STREAM_PART)
 					bytes += round8((uint64_t)t.count * t.elsize);
+				else if (t.codec != MLOD_SCODEC_RAW && (uint64_t)t.count * t.elsize > need)
+					need = (uint64_t)t.count * t.elsize;
 			cx_rewind(&x);
 			TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), P, "", "", err));
 		}
-		if (bytes > sumraw - blocks_used || x.max_decoded > maxraw)
+		if (bytes > sumraw - blocks_used || need > maxraw)
 			FAIL("%s: internal block size mismatch", x.label);
+		if (need > temp_cap) {
+			pk_free(al, temp);
+			temp_cap = 0;
+			if (!(temp = pk_malloc(al, 1, (size_t)need + 8)))
+				FAIL("%s: out of memory for %llu bytes of scratch", x.label, (unsigned long long)need);
+			temp_cap = need;
+		}
 		x.temp = temp, x.aux = 0; /* the decode's scratch, shared by the levels (cx_done frees none) */
 		uint8_t *at = blocks + blocks_used;
 		blocks_used += bytes;
