@@ -12,24 +12,28 @@
  * weights u8, morph target deltas) and its streams coded with meshopt
  * 0.18, each padded to 4 bytes as stored. Two layouts:
  *
- *   (a) what the pack stores: each level of each part its own vertex and
- *       index streams, quantised to that level's own box, in the best of
- *       the writer's three orders (mlod_pack_vertex_order). Checked
- *       against the MESH chunks mlod_pack_write makes of the same input
- *       (their streams but 'PART', same padding): the two must agree.
+ *   (a) what the pack stored up to format 1.x: each level of each part its
+ *       own vertex and index streams, quantised to that level's own box,
+ *       in the best of the writer's three orders (mlod_pack_vertex_order).
  *   (b) per part one vertex buffer: the coarsest level's vertices, then
  *       each finer level's vertices that are not bit-identical (all
  *       quantised attributes) to one already in the buffer, appended in
  *       level order; one index buffer per level into that prefix. All
- *       levels of a part share one grid: the union of the levels' boxes
- *       (positions, UVs; morph deltas: the largest |delta| of any level).
+ *       levels of a part share one grid, the writer's: the union of the
+ *       levels' boxes at level 0's steps, or at the union's 16-bit steps
+ *       where it is wider than 65535 of them (positions, UVs; morph
+ *       deltas: the largest |delta| of any level).
  *       Within a level's appended block the vertices follow one of the
  *       writer's three orders applied to that level's triangles, chosen
  *       level by level, coarsest first: the one that codes the block and
- *       the level's indices to the fewest bytes. Coded two ways: b1 the whole buffer as one meshopt vertex
- *       stream per attribute (a reader must have every level before it
- *       can decode any), b2 each level's appended block as its own
- *       streams (streamable coarse to fine, as the pack's chunks are).
+ *       the level's indices to the fewest bytes. Coded two ways: b1 the
+ *       whole buffer as one meshopt vertex stream per attribute (a reader
+ *       must have every level before it can decode any), b2 each level's
+ *       appended block as its own streams (streamable coarse to fine, as
+ *       the pack's chunks are). b2 is what the pack stores since format
+ *       2.0 (mlod(5) MESH levels): checked against the MESH chunks
+ *       mlod_pack_write makes of the same input (their streams but 'PART',
+ *       same padding), the two must agree.
  *
  * Per input: stream bytes of (a), of (a) quantised on (b)'s grid (what
  * the grid alone changes), b1 and b2; unique vertices of (b)
@@ -535,8 +539,10 @@ static uint32_t *append_level(vset *set, uint8_t *G, uint32_t *count, const uint
 	return idx;
 }
 
-/* (b)'s grid for every level of a part: level 0's steps from the corner
- * of the union of the levels' boxes (see the top). */
+/* (b)'s grid for every level of a part, the writer's (lib/pack/packwrite.c
+ * part_grid): level 0's steps from the corner of the union of the levels'
+ * boxes, or the union's 16-bit steps where the union is wider than 65535
+ * of level 0's; morph deltas: the largest |delta| of any level. */
 static grid shared_grid(const mlod_primitive *const *lv, int n, totals *T)
 {
 	grid g = {0}, g0 = {0};
@@ -544,6 +550,18 @@ static grid shared_grid(const mlod_primitive *const *lv, int n, totals *T)
 	g0.tscale = xmalloc(sizeof(float) * ((size_t)lv[0]->target_count + 1));
 	make_grid(&g, lv, n);
 	make_grid(&g0, lv, 1);
+	float pmx[3] = {0, 0, 0}, umx[MLOD_PACK_MAX_UV][2] = {{0}};
+	for (int k = 0; k < n; k++) /* the union's upper corner */
+		for (int v = 0; v < lv[k]->vertex_count; v++) {
+			int first = k == 0 && v == 0;
+			for (int a = 0; a < 3; a++)
+				if (first || lv[k]->positions[3 * v + a] > pmx[a])
+					pmx[a] = lv[k]->positions[3 * v + a];
+			for (int s = 0; s < uv_sets(lv[0]); s++)
+				for (int a = 0; a < 2; a++)
+					if (first || lv[k]->uvs[s][2 * v + a] > umx[s][a])
+						umx[s][a] = lv[k]->uvs[s][2 * v + a];
+		}
 	/* Level 0's steps from the union's corner: every level at the finest
 	 * level's precision; a union wider than level 0's box takes codes
 	 * past 2^bits - 1, which the u16 holds. */
@@ -552,17 +570,15 @@ static grid shared_grid(const mlod_primitive *const *lv, int n, totals *T)
 		wider |= g.pscale[a] != g0.pscale[a];
 		if (g0.pscale[a] > 0.0f && g.pscale[a] / g0.pscale[a] > T->widest)
 			T->widest = g.pscale[a] / g0.pscale[a];
-		if (g0.pscale[a] > 0.0f)
-			g.pscale[a] = g0.pscale[a];
+		float s16 = mlod_pack_range_scale_bits(g.pmin[a], pmx[a], 16);
+		g.pscale[a] = g0.pscale[a] > s16 ? g0.pscale[a] : s16;
 	}
 	T->union_wider += wider;
 	for (int s = 0; s < uv_sets(lv[0]); s++)
-		for (int a = 0; a < 2; a++)
-			if (g0.uscale[s][a] > 0.0f)
-				g.uscale[s][a] = g0.uscale[s][a];
-	for (int t = 0; t < lv[0]->target_count; t++)
-		if (g0.tscale[t] > 0.0f)
-			g.tscale[t] = g0.tscale[t];
+		for (int a = 0; a < 2; a++) {
+			float s16 = mlod_pack_range_scale_bits(g.umin[s][a], umx[s][a], 16);
+			g.uscale[s][a] = g0.uscale[s][a] > s16 ? g0.uscale[s][a] : s16;
+		}
 	free(g0.tscale);
 	return g;
 }
@@ -753,7 +769,8 @@ static void layout_c(const mlod_mesh_levels *ML, int instance, int primitive, co
 }
 
 /* The stream bytes of the MESH chunks mlod_pack_write makes (but 'PART'),
- * padded as stored: what (a) must come to. */
+ * padded as stored: what (b2), the pack's layout since format 2.0, must
+ * come to. */
 static size_t packed_mesh_bytes(const char *path, int *levels)
 {
 	FILE *f = fopen(path, "rb");
@@ -947,9 +964,9 @@ int main(int argc, char **argv)
 		       " %.0f us, %.0f MB/s | %.0f us (%ld vertices) |\n",
 		       name, T.levels, T.parts, T.a, T.ag, T.b1, T.b2, r, T.verts_a, T.unique_b,
 		       100.0 * (double)T.unique_b / (double)T.verts_a, ua, ma, u1, m1, u2, m2, ux, gathered);
-		if (packed != T.a || packed_levels != T.levels) {
-			fprintf(stderr, "bench_layout: %s: (a) computed %zu bytes over %d levels, the pack's MESH streams %zu over %d\n",
-			        name, T.a, T.levels, packed, packed_levels);
+		if (packed != T.b2 || packed_levels != T.levels) {
+			fprintf(stderr, "bench_layout: %s: (b2) computed %zu bytes over %d levels, the pack's MESH streams %zu over %d\n",
+			        name, T.b2, T.levels, packed, packed_levels);
 			return 3;
 		}
 		/* per level: (b)'s prefix against what the level uses */

@@ -309,6 +309,10 @@ struct ctx {
 	float mesh_error[MLOD_MESH_MAX_LEVELS];
 	mlod_mesh_levels ML;
 	int has_ML;
+	struct mpart *mp;          /* the parts of layout b2 (mesh_parts) */
+	int mp_count, mp_ready;
+	int **lmaps;               /* per level and instance: level_joint_map, or NULL */
+	int lmap_count;
 	/* motion */
 	struct clip_levels *clips;
 	mlod_motion_level *owned_levels;
@@ -813,207 +817,6 @@ static mlod_result mesh_levels(struct ctx *x)
 	return MLOD_OK;
 }
 
-/* One part: a triangle primitive of an instance at one level. jmap maps
- * the primitive's joint indices to the full skin's (NULL: as they are). */
-struct part {
-	mlod_pack_part_rec rec;
-	const mlod_primitive *p;
-	const int *jmap;
-	int jmap_count;
-};
-
-/* Adds a per-vertex stream in the part's stored order (remap[old] = new). */
-static void cb_add_vertices(chunkb *cb, uint32_t tag, uint32_t nv, uint16_t size, const void *data,
-                            const uint32_t *remap, void *scratch)
-{
-	if (nv)
-		meshopt_remapVertexBuffer(scratch, data, nv, size, remap);
-	cb_add(cb, tag, nv, size, scratch, 0);
-}
-
-static void add_part_streams(struct ctx *x, chunkb *cb, struct part *pt, int order)
-{
-	const mlod_primitive *p = pt->p;
-	mlod_pack_part_rec *rec = &pt->rec;
-	uint32_t nv = (uint32_t)p->vertex_count;
-	size_t cap = (size_t)nv + 1;
-	void *tmp = malloc(16 * cap > (size_t)p->index_count * 4 + 4 ? 16 * cap : (size_t)p->index_count * 4 + 4);
-	void *perm = malloc(16 * cap);
-	uint32_t *remap = malloc(sizeof *remap * cap);
-	/* Indices (a primitive without them gets 0, 1, 2, ...), and the
-	 * stored order (mlod_pack_vertex_order). */
-	uint32_t ni = p->index_count > 0 ? (uint32_t)p->index_count : nv;
-	ni -= ni % 3;
-	uint32_t *i32 = malloc(sizeof(uint32_t) * ((size_t)ni + 1));
-	uint32_t *in32 = malloc(sizeof(uint32_t) * ((size_t)ni + 1));
-	if (!tmp || !perm || !remap || !i32 || !in32) {
-		free(tmp), free(perm), free(remap), free(i32), free(in32);
-		cb->fail = 1;
-		return;
-	}
-	for (uint32_t i = 0; i < ni; i++)
-		in32[i] = p->index_count > 0 ? p->indices[i] : i;
-	if (mlod_pack_vertex_order(order, in32, ni, nv, remap, i32) != 0) {
-		free(tmp), free(perm), free(remap), free(i32), free(in32);
-		cb->fail = 1;
-		return;
-	}
-	free(in32);
-	/* Positions. */
-	float mn[3] = {0, 0, 0}, mx[3] = {0, 0, 0};
-	for (uint32_t v = 0; v < nv; v++)
-		for (int a = 0; a < 3; a++) {
-			float f = p->positions[3 * v + a];
-			if (v == 0 || f < mn[a])
-				mn[a] = f;
-			if (v == 0 || f > mx[a])
-				mx[a] = f;
-		}
-	for (int a = 0; a < 3; a++) {
-		rec->pos_min[a] = mn[a];
-		rec->pos_scale[a] = mlod_pack_range_scale_bits(mn[a], mx[a], x->opt->position_bits);
-	}
-	uint16_t *q16 = tmp;
-	for (uint32_t v = 0; v < nv; v++) {
-		for (int a = 0; a < 3; a++)
-			q16[4 * v + a] = mlod_pack_qu16(p->positions[3 * v + a], mn[a], rec->pos_scale[a]);
-		q16[4 * v + 3] = 0;
-	}
-	cb_add_vertices(cb, MLOD_STREAM_POSQ, nv, 8, tmp, remap, perm);
-	int16_t *s16 = tmp;
-	if (p->normals) {
-		rec->flags |= MLOD_PART_NORMALS;
-		for (uint32_t v = 0; v < nv; v++)
-			mlod_pack_oct_encode_bits(p->normals + 3 * v, x->opt->normal_bits, s16 + 2 * v);
-		cb_add_vertices(cb, MLOD_STREAM_NRMQ, nv, 4, tmp, remap, perm);
-	}
-	if (p->tangents) {
-		rec->flags |= MLOD_PART_TANGENTS;
-		for (uint32_t v = 0; v < nv; v++) {
-			mlod_pack_oct_encode_bits(p->tangents + 4 * v, x->opt->normal_bits, s16 + 4 * v);
-			s16[4 * v + 2] = p->tangents[4 * v + 3] < 0.0f ? -32767 : 32767;
-			s16[4 * v + 3] = 0;
-		}
-		cb_add_vertices(cb, MLOD_STREAM_TANQ, nv, 8, tmp, remap, perm);
-	}
-	int sets = p->uv_set_count < MLOD_PACK_MAX_UV ? p->uv_set_count : MLOD_PACK_MAX_UV;
-	rec->uv_sets = (uint32_t)sets;
-	for (int s = 0; s < sets; s++) {
-		float umn[2] = {0, 0}, umx[2] = {0, 0};
-		for (uint32_t v = 0; v < nv; v++)
-			for (int a = 0; a < 2; a++) {
-				float f = p->uvs[s][2 * v + a];
-				if (v == 0 || f < umn[a])
-					umn[a] = f;
-				if (v == 0 || f > umx[a])
-					umx[a] = f;
-			}
-		for (int a = 0; a < 2; a++) {
-			rec->uv_min[s][a] = umn[a];
-			rec->uv_scale[s][a] = mlod_pack_range_scale_bits(umn[a], umx[a], x->opt->uv_bits);
-		}
-		for (uint32_t v = 0; v < nv; v++)
-			for (int a = 0; a < 2; a++)
-				q16[2 * v + a] = mlod_pack_qu16(p->uvs[s][2 * v + a], umn[a], rec->uv_scale[s][a]);
-		cb_add_vertices(cb, MLOD_STREAM_UVQ0 + ((uint32_t)s << 24), nv, 4, tmp, remap, perm);
-	}
-	if (p->color_set_count > 0) {
-		uint8_t *u8 = tmp;
-		rec->flags |= MLOD_PART_COLORS;
-		for (uint32_t v = 0; v < 4 * nv; v++) {
-			float f = p->colors[0][v];
-			f = f > 0.0f ? (f < 1.0f ? f : 1.0f) : 0.0f;
-			u8[v] = (uint8_t)lrintf(f * 255.0f);
-		}
-		cb_add_vertices(cb, MLOD_STREAM_COLQ, nv, 4, tmp, remap, perm);
-	}
-	if (rec->skin >= 0 && p->weight_set_count > 0) {
-		const mlod_skin *sk = &x->v.skeleton.skins[rec->skin];
-		int wide = sk->joint_count > 256;
-		uint16_t *jj = malloc(sizeof(uint16_t) * 4 * cap);
-		uint8_t *ww = malloc(4 * cap);
-		if (!jj || !ww) {
-			free(jj);
-			free(ww);
-			free(tmp), free(perm), free(remap), free(i32);
-			cb->fail = 1;
-			return;
-		}
-		rec->flags |= MLOD_PART_SKINNED | (wide ? MLOD_PART_JOINTS16 : 0);
-		for (uint32_t v = 0; v < nv; v++) {
-			int bj[4];
-			float bw[4];
-			mlod_pack_top4(p, v, pt->jmap, pt->jmap_count, bj, bw);
-			uint8_t q[4];
-			mlod_pack_weights8(bw, q);
-			for (int t = 0; t < 4; t++) {
-				int jt = q[t] ? bj[t] : 0;
-				if (jt < 0 || jt >= sk->joint_count)
-					jt = 0;
-				jj[4 * v + t] = (uint16_t)jt;
-				ww[4 * v + t] = q[t];
-			}
-		}
-		if (wide) {
-			cb_add_vertices(cb, MLOD_STREAM_JN16, nv, 8, jj, remap, perm);
-		} else {
-			uint8_t *j8 = tmp;
-			for (uint32_t i = 0; i < 4 * nv; i++)
-				j8[i] = (uint8_t)jj[i];
-			cb_add_vertices(cb, MLOD_STREAM_JNT8, nv, 4, j8, remap, perm);
-		}
-		cb_add_vertices(cb, MLOD_STREAM_WGT8, nv, 4, ww, remap, perm);
-		free(jj);
-		free(ww);
-	}
-	rec->index_count = ni;
-	if (nv <= 65536) {
-		uint16_t *i16 = (uint16_t *)i32; /* in place, front to back */
-		rec->flags |= MLOD_PART_INDEX16;
-		for (uint32_t i = 0; i < ni; i++)
-			i16[i] = (uint16_t)i32[i];
-		cb_add(cb, MLOD_STREAM_IDX, ni, 2, i16, 1);
-	} else {
-		cb_add(cb, MLOD_STREAM_IDX, ni, 4, i32, 1);
-	}
-	free(i32);
-	/* Morph target positions. */
-	int nt = p->target_count;
-	rec->target_count = (uint32_t)nt;
-	if (nt > 0) {
-		float *scale = malloc(sizeof(float) * (size_t)nt);
-		if (!scale) {
-			free(tmp), free(perm), free(remap);
-			cb->fail = 1;
-			return;
-		}
-		for (int t = 0; t < nt; t++) {
-			float m = 0.0f;
-			const float *d = p->targets[t].positions;
-			for (uint32_t i = 0; d && i < 3 * nv; i++)
-				m = fabsf(d[i]) > m ? fabsf(d[i]) : m;
-			scale[t] = m > 0.0f ? (float)(m / (ldexp(1.0, x->opt->position_bits - 1) - 1.0)) : 0.0f;
-		}
-		cb_add(cb, MLOD_STREAM_MTSC, (uint32_t)nt, 4, scale, 0);
-		for (int t = 0; t < nt; t++) {
-			const float *d = p->targets[t].positions;
-			for (uint32_t v = 0; v < nv; v++) {
-				for (int a = 0; a < 3; a++) {
-					float f = d && scale[t] > 0.0f ? d[3 * v + a] / scale[t] : 0.0f;
-					f = f > 32767.0f ? 32767.0f : f < -32767.0f ? -32767.0f : f;
-					s16[4 * v + a] = (int16_t)lrintf(f);
-				}
-				s16[4 * v + 3] = 0;
-			}
-			cb_add_vertices(cb, MLOD_STREAM_MTPQ, nv, 8, tmp, remap, perm);
-		}
-		free(scale);
-	}
-	free(tmp);
-	free(perm);
-	free(remap);
-}
-
 /* The meshopt-coded bytes of the streams from `from` on. */
 static size_t cb_coded_bytes(const chunkb *cb, int from)
 {
@@ -1057,28 +860,282 @@ static size_t cb_coded_bytes(const chunkb *cb, int from)
 	return total;
 }
 
-/* A part's streams in the order (mlod_pack_vertex_order) that codes to
- * the fewest bytes; input order with codec none. */
-static void add_part(struct ctx *x, chunkb *cb, struct part *pt)
+/* ------------------------------------------------------------------ */
+/* Layout b2 (mlod(5) MESH levels): per part one buffer of quantised     */
+/* vertices on one grid, each vertex placed by the coarsest level that   */
+/* has it; MESH level k carries its block of new vertices and its        */
+/* indices into the buffer's prefix. The chunks are made coarsest first. */
+/* ------------------------------------------------------------------ */
+
+/* A part's vertex attribute in the interleaved working buffer. */
+typedef struct mattr {
+	uint32_t tag;
+	uint16_t size;
+	int off;
+} mattr;
+
+/* One part: a triangle primitive of an instance, at every level. jmap
+ * maps a level primitive's joint indices to the full skin's (NULL: as
+ * they are). */
+struct mpart {
+	mlod_pack_part_rec rec; /* the level-independent fields and the grid */
+	const mlod_primitive *lv[MLOD_MESH_MAX_LEVELS + 1];
+	const int *jmap[MLOD_MESH_MAX_LEVELS + 1];
+	int jmap_count[MLOD_MESH_MAX_LEVELS + 1];
+	float *tscale;          /* per morph target */
+	mattr *attr;
+	int nattr, ntargets, stride, skinned, wide;
+	uint8_t *G;             /* the buffer, interleaved */
+	uint32_t count;
+	uint32_t *slot;         /* hash set of G's vertices: id + 1, 0 empty */
+	size_t slot_cap;
+};
+
+/* The attributes a level primitive has (the part's skin, -1 none). */
+static uint32_t prim_signature(const mlod_primitive *p, int skin)
 {
-	if (x->opt->codec != MLOD_CODEC_MESHOPT) {
-		add_part_streams(x, cb, pt, 0);
+	int sets = p->uv_set_count < MLOD_PACK_MAX_UV ? p->uv_set_count : MLOD_PACK_MAX_UV;
+	return (p->normals ? 1u : 0u) | (p->tangents ? 2u : 0u) | (p->color_set_count > 0 ? 4u : 0u) |
+	       (skin >= 0 && p->weight_set_count > 0 ? 8u : 0u) | (uint32_t)sets << 4 | (uint32_t)p->target_count << 8;
+}
+
+/* The grid of every level of a part: the union of the levels' boxes,
+ * level 0's steps (positions_bits and uv_bits of level 0's box); a union
+ * wider than 65535 such steps takes the union's 16-bit steps. Morph
+ * deltas: the largest |delta| of any level. bench/bench_layout makes the
+ * same grid (mlod_pack_b2_grid). */
+static void part_grid(struct ctx *x, struct mpart *m, int M)
+{
+	const mlod_primitive *p0 = m->lv[0];
+	float mn[3], mx[3], mn0[3], mx0[3];
+	for (int k = 0; k < M; k++) {
+		const mlod_primitive *p = m->lv[k];
+		for (int v = 0; v < p->vertex_count; v++)
+			for (int a = 0; a < 3; a++) {
+				float f = p->positions[3 * v + a];
+				int first = k == 0 && v == 0;
+				if (first || f < mn[a])
+					mn[a] = f;
+				if (first || f > mx[a])
+					mx[a] = f;
+				if (k == 0)
+					mn0[a] = first || f < mn0[a] ? f : mn0[a], mx0[a] = first || f > mx0[a] ? f : mx0[a];
+			}
+	}
+	for (int a = 0; a < 3; a++) {
+		float s0 = mlod_pack_range_scale_bits(mn0[a], mx0[a], x->opt->position_bits);
+		float s16 = mlod_pack_range_scale_bits(mn[a], mx[a], 16);
+		m->rec.pos_min[a] = mn[a];
+		m->rec.pos_scale[a] = s0 > s16 ? s0 : s16;
+	}
+	for (int s = 0; s < (int)m->rec.uv_sets; s++) {
+		float umn[2], umx[2], umn0[2], umx0[2];
+		for (int k = 0; k < M; k++) {
+			const mlod_primitive *p = m->lv[k];
+			for (int v = 0; v < p->vertex_count; v++)
+				for (int a = 0; a < 2; a++) {
+					float f = p->uvs[s][2 * v + a];
+					int first = k == 0 && v == 0;
+					if (first || f < umn[a])
+						umn[a] = f;
+					if (first || f > umx[a])
+						umx[a] = f;
+					if (k == 0)
+						umn0[a] = first || f < umn0[a] ? f : umn0[a],
+						umx0[a] = first || f > umx0[a] ? f : umx0[a];
+				}
+		}
+		for (int a = 0; a < 2; a++) {
+			float s0 = mlod_pack_range_scale_bits(umn0[a], umx0[a], x->opt->uv_bits);
+			float s16 = mlod_pack_range_scale_bits(umn[a], umx[a], 16);
+			m->rec.uv_min[s][a] = umn[a];
+			m->rec.uv_scale[s][a] = s0 > s16 ? s0 : s16;
+		}
+	}
+	for (int t = 0; t < m->ntargets; t++) {
+		float mt = 0.0f;
+		for (int k = 0; k < M; k++) {
+			const float *d = m->lv[k]->targets[t].positions;
+			for (int i = 0; d && i < 3 * m->lv[k]->vertex_count; i++)
+				mt = fabsf(d[i]) > mt ? fabsf(d[i]) : mt;
+		}
+		m->tscale[t] = mt > 0.0f ? (float)(mt / (ldexp(1.0, x->opt->position_bits - 1) - 1.0)) : 0.0f;
+	}
+	(void)p0;
+}
+
+/* Level k's vertices quantised on the part's grid into V (interleaved). */
+static void part_quantise(struct ctx *x, const struct mpart *m, int k, uint8_t *V)
+{
+	const mlod_primitive *p = m->lv[k];
+	const mlod_pack_part_rec *rec = &m->rec;
+	int nv = p->vertex_count;
+	memset(V, 0, (size_t)nv * (size_t)m->stride);
+	for (int v = 0; v < nv; v++) {
+		uint8_t *o = V + (size_t)v * (size_t)m->stride;
+		int a = 0;
+		uint16_t q[4] = {0, 0, 0, 0};
+		for (int c = 0; c < 3; c++)
+			q[c] = mlod_pack_qu16(p->positions[3 * v + c], rec->pos_min[c], rec->pos_scale[c]);
+		memcpy(o + m->attr[a++].off, q, 8);
+		if (p->normals) {
+			int16_t s[2];
+			mlod_pack_oct_encode_bits(p->normals + 3 * v, x->opt->normal_bits, s);
+			memcpy(o + m->attr[a++].off, s, 4);
+		}
+		if (p->tangents) {
+			int16_t s[4] = {0, 0, 0, 0};
+			mlod_pack_oct_encode_bits(p->tangents + 4 * v, x->opt->normal_bits, s);
+			s[2] = p->tangents[4 * v + 3] < 0.0f ? -32767 : 32767;
+			memcpy(o + m->attr[a++].off, s, 8);
+		}
+		for (uint32_t s = 0; s < rec->uv_sets; s++) {
+			uint16_t u[2];
+			for (int c = 0; c < 2; c++)
+				u[c] = mlod_pack_qu16(p->uvs[s][2 * v + c], rec->uv_min[s][c], rec->uv_scale[s][c]);
+			memcpy(o + m->attr[a++].off, u, 4);
+		}
+		if (p->color_set_count > 0) {
+			uint8_t *u8 = o + m->attr[a++].off;
+			for (int c = 0; c < 4; c++) {
+				float f = p->colors[0][4 * v + c];
+				f = f > 0.0f ? (f < 1.0f ? f : 1.0f) : 0.0f;
+				u8[c] = (uint8_t)lrintf(f * 255.0f);
+			}
+		}
+		if (m->skinned) {
+			int joints = x->v.skeleton.skins[rec->skin].joint_count;
+			int bj[4];
+			float bw[4];
+			mlod_pack_top4(p, (uint32_t)v, m->jmap[k], m->jmap_count[k], bj, bw);
+			uint8_t w8[4], j8[4];
+			uint16_t j16[4];
+			mlod_pack_weights8(bw, w8);
+			for (int t = 0; t < 4; t++) {
+				int jt = w8[t] ? bj[t] : 0;
+				if (jt < 0 || jt >= joints)
+					jt = 0;
+				j16[t] = (uint16_t)jt, j8[t] = (uint8_t)jt;
+			}
+			if (m->wide)
+				memcpy(o + m->attr[a++].off, j16, 8);
+			else
+				memcpy(o + m->attr[a++].off, j8, 4);
+			memcpy(o + m->attr[a++].off, w8, 4);
+		}
+		for (int t = 0; t < m->ntargets; t++) {
+			const float *d = p->targets[t].positions;
+			int16_t s[4] = {0, 0, 0, 0};
+			for (int c = 0; c < 3; c++) {
+				float f = d && m->tscale[t] > 0.0f ? d[3 * v + c] / m->tscale[t] : 0.0f;
+				f = f > 32767.0f ? 32767.0f : f < -32767.0f ? -32767.0f : f;
+				s[c] = (int16_t)lrintf(f);
+			}
+			memcpy(o + m->attr[a++].off, s, 8);
+		}
+	}
+}
+
+static uint64_t vhash(const uint8_t *p, int n)
+{
+	uint64_t h = 1469598103934665603ull;
+	for (int i = 0; i < n; i++)
+		h = (h ^ p[i]) * 1099511628211ull;
+	return h;
+}
+
+/* The id of vertex key in the part's buffer, appending it when new. */
+static uint32_t part_vertex(struct mpart *m, const uint8_t *key)
+{
+	size_t i = vhash(key, m->stride) & (m->slot_cap - 1);
+	while (m->slot[i]) {
+		uint32_t id = m->slot[i] - 1;
+		if (memcmp(m->G + (size_t)id * (size_t)m->stride, key, (size_t)m->stride) == 0)
+			return id;
+		i = (i + 1) & (m->slot_cap - 1);
+	}
+	memcpy(m->G + (size_t)m->count * (size_t)m->stride, key, (size_t)m->stride);
+	m->slot[i] = ++m->count;
+	return m->count - 1;
+}
+
+/* Appends level V's vertices not yet in the buffer, in order o of the
+ * level's triangles (mlod_pack_vertex_order); the level's indices into
+ * the buffer, or NULL when out of memory. */
+static uint32_t *part_append(struct mpart *m, const uint8_t *V, const uint32_t *in, uint32_t ni, uint32_t nv, int o)
+{
+	uint32_t *remap = malloc(sizeof *remap * ((size_t)nv + 1));
+	uint32_t *inv = malloc(sizeof *inv * ((size_t)nv + 1));
+	uint32_t *out = malloc(sizeof *out * ((size_t)ni + 1));
+	uint32_t *gid = malloc(sizeof *gid * ((size_t)nv + 1));
+	uint32_t *idx = malloc(sizeof *idx * ((size_t)ni + 1));
+	if (!remap || !inv || !out || !gid || !idx || mlod_pack_vertex_order(o, in, ni, nv, remap, out) != 0) {
+		free(remap), free(inv), free(out), free(gid), free(idx);
+		return NULL;
+	}
+	for (uint32_t v = 0; v < nv; v++)
+		inv[remap[v]] = v;
+	for (uint32_t j = 0; j < nv; j++)
+		gid[j] = part_vertex(m, V + (size_t)inv[j] * (size_t)m->stride);
+	for (uint32_t t = 0; t < ni; t++)
+		idx[t] = gid[out[t]];
+	free(remap), free(inv), free(out), free(gid);
+	return idx;
+}
+
+/* Adds the streams of the part's block (vertices first .. count - 1 of
+ * the buffer) and of its level's indices, in the chunk's stream order. */
+static void part_block_streams(chunkb *cb, const struct mpart *m, uint32_t first, const uint32_t *idx, uint32_t ni)
+{
+	uint32_t n = m->count - first;
+	uint8_t *s = malloc((size_t)n * 8 + 8);
+	if (!s) {
+		cb->fail = 1;
 		return;
 	}
-	int best = 0, from = cb->n;
-	size_t best_bytes = 0;
-	mlod_pack_part_rec rec0 = pt->rec;
-	for (int o = 0; o < MLOD_PACK_ORDERS && !cb->fail; o++) {
-		pt->rec = rec0;
-		add_part_streams(x, cb, pt, o);
-		size_t b = cb->fail ? 0 : cb_coded_bytes(cb, from);
-		if (o == 0 || b < best_bytes)
-			best = o, best_bytes = b;
-		while (cb->n > from)
-			free(cb->s[--cb->n].data);
+	int plain = m->nattr - m->ntargets;
+	for (int a = 0; a <= m->nattr; a++) {
+		if (a == plain) { /* the indices, then the targets' scales */
+			if (m->count <= 65536) {
+				uint16_t *i16 = malloc(sizeof *i16 * ((size_t)ni + 1));
+				if (!i16) {
+					cb->fail = 1;
+					break;
+				}
+				for (uint32_t i = 0; i < ni; i++)
+					i16[i] = (uint16_t)idx[i];
+				cb_add(cb, MLOD_STREAM_IDX, ni, 2, i16, 1);
+				free(i16);
+			} else {
+				cb_add(cb, MLOD_STREAM_IDX, ni, 4, idx, 1);
+			}
+			if (m->ntargets)
+				cb_add(cb, MLOD_STREAM_MTSC, (uint32_t)m->ntargets, 4, m->tscale, 0);
+		}
+		if (a == m->nattr)
+			break;
+		const mattr *at = &m->attr[a];
+		for (uint32_t v = 0; v < n; v++)
+			memcpy(s + (size_t)v * at->size, m->G + (size_t)(first + v) * (size_t)m->stride + at->off, at->size);
+		cb_add(cb, at->tag, n, at->size, s, 0);
 	}
-	pt->rec = rec0;
-	add_part_streams(x, cb, pt, best);
+	free(s);
+}
+
+static void mesh_parts_free(struct ctx *x)
+{
+	for (int i = 0; i < x->mp_count; i++) {
+		struct mpart *m = &x->mp[i];
+		free(m->tscale), free(m->attr), free(m->G), free(m->slot);
+	}
+	free(x->mp);
+	x->mp = NULL;
+	x->mp_count = 0;
+	for (int i = 0; i < x->lmap_count; i++)
+		free(x->lmaps[i]);
+	free(x->lmaps);
+	x->lmaps = NULL;
+	x->lmap_count = 0;
 }
 
 /* Maps the joints of a level skin (input skin `lsk`) to the full skin
@@ -1117,99 +1174,222 @@ static int *level_joint_map(const mlod_skeleton *s, const mlod_skin *lsk, const 
 	return map;
 }
 
-static mlod_result mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count)
+/* The parts (level 0's triangle primitives of every instance) with their
+ * level primitives, attributes, grids and buffers. Every level of a part
+ * must have triangles and the attributes level 0 has. */
+static mlod_result mesh_parts(struct ctx *x, int M)
 {
 	const mlod_character *c = &x->v;
-	chunkb cb = {0};
-	struct part *parts = NULL;
-	int np = 0, cap = 0;
-	int **maps = calloc((size_t)c->instance_count + 1, sizeof *maps);
 	mlod_result r = MLOD_OK;
-	if (!maps)
+	int cap = 0;
+	x->lmap_count = c->instance_count * M;
+	x->lmaps = calloc((size_t)x->lmap_count + 1, sizeof *x->lmaps);
+	if (!x->lmaps)
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 	for (int i = 0; i < c->instance_count; i++) {
 		const mlod_instance *in = &c->instances[i];
 		const mlod_mesh *m = &c->meshes[in->mesh];
-		const mlod_mesh *lm = m;
-		int lmap_count = 0;
-		if (k > 0 && x->level_mesh[k - 1]) {
-			lm = &x->level_mesh[k - 1][i];
-		} else if (k > 0 && x->level_node[k - 1] && x->level_node[k - 1][i] >= 0) {
-			int gm = -1, gs = -1;
-			if ((r = mlod_gltf_node_refs(x->doc, x->level_node[k - 1][i], &gm, &gs, x->err)) != MLOD_OK)
-				goto done;
-			int mi = mesh_of_gltf(x->in, gm);
-			if (mi < 0) {
-				r = mlod_fail(x->err, MLOD_ERR_PARSE, "mesh level %d of node %d: its mesh %d was not read", k,
-				              in->node, gm);
-				goto done;
-			}
-			lm = &x->in->meshes[mi];
-			int ls = skin_of_gltf(&x->in->skeleton, gs);
-			if (in->skin >= 0 && ls >= 0 && x->view_skin[ls] != in->skin) {
-				maps[i] = level_joint_map(&c->skeleton, &x->in->skeleton.skins[ls], &c->skeleton.skins[in->skin]);
-				if (!maps[i]) {
-					r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
-					goto done;
+		const mlod_mesh *lm[MLOD_MESH_MAX_LEVELS + 1];
+		int lmap_count[MLOD_MESH_MAX_LEVELS + 1] = {0};
+		for (int k = 0; k < M; k++) {
+			lm[k] = m;
+			if (k > 0 && x->level_mesh[k - 1]) {
+				lm[k] = &x->level_mesh[k - 1][i];
+			} else if (k > 0 && x->level_node[k - 1] && x->level_node[k - 1][i] >= 0) {
+				int gm = -1, gs = -1;
+				if ((r = mlod_gltf_node_refs(x->doc, x->level_node[k - 1][i], &gm, &gs, x->err)) != MLOD_OK)
+					return r;
+				int mi = mesh_of_gltf(x->in, gm);
+				if (mi < 0)
+					return mlod_fail(x->err, MLOD_ERR_PARSE, "mesh level %d of node %d: its mesh %d was not read", k,
+					                 in->node, gm);
+				lm[k] = &x->in->meshes[mi];
+				int ls = skin_of_gltf(&x->in->skeleton, gs);
+				if (in->skin >= 0 && ls >= 0 && x->view_skin[ls] != in->skin) {
+					int **mp = &x->lmaps[k * c->instance_count + i];
+					*mp = level_joint_map(&c->skeleton, &x->in->skeleton.skins[ls], &c->skeleton.skins[in->skin]);
+					if (!*mp)
+						return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+					lmap_count[k] = x->in->skeleton.skins[ls].joint_count;
 				}
-				lmap_count = x->in->skeleton.skins[ls].joint_count;
 			}
 		}
-		for (int p = 0; p < lm->primitive_count && p < m->primitive_count; p++) {
-			const mlod_primitive *pr = &lm->primitives[p];
-			if (m->primitives[p].mode != 4 || pr->mode != 4 || pr->vertex_count <= 0)
+		for (int p = 0; p < m->primitive_count; p++) {
+			const mlod_primitive *p0 = &m->primitives[p];
+			if (p0->mode != 4 || p0->vertex_count <= 0)
 				continue;
-			if (np == cap) {
+			if (x->mp_count == cap) {
 				cap = cap ? 2 * cap : 16;
-				struct part *q = realloc(parts, sizeof *q * (size_t)cap);
-				if (!q) {
-					r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
-					goto done;
-				}
-				parts = q;
+				struct mpart *q = realloc(x->mp, sizeof *q * (size_t)cap);
+				if (!q)
+					return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+				x->mp = q;
 			}
-			struct part *pt = &parts[np++];
+			struct mpart *pt = &x->mp[x->mp_count++];
 			memset(pt, 0, sizeof *pt);
-			pt->p = pr;
-			pt->jmap = maps[i];
-			pt->jmap_count = lmap_count;
-			pt->rec.instance = (uint32_t)i;
-			pt->rec.node = in->node;
-			pt->rec.mesh = m->gltf_index;
-			pt->rec.primitive = (uint32_t)p;
-			pt->rec.skin = in->skin;
-			pt->rec.joint = in->joint;
-			pt->rec.material = m->primitives[p].material;
-			pt->rec.vertex_count = (uint32_t)pr->vertex_count;
-			memcpy(pt->rec.offset, in->offset.m, sizeof pt->rec.offset);
+			size_t total = 0;
+			for (int k = 0; k < M; k++) {
+				const mlod_primitive *pr = p < lm[k]->primitive_count ? &lm[k]->primitives[p] : NULL;
+				if (!pr || pr->mode != 4 || pr->vertex_count <= 0)
+					return mlod_fail(x->err, MLOD_ERR_UNSUPPORTED,
+					                 "mesh level %d of node %d: primitive %d has no triangles (every level of a "
+					                 "part needs some)",
+					                 k, in->node, p);
+				if (prim_signature(pr, in->skin) != prim_signature(p0, in->skin))
+					return mlod_fail(x->err, MLOD_ERR_UNSUPPORTED,
+					                 "mesh level %d of node %d: primitive %d has other attributes than level 0 "
+					                 "(normals, tangents, UV sets, colours, weights or morph targets); the "
+					                 "pack stores a part's levels with one set",
+					                 k, in->node, p);
+				pt->lv[k] = pr;
+				pt->jmap[k] = x->lmaps[k * c->instance_count + i];
+				pt->jmap_count[k] = lmap_count[k];
+				total += (size_t)pr->vertex_count;
+			}
+			mlod_pack_part_rec *rec = &pt->rec;
+			rec->instance = (uint32_t)i;
+			rec->node = in->node;
+			rec->mesh = m->gltf_index;
+			rec->primitive = (uint32_t)p;
+			rec->skin = in->skin;
+			rec->joint = in->joint;
+			rec->material = p0->material;
+			memcpy(rec->offset, in->offset.m, sizeof rec->offset);
+			rec->uv_sets = (uint32_t)(p0->uv_set_count < MLOD_PACK_MAX_UV ? p0->uv_set_count : MLOD_PACK_MAX_UV);
+			rec->target_count = (uint32_t)p0->target_count;
+			pt->skinned = in->skin >= 0 && p0->weight_set_count > 0;
+			pt->wide = pt->skinned && c->skeleton.skins[in->skin].joint_count > 256;
+			pt->ntargets = p0->target_count;
+			rec->flags = (p0->normals ? MLOD_PART_NORMALS : 0) | (p0->tangents ? MLOD_PART_TANGENTS : 0) |
+			             (p0->color_set_count > 0 ? MLOD_PART_COLORS : 0) | (pt->skinned ? MLOD_PART_SKINNED : 0) |
+			             (pt->wide ? MLOD_PART_JOINTS16 : 0);
+			pt->attr = malloc(sizeof *pt->attr * (size_t)(8 + MLOD_PACK_MAX_UV + pt->ntargets));
+			pt->tscale = malloc(sizeof(float) * ((size_t)pt->ntargets + 1));
+			if (!pt->attr || !pt->tscale)
+				return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+#define ATTR(t, s) (pt->attr[pt->nattr++] = (mattr){(t), (s), pt->stride}, pt->stride += (s))
+			ATTR(MLOD_STREAM_POSQ, 8);
+			if (p0->normals)
+				ATTR(MLOD_STREAM_NRMQ, 4);
+			if (p0->tangents)
+				ATTR(MLOD_STREAM_TANQ, 8);
+			for (uint32_t s = 0; s < rec->uv_sets; s++)
+				ATTR(MLOD_STREAM_UVQ0 + (s << 24), 4);
+			if (p0->color_set_count > 0)
+				ATTR(MLOD_STREAM_COLQ, 4);
+			if (pt->skinned) {
+				if (pt->wide)
+					ATTR(MLOD_STREAM_JN16, 8);
+				else
+					ATTR(MLOD_STREAM_JNT8, 4);
+				ATTR(MLOD_STREAM_WGT8, 4);
+			}
+			for (int t = 0; t < pt->ntargets; t++)
+				ATTR(MLOD_STREAM_MTPQ, 8);
+#undef ATTR
+			part_grid(x, pt, M);
+			pt->slot_cap = 16;
+			while (pt->slot_cap < 2 * total + 2)
+				pt->slot_cap *= 2;
+			pt->G = malloc(total * (size_t)pt->stride + 1);
+			pt->slot = calloc(pt->slot_cap, sizeof *pt->slot);
+			if (!pt->G || !pt->slot)
+				return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 		}
 	}
+	return MLOD_OK;
+}
+
+/* Level k of one part: appends its new vertices (in the order of the
+ * writer's that codes the block and the indices to the fewest bytes; the
+ * input order with codec none) and adds their streams; rec is the part's
+ * record at this level. */
+static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pack_part_rec *rec)
+{
+	const mlod_primitive *p = m->lv[k];
+	uint32_t nv = (uint32_t)p->vertex_count;
+	uint32_t ni = p->index_count > 0 ? (uint32_t)p->index_count : nv;
+	ni -= ni % 3;
+	uint8_t *V = malloc((size_t)nv * (size_t)m->stride + 1);
+	uint32_t *in = malloc(sizeof *in * ((size_t)ni + 1));
+	uint32_t *saved = malloc(sizeof *saved * m->slot_cap);
+	uint32_t *idx = NULL;
+	unsigned char *seen = NULL;
+	int ok = 0;
+	if (!V || !in || !saved)
+		goto done;
+	for (uint32_t i = 0; i < ni; i++)
+		in[i] = p->index_count > 0 ? p->indices[i] : i;
+	part_quantise(x, m, k, V);
+	uint32_t count0 = m->count;
+	int best = 0;
+	if (x->opt->codec == MLOD_CODEC_MESHOPT) {
+		size_t best_bytes = 0;
+		memcpy(saved, m->slot, sizeof *saved * m->slot_cap);
+		for (int o = 0; o < MLOD_PACK_ORDERS; o++) {
+			uint32_t *ix = part_append(m, V, in, ni, nv, o);
+			if (!ix)
+				goto done;
+			int from = cb->n;
+			part_block_streams(cb, m, count0, ix, ni);
+			size_t b = cb->fail ? 0 : cb_coded_bytes(cb, from);
+			while (cb->n > from)
+				free(cb->s[--cb->n].data);
+			free(ix);
+			if (o == 0 || b < best_bytes)
+				best = o, best_bytes = b;
+			memcpy(m->slot, saved, sizeof *saved * m->slot_cap);
+			m->count = count0;
+		}
+	}
+	if (!(idx = part_append(m, V, in, ni, nv, best)))
+		goto done;
+	part_block_streams(cb, m, count0, idx, ni);
+	/* The vertices the level uses: what a reader gathers from the prefix. */
+	if (!(seen = calloc((size_t)m->count + 1, 1)))
+		goto done;
+	*rec = m->rec;
+	rec->vertex_count = 0;
+	for (uint32_t t = 0; t < ni; t++)
+		if (!seen[idx[t]])
+			seen[idx[t]] = 1, rec->vertex_count++;
+	rec->index_count = ni;
+	if (m->count <= 65536)
+		rec->flags |= MLOD_PART_INDEX16;
+	ok = 1;
+done:
+	free(V), free(in), free(saved), free(idx), free(seen);
+	return ok;
+}
+
+static mlod_result mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count)
+{
+	chunkb cb = {0};
+	mlod_result r = MLOD_OK;
+	if (!x->mp_ready) { /* the coarsest level comes first */
+		if ((r = mesh_parts(x, k + 1)) != MLOD_OK)
+			return r;
+		x->mp_ready = 1;
+	}
+	int np = x->mp_count;
+	mlod_pack_part_rec *recs = malloc(sizeof *recs * ((size_t)np + 1));
+	if (!recs)
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 	/* PART first: its records are complete once the streams are made. */
 	cb_add(&cb, MLOD_STREAM_PART, 0, sizeof(mlod_pack_part_rec), NULL, 0);
-	for (int i = 0; i < np; i++)
-		add_part(x, &cb, &parts[i]);
-	if (!cb.fail) {
-		mlod_pack_part_rec *recs = malloc(sizeof *recs * ((size_t)np + 1));
-		if (!recs) {
+	for (int i = 0; i < np && !cb.fail; i++)
+		if (!part_level(x, &cb, &x->mp[i], k, &recs[i]))
 			cb.fail = 1;
-		} else {
-			for (int i = 0; i < np; i++)
-				recs[i] = parts[i].rec;
-			free(cb.s[0].data);
-			cb.s[0].data = (uint8_t *)recs;
-			cb.s[0].count = (uint32_t)np;
-		}
+	if (!cb.fail) {
+		free(cb.s[0].data);
+		cb.s[0].data = (uint8_t *)recs;
+		cb.s[0].count = (uint32_t)np;
+		recs = NULL;
 	}
+	free(recs);
 	*part_count = np;
-	r = cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MESH, MLOD_LAYER_MESH, k, 0, k > 0 ? x->mesh_error[k - 1] : 0.0f,
-	              x->err);
-done:
-	cb_free(&cb);
-	for (int i = 0; i < c->instance_count; i++)
-		free(maps[i]);
-	free(maps);
-	free(parts);
-	return r;
+	return cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MESH, MLOD_LAYER_MESH, k, 0, k > 0 ? x->mesh_error[k - 1] : 0.0f,
+	                 x->err);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1748,6 +1928,7 @@ void mlod_pack_options_default(mlod_pack_options *opt)
 
 static void ctx_free(struct ctx *x)
 {
+	mesh_parts_free(x);
 	for (int k = 0; k < MLOD_SKEL_MAX_LEVELS; k++) {
 		free(x->kept[k]);
 		free(x->remap[k]);

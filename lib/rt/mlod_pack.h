@@ -8,7 +8,7 @@
  * meshoptimizer's decoder, and never prints or exits.
  *
  * ------------------------------------------------------------------
- * File layout (format 1.0). Everything is little-endian.
+ * File layout (format 2.0). Everything is little-endian.
  *
  *   header      32 bytes at offset 0
  *   TOC         chunk_count entries of 48 bytes, right after the header
@@ -17,7 +17,8 @@
  *
  * Header:
  *   0  u8[4]  magic "MLOD"
- *   4  u16    major version (MLOD_PACK_MAJOR); a reader refuses a newer one
+ *   4  u16    major version (MLOD_PACK_MAJOR); a reader refuses a newer one,
+ *             and an older one (1.x: MESH layout a, no decode path)
  *   6  u16    minor version; a newer minor only adds what older readers skip
  *   8  u32    flags (0; a reader ignores bits it does not know)
  *  12  u32    chunk_count (at most MLOD_PACK_MAX_CHUNKS)
@@ -97,7 +98,19 @@
  *          fold.c's skin transfer does; R is in the rest pose.)
  *
  * MESH level k (layer mesh; level 0 is the input's meshes): one part per
- *   instance and triangle primitive, in instance then primitive order.
+ *   instance and triangle primitive, in instance then primitive order, the
+ *   same parts at every level. Layout b2 (mlod(5) MESH levels): a part's
+ *   levels share one buffer of quantised vertices on one grid, each vertex
+ *   once, placed by the coarsest level that has it (coarsest level's
+ *   first); level k's prefix is the vertices of levels k and coarser.
+ *   MESH level k carries, per part, its block (the vertices the coarser
+ *   levels lack: every vertex stream below has the block's count) and its
+ *   indices into its prefix. A decode of level k reads every coarser MESH
+ *   chunk's blocks too and gathers the vertices level k's indices use, in
+ *   first-use order, renumbering the indices: the decoded mlod_pack_part is
+ *   that level alone. A part's records at two levels differ only in
+ *   vertex_count (the distinct prefix vertices its indices use: the
+ *   decoded count), index_count and MLOD_PART_INDEX16.
  *   'PART' part records (mlod_pack_part_rec)
  *   then per part, the streams its flags name, in this order:
  *   'POSQ' u16[4] per vertex: position = min + q * scale (q[3] is 0)
@@ -109,11 +122,14 @@
  *   'JNT8' u8[4] or 'JN16' u16[4] per vertex: joints of the part's skin
  *          (indices into that skin's joint list of the full skeleton)
  *   'WGT8' u8[4] per vertex: weights, unorm8, summing exactly to 255
- *   'IDX ' u32 (or u16, element size 2) per index: triangles
+ *   'IDX ' u32 (or u16, element size 2) per index: triangles, each below
+ *          the prefix's vertex count (the writer uses u16 up to 65536)
  *   'MTPQ' per morph target: i16[4] per vertex position delta
  *          = q * target_scale[t] (q[3] is 0); 'MTSC' f32 per target before
  *          them: the targets' scales
- *   (Writer's notes: every level has the same parts, in the same order; a
+ *   (Writer's notes: the grid is the union of the levels' boxes in level
+ *   0's steps (or the union's 16-bit steps where it is wider than 65535 of
+ *   them), morph deltas scaled by the largest of any level; a
  *   rigid part (joint >= 0, skin -1) has no joints or weights and follows
  *   its joint through offset; a vertex's 4 largest influences over all
  *   its glTF weight sets are kept; 'PART' comes first but is filled last.)
@@ -179,6 +195,7 @@
  * - INFO 'NAME': the clips' names follow the character's name (at
  *   rec.name), one after the other, in clip order.
  * - MESH: 'POSQ' and 'IDX ' are always there (possibly with 0 elements);
+ *   every MESH level from the coarsest to k is in the TOC when k decodes;
  *   'MTSC' and the 'MTPQ' streams only when target_count > 0. pos_scale
  *   and the target scales are >= 0, and every range (min + 65535 * scale)
  *   finite; unknown part flags are refused. Normals and
@@ -205,7 +222,7 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 1
+#define MLOD_PACK_MAJOR 2
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32
 #define MLOD_PACK_TOC_ENTRY_SIZE 48
@@ -496,6 +513,15 @@ mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void
                                   const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err);
 mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
                                     const mlod_pack_skeleton *skel, mlod_pack_motion *out, mlod_error *err);
+/* A MESH level needs the blocks of every coarser MESH level (layout b2):
+ * mlod_pack_decode_mesh reads them from data (a prefix that holds the
+ * chunk holds them too). mlod_pack_decode_mesh_fetch reads each chunk
+ * through fetch instead, coarsest first: fetch(user, chunk, &bytes, err)
+ * sets bytes to the chunk's stored_size bytes (valid until the next call)
+ * or fails with a message; the decode checks them like any chunk's. */
+typedef mlod_result (*mlod_pack_fetch_fn)(void *user, uint32_t chunk, const void **bytes, mlod_error *err);
+mlod_result mlod_pack_decode_mesh_fetch(const mlod_pack *p, uint32_t chunk, mlod_pack_fetch_fn fetch, void *user,
+                                        const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err);
 /* The DOC chunk's glb bytes (*glb points into data after the CRC check;
  * the stream is stored raw). */
 mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, const void **glb, size_t *glb_size,

@@ -11,6 +11,11 @@
  * (freed before the decode returns); raw streams are read in place.
  * Every allocation is the pack's allocator's (mlod_pack_open_alloc; malloc
  * by default), and a block starts with that allocator, for *_free.
+ * A MESH level (layout b2, mlod(5)) also decodes the vertex blocks of every
+ * coarser MESH chunk, each checked like any chunk, into scratch sized from
+ * their TOC raw sizes (freed before the decode returns), then gathers the
+ * vertices its indices use; its block is sized from its part records,
+ * whose vertex counts the gathering must meet exactly.
  *
  * Byte order: the format is little-endian, and so must the host be (the
  * index codec's output and the records are read with memcpy); the
@@ -36,6 +41,15 @@ static void *pk_calloc(const mlod_pack_alloc *a, size_t n, size_t size)
 	if (p)
 		memset(p, 0, bytes);
 	return p;
+}
+
+/* As pk_calloc, not zeroed: for scratch written before it is read. */
+static void *pk_malloc(const mlod_pack_alloc *a, size_t n, size_t size)
+{
+	if (size && n > SIZE_MAX / size)
+		return NULL;
+	size_t bytes = n * size > 0 ? n * size : 1;
+	return a && a->malloc && a->free ? a->malloc(a->user, bytes) : malloc(bytes);
 }
 
 static void pk_free(const mlod_pack_alloc *a, void *p)
@@ -252,6 +266,10 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		                 minor, MLOD_PACK_MAJOR);
 	if (major == 0)
 		return mlod_fail(err, MLOD_ERR_PARSE, "pack format %u.%u does not exist (the first is 1.0)", major, minor);
+	if (major < MLOD_PACK_MAJOR)
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED,
+		                 "mlod %u.%u pack: made by an older mlod-pack; pack the input again (this reader reads %d.x)",
+		                 major, minor, MLOD_PACK_MAJOR);
 	uint32_t hcrc = mlod_pack_crc32(0, d, 28);
 	if (hcrc != rd32(d + 28))
 		return mlod_fail(err, MLOD_ERR_PARSE, "pack header: CRC mismatch (stored 0x%08x, computed 0x%08x)",
@@ -436,14 +454,10 @@ typedef struct cx {
 	mlod_pack_alloc alloc; /* the pack's */
 } cx;
 
-/* Checks the chunk (type, codec, bounds, CRC) and its stream container
- * (sizes add up to the stored and the raw size). */
-static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, const void *data, size_t size, cx *x,
-                            mlod_error *err)
+/* Checks the chunk's TOC entry (index, type, codec). */
+static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx *x, mlod_error *err)
 {
 	memset(x, 0, sizeof *x);
-	if (!p || (!data && size))
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: the pack or the data is NULL");
 	if (index >= p->chunk_count)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: chunk %u does not exist (the pack has %u)", index,
 		                 p->chunk_count);
@@ -459,10 +473,14 @@ static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, c
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: Draco chunks need the Draco decoder, not built in", x->label);
 	if (c->codec != MLOD_CODEC_NONE && c->codec != MLOD_CODEC_MESHOPT)
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: unknown chunk codec %u", x->label, c->codec);
-	if (c->offset > size || c->stored_size > size - c->offset)
-		return mlod_fail(err, MLOD_ERR_PARSE, "%s: truncated: the chunk ends at byte %llu, the data has %zu", x->label,
-		                 (unsigned long long)(c->offset + c->stored_size), size);
-	x->base = (const uint8_t *)data + c->offset;
+	return MLOD_OK;
+}
+
+/* Checks the chunk's bytes at x->base (CRC) and its stream container
+ * (sizes add up to the stored and the raw size). */
+static mlod_result cx_parse(cx *x, mlod_error *err)
+{
+	const mlod_pack_chunk *c = x->c;
 	uint32_t crc = mlod_pack_crc32(0, x->base, c->stored_size);
 	if (crc != c->crc)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: CRC mismatch (stored 0x%08x, computed 0x%08x)", x->label, c->crc,
@@ -525,6 +543,24 @@ static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, c
 	x->next = 0;
 	x->cursor = 4 + 16 * (uint64_t)n;
 	return MLOD_OK;
+}
+
+/* cx_head and cx_parse on the chunk's bytes in data (a file or a prefix). */
+static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, const void *data, size_t size, cx *x,
+                            mlod_error *err)
+{
+	memset(x, 0, sizeof *x);
+	if (!p || (!data && size))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: the pack or the data is NULL");
+	mlod_result r = cx_head(p, index, type, x, err);
+	if (r != MLOD_OK)
+		return r;
+	const mlod_pack_chunk *c = x->c;
+	if (c->offset > size || c->stored_size > size - c->offset)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: truncated: the chunk ends at byte %llu, the data has %zu", x->label,
+		                 (unsigned long long)(c->offset + c->stored_size), size);
+	x->base = (const uint8_t *)data + c->offset;
+	return cx_parse(x, err);
 }
 
 static void cx_rewind(cx *x)
@@ -625,6 +661,24 @@ static mlod_result cx_load(cx *x, const stream *s, const uint8_t **out, mlod_err
 		                 s->index, tagn(s->tag).s,
 		                 s->codec == MLOD_SCODEC_MESHOPT_VERTEX ? "vertex" : "index", rc);
 	*out = dst;
+	return MLOD_OK;
+}
+
+/* The stream's decoded bytes written to dst (count * element size bytes):
+ * a copy of a raw stream, or the meshopt decoder's output in place. */
+static mlod_result cx_load_into(cx *x, const stream *s, uint8_t *dst, mlod_error *err)
+{
+	if (s->codec == MLOD_SCODEC_RAW) {
+		if (s->count)
+			memcpy(dst, s->src, (size_t)s->count * s->elsize);
+		return MLOD_OK;
+	}
+	int rc = s->codec == MLOD_SCODEC_MESHOPT_VERTEX
+	                 ? meshopt_decodeVertexBuffer(dst, s->count, s->elsize, s->src, s->stored)
+	                 : meshopt_decodeIndexBuffer(dst, s->count, s->elsize, s->src, s->stored);
+	if (rc != 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': the meshopt %s codec failed (%d)", x->label,
+		                 s->index, tagn(s->tag).s, s->codec == MLOD_SCODEC_MESHOPT_VERTEX ? "vertex" : "index", rc);
 	return MLOD_OK;
 }
 
@@ -1081,224 +1135,573 @@ static void oct_decode(int16_t qx, int16_t qy, float *out)
 	out[2] = z / len;
 }
 
-/* The decoded bytes per element of a mesh stream (0: not a mesh stream). */
-static uint64_t mesh_out_size(uint32_t tag)
-{
-	switch (tag) {
-	case MLOD_STREAM_POSQ: return 12;
-	case MLOD_STREAM_NRMQ: return 12;
-	case MLOD_STREAM_TANQ: return 16;
-	case MLOD_STREAM_COLQ: return 16;
-	case MLOD_STREAM_JNT8: return 8;
-	case MLOD_STREAM_JN16: return 8;
-	case MLOD_STREAM_WGT8: return 16;
-	case MLOD_STREAM_IDX: return 4;
-	case MLOD_STREAM_MTSC: return 0; /* sized apart */
-	case MLOD_STREAM_MTPQ: return 12;
-	}
-	for (uint32_t s = 0; s < MLOD_PACK_MAX_UV; s++)
-		if (tag == MLOD_STREAM_UVQ0 + (s << 24))
-			return 8;
-	return 0;
-}
-
 #define PART_KNOWN_FLAGS                                                                                        \
 	(MLOD_PART_NORMALS | MLOD_PART_TANGENTS | MLOD_PART_COLORS | MLOD_PART_SKINNED | MLOD_PART_JOINTS16 |    \
 	 MLOD_PART_INDEX16)
 
-mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
-                                  const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err)
+/* A part's vertex streams in a MESH chunk, in order, with their element
+ * sizes (the targets' 'MTPQ' last, after 'IDX ' and 'MTSC'); the count. */
+static int part_vstreams(const mlod_pack_part_rec *rc, uint32_t *tag, uint32_t *size)
+{
+	int n = 0;
+	uint32_t f = rc->flags;
+	tag[n] = MLOD_STREAM_POSQ, size[n++] = 8;
+	if (f & MLOD_PART_NORMALS)
+		tag[n] = MLOD_STREAM_NRMQ, size[n++] = 4;
+	if (f & MLOD_PART_TANGENTS)
+		tag[n] = MLOD_STREAM_TANQ, size[n++] = 8;
+	for (uint32_t t = 0; t < rc->uv_sets && t < MLOD_PACK_MAX_UV; t++)
+		tag[n] = MLOD_STREAM_UVQ0 + (t << 24), size[n++] = 4;
+	if (f & MLOD_PART_COLORS)
+		tag[n] = MLOD_STREAM_COLQ, size[n++] = 4;
+	if (f & MLOD_PART_SKINNED) {
+		int j16 = (f & MLOD_PART_JOINTS16) != 0;
+		tag[n] = j16 ? MLOD_STREAM_JN16 : MLOD_STREAM_JNT8, size[n++] = j16 ? 8 : 4;
+		tag[n] = MLOD_STREAM_WGT8, size[n++] = 4;
+	}
+	return n;
+}
+
+enum { VSTREAMS_MAX = 4 + MLOD_PACK_MAX_UV + 2 };
+
+/* Checks a part record (as layout a's reader did). */
+static mlod_result check_part_rec(const cx *x, uint32_t i, const mlod_pack_part_rec *rc, uint32_t J, uint32_t S,
+                                  mlod_error *err)
+{
+	uint32_t f = rc->flags;
+	if (f & ~PART_KNOWN_FLAGS)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: unknown flags 0x%x", x->label, i, f & ~PART_KNOWN_FLAGS);
+	if ((f & MLOD_PART_JOINTS16) && !(f & MLOD_PART_SKINNED))
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: JOINTS16 without SKINNED", x->label, i);
+	if (rc->index_count % 3 != 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: index count %u is not a multiple of 3", x->label, i,
+		                 rc->index_count);
+	if (rc->uv_sets > MLOD_PACK_MAX_UV)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: %u UV sets, more than %d", x->label, i, rc->uv_sets,
+		                 MLOD_PACK_MAX_UV);
+	if (rc->skin < -1 || rc->skin >= (int64_t)S)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: skin %d is not -1 or below the skeleton's %u skins",
+		                 x->label, i, rc->skin, S);
+	if ((f & MLOD_PART_SKINNED) && rc->skin < 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: skinned, but without a skin", x->label, i);
+	if (rc->joint < -1 || rc->joint >= (int64_t)J)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: joint %d is not -1 or below the skeleton's %u joints",
+		                 x->label, i, rc->joint, J);
+	if (rc->node < -1 || rc->mesh < -1 || rc->material < -1)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: node %d, mesh %d, material %d: each must be -1 or an index",
+		                 x->label, i, rc->node, rc->mesh, rc->material);
+	if (!all_finite(rc->offset, 16))
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: its offset matrix is not finite", x->label, i);
+	for (int a = 0; a < 3; a++)
+		if (!isfinite(rc->pos_min[a]) || !(rc->pos_scale[a] >= 0) ||
+		    !isfinite(rc->pos_min[a] + 65535.0f * rc->pos_scale[a]))
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: position range %g + q * %g is not finite and increasing",
+			                 x->label, i, (double)rc->pos_min[a], (double)rc->pos_scale[a]);
+	for (uint32_t t = 0; t < rc->uv_sets; t++)
+		for (int a = 0; a < 2; a++)
+			if (!isfinite(rc->uv_min[t][a]) || !isfinite(rc->uv_scale[t][a]) ||
+			    !isfinite(rc->uv_min[t][a] + 65535.0f * rc->uv_scale[t][a]))
+				return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: UV set %u range %g + q * %g is not finite", x->label,
+				                 i, t, (double)rc->uv_min[t][a], (double)rc->uv_scale[t][a]);
+	if (rc->vertex_count > rc->index_count)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: %u vertices, more than its %u indices can use", x->label, i,
+		                 rc->vertex_count, rc->index_count);
+	return MLOD_OK;
+}
+
+/* Two levels' records of one part agree on everything but the counts and
+ * the 16-bit index flag. */
+static int same_part(const mlod_pack_part_rec *a, const mlod_pack_part_rec *b)
+{
+	mlod_pack_part_rec x = *a, y = *b;
+	x.vertex_count = y.vertex_count = 0;
+	x.index_count = y.index_count = 0;
+	x.flags &= ~MLOD_PART_INDEX16;
+	y.flags &= ~MLOD_PART_INDEX16;
+	return memcmp(&x, &y, sizeof x) == 0;
+}
+
+/* The levels' blocks of one part: level l (0 the coarsest read) holds the
+ * part's vertices first[l] .. first[l] + count[l] - 1, each attribute's
+ * count[l] elements one after the other from base[l]. */
+typedef struct mblock {
+	uint8_t *base;
+	uint64_t first;
+	uint32_t count;
+} mblock;
+
+/* The chunk's bytes for a mesh decode: fetch gives it by TOC index. */
+typedef struct mesh_src {
+	const mlod_pack *p;
+	const void *data; /* whole file or prefix */
+	size_t size;
+	mlod_pack_fetch_fn fetch;
+	void *user;
+} mesh_src;
+
+static mlod_result mesh_begin(const mesh_src *m, uint32_t index, cx *x, mlod_error *err)
+{
+	if (!m->fetch)
+		return cx_begin(m->p, index, MLOD_CHUNK_MESH, m->data, m->size, x, err);
+	mlod_result r = cx_head(m->p, index, MLOD_CHUNK_MESH, x, err);
+	if (r != MLOD_OK)
+		return r;
+	const void *bytes = NULL;
+	if ((r = m->fetch(m->user, index, &bytes, err)) != MLOD_OK)
+		return r;
+	if (!bytes && x->c->stored_size)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: the fetch gave no bytes", x->label);
+	x->base = bytes;
+	return cx_parse(x, err);
+}
+
+static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pack_skeleton *skel, mlod_pack_mesh *out,
+                               mlod_error *err)
 {
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_mesh: out is NULL");
 	memset(out, 0, sizeof *out);
+	const mlod_pack *p = m->p;
+	if (!p || (!m->fetch && !m->data && m->size))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: the pack or the data is NULL");
 	cx x;
+	mlod_result r = cx_head(p, chunk, MLOD_CHUNK_MESH, &x, err);
+	if (r != MLOD_OK)
+		return r;
+	/* The chunks to read: every MESH level from the coarsest down to this
+	 * one (their blocks make the prefix this level's indices refer to). */
+	unsigned K = p->chunks[chunk].level, top = K;
+	for (uint32_t i = 0; i < p->chunk_count; i++)
+		if (p->chunks[i].type == MLOD_CHUNK_MESH && p->chunks[i].level > top)
+			top = p->chunks[i].level;
+	uint32_t nlev = top - K + 1;
+	const mlod_pack_alloc *al = &p->alloc;
 	bump b = {0};
 	stream s;
 	const uint8_t *src;
-	mlod_result r = cx_begin(p, chunk, MLOD_CHUNK_MESH, data, size, &x, err);
-	if (r != MLOD_OK)
-		return r;
 	uint32_t J = skel ? skel->joint_count : 0, S = skel ? skel->skin_count : 0;
-	/* Size the block from the stream headers. */
-	stream sp;
-	TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), UINT64_MAX, "", "", err));
-	uint64_t P = sp.count, total = round8(P * sizeof(mlod_pack_part));
-	while (cx_next(&x, &s)) {
-		uint64_t per = mesh_out_size(s.tag);
-		if (s.tag == MLOD_STREAM_MTSC)
-			total += round8((uint64_t)s.count * sizeof(float *)) + round8((uint64_t)s.count * 4);
-		else if (per)
-			total += round8(per * s.count);
-		else
-			FAIL("%s: stream %u is '%s', not a mesh stream", x.label, s.index, tagn(s.tag).s);
+	uint64_t P = 0;
+	mlod_pack_part_rec *recs0 = NULL; /* the coarsest level's records */
+	mblock *blk = NULL;               /* nlev * P */
+	uint8_t *blocks = NULL, *temp = NULL; /* the levels' blocks; meshopt's output of the other streams */
+	uint64_t blocks_used = 0, sumraw = 0, maxraw = 0, temp_cap = 0;
+	uint32_t *map = NULL, *used = NULL;
+	uint8_t *work = NULL, *gather = NULL;
+	int lev_open = 0;
+	memset(&x, 0, sizeof x);
+	/* The chunks' raw sizes bound what their blocks and streams decode to
+	 * (cx_parse checks them): two allocations for every level. */
+	for (uint32_t l = 0; l < nlev; l++) {
+		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, top - l, 0);
+		uint64_t raw = ci >= 0 ? p->chunks[ci].raw_size : 0;
+		sumraw += raw;
+		maxraw = raw > maxraw ? raw : maxraw;
 	}
-	cx_rewind(&x);
-	TRY(cx_temp(&x, 0, err));
-	TRY(bump_alloc(&b, &x, total, err));
-	mlod_pack_part *parts;
-	TAKE(parts, P * sizeof *parts);
-	TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), UINT64_MAX, "", "", err));
-	TRY(cx_load(&x, &sp, &src, err));
-	for (uint64_t i = 0; i < P; i++)
-		memcpy(&parts[i].rec, src + i * sizeof(mlod_pack_part_rec), sizeof(mlod_pack_part_rec));
-	for (uint32_t i = 0; i < P; i++) {
-		mlod_pack_part *pt = &parts[i];
-		const mlod_pack_part_rec *rc = &pt->rec;
-		char what[32];
-		snprintf(what, sizeof what, "part %u", i);
-		uint32_t V = rc->vertex_count, f = rc->flags;
-		if (f & ~PART_KNOWN_FLAGS)
-			FAIL("%s: part %u: unknown flags 0x%x", x.label, i, f & ~PART_KNOWN_FLAGS);
-		if ((f & MLOD_PART_JOINTS16) && !(f & MLOD_PART_SKINNED))
-			FAIL("%s: part %u: JOINTS16 without SKINNED", x.label, i);
-		if (rc->index_count % 3 != 0)
-			FAIL("%s: part %u: index count %u is not a multiple of 3", x.label, i, rc->index_count);
-		if (rc->uv_sets > MLOD_PACK_MAX_UV)
-			FAIL("%s: part %u: %u UV sets, more than %d", x.label, i, rc->uv_sets, MLOD_PACK_MAX_UV);
-		if (rc->skin < -1 || rc->skin >= (int64_t)S)
-			FAIL("%s: part %u: skin %d is not -1 or below the skeleton's %u skins", x.label, i, rc->skin, S);
-		if ((f & MLOD_PART_SKINNED) && rc->skin < 0)
-			FAIL("%s: part %u: skinned, but without a skin", x.label, i);
-		if (rc->joint < -1 || rc->joint >= (int64_t)J)
-			FAIL("%s: part %u: joint %d is not -1 or below the skeleton's %u joints", x.label, i, rc->joint, J);
-		if (rc->node < -1 || rc->mesh < -1 || rc->material < -1)
-			FAIL("%s: part %u: node %d, mesh %d, material %d: each must be -1 or an index", x.label, i, rc->node,
-			     rc->mesh, rc->material);
-		if (!all_finite(rc->offset, 16))
-			FAIL("%s: part %u: its offset matrix is not finite", x.label, i);
-		for (int a = 0; a < 3; a++)
-			if (!isfinite(rc->pos_min[a]) || !(rc->pos_scale[a] >= 0) ||
-			    !isfinite(rc->pos_min[a] + 65535.0f * rc->pos_scale[a]))
-				FAIL("%s: part %u: position range %g + q * %g is not finite and increasing", x.label, i,
-				     (double)rc->pos_min[a], (double)rc->pos_scale[a]);
-		for (uint32_t t = 0; t < rc->uv_sets; t++)
-			for (int a = 0; a < 2; a++)
-				if (!isfinite(rc->uv_min[t][a]) || !isfinite(rc->uv_scale[t][a]) ||
-				    !isfinite(rc->uv_min[t][a] + 65535.0f * rc->uv_scale[t][a]))
-					FAIL("%s: part %u: UV set %u range %g + q * %g is not finite", x.label, i, t,
-					     (double)rc->uv_min[t][a], (double)rc->uv_scale[t][a]);
-
-		/* Positions. */
-		TRY(cx_expect(&x, &s, MLOD_STREAM_POSQ, 8, V, what, "vertex count", err));
-		TRY(cx_load(&x, &s, &src, err));
-		TAKE(pt->positions, (uint64_t)V * 12);
-		for (uint32_t v = 0; v < V; v++)
-			for (int a = 0; a < 3; a++)
-				pt->positions[3 * v + a] = rc->pos_min[a] + rd16(src + 8 * (size_t)v + 2 * a) * rc->pos_scale[a];
-		if (f & MLOD_PART_NORMALS) {
-			TRY(cx_expect(&x, &s, MLOD_STREAM_NRMQ, 4, V, what, "vertex count", err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(pt->normals, (uint64_t)V * 12);
-			for (uint32_t v = 0; v < V; v++)
-				oct_decode(rdi16(src + 4 * (size_t)v), rdi16(src + 4 * (size_t)v + 2), pt->normals + 3 * (size_t)v);
+	if (sumraw > PACK_MAX_BLOCK)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "MESH level %u: decoding it and the coarser levels needs %llu bytes, more "
+		                 "than the reader's limit", K, (unsigned long long)sumraw);
+	blocks = pk_malloc(al, 1, (size_t)sumraw + 8);
+	if (!blocks)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "MESH level %u: out of memory", K);
+	for (uint32_t l = 0; l < nlev; l++) {
+		unsigned L = top - l;
+		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, L, 0);
+		if (ci < 0) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "MESH level %u: MESH level %u is missing (a level needs every coarser "
+			              "one)", K, L);
+			goto fail;
 		}
-		if (f & MLOD_PART_TANGENTS) {
-			TRY(cx_expect(&x, &s, MLOD_STREAM_TANQ, 8, V, what, "vertex count", err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(pt->tangents, (uint64_t)V * 16);
-			for (uint32_t v = 0; v < V; v++) {
-				const uint8_t *e = src + 8 * (size_t)v;
-				int16_t w = rdi16(e + 4);
-				if (w != 32767 && w != -32767)
-					FAIL("%s: part %u: vertex %u: tangent handedness %d is not -32767 or 32767", x.label, i, v, w);
-				oct_decode(rdi16(e), rdi16(e + 2), pt->tangents + 4 * (size_t)v);
-				pt->tangents[4 * (size_t)v + 3] = w > 0 ? 1.0f : -1.0f;
+		TRY(mesh_begin(m, (uint32_t)ci, &x, err));
+		lev_open = 1;
+		stream sp;
+		TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), l ? P : UINT64_MAX, "",
+		              "the parts of the coarsest level", err));
+		if (l == 0) {
+			P = sp.count;
+			if (P * (2 * sizeof *recs0 + nlev * sizeof *blk + sizeof(mlod_pack_part)) > PACK_MAX_BLOCK) {
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "%s: %llu parts: decoding them needs more than the reader's limit",
+				              x.label, (unsigned long long)P);
+				goto fail;
+			}
+			recs0 = pk_calloc(al, P + 1, sizeof *recs0);
+			blk = pk_calloc(al, (uint64_t)nlev * P + 1, sizeof *blk);
+			if (!recs0 || !blk) {
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for %llu parts", x.label, (unsigned long long)P);
+				goto fail;
 			}
 		}
-		for (uint32_t t = 0; t < rc->uv_sets; t++) {
-			TRY(cx_expect(&x, &s, MLOD_STREAM_UVQ0 + (t << 24), 4, V, what, "vertex count", err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(pt->uvs[t], (uint64_t)V * 8);
-			for (uint32_t v = 0; v < V; v++)
-				for (int a = 0; a < 2; a++)
-					pt->uvs[t][2 * (size_t)v + a] =
-					        rc->uv_min[t][a] + rd16(src + 4 * (size_t)v + 2 * a) * rc->uv_scale[t][a];
+		/* Size this level's blocks from the stream headers. */
+		uint64_t bytes = 0;
+		/* meshopt's output of the streams not decoded into a block: 'PART'
+		 * (read above), 'IDX ' and 'MTSC' */
+		uint64_t need = sp.codec != MLOD_SCODEC_RAW ? (uint64_t)sp.count * sp.elsize : 0;
+		{
+			stream t;
+			while (cx_next(&x, &t))
+				if (t.tag != MLOD_STREAM_IDX && t.tag != MLOD_STREAM_MTSC && t.tag != MLOD_STREAM_PART)
+					bytes += round8((uint64_t)t.count * t.elsize);
+				else if (t.codec != MLOD_SCODEC_RAW && (uint64_t)t.count * t.elsize > need)
+					need = (uint64_t)t.count * t.elsize;
+			cx_rewind(&x);
+			TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), P, "", "", err));
 		}
-		if (f & MLOD_PART_COLORS) {
-			TRY(cx_expect(&x, &s, MLOD_STREAM_COLQ, 4, V, what, "vertex count", err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(pt->colors, (uint64_t)V * 16);
-			for (size_t k = 0; k < (size_t)V * 4; k++)
-				pt->colors[k] = src[k] / 255.0f;
+		if (bytes > sumraw - blocks_used || need > maxraw)
+			FAIL("%s: internal block size mismatch", x.label);
+		if (need > temp_cap) {
+			pk_free(al, temp);
+			temp_cap = 0;
+			if (!(temp = pk_malloc(al, 1, (size_t)need + 8)))
+				FAIL("%s: out of memory for %llu bytes of scratch", x.label, (unsigned long long)need);
+			temp_cap = need;
 		}
-		if (f & MLOD_PART_SKINNED) {
-			int j16 = (f & MLOD_PART_JOINTS16) != 0;
-			uint32_t skin_joints = skel->skins[rc->skin].joint_count;
-			TRY(cx_expect(&x, &s, j16 ? MLOD_STREAM_JN16 : MLOD_STREAM_JNT8, j16 ? 8 : 4, V, what, "vertex count",
-			              err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(pt->joints, (uint64_t)V * 8);
-			for (size_t k = 0; k < (size_t)V * 4; k++) {
-				uint16_t jv = j16 ? rd16(src + 2 * k) : src[k];
-				if (jv >= skin_joints)
-					FAIL("%s: part %u: vertex %zu: joint %u is not below skin %d's %u joints", x.label, i, k / 4,
-					     jv, rc->skin, skin_joints);
-				pt->joints[k] = jv;
+		x.temp = temp, x.aux = 0; /* the decode's scratch, shared by the levels (cx_done frees none) */
+		uint8_t *at = blocks + blocks_used;
+		blocks_used += bytes;
+		TRY(cx_load(&x, &sp, &src, err));
+		mlod_pack_part_rec *recs = pk_calloc(al, P + 1, sizeof *recs);
+		if (!recs) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory", x.label);
+			goto fail;
+		}
+		for (uint64_t i = 0; i < P; i++)
+			memcpy(&recs[i], src + i * sizeof(mlod_pack_part_rec), sizeof(mlod_pack_part_rec));
+		for (uint32_t i = 0; i < P && r == MLOD_OK; i++) {
+			r = check_part_rec(&x, i, &recs[i], J, S, err);
+			if (r == MLOD_OK && l == 0)
+				recs0[i] = recs[i];
+			else if (r == MLOD_OK && !same_part(&recs[i], &recs0[i]))
+				r = mlod_fail(err, MLOD_ERR_PARSE,
+				              "%s: part %u: its record differs from MESH level %u's (a part's levels share its "
+				              "node, skin, attributes and grid)",
+				              x.label, i, top);
+		}
+		if (r != MLOD_OK) {
+			pk_free(al, recs);
+			goto fail;
+		}
+		for (uint32_t i = 0; i < P && r == MLOD_OK; i++) {
+			const mlod_pack_part_rec *rc = &recs[i];
+			mblock *mb = &blk[(uint64_t)l * P + i];
+			char what[32];
+			snprintf(what, sizeof what, "part %u", i);
+			uint32_t tag[VSTREAMS_MAX], size[VSTREAMS_MAX];
+			int nv = part_vstreams(rc, tag, size);
+			mb->first = l ? blk[(uint64_t)(l - 1) * P + i].first + blk[(uint64_t)(l - 1) * P + i].count : 0;
+			mb->base = at;
+			uint64_t off = 0;
+			for (int a = 0; a < nv && r == MLOD_OK; a++) {
+				r = cx_expect(&x, &s, tag[a], size[a], a ? mb->count : UINT64_MAX, what, "the block's vertex count",
+				              err);
+				if (r == MLOD_OK && a == 0)
+					mb->count = s.count;
+				if (r == MLOD_OK)
+					r = cx_load_into(&x, &s, mb->base + off, err);
+				off += (uint64_t)s.count * size[a];
 			}
-			TRY(cx_expect(&x, &s, MLOD_STREAM_WGT8, 4, V, what, "vertex count", err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(pt->weights, (uint64_t)V * 16);
-			for (uint32_t v = 0; v < V; v++) {
-				const uint8_t *e = src + 4 * (size_t)v;
-				unsigned sum = (unsigned)e[0] + e[1] + e[2] + e[3];
-				if (sum != 255)
-					FAIL("%s: part %u: vertex %u: weights sum to %u, not 255", x.label, i, v, sum);
-				for (int a = 0; a < 4; a++)
-					pt->weights[4 * (size_t)v + a] = e[a] / 255.0f;
-			}
-		}
-		int i16 = (f & MLOD_PART_INDEX16) != 0;
-		TRY(cx_expect(&x, &s, MLOD_STREAM_IDX, i16 ? 2 : 4, rc->index_count, what, "index count", err));
-		TRY(cx_load(&x, &s, &src, err));
-		TAKE(pt->indices, (uint64_t)rc->index_count * 4);
-		for (uint32_t k = 0; k < rc->index_count; k++) {
-			uint32_t iv;
-			if (i16) {
-				uint16_t v16;
-				memcpy(&v16, src + 2 * (size_t)k, 2);
-				iv = v16;
-			} else {
-				memcpy(&iv, src + 4 * (size_t)k, 4);
-			}
-			if (iv >= V)
-				FAIL("%s: part %u: index %u >= vertex count %u (at position %u)", x.label, i, iv, V, k);
-			pt->indices[k] = iv;
-		}
-		if (rc->target_count > 0) {
-			uint32_t T = rc->target_count;
-			float *scales;
-			TRY(cx_expect(&x, &s, MLOD_STREAM_MTSC, 4, T, what, "target count", err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(pt->targets, (uint64_t)T * sizeof(float *));
-			TAKE(scales, (uint64_t)T * 4);
-			memcpy(scales, src, (size_t)T * 4);
-			for (uint32_t t = 0; t < T; t++)
-				if (!(scales[t] >= 0) || !isfinite(scales[t] * 32768.0f))
-					FAIL("%s: part %u: morph target %u: scale %g is not finite and >= 0", x.label, i, t,
-					     (double)scales[t]);
-			for (uint32_t t = 0; t < T; t++) {
+			if (r != MLOD_OK)
+				break;
+			int i16 = (rc->flags & MLOD_PART_INDEX16) != 0;
+			r = cx_expect(&x, &s, MLOD_STREAM_IDX, i16 ? 2 : 4, rc->index_count, what, "index count", err);
+			if (r == MLOD_OK && rc->target_count > 0)
+				r = cx_expect(&x, &s, MLOD_STREAM_MTSC, 4, rc->target_count, what, "target count", err);
+			for (uint32_t t = 0; t < rc->target_count && r == MLOD_OK; t++) {
 				char twhat[64];
 				snprintf(twhat, sizeof twhat, "part %u target %u", i, t);
-				TRY(cx_expect(&x, &s, MLOD_STREAM_MTPQ, 8, V, twhat, "vertex count", err));
-				TRY(cx_load(&x, &s, &src, err));
-				TAKE(pt->targets[t], (uint64_t)V * 12);
-				for (uint32_t v = 0; v < V; v++)
-					for (int a = 0; a < 3; a++)
-						pt->targets[t][3 * (size_t)v + a] = rdi16(src + 8 * (size_t)v + 2 * a) * scales[t];
+				r = cx_expect(&x, &s, MLOD_STREAM_MTPQ, 8, mb->count, twhat, "the block's vertex count", err);
+				if (r == MLOD_OK)
+					r = cx_load_into(&x, &s, mb->base + off, err);
+				off += (uint64_t)s.count * 8;
+			}
+			at += round8(off);
+			if (r != MLOD_OK || l + 1 < nlev)
+				continue;
+			/* This level: gather the vertices its indices use. */
+			uint64_t prefix = mb->first + mb->count;
+			if (rc->vertex_count > prefix) {
+				r = mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: %u vertices, more than its prefix of %llu (MESH levels %u to %u)",
+				              x.label, i, rc->vertex_count, (unsigned long long)prefix, top, K);
+				break;
 			}
 		}
+		if (r != MLOD_OK) {
+			pk_free(al, recs);
+			goto fail;
+		}
+		if (l + 1 < nlev) {
+			TRY(cx_end(&x, err));
+			x.temp = NULL;
+			cx_done(&x);
+			lev_open = 0;
+			pk_free(al, recs);
+			continue;
+		}
+		/* The finest level read is the one asked for: its output. */
+		uint64_t total = round8(P * sizeof(mlod_pack_part)), big_prefix = 1, big_v = 1;
+		for (uint32_t i = 0; i < P; i++) {
+			const mlod_pack_part_rec *rc = &recs[i];
+			uint64_t V = rc->vertex_count, T = rc->target_count;
+			uint32_t f = rc->flags;
+			total += round8(V * 12);
+			total += (f & MLOD_PART_NORMALS) ? round8(V * 12) : 0;
+			total += (f & MLOD_PART_TANGENTS) ? round8(V * 16) : 0;
+			total += (uint64_t)rc->uv_sets * round8(V * 8);
+			total += (f & MLOD_PART_COLORS) ? round8(V * 16) : 0;
+			total += (f & MLOD_PART_SKINNED) ? round8(V * 8) + round8(V * 16) : 0;
+			total += round8((uint64_t)rc->index_count * 4);
+			if (T)
+				total += round8(T * sizeof(float *)) + round8(T * 4) + T * round8(V * 12);
+			const mblock *mb = &blk[(uint64_t)l * P + i];
+			uint64_t stride = 0;
+			uint32_t tag[VSTREAMS_MAX], size[VSTREAMS_MAX];
+			int nv = part_vstreams(rc, tag, size);
+			for (int a = 0; a < nv; a++)
+				stride += size[a];
+			stride += 8 * T;
+			big_prefix = mb->first + mb->count > big_prefix ? mb->first + mb->count : big_prefix;
+			big_v = V * stride > big_v ? V * stride : big_v;
+			if (total > PACK_MAX_BLOCK || big_v > PACK_MAX_BLOCK)
+				break;
+		}
+		if (big_prefix > PACK_MAX_BLOCK / 8 || big_v > PACK_MAX_BLOCK) {
+			pk_free(al, recs);
+			FAIL("%s: its parts' prefixes (%llu vertices) are larger than the reader's limit", x.label,
+			     (unsigned long long)big_prefix);
+		}
+		r = bump_alloc(&b, &x, total, err);
+		work = pk_malloc(al, 1, (size_t)(8 * big_prefix + big_v + 8));
+		if (work) {
+			map = (uint32_t *)work;
+			used = map + big_prefix;
+			gather = (uint8_t *)(used + big_prefix);
+		}
+		if (r == MLOD_OK && !work)
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory", x.label);
+		if (r != MLOD_OK) {
+			pk_free(al, recs);
+			goto fail;
+		}
+		mlod_pack_part *parts = bump_take(&b, P * sizeof *parts);
+		if (!parts) {
+			pk_free(al, recs);
+			FAIL("%s: internal block size mismatch", x.label);
+		}
+		for (uint64_t i = 0; i < P; i++)
+			parts[i].rec = recs[i];
+		pk_free(al, recs);
+		/* Walk the chunk again for the indices and the targets' scales. */
+		cx_rewind(&x);
+		TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), P, "", "", err));
+		for (uint32_t i = 0; i < P; i++) {
+			mlod_pack_part *pt = &parts[i];
+			const mlod_pack_part_rec *rc = &pt->rec;
+			uint32_t tag[VSTREAMS_MAX], size[VSTREAMS_MAX];
+			int nvs = part_vstreams(rc, tag, size);
+			for (int a = 0; a < nvs; a++)
+				cx_next(&x, &s);
+			cx_next(&x, &s); /* 'IDX ', checked above */
+			TRY(cx_load(&x, &s, &src, err));
+			int i16 = (rc->flags & MLOD_PART_INDEX16) != 0;
+			const mblock *mb = &blk[(uint64_t)l * P + i];
+			uint64_t prefix = mb->first + mb->count;
+			uint32_t V = rc->vertex_count, nused = 0;
+			for (uint64_t v = 0; v < prefix; v++)
+				map[v] = UINT32_MAX;
+			TAKE(pt->indices, (uint64_t)rc->index_count * 4);
+			for (uint32_t k = 0; k < rc->index_count; k++) {
+				uint32_t iv;
+				if (i16) {
+					uint16_t v16;
+					memcpy(&v16, src + 2 * (size_t)k, 2);
+					iv = v16;
+				} else {
+					memcpy(&iv, src + 4 * (size_t)k, 4);
+				}
+				if (iv >= prefix)
+					FAIL("%s: part %u: index %u refers past its prefix of %llu vertices (MESH levels %u to %u; at "
+					     "position %u)",
+					     x.label, i, iv, (unsigned long long)prefix, top, K, k);
+				if (map[iv] == UINT32_MAX) {
+					if (nused == V)
+						FAIL("%s: part %u: its indices use more than its %u vertices", x.label, i, V);
+					used[nused] = iv;
+					map[iv] = nused++;
+				}
+				pt->indices[k] = map[iv];
+			}
+			if (nused != V)
+				FAIL("%s: part %u: its indices use %u vertices, its record says %u", x.label, i, nused, V);
+			float *scales = NULL;
+			uint32_t T = rc->target_count;
+			if (T) {
+				cx_next(&x, &s); /* 'MTSC', checked above */
+				TRY(cx_load(&x, &s, &src, err));
+				TAKE(pt->targets, (uint64_t)T * sizeof(float *));
+				TAKE(scales, (uint64_t)T * 4);
+				memcpy(scales, src, (size_t)T * 4);
+				for (uint32_t t = 0; t < T; t++)
+					if (!(scales[t] >= 0) || !isfinite(scales[t] * 32768.0f))
+						FAIL("%s: part %u: morph target %u: scale %g is not finite and >= 0", x.label, i, t,
+						     (double)scales[t]);
+				for (uint32_t t = 0; t < T; t++)
+					cx_next(&x, &s);
+			}
+			/* Gather: each attribute of the level's vertices, one after
+			 * the other, from the levels' blocks (coarsest first; map[v]
+			 * becomes vertex v's block). */
+			for (uint32_t v = 0; v < V; v++) {
+				uint32_t lo = 0, hi = nlev - 1;
+				while (lo < hi) {
+					uint32_t mid = lo + (hi - lo + 1) / 2;
+					if (blk[(uint64_t)mid * P + i].first <= used[v])
+						lo = mid;
+					else
+						hi = mid - 1;
+				}
+				map[v] = lo;
+			}
+			uint64_t aoff = 0, before = 0;
+			const uint8_t *g[VSTREAMS_MAX] = {0};
+			for (int a = 0; a < nvs + (int)T; a++) {
+				uint32_t es = a < nvs ? size[a] : 8;
+				uint8_t *dst = gather + aoff;
+				const uint8_t *from[64];
+				uint64_t first[64];
+				for (uint32_t q = 0; q < nlev && q < 64; q++) { /* attribute a of each level's block */
+					const mblock *bb = &blk[(uint64_t)q * P + i];
+					from[q] = bb->base + before * bb->count, first[q] = bb->first;
+				}
+				for (uint32_t v = 0; v < V; v++) {
+					const uint8_t *sv;
+					if (map[v] < 64) {
+						sv = from[map[v]] + (used[v] - first[map[v]]) * es;
+					} else {
+						const mblock *bb = &blk[(uint64_t)map[v] * P + i];
+						sv = bb->base + before * bb->count + (used[v] - bb->first) * es;
+					}
+					if (es == 4)
+						memcpy(dst + (size_t)v * 4, sv, 4);
+					else
+						memcpy(dst + (size_t)v * 8, sv, 8);
+				}
+				if (a < nvs)
+					g[a] = dst;
+				aoff += (uint64_t)V * es;
+				before += es;
+			}
+			/* Dequantise. */
+			int a = 0;
+			const uint8_t *q = g[a++];
+			TAKE(pt->positions, (uint64_t)V * 12);
+			for (uint32_t v = 0; v < V; v++)
+				for (int c = 0; c < 3; c++)
+					pt->positions[3 * v + c] = rc->pos_min[c] + rd16(q + 8 * (size_t)v + 2 * c) * rc->pos_scale[c];
+			if (rc->flags & MLOD_PART_NORMALS) {
+				q = g[a++];
+				TAKE(pt->normals, (uint64_t)V * 12);
+				for (uint32_t v = 0; v < V; v++)
+					oct_decode(rdi16(q + 4 * (size_t)v), rdi16(q + 4 * (size_t)v + 2), pt->normals + 3 * (size_t)v);
+			}
+			if (rc->flags & MLOD_PART_TANGENTS) {
+				q = g[a++];
+				TAKE(pt->tangents, (uint64_t)V * 16);
+				for (uint32_t v = 0; v < V; v++) {
+					const uint8_t *e = q + 8 * (size_t)v;
+					int16_t w = rdi16(e + 4);
+					if (w != 32767 && w != -32767)
+						FAIL("%s: part %u: vertex %u: tangent handedness %d is not -32767 or 32767", x.label, i, v, w);
+					oct_decode(rdi16(e), rdi16(e + 2), pt->tangents + 4 * (size_t)v);
+					pt->tangents[4 * (size_t)v + 3] = w > 0 ? 1.0f : -1.0f;
+				}
+			}
+			for (uint32_t t = 0; t < rc->uv_sets; t++) {
+				q = g[a++];
+				TAKE(pt->uvs[t], (uint64_t)V * 8);
+				for (uint32_t v = 0; v < V; v++)
+					for (int c = 0; c < 2; c++)
+						pt->uvs[t][2 * (size_t)v + c] =
+						        rc->uv_min[t][c] + rd16(q + 4 * (size_t)v + 2 * c) * rc->uv_scale[t][c];
+			}
+			if (rc->flags & MLOD_PART_COLORS) {
+				q = g[a++];
+				TAKE(pt->colors, (uint64_t)V * 16);
+				for (size_t k = 0; k < (size_t)V * 4; k++)
+					pt->colors[k] = q[k] / 255.0f;
+			}
+			if (rc->flags & MLOD_PART_SKINNED) {
+				int j16 = (rc->flags & MLOD_PART_JOINTS16) != 0;
+				uint32_t skin_joints = skel->skins[rc->skin].joint_count;
+				q = g[a++];
+				TAKE(pt->joints, (uint64_t)V * 8);
+				for (size_t k = 0; k < (size_t)V * 4; k++) {
+					uint16_t jv = j16 ? rd16(q + 2 * k) : q[k];
+					if (jv >= skin_joints)
+						FAIL("%s: part %u: vertex %zu: joint %u is not below skin %d's %u joints", x.label, i, k / 4,
+						     jv, rc->skin, skin_joints);
+					pt->joints[k] = jv;
+				}
+				q = g[a++];
+				TAKE(pt->weights, (uint64_t)V * 16);
+				for (uint32_t v = 0; v < V; v++) {
+					const uint8_t *e = q + 4 * (size_t)v;
+					unsigned sum = (unsigned)e[0] + e[1] + e[2] + e[3];
+					if (sum != 255)
+						FAIL("%s: part %u: vertex %u: weights sum to %u, not 255", x.label, i, v, sum);
+					for (int c = 0; c < 4; c++)
+						pt->weights[4 * (size_t)v + c] = e[c] / 255.0f;
+				}
+			}
+			q = gather;
+			for (int c = 0; c < nvs; c++)
+				q += (size_t)V * size[c];
+			for (uint32_t t = 0; t < T; t++) {
+				TAKE(pt->targets[t], (uint64_t)V * 12);
+				const uint8_t *e = q + (size_t)t * V * 8;
+				for (uint32_t v = 0; v < V; v++)
+					for (int c = 0; c < 3; c++)
+						pt->targets[t][3 * (size_t)v + c] = rdi16(e + 8 * (size_t)v + 2 * c) * scales[t];
+			}
+		}
+		TRY(cx_end(&x, err));
+		x.temp = NULL;
+		cx_done(&x);
+		lev_open = 0;
+		out->part_count = (uint32_t)P;
+		out->parts = parts;
+		out->block = b.base;
+		b.base = NULL;
 	}
-	TRY(cx_end(&x, err));
-	cx_done(&x);
-	out->part_count = (uint32_t)P;
-	out->parts = parts;
-	out->block = b.base;
-	return MLOD_OK;
+	r = MLOD_OK;
 fail:
-	cx_done(&x);
-	pk_free(&x.alloc, b.base);
+	if (lev_open) {
+		x.temp = NULL;
+		cx_done(&x);
+	}
+	pk_free(al, b.base);
+	pk_free(al, blocks);
+	pk_free(al, temp);
+	pk_free(al, recs0);
+	pk_free(al, blk);
+	pk_free(al, work);
 	return r;
+}
+
+mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                  const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err)
+{
+	mesh_src m = {p, data, size, NULL, NULL};
+	return decode_mesh(&m, chunk, skel, out, err);
+}
+
+mlod_result mlod_pack_decode_mesh_fetch(const mlod_pack *p, uint32_t chunk, mlod_pack_fetch_fn fetch, void *user,
+                                        const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err)
+{
+	if (!fetch) {
+		if (out)
+			memset(out, 0, sizeof *out);
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_mesh_fetch: fetch is NULL");
+	}
+	mesh_src m = {p, NULL, 0, fetch, user};
+	return decode_mesh(&m, chunk, skel, out, err);
 }
 
 void mlod_pack_mesh_free(mlod_pack_mesh *x)

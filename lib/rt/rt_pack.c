@@ -4,7 +4,11 @@
  * (lib/rt/pack.c) inside mlod_rt_stream. Sources other than memory read a
  * chunk into a staging buffer (allocated at open, the size of the largest
  * chunk) and decode it through a copy of the TOC whose entry for that
- * chunk says offset 0. The reader allocates through the context's
+ * chunk says offset 0; a MESH level (layout b2) needs the vertex blocks of
+ * every coarser MESH level, so its load reads those chunks again through
+ * the read callback, coarsest first, each into the staging buffer
+ * (mlod_pack_decode_mesh_fetch): nothing is kept between loads, and the
+ * coarser blocks live only in the decode's scratch. The reader allocates through the context's
  * allocator (mlod_pack_open_alloc), so every allocation of a context is
  * its allocator's.
  */
@@ -44,8 +48,33 @@ static mlod_result chunk_bytes(mlod_rt_ctx *ctx, uint32_t chunk, const mlod_pack
 	return MLOD_OK;
 }
 
+/* mlod_pack_fetch_fn for a read source: reads the chunk into the
+ * staging buffer again (a MESH level re-reads the coarser levels' chunks,
+ * whose vertex blocks it needs, one after the other). */
+static mlod_result fetch_chunk(void *user, uint32_t chunk, const void **bytes, mlod_error *err)
+{
+	mlod_rt_ctx *ctx = user;
+	const mlod_pack_chunk *c = &ctx->pack.chunks[chunk];
+	if (c->stored_size > ctx->staging_size)
+		return mlod_fail(err, MLOD_ERR_PARSE, "chunk %u: %u bytes, larger than the staging buffer", chunk,
+		                 c->stored_size);
+	if (ctx->read(ctx->read_user, c->offset, c->stored_size, ctx->staging) != 0)
+		return mlod_fail(err, MLOD_ERR_IO, "chunk %u: reading %u bytes at offset %llu failed", chunk, c->stored_size,
+		                 (unsigned long long)c->offset);
+	*bytes = ctx->staging;
+	return MLOD_OK;
+}
+
 static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 {
+	if (u->layer == MLOD_RT_MESH) {
+		memset(&u->dec, 0, sizeof u->dec);
+		if (ctx->source == SRC_MEMORY)
+			return mlod_pack_decode_mesh(&ctx->pack, (uint32_t)u->chunk, ctx->data, ctx->size, ctx->skel,
+			                             &u->dec.mesh, err);
+		return mlod_pack_decode_mesh_fetch(&ctx->pack, (uint32_t)u->chunk, fetch_chunk, ctx, ctx->skel, &u->dec.mesh,
+		                                   err);
+	}
 	const mlod_pack *p;
 	const void *data;
 	size_t size;
@@ -208,6 +237,15 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 		u->chunk = c;
 		u->stored_size = ctx->pack.chunks[c].stored_size;
 		u->raw_size = ctx->pack.chunks[c].raw_size;
+		/* A mesh level decodes its own and every coarser MESH chunk and
+		 * gathers from their blocks: its raw size, for the load's size
+		 * hint, is theirs together (a level's decoded size is at most 4
+		 * times that, as for any chunk). */
+		for (uint32_t k = u->level + 1u; u->layer == MLOD_RT_MESH && k < ctx->levels[MLOD_RT_MESH]; k++) {
+			int ck = mlod_pack_find(&ctx->pack, MLOD_CHUNK_MESH, k, 0);
+			uint64_t sum = (uint64_t)u->raw_size + (ck >= 0 ? ctx->pack.chunks[ck].raw_size : 0);
+			u->raw_size = sum > UINT32_MAX ? UINT32_MAX : (uint32_t)sum;
+		}
 		u->error = ctx->pack.chunks[c].error;
 		u->distance = ctx->pack.chunks[c].distance;
 	}

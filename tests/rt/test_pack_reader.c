@@ -306,8 +306,11 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 #define NI1 36
 #define NK 5 /* keys */
 
+/* A part at one level (layout b2): its prefix is truth vertices 0 .. V - 1,
+ * of which its chunk's block holds first .. V - 1 (the coarser level's
+ * block the rest); its indices refer to the prefix. */
 typedef struct part_truth {
-	uint32_t flags, V, I, uv_sets, T;
+	uint32_t flags, V, I, uv_sets, T, first;
 	int32_t skin, joint;
 	float pos[NV0][3], nrm[NV0][3], tan[NV0][4], uv[2][NV0][2], col[NV0][4], wgt[NV0][4], morph[NV0][3];
 	uint16_t jnt[NV0][4];
@@ -316,7 +319,7 @@ typedef struct part_truth {
 	float pos_min[3], pos_scale[3], uv_min[2][2], uv_scale[2][2], mscale;
 } part_truth;
 
-static part_truth parts_truth[3]; /* level 0: parts 0, 1; level 1: part 2 */
+static part_truth parts_truth[4]; /* level 0: parts 0, 1; level 1: parts 0, 1 as 2, 3 */
 static float ibm_truth[NJ][16];
 static float time_truth[NK];
 static float vec_truth[NK * 3][3];
@@ -415,6 +418,28 @@ static void make_part(part_truth *t, uint32_t flags, uint32_t V, uint32_t I, uin
 		t->idx[k] = rnd() % V;
 }
 
+/* The vertices of the prefix a part's indices use. */
+static uint32_t used_vertices(const part_truth *t)
+{
+	uint8_t seen[NV0] = {0};
+	uint32_t n = 0;
+	for (uint32_t k = 0; k < t->I; k++)
+		if (!seen[t->idx[k]])
+			seen[t->idx[k]] = 1, n++;
+	return n;
+}
+
+/* Level 1 of a part: the first V vertices of level 0's, I indices; the
+ * first V of them 0 .. V - 1, so that the gathered vertices keep their
+ * order (a raw chunk: the index codec rotates no triangle). */
+static void coarse_part(part_truth *t, const part_truth *fine, uint32_t V, uint32_t I, uint32_t flags)
+{
+	*t = *fine;
+	t->V = V, t->I = I, t->first = 0, t->flags = flags;
+	for (uint32_t k = 0; k < I; k++)
+		t->idx[k] = k < V ? k : rnd() % V;
+}
+
 static void part_rec(const part_truth *t, uint32_t instance, buf *b)
 {
 	mlod_pack_part_rec r;
@@ -427,7 +452,7 @@ static void part_rec(const part_truth *t, uint32_t instance, buf *b)
 	r.joint = t->joint;
 	r.material = -1;
 	r.flags = t->flags;
-	r.vertex_count = t->V;
+	r.vertex_count = used_vertices(t);
 	r.index_count = t->I;
 	r.uv_sets = t->uv_sets;
 	r.target_count = t->T;
@@ -443,17 +468,18 @@ static void part_rec(const part_truth *t, uint32_t instance, buf *b)
 /* Appends a part's streams; vc/ic: the codecs of vertex and index streams. */
 static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
 {
+	const uint32_t F = t->first, n = t->V - t->first;
 	wstream *s = add_stream(c, MLOD_STREAM_POSQ, 8, vc);
-	s->count = t->V;
-	for (uint32_t v = 0; v < t->V; v++) {
+	s->count = n;
+	for (uint32_t v = F; v < t->V; v++) {
 		for (int a = 0; a < 3; a++)
 			put16(&s->data, (uint16_t)lrintf((t->pos[v][a] - t->pos_min[a]) / t->pos_scale[a]));
 		put16(&s->data, 0);
 	}
 	if (t->flags & MLOD_PART_NORMALS) {
 		s = add_stream(c, MLOD_STREAM_NRMQ, 4, vc);
-		s->count = t->V;
-		for (uint32_t v = 0; v < t->V; v++) {
+		s->count = n;
+		for (uint32_t v = F; v < t->V; v++) {
 			int16_t qx, qy;
 			oct_encode(t->nrm[v], &qx, &qy);
 			put16(&s->data, (uint16_t)qx);
@@ -462,8 +488,8 @@ static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
 	}
 	if (t->flags & MLOD_PART_TANGENTS) {
 		s = add_stream(c, MLOD_STREAM_TANQ, 8, vc);
-		s->count = t->V;
-		for (uint32_t v = 0; v < t->V; v++) {
+		s->count = n;
+		for (uint32_t v = F; v < t->V; v++) {
 			int16_t qx, qy;
 			oct_encode(t->tan[v], &qx, &qy);
 			put16(&s->data, (uint16_t)qx);
@@ -474,21 +500,21 @@ static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
 	}
 	for (uint32_t u = 0; u < t->uv_sets; u++) {
 		s = add_stream(c, MLOD_STREAM_UVQ0 + (u << 24), 4, vc);
-		s->count = t->V;
-		for (uint32_t v = 0; v < t->V; v++)
+		s->count = n;
+		for (uint32_t v = F; v < t->V; v++)
 			for (int a = 0; a < 2; a++)
 				put16(&s->data, (uint16_t)lrintf((t->uv[u][v][a] - t->uv_min[u][a]) / t->uv_scale[u][a]));
 	}
 	if (t->flags & MLOD_PART_COLORS) {
 		s = add_stream(c, MLOD_STREAM_COLQ, 4, vc);
-		s->count = t->V;
-		put(&s->data, t->cq, 4 * (size_t)t->V);
+		s->count = n;
+		put(&s->data, t->cq[F], 4 * (size_t)n);
 	}
 	if (t->flags & MLOD_PART_SKINNED) {
 		int j16 = (t->flags & MLOD_PART_JOINTS16) != 0;
 		s = add_stream(c, j16 ? MLOD_STREAM_JN16 : MLOD_STREAM_JNT8, j16 ? 8 : 4, vc);
-		s->count = t->V;
-		for (uint32_t v = 0; v < t->V; v++)
+		s->count = n;
+		for (uint32_t v = F; v < t->V; v++)
 			for (int a = 0; a < 4; a++) {
 				if (j16)
 					put16(&s->data, t->jnt[v][a]);
@@ -496,8 +522,8 @@ static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
 					put8(&s->data, (uint8_t)t->jnt[v][a]);
 			}
 		s = add_stream(c, MLOD_STREAM_WGT8, 4, vc);
-		s->count = t->V;
-		put(&s->data, t->wq, 4 * (size_t)t->V);
+		s->count = n;
+		put(&s->data, t->wq[F], 4 * (size_t)n);
 	}
 	int i16 = (t->flags & MLOD_PART_INDEX16) != 0;
 	s = add_stream(c, MLOD_STREAM_IDX, i16 ? 2 : 4, ic);
@@ -515,8 +541,8 @@ static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
 			putf(&s->data, t->mscale);
 		for (uint32_t k = 0; k < t->T; k++) {
 			s = add_stream(c, MLOD_STREAM_MTPQ, 8, vc);
-			s->count = t->V;
-			for (uint32_t v = 0; v < t->V; v++) {
+			s->count = n;
+			for (uint32_t v = F; v < t->V; v++) {
 				for (int a = 0; a < 3; a++)
 					put16(&s->data, (uint16_t)(int16_t)lrintf(t->morph[v][a] / t->mscale));
 				put16(&s->data, 0);
@@ -618,15 +644,25 @@ static int make_chunks(wchunk *c, int with_unknown)
 		for (int k = 0; k < 16; k++)
 			putf(&s->data, ibm_truth[palj[j]][k]);
 
-	/* MESH level 1: one raw part, JNT8, u16 indices. */
+	/* The parts: level 0's, then level 1's from them (16 and 10 of their
+	 * vertices; part 0 with u16 indices at level 1, u32 at level 0). */
+	make_part(&parts_truth[0],
+	          MLOD_PART_NORMALS | MLOD_PART_TANGENTS | MLOD_PART_COLORS | MLOD_PART_SKINNED, NV0, NI0, 2, 1, 0, -1);
+	make_part(&parts_truth[1], MLOD_PART_SKINNED | MLOD_PART_JOINTS16 | MLOD_PART_INDEX16, NV1, NI1, 0, 0, 0, 2);
+	coarse_part(&parts_truth[2], &parts_truth[0], 16, 24, parts_truth[0].flags | MLOD_PART_INDEX16);
+	coarse_part(&parts_truth[3], &parts_truth[1], 10, 12, parts_truth[1].flags);
+	parts_truth[0].first = 16, parts_truth[1].first = 10;
+
+	/* MESH level 1: the two parts raw: every vertex of their prefixes. */
 	ch = &c[C_MESH1];
 	ch->type = MLOD_CHUNK_MESH, ch->layer = MLOD_LAYER_MESH, ch->level = 1;
 	ch->error = 0.01f, ch->distance = 9.35f;
-	make_part(&parts_truth[2], MLOD_PART_NORMALS | MLOD_PART_SKINNED | MLOD_PART_INDEX16, 12, 18, 1, 0, 0, -1);
 	s = add_stream(ch, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), MLOD_SCODEC_RAW);
-	s->count = 1;
+	s->count = 2;
 	part_rec(&parts_truth[2], 0, &s->data);
+	part_rec(&parts_truth[3], 1, &s->data);
 	part_streams(ch, &parts_truth[2], MLOD_SCODEC_RAW, MLOD_SCODEC_RAW);
+	part_streams(ch, &parts_truth[3], MLOD_SCODEC_RAW, MLOD_SCODEC_RAW);
 
 	/* MOTION level 1 of clip 0: one raw channel. */
 	ch = &c[C_MOT1];
@@ -653,12 +689,9 @@ static int make_chunks(wchunk *c, int with_unknown)
 	for (int k = 0; k < 6; k++)
 		putf(&s->data, (float)k);
 
-	/* MESH level 0: two meshopt-coded parts. */
+	/* MESH level 0: the two parts' new vertices, meshopt-coded. */
 	ch = &c[C_MESH0];
 	ch->type = MLOD_CHUNK_MESH, ch->layer = MLOD_LAYER_MESH, ch->codec = MLOD_CODEC_MESHOPT;
-	make_part(&parts_truth[0],
-	          MLOD_PART_NORMALS | MLOD_PART_TANGENTS | MLOD_PART_COLORS | MLOD_PART_SKINNED, NV0, NI0, 2, 1, 0, -1);
-	make_part(&parts_truth[1], MLOD_PART_SKINNED | MLOD_PART_JOINTS16 | MLOD_PART_INDEX16, NV1, NI1, 0, 0, 0, 2);
 	s = add_stream(ch, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), MLOD_SCODEC_MESHOPT_VERTEX);
 	s->count = 2;
 	part_rec(&parts_truth[0], 0, &s->data);
@@ -869,7 +902,7 @@ TEST(open_reads_header_and_toc)
 	buf b = make_pack(0);
 	mlod_pack p;
 	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
-	int ok = p.major == 1 && p.minor == 0 && p.chunk_count == C_COUNT && p.file_size == b.n &&
+	int ok = p.major == MLOD_PACK_MAJOR && p.minor == 0 && p.chunk_count == C_COUNT && p.file_size == b.n &&
 	         p.chunks[C_MESH0].type == MLOD_CHUNK_MESH && p.chunks[C_MESH0].codec == MLOD_CODEC_MESHOPT &&
 	         p.chunks[C_MESH1].level == 1 && p.chunks[C_MESH1].error == 0.01f &&
 	         p.chunks[C_MESH1].distance == 9.35f && p.chunks[C_MESH1].offset % 16 == 0;
@@ -958,71 +991,89 @@ static double angle3(const float *a, const float *b)
 	return atan2(sqrt(c0 * c0 + c1 * c1 + c2 * c2), (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2]);
 }
 
-/* Compares a decoded part with what was encoded. */
-static int check_part(const mlod_pack_part *pt, const part_truth *t, char *why, size_t n)
+/* Decoded vertex dv of pt against truth vertex tv of t: 0 and why when
+ * they differ. */
+static int check_vertex(const mlod_pack_part *pt, uint32_t v, const part_truth *t, uint32_t w, char *why, size_t n)
 {
-	if (pt->rec.vertex_count != t->V || pt->rec.index_count != t->I || pt->rec.flags != t->flags ||
-	    pt->rec.uv_sets != t->uv_sets || pt->rec.target_count != t->T || pt->rec.skin != t->skin ||
-	    pt->rec.joint != t->joint)
-		return snprintf(why, n, "record differs"), 0;
 	/* Octahedral snorm16: at most 3 * sqrt(2) / 2 / 32767 = 6.4742e-5 rad
 	 * (at a face's centre, mlod(5)); 1e-6 more for float rounding. */
 	const double oct_bound = 3.0 * sqrt(2.0) / 2.0 / 32767.0 + 1e-6;
-	for (uint32_t v = 0; v < t->V; v++) {
-		for (int a = 0; a < 3; a++)
-			if (fabs(pt->positions[3 * v + a] - t->pos[v][a]) > 0.5 * t->pos_scale[a] + 1e-6)
-				return snprintf(why, n, "vertex %u position %d: %g vs %g", v, a, pt->positions[3 * v + a],
-				                t->pos[v][a]), 0;
-		if (t->flags & MLOD_PART_NORMALS) {
-			double ang = angle3(pt->normals + 3 * v, t->nrm[v]);
-			if (ang > oct_bound)
-				return snprintf(why, n, "vertex %u normal off by %g rad", v, ang), 0;
-		} else if (pt->normals) {
-			return snprintf(why, n, "normals without the flag"), 0;
-		}
-		if (t->flags & MLOD_PART_TANGENTS) {
-			const float *d = pt->tangents + 4 * v;
-			double ang = angle3(d, t->tan[v]);
-			if (ang > oct_bound || d[3] != t->tan[v][3])
-				return snprintf(why, n, "vertex %u tangent off by %g rad, w %g", v, ang, d[3]), 0;
-		}
-		for (uint32_t s = 0; s < t->uv_sets; s++)
-			for (int a = 0; a < 2; a++)
-				if (fabs(pt->uvs[s][2 * v + a] - t->uv[s][v][a]) > 0.5 * t->uv_scale[s][a] + 1e-6)
-					return snprintf(why, n, "vertex %u uv %u", v, s), 0;
-		if (t->flags & MLOD_PART_COLORS)
-			for (int a = 0; a < 4; a++)
-				if (pt->colors[4 * v + a] != t->col[v][a])
-					return snprintf(why, n, "vertex %u colour", v), 0;
-		if (t->flags & MLOD_PART_SKINNED) {
-			float sum = 0;
-			for (int a = 0; a < 4; a++) {
-				if (pt->joints[4 * v + a] != t->jnt[v][a])
-					return snprintf(why, n, "vertex %u joint %d", v, a), 0;
-				if (pt->weights[4 * v + a] != t->wq[v][a] / 255.0f)
-					return snprintf(why, n, "vertex %u weight %d", v, a), 0;
-				/* Largest remainder: within 3/4 of a step of the input. */
-				if (fabs(pt->weights[4 * v + a] - t->wgt[v][a]) > 0.75 / 255 + 1e-6)
-					return snprintf(why, n, "vertex %u weight %d off the input", v, a), 0;
-				sum += pt->weights[4 * v + a];
-			}
-			if (fabsf(sum - 1) > 1e-5f)
-				return snprintf(why, n, "vertex %u weights sum to %g", v, sum), 0;
-		}
-		for (uint32_t k = 0; k < t->T; k++)
-			for (int a = 0; a < 3; a++)
-				if (fabs(pt->targets[k][3 * v + a] - t->morph[v][a]) > 0.5 * t->mscale + 1e-7)
-					return snprintf(why, n, "vertex %u morph %u", v, k), 0;
+	for (int a = 0; a < 3; a++)
+		if (fabs(pt->positions[3 * v + a] - t->pos[w][a]) > 0.5 * t->pos_scale[a] + 1e-6)
+			return snprintf(why, n, "vertex %u position %d: %g vs %g", v, a, pt->positions[3 * v + a], t->pos[w][a]),
+			       0;
+	if (t->flags & MLOD_PART_NORMALS) {
+		double ang = angle3(pt->normals + 3 * v, t->nrm[w]);
+		if (ang > oct_bound)
+			return snprintf(why, n, "vertex %u normal off by %g rad", v, ang), 0;
+	} else if (pt->normals) {
+		return snprintf(why, n, "normals without the flag"), 0;
 	}
-	/* The index codec keeps the triangles' order and winding but may
-	 * rotate each triangle's corners. */
+	if (t->flags & MLOD_PART_TANGENTS) {
+		const float *d = pt->tangents + 4 * v;
+		double ang = angle3(d, t->tan[w]);
+		if (ang > oct_bound || d[3] != t->tan[w][3])
+			return snprintf(why, n, "vertex %u tangent off by %g rad, w %g", v, ang, d[3]), 0;
+	}
+	for (uint32_t s = 0; s < t->uv_sets; s++)
+		for (int a = 0; a < 2; a++)
+			if (fabs(pt->uvs[s][2 * v + a] - t->uv[s][w][a]) > 0.5 * t->uv_scale[s][a] + 1e-6)
+				return snprintf(why, n, "vertex %u uv %u", v, s), 0;
+	if (t->flags & MLOD_PART_COLORS)
+		for (int a = 0; a < 4; a++)
+			if (pt->colors[4 * v + a] != t->col[w][a])
+				return snprintf(why, n, "vertex %u colour", v), 0;
+	if (t->flags & MLOD_PART_SKINNED) {
+		float sum = 0;
+		for (int a = 0; a < 4; a++) {
+			if (pt->joints[4 * v + a] != t->jnt[w][a])
+				return snprintf(why, n, "vertex %u joint %d", v, a), 0;
+			if (pt->weights[4 * v + a] != t->wq[w][a] / 255.0f)
+				return snprintf(why, n, "vertex %u weight %d", v, a), 0;
+			/* Largest remainder: within 3/4 of a step of the input. */
+			if (fabs(pt->weights[4 * v + a] - t->wgt[w][a]) > 0.75 / 255 + 1e-6)
+				return snprintf(why, n, "vertex %u weight %d off the input", v, a), 0;
+			sum += pt->weights[4 * v + a];
+		}
+		if (fabsf(sum - 1) > 1e-5f)
+			return snprintf(why, n, "vertex %u weights sum to %g", v, sum), 0;
+	}
+	for (uint32_t k = 0; k < t->T; k++)
+		for (int a = 0; a < 3; a++)
+			if (fabs(pt->targets[k][3 * v + a] - t->morph[w][a]) > 0.5 * t->mscale + 1e-7)
+				return snprintf(why, n, "vertex %u morph %u", v, k), 0;
+	return 1;
+}
+
+/* Compares a decoded part with what was encoded: the reader gathers the
+ * vertices the level's indices use (in first-use order), so each decoded
+ * triangle must carry the truth triangle's vertices, up to the rotation
+ * of its corners the index codec may make (it keeps the triangles' order
+ * and winding); and no two truth vertices may become one. */
+static int check_part(const mlod_pack_part *pt, const part_truth *t, char *why, size_t n)
+{
+	if (pt->rec.vertex_count != used_vertices(t) || pt->rec.index_count != t->I ||
+	    (pt->rec.flags & ~MLOD_PART_INDEX16) != (t->flags & ~MLOD_PART_INDEX16) || pt->rec.uv_sets != t->uv_sets ||
+	    pt->rec.target_count != t->T || pt->rec.skin != t->skin || pt->rec.joint != t->joint)
+		return snprintf(why, n, "record differs"), 0;
+	uint32_t of[NV0];
+	for (uint32_t v = 0; v < NV0; v++)
+		of[v] = UINT32_MAX;
 	for (uint32_t k = 0; k < t->I; k += 3) {
 		const uint32_t *a = pt->indices + k, *e = t->idx + k;
 		int same = 0;
-		for (int r = 0; r < 3; r++)
-			same |= a[0] == e[r] && a[1] == e[(r + 1) % 3] && a[2] == e[(r + 2) % 3];
+		char w2[256] = "";
+		for (int r = 0; r < 3 && !same; r++) {
+			same = 1;
+			for (int j = 0; j < 3 && same; j++)
+				same = a[j] < pt->rec.vertex_count && check_vertex(pt, a[j], t, e[(j + r) % 3], w2, sizeof w2) &&
+				       (of[a[j]] == UINT32_MAX || of[a[j]] == e[(j + r) % 3]);
+			for (int j = 0; same && j < 3; j++)
+				of[a[j]] = e[(j + r) % 3];
+		}
 		if (!same)
-			return snprintf(why, n, "triangle %u: %u %u %u vs %u %u %u", k / 3, a[0], a[1], a[2], e[0], e[1], e[2]),
+			return snprintf(why, n, "triangle %u: %u %u %u vs %u %u %u (%s)", k / 3, a[0], a[1], a[2], e[0], e[1],
+			                e[2], w2),
 			       0;
 	}
 	return 1;
@@ -1039,9 +1090,10 @@ TEST(decode_mesh_meshopt_and_raw)
 	CHECK_OK(mlod_pack_decode_mesh(&p, C_MESH0, b.p, b.n, &s, &m0, &terr));
 	CHECK_OK(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &s, &m1, &terr));
 	char why[256] = "";
-	int ok = m0.part_count == 2 && m1.part_count == 1 && check_part(&m0.parts[0], &parts_truth[0], why, sizeof why) &&
+	int ok = m0.part_count == 2 && m1.part_count == 2 && check_part(&m0.parts[0], &parts_truth[0], why, sizeof why) &&
 	         check_part(&m0.parts[1], &parts_truth[1], why, sizeof why) &&
-	         check_part(&m1.parts[0], &parts_truth[2], why, sizeof why) && m0.parts[1].rec.instance == 1 &&
+	         check_part(&m1.parts[0], &parts_truth[2], why, sizeof why) &&
+	         check_part(&m1.parts[1], &parts_truth[3], why, sizeof why) && m0.parts[1].rec.instance == 1 &&
 	         m0.parts[1].normals == NULL && m0.parts[1].uvs[0] == NULL && m0.parts[1].targets == NULL;
 	mlod_pack_mesh_free(&m0);
 	mlod_pack_mesh_free(&m1);
@@ -1142,8 +1194,8 @@ TEST(newer_major_is_refused)
 {
 	static wchunk c[C_COUNT + 1];
 	int n = make_chunks(c, 0);
-	buf b = build_pack(c, n, 2, 0);
-	buf m = build_pack(c, n, 1, 7); /* a newer minor reads */
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR + 1, 0);
+	buf m = build_pack(c, n, MLOD_PACK_MAJOR, 7); /* a newer minor reads */
 	free_chunks(c, n);
 	mlod_pack p = {0};
 	memset(&terr, 0, sizeof terr);
@@ -1156,8 +1208,26 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 2.0 is newer than this reader's 1.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 3.0 is newer than this reader's 2.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
+}
+
+/* Format 2.0 changed the MESH layout (b2): a 1.x pack is refused whole,
+ * with what to do; there is no 1.x decode. */
+TEST(older_major_is_refused)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, 1, 0);
+	free_chunks(c, n);
+	mlod_pack p = {0};
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_open(b.p, b.n, &p, &terr);
+	free(b.p);
+	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && p.chunks == NULL, "returned %d: %s", (int)r, terr.message);
+	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
+	                               "reads 2.x)") == 0,
+	          "message: %s", terr.message);
 }
 
 TEST(draco_chunks_are_unsupported)
@@ -1165,7 +1235,7 @@ TEST(draco_chunks_are_unsupported)
 	static wchunk c[C_COUNT + 1];
 	int n = make_chunks(c, 0);
 	c[C_MESH1].codec = MLOD_CODEC_DRACO;
-	buf b = build_pack(c, n, 1, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	free_chunks(c, n);
 	mlod_pack p = {0};
 	mlod_pack_mesh m = {0};
@@ -1305,7 +1375,7 @@ static buf edited_pack(edit_fn edit)
 	static wchunk c[C_COUNT + 1];
 	int n = make_chunks(c, 0);
 	edit(c);
-	buf b = build_pack(c, n, 1, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	free_chunks(c, n);
 	return b;
 }
@@ -1319,6 +1389,19 @@ static uint8_t *stream_data(wchunk *c, int chunk, uint32_t tag, int nth)
 }
 
 static void e_index(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_IDX, 0) + 4 * 7, NV0 + 3); }
+/* Level 1's part 1 (u16 indices, a prefix of 10 vertices): index 10. */
+static void e_index_coarse(wchunk *c)
+{
+	uint8_t *d = stream_data(c, C_MESH1, MLOD_STREAM_IDX, 1);
+	d[8] = 10, d[9] = 0;
+}
+static void e_part_count(wchunk *c) { c[C_MESH0].s[0].count = 1, c[C_MESH0].s[0].data.n = sizeof(mlod_pack_part_rec); }
+/* Level 0's part 1 on another grid than level 1's: pos_min[0]. */
+static void e_part_grid(wchunk *c)
+{
+	uint8_t *d = stream_data(c, C_MESH0, MLOD_STREAM_PART, 0) + sizeof(mlod_pack_part_rec) + 112;
+	wr32(d, 0x3f000000u);
+}
 static void e_parent(wchunk *c) { wr32(stream_data(c, C_SKEL, MLOD_STREAM_JNTS, 0) + 116 * 2, 3); }
 static void e_palj(wchunk *c) { wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALJ, 0) + 4 * 3, 2); }
 static void e_weights(wchunk *c) { stream_data(c, C_MESH1, MLOD_STREAM_WGT8, 0)[4 * 5] ^= 1; }
@@ -1392,14 +1475,17 @@ TEST(structural_checks_name_the_chunk)
 		mlod_result code;
 		const char *text;
 	} cases[] = {
-		{e_index, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: index 43 >= vertex count 40 (at position 7)"},
+		{e_index, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: index 43 refers past its prefix of 40 vertices (MESH levels 1 to 0; at position 7)"},
+		{e_index_coarse, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 1: index 10 refers past its prefix of 10 vertices (MESH levels 1 to 1; at position 4)"},
+		{e_part_count, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: stream 0 'PART' has 1 elements, expected 2 (the parts of the coarsest level)"},
+		{e_part_grid, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 1: its record differs from MESH level 1's"},
 		{e_parent, C_SKEL, MLOD_ERR_PARSE, "SKELETON: joint 2: parent 3 is not -1 or an earlier joint"},
 		{e_palj, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: palette entry 3 (skin 0 joint 3): joint 2 is not a kept joint"},
 		{e_weights, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: vertex 5: weights sum to"},
 		{e_skin_joint, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: vertex 2: joint 4 is not below skin 0's 4 joints"},
 		{e_uv_sets, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: 5 UV sets, more than 4"},
-		{e_stream_order, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: stream 2 is 'UVQ0', expected 'NRMQ'"},
-		{e_vertex_count, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: stream 2 'NRMQ' has 11 elements, expected 12 (vertex count)"},
+		{e_stream_order, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: stream 2 is 'TANQ', expected 'NRMQ'"},
+		{e_vertex_count, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: stream 2 'NRMQ' has 15 elements, expected 16 (the block's vertex count)"},
 		{e_nan, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: a translation value is not finite"},
 		{e_time, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: time array 0: key 1: time 0 is not after 0"},
 		{e_chan_joint, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: channel 0: joint 4 is not below the skeleton's 4 joints"},
@@ -1532,39 +1618,40 @@ TEST(absurd_sizes)
 	int n = make_chunks(c, 0);
 	/* A meshopt stream of 16 M part records (3.4 GB decoded, raw size
 	 * consistent): NOMEM before any allocation. */
-	wchunk *m = &c[C_MESH0];
+	wchunk *m = &c[C_MESH1]; /* the coarsest: it sets the part count */
+	m->codec = MLOD_CODEC_MESHOPT;
 	for (int i = 0; i < m->ns; i++)
 		free(m->s[i].data.p);
 	m->ns = 0;
 	wstream *s = add_stream(m, MLOD_STREAM_PART, 200, MLOD_SCODEC_MESHOPT_VERTEX);
 	s->count = 0;
-	buf b = build_pack(c, n, 1, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	/* Patch the stream header and the raw size in place. */
 	mlod_pack p;
 	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
-	uint8_t *ch = b.p + p.chunks[C_MESH0].offset;
+	uint8_t *ch = b.p + p.chunks[C_MESH1].offset;
 	mlod_pack_close(&p);
 	wr32(ch + 4 + 4, 0x01000000u);
 	uint64_t raw = 4 + 16 + (uint64_t)0x01000000 * 200;
-	wr32(b.p + 32 + 48 * C_MESH0 + 28, (uint32_t)raw);
+	wr32(b.p + 32 + 48 * C_MESH1 + 28, (uint32_t)raw);
 	restamp(b.p, b.n);
 	mlod_pack_mesh mesh;
 	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
 	memset(&terr, 0, sizeof terr);
-	mlod_result r1 = mlod_pack_decode_mesh(&p, C_MESH0, b.p, b.n, NULL, &mesh, &terr);
+	mlod_result r1 = mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, NULL, &mesh, &terr);
 	char m1[sizeof terr.message];
 	memcpy(m1, terr.message, sizeof m1);
 	/* The same with a raw size that does not match: PARSE. */
-	wr32(b.p + 32 + 48 * C_MESH0 + 28, 1000);
+	wr32(b.p + 32 + 48 * C_MESH1 + 28, 1000);
 	restamp(b.p, b.n);
 	mlod_pack_close(&p);
 	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
 	memset(&terr, 0, sizeof terr);
-	mlod_result r2 = mlod_pack_decode_mesh(&p, C_MESH0, b.p, b.n, NULL, &mesh, &terr);
+	mlod_result r2 = mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, NULL, &mesh, &terr);
 	mlod_pack_close(&p);
 	free(b.p);
 	free_chunks(c, n);
-	CHECK_MSG(r1 == MLOD_ERR_NOMEM && strstr(m1, "MESH level 0:"), "returned %d: %s", (int)r1, m1);
+	CHECK_MSG(r1 == MLOD_ERR_NOMEM && strstr(m1, "MESH level 1:"), "returned %d: %s", (int)r1, m1);
 	CHECK_MSG(r2 == MLOD_ERR_PARSE && strstr(terr.message, "raw size 1000 in the TOC"), "returned %d: %s", (int)r2,
 	          terr.message);
 }
@@ -1576,7 +1663,7 @@ TEST(meshopt_streams)
 	int n = make_chunks(c, 0);
 	c[C_MESH1].codec = MLOD_CODEC_MESHOPT;
 	c[C_MESH1].s[0].codec = MLOD_SCODEC_MESHOPT_VERTEX;
-	buf b = build_pack(c, n, 1, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	free_chunks(c, n);
 	mlod_pack p;
 	mlod_pack_mesh m;
@@ -1656,6 +1743,7 @@ int main(int argc, char **argv)
 	RUN(free_accepts_zeroed);
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
+	RUN(older_major_is_refused);
 	RUN(draco_chunks_are_unsupported);
 	RUN(every_prefix);
 	RUN(structural_checks_name_the_chunk);

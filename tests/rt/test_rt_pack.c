@@ -166,7 +166,7 @@ static void write_pack(bytes *out)
 	}
 	memset(out, 0, sizeof *out);
 	put(out, "MLOD", 4);
-	put16(out, 1), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
+	put16(out, MLOD_PACK_MAJOR), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
 	put32(out, 0), put32(out, 0); /* CRCs below */
 	for (int i = 0; i < nchunks; i++) {
 		chunk *c = &chunks[i];
@@ -203,19 +203,39 @@ static void oct(const float *n, int16_t *q)
 	q[0] = (int16_t)lrintf(x * 32767), q[1] = (int16_t)lrintf(y * 32767);
 }
 
+/* The fixture's mesh levels as the pack stores them (layout b2): level
+ * 0's parts at every level (a part a coarser fixture level lacks has no
+ * vertices there), one grid per part (the union of its levels' boxes),
+ * and each level's block holding all its vertices (no vertex shared with a
+ * coarser level: the format allows it) after the coarser levels' blocks;
+ * its indices use every vertex of its block in order, so that the reader's
+ * gathered level is the fixture's, vertex for vertex. */
+static const mlod_pack_mesh *fx_levels[3];
+
+static const mlod_pack_part *level_part(uint32_t level, uint32_t i)
+{
+	return i < fx_levels[level]->part_count ? &fx_levels[level]->parts[i] : NULL;
+}
+
 static void mesh_chunk(const mlod_pack_mesh *m, uint32_t level)
 {
+	(void)m;
+	const mlod_pack_mesh *m0 = fx_levels[0];
 	chunk *c = new_chunk(MLOD_CHUNK_MESH, MLOD_LAYER_MESH, level, 0, fx_vmesh[level].error, fx_vmesh[level].distance);
 	bytes *b = stream(c, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec));
-	for (uint32_t i = 0; i < m->part_count; i++) {
-		const mlod_pack_part *p = &m->parts[i];
-		mlod_pack_part_rec r = p->rec;
-		r.index_count = r.vertex_count >= 3 ? 3 : 0;
+	for (uint32_t i = 0; i < m0->part_count; i++) {
+		mlod_pack_part_rec r = m0->parts[i].rec;
+		const mlod_pack_part *p = level_part(level, i);
+		r.vertex_count = p ? p->rec.vertex_count : 0;
+		r.index_count = (r.vertex_count + 2) / 3 * 3;
 		for (int a = 0; a < 3; a++) {
 			float lo = 1e30f, hi = -1e30f;
-			for (uint32_t v = 0; v < r.vertex_count; v++) {
-				float x = p->positions[3 * v + a];
-				lo = x < lo ? x : lo, hi = x > hi ? x : hi;
+			for (uint32_t l = 0; l < 3; l++) {
+				const mlod_pack_part *q = level_part(l, i);
+				for (uint32_t v = 0; q && v < q->rec.vertex_count; v++) {
+					float x = q->positions[3 * v + a];
+					lo = x < lo ? x : lo, hi = x > hi ? x : hi;
+				}
 			}
 			r.pos_min[a] = lo;
 			r.pos_scale[a] = (hi - lo) / 65535.0f;
@@ -223,9 +243,12 @@ static void mesh_chunk(const mlod_pack_mesh *m, uint32_t level)
 		put(b, &r, sizeof r);
 	}
 	stream_end(c);
-	for (uint32_t i = 0; i < m->part_count; i++) {
-		const mlod_pack_part *p = &m->parts[i];
+	for (uint32_t i = 0; i < m0->part_count; i++) {
+		const mlod_pack_part *p = level_part(level, i);
 		const mlod_pack_part_rec *r = (const mlod_pack_part_rec *)c->data[0].d + i;
+		uint32_t base = 0;
+		for (uint32_t l = level + 1; l < 3; l++)
+			base += level_part(l, i) ? level_part(l, i)->rec.vertex_count : 0;
 		b = stream(c, MLOD_STREAM_POSQ, 8);
 		for (uint32_t v = 0; v < r->vertex_count; v++) {
 			for (int a = 0; a < 3; a++)
@@ -265,7 +288,7 @@ static void mesh_chunk(const mlod_pack_mesh *m, uint32_t level)
 		}
 		b = stream(c, MLOD_STREAM_IDX, 4);
 		for (uint32_t k = 0; k < r->index_count; k++)
-			put32(b, k);
+			put32(b, base + (k < r->vertex_count ? k : r->vertex_count - 1));
 		stream_end(c);
 	}
 }
@@ -372,6 +395,7 @@ static void build_pack(bytes *out)
 		stream_end(c);
 	}
 	const mlod_pack_mesh *ml[3] = { &fx_mesh0, &fx_mesh1, &fx_mesh2 };
+	memcpy(fx_levels, ml, sizeof ml);
 	for (int l = 2; l >= 0; l--) {
 		mesh_chunk(ml[l], (uint32_t)l);
 		for (uint32_t clip = 0; clip < 2; clip++)
@@ -805,6 +829,54 @@ TEST(mutations)
 	CHECK(opened > 0, "no mutated pack opened: the CRC-fixed half should reach the decoders");
 }
 
+/* A read source loads a MESH level by reading its chunk and every coarser
+ * MESH chunk again through the callback (layout b2: the level's indices
+ * refer to the coarser levels' vertex blocks), one after the other, and
+ * keeps nothing of them; with a budget, through the callback too, the
+ * resident bytes never pass it. */
+TEST(read_source_rereads_coarser_mesh)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_read(mem_read, &pack, pack.n, NULL, &ctx, &e), e);
+	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MESH, 0, 0, &e), e);
+	int before = reads;
+	uint32_t loaded = 0;
+	CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, &loaded, &e), e);
+	CHECK(loaded == 1 && reads - before == 3, "%u loads, %d reads (MESH levels 2, 1 and 0 expected)", loaded,
+	      reads - before);
+	CHECK(mlod_rt_mesh_vertex_count(ctx, 0) == 7 && mlod_rt_mesh_part_count(ctx, 0) == 3,
+	      "level 0: %u vertices, %u parts", mlod_rt_mesh_vertex_count(ctx, 0), mlod_rt_mesh_part_count(ctx, 0));
+	mlod_rt_close(ctx);
+	mlod_rt_stats s;
+	CHECK_OK(mlod_rt_open_read(mem_read, &pack, pack.n, NULL, &ctx, &e), e);
+	mlod_rt_stats_get(ctx, &s);
+	const size_t at_open = s.resident_bytes; /* the coarse levels and the staging buffer */
+	mlod_rt_close(ctx);
+	for (size_t extra = 0; extra <= 8000; extra += 1000) {
+		mlod_rt_config cfg = { at_open + extra, 16, NULL };
+		CHECK_OK(mlod_rt_open_read(mem_read, &pack, pack.n, &cfg, &ctx, &e), e);
+		mlod_rt_select sel;
+		mlod_rt_select_default(&sel);
+		uint32_t ids[4];
+		float d[4];
+		for (int i = 0; i < 4; i++)
+			CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)i % 2, 0, MLOD_RT_LOOP, &ids[i], &e), e);
+		for (int f = 0; f < 30; f++) {
+			for (int i = 0; i < 4; i++)
+				d[i] = (float)((i * 37 + f * 11) % 200);
+			CHECK_OK(mlod_rt_update(ctx, &sel, ids, d, 4, 0.05f, &e), e);
+			CHECK_OK(mlod_rt_stream(ctx, 4096, NULL, &e), e);
+			mlod_rt_stats_get(ctx, &s);
+			CHECK(s.peak_resident_bytes <= at_open + extra, "budget %zu: peak %zu", at_open + extra,
+			      s.peak_resident_bytes);
+			for (int i = 0; i < 4; i++) /* always some level to show */
+				CHECK(mlod_rt_instance_state(ctx, ids[i])->level[MLOD_RT_MESH] < 3, "instance %d has no mesh level", i);
+		}
+		mlod_rt_close(ctx);
+	}
+}
+
 TEST(pack_budget)
 {
 	mlod_error e;
@@ -846,6 +918,7 @@ int main(void)
 	printf("# pack of %zu bytes, %d chunks\n", pack.n, nchunks);
 	RUN(pack_equals_views);
 	RUN(pack_poses_as_its_decoded_views);
+	RUN(read_source_rereads_coarser_mesh);
 	RUN(pack_budget);
 	RUN(hooks_only);
 	RUN(truncated_prefixes);

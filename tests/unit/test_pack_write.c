@@ -267,66 +267,101 @@ TEST(pack_mesh_streams)
 	uint32_t chunks = rd32(p + 12);
 	CHECK(rd32(p + 24) == crc(p + 32, 48 * (size_t)chunks));
 	CHECK(st.mesh.levels == 2 && st.skeleton.levels == 1 && st.motion.levels == 1);
-	/* MESH level 0: the input's primitive, quantised. */
-	const uint8_t *mesh = NULL;
+	/* MESH level 0: the input's primitive, quantised. Layout b2: level
+	 * 1's block of vertices, then level 0's, make the prefix level 0's
+	 * indices refer to. */
+	const uint8_t *mesh = NULL, *mesh1 = NULL;
 	for (uint32_t i = 0; i < chunks; i++) {
 		const uint8_t *e = p + 32 + 48 * i;
 		uint64_t off = rd32(e + 16) | (uint64_t)rd32(e + 20) << 32;
 		CHECK(rd32(e + 32) == crc(p + off, rd32(e + 24)));
 		if (rd32(e) == MLOD_CHUNK_MESH && e[6] == 0 && e[7] == 0)
 			mesh = p + off;
+		if (rd32(e) == MLOD_CHUNK_MESH && e[6] == 1 && e[7] == 0)
+			mesh1 = p + off;
 	}
-	CHECK(mesh);
-	uint32_t cnt, esz;
+	CHECK(mesh && mesh1);
+	uint32_t cnt, esz, c1, e1;
 	mlod_pack_part_rec *part = (mlod_pack_part_rec *)stream(mesh, MLOD_STREAM_PART, 0, &cnt, &esz);
-	CHECK(part && cnt == 1 && esz == sizeof *part);
+	mlod_pack_part_rec *part1 = (mlod_pack_part_rec *)stream(mesh1, MLOD_STREAM_PART, 0, &c1, &e1);
+	CHECK(part && cnt == 1 && esz == sizeof *part && part1 && c1 == 1);
 	const mlod_primitive *pr = &c.meshes[c.instances[0].mesh].primitives[0];
-	CHECK(part->vertex_count == (uint32_t)pr->vertex_count && part->index_count == (uint32_t)pr->index_count);
+	/* the vertices its triangles use, bit-identical ones once */
+	CHECK(part->vertex_count <= (uint32_t)pr->vertex_count && part->index_count == (uint32_t)pr->index_count);
 	CHECK(part->flags & MLOD_PART_SKINNED);
-	/* the part's box over 2^position_bits - 1 steps (mlod(5)) */
+	/* one grid for the part's levels: level 0's steps (its box over
+	 * 2^position_bits - 1) from the corner of the levels' boxes (mlod(5)) */
 	for (int a = 0; a < 3; a++) {
 		float lo = INFINITY, hi = -INFINITY;
 		for (int u = 0; u < pr->vertex_count; u++)
 			lo = fminf(lo, pr->positions[3 * u + a]), hi = fmaxf(hi, pr->positions[3 * u + a]);
 		double want = ((double)hi - lo) / (ldexp(1.0, opt.position_bits) - 1.0);
-		CHECK(part->pos_min[a] == lo);
+		CHECK(part->pos_min[a] <= lo && part->pos_min[a] == part1->pos_min[a]);
 		CHECK_NEAR(part->pos_scale[a], want, want * 1e-6);
+		CHECK(part->pos_scale[a] == part1->pos_scale[a]);
 	}
-	uint16_t *pos = (uint16_t *)stream(mesh, MLOD_STREAM_POSQ, 0, &cnt, &esz);
-	int16_t *nrm = (int16_t *)stream(mesh, MLOD_STREAM_NRMQ, 0, &cnt, &esz);
-	uint8_t *wgt = stream(mesh, MLOD_STREAM_WGT8, 0, &cnt, &esz);
-	uint8_t *jnt = stream(mesh, MLOD_STREAM_JNT8, 0, &cnt, &esz);
+	/* The prefix: both blocks of each vertex stream. */
+	uint8_t *blk[2][4];
+	uint32_t bn[2] = {0, 0};
+	static const uint32_t tags[4] = {MLOD_STREAM_POSQ, MLOD_STREAM_NRMQ, MLOD_STREAM_WGT8, MLOD_STREAM_JNT8};
+	static const uint32_t sizes[4] = {8, 4, 4, 4};
+	for (int l = 0; l < 2; l++)
+		for (int t = 0; t < 4; t++) {
+			blk[l][t] = stream(l ? mesh : mesh1, tags[t], 0, &cnt, &esz);
+			CHECK(blk[l][t] && esz == sizes[t]);
+			bn[l] = cnt;
+		}
+	uint32_t total = bn[0] + bn[1];
+	uint8_t *pref[4];
+	for (int t = 0; t < 4; t++) {
+		pref[t] = malloc((size_t)total * sizes[t] + 1);
+		memcpy(pref[t], blk[0][t], (size_t)bn[0] * sizes[t]);
+		memcpy(pref[t] + (size_t)bn[0] * sizes[t], blk[1][t], (size_t)bn[1] * sizes[t]);
+		free(blk[0][t]), free(blk[1][t]);
+	}
+	uint16_t *pos = (uint16_t *)pref[0];
+	int16_t *nrm = (int16_t *)pref[1];
+	uint8_t *wgt = pref[2], *jnt = pref[3];
 	uint16_t *idx = (uint16_t *)stream(mesh, MLOD_STREAM_IDX, 0, &cnt, &esz);
-	CHECK(pos && nrm && wgt && jnt && idx && esz == 2 && cnt == part->index_count);
-	/* The stored order is one of mlod_pack_vertex_order's: find the one
-	 * whose triangles (each up to a rotation of its corners, which the
-	 * index codec may make) are the stored ones, and check every vertex
-	 * through its remap. */
+	CHECK(idx && esz == 2 && cnt == part->index_count);
+	/* Level 0's triangles follow one of mlod_pack_vertex_order's orders
+	 * (each up to a rotation of its corners, which the index codec may
+	 * make), each order-local vertex standing for one prefix vertex: find
+	 * the order, then check every vertex through it. */
 	uint32_t nv = (uint32_t)pr->vertex_count, ni = part->index_count;
 	uint32_t *remap = malloc(sizeof *remap * nv), *want_idx = malloc(sizeof *want_idx * ni);
+	uint32_t *gid = malloc(sizeof *gid * nv), *best_gid = malloc(sizeof *gid * nv);
 	int order = -1;
 	for (int o = 0; o < MLOD_PACK_ORDERS && order < 0; o++) {
 		CHECK(mlod_pack_vertex_order(o, (const uint32_t *)pr->indices, ni, nv, remap, want_idx) == 0);
+		for (uint32_t v = 0; v < nv; v++)
+			gid[v] = UINT32_MAX;
 		int same = 1;
 		for (uint32_t t = 0; same && t < ni; t += 3) {
 			int rot = 0;
-			for (int r = 0; r < 3; r++)
-				if (idx[t] == want_idx[t + r] && idx[t + 1] == want_idx[t + (r + 1) % 3] &&
-				    idx[t + 2] == want_idx[t + (r + 2) % 3])
-					rot = 1;
+			for (int r = 0; r < 3 && !rot; r++) {
+				rot = 1;
+				for (int j = 0; j < 3; j++) {
+					uint32_t l = want_idx[t + (r + j) % 3];
+					rot &= idx[t + j] < total && (gid[l] == UINT32_MAX || gid[l] == idx[t + j]);
+				}
+				for (int j = 0; rot && j < 3; j++)
+					gid[want_idx[t + (r + j) % 3]] = idx[t + j];
+			}
 			same = rot;
 		}
 		if (same)
-			order = o;
+			order = o, memcpy(best_gid, gid, sizeof *gid * nv);
 	}
 	CHECK_MSG(order >= 0, "the stored triangles are none of the orders'");
-	printf("# MESH level 0 stored in order %d\n", order);
+	printf("# MESH level 0 stored in order %d, its block %u vertices after level 1's %u\n", order, bn[1], bn[0]);
 	for (int u = 0; order >= 0 && u < pr->vertex_count; u++) {
-		int v = (int)remap[u]; /* stored index of input vertex u */
+		if (best_gid[remap[u]] == UINT32_MAX)
+			continue; /* no triangle uses it */
+		int v = (int)best_gid[remap[u]]; /* the prefix vertex of input vertex u */
 		for (int a = 0; a < 3; a++) {
 			float back = part->pos_min[a] + (float)pos[4 * v + a] * part->pos_scale[a];
 			CHECK_NEAR(back, pr->positions[3 * u + a], 0.5 * part->pos_scale[a] + 1e-5);
-			CHECK(pos[4 * v + a] < 1u << opt.position_bits);
 		}
 		float d[3];
 		mlod_pack_oct_decode(nrm + 2 * v, d);
@@ -346,6 +381,9 @@ TEST(pack_mesh_streams)
 			          got, want / sum);
 		}
 	}
+	free(gid);
+	free(best_gid);
+	free(part1);
 	free(remap);
 	free(want_idx);
 	free(part);

@@ -406,22 +406,31 @@ static void morph_pack(const char *path)
 			if (c.clip_count)
 				mlod_clip_sample(&c.clips[0], t, local);
 			mlod_pose_world(s, local, world);
-			size_t base = 0;
+			/* The pack's level keeps the input's triangles in order with
+			 * codec none, but its vertices are those the triangles use,
+			 * in first-use order (layout b2): compared corner by corner. */
 			for (uint32_t p = 0; p < v.mesh.part_count; p++) {
 				const mlod_pack_part *pt = &v.parts[p];
 				const mlod_primitive *q0 = v.prims[p];
 				mlod_primitive qm = *q0;
+				mlod_rt_part_info info;
+				CHECK_OK(mlod_rt_mesh_part(ctx, 0, p, &info, &terr));
+				uint32_t ni = q0->index_count > 0 ? (uint32_t)q0->index_count : (uint32_t)q0->vertex_count;
+				CHECK(info.index_count == ni - ni % 3);
 				for (int morphed = 0; morphed < 2; morphed++) {
 					if (morphed && q0->target_count > 0)
 						qm.positions = (float *)bake_morph(q0, pt->rec.instance, 3, mp);
 					bake_part(s, pt, &qm, world, sm, bp, bn);
 					const float *r = morphed ? ra : rb;
-					for (size_t i = 0; i < 3 * (size_t)pt->rec.vertex_count; i++) {
-						double d = fabs((double)r[3 * base + i] - bp[i]) / diag;
-						worst[morphed] = d > worst[morphed] ? d : worst[morphed];
+					for (uint32_t k = 0; k < info.index_count && info.index_count == ni - ni % 3; k++) {
+						size_t rv = (size_t)info.first_vertex + info.indices[k];
+						size_t iv = q0->index_count > 0 ? (size_t)q0->indices[k] : k;
+						for (int a = 0; a < 3; a++) {
+							double d = fabs((double)r[3 * rv + a] - bp[3 * iv + a]) / diag;
+							worst[morphed] = d > worst[morphed] ? d : worst[morphed];
+						}
 					}
 				}
-				base += pt->rec.vertex_count;
 			}
 		}
 		for (int i = 0; i < 2; i++)
