@@ -1455,6 +1455,70 @@ static double time_step(const float *const *arr, const int *cnt, int n, uint32_t
 	return 0;
 }
 
+/* A rotation key's lattice value the reader rebuilds (mlod(5) ROTQ): the
+ * component big from the three others n (big's own entry ignored), as
+ * lib/motion rounds onto the lattice of normalised shorts. */
+static long rotq_big(const long *n, int big)
+{
+	double sum = 0.0;
+	for (int c = 0; c < 4; c++)
+		if (c != big) {
+			float f = (float)((double)n[c] / 32767.0);
+			sum += (double)f * f;
+		}
+	return lrint(sqrt(sum < 1.0 ? 1.0 - sum : 0.0) * 32767.0);
+}
+
+/* One 'ROTQ' key: the three components other than the one at index big
+ * (in index order), then big. When r is a lattice point (n / 32767) whose
+ * component big, made non-negative, is what the reader rebuilds from the
+ * other three (as lib/motion's levels are), it comes back exactly (up to
+ * the sign); else r is normalised, big is its largest component, made
+ * non-negative, and the three go to the nearest lattice points. */
+static void rotq_encode(const float *r, int16_t *out)
+{
+	long n[4], m[4];
+	int order[4] = {0, 1, 2, 3};
+	for (int c = 0; c < 4; c++) {
+		double e = r[c] > 1 ? 1 : r[c] < -1 ? -1 : r[c];
+		n[c] = lrint(e * 32767.0);
+	}
+	for (int i = 1; i < 4; i++) /* by decreasing |n|, index order on ties */
+		for (int j = i; j > 0 && labs(n[order[j]]) > labs(n[order[j - 1]]); j--) {
+			int t = order[j];
+			order[j] = order[j - 1], order[j - 1] = t;
+		}
+	int big = -1;
+	for (int i = 0; i < 4 && big < 0; i++) {
+		int b = order[i];
+		long sign = n[b] < 0 ? -1 : 1;
+		for (int c = 0; c < 4; c++)
+			m[c] = sign * n[c];
+		if (rotq_big(m, b) == m[b])
+			big = b;
+	}
+	if (big < 0) {
+		double len = 0.0, u[4];
+		for (int c = 0; c < 4; c++)
+			len += (double)r[c] * r[c];
+		len = len > 0.0 ? sqrt(len) : 1.0;
+		big = 0;
+		for (int c = 0; c < 4; c++) {
+			u[c] = r[c] / len;
+			big = fabs(u[c]) > fabs(u[big]) ? c : big;
+		}
+		double sign = u[big] < 0 ? -1.0 : 1.0;
+		for (int c = 0; c < 4; c++) {
+			double e = sign * u[c];
+			m[c] = lrint((e > 1 ? 1 : e < -1 ? -1 : e) * 32767.0);
+		}
+	}
+	for (int c = 0, i = 0; c < 4; c++)
+		if (c != big)
+			out[i++] = (int16_t)m[c];
+	out[3] = (int16_t)big;
+}
+
 static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int item, float error, chunks *out)
 {
 	chunkb cb = {0};
@@ -1541,22 +1605,8 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		int konst = constant_channel(ch);
 		uint32_t keys = konst ? 1 : (uint32_t)ch->key_count, per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
 		if (ch->path == MLOD_PATH_ROTATION && per == 1) {
-			/* Nearest lattice point, each key's sign continuing the last. */
-			for (uint32_t v = 0; v < keys; v++, at_q++) {
-				const float *r = ch->values + 4 * (size_t)v;
-				double sign = 1;
-				if (v > 0) {
-					double dot = 0;
-					for (int c = 0; c < 4; c++)
-						dot += (double)r[c] * q[4 * (at_q - 1) + c];
-					sign = dot < 0 ? -1 : 1;
-				}
-				for (int c = 0; c < 4; c++) {
-					double e = sign * r[c];
-					e = e > 1 ? 1 : e < -1 ? -1 : e;
-					q[4 * at_q + c] = (int16_t)lrint(e * 32767.0);
-				}
-			}
+			for (uint32_t v = 0; v < keys; v++, at_q++)
+				rotq_encode(ch->values + 4 * (size_t)v, q + 4 * at_q);
 		} else if (ch->path == MLOD_PATH_ROTATION) {
 			memcpy(rf + 4 * at_f, ch->values, sizeof(float) * 4 * 3 * keys);
 			at_f += 3 * (size_t)keys;

@@ -8,7 +8,7 @@
  * meshoptimizer's decoder, and never prints or exits.
  *
  * ------------------------------------------------------------------
- * File layout (format 1.0). Everything is little-endian.
+ * File layout (format 2.0). Everything is little-endian.
  *
  *   header      32 bytes at offset 0
  *   TOC         chunk_count entries of 48 bytes, right after the header
@@ -17,7 +17,8 @@
  *
  * Header:
  *   0  u8[4]  magic "MLOD"
- *   4  u16    major version (MLOD_PACK_MAJOR); a reader refuses a newer one
+ *   4  u16    major version (MLOD_PACK_MAJOR); a reader refuses any other
+ *             (an older one: pack the input again)
  *   6  u16    minor version; a newer minor only adds what older readers skip
  *   8  u32    flags (0; a reader ignores bits it does not know)
  *  12  u32    chunk_count (at most MLOD_PACK_MAX_CHUNKS)
@@ -138,10 +139,14 @@
  *   then the values, three streams, each holding the keys of its
  *   channels one channel after the other in channel order (possibly 0
  *   elements):
- *   'ROTQ' i16[4] per key of every non-cubic rotation (value = q / 32767):
- *          the rotation rounded to the nearest lattice point, each key's
- *          sign chosen for continuity with the key before (q and -q are
- *          one rotation);
+ *   'ROTQ' i16[4] per key of every non-cubic rotation: the components but
+ *          the one at index i, in index order, on the lattice of
+ *          normalised shorts (value = q / 32767), then i (0..3); the
+ *          reader rebuilds component i as lrint(sqrt(max(0, 1 - s)) *
+ *          32767) / 32767, s the sum of the others' squares (each the f32
+ *          nearest q / 32767, summed in f64), then negates the key when
+ *          its dot product with the key before is negative (q and -q are
+ *          one rotation). (Format 1.0 stored the four components.)
  *   'ROTF' f32[4], 3 per key (in-tangent, value, out-tangent), of every
  *          cubic-spline rotation;
  *   'VEC3' f32[3] per key (3 per key for cubic splines) of every
@@ -205,7 +210,7 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 1
+#define MLOD_PACK_MAJOR 2
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32
 #define MLOD_PACK_TOC_ENTRY_SIZE 48

@@ -252,6 +252,9 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		                 minor, MLOD_PACK_MAJOR);
 	if (major == 0)
 		return mlod_fail(err, MLOD_ERR_PARSE, "pack format %u.%u does not exist (the first is 1.0)", major, minor);
+	if (major < MLOD_PACK_MAJOR)
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "mlod %u.%u pack: made by an older mlod-pack; pack the input again",
+		                 major, minor);
 	uint32_t hcrc = mlod_pack_crc32(0, d, 28);
 	if (hcrc != rd32(d + 28))
 		return mlod_fail(err, MLOD_ERR_PARSE, "pack header: CRC mismatch (stored 0x%08x, computed 0x%08x)",
@@ -1454,8 +1457,27 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 			continue;
 		uint64_t values = ch->rec.key_count;
 		TAKE(ch->values, values * 16);
-		for (size_t k = 0; k < values * 4; k++)
-			ch->values[k] = rdi16(src + 2 * k) / 32767.0f;
+		for (size_t k = 0; k < values; k++) {
+			/* Three lattice components, then the index of the fourth,
+			 * rebuilt non-negative on the lattice; then the sign that
+			 * continues the key before. */
+			const uint8_t *e = src + 8 * k;
+			int big = rdi16(e + 6);
+			if (big < 0 || big > 3)
+				FAIL("%s: channel %u: rotation key %zu: component index %d is not 0 to 3", x.label, i, k, big);
+			float *v = ch->values + 4 * k;
+			double sum = 0.0, dot = 0.0;
+			for (int c = 0, j = 0; c < 4; c++)
+				if (c != big) {
+					v[c] = (float)(rdi16(e + 2 * j++) / 32767.0);
+					sum += (double)v[c] * v[c];
+				}
+			v[big] = (float)(lrint(sqrt(sum < 1.0 ? 1.0 - sum : 0.0) * 32767.0) / 32767.0);
+			for (int c = 0; k > 0 && c < 4; c++)
+				dot += (double)v[c] * v[c - 4];
+			for (int c = 0; dot < 0.0 && c < 4; c++)
+				v[c] = -v[c];
+		}
 		src += values * 8;
 	}
 	TRY(cx_expect(&x, &s, MLOD_STREAM_ROTF, 16, nf, "", "3 values per key of the cubic rotations", err));

@@ -120,6 +120,7 @@ static void put64(buf *b, uint64_t v) { put32(b, (uint32_t)v); put32(b, (uint32_
 static void putf(buf *b, float f) { uint32_t u; memcpy(&u, &f, 4); put32(b, u); }
 static void pad_to(buf *b, size_t align) { while (b->n % align) put8(b, 0); }
 static void wr32(uint8_t *p, uint32_t v) { p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24); }
+static void wr16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); }
 static uint32_t get32(const uint8_t *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
 static uint64_t get64(const uint8_t *p) { return get32(p) | (uint64_t)get32(p + 4) << 32; }
 
@@ -321,7 +322,7 @@ static float ibm_truth[NJ][16];
 static float time_truth[NK];
 static float vec_truth[NK * 3][3];
 static float rot_truth[NK * 3][4];
-static int16_t rotq_truth[NK][4];
+static int16_t rotq_truth[NK][4], rotq_enc[NK][4];
 
 static const int32_t parents[NJ] = {-1, 0, 1, 1};
 
@@ -689,9 +690,28 @@ static int make_chunks(wchunk *c, int with_unknown)
 		for (int a = 0; a < 4; a++)
 			rot_truth[k][a] = q[a] / sqrtf(l);
 	}
-	for (int k = 0; k < NK; k++)
-		for (int a = 0; a < 4; a++)
-			rotq_truth[k][a] = (int16_t)lrintf(rot_truth[k][a] * 32767.0f);
+	/* ROTQ: the three components but the largest, on the lattice, then
+	 * its index; the reader rebuilds it non-negative, then continues the
+	 * sign of the key before (rotq_truth: what it returns, x 32767). */
+	for (int k = 0; k < NK; k++) {
+		int big = 0;
+		for (int a = 1; a < 4; a++)
+			big = fabsf(rot_truth[k][a]) > fabsf(rot_truth[k][big]) ? a : big;
+		float sign = rot_truth[k][big] < 0 ? -1.0f : 1.0f;
+		double sum = 0, dot = 0;
+		for (int a = 0, j = 0; a < 4; a++)
+			if (a != big) {
+				rotq_enc[k][j++] = rotq_truth[k][a] = (int16_t)lrintf(sign * rot_truth[k][a] * 32767.0f);
+				float f = (float)(rotq_truth[k][a] / 32767.0);
+				sum += (double)f * f;
+			}
+		rotq_enc[k][3] = (int16_t)big;
+		rotq_truth[k][big] = (int16_t)lrint(sqrt(1.0 - sum) * 32767.0);
+		for (int a = 0; k > 0 && a < 4; a++)
+			dot += (double)rotq_truth[k][a] * rotq_truth[k - 1][a];
+		for (int a = 0; dot < 0 && a < 4; a++)
+			rotq_truth[k][a] = (int16_t)-rotq_truth[k][a];
+	}
 	/* the two time arrays, one after the other, as ticks */
 	s = add_stream(ch, MLOD_STREAM_TICK, 4, MLOD_SCODEC_MESHOPT_VERTEX);
 	s->count = 2 * NK;
@@ -703,7 +723,7 @@ static int make_chunks(wchunk *c, int with_unknown)
 	s->count = NK;
 	for (int k = 0; k < NK; k++)
 		for (int a = 0; a < 4; a++)
-			put16(&s->data, (uint16_t)rotq_truth[k][a]);
+			put16(&s->data, (uint16_t)rotq_enc[k][a]);
 	s = add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
 	s->count = NK * 3;
 	for (int k = 0; k < NK * 3; k++)
@@ -869,7 +889,7 @@ TEST(open_reads_header_and_toc)
 	buf b = make_pack(0);
 	mlod_pack p;
 	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
-	int ok = p.major == 1 && p.minor == 0 && p.chunk_count == C_COUNT && p.file_size == b.n &&
+	int ok = p.major == MLOD_PACK_MAJOR && p.minor == 0 && p.chunk_count == C_COUNT && p.file_size == b.n &&
 	         p.chunks[C_MESH0].type == MLOD_CHUNK_MESH && p.chunks[C_MESH0].codec == MLOD_CODEC_MESHOPT &&
 	         p.chunks[C_MESH1].level == 1 && p.chunks[C_MESH1].error == 0.01f &&
 	         p.chunks[C_MESH1].distance == 9.35f && p.chunks[C_MESH1].offset % 16 == 0;
@@ -1069,8 +1089,9 @@ TEST(decode_motion)
 		for (int a = 0; ok && a < 3; a++)
 			ok = m.channels[0].values[3 * k + a] == vec_truth[k][a] && m.channels[3].values[3 * k + a] == vec_truth[k][a];
 		for (int a = 0; ok && a < 4; a++)
-			ok = m.channels[1].values[4 * k + a] == rotq_truth[k][a] / 32767.0f &&
-			     fabsf(m.channels[1].values[4 * k + a] - rot_truth[k][a]) <= 0.5f / 32767 + 1e-7f;
+			ok = m.channels[1].values[4 * k + a] == (float)(rotq_truth[k][a] / 32767.0) &&
+			     fminf(fabsf(m.channels[1].values[4 * k + a] - rot_truth[k][a]),
+			           fabsf(m.channels[1].values[4 * k + a] + rot_truth[k][a])) <= 2.0f / 32767 + 1e-7f;
 	}
 	for (int k = 0; ok && k < 3 * NK; k++)
 		for (int a = 0; ok && a < 4; a++)
@@ -1142,8 +1163,8 @@ TEST(newer_major_is_refused)
 {
 	static wchunk c[C_COUNT + 1];
 	int n = make_chunks(c, 0);
-	buf b = build_pack(c, n, 2, 0);
-	buf m = build_pack(c, n, 1, 7); /* a newer minor reads */
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR + 1, 0);
+	buf m = build_pack(c, n, MLOD_PACK_MAJOR, 7); /* a newer minor reads */
 	free_chunks(c, n);
 	mlod_pack p = {0};
 	memset(&terr, 0, sizeof terr);
@@ -1156,8 +1177,26 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 2.0 is newer than this reader's 1.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 3.0 is newer than this reader's 2.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
+}
+
+/* Format 2.0 changed the MOTION streams: a 1.x pack is refused, with what
+ * to do (there is no 1.x decode path). */
+TEST(older_major_is_refused)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, 1, 0);
+	free_chunks(c, n);
+	mlod_pack p = {0};
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_open(b.p, b.n, &p, &terr);
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, terr.message);
+	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again") == 0,
+	          "message: %s", terr.message);
 }
 
 TEST(draco_chunks_are_unsupported)
@@ -1165,7 +1204,7 @@ TEST(draco_chunks_are_unsupported)
 	static wchunk c[C_COUNT + 1];
 	int n = make_chunks(c, 0);
 	c[C_MESH1].codec = MLOD_CODEC_DRACO;
-	buf b = build_pack(c, n, 1, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	free_chunks(c, n);
 	mlod_pack p = {0};
 	mlod_pack_mesh m = {0};
@@ -1305,7 +1344,7 @@ static buf edited_pack(edit_fn edit)
 	static wchunk c[C_COUNT + 1];
 	int n = make_chunks(c, 0);
 	edit(c);
-	buf b = build_pack(c, n, 1, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	free_chunks(c, n);
 	return b;
 }
@@ -1382,6 +1421,7 @@ static void e_tick_elsize(wchunk *c)
 static void e_morph_scale(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_MTSC, 0), 0xbf800000u); }
 static void e_no_skin(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 16, 0xffffffffu); }
 static void e_rotq_cubic(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 + 8, 2); }
+static void e_rotq_index(wchunk *c) { wr16(stream_data(c, C_MOT0, MLOD_STREAM_ROTQ, 0) + 8 * 2 + 6, 4); }
 static void e_part_flags(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x48); }
 
 TEST(structural_checks_name_the_chunk)
@@ -1421,6 +1461,7 @@ TEST(structural_checks_name_the_chunk)
 		{e_morph_scale, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: morph target 0: scale -1 is not finite and >= 0"},
 		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
 		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (keys of the non-cubic rotations)"},
+		{e_rotq_index, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 2: component index 4 is not 0 to 3"},
 		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x40"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
@@ -1538,7 +1579,7 @@ TEST(absurd_sizes)
 	m->ns = 0;
 	wstream *s = add_stream(m, MLOD_STREAM_PART, 200, MLOD_SCODEC_MESHOPT_VERTEX);
 	s->count = 0;
-	buf b = build_pack(c, n, 1, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	/* Patch the stream header and the raw size in place. */
 	mlod_pack p;
 	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
@@ -1576,7 +1617,7 @@ TEST(meshopt_streams)
 	int n = make_chunks(c, 0);
 	c[C_MESH1].codec = MLOD_CODEC_MESHOPT;
 	c[C_MESH1].s[0].codec = MLOD_SCODEC_MESHOPT_VERTEX;
-	buf b = build_pack(c, n, 1, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	free_chunks(c, n);
 	mlod_pack p;
 	mlod_pack_mesh m;
@@ -1656,6 +1697,7 @@ int main(int argc, char **argv)
 	RUN(free_accepts_zeroed);
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
+	RUN(older_major_is_refused);
 	RUN(draco_chunks_are_unsupported);
 	RUN(every_prefix);
 	RUN(structural_checks_name_the_chunk);

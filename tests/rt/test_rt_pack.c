@@ -166,7 +166,7 @@ static void write_pack(bytes *out)
 	}
 	memset(out, 0, sizeof *out);
 	put(out, "MLOD", 4);
-	put16(out, 1), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
+	put16(out, MLOD_PACK_MAJOR), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
 	put32(out, 0), put32(out, 0); /* CRCs below */
 	for (int i = 0; i < nchunks; i++) {
 		chunk *c = &chunks[i];
@@ -304,14 +304,23 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 			int is = ch->rec.path == 1 ? (per == 1 ? 0 : 1) : 2;
 			if (is != kind)
 				continue;
-			for (uint32_t k = 0; k < K * per * (kind == 2 ? 3 : 4); k++) {
-				if (kind == 0) {
-					int16_t q = (int16_t)lrintf(ch->values[k] * 32767.0f);
-					put(b, &q, 2);
-				} else {
-					putf(b, ch->values[k]);
-				}
+			for (uint32_t k = 0; kind == 0 && k < K; k++) {
+				/* smallest three: the components but the largest, then its index */
+				const float *v = ch->values + 4 * (size_t)k;
+				int big = 0;
+				for (int a = 1; a < 4; a++)
+					big = fabsf(v[a]) > fabsf(v[big]) ? a : big;
+				float sign = v[big] < 0 ? -1.0f : 1.0f;
+				for (int a = 0; a < 4; a++)
+					if (a != big) {
+						int16_t q = (int16_t)lrintf(sign * v[a] * 32767.0f);
+						put(b, &q, 2);
+					}
+				int16_t q = (int16_t)big;
+				put(b, &q, 2);
 			}
+			for (uint32_t k = 0; kind != 0 && k < K * per * (kind == 2 ? 3 : 4); k++)
+				putf(b, ch->values[k]);
 		}
 		stream_end(c);
 	}

@@ -373,7 +373,7 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
  * (mlod_motion_point_error, radius pd) of every joint at the input's
  * common timeline frames and midpoints, each clip sampled and posed by the
  * bake library (not lib/motion's own evaluator): at most e0 plus the ROTQ
- * lattice's share (mlod(5): each rotation key within 2 asin(1/32767) rad;
+ * lattice's share (mlod(5): each rotation key within MLOD_PACK_ROTQ_ANGLE;
  * a rotation of the joint or an ancestor g off by that angle moves the
  * joint's origin by at most the angle times |o_joint - o_g| and turns its
  * world 3x3 part M by that angle, which the point error weighs by pd
@@ -422,7 +422,7 @@ static const char *level0_within(const mlod_character *c, const mlod_clip *a, co
 	for (int i = 0; i < b->channel_count; i++)
 		if (b->channels[i].path == MLOD_PATH_ROTATION && b->channels[i].interp != MLOD_INTERP_CUBICSPLINE)
 			rotq[b->channels[i].joint] = 1;
-	const double angle = 2.0 * asin(1.0 / 32767.0);
+	const double angle = MLOD_PACK_ROTQ_ANGLE;
 	for (int i = 0; i < n && !fail; i++) {
 		mlod_pose_rest(&c->skeleton, la);
 		mlod_pose_rest(&c->skeleton, lb);
@@ -539,7 +539,8 @@ static const char *round_trip(const char *path, const mlod_pack_options *opt, ch
 	}
 	/* Clips: level 0 under the clip's name, within mlod(5)'s bounds: key
 	 * times exact or within MLOD_PACK_TICK_TOLERANCE of the clip's span,
-	 * int16 rotations within MLOD_PACK_ROTQ_BOUND per component (q and -q
+	 * int16 rotations within MLOD_PACK_ROTQ_BOUND per component of the
+	 * normalised key (q and -q
 	 * are one rotation: the writer keeps signs continuous), other values
 	 * exact; a channel whose keys are all equal may come back as one key
 	 * at its last time. */
@@ -576,10 +577,13 @@ static const char *round_trip(const char *path, const mlod_pack_options *opt, ch
 						FAIL("clip '%s' channel %d key %d: time %.9g, unpacked %.9g", a->name, ch, i, x->times[i],
 						     y->times[j]);
 				const float *xv = x->values + (size_t)comps * (size_t)i, *yv = y->values + (size_t)comps * (size_t)j;
-				double e_pos = 0, e_neg = 0;
+				double e_pos = 0, e_neg = 0, len = 0;
+				for (int v = 0; v < comps; v++)
+					len += (double)xv[v] * xv[v];
+				len = rot && len > 0 ? sqrt(len) : 1.0; /* ROTQ: against the normalised key */
 				for (int v = 0; v < comps; v++) {
-					e_pos = fmax(e_pos, fabs((double)xv[v] - yv[v]));
-					e_neg = fmax(e_neg, fabs((double)xv[v] + yv[v]));
+					e_pos = fmax(e_pos, fabs((double)xv[v] / len - yv[v]));
+					e_neg = fmax(e_neg, fabs((double)xv[v] / len + yv[v]));
 				}
 				double e = rot ? fmin(e_pos, e_neg) : e_pos;
 				if (e > vtol)
