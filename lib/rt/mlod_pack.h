@@ -200,6 +200,7 @@
 #ifndef MLOD_PACK_H
 #define MLOD_PACK_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -282,8 +283,44 @@ typedef enum mlod_pack_codec {
 #define MLOD_STREAM_TIME MLOD_FOURCC('T', 'I', 'M', 'E')
 #define MLOD_STREAM_TICK MLOD_FOURCC('T', 'I', 'C', 'K')
 #define MLOD_STREAM_ROTQ MLOD_FOURCC('R', 'O', 'T', 'Q')
+/* TOC flags of a MOTION chunk: its rotation keys build on the clip's next
+ * coarser level (level + 1, earlier in the file). */
+#define MLOD_PACK_CHUNK_NESTED 1u
+
+/* One 'ROTQ' key as lattice integers (value = n / 32767): e the stored
+ * element; base, for a key whose time the base channel also has, that
+ * key as returned (else NULL): n = base + e, each wrapped to 16 bits;
+ * else the three components but e[3]'s in index order, the one at e[3]
+ * rebuilt non-negative (e[3] must be 0 to 3). prev: the key before as
+ * returned (NULL for the first): n is negated when its dot product with
+ * prev is negative. The writer and the reader share it. */
+static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, const int16_t *prev, int16_t n[4])
+{
+	if (base) {
+		for (int c = 0; c < 4; c++)
+			n[c] = (int16_t)(uint16_t)((uint16_t)base[c] + (uint16_t)e[c]);
+	} else {
+		int big = e[3] & 3;
+		double sum = 0.0;
+		for (int c = 0, j = 0; c < 4; c++)
+			if (c != big) {
+				float f = (float)(e[j] / 32767.0);
+				n[c] = e[j++];
+				sum += (double)f * f;
+			}
+		n[big] = (int16_t)lrint(sqrt(sum < 1.0 ? 1.0 - sum : 0.0) * 32767.0);
+	}
+	if (prev) {
+		int64_t dot = 0;
+		for (int c = 0; c < 4; c++)
+			dot += (int64_t)n[c] * prev[c];
+		for (int c = 0; dot < 0 && c < 4; c++)
+			n[c] = (int16_t)-n[c];
+	}
+}
 #define MLOD_STREAM_ROTF MLOD_FOURCC('R', 'O', 'T', 'F')
 #define MLOD_STREAM_VEC3 MLOD_FOURCC('V', 'E', 'C', '3')
+#define MLOD_STREAM_ROTD MLOD_FOURCC('R', 'O', 'T', 'D')
 #define MLOD_STREAM_GLB MLOD_FOURCC('G', 'L', 'B', ' ')
 
 /* ------------------------------------------------------------------ */
@@ -501,6 +538,15 @@ mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void
                                   const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err);
 mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
                                     const mlod_pack_skeleton *skel, mlod_pack_motion *out, mlod_error *err);
+/* A MOTION chunk with MLOD_PACK_CHUNK_NESTED builds on the clip's next
+ * coarser level: mlod_pack_decode_motion decodes that level (and what it
+ * builds on) from data, which must then hold it too (a whole file or a
+ * prefix); mlod_pack_decode_motion_on takes it decoded instead (base: the
+ * clip's level + 1, required for a nested chunk, else ignored), as a
+ * runtime that keeps it does. */
+mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                       const mlod_pack_skeleton *skel, const mlod_pack_motion *base,
+                                       mlod_pack_motion *out, mlod_error *err);
 /* The DOC chunk's glb bytes (*glb points into data after the CRC check;
  * the stream is stored raw). */
 mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, const void **glb, size_t *glb_size,

@@ -648,6 +648,7 @@ static int make_chunks(wchunk *c, int with_unknown)
 	putf(&s->data, 0.0f);
 	putf(&s->data, 1.0f);
 	add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_RAW);
+	add_stream(ch, MLOD_STREAM_ROTD, 8, MLOD_SCODEC_RAW);
 	add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
 	s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_RAW);
 	s->count = 2;
@@ -724,6 +725,7 @@ static int make_chunks(wchunk *c, int with_unknown)
 	for (int k = 0; k < NK; k++)
 		for (int a = 0; a < 4; a++)
 			put16(&s->data, (uint16_t)rotq_enc[k][a]);
+	add_stream(ch, MLOD_STREAM_ROTD, 8, MLOD_SCODEC_MESHOPT_VERTEX);
 	s = add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
 	s->count = NK * 3;
 	for (int k = 0; k < NK * 3; k++)
@@ -1399,7 +1401,7 @@ static void e_extra_stream(wchunk *c)
 		putf(&s->data, 2.0f);
 }
 static void e_dup_channel(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 2, 1); }
-static void e_no_vec3(wchunk *c) { wchunk_free_stream(&c[C_MOT1], 5); }
+static void e_no_vec3(wchunk *c) { wchunk_free_stream(&c[C_MOT1], 6); }
 static void e_missing_rotation(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1); }
 static void e_time_order(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 3 + 16, 2); }
 static void e_time_keys(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 12, 3); }
@@ -1448,7 +1450,7 @@ TEST(structural_checks_name_the_chunk)
 		{e_vertex_elsize, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: stream 1 'POSQ' has elements of 6 bytes, expected 8"},
 		{e_info_levels, C_INFO, MLOD_ERR_PARSE, "INFO: the TOC has SKELETON level 1, but INFO counts"},
 		{e_clip_names, C_INFO, MLOD_ERR_PARSE, "INFO: the string table 'NAME' ends before clip 0's name"},
-		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 6 'VEC3')"},
+		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 7 'VEC3')"},
 		{e_time_order, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 3: time array 2 is not below 2 (the arrays go in first-use order)"},
 		{e_time_keys, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 2 'TIME' has 2 elements, expected 3 (the time arrays' keys)"},
 		{e_time_shared_keys, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: 6 keys, but time array 0 has 5"},
@@ -1456,11 +1458,11 @@ TEST(structural_checks_name_the_chunk)
 		{e_step_nan, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: step nan is not finite and >= 0"},
 		{e_tick_elsize, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 'TICK' has elements of 1 bytes, expected 2 or 4"},
 		{e_dup_channel, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 2: a second rotation channel of joint 1"},
-		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 3 'ROTQ' has 0 elements, expected 2 (keys of the non-cubic rotations)"},
-		{e_no_vec3, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: missing stream 'VEC3' (the chunk has 5 streams)"},
+		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 3 'ROTQ' has 0 elements, expected 2 (rotation keys without a base key)"},
+		{e_no_vec3, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: missing stream 'VEC3' (the chunk has 6 streams)"},
 		{e_morph_scale, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: morph target 0: scale -1 is not finite and >= 0"},
 		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
-		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (keys of the non-cubic rotations)"},
+		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (rotation keys without a base key)"},
 		{e_rotq_index, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 2: component index 4 is not 0 to 3"},
 		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x40"},
 	};

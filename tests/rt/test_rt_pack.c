@@ -294,8 +294,13 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 			putf(b, ch->times[k]);
 	}
 	stream_end(c);
-	/* the values: ROTQ, ROTF, VEC3, each its channels' keys in order */
+	/* the values: ROTQ, ROTD (none: not nested), ROTF, VEC3, each its
+	 * channels' keys in order */
 	for (int kind = 0; kind < 3; kind++) {
+		if (kind == 1) {
+			stream(c, MLOD_STREAM_ROTD, 8);
+			stream_end(c);
+		}
 		b = stream(c, kind == 0 ? MLOD_STREAM_ROTQ : kind == 1 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3,
 		           kind == 0 ? 8 : kind == 1 ? 16 : 12);
 		for (uint32_t i = 0; i < m->channel_count; i++) {

@@ -402,8 +402,8 @@ static double sigma_max3(const mlod_mat4 *w)
 	return sqrt(lam);
 }
 
-static const char *level0_within(const mlod_character *c, const mlod_clip *a, const mlod_clip *b, double e0,
-                                 double pd, double height, double *worst, char *msg, size_t cap)
+static const char *level_within(const mlod_character *c, const mlod_clip *a, const mlod_clip *b, double e0,
+                                 double toc, double pd, double height, double *worst, char *msg, size_t cap)
 {
 	mlod_motion_options mo = {0};
 	mlod_clip common;
@@ -431,14 +431,25 @@ static const char *level0_within(const mlod_character *c, const mlod_clip *a, co
 		mlod_pose_world(&c->skeleton, la, wa);
 		mlod_pose_world(&c->skeleton, lb, wb);
 		for (int j = 0; j < nj && !fail; j++) {
-			double lattice = 0, radius = pd * sigma_max3(&wa[j]);
+			double lattice = 0, origin = 0, radius = pd * sigma_max3(&wa[j]);
 			for (int g = j; g >= 0; g = c->skeleton.joints[g].parent)
 				if (rotq[g]) {
 					double d = 0;
 					for (int r = 0; r < 3; r++)
 						d += ((double)wa[j].m[12 + r] - wa[g].m[12 + r]) * ((double)wa[j].m[12 + r] - wa[g].m[12 + r]);
 					lattice += angle * (sqrt(d) + radius);
+					origin += angle * sqrt(d);
 				}
+			/* the TOC's joint position error, honest up to the lattice */
+			double jp = 0;
+			for (int r = 0; r < 3; r++)
+				jp += ((double)wa[j].m[12 + r] - wb[j].m[12 + r]) * ((double)wa[j].m[12 + r] - wb[j].m[12 + r]);
+			jp = sqrt(jp);
+			if (toc >= 0 && jp > toc + origin + 1e-6 * height) {
+				snprintf(msg, cap, "clip '%s' joint %d at %.5g s: position error %.6g, TOC error %.6g + lattice %.6g",
+				         a->name, j, (double)t[i], jp, toc, origin);
+				fail = msg;
+			}
 			double e = mlod_motion_point_error(&wa[j], &wb[j], pd), bound = e0 + lattice + 1e-6 * height;
 			if (e / bound > *worst)
 				*worst = e / bound;
@@ -454,7 +465,20 @@ static const char *level0_within(const mlod_character *c, const mlod_clip *a, co
 	return fail;
 }
 
-static double worst_level0;
+static double worst_level0, worst_level[4];
+
+/* The TOC error of MOTION level l of clip q, or -1. */
+static double toc_error(const void *pack, size_t size, int l, int q)
+{
+	mlod_pack p;
+	mlod_error e = {0};
+	if (mlod_pack_open(pack, size, &p, &e) != MLOD_OK)
+		return -1;
+	int ci = mlod_pack_find(&p, MLOD_CHUNK_MOTION, (unsigned)l, (unsigned)q);
+	double r = ci >= 0 ? p.chunks[ci].error : -1;
+	mlod_pack_close(&p);
+	return r;
+}
 static int level0_fewer_keys; /* the sample's level 0 must have fewer keys than its input */
 
 /* Packs path with opt, unpacks, writes and reloads the glb, compares. */
@@ -552,7 +576,8 @@ static const char *round_trip(const char *path, const mlod_pack_options *opt, ch
 		if (!b)
 			FAIL("clip '%s' missing", a->name);
 		if (!opt->lossless_motion) {
-			const char *why = level0_within(&c, a, b, e0, pd, st.height, &worst_level0, msg, cap);
+			const char *why = level_within(&c, a, b, e0, toc_error(pack, pack_size, 0, k), pd, st.height, &worst_level0,
+			                               msg, cap);
 			if (why) {
 				fail = why;
 				goto done;
@@ -590,11 +615,26 @@ static const char *round_trip(const char *path, const mlod_pack_options *opt, ch
 					FAIL("clip '%s' channel %d key %d: values off by %.3g (bound %.3g)", a->name, ch, i, e, vtol);
 			}
 		}
-		/* Coarser levels are there too. */
-		char name[300];
-		snprintf(name, sizeof name, "%s@lod1", a->name);
-		if (st.motion.levels > 1 && !clip_named(&c2, name))
-			FAIL("clip '%s' missing", name);
+		/* Coarser levels are there too, each within its bound (the
+		 * default bounds, which every level of the samples meets) and its
+		 * TOC error, plus the ROTQ lattice's share. */
+		for (int l = 1; l < st.motion.levels; l++) {
+			char name[300];
+			snprintf(name, sizeof name, "%s@lod%d", a->name, l);
+			const mlod_clip *bl = clip_named(&c2, name);
+			if (!bl)
+				FAIL("clip '%s' missing", name);
+			if (l > opt->motion_bound_count)
+				continue;
+			double bound = opt->motion_percent[l - 1] ? opt->motion_bounds[l - 1] * st.height / 100.0
+			                                          : opt->motion_bounds[l - 1];
+			const char *why = level_within(&c, a, bl, bound, toc_error(pack, pack_size, l, k), pd, st.height,
+			                               &worst_level[l < 4 ? l : 3], msg, cap);
+			if (why) {
+				fail = why;
+				goto done;
+			}
+		}
 	}
 done:
 	mlod_character_free(&c);
@@ -620,11 +660,13 @@ static void sample_bits(const char *path, int pb, int nb, int ub, int fewer)
 		opt.position_bits = pb, opt.normal_bits = nb, opt.uv_bits = ub;
 	pos_bits = opt.position_bits, nrm_bits = opt.normal_bits, uv_bits = opt.uv_bits;
 	worst_pos_ratio = worst_pos_err = worst_nrm = worst_uv_ratio = worst_w = worst_level0 = 0;
+	memset(worst_level, 0, sizeof worst_level);
 	level0_fewer_keys = fewer;
 	const char *why = round_trip(path, &opt, msg, sizeof msg - 64);
 	fprintf(stderr, "%s (bits %d %d %d): max position error %.3g (%.3f of the half-step bound), normal %.3g rad, uv %.3f of bound, "
-	        "weight %.4f; motion level 0 point error %.3f of its bound\n", path, pos_bits, nrm_bits, uv_bits, worst_pos_err,
-	        worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w, worst_level0);
+	        "weight %.4f; motion level 0 point error %.3f of its bound, levels 1-3 %.3f %.3f %.3f\n", path, pos_bits,
+	        nrm_bits, uv_bits, worst_pos_err, worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w, worst_level0,
+	        worst_level[1], worst_level[2], worst_level[3]);
 	CHECK_MSG(!why, "%.200s: %.700s", path, why);
 	opt.lossless_motion = 1;
 	opt.no_skeleton_levels = opt.no_mesh_levels = 1;
