@@ -32,7 +32,7 @@
  *   5  u8     codec (MLOD_CODEC_*): the codec of the chunk's streams
  *   6  u16    level: 0 the finest (the input as read), larger is coarser
  *   8  u16    item: the clip for MOTION chunks, else 0
- *  10  u16    flags (0)
+ *  10  u16    flags (MLOD_PACK_CHUNK_NESTED for a nested MOTION level, else 0)
  *  12  u32    reserved (0)
  *  16  u64    offset of the chunk from the start of the file (16-aligned)
  *  24  u32    stored size in bytes
@@ -139,18 +139,26 @@
  *   then the values, three streams, each holding the keys of its
  *   channels one channel after the other in channel order (possibly 0
  *   elements):
- *   'ROTQ' i16[4] per key of every non-cubic rotation: the components but
- *          the one at index i, in index order, on the lattice of
- *          normalised shorts (value = q / 32767), then i (0..3); the
- *          reader rebuilds component i as lrint(sqrt(max(0, 1 - s)) *
- *          32767) / 32767, s the sum of the others' squares (each the f32
- *          nearest q / 32767, summed in f64), then negates the key when
- *          its dot product with the key before is negative (q and -q are
- *          one rotation). (Format 1.0 stored the four components.)
+ *   'ROTQ' i16[4] per key of every non-cubic rotation without a base key
+ *          (below): the components but the one at index i, in index
+ *          order, on the lattice of normalised shorts (value = q /
+ *          32767), then i (0..3); the reader rebuilds component i as
+ *          lrint(sqrt(max(0, 1 - s)) * 32767) / 32767, s the sum of the
+ *          others' squares (each the f32 nearest q / 32767, summed in f64);
+ *   'ROTD' i16[4] per key of every non-cubic rotation with a base key: its
+ *          lattice integers minus the base key's, wrapped to 16 bits;
+ *          after either, a key is negated when its dot product with the
+ *          channel's key before is negative (q and -q are one rotation)
+ *          (mlod_pack_rotq_key). (Format 1.0 stored the four components.)
  *   'ROTF' f32[4], 3 per key (in-tangent, value, out-tangent), of every
  *          cubic-spline rotation;
  *   'VEC3' f32[3] per key (3 per key for cubic splines) of every
  *          translation and scale.
+ *   A chunk with TOC flag MLOD_PACK_CHUNK_NESTED builds on the clip's
+ *   level + 1 (which exists and stands before it): a rotation key has a
+ *   base key when that level's non-cubic rotation channel of the joint
+ *   has a key at exactly the same (decoded) time. The writer nests every
+ *   level but the coarsest and keeps the clip's own values at every level.
  *   (Writer's notes: a non-cubic channel whose keys all hold one value is
  *   stored as one key at its last time, which keeps the clip's duration;
  *   key times go as ticks when every one is a multiple of one step within
