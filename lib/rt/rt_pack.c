@@ -45,21 +45,17 @@ static mlod_result chunk_bytes(mlod_rt_ctx *ctx, uint32_t chunk, const mlod_pack
 }
 
 /* A MOTION chunk decoded into out. A nested one (MLOD_PACK_CHUNK_NESTED)
- * builds on the clip's next coarser level: its resident unit, else that
- * chain decoded here from the nearest resident level (the coarsest is
- * pinned) or the first chunk that is not nested, and freed again. */
+ * builds on the clip's next coarser level, as the reader returns it: the
+ * chain of levels it builds on is decoded here, from the first that is
+ * not nested, and freed again (a resident level's keys may have been
+ * normalised: prepare_motion). */
 static mlod_result motion_load(mlod_rt_ctx *ctx, uint32_t chunk, mlod_pack_motion *out, mlod_error *err)
 {
 	const mlod_pack_chunk *c = &ctx->pack.chunks[chunk];
 	const mlod_pack_motion *base = NULL;
-	unsigned top = c->level; /* the finest level of the chain decoded here */
+	unsigned top = c->level; /* the coarsest level of the chain decoded here */
 	int ci = (int)chunk;
 	while (ci >= 0 && (ctx->pack.chunks[ci].flags & MLOD_PACK_CHUNK_NESTED)) {
-		const rt_unit *bu = rt_unit_get(ctx, MLOD_RT_MOTION, top + 1, c->item);
-		if (bu && bu->state == RT_UNIT_RESIDENT && bu->motion) {
-			base = bu->motion;
-			break;
-		}
 		if (top == 65535 || (ci = mlod_pack_find(&ctx->pack, MLOD_CHUNK_MOTION, top + 1, c->item)) < 0)
 			return mlod_fail(err, MLOD_ERR_PARSE, "MOTION level %u of clip %u: builds on level %u, which the pack lacks",
 			                 top, (unsigned)c->item, top + 1);
