@@ -135,7 +135,7 @@ typedef struct wstream {
 typedef struct wchunk {
 	uint32_t type;
 	uint8_t layer, codec;
-	uint16_t level, item;
+	uint16_t level, item, flags;
 	float error, distance;
 	int ns;
 	wstream s[MAXS];
@@ -277,7 +277,7 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		put8(&out, c[i].codec);
 		put16(&out, c[i].level);
 		put16(&out, c[i].item);
-		put16(&out, 0);
+		put16(&out, c[i].flags);
 		put32(&out, 0);
 		put64(&out, off[i]);
 		put32(&out, (uint32_t)chunks[i].n);
@@ -1201,6 +1201,57 @@ TEST(older_major_is_refused)
 	          "message: %s", terr.message);
 }
 
+/* A nested MOTION level (TOC flag MLOD_PACK_CHUNK_NESTED) builds on the
+ * clip's next coarser level: the coarsest cannot be nested, and
+ * mlod_pack_decode_motion_on needs the base; with one whose channels hold
+ * no rotation, every key of level 0 stands on its own and decodes as
+ * before. */
+TEST(nested_motion_needs_its_base)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	c[C_MOT1].flags = MLOD_PACK_CHUNK_NESTED;
+	buf b1 = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	c[C_MOT1].flags = 0;
+	c[C_MOT0].flags = MLOD_PACK_CHUNK_NESTED;
+	buf b0 = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	free_chunks(c, n);
+	mlod_pack p = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_motion m = {0}, base = {0};
+	CHECK_OK(mlod_pack_open(b1.p, b1.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b1.p, b1.n, &s, &terr));
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_motion(&p, C_MOT1, b1.p, b1.n, &s, &m, &terr);
+	CHECK_MSG(r == MLOD_ERR_PARSE &&
+	              strcmp(terr.message, "MOTION level 1 of clip 0: builds on level 2, which the pack lacks") == 0,
+	          "returned %d: %s", (int)r, terr.message);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b0.p, b0.n, &p, &terr));
+	memset(&terr, 0, sizeof terr);
+	r = mlod_pack_decode_motion_on(&p, C_MOT0, b0.p, b0.n, &s, NULL, &m, &terr);
+	CHECK_MSG(r == MLOD_ERR_PARSE &&
+	              strcmp(terr.message, "MOTION level 0 of clip 0: builds on level 1, which was not given") == 0,
+	          "returned %d: %s", (int)r, terr.message);
+	CHECK_OK(mlod_pack_decode_motion(&p, C_MOT0, b0.p, b0.n, &s, &m, &terr));
+	CHECK_OK(mlod_pack_decode_motion(&p, C_MOT1, b0.p, b0.n, &s, &base, &terr));
+	mlod_pack_motion m2 = {0};
+	CHECK_OK(mlod_pack_decode_motion_on(&p, C_MOT0, b0.p, b0.n, &s, &base, &m2, &terr));
+	int same = m.channel_count == 4 && m2.channel_count == 4;
+	for (int k = 0; same && k < NK; k++)
+		for (int a = 0; same && a < 4; a++)
+			same = m.channels[1].values[4 * k + a] == (float)(rotq_truth[k][a] / 32767.0) &&
+			       m2.channels[1].values[4 * k + a] == m.channels[1].values[4 * k + a];
+	CHECK(same);
+	mlod_pack_motion_free(&m);
+	mlod_pack_motion_free(&m2);
+	mlod_pack_motion_free(&base);
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_close(&p);
+	free(b1.p);
+	free(b0.p);
+}
+
 TEST(draco_chunks_are_unsupported)
 {
 	static wchunk c[C_COUNT + 1];
@@ -1700,6 +1751,7 @@ int main(int argc, char **argv)
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
 	RUN(older_major_is_refused);
+	RUN(nested_motion_needs_its_base);
 	RUN(draco_chunks_are_unsupported);
 	RUN(every_prefix);
 	RUN(structural_checks_name_the_chunk);
