@@ -294,6 +294,9 @@ typedef enum mlod_pack_codec {
 /* TOC flags of a MOTION chunk: its rotation keys build on the clip's next
  * coarser level (level + 1, earlier in the file). */
 #define MLOD_PACK_CHUNK_NESTED 1u
+/* At most this many nested levels in a row (a reader refuses a longer
+ * chain: each load decodes it). */
+#define MLOD_PACK_MAX_NESTING 64
 
 /* One 'ROTQ' key as lattice integers (value = n / 32767): e the stored
  * element; base, for a key whose time the base channel also has, that

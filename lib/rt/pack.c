@@ -1354,6 +1354,9 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	unsigned top = c->level;
 	int ci = (int)chunk;
 	while (ci >= 0 && (p->chunks[ci].flags & MLOD_PACK_CHUNK_NESTED)) {
+		if (top - c->level >= MLOD_PACK_MAX_NESTING)
+			return mlod_fail(err, MLOD_ERR_PARSE, "MOTION level %u of clip %u: more than %d nested levels in a row",
+			                 (unsigned)c->level, (unsigned)c->item, MLOD_PACK_MAX_NESTING);
 		if (top == 65535 || (ci = mlod_pack_find(p, MLOD_CHUNK_MOTION, top + 1, c->item)) < 0)
 			return mlod_fail(err, MLOD_ERR_PARSE, "MOTION level %u of clip %u: builds on level %u, which the pack lacks",
 			                 top, (unsigned)c->item, top + 1);

@@ -56,6 +56,9 @@ static mlod_result motion_load(mlod_rt_ctx *ctx, uint32_t chunk, mlod_pack_motio
 	unsigned top = c->level; /* the coarsest level of the chain decoded here */
 	int ci = (int)chunk;
 	while (ci >= 0 && (ctx->pack.chunks[ci].flags & MLOD_PACK_CHUNK_NESTED)) {
+		if (top - c->level >= MLOD_PACK_MAX_NESTING)
+			return mlod_fail(err, MLOD_ERR_PARSE, "MOTION level %u of clip %u: more than %d nested levels in a row",
+			                 (unsigned)c->level, (unsigned)c->item, MLOD_PACK_MAX_NESTING);
 		if (top == 65535 || (ci = mlod_pack_find(&ctx->pack, MLOD_CHUNK_MOTION, top + 1, c->item)) < 0)
 			return mlod_fail(err, MLOD_ERR_PARSE, "MOTION level %u of clip %u: builds on level %u, which the pack lacks",
 			                 top, (unsigned)c->item, top + 1);
