@@ -7,9 +7,11 @@
  *              inverse binds, materials of the primitives, index lists;
  *              with lossless_motion, clip key times and values (ROTQ
  *              within its lattice bound)
- *   bounded    motion level 0 (the default): at the input clip's common
+ *   bounded    every motion level (level 0 by default, and the coarser
+ *              ones as <clip>@lod<k>): at the input clip's common
  *              timeline frames and midpoints, every joint's point error
- *              within the level-0 bound plus the ROTQ lattice's share,
+ *              within the level's bound, and its position error within
+ *              the level's TOC error, each plus the ROTQ lattice's share,
  *              both clips sampled and posed with the bake library
  *   quantised  (mlod(5)) positions within half a step of position_bits
  *              of the part's box per axis, normals within
