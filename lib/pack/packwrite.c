@@ -1531,13 +1531,14 @@ typedef struct motion_img {
 		uint32_t joint, path, interp, keys;
 		float *times;
 		int16_t *rot;
+		float *vec; /* non-cubic translations and scales: the values */
 	} *ch;
 } motion_img;
 
 static void motion_img_free(motion_img *m)
 {
 	for (int i = 0; m && i < m->n; i++)
-		free(m->ch[i].times), free(m->ch[i].rot);
+		free(m->ch[i].times), free(m->ch[i].rot), free(m->ch[i].vec);
 	if (m)
 		free(m->ch), memset(m, 0, sizeof *m);
 }
@@ -1630,7 +1631,7 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 	else
 		img->n = n;
 	for (int i = 0; i < img->n; i++)
-		img->ch[i] = (struct img_chan){recs[i].joint, recs[i].path, recs[i].interp, recs[i].key_count, NULL, NULL};
+		img->ch[i] = (struct img_chan){recs[i].joint, recs[i].path, recs[i].interp, recs[i].key_count, NULL, NULL, NULL};
 	int *ta = malloc(sizeof *ta * ((size_t)n + 1));
 	if (!ta)
 		cb.fail = 1;
@@ -1689,6 +1690,9 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		if (ic->path == MLOD_PATH_ROTATION && ic->interp != MLOD_INTERP_CUBICSPLINE &&
 		    !(ic->rot = malloc(sizeof *ic->rot * 4 * ic->keys)))
 			cb.fail = 1;
+		if (ic->path != MLOD_PATH_ROTATION && ic->interp != MLOD_INTERP_CUBICSPLINE &&
+		    !(ic->vec = malloc(sizeof *ic->vec * 3 * ic->keys)))
+			cb.fail = 1;
 	}
 	free(dt);
 	free(dt_at);
@@ -1709,9 +1713,10 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 			nv += per * keys;
 	}
 	int16_t *q = malloc(sizeof(int16_t) * 4 * (nq + 1)), *qd = malloc(sizeof(int16_t) * 4 * (nq + 1));
-	size_t at_d = 0, at_a = 0;
+	uint32_t *vd = malloc(sizeof *vd * 3 * (nv + 1));
+	size_t at_d = 0, at_a = 0, at_vd = 0;
 	float *rf = malloc(sizeof(float) * 4 * (nf + 1)), *v3 = malloc(sizeof(float) * 3 * (nv + 1));
-	if (!q || !qd || !rf || !v3)
+	if (!q || !qd || !vd || !rf || !v3)
 		cb.fail = 1;
 	size_t at_q = 0, at_f = 0, at_v = 0;
 	for (int i = 0; i < n && !cb.fail; i++) {
@@ -1735,17 +1740,46 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		} else if (ch->path == MLOD_PATH_ROTATION) {
 			memcpy(rf + 4 * at_f, ch->values, sizeof(float) * 4 * 3 * keys);
 			at_f += 3 * (size_t)keys;
-		} else {
+		} else if (per == 3) {
 			memcpy(v3 + 3 * at_v, ch->values, sizeof(float) * 3 * per * keys);
 			at_v += (size_t)per * keys;
+		} else {
+			/* on the base's key at the same time, if any: the bit
+			 * patterns' differences ('VECD'); else as they are */
+			struct img_chan *ic = &img->ch[i];
+			const struct img_chan *bc = NULL;
+			for (int j = 0; base && j < base->n; j++)
+				if (base->ch[j].joint == ic->joint && base->ch[j].path == ic->path &&
+				    base->ch[j].interp != MLOD_INTERP_CUBICSPLINE)
+					bc = &base->ch[j];
+			memcpy(ic->vec, ch->values, sizeof(float) * 3 * keys);
+			for (uint32_t v = 0; v < keys; v++) {
+				long b = img_key(bc, ic->times[v]);
+				for (int c = 0; c < 3; c++) {
+					uint32_t a, bb;
+					memcpy(&a, ch->values + 3 * (size_t)v + c, 4);
+					if (b >= 0) {
+						memcpy(&bb, bc->vec + 3 * b + c, 4);
+						vd[3 * at_vd + c] = a - bb;
+					} else {
+						v3[3 * at_v + c] = ch->values[3 * (size_t)v + c];
+					}
+				}
+				if (b >= 0)
+					at_vd++;
+				else
+					at_v++;
+			}
 		}
 	}
 	cb_add(&cb, MLOD_STREAM_ROTQ, (uint32_t)at_a, 8, q, 0);
 	cb_add(&cb, MLOD_STREAM_ROTD, (uint32_t)at_d, 8, qd, 0);
 	cb_add(&cb, MLOD_STREAM_ROTF, (uint32_t)nf, 16, rf, 0);
-	cb_add(&cb, MLOD_STREAM_VEC3, (uint32_t)nv, 12, v3, 0);
+	cb_add(&cb, MLOD_STREAM_VEC3, (uint32_t)at_v, 12, v3, 0);
+	cb_add(&cb, MLOD_STREAM_VECD, (uint32_t)at_vd, 12, vd, 0);
 	free(q);
 	free(qd);
+	free(vd);
 	free(rf);
 	free(v3);
 	mlod_result r = cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, k, item, error, x->err);

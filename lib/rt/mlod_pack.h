@@ -153,11 +153,16 @@
  *   'ROTF' f32[4], 3 per key (in-tangent, value, out-tangent), of every
  *          cubic-spline rotation;
  *   'VEC3' f32[3] per key (3 per key for cubic splines) of every
- *          translation and scale.
+ *          translation and scale without a base key;
+ *   'VECD' u32[3] per key of every translation and scale with a base key
+ *          (non-cubic): its f32 bit patterns minus the base key's,
+ *          wrapped to 32 bits.
  *   A chunk with TOC flag MLOD_PACK_CHUNK_NESTED builds on the clip's
  *   level + 1 (which exists and stands before it): a rotation key has a
  *   base key when that level's non-cubic rotation channel of the joint
- *   has a key at exactly the same (decoded) time. The writer nests every
+ *   has a key at exactly the same (decoded) time; a translation or scale
+ *   key when that level's non-cubic channel of the joint and path does.
+ *   The writer nests every
  *   level but the coarsest and keeps the clip's own values at every level.
  *   (Writer's notes: a non-cubic channel whose keys all hold one value is
  *   stored as one key at its last time, which keeps the clip's duration;
@@ -332,6 +337,7 @@ static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, c
 #define MLOD_STREAM_ROTF MLOD_FOURCC('R', 'O', 'T', 'F')
 #define MLOD_STREAM_VEC3 MLOD_FOURCC('V', 'E', 'C', '3')
 #define MLOD_STREAM_ROTD MLOD_FOURCC('R', 'O', 'T', 'D')
+#define MLOD_STREAM_VECD MLOD_FOURCC('V', 'E', 'C', 'D')
 #define MLOD_STREAM_GLB MLOD_FOURCC('G', 'L', 'B', ' ')
 
 /* ------------------------------------------------------------------ */

@@ -1326,6 +1326,16 @@ static const mlod_pack_channel *base_channel(const mlod_pack_motion *base, uint3
 	return NULL;
 }
 
+/* The same for a non-cubic translation or scale channel (path). */
+static const mlod_pack_channel *base_vec_channel(const mlod_pack_motion *base, const mlod_pack_channel_rec *rc)
+{
+	for (uint32_t i = 0; base && rc->interp != 2 && i < base->channel_count; i++)
+		if (base->channels[i].rec.joint == rc->joint && base->channels[i].rec.path == rc->path &&
+		    base->channels[i].rec.interp != 2)
+			return &base->channels[i];
+	return NULL;
+}
+
 /* The index of time t in a base channel's times (increasing), or -1. */
 static int64_t base_key(const mlod_pack_channel *bc, float t)
 {
@@ -1405,7 +1415,7 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	while (cx_next(&x, &s)) {
 		uint64_t per = s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK ? 4
 		               : s.tag == MLOD_STREAM_ROTQ || s.tag == MLOD_STREAM_ROTD || s.tag == MLOD_STREAM_ROTF ? 16
-		               : s.tag == MLOD_STREAM_VEC3                                ? 12
+		               : s.tag == MLOD_STREAM_VEC3 || s.tag == MLOD_STREAM_VECD   ? 12
 		                                                                          : 0;
 		if (!per)
 			FAIL("%s: stream %u is '%s', not a motion stream", x.label, s.index, tagn(s.tag).s);
@@ -1582,16 +1592,54 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 		if (!all_finite(ch->values, values * 4))
 			FAIL("%s: channel %u: a rotation value is not finite", x.label, i);
 	}
-	TRY(cx_expect(&x, &s, MLOD_STREAM_VEC3, 12, nv, "", "keys of the translations and scales", err));
+	/* 'VEC3' holds the translation and scale keys without a base key,
+	 * 'VECD' those with one (non-cubic, the base's channel of the joint
+	 * and path keying the same time) as the differences of their f32 bit
+	 * patterns, each wrapped to 32 bits. */
+	uint64_t nvd = 0;
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path == 1)
+			continue;
+		const mlod_pack_channel *bc = base_vec_channel(base, &ch->rec);
+		for (uint32_t k = 0; bc && k < ch->rec.key_count; k++)
+			nvd += base_key(bc, ch->times[k]) >= 0;
+	}
+	TRY(cx_expect(&x, &s, MLOD_STREAM_VEC3, 12, nv - nvd, "", "translation and scale keys without a base key", err));
 	TRY(cx_load(&x, &s, &src, err));
 	for (uint32_t i = 0; i < C; i++) {
 		mlod_pack_channel *ch = &chans[i];
 		if (ch->rec.path == 1)
 			continue;
+		const mlod_pack_channel *bc = base_vec_channel(base, &ch->rec);
+		uint32_t per = ch->rec.interp == 2 ? 3 : 1;
+		TAKE(ch->values, (uint64_t)per * ch->rec.key_count * 12);
+		for (uint32_t k = 0; k < ch->rec.key_count; k++)
+			if (base_key(bc, ch->times[k]) < 0) {
+				memcpy(ch->values + 3 * (size_t)per * k, src, 12 * (size_t)per);
+				src += 12 * (size_t)per;
+			}
+	}
+	TRY(cx_expect(&x, &s, MLOD_STREAM_VECD, 12, nvd, "", "translation and scale keys on a base key", err));
+	TRY(cx_load(&x, &s, &src, err));
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path == 1)
+			continue;
+		const mlod_pack_channel *bc = base_vec_channel(base, &ch->rec);
+		for (uint32_t k = 0; bc && k < ch->rec.key_count; k++) {
+			int64_t at = base_key(bc, ch->times[k]);
+			if (at < 0)
+				continue;
+			for (int c = 0; c < 3; c++) {
+				uint32_t bb, v;
+				memcpy(&bb, bc->values + 3 * at + c, 4);
+				v = bb + rd32(src + 4 * c);
+				memcpy(ch->values + 3 * (size_t)k + c, &v, 4);
+			}
+			src += 12;
+		}
 		uint64_t values = (ch->rec.interp == 2 ? 3 : 1) * (uint64_t)ch->rec.key_count;
-		TAKE(ch->values, values * 12);
-		memcpy(ch->values, src, values * 12);
-		src += values * 12;
 		if (!all_finite(ch->values, values * 3))
 			FAIL("%s: channel %u: a %s value is not finite", x.label, i, path_names[ch->rec.path]);
 	}

@@ -654,6 +654,7 @@ static int make_chunks(wchunk *c, int with_unknown)
 	s->count = 2;
 	for (int k = 0; k < 6; k++)
 		putf(&s->data, (float)k);
+	add_stream(ch, MLOD_STREAM_VECD, 12, MLOD_SCODEC_RAW);
 
 	/* MESH level 0: two meshopt-coded parts. */
 	ch = &c[C_MESH0];
@@ -737,6 +738,7 @@ static int make_chunks(wchunk *c, int with_unknown)
 		for (int k = 0; k < NK; k++)
 			for (int a = 0; a < 3; a++)
 				putf(&s->data, vec_truth[k][a]);
+	add_stream(ch, MLOD_STREAM_VECD, 12, MLOD_SCODEC_MESHOPT_VERTEX);
 
 	/* DOC */
 	ch = &c[C_DOC];
@@ -1201,11 +1203,13 @@ TEST(older_major_is_refused)
 	          "message: %s", terr.message);
 }
 
+static uint8_t *stream_data(wchunk *c, int chunk, uint32_t tag, int nth);
+
 /* A nested MOTION level (TOC flag MLOD_PACK_CHUNK_NESTED) builds on the
  * clip's next coarser level: the coarsest cannot be nested, and
- * mlod_pack_decode_motion_on needs the base; with one whose channels hold
- * no rotation, every key of level 0 stands on its own and decodes as
- * before. */
+ * mlod_pack_decode_motion_on needs the base; with one whose channel
+ * (joint 1's translation) level 0 lacks, every key of level 0 stands on
+ * its own and decodes as before. */
 TEST(nested_motion_needs_its_base)
 {
 	static wchunk c[C_COUNT + 1];
@@ -1214,6 +1218,7 @@ TEST(nested_motion_needs_its_base)
 	buf b1 = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	c[C_MOT1].flags = 0;
 	c[C_MOT0].flags = MLOD_PACK_CHUNK_NESTED;
+	wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0), 1); /* joint 1's translation: no key of level 0's */
 	buf b0 = build_pack(c, n, MLOD_PACK_MAJOR, 0);
 	free_chunks(c, n);
 	mlod_pack p = {0};
@@ -1452,7 +1457,11 @@ static void e_extra_stream(wchunk *c)
 		putf(&s->data, 2.0f);
 }
 static void e_dup_channel(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 2, 1); }
-static void e_no_vec3(wchunk *c) { wchunk_free_stream(&c[C_MOT1], 6); }
+static void e_no_vec3(wchunk *c)
+{
+	wchunk_free_stream(&c[C_MOT1], 7); /* VECD */
+	wchunk_free_stream(&c[C_MOT1], 6);
+}
 static void e_missing_rotation(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1); }
 static void e_time_order(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 3 + 16, 2); }
 static void e_time_keys(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 12, 3); }
@@ -1501,7 +1510,7 @@ TEST(structural_checks_name_the_chunk)
 		{e_vertex_elsize, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: stream 1 'POSQ' has elements of 6 bytes, expected 8"},
 		{e_info_levels, C_INFO, MLOD_ERR_PARSE, "INFO: the TOC has SKELETON level 1, but INFO counts"},
 		{e_clip_names, C_INFO, MLOD_ERR_PARSE, "INFO: the string table 'NAME' ends before clip 0's name"},
-		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 7 'VEC3')"},
+		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 8 'VEC3')"},
 		{e_time_order, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 3: time array 2 is not below 2 (the arrays go in first-use order)"},
 		{e_time_keys, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 2 'TIME' has 2 elements, expected 3 (the time arrays' keys)"},
 		{e_time_shared_keys, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: 6 keys, but time array 0 has 5"},

@@ -329,6 +329,8 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 		}
 		stream_end(c);
 	}
+	stream(c, MLOD_STREAM_VECD, 12); /* none: not nested */
+	stream_end(c);
 }
 
 static void build_pack(bytes *out)
