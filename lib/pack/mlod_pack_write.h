@@ -153,16 +153,21 @@ double mlod_pack_oct_bound(int bits);
 #define MLOD_PACK_NORMAL_BITS_DEFAULT 8
 #define MLOD_PACK_UV_BITS_DEFAULT 12
 
-/* 'ROTQ' rotations: each component of a unit quaternion (up to the sign
- * the writer picks for continuity) is within half a step, 1/65534, of the
- * input; the 4-vector error is then at most 1/32767 and the rotation
- * angle between input and decoded (normalised) at most 2 asin(1/32767). */
-#define MLOD_PACK_ROTQ_BOUND (1.0 / 65534.0)
+/* 'ROTQ' rotations (mlod(5) QUANTISATION): a key on the lattice of
+ * normalised shorts whose largest component is the one the reader
+ * rebuilds from the other three (every key of lib/motion's levels) comes
+ * back exactly, up to the sign. Any other key: the normalised input's
+ * three smaller components within half a step h = 1/65534, the largest
+ * (rebuilt, then on the lattice) within 4 h (3 h from the others' rounding,
+ * as the largest is at least 1/2, plus h), so each component within
+ * MLOD_PACK_ROTQ_BOUND, the 4-vector within sqrt(19) h and the rotation
+ * angle at most 2 asin(sqrt(19) h) (MLOD_PACK_ROTQ_ANGLE). */
+#define MLOD_PACK_ROTQ_BOUND (2.0 / 32767.0)
 /* Key times as 'TICK': each decoded time is the time given, or within
  * MLOD_PACK_TICK_TOLERANCE * max(|t|, step) of it (about 8 f32 ulps:
  * 4.8 microseconds at t = 5 s); the writer prefers a step that is exact. */
 #define MLOD_PACK_TICK_TOLERANCE (1.0 / 1048576.0)
-#define MLOD_PACK_ROTQ_ANGLE 6.1037e-5 /* radians, 2 asin(1/32767) rounded up; 0.0035 degrees */
+#define MLOD_PACK_ROTQ_ANGLE 1.3304e-4 /* radians, 2 asin(sqrt(19) / 65534) rounded up; 0.0076 degrees */
 void mlod_pack_oct_decode(const int16_t in[2], float n[3]);
 
 /* A value within [min, min + 65535 * scale] to u16: q = round((v - min) /

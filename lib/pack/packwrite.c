@@ -148,7 +148,7 @@ static void cb_free(chunkb *cb)
 typedef struct chunk {
 	uint32_t type;
 	uint8_t layer, codec;
-	uint16_t level, item;
+	uint16_t level, item, flags;
 	float error, distance;
 	uint8_t *data;
 	size_t size;
@@ -318,6 +318,7 @@ struct ctx {
 	mlod_motion_level *owned_levels;
 	int owned_count;
 	mlod_motion_level *level0_owned; /* per clip; clip.channels NULL where level 0 is the input's */
+	struct motion_img *motion_imgs;  /* per clip, two: the last MOTION chunk written and the one before */
 	int motion_count;          /* levels >= 1, over all clips */
 };
 
@@ -1429,6 +1430,7 @@ static mlod_result motion_level0(struct ctx *x)
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 	mlod_motion_options mo = {0};
 	mo.point_distance = motion_point_distance(x);
+	mo.precision = MLOD_MOTION_PRECISION_FULL; /* every level keeps the clip's own values (mlod(5) MOTION levels) */
 	mlod_result r = MLOD_OK;
 	int kept = 0;
 	for (int q = 0; r == MLOD_OK && q < c->clip_count; q++) {
@@ -1440,7 +1442,7 @@ static mlod_result motion_level0(struct ctx *x)
 			mlod_motion_level best;
 			mlod_error why = {0};
 			mlod_result e = mlod_motion_next_level_best(m, methods, 2, MLOD_MOTION_MAX_ERROR, e0, &best, &why);
-			if (e == MLOD_OK && best.bytes < mlod_clip_key_bytes(&c->clips[q])) {
+			if (e == MLOD_OK && best.keys < mlod_clip_key_count(&c->clips[q])) {
 				x->level0_owned[q] = best;
 				x->clips[q].level0 = &x->level0_owned[q].clip;
 				x->clips[q].error0 = (float)best.error.max;
@@ -1518,6 +1520,7 @@ static mlod_result motion_levels(struct ctx *x)
 	qsort(bounds, (size_t)nb, sizeof *bounds, double_asc);
 	mlod_motion_options mo = {0};
 	mo.point_distance = motion_point_distance(x);
+	mo.precision = MLOD_MOTION_PRECISION_FULL; /* every level keeps the clip's own values (mlod(5) MOTION levels) */
 	x->owned_levels = calloc((size_t)c->clip_count * (size_t)(nb > 0 ? nb : 1), sizeof *x->owned_levels);
 	if (!x->owned_levels)
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
@@ -1635,7 +1638,147 @@ static double time_step(const float *const *arr, const int *cnt, int n, uint32_t
 	return 0;
 }
 
-static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int item, float error, chunks *out)
+/* A rotation key's lattice value the reader rebuilds (mlod(5) ROTQ): the
+ * component big from the three others n (big's own entry ignored), as
+ * lib/motion rounds onto the lattice of normalised shorts. */
+static long rotq_big(const long *n, int big)
+{
+	double sum = 0.0;
+	for (int c = 0; c < 4; c++)
+		if (c != big) {
+			float f = (float)((double)n[c] / 32767.0);
+			sum += (double)f * f;
+		}
+	return lrint(sqrt(sum < 1.0 ? 1.0 - sum : 0.0) * 32767.0);
+}
+
+/* One 'ROTQ' key: the three components other than the one at index big
+ * (in index order), then big. When r is a lattice point (n / 32767) whose
+ * component big, made non-negative, is what the reader rebuilds from the
+ * other three (as lib/motion's levels are), it comes back exactly (up to
+ * the sign); else r is normalised, big is its largest component, made
+ * non-negative, and the three go to the nearest lattice points. */
+static void rotq_encode(const float *r, int16_t *out)
+{
+	long n[4], m[4];
+	int order[4] = {0, 1, 2, 3};
+	for (int c = 0; c < 4; c++) {
+		double e = r[c] > 1 ? 1 : r[c] < -1 ? -1 : r[c];
+		n[c] = lrint(e * 32767.0);
+	}
+	for (int i = 1; i < 4; i++) /* by decreasing |n|, index order on ties */
+		for (int j = i; j > 0 && labs(n[order[j]]) > labs(n[order[j - 1]]); j--) {
+			int t = order[j];
+			order[j] = order[j - 1], order[j - 1] = t;
+		}
+	int big = -1;
+	for (int i = 0; i < 4 && big < 0; i++) {
+		int b = order[i];
+		long sign = n[b] < 0 ? -1 : 1;
+		for (int c = 0; c < 4; c++)
+			m[c] = sign * n[c];
+		if (rotq_big(m, b) == m[b])
+			big = b;
+	}
+	if (big < 0) {
+		double len = 0.0, u[4];
+		for (int c = 0; c < 4; c++)
+			len += (double)r[c] * r[c];
+		len = len > 0.0 ? sqrt(len) : 1.0;
+		big = 0;
+		for (int c = 0; c < 4; c++) {
+			u[c] = r[c] / len;
+			big = fabs(u[c]) > fabs(u[big]) ? c : big;
+		}
+		double sign = u[big] < 0 ? -1.0 : 1.0;
+		for (int c = 0; c < 4; c++) {
+			double e = sign * u[c];
+			m[c] = lrint((e > 1 ? 1 : e < -1 ? -1 : e) * 32767.0);
+		}
+	}
+	for (int c = 0, i = 0; c < 4; c++)
+		if (c != big)
+			out[i++] = (int16_t)m[c];
+	out[3] = (int16_t)big;
+}
+
+/* A MOTION chunk as the reader returns it, for the next finer level to
+ * build on: per channel its key times and, for non-cubic rotations, its
+ * keys as lattice integers (mlod_pack_rotq_key). */
+typedef struct motion_img {
+	int n;
+	struct img_chan {
+		uint32_t joint, path, interp, keys;
+		float *times;
+		int16_t *rot;
+		float *vec; /* non-cubic translations and scales: the values */
+	} *ch;
+} motion_img;
+
+static void motion_img_free(motion_img *m)
+{
+	for (int i = 0; m && i < m->n; i++)
+		free(m->ch[i].times), free(m->ch[i].rot), free(m->ch[i].vec);
+	if (m)
+		free(m->ch), memset(m, 0, sizeof *m);
+}
+
+/* As pack.c's base_channel and base_key. */
+static const struct img_chan *img_channel(const motion_img *m, uint32_t joint)
+{
+	for (int i = 0; m && i < m->n; i++)
+		if (m->ch[i].joint == joint && m->ch[i].path == MLOD_PATH_ROTATION &&
+		    m->ch[i].interp != MLOD_INTERP_CUBICSPLINE)
+			return &m->ch[i];
+	return NULL;
+}
+
+static long img_key(const struct img_chan *c, float t)
+{
+	uint32_t lo = 0, hi = c ? c->keys : 0;
+	while (lo < hi) {
+		uint32_t mid = lo + (hi - lo) / 2;
+		if (c->times[mid] < t)
+			lo = mid + 1;
+		else
+			hi = mid;
+	}
+	return c && lo < c->keys && c->times[lo] == t ? (long)lo : -1;
+}
+
+/* A 'ROTQ' key on its base's key bn: the lattice point r is (else the
+ * nearest to r normalised), with the sign nearer bn, minus bn, each
+ * component wrapped to 16 bits (the reader adds bn back). */
+static void rotq_encode_on(const float *r, const int16_t *bn, int16_t *out)
+{
+	long t[4];
+	int lattice = 1;
+	for (int c = 0; c < 4; c++) {
+		double e = r[c] > 1 ? 1 : r[c] < -1 ? -1 : r[c];
+		t[c] = lrint(e * 32767.0);
+		lattice &= (float)((double)t[c] / 32767.0) == r[c];
+	}
+	if (!lattice) {
+		double len = 0.0;
+		for (int c = 0; c < 4; c++)
+			len += (double)r[c] * r[c];
+		len = len > 0.0 ? sqrt(len) : 1.0;
+		for (int c = 0; c < 4; c++)
+			t[c] = lrint(r[c] / len * 32767.0);
+	}
+	long dot = 0;
+	for (int c = 0; c < 4; c++)
+		dot += t[c] * bn[c];
+	for (int c = 0; c < 4; c++)
+		out[c] = (int16_t)(uint16_t)((uint16_t)(dot < 0 ? -t[c] : t[c]) - (uint16_t)bn[c]);
+}
+
+/* One MOTION chunk of level k of clip item. base: the clip's level k + 1
+ * as the reader returns it (NULL: none, level k is the coarsest); its
+ * rotation keys then build on it (MLOD_PACK_CHUNK_NESTED). img gets this
+ * chunk as the reader returns it. */
+static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int item, float error,
+                                const motion_img *base, motion_img *img, chunks *out)
 {
 	chunkb cb = {0};
 	int n = clip->channel_count;
@@ -1660,6 +1803,20 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		                                  (uint32_t)keys, (uint32_t)a};
 	}
 	cb_add(&cb, MLOD_STREAM_CHAN, (uint32_t)n, sizeof *recs, recs, 0);
+	/* this chunk as the reader returns it: the channels */
+	motion_img_free(img);
+	img->ch = calloc((size_t)n + 1, sizeof *img->ch);
+	if (!img->ch)
+		cb.fail = 1;
+	else
+		img->n = n;
+	for (int i = 0; i < img->n; i++)
+		img->ch[i] = (struct img_chan){recs[i].joint, recs[i].path, recs[i].interp, recs[i].key_count, NULL, NULL, NULL};
+	int *ta = malloc(sizeof *ta * ((size_t)n + 1));
+	if (!ta)
+		cb.fail = 1;
+	for (int i = 0; ta && i < n; i++)
+		ta[i] = (int)recs[i].time;
 	free(recs);
 	uint32_t max_tick = 0;
 	double step = time_step(arr, cnt, na, &max_tick);
@@ -1672,17 +1829,23 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		nt += (size_t)cnt[a];
 	int wide = max_tick > 65535 || x->opt->codec == MLOD_CODEC_MESHOPT;
 	uint8_t *tk = malloc(4 * (nt + 1));
-	if (!tk) {
+	float *dt = malloc(sizeof *dt * (nt + 1)); /* the times as the reader returns them */
+	size_t *dt_at = malloc(sizeof *dt_at * ((size_t)na + 1));
+	if (!tk || !dt || !dt_at) {
 		cb.fail = 1;
 	} else {
 		size_t at = 0;
 		for (int a = 0; a < na; a++)
 			for (int q = 0; q < cnt[a]; q++, at++) {
+				if (q == 0)
+					dt_at[a] = at;
+				dt[at] = arr[a][q];
 				if (step == 0) {
 					memcpy(tk + 4 * at, &arr[a][q], 4);
 					continue;
 				}
 				uint32_t v = (uint32_t)floor((double)arr[a][q] / step + 0.5);
+				dt[at] = (float)((double)v * step);
 				if (wide)
 					put_u32(tk + 4 * at, v);
 				else
@@ -1692,10 +1855,28 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 			cb_add(&cb, MLOD_STREAM_TIME, (uint32_t)nt, 4, tk, 0);
 		else
 			cb_add(&cb, MLOD_STREAM_TICK, (uint32_t)nt, wide ? 4 : 2, tk, 0);
-		free(tk);
 	}
+	free(tk);
 	free(arr);
 	free(cnt);
+	for (int i = 0; !cb.fail && i < img->n; i++) {
+		struct img_chan *ic = &img->ch[i];
+		ic->times = malloc(sizeof *ic->times * ic->keys);
+		if (!ic->times) {
+			cb.fail = 1;
+			break;
+		}
+		memcpy(ic->times, dt + dt_at[ta[i]], sizeof *ic->times * ic->keys);
+		if (ic->path == MLOD_PATH_ROTATION && ic->interp != MLOD_INTERP_CUBICSPLINE &&
+		    !(ic->rot = malloc(sizeof *ic->rot * 4 * ic->keys)))
+			cb.fail = 1;
+		if (ic->path != MLOD_PATH_ROTATION && ic->interp != MLOD_INTERP_CUBICSPLINE &&
+		    !(ic->vec = malloc(sizeof *ic->vec * 3 * ic->keys)))
+			cb.fail = 1;
+	}
+	free(dt);
+	free(dt_at);
+	free(ta);
 	/* The values: 'ROTQ' (non-cubic rotations), 'ROTF' (cubic rotations),
 	 * 'VEC3' (translations and scales), each one stream of its channels'
 	 * keys in channel order. */
@@ -1711,9 +1892,11 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		else
 			nv += per * keys;
 	}
-	int16_t *q = malloc(sizeof(int16_t) * 4 * (nq + 1));
+	int16_t *q = malloc(sizeof(int16_t) * 4 * (nq + 1)), *qd = malloc(sizeof(int16_t) * 4 * (nq + 1));
+	uint32_t *vd = malloc(sizeof *vd * 3 * (nv + 1));
+	size_t at_d = 0, at_a = 0, at_vd = 0;
 	float *rf = malloc(sizeof(float) * 4 * (nf + 1)), *v3 = malloc(sizeof(float) * 3 * (nv + 1));
-	if (!q || !rf || !v3)
+	if (!q || !qd || !vd || !rf || !v3)
 		cb.fail = 1;
 	size_t at_q = 0, at_f = 0, at_v = 0;
 	for (int i = 0; i < n && !cb.fail; i++) {
@@ -1721,37 +1904,68 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		int konst = constant_channel(ch);
 		uint32_t keys = konst ? 1 : (uint32_t)ch->key_count, per = ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1;
 		if (ch->path == MLOD_PATH_ROTATION && per == 1) {
-			/* Nearest lattice point, each key's sign continuing the last. */
+			/* on the base's key at the same time, if any; else on its own */
+			struct img_chan *ic = &img->ch[i];
+			const struct img_chan *bc = img_channel(base, ic->joint);
 			for (uint32_t v = 0; v < keys; v++, at_q++) {
-				const float *r = ch->values + 4 * (size_t)v;
-				double sign = 1;
-				if (v > 0) {
-					double dot = 0;
-					for (int c = 0; c < 4; c++)
-						dot += (double)r[c] * q[4 * (at_q - 1) + c];
-					sign = dot < 0 ? -1 : 1;
-				}
-				for (int c = 0; c < 4; c++) {
-					double e = sign * r[c];
-					e = e > 1 ? 1 : e < -1 ? -1 : e;
-					q[4 * at_q + c] = (int16_t)lrint(e * 32767.0);
-				}
+				long b = img_key(bc, ic->times[v]);
+				int16_t *e = b >= 0 ? qd + 4 * at_d++ : q + 4 * at_a++;
+				if (b >= 0)
+					rotq_encode_on(ch->values + 4 * (size_t)v, bc->rot + 4 * b, e);
+				else
+					rotq_encode(ch->values + 4 * (size_t)v, e);
+				mlod_pack_rotq_key(e, b >= 0 ? bc->rot + 4 * b : NULL, v > 0 ? ic->rot + 4 * (v - 1) : NULL,
+				                   ic->rot + 4 * v);
 			}
 		} else if (ch->path == MLOD_PATH_ROTATION) {
 			memcpy(rf + 4 * at_f, ch->values, sizeof(float) * 4 * 3 * keys);
 			at_f += 3 * (size_t)keys;
-		} else {
+		} else if (per == 3) {
 			memcpy(v3 + 3 * at_v, ch->values, sizeof(float) * 3 * per * keys);
 			at_v += (size_t)per * keys;
+		} else {
+			/* on the base's key at the same time, if any: the bit
+			 * patterns' differences ('VECD'); else as they are */
+			struct img_chan *ic = &img->ch[i];
+			const struct img_chan *bc = NULL;
+			for (int j = 0; base && j < base->n; j++)
+				if (base->ch[j].joint == ic->joint && base->ch[j].path == ic->path &&
+				    base->ch[j].interp != MLOD_INTERP_CUBICSPLINE)
+					bc = &base->ch[j];
+			memcpy(ic->vec, ch->values, sizeof(float) * 3 * keys);
+			for (uint32_t v = 0; v < keys; v++) {
+				long b = img_key(bc, ic->times[v]);
+				for (int c = 0; c < 3; c++) {
+					uint32_t a, bb;
+					memcpy(&a, ch->values + 3 * (size_t)v + c, 4);
+					if (b >= 0) {
+						memcpy(&bb, bc->vec + 3 * b + c, 4);
+						vd[3 * at_vd + c] = a - bb;
+					} else {
+						v3[3 * at_v + c] = ch->values[3 * (size_t)v + c];
+					}
+				}
+				if (b >= 0)
+					at_vd++;
+				else
+					at_v++;
+			}
 		}
 	}
-	cb_add(&cb, MLOD_STREAM_ROTQ, (uint32_t)nq, 8, q, 0);
+	cb_add(&cb, MLOD_STREAM_ROTQ, (uint32_t)at_a, 8, q, 0);
+	cb_add(&cb, MLOD_STREAM_ROTD, (uint32_t)at_d, 8, qd, 0);
 	cb_add(&cb, MLOD_STREAM_ROTF, (uint32_t)nf, 16, rf, 0);
-	cb_add(&cb, MLOD_STREAM_VEC3, (uint32_t)nv, 12, v3, 0);
+	cb_add(&cb, MLOD_STREAM_VEC3, (uint32_t)at_v, 12, v3, 0);
+	cb_add(&cb, MLOD_STREAM_VECD, (uint32_t)at_vd, 12, vd, 0);
 	free(q);
+	free(qd);
+	free(vd);
 	free(rf);
 	free(v3);
-	return cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, k, item, error, x->err);
+	mlod_result r = cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MOTION, MLOD_LAYER_MOTION, k, item, error, x->err);
+	if (r == MLOD_OK && base)
+		out->c[out->n - 1].flags = MLOD_PACK_CHUNK_NESTED;
+	return r;
 }
 
 /* ------------------------------------------------------------------ */
@@ -1943,6 +2157,9 @@ static void ctx_free(struct ctx *x)
 	for (int q = 0; x->level0_owned && q < x->v.clip_count; q++)
 		mlod_motion_level_free(&x->level0_owned[q]);
 	free(x->level0_owned);
+	for (int i = 0; x->motion_imgs && i < 2 * x->v.clip_count; i++)
+		motion_img_free(&x->motion_imgs[i]);
+	free(x->motion_imgs);
 	free(x->clips);
 	free(x->world);
 	free(x->view_skin);
@@ -2012,6 +2229,10 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			x.clips[q].error[k] = k ? x.clips[q].error[k - 1] : x.clips[q].error0;
 		}
 	x.st->motion.seconds = now_seconds() - t0;
+	if (!(x.motion_imgs = calloc(2 * (size_t)x.v.clip_count + 1, sizeof *x.motion_imgs))) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
 
 	/* The chunks after INFO, in file order. */
 	int S = 1 + x.skel_count;
@@ -2038,9 +2259,30 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		t0 = now_seconds();
 		for (int q = 0; k < A && q < x.v.clip_count; q++) {
 			const mlod_clip *cl = k == 0 ? x.clips[q].level0 : x.clips[q].clip[k - 1];
-			if ((r = motion_chunk(&x, cl, k, q, k == 0 ? x.clips[q].error0 : x.clips[q].error[k - 1], &body)) !=
-			    MLOD_OK)
+			motion_img *mi = &x.motion_imgs[2 * q + (k & 1)], *base = k + 1 < A ? &x.motion_imgs[2 * q + !(k & 1)] : NULL;
+			if ((r = motion_chunk(&x, cl, k, q, k == 0 ? x.clips[q].error0 : x.clips[q].error[k - 1], base, mi,
+			                      &body)) != MLOD_OK)
 				goto done;
+			/* A reduced level 0 that stores more than the clip as read
+			 * gives way to it (error 0). */
+			if (k == 0 && cl != &x.v.clips[q]) {
+				chunks alt = {0};
+				motion_img alt_img = {0};
+				r = motion_chunk(&x, &x.v.clips[q], 0, q, 0.0f, base, &alt_img, &alt);
+				if (r == MLOD_OK && alt.c[0].size < body.c[body.n - 1].size) {
+					free(body.c[body.n - 1].data);
+					body.c[body.n - 1] = alt.c[0];
+					alt.n = 0;
+					x.clips[q].level0 = &x.v.clips[q];
+					x.clips[q].error0 = 0.0f;
+				}
+				for (int i = 0; i < alt.n; i++)
+					free(alt.c[i].data);
+				free(alt.c);
+				motion_img_free(&alt_img);
+				if (r != MLOD_OK)
+					goto done;
+			}
 		}
 		x.st->motion.seconds += now_seconds() - t0;
 	}
@@ -2166,6 +2408,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			e[5] = ch->codec;
 			put_u16(e + 6, ch->level);
 			put_u16(e + 8, ch->item);
+			put_u16(e + 10, ch->flags);
 			put_u64(e + 16, ch->offset);
 			put_u32(e + 24, (uint32_t)ch->size);
 			put_u32(e + 28, ch->raw);

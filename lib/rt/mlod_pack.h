@@ -32,7 +32,7 @@
  *   5  u8     codec (MLOD_CODEC_*): the codec of the chunk's streams
  *   6  u16    level: 0 the finest (the input as read), larger is coarser
  *   8  u16    item: the clip for MOTION chunks, else 0
- *  10  u16    flags (0)
+ *  10  u16    flags (MLOD_PACK_CHUNK_NESTED for a nested MOTION level, else 0)
  *  12  u32    reserved (0)
  *  16  u64    offset of the chunk from the start of the file (16-aligned)
  *  24  u32    stored size in bytes
@@ -154,14 +154,31 @@
  *   then the values, three streams, each holding the keys of its
  *   channels one channel after the other in channel order (possibly 0
  *   elements):
- *   'ROTQ' i16[4] per key of every non-cubic rotation (value = q / 32767):
- *          the rotation rounded to the nearest lattice point, each key's
- *          sign chosen for continuity with the key before (q and -q are
- *          one rotation);
+ *   'ROTQ' i16[4] per key of every non-cubic rotation without a base key
+ *          (below): the components but the one at index i, in index
+ *          order, on the lattice of normalised shorts (value = q /
+ *          32767), then i (0..3); the reader rebuilds component i as
+ *          lrint(sqrt(max(0, 1 - s)) * 32767) / 32767, s the sum of the
+ *          others' squares (each the f32 nearest q / 32767, summed in f64);
+ *   'ROTD' i16[4] per key of every non-cubic rotation with a base key: its
+ *          lattice integers minus the base key's, wrapped to 16 bits;
+ *          after either, a key is negated when its dot product with the
+ *          channel's key before is negative (q and -q are one rotation)
+ *          (mlod_pack_rotq_key). (Format 1.0 stored the four components.)
  *   'ROTF' f32[4], 3 per key (in-tangent, value, out-tangent), of every
  *          cubic-spline rotation;
  *   'VEC3' f32[3] per key (3 per key for cubic splines) of every
- *          translation and scale.
+ *          translation and scale without a base key;
+ *   'VECD' u32[3] per key of every translation and scale with a base key
+ *          (non-cubic): its f32 bit patterns minus the base key's,
+ *          wrapped to 32 bits.
+ *   A chunk with TOC flag MLOD_PACK_CHUNK_NESTED builds on the clip's
+ *   level + 1 (which exists and stands before it): a rotation key has a
+ *   base key when that level's non-cubic rotation channel of the joint
+ *   has a key at exactly the same (decoded) time; a translation or scale
+ *   key when that level's non-cubic channel of the joint and path does.
+ *   The writer nests every
+ *   level but the coarsest and keeps the clip's own values at every level.
  *   (Writer's notes: a non-cubic channel whose keys all hold one value is
  *   stored as one key at its last time, which keeps the clip's duration;
  *   key times go as ticks when every one is a multiple of one step within
@@ -212,6 +229,7 @@
 #ifndef MLOD_PACK_H
 #define MLOD_PACK_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -294,8 +312,48 @@ typedef enum mlod_pack_codec {
 #define MLOD_STREAM_TIME MLOD_FOURCC('T', 'I', 'M', 'E')
 #define MLOD_STREAM_TICK MLOD_FOURCC('T', 'I', 'C', 'K')
 #define MLOD_STREAM_ROTQ MLOD_FOURCC('R', 'O', 'T', 'Q')
+/* TOC flags of a MOTION chunk: its rotation keys build on the clip's next
+ * coarser level (level + 1, earlier in the file). */
+#define MLOD_PACK_CHUNK_NESTED 1u
+/* At most this many nested levels in a row (a reader refuses a longer
+ * chain: each load decodes it). */
+#define MLOD_PACK_MAX_NESTING 64
+
+/* One 'ROTQ' key as lattice integers (value = n / 32767): e the stored
+ * element; base, for a key whose time the base channel also has, that
+ * key as returned (else NULL): n = base + e, each wrapped to 16 bits;
+ * else the three components but e[3]'s in index order, the one at e[3]
+ * rebuilt non-negative (e[3] must be 0 to 3). prev: the key before as
+ * returned (NULL for the first): n is negated when its dot product with
+ * prev is negative. The writer and the reader share it. */
+static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, const int16_t *prev, int16_t n[4])
+{
+	if (base) {
+		for (int c = 0; c < 4; c++)
+			n[c] = (int16_t)(uint16_t)((uint16_t)base[c] + (uint16_t)e[c]);
+	} else {
+		int big = e[3] & 3;
+		double sum = 0.0;
+		for (int c = 0, j = 0; c < 4; c++)
+			if (c != big) {
+				float f = (float)(e[j] / 32767.0);
+				n[c] = e[j++];
+				sum += (double)f * f;
+			}
+		n[big] = (int16_t)lrint(sqrt(sum < 1.0 ? 1.0 - sum : 0.0) * 32767.0);
+	}
+	if (prev) {
+		int64_t dot = 0;
+		for (int c = 0; c < 4; c++)
+			dot += (int64_t)n[c] * prev[c];
+		for (int c = 0; dot < 0 && c < 4; c++)
+			n[c] = (int16_t)-n[c];
+	}
+}
 #define MLOD_STREAM_ROTF MLOD_FOURCC('R', 'O', 'T', 'F')
 #define MLOD_STREAM_VEC3 MLOD_FOURCC('V', 'E', 'C', '3')
+#define MLOD_STREAM_ROTD MLOD_FOURCC('R', 'O', 'T', 'D')
+#define MLOD_STREAM_VECD MLOD_FOURCC('V', 'E', 'C', 'D')
 #define MLOD_STREAM_GLB MLOD_FOURCC('G', 'L', 'B', ' ')
 
 /* ------------------------------------------------------------------ */
@@ -522,6 +580,15 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 typedef mlod_result (*mlod_pack_fetch_fn)(void *user, uint32_t chunk, const void **bytes, mlod_error *err);
 mlod_result mlod_pack_decode_mesh_fetch(const mlod_pack *p, uint32_t chunk, mlod_pack_fetch_fn fetch, void *user,
                                         const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err);
+/* A MOTION chunk with MLOD_PACK_CHUNK_NESTED builds on the clip's next
+ * coarser level: mlod_pack_decode_motion decodes that level (and what it
+ * builds on) from data, which must then hold it too (a whole file or a
+ * prefix); mlod_pack_decode_motion_on takes it decoded instead (base: the
+ * clip's level + 1, required for a nested chunk, else ignored), as a
+ * runtime that keeps it does. */
+mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                       const mlod_pack_skeleton *skel, const mlod_pack_motion *base,
+                                       mlod_pack_motion *out, mlod_error *err);
 /* The DOC chunk's glb bytes (*glb points into data after the CRC check;
  * the stream is stored raw). */
 mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, const void **glb, size_t *glb_size,

@@ -1716,8 +1716,79 @@ void mlod_pack_mesh_free(mlod_pack_mesh *x)
 /* MOTION level k of clip c                                            */
 /* ------------------------------------------------------------------ */
 
+/* The base channel of a rotation channel: the base's non-cubic rotation
+ * of the same joint, or NULL. */
+static const mlod_pack_channel *base_channel(const mlod_pack_motion *base, uint32_t joint)
+{
+	for (uint32_t i = 0; base && i < base->channel_count; i++)
+		if (base->channels[i].rec.joint == joint && base->channels[i].rec.path == 1 && base->channels[i].rec.interp != 2)
+			return &base->channels[i];
+	return NULL;
+}
+
+/* The same for a non-cubic translation or scale channel (path). */
+static const mlod_pack_channel *base_vec_channel(const mlod_pack_motion *base, const mlod_pack_channel_rec *rc)
+{
+	for (uint32_t i = 0; base && rc->interp != 2 && i < base->channel_count; i++)
+		if (base->channels[i].rec.joint == rc->joint && base->channels[i].rec.path == rc->path &&
+		    base->channels[i].rec.interp != 2)
+			return &base->channels[i];
+	return NULL;
+}
+
+/* The index of time t in a base channel's times (increasing), or -1. */
+static int64_t base_key(const mlod_pack_channel *bc, float t)
+{
+	uint32_t lo = 0, hi = bc ? bc->rec.key_count : 0;
+	while (lo < hi) {
+		uint32_t mid = lo + (hi - lo) / 2;
+		if (bc->times[mid] < t)
+			lo = mid + 1;
+		else
+			hi = mid;
+	}
+	return bc && lo < bc->rec.key_count && bc->times[lo] == t ? (int64_t)lo : -1;
+}
+
 mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
                                     const mlod_pack_skeleton *skel, mlod_pack_motion *out, mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_motion: out is NULL");
+	memset(out, 0, sizeof *out);
+	if (!p || chunk >= p->chunk_count || p->chunks[chunk].type != MLOD_CHUNK_MOTION ||
+	    !(p->chunks[chunk].flags & MLOD_PACK_CHUNK_NESTED))
+		return mlod_pack_decode_motion_on(p, chunk, data, size, skel, NULL, out, err);
+	/* The chain of levels it builds on, decoded from the coarsest up. */
+	const mlod_pack_chunk *c = &p->chunks[chunk];
+	unsigned top = c->level;
+	int ci = (int)chunk;
+	while (ci >= 0 && (p->chunks[ci].flags & MLOD_PACK_CHUNK_NESTED)) {
+		if (top - c->level >= MLOD_PACK_MAX_NESTING)
+			return mlod_fail(err, MLOD_ERR_PARSE, "MOTION level %u of clip %u: more than %d nested levels in a row",
+			                 (unsigned)c->level, (unsigned)c->item, MLOD_PACK_MAX_NESTING);
+		if (top == 65535 || (ci = mlod_pack_find(p, MLOD_CHUNK_MOTION, top + 1, c->item)) < 0)
+			return mlod_fail(err, MLOD_ERR_PARSE, "MOTION level %u of clip %u: builds on level %u, which the pack lacks",
+			                 top, (unsigned)c->item, top + 1);
+		top++;
+	}
+	mlod_pack_motion base = {0}, next;
+	for (unsigned l = top + 1; l-- > c->level;) {
+		int k = l == c->level ? (int)chunk : mlod_pack_find(p, MLOD_CHUNK_MOTION, l, c->item);
+		mlod_result r = mlod_pack_decode_motion_on(p, (uint32_t)k, data, size, skel, l == top ? NULL : &base,
+		                                           l == c->level ? out : &next, err);
+		mlod_pack_motion_free(&base);
+		if (r != MLOD_OK)
+			return r;
+		if (l > c->level)
+			base = next;
+	}
+	return MLOD_OK;
+}
+
+mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                       const mlod_pack_skeleton *skel, const mlod_pack_motion *base,
+                                       mlod_pack_motion *out, mlod_error *err)
 {
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_motion: out is NULL");
@@ -1729,6 +1800,11 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	mlod_result r = cx_begin(p, chunk, MLOD_CHUNK_MOTION, data, size, &x, err);
 	if (r != MLOD_OK)
 		return r;
+	const int nested = (x.c->flags & MLOD_PACK_CHUNK_NESTED) != 0;
+	if (!nested)
+		base = NULL;
+	else if (!base)
+		FAIL("%s: builds on level %u, which was not given", x.label, (unsigned)x.c->level + 1);
 	uint32_t J = skel ? skel->joint_count : 0;
 	stream sc, sstep;
 	TRY(cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
@@ -1738,8 +1814,8 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel)) + 8 * C;
 	while (cx_next(&x, &s)) {
 		uint64_t per = s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK ? 4
-		               : s.tag == MLOD_STREAM_ROTQ || s.tag == MLOD_STREAM_ROTF ? 16
-		               : s.tag == MLOD_STREAM_VEC3                                ? 12
+		               : s.tag == MLOD_STREAM_ROTQ || s.tag == MLOD_STREAM_ROTD || s.tag == MLOD_STREAM_ROTF ? 16
+		               : s.tag == MLOD_STREAM_VEC3 || s.tag == MLOD_STREAM_VECD   ? 12
 		                                                                          : 0;
 		if (!per)
 			FAIL("%s: stream %u is '%s', not a motion stream", x.label, s.index, tagn(s.tag).s);
@@ -1849,17 +1925,59 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 	}
 	/* The values: 'ROTQ', 'ROTF', 'VEC3', each the keys of its channels
 	 * one channel after the other, in channel order. */
-	TRY(cx_expect(&x, &s, MLOD_STREAM_ROTQ, 8, nq, "", "keys of the non-cubic rotations", err));
-	TRY(cx_load(&x, &s, &src, err));
+	/* 'ROTQ' holds the rotation keys on their own, 'ROTD' those on a key
+	 * of the base at the same time (mlod_pack_rotq_key): each element goes
+	 * to its key's slot, then every key is decoded in place. */
+	uint64_t nd = 0;
 	for (uint32_t i = 0; i < C; i++) {
 		mlod_pack_channel *ch = &chans[i];
 		if (ch->rec.path != 1 || ch->rec.interp == 2)
 			continue;
-		uint64_t values = ch->rec.key_count;
-		TAKE(ch->values, values * 16);
-		for (size_t k = 0; k < values * 4; k++)
-			ch->values[k] = rdi16(src + 2 * k) / 32767.0f;
-		src += values * 8;
+		TAKE(ch->values, (uint64_t)ch->rec.key_count * 16);
+		const mlod_pack_channel *bc = base_channel(base, ch->rec.joint);
+		for (uint32_t k = 0; bc && k < ch->rec.key_count; k++)
+			nd += base_key(bc, ch->times[k]) >= 0;
+	}
+	for (int pass = 0; pass < 2; pass++) {
+		if (pass == 0)
+			TRY(cx_expect(&x, &s, MLOD_STREAM_ROTQ, 8, nq - nd, "", "rotation keys without a base key", err));
+		else
+			TRY(cx_expect(&x, &s, MLOD_STREAM_ROTD, 8, nd, "", "rotation keys on a base key", err));
+		TRY(cx_load(&x, &s, &src, err));
+		for (uint32_t i = 0; i < C; i++) {
+			mlod_pack_channel *ch = &chans[i];
+			if (ch->rec.path != 1 || ch->rec.interp == 2)
+				continue;
+			const mlod_pack_channel *bc = base_channel(base, ch->rec.joint);
+			for (uint32_t k = 0; k < ch->rec.key_count; k++)
+				if ((base_key(bc, ch->times[k]) >= 0) == pass) {
+					memcpy(ch->values + 4 * (size_t)k, src, 8);
+					src += 8;
+				}
+		}
+	}
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path != 1 || ch->rec.interp == 2)
+			continue;
+		const mlod_pack_channel *bc = base_channel(base, ch->rec.joint);
+		int16_t n[4], prev[4], bn[4];
+		for (uint32_t k = 0; k < ch->rec.key_count; k++) {
+			const uint8_t *e = (const uint8_t *)(ch->values + 4 * (size_t)k);
+			int16_t el[4];
+			for (int c = 0; c < 4; c++)
+				el[c] = rdi16(e + 2 * c);
+			int64_t at = base_key(bc, ch->times[k]);
+			if (at >= 0)
+				for (int c = 0; c < 4; c++)
+					bn[c] = (int16_t)lrint((double)bc->values[4 * at + c] * 32767.0);
+			else if (el[3] < 0 || el[3] > 3)
+				FAIL("%s: channel %u: rotation key %u: component index %d is not 0 to 3", x.label, i, k, el[3]);
+			mlod_pack_rotq_key(el, at >= 0 ? bn : NULL, k > 0 ? prev : NULL, n);
+			for (int c = 0; c < 4; c++)
+				ch->values[4 * (size_t)k + c] = (float)(n[c] / 32767.0);
+			memcpy(prev, n, sizeof prev);
+		}
 	}
 	TRY(cx_expect(&x, &s, MLOD_STREAM_ROTF, 16, nf, "", "3 values per key of the cubic rotations", err));
 	TRY(cx_load(&x, &s, &src, err));
@@ -1874,16 +1992,54 @@ mlod_result mlod_pack_decode_motion(const mlod_pack *p, uint32_t chunk, const vo
 		if (!all_finite(ch->values, values * 4))
 			FAIL("%s: channel %u: a rotation value is not finite", x.label, i);
 	}
-	TRY(cx_expect(&x, &s, MLOD_STREAM_VEC3, 12, nv, "", "keys of the translations and scales", err));
+	/* 'VEC3' holds the translation and scale keys without a base key,
+	 * 'VECD' those with one (non-cubic, the base's channel of the joint
+	 * and path keying the same time) as the differences of their f32 bit
+	 * patterns, each wrapped to 32 bits. */
+	uint64_t nvd = 0;
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path == 1)
+			continue;
+		const mlod_pack_channel *bc = base_vec_channel(base, &ch->rec);
+		for (uint32_t k = 0; bc && k < ch->rec.key_count; k++)
+			nvd += base_key(bc, ch->times[k]) >= 0;
+	}
+	TRY(cx_expect(&x, &s, MLOD_STREAM_VEC3, 12, nv - nvd, "", "translation and scale keys without a base key", err));
 	TRY(cx_load(&x, &s, &src, err));
 	for (uint32_t i = 0; i < C; i++) {
 		mlod_pack_channel *ch = &chans[i];
 		if (ch->rec.path == 1)
 			continue;
+		const mlod_pack_channel *bc = base_vec_channel(base, &ch->rec);
+		uint32_t per = ch->rec.interp == 2 ? 3 : 1;
+		TAKE(ch->values, (uint64_t)per * ch->rec.key_count * 12);
+		for (uint32_t k = 0; k < ch->rec.key_count; k++)
+			if (base_key(bc, ch->times[k]) < 0) {
+				memcpy(ch->values + 3 * (size_t)per * k, src, 12 * (size_t)per);
+				src += 12 * (size_t)per;
+			}
+	}
+	TRY(cx_expect(&x, &s, MLOD_STREAM_VECD, 12, nvd, "", "translation and scale keys on a base key", err));
+	TRY(cx_load(&x, &s, &src, err));
+	for (uint32_t i = 0; i < C; i++) {
+		mlod_pack_channel *ch = &chans[i];
+		if (ch->rec.path == 1)
+			continue;
+		const mlod_pack_channel *bc = base_vec_channel(base, &ch->rec);
+		for (uint32_t k = 0; bc && k < ch->rec.key_count; k++) {
+			int64_t at = base_key(bc, ch->times[k]);
+			if (at < 0)
+				continue;
+			for (int c = 0; c < 3; c++) {
+				uint32_t bb, v;
+				memcpy(&bb, bc->values + 3 * at + c, 4);
+				v = bb + rd32(src + 4 * c);
+				memcpy(ch->values + 3 * (size_t)k + c, &v, 4);
+			}
+			src += 12;
+		}
 		uint64_t values = (ch->rec.interp == 2 ? 3 : 1) * (uint64_t)ch->rec.key_count;
-		TAKE(ch->values, values * 12);
-		memcpy(ch->values, src, values * 12);
-		src += values * 12;
 		if (!all_finite(ch->values, values * 3))
 			FAIL("%s: channel %u: a %s value is not finite", x.label, i, path_names[ch->rec.path]);
 	}

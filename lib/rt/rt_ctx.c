@@ -488,7 +488,16 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 			}
 		return 0;
 	}
-	return 4 * (size_t)u->raw_size + 256 + plan;
+	size_t hint = 4 * (size_t)u->raw_size + 256 + plan;
+	/* A nested motion level decodes the coarser ones it builds on (rt_pack.c
+	 * motion_load), each freed before it returns; at most two at a time,
+	 * counted here as all of them. */
+	for (const rt_unit *v = u; v && v->chunk >= 0 && (ctx->pack.chunks[v->chunk].flags & MLOD_PACK_CHUNK_NESTED);) {
+		if (!(v = rt_unit_get(ctx, MLOD_RT_MOTION, (uint32_t)v->level + 1, v->item)))
+			break;
+		hint += 4 * (size_t)v->raw_size + 256;
+	}
+	return hint;
 }
 
 /* ---------------------------------------------------------------- */

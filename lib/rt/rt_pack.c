@@ -65,6 +65,46 @@ static mlod_result fetch_chunk(void *user, uint32_t chunk, const void **bytes, m
 	return MLOD_OK;
 }
 
+/* A MOTION chunk decoded into out. A nested one (MLOD_PACK_CHUNK_NESTED)
+ * builds on the clip's next coarser level, as the reader returns it: the
+ * chain of levels it builds on is decoded here, from the first that is
+ * not nested, and freed again (a resident level's keys may have been
+ * normalised: prepare_motion). */
+static mlod_result motion_load(mlod_rt_ctx *ctx, uint32_t chunk, mlod_pack_motion *out, mlod_error *err)
+{
+	const mlod_pack_chunk *c = &ctx->pack.chunks[chunk];
+	const mlod_pack_motion *base = NULL;
+	unsigned top = c->level; /* the coarsest level of the chain decoded here */
+	int ci = (int)chunk;
+	while (ci >= 0 && (ctx->pack.chunks[ci].flags & MLOD_PACK_CHUNK_NESTED)) {
+		if (top - c->level >= MLOD_PACK_MAX_NESTING)
+			return mlod_fail(err, MLOD_ERR_PARSE, "MOTION level %u of clip %u: more than %d nested levels in a row",
+			                 (unsigned)c->level, (unsigned)c->item, MLOD_PACK_MAX_NESTING);
+		if (top == 65535 || (ci = mlod_pack_find(&ctx->pack, MLOD_CHUNK_MOTION, top + 1, c->item)) < 0)
+			return mlod_fail(err, MLOD_ERR_PARSE, "MOTION level %u of clip %u: builds on level %u, which the pack lacks",
+			                 top, (unsigned)c->item, top + 1);
+		top++;
+	}
+	mlod_pack_motion tmp[2];
+	memset(tmp, 0, sizeof tmp);
+	mlod_result r = MLOD_OK;
+	for (unsigned l = top + 1; r == MLOD_OK && l-- > c->level;) {
+		int k = l == c->level ? (int)chunk : mlod_pack_find(&ctx->pack, MLOD_CHUNK_MOTION, l, c->item);
+		const mlod_pack *p;
+		const void *data;
+		size_t size;
+		mlod_pack shadow;
+		mlod_pack_motion *dst = l == c->level ? out : &tmp[l & 1];
+		if ((r = chunk_bytes(ctx, (uint32_t)k, &p, &data, &size, &shadow, err)) == MLOD_OK)
+			r = mlod_pack_decode_motion_on(p, (uint32_t)k, data, size, ctx->skel, base, dst, err);
+		mlod_pack_motion_free(&tmp[!(l & 1)]);
+		base = dst;
+	}
+	mlod_pack_motion_free(&tmp[0]);
+	mlod_pack_motion_free(&tmp[1]);
+	return r;
+}
+
 static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 {
 	if (u->layer == MLOD_RT_MESH) {
@@ -75,6 +115,10 @@ static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 		return mlod_pack_decode_mesh_fetch(&ctx->pack, (uint32_t)u->chunk, fetch_chunk, ctx, ctx->skel, &u->dec.mesh,
 		                                   err);
 	}
+	if (u->layer == MLOD_RT_MOTION) {
+		memset(&u->dec, 0, sizeof u->dec);
+		return motion_load(ctx, (uint32_t)u->chunk, &u->dec.motion, err);
+	}
 	const mlod_pack *p;
 	const void *data;
 	size_t size;
@@ -83,14 +127,7 @@ static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 	if (r)
 		return r;
 	memset(&u->dec, 0, sizeof u->dec);
-	switch (u->layer) {
-	case MLOD_RT_SKELETON:
-		return mlod_pack_decode_skel_level(p, (uint32_t)u->chunk, data, size, ctx->skel, &u->dec.skel, err);
-	case MLOD_RT_MESH:
-		return mlod_pack_decode_mesh(p, (uint32_t)u->chunk, data, size, ctx->skel, &u->dec.mesh, err);
-	default:
-		return mlod_pack_decode_motion(p, (uint32_t)u->chunk, data, size, ctx->skel, &u->dec.motion, err);
-	}
+	return mlod_pack_decode_skel_level(p, (uint32_t)u->chunk, data, size, ctx->skel, &u->dec.skel, err);
 }
 
 static void pack_unload(mlod_rt_ctx *ctx, rt_unit *u)

@@ -33,9 +33,10 @@ for (let i = 0; i < n; i++) {
 	const c = {
 		type: fourcc(e.readUInt32LE(0)), layer: e[4], codec: e[5], level: e.readUInt16LE(6), item: e.readUInt16LE(8),
 		offset: Number(e.readBigUInt64LE(16)), stored: e.readUInt32LE(24), raw: e.readUInt32LE(28),
-		crc: e.readUInt32LE(32), error: e.readFloatLE(36), distance: e.readFloatLE(40),
+		crc: e.readUInt32LE(32), error: e.readFloatLE(36), distance: e.readFloatLE(40), flags: e.readUInt16LE(10),
 	};
-	if (e.readUInt16LE(10) || e.readUInt32LE(12) || e.readUInt32LE(44)) die(`chunk ${i}: reserved bytes`);
+	// flags: only ANIM's 1, nested on the clip's next coarser level (checked below)
+	if ((c.flags && (c.type !== 'ANIM' || c.flags !== 1)) || e.readUInt32LE(12) || e.readUInt32LE(44)) die(`chunk ${i}: reserved bytes`);
 	if (c.offset % 16) die(`chunk ${i}: offset ${c.offset} not 16-aligned`);
 	if (c.offset < end) die(`chunk ${i}: overlaps`);
 	if (b.subarray(end, c.offset).some((x) => x !== 0)) die(`chunk ${i}: padding not zero`);
@@ -116,6 +117,8 @@ if (out.first_drawable > b.length || out.first_drawable < chunks[1].offset + chu
 for (const c of chunks) {
 	const coarsest = c.type === 'MESH' ? out.mesh_levels - 1 : c.type === 'ANIM' ? out.motion_levels - 1 : c.type === 'SKEL' ? out.skeleton_levels - 1 : -1;
 	if (c.level === coarsest && c.offset + c.stored > out.first_drawable) die(`${c.type} level ${c.level} past first_drawable`);
+	// a nested ANIM level builds on the clip's next coarser one, earlier in the file
+	if (c.flags && !chunks.some((d) => d.type === 'ANIM' && d.item === c.item && d.level === c.level + 1 && d.offset < c.offset)) die(`ANIM level ${c.level} of clip ${c.item}: nested on a level the pack lacks`);
 }
 if (process.argv[3] === '--doc') {
 	const d = chunks[n - 1], s = d.streams[0];

@@ -1,5 +1,6 @@
 # The levels the piped stages leave are the levels mlod-pack computes
-# alone: on RobotExpressive (no skeleton level within the default bound,
+# alone (mlod-motion with --precision full: mlod-pack keeps the clip's own
+# values at every motion level, mlod(5) MOTION levels): on RobotExpressive (no skeleton level within the default bound,
 # so the mesh levels follow none), every MESH and ANIM chunk of the piped
 # pack is byte-identical to the direct pack's (same CRC, same place). So
 # is the DOC chunk (the piped input's level nodes, skins and meshes, level
@@ -7,7 +8,7 @@
 # by the name alone ("" piped, "RobotExpressive" direct: 16 bytes).
 set -e
 "$BIN/mlod-label" < "$ROOT/samples/RobotExpressive.glb" | "$BIN/mlod-skelgraph" 2>/dev/null | "$BIN/mlod-bgm" |
-	"$BIN/mlod-motion" | "$BIN/mlod-pack" -o piped.mlod
+	"$BIN/mlod-motion" --precision full | "$BIN/mlod-pack" -o piped.mlod
 "$BIN/mlod-pack" "$ROOT/samples/RobotExpressive.glb" -o direct.mlod
 node "$ROOT/tests/cli/pack_check.mjs" piped.mlod > p.json
 node "$ROOT/tests/cli/pack_check.mjs" direct.mlod > d.json

@@ -120,6 +120,7 @@ static void put64(buf *b, uint64_t v) { put32(b, (uint32_t)v); put32(b, (uint32_
 static void putf(buf *b, float f) { uint32_t u; memcpy(&u, &f, 4); put32(b, u); }
 static void pad_to(buf *b, size_t align) { while (b->n % align) put8(b, 0); }
 static void wr32(uint8_t *p, uint32_t v) { p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)(v >> 16); p[3] = (uint8_t)(v >> 24); }
+static void wr16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); }
 static uint32_t get32(const uint8_t *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
 static uint64_t get64(const uint8_t *p) { return get32(p) | (uint64_t)get32(p + 4) << 32; }
 
@@ -134,7 +135,7 @@ typedef struct wstream {
 typedef struct wchunk {
 	uint32_t type;
 	uint8_t layer, codec;
-	uint16_t level, item;
+	uint16_t level, item, flags;
 	float error, distance;
 	int ns;
 	wstream s[MAXS];
@@ -276,7 +277,7 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		put8(&out, c[i].codec);
 		put16(&out, c[i].level);
 		put16(&out, c[i].item);
-		put16(&out, 0);
+		put16(&out, c[i].flags);
 		put32(&out, 0);
 		put64(&out, off[i]);
 		put32(&out, (uint32_t)chunks[i].n);
@@ -324,7 +325,7 @@ static float ibm_truth[NJ][16];
 static float time_truth[NK];
 static float vec_truth[NK * 3][3];
 static float rot_truth[NK * 3][4];
-static int16_t rotq_truth[NK][4];
+static int16_t rotq_truth[NK][4], rotq_enc[NK][4];
 
 static const int32_t parents[NJ] = {-1, 0, 1, 1};
 
@@ -683,11 +684,13 @@ static int make_chunks(wchunk *c, int with_unknown)
 	putf(&s->data, 0.0f);
 	putf(&s->data, 1.0f);
 	add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_RAW);
+	add_stream(ch, MLOD_STREAM_ROTD, 8, MLOD_SCODEC_RAW);
 	add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
 	s = add_stream(ch, MLOD_STREAM_VEC3, 12, MLOD_SCODEC_RAW);
 	s->count = 2;
 	for (int k = 0; k < 6; k++)
 		putf(&s->data, (float)k);
+	add_stream(ch, MLOD_STREAM_VECD, 12, MLOD_SCODEC_RAW);
 
 	/* MESH level 0: the two parts' new vertices, meshopt-coded. */
 	ch = &c[C_MESH0];
@@ -722,9 +725,28 @@ static int make_chunks(wchunk *c, int with_unknown)
 		for (int a = 0; a < 4; a++)
 			rot_truth[k][a] = q[a] / sqrtf(l);
 	}
-	for (int k = 0; k < NK; k++)
-		for (int a = 0; a < 4; a++)
-			rotq_truth[k][a] = (int16_t)lrintf(rot_truth[k][a] * 32767.0f);
+	/* ROTQ: the three components but the largest, on the lattice, then
+	 * its index; the reader rebuilds it non-negative, then continues the
+	 * sign of the key before (rotq_truth: what it returns, x 32767). */
+	for (int k = 0; k < NK; k++) {
+		int big = 0;
+		for (int a = 1; a < 4; a++)
+			big = fabsf(rot_truth[k][a]) > fabsf(rot_truth[k][big]) ? a : big;
+		float sign = rot_truth[k][big] < 0 ? -1.0f : 1.0f;
+		double sum = 0, dot = 0;
+		for (int a = 0, j = 0; a < 4; a++)
+			if (a != big) {
+				rotq_enc[k][j++] = rotq_truth[k][a] = (int16_t)lrintf(sign * rot_truth[k][a] * 32767.0f);
+				float f = (float)(rotq_truth[k][a] / 32767.0);
+				sum += (double)f * f;
+			}
+		rotq_enc[k][3] = (int16_t)big;
+		rotq_truth[k][big] = (int16_t)lrint(sqrt(1.0 - sum) * 32767.0);
+		for (int a = 0; k > 0 && a < 4; a++)
+			dot += (double)rotq_truth[k][a] * rotq_truth[k - 1][a];
+		for (int a = 0; dot < 0 && a < 4; a++)
+			rotq_truth[k][a] = (int16_t)-rotq_truth[k][a];
+	}
 	/* the two time arrays, one after the other, as ticks */
 	s = add_stream(ch, MLOD_STREAM_TICK, 4, MLOD_SCODEC_MESHOPT_VERTEX);
 	s->count = 2 * NK;
@@ -736,7 +758,8 @@ static int make_chunks(wchunk *c, int with_unknown)
 	s->count = NK;
 	for (int k = 0; k < NK; k++)
 		for (int a = 0; a < 4; a++)
-			put16(&s->data, (uint16_t)rotq_truth[k][a]);
+			put16(&s->data, (uint16_t)rotq_enc[k][a]);
+	add_stream(ch, MLOD_STREAM_ROTD, 8, MLOD_SCODEC_MESHOPT_VERTEX);
 	s = add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
 	s->count = NK * 3;
 	for (int k = 0; k < NK * 3; k++)
@@ -748,6 +771,7 @@ static int make_chunks(wchunk *c, int with_unknown)
 		for (int k = 0; k < NK; k++)
 			for (int a = 0; a < 3; a++)
 				putf(&s->data, vec_truth[k][a]);
+	add_stream(ch, MLOD_STREAM_VECD, 12, MLOD_SCODEC_MESHOPT_VERTEX);
 
 	/* DOC */
 	ch = &c[C_DOC];
@@ -1121,8 +1145,9 @@ TEST(decode_motion)
 		for (int a = 0; ok && a < 3; a++)
 			ok = m.channels[0].values[3 * k + a] == vec_truth[k][a] && m.channels[3].values[3 * k + a] == vec_truth[k][a];
 		for (int a = 0; ok && a < 4; a++)
-			ok = m.channels[1].values[4 * k + a] == rotq_truth[k][a] / 32767.0f &&
-			     fabsf(m.channels[1].values[4 * k + a] - rot_truth[k][a]) <= 0.5f / 32767 + 1e-7f;
+			ok = m.channels[1].values[4 * k + a] == (float)(rotq_truth[k][a] / 32767.0) &&
+			     fminf(fabsf(m.channels[1].values[4 * k + a] - rot_truth[k][a]),
+			           fabsf(m.channels[1].values[4 * k + a] + rot_truth[k][a])) <= 2.0f / 32767 + 1e-7f;
 	}
 	for (int k = 0; ok && k < 3 * NK; k++)
 		for (int a = 0; ok && a < 4; a++)
@@ -1212,8 +1237,8 @@ TEST(newer_major_is_refused)
 	CHECK(r2 == MLOD_OK && minor == 7);
 }
 
-/* Format 2.0 changed the MESH layout (b2): a 1.x pack is refused whole,
- * with what to do; there is no 1.x decode. */
+/* Format 2.0 changed the MESH layout (b2) and the MOTION streams: a 1.x
+ * pack is refused whole, with what to do; there is no 1.x decode. */
 TEST(older_major_is_refused)
 {
 	static wchunk c[C_COUNT + 1];
@@ -1228,6 +1253,60 @@ TEST(older_major_is_refused)
 	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
 	                               "reads 2.x)") == 0,
 	          "message: %s", terr.message);
+}
+
+static uint8_t *stream_data(wchunk *c, int chunk, uint32_t tag, int nth);
+
+/* A nested MOTION level (TOC flag MLOD_PACK_CHUNK_NESTED) builds on the
+ * clip's next coarser level: the coarsest cannot be nested, and
+ * mlod_pack_decode_motion_on needs the base; with one whose channel
+ * (joint 1's translation) level 0 lacks, every key of level 0 stands on
+ * its own and decodes as before. */
+TEST(nested_motion_needs_its_base)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	c[C_MOT1].flags = MLOD_PACK_CHUNK_NESTED;
+	buf b1 = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	c[C_MOT1].flags = 0;
+	c[C_MOT0].flags = MLOD_PACK_CHUNK_NESTED;
+	wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0), 1); /* joint 1's translation: no key of level 0's */
+	buf b0 = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	free_chunks(c, n);
+	mlod_pack p = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_motion m = {0}, base = {0};
+	CHECK_OK(mlod_pack_open(b1.p, b1.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b1.p, b1.n, &s, &terr));
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_motion(&p, C_MOT1, b1.p, b1.n, &s, &m, &terr);
+	CHECK_MSG(r == MLOD_ERR_PARSE &&
+	              strcmp(terr.message, "MOTION level 1 of clip 0: builds on level 2, which the pack lacks") == 0,
+	          "returned %d: %s", (int)r, terr.message);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b0.p, b0.n, &p, &terr));
+	memset(&terr, 0, sizeof terr);
+	r = mlod_pack_decode_motion_on(&p, C_MOT0, b0.p, b0.n, &s, NULL, &m, &terr);
+	CHECK_MSG(r == MLOD_ERR_PARSE &&
+	              strcmp(terr.message, "MOTION level 0 of clip 0: builds on level 1, which was not given") == 0,
+	          "returned %d: %s", (int)r, terr.message);
+	CHECK_OK(mlod_pack_decode_motion(&p, C_MOT0, b0.p, b0.n, &s, &m, &terr));
+	CHECK_OK(mlod_pack_decode_motion(&p, C_MOT1, b0.p, b0.n, &s, &base, &terr));
+	mlod_pack_motion m2 = {0};
+	CHECK_OK(mlod_pack_decode_motion_on(&p, C_MOT0, b0.p, b0.n, &s, &base, &m2, &terr));
+	int same = m.channel_count == 4 && m2.channel_count == 4;
+	for (int k = 0; same && k < NK; k++)
+		for (int a = 0; same && a < 4; a++)
+			same = m.channels[1].values[4 * k + a] == (float)(rotq_truth[k][a] / 32767.0) &&
+			       m2.channels[1].values[4 * k + a] == m.channels[1].values[4 * k + a];
+	CHECK(same);
+	mlod_pack_motion_free(&m);
+	mlod_pack_motion_free(&m2);
+	mlod_pack_motion_free(&base);
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_close(&p);
+	free(b1.p);
+	free(b0.p);
 }
 
 TEST(draco_chunks_are_unsupported)
@@ -1443,7 +1522,11 @@ static void e_extra_stream(wchunk *c)
 		putf(&s->data, 2.0f);
 }
 static void e_dup_channel(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 2, 1); }
-static void e_no_vec3(wchunk *c) { wchunk_free_stream(&c[C_MOT1], 5); }
+static void e_no_vec3(wchunk *c)
+{
+	wchunk_free_stream(&c[C_MOT1], 7); /* VECD */
+	wchunk_free_stream(&c[C_MOT1], 6);
+}
 static void e_missing_rotation(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 4, 1); }
 static void e_time_order(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 * 3 + 16, 2); }
 static void e_time_keys(wchunk *c) { wr32(stream_data(c, C_MOT1, MLOD_STREAM_CHAN, 0) + 12, 3); }
@@ -1465,6 +1548,7 @@ static void e_tick_elsize(wchunk *c)
 static void e_morph_scale(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_MTSC, 0), 0xbf800000u); }
 static void e_no_skin(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 16, 0xffffffffu); }
 static void e_rotq_cubic(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 + 8, 2); }
+static void e_rotq_index(wchunk *c) { wr16(stream_data(c, C_MOT0, MLOD_STREAM_ROTQ, 0) + 8 * 2 + 6, 4); }
 static void e_part_flags(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x48); }
 
 TEST(structural_checks_name_the_chunk)
@@ -1494,7 +1578,7 @@ TEST(structural_checks_name_the_chunk)
 		{e_vertex_elsize, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: stream 1 'POSQ' has elements of 6 bytes, expected 8"},
 		{e_info_levels, C_INFO, MLOD_ERR_PARSE, "INFO: the TOC has SKELETON level 1, but INFO counts"},
 		{e_clip_names, C_INFO, MLOD_ERR_PARSE, "INFO: the string table 'NAME' ends before clip 0's name"},
-		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 6 'VEC3')"},
+		{e_extra_stream, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: 1 unexpected streams after the last one it needs (stream 8 'VEC3')"},
 		{e_time_order, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 3: time array 2 is not below 2 (the arrays go in first-use order)"},
 		{e_time_keys, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 2 'TIME' has 2 elements, expected 3 (the time arrays' keys)"},
 		{e_time_shared_keys, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: 6 keys, but time array 0 has 5"},
@@ -1502,11 +1586,12 @@ TEST(structural_checks_name_the_chunk)
 		{e_step_nan, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: step nan is not finite and >= 0"},
 		{e_tick_elsize, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 'TICK' has elements of 1 bytes, expected 2 or 4"},
 		{e_dup_channel, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 2: a second rotation channel of joint 1"},
-		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 3 'ROTQ' has 0 elements, expected 2 (keys of the non-cubic rotations)"},
-		{e_no_vec3, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: missing stream 'VEC3' (the chunk has 5 streams)"},
+		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 3 'ROTQ' has 0 elements, expected 2 (rotation keys without a base key)"},
+		{e_no_vec3, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: missing stream 'VEC3' (the chunk has 6 streams)"},
 		{e_morph_scale, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: morph target 0: scale -1 is not finite and >= 0"},
 		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
-		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (keys of the non-cubic rotations)"},
+		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (rotation keys without a base key)"},
+		{e_rotq_index, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 2: component index 4 is not 0 to 3"},
 		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x40"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
@@ -1744,6 +1829,7 @@ int main(int argc, char **argv)
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
 	RUN(older_major_is_refused);
+	RUN(nested_motion_needs_its_base);
 	RUN(draco_chunks_are_unsupported);
 	RUN(every_prefix);
 	RUN(structural_checks_name_the_chunk);

@@ -317,8 +317,13 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 			putf(b, ch->times[k]);
 	}
 	stream_end(c);
-	/* the values: ROTQ, ROTF, VEC3, each its channels' keys in order */
+	/* the values: ROTQ, ROTD (none: not nested), ROTF, VEC3, each its
+	 * channels' keys in order */
 	for (int kind = 0; kind < 3; kind++) {
+		if (kind == 1) {
+			stream(c, MLOD_STREAM_ROTD, 8);
+			stream_end(c);
+		}
 		b = stream(c, kind == 0 ? MLOD_STREAM_ROTQ : kind == 1 ? MLOD_STREAM_ROTF : MLOD_STREAM_VEC3,
 		           kind == 0 ? 8 : kind == 1 ? 16 : 12);
 		for (uint32_t i = 0; i < m->channel_count; i++) {
@@ -327,17 +332,28 @@ static void motion_chunk(const mlod_pack_motion *m, uint32_t level, uint32_t cli
 			int is = ch->rec.path == 1 ? (per == 1 ? 0 : 1) : 2;
 			if (is != kind)
 				continue;
-			for (uint32_t k = 0; k < K * per * (kind == 2 ? 3 : 4); k++) {
-				if (kind == 0) {
-					int16_t q = (int16_t)lrintf(ch->values[k] * 32767.0f);
-					put(b, &q, 2);
-				} else {
-					putf(b, ch->values[k]);
-				}
+			for (uint32_t k = 0; kind == 0 && k < K; k++) {
+				/* smallest three: the components but the largest, then its index */
+				const float *v = ch->values + 4 * (size_t)k;
+				int big = 0;
+				for (int a = 1; a < 4; a++)
+					big = fabsf(v[a]) > fabsf(v[big]) ? a : big;
+				float sign = v[big] < 0 ? -1.0f : 1.0f;
+				for (int a = 0; a < 4; a++)
+					if (a != big) {
+						int16_t q = (int16_t)lrintf(sign * v[a] * 32767.0f);
+						put(b, &q, 2);
+					}
+				int16_t q = (int16_t)big;
+				put(b, &q, 2);
 			}
+			for (uint32_t k = 0; kind != 0 && k < K * per * (kind == 2 ? 3 : 4); k++)
+				putf(b, ch->values[k]);
 		}
 		stream_end(c);
 	}
+	stream(c, MLOD_STREAM_VECD, 12); /* none: not nested */
+	stream_end(c);
 }
 
 static void build_pack(bytes *out)

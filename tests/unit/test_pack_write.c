@@ -13,6 +13,8 @@
 
 #include <meshoptimizer.h>
 
+#include "rt/mlod_rt.h"
+
 /* A small deterministic generator (xorshift). */
 static uint32_t rng = 2463534242u;
 static float frand(void)
@@ -626,10 +628,105 @@ TEST(pack_joints16)
  * key time bit for bit, or within MLOD_PACK_TICK_TOLERANCE as ticks (time
  * arrays shared, ticks for sampled clips), and
  * every translation, scale and cubic value bit for bit; non-cubic
- * rotations ('ROTQ') within MLOD_PACK_ROTQ_BOUND per component up to the
- * sign and MLOD_PACK_ROTQ_ANGLE in angle; a constant channel as one key
+ * rotations ('ROTQ') within MLOD_PACK_ROTQ_BOUND per component of the
+ * normalised input up to the sign and MLOD_PACK_ROTQ_ANGLE in angle; a constant channel as one key
  * at its last time holding every key's value; with the meshopt codec and
  * lossless_motion (the default level 0 is within a bound: test_unpack). */
+/* Nested motion levels (mlod(5)): on the walk every ANIM level but the
+ * coarsest has the nested flag and most rotation keys go as 'ROTD'. The
+ * runtime streams level 0 alone (levels 1 and 2 not resident: it decodes
+ * the chain for the while and frees it, staying within its budget) and
+ * poses exactly as a runtime that streamed the levels coarse to fine. (It
+ * caught the runtime building on a resident level whose keys it had
+ * normalised in place.) */
+TEST(nested_motion_streams_alone)
+{
+	size_t n = 0;
+	void *in = slurp("samples/cmu_12_01_walk.bvh", &n);
+	CHECK(in);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	opt.no_skeleton_levels = 1;
+	void *out = NULL;
+	size_t size = 0;
+	CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, NULL, &terr));
+	mlod_pack pk;
+	CHECK_OK(mlod_pack_open(out, size, &pk, &terr));
+	uint32_t levels = 0, rotd = 0, rotq = 0;
+	for (uint32_t i = 0; i < pk.chunk_count; i++)
+		if (pk.chunks[i].type == MLOD_CHUNK_MOTION)
+			levels++;
+	for (uint32_t i = 0; i < pk.chunk_count; i++) {
+		const mlod_pack_chunk *ch = &pk.chunks[i];
+		if (ch->type != MLOD_CHUNK_MOTION)
+			continue;
+		CHECK_MSG(!!(ch->flags & MLOD_PACK_CHUNK_NESTED) == (ch->level + 1u < levels), "level %u: flags %u",
+		          (unsigned)ch->level, (unsigned)ch->flags);
+		uint32_t cnt, esz;
+		void *q = stream((const uint8_t *)out + ch->offset, MLOD_STREAM_ROTQ, 0, &cnt, &esz);
+		rotq += cnt, free(q);
+		q = stream((const uint8_t *)out + ch->offset, MLOD_STREAM_ROTD, 0, &cnt, &esz);
+		rotd += cnt, free(q);
+	}
+	mlod_pack_close(&pk);
+	CHECK_MSG(levels == 4 && rotd > rotq / 2, "%u levels, %u ROTQ and %u ROTD keys", levels, rotq, rotd);
+	mlod_rt_ctx *a = NULL, *b = NULL;
+	mlod_rt_config cfg = {0};
+	cfg.budget_bytes = 1u << 20;
+	CHECK_OK(mlod_rt_open_memory(out, size, &cfg, &a, &terr));
+	CHECK_OK(mlod_rt_open_memory(out, size, &cfg, &b, &terr));
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	uint32_t ia, ib, loaded = 0;
+	CHECK_OK(mlod_rt_instance_create(a, 0, 0.0f, MLOD_RT_LOOP, &ia, &terr));
+	CHECK_OK(mlod_rt_instance_create(b, 0, 0.0f, MLOD_RT_LOOP, &ib, &terr));
+	float d = 0;
+	/* a: level 0 alone */
+	sel.force_level = 0;
+	CHECK_OK(mlod_rt_update(a, &sel, &ia, &d, 1, 0.0f, &terr));
+	CHECK_OK(mlod_rt_stream(a, SIZE_MAX, &loaded, &terr));
+	mlod_rt_level_info li[4];
+	for (uint32_t l = 0; l < 4; l++)
+		CHECK_OK(mlod_rt_level_info_get(a, MLOD_RT_MOTION, l, 0, &li[l], &terr));
+	CHECK_MSG(li[0].resident && !li[1].resident && !li[2].resident && li[3].resident, "resident %d %d %d %d",
+	          li[0].resident, li[1].resident, li[2].resident, li[3].resident);
+	mlod_rt_stats sa;
+	mlod_rt_stats_get(a, &sa);
+	CHECK(sa.peak_resident_bytes <= cfg.budget_bytes);
+	/* b: coarse to fine */
+	for (int l = 2; l >= 0; l--) {
+		sel.force_level = l;
+		CHECK_OK(mlod_rt_update(b, &sel, &ib, &d, 1, 0.0f, &terr));
+		CHECK_OK(mlod_rt_stream(b, SIZE_MAX, &loaded, &terr));
+	}
+	CHECK(mlod_rt_instance_state(a, ia)->level[MLOD_RT_MOTION] == 0 &&
+	      mlod_rt_instance_state(b, ib)->level[MLOD_RT_MOTION] == 0);
+	mlod_rt_scratch *sa_ = mlod_rt_scratch_create(a), *sb = mlod_rt_scratch_create(b);
+	CHECK(sa_ && sb);
+	uint32_t J = mlod_rt_joint_count(a), same = 0;
+	for (int k = 0; sa_ && sb && k < 50; k++) {
+		const float *wa = NULL, *wb = NULL;
+		CHECK_OK(mlod_rt_update(a, &sel, &ia, &d, 1, 0.037f, &terr));
+		CHECK_OK(mlod_rt_update(b, &sel, &ib, &d, 1, 0.037f, &terr));
+		CHECK_OK(mlod_rt_pose(a, sa_, ia, &wa, NULL, NULL, &terr));
+		CHECK_OK(mlod_rt_pose(b, sb, ib, &wb, NULL, NULL, &terr));
+		same += wa && wb && memcmp(wa, wb, sizeof(float) * 16 * J) == 0;
+	}
+	CHECK_MSG(same == 50, "%u of 50 poses the same", same);
+	mlod_rt_scratch_destroy(a, sa_);
+	mlod_rt_scratch_destroy(b, sb);
+	mlod_rt_close(a);
+	mlod_rt_close(b);
+	mlod_free(out);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	free(in);
+}
+
 TEST(pack_lossless_fields)
 {
 	const char *files[] = {"samples/RobotExpressive.glb", "samples/cmu_12_01_walk.bvh"};
@@ -731,12 +828,14 @@ TEST(pack_lossless_fields)
 						CHECK(memcmp(got, want, 4 * (size_t)comps * per) == 0);
 						continue;
 					}
-					/* ROTQ: within half a step per component, up to the sign */
-					double dot = 0, e = 0;
+					/* ROTQ: within the bound per component of the normalised
+					 * input, up to the sign */
+					double dot = 0, e = 0, len = 0;
 					for (int a = 0; a < 4; a++)
-						dot += (double)got[a] * want[a];
+						dot += (double)got[a] * want[a], len += (double)want[a] * want[a];
+					len = sqrt(len);
 					for (int a = 0; a < 4; a++) {
-						double d = fabs((dot < 0 ? -got[a] : got[a]) - want[a]);
+						double d = fabs((dot < 0 ? -got[a] : got[a]) - want[a] / len);
 						e = d > e ? d : e;
 					}
 					float ang = mlod_quat_angle((mlod_quat){got[0], got[1], got[2], got[3]},
@@ -855,6 +954,7 @@ int main(void)
 	RUN(pack_palette_is_fold);
 	RUN(pack_joints16);
 	RUN(pack_lossless_fields);
+	RUN(nested_motion_streams_alone);
 	RUN(motion_level0_bound);
 	TEST_EXIT();
 }

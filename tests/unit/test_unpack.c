@@ -7,9 +7,11 @@
  *              inverse binds, materials of the primitives, index lists;
  *              with lossless_motion, clip key times and values (ROTQ
  *              within its lattice bound)
- *   bounded    motion level 0 (the default): at the input clip's common
+ *   bounded    every motion level (level 0 by default, and the coarser
+ *              ones as <clip>@lod<k>): at the input clip's common
  *              timeline frames and midpoints, every joint's point error
- *              within the level-0 bound plus the ROTQ lattice's share,
+ *              within the level's bound, and its position error within
+ *              the level's TOC error, each plus the ROTQ lattice's share,
  *              both clips sampled and posed with the bake library
  *   quantised  (mlod(5)) positions within half a step of position_bits
  *              of the part's box per axis, normals within
@@ -380,7 +382,7 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
  * (mlod_motion_point_error, radius pd) of every joint at the input's
  * common timeline frames and midpoints, each clip sampled and posed by the
  * bake library (not lib/motion's own evaluator): at most e0 plus the ROTQ
- * lattice's share (mlod(5): each rotation key within 2 asin(1/32767) rad;
+ * lattice's share (mlod(5): each rotation key within MLOD_PACK_ROTQ_ANGLE;
  * a rotation of the joint or an ancestor g off by that angle moves the
  * joint's origin by at most the angle times |o_joint - o_g| and turns its
  * world 3x3 part M by that angle, which the point error weighs by pd
@@ -409,8 +411,8 @@ static double sigma_max3(const mlod_mat4 *w)
 	return sqrt(lam);
 }
 
-static const char *level0_within(const mlod_character *c, const mlod_clip *a, const mlod_clip *b, double e0,
-                                 double pd, double height, double *worst, char *msg, size_t cap)
+static const char *level_within(const mlod_character *c, const mlod_clip *a, const mlod_clip *b, double e0,
+                                 double toc, double pd, double height, double *worst, char *msg, size_t cap)
 {
 	mlod_motion_options mo = {0};
 	mlod_clip common;
@@ -429,7 +431,7 @@ static const char *level0_within(const mlod_character *c, const mlod_clip *a, co
 	for (int i = 0; i < b->channel_count; i++)
 		if (b->channels[i].path == MLOD_PATH_ROTATION && b->channels[i].interp != MLOD_INTERP_CUBICSPLINE)
 			rotq[b->channels[i].joint] = 1;
-	const double angle = 2.0 * asin(1.0 / 32767.0);
+	const double angle = MLOD_PACK_ROTQ_ANGLE;
 	for (int i = 0; i < n && !fail; i++) {
 		mlod_pose_rest(&c->skeleton, la);
 		mlod_pose_rest(&c->skeleton, lb);
@@ -438,14 +440,25 @@ static const char *level0_within(const mlod_character *c, const mlod_clip *a, co
 		mlod_pose_world(&c->skeleton, la, wa);
 		mlod_pose_world(&c->skeleton, lb, wb);
 		for (int j = 0; j < nj && !fail; j++) {
-			double lattice = 0, radius = pd * sigma_max3(&wa[j]);
+			double lattice = 0, origin = 0, radius = pd * sigma_max3(&wa[j]);
 			for (int g = j; g >= 0; g = c->skeleton.joints[g].parent)
 				if (rotq[g]) {
 					double d = 0;
 					for (int r = 0; r < 3; r++)
 						d += ((double)wa[j].m[12 + r] - wa[g].m[12 + r]) * ((double)wa[j].m[12 + r] - wa[g].m[12 + r]);
 					lattice += angle * (sqrt(d) + radius);
+					origin += angle * sqrt(d);
 				}
+			/* the TOC's joint position error, honest up to the lattice */
+			double jp = 0;
+			for (int r = 0; r < 3; r++)
+				jp += ((double)wa[j].m[12 + r] - wb[j].m[12 + r]) * ((double)wa[j].m[12 + r] - wb[j].m[12 + r]);
+			jp = sqrt(jp);
+			if (toc >= 0 && jp > toc + origin + 1e-6 * height) {
+				snprintf(msg, cap, "clip '%s' joint %d at %.5g s: position error %.6g, TOC error %.6g + lattice %.6g",
+				         a->name, j, (double)t[i], jp, toc, origin);
+				fail = msg;
+			}
 			double e = mlod_motion_point_error(&wa[j], &wb[j], pd), bound = e0 + lattice + 1e-6 * height;
 			if (e / bound > *worst)
 				*worst = e / bound;
@@ -461,7 +474,20 @@ static const char *level0_within(const mlod_character *c, const mlod_clip *a, co
 	return fail;
 }
 
-static double worst_level0;
+static double worst_level0, worst_level[4];
+
+/* The TOC error of MOTION level l of clip q, or -1. */
+static double toc_error(const void *pack, size_t size, int l, int q)
+{
+	mlod_pack p;
+	mlod_error e = {0};
+	if (mlod_pack_open(pack, size, &p, &e) != MLOD_OK)
+		return -1;
+	int ci = mlod_pack_find(&p, MLOD_CHUNK_MOTION, (unsigned)l, (unsigned)q);
+	double r = ci >= 0 ? p.chunks[ci].error : -1;
+	mlod_pack_close(&p);
+	return r;
+}
 static int level0_fewer_keys; /* the sample's level 0 must have fewer keys than its input */
 
 /* Packs path with opt, unpacks, writes and reloads the glb, compares. */
@@ -568,7 +594,8 @@ static const char *round_trip(const char *path, const mlod_pack_options *opt, ch
 	mlod_pack_mesh_free(&pm), mlod_pack_skeleton_free(&psk), mlod_pack_close(&pk);
 	/* Clips: level 0 under the clip's name, within mlod(5)'s bounds: key
 	 * times exact or within MLOD_PACK_TICK_TOLERANCE of the clip's span,
-	 * int16 rotations within MLOD_PACK_ROTQ_BOUND per component (q and -q
+	 * int16 rotations within MLOD_PACK_ROTQ_BOUND per component of the
+	 * normalised key (q and -q
 	 * are one rotation: the writer keeps signs continuous), other values
 	 * exact; a channel whose keys are all equal may come back as one key
 	 * at its last time. */
@@ -580,7 +607,8 @@ static const char *round_trip(const char *path, const mlod_pack_options *opt, ch
 		if (!b)
 			FAIL("clip '%s' missing", a->name);
 		if (!opt->lossless_motion) {
-			const char *why = level0_within(&c, a, b, e0, pd, st.height, &worst_level0, msg, cap);
+			const char *why = level_within(&c, a, b, e0, toc_error(pack, pack_size, 0, k), pd, st.height, &worst_level0,
+			                               msg, cap);
 			if (why) {
 				fail = why;
 				goto done;
@@ -605,21 +633,39 @@ static const char *round_trip(const char *path, const mlod_pack_options *opt, ch
 						FAIL("clip '%s' channel %d key %d: time %.9g, unpacked %.9g", a->name, ch, i, x->times[i],
 						     y->times[j]);
 				const float *xv = x->values + (size_t)comps * (size_t)i, *yv = y->values + (size_t)comps * (size_t)j;
-				double e_pos = 0, e_neg = 0;
+				double e_pos = 0, e_neg = 0, len = 0;
+				for (int v = 0; v < comps; v++)
+					len += (double)xv[v] * xv[v];
+				len = rot && len > 0 ? sqrt(len) : 1.0; /* ROTQ: against the normalised key */
 				for (int v = 0; v < comps; v++) {
-					e_pos = fmax(e_pos, fabs((double)xv[v] - yv[v]));
-					e_neg = fmax(e_neg, fabs((double)xv[v] + yv[v]));
+					e_pos = fmax(e_pos, fabs((double)xv[v] / len - yv[v]));
+					e_neg = fmax(e_neg, fabs((double)xv[v] / len + yv[v]));
 				}
 				double e = rot ? fmin(e_pos, e_neg) : e_pos;
 				if (e > vtol)
 					FAIL("clip '%s' channel %d key %d: values off by %.3g (bound %.3g)", a->name, ch, i, e, vtol);
 			}
 		}
-		/* Coarser levels are there too. */
-		char name[300];
-		snprintf(name, sizeof name, "%s@lod1", a->name);
-		if (st.motion.levels > 1 && !clip_named(&c2, name))
-			FAIL("clip '%s' missing", name);
+		/* Coarser levels are there too, each within its bound (the
+		 * default bounds, which every level of the samples meets) and its
+		 * TOC error, plus the ROTQ lattice's share. */
+		for (int l = 1; l < st.motion.levels; l++) {
+			char name[300];
+			snprintf(name, sizeof name, "%s@lod%d", a->name, l);
+			const mlod_clip *bl = clip_named(&c2, name);
+			if (!bl)
+				FAIL("clip '%s' missing", name);
+			if (l > opt->motion_bound_count)
+				continue;
+			double bound = opt->motion_percent[l - 1] ? opt->motion_bounds[l - 1] * st.height / 100.0
+			                                          : opt->motion_bounds[l - 1];
+			const char *why = level_within(&c, a, bl, bound, toc_error(pack, pack_size, l, k), pd, st.height,
+			                               &worst_level[l < 4 ? l : 3], msg, cap);
+			if (why) {
+				fail = why;
+				goto done;
+			}
+		}
 	}
 done:
 	mlod_character_free(&c);
@@ -645,11 +691,13 @@ static void sample_bits(const char *path, int pb, int nb, int ub, int fewer)
 		opt.position_bits = pb, opt.normal_bits = nb, opt.uv_bits = ub;
 	pos_bits = opt.position_bits, nrm_bits = opt.normal_bits, uv_bits = opt.uv_bits;
 	worst_pos_ratio = worst_pos_err = worst_nrm = worst_uv_ratio = worst_w = worst_level0 = 0;
+	memset(worst_level, 0, sizeof worst_level);
 	level0_fewer_keys = fewer;
 	const char *why = round_trip(path, &opt, msg, sizeof msg - 64);
 	fprintf(stderr, "%s (bits %d %d %d): max position error %.3g (%.3f of the half-step bound), normal %.3g rad, uv %.3f of bound, "
-	        "weight %.4f; motion level 0 point error %.3f of its bound\n", path, pos_bits, nrm_bits, uv_bits, worst_pos_err,
-	        worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w, worst_level0);
+	        "weight %.4f; motion level 0 point error %.3f of its bound, levels 1-3 %.3f %.3f %.3f\n", path, pos_bits,
+	        nrm_bits, uv_bits, worst_pos_err, worst_pos_ratio, worst_nrm, worst_uv_ratio, worst_w, worst_level0,
+	        worst_level[1], worst_level[2], worst_level[3]);
 	CHECK_MSG(!why, "%.200s: %.700s", path, why);
 	opt.lossless_motion = 1;
 	opt.no_skeleton_levels = opt.no_mesh_levels = 1;
