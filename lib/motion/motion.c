@@ -752,18 +752,24 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
 }
 
 /* Is level_max_error(m, clip) <= bound? It stops at the first error
- * above. */
+ * above. The samples are independent: every LEVEL_STRIDE-th goes first
+ * (a level that does not fit usually fails sooner), then the others in
+ * order; the answer is the same. */
+#define LEVEL_STRIDE 16
 static int level_within(mlod_motion *m, const mlod_clip *clip, double bound)
 {
 	level_walk w;
 	walk_begin(m, clip, &w);
-	int ok = 1;
-	for (int f = 0; f < m->samples && ok; f++) {
-		const mlod_mat4 *w0 = orig_world(m, f);
-		walk_pose(m, &w, f);
-		for (int j = 0; j < m->s->joint_count && ok; j++)
-			ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
-	}
+	int ok = 1, stride = m->samples >= 4 * LEVEL_STRIDE ? LEVEL_STRIDE : 1;
+	for (int pass = stride > 1 ? 0 : 1; pass < 2 && ok; pass++)
+		for (int f = 0; f < m->samples && ok; f += pass ? 1 : stride) {
+			if (pass == 1 && stride > 1 && f % stride == 0)
+				continue;
+			const mlod_mat4 *w0 = orig_world(m, f);
+			walk_pose(m, &w, f);
+			for (int j = 0; j < m->s->joint_count && ok; j++)
+				ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
+		}
 	return ok;
 }
 
@@ -1132,14 +1138,26 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 		mlod_clip_free(&src);
 		return -1;
 	}
-	int hi = (int)ceil(log2(bound)) + 1, lo = hi - GRID_RANGE;
-	if (!round_fits(m, &src, clip, lo, adj, e, bound)) {
+	/* The coarsest grid from 2^(hi - GRID_RANGE) to 2^hi that fits: from
+	 * the top down by doubling steps (hi - 1, hi - 2, hi - 4, ...), then
+	 * bisection; a grid that does not fit is usually found so in a few
+	 * samples (level_within), one that fits costs a whole walk, and the
+	 * steps meet few of those. */
+	int top = (int)ceil(log2(bound)) + 1, hi = top + 1, lo = top - GRID_RANGE, found = 0;
+	for (int step = 0; !found; step = step ? 2 * step : 1) {
+		int g = top - step < lo ? lo : top - step;
+		if (round_fits(m, &src, clip, g, adj, e, bound))
+			found = 1, lo = g;
+		else if (g == lo)
+			break;
+		else
+			hi = g;
+	}
+	if (!found) {
 		for (int i = 0; i < n; i++)
 			e[i] = NO_ROUNDING;
 		round_clip(&src, clip, e, SHORTS(m));
 	} else {
-		if (round_fits(m, &src, clip, hi, adj, e, bound))
-			lo = hi;
 		while (hi - lo > 1) {
 			int mid = lo + (hi - lo) / 2;
 			if (round_fits(m, &src, clip, mid, adj, e, bound))
