@@ -62,6 +62,8 @@ typedef struct reducer {
 	const mlod_channel *good_ch; /* and of what: channel, samples */
 	int good_lo, good_hi;
 	unsigned char *kept;
+	unsigned *stamp;         /* S: the check that took the sample first */
+	unsigned stamp_now;
 } reducer;
 
 static int comps_of(const mlod_channel *ch)
@@ -154,22 +156,40 @@ static int sample_check(reducer *R, const mlod_channel *ch, const float *va, con
 /* Checks channel ch taking, at samples lo..hi (inclusive), the values of
  * the segment between its keys at frames a and b (or a's value, constant).
  * The samples are independent (each needs only the current matrices at
- * that sample), so every SWEEP_STRIDE-th goes first, then the others in
- * order: a failing check usually stops sooner. When every sample fits, the results
- * become the good buffers, which sweep_commit applies. */
+ * that sample), so they go in the order that finds a failure soonest: the
+ * frames of the keys the segment removes first (gone[0..ngone - 1], the
+ * last first: there the segment departs most from what was kept), then
+ * every SWEEP_STRIDE-th sample, then the others in order. The answer is
+ * the same in any order. When every sample fits, the results become the
+ * good buffers, which sweep_commit applies. */
 #define SWEEP_STRIDE 8
-static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget)
+static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget,
+                       const int *gone, int ngone)
 {
 	int comps = comps_of(ch);
 	eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
 	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
 	const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
 	int stride = hi - lo + 1 >= 4 * SWEEP_STRIDE ? SWEEP_STRIDE : 1;
-	for (int f = lo; f <= hi && stride > 1; f += stride)
+	unsigned id = ++R->stamp_now;
+	if (id == 0) { /* wrapped: start the stamps again */
+		memset(R->stamp, 0, sizeof(unsigned) * (size_t)R->S);
+		id = R->stamp_now = 1;
+	}
+	for (int k = ngone - 1; k >= 0; k--) {
+		int f = gone[k] * R->per;
+		R->stamp[f] = id;
 		if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
 			return 0;
+	}
+	for (int f = lo; f <= hi && stride > 1; f += stride)
+		if (R->stamp[f] != id) {
+			R->stamp[f] = id;
+			if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+				return 0;
+		}
 	for (int f = lo; f <= hi; f++) /* the rest in order (memory order) */
-		if ((stride == 1 || (f - lo) % stride != 0) && !sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+		if (R->stamp[f] != id && !sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
 			return 0;
 	R->good = 1 - R->good;
 	R->good_ch = ch, R->good_lo = lo, R->good_hi = hi;
@@ -180,7 +200,7 @@ static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo,
 static void sweep_commit(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant)
 {
 	if (R->good_ch != ch || R->good_lo != lo || R->good_hi != hi)
-		sweep_check(R, ch, a, b, lo, hi, constant, HUGE_VAL); /* not reached: the last fit is the one applied */
+		sweep_check(R, ch, a, b, lo, hi, constant, HUGE_VAL, NULL, 0); /* not reached: the last fit is the one applied */
 	int j = ch->joint, g = R->good;
 	const int *sub = R->sub + R->sub_start[j];
 	int nsub = R->sub_start[j + 1] - R->sub_start[j];
@@ -207,7 +227,7 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 	for (int i = 0; i + 2 < nk + 0 && i < nk - 1;) {
 		int ok = i + 1, fail = nk, step = 1, probe = i + 2;
 		while (probe < nk) {
-			if (sweep_check(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget)) {
+			if (sweep_check(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget, K + i + 1, probe - i - 1)) {
 				ok = probe;
 				step *= 2;
 				probe = i + 1 + step;
@@ -217,14 +237,14 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 			}
 		}
 		if (fail == nk && ok < nk - 1) {
-			if (sweep_check(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget))
+			if (sweep_check(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget, K + i + 1, nk - 2 - i))
 				ok = nk - 1;
 			else
 				fail = nk - 1;
 		}
 		while (fail - ok > 1) {
 			int mid = ok + (fail - ok) / 2;
-			if (sweep_check(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget))
+			if (sweep_check(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget, K + i + 1, mid - i - 1))
 				ok = mid;
 			else
 				fail = mid;
@@ -257,7 +277,7 @@ static void collapse_channel(reducer *R, int c, double budget)
 	int comps = comps_of(ch);
 	if (memcmp(ch->values, ch->values + (size_t)(R->F - 1) * (size_t)comps, sizeof(float) * (size_t)comps) != 0)
 		return;
-	if (!sweep_check(R, ch, 0, 0, 1, R->S - 1, 1, budget))
+	if (!sweep_check(R, ch, 0, 0, 1, R->S - 1, 1, budget, NULL, 0))
 		return;
 	sweep_commit(R, ch, 0, 0, 1, R->S - 1, 1);
 	memset(row + 1, 0, (size_t)R->F - 1);
@@ -274,6 +294,7 @@ static void reducer_free(reducer *R)
 	free(R->lc);
 	free(R->lm);
 	free(R->wc);
+	free(R->stamp);
 	for (int i = 0; i < 2; i++) {
 		free(R->wb[i]);
 		free(R->lb[i]);
@@ -353,6 +374,7 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	R.lc = malloc(sizeof(mlod_trs) * FJ);
 	R.lm = malloc(sizeof(mlod_mat4) * FJ);
 	R.wc = malloc(sizeof(mlod_mat4) * FJ);
+	R.stamp = calloc((size_t)R.S, sizeof(unsigned));
 	for (int i = 0; i < 2; i++) {
 		R.wb[i] = malloc(sizeof(mlod_mat4) * FJ);
 		R.lb[i] = malloc(sizeof(mlod_trs) * (size_t)R.S);
@@ -362,7 +384,7 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	int *K = malloc(sizeof(int) * (size_t)R.F);
 	int *prevk = malloc(sizeof(int) * (size_t)R.F), *nextk = malloc(sizeof(int) * (size_t)R.F);
 	int *fill = NULL;
-	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.wb[0] || !R.wb[1] || !R.lb[0] ||
+	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.stamp || !R.wb[0] || !R.wb[1] || !R.lb[0] ||
 	    !R.lb[1] || !R.lmb[0] || !R.lmb[1] || !depth || !K || !prevk || !nextk) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
