@@ -1006,15 +1006,16 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	const mlod_skeleton *s = m->s;
 	int F = m->samples, J = s->joint_count, n = clip->channel_count;
 	size_t FJ = (size_t)F * (size_t)J;
-	mlod_trs *L = malloc(sizeof *L * FJ), *Lj = malloc(sizeof *Lj * (size_t)F);
-	mlod_mat4 *W = malloc(sizeof *W * FJ), *T = malloc(sizeof *T * FJ);
-	mlod_mat4 *LM = malloc(sizeof *LM * FJ), *LMj = malloc(sizeof *LMj * (size_t)F);
+	mlod_trs *L = malloc(sizeof *L * FJ), *Lj = malloc(sizeof *Lj * (size_t)F), *Lj2 = malloc(sizeof *Lj2 * (size_t)F);
+	mlod_mat4 *W = malloc(sizeof *W * FJ), *T = malloc(sizeof *T * FJ), *T2 = malloc(sizeof *T2 * FJ);
+	mlod_mat4 *LM = malloc(sizeof *LM * FJ), *LMj = malloc(sizeof *LMj * (size_t)F), *LMj2 = malloc(sizeof *LMj2 * (size_t)F);
 	int *sub = malloc(sizeof(int) * (size_t)J), *pos = malloc(sizeof(int) * (size_t)J);
 	const float *times = m->st;
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
-	if (!L || !Lj || !W || !T || !LM || !LMj || !sub || !pos) {
+	if (!L || !Lj || !W || !T || !LM || !LMj || !sub || !pos || !Lj2 || !T2 || !LMj2) {
 		free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
+		free(Lj2), free(LMj2), free(T2);
 		return -1;
 	}
 	level_walk walk;
@@ -1048,12 +1049,17 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 			if (a == j)
 				pos[d] = ns, sub[ns++] = d;
 		}
-		while (adj[i] < CHANNEL_COARSER) {
-			adj[i]++;
+		/* The coarsest adjustment up to CHANNEL_COARSER that fits: the
+		 * largest first, then bisection (a try that does not fit usually
+		 * stops within a few samples, one that fits checks them all). The
+		 * try's local transform of j and world matrices of its subtree go
+		 * to Lj, LMj and T (ns per sample); those of the best fit so far
+		 * are kept in Lj2, LMj2, T2. */
+		int ok_adj = adj[i], bad_adj = CHANNEL_COARSER + 1, have = 0;
+		for (int want = CHANNEL_COARSER; bad_adj - ok_adj > 1; want = ok_adj + (bad_adj - ok_adj) / 2) {
+			adj[i] = want;
 			channel_exps(m, src, g, adj, e);
 			round_channel(&src->channels[i], ch, e[i], SHORTS(m));
-			/* The try's local transform of j and world matrices of its
-			 * subtree go to Lj, LMj and T (ns per sample); kept if it fits. */
 			int ok = 1;
 			eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
 			/* Every stride-th sample first, then the rest in order. */
@@ -1091,22 +1097,31 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 						ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
 					}
 				}
-			if (!ok) {
-				adj[i]--;
-				channel_exps(m, src, g, adj, e);
-				round_channel(&src->channels[i], ch, e[i], SHORTS(m));
-				break;
+			if (ok) {
+				mlod_trs *tl = Lj;
+				mlod_mat4 *tm = LMj, *tt = T;
+				Lj = Lj2, LMj = LMj2, T = T2;
+				Lj2 = tl, LMj2 = tm, T2 = tt;
+				ok_adj = want, have = 1;
+			} else {
+				bad_adj = want;
 			}
-			for (int f = 0; f < F; f++) {
-				mlod_mat4 *wf = W + (size_t)f * (size_t)J;
-				L[(size_t)f * (size_t)J + (size_t)j] = Lj[f];
-				LM[(size_t)f * (size_t)J + (size_t)j] = LMj[f];
-				for (int k = 0; k < ns; k++)
-					wf[sub[k]] = T[(size_t)f * (size_t)ns + (size_t)k];
-			}
+		}
+		adj[i] = ok_adj;
+		channel_exps(m, src, g, adj, e);
+		round_channel(&src->channels[i], ch, e[i], SHORTS(m));
+		if (!have)
+			continue;
+		for (int f = 0; f < F; f++) {
+			mlod_mat4 *wf = W + (size_t)f * (size_t)J;
+			L[(size_t)f * (size_t)J + (size_t)j] = Lj2[f];
+			LM[(size_t)f * (size_t)J + (size_t)j] = LMj2[f];
+			for (int k = 0; k < ns; k++)
+				wf[sub[k]] = T2[(size_t)f * (size_t)ns + (size_t)k];
 		}
 	}
 	free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
+	free(Lj2), free(LMj2), free(T2);
 	return 0;
 }
 
