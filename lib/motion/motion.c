@@ -343,17 +343,24 @@ static void pose_at(mlod_motion *m, const mlod_clip *clip, float t, mlod_mat4 *w
 	mlod_pose_world(m->s, m->local, world);
 }
 
-/* Fills node values from common frame f, and its Euler angles. */
-static void node_euler(const mlod_motion *m, fnode *nd)
+/* Fills node values from common frame f, and its Euler angles (with
+ * skip_constant, not those of constant channels, which node_distance
+ * leaves out). */
+static void node_euler_of(const mlod_motion *m, fnode *nd, int skip_constant)
 {
 	for (int i = 0; i < m->common.channel_count; i++) {
 		int slot = m->euler_slot[i];
-		if (slot < 0)
+		if (slot < 0 || (skip_constant && m->constant[i]))
 			continue;
 		const float *q = nd->values + m->offset[i];
 		mlod_quat r = { q[0], q[1], q[2], q[3] };
 		mlod_quat_to_euler(m->s->joints[m->common.channels[i].joint].euler, r, nd->values + m->value_count + 3 * slot);
 	}
+}
+
+static void node_euler(const mlod_motion *m, fnode *nd)
+{
+	node_euler_of(m, nd, 0);
 }
 
 static int node_from_frame(const mlod_motion *m, int f, fnode *nd)
@@ -1318,8 +1325,11 @@ static double residual_of(const mlod_motion *m, const fnode *p, const fnode *x, 
 	if (!tmp.values)
 		return -1.0;
 	float u = (float)((x->time - p->time) / (q->time - p->time));
+	/* Only what node_distance reads: the constant channels are left out. */
 	for (int i = 0; i < m->common.channel_count; i++) {
 		const mlod_channel *ch = &m->common.channels[i];
+		if (m->constant[i])
+			continue;
 		const float *a = p->values + m->offset[i], *b = q->values + m->offset[i];
 		float *o = tmp.values + m->offset[i];
 		if (ch->interp == MLOD_INTERP_STEP) {
@@ -1333,7 +1343,7 @@ static double residual_of(const mlod_motion *m, const fnode *p, const fnode *x, 
 				o[c] = a[c] + (b[c] - a[c]) * u;
 		}
 	}
-	node_euler(m, &tmp);
+	node_euler_of(m, &tmp, 1);
 	double d = node_distance(m, x, &tmp);
 	free(tmp.values);
 	return d;
