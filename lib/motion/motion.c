@@ -1207,6 +1207,20 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 	return bad ? -1 : 0;
 }
 
+/* The fewest bytes a level clip can store whatever its values' rounding:
+ * with auto precision every rotation as shorts (8 bytes a key instead of
+ * 16). */
+static long least_bytes(const mlod_motion *m, const mlod_clip *clip)
+{
+	long least = mlod_clip_key_bytes(clip);
+	for (int i = 0; SHORTS(m) && i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		if (ch->path == MLOD_PATH_ROTATION && ch->interp != MLOD_INTERP_CUBICSPLINE && !ch->short_values)
+			least -= 8L * ch->key_count;
+	}
+	return least;
+}
+
 /* Fills the level's counts and its error as mlod_joint_deviation measures
  * it, after rounding its values within bound (< 0: a level chosen by
  * threshold or fraction, whose error e may grow to e / (1 - share), the
@@ -1218,14 +1232,8 @@ static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double b
 	out->keys = mlod_clip_key_count(&out->clip);
 	out->bytes = mlod_clip_key_bytes(&out->clip);
 	if (max_bytes >= 0) {
-		/* Rounding keeps the keys; at most, auto precision stores every
-		 * rotation as shorts (8 bytes a key instead of 16). */
-		long least = out->bytes;
-		for (int i = 0; SHORTS(m) && i < out->clip.channel_count; i++) {
-			const mlod_channel *ch = &out->clip.channels[i];
-			if (ch->path == MLOD_PATH_ROTATION && ch->interp != MLOD_INTERP_CUBICSPLINE && !ch->short_values)
-				least -= 8L * ch->key_count;
-		}
+		/* Rounding keeps the keys. */
+		long least = least_bytes(m, &out->clip);
 		if (least > max_bytes) {
 			out->bytes = least;
 			out->unfinished = 1;
@@ -1550,6 +1558,22 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 					return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 				}
 				ok = line_within(m, &l, &c, removal_bound(m, value));
+				if (!ok && max_bytes >= 0 && least_bytes(m, &c) > max_bytes) {
+					/* The level would be finer than this line, so larger
+					 * (the tree's lines grow finer as the threshold goes
+					 * down): it cannot win. Left unfinished; the next
+					 * frames level builds on the last finished one. */
+					memset(out, 0, sizeof *out);
+					out->method = MLOD_MOTION_FRAMES;
+					out->threshold = t;
+					out->keys = mlod_clip_key_count(&c);
+					out->bytes = least_bytes(m, &c);
+					out->unfinished = 1;
+					mlod_clip_free(&c);
+					line_free(&l);
+					line_free(&best);
+					return MLOD_OK;
+				}
 				mlod_clip_free(&c);
 			}
 			if (target == MLOD_MOTION_FRACTION) {
