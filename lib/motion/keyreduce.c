@@ -64,6 +64,7 @@ typedef struct reducer {
 	unsigned char *kept;
 	unsigned *stamp;         /* S: the check that took the sample first */
 	unsigned stamp_now;
+	eval_scratch own;        /* the arrays above (lc to stamp) when no scratch is given */
 } reducer;
 
 static int comps_of(const mlod_channel *ch)
@@ -291,15 +292,7 @@ static void reducer_free(reducer *R)
 	free(R->sub);
 	if (R->own_w0)
 		free(R->w0);
-	free(R->lc);
-	free(R->lm);
-	free(R->wc);
-	free(R->stamp);
-	for (int i = 0; i < 2; i++) {
-		free(R->wb[i]);
-		free(R->lb[i]);
-		free(R->lmb[i]);
-	}
+	free(R->own.p); /* lc to stamp: in the scratch */
 }
 
 static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
@@ -344,12 +337,12 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                            double point_distance, int subdivide, unsigned char *kept, mlod_error *err)
 {
-	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, err);
+	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, NULL, err);
 }
 
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
-                          double *max_error, mlod_error *err)
+                          double *max_error, eval_scratch *scratch, mlod_error *err)
 {
 	if (max_error)
 		*max_error = -1.0;
@@ -371,14 +364,24 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	R.sub_start = calloc((size_t)R.J + 1, sizeof(int));
 	R.own_w0 = !w0;
 	R.w0 = w0 ? (mlod_mat4 *)w0 : malloc(sizeof(mlod_mat4) * FJ); /* not written when given */
-	R.lc = malloc(sizeof(mlod_trs) * FJ);
-	R.lm = malloc(sizeof(mlod_mat4) * FJ);
-	R.wc = malloc(sizeof(mlod_mat4) * FJ);
-	R.stamp = calloc((size_t)R.S, sizeof(unsigned));
-	for (int i = 0; i < 2; i++) {
-		R.wb[i] = malloc(sizeof(mlod_mat4) * FJ);
-		R.lb[i] = malloc(sizeof(mlod_trs) * (size_t)R.S);
-		R.lmb[i] = malloc(sizeof(mlod_mat4) * (size_t)R.S);
+	{
+		size_t S = (size_t)R.S;
+		size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 4 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
+		              2 * eval_carve_size(sizeof(mlod_trs) * S) + 2 * eval_carve_size(sizeof(mlod_mat4) * S) +
+		              eval_carve_size(sizeof(unsigned) * S);
+		char *at = eval_scratch_get(scratch ? scratch : &R.own, need);
+		if (at) {
+			R.lc = eval_carve(&at, sizeof(mlod_trs) * FJ);
+			R.lm = eval_carve(&at, sizeof(mlod_mat4) * FJ);
+			R.wc = eval_carve(&at, sizeof(mlod_mat4) * FJ);
+			R.stamp = eval_carve(&at, sizeof(unsigned) * S);
+			memset(R.stamp, 0, sizeof(unsigned) * S);
+			for (int i = 0; i < 2; i++) {
+				R.wb[i] = eval_carve(&at, sizeof(mlod_mat4) * FJ);
+				R.lb[i] = eval_carve(&at, sizeof(mlod_trs) * S);
+				R.lmb[i] = eval_carve(&at, sizeof(mlod_mat4) * S);
+			}
+		}
 	}
 	int *depth = malloc(sizeof(int) * (size_t)R.J);
 	int *K = malloc(sizeof(int) * (size_t)R.F);

@@ -290,6 +290,7 @@ struct mlod_motion {
 	unsigned char *kept;   /* channel_count * frames */
 	memo *memo;            /* the tree's distances and residuals */
 	memo *segmemo;         /* frames level under way: segments of lines within its bound */
+	eval_scratch scratch;  /* the large arrays of the key reduction and of refine_channels */
 };
 
 static void line_free(line *l)
@@ -327,6 +328,7 @@ void mlod_motion_free(mlod_motion *m)
 	if (m->segmemo)
 		free(m->segmemo->slot);
 	free(m->segmemo);
+	free(m->scratch.p);
 	free(m);
 }
 
@@ -1013,18 +1015,31 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	const mlod_skeleton *s = m->s;
 	int F = m->samples, J = s->joint_count, n = clip->channel_count;
 	size_t FJ = (size_t)F * (size_t)J;
-	mlod_trs *L = malloc(sizeof *L * FJ), *Lj = malloc(sizeof *Lj * (size_t)F), *Lj2 = malloc(sizeof *Lj2 * (size_t)F);
-	mlod_mat4 *W = malloc(sizeof *W * FJ), *T = malloc(sizeof *T * FJ), *T2 = malloc(sizeof *T2 * FJ);
-	mlod_mat4 *LM = malloc(sizeof *LM * FJ), *LMj = malloc(sizeof *LMj * (size_t)F), *LMj2 = malloc(sizeof *LMj2 * (size_t)F);
-	int *sub = malloc(sizeof(int) * (size_t)J), *pos = malloc(sizeof(int) * (size_t)J);
+	size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 4 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
+	              2 * eval_carve_size(sizeof(mlod_trs) * (size_t)F) + 2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) +
+	              2 * eval_carve_size(sizeof(int) * (size_t)J);
+	char *at = eval_scratch_get(&m->scratch, need);
+	mlod_trs *L = NULL, *Lj = NULL, *Lj2 = NULL;
+	mlod_mat4 *W = NULL, *T = NULL, *T2 = NULL, *LM = NULL, *LMj = NULL, *LMj2 = NULL;
+	int *sub = NULL, *pos = NULL;
+	if (at) {
+		L = eval_carve(&at, sizeof *L * FJ);
+		W = eval_carve(&at, sizeof *W * FJ);
+		T = eval_carve(&at, sizeof *T * FJ);
+		T2 = eval_carve(&at, sizeof *T2 * FJ);
+		LM = eval_carve(&at, sizeof *LM * FJ);
+		Lj = eval_carve(&at, sizeof *Lj * (size_t)F);
+		Lj2 = eval_carve(&at, sizeof *Lj2 * (size_t)F);
+		LMj = eval_carve(&at, sizeof *LMj * (size_t)F);
+		LMj2 = eval_carve(&at, sizeof *LMj2 * (size_t)F);
+		sub = eval_carve(&at, sizeof(int) * (size_t)J);
+		pos = eval_carve(&at, sizeof(int) * (size_t)J);
+	}
 	const float *times = m->st;
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
-	if (!L || !Lj || !W || !T || !LM || !LMj || !sub || !pos || !Lj2 || !T2 || !LMj2) {
-		free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
-		free(Lj2), free(LMj2), free(T2);
+	if (!at)
 		return -1;
-	}
 	level_walk walk;
 	walk_begin(m, clip, &walk);
 	for (int f = 0; f < F; f++) {
@@ -1127,9 +1142,7 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 				wf[sub[k]] = T2[(size_t)f * (size_t)ns + (size_t)k];
 		}
 	}
-	free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
-	free(Lj2), free(LMj2), free(T2);
-	return 0;
+	return 0; /* the arrays stay in m->scratch */
 }
 
 /* Rounds the level's values to the coarsest grids that keep its point
@@ -1659,7 +1672,7 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	memcpy(kept, m->kept, size);
 	memset(clip, 0, sizeof *clip);
 	double e = -1.0;
-	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, err) !=
+	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, &m->scratch, err) !=
 	    MLOD_OK)
 		return -1.0;
 	if (clip_from_kept(m, kept, clip) != 0) {
