@@ -465,10 +465,12 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		size_t base = (size_t)f * (size_t)R.J;
 		mlod_trs *l = R.lc + base;
 		for (int j = 0; j < R.J; j++)
-			R.lm[base + (size_t)j] = mlod_mat4_from_trs(&l[j]);
+			R.lm[base + (size_t)j] = eval_from_trs(&l[j]); /* mlod_mat4_from_trs, inline */
 		for (int j = 0; j < R.J; j++) {
 			int p = s->joints[j].parent;
-			R.wc[base + (size_t)j] = mlod_mat4_mul(p < 0 ? &s->joints[j].base : &R.wc[base + (size_t)p], &R.lm[base + (size_t)j]);
+			/* mlod_mat4_mul; below a root, its affine form (the same floats) */
+			R.wc[base + (size_t)j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &R.lm[base + (size_t)j])
+			                               : eval_mul_affine(&R.wc[base + (size_t)p], &R.lm[base + (size_t)j]);
 		}
 	}
 
