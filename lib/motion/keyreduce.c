@@ -82,27 +82,6 @@ static void set_path(mlod_trs *l, mlod_path path, const float *v)
 	}
 }
 
-/* The value at sample f of a channel keyed at frames a < b (f strictly
- * between them), as mlod_clip_sample computes it from those two keys. */
-static void segment_value(const reducer *R, const mlod_channel *ch, int a, int b, int f, float *out)
-{
-	int comps = comps_of(ch);
-	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
-	if (ch->interp == MLOD_INTERP_STEP) {
-		memcpy(out, va, sizeof(float) * (size_t)comps);
-		return;
-	}
-	const float t0 = R->times[a * R->per], t1 = R->times[b * R->per], dt = t1 - t0;
-	const float u = (R->times[f] - t0) / dt;
-	if (comps == 4) {
-		mlod_quat q = mlod_quat_slerp((mlod_quat){ va[0], va[1], va[2], va[3] }, (mlod_quat){ vb[0], vb[1], vb[2], vb[3] }, u);
-		out[0] = q.x, out[1] = q.y, out[2] = q.z, out[3] = q.w;
-	} else {
-		for (int c = 0; c < 3; c++)
-			out[c] = va[c] + (vb[c] - va[c]) * u;
-	}
-}
-
 /* Does the joint's world matrix w stay within budget of w0? A float
  * bound of the point error decides first (the same answer); only when it
  * cannot, mlod_motion_point_within with its early exits. */
@@ -126,7 +105,8 @@ static int sample_check(reducer *R, const mlod_channel *ch, const float *va, con
 	if (constant || ch->interp == MLOD_INTERP_STEP) {
 		memcpy(v, va, sizeof(float) * (size_t)comps);
 	} else {
-		/* segment_value, with the slerp's per-segment part done once. */
+		/* As mlod_clip_sample computes it from the two keys, with the
+		 * slerp's per-segment part done once. */
 		const float u = (R->times[f] - t0) / dt;
 		if (comps == 4) {
 			mlod_quat q = eval_slerp(seg, va, vb, u);
@@ -449,6 +429,8 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 			if (row[k])
 				n = k;
 		}
+		eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+		int seg_a = -1;
 		for (int f = 0; f < R.S; f++) {
 			float v[4];
 			int comps = comps_of(ch);
@@ -456,7 +438,23 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 				int k = f >= last * R.per && first != last ? last : first;
 				memcpy(v, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
 			} else {
-				segment_value(&R, ch, prevk[f / R.per], nextk[f / R.per], f, v);
+				/* As mlod_clip_sample computes it from the kept keys around f,
+				 * the slerp's per-segment part done once a segment. */
+				int a = prevk[f / R.per], b = nextk[f / R.per];
+				if (a != seg_a)
+					seg.ready = 0, seg_a = a;
+				const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
+				const float t0 = R.times[a * R.per], dt = R.times[b * R.per] - t0;
+				const float u = (R.times[f] - t0) / dt;
+				if (ch->interp == MLOD_INTERP_STEP) {
+					memcpy(v, va, sizeof(float) * (size_t)comps);
+				} else if (comps == 4) {
+					mlod_quat q = eval_slerp(&seg, va, vb, u);
+					v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
+				} else {
+					for (int c = 0; c < 3; c++)
+						v[c] = va[c] + (vb[c] - va[c]) * u;
+				}
 			}
 			set_path(&R.lc[(size_t)f * (size_t)R.J + (size_t)ch->joint], ch->path, v);
 		}
@@ -481,7 +479,7 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		collapse_channel(&R, c, bound);
 	/* The largest point error of the result, as motion.c's
 	 * level_max_error measures the level clip of these keys: the same
-	 * sampling (the kept values and segment_value are mlod_clip_sample's on
+	 * sampling (the kept values are mlod_clip_sample's on
 	 * those keys) and kinematics, when no sample time is past the clip's
 	 * duration (mlod_clip_sample would clamp it). */
 	if (max_error && R.times[R.S - 1] <= common->duration) {
