@@ -722,7 +722,8 @@ static double level_max_error(mlod_motion *m, const mlod_clip *clip)
  * the same float operations, and the clip as read from its cache).
  * Returns 0 when it could not (no cache, or a NaN error): the caller then
  * measures as those functions do. */
-static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_error, mlod_deviation *dev)
+static int level_measure_of(mlod_motion *m, const mlod_clip *clip, const mlod_mat4 *known, double *point_error,
+                            mlod_deviation *dev)
 {
 	if (!m->cache0)
 		return 0;
@@ -733,9 +734,13 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
 	long count = 0;
 	for (int f = 0; f < m->samples; f++) {
 		const mlod_mat4 *w0 = orig_world(m, f);
-		walk_pose(m, &w, f);
+		const mlod_mat4 *wl = m->world;
+		if (known)
+			wl = known + (size_t)f * (size_t)s->joint_count;
+		else
+			walk_pose(m, &w, f);
 		for (int j = 0; j < s->joint_count; j++) {
-			double e = eval_error_over(&m->world[j], &w0[j], m->radius[j], worst);
+			double e = eval_error_over(&wl[j], &w0[j], m->radius[j], worst);
 			if (e >= 0.0 && !(e <= worst))
 				worst = e;
 			else if (e != e)
@@ -744,7 +749,7 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
 				mlod_v3 o = { 0, 0, 0 };
 				if (k == 1)
 					o = s->joints[j].end_site;
-				mlod_v3 x = mlod_mat4_point(&w0[j], o), y = mlod_mat4_point(&m->world[j], o);
+				mlod_v3 x = mlod_mat4_point(&w0[j], o), y = mlod_mat4_point(&wl[j], o);
 				double d = mlod_v3_length(mlod_v3_sub(x, y));
 				sum += d;
 				count++;
@@ -758,6 +763,12 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
 	dev->max = max;
 	dev->mean = count ? sum / (double)count : 0.0;
 	return 1;
+}
+
+/* level_measure_of walking the level clip. */
+static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_error, mlod_deviation *dev)
+{
+	return level_measure_of(m, clip, NULL, point_error, dev);
 }
 
 /* Is level_max_error(m, clip) <= bound? It stops at the first error
@@ -1010,7 +1021,7 @@ static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int
  * operations as mlod_pose_world. Needs m->cache0. Returns -1 when out of
  * memory; clip is then rounded with adj as it was. */
 static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int g, int *adj, int *e,
-                           double bound)
+                           double bound, const mlod_mat4 **world)
 {
 	const mlod_skeleton *s = m->s;
 	int F = m->samples, J = s->joint_count, n = clip->channel_count;
@@ -1142,7 +1153,8 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 				wf[sub[k]] = T2[(size_t)f * (size_t)ns + (size_t)k];
 		}
 	}
-	return 0; /* the arrays stay in m->scratch */
+	*world = W; /* in m->scratch: valid until its next use */
+	return 0;
 }
 
 /* Rounds the level's values to the coarsest grids that keep its point
@@ -1202,12 +1214,15 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 		}
 		/* Channels in their order (measured as good as round robin or
 		 * leaves first); the result is measured again as a whole. */
-		if (m->cache0 && refine_channels(m, &src, clip, lo, adj, e, bound) != 0)
-			bad = 1;
-		/* round_fits, measuring the level at the same time. */
+		const mlod_mat4 *world = NULL;
+		if (m->cache0 && refine_channels(m, &src, clip, lo, adj, e, bound, &world) != 0)
+			bad = 1, world = NULL;
+		/* round_fits, measuring the level at the same time; refine_channels
+		 * left the level's world matrices at every sample (the same floats
+		 * as a walk of the clip). */
 		channel_exps(m, &src, lo, adj, e);
 		round_clip(&src, clip, e, SHORTS(m));
-		meas->valid = level_measure(m, clip, &meas->point_error, &meas->dev) && meas->point_error <= bound;
+		meas->valid = level_measure_of(m, clip, world, &meas->point_error, &meas->dev) && meas->point_error <= bound;
 		if (!meas->valid && !level_within(m, clip, bound)) {
 			memset(adj, 0, sizeof(int) * (size_t)n); /* fitted in the bisection */
 			round_fits(m, &src, clip, lo, adj, e, bound);
