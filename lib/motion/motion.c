@@ -1185,33 +1185,20 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 		mlod_clip_free(&src);
 		return -1;
 	}
-	/* The coarsest grid from 2^(hi - GRID_RANGE) to 2^hi that fits: from
-	 * the top down by doubling steps (hi - 1, hi - 2, hi - 4, ...), then
-	 * bisection; a grid that does not fit is usually found so in a few
-	 * samples (level_within), one that fits costs a whole walk, and the
-	 * steps meet few of those. */
-	int top = (int)ceil(log2(bound)) + 1, hi = top + 1, lo = top - GRID_RANGE, found = 0;
-	for (int step = 0; !found; step = step ? 2 * step : 1) {
-		int g = top - step < lo ? lo : top - step;
+	/* The coarsest grid from 2^(top - GRID_RANGE) to 2^top that fits,
+	 * from the top down one grid at a time: a grid that does not fit is
+	 * usually found so within a few samples (level_within), one that fits
+	 * costs a whole walk, and this meets one (a bisection met about
+	 * three a level). */
+	int top = (int)ceil(log2(bound)) + 1, lo = top - GRID_RANGE, found = 0;
+	for (int g = top; g >= lo && !found; g--)
 		if (round_fits(m, &src, clip, g, adj, e, bound))
 			found = 1, lo = g;
-		else if (g == lo)
-			break;
-		else
-			hi = g;
-	}
 	if (!found) {
 		for (int i = 0; i < n; i++)
 			e[i] = NO_ROUNDING;
 		round_clip(&src, clip, e, SHORTS(m));
 	} else {
-		while (hi - lo > 1) {
-			int mid = lo + (hi - lo) / 2;
-			if (round_fits(m, &src, clip, mid, adj, e, bound))
-				lo = mid;
-			else
-				hi = mid;
-		}
 		/* Channels in their order (measured as good as round robin or
 		 * leaves first); the result is measured again as a whole. */
 		const mlod_mat4 *world = NULL;
