@@ -62,6 +62,9 @@ typedef struct reducer {
 	const mlod_channel *good_ch; /* and of what: channel, samples */
 	int good_lo, good_hi;
 	unsigned char *kept;
+	unsigned *stamp;         /* S: the check that took the sample first */
+	unsigned stamp_now;
+	eval_scratch own;        /* the arrays above (lc to stamp) when no scratch is given */
 } reducer;
 
 static int comps_of(const mlod_channel *ch)
@@ -76,27 +79,6 @@ static void set_path(mlod_trs *l, mlod_path path, const float *v)
 	case MLOD_PATH_TRANSLATION: l->t.x = v[0], l->t.y = v[1], l->t.z = v[2]; break;
 	case MLOD_PATH_SCALE: l->s.x = v[0], l->s.y = v[1], l->s.z = v[2]; break;
 	case MLOD_PATH_ROTATION: l->r = eval_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
-	}
-}
-
-/* The value at sample f of a channel keyed at frames a < b (f strictly
- * between them), as mlod_clip_sample computes it from those two keys. */
-static void segment_value(const reducer *R, const mlod_channel *ch, int a, int b, int f, float *out)
-{
-	int comps = comps_of(ch);
-	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
-	if (ch->interp == MLOD_INTERP_STEP) {
-		memcpy(out, va, sizeof(float) * (size_t)comps);
-		return;
-	}
-	const float t0 = R->times[a * R->per], t1 = R->times[b * R->per], dt = t1 - t0;
-	const float u = (R->times[f] - t0) / dt;
-	if (comps == 4) {
-		mlod_quat q = mlod_quat_slerp((mlod_quat){ va[0], va[1], va[2], va[3] }, (mlod_quat){ vb[0], vb[1], vb[2], vb[3] }, u);
-		out[0] = q.x, out[1] = q.y, out[2] = q.z, out[3] = q.w;
-	} else {
-		for (int c = 0; c < 3; c++)
-			out[c] = va[c] + (vb[c] - va[c]) * u;
 	}
 }
 
@@ -123,7 +105,8 @@ static int sample_check(reducer *R, const mlod_channel *ch, const float *va, con
 	if (constant || ch->interp == MLOD_INTERP_STEP) {
 		memcpy(v, va, sizeof(float) * (size_t)comps);
 	} else {
-		/* segment_value, with the slerp's per-segment part done once. */
+		/* As mlod_clip_sample computes it from the two keys, with the
+		 * slerp's per-segment part done once. */
 		const float u = (R->times[f] - t0) / dt;
 		if (comps == 4) {
 			mlod_quat q = eval_slerp(seg, va, vb, u);
@@ -154,22 +137,40 @@ static int sample_check(reducer *R, const mlod_channel *ch, const float *va, con
 /* Checks channel ch taking, at samples lo..hi (inclusive), the values of
  * the segment between its keys at frames a and b (or a's value, constant).
  * The samples are independent (each needs only the current matrices at
- * that sample), so every SWEEP_STRIDE-th goes first, then the others in
- * order: a failing check usually stops sooner. When every sample fits, the results
- * become the good buffers, which sweep_commit applies. */
+ * that sample), so they go in the order that finds a failure soonest: the
+ * frames of the keys the segment removes first (gone[0..ngone - 1], the
+ * last first: there the segment departs most from what was kept), then
+ * every SWEEP_STRIDE-th sample, then the others in order. The answer is
+ * the same in any order. When every sample fits, the results become the
+ * good buffers, which sweep_commit applies. */
 #define SWEEP_STRIDE 8
-static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget)
+static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget,
+                       const int *gone, int ngone)
 {
 	int comps = comps_of(ch);
 	eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
 	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
 	const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
 	int stride = hi - lo + 1 >= 4 * SWEEP_STRIDE ? SWEEP_STRIDE : 1;
-	for (int f = lo; f <= hi && stride > 1; f += stride)
+	unsigned id = ++R->stamp_now;
+	if (id == 0) { /* wrapped: start the stamps again */
+		memset(R->stamp, 0, sizeof(unsigned) * (size_t)R->S);
+		id = R->stamp_now = 1;
+	}
+	for (int k = ngone - 1; k >= 0; k--) {
+		int f = gone[k] * R->per;
+		R->stamp[f] = id;
 		if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
 			return 0;
+	}
+	for (int f = lo; f <= hi && stride > 1; f += stride)
+		if (R->stamp[f] != id) {
+			R->stamp[f] = id;
+			if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+				return 0;
+		}
 	for (int f = lo; f <= hi; f++) /* the rest in order (memory order) */
-		if ((stride == 1 || (f - lo) % stride != 0) && !sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+		if (R->stamp[f] != id && !sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
 			return 0;
 	R->good = 1 - R->good;
 	R->good_ch = ch, R->good_lo = lo, R->good_hi = hi;
@@ -180,7 +181,7 @@ static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo,
 static void sweep_commit(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant)
 {
 	if (R->good_ch != ch || R->good_lo != lo || R->good_hi != hi)
-		sweep_check(R, ch, a, b, lo, hi, constant, HUGE_VAL); /* not reached: the last fit is the one applied */
+		sweep_check(R, ch, a, b, lo, hi, constant, HUGE_VAL, NULL, 0); /* not reached: the last fit is the one applied */
 	int j = ch->joint, g = R->good;
 	const int *sub = R->sub + R->sub_start[j];
 	int nsub = R->sub_start[j + 1] - R->sub_start[j];
@@ -207,7 +208,7 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 	for (int i = 0; i + 2 < nk + 0 && i < nk - 1;) {
 		int ok = i + 1, fail = nk, step = 1, probe = i + 2;
 		while (probe < nk) {
-			if (sweep_check(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget)) {
+			if (sweep_check(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget, K + i + 1, probe - i - 1)) {
 				ok = probe;
 				step *= 2;
 				probe = i + 1 + step;
@@ -217,14 +218,14 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 			}
 		}
 		if (fail == nk && ok < nk - 1) {
-			if (sweep_check(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget))
+			if (sweep_check(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget, K + i + 1, nk - 2 - i))
 				ok = nk - 1;
 			else
 				fail = nk - 1;
 		}
 		while (fail - ok > 1) {
 			int mid = ok + (fail - ok) / 2;
-			if (sweep_check(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget))
+			if (sweep_check(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget, K + i + 1, mid - i - 1))
 				ok = mid;
 			else
 				fail = mid;
@@ -257,7 +258,7 @@ static void collapse_channel(reducer *R, int c, double budget)
 	int comps = comps_of(ch);
 	if (memcmp(ch->values, ch->values + (size_t)(R->F - 1) * (size_t)comps, sizeof(float) * (size_t)comps) != 0)
 		return;
-	if (!sweep_check(R, ch, 0, 0, 1, R->S - 1, 1, budget))
+	if (!sweep_check(R, ch, 0, 0, 1, R->S - 1, 1, budget, NULL, 0))
 		return;
 	sweep_commit(R, ch, 0, 0, 1, R->S - 1, 1);
 	memset(row + 1, 0, (size_t)R->F - 1);
@@ -271,14 +272,7 @@ static void reducer_free(reducer *R)
 	free(R->sub);
 	if (R->own_w0)
 		free(R->w0);
-	free(R->lc);
-	free(R->lm);
-	free(R->wc);
-	for (int i = 0; i < 2; i++) {
-		free(R->wb[i]);
-		free(R->lb[i]);
-		free(R->lmb[i]);
-	}
+	free(R->own.p); /* lc to stamp: in the scratch */
 }
 
 static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
@@ -323,12 +317,12 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                            double point_distance, int subdivide, unsigned char *kept, mlod_error *err)
 {
-	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, err);
+	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, NULL, err);
 }
 
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
-                          double *max_error, mlod_error *err)
+                          double *max_error, eval_scratch *scratch, mlod_error *err)
 {
 	if (max_error)
 		*max_error = -1.0;
@@ -350,19 +344,30 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	R.sub_start = calloc((size_t)R.J + 1, sizeof(int));
 	R.own_w0 = !w0;
 	R.w0 = w0 ? (mlod_mat4 *)w0 : malloc(sizeof(mlod_mat4) * FJ); /* not written when given */
-	R.lc = malloc(sizeof(mlod_trs) * FJ);
-	R.lm = malloc(sizeof(mlod_mat4) * FJ);
-	R.wc = malloc(sizeof(mlod_mat4) * FJ);
-	for (int i = 0; i < 2; i++) {
-		R.wb[i] = malloc(sizeof(mlod_mat4) * FJ);
-		R.lb[i] = malloc(sizeof(mlod_trs) * (size_t)R.S);
-		R.lmb[i] = malloc(sizeof(mlod_mat4) * (size_t)R.S);
+	{
+		size_t S = (size_t)R.S;
+		size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 4 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
+		              2 * eval_carve_size(sizeof(mlod_trs) * S) + 2 * eval_carve_size(sizeof(mlod_mat4) * S) +
+		              eval_carve_size(sizeof(unsigned) * S);
+		char *at = eval_scratch_get(scratch ? scratch : &R.own, need);
+		if (at) {
+			R.lc = eval_carve(&at, sizeof(mlod_trs) * FJ);
+			R.lm = eval_carve(&at, sizeof(mlod_mat4) * FJ);
+			R.wc = eval_carve(&at, sizeof(mlod_mat4) * FJ);
+			R.stamp = eval_carve(&at, sizeof(unsigned) * S);
+			memset(R.stamp, 0, sizeof(unsigned) * S);
+			for (int i = 0; i < 2; i++) {
+				R.wb[i] = eval_carve(&at, sizeof(mlod_mat4) * FJ);
+				R.lb[i] = eval_carve(&at, sizeof(mlod_trs) * S);
+				R.lmb[i] = eval_carve(&at, sizeof(mlod_mat4) * S);
+			}
+		}
 	}
 	int *depth = malloc(sizeof(int) * (size_t)R.J);
 	int *K = malloc(sizeof(int) * (size_t)R.F);
 	int *prevk = malloc(sizeof(int) * (size_t)R.F), *nextk = malloc(sizeof(int) * (size_t)R.F);
 	int *fill = NULL;
-	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.wb[0] || !R.wb[1] || !R.lb[0] ||
+	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.stamp || !R.wb[0] || !R.wb[1] || !R.lb[0] ||
 	    !R.lb[1] || !R.lmb[0] || !R.lmb[1] || !depth || !K || !prevk || !nextk) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
@@ -424,6 +429,8 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 			if (row[k])
 				n = k;
 		}
+		eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+		int seg_a = -1;
 		for (int f = 0; f < R.S; f++) {
 			float v[4];
 			int comps = comps_of(ch);
@@ -431,7 +438,23 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 				int k = f >= last * R.per && first != last ? last : first;
 				memcpy(v, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
 			} else {
-				segment_value(&R, ch, prevk[f / R.per], nextk[f / R.per], f, v);
+				/* As mlod_clip_sample computes it from the kept keys around f,
+				 * the slerp's per-segment part done once a segment. */
+				int a = prevk[f / R.per], b = nextk[f / R.per];
+				if (a != seg_a)
+					seg.ready = 0, seg_a = a;
+				const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
+				const float t0 = R.times[a * R.per], dt = R.times[b * R.per] - t0;
+				const float u = (R.times[f] - t0) / dt;
+				if (ch->interp == MLOD_INTERP_STEP) {
+					memcpy(v, va, sizeof(float) * (size_t)comps);
+				} else if (comps == 4) {
+					mlod_quat q = eval_slerp(&seg, va, vb, u);
+					v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
+				} else {
+					for (int c = 0; c < 3; c++)
+						v[c] = va[c] + (vb[c] - va[c]) * u;
+				}
 			}
 			set_path(&R.lc[(size_t)f * (size_t)R.J + (size_t)ch->joint], ch->path, v);
 		}
@@ -440,10 +463,12 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		size_t base = (size_t)f * (size_t)R.J;
 		mlod_trs *l = R.lc + base;
 		for (int j = 0; j < R.J; j++)
-			R.lm[base + (size_t)j] = mlod_mat4_from_trs(&l[j]);
+			R.lm[base + (size_t)j] = eval_from_trs(&l[j]); /* mlod_mat4_from_trs, inline */
 		for (int j = 0; j < R.J; j++) {
 			int p = s->joints[j].parent;
-			R.wc[base + (size_t)j] = mlod_mat4_mul(p < 0 ? &s->joints[j].base : &R.wc[base + (size_t)p], &R.lm[base + (size_t)j]);
+			/* mlod_mat4_mul; below a root, its affine form (the same floats) */
+			R.wc[base + (size_t)j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &R.lm[base + (size_t)j])
+			                               : eval_mul_affine(&R.wc[base + (size_t)p], &R.lm[base + (size_t)j]);
 		}
 	}
 
@@ -454,7 +479,7 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		collapse_channel(&R, c, bound);
 	/* The largest point error of the result, as motion.c's
 	 * level_max_error measures the level clip of these keys: the same
-	 * sampling (the kept values and segment_value are mlod_clip_sample's on
+	 * sampling (the kept values are mlod_clip_sample's on
 	 * those keys) and kinematics, when no sample time is past the clip's
 	 * duration (mlod_clip_sample would clamp it). */
 	if (max_error && R.times[R.S - 1] <= common->duration) {

@@ -168,7 +168,9 @@ typedef struct mlod_motion_level {
 	                             and scales finer by their joint's reach), scene units; 0: none */
 	int unfinished;           /* mlod_motion_next_level_under only: more bytes than its limit
 	                             whatever the rounding; clip holds the kept keys unrounded,
-	                             bytes the fewest it could store, errors are not measured */
+	                             bytes the fewest it could store, errors are not measured; a
+	                             frames level whose search stopped early (below) has no clip,
+	                             and bytes are those of the line that stopped it */
 } mlod_motion_level;
 
 /* Builds the next level of a method: each level is made from the previous
@@ -189,7 +191,12 @@ void mlod_motion_level_free(mlod_motion_level *l);
  * chosen as there, and the method's next level builds on them, but a
  * level that would store more than max_bytes however its values are
  * rounded is left unfinished (mlod_motion_level.unfinished), which saves
- * the rounding and measuring. */
+ * the rounding and measuring. With MLOD_MOTION_MAX_ERROR, the frames
+ * method also stops its search on the threshold as soon as a line it
+ * rejects (too coarse for the bound) stores more than max_bytes: the
+ * level would be a finer line, so larger (the tree's lines grow finer as
+ * the threshold goes down). That level is left unfinished without keys,
+ * and the method's next level builds on its last finished level. */
 mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                          double value, long max_bytes, mlod_motion_level *out, mlod_error *err);
 

@@ -290,6 +290,7 @@ struct mlod_motion {
 	unsigned char *kept;   /* channel_count * frames */
 	memo *memo;            /* the tree's distances and residuals */
 	memo *segmemo;         /* frames level under way: segments of lines within its bound */
+	eval_scratch scratch;  /* the large arrays of the key reduction and of refine_channels */
 };
 
 static void line_free(line *l)
@@ -327,6 +328,7 @@ void mlod_motion_free(mlod_motion *m)
 	if (m->segmemo)
 		free(m->segmemo->slot);
 	free(m->segmemo);
+	free(m->scratch.p);
 	free(m);
 }
 
@@ -343,17 +345,24 @@ static void pose_at(mlod_motion *m, const mlod_clip *clip, float t, mlod_mat4 *w
 	mlod_pose_world(m->s, m->local, world);
 }
 
-/* Fills node values from common frame f, and its Euler angles. */
-static void node_euler(const mlod_motion *m, fnode *nd)
+/* Fills node values from common frame f, and its Euler angles (with
+ * skip_constant, not those of constant channels, which node_distance
+ * leaves out). */
+static void node_euler_of(const mlod_motion *m, fnode *nd, int skip_constant)
 {
 	for (int i = 0; i < m->common.channel_count; i++) {
 		int slot = m->euler_slot[i];
-		if (slot < 0)
+		if (slot < 0 || (skip_constant && m->constant[i]))
 			continue;
 		const float *q = nd->values + m->offset[i];
 		mlod_quat r = { q[0], q[1], q[2], q[3] };
 		mlod_quat_to_euler(m->s->joints[m->common.channels[i].joint].euler, r, nd->values + m->value_count + 3 * slot);
 	}
+}
+
+static void node_euler(const mlod_motion *m, fnode *nd)
+{
+	node_euler_of(m, nd, 0);
 }
 
 static int node_from_frame(const mlod_motion *m, int f, fnode *nd)
@@ -713,7 +722,8 @@ static double level_max_error(mlod_motion *m, const mlod_clip *clip)
  * the same float operations, and the clip as read from its cache).
  * Returns 0 when it could not (no cache, or a NaN error): the caller then
  * measures as those functions do. */
-static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_error, mlod_deviation *dev)
+static int level_measure_of(mlod_motion *m, const mlod_clip *clip, const mlod_mat4 *known, double *point_error,
+                            mlod_deviation *dev)
 {
 	if (!m->cache0)
 		return 0;
@@ -724,9 +734,13 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
 	long count = 0;
 	for (int f = 0; f < m->samples; f++) {
 		const mlod_mat4 *w0 = orig_world(m, f);
-		walk_pose(m, &w, f);
+		const mlod_mat4 *wl = m->world;
+		if (known)
+			wl = known + (size_t)f * (size_t)s->joint_count;
+		else
+			walk_pose(m, &w, f);
 		for (int j = 0; j < s->joint_count; j++) {
-			double e = eval_error_over(&m->world[j], &w0[j], m->radius[j], worst);
+			double e = eval_error_over(&wl[j], &w0[j], m->radius[j], worst);
 			if (e >= 0.0 && !(e <= worst))
 				worst = e;
 			else if (e != e)
@@ -735,7 +749,7 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
 				mlod_v3 o = { 0, 0, 0 };
 				if (k == 1)
 					o = s->joints[j].end_site;
-				mlod_v3 x = mlod_mat4_point(&w0[j], o), y = mlod_mat4_point(&m->world[j], o);
+				mlod_v3 x = mlod_mat4_point(&w0[j], o), y = mlod_mat4_point(&wl[j], o);
 				double d = mlod_v3_length(mlod_v3_sub(x, y));
 				sum += d;
 				count++;
@@ -751,19 +765,31 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
 	return 1;
 }
 
+/* level_measure_of walking the level clip. */
+static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_error, mlod_deviation *dev)
+{
+	return level_measure_of(m, clip, NULL, point_error, dev);
+}
+
 /* Is level_max_error(m, clip) <= bound? It stops at the first error
- * above. */
+ * above. The samples are independent: every LEVEL_STRIDE-th goes first
+ * (a level that does not fit usually fails sooner), then the others in
+ * order; the answer is the same. */
+#define LEVEL_STRIDE 16
 static int level_within(mlod_motion *m, const mlod_clip *clip, double bound)
 {
 	level_walk w;
 	walk_begin(m, clip, &w);
-	int ok = 1;
-	for (int f = 0; f < m->samples && ok; f++) {
-		const mlod_mat4 *w0 = orig_world(m, f);
-		walk_pose(m, &w, f);
-		for (int j = 0; j < m->s->joint_count && ok; j++)
-			ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
-	}
+	int ok = 1, stride = m->samples >= 4 * LEVEL_STRIDE ? LEVEL_STRIDE : 1;
+	for (int pass = stride > 1 ? 0 : 1; pass < 2 && ok; pass++)
+		for (int f = 0; f < m->samples && ok; f += pass ? 1 : stride) {
+			if (pass == 1 && stride > 1 && f % stride == 0)
+				continue;
+			const mlod_mat4 *w0 = orig_world(m, f);
+			walk_pose(m, &w, f);
+			for (int j = 0; j < m->s->joint_count && ok; j++)
+				ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
+		}
 	return ok;
 }
 
@@ -995,22 +1021,36 @@ static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int
  * operations as mlod_pose_world. Needs m->cache0. Returns -1 when out of
  * memory; clip is then rounded with adj as it was. */
 static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int g, int *adj, int *e,
-                           double bound)
+                           double bound, const mlod_mat4 **world)
 {
 	const mlod_skeleton *s = m->s;
 	int F = m->samples, J = s->joint_count, n = clip->channel_count;
 	size_t FJ = (size_t)F * (size_t)J;
-	mlod_trs *L = malloc(sizeof *L * FJ), *Lj = malloc(sizeof *Lj * (size_t)F);
-	mlod_mat4 *W = malloc(sizeof *W * FJ), *T = malloc(sizeof *T * FJ);
-	mlod_mat4 *LM = malloc(sizeof *LM * FJ), *LMj = malloc(sizeof *LMj * (size_t)F);
-	int *sub = malloc(sizeof(int) * (size_t)J), *pos = malloc(sizeof(int) * (size_t)J);
+	size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 4 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
+	              2 * eval_carve_size(sizeof(mlod_trs) * (size_t)F) + 2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) +
+	              2 * eval_carve_size(sizeof(int) * (size_t)J);
+	char *at = eval_scratch_get(&m->scratch, need);
+	mlod_trs *L = NULL, *Lj = NULL, *Lj2 = NULL;
+	mlod_mat4 *W = NULL, *T = NULL, *T2 = NULL, *LM = NULL, *LMj = NULL, *LMj2 = NULL;
+	int *sub = NULL, *pos = NULL;
+	if (at) {
+		L = eval_carve(&at, sizeof *L * FJ);
+		W = eval_carve(&at, sizeof *W * FJ);
+		T = eval_carve(&at, sizeof *T * FJ);
+		T2 = eval_carve(&at, sizeof *T2 * FJ);
+		LM = eval_carve(&at, sizeof *LM * FJ);
+		Lj = eval_carve(&at, sizeof *Lj * (size_t)F);
+		Lj2 = eval_carve(&at, sizeof *Lj2 * (size_t)F);
+		LMj = eval_carve(&at, sizeof *LMj * (size_t)F);
+		LMj2 = eval_carve(&at, sizeof *LMj2 * (size_t)F);
+		sub = eval_carve(&at, sizeof(int) * (size_t)J);
+		pos = eval_carve(&at, sizeof(int) * (size_t)J);
+	}
 	const float *times = m->st;
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
-	if (!L || !Lj || !W || !T || !LM || !LMj || !sub || !pos) {
-		free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
+	if (!at)
 		return -1;
-	}
 	level_walk walk;
 	walk_begin(m, clip, &walk);
 	for (int f = 0; f < F; f++) {
@@ -1042,12 +1082,17 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 			if (a == j)
 				pos[d] = ns, sub[ns++] = d;
 		}
-		while (adj[i] < CHANNEL_COARSER) {
-			adj[i]++;
+		/* The coarsest adjustment up to CHANNEL_COARSER that fits: the
+		 * largest first, then bisection (a try that does not fit usually
+		 * stops within a few samples, one that fits checks them all). The
+		 * try's local transform of j and world matrices of its subtree go
+		 * to Lj, LMj and T (ns per sample); those of the best fit so far
+		 * are kept in Lj2, LMj2, T2. */
+		int ok_adj = adj[i], bad_adj = CHANNEL_COARSER + 1, have = 0;
+		for (int want = CHANNEL_COARSER; bad_adj - ok_adj > 1; want = ok_adj + (bad_adj - ok_adj) / 2) {
+			adj[i] = want;
 			channel_exps(m, src, g, adj, e);
 			round_channel(&src->channels[i], ch, e[i], SHORTS(m));
-			/* The try's local transform of j and world matrices of its
-			 * subtree go to Lj, LMj and T (ns per sample); kept if it fits. */
 			int ok = 1;
 			eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
 			/* Every stride-th sample first, then the rest in order. */
@@ -1085,22 +1130,30 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 						ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
 					}
 				}
-			if (!ok) {
-				adj[i]--;
-				channel_exps(m, src, g, adj, e);
-				round_channel(&src->channels[i], ch, e[i], SHORTS(m));
-				break;
-			}
-			for (int f = 0; f < F; f++) {
-				mlod_mat4 *wf = W + (size_t)f * (size_t)J;
-				L[(size_t)f * (size_t)J + (size_t)j] = Lj[f];
-				LM[(size_t)f * (size_t)J + (size_t)j] = LMj[f];
-				for (int k = 0; k < ns; k++)
-					wf[sub[k]] = T[(size_t)f * (size_t)ns + (size_t)k];
+			if (ok) {
+				mlod_trs *tl = Lj;
+				mlod_mat4 *tm = LMj, *tt = T;
+				Lj = Lj2, LMj = LMj2, T = T2;
+				Lj2 = tl, LMj2 = tm, T2 = tt;
+				ok_adj = want, have = 1;
+			} else {
+				bad_adj = want;
 			}
 		}
+		adj[i] = ok_adj;
+		channel_exps(m, src, g, adj, e);
+		round_channel(&src->channels[i], ch, e[i], SHORTS(m));
+		if (!have)
+			continue;
+		for (int f = 0; f < F; f++) {
+			mlod_mat4 *wf = W + (size_t)f * (size_t)J;
+			L[(size_t)f * (size_t)J + (size_t)j] = Lj2[f];
+			LM[(size_t)f * (size_t)J + (size_t)j] = LMj2[f];
+			for (int k = 0; k < ns; k++)
+				wf[sub[k]] = T2[(size_t)f * (size_t)ns + (size_t)k];
+		}
 	}
-	free(L), free(Lj), free(W), free(T), free(LM), free(LMj), free(sub), free(pos);
+	*world = W; /* in m->scratch: valid until its next use */
 	return 0;
 }
 
@@ -1132,29 +1185,31 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 		mlod_clip_free(&src);
 		return -1;
 	}
-	int hi = (int)ceil(log2(bound)) + 1, lo = hi - GRID_RANGE;
-	if (!round_fits(m, &src, clip, lo, adj, e, bound)) {
+	/* The coarsest grid from 2^(top - GRID_RANGE) to 2^top that fits,
+	 * from the top down one grid at a time: a grid that does not fit is
+	 * usually found so within a few samples (level_within), one that fits
+	 * costs a whole walk, and this meets one (a bisection met about
+	 * three a level). */
+	int top = (int)ceil(log2(bound)) + 1, lo = top - GRID_RANGE, found = 0;
+	for (int g = top; g >= lo && !found; g--)
+		if (round_fits(m, &src, clip, g, adj, e, bound))
+			found = 1, lo = g;
+	if (!found) {
 		for (int i = 0; i < n; i++)
 			e[i] = NO_ROUNDING;
 		round_clip(&src, clip, e, SHORTS(m));
 	} else {
-		if (round_fits(m, &src, clip, hi, adj, e, bound))
-			lo = hi;
-		while (hi - lo > 1) {
-			int mid = lo + (hi - lo) / 2;
-			if (round_fits(m, &src, clip, mid, adj, e, bound))
-				lo = mid;
-			else
-				hi = mid;
-		}
 		/* Channels in their order (measured as good as round robin or
 		 * leaves first); the result is measured again as a whole. */
-		if (m->cache0 && refine_channels(m, &src, clip, lo, adj, e, bound) != 0)
-			bad = 1;
-		/* round_fits, measuring the level at the same time. */
+		const mlod_mat4 *world = NULL;
+		if (m->cache0 && refine_channels(m, &src, clip, lo, adj, e, bound, &world) != 0)
+			bad = 1, world = NULL;
+		/* round_fits, measuring the level at the same time; refine_channels
+		 * left the level's world matrices at every sample (the same floats
+		 * as a walk of the clip). */
 		channel_exps(m, &src, lo, adj, e);
 		round_clip(&src, clip, e, SHORTS(m));
-		meas->valid = level_measure(m, clip, &meas->point_error, &meas->dev) && meas->point_error <= bound;
+		meas->valid = level_measure_of(m, clip, world, &meas->point_error, &meas->dev) && meas->point_error <= bound;
 		if (!meas->valid && !level_within(m, clip, bound)) {
 			memset(adj, 0, sizeof(int) * (size_t)n); /* fitted in the bisection */
 			round_fits(m, &src, clip, lo, adj, e, bound);
@@ -1165,6 +1220,20 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 	free(e);
 	mlod_clip_free(&src);
 	return bad ? -1 : 0;
+}
+
+/* The fewest bytes a level clip can store whatever its values' rounding:
+ * with auto precision every rotation as shorts (8 bytes a key instead of
+ * 16). */
+static long least_bytes(const mlod_motion *m, const mlod_clip *clip)
+{
+	long least = mlod_clip_key_bytes(clip);
+	for (int i = 0; SHORTS(m) && i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		if (ch->path == MLOD_PATH_ROTATION && ch->interp != MLOD_INTERP_CUBICSPLINE && !ch->short_values)
+			least -= 8L * ch->key_count;
+	}
+	return least;
 }
 
 /* Fills the level's counts and its error as mlod_joint_deviation measures
@@ -1178,14 +1247,8 @@ static mlod_result level_finish(mlod_motion *m, mlod_motion_level *out, double b
 	out->keys = mlod_clip_key_count(&out->clip);
 	out->bytes = mlod_clip_key_bytes(&out->clip);
 	if (max_bytes >= 0) {
-		/* Rounding keeps the keys; at most, auto precision stores every
-		 * rotation as shorts (8 bytes a key instead of 16). */
-		long least = out->bytes;
-		for (int i = 0; SHORTS(m) && i < out->clip.channel_count; i++) {
-			const mlod_channel *ch = &out->clip.channels[i];
-			if (ch->path == MLOD_PATH_ROTATION && ch->interp != MLOD_INTERP_CUBICSPLINE && !ch->short_values)
-				least -= 8L * ch->key_count;
-		}
+		/* Rounding keeps the keys. */
+		long least = least_bytes(m, &out->clip);
 		if (least > max_bytes) {
 			out->bytes = least;
 			out->unfinished = 1;
@@ -1285,8 +1348,11 @@ static double residual_of(const mlod_motion *m, const fnode *p, const fnode *x, 
 	if (!tmp.values)
 		return -1.0;
 	float u = (float)((x->time - p->time) / (q->time - p->time));
+	/* Only what node_distance reads: the constant channels are left out. */
 	for (int i = 0; i < m->common.channel_count; i++) {
 		const mlod_channel *ch = &m->common.channels[i];
+		if (m->constant[i])
+			continue;
 		const float *a = p->values + m->offset[i], *b = q->values + m->offset[i];
 		float *o = tmp.values + m->offset[i];
 		if (ch->interp == MLOD_INTERP_STEP) {
@@ -1300,7 +1366,7 @@ static double residual_of(const mlod_motion *m, const fnode *p, const fnode *x, 
 				o[c] = a[c] + (b[c] - a[c]) * u;
 		}
 	}
-	node_euler(m, &tmp);
+	node_euler_of(m, &tmp, 1);
 	double d = node_distance(m, x, &tmp);
 	free(tmp.values);
 	return d;
@@ -1507,6 +1573,22 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 					return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 				}
 				ok = line_within(m, &l, &c, removal_bound(m, value));
+				if (!ok && max_bytes >= 0 && least_bytes(m, &c) > max_bytes) {
+					/* The level would be finer than this line, so larger
+					 * (the tree's lines grow finer as the threshold goes
+					 * down): it cannot win. Left unfinished; the next
+					 * frames level builds on the last finished one. */
+					memset(out, 0, sizeof *out);
+					out->method = MLOD_MOTION_FRAMES;
+					out->threshold = t;
+					out->keys = mlod_clip_key_count(&c);
+					out->bytes = least_bytes(m, &c);
+					out->unfinished = 1;
+					mlod_clip_free(&c);
+					line_free(&l);
+					line_free(&best);
+					return MLOD_OK;
+				}
 				mlod_clip_free(&c);
 			}
 			if (target == MLOD_MOTION_FRACTION) {
@@ -1592,7 +1674,7 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	memcpy(kept, m->kept, size);
 	memset(clip, 0, sizeof *clip);
 	double e = -1.0;
-	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, err) !=
+	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, &m->scratch, err) !=
 	    MLOD_OK)
 		return -1.0;
 	if (clip_from_kept(m, kept, clip) != 0) {

@@ -29,6 +29,8 @@
 #endif
 
 #include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "motion/mlod_motion.h"
@@ -340,13 +342,43 @@ static inline void eval_pose_world(const mlod_skeleton *s, const mlod_trs *local
 	}
 }
 
+/* A buffer kept across calls (not its contents), so that the large
+ * per-call arrays of the key reduction and the rounding are not mapped
+ * and faulted in again at every call. */
+typedef struct eval_scratch {
+	void *p;
+	size_t size;
+} eval_scratch;
+
+/* At least size bytes, or NULL when out of memory. */
+static inline void *eval_scratch_get(eval_scratch *sc, size_t size)
+{
+	if (sc->size < size || !sc->p) {
+		free(sc->p);
+		sc->p = malloc(size > 0 ? size : 1);
+		sc->size = sc->p ? size : 0;
+	}
+	return sc->p;
+}
+
+/* The next n bytes of a scratch buffer, 64-byte aligned (*at moves on);
+ * eval_carve_size(n) is what it takes at most. */
+#define eval_carve_size(n) ((size_t)(n) + 64u)
+static inline void *eval_carve(char **at, size_t n)
+{
+	uintptr_t a = ((uintptr_t)*at + 63u) & ~(uintptr_t)63u;
+	*at = (char *)a + n;
+	return (void *)a;
+}
+
 /* mlod_keyreduce, with the clip as read at the samples given (w0, samples
  * * joints world matrices as mlod_pose_world makes them; NULL: computed),
  * and *max_error (if not NULL) the largest point error of the result as
  * motion.c's level_max_error measures its level clip, or -1 when not
- * measured (a NaN, or samples past the clip's duration). */
+ * measured (a NaN, or samples past the clip's duration); its large arrays
+ * in *scratch (NULL: its own, freed on return). */
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
-                          double *max_error, mlod_error *err);
+                          double *max_error, eval_scratch *scratch, mlod_error *err);
 
 #endif /* MLOD_MOTION_EVAL_H */
