@@ -9,7 +9,7 @@ node -e '
 const fs = require("fs");
 const a = JSON.parse(fs.readFileSync("exact.json")), b = JSON.parse(fs.readFileSync("fast.json"));
 if (a.options.fast_cost !== false || b.options.fast_cost !== true) throw new Error("fast_cost not reported");
-if (a.levels.length !== 3 || b.levels.length !== 3) throw new Error("levels");
+if (a.levels.length !== 4 || b.levels.length !== 4) throw new Error("levels: " + a.levels.length + ", " + b.levels.length); // the default ratios 0.5,0.25,0.1,0.03
 a.levels.forEach((l, k) => {
   const m = b.levels[k];
   if (l.triangles !== m.triangles) throw new Error("level " + (k + 1) + ": " + m.triangles + " triangles, default " + l.triangles);
