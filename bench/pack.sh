@@ -19,7 +19,8 @@ bin=$BUILD/bin
 gltfpack="node tests/node/node_modules/gltfpack/cli.js"
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/mlod-bench-pack.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT INT TERM
-ratios="0.5 0.25 0.1"
+ratios="0.5 0.25 0.1 0.03" # the mesh levels mlod-pack makes by default (MLOD_MESH_RATIOS_DEFAULT)
+levels=$(( $(echo $ratios | wc -w) + 1 ))
 
 sizes() { # sizes FILE: raw gzip zstd
 	printf '%s %s %s' "$(wc -c < "$1")" "$(gzip -9 -c "$1" | wc -c)" "$(zstd -19 -q -c "$1" | wc -c)"
@@ -42,8 +43,8 @@ echo
 echo
 echo "## Pack: every level in one file, against gltfpack 1.3"
 echo
-echo "| input | file | raw | gzip -9 | zstd -19 | raw, no textures | pack / file (gzip) |"
-echo "|---|---|---|---|---|---|---|"
+echo "| input | file | raw | gzip -9 | zstd -19 | raw, no textures | pack / file (raw) | pack / file (gzip) |"
+echo "|---|---|---|---|---|---|---|---|"
 for f in $INPUTS; do
 	name=$(basename "$f"); name=${name%.*}
 	case $f in
@@ -64,12 +65,12 @@ for f in $INPUTS; do
 		cat "$tmp/$name.gp$r.glb" >> "$tmp/$name.gpl.bin"
 	done
 	set -- $(sizes "$tmp/$name.mlod"); pr=$1 pg=$2 pz=$3
-	for row in "pack:$tmp/$name.mlod:1" "pack --codec none:$tmp/$name.none.mlod:1" "gltfpack -cc:$tmp/$name.gp.glb:1" "gltfpack -cc, per level:$tmp/$name.gpl.bin:4" "pipeline glb:$tmp/$name.pipe.glb:1"; do
+	for row in "pack:$tmp/$name.mlod:1" "pack --codec none:$tmp/$name.none.mlod:1" "gltfpack -cc:$tmp/$name.gp.glb:1" "gltfpack -cc, per level:$tmp/$name.gpl.bin:$levels" "pipeline glb:$tmp/$name.pipe.glb:1"; do
 		label=${row%%:*}; rest=${row#*:}; file=${rest%:*}; copies=${rest##*:}
 		set -- $(sizes "$file")
-		echo "| $name | $label | $1 | $2 | $3 | $(( $1 - images * copies )) | $(ratio "$pg" "$2") |"
+		echo "| $name | $label | $1 | $2 | $3 | $(( $1 - images * copies )) | $(ratio "$pr" "$1") | $(ratio "$pg" "$2") |"
 	done
-	echo "| $name | pack time | $(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f s", b - a }') | | | | |"
+	echo "| $name | pack time | $(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f s", b - a }') | | | | | |"
 done
 echo
 echo "Goal (issue 11): the pack at most 1.3x 'gltfpack -cc' and at most 0.6x 'gltfpack -cc, per level'."
