@@ -1822,8 +1822,10 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 	double step = time_step(arr, cnt, na, &max_tick);
 	cb_add(&cb, MLOD_STREAM_STEP, 1, 8, &step, 0);
 	/* The key times: one stream, the arrays one after the other; f32, or
-	 * u16 ticks raw, u32 where they do not fit or the vertex codec (a
-	 * multiple of 4 bytes) applies. */
+	 * ticks, each array's first then each next minus the one before (the
+	 * vertex codec's byte deltas then see second differences: nearly
+	 * nothing for evenly sampled arrays); u16 raw, u32 where they do not
+	 * fit or the vertex codec (a multiple of 4 bytes) applies. */
 	size_t nt = 0;
 	for (int a = 0; a < na; a++)
 		nt += (size_t)cnt[a];
@@ -1846,6 +1848,8 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 				}
 				uint32_t v = (uint32_t)floor((double)arr[a][q] / step + 0.5);
 				dt[at] = (float)((double)v * step);
+				if (q > 0) /* the tick before's difference */
+					v -= (uint32_t)floor((double)arr[a][q - 1] / step + 0.5);
 				if (wide)
 					put_u32(tk + 4 * at, v);
 				else

@@ -148,9 +148,10 @@
  *   length is the key_count of the channels referring to it):
  *   'TIME' f32 per key (seconds), when step is 0, or
  *   'TICK' u16 (element size 2) or u32 (element size 4) per key, when
- *          step > 0: time = (float)((double)tick * step): the key time
- *          read, or within 2^-20 * max(|t|, step) of it (mlod(5),
- *          QUANTISATION)
+ *          step > 0: each array's first tick, then each next tick minus
+ *          the one before (every tick below 2^32); time =
+ *          (float)((double)tick * step): the key time read, or within
+ *          2^-20 * max(|t|, step) of it (mlod(5), QUANTISATION)
  *   then the values, three streams, each holding the keys of its
  *   channels one channel after the other in channel order (possibly 0
  *   elements):

@@ -1900,9 +1900,17 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	TAKE(all, nt * 4);
 	if (s.tag == MLOD_STREAM_TIME)
 		memcpy(all, src, (size_t)nt * 4);
-	else
-		for (uint64_t k = 0; k < nt; k++)
-			all[k] = (float)((double)(s.elsize == 2 ? rd16(src + 2 * k) : rd32(src + 4 * k)) * step);
+	else /* each array's first tick, then each next's difference */
+		for (uint64_t t = 0, k = 0; t < T; t++) {
+			uint64_t tick = 0;
+			for (uint32_t q = 0; q < tcount[t]; q++, k++) {
+				tick += s.elsize == 2 ? rd16(src + 2 * k) : rd32(src + 4 * k);
+				if (tick > UINT32_MAX)
+					FAIL("%s: stream %u '%s': time array %u: key %u: tick %llu is above 2^32 - 1", x.label,
+					     s.index, tagn(s.tag).s, (unsigned)t, q, (unsigned long long)tick);
+				all[k] = (float)((double)tick * step);
+			}
+		}
 	for (uint64_t t = 0, at = 0; t < T; at += tcount[t++]) {
 		const float *times = all + at;
 		for (uint32_t k = 0; k < tcount[t]; k++) {

@@ -747,12 +747,13 @@ static int make_chunks(wchunk *c, int with_unknown)
 		for (int a = 0; dot < 0 && a < 4; a++)
 			rotq_truth[k][a] = (int16_t)-rotq_truth[k][a];
 	}
-	/* the two time arrays, one after the other, as ticks */
+	/* the two time arrays, one after the other, as ticks: each array's
+	 * first (0), then each next's difference (1) */
 	s = add_stream(ch, MLOD_STREAM_TICK, 4, MLOD_SCODEC_MESHOPT_VERTEX);
 	s->count = 2 * NK;
 	for (int a = 0; a < 2; a++)
 		for (int k = 0; k < NK; k++)
-			put32(&s->data, (uint32_t)k);
+			put32(&s->data, k > 0);
 	/* the values: ROTQ (channel 1), ROTF (channel 2), VEC3 (channels 0, 3) */
 	s = add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_MESHOPT_VERTEX);
 	s->count = NK;
@@ -1545,6 +1546,18 @@ static void e_tick_elsize(wchunk *c)
 	s->elsize = 1;
 	s->data.n = s->count;
 }
+static void e_tick_overflow(wchunk *c)
+{
+	/* ticks 0, 2^32 - 1, then one more: past u32 */
+	uint8_t *d = stream_data(c, C_MOT0, MLOD_STREAM_TICK, 0);
+	wr32(d + 4, 0xffffffffu);
+	wr32(d + 8, 1);
+}
+static void e_tick_repeat(wchunk *c)
+{
+	/* a difference of 0: a key at the time before's */
+	wr32(stream_data(c, C_MOT0, MLOD_STREAM_TICK, 0) + 8, 0);
+}
 static void e_morph_scale(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_MTSC, 0), 0xbf800000u); }
 static void e_no_skin(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 16, 0xffffffffu); }
 static void e_rotq_cubic(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 + 8, 2); }
@@ -1585,6 +1598,8 @@ TEST(structural_checks_name_the_chunk)
 		{e_step_zero, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 is 'TICK', expected 'TIME' (step 0)"},
 		{e_step_nan, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: step nan is not finite and >= 0"},
 		{e_tick_elsize, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 'TICK' has elements of 1 bytes, expected 2 or 4"},
+		{e_tick_overflow, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 'TICK': time array 0: key 2: tick 4294967296 is above 2^32 - 1"},
+		{e_tick_repeat, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: time array 0: key 2: time 0.25 is not after 0.25"},
 		{e_dup_channel, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 2: a second rotation channel of joint 1"},
 		{e_missing_rotation, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: stream 3 'ROTQ' has 0 elements, expected 2 (rotation keys without a base key)"},
 		{e_no_vec3, C_MOT1, MLOD_ERR_PARSE, "MOTION level 1 of clip 0: missing stream 'VEC3' (the chunk has 6 streams)"},
