@@ -535,6 +535,76 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	return MLOD_OK;
 }
 
+static int clip_copy(const mlod_clip *src, mlod_clip *dst);
+
+/* A copy of n bytes at p, or NULL (also when p is NULL). */
+static void *dup_bytes(const void *p, size_t n)
+{
+	void *d = p ? malloc(n > 0 ? n : 1) : NULL;
+	if (d)
+		memcpy(d, p, n);
+	return d;
+}
+
+mlod_result mlod_motion_create_like(const mlod_motion *first, mlod_motion **out, mlod_error *err)
+{
+	if (out)
+		*out = NULL;
+	if (!first || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_create_like: NULL argument");
+	mlod_motion *m = calloc(1, sizeof *m);
+	if (!m)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	/* What mlod_motion_create computes from the character, the clip and
+	 * the options, copied; each method's state starts afresh. */
+	m->c = first->c;
+	m->s = first->s;
+	m->orig = first->orig;
+	m->opt = first->opt;
+	m->info = first->info;
+	m->frames = first->frames;
+	m->sub = first->sub;
+	m->samples = first->samples;
+	m->height = first->height;
+	m->value_count = first->value_count;
+	m->rot_count = first->rot_count;
+	m->clip_end_ok = first->clip_end_ok;
+	int n = first->s->joint_count, nch = first->common.channel_count, F = first->frames;
+	int bad = clip_copy(&first->common, &m->common) != 0;
+	if (!bad && !first->common.name) {
+		free(m->common.name);
+		m->common.name = NULL;
+	}
+	m->st = dup_bytes(first->st, sizeof(float) * (size_t)first->samples);
+	m->weight = dup_bytes(first->weight, sizeof(double) * (size_t)n);
+	m->offset = dup_bytes(first->offset, sizeof(int) * (size_t)nch);
+	m->euler_slot = dup_bytes(first->euler_slot, sizeof(int) * (size_t)nch);
+	m->constant = dup_bytes(first->constant, (size_t)nch);
+	m->radius = dup_bytes(first->radius, sizeof(double) * (size_t)n);
+	m->reach_exp = dup_bytes(first->reach_exp, sizeof(int) * (size_t)n);
+	m->cache0 = dup_bytes(first->cache0, sizeof(mlod_mat4) * (size_t)first->samples * (size_t)n);
+	m->local = malloc(sizeof *m->local * (size_t)n);
+	m->world = malloc(sizeof *m->world * (size_t)n);
+	m->world0 = malloc(sizeof *m->world0 * (size_t)n);
+	m->walk_segs = malloc(sizeof *m->walk_segs * (size_t)nch);
+	m->walk_local = malloc(sizeof *m->walk_local * (size_t)n);
+	m->kept = malloc((size_t)nch * (size_t)F);
+	m->memo = calloc(1, sizeof *m->memo);
+	m->segmemo = calloc(1, sizeof *m->segmemo);
+	if (bad || !m->st || !m->weight || !m->offset || !m->euler_slot || !m->constant || !m->radius || !m->reach_exp ||
+	    (first->cache0 && !m->cache0) || !m->local || !m->world || !m->world0 || !m->walk_segs || !m->walk_local ||
+	    !m->kept || !m->memo || !m->segmemo) {
+		mlod_motion_free(m);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	for (int i = 0; i < nch; i++)
+		m->walk_segs[i].k = -1, m->walk_segs[i].ready = 0;
+	mlod_pose_rest(m->s, m->walk_local);
+	memset(m->kept, 1, (size_t)nch * (size_t)F);
+	*out = m;
+	return MLOD_OK;
+}
+
 /* ---------------------------------------------------------------- */
 /* Levels as clips, and their error                                   */
 /* ---------------------------------------------------------------- */
