@@ -68,7 +68,8 @@ static mlod_result clip_item(void *ctx, int k)
 	mlod_motion *m[2] = { NULL, NULL };
 	int n = b->method_count;
 	for (int i = 0; i < n; i++) {
-		o->result = mlod_motion_create(b->c, b->clips[k], b->opt, &m[i], &o->error);
+		o->result = i == 0 ? mlod_motion_create(b->c, b->clips[k], b->opt, &m[i], &o->error)
+		                   : mlod_motion_create_like(m[0], &m[i], &o->error);
 		if (o->result != MLOD_OK)
 			goto done;
 	}

@@ -149,6 +149,11 @@ typedef struct mlod_motion mlod_motion;
 
 mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_motion_options *opt,
                                mlod_motion **out, mlod_error *err);
+/* Another motion of first's clip with first's options (for the other
+ * method), its setup (common timeline, the clip as read at every sample)
+ * copied instead of computed again: the same as mlod_motion_create with
+ * them; first may be freed before it. */
+mlod_result mlod_motion_create_like(const mlod_motion *first, mlod_motion **out, mlod_error *err);
 void mlod_motion_free(mlod_motion *m);
 /* The clip's common timeline. */
 const mlod_motion_timeline *mlod_motion_timeline_info(const mlod_motion *m);

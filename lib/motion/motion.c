@@ -535,6 +535,76 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	return MLOD_OK;
 }
 
+static int clip_copy(const mlod_clip *src, mlod_clip *dst);
+
+/* A copy of n bytes at p, or NULL (also when p is NULL). */
+static void *dup_bytes(const void *p, size_t n)
+{
+	void *d = p ? malloc(n > 0 ? n : 1) : NULL;
+	if (d)
+		memcpy(d, p, n);
+	return d;
+}
+
+mlod_result mlod_motion_create_like(const mlod_motion *first, mlod_motion **out, mlod_error *err)
+{
+	if (out)
+		*out = NULL;
+	if (!first || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_create_like: NULL argument");
+	mlod_motion *m = calloc(1, sizeof *m);
+	if (!m)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	/* What mlod_motion_create computes from the character, the clip and
+	 * the options, copied; each method's state starts afresh. */
+	m->c = first->c;
+	m->s = first->s;
+	m->orig = first->orig;
+	m->opt = first->opt;
+	m->info = first->info;
+	m->frames = first->frames;
+	m->sub = first->sub;
+	m->samples = first->samples;
+	m->height = first->height;
+	m->value_count = first->value_count;
+	m->rot_count = first->rot_count;
+	m->clip_end_ok = first->clip_end_ok;
+	int n = first->s->joint_count, nch = first->common.channel_count, F = first->frames;
+	int bad = clip_copy(&first->common, &m->common) != 0;
+	if (!bad && !first->common.name) {
+		free(m->common.name);
+		m->common.name = NULL;
+	}
+	m->st = dup_bytes(first->st, sizeof(float) * (size_t)first->samples);
+	m->weight = dup_bytes(first->weight, sizeof(double) * (size_t)n);
+	m->offset = dup_bytes(first->offset, sizeof(int) * (size_t)nch);
+	m->euler_slot = dup_bytes(first->euler_slot, sizeof(int) * (size_t)nch);
+	m->constant = dup_bytes(first->constant, (size_t)nch);
+	m->radius = dup_bytes(first->radius, sizeof(double) * (size_t)n);
+	m->reach_exp = dup_bytes(first->reach_exp, sizeof(int) * (size_t)n);
+	m->cache0 = dup_bytes(first->cache0, sizeof(mlod_mat4) * (size_t)first->samples * (size_t)n);
+	m->local = malloc(sizeof *m->local * (size_t)n);
+	m->world = malloc(sizeof *m->world * (size_t)n);
+	m->world0 = malloc(sizeof *m->world0 * (size_t)n);
+	m->walk_segs = malloc(sizeof *m->walk_segs * (size_t)nch);
+	m->walk_local = malloc(sizeof *m->walk_local * (size_t)n);
+	m->kept = malloc((size_t)nch * (size_t)F);
+	m->memo = calloc(1, sizeof *m->memo);
+	m->segmemo = calloc(1, sizeof *m->segmemo);
+	if (bad || !m->st || !m->weight || !m->offset || !m->euler_slot || !m->constant || !m->radius || !m->reach_exp ||
+	    (first->cache0 && !m->cache0) || !m->local || !m->world || !m->world0 || !m->walk_segs || !m->walk_local ||
+	    !m->kept || !m->memo || !m->segmemo) {
+		mlod_motion_free(m);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	for (int i = 0; i < nch; i++)
+		m->walk_segs[i].k = -1, m->walk_segs[i].ready = 0;
+	mlod_pose_rest(m->s, m->walk_local);
+	memset(m->kept, 1, (size_t)nch * (size_t)F);
+	*out = m;
+	return MLOD_OK;
+}
+
 /* ---------------------------------------------------------------- */
 /* Levels as clips, and their error                                   */
 /* ---------------------------------------------------------------- */
@@ -776,21 +846,51 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
  * (a level that does not fit usually fails sooner), then the others in
  * order; the answer is the same. */
 #define LEVEL_STRIDE 16
-static int level_within(mlod_motion *m, const mlod_clip *clip, double bound)
+/* With L, LM, W (samples * joints each) and a clip eval_sample samples,
+ * each sample visited leaves there the level's local transforms, their
+ * matrices and its world matrices (the same floats as walk_pose and
+ * eval_from_trs), and *kept is set: when the level fits, at every sample. */
+static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L, mlod_mat4 *LM,
+                             mlod_mat4 *W, int *kept)
 {
 	level_walk w;
 	walk_begin(m, clip, &w);
+	const mlod_skeleton *s = m->s;
+	const int J = s->joint_count, keep = L && w.fast;
 	int ok = 1, stride = m->samples >= 4 * LEVEL_STRIDE ? LEVEL_STRIDE : 1;
+	if (kept)
+		*kept = keep;
 	for (int pass = stride > 1 ? 0 : 1; pass < 2 && ok; pass++)
 		for (int f = 0; f < m->samples && ok; f += pass ? 1 : stride) {
 			if (pass == 1 && stride > 1 && f % stride == 0)
 				continue;
 			const mlod_mat4 *w0 = orig_world(m, f);
-			walk_pose(m, &w, f);
-			for (int j = 0; j < m->s->joint_count && ok; j++)
-				ok = eval_within(&m->world[j], &w0[j], m->radius[j], bound);
+			const mlod_mat4 *wl = m->world;
+			if (keep) {
+				/* walk_pose (eval_sample, eval_pose_world) into the buffers */
+				size_t base = (size_t)f * (size_t)J;
+				mlod_trs *lf = L + base;
+				mlod_mat4 *lmf = LM + base, *wf = W + base;
+				eval_sample(clip, w.segs, m->st[f], w.local);
+				memcpy(lf, w.local, sizeof *lf * (size_t)J);
+				for (int j = 0; j < J; j++) {
+					int p = s->joints[j].parent;
+					lmf[j] = eval_from_trs(&lf[j]);
+					wf[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
+				}
+				wl = wf;
+			} else {
+				walk_pose(m, &w, f);
+			}
+			for (int j = 0; j < J && ok; j++)
+				ok = eval_within(&wl[j], &w0[j], m->radius[j], bound);
 		}
 	return ok;
+}
+
+static int level_within(mlod_motion *m, const mlod_clip *clip, double bound)
+{
+	return level_within_keep(m, clip, bound, NULL, NULL, NULL, NULL);
 }
 
 
@@ -1004,56 +1104,84 @@ static void channel_exps(const mlod_motion *m, const mlod_clip *clip, int g, con
 	}
 }
 
+/* The rounding refinement's arrays, in m->scratch (carved the same way
+ * at every call, so that what one call leaves there the next finds). */
+typedef struct refine_bufs {
+	mlod_trs *L, *Lj, *Lj2;                  /* samples * joints; samples; samples */
+	mlod_mat4 *W, *T, *T2, *LM, *LMj, *LMj2; /* samples * joints (4), samples (2) */
+	int *sub, *pos;                          /* joints */
+} refine_bufs;
+
+static int refine_bufs_get(mlod_motion *m, refine_bufs *b)
+{
+	int F = m->samples, J = m->s->joint_count;
+	size_t FJ = (size_t)F * (size_t)J;
+	size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 4 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
+	              2 * eval_carve_size(sizeof(mlod_trs) * (size_t)F) + 2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) +
+	              2 * eval_carve_size(sizeof(int) * (size_t)J);
+	char *at = eval_scratch_get(&m->scratch, need);
+	memset(b, 0, sizeof *b);
+	if (!at)
+		return 0;
+	b->L = eval_carve(&at, sizeof *b->L * FJ);
+	b->W = eval_carve(&at, sizeof *b->W * FJ);
+	b->T = eval_carve(&at, sizeof *b->T * FJ);
+	b->T2 = eval_carve(&at, sizeof *b->T2 * FJ);
+	b->LM = eval_carve(&at, sizeof *b->LM * FJ);
+	b->Lj = eval_carve(&at, sizeof *b->Lj * (size_t)F);
+	b->Lj2 = eval_carve(&at, sizeof *b->Lj2 * (size_t)F);
+	b->LMj = eval_carve(&at, sizeof *b->LMj * (size_t)F);
+	b->LMj2 = eval_carve(&at, sizeof *b->LMj2 * (size_t)F);
+	b->sub = eval_carve(&at, sizeof(int) * (size_t)J);
+	b->pos = eval_carve(&at, sizeof(int) * (size_t)J);
+	return 1;
+}
+
 /* Rounds src's values into clip with level grid g and adjustments adj;
- * is the error within bound? */
-static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int g, const int *adj, int *e,
-                      double bound)
+ * is the error within bound? With rb, as level_within_keep into its L,
+ * LM and W (*kept). */
+static int round_fits_keep(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int g, const int *adj, int *e,
+                           double bound, refine_bufs *rb, int *kept)
 {
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
+	if (rb)
+		return level_within_keep(m, clip, bound, rb->L, rb->LM, rb->W, kept);
 	return level_within(m, clip, bound);
+}
+
+static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int g, const int *adj, int *e,
+                      double bound)
+{
+	return round_fits_keep(m, src, clip, g, adj, e, bound, NULL, NULL);
 }
 
 /* Per-channel refinement: each channel in turn goes to coarser grids
  * (adj[i] + 1, + 2, ...) while the bound holds. The rounded clip's local
  * transforms and world matrices are kept at every common frame, so a try
  * recomputes only the channel's joint and its descendants, with the same
- * operations as mlod_pose_world. Needs m->cache0. Returns -1 when out of
+ * operations as mlod_pose_world. Needs m->cache0. walked: the buffers
+ * (refine_bufs) already hold the clip as rounded with g and adj at every
+ * sample (level_within_keep of it fitted). Returns -1 when out of
  * memory; clip is then rounded with adj as it was. */
 static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int g, int *adj, int *e,
-                           double bound, const mlod_mat4 **world)
+                           double bound, const mlod_mat4 **world, int walked)
 {
 	const mlod_skeleton *s = m->s;
 	int F = m->samples, J = s->joint_count, n = clip->channel_count;
-	size_t FJ = (size_t)F * (size_t)J;
-	size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 4 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
-	              2 * eval_carve_size(sizeof(mlod_trs) * (size_t)F) + 2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) +
-	              2 * eval_carve_size(sizeof(int) * (size_t)J);
-	char *at = eval_scratch_get(&m->scratch, need);
-	mlod_trs *L = NULL, *Lj = NULL, *Lj2 = NULL;
-	mlod_mat4 *W = NULL, *T = NULL, *T2 = NULL, *LM = NULL, *LMj = NULL, *LMj2 = NULL;
-	int *sub = NULL, *pos = NULL;
-	if (at) {
-		L = eval_carve(&at, sizeof *L * FJ);
-		W = eval_carve(&at, sizeof *W * FJ);
-		T = eval_carve(&at, sizeof *T * FJ);
-		T2 = eval_carve(&at, sizeof *T2 * FJ);
-		LM = eval_carve(&at, sizeof *LM * FJ);
-		Lj = eval_carve(&at, sizeof *Lj * (size_t)F);
-		Lj2 = eval_carve(&at, sizeof *Lj2 * (size_t)F);
-		LMj = eval_carve(&at, sizeof *LMj * (size_t)F);
-		LMj2 = eval_carve(&at, sizeof *LMj2 * (size_t)F);
-		sub = eval_carve(&at, sizeof(int) * (size_t)J);
-		pos = eval_carve(&at, sizeof(int) * (size_t)J);
-	}
+	refine_bufs rb;
+	int got = refine_bufs_get(m, &rb);
+	mlod_trs *L = rb.L, *Lj = rb.Lj, *Lj2 = rb.Lj2;
+	mlod_mat4 *W = rb.W, *T = rb.T, *T2 = rb.T2, *LM = rb.LM, *LMj = rb.LMj, *LMj2 = rb.LMj2;
+	int *sub = rb.sub, *pos = rb.pos;
 	const float *times = m->st;
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
-	if (!at)
+	if (!got)
 		return -1;
 	level_walk walk;
 	walk_begin(m, clip, &walk);
-	for (int f = 0; f < F; f++) {
+	for (int f = 0; f < F && !walked; f++) {
 		mlod_trs *lf = L + (size_t)f * (size_t)J;
 		if (walk.fast) {
 			eval_sample(clip, walk.segs, times[f], walk.local);
@@ -1190,9 +1318,13 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 	 * usually found so within a few samples (level_within), one that fits
 	 * costs a whole walk, and this meets one (a bisection met about
 	 * three a level). */
+	/* With the cache, the walk of the grid that fits stays in the
+	 * refinement's buffers, which it then starts from. */
+	refine_bufs rb;
+	int have_rb = m->cache0 && refine_bufs_get(m, &rb), walked = 0;
 	int top = (int)ceil(log2(bound)) + 1, lo = top - GRID_RANGE, found = 0;
 	for (int g = top; g >= lo && !found; g--)
-		if (round_fits(m, &src, clip, g, adj, e, bound))
+		if (round_fits_keep(m, &src, clip, g, adj, e, bound, have_rb ? &rb : NULL, &walked))
 			found = 1, lo = g;
 	if (!found) {
 		for (int i = 0; i < n; i++)
@@ -1202,7 +1334,7 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 		/* Channels in their order (measured as good as round robin or
 		 * leaves first); the result is measured again as a whole. */
 		const mlod_mat4 *world = NULL;
-		if (m->cache0 && refine_channels(m, &src, clip, lo, adj, e, bound, &world) != 0)
+		if (m->cache0 && refine_channels(m, &src, clip, lo, adj, e, bound, &world, have_rb && walked) != 0)
 			bad = 1, world = NULL;
 		/* round_fits, measuring the level at the same time; refine_channels
 		 * left the level's world matrices at every sample (the same floats

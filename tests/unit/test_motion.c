@@ -1150,6 +1150,38 @@ TEST(build_levels_same_at_any_thread_count)
 	mlod_character_free(&c);
 }
 
+TEST(create_like_same_as_create)
+{
+	/* mlod_motion_create_like: the same levels (each method) as a motion
+	 * made by mlod_motion_create, and independent of the first (freed
+	 * before the copy is used). */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	mlod_motion *like = NULL, *fresh = NULL, *first = NULL;
+	CHECK(mlod_motion_create_like(NULL, &like, &terr) == MLOD_ERR_INVALID_ARG && like == NULL);
+	for (int method = 0; method < 2; method++) {
+		mlod_motion_method mm = method ? MLOD_MOTION_KEYS : MLOD_MOTION_FRAMES;
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &first, &terr));
+		CHECK_OK(mlod_motion_create_like(first, &like, &terr));
+		mlod_motion_free(first);
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &fresh, &terr));
+		CHECK(mlod_motion_timeline_info(like)->frames == mlod_motion_timeline_info(fresh)->frames);
+		for (int s = 0; s < 2; s++) {
+			mlod_motion_level a, b;
+			double bound = (s ? 0.01 : 0.002) * h;
+			CHECK_OK(mlod_motion_next_level(like, mm, MLOD_MOTION_MAX_ERROR, bound, &a, &terr));
+			CHECK_OK(mlod_motion_next_level(fresh, mm, MLOD_MOTION_MAX_ERROR, bound, &b, &terr));
+			CHECK_MSG(same_level(&a, &b), "method %d, level %d", method, s);
+			mlod_motion_level_free(&a);
+			mlod_motion_level_free(&b);
+		}
+		mlod_motion_free(like);
+		mlod_motion_free(fresh);
+	}
+	mlod_character_free(&c);
+}
+
 TEST(bake_report_same_at_any_thread_count)
 {
 	/* mlod_motion_bake_run and its JSON report: the same text at 1 and 3
@@ -1212,5 +1244,6 @@ int main(void)
 	RUN(fast_checks_match_exact);
 	RUN(build_levels_same_at_any_thread_count);
 	RUN(bake_report_same_at_any_thread_count);
+	RUN(create_like_same_as_create);
 	TEST_EXIT();
 }
