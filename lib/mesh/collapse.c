@@ -768,7 +768,8 @@ static int same_influences(const mlod_influences *x, const mlod_influences *y)
  * vertices' influences differ. Per pose p, the posed location y = sum_j
  * w_j (L_j x + t_j) lies within R_p of c_p, the mean of the points z_j =
  * L_j bary + t_j over the joints j of the vertices (R_p = max_j |z_j -
- * c_p| + r max_j |L_j|, the Frobenius norm bounding the spectral one).
+ * c_p| + r max |L|, L any skin matrix's linear part, the Frobenius norm
+ * bounding the spectral one).
  * The pose's summed quadric f satisfies, for every y, f(y) >= f(y_mu) +
  * mu |y_mu - c_p|^2 - mu |y - c_p|^2, y_mu the minimiser of f + mu |. -
  * c_p|^2 (a regularised solve, sound where f is singular), so f(y) >=
@@ -776,7 +777,7 @@ static int same_influences(const mlod_influences *x, const mlod_influences *y)
  * error, far above the bind pose's term alone. Slack covers the rounding
  * of the exact sum (float weights, cancellation in the quadric's value).
  * Returns -1 when it does not apply. */
-static double posed_min_bound(const mlod_bgm *g, const int *v, int k, const double *bary, double r)
+static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *bary, double r)
 {
 	int J = g->joint_count, nj = 0;
 	uint16_t joint[3 * MLOD_MAX_INFLUENCES];
@@ -795,22 +796,33 @@ static double posed_min_bound(const mlod_bgm *g, const int *v, int k, const doub
 		}
 	}
 	size_t P = (size_t)g->pose_count;
-	double lb = 0.0;
+	if (!(g->skin_norm > 0.0)) {
+		/* The largest Frobenius norm of a skin matrix's linear part. */
+		for (size_t m = 0; m < P * (size_t)J; m++) {
+			double l = 0.0;
+			for (int i = 0; i < 3; i++)
+				for (int e = 0; e < 3; e++)
+					l += (double)g->skin[12 * m + 4 * (size_t)i + (size_t)e] * g->skin[12 * m + 4 * (size_t)i + (size_t)e];
+			g->skin_norm = fmax(g->skin_norm, sqrt(l));
+		}
+	}
+	const double *qv[3];
+	for (int i = 0; i < k; i++)
+		qv[i] = g->quadric + (size_t)v[i] * P * 10;
+	double lb = 0.0, rl = r * g->skin_norm, inv = 1.0 / nj;
 	for (size_t p = 0; p < P; p++) {
 		const float *S = g->skin + p * (size_t)J * 12;
-		double z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {0, 0, 0}, lmax = 0.0;
+		double z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {0, 0, 0};
 		for (int j = 0; j < nj; j++) {
 			const float *m = S + 12 * (size_t)joint[j];
-			double l = 0.0;
 			for (int i = 0; i < 3; i++) {
 				z[j][i] = (double)m[4 * i] * bary[0] + (double)m[4 * i + 1] * bary[1] +
 				          (double)m[4 * i + 2] * bary[2] + (double)m[4 * i + 3];
-				c[i] += z[j][i] / nj;
-				for (int e = 0; e < 3; e++)
-					l += (double)m[4 * i + e] * m[4 * i + e];
+				c[i] += z[j][i];
 			}
-			lmax = fmax(lmax, l);
 		}
+		for (int i = 0; i < 3; i++)
+			c[i] *= inv;
 		double spread = 0.0, far = 0.0;
 		for (int j = 0; j < nj; j++) {
 			double d = 0.0, a = 0.0;
@@ -821,13 +833,13 @@ static double posed_min_bound(const mlod_bgm *g, const int *v, int k, const doub
 			spread = fmax(spread, d);
 			far = fmax(far, a);
 		}
-		double R = (sqrt(spread) + r * sqrt(lmax)) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + r * sqrt(lmax));
+		double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
 		double q[10];
-		for (int e = 0; e < 10; e++) {
-			q[e] = 0.0;
-			for (int i = 0; i < k; i++)
-				q[e] += g->quadric[((size_t)v[i] * P + p) * 10 + (size_t)e];
-		}
+		for (int e = 0; e < 10; e++)
+			q[e] = qv[0][10 * p + (size_t)e];
+		for (int i = 1; i < k; i++)
+			for (int e = 0; e < 10; e++)
+				q[e] += qv[i][10 * p + (size_t)e];
 		double tr = q[0] + q[4] + q[7];
 		if (!(tr > 0.0) || !isfinite(tr))
 			continue;
