@@ -885,7 +885,9 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
  * the other poses' terms not being negative; the optimal placement,
  * unknown here, lies within sqrt(lmax) of the barycenter (plan() drops
  * it beyond), where the convex quadric is at least its tangent plane at
- * the barycenter. The fast cost (mlod_bgm_options.fast_cost) is the
+ * the barycenter; or, when higher, posed_min_bound's sum over poses of
+ * each pose's least error near where any of these placements can go,
+ * whatever its weights. The fast cost (mlod_bgm_options.fast_cost) is the
  * pulled-back sum for every operation. */
 static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 {
