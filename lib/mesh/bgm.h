@@ -101,6 +101,8 @@ struct mlod_bgm {
 	                         * -1 first until bgm_quadric_rest needs them), then the sum
 	                         * over poses of their traces */
 	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
+	double skin_norm;       /* collapse.c: the largest Frobenius norm of a skin matrix's
+	                         * linear part, 0 until worked out */
 
 	/* Statistics. */
 	int input_vertices, input_triangles, dropped, border_edges, nonmanifold_edges;

@@ -762,6 +762,112 @@ static int same_influences(const mlod_influences *x, const mlod_influences *y)
 	return 1;
 }
 
+/* A lower bound of the summed posed error (not normalised) of any
+ * placement x within r of bary skinned with any convex combination of
+ * the influences of the k vertices v: the bound for operations whose
+ * vertices' influences differ. Per pose p, the posed location y = sum_j
+ * w_j (L_j x + t_j) lies within R_p of c_p, the mean of the points z_j =
+ * L_j bary + t_j over the joints j of the vertices (R_p = max_j |z_j -
+ * c_p| + r max |L|, L any skin matrix's linear part, the Frobenius norm
+ * bounding the spectral one).
+ * The pose's summed quadric f satisfies, for every y, f(y) >= f(y_mu) +
+ * mu |y_mu - c_p|^2 - mu |y - c_p|^2, y_mu the minimiser of f + mu |. -
+ * c_p|^2 (a regularised solve, sound where f is singular), so f(y) >=
+ * f(y_mu) + mu |y_mu - c_p|^2 - mu R_p^2: near each pose's own least
+ * error, far above the bind pose's term alone. Slack covers the rounding
+ * of the exact sum (float weights, cancellation in the quadric's value).
+ * Returns -1 when it does not apply. */
+static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *bary, double r)
+{
+	int J = g->joint_count, nj = 0;
+	uint16_t joint[3 * MLOD_MAX_INFLUENCES];
+	if (J <= 0)
+		return -1.0;
+	for (int i = 0; i < k; i++) {
+		const mlod_influences *in = &g->inf[v[i]];
+		if (in->count <= 0)
+			return -1.0;
+		for (int a = 0; a < in->count && a < MLOD_MAX_INFLUENCES; a++) {
+			int s = 0;
+			while (s < nj && joint[s] != in->joints[a])
+				s++;
+			if (s == nj)
+				joint[nj++] = in->joints[a];
+		}
+	}
+	size_t P = (size_t)g->pose_count;
+	if (!(g->skin_norm > 0.0)) {
+		/* The largest Frobenius norm of a skin matrix's linear part. */
+		for (size_t m = 0; m < P * (size_t)J; m++) {
+			double l = 0.0;
+			for (int i = 0; i < 3; i++)
+				for (int e = 0; e < 3; e++)
+					l += (double)g->skin[12 * m + 4 * (size_t)i + (size_t)e] * g->skin[12 * m + 4 * (size_t)i + (size_t)e];
+			g->skin_norm = fmax(g->skin_norm, sqrt(l));
+		}
+	}
+	const double *qv[3];
+	for (int i = 0; i < k; i++)
+		qv[i] = g->quadric + (size_t)v[i] * P * 10;
+	double lb = 0.0, rl = r * g->skin_norm, inv = 1.0 / nj;
+	for (size_t p = 0; p < P; p++) {
+		const float *S = g->skin + p * (size_t)J * 12;
+		double z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {0, 0, 0};
+		for (int j = 0; j < nj; j++) {
+			const float *m = S + 12 * (size_t)joint[j];
+			for (int i = 0; i < 3; i++) {
+				z[j][i] = (double)m[4 * i] * bary[0] + (double)m[4 * i + 1] * bary[1] +
+				          (double)m[4 * i + 2] * bary[2] + (double)m[4 * i + 3];
+				c[i] += z[j][i];
+			}
+		}
+		for (int i = 0; i < 3; i++)
+			c[i] *= inv;
+		double spread = 0.0, far = 0.0;
+		for (int j = 0; j < nj; j++) {
+			double d = 0.0, a = 0.0;
+			for (int i = 0; i < 3; i++) {
+				d += (z[j][i] - c[i]) * (z[j][i] - c[i]);
+				a += z[j][i] * z[j][i];
+			}
+			spread = fmax(spread, d);
+			far = fmax(far, a);
+		}
+		double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
+		double q[10];
+		for (int e = 0; e < 10; e++)
+			q[e] = qv[0][10 * p + (size_t)e];
+		for (int i = 1; i < k; i++)
+			for (int e = 0; e < 10; e++)
+				q[e] += qv[i][10 * p + (size_t)e];
+		double tr = q[0] + q[4] + q[7];
+		if (!(tr > 0.0) || !isfinite(tr))
+			continue;
+		double mu = 1e-5 * tr, y[3];
+		double a = q[0] + mu, b = q[1], cc = q[2], d = q[4] + mu, e = q[5], f = q[7] + mu;
+		double det = a * (d * f - e * e) - b * (b * f - cc * e) + cc * (b * e - cc * d);
+		if (!(fabs(det) > 0.0))
+			continue;
+		double r0 = -q[3] + mu * c[0], r1 = -q[6] + mu * c[1], r2 = -q[8] + mu * c[2];
+		y[0] = (r0 * (d * f - e * e) - b * (r1 * f - e * r2) + cc * (r1 * e - d * r2)) / det;
+		y[1] = (a * (r1 * f - e * r2) - r0 * (b * f - cc * e) + cc * (b * r2 - r1 * cc)) / det;
+		y[2] = (a * (d * r2 - r1 * e) - b * (b * r2 - r1 * cc) + r0 * (b * e - cc * d)) / det;
+		double val = bgm_quadric_eval(q, y), dy = 0.0;
+		for (int i = 0; i < 3; i++)
+			dy += (y[i] - c[i]) * (y[i] - c[i]);
+		val += mu * dy - mu * R * R;
+		/* Rounding: the terms of the quadric's value at a point within
+		 * R of c, far above the errors of the sums here and in plan(). */
+		double ym = fmax(fmax(fabs(c[0]), fabs(c[1])), fabs(c[2])) + R;
+		double mag = fabs(q[9]) + 2.0 * (fabs(q[3]) + fabs(q[6]) + fabs(q[8])) * ym +
+		             (fabs(q[0]) + fabs(q[4]) + fabs(q[7]) + 2.0 * (fabs(q[1]) + fabs(q[2]) + fabs(q[5]))) * ym * ym;
+		val -= 1e-12 * mag;
+		if (val > 0.0 && isfinite(val))
+			lb += val;
+	}
+	return lb;
+}
+
 /* A lower bound of the cost plan() finds for operation op on face f,
  * from the quadrics alone (no patch, no validity): the least over every
  * placement plan() may try, valid or not, plus plan()'s compactness
@@ -779,7 +885,9 @@ static int same_influences(const mlod_influences *x, const mlod_influences *y)
  * the other poses' terms not being negative; the optimal placement,
  * unknown here, lies within sqrt(lmax) of the barycenter (plan() drops
  * it beyond), where the convex quadric is at least its tangent plane at
- * the barycenter. The fast cost (mlod_bgm_options.fast_cost) is the
+ * the barycenter; or, when higher, posed_min_bound's sum over poses of
+ * each pose's least error near where any of these placements can go,
+ * whatever its weights. The fast cost (mlod_bgm_options.fast_cost) is the
  * pulled-back sum for every operation. */
 static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 {
@@ -844,6 +952,17 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 				gl += gr[i] * gr[i];
 			double t = bgm_quadric_eval(Q, bary) - 2.0 * sqrt(gl) * sqrt(lmax) * (1.0 + 1e-9);
 			lb = fmin(lb, t > 0.0 ? t : 0.0);
+			lb = fmax(lb, posed_min_bound(g, v, K, bary, sqrt(lmax)));
+		} else {
+			/* Barycenter and vertices: within the longest edge too. */
+			double lmax = 0.0;
+			for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
+				double l = 0.0;
+				for (int i = 0; i < 3; i++)
+					l += (P[e][i] - P[(e + 1) % K][i]) * (P[e][i] - P[(e + 1) % K][i]);
+				lmax = fmax(lmax, l);
+			}
+			lb = fmax(lb, posed_min_bound(g, v, K, bary, sqrt(lmax)));
 		}
 		margin = 1.0 - 1e-9; /* rounding: stay below the exact sum */
 		*weak = 1;

@@ -165,9 +165,40 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			to_rows(&in->offset, S);
 		}
 	}
-	/* Per pose: skin the nodes, then add each face's plane to its nodes. */
+	/* The skin matrices the nodes use (all of them for a static mesh). */
+	unsigned char *used = calloc((size_t)J, 1);
+	if (!used) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+		goto done;
+	}
+	if (g->joint_count == 0)
+		used[0] = 1;
+	for (int v = 0; v < g->node_count; v++)
+		for (int k = 0; k < g->inf[v].count && k < MLOD_MAX_INFLUENCES; k++)
+			if (g->inf[v].joints[k] < J)
+				used[g->inf[v].joints[k]] = 1;
+	/* Per pose: skin the nodes, then add each face's plane to its nodes.
+	 * A pose whose used skin matrices are bit for bit an earlier pose's
+	 * (a rigid part or a joint the clip leaves still) has that pose's
+	 * quadrics, every step being the same arithmetic on the same values:
+	 * they are copied. */
 	for (int p = 0; p < P; p++) {
 		double M[12];
+		int same = -1;
+		for (int q = 0; q < p && same < 0; q++) {
+			const float *a = g->skin + (size_t)p * (size_t)J * 12, *b = g->skin + (size_t)q * (size_t)J * 12;
+			int eq = 1;
+			for (int j = 0; j < J && eq; j++)
+				eq = !used[j] || memcmp(a + 12 * (size_t)j, b + 12 * (size_t)j, 12 * sizeof *a) == 0;
+			if (eq)
+				same = q;
+		}
+		if (same >= 0) {
+			for (int v = 0; v < g->node_count; v++)
+				memcpy(g->quadric + ((size_t)v * (size_t)P + (size_t)p) * 10,
+				       g->quadric + ((size_t)v * (size_t)P + (size_t)same) * 10, 10 * sizeof *g->quadric);
+			continue;
+		}
 		for (int v = 0; v < g->node_count; v++) {
 			blend(g, p, &g->inf[v], M);
 			apply(M, g->nodes[v].p, posed + 3 * v);
@@ -221,6 +252,7 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			}
 		}
 	}
+	free(used);
 	for (int v = 0; v < g->node_count; v++)
 		bgm_quadric_rest_reset(g, v);
 done:
