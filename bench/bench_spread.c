@@ -274,7 +274,9 @@ static int measure(const mlod_character *full, const mlod_character *level, cons
 		if (map)
 			for (int j = 0; j < J; j++)
 				world[j] = w[map[j]];
-		if (mlod_pose_character(level, map ? world : w, &b, NULL) != MLOD_OK) {
+		mlod_error err = {0};
+		if (mlod_pose_character(level, map ? world : w, &b, &err) != MLOD_OK) {
+			fprintf(stderr, "bench_spread: posing a level: %s\n", err.message);
 			r = -1;
 			break;
 		}
@@ -282,8 +284,11 @@ static int measure(const mlod_character *full, const mlod_character *level, cons
 			mlod_posed bd;
 			densify(&b, dens[d], &bd);
 			mlod_deviation dv;
-			if (mlod_surface_deviation(&full_posed_dense[(size_t)k * nd + d], &bd, &dv, NULL) != MLOD_OK)
+			mlod_error err = {0};
+			if (mlod_surface_deviation(&full_posed_dense[(size_t)k * nd + d], &bd, &dv, &err) != MLOD_OK) {
+				fprintf(stderr, "bench_spread: measuring at D = %d: %s\n", dens[d], err.message);
 				r = -1;
+			}
 			mlod_posed_free(&bd);
 			if (r)
 				break;
@@ -404,6 +409,7 @@ int main(int argc, char **argv)
 
 	/* res[method][level][density][seed] */
 	static mlod_deviation res[METHODS][LEVELS][MAX_DENS][MAX_SEEDS];
+	int failed[METHODS][LEVELS] = {{0}};
 	for (int s = 0; s < nseeds; s++) {
 		mlod_pose_set ps = {0};
 		if (mlod_pose_set_make(&c, 0, 0, MLOD_MESH_RANDOM_POSES, (uint64_t)(MLOD_MESH_MEASURE_SEED + s),
@@ -424,8 +430,14 @@ int main(int argc, char **argv)
 				if (!lv[m][k])
 					continue;
 				mlod_deviation out[MAX_DENS];
-				if (measure(&c, lv[m][k], maps[m][k], &ps, fp, dens, nd, out) != 0)
-					die(path, "measuring failed");
+				if (failed[m][k])
+					continue;
+				if (measure(&c, lv[m][k], maps[m][k], &ps, fp, dens, nd, out) != 0) {
+					/* as bench_mesh quality: the cell is left out ("-") */
+					fprintf(stderr, "bench_spread: %s: measuring %s at %g failed\n", path, method_name[m], ratios[k]);
+					failed[m][k] = 1;
+					continue;
+				}
 				for (int d = 0; d < nd; d++)
 					res[m][k][d][s] = out[d];
 			}
@@ -446,6 +458,11 @@ int main(int argc, char **argv)
 			for (int m = 0; m < METHODS; m++) {
 				if (!lv[m][k])
 					continue;
+				if (failed[m][k]) {
+					printf("| %d%% | %d | %s | %d | - | - | - | - | not measured (mlod_surface_deviation failed) |\n",
+					       (int)(100 * ratios[k] + 0.5), dens[d], method_name[m], tris[m][k]);
+					continue;
+				}
 				double v[2][3]; /* [mean|max][avg,min,max] */
 				double q[2][3];
 				for (int f = 0; f < 2; f++) {
@@ -465,6 +482,8 @@ int main(int argc, char **argv)
 				       dens[d], method_name[m], tris[m][k], v[0][0], v[0][1], v[0][2], v[1][0], v[1][1], v[1][2]);
 				if (m == 0)
 					printf(" | | | |\n");
+				else if (failed[0][k] || fabs((double)tris[0][k] - tris[m][k]) > 0.01 * tris[m][k] + 1)
+					printf(" | - | - | unequal triangle counts: no ratio (as bench_mesh) |\n");
 				else {
 					/* mlod wins (loses) beyond the spread when every seed's ratio is
 					 * below (above) 1; a tie when the seeds' ratios straddle 1. */
