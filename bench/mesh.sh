@@ -51,3 +51,21 @@ echo "of the triangles (posed cost: of the whole character, shared by cost as ml
 echo "primitive). gltfpack and the paper's rules may stop short: see the tris columns. The default row's ratios"
 echo "against the peers are given where the triangle counts match within 1%."
 echo
+echo "## Mesh layer: spread of the posed error over pose seeds and sampling density"
+echo
+echo "mlod's default chain (as mlod-bgm makes it), meshopt_simplify and gltfpack (-si R -se 1 -noq, as above),"
+echo "each over 5 pose seeds (2008..2012) of 8 random poses, with both posed meshes split into D = 1, 4, 16"
+echo "triangles per triangle before measuring (D = 1 is mlod_posed_error). Verdicts: better/worse when every"
+echo "seed's mean ratio is below/above 1, else a tie."
+for f in $glbs; do
+	name=$(basename "$f" .glb)
+	files='' n=0
+	for r in 0.5 0.25 0.1; do
+		out="$tmp/$name-$r.glb"
+		if [ -f "$out" ]; then files="$files $out" n=$((n + 1)); fi
+	done
+	[ "$n" -eq 3 ] || files= # the three gltfpack levels or none
+	# shellcheck disable=SC2086
+	"$BUILD/bench/bench_spread" "$f" $files 2> "$tmp/stderr" || cat "$tmp/stderr" >&2
+	echo
+done
