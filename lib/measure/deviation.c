@@ -6,7 +6,10 @@
  * Nearest points come from a bounding volume hierarchy over the target's
  * triangles (object-median splits on the longest axis, so the depth is
  * logarithmic; leaves of up to 8), searched nearer child first and pruned
- * by box distance, each query seeded with the previous sample's triangle;
+ * by box distance, each query seeded with the previous sample's triangle
+ * (or, given warm starts, surface.h, with the triangle that was nearest to
+ * the same sample at another pose: a tighter first bound; the search stays
+ * exact, so the result does not depend on the seed);
  * a leaf's triangle is skipped when its plane is already farther than the
  * best. The samples are visited in the leaf order of their own mesh's
  * hierarchy, so consecutive queries are neighbours, and summed in the

@@ -14,7 +14,12 @@
  * hierarchy (struct mlod_pose_cache): measuring every level of a character
  * builds that hierarchy once per pose. The full character is still posed
  * at every call, and the kept one used only when it is the same, byte for
- * byte.
+ * byte. Each call measures its first pose alone, recording every sample's
+ * nearest triangle in both directions, and the other poses (in parallel)
+ * start their searches from those: skinning moves a sample and its nearest
+ * triangle together, so the first bound is nearly the answer and the
+ * search prunes most of the hierarchy. The result is the same, bit for
+ * bit, as the search is exact.
  */
 #include <math.h>
 #include <pthread.h>
