@@ -17,8 +17,9 @@
  * byte. Each call measures its first pose alone, recording every sample's
  * nearest triangle in both directions, and the other poses (in parallel)
  * start their searches from those: skinning moves a sample and its nearest
- * triangle together, so the first bound is nearly the answer and the
- * search prunes most of the hierarchy. The result is the same, bit for
+ * triangle together, so the first bound is nearly always the answer
+ * (mlod-bgm on a 50k-triangle tubeman: 2.1 full point-triangle distances
+ * and 24 nodes a query, from 5.4 and 29). The result is the same, bit for
  * bit, as the search is exact.
  */
 #include <math.h>
