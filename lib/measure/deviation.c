@@ -327,7 +327,8 @@ static double plane_dist2(const double *p, const tri *t)
  * queries cheap. */
 static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 {
-	double best = triangle_dist2(p, &b->tris[*hint]);
+	const int start = *hint; /* measured here, so skipped in its leaf */
+	double best = triangle_dist2(p, &b->tris[start]);
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
 	int top = 0, at = 0;
 	double at_d2 = box_dist2(p, &b->nodes[0]);
@@ -346,8 +347,8 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 		}
 		if (at_d2 < best)
 			for (int k = n->first; k < n->first + n->count; k++) {
-				if (plane_dist2(p, &b->tris[k]) >= best)
-					continue; /* its plane is already farther than the best */
+				if (k == start || plane_dist2(p, &b->tris[k]) >= best)
+					continue; /* measured first, or its plane is already farther than the best */
 				double d = triangle_dist2(p, &b->tris[k]);
 				if (d < best)
 					best = d, *hint = k;
