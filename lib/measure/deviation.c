@@ -6,7 +6,10 @@
  * Nearest points come from a bounding volume hierarchy over the target's
  * triangles (object-median splits on the longest axis, so the depth is
  * logarithmic; leaves of up to 8), searched nearer child first and pruned
- * by box distance, each query seeded with the previous sample's triangle;
+ * by box distance, each query seeded with the previous sample's triangle
+ * (or, given warm starts, surface.h, with the triangle that was nearest to
+ * the same sample at another pose: a tighter first bound; the search stays
+ * exact, so the result does not depend on the seed);
  * a leaf's triangle is skipped when its plane is already farther than the
  * best. The samples are visited in the leaf order of their own mesh's
  * hierarchy, so consecutive queries are neighbours, and summed in the
@@ -42,6 +45,8 @@ typedef struct bvh {
 	int node_count;
 	tri *tris;  /* in leaf order */
 	int *order; /* the mesh's triangle at each place of tris */
+	int *place; /* the place in tris of each of the mesh's triangles */
+	int tri_count;
 } bvh;
 
 /* ---------------------------------------------------------------- */
@@ -241,8 +246,10 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 	out->nodes = malloc((size_t)2 * n * sizeof *out->nodes);
 	out->tris = malloc((size_t)n * sizeof *out->tris);
 	out->order = malloc((size_t)n * sizeof *out->order);
+	out->place = malloc((size_t)n * sizeof *out->place);
 	out->node_count = 1;
-	if (!b.items || !out->nodes || !out->tris || !out->order) {
+	out->tri_count = n;
+	if (!b.items || !out->nodes || !out->tris || !out->order || !out->place) {
 		free(b.items);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", n);
 	}
@@ -259,6 +266,7 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 		out->nodes = fit;
 	for (int k = 0; k < n; k++) {
 		out->order[k] = b.items[k].t;
+		out->place[out->order[k]] = k;
 		const uint32_t *ix = m->indices + 3 * (size_t)out->order[k];
 		tri *t = &out->tris[k];
 		for (int a = 0; a < 3; a++) {
@@ -284,6 +292,7 @@ static void bvh_free(bvh *b)
 	free(b->nodes);
 	free(b->tris);
 	free(b->order);
+	free(b->place);
 }
 
 /* Squared distance from p to the node's box: p less its clamp to the box
@@ -318,7 +327,8 @@ static double plane_dist2(const double *p, const tri *t)
  * queries cheap. */
 static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 {
-	double best = triangle_dist2(p, &b->tris[*hint]);
+	const int start = *hint; /* measured here, so skipped in its leaf */
+	double best = triangle_dist2(p, &b->tris[start]);
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
 	int top = 0, at = 0;
 	double at_d2 = box_dist2(p, &b->nodes[0]);
@@ -337,8 +347,8 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 		}
 		if (at_d2 < best)
 			for (int k = n->first; k < n->first + n->count; k++) {
-				if (plane_dist2(p, &b->tris[k]) >= best)
-					continue; /* its plane is already farther than the best */
+				if (k == start || plane_dist2(p, &b->tris[k]) >= best)
+					continue; /* measured first, or its plane is already farther than the best */
 				double d = triangle_dist2(p, &b->tris[k]);
 				if (d < best)
 					best = d, *hint = k;
@@ -377,8 +387,8 @@ static mlod_result check_mesh(const mlod_posed *m, const char *which, mlod_error
  * another and each starts from a close triangle; the distances are then
  * summed in the mesh's order (used vertices, then triangles), so the sum
  * does not depend on the visiting order. */
-static mlod_result measure(const mlod_posed *from, const bvh *from_bvh, const bvh *to, double *sum, double *max,
-                           long *count, mlod_error *err)
+static mlod_result measure(const mlod_posed *from, const bvh *from_bvh, const bvh *to, const int *warm, int *near,
+                           double *sum, double *max, long *count, mlod_error *err)
 {
 	double *dv = malloc(((size_t)from->vertex_count + (size_t)from->triangle_count) * sizeof *dv);
 	if (!dv)
@@ -397,13 +407,21 @@ static mlod_result measure(const mlod_posed *from, const bvh *from_bvh, const bv
 				continue;
 			const float *q = from->positions + 3 * (size_t)ix[c];
 			const double p[3] = { q[0], q[1], q[2] };
+			if (warm && (unsigned)warm[ix[c]] < (unsigned)to->tri_count)
+				hint = to->place[warm[ix[c]]];
 			dv[ix[c]] = sqrt(bvh_nearest2(to, p, &hint));
+			if (near)
+				near[ix[c]] = to->order[hint];
 		}
 		double p[3];
 		for (int a = 0; a < 3; a++)
 			p[a] = ((double)from->positions[3 * (size_t)ix[0] + a] + from->positions[3 * (size_t)ix[1] + a] +
 			        from->positions[3 * (size_t)ix[2] + a]) / 3.0;
+		if (warm && (unsigned)warm[from->vertex_count + t] < (unsigned)to->tri_count)
+			hint = to->place[warm[from->vertex_count + t]];
 		dt[t] = sqrt(bvh_nearest2(to, p, &hint));
+		if (near)
+			near[from->vertex_count + t] = to->order[hint];
 	}
 	double s = *sum, m = *max;
 	long n = *count;
@@ -439,14 +457,16 @@ static double diagonal(const mlod_posed *m)
 
 /* Adds both directions between a (with its hierarchy ta) and b. */
 static mlod_result both_ways(const mlod_posed *a, const bvh *ta, const mlod_posed *b, double diag,
-                             mlod_deviation *out, mlod_error *err)
+                             const mlod_warm *warm, mlod_deviation *out, mlod_error *err)
 {
 	bvh tb = { 0 };
 	double sum = 0.0, max = 0.0;
 	long count = 0;
 	mlod_result r;
-	if (!(r = bvh_build(b, &tb, err)) && !(r = measure(a, ta, &tb, &sum, &max, &count, err)))
-		r = measure(b, &tb, ta, &sum, &max, &count, err);
+	const int *wa = warm && !warm->record ? warm->a : NULL, *wb = warm && !warm->record ? warm->b : NULL;
+	int *na = warm && warm->record ? warm->a : NULL, *nb = warm && warm->record ? warm->b : NULL;
+	if (!(r = bvh_build(b, &tb, err)) && !(r = measure(a, ta, &tb, wa, na, &sum, &max, &count, err)))
+		r = measure(b, &tb, ta, wb, nb, &sum, &max, &count, err);
 	bvh_free(&tb);
 	if (r)
 		return r;
@@ -469,7 +489,7 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	bvh ta = { 0 };
 	if (!(r = bvh_build(a, &ta, err)))
-		r = both_ways(a, &ta, b, diag, out, err);
+		r = both_ways(a, &ta, b, diag, NULL, out, err);
 	bvh_free(&ta);
 	return r;
 }
@@ -528,13 +548,16 @@ int mlod_surface_is(const mlod_surface *s, const mlod_posed *m)
 	       !memcmp(s->mesh.indices, m->indices, 3 * (size_t)m->triangle_count * sizeof *m->indices);
 }
 
-mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, mlod_deviation *out,
-                                      mlod_error *err)
+mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, const mlod_warm *warm,
+                                      mlod_deviation *out, mlod_error *err)
 {
 	mlod_result r;
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: no output");
 	if ((r = check_mesh(b, "b", err)))
 		return r;
-	return both_ways(&a->mesh, &a->tree, b, a->diag, out, err);
+	if (warm && (warm->a_count != a->mesh.vertex_count + a->mesh.triangle_count ||
+	             warm->b_count != b->vertex_count + b->triangle_count))
+		warm = NULL; /* made for other meshes: measured without */
+	return both_ways(&a->mesh, &a->tree, b, a->diag, warm, out, err);
 }

@@ -14,7 +14,13 @@
  * hierarchy (struct mlod_pose_cache): measuring every level of a character
  * builds that hierarchy once per pose. The full character is still posed
  * at every call, and the kept one used only when it is the same, byte for
- * byte.
+ * byte. Each call measures its first pose alone, recording every sample's
+ * nearest triangle in both directions, and the other poses (in parallel)
+ * start their searches from those: skinning moves a sample and its nearest
+ * triangle together, so the first bound is nearly always the answer
+ * (mlod-bgm on a 50k-triangle tubeman: 2.1 full point-triangle distances
+ * and 24 nodes a query, from 5.4 and 29). The result is the same, bit for
+ * bit, as the search is exact.
  */
 #include <math.h>
 #include <pthread.h>
@@ -192,18 +198,32 @@ typedef struct posed_job {
 	const mlod_pose_set *poses;
 	mlod_deviation *d;      /* per pose */
 	mlod_error *errs;       /* per pose */
+	mlod_warm warm;         /* nearest triangles at the first pose, warm starts for the others */
+	int first;              /* the pose of item 0 */
 } posed_job;
 
-static mlod_result posed_one(void *ctx, int k)
+static mlod_result posed_one(void *ctx, int item)
 {
 	posed_job *j = ctx;
+	int k = j->first + item;
 	const mlod_mat4 *world = j->poses->world + (size_t)k * (size_t)j->poses->joint_count;
 	mlod_posed a = {0}, b = {0};
 	mlod_result r;
 	if ((r = mlod_pose_character(j->full, world, &a, &j->errs[k])) == MLOD_OK &&
 	    (r = mlod_pose_character(j->level, world, &b, &j->errs[k])) == MLOD_OK) {
 		const mlod_surface *kept = cache_get(j->poses->cache, k, &a);
-		r = kept ? mlod_surface_deviation_to(kept, &b, &j->d[k], &j->errs[k])
+		if (kept && j->warm.record) { /* the first pose, alone: the warm starts' memory */
+			j->warm.a_count = a.vertex_count + a.triangle_count;
+			j->warm.b_count = b.vertex_count + b.triangle_count;
+			j->warm.a = calloc((size_t)j->warm.a_count, sizeof *j->warm.a);
+			j->warm.b = calloc((size_t)j->warm.b_count, sizeof *j->warm.b);
+			if (!j->warm.a || !j->warm.b) {
+				free(j->warm.a);
+				free(j->warm.b);
+				j->warm.a = j->warm.b = NULL;
+			}
+		}
+		r = kept ? mlod_surface_deviation_to(kept, &b, j->warm.a ? &j->warm : NULL, &j->d[k], &j->errs[k])
 		         : mlod_surface_deviation(&a, &b, &j->d[k], &j->errs[k]);
 	}
 	mlod_posed_free(&a);
@@ -223,13 +243,21 @@ mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *l
 	if (poses->count <= 0)
 		return MLOD_OK;
 	posed_job j = { full, level, poses, calloc((size_t)poses->count, sizeof *j.d),
-	                calloc((size_t)poses->count, sizeof *j.errs) };
+	                calloc((size_t)poses->count, sizeof *j.errs), { 0 }, 0 };
 	if (!j.d || !j.errs) {
 		free(j.d);
 		free(j.errs);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "mlod_posed_error: out of memory for %d poses", poses->count);
 	}
-	mlod_result r = mlod_parallel_for(poses->count, poses->threads, posed_one, &j);
+	/* The first pose alone, recording each sample's nearest triangle; the
+	 * others, in parallel, start from those (only the search's speed
+	 * depends on them, never a result). Without the memory for them, all
+	 * poses are measured cold. */
+	j.warm.record = 1;
+	mlod_result r = posed_one(&j, 0);
+	j.warm.record = 0, j.first = 1;
+	if (r == MLOD_OK)
+		r = mlod_parallel_for(poses->count - 1, poses->threads, posed_one, &j);
 	if (r != MLOD_OK) {
 		for (int k = 0; k < poses->count; k++)
 			if (j.errs[k].code != MLOD_OK) {
@@ -250,5 +278,7 @@ mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *l
 	}
 	free(j.d);
 	free(j.errs);
+	free(j.warm.a);
+	free(j.warm.b);
 	return r;
 }

@@ -1,5 +1,6 @@
 /* test_deviation.c: surface deviation against hand results and brute force. */
 #include "test.h"
+#include "measure/surface.h"
 
 #define PI 3.14159265358979323846
 
@@ -371,6 +372,60 @@ TEST(posed_error_kept_full)
 	mlod_character_free(&c);
 }
 
+/* Warm starts (surface.h) change only where each search begins: recorded
+ * at one placement and used at another, or filled with nonsense, or made
+ * for meshes of other sizes, the result has the same bits as without. */
+TEST(warm_starts_same_bits)
+{
+	mlod_posed a = sphere(14, 20, 1.0, 0.08), b = sphere(9, 13, 1.0, 0.15);
+	mlod_surface *s;
+	CHECK_OK(mlod_surface_make(&a, &s, &terr));
+	int na = a.vertex_count + a.triangle_count, nb = b.vertex_count + b.triangle_count;
+	int *wa = malloc(sizeof *wa * (size_t)na), *wb = malloc(sizeof *wb * (size_t)nb);
+	for (int i = 0; i < na; i++)
+		wa[i] = -7;
+	for (int i = 0; i < nb; i++)
+		wb[i] = -7;
+	mlod_warm rec = { wa, wb, na, nb, 1 };
+	mlod_deviation cold, d;
+	CHECK_OK(mlod_surface_deviation(&a, &b, &cold, &terr));
+	CHECK_OK(mlod_surface_deviation_to(s, &b, &rec, &d, &terr));
+	CHECK(same_deviation(&cold, &d));
+	int in_range = 1;
+	for (int i = 0; i < na; i++)
+		in_range &= wa[i] >= 0 && wa[i] < b.triangle_count;
+	for (int i = 0; i < nb; i++)
+		in_range &= wb[i] >= 0 && wb[i] < a.triangle_count;
+	CHECK(in_range); /* every sample got its nearest triangle */
+	/* b moved and bent a little: the recorded triangles are near, not all nearest */
+	mlod_posed b2 = copy_translated(&b, 0.03f, -0.02f, 0.05f);
+	for (int i = 0; i < 3 * b2.vertex_count; i++)
+		b2.positions[i] += (float)rnd(-0.02, 0.02);
+	mlod_warm use = { wa, wb, na, nb, 0 };
+	CHECK_OK(mlod_surface_deviation(&a, &b2, &cold, &terr));
+	CHECK_OK(mlod_surface_deviation_to(s, &b2, &use, &d, &terr));
+	CHECK(same_deviation(&cold, &d));
+	CHECK_OK(mlod_surface_deviation_to(s, &b2, NULL, &d, &terr));
+	CHECK(same_deviation(&cold, &d));
+	/* nonsense: out of range, negative, far triangles */
+	for (int i = 0; i < na; i++)
+		wa[i] = i % 3 == 0 ? -1 - i : i % 3 == 1 ? b.triangle_count + i : (int)rnd(0, b.triangle_count - 1e-9);
+	for (int i = 0; i < nb; i++)
+		wb[i] = i % 2 ? a.triangle_count - 1 - i % a.triangle_count : 1 << 30;
+	CHECK_OK(mlod_surface_deviation_to(s, &b2, &use, &d, &terr));
+	CHECK(same_deviation(&cold, &d));
+	/* made for meshes of other sizes */
+	mlod_warm other = { wa, wb, na - 1, nb, 0 };
+	CHECK_OK(mlod_surface_deviation_to(s, &b2, &other, &d, &terr));
+	CHECK(same_deviation(&cold, &d));
+	free(wa);
+	free(wb);
+	mlod_surface_free(s);
+	mlod_posed_free(&a);
+	mlod_posed_free(&b);
+	mlod_posed_free(&b2);
+}
+
 int main(void)
 {
 	RUN(identical_meshes);
@@ -381,5 +436,6 @@ int main(void)
 	RUN(unused_vertices_do_not_count);
 	RUN(bad_input);
 	RUN(posed_error_kept_full);
+	RUN(warm_starts_same_bits);
 	TEST_EXIT();
 }
