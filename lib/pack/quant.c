@@ -182,8 +182,13 @@ int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint
 	unsigned int *cache = malloc(sizeof *cache * ((size_t)ni + 1));
 	if (!cache)
 		return -1;
-	meshopt_optimizeVertexCache(cache, indices, ni, nv);
-	if (order == 1) {
+	if (order == 3)
+		meshopt_optimizeVertexCacheStrip(cache, indices, ni, nv);
+	else if (order == 4 || order == 5)
+		meshopt_optimizeVertexCacheFifo(cache, indices, ni, nv, MLOD_PACK_INDEX_FIFO);
+	else
+		meshopt_optimizeVertexCache(cache, indices, ni, nv);
+	if (order == 1 || order == 4) {
 		for (uint32_t v = 0; v < nv; v++)
 			remap[v] = v;
 		memcpy(out, cache, sizeof *out * ni);
