@@ -166,8 +166,8 @@ float mlod_pack_switch_distance(float error)
 	return (float)((double)error * MLOD_PACK_LINES / (2.0 * tan(MLOD_PACK_FOV_Y * pi / 360.0) * MLOD_PACK_PIXELS));
 }
 
-int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, uint32_t *remap,
-                           uint32_t *out)
+int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
+                           uint32_t *remap, uint32_t *out)
 {
 	int ok = ni % 3 == 0 && order > 0;
 	for (uint32_t i = 0; ok && i < ni; i++)
@@ -184,11 +184,17 @@ int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint
 		return -1;
 	if (order == 3)
 		meshopt_optimizeVertexCacheStrip(cache, indices, ni, nv);
-	else if (order == 4 || order == 5)
+	else if (order == 4 || order == 5 || order == 7)
 		meshopt_optimizeVertexCacheFifo(cache, indices, ni, nv, MLOD_PACK_INDEX_FIFO);
 	else
 		meshopt_optimizeVertexCache(cache, indices, ni, nv);
-	if (order == 1 || order == 4) {
+	if ((order == 6 || order == 7) && positions) {
+		meshopt_spatialSortRemap(remap, positions, nv, 3 * sizeof(float));
+		meshopt_remapIndexBuffer(out, cache, ni, remap);
+		free(cache);
+		return 0;
+	}
+	if (order == 1 || order == 4 || order == 6 || order == 7) {
 		for (uint32_t v = 0; v < nv; v++)
 			remap[v] = v;
 		memcpy(out, cache, sizeof *out * ni);
