@@ -14,7 +14,7 @@
  *
  *   (a) what the pack stored up to format 1.x: each level of each part its
  *       own vertex and index streams, quantised to that level's own box,
- *       in the best of the writer's eight orders (mlod_pack_vertex_order).
+ *       in the best of the writer's ten orders (mlod_pack_vertex_order).
  *   (b) per part one vertex buffer: the coarsest level's vertices, then
  *       each finer level's vertices that are not bit-identical (all
  *       quantised attributes) to one already in the buffer, appended in
@@ -24,7 +24,7 @@
  *       where it is wider than 65535 of them (positions, UVs; morph
  *       deltas: the largest |delta| of any level).
  *       Within a level's appended block the vertices follow one of the
- *       writer's eight orders applied to that level's triangles, chosen
+ *       writer's ten orders applied to that level's triangles, chosen
  *       level by level, coarsest first: the one that codes the block and
  *       the level's indices to the fewest bytes. Coded two ways: b1 the
  *       whole buffer as one meshopt vertex stream per attribute (a reader
@@ -622,7 +622,7 @@ static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide,
 	uint32_t *idx[MAXL], prefix[MAXL], used[MAXL], count = 0;
 	size_t tsc = L.targets ? code(g.tscale, (uint32_t)L.targets, 4, 0, NULL) : 0;
 	/* Coarsest first; each level's block in the order (of the writer's
-	 * eight, on that level's triangles) that codes its block and indices
+	 * ten, on that level's triangles) that codes its block and indices
 	 * to the fewest bytes. */
 	for (int k = n - 1; k >= 0; k--) {
 		uint32_t count0 = count;
