@@ -14,7 +14,7 @@
  *
  *   (a) what the pack stored up to format 1.x: each level of each part its
  *       own vertex and index streams, quantised to that level's own box,
- *       in the best of the writer's three orders (mlod_pack_vertex_order).
+ *       in the best of the writer's ten orders (mlod_pack_vertex_order).
  *   (b) per part one vertex buffer: the coarsest level's vertices, then
  *       each finer level's vertices that are not bit-identical (all
  *       quantised attributes) to one already in the buffer, appended in
@@ -24,7 +24,7 @@
  *       where it is wider than 65535 of them (positions, UVs; morph
  *       deltas: the largest |delta| of any level).
  *       Within a level's appended block the vertices follow one of the
- *       writer's three orders applied to that level's triangles, chosen
+ *       writer's ten orders applied to that level's triangles, chosen
  *       level by level, coarsest first: the one that codes the block and
  *       the level's indices to the fewest bytes. Coded two ways: b1 the
  *       whole buffer as one meshopt vertex stream per attribute (a reader
@@ -460,7 +460,7 @@ static void layout_a(const mlod_primitive *p, int level, int skin, int wide, con
 	int best_o = 0;
 	for (int pass = 0; pass < 2; pass++)
 		for (int o = pass ? best_o : 0; o < (pass ? best_o + 1 : MLOD_PACK_ORDERS); o++) {
-			if (mlod_pack_vertex_order(o, in, ni, nv, remap, out) != 0)
+			if (mlod_pack_vertex_order(o, in, ni, nv, p->positions, remap, out) != 0)
 				exit(1);
 			for (uint32_t v = 0; v < nv; v++)
 				memcpy(W + (size_t)remap[v] * (size_t)L.stride, V + (size_t)v * (size_t)L.stride, (size_t)L.stride);
@@ -513,14 +513,14 @@ static uint32_t vset_get(vset *s, uint8_t *G, uint32_t *n, const uint8_t *key, i
  * level's triangles; returns its indices into G, *used the distinct
  * vertices of G it has. */
 static uint32_t *append_level(vset *set, uint8_t *G, uint32_t *count, const uint8_t *V, const uint32_t *in,
-                              uint32_t ni, uint32_t nv, int o, int stride, uint32_t *used)
+                              uint32_t ni, uint32_t nv, const float *positions, int o, int stride, uint32_t *used)
 {
 	uint32_t *remap = xmalloc(sizeof *remap * ((size_t)nv + 1));
 	uint32_t *inv = xmalloc(sizeof *inv * ((size_t)nv + 1));
 	uint32_t *out = xmalloc(sizeof *out * ((size_t)ni + 1));
 	uint32_t *gid = xmalloc(sizeof *gid * ((size_t)nv + 1));
 	uint32_t *idx = xmalloc(sizeof *idx * ((size_t)ni + 1));
-	if (mlod_pack_vertex_order(o, in, ni, nv, remap, out) != 0)
+	if (mlod_pack_vertex_order(o, in, ni, nv, positions, remap, out) != 0)
 		exit(1);
 	for (uint32_t v = 0; v < nv; v++)
 		inv[remap[v]] = v;
@@ -622,7 +622,7 @@ static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide,
 	uint32_t *idx[MAXL], prefix[MAXL], used[MAXL], count = 0;
 	size_t tsc = L.targets ? code(g.tscale, (uint32_t)L.targets, 4, 0, NULL) : 0;
 	/* Coarsest first; each level's block in the order (of the writer's
-	 * three, on that level's triangles) that codes its block and indices
+	 * ten, on that level's triangles) that codes its block and indices
 	 * to the fewest bytes. */
 	for (int k = n - 1; k >= 0; k--) {
 		uint32_t count0 = count;
@@ -634,7 +634,7 @@ static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide,
 			memcpy(set.slot, saved, sizeof *saved * set.cap);
 			count = count0;
 			uint32_t u;
-			uint32_t *ix = append_level(&set, G, &count, V[k], in[k], ni[k], nv[k], o, L.stride, &u);
+			uint32_t *ix = append_level(&set, G, &count, V[k], in[k], ni[k], nv[k], lv[k]->positions, o, L.stride, &u);
 			if (t == MLOD_PACK_ORDERS) {
 				idx[k] = ix, used[k] = u, prefix[k] = count;
 				break;

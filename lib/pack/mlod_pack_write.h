@@ -198,14 +198,31 @@ void mlod_pack_top4(const mlod_primitive *p, uint32_t v, const int *jmap, int jm
  *     (meshopt_optimizeVertexCache), vertices as input;
  *   2 as 1, then the vertices in the order those triangles first use them
  *     (meshopt_optimizeVertexFetchRemap), vertices no triangle uses after
- *     them in input order.
+ *     them in input order;
+ *   3 as 2 with the triangles in strip order
+ *     (meshopt_optimizeVertexCacheStrip);
+ *   4 as 1 with the triangles for a FIFO cache of MLOD_PACK_INDEX_FIFO
+ *     vertices, the size of the vertex FIFO of meshopt's index codec
+ *     (meshopt_optimizeVertexCacheFifo);
+ *   5 as 4, then the vertices in first-use order as in 2;
+ *   6 as 1, then the vertices in spatial order (meshopt_spatialSortRemap
+ *     of positions, 3 floats per vertex): near vertices, notably the
+ *     copies of a position along a seam or crease, stand next to each
+ *     other; as 1 when positions is NULL;
+ *   7 as 4, then the vertices in spatial order as in 6 (as 4 when
+ *     positions is NULL);
+ *   8 as 2, then each vertex whose position is bit-identical to an
+ *     earlier one's moved to follow the first of them (as 2 when
+ *     positions is NULL);
+ *   9 as 5, then the copies of a position together as in 8.
  * remap[old] = new (nv entries), out[ni] the triangles in new vertex
  * indices. ni is a multiple of 3 and every index below nv, else the order
  * is left as it is (identity remap, out = indices). 0, or -1 when out of
  * memory. */
-#define MLOD_PACK_ORDERS 3
-int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, uint32_t *remap,
-                           uint32_t *out);
+#define MLOD_PACK_ORDERS 10
+#define MLOD_PACK_INDEX_FIFO 16
+int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
+                           uint32_t *remap, uint32_t *out);
 
 /* The switch distance of an error (scene units) at MLOD_PACK_FOV_Y,
  * MLOD_PACK_LINES and MLOD_PACK_PIXELS: error * lines / (2 tan(fov / 2)

@@ -1063,14 +1063,15 @@ static uint32_t part_vertex(struct mpart *m, const uint8_t *key)
 /* Appends level V's vertices not yet in the buffer, in order o of the
  * level's triangles (mlod_pack_vertex_order); the level's indices into
  * the buffer, or NULL when out of memory. */
-static uint32_t *part_append(struct mpart *m, const uint8_t *V, const uint32_t *in, uint32_t ni, uint32_t nv, int o)
+static uint32_t *part_append(struct mpart *m, const uint8_t *V, const uint32_t *in, uint32_t ni, uint32_t nv,
+                             const float *positions, int o)
 {
 	uint32_t *remap = malloc(sizeof *remap * ((size_t)nv + 1));
 	uint32_t *inv = malloc(sizeof *inv * ((size_t)nv + 1));
 	uint32_t *out = malloc(sizeof *out * ((size_t)ni + 1));
 	uint32_t *gid = malloc(sizeof *gid * ((size_t)nv + 1));
 	uint32_t *idx = malloc(sizeof *idx * ((size_t)ni + 1));
-	if (!remap || !inv || !out || !gid || !idx || mlod_pack_vertex_order(o, in, ni, nv, remap, out) != 0) {
+	if (!remap || !inv || !out || !gid || !idx || mlod_pack_vertex_order(o, in, ni, nv, positions, remap, out) != 0) {
 		free(remap), free(inv), free(out), free(gid), free(idx);
 		return NULL;
 	}
@@ -1328,7 +1329,7 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 		size_t best_bytes = 0;
 		memcpy(saved, m->slot, sizeof *saved * m->slot_cap);
 		for (int o = 0; o < MLOD_PACK_ORDERS; o++) {
-			uint32_t *ix = part_append(m, V, in, ni, nv, o);
+			uint32_t *ix = part_append(m, V, in, ni, nv, p->positions, o);
 			if (!ix)
 				goto done;
 			int from = cb->n;
@@ -1343,7 +1344,7 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 			m->count = count0;
 		}
 	}
-	if (!(idx = part_append(m, V, in, ni, nv, best)))
+	if (!(idx = part_append(m, V, in, ni, nv, p->positions, best)))
 		goto done;
 	part_block_streams(cb, m, count0, idx, ni);
 	/* The vertices the level uses: what a reader gathers from the prefix. */

@@ -166,8 +166,49 @@ float mlod_pack_switch_distance(float error)
 	return (float)((double)error * MLOD_PACK_LINES / (2.0 * tan(MLOD_PACK_FOV_Y * pi / 360.0) * MLOD_PACK_PIXELS));
 }
 
-int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, uint32_t *remap,
-                           uint32_t *out)
+/* Rewrites the first-use order remap (old -> new) so that the vertices
+ * with bit-identical positions follow the first of them to come, in
+ * first-use order among themselves. 0, or -1 when out of memory. */
+static int group_copies(const float *positions, uint32_t nv, uint32_t *remap)
+{
+	size_t cap = 16;
+	while (cap < 2 * (size_t)nv + 2)
+		cap *= 2;
+	uint32_t *ord = malloc(sizeof *ord * ((size_t)nv + 1)), *rep = malloc(sizeof *rep * ((size_t)nv + 1));
+	uint32_t *next = malloc(sizeof *next * ((size_t)nv + 1)), *tail = malloc(sizeof *tail * ((size_t)nv + 1));
+	uint32_t *slot = calloc(cap, sizeof *slot);
+	int ok = ord && rep && next && tail && slot;
+	for (uint32_t v = 0; ok && v < nv; v++)
+		ord[remap[v]] = v;
+	for (uint32_t i = 0; ok && i < nv; i++) {
+		uint32_t v = ord[i];
+		uint64_t h = 1469598103934665603ull;
+		const unsigned char *b = (const unsigned char *)(positions + 3 * (size_t)v);
+		for (int k = 0; k < 12; k++)
+			h = (h ^ b[k]) * 1099511628211ull;
+		size_t s = (size_t)h & (cap - 1);
+		while (slot[s] && memcmp(positions + 3 * (size_t)(slot[s] - 1), positions + 3 * (size_t)v, 12) != 0)
+			s = (s + 1) & (cap - 1);
+		next[v] = UINT32_MAX;
+		if (!slot[s]) {
+			slot[s] = v + 1;
+			rep[v] = v, tail[v] = v;
+		} else {
+			uint32_t r = slot[s] - 1;
+			rep[v] = r, next[tail[r]] = v, tail[r] = v;
+		}
+	}
+	uint32_t at = 0;
+	for (uint32_t i = 0; ok && i < nv; i++)
+		if (rep[ord[i]] == ord[i])
+			for (uint32_t v = ord[i]; v != UINT32_MAX; v = next[v])
+				remap[v] = at++;
+	free(ord), free(rep), free(next), free(tail), free(slot);
+	return ok ? 0 : -1;
+}
+
+int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
+                           uint32_t *remap, uint32_t *out)
 {
 	int ok = ni % 3 == 0 && order > 0;
 	for (uint32_t i = 0; ok && i < ni; i++)
@@ -182,8 +223,19 @@ int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint
 	unsigned int *cache = malloc(sizeof *cache * ((size_t)ni + 1));
 	if (!cache)
 		return -1;
-	meshopt_optimizeVertexCache(cache, indices, ni, nv);
-	if (order == 1) {
+	if (order == 3)
+		meshopt_optimizeVertexCacheStrip(cache, indices, ni, nv);
+	else if (order == 4 || order == 5 || order == 7 || order == 9)
+		meshopt_optimizeVertexCacheFifo(cache, indices, ni, nv, MLOD_PACK_INDEX_FIFO);
+	else
+		meshopt_optimizeVertexCache(cache, indices, ni, nv);
+	if ((order == 6 || order == 7) && positions) {
+		meshopt_spatialSortRemap(remap, positions, nv, 3 * sizeof(float));
+		meshopt_remapIndexBuffer(out, cache, ni, remap);
+		free(cache);
+		return 0;
+	}
+	if (order == 1 || order == 4 || order == 6 || order == 7) {
 		for (uint32_t v = 0; v < nv; v++)
 			remap[v] = v;
 		memcpy(out, cache, sizeof *out * ni);
@@ -194,6 +246,10 @@ int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint
 	for (uint32_t v = 0; v < nv; v++)
 		if (remap[v] == ~0u)
 			remap[v] = (uint32_t)used++;
+	if ((order == 8 || order == 9) && positions && group_copies(positions, nv, remap) != 0) {
+		free(cache);
+		return -1;
+	}
 	meshopt_remapIndexBuffer(out, cache, ni, remap);
 	free(cache);
 	return 0;

@@ -335,7 +335,7 @@ TEST(pack_mesh_streams)
 	uint32_t *gid = malloc(sizeof *gid * nv), *best_gid = malloc(sizeof *gid * nv);
 	int order = -1;
 	for (int o = 0; o < MLOD_PACK_ORDERS && order < 0; o++) {
-		CHECK(mlod_pack_vertex_order(o, (const uint32_t *)pr->indices, ni, nv, remap, want_idx) == 0);
+		CHECK(mlod_pack_vertex_order(o, (const uint32_t *)pr->indices, ni, nv, pr->positions, remap, want_idx) == 0);
 		for (uint32_t v = 0; v < nv; v++)
 			gid[v] = UINT32_MAX;
 		int same = 1;
