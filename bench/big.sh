@@ -73,7 +73,7 @@ echo
 echo "| run | CPU s | split (ms) |"
 echo "|---|---:|---|"
 awk -v t="$bgm" -v b="$build_ms" -v c="$collapse_ms" 'BEGIN {
-	printf "| mlod-bgm (levels 50/25/10%%) | %.2f | BGM build %.0f, collapses %.0f (the rest: loading, the posed error of each level, writing) |\n", t, b, c }'
+	printf "| mlod-bgm (default levels) | %.2f | BGM build %.0f, collapses %.0f (the rest: loading, the posed error of each level, writing) |\n", t, b, c }'
 awk -v t="$pack" -v s="$(layer_ms skeleton)" -v m="$(layer_ms mesh)" -v o="$(layer_ms motion)" 'BEGIN {
 	printf "| mlod-pack (every layer, every level) | %.2f | skeleton %.0f, mesh %.0f, motion %.0f |\n", t, s, m, o }'
 awk -v s="$skel" -v m="$motion" -v b="$bgm" 'BEGIN {
