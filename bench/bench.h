@@ -4,6 +4,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "mlod.h"
@@ -50,6 +51,29 @@ static inline int bench_load(const char *who, const char *path, mlod_character *
 	if (r != MLOD_OK)
 		fprintf(stderr, "%s: %s: %s\n", who, path, data ? err.message : "out of memory");
 	return r == MLOD_OK ? 0 : -1;
+}
+
+/* The file name of a path (after its last '/'). */
+static inline const char *bench_base_name(const char *path)
+{
+	const char *s = strrchr(path, '/');
+	return s ? s + 1 : path;
+}
+
+/* Triangles of a primitive (mode 4, indexed or not; 0 for other modes)
+ * and of a character's instances. */
+static inline int bench_triangles(const mlod_primitive *p)
+{
+	return p->mode == 4 ? (p->index_count > 0 ? p->index_count : p->vertex_count) / 3 : 0;
+}
+
+static inline int bench_character_triangles(const mlod_character *c)
+{
+	int t = 0;
+	for (int i = 0; i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
+			t += bench_triangles(&c->meshes[c->instances[i].mesh].primitives[p]);
+	return t;
 }
 
 #endif

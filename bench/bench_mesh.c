@@ -37,29 +37,9 @@
 
 static const double ratios[] = {MLOD_MESH_RATIOS_DEFAULT}; /* the first three measured */
 
-static const char *base_name(const char *path)
-{
-	const char *s = strrchr(path, '/');
-	return s ? s + 1 : path;
-}
-
 static int load(const char *path, mlod_character *c)
 {
 	return bench_load("bench_mesh", path, c, NULL);
-}
-
-static int triangles(const mlod_primitive *p)
-{
-	return p->mode == 4 ? (p->index_count > 0 ? p->index_count : p->vertex_count) / 3 : 0;
-}
-
-static int character_triangles(const mlod_character *c)
-{
-	int t = 0;
-	for (int i = 0; i < c->instance_count; i++)
-		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
-			t += triangles(&c->meshes[c->instances[i].mesh].primitives[p]);
-	return t;
 }
 
 /* Poses for the posed cost, as mlod-bgm makes them. */
@@ -109,7 +89,7 @@ static void levelset_init(struct levelset *L, const mlod_character *c)
 static void levelset_count(struct levelset *L)
 {
 	for (int k = 0; k < 3; k++)
-		L->tris[k] = character_triangles(&L->view[k]);
+		L->tris[k] = bench_character_triangles(&L->view[k]);
 }
 
 static void levelset_free(struct levelset *L)
@@ -164,7 +144,7 @@ static double mlod_levels(const mlod_character *c, const mlod_bgm_options *base,
 			continue;
 		const mlod_mesh *m = &c->meshes[c->instances[i].mesh];
 		for (int p = 0; p < m->primitive_count && p < 8; p++) {
-			int T = triangles(&m->primitives[p]);
+			int T = bench_triangles(&m->primitives[p]);
 			mlod_bgm *g = NULL;
 			if (T < 4 || mlod_bgm_build(c, i, p, &opt, &g, NULL) != MLOD_OK)
 				continue;
@@ -180,7 +160,7 @@ static double mlod_levels(const mlod_character *c, const mlod_bgm_options *base,
 			mlod_bgm_share_budget(bgms, n, (long)ceil(ratios[k] * (double)total), prefix);
 		for (int j = 0; j < n; j++) {
 			int i = where[j][0], p = where[j][1];
-			int pre = shared ? prefix[j] : mlod_bgm_prefix_for(bgms[j], (int)ceil(ratios[k] * triangles(&c->meshes[c->instances[i].mesh].primitives[p])));
+			int pre = shared ? prefix[j] : mlod_bgm_prefix_for(bgms[j], (int)ceil(ratios[k] * bench_triangles(&c->meshes[c->instances[i].mesh].primitives[p])));
 			if (mlod_bgm_extract(bgms[j], pre, c->instances[i].skin < 0, &L->meshes[k][i].primitives[p], NULL) == MLOD_OK)
 				L->owned[k][i][p] = 1;
 		}
@@ -213,7 +193,7 @@ static double meshopt_levels(const mlod_character *c, struct levelset *L)
 		const mlod_mesh *m = &c->meshes[c->instances[i].mesh];
 		for (int p = 0; p < m->primitive_count && p < 8; p++) {
 			const mlod_primitive *pr = &m->primitives[p];
-			int T = triangles(pr);
+			int T = bench_triangles(pr);
 			if (T < 4)
 				continue;
 			uint32_t *idx = pr->indices, *own = NULL;
@@ -306,7 +286,7 @@ static int load_meshed(const char *path, mlod_character *c)
 {
 	if (load(path, c) != 0)
 		return 0;
-	int T = character_triangles(c);
+	int T = bench_character_triangles(c);
 	if (T == 0)
 		mlod_character_free(c);
 	return T;
@@ -337,7 +317,7 @@ static void table1(int argc, char **argv)
 				decim[run] = st.collapses > 0 ? 1e4 * st.collapse / st.collapses : 0.0;
 				collapses = st.collapses;
 			}
-			printf("| %s | %d | %s | %.2f | %.3f | %d | %s | %s |\n", base_name(argv[a]), T,
+			printf("| %s | %d | %s | %.2f | %.3f | %d | %s | %s |\n", bench_base_name(argv[a]), T,
 			       cost ? "compactness, triangle (paper)" : "posed, edge (default)", bench_median(build, RUNS), bench_median(decim, RUNS), collapses,
 			       "142 ms (982 tris), 7.7-8.8 s (7186), 11.6 s (6656)", "1-12 ms");
 		}
@@ -374,7 +354,7 @@ static void speed(int argc, char **argv)
 			}
 		}
 		double tp = bench_median(t[0], RUNS), tc = bench_median(t[1], RUNS), tm = bench_median(t[2], RUNS);
-		printf("| %s | %d | %.1f | %.1f | %.2f | %.0fx | %.0fx |\n", base_name(argv[a]), T, tp, tc, tm, tp / tm, tc / tm);
+		printf("| %s | %d | %.1f | %.1f | %.2f | %.0fx | %.0fx |\n", bench_base_name(argv[a]), T, tp, tc, tm, tp / tm, tc / tm);
 		mlod_character_free(&c);
 	}
 	printf("\nThe whole chain of three levels (50%%, 25%%, 10%% of the triangles): mlod makes its poses, builds "
@@ -421,7 +401,7 @@ static void chain(int argc, char **argv)
 				best[m] = t < best[m] ? t : best[m];
 				levelset_free(&L);
 			}
-		printf("| %s | %d | %.2f | %.2f | %.2f | %.1fx | %.1fx |\n", base_name(argv[a]), T, best[0], best[1], best[2],
+		printf("| %s | %d | %.2f | %.2f | %.2f | %.1fx | %.1fx |\n", bench_base_name(argv[a]), T, best[0], best[1], best[2],
 		       best[0] / best[2], best[1] / best[2]);
 		mlod_character_free(&c);
 	}
@@ -441,7 +421,7 @@ static void quality(int argc, char **argv)
 	mlod_character c;
 	if (argc < 1 || load(argv[0], &c) != 0)
 		return;
-	const char *name = base_name(argv[0]);
+	const char *name = bench_base_name(argv[0]);
 	struct method methods[] = {
 		{"mlod posed, optimal, all, edge (default)", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_ALL}},
 		{"mlod posed --fast-cost, optimal, all, edge", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_ALL, .fast_cost = 1}},
@@ -460,7 +440,7 @@ static void quality(int argc, char **argv)
 	mlod_pose_set clip = {0}, random = {0};
 	mlod_pose_set_make(&c, 0, 16, 0, 0, 0.0f, &clip, NULL);
 	mlod_pose_set_make(&c, 0, 0, MLOD_MESH_RANDOM_POSES, MLOD_MESH_MEASURE_SEED, MLOD_MESH_RANDOM_ANGLE, &random, NULL);
-	int T = character_triangles(&c);
+	int T = bench_character_triangles(&c);
 	/* results[method][pose set][level] */
 	mlod_deviation res[16][2][3];
 	int tris[16][3], ok[16][3];
@@ -471,7 +451,7 @@ static void quality(int argc, char **argv)
 				mlod_character g;
 				if (argc < 4 || load(argv[1 + k], &g) != 0)
 					continue;
-				tris[m][k] = character_triangles(&g);
+				tris[m][k] = bench_character_triangles(&g);
 				ok[m][k] = posed_error(&c, &g, &clip, &res[m][0][k]) == 0 && posed_error(&c, &g, &random, &res[m][1][k]) == 0;
 				mlod_character_free(&g);
 			}

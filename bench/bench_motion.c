@@ -69,12 +69,6 @@ static int load_sized(const char *path, mlod_character *c, double *h, double *pd
 	return 0;
 }
 
-static const char *base_name(const char *path)
-{
-	const char *s = strrchr(path, '/');
-	return s ? s + 1 : path;
-}
-
 /* ---------------------------------------------------------------- */
 /* Key data: raw layout and compressed sizes                         */
 /* ---------------------------------------------------------------- */
@@ -282,7 +276,7 @@ static int cmd_peers(int argc, char **argv)
 	sizes s0 = clip_sizes(clips, a.clip_count);
 	printf("%s: %d clips, %d joints, height %.4g. Key data in bytes as each file stores it; "
 	       "error: max world joint position error over all clips, %% of the height, measured by mlod.\n\n",
-	       base_name(argv[0]), a.clip_count, a.skeleton.joint_count, h);
+	       bench_base_name(argv[0]), a.clip_count, a.skeleton.joint_count, h);
 	printf("| output | keys | raw | gzip -9 | zstd -19 | max error %% | mean error %% | raw vs peer | gzip vs peer | zstd vs peer | max error <= peer |\n");
 	printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
 	mlod_deviation zero = {0, 0, 0};
@@ -391,7 +385,7 @@ static int cmd_precision(int argc, char **argv)
 		if (load_sized(argv[i], &c, &h, &pd) != 0)
 			continue;
 		for (int v = 0; v < (int)(sizeof runs / sizeof runs[0]); v++) {
-			printf("| %s | %s | %s", base_name(argv[i]), names[runs[v].precision], runs[v].share > 0.0 ? "" : "-");
+			printf("| %s | %s | %s", bench_base_name(argv[i]), names[runs[v].precision], runs[v].share > 0.0 ? "" : "-");
 			if (runs[v].share > 0.0)
 				printf("%g", runs[v].share);
 			printf(" |");
@@ -469,7 +463,7 @@ static int cmd_methods(int argc, char **argv)
 			}
 			if (v == 0)
 				ref = bytes[1];
-			printf("| %s | %d | %ld | %s | %ld | %ld | %ld | %ld | %ld | %ld | %.2fx |\n", base_name(argv[i]),
+			printf("| %s | %d | %ld | %s | %ld | %ld | %ld | %ld | %ld | %ld | %.2fx |\n", bench_base_name(argv[i]),
 			       c.clip_count, keys0, names[v], keys[0], bytes[0], keys[1], bytes[1], keys[2], bytes[2],
 			       (double)bytes[1] / (double)ref);
 		}
@@ -545,7 +539,7 @@ static int cmd_speed(int argc, char **argv)
 				runs[r] = bench_now() - t0;
 			}
 			double t = bench_median(runs, SPEED_RUNS);
-			printf("| %s | %d | %ld | %d | %s | %.1f | %.1f | %.0f |\n", base_name(argv[i]), c.clip_count, frames,
+			printf("| %s | %d | %ld | %d | %s | %.1f | %.1f | %.0f |\n", bench_base_name(argv[i]), c.clip_count, frames,
 			       c.skeleton.joint_count, names[v], 1000.0 * t / c.clip_count, c.clip_count / t, (double)frames / t);
 		}
 		mlod_character_free(&c);
@@ -651,7 +645,7 @@ static int cmd_between(int argc, char **argv)
 				mlod_motion_free(mo[0]);
 				mlod_motion_free(mo[1]);
 			}
-			printf("| %s | %d | %d | %ld | %ld | %.0f | %.4f | %d of %d |\n", base_name(argv[i]), c.clip_count, subs[v],
+			printf("| %s | %d | %d | %ld | %ld | %.0f | %.4f | %d of %d |\n", bench_base_name(argv[i]), c.clip_count, subs[v],
 			       keys, bytes, ms, worst, over, levels);
 		}
 		mlod_character_free(&c);
@@ -704,7 +698,7 @@ static int cmd_pointerr(int argc, char **argv)
 	printf("%s: %d clips, %d joints, height %.4g, point distance %.4g. Point error per clip at the frames and "
 	       "midpoints: max and mean over joints and samples, p99 of each sample's largest; scene units and %% of "
 	       "the height.\n\n",
-	       base_name(argv[0]), a.clip_count, a.skeleton.joint_count, h, pd);
+	       bench_base_name(argv[0]), a.clip_count, a.skeleton.joint_count, h, pd);
 	printf("| file | clip | samples | max | max %% | p99 %% | mean %% |\n|---|---|---:|---:|---:|---:|---:|\n");
 	int rc = 0;
 	for (int p = 1; p < argc; p++) {

@@ -49,26 +49,6 @@ static void die(const char *path, const char *what)
 	exit(2);
 }
 
-static const char *base_name(const char *path)
-{
-	const char *s = strrchr(path, '/');
-	return s ? s + 1 : path;
-}
-
-static int triangles(const mlod_primitive *p)
-{
-	return p->mode == 4 ? (p->index_count > 0 ? p->index_count : p->vertex_count) / 3 : 0;
-}
-
-static int character_triangles(const mlod_character *c)
-{
-	int t = 0;
-	for (int i = 0; i < c->instance_count; i++)
-		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
-			t += triangles(&c->meshes[c->instances[i].mesh].primitives[p]);
-	return t;
-}
-
 /* ---------------------------------------------------------------- */
 /* meshopt_simplify levels                                           */
 /* ---------------------------------------------------------------- */
@@ -121,7 +101,7 @@ static void mo_level_make(const mlod_character *c, double ratio, struct mo_level
 		for (int p = 0; p < m->primitive_count; p++) {
 			const mlod_primitive *pr = &m->primitives[p];
 			L->meshes[i].primitives[p] = *pr;
-			int T = triangles(pr);
+			int T = bench_triangles(pr);
 			if ((c->instances[i].skin < 0 && c->instances[i].joint < 0) || T < 4)
 				continue;
 			uint32_t *idx = pr->indices, *own = NULL;
@@ -339,7 +319,7 @@ int main(int argc, char **argv)
 	mlod_character c;
 	if (bench_load("bench_spread", path, &c, NULL) != 0)
 		return 2;
-	int T = character_triangles(&c);
+	int T = bench_character_triangles(&c);
 	if (T == 0)
 		die(path, "no triangles");
 
@@ -361,7 +341,7 @@ int main(int argc, char **argv)
 	struct mo_level mo[LEVELS];
 	for (int k = 0; k < LEVELS; k++) {
 		mo_level_make(&c, ratios[k], &mo[k]);
-		lv[1][k] = &mo[k].view, tris[1][k] = character_triangles(&mo[k].view);
+		lv[1][k] = &mo[k].view, tris[1][k] = bench_character_triangles(&mo[k].view);
 	}
 	mlod_character gp[LEVELS];
 	int gp_ok[LEVELS] = {0};
@@ -374,7 +354,7 @@ int main(int argc, char **argv)
 			continue;
 		}
 		gp_ok[k] = 1;
-		lv[2][k] = &gp[k], tris[2][k] = character_triangles(&gp[k]);
+		lv[2][k] = &gp[k], tris[2][k] = bench_character_triangles(&gp[k]);
 	}
 
 	/* Check: at density 1 this is mlod_posed_error, to the bit. */
@@ -450,7 +430,7 @@ int main(int argc, char **argv)
 
 	printf("\n**%s, %d triangles: %d seeds (%d..%d) x %d random poses, up to 40 degrees per joint** (%% of the diagonal; "
 	       "mean over seeds [min-max over seeds])\n\n",
-	       base_name(path), T, nseeds, MLOD_MESH_MEASURE_SEED, MLOD_MESH_MEASURE_SEED + nseeds - 1, MLOD_MESH_RANDOM_POSES);
+	       bench_base_name(path), T, nseeds, MLOD_MESH_MEASURE_SEED, MLOD_MESH_MEASURE_SEED + nseeds - 1, MLOD_MESH_RANDOM_POSES);
 	printf("| level | D | method | tris | mean error | Hausdorff | mlod/peer mean | mlod/peer Hausdorff | mean verdict |\n"
 	       "|---|---:|---|---:|---|---|---|---|---|\n");
 	for (int k = 0; k < LEVELS; k++)

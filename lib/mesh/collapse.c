@@ -337,6 +337,22 @@ static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 	}
 }
 
+/* Whether a placement stays near the collapsed vertices P[0..K-1]: at
+ * most their longest edge from the barycenter (K == 2: the one edge). */
+static int near_collapsed(const double *const P[3], int K, const double bary[3], const double opt[3])
+{
+	double lmax = 0.0, d = 0.0;
+	for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
+		double l = 0.0;
+		for (int i = 0; i < 3; i++)
+			l += (P[e][i] - P[(e + 1) % K][i]) * (P[e][i] - P[(e + 1) % K][i]);
+		lmax = fmax(lmax, l);
+	}
+	for (int i = 0; i < 3; i++)
+		d += (opt[i] - bary[i]) * (opt[i] - bary[i]);
+	return d <= lmax;
+}
+
 /* Works out operation op on face t (its triangle collapse, or the
  * collapse of one of its edges); returns 1 when it is valid (pl holds
  * the cheapest valid placement), else 0. */
@@ -543,18 +559,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			}
 			{
 				if (found) {
-					/* Stay near the collapsed vertices: at most their
-					 * longest edge from the barycenter. */
-					double lmax = 0.0, d = 0.0;
-					for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
-						double l = 0.0;
-						for (int i = 0; i < 3; i++)
-							l += (P[e][i] - P[(e + 1) % K][i]) * (P[e][i] - P[(e + 1) % K][i]);
-						lmax = fmax(lmax, l);
-					}
-					for (int i = 0; i < 3; i++)
-						d += (opt[i] - bary[i]) * (opt[i] - bary[i]);
-					if (d <= lmax) {
+					if (near_collapsed(P, K, bary, opt)) {
 						memcpy(cand[nc], opt, sizeof cand[nc]);
 						cand_role[nc] = 0;
 						cand_snap[nc++] = -1;
@@ -1019,16 +1024,7 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		}
 		memcpy(opt, mm->opt, sizeof opt);
 		if (mm->opt_state == 1) {
-			double lmax = 0.0, d = 0.0;
-			for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
-				double l = 0.0;
-				for (int i = 0; i < 3; i++)
-					l += (P[e][i] - P[(e + 1) % K][i]) * (P[e][i] - P[(e + 1) % K][i]);
-				lmax = fmax(lmax, l);
-			}
-			for (int i = 0; i < 3; i++)
-				d += (opt[i] - bary[i]) * (opt[i] - bary[i]);
-			if (d <= lmax) {
+			if (near_collapsed(P, K, bary, opt)) {
 				role[nc] = 0;
 				memcpy(cand[nc++], opt, sizeof cand[0]);
 			}
