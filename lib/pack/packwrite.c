@@ -1437,7 +1437,7 @@ static mlod_result motion_level0(struct ctx *x)
 	for (int q = 0; r == MLOD_OK && q < c->clip_count; q++) {
 		mlod_motion *m[2] = {NULL, NULL};
 		for (int i = 0; r == MLOD_OK && i < 2; i++)
-			r = mlod_motion_create(c, q, &mo, &m[i], x->err);
+			r = i == 0 ? mlod_motion_create(c, q, &mo, &m[i], x->err) : mlod_motion_create_like(m[0], &m[i], x->err);
 		if (r == MLOD_OK && mlod_motion_timeline_info(m[0])->frames >= 3) {
 			static const mlod_motion_method methods[2] = {MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS};
 			mlod_motion_level best;
@@ -1529,7 +1529,7 @@ static mlod_result motion_levels(struct ctx *x)
 	for (int q = 0; r == MLOD_OK && q < c->clip_count; q++) {
 		mlod_motion *m[2] = {NULL, NULL};
 		for (int i = 0; r == MLOD_OK && i < 2; i++)
-			r = mlod_motion_create(c, q, &mo, &m[i], x->err);
+			r = i == 0 ? mlod_motion_create(c, q, &mo, &m[i], x->err) : mlod_motion_create_like(m[0], &m[i], x->err);
 		if (r == MLOD_OK && mlod_motion_timeline_info(m[0])->frames < 3)
 			short_clips++;
 		else
