@@ -76,4 +76,24 @@ static inline int bench_character_triangles(const mlod_character *c)
 	return t;
 }
 
+/* map[j]: the joint of full with the name of level's joint j (a peer's
+ * file has its own skeleton); NULL when a name is missing or out of
+ * memory. The caller frees it. */
+static inline int *bench_joint_map(const mlod_character *full, const mlod_character *level)
+{
+	int J = level->skeleton.joint_count;
+	int *map = malloc(sizeof(int) * (size_t)(J + 1));
+	for (int j = 0; map && j < J; j++) {
+		map[j] = -1;
+		for (int k = 0; k < full->skeleton.joint_count; k++)
+			if (strcmp(full->skeleton.joints[k].name, level->skeleton.joints[j].name) == 0)
+				map[j] = k;
+		if (map[j] < 0) {
+			free(map);
+			return NULL;
+		}
+	}
+	return map;
+}
+
 #endif

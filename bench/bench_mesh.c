@@ -237,17 +237,9 @@ static int posed_error(const mlod_character *full, const mlod_character *level, 
 	}
 	/* Map the other file's joints by name. */
 	int J = level->skeleton.joint_count;
-	int *map = malloc(sizeof(int) * (size_t)(J + 1));
-	for (int j = 0; j < J; j++) {
-		map[j] = -1;
-		for (int k = 0; k < full->skeleton.joint_count; k++)
-			if (strcmp(full->skeleton.joints[k].name, level->skeleton.joints[j].name) == 0)
-				map[j] = k;
-		if (map[j] < 0) {
-			free(map);
-			return -1;
-		}
-	}
+	int *map = bench_joint_map(full, level);
+	if (!map)
+		return -1;
 	mlod_mat4 *world = malloc(sizeof *world * (size_t)(J + 1));
 	mlod_posed a = {0}, b = {0};
 	double sum = 0.0;

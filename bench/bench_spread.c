@@ -214,27 +214,6 @@ static void densify(const mlod_posed *in, int d, mlod_posed *out)
 /* Measuring                                                         */
 /* ---------------------------------------------------------------- */
 
-/* map[j]: the joint of full that is level's joint j (by name); NULL when
- * level shares full's skeleton. */
-static int *joint_map(const mlod_character *full, const mlod_character *level)
-{
-	int J = level->skeleton.joint_count;
-	int *map = malloc(sizeof(int) * (size_t)(J + 1));
-	if (!map)
-		die("map", "out of memory");
-	for (int j = 0; j < J; j++) {
-		map[j] = -1;
-		for (int k = 0; k < full->skeleton.joint_count; k++)
-			if (strcmp(full->skeleton.joints[k].name, level->skeleton.joints[j].name) == 0)
-				map[j] = k;
-		if (map[j] < 0) {
-			free(map);
-			return NULL;
-		}
-	}
-	return map;
-}
-
 /* Error of level against full over the poses at each density: mean over
  * poses of the mean, largest max. Returns -1 on failure. */
 static int measure(const mlod_character *full, const mlod_character *level, const int *map,
@@ -348,7 +327,7 @@ int main(int argc, char **argv)
 	for (int k = 0; k < LEVELS && argc - a == 4; k++) {
 		if (bench_load("bench_spread", argv[a + 1 + k], &gp[k], NULL) != 0)
 			continue;
-		if (!(maps[2][k] = joint_map(&c, &gp[k]))) {
+		if (!(maps[2][k] = bench_joint_map(&c, &gp[k]))) {
 			fprintf(stderr, "bench_spread: %s: a joint is not in %s\n", argv[a + 1 + k], path);
 			mlod_character_free(&gp[k]);
 			continue;

@@ -337,6 +337,23 @@ static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 	}
 }
 
+/* The tie-break term of a collapse: the collapsed triangle's area times
+ * its lack of compactness, or for an edge the mean over its faces. */
+static double collapse_tie(const mlod_bgm *g, int f, int op, int K, const double *const P[3])
+{
+	if (K == 3)
+		return sqrt(area_sq(P[0], P[1], P[2])) * (1.0 - bgm_compactness(P[0], P[1], P[2]));
+	const bgm_face *F = &g->faces[f];
+	int faces[2] = {f, F->adj[op]}, nr = faces[1] >= 0 ? 2 : 1;
+	double tie = 0.0;
+	for (int j = 0; j < nr; j++) {
+		const bgm_face *h = &g->faces[faces[j]];
+		const double *a = g->nodes[h->n[0]].p, *b = g->nodes[h->n[1]].p, *c = g->nodes[h->n[2]].p;
+		tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / nr;
+	}
+	return tie;
+}
+
 /* Whether a placement stays near the collapsed vertices P[0..K-1]: at
  * most their longest edge from the barycenter (K == 2: the one edge). */
 static int near_collapsed(const double *const P[3], int K, const double bary[3], const double opt[3])
@@ -910,17 +927,7 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		if (j > 0 && same)
 			same = same_influences(&g->inf[v[0]], &g->inf[v[j]]);
 	}
-	double tie = 0.0;
-	if (K == 3) {
-		tie = sqrt(area_sq(P[0], P[1], P[2])) * (1.0 - bgm_compactness(P[0], P[1], P[2]));
-	} else {
-		int faces[2] = {f, F->adj[op]}, nr = faces[1] >= 0 ? 2 : 1;
-		for (int j = 0; j < nr; j++) {
-			const bgm_face *h = &g->faces[faces[j]];
-			const double *a = g->nodes[h->n[0]].p, *b = g->nodes[h->n[1]].p, *c = g->nodes[h->n[2]].p;
-			tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / nr;
-		}
-	}
+	double tie = collapse_tie(g, f, op, K, P);
 	double lb, margin = 1.0;
 	if (same || g->opt.fast_cost) {
 		for (int j = 0; j < K; j++) {
@@ -1056,17 +1063,7 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 	}
 	if (best == HUGE_VAL)
 		best = 0.0;
-	double tie = 0.0;
-	if (K == 3) {
-		tie = sqrt(area_sq(P[0], P[1], P[2])) * (1.0 - bgm_compactness(P[0], P[1], P[2]));
-	} else {
-		int faces[2] = {f, F->adj[op]}, nr = faces[1] >= 0 ? 2 : 1;
-		for (int j = 0; j < nr; j++) {
-			const bgm_face *h = &g->faces[faces[j]];
-			const double *a = g->nodes[h->n[0]].p, *b = g->nodes[h->n[1]].p, *c = g->nodes[h->n[2]].p;
-			tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / nr;
-		}
-	}
+	double tie = collapse_tie(g, f, op, K, P);
 	return best + TIE_WEIGHT * tie;
 }
 
