@@ -368,74 +368,6 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
 /* Skinning                                                          */
 /* ---------------------------------------------------------------- */
 
-/* Vertices of a rigid or static part (or a stretch of them) by M: the
- * point M p and the normal M n normalised, each coordinate summed in the
- * order M[r] x + M[4 + r] y + M[8 + r] z (+ M[12 + r]). With the GCC/Clang
- * vector extension one 4-lane multiply-add chain per point and per normal
- * (the same operations in the same order per lane: the same floats). */
-#if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
-typedef float rt_tv4 __attribute__((vector_size(16)));
-static inline rt_tv4 tld4(const float *p)
-{
-	rt_tv4 v;
-	memcpy(&v, p, sizeof v);
-	return v;
-}
-
-static void transform_range(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
-                            float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
-{
-	const rt_tv4 c0 = tld4(M), c1 = tld4(M + 4), c2 = tld4(M + 8), c3 = tld4(M + 12);
-	for (size_t v = 0; v < n; v++) {
-		const float *q = pos + 3 * v;
-		const rt_tv4 o = c0 * q[0] + c1 * q[1] + c2 * q[2] + c3;
-		float *restrict op = (float *)((char *)out_pos + v * ps);
-		op[0] = o[0], op[1] = o[1], op[2] = o[2];
-	}
-	if (!out_nrm)
-		return;
-	for (size_t v = 0; v < n; v++) {
-		float *restrict on = (float *)((char *)out_nrm + v * ns);
-		if (!nrm) {
-			on[0] = on[1] = on[2] = 0.0f;
-			continue;
-		}
-		const float *nn = nrm + 3 * v;
-		const rt_tv4 t = c0 * nn[0] + c1 * nn[1] + c2 * nn[2];
-		const float len2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
-		const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
-		on[0] = t[0] * il, on[1] = t[1] * il, on[2] = t[2] * il;
-	}
-}
-#else
-static void transform_range(size_t n, const float *pos, const float *nrm, const float *M, float *out_pos, size_t ps,
-                            float *out_nrm, size_t ns)
-{
-	for (size_t v = 0; v < n; v++) {
-		const float *q = pos + 3 * v;
-		float *o = (float *)((char *)out_pos + v * ps);
-		for (int r = 0; r < 3; r++)
-			o[r] = M[r] * q[0] + M[4 + r] * q[1] + M[8 + r] * q[2] + M[12 + r];
-		if (out_nrm) {
-			float *on = (float *)((char *)out_nrm + v * ns);
-			if (!nrm) {
-				on[0] = on[1] = on[2] = 0.0f;
-				continue;
-			}
-			const float *nn = nrm + 3 * v;
-			float len2 = 0.0f;
-			for (int r = 0; r < 3; r++) {
-				on[r] = M[r] * nn[0] + M[4 + r] * nn[1] + M[8 + r] * nn[2];
-				len2 += on[r] * on[r];
-			}
-			const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
-			for (int r = 0; r < 3; r++)
-				on[r] *= il;
-		}
-	}
-}
-#endif
-
 /* Morphing goes through a buffer on the stack, this many vertices at a
  * time: no allocation. */
 enum { RT_MORPH_RUN = 128 };
@@ -554,7 +486,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 						x[0] = x[1] = x[2] = 0.0f;
 					}
 			} else {
-				transform_range(m, pos, nrm, M, o, pos_stride, onr, nrm_stride);
+				rt_transform(m, pos, nrm, M, o, pos_stride, onr, nrm_stride);
 			}
 			v0 += m;
 		}

@@ -163,6 +163,15 @@ size_t rt_bytes_skel_level(const mlod_pack_skel_level *l);
 size_t rt_bytes_mesh(const mlod_pack_mesh *m);
 size_t rt_bytes_motion(const mlod_pack_motion *m);
 
+/* rt_skin.c: the vertices of a rigid or static part (or a stretch of
+ * them) by the affine M: the point M p and the normal M n normalised (nrm
+ * NULL: zero normals; out_nrm NULL: none), each coordinate summed in the
+ * order M[r] x + M[4 + r] y + M[8 + r] z (+ M[12 + r]), the normal's
+ * squared length as x x + y y + z z, then times 1 / sqrt of it (0 when
+ * not positive): the same floats whichever path computes them. */
+void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, float *out_pos, size_t ps,
+                  float *out_nrm, size_t ns);
+
 /* rt_math.h: the affine helpers rt_mat_mul (a * b), rt_mat_trs
  * (mlod_mat4_from_trs) and rt_mat_mul_trs (parent * rt_mat_trs(t)). */
 #include "rt_math.h"

@@ -238,3 +238,150 @@ void mlod_rt_skin_lbs_scalar(size_t n, const float *positions, const float *norm
 		}
 	}
 }
+
+/* ---------------------------------------------------------------- */
+/* Rigid and static parts (rt_internal.h)                            */
+/* ---------------------------------------------------------------- */
+
+#if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
+/* One vertex at a time: one 4-lane multiply-add chain per point and per
+ * normal (the tail of the 4-wide loop below, and its stand-in without
+ * SSE2). */
+static void transform_one_by_one(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
+                                 float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
+{
+	const rt_v4 c0 = ld4(M), c1 = ld4(M + 4), c2 = ld4(M + 8), c3 = ld4(M + 12);
+	for (size_t v = 0; v < n; v++) {
+		const float *q = pos + 3 * v;
+		const rt_v4 o = c0 * q[0] + c1 * q[1] + c2 * q[2] + c3;
+		float *restrict op = (float *)((char *)out_pos + v * ps);
+		op[0] = o[0], op[1] = o[1], op[2] = o[2];
+	}
+	if (!out_nrm)
+		return;
+	for (size_t v = 0; v < n; v++) {
+		float *restrict on = (float *)((char *)out_nrm + v * ns);
+		if (!nrm) {
+			on[0] = on[1] = on[2] = 0.0f;
+			continue;
+		}
+		const float *nn = nrm + 3 * v;
+		const rt_v4 t = c0 * nn[0] + c1 * nn[1] + c2 * nn[2];
+		const float len2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+		const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
+		on[0] = t[0] * il, on[1] = t[1] * il, on[2] = t[2] * il;
+	}
+}
+
+#if defined(RT_SSE2)
+/* (a[i0], a[i1], b[i2], b[i3]) */
+#define RT_SH(a, b, i0, i1, i2, i3) _mm_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0))
+
+/* Four packed xyz (12 floats at p) as X, Y, Z lanes. */
+static inline void load_xyz4(const float *p, __m128 *x, __m128 *y, __m128 *z)
+{
+	const __m128 a = _mm_loadu_ps(p), b = _mm_loadu_ps(p + 4), c = _mm_loadu_ps(p + 8);
+	*x = RT_SH(a, RT_SH(b, c, 2, 0, 1, 0), 0, 3, 0, 2);
+	*y = RT_SH(RT_SH(a, b, 1, 0, 0, 0), RT_SH(b, c, 3, 0, 2, 0), 0, 2, 0, 2);
+	*z = RT_SH(RT_SH(a, b, 2, 0, 1, 0), RT_SH(c, c, 0, 0, 3, 0), 0, 2, 0, 2);
+}
+
+/* X, Y, Z lanes stored as four xyz, stride bytes apart. */
+static inline void store_xyz4(float *restrict out, size_t stride, __m128 x, __m128 y, __m128 z)
+{
+	const __m128 a = RT_SH(RT_SH(x, y, 0, 0, 0, 0), RT_SH(z, x, 0, 0, 1, 1), 0, 2, 0, 2);
+	const __m128 b = RT_SH(RT_SH(y, z, 1, 1, 1, 1), RT_SH(x, y, 2, 2, 2, 2), 0, 2, 0, 2);
+	const __m128 c = RT_SH(RT_SH(z, x, 2, 2, 3, 3), RT_SH(y, z, 3, 3, 3, 3), 0, 2, 0, 2);
+	if (stride == 12) {
+		_mm_storeu_ps(out, a), _mm_storeu_ps(out + 4, b), _mm_storeu_ps(out + 8, c);
+		return;
+	}
+	float t[12];
+	_mm_storeu_ps(t, a), _mm_storeu_ps(t + 4, b), _mm_storeu_ps(t + 8, c);
+	for (int k = 0; k < 4; k++)
+		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
+}
+
+/* Four vertices at a time across the lanes (x of four points in one
+ * vector): per lane the one-by-one loop's operations in its order, so the
+ * same floats; the normals' 1 / sqrt four at a time (SSE2's square root
+ * and division are IEEE's, as sqrtf and / are). */
+void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
+                  float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
+{
+	const size_t n4 = n & ~(size_t)3;
+	__m128 m[16];
+	for (int k = 0; k < 16; k++)
+		m[k] = _mm_set1_ps(M[k]);
+	for (size_t v = 0; v < n4; v += 4) {
+		__m128 x, y, z;
+		load_xyz4(pos + 3 * v, &x, &y, &z);
+		const __m128 ox = _mm_add_ps(
+			_mm_add_ps(_mm_add_ps(_mm_mul_ps(m[0], x), _mm_mul_ps(m[4], y)), _mm_mul_ps(m[8], z)), m[12]);
+		const __m128 oy = _mm_add_ps(
+			_mm_add_ps(_mm_add_ps(_mm_mul_ps(m[1], x), _mm_mul_ps(m[5], y)), _mm_mul_ps(m[9], z)), m[13]);
+		const __m128 oz = _mm_add_ps(
+			_mm_add_ps(_mm_add_ps(_mm_mul_ps(m[2], x), _mm_mul_ps(m[6], y)), _mm_mul_ps(m[10], z)), m[14]);
+		store_xyz4((float *)((char *)out_pos + v * ps), ps, ox, oy, oz);
+	}
+	if (out_nrm && nrm) {
+		const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+		for (size_t v = 0; v < n4; v += 4) {
+			__m128 x, y, z;
+			load_xyz4(nrm + 3 * v, &x, &y, &z);
+			const __m128 tx = _mm_add_ps(_mm_add_ps(_mm_mul_ps(m[0], x), _mm_mul_ps(m[4], y)), _mm_mul_ps(m[8], z));
+			const __m128 ty = _mm_add_ps(_mm_add_ps(_mm_mul_ps(m[1], x), _mm_mul_ps(m[5], y)), _mm_mul_ps(m[9], z));
+			const __m128 tz = _mm_add_ps(_mm_add_ps(_mm_mul_ps(m[2], x), _mm_mul_ps(m[6], y)), _mm_mul_ps(m[10], z));
+			const __m128 l2 =
+				_mm_add_ps(_mm_add_ps(_mm_mul_ps(tx, tx), _mm_mul_ps(ty, ty)), _mm_mul_ps(tz, tz));
+			const __m128 il = _mm_and_ps(_mm_cmpgt_ps(l2, zero), _mm_div_ps(one, _mm_sqrt_ps(l2)));
+			store_xyz4((float *)((char *)out_nrm + v * ns), ns, _mm_mul_ps(tx, il), _mm_mul_ps(ty, il),
+			           _mm_mul_ps(tz, il));
+		}
+	} else if (out_nrm) {
+		for (size_t v = 0; v < n4; v++) {
+			float *restrict on = (float *)((char *)out_nrm + v * ns);
+			on[0] = on[1] = on[2] = 0.0f;
+		}
+	}
+	if (n4 < n)
+		transform_one_by_one(n - n4, pos + 3 * n4, nrm ? nrm + 3 * n4 : NULL, M,
+		                     (float *)((char *)out_pos + n4 * ps), ps,
+		                     out_nrm ? (float *)((char *)out_nrm + n4 * ns) : NULL, ns);
+}
+#undef RT_SH
+#else
+void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
+                  float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
+{
+	transform_one_by_one(n, pos, nrm, M, out_pos, ps, out_nrm, ns);
+}
+#endif
+#else
+void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, float *out_pos, size_t ps,
+                  float *out_nrm, size_t ns)
+{
+	for (size_t v = 0; v < n; v++) {
+		const float *q = pos + 3 * v;
+		float *o = (float *)((char *)out_pos + v * ps);
+		for (int r = 0; r < 3; r++)
+			o[r] = M[r] * q[0] + M[4 + r] * q[1] + M[8 + r] * q[2] + M[12 + r];
+		if (out_nrm) {
+			float *on = (float *)((char *)out_nrm + v * ns);
+			if (!nrm) {
+				on[0] = on[1] = on[2] = 0.0f;
+				continue;
+			}
+			const float *nn = nrm + 3 * v;
+			float len2 = 0.0f;
+			for (int r = 0; r < 3; r++) {
+				on[r] = M[r] * nn[0] + M[4 + r] * nn[1] + M[8 + r] * nn[2];
+				len2 += on[r] * on[r];
+			}
+			const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
+			for (int r = 0; r < 3; r++)
+				on[r] *= il;
+		}
+	}
+}
+#endif
