@@ -24,6 +24,19 @@
 
 #include "rt_internal.h"
 
+/* GCC on x86-64 Linux: the two kernels (mlod_rt_skin_lbs, rt_transform)
+ * are also built for AVX2 and picked at load by the CPU (an ifunc). Their
+ * source and so their operations are the same: the VEX encoding only
+ * saves register copies (no FMA: -std=c11 does not contract, and AVX2
+ * does not bring FMA), so the floats are the same. -DMLOD_RT_NO_CLONES
+ * turns it off. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
+	!defined(MLOD_RT_NO_CLONES) && !defined(MLOD_RT_NO_VECTOR_EXT)
+#define RT_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RT_CLONES
+#endif
+
 #if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
 /* GCC and Clang: 4-lane vectors (SSE, NEON), one matrix column per vector,
  * written with the compilers' vector extension; the same arithmetic, in
@@ -150,10 +163,10 @@ static inline __attribute__((always_inline)) void lbs_run(const int N, size_t v0
 		normalise_run(v1 - v0, tn, (float *)((char *)out_nrm + v0 * nrm_stride), nrm_stride);
 }
 
-void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const float *restrict normals,
-                      const uint16_t *restrict joints, const float *restrict weights,
-                      const float *restrict palette, float *restrict out_pos, size_t pos_stride,
-                      float *restrict out_nrm, size_t nrm_stride)
+RT_CLONES void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const float *restrict normals,
+                                const uint16_t *restrict joints, const float *restrict weights,
+                                const float *restrict palette, float *restrict out_pos, size_t pos_stride,
+                                float *restrict out_nrm, size_t nrm_stride)
 {
 	for (size_t v0 = 0; v0 < n; v0 += RT_RUN) {
 		const size_t v1 = n - v0 < RT_RUN ? n : v0 + RT_RUN;
@@ -306,8 +319,8 @@ static inline void store_xyz4(float *restrict out, size_t stride, __m128 x, __m1
  * vector): per lane the one-by-one loop's operations in its order, so the
  * same floats; the normals' 1 / sqrt four at a time (SSE2's square root
  * and division are IEEE's, as sqrtf and / are). */
-void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
-                  float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
+RT_CLONES void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
+                            float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
 {
 	const size_t n4 = n & ~(size_t)3;
 	__m128 m[16];
