@@ -24,12 +24,12 @@
 
 #include "rt_internal.h"
 
-/* GCC on x86-64 Linux: the two kernels (mlod_rt_skin_lbs, rt_transform)
- * are also built for AVX2 and picked at load by the CPU (an ifunc). Their
- * source and so their operations are the same: the VEX encoding only
- * saves register copies (no FMA: -std=c11 does not contract, and AVX2
- * does not bring FMA), so the floats are the same. -DMLOD_RT_NO_CLONES
- * turns it off. */
+/* GCC on x86-64 Linux: mlod_rt_skin_lbs is also built for AVX2 and picked
+ * at load by the CPU (an ifunc). The source and so the operations are the
+ * same: the VEX encoding only saves register copies (no FMA: -std=c11
+ * does not contract, and AVX2 does not bring FMA), so the floats are the
+ * same; 5% off the tubeman's far instances. -DMLOD_RT_NO_CLONES turns it
+ * off. (rt_transform has its own 8-wide AVX loop, below.) */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
 	!defined(MLOD_RT_NO_CLONES) && !defined(MLOD_RT_NO_VECTOR_EXT)
 #define RT_CLONES __attribute__((target_clones("avx2", "default")))
