@@ -19,6 +19,7 @@
  * and in a fixed order, so deterministic. A mesh can be kept with its
  * hierarchy (mlod_surface, surface.h) and measured against many others. */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -46,6 +47,8 @@ typedef struct bvh {
 	tri *tris;  /* in leaf order */
 	int *order; /* the mesh's triangle at each place of tris */
 	int *place; /* the place in tris of each of the mesh's triangles */
+	int *parent; /* each node's parent (the root's: -1) */
+	int *leaf;   /* the leaf holding each place of tris */
 	int tri_count;
 } bvh;
 
@@ -211,6 +214,8 @@ static void build_node(builder *b, int index, int lo, int hi)
 			n->lo[a] = lo3[a], n->hi[a] = hi3[a];
 		n->first = lo;
 		n->count = hi - lo;
+		for (int k = lo; k < hi; k++)
+			b->out->leaf[k] = index;
 		return;
 	}
 	for (int k = lo; k < hi; k++)
@@ -227,6 +232,7 @@ static void build_node(builder *b, int index, int lo, int hi)
 	select_nth(b, lo, hi, mid, axis);
 	int left = b->out->node_count;
 	b->out->node_count += 2;
+	b->out->parent[left] = b->out->parent[left + 1] = index;
 	build_node(b, left, lo, mid);
 	build_node(b, left + 1, mid, hi);
 	n = &b->out->nodes[index];
@@ -247,9 +253,11 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 	out->tris = malloc((size_t)n * sizeof *out->tris);
 	out->order = malloc((size_t)n * sizeof *out->order);
 	out->place = malloc((size_t)n * sizeof *out->place);
+	out->parent = malloc((size_t)2 * n * sizeof *out->parent);
+	out->leaf = malloc((size_t)n * sizeof *out->leaf);
 	out->node_count = 1;
 	out->tri_count = n;
-	if (!b.items || !out->nodes || !out->tris || !out->order || !out->place) {
+	if (!b.items || !out->nodes || !out->tris || !out->order || !out->place || !out->parent || !out->leaf) {
 		free(b.items);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", n);
 	}
@@ -260,6 +268,7 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 			b.items[t].c[a] = (m->positions[3 * (size_t)ix[0] + a] + m->positions[3 * (size_t)ix[1] + a] +
 			                   m->positions[3 * (size_t)ix[2] + a]) / 3.0f;
 	}
+	out->parent[0] = -1;
 	build_node(&b, 0, 0, n);
 	node *fit = realloc(out->nodes, (size_t)out->node_count * sizeof *out->nodes);
 	if (fit)
@@ -293,6 +302,8 @@ static void bvh_free(bvh *b)
 	free(b->tris);
 	free(b->order);
 	free(b->place);
+	free(b->parent);
+	free(b->leaf);
 }
 
 /* Squared distance from p to the node's box: p less its clamp to the box
@@ -322,16 +333,15 @@ static double plane_dist2(const double *p, const tri *t)
 	return d > 0.0 ? d * d : 0.0;
 }
 
-/* Squared distance from p to the nearest triangle. *hint is a triangle to
- * start from (updated to the nearest one), which makes neighbouring
- * queries cheap. */
-static double bvh_nearest2(const bvh *b, const double *p, int *hint)
+/* The nearest triangle in the subtree at node at (at_d2: p's squared
+ * distance to its box) if nearer than best: searched nearer child first,
+ * pruned by box distance, a leaf's triangle skipped when its plane is
+ * already farther than the best, or when it is skip. */
+static double subtree_nearest2(const bvh *b, const double *p, int at, double at_d2, double best, int skip,
+                               int *hint)
 {
-	const int start = *hint; /* measured here, so skipped in its leaf */
-	double best = triangle_dist2(p, &b->tris[start]);
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
-	int top = 0, at = 0;
-	double at_d2 = box_dist2(p, &b->nodes[0]);
+	int top = 0;
 	for (;;) {
 		const node *n = &b->nodes[at];
 		if (at_d2 < best && n->count == 0) {
@@ -347,16 +357,38 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 		}
 		if (at_d2 < best)
 			for (int k = n->first; k < n->first + n->count; k++) {
-				if (k == start || plane_dist2(p, &b->tris[k]) >= best)
-					continue; /* measured first, or its plane is already farther than the best */
+				if (k == skip || plane_dist2(p, &b->tris[k]) >= best)
+					continue;
 				double d = triangle_dist2(p, &b->tris[k]);
 				if (d < best)
 					best = d, *hint = k;
 			}
 		if (top == 0)
-			break;
+			return best;
 		--top;
 		at = stack[top].node, at_d2 = stack[top].d2;
+	}
+}
+
+/* Squared distance from p to the nearest triangle. *hint is a triangle to
+ * start from (updated to the nearest one), which makes neighbouring
+ * queries cheap. The search goes up from the hint's leaf: its other
+ * triangles, then at each ancestor the other child's subtree (pruned by
+ * its box when no nearer than the best so far). The leaf and those
+ * subtrees make the whole tree, so the result is the nearest, as from the
+ * root down; starting next to the answer, it tests about one box per
+ * level instead of two per level and more. */
+static double bvh_nearest2(const bvh *b, const double *p, int *hint)
+{
+	const int start = *hint; /* measured here, so skipped in its leaf */
+	double best = triangle_dist2(p, &b->tris[start]);
+	int at = b->leaf[start];
+	best = subtree_nearest2(b, p, at, 0.0, best, start, hint);
+	for (int up = b->parent[at]; up >= 0; at = up, up = b->parent[up]) {
+		int other = b->nodes[up].first == at ? at + 1 : at - 1;
+		double d2 = box_dist2(p, &b->nodes[other]);
+		if (d2 < best)
+			best = subtree_nearest2(b, p, other, d2, best, -1, hint);
 	}
 	return best;
 }
@@ -441,6 +473,103 @@ static mlod_result measure(const mlod_posed *from, const bvh *from_bvh, const bv
 	return MLOD_OK;
 }
 
+/* Triangle t of m, as the hierarchy keeps it (without its normal). */
+static void mesh_tri(const mlod_posed *m, int t, tri *out)
+{
+	const uint32_t *ix = m->indices + 3 * (size_t)t;
+	for (int a = 0; a < 3; a++) {
+		out->a[a] = m->positions[3 * (size_t)ix[0] + a];
+		out->b[a] = m->positions[3 * (size_t)ix[1] + a];
+		out->c[a] = m->positions[3 * (size_t)ix[2] + a];
+	}
+	out->degenerate = is_degenerate(out);
+}
+
+/* A mesh measured against, with its hierarchy built when first needed
+ * (under lock when there is one: a kept surface, shared by calls). */
+typedef struct target {
+	const mlod_posed *mesh;
+	bvh *tree;
+	int *built;
+	pthread_mutex_t *lock;
+} target;
+
+static mlod_result target_tree(const target *t, const bvh **out, mlod_error *err)
+{
+	mlod_result r = MLOD_OK;
+	if (t->lock)
+		pthread_mutex_lock(t->lock);
+	if (!*t->built) {
+		if ((r = bvh_build(t->mesh, t->tree, err)) == MLOD_OK)
+			*t->built = 1;
+		else {
+			bvh_free(t->tree); /* what was allocated before the failure */
+			memset(t->tree, 0, sizeof *t->tree);
+		}
+	}
+	if (t->lock)
+		pthread_mutex_unlock(t->lock);
+	*out = t->tree;
+	return r;
+}
+
+/* measure's bounded form (mlod_warm's bound): from's samples in the mesh's
+ * order, each counted with its distance to its warm triangle unless that
+ * may exceed the largest distance known (*top, at least the floor), when
+ * it is searched (from the warm triangle) and *top follows. */
+static mlod_result measure_bound(const mlod_posed *from, const target *onto, const int *warm, double *top,
+                                 double *sum, double *max, long *count, mlod_error *err)
+{
+	const bvh *to = NULL;
+	const int tris = onto->mesh->triangle_count;
+	unsigned char *used = calloc((size_t)from->vertex_count, 1);
+	if (!used)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %d marks", from->vertex_count);
+	for (long k = 0; k < 3L * from->triangle_count; k++)
+		used[from->indices[k]] = 1;
+	double s = *sum, m = *max, t = *top;
+	long n = *count;
+	int hint = 0;
+	for (long i = 0; i < (long)from->vertex_count + from->triangle_count; i++) {
+		double p[3];
+		if (i < from->vertex_count) {
+			if (!used[i])
+				continue; /* not on the surface */
+			for (int a = 0; a < 3; a++)
+				p[a] = from->positions[3 * (size_t)i + a];
+		} else {
+			const uint32_t *ix = from->indices + 3 * (size_t)(i - from->vertex_count);
+			for (int a = 0; a < 3; a++)
+				p[a] = ((double)from->positions[3 * (size_t)ix[0] + a] + from->positions[3 * (size_t)ix[1] + a] +
+				        from->positions[3 * (size_t)ix[2] + a]) / 3.0;
+		}
+		double d = INFINITY;
+		int w = warm[i];
+		if ((unsigned)w < (unsigned)tris) {
+			tri near;
+			mesh_tri(onto->mesh, w, &near);
+			d = sqrt(triangle_dist2(p, &near));
+		}
+		if (d > t) { /* it may raise the max: searched */
+			mlod_result r;
+			if (!to && (r = target_tree(onto, &to, err)) != MLOD_OK) {
+				free(used);
+				return r;
+			}
+			if ((unsigned)w < (unsigned)tris)
+				hint = to->place[w];
+			d = sqrt(bvh_nearest2(to, p, &hint));
+		}
+		t = d > t ? d : t;
+		s += d;
+		m = d > m ? d : m;
+		n++;
+	}
+	*sum = s, *max = m, *top = t, *count = n;
+	free(used);
+	return MLOD_OK;
+}
+
 /* Diagonal of the bounding box of the vertices a's triangles use. */
 static double diagonal(const mlod_posed *m)
 {
@@ -456,18 +585,33 @@ static double diagonal(const mlod_posed *m)
 }
 
 /* Adds both directions between a (with its hierarchy ta) and b. */
-static mlod_result both_ways(const mlod_posed *a, const bvh *ta, const mlod_posed *b, double diag,
-                             const mlod_warm *warm, mlod_deviation *out, mlod_error *err)
+static mlod_result both_ways(const target *ta, const mlod_posed *b, double diag, mlod_warm *warm,
+                             mlod_deviation *out, mlod_error *err)
 {
 	bvh tb = { 0 };
+	int b_built = 0;
+	const target onto_b = { b, &tb, &b_built, NULL };
+	const mlod_posed *a = ta->mesh;
+	const bvh *tree_a, *tree_b;
 	double sum = 0.0, max = 0.0;
 	long count = 0;
 	mlod_result r;
 	const int *wa = warm && !warm->record ? warm->a : NULL, *wb = warm && !warm->record ? warm->b : NULL;
 	int *na = warm && warm->record ? warm->a : NULL, *nb = warm && warm->record ? warm->b : NULL;
-	if (!(r = bvh_build(b, &tb, err)) && !(r = measure(a, ta, &tb, wa, na, &sum, &max, &count, err)))
-		r = measure(b, &tb, ta, wb, nb, &sum, &max, &count, err);
-	bvh_free(&tb);
+	if (warm && warm->bound && !warm->record) {
+		/* the recording pose's max, as a fraction of the diagonal there, in
+		 * this pose's units, a little less so that rounding cannot let a
+		 * bound past it; the hierarchies built only if a sample is searched */
+		double top = warm->floor * diag * (1.0 - 1e-12);
+		if (!(r = measure_bound(a, &onto_b, warm->a, &top, &sum, &max, &count, err)))
+			r = measure_bound(b, ta, warm->b, &top, &sum, &max, &count, err);
+	} else if (!(r = target_tree(ta, &tree_a, err)) && !(r = target_tree(&onto_b, &tree_b, err)) &&
+	           !(r = measure(a, tree_a, tree_b, wa, na, &sum, &max, &count, err)))
+		r = measure(b, tree_b, tree_a, wb, nb, &sum, &max, &count, err);
+	if (!r && warm && warm->record)
+		warm->floor = max / diag;
+	if (b_built)
+		bvh_free(&tb);
 	if (r)
 		return r;
 	out->mean = 100.0 * sum / (double)count / diag;
@@ -488,9 +632,11 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 	if (!(diag > 0.0))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	bvh ta = { 0 };
-	if (!(r = bvh_build(a, &ta, err)))
-		r = both_ways(a, &ta, b, diag, NULL, out, err);
-	bvh_free(&ta);
+	int built = 0;
+	const target onto_a = { a, &ta, &built, NULL };
+	r = both_ways(&onto_a, b, diag, NULL, out, err);
+	if (built)
+		bvh_free(&ta);
 	return r;
 }
 
@@ -500,7 +646,9 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 
 struct mlod_surface {
 	mlod_posed mesh;
-	bvh tree;
+	bvh tree;   /* built when first searched (target_tree) */
+	int built;
+	pthread_mutex_t lock;
 	double diag;
 };
 
@@ -514,6 +662,10 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 	if (!(diag > 0.0))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	mlod_surface *s = calloc(1, sizeof *s);
+	if (s && pthread_mutex_init(&s->lock, NULL) != 0) {
+		free(s);
+		s = NULL;
+	}
 	size_t pos = 3 * (size_t)m->vertex_count * sizeof *m->positions, ind = 3 * (size_t)m->triangle_count * sizeof *m->indices;
 	if (!s || !(s->mesh.positions = malloc(pos)) || !(s->mesh.indices = malloc(ind))) {
 		mlod_surface_free(s);
@@ -524,10 +676,6 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 	s->mesh.vertex_count = m->vertex_count;
 	s->mesh.triangle_count = m->triangle_count;
 	s->diag = diag;
-	if ((r = bvh_build(&s->mesh, &s->tree, err))) {
-		mlod_surface_free(s);
-		return r;
-	}
 	*out = s;
 	return MLOD_OK;
 }
@@ -536,7 +684,9 @@ void mlod_surface_free(mlod_surface *s)
 {
 	if (!s)
 		return;
-	bvh_free(&s->tree);
+	if (s->built)
+		bvh_free(&s->tree);
+	pthread_mutex_destroy(&s->lock);
 	mlod_posed_free(&s->mesh);
 	free(s);
 }
@@ -548,7 +698,7 @@ int mlod_surface_is(const mlod_surface *s, const mlod_posed *m)
 	       !memcmp(s->mesh.indices, m->indices, 3 * (size_t)m->triangle_count * sizeof *m->indices);
 }
 
-mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, const mlod_warm *warm,
+mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, mlod_warm *warm,
                                       mlod_deviation *out, mlod_error *err)
 {
 	mlod_result r;
@@ -559,5 +709,7 @@ mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b
 	if (warm && (warm->a_count != a->mesh.vertex_count + a->mesh.triangle_count ||
 	             warm->b_count != b->vertex_count + b->triangle_count))
 		warm = NULL; /* made for other meshes: measured without */
-	return both_ways(&a->mesh, &a->tree, b, a->diag, warm, out, err);
+	mlod_surface *s = (mlod_surface *)a; /* only its lazily built hierarchy changes, under its lock */
+	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock };
+	return both_ways(&onto_a, b, a->diag, warm, out, err);
 }

@@ -386,7 +386,7 @@ TEST(warm_starts_same_bits)
 		wa[i] = -7;
 	for (int i = 0; i < nb; i++)
 		wb[i] = -7;
-	mlod_warm rec = { wa, wb, na, nb, 1 };
+	mlod_warm rec = { wa, wb, na, nb, 1, 0, 0.0 };
 	mlod_deviation cold, d;
 	CHECK_OK(mlod_surface_deviation(&a, &b, &cold, &terr));
 	CHECK_OK(mlod_surface_deviation_to(s, &b, &rec, &d, &terr));
@@ -401,7 +401,7 @@ TEST(warm_starts_same_bits)
 	mlod_posed b2 = copy_translated(&b, 0.03f, -0.02f, 0.05f);
 	for (int i = 0; i < 3 * b2.vertex_count; i++)
 		b2.positions[i] += (float)rnd(-0.02, 0.02);
-	mlod_warm use = { wa, wb, na, nb, 0 };
+	mlod_warm use = { wa, wb, na, nb, 0, 0, 0.0 };
 	CHECK_OK(mlod_surface_deviation(&a, &b2, &cold, &terr));
 	CHECK_OK(mlod_surface_deviation_to(s, &b2, &use, &d, &terr));
 	CHECK(same_deviation(&cold, &d));
@@ -415,7 +415,7 @@ TEST(warm_starts_same_bits)
 	CHECK_OK(mlod_surface_deviation_to(s, &b2, &use, &d, &terr));
 	CHECK(same_deviation(&cold, &d));
 	/* made for meshes of other sizes */
-	mlod_warm other = { wa, wb, na - 1, nb, 0 };
+	mlod_warm other = { wa, wb, na - 1, nb, 0, 0, 0.0 };
 	CHECK_OK(mlod_surface_deviation_to(s, &b2, &other, &d, &terr));
 	CHECK(same_deviation(&cold, &d));
 	free(wa);
