@@ -41,7 +41,7 @@ typedef struct tri {
 	int degenerate;
 } tri;
 
-typedef struct bvh {
+struct mlod_bvh {
 	node *nodes;
 	int node_count;
 	tri *tris;  /* in leaf order */
@@ -50,7 +50,9 @@ typedef struct bvh {
 	int *parent; /* each node's parent (the root's: -1) */
 	int *leaf;   /* the leaf holding each place of tris */
 	int tri_count;
-} bvh;
+	int borrowed; /* order, place, parent and leaf belong to the tree this one was refitted from */
+};
+typedef struct mlod_bvh bvh;
 
 /* ---------------------------------------------------------------- */
 /* Point-triangle distance                                           */
@@ -245,6 +247,8 @@ static void build_node(builder *b, int index, int lo, int hi)
 	n->count = 0;
 }
 
+static void fill_tris(const mlod_posed *m, bvh *out);
+
 static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 {
 	int n = m->triangle_count;
@@ -276,6 +280,16 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 	for (int k = 0; k < n; k++) {
 		out->order[k] = b.items[k].t;
 		out->place[out->order[k]] = k;
+	}
+	free(b.items);
+	fill_tris(m, out);
+	return MLOD_OK;
+}
+
+/* The triangles of m in the tree's leaf order, with their normals. */
+static void fill_tris(const mlod_posed *m, bvh *out)
+{
+	for (int k = 0; k < out->tri_count; k++) {
 		const uint32_t *ix = m->indices + 3 * (size_t)out->order[k];
 		tri *t = &out->tris[k];
 		for (int a = 0; a < 3; a++) {
@@ -292,7 +306,44 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 		for (int a = 0; a < 3; a++)
 			t->n[a] = t->degenerate || !(len > 0.0) ? 0.0 : nn[a] / len;
 	}
-	free(b.items);
+}
+
+/* A hierarchy of the same mesh at another pose (the same triangles, other
+ * positions): from's tree and order, its boxes fitted again bottom-up
+ * (children come after their parent). Looser than one built there, it
+ * costs a search a little more, a build far more; a search's result does
+ * not depend on the tree. */
+static mlod_result bvh_refit(const bvh *from, const mlod_posed *m, bvh *out, mlod_error *err)
+{
+	memset(out, 0, sizeof *out);
+	out->nodes = malloc((size_t)from->node_count * sizeof *out->nodes);
+	out->tris = malloc((size_t)from->tri_count * sizeof *out->tris);
+	out->borrowed = 1;
+	if (!out->nodes || !out->tris)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", from->tri_count);
+	out->node_count = from->node_count;
+	out->tri_count = from->tri_count;
+	out->order = from->order, out->place = from->place, out->parent = from->parent, out->leaf = from->leaf;
+	fill_tris(m, out);
+	for (int i = out->node_count - 1; i >= 0; i--) {
+		node *n = &out->nodes[i];
+		n->first = from->nodes[i].first, n->count = from->nodes[i].count;
+		for (int a = 0; a < 3; a++)
+			n->lo[a] = INFINITY, n->hi[a] = -INFINITY;
+		if (n->count > 0)
+			for (int k = n->first; k < n->first + n->count; k++) {
+				const tri *t = &out->tris[k];
+				for (int a = 0; a < 3; a++) {
+					n->lo[a] = fmin(n->lo[a], fmin(t->a[a], fmin(t->b[a], t->c[a])));
+					n->hi[a] = fmax(n->hi[a], fmax(t->a[a], fmax(t->b[a], t->c[a])));
+				}
+			}
+		else
+			for (int a = 0; a < 3; a++) {
+				n->lo[a] = fmin(out->nodes[n->first].lo[a], out->nodes[n->first + 1].lo[a]);
+				n->hi[a] = fmax(out->nodes[n->first].hi[a], out->nodes[n->first + 1].hi[a]);
+			}
+	}
 	return MLOD_OK;
 }
 
@@ -300,10 +351,12 @@ static void bvh_free(bvh *b)
 {
 	free(b->nodes);
 	free(b->tris);
-	free(b->order);
-	free(b->place);
-	free(b->parent);
-	free(b->leaf);
+	if (!b->borrowed) {
+		free(b->order);
+		free(b->place);
+		free(b->parent);
+		free(b->leaf);
+	}
 }
 
 /* Squared distance from p to the node's box: p less its clamp to the box
@@ -492,6 +545,7 @@ typedef struct target {
 	bvh *tree;
 	int *built;
 	pthread_mutex_t *lock;
+	const bvh *like; /* the same triangles' tree at another pose, refitted (NULL: built) */
 } target;
 
 static mlod_result target_tree(const target *t, const bvh **out, mlod_error *err)
@@ -500,7 +554,11 @@ static mlod_result target_tree(const target *t, const bvh **out, mlod_error *err
 	if (t->lock)
 		pthread_mutex_lock(t->lock);
 	if (!*t->built) {
-		if ((r = bvh_build(t->mesh, t->tree, err)) == MLOD_OK)
+		if (t->like && t->like->tri_count == t->mesh->triangle_count)
+			r = bvh_refit(t->like, t->mesh, t->tree, err);
+		else
+			r = bvh_build(t->mesh, t->tree, err);
+		if (r == MLOD_OK)
 			*t->built = 1;
 		else {
 			bvh_free(t->tree); /* what was allocated before the failure */
@@ -513,61 +571,158 @@ static mlod_result target_tree(const target *t, const bvh **out, mlod_error *err
 	return r;
 }
 
-/* measure's bounded form (mlod_warm's bound): from's samples in the mesh's
- * order, each counted with its distance to its warm triangle unless that
- * may exceed the largest distance known (*top, at least the floor), when
- * it is searched (from the warm triangle) and *top follows. */
-static mlod_result measure_bound(const mlod_posed *from, const target *onto, const int *warm, double *top,
-                                 double *sum, double *max, long *count, mlod_error *err)
+/* The sample at place i of from (its vertices, then its triangles'
+ * centroids); 0 for a vertex no triangle uses (not on the surface). */
+static int sample_at(const mlod_posed *from, const unsigned char *used, long i, double *p)
 {
-	const bvh *to = NULL;
-	const int tris = onto->mesh->triangle_count;
-	unsigned char *used = calloc((size_t)from->vertex_count, 1);
-	if (!used)
-		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %d marks", from->vertex_count);
-	for (long k = 0; k < 3L * from->triangle_count; k++)
-		used[from->indices[k]] = 1;
-	double s = *sum, m = *max, t = *top;
-	long n = *count;
-	int hint = 0;
+	if (i < from->vertex_count) {
+		if (!used[i])
+			return 0;
+		for (int a = 0; a < 3; a++)
+			p[a] = from->positions[3 * (size_t)i + a];
+		return 1;
+	}
+	const uint32_t *ix = from->indices + 3 * (size_t)(i - from->vertex_count);
+	for (int a = 0; a < 3; a++)
+		p[a] = ((double)from->positions[3 * (size_t)ix[0] + a] + from->positions[3 * (size_t)ix[1] + a] +
+		        from->positions[3 * (size_t)ix[2] + a]) / 3.0;
+	return 1;
+}
+
+/* One way of measure's bounded form (mlod_warm's bound): each sample's
+ * distance to its warm triangle in dist (-1: not a sample, INFINITY: no
+ * warm triangle), from's vertices then its triangles. */
+static void bound_distances(const mlod_posed *from, const unsigned char *used, const mlod_posed *onto,
+                            const int *warm, double *dist)
+{
 	for (long i = 0; i < (long)from->vertex_count + from->triangle_count; i++) {
 		double p[3];
-		if (i < from->vertex_count) {
-			if (!used[i])
-				continue; /* not on the surface */
-			for (int a = 0; a < 3; a++)
-				p[a] = from->positions[3 * (size_t)i + a];
-		} else {
-			const uint32_t *ix = from->indices + 3 * (size_t)(i - from->vertex_count);
-			for (int a = 0; a < 3; a++)
-				p[a] = ((double)from->positions[3 * (size_t)ix[0] + a] + from->positions[3 * (size_t)ix[1] + a] +
-				        from->positions[3 * (size_t)ix[2] + a]) / 3.0;
+		if (!sample_at(from, used, i, p)) {
+			dist[i] = -1.0;
+			continue;
 		}
-		double d = INFINITY;
-		int w = warm[i];
-		if ((unsigned)w < (unsigned)tris) {
+		dist[i] = INFINITY;
+		if ((unsigned)warm[i] < (unsigned)onto->triangle_count) {
 			tri near;
-			mesh_tri(onto->mesh, w, &near);
-			d = sqrt(triangle_dist2(p, &near));
+			mesh_tri(onto, warm[i], &near);
+			dist[i] = sqrt(triangle_dist2(p, &near));
 		}
-		if (d > t) { /* it may raise the max: searched */
-			mlod_result r;
-			if (!to && (r = target_tree(onto, &to, err)) != MLOD_OK) {
-				free(used);
-				return r;
-			}
-			if ((unsigned)w < (unsigned)tris)
-				hint = to->place[w];
-			d = sqrt(bvh_nearest2(to, p, &hint));
-		}
-		t = d > t ? d : t;
-		s += d;
-		m = d > m ? d : m;
-		n++;
 	}
-	*sum = s, *max = m, *top = t, *count = n;
-	free(used);
+}
+
+/* A sample whose bound may raise the max. */
+typedef struct candidate {
+	double bound;
+	int way; /* 0: a's sample on b, 1: b's on a */
+	int i;
+} candidate;
+
+static int by_bound(const void *x, const void *y)
+{
+	const candidate *u = x, *v = y;
+	if (u->bound != v->bound)
+		return u->bound > v->bound ? -1 : 1;
+	return u->way != v->way ? u->way - v->way : u->i - v->i;
+}
+
+/* Searches of a target before its hierarchy is built: each looks at every
+ * triangle, which costs less than a build for a few. */
+#define BRUTE_SEARCHES 0
+
+/* Squared distance from p to the nearest triangle of the target, the
+ * same bits as bvh_nearest2: by looking at every triangle for the first
+ * few searches, through the hierarchy after. */
+static mlod_result target_nearest2(const target *t, int *searches, const double *p, int warm, double *d2,
+                                   mlod_error *err)
+{
+	const int tris = t->mesh->triangle_count;
+	if (++*searches <= BRUTE_SEARCHES) {
+		double best = INFINITY;
+		for (int k = 0; k < tris; k++) {
+			tri x;
+			mesh_tri(t->mesh, k, &x);
+			double d = triangle_dist2(p, &x);
+			best = d < best ? d : best;
+		}
+		*d2 = best;
+		return MLOD_OK;
+	}
+	const bvh *tree;
+	mlod_result r = target_tree(t, &tree, err);
+	if (r != MLOD_OK)
+		return r;
+	int hint = (unsigned)warm < (unsigned)tris ? tree->place[warm] : 0;
+	*d2 = bvh_nearest2(tree, p, &hint);
 	return MLOD_OK;
+}
+
+/* measure's bounded form (mlod_warm's bound), both ways: every sample's
+ * distance to its warm triangle first; then the samples whose bound
+ * exceeds *top (the floor in this pose's units) searched, largest bound
+ * first, *top following the largest distance found, until the next bound
+ * is no more than *top: none of the rest can raise the max. The sums then
+ * in the mesh's order, a's samples then b's, as measure's. */
+static mlod_result measure_bound(const target *ta, const target *tb, const mlod_warm *warm, double top, double *sum,
+                                 double *max, long *count, mlod_error *err)
+{
+	const mlod_posed *m[2] = { ta->mesh, tb->mesh };
+	const target *onto[2] = { tb, ta };
+	const int *w[2] = { warm->a, warm->b };
+	long n[2] = { (long)m[0]->vertex_count + m[0]->triangle_count, (long)m[1]->vertex_count + m[1]->triangle_count };
+	unsigned char *used[2] = { calloc((size_t)m[0]->vertex_count, 1), calloc((size_t)m[1]->vertex_count, 1) };
+	double *dist[2] = { malloc(sizeof(double) * (size_t)n[0]), malloc(sizeof(double) * (size_t)n[1]) };
+	candidate *c = NULL;
+	mlod_result r = MLOD_OK;
+	if (!used[0] || !used[1] || !dist[0] || !dist[1]) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %ld distances", n[0] + n[1]);
+		goto done;
+	}
+	long candidates = 0;
+	for (int way = 0; way < 2; way++) {
+		for (long k = 0; k < 3L * m[way]->triangle_count; k++)
+			used[way][m[way]->indices[k]] = 1;
+		bound_distances(m[way], used[way], onto[way]->mesh, w[way], dist[way]);
+		for (long i = 0; i < n[way]; i++)
+			candidates += dist[way][i] > top;
+	}
+	if (candidates > 0 && !(c = malloc(sizeof *c * (size_t)candidates))) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %ld candidates", candidates);
+		goto done;
+	}
+	candidates = 0;
+	for (int way = 0; way < 2; way++)
+		for (long i = 0; i < n[way]; i++)
+			if (dist[way][i] > top)
+				c[candidates].bound = dist[way][i], c[candidates].way = way, c[candidates++].i = (int)i;
+	if (candidates > 1)
+		qsort(c, (size_t)candidates, sizeof *c, by_bound);
+	int searches[2] = { 0, 0 };
+	for (long k = 0; k < candidates && c[k].bound > top; k++) {
+		int way = c[k].way, i = c[k].i;
+		double p[3], d2;
+		sample_at(m[way], used[way], i, p);
+		if ((r = target_nearest2(onto[way], &searches[way], p, w[way][i], &d2, err)) != MLOD_OK)
+			goto done;
+		dist[way][i] = sqrt(d2);
+		top = dist[way][i] > top ? dist[way][i] : top;
+	}
+	double s = *sum, mx = *max;
+	long cnt = *count;
+	for (int way = 0; way < 2; way++)
+		for (long i = 0; i < n[way]; i++)
+			if (dist[way][i] >= 0.0) {
+				s += dist[way][i];
+				mx = dist[way][i] > mx ? dist[way][i] : mx;
+				cnt++;
+			}
+	*sum = s, *max = mx, *count = cnt;
+done:
+	free(used[0]);
+	free(used[1]);
+	free(dist[0]);
+	free(dist[1]);
+	free(c);
+	return r;
 }
 
 /* Diagonal of the bounding box of the vertices a's triangles use. */
@@ -590,7 +745,7 @@ static mlod_result both_ways(const target *ta, const mlod_posed *b, double diag,
 {
 	bvh tb = { 0 };
 	int b_built = 0;
-	const target onto_b = { b, &tb, &b_built, NULL };
+	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL };
 	const mlod_posed *a = ta->mesh;
 	const bvh *tree_a, *tree_b;
 	double sum = 0.0, max = 0.0;
@@ -602,15 +757,15 @@ static mlod_result both_ways(const target *ta, const mlod_posed *b, double diag,
 		/* the recording pose's max, as a fraction of the diagonal there, in
 		 * this pose's units, a little less so that rounding cannot let a
 		 * bound past it; the hierarchies built only if a sample is searched */
-		double top = warm->floor * diag * (1.0 - 1e-12);
-		if (!(r = measure_bound(a, &onto_b, warm->a, &top, &sum, &max, &count, err)))
-			r = measure_bound(b, ta, warm->b, &top, &sum, &max, &count, err);
+		r = measure_bound(ta, &onto_b, warm, warm->floor * diag * (1.0 - 1e-12), &sum, &max, &count, err);
 	} else if (!(r = target_tree(ta, &tree_a, err)) && !(r = target_tree(&onto_b, &tree_b, err)) &&
 	           !(r = measure(a, tree_a, tree_b, wa, na, &sum, &max, &count, err)))
 		r = measure(b, tree_b, tree_a, wb, nb, &sum, &max, &count, err);
 	if (!r && warm && warm->record)
 		warm->floor = max / diag;
-	if (b_built)
+	if (b_built && !r && warm && warm->record && !warm->b_tree && (warm->b_tree = malloc(sizeof tb)))
+		*warm->b_tree = tb; /* for the other poses to refit */
+	else if (b_built)
 		bvh_free(&tb);
 	if (r)
 		return r;
@@ -633,7 +788,7 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	bvh ta = { 0 };
 	int built = 0;
-	const target onto_a = { a, &ta, &built, NULL };
+	const target onto_a = { a, &ta, &built, NULL, NULL };
 	r = both_ways(&onto_a, b, diag, NULL, out, err);
 	if (built)
 		bvh_free(&ta);
@@ -649,6 +804,7 @@ struct mlod_surface {
 	bvh tree;   /* built when first searched (target_tree) */
 	int built;
 	pthread_mutex_t lock;
+	mlod_surface *like; /* mlod_surface_like */
 	double diag;
 };
 
@@ -678,6 +834,22 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 	s->diag = diag;
 	*out = s;
 	return MLOD_OK;
+}
+
+void mlod_surface_like(mlod_surface *s, mlod_surface *like)
+{
+	if (like && like != s && like->mesh.triangle_count == s->mesh.triangle_count &&
+	    !memcmp(like->mesh.indices, s->mesh.indices, 3 * (size_t)s->mesh.triangle_count * sizeof *s->mesh.indices))
+		s->like = like;
+}
+
+void mlod_warm_release(mlod_warm *w)
+{
+	if (w && w->b_tree) {
+		bvh_free(w->b_tree);
+		free(w->b_tree);
+		w->b_tree = NULL;
+	}
 }
 
 void mlod_surface_free(mlod_surface *s)
@@ -710,6 +882,12 @@ mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b
 	             warm->b_count != b->vertex_count + b->triangle_count))
 		warm = NULL; /* made for other meshes: measured without */
 	mlod_surface *s = (mlod_surface *)a; /* only its lazily built hierarchy changes, under its lock */
-	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock };
+	const bvh *like = NULL;
+	if (s->like) {
+		pthread_mutex_lock(&s->like->lock);
+		like = s->like->built ? &s->like->tree : NULL;
+		pthread_mutex_unlock(&s->like->lock);
+	}
+	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like };
 	return both_ways(&onto_a, b, a->diag, warm, out, err);
 }

@@ -99,6 +99,8 @@ static const mlod_surface *cache_get(struct mlod_pose_cache *c, int k, const mlo
 		if (mlod_surface_make(a, &made, NULL) != MLOD_OK)
 			return NULL;
 		pthread_mutex_lock(&c->lock);
+		if (k > 0 && c->full[0])
+			mlod_surface_like(made, c->full[0]); /* its hierarchy refitted from pose 0's */
 		if (!c->full[k])
 			c->full[k] = made, made = NULL;
 		s = c->full[k];
@@ -292,5 +294,6 @@ mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *l
 	free(j.errs);
 	free(j.warm.a);
 	free(j.warm.b);
+	mlod_warm_release(&j.warm);
 	return r;
 }

@@ -16,6 +16,12 @@ typedef struct mlod_surface mlod_surface;
 mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_error *err);
 void mlod_surface_free(mlod_surface *s);
 
+/* s's hierarchy, when a search needs it, is then like's refitted to s's
+ * positions (built if like has none by then): like must be the same mesh
+ * at another pose, outlive s and not be freed before it; else (other
+ * triangles) nothing changes. */
+void mlod_surface_like(mlod_surface *s, mlod_surface *like);
+
 /* 1 when s holds m: the same counts, positions and indices, byte for byte. */
 int mlod_surface_is(const mlod_surface *s, const mlod_posed *m);
 
@@ -44,7 +50,13 @@ typedef struct mlod_warm {
 	 * only when a sample is searched. */
 	int bound;
 	double floor;
+	/* b's hierarchy at the recording pose, kept there (free it with
+	 * mlod_warm_release); the other poses refit it when they search b */
+	struct mlod_bvh *b_tree;
 } mlod_warm;
+
+/* Frees what a recording kept in w (not w itself). */
+void mlod_warm_release(mlod_warm *w);
 
 /* mlod_surface_deviation of a's mesh and b, the same result to the bit,
  * with warm starts when warm is not NULL (with its bound, the max only).
