@@ -334,14 +334,17 @@ static mlod_result bvh_refit(const bvh *from, const mlod_posed *m, bvh *out, mlo
 			for (int k = n->first; k < n->first + n->count; k++) {
 				const tri *t = &out->tris[k];
 				for (int a = 0; a < 3; a++) {
-					n->lo[a] = fmin(n->lo[a], fmin(t->a[a], fmin(t->b[a], t->c[a])));
-					n->hi[a] = fmax(n->hi[a], fmax(t->a[a], fmax(t->b[a], t->c[a])));
+					double lo = t->a[a] < t->b[a] ? t->a[a] : t->b[a], hi = t->a[a] > t->b[a] ? t->a[a] : t->b[a];
+					lo = t->c[a] < lo ? t->c[a] : lo, hi = t->c[a] > hi ? t->c[a] : hi;
+					n->lo[a] = lo < n->lo[a] ? lo : n->lo[a];
+					n->hi[a] = hi > n->hi[a] ? hi : n->hi[a];
 				}
 			}
 		else
 			for (int a = 0; a < 3; a++) {
-				n->lo[a] = fmin(out->nodes[n->first].lo[a], out->nodes[n->first + 1].lo[a]);
-				n->hi[a] = fmax(out->nodes[n->first].hi[a], out->nodes[n->first + 1].hi[a]);
+				const node *l = &out->nodes[n->first], *r = &out->nodes[n->first + 1];
+				n->lo[a] = l->lo[a] < r->lo[a] ? l->lo[a] : r->lo[a];
+				n->hi[a] = l->hi[a] > r->hi[a] ? l->hi[a] : r->hi[a];
 			}
 	}
 	return MLOD_OK;
