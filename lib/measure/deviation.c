@@ -5,8 +5,9 @@
  * centroids) are projected to the nearest point of the other surface.
  * Nearest points come from a bounding volume hierarchy over the target's
  * triangles (object-median splits on the longest axis, so the depth is
- * logarithmic; leaves of up to 8), searched nearer child first and pruned
- * by box distance, each query seeded with the previous sample's triangle
+ * logarithmic; leaves of up to 8), searched up from the seed triangle's
+ * leaf (each other subtree nearer child first) and pruned by box
+ * distance, each query seeded with the previous sample's triangle
  * (or, given warm starts, surface.h, with the triangle that was nearest to
  * the same sample at another pose: a tighter first bound; the search stays
  * exact, so the result does not depend on the seed);
@@ -17,7 +18,11 @@
  * method of Ericson, "Real-Time Collision Detection" (2005), 5.1.5;
  * degenerate triangles are measured as their three edges. Single-threaded
  * and in a fixed order, so deterministic. A mesh can be kept with its
- * hierarchy (mlod_surface, surface.h) and measured against many others. */
+ * hierarchy (mlod_surface, surface.h) and measured against many others.
+ * With warm starts' bound (surface.h) only the samples that may raise the
+ * max are searched, the others counted with their distance to their warm
+ * triangle; hierarchies are then built (or refitted from the same mesh's
+ * at another pose) only when a search needs them. */
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
