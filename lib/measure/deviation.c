@@ -5,8 +5,9 @@
  * centroids) are projected to the nearest point of the other surface.
  * Nearest points come from a bounding volume hierarchy over the target's
  * triangles (object-median splits on the longest axis, so the depth is
- * logarithmic; leaves of up to 8), searched nearer child first and pruned
- * by box distance, each query seeded with the previous sample's triangle
+ * logarithmic; leaves of up to 8), searched up from the seed triangle's
+ * leaf (each other subtree nearer child first) and pruned by box
+ * distance, each query seeded with the previous sample's triangle
  * (or, given warm starts, surface.h, with the triangle that was nearest to
  * the same sample at another pose: a tighter first bound; the search stays
  * exact, so the result does not depend on the seed);
@@ -17,8 +18,13 @@
  * method of Ericson, "Real-Time Collision Detection" (2005), 5.1.5;
  * degenerate triangles are measured as their three edges. Single-threaded
  * and in a fixed order, so deterministic. A mesh can be kept with its
- * hierarchy (mlod_surface, surface.h) and measured against many others. */
+ * hierarchy (mlod_surface, surface.h) and measured against many others.
+ * With warm starts' bound (surface.h) only the samples that may raise the
+ * max are searched, the others counted with their distance to their warm
+ * triangle; hierarchies are then built (or refitted from the same mesh's
+ * at another pose) only when a search needs them. */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -40,14 +46,18 @@ typedef struct tri {
 	int degenerate;
 } tri;
 
-typedef struct bvh {
+struct mlod_bvh {
 	node *nodes;
 	int node_count;
 	tri *tris;  /* in leaf order */
 	int *order; /* the mesh's triangle at each place of tris */
 	int *place; /* the place in tris of each of the mesh's triangles */
+	int *parent; /* each node's parent (the root's: -1) */
+	int *leaf;   /* the leaf holding each place of tris */
 	int tri_count;
-} bvh;
+	int borrowed; /* order, place, parent and leaf belong to the tree this one was refitted from */
+};
+typedef struct mlod_bvh bvh;
 
 /* ---------------------------------------------------------------- */
 /* Point-triangle distance                                           */
@@ -211,6 +221,8 @@ static void build_node(builder *b, int index, int lo, int hi)
 			n->lo[a] = lo3[a], n->hi[a] = hi3[a];
 		n->first = lo;
 		n->count = hi - lo;
+		for (int k = lo; k < hi; k++)
+			b->out->leaf[k] = index;
 		return;
 	}
 	for (int k = lo; k < hi; k++)
@@ -227,6 +239,7 @@ static void build_node(builder *b, int index, int lo, int hi)
 	select_nth(b, lo, hi, mid, axis);
 	int left = b->out->node_count;
 	b->out->node_count += 2;
+	b->out->parent[left] = b->out->parent[left + 1] = index;
 	build_node(b, left, lo, mid);
 	build_node(b, left + 1, mid, hi);
 	n = &b->out->nodes[index];
@@ -239,6 +252,8 @@ static void build_node(builder *b, int index, int lo, int hi)
 	n->count = 0;
 }
 
+static void fill_tris(const mlod_posed *m, bvh *out);
+
 static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 {
 	int n = m->triangle_count;
@@ -247,9 +262,11 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 	out->tris = malloc((size_t)n * sizeof *out->tris);
 	out->order = malloc((size_t)n * sizeof *out->order);
 	out->place = malloc((size_t)n * sizeof *out->place);
+	out->parent = malloc((size_t)2 * n * sizeof *out->parent);
+	out->leaf = malloc((size_t)n * sizeof *out->leaf);
 	out->node_count = 1;
 	out->tri_count = n;
-	if (!b.items || !out->nodes || !out->tris || !out->order || !out->place) {
+	if (!b.items || !out->nodes || !out->tris || !out->order || !out->place || !out->parent || !out->leaf) {
 		free(b.items);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", n);
 	}
@@ -260,6 +277,7 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 			b.items[t].c[a] = (m->positions[3 * (size_t)ix[0] + a] + m->positions[3 * (size_t)ix[1] + a] +
 			                   m->positions[3 * (size_t)ix[2] + a]) / 3.0f;
 	}
+	out->parent[0] = -1;
 	build_node(&b, 0, 0, n);
 	node *fit = realloc(out->nodes, (size_t)out->node_count * sizeof *out->nodes);
 	if (fit)
@@ -267,6 +285,16 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 	for (int k = 0; k < n; k++) {
 		out->order[k] = b.items[k].t;
 		out->place[out->order[k]] = k;
+	}
+	free(b.items);
+	fill_tris(m, out);
+	return MLOD_OK;
+}
+
+/* The triangles of m in the tree's leaf order, with their normals. */
+static void fill_tris(const mlod_posed *m, bvh *out)
+{
+	for (int k = 0; k < out->tri_count; k++) {
 		const uint32_t *ix = m->indices + 3 * (size_t)out->order[k];
 		tri *t = &out->tris[k];
 		for (int a = 0; a < 3; a++) {
@@ -283,7 +311,47 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 		for (int a = 0; a < 3; a++)
 			t->n[a] = t->degenerate || !(len > 0.0) ? 0.0 : nn[a] / len;
 	}
-	free(b.items);
+}
+
+/* A hierarchy of the same mesh at another pose (the same triangles, other
+ * positions): from's tree and order, its boxes fitted again bottom-up
+ * (children come after their parent). Looser than one built there, it
+ * costs a search a little more, a build far more; a search's result does
+ * not depend on the tree. */
+static mlod_result bvh_refit(const bvh *from, const mlod_posed *m, bvh *out, mlod_error *err)
+{
+	memset(out, 0, sizeof *out);
+	out->nodes = malloc((size_t)from->node_count * sizeof *out->nodes);
+	out->tris = malloc((size_t)from->tri_count * sizeof *out->tris);
+	out->borrowed = 1;
+	if (!out->nodes || !out->tris)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", from->tri_count);
+	out->node_count = from->node_count;
+	out->tri_count = from->tri_count;
+	out->order = from->order, out->place = from->place, out->parent = from->parent, out->leaf = from->leaf;
+	fill_tris(m, out);
+	for (int i = out->node_count - 1; i >= 0; i--) {
+		node *n = &out->nodes[i];
+		n->first = from->nodes[i].first, n->count = from->nodes[i].count;
+		for (int a = 0; a < 3; a++)
+			n->lo[a] = INFINITY, n->hi[a] = -INFINITY;
+		if (n->count > 0)
+			for (int k = n->first; k < n->first + n->count; k++) {
+				const tri *t = &out->tris[k];
+				for (int a = 0; a < 3; a++) {
+					double lo = t->a[a] < t->b[a] ? t->a[a] : t->b[a], hi = t->a[a] > t->b[a] ? t->a[a] : t->b[a];
+					lo = t->c[a] < lo ? t->c[a] : lo, hi = t->c[a] > hi ? t->c[a] : hi;
+					n->lo[a] = lo < n->lo[a] ? lo : n->lo[a];
+					n->hi[a] = hi > n->hi[a] ? hi : n->hi[a];
+				}
+			}
+		else
+			for (int a = 0; a < 3; a++) {
+				const node *l = &out->nodes[n->first], *r = &out->nodes[n->first + 1];
+				n->lo[a] = l->lo[a] < r->lo[a] ? l->lo[a] : r->lo[a];
+				n->hi[a] = l->hi[a] > r->hi[a] ? l->hi[a] : r->hi[a];
+			}
+	}
 	return MLOD_OK;
 }
 
@@ -291,8 +359,12 @@ static void bvh_free(bvh *b)
 {
 	free(b->nodes);
 	free(b->tris);
-	free(b->order);
-	free(b->place);
+	if (!b->borrowed) {
+		free(b->order);
+		free(b->place);
+		free(b->parent);
+		free(b->leaf);
+	}
 }
 
 /* Squared distance from p to the node's box: p less its clamp to the box
@@ -322,16 +394,15 @@ static double plane_dist2(const double *p, const tri *t)
 	return d > 0.0 ? d * d : 0.0;
 }
 
-/* Squared distance from p to the nearest triangle. *hint is a triangle to
- * start from (updated to the nearest one), which makes neighbouring
- * queries cheap. */
-static double bvh_nearest2(const bvh *b, const double *p, int *hint)
+/* The nearest triangle in the subtree at node at (at_d2: p's squared
+ * distance to its box) if nearer than best: searched nearer child first,
+ * pruned by box distance, a leaf's triangle skipped when its plane is
+ * already farther than the best, or when it is skip. */
+static double subtree_nearest2(const bvh *b, const double *p, int at, double at_d2, double best, int skip,
+                               int *hint)
 {
-	const int start = *hint; /* measured here, so skipped in its leaf */
-	double best = triangle_dist2(p, &b->tris[start]);
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
-	int top = 0, at = 0;
-	double at_d2 = box_dist2(p, &b->nodes[0]);
+	int top = 0;
 	for (;;) {
 		const node *n = &b->nodes[at];
 		if (at_d2 < best && n->count == 0) {
@@ -347,16 +418,38 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 		}
 		if (at_d2 < best)
 			for (int k = n->first; k < n->first + n->count; k++) {
-				if (k == start || plane_dist2(p, &b->tris[k]) >= best)
-					continue; /* measured first, or its plane is already farther than the best */
+				if (k == skip || plane_dist2(p, &b->tris[k]) >= best)
+					continue;
 				double d = triangle_dist2(p, &b->tris[k]);
 				if (d < best)
 					best = d, *hint = k;
 			}
 		if (top == 0)
-			break;
+			return best;
 		--top;
 		at = stack[top].node, at_d2 = stack[top].d2;
+	}
+}
+
+/* Squared distance from p to the nearest triangle. *hint is a triangle to
+ * start from (updated to the nearest one), which makes neighbouring
+ * queries cheap. The search goes up from the hint's leaf: its other
+ * triangles, then at each ancestor the other child's subtree (pruned by
+ * its box when no nearer than the best so far). The leaf and those
+ * subtrees make the whole tree, so the result is the nearest, as from the
+ * root down; starting next to the answer, it tests about one box per
+ * level instead of two per level and more. */
+static double bvh_nearest2(const bvh *b, const double *p, int *hint)
+{
+	const int start = *hint; /* measured here, so skipped in its leaf */
+	double best = triangle_dist2(p, &b->tris[start]);
+	int at = b->leaf[start];
+	best = subtree_nearest2(b, p, at, 0.0, best, start, hint);
+	for (int up = b->parent[at]; up >= 0; at = up, up = b->parent[up]) {
+		int other = b->nodes[up].first == at ? at + 1 : at - 1;
+		double d2 = box_dist2(p, &b->nodes[other]);
+		if (d2 < best)
+			best = subtree_nearest2(b, p, other, d2, best, -1, hint);
 	}
 	return best;
 }
@@ -441,6 +534,205 @@ static mlod_result measure(const mlod_posed *from, const bvh *from_bvh, const bv
 	return MLOD_OK;
 }
 
+/* Triangle t of m, as the hierarchy keeps it (without its normal). */
+static void mesh_tri(const mlod_posed *m, int t, tri *out)
+{
+	const uint32_t *ix = m->indices + 3 * (size_t)t;
+	for (int a = 0; a < 3; a++) {
+		out->a[a] = m->positions[3 * (size_t)ix[0] + a];
+		out->b[a] = m->positions[3 * (size_t)ix[1] + a];
+		out->c[a] = m->positions[3 * (size_t)ix[2] + a];
+	}
+	out->degenerate = is_degenerate(out);
+}
+
+/* A mesh measured against, with its hierarchy built when first needed
+ * (under lock when there is one: a kept surface, shared by calls). */
+typedef struct target {
+	const mlod_posed *mesh;
+	bvh *tree;
+	int *built;
+	pthread_mutex_t *lock;
+	const bvh *like; /* the same triangles' tree at another pose, refitted (NULL: built) */
+} target;
+
+static mlod_result target_tree(const target *t, const bvh **out, mlod_error *err)
+{
+	mlod_result r = MLOD_OK;
+	if (t->lock)
+		pthread_mutex_lock(t->lock);
+	if (!*t->built) {
+		if (t->like && t->like->tri_count == t->mesh->triangle_count)
+			r = bvh_refit(t->like, t->mesh, t->tree, err);
+		else
+			r = bvh_build(t->mesh, t->tree, err);
+		if (r == MLOD_OK)
+			*t->built = 1;
+		else {
+			bvh_free(t->tree); /* what was allocated before the failure */
+			memset(t->tree, 0, sizeof *t->tree);
+		}
+	}
+	if (t->lock)
+		pthread_mutex_unlock(t->lock);
+	*out = t->tree;
+	return r;
+}
+
+/* The sample at place i of from (its vertices, then its triangles'
+ * centroids); 0 for a vertex no triangle uses (not on the surface). */
+static int sample_at(const mlod_posed *from, const unsigned char *used, long i, double *p)
+{
+	if (i < from->vertex_count) {
+		if (!used[i])
+			return 0;
+		for (int a = 0; a < 3; a++)
+			p[a] = from->positions[3 * (size_t)i + a];
+		return 1;
+	}
+	const uint32_t *ix = from->indices + 3 * (size_t)(i - from->vertex_count);
+	for (int a = 0; a < 3; a++)
+		p[a] = ((double)from->positions[3 * (size_t)ix[0] + a] + from->positions[3 * (size_t)ix[1] + a] +
+		        from->positions[3 * (size_t)ix[2] + a]) / 3.0;
+	return 1;
+}
+
+/* One way of measure's bounded form (mlod_warm's bound): each sample's
+ * distance to its warm triangle in dist (-1: not a sample, INFINITY: no
+ * warm triangle), from's vertices then its triangles. */
+static void bound_distances(const mlod_posed *from, const unsigned char *used, const mlod_posed *onto,
+                            const int *warm, double *dist)
+{
+	for (long i = 0; i < (long)from->vertex_count + from->triangle_count; i++) {
+		double p[3];
+		if (!sample_at(from, used, i, p)) {
+			dist[i] = -1.0;
+			continue;
+		}
+		dist[i] = INFINITY;
+		if ((unsigned)warm[i] < (unsigned)onto->triangle_count) {
+			tri near;
+			mesh_tri(onto, warm[i], &near);
+			dist[i] = sqrt(triangle_dist2(p, &near));
+		}
+	}
+}
+
+/* A sample whose bound may raise the max. */
+typedef struct candidate {
+	double bound;
+	int way; /* 0: a's sample on b, 1: b's on a */
+	int i;
+} candidate;
+
+static int by_bound(const void *x, const void *y)
+{
+	const candidate *u = x, *v = y;
+	if (u->bound != v->bound)
+		return u->bound > v->bound ? -1 : 1;
+	return u->way != v->way ? u->way - v->way : u->i - v->i;
+}
+
+/* Searches of a target before its hierarchy is built: each looks at every
+ * triangle, which costs less than a build for a few. */
+#define BRUTE_SEARCHES 0
+
+/* Squared distance from p to the nearest triangle of the target, the
+ * same bits as bvh_nearest2: by looking at every triangle for the first
+ * few searches, through the hierarchy after. */
+static mlod_result target_nearest2(const target *t, int *searches, const double *p, int warm, double *d2,
+                                   mlod_error *err)
+{
+	const int tris = t->mesh->triangle_count;
+	if (++*searches <= BRUTE_SEARCHES) {
+		double best = INFINITY;
+		for (int k = 0; k < tris; k++) {
+			tri x;
+			mesh_tri(t->mesh, k, &x);
+			double d = triangle_dist2(p, &x);
+			best = d < best ? d : best;
+		}
+		*d2 = best;
+		return MLOD_OK;
+	}
+	const bvh *tree;
+	mlod_result r = target_tree(t, &tree, err);
+	if (r != MLOD_OK)
+		return r;
+	int hint = (unsigned)warm < (unsigned)tris ? tree->place[warm] : 0;
+	*d2 = bvh_nearest2(tree, p, &hint);
+	return MLOD_OK;
+}
+
+/* measure's bounded form (mlod_warm's bound), both ways: every sample's
+ * distance to its warm triangle first; then the samples whose bound
+ * exceeds *top (the floor in this pose's units) searched, largest bound
+ * first, *top following the largest distance found, until the next bound
+ * is no more than *top: none of the rest can raise the max. The sums then
+ * in the mesh's order, a's samples then b's, as measure's. */
+static mlod_result measure_bound(const target *ta, const target *tb, const mlod_warm *warm, double top, double *sum,
+                                 double *max, long *count, mlod_error *err)
+{
+	const mlod_posed *m[2] = { ta->mesh, tb->mesh };
+	const target *onto[2] = { tb, ta };
+	const int *w[2] = { warm->a, warm->b };
+	long n[2] = { (long)m[0]->vertex_count + m[0]->triangle_count, (long)m[1]->vertex_count + m[1]->triangle_count };
+	unsigned char *used[2] = { calloc((size_t)m[0]->vertex_count, 1), calloc((size_t)m[1]->vertex_count, 1) };
+	double *dist[2] = { malloc(sizeof(double) * (size_t)n[0]), malloc(sizeof(double) * (size_t)n[1]) };
+	candidate *c = NULL;
+	mlod_result r = MLOD_OK;
+	if (!used[0] || !used[1] || !dist[0] || !dist[1]) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %ld distances", n[0] + n[1]);
+		goto done;
+	}
+	long candidates = 0;
+	for (int way = 0; way < 2; way++) {
+		for (long k = 0; k < 3L * m[way]->triangle_count; k++)
+			used[way][m[way]->indices[k]] = 1;
+		bound_distances(m[way], used[way], onto[way]->mesh, w[way], dist[way]);
+		for (long i = 0; i < n[way]; i++)
+			candidates += dist[way][i] > top;
+	}
+	if (candidates > 0 && !(c = malloc(sizeof *c * (size_t)candidates))) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %ld candidates", candidates);
+		goto done;
+	}
+	candidates = 0;
+	for (int way = 0; way < 2; way++)
+		for (long i = 0; i < n[way]; i++)
+			if (dist[way][i] > top)
+				c[candidates].bound = dist[way][i], c[candidates].way = way, c[candidates++].i = (int)i;
+	if (candidates > 1)
+		qsort(c, (size_t)candidates, sizeof *c, by_bound);
+	int searches[2] = { 0, 0 };
+	for (long k = 0; k < candidates && c[k].bound > top; k++) {
+		int way = c[k].way, i = c[k].i;
+		double p[3], d2;
+		sample_at(m[way], used[way], i, p);
+		if ((r = target_nearest2(onto[way], &searches[way], p, w[way][i], &d2, err)) != MLOD_OK)
+			goto done;
+		dist[way][i] = sqrt(d2);
+		top = dist[way][i] > top ? dist[way][i] : top;
+	}
+	double s = *sum, mx = *max;
+	long cnt = *count;
+	for (int way = 0; way < 2; way++)
+		for (long i = 0; i < n[way]; i++)
+			if (dist[way][i] >= 0.0) {
+				s += dist[way][i];
+				mx = dist[way][i] > mx ? dist[way][i] : mx;
+				cnt++;
+			}
+	*sum = s, *max = mx, *count = cnt;
+done:
+	free(used[0]);
+	free(used[1]);
+	free(dist[0]);
+	free(dist[1]);
+	free(c);
+	return r;
+}
+
 /* Diagonal of the bounding box of the vertices a's triangles use. */
 static double diagonal(const mlod_posed *m)
 {
@@ -456,18 +748,33 @@ static double diagonal(const mlod_posed *m)
 }
 
 /* Adds both directions between a (with its hierarchy ta) and b. */
-static mlod_result both_ways(const mlod_posed *a, const bvh *ta, const mlod_posed *b, double diag,
-                             const mlod_warm *warm, mlod_deviation *out, mlod_error *err)
+static mlod_result both_ways(const target *ta, const mlod_posed *b, double diag, mlod_warm *warm,
+                             mlod_deviation *out, mlod_error *err)
 {
 	bvh tb = { 0 };
+	int b_built = 0;
+	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL };
+	const mlod_posed *a = ta->mesh;
+	const bvh *tree_a, *tree_b;
 	double sum = 0.0, max = 0.0;
 	long count = 0;
 	mlod_result r;
 	const int *wa = warm && !warm->record ? warm->a : NULL, *wb = warm && !warm->record ? warm->b : NULL;
 	int *na = warm && warm->record ? warm->a : NULL, *nb = warm && warm->record ? warm->b : NULL;
-	if (!(r = bvh_build(b, &tb, err)) && !(r = measure(a, ta, &tb, wa, na, &sum, &max, &count, err)))
-		r = measure(b, &tb, ta, wb, nb, &sum, &max, &count, err);
-	bvh_free(&tb);
+	if (warm && warm->bound && !warm->record) {
+		/* the recording pose's max, as a fraction of the diagonal there, in
+		 * this pose's units, a little less so that rounding cannot let a
+		 * bound past it; the hierarchies built only if a sample is searched */
+		r = measure_bound(ta, &onto_b, warm, warm->floor * diag * (1.0 - 1e-12), &sum, &max, &count, err);
+	} else if (!(r = target_tree(ta, &tree_a, err)) && !(r = target_tree(&onto_b, &tree_b, err)) &&
+	           !(r = measure(a, tree_a, tree_b, wa, na, &sum, &max, &count, err)))
+		r = measure(b, tree_b, tree_a, wb, nb, &sum, &max, &count, err);
+	if (!r && warm && warm->record)
+		warm->floor = max / diag;
+	if (b_built && !r && warm && warm->record && !warm->b_tree && (warm->b_tree = malloc(sizeof tb)))
+		*warm->b_tree = tb; /* for the other poses to refit */
+	else if (b_built)
+		bvh_free(&tb);
 	if (r)
 		return r;
 	out->mean = 100.0 * sum / (double)count / diag;
@@ -488,9 +795,11 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 	if (!(diag > 0.0))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	bvh ta = { 0 };
-	if (!(r = bvh_build(a, &ta, err)))
-		r = both_ways(a, &ta, b, diag, NULL, out, err);
-	bvh_free(&ta);
+	int built = 0;
+	const target onto_a = { a, &ta, &built, NULL, NULL };
+	r = both_ways(&onto_a, b, diag, NULL, out, err);
+	if (built)
+		bvh_free(&ta);
 	return r;
 }
 
@@ -500,7 +809,10 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 
 struct mlod_surface {
 	mlod_posed mesh;
-	bvh tree;
+	bvh tree;   /* built when first searched (target_tree) */
+	int built;
+	pthread_mutex_t lock;
+	mlod_surface *like; /* mlod_surface_like */
 	double diag;
 };
 
@@ -514,6 +826,10 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 	if (!(diag > 0.0))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	mlod_surface *s = calloc(1, sizeof *s);
+	if (s && pthread_mutex_init(&s->lock, NULL) != 0) {
+		free(s);
+		s = NULL;
+	}
 	size_t pos = 3 * (size_t)m->vertex_count * sizeof *m->positions, ind = 3 * (size_t)m->triangle_count * sizeof *m->indices;
 	if (!s || !(s->mesh.positions = malloc(pos)) || !(s->mesh.indices = malloc(ind))) {
 		mlod_surface_free(s);
@@ -524,19 +840,33 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 	s->mesh.vertex_count = m->vertex_count;
 	s->mesh.triangle_count = m->triangle_count;
 	s->diag = diag;
-	if ((r = bvh_build(&s->mesh, &s->tree, err))) {
-		mlod_surface_free(s);
-		return r;
-	}
 	*out = s;
 	return MLOD_OK;
+}
+
+void mlod_surface_like(mlod_surface *s, mlod_surface *like)
+{
+	if (like && like != s && like->mesh.triangle_count == s->mesh.triangle_count &&
+	    !memcmp(like->mesh.indices, s->mesh.indices, 3 * (size_t)s->mesh.triangle_count * sizeof *s->mesh.indices))
+		s->like = like;
+}
+
+void mlod_warm_release(mlod_warm *w)
+{
+	if (w && w->b_tree) {
+		bvh_free(w->b_tree);
+		free(w->b_tree);
+		w->b_tree = NULL;
+	}
 }
 
 void mlod_surface_free(mlod_surface *s)
 {
 	if (!s)
 		return;
-	bvh_free(&s->tree);
+	if (s->built)
+		bvh_free(&s->tree);
+	pthread_mutex_destroy(&s->lock);
 	mlod_posed_free(&s->mesh);
 	free(s);
 }
@@ -548,7 +878,7 @@ int mlod_surface_is(const mlod_surface *s, const mlod_posed *m)
 	       !memcmp(s->mesh.indices, m->indices, 3 * (size_t)m->triangle_count * sizeof *m->indices);
 }
 
-mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, const mlod_warm *warm,
+mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, mlod_warm *warm,
                                       mlod_deviation *out, mlod_error *err)
 {
 	mlod_result r;
@@ -559,5 +889,13 @@ mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b
 	if (warm && (warm->a_count != a->mesh.vertex_count + a->mesh.triangle_count ||
 	             warm->b_count != b->vertex_count + b->triangle_count))
 		warm = NULL; /* made for other meshes: measured without */
-	return both_ways(&a->mesh, &a->tree, b, a->diag, warm, out, err);
+	mlod_surface *s = (mlod_surface *)a; /* only its lazily built hierarchy changes, under its lock */
+	const bvh *like = NULL;
+	if (s->like) {
+		pthread_mutex_lock(&s->like->lock);
+		like = s->like->built ? &s->like->tree : NULL;
+		pthread_mutex_unlock(&s->like->lock);
+	}
+	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like };
+	return both_ways(&onto_a, b, a->diag, warm, out, err);
 }

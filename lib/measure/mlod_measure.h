@@ -81,10 +81,26 @@ mlod_result mlod_pose_set_make(const mlod_character *c, int bind, int per_clip, 
                                float max_angle, mlod_pose_set *out, mlod_error *err);
 void mlod_pose_set_free(mlod_pose_set *s);
 
+/* With on set, mlod_posed_error on a set made by mlod_pose_set_make
+ * searches the nearest point at the poses after the first only for the
+ * samples that may raise the max: the same max, to the bit, and a mean
+ * at least the exact one (see there). Off (as made): every sample
+ * searched. Does nothing to a set made by hand. */
+void mlod_pose_set_bound_mean(mlod_pose_set *s, int on);
+
 /* Posed surface error of a level against the full character: at every
  * pose, mlod_surface_deviation of the posed level against the posed full
  * character; mean is the mean over poses of the mean, max the largest max
  * (Hausdorff), both in % of the full character's diagonal in that pose.
+ * With mlod_pose_set_bound_mean on, the first pose is measured so and records
+ * each sample's nearest triangle; at the other poses a sample's distance
+ * to that triangle (an upper bound of its distance to the surface) stands
+ * for it, and the search runs only when that bound exceeds both the first
+ * pose's max (as a fraction of the diagonal) and the largest distance
+ * searched so far at that pose: a sample left unsearched cannot raise the
+ * max. So max is the same, bit for bit, and mean at least the exact one
+ * (and equal where the recorded triangle is still the nearest); both are
+ * the same at any thread count.
  * With a pose set from mlod_pose_set_make, the first call keeps the posed
  * full character of each pose and its hierarchy in the set's cache, and
  * later calls whose full character poses to the same bytes there reuse

@@ -20,7 +20,11 @@
  * triangle together, so the first bound is nearly always the answer
  * (mlod-bgm on a 50k-triangle tubeman: 2.1 full point-triangle distances
  * and 24 nodes a query, from 5.4 and 29). The result is the same, bit for
- * bit, as the search is exact.
+ * bit, as the search is exact. With mlod_pose_set_bound_mean (mlod-bgm's
+ * levels), the other poses search only the samples whose distance to
+ * their recorded triangle could raise the max (mlod_warm's bound): the
+ * same max, a mean at least the exact one, and on the 50k-triangle
+ * tubeman 1.5 s of mlod-bgm's 2.9 s CPU saved (bench/RESULTS.md, Run 15).
  */
 #include <math.h>
 #include <pthread.h>
@@ -51,6 +55,7 @@ struct mlod_pose_cache {
 	pthread_mutex_t lock;
 	int count;
 	mlod_surface **full;
+	int bound_mean; /* mlod_pose_set_bound_mean */
 };
 
 static struct mlod_pose_cache *cache_make(int count)
@@ -94,6 +99,8 @@ static const mlod_surface *cache_get(struct mlod_pose_cache *c, int k, const mlo
 		if (mlod_surface_make(a, &made, NULL) != MLOD_OK)
 			return NULL;
 		pthread_mutex_lock(&c->lock);
+		if (k > 0 && c->full[0])
+			mlod_surface_like(made, c->full[0]); /* its hierarchy refitted from pose 0's */
 		if (!c->full[k])
 			c->full[k] = made, made = NULL;
 		s = c->full[k];
@@ -183,6 +190,12 @@ done:
 	return r;
 }
 
+void mlod_pose_set_bound_mean(mlod_pose_set *s, int on)
+{
+	if (s && s->cache)
+		s->cache->bound_mean = on != 0;
+}
+
 void mlod_pose_set_free(mlod_pose_set *s)
 {
 	if (!s)
@@ -256,6 +269,7 @@ mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *l
 	j.warm.record = 1;
 	mlod_result r = posed_one(&j, 0);
 	j.warm.record = 0, j.first = 1;
+	j.warm.bound = poses->cache && poses->cache->bound_mean;
 	if (r == MLOD_OK)
 		r = mlod_parallel_for(poses->count - 1, poses->threads, posed_one, &j);
 	if (r != MLOD_OK) {
@@ -280,5 +294,6 @@ mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *l
 	free(j.errs);
 	free(j.warm.a);
 	free(j.warm.b);
+	mlod_warm_release(&j.warm);
 	return r;
 }

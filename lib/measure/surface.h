@@ -16,6 +16,12 @@ typedef struct mlod_surface mlod_surface;
 mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_error *err);
 void mlod_surface_free(mlod_surface *s);
 
+/* s's hierarchy, when a search needs it, is then like's refitted to s's
+ * positions (built if like has none by then): like must be the same mesh
+ * at another pose, outlive s and not be freed before it; else (other
+ * triangles) nothing changes. */
+void mlod_surface_like(mlod_surface *s, mlod_surface *like);
+
 /* 1 when s holds m: the same counts, positions and indices, byte for byte. */
 int mlod_surface_is(const mlod_surface *s, const mlod_posed *m);
 
@@ -30,11 +36,33 @@ typedef struct mlod_warm {
 	int *a, *b;
 	int a_count, b_count;
 	int record;
+	/* Searching only where the max may grow (set with record unset): a
+	 * sample's distance to its warm triangle is an upper bound of its
+	 * distance to the surface; when that bound is no more than floor (a
+	 * fraction of a's diagonal known not to exceed the largest distance
+	 * of the whole measure over a's diagonal: the recording pose's, which
+	 * writes it) nor the largest distance searched so far in this call,
+	 * the sample cannot raise the max and counts with its bound,
+	 * unsearched. The max is then the same as searching every sample,
+	 * and the mean an upper bound of it, equal where the warm triangle is
+	 * still the nearest. Samples are then visited in the mesh's order, so
+	 * the result depends on nothing else. The hierarchies are then built
+	 * only when a sample is searched. */
+	int bound;
+	double floor;
+	/* b's hierarchy at the recording pose, kept there (free it with
+	 * mlod_warm_release); the other poses refit it when they search b */
+	struct mlod_bvh *b_tree;
 } mlod_warm;
 
+/* Frees what a recording kept in w (not w itself). */
+void mlod_warm_release(mlod_warm *w);
+
 /* mlod_surface_deviation of a's mesh and b, the same result to the bit,
- * with warm starts when warm is not NULL. */
-mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, const mlod_warm *warm,
+ * with warm starts when warm is not NULL (with its bound, the max only).
+ * a's hierarchy is built by the first call that searches it (under a
+ * lock: calls may share a). */
+mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b, mlod_warm *warm,
                                       mlod_deviation *out, mlod_error *err);
 
 #endif /* MLOD_MEASURE_SURFACE_H */

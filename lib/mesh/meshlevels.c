@@ -186,6 +186,7 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 	L->opt.eta = L->eta;
 	L->opt.poses = &L->train;
 	L->measure.threads = L->opt.threads;
+	mlod_pose_set_bound_mean(&L->measure, 1); /* the same max, the mean an upper bound: mlod-bgm(1) */
 	int n = 0;
 	for (int i = 0; i < c->instance_count; i++)
 		n += c->meshes[c->instances[i].mesh].primitive_count;

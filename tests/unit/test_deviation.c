@@ -372,6 +372,58 @@ TEST(posed_error_kept_full)
 	mlod_character_free(&c);
 }
 
+/* mlod_pose_set_bound_mean (mlod-bgm's levels): at every pose after the
+ * first, only the samples that may raise the max are searched: against
+ * the exact measure on the same set, the max has the same bits and the
+ * mean is no less; the result is the same on two threads, and a set made
+ * by hand (nothing kept) is measured exactly. */
+TEST(posed_error_bound_mean)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	mlod_pose_set poses;
+	CHECK_OK(mlod_pose_set_make(&c, 1, 4, 8, 2008, 0.6981317f, &poses, &terr));
+	mlod_pose_set hand = { poses.count, poses.joint_count, poses.world, 0, NULL };
+	mlod_bgm_options opt = {0};
+	mlod_bgm *g;
+	CHECK_OK(mlod_bgm_build(&c, 0, 0, &opt, &g, &terr));
+	mlod_bgm_info info;
+	mlod_bgm_get_info(g, &info);
+	CHECK_OK(mlod_bgm_simplify(g, info.triangles / 30, 0, &terr));
+	const int keep[3] = { 2, 10, 30 };
+	double moved = 0.0;
+	for (int k = 0; k < 3; k++) {
+		mlod_primitive q;
+		mlod_mesh mesh = {0};
+		CHECK_OK(mlod_bgm_extract(g, mlod_bgm_prefix_for(g, info.triangles / keep[k]), 0, &q, &terr));
+		mesh.primitive_count = 1;
+		mesh.primitives = &q;
+		mlod_character v = view_of(&c, &mesh);
+		mlod_deviation exact, bounded, two, by_hand;
+		mlod_pose_set_bound_mean(&poses, 0);
+		poses.threads = 1;
+		CHECK_OK(mlod_posed_error(&c, &v, &poses, &exact, &terr));
+		mlod_pose_set_bound_mean(&poses, 1);
+		CHECK_OK(mlod_posed_error(&c, &v, &poses, &bounded, &terr));
+		poses.threads = 2;
+		CHECK_OK(mlod_posed_error(&c, &v, &poses, &two, &terr));
+		mlod_pose_set_bound_mean(&hand, 1); /* nothing to set: measured exactly */
+		CHECK_OK(mlod_posed_error(&c, &v, &hand, &by_hand, &terr));
+		CHECK_MSG(bounded.max == exact.max && bounded.mean >= exact.mean,
+		          "1/%d of the triangles: bounded %.17g/%.17g, exact %.17g/%.17g", keep[k], bounded.mean,
+		          bounded.max, exact.mean, exact.max);
+		CHECK(same_deviation(&bounded, &two));
+		CHECK(same_deviation(&by_hand, &exact));
+		moved = fmax(moved, bounded.mean / exact.mean);
+		mlod_primitive_free(&q);
+		free(v.instances);
+	}
+	CHECK(moved > 1.0 && moved < 1.5); /* the bound is not the exact mean here, nor far from it */
+	mlod_bgm_free(g);
+	mlod_pose_set_free(&poses);
+	mlod_character_free(&c);
+}
+
 /* Warm starts (surface.h) change only where each search begins: recorded
  * at one placement and used at another, or filled with nonsense, or made
  * for meshes of other sizes, the result has the same bits as without. */
@@ -386,7 +438,7 @@ TEST(warm_starts_same_bits)
 		wa[i] = -7;
 	for (int i = 0; i < nb; i++)
 		wb[i] = -7;
-	mlod_warm rec = { wa, wb, na, nb, 1 };
+	mlod_warm rec = { wa, wb, na, nb, 1, 0, 0.0, NULL };
 	mlod_deviation cold, d;
 	CHECK_OK(mlod_surface_deviation(&a, &b, &cold, &terr));
 	CHECK_OK(mlod_surface_deviation_to(s, &b, &rec, &d, &terr));
@@ -401,12 +453,24 @@ TEST(warm_starts_same_bits)
 	mlod_posed b2 = copy_translated(&b, 0.03f, -0.02f, 0.05f);
 	for (int i = 0; i < 3 * b2.vertex_count; i++)
 		b2.positions[i] += (float)rnd(-0.02, 0.02);
-	mlod_warm use = { wa, wb, na, nb, 0 };
+	mlod_warm use = { wa, wb, na, nb, 0, 0, 0.0, NULL };
 	CHECK_OK(mlod_surface_deviation(&a, &b2, &cold, &terr));
 	CHECK_OK(mlod_surface_deviation_to(s, &b2, &use, &d, &terr));
 	CHECK(same_deviation(&cold, &d));
 	CHECK_OK(mlod_surface_deviation_to(s, &b2, NULL, &d, &terr));
 	CHECK(same_deviation(&cold, &d));
+	/* bounded (searching only what may raise the max), with no floor: the
+	 * same max, a mean no less, and here more (some recorded triangles are
+	 * no longer the nearest) */
+	mlod_warm bounded = { wa, wb, na, nb, 0, 1, 0.0, NULL };
+	CHECK_OK(mlod_surface_deviation_to(s, &b2, &bounded, &d, &terr));
+	CHECK_MSG(d.max == cold.max && d.mean > cold.mean, "bounded %.17g/%.17g, exact %.17g/%.17g", d.mean, d.max,
+	          cold.mean, cold.max);
+	/* a floor above every distance: nothing searched, every sample counted
+	 * with its recorded triangle, the max then at least the exact one */
+	bounded.floor = 10.0;
+	CHECK_OK(mlod_surface_deviation_to(s, &b2, &bounded, &d, &terr));
+	CHECK(d.max >= cold.max && d.mean > cold.mean);
 	/* nonsense: out of range, negative, far triangles */
 	for (int i = 0; i < na; i++)
 		wa[i] = i % 3 == 0 ? -1 - i : i % 3 == 1 ? b.triangle_count + i : (int)rnd(0, b.triangle_count - 1e-9);
@@ -414,8 +478,14 @@ TEST(warm_starts_same_bits)
 		wb[i] = i % 2 ? a.triangle_count - 1 - i % a.triangle_count : 1 << 30;
 	CHECK_OK(mlod_surface_deviation_to(s, &b2, &use, &d, &terr));
 	CHECK(same_deviation(&cold, &d));
+	/* bounded with nonsense: each sample without a recorded triangle is
+	 * searched, a far one gives a bound that is searched when above the
+	 * max so far: the max the same bits */
+	mlod_warm nonsense = { wa, wb, na, nb, 0, 1, 0.0, NULL };
+	CHECK_OK(mlod_surface_deviation_to(s, &b2, &nonsense, &d, &terr));
+	CHECK(d.max == cold.max && d.mean >= cold.mean);
 	/* made for meshes of other sizes */
-	mlod_warm other = { wa, wb, na - 1, nb, 0 };
+	mlod_warm other = { wa, wb, na - 1, nb, 0, 0, 0.0, NULL };
 	CHECK_OK(mlod_surface_deviation_to(s, &b2, &other, &d, &terr));
 	CHECK(same_deviation(&cold, &d));
 	free(wa);
@@ -436,6 +506,7 @@ int main(void)
 	RUN(unused_vertices_do_not_count);
 	RUN(bad_input);
 	RUN(posed_error_kept_full);
+	RUN(posed_error_bound_mean);
 	RUN(warm_starts_same_bits);
 	TEST_EXIT();
 }
