@@ -370,13 +370,21 @@ static int near_collapsed(const double *const P[3], int K, const double bary[3],
 	return d <= lmax;
 }
 
+/* Whether collapses may move and remove border vertices: with
+ * mlod_bgm_options.allow_border from the start, else once nothing else
+ * collapses (mlod_bgm_simplify's border phase). */
+static int borders_ok(const mlod_bgm *g)
+{
+	return g->opt.allow_border || g->border_phase;
+}
+
 /* Works out operation op on face t (its triangle collapse, or the
  * collapse of one of its edges); returns 1 when it is valid (pl holds
  * the cheapest valid placement), else 0. */
 static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm)
 {
 	const bgm_face *T = &g->faces[t];
-	int allow_border = g->opt.allow_border;
+	int allow_border = borders_ok(g);
 	if (T->death != BGM_ALIVE)
 		return 0;
 	pl->t = t;
@@ -438,13 +446,19 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		if (count > 2)
 			return 0;
 	}
-	int border = 0, special[3] = {0, 0, 0};
+	int border = 0, nb = 0, onb[3] = {0, 0, 0}, tex[3] = {0, 0, 0}, anytex = 0, special[3] = {0, 0, 0};
 	for (int i = 0; i < K; i++) {
-		int fb = (g->nodes[pl->v[i]].flags & BGM_BORDER) != 0, texture;
-		node_seams(g, pl->v[i], &texture, &pl->hard[i]);
-		border |= fb;
-		special[i] = fb || texture;
+		onb[i] = (g->nodes[pl->v[i]].flags & BGM_BORDER) != 0;
+		node_seams(g, pl->v[i], &tex[i], &pl->hard[i]);
+		border |= onb[i];
+		nb += onb[i];
+		anytex |= tex[i];
 	}
+	/* A texture seam among the collapsed vertices: v-bar snaps onto a
+	 * seam (or border) vertex keeping every wedge group whole. Without
+	 * one, a border only restricts where v-bar goes (border_places). */
+	for (int i = 0; i < K && anytex; i++)
+		special[i] = onb[i] || tex[i];
 	/* The link condition: the re-meshed faces form one fan around v-bar. */
 	if (!bgm_link_ok(from, to, pl->nk, border))
 		return 0;
@@ -497,7 +511,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 
 	/* Candidate placements. */
 	double cand[MAX_CANDIDATES][3];
-	int cand_snap[MAX_CANDIDATES], cand_role[MAX_CANDIDATES], nc = 0;
+	int cand_snap[MAX_CANDIDATES], cand_role[MAX_CANDIDATES], cand_at[MAX_CANDIDATES], nc = 0;
 	const double *P[3] = {g->nodes[pl->v[0]].p, g->nodes[pl->v[1]].p, K == 3 ? g->nodes[pl->v[2]].p : NULL};
 	double bary[3];
 	for (int i = 0; i < 3; i++) {
@@ -526,10 +540,41 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 				continue;
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
+			cand_at[nc] = s;
 			cand_snap[nc++] = s;
 		}
 		if (nc == 0)
 			return 0;
+	} else if (border) {
+		/* The border stays where it is: v-bar goes to a border vertex,
+		 * or for an edge along the border also to its midpoint. */
+		int along = -1;
+		if (nb >= 2) {
+			/* Two border vertices must share a border edge of t (else the
+			 * collapse would pinch two stretches of border together); three
+			 * never collapse. */
+			for (int e = 0; e < 3 && nb == 2; e++) {
+				int x = owner_of(pl, T->n[e]), y = owner_of(pl, T->n[(e + 1) % 3]);
+				if (x >= 0 && y >= 0 && onb[x] && onb[y] && T->adj[e] < 0)
+					along = e;
+			}
+			if (along < 0)
+				return 0;
+		}
+		for (int s = 0; s < K; s++) {
+			if (!onb[s])
+				continue;
+			memcpy(cand[nc], P[s], sizeof cand[nc]);
+			cand_role[nc] = 1 + s;
+			cand_at[nc] = s;
+			cand_snap[nc++] = -1;
+		}
+		if (K == 2 && nb == 2) {
+			memcpy(cand[nc], bary, sizeof cand[nc]);
+			cand_role[nc] = 4;
+			cand_at[nc] = -1;
+			cand_snap[nc++] = -1;
+		}
 	}
 	/* The summed posed quadrics of the collapsed vertices, and their area
 	 * (the normaliser of the posed cost). */
@@ -554,7 +599,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			mm->known |= MEMO_WSUM;
 		}
 	}
-	if (!(special[0] || special[1] || special[2])) {
+	if (!(special[0] || special[1] || special[2]) && !border) {
 		if (g->opt.placement == MLOD_PLACE_OPTIMAL && g->pose_count > 0) {
 			mlod_influences w;
 			double opt[3];
@@ -579,6 +624,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 					if (near_collapsed(P, K, bary, opt)) {
 						memcpy(cand[nc], opt, sizeof cand[nc]);
 						cand_role[nc] = 0;
+						cand_at[nc] = -1;
 						cand_snap[nc++] = -1;
 					}
 				}
@@ -588,11 +634,13 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			for (int s = 0; s < K && K == 2; s++) {
 				memcpy(cand[nc], P[s], sizeof cand[nc]);
 				cand_role[nc] = 1 + s;
+				cand_at[nc] = s;
 				cand_snap[nc++] = -1;
 			}
 		}
 		memcpy(cand[nc], bary, sizeof cand[nc]);
 		cand_role[nc] = 4;
+		cand_at[nc] = -1;
 		cand_snap[nc++] = -1;
 	}
 
@@ -706,9 +754,9 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		return 0;
 	memcpy(pl->pos, cand[best], sizeof pl->pos);
 	pl->snap = cand_snap[best];
-	if (pl->snap >= 0) {
+	if (cand_at[best] >= 0) {
 		pl->lambda[0] = pl->lambda[1] = pl->lambda[2] = 0.0;
-		pl->lambda[pl->snap] = 1.0;
+		pl->lambda[cand_at[best]] = 1.0;
 	} else if (K == 3) {
 		barycentric(P[0], P[1], P[2], pl->pos, pl->lambda);
 	} else {
@@ -1075,7 +1123,7 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 		if (op != OP_TRIANGLE && i != op && i != (op + 1) % 3)
 			continue;
 		int fl = g->nodes[F->n[i]].flags;
-		if ((fl & BGM_LOCKED) || !(fl & BGM_ELIGIBLE) || (!g->opt.allow_border && (fl & BGM_BORDER)))
+		if ((fl & BGM_LOCKED) || !(fl & BGM_ELIGIBLE) || (!borders_ok(g) && (fl & BGM_BORDER)))
 			return 0; /* never collapsible while these nodes live */
 	}
 	double key;
@@ -1327,8 +1375,22 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			}
 	}
 	int done_count = 0;
-	while (g->heap.count > 0 && (target <= 0 || g->live_triangles > target) &&
-	       (max_collapses <= 0 || done_count < max_collapses)) {
+	while ((target <= 0 || g->live_triangles > target) && (max_collapses <= 0 || done_count < max_collapses)) {
+		if (g->heap.count == 0) {
+			/* Nothing else collapses: without --allow-border, open borders
+			 * go last (every prefix before is what it was without them).
+			 * Every live face is queued again, border collapses with it. */
+			if (borders_ok(g) || g->border_edges == 0)
+				break;
+			g->border_phase = 1;
+			memset(g->opstate, 0, (size_t)g->opstate_cap);
+			for (int f = 0; f < g->face_count; f++)
+				if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
+					r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+					goto done;
+				}
+			continue;
+		}
 		heap_entry e = heap_pop(&g->heap);
 		if (g->faces[e.face].death != BGM_ALIVE) {
 			memo_release(&g->heap, e.memo);
