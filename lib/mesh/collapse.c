@@ -370,6 +370,32 @@ static int near_collapsed(const double *const P[3], int K, const double bary[3],
 	return d <= lmax;
 }
 
+/* The other end of each border edge at node v but the one to w: 1 when
+ * some is also a border neighbour of w, so that collapsing the border
+ * edge (v, w) would close a hole of three edges. */
+static int closes_hole(const mlod_bgm *g, int v, int w)
+{
+	const bgm_node *n = &g->nodes[v], *m = &g->nodes[w];
+	for (int i = 0; i < n->inc_count; i++) {
+		const bgm_face *F = &g->faces[g->inc[n->inc_first + i]];
+		for (int e = 0; e < 3; e++) {
+			if (F->adj[e] >= 0 || (F->n[e] != v && F->n[(e + 1) % 3] != v))
+				continue;
+			int x = F->n[e] == v ? F->n[(e + 1) % 3] : F->n[e];
+			if (x == w)
+				continue;
+			for (int j = 0; j < m->inc_count; j++) {
+				const bgm_face *H = &g->faces[g->inc[m->inc_first + j]];
+				for (int k = 0; k < 3; k++)
+					if (H->adj[k] < 0 && ((H->n[k] == w && H->n[(k + 1) % 3] == x) ||
+					                      (H->n[k] == x && H->n[(k + 1) % 3] == w)))
+						return 1;
+			}
+		}
+	}
+	return 0;
+}
+
 /* Whether collapses may move and remove border vertices: with
  * mlod_bgm_options.allow_border from the start, else once nothing else
  * collapses (mlod_bgm_simplify's border phase). */
@@ -558,7 +584,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 				if (x >= 0 && y >= 0 && onb[x] && onb[y] && T->adj[e] < 0)
 					along = e;
 			}
-			if (along < 0)
+			if (along < 0 || closes_hole(g, T->n[along], T->n[(along + 1) % 3]))
 				return 0;
 		}
 		for (int s = 0; s < K; s++) {
@@ -1177,6 +1203,19 @@ static int push_face(mlod_bgm *g, int f, struct plan *scratch)
 	return 0;
 }
 
+/* 1 when node v has a live edge with one face. */
+static int on_border(const mlod_bgm *g, int v)
+{
+	const bgm_node *n = &g->nodes[v];
+	for (int i = 0; i < n->inc_count; i++) {
+		const bgm_face *F = &g->faces[g->inc[n->inc_first + i]];
+		for (int e = 0; e < 3; e++)
+			if (F->adj[e] < 0 && (F->n[e] == v || F->n[(e + 1) % 3] == v))
+				return 1;
+	}
+	return 0;
+}
+
 /* Applies a planned collapse; returns 0, or -1 when out of memory. */
 static int apply(mlod_bgm *g, struct plan *pl)
 {
@@ -1332,6 +1371,17 @@ static int apply(mlod_bgm *g, struct plan *pl)
 		}
 	}
 
+	/* Border flags as the new faces leave them: a collapse along a border
+	 * can close a hole, leaving v-bar or a ring vertex inside. */
+	for (int j = 0; j < pl->nk; j++)
+		for (int k = 0; k < 3; k++) {
+			bgm_node *n = &g->nodes[g->faces[first + j].n[k]];
+			if (on_border(g, g->faces[first + j].n[k]))
+				n->flags |= BGM_BORDER;
+			else
+				n->flags &= ~BGM_BORDER;
+		}
+
 	mlod_vsplit *r = &g->records[g->record_count++];
 	memset(r, 0, sizeof *r);
 	for (int i = 0; i < 3; i++)
@@ -1367,6 +1417,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 	}
 	if (!g->heap.ready) {
 		g->heap.ready = 1;
+		g->swept = g->record_count;
 		g->heap.memo_free = -1;
 		for (int f = 0; f < g->face_count; f++)
 			if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
@@ -1380,9 +1431,11 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			/* Nothing else collapses: without --allow-border, open borders
 			 * go last (every prefix before is what it was without them).
 			 * Every live face is queued again, border collapses with it. */
-			if (borders_ok(g) || g->border_edges == 0)
+			if (!borders_ok(g) && g->border_edges > 0)
+				g->border_phase = 1;
+			else if (g->record_count == g->swept)
 				break;
-			g->border_phase = 1;
+			g->swept = g->record_count;
 			memset(g->opstate, 0, (size_t)g->opstate_cap);
 			for (int f = 0; f < g->face_count; f++)
 				if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
