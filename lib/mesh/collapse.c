@@ -55,6 +55,8 @@
 #define FLIP_COS 0.2        /* a re-meshed face may turn by less than ~78 degrees */
 #define DEGENERATE 1e-3     /* compactness under which a new face counts as degenerate */
 #define TIE_WEIGHT 1e-5     /* compactness tie-break of the posed cost */
+#define BORDER_PENALTY 50.0 /* posed cost factor of a collapse moving a border vertex (measured:
+                             * bench/RESULTS.md, border collapses) */
 
 /* An operation on a face: collapse the triangle, or one of its edges. */
 #define OP_TRIANGLE 3       /* ops 0..2: the edge (n[op], n[(op + 1) % 3]) */
@@ -396,12 +398,21 @@ static int closes_hole(const mlod_bgm *g, int v, int w)
 	return 0;
 }
 
-/* Whether collapses may move and remove border vertices: with
- * mlod_bgm_options.allow_border from the start, else once nothing else
- * collapses (mlod_bgm_simplify's border phase). */
+/* Whether collapses may move and remove border vertices: with the posed
+ * cost or mlod_bgm_options.allow_border from the start, else (the
+ * compactness cost, which cannot rank them) once nothing else collapses
+ * (mlod_bgm_simplify's border phase). */
 static int borders_ok(const mlod_bgm *g)
 {
-	return g->opt.allow_border || g->border_phase;
+	return g->opt.allow_border || g->border_phase || g->opt.cost == MLOD_COST_POSED;
+}
+
+/* What a collapse that moves a border vertex costs, times its posed cost:
+ * BORDER_PENALTY unless mlod_bgm_options.allow_border ranks it like any
+ * other. */
+static double border_factor(const mlod_bgm *g)
+{
+	return g->opt.allow_border ? 1.0 : BORDER_PENALTY;
 }
 
 /* Works out operation op on face t (its triangle collapse, or the
@@ -778,6 +789,8 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	}
 	if (best < 0)
 		return 0;
+	if (border && g->opt.cost == MLOD_COST_POSED)
+		pl->cost *= border_factor(g);
 	memcpy(pl->pos, cand[best], sizeof pl->pos);
 	pl->snap = cand_snap[best];
 	if (cand_at[best] >= 0) {
