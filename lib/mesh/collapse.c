@@ -20,19 +20,31 @@
  * face.
  *
  * The paper does not check validity; a collapse is refused when
- * - a collapsed vertex is locked, not eligible (4.2.2), or on a border
- *   (unless borders are allowed);
+ * - a collapsed vertex is locked or not eligible (4.2.2);
+ * - two collapsed vertices are on a border but not joined by a border
+ *   edge of t (the collapse would pinch the border), three are, or the
+ *   border edge bounds a hole of three edges (it would close);
  * - the re-meshed patch would not be one fan around v-bar (the link
  *   condition generalised to a triangle: this also refuses duplicate
  *   faces and the closing of tunnels);
  * - a re-meshed face would flip in the bind pose, or be degenerate;
- * - the attribute wedges of the patch cannot be carried over: at a seam
- *   (a vertex with several wedges) or an allowed border, v-bar snaps onto
- *   one such vertex s, and every wedge group (wedges joined through the
- *   removed faces) must hold exactly one wedge of s and at most one of
- *   each other vertex; seam-free patches give v-bar one wedge
- *   interpolated inside t (along the edge). So seams neither tear nor
- *   smear.
+ * - the attribute wedges of the patch cannot be carried over: at a
+ *   texture seam (wedges differing in more than normals), v-bar snaps
+ *   onto a seam (or, with a border, border) vertex s, and every wedge
+ *   group (wedges joined through the removed faces) must hold exactly one
+ *   wedge of s and at most one of each other vertex. Elsewhere v-bar gets
+ *   one wedge interpolated inside t (along the edge), the corners of a
+ *   vertex with hard normal edges keeping their own normals: every wedge
+ *   of a flat-shaded vertex collapses the same way. So seams neither tear
+ *   nor smear.
+ * Open borders stay where they are: a collapse moving a border vertex
+ * puts v-bar on a border vertex, or for an edge along the border also at
+ * its midpoint, and the border planes of quadric.c price it. With the
+ * posed cost such collapses rank with the rest at BORDER_PENALTY times
+ * their cost (1 with mlod_bgm_options.allow_border); the compactness
+ * cost, which cannot price them, lets them in only once nothing else
+ * collapses. When the queue empties, every live face is queued once
+ * more, so that the sequence ends where no valid collapse is left.
  * v-bar goes to t's barycenter (the paper) or to the posed quadric's
  * optimum (or the barycenter, or for an edge either end, when that is
  * cheaper); Power Skinning
