@@ -40,9 +40,11 @@
  * Open borders stay where they are: a collapse moving a border vertex
  * puts v-bar on a border vertex, or for an edge along the border also at
  * its midpoint, and the border planes of quadric.c price it. With the
- * posed cost such collapses rank with the rest at BORDER_PENALTY times
- * their cost (1 with mlod_bgm_options.allow_border); the compactness
- * cost, which cannot price them, lets them in only once nothing else
+ * posed cost a collapse along the border (two border vertices: the
+ * border's shape changes) ranks with the rest at BORDER_PENALTY times its
+ * cost (1 with mlod_bgm_options.allow_border); one whose only border
+ * vertex stays put costs what it costs. The compactness cost, which
+ * cannot price them, lets border collapses in only once nothing else
  * collapses. When the queue empties, every live face is queued once
  * more, so that the sequence ends where no valid collapse is left.
  * v-bar goes to t's barycenter (the paper) or to the posed quadric's
@@ -67,8 +69,8 @@
 #define FLIP_COS 0.2        /* a re-meshed face may turn by less than ~78 degrees */
 #define DEGENERATE 1e-3     /* compactness under which a new face counts as degenerate */
 #define TIE_WEIGHT 1e-5     /* compactness tie-break of the posed cost */
-#define BORDER_PENALTY 50.0 /* posed cost factor of a collapse moving a border vertex (measured:
-                             * bench/RESULTS.md, border collapses) */
+#define BORDER_PENALTY 50.0 /* posed cost factor of a collapse along a border (measured:
+                             * bench/RESULTS.md, the mesh layer's floor) */
 
 /* An operation on a face: collapse the triangle, or one of its edges. */
 #define OP_TRIANGLE 3       /* ops 0..2: the edge (n[op], n[(op + 1) % 3]) */
@@ -419,7 +421,7 @@ static int borders_ok(const mlod_bgm *g)
 	return g->opt.allow_border || g->border_phase || g->opt.cost == MLOD_COST_POSED;
 }
 
-/* What a collapse that moves a border vertex costs, times its posed cost:
+/* What a collapse along a border costs, times its posed cost:
  * BORDER_PENALTY unless mlod_bgm_options.allow_border ranks it like any
  * other. */
 static double border_factor(const mlod_bgm *g)
@@ -801,8 +803,8 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	}
 	if (best < 0)
 		return 0;
-	if (border && g->opt.cost == MLOD_COST_POSED)
-		pl->cost *= border_factor(g);
+	if (nb >= 2 && g->opt.cost == MLOD_COST_POSED)
+		pl->cost *= border_factor(g); /* the border moves (a lone border vertex stays put) */
 	memcpy(pl->pos, cand[best], sizeof pl->pos);
 	pl->snap = cand_snap[best];
 	if (cand_at[best] >= 0) {

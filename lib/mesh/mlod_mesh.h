@@ -105,9 +105,9 @@ typedef struct mlod_bgm_options {
 	mlod_collapse_op op;
 	mlod_eligibility eligibility;
 	double tau;                  /* 0 means 1 */
-	int allow_border;            /* collapses moving border vertices rank at their plain posed
-	                              * cost (default: 50 times it), and with the compactness cost
-	                              * from the start (default: once nothing else collapses) */
+	int allow_border;            /* collapses along a border rank at their plain posed cost
+	                              * (default: 50 times it), and with the compactness cost border
+	                              * collapses start at once (default: once nothing else does) */
 	int fast_cost;               /* posed cost: every pose's quadrics pulled back into bind
 	                              * space with each vertex's own influences (DeCoro &
 	                              * Rusinkiewicz 2005), not skinned with each placement's:
