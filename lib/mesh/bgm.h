@@ -121,8 +121,8 @@ struct mlod_bgm {
 		int memo_count, memo_cap, memo_free;
 	} heap;
 	int swept;              /* collapse.c: record_count when every live face was last queued */
-	int border_phase;       /* collapse.c: border vertices may collapse (without
-	                         * opt.allow_border, once nothing else could) */
+	int border_phase;       /* collapse.c: border vertices may collapse (the compactness
+	                         * cost without opt.allow_border: once nothing else could) */
 	unsigned char *opstate; /* per face and op (collapse.c): refused when last looked at, queued */
 	int opstate_cap;
 };

@@ -507,7 +507,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	}
 	/* A texture seam among the collapsed vertices: v-bar snaps onto a
 	 * seam (or border) vertex keeping every wedge group whole. Without
-	 * one, a border only restricts where v-bar goes (border_places). */
+	 * one, a border only restricts where v-bar goes (below). */
 	for (int i = 0; i < K && anytex; i++)
 		special[i] = onb[i] || tex[i];
 	/* The link condition: the re-meshed faces form one fan around v-bar. */

@@ -145,7 +145,8 @@ typedef struct mlod_bgm_info {
 	int collapses;         /* recorded so far */
 	int live_triangles;    /* after all of them */
 	int caps;              /* collapses whose v-bar had more than 4 influences */
-	int snaps;             /* collapses that snapped v-bar to a seam or border vertex */
+	int snaps;             /* collapses that snapped v-bar to a texture seam's vertex, keeping
+	                        * its wedges (a border vertex with the seam on a border) */
 	int refused;           /* candidate collapses refused as invalid */
 	double build_seconds;
 	double collapse_seconds;
