@@ -52,7 +52,8 @@ static const char usage_text[] =
 	"  -E, --eligibility NAME   vertices that may go: all, bend or literal\n"
 	"                           (default: all with the posed cost, bend otherwise)\n"
 	"  -t, --tau T              eligibility threshold factor (default 1)\n"
-	"  -b, --allow-border       let collapses move and remove border vertices\n"
+	"  -b, --allow-border       rank collapses along open borders at their plain\n"
+	"                           posed cost (default: 50 times it)\n"
 	"  -F, --fast-cost          posed cost: pull each vertex's posed quadrics back\n"
 	"                           into bind space with its own weights (faster; the\n"
 	"                           new vertex's weights no longer count, some more\n"
@@ -158,7 +159,7 @@ static void report_table(const struct job *job)
 	       "frames, %d random up to 40 degrees)\n",
 	       mlod_mesh_cost_name(L->opt.cost), L->opt.fast_cost && L->opt.cost == MLOD_COST_POSED ? " (fast)" : "",
 	       mlod_mesh_op_name(L->opt.op), mlod_mesh_budget_name(L->budget), mlod_mesh_placement_name(L->opt.placement),
-	       mlod_mesh_eligibility_name(L->opt.eligibility), L->opt.tau, L->opt.allow_border ? ", borders allowed" : "",
+	       mlod_mesh_eligibility_name(L->opt.eligibility), L->opt.tau, L->opt.allow_border ? ", border collapses at plain cost" : "",
 	       L->measure.count, MLOD_MESH_RANDOM_POSES);
 	printf("%5s  %6s  %9s  %8s  %10s  %10s  %5s  %9s  %11s\n", "level", "ratio", "triangles", "vertices", "mean%",
 	       "max%", "caps", "build ms", "collapse ms");

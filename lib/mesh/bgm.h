@@ -120,6 +120,9 @@ struct mlod_bgm {
 		                            * released with free() by mlod_bgm_free */
 		int memo_count, memo_cap, memo_free;
 	} heap;
+	int swept;              /* collapse.c: record_count when every live face was last queued */
+	int border_phase;       /* collapse.c: border vertices may collapse (the compactness
+	                         * cost without opt.allow_border: once nothing else could) */
 	unsigned char *opstate; /* per face and op (collapse.c): refused when last looked at, queued */
 	int opstate_cap;
 };

@@ -20,19 +20,33 @@
  * face.
  *
  * The paper does not check validity; a collapse is refused when
- * - a collapsed vertex is locked, not eligible (4.2.2), or on a border
- *   (unless borders are allowed);
+ * - a collapsed vertex is locked or not eligible (4.2.2);
+ * - two collapsed vertices are on a border but not joined by a border
+ *   edge of t (the collapse would pinch the border), three are, or the
+ *   border edge bounds a hole of three edges (it would close);
  * - the re-meshed patch would not be one fan around v-bar (the link
  *   condition generalised to a triangle: this also refuses duplicate
  *   faces and the closing of tunnels);
  * - a re-meshed face would flip in the bind pose, or be degenerate;
- * - the attribute wedges of the patch cannot be carried over: at a seam
- *   (a vertex with several wedges) or an allowed border, v-bar snaps onto
- *   one such vertex s, and every wedge group (wedges joined through the
- *   removed faces) must hold exactly one wedge of s and at most one of
- *   each other vertex; seam-free patches give v-bar one wedge
- *   interpolated inside t (along the edge). So seams neither tear nor
- *   smear.
+ * - the attribute wedges of the patch cannot be carried over: at a
+ *   texture seam (wedges differing in more than normals), v-bar snaps
+ *   onto a seam (or, with a border, border) vertex s, and every wedge
+ *   group (wedges joined through the removed faces) must hold exactly one
+ *   wedge of s and at most one of each other vertex. Elsewhere v-bar gets
+ *   one wedge interpolated inside t (along the edge), the corners of a
+ *   vertex with hard normal edges keeping their own normals: every wedge
+ *   of a flat-shaded vertex collapses the same way. So seams neither tear
+ *   nor smear.
+ * Open borders stay where they are: a collapse moving a border vertex
+ * puts v-bar on a border vertex, or for an edge along the border also at
+ * its midpoint, and the border planes of quadric.c price it. With the
+ * posed cost a collapse along the border (two border vertices: the
+ * border's shape changes) ranks with the rest at BORDER_PENALTY times its
+ * cost (1 with mlod_bgm_options.allow_border); one whose only border
+ * vertex stays put costs what it costs. The compactness cost, which
+ * cannot price them, lets border collapses in only once nothing else
+ * collapses. When the queue empties, every live face is queued once
+ * more, so that the sequence ends where no valid collapse is left.
  * v-bar goes to t's barycenter (the paper) or to the posed quadric's
  * optimum (or the barycenter, or for an edge either end, when that is
  * cheaper); Power Skinning
@@ -55,6 +69,8 @@
 #define FLIP_COS 0.2        /* a re-meshed face may turn by less than ~78 degrees */
 #define DEGENERATE 1e-3     /* compactness under which a new face counts as degenerate */
 #define TIE_WEIGHT 1e-5     /* compactness tie-break of the posed cost */
+#define BORDER_PENALTY 50.0 /* posed cost factor of a collapse along a border (measured:
+                             * bench/RESULTS.md, the mesh layer's floor) */
 
 /* An operation on a face: collapse the triangle, or one of its edges. */
 #define OP_TRIANGLE 3       /* ops 0..2: the edge (n[op], n[(op + 1) % 3]) */
@@ -370,13 +386,56 @@ static int near_collapsed(const double *const P[3], int K, const double bary[3],
 	return d <= lmax;
 }
 
+/* The other end of each border edge at node v but the one to w: 1 when
+ * some is also a border neighbour of w, so that collapsing the border
+ * edge (v, w) would close a hole of three edges. */
+static int closes_hole(const mlod_bgm *g, int v, int w)
+{
+	const bgm_node *n = &g->nodes[v], *m = &g->nodes[w];
+	for (int i = 0; i < n->inc_count; i++) {
+		const bgm_face *F = &g->faces[g->inc[n->inc_first + i]];
+		for (int e = 0; e < 3; e++) {
+			if (F->adj[e] >= 0 || (F->n[e] != v && F->n[(e + 1) % 3] != v))
+				continue;
+			int x = F->n[e] == v ? F->n[(e + 1) % 3] : F->n[e];
+			if (x == w)
+				continue;
+			for (int j = 0; j < m->inc_count; j++) {
+				const bgm_face *H = &g->faces[g->inc[m->inc_first + j]];
+				for (int k = 0; k < 3; k++)
+					if (H->adj[k] < 0 && ((H->n[k] == w && H->n[(k + 1) % 3] == x) ||
+					                      (H->n[k] == x && H->n[(k + 1) % 3] == w)))
+						return 1;
+			}
+		}
+	}
+	return 0;
+}
+
+/* Whether collapses may move and remove border vertices: with the posed
+ * cost or mlod_bgm_options.allow_border from the start, else (the
+ * compactness cost, which cannot rank them) once nothing else collapses
+ * (mlod_bgm_simplify's border phase). */
+static int borders_ok(const mlod_bgm *g)
+{
+	return g->opt.allow_border || g->border_phase || g->opt.cost == MLOD_COST_POSED;
+}
+
+/* What a collapse along a border costs, times its posed cost:
+ * BORDER_PENALTY unless mlod_bgm_options.allow_border ranks it like any
+ * other. */
+static double border_factor(const mlod_bgm *g)
+{
+	return g->opt.allow_border ? 1.0 : BORDER_PENALTY;
+}
+
 /* Works out operation op on face t (its triangle collapse, or the
  * collapse of one of its edges); returns 1 when it is valid (pl holds
  * the cheapest valid placement), else 0. */
 static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm)
 {
 	const bgm_face *T = &g->faces[t];
-	int allow_border = g->opt.allow_border;
+	int allow_border = borders_ok(g);
 	if (T->death != BGM_ALIVE)
 		return 0;
 	pl->t = t;
@@ -438,13 +497,19 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		if (count > 2)
 			return 0;
 	}
-	int border = 0, special[3] = {0, 0, 0};
+	int border = 0, nb = 0, onb[3] = {0, 0, 0}, tex[3] = {0, 0, 0}, anytex = 0, special[3] = {0, 0, 0};
 	for (int i = 0; i < K; i++) {
-		int fb = (g->nodes[pl->v[i]].flags & BGM_BORDER) != 0, texture;
-		node_seams(g, pl->v[i], &texture, &pl->hard[i]);
-		border |= fb;
-		special[i] = fb || texture;
+		onb[i] = (g->nodes[pl->v[i]].flags & BGM_BORDER) != 0;
+		node_seams(g, pl->v[i], &tex[i], &pl->hard[i]);
+		border |= onb[i];
+		nb += onb[i];
+		anytex |= tex[i];
 	}
+	/* A texture seam among the collapsed vertices: v-bar snaps onto a
+	 * seam (or border) vertex keeping every wedge group whole. Without
+	 * one, a border only restricts where v-bar goes (below). */
+	for (int i = 0; i < K && anytex; i++)
+		special[i] = onb[i] || tex[i];
 	/* The link condition: the re-meshed faces form one fan around v-bar. */
 	if (!bgm_link_ok(from, to, pl->nk, border))
 		return 0;
@@ -497,7 +562,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 
 	/* Candidate placements. */
 	double cand[MAX_CANDIDATES][3];
-	int cand_snap[MAX_CANDIDATES], cand_role[MAX_CANDIDATES], nc = 0;
+	int cand_snap[MAX_CANDIDATES], cand_role[MAX_CANDIDATES], cand_at[MAX_CANDIDATES], nc = 0;
 	const double *P[3] = {g->nodes[pl->v[0]].p, g->nodes[pl->v[1]].p, K == 3 ? g->nodes[pl->v[2]].p : NULL};
 	double bary[3];
 	for (int i = 0; i < 3; i++) {
@@ -526,10 +591,41 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 				continue;
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
+			cand_at[nc] = s;
 			cand_snap[nc++] = s;
 		}
 		if (nc == 0)
 			return 0;
+	} else if (border) {
+		/* The border stays where it is: v-bar goes to a border vertex,
+		 * or for an edge along the border also to its midpoint. */
+		int along = -1;
+		if (nb >= 2) {
+			/* Two border vertices must share a border edge of t (else the
+			 * collapse would pinch two stretches of border together); three
+			 * never collapse. */
+			for (int e = 0; e < 3 && nb == 2; e++) {
+				int x = owner_of(pl, T->n[e]), y = owner_of(pl, T->n[(e + 1) % 3]);
+				if (x >= 0 && y >= 0 && onb[x] && onb[y] && T->adj[e] < 0)
+					along = e;
+			}
+			if (along < 0 || closes_hole(g, T->n[along], T->n[(along + 1) % 3]))
+				return 0;
+		}
+		for (int s = 0; s < K; s++) {
+			if (!onb[s])
+				continue;
+			memcpy(cand[nc], P[s], sizeof cand[nc]);
+			cand_role[nc] = 1 + s;
+			cand_at[nc] = s;
+			cand_snap[nc++] = -1;
+		}
+		if (K == 2 && nb == 2) {
+			memcpy(cand[nc], bary, sizeof cand[nc]);
+			cand_role[nc] = 4;
+			cand_at[nc] = -1;
+			cand_snap[nc++] = -1;
+		}
 	}
 	/* The summed posed quadrics of the collapsed vertices, and their area
 	 * (the normaliser of the posed cost). */
@@ -554,7 +650,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			mm->known |= MEMO_WSUM;
 		}
 	}
-	if (!(special[0] || special[1] || special[2])) {
+	if (!(special[0] || special[1] || special[2]) && !border) {
 		if (g->opt.placement == MLOD_PLACE_OPTIMAL && g->pose_count > 0) {
 			mlod_influences w;
 			double opt[3];
@@ -579,6 +675,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 					if (near_collapsed(P, K, bary, opt)) {
 						memcpy(cand[nc], opt, sizeof cand[nc]);
 						cand_role[nc] = 0;
+						cand_at[nc] = -1;
 						cand_snap[nc++] = -1;
 					}
 				}
@@ -588,11 +685,13 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			for (int s = 0; s < K && K == 2; s++) {
 				memcpy(cand[nc], P[s], sizeof cand[nc]);
 				cand_role[nc] = 1 + s;
+				cand_at[nc] = s;
 				cand_snap[nc++] = -1;
 			}
 		}
 		memcpy(cand[nc], bary, sizeof cand[nc]);
 		cand_role[nc] = 4;
+		cand_at[nc] = -1;
 		cand_snap[nc++] = -1;
 	}
 
@@ -704,11 +803,13 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	}
 	if (best < 0)
 		return 0;
+	if (nb >= 2 && g->opt.cost == MLOD_COST_POSED)
+		pl->cost *= border_factor(g); /* the border moves (a lone border vertex stays put) */
 	memcpy(pl->pos, cand[best], sizeof pl->pos);
 	pl->snap = cand_snap[best];
-	if (pl->snap >= 0) {
+	if (cand_at[best] >= 0) {
 		pl->lambda[0] = pl->lambda[1] = pl->lambda[2] = 0.0;
-		pl->lambda[pl->snap] = 1.0;
+		pl->lambda[cand_at[best]] = 1.0;
 	} else if (K == 3) {
 		barycentric(P[0], P[1], P[2], pl->pos, pl->lambda);
 	} else {
@@ -1075,7 +1176,7 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 		if (op != OP_TRIANGLE && i != op && i != (op + 1) % 3)
 			continue;
 		int fl = g->nodes[F->n[i]].flags;
-		if ((fl & BGM_LOCKED) || !(fl & BGM_ELIGIBLE) || (!g->opt.allow_border && (fl & BGM_BORDER)))
+		if ((fl & BGM_LOCKED) || !(fl & BGM_ELIGIBLE) || (!borders_ok(g) && (fl & BGM_BORDER)))
 			return 0; /* never collapsible while these nodes live */
 	}
 	double key;
@@ -1126,6 +1227,19 @@ static int push_face(mlod_bgm *g, int f, struct plan *scratch)
 	for (int e = 0; e < 3; e++)
 		if (!queued_across(g, f, e) && push_op(g, f, e, scratch))
 			return -1;
+	return 0;
+}
+
+/* 1 when node v has a live edge with one face. */
+static int on_border(const mlod_bgm *g, int v)
+{
+	const bgm_node *n = &g->nodes[v];
+	for (int i = 0; i < n->inc_count; i++) {
+		const bgm_face *F = &g->faces[g->inc[n->inc_first + i]];
+		for (int e = 0; e < 3; e++)
+			if (F->adj[e] < 0 && (F->n[e] == v || F->n[(e + 1) % 3] == v))
+				return 1;
+	}
 	return 0;
 }
 
@@ -1284,6 +1398,17 @@ static int apply(mlod_bgm *g, struct plan *pl)
 		}
 	}
 
+	/* Border flags as the new faces leave them: a collapse along a border
+	 * can close a hole, leaving v-bar or a ring vertex inside. */
+	for (int j = 0; j < pl->nk; j++)
+		for (int k = 0; k < 3; k++) {
+			bgm_node *n = &g->nodes[g->faces[first + j].n[k]];
+			if (on_border(g, g->faces[first + j].n[k]))
+				n->flags |= BGM_BORDER;
+			else
+				n->flags &= ~BGM_BORDER;
+		}
+
 	mlod_vsplit *r = &g->records[g->record_count++];
 	memset(r, 0, sizeof *r);
 	for (int i = 0; i < 3; i++)
@@ -1319,6 +1444,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 	}
 	if (!g->heap.ready) {
 		g->heap.ready = 1;
+		g->swept = g->record_count;
 		g->heap.memo_free = -1;
 		for (int f = 0; f < g->face_count; f++)
 			if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
@@ -1327,8 +1453,24 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			}
 	}
 	int done_count = 0;
-	while (g->heap.count > 0 && (target <= 0 || g->live_triangles > target) &&
-	       (max_collapses <= 0 || done_count < max_collapses)) {
+	while ((target <= 0 || g->live_triangles > target) && (max_collapses <= 0 || done_count < max_collapses)) {
+		if (g->heap.count == 0) {
+			/* Nothing else collapses: without --allow-border, open borders
+			 * go last (every prefix before is what it was without them).
+			 * Every live face is queued again, border collapses with it. */
+			if (!borders_ok(g) && g->border_edges > 0)
+				g->border_phase = 1;
+			else if (g->record_count == g->swept)
+				break;
+			g->swept = g->record_count;
+			memset(g->opstate, 0, (size_t)g->opstate_cap);
+			for (int f = 0; f < g->face_count; f++)
+				if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
+					r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
+					goto done;
+				}
+			continue;
+		}
 		heap_entry e = heap_pop(&g->heap);
 		if (g->faces[e.face].death != BGM_ALIVE) {
 			memo_release(&g->heap, e.memo);

@@ -79,8 +79,10 @@ typedef enum mlod_mesh_cost {
 	MLOD_COST_POSED         /* beyond the paper: quadric error summed over poses, compactness as tie-break */
 } mlod_mesh_cost;
 
-/* Where v-bar goes. Next to a seam or an allowed border it always snaps
- * to a seam (border) vertex, so that textures neither tear nor smear. */
+/* Where v-bar goes. Next to a texture seam it always snaps to a seam
+ * vertex (a border vertex when a border is involved), so that textures
+ * neither tear nor smear; a collapse moving a border vertex puts v-bar on
+ * a border vertex or the midpoint of a border edge. */
 typedef enum mlod_placement {
 	MLOD_PLACE_DEFAULT = 0, /* OPTIMAL with the posed cost (measured), BARYCENTER with compactness (the paper) */
 	MLOD_PLACE_BARYCENTER,  /* the paper: the triangle's barycenter */
@@ -103,7 +105,9 @@ typedef struct mlod_bgm_options {
 	mlod_collapse_op op;
 	mlod_eligibility eligibility;
 	double tau;                  /* 0 means 1 */
-	int allow_border;            /* let collapses move and remove border vertices */
+	int allow_border;            /* collapses along a border rank at their plain posed cost
+	                              * (default: 50 times it), and with the compactness cost border
+	                              * collapses start at once (default: once nothing else does) */
 	int fast_cost;               /* posed cost: every pose's quadrics pulled back into bind
 	                              * space with each vertex's own influences (DeCoro &
 	                              * Rusinkiewicz 2005), not skinned with each placement's:
@@ -141,7 +145,8 @@ typedef struct mlod_bgm_info {
 	int collapses;         /* recorded so far */
 	int live_triangles;    /* after all of them */
 	int caps;              /* collapses whose v-bar had more than 4 influences */
-	int snaps;             /* collapses that snapped v-bar to a seam or border vertex */
+	int snaps;             /* collapses that snapped v-bar to a texture seam's vertex, keeping
+	                        * its wedges (a border vertex with the seam on a border) */
 	int refused;           /* candidate collapses refused as invalid */
 	double build_seconds;
 	double collapse_seconds;

@@ -18,7 +18,7 @@ const p = JSON.parse(fs.readFileSync('p.json')).toc, d = JSON.parse(fs.readFileS
 if (p.length !== d.length) throw new Error('chunk counts');
 const levels = (t) => t.filter((x) => /^(MESH|ANIM|SKEL)/.test(x));
 if (levels(p).join() !== levels(d).join()) throw new Error('level chunks differ: ' + levels(p).filter((x, i) => x !== levels(d)[i]).join(', '));
-if (levels(p).length !== 1 + 4 + 14 * 4) throw new Error('levels: ' + levels(p).length);
+if (levels(p).length !== 1 + 5 + 14 * 4) throw new Error('levels: ' + levels(p).length);
 const doc = (t) => t.filter((x) => /^DOC/.test(x)).join();
 if (doc(p) !== doc(d)) throw new Error('DOC chunks differ: ' + doc(p) + ' ' + doc(d));
 const sp = fs.statSync('piped.mlod').size, sd = fs.statSync('direct.mlod').size;

@@ -6,7 +6,7 @@ node "$ROOT/tests/cli/pack_check.mjs" robot.mlod > c.json
 node - <<'JS'
 const fs = require('fs');
 const c = JSON.parse(fs.readFileSync('c.json'));
-const want = { joints: 43, skins: 4, skeleton_levels: 1, mesh_levels: 4, clips: 14, motion_levels: 4, parts: 19 };
+const want = { joints: 43, skins: 4, skeleton_levels: 1, mesh_levels: 5, clips: 14, motion_levels: 4, parts: 19 };
 for (const k in want) if (c[k] !== want[k]) throw new Error(`${k}: ${c[k]}`);
 if (c.clip_names[0] !== 'Dance' || c.clip_names.length !== 14) throw new Error('clip names');
 for (const t of ['MTSC', 'MTPQ', 'ROTQ']) if (!c.tags.includes(t)) throw new Error('no ' + t);
