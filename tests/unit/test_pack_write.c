@@ -220,6 +220,8 @@ static uint8_t *stream(const uint8_t *chunk, uint32_t tag, int nth, uint32_t *co
 				memcpy(out, chunk + at, (size_t)*count * *size);
 			else if (h[10] == MLOD_SCODEC_MESHOPT_VERTEX)
 				meshopt_decodeVertexBuffer(out, *count, *size, chunk + at, stored);
+			else if (h[10] == MLOD_SCODEC_MESHOPT_SEQUENCE)
+				meshopt_decodeIndexSequence(out, *count, *size, chunk + at, stored);
 			else
 				meshopt_decodeIndexBuffer(out, *count, *size, chunk + at, stored);
 			return out;
@@ -326,6 +328,30 @@ TEST(pack_mesh_streams)
 	uint8_t *wgt = pref[2], *jnt = pref[3];
 	uint16_t *idx = (uint16_t *)stream(mesh, MLOD_STREAM_IDX, 0, &cnt, &esz);
 	CHECK(idx && esz == 2 && cnt == part->index_count);
+	/* In the level's own numbering (MLOD_PART_LOCAL): its vertices, in
+	 * first-use order, are the block's next ones where 'INEW' (with
+	 * NEWBITS) sets their bits, else the next of 'IMAP'. Map idx through. */
+	uint16_t *imap = (uint16_t *)stream(mesh, MLOD_STREAM_IMAP, 0, &c1, &e1);
+	uint32_t nw = 0, ew = 0, *inew = (uint32_t *)stream(mesh, MLOD_STREAM_INEW, 0, &nw, &ew);
+	CHECK(!imap == !(part->flags & MLOD_PART_LOCAL) && !inew == !(part->flags & MLOD_PART_NEWBITS));
+	if (imap) {
+		uint32_t V = part->vertex_count, *to = malloc(sizeof *to * ((size_t)V + 1)), nnew = 0, nold = 0;
+		CHECK(e1 == 2 && (!inew || (ew == 4 && nw == (V + 31) / 32)));
+		for (uint32_t v = 0; v < V; v++)
+			to[v] = inew && inew[v / 32] >> (v % 32) & 1u ? bn[0] + nnew++ : nold < c1 ? imap[nold++] : total;
+		CHECK(nold == c1 && nnew <= bn[1]);
+		uint8_t *used = calloc((size_t)V + 1, 1);
+		uint32_t nused = 0;
+		for (uint32_t t = 0; t < cnt; t++) {
+			uint16_t l = idx[t] < V ? idx[t] : 0;
+			CHECK(idx[t] < V && to[l] < total);
+			nused += !used[l], used[l] = 1;
+			idx[t] = (uint16_t)to[l];
+		}
+		CHECK(nused == V); /* every vertex of the level used */
+		free(to), free(used);
+	}
+	free(imap), free(inew);
 	/* Level 0's triangles follow one of mlod_pack_vertex_order's orders
 	 * (each up to a rotation of its corners, which the index codec may
 	 * make), each order-local vertex standing for one prefix vertex: find
@@ -356,7 +382,11 @@ TEST(pack_mesh_streams)
 			order = o, memcpy(best_gid, gid, sizeof *gid * nv);
 	}
 	CHECK_MSG(order >= 0, "the stored triangles are none of the orders'");
-	printf("# MESH level 0 stored in order %d, its block %u vertices after level 1's %u\n", order, bn[1], bn[0]);
+	printf("# MESH level 0 stored in order %d, its block %u vertices after level 1's %u, %s numbering\n", order,
+	       bn[1], bn[0],
+	       part->flags & MLOD_PART_NEWBITS ? "its own (new vertices marked)"
+	       : part->flags & MLOD_PART_LOCAL ? "its own (a map of every vertex)"
+	                                       : "the prefix's");
 	for (int u = 0; order >= 0 && u < pr->vertex_count; u++) {
 		if (best_gid[remap[u]] == UINT32_MAX)
 			continue; /* no triangle uses it */
