@@ -1070,14 +1070,14 @@ static uint32_t part_vertex(struct mpart *m, const uint8_t *key)
  * level's triangles (mlod_pack_vertex_order); the level's indices into
  * the buffer, or NULL when out of memory. */
 static uint32_t *part_append(struct mpart *m, const uint8_t *V, const uint32_t *in, uint32_t ni, uint32_t nv,
-                             const float *positions, int o)
+                             const float *positions, int o, mlod_pack_order_memo *memo)
 {
 	uint32_t *remap = malloc(sizeof *remap * ((size_t)nv + 1));
 	uint32_t *inv = malloc(sizeof *inv * ((size_t)nv + 1));
 	uint32_t *out = malloc(sizeof *out * ((size_t)ni + 1));
 	uint32_t *gid = malloc(sizeof *gid * ((size_t)nv + 1));
 	uint32_t *idx = malloc(sizeof *idx * ((size_t)ni + 1));
-	if (!remap || !inv || !out || !gid || !idx || mlod_pack_vertex_order(o, in, ni, nv, positions, remap, out) != 0) {
+	if (!remap || !inv || !out || !gid || !idx || mlod_pack_vertex_order_memo(o, in, ni, nv, positions, memo, remap, out) != 0) {
 		free(remap), free(inv), free(out), free(gid), free(idx);
 		return NULL;
 	}
@@ -1449,6 +1449,7 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	uint32_t *in = malloc(sizeof *in * ((size_t)ni + 1));
 	uint32_t *saved = malloc(sizeof *saved * m->slot_cap);
 	iforms f = {0};
+	mlod_pack_order_memo memo = {{NULL, NULL}}; /* the triangle orders the vertex orders share */
 	f.seen = calloc((size_t)m->count + nv + 1, sizeof *f.seen);
 	f.map = malloc(sizeof *f.map * ((size_t)ni + 1));
 	f.lidx = malloc(sizeof *f.lidx * ((size_t)ni + 1));
@@ -1467,7 +1468,7 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 		size_t best_bytes = 0;
 		memcpy(saved, m->slot, sizeof *saved * m->slot_cap);
 		for (int o = 0; o < MLOD_PACK_ORDERS; o++) {
-			uint32_t *ix = part_append(m, V, in, ni, nv, p->positions, o);
+			uint32_t *ix = part_append(m, V, in, ni, nv, p->positions, o, &memo);
 			if (!ix)
 				goto done;
 			int from = cb->n, loc;
@@ -1483,7 +1484,7 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 			m->count = count0;
 		}
 	}
-	if (!(idx = part_append(m, V, in, ni, nv, p->positions, best)))
+	if (!(idx = part_append(m, V, in, ni, nv, p->positions, best, &memo)))
 		goto done;
 	/* The vertices the level uses: what a reader gathers from the prefix. */
 	size_t st;
@@ -1503,6 +1504,7 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	ok = 1;
 done:
 	free(V), free(in), free(saved), free(idx), free(f.seen), free(f.map), free(f.lidx), free(f.words), free(f.old);
+	mlod_pack_order_memo_free(&memo);
 	return ok;
 }
 
