@@ -224,13 +224,14 @@ void mlod_pack_top4(const mlod_primitive *p, uint32_t v, const int *jmap, int jm
 int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
                            uint32_t *remap, uint32_t *out);
 
-/* The same, keeping the two triangle orders that several orders share
- * (meshopt_optimizeVertexCache's, 1 2 6 8, and the FIFO one, 4 5 7 9) in
- * memo between calls on the same indices, so that each is made once;
+/* The same, keeping the triangle orders in memo between calls on the
+ * same indices (meshopt_optimizeVertexCache's, which orders 1 2 6 8
+ * share, the FIFO one of 4 5 7 9, the strip one of 3), so that each is
+ * made once;
  * zero it before the first call, release it with
  * mlod_pack_order_memo_free. The results equal mlod_pack_vertex_order's. */
 typedef struct mlod_pack_order_memo {
-	uint32_t *tri[2]; /* the cache and FIFO triangle orders, ni each, or NULL */
+	uint32_t *tri[3]; /* the cache, FIFO and strip triangle orders, ni each, or NULL */
 } mlod_pack_order_memo;
 int mlod_pack_vertex_order_memo(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
                                 mlod_pack_order_memo *memo, uint32_t *remap, uint32_t *out);

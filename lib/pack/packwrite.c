@@ -1068,9 +1068,12 @@ static uint32_t part_vertex(struct mpart *m, const uint8_t *key)
 
 /* Appends level V's vertices not yet in the buffer, in order o of the
  * level's triangles (mlod_pack_vertex_order); the level's indices into
- * the buffer, or NULL when out of memory. */
+ * the buffer, or NULL when out of memory. With cls (each vertex of V: its
+ * buffer id as the hash set gave it, or for a vertex the buffer lacked,
+ * count + the first of its bit-identical copies in V), the same without
+ * the hash set, which it leaves as it was (for trying orders). */
 static uint32_t *part_append(struct mpart *m, const uint8_t *V, const uint32_t *in, uint32_t ni, uint32_t nv,
-                             const float *positions, int o, mlod_pack_order_memo *memo)
+                             const float *positions, int o, mlod_pack_order_memo *memo, const uint32_t *cls)
 {
 	uint32_t *remap = malloc(sizeof *remap * ((size_t)nv + 1));
 	uint32_t *inv = malloc(sizeof *inv * ((size_t)nv + 1));
@@ -1083,8 +1086,27 @@ static uint32_t *part_append(struct mpart *m, const uint8_t *V, const uint32_t *
 	}
 	for (uint32_t v = 0; v < nv; v++)
 		inv[remap[v]] = v;
-	for (uint32_t j = 0; j < nv; j++)
-		gid[j] = part_vertex(m, V + (size_t)inv[j] * (size_t)m->stride);
+	if (cls) { /* remap becomes each new class's id: UINT32_MAX until placed */
+		uint32_t count0 = m->count;
+		for (uint32_t v = 0; v < nv; v++)
+			remap[v] = UINT32_MAX;
+		for (uint32_t j = 0; j < nv; j++) {
+			uint32_t c = cls[inv[j]];
+			if (c < count0) {
+				gid[j] = c;
+				continue;
+			}
+			if (remap[c - count0] == UINT32_MAX) {
+				memcpy(m->G + (size_t)m->count * (size_t)m->stride, V + (size_t)inv[j] * (size_t)m->stride,
+				       (size_t)m->stride);
+				remap[c - count0] = m->count++;
+			}
+			gid[j] = remap[c - count0];
+		}
+	} else {
+		for (uint32_t j = 0; j < nv; j++)
+			gid[j] = part_vertex(m, V + (size_t)inv[j] * (size_t)m->stride);
+	}
 	for (uint32_t t = 0; t < ni; t++)
 		idx[t] = gid[out[t]];
 	free(remap), free(inv), free(out), free(gid);
@@ -1449,13 +1471,13 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	uint32_t *in = malloc(sizeof *in * ((size_t)ni + 1));
 	uint32_t *saved = malloc(sizeof *saved * m->slot_cap);
 	iforms f = {0};
-	mlod_pack_order_memo memo = {{NULL, NULL}}; /* the triangle orders the vertex orders share */
+	mlod_pack_order_memo memo = {{NULL, NULL, NULL}}; /* the triangle orders the vertex orders share */
 	f.seen = calloc((size_t)m->count + nv + 1, sizeof *f.seen);
 	f.map = malloc(sizeof *f.map * ((size_t)ni + 1));
 	f.lidx = malloc(sizeof *f.lidx * ((size_t)ni + 1));
 	f.words = malloc(sizeof *f.words * ((size_t)ni / 32 + 2));
 	f.old = malloc(sizeof *f.old * ((size_t)ni + 1));
-	uint32_t *idx = NULL;
+	uint32_t *idx = NULL, *cls = NULL;
 	int ok = 0, local = 0;
 	if (!V || !in || !saved || !f.seen || !f.map || !f.lidx || !f.words || !f.old)
 		goto done;
@@ -1466,9 +1488,17 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	int best = 0;
 	if (x->opt->codec == MLOD_CODEC_MESHOPT) {
 		size_t best_bytes = 0;
+		/* Each vertex's class once (part_append's cls), the hash set
+		 * then as it was: the orders tried need no hashing. */
 		memcpy(saved, m->slot, sizeof *saved * m->slot_cap);
+		if (!(cls = malloc(sizeof *cls * ((size_t)nv + 1))))
+			goto done;
+		for (uint32_t v = 0; v < nv; v++)
+			cls[v] = part_vertex(m, V + (size_t)v * (size_t)m->stride);
+		memcpy(m->slot, saved, sizeof *saved * m->slot_cap);
+		m->count = count0;
 		for (int o = 0; o < MLOD_PACK_ORDERS; o++) {
-			uint32_t *ix = part_append(m, V, in, ni, nv, p->positions, o, &memo);
+			uint32_t *ix = part_append(m, V, in, ni, nv, p->positions, o, &memo, cls);
 			if (!ix)
 				goto done;
 			int from = cb->n, loc;
@@ -1480,11 +1510,10 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 			free(ix);
 			if (o == 0 || b < best_bytes)
 				best = o, best_bytes = b;
-			memcpy(m->slot, saved, sizeof *saved * m->slot_cap);
 			m->count = count0;
 		}
 	}
-	if (!(idx = part_append(m, V, in, ni, nv, p->positions, best, &memo)))
+	if (!(idx = part_append(m, V, in, ni, nv, p->positions, best, &memo, NULL)))
 		goto done;
 	/* The vertices the level uses: what a reader gathers from the prefix. */
 	size_t st;
@@ -1505,6 +1534,7 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 done:
 	free(V), free(in), free(saved), free(idx), free(f.seen), free(f.map), free(f.lidx), free(f.words), free(f.old);
 	mlod_pack_order_memo_free(&memo);
+	free(cls);
 	return ok;
 }
 

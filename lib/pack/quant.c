@@ -209,8 +209,8 @@ static int group_copies(const float *positions, uint32_t nv, uint32_t *remap)
 
 void mlod_pack_order_memo_free(mlod_pack_order_memo *memo)
 {
-	free(memo->tri[0]), free(memo->tri[1]);
-	memo->tri[0] = memo->tri[1] = NULL;
+	free(memo->tri[0]), free(memo->tri[1]), free(memo->tri[2]);
+	memo->tri[0] = memo->tri[1] = memo->tri[2] = NULL;
 }
 
 int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
@@ -235,17 +235,17 @@ int mlod_pack_vertex_order_memo(int order, const uint32_t *indices, uint32_t ni,
 	unsigned int *cache = malloc(sizeof *cache * ((size_t)ni + 1));
 	if (!cache)
 		return -1;
-	int fifo = order == 4 || order == 5 || order == 7 || order == 9;
-	if (order == 3)
+	int kind = order == 3 ? 2 : order == 4 || order == 5 || order == 7 || order == 9 ? 1 : 0;
+	if (memo && memo->tri[kind])
+		memcpy(cache, memo->tri[kind], sizeof *cache * ni);
+	else if (kind == 2)
 		meshopt_optimizeVertexCacheStrip(cache, indices, ni, nv);
-	else if (memo && memo->tri[fifo])
-		memcpy(cache, memo->tri[fifo], sizeof *cache * ni);
-	else if (fifo)
+	else if (kind == 1)
 		meshopt_optimizeVertexCacheFifo(cache, indices, ni, nv, MLOD_PACK_INDEX_FIFO);
 	else
 		meshopt_optimizeVertexCache(cache, indices, ni, nv);
-	if (memo && order != 3 && !memo->tri[fifo] && (memo->tri[fifo] = malloc(sizeof *cache * ((size_t)ni + 1))))
-		memcpy(memo->tri[fifo], cache, sizeof *cache * ni);
+	if (memo && !memo->tri[kind] && (memo->tri[kind] = malloc(sizeof *cache * ((size_t)ni + 1))))
+		memcpy(memo->tri[kind], cache, sizeof *cache * ni);
 	if ((order == 6 || order == 7) && positions) {
 		meshopt_spatialSortRemap(remap, positions, nv, 3 * sizeof(float));
 		meshopt_remapIndexBuffer(out, cache, ni, remap);
