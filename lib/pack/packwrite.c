@@ -2034,6 +2034,42 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 			cb_add(&cb, MLOD_STREAM_TIME, (uint32_t)nt, 4, tk, 0);
 		else
 			cb_add(&cb, MLOD_STREAM_TICK, (uint32_t)nt, wide ? 4 : 2, tk, 0);
+		/* Or 'TBIT' (format 3.0), each array's first tick then a bit per
+		 * tick after it: whichever stores fewer bytes. */
+		if (step > 0 && !cb.fail) {
+			size_t nbits = 0;
+			for (int a = 0; a < na; a++)
+				if (cnt[a] > 0)
+					nbits += (size_t)((uint32_t)floor((double)arr[a][cnt[a] - 1] / step + 0.5) -
+					                  (uint32_t)floor((double)arr[a][0] / step + 0.5));
+			size_t nw = (size_t)na + (nbits + 31) / 32;
+			uint32_t *w = nw <= UINT32_MAX ? calloc(nw + 1, 4) : NULL;
+			if (!w) {
+				cb.fail = 1;
+			} else {
+				size_t b = 0;
+				for (int a = 0; a < na; a++) {
+					uint32_t first = cnt[a] > 0 ? (uint32_t)floor((double)arr[a][0] / step + 0.5) : 0;
+					w[a] = first;
+					for (int q = 1; q < cnt[a]; q++) {
+						uint32_t tq = (uint32_t)floor((double)arr[a][q] / step + 0.5);
+						uint32_t tp = (uint32_t)floor((double)arr[a][q - 1] / step + 0.5);
+						b += tq - tp; /* the key's bit: the last of its gap */
+						w[(size_t)na + (b - 1) / 32] |= 1u << ((b - 1) % 32);
+					}
+				}
+				stream tb = {MLOD_STREAM_TBIT, (uint32_t)nw, 4, 0, (uint8_t *)w};
+				const stream *st = &cb.s[cb.n - 1];
+				int coded = x->opt->codec == MLOD_CODEC_MESHOPT;
+				size_t bt = coded ? stream_coded_bytes(&tb) : nw * 4;
+				size_t bk = coded ? stream_coded_bytes(st) : ((size_t)st->count * st->size + 3) & ~(size_t)3;
+				if (bt < bk) {
+					free(cb.s[--cb.n].data);
+					cb_add(&cb, MLOD_STREAM_TBIT, (uint32_t)nw, 4, w, 0);
+				}
+				free(w);
+			}
+		}
 	}
 	free(tk);
 	free(arr);

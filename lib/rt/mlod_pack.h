@@ -19,7 +19,8 @@
  *   0  u8[4]  magic "MLOD"
  *   4  u16    major version (MLOD_PACK_MAJOR); a reader refuses a newer one,
  *             and one older than MLOD_PACK_MAJOR_OLDEST (1.x: MESH layout
- *             a, no decode path); 2.x is 3.x without MLOD_PART_LOCAL
+ *             a, no decode path); 2.x is 3.x without MLOD_PART_LOCAL,
+ *             the sequence codec and 'TBIT'
  *   6  u16    minor version; a newer minor only adds what older readers skip
  *   8  u32    flags (0; a reader ignores bits it does not know)
  *  12  u32    chunk_count (at most MLOD_PACK_MAX_CHUNKS)
@@ -164,7 +165,14 @@
  *          step > 0: each array's first tick, then each next tick minus
  *          the one before (every tick below 2^32); time =
  *          (float)((double)tick * step): the key time read, or within
- *          2^-20 * max(|t|, step) of it (mlod(5), QUANTISATION)
+ *          2^-20 * max(|t|, step) of it (mlod(5), QUANTISATION); or
+ *   'TBIT' u32 words, when step > 0 (format 3.0; the writer stores the
+ *          smaller of the two): each array's first tick (one word per
+ *          array), then one bit stream (bit b is bit b % 32 of word
+ *          arrays + b / 32): per array in order, a bit per tick after its
+ *          first, set where the array has a key, ending with its last
+ *          key's bit; the next array's bits follow at once; exactly as
+ *          many words as that takes
  *   then the values, three streams, each holding the keys of its
  *   channels one channel after the other in channel order (possibly 0
  *   elements):
@@ -329,6 +337,7 @@ typedef enum mlod_pack_codec {
 #define MLOD_STREAM_STEP MLOD_FOURCC('S', 'T', 'E', 'P')
 #define MLOD_STREAM_TIME MLOD_FOURCC('T', 'I', 'M', 'E')
 #define MLOD_STREAM_TICK MLOD_FOURCC('T', 'I', 'C', 'K')
+#define MLOD_STREAM_TBIT MLOD_FOURCC('T', 'B', 'I', 'T')
 #define MLOD_STREAM_ROTQ MLOD_FOURCC('R', 'O', 'T', 'Q')
 /* TOC flags of a MOTION chunk: its rotation keys build on the clip's next
  * coarser level (level + 1, earlier in the file). */

@@ -1887,7 +1887,9 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	 * rounding each */
 	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel)) + 8 * C;
 	while (cx_next(&x, &s)) {
-		uint64_t per = s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK ? 4
+		/* 'TBIT': each key but an array's first takes a bit at least */
+		uint64_t per = s.tag == MLOD_STREAM_TBIT                                 ? 4 * 32
+		               : s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK ? 4
 		               : s.tag == MLOD_STREAM_ROTQ || s.tag == MLOD_STREAM_ROTD || s.tag == MLOD_STREAM_ROTF ? 16
 		               : s.tag == MLOD_STREAM_VEC3 || s.tag == MLOD_STREAM_VECD   ? 12
 		                                                                          : 0;
@@ -1960,21 +1962,46 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	/* The key times: one stream, the arrays one after the other. */
 	if (!cx_next(&x, &s))
 		FAIL("%s: missing its key times", x.label);
-	if (s.tag != (step > 0 ? MLOD_STREAM_TICK : MLOD_STREAM_TIME))
+	if (step > 0 ? s.tag != MLOD_STREAM_TICK && s.tag != MLOD_STREAM_TBIT : s.tag != MLOD_STREAM_TIME)
 		FAIL("%s: stream %u is '%s', expected '%s' (step %g)", x.label, s.index, tagn(s.tag).s,
-		     step > 0 ? "TICK" : "TIME", step);
+		     step > 0 ? "TICK' or 'TBIT" : "TIME", step);
 	if (s.tag == MLOD_STREAM_TICK ? s.elsize != 2 && s.elsize != 4 : s.elsize != 4)
 		FAIL("%s: stream %u '%s' has elements of %u bytes, expected %s", x.label, s.index, tagn(s.tag).s, s.elsize,
 		     s.tag == MLOD_STREAM_TICK ? "2 or 4" : "4");
-	if (s.count != nt)
-		FAIL("%s: stream %u '%s' has %u elements, expected %llu (the time arrays' keys)", x.label, s.index,
-		     tagn(s.tag).s, s.count, (unsigned long long)nt);
+	if (s.tag == MLOD_STREAM_TBIT ? s.count < T : s.count != nt)
+		FAIL("%s: stream %u '%s' has %u elements, expected %s%llu (the time arrays' %s)", x.label, s.index,
+		     tagn(s.tag).s, s.count, s.tag == MLOD_STREAM_TBIT ? "at least " : "",
+		     (unsigned long long)(s.tag == MLOD_STREAM_TBIT ? T : nt),
+		     s.tag == MLOD_STREAM_TBIT ? "first ticks" : "keys");
 	TRY(cx_load(&x, &s, &src, err));
 	float *all;
 	TAKE(all, nt * 4);
-	if (s.tag == MLOD_STREAM_TIME)
+	if (s.tag == MLOD_STREAM_TIME) {
 		memcpy(all, src, (size_t)nt * 4);
-	else /* each array's first tick, then each next's difference */
+	} else if (s.tag == MLOD_STREAM_TBIT) { /* each array's first tick, then a bit per tick after it */
+		uint64_t nbits = 32 * ((uint64_t)s.count - T), b = 0;
+		for (uint64_t t = 0, k = 0; t < T; t++) {
+			uint64_t tick = rd32(src + 4 * t);
+			for (uint32_t q = 0; q < tcount[t]; q++, k++) {
+				while (q > 0) { /* to the next set bit */
+					if (b == nbits)
+						FAIL("%s: stream %u 'TBIT': time array %u: key %u: the bits run out", x.label, s.index,
+						     (unsigned)t, q);
+					tick++;
+					uint32_t w = rd32(src + 4 * (T + b / 32));
+					if (w >> (b++ % 32) & 1u)
+						break;
+				}
+				if (tick > UINT32_MAX)
+					FAIL("%s: stream %u 'TBIT': time array %u: key %u: tick %llu is above 2^32 - 1", x.label,
+					     s.index, (unsigned)t, q, (unsigned long long)tick);
+				all[k] = (float)((double)tick * step);
+			}
+		}
+		if ((b + 31) / 32 != (uint64_t)s.count - T)
+			FAIL("%s: stream %u 'TBIT' has %u elements, expected %llu (the arrays' first ticks and bits)", x.label,
+			     s.index, s.count, (unsigned long long)(T + (b + 31) / 32));
+	} else /* each array's first tick, then each next's difference */
 		for (uint64_t t = 0, k = 0; t < T; t++) {
 			uint64_t tick = 0;
 			for (uint32_t q = 0; q < tcount[t]; q++, k++) {

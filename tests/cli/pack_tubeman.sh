@@ -13,7 +13,7 @@ const c = JSON.parse(fs.readFileSync('c.json')), r = JSON.parse(fs.readFileSync(
 const want = { joints: 31, skins: 1, skeleton_levels: 3, mesh_levels: 5, clips: 1, motion_levels: 4, parts: 1, name: 'tubeman' };
 for (const k in want) if (c[k] !== want[k]) throw new Error(`${k}: ${c[k]}`);
 for (const t of ['KEPT', 'PALJ', 'PALB', 'POSQ', 'NRMQ', 'JNT8', 'WGT8', 'IDX ', 'IMAP', 'CHAN', 'STEP', 'ROTQ']) if (!c.tags.includes(t)) throw new Error('no ' + t);
-if (!c.tags.includes('TIME') && !c.tags.includes('TICK')) throw new Error('no key times');
+if (!c.tags.includes('TIME') && !c.tags.includes('TICK') && !c.tags.includes('TBIT')) throw new Error('no key times');
 if (JSON.stringify(c.stream_codecs) !== '[0,1,2,3]') throw new Error('stream codecs ' + c.stream_codecs);
 const levels = { skeleton: 3, mesh: 5, motion: 4 };
 for (const l in levels) if (r.layers[l].source !== 'computed' || r.layers[l].levels !== levels[l]) throw new Error(l);

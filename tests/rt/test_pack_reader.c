@@ -1176,6 +1176,63 @@ TEST(decode_mesh_meshopt_and_raw)
 	CHECK_MSG(ok, "%s", why);
 }
 
+/* MOTION level 0's key times as 'TBIT' (format 3.0) instead of 'TICK':
+ * the two arrays' first ticks (0, 0), then the bits of ticks 1 to NK - 1
+ * of each, set: the same times; words as given. */
+static void motion_tbit(wchunk *c, uint32_t bits, uint32_t words)
+{
+	for (int i = 0; i < c[C_MOT0].ns; i++) {
+		wstream *s = &c[C_MOT0].s[i];
+		if (s->tag != MLOD_STREAM_TICK)
+			continue;
+		s->tag = MLOD_STREAM_TBIT;
+		s->data.n = 0;
+		put32(&s->data, 0);
+		put32(&s->data, 0);
+		put32(&s->data, bits);
+		for (uint32_t w = 3; w < words; w++)
+			put32(&s->data, 0);
+		s->count = words;
+	}
+}
+
+TEST(motion_tick_bits)
+{
+	_Static_assert(NK == 5, "the bits below are for 5 keys per array");
+	static const struct {
+		uint32_t bits, words;
+		mlod_result code;
+		const char *text;
+	} cases[] = {
+	        {0xff, 3, MLOD_OK, ""},
+	        {0x7f, 3, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 'TBIT': time array 1: key 4: the bits run out"},
+	        {0xff, 4, MLOD_ERR_PARSE,
+	         "MOTION level 0 of clip 0: stream 2 'TBIT' has 4 elements, expected 3 (the arrays' first ticks and bits)"},
+	};
+	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+		static wchunk c[C_COUNT + 1];
+		int n = make_chunks(c, 0);
+		motion_tbit(c, cases[k].bits, cases[k].words);
+		buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+		free_chunks(c, n);
+		mlod_pack p = {0};
+		mlod_pack_skeleton s = {0};
+		mlod_pack_motion m = {0};
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+		CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &s, &terr));
+		memset(&terr, 0, sizeof terr);
+		mlod_result r = mlod_pack_decode_motion(&p, C_MOT0, b.p, b.n, &s, &m, &terr);
+		int ok = r == cases[k].code && strstr(terr.message, cases[k].text) != NULL;
+		for (int q = 0; ok && r == MLOD_OK && q < NK; q++)
+			ok = m.channels[1].times[q] == time_truth[q] && m.channels[3].times[q] == time_truth[q];
+		CHECK_MSG(ok, "case %zu: returned %d: %s", k, (int)r, terr.message);
+		mlod_pack_motion_free(&m);
+		mlod_pack_skeleton_free(&s);
+		mlod_pack_close(&p);
+		free(b.p);
+	}
+}
+
 TEST(decode_motion)
 {
 	buf b = make_pack(0);
@@ -1945,6 +2002,7 @@ int main(int argc, char **argv)
 	RUN(newer_major_is_refused);
 	RUN(older_major_is_refused);
 	RUN(format_2_0_reads);
+	RUN(motion_tick_bits);
 	RUN(nested_motion_needs_its_base);
 	RUN(draco_chunks_are_unsupported);
 	RUN(every_prefix);

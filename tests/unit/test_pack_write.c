@@ -809,21 +809,22 @@ TEST(pack_lossless_fields)
 				continue;
 			/* the chunk's streams: time arrays shared, ticks for sampled clips */
 			const uint8_t *ch = (const uint8_t *)out + pk.chunks[ci].offset;
-			uint32_t n0 = rd32(ch), ntime = 0, time_keys = 0, keys = 0;
+			uint32_t n0 = rd32(ch), ntime = 0, time_keys = 0, keys = 0, bits = 0;
 			for (uint32_t s = 0; s < n0; s++) {
 				uint32_t tg = rd32(ch + 4 + 16 * s);
 				if (tg == MLOD_STREAM_TIME || tg == MLOD_STREAM_TICK)
 					ntime++, time_keys += rd32(ch + 4 + 16 * s + 4);
-				ticks += tg == MLOD_STREAM_TICK;
+				bits += tg == MLOD_STREAM_TBIT; /* words, not keys */
+				ticks += tg == MLOD_STREAM_TICK || tg == MLOD_STREAM_TBIT;
 			}
 			for (int k = 0; k < clip->channel_count; k++)
 				keys += (uint32_t)clip->channels[k].key_count;
-			CHECK(ntime == 1 && time_keys < keys); /* one stream, arrays shared */
+			CHECK(ntime + bits == 1 && (bits || time_keys < keys)); /* one stream, arrays shared */
 			double *stp = (double *)stream(ch, MLOD_STREAM_STEP, 0, &cnt, &esz);
 			CHECK(stp && cnt == 1 && esz == 8);
 			double step = stp ? *stp : 0;
 			free(stp);
-			/* a key time back: exact as 'TIME', within the tolerance as 'TICK' */
+			/* a key time back: exact as 'TIME', within the tolerance as 'TICK' or 'TBIT' */
 #define TIME_OK(got, want)                                                                                         \
 	((got) == (want) || (step > 0 && fabs((double)(got) - (want)) <=                                               \
 	                                      MLOD_PACK_TICK_TOLERANCE * (fabs((double)(want)) > step ? fabs((double)(want)) : step)))
