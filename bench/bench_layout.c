@@ -31,9 +31,11 @@
  *       must have every level before it can decode any), b2 each level's
  *       appended block as its own streams (streamable coarse to fine, as
  *       the pack's chunks are). b2 is what the pack stores since format
- *       2.0 (mlod(5) MESH levels): checked against the MESH chunks
- *       mlod_pack_write makes of the same input (their streams but 'PART',
- *       same padding), the two must agree.
+ *       2.0 (mlod(5) MESH levels), with each level's indices in the
+ *       writer's form (format 3.0: the level's own numbering and its map
+ *       where that codes smaller, mlod_pack_index_cost): checked against
+ *       the MESH chunks mlod_pack_write makes of the same input (their
+ *       streams but 'PART', same padding), the two must agree.
  *
  * Per input: stream bytes of (a), of (a) quantised on (b)'s grid (what
  * the grid alone changes), b1 and b2; unique vertices of (b)
@@ -411,7 +413,7 @@ typedef struct totals {
 	long verts_a, unique_b;            /* sum of level vertices; (b)'s buffer */
 	long nv[MAXL], prefix[MAXL], used[MAXL]; /* per level */
 	size_t la[MAXL], lb2[MAXL];        /* per level: (a)'s bytes, (b2)'s (its block and indices) */
-	size_t ia, ib1;                    /* of them, index streams ((b2)'s are (b1)'s) */
+	size_t ia, ib1;                    /* of them, index streams ((b1)'s, in the prefix's numbering) */
 	int union_wider;                   /* parts whose union box is wider than level 0's */
 	double widest;                     /* the largest union / level 0 extent over axes and parts */
 	unsigned maxcode;                  /* (b)'s largest position code */
@@ -639,21 +641,26 @@ static void layout_b(const mlod_primitive *const *lv, int n, int skin, int wide,
 				idx[k] = ix, used[k] = u, prefix[k] = count;
 				break;
 			}
-			size_t b = code_vertices(G, count0, count - count0, &L, NULL) + code_indices(ix, ni[k], count, NULL);
+			size_t st; /* the level's indices in the writer's form (format 3.0) */
+			size_t b = code_vertices(G, count0, count - count0, &L, NULL) + mlod_pack_index_cost(ix, ni[k], count0, count, &st);
 			if (t == 0 || b < best)
 				best = b, bo = o;
 			free(ix);
 		}
 	}
-	/* b1: the buffer whole; b2: per level block. Indices the same. */
+	/* b1: the buffer whole, the indices in its numbering; b2: per level
+	 * block, the indices in the writer's form (the prefix's numbering or,
+	 * format 3.0, the level's own with its map: mlod_pack_index_cost);
+	 * the decode times take the prefix's numbering for both. */
 	size_t b1 = code_vertices(G, 0, count, &L, &T->B1) + tsc, b2 = 0;
 	for (int k = n - 1; k >= 0; k--) {
 		uint32_t first = k == n - 1 ? 0 : prefix[k + 1];
-		size_t vb = code_vertices(G, first, prefix[k] - first, &L, &T->B2) + tsc;
-		size_t ib = code_indices(idx[k], ni[k], prefix[k], &T->B2);
-		code_indices(idx[k], ni[k], prefix[k], &T->B1);
-		b1 += ib, b2 += vb + ib;
-		T->ib1 += ib, T->lb2[k] += vb + ib;
+		size_t vb = code_vertices(G, first, prefix[k] - first, &L, &T->B2) + tsc, ib2;
+		code_indices(idx[k], ni[k], prefix[k], &T->B2);
+		mlod_pack_index_cost(idx[k], ni[k], first, prefix[k], &ib2);
+		size_t ib = code_indices(idx[k], ni[k], prefix[k], &T->B1);
+		b1 += ib, b2 += vb + ib2;
+		T->ib1 += ib, T->lb2[k] += vb + ib2;
 		T->prefix[k] += prefix[k], T->used[k] += used[k];
 	}
 	T->b1 += b1, T->b2 += b2, T->unique_b += count;

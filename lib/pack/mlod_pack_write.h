@@ -224,6 +224,28 @@ void mlod_pack_top4(const mlod_primitive *p, uint32_t v, const int *jmap, int jm
 int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
                            uint32_t *remap, uint32_t *out);
 
+/* The same, keeping the triangle orders in memo between calls on the
+ * same indices (meshopt_optimizeVertexCache's, which orders 1 2 6 8
+ * share, the FIFO one of 4 5 7 9, the strip one of 3), so that each is
+ * made once;
+ * zero it before the first call, release it with
+ * mlod_pack_order_memo_free. The results equal mlod_pack_vertex_order's. */
+typedef struct mlod_pack_order_memo {
+	uint32_t *tri[3]; /* the cache, FIFO and strip triangle orders, ni each, or NULL */
+} mlod_pack_order_memo;
+int mlod_pack_vertex_order_memo(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
+                                mlod_pack_order_memo *memo, uint32_t *remap, uint32_t *out);
+void mlod_pack_order_memo_free(mlod_pack_order_memo *memo);
+
+/* A level's indices idx (ni, into a prefix of count vertices whose last
+ * count - count0 are the level's block) in the form the writer stores
+ * (mlod(5) MESH levels: the prefix's numbering, or the level's own with
+ * 'IMAP' and, when the block is in first-use order, 'INEW'): returns the
+ * cost the writer compares (the streams' meshopt-coded bytes, each padded
+ * to 4, and 16 per stream beyond 'IDX '); *stored the same without the
+ * headers. 0 (and *stored 0) when out of memory. */
+size_t mlod_pack_index_cost(const uint32_t *idx, uint32_t ni, uint32_t count0, uint32_t count, size_t *stored);
+
 /* The switch distance of an error (scene units) at MLOD_PACK_FOV_Y,
  * MLOD_PACK_LINES and MLOD_PACK_PIXELS: error * lines / (2 tan(fov / 2)
  * pixels). */

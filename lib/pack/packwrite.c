@@ -161,6 +161,88 @@ typedef struct chunks {
 	int n, cap;
 } chunks;
 
+/* The u32 copy of an index stream's elements (2 or 4 bytes each), and
+ * their largest; NULL when out of memory. */
+static unsigned int *stream_u32(const stream *s, unsigned int *maxv)
+{
+	unsigned int *idx = malloc(sizeof *idx * ((size_t)s->count + 1));
+	*maxv = 0;
+	if (!idx)
+		return NULL;
+	for (uint32_t k = 0; k < s->count; k++) {
+		if (s->size == 2) {
+			uint16_t v;
+			memcpy(&v, s->data + 2 * k, 2);
+			idx[k] = v;
+		} else {
+			memcpy(&idx[k], s->data + 4 * k, 4);
+		}
+		*maxv = idx[k] > *maxv ? idx[k] : *maxv;
+	}
+	return idx;
+}
+
+/* A stream's meshopt coding as cb_finish makes it: the stream codec and
+ * the coded bytes in *enc (malloc'd; NULL and MLOD_SCODEC_RAW when it
+ * stays raw). Returns 0 when out of memory. */
+static int stream_encode(const stream *s, uint8_t *scodec, unsigned char **enc, size_t *enc_size)
+{
+	size_t bytes = (size_t)s->count * s->size;
+	*scodec = MLOD_SCODEC_RAW, *enc = NULL, *enc_size = 0;
+	if (s->count == 0)
+		return 1;
+	if (s->index && (s->size == 2 || s->size == 4) && (s->index == 2 || s->count % 3 == 0)) {
+		unsigned int maxv, *idx = stream_u32(s, &maxv);
+		if (!idx)
+			return 0;
+		size_t bound = s->index == 2 ? meshopt_encodeIndexSequenceBound(s->count, (size_t)maxv + 1)
+		                             : meshopt_encodeIndexBufferBound(s->count, (size_t)maxv + 1);
+		if (!(*enc = malloc(bound))) {
+			free(idx);
+			return 0;
+		}
+		*enc_size = s->index == 2 ? meshopt_encodeIndexSequence(*enc, bound, idx, s->count)
+		                          : meshopt_encodeIndexBuffer(*enc, bound, idx, s->count);
+		free(idx);
+		if (*enc_size > 0)
+			*scodec = s->index == 2 ? MLOD_SCODEC_MESHOPT_SEQUENCE : MLOD_SCODEC_MESHOPT_INDEX;
+	} else if (!s->index && s->size % 4 == 0 && s->size <= 256) {
+		size_t bound = meshopt_encodeVertexBufferBound(s->count, s->size);
+		if (!(*enc = malloc(bound)))
+			return 0;
+		*enc_size = meshopt_encodeVertexBuffer(*enc, bound, s->data, s->count, s->size);
+		if (*enc_size > 0 && *enc_size < bytes)
+			*scodec = MLOD_SCODEC_MESHOPT_VERTEX;
+	}
+	if (*scodec == MLOD_SCODEC_RAW) {
+		free(*enc);
+		*enc = NULL, *enc_size = 0;
+	}
+	return 1;
+}
+
+/* The stored bytes of one stream with the meshopt codecs (padded to 4). */
+static size_t stream_coded_bytes(const stream *s)
+{
+	uint8_t scodec;
+	unsigned char *enc;
+	size_t enc_size;
+	size_t got = (size_t)s->count * s->size;
+	if (stream_encode(s, &scodec, &enc, &enc_size) && scodec != MLOD_SCODEC_RAW)
+		got = enc_size;
+	free(enc);
+	return (got + 3) & ~(size_t)3;
+}
+
+/* The meshopt-coded bytes of the streams from `from` on. */
+static size_t cb_coded_bytes(const chunkb *cb, int from)
+{
+	size_t total = 0;
+	for (int i = from; i < cb->n; i++)
+		total += stream_coded_bytes(&cb->s[i]);
+	return total;
+}
+
 /* Encodes the streams of cb into a chunk (the stream container). */
 static mlod_result cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uint32_t type, int layer, int level,
                              int item, float error, mlod_error *err)
@@ -181,41 +263,8 @@ static mlod_result cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uin
 		uint8_t *enc = NULL;
 		size_t enc_size = 0;
 		raw += (uint32_t)((bytes + 3) & ~(size_t)3);
-		if (codec == MLOD_CODEC_MESHOPT && s->count > 0) {
-			if (s->index && s->count % 3 == 0 && (s->size == 2 || s->size == 4)) {
-				unsigned int *idx = malloc(sizeof *idx * s->count), maxv = 0;
-				if (!idx)
-					goto nomem;
-				for (uint32_t k = 0; k < s->count; k++) {
-					if (s->size == 2) {
-						uint16_t v;
-						memcpy(&v, s->data + 2 * k, 2);
-						idx[k] = v;
-					} else {
-						memcpy(&idx[k], s->data + 4 * k, 4);
-					}
-					maxv = idx[k] > maxv ? idx[k] : maxv;
-				}
-				size_t bound = meshopt_encodeIndexBufferBound(s->count, (size_t)maxv + 1);
-				enc = malloc(bound);
-				if (!enc) {
-					free(idx);
-					goto nomem;
-				}
-				enc_size = meshopt_encodeIndexBuffer(enc, bound, idx, s->count);
-				free(idx);
-				if (enc_size > 0)
-					scodec = MLOD_SCODEC_MESHOPT_INDEX;
-			} else if (!s->index && s->size % 4 == 0 && s->size <= 256) {
-				size_t bound = meshopt_encodeVertexBufferBound(s->count, s->size);
-				enc = malloc(bound);
-				if (!enc)
-					goto nomem;
-				enc_size = meshopt_encodeVertexBuffer(enc, bound, s->data, s->count, s->size);
-				if (enc_size > 0 && enc_size < bytes)
-					scodec = MLOD_SCODEC_MESHOPT_VERTEX;
-			}
-		}
+		if (codec == MLOD_CODEC_MESHOPT && !stream_encode(s, &scodec, &enc, &enc_size))
+			goto nomem;
 		const uint8_t *data = scodec == MLOD_SCODEC_RAW ? s->data : enc;
 		size_t stored = scodec == MLOD_SCODEC_RAW ? bytes : enc_size;
 		uint8_t h[16] = {0};
@@ -818,49 +867,6 @@ static mlod_result mesh_levels(struct ctx *x)
 	return MLOD_OK;
 }
 
-/* The meshopt-coded bytes of the streams from `from` on. */
-static size_t cb_coded_bytes(const chunkb *cb, int from)
-{
-	size_t total = 0;
-	for (int i = from; i < cb->n; i++) {
-		const stream *s = &cb->s[i];
-		size_t bytes = (size_t)s->count * s->size, got = bytes;
-		unsigned char *enc = NULL;
-		if (s->count == 0)
-			continue;
-		if (s->index && s->count % 3 == 0 && (s->size == 2 || s->size == 4)) {
-			unsigned int *idx = malloc(sizeof *idx * s->count), maxv = 0;
-			if (idx) {
-				for (uint32_t k = 0; k < s->count; k++) {
-					if (s->size == 2) {
-						uint16_t v;
-						memcpy(&v, s->data + 2 * k, 2);
-						idx[k] = v;
-					} else {
-						memcpy(&idx[k], s->data + 4 * k, 4);
-					}
-					maxv = idx[k] > maxv ? idx[k] : maxv;
-				}
-				size_t bound = meshopt_encodeIndexBufferBound(s->count, (size_t)maxv + 1);
-				if ((enc = malloc(bound)) != NULL) {
-					size_t e = meshopt_encodeIndexBuffer(enc, bound, idx, s->count);
-					got = e > 0 ? e : bytes;
-				}
-			}
-			free(idx);
-		} else if (!s->index && s->size % 4 == 0) {
-			size_t bound = meshopt_encodeVertexBufferBound(s->count, s->size);
-			if ((enc = malloc(bound)) != NULL) {
-				size_t e = meshopt_encodeVertexBuffer(enc, bound, s->data, s->count, s->size);
-				got = e > 0 && e < bytes ? e : bytes;
-			}
-		}
-		free(enc);
-		total += (got + 3) & ~(size_t)3;
-	}
-	return total;
-}
-
 /* ------------------------------------------------------------------ */
 /* Layout b2 (mlod(5) MESH levels): per part one buffer of quantised     */
 /* vertices on one grid, each vertex placed by the coarsest level that   */
@@ -1062,32 +1068,126 @@ static uint32_t part_vertex(struct mpart *m, const uint8_t *key)
 
 /* Appends level V's vertices not yet in the buffer, in order o of the
  * level's triangles (mlod_pack_vertex_order); the level's indices into
- * the buffer, or NULL when out of memory. */
+ * the buffer, or NULL when out of memory. With cls (each vertex of V: its
+ * buffer id as the hash set gave it, or for a vertex the buffer lacked,
+ * count + the first of its bit-identical copies in V), the same without
+ * the hash set, which it leaves as it was (for trying orders). */
 static uint32_t *part_append(struct mpart *m, const uint8_t *V, const uint32_t *in, uint32_t ni, uint32_t nv,
-                             const float *positions, int o)
+                             const float *positions, int o, mlod_pack_order_memo *memo, const uint32_t *cls)
 {
 	uint32_t *remap = malloc(sizeof *remap * ((size_t)nv + 1));
 	uint32_t *inv = malloc(sizeof *inv * ((size_t)nv + 1));
 	uint32_t *out = malloc(sizeof *out * ((size_t)ni + 1));
 	uint32_t *gid = malloc(sizeof *gid * ((size_t)nv + 1));
 	uint32_t *idx = malloc(sizeof *idx * ((size_t)ni + 1));
-	if (!remap || !inv || !out || !gid || !idx || mlod_pack_vertex_order(o, in, ni, nv, positions, remap, out) != 0) {
+	if (!remap || !inv || !out || !gid || !idx || mlod_pack_vertex_order_memo(o, in, ni, nv, positions, memo, remap, out) != 0) {
 		free(remap), free(inv), free(out), free(gid), free(idx);
 		return NULL;
 	}
 	for (uint32_t v = 0; v < nv; v++)
 		inv[remap[v]] = v;
-	for (uint32_t j = 0; j < nv; j++)
-		gid[j] = part_vertex(m, V + (size_t)inv[j] * (size_t)m->stride);
+	if (cls) { /* remap becomes each new class's id: UINT32_MAX until placed */
+		uint32_t count0 = m->count;
+		for (uint32_t v = 0; v < nv; v++)
+			remap[v] = UINT32_MAX;
+		for (uint32_t j = 0; j < nv; j++) {
+			uint32_t c = cls[inv[j]];
+			if (c < count0) {
+				gid[j] = c;
+				continue;
+			}
+			if (remap[c - count0] == UINT32_MAX) {
+				memcpy(m->G + (size_t)m->count * (size_t)m->stride, V + (size_t)inv[j] * (size_t)m->stride,
+				       (size_t)m->stride);
+				remap[c - count0] = m->count++;
+			}
+			gid[j] = remap[c - count0];
+		}
+	} else {
+		for (uint32_t j = 0; j < nv; j++)
+			gid[j] = part_vertex(m, V + (size_t)inv[j] * (size_t)m->stride);
+	}
 	for (uint32_t t = 0; t < ni; t++)
 		idx[t] = gid[out[t]];
 	free(remap), free(inv), free(out), free(gid);
 	return idx;
 }
 
+/* The level's own numbering of its indices idx (ni of them, into a prefix
+ * of count vertices): its vertices in first-use order into map (the prefix
+ * vertex of each; *nused of them) and the renumbered indices into local.
+ * seen is count zeroed u32s, left zeroed. */
+static void local_form(const uint32_t *idx, uint32_t ni, uint32_t *seen, uint32_t *map, uint32_t *nused,
+                       uint32_t *local)
+{
+	uint32_t n = 0;
+	for (uint32_t t = 0; t < ni; t++) {
+		if (!seen[idx[t]])
+			map[n] = idx[t], seen[idx[t]] = ++n;
+		local[t] = seen[idx[t]] - 1;
+	}
+	for (uint32_t v = 0; v < n; v++)
+		seen[map[v]] = 0;
+	*nused = n;
+}
+
+/* The level's own numbering in the stored form (MLOD_PART_LOCAL): from
+ * local_form's map (nused vertices), the words of 'INEW' (bit v set:
+ * vertex v is the next of the level's block, which starts at count0) and
+ * the prefix vertices of the others ('IMAP', *nold of them). Without
+ * split, or when the block's vertices are not in the order the level
+ * first uses them, no bit is set and 'IMAP' lists every vertex; returns
+ * whether bits were set. */
+static int local_split(const uint32_t *map, uint32_t nused, uint32_t count0, int split, uint32_t *words, uint32_t *old,
+                       uint32_t *nold)
+{
+	uint32_t nn = 0, no = 0;
+	memset(words, 0, sizeof *words * (((size_t)nused + 31) / 32));
+	if (!split)
+		count0 = UINT32_MAX;
+	for (uint32_t v = 0; v < nused; v++) {
+		if (map[v] < count0) {
+			old[no++] = map[v];
+			continue;
+		}
+		if (map[v] != count0 + nn) { /* out of order: list them all */
+			memset(words, 0, sizeof *words * (((size_t)nused + 31) / 32));
+			memcpy(old, map, sizeof *old * nused);
+			*nold = nused;
+			return 0;
+		}
+		nn++;
+		words[v / 32] |= 1u << (v % 32);
+	}
+	*nold = no;
+	return split;
+}
+
+/* Adds an index stream of n u32s as u16 when wide is 0. */
+static void add_index_stream(chunkb *cb, uint32_t tag, const uint32_t *v, uint32_t n, int wide, int index)
+{
+	if (wide) {
+		cb_add(cb, tag, n, 4, v, index);
+		return;
+	}
+	uint16_t *i16 = malloc(sizeof *i16 * ((size_t)n + 1));
+	if (!i16) {
+		cb->fail = 1;
+		return;
+	}
+	for (uint32_t i = 0; i < n; i++)
+		i16[i] = (uint16_t)v[i];
+	cb_add(cb, tag, n, 2, i16, index);
+	free(i16);
+}
+
 /* Adds the streams of the part's block (vertices first .. count - 1 of
- * the buffer) and of its level's indices, in the chunk's stream order. */
-static void part_block_streams(chunkb *cb, const struct mpart *m, uint32_t first, const uint32_t *idx, uint32_t ni)
+ * the buffer) and of its level's indices, in the chunk's stream order:
+ * with local, 'INEW' (nwords words; none when words is NULL), 'IMAP'
+ * (old, nold of them) and 'IDX ' in the level's own numbering (idx then
+ * holds those). */
+static void part_block_streams(chunkb *cb, const struct mpart *m, uint32_t first, const uint32_t *idx, uint32_t ni,
+                               int local, const uint32_t *words, uint32_t nwords, const uint32_t *old, uint32_t nold)
 {
 	uint32_t n = m->count - first;
 	uint8_t *s = malloc((size_t)n * 8 + 8);
@@ -1095,22 +1195,15 @@ static void part_block_streams(chunkb *cb, const struct mpart *m, uint32_t first
 		cb->fail = 1;
 		return;
 	}
-	int plain = m->nattr - m->ntargets;
+	int plain = m->nattr - m->ntargets, wide = m->count > 65536;
 	for (int a = 0; a <= m->nattr; a++) {
 		if (a == plain) { /* the indices, then the targets' scales */
-			if (m->count <= 65536) {
-				uint16_t *i16 = malloc(sizeof *i16 * ((size_t)ni + 1));
-				if (!i16) {
-					cb->fail = 1;
-					break;
-				}
-				for (uint32_t i = 0; i < ni; i++)
-					i16[i] = (uint16_t)idx[i];
-				cb_add(cb, MLOD_STREAM_IDX, ni, 2, i16, 1);
-				free(i16);
-			} else {
-				cb_add(cb, MLOD_STREAM_IDX, ni, 4, idx, 1);
+			if (local) {
+				if (words)
+					cb_add(cb, MLOD_STREAM_INEW, nwords, 4, words, 0);
+				add_index_stream(cb, MLOD_STREAM_IMAP, old, nold, wide, 2);
 			}
+			add_index_stream(cb, MLOD_STREAM_IDX, idx, ni, wide, 1);
 			if (m->ntargets)
 				cb_add(cb, MLOD_STREAM_MTSC, (uint32_t)m->ntargets, 4, m->tscale, 0);
 		}
@@ -1302,10 +1395,72 @@ static mlod_result mesh_parts(struct ctx *x, int M)
 	return MLOD_OK;
 }
 
+/* A level's index forms (mlod(5) MESH levels): its indices as they are,
+ * or in its own numbering (MLOD_PART_LOCAL); the working arrays as
+ * local_form and local_split take them. */
+typedef struct iforms {
+	uint32_t *seen, *map, *lidx, *words, *old;
+	uint32_t nused, nold;
+	int split; /* the local form has 'INEW' */
+} iforms;
+
+/* The coded bytes of a level's indices idx (into a prefix of count
+ * vertices, the level's block from count0) in the smaller of the forms,
+ * with 16 for each stream beyond 'IDX ' (*stored: without them); *local
+ * 1 when that is the level's own numbering (f then holds it). */
+static size_t index_bytes(const uint32_t *idx, uint32_t ni, uint32_t count0, uint32_t count, iforms *f, int *local,
+                          size_t *stored)
+{
+	int wide = count > 65536;
+	chunkb t = {0};
+	add_index_stream(&t, MLOD_STREAM_IDX, idx, ni, wide, 1);
+	size_t g = t.fail ? 0 : stream_coded_bytes(&t.s[0]), best[2] = {g, g};
+	local_form(idx, ni, f->seen, f->map, &f->nused, f->lidx);
+	add_index_stream(&t, MLOD_STREAM_IDX, f->lidx, ni, wide, 1);
+	size_t li = t.fail ? 0 : stream_coded_bytes(&t.s[1]);
+	for (int split = 1; split >= 0 && !t.fail; split--) { /* with the bits, then without */
+		if (!local_split(f->map, f->nused, count0, split, f->words, f->old, &f->nold) && split)
+			continue;
+		if (split)
+			cb_add(&t, MLOD_STREAM_INEW, (f->nused + 31) / 32, 4, f->words, 0);
+		add_index_stream(&t, MLOD_STREAM_IMAP, f->old, f->nold, wide, 2);
+		/* the streams beyond 'IDX ': their 16-byte headers count */
+		best[split] = t.fail ? g : 16 * (size_t)(1 + split) + li + stream_coded_bytes(&t.s[t.n - 1]) +
+		                                   (split ? stream_coded_bytes(&t.s[t.n - 2]) : 0);
+	}
+	cb_free(&t);
+	int split = best[1] < best[0];
+	size_t l = best[split];
+	*local = l < g;
+	f->split = *local && split;
+	if (*local) /* f holds the form chosen */
+		local_split(f->map, f->nused, count0, split, f->words, f->old, &f->nold);
+	*stored = *local ? l - 16 * (size_t)(1 + split) : g;
+	return l < g ? l : g;
+}
+
+size_t mlod_pack_index_cost(const uint32_t *idx, uint32_t ni, uint32_t count0, uint32_t count, size_t *stored)
+{
+	iforms f = {0};
+	size_t cost = 0;
+	int local;
+	*stored = 0;
+	f.seen = calloc((size_t)count + 1, sizeof *f.seen);
+	f.map = malloc(sizeof *f.map * ((size_t)ni + 1));
+	f.lidx = malloc(sizeof *f.lidx * ((size_t)ni + 1));
+	f.words = malloc(sizeof *f.words * ((size_t)ni / 32 + 2));
+	f.old = malloc(sizeof *f.old * ((size_t)ni + 1));
+	if (f.seen && f.map && f.lidx && f.words && f.old)
+		cost = index_bytes(idx, ni, count0, count, &f, &local, stored);
+	free(f.seen), free(f.map), free(f.lidx), free(f.words), free(f.old);
+	return cost;
+}
+
 /* Level k of one part: appends its new vertices (in the order of the
  * writer's that codes the block and the indices to the fewest bytes; the
- * input order with codec none) and adds their streams; rec is the part's
- * record at this level. */
+ * input order with codec none) and adds their streams, with the indices
+ * in the level's own numbering when that codes smaller (MLOD_PART_LOCAL);
+ * rec is the part's record at this level. */
 static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pack_part_rec *rec)
 {
 	const mlod_primitive *p = m->lv[k];
@@ -1315,10 +1470,16 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	uint8_t *V = malloc((size_t)nv * (size_t)m->stride + 1);
 	uint32_t *in = malloc(sizeof *in * ((size_t)ni + 1));
 	uint32_t *saved = malloc(sizeof *saved * m->slot_cap);
-	uint32_t *idx = NULL;
-	unsigned char *seen = NULL;
-	int ok = 0;
-	if (!V || !in || !saved)
+	iforms f = {0};
+	mlod_pack_order_memo memo = {{NULL, NULL, NULL}}; /* the triangle orders the vertex orders share */
+	f.seen = calloc((size_t)m->count + nv + 1, sizeof *f.seen);
+	f.map = malloc(sizeof *f.map * ((size_t)ni + 1));
+	f.lidx = malloc(sizeof *f.lidx * ((size_t)ni + 1));
+	f.words = malloc(sizeof *f.words * ((size_t)ni / 32 + 2));
+	f.old = malloc(sizeof *f.old * ((size_t)ni + 1));
+	uint32_t *idx = NULL, *cls = NULL;
+	int ok = 0, local = 0;
+	if (!V || !in || !saved || !f.seen || !f.map || !f.lidx || !f.words || !f.old)
 		goto done;
 	for (uint32_t i = 0; i < ni; i++)
 		in[i] = p->index_count > 0 ? p->indices[i] : i;
@@ -1327,40 +1488,53 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	int best = 0;
 	if (x->opt->codec == MLOD_CODEC_MESHOPT) {
 		size_t best_bytes = 0;
+		/* Each vertex's class once (part_append's cls), the hash set
+		 * then as it was: the orders tried need no hashing. */
 		memcpy(saved, m->slot, sizeof *saved * m->slot_cap);
+		if (!(cls = malloc(sizeof *cls * ((size_t)nv + 1))))
+			goto done;
+		for (uint32_t v = 0; v < nv; v++)
+			cls[v] = part_vertex(m, V + (size_t)v * (size_t)m->stride);
+		memcpy(m->slot, saved, sizeof *saved * m->slot_cap);
+		m->count = count0;
 		for (int o = 0; o < MLOD_PACK_ORDERS; o++) {
-			uint32_t *ix = part_append(m, V, in, ni, nv, p->positions, o);
+			uint32_t *ix = part_append(m, V, in, ni, nv, p->positions, o, &memo, cls);
 			if (!ix)
 				goto done;
-			int from = cb->n;
-			part_block_streams(cb, m, count0, ix, ni);
-			size_t b = cb->fail ? 0 : cb_coded_bytes(cb, from);
+			int from = cb->n, loc;
+			size_t st;
+			part_block_streams(cb, m, count0, ix, 0, 0, NULL, 0, NULL, 0); /* the vertex streams (no indices) */
+			size_t b = cb->fail ? 0 : cb_coded_bytes(cb, from) + index_bytes(ix, ni, count0, m->count, &f, &loc, &st);
 			while (cb->n > from)
 				free(cb->s[--cb->n].data);
 			free(ix);
 			if (o == 0 || b < best_bytes)
 				best = o, best_bytes = b;
-			memcpy(m->slot, saved, sizeof *saved * m->slot_cap);
 			m->count = count0;
 		}
 	}
-	if (!(idx = part_append(m, V, in, ni, nv, p->positions, best)))
+	if (!(idx = part_append(m, V, in, ni, nv, p->positions, best, &memo, NULL)))
 		goto done;
-	part_block_streams(cb, m, count0, idx, ni);
 	/* The vertices the level uses: what a reader gathers from the prefix. */
-	if (!(seen = calloc((size_t)m->count + 1, 1)))
-		goto done;
+	size_t st;
+	if (x->opt->codec == MLOD_CODEC_MESHOPT)
+		index_bytes(idx, ni, count0, m->count, &f, &local, &st);
+	else
+		local_form(idx, ni, f.seen, f.map, &f.nused, f.lidx);
+	part_block_streams(cb, m, count0, local ? f.lidx : idx, ni, local, f.split ? f.words : NULL, (f.nused + 31) / 32,
+	                   f.old, f.nold);
 	*rec = m->rec;
-	rec->vertex_count = 0;
-	for (uint32_t t = 0; t < ni; t++)
-		if (!seen[idx[t]])
-			seen[idx[t]] = 1, rec->vertex_count++;
+	rec->vertex_count = f.nused;
 	rec->index_count = ni;
 	if (m->count <= 65536)
 		rec->flags |= MLOD_PART_INDEX16;
+	if (local)
+		rec->flags |= MLOD_PART_LOCAL | (f.split ? MLOD_PART_NEWBITS : 0);
 	ok = 1;
 done:
-	free(V), free(in), free(saved), free(idx), free(seen);
+	free(V), free(in), free(saved), free(idx), free(f.seen), free(f.map), free(f.lidx), free(f.words), free(f.old);
+	mlod_pack_order_memo_free(&memo);
+	free(cls);
 	return ok;
 }
 
@@ -1860,6 +2034,42 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 			cb_add(&cb, MLOD_STREAM_TIME, (uint32_t)nt, 4, tk, 0);
 		else
 			cb_add(&cb, MLOD_STREAM_TICK, (uint32_t)nt, wide ? 4 : 2, tk, 0);
+		/* Or 'TBIT' (format 3.0), each array's first tick then a bit per
+		 * tick after it: whichever stores fewer bytes. */
+		if (step > 0 && !cb.fail) {
+			size_t nbits = 0;
+			for (int a = 0; a < na; a++)
+				if (cnt[a] > 0)
+					nbits += (size_t)((uint32_t)floor((double)arr[a][cnt[a] - 1] / step + 0.5) -
+					                  (uint32_t)floor((double)arr[a][0] / step + 0.5));
+			size_t nw = (size_t)na + (nbits + 31) / 32;
+			uint32_t *w = nw <= UINT32_MAX ? calloc(nw + 1, 4) : NULL;
+			if (!w) {
+				cb.fail = 1;
+			} else {
+				size_t b = 0;
+				for (int a = 0; a < na; a++) {
+					uint32_t first = cnt[a] > 0 ? (uint32_t)floor((double)arr[a][0] / step + 0.5) : 0;
+					w[a] = first;
+					for (int q = 1; q < cnt[a]; q++) {
+						uint32_t tq = (uint32_t)floor((double)arr[a][q] / step + 0.5);
+						uint32_t tp = (uint32_t)floor((double)arr[a][q - 1] / step + 0.5);
+						b += tq - tp; /* the key's bit: the last of its gap */
+						w[(size_t)na + (b - 1) / 32] |= 1u << ((b - 1) % 32);
+					}
+				}
+				stream tb = {MLOD_STREAM_TBIT, (uint32_t)nw, 4, 0, (uint8_t *)w};
+				const stream *st = &cb.s[cb.n - 1];
+				int coded = x->opt->codec == MLOD_CODEC_MESHOPT;
+				size_t bt = coded ? stream_coded_bytes(&tb) : nw * 4;
+				size_t bk = coded ? stream_coded_bytes(st) : ((size_t)st->count * st->size + 3) & ~(size_t)3;
+				if (bt < bk) {
+					free(cb.s[--cb.n].data);
+					cb_add(&cb, MLOD_STREAM_TBIT, (uint32_t)nw, 4, w, 0);
+				}
+				free(w);
+			}
+		}
 	}
 	free(tk);
 	free(arr);

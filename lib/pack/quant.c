@@ -207,8 +207,20 @@ static int group_copies(const float *positions, uint32_t nv, uint32_t *remap)
 	return ok ? 0 : -1;
 }
 
+void mlod_pack_order_memo_free(mlod_pack_order_memo *memo)
+{
+	free(memo->tri[0]), free(memo->tri[1]), free(memo->tri[2]);
+	memo->tri[0] = memo->tri[1] = memo->tri[2] = NULL;
+}
+
 int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
                            uint32_t *remap, uint32_t *out)
+{
+	return mlod_pack_vertex_order_memo(order, indices, ni, nv, positions, NULL, remap, out);
+}
+
+int mlod_pack_vertex_order_memo(int order, const uint32_t *indices, uint32_t ni, uint32_t nv, const float *positions,
+                                mlod_pack_order_memo *memo, uint32_t *remap, uint32_t *out)
 {
 	int ok = ni % 3 == 0 && order > 0;
 	for (uint32_t i = 0; ok && i < ni; i++)
@@ -223,12 +235,17 @@ int mlod_pack_vertex_order(int order, const uint32_t *indices, uint32_t ni, uint
 	unsigned int *cache = malloc(sizeof *cache * ((size_t)ni + 1));
 	if (!cache)
 		return -1;
-	if (order == 3)
+	int kind = order == 3 ? 2 : order == 4 || order == 5 || order == 7 || order == 9 ? 1 : 0;
+	if (memo && memo->tri[kind])
+		memcpy(cache, memo->tri[kind], sizeof *cache * ni);
+	else if (kind == 2)
 		meshopt_optimizeVertexCacheStrip(cache, indices, ni, nv);
-	else if (order == 4 || order == 5 || order == 7 || order == 9)
+	else if (kind == 1)
 		meshopt_optimizeVertexCacheFifo(cache, indices, ni, nv, MLOD_PACK_INDEX_FIFO);
 	else
 		meshopt_optimizeVertexCache(cache, indices, ni, nv);
+	if (memo && !memo->tri[kind] && (memo->tri[kind] = malloc(sizeof *cache * ((size_t)ni + 1))))
+		memcpy(memo->tri[kind], cache, sizeof *cache * ni);
 	if ((order == 6 || order == 7) && positions) {
 		meshopt_spatialSortRemap(remap, positions, nv, 3 * sizeof(float));
 		meshopt_remapIndexBuffer(out, cache, ni, remap);

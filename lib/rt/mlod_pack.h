@@ -8,7 +8,7 @@
  * meshoptimizer's decoder, and never prints or exits.
  *
  * ------------------------------------------------------------------
- * File layout (format 2.0). Everything is little-endian.
+ * File layout (format 3.0). Everything is little-endian.
  *
  *   header      32 bytes at offset 0
  *   TOC         chunk_count entries of 48 bytes, right after the header
@@ -18,7 +18,9 @@
  * Header:
  *   0  u8[4]  magic "MLOD"
  *   4  u16    major version (MLOD_PACK_MAJOR); a reader refuses a newer one,
- *             and an older one (1.x: MESH layout a, no decode path)
+ *             and one older than MLOD_PACK_MAJOR_OLDEST (1.x: MESH layout
+ *             a, no decode path); 2.x is 3.x without MLOD_PART_LOCAL,
+ *             the sequence codec and 'TBIT'
  *   6  u16    minor version; a newer minor only adds what older readers skip
  *   8  u32    flags (0; a reader ignores bits it does not know)
  *  12  u32    chunk_count (at most MLOD_PACK_MAX_CHUNKS)
@@ -58,7 +60,7 @@
  *     0 u32  tag (MLOD_STREAM_*, a fourcc)
  *     4 u32  element count
  *     8 u16  element size in bytes (1..256; a multiple of 4 for the meshopt
- *            vertex codec, 2 or 4 for the index codec)
+ *            vertex codec, 2 or 4 for the index and sequence codecs)
  *    10 u8   stream codec (MLOD_SCODEC_*)
  *    11 u8   reserved (0)
  *    12 u32  stored byte size
@@ -110,7 +112,10 @@
  *   first-use order, renumbering the indices: the decoded mlod_pack_part is
  *   that level alone. A part's records at two levels differ only in
  *   vertex_count (the distinct prefix vertices its indices use: the
- *   decoded count), index_count and MLOD_PART_INDEX16.
+ *   decoded count), index_count, MLOD_PART_INDEX16, MLOD_PART_LOCAL and
+ *   MLOD_PART_NEWBITS. With MLOD_PART_LOCAL (3.0) a part's level stores
+ *   that decoded numbering itself: 'IMAP' (after 'INEW' with NEWBITS),
+ *   then 'IDX ' below vertex_count.
  *   'PART' part records (mlod_pack_part_rec)
  *   then per part, the streams its flags name, in this order:
  *   'POSQ' u16[4] per vertex: position = min + q * scale (q[3] is 0)
@@ -122,8 +127,17 @@
  *   'JNT8' u8[4] or 'JN16' u16[4] per vertex: joints of the part's skin
  *          (indices into that skin's joint list of the full skeleton)
  *   'WGT8' u8[4] per vertex: weights, unorm8, summing exactly to 255
+ *   'INEW' with MLOD_PART_NEWBITS: u32 words, (vertex_count + 31) / 32 of
+ *          them: bit v % 32 of word v / 32 set says the level's vertex v
+ *          is the next vertex of its own block (from the block's first)
+ *   'IMAP' with MLOD_PART_LOCAL: u32 (u16 with INDEX16) per level vertex
+ *          whose 'INEW' bit is clear, in order: its prefix vertex (every
+ *          vertex without NEWBITS); the stream codec may be
+ *          MLOD_SCODEC_MESHOPT_SEQUENCE
  *   'IDX ' u32 (or u16, element size 2) per index: triangles, each below
- *          the prefix's vertex count (the writer uses u16 up to 65536)
+ *          the prefix's vertex count (the writer uses u16 up to 65536);
+ *          with MLOD_PART_LOCAL below vertex_count (the level's own
+ *          numbering: the writer stores whichever codes smaller)
  *   'MTPQ' per morph target: i16[4] per vertex position delta
  *          = q * target_scale[t] (q[3] is 0); 'MTSC' f32 per target before
  *          them: the targets' scales
@@ -151,7 +165,14 @@
  *          step > 0: each array's first tick, then each next tick minus
  *          the one before (every tick below 2^32); time =
  *          (float)((double)tick * step): the key time read, or within
- *          2^-20 * max(|t|, step) of it (mlod(5), QUANTISATION)
+ *          2^-20 * max(|t|, step) of it (mlod(5), QUANTISATION); or
+ *   'TBIT' u32 words, when step > 0 (format 3.0; the writer stores the
+ *          smaller of the two): each array's first tick (one word per
+ *          array), then one bit stream (bit b is bit b % 32 of word
+ *          arrays + b / 32): per array in order, a bit per tick after its
+ *          first, set where the array has a key, ending with its last
+ *          key's bit; the next array's bits follow at once; exactly as
+ *          many words as that takes
  *   then the values, three streams, each holding the keys of its
  *   channels one channel after the other in channel order (possibly 0
  *   elements):
@@ -241,7 +262,8 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 2
+#define MLOD_PACK_MAJOR 3
+#define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32
 #define MLOD_PACK_TOC_ENTRY_SIZE 48
@@ -285,6 +307,7 @@ typedef enum mlod_pack_codec {
 #define MLOD_SCODEC_RAW 0
 #define MLOD_SCODEC_MESHOPT_VERTEX 1 /* meshopt_decodeVertexBuffer */
 #define MLOD_SCODEC_MESHOPT_INDEX 2  /* meshopt_decodeIndexBuffer */
+#define MLOD_SCODEC_MESHOPT_SEQUENCE 3 /* meshopt_decodeIndexSequence (format 3.0) */
 
 /* Stream tags. */
 #define MLOD_STREAM_INFO MLOD_FOURCC('I', 'N', 'F', 'O')
@@ -306,12 +329,15 @@ typedef enum mlod_pack_codec {
 #define MLOD_STREAM_JN16 MLOD_FOURCC('J', 'N', '1', '6')
 #define MLOD_STREAM_WGT8 MLOD_FOURCC('W', 'G', 'T', '8')
 #define MLOD_STREAM_IDX MLOD_FOURCC('I', 'D', 'X', ' ')
+#define MLOD_STREAM_INEW MLOD_FOURCC('I', 'N', 'E', 'W')
+#define MLOD_STREAM_IMAP MLOD_FOURCC('I', 'M', 'A', 'P')
 #define MLOD_STREAM_MTSC MLOD_FOURCC('M', 'T', 'S', 'C')
 #define MLOD_STREAM_MTPQ MLOD_FOURCC('M', 'T', 'P', 'Q')
 #define MLOD_STREAM_CHAN MLOD_FOURCC('C', 'H', 'A', 'N')
 #define MLOD_STREAM_STEP MLOD_FOURCC('S', 'T', 'E', 'P')
 #define MLOD_STREAM_TIME MLOD_FOURCC('T', 'I', 'M', 'E')
 #define MLOD_STREAM_TICK MLOD_FOURCC('T', 'I', 'C', 'K')
+#define MLOD_STREAM_TBIT MLOD_FOURCC('T', 'B', 'I', 'T')
 #define MLOD_STREAM_ROTQ MLOD_FOURCC('R', 'O', 'T', 'Q')
 /* TOC flags of a MOTION chunk: its rotation keys build on the clip's next
  * coarser level (level + 1, earlier in the file). */
@@ -404,7 +430,9 @@ typedef struct mlod_pack_skin_rec {
 #define MLOD_PART_COLORS 0x4u
 #define MLOD_PART_SKINNED 0x8u    /* joints and weights */
 #define MLOD_PART_JOINTS16 0x10u  /* 'JN16' instead of 'JNT8' */
-#define MLOD_PART_INDEX16 0x20u   /* 'IDX ' elements are u16 */
+#define MLOD_PART_INDEX16 0x20u   /* 'IDX ' (and 'IMAP') elements are u16 */
+#define MLOD_PART_LOCAL 0x40u     /* 'IMAP', then 'IDX ' in the level's own numbering (3.0) */
+#define MLOD_PART_NEWBITS 0x80u   /* with LOCAL: 'INEW' before 'IMAP' (3.0) */
 
 typedef struct mlod_pack_part_rec {
 	uint32_t instance;         /* the character's instance */

@@ -266,10 +266,11 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		                 minor, MLOD_PACK_MAJOR);
 	if (major == 0)
 		return mlod_fail(err, MLOD_ERR_PARSE, "pack format %u.%u does not exist (the first is 1.0)", major, minor);
-	if (major < MLOD_PACK_MAJOR)
+	if (major < MLOD_PACK_MAJOR_OLDEST)
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED,
-		                 "mlod %u.%u pack: made by an older mlod-pack; pack the input again (this reader reads %d.x)",
-		                 major, minor, MLOD_PACK_MAJOR);
+		                 "mlod %u.%u pack: made by an older mlod-pack; pack the input again (this reader reads %d.x "
+		                 "and %d.x)",
+		                 major, minor, MLOD_PACK_MAJOR_OLDEST, MLOD_PACK_MAJOR);
 	uint32_t hcrc = mlod_pack_crc32(0, d, 28);
 	if (hcrc != rd32(d + 28))
 		return mlod_fail(err, MLOD_ERR_PARSE, "pack header: CRC mismatch (stored 0x%08x, computed 0x%08x)",
@@ -503,7 +504,7 @@ static mlod_result cx_parse(cx *x, mlod_error *err)
 		if (elsize < 1 || elsize > 256)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': element size %u is not 1 to 256", x->label, i,
 			                 tagn(tag).s, elsize);
-		if (codec > MLOD_SCODEC_MESHOPT_INDEX)
+		if (codec > MLOD_SCODEC_MESHOPT_SEQUENCE)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': unknown stream codec %u", x->label, i,
 			                 tagn(tag).s, codec);
 		if (codec != MLOD_SCODEC_RAW && c->codec == MLOD_CODEC_NONE)
@@ -517,6 +518,11 @@ static mlod_result cx_parse(cx *x, mlod_error *err)
 		if (codec == MLOD_SCODEC_MESHOPT_INDEX && elsize != 2 && elsize != 4)
 			return mlod_fail(err, MLOD_ERR_PARSE,
 			                 "%s: stream %u '%s': the meshopt index codec needs an element size of 2 or 4, not %u",
+			                 x->label, i, tagn(tag).s, elsize);
+		if (codec == MLOD_SCODEC_MESHOPT_SEQUENCE && elsize != 2 && elsize != 4)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': the meshopt index sequence codec needs an element size of 2 or 4, "
+			                 "not %u",
 			                 x->label, i, tagn(tag).s, elsize);
 		if (codec == MLOD_SCODEC_MESHOPT_INDEX && count % 3 != 0)
 			return mlod_fail(err, MLOD_ERR_PARSE,
@@ -643,6 +649,8 @@ static void cx_done(cx *x)
 
 /* The stream's decoded bytes: in place for raw streams, else decoded into
  * the temporary buffer (valid until the next load). */
+static mlod_result cx_load_into(cx *x, const stream *s, uint8_t *dst, mlod_error *err);
+
 static mlod_result cx_load(cx *x, const stream *s, const uint8_t **out, mlod_error *err)
 {
 	if (s->codec == MLOD_SCODEC_RAW) {
@@ -651,17 +659,10 @@ static mlod_result cx_load(cx *x, const stream *s, const uint8_t **out, mlod_err
 	}
 	static unsigned char dummy[256];
 	unsigned char *dst = x->temp && x->max_decoded ? x->temp + x->aux : dummy;
-	int rc;
-	if (s->codec == MLOD_SCODEC_MESHOPT_VERTEX)
-		rc = meshopt_decodeVertexBuffer(dst, s->count, s->elsize, s->src, s->stored);
-	else
-		rc = meshopt_decodeIndexBuffer(dst, s->count, s->elsize, s->src, s->stored);
-	if (rc != 0)
-		return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': the meshopt %s codec failed (%d)", x->label,
-		                 s->index, tagn(s->tag).s,
-		                 s->codec == MLOD_SCODEC_MESHOPT_VERTEX ? "vertex" : "index", rc);
-	*out = dst;
-	return MLOD_OK;
+	mlod_result r = cx_load_into(x, s, dst, err);
+	if (r == MLOD_OK)
+		*out = dst;
+	return r;
 }
 
 /* The stream's decoded bytes written to dst (count * element size bytes):
@@ -675,10 +676,16 @@ static mlod_result cx_load_into(cx *x, const stream *s, uint8_t *dst, mlod_error
 	}
 	int rc = s->codec == MLOD_SCODEC_MESHOPT_VERTEX
 	                 ? meshopt_decodeVertexBuffer(dst, s->count, s->elsize, s->src, s->stored)
+	         : s->codec == MLOD_SCODEC_MESHOPT_SEQUENCE
+	                 ? meshopt_decodeIndexSequence(dst, s->count, s->elsize, s->src, s->stored)
 	                 : meshopt_decodeIndexBuffer(dst, s->count, s->elsize, s->src, s->stored);
 	if (rc != 0)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': the meshopt %s codec failed (%d)", x->label,
-		                 s->index, tagn(s->tag).s, s->codec == MLOD_SCODEC_MESHOPT_VERTEX ? "vertex" : "index", rc);
+		                 s->index, tagn(s->tag).s,
+		                 s->codec == MLOD_SCODEC_MESHOPT_VERTEX     ? "vertex"
+		                 : s->codec == MLOD_SCODEC_MESHOPT_SEQUENCE ? "index sequence"
+		                                                            : "index",
+		                 rc);
 	return MLOD_OK;
 }
 
@@ -1137,7 +1144,7 @@ static void oct_decode(int16_t qx, int16_t qy, float *out)
 
 #define PART_KNOWN_FLAGS                                                                                        \
 	(MLOD_PART_NORMALS | MLOD_PART_TANGENTS | MLOD_PART_COLORS | MLOD_PART_SKINNED | MLOD_PART_JOINTS16 |    \
-	 MLOD_PART_INDEX16)
+	 MLOD_PART_INDEX16 | MLOD_PART_LOCAL | MLOD_PART_NEWBITS)
 
 /* A part's vertex streams in a MESH chunk, in order, with their element
  * sizes (the targets' 'MTPQ' last, after 'IDX ' and 'MTSC'); the count. */
@@ -1171,6 +1178,8 @@ static mlod_result check_part_rec(const cx *x, uint32_t i, const mlod_pack_part_
 	uint32_t f = rc->flags;
 	if (f & ~PART_KNOWN_FLAGS)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: unknown flags 0x%x", x->label, i, f & ~PART_KNOWN_FLAGS);
+	if ((f & MLOD_PART_NEWBITS) && !(f & MLOD_PART_LOCAL))
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: NEWBITS without LOCAL", x->label, i);
 	if ((f & MLOD_PART_JOINTS16) && !(f & MLOD_PART_SKINNED))
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: JOINTS16 without SKINNED", x->label, i);
 	if (rc->index_count % 3 != 0)
@@ -1216,8 +1225,8 @@ static int same_part(const mlod_pack_part_rec *a, const mlod_pack_part_rec *b)
 	mlod_pack_part_rec x = *a, y = *b;
 	x.vertex_count = y.vertex_count = 0;
 	x.index_count = y.index_count = 0;
-	x.flags &= ~MLOD_PART_INDEX16;
-	y.flags &= ~MLOD_PART_INDEX16;
+	x.flags &= ~(MLOD_PART_INDEX16 | MLOD_PART_LOCAL | MLOD_PART_NEWBITS);
+	y.flags &= ~(MLOD_PART_INDEX16 | MLOD_PART_LOCAL | MLOD_PART_NEWBITS);
 	return memcmp(&x, &y, sizeof x) == 0;
 }
 
@@ -1338,7 +1347,8 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 		{
 			stream t;
 			while (cx_next(&x, &t))
-				if (t.tag != MLOD_STREAM_IDX && t.tag != MLOD_STREAM_MTSC && t.tag != MLOD_STREAM_PART)
+				if (t.tag != MLOD_STREAM_IDX && t.tag != MLOD_STREAM_INEW && t.tag != MLOD_STREAM_IMAP &&
+				    t.tag != MLOD_STREAM_MTSC && t.tag != MLOD_STREAM_PART)
 					bytes += round8((uint64_t)t.count * t.elsize);
 				else if (t.codec != MLOD_SCODEC_RAW && (uint64_t)t.count * t.elsize > need)
 					need = (uint64_t)t.count * t.elsize;
@@ -1401,7 +1411,15 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			if (r != MLOD_OK)
 				break;
 			int i16 = (rc->flags & MLOD_PART_INDEX16) != 0;
-			r = cx_expect(&x, &s, MLOD_STREAM_IDX, i16 ? 2 : 4, rc->index_count, what, "index count", err);
+			if (rc->flags & MLOD_PART_LOCAL) {
+				if (rc->flags & MLOD_PART_NEWBITS)
+					r = cx_expect(&x, &s, MLOD_STREAM_INEW, 4, ((uint64_t)rc->vertex_count + 31) / 32, what,
+					              "a bit per vertex", err);
+				if (r == MLOD_OK) /* its count: checked against 'INEW' when decoded */
+					r = cx_expect(&x, &s, MLOD_STREAM_IMAP, i16 ? 2 : 4, UINT64_MAX, what, "", err);
+			}
+			if (r == MLOD_OK)
+				r = cx_expect(&x, &s, MLOD_STREAM_IDX, i16 ? 2 : 4, rc->index_count, what, "index count", err);
 			if (r == MLOD_OK && rc->target_count > 0)
 				r = cx_expect(&x, &s, MLOD_STREAM_MTSC, 4, rc->target_count, what, "target count", err);
 			for (uint32_t t = 0; t < rc->target_count && r == MLOD_OK; t++) {
@@ -1498,16 +1516,72 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			int nvs = part_vstreams(rc, tag, size);
 			for (int a = 0; a < nvs; a++)
 				cx_next(&x, &s);
-			cx_next(&x, &s); /* 'IDX ', checked above */
-			TRY(cx_load(&x, &s, &src, err));
-			int i16 = (rc->flags & MLOD_PART_INDEX16) != 0;
+			int i16 = (rc->flags & MLOD_PART_INDEX16) != 0, local = (rc->flags & MLOD_PART_LOCAL) != 0;
 			const mblock *mb = &blk[(uint64_t)l * P + i];
 			uint64_t prefix = mb->first + mb->count;
 			uint32_t V = rc->vertex_count, nused = 0;
-			for (uint64_t v = 0; v < prefix; v++)
+			if (local) { /* the prefix vertex of each of the level's: 'INEW', 'IMAP' */
+				uint32_t nnew = 0, nold = 0, w = 0;
+				int bits = (rc->flags & MLOD_PART_NEWBITS) != 0;
+				if (bits) {
+					cx_next(&x, &s);
+					TRY(cx_load(&x, &s, &src, err));
+				}
+				for (uint32_t v = 0; v < V; v++) {
+					if (bits)
+						memcpy(&w, src + 4 * (size_t)(v / 32), 4);
+					if (!(w >> (v % 32) & 1u)) {
+						used[v] = UINT32_MAX, nold++;
+						continue;
+					}
+					if (nnew == mb->count)
+						FAIL("%s: part %u: 'INEW' marks more than its block's %u vertices new", x.label, i,
+						     mb->count);
+					used[v] = (uint32_t)mb->first + nnew++;
+				}
+				cx_next(&x, &s);
+				if (s.count != nold)
+					FAIL("%s: part %u: stream %u 'IMAP' has %u elements, expected %u (the vertices 'INEW' leaves)",
+					     x.label, i, s.index, s.count, nold);
+				TRY(cx_load(&x, &s, &src, err));
+				for (uint32_t v = 0, o = 0; v < V; v++) {
+					if (used[v] != UINT32_MAX)
+						continue;
+					uint32_t iv;
+					if (i16) {
+						uint16_t v16;
+						memcpy(&v16, src + 2 * (size_t)o, 2);
+						iv = v16;
+					} else {
+						memcpy(&iv, src + 4 * (size_t)o, 4);
+					}
+					if (iv >= prefix)
+						FAIL("%s: part %u: vertex %u maps to %u, past its prefix of %llu vertices (MESH levels %u "
+						     "to %u)",
+						     x.label, i, v, iv, (unsigned long long)prefix, top, K);
+					used[v] = iv, o++;
+				}
+				nused = V;
+			}
+			cx_next(&x, &s); /* 'IDX ', checked above */
+			TRY(cx_load(&x, &s, &src, err));
+			for (uint64_t v = 0; v < prefix && !local; v++)
 				map[v] = UINT32_MAX;
 			TAKE(pt->indices, (uint64_t)rc->index_count * 4);
-			for (uint32_t k = 0; k < rc->index_count; k++) {
+			for (uint32_t k = 0; k < rc->index_count && local; k++) {
+				uint32_t iv;
+				if (i16) {
+					uint16_t v16;
+					memcpy(&v16, src + 2 * (size_t)k, 2);
+					iv = v16;
+				} else {
+					memcpy(&iv, src + 4 * (size_t)k, 4);
+				}
+				if (iv >= V)
+					FAIL("%s: part %u: index %u refers past its %u vertices (at position %u)", x.label, i, iv, V, k);
+				pt->indices[k] = iv;
+			}
+			for (uint32_t k = 0; k < rc->index_count && !local; k++) {
 				uint32_t iv;
 				if (i16) {
 					uint16_t v16;
@@ -1813,7 +1887,9 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	 * rounding each */
 	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel)) + 8 * C;
 	while (cx_next(&x, &s)) {
-		uint64_t per = s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK ? 4
+		/* 'TBIT': each key but an array's first takes a bit at least */
+		uint64_t per = s.tag == MLOD_STREAM_TBIT                                 ? 4 * 32
+		               : s.tag == MLOD_STREAM_TIME || s.tag == MLOD_STREAM_TICK ? 4
 		               : s.tag == MLOD_STREAM_ROTQ || s.tag == MLOD_STREAM_ROTD || s.tag == MLOD_STREAM_ROTF ? 16
 		               : s.tag == MLOD_STREAM_VEC3 || s.tag == MLOD_STREAM_VECD   ? 12
 		                                                                          : 0;
@@ -1886,21 +1962,46 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	/* The key times: one stream, the arrays one after the other. */
 	if (!cx_next(&x, &s))
 		FAIL("%s: missing its key times", x.label);
-	if (s.tag != (step > 0 ? MLOD_STREAM_TICK : MLOD_STREAM_TIME))
+	if (step > 0 ? s.tag != MLOD_STREAM_TICK && s.tag != MLOD_STREAM_TBIT : s.tag != MLOD_STREAM_TIME)
 		FAIL("%s: stream %u is '%s', expected '%s' (step %g)", x.label, s.index, tagn(s.tag).s,
-		     step > 0 ? "TICK" : "TIME", step);
+		     step > 0 ? "TICK' or 'TBIT" : "TIME", step);
 	if (s.tag == MLOD_STREAM_TICK ? s.elsize != 2 && s.elsize != 4 : s.elsize != 4)
 		FAIL("%s: stream %u '%s' has elements of %u bytes, expected %s", x.label, s.index, tagn(s.tag).s, s.elsize,
 		     s.tag == MLOD_STREAM_TICK ? "2 or 4" : "4");
-	if (s.count != nt)
-		FAIL("%s: stream %u '%s' has %u elements, expected %llu (the time arrays' keys)", x.label, s.index,
-		     tagn(s.tag).s, s.count, (unsigned long long)nt);
+	if (s.tag == MLOD_STREAM_TBIT ? s.count < T : s.count != nt)
+		FAIL("%s: stream %u '%s' has %u elements, expected %s%llu (the time arrays' %s)", x.label, s.index,
+		     tagn(s.tag).s, s.count, s.tag == MLOD_STREAM_TBIT ? "at least " : "",
+		     (unsigned long long)(s.tag == MLOD_STREAM_TBIT ? T : nt),
+		     s.tag == MLOD_STREAM_TBIT ? "first ticks" : "keys");
 	TRY(cx_load(&x, &s, &src, err));
 	float *all;
 	TAKE(all, nt * 4);
-	if (s.tag == MLOD_STREAM_TIME)
+	if (s.tag == MLOD_STREAM_TIME) {
 		memcpy(all, src, (size_t)nt * 4);
-	else /* each array's first tick, then each next's difference */
+	} else if (s.tag == MLOD_STREAM_TBIT) { /* each array's first tick, then a bit per tick after it */
+		uint64_t nbits = 32 * ((uint64_t)s.count - T), b = 0;
+		for (uint64_t t = 0, k = 0; t < T; t++) {
+			uint64_t tick = rd32(src + 4 * t);
+			for (uint32_t q = 0; q < tcount[t]; q++, k++) {
+				while (q > 0) { /* to the next set bit */
+					if (b == nbits)
+						FAIL("%s: stream %u 'TBIT': time array %u: key %u: the bits run out", x.label, s.index,
+						     (unsigned)t, q);
+					tick++;
+					uint32_t w = rd32(src + 4 * (T + b / 32));
+					if (w >> (b++ % 32) & 1u)
+						break;
+				}
+				if (tick > UINT32_MAX)
+					FAIL("%s: stream %u 'TBIT': time array %u: key %u: tick %llu is above 2^32 - 1", x.label,
+					     s.index, (unsigned)t, q, (unsigned long long)tick);
+				all[k] = (float)((double)tick * step);
+			}
+		}
+		if ((b + 31) / 32 != (uint64_t)s.count - T)
+			FAIL("%s: stream %u 'TBIT' has %u elements, expected %llu (the arrays' first ticks and bits)", x.label,
+			     s.index, s.count, (unsigned long long)(T + (b + 31) / 32));
+	} else /* each array's first tick, then each next's difference */
 		for (uint64_t t = 0, k = 0; t < T; t++) {
 			uint64_t tick = 0;
 			for (uint32_t q = 0; q < tcount[t]; q++, k++) {

@@ -19,7 +19,7 @@ const fourcc = (u) => String.fromCharCode(u & 255, (u >> 8) & 255, (u >> 16) & 2
 if (b.length < 32 || b.subarray(0, 4).toString('latin1') !== 'MLOD') die('no MLOD magic');
 const major = b.readUInt16LE(4), minor = b.readUInt16LE(6), flags = b.readUInt32LE(8), n = b.readUInt32LE(12);
 const size = Number(b.readBigUInt64LE(16));
-if (major !== 2 || minor !== 0) die(`version ${major}.${minor}`);
+if (major !== 3 || minor !== 0) die(`version ${major}.${minor}`);
 if (flags !== 0) die('flags');
 if (size !== b.length) die(`file_size ${size}, file ${b.length}`);
 if (crc32(b.subarray(0, 28)) !== b.readUInt32LE(28)) die('header CRC');
@@ -62,7 +62,8 @@ for (let i = 0; i < n; i++) {
 		if (st.codec === 0 && st.stored !== st.count * st.size) die(`chunk ${i}: raw stream ${st.tag}: stored ${st.stored}`);
 		if (st.codec === 1 && st.size % 4) die(`chunk ${i}: vertex codec on element size ${st.size}`);
 		if (st.codec === 2 && (st.size !== 2 && st.size !== 4 || st.count % 3)) die(`chunk ${i}: index codec on ${st.tag}`);
-		if (st.codec > 2) die(`chunk ${i}: stream codec ${st.codec}`);
+		if (st.codec === 3 && (st.size !== 2 && st.size !== 4 || st.tag !== 'IMAP')) die(`chunk ${i}: index sequence codec on ${st.tag}`);
+		if (st.codec > 3) die(`chunk ${i}: stream codec ${st.codec}`);
 		st.at = p;
 		p += (st.stored + 3) & ~3;
 		raw += (st.count * st.size + 3) & ~3;

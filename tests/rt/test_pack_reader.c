@@ -185,7 +185,7 @@ static buf chunk_bytes(const wchunk *c, uint32_t *raw)
 			size_t bound = meshopt_encodeVertexBufferBound(count, s->elsize);
 			enc[i].p = malloc(bound);
 			enc[i].n = meshopt_encodeVertexBuffer(enc[i].p, bound, s->data.p, count, s->elsize);
-		} else if (s->codec == MLOD_SCODEC_MESHOPT_INDEX) {
+		} else if (s->codec == MLOD_SCODEC_MESHOPT_INDEX || s->codec == MLOD_SCODEC_MESHOPT_SEQUENCE) {
 			unsigned *idx = malloc(sizeof(unsigned) * (count ? count : 1));
 			unsigned maxv = 0;
 			for (uint32_t k = 0; k < count; k++) {
@@ -199,9 +199,12 @@ static buf chunk_bytes(const wchunk *c, uint32_t *raw)
 				if (idx[k] > maxv)
 					maxv = idx[k];
 			}
-			size_t bound = meshopt_encodeIndexBufferBound(count, maxv + 1);
+			int seq = s->codec == MLOD_SCODEC_MESHOPT_SEQUENCE;
+			size_t bound = seq ? meshopt_encodeIndexSequenceBound(count, maxv + 1)
+			                   : meshopt_encodeIndexBufferBound(count, maxv + 1);
 			enc[i].p = malloc(bound);
-			enc[i].n = meshopt_encodeIndexBuffer(enc[i].p, bound, idx, count);
+			enc[i].n = seq ? meshopt_encodeIndexSequence(enc[i].p, bound, idx, count)
+			               : meshopt_encodeIndexBuffer(enc[i].p, bound, idx, count);
 			free(idx);
 		} else {
 			put(&enc[i], s->data.p, s->data.n);
@@ -527,13 +530,50 @@ static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
 		put(&s->data, t->wq[F], 4 * (size_t)n);
 	}
 	int i16 = (t->flags & MLOD_PART_INDEX16) != 0;
+	uint32_t local[NI0], at[NV0], nmap = 0;
+	for (uint32_t k = 0; k < t->I; k++)
+		local[k] = t->idx[k];
+	if (t->flags & MLOD_PART_LOCAL) {
+		/* The prefix vertices in first-use order; with NEWBITS, 'INEW'
+		 * marks those that are the block's next ones, and 'IMAP' lists
+		 * the others. */
+		uint32_t map[NV0], words[NV0 / 32 + 1] = {0}, nnew = 0, nold = 0;
+		for (uint32_t v = 0; v < NV0; v++)
+			at[v] = UINT32_MAX;
+		for (uint32_t k = 0; k < t->I; k++) {
+			if (at[t->idx[k]] == UINT32_MAX)
+				map[nmap] = t->idx[k], at[t->idx[k]] = nmap++;
+			local[k] = at[t->idx[k]];
+		}
+		if (t->flags & MLOD_PART_NEWBITS) {
+			for (uint32_t v = 0; v < nmap; v++)
+				if (map[v] == F + nnew)
+					words[v / 32] |= 1u << (v % 32), nnew++;
+			s = add_stream(c, MLOD_STREAM_INEW, 4, MLOD_SCODEC_RAW);
+			s->count = (nmap + 31) / 32;
+			for (uint32_t w = 0; w < s->count; w++)
+				put32(&s->data, words[w]);
+		}
+		s = add_stream(c, MLOD_STREAM_IMAP, i16 ? 2 : 4,
+		               ic == MLOD_SCODEC_MESHOPT_INDEX ? MLOD_SCODEC_MESHOPT_SEQUENCE : MLOD_SCODEC_RAW);
+		for (uint32_t v = 0; v < nmap; v++) {
+			if (words[v / 32] >> (v % 32) & 1u)
+				continue;
+			if (i16)
+				put16(&s->data, (uint16_t)map[v]);
+			else
+				put32(&s->data, map[v]);
+			nold++;
+		}
+		s->count = nold;
+	}
 	s = add_stream(c, MLOD_STREAM_IDX, i16 ? 2 : 4, ic);
 	s->count = t->I;
 	for (uint32_t k = 0; k < t->I; k++) {
 		if (i16)
-			put16(&s->data, (uint16_t)t->idx[k]);
+			put16(&s->data, (uint16_t)local[k]);
 		else
-			put32(&s->data, t->idx[k]);
+			put32(&s->data, local[k]);
 	}
 	if (t->T) {
 		s = add_stream(c, MLOD_STREAM_MTSC, 4, MLOD_SCODEC_RAW);
@@ -551,6 +591,11 @@ static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
 		}
 	}
 }
+
+/* Parts 1 of level 0 (its map a list) and 0 of level 1 (its vertices all
+ * the block's, NEWBITS) in their own numbering (format 3.0), unless a
+ * test sets it 0 (a format 2.0 pack). */
+static uint32_t local_flag = MLOD_PART_LOCAL;
 
 /* The chunks of the test character, in the format's order:
  * INFO, SKELETON, SKELETON 1, MESH 1, MOTION 1/0, MESH 0, MOTION 0/0, DOC.
@@ -649,9 +694,11 @@ static int make_chunks(wchunk *c, int with_unknown)
 	 * vertices; part 0 with u16 indices at level 1, u32 at level 0). */
 	make_part(&parts_truth[0],
 	          MLOD_PART_NORMALS | MLOD_PART_TANGENTS | MLOD_PART_COLORS | MLOD_PART_SKINNED, NV0, NI0, 2, 1, 0, -1);
-	make_part(&parts_truth[1], MLOD_PART_SKINNED | MLOD_PART_JOINTS16 | MLOD_PART_INDEX16, NV1, NI1, 0, 0, 0, 2);
-	coarse_part(&parts_truth[2], &parts_truth[0], 16, 24, parts_truth[0].flags | MLOD_PART_INDEX16);
-	coarse_part(&parts_truth[3], &parts_truth[1], 10, 12, parts_truth[1].flags);
+	make_part(&parts_truth[1], MLOD_PART_SKINNED | MLOD_PART_JOINTS16 | MLOD_PART_INDEX16 | local_flag, NV1, NI1, 0, 0,
+	          0, 2);
+	coarse_part(&parts_truth[2], &parts_truth[0], 16, 24,
+	            parts_truth[0].flags | MLOD_PART_INDEX16 | local_flag | (local_flag ? MLOD_PART_NEWBITS : 0));
+	coarse_part(&parts_truth[3], &parts_truth[1], 10, 12, parts_truth[1].flags & ~MLOD_PART_LOCAL);
 	parts_truth[0].first = 16, parts_truth[1].first = 10;
 
 	/* MESH level 1: the two parts raw: every vertex of their prefixes. */
@@ -1129,6 +1176,63 @@ TEST(decode_mesh_meshopt_and_raw)
 	CHECK_MSG(ok, "%s", why);
 }
 
+/* MOTION level 0's key times as 'TBIT' (format 3.0) instead of 'TICK':
+ * the two arrays' first ticks (0, 0), then the bits of ticks 1 to NK - 1
+ * of each, set: the same times; words as given. */
+static void motion_tbit(wchunk *c, uint32_t bits, uint32_t words)
+{
+	for (int i = 0; i < c[C_MOT0].ns; i++) {
+		wstream *s = &c[C_MOT0].s[i];
+		if (s->tag != MLOD_STREAM_TICK)
+			continue;
+		s->tag = MLOD_STREAM_TBIT;
+		s->data.n = 0;
+		put32(&s->data, 0);
+		put32(&s->data, 0);
+		put32(&s->data, bits);
+		for (uint32_t w = 3; w < words; w++)
+			put32(&s->data, 0);
+		s->count = words;
+	}
+}
+
+TEST(motion_tick_bits)
+{
+	_Static_assert(NK == 5, "the bits below are for 5 keys per array");
+	static const struct {
+		uint32_t bits, words;
+		mlod_result code;
+		const char *text;
+	} cases[] = {
+	        {0xff, 3, MLOD_OK, ""},
+	        {0x7f, 3, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 2 'TBIT': time array 1: key 4: the bits run out"},
+	        {0xff, 4, MLOD_ERR_PARSE,
+	         "MOTION level 0 of clip 0: stream 2 'TBIT' has 4 elements, expected 3 (the arrays' first ticks and bits)"},
+	};
+	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+		static wchunk c[C_COUNT + 1];
+		int n = make_chunks(c, 0);
+		motion_tbit(c, cases[k].bits, cases[k].words);
+		buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+		free_chunks(c, n);
+		mlod_pack p = {0};
+		mlod_pack_skeleton s = {0};
+		mlod_pack_motion m = {0};
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+		CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &s, &terr));
+		memset(&terr, 0, sizeof terr);
+		mlod_result r = mlod_pack_decode_motion(&p, C_MOT0, b.p, b.n, &s, &m, &terr);
+		int ok = r == cases[k].code && strstr(terr.message, cases[k].text) != NULL;
+		for (int q = 0; ok && r == MLOD_OK && q < NK; q++)
+			ok = m.channels[1].times[q] == time_truth[q] && m.channels[3].times[q] == time_truth[q];
+		CHECK_MSG(ok, "case %zu: returned %d: %s", k, (int)r, terr.message);
+		mlod_pack_motion_free(&m);
+		mlod_pack_skeleton_free(&s);
+		mlod_pack_close(&p);
+		free(b.p);
+	}
+}
+
 TEST(decode_motion)
 {
 	buf b = make_pack(0);
@@ -1234,7 +1338,7 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 3.0 is newer than this reader's 2.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 4.0 is newer than this reader's 3.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
 }
 
@@ -1252,8 +1356,41 @@ TEST(older_major_is_refused)
 	free(b.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && p.chunks == NULL, "returned %d: %s", (int)r, terr.message);
 	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
-	                               "reads 2.x)") == 0,
+	                               "reads 2.x and 3.x)") == 0,
 	          "message: %s", terr.message);
+}
+
+/* Format 3.0 added parts in their own numbering (MLOD_PART_LOCAL, 'IMAP')
+ * and the index sequence codec; a 2.0 pack, which has neither, reads. */
+TEST(format_2_0_reads)
+{
+	static wchunk c[C_COUNT + 1];
+	local_flag = 0;
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, 2, 0);
+	free_chunks(c, n);
+	mlod_pack p = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_mesh m0 = {0}, m1 = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK(p.major == 2 && p.minor == 0);
+	CHECK(!(parts_truth[1].flags & MLOD_PART_LOCAL) && !(parts_truth[2].flags & MLOD_PART_LOCAL));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &s, &terr));
+	CHECK_OK(mlod_pack_decode_mesh(&p, C_MESH0, b.p, b.n, &s, &m0, &terr));
+	CHECK_OK(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &s, &m1, &terr));
+	char why[256] = "";
+	int ok = m0.part_count == 2 && m1.part_count == 2 && check_part(&m0.parts[0], &parts_truth[0], why, sizeof why) &&
+	         check_part(&m0.parts[1], &parts_truth[1], why, sizeof why) &&
+	         check_part(&m1.parts[0], &parts_truth[2], why, sizeof why) &&
+	         check_part(&m1.parts[1], &parts_truth[3], why, sizeof why) &&
+	         !(m0.parts[1].rec.flags & MLOD_PART_LOCAL);
+	mlod_pack_mesh_free(&m0);
+	mlod_pack_mesh_free(&m1);
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_close(&p);
+	free(b.p);
+	local_flag = MLOD_PART_LOCAL;
+	CHECK_MSG(ok, "%s", why);
 }
 
 static uint8_t *stream_data(wchunk *c, int chunk, uint32_t tag, int nth);
@@ -1562,7 +1699,23 @@ static void e_morph_scale(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_
 static void e_no_skin(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 16, 0xffffffffu); }
 static void e_rotq_cubic(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 + 8, 2); }
 static void e_rotq_index(wchunk *c) { wr16(stream_data(c, C_MOT0, MLOD_STREAM_ROTQ, 0) + 8 * 2 + 6, 4); }
-static void e_part_flags(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x48); }
+static void e_part_flags(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x108); }
+static void e_newbits_alone(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x88); }
+/* Level 0's part 1 in its own numbering (u16): its map's first vertex
+ * past the prefix. Level 1's part 0 (16 vertices, every one marked new):
+ * an index past its vertices; vertex 0 not marked new, with no 'IMAP'
+ * entry for it. */
+static void e_imap_past(wchunk *c)
+{
+	uint8_t *d = stream_data(c, C_MESH0, MLOD_STREAM_IMAP, 0);
+	d[0] = NV1, d[1] = 0;
+}
+static void e_inew_imap(wchunk *c) { stream_data(c, C_MESH1, MLOD_STREAM_INEW, 0)[0] = 0xfe; }
+static void e_local_index(wchunk *c)
+{
+	uint8_t *d = stream_data(c, C_MESH1, MLOD_STREAM_IDX, 0);
+	d[8] = 16, d[9] = 0;
+}
 
 TEST(structural_checks_name_the_chunk)
 {
@@ -1607,7 +1760,11 @@ TEST(structural_checks_name_the_chunk)
 		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
 		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (rotation keys without a base key)"},
 		{e_rotq_index, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 2: component index 4 is not 0 to 3"},
-		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x40"},
+		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x100"},
+		{e_newbits_alone, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: NEWBITS without LOCAL"},
+		{e_imap_past, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 1: vertex 0 maps to 24, past its prefix of 24 vertices (MESH levels 1 to 0)"},
+		{e_inew_imap, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: stream 10 'IMAP' has 0 elements, expected 1 (the vertices 'INEW' leaves)"},
+		{e_local_index, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: index 16 refers past its 16 vertices (at position 4)"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
 		buf b = edited_pack(cases[k].edit);
@@ -1844,6 +2001,8 @@ int main(int argc, char **argv)
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
 	RUN(older_major_is_refused);
+	RUN(format_2_0_reads);
+	RUN(motion_tick_bits);
 	RUN(nested_motion_needs_its_base);
 	RUN(draco_chunks_are_unsupported);
 	RUN(every_prefix);

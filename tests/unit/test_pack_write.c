@@ -220,6 +220,8 @@ static uint8_t *stream(const uint8_t *chunk, uint32_t tag, int nth, uint32_t *co
 				memcpy(out, chunk + at, (size_t)*count * *size);
 			else if (h[10] == MLOD_SCODEC_MESHOPT_VERTEX)
 				meshopt_decodeVertexBuffer(out, *count, *size, chunk + at, stored);
+			else if (h[10] == MLOD_SCODEC_MESHOPT_SEQUENCE)
+				meshopt_decodeIndexSequence(out, *count, *size, chunk + at, stored);
 			else
 				meshopt_decodeIndexBuffer(out, *count, *size, chunk + at, stored);
 			return out;
@@ -326,6 +328,30 @@ TEST(pack_mesh_streams)
 	uint8_t *wgt = pref[2], *jnt = pref[3];
 	uint16_t *idx = (uint16_t *)stream(mesh, MLOD_STREAM_IDX, 0, &cnt, &esz);
 	CHECK(idx && esz == 2 && cnt == part->index_count);
+	/* In the level's own numbering (MLOD_PART_LOCAL): its vertices, in
+	 * first-use order, are the block's next ones where 'INEW' (with
+	 * NEWBITS) sets their bits, else the next of 'IMAP'. Map idx through. */
+	uint16_t *imap = (uint16_t *)stream(mesh, MLOD_STREAM_IMAP, 0, &c1, &e1);
+	uint32_t nw = 0, ew = 0, *inew = (uint32_t *)stream(mesh, MLOD_STREAM_INEW, 0, &nw, &ew);
+	CHECK(!imap == !(part->flags & MLOD_PART_LOCAL) && !inew == !(part->flags & MLOD_PART_NEWBITS));
+	if (imap) {
+		uint32_t V = part->vertex_count, *to = malloc(sizeof *to * ((size_t)V + 1)), nnew = 0, nold = 0;
+		CHECK(e1 == 2 && (!inew || (ew == 4 && nw == (V + 31) / 32)));
+		for (uint32_t v = 0; v < V; v++)
+			to[v] = inew && inew[v / 32] >> (v % 32) & 1u ? bn[0] + nnew++ : nold < c1 ? imap[nold++] : total;
+		CHECK(nold == c1 && nnew <= bn[1]);
+		uint8_t *used = calloc((size_t)V + 1, 1);
+		uint32_t nused = 0;
+		for (uint32_t t = 0; t < cnt; t++) {
+			uint16_t l = idx[t] < V ? idx[t] : 0;
+			CHECK(idx[t] < V && to[l] < total);
+			nused += !used[l], used[l] = 1;
+			idx[t] = (uint16_t)to[l];
+		}
+		CHECK(nused == V); /* every vertex of the level used */
+		free(to), free(used);
+	}
+	free(imap), free(inew);
 	/* Level 0's triangles follow one of mlod_pack_vertex_order's orders
 	 * (each up to a rotation of its corners, which the index codec may
 	 * make), each order-local vertex standing for one prefix vertex: find
@@ -356,7 +382,11 @@ TEST(pack_mesh_streams)
 			order = o, memcpy(best_gid, gid, sizeof *gid * nv);
 	}
 	CHECK_MSG(order >= 0, "the stored triangles are none of the orders'");
-	printf("# MESH level 0 stored in order %d, its block %u vertices after level 1's %u\n", order, bn[1], bn[0]);
+	printf("# MESH level 0 stored in order %d, its block %u vertices after level 1's %u, %s numbering\n", order,
+	       bn[1], bn[0],
+	       part->flags & MLOD_PART_NEWBITS ? "its own (new vertices marked)"
+	       : part->flags & MLOD_PART_LOCAL ? "its own (a map of every vertex)"
+	                                       : "the prefix's");
 	for (int u = 0; order >= 0 && u < pr->vertex_count; u++) {
 		if (best_gid[remap[u]] == UINT32_MAX)
 			continue; /* no triangle uses it */
@@ -779,21 +809,22 @@ TEST(pack_lossless_fields)
 				continue;
 			/* the chunk's streams: time arrays shared, ticks for sampled clips */
 			const uint8_t *ch = (const uint8_t *)out + pk.chunks[ci].offset;
-			uint32_t n0 = rd32(ch), ntime = 0, time_keys = 0, keys = 0;
+			uint32_t n0 = rd32(ch), ntime = 0, time_keys = 0, keys = 0, bits = 0;
 			for (uint32_t s = 0; s < n0; s++) {
 				uint32_t tg = rd32(ch + 4 + 16 * s);
 				if (tg == MLOD_STREAM_TIME || tg == MLOD_STREAM_TICK)
 					ntime++, time_keys += rd32(ch + 4 + 16 * s + 4);
-				ticks += tg == MLOD_STREAM_TICK;
+				bits += tg == MLOD_STREAM_TBIT; /* words, not keys */
+				ticks += tg == MLOD_STREAM_TICK || tg == MLOD_STREAM_TBIT;
 			}
 			for (int k = 0; k < clip->channel_count; k++)
 				keys += (uint32_t)clip->channels[k].key_count;
-			CHECK(ntime == 1 && time_keys < keys); /* one stream, arrays shared */
+			CHECK(ntime + bits == 1 && (bits || time_keys < keys)); /* one stream, arrays shared */
 			double *stp = (double *)stream(ch, MLOD_STREAM_STEP, 0, &cnt, &esz);
 			CHECK(stp && cnt == 1 && esz == 8);
 			double step = stp ? *stp : 0;
 			free(stp);
-			/* a key time back: exact as 'TIME', within the tolerance as 'TICK' */
+			/* a key time back: exact as 'TIME', within the tolerance as 'TICK' or 'TBIT' */
 #define TIME_OK(got, want)                                                                                         \
 	((got) == (want) || (step > 0 && fabs((double)(got) - (want)) <=                                               \
 	                                      MLOD_PACK_TICK_TOLERANCE * (fabs((double)(want)) > step ? fabs((double)(want)) : step)))
