@@ -97,29 +97,18 @@ double mlod_motion_point_distance(const mlod_skeleton *s, int metres)
 /* Sum of |wrapped differences| between two Euler triples of one order,
  * the nearer of the two triples of b: (A, B, C) and (A + pi, pi - B, C + pi)
  * over the order's axes, outermost first. */
-/* mlod_wrap_angle(a), the same double: for a + pi in (0, 2 pi), fmod(a +
- * pi, 2 pi) is a + pi itself (fmod is exact, and returns x for 0 <= x <
- * y), so the call is left out. */
-static inline double wrap_angle(double a)
-{
-	double x = a + MLOD_PI;
-	if (x > 0.0 && x < 2.0 * MLOD_PI)
-		return x - MLOD_PI;
-	return mlod_wrap_angle(a);
-}
-
 static double euler_change(mlod_euler_order order, const float *ea, const float *eb)
 {
 	const int *ax = mlod_euler_axes(order);
 	double d1 = 0.0, d2 = 0.0;
 	for (int a = 0; a < 3; a++)
-		d1 += fabs(wrap_angle((double)eb[a] - ea[a]));
+		d1 += fabs(eval_wrap_angle((double)eb[a] - ea[a]));
 	double alt[3];
 	alt[ax[0]] = eb[ax[0]] + MLOD_PI;
 	alt[ax[1]] = MLOD_PI - eb[ax[1]];
 	alt[ax[2]] = eb[ax[2]] + MLOD_PI;
 	for (int a = 0; a < 3; a++)
-		d2 += fabs(wrap_angle(alt[a] - ea[a]));
+		d2 += fabs(eval_wrap_angle(alt[a] - ea[a]));
 	return d1 < d2 ? d1 : d2;
 }
 

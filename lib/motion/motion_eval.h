@@ -139,6 +139,11 @@ static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, d
 	return ((double)sqrtf(dp2) + radius * (double)sqrtf(frob)) * (1.0 + 1e-5) + 1e-18 * (1.0 + radius);
 }
 
+/* mlod_motion_point_error(w, w0, radius) <= limit, exactly that answer,
+ * its largest singular value computed only when cheaper bounds of it
+ * cannot tell (pointerror.c). */
+int eval_point_error_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit);
+
 /* Is mlod_motion_point_error(w, w0, radius) <= limit? Exactly that
  * answer; the exact error is computed only when the bounds cannot tell. */
 static inline int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
@@ -154,7 +159,7 @@ static inline int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double ra
 		}
 	if (dp + radius * (sqrt(frob) * EVAL_FROB_MARGIN) <= limit)
 		return 1;
-	return mlod_motion_point_error(w, w0, radius) <= limit;
+	return eval_point_error_within(w, w0, radius, limit);
 }
 
 /* mlod_motion_point_error(w, w0, radius), or -1 when a bound shows that
@@ -170,9 +175,32 @@ static inline double eval_error_over(const mlod_mat4 *w, const mlod_mat4 *w0, do
 			double a = (double)w->m[c * 4 + r] - w0->m[c * 4 + r];
 			frob += a * a;
 		}
-	if (dp + radius * (sqrt(frob) * EVAL_FROB_MARGIN) <= limit)
-		return -1.0;
+	if (dp + radius * (sqrt(frob) * EVAL_FROB_MARGIN) <= limit || eval_point_error_within(w, w0, radius, limit))
+		return -1.0; /* the callers keep the largest error: one within the limit changes nothing */
 	return mlod_motion_point_error(w, w0, radius);
+}
+
+/* mlod_wrap_angle(a), the same double: for x = a + pi in (0, 2 pi),
+ * fmod(x, 2 pi) is x itself (fmod is exact, and returns x for 0 <= x < y),
+ * so the call is left out; and so for x in [2 pi, 4 pi), where fmod's
+ * exact result is x - 2 pi (a difference of two doubles within a factor
+ * two of each other, exact: Sterbenz), and for x in (-2 pi, 0], where it
+ * is x (then x <= 0 takes 2 pi, as mlod_wrap_angle does). */
+static inline double eval_wrap_angle(double a)
+{
+	const double y = 2.0 * MLOD_PI;
+	double x = a + MLOD_PI;
+	if (x > 0.0 && x < y)
+		return x - MLOD_PI;
+	if (x >= y && x < 2.0 * y) {
+		x -= y;
+		if (x <= 0.0)
+			x += y;
+		return x - MLOD_PI;
+	}
+	if (x > -y && x <= 0.0)
+		return (x + y) - MLOD_PI;
+	return mlod_wrap_angle(a);
 }
 
 /* Per channel: the segment a cursor is in and what slerp needs of it. */
