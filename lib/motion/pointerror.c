@@ -45,17 +45,19 @@ static double sigma_max(const double a[9])
 	return lambda > 0.0 ? sqrt(lambda) * (1.0 + 1e-9) : 0.0;
 }
 
-/* Bounds of sigma_max(a) as computed, without its trigonometry: *lo <=
- * sigma_max(a) <= *hi. B = A^T A as sigma_max forms it; sigma_max's
+/* Is base + rad * sigma_max(a) <= limit (rad >= 0)? Exactly that answer,
+ * from bounds of sigma_max(a) as computed where they fall on one side of
+ * the limit (the sum is monotone in it), cheapest first, and sigma_max
+ * only between them. B = A^T A as sigma_max forms it; sigma_max's
  * eigenvalue is never below B's largest diagonal entry (the same floats),
- * nor, but for its rounding (far below 1e-7 relative, even where two
- * eigenvalues meet and acos loses half the digits), below the Rayleigh
- * quotient of any vector, here B's column of that diagonal entry (a
- * rotation's error A' - A = A (R - I) has two equal singular values and
- * that column lies in their plane: the quotient is the largest
- * eigenvalue); nor above B's largest absolute row sum (Gershgorin). The
- * 1e-5 margins cover the roundings 100 times over. */
-static void sigma_bounds(const double a[9], double *lo, double *hi)
+ * nor above B's largest absolute row sum (Gershgorin), nor, but for its
+ * rounding (far below 1e-7 relative, even where two eigenvalues meet and
+ * acos loses half the digits), below the Rayleigh quotient of any vector,
+ * here B's column of that diagonal entry (a rotation's error
+ * A' - A = A (R - I) has two equal singular values and that column lies
+ * in their plane: the quotient is the largest eigenvalue). The 1e-5
+ * margins cover the roundings 100 times over. */
+static int sigma_decide(const double a[9], double rad, double base, double limit)
 {
 	double b[3][3];
 	for (int i = 0; i < 3; i++)
@@ -64,25 +66,26 @@ static void sigma_bounds(const double a[9], double *lo, double *hi)
 	int k = b[1][1] > b[0][0] ? 1 : 0;
 	if (b[2][2] > b[k][k])
 		k = 2;
-	double diag = b[k][k]; /* the largest; a NaN makes every bound NaN below */
-	const double *v = b[k];
-	double bv[3], vv = 0.0, vbv = 0.0, g = 0.0;
+	double diag = b[k][k]; /* the largest (or a NaN's place: then 0 below) */
+	if (!(base + rad * (diag > 0.0 ? sqrt(diag) * (1.0 + 1e-9) : 0.0) <= limit))
+		return 0;
+	double g = 0.0;
 	for (int i = 0; i < 3; i++) {
-		bv[i] = b[i][0] * v[0] + b[i][1] * v[1] + b[i][2] * v[2];
-		vv += v[i] * v[i];
-		vbv += v[i] * bv[i];
 		double row = fabs(b[i][0]) + fabs(b[i][1]) + fabs(b[i][2]);
 		if (!(row <= g))
 			g = row; /* a NaN stays */
 	}
-	double l = diag > 0.0 ? sqrt(diag) * (1.0 + 1e-9) : 0.0;
-	if (vv > 0.0 && vbv > 0.0) {
-		double rq = sqrt(vbv / vv) * (1.0 - 1e-5);
-		if (rq > l)
-			l = rq;
+	if (base + rad * (sqrt(g) * (1.0 + 1e-5)) <= limit)
+		return 1;
+	const double *v = b[k];
+	double vv = 0.0, vbv = 0.0;
+	for (int i = 0; i < 3; i++) {
+		vv += v[i] * v[i];
+		vbv += v[i] * (b[i][0] * v[0] + b[i][1] * v[1] + b[i][2] * v[2]);
 	}
-	*lo = l;
-	*hi = sqrt(g) * (1.0 + 1e-5);
+	if (vv > 0.0 && vbv > 0.0 && base + rad * (sqrt(vbv / vv) * (1.0 - 1e-5)) > limit)
+		return 0;
+	return base + rad * sigma_max(a) <= limit;
 }
 
 int eval_point_error_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
@@ -93,15 +96,8 @@ int eval_point_error_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radi
 	for (int c = 0; c < 3; c++)
 		for (int r = 0; r < 3; r++)
 			m[c * 3 + r] = (double)w->m[c * 4 + r] - w0->m[c * 4 + r];
-	double dp = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), lo, hi;
-	sigma_bounds(m, &lo, &hi);
-	/* mlod_motion_point_error's sum is monotone in sigma_max: the bounds
-	 * decide it when they fall on one side of the limit. */
-	if (!(dp + radius * lo <= limit))
-		return 0;
-	if (dp + radius * hi <= limit)
-		return 1;
-	return dp + radius * sigma_max(m) <= limit;
+	/* mlod_motion_point_error's sum, compared */
+	return sigma_decide(m, radius, sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), limit);
 }
 
 double mlod_motion_point_error(const mlod_mat4 *a, const mlod_mat4 *b, double radius)
@@ -130,11 +126,5 @@ int mlod_motion_point_within(const mlod_mat4 *w, const mlod_mat4 *w0, double rad
 	double room = budget - dp, rad = radius;
 	if (rad * rad * frob <= room * room)
 		return 1; /* sigma_max <= Frobenius norm */
-	double lo, hi;
-	sigma_bounds(a, &lo, &hi); /* rad * sigma_max is monotone in sigma_max */
-	if (rad * lo > room)
-		return 0;
-	if (rad * hi <= room)
-		return 1;
-	return rad * sigma_max(a) <= room;
+	return sigma_decide(a, rad, 0.0, room); /* 0 + x is x */
 }
