@@ -45,6 +45,7 @@
  * vector extension computes a column at once); the last row (0, 0, 0, 1). */
 #if defined(__GNUC__)
 typedef float eval_v4 __attribute__((vector_size(16)));
+typedef int32_t eval_v4i __attribute__((vector_size(16)));
 #endif
 
 EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
@@ -61,6 +62,14 @@ EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 	s0 = s0 + a1 * b->m[1], s1 = s1 + a1 * b->m[5], s2 = s2 + a1 * b->m[9], s3 = s3 + a1 * b->m[13];
 	s0 = s0 + a2 * b->m[2], s1 = s1 + a2 * b->m[6], s2 = s2 + a2 * b->m[10], s3 = s3 + a2 * b->m[14];
 	s3 = s3 + a3;
+	/* The last row (0, 0, 0, 1) set in the vectors (lane 3 cleared, then
+	 * 1.0f's bits in the last), so the columns go out as they are
+	 * instead of through scalar stores. */
+	const eval_v4i keep = { -1, -1, -1, 0 }, one = { 0, 0, 0, 0x3f800000 };
+	s0 = (eval_v4)((eval_v4i)s0 & keep);
+	s1 = (eval_v4)((eval_v4i)s1 & keep);
+	s2 = (eval_v4)((eval_v4i)s2 & keep);
+	s3 = (eval_v4)(((eval_v4i)s3 & keep) | one);
 	memcpy(r.m, &s0, sizeof s0);
 	memcpy(r.m + 4, &s1, sizeof s1);
 	memcpy(r.m + 8, &s2, sizeof s2);
@@ -78,8 +87,10 @@ EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 		}
 	}
 #endif
+#if !defined(__GNUC__)
 	r.m[3] = r.m[7] = r.m[11] = 0.0f;
 	r.m[15] = 1.0f;
+#endif
 	return r;
 }
 
@@ -117,14 +128,19 @@ EVAL_INLINE mlod_mat4 eval_from_trs(const mlod_trs *trs)
 static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, double radius)
 {
 #if defined(__GNUC__)
-	eval_v4 d[4];
-	for (int c = 0; c < 4; c++) {
-		eval_v4 x, y;
-		memcpy(&x, w->m + 4 * c, sizeof x);
-		memcpy(&y, w0->m + 4 * c, sizeof y);
-		d[c] = x - y;
-	}
-	eval_v4 f = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], t = d[3] * d[3];
+	/* Written out: GCC kept the loop over the columns, and the differences
+	 * on the stack. */
+	eval_v4 x0, x1, x2, x3, y0, y1, y2, y3;
+	memcpy(&x0, w->m, sizeof x0);
+	memcpy(&x1, w->m + 4, sizeof x1);
+	memcpy(&x2, w->m + 8, sizeof x2);
+	memcpy(&x3, w->m + 12, sizeof x3);
+	memcpy(&y0, w0->m, sizeof y0);
+	memcpy(&y1, w0->m + 4, sizeof y1);
+	memcpy(&y2, w0->m + 8, sizeof y2);
+	memcpy(&y3, w0->m + 12, sizeof y3);
+	eval_v4 d0 = x0 - y0, d1 = x1 - y1, d2 = x2 - y2, d3 = x3 - y3;
+	eval_v4 f = d0 * d0 + d1 * d1 + d2 * d2, t = d3 * d3;
 	float frob = (f[0] + f[1]) + (f[2] + f[3]), dp2 = (t[0] + t[1]) + (t[2] + t[3]);
 #else
 	float frob = 0.0f, dp2 = 0.0f;
