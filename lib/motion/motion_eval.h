@@ -104,13 +104,12 @@ EVAL_INLINE mlod_mat4 eval_from_trs(const mlod_trs *trs)
 	r[0][0] = 1 - s * (y * y + z * z); r[0][1] = s * (x * y - w * z);     r[0][2] = s * (x * z + w * y);
 	r[1][0] = s * (x * y + w * z);     r[1][1] = 1 - s * (x * x + z * z); r[1][2] = s * (y * z - w * x);
 	r[2][0] = s * (x * z - w * y);     r[2][1] = s * (y * z + w * x);     r[2][2] = 1 - s * (x * x + y * y);
-	const float sc[3] = { trs->s.x, trs->s.y, trs->s.z };
+	const double sx = trs->s.x, sy = trs->s.y, sz = trs->s.z;
 	mlod_mat4 m;
-	for (int c = 0; c < 3; c++) {
-		for (int row = 0; row < 3; row++)
-			m.m[c * 4 + row] = (float)(r[row][c] * sc[c]);
-		m.m[c * 4 + 3] = 0.0f;
-	}
+	/* Written out (GCC kept the loops): column c scaled by s[c]. */
+	m.m[0] = (float)(r[0][0] * sx), m.m[1] = (float)(r[1][0] * sx), m.m[2] = (float)(r[2][0] * sx), m.m[3] = 0.0f;
+	m.m[4] = (float)(r[0][1] * sy), m.m[5] = (float)(r[1][1] * sy), m.m[6] = (float)(r[2][1] * sy), m.m[7] = 0.0f;
+	m.m[8] = (float)(r[0][2] * sz), m.m[9] = (float)(r[1][2] * sz), m.m[10] = (float)(r[2][2] * sz), m.m[11] = 0.0f;
 	m.m[12] = trs->t.x;
 	m.m[13] = trs->t.y;
 	m.m[14] = trs->t.z;
@@ -141,7 +140,16 @@ static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, d
 	memcpy(&y3, w0->m + 12, sizeof y3);
 	eval_v4 d0 = x0 - y0, d1 = x1 - y1, d2 = x2 - y2, d3 = x3 - y3;
 	eval_v4 f = d0 * d0 + d1 * d1 + d2 * d2, t = d3 * d3;
+#if defined(__clang__)
 	float frob = (f[0] + f[1]) + (f[2] + f[3]), dp2 = (t[0] + t[1]) + (t[2] + t[3]);
+#else
+	/* The same sums, both at once: (f0 + f1, f2 + f3, t0 + t1, t2 + t3),
+	 * then each pair's sum in lanes 0 and 2. */
+	const eval_v4i even = { 0, 2, 4, 6 }, odd = { 1, 3, 5, 7 }, swap = { 1, 0, 3, 2 };
+	eval_v4 p = __builtin_shuffle(f, t, even) + __builtin_shuffle(f, t, odd);
+	p = p + __builtin_shuffle(p, swap);
+	float frob = p[0], dp2 = p[2];
+#endif
 #else
 	float frob = 0.0f, dp2 = 0.0f;
 	for (int i = 0; i < 16; i++) {
