@@ -998,15 +998,15 @@ static float short_value(long n)
 }
 
 /* Rounds a unit quaternion onto the lattice of normalised shorts: its three
- * smaller components to multiples of 2^a / 32767, the largest to the
- * nearest lattice value that makes it unit. */
-static void round_quat_short(float *q, int a)
+ * smaller components to multiples of step / 32767 (step a power of two),
+ * the largest to the nearest lattice value that makes it unit. */
+static void round_quat_short(float *q, double step)
 {
 	int big = 0;
 	for (int c = 1; c < 4; c++)
 		if (fabsf(q[c]) > fabsf(q[big]))
 			big = c;
-	double step = ldexp(1.0, a), sum = 0.0;
+	double sum = 0.0;
 	long n[4];
 	for (int c = 0; c < 4; c++)
 		if (c != big) {
@@ -1036,8 +1036,9 @@ static void round_channel(const mlod_channel *a, mlod_channel *b, int e, int sho
 		return;
 	if (shorts && comps == 4 && a->interp != MLOD_INTERP_CUBICSPLINE) {
 		int lattice = e + 15 > 0 ? e + 15 : 0; /* 2^e is about 2^(e + 15) / 32767 */
+		const double step = ldexp(1.0, lattice); /* once a channel, not once a key */
 		for (int k = 0; k < n; k++)
-			round_quat_short(b->values + (size_t)k * 4u, k == 0 || k == n - 1 ? 0 : lattice);
+			round_quat_short(b->values + (size_t)k * 4u, k == 0 || k == n - 1 ? 1.0 : step);
 		b->short_values = 1;
 		return;
 	}

@@ -60,9 +60,12 @@ static double sigma_max(const double a[9])
 static int sigma_decide(const double a[9], double rad, double base, double limit)
 {
 	double b[3][3];
-	for (int i = 0; i < 3; i++)
-		for (int j = i; j < 3; j++)
-			b[i][j] = b[j][i] = a[0 * 3 + i] * a[0 * 3 + j] + a[1 * 3 + i] * a[1 * 3 + j] + a[2 * 3 + i] * a[2 * 3 + j];
+	/* Written out: b[i][j] = sum over c of a[c * 3 + i] a[c * 3 + j], in
+	 * sigma_max's order. */
+#define SIGMA_B(i, j) (a[0 * 3 + i] * a[0 * 3 + j] + a[1 * 3 + i] * a[1 * 3 + j] + a[2 * 3 + i] * a[2 * 3 + j])
+	b[0][0] = SIGMA_B(0, 0), b[1][1] = SIGMA_B(1, 1), b[2][2] = SIGMA_B(2, 2);
+	b[0][1] = b[1][0] = SIGMA_B(0, 1), b[0][2] = b[2][0] = SIGMA_B(0, 2), b[1][2] = b[2][1] = SIGMA_B(1, 2);
+#undef SIGMA_B
 	int k = b[1][1] > b[0][0] ? 1 : 0;
 	if (b[2][2] > b[k][k])
 		k = 2;
