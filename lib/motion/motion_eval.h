@@ -16,7 +16,10 @@
  *   zeros (or the parent's translation times 1): they are left out.
  * - sigma_max(A) <= |A|_F: a joint whose origin error plus radius times
  *   the Frobenius norm (with a margin far above rounding) is within the
- *   limit is within it; only the others take the exact sigma_max.
+ *   limit is within it; the others take cheaper bounds of sigma_max before
+ *   sigma_max itself (eval_point_error_within, pointerror.c).
+ * - eval_wrap_angle: mlod_wrap_angle without fmod where fmod's exact
+ *   result is known.
  */
 #ifndef MLOD_MOTION_EVAL_H
 #define MLOD_MOTION_EVAL_H
