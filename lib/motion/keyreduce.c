@@ -73,7 +73,7 @@ static int comps_of(const mlod_channel *ch)
 }
 
 /* Sets one path of a local transform from comps values, as mlod_clip_sample does. */
-static void set_path(mlod_trs *l, mlod_path path, const float *v)
+EVAL_INLINE void set_path(mlod_trs *l, mlod_path path, const float *v)
 {
 	switch (path) {
 	case MLOD_PATH_TRANSLATION: l->t.x = v[0], l->t.y = v[1], l->t.z = v[2]; break;

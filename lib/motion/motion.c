@@ -97,29 +97,18 @@ double mlod_motion_point_distance(const mlod_skeleton *s, int metres)
 /* Sum of |wrapped differences| between two Euler triples of one order,
  * the nearer of the two triples of b: (A, B, C) and (A + pi, pi - B, C + pi)
  * over the order's axes, outermost first. */
-/* mlod_wrap_angle(a), the same double: for a + pi in (0, 2 pi), fmod(a +
- * pi, 2 pi) is a + pi itself (fmod is exact, and returns x for 0 <= x <
- * y), so the call is left out. */
-static inline double wrap_angle(double a)
-{
-	double x = a + MLOD_PI;
-	if (x > 0.0 && x < 2.0 * MLOD_PI)
-		return x - MLOD_PI;
-	return mlod_wrap_angle(a);
-}
-
 static double euler_change(mlod_euler_order order, const float *ea, const float *eb)
 {
 	const int *ax = mlod_euler_axes(order);
 	double d1 = 0.0, d2 = 0.0;
 	for (int a = 0; a < 3; a++)
-		d1 += fabs(wrap_angle((double)eb[a] - ea[a]));
+		d1 += fabs(eval_wrap_angle((double)eb[a] - ea[a]));
 	double alt[3];
 	alt[ax[0]] = eb[ax[0]] + MLOD_PI;
 	alt[ax[1]] = MLOD_PI - eb[ax[1]];
 	alt[ax[2]] = eb[ax[2]] + MLOD_PI;
 	for (int a = 0; a < 3; a++)
-		d2 += fabs(wrap_angle(alt[a] - ea[a]));
+		d2 += fabs(eval_wrap_angle(alt[a] - ea[a]));
 	return d1 < d2 ? d1 : d2;
 }
 
@@ -1009,15 +998,15 @@ static float short_value(long n)
 }
 
 /* Rounds a unit quaternion onto the lattice of normalised shorts: its three
- * smaller components to multiples of 2^a / 32767, the largest to the
- * nearest lattice value that makes it unit. */
-static void round_quat_short(float *q, int a)
+ * smaller components to multiples of step / 32767 (step a power of two),
+ * the largest to the nearest lattice value that makes it unit. */
+static void round_quat_short(float *q, double step)
 {
 	int big = 0;
 	for (int c = 1; c < 4; c++)
 		if (fabsf(q[c]) > fabsf(q[big]))
 			big = c;
-	double step = ldexp(1.0, a), sum = 0.0;
+	double sum = 0.0;
 	long n[4];
 	for (int c = 0; c < 4; c++)
 		if (c != big) {
@@ -1047,8 +1036,9 @@ static void round_channel(const mlod_channel *a, mlod_channel *b, int e, int sho
 		return;
 	if (shorts && comps == 4 && a->interp != MLOD_INTERP_CUBICSPLINE) {
 		int lattice = e + 15 > 0 ? e + 15 : 0; /* 2^e is about 2^(e + 15) / 32767 */
+		const double step = ldexp(1.0, lattice); /* once a channel, not once a key */
 		for (int k = 0; k < n; k++)
-			round_quat_short(b->values + (size_t)k * 4u, k == 0 || k == n - 1 ? 0 : lattice);
+			round_quat_short(b->values + (size_t)k * 4u, k == 0 || k == n - 1 ? 1.0 : step);
 		b->short_values = 1;
 		return;
 	}

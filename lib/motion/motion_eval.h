@@ -16,7 +16,10 @@
  *   zeros (or the parent's translation times 1): they are left out.
  * - sigma_max(A) <= |A|_F: a joint whose origin error plus radius times
  *   the Frobenius norm (with a margin far above rounding) is within the
- *   limit is within it; only the others take the exact sigma_max.
+ *   limit is within it; the others take cheaper bounds of sigma_max before
+ *   sigma_max itself (eval_point_error_within, pointerror.c).
+ * - eval_wrap_angle: mlod_wrap_angle without fmod where fmod's exact
+ *   result is known.
  */
 #ifndef MLOD_MOTION_EVAL_H
 #define MLOD_MOTION_EVAL_H
@@ -45,6 +48,7 @@
  * vector extension computes a column at once); the last row (0, 0, 0, 1). */
 #if defined(__GNUC__)
 typedef float eval_v4 __attribute__((vector_size(16)));
+typedef int32_t eval_v4i __attribute__((vector_size(16)));
 #endif
 
 EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
@@ -61,6 +65,14 @@ EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 	s0 = s0 + a1 * b->m[1], s1 = s1 + a1 * b->m[5], s2 = s2 + a1 * b->m[9], s3 = s3 + a1 * b->m[13];
 	s0 = s0 + a2 * b->m[2], s1 = s1 + a2 * b->m[6], s2 = s2 + a2 * b->m[10], s3 = s3 + a2 * b->m[14];
 	s3 = s3 + a3;
+	/* The last row (0, 0, 0, 1) set in the vectors (lane 3 cleared, then
+	 * 1.0f's bits in the last), so the columns go out as they are
+	 * instead of through scalar stores. */
+	const eval_v4i keep = { -1, -1, -1, 0 }, one = { 0, 0, 0, 0x3f800000 };
+	s0 = (eval_v4)((eval_v4i)s0 & keep);
+	s1 = (eval_v4)((eval_v4i)s1 & keep);
+	s2 = (eval_v4)((eval_v4i)s2 & keep);
+	s3 = (eval_v4)(((eval_v4i)s3 & keep) | one);
 	memcpy(r.m, &s0, sizeof s0);
 	memcpy(r.m + 4, &s1, sizeof s1);
 	memcpy(r.m + 8, &s2, sizeof s2);
@@ -78,8 +90,10 @@ EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 		}
 	}
 #endif
+#if !defined(__GNUC__)
 	r.m[3] = r.m[7] = r.m[11] = 0.0f;
 	r.m[15] = 1.0f;
+#endif
 	return r;
 }
 
@@ -93,13 +107,12 @@ EVAL_INLINE mlod_mat4 eval_from_trs(const mlod_trs *trs)
 	r[0][0] = 1 - s * (y * y + z * z); r[0][1] = s * (x * y - w * z);     r[0][2] = s * (x * z + w * y);
 	r[1][0] = s * (x * y + w * z);     r[1][1] = 1 - s * (x * x + z * z); r[1][2] = s * (y * z - w * x);
 	r[2][0] = s * (x * z - w * y);     r[2][1] = s * (y * z + w * x);     r[2][2] = 1 - s * (x * x + y * y);
-	const float sc[3] = { trs->s.x, trs->s.y, trs->s.z };
+	const double sx = trs->s.x, sy = trs->s.y, sz = trs->s.z;
 	mlod_mat4 m;
-	for (int c = 0; c < 3; c++) {
-		for (int row = 0; row < 3; row++)
-			m.m[c * 4 + row] = (float)(r[row][c] * sc[c]);
-		m.m[c * 4 + 3] = 0.0f;
-	}
+	/* Written out (GCC kept the loops): column c scaled by s[c]. */
+	m.m[0] = (float)(r[0][0] * sx), m.m[1] = (float)(r[1][0] * sx), m.m[2] = (float)(r[2][0] * sx), m.m[3] = 0.0f;
+	m.m[4] = (float)(r[0][1] * sy), m.m[5] = (float)(r[1][1] * sy), m.m[6] = (float)(r[2][1] * sy), m.m[7] = 0.0f;
+	m.m[8] = (float)(r[0][2] * sz), m.m[9] = (float)(r[1][2] * sz), m.m[10] = (float)(r[2][2] * sz), m.m[11] = 0.0f;
 	m.m[12] = trs->t.x;
 	m.m[13] = trs->t.y;
 	m.m[14] = trs->t.z;
@@ -117,15 +130,35 @@ EVAL_INLINE mlod_mat4 eval_from_trs(const mlod_trs *trs)
 static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, double radius)
 {
 #if defined(__GNUC__)
-	eval_v4 d[4];
-	for (int c = 0; c < 4; c++) {
-		eval_v4 x, y;
-		memcpy(&x, w->m + 4 * c, sizeof x);
-		memcpy(&y, w0->m + 4 * c, sizeof y);
-		d[c] = x - y;
-	}
-	eval_v4 f = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], t = d[3] * d[3];
+	/* Written out: GCC kept the loop over the columns, and the differences
+	 * on the stack. */
+	eval_v4 x0, x1, x2, x3, y0, y1, y2, y3;
+	memcpy(&x0, w->m, sizeof x0);
+	memcpy(&x1, w->m + 4, sizeof x1);
+	memcpy(&x2, w->m + 8, sizeof x2);
+	memcpy(&x3, w->m + 12, sizeof x3);
+	memcpy(&y0, w0->m, sizeof y0);
+	memcpy(&y1, w0->m + 4, sizeof y1);
+	memcpy(&y2, w0->m + 8, sizeof y2);
+	memcpy(&y3, w0->m + 12, sizeof y3);
+	eval_v4 d0 = x0 - y0, d1 = x1 - y1, d2 = x2 - y2, d3 = x3 - y3;
+	eval_v4 f = d0 * d0 + d1 * d1 + d2 * d2, t = d3 * d3;
+#if defined(__clang__)
 	float frob = (f[0] + f[1]) + (f[2] + f[3]), dp2 = (t[0] + t[1]) + (t[2] + t[3]);
+#else
+	/* The same sums, both at once: (f0 + f1, f2 + f3, t0 + t1, t2 + t3),
+	 * then each pair's sum in lanes 0 and 2. */
+	const eval_v4i even = { 0, 2, 4, 6 }, odd = { 1, 3, 5, 7 }, swap = { 1, 0, 3, 2 };
+	eval_v4 p = __builtin_shuffle(f, t, even) + __builtin_shuffle(f, t, odd);
+	p = p + __builtin_shuffle(p, swap);
+#if defined(__SSE__)
+	/* Both roots in one instruction (the same IEEE square roots, without
+	 * sqrtf's errno test: the sums are never negative). */
+	p = __builtin_ia32_sqrtps(p);
+	return ((double)p[2] + radius * (double)p[0]) * (1.0 + 1e-5) + 1e-18 * (1.0 + radius);
+#endif
+	float frob = p[0], dp2 = p[2];
+#endif
 #else
 	float frob = 0.0f, dp2 = 0.0f;
 	for (int i = 0; i < 16; i++) {
@@ -138,6 +171,11 @@ static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, d
 #endif
 	return ((double)sqrtf(dp2) + radius * (double)sqrtf(frob)) * (1.0 + 1e-5) + 1e-18 * (1.0 + radius);
 }
+
+/* mlod_motion_point_error(w, w0, radius) <= limit, exactly that answer,
+ * its largest singular value computed only when cheaper bounds of it
+ * cannot tell (pointerror.c). */
+int eval_point_error_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit);
 
 /* Is mlod_motion_point_error(w, w0, radius) <= limit? Exactly that
  * answer; the exact error is computed only when the bounds cannot tell. */
@@ -154,7 +192,7 @@ static inline int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double ra
 		}
 	if (dp + radius * (sqrt(frob) * EVAL_FROB_MARGIN) <= limit)
 		return 1;
-	return mlod_motion_point_error(w, w0, radius) <= limit;
+	return eval_point_error_within(w, w0, radius, limit);
 }
 
 /* mlod_motion_point_error(w, w0, radius), or -1 when a bound shows that
@@ -170,9 +208,32 @@ static inline double eval_error_over(const mlod_mat4 *w, const mlod_mat4 *w0, do
 			double a = (double)w->m[c * 4 + r] - w0->m[c * 4 + r];
 			frob += a * a;
 		}
-	if (dp + radius * (sqrt(frob) * EVAL_FROB_MARGIN) <= limit)
-		return -1.0;
+	if (dp + radius * (sqrt(frob) * EVAL_FROB_MARGIN) <= limit || eval_point_error_within(w, w0, radius, limit))
+		return -1.0; /* the callers keep the largest error: one within the limit changes nothing */
 	return mlod_motion_point_error(w, w0, radius);
+}
+
+/* mlod_wrap_angle(a), the same double: for x = a + pi in (0, 2 pi),
+ * fmod(x, 2 pi) is x itself (fmod is exact, and returns x for 0 <= x < y),
+ * so the call is left out; and so for x in [2 pi, 4 pi), where fmod's
+ * exact result is x - 2 pi (a difference of two doubles within a factor
+ * two of each other, exact: Sterbenz), and for x in (-2 pi, 0], where it
+ * is x (then x <= 0 takes 2 pi, as mlod_wrap_angle does). */
+static inline double eval_wrap_angle(double a)
+{
+	const double y = 2.0 * MLOD_PI;
+	double x = a + MLOD_PI;
+	if (x > 0.0 && x < y)
+		return x - MLOD_PI;
+	if (x >= y && x < 2.0 * y) {
+		x -= y;
+		if (x <= 0.0)
+			x += y;
+		return x - MLOD_PI;
+	}
+	if (x > -y && x <= 0.0)
+		return (x + y) - MLOD_PI;
+	return mlod_wrap_angle(a);
 }
 
 /* Per channel: the segment a cursor is in and what slerp needs of it. */

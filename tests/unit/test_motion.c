@@ -993,7 +993,7 @@ static mlod_trs random_trs(int scaled)
 
 TEST(fast_checks_match_exact)
 {
-	long wrong_within = 0, wrong_over = 0, low_bound = 0, pairs = 0;
+	long wrong_within = 0, wrong_over = 0, low_bound = 0, pairs = 0, wrong_point = 0;
 	for (int i = 0; i < 200000; i++) {
 		mlod_trs a = random_trs(i % 4 == 0), b = a;
 		double size = i % 3 == 0 ? 1e-6 : i % 3 == 1 ? 1e-3 : 0.1;
@@ -1014,8 +1014,13 @@ TEST(fast_checks_match_exact)
 		for (int k = 0; k < 7; k++) {
 			int exact = e <= limits[k];
 			pairs++;
-			if (eval_within(&w, &w0, r, limits[k]) != exact)
+			if (eval_within(&w, &w0, r, limits[k]) != exact || eval_point_error_within(&w, &w0, r, limits[k]) != exact)
 				wrong_within++;
+			/* mlod_motion_point_within compares within the budget left by
+			 * the origin's error: the same answer away from rounding. */
+			if ((k == 3 && !mlod_motion_point_within(&w, &w0, r, limits[k])) ||
+			    (k == 4 && e > 1e-300 && mlod_motion_point_within(&w, &w0, r, limits[k])))
+				wrong_point++;
 			double o = eval_error_over(&w, &w0, r, limits[k]);
 			if (o < 0.0 ? !exact : memcmp(&o, &e, sizeof o) != 0)
 				wrong_over++;
@@ -1024,6 +1029,27 @@ TEST(fast_checks_match_exact)
 	CHECK_MSG(low_bound == 0, "float bound below the exact error %ld times", low_bound);
 	CHECK_MSG(wrong_within == 0, "eval_within differs from the exact check %ld times in %ld", wrong_within, pairs);
 	CHECK_MSG(wrong_over == 0, "eval_error_over differs from the exact error %ld times in %ld", wrong_over, pairs);
+	CHECK_MSG(wrong_point == 0, "mlod_motion_point_within wrong %ld times 1e-7 off the error", wrong_point);
+
+	/* eval_wrap_angle: mlod_wrap_angle's doubles, at the edges of its
+	 * shortcuts (multiples of pi, -0) and at random. */
+	long wrong_wrap = 0;
+	for (int i = 0; i < 400000; i++) {
+		double a;
+		if (i < 64) {
+			double edge = (double)(i / 8 - 4) * MLOD_PI; /* -4 pi .. 3 pi */
+			int m = i % 8;
+			a = m == 0 ? edge : m == 1 ? nextafter(edge, HUGE_VAL) : m == 2 ? nextafter(edge, -HUGE_VAL)
+			  : m == 3 ? -0.0 : m == 4 ? edge - MLOD_PI : m == 5 ? 2.0 * MLOD_PI * (i / 8 - 4) + MLOD_PI
+			  : m == 6 ? nextafter(3.0 * MLOD_PI, 0.0) : nextafter(-3.0 * MLOD_PI, 0.0);
+		} else {
+			a = (urand() - 0.5) * (i % 2 ? 14.0 : 40.0);
+		}
+		double x = eval_wrap_angle(a), y = mlod_wrap_angle(a);
+		if (memcmp(&x, &y, sizeof x) != 0)
+			wrong_wrap++;
+	}
+	CHECK_MSG(wrong_wrap == 0, "eval_wrap_angle differs from mlod_wrap_angle %ld times", wrong_wrap);
 
 	long wrong_mul = 0, wrong_trs = 0;
 	for (int i = 0; i < 100000; i++) {
