@@ -24,7 +24,7 @@
  * levels), the other poses search only the samples whose distance to
  * their recorded triangle could raise the max (mlod_warm's bound): the
  * same max, a mean at least the exact one, and on the 50k-triangle
- * tubeman 1.5 s of mlod-bgm's 2.9 s CPU saved (bench/RESULTS.md, Run 15).
+ * tubeman 1.5 s of mlod-bgm's 2.9 s CPU saved (bench/RESULTS.md, Run 16).
  */
 #include <math.h>
 #include <pthread.h>
