@@ -175,6 +175,13 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
 #define MLOD_SKEL_SAMPLES 120
 #define MLOD_SKEL_MAX_LEVELS 32
 
+/* mlod_vertex_deviation(a, b, ...), the same numbers bit for bit, for a
+ * level b of a (mlod_skel_level_apply): only the vertices whose skin
+ * matrices or weights differ in b at a time are skinned, in both
+ * (skeldev.c). Other pairs of characters go to mlod_vertex_deviation. */
+mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_character *b, int max_samples,
+                                       mlod_deviation *out, mlod_error *err);
+
 /* A level made and measured. */
 typedef struct mlod_skel_built {
 	mlod_skel_level skel;

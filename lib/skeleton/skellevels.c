@@ -62,7 +62,7 @@ static mlod_result measure(const mlod_skel_levels *L, mlod_skel_built *b, mlod_e
 		return r;
 	b->bound_error = 100.0 * b->joint.max / L->height;
 	if (L->has_mesh) {
-		if ((r = mlod_vertex_deviation(c, &b->c, MLOD_SKEL_SAMPLES, &b->vertex, err)) != MLOD_OK)
+		if ((r = mlod_skel_vertex_deviation(c, &b->c, MLOD_SKEL_SAMPLES, &b->vertex, err)) != MLOD_OK)
 			return r;
 		b->has_mesh_error = 1;
 		b->bound_error = b->vertex.max * b->vertex.scale / L->height;
