@@ -157,16 +157,26 @@ static inline float skin_blend(const mlod_primitive *p, int v, const mlod_mat4 *
 	float wsum = 0.0f;
 	for (int e = 0; e < 16; e++)
 		m[e] = 0.0f;
-	for (int s = 0; s < p->weight_set_count; s++)
+	for (int s = 0; s < p->weight_set_count; s++) {
+		const float *ws = p->weights[s] + 4 * v;
+		const uint16_t *js = p->joints[s] + 4 * v;
 		for (int k = 0; k < 4; k++) {
-			float w = p->weights[s][4 * v + k];
+			float w = ws[k];
 			if (!(w > 0.0f))
 				continue;
-			const float *j = skin_mats[p->joints[s][4 * v + k]].m;
-			for (int e = 0; e < 16; e++)
+			const float *j = skin_mats[js[k]].m;
+			/* column by column: one vector operation each */
+			for (int e = 0; e < 4; e++)
+				m[e] += w * j[e];
+			for (int e = 4; e < 8; e++)
+				m[e] += w * j[e];
+			for (int e = 8; e < 12; e++)
+				m[e] += w * j[e];
+			for (int e = 12; e < 16; e++)
 				m[e] += w * j[e];
 			wsum += w;
 		}
+	}
 	return wsum;
 }
 
@@ -175,8 +185,10 @@ static inline float skin_blend(const mlod_primitive *p, int v, const mlod_mat4 *
 static inline void skin_point(const float m[16], const float *pos, float wsum, float *op)
 {
 	const float inv = 1.0f / wsum;
-	for (int r = 0; r < 3; r++)
-		op[r] = (m[r] * pos[0] + m[4 + r] * pos[1] + m[8 + r] * pos[2] + m[12 + r]) * inv;
+	float o[4]; /* the fourth row too: four lanes */
+	for (int r = 0; r < 4; r++)
+		o[r] = (m[r] * pos[0] + m[4 + r] * pos[1] + m[8 + r] * pos[2] + m[12 + r]) * inv;
+	memcpy(op, o, 3 * sizeof *op);
 }
 
 void mlod_skin_vertex(const mlod_primitive *p, int v, const mlod_mat4 *skin_mats, float out[3])
