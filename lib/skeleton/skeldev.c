@@ -11,7 +11,8 @@
  * characters (mlod_skin_vertex), so its deviation is exactly 0: it is
  * counted, and adding 0 to the sum changes nothing. Whether the matrices
  * are equal is checked bit for bit at each time, not assumed from the
- * skeleton; only the other vertices are skinned, in both characters.
+ * skeleton; only the other vertices are skinned, in both characters,
+ * and a's positions can be kept for the next level (the cache).
  */
 #include <float.h>
 #include <math.h>
@@ -178,8 +179,83 @@ static void work_free(struct dev_work *w)
 	free(w->times);
 }
 
+/* The cache: a's skinned positions at the measured times of each clip,
+ * filled as vertices are skinned; at most MLOD_SKEL_CACHE_BYTES. */
+struct mlod_skel_pose_cache {
+	const mlod_character *a;
+	int max_samples;
+	size_t vertices;
+	size_t bytes;
+	int clip_count;
+	float **pos;          /* per clip (or the one rest pose): times * vertices * 3 */
+	unsigned char **have; /* per clip: times * vertices, 1 where pos is filled */
+};
+
+mlod_skel_pose_cache *mlod_skel_pose_cache_new(void)
+{
+	return calloc(1, sizeof(mlod_skel_pose_cache));
+}
+
+void mlod_skel_pose_cache_free(mlod_skel_pose_cache *cache)
+{
+	if (!cache)
+		return;
+	for (int k = 0; k < cache->clip_count; k++) {
+		free(cache->pos[k]);
+		free(cache->have[k]);
+	}
+	free(cache->pos);
+	free(cache->have);
+	free(cache);
+}
+
+/* Clip k's part of the cache (k < 0: the rest pose), n times, or NULL
+ * (no cache, another character, over budget, out of memory). */
+static int cache_clip(mlod_skel_pose_cache *cache, const mlod_character *a, int max_samples, size_t vertices, int k,
+                      int n, float **pos, unsigned char **have)
+{
+	*pos = NULL;
+	*have = NULL;
+	if (!cache)
+		return 0;
+	if (!cache->pos) {
+		int clips = a->clip_count > 0 ? a->clip_count : 1;
+		cache->pos = calloc((size_t)clips, sizeof *cache->pos);
+		cache->have = calloc((size_t)clips, sizeof *cache->have);
+		if (!cache->pos || !cache->have) {
+			free(cache->pos), free(cache->have);
+			cache->pos = NULL, cache->have = NULL;
+			return 0;
+		}
+		cache->a = a;
+		cache->max_samples = max_samples;
+		cache->vertices = vertices;
+		cache->clip_count = clips;
+	}
+	if (cache->a != a || cache->max_samples != max_samples || cache->vertices != vertices)
+		return 0;
+	int slot = k < 0 ? 0 : k;
+	if (!cache->pos[slot]) {
+		size_t entries = (size_t)n * vertices;
+		size_t bytes = entries * (3 * sizeof(float) + 1);
+		if (vertices == 0 || entries / vertices != (size_t)n || cache->bytes + bytes > MLOD_SKEL_CACHE_BYTES)
+			return 0;
+		cache->pos[slot] = malloc(entries * 3 * sizeof(float));
+		cache->have[slot] = calloc(entries, 1);
+		if (!cache->pos[slot] || !cache->have[slot]) {
+			free(cache->pos[slot]), free(cache->have[slot]);
+			cache->pos[slot] = NULL, cache->have[slot] = NULL;
+			return 0;
+		}
+		cache->bytes += bytes;
+	}
+	*pos = cache->pos[slot];
+	*have = cache->have[slot];
+	return 1;
+}
+
 mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_character *b, int max_samples,
-                                       mlod_deviation *out, mlod_error *err)
+                                       mlod_skel_pose_cache *cache, mlod_deviation *out, mlod_error *err)
 {
 	memset(out, 0, sizeof *out);
 	if (!same_layout(a, b))
@@ -283,8 +359,13 @@ mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_chara
 			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory measuring deviation");
 			goto done;
 		}
+		float *cpos;
+		unsigned char *chave;
+		cache_clip(cache, a, max_samples, vertices, k, n, &cpos, &chave);
 		for (int ti = 0; ti < n; ti++) {
 			float t = w.times ? w.times[ti] : 0.0f;
+			float *tpos = cpos ? cpos + (size_t)ti * vertices * 3 : NULL;
+			unsigned char *thave = chave ? chave + (size_t)ti * vertices : NULL;
 			pose_at(a, k, t, w.la, w.wa);
 			pose_at(b, k, t, w.lb, w.wb);
 			at = 0;
@@ -326,7 +407,15 @@ mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_chara
 						if (ia->skin >= 0) {
 							if (w.group[at] >= 0 && w.equal[w.group[at]])
 								continue; /* deviation 0 */
-							mlod_skin_vertex(pa, v, w.sa, x);
+							if (thave && thave[at]) {
+								memcpy(x, tpos + 3 * at, sizeof x);
+							} else {
+								mlod_skin_vertex(pa, v, w.sa, x);
+								if (thave) {
+									memcpy(tpos + 3 * at, x, sizeof x);
+									thave[at] = 1;
+								}
+							}
 							mlod_skin_vertex(pb, v, w.sb, y);
 						} else {
 							if (rigid_same && w.group[at] >= 0)
