@@ -164,6 +164,7 @@ struct dev_work {
 	mlod_mat4 *wa, *wb, *sa, *sb;
 	unsigned char *state;
 	int *group;      /* per vertex: its group of pairs (same_weights), or -1 */
+	int *run;        /* per vertex: how many vertices from it on have its group, in its primitive */
 	int *first;      /* per group: its first pair; group g's are first[g]..first[g + 1] */
 	uint32_t *pairs;
 	int *hash;       /* open addressing over the groups of one instance */
@@ -174,7 +175,7 @@ struct dev_work {
 
 static void work_free(struct dev_work *w)
 {
-	free(w->la), free(w->lb), free(w->wa), free(w->wb), free(w->sa), free(w->sb);
+	free(w->la), free(w->lb), free(w->run), free(w->wa), free(w->wb), free(w->sa), free(w->sb);
 	free(w->state), free(w->group), free(w->first), free(w->pairs), free(w->hash), free(w->equal), free(w->groups_of);
 	free(w->times);
 }
@@ -277,17 +278,19 @@ mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_chara
 				vertices += (size_t)m->primitives[p].vertex_count;
 	}
 	struct dev_work w = {
-		malloc(sizeof(mlod_trs) * ja), malloc(sizeof(mlod_trs) * jb), malloc(sizeof(mlod_mat4) * ja),
-		malloc(sizeof(mlod_mat4) * jb), malloc(sizeof(mlod_mat4) * na), malloc(sizeof(mlod_mat4) * nb),
-		malloc(na * nb), malloc(sizeof(int) * (vertices + 1)), malloc(sizeof(int) * (vertices + 2)),
-		malloc(sizeof(uint32_t) * (4 * MLOD_MAX_SETS * vertices + 1)), NULL, malloc(vertices + 1),
-		malloc(sizeof(int) * ((size_t)a->instance_count + 1)), NULL};
+		.la = malloc(sizeof(mlod_trs) * ja), .lb = malloc(sizeof(mlod_trs) * jb),
+		.wa = malloc(sizeof(mlod_mat4) * ja), .wb = malloc(sizeof(mlod_mat4) * jb),
+		.sa = malloc(sizeof(mlod_mat4) * na), .sb = malloc(sizeof(mlod_mat4) * nb), .state = malloc(na * nb),
+		.group = malloc(sizeof(int) * (vertices + 1)), .run = malloc(sizeof(int) * (vertices + 1)),
+		.first = malloc(sizeof(int) * (vertices + 2)),
+		.pairs = malloc(sizeof(uint32_t) * (4 * MLOD_MAX_SETS * vertices + 1)), .equal = malloc(vertices + 1),
+		.groups_of = malloc(sizeof(int) * ((size_t)a->instance_count + 1))};
 	size_t hash_size = 16;
 	while (hash_size < 2 * vertices)
 		hash_size *= 2;
 	w.hash = malloc(sizeof(int) * hash_size);
 	mlod_result r = MLOD_OK;
-	if (!w.la || !w.lb || !w.wa || !w.wb || !w.sa || !w.sb || !w.state || !w.group || !w.first || !w.pairs ||
+	if (!w.la || !w.lb || !w.wa || !w.wb || !w.sa || !w.sb || !w.state || !w.group || !w.run || !w.first || !w.pairs ||
 	    !w.hash || !w.equal || !w.groups_of) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory measuring deviation");
 		goto done;
@@ -310,6 +313,7 @@ mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_chara
 			const mlod_primitive *pa = &ma->primitives[p], *pb = &mb->primitives[p];
 			if (prim_triangles(pa) == 0)
 				continue;
+			size_t base = at;
 			for (int v = 0; v < pa->vertex_count; v++, at++) {
 				int n = 0;
 				uint32_t *list = w.pairs + w.first[groups];
@@ -339,6 +343,8 @@ mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_chara
 					}
 				}
 			}
+			for (size_t e = at; e-- > base;)
+				w.run[e] = e + 1 < at && w.group[e + 1] == w.group[e] ? w.run[e + 1] + 1 : 1;
 		}
 	}
 	w.groups_of[a->instance_count] = groups;
@@ -401,12 +407,16 @@ mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_chara
 					const mlod_primitive *pa = &ma->primitives[p], *pb = &mb->primitives[p];
 					if (prim_triangles(pa) == 0)
 						continue;
+					count += pa->vertex_count;
 					for (int v = 0; v < pa->vertex_count; v++, at++) {
-						count++;
 						float x[3], y[3];
 						if (ia->skin >= 0) {
-							if (w.group[at] >= 0 && w.equal[w.group[at]])
-								continue; /* deviation 0 */
+							if (w.group[at] >= 0 && w.equal[w.group[at]]) {
+								/* deviation 0, and for the rest of the run */
+								v += w.run[at] - 1;
+								at += (size_t)w.run[at] - 1;
+								continue;
+							}
 							if (thave && thave[at]) {
 								memcpy(x, tpos + 3 * at, sizeof x);
 							} else {
@@ -418,8 +428,11 @@ mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_chara
 							}
 							mlod_skin_vertex(pb, v, w.sb, y);
 						} else {
-							if (rigid_same && w.group[at] >= 0)
+							if (rigid_same && w.group[at] >= 0) {
+								v += w.run[at] - 1;
+								at += (size_t)w.run[at] - 1;
 								continue;
+							}
 							const float *s = pa->positions + 3 * v, *u = pb->positions + 3 * v;
 							mlod_v3 px = mlod_mat4_point(&ra, (mlod_v3){s[0], s[1], s[2]});
 							mlod_v3 py = mlod_mat4_point(&rb, (mlod_v3){u[0], u[1], u[2]});
