@@ -277,8 +277,14 @@ static void pose_primitive(const mlod_primitive *p, const mlod_mat4 *skin_mats, 
 		}
 	}
 	long n = 3 * primitive_triangles(p);
-	for (long i = 0; i < n; i++)
-		tri[i] = base + (p->index_count > 0 ? p->indices[i] : (uint32_t)i);
+	if (p->index_count > 0 && base == 0)
+		memcpy(tri, p->indices, (size_t)n * sizeof *tri);
+	else if (p->index_count > 0)
+		for (long i = 0; i < n; i++)
+			tri[i] = base + p->indices[i];
+	else
+		for (long i = 0; i < n; i++)
+			tri[i] = base + (uint32_t)i;
 }
 
 mlod_result mlod_pose_character(const mlod_character *c, const mlod_mat4 *world,
