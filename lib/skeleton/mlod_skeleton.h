@@ -224,7 +224,8 @@ mlod_result mlod_skel_levels_init(mlod_skel_levels *L, const mlod_character *c, 
 void mlod_skel_levels_free(mlod_skel_levels *L);
 
 /* Makes and measures one level: at an energy threshold (threshold >= 0),
- * else removing the first `removed` joints of the order. */
+ * else removing the first `removed` joints of the order. It fills L's
+ * cache: one thread at a time per L. */
 mlod_result mlod_skel_levels_make(const mlod_skel_levels *L, double threshold, int removed, mlod_skel_built *out,
                                   mlod_error *err);
 void mlod_skel_built_free(mlod_skel_built *b);
