@@ -219,6 +219,8 @@ void mlod_skin_matrices(const mlod_skin *skin, const mlod_mat4 *world, mlod_mat4
  * bind position. */
 void mlod_skin_primitive(const mlod_primitive *p, const mlod_mat4 *skin_mats,
                          float *out_positions, float *out_normals);
+/* The position mlod_skin_primitive gives vertex v, bit for bit. */
+void mlod_skin_vertex(const mlod_primitive *p, int v, const mlod_mat4 *skin_mats, float out[3]);
 
 /* A character posed as one triangle soup, for measuring. */
 typedef struct mlod_posed {

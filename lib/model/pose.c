@@ -146,25 +146,69 @@ void mlod_skin_matrices(const mlod_skin *skin, const mlod_mat4 *world, mlod_mat4
 /* Skinning                                                          */
 /* ---------------------------------------------------------------- */
 
+/* The blended skin matrix of vertex v (column-major, 16 floats: the
+ * fourth row is blended too, and unused, so that each column is four
+ * floats the compiler can treat as one vector) and the sum of its
+ * weights. Every entry gets the same operations in the same order
+ * whichever of the callers below runs it, so mlod_skin_vertex and
+ * mlod_skin_primitive give the same bits. */
+static inline float skin_blend(const mlod_primitive *p, int v, const mlod_mat4 *skin_mats, float m[16])
+{
+	float wsum = 0.0f;
+	for (int e = 0; e < 16; e++)
+		m[e] = 0.0f;
+	for (int s = 0; s < p->weight_set_count; s++) {
+		const float *ws = p->weights[s] + 4 * v;
+		const uint16_t *js = p->joints[s] + 4 * v;
+		for (int k = 0; k < 4; k++) {
+			float w = ws[k];
+			if (!(w > 0.0f))
+				continue;
+			const float *j = skin_mats[js[k]].m;
+			/* column by column: one vector operation each */
+			for (int e = 0; e < 4; e++)
+				m[e] += w * j[e];
+			for (int e = 4; e < 8; e++)
+				m[e] += w * j[e];
+			for (int e = 8; e < 12; e++)
+				m[e] += w * j[e];
+			for (int e = 12; e < 16; e++)
+				m[e] += w * j[e];
+			wsum += w;
+		}
+	}
+	return wsum;
+}
+
+/* The skinned position of a vertex at pos with blended matrix m and
+ * weight sum wsum > 0. */
+static inline void skin_point(const float m[16], const float *pos, float wsum, float *op)
+{
+	const float inv = 1.0f / wsum;
+	float o[4]; /* the fourth row too: four lanes */
+	for (int r = 0; r < 4; r++)
+		o[r] = (m[r] * pos[0] + m[4 + r] * pos[1] + m[8 + r] * pos[2] + m[12 + r]) * inv;
+	memcpy(op, o, 3 * sizeof *op);
+}
+
+void mlod_skin_vertex(const mlod_primitive *p, int v, const mlod_mat4 *skin_mats, float out[3])
+{
+	float m[16];
+	float wsum = skin_blend(p, v, skin_mats, m);
+	if (!(wsum > 0.0f))
+		memcpy(out, p->positions + 3 * v, 3 * sizeof *out);
+	else
+		skin_point(m, p->positions + 3 * v, wsum, out);
+}
+
 void mlod_skin_primitive(const mlod_primitive *p, const mlod_mat4 *skin_mats,
                          float *out_positions, float *out_normals)
 {
 	const int do_normals = out_normals && p->normals;
 	for (int v = 0; v < p->vertex_count; v++) {
 		const float *pos = p->positions + 3 * v;
-		float m[12] = { 0 }; /* blended upper 3 rows, column-major 4 columns */
-		float wsum = 0.0f;
-		for (int s = 0; s < p->weight_set_count; s++)
-			for (int k = 0; k < 4; k++) {
-				float w = p->weights[s][4 * v + k];
-				if (!(w > 0.0f))
-					continue;
-				const float *j = skin_mats[p->joints[s][4 * v + k]].m;
-				for (int c = 0; c < 4; c++)
-					for (int r = 0; r < 3; r++)
-						m[c * 3 + r] += w * j[c * 4 + r];
-				wsum += w;
-			}
+		float m[16];
+		float wsum = skin_blend(p, v, skin_mats, m);
 		float *op = out_positions + 3 * v;
 		if (!(wsum > 0.0f)) { /* unweighted: stays at bind */
 			memcpy(op, pos, 3 * sizeof *op);
@@ -172,14 +216,12 @@ void mlod_skin_primitive(const mlod_primitive *p, const mlod_mat4 *skin_mats,
 				memcpy(out_normals + 3 * v, p->normals + 3 * v, 3 * sizeof *out_normals);
 			continue;
 		}
-		const float inv = 1.0f / wsum;
-		for (int r = 0; r < 3; r++)
-			op[r] = (m[r] * pos[0] + m[3 + r] * pos[1] + m[6 + r] * pos[2] + m[9 + r]) * inv;
+		skin_point(m, pos, wsum, op);
 		if (do_normals) {
 			const float *n = p->normals + 3 * v;
 			float *on = out_normals + 3 * v, len2 = 0.0f;
 			for (int r = 0; r < 3; r++) {
-				on[r] = m[r] * n[0] + m[3 + r] * n[1] + m[6 + r] * n[2];
+				on[r] = m[r] * n[0] + m[4 + r] * n[1] + m[8 + r] * n[2];
 				len2 += on[r] * on[r];
 			}
 			if (len2 > 0.0f) {
@@ -235,8 +277,14 @@ static void pose_primitive(const mlod_primitive *p, const mlod_mat4 *skin_mats, 
 		}
 	}
 	long n = 3 * primitive_triangles(p);
-	for (long i = 0; i < n; i++)
-		tri[i] = base + (p->index_count > 0 ? p->indices[i] : (uint32_t)i);
+	if (p->index_count > 0 && base == 0)
+		memcpy(tri, p->indices, (size_t)n * sizeof *tri);
+	else if (p->index_count > 0)
+		for (long i = 0; i < n; i++)
+			tri[i] = base + p->indices[i];
+	else
+		for (long i = 0; i < n; i++)
+			tri[i] = base + (uint32_t)i;
 }
 
 mlod_result mlod_pose_character(const mlod_character *c, const mlod_mat4 *world,

@@ -163,9 +163,10 @@ static mlod_result fold_clip_joint(struct folder *f, const mlod_clip *clip, int 
 		return MLOD_OK; /* the folded rest transform covers it */
 	}
 	count = mlod_clip_key_times(clip, use, 1, &times, NULL);
-	free(use);
-	if (count < 0)
+	if (count < 0) {
+		free(use);
 		goto nomem;
+	}
 
 	mlod_trs *pose = malloc(sizeof *pose * (size_t)s->joint_count);
 	mlod_channel tc = {0}, rc = {0}, sc = {0};
@@ -173,6 +174,7 @@ static mlod_result fold_clip_joint(struct folder *f, const mlod_clip *clip, int 
 	if (!pose || channel_init(&tc, nj, MLOD_PATH_TRANSLATION, interp, count) ||
 	    channel_init(&rc, nj, MLOD_PATH_ROTATION, interp, count) ||
 	    channel_init(&sc, nj, MLOD_PATH_SCALE, interp, count)) {
+		free(use);
 		free(pose);
 		free(tc.times), free(tc.values), free(rc.times), free(rc.values), free(sc.times), free(sc.values);
 		goto nomem;
@@ -180,8 +182,12 @@ static mlod_result fold_clip_joint(struct folder *f, const mlod_clip *clip, int 
 	int scaled = 0;
 	mlod_quat prev = mlod_quat_identity();
 	for (int i = 0; i < count; i++) {
-		mlod_pose_rest(s, pose);
-		mlod_clip_sample(clip, times[i], pose);
+		/* The chain's joints only: mlod_clip_sample over the channels in use, in order. */
+		for (int a = j; a != top; a = s->joints[a].parent)
+			pose[a] = s->joints[a].rest;
+		for (int c = 0; c < clip->channel_count; c++)
+			if (use[c])
+				mlod_channel_sample(&clip->channels[c], clip->duration, times[i], &pose[clip->channels[c].joint]);
 		mlod_mat4 m = chain_product(s, pose, top, j);
 		mlod_trs trs;
 		if (mlod_mat4_to_trs(&m, &trs, 1e-4f) != 0)
@@ -197,6 +203,7 @@ static mlod_result fold_clip_joint(struct folder *f, const mlod_clip *clip, int 
 			scaled = 1;
 	}
 	free(pose);
+	free(use);
 	out->channels[out->channel_count++] = tc;
 	out->channels[out->channel_count++] = rc;
 	if (scaled) {

@@ -175,6 +175,23 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
 #define MLOD_SKEL_SAMPLES 120
 #define MLOD_SKEL_MAX_LEVELS 32
 
+/* a's skinned positions kept between calls of mlod_skel_vertex_deviation
+ * for levels of the same character a (same max_samples), up to
+ * MLOD_SKEL_CACHE_BYTES; past that, positions are skinned again. Not
+ * shared between threads. */
+typedef struct mlod_skel_pose_cache mlod_skel_pose_cache;
+#define MLOD_SKEL_CACHE_BYTES ((size_t)128 << 20)
+mlod_skel_pose_cache *mlod_skel_pose_cache_new(void); /* NULL when out of memory */
+void mlod_skel_pose_cache_free(mlod_skel_pose_cache *cache);
+
+/* mlod_vertex_deviation(a, b, ...), the same numbers bit for bit, for a
+ * level b of a (mlod_skel_level_apply): only the vertices whose skin
+ * matrices or weights differ in b at a time are skinned, in both, a's
+ * from cache when it has them (cache may be NULL) (skeldev.c). Other
+ * pairs of characters go to mlod_vertex_deviation. */
+mlod_result mlod_skel_vertex_deviation(const mlod_character *a, const mlod_character *b, int max_samples,
+                                       mlod_skel_pose_cache *cache, mlod_deviation *out, mlod_error *err);
+
 /* A level made and measured. */
 typedef struct mlod_skel_built {
 	mlod_skel_level skel;
@@ -196,6 +213,7 @@ typedef struct mlod_skel_levels {
 	int minor_count;
 	double height;           /* mlod_skeleton_height */
 	int has_mesh;
+	mlod_skel_pose_cache *cache; /* the full character's posed vertices, for measuring levels (or NULL) */
 	int count;
 	mlod_skel_built levels[MLOD_SKEL_MAX_LEVELS];
 } mlod_skel_levels;
@@ -206,7 +224,8 @@ mlod_result mlod_skel_levels_init(mlod_skel_levels *L, const mlod_character *c, 
 void mlod_skel_levels_free(mlod_skel_levels *L);
 
 /* Makes and measures one level: at an energy threshold (threshold >= 0),
- * else removing the first `removed` joints of the order. */
+ * else removing the first `removed` joints of the order. It fills L's
+ * cache: one thread at a time per L. */
 mlod_result mlod_skel_levels_make(const mlod_skel_levels *L, double threshold, int removed, mlod_skel_built *out,
                                   mlod_error *err);
 void mlod_skel_built_free(mlod_skel_built *b);

@@ -28,6 +28,7 @@ mlod_result mlod_skel_levels_init(mlod_skel_levels *L, const mlod_character *c, 
 	}
 	L->minor_count = mlod_skel_removal_order(&c->skeleton, info, L->order);
 	L->has_mesh = c->instance_count > 0;
+	L->cache = L->has_mesh ? mlod_skel_pose_cache_new() : NULL; /* NULL only costs time */
 	return MLOD_OK;
 }
 
@@ -43,6 +44,7 @@ void mlod_skel_levels_free(mlod_skel_levels *L)
 	for (int k = 0; k < L->count; k++)
 		mlod_skel_built_free(&L->levels[k]);
 	mlod_skelgraph_free(&L->graph);
+	mlod_skel_pose_cache_free(L->cache);
 	free(L->order);
 	memset(L, 0, sizeof *L);
 }
@@ -62,7 +64,7 @@ static mlod_result measure(const mlod_skel_levels *L, mlod_skel_built *b, mlod_e
 		return r;
 	b->bound_error = 100.0 * b->joint.max / L->height;
 	if (L->has_mesh) {
-		if ((r = mlod_vertex_deviation(c, &b->c, MLOD_SKEL_SAMPLES, &b->vertex, err)) != MLOD_OK)
+		if ((r = mlod_skel_vertex_deviation(c, &b->c, MLOD_SKEL_SAMPLES, L->cache, &b->vertex, err)) != MLOD_OK)
 			return r;
 		b->has_mesh_error = 1;
 		b->bound_error = b->vertex.max * b->vertex.scale / L->height;
