@@ -369,8 +369,9 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
 /* ---------------------------------------------------------------- */
 
 /* Morphing goes through a buffer on the stack, this many vertices at a
- * time: no allocation. */
-enum { RT_MORPH_RUN = 128 };
+ * time: no allocation. A multiple of RT_SKIN_RUN, so each stretch starts
+ * a run of the part's buckets. */
+enum { RT_MORPH_RUN = 2 * RT_SKIN_RUN };
 
 /* The instance's morph weights for part i of a level and the targets to
  * apply (*nt), or NULL when every weight is 0 (nothing to do). */
@@ -478,8 +479,9 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 			float *o = (float *)((char *)op + v0 * pos_stride);
 			float *onr = on ? (float *)((char *)on + v0 * nrm_stride) : NULL;
 			if (skinned) {
-				mlod_rt_skin_lbs(m, pos, onr ? nrm : NULL, p->joints + 4 * v0, p->weights + 4 * v0, pal, o,
-				                 pos_stride, onr, nrm_stride);
+				const uint8_t *ord = mu->skin_order + mu->skin_order_at[i];
+				rt_skin_lbs_ordered(m, pos, onr ? nrm : NULL, p->joints + 4 * v0, p->weights + 4 * v0, pal, o,
+				                    pos_stride, onr, nrm_stride, ord + v0, ord + n + 4 * (v0 / RT_SKIN_RUN));
 				if (onr && !nrm)
 					for (size_t v = 0; v < m; v++) {
 						float *x = (float *)((char *)onr + v * nrm_stride);

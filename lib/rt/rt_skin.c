@@ -48,7 +48,7 @@ typedef float rt_v4 __attribute__((vector_size(16)));
 #include <emmintrin.h>
 #endif
 
-#define RT_RUN 64 /* vertices per run */
+#define RT_RUN RT_SKIN_RUN /* vertices per run */
 
 static inline rt_v4 ld4(const float *p)
 {
@@ -136,6 +136,42 @@ static void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out, siz
 	}
 }
 
+/* Skins the vertices v0 .. v1 - 1 of a run whose vertices with k + 1
+ * influences are l[k][0..c[k]) (offsets within the run, increasing), and
+ * normalises the run's normals (when N). */
+static inline __attribute__((always_inline)) void lbs_sorted(const int N, size_t v0, size_t v1,
+                                                           const uint8_t *const l[4], const size_t c[4],
+                                                           const float *restrict positions,
+                                                           const float *restrict normals,
+                                                           const uint16_t *restrict joints,
+                                                           const float *restrict weights,
+                                                           const float *restrict palette, float *restrict out_pos,
+                                                           size_t pos_stride, float *restrict out_nrm,
+                                                           size_t nrm_stride)
+{
+	rt_v4 tn[RT_RUN];
+	lbs_list(1, N, l[0], c[0], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(2, N, l[1], c[1], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(3, N, l[2], c[2], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(4, N, l[3], c[3], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	if (N)
+		normalise_run(v1 - v0, tn, (float *)((char *)out_nrm + v0 * nrm_stride), nrm_stride);
+}
+
+/* The run v0 .. v1 - 1 bucketed by influence count, in order: l[k] the
+ * offsets within the run of the c[k] vertices with k + 1 influences. */
+static inline void bucket_run(const float *restrict weights, size_t v0, size_t v1, uint8_t l[4][RT_RUN],
+                              size_t c[4])
+{
+	uint64_t packed = 0; /* the four counts, 16 bits each: no store in the chain */
+	for (size_t v = v0; v < v1; v++) {
+		const unsigned sh = 16 * (influences(weights + 4 * v) - 1);
+		l[sh / 16][(packed >> sh) & 0xffff] = (uint8_t)(v - v0);
+		packed += (uint64_t)1 << sh;
+	}
+	c[0] = packed & 0xffff, c[1] = packed >> 16 & 0xffff, c[2] = packed >> 32 & 0xffff, c[3] = packed >> 48;
+}
+
 static inline __attribute__((always_inline)) void lbs_run(const int N, size_t v0, size_t v1,
                                                         const float *restrict positions,
                                                         const float *restrict normals,
@@ -145,22 +181,12 @@ static inline __attribute__((always_inline)) void lbs_run(const int N, size_t v0
                                                         size_t pos_stride, float *restrict out_nrm,
                                                         size_t nrm_stride)
 {
-	/* The run's vertices bucketed by influence count, in order. */
 	uint8_t list[4][RT_RUN];
-	uint64_t packed = 0; /* the four counts, 16 bits each: no store in the chain */
-	for (size_t v = v0; v < v1; v++) {
-		const unsigned sh = 16 * (influences(weights + 4 * v) - 1);
-		list[sh / 16][(packed >> sh) & 0xffff] = (uint8_t)(v - v0);
-		packed += (uint64_t)1 << sh;
-	}
-	const size_t count[4] = { packed & 0xffff, packed >> 16 & 0xffff, packed >> 32 & 0xffff, packed >> 48 };
-	rt_v4 tn[RT_RUN];
-	lbs_list(1, N, list[0], count[0], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	lbs_list(2, N, list[1], count[1], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	lbs_list(3, N, list[2], count[2], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	lbs_list(4, N, list[3], count[3], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	if (N)
-		normalise_run(v1 - v0, tn, (float *)((char *)out_nrm + v0 * nrm_stride), nrm_stride);
+	size_t c[4];
+	bucket_run(weights, v0, v1, list, c);
+	const uint8_t *const l[4] = { list[0], list[1], list[2], list[3] };
+	lbs_sorted(N, v0, v1, l, c, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm,
+	           nrm_stride);
 }
 
 RT_CLONES void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const float *restrict normals,
@@ -174,6 +200,40 @@ RT_CLONES void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const
 			lbs_run(1, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride);
 		else
 			lbs_run(0, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride);
+	}
+}
+
+void rt_skin_order(size_t n, const float *weights, uint8_t *order)
+{
+	for (size_t v0 = 0, r = 0; v0 < n; v0 += RT_RUN, r++) {
+		const size_t v1 = n - v0 < RT_RUN ? n : v0 + RT_RUN;
+		uint8_t l[4][RT_RUN];
+		size_t c[4], o = v0;
+		bucket_run(weights, v0, v1, l, c);
+		for (int k = 0; k < 4; o += c[k], k++) {
+			memcpy(order + o, l[k], c[k]);
+			order[n + 4 * r + (size_t)k] = (uint8_t)c[k];
+		}
+	}
+}
+
+RT_CLONES void rt_skin_lbs_ordered(size_t n, const float *restrict positions, const float *restrict normals,
+                                   const uint16_t *restrict joints, const float *restrict weights,
+                                   const float *restrict palette, float *restrict out_pos, size_t pos_stride,
+                                   float *restrict out_nrm, size_t nrm_stride, const uint8_t *restrict list,
+                                   const uint8_t *restrict counts)
+{
+	for (size_t v0 = 0, r = 0; v0 < n; v0 += RT_RUN, r++) {
+		const size_t v1 = n - v0 < RT_RUN ? n : v0 + RT_RUN;
+		const size_t c[4] = { counts[4 * r], counts[4 * r + 1], counts[4 * r + 2], counts[4 * r + 3] };
+		const uint8_t *const l[4] = { list + v0, list + v0 + c[0], list + v0 + c[0] + c[1],
+		                              list + v0 + c[0] + c[1] + c[2] };
+		if (normals)
+			lbs_sorted(1, v0, v1, l, c, positions, normals, joints, weights, palette, out_pos, pos_stride,
+			           out_nrm, nrm_stride);
+		else
+			lbs_sorted(0, v0, v1, l, c, positions, normals, joints, weights, palette, out_pos, pos_stride,
+			           out_nrm, nrm_stride);
 	}
 }
 #else
@@ -214,6 +274,21 @@ void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const float *re
 	}
 }
 
+
+/* No buckets without the vector loops: the plain loop reads every weight. */
+void rt_skin_order(size_t n, const float *weights, uint8_t *order)
+{
+	(void)weights;
+	memset(order, 0, RT_SKIN_ORDER_BYTES(n));
+}
+
+void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals, const uint16_t *joints,
+                         const float *weights, const float *palette, float *out_pos, size_t pos_stride,
+                         float *out_nrm, size_t nrm_stride, const uint8_t *list, const uint8_t *counts)
+{
+	(void)list, (void)counts;
+	mlod_rt_skin_lbs(n, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride);
+}
 #endif
 
 #if defined(__GNUC__) && !defined(__clang__)
