@@ -105,34 +105,68 @@ static inline __attribute__((always_inline)) void lbs_list(const int K, const in
 	}
 }
 
+#if defined(RT_SSE2)
+/* (a[i0], a[i1], b[i2], b[i3]) */
+#define RT_SH(a, b, i0, i1, i2, i3) _mm_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0))
+
+/* X, Y, Z lanes stored as four xyz, stride bytes apart. */
+static inline void store_xyz4(float *restrict out, size_t stride, __m128 x, __m128 y, __m128 z)
+{
+	const __m128 a = RT_SH(RT_SH(x, y, 0, 0, 0, 0), RT_SH(z, x, 0, 0, 1, 1), 0, 2, 0, 2);
+	const __m128 b = RT_SH(RT_SH(y, z, 1, 1, 1, 1), RT_SH(x, y, 2, 2, 2, 2), 0, 2, 0, 2);
+	const __m128 c = RT_SH(RT_SH(z, x, 2, 2, 3, 3), RT_SH(y, z, 3, 3, 3, 3), 0, 2, 0, 2);
+	if (stride == 12) {
+		_mm_storeu_ps(out, a), _mm_storeu_ps(out + 4, b), _mm_storeu_ps(out + 8, c);
+		return;
+	}
+	float t[12];
+	_mm_storeu_ps(t, a), _mm_storeu_ps(t + 4, b), _mm_storeu_ps(t + 8, c);
+	for (int k = 0; k < 4; k++)
+		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
+}
+
+#endif
+
 /* Normalises the run's m blended normals and stores them at out. */
 static void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out, size_t stride)
 {
 	for (size_t i = m; i % 4; i++)
 		tn[i] = (rt_v4){ 0, 0, 0, 0 };
 	for (size_t i0 = 0; i0 < m; i0 += 4) {
-		float il[4];
 #if defined(RT_SSE2)
-		/* Four vertices at a time: squares transposed, one square root. */
-		__m128 s0 = (__m128)(tn[i0] * tn[i0]), s1 = (__m128)(tn[i0 + 1] * tn[i0 + 1]),
-		       s2 = (__m128)(tn[i0 + 2] * tn[i0 + 2]), s3 = (__m128)(tn[i0 + 3] * tn[i0 + 3]);
-		_MM_TRANSPOSE4_PS(s0, s1, s2, s3);
-		const __m128 l2 = _mm_add_ps(_mm_add_ps(s0, s1), s2);
+		/* Four vertices at a time, transposed (x of the four in one
+		 * vector): per lane (x x + y y) + z z, one square root and
+		 * division, each component times 1 / sqrt, as the plain loop
+		 * below; stored back as four xyz. */
+		__m128 x = (__m128)tn[i0], y = (__m128)tn[i0 + 1], z = (__m128)tn[i0 + 2], w = (__m128)tn[i0 + 3];
+		_MM_TRANSPOSE4_PS(x, y, z, w);
+		const __m128 l2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_mul_ps(z, z));
 		const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(l2));
-		_mm_storeu_ps(il, _mm_and_ps(_mm_cmpgt_ps(l2, _mm_setzero_ps()), inv));
+		const __m128 il = _mm_and_ps(_mm_cmpgt_ps(l2, _mm_setzero_ps()), inv);
+		x = _mm_mul_ps(x, il), y = _mm_mul_ps(y, il), z = _mm_mul_ps(z, il);
+		float *restrict on = (float *)((char *)out + i0 * stride);
+		if (m - i0 >= 4) {
+			store_xyz4(on, stride, x, y, z);
+		} else {
+			float t[12];
+			store_xyz4(t, 12, x, y, z);
+			for (size_t k = 0; k < m - i0; k++)
+				memcpy((char *)on + k * stride, t + 3 * k, 3 * sizeof(float));
+		}
 #else
+		float il[4];
 		for (int k = 0; k < 4; k++) {
 			const rt_v4 t = tn[i0 + k];
 			const float l2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
 			il[k] = l2 > 0.0f ? 1.0f / sqrtf(l2) : 0.0f;
 		}
-#endif
 		const size_t e = m - i0 < 4 ? m - i0 : 4;
 		for (size_t k = 0; k < e; k++) {
 			const rt_v4 r = tn[i0 + k] * il[k];
 			float *restrict on = (float *)((char *)out + (i0 + k) * stride);
 			on[0] = r[0], on[1] = r[1], on[2] = r[2];
 		}
+#endif
 	}
 }
 
@@ -362,9 +396,6 @@ static void transform_one_by_one(size_t n, const float *restrict pos, const floa
 }
 
 #if defined(RT_SSE2)
-/* (a[i0], a[i1], b[i2], b[i3]) */
-#define RT_SH(a, b, i0, i1, i2, i3) _mm_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0))
-
 /* Four packed xyz (12 floats at p) as X, Y, Z lanes. */
 static inline void load_xyz4(const float *p, __m128 *x, __m128 *y, __m128 *z)
 {
@@ -372,22 +403,6 @@ static inline void load_xyz4(const float *p, __m128 *x, __m128 *y, __m128 *z)
 	*x = RT_SH(a, RT_SH(b, c, 2, 0, 1, 0), 0, 3, 0, 2);
 	*y = RT_SH(RT_SH(a, b, 1, 0, 0, 0), RT_SH(b, c, 3, 0, 2, 0), 0, 2, 0, 2);
 	*z = RT_SH(RT_SH(a, b, 2, 0, 1, 0), RT_SH(c, c, 0, 0, 3, 0), 0, 2, 0, 2);
-}
-
-/* X, Y, Z lanes stored as four xyz, stride bytes apart. */
-static inline void store_xyz4(float *restrict out, size_t stride, __m128 x, __m128 y, __m128 z)
-{
-	const __m128 a = RT_SH(RT_SH(x, y, 0, 0, 0, 0), RT_SH(z, x, 0, 0, 1, 1), 0, 2, 0, 2);
-	const __m128 b = RT_SH(RT_SH(y, z, 1, 1, 1, 1), RT_SH(x, y, 2, 2, 2, 2), 0, 2, 0, 2);
-	const __m128 c = RT_SH(RT_SH(z, x, 2, 2, 3, 3), RT_SH(y, z, 3, 3, 3, 3), 0, 2, 0, 2);
-	if (stride == 12) {
-		_mm_storeu_ps(out, a), _mm_storeu_ps(out + 4, b), _mm_storeu_ps(out + 8, c);
-		return;
-	}
-	float t[12];
-	_mm_storeu_ps(t, a), _mm_storeu_ps(t + 4, b), _mm_storeu_ps(t + 8, c);
-	for (int k = 0; k < 4; k++)
-		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
 }
 
 /* Four vertices at a time across the lanes (x of four points in one
