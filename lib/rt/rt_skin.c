@@ -11,7 +11,10 @@
  * the scalar loop's, bit for bit, where the compiler does not contract
  * to fused multiply-adds); the point and the normal are then one 4-lane
  * multiply-add chain each. The run's normals are normalised after it, 4
- * at a time (SSE2: one square root and one division per 4 vertices).
+ * at a time (SSE2: transposed, one square root and one division per 4
+ * vertices, stored as rt_transform stores). mlod_rt_skin does not bucket
+ * every frame: prepare_mesh (rt_ctx.c) keeps each skinned part's buckets
+ * from rt_skin_order, and rt_skin_lbs_ordered is the same loop given them.
  * It is written with the GCC/Clang vector extension; SSE2 intrinsics (the
  * x86-64 baseline) only for the bucketing mask and the normalisation, each
  * with a plain C fallback (forced with -DMLOD_RT_NO_SSE2). Other compilers
