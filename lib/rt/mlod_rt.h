@@ -123,8 +123,9 @@
  * sampling. Joints without a channel keep their rest TRS. The one
  * departure: slerp's weights come from one sine and one cosine instead of
  * three sines, which in double moves them by about 1e-13 of themselves,
- * far below a float's resolution (the committed samples' poses are the
- * same floats). The levels the runtime decodes from a pack have their
+ * and a normalisation multiplies by 1 / length instead of dividing by it
+ * (an ulp of a double), both far below a float's resolution (the committed
+ * samples' poses are the same floats). The levels the runtime decodes from a pack have their
  * rotation keys normalised once when they load (when that gives the same
  * samples), so that sampling need not normalise them every frame; views
  * are never changed.

@@ -305,6 +305,17 @@ fail:
 	return r;
 }
 
+/* The bytes of a mesh level's bucket tables (prepare_mesh): an offset per
+ * part and each skinned part's RT_SKIN_ORDER_BYTES. */
+static size_t skin_order_bytes(const mlod_pack_mesh *m)
+{
+	size_t b = 4 * (size_t)m->part_count;
+	for (uint32_t i = 0; i < m->part_count; i++)
+		if (m->parts[i].rec.skin >= 0)
+			b += RT_SKIN_ORDER_BYTES(m->parts[i].rec.vertex_count);
+	return b;
+}
+
 /* Checks a mesh level and lists what skinning it reads (u->pal_used, the
  * palette entries, and u->rigid, the joints of its rigid parts), so that
  * mlod_rt_skin poses and multiplies only those. The kernel reads a
@@ -317,7 +328,7 @@ static mlod_result prepare_mesh(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_me
 	if (r)
 		return r;
 	const uint32_t P = ctx->palette_size, J = ctx->joint_count;
-	const size_t bytes = 4 * ((size_t)P + J);
+	const size_t bytes = 4 * ((size_t)P + J) + skin_order_bytes(m);
 	uint32_t *block = rt_alloc(ctx, bytes ? bytes : 4);
 	uint8_t *mark = rt_alloc(ctx, (P > J ? P : J) + 1);
 	if (!block || !mark) {
@@ -354,6 +365,18 @@ static mlod_result prepare_mesh(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_me
 		}
 	}
 	rt_free(ctx, mark);
+	/* The skinned parts' influence-count buckets, once (rt_skin_order). */
+	u->skin_order_at = block + P + J;
+	u->skin_order = (uint8_t *)(u->skin_order_at + m->part_count);
+	size_t at = 0;
+	for (uint32_t i = 0; i < m->part_count; i++) {
+		const mlod_pack_part *p = &m->parts[i];
+		u->skin_order_at[i] = (uint32_t)at;
+		if (p->rec.skin < 0)
+			continue;
+		rt_skin_order(p->rec.vertex_count, p->weights, u->skin_order + at);
+		at += RT_SKIN_ORDER_BYTES(p->rec.vertex_count);
+	}
 	u->plan_block = block;
 	u->bytes += bytes;
 	return MLOD_OK;
@@ -374,6 +397,7 @@ static void unit_release(mlod_rt_ctx *ctx, rt_unit *u)
 	memset(&u->plan, 0, sizeof u->plan);
 	u->pal_used = u->rigid = NULL;
 	u->pal_used_count = u->rigid_count = 0;
+	u->skin_order_at = NULL, u->skin_order = NULL;
 	ctx->unit_gen++;
 	u->chan_flags = NULL;
 	u->skel = NULL, u->mesh = NULL, u->motion = NULL;
@@ -470,7 +494,12 @@ static size_t evictable_bytes(const mlod_rt_ctx *ctx)
  * become floats; positions and normals grow less), the decoded structs at
  * most double their records, and the alignment of each stream costs less
  * than 4 times its 16-byte header; plus the skeleton level's tables, or
- * the mesh level's lists (prepare_mesh). */
+ * the mesh level's lists and bucket tables (prepare_mesh). For a pack's
+ * mesh level the bucket tables are bounded by the raw size / 4: each
+ * vertex of a skinned part has at least 16 raw bytes (u16[4] position,
+ * u8[4] joints and weights, mlod(5)) and costs 1 + 1/16 bytes, each part
+ * a record of far more than its 8 bytes (an offset and a partial run's 4
+ * counts). */
 static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 {
 	size_t plan = u->layer == MLOD_RT_SKELETON ? (size_t)ctx->joint_count * (4 + 1 + 4 + 64)
@@ -479,16 +508,16 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 	if (!ctx->load) {
 		const mlod_rt_view_level *v = u->view;
 		if (v && v->bytes)
-			return v->bytes + plan;
+			return v->bytes + plan + (u->layer == MLOD_RT_MESH && v->data ? skin_order_bytes(v->data) : 0);
 		if (v && v->data)
 			switch (u->layer) {
 			case MLOD_RT_SKELETON: return rt_bytes_skel_level(v->data) + plan;
-			case MLOD_RT_MESH: return rt_bytes_mesh(v->data) + plan;
+			case MLOD_RT_MESH: return rt_bytes_mesh(v->data) + plan + skin_order_bytes(v->data);
 			default: return rt_bytes_motion(v->data);
 			}
 		return 0;
 	}
-	size_t hint = 4 * (size_t)u->raw_size + 256 + plan;
+	size_t hint = 4 * (size_t)u->raw_size + 256 + plan + (u->layer == MLOD_RT_MESH ? (size_t)u->raw_size / 4 : 0);
 	/* A nested motion level decodes the coarser ones it builds on (rt_pack.c
 	 * motion_load), each freed before it returns; at most two at a time,
 	 * counted here as all of them. */

@@ -57,7 +57,10 @@ static void key_pos(const float *times, uint32_t n, float t, rt_key_pos *p)
 	}
 }
 
-/* mlod_quat_normalize, inline: the same doubles. */
+/* mlod_quat_normalize, inline, in doubles, but for one division: times
+ * 1 / n instead of four divisions by n. The two differ by at most an ulp
+ * of a double (1e-16), so the floats they round to agree but for a rare
+ * last bit (a double within 1e-16 of a float's rounding boundary). */
 static inline void quat_norm(const float *q, float *out)
 {
 	const double n = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
@@ -65,10 +68,12 @@ static inline void quat_norm(const float *q, float *out)
 		out[0] = out[1] = out[2] = 0.0f, out[3] = 1.0f;
 		return;
 	}
-	out[0] = (float)(q[0] / n), out[1] = (float)(q[1] / n), out[2] = (float)(q[2] / n), out[3] = (float)(q[3] / n);
+	const double r = 1.0 / n;
+	out[0] = (float)(q[0] * r), out[1] = (float)(q[1] * r), out[2] = (float)(q[2] * r), out[3] = (float)(q[3] * r);
 }
 
-/* lib/core/math.c's quat_blend: the same doubles. */
+/* lib/core/math.c's quat_blend, in doubles, with quat_norm's one
+ * division. */
 static inline void quat_blend(const float *a, double wa, const float *b, double wb, float *out)
 {
 	const double x = wa * a[0] + wb * b[0], y = wa * a[1] + wb * b[1];
@@ -78,7 +83,8 @@ static inline void quat_blend(const float *a, double wa, const float *b, double 
 		out[0] = out[1] = out[2] = 0.0f, out[3] = 1.0f;
 		return;
 	}
-	out[0] = (float)(x / n), out[1] = (float)(y / n), out[2] = (float)(z / n), out[3] = (float)(w / n);
+	const double r = 1.0 / n;
+	out[0] = (float)(x * r), out[1] = (float)(y * r), out[2] = (float)(z * r), out[3] = (float)(w * r);
 }
 
 /* mlod_quat_slerp(a, b, t), the same doubles; unit: a and b are their own
@@ -369,8 +375,9 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
 /* ---------------------------------------------------------------- */
 
 /* Morphing goes through a buffer on the stack, this many vertices at a
- * time: no allocation. */
-enum { RT_MORPH_RUN = 128 };
+ * time: no allocation. A multiple of RT_SKIN_RUN, so each stretch starts
+ * a run of the part's buckets. */
+enum { RT_MORPH_RUN = 2 * RT_SKIN_RUN };
 
 /* The instance's morph weights for part i of a level and the targets to
  * apply (*nt), or NULL when every weight is 0 (nothing to do). */
@@ -478,8 +485,9 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 			float *o = (float *)((char *)op + v0 * pos_stride);
 			float *onr = on ? (float *)((char *)on + v0 * nrm_stride) : NULL;
 			if (skinned) {
-				mlod_rt_skin_lbs(m, pos, onr ? nrm : NULL, p->joints + 4 * v0, p->weights + 4 * v0, pal, o,
-				                 pos_stride, onr, nrm_stride);
+				const uint8_t *ord = mu->skin_order + mu->skin_order_at[i];
+				rt_skin_lbs_ordered(m, pos, onr ? nrm : NULL, p->joints + 4 * v0, p->weights + 4 * v0, pal, o,
+				                    pos_stride, onr, nrm_stride, ord + v0, ord + n + 4 * (v0 / RT_SKIN_RUN));
 				if (onr && !nrm)
 					for (size_t v = 0; v < m; v++) {
 						float *x = (float *)((char *)onr + v * nrm_stride);

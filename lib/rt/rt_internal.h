@@ -52,6 +52,10 @@ typedef struct rt_unit {
 	 * weight), increasing, and the joints its rigid parts follow. */
 	uint32_t pal_used_count, rigid_count;
 	uint32_t *pal_used, *rigid;
+	/* Mesh levels: per part, the offset in skin_order of its buckets
+	 * (rt_skin_order; skinned parts only), all in plan_block. */
+	uint32_t *skin_order_at;
+	uint8_t *skin_order;
 	uint8_t *chan_flags;      /* resident motion levels: a bit per channel (in ctx->chan_bits) */
 	void *plan_block;
 } rt_unit;
@@ -171,6 +175,23 @@ size_t rt_bytes_motion(const mlod_pack_motion *m);
  * not positive): the same floats whichever path computes them. */
 void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, float *out_pos, size_t ps,
                   float *out_nrm, size_t ns);
+
+/* rt_skin.c: the influence-count buckets of a skinned part (prepare_mesh
+ * builds them when a mesh level loads, so mlod_rt_skin_lbs's per-run
+ * bucketing is not redone every frame). For n vertices in runs of
+ * RT_SKIN_RUN, order holds RT_SKIN_ORDER_BYTES(n) bytes: first n, per run
+ * the offsets within the run of its vertices with 1, then 2, 3 and 4
+ * influences (up to the last non-zero weight, at least 1; increasing in
+ * each bucket), then 4 per run, the run's four bucket sizes.
+ * rt_skin_lbs_ordered is mlod_rt_skin_lbs given them (list: order + v0,
+ * counts: order + n + 4 v0 / RT_SKIN_RUN of the same part, for v0 a
+ * multiple of RT_SKIN_RUN): the same floats. */
+#define RT_SKIN_RUN 64
+#define RT_SKIN_ORDER_BYTES(n) ((size_t)(n) + 4 * (((size_t)(n) + RT_SKIN_RUN - 1) / RT_SKIN_RUN))
+void rt_skin_order(size_t n, const float *weights, uint8_t *order);
+void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals, const uint16_t *joints,
+                         const float *weights, const float *palette, float *out_pos, size_t pos_stride,
+                         float *out_nrm, size_t nrm_stride, const uint8_t *list, const uint8_t *counts);
 
 /* rt_math.h: the affine helpers rt_mat_mul (a * b), rt_mat_trs
  * (mlod_mat4_from_trs) and rt_mat_mul_trs (parent * rt_mat_trs(t)). */

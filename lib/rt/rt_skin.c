@@ -11,7 +11,10 @@
  * the scalar loop's, bit for bit, where the compiler does not contract
  * to fused multiply-adds); the point and the normal are then one 4-lane
  * multiply-add chain each. The run's normals are normalised after it, 4
- * at a time (SSE2: one square root and one division per 4 vertices).
+ * at a time (SSE2: transposed, one square root and one division per 4
+ * vertices, stored as rt_transform stores). mlod_rt_skin does not bucket
+ * every frame: prepare_mesh (rt_ctx.c) keeps each skinned part's buckets
+ * from rt_skin_order, and rt_skin_lbs_ordered is the same loop given them.
  * It is written with the GCC/Clang vector extension; SSE2 intrinsics (the
  * x86-64 baseline) only for the bucketing mask and the normalisation, each
  * with a plain C fallback (forced with -DMLOD_RT_NO_SSE2). Other compilers
@@ -48,7 +51,7 @@ typedef float rt_v4 __attribute__((vector_size(16)));
 #include <emmintrin.h>
 #endif
 
-#define RT_RUN 64 /* vertices per run */
+#define RT_RUN RT_SKIN_RUN /* vertices per run */
 
 static inline rt_v4 ld4(const float *p)
 {
@@ -105,35 +108,105 @@ static inline __attribute__((always_inline)) void lbs_list(const int K, const in
 	}
 }
 
+#if defined(RT_SSE2)
+/* (a[i0], a[i1], b[i2], b[i3]) */
+#define RT_SH(a, b, i0, i1, i2, i3) _mm_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0))
+
+/* X, Y, Z lanes stored as four xyz, stride bytes apart. */
+static inline void store_xyz4(float *restrict out, size_t stride, __m128 x, __m128 y, __m128 z)
+{
+	const __m128 a = RT_SH(RT_SH(x, y, 0, 0, 0, 0), RT_SH(z, x, 0, 0, 1, 1), 0, 2, 0, 2);
+	const __m128 b = RT_SH(RT_SH(y, z, 1, 1, 1, 1), RT_SH(x, y, 2, 2, 2, 2), 0, 2, 0, 2);
+	const __m128 c = RT_SH(RT_SH(z, x, 2, 2, 3, 3), RT_SH(y, z, 3, 3, 3, 3), 0, 2, 0, 2);
+	if (stride == 12) {
+		_mm_storeu_ps(out, a), _mm_storeu_ps(out + 4, b), _mm_storeu_ps(out + 8, c);
+		return;
+	}
+	float t[12];
+	_mm_storeu_ps(t, a), _mm_storeu_ps(t + 4, b), _mm_storeu_ps(t + 8, c);
+	for (int k = 0; k < 4; k++)
+		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
+}
+
+#endif
+
 /* Normalises the run's m blended normals and stores them at out. */
 static void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out, size_t stride)
 {
 	for (size_t i = m; i % 4; i++)
 		tn[i] = (rt_v4){ 0, 0, 0, 0 };
 	for (size_t i0 = 0; i0 < m; i0 += 4) {
-		float il[4];
 #if defined(RT_SSE2)
-		/* Four vertices at a time: squares transposed, one square root. */
-		__m128 s0 = (__m128)(tn[i0] * tn[i0]), s1 = (__m128)(tn[i0 + 1] * tn[i0 + 1]),
-		       s2 = (__m128)(tn[i0 + 2] * tn[i0 + 2]), s3 = (__m128)(tn[i0 + 3] * tn[i0 + 3]);
-		_MM_TRANSPOSE4_PS(s0, s1, s2, s3);
-		const __m128 l2 = _mm_add_ps(_mm_add_ps(s0, s1), s2);
+		/* Four vertices at a time, transposed (x of the four in one
+		 * vector): per lane (x x + y y) + z z, one square root and
+		 * division, each component times 1 / sqrt, as the plain loop
+		 * below; stored back as four xyz. */
+		__m128 x = (__m128)tn[i0], y = (__m128)tn[i0 + 1], z = (__m128)tn[i0 + 2], w = (__m128)tn[i0 + 3];
+		_MM_TRANSPOSE4_PS(x, y, z, w);
+		const __m128 l2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_mul_ps(z, z));
 		const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(l2));
-		_mm_storeu_ps(il, _mm_and_ps(_mm_cmpgt_ps(l2, _mm_setzero_ps()), inv));
+		const __m128 il = _mm_and_ps(_mm_cmpgt_ps(l2, _mm_setzero_ps()), inv);
+		x = _mm_mul_ps(x, il), y = _mm_mul_ps(y, il), z = _mm_mul_ps(z, il);
+		float *restrict on = (float *)((char *)out + i0 * stride);
+		if (m - i0 >= 4) {
+			store_xyz4(on, stride, x, y, z);
+		} else {
+			float t[12];
+			store_xyz4(t, 12, x, y, z);
+			for (size_t k = 0; k < m - i0; k++)
+				memcpy((char *)on + k * stride, t + 3 * k, 3 * sizeof(float));
+		}
 #else
+		float il[4];
 		for (int k = 0; k < 4; k++) {
 			const rt_v4 t = tn[i0 + k];
 			const float l2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
 			il[k] = l2 > 0.0f ? 1.0f / sqrtf(l2) : 0.0f;
 		}
-#endif
 		const size_t e = m - i0 < 4 ? m - i0 : 4;
 		for (size_t k = 0; k < e; k++) {
 			const rt_v4 r = tn[i0 + k] * il[k];
 			float *restrict on = (float *)((char *)out + (i0 + k) * stride);
 			on[0] = r[0], on[1] = r[1], on[2] = r[2];
 		}
+#endif
 	}
+}
+
+/* Skins the vertices v0 .. v1 - 1 of a run whose vertices with k + 1
+ * influences are l[k][0..c[k]) (offsets within the run, increasing), and
+ * normalises the run's normals (when N). */
+static inline __attribute__((always_inline)) void lbs_sorted(const int N, size_t v0, size_t v1,
+                                                           const uint8_t *const l[4], const size_t c[4],
+                                                           const float *restrict positions,
+                                                           const float *restrict normals,
+                                                           const uint16_t *restrict joints,
+                                                           const float *restrict weights,
+                                                           const float *restrict palette, float *restrict out_pos,
+                                                           size_t pos_stride, float *restrict out_nrm,
+                                                           size_t nrm_stride)
+{
+	rt_v4 tn[RT_RUN];
+	lbs_list(1, N, l[0], c[0], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(2, N, l[1], c[1], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(3, N, l[2], c[2], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(4, N, l[3], c[3], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	if (N)
+		normalise_run(v1 - v0, tn, (float *)((char *)out_nrm + v0 * nrm_stride), nrm_stride);
+}
+
+/* The run v0 .. v1 - 1 bucketed by influence count, in order: l[k] the
+ * offsets within the run of the c[k] vertices with k + 1 influences. */
+static inline void bucket_run(const float *restrict weights, size_t v0, size_t v1, uint8_t l[4][RT_RUN],
+                              size_t c[4])
+{
+	uint64_t packed = 0; /* the four counts, 16 bits each: no store in the chain */
+	for (size_t v = v0; v < v1; v++) {
+		const unsigned sh = 16 * (influences(weights + 4 * v) - 1);
+		l[sh / 16][(packed >> sh) & 0xffff] = (uint8_t)(v - v0);
+		packed += (uint64_t)1 << sh;
+	}
+	c[0] = packed & 0xffff, c[1] = packed >> 16 & 0xffff, c[2] = packed >> 32 & 0xffff, c[3] = packed >> 48;
 }
 
 static inline __attribute__((always_inline)) void lbs_run(const int N, size_t v0, size_t v1,
@@ -145,22 +218,12 @@ static inline __attribute__((always_inline)) void lbs_run(const int N, size_t v0
                                                         size_t pos_stride, float *restrict out_nrm,
                                                         size_t nrm_stride)
 {
-	/* The run's vertices bucketed by influence count, in order. */
 	uint8_t list[4][RT_RUN];
-	uint64_t packed = 0; /* the four counts, 16 bits each: no store in the chain */
-	for (size_t v = v0; v < v1; v++) {
-		const unsigned sh = 16 * (influences(weights + 4 * v) - 1);
-		list[sh / 16][(packed >> sh) & 0xffff] = (uint8_t)(v - v0);
-		packed += (uint64_t)1 << sh;
-	}
-	const size_t count[4] = { packed & 0xffff, packed >> 16 & 0xffff, packed >> 32 & 0xffff, packed >> 48 };
-	rt_v4 tn[RT_RUN];
-	lbs_list(1, N, list[0], count[0], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	lbs_list(2, N, list[1], count[1], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	lbs_list(3, N, list[2], count[2], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	lbs_list(4, N, list[3], count[3], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	if (N)
-		normalise_run(v1 - v0, tn, (float *)((char *)out_nrm + v0 * nrm_stride), nrm_stride);
+	size_t c[4];
+	bucket_run(weights, v0, v1, list, c);
+	const uint8_t *const l[4] = { list[0], list[1], list[2], list[3] };
+	lbs_sorted(N, v0, v1, l, c, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm,
+	           nrm_stride);
 }
 
 RT_CLONES void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const float *restrict normals,
@@ -174,6 +237,40 @@ RT_CLONES void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const
 			lbs_run(1, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride);
 		else
 			lbs_run(0, v0, v1, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride);
+	}
+}
+
+void rt_skin_order(size_t n, const float *weights, uint8_t *order)
+{
+	for (size_t v0 = 0, r = 0; v0 < n; v0 += RT_RUN, r++) {
+		const size_t v1 = n - v0 < RT_RUN ? n : v0 + RT_RUN;
+		uint8_t l[4][RT_RUN];
+		size_t c[4], o = v0;
+		bucket_run(weights, v0, v1, l, c);
+		for (int k = 0; k < 4; o += c[k], k++) {
+			memcpy(order + o, l[k], c[k]);
+			order[n + 4 * r + (size_t)k] = (uint8_t)c[k];
+		}
+	}
+}
+
+RT_CLONES void rt_skin_lbs_ordered(size_t n, const float *restrict positions, const float *restrict normals,
+                                   const uint16_t *restrict joints, const float *restrict weights,
+                                   const float *restrict palette, float *restrict out_pos, size_t pos_stride,
+                                   float *restrict out_nrm, size_t nrm_stride, const uint8_t *restrict list,
+                                   const uint8_t *restrict counts)
+{
+	for (size_t v0 = 0, r = 0; v0 < n; v0 += RT_RUN, r++) {
+		const size_t v1 = n - v0 < RT_RUN ? n : v0 + RT_RUN;
+		const size_t c[4] = { counts[4 * r], counts[4 * r + 1], counts[4 * r + 2], counts[4 * r + 3] };
+		const uint8_t *const l[4] = { list + v0, list + v0 + c[0], list + v0 + c[0] + c[1],
+		                              list + v0 + c[0] + c[1] + c[2] };
+		if (normals)
+			lbs_sorted(1, v0, v1, l, c, positions, normals, joints, weights, palette, out_pos, pos_stride,
+			           out_nrm, nrm_stride);
+		else
+			lbs_sorted(0, v0, v1, l, c, positions, normals, joints, weights, palette, out_pos, pos_stride,
+			           out_nrm, nrm_stride);
 	}
 }
 #else
@@ -214,6 +311,21 @@ void mlod_rt_skin_lbs(size_t n, const float *restrict positions, const float *re
 	}
 }
 
+
+/* No buckets without the vector loops: the plain loop reads every weight. */
+void rt_skin_order(size_t n, const float *weights, uint8_t *order)
+{
+	(void)weights;
+	memset(order, 0, RT_SKIN_ORDER_BYTES(n));
+}
+
+void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals, const uint16_t *joints,
+                         const float *weights, const float *palette, float *out_pos, size_t pos_stride,
+                         float *out_nrm, size_t nrm_stride, const uint8_t *list, const uint8_t *counts)
+{
+	(void)list, (void)counts;
+	mlod_rt_skin_lbs(n, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm, nrm_stride);
+}
 #endif
 
 #if defined(__GNUC__) && !defined(__clang__)
@@ -287,9 +399,6 @@ static void transform_one_by_one(size_t n, const float *restrict pos, const floa
 }
 
 #if defined(RT_SSE2)
-/* (a[i0], a[i1], b[i2], b[i3]) */
-#define RT_SH(a, b, i0, i1, i2, i3) _mm_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0))
-
 /* Four packed xyz (12 floats at p) as X, Y, Z lanes. */
 static inline void load_xyz4(const float *p, __m128 *x, __m128 *y, __m128 *z)
 {
@@ -297,22 +406,6 @@ static inline void load_xyz4(const float *p, __m128 *x, __m128 *y, __m128 *z)
 	*x = RT_SH(a, RT_SH(b, c, 2, 0, 1, 0), 0, 3, 0, 2);
 	*y = RT_SH(RT_SH(a, b, 1, 0, 0, 0), RT_SH(b, c, 3, 0, 2, 0), 0, 2, 0, 2);
 	*z = RT_SH(RT_SH(a, b, 2, 0, 1, 0), RT_SH(c, c, 0, 0, 3, 0), 0, 2, 0, 2);
-}
-
-/* X, Y, Z lanes stored as four xyz, stride bytes apart. */
-static inline void store_xyz4(float *restrict out, size_t stride, __m128 x, __m128 y, __m128 z)
-{
-	const __m128 a = RT_SH(RT_SH(x, y, 0, 0, 0, 0), RT_SH(z, x, 0, 0, 1, 1), 0, 2, 0, 2);
-	const __m128 b = RT_SH(RT_SH(y, z, 1, 1, 1, 1), RT_SH(x, y, 2, 2, 2, 2), 0, 2, 0, 2);
-	const __m128 c = RT_SH(RT_SH(z, x, 2, 2, 3, 3), RT_SH(y, z, 3, 3, 3, 3), 0, 2, 0, 2);
-	if (stride == 12) {
-		_mm_storeu_ps(out, a), _mm_storeu_ps(out + 4, b), _mm_storeu_ps(out + 8, c);
-		return;
-	}
-	float t[12];
-	_mm_storeu_ps(t, a), _mm_storeu_ps(t + 4, b), _mm_storeu_ps(t + 8, c);
-	for (int k = 0; k < 4; k++)
-		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
 }
 
 /* Four vertices at a time across the lanes (x of four points in one

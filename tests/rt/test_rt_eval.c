@@ -670,6 +670,97 @@ TEST(skin_plan_matches_full_pose)
 	mlod_rt_close(ctx);
 }
 
+/* One case of skin_buckets_at_load: 0 when equal, else 1 and t_msg_
+ * says why. */
+static int skin_buckets_case(mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, int morph, uint32_t n_,
+                             const float *pos, const float *nrm, const uint16_t *jnt, const float *wgt,
+                             const float *dlt, float *mor, float *out, float *outn, float *ref, float *refn)
+{
+	mlod_error e;
+	const float w = morph ? 0.625f : 0.0f;
+	const float *P;
+	uint32_t n;
+	if (mlod_rt_instance_set_morph_weights(ctx, id, 0, &w, 1, &e) ||
+	    mlod_rt_skin(ctx, s, id, out, 12, outn, 12, n_, &n, &e) || mlod_rt_palette(ctx, s, &P, NULL, &e)) {
+		snprintf(t_msg_, sizeof t_msg_, "morph %d: %s", morph, e.message);
+		return 1;
+	}
+	if (n != n_) {
+		snprintf(t_msg_, sizeof t_msg_, "%u vertices written, %u expected", n, n_);
+		return 1;
+	}
+	for (size_t k = 0; k < 3 * (size_t)n_; k++) /* the runtime's morph: position, then + weight * delta */
+		mor[k] = pos[k], mor[k] += w * dlt[k];
+	mlod_rt_skin_lbs(n_, morph ? mor : pos, nrm, jnt, wgt, P, ref, 12, refn, 12);
+	for (uint32_t v = 0; v < n_; v++)
+		if (memcmp(out + 3 * v, ref + 3 * v, 12) || memcmp(outn + 3 * v, refn + 3 * v, 12)) {
+			snprintf(t_msg_, sizeof t_msg_, "morph %d vertex %u: (%g %g %g) against mlod_rt_skin_lbs's (%g %g %g)",
+			         morph, v, out[3 * v], out[3 * v + 1], out[3 * v + 2], ref[3 * v], ref[3 * v + 1], ref[3 * v + 2]);
+			return 1;
+		}
+	return 0;
+}
+
+/* mlod_rt_skin skins with the buckets built when its mesh level loaded
+ * (rt_skin_order): a skinned part of 1,000 vertices (16 runs, the last
+ * partial) whose influence patterns are every one of the 16 (zeros before
+ * the last non-zero weight too), with and without a morph target (runs
+ * of 128 through the stack buffer), gives mlod_rt_skin_lbs's floats on
+ * the same palette, bit for bit. A bucket list offset by a run, a wrong
+ * count or a stale order would move vertices. */
+TEST(skin_buckets_at_load)
+{
+	enum { N = 1000 };
+	static float pos[3 * N], nrm[3 * N], wgt[4 * N], dlt[3 * N], mor[3 * N];
+	static float out[3 * N], outn[3 * N], ref[3 * N], refn[3 * N];
+	static uint16_t jnt[4 * N];
+	static float *targets[1] = { dlt };
+	unsigned seed = 12345;
+	for (int v = 0; v < N; v++) {
+		for (int c = 0; c < 3; c++) {
+			seed = seed * 1103515245u + 12345u;
+			pos[3 * v + c] = (float)((seed >> 8) % 2000) / 1000.0f - 1.0f;
+			nrm[3 * v + c] = (float)((seed >> 4) % 200) / 100.0f - 1.0f;
+			dlt[3 * v + c] = (float)((seed >> 12) % 100) / 400.0f;
+		}
+		seed = seed * 1103515245u + 12345u;
+		const unsigned pattern = ((seed >> 16) % 15) + 1; /* non-zero weights: bits of 1..15 */
+		float sum = 0;
+		for (int k = 0; k < 4; k++) {
+			jnt[4 * v + k] = (uint16_t)((v + 3 * k) % FX_J);
+			wgt[4 * v + k] = (pattern >> k) & 1 ? (float)(k + 1) : 0.0f;
+			sum += wgt[4 * v + k];
+		}
+		for (int k = 0; k < 4; k++)
+			wgt[4 * v + k] /= sum;
+	}
+	mlod_pack_part part;
+	fx_part(&part, pos, nrm, jnt, wgt, N, 0, -1, NULL);
+	part.targets = targets;
+	part.rec.target_count = 1;
+	mlod_pack_mesh saved = fx_mesh0;
+	fx_mesh0 = (mlod_pack_mesh){ 1, &part, NULL };
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_all(NULL, &e); /* the views point at fx_mesh0: restored after closing */
+	if (!ctx)
+		fx_mesh0 = saved;
+	CHECK(ctx, "open: %s", e.message);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	uint32_t id;
+	int failed = 0;
+	if (mlod_rt_instance_create(ctx, 0, 0.7f, MLOD_RT_LOOP, &id, &e) || force(ctx, id, 0, &e)) {
+		snprintf(t_msg_, sizeof t_msg_, "instance: %s", e.message);
+		failed = 1;
+	}
+	for (int morph = 0; morph < 2 && !failed; morph++)
+		failed = skin_buckets_case(ctx, s, id, morph, N, pos, nrm, jnt, wgt, dlt, mor, out, outn, ref, refn);
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+	fx_mesh0 = saved;
+	if (failed) /* t_msg_ says why */
+		t_failed_ = 1;
+}
+
 int main(void)
 {
 	fx_build(0);
@@ -682,5 +773,6 @@ int main(void)
 	RUN(no_allocation_per_frame);
 	RUN(morph_targets);
 	RUN(skin_plan_matches_full_pose);
+	RUN(skin_buckets_at_load);
 	TEST_EXIT();
 }

@@ -8,12 +8,17 @@
  * (rt_test.h, fx_build(1)): coarse levels 500 + 1000 + 2 * 700 = 2900,
  * plus the runtime's table of a skeleton level (73 bytes per joint: 365)
  * and its lists of a mesh level (4 bytes per palette entry and joint: 40,
- * MESH_PLAN).
+ * MESH_PLAN) with its skinned parts' influence-count buckets (4 bytes per
+ * part, and per skinned part 1 per vertex and 4 per run of 64: levels 0,
+ * 1 and 2 have 3, 2 and 1 parts, their skinned part 4, 2 and 1 vertices:
+ * 20, 14 and 9 bytes; MESH_ORDER1 and MESH_ORDER2 below).
  */
 #include "rt_test.h"
 
 #define MESH_PLAN 40u
-#define COARSE (2900u + 365u + MESH_PLAN)
+#define MESH_ORDER1 14u
+#define MESH_ORDER2 9u
+#define COARSE (2900u + 365u + MESH_PLAN + MESH_ORDER2)
 
 static mlod_rt_ctx *open_budget(size_t budget, mlod_error *e)
 {
@@ -155,7 +160,7 @@ static void frame(mlod_rt_ctx *ctx)
 TEST(lru_eviction)
 {
 	mlod_error e;
-	mlod_rt_ctx *ctx = open_budget(COARSE + 3500 + MESH_PLAN, &e);
+	mlod_rt_ctx *ctx = open_budget(COARSE + 3500 + MESH_PLAN + MESH_ORDER1, &e);
 	CHECK(ctx, "open: %s", e.message);
 	frame(ctx);
 	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MESH, 1, 0, &e), e); /* 2000 + MESH_PLAN */
