@@ -488,6 +488,7 @@ TEST(warm_starts_same_bits)
 	mlod_warm other = { wa, wb, na - 1, nb, 0, 0, 0.0, NULL };
 	CHECK_OK(mlod_surface_deviation_to(s, &b2, &other, &d, &terr));
 	CHECK(same_deviation(&cold, &d));
+	mlod_warm_release(&rec); /* the tree the recording kept for the other poses */
 	free(wa);
 	free(wb);
 	mlod_surface_free(s);
