@@ -284,14 +284,17 @@ void bgm_quadric_rest_reset(mlod_bgm *g, int v)
 	double *r = g->rquad + (size_t)v * BGM_RQUAD, t = 0.0;
 	for (int p = 0; p < g->pose_count; p++)
 		t += q[10 * p] + q[10 * p + 4] + q[10 * p + 7];
-	r[0] = -1.0;
+	r[0] = NAN; /* not computed yet: bgm_quadric_rest */
 	r[10] = t;
 }
 
 const double *bgm_quadric_rest(mlod_bgm *g, int v)
 {
 	double *r = g->rquad + (size_t)v * BGM_RQUAD;
-	if (r[0] < 0.0)
+	/* NaN marks it unknown: a computed r[0] may round below 0 (a
+	 * direction the planes leave free), which must not recompute it at
+	 * every use. */
+	if (isnan(r[0]))
 		bgm_quadric_pullback(g, g->quadric + (size_t)v * (size_t)g->pose_count * 10, &g->inf[v], r);
 	return r;
 }
@@ -313,7 +316,7 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 		/* T = Q * [M; 0 0 0 1], H += [M; 0 0 0 1]^T * T (the terms of the
 		 * last row's zeros left out). */
 		for (int i = 0; i < 4; i++) {
-			for (int j = 0; j < 3; j++)
+			for (int j = 0; j < 3 && i < 3; j++) /* T[3][0..2] is not used */
 				T[i][j] = Q[i][0] * M[j] + Q[i][1] * M[4 + j] + Q[i][2] * M[8 + j];
 			T[i][3] = Q[i][0] * M[3] + Q[i][1] * M[7] + Q[i][2] * M[11] + Q[i][3];
 		}
