@@ -78,13 +78,22 @@
 #define QUEUED(op) (16u << (op))       /* opstate: has an entry in the heap */
 #define ALL_BLOCKED 15u
 
-typedef struct bgm_heap_entry {
+/* A queued operation, as the heap hands it back. */
+typedef struct heap_entry {
 	double key;
 	int face;
 	int op;
 	int weak;   /* key is lower_key's bind-pose bound: exact_bound comes next */
 	int memo;   /* into heap.memo, or -1 */
 } heap_entry;
+
+/* As the heap stores it: 16 bytes, four children to a 64-byte line
+ * (tag: op in bits 0-1, weak in bit 2, memo + 1 above). */
+struct bgm_heap_entry {
+	double key;
+	int face;
+	unsigned tag;
+};
 
 /* What the exact posed cost of an operation's placements came to. It
  * depends only on the collapsed vertices (quadrics, positions and
@@ -128,20 +137,24 @@ static void memo_release(struct bgm_heap *h, int i)
 	h->memo_free = i;
 }
 
-static int entry_less(const heap_entry *a, const heap_entry *b)
+/* The queue's order: key, then face, then op (a total order, so the
+ * operations come out in the same order whatever the heap's shape). */
+static int entry_less(const struct bgm_heap_entry *a, const struct bgm_heap_entry *b)
 {
 	return a->key < b->key ||
-	       (a->key == b->key && (a->face < b->face || (a->face == b->face && a->op < b->op)));
+	       (a->key == b->key && (a->face < b->face || (a->face == b->face && (a->tag & 3u) < (b->tag & 3u))));
 }
 
+/* A 4-ary heap: half the levels of a binary one, its entries' cache
+ * misses being what a large mesh's collapses wait on. */
 static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak, int memo_slot)
 {
 	if (bgm_grow((void **)&h->e, &h->cap, h->count + 1, sizeof *h->e))
 		return -1;
 	int i = h->count++;
-	heap_entry x = {key, face, op, weak, memo_slot};
+	struct bgm_heap_entry x = {key, face, (unsigned)op | (weak ? 4u : 0u) | (unsigned)(memo_slot + 1) << 3};
 	while (i > 0) {
-		int p = (i - 1) / 2;
+		int p = (i - 1) / 4;
 		if (!entry_less(&x, &h->e[p]))
 			break;
 		h->e[i] = h->e[p];
@@ -153,22 +166,24 @@ static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak,
 
 static heap_entry heap_pop(struct bgm_heap *h)
 {
-	heap_entry top = h->e[0], x = h->e[--h->count];
-	int i = 0;
+	struct bgm_heap_entry t = h->e[0], x = h->e[--h->count];
+	int i = 0, n = h->count;
 	for (;;) {
-		int l = 2 * i + 1, r = l + 1, m = i;
-		const heap_entry *best = &x;
-		if (l < h->count && entry_less(&h->e[l], best))
-			m = l, best = &h->e[l];
-		if (r < h->count && entry_less(&h->e[r], best))
-			m = r;
-		if (m == i)
+		int c = 4 * i + 1, m = c;
+		if (c >= n)
+			break;
+		int end = c + 4 < n ? c + 4 : n;
+		for (int j = c + 1; j < end; j++)
+			if (entry_less(&h->e[j], &h->e[m]))
+				m = j;
+		if (!entry_less(&h->e[m], &x))
 			break;
 		h->e[i] = h->e[m];
 		i = m;
 	}
-	if (h->count > 0)
+	if (n > 0)
 		h->e[i] = x;
+	heap_entry top = {t.key, t.face, (int)(t.tag & 3u), (int)(t.tag >> 2 & 1u), (int)(t.tag >> 3) - 1};
 	return top;
 }
 
