@@ -77,6 +77,11 @@
 #define BLOCKED(op) (1u << (op))       /* opstate: refused when last planned */
 #define QUEUED(op) (16u << (op))       /* opstate: has an entry in the heap */
 #define ALL_BLOCKED 15u
+/* opstate of a dead face: its queue entries are dropped when popped
+ * (read here rather than the face's death, a cache miss in a large
+ * mesh). No live face has every bit: an op is never both blocked and
+ * queued. */
+#define DEAD 255u
 
 /* A queued operation, as the heap hands it back. */
 typedef struct heap_entry {
@@ -876,7 +881,8 @@ static int grow_face_arrays(mlod_bgm *g)
 		unsigned char *b = realloc(g->opstate, (size_t)g->face_cap);
 		if (!b)
 			return -1;
-		memset(b + g->opstate_cap, 0, (size_t)(g->face_cap - g->opstate_cap));
+		for (int f = g->opstate_cap; f < g->face_cap; f++)
+			b[f] = f < g->face_count && g->faces[f].death != BGM_ALIVE ? DEAD : 0;
 		g->opstate = b;
 		g->opstate_cap = g->face_cap;
 	}
@@ -898,6 +904,13 @@ static int same_influences(const mlod_influences *x, const mlod_influences *y)
 		if (x->joints[i] != y->joints[i] || x->weights[i] != y->weights[i])
 			return 0;
 	return 1;
+}
+
+/* fmax without the library call (the same value: NaN gives the other
+ * argument; the arguments here are never zeros of both signs). */
+static inline double max_d(double a, double b)
+{
+	return a != a ? b : b != b ? a : a > b ? a : b;
 }
 
 /* A lower bound of the summed posed error (not normalised) of any
@@ -941,7 +954,7 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 			for (int i = 0; i < 3; i++)
 				for (int e = 0; e < 3; e++)
 					l += (double)g->skin[12 * m + 4 * (size_t)i + (size_t)e] * g->skin[12 * m + 4 * (size_t)i + (size_t)e];
-			g->skin_norm = fmax(g->skin_norm, sqrt(l));
+			g->skin_norm = max_d(g->skin_norm, sqrt(l));
 		}
 	}
 	const double *qv[3];
@@ -968,8 +981,8 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 				d += (z[j][i] - c[i]) * (z[j][i] - c[i]);
 				a += z[j][i] * z[j][i];
 			}
-			spread = fmax(spread, d);
-			far = fmax(far, a);
+			spread = max_d(spread, d);
+			far = max_d(far, a);
 		}
 		double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
 		double q[10];
@@ -996,7 +1009,7 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 		val += mu * dy - mu * R * R;
 		/* Rounding: the terms of the quadric's value at a point within
 		 * R of c, far above the errors of the sums here and in plan(). */
-		double ym = fmax(fmax(fabs(c[0]), fabs(c[1])), fabs(c[2])) + R;
+		double ym = max_d(max_d(fabs(c[0]), fabs(c[1])), fabs(c[2])) + R;
 		double mag = fabs(q[9]) + 2.0 * (fabs(q[3]) + fabs(q[6]) + fabs(q[8])) * ym +
 		             (fabs(q[0]) + fabs(q[4]) + fabs(q[7]) + 2.0 * (fabs(q[1]) + fabs(q[2]) + fabs(q[5]))) * ym * ym;
 		val -= 1e-12 * mag;
@@ -1356,6 +1369,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	for (int j = 0; j < pl->nf; j++) {
 		bgm_face *f = &g->faces[pl->faces[j]];
 		f->death = stamp;
+		g->opstate[pl->faces[j]] = DEAD;
 		for (int k = 0; k < 3; k++)
 			bgm_inc_remove(g, f->n[k], pl->faces[j]);
 		g->removed[g->removed_len + j] = pl->faces[j];
@@ -1478,7 +1492,8 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			else if (g->record_count == g->swept)
 				break;
 			g->swept = g->record_count;
-			memset(g->opstate, 0, (size_t)g->opstate_cap);
+			for (int f = 0; f < g->opstate_cap; f++)
+				g->opstate[f] = f < g->face_count && g->faces[f].death != BGM_ALIVE ? DEAD : 0;
 			for (int f = 0; f < g->face_count; f++)
 				if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
 					r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
@@ -1487,7 +1502,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			continue;
 		}
 		heap_entry e = heap_pop(&g->heap);
-		if (g->faces[e.face].death != BGM_ALIVE) {
+		if (g->opstate[e.face] == DEAD) {
 			memo_release(&g->heap, e.memo);
 			continue;
 		}
