@@ -366,10 +366,33 @@ static double area_sq(const double *a, const double *b, const double *c)
  * sums them. */
 static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 {
-	for (int k = 0; k < 10 * g->pose_count; k++) {
-		Q[k] = 0.0;
-		for (int j = 0; j < pl->k; j++)
-			Q[k] += g->quadric[((size_t)pl->v[j] * (size_t)g->pose_count) * 10 + (size_t)k];
+	/* Each sum from 0 in the vertices' order (the same bits whatever
+	 * loop makes it). */
+	size_t n = 10 * (size_t)g->pose_count;
+	const double *a = g->quadric + (size_t)pl->v[0] * n, *b = pl->k > 1 ? g->quadric + (size_t)pl->v[1] * n : NULL;
+	if (pl->k == 3) {
+		const double *c = g->quadric + (size_t)pl->v[2] * n;
+		for (size_t k = 0; k < n; k++) {
+			double s = 0.0;
+			s += a[k];
+			s += b[k];
+			s += c[k];
+			Q[k] = s;
+		}
+	} else if (pl->k == 2) {
+		for (size_t k = 0; k < n; k++) {
+			double s = 0.0;
+			s += a[k];
+			s += b[k];
+			Q[k] = s;
+		}
+	} else {
+		for (size_t k = 0; k < n; k++) {
+			double s = 0.0;
+			for (int j = 0; j < pl->k; j++)
+				s += g->quadric[(size_t)pl->v[j] * n + k];
+			Q[k] = s;
+		}
 	}
 }
 
@@ -986,11 +1009,15 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 		}
 		double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
 		double q[10];
-		for (int e = 0; e < 10; e++)
-			q[e] = qv[0][10 * p + (size_t)e];
-		for (int i = 1; i < k; i++)
-			for (int e = 0; e < 10; e++)
-				q[e] += qv[i][10 * p + (size_t)e];
+		const double *q0 = qv[0] + 10 * p, *q1 = k > 1 ? qv[1] + 10 * p : NULL, *q2 = k > 2 ? qv[2] + 10 * p : NULL;
+		for (int e = 0; e < 10; e++) {
+			double t = q0[e];
+			if (q1)
+				t += q1[e];
+			if (q2)
+				t += q2[e];
+			q[e] = t;
+		}
 		double tr = q[0] + q[4] + q[7];
 		if (!(tr > 0.0) || !isfinite(tr))
 			continue;
