@@ -314,31 +314,40 @@ const double *bgm_quadric_rest(mlod_bgm *g, int v)
  * quadrics q pulled back into bind space. */
 void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influences *inf, double *h)
 {
-	double H[4][4] = {{0}};
+	/* H's upper triangle, packed as a quadric: every entry a sum over
+	 * poses from 0, each term in the order of the matrix products
+	 * T = Q [M; 0 0 0 1] and [M; 0 0 0 1]^T T (the last row's zeros left
+	 * out), written out entry by entry. */
+	double H[10] = {0};
 	for (int p = 0; p < g->pose_count; p++) {
-		double M[12], Q[4][4], T[4][4];
+		double M[12];
 		const double *a = q + 10 * p;
 		blend(g, p, inf, M);
-		int k = 0;
-		for (int i = 0; i < 4; i++)
-			for (int j = i; j < 4; j++)
-				Q[i][j] = Q[j][i] = a[k++];
-		/* T = Q * [M; 0 0 0 1], H += [M; 0 0 0 1]^T * T (the terms of the
-		 * last row's zeros left out). */
-		for (int i = 0; i < 4; i++) {
-			for (int j = 0; j < 3 && i < 3; j++) /* T[3][0..2] is not used */
-				T[i][j] = Q[i][0] * M[j] + Q[i][1] * M[4 + j] + Q[i][2] * M[8 + j];
-			T[i][3] = Q[i][0] * M[3] + Q[i][1] * M[7] + Q[i][2] * M[11] + Q[i][3];
-		}
-		for (int i = 0; i < 3; i++)
-			for (int j = i; j < 4; j++)
-				H[i][j] += M[i] * T[0][j] + M[4 + i] * T[1][j] + M[8 + i] * T[2][j];
-		H[3][3] += M[3] * T[0][3] + M[7] * T[1][3] + M[11] * T[2][3] + T[3][3];
+		double t00 = a[0] * M[0] + a[1] * M[4] + a[2] * M[8];
+		double t01 = a[0] * M[1] + a[1] * M[5] + a[2] * M[9];
+		double t02 = a[0] * M[2] + a[1] * M[6] + a[2] * M[10];
+		double t10 = a[1] * M[0] + a[4] * M[4] + a[5] * M[8];
+		double t11 = a[1] * M[1] + a[4] * M[5] + a[5] * M[9];
+		double t12 = a[1] * M[2] + a[4] * M[6] + a[5] * M[10];
+		double t20 = a[2] * M[0] + a[5] * M[4] + a[7] * M[8];
+		double t21 = a[2] * M[1] + a[5] * M[5] + a[7] * M[9];
+		double t22 = a[2] * M[2] + a[5] * M[6] + a[7] * M[10];
+		double t03 = a[0] * M[3] + a[1] * M[7] + a[2] * M[11] + a[3];
+		double t13 = a[1] * M[3] + a[4] * M[7] + a[5] * M[11] + a[6];
+		double t23 = a[2] * M[3] + a[5] * M[7] + a[7] * M[11] + a[8];
+		double t33 = a[3] * M[3] + a[6] * M[7] + a[8] * M[11] + a[9];
+		H[0] += M[0] * t00 + M[4] * t10 + M[8] * t20;
+		H[1] += M[0] * t01 + M[4] * t11 + M[8] * t21;
+		H[2] += M[0] * t02 + M[4] * t12 + M[8] * t22;
+		H[3] += M[0] * t03 + M[4] * t13 + M[8] * t23;
+		H[4] += M[1] * t01 + M[5] * t11 + M[9] * t21;
+		H[5] += M[1] * t02 + M[5] * t12 + M[9] * t22;
+		H[6] += M[1] * t03 + M[5] * t13 + M[9] * t23;
+		H[7] += M[2] * t02 + M[6] * t12 + M[10] * t22;
+		H[8] += M[2] * t03 + M[6] * t13 + M[10] * t23;
+		H[9] += M[3] * t03 + M[7] * t13 + M[11] * t23 + t33;
 	}
-	int k = 0;
-	for (int i = 0; i < 4; i++)
-		for (int j = i; j < 4; j++)
-			h[k++] = H[i][j];
+	memcpy(h, H, sizeof H);
 }
 
 double bgm_quadric_eval(const double *h, const double *x)
