@@ -92,7 +92,7 @@ static void edge_quadric(const double *a, const double *b, const double *n, doub
 }
 
 /* The blended 3x4 matrix of pose p for influences inf. */
-static void blend(const mlod_bgm *g, int p, const mlod_influences *inf, double *M)
+static inline void blend(const mlod_bgm *g, int p, const mlod_influences *inf, double *M)
 {
 	const float *S = g->skin + (size_t)p * (size_t)(g->joint_count > 0 ? g->joint_count : 1) * 12;
 	if (g->joint_count == 0 || inf->count == 0) {
@@ -109,13 +109,13 @@ static void blend(const mlod_bgm *g, int p, const mlod_influences *inf, double *
 	}
 }
 
-static void apply(const double *M, const double *x, double *y)
+static inline void apply(const double *M, const double *x, double *y)
 {
 	for (int r = 0; r < 3; r++)
 		y[r] = M[4 * r] * x[0] + M[4 * r + 1] * x[1] + M[4 * r + 2] * x[2] + M[4 * r + 3];
 }
 
-static double eval(const double *q, const double *x)
+static inline double eval(const double *q, const double *x)
 {
 	return q[0] * x[0] * x[0] + 2 * q[1] * x[0] * x[1] + 2 * q[2] * x[0] * x[2] + 2 * q[3] * x[0] +
 	       q[4] * x[1] * x[1] + 2 * q[5] * x[1] * x[2] + 2 * q[6] * x[1] + q[7] * x[2] * x[2] + 2 * q[8] * x[2] + q[9];
