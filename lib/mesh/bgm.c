@@ -324,12 +324,31 @@ struct edge_rec {
 	int forward;  /* n[e] < n[e + 1] */
 };
 
-static int edge_order(const void *a, const void *b)
+/* Sorts edges (made face after face, edge after edge) by key, then
+ * face, then edge, through tmp: a stable counting sort by the high node,
+ * then by the low one (nodes below n), which keeps equal keys in the
+ * order they were made. Returns -1 when out of memory. */
+static int sort_edges(struct edge_rec *edges, struct edge_rec *tmp, int ne, int n)
 {
-	const struct edge_rec *x = a, *y = b;
-	if (x->key != y->key)
-		return x->key < y->key ? -1 : 1;
-	return (x->face > y->face) - (x->face < y->face);
+	int *count = malloc(sizeof *count * ((size_t)n + 1));
+	if (!count)
+		return -1;
+	for (int pass = 0; pass < 2; pass++) {
+		struct edge_rec *from = pass == 0 ? edges : tmp, *to = pass == 0 ? tmp : edges;
+		int shift = pass == 0 ? 0 : 32;
+		memset(count, 0, sizeof *count * ((size_t)n + 1));
+		for (int i = 0; i < ne; i++)
+			count[(uint32_t)(from[i].key >> shift)]++;
+		for (int v = 0, at = 0; v < n; v++) {
+			int c = count[v];
+			count[v] = at;
+			at += c;
+		}
+		for (int i = 0; i < ne; i++)
+			to[count[(uint32_t)(from[i].key >> shift)]++] = from[i];
+	}
+	free(count);
+	return 0;
 }
 
 /* Checks a link given as directed edges from[i] -> to[i]: 1 when they
@@ -563,7 +582,15 @@ static mlod_result build(mlod_bgm *g, const mlod_character *c, const mlod_instan
 			int lo = a < b ? a : b, hi = a < b ? b : a;
 			edges[ne++] = (struct edge_rec){((uint64_t)(uint32_t)lo << 32) | (uint32_t)hi, f, e, a < b};
 		}
-	qsort(edges, (size_t)ne, sizeof *edges, edge_order);
+	{
+		struct edge_rec *tmp = malloc(sizeof *tmp * ((size_t)ne + 1));
+		int bad = !tmp || sort_edges(edges, tmp, ne, g->node_count);
+		free(tmp);
+		if (bad) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building the dual graph");
+			goto done;
+		}
+	}
 	for (int i = 0; i < ne;) {
 		int j = i;
 		while (j < ne && edges[j].key == edges[i].key)

@@ -98,7 +98,7 @@ struct mlod_bgm {
 	float *skin;
 	double *rquad;          /* per node BGM_RQUAD doubles: its posed quadrics pulled back
 	                         * into bind space with its influences (bgm_quadric_pullback;
-	                         * -1 first until bgm_quadric_rest needs them), then the sum
+	                         * NaN first until bgm_quadric_rest needs them), then the sum
 	                         * over poses of their traces */
 	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
 	double skin_norm;       /* collapse.c: the largest Frobenius norm of a skin matrix's

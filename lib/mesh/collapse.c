@@ -77,14 +77,28 @@
 #define BLOCKED(op) (1u << (op))       /* opstate: refused when last planned */
 #define QUEUED(op) (16u << (op))       /* opstate: has an entry in the heap */
 #define ALL_BLOCKED 15u
+/* opstate of a dead face: its queue entries are dropped when popped
+ * (read here rather than the face's death, a cache miss in a large
+ * mesh). No live face has every bit: an op is never both blocked and
+ * queued. */
+#define DEAD 255u
 
-typedef struct bgm_heap_entry {
+/* A queued operation, as the heap hands it back. */
+typedef struct heap_entry {
 	double key;
 	int face;
 	int op;
 	int weak;   /* key is lower_key's bind-pose bound: exact_bound comes next */
 	int memo;   /* into heap.memo, or -1 */
 } heap_entry;
+
+/* As the heap stores it: 16 bytes, four children to a 64-byte line
+ * (tag: op in bits 0-1, weak in bit 2, memo + 1 above). */
+struct bgm_heap_entry {
+	double key;
+	int face;
+	unsigned tag;
+};
 
 /* What the exact posed cost of an operation's placements came to. It
  * depends only on the collapsed vertices (quadrics, positions and
@@ -128,20 +142,24 @@ static void memo_release(struct bgm_heap *h, int i)
 	h->memo_free = i;
 }
 
-static int entry_less(const heap_entry *a, const heap_entry *b)
+/* The queue's order: key, then face, then op (a total order, so the
+ * operations come out in the same order whatever the heap's shape). */
+static int entry_less(const struct bgm_heap_entry *a, const struct bgm_heap_entry *b)
 {
 	return a->key < b->key ||
-	       (a->key == b->key && (a->face < b->face || (a->face == b->face && a->op < b->op)));
+	       (a->key == b->key && (a->face < b->face || (a->face == b->face && (a->tag & 3u) < (b->tag & 3u))));
 }
 
+/* A 4-ary heap: half the levels of a binary one, its entries' cache
+ * misses being what a large mesh's collapses wait on. */
 static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak, int memo_slot)
 {
 	if (bgm_grow((void **)&h->e, &h->cap, h->count + 1, sizeof *h->e))
 		return -1;
 	int i = h->count++;
-	heap_entry x = {key, face, op, weak, memo_slot};
+	struct bgm_heap_entry x = {key, face, (unsigned)op | (weak ? 4u : 0u) | (unsigned)(memo_slot + 1) << 3};
 	while (i > 0) {
-		int p = (i - 1) / 2;
+		int p = (i - 1) / 4;
 		if (!entry_less(&x, &h->e[p]))
 			break;
 		h->e[i] = h->e[p];
@@ -153,22 +171,24 @@ static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak,
 
 static heap_entry heap_pop(struct bgm_heap *h)
 {
-	heap_entry top = h->e[0], x = h->e[--h->count];
-	int i = 0;
+	struct bgm_heap_entry t = h->e[0], x = h->e[--h->count];
+	int i = 0, n = h->count;
 	for (;;) {
-		int l = 2 * i + 1, r = l + 1, m = i;
-		const heap_entry *best = &x;
-		if (l < h->count && entry_less(&h->e[l], best))
-			m = l, best = &h->e[l];
-		if (r < h->count && entry_less(&h->e[r], best))
-			m = r;
-		if (m == i)
+		int c = 4 * i + 1, m = c;
+		if (c >= n)
+			break;
+		int end = c + 4 < n ? c + 4 : n;
+		for (int j = c + 1; j < end; j++)
+			if (entry_less(&h->e[j], &h->e[m]))
+				m = j;
+		if (!entry_less(&h->e[m], &x))
 			break;
 		h->e[i] = h->e[m];
 		i = m;
 	}
-	if (h->count > 0)
+	if (n > 0)
 		h->e[i] = x;
+	heap_entry top = {t.key, t.face, (int)(t.tag & 3u), (int)(t.tag >> 2 & 1u), (int)(t.tag >> 3) - 1};
 	return top;
 }
 
@@ -346,10 +366,33 @@ static double area_sq(const double *a, const double *b, const double *c)
  * sums them. */
 static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 {
-	for (int k = 0; k < 10 * g->pose_count; k++) {
-		Q[k] = 0.0;
-		for (int j = 0; j < pl->k; j++)
-			Q[k] += g->quadric[((size_t)pl->v[j] * (size_t)g->pose_count) * 10 + (size_t)k];
+	/* Each sum from 0 in the vertices' order (the same bits whatever
+	 * loop makes it). */
+	size_t n = 10 * (size_t)g->pose_count;
+	const double *a = g->quadric + (size_t)pl->v[0] * n, *b = pl->k > 1 ? g->quadric + (size_t)pl->v[1] * n : NULL;
+	if (pl->k == 3) {
+		const double *c = g->quadric + (size_t)pl->v[2] * n;
+		for (size_t k = 0; k < n; k++) {
+			double s = 0.0;
+			s += a[k];
+			s += b[k];
+			s += c[k];
+			Q[k] = s;
+		}
+	} else if (pl->k == 2) {
+		for (size_t k = 0; k < n; k++) {
+			double s = 0.0;
+			s += a[k];
+			s += b[k];
+			Q[k] = s;
+		}
+	} else {
+		for (size_t k = 0; k < n; k++) {
+			double s = 0.0;
+			for (int j = 0; j < pl->k; j++)
+				s += g->quadric[(size_t)pl->v[j] * n + k];
+			Q[k] = s;
+		}
 	}
 }
 
@@ -861,7 +904,8 @@ static int grow_face_arrays(mlod_bgm *g)
 		unsigned char *b = realloc(g->opstate, (size_t)g->face_cap);
 		if (!b)
 			return -1;
-		memset(b + g->opstate_cap, 0, (size_t)(g->face_cap - g->opstate_cap));
+		for (int f = g->opstate_cap; f < g->face_cap; f++)
+			b[f] = f < g->face_count && g->faces[f].death != BGM_ALIVE ? DEAD : 0;
 		g->opstate = b;
 		g->opstate_cap = g->face_cap;
 	}
@@ -883,6 +927,13 @@ static int same_influences(const mlod_influences *x, const mlod_influences *y)
 		if (x->joints[i] != y->joints[i] || x->weights[i] != y->weights[i])
 			return 0;
 	return 1;
+}
+
+/* fmax without the library call (the same value: NaN gives the other
+ * argument; the arguments here are never zeros of both signs). */
+static inline double max_d(double a, double b)
+{
+	return a != a ? b : b != b ? a : a > b ? a : b;
 }
 
 /* A lower bound of the summed posed error (not normalised) of any
@@ -926,7 +977,7 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 			for (int i = 0; i < 3; i++)
 				for (int e = 0; e < 3; e++)
 					l += (double)g->skin[12 * m + 4 * (size_t)i + (size_t)e] * g->skin[12 * m + 4 * (size_t)i + (size_t)e];
-			g->skin_norm = fmax(g->skin_norm, sqrt(l));
+			g->skin_norm = max_d(g->skin_norm, sqrt(l));
 		}
 	}
 	const double *qv[3];
@@ -953,16 +1004,20 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 				d += (z[j][i] - c[i]) * (z[j][i] - c[i]);
 				a += z[j][i] * z[j][i];
 			}
-			spread = fmax(spread, d);
-			far = fmax(far, a);
+			spread = max_d(spread, d);
+			far = max_d(far, a);
 		}
 		double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
 		double q[10];
-		for (int e = 0; e < 10; e++)
-			q[e] = qv[0][10 * p + (size_t)e];
-		for (int i = 1; i < k; i++)
-			for (int e = 0; e < 10; e++)
-				q[e] += qv[i][10 * p + (size_t)e];
+		const double *q0 = qv[0] + 10 * p, *q1 = k > 1 ? qv[1] + 10 * p : NULL, *q2 = k > 2 ? qv[2] + 10 * p : NULL;
+		for (int e = 0; e < 10; e++) {
+			double t = q0[e];
+			if (q1)
+				t += q1[e];
+			if (q2)
+				t += q2[e];
+			q[e] = t;
+		}
 		double tr = q[0] + q[4] + q[7];
 		if (!(tr > 0.0) || !isfinite(tr))
 			continue;
@@ -981,7 +1036,7 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 		val += mu * dy - mu * R * R;
 		/* Rounding: the terms of the quadric's value at a point within
 		 * R of c, far above the errors of the sums here and in plan(). */
-		double ym = fmax(fmax(fabs(c[0]), fabs(c[1])), fabs(c[2])) + R;
+		double ym = max_d(max_d(fabs(c[0]), fabs(c[1])), fabs(c[2])) + R;
 		double mag = fabs(q[9]) + 2.0 * (fabs(q[3]) + fabs(q[6]) + fabs(q[8])) * ym +
 		             (fabs(q[0]) + fabs(q[4]) + fabs(q[7]) + 2.0 * (fabs(q[1]) + fabs(q[2]) + fabs(q[5]))) * ym * ym;
 		val -= 1e-12 * mag;
@@ -1341,6 +1396,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	for (int j = 0; j < pl->nf; j++) {
 		bgm_face *f = &g->faces[pl->faces[j]];
 		f->death = stamp;
+		g->opstate[pl->faces[j]] = DEAD;
 		for (int k = 0; k < 3; k++)
 			bgm_inc_remove(g, f->n[k], pl->faces[j]);
 		g->removed[g->removed_len + j] = pl->faces[j];
@@ -1463,7 +1519,8 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			else if (g->record_count == g->swept)
 				break;
 			g->swept = g->record_count;
-			memset(g->opstate, 0, (size_t)g->opstate_cap);
+			for (int f = 0; f < g->opstate_cap; f++)
+				g->opstate[f] = f < g->face_count && g->faces[f].death != BGM_ALIVE ? DEAD : 0;
 			for (int f = 0; f < g->face_count; f++)
 				if (g->faces[f].death == BGM_ALIVE && push_face(g, f, scratch)) {
 					r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
@@ -1472,7 +1529,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			continue;
 		}
 		heap_entry e = heap_pop(&g->heap);
-		if (g->faces[e.face].death != BGM_ALIVE) {
+		if (g->opstate[e.face] == DEAD) {
 			memo_release(&g->heap, e.memo);
 			continue;
 		}

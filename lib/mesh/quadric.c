@@ -92,7 +92,7 @@ static void edge_quadric(const double *a, const double *b, const double *n, doub
 }
 
 /* The blended 3x4 matrix of pose p for influences inf. */
-static void blend(const mlod_bgm *g, int p, const mlod_influences *inf, double *M)
+static inline void blend(const mlod_bgm *g, int p, const mlod_influences *inf, double *M)
 {
 	const float *S = g->skin + (size_t)p * (size_t)(g->joint_count > 0 ? g->joint_count : 1) * 12;
 	if (g->joint_count == 0 || inf->count == 0) {
@@ -109,13 +109,13 @@ static void blend(const mlod_bgm *g, int p, const mlod_influences *inf, double *
 	}
 }
 
-static void apply(const double *M, const double *x, double *y)
+static inline void apply(const double *M, const double *x, double *y)
 {
 	for (int r = 0; r < 3; r++)
 		y[r] = M[4 * r] * x[0] + M[4 * r + 1] * x[1] + M[4 * r + 2] * x[2] + M[4 * r + 3];
 }
 
-static double eval(const double *q, const double *x)
+static inline double eval(const double *q, const double *x)
 {
 	return q[0] * x[0] * x[0] + 2 * q[1] * x[0] * x[1] + 2 * q[2] * x[0] * x[2] + 2 * q[3] * x[0] +
 	       q[4] * x[1] * x[1] + 2 * q[5] * x[1] * x[2] + 2 * q[6] * x[1] + q[7] * x[2] * x[2] + 2 * q[8] * x[2] + q[9];
@@ -135,10 +135,16 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	/* Per face, in the pose at hand: bgm_face_normal of its corners in
 	 * order, and that normal's length (computed on first use, -1 before). */
 	double *fn = malloc(sizeof(double) * 4 * (size_t)g->face_count + 1);
+	/* One pose's quadrics, node after node: the faces add into this
+	 * small array (not into g->quadric, where a node's poses sit
+	 * together and one pose's nodes are P * 10 doubles apart, a cache
+	 * miss for nearly every add on a large mesh), which is then copied
+	 * out. Each node's sum is made in the same order from the same 0. */
+	double *acc = malloc(sizeof(double) * 10 * (size_t)g->node_count + 1);
 	g->skin = malloc(sizeof(float) * 12 * (size_t)J * (size_t)P);
 	g->quadric = calloc((size_t)g->node_cap * (size_t)P * 10, sizeof *g->quadric);
 	g->rquad = malloc(sizeof *g->rquad * (size_t)g->node_cap * BGM_RQUAD);
-	if (!mats || !rest || !local || !posed || !fn || !g->skin || !g->quadric || !g->rquad) {
+	if (!mats || !rest || !local || !posed || !fn || !acc || !g->skin || !g->quadric || !g->rquad) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
 		goto done;
 	}
@@ -205,12 +211,13 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 		}
 		for (int f = 0; f < g->face_count; f++)
 			fn[4 * f + 3] = -1.0;
+		memset(acc, 0, sizeof(double) * 10 * (size_t)g->node_count);
 		for (int f = 0; f < g->face_count; f++) {
 			const bgm_face *F = &g->faces[f];
 			double q[10] = {0};
 			plane_quadric(posed + 3 * F->n[0], posed + 3 * F->n[1], posed + 3 * F->n[2], q);
 			for (int i = 0; i < 3; i++) {
-				double *Q = g->quadric + ((size_t)F->n[i] * (size_t)P + (size_t)p) * 10;
+				double *Q = acc + (size_t)F->n[i] * 10;
 				for (int k = 0; k < 10; k++)
 					Q[k] += q[k];
 			}
@@ -245,12 +252,14 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 					edge_quadric(a, b, n2, q2);
 				int ends[2] = {F->n[e], F->n[(e + 1) % 3]};
 				for (int i = 0; i < 2; i++) {
-					double *Q = g->quadric + ((size_t)ends[i] * (size_t)P + (size_t)p) * 10;
+					double *Q = acc + (size_t)ends[i] * 10;
 					for (int k = 0; k < 10; k++)
 						Q[k] += q2[k];
 				}
 			}
 		}
+		for (int v = 0; v < g->node_count; v++)
+			memcpy(g->quadric + ((size_t)v * (size_t)P + (size_t)p) * 10, acc + (size_t)v * 10, 10 * sizeof *acc);
 	}
 	free(used);
 	for (int v = 0; v < g->node_count; v++)
@@ -261,6 +270,7 @@ done:
 	free(local);
 	free(posed);
 	free(fn);
+	free(acc);
 	return r;
 }
 
@@ -284,14 +294,17 @@ void bgm_quadric_rest_reset(mlod_bgm *g, int v)
 	double *r = g->rquad + (size_t)v * BGM_RQUAD, t = 0.0;
 	for (int p = 0; p < g->pose_count; p++)
 		t += q[10 * p] + q[10 * p + 4] + q[10 * p + 7];
-	r[0] = -1.0;
+	r[0] = NAN; /* not computed yet: bgm_quadric_rest */
 	r[10] = t;
 }
 
 const double *bgm_quadric_rest(mlod_bgm *g, int v)
 {
 	double *r = g->rquad + (size_t)v * BGM_RQUAD;
-	if (r[0] < 0.0)
+	/* NaN marks it unknown: a computed r[0] may round below 0 (a
+	 * direction the planes leave free), which must not recompute it at
+	 * every use. */
+	if (isnan(r[0]))
 		bgm_quadric_pullback(g, g->quadric + (size_t)v * (size_t)g->pose_count * 10, &g->inf[v], r);
 	return r;
 }
@@ -301,31 +314,40 @@ const double *bgm_quadric_rest(mlod_bgm *g, int v)
  * quadrics q pulled back into bind space. */
 void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influences *inf, double *h)
 {
-	double H[4][4] = {{0}};
+	/* H's upper triangle, packed as a quadric: every entry a sum over
+	 * poses from 0, each term in the order of the matrix products
+	 * T = Q [M; 0 0 0 1] and [M; 0 0 0 1]^T T (the last row's zeros left
+	 * out), written out entry by entry. */
+	double H[10] = {0};
 	for (int p = 0; p < g->pose_count; p++) {
-		double M[12], Q[4][4], T[4][4];
+		double M[12];
 		const double *a = q + 10 * p;
 		blend(g, p, inf, M);
-		int k = 0;
-		for (int i = 0; i < 4; i++)
-			for (int j = i; j < 4; j++)
-				Q[i][j] = Q[j][i] = a[k++];
-		/* T = Q * [M; 0 0 0 1], H += [M; 0 0 0 1]^T * T (the terms of the
-		 * last row's zeros left out). */
-		for (int i = 0; i < 4; i++) {
-			for (int j = 0; j < 3; j++)
-				T[i][j] = Q[i][0] * M[j] + Q[i][1] * M[4 + j] + Q[i][2] * M[8 + j];
-			T[i][3] = Q[i][0] * M[3] + Q[i][1] * M[7] + Q[i][2] * M[11] + Q[i][3];
-		}
-		for (int i = 0; i < 3; i++)
-			for (int j = i; j < 4; j++)
-				H[i][j] += M[i] * T[0][j] + M[4 + i] * T[1][j] + M[8 + i] * T[2][j];
-		H[3][3] += M[3] * T[0][3] + M[7] * T[1][3] + M[11] * T[2][3] + T[3][3];
+		double t00 = a[0] * M[0] + a[1] * M[4] + a[2] * M[8];
+		double t01 = a[0] * M[1] + a[1] * M[5] + a[2] * M[9];
+		double t02 = a[0] * M[2] + a[1] * M[6] + a[2] * M[10];
+		double t10 = a[1] * M[0] + a[4] * M[4] + a[5] * M[8];
+		double t11 = a[1] * M[1] + a[4] * M[5] + a[5] * M[9];
+		double t12 = a[1] * M[2] + a[4] * M[6] + a[5] * M[10];
+		double t20 = a[2] * M[0] + a[5] * M[4] + a[7] * M[8];
+		double t21 = a[2] * M[1] + a[5] * M[5] + a[7] * M[9];
+		double t22 = a[2] * M[2] + a[5] * M[6] + a[7] * M[10];
+		double t03 = a[0] * M[3] + a[1] * M[7] + a[2] * M[11] + a[3];
+		double t13 = a[1] * M[3] + a[4] * M[7] + a[5] * M[11] + a[6];
+		double t23 = a[2] * M[3] + a[5] * M[7] + a[7] * M[11] + a[8];
+		double t33 = a[3] * M[3] + a[6] * M[7] + a[8] * M[11] + a[9];
+		H[0] += M[0] * t00 + M[4] * t10 + M[8] * t20;
+		H[1] += M[0] * t01 + M[4] * t11 + M[8] * t21;
+		H[2] += M[0] * t02 + M[4] * t12 + M[8] * t22;
+		H[3] += M[0] * t03 + M[4] * t13 + M[8] * t23;
+		H[4] += M[1] * t01 + M[5] * t11 + M[9] * t21;
+		H[5] += M[1] * t02 + M[5] * t12 + M[9] * t22;
+		H[6] += M[1] * t03 + M[5] * t13 + M[9] * t23;
+		H[7] += M[2] * t02 + M[6] * t12 + M[10] * t22;
+		H[8] += M[2] * t03 + M[6] * t13 + M[10] * t23;
+		H[9] += M[3] * t03 + M[7] * t13 + M[11] * t23 + t33;
 	}
-	int k = 0;
-	for (int i = 0; i < 4; i++)
-		for (int j = i; j < 4; j++)
-			h[k++] = H[i][j];
+	memcpy(h, H, sizeof H);
 }
 
 double bgm_quadric_eval(const double *h, const double *x)
