@@ -2,6 +2,7 @@
  * packwrite.c: gathers the levels of every layer and writes the .mlod
  * pack (mlod_pack_write.h; the layout is rt/mlod_pack.h's).
  */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -2016,13 +2017,16 @@ static double sigma_bound3(const mlod_mat4 *w)
  * a key of g off by angle a moves j's points by at most a times that. The
  * shifts go up one at a time, leaves first, round after round, while every
  * joint's sum of angle times reach stays within its budget: share *
- * error plus that sum at shift 0. */
-static mlod_result rotq_shifts(struct ctx *x, const mlod_clip *orig, const mlod_clip *lvl, double error, int *shift)
+ * error plus that sum at shift 0. tgrid gets each joint's translation
+ * grid exponent (INT_MIN: exact), raised in the same rounds against the
+ * same sums. */
+static mlod_result rotq_shifts(struct ctx *x, const mlod_clip *orig, const mlod_clip *lvl, double error, int *shift,
+                               int *tgrid)
 {
 	const mlod_skeleton *sk = &x->v.skeleton;
 	int nj = sk->joint_count;
 	for (int j = 0; j < nj; j++)
-		shift[j] = 0;
+		shift[j] = 0, tgrid[j] = INT_MIN;
 	if (!(error > 0.0) || nj <= 0 || orig->channel_count <= 0)
 		return MLOD_OK;
 	mlod_motion_options mo = {0};
@@ -2036,8 +2040,10 @@ static mlod_result rotq_shifts(struct ctx *x, const mlod_clip *orig, const mlod_
 	mlod_trs *loc = malloc(sizeof *loc * (size_t)nj);
 	mlod_mat4 *w = malloc(sizeof *w * (size_t)nj);
 	double *reach = calloc((size_t)nj * nj, sizeof *reach), *budget = calloc((size_t)nj, sizeof *budget);
-	unsigned char *rot = calloc((size_t)nj, 1);
-	if (!t || !loc || !w || !reach || !budget || !rot) {
+	double *tmax = calloc((size_t)nj, sizeof *tmax), *ps = calloc((size_t)nj, sizeof *ps);
+	unsigned char *rot = calloc((size_t)nj, 1), *tr = calloc((size_t)nj, 1);
+	int *tl = calloc((size_t)nj, sizeof *tl), *tbase = calloc((size_t)nj, sizeof *tbase);
+	if (!t || !loc || !w || !reach || !budget || !rot || !tmax || !ps || !tr || !tl || !tbase) {
 		r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
@@ -2047,12 +2053,36 @@ static mlod_result rotq_shifts(struct ctx *x, const mlod_clip *orig, const mlod_
 		if (lvl->channels[i].path == MLOD_PATH_ROTATION && lvl->channels[i].interp != MLOD_INTERP_CUBICSPLINE &&
 		    lvl->channels[i].joint >= 0 && lvl->channels[i].joint < nj)
 			rot[lvl->channels[i].joint] = 1;
+	/* translations: grid 2^(tbase + tl), tbase the exponent of the ulp of
+	 * the channel's largest |value| (tl 0: exact) */
+	for (int i = 0; i < lvl->channel_count; i++) {
+		const mlod_channel *ch = &lvl->channels[i];
+		if (ch->path != MLOD_PATH_TRANSLATION || ch->interp == MLOD_INTERP_CUBICSPLINE || ch->joint < 0 ||
+		    ch->joint >= nj)
+			continue;
+		tr[ch->joint] = 1;
+		for (int k = 0; k < 3 * ch->key_count; k++)
+			tmax[ch->joint] = fabs((double)ch->values[k]) > tmax[ch->joint] ? fabs((double)ch->values[k]) : tmax[ch->joint];
+	}
+	for (int j = 0; j < nj; j++) {
+		int ex = 0;
+		frexp(tmax[j], &ex);
+		tbase[j] = ex - 24;
+		if (!isfinite(tmax[j]) || !(tmax[j] > 0.0))
+			tr[j] = 0;
+	}
+	if (n == 0)
+		goto done; /* nothing to measure the reach on: shifts 0 */
 	for (int i = 0; i < n; i++) {
 		mlod_pose_rest(sk, loc);
 		mlod_clip_sample(orig, t[i], loc);
 		mlod_pose_world(sk, loc, w);
 		for (int j = 0; j < nj; j++) {
 			double rad = pd * sigma_bound3(&w[j]);
+			int pa = sk->joints[j].parent;
+			double sp = sigma_bound3(pa < 0 ? &sk->joints[j].base : &w[pa]);
+			if (!(sp <= ps[j]))
+				ps[j] = isfinite(sp) ? sp : INFINITY;
 			for (int g = j; g >= 0; g = sk->joints[g].parent) {
 				double d = 0.0;
 				for (int c = 0; c < 3; c++)
@@ -2064,7 +2094,7 @@ static mlod_result rotq_shifts(struct ctx *x, const mlod_clip *orig, const mlod_
 		}
 	}
 	for (size_t i = 0; i < (size_t)nj * nj; i++)
-		if (!isfinite(reach[i]))
+		if (!isfinite(reach[i]) || (i < (size_t)nj && !isfinite(ps[i])))
 			goto done; /* shifts 0 */
 	for (int j = 0; j < nj; j++) {
 		double b = MLOD_PACK_ROTQ_SHARE * error;
@@ -2073,30 +2103,40 @@ static mlod_result rotq_shifts(struct ctx *x, const mlod_clip *orig, const mlod_
 				b += a0 * reach[(size_t)g * nj + j];
 		budget[j] = b;
 	}
+	/* A translation of g off by the grid's half step per component moves
+	 * g and every joint below it by at most sqrt(3) 2^(e - 1) times the
+	 * scale of g's parent's world matrix (its base for a root). */
 	for (int changed = 1; changed;) {
 		changed = 0;
-		for (int g = nj - 1; g >= 0; g--) {
-			if (!rot[g] || shift[g] >= MLOD_PACK_ROTQ_SHIFT_MAX)
-				continue;
-			shift[g]++;
-			int ok = 1;
-			for (int j = 0; j < nj && ok; j++) {
-				if (!(reach[(size_t)g * nj + j] > 0.0) && j != g)
-					continue; /* not below g */
-				double e = 0.0;
-				for (int a = j; a >= 0; a = sk->joints[a].parent)
-					if (rot[a])
-						e += mlod_pack_rotq_angle(shift[a]) * reach[(size_t)a * nj + j];
-				ok = e <= budget[j];
+		for (int g = nj - 1; g >= 0; g--)
+			for (int kind = 0; kind < 2; kind++) {
+				if (kind == 0 ? !rot[g] || shift[g] >= MLOD_PACK_ROTQ_SHIFT_MAX : !tr[g] || tl[g] >= 24)
+					continue;
+				(kind == 0 ? shift : tl)[g]++;
+				int ok = 1;
+				for (int j = 0; j < nj && ok; j++) {
+					if (!(reach[(size_t)g * nj + j] > 0.0) && j != g)
+						continue; /* not below g */
+					double e = 0.0;
+					for (int a = j; a >= 0; a = sk->joints[a].parent) {
+						if (rot[a])
+							e += mlod_pack_rotq_angle(shift[a]) * reach[(size_t)a * nj + j];
+						if (tr[a] && tl[a] > 0)
+							e += sqrt(3.0) * ldexp(1.0, tbase[a] + tl[a] - 1) * ps[a] * (1.0 + 1e-9);
+					}
+					ok = e <= budget[j];
+				}
+				if (ok)
+					changed = 1;
+				else
+					(kind == 0 ? shift : tl)[g]--;
 			}
-			if (ok)
-				changed = 1;
-			else
-				shift[g]--;
-		}
 	}
+	for (int j = 0; j < nj; j++)
+		tgrid[j] = tr[j] && tl[j] > 0 ? tbase[j] + tl[j] : INT_MIN;
 done:
-	free(t), free(loc), free(w), free(reach), free(budget), free(rot);
+	free(t), free(loc), free(w), free(reach), free(budget), free(rot), free(tmax), free(ps), free(tr), free(tl),
+	    free(tbase);
 	mlod_clip_free(&common);
 	return r;
 }
@@ -2133,7 +2173,10 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 	cb_add(&cb, MLOD_STREAM_CHAN, (uint32_t)n, sizeof *recs, recs, 0);
 	/* the rotation keys' lattice per joint: level 0 the finest */
 	int nj = x->v.skeleton.joint_count, *shift = calloc((size_t)nj + 1, sizeof *shift);
-	if (!shift) {
+	int *tgrid = malloc(sizeof *tgrid * ((size_t)nj + 1));
+	for (int j = 0; tgrid && j < nj; j++)
+		tgrid[j] = INT_MIN;
+	if (!shift || !tgrid) {
 		cb.fail = 1;
 	} else if (item < x->v.clip_count && !x->clips[item].no_shifts) {
 		/* one set of shifts for every level of the clip, from the
@@ -2145,9 +2188,9 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		emin = cl->error0 < emin ? cl->error0 : emin;
 		for (int l = 0; l < cl->count; l++)
 			emin = cl->error[l] < emin ? cl->error[l] : emin;
-		mlod_result sr = rotq_shifts(x, &x->v.clips[item], &x->v.clips[item], emin, shift);
+		mlod_result sr = rotq_shifts(x, &x->v.clips[item], &x->v.clips[item], emin, shift, tgrid);
 		if (sr != MLOD_OK) {
-			free(shift), free(recs), free(arr), free(cnt), cb_free(&cb);
+			free(shift), free(tgrid), free(recs), free(arr), free(cnt), cb_free(&cb);
 			return sr;
 		}
 	}
@@ -2321,17 +2364,20 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 				if (base->ch[j].joint == ic->joint && base->ch[j].path == ic->path &&
 				    base->ch[j].interp != MLOD_INTERP_CUBICSPLINE)
 					bc = &base->ch[j];
-			memcpy(ic->vec, ch->values, sizeof(float) * 3 * keys);
+			/* a translation on its joint's grid (rotq_shifts), if any */
+			int e = ch->path == MLOD_PATH_TRANSLATION && ic->joint < (uint32_t)nj ? tgrid[ic->joint] : INT_MIN;
+			for (size_t c = 0; c < 3 * (size_t)keys; c++)
+				ic->vec[c] = e == INT_MIN ? ch->values[c] : (float)ldexp(rint(ldexp((double)ch->values[c], -e)), e);
 			for (uint32_t v = 0; v < keys; v++) {
 				long b = img_key(bc, ic->times[v]);
 				for (int c = 0; c < 3; c++) {
 					uint32_t a, bb;
-					memcpy(&a, ch->values + 3 * (size_t)v + c, 4);
+					memcpy(&a, ic->vec + 3 * (size_t)v + c, 4);
 					if (b >= 0) {
 						memcpy(&bb, bc->vec + 3 * b + c, 4);
 						vd[3 * at_vd + c] = a - bb;
 					} else {
-						v3[3 * at_v + c] = ch->values[3 * (size_t)v + c];
+						v3[3 * at_v + c] = ic->vec[3 * (size_t)v + c];
 					}
 				}
 				if (b >= 0)
@@ -2342,6 +2388,7 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		}
 	}
 	free(shift);
+	free(tgrid);
 	cb_add(&cb, MLOD_STREAM_ROTQ, (uint32_t)at_a, 8, q, 0);
 	cb_add(&cb, MLOD_STREAM_ROTD, (uint32_t)at_d, 8, qd, 0);
 	cb_add(&cb, MLOD_STREAM_ROTF, (uint32_t)nf, 16, rf, 0);
