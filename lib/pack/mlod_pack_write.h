@@ -168,6 +168,20 @@ double mlod_pack_oct_bound(int bits);
  * 4.8 microseconds at t = 5 s); the writer prefers a step that is exact. */
 #define MLOD_PACK_TICK_TOLERANCE (1.0 / 1048576.0)
 #define MLOD_PACK_ROTQ_ANGLE 1.3304e-4 /* radians, 2 asin(sqrt(19) / 65534) rounded up; 0.0076 degrees */
+/* Format 4.0: the rotation keys of every motion level may go on a coarser
+ * lattice per joint (steps of 2^shift lattice units, shift 0 to
+ * MLOD_PACK_ROTQ_SHIFT_MAX), each key then within 2 asin(sqrt(19) h 2^shift)
+ * rad (mlod_pack_rotq_angle). The writer picks the shifts from the clip's
+ * posed joints so that the shifts' part of every joint's point error
+ * (mlod_motion_point_error, the angle times the joint's distance to each
+ * rotated ancestor plus its point distance) stays within
+ * MLOD_PACK_ROTQ_SHARE times the level's TOC error on top of what shift 0
+ * gives (MLOD_PACK_ROTQ_ANGLE's share), with the joints' non-cubic
+ * translations rounded to power-of-two grids within the same sums; one
+ * set per clip (from the smallest TOC error of its levels), kept where the
+ * clip's MOTION chunks get smaller. */
+#define MLOD_PACK_ROTQ_SHARE 0.25
+double mlod_pack_rotq_angle(int shift);
 void mlod_pack_oct_decode(const int16_t in[2], float n[3]);
 
 /* A value within [min, min + 65535 * scale] to u16: q = round((v - min) /

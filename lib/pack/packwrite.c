@@ -2,6 +2,7 @@
  * packwrite.c: gathers the levels of every layer and writes the .mlod
  * pack (mlod_pack_write.h; the layout is rt/mlod_pack.h's).
  */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -329,6 +330,7 @@ struct clip_levels {
 	const mlod_clip *level0;   /* the input clip, or its reduction (motion_level0) */
 	float error0;              /* level 0's joint position error against the input clip */
 	int count;                 /* levels >= 1 */
+	int no_shifts;             /* its rotation keys all at shift 0 (motion_shift_choice) */
 	const mlod_clip *clip[MLOD_PACK_MAX_MOTION_LEVELS];
 	float error[MLOD_PACK_MAX_MOTION_LEVELS];
 };
@@ -1833,9 +1835,29 @@ static long rotq_big(const long *n, int big)
  * other three (as lib/motion's levels are), it comes back exactly (up to
  * the sign); else r is normalised, big is its largest component, made
  * non-negative, and the three go to the nearest lattice points. */
-static void rotq_encode(const float *r, int16_t *out)
+static void rotq_encode(const float *r, int16_t *out, int shift)
 {
 	long n[4], m[4];
+	if (shift > 0) { /* the normalised key, its three smaller components on the coarser lattice */
+		double len = 0.0, u[4];
+		int big = 0;
+		for (int c = 0; c < 4; c++)
+			len += (double)r[c] * r[c];
+		len = len > 0.0 ? sqrt(len) : 1.0;
+		for (int c = 0; c < 4; c++) {
+			u[c] = r[c] / len;
+			big = fabs(u[c]) > fabs(u[big]) ? c : big;
+		}
+		double sign = u[big] < 0 ? -1.0 : 1.0, step = ldexp(1.0, shift);
+		long lim = 32767L >> shift;
+		for (int c = 0, i = 0; c < 4; c++)
+			if (c != big) {
+				long k = lrint(sign * u[c] * 32767.0 / step);
+				out[i++] = (int16_t)(k > lim ? lim : k < -lim ? -lim : k);
+			}
+		out[3] = (int16_t)(big | shift << 2);
+		return;
+	}
 	int order[4] = {0, 1, 2, 3};
 	for (int c = 0; c < 4; c++) {
 		double e = r[c] > 1 ? 1 : r[c] < -1 ? -1 : r[c];
@@ -1924,7 +1946,7 @@ static long img_key(const struct img_chan *c, float t)
 /* A 'ROTQ' key on its base's key bn: the lattice point r is (else the
  * nearest to r normalised), with the sign nearer bn, minus bn, each
  * component wrapped to 16 bits (the reader adds bn back). */
-static void rotq_encode_on(const float *r, const int16_t *bn, int16_t *out)
+static void rotq_encode_on(const float *r, const int16_t *bn, int16_t *out, int shift)
 {
 	long t[4];
 	int lattice = 1;
@@ -1944,8 +1966,179 @@ static void rotq_encode_on(const float *r, const int16_t *bn, int16_t *out)
 	long dot = 0;
 	for (int c = 0; c < 4; c++)
 		dot += t[c] * bn[c];
+	if (shift > 0) { /* the base key itself when within the shift's angle of r */
+		double lr = 0.0, lb = 0.0, d2 = 0.0, sd = 0.0;
+		for (int c = 0; c < 4; c++)
+			lr += (double)r[c] * r[c], lb += (double)bn[c] * bn[c], sd += (double)r[c] * bn[c];
+		lr = sqrt(lr), lb = sqrt(lb);
+		for (int c = 0; c < 4; c++) {
+			double e = (sd < 0 ? -r[c] : r[c]) / lr - bn[c] / lb;
+			d2 += e * e;
+		}
+		if (lr > 0.0 && lb > 0.0 && 4.0 * asin(fmin(1.0, sqrt(d2) / 2.0)) <= mlod_pack_rotq_angle(shift) * (1.0 - 1e-6)) {
+			memset(out, 0, 4 * sizeof *out);
+			return;
+		}
+	}
 	for (int c = 0; c < 4; c++)
 		out[c] = (int16_t)(uint16_t)((uint16_t)(dot < 0 ? -t[c] : t[c]) - (uint16_t)bn[c]);
+}
+
+double mlod_pack_rotq_angle(int shift)
+{
+	double h = sqrt(19.0) * ldexp(1.0, shift) / 65534.0;
+	return 2.0 * asin(h < 1.0 ? h : 1.0) * (1.0 + 1e-9);
+}
+
+/* An upper bound of the largest singular value of w's 3x3 part M: the
+ * square root of the largest absolute row sum of M^T M (Gershgorin),
+ * exact for a rotation times a uniform scale. */
+static double sigma_bound3(const mlod_mat4 *w)
+{
+	double g = 0.0;
+	for (int a = 0; a < 3; a++) {
+		double row = 0.0;
+		for (int b = 0; b < 3; b++) {
+			double d = 0.0;
+			for (int r = 0; r < 3; r++)
+				d += (double)w->m[4 * a + r] * w->m[4 * b + r];
+			row += fabs(d);
+		}
+		g = row > g ? row : g;
+	}
+	return sqrt(g);
+}
+
+/* Per joint, the lattice shift of the rotation keys of a motion level of
+ * TOC error `error` whose channels are lvl's (mlod_pack_write.h
+ * MLOD_PACK_ROTQ_SHARE): reach[g * nj + j] is the largest, over the
+ * original clip's frames and midpoints, of joint j's distance to its
+ * ancestor g (or itself) plus its point distance times its world scale;
+ * a key of g off by angle a moves j's points by at most a times that. The
+ * shifts go up one at a time, leaves first, round after round, while every
+ * joint's sum of angle times reach stays within its budget: share *
+ * error plus that sum at shift 0. tgrid gets each joint's translation
+ * grid exponent (INT_MIN: exact), raised in the same rounds against the
+ * same sums. */
+static mlod_result rotq_shifts(struct ctx *x, const mlod_clip *orig, const mlod_clip *lvl, double error, int *shift,
+                               int *tgrid)
+{
+	const mlod_skeleton *sk = &x->v.skeleton;
+	int nj = sk->joint_count;
+	for (int j = 0; j < nj; j++)
+		shift[j] = 0, tgrid[j] = INT_MIN;
+	if (!(error > 0.0) || nj <= 0 || orig->channel_count <= 0)
+		return MLOD_OK;
+	mlod_motion_options mo = {0};
+	mlod_clip common;
+	mlod_result r = mlod_motion_common_clip(orig, &mo, &common, NULL, x->err);
+	if (r != MLOD_OK)
+		return r;
+	int frames = common.channel_count > 0 ? common.channels[0].key_count : 0, n = frames > 0 ? 2 * (frames - 1) + 1 : 0;
+	double pd = motion_point_distance(x), a0 = mlod_pack_rotq_angle(0);
+	float *t = malloc(sizeof *t * ((size_t)n + 1));
+	mlod_trs *loc = malloc(sizeof *loc * (size_t)nj);
+	mlod_mat4 *w = malloc(sizeof *w * (size_t)nj);
+	double *reach = calloc((size_t)nj * nj, sizeof *reach), *budget = calloc((size_t)nj, sizeof *budget);
+	double *tmax = calloc((size_t)nj, sizeof *tmax), *ps = calloc((size_t)nj, sizeof *ps);
+	unsigned char *rot = calloc((size_t)nj, 1), *tr = calloc((size_t)nj, 1);
+	int *tl = calloc((size_t)nj, sizeof *tl), *tbase = calloc((size_t)nj, sizeof *tbase);
+	if (!t || !loc || !w || !reach || !budget || !rot || !tmax || !ps || !tr || !tl || !tbase) {
+		r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	if (n > 0)
+		mlod_motion_sample_times(common.channels[0].times, frames, 2, t);
+	for (int i = 0; i < lvl->channel_count; i++)
+		if (lvl->channels[i].path == MLOD_PATH_ROTATION && lvl->channels[i].interp != MLOD_INTERP_CUBICSPLINE &&
+		    lvl->channels[i].joint >= 0 && lvl->channels[i].joint < nj)
+			rot[lvl->channels[i].joint] = 1;
+	/* translations: grid 2^(tbase + tl), tbase the exponent of the ulp of
+	 * the channel's largest |value| (tl 0: exact) */
+	for (int i = 0; i < lvl->channel_count; i++) {
+		const mlod_channel *ch = &lvl->channels[i];
+		if (ch->path != MLOD_PATH_TRANSLATION || ch->interp == MLOD_INTERP_CUBICSPLINE || ch->joint < 0 ||
+		    ch->joint >= nj)
+			continue;
+		tr[ch->joint] = 1;
+		for (int k = 0; k < 3 * ch->key_count; k++)
+			tmax[ch->joint] = fabs((double)ch->values[k]) > tmax[ch->joint] ? fabs((double)ch->values[k]) : tmax[ch->joint];
+	}
+	for (int j = 0; j < nj; j++) {
+		int ex = 0;
+		frexp(tmax[j], &ex);
+		tbase[j] = ex - 24;
+		if (!isfinite(tmax[j]) || !(tmax[j] > 0.0))
+			tr[j] = 0;
+	}
+	if (n == 0)
+		goto done; /* nothing to measure the reach on: shifts 0 */
+	for (int i = 0; i < n; i++) {
+		mlod_pose_rest(sk, loc);
+		mlod_clip_sample(orig, t[i], loc);
+		mlod_pose_world(sk, loc, w);
+		for (int j = 0; j < nj; j++) {
+			double rad = pd * sigma_bound3(&w[j]);
+			int pa = sk->joints[j].parent;
+			double sp = sigma_bound3(pa < 0 ? &sk->joints[j].base : &w[pa]);
+			if (!(sp <= ps[j]))
+				ps[j] = isfinite(sp) ? sp : INFINITY;
+			for (int g = j; g >= 0; g = sk->joints[g].parent) {
+				double d = 0.0;
+				for (int c = 0; c < 3; c++)
+					d += ((double)w[j].m[12 + c] - w[g].m[12 + c]) * ((double)w[j].m[12 + c] - w[g].m[12 + c]);
+				d = sqrt(d) + rad;
+				if (!(d <= reach[(size_t)g * nj + j])) /* NaN too: no coarser lattice */
+					reach[(size_t)g * nj + j] = isfinite(d) ? d : INFINITY;
+			}
+		}
+	}
+	for (size_t i = 0; i < (size_t)nj * nj; i++)
+		if (!isfinite(reach[i]) || (i < (size_t)nj && !isfinite(ps[i])))
+			goto done; /* shifts 0 */
+	for (int j = 0; j < nj; j++) {
+		double b = MLOD_PACK_ROTQ_SHARE * error;
+		for (int g = j; g >= 0; g = sk->joints[g].parent)
+			if (rot[g])
+				b += a0 * reach[(size_t)g * nj + j];
+		budget[j] = b;
+	}
+	/* A translation of g off by the grid's half step per component moves
+	 * g and every joint below it by at most sqrt(3) 2^(e - 1) times the
+	 * scale of g's parent's world matrix (its base for a root). */
+	for (int changed = 1; changed;) {
+		changed = 0;
+		for (int g = nj - 1; g >= 0; g--)
+			for (int kind = 0; kind < 2; kind++) {
+				if (kind == 0 ? !rot[g] || shift[g] >= MLOD_PACK_ROTQ_SHIFT_MAX : !tr[g] || tl[g] >= 24)
+					continue;
+				(kind == 0 ? shift : tl)[g]++;
+				int ok = 1;
+				for (int j = 0; j < nj && ok; j++) {
+					if (!(reach[(size_t)g * nj + j] > 0.0) && j != g)
+						continue; /* not below g */
+					double e = 0.0;
+					for (int a = j; a >= 0; a = sk->joints[a].parent) {
+						if (rot[a])
+							e += mlod_pack_rotq_angle(shift[a]) * reach[(size_t)a * nj + j];
+						if (tr[a] && tl[a] > 0)
+							e += sqrt(3.0) * ldexp(1.0, tbase[a] + tl[a] - 1) * ps[a] * (1.0 + 1e-9);
+					}
+					ok = e <= budget[j];
+				}
+				if (ok)
+					changed = 1;
+				else
+					(kind == 0 ? shift : tl)[g]--;
+			}
+	}
+	for (int j = 0; j < nj; j++)
+		tgrid[j] = tr[j] && tl[j] > 0 ? tbase[j] + tl[j] : INT_MIN;
+done:
+	free(t), free(loc), free(w), free(reach), free(budget), free(rot), free(tmax), free(ps), free(tr), free(tl),
+	    free(tbase);
+	mlod_clip_free(&common);
+	return r;
 }
 
 /* One MOTION chunk of level k of clip item. base: the clip's level k + 1
@@ -1978,6 +2171,29 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 		                                  (uint32_t)keys, (uint32_t)a};
 	}
 	cb_add(&cb, MLOD_STREAM_CHAN, (uint32_t)n, sizeof *recs, recs, 0);
+	/* the rotation keys' lattice per joint: level 0 the finest */
+	int nj = x->v.skeleton.joint_count, *shift = calloc((size_t)nj + 1, sizeof *shift);
+	int *tgrid = malloc(sizeof *tgrid * ((size_t)nj + 1));
+	for (int j = 0; tgrid && j < nj; j++)
+		tgrid[j] = INT_MIN;
+	if (!shift || !tgrid) {
+		cb.fail = 1;
+	} else if (item < x->v.clip_count && !x->clips[item].no_shifts) {
+		/* one set of shifts for every level of the clip, from the
+		 * smallest TOC error, level 0's included: a finer level's key on
+		 * its base's then mostly stores zeros (below); per-level shifts
+		 * cost more (mlod(5)) */
+		double emin = error;
+		const struct clip_levels *cl = &x->clips[item];
+		emin = cl->error0 < emin ? cl->error0 : emin;
+		for (int l = 0; l < cl->count; l++)
+			emin = cl->error[l] < emin ? cl->error[l] : emin;
+		mlod_result sr = rotq_shifts(x, &x->v.clips[item], &x->v.clips[item], emin, shift, tgrid);
+		if (sr != MLOD_OK) {
+			free(shift), free(tgrid), free(recs), free(arr), free(cnt), cb_free(&cb);
+			return sr;
+		}
+	}
 	/* this chunk as the reader returns it: the channels */
 	motion_img_free(img);
 	img->ch = calloc((size_t)n + 1, sizeof *img->ch);
@@ -2125,10 +2341,11 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 			for (uint32_t v = 0; v < keys; v++, at_q++) {
 				long b = img_key(bc, ic->times[v]);
 				int16_t *e = b >= 0 ? qd + 4 * at_d++ : q + 4 * at_a++;
+				int sh = ic->joint < (uint32_t)nj ? shift[ic->joint] : 0;
 				if (b >= 0)
-					rotq_encode_on(ch->values + 4 * (size_t)v, bc->rot + 4 * b, e);
+					rotq_encode_on(ch->values + 4 * (size_t)v, bc->rot + 4 * b, e, sh);
 				else
-					rotq_encode(ch->values + 4 * (size_t)v, e);
+					rotq_encode(ch->values + 4 * (size_t)v, e, sh);
 				mlod_pack_rotq_key(e, b >= 0 ? bc->rot + 4 * b : NULL, v > 0 ? ic->rot + 4 * (v - 1) : NULL,
 				                   ic->rot + 4 * v);
 			}
@@ -2147,17 +2364,20 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 				if (base->ch[j].joint == ic->joint && base->ch[j].path == ic->path &&
 				    base->ch[j].interp != MLOD_INTERP_CUBICSPLINE)
 					bc = &base->ch[j];
-			memcpy(ic->vec, ch->values, sizeof(float) * 3 * keys);
+			/* a translation on its joint's grid (rotq_shifts), if any */
+			int e = ch->path == MLOD_PATH_TRANSLATION && ic->joint < (uint32_t)nj ? tgrid[ic->joint] : INT_MIN;
+			for (size_t c = 0; c < 3 * (size_t)keys; c++)
+				ic->vec[c] = e == INT_MIN ? ch->values[c] : (float)ldexp(rint(ldexp((double)ch->values[c], -e)), e);
 			for (uint32_t v = 0; v < keys; v++) {
 				long b = img_key(bc, ic->times[v]);
 				for (int c = 0; c < 3; c++) {
 					uint32_t a, bb;
-					memcpy(&a, ch->values + 3 * (size_t)v + c, 4);
+					memcpy(&a, ic->vec + 3 * (size_t)v + c, 4);
 					if (b >= 0) {
 						memcpy(&bb, bc->vec + 3 * b + c, 4);
 						vd[3 * at_vd + c] = a - bb;
 					} else {
-						v3[3 * at_v + c] = ch->values[3 * (size_t)v + c];
+						v3[3 * at_v + c] = ic->vec[3 * (size_t)v + c];
 					}
 				}
 				if (b >= 0)
@@ -2167,6 +2387,8 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 			}
 		}
 	}
+	free(shift);
+	free(tgrid);
 	cb_add(&cb, MLOD_STREAM_ROTQ, (uint32_t)at_a, 8, q, 0);
 	cb_add(&cb, MLOD_STREAM_ROTD, (uint32_t)at_d, 8, qd, 0);
 	cb_add(&cb, MLOD_STREAM_ROTF, (uint32_t)nf, 16, rf, 0);
@@ -2181,6 +2403,37 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
 	if (r == MLOD_OK && base)
 		out->c[out->n - 1].flags = MLOD_PACK_CHUNK_NESTED;
 	return r;
+}
+
+/* Per clip, whether its MOTION chunks (levels A - 1 to 0) store fewer
+ * bytes with the rotation lattice shifts or without (the shifts change
+ * the keys' bases and their sign choices, which can cost more than they
+ * save). Sets no_shifts where they do not pay. */
+static mlod_result motion_shift_choice(struct ctx *x, int A)
+{
+	for (int q = 0; q < x->v.clip_count; q++) {
+		size_t bytes[2] = {0, 0};
+		for (int pass = 0; pass < 2; pass++) {
+			motion_img img[2] = {{0, NULL}, {0, NULL}};
+			x->clips[q].no_shifts = pass;
+			for (int k = A - 1; k >= 0; k--) {
+				chunks c = {0};
+				const mlod_clip *cl = k == 0 ? x->clips[q].level0 : x->clips[q].clip[k - 1];
+				mlod_result r = motion_chunk(x, cl, k, q, k == 0 ? x->clips[q].error0 : x->clips[q].error[k - 1],
+				                             k + 1 < A ? &img[!(k & 1)] : NULL, &img[k & 1], &c);
+				for (int i = 0; i < c.n; i++)
+					bytes[pass] += c.c[i].size, free(c.c[i].data);
+				free(c.c);
+				if (r != MLOD_OK) {
+					motion_img_free(&img[0]), motion_img_free(&img[1]);
+					return r;
+				}
+			}
+			motion_img_free(&img[0]), motion_img_free(&img[1]);
+		}
+		x->clips[q].no_shifts = bytes[1] <= bytes[0];
+	}
+	return MLOD_OK;
 }
 
 /* ------------------------------------------------------------------ */
@@ -2443,6 +2696,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			x.clips[q].clip[k] = k ? x.clips[q].clip[k - 1] : x.clips[q].level0;
 			x.clips[q].error[k] = k ? x.clips[q].error[k - 1] : x.clips[q].error0;
 		}
+	if ((r = motion_shift_choice(&x, A)) != MLOD_OK)
+		goto done;
 	x.st->motion.seconds = now_seconds() - t0;
 	if (!(x.motion_imgs = calloc(2 * (size_t)x.v.clip_count + 1, sizeof *x.motion_imgs))) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");

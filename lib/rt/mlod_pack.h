@@ -179,7 +179,9 @@
  *   'ROTQ' i16[4] per key of every non-cubic rotation without a base key
  *          (below): the components but the one at index i, in index
  *          order, on the lattice of normalised shorts (value = q /
- *          32767), then i (0..3); the reader rebuilds component i as
+ *          32767), each stored as q >> shift, then i + 4 * shift (shift
+ *          0..MLOD_PACK_ROTQ_SHIFT_MAX; 0 before format 4.0, where the
+ *          element is i, 0..3); the reader rebuilds component i as
  *          lrint(sqrt(max(0, 1 - s)) * 32767) / 32767, s the sum of the
  *          others' squares (each the f32 nearest q / 32767, summed in f64);
  *   'ROTD' i16[4] per key of every non-cubic rotation with a base key: its
@@ -262,7 +264,7 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 3
+#define MLOD_PACK_MAJOR 4
 #define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32
@@ -346,11 +348,17 @@ typedef enum mlod_pack_codec {
  * chain: each load decodes it). */
 #define MLOD_PACK_MAX_NESTING 64
 
+/* The largest lattice shift of a 'ROTQ' key (format 4.0): its three
+ * stored components count steps of 2^shift lattice units. */
+#define MLOD_PACK_ROTQ_SHIFT_MAX 8
+
 /* One 'ROTQ' key as lattice integers (value = n / 32767): e the stored
  * element; base, for a key whose time the base channel also has, that
  * key as returned (else NULL): n = base + e, each wrapped to 16 bits;
- * else the three components but e[3]'s in index order, the one at e[3]
- * rebuilt non-negative (e[3] must be 0 to 3). prev: the key before as
+ * else, with i = e[3] & 3 and shift = e[3] >> 2 (0 before format 4.0;
+ * e[3] 0 to 4 * MLOD_PACK_ROTQ_SHIFT_MAX + 3, each |e[j]| at most 32767
+ * >> shift), the three components but i's in index order, each e[j] *
+ * 2^shift, the one at i rebuilt non-negative. prev: the key before as
  * returned (NULL for the first): n is negated when its dot product with
  * prev is negative. The writer and the reader share it. */
 static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, const int16_t *prev, int16_t n[4])
@@ -359,12 +367,14 @@ static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, c
 		for (int c = 0; c < 4; c++)
 			n[c] = (int16_t)(uint16_t)((uint16_t)base[c] + (uint16_t)e[c]);
 	} else {
-		int big = e[3] & 3;
+		int big = e[3] & 3, shift = (e[3] >> 2) & 15;
 		double sum = 0.0;
 		for (int c = 0, j = 0; c < 4; c++)
 			if (c != big) {
-				float f = (float)(e[j] / 32767.0);
-				n[c] = e[j++];
+				long v = (long)e[j++] * (1L << shift);
+				v = v > 32767 ? 32767 : v < -32767 ? -32767 : v;
+				float f = (float)(v / 32767.0);
+				n[c] = (int16_t)v;
 				sum += (double)f * f;
 			}
 		n[big] = (int16_t)lrint(sqrt(sum < 1.0 ? 1.0 - sum : 0.0) * 32767.0);

@@ -269,7 +269,7 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 	if (major < MLOD_PACK_MAJOR_OLDEST)
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED,
 		                 "mlod %u.%u pack: made by an older mlod-pack; pack the input again (this reader reads %d.x "
-		                 "and %d.x)",
+		                 "to %d.x)",
 		                 major, minor, MLOD_PACK_MAJOR_OLDEST, MLOD_PACK_MAJOR);
 	uint32_t hcrc = mlod_pack_crc32(0, d, 28);
 	if (hcrc != rd32(d + 28))
@@ -2080,8 +2080,14 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 			if (at >= 0)
 				for (int c = 0; c < 4; c++)
 					bn[c] = (int16_t)lrint((double)bc->values[4 * at + c] * 32767.0);
-			else if (el[3] < 0 || el[3] > 3)
-				FAIL("%s: channel %u: rotation key %u: component index %d is not 0 to 3", x.label, i, k, el[3]);
+			else if (el[3] < 0 || el[3] > (p->major >= 4 ? 4 * MLOD_PACK_ROTQ_SHIFT_MAX + 3 : 3))
+				FAIL("%s: channel %u: rotation key %u: component index and shift %d out of range", x.label, i,
+				     k, el[3]);
+			else
+				for (int c = 0; c < 3; c++)
+					if (el[c] > (32767 >> (el[3] >> 2)) || el[c] < -(32767 >> (el[3] >> 2)))
+						FAIL("%s: channel %u: rotation key %u: component %d past the lattice", x.label, i,
+						     k, el[c]);
 			mlod_pack_rotq_key(el, at >= 0 ? bn : NULL, k > 0 ? prev : NULL, n);
 			for (int c = 0; c < 4; c++)
 				ch->values[4 * (size_t)k + c] = (float)(n[c] / 32767.0);

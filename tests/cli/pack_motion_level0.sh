@@ -4,7 +4,8 @@
 # (error 0); --motion-level0-error in % and in scene units (at 0.01% the
 # walk's reduced level 0, whose values are the clip's own, stores more than
 # the clip as read, which it then keeps: error 0, the lossless bytes); the coarser
-# levels the same whatever level 0 gets; --report=json's level0_error is
+# levels the same keys and TOC errors whatever level 0 gets (their rotation
+# lattices follow the smallest TOC error, level 0's included: mlod(5)); --report=json's level0_error is
 # the TOC's; piped (mlod-motion --precision full) and direct packs agree
 # with --lossless-motion too. test_unpack measures the unpacked level 0.
 set -e
@@ -20,7 +21,7 @@ node - <<'JS'
 const fs = require('fs');
 const j = (n) => JSON.parse(fs.readFileSync(`${n}.json`, 'utf8'));
 const l0 = (p) => p.chunks.find((c) => c.type === 'ANIM' && c.level === 0);
-const coarse = (p) => p.chunks.filter((c) => c.type === 'ANIM' && c.level > 0).map((c) => c.crc).join();
+const coarse = (p) => p.chunks.filter((c) => c.type === 'ANIM' && c.level > 0).map((c) => `${c.raw}/${c.error}`).join();
 const [d, ll, p01, abs] = ['def', 'll', 'p01', 'abs'].map(j);
 const h = d.height;
 if (!(l0(d).error > 0 && l0(d).error <= 0.0005 * h)) throw new Error(`default: error ${l0(d).error}`);

@@ -1338,8 +1338,25 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 4.0 is newer than this reader's 3.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 5.0 is newer than this reader's 4.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
+}
+
+/* Format 4.0's shifted 'ROTQ' keys: e[3] = index | shift << 2, the three
+ * stored components times 2^shift; the rebuilt one as at shift 0; shift 0
+ * as before. */
+TEST(rotq_shift_decodes)
+{
+	int16_t e[4] = {100, -50, 20, (int16_t)(3 | 2 << 2)}, n[4];
+	mlod_pack_rotq_key(e, NULL, NULL, n);
+	double s = 0;
+	for (int c = 0; c < 3; c++)
+		s += (double)(float)(n[c] / 32767.0) * (float)(n[c] / 32767.0);
+	CHECK_MSG(n[0] == 400 && n[1] == -200 && n[2] == 80 && n[3] == (int16_t)lrint(sqrt(1.0 - s) * 32767.0),
+	          "%d %d %d %d", n[0], n[1], n[2], n[3]);
+	int16_t z[4] = {400, -200, 80, 3}, m[4];
+	mlod_pack_rotq_key(z, NULL, NULL, m);
+	CHECK(memcmp(n, m, sizeof n) == 0);
 }
 
 /* Format 2.0 changed the MESH layout (b2) and the MOTION streams: a 1.x
@@ -1356,7 +1373,7 @@ TEST(older_major_is_refused)
 	free(b.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && p.chunks == NULL, "returned %d: %s", (int)r, terr.message);
 	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
-	                               "reads 2.x and 3.x)") == 0,
+	                               "reads 2.x to 4.x)") == 0,
 	          "message: %s", terr.message);
 }
 
@@ -1698,7 +1715,17 @@ static void e_tick_repeat(wchunk *c)
 static void e_morph_scale(wchunk *c) { wr32(stream_data(c, C_MESH0, MLOD_STREAM_MTSC, 0), 0xbf800000u); }
 static void e_no_skin(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 16, 0xffffffffu); }
 static void e_rotq_cubic(wchunk *c) { wr32(stream_data(c, C_MOT0, MLOD_STREAM_CHAN, 0) + 20 + 8, 2); }
-static void e_rotq_index(wchunk *c) { wr16(stream_data(c, C_MOT0, MLOD_STREAM_ROTQ, 0) + 8 * 2 + 6, 4); }
+static void e_rotq_index(wchunk *c)
+{
+	wr16(stream_data(c, C_MOT0, MLOD_STREAM_ROTQ, 0) + 8 * 2 + 6, 4 * MLOD_PACK_ROTQ_SHIFT_MAX + 4);
+}
+/* Format 4.0: key 2 at shift 8 (index 0), its first component 200 past 32767 >> 8. */
+static void e_rotq_past(wchunk *c)
+{
+	uint8_t *d = stream_data(c, C_MOT0, MLOD_STREAM_ROTQ, 0) + 8 * 2;
+	wr16(d, 200);
+	wr16(d + 6, 4 * 8);
+}
 static void e_part_flags(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x108); }
 static void e_newbits_alone(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 28, 0x88); }
 /* Level 0's part 1 in its own numbering (u16): its map's first vertex
@@ -1759,7 +1786,8 @@ TEST(structural_checks_name_the_chunk)
 		{e_morph_scale, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 0: morph target 0: scale -1 is not finite and >= 0"},
 		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
 		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (rotation keys without a base key)"},
-		{e_rotq_index, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 2: component index 4 is not 0 to 3"},
+		{e_rotq_index, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 2: component index and shift 36 out of range"},
+		{e_rotq_past, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 2: component 200 past the lattice"},
 		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x100"},
 		{e_newbits_alone, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: NEWBITS without LOCAL"},
 		{e_imap_past, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 1: vertex 0 maps to 24, past its prefix of 24 vertices (MESH levels 1 to 0)"},
@@ -2001,6 +2029,7 @@ int main(int argc, char **argv)
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
 	RUN(older_major_is_refused);
+	RUN(rotq_shift_decodes);
 	RUN(format_2_0_reads);
 	RUN(motion_tick_bits);
 	RUN(nested_motion_needs_its_base);

@@ -382,7 +382,9 @@ static const char *compare_primitive(const mlod_primitive *a, const mlod_primiti
  * (mlod_motion_point_error, radius pd) of every joint at the input's
  * common timeline frames and midpoints, each clip sampled and posed by the
  * bake library (not lib/motion's own evaluator): at most e0 plus the ROTQ
- * lattice's share (mlod(5): each rotation key within MLOD_PACK_ROTQ_ANGLE;
+ * lattice's share (mlod(5): each rotation key within MLOD_PACK_ROTQ_ANGLE,
+ * plus MLOD_PACK_ROTQ_SHARE of the level's TOC error for format 4.0's
+ * coarser lattices;
  * a rotation of the joint or an ancestor g off by that angle moves the
  * joint's origin by at most the angle times |o_joint - o_g| and turns its
  * world 3x3 part M by that angle, which the point error weighs by pd
@@ -432,6 +434,9 @@ static const char *level_within(const mlod_character *c, const mlod_clip *a, con
 		if (b->channels[i].path == MLOD_PATH_ROTATION && b->channels[i].interp != MLOD_INTERP_CUBICSPLINE)
 			rotq[b->channels[i].joint] = 1;
 	const double angle = MLOD_PACK_ROTQ_ANGLE;
+	/* format 4.0: the coarser lattices may add this much more (mlod(5)
+	 * QUANTISATION; the writer's shifts are not consulted) */
+	const double share = toc > 0 ? MLOD_PACK_ROTQ_SHARE * toc : 0.0;
 	for (int i = 0; i < n && !fail; i++) {
 		mlod_pose_rest(&c->skeleton, la);
 		mlod_pose_rest(&c->skeleton, lb);
@@ -454,17 +459,19 @@ static const char *level_within(const mlod_character *c, const mlod_clip *a, con
 			for (int r = 0; r < 3; r++)
 				jp += ((double)wa[j].m[12 + r] - wb[j].m[12 + r]) * ((double)wa[j].m[12 + r] - wb[j].m[12 + r]);
 			jp = sqrt(jp);
-			if (toc >= 0 && jp > toc + origin + 1e-6 * height) {
-				snprintf(msg, cap, "clip '%s' joint %d at %.5g s: position error %.6g, TOC error %.6g + lattice %.6g",
-				         a->name, j, (double)t[i], jp, toc, origin);
+			if (toc >= 0 && jp > toc + origin + share + 1e-6 * height) {
+				snprintf(msg, cap,
+				         "clip '%s' joint %d at %.5g s: position error %.6g, TOC error %.6g + lattice %.6g + share %.6g",
+				         a->name, j, (double)t[i], jp, toc, origin, share);
 				fail = msg;
 			}
-			double e = mlod_motion_point_error(&wa[j], &wb[j], pd), bound = e0 + lattice + 1e-6 * height;
+			double e = mlod_motion_point_error(&wa[j], &wb[j], pd), bound = e0 + lattice + share + 1e-6 * height;
 			if (e / bound > *worst)
 				*worst = e / bound;
 			if (e > bound) {
-				snprintf(msg, cap, "clip '%s' joint %d at %.5g s: point error %.6g, bound %.6g (level 0 %.6g + lattice %.6g)",
-				         a->name, j, (double)t[i], e, bound, e0, lattice);
+				snprintf(msg, cap,
+				         "clip '%s' joint %d at %.5g s: point error %.6g, bound %.6g (level %.6g + lattice %.6g + share %.6g)",
+				         a->name, j, (double)t[i], e, bound, e0, lattice, share);
 				fail = msg;
 			}
 		}
