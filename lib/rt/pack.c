@@ -647,6 +647,20 @@ static void cx_done(cx *x)
 	x->temp = NULL;
 }
 
+/* Index k of a decoded index stream of 16-bit (i16) or 32-bit entries, in
+ * the machine's byte order (as the index decoders write them). */
+static uint32_t index_at(const uint8_t *src, int i16, uint32_t k)
+{
+	if (i16) {
+		uint16_t v;
+		memcpy(&v, src + 2 * (size_t)k, 2);
+		return v;
+	}
+	uint32_t v;
+	memcpy(&v, src + 4 * (size_t)k, 4);
+	return v;
+}
+
 /* The stream's decoded bytes: in place for raw streams, else decoded into
  * the temporary buffer (valid until the next load). */
 static mlod_result cx_load_into(cx *x, const stream *s, uint8_t *dst, mlod_error *err);
@@ -1547,14 +1561,7 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 				for (uint32_t v = 0, o = 0; v < V; v++) {
 					if (used[v] != UINT32_MAX)
 						continue;
-					uint32_t iv;
-					if (i16) {
-						uint16_t v16;
-						memcpy(&v16, src + 2 * (size_t)o, 2);
-						iv = v16;
-					} else {
-						memcpy(&iv, src + 4 * (size_t)o, 4);
-					}
+					const uint32_t iv = index_at(src, i16, o);
 					if (iv >= prefix)
 						FAIL("%s: part %u: vertex %u maps to %u, past its prefix of %llu vertices (MESH levels %u "
 						     "to %u)",
@@ -1569,27 +1576,13 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 				map[v] = UINT32_MAX;
 			TAKE(pt->indices, (uint64_t)rc->index_count * 4);
 			for (uint32_t k = 0; k < rc->index_count && local; k++) {
-				uint32_t iv;
-				if (i16) {
-					uint16_t v16;
-					memcpy(&v16, src + 2 * (size_t)k, 2);
-					iv = v16;
-				} else {
-					memcpy(&iv, src + 4 * (size_t)k, 4);
-				}
+				const uint32_t iv = index_at(src, i16, k);
 				if (iv >= V)
 					FAIL("%s: part %u: index %u refers past its %u vertices (at position %u)", x.label, i, iv, V, k);
 				pt->indices[k] = iv;
 			}
 			for (uint32_t k = 0; k < rc->index_count && !local; k++) {
-				uint32_t iv;
-				if (i16) {
-					uint16_t v16;
-					memcpy(&v16, src + 2 * (size_t)k, 2);
-					iv = v16;
-				} else {
-					memcpy(&iv, src + 4 * (size_t)k, 4);
-				}
+				const uint32_t iv = index_at(src, i16, k);
 				if (iv >= prefix)
 					FAIL("%s: part %u: index %u refers past its prefix of %llu vertices (MESH levels %u to %u; at "
 					     "position %u)",
