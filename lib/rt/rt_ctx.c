@@ -184,6 +184,14 @@ static void mat_identity(float *m)
 	m[0] = m[5] = m[10] = m[15] = 1.0f;
 }
 
+/* The runtime's tables of a motion level of C channels (prepare_motion):
+ * per joint a fixed local matrix, a flag and a channel range, and the
+ * channels' order: 69 bytes per joint, 4 per channel, plus 4. */
+static size_t motion_plan_bytes(uint32_t J, uint32_t C)
+{
+	return 16 * sizeof(float) * (size_t)J + ((size_t)J + 1 + C) * sizeof(uint32_t) + J;
+}
+
 /* Checks a motion level and sets its channel bits (ctx->chan_bits). A
  * level the runtime decoded (owned) has the keys of a non-cubic rotation
  * replaced by their normalisation when each of those is its own: sampling
@@ -193,8 +201,55 @@ static void mat_identity(float *m)
 static mlod_result prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_motion *m, mlod_error *err)
 {
 	mlod_result r = check_motion(ctx, m, u->level, u->item, err);
-	if (r || !ctx->chan_bits)
+	if (r)
 		return r;
+	/* The channels by joint (a counting sort, stable), and the fixed
+	 * local matrices of the joints whose channels all have one key. */
+	const uint32_t J = ctx->joint_count, C = m->channel_count;
+	const size_t cbytes = motion_plan_bytes(J, C);
+	float *cblock = rt_alloc(ctx, cbytes);
+	if (!cblock)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "motion level %u of clip %u: out of memory", u->level, u->item);
+	u->plan_block = cblock;
+	u->bytes += cbytes;
+	u->static_mat = cblock;
+	u->chan_at = (uint32_t *)(cblock + 16 * (size_t)J), u->chan_list = u->chan_at + J + 1;
+	u->animated = (uint8_t *)(u->chan_list + C);
+	memset(u->chan_at, 0, ((size_t)J + 1) * sizeof(uint32_t));
+	for (uint32_t i = 0; i < C; i++)
+		u->chan_at[m->channels[i].rec.joint + 1]++;
+	for (uint32_t j = 0; j < J; j++)
+		u->chan_at[j + 1] += u->chan_at[j];
+	for (uint32_t i = 0; i < C; i++)
+		u->chan_list[u->chan_at[m->channels[i].rec.joint]++] = i;
+	for (uint32_t j = J; j > 0; j--) /* each chan_at[j] is now the end of joint j's: shift back */
+		u->chan_at[j] = u->chan_at[j - 1];
+	u->chan_at[0] = 0;
+	for (uint32_t j = 0; j < J; j++) {
+		mlod_trs l = ctx->rest_local[j];
+		u->animated[j] = 0;
+		for (uint32_t c = u->chan_at[j]; c < u->chan_at[j + 1]; c++) {
+			const mlod_pack_channel *ch = &m->channels[u->chan_list[c]];
+			if (ch->rec.key_count > 1)
+				u->animated[j] = 1;
+			if (ch->rec.key_count != 1)
+				continue;
+			/* sample_one's copy of a lone key (normalised if a rotation) */
+			const int rot = ch->rec.path == 1, cubic = ch->rec.interp == 2;
+			const float *q = ch->values + (cubic ? (rot ? 4 : 3) : 0);
+			if (rot) {
+				mlod_quat n = mlod_quat_normalize((mlod_quat){ q[0], q[1], q[2], q[3] });
+				l.r = n;
+			} else if (ch->rec.path == 0) {
+				l.t.x = q[0], l.t.y = q[1], l.t.z = q[2];
+			} else {
+				l.s.x = q[0], l.s.y = q[1], l.s.z = q[2];
+			}
+		}
+		rt_trs_cols(&l, u->static_mat + 16 * (size_t)j);
+	}
+	if (!ctx->chan_bits)
+		return MLOD_OK;
 	uint8_t *bits = ctx->chan_bits + (size_t)(u - &ctx->units[ctx->unit_base[MLOD_RT_MOTION]]) * ctx->chan_bytes;
 	memset(bits, 0, ctx->chan_bytes);
 	for (uint32_t i = 0; i < m->channel_count && i < 8 * ctx->chan_bytes; i++) {
@@ -400,6 +455,8 @@ static void unit_release(mlod_rt_ctx *ctx, rt_unit *u)
 	u->skin_order_at = NULL, u->skin_order = NULL;
 	ctx->unit_gen++;
 	u->chan_flags = NULL;
+	u->chan_at = u->chan_list = NULL;
+	u->animated = NULL, u->static_mat = NULL;
 	u->skel = NULL, u->mesh = NULL, u->motion = NULL;
 	ctx->resident_bytes -= u->bytes;
 	u->bytes = 0;
@@ -507,13 +564,19 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 	                                           : 0;
 	if (!ctx->load) {
 		const mlod_rt_view_level *v = u->view;
+		if (v && v->bytes && u->layer == MLOD_RT_MOTION)
+			return v->bytes + (v->data ? motion_plan_bytes(ctx->joint_count,
+			                                               ((const mlod_pack_motion *)v->data)->channel_count)
+			                           : 0);
 		if (v && v->bytes)
 			return v->bytes + plan + (u->layer == MLOD_RT_MESH && v->data ? skin_order_bytes(v->data) : 0);
 		if (v && v->data)
 			switch (u->layer) {
 			case MLOD_RT_SKELETON: return rt_bytes_skel_level(v->data) + plan;
 			case MLOD_RT_MESH: return rt_bytes_mesh(v->data) + plan + skin_order_bytes(v->data);
-			default: return rt_bytes_motion(v->data);
+			default:
+				return rt_bytes_motion(v->data) +
+				       motion_plan_bytes(ctx->joint_count, ((const mlod_pack_motion *)v->data)->channel_count);
 			}
 		return 0;
 	}
@@ -526,6 +589,10 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 			break;
 		hint += 4 * (size_t)v->raw_size + 256;
 	}
+	/* A motion level's tables: its channels (decoded, counted in the hint
+	 * so far at sizeof(mlod_pack_channel) each) are at most hint / that. */
+	if (u->layer == MLOD_RT_MOTION)
+		hint += motion_plan_bytes(ctx->joint_count, 0) + 4 * (hint / sizeof(mlod_pack_channel));
 	return hint;
 }
 

@@ -152,49 +152,48 @@ static void sample_channel(const mlod_pack_channel *ch, const rt_key_pos *p, int
 		memcpy(out, q, 3 * sizeof *out);
 }
 
-/* Samples the channels of the posed joints into local. flags: the motion
- * unit's channel bits, nbits of them (ctx->chan_bits; NULL: none). A
- * value read from a key (one key, clamped, STEP: a constant channel is
- * stored as one key) is copied here; sample_channel interpolates. */
-static void sample_motion(const mlod_pack_motion *m, const uint8_t *flags, uint32_t nbits, float t,
-                          const uint8_t *needed, mlod_trs *local)
+/* Channel i of m into local, *p the last key position found (a key-time
+ * array shared with the channel before is searched once). flags: the
+ * motion unit's channel bits, nbits of them (ctx->chan_bits; NULL:
+ * none). A value read from a key (one key, clamped, STEP: a constant
+ * channel is stored as one key) is copied here; sample_channel
+ * interpolates. */
+static inline void sample_one(const mlod_pack_motion *m, uint32_t i, const uint8_t *flags, uint32_t nbits, float t,
+                              rt_key_pos *p, mlod_trs *local)
 {
-	rt_key_pos p = { NULL, 0, 0, 0, 0.0f, 0.0f };
-	for (uint32_t i = 0; i < m->channel_count; i++) {
-		const mlod_pack_channel *ch = &m->channels[i];
-		const uint32_t n = ch->rec.key_count;
-		if (n < 1 || !needed[ch->rec.joint])
-			continue;
-		const int rot = ch->rec.path != 0 && ch->rec.path != 2;
-		const int unit = rot && flags && i < nbits ? (flags[i >> 3] >> (i & 7)) & 1 : 0;
-		const int comps = rot ? 4 : 3;
-		const float *key;
-		float v[4];
-		uint32_t k = 0;
-		if (n > 1) {
-			if (ch->times != p.times || n != p.n)
-				key_pos(ch->times, n, t, &p);
-			k = p.k >= 0 ? (uint32_t)p.k : p.i;
-		}
-		if (n == 1 || p.k >= 0 || ch->rec.interp == 1) { /* on a key, or STEP */
-			const int cubic = ch->rec.interp == 2;
-			key = ch->values + (size_t)k * (cubic ? 3 * (size_t)comps : (size_t)comps) + (cubic ? comps : 0);
-			if (rot && !unit) {
-				quat_norm(key, v);
-				key = v;
-			}
-		} else {
-			sample_channel(ch, &p, comps, unit, v);
+	const mlod_pack_channel *ch = &m->channels[i];
+	const uint32_t n = ch->rec.key_count;
+	if (n < 1)
+		return;
+	const int rot = ch->rec.path != 0 && ch->rec.path != 2;
+	const int unit = rot && flags && i < nbits ? (flags[i >> 3] >> (i & 7)) & 1 : 0;
+	const int comps = rot ? 4 : 3;
+	const float *key;
+	float v[4];
+	uint32_t k = 0;
+	if (n > 1) {
+		if (ch->times != p->times || n != p->n)
+			key_pos(ch->times, n, t, p);
+		k = p->k >= 0 ? (uint32_t)p->k : p->i;
+	}
+	if (n == 1 || p->k >= 0 || ch->rec.interp == 1) { /* on a key, or STEP */
+		const int cubic = ch->rec.interp == 2;
+		key = ch->values + (size_t)k * (cubic ? 3 * (size_t)comps : (size_t)comps) + (cubic ? comps : 0);
+		if (rot && !unit) {
+			quat_norm(key, v);
 			key = v;
 		}
-		mlod_trs *l = &local[ch->rec.joint];
-		if (rot)
-			l->r.x = key[0], l->r.y = key[1], l->r.z = key[2], l->r.w = key[3];
-		else if (ch->rec.path == 0)
-			l->t.x = key[0], l->t.y = key[1], l->t.z = key[2];
-		else
-			l->s.x = key[0], l->s.y = key[1], l->s.z = key[2];
+	} else {
+		sample_channel(ch, p, comps, unit, v);
+		key = v;
 	}
+	mlod_trs *l = &local[ch->rec.joint];
+	if (rot)
+		l->r.x = key[0], l->r.y = key[1], l->r.z = key[2], l->r.w = key[3];
+	else if (ch->rec.path == 0)
+		l->t.x = key[0], l->t.y = key[1], l->t.z = key[2];
+	else
+		l->s.x = key[0], l->s.y = key[1], l->s.z = key[2];
 }
 
 /* ---------------------------------------------------------------- */
@@ -255,24 +254,50 @@ static float sample_time(const mlod_rt_ctx *ctx, const mlod_rt_state *st)
 }
 
 /* Poses the npose joints posed[] (increasing: parents first) of the
- * instance: the rest pose, the motion level's channels of the joints
- * needed[] flags, and the world matrices. */
+ * instance: each joint's local transform (the rest transform, then the
+ * motion level's channels of it) and its world matrix. A joint whose
+ * channels all have one key (u->animated 0) takes the local matrix its
+ * motion level made at load, the same floats; only the others are
+ * sampled, through the level's channels by joint (chan_at, chan_list),
+ * a joint's in the level's order, so a later channel of the same joint
+ * and path still wins. */
 static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_rt_state *st, const uint32_t *posed,
-                        uint32_t npose, const uint8_t *needed)
+                        uint32_t npose)
 {
 	const mlod_pack_joint_rec *jr = ctx->skel->joints;
 	mlod_trs *local = s->local;
 	float *W = s->world;
-	for (uint32_t i = 0; i < npose; i++)
-		local[posed[i]] = ctx->rest_local[posed[i]];
+	const rt_unit *mu = NULL;
 	if (ctx->clip_count) {
-		const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MOTION, st->level[MLOD_RT_MOTION], st->clip);
-		if (mu && mu->state == RT_UNIT_RESIDENT)
-			sample_motion(mu->motion, mu->chan_flags, 8 * ctx->chan_bytes, sample_time(ctx, st), needed, local);
+		mu = rt_unit_get(ctx, MLOD_RT_MOTION, st->level[MLOD_RT_MOTION], st->clip);
+		if (mu && mu->state != RT_UNIT_RESIDENT)
+			mu = NULL;
 	}
+	if (!mu) { /* the rest pose */
+		for (uint32_t i = 0; i < npose; i++) {
+			const uint32_t j = posed[i];
+			local[j] = ctx->rest_local[j];
+			rt_mat_mul_trs(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, &local[j],
+			               W + 16 * (size_t)j);
+		}
+		return;
+	}
+	const mlod_pack_motion *m = mu->motion;
+	const uint8_t *flags = mu->chan_flags;
+	const uint32_t nbits = 8 * ctx->chan_bytes;
+	const float t = sample_time(ctx, st);
+	rt_key_pos p = { NULL, 0, 0, 0, 0.0f, 0.0f };
 	for (uint32_t i = 0; i < npose; i++) {
 		const uint32_t j = posed[i];
-		rt_mat_mul_trs(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, &local[j], W + 16 * (size_t)j);
+		const float *parent = jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent;
+		if (!mu->animated[j]) {
+			rt_mat_mul(parent, mu->static_mat + 16 * (size_t)j, W + 16 * (size_t)j);
+			continue;
+		}
+		local[j] = ctx->rest_local[j];
+		for (uint32_t c = mu->chan_at[j]; c < mu->chan_at[j + 1]; c++)
+			sample_one(m, mu->chan_list[c], flags, nbits, t, &p, local);
+		rt_mat_mul_trs(parent, &local[j], W + 16 * (size_t)j);
 	}
 }
 
@@ -285,8 +310,7 @@ mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	const mlod_rt_state *st = &ctx->inst[id].st;
 	const rt_unit *su = skel_unit(ctx, st);
-	pose_joints(ctx, s, st, su ? su->plan.posed : ctx->all_joints, su ? su->plan.posed_count : ctx->joint_count,
-	            su ? su->plan.needed : ctx->all_needed);
+	pose_joints(ctx, s, st, su ? su->plan.posed : ctx->all_joints, su ? su->plan.posed_count : ctx->joint_count);
 	s->skel_unit = su;
 	s->id = id;
 	s->posed = 1;
@@ -439,7 +463,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	 * rigid parts follow (with their ancestors), and those entries. */
 	const rt_unit *su = skel_unit(ctx, st);
 	skin_plan(ctx, s, su, mu);
-	pose_joints(ctx, s, st, s->plan_posed, s->plan_count, s->plan_need);
+	pose_joints(ctx, s, st, s->plan_posed, s->plan_count);
 	s->skel_unit = su;
 	s->id = id;
 	s->posed = 2;

@@ -57,6 +57,18 @@ typedef struct rt_unit {
 	uint32_t *skin_order_at;
 	uint8_t *skin_order;
 	uint8_t *chan_flags;      /* resident motion levels: a bit per channel (in ctx->chan_bits) */
+	/* Resident motion levels: their channels by joint, in plan_block:
+	 * joint j's are chan_list[chan_at[j] .. chan_at[j + 1] - 1], in the
+	 * level's order (so a later channel of the same path still wins), so
+	 * a pose samples only the channels of the joints it poses. */
+	uint32_t *chan_at;        /* joint_count + 1 */
+	uint32_t *chan_list;      /* channel_count */
+	/* Resident motion levels, per joint: 1 when a channel of it has more
+	 * than one key (animated: sampled per frame); else its local matrix
+	 * is fixed, rt_trs_cols of the rest transform after its one-key
+	 * channels, in static_mat (16 floats per joint), made at load. */
+	uint8_t *animated;        /* joint_count */
+	float *static_mat;        /* 16 per joint */
 	void *plan_block;
 } rt_unit;
 
