@@ -184,12 +184,13 @@ static void mat_identity(float *m)
 	m[0] = m[5] = m[10] = m[15] = 1.0f;
 }
 
-/* The runtime's tables of a motion level of C channels (prepare_motion):
- * per joint a fixed local matrix, a flag and a channel range, and the
- * channels' order: 69 bytes per joint, 4 per channel, plus 4. */
-static size_t motion_plan_bytes(uint32_t J, uint32_t C)
+/* The runtime's tables of a motion level of C channels, S of its joints
+ * with one-key channels only (prepare_motion): per joint a channel range
+ * and a fixed-matrix index, the channels' order, and S matrices: 8 bytes
+ * per joint, 4 per channel, 64 per such joint, plus 4. */
+static size_t motion_plan_bytes(uint32_t J, uint32_t C, uint32_t S)
 {
-	return 16 * sizeof(float) * (size_t)J + ((size_t)J + 1 + C) * sizeof(uint32_t) + J;
+	return ((size_t)2 * J + 1 + C) * sizeof(uint32_t) + 16 * sizeof(float) * (size_t)S;
 }
 
 /* Checks a motion level and sets its channel bits (ctx->chan_bits). A
@@ -206,15 +207,28 @@ static mlod_result prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_
 	/* The channels by joint (a counting sort, stable), and the fixed
 	 * local matrices of the joints whose channels all have one key. */
 	const uint32_t J = ctx->joint_count, C = m->channel_count;
-	const size_t cbytes = motion_plan_bytes(J, C);
-	float *cblock = rt_alloc(ctx, cbytes);
+	uint32_t S = 0;
+	{
+		uint8_t *mark = rt_calloc(ctx, (size_t)J + 1, 2); /* [j]: has a channel; [J + 1 + j]: one with keys > 1 */
+		if (!mark)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "motion level %u of clip %u: out of memory", u->level, u->item);
+		for (uint32_t i = 0; i < C; i++) {
+			mark[m->channels[i].rec.joint] = 1;
+			if (m->channels[i].rec.key_count > 1)
+				mark[J + 1 + m->channels[i].rec.joint] = 1;
+		}
+		for (uint32_t j = 0; j < J; j++)
+			S += mark[j] && !mark[J + 1 + j];
+		rt_free(ctx, mark);
+	}
+	const size_t cbytes = motion_plan_bytes(J, C, S);
+	uint32_t *cblock = rt_alloc(ctx, cbytes);
 	if (!cblock)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "motion level %u of clip %u: out of memory", u->level, u->item);
 	u->plan_block = cblock;
 	u->bytes += cbytes;
-	u->static_mat = cblock;
-	u->chan_at = (uint32_t *)(cblock + 16 * (size_t)J), u->chan_list = u->chan_at + J + 1;
-	u->animated = (uint8_t *)(u->chan_list + C);
+	u->chan_at = cblock, u->fixed = cblock + J + 1, u->chan_list = u->fixed + J;
+	u->static_mat = (float *)(u->chan_list + C);
 	memset(u->chan_at, 0, ((size_t)J + 1) * sizeof(uint32_t));
 	for (uint32_t i = 0; i < C; i++)
 		u->chan_at[m->channels[i].rec.joint + 1]++;
@@ -225,28 +239,32 @@ static mlod_result prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_
 	for (uint32_t j = J; j > 0; j--) /* each chan_at[j] is now the end of joint j's: shift back */
 		u->chan_at[j] = u->chan_at[j - 1];
 	u->chan_at[0] = 0;
+	uint32_t k = 0;
 	for (uint32_t j = 0; j < J; j++) {
+		u->fixed[j] = 1;
+		if (u->chan_at[j] == u->chan_at[j + 1])
+			continue;
 		mlod_trs l = ctx->rest_local[j];
-		u->animated[j] = 0;
-		for (uint32_t c = u->chan_at[j]; c < u->chan_at[j + 1]; c++) {
+		for (uint32_t c = u->chan_at[j]; c < u->chan_at[j + 1] && u->fixed[j]; c++) {
 			const mlod_pack_channel *ch = &m->channels[u->chan_list[c]];
 			if (ch->rec.key_count > 1)
-				u->animated[j] = 1;
+				u->fixed[j] = 0;
 			if (ch->rec.key_count != 1)
 				continue;
 			/* sample_one's copy of a lone key (normalised if a rotation) */
 			const int rot = ch->rec.path == 1, cubic = ch->rec.interp == 2;
 			const float *q = ch->values + (cubic ? (rot ? 4 : 3) : 0);
-			if (rot) {
-				mlod_quat n = mlod_quat_normalize((mlod_quat){ q[0], q[1], q[2], q[3] });
-				l.r = n;
-			} else if (ch->rec.path == 0) {
+			if (rot)
+				l.r = mlod_quat_normalize((mlod_quat){ q[0], q[1], q[2], q[3] });
+			else if (ch->rec.path == 0)
 				l.t.x = q[0], l.t.y = q[1], l.t.z = q[2];
-			} else {
+			else
 				l.s.x = q[0], l.s.y = q[1], l.s.z = q[2];
-			}
 		}
-		rt_trs_cols(&l, u->static_mat + 16 * (size_t)j);
+		if (u->fixed[j]) {
+			rt_trs_cols(&l, u->static_mat + 16 * (size_t)k);
+			u->fixed[j] = 2 + k++;
+		}
 	}
 	if (!ctx->chan_bits)
 		return MLOD_OK;
@@ -456,7 +474,7 @@ static void unit_release(mlod_rt_ctx *ctx, rt_unit *u)
 	ctx->unit_gen++;
 	u->chan_flags = NULL;
 	u->chan_at = u->chan_list = NULL;
-	u->animated = NULL, u->static_mat = NULL;
+	u->fixed = NULL, u->static_mat = NULL;
 	u->skel = NULL, u->mesh = NULL, u->motion = NULL;
 	ctx->resident_bytes -= u->bytes;
 	u->bytes = 0;
@@ -544,6 +562,17 @@ static size_t evictable_bytes(const mlod_rt_ctx *ctx)
 	return b;
 }
 
+/* motion_plan_bytes of a motion level's views, bounding its joints with
+ * one-key channels only by the joints and by its one-key channels. */
+static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m)
+{
+	const uint32_t J = ctx->joint_count, C = m->channel_count;
+	uint32_t S = 0;
+	for (uint32_t i = 0; i < C; i++)
+		S += m->channels[i].rec.key_count == 1;
+	return motion_plan_bytes(J, C, S < J ? S : J);
+}
+
 /* An upper bound of a unit's resident size before loading it, so that
  * room is made before decoding and resident bytes never pass the budget,
  * not even while a level decodes. Views know their size. For packs:
@@ -565,9 +594,7 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 	if (!ctx->load) {
 		const mlod_rt_view_level *v = u->view;
 		if (v && v->bytes && u->layer == MLOD_RT_MOTION)
-			return v->bytes + (v->data ? motion_plan_bytes(ctx->joint_count,
-			                                               ((const mlod_pack_motion *)v->data)->channel_count)
-			                           : 0);
+			return v->bytes + (v->data ? motion_plan_hint(ctx, v->data) : 0);
 		if (v && v->bytes)
 			return v->bytes + plan + (u->layer == MLOD_RT_MESH && v->data ? skin_order_bytes(v->data) : 0);
 		if (v && v->data)
@@ -575,8 +602,7 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 			case MLOD_RT_SKELETON: return rt_bytes_skel_level(v->data) + plan;
 			case MLOD_RT_MESH: return rt_bytes_mesh(v->data) + plan + skin_order_bytes(v->data);
 			default:
-				return rt_bytes_motion(v->data) +
-				       motion_plan_bytes(ctx->joint_count, ((const mlod_pack_motion *)v->data)->channel_count);
+				return rt_bytes_motion(v->data) + motion_plan_hint(ctx, v->data);
 			}
 		return 0;
 	}
@@ -592,7 +618,7 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 	/* A motion level's tables: its channels (decoded, counted in the hint
 	 * so far at sizeof(mlod_pack_channel) each) are at most hint / that. */
 	if (u->layer == MLOD_RT_MOTION)
-		hint += motion_plan_bytes(ctx->joint_count, 0) + 4 * (hint / sizeof(mlod_pack_channel));
+		hint += motion_plan_bytes(ctx->joint_count, 0, ctx->joint_count) + 4 * (hint / sizeof(mlod_pack_channel));
 	return hint;
 }
 
@@ -734,6 +760,7 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 			                 (int)s->joints[j].parent);
 	ctx->skin_offset = rt_calloc(ctx, s->skin_count + 1, sizeof *ctx->skin_offset);
 	ctx->rest_world = rt_calloc(ctx, J, 16 * sizeof(float));
+	ctx->rest_mat = rt_calloc(ctx, J, 16 * sizeof(float));
 	ctx->rest_local = rt_calloc(ctx, J, sizeof *ctx->rest_local);
 	ctx->all_joints = rt_calloc(ctx, J, sizeof *ctx->all_joints);
 	ctx->all_needed = rt_calloc(ctx, J, 1);
@@ -742,7 +769,7 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 	const size_t motion_units = (size_t)ctx->levels[MLOD_RT_MOTION] * ctx->clip_count;
 	ctx->chan_bytes = (3 * J + 7) / 8;
 	ctx->chan_bits = motion_units ? rt_calloc(ctx, motion_units, ctx->chan_bytes) : NULL;
-	if ((motion_units && !ctx->chan_bits) || !ctx->skin_offset || !ctx->rest_world || !ctx->rest_local || !ctx->all_joints || !ctx->all_needed ||
+	if ((motion_units && !ctx->chan_bits) || !ctx->skin_offset || !ctx->rest_world || !ctx->rest_mat || !ctx->rest_local || !ctx->all_joints || !ctx->all_needed ||
 	    !ctx->clip_duration || !ctx->inst)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
 	uint64_t pal = 0;
@@ -773,7 +800,7 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 		               { jr->r[0], jr->r[1], jr->r[2], jr->r[3] },
 		               { jr->s[0], jr->s[1], jr->s[2] } };
 		ctx->rest_local[j] = t;
-		float l[16];
+		float *l = ctx->rest_mat + 16 * (size_t)j;
 		rt_mat_trs(&t, l);
 		rt_mat_mul(jr->parent < 0 ? jr->base : ctx->rest_world + 16 * (size_t)jr->parent, l,
 		           ctx->rest_world + 16 * (size_t)j);
@@ -883,6 +910,7 @@ void mlod_rt_close(mlod_rt_ctx *ctx)
 	rt_free(ctx, ctx->units);
 	rt_free(ctx, ctx->skin_offset);
 	rt_free(ctx, ctx->rest_world);
+	rt_free(ctx, ctx->rest_mat);
 	rt_free(ctx, ctx->rest_local);
 	rt_free(ctx, ctx->all_joints);
 	rt_free(ctx, ctx->all_needed);

@@ -255,9 +255,9 @@ static float sample_time(const mlod_rt_ctx *ctx, const mlod_rt_state *st)
 
 /* Poses the npose joints posed[] (increasing: parents first) of the
  * instance: each joint's local transform (the rest transform, then the
- * motion level's channels of it) and its world matrix. A joint whose
- * channels all have one key (u->animated 0) takes the local matrix its
- * motion level made at load, the same floats; only the others are
+ * motion level's channels of it) and its world matrix. A joint without
+ * channels or whose channels all have one key (u->fixed) takes the local
+ * matrix made at open or at the level's load, the same floats; only the others are
  * sampled, through the level's channels by joint (chan_at, chan_list),
  * a joint's in the level's order, so a later channel of the same joint
  * and path still wins. */
@@ -276,9 +276,8 @@ static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_r
 	if (!mu) { /* the rest pose */
 		for (uint32_t i = 0; i < npose; i++) {
 			const uint32_t j = posed[i];
-			local[j] = ctx->rest_local[j];
-			rt_mat_mul_trs(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, &local[j],
-			               W + 16 * (size_t)j);
+			rt_mat_mul(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, ctx->rest_mat + 16 * (size_t)j,
+			           W + 16 * (size_t)j);
 		}
 		return;
 	}
@@ -290,8 +289,10 @@ static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_r
 	for (uint32_t i = 0; i < npose; i++) {
 		const uint32_t j = posed[i];
 		const float *parent = jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent;
-		if (!mu->animated[j]) {
-			rt_mat_mul(parent, mu->static_mat + 16 * (size_t)j, W + 16 * (size_t)j);
+		const uint32_t f = mu->fixed[j];
+		if (f) {
+			rt_mat_mul(parent, f == 1 ? ctx->rest_mat + 16 * (size_t)j : mu->static_mat + 16 * (size_t)(f - 2),
+			           W + 16 * (size_t)j);
 			continue;
 		}
 		local[j] = ctx->rest_local[j];

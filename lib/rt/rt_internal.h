@@ -63,12 +63,13 @@ typedef struct rt_unit {
 	 * a pose samples only the channels of the joints it poses. */
 	uint32_t *chan_at;        /* joint_count + 1 */
 	uint32_t *chan_list;      /* channel_count */
-	/* Resident motion levels, per joint: 1 when a channel of it has more
+	/* Resident motion levels, per joint: 0 when a channel of it has more
 	 * than one key (animated: sampled per frame); else its local matrix
-	 * is fixed, rt_trs_cols of the rest transform after its one-key
-	 * channels, in static_mat (16 floats per joint), made at load. */
-	uint8_t *animated;        /* joint_count */
-	float *static_mat;        /* 16 per joint */
+	 * is fixed, made at load: 1, no channel: ctx->rest_mat; k >= 2, its
+	 * channels all have one key: static_mat + 16 * (k - 2), rt_trs_cols
+	 * of the rest transform after those keys. */
+	uint32_t *fixed;          /* joint_count */
+	float *static_mat;        /* 16 per joint with one-key channels only */
 	void *plan_block;
 } rt_unit;
 
@@ -112,6 +113,7 @@ struct mlod_rt_ctx {
 	uint32_t joint_count, skin_count, palette_size;
 	uint32_t *skin_offset;    /* skin_count: first palette entry of each skin */
 	float *rest_world;        /* 16 per joint */
+	float *rest_mat;          /* 16 per joint: the local matrix of the rest transform */
 	mlod_trs *rest_local;     /* joint_count */
 	uint32_t *all_joints;     /* 0..joint_count-1: level 0's posed and kept list */
 	uint8_t *all_needed;      /* joint_count ones */
