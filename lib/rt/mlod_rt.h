@@ -130,11 +130,11 @@
  * same floats). The levels the runtime decodes from a pack have their
  * rotation keys normalised once when they load (when that gives the same
  * samples), so that sampling need not normalise them every frame; views
- * are never changed. A motion level's load also sorts its channels by
- * joint and makes the local matrix of each joint whose channels all have
- * one key (counted in its resident bytes: mlod_rt_eval(3)), so a pose
- * samples only its joints' channels and a joint without a channel of
- * several keys costs one matrix product.
+ * are never changed. A motion level's load also lists the channels of
+ * its animated joints (a channel of several keys) and makes the local
+ * matrix of each joint whose channels all have one key (counted in its
+ * resident bytes: mlod_rt_eval(3)), so a pose samples only the animated
+ * joints' channels and any other joint costs one matrix product.
  *
  * Skeleton levels, folded at run time: a kept joint c whose parent chain
  * j1 (its parent) ... jk was removed gets the local transform

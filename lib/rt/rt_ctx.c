@@ -184,19 +184,19 @@ static void mat_identity(float *m)
 	m[0] = m[5] = m[10] = m[15] = 1.0f;
 }
 
-/* The runtime's tables of a motion level of C channels, S of its joints
- * with one-key channels only (prepare_motion): per joint a channel range
- * and a fixed-matrix index, the channels' order, and S matrices: 8 bytes
- * per joint, 4 per channel, 64 per such joint, plus 4. */
-static size_t motion_plan_bytes(uint32_t J, uint32_t C, uint32_t S)
+/* The runtime's tables of a motion level (prepare_motion): a fixed-matrix
+ * index per joint, the A channels of its animated joints, and the
+ * matrices of its S joints with one-key channels only: 4 bytes per joint
+ * and per such channel, 64 per such joint. */
+static size_t motion_plan_bytes(uint32_t J, uint32_t A, uint32_t S)
 {
-	return ((size_t)2 * J + 1 + C) * sizeof(uint32_t) + 16 * sizeof(float) * (size_t)S;
+	return ((size_t)J + A) * sizeof(uint32_t) + 16 * sizeof(float) * (size_t)S;
 }
 
 /* Checks a motion level and sets its channel bits (ctx->chan_bits). A
  * level the runtime decoded (owned) has the keys of a non-cubic rotation
  * replaced by their normalisation when each of those is its own: sampling
- * normalises every key it reads (mlod_quat_slerp, and sample_motion after
+ * normalises every key it reads (mlod_quat_slerp, and sample_one after
  * a key or STEP), so the samples stay the same floats, and the keys need
  * no normalising per frame. The caller's views are only read. */
 static mlod_result prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_motion *m, mlod_error *err)
@@ -204,68 +204,64 @@ static mlod_result prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_
 	mlod_result r = check_motion(ctx, m, u->level, u->item, err);
 	if (r)
 		return r;
-	/* The channels by joint (a counting sort, stable), and the fixed
-	 * local matrices of the joints whose channels all have one key. */
+	/* The joints' fixed local matrices and the animated joints' channels. */
 	const uint32_t J = ctx->joint_count, C = m->channel_count;
-	uint32_t S = 0;
-	{
-		uint8_t *mark = rt_calloc(ctx, (size_t)J + 1, 2); /* [j]: has a channel; [J + 1 + j]: one with keys > 1 */
-		if (!mark)
-			return mlod_fail(err, MLOD_ERR_NOMEM, "motion level %u of clip %u: out of memory", u->level, u->item);
-		for (uint32_t i = 0; i < C; i++) {
-			mark[m->channels[i].rec.joint] = 1;
-			if (m->channels[i].rec.key_count > 1)
-				mark[J + 1 + m->channels[i].rec.joint] = 1;
-		}
-		for (uint32_t j = 0; j < J; j++)
-			S += mark[j] && !mark[J + 1 + j];
-		rt_free(ctx, mark);
-	}
-	const size_t cbytes = motion_plan_bytes(J, C, S);
-	uint32_t *cblock = rt_alloc(ctx, cbytes);
-	if (!cblock)
+	/* [j]: has a channel; [J + j]: one with more than one key */
+	uint8_t *mark = rt_calloc(ctx, (size_t)J + 1, 2);
+	mlod_trs *l = rt_calloc(ctx, (size_t)J + 1, sizeof *l);
+	if (!mark || !l) {
+		rt_free(ctx, mark), rt_free(ctx, l);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "motion level %u of clip %u: out of memory", u->level, u->item);
+	}
+	for (uint32_t i = 0; i < C; i++) {
+		mark[m->channels[i].rec.joint] = 1;
+		if (m->channels[i].rec.key_count > 1)
+			mark[J + m->channels[i].rec.joint] = 1;
+	}
+	uint32_t S = 0, A = 0;
+	for (uint32_t j = 0; j < J; j++)
+		S += mark[j] && !mark[J + j];
+	for (uint32_t i = 0; i < C; i++)
+		A += mark[J + m->channels[i].rec.joint];
+	const size_t cbytes = motion_plan_bytes(J, A, S);
+	uint32_t *cblock = rt_alloc(ctx, cbytes ? cbytes : 4);
+	if (!cblock) {
+		rt_free(ctx, mark), rt_free(ctx, l);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "motion level %u of clip %u: out of memory", u->level, u->item);
+	}
 	u->plan_block = cblock;
 	u->bytes += cbytes;
-	u->chan_at = cblock, u->fixed = cblock + J + 1, u->chan_list = u->fixed + J;
-	u->static_mat = (float *)(u->chan_list + C);
-	memset(u->chan_at, 0, ((size_t)J + 1) * sizeof(uint32_t));
-	for (uint32_t i = 0; i < C; i++)
-		u->chan_at[m->channels[i].rec.joint + 1]++;
-	for (uint32_t j = 0; j < J; j++)
-		u->chan_at[j + 1] += u->chan_at[j];
-	for (uint32_t i = 0; i < C; i++)
-		u->chan_list[u->chan_at[m->channels[i].rec.joint]++] = i;
-	for (uint32_t j = J; j > 0; j--) /* each chan_at[j] is now the end of joint j's: shift back */
-		u->chan_at[j] = u->chan_at[j - 1];
-	u->chan_at[0] = 0;
+	u->fixed = cblock, u->anim = cblock + J, u->anim_count = A;
+	u->static_mat = (float *)(u->anim + A);
 	uint32_t k = 0;
 	for (uint32_t j = 0; j < J; j++) {
-		u->fixed[j] = 1;
-		if (u->chan_at[j] == u->chan_at[j + 1])
-			continue;
-		mlod_trs l = ctx->rest_local[j];
-		for (uint32_t c = u->chan_at[j]; c < u->chan_at[j + 1] && u->fixed[j]; c++) {
-			const mlod_pack_channel *ch = &m->channels[u->chan_list[c]];
-			if (ch->rec.key_count > 1)
-				u->fixed[j] = 0;
-			if (ch->rec.key_count != 1)
-				continue;
-			/* sample_one's copy of a lone key (normalised if a rotation) */
-			const int rot = ch->rec.path == 1, cubic = ch->rec.interp == 2;
-			const float *q = ch->values + (cubic ? (rot ? 4 : 3) : 0);
-			if (rot)
-				l.r = mlod_quat_normalize((mlod_quat){ q[0], q[1], q[2], q[3] });
-			else if (ch->rec.path == 0)
-				l.t.x = q[0], l.t.y = q[1], l.t.z = q[2];
-			else
-				l.s.x = q[0], l.s.y = q[1], l.s.z = q[2];
-		}
-		if (u->fixed[j]) {
-			rt_trs_cols(&l, u->static_mat + 16 * (size_t)k);
-			u->fixed[j] = 2 + k++;
-		}
+		u->fixed[j] = mark[J + j] ? 0 : mark[j] ? 2 + k++ : 1;
+		l[j] = ctx->rest_local[j];
 	}
+	A = 0;
+	for (uint32_t i = 0; i < C; i++) {
+		const mlod_pack_channel *ch = &m->channels[i];
+		const uint32_t j = ch->rec.joint;
+		if (!u->fixed[j]) {
+			u->anim[A++] = i;
+			continue;
+		}
+		if (ch->rec.key_count != 1)
+			continue;
+		/* sample_one's copy of a lone key (normalised if a rotation) */
+		const int rot = ch->rec.path == 1, cubic = ch->rec.interp == 2;
+		const float *q = ch->values + (cubic ? (rot ? 4 : 3) : 0);
+		if (rot)
+			l[j].r = mlod_quat_normalize((mlod_quat){ q[0], q[1], q[2], q[3] });
+		else if (ch->rec.path == 0)
+			l[j].t.x = q[0], l[j].t.y = q[1], l[j].t.z = q[2];
+		else
+			l[j].s.x = q[0], l[j].s.y = q[1], l[j].s.z = q[2];
+	}
+	for (uint32_t j = 0; j < J; j++)
+		if (u->fixed[j] >= 2)
+			rt_trs_cols(&l[j], u->static_mat + 16 * (size_t)(u->fixed[j] - 2));
+	rt_free(ctx, mark), rt_free(ctx, l);
 	if (!ctx->chan_bits)
 		return MLOD_OK;
 	uint8_t *bits = ctx->chan_bits + (size_t)(u - &ctx->units[ctx->unit_base[MLOD_RT_MOTION]]) * ctx->chan_bytes;
@@ -473,8 +469,7 @@ static void unit_release(mlod_rt_ctx *ctx, rt_unit *u)
 	u->skin_order_at = NULL, u->skin_order = NULL;
 	ctx->unit_gen++;
 	u->chan_flags = NULL;
-	u->chan_at = u->chan_list = NULL;
-	u->fixed = NULL, u->static_mat = NULL;
+	u->fixed = u->anim = NULL, u->anim_count = 0, u->static_mat = NULL;
 	u->skel = NULL, u->mesh = NULL, u->motion = NULL;
 	ctx->resident_bytes -= u->bytes;
 	u->bytes = 0;

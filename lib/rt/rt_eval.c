@@ -32,7 +32,7 @@ static uint32_t find_key(const float *times, uint32_t n, float t)
 
 /* Where t falls in a channel's key times: on key k (clamped, or one key),
  * or between keys i and i + 1 at u. Channels sharing a key-time array
- * (the pack's, mlod(5)) share it, so sample_motion finds it once. */
+ * (the pack's, mlod(5)) share it, so pose_joints finds it once. */
 typedef struct rt_key_pos {
 	const float *times;
 	uint32_t n;
@@ -172,7 +172,7 @@ static inline void quat_slerp(const float *a, const float *b, float t, int unit,
 
 /* One channel between keys p->i and p->i + 1 (LINEAR or CUBICSPLINE), as
  * lib/model/pose.c's sample_channel followed, for rotations, by
- * sample_motion's normalisation. */
+ * sample_one's normalisation. */
 static void sample_channel(const mlod_pack_channel *ch, const rt_key_pos *p, int comps, int unit, float *out)
 {
 	const int cubic = ch->rec.interp == 2;
@@ -306,16 +306,15 @@ static float sample_time(const mlod_rt_ctx *ctx, const mlod_rt_state *st)
 	return t;
 }
 
-/* Poses the npose joints posed[] (increasing: parents first) of the
- * instance: each joint's local transform (the rest transform, then the
- * motion level's channels of it) and its world matrix. A joint without
- * channels or whose channels all have one key (u->fixed) takes the local
- * matrix made at open or at the level's load, the same floats; only the others are
- * sampled, through the level's channels by joint (chan_at, chan_list),
- * a joint's in the level's order, so a later channel of the same joint
- * and path still wins. */
+/* Poses the npose joints posed[] (increasing: parents first; needed[]
+ * flags them) of the instance: each joint's local transform (the rest
+ * transform, then the motion level's channels of it) and its world
+ * matrix. A joint without channels or whose channels all have one key
+ * (u->fixed) takes the local matrix made at open or at the level's load,
+ * the same floats; only the others' channels are sampled, in the level's
+ * order (u->anim). */
 static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_rt_state *st, const uint32_t *posed,
-                        uint32_t npose)
+                        uint32_t npose, const uint8_t *needed)
 {
 	const mlod_pack_joint_rec *jr = ctx->skel->joints;
 	mlod_trs *local = s->local;
@@ -338,15 +337,14 @@ static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_r
 	const uint8_t *flags = mu->chan_flags;
 	const uint32_t nbits = 8 * ctx->chan_bytes;
 	const float t = sample_time(ctx, st);
+	for (uint32_t i = 0; i < npose; i++)
+		if (!mu->fixed[posed[i]])
+			local[posed[i]] = ctx->rest_local[posed[i]];
 	rt_key_pos p = { NULL, 0, 0, 0, 0.0f, 0.0f };
-	/* Sampling first, then the world matrices (one chain of products). */
-	for (uint32_t i = 0; i < npose; i++) {
-		const uint32_t j = posed[i];
-		if (mu->fixed[j])
-			continue;
-		local[j] = ctx->rest_local[j];
-		for (uint32_t c = mu->chan_at[j]; c < mu->chan_at[j + 1]; c++)
-			sample_one(m, mu->chan_list[c], flags, nbits, t, &p, local);
+	for (uint32_t a = 0; a < mu->anim_count; a++) {
+		const uint32_t i = mu->anim[a];
+		if (needed[m->channels[i].rec.joint])
+			sample_one(m, i, flags, nbits, t, &p, local);
 	}
 	for (uint32_t i = 0; i < npose; i++) {
 		const uint32_t j = posed[i];
@@ -369,7 +367,8 @@ mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	const mlod_rt_state *st = &ctx->inst[id].st;
 	const rt_unit *su = skel_unit(ctx, st);
-	pose_joints(ctx, s, st, su ? su->plan.posed : ctx->all_joints, su ? su->plan.posed_count : ctx->joint_count);
+	pose_joints(ctx, s, st, su ? su->plan.posed : ctx->all_joints, su ? su->plan.posed_count : ctx->joint_count,
+	            su ? su->plan.needed : ctx->all_needed);
 	s->skel_unit = su;
 	s->id = id;
 	s->posed = 1;
@@ -522,7 +521,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	 * rigid parts follow (with their ancestors), and those entries. */
 	const rt_unit *su = skel_unit(ctx, st);
 	skin_plan(ctx, s, su, mu);
-	pose_joints(ctx, s, st, s->plan_posed, s->plan_count);
+	pose_joints(ctx, s, st, s->plan_posed, s->plan_count, s->plan_need);
 	s->skel_unit = su;
 	s->id = id;
 	s->posed = 2;

@@ -57,18 +57,16 @@ typedef struct rt_unit {
 	uint32_t *skin_order_at;
 	uint8_t *skin_order;
 	uint8_t *chan_flags;      /* resident motion levels: a bit per channel (in ctx->chan_bits) */
-	/* Resident motion levels: their channels by joint, in plan_block:
-	 * joint j's are chan_list[chan_at[j] .. chan_at[j + 1] - 1], in the
-	 * level's order (so a later channel of the same path still wins), so
-	 * a pose samples only the channels of the joints it poses. */
-	uint32_t *chan_at;        /* joint_count + 1 */
-	uint32_t *chan_list;      /* channel_count */
-	/* Resident motion levels, per joint: 0 when a channel of it has more
-	 * than one key (animated: sampled per frame); else its local matrix
-	 * is fixed, made at load: 1, no channel: ctx->rest_mat; k >= 2, its
-	 * channels all have one key: static_mat + 16 * (k - 2), rt_trs_cols
-	 * of the rest transform after those keys. */
+	/* Resident motion levels, in plan_block. Per joint (fixed): 0 when a
+	 * channel of it has more than one key (animated: sampled per frame);
+	 * else its local matrix is fixed, made at load: 1, no channel:
+	 * ctx->rest_mat; k >= 2, its channels all have one key: static_mat +
+	 * 16 * (k - 2), rt_trs_cols of the rest transform after those keys.
+	 * anim: the channels of the animated joints, in the level's order (so
+	 * a later channel of the same joint and path still wins). */
 	uint32_t *fixed;          /* joint_count */
+	uint32_t *anim;           /* anim_count */
+	uint32_t anim_count;
 	float *static_mat;        /* 16 per joint with one-key channels only */
 	void *plan_block;
 } rt_unit;
