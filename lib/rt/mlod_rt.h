@@ -122,13 +122,19 @@
  * with tangents scaled by the key interval; rotations are normalised after
  * sampling. Joints without a channel keep their rest TRS. The one
  * departure: slerp's weights come from one sine and one cosine instead of
- * three sines, which in double moves them by about 1e-13 of themselves,
- * and a normalisation multiplies by 1 / length instead of dividing by it
- * (an ulp of a double), both far below a float's resolution (the committed
- * samples' poses are the same floats). The levels the runtime decodes from a pack have their
+ * three sines, which in double moves them by about 1e-13 of themselves, or,
+ * for keys within 26 degrees, from power series in the squared angle (no
+ * acos, sin or cos; at most 3e-14 of themselves), and a normalisation
+ * multiplies by 1 / length instead of dividing by it (an ulp of a double),
+ * all far below a float's resolution (the committed samples' poses are the
+ * same floats). The levels the runtime decodes from a pack have their
  * rotation keys normalised once when they load (when that gives the same
  * samples), so that sampling need not normalise them every frame; views
- * are never changed.
+ * are never changed. A motion level's load also lists the channels of
+ * its animated joints (a channel of several keys) and makes the local
+ * matrix of each joint whose channels all have one key (counted in its
+ * resident bytes: mlod_rt_eval(3)), so a pose samples only the animated
+ * joints' channels and any other joint costs one matrix product.
  *
  * Skeleton levels, folded at run time: a kept joint c whose parent chain
  * j1 (its parent) ... jk was removed gets the local transform

@@ -184,17 +184,86 @@ static void mat_identity(float *m)
 	m[0] = m[5] = m[10] = m[15] = 1.0f;
 }
 
+/* The runtime's tables of a motion level (prepare_motion): a fixed-matrix
+ * index per joint, the A channels of its animated joints, and the
+ * matrices of its S joints with one-key channels only: 4 bytes per joint
+ * and per such channel, 64 per such joint. */
+static size_t motion_plan_bytes(uint32_t J, uint32_t A, uint32_t S)
+{
+	return ((size_t)J + A) * sizeof(uint32_t) + 16 * sizeof(float) * (size_t)S;
+}
+
 /* Checks a motion level and sets its channel bits (ctx->chan_bits). A
  * level the runtime decoded (owned) has the keys of a non-cubic rotation
  * replaced by their normalisation when each of those is its own: sampling
- * normalises every key it reads (mlod_quat_slerp, and sample_motion after
+ * normalises every key it reads (mlod_quat_slerp, and sample_one after
  * a key or STEP), so the samples stay the same floats, and the keys need
  * no normalising per frame. The caller's views are only read. */
 static mlod_result prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_motion *m, mlod_error *err)
 {
 	mlod_result r = check_motion(ctx, m, u->level, u->item, err);
-	if (r || !ctx->chan_bits)
+	if (r)
 		return r;
+	/* The joints' fixed local matrices and the animated joints' channels. */
+	const uint32_t J = ctx->joint_count, C = m->channel_count;
+	/* [j]: has a channel; [J + j]: one with more than one key */
+	uint8_t *mark = rt_calloc(ctx, (size_t)J + 1, 2);
+	mlod_trs *l = rt_calloc(ctx, (size_t)J + 1, sizeof *l);
+	if (!mark || !l) {
+		rt_free(ctx, mark), rt_free(ctx, l);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "motion level %u of clip %u: out of memory", u->level, u->item);
+	}
+	for (uint32_t i = 0; i < C; i++) {
+		mark[m->channels[i].rec.joint] = 1;
+		if (m->channels[i].rec.key_count > 1)
+			mark[J + m->channels[i].rec.joint] = 1;
+	}
+	uint32_t S = 0, A = 0;
+	for (uint32_t j = 0; j < J; j++)
+		S += mark[j] && !mark[J + j];
+	for (uint32_t i = 0; i < C; i++)
+		A += mark[J + m->channels[i].rec.joint];
+	const size_t cbytes = motion_plan_bytes(J, A, S);
+	uint32_t *cblock = rt_alloc(ctx, cbytes ? cbytes : 4);
+	if (!cblock) {
+		rt_free(ctx, mark), rt_free(ctx, l);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "motion level %u of clip %u: out of memory", u->level, u->item);
+	}
+	u->plan_block = cblock;
+	u->bytes += cbytes;
+	u->fixed = cblock, u->anim = cblock + J, u->anim_count = A;
+	u->static_mat = (float *)(u->anim + A);
+	uint32_t k = 0;
+	for (uint32_t j = 0; j < J; j++) {
+		u->fixed[j] = mark[J + j] ? 0 : mark[j] ? 2 + k++ : 1;
+		l[j] = ctx->rest_local[j];
+	}
+	A = 0;
+	for (uint32_t i = 0; i < C; i++) {
+		const mlod_pack_channel *ch = &m->channels[i];
+		const uint32_t j = ch->rec.joint;
+		if (!u->fixed[j]) {
+			u->anim[A++] = i;
+			continue;
+		}
+		if (ch->rec.key_count != 1)
+			continue;
+		/* sample_one's copy of a lone key (normalised if a rotation) */
+		const int rot = ch->rec.path == 1, cubic = ch->rec.interp == 2;
+		const float *q = ch->values + (cubic ? (rot ? 4 : 3) : 0);
+		if (rot)
+			l[j].r = mlod_quat_normalize((mlod_quat){ q[0], q[1], q[2], q[3] });
+		else if (ch->rec.path == 0)
+			l[j].t.x = q[0], l[j].t.y = q[1], l[j].t.z = q[2];
+		else
+			l[j].s.x = q[0], l[j].s.y = q[1], l[j].s.z = q[2];
+	}
+	for (uint32_t j = 0; j < J; j++)
+		if (u->fixed[j] >= 2)
+			rt_trs_cols(&l[j], u->static_mat + 16 * (size_t)(u->fixed[j] - 2));
+	rt_free(ctx, mark), rt_free(ctx, l);
+	if (!ctx->chan_bits)
+		return MLOD_OK;
 	uint8_t *bits = ctx->chan_bits + (size_t)(u - &ctx->units[ctx->unit_base[MLOD_RT_MOTION]]) * ctx->chan_bytes;
 	memset(bits, 0, ctx->chan_bytes);
 	for (uint32_t i = 0; i < m->channel_count && i < 8 * ctx->chan_bytes; i++) {
@@ -400,6 +469,7 @@ static void unit_release(mlod_rt_ctx *ctx, rt_unit *u)
 	u->skin_order_at = NULL, u->skin_order = NULL;
 	ctx->unit_gen++;
 	u->chan_flags = NULL;
+	u->fixed = u->anim = NULL, u->anim_count = 0, u->static_mat = NULL;
 	u->skel = NULL, u->mesh = NULL, u->motion = NULL;
 	ctx->resident_bytes -= u->bytes;
 	u->bytes = 0;
@@ -487,6 +557,17 @@ static size_t evictable_bytes(const mlod_rt_ctx *ctx)
 	return b;
 }
 
+/* motion_plan_bytes of a motion level's views, bounding its joints with
+ * one-key channels only by the joints and by its one-key channels. */
+static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m)
+{
+	const uint32_t J = ctx->joint_count, C = m->channel_count;
+	uint32_t S = 0;
+	for (uint32_t i = 0; i < C; i++)
+		S += m->channels[i].rec.key_count == 1;
+	return motion_plan_bytes(J, C, S < J ? S : J);
+}
+
 /* An upper bound of a unit's resident size before loading it, so that
  * room is made before decoding and resident bytes never pass the budget,
  * not even while a level decodes. Views know their size. For packs:
@@ -507,13 +588,16 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 	                                           : 0;
 	if (!ctx->load) {
 		const mlod_rt_view_level *v = u->view;
+		if (v && v->bytes && u->layer == MLOD_RT_MOTION)
+			return v->bytes + (v->data ? motion_plan_hint(ctx, v->data) : 0);
 		if (v && v->bytes)
 			return v->bytes + plan + (u->layer == MLOD_RT_MESH && v->data ? skin_order_bytes(v->data) : 0);
 		if (v && v->data)
 			switch (u->layer) {
 			case MLOD_RT_SKELETON: return rt_bytes_skel_level(v->data) + plan;
 			case MLOD_RT_MESH: return rt_bytes_mesh(v->data) + plan + skin_order_bytes(v->data);
-			default: return rt_bytes_motion(v->data);
+			default:
+				return rt_bytes_motion(v->data) + motion_plan_hint(ctx, v->data);
 			}
 		return 0;
 	}
@@ -526,6 +610,10 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 			break;
 		hint += 4 * (size_t)v->raw_size + 256;
 	}
+	/* A motion level's tables: its channels (decoded, counted in the hint
+	 * so far at sizeof(mlod_pack_channel) each) are at most hint / that. */
+	if (u->layer == MLOD_RT_MOTION)
+		hint += motion_plan_bytes(ctx->joint_count, 0, ctx->joint_count) + 4 * (hint / sizeof(mlod_pack_channel));
 	return hint;
 }
 
@@ -667,6 +755,7 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 			                 (int)s->joints[j].parent);
 	ctx->skin_offset = rt_calloc(ctx, s->skin_count + 1, sizeof *ctx->skin_offset);
 	ctx->rest_world = rt_calloc(ctx, J, 16 * sizeof(float));
+	ctx->rest_mat = rt_calloc(ctx, J, 16 * sizeof(float));
 	ctx->rest_local = rt_calloc(ctx, J, sizeof *ctx->rest_local);
 	ctx->all_joints = rt_calloc(ctx, J, sizeof *ctx->all_joints);
 	ctx->all_needed = rt_calloc(ctx, J, 1);
@@ -675,7 +764,7 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 	const size_t motion_units = (size_t)ctx->levels[MLOD_RT_MOTION] * ctx->clip_count;
 	ctx->chan_bytes = (3 * J + 7) / 8;
 	ctx->chan_bits = motion_units ? rt_calloc(ctx, motion_units, ctx->chan_bytes) : NULL;
-	if ((motion_units && !ctx->chan_bits) || !ctx->skin_offset || !ctx->rest_world || !ctx->rest_local || !ctx->all_joints || !ctx->all_needed ||
+	if ((motion_units && !ctx->chan_bits) || !ctx->skin_offset || !ctx->rest_world || !ctx->rest_mat || !ctx->rest_local || !ctx->all_joints || !ctx->all_needed ||
 	    !ctx->clip_duration || !ctx->inst)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
 	uint64_t pal = 0;
@@ -706,7 +795,7 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 		               { jr->r[0], jr->r[1], jr->r[2], jr->r[3] },
 		               { jr->s[0], jr->s[1], jr->s[2] } };
 		ctx->rest_local[j] = t;
-		float l[16];
+		float *l = ctx->rest_mat + 16 * (size_t)j;
 		rt_mat_trs(&t, l);
 		rt_mat_mul(jr->parent < 0 ? jr->base : ctx->rest_world + 16 * (size_t)jr->parent, l,
 		           ctx->rest_world + 16 * (size_t)j);
@@ -816,6 +905,7 @@ void mlod_rt_close(mlod_rt_ctx *ctx)
 	rt_free(ctx, ctx->units);
 	rt_free(ctx, ctx->skin_offset);
 	rt_free(ctx, ctx->rest_world);
+	rt_free(ctx, ctx->rest_mat);
 	rt_free(ctx, ctx->rest_local);
 	rt_free(ctx, ctx->all_joints);
 	rt_free(ctx, ctx->all_needed);

@@ -32,7 +32,7 @@ static uint32_t find_key(const float *times, uint32_t n, float t)
 
 /* Where t falls in a channel's key times: on key k (clamped, or one key),
  * or between keys i and i + 1 at u. Channels sharing a key-time array
- * (the pack's, mlod(5)) share it, so sample_motion finds it once. */
+ * (the pack's, mlod(5)) share it, so pose_joints finds it once. */
 typedef struct rt_key_pos {
 	const float *times;
 	uint32_t n;
@@ -87,6 +87,55 @@ static inline void quat_blend(const float *a, double wa, const float *b, double 
 	out[0] = (float)(x * r), out[1] = (float)(y * r), out[2] = (float)(z * r), out[3] = (float)(w * r);
 }
 
+/* cos(t theta) and sin(t theta) / sin theta for theta = acos(d), 0.9 <= d
+ * <= 1, t in [0, 1], by power series in doubles instead of acos, sin and
+ * cos: with y = 1 - d (exact), x = theta^2 = 2 sum_n (2y)^n / (n^2
+ * binomial(2n, n)) (as 4 asin(sqrt(y / 2))^2; 12 terms, y <= 0.1: the
+ * next is below 1e-17 of x); then with S(z) = sin(sqrt z) / sqrt z and
+ * C(z) = cos(sqrt z) (Taylor, 9 and 10 terms for z <= x <= 0.21),
+ * sin(t theta) / sin theta = t S(t^2 x) / S(x) and cos(t theta) =
+ * C(t^2 x). Against acos, sin and cos over 2e5 random d and t the weight
+ * differs by at most 3e-14 of itself and the cosine by 1.2e-16, like the
+ * one-sine identity below, far below a float's 6e-8. */
+static inline void slerp_weights_near(double d, double t, double *ct, double *wb)
+{
+	const double y = 1.0 - d;
+	/* Horner, written out */
+	const double x =
+	    y * (2.0 + y * (0.33333333333333331 +
+	                    y * (0.088888888888888892 +
+	                         y * (0.028571428571428571 +
+	                              y * (0.010158730158730159 +
+	                                   y * (0.0038480038480038481 +
+	                                        y * (0.0015222872365729509 +
+	                                             y * (0.0006216006216006216 +
+	                                                  y * (0.00026001594629045609 +
+	                                                       y * (0.00011084890341856287 +
+	                                                            y * (4.7986538276434138e-05 +
+	                                                                 y * 2.1037576563219316e-05)))))))))));
+	const double z = t * t * x;
+#define RT_SINC(v)                                                                                             \
+	(1.0 + (v) * (-0.16666666666666666 +                                                                   \
+	              (v) * (0.0083333333333333332 +                                                           \
+	                     (v) * (-0.00019841269841269841 +                                                  \
+	                            (v) * (2.7557319223985893e-06 +                                            \
+	                                   (v) * (-2.505210838544172e-08 +                                     \
+	                                          (v) * (1.6059043836821613e-10 +                              \
+	                                                 (v) * (-7.6471637318198164e-13 +                      \
+	                                                        (v) * 2.8114572543455206e-15))))))))
+	const double sx = RT_SINC(x), sz = RT_SINC(z);
+#undef RT_SINC
+	*ct = 1.0 + z * (-0.5 +
+	                 z * (0.041666666666666664 +
+	                      z * (-0.0013888888888888889 +
+	                           z * (2.4801587301587302e-05 +
+	                                z * (-2.7557319223985888e-07 +
+	                                     z * (2.08767569878681e-09 +
+	                                          z * (-1.1470745597729725e-11 +
+	                                               z * (4.7794773323873853e-14 + z * -1.5619206968586225e-16))))))));
+	*wb = t * sz / sx;
+}
+
 /* mlod_quat_slerp(a, b, t), the same doubles; unit: a and b are their own
  * normalisation (the channel's bit in ctx->chan_bits), which it then
  * skips. */
@@ -111,15 +160,19 @@ static inline void quat_slerp(const float *a, const float *b, float t, int unit,
 	 * they differ from mlod_quat_slerp's by ~1e-13 of the weight (d <=
 	 * 0.9995 keeps 1 - d^2 >= 1e-3), far below a float's 6e-8, so the
 	 * blended floats agree but for a rare last bit. */
-	const double theta = acos(d), s = sqrt(1.0 - d * d);
-	const double st = sin(t * theta), ct = cos(t * theta);
-	const double wb = st / s;
+	double ct, wb;
+	if (d >= 0.9) { /* theta <= 26 degrees, most key pairs: no acos, sin, cos */
+		slerp_weights_near(d, t, &ct, &wb);
+	} else {
+		const double theta = acos(d), s = sqrt(1.0 - d * d);
+		ct = cos(t * theta), wb = sin(t * theta) / s;
+	}
 	quat_blend(a, ct - d * wb, b, sign * wb, out);
 }
 
 /* One channel between keys p->i and p->i + 1 (LINEAR or CUBICSPLINE), as
  * lib/model/pose.c's sample_channel followed, for rotations, by
- * sample_motion's normalisation. */
+ * sample_one's normalisation. */
 static void sample_channel(const mlod_pack_channel *ch, const rt_key_pos *p, int comps, int unit, float *out)
 {
 	const int cubic = ch->rec.interp == 2;
@@ -152,49 +205,48 @@ static void sample_channel(const mlod_pack_channel *ch, const rt_key_pos *p, int
 		memcpy(out, q, 3 * sizeof *out);
 }
 
-/* Samples the channels of the posed joints into local. flags: the motion
- * unit's channel bits, nbits of them (ctx->chan_bits; NULL: none). A
- * value read from a key (one key, clamped, STEP: a constant channel is
- * stored as one key) is copied here; sample_channel interpolates. */
-static void sample_motion(const mlod_pack_motion *m, const uint8_t *flags, uint32_t nbits, float t,
-                          const uint8_t *needed, mlod_trs *local)
+/* Channel i of m into local, *p the last key position found (a key-time
+ * array shared with the channel before is searched once). flags: the
+ * motion unit's channel bits, nbits of them (ctx->chan_bits; NULL:
+ * none). A value read from a key (one key, clamped, STEP: a constant
+ * channel is stored as one key) is copied here; sample_channel
+ * interpolates. */
+static inline void sample_one(const mlod_pack_motion *m, uint32_t i, const uint8_t *flags, uint32_t nbits, float t,
+                              rt_key_pos *p, mlod_trs *local)
 {
-	rt_key_pos p = { NULL, 0, 0, 0, 0.0f, 0.0f };
-	for (uint32_t i = 0; i < m->channel_count; i++) {
-		const mlod_pack_channel *ch = &m->channels[i];
-		const uint32_t n = ch->rec.key_count;
-		if (n < 1 || !needed[ch->rec.joint])
-			continue;
-		const int rot = ch->rec.path != 0 && ch->rec.path != 2;
-		const int unit = rot && flags && i < nbits ? (flags[i >> 3] >> (i & 7)) & 1 : 0;
-		const int comps = rot ? 4 : 3;
-		const float *key;
-		float v[4];
-		uint32_t k = 0;
-		if (n > 1) {
-			if (ch->times != p.times || n != p.n)
-				key_pos(ch->times, n, t, &p);
-			k = p.k >= 0 ? (uint32_t)p.k : p.i;
-		}
-		if (n == 1 || p.k >= 0 || ch->rec.interp == 1) { /* on a key, or STEP */
-			const int cubic = ch->rec.interp == 2;
-			key = ch->values + (size_t)k * (cubic ? 3 * (size_t)comps : (size_t)comps) + (cubic ? comps : 0);
-			if (rot && !unit) {
-				quat_norm(key, v);
-				key = v;
-			}
-		} else {
-			sample_channel(ch, &p, comps, unit, v);
+	const mlod_pack_channel *ch = &m->channels[i];
+	const uint32_t n = ch->rec.key_count;
+	if (n < 1)
+		return;
+	const int rot = ch->rec.path != 0 && ch->rec.path != 2;
+	const int unit = rot && flags && i < nbits ? (flags[i >> 3] >> (i & 7)) & 1 : 0;
+	const int comps = rot ? 4 : 3;
+	const float *key;
+	float v[4];
+	uint32_t k = 0;
+	if (n > 1) {
+		if (ch->times != p->times || n != p->n)
+			key_pos(ch->times, n, t, p);
+		k = p->k >= 0 ? (uint32_t)p->k : p->i;
+	}
+	if (n == 1 || p->k >= 0 || ch->rec.interp == 1) { /* on a key, or STEP */
+		const int cubic = ch->rec.interp == 2;
+		key = ch->values + (size_t)k * (cubic ? 3 * (size_t)comps : (size_t)comps) + (cubic ? comps : 0);
+		if (rot && !unit) {
+			quat_norm(key, v);
 			key = v;
 		}
-		mlod_trs *l = &local[ch->rec.joint];
-		if (rot)
-			l->r.x = key[0], l->r.y = key[1], l->r.z = key[2], l->r.w = key[3];
-		else if (ch->rec.path == 0)
-			l->t.x = key[0], l->t.y = key[1], l->t.z = key[2];
-		else
-			l->s.x = key[0], l->s.y = key[1], l->s.z = key[2];
+	} else {
+		sample_channel(ch, p, comps, unit, v);
+		key = v;
 	}
+	mlod_trs *l = &local[ch->rec.joint];
+	if (rot)
+		l->r.x = key[0], l->r.y = key[1], l->r.z = key[2], l->r.w = key[3];
+	else if (ch->rec.path == 0)
+		l->t.x = key[0], l->t.y = key[1], l->t.z = key[2];
+	else
+		l->s.x = key[0], l->s.y = key[1], l->s.z = key[2];
 }
 
 /* ---------------------------------------------------------------- */
@@ -254,25 +306,55 @@ static float sample_time(const mlod_rt_ctx *ctx, const mlod_rt_state *st)
 	return t;
 }
 
-/* Poses the npose joints posed[] (increasing: parents first) of the
- * instance: the rest pose, the motion level's channels of the joints
- * needed[] flags, and the world matrices. */
+/* Poses the npose joints posed[] (increasing: parents first; needed[]
+ * flags them) of the instance: each joint's local transform (the rest
+ * transform, then the motion level's channels of it) and its world
+ * matrix. A joint without channels or whose channels all have one key
+ * (u->fixed) takes the local matrix made at open or at the level's load,
+ * the same floats; only the others' channels are sampled, in the level's
+ * order (u->anim). */
 static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_rt_state *st, const uint32_t *posed,
                         uint32_t npose, const uint8_t *needed)
 {
 	const mlod_pack_joint_rec *jr = ctx->skel->joints;
 	mlod_trs *local = s->local;
 	float *W = s->world;
-	for (uint32_t i = 0; i < npose; i++)
-		local[posed[i]] = ctx->rest_local[posed[i]];
+	const rt_unit *mu = NULL;
 	if (ctx->clip_count) {
-		const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MOTION, st->level[MLOD_RT_MOTION], st->clip);
-		if (mu && mu->state == RT_UNIT_RESIDENT)
-			sample_motion(mu->motion, mu->chan_flags, 8 * ctx->chan_bytes, sample_time(ctx, st), needed, local);
+		mu = rt_unit_get(ctx, MLOD_RT_MOTION, st->level[MLOD_RT_MOTION], st->clip);
+		if (mu && mu->state != RT_UNIT_RESIDENT)
+			mu = NULL;
+	}
+	if (!mu) { /* the rest pose */
+		for (uint32_t i = 0; i < npose; i++) {
+			const uint32_t j = posed[i];
+			rt_mat_mul(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, ctx->rest_mat + 16 * (size_t)j,
+			           W + 16 * (size_t)j);
+		}
+		return;
+	}
+	const mlod_pack_motion *m = mu->motion;
+	const uint8_t *flags = mu->chan_flags;
+	const uint32_t nbits = 8 * ctx->chan_bytes;
+	const float t = sample_time(ctx, st);
+	for (uint32_t i = 0; i < npose; i++)
+		if (!mu->fixed[posed[i]])
+			local[posed[i]] = ctx->rest_local[posed[i]];
+	rt_key_pos p = { NULL, 0, 0, 0, 0.0f, 0.0f };
+	for (uint32_t a = 0; a < mu->anim_count; a++) {
+		const uint32_t i = mu->anim[a];
+		if (needed[m->channels[i].rec.joint])
+			sample_one(m, i, flags, nbits, t, &p, local);
 	}
 	for (uint32_t i = 0; i < npose; i++) {
 		const uint32_t j = posed[i];
-		rt_mat_mul_trs(jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent, &local[j], W + 16 * (size_t)j);
+		const float *parent = jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent;
+		const uint32_t f = mu->fixed[j];
+		if (f)
+			rt_mat_mul(parent, f == 1 ? ctx->rest_mat + 16 * (size_t)j : mu->static_mat + 16 * (size_t)(f - 2),
+			           W + 16 * (size_t)j);
+		else
+			rt_mat_mul_trs(parent, &local[j], W + 16 * (size_t)j);
 	}
 }
 

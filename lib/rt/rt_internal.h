@@ -57,6 +57,17 @@ typedef struct rt_unit {
 	uint32_t *skin_order_at;
 	uint8_t *skin_order;
 	uint8_t *chan_flags;      /* resident motion levels: a bit per channel (in ctx->chan_bits) */
+	/* Resident motion levels, in plan_block. Per joint (fixed): 0 when a
+	 * channel of it has more than one key (animated: sampled per frame);
+	 * else its local matrix is fixed, made at load: 1, no channel:
+	 * ctx->rest_mat; k >= 2, its channels all have one key: static_mat +
+	 * 16 * (k - 2), rt_trs_cols of the rest transform after those keys.
+	 * anim: the channels of the animated joints, in the level's order (so
+	 * a later channel of the same joint and path still wins). */
+	uint32_t *fixed;          /* joint_count */
+	uint32_t *anim;           /* anim_count */
+	uint32_t anim_count;
+	float *static_mat;        /* 16 per joint with one-key channels only */
 	void *plan_block;
 } rt_unit;
 
@@ -100,6 +111,7 @@ struct mlod_rt_ctx {
 	uint32_t joint_count, skin_count, palette_size;
 	uint32_t *skin_offset;    /* skin_count: first palette entry of each skin */
 	float *rest_world;        /* 16 per joint */
+	float *rest_mat;          /* 16 per joint: the local matrix of the rest transform */
 	mlod_trs *rest_local;     /* joint_count */
 	uint32_t *all_joints;     /* 0..joint_count-1: level 0's posed and kept list */
 	uint8_t *all_needed;      /* joint_count ones */

@@ -761,11 +761,91 @@ TEST(skin_buckets_at_load)
 		t_failed_ = 1;
 }
 
+/* fixed_joints_and_near_slerp's checks on the open ctx: NULL, or what
+ * went wrong. */
+#define FCHECK(cond, ...)                                                                                            \
+	do {                                                                                                       \
+		if (!(cond)) {                                                                                     \
+			snprintf(why, sizeof why, __VA_ARGS__);                                                    \
+			return why;                                                                                \
+		}                                                                                                  \
+	} while (0)
+static const char *fixed_check(mlod_rt_ctx *ctx, mlod_rt_scratch *s)
+{
+	static char why[200];
+	mlod_error e;
+	uint32_t id;
+	FCHECK(mlod_rt_instance_create(ctx, 1, 1.0f, 0, &id, &e) == MLOD_OK, "create: %.120s", e.message);
+	FCHECK(force(ctx, id, 0, &e) == MLOD_OK, "update: %.120s", e.message);
+	const float *W;
+	FCHECK(mlod_rt_pose(ctx, s, id, &W, NULL, NULL, &e) == MLOD_OK, "pose: %.120s", e.message);
+	/* joint 0, no channel: its rest world matrix */
+	FCHECK(fx_maxdiff(W, fx_rest_world[0], 16) <= 1e-6, "joint 0 is not at rest");
+	float L[16];
+	local_of(W, 0, 1, L); /* Rz(30), the rest translation */
+	const double c30 = cos(30 * M_PI / 180), s30 = sin(30 * M_PI / 180);
+	FCHECK(NEAR(L[0], c30, 1e-6) && NEAR(L[1], s30, 1e-6) && NEAR(L[4], -s30, 1e-6) && NEAR(L[5], c30, 1e-6) &&
+	           NEAR(L[10], 1, 1e-6),
+	       "L1 is not Rz(30): %g %g %g %g", L[0], L[1], L[4], L[5]);
+	FCHECK(NEAR(L[12], fx_joints[1].t[0], 1e-6) && NEAR(L[13], fx_joints[1].t[1], 1e-6) &&
+	           NEAR(L[14], fx_joints[1].t[2], 1e-6),
+	       "L1 t = %g %g %g", L[12], L[13], L[14]);
+	local_of(W, 1, 2, L); /* translation: the later channel's */
+	FCHECK(NEAR(L[12], 0.25, 1e-6) && NEAR(L[13], 0, 1e-6) && NEAR(L[14], 0, 1e-6), "L2 t = %g %g %g", L[12],
+	       L[13], L[14]);
+	local_of(W, 2, 3, L); /* slerp Rz(0) -> Rz(40) at 1 / 4: Rz(10), scaled by 2 */
+	const double c10 = cos(10 * M_PI / 180), s10 = sin(10 * M_PI / 180);
+	FCHECK(NEAR(L[0], 2 * c10, 2e-6) && NEAR(L[1], 2 * s10, 2e-6) && NEAR(L[4], -2 * s10, 2e-6) &&
+	           NEAR(L[5], 2 * c10, 2e-6) && NEAR(L[10], 2, 2e-6),
+	       "L3 is not 2 Rz(10): %.7g %.7g %.7g", L[0], L[1], L[10]);
+	/* joint 4, no channel: its rest local transform under joint 1 */
+	local_of(W, 1, 4, L);
+	FCHECK(NEAR(L[12], fx_joints[4].t[0], 1e-6) && NEAR(L[13], fx_joints[4].t[1], 1e-6) &&
+	           NEAR(L[14], fx_joints[4].t[2], 1e-6),
+	       "L4 t = %g %g %g", L[12], L[13], L[14]);
+	return NULL;
+}
+#undef FCHECK
+
+/* A motion level's one-key channels (their joints' local matrices made at
+ * load), a joint without channels (the rest matrix), two one-key channels
+ * of one joint and path (the later wins), a joint mixing a one-key and an
+ * animated channel, and a slerp within 26 degrees (the series weights):
+ * clip 1's levels replaced by such a level while the ctx is open. */
+TEST(fixed_joints_and_near_slerp)
+{
+	static const float t0[1] = { 0 }, t04[2] = { 0, 4 };
+	static float r1[4], tr2a[3] = { 0.5f, 0, 0 }, tr2b[3] = { 0.25f, 0, 0 }, r3[8], s3[3] = { 2, 2, 2 };
+	fx_quat_z(30, r1);
+	for (int k = 0; k < 4; k++)
+		r1[k] *= 2; /* not unit */
+	fx_quat_z(0, r3), fx_quat_z(40, r3 + 4);
+	mlod_pack_channel ch[5];
+	fx_channel(&ch[0], 1, 1, 0, 1, t0, r1);
+	fx_channel(&ch[1], 2, 0, 0, 1, t0, tr2a);
+	fx_channel(&ch[2], 2, 0, 1, 1, t0, tr2b);
+	fx_channel(&ch[3], 3, 1, 0, 2, t04, r3);
+	fx_channel(&ch[4], 3, 2, 0, 1, t0, s3);
+	mlod_pack_motion saved[3];
+	memcpy(saved, fx_mo[1], sizeof saved);
+	for (int l = 0; l < 3; l++)
+		fx_motion(&fx_mo[1][l], ch, 5, 4);
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_all(NULL, &e); /* the views stay until close */
+	mlod_rt_scratch *s = ctx ? mlod_rt_scratch_create(ctx) : NULL;
+	const char *why = s ? fixed_check(ctx, s) : "open failed";
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+	memcpy(fx_mo[1], saved, sizeof saved);
+	CHECK(!why, "%s", why);
+}
+
 int main(void)
 {
 	fx_build(0);
 	RUN(sample_hand_values);
 	RUN(sample_loop_and_clamp);
+	RUN(fixed_joints_and_near_slerp);
 	RUN(fold_matches_full_skeleton);
 	RUN(skin_hand_lbs);
 	RUN(kernel_matches_scalar);

@@ -11,14 +11,19 @@
  * MESH_PLAN) with its skinned parts' influence-count buckets (4 bytes per
  * part, and per skinned part 1 per vertex and 4 per run of 64: levels 0,
  * 1 and 2 have 3, 2 and 1 parts, their skinned part 4, 2 and 1 vertices:
- * 20, 14 and 9 bytes; MESH_ORDER1 and MESH_ORDER2 below).
+ * 20, 14 and 9 bytes; MESH_ORDER1 and MESH_ORDER2 below) and the tables
+ * of a motion level (4 bytes per joint and per channel of a joint with a
+ * channel of several keys, every one here, and 64 per joint whose channels
+ * all have one key, none here: MOTION_PLAN(channels) below; clip 0's
+ * levels have 5, 2 and 1 channels, clip 1's 1 each).
  */
 #include "rt_test.h"
 
 #define MESH_PLAN 40u
 #define MESH_ORDER1 14u
 #define MESH_ORDER2 9u
-#define COARSE (2900u + 365u + MESH_PLAN + MESH_ORDER2)
+#define MOTION_PLAN(c) (4u * 5u + 4u * (c))
+#define COARSE (2900u + 365u + MESH_PLAN + MESH_ORDER2 + 2u * MOTION_PLAN(1u))
 
 static mlod_rt_ctx *open_budget(size_t budget, mlod_error *e)
 {
@@ -160,17 +165,17 @@ static void frame(mlod_rt_ctx *ctx)
 TEST(lru_eviction)
 {
 	mlod_error e;
-	mlod_rt_ctx *ctx = open_budget(COARSE + 3500 + MESH_PLAN + MESH_ORDER1, &e);
+	mlod_rt_ctx *ctx = open_budget(COARSE + 3500 + MESH_PLAN + MESH_ORDER1 + MOTION_PLAN(2u), &e);
 	CHECK(ctx, "open: %s", e.message);
 	frame(ctx);
 	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MESH, 1, 0, &e), e); /* 2000 + MESH_PLAN */
 	CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
 	frame(ctx);
-	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MOTION, 1, 0, &e), e); /* 1500: exactly full */
+	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MOTION, 1, 0, &e), e); /* 1500 + MOTION_PLAN(2): exactly full */
 	CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
 	CHECK(resident(ctx, MLOD_RT_MESH, 1, 0) && resident(ctx, MLOD_RT_MOTION, 1, 0), "both should fit");
 	frame(ctx);
-	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MOTION, 1, 1, &e), e); /* 1500 more: evict the least recently wanted */
+	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MOTION, 1, 1, &e), e); /* 1500 + MOTION_PLAN(1) more: evict the LRU */
 	CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
 	CHECK(!resident(ctx, MLOD_RT_MESH, 1, 0) && resident(ctx, MLOD_RT_MOTION, 1, 0) &&
 	          resident(ctx, MLOD_RT_MOTION, 1, 1),
