@@ -635,12 +635,22 @@ static void degenerate_flags(const mlod_posed *m, unsigned char *flags)
 static void bound_distances(const mlod_posed *from, const unsigned char *used, const mlod_posed *onto,
                             const unsigned char *degen, const int *warm, double *dist)
 {
-	const float *x = onto->positions;
-	for (long i = 0; i < (long)from->vertex_count + from->triangle_count; i++) {
+	const float *x = onto->positions, *f = from->positions;
+	const long nv = from->vertex_count, n = nv + from->triangle_count;
+	for (long i = 0; i < n; i++) {
+		/* the sample as sample_at makes it, without its call and branch */
 		double p[3];
-		if (!sample_at(from, used, i, p)) {
-			dist[i] = -1.0;
-			continue;
+		if (i < nv) {
+			if (!used[i]) {
+				dist[i] = -1.0;
+				continue;
+			}
+			p[0] = f[3 * i], p[1] = f[3 * i + 1], p[2] = f[3 * i + 2];
+		} else {
+			const uint32_t *ix = from->indices + 3 * (size_t)(i - nv);
+			const float *u = f + 3 * (size_t)ix[0], *v = f + 3 * (size_t)ix[1], *w = f + 3 * (size_t)ix[2];
+			for (int a = 0; a < 3; a++)
+				p[a] = ((double)u[a] + v[a] + w[a]) / 3.0;
 		}
 		dist[i] = INFINITY;
 		if ((unsigned)warm[i] < (unsigned)onto->triangle_count) {
