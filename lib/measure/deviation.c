@@ -22,7 +22,9 @@
  * With warm starts' bound (surface.h) only the samples that may raise the
  * max are searched, the others counted with their distance to their warm
  * triangle; hierarchies are then built (or refitted from the same mesh's
- * at another pose) only when a search needs them. */
+ * at another pose) only when a search needs them, and the triangles'
+ * degenerate flags are made once per mesh (a kept surface's once per
+ * pose, for every level), not once per sample. */
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
