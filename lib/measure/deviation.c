@@ -458,7 +458,7 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 	int at = b->leaf[start];
 	best = subtree_nearest2(b, p, at, 0.0, best, start, hint);
 	for (int up = b->parent[at]; up >= 0; at = up, up = b->parent[up]) {
-		int other = b->nodes[up].first == at ? at + 1 : at - 1;
+		int other = at & 1 ? at + 1 : at - 1; /* children come in pairs from 1: left odd, right even */
 		double d2 = box_dist2(p, &b->nodes[other]);
 		if (d2 < best)
 			best = subtree_nearest2(b, p, other, d2, best, -1, hint);
