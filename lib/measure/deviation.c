@@ -22,7 +22,9 @@
  * With warm starts' bound (surface.h) only the samples that may raise the
  * max are searched, the others counted with their distance to their warm
  * triangle; hierarchies are then built (or refitted from the same mesh's
- * at another pose) only when a search needs them. */
+ * at another pose) only when a search needs them, and the triangles'
+ * degenerate flags are made once per mesh (a kept surface's once per
+ * pose, for every level), not once per sample. */
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -93,11 +95,11 @@ static double segment_dist2(const double *p, const double *a, const double *b)
 	return dist2_to(p, q);
 }
 
-/* Squared distance from p to the triangle (Ericson, 5.1.5). */
-static double triangle_dist2(const double *p, const tri *t)
+/* Squared distance from p to the triangle a b c (Ericson, 5.1.5);
+ * degenerate (is_degenerate) measured as its three edges. */
+static inline double points_dist2(const double *p, const double *a, const double *b, const double *c, int degenerate)
 {
-	const double *a = t->a, *b = t->b, *c = t->c;
-	if (t->degenerate) {
+	if (degenerate) {
 		double d = segment_dist2(p, a, b), e = segment_dist2(p, b, c), f = segment_dist2(p, c, a);
 		return fmin(d, fmin(e, f));
 	}
@@ -143,15 +145,25 @@ static double triangle_dist2(const double *p, const tri *t)
 	return dist2_to(p, q);
 }
 
+static double triangle_dist2(const double *p, const tri *t)
+{
+	return points_dist2(p, t->a, t->b, t->c, t->degenerate);
+}
+
 /* A triangle is degenerate when its area is negligible against its edges:
  * then the face formula would divide by (nearly) zero. */
-static int is_degenerate(const tri *t)
+static int points_degenerate(const double *a, const double *b, const double *c)
 {
 	double ab[3], ac[3];
-	sub3(t->b, t->a, ab);
-	sub3(t->c, t->a, ac);
+	sub3(b, a, ab);
+	sub3(c, a, ac);
 	double n[3] = { ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0] };
 	return dot3(n, n) <= 1e-12 * dot3(ab, ab) * dot3(ac, ac);
+}
+
+static int is_degenerate(const tri *t)
+{
+	return points_degenerate(t->a, t->b, t->c);
 }
 
 /* ---------------------------------------------------------------- */
@@ -446,7 +458,7 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 	int at = b->leaf[start];
 	best = subtree_nearest2(b, p, at, 0.0, best, start, hint);
 	for (int up = b->parent[at]; up >= 0; at = up, up = b->parent[up]) {
-		int other = b->nodes[up].first == at ? at + 1 : at - 1;
+		int other = at & 1 ? at + 1 : at - 1; /* children come in pairs from 1: left odd, right even */
 		double d2 = box_dist2(p, &b->nodes[other]);
 		if (d2 < best)
 			best = subtree_nearest2(b, p, other, d2, best, -1, hint);
@@ -462,6 +474,16 @@ static mlod_result check_mesh(const mlod_posed *m, const char *which, mlod_error
 {
 	if (!m || m->vertex_count <= 0 || m->triangle_count <= 0 || !m->positions || !m->indices)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh %s is empty", which);
+	/* the common case first: every index in range, every vertex finite
+	 * (each vertex once, not once per corner); else the corners in order,
+	 * to name the first bad one */
+	int ok = 1;
+	for (long i = 0; i < 3L * m->triangle_count; i++)
+		ok &= m->indices[i] < (uint32_t)m->vertex_count;
+	for (long i = 0; ok && i < 3L * m->vertex_count; i++)
+		ok &= isfinite(m->positions[i]) != 0;
+	if (ok)
+		return MLOD_OK;
 	for (long i = 0; i < 3L * m->triangle_count; i++) {
 		uint32_t v = m->indices[i];
 		if (v >= (uint32_t)m->vertex_count)
@@ -554,6 +576,7 @@ typedef struct target {
 	int *built;
 	pthread_mutex_t *lock;
 	const bvh *like; /* the same triangles' tree at another pose, refitted (NULL: built) */
+	const unsigned char *degen; /* its triangles' degenerate_flags (NULL: made when needed) */
 } target;
 
 static mlod_result target_tree(const target *t, const bvh **out, mlod_error *err)
@@ -597,23 +620,46 @@ static int sample_at(const mlod_posed *from, const unsigned char *used, long i, 
 	return 1;
 }
 
+/* Whether each triangle of m is degenerate (is_degenerate), into flags. */
+static void degenerate_flags(const mlod_posed *m, unsigned char *flags)
+{
+	for (int t = 0; t < m->triangle_count; t++) {
+		tri x;
+		mesh_tri(m, t, &x);
+		flags[t] = (unsigned char)x.degenerate;
+	}
+}
+
 /* One way of measure's bounded form (mlod_warm's bound): each sample's
  * distance to its warm triangle in dist (-1: not a sample, INFINITY: no
- * warm triangle), from's vertices then its triangles. */
+ * warm triangle), from's vertices then its triangles; degen: onto's
+ * triangles' degenerate_flags, made once per mesh rather than per sample. */
 static void bound_distances(const mlod_posed *from, const unsigned char *used, const mlod_posed *onto,
-                            const int *warm, double *dist)
+                            const unsigned char *degen, const int *warm, double *dist)
 {
-	for (long i = 0; i < (long)from->vertex_count + from->triangle_count; i++) {
+	const float *x = onto->positions, *f = from->positions;
+	const long nv = from->vertex_count, n = nv + from->triangle_count;
+	for (long i = 0; i < n; i++) {
+		/* the sample as sample_at makes it, without its call and branch */
 		double p[3];
-		if (!sample_at(from, used, i, p)) {
-			dist[i] = -1.0;
-			continue;
+		if (i < nv) {
+			if (!used[i]) {
+				dist[i] = -1.0;
+				continue;
+			}
+			p[0] = f[3 * i], p[1] = f[3 * i + 1], p[2] = f[3 * i + 2];
+		} else {
+			const uint32_t *ix = from->indices + 3 * (size_t)(i - nv);
+			const float *u = f + 3 * (size_t)ix[0], *v = f + 3 * (size_t)ix[1], *w = f + 3 * (size_t)ix[2];
+			for (int a = 0; a < 3; a++)
+				p[a] = ((double)u[a] + v[a] + w[a]) / 3.0;
 		}
 		dist[i] = INFINITY;
 		if ((unsigned)warm[i] < (unsigned)onto->triangle_count) {
-			tri near;
-			mesh_tri(onto, warm[i], &near);
-			dist[i] = sqrt(triangle_dist2(p, &near));
+			const uint32_t *ix = onto->indices + 3 * (size_t)warm[i];
+			const float *u = x + 3 * (size_t)ix[0], *v = x + 3 * (size_t)ix[1], *w = x + 3 * (size_t)ix[2];
+			const double a[3] = { u[0], u[1], u[2] }, b[3] = { v[0], v[1], v[2] }, c[3] = { w[0], w[1], w[2] };
+			dist[i] = sqrt(points_dist2(p, a, b, c, degen[warm[i]]));
 		}
 	}
 }
@@ -679,9 +725,14 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 	long n[2] = { (long)m[0]->vertex_count + m[0]->triangle_count, (long)m[1]->vertex_count + m[1]->triangle_count };
 	unsigned char *used[2] = { calloc((size_t)m[0]->vertex_count, 1), calloc((size_t)m[1]->vertex_count, 1) };
 	double *dist[2] = { malloc(sizeof(double) * (size_t)n[0]), malloc(sizeof(double) * (size_t)n[1]) };
+	unsigned char *made[2] = { NULL, NULL };
+	const unsigned char *degen[2] = { onto[0]->degen, onto[1]->degen };
 	candidate *c = NULL;
 	mlod_result r = MLOD_OK;
-	if (!used[0] || !used[1] || !dist[0] || !dist[1]) {
+	for (int way = 0; way < 2; way++)
+		if (!degen[way] && (made[way] = malloc((size_t)onto[way]->mesh->triangle_count)))
+			degenerate_flags(onto[way]->mesh, made[way]), degen[way] = made[way];
+	if (!used[0] || !used[1] || !dist[0] || !dist[1] || !degen[0] || !degen[1]) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate %ld distances", n[0] + n[1]);
 		goto done;
 	}
@@ -689,7 +740,7 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 	for (int way = 0; way < 2; way++) {
 		for (long k = 0; k < 3L * m[way]->triangle_count; k++)
 			used[way][m[way]->indices[k]] = 1;
-		bound_distances(m[way], used[way], onto[way]->mesh, w[way], dist[way]);
+		bound_distances(m[way], used[way], onto[way]->mesh, degen[way], w[way], dist[way]);
 		for (long i = 0; i < n[way]; i++)
 			candidates += dist[way][i] > top;
 	}
@@ -725,6 +776,8 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 			}
 	*sum = s, *max = mx, *count = cnt;
 done:
+	free(made[0]);
+	free(made[1]);
 	free(used[0]);
 	free(used[1]);
 	free(dist[0]);
@@ -753,7 +806,7 @@ static mlod_result both_ways(const target *ta, const mlod_posed *b, double diag,
 {
 	bvh tb = { 0 };
 	int b_built = 0;
-	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL };
+	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL, NULL };
 	const mlod_posed *a = ta->mesh;
 	const bvh *tree_a, *tree_b;
 	double sum = 0.0, max = 0.0;
@@ -796,7 +849,7 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	bvh ta = { 0 };
 	int built = 0;
-	const target onto_a = { a, &ta, &built, NULL, NULL };
+	const target onto_a = { a, &ta, &built, NULL, NULL, NULL };
 	r = both_ways(&onto_a, b, diag, NULL, out, err);
 	if (built)
 		bvh_free(&ta);
@@ -814,6 +867,7 @@ struct mlod_surface {
 	pthread_mutex_t lock;
 	mlod_surface *like; /* mlod_surface_like */
 	double diag;
+	unsigned char *degen; /* its triangles' degenerate_flags, for every level's bounded measure */
 };
 
 mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_error *err)
@@ -831,7 +885,8 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 		s = NULL;
 	}
 	size_t pos = 3 * (size_t)m->vertex_count * sizeof *m->positions, ind = 3 * (size_t)m->triangle_count * sizeof *m->indices;
-	if (!s || !(s->mesh.positions = malloc(pos)) || !(s->mesh.indices = malloc(ind))) {
+	if (!s || !(s->mesh.positions = malloc(pos)) || !(s->mesh.indices = malloc(ind)) ||
+	    !(s->degen = malloc((size_t)m->triangle_count))) {
 		mlod_surface_free(s);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: out of memory");
 	}
@@ -840,6 +895,7 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 	s->mesh.vertex_count = m->vertex_count;
 	s->mesh.triangle_count = m->triangle_count;
 	s->diag = diag;
+	degenerate_flags(&s->mesh, s->degen);
 	*out = s;
 	return MLOD_OK;
 }
@@ -868,6 +924,7 @@ void mlod_surface_free(mlod_surface *s)
 		bvh_free(&s->tree);
 	pthread_mutex_destroy(&s->lock);
 	mlod_posed_free(&s->mesh);
+	free(s->degen);
 	free(s);
 }
 
@@ -896,6 +953,6 @@ mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b
 		like = s->like->built ? &s->like->tree : NULL;
 		pthread_mutex_unlock(&s->like->lock);
 	}
-	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like };
+	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen };
 	return both_ways(&onto_a, b, a->diag, warm, out, err);
 }

@@ -497,6 +497,57 @@ TEST(warm_starts_same_bits)
 	mlod_posed_free(&b2);
 }
 
+/* The bounded measure (its triangles read from the mesh, their
+ * degenerate flags made once per mesh, not per sample) with degenerate
+ * triangles on both sides, and a non-finite vertex no triangle uses (the
+ * input check's quick path): recorded at the same positions and with a
+ * floor above every distance, nothing is searched and every sample
+ * counts with its recorded triangle, its nearest: the same bits as the
+ * exact measure. (A sample measured against a wrong triangle fails it.) */
+TEST(bounded_degenerate_same_bits)
+{
+	mlod_posed g = grid(6, 1.0f), h = grid(3, 1.0f);
+	mlod_posed a = alloc_mesh(g.vertex_count + 1, g.triangle_count), b = copy_translated(&h, 0.01f, 0.02f, 0.05f);
+	memcpy(a.positions, g.positions, 3 * sizeof(float) * (size_t)g.vertex_count);
+	memcpy(a.indices, g.indices, 3 * sizeof(uint32_t) * (size_t)g.triangle_count);
+	a.positions[3 * g.vertex_count] = NAN; /* the extra vertex: no triangle uses it */
+	a.positions[3 * g.vertex_count + 1] = a.positions[3 * g.vertex_count + 2] = 0.0f;
+	for (int t = 0; t < a.triangle_count; t += 5)
+		a.indices[3 * t + 2] = a.indices[3 * t + 1]; /* a segment */
+	for (int t = 0; t < b.triangle_count; t += 3)
+		b.indices[3 * t + 2] = b.indices[3 * t];
+	mlod_surface *s;
+	CHECK_OK(mlod_surface_make(&a, &s, &terr));
+	int na = a.vertex_count + a.triangle_count, nb = b.vertex_count + b.triangle_count;
+	int *wa = malloc(sizeof *wa * (size_t)na), *wb = malloc(sizeof *wb * (size_t)nb);
+	mlod_warm rec = { wa, wb, na, nb, 1, 0, 0.0, NULL };
+	mlod_deviation cold, d;
+	CHECK_OK(mlod_surface_deviation(&a, &b, &cold, &terr));
+	CHECK_OK(mlod_surface_deviation_to(s, &b, &rec, &d, &terr));
+	CHECK(same_deviation(&cold, &d));
+	int on_degenerate = 0;
+	for (int i = 0; i < na; i++)
+		on_degenerate += wa[i] >= 0 && wa[i] % 3 == 0; /* b's degenerate ones */
+	for (int i = 0; i < nb; i++)
+		on_degenerate += wb[i] >= 0 && wb[i] % 5 == 0; /* a's */
+	CHECK_MSG(on_degenerate > 0, "no sample's nearest triangle is degenerate");
+	mlod_warm bounded = { wa, wb, na, nb, 0, 1, 10.0, NULL };
+	CHECK_OK(mlod_surface_deviation_to(s, &b, &bounded, &d, &terr));
+	CHECK_MSG(same_deviation(&cold, &d), "bounded %.17g/%.17g, exact %.17g/%.17g", d.mean, d.max, cold.mean,
+	          cold.max);
+	a.indices[0] = (uint32_t)g.vertex_count; /* now a triangle uses it */
+	CHECK(mlod_surface_deviation(&a, &b, &d, &terr) == MLOD_ERR_PARSE);
+	CHECK(strstr(terr.message, "not finite") != NULL);
+	mlod_warm_release(&rec);
+	free(wa);
+	free(wb);
+	mlod_surface_free(s);
+	mlod_posed_free(&a);
+	mlod_posed_free(&b);
+	mlod_posed_free(&g);
+	mlod_posed_free(&h);
+}
+
 int main(void)
 {
 	RUN(identical_meshes);
@@ -509,5 +560,6 @@ int main(void)
 	RUN(posed_error_kept_full);
 	RUN(posed_error_bound_mean);
 	RUN(warm_starts_same_bits);
+	RUN(bounded_degenerate_same_bits);
 	TEST_EXIT();
 }
