@@ -107,8 +107,13 @@ static double euler_change(mlod_euler_order order, const float *ea, const float 
 	alt[ax[0]] = eb[ax[0]] + MLOD_PI;
 	alt[ax[1]] = MLOD_PI - eb[ax[1]];
 	alt[ax[2]] = eb[ax[2]] + MLOD_PI;
-	for (int a = 0; a < 3; a++)
+	/* d2's partial sums only grow (each term is >= 0, and rounding is
+	 * monotonic): once d1 is below one, it is below d2. */
+	for (int a = 0; a < 3; a++) {
 		d2 += fabs(eval_wrap_angle(alt[a] - ea[a]));
+		if (d1 < d2)
+			return d1;
+	}
 	return d1 < d2 ? d1 : d2;
 }
 
