@@ -213,8 +213,13 @@ void mlod_quat_to_euler(mlod_euler_order order, mlod_quat q, float angles[3])
 			m[i][j] = r[ax[i]][ax[j]];
 
 	/* m = Rx(a) Ry(b) Rz(c): m[1][2] = -sin a cos b, m[2][2] = cos a cos b. */
-	double cb = hypot(m[1][2], m[2][2]);
-	double a = cb > 1e-7 ? atan2(-m[1][2], m[2][2]) : 0.0;
+	/* cb = hypot(m[1][2], m[2][2]) only decides cb > 1e-7. Its square
+	 * in doubles (relative error a few 2^-53, or far below 1e-14 when it
+	 * underflows) decides it alike 1% away from the limit; between, or
+	 * for a NaN, hypot does. */
+	double cb2 = m[1][2] * m[1][2] + m[2][2] * m[2][2];
+	int tilt = cb2 >= 1.01e-14 ? 1 : cb2 <= 0.99e-14 ? 0 : hypot(m[1][2], m[2][2]) > 1e-7;
+	double a = tilt ? atan2(-m[1][2], m[2][2]) : 0.0;
 	double ca = cos(a), sa = sin(a);
 	double b = atan2(m[0][2], -sa * m[1][2] + ca * m[2][2]);
 	/* Rx(a)^T m = Ry(b) Rz(c), whose row 1 is (sin c, cos c, 0). */

@@ -107,8 +107,13 @@ static double euler_change(mlod_euler_order order, const float *ea, const float 
 	alt[ax[0]] = eb[ax[0]] + MLOD_PI;
 	alt[ax[1]] = MLOD_PI - eb[ax[1]];
 	alt[ax[2]] = eb[ax[2]] + MLOD_PI;
-	for (int a = 0; a < 3; a++)
+	/* d2's partial sums only grow (each term is >= 0, and rounding is
+	 * monotonic): once d1 is below one, it is below d2. */
+	for (int a = 0; a < 3; a++) {
 		d2 += fabs(eval_wrap_angle(alt[a] - ea[a]));
+		if (d1 < d2)
+			return d1;
+	}
 	return d1 < d2 ? d1 : d2;
 }
 
@@ -1494,8 +1499,11 @@ static double residual_of(const mlod_motion *m, const fnode *p, const fnode *x, 
 	return d;
 }
 
-/* Fuses a and b into *o (which owns new values). */
-static int fuse(const mlod_motion *m, const line *l, int i, fnode *o)
+/* Fuses a and b into *o (which owns new values). With moved (a pass that
+ * steals from l), a kept frame's values move to *o instead of being
+ * copied, and moved marks it: it still serves as a neighbour until the
+ * pass ends, as in tree_pass. */
+static int fuse(const mlod_motion *m, const line *l, int i, fnode *o, unsigned char *moved)
 {
 	const fnode *a = &l->v[i], *b = &l->v[i + 1];
 	size_t size = sizeof(float) * (size_t)(m->value_count + 3 * m->rot_count + 1);
@@ -1511,11 +1519,17 @@ static int fuse(const mlod_motion *m, const line *l, int i, fnode *o)
 			return -1;
 		keep = ra >= rb ? a : b; /* drop the one interpolation reproduces better */
 	}
-	o->values = malloc(size);
-	if (!o->values)
-		return -1;
+	if (keep && moved) {
+		o->values = keep->values;
+		moved[keep == a ? i : i + 1] = 1;
+	} else {
+		o->values = malloc(size);
+		if (!o->values)
+			return -1;
+		if (keep)
+			memcpy(o->values, keep->values, size);
+	}
 	if (keep) {
-		memcpy(o->values, keep->values, size);
 		o->time = keep->time;
 		o->frame = keep->frame;
 		o->leaves = a->leaves + b->leaves;
@@ -1567,9 +1581,9 @@ static int tree_pass(const mlod_motion *m, line *in, double T, line *out, int st
 		fnode *o = &out->v[out->n];
 		if (i + 1 < in->n && !(pinned(m, &in->v[i]) && pinned(m, &in->v[i + 1])) &&
 		    frame_distance(m, &in->v[i], &in->v[i + 1]) < T) {
-			if (fuse(m, in, i, o) != 0) {
-				free(moved);
-				return -1;
+			if (fuse(m, in, i, o, moved) != 0) {
+				fused = -1;
+				break;
 			}
 			out->n++;
 			fused++;
@@ -1590,6 +1604,7 @@ static int tree_pass(const mlod_motion *m, line *in, double T, line *out, int st
 			i++;
 		}
 	}
+	/* Also after a failure, so that in and out never share values. */
 	for (int i = 0; steal && i < in->n; i++)
 		if (moved[i])
 			in->v[i].values = NULL; /* now owned by out */

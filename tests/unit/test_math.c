@@ -208,6 +208,43 @@ TEST(euler_gimbal_lock)
 	}
 }
 
+/* Near gimbal lock the first angle is 0 exactly when hypot(m[1][2],
+ * m[2][2]) <= 1e-7 (m: the rotation's rows, doubles from the float
+ * quaternion); mlod_quat_to_euler decides most cases from the square,
+ * which must agree, on both sides and close to the limit. */
+TEST(euler_tilt_limit)
+{
+	int near_below = 0, near_above = 0, between = 0;
+	for (int k = 0; k < 40000; k++) {
+		/* at the lock, then each component a few floats away */
+		float ang[3] = { (float)rnd(-PI, PI), (float)(PI / 2), (float)rnd(-PI, PI) };
+		mlod_quat q = mlod_quat_from_euler(MLOD_EULER_XYZ, ang);
+		float *c[4] = { &q.x, &q.y, &q.z, &q.w };
+		for (int i = 0; i < 4; i++)
+			for (int u = (int)rnd(0, 7) - 3; u != 0; u += u > 0 ? -1 : 1)
+				*c[i] = nextafterf(*c[i], u > 0 ? 2.0f : -2.0f);
+		/* the rows as mlod_quat_to_euler computes them (XYZ: no permutation) */
+		double x = q.x, y = q.y, z = q.z, w = q.w, n = x * x + y * y + z * z + w * w, s = n > 0.0 ? 2.0 / n : 0.0;
+		double m12 = s * (y * z - w * x), m22 = 1 - s * (x * x + y * y), cb = hypot(m12, m22);
+		double a = atan2(-m12, m22);
+		if (!(fabs(a) > 1e-3))
+			continue; /* a first angle that could round to 0 by itself */
+		float back[3];
+		mlod_quat_to_euler(MLOD_EULER_XYZ, q, back);
+		CHECK_MSG((back[0] != 0.0f) == (cb > 1e-7), "cb %.17g angle %g", cb, back[0]);
+		if (cb > 0.94e-7 && cb <= 1e-7)
+			near_below++;
+		if (cb > 1e-7 && cb < 1.06e-7)
+			near_above++;
+		double cb2 = m12 * m12 + m22 * m22;
+		if (cb2 > 0.99e-14 && cb2 < 1.01e-14)
+			between++;
+	}
+	printf("# euler_tilt_limit: %d just below the limit, %d just above, %d decided by hypot\n", near_below,
+	       near_above, between);
+	CHECK(near_below > 0 && near_above > 0);
+}
+
 TEST(euler_order_names)
 {
 	for (int o = 0; o < 6; o++) {
@@ -340,6 +377,7 @@ int main(void)
 	RUN(euler_matches_matrix_products);
 	RUN(euler_round_trip_all_orders);
 	RUN(euler_gimbal_lock);
+	RUN(euler_tilt_limit);
 	RUN(euler_order_names);
 	RUN(trs_round_trip);
 	RUN(trs_shear_and_singular);
