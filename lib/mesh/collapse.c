@@ -1199,7 +1199,11 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 	}
 	role[nc] = 4;
 	memcpy(cand[nc++], bary, sizeof cand[0]);
-	double best = HUGE_VAL;
+	/* The least sum so far (the least stays the least divided by wsum):
+	 * a candidate's sum stops once it reaches it, its terms being
+	 * positive, and is then neither the least nor memoised (plan() sums
+	 * it when it needs it). */
+	double best = HUGE_VAL, least = HUGE_VAL;
 	for (int k = 0; k < nc; k++) {
 		mlod_influences w;
 		mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
@@ -1211,10 +1215,13 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		} else {
 			if (!q_ready)
 				sum_quadrics(g, &pv, Q), q_ready = 1;
-			e = bgm_quadric_error(g, Q, &w, cand[k], HUGE_VAL);
+			e = bgm_quadric_error(g, Q, &w, cand[k], least);
+			if (e == HUGE_VAL && least < HUGE_VAL)
+				continue; /* at least the least: the minimum stays */
 			mm->e[role[k]] = e;
 			mm->known |= 1u << role[k];
 		}
+		least = fmin(least, e);
 		best = fmin(best, wsum > 0.0 ? e / wsum : 0.0);
 	}
 	if (best == HUGE_VAL)
