@@ -60,6 +60,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include "bgm.h"
 
@@ -984,16 +987,32 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 	for (int i = 0; i < k; i++)
 		qv[i] = g->quadric + (size_t)v[i] * P * 10;
 	double lb = 0.0, rl = r * g->skin_norm, inv = 1.0 / nj;
+#ifdef __SSE2__
+	const __m128d bx = _mm_set1_pd(bary[0]), by = _mm_set1_pd(bary[1]), bz = _mm_set1_pd(bary[2]);
+#endif
 	for (size_t p = 0; p < P; p++) {
 		const float *S = g->skin + p * (size_t)J * 12;
 		double z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {0, 0, 0};
 		for (int j = 0; j < nj; j++) {
 			const float *m = S + 12 * (size_t)joint[j];
+#ifdef __SSE2__
+			/* Rows 0 and 1 side by side: the same products and sums, in
+			 * the same order, as row 2's (SSE2 rounds as scalar code). */
+			__m128 r0 = _mm_loadu_ps(m), r1 = _mm_loadu_ps(m + 4);
+			__m128 lo = _mm_unpacklo_ps(r0, r1), hi = _mm_unpackhi_ps(r0, r1);
+			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_cvtps_pd(lo), bx), _mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(lo, lo)), by));
+			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_cvtps_pd(hi), bz)), _mm_cvtps_pd(_mm_movehl_ps(hi, hi)));
+			_mm_storeu_pd(z[j], t);
+			z[j][2] = (double)m[8] * bary[0] + (double)m[9] * bary[1] + (double)m[10] * bary[2] + (double)m[11];
+			for (int i = 0; i < 3; i++)
+				c[i] += z[j][i];
+#else
 			for (int i = 0; i < 3; i++) {
 				z[j][i] = (double)m[4 * i] * bary[0] + (double)m[4 * i + 1] * bary[1] +
 				          (double)m[4 * i + 2] * bary[2] + (double)m[4 * i + 3];
 				c[i] += z[j][i];
 			}
+#endif
 		}
 		for (int i = 0; i < 3; i++)
 			c[i] *= inv;
@@ -1009,14 +1028,17 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 		}
 		double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
 		double q[10];
-		const double *q0 = qv[0] + 10 * p, *q1 = k > 1 ? qv[1] + 10 * p : NULL, *q2 = k > 2 ? qv[2] + 10 * p : NULL;
-		for (int e = 0; e < 10; e++) {
-			double t = q0[e];
-			if (q1)
-				t += q1[e];
-			if (q2)
-				t += q2[e];
-			q[e] = t;
+		const double *q0 = qv[0] + 10 * p;
+		if (k == 1) {
+			memcpy(q, q0, sizeof q);
+		} else if (k == 2) {
+			const double *q1 = qv[1] + 10 * p;
+			for (int e = 0; e < 10; e++)
+				q[e] = q0[e] + q1[e];
+		} else {
+			const double *q1 = qv[1] + 10 * p, *q2 = qv[2] + 10 * p;
+			for (int e = 0; e < 10; e++)
+				q[e] = q0[e] + q1[e] + q2[e];
 		}
 		double tr = q[0] + q[4] + q[7];
 		if (!(tr > 0.0) || !isfinite(tr))
