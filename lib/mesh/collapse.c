@@ -1052,7 +1052,11 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 		y[0] = (r0 * (d * f - e * e) - b * (r1 * f - e * r2) + cc * (r1 * e - d * r2)) / det;
 		y[1] = (a * (r1 * f - e * r2) - r0 * (b * f - cc * e) + cc * (b * r2 - r1 * cc)) / det;
 		y[2] = (a * (d * r2 - r1 * e) - b * (b * r2 - r1 * cc) + r0 * (b * e - cc * d)) / det;
-		double val = bgm_quadric_eval(q, y), dy = 0.0;
+		/* bgm_quadric_eval(q, y), written out here (the same sum) */
+		double val = q[0] * y[0] * y[0] + 2 * q[1] * y[0] * y[1] + 2 * q[2] * y[0] * y[2] + 2 * q[3] * y[0] +
+		             q[4] * y[1] * y[1] + 2 * q[5] * y[1] * y[2] + 2 * q[6] * y[1] + q[7] * y[2] * y[2] + 2 * q[8] * y[2] + q[9];
+		double dy = 0.0;
+		val = val > 0.0 ? val : 0.0;
 		for (int i = 0; i < 3; i++)
 			dy += (y[i] - c[i]) * (y[i] - c[i]);
 		val += mu * dy - mu * R * R;
