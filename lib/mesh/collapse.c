@@ -1253,6 +1253,14 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 	if (best == HUGE_VAL)
 		best = 0.0;
 	double tie = collapse_tie(g, f, op, K, P);
+	/* Along a border (two border vertices as the flags stand), plan()'s
+	 * cost is border_factor() times this: so is the bound, and such an
+	 * operation goes back at it without being planned first. */
+	int nb = 0;
+	for (int j = 0; j < K; j++)
+		nb += (g->nodes[pv.v[j]].flags & BGM_BORDER) != 0;
+	if (nb >= 2)
+		return (best + TIE_WEIGHT * tie) * border_factor(g);
 	return best + TIE_WEIGHT * tie;
 }
 
