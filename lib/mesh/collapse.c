@@ -1161,7 +1161,17 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		margin = 1.0 - 1e-9; /* rounding: stay below the exact sum */
 		*weak = 1;
 	}
-	return (wsum > 0.0 ? lb / wsum : 0.0) * margin + TIE_WEIGHT * tie;
+	double key = (wsum > 0.0 ? lb / wsum : 0.0) * margin + TIE_WEIGHT * tie;
+	if (!*weak) {
+		/* Along a border as the flags stand: plan()'s factor (exact_bound
+		 * takes it for the others). */
+		int nb = 0;
+		for (int j = 0; j < K; j++)
+			nb += (g->nodes[v[j]].flags & BGM_BORDER) != 0;
+		if (nb >= 2)
+			key *= border_factor(g);
+	}
+	return key;
 }
 
 /* A lower bound of plan()'s exact cost for operation op on face f that
