@@ -60,6 +60,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include "bgm.h"
 
@@ -984,16 +987,32 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 	for (int i = 0; i < k; i++)
 		qv[i] = g->quadric + (size_t)v[i] * P * 10;
 	double lb = 0.0, rl = r * g->skin_norm, inv = 1.0 / nj;
+#ifdef __SSE2__
+	const __m128d bx = _mm_set1_pd(bary[0]), by = _mm_set1_pd(bary[1]), bz = _mm_set1_pd(bary[2]);
+#endif
 	for (size_t p = 0; p < P; p++) {
 		const float *S = g->skin + p * (size_t)J * 12;
 		double z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {0, 0, 0};
 		for (int j = 0; j < nj; j++) {
 			const float *m = S + 12 * (size_t)joint[j];
+#ifdef __SSE2__
+			/* Rows 0 and 1 side by side: the same products and sums, in
+			 * the same order, as row 2's (SSE2 rounds as scalar code). */
+			__m128 r0 = _mm_loadu_ps(m), r1 = _mm_loadu_ps(m + 4);
+			__m128 lo = _mm_unpacklo_ps(r0, r1), hi = _mm_unpackhi_ps(r0, r1);
+			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_cvtps_pd(lo), bx), _mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(lo, lo)), by));
+			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_cvtps_pd(hi), bz)), _mm_cvtps_pd(_mm_movehl_ps(hi, hi)));
+			_mm_storeu_pd(z[j], t);
+			z[j][2] = (double)m[8] * bary[0] + (double)m[9] * bary[1] + (double)m[10] * bary[2] + (double)m[11];
+			for (int i = 0; i < 3; i++)
+				c[i] += z[j][i];
+#else
 			for (int i = 0; i < 3; i++) {
 				z[j][i] = (double)m[4 * i] * bary[0] + (double)m[4 * i + 1] * bary[1] +
 				          (double)m[4 * i + 2] * bary[2] + (double)m[4 * i + 3];
 				c[i] += z[j][i];
 			}
+#endif
 		}
 		for (int i = 0; i < 3; i++)
 			c[i] *= inv;
@@ -1009,14 +1028,17 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 		}
 		double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
 		double q[10];
-		const double *q0 = qv[0] + 10 * p, *q1 = k > 1 ? qv[1] + 10 * p : NULL, *q2 = k > 2 ? qv[2] + 10 * p : NULL;
-		for (int e = 0; e < 10; e++) {
-			double t = q0[e];
-			if (q1)
-				t += q1[e];
-			if (q2)
-				t += q2[e];
-			q[e] = t;
+		const double *q0 = qv[0] + 10 * p;
+		if (k == 1) {
+			memcpy(q, q0, sizeof q);
+		} else if (k == 2) {
+			const double *q1 = qv[1] + 10 * p;
+			for (int e = 0; e < 10; e++)
+				q[e] = q0[e] + q1[e];
+		} else {
+			const double *q1 = qv[1] + 10 * p, *q2 = qv[2] + 10 * p;
+			for (int e = 0; e < 10; e++)
+				q[e] = q0[e] + q1[e] + q2[e];
 		}
 		double tr = q[0] + q[4] + q[7];
 		if (!(tr > 0.0) || !isfinite(tr))
@@ -1030,7 +1052,11 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 		y[0] = (r0 * (d * f - e * e) - b * (r1 * f - e * r2) + cc * (r1 * e - d * r2)) / det;
 		y[1] = (a * (r1 * f - e * r2) - r0 * (b * f - cc * e) + cc * (b * r2 - r1 * cc)) / det;
 		y[2] = (a * (d * r2 - r1 * e) - b * (b * r2 - r1 * cc) + r0 * (b * e - cc * d)) / det;
-		double val = bgm_quadric_eval(q, y), dy = 0.0;
+		/* bgm_quadric_eval(q, y), written out here (the same sum) */
+		double val = q[0] * y[0] * y[0] + 2 * q[1] * y[0] * y[1] + 2 * q[2] * y[0] * y[2] + 2 * q[3] * y[0] +
+		             q[4] * y[1] * y[1] + 2 * q[5] * y[1] * y[2] + 2 * q[6] * y[1] + q[7] * y[2] * y[2] + 2 * q[8] * y[2] + q[9];
+		double dy = 0.0;
+		val = val > 0.0 ? val : 0.0;
 		for (int i = 0; i < 3; i++)
 			dy += (y[i] - c[i]) * (y[i] - c[i]);
 		val += mu * dy - mu * R * R;
@@ -1135,7 +1161,17 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		margin = 1.0 - 1e-9; /* rounding: stay below the exact sum */
 		*weak = 1;
 	}
-	return (wsum > 0.0 ? lb / wsum : 0.0) * margin + TIE_WEIGHT * tie;
+	double key = (wsum > 0.0 ? lb / wsum : 0.0) * margin + TIE_WEIGHT * tie;
+	if (!*weak) {
+		/* Along a border as the flags stand: plan()'s factor (exact_bound
+		 * takes it for the others). */
+		int nb = 0;
+		for (int j = 0; j < K; j++)
+			nb += (g->nodes[v[j]].flags & BGM_BORDER) != 0;
+		if (nb >= 2)
+			key *= border_factor(g);
+	}
+	return key;
 }
 
 /* A lower bound of plan()'s exact cost for operation op on face f that
@@ -1199,7 +1235,11 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 	}
 	role[nc] = 4;
 	memcpy(cand[nc++], bary, sizeof cand[0]);
-	double best = HUGE_VAL;
+	/* The least sum so far (the least stays the least divided by wsum):
+	 * a candidate's sum stops once it reaches it, its terms being
+	 * positive, and is then neither the least nor memoised (plan() sums
+	 * it when it needs it). */
+	double best = HUGE_VAL, least = HUGE_VAL;
 	for (int k = 0; k < nc; k++) {
 		mlod_influences w;
 		mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
@@ -1211,15 +1251,26 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		} else {
 			if (!q_ready)
 				sum_quadrics(g, &pv, Q), q_ready = 1;
-			e = bgm_quadric_error(g, Q, &w, cand[k], HUGE_VAL);
+			e = bgm_quadric_error(g, Q, &w, cand[k], least);
+			if (e == HUGE_VAL && least < HUGE_VAL)
+				continue; /* at least the least: the minimum stays */
 			mm->e[role[k]] = e;
 			mm->known |= 1u << role[k];
 		}
+		least = fmin(least, e);
 		best = fmin(best, wsum > 0.0 ? e / wsum : 0.0);
 	}
 	if (best == HUGE_VAL)
 		best = 0.0;
 	double tie = collapse_tie(g, f, op, K, P);
+	/* Along a border (two border vertices as the flags stand), plan()'s
+	 * cost is border_factor() times this: so is the bound, and such an
+	 * operation goes back at it without being planned first. */
+	int nb = 0;
+	for (int j = 0; j < K; j++)
+		nb += (g->nodes[pv.v[j]].flags & BGM_BORDER) != 0;
+	if (nb >= 2)
+		return (best + TIE_WEIGHT * tie) * border_factor(g);
 	return best + TIE_WEIGHT * tie;
 }
 
