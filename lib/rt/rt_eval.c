@@ -569,7 +569,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 			if (skinned) {
 				const uint8_t *ord = mu->skin_order + mu->skin_order_at[i];
 				rt_skin_lbs_ordered(m, pos, onr ? nrm : NULL, p->joints + 4 * v0, p->weights + 4 * v0, pal, o,
-				                    pos_stride, onr, nrm_stride, ord + v0, ord + n + 4 * (v0 / RT_SKIN_RUN));
+				                    pos_stride, onr, nrm_stride, ord + v0, ord + n + 5 * (v0 / RT_SKIN_RUN));
 				if (onr && !nrm)
 					for (size_t v = 0; v < m; v++) {
 						float *x = (float *)((char *)onr + v * nrm_stride);

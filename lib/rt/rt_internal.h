@@ -192,14 +192,15 @@ void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, 
  * builds them when a mesh level loads, so mlod_rt_skin_lbs's per-run
  * bucketing is not redone every frame). For n vertices in runs of
  * RT_SKIN_RUN, order holds RT_SKIN_ORDER_BYTES(n) bytes: first n, per run
- * the offsets within the run of its vertices with 1, then 2, 3 and 4
- * influences (up to the last non-zero weight, at least 1; increasing in
- * each bucket), then 4 per run, the run's four bucket sizes.
+ * the offsets within the run of its vertices with one influence of
+ * weight exactly 1, then 1, 2, 3 and 4 influences (up to the last
+ * non-zero weight, at least 1; increasing in each bucket), then 5 per
+ * run, the run's five bucket sizes.
  * rt_skin_lbs_ordered is mlod_rt_skin_lbs given them (list: order + v0,
- * counts: order + n + 4 v0 / RT_SKIN_RUN of the same part, for v0 a
+ * counts: order + n + 5 v0 / RT_SKIN_RUN of the same part, for v0 a
  * multiple of RT_SKIN_RUN): the same floats. */
 #define RT_SKIN_RUN 64
-#define RT_SKIN_ORDER_BYTES(n) ((size_t)(n) + 4 * (((size_t)(n) + RT_SKIN_RUN - 1) / RT_SKIN_RUN))
+#define RT_SKIN_ORDER_BYTES(n) ((size_t)(n) + 5 * (((size_t)(n) + RT_SKIN_RUN - 1) / RT_SKIN_RUN))
 void rt_skin_order(size_t n, const float *weights, uint8_t *order);
 void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals, const uint16_t *joints,
                          const float *weights, const float *palette, float *out_pos, size_t pos_stride,

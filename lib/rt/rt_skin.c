@@ -3,9 +3,10 @@
  *
  * mlod_rt_skin_lbs works in runs of 64 vertices. A run's vertices are
  * first bucketed by how many influences they use (up to the last non-zero
- * weight: a zero weight adds nothing, so skipping it changes no result),
- * then each bucket goes through a loop specialised for its count, 1 to 4,
- * with no branch per influence. The loops blend the palette matrices
+ * weight: a zero weight adds nothing, so skipping it changes no result;
+ * one influence of weight exactly 1 is a bucket of its own, which skips
+ * the multiplies by 1), then each bucket goes through a loop specialised
+ * for its count, with no branch per influence. The loops blend the palette matrices
  * (16 floats each, column-major) 4 lanes at a time, one matrix column per
  * vector, in the scalar loop's order of operations (so the results are
  * the scalar loop's, bit for bit, where the compiler does not contract
@@ -65,7 +66,10 @@ static inline rt_v4 ld4(const float *p)
  * no result. */
 static const uint8_t rt_kcount[16] = { 1, 1, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4 };
 
-static inline unsigned influences(const float *w)
+/* A vertex's bucket: 0 for one influence of weight exactly 1 (its blend
+ * is the matrix itself: 1 x is x for every float, so its loop skips the
+ * four multiplies by the weight), else its count of influences, 1 to 4. */
+static inline unsigned bucket_of(const float *w)
 {
 #if defined(RT_SSE2)
 	const unsigned bits = (unsigned)_mm_movemask_ps(_mm_cmpneq_ps(_mm_loadu_ps(w), _mm_setzero_ps()));
@@ -73,11 +77,12 @@ static inline unsigned influences(const float *w)
 	const unsigned bits = (unsigned)(w[0] != 0.0f) | (unsigned)(w[1] != 0.0f) << 1 |
 	                      (unsigned)(w[2] != 0.0f) << 2 | (unsigned)(w[3] != 0.0f) << 3;
 #endif
-	return rt_kcount[bits];
+	return bits == 1 && w[0] == 1.0f ? 0 : rt_kcount[bits];
 }
 
-/* Skins the vertices v0 + list[0..m) of a run, each with K influences:
- * positions stored, normals (when N) left unnormalised in tn[i]. */
+/* Skins the vertices v0 + list[0..m) of a run, each with K influences
+ * (K 0: one of weight 1): positions stored, normals (when N) left
+ * unnormalised in tn[i]. */
 static inline __attribute__((always_inline)) void lbs_list(const int K, const int N, const uint8_t *restrict list,
                                                          size_t m, size_t v0, const float *restrict positions,
                                                          const float *restrict normals,
@@ -91,7 +96,11 @@ static inline __attribute__((always_inline)) void lbs_list(const int K, const in
 		const uint16_t *j = joints + 4 * v;
 		const float *w = weights + 4 * v;
 		const float *a = palette + 16 * (size_t)j[0];
-		rt_v4 c0 = w[0] * ld4(a), c1 = w[0] * ld4(a + 4), c2 = w[0] * ld4(a + 8), c3 = w[0] * ld4(a + 12);
+		rt_v4 c0, c1, c2, c3;
+		if (K == 0)
+			c0 = ld4(a), c1 = ld4(a + 4), c2 = ld4(a + 8), c3 = ld4(a + 12);
+		else
+			c0 = w[0] * ld4(a), c1 = w[0] * ld4(a + 4), c2 = w[0] * ld4(a + 8), c3 = w[0] * ld4(a + 12);
 		for (int k = 1; k < K; k++) {
 			const float *b = palette + 16 * (size_t)j[k];
 			const float wk = w[k];
@@ -173,11 +182,11 @@ static void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out, siz
 	}
 }
 
-/* Skins the vertices v0 .. v1 - 1 of a run whose vertices with k + 1
- * influences are l[k][0..c[k]) (offsets within the run, increasing), and
+/* Skins the vertices v0 .. v1 - 1 of a run whose vertices in bucket k
+ * (bucket_of) are l[k][0..c[k]) (offsets within the run, increasing), and
  * normalises the run's normals (when N). */
 static inline __attribute__((always_inline)) void lbs_sorted(const int N, size_t v0, size_t v1,
-                                                           const uint8_t *const l[4], const size_t c[4],
+                                                           const uint8_t *const l[5], const size_t c[5],
                                                            const float *restrict positions,
                                                            const float *restrict normals,
                                                            const uint16_t *restrict joints,
@@ -187,26 +196,28 @@ static inline __attribute__((always_inline)) void lbs_sorted(const int N, size_t
                                                            size_t nrm_stride)
 {
 	rt_v4 tn[RT_RUN];
-	lbs_list(1, N, l[0], c[0], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	lbs_list(2, N, l[1], c[1], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	lbs_list(3, N, l[2], c[2], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
-	lbs_list(4, N, l[3], c[3], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(0, N, l[0], c[0], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(1, N, l[1], c[1], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(2, N, l[2], c[2], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(3, N, l[3], c[3], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
+	lbs_list(4, N, l[4], c[4], v0, positions, normals, joints, weights, palette, out_pos, pos_stride, tn);
 	if (N)
 		normalise_run(v1 - v0, tn, (float *)((char *)out_nrm + v0 * nrm_stride), nrm_stride);
 }
 
-/* The run v0 .. v1 - 1 bucketed by influence count, in order: l[k] the
- * offsets within the run of the c[k] vertices with k + 1 influences. */
-static inline void bucket_run(const float *restrict weights, size_t v0, size_t v1, uint8_t l[4][RT_RUN],
-                              size_t c[4])
+/* The run v0 .. v1 - 1 bucketed (bucket_of), in order: l[k] the offsets
+ * within the run of the c[k] vertices in bucket k. */
+static inline void bucket_run(const float *restrict weights, size_t v0, size_t v1, uint8_t l[5][RT_RUN],
+                              size_t c[5])
 {
-	uint64_t packed = 0; /* the four counts, 16 bits each: no store in the chain */
+	uint64_t packed = 0; /* the five counts, 12 bits each: no store in the chain */
 	for (size_t v = v0; v < v1; v++) {
-		const unsigned sh = 16 * (influences(weights + 4 * v) - 1);
-		l[sh / 16][(packed >> sh) & 0xffff] = (uint8_t)(v - v0);
+		const unsigned sh = 12 * bucket_of(weights + 4 * v);
+		l[sh / 12][(packed >> sh) & 0xfff] = (uint8_t)(v - v0);
 		packed += (uint64_t)1 << sh;
 	}
-	c[0] = packed & 0xffff, c[1] = packed >> 16 & 0xffff, c[2] = packed >> 32 & 0xffff, c[3] = packed >> 48;
+	for (int k = 0; k < 5; k++)
+		c[k] = packed >> (12 * k) & 0xfff;
 }
 
 static inline __attribute__((always_inline)) void lbs_run(const int N, size_t v0, size_t v1,
@@ -218,10 +229,10 @@ static inline __attribute__((always_inline)) void lbs_run(const int N, size_t v0
                                                         size_t pos_stride, float *restrict out_nrm,
                                                         size_t nrm_stride)
 {
-	uint8_t list[4][RT_RUN];
-	size_t c[4];
+	uint8_t list[5][RT_RUN];
+	size_t c[5];
 	bucket_run(weights, v0, v1, list, c);
-	const uint8_t *const l[4] = { list[0], list[1], list[2], list[3] };
+	const uint8_t *const l[5] = { list[0], list[1], list[2], list[3], list[4] };
 	lbs_sorted(N, v0, v1, l, c, positions, normals, joints, weights, palette, out_pos, pos_stride, out_nrm,
 	           nrm_stride);
 }
@@ -244,12 +255,12 @@ void rt_skin_order(size_t n, const float *weights, uint8_t *order)
 {
 	for (size_t v0 = 0, r = 0; v0 < n; v0 += RT_RUN, r++) {
 		const size_t v1 = n - v0 < RT_RUN ? n : v0 + RT_RUN;
-		uint8_t l[4][RT_RUN];
-		size_t c[4], o = v0;
+		uint8_t l[5][RT_RUN];
+		size_t c[5], o = v0;
 		bucket_run(weights, v0, v1, l, c);
-		for (int k = 0; k < 4; o += c[k], k++) {
+		for (int k = 0; k < 5; o += c[k], k++) {
 			memcpy(order + o, l[k], c[k]);
-			order[n + 4 * r + (size_t)k] = (uint8_t)c[k];
+			order[n + 5 * r + (size_t)k] = (uint8_t)c[k];
 		}
 	}
 }
@@ -262,9 +273,10 @@ RT_CLONES void rt_skin_lbs_ordered(size_t n, const float *restrict positions, co
 {
 	for (size_t v0 = 0, r = 0; v0 < n; v0 += RT_RUN, r++) {
 		const size_t v1 = n - v0 < RT_RUN ? n : v0 + RT_RUN;
-		const size_t c[4] = { counts[4 * r], counts[4 * r + 1], counts[4 * r + 2], counts[4 * r + 3] };
-		const uint8_t *const l[4] = { list + v0, list + v0 + c[0], list + v0 + c[0] + c[1],
-		                              list + v0 + c[0] + c[1] + c[2] };
+		const uint8_t *cr = counts + 5 * r;
+		const size_t c[5] = { cr[0], cr[1], cr[2], cr[3], cr[4] };
+		const uint8_t *const l[5] = { list + v0, list + v0 + c[0], list + v0 + c[0] + c[1],
+		                              list + v0 + c[0] + c[1] + c[2], list + v0 + c[0] + c[1] + c[2] + c[3] };
 		if (normals)
 			lbs_sorted(1, v0, v1, l, c, positions, normals, joints, weights, palette, out_pos, pos_stride,
 			           out_nrm, nrm_stride);

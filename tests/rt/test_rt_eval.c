@@ -280,7 +280,8 @@ static float frand(void)
 }
 
 /* The kernel against the scalar loop: 1 to 4 influences in every pattern
- * (zero weights first, between and last), lengths around the kernel's runs
+ * (zero weights first, between and last; one influence of weight 1 and
+ * of another weight), lengths around the kernel's runs
  * of 64, zero normals, no normals, and positions and normals interleaved
  * in one buffer with a gap the kernel must not touch. */
 TEST(kernel_matches_scalar)
@@ -296,7 +297,7 @@ TEST(kernel_matches_scalar)
 		mlod_mat4 M = mlod_mat4_from_trs(&t);
 		memcpy(pal + 16 * m, M.m, sizeof M.m);
 	}
-	int pattern_seen[16] = { 0 };
+	int pattern_seen[16] = { 0 }, unit_seen[3] = { 0 };
 	for (int v = 0; v < N; v++) {
 		float s = 0;
 		for (int k = 0; k < 3; k++)
@@ -312,9 +313,15 @@ TEST(kernel_matches_scalar)
 		}
 		for (int k = 0; k < 4; k++)
 			wgt[4 * v + k] /= s;
+		/* One influence: of weight exactly 1 (x / x: the kernel's own
+		 * bucket) or, every other such vertex, of weight 0.75. */
+		if (mask == 1 && v % 2)
+			wgt[4 * v] = 0.75f;
+		unit_seen[mask == 1 ? wgt[4 * v] == 1.0f : 2] = 1;
 	}
 	for (int m = 1; m < 16; m++)
 		CHECK(pattern_seen[m], "influence pattern %d not covered", m);
+	CHECK(unit_seen[0] && unit_seen[1], "one influence of weight 1 and of another weight not both covered");
 	static const int lengths[] = { 0, 1, 3, 63, 64, 65, 127, 129, 200, N };
 	for (size_t l = 0; l < sizeof lengths / sizeof lengths[0]; l++) {
 		const int n = lengths[l];
