@@ -32,8 +32,9 @@ CXXFLAGS += -std=c++14 -pthread -Wall -Wextra $(CFLAGS_$(config))
 LDFLAGS_sanitize := -fsanitize=address,undefined
 LDFLAGS += -pthread $(LDFLAGS_$(config))
 # meshoptimizer's codecs (the pack writer's encoder, the runtime's decoder) and
-# Draco's core mesh codec (lib/pack/draco.cpp); -ltinygltf before -ldraco.
-LDLIBS := -ltinygltf -lmeshoptimizer -ldraco -lstdc++ -lm
+# Draco's core mesh codec (lib/pack/draco.cpp); -ltinygltf before -ldraco;
+# zstd (libzstd-dev), the pack's entropy stage (writer and reader).
+LDLIBS := -ltinygltf -lmeshoptimizer -ldraco -lzstd -lstdc++ -lm
 
 B := build/$(config)
 BIN := $(B)/bin
@@ -83,7 +84,7 @@ $(B)/lib/rt/%.o: lib/rt/%.c
 # libmlod. A bake-side symbol in the runtime fails this link.
 RT_TEST_SRC := $(sort $(wildcard tests/rt/*.c))
 RT_TESTS := $(RT_TEST_SRC:tests/rt/%.c=$(B)/tests/rt/%)
-RT_LDLIBS := -lmeshoptimizer -lm
+RT_LDLIBS := -lmeshoptimizer -lzstd -lm
 $(B)/tests/rt/%: tests/rt/%.c $(B)/libmlodrt.a
 	@mkdir -p $(@D)
 	$(CC) $(RT_CPPFLAGS) $(CFLAGS) $(LDFLAGS) $^ $(RT_LDLIBS) -o $@
@@ -113,6 +114,8 @@ $(B)/bench/%: $(B)/bench/%.o $(B)/libmlod.a $(B)/libmlodrt.a
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 # bench/crowd writes its picture with libpng (libpng-dev), linked there only.
 $(B)/bench/crowd: LDLIBS += -lpng
+# bench/pack_streams -z also measures deflate (zlib1g-dev) on each chunk.
+$(B)/bench/pack_streams: LDLIBS += -lz
 
 unit: $(UNIT) $(HELPERS) $(RT_TESTS)
 
@@ -187,7 +190,7 @@ fuzz: build/fuzz/fuzz_pack $(B)/tests/rt/test_pack_reader
 build/fuzz/fuzz_pack: tests/fuzz/fuzz_pack.c $(RT_C) lib/rt/mlod_pack.h $(sort $(wildcard lib/core/*.c)) lib/core/mlod_core.h
 	@mkdir -p $(@D)
 	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { echo "make fuzz needs clang with libFuzzer (Debian: clang libclang-rt-dev)" >&2; exit 1; }
-	$(FUZZ_CC) -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined $(RT_CPPFLAGS) tests/fuzz/fuzz_pack.c $(RT_C) $(sort $(wildcard lib/core/*.c)) -lmeshoptimizer -lm -o $@
+	$(FUZZ_CC) -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined $(RT_CPPFLAGS) tests/fuzz/fuzz_pack.c $(RT_C) $(sort $(wildcard lib/core/*.c)) -lmeshoptimizer -lzstd -lm -o $@
 # ----------------------------------------------------------------------
 
 -include $(shell find build -name '*.d' 2>/dev/null)

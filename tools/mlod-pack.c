@@ -29,6 +29,9 @@ static const char usage_text[] =
 	"                             well as the pack, else instead of it); FORMAT\n"
 	"                             is table or json\n"
 	"      --codec NAME           meshopt (default) or none (draco: not built yet)\n"
+	"      --entropy NAME         zstd (default): each chunk but INFO through\n"
+	"                             zstd -19 after its codec where that stores\n"
+	"                             fewer bytes; none: the codec alone\n"
 	"      --name NAME            the character's name in the pack (default: the\n"
 	"                             input file's name without its extension)\n"
 	"mesh levels (as mlod-bgm):\n"
@@ -54,7 +57,8 @@ static const char usage_text[] =
 	"      --no-skeleton-levels, --no-mesh-levels, --no-motion-levels\n"
 	"                             pack that layer at level 0 only\n"
 	"      --info FILE            print the pack's chunks (layer, level, clip,\n"
-	"                             codec, sizes, error, switch distance) and totals;\n"
+	"                             codec and entropy stage, sizes, error, switch\n"
+	"                             distance) and totals;\n"
 	"                             every chunk is decoded and checked\n"
 	"      --json                 with --info: as JSON (= --report=json)\n"
 	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels,\n"
@@ -216,14 +220,24 @@ static void check_chunks(const mlod_pack *p, const void *data, size_t size, cons
 			r = mlod_pack_decode_motion(p, i, data, size, have_skel ? &skel : NULL, &x, &err);
 			mlod_pack_motion_free(&x);
 		} else if (c->type == MLOD_CHUNK_DOC) {
-			const void *glb;
-			size_t n;
-			r = mlod_pack_doc(p, data, size, &glb, &n, &err);
+			mlod_pack_doc_bytes glb;
+			r = mlod_pack_decode_doc(p, data, size, &glb, &err);
+			mlod_pack_doc_free(&glb);
 		}
 	}
 	mlod_pack_skeleton_free(&skel);
 	if (r != MLOD_OK)
 		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
+}
+
+/* The codec column: "meshopt", or "meshopt+zstd" with an entropy stage. */
+static const char *codec_column(const mlod_pack_chunk *c, char *buf, size_t n)
+{
+	if (c->entropy == MLOD_ENTROPY_NONE)
+		snprintf(buf, n, "%s", mlod_pack_codec_name(c->codec));
+	else
+		snprintf(buf, n, "%s+%s", mlod_pack_codec_name(c->codec), mlod_pack_entropy_name(c->entropy));
+	return buf;
 }
 
 static int pack_info(const char *path, enum tool_report report)
@@ -277,9 +291,10 @@ static int pack_info(const char *path, enum tool_report report)
 				tool_json_string(f, info.clip_names[c->item]);
 			else
 				fputs("null", f);
-			fprintf(f, ", \"codec\": \"%s\", \"offset\": %llu, \"stored\": %u, \"raw\": %u, \"crc\": %u, "
-			        "\"error\": %.9g, \"error_percent\": %.9g, \"distance\": %.9g}%s\n",
-			        mlod_pack_codec_name(c->codec), (unsigned long long)c->offset, c->stored_size, c->raw_size, c->crc,
+			fprintf(f, ", \"codec\": \"%s\", \"entropy\": \"%s\", \"offset\": %llu, \"stored\": %u, \"coded\": %u, "
+			        "\"raw\": %u, \"crc\": %u, \"error\": %.9g, \"error_percent\": %.9g, \"distance\": %.9g}%s\n",
+			        mlod_pack_codec_name(c->codec), mlod_pack_entropy_name(c->entropy), (unsigned long long)c->offset,
+			        c->stored_size, c->entropy ? c->coded_size : c->stored_size, c->raw_size, c->crc,
 			        c->error, ref > 0.0 ? 100.0 * c->error / ref : 0.0, c->distance, i + 1 < p.chunk_count ? "," : "");
 		}
 		fprintf(f, "  ],\n  \"layers\": {\n");
@@ -296,7 +311,7 @@ static int pack_info(const char *path, enum tool_report report)
 		fprintf(f, "# character '%s': %u joints, %u skins, %u parts, %u clips; levels: skeleton %u, mesh %u, motion %u; "
 		        "height %.4g, diagonal %.4g\n", info.name, ir->joint_count, ir->skin_count, ir->instance_count,
 		        ir->clip_count, ir->skeleton_levels, ir->mesh_levels, ir->motion_levels, ir->height, ir->diagonal);
-		fprintf(f, "%-5s %-8s %5s  %-20s %-7s %10s %10s %11s %9s %11s\n", "type", "layer", "level", "item", "codec",
+		fprintf(f, "%-5s %-8s %5s  %-20s %-12s %10s %10s %11s %9s %11s\n", "type", "layer", "level", "item", "codec",
 		        "stored", "raw", "error", "error%", "distance");
 		for (uint32_t i = 0; i < p.chunk_count; i++) {
 			const mlod_pack_chunk *c = &p.chunks[i];
@@ -306,8 +321,9 @@ static int pack_info(const char *path, enum tool_report report)
 				snprintf(item, sizeof item, "%s", info.clip_names[c->item]);
 			else
 				snprintf(item, sizeof item, "-");
-			fprintf(f, "%-5s %-8s %5u  %-20s %-7s %10u %10u %11.4g %8.4g%% %11.4g\n", mlod_pack_type_name(c->type),
-			        mlod_pack_layer_name(c->layer), c->level, item, mlod_pack_codec_name(c->codec), c->stored_size,
+			char cc[32];
+			fprintf(f, "%-5s %-8s %5u  %-20s %-12s %10u %10u %11.4g %8.4g%% %11.4g\n", mlod_pack_type_name(c->type),
+			        mlod_pack_layer_name(c->layer), c->level, item, codec_column(c, cc, sizeof cc), c->stored_size,
 			        c->raw_size, c->error, ref > 0.0 ? 100.0 * c->error / ref : 0.0, c->distance);
 		}
 		for (unsigned l = 0; l < 4; l++)
@@ -345,12 +361,13 @@ static int pack_extract(const char *path, const char *output)
 
 int main(int argc, char **argv)
 {
-	enum { OPT_CODEC = 256, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH, OPT_NO_MOTION, OPT_INFO, OPT_JSON,
+	enum { OPT_CODEC = 256, OPT_ENTROPY, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH, OPT_NO_MOTION, OPT_INFO, OPT_JSON,
 	       OPT_POS_BITS, OPT_NRM_BITS, OPT_UV_BITS, OPT_LEVEL0_ERR, OPT_LOSSLESS_MOTION };
 	static const struct option longopts[] = {
 		{"output", required_argument, NULL, 'o'},
 		{"report", optional_argument, NULL, 'r'},
 		{"codec", required_argument, NULL, OPT_CODEC},
+		{"entropy", required_argument, NULL, OPT_ENTROPY},
 		{"name", required_argument, NULL, OPT_NAME},
 		{"ratios", required_argument, NULL, 'R'},
 		{"max-error", required_argument, NULL, 'e'},
@@ -395,6 +412,14 @@ int main(int argc, char **argv)
 			else
 				tool_usage_error("--codec: unknown value '%s' (meshopt, none or draco)", optarg);
 			codec = optarg;
+			break;
+		case OPT_ENTROPY:
+			if (strcmp(optarg, "zstd") == 0)
+				opt.entropy = MLOD_ENTROPY_ZSTD;
+			else if (strcmp(optarg, "none") == 0)
+				opt.entropy = MLOD_ENTROPY_NONE;
+			else
+				tool_usage_error("--entropy: unknown value '%s' (zstd or none)", optarg);
 			break;
 		case OPT_NAME: name = optarg; break;
 		case 'R':
@@ -473,10 +498,12 @@ int main(int argc, char **argv)
 		fprintf(stderr, "%s: %s: no animation: the pack has no motion levels\n", tool_name, label);
 	if (output || report == REPORT_NONE)
 		tool_write_output(output, pack, pack_size, 1);
+	char codec_label[48];
+	snprintf(codec_label, sizeof codec_label, "%s%s", codec, opt.entropy == MLOD_ENTROPY_ZSTD ? "+zstd" : "");
 	if (report == REPORT_TABLE)
-		report_table(stdout, label, &st, codec);
+		report_table(stdout, label, &st, codec_label);
 	else if (report == REPORT_JSON)
-		report_json(stdout, label, &st, codec);
+		report_json(stdout, label, &st, codec_label);
 	if (fflush(stdout) != 0)
 		tool_die(EXIT_OUTPUT, "<stdout>", "write error");
 	mlod_free(pack);

@@ -66,6 +66,9 @@ extern "C" {
  * mlod_pack_options_default. */
 typedef struct mlod_pack_options {
 	mlod_pack_codec codec;       /* NONE or MESHOPT (DRACO: MLOD_ERR_UNSUPPORTED) */
+	int entropy;                 /* MLOD_ENTROPY_ZSTD (the default) or _NONE: each
+	                              * chunk but INFO through zstd -19 after its codec,
+	                              * kept where it stores fewer bytes (mlod(5)) */
 	const char *name;            /* the character's name in INFO; NULL: "" */
 	/* skeleton, when computed */
 	double skel_max_error;       /* % of the skeleton height (MLOD_SKEL_MAX_ERROR_DEFAULT) */

@@ -10,6 +10,7 @@
 #include <time.h>
 
 #include <meshoptimizer.h>
+#include <zstd.h>
 
 #include "pack/mlod_pack_write.h"
 #include "record/mlod_record.h"
@@ -148,12 +149,12 @@ static void cb_free(chunkb *cb)
 
 typedef struct chunk {
 	uint32_t type;
-	uint8_t layer, codec;
+	uint8_t layer, codec, entropy;
 	uint16_t level, item, flags;
 	float error, distance;
 	uint8_t *data;
 	size_t size;
-	uint32_t raw;
+	uint32_t raw, coded; /* coded: with an entropy stage, the container's size */
 	uint64_t offset;
 } chunk;
 
@@ -308,6 +309,37 @@ nomem:
 	free(b.p);
 	cb_free(cb);
 	return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+}
+
+/* The entropy stage (mlod(5), format 5.0): zstd at this level over the
+ * chunk's whole container, kept when it stores fewer bytes and the
+ * container is at most the raw size (the reader's bound). Deterministic:
+ * one-shot compression, one thread, the frame with its content size. */
+#define PACK_ZSTD_LEVEL 19
+
+static mlod_result chunk_entropy(chunk *c, mlod_error *err)
+{
+	if (c->type == MLOD_CHUNK_INFO || c->size < 4 || c->size > c->raw)
+		return MLOD_OK;
+	size_t cap = ZSTD_compressBound(c->size);
+	uint8_t *z = malloc(cap);
+	if (!z)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+	size_t n = ZSTD_compress(z, cap, c->data, c->size, PACK_ZSTD_LEVEL);
+	if (ZSTD_isError(n)) {
+		free(z);
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd: %s", ZSTD_getErrorName(n));
+	}
+	if (n >= c->size) {
+		free(z);
+		return MLOD_OK;
+	}
+	free(c->data);
+	c->coded = (uint32_t)c->size;
+	c->data = z;
+	c->size = n;
+	c->entropy = MLOD_ENTROPY_ZSTD;
+	return MLOD_OK;
 }
 
 /* A string table. */
@@ -2592,6 +2624,7 @@ void mlod_pack_options_default(mlod_pack_options *opt)
 	static const double ratios[] = {MLOD_MESH_RATIOS_DEFAULT}, bounds[] = {MLOD_PACK_MOTION_BOUNDS_DEFAULT};
 	memset(opt, 0, sizeof *opt);
 	opt->codec = MLOD_CODEC_MESHOPT;
+	opt->entropy = MLOD_ENTROPY_ZSTD;
 	opt->skel_max_error = MLOD_SKEL_MAX_ERROR_DEFAULT;
 	opt->ratio_count = (int)(sizeof ratios / sizeof *ratios);
 	memcpy(opt->ratios, ratios, sizeof ratios);
@@ -2663,6 +2696,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "the draco codec is not built yet");
 	if (opt->codec != MLOD_CODEC_NONE && opt->codec != MLOD_CODEC_MESHOPT)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "unknown codec %d", (int)opt->codec);
+	if (opt->entropy != MLOD_ENTROPY_NONE && opt->entropy != MLOD_ENTROPY_ZSTD)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "unknown entropy stage %d", opt->entropy);
 	memset(&x, 0, sizeof x);
 	x.doc = doc;
 	x.in = c;
@@ -2797,6 +2832,12 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			goto done;
 	}
 
+	/* The entropy stage, after every choice above was made on the codec's
+	 * bytes (INFO has none: its size must not depend on the offsets). */
+	for (int i = 0; opt->entropy == MLOD_ENTROPY_ZSTD && i < body.n; i++)
+		if ((r = chunk_entropy(&body.c[i], err)) != MLOD_OK)
+			goto done;
+
 	/* INFO: its size does not depend on its values (its streams are raw). */
 	strtab names = {0};
 	mlod_pack_info_rec info;
@@ -2875,7 +2916,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			uint8_t *e = f.p + MLOD_PACK_HEADER_SIZE + (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)i;
 			put_u32(e, ch->type);
 			e[4] = ch->layer;
-			e[5] = ch->codec;
+			e[5] = (uint8_t)(ch->codec | ch->entropy << 4);
+			put_u32(e + 12, ch->entropy ? ch->coded : 0);
 			put_u16(e + 6, ch->level);
 			put_u16(e + 8, ch->item);
 			put_u16(e + 10, ch->flags);

@@ -455,11 +455,12 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			goto done;
 		have_skel = 1;
 	}
-	const void *glb;
-	size_t glb_size;
-	if ((r = mlod_pack_doc(&p, data, size, &glb, &glb_size, err)) != MLOD_OK)
+	mlod_pack_doc_bytes glb;
+	if ((r = mlod_pack_decode_doc(&p, data, size, &glb, err)) != MLOD_OK)
 		goto done;
-	if ((r = read_doc(glb, glb_size, &doc, err)) != MLOD_OK)
+	r = read_doc(glb.glb, glb.size, &doc, err);
+	mlod_pack_doc_free(&glb);
+	if (r != MLOD_OK)
 		goto done;
 	if ((r = build_skeleton(have_skel ? &skel : NULL, &s, err)) != MLOD_OK)
 		goto done;

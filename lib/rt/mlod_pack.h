@@ -264,7 +264,7 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 4
+#define MLOD_PACK_MAJOR 5
 #define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32
@@ -304,6 +304,14 @@ typedef enum mlod_pack_codec {
 	MLOD_CODEC_MESHOPT = 1, /* meshoptimizer's vertex and index codecs */
 	MLOD_CODEC_DRACO = 2    /* Draco's mesh codec (mesh chunks) */
 } mlod_pack_codec;
+
+/* A chunk's entropy stage (format 5.0; TOC codec byte bits 4-7): a
+ * general-purpose compressor over the chunk's whole stream container, as
+ * its codec made it. The TOC's coded size (bytes 12-15) is then the
+ * container's size, at least 4 and at most the raw size; the stored bytes
+ * are one zstd frame that says that size. INFO never has one. */
+#define MLOD_ENTROPY_NONE 0
+#define MLOD_ENTROPY_ZSTD 1
 
 /* A stream's codec. */
 #define MLOD_SCODEC_RAW 0
@@ -482,7 +490,9 @@ typedef struct mlod_pack_channel_rec {
 /* One TOC entry, as read. */
 typedef struct mlod_pack_chunk {
 	uint32_t type;
-	uint8_t layer, codec;
+	uint8_t layer, codec;      /* codec: the TOC byte's bits 0-3 */
+	uint8_t entropy;           /* the TOC codec byte's bits 4-7 (MLOD_ENTROPY_*; format 5.0) */
+	uint32_t coded_size;       /* with an entropy stage, the container's bytes (TOC bytes 12-15), else 0 */
 	uint16_t level, item, flags;
 	uint64_t offset;
 	uint32_t stored_size, raw_size, crc;
@@ -633,6 +643,19 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, const void **glb, size_t *glb_size,
                           mlod_error *err);
 
+/* The DOC chunk's glb bytes, copied out of the chunk (its entropy stage
+ * undone): glb lives in block; release with mlod_pack_doc_free.
+ * mlod_pack_doc, which points into data, fails with MLOD_ERR_INVALID_ARG
+ * for a DOC chunk with an entropy stage. */
+typedef struct mlod_pack_doc_bytes {
+	const uint8_t *glb;
+	size_t size;
+	void *block;
+} mlod_pack_doc_bytes;
+mlod_result mlod_pack_decode_doc(const mlod_pack *p, const void *data, size_t size, mlod_pack_doc_bytes *out,
+                                 mlod_error *err);
+void mlod_pack_doc_free(mlod_pack_doc_bytes *x);
+
 void mlod_pack_info_free(mlod_pack_info *x);
 void mlod_pack_skeleton_free(mlod_pack_skeleton *x);
 void mlod_pack_skel_level_free(mlod_pack_skel_level *x);
@@ -648,6 +671,7 @@ int mlod_pack_find(const mlod_pack *p, uint32_t type, unsigned level, unsigned i
  * the reader: the comment named it, no declaration did. */
 const char *mlod_pack_type_name(uint32_t type);
 const char *mlod_pack_codec_name(unsigned codec);
+const char *mlod_pack_entropy_name(unsigned entropy); /* "none", "zstd" */
 const char *mlod_pack_layer_name(unsigned layer);
 
 #ifdef __cplusplus

@@ -28,6 +28,10 @@
 #include <string.h>
 
 #include <meshoptimizer.h>
+/* ZSTD_createDCtx_advanced (the allocator hooks) is in zstd's advanced
+ * API; libzstd exports it. */
+#define ZSTD_STATIC_LINKING_ONLY
+#include <zstd.h>
 
 #include "mlod_pack.h"
 
@@ -307,7 +311,9 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		mlod_pack_chunk *c = &chunks[i];
 		c->type = rd32(e);
 		c->layer = e[4];
-		c->codec = e[5];
+		c->codec = e[5] & 15u;
+		c->entropy = e[5] >> 4;
+		c->coded_size = c->entropy ? rd32(e + 12) : 0;
 		c->level = rd16(e + 6);
 		c->item = rd16(e + 8);
 		c->flags = rd16(e + 10);
@@ -329,6 +335,12 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): bytes %llu to %llu lie outside the file (%llu bytes)",
 			              i, label, (unsigned long long)c->offset,
 			              (unsigned long long)c->offset + c->stored_size, (unsigned long long)file_size);
+		} else if (c->entropy && major < 5) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): codec 0x%02x: an entropy stage in a %u.%u pack "
+			              "(format 5.0 added them)", i, label, e[5], major, minor);
+		} else if (c->entropy && (c->coded_size < 4 || c->coded_size > c->raw_size)) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): coded size %u is not 4 to its raw size %u", i, label,
+			              c->coded_size, c->raw_size);
 		} else if (!isfinite(c->error) || c->error < 0 || !isfinite(c->distance) || c->distance < 0) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): error %g and switch distance %g must be finite and >= 0",
 			              i, label, (double)c->error, (double)c->distance);
@@ -345,6 +357,8 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): level %u, expected 0", i, label, c->level);
 			else if (c->type != MLOD_CHUNK_MOTION && c->item != 0)
 				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): item %u, expected 0", i, label, c->item);
+			else if (c->entropy && c->type == MLOD_CHUNK_INFO)
+				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): INFO has no entropy stage", i, label);
 			else if (c->codec == MLOD_CODEC_DRACO && c->type != MLOD_CHUNK_MESH)
 				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the Draco codec is for MESH chunks only", i,
 				              label);
@@ -423,6 +437,15 @@ const char *mlod_pack_codec_name(unsigned codec)
 	return "unknown";
 }
 
+const char *mlod_pack_entropy_name(unsigned entropy)
+{
+	switch (entropy) {
+	case MLOD_ENTROPY_NONE: return "none";
+	case MLOD_ENTROPY_ZSTD: return "zstd";
+	}
+	return "unknown";
+}
+
 const char *mlod_pack_layer_name(unsigned layer)
 {
 	switch (layer) {
@@ -446,7 +469,10 @@ typedef struct stream {
 typedef struct cx {
 	const mlod_pack_chunk *c;
 	char label[64];
-	const uint8_t *base; /* the chunk's stored bytes */
+	const uint8_t *base; /* the chunk's stream container: its stored bytes, or
+	                      * plain for a chunk with an entropy stage */
+	uint64_t size;        /* the container's bytes at base */
+	uint8_t *plain;       /* the entropy stage's output (owned) */
 	uint32_t nstreams, next;
 	uint64_t cursor;      /* offset in the chunk of stream next's bytes */
 	uint64_t max_decoded; /* the largest meshopt-coded stream, decoded */
@@ -474,11 +500,73 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: Draco chunks need the Draco decoder, not built in", x->label);
 	if (c->codec != MLOD_CODEC_NONE && c->codec != MLOD_CODEC_MESHOPT)
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: unknown chunk codec %u", x->label, c->codec);
+	if (c->entropy != MLOD_ENTROPY_NONE && c->entropy != MLOD_ENTROPY_ZSTD)
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: unknown entropy stage %u", x->label, c->entropy);
+	return MLOD_OK;
+}
+
+/* The one place that undoes an entropy stage: the chunk's stored bytes at
+ * x->base (CRC checked) become its stream container in x->plain, exactly
+ * the TOC's coded size (checked against the raw size at open) and nothing
+ * else: the frame must say that size, hold one frame and nothing after
+ * it, and decode to exactly that; the output buffer is that size, so no
+ * frame can write more. zstd's context comes from the pack's allocator. */
+static void *zs_alloc(void *user, size_t size)
+{
+	const mlod_pack_alloc *a = user;
+	return a->malloc(a->user, size);
+}
+
+static void zs_free(void *user, void *p)
+{
+	const mlod_pack_alloc *a = user;
+	if (p)
+		a->free(a->user, p);
+}
+
+static mlod_result cx_unpack(cx *x, mlod_error *err)
+{
+	const mlod_pack_chunk *c = x->c;
+	uint64_t want = c->coded_size;
+	if (want > PACK_MAX_BLOCK)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: its container of %llu bytes is more than the reader's limit",
+		                 x->label, (unsigned long long)want);
+	unsigned long long said = ZSTD_getFrameContentSize(x->base, c->stored_size);
+	if (said == ZSTD_CONTENTSIZE_ERROR)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: not a zstd frame (its %u bytes)", x->label, c->stored_size);
+	if (said == ZSTD_CONTENTSIZE_UNKNOWN || said != want)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame says %s%llu bytes, the TOC's coded size is %llu",
+		                 x->label, said == ZSTD_CONTENTSIZE_UNKNOWN ? "no size, not " : "", said == ZSTD_CONTENTSIZE_UNKNOWN ? 0ull : said,
+		                 (unsigned long long)want);
+	size_t frame = ZSTD_findFrameCompressedSize(x->base, c->stored_size);
+	if (ZSTD_isError(frame) || frame != c->stored_size)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame %s its %u bytes", x->label,
+		                 ZSTD_isError(frame) ? "is truncated or malformed in" : "does not end at the end of",
+		                 c->stored_size);
+	x->plain = pk_malloc(&x->alloc, 1, (size_t)want);
+	if (!x->plain)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for its %llu-byte container", x->label,
+		                 (unsigned long long)want);
+	ZSTD_customMem mem = {zs_alloc, zs_free, &x->alloc};
+	ZSTD_DCtx *z = x->alloc.malloc && x->alloc.free ? ZSTD_createDCtx_advanced(mem) : ZSTD_createDCtx();
+	if (!z)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for the zstd decoder", x->label);
+	size_t got = ZSTD_decompressDCtx(z, x->plain, (size_t)want, x->base, c->stored_size);
+	ZSTD_freeDCtx(z);
+	if (ZSTD_isError(got))
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: zstd: %s", x->label, ZSTD_getErrorName(got));
+	if (got != want)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: zstd gave %zu bytes, the TOC's coded size is %llu", x->label, got,
+		                 (unsigned long long)want);
+	x->base = x->plain;
+	x->size = want;
 	return MLOD_OK;
 }
 
 /* Checks the chunk's bytes at x->base (CRC) and its stream container
  * (sizes add up to the stored and the raw size). */
+static mlod_result cx_container(cx *x, mlod_error *err);
+
 static mlod_result cx_parse(cx *x, mlod_error *err)
 {
 	const mlod_pack_chunk *c = x->c;
@@ -486,17 +574,34 @@ static mlod_result cx_parse(cx *x, mlod_error *err)
 	if (crc != c->crc)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: CRC mismatch (stored 0x%08x, computed 0x%08x)", x->label, c->crc,
 		                 crc);
-	if (c->stored_size < 4)
-		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %u bytes, too short for its stream count", x->label,
-		                 c->stored_size);
+	x->size = c->stored_size;
+	mlod_result r = c->entropy == MLOD_ENTROPY_NONE ? MLOD_OK : cx_unpack(x, err);
+	if (r == MLOD_OK)
+		r = cx_container(x, err);
+	if (r != MLOD_OK) {
+		pk_free(&x->alloc, x->plain);
+		x->plain = NULL;
+	}
+	return r;
+}
+
+/* The stream container at x->base, x->size bytes. */
+static mlod_result cx_container(cx *x, mlod_error *err)
+{
+	const mlod_pack_chunk *c = x->c;
+	const char *what = c->entropy == MLOD_ENTROPY_NONE ? "" : " decoded";
+	uint64_t csize = x->size;
+	if (csize < 4)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %llu%s bytes, too short for its stream count", x->label,
+		                 (unsigned long long)csize, what);
 	uint32_t n = rd32(x->base);
 	if (n > MLOD_PACK_MAX_STREAMS)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %u streams, more than the format's %d", x->label, n,
 		                 MLOD_PACK_MAX_STREAMS);
 	uint64_t cursor = 4 + 16 * (uint64_t)n, raw = cursor;
-	if (cursor > c->stored_size)
-		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %u stream headers do not fit in its %u bytes", x->label, n,
-		                 c->stored_size);
+	if (cursor > csize)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: %u stream headers do not fit in its %llu%s bytes", x->label, n,
+		                 (unsigned long long)csize, what);
 	for (uint32_t i = 0; i < n; i++) {
 		const uint8_t *h = x->base + 4 + 16 * (size_t)i;
 		uint32_t tag = rd32(h), count = rd32(h + 4), elsize = rd16(h + 8), codec = h[10], stored = rd32(h + 12);
@@ -531,17 +636,18 @@ static mlod_result cx_parse(cx *x, mlod_error *err)
 		if (codec == MLOD_SCODEC_RAW && stored != decoded)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': %u bytes stored for %u elements of %u bytes",
 			                 x->label, i, tagn(tag).s, stored, count, elsize);
-		if (pad4(stored) > c->stored_size - cursor)
-			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s' (%u bytes at %llu) runs past the chunk's %u bytes",
-			                 x->label, i, tagn(tag).s, stored, (unsigned long long)cursor, c->stored_size);
+		if (pad4(stored) > csize - cursor)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s' (%u bytes at %llu) runs past the chunk's %llu%s bytes", x->label, i,
+			                 tagn(tag).s, stored, (unsigned long long)cursor, (unsigned long long)csize, what);
 		cursor += pad4(stored);
 		raw += pad4(decoded);
 		if (codec != MLOD_SCODEC_RAW && decoded > x->max_decoded)
 			x->max_decoded = decoded;
 	}
-	if (cursor != c->stored_size)
-		return mlod_fail(err, MLOD_ERR_PARSE, "%s: its streams end at byte %llu of its %u", x->label,
-		                 (unsigned long long)cursor, c->stored_size);
+	if (cursor != csize)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: its streams end at byte %llu of its %llu%s", x->label,
+		                 (unsigned long long)cursor, (unsigned long long)csize, what);
 	if (raw != c->raw_size)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: raw size %u in the TOC, but its streams decode to %llu bytes",
 		                 x->label, c->raw_size, (unsigned long long)raw);
@@ -645,6 +751,8 @@ static void cx_done(cx *x)
 {
 	pk_free(&x->alloc, x->temp);
 	x->temp = NULL;
+	pk_free(&x->alloc, x->plain);
+	x->plain = NULL;
 }
 
 /* Index k of a decoded index stream of 16-bit (i16) or 32-bit entries, in
@@ -2176,6 +2284,27 @@ void mlod_pack_motion_free(mlod_pack_motion *x)
 /* DOC                                                                 */
 /* ------------------------------------------------------------------ */
 
+/* The DOC chunk's 'GLB ' stream, checked; x is left open (cx_done). */
+static mlod_result doc_begin(const mlod_pack *p, const void *data, size_t size, cx *x, stream *s, mlod_error *err)
+{
+	if (!p)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_doc: the pack is NULL");
+	int ci = mlod_pack_find(p, MLOD_CHUNK_DOC, 0, 0);
+	if (ci < 0)
+		return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no DOC chunk");
+	mlod_result r = cx_begin(p, (uint32_t)ci, MLOD_CHUNK_DOC, data, size, x, err);
+	if (r != MLOD_OK)
+		return r;
+	r = cx_expect(x, s, MLOD_STREAM_GLB, 1, UINT64_MAX, "", "", err);
+	if (r == MLOD_OK)
+		r = cx_end(x, err);
+	if (r == MLOD_OK && s->codec != MLOD_SCODEC_RAW)
+		r = mlod_fail(err, MLOD_ERR_PARSE, "DOC: the 'GLB ' stream must be stored raw");
+	if (r != MLOD_OK)
+		cx_done(x);
+	return r;
+}
+
 mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, const void **glb, size_t *glb_size,
                           mlod_error *err)
 {
@@ -2183,24 +2312,52 @@ mlod_result mlod_pack_doc(const mlod_pack *p, const void *data, size_t size, con
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_doc: glb or glb_size is NULL");
 	*glb = NULL;
 	*glb_size = 0;
-	if (!p)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_doc: the pack is NULL");
-	int ci = mlod_pack_find(p, MLOD_CHUNK_DOC, 0, 0);
-	if (ci < 0)
-		return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no DOC chunk");
+	int ci = p ? mlod_pack_find(p, MLOD_CHUNK_DOC, 0, 0) : -1;
+	if (ci >= 0 && p->chunks[ci].entropy != MLOD_ENTROPY_NONE)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG,
+		                 "DOC: stored with the %s entropy stage, so its bytes are not in the file: use "
+		                 "mlod_pack_decode_doc",
+		                 mlod_pack_entropy_name(p->chunks[ci].entropy));
 	cx x;
 	stream s;
-	mlod_result r = cx_begin(p, (uint32_t)ci, MLOD_CHUNK_DOC, data, size, &x, err);
+	mlod_result r = doc_begin(p, data, size, &x, &s, err);
 	if (r != MLOD_OK)
 		return r;
-	r = cx_expect(&x, &s, MLOD_STREAM_GLB, 1, UINT64_MAX, "", "", err);
-	if (r == MLOD_OK)
-		r = cx_end(&x, err);
-	if (r != MLOD_OK)
-		return r;
-	if (s.codec != MLOD_SCODEC_RAW)
-		return mlod_fail(err, MLOD_ERR_PARSE, "DOC: the 'GLB ' stream must be stored raw");
 	*glb = s.src;
 	*glb_size = s.count;
+	cx_done(&x);
 	return MLOD_OK;
+}
+
+mlod_result mlod_pack_decode_doc(const mlod_pack *p, const void *data, size_t size, mlod_pack_doc_bytes *out,
+                                 mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_doc: out is NULL");
+	memset(out, 0, sizeof *out);
+	cx x;
+	stream s;
+	mlod_result r = doc_begin(p, data, size, &x, &s, err);
+	if (r != MLOD_OK)
+		return r;
+	bump b = {0};
+	r = bump_alloc(&b, &x, round8((uint64_t)s.count), err);
+	if (r == MLOD_OK) {
+		uint8_t *g = bump_take(&b, s.count);
+		if (s.count)
+			memcpy(g, s.src, s.count);
+		out->glb = g;
+		out->size = s.count;
+		out->block = b.base;
+	}
+	cx_done(&x);
+	return r;
+}
+
+void mlod_pack_doc_free(mlod_pack_doc_bytes *x)
+{
+	if (!x)
+		return;
+	block_free(x->block);
+	memset(x, 0, sizeof *x);
 }
