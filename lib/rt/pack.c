@@ -338,6 +338,8 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		} else if (c->entropy && major < 5) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): codec 0x%02x: an entropy stage in a %u.%u pack "
 			              "(format 5.0 added them)", i, label, e[5], major, minor);
+		} else if (c->entropy && c->type == MLOD_CHUNK_INFO) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): INFO has no entropy stage", i, label);
 		} else if (c->entropy && (c->coded_size < 4 || c->coded_size > c->raw_size)) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): coded size %u is not 4 to its raw size %u", i, label,
 			              c->coded_size, c->raw_size);
@@ -357,8 +359,6 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): level %u, expected 0", i, label, c->level);
 			else if (c->type != MLOD_CHUNK_MOTION && c->item != 0)
 				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): item %u, expected 0", i, label, c->item);
-			else if (c->entropy && c->type == MLOD_CHUNK_INFO)
-				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): INFO has no entropy stage", i, label);
 			else if (c->codec == MLOD_CODEC_DRACO && c->type != MLOD_CHUNK_MESH)
 				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the Draco codec is for MESH chunks only", i,
 				              label);

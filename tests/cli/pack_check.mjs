@@ -7,7 +7,9 @@
 //
 // --doc writes the DOC chunk's glb to OUT.glb.
 // It does not decode streams: the round trip through the reader
-// (lib/rt/pack.c) is for the tests that come with it.
+// (lib/rt/pack.c) is for the tests that come with it. A chunk with the
+// zstd entropy stage (format 5.0) is undone with the zstd tool first.
+import { execFileSync } from 'node:child_process';
 import { readFileSync, writeFileSync } from 'node:fs';
 import { crc32 } from 'node:zlib';
 
@@ -19,7 +21,7 @@ const fourcc = (u) => String.fromCharCode(u & 255, (u >> 8) & 255, (u >> 16) & 2
 if (b.length < 32 || b.subarray(0, 4).toString('latin1') !== 'MLOD') die('no MLOD magic');
 const major = b.readUInt16LE(4), minor = b.readUInt16LE(6), flags = b.readUInt32LE(8), n = b.readUInt32LE(12);
 const size = Number(b.readBigUInt64LE(16));
-if (major !== 4 || minor !== 0) die(`version ${major}.${minor}`);
+if (major !== 5 || minor !== 0) die(`version ${major}.${minor}`);
 if (flags !== 0) die('flags');
 if (size !== b.length) die(`file_size ${size}, file ${b.length}`);
 if (crc32(b.subarray(0, 28)) !== b.readUInt32LE(28)) die('header CRC');
@@ -31,19 +33,25 @@ let end = 32 + 48 * n;
 for (let i = 0; i < n; i++) {
 	const e = b.subarray(32 + 48 * i, 80 + 48 * i);
 	const c = {
-		type: fourcc(e.readUInt32LE(0)), layer: e[4], codec: e[5], level: e.readUInt16LE(6), item: e.readUInt16LE(8),
+		type: fourcc(e.readUInt32LE(0)), layer: e[4], codec: e[5] & 15, entropy: e[5] >> 4, coded: e.readUInt32LE(12),
+		level: e.readUInt16LE(6), item: e.readUInt16LE(8),
 		offset: Number(e.readBigUInt64LE(16)), stored: e.readUInt32LE(24), raw: e.readUInt32LE(28),
 		crc: e.readUInt32LE(32), error: e.readFloatLE(36), distance: e.readFloatLE(40), flags: e.readUInt16LE(10),
 	};
 	// flags: only ANIM's 1, nested on the clip's next coarser level (checked below)
-	if ((c.flags && (c.type !== 'ANIM' || c.flags !== 1)) || e.readUInt32LE(12) || e.readUInt32LE(44)) die(`chunk ${i}: reserved bytes`);
+	if ((c.flags && (c.type !== 'ANIM' || c.flags !== 1)) || (c.coded && !c.entropy) || e.readUInt32LE(44)) die(`chunk ${i}: reserved bytes`);
+	// the entropy stage: zstd (1), never on INFO, its container at most the raw size
+	if (c.entropy > 1 || (c.entropy && (c.type === 'INFO' || c.coded < 4 || c.coded > c.raw))) die(`chunk ${i}: entropy ${c.entropy}, coded size ${c.coded}`);
 	if (c.offset % 16) die(`chunk ${i}: offset ${c.offset} not 16-aligned`);
 	if (c.offset < end) die(`chunk ${i}: overlaps`);
 	if (b.subarray(end, c.offset).some((x) => x !== 0)) die(`chunk ${i}: padding not zero`);
 	if (c.offset + c.stored > b.length) die(`chunk ${i}: past the end`);
 	end = c.offset + c.stored;
-	const d = b.subarray(c.offset, end);
-	if (crc32(d) !== c.crc) die(`chunk ${i} (${c.type}): CRC`);
+	const stored = b.subarray(c.offset, end);
+	if (crc32(stored) !== c.crc) die(`chunk ${i} (${c.type}): CRC`);
+	const d = c.entropy ? execFileSync('zstd', ['-d', '-q', '-c'], { input: stored, maxBuffer: 1 << 30 }) : stored;
+	if (c.entropy && d.length !== c.coded) die(`chunk ${i} (${c.type}): zstd gave ${d.length} bytes, coded size ${c.coded}`);
+	c.data = d;
 	// ANIM level 0 states its error against the input clip (0 when lossless); its distance is 0
 	if (c.level === 0 && ((c.error !== 0 && c.type !== 'ANIM') || c.distance !== 0)) die(`chunk ${i}: error or distance at level 0`);
 	if (!(c.error >= 0) || (c.level > 0 && (c.error > 0) !== (c.distance > 0))) die(`chunk ${i}: error ${c.error}, distance ${c.distance}`);
@@ -104,6 +112,7 @@ const out = {
 	bounds_min: [f(8), f(9), f(10)], bounds_max: [f(11), f(12), f(13)], height: f(14), diagonal: f(15), first_drawable: u(16),
 	count: {},
 	codecs: [...new Set(chunks.map((c) => c.codec))].sort(),
+	entropy: [...new Set(chunks.map((c) => c.entropy))].sort(),
 	stream_codecs: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.codec)))].sort(),
 	tags: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.tag)))].sort(),
 	doc: chunks[n - 1].streams[0].count,
@@ -124,6 +133,6 @@ for (const c of chunks) {
 if (process.argv[3] === '--doc') {
 	const d = chunks[n - 1], s = d.streams[0];
 	if (s.tag !== 'GLB ' || s.codec !== 0) die('DOC stream');
-	writeFileSync(process.argv[4], b.subarray(d.offset + s.at, d.offset + s.at + s.count));
+	writeFileSync(process.argv[4], d.data.subarray(s.at, s.at + s.count));
 }
 console.log(JSON.stringify(out));

@@ -7,8 +7,12 @@ for s in tubeman.glb RobotExpressive.glb cmu_12_01_walk.bvh; do
 	"$BIN/mlod-pack" "$ROOT/samples/$s" -o "$n.mlod" 2> /dev/null
 	"$BIN/mlod-pack" --info "$n.mlod" > "$n.txt"
 	size=$(wc -c < "$n.mlod" | tr -d ' ')
-	grep -q "^# $n.mlod: mlod 4\.0, $size bytes, [0-9]* chunks$" "$n.txt"
+	grep -q "^# $n.mlod: mlod 5\.0, $size bytes, [0-9]* chunks$" "$n.txt"
 	grep -q "^INFO  none " "$n.txt"
+	# the codec column names the entropy stage: INFO has none, DOC zstd
+	grep -q "^INFO  none         0  -  *none  " "$n.txt"
+	grep -q "^DOC   none         0  -  *none+zstd  " "$n.txt"
+	grep -q "^SKEL  skeleton     0  -  *meshopt+zstd  " "$n.txt"
 	grep -q "^SKEL  skeleton     0 " "$n.txt"
 	grep -q "^DOC   none " "$n.txt"
 	grep -q "^# total $size bytes: " "$n.txt"

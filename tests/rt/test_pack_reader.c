@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include <meshoptimizer.h>
+#include <zstd.h>
 
 #include "mlod_pack.h"
 
@@ -252,9 +253,28 @@ static void restamp(uint8_t *d, size_t n)
 	wr32(d + 28, mlod_pack_crc32(0, d, 28));
 }
 
+/* When set, build_pack gives every chunk with streams but INFO the zstd
+ * entropy stage at this level (format 5.0), smaller or not, where its
+ * container is at most its raw size (the format's bound; MESH level 0's
+ * random indices and MOTION level 0's meshopt streams code to more). */
+static int zstd_level;
+
+/* The zstd frame of a chunk's container. */
+static buf zstd_frame(const buf *in, int level)
+{
+	buf z = {0};
+	size_t cap = ZSTD_compressBound(in->n);
+	z.p = malloc(cap);
+	z.n = ZSTD_compress(z.p, cap, in->p, in->n, level);
+	if (ZSTD_isError(z.n))
+		z.n = 0;
+	return z;
+}
+
 /* The file: header, TOC, chunks on 16-byte boundaries. */
 static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 {
+	uint32_t coded[64] = {0};
 	buf chunks[64];
 	uint32_t raw[64];
 	uint64_t off[64];
@@ -262,6 +282,12 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 	for (int i = 0; i < nc; i++) {
 		at = (at + 15) & ~(uint64_t)15;
 		chunks[i] = chunk_bytes(&c[i], &raw[i]);
+		if (zstd_level && c[i].type != MLOD_CHUNK_INFO && c[i].ns && !c[i].payload.n && chunks[i].n <= raw[i]) {
+			buf z = zstd_frame(&chunks[i], zstd_level);
+			coded[i] = (uint32_t)chunks[i].n;
+			free(chunks[i].p);
+			chunks[i] = z;
+		}
 		off[i] = at;
 		at += chunks[i].n;
 	}
@@ -277,11 +303,11 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 	for (int i = 0; i < nc; i++) {
 		put32(&out, c[i].type);
 		put8(&out, c[i].layer);
-		put8(&out, c[i].codec);
+		put8(&out, (uint8_t)(c[i].codec | (coded[i] ? MLOD_ENTROPY_ZSTD << 4 : 0)));
 		put16(&out, c[i].level);
 		put16(&out, c[i].item);
 		put16(&out, c[i].flags);
-		put32(&out, 0);
+		put32(&out, coded[i]);
 		put64(&out, off[i]);
 		put32(&out, (uint32_t)chunks[i].n);
 		put32(&out, raw[i]);
@@ -936,12 +962,18 @@ static int decode_all(const uint8_t *d, size_t n, const mlod_pack_skeleton *give
 				if (!sk || m.channels[k].rec.joint >= sk->joint_count)
 					*bad = 1;
 			mlod_pack_motion_free(&m);
-		} else if (c->type == MLOD_CHUNK_DOC) {
+		} else if (c->type == MLOD_CHUNK_DOC && c->entropy == MLOD_ENTROPY_NONE) {
 			const void *g;
 			size_t gs;
 			r = mlod_pack_doc(&p, d, n, &g, &gs, &e);
 			if (r == MLOD_OK && ((const uint8_t *)g < d || (const uint8_t *)g + gs > d + n))
 				*bad = 1;
+		} else if (c->type == MLOD_CHUNK_DOC) {
+			mlod_pack_doc_bytes g;
+			r = mlod_pack_decode_doc(&p, d, n, &g, &e);
+			if (r == MLOD_OK && (g.size > c->raw_size || (g.size && !g.glb)))
+				*bad = 1;
+			mlod_pack_doc_free(&g);
 		} else {
 			continue;
 		}
@@ -1338,7 +1370,7 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 5.0 is newer than this reader's 4.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 6.0 is newer than this reader's 5.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
 }
 
@@ -1373,7 +1405,7 @@ TEST(older_major_is_refused)
 	free(b.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && p.chunks == NULL, "returned %d: %s", (int)r, terr.message);
 	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
-	                               "reads 2.x to 4.x)") == 0,
+	                               "reads 2.x to 5.x)") == 0,
 	          "message: %s", terr.message);
 }
 
@@ -1485,7 +1517,205 @@ TEST(draco_chunks_are_unsupported)
 
 /* A prefix of the pack: open fails until the TOC is in, and then each chunk
  * decodes exactly when its end lies inside the prefix. */
+static void every_prefix_of_pack(void);
 TEST(every_prefix)
+{
+	every_prefix_of_pack();
+}
+
+/* Every prefix again with the entropy stage on every chunk but INFO. */
+TEST(every_prefix_zstd)
+{
+	zstd_level = 3;
+	every_prefix_of_pack();
+	zstd_level = 0;
+}
+
+/* With the entropy stage, every chunk decodes to what it decodes to
+ * without it: the same records, attributes, keys and DOC bytes. */
+TEST(entropy_decodes_the_same)
+{
+	buf a = make_pack(0);
+	zstd_level = 19;
+	buf z = make_pack(0);
+	zstd_level = 0;
+	mlod_pack pa, pz;
+	CHECK_OK(mlod_pack_open(a.p, a.n, &pa, &terr));
+	CHECK_OK(mlod_pack_open(z.p, z.n, &pz, &terr));
+	int coded = 0;
+	for (uint32_t i = 0; i < pz.chunk_count; i++)
+		coded += pz.chunks[i].entropy == MLOD_ENTROPY_ZSTD;
+	int plain_mesh0_mot0 = pz.chunks[C_MESH0].entropy || pz.chunks[C_MOT0].entropy;
+	mlod_pack_skeleton sa, sz;
+	CHECK_OK(mlod_pack_decode_skeleton(&pa, a.p, a.n, &sa, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&pz, z.p, z.n, &sz, &terr));
+	int same = sa.joint_count == sz.joint_count &&
+	           memcmp(sa.joints, sz.joints, sizeof *sa.joints * sa.joint_count) == 0 &&
+	           memcmp(sa.inverse_bind[0], sz.inverse_bind[0], 64 * (size_t)sa.skins[0].joint_count) == 0;
+	for (uint32_t i = 0; i < pa.chunk_count; i++) {
+		const mlod_pack_chunk *c = &pa.chunks[i];
+		if (c->type == MLOD_CHUNK_MESH) {
+			mlod_pack_mesh ma, mz;
+			CHECK_OK(mlod_pack_decode_mesh(&pa, i, a.p, a.n, &sa, &ma, &terr));
+			CHECK_OK(mlod_pack_decode_mesh(&pz, i, z.p, z.n, &sz, &mz, &terr));
+			for (uint32_t k = 0; k < ma.part_count; k++) {
+				const mlod_pack_part *x = &ma.parts[k], *y = &mz.parts[k];
+				same = same && memcmp(&x->rec, &y->rec, sizeof x->rec) == 0 &&
+				       memcmp(x->positions, y->positions, 12 * (size_t)x->rec.vertex_count) == 0 &&
+				       memcmp(x->indices, y->indices, 4 * (size_t)x->rec.index_count) == 0;
+			}
+			mlod_pack_mesh_free(&ma);
+			mlod_pack_mesh_free(&mz);
+		} else if (c->type == MLOD_CHUNK_MOTION) {
+			mlod_pack_motion ma, mz;
+			CHECK_OK(mlod_pack_decode_motion(&pa, i, a.p, a.n, &sa, &ma, &terr));
+			CHECK_OK(mlod_pack_decode_motion(&pz, i, z.p, z.n, &sz, &mz, &terr));
+			same = same && ma.channel_count == mz.channel_count && ma.duration == mz.duration;
+			for (uint32_t k = 0; same && k < ma.channel_count; k++) {
+				const mlod_pack_channel *x = &ma.channels[k], *y = &mz.channels[k];
+				size_t nv = (x->rec.path == 1 ? 4 : 3) * (x->rec.interp == 2 ? 3 : 1) * (size_t)x->rec.key_count;
+				same = memcmp(&x->rec, &y->rec, sizeof x->rec) == 0 &&
+				       memcmp(x->times, y->times, 4 * (size_t)x->rec.key_count) == 0 &&
+				       memcmp(x->values, y->values, 4 * nv) == 0;
+			}
+			mlod_pack_motion_free(&ma);
+			mlod_pack_motion_free(&mz);
+		}
+	}
+	const void *g;
+	size_t gs;
+	mlod_pack_doc_bytes gz;
+	CHECK_OK(mlod_pack_doc(&pa, a.p, a.n, &g, &gs, &terr));
+	CHECK_OK(mlod_pack_decode_doc(&pz, z.p, z.n, &gz, &terr));
+	same = same && gs == gz.size && memcmp(g, gz.glb, gs) == 0;
+	/* mlod_pack_doc cannot point into a zstd frame: it says so. */
+	CHECK_ERR(mlod_pack_doc(&pz, z.p, z.n, &g, &gs, &terr), MLOD_ERR_INVALID_ARG,
+	          "DOC: stored with the zstd entropy stage");
+	mlod_pack_doc_free(&gz);
+	mlod_pack_skeleton_free(&sa);
+	mlod_pack_skeleton_free(&sz);
+	mlod_pack_close(&pa);
+	mlod_pack_close(&pz);
+	free(a.p);
+	free(z.p);
+	CHECK_MSG(coded == C_COUNT - 3 && !plain_mesh0_mot0, "%d chunks with the entropy stage", coded);
+	CHECK(same);
+}
+
+/* The entropy stage's hostile cases, each naming the chunk: the TOC's
+ * coded size against the raw size and the frame, a frame without its
+ * size, a bomb (a frame that says, or gives, more than the coded size),
+ * a truncated or damaged frame, an entropy stage in a 4.0 pack or on
+ * INFO, an unknown stage. */
+TEST(entropy_checks)
+{
+	zstd_level = 19;
+	buf b = make_pack(0);
+	zstd_level = 0;
+	uint8_t *d = malloc(b.n + 4096);
+	mlod_pack p;
+	mlod_pack_mesh m;
+	uint8_t *e1 = b.p + 32 + 48 * C_MESH1;
+	uint64_t off = get64(e1 + 16);
+	uint32_t stored = get32(e1 + 24), raw = get32(e1 + 28), coded = get32(e1 + 12);
+	CHECK(e1[5] >> 4 == MLOD_ENTROPY_ZSTD && coded > 0 && coded <= raw);
+#define OPEN_FAILS(stmt, code, text)                                                                             \
+	do {                                                                                                    \
+		memcpy(d, b.p, b.n);                                                                            \
+		uint8_t *e = d + 32 + 48 * C_MESH1;                                                             \
+		(void)e;                                                                                        \
+		stmt;                                                                                           \
+		restamp(d, b.n);                                                                                \
+		CHECK_ERR(mlod_pack_open(d, b.n, &p, &terr), code, text);                                       \
+	} while (0)
+#define DECODE_FAILS(stmt, code, text)                                                                           \
+	do {                                                                                                    \
+		memcpy(d, b.p, b.n);                                                                            \
+		uint8_t *e = d + 32 + 48 * C_MESH1;                                                             \
+		(void)e;                                                                                        \
+		stmt;                                                                                           \
+		restamp(d, b.n);                                                                                \
+		CHECK_OK(mlod_pack_open(d, b.n, &p, &terr));                                                    \
+		CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, d, b.n, NULL, &m, &terr), code, text);             \
+		mlod_pack_close(&p);                                                                            \
+	} while (0)
+	OPEN_FAILS(wr32(e + 12, raw + 1), MLOD_ERR_PARSE, "TOC entry 3 (MESH level 1): coded size");
+	OPEN_FAILS(wr32(e + 12, 0), MLOD_ERR_PARSE, "TOC entry 3 (MESH level 1): coded size 0 is not 4 to its raw size");
+	OPEN_FAILS(wr16(d + 4, 4), MLOD_ERR_PARSE, "TOC entry 1 (SKELETON): codec 0x10: an entropy stage in a 4.0 pack");
+	OPEN_FAILS(d[32 + 5] = 0x10, MLOD_ERR_PARSE, "TOC entry 0 (INFO): INFO has no entropy stage");
+	DECODE_FAILS(e[5] = 0x20, MLOD_ERR_UNSUPPORTED, "MESH level 1: unknown entropy stage 2");
+	/* The TOC says fewer bytes than the frame holds (a bomb): refused
+	 * before decoding; more: the frame does not give them. */
+	DECODE_FAILS(wr32(e + 12, coded - 1), MLOD_ERR_PARSE, "MESH level 1: the zstd frame says");
+	DECODE_FAILS(wr32(e + 12, coded + 1 <= raw ? coded + 1 : coded - 1), MLOD_ERR_PARSE,
+	             "MESH level 1: the zstd frame says");
+	/* Damaged and truncated frames (CRC re-stamped). */
+	DECODE_FAILS(d[off] ^= 0xff, MLOD_ERR_PARSE, "MESH level 1: not a zstd frame");
+	DECODE_FAILS(wr32(e + 24, stored - 3), MLOD_ERR_PARSE, "MESH level 1: the zstd frame is truncated or malformed");
+	/* The frame's last block damaged: zstd's own checks, or the container's. */
+	memcpy(d, b.p, b.n);
+	d[off + stored - 2] ^= 0x5a;
+	restamp(d, b.n);
+	CHECK_OK(mlod_pack_open(d, b.n, &p, &terr));
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_mesh(&p, C_MESH1, d, b.n, NULL, &m, &terr);
+	mlod_pack_close(&p);
+	CHECK_MSG(r == MLOD_ERR_PARSE && strncmp(terr.message, "MESH level 1: ", 14) == 0, "returned %d: %s", (int)r,
+	          terr.message);
+	free(d);
+	free(b.p);
+	/* A frame without its content size, and a bomb: a frame of 1 MiB of
+	 * zeros (about 100 bytes) in place of DOC, whose TOC says 40 bytes. */
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	zstd_level = 19;
+	buf z = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	zstd_level = 0;
+	free_chunks(c, n);
+	mlod_pack pz;
+	CHECK_OK(mlod_pack_open(z.p, z.n, &pz, &terr));
+	const mlod_pack_chunk *doc = &pz.chunks[C_DOC];
+	size_t big = (size_t)1 << 20;
+	uint8_t *zeros = calloc(1, big);
+	size_t cap = ZSTD_compressBound(big);
+	uint8_t *bomb = malloc(cap);
+	size_t bn = ZSTD_compress(bomb, cap, zeros, big, 19);
+	ZSTD_CCtx *cc = ZSTD_createCCtx();
+	ZSTD_CCtx_setParameter(cc, ZSTD_c_contentSizeFlag, 0);
+	uint8_t *nosize = malloc(cap);
+	size_t nn = ZSTD_compress2(cc, nosize, cap, zeros, 40);
+	ZSTD_freeCCtx(cc);
+	CHECK(!ZSTD_isError(bn) && !ZSTD_isError(nn) && bn <= doc->stored_size + 4096 && nn <= 4096);
+	for (int k = 0; k < 2; k++) {
+		const uint8_t *frame = k ? nosize : bomb;
+		size_t fn = k ? nn : bn;
+		buf t = {0};
+		put(&t, z.p, doc->offset);
+		put(&t, frame, fn);
+		uint8_t *e = t.p + 32 + 48 * C_DOC;
+		wr32(e + 24, (uint32_t)fn);
+		wr32(e + 12, 40);
+		wr32(t.p + 16, (uint32_t)t.n);
+		restamp(t.p, t.n);
+		mlod_pack q;
+		mlod_pack_doc_bytes g;
+		CHECK_OK(mlod_pack_open(t.p, t.n, &q, &terr));
+		CHECK_ERR(mlod_pack_decode_doc(&q, t.p, t.n, &g, &terr), MLOD_ERR_PARSE,
+		          k ? "DOC: the zstd frame says no size, not 0 bytes, the TOC's coded size is 40"
+		            : "DOC: the zstd frame says 1048576 bytes, the TOC's coded size is 40");
+		mlod_pack_close(&q);
+		free(t.p);
+	}
+	free(zeros);
+	free(bomb);
+	free(nosize);
+	mlod_pack_close(&pz);
+	free(z.p);
+#undef OPEN_FAILS
+#undef DECODE_FAILS
+}
+
+static void every_prefix_of_pack(void)
 {
 	buf b = make_pack(0);
 	mlod_pack full = {0};
@@ -1600,6 +1830,27 @@ TEST(mutations_restamped)
 	run_mutations(1, 10000, &opened, &decoded, &bad, why, sizeof why);
 	CHECK_MSG(!bad, "%s", why);
 	CHECK_MSG(opened > 3000 && decoded > 10000, "%d opened, %d chunks decoded", opened, decoded);
+}
+
+/* The same with every chunk but INFO behind the zstd entropy stage: a
+ * mutated frame fails with a message (zstd's own checks, the frame's
+ * content size against the TOC's coded size), never a crash or a read
+ * past the data. */
+TEST(mutations_zstd)
+{
+	zstd_level = 19;
+	rng_state = 24680;
+	int opened = 0, decoded = 0, bad = 0;
+	char why[200] = "";
+	run_mutations(0, 10000, &opened, &decoded, &bad, why, sizeof why);
+	CHECK_MSG(!bad, "%s", why);
+	CHECK_MSG(opened > 1000, "only %d of 10000 opened", opened);
+	rng_state = 13579;
+	opened = decoded = bad = 0;
+	run_mutations(1, 10000, &opened, &decoded, &bad, why, sizeof why);
+	zstd_level = 0;
+	CHECK_MSG(!bad, "%s", why);
+	CHECK_MSG(opened > 3000 && decoded > 3000, "%d opened, %d chunks decoded", opened, decoded);
 }
 
 /* A pack with one change to the character, for the targeted checks. */
@@ -2035,11 +2286,15 @@ int main(int argc, char **argv)
 	RUN(nested_motion_needs_its_base);
 	RUN(draco_chunks_are_unsupported);
 	RUN(every_prefix);
+	RUN(entropy_decodes_the_same);
+	RUN(every_prefix_zstd);
+	RUN(entropy_checks);
 	RUN(structural_checks_name_the_chunk);
 	RUN(toc_checks);
 	RUN(absurd_sizes);
 	RUN(meshopt_streams);
 	RUN(mutations_plain);
 	RUN(mutations_restamped);
+	RUN(mutations_zstd);
 	return test_total_fail_ ? 1 : 0;
 }

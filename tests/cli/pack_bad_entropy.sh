@@ -1,0 +1,1 @@
+"$BIN/mlod-pack" --entropy zip "$ROOT/samples/tubeman.glb"
