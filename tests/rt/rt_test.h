@@ -1,7 +1,7 @@
 /*
  * rt_test.h: the runtime tests' harness and their hand-built character
  * (decoded views, no pack), for tests/rt/test_rt_*.c. These programs link
- * only libmlodrt.a, -lmeshoptimizer and -lm, and include only lib/core and
+ * only libmlodrt.a, -lmeshoptimizer, -lzstd and -lm, and include only lib/core and
  * lib/rt headers. Each test prints "PASS name" or "FAIL name: why".
  *
  * The character: joints 0 (root, base = translate(0, 0, 0.5)), 1 (child
