@@ -798,6 +798,7 @@ static size_t packed_mesh_bytes(const char *path, int *levels)
 	}
 	mlod_pack_options opt;
 	mlod_pack_options_default(&opt);
+	opt.entropy = MLOD_ENTROPY_NONE; /* the streams as the codec stores them, read in place below */
 	void *pack = NULL;
 	size_t pack_size = 0;
 	if (mlod_pack_write(doc, &c, mlod_detect_format(data, got), data, got, &opt, &pack, &pack_size, NULL, &err) !=

@@ -4,11 +4,12 @@
  * This header owns the format: every constant, every byte layout and the
  * decoded view of each chunk. The bake side's writer (lib/pack) includes
  * it to write what this reader reads; the runtime (mlod_rt.h), mlod-pack
- * --info and -x read through it. It is C11, depends only on the core and
- * meshoptimizer's decoder, and never prints or exits.
+ * --info and -x read through it. It is C11, depends only on the core,
+ * meshoptimizer's decoder and libzstd's (the entropy stage, format 5.0),
+ * and never prints or exits.
  *
  * ------------------------------------------------------------------
- * File layout (format 3.0). Everything is little-endian.
+ * File layout (format 5.0). Everything is little-endian.
  *
  *   header      32 bytes at offset 0
  *   TOC         chunk_count entries of 48 bytes, right after the header
@@ -31,11 +32,14 @@
  * TOC entry (48 bytes):
  *   0  u32    type (MLOD_CHUNK_*); a reader skips types it does not know
  *   4  u8     layer (MLOD_LAYER_*)
- *   5  u8     codec (MLOD_CODEC_*): the codec of the chunk's streams
+ *   5  u8     codec: bits 0-3 the codec of the chunk's streams
+ *             (MLOD_CODEC_*); bits 4-7 the entropy stage over the whole
+ *             chunk (MLOD_ENTROPY_*, format 5.0; 0 before)
  *   6  u16    level: 0 the finest (the input as read), larger is coarser
  *   8  u16    item: the clip for MOTION chunks, else 0
  *  10  u16    flags (MLOD_PACK_CHUNK_NESTED for a nested MOTION level, else 0)
- *  12  u32    reserved (0)
+ *  12  u32    coded size: with an entropy stage, the stream container's
+ *             bytes (what the stage decodes to: 4 to the raw size); else 0
  *  16  u64    offset of the chunk from the start of the file (16-aligned)
  *  24  u32    stored size in bytes
  *  28  u32    raw size: the chunk's size with every stream decoded
@@ -54,7 +58,10 @@
  * every chunk whose end lies inside it, and so the coarse levels first;
  * mlod-pack --info says how many bytes the first drawable level needs.
  *
- * Chunk payload: a stream container.
+ * Chunk payload: a stream container; with entropy stage MLOD_ENTROPY_ZSTD,
+ * one zstd frame of it that states its size (the coded size) and nothing
+ * after it (mlod(5) ENTROPY STAGE). Each chunk's stage is its own: no
+ * dictionary, so every chunk still decodes from its own bytes.
  *   u32 stream_count (at most MLOD_PACK_MAX_STREAMS)
  *   stream_count stream headers of 16 bytes:
  *     0 u32  tag (MLOD_STREAM_*, a fourcc)

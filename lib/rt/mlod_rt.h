@@ -3,7 +3,8 @@
  * skeleton, mesh and motion levels per character by distance, samples the
  * motion, builds the pose and the skinning palette and linear-blend-skins
  * the mesh level into the caller's buffers. C11; depends only on the core
- * (mlod_core.h), the pack reader (mlod_pack.h) and meshoptimizer's decoder.
+ * (mlod_core.h), the pack reader (mlod_pack.h), meshoptimizer's decoder and
+ * libzstd's (the pack's entropy stage, mlod(5)).
  * It never prints or exits. See mlod_rt(3) and the pages it names.
  *
  * ------------------------------------------------------------------
