@@ -526,6 +526,10 @@ typedef struct mlod_pack {
 	uint32_t chunk_count;
 	mlod_pack_chunk *chunks;
 	mlod_pack_alloc alloc;     /* the TOC's, and every decode's from this pack */
+	void *zstd;                /* the entropy stage's decoder, made by open with alloc when
+	                            * a chunk has the zstd stage (else NULL), freed by close.
+	                            * The decodes of one opened pack share it: run them on one
+	                            * thread at a time (open the pack once per thread else). */
 } mlod_pack;
 
 /* Parses and checks the header and TOC from the first bytes of a file
@@ -538,6 +542,9 @@ mlod_result mlod_pack_open(const void *data, size_t size, mlod_pack *out, mlod_e
 mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_alloc *alloc, mlod_pack *out,
                                  mlod_error *err);
 void mlod_pack_close(mlod_pack *p);
+/* The bytes the pack's zstd decoder holds from open to close (0 without
+ * one), for a caller that counts its memory. */
+size_t mlod_pack_decoder_bytes(const mlod_pack *p);
 
 /* The CRC32 the format uses. */
 uint32_t mlod_pack_crc32(uint32_t crc, const void *data, size_t size);

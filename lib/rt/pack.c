@@ -242,6 +242,65 @@ static uint64_t order_key(const mlod_pack_chunk *c)
 }
 
 /* ------------------------------------------------------------------ */
+/* The entropy stage's decoder                                         */
+/* ------------------------------------------------------------------ */
+
+/* zstd's decoder context, one per opened pack (its set-up costs about as
+ * much as decoding a small chunk, so the decodes share it), made with the
+ * pack's allocator: a block holding a copy of the allocator (zstd's hooks
+ * point to it, so the pack struct may be copied) and the context. */
+typedef struct zdec {
+	mlod_pack_alloc a;
+	ZSTD_DCtx *z;
+} zdec;
+
+static void *zs_alloc(void *user, size_t size)
+{
+	const mlod_pack_alloc *a = user;
+	return a->malloc(a->user, size);
+}
+
+static void zs_free(void *user, void *p)
+{
+	const mlod_pack_alloc *a = user;
+	if (p)
+		a->free(a->user, p);
+}
+
+static zdec *zdec_new(const mlod_pack_alloc *alloc)
+{
+	zdec *d = pk_calloc(alloc, 1, sizeof *d);
+	if (!d)
+		return NULL;
+	if (alloc && alloc->malloc && alloc->free) {
+		d->a = *alloc;
+		ZSTD_customMem mem = {zs_alloc, zs_free, &d->a};
+		d->z = ZSTD_createDCtx_advanced(mem);
+	} else {
+		d->z = ZSTD_createDCtx();
+	}
+	if (!d->z) {
+		pk_free(alloc, d);
+		return NULL;
+	}
+	return d;
+}
+
+static void zdec_free(const mlod_pack_alloc *alloc, zdec *d)
+{
+	if (!d)
+		return;
+	ZSTD_freeDCtx(d->z);
+	pk_free(alloc, d);
+}
+
+size_t mlod_pack_decoder_bytes(const mlod_pack *p)
+{
+	const zdec *d = p ? p->zstd : NULL;
+	return d ? sizeof *d + ZSTD_sizeof_DCtx(d->z) : 0;
+}
+
+/* ------------------------------------------------------------------ */
 /* Header and TOC                                                      */
 /* ------------------------------------------------------------------ */
 
@@ -378,10 +437,17 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 	if (r == MLOD_OK && file_size != prev_end)
 		r = mlod_fail(err, MLOD_ERR_PARSE, "pack header: file size %llu, but the %s ends at byte %llu",
 		              (unsigned long long)file_size, n ? "last chunk" : "TOC", (unsigned long long)prev_end);
+	int zstd = 0;
+	for (uint32_t i = 0; r == MLOD_OK && i < n; i++)
+		zstd |= chunks[i].entropy == MLOD_ENTROPY_ZSTD;
+	zdec *zd = NULL;
+	if (r == MLOD_OK && zstd && !(zd = zdec_new(alloc)))
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "pack TOC: out of memory for the zstd decoder");
 	if (r != MLOD_OK) {
 		pk_free(alloc, chunks);
 		return r;
 	}
+	out->zstd = zd;
 	out->major = (uint16_t)major;
 	out->minor = (uint16_t)minor;
 	out->flags = flags;
@@ -400,6 +466,7 @@ void mlod_pack_close(mlod_pack *p)
 	if (!p)
 		return;
 	pk_free(&p->alloc, p->chunks);
+	zdec_free(&p->alloc, p->zstd);
 	memset(p, 0, sizeof *p);
 }
 
@@ -473,6 +540,7 @@ typedef struct cx {
 	                      * plain for a chunk with an entropy stage */
 	uint64_t size;        /* the container's bytes at base */
 	uint8_t *plain;       /* the entropy stage's output (owned) */
+	zdec *zd;             /* the pack's zstd decoder */
 	uint32_t nstreams, next;
 	uint64_t cursor;      /* offset in the chunk of stream next's bytes */
 	uint64_t max_decoded; /* the largest meshopt-coded stream, decoded */
@@ -491,6 +559,7 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
 	const mlod_pack_chunk *c = &p->chunks[index];
 	x->c = c;
 	x->alloc = p->alloc;
+	x->zd = p->zstd;
 	chunk_label(c->type, c->level, c->item, x->label, sizeof x->label);
 	if (c->type != type) {
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: chunk %u is %s, not a %s chunk", index, x->label,
@@ -510,19 +579,7 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
  * the TOC's coded size (checked against the raw size at open) and nothing
  * else: the frame must say that size, hold one frame and nothing after
  * it, and decode to exactly that; the output buffer is that size, so no
- * frame can write more. zstd's context comes from the pack's allocator. */
-static void *zs_alloc(void *user, size_t size)
-{
-	const mlod_pack_alloc *a = user;
-	return a->malloc(a->user, size);
-}
-
-static void zs_free(void *user, void *p)
-{
-	const mlod_pack_alloc *a = user;
-	if (p)
-		a->free(a->user, p);
-}
+ * frame can write more. The context is the pack's (zdec, made at open). */
 
 static mlod_result cx_unpack(cx *x, mlod_error *err)
 {
@@ -547,12 +604,10 @@ static mlod_result cx_unpack(cx *x, mlod_error *err)
 	if (!x->plain)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for its %llu-byte container", x->label,
 		                 (unsigned long long)want);
-	ZSTD_customMem mem = {zs_alloc, zs_free, &x->alloc};
-	ZSTD_DCtx *z = x->alloc.malloc && x->alloc.free ? ZSTD_createDCtx_advanced(mem) : ZSTD_createDCtx();
-	if (!z)
-		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for the zstd decoder", x->label);
-	size_t got = ZSTD_decompressDCtx(z, x->plain, (size_t)want, x->base, c->stored_size);
-	ZSTD_freeDCtx(z);
+	if (!x->zd)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: the pack has no zstd decoder (not opened by mlod_pack_open)",
+		                 x->label);
+	size_t got = ZSTD_decompressDCtx(x->zd->z, x->plain, (size_t)want, x->base, c->stored_size);
 	if (ZSTD_isError(got))
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: zstd: %s", x->label, ZSTD_getErrorName(got));
 	if (got != want)

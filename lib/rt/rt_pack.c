@@ -202,6 +202,9 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 	if (r)
 		return r;
 	ctx->pack_open = 1;
+	/* The pack's zstd decoder (format 5.0's entropy stage) lives as long
+	 * as the pack: resident, like the staging buffer. */
+	ctx->resident_bytes += mlod_pack_decoder_bytes(&ctx->pack);
 	if (ctx->pack.file_size != (ctx->source == SRC_MEMORY ? (uint64_t)ctx->size : ctx->file_size))
 		return mlod_fail(err, MLOD_ERR_PARSE, "the pack says %llu bytes, the source has %llu",
 		                 (unsigned long long)ctx->pack.file_size,

@@ -83,6 +83,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	const void *glb;
 	size_t glb_size;
 	mlod_pack_doc(&p, data, size, &glb, &glb_size, &e);
+	mlod_pack_doc_bytes doc;
+	mlod_pack_decode_doc(&p, data, size, &doc, &e); /* also with the entropy stage */
+	mlod_pack_doc_free(&doc);
 	mlod_pack_skeleton_free(&skel);
 	mlod_pack_close(&p);
 	return 0;

@@ -2254,10 +2254,12 @@ TEST(meshopt_streams)
 }
 
 /* test_pack_reader --write-seed FILE writes the test character's pack
- * (make fuzz starts its corpus with it). */
+ * (make fuzz starts its corpus with it); --write-seed-zstd the same with
+ * the zstd entropy stage. */
 int main(int argc, char **argv)
 {
-	if (argc == 3 && strcmp(argv[1], "--write-seed") == 0) {
+	if (argc == 3 && (strcmp(argv[1], "--write-seed") == 0 || strcmp(argv[1], "--write-seed-zstd") == 0)) {
+		zstd_level = argv[1][12] ? 19 : 0;
 		buf b = make_pack(0);
 		FILE *f = fopen(argv[2], "wb");
 		int ok = f && fwrite(b.p, 1, b.n, f) == b.n;
