@@ -12,6 +12,7 @@
 #include "test.h"
 
 #include <meshoptimizer.h>
+#include <zstd.h>
 
 #include "rt/mlod_rt.h"
 
@@ -259,6 +260,7 @@ TEST(pack_mesh_streams)
 	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
 	mlod_pack_options opt;
 	mlod_pack_options_default(&opt);
+	opt.entropy = MLOD_ENTROPY_NONE; /* the streams read in place below */
 	opt.ratio_count = 1;
 	opt.ratios[0] = 0.5;
 	opt.no_skeleton_levels = opt.no_motion_levels = 1;
@@ -516,6 +518,7 @@ TEST(pack_palette_is_fold)
 		mlod_pack_options_default(&opt);
 		opt.no_mesh_levels = opt.no_motion_levels = 1;
 		opt.codec = MLOD_CODEC_NONE;
+		opt.entropy = MLOD_ENTROPY_NONE; /* the streams read in place below */
 		void *out = NULL;
 		size_t size = 0;
 		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, NULL, &terr));
@@ -620,6 +623,7 @@ TEST(pack_joints16)
 	c.instances = &inst;
 	mlod_pack_options opt;
 	mlod_pack_options_default(&opt);
+	opt.entropy = MLOD_ENTROPY_NONE; /* the streams read in place below */
 	opt.no_skeleton_levels = opt.no_mesh_levels = opt.no_motion_levels = 1;
 	void *out = NULL;
 	size_t size = 0;
@@ -680,6 +684,7 @@ TEST(nested_motion_streams_alone)
 	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
 	mlod_pack_options opt;
 	mlod_pack_options_default(&opt);
+	opt.entropy = MLOD_ENTROPY_NONE; /* the streams read in place below */
 	opt.no_skeleton_levels = 1;
 	void *out = NULL;
 	size_t size = 0;
@@ -772,6 +777,7 @@ TEST(pack_lossless_fields)
 		CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
 		mlod_pack_options opt;
 		mlod_pack_options_default(&opt);
+		opt.entropy = MLOD_ENTROPY_NONE; /* the streams read in place below */
 		opt.no_skeleton_levels = opt.no_mesh_levels = opt.no_motion_levels = 1;
 		opt.lossless_motion = 1;
 		void *out = NULL;
@@ -932,6 +938,69 @@ static float entry_error(const uint8_t *e)
  * made from the clip as read; their rotation lattices follow the smallest
  * TOC error, level 0's included, mlod(5) QUANTISATION).
  * A smaller bound keeps more bytes. */
+/* The entropy stage (format 5.0): with zstd every chunk but INFO is a
+ * zstd frame smaller than its container where it has the stage, the
+ * containers are those of the pack without it (the same bytes after
+ * ZSTD_decompress; INFO but its first_drawable), the pack is smaller, and
+ * the same at any thread count;
+ * without it no chunk has one. */
+TEST(entropy_stage)
+{
+	size_t n = 0;
+	void *in = slurp("samples/RobotExpressive.glb", &n);
+	CHECK(in);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+	void *out[3] = {NULL, NULL, NULL};
+	size_t size[3] = {0, 0, 0};
+	for (int k = 0; k < 3; k++) {
+		mlod_pack_options opt;
+		mlod_pack_options_default(&opt);
+		opt.entropy = k == 0 ? MLOD_ENTROPY_NONE : MLOD_ENTROPY_ZSTD;
+		opt.bgm.threads = k == 2 ? 2 : 1;
+		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out[k], &size[k], NULL, &terr));
+	}
+	CHECK(size[1] == size[2] && memcmp(out[1], out[2], size[1]) == 0);
+	CHECK_MSG(size[1] < size[0] * 6 / 10, "zstd %zu bytes, none %zu", size[1], size[0]);
+	mlod_pack pn, pz;
+	CHECK_OK(mlod_pack_open(out[0], size[0], &pn, &terr));
+	CHECK_OK(mlod_pack_open(out[1], size[1], &pz, &terr));
+	CHECK(pn.chunk_count == pz.chunk_count && pn.major == 5 && pz.major == 5 && !pn.zstd && pz.zstd);
+	int staged = 0, same = 1;
+	for (uint32_t i = 0; i < pz.chunk_count; i++) {
+		const mlod_pack_chunk *a = &pn.chunks[i], *z = &pz.chunks[i];
+		CHECK(a->entropy == MLOD_ENTROPY_NONE && a->coded_size == 0);
+		CHECK(a->type == z->type && a->level == z->level && a->item == z->item && a->codec == z->codec &&
+		      a->raw_size == z->raw_size);
+		const uint8_t *za = (const uint8_t *)out[1] + z->offset;
+		if (z->entropy == MLOD_ENTROPY_NONE) { /* INFO: its first_drawable differs */
+			same &= z->stored_size == a->stored_size &&
+			        (z->type == MLOD_CHUNK_INFO ||
+			         memcmp(za, (const uint8_t *)out[0] + a->offset, a->stored_size) == 0);
+			continue;
+		}
+		CHECK(z->type != MLOD_CHUNK_INFO && z->entropy == MLOD_ENTROPY_ZSTD);
+		CHECK(z->coded_size == a->stored_size && z->stored_size < z->coded_size && z->coded_size <= z->raw_size);
+		uint8_t *back = malloc(z->coded_size);
+		size_t got = ZSTD_decompress(back, z->coded_size, za, z->stored_size);
+		same &= got == a->stored_size && memcmp(back, (const uint8_t *)out[0] + a->offset, got) == 0;
+		free(back);
+		staged++;
+	}
+	/* every chunk but INFO is smaller through zstd on the robot */
+	CHECK_MSG(staged == (int)pz.chunk_count - 1, "%d of %u chunks with the stage", staged, pz.chunk_count);
+	CHECK(same);
+	mlod_pack_close(&pn);
+	mlod_pack_close(&pz);
+	for (int k = 0; k < 3; k++)
+		mlod_free(out[k]);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	free(in);
+}
+
 TEST(motion_level0_bound)
 {
 	size_t n = 0;
@@ -989,5 +1058,6 @@ int main(void)
 	RUN(pack_lossless_fields);
 	RUN(nested_motion_streams_alone);
 	RUN(motion_level0_bound);
+	RUN(entropy_stage);
 	TEST_EXIT();
 }
