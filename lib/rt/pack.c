@@ -580,7 +580,6 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
  * else: the frame must say that size, hold one frame and nothing after
  * it, and decode to exactly that; the output buffer is that size, so no
  * frame can write more. The context is the pack's (zdec, made at open). */
-
 static mlod_result cx_unpack(cx *x, mlod_error *err)
 {
 	const mlod_pack_chunk *c = x->c;
@@ -591,10 +590,13 @@ static mlod_result cx_unpack(cx *x, mlod_error *err)
 	unsigned long long said = ZSTD_getFrameContentSize(x->base, c->stored_size);
 	if (said == ZSTD_CONTENTSIZE_ERROR)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: not a zstd frame (its %u bytes)", x->label, c->stored_size);
-	if (said == ZSTD_CONTENTSIZE_UNKNOWN || said != want)
-		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame says %s%llu bytes, the TOC's coded size is %llu",
-		                 x->label, said == ZSTD_CONTENTSIZE_UNKNOWN ? "no size, not " : "", said == ZSTD_CONTENTSIZE_UNKNOWN ? 0ull : said,
+	if (said == ZSTD_CONTENTSIZE_UNKNOWN)
+		return mlod_fail(err, MLOD_ERR_PARSE,
+		                 "%s: the zstd frame does not state its size (the TOC's coded size is %llu)", x->label,
 		                 (unsigned long long)want);
+	if (said != want)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame says %llu bytes, the TOC's coded size is %llu",
+		                 x->label, said, (unsigned long long)want);
 	size_t frame = ZSTD_findFrameCompressedSize(x->base, c->stored_size);
 	if (ZSTD_isError(frame) || frame != c->stored_size)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame %s its %u bytes", x->label,
@@ -618,10 +620,11 @@ static mlod_result cx_unpack(cx *x, mlod_error *err)
 	return MLOD_OK;
 }
 
-/* Checks the chunk's bytes at x->base (CRC) and its stream container
- * (sizes add up to the stored and the raw size). */
 static mlod_result cx_container(cx *x, mlod_error *err);
 
+/* Checks the chunk's bytes at x->base (CRC), undoes its entropy stage, and
+ * checks its stream container (sizes add up to the container's and the
+ * raw size). */
 static mlod_result cx_parse(cx *x, mlod_error *err)
 {
 	const mlod_pack_chunk *c = x->c;

@@ -1701,7 +1701,7 @@ TEST(entropy_checks)
 		mlod_pack_doc_bytes g;
 		CHECK_OK(mlod_pack_open(t.p, t.n, &q, &terr));
 		CHECK_ERR(mlod_pack_decode_doc(&q, t.p, t.n, &g, &terr), MLOD_ERR_PARSE,
-		          k ? "DOC: the zstd frame says no size, not 0 bytes, the TOC's coded size is 40"
+		          k ? "DOC: the zstd frame does not state its size (the TOC's coded size is 40)"
 		            : "DOC: the zstd frame says 1048576 bytes, the TOC's coded size is 40");
 		mlod_pack_close(&q);
 		free(t.p);
