@@ -361,8 +361,9 @@ static int pack_extract(const char *path, const char *output)
 
 int main(int argc, char **argv)
 {
-	enum { OPT_CODEC = 256, OPT_ENTROPY, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH, OPT_NO_MOTION, OPT_INFO, OPT_JSON,
-	       OPT_POS_BITS, OPT_NRM_BITS, OPT_UV_BITS, OPT_LEVEL0_ERR, OPT_LOSSLESS_MOTION };
+	enum { OPT_CODEC = 256, OPT_ENTROPY, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH,
+	       OPT_NO_MOTION, OPT_INFO, OPT_JSON, OPT_POS_BITS, OPT_NRM_BITS, OPT_UV_BITS, OPT_LEVEL0_ERR,
+	       OPT_LOSSLESS_MOTION };
 	static const struct option longopts[] = {
 		{"output", required_argument, NULL, 'o'},
 		{"report", optional_argument, NULL, 'r'},
