@@ -496,6 +496,34 @@ static void morph_range(const mlod_pack_part *p, const float *w, uint32_t nt, si
 	}
 }
 
+/* A rigid part's normals need no renormalising when M's linear part is a
+ * rotation times a scale s > 0 and its normals are unit: then M n / s is
+ * M n normalised. The Gram matrix of M's columns, over its mean diagonal
+ * s^2, differs from the identity by at most RT_UNIT_TOL in every entry,
+ * so its eigenvalues lie within 1 +- 3 RT_UNIT_TOL and | U n | within
+ * 1 +- 2 RT_UNIT_TOL of | n |, which prepare_mesh checked to be within
+ * RT_UNIT_TOL of 1: U n is M n normalised to within 3 RT_UNIT_TOL of its
+ * length (and float rounding), in the same direction. Returns 1 and U =
+ * M / s (the first three columns) when so, else 0. */
+static int rigid_unit(const float *M, float *U)
+{
+	double g[3][3];
+	for (int a = 0; a < 3; a++)
+		for (int b = a; b < 3; b++)
+			g[a][b] = (double)M[4 * a] * M[4 * b] + (double)M[4 * a + 1] * M[4 * b + 1] +
+			          (double)M[4 * a + 2] * M[4 * b + 2];
+	const double s2 = (g[0][0] + g[1][1] + g[2][2]) / 3.0, tol = RT_UNIT_TOL * s2;
+	if (!(s2 > 1e-30 && s2 < 1e30))
+		return 0;
+	if (!(fabs(g[0][0] - s2) <= tol && fabs(g[1][1] - s2) <= tol && fabs(g[2][2] - s2) <= tol &&
+	      fabs(g[0][1]) <= tol && fabs(g[0][2]) <= tol && fabs(g[1][2]) <= tol))
+		return 0;
+	const double is = 1.0 / sqrt(s2);
+	for (int k = 0; k < 12; k++)
+		U[k] = (float)(M[k] * is);
+	return 1;
+}
+
 mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float *positions,
                          size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
                          uint32_t *vertex_count, mlod_error *err)
@@ -553,6 +581,10 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		} else if (!skinned) {
 			memcpy(M, p->rec.offset, sizeof M);
 		}
+		/* Rigid and static parts with unit normals: skip renormalising
+		 * when M allows (rigid_unit). */
+		float U[12];
+		const int unit = !skinned && on && p->normals && mu->skin_order_at[i] && rigid_unit(M, U);
 		uint32_t nt = 0;
 		const float *mw = part_morph(ctx, id, i, p, &nt);
 		/* The whole part at once, or runs of RT_MORPH_RUN when morphed. */
@@ -576,7 +608,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 						x[0] = x[1] = x[2] = 0.0f;
 					}
 			} else {
-				rt_transform(m, pos, nrm, M, o, pos_stride, onr, nrm_stride);
+				rt_transform(m, pos, nrm, M, unit ? U : NULL, o, pos_stride, onr, nrm_stride);
 			}
 			v0 += m;
 		}

@@ -382,10 +382,11 @@ void mlod_rt_skin_lbs_scalar(size_t n, const float *positions, const float *norm
 
 #if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
 /* One vertex at a time: one 4-lane multiply-add chain per point and per
- * normal (the tail of the 4-wide loop below, and its stand-in without
- * SSE2). */
+ * normal (the tail of the 4-wide loop below for fewer than 4 vertices,
+ * and its stand-in without SSE2). U: see rt_transform. */
 static void transform_one_by_one(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
-                                 float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
+                                 const float *U, float *restrict out_pos, size_t ps, float *restrict out_nrm,
+                                 size_t ns)
 {
 	const rt_v4 c0 = ld4(M), c1 = ld4(M + 4), c2 = ld4(M + 8), c3 = ld4(M + 12);
 	for (size_t v = 0; v < n; v++) {
@@ -396,6 +397,8 @@ static void transform_one_by_one(size_t n, const float *restrict pos, const floa
 	}
 	if (!out_nrm)
 		return;
+	const float *N = U ? U : M;
+	const rt_v4 u0 = ld4(N), u1 = ld4(N + 4), u2 = ld4(N + 8);
 	for (size_t v = 0; v < n; v++) {
 		float *restrict on = (float *)((char *)out_nrm + v * ns);
 		if (!nrm) {
@@ -403,7 +406,11 @@ static void transform_one_by_one(size_t n, const float *restrict pos, const floa
 			continue;
 		}
 		const float *nn = nrm + 3 * v;
-		const rt_v4 t = c0 * nn[0] + c1 * nn[1] + c2 * nn[2];
+		const rt_v4 t = u0 * nn[0] + u1 * nn[1] + u2 * nn[2];
+		if (U) {
+			on[0] = t[0], on[1] = t[1], on[2] = t[2];
+			continue;
+		}
 		const float len2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
 		const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
 		on[0] = t[0] * il, on[1] = t[1] * il, on[2] = t[2] * il;
@@ -423,15 +430,18 @@ static inline void load_xyz4(const float *p, __m128 *x, __m128 *y, __m128 *z)
 /* Four vertices at a time across the lanes (x of four points in one
  * vector): per lane the one-by-one loop's operations in its order, so the
  * same floats; the normals' 1 / sqrt four at a time (SSE2's square root
- * and division are IEEE's, as sqrtf and / are). */
+ * and division are IEEE's, as sqrtf and / are). n >= 4: when n is not a
+ * multiple of 4 the last block is the last 4 vertices, overlapping the
+ * one before (those vertices are computed and stored twice, the same
+ * floats both times), so there is no one-by-one tail. */
 static void transform4(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
-                       float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
+                       const float *U, float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
 {
-	const size_t n4 = n & ~(size_t)3;
 	__m128 m[16];
 	for (int k = 0; k < 16; k++)
 		m[k] = _mm_set1_ps(M[k]);
-	for (size_t v = 0; v < n4; v += 4) {
+	for (size_t v0 = 0; v0 < n; v0 += 4) {
+		const size_t v = n - v0 < 4 ? n - 4 : v0;
 		__m128 x, y, z;
 		load_xyz4(pos + 3 * v, &x, &y, &z);
 		const __m128 ox = _mm_add_ps(
@@ -443,29 +453,33 @@ static void transform4(size_t n, const float *restrict pos, const float *restric
 		store_xyz4((float *)((char *)out_pos + v * ps), ps, ox, oy, oz);
 	}
 	if (out_nrm && nrm) {
+		if (U)
+			for (int k = 0; k < 11; k++)
+				m[k] = _mm_set1_ps(U[k]);
 		const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
-		for (size_t v = 0; v < n4; v += 4) {
+		for (size_t v0 = 0; v0 < n; v0 += 4) {
+			const size_t v = n - v0 < 4 ? n - 4 : v0;
 			__m128 x, y, z;
 			load_xyz4(nrm + 3 * v, &x, &y, &z);
 			const __m128 tx = _mm_add_ps(_mm_add_ps(_mm_mul_ps(m[0], x), _mm_mul_ps(m[4], y)), _mm_mul_ps(m[8], z));
 			const __m128 ty = _mm_add_ps(_mm_add_ps(_mm_mul_ps(m[1], x), _mm_mul_ps(m[5], y)), _mm_mul_ps(m[9], z));
 			const __m128 tz = _mm_add_ps(_mm_add_ps(_mm_mul_ps(m[2], x), _mm_mul_ps(m[6], y)), _mm_mul_ps(m[10], z));
+			float *restrict on = (float *)((char *)out_nrm + v * ns);
+			if (U) {
+				store_xyz4(on, ns, tx, ty, tz);
+				continue;
+			}
 			const __m128 l2 =
 				_mm_add_ps(_mm_add_ps(_mm_mul_ps(tx, tx), _mm_mul_ps(ty, ty)), _mm_mul_ps(tz, tz));
 			const __m128 il = _mm_and_ps(_mm_cmpgt_ps(l2, zero), _mm_div_ps(one, _mm_sqrt_ps(l2)));
-			store_xyz4((float *)((char *)out_nrm + v * ns), ns, _mm_mul_ps(tx, il), _mm_mul_ps(ty, il),
-			           _mm_mul_ps(tz, il));
+			store_xyz4(on, ns, _mm_mul_ps(tx, il), _mm_mul_ps(ty, il), _mm_mul_ps(tz, il));
 		}
 	} else if (out_nrm) {
-		for (size_t v = 0; v < n4; v++) {
+		for (size_t v = 0; v < n; v++) {
 			float *restrict on = (float *)((char *)out_nrm + v * ns);
 			on[0] = on[1] = on[2] = 0.0f;
 		}
 	}
-	if (n4 < n)
-		transform_one_by_one(n - n4, pos + 3 * n4, nrm ? nrm + 3 * n4 : NULL, M,
-		                     (float *)((char *)out_pos + n4 * ps), ps,
-		                     out_nrm ? (float *)((char *)out_nrm + n4 * ns) : NULL, ns);
 }
 
 #if defined(__x86_64__) && !defined(MLOD_RT_NO_AVX)
@@ -510,83 +524,113 @@ __attribute__((target("avx"))) static inline void store_xyz8(float *restrict out
 		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
 }
 
-__attribute__((target("avx"))) static size_t transform8(size_t n, const float *restrict pos,
-                                                      const float *restrict nrm, const float *M,
-                                                      float *restrict out_pos, size_t ps, float *restrict out_nrm,
-                                                      size_t ns)
+/* The 8 vertices from v: points by m (16 broadcast entries); normals by
+ * m's first three columns, normalised (K 1) or as they are (K 0). */
+__attribute__((target("avx"))) static inline __attribute__((always_inline)) void
+pos8(size_t v, const float *restrict pos, const __m256 *m, float *restrict out_pos, size_t ps)
 {
-	const size_t n8 = n & ~(size_t)7;
+	__m256 x, y, z;
+	load_xyz8(pos + 3 * v, &x, &y, &z);
+	const __m256 ox = _mm256_add_ps(
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[0], x), _mm256_mul_ps(m[4], y)), _mm256_mul_ps(m[8], z)), m[12]);
+	const __m256 oy = _mm256_add_ps(
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[1], x), _mm256_mul_ps(m[5], y)), _mm256_mul_ps(m[9], z)), m[13]);
+	const __m256 oz = _mm256_add_ps(
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[2], x), _mm256_mul_ps(m[6], y)), _mm256_mul_ps(m[10], z)), m[14]);
+	store_xyz8((float *)((char *)out_pos + v * ps), ps, ox, oy, oz);
+}
+
+__attribute__((target("avx"))) static inline __attribute__((always_inline)) void
+nrm8(const int K, size_t v, const float *restrict nrm, const __m256 *m, float *restrict out_nrm, size_t ns)
+{
+	__m256 x, y, z;
+	load_xyz8(nrm + 3 * v, &x, &y, &z);
+	const __m256 tx =
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[0], x), _mm256_mul_ps(m[4], y)), _mm256_mul_ps(m[8], z));
+	const __m256 ty =
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[1], x), _mm256_mul_ps(m[5], y)), _mm256_mul_ps(m[9], z));
+	const __m256 tz =
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[2], x), _mm256_mul_ps(m[6], y)), _mm256_mul_ps(m[10], z));
+	float *restrict on = (float *)((char *)out_nrm + v * ns);
+	if (!K) {
+		store_xyz8(on, ns, tx, ty, tz);
+		return;
+	}
+	const __m256 l2 =
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(tx, tx), _mm256_mul_ps(ty, ty)), _mm256_mul_ps(tz, tz));
+	const __m256 il = _mm256_and_ps(_mm256_cmp_ps(l2, _mm256_setzero_ps(), _CMP_GT_OQ),
+	                                _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_sqrt_ps(l2)));
+	store_xyz8(on, ns, _mm256_mul_ps(tx, il), _mm256_mul_ps(ty, il), _mm256_mul_ps(tz, il));
+}
+
+/* n >= 8: blocks of 8 and, when n is not a multiple of 8, the last 8
+ * vertices (overlapping the block before: those are computed and stored
+ * twice, the same floats both times). */
+__attribute__((target("avx"))) static void transform8(size_t n, const float *restrict pos,
+                                                    const float *restrict nrm, const float *M, const float *U,
+                                                    float *restrict out_pos, size_t ps, float *restrict out_nrm,
+                                                    size_t ns)
+{
 	__m256 m[16];
 	for (int k = 0; k < 16; k++)
 		m[k] = _mm256_set1_ps(M[k]);
-	for (size_t v = 0; v < n8; v += 8) {
-		__m256 x, y, z;
-		load_xyz8(pos + 3 * v, &x, &y, &z);
-		const __m256 ox = _mm256_add_ps(
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[0], x), _mm256_mul_ps(m[4], y)), _mm256_mul_ps(m[8], z)),
-			m[12]);
-		const __m256 oy = _mm256_add_ps(
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[1], x), _mm256_mul_ps(m[5], y)), _mm256_mul_ps(m[9], z)),
-			m[13]);
-		const __m256 oz = _mm256_add_ps(
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[2], x), _mm256_mul_ps(m[6], y)), _mm256_mul_ps(m[10], z)),
-			m[14]);
-		store_xyz8((float *)((char *)out_pos + v * ps), ps, ox, oy, oz);
-	}
+	const size_t n8 = n & ~(size_t)7;
+	for (size_t v = 0; v < n8; v += 8)
+		pos8(v, pos, m, out_pos, ps);
+	if (n8 < n)
+		pos8(n - 8, pos, m, out_pos, ps);
 	if (!out_nrm)
-		return n8;
+		return;
 	if (!nrm) {
-		for (size_t v = 0; v < n8; v++) {
+		for (size_t v = 0; v < n; v++) {
 			float *restrict on = (float *)((char *)out_nrm + v * ns);
 			on[0] = on[1] = on[2] = 0.0f;
 		}
-		return n8;
+		return;
 	}
-	const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
-	for (size_t v = 0; v < n8; v += 8) {
-		__m256 x, y, z;
-		load_xyz8(nrm + 3 * v, &x, &y, &z);
-		const __m256 tx =
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[0], x), _mm256_mul_ps(m[4], y)), _mm256_mul_ps(m[8], z));
-		const __m256 ty =
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[1], x), _mm256_mul_ps(m[5], y)), _mm256_mul_ps(m[9], z));
-		const __m256 tz =
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[2], x), _mm256_mul_ps(m[6], y)), _mm256_mul_ps(m[10], z));
-		const __m256 l2 =
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(tx, tx), _mm256_mul_ps(ty, ty)), _mm256_mul_ps(tz, tz));
-		const __m256 il =
-			_mm256_and_ps(_mm256_cmp_ps(l2, zero, _CMP_GT_OQ), _mm256_div_ps(one, _mm256_sqrt_ps(l2)));
-		store_xyz8((float *)((char *)out_nrm + v * ns), ns, _mm256_mul_ps(tx, il), _mm256_mul_ps(ty, il),
-		           _mm256_mul_ps(tz, il));
+	if (U) {
+		for (int k = 0; k < 11; k++)
+			m[k] = _mm256_set1_ps(U[k]);
+		for (size_t v = 0; v < n8; v += 8)
+			nrm8(0, v, nrm, m, out_nrm, ns);
+		if (n8 < n)
+			nrm8(0, n - 8, nrm, m, out_nrm, ns);
+	} else {
+		for (size_t v = 0; v < n8; v += 8)
+			nrm8(1, v, nrm, m, out_nrm, ns);
+		if (n8 < n)
+			nrm8(1, n - 8, nrm, m, out_nrm, ns);
 	}
-	return n8;
 }
 #undef RT_SH8
 #define RT_AVX 1
 #endif
 
-void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
+void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M, const float *U,
                   float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
 {
-	size_t d = 0;
 #if defined(RT_AVX)
-	if (n >= 8 && __builtin_cpu_supports("avx"))
-		d = transform8(n, pos, nrm, M, out_pos, ps, out_nrm, ns);
+	if (n >= 8 && __builtin_cpu_supports("avx")) {
+		transform8(n, pos, nrm, M, U, out_pos, ps, out_nrm, ns);
+		return;
+	}
 #endif
-	transform4(n - d, pos + 3 * d, nrm ? nrm + 3 * d : NULL, M, (float *)((char *)out_pos + d * ps), ps,
-	           out_nrm ? (float *)((char *)out_nrm + d * ns) : NULL, ns);
+	if (n >= 4)
+		transform4(n, pos, nrm, M, U, out_pos, ps, out_nrm, ns);
+	else
+		transform_one_by_one(n, pos, nrm, M, U, out_pos, ps, out_nrm, ns);
 }
 #undef RT_SH
 #else
-void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
+void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M, const float *U,
                   float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
 {
-	transform_one_by_one(n, pos, nrm, M, out_pos, ps, out_nrm, ns);
+	transform_one_by_one(n, pos, nrm, M, U, out_pos, ps, out_nrm, ns);
 }
 #endif
 #else
-void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, float *out_pos, size_t ps,
-                  float *out_nrm, size_t ns)
+void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, const float *U, float *out_pos,
+                  size_t ps, float *out_nrm, size_t ns)
 {
 	for (size_t v = 0; v < n; v++) {
 		const float *q = pos + 3 * v;
@@ -599,12 +643,14 @@ void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, 
 				on[0] = on[1] = on[2] = 0.0f;
 				continue;
 			}
-			const float *nn = nrm + 3 * v;
+			const float *nn = nrm + 3 * v, *N = U ? U : M;
 			float len2 = 0.0f;
 			for (int r = 0; r < 3; r++) {
-				on[r] = M[r] * nn[0] + M[4 + r] * nn[1] + M[8 + r] * nn[2];
+				on[r] = N[r] * nn[0] + N[4 + r] * nn[1] + N[8 + r] * nn[2];
 				len2 += on[r] * on[r];
 			}
+			if (U)
+				continue;
 			const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
 			for (int r = 0; r < 3; r++)
 				on[r] *= il;
