@@ -8,7 +8,8 @@
  * the multiplies by 1), then each bucket goes through a loop specialised
  * for its count, with no branch per influence. The loops blend the palette matrices
  * (16 floats each, column-major) 4 lanes at a time, one matrix column per
- * vector, in the scalar loop's order of operations (so the results are
+ * vector (two columns per 8-lane vector for two or more influences: one
+ * AVX instruction in the AVX2 build), in the scalar loop's order of operations (so the results are
  * the scalar loop's, bit for bit, where the compiler does not contract
  * to fused multiply-adds); the point and the normal are then one 4-lane
  * multiply-add chain each. The run's normals are normalised after it, 4
@@ -17,7 +18,9 @@
  * every frame: prepare_mesh (rt_ctx.c) keeps each skinned part's buckets
  * from rt_skin_order, and rt_skin_lbs_ordered is the same loop given them.
  * It is written with the GCC/Clang vector extension; SSE2 intrinsics (the
- * x86-64 baseline) only for the bucketing mask and the normalisation, each
+ * x86-64 baseline) only for the bucketing mask and the normalisation (inlined
+ * into each build: called from the AVX2 one as a separate SSE function it
+ * ran 3 times slower on the test machine, AMD EPYC), each
  * with a plain C fallback (forced with -DMLOD_RT_NO_SSE2). Other compilers
  * (or -DMLOD_RT_NO_VECTOR_EXT) get fixed-length restrict loops that the
  * auto-vectoriser handles. mlod_rt_skin_lbs_scalar is the plain loop they
@@ -61,6 +64,16 @@ static inline rt_v4 ld4(const float *p)
 	return v;
 }
 
+/* 8-lane vectors for the blend (two matrix columns each), where the
+ * compiler has __builtin_shufflevector to take their halves. */
+#if defined(__clang__) || __GNUC__ >= 12
+#define RT_V8 1
+typedef float rt_v8 __attribute__((vector_size(32)));
+#else
+#define RT_V8 0
+#endif
+
+
 /* The influences of a vertex the kernel blends: up to the last non-zero
  * weight (at least 1); a zero weight adds nothing, so skipping it changes
  * no result. */
@@ -97,14 +110,28 @@ static inline __attribute__((always_inline)) void lbs_list(const int K, const in
 		const float *w = weights + 4 * v;
 		const float *a = palette + 16 * (size_t)j[0];
 		rt_v4 c0, c1, c2, c3;
-		if (K == 0)
-			c0 = ld4(a), c1 = ld4(a + 4), c2 = ld4(a + 8), c3 = ld4(a + 12);
-		else
-			c0 = w[0] * ld4(a), c1 = w[0] * ld4(a + 4), c2 = w[0] * ld4(a + 8), c3 = w[0] * ld4(a + 12);
-		for (int k = 1; k < K; k++) {
-			const float *b = palette + 16 * (size_t)j[k];
-			const float wk = w[k];
-			c0 += wk * ld4(b), c1 += wk * ld4(b + 4), c2 += wk * ld4(b + 8), c3 += wk * ld4(b + 12);
+		if (K <= 1 || !RT_V8) {
+			if (K == 0)
+				c0 = ld4(a), c1 = ld4(a + 4), c2 = ld4(a + 8), c3 = ld4(a + 12);
+			else
+				c0 = w[0] * ld4(a), c1 = w[0] * ld4(a + 4), c2 = w[0] * ld4(a + 8), c3 = w[0] * ld4(a + 12);
+		} else {
+			/* Two columns per 8-lane vector (one AVX instruction each in
+			 * the AVX2 build, two SSE ones otherwise): lane for lane the
+			 * 4-lane blend's operations, so the same floats. */
+#if RT_V8
+			rt_v8 c01, c23, b01, b23;
+			memcpy(&b01, a, sizeof b01), memcpy(&b23, a + 8, sizeof b23);
+			c01 = w[0] * b01, c23 = w[0] * b23;
+			for (int k = 1; k < K; k++) {
+				const float *b = palette + 16 * (size_t)j[k];
+				const float wk = w[k];
+				memcpy(&b01, b, sizeof b01), memcpy(&b23, b + 8, sizeof b23);
+				c01 += wk * b01, c23 += wk * b23;
+			}
+			c0 = __builtin_shufflevector(c01, c01, 0, 1, 2, 3), c1 = __builtin_shufflevector(c01, c01, 4, 5, 6, 7);
+			c2 = __builtin_shufflevector(c23, c23, 0, 1, 2, 3), c3 = __builtin_shufflevector(c23, c23, 4, 5, 6, 7);
+#endif
 		}
 		const float *p = positions + 3 * v;
 		const rt_v4 o = c0 * p[0] + c1 * p[1] + c2 * p[2] + c3;
@@ -140,7 +167,8 @@ static inline void store_xyz4(float *restrict out, size_t stride, __m128 x, __m1
 #endif
 
 /* Normalises the run's m blended normals and stores them at out. */
-static void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out, size_t stride)
+static inline __attribute__((always_inline)) void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out,
+                                                              size_t stride)
 {
 	for (size_t i = m; i % 4; i++)
 		tn[i] = (rt_v4){ 0, 0, 0, 0 };
