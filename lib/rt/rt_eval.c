@@ -561,6 +561,10 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	}
 	size_t base = 0;
 	float morphed[3 * RT_MORPH_RUN];
+	float M[16], U[12];
+	int m_ok = 0, m_unit = -1;
+	int32_t m_joint = -1;
+	const float *m_off = NULL;
 	for (uint32_t i = 0; i < mu->mesh->part_count; i++) {
 		const mlod_pack_part *p = &mu->mesh->parts[i];
 		const uint32_t n = p->rec.vertex_count;
@@ -568,23 +572,33 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		float *on = normals ? (float *)((char *)normals + base * nrm_stride) : NULL;
 		const int skinned = p->rec.skin >= 0;
 		const float *pal = skinned ? s->palette + 16 * (size_t)ctx->skin_offset[p->rec.skin] : NULL;
-		float M[16];
-		if (!skinned && p->rec.joint >= 0) {
-			const uint32_t j = (uint32_t)p->rec.joint;
-			if (su && su->plan.stand[j] != (int32_t)j) {
-				float t[16];
-				rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
-				rt_mat_mul(t, p->rec.offset, M);
+		/* A rigid or static part's matrix, kept for the next part when it
+		 * follows the same joint with the same offset (the robot's mesh
+		 * levels have 15 rigid parts on 12 joints). */
+		if (!skinned && !(m_ok && p->rec.joint == m_joint &&
+		                  (m_off == p->rec.offset || memcmp(m_off, p->rec.offset, sizeof M) == 0))) {
+			if (p->rec.joint >= 0) {
+				const uint32_t j = (uint32_t)p->rec.joint;
+				if (su && su->plan.stand[j] != (int32_t)j) {
+					float t[16];
+					rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
+					rt_mat_mul(t, p->rec.offset, M);
+				} else {
+					rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
+				}
 			} else {
-				rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
+				memcpy(M, p->rec.offset, sizeof M);
 			}
-		} else if (!skinned) {
-			memcpy(M, p->rec.offset, sizeof M);
+			m_ok = 1, m_joint = p->rec.joint, m_off = p->rec.offset, m_unit = -1;
 		}
 		/* Rigid and static parts with unit normals: skip renormalising
-		 * when M allows (rigid_unit). */
-		float U[12];
-		const int unit = !skinned && on && p->normals && mu->skin_order_at[i] && rigid_unit(M, U);
+		 * when M allows (rigid_unit, once per matrix). */
+		int unit = 0;
+		if (!skinned && on && p->normals && mu->skin_order_at[i]) {
+			if (m_unit < 0)
+				m_unit = rigid_unit(M, U);
+			unit = m_unit;
+		}
 		uint32_t nt = 0;
 		const float *mw = part_morph(ctx, id, i, p, &nt);
 		/* The whole part at once, or runs of RT_MORPH_RUN when morphed. */
