@@ -498,25 +498,27 @@ static void morph_range(const mlod_pack_part *p, const float *w, uint32_t nt, si
 
 /* A rigid part's normals need no renormalising when M's linear part is a
  * rotation times a scale s > 0 and its normals are unit: then M n / s is
- * M n normalised. The Gram matrix of M's columns, over its mean diagonal
- * s^2, differs from the identity by at most RT_UNIT_TOL in every entry,
- * so its eigenvalues lie within 1 +- 3 RT_UNIT_TOL and | U n | within
- * 1 +- 2 RT_UNIT_TOL of | n |, which prepare_mesh checked to be within
- * RT_UNIT_TOL of 1: U n is M n normalised to within 3 RT_UNIT_TOL of its
- * length (and float rounding), in the same direction. Returns 1 and U =
- * M / s (the first three columns) when so, else 0. */
+ * M n normalised. The Gram matrix of M's columns, over s^2 = its first
+ * entry, differs from the identity by at most RT_UNIT_TOL in every entry
+ * (0 in the first), so its eigenvalues lie within 1 +- 3 RT_UNIT_TOL and
+ * | U n | within 1 +- 2 RT_UNIT_TOL of | n |, which prepare_mesh checked to
+ * be within RT_UNIT_TOL of 1: U n is M n normalised to within
+ * 3 RT_UNIT_TOL of its length (and float rounding), in the same
+ * direction. Returns 1 and U = M / s (the first three columns) when so,
+ * else 0. */
 static int rigid_unit(const float *M, float *U)
 {
-	double g[3][3];
-	for (int a = 0; a < 3; a++)
-		for (int b = a; b < 3; b++)
-			g[a][b] = (double)M[4 * a] * M[4 * b] + (double)M[4 * a + 1] * M[4 * b + 1] +
-			          (double)M[4 * a + 2] * M[4 * b + 2];
-	const double s2 = (g[0][0] + g[1][1] + g[2][2]) / 3.0, tol = RT_UNIT_TOL * s2;
+	const double a0 = M[0], a1 = M[1], a2 = M[2], b0 = M[4], b1 = M[5], b2 = M[6], c0 = M[8], c1 = M[9],
+	             c2 = M[10];
+	const double s2 = a0 * a0 + a1 * a1 + a2 * a2, tol = RT_UNIT_TOL * s2;
 	if (!(s2 > 1e-30 && s2 < 1e30))
 		return 0;
-	if (!(fabs(g[0][0] - s2) <= tol && fabs(g[1][1] - s2) <= tol && fabs(g[2][2] - s2) <= tol &&
-	      fabs(g[0][1]) <= tol && fabs(g[0][2]) <= tol && fabs(g[1][2]) <= tol))
+	const double d[5] = { b0 * b0 + b1 * b1 + b2 * b2 - s2, c0 * c0 + c1 * c1 + c2 * c2 - s2,
+		              a0 * b0 + a1 * b1 + a2 * b2, a0 * c0 + a1 * c1 + a2 * c2, b0 * c0 + b1 * c1 + b2 * c2 };
+	int ok = 1;
+	for (int k = 0; k < 5; k++)
+		ok &= fabs(d[k]) <= tol;
+	if (!ok)
 		return 0;
 	const double is = 1.0 / sqrt(s2);
 	for (int k = 0; k < 12; k++)
