@@ -14,7 +14,8 @@
  * to fused multiply-adds); the point and the normal are then one 4-lane
  * multiply-add chain each. The run's normals are normalised after it, 4
  * at a time (SSE2: transposed, one square root and one division per 4
- * vertices, stored as rt_transform stores). mlod_rt_skin does not bucket
+ * vertices, stored as rt_transform stores), 8 at a time where the CPU has
+ * AVX (checked at run time; lane for lane the same operations). mlod_rt_skin does not bucket
  * every frame: prepare_mesh (rt_ctx.c) keeps each skinned part's buckets
  * from rt_skin_order, and rt_skin_lbs_ordered is the same loop given them.
  * It is written with the GCC/Clang vector extension; SSE2 intrinsics (the
@@ -166,13 +167,82 @@ static inline void store_xyz4(float *restrict out, size_t stride, __m128 x, __m1
 
 #endif
 
+#if defined(RT_SSE2) && defined(__x86_64__) && !defined(MLOD_RT_NO_AVX)
+/* AVX helpers (each caller checks the CPU at run time): xyz of 8
+ * vertices as X, Y, Z lanes and back, 4 per 128-bit half. */
+#define RT_AVX 1
+#include <immintrin.h>
+#define RT_SH8(a, b, i0, i1, i2, i3) _mm256_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0))
+
+__attribute__((target("avx"))) static inline __m256 load2(const float *p, const float *q)
+{
+	return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(q), 1);
+}
+
+__attribute__((target("avx"))) static inline void load_xyz8(const float *p, __m256 *x, __m256 *y, __m256 *z)
+{
+	const __m256 a = load2(p, p + 12), b = load2(p + 4, p + 16), c = load2(p + 8, p + 20);
+	*x = RT_SH8(a, RT_SH8(b, c, 2, 0, 1, 0), 0, 3, 0, 2);
+	*y = RT_SH8(RT_SH8(a, b, 1, 0, 0, 0), RT_SH8(b, c, 3, 0, 2, 0), 0, 2, 0, 2);
+	*z = RT_SH8(RT_SH8(a, b, 2, 0, 1, 0), RT_SH8(c, c, 0, 0, 3, 0), 0, 2, 0, 2);
+}
+
+__attribute__((target("avx"))) static inline void store_xyz8(float *restrict out, size_t stride, __m256 x, __m256 y,
+                                                           __m256 z)
+{
+	const __m256 a = RT_SH8(RT_SH8(x, y, 0, 0, 0, 0), RT_SH8(z, x, 0, 0, 1, 1), 0, 2, 0, 2);
+	const __m256 b = RT_SH8(RT_SH8(y, z, 1, 1, 1, 1), RT_SH8(x, y, 2, 2, 2, 2), 0, 2, 0, 2);
+	const __m256 c = RT_SH8(RT_SH8(z, x, 2, 2, 3, 3), RT_SH8(y, z, 3, 3, 3, 3), 0, 2, 0, 2);
+	if (stride == 12) {
+		_mm_storeu_ps(out, _mm256_castps256_ps128(a)), _mm_storeu_ps(out + 4, _mm256_castps256_ps128(b));
+		_mm_storeu_ps(out + 8, _mm256_castps256_ps128(c)), _mm_storeu_ps(out + 12, _mm256_extractf128_ps(a, 1));
+		_mm_storeu_ps(out + 16, _mm256_extractf128_ps(b, 1)), _mm_storeu_ps(out + 20, _mm256_extractf128_ps(c, 1));
+		return;
+	}
+	float t[24];
+	_mm_storeu_ps(t, _mm256_castps256_ps128(a)), _mm_storeu_ps(t + 4, _mm256_castps256_ps128(b));
+	_mm_storeu_ps(t + 8, _mm256_castps256_ps128(c)), _mm_storeu_ps(t + 12, _mm256_extractf128_ps(a, 1));
+	_mm_storeu_ps(t + 16, _mm256_extractf128_ps(b, 1)), _mm_storeu_ps(t + 20, _mm256_extractf128_ps(c, 1));
+	for (int k = 0; k < 8; k++)
+		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
+}
+
+/* Normalises tn[i0 .. i0 + 8) as normalise_run does 4 at a time, the low
+ * 128-bit half carrying the first 4, the high half the next 4: lane for
+ * lane the same operations, so the same floats. */
+__attribute__((target("avx"))) static void normalise8(const rt_v4 *restrict tn, float *restrict on, size_t stride)
+{
+	__m256 x = load2((const float *)&tn[0], (const float *)&tn[4]);
+	__m256 y = load2((const float *)&tn[1], (const float *)&tn[5]);
+	__m256 z = load2((const float *)&tn[2], (const float *)&tn[6]);
+	__m256 w = load2((const float *)&tn[3], (const float *)&tn[7]);
+	/* _MM_TRANSPOSE4_PS within each half */
+	const __m256 t0 = _mm256_unpacklo_ps(x, y), t1 = _mm256_unpacklo_ps(z, w);
+	const __m256 t2 = _mm256_unpackhi_ps(x, y), t3 = _mm256_unpackhi_ps(z, w);
+	x = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0));
+	y = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2));
+	z = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0));
+	const __m256 l2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z));
+	const __m256 inv = _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_sqrt_ps(l2));
+	const __m256 il = _mm256_and_ps(_mm256_cmp_ps(l2, _mm256_setzero_ps(), _CMP_GT_OQ), inv);
+	store_xyz8(on, stride, _mm256_mul_ps(x, il), _mm256_mul_ps(y, il), _mm256_mul_ps(z, il));
+}
+#endif
+
 /* Normalises the run's m blended normals and stores them at out. */
 static inline __attribute__((always_inline)) void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out,
                                                               size_t stride)
 {
 	for (size_t i = m; i % 4; i++)
 		tn[i] = (rt_v4){ 0, 0, 0, 0 };
-	for (size_t i0 = 0; i0 < m; i0 += 4) {
+	size_t i0 = 0;
+#if defined(RT_AVX)
+	/* 8 at a time with AVX (256-bit square roots and divisions) */
+	if (m >= 8 && __builtin_cpu_supports("avx"))
+		for (; i0 + 8 <= m; i0 += 8)
+			normalise8(tn + i0, (float *)((char *)out + i0 * stride), stride);
+#endif
+	for (; i0 < m; i0 += 4) {
 #if defined(RT_SSE2)
 		/* Four vertices at a time, transposed (x of the four in one
 		 * vector): per lane (x x + y y) + z z, one square root and
@@ -510,48 +580,11 @@ static void transform4(size_t n, const float *restrict pos, const float *restric
 	}
 }
 
-#if defined(__x86_64__) && !defined(MLOD_RT_NO_AVX)
+#if defined(RT_AVX)
 /* With AVX (checked at run time), 8 vertices at a time: the 4-wide loop's
  * shuffles work within each 128-bit half, so the low half carries
  * vertices 0-3 and the high half 4-7, and the arithmetic is the 4-wide
- * loop's, lane for lane (no FMA): the same floats. Returns the vertices
- * done (n rounded down to 8). */
-#include <immintrin.h>
-#define RT_SH8(a, b, i0, i1, i2, i3) _mm256_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0))
-
-__attribute__((target("avx"))) static inline __m256 load2(const float *p, const float *q)
-{
-	return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(q), 1);
-}
-
-__attribute__((target("avx"))) static inline void load_xyz8(const float *p, __m256 *x, __m256 *y, __m256 *z)
-{
-	const __m256 a = load2(p, p + 12), b = load2(p + 4, p + 16), c = load2(p + 8, p + 20);
-	*x = RT_SH8(a, RT_SH8(b, c, 2, 0, 1, 0), 0, 3, 0, 2);
-	*y = RT_SH8(RT_SH8(a, b, 1, 0, 0, 0), RT_SH8(b, c, 3, 0, 2, 0), 0, 2, 0, 2);
-	*z = RT_SH8(RT_SH8(a, b, 2, 0, 1, 0), RT_SH8(c, c, 0, 0, 3, 0), 0, 2, 0, 2);
-}
-
-__attribute__((target("avx"))) static inline void store_xyz8(float *restrict out, size_t stride, __m256 x, __m256 y,
-                                                           __m256 z)
-{
-	const __m256 a = RT_SH8(RT_SH8(x, y, 0, 0, 0, 0), RT_SH8(z, x, 0, 0, 1, 1), 0, 2, 0, 2);
-	const __m256 b = RT_SH8(RT_SH8(y, z, 1, 1, 1, 1), RT_SH8(x, y, 2, 2, 2, 2), 0, 2, 0, 2);
-	const __m256 c = RT_SH8(RT_SH8(z, x, 2, 2, 3, 3), RT_SH8(y, z, 3, 3, 3, 3), 0, 2, 0, 2);
-	if (stride == 12) {
-		_mm_storeu_ps(out, _mm256_castps256_ps128(a)), _mm_storeu_ps(out + 4, _mm256_castps256_ps128(b));
-		_mm_storeu_ps(out + 8, _mm256_castps256_ps128(c)), _mm_storeu_ps(out + 12, _mm256_extractf128_ps(a, 1));
-		_mm_storeu_ps(out + 16, _mm256_extractf128_ps(b, 1)), _mm_storeu_ps(out + 20, _mm256_extractf128_ps(c, 1));
-		return;
-	}
-	float t[24];
-	_mm_storeu_ps(t, _mm256_castps256_ps128(a)), _mm_storeu_ps(t + 4, _mm256_castps256_ps128(b));
-	_mm_storeu_ps(t + 8, _mm256_castps256_ps128(c)), _mm_storeu_ps(t + 12, _mm256_extractf128_ps(a, 1));
-	_mm_storeu_ps(t + 16, _mm256_extractf128_ps(b, 1)), _mm_storeu_ps(t + 20, _mm256_extractf128_ps(c, 1));
-	for (int k = 0; k < 8; k++)
-		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
-}
-
+ * loop's, lane for lane (no FMA): the same floats. */
 /* The 8 vertices from v: points by m (16 broadcast entries); normals by
  * m's first three columns, normalised (K 1) or as they are (K 0). */
 __attribute__((target("avx"))) static inline __attribute__((always_inline)) void
@@ -630,8 +663,6 @@ __attribute__((target("avx"))) static void transform8(size_t n, const float *res
 			nrm8(1, n - 8, nrm, m, out_nrm, ns);
 	}
 }
-#undef RT_SH8
-#define RT_AVX 1
 #endif
 
 void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M, const float *U,
