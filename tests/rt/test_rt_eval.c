@@ -4,7 +4,8 @@
  * levels give the full skeleton's world matrices at their kept joints),
  * skinning against a hand-computed LBS (skinned, rigid, static parts;
  * strides), the vectorised kernel against the scalar one, the rigid
- * parts' 4-wide transform against a plain loop float for float, and no
+ * parts' 4-wide transform against a plain loop float for float, rigid
+ * normals without renormalising only where the matrix allows, and no
  * allocation per frame (counting allocator). Morph targets: the runtime's
  * morphed output equals its output for the same character with the
  * deltas added to the positions by hand, at every mesh level and kind of
