@@ -374,6 +374,20 @@ fail:
 	return r;
 }
 
+/* 1 when n normals (3 floats each) all have unit length to within
+ * RT_UNIT_TOL (| |n|^2 - 1 | <= 2 RT_UNIT_TOL), else 0 (none: 0). */
+static uint32_t rt_unit_normals(const float *nrm, size_t n)
+{
+	if (!nrm)
+		return 0;
+	for (size_t v = 0; v < n; v++) {
+		const double x = nrm[3 * v], y = nrm[3 * v + 1], z = nrm[3 * v + 2];
+		if (!(fabs(x * x + y * y + z * z - 1.0) <= 2.0 * RT_UNIT_TOL))
+			return 0;
+	}
+	return 1;
+}
+
 /* The bytes of a mesh level's bucket tables (prepare_mesh): an offset per
  * part and each skinned part's RT_SKIN_ORDER_BYTES. */
 static size_t skin_order_bytes(const mlod_pack_mesh *m)
@@ -441,8 +455,10 @@ static mlod_result prepare_mesh(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_me
 	for (uint32_t i = 0; i < m->part_count; i++) {
 		const mlod_pack_part *p = &m->parts[i];
 		u->skin_order_at[i] = (uint32_t)at;
-		if (p->rec.skin < 0)
+		if (p->rec.skin < 0) {
+			u->skin_order_at[i] = rt_unit_normals(p->normals, p->rec.vertex_count);
 			continue;
+		}
 		rt_skin_order(p->rec.vertex_count, p->weights, u->skin_order + at);
 		at += RT_SKIN_ORDER_BYTES(p->rec.vertex_count);
 	}

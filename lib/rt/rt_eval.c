@@ -496,6 +496,36 @@ static void morph_range(const mlod_pack_part *p, const float *w, uint32_t nt, si
 	}
 }
 
+/* A rigid part's normals need no renormalising when M's linear part is a
+ * rotation times a scale s > 0 and its normals are unit: then M n / s is
+ * M n normalised. The Gram matrix of M's columns, over s^2 = its first
+ * entry, differs from the identity by at most RT_UNIT_TOL in every entry
+ * (0 in the first), so its eigenvalues lie within 1 +- 3 RT_UNIT_TOL and
+ * | U n | within 1 +- 2 RT_UNIT_TOL of | n |, which prepare_mesh checked to
+ * be within RT_UNIT_TOL of 1: U n is M n normalised to within
+ * 3 RT_UNIT_TOL of its length (and float rounding), in the same
+ * direction. Returns 1 and U = M / s (the first three columns) when so,
+ * else 0. */
+static int rigid_unit(const float *M, float *U)
+{
+	const double a0 = M[0], a1 = M[1], a2 = M[2], b0 = M[4], b1 = M[5], b2 = M[6], c0 = M[8], c1 = M[9],
+	             c2 = M[10];
+	const double s2 = a0 * a0 + a1 * a1 + a2 * a2, tol = RT_UNIT_TOL * s2;
+	if (!(s2 > 1e-30 && s2 < 1e30))
+		return 0;
+	const double d[5] = { b0 * b0 + b1 * b1 + b2 * b2 - s2, c0 * c0 + c1 * c1 + c2 * c2 - s2,
+		              a0 * b0 + a1 * b1 + a2 * b2, a0 * c0 + a1 * c1 + a2 * c2, b0 * c0 + b1 * c1 + b2 * c2 };
+	int ok = 1;
+	for (int k = 0; k < 5; k++)
+		ok &= fabs(d[k]) <= tol;
+	if (!ok)
+		return 0;
+	const double is = 1.0 / sqrt(s2);
+	for (int k = 0; k < 12; k++)
+		U[k] = (float)(M[k] * is);
+	return 1;
+}
+
 mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float *positions,
                          size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
                          uint32_t *vertex_count, mlod_error *err)
@@ -533,6 +563,10 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	}
 	size_t base = 0;
 	float morphed[3 * RT_MORPH_RUN];
+	float M[16], U[12];
+	int m_ok = 0, m_unit = -1;
+	int32_t m_joint = -1;
+	const float *m_off = NULL;
 	for (uint32_t i = 0; i < mu->mesh->part_count; i++) {
 		const mlod_pack_part *p = &mu->mesh->parts[i];
 		const uint32_t n = p->rec.vertex_count;
@@ -540,18 +574,32 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		float *on = normals ? (float *)((char *)normals + base * nrm_stride) : NULL;
 		const int skinned = p->rec.skin >= 0;
 		const float *pal = skinned ? s->palette + 16 * (size_t)ctx->skin_offset[p->rec.skin] : NULL;
-		float M[16];
-		if (!skinned && p->rec.joint >= 0) {
-			const uint32_t j = (uint32_t)p->rec.joint;
-			if (su && su->plan.stand[j] != (int32_t)j) {
-				float t[16];
-				rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
-				rt_mat_mul(t, p->rec.offset, M);
+		/* A rigid or static part's matrix, kept for the next part when it
+		 * follows the same joint with the same offset (the robot's mesh
+		 * levels have 15 rigid parts on 12 joints). */
+		if (!skinned && !(m_ok && p->rec.joint == m_joint &&
+		                  (m_off == p->rec.offset || memcmp(m_off, p->rec.offset, sizeof M) == 0))) {
+			if (p->rec.joint >= 0) {
+				const uint32_t j = (uint32_t)p->rec.joint;
+				if (su && su->plan.stand[j] != (int32_t)j) {
+					float t[16];
+					rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
+					rt_mat_mul(t, p->rec.offset, M);
+				} else {
+					rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
+				}
 			} else {
-				rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
+				memcpy(M, p->rec.offset, sizeof M);
 			}
-		} else if (!skinned) {
-			memcpy(M, p->rec.offset, sizeof M);
+			m_ok = 1, m_joint = p->rec.joint, m_off = p->rec.offset, m_unit = -1;
+		}
+		/* Rigid and static parts with unit normals: skip renormalising
+		 * when M allows (rigid_unit, once per matrix). */
+		int unit = 0;
+		if (!skinned && on && p->normals && mu->skin_order_at[i]) {
+			if (m_unit < 0)
+				m_unit = rigid_unit(M, U);
+			unit = m_unit;
 		}
 		uint32_t nt = 0;
 		const float *mw = part_morph(ctx, id, i, p, &nt);
@@ -576,7 +624,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 						x[0] = x[1] = x[2] = 0.0f;
 					}
 			} else {
-				rt_transform(m, pos, nrm, M, o, pos_stride, onr, nrm_stride);
+				rt_transform(m, pos, nrm, M, unit ? U : NULL, o, pos_stride, onr, nrm_stride);
 			}
 			v0 += m;
 		}

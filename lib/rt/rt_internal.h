@@ -53,7 +53,9 @@ typedef struct rt_unit {
 	uint32_t pal_used_count, rigid_count;
 	uint32_t *pal_used, *rigid;
 	/* Mesh levels: per part, the offset in skin_order of its buckets
-	 * (rt_skin_order; skinned parts only), all in plan_block. */
+	 * (rt_skin_order; skinned parts), all in plan_block; for a rigid or
+	 * static part 1 when its normals all have unit length to within
+	 * RT_UNIT_TOL (mlod_rt_skin may then skip renormalising them), else 0. */
 	uint32_t *skin_order_at;
 	uint8_t *skin_order;
 	uint8_t *chan_flags;      /* resident motion levels: a bit per channel (in ctx->chan_bits) */
@@ -184,9 +186,12 @@ size_t rt_bytes_motion(const mlod_pack_motion *m);
  * NULL: zero normals; out_nrm NULL: none), each coordinate summed in the
  * order M[r] x + M[4 + r] y + M[8 + r] z (+ M[12 + r]), the normal's
  * squared length as x x + y y + z z, then times 1 / sqrt of it (0 when
- * not positive): the same floats whichever path computes them. */
-void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, float *out_pos, size_t ps,
-                  float *out_nrm, size_t ns);
+ * not positive): the same floats whichever path computes them. With U
+ * not NULL the normal is U n (U's first three columns, the same order of
+ * sums), not normalised: for M's linear part a rotation times a scale s
+ * and unit input normals, mlod_rt_skin passes U = M / s (rigid_unit). */
+void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, const float *U, float *out_pos,
+                  size_t ps, float *out_nrm, size_t ns);
 
 /* rt_skin.c: the influence-count buckets of a skinned part (prepare_mesh
  * builds them when a mesh level loads, so mlod_rt_skin_lbs's per-run
@@ -200,6 +205,9 @@ void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, 
  * counts: order + n + 5 v0 / RT_SKIN_RUN of the same part, for v0 a
  * multiple of RT_SKIN_RUN): the same floats. */
 #define RT_SKIN_RUN 64
+/* The relative tolerance of a unit normal's length and of a rigid
+ * matrix's linear part as a rotation times a scale (rigid_unit). */
+#define RT_UNIT_TOL 1e-6
 #define RT_SKIN_ORDER_BYTES(n) ((size_t)(n) + 5 * (((size_t)(n) + RT_SKIN_RUN - 1) / RT_SKIN_RUN))
 void rt_skin_order(size_t n, const float *weights, uint8_t *order);
 void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals, const uint16_t *joints,

@@ -8,16 +8,20 @@
  * the multiplies by 1), then each bucket goes through a loop specialised
  * for its count, with no branch per influence. The loops blend the palette matrices
  * (16 floats each, column-major) 4 lanes at a time, one matrix column per
- * vector, in the scalar loop's order of operations (so the results are
+ * vector (two columns per 8-lane vector for two or more influences: one
+ * AVX instruction in the AVX2 build), in the scalar loop's order of operations (so the results are
  * the scalar loop's, bit for bit, where the compiler does not contract
  * to fused multiply-adds); the point and the normal are then one 4-lane
  * multiply-add chain each. The run's normals are normalised after it, 4
  * at a time (SSE2: transposed, one square root and one division per 4
- * vertices, stored as rt_transform stores). mlod_rt_skin does not bucket
+ * vertices, stored as rt_transform stores), 8 at a time where the CPU has
+ * AVX (checked at run time; lane for lane the same operations). mlod_rt_skin does not bucket
  * every frame: prepare_mesh (rt_ctx.c) keeps each skinned part's buckets
  * from rt_skin_order, and rt_skin_lbs_ordered is the same loop given them.
  * It is written with the GCC/Clang vector extension; SSE2 intrinsics (the
- * x86-64 baseline) only for the bucketing mask and the normalisation, each
+ * x86-64 baseline) only for the bucketing mask and the normalisation (inlined
+ * into each build: called from the AVX2 one as a separate SSE function it
+ * ran 3 times slower on the test machine, AMD EPYC), each
  * with a plain C fallback (forced with -DMLOD_RT_NO_SSE2). Other compilers
  * (or -DMLOD_RT_NO_VECTOR_EXT) get fixed-length restrict loops that the
  * auto-vectoriser handles. mlod_rt_skin_lbs_scalar is the plain loop they
@@ -61,6 +65,16 @@ static inline rt_v4 ld4(const float *p)
 	return v;
 }
 
+/* 8-lane vectors for the blend (two matrix columns each), where the
+ * compiler has __builtin_shufflevector to take their halves. */
+#if defined(__clang__) || __GNUC__ >= 12
+#define RT_V8 1
+typedef float rt_v8 __attribute__((vector_size(32)));
+#else
+#define RT_V8 0
+#endif
+
+
 /* The influences of a vertex the kernel blends: up to the last non-zero
  * weight (at least 1); a zero weight adds nothing, so skipping it changes
  * no result. */
@@ -97,14 +111,28 @@ static inline __attribute__((always_inline)) void lbs_list(const int K, const in
 		const float *w = weights + 4 * v;
 		const float *a = palette + 16 * (size_t)j[0];
 		rt_v4 c0, c1, c2, c3;
-		if (K == 0)
-			c0 = ld4(a), c1 = ld4(a + 4), c2 = ld4(a + 8), c3 = ld4(a + 12);
-		else
-			c0 = w[0] * ld4(a), c1 = w[0] * ld4(a + 4), c2 = w[0] * ld4(a + 8), c3 = w[0] * ld4(a + 12);
-		for (int k = 1; k < K; k++) {
-			const float *b = palette + 16 * (size_t)j[k];
-			const float wk = w[k];
-			c0 += wk * ld4(b), c1 += wk * ld4(b + 4), c2 += wk * ld4(b + 8), c3 += wk * ld4(b + 12);
+		if (K <= 1 || !RT_V8) {
+			if (K == 0)
+				c0 = ld4(a), c1 = ld4(a + 4), c2 = ld4(a + 8), c3 = ld4(a + 12);
+			else
+				c0 = w[0] * ld4(a), c1 = w[0] * ld4(a + 4), c2 = w[0] * ld4(a + 8), c3 = w[0] * ld4(a + 12);
+		} else {
+			/* Two columns per 8-lane vector (one AVX instruction each in
+			 * the AVX2 build, two SSE ones otherwise): lane for lane the
+			 * 4-lane blend's operations, so the same floats. */
+#if RT_V8
+			rt_v8 c01, c23, b01, b23;
+			memcpy(&b01, a, sizeof b01), memcpy(&b23, a + 8, sizeof b23);
+			c01 = w[0] * b01, c23 = w[0] * b23;
+			for (int k = 1; k < K; k++) {
+				const float *b = palette + 16 * (size_t)j[k];
+				const float wk = w[k];
+				memcpy(&b01, b, sizeof b01), memcpy(&b23, b + 8, sizeof b23);
+				c01 += wk * b01, c23 += wk * b23;
+			}
+			c0 = __builtin_shufflevector(c01, c01, 0, 1, 2, 3), c1 = __builtin_shufflevector(c01, c01, 4, 5, 6, 7);
+			c2 = __builtin_shufflevector(c23, c23, 0, 1, 2, 3), c3 = __builtin_shufflevector(c23, c23, 4, 5, 6, 7);
+#endif
 		}
 		const float *p = positions + 3 * v;
 		const rt_v4 o = c0 * p[0] + c1 * p[1] + c2 * p[2] + c3;
@@ -139,12 +167,82 @@ static inline void store_xyz4(float *restrict out, size_t stride, __m128 x, __m1
 
 #endif
 
+#if defined(RT_SSE2) && defined(__x86_64__) && !defined(MLOD_RT_NO_AVX)
+/* AVX helpers (each caller checks the CPU at run time): xyz of 8
+ * vertices as X, Y, Z lanes and back, 4 per 128-bit half. */
+#define RT_AVX 1
+#include <immintrin.h>
+#define RT_SH8(a, b, i0, i1, i2, i3) _mm256_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0))
+
+__attribute__((target("avx"))) static inline __m256 load2(const float *p, const float *q)
+{
+	return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(q), 1);
+}
+
+__attribute__((target("avx"))) static inline void load_xyz8(const float *p, __m256 *x, __m256 *y, __m256 *z)
+{
+	const __m256 a = load2(p, p + 12), b = load2(p + 4, p + 16), c = load2(p + 8, p + 20);
+	*x = RT_SH8(a, RT_SH8(b, c, 2, 0, 1, 0), 0, 3, 0, 2);
+	*y = RT_SH8(RT_SH8(a, b, 1, 0, 0, 0), RT_SH8(b, c, 3, 0, 2, 0), 0, 2, 0, 2);
+	*z = RT_SH8(RT_SH8(a, b, 2, 0, 1, 0), RT_SH8(c, c, 0, 0, 3, 0), 0, 2, 0, 2);
+}
+
+__attribute__((target("avx"))) static inline void store_xyz8(float *restrict out, size_t stride, __m256 x, __m256 y,
+                                                           __m256 z)
+{
+	const __m256 a = RT_SH8(RT_SH8(x, y, 0, 0, 0, 0), RT_SH8(z, x, 0, 0, 1, 1), 0, 2, 0, 2);
+	const __m256 b = RT_SH8(RT_SH8(y, z, 1, 1, 1, 1), RT_SH8(x, y, 2, 2, 2, 2), 0, 2, 0, 2);
+	const __m256 c = RT_SH8(RT_SH8(z, x, 2, 2, 3, 3), RT_SH8(y, z, 3, 3, 3, 3), 0, 2, 0, 2);
+	if (stride == 12) {
+		_mm_storeu_ps(out, _mm256_castps256_ps128(a)), _mm_storeu_ps(out + 4, _mm256_castps256_ps128(b));
+		_mm_storeu_ps(out + 8, _mm256_castps256_ps128(c)), _mm_storeu_ps(out + 12, _mm256_extractf128_ps(a, 1));
+		_mm_storeu_ps(out + 16, _mm256_extractf128_ps(b, 1)), _mm_storeu_ps(out + 20, _mm256_extractf128_ps(c, 1));
+		return;
+	}
+	float t[24];
+	_mm_storeu_ps(t, _mm256_castps256_ps128(a)), _mm_storeu_ps(t + 4, _mm256_castps256_ps128(b));
+	_mm_storeu_ps(t + 8, _mm256_castps256_ps128(c)), _mm_storeu_ps(t + 12, _mm256_extractf128_ps(a, 1));
+	_mm_storeu_ps(t + 16, _mm256_extractf128_ps(b, 1)), _mm_storeu_ps(t + 20, _mm256_extractf128_ps(c, 1));
+	for (int k = 0; k < 8; k++)
+		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
+}
+
+/* Normalises tn[i0 .. i0 + 8) as normalise_run does 4 at a time, the low
+ * 128-bit half carrying the first 4, the high half the next 4: lane for
+ * lane the same operations, so the same floats. */
+__attribute__((target("avx"))) static void normalise8(const rt_v4 *restrict tn, float *restrict on, size_t stride)
+{
+	__m256 x = load2((const float *)&tn[0], (const float *)&tn[4]);
+	__m256 y = load2((const float *)&tn[1], (const float *)&tn[5]);
+	__m256 z = load2((const float *)&tn[2], (const float *)&tn[6]);
+	__m256 w = load2((const float *)&tn[3], (const float *)&tn[7]);
+	/* _MM_TRANSPOSE4_PS within each half */
+	const __m256 t0 = _mm256_unpacklo_ps(x, y), t1 = _mm256_unpacklo_ps(z, w);
+	const __m256 t2 = _mm256_unpackhi_ps(x, y), t3 = _mm256_unpackhi_ps(z, w);
+	x = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0));
+	y = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2));
+	z = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0));
+	const __m256 l2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z));
+	const __m256 inv = _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_sqrt_ps(l2));
+	const __m256 il = _mm256_and_ps(_mm256_cmp_ps(l2, _mm256_setzero_ps(), _CMP_GT_OQ), inv);
+	store_xyz8(on, stride, _mm256_mul_ps(x, il), _mm256_mul_ps(y, il), _mm256_mul_ps(z, il));
+}
+#endif
+
 /* Normalises the run's m blended normals and stores them at out. */
-static void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out, size_t stride)
+static inline __attribute__((always_inline)) void normalise_run(size_t m, rt_v4 *restrict tn, float *restrict out,
+                                                              size_t stride)
 {
 	for (size_t i = m; i % 4; i++)
 		tn[i] = (rt_v4){ 0, 0, 0, 0 };
-	for (size_t i0 = 0; i0 < m; i0 += 4) {
+	size_t i0 = 0;
+#if defined(RT_AVX)
+	/* 8 at a time with AVX (256-bit square roots and divisions) */
+	if (m >= 8 && __builtin_cpu_supports("avx"))
+		for (; i0 + 8 <= m; i0 += 8)
+			normalise8(tn + i0, (float *)((char *)out + i0 * stride), stride);
+#endif
+	for (; i0 < m; i0 += 4) {
 #if defined(RT_SSE2)
 		/* Four vertices at a time, transposed (x of the four in one
 		 * vector): per lane (x x + y y) + z z, one square root and
@@ -382,10 +480,11 @@ void mlod_rt_skin_lbs_scalar(size_t n, const float *positions, const float *norm
 
 #if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
 /* One vertex at a time: one 4-lane multiply-add chain per point and per
- * normal (the tail of the 4-wide loop below, and its stand-in without
- * SSE2). */
+ * normal (the tail of the 4-wide loop below for fewer than 4 vertices,
+ * and its stand-in without SSE2). U: see rt_transform. */
 static void transform_one_by_one(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
-                                 float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
+                                 const float *U, float *restrict out_pos, size_t ps, float *restrict out_nrm,
+                                 size_t ns)
 {
 	const rt_v4 c0 = ld4(M), c1 = ld4(M + 4), c2 = ld4(M + 8), c3 = ld4(M + 12);
 	for (size_t v = 0; v < n; v++) {
@@ -396,6 +495,8 @@ static void transform_one_by_one(size_t n, const float *restrict pos, const floa
 	}
 	if (!out_nrm)
 		return;
+	const float *N = U ? U : M;
+	const rt_v4 u0 = ld4(N), u1 = ld4(N + 4), u2 = ld4(N + 8);
 	for (size_t v = 0; v < n; v++) {
 		float *restrict on = (float *)((char *)out_nrm + v * ns);
 		if (!nrm) {
@@ -403,7 +504,11 @@ static void transform_one_by_one(size_t n, const float *restrict pos, const floa
 			continue;
 		}
 		const float *nn = nrm + 3 * v;
-		const rt_v4 t = c0 * nn[0] + c1 * nn[1] + c2 * nn[2];
+		const rt_v4 t = u0 * nn[0] + u1 * nn[1] + u2 * nn[2];
+		if (U) {
+			on[0] = t[0], on[1] = t[1], on[2] = t[2];
+			continue;
+		}
 		const float len2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
 		const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
 		on[0] = t[0] * il, on[1] = t[1] * il, on[2] = t[2] * il;
@@ -423,15 +528,18 @@ static inline void load_xyz4(const float *p, __m128 *x, __m128 *y, __m128 *z)
 /* Four vertices at a time across the lanes (x of four points in one
  * vector): per lane the one-by-one loop's operations in its order, so the
  * same floats; the normals' 1 / sqrt four at a time (SSE2's square root
- * and division are IEEE's, as sqrtf and / are). */
+ * and division are IEEE's, as sqrtf and / are). n >= 4: when n is not a
+ * multiple of 4 the last block is the last 4 vertices, overlapping the
+ * one before (those vertices are computed and stored twice, the same
+ * floats both times), so there is no one-by-one tail. */
 static void transform4(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
-                       float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
+                       const float *U, float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
 {
-	const size_t n4 = n & ~(size_t)3;
 	__m128 m[16];
 	for (int k = 0; k < 16; k++)
 		m[k] = _mm_set1_ps(M[k]);
-	for (size_t v = 0; v < n4; v += 4) {
+	for (size_t v0 = 0; v0 < n; v0 += 4) {
+		const size_t v = n - v0 < 4 ? n - 4 : v0;
 		__m128 x, y, z;
 		load_xyz4(pos + 3 * v, &x, &y, &z);
 		const __m128 ox = _mm_add_ps(
@@ -443,150 +551,145 @@ static void transform4(size_t n, const float *restrict pos, const float *restric
 		store_xyz4((float *)((char *)out_pos + v * ps), ps, ox, oy, oz);
 	}
 	if (out_nrm && nrm) {
+		if (U)
+			for (int k = 0; k < 11; k++)
+				m[k] = _mm_set1_ps(U[k]);
 		const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
-		for (size_t v = 0; v < n4; v += 4) {
+		for (size_t v0 = 0; v0 < n; v0 += 4) {
+			const size_t v = n - v0 < 4 ? n - 4 : v0;
 			__m128 x, y, z;
 			load_xyz4(nrm + 3 * v, &x, &y, &z);
 			const __m128 tx = _mm_add_ps(_mm_add_ps(_mm_mul_ps(m[0], x), _mm_mul_ps(m[4], y)), _mm_mul_ps(m[8], z));
 			const __m128 ty = _mm_add_ps(_mm_add_ps(_mm_mul_ps(m[1], x), _mm_mul_ps(m[5], y)), _mm_mul_ps(m[9], z));
 			const __m128 tz = _mm_add_ps(_mm_add_ps(_mm_mul_ps(m[2], x), _mm_mul_ps(m[6], y)), _mm_mul_ps(m[10], z));
+			float *restrict on = (float *)((char *)out_nrm + v * ns);
+			if (U) {
+				store_xyz4(on, ns, tx, ty, tz);
+				continue;
+			}
 			const __m128 l2 =
 				_mm_add_ps(_mm_add_ps(_mm_mul_ps(tx, tx), _mm_mul_ps(ty, ty)), _mm_mul_ps(tz, tz));
 			const __m128 il = _mm_and_ps(_mm_cmpgt_ps(l2, zero), _mm_div_ps(one, _mm_sqrt_ps(l2)));
-			store_xyz4((float *)((char *)out_nrm + v * ns), ns, _mm_mul_ps(tx, il), _mm_mul_ps(ty, il),
-			           _mm_mul_ps(tz, il));
+			store_xyz4(on, ns, _mm_mul_ps(tx, il), _mm_mul_ps(ty, il), _mm_mul_ps(tz, il));
 		}
 	} else if (out_nrm) {
-		for (size_t v = 0; v < n4; v++) {
+		for (size_t v = 0; v < n; v++) {
 			float *restrict on = (float *)((char *)out_nrm + v * ns);
 			on[0] = on[1] = on[2] = 0.0f;
 		}
 	}
-	if (n4 < n)
-		transform_one_by_one(n - n4, pos + 3 * n4, nrm ? nrm + 3 * n4 : NULL, M,
-		                     (float *)((char *)out_pos + n4 * ps), ps,
-		                     out_nrm ? (float *)((char *)out_nrm + n4 * ns) : NULL, ns);
 }
 
-#if defined(__x86_64__) && !defined(MLOD_RT_NO_AVX)
+#if defined(RT_AVX)
 /* With AVX (checked at run time), 8 vertices at a time: the 4-wide loop's
  * shuffles work within each 128-bit half, so the low half carries
  * vertices 0-3 and the high half 4-7, and the arithmetic is the 4-wide
- * loop's, lane for lane (no FMA): the same floats. Returns the vertices
- * done (n rounded down to 8). */
-#include <immintrin.h>
-#define RT_SH8(a, b, i0, i1, i2, i3) _mm256_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0))
-
-__attribute__((target("avx"))) static inline __m256 load2(const float *p, const float *q)
+ * loop's, lane for lane (no FMA): the same floats. */
+/* The 8 vertices from v: points by m (16 broadcast entries); normals by
+ * m's first three columns, normalised (K 1) or as they are (K 0). */
+__attribute__((target("avx"))) static inline __attribute__((always_inline)) void
+pos8(size_t v, const float *restrict pos, const __m256 *m, float *restrict out_pos, size_t ps)
 {
-	return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(q), 1);
+	__m256 x, y, z;
+	load_xyz8(pos + 3 * v, &x, &y, &z);
+	const __m256 ox = _mm256_add_ps(
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[0], x), _mm256_mul_ps(m[4], y)), _mm256_mul_ps(m[8], z)), m[12]);
+	const __m256 oy = _mm256_add_ps(
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[1], x), _mm256_mul_ps(m[5], y)), _mm256_mul_ps(m[9], z)), m[13]);
+	const __m256 oz = _mm256_add_ps(
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[2], x), _mm256_mul_ps(m[6], y)), _mm256_mul_ps(m[10], z)), m[14]);
+	store_xyz8((float *)((char *)out_pos + v * ps), ps, ox, oy, oz);
 }
 
-__attribute__((target("avx"))) static inline void load_xyz8(const float *p, __m256 *x, __m256 *y, __m256 *z)
+__attribute__((target("avx"))) static inline __attribute__((always_inline)) void
+nrm8(const int K, size_t v, const float *restrict nrm, const __m256 *m, float *restrict out_nrm, size_t ns)
 {
-	const __m256 a = load2(p, p + 12), b = load2(p + 4, p + 16), c = load2(p + 8, p + 20);
-	*x = RT_SH8(a, RT_SH8(b, c, 2, 0, 1, 0), 0, 3, 0, 2);
-	*y = RT_SH8(RT_SH8(a, b, 1, 0, 0, 0), RT_SH8(b, c, 3, 0, 2, 0), 0, 2, 0, 2);
-	*z = RT_SH8(RT_SH8(a, b, 2, 0, 1, 0), RT_SH8(c, c, 0, 0, 3, 0), 0, 2, 0, 2);
-}
-
-__attribute__((target("avx"))) static inline void store_xyz8(float *restrict out, size_t stride, __m256 x, __m256 y,
-                                                           __m256 z)
-{
-	const __m256 a = RT_SH8(RT_SH8(x, y, 0, 0, 0, 0), RT_SH8(z, x, 0, 0, 1, 1), 0, 2, 0, 2);
-	const __m256 b = RT_SH8(RT_SH8(y, z, 1, 1, 1, 1), RT_SH8(x, y, 2, 2, 2, 2), 0, 2, 0, 2);
-	const __m256 c = RT_SH8(RT_SH8(z, x, 2, 2, 3, 3), RT_SH8(y, z, 3, 3, 3, 3), 0, 2, 0, 2);
-	if (stride == 12) {
-		_mm_storeu_ps(out, _mm256_castps256_ps128(a)), _mm_storeu_ps(out + 4, _mm256_castps256_ps128(b));
-		_mm_storeu_ps(out + 8, _mm256_castps256_ps128(c)), _mm_storeu_ps(out + 12, _mm256_extractf128_ps(a, 1));
-		_mm_storeu_ps(out + 16, _mm256_extractf128_ps(b, 1)), _mm_storeu_ps(out + 20, _mm256_extractf128_ps(c, 1));
+	__m256 x, y, z;
+	load_xyz8(nrm + 3 * v, &x, &y, &z);
+	const __m256 tx =
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[0], x), _mm256_mul_ps(m[4], y)), _mm256_mul_ps(m[8], z));
+	const __m256 ty =
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[1], x), _mm256_mul_ps(m[5], y)), _mm256_mul_ps(m[9], z));
+	const __m256 tz =
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[2], x), _mm256_mul_ps(m[6], y)), _mm256_mul_ps(m[10], z));
+	float *restrict on = (float *)((char *)out_nrm + v * ns);
+	if (!K) {
+		store_xyz8(on, ns, tx, ty, tz);
 		return;
 	}
-	float t[24];
-	_mm_storeu_ps(t, _mm256_castps256_ps128(a)), _mm_storeu_ps(t + 4, _mm256_castps256_ps128(b));
-	_mm_storeu_ps(t + 8, _mm256_castps256_ps128(c)), _mm_storeu_ps(t + 12, _mm256_extractf128_ps(a, 1));
-	_mm_storeu_ps(t + 16, _mm256_extractf128_ps(b, 1)), _mm_storeu_ps(t + 20, _mm256_extractf128_ps(c, 1));
-	for (int k = 0; k < 8; k++)
-		memcpy((char *)out + (size_t)k * stride, t + 3 * k, 3 * sizeof(float));
+	const __m256 l2 =
+		_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(tx, tx), _mm256_mul_ps(ty, ty)), _mm256_mul_ps(tz, tz));
+	const __m256 il = _mm256_and_ps(_mm256_cmp_ps(l2, _mm256_setzero_ps(), _CMP_GT_OQ),
+	                                _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_sqrt_ps(l2)));
+	store_xyz8(on, ns, _mm256_mul_ps(tx, il), _mm256_mul_ps(ty, il), _mm256_mul_ps(tz, il));
 }
 
-__attribute__((target("avx"))) static size_t transform8(size_t n, const float *restrict pos,
-                                                      const float *restrict nrm, const float *M,
-                                                      float *restrict out_pos, size_t ps, float *restrict out_nrm,
-                                                      size_t ns)
+/* n >= 8: blocks of 8 and, when n is not a multiple of 8, the last 8
+ * vertices (overlapping the block before: those are computed and stored
+ * twice, the same floats both times). */
+__attribute__((target("avx"))) static void transform8(size_t n, const float *restrict pos,
+                                                    const float *restrict nrm, const float *M, const float *U,
+                                                    float *restrict out_pos, size_t ps, float *restrict out_nrm,
+                                                    size_t ns)
 {
-	const size_t n8 = n & ~(size_t)7;
 	__m256 m[16];
 	for (int k = 0; k < 16; k++)
 		m[k] = _mm256_set1_ps(M[k]);
-	for (size_t v = 0; v < n8; v += 8) {
-		__m256 x, y, z;
-		load_xyz8(pos + 3 * v, &x, &y, &z);
-		const __m256 ox = _mm256_add_ps(
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[0], x), _mm256_mul_ps(m[4], y)), _mm256_mul_ps(m[8], z)),
-			m[12]);
-		const __m256 oy = _mm256_add_ps(
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[1], x), _mm256_mul_ps(m[5], y)), _mm256_mul_ps(m[9], z)),
-			m[13]);
-		const __m256 oz = _mm256_add_ps(
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[2], x), _mm256_mul_ps(m[6], y)), _mm256_mul_ps(m[10], z)),
-			m[14]);
-		store_xyz8((float *)((char *)out_pos + v * ps), ps, ox, oy, oz);
-	}
+	const size_t n8 = n & ~(size_t)7;
+	for (size_t v = 0; v < n8; v += 8)
+		pos8(v, pos, m, out_pos, ps);
+	if (n8 < n)
+		pos8(n - 8, pos, m, out_pos, ps);
 	if (!out_nrm)
-		return n8;
+		return;
 	if (!nrm) {
-		for (size_t v = 0; v < n8; v++) {
+		for (size_t v = 0; v < n; v++) {
 			float *restrict on = (float *)((char *)out_nrm + v * ns);
 			on[0] = on[1] = on[2] = 0.0f;
 		}
-		return n8;
+		return;
 	}
-	const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
-	for (size_t v = 0; v < n8; v += 8) {
-		__m256 x, y, z;
-		load_xyz8(nrm + 3 * v, &x, &y, &z);
-		const __m256 tx =
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[0], x), _mm256_mul_ps(m[4], y)), _mm256_mul_ps(m[8], z));
-		const __m256 ty =
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[1], x), _mm256_mul_ps(m[5], y)), _mm256_mul_ps(m[9], z));
-		const __m256 tz =
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[2], x), _mm256_mul_ps(m[6], y)), _mm256_mul_ps(m[10], z));
-		const __m256 l2 =
-			_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(tx, tx), _mm256_mul_ps(ty, ty)), _mm256_mul_ps(tz, tz));
-		const __m256 il =
-			_mm256_and_ps(_mm256_cmp_ps(l2, zero, _CMP_GT_OQ), _mm256_div_ps(one, _mm256_sqrt_ps(l2)));
-		store_xyz8((float *)((char *)out_nrm + v * ns), ns, _mm256_mul_ps(tx, il), _mm256_mul_ps(ty, il),
-		           _mm256_mul_ps(tz, il));
+	if (U) {
+		for (int k = 0; k < 11; k++)
+			m[k] = _mm256_set1_ps(U[k]);
+		for (size_t v = 0; v < n8; v += 8)
+			nrm8(0, v, nrm, m, out_nrm, ns);
+		if (n8 < n)
+			nrm8(0, n - 8, nrm, m, out_nrm, ns);
+	} else {
+		for (size_t v = 0; v < n8; v += 8)
+			nrm8(1, v, nrm, m, out_nrm, ns);
+		if (n8 < n)
+			nrm8(1, n - 8, nrm, m, out_nrm, ns);
 	}
-	return n8;
 }
-#undef RT_SH8
-#define RT_AVX 1
 #endif
 
-void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
+void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M, const float *U,
                   float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
 {
-	size_t d = 0;
 #if defined(RT_AVX)
-	if (n >= 8 && __builtin_cpu_supports("avx"))
-		d = transform8(n, pos, nrm, M, out_pos, ps, out_nrm, ns);
+	if (n >= 8 && __builtin_cpu_supports("avx")) {
+		transform8(n, pos, nrm, M, U, out_pos, ps, out_nrm, ns);
+		return;
+	}
 #endif
-	transform4(n - d, pos + 3 * d, nrm ? nrm + 3 * d : NULL, M, (float *)((char *)out_pos + d * ps), ps,
-	           out_nrm ? (float *)((char *)out_nrm + d * ns) : NULL, ns);
+	if (n >= 4)
+		transform4(n, pos, nrm, M, U, out_pos, ps, out_nrm, ns);
+	else
+		transform_one_by_one(n, pos, nrm, M, U, out_pos, ps, out_nrm, ns);
 }
 #undef RT_SH
 #else
-void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M,
+void rt_transform(size_t n, const float *restrict pos, const float *restrict nrm, const float *M, const float *U,
                   float *restrict out_pos, size_t ps, float *restrict out_nrm, size_t ns)
 {
-	transform_one_by_one(n, pos, nrm, M, out_pos, ps, out_nrm, ns);
+	transform_one_by_one(n, pos, nrm, M, U, out_pos, ps, out_nrm, ns);
 }
 #endif
 #else
-void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, float *out_pos, size_t ps,
-                  float *out_nrm, size_t ns)
+void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, const float *U, float *out_pos,
+                  size_t ps, float *out_nrm, size_t ns)
 {
 	for (size_t v = 0; v < n; v++) {
 		const float *q = pos + 3 * v;
@@ -599,12 +702,14 @@ void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, 
 				on[0] = on[1] = on[2] = 0.0f;
 				continue;
 			}
-			const float *nn = nrm + 3 * v;
+			const float *nn = nrm + 3 * v, *N = U ? U : M;
 			float len2 = 0.0f;
 			for (int r = 0; r < 3; r++) {
-				on[r] = M[r] * nn[0] + M[4 + r] * nn[1] + M[8 + r] * nn[2];
+				on[r] = N[r] * nn[0] + N[4 + r] * nn[1] + N[8 + r] * nn[2];
 				len2 += on[r] * on[r];
 			}
+			if (U)
+				continue;
 			const float il = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
 			for (int r = 0; r < 3; r++)
 				on[r] *= il;

@@ -4,7 +4,8 @@
  * levels give the full skeleton's world matrices at their kept joints),
  * skinning against a hand-computed LBS (skinned, rigid, static parts;
  * strides), the vectorised kernel against the scalar one, the rigid
- * parts' 4-wide transform against a plain loop float for float, and no
+ * parts' 4-wide transform against a plain loop float for float, rigid
+ * normals without renormalising only where the matrix allows, and no
  * allocation per frame (counting allocator). Morph targets: the runtime's
  * morphed output equals its output for the same character with the
  * deltas added to the positions by hand, at every mesh level and kind of
@@ -372,6 +373,9 @@ TEST(rigid_transform_exact)
 	               { 1.0f, 1.5f, 0.75f } };
 	mlod_mat4 MM = mlod_mat4_from_trs(&t);
 	const float *M = MM.m;
+	float U[12];
+	for (int k = 0; k < 12; k++)
+		U[k] = M[k] * 0.5f + (float)k;
 	for (int v = 0; v < N; v++)
 		for (int k = 0; k < 3; k++)
 			pos[3 * v + k] = frand() * 4 - 2, nrm[3 * v + k] = v % 7 == 3 ? 0.0f : frand() - 0.5f;
@@ -380,13 +384,13 @@ TEST(rigid_transform_exact)
 	int checked = 0;
 	for (size_t l = 0; l < sizeof lengths / sizeof lengths[0]; l++)
 		for (size_t si = 0; si < 3; si++)
-			for (int mode = 0; mode < 3; mode++) { /* normals, no input normals, no output normals */
+			for (int mode = 0; mode < 4; mode++) { /* normals, no input normals, no output normals, by U */
 				const int n = lengths[l];
 				const size_t st = strides[si], fs = st / 4;
 				for (int i = 0; i < S * N; i++)
 					a[i] = b[i] = an[i] = bn[i] = -7.0f;
 				const float *in_n = mode == 1 ? NULL : nrm;
-				rt_transform((size_t)n, pos, in_n, M, a, st, mode == 2 ? NULL : an, st);
+				rt_transform((size_t)n, pos, in_n, M, mode == 3 ? U : NULL, a, st, mode == 2 ? NULL : an, st);
 				for (int v = 0; v < n; v++) {
 					const float *q = pos + 3 * v;
 					float *o = b + fs * (size_t)v, *on = bn + fs * (size_t)v;
@@ -400,6 +404,11 @@ TEST(rigid_transform_exact)
 					}
 					const float *nn = nrm + 3 * v;
 					float tt[3];
+					if (mode == 3) { /* U n as it is */
+						for (int r = 0; r < 3; r++)
+							on[r] = U[r] * nn[0] + U[4 + r] * nn[1] + U[8 + r] * nn[2];
+						continue;
+					}
 					for (int r = 0; r < 3; r++)
 						tt[r] = M[r] * nn[0] + M[4 + r] * nn[1] + M[8 + r] * nn[2];
 					const float len2 = tt[0] * tt[0] + tt[1] * tt[1] + tt[2] * tt[2];
@@ -414,6 +423,78 @@ TEST(rigid_transform_exact)
 				checked++;
 			}
 	printf("# rt_transform: %d cases equal to the plain loop, float for float\n", checked);
+}
+
+/* Rigid normals without renormalising (rigid_unit in rt_eval.c): the
+ * rigid part on joint 4 (scaled uniformly 1 -> 3 by clip 0) gives normals
+ * equal to M n normalised to within the bound (3e-6 plus rounding) with its
+ * offset a rotation, a rotation times 2, and, where renormalising cannot be
+ * skipped, a non-uniform scale (1, 2, 0.5), a shear, and input normals that
+ * are not unit (the part's normals scaled by 1.5). Fails when the skip
+ * ignores the scale or takes a matrix or normals it does not hold for. */
+TEST(rigid_unit_normals)
+{
+	static const float c = 0.8f, sn = 0.6f;
+	const float rot[16] = { c, sn, 0, 0, -sn, c, 0, 0, 0, 0, 1, 0, 0.5f, 0, 0, 1 };
+	float offs[5][16];
+	for (int k = 0; k < 5; k++)
+		memcpy(offs[k], rot, sizeof rot);
+	for (int k = 0; k < 12; k++)
+		offs[1][k] *= 2.0f;
+	for (int r = 0; r < 3; r++)
+		offs[2][r] *= 1.0f, offs[2][4 + r] *= 2.0f, offs[2][8 + r] *= 0.5f;
+	offs[3][4] += 0.3f; /* shear */
+	float saved_off[16], big[6];
+	memcpy(saved_off, fx_m0_parts[1].rec.offset, sizeof saved_off);
+	for (int k = 0; k < 6; k++)
+		big[k] = 1.5f * fx_m0_nrm1[k];
+	for (int cse = 0; cse < 5; cse++) {
+		memcpy(fx_m0_parts[1].rec.offset, offs[cse == 4 ? 0 : cse], sizeof saved_off);
+		if (cse == 4)
+			fx_m0_parts[1].normals = big;
+		mlod_error e;
+		mlod_rt_ctx *ctx = open_all(NULL, &e);
+		CHECK(ctx, "open: %s", e.message);
+		mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+		uint32_t id, n;
+		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.0f, 0, &id, &e), e);
+		CHECK_OK(force(ctx, id, 0, &e), e);
+		double worst = 0;
+		for (int step = 0; step <= 8; step++) {
+			float buf[6 * 7];
+			CHECK_OK(mlod_rt_instance_set(ctx, id, 0, 0.25f * (float)step, 0, &e), e);
+			CHECK_OK(mlod_rt_skin(ctx, s, id, buf, 24, buf + 3, 24, 7, &n, &e), e);
+			const float *W;
+			CHECK_OK(mlod_rt_pose(ctx, s, id, &W, NULL, NULL, &e), e);
+			const float *O = fx_m0_parts[1].rec.offset, *in = fx_m0_parts[1].normals;
+			for (int v = 0; v < 2; v++) {
+				double t[3], l = 0;
+				for (int r = 0; r < 3; r++) {
+					t[r] = 0;
+					for (int a = 0; a < 3; a++) { /* (W4 O) column a, row r, times n[a] */
+						double m = 0;
+						for (int b = 0; b < 3; b++)
+							m += (double)W[16 * 4 + 4 * b + r] * O[4 * a + b];
+						t[r] += m * in[3 * v + a];
+					}
+					l += t[r] * t[r];
+				}
+				for (int r = 0; r < 3; r++) {
+					const double d = fabs(buf[6 * (4 + v) + 3 + r] - t[r] / sqrt(l));
+					worst = d > worst ? d : worst;
+				}
+			}
+		}
+		/* A rotation (times a scale): within the skip's bound; else
+		 * renormalised, so within rounding. */
+		const double tol = cse <= 1 ? 4e-6 : 5e-7;
+		printf("# rigid normals, offset case %d: worst %.3g (tolerance %.3g)\n", cse, worst, tol);
+		CHECK(worst <= tol, "offset case %d: rigid normals off by %g", cse, worst);
+		mlod_rt_scratch_destroy(ctx, s);
+		mlod_rt_close(ctx);
+	}
+	memcpy(fx_m0_parts[1].rec.offset, saved_off, sizeof saved_off);
+	fx_m0_parts[1].normals = fx_m0_nrm1;
 }
 
 /* The counting allocator. */
@@ -857,6 +938,7 @@ int main(void)
 	RUN(skin_hand_lbs);
 	RUN(kernel_matches_scalar);
 	RUN(rigid_transform_exact);
+	RUN(rigid_unit_normals);
 	RUN(no_allocation_per_frame);
 	RUN(morph_targets);
 	RUN(skin_plan_matches_full_pose);
