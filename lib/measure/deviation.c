@@ -900,6 +900,18 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 	return MLOD_OK;
 }
 
+const mlod_posed *mlod_surface_mesh(const mlod_surface *s)
+{
+	return &s->mesh;
+}
+
+mlod_result mlod_surface_build(mlod_surface *s, mlod_error *err)
+{
+	const target t = { &s->mesh, &s->tree, &s->built, &s->lock, NULL, s->degen };
+	const bvh *tree;
+	return target_tree(&t, &tree, err);
+}
+
 void mlod_surface_like(mlod_surface *s, mlod_surface *like)
 {
 	if (like && like != s && like->mesh.triangle_count == s->mesh.triangle_count &&
