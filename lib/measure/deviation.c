@@ -314,12 +314,12 @@ static void fill_tris(const mlod_posed *m, bvh *out)
 			t->b[a] = m->positions[3 * (size_t)ix[1] + a];
 			t->c[a] = m->positions[3 * (size_t)ix[2] + a];
 		}
-		t->degenerate = is_degenerate(t);
 		double ab[3], ac[3];
 		sub3(t->b, t->a, ab);
 		sub3(t->c, t->a, ac);
 		double nn[3] = { ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0] };
-		double len = sqrt(dot3(nn, nn));
+		double n2 = dot3(nn, nn), len = sqrt(n2);
+		t->degenerate = n2 <= 1e-12 * dot3(ab, ab) * dot3(ac, ac); /* is_degenerate, its cross product shared */
 		for (int a = 0; a < 3; a++)
 			t->n[a] = t->degenerate || !(len > 0.0) ? 0.0 : nn[a] / len;
 	}
@@ -623,10 +623,13 @@ static int sample_at(const mlod_posed *from, const unsigned char *used, long i, 
 /* Whether each triangle of m is degenerate (is_degenerate), into flags. */
 static void degenerate_flags(const mlod_posed *m, unsigned char *flags)
 {
+	const float *x = m->positions;
 	for (int t = 0; t < m->triangle_count; t++) {
-		tri x;
-		mesh_tri(m, t, &x);
-		flags[t] = (unsigned char)x.degenerate;
+		/* is_degenerate on the corners as mesh_tri makes them, without the copy */
+		const uint32_t *ix = m->indices + 3 * (size_t)t;
+		const float *u = x + 3 * (size_t)ix[0], *v = x + 3 * (size_t)ix[1], *w = x + 3 * (size_t)ix[2];
+		const double a[3] = { u[0], u[1], u[2] }, b[3] = { v[0], v[1], v[2] }, c[3] = { w[0], w[1], w[2] };
+		flags[t] = (unsigned char)points_degenerate(a, b, c);
 	}
 }
 
@@ -671,12 +674,31 @@ typedef struct candidate {
 	int i;
 } candidate;
 
-static int by_bound(const void *x, const void *y)
+/* Whether u is searched before v: larger bound first, then a's samples
+ * before b's, then in the mesh's order (a total order). */
+static int before(const candidate *u, const candidate *v)
 {
-	const candidate *u = x, *v = y;
 	if (u->bound != v->bound)
-		return u->bound > v->bound ? -1 : 1;
-	return u->way != v->way ? u->way - v->way : u->i - v->i;
+		return u->bound > v->bound;
+	return u->way != v->way ? u->way < v->way : u->i < v->i;
+}
+
+/* Moves c[at] down the heap of n (the first to search at the root). */
+static void sift_down(candidate *c, long n, long at)
+{
+	candidate x = c[at];
+	for (;;) {
+		long l = 2 * at + 1;
+		if (l >= n)
+			break;
+		if (l + 1 < n && before(&c[l + 1], &c[l]))
+			l++;
+		if (!before(&c[l], &x))
+			break;
+		c[at] = c[l];
+		at = l;
+	}
+	c[at] = x;
 }
 
 /* Searches of a target before its hierarchy is built: each looks at every
@@ -753,11 +775,15 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 		for (long i = 0; i < n[way]; i++)
 			if (dist[way][i] > top)
 				c[candidates].bound = dist[way][i], c[candidates].way = way, c[candidates++].i = (int)i;
-	if (candidates > 1)
-		qsort(c, (size_t)candidates, sizeof *c, by_bound);
+	/* in before's order, taken from a heap: the search usually stops
+	 * after a few, and sorting them all cost more than the searches */
+	for (long k = candidates / 2 - 1; k >= 0; k--)
+		sift_down(c, candidates, k);
 	int searches[2] = { 0, 0 };
-	for (long k = 0; k < candidates && c[k].bound > top; k++) {
-		int way = c[k].way, i = c[k].i;
+	for (long left = candidates; left > 0 && c[0].bound > top;) {
+		int way = c[0].way, i = c[0].i;
+		c[0] = c[--left];
+		sift_down(c, left, 0);
 		double p[3], d2;
 		sample_at(m[way], used[way], i, p);
 		if ((r = target_nearest2(onto[way], &searches[way], p, w[way][i], &d2, err)) != MLOD_OK)
@@ -786,16 +812,30 @@ done:
 	return r;
 }
 
-/* Diagonal of the bounding box of the vertices a's triangles use. */
+/* Diagonal of the bounding box of the vertices a's triangles use (each
+ * once, marked first; by corner when out of memory: the same box). */
 static double diagonal(const mlod_posed *m)
 {
 	double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-	for (long i = 0; i < 3L * m->triangle_count; i++)
-		for (int a = 0; a < 3; a++) {
-			double x = m->positions[3 * (size_t)m->indices[i] + a];
-			lo[a] = x < lo[a] ? x : lo[a];
-			hi[a] = x > hi[a] ? x : hi[a];
-		}
+	unsigned char *used = calloc((size_t)m->vertex_count + 1, 1);
+	if (used) {
+		for (long i = 0; i < 3L * m->triangle_count; i++)
+			used[m->indices[i]] = 1;
+		for (int v = 0; v < m->vertex_count; v++)
+			if (used[v])
+				for (int a = 0; a < 3; a++) {
+					double x = m->positions[3 * (size_t)v + a];
+					lo[a] = x < lo[a] ? x : lo[a];
+					hi[a] = x > hi[a] ? x : hi[a];
+				}
+		free(used);
+	} else
+		for (long i = 0; i < 3L * m->triangle_count; i++)
+			for (int a = 0; a < 3; a++) {
+				double x = m->positions[3 * (size_t)m->indices[i] + a];
+				lo[a] = x < lo[a] ? x : lo[a];
+				hi[a] = x > hi[a] ? x : hi[a];
+			}
 	return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
 	            (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
@@ -907,8 +947,13 @@ const mlod_posed *mlod_surface_mesh(const mlod_surface *s)
 
 mlod_result mlod_surface_build(mlod_surface *s, mlod_error *err)
 {
-	const target t = { &s->mesh, &s->tree, &s->built, &s->lock, NULL, s->degen };
-	const bvh *tree;
+	const bvh *like = NULL, *tree;
+	if (s->like) {
+		pthread_mutex_lock(&s->like->lock);
+		like = s->like->built ? &s->like->tree : NULL;
+		pthread_mutex_unlock(&s->like->lock);
+	}
+	const target t = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen };
 	return target_tree(&t, &tree, err);
 }
 

@@ -175,8 +175,11 @@ mlod_result mlod_pose_set_keep(const mlod_pose_set *s, const mlod_character *ful
 		pthread_mutex_lock(&c->lock);
 		c->owner[k] = full;
 		pthread_mutex_unlock(&c->lock);
-		if (k == 0)
-			r = mlod_surface_build(kept, err); /* every call's first pose searches it */
+		/* every call's first pose searches pose 0's; the bounded poses
+		 * (mlod_pose_set_bound_mean) nearly always some sample of each
+		 * other pose: refitted from pose 0's, when that one is kept */
+		if (k == 0 || c->bound_mean)
+			r = mlod_surface_build(kept, err);
 	}
 	mlod_posed_free(&a);
 	return r;

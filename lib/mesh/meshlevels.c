@@ -156,17 +156,20 @@ static mlod_result part_one(void *ctx, int k)
 	return MLOD_OK;
 }
 
-/* Items [0, parts) are the primitives (part_one); then one per measuring
- * pose: the full character kept posed there (mlod_pose_set_keep), work the
- * levels' measure would do first, done while the primitives collapse. A
- * pose that cannot be kept is not an error here: the measure then poses
- * the character itself, and reports what is wrong. */
-static mlod_result part_or_pose(void *ctx, int k)
+/* Items [0, parts) are the primitives (part_one); the last one keeps the
+ * full character posed at every measuring pose, in pose order (so that
+ * every later pose's hierarchy is refitted from pose 0's), with
+ * mlod_pose_set_keep: work the levels' measure would do first, done while
+ * the primitives collapse. A pose that cannot be kept is not an error
+ * here: the measure then poses the character itself, and reports what is
+ * wrong. */
+static mlod_result part_or_poses(void *ctx, int k)
 {
 	part_job *j = ctx;
 	if (k < j->parts)
 		return part_one(ctx, k);
-	mlod_pose_set_keep(&j->L->measure, j->L->c, k - j->parts, NULL);
+	for (int p = 0; p < j->L->measure.count; p++)
+		mlod_pose_set_keep(&j->L->measure, j->L->c, p, NULL);
 	return MLOD_OK;
 }
 
@@ -231,7 +234,7 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 	/* Each primitive's BGM is built and simplified on its own: in
 	 * parallel, with the results gathered in primitive order; and the
 	 * full character kept posed at each measuring pose meanwhile. */
-	mlod_parallel_for(n + L->measure.count, L->opt.threads, part_or_pose, &j);
+	mlod_parallel_for(n + 1, L->opt.threads, part_or_poses, &j);
 	for (int k = 0; k < n; k++) {
 		int i = j.part[2 * k], p = j.part[2 * k + 1];
 		const mlod_instance *in = &c->instances[i];
