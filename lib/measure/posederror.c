@@ -14,9 +14,11 @@
  * hierarchy (struct mlod_pose_cache): measuring every level of a character
  * builds that hierarchy once per pose. The full character is still posed
  * at every call, and the kept one used only when it is the same, byte for
- * byte. Each call measures its first pose alone, recording every sample's
- * nearest triangle in both directions, and the other poses (in parallel)
- * start their searches from those: skinning moves a sample and its nearest
+ * byte (or, kept with mlod_pose_set_keep, not posed again). Each level's
+ * first pose is measured first (mlod_posed_errors: the levels in
+ * parallel), recording every sample's nearest triangle in both
+ * directions, and the other poses (of every level, in parallel) start
+ * their searches from those: skinning moves a sample and its nearest
  * triangle together, so the first bound is nearly always the answer
  * (mlod-bgm on a 50k-triangle tubeman: 2.1 full point-triangle distances
  * and 24 nodes a query, from 5.4 and 29). The result is the same, bit for
