@@ -324,23 +324,43 @@ static mlod_result posed_one(void *ctx, int item)
 	return r;
 }
 
-/* The levels of mlod_posed_errors: item i the first pose of level i;
- * then item i * per + p pose p + 1 of level i. */
+/* The levels of mlod_posed_errors, in one mlod_parallel_for: item i < count
+ * is the first pose of level i (recording the warm starts); then item
+ * count + i * per + p is pose p + 1 of level i, which waits until level
+ * i's first pose is done (items are handed out in order, so every first
+ * pose has started by then: no barrier between the two kinds, and no
+ * wait that a barrier would not have). */
 typedef struct posed_batch {
 	posed_job *jobs;
-	int per;
+	int count, per;
+	int bound;
+	unsigned char *done;   /* per level: its first pose measured */
+	pthread_mutex_t lock;
+	pthread_cond_t cond;
 } posed_batch;
 
-static mlod_result batch_first(void *ctx, int i)
+static mlod_result batch_item(void *ctx, int item)
 {
 	posed_batch *b = ctx;
-	return posed_one(&b->jobs[i], 0);
-}
-
-static mlod_result batch_rest(void *ctx, int item)
-{
-	posed_batch *b = ctx;
-	return posed_one(&b->jobs[item / b->per], item % b->per);
+	if (item < b->count) {
+		posed_job *j = &b->jobs[item];
+		mlod_result r = posed_one(j, 0);
+		pthread_mutex_lock(&b->lock);
+		j->warm.record = 0, j->first = 1, j->warm.bound = b->bound;
+		b->done[item] = r == MLOD_OK ? 1 : 2;
+		pthread_cond_broadcast(&b->cond);
+		pthread_mutex_unlock(&b->lock);
+		return r;
+	}
+	item -= b->count;
+	int i = item / b->per;
+	pthread_mutex_lock(&b->lock);
+	while (!b->done[i])
+		pthread_cond_wait(&b->cond, &b->lock);
+	int ok = b->done[i] == 1;
+	pthread_mutex_unlock(&b->lock);
+	/* a level whose first pose failed reports that failure, not its others */
+	return ok ? posed_one(&b->jobs[i], item % b->per) : MLOD_OK;
 }
 
 mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *level, const mlod_pose_set *poses,
@@ -388,14 +408,16 @@ mlod_result mlod_posed_errors(const mlod_character *full, const mlod_character *
 	 * for them, a level's poses are measured cold. Every item writes only
 	 * its own level and pose: the work is spread over the levels and
 	 * poses, and the results do not depend on the thread count. */
-	posed_batch b = { jobs, P - 1 };
-	mlod_result r = mlod_parallel_for(count, poses->threads, batch_first, &b);
-	for (int i = 0; i < count; i++) {
-		jobs[i].warm.record = 0, jobs[i].first = 1;
-		jobs[i].warm.bound = poses->cache && poses->cache->bound_mean;
-	}
-	if (r == MLOD_OK && P > 1)
-		r = mlod_parallel_for(count * (P - 1), poses->threads, batch_rest, &b);
+	posed_batch b = { jobs, count, P - 1, poses->cache && poses->cache->bound_mean, calloc((size_t)count, 1),
+	                  PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER };
+	mlod_result r;
+	if (!b.done)
+		r = mlod_fail(&errs[0], MLOD_ERR_NOMEM, "mlod_posed_error: out of memory for %d levels", count);
+	else
+		r = mlod_parallel_for(count * P, poses->threads, batch_item, &b);
+	free(b.done);
+	pthread_mutex_destroy(&b.lock);
+	pthread_cond_destroy(&b.cond);
 	if (r != MLOD_OK) {
 		/* the first failure, in level order then pose order, of the items run */
 		for (long k = 0; k < (long)count * P; k++)
