@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "meshlevels.h"
+#include "bgm.h" /* bgm_seconds */
 
 /* One primitive of one instance. */
 struct mlod_mesh_part {
@@ -414,8 +415,12 @@ static mlod_result extract_level(mlod_mesh_levels *L, mlod_mesh_level *lv, doubl
 static mlod_result make_level(mlod_mesh_levels *L, mlod_mesh_level *lv, double ratio, mlod_error *err)
 {
 	mlod_result r = extract_level(L, lv, ratio, err);
-	if (r == MLOD_OK && (r = mlod_posed_error(L->c, &lv->view, &L->measure, &lv->error, err)) != MLOD_OK)
+	if (r != MLOD_OK)
+		return r;
+	double t0 = bgm_seconds();
+	if ((r = mlod_posed_error(L->c, &lv->view, &L->measure, &lv->error, err)) != MLOD_OK)
 		free_level(L, lv);
+	L->measure_seconds += bgm_seconds() - t0;
 	return r;
 }
 
@@ -471,7 +476,9 @@ mlod_result mlod_mesh_levels_by_ratio(mlod_mesh_levels *L, const double *ratios,
 	mlod_deviation dev[MLOD_MESH_MAX_LEVELS];
 	for (int k = first; k < L->count; k++)
 		views[k - first] = &L->levels[k].view;
+	double t0 = bgm_seconds();
 	mlod_result r = mlod_posed_errors(L->c, views, L->count - first, &L->measure, dev, err);
+	L->measure_seconds += bgm_seconds() - t0;
 	if (r != MLOD_OK) {
 		drop_levels(L, first);
 		return r;
