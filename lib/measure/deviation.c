@@ -29,6 +29,9 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "measure/mlod_measure.h"
 #include "measure/surface.h"
@@ -45,6 +48,8 @@ typedef struct node {
 typedef struct tri {
 	double a[3], b[3], c[3];
 	double n[3];    /* unit normal (0 for a degenerate triangle) */
+	double off;     /* n . a */
+	double a1;      /* |a| in the 1-norm: plane_dist2's slack */
 	int degenerate;
 } tri;
 
@@ -322,6 +327,8 @@ static void fill_tris(const mlod_posed *m, bvh *out)
 		t->degenerate = n2 <= 1e-12 * dot3(ab, ab) * dot3(ac, ac); /* is_degenerate, its cross product shared */
 		for (int a = 0; a < 3; a++)
 			t->n[a] = t->degenerate || !(len > 0.0) ? 0.0 : nn[a] / len;
+		t->off = t->n[0] * t->a[0] + t->n[1] * t->a[1] + t->n[2] * t->a[2];
+		t->a1 = fabs(t->a[0]) + fabs(t->a[1]) + fabs(t->a[2]);
 	}
 }
 
@@ -393,16 +400,42 @@ static inline double box_dist2(const double *p, const node *n)
 	return d2;
 }
 
-/* A lower bound of triangle_dist2: the squared distance to the
- * triangle's plane, less a slack (1e-12 of |p - a|, a thousand times the
- * rounding of the dot product) so that rounding can never make it exceed
- * the distance triangle_dist2 computes: a triangle skipped by it could
- * not have been nearer, and the result is the same as without it. */
-static double plane_dist2(const double *p, const tri *t)
+/* box_dist2 of two nodes at once (a node's children, l and l + 1): each
+ * lane does box_dist2's operations in its order (max, min, subtract,
+ * square, sum over the axes from 0), so the bits are the same. */
+static inline void box_pair_dist2(const double *p, const node *l, double *dl, double *dr)
 {
-	double u[3] = { p[0] - t->a[0], p[1] - t->a[1], p[2] - t->a[2] };
-	double d = fabs(u[0] * t->n[0] + u[1] * t->n[1] + u[2] * t->n[2]);
-	d -= 1e-12 * (fabs(u[0]) + fabs(u[1]) + fabs(u[2]));
+#if defined(__SSE2__)
+	const node *r = l + 1;
+	__m128d d2 = _mm_setzero_pd();
+	for (int a = 0; a < 3; a++) {
+		__m128d pa = _mm_set1_pd(p[a]);
+		__m128d c = _mm_max_pd(pa, _mm_set_pd(r->lo[a], l->lo[a])); /* p > lo ? p : lo */
+		c = _mm_min_pd(c, _mm_set_pd(r->hi[a], l->hi[a]));          /* c < hi ? c : hi */
+		__m128d d = _mm_sub_pd(pa, c);
+		d2 = _mm_add_pd(d2, _mm_mul_pd(d, d));
+	}
+	*dl = _mm_cvtsd_f64(d2);
+	*dr = _mm_cvtsd_f64(_mm_unpackhi_pd(d2, d2));
+#else
+	*dl = box_dist2(p, l);
+	*dr = box_dist2(p, l + 1);
+#endif
+}
+
+/* A lower bound of triangle_dist2: the squared distance to the
+ * triangle's plane, |n . p - n . a|, less a slack (1e-12 of |p| + |a| in
+ * the 1-norm, p1 and t->a1: no less than the 1e-12 of |p - a| this test
+ * once took, and a thousand times the rounding of either dot product) so
+ * that rounding can never make it exceed the distance triangle_dist2
+ * computes. A triangle skipped by it could not have been nearer; and as
+ * a triangle no nearer than the best changes nothing (neither the best
+ * nor the hint), the result is the same as without the test, or with any
+ * other lower bound. */
+static inline double plane_dist2(const double *p, double p1, const tri *t)
+{
+	double d = fabs(p[0] * t->n[0] + p[1] * t->n[1] + p[2] * t->n[2] - t->off);
+	d -= 1e-12 * (p1 + t->a1);
 	return d > 0.0 ? d * d : 0.0;
 }
 
@@ -415,12 +448,14 @@ static double subtree_nearest2(const bvh *b, const double *p, int at, double at_
 {
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
 	int top = 0;
+	const double p1 = fabs(p[0]) + fabs(p[1]) + fabs(p[2]);
 	for (;;) {
 		const node *n = &b->nodes[at];
 		if (at_d2 < best && n->count == 0) {
 			/* on into the nearer child; the farther one waits on the stack */
 			int l = n->first, r = n->first + 1;
-			double dl = box_dist2(p, &b->nodes[l]), dr = box_dist2(p, &b->nodes[r]);
+			double dl, dr;
+			box_pair_dist2(p, &b->nodes[l], &dl, &dr);
 			int near = dl <= dr ? l : r, far = dl <= dr ? r : l;
 			double dnear = dl <= dr ? dl : dr, dfar = dl <= dr ? dr : dl;
 			if (dfar < best)
@@ -430,7 +465,7 @@ static double subtree_nearest2(const bvh *b, const double *p, int at, double at_
 		}
 		if (at_d2 < best)
 			for (int k = n->first; k < n->first + n->count; k++) {
-				if (k == skip || plane_dist2(p, &b->tris[k]) >= best)
+				if (k == skip || plane_dist2(p, p1, &b->tris[k]) >= best)
 					continue;
 				double d = triangle_dist2(p, &b->tris[k]);
 				if (d < best)
