@@ -190,8 +190,8 @@ static void report_json(const struct job *job)
 	       L->vertices, t.nodes, t.seam_nodes);
 	printf("  \"border_edges\": %d,\n  \"nonmanifold_edges\": %d,\n  \"locked_nodes\": %d,\n  \"eligible_nodes\": %d,\n",
 	       t.border_edges, t.nonmanifold_edges, t.locked_nodes, t.eligible_nodes);
-	printf("  \"simplified_primitives\": %d,\n  \"static_primitives\": %d,\n  \"build_ms\": %.6g,\n", L->simplified,
-	       L->statics, 1e3 * L->build_seconds);
+	printf("  \"simplified_primitives\": %d,\n  \"static_primitives\": %d,\n  \"build_ms\": %.6g,\n  \"measure_ms\": %.6g,\n",
+	       L->simplified, L->statics, 1e3 * L->build_seconds, 1e3 * L->measure_seconds);
 	printf("  \"options\": {\"cost\": \"%s\", \"collapse\": \"%s\", \"budget\": \"%s\", \"placement\": \"%s\", "
 	       "\"eligibility\": \"%s\", \"tau\": %g, \"allow_border\": %s, \"fast_cost\": %s},\n",
 	       mlod_mesh_cost_name(L->opt.cost), mlod_mesh_op_name(L->opt.op), mlod_mesh_budget_name(L->budget),

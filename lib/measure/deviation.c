@@ -29,6 +29,9 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "measure/mlod_measure.h"
 #include "measure/surface.h"
@@ -45,6 +48,8 @@ typedef struct node {
 typedef struct tri {
 	double a[3], b[3], c[3];
 	double n[3];    /* unit normal (0 for a degenerate triangle) */
+	double off;     /* n . a */
+	double a1;      /* |a| in the 1-norm: plane_dist2's slack */
 	int degenerate;
 } tri;
 
@@ -314,14 +319,16 @@ static void fill_tris(const mlod_posed *m, bvh *out)
 			t->b[a] = m->positions[3 * (size_t)ix[1] + a];
 			t->c[a] = m->positions[3 * (size_t)ix[2] + a];
 		}
-		t->degenerate = is_degenerate(t);
 		double ab[3], ac[3];
 		sub3(t->b, t->a, ab);
 		sub3(t->c, t->a, ac);
 		double nn[3] = { ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0] };
-		double len = sqrt(dot3(nn, nn));
+		double n2 = dot3(nn, nn), len = sqrt(n2);
+		t->degenerate = n2 <= 1e-12 * dot3(ab, ab) * dot3(ac, ac); /* is_degenerate, its cross product shared */
 		for (int a = 0; a < 3; a++)
 			t->n[a] = t->degenerate || !(len > 0.0) ? 0.0 : nn[a] / len;
+		t->off = t->n[0] * t->a[0] + t->n[1] * t->a[1] + t->n[2] * t->a[2];
+		t->a1 = fabs(t->a[0]) + fabs(t->a[1]) + fabs(t->a[2]);
 	}
 }
 
@@ -393,16 +400,42 @@ static inline double box_dist2(const double *p, const node *n)
 	return d2;
 }
 
-/* A lower bound of triangle_dist2: the squared distance to the
- * triangle's plane, less a slack (1e-12 of |p - a|, a thousand times the
- * rounding of the dot product) so that rounding can never make it exceed
- * the distance triangle_dist2 computes: a triangle skipped by it could
- * not have been nearer, and the result is the same as without it. */
-static double plane_dist2(const double *p, const tri *t)
+/* box_dist2 of two nodes at once (a node's children, l and l + 1): each
+ * lane does box_dist2's operations in its order (max, min, subtract,
+ * square, sum over the axes from 0), so the bits are the same. */
+static inline void box_pair_dist2(const double *p, const node *l, double *dl, double *dr)
 {
-	double u[3] = { p[0] - t->a[0], p[1] - t->a[1], p[2] - t->a[2] };
-	double d = fabs(u[0] * t->n[0] + u[1] * t->n[1] + u[2] * t->n[2]);
-	d -= 1e-12 * (fabs(u[0]) + fabs(u[1]) + fabs(u[2]));
+#if defined(__SSE2__)
+	const node *r = l + 1;
+	__m128d d2 = _mm_setzero_pd();
+	for (int a = 0; a < 3; a++) {
+		__m128d pa = _mm_set1_pd(p[a]);
+		__m128d c = _mm_max_pd(pa, _mm_set_pd(r->lo[a], l->lo[a])); /* p > lo ? p : lo */
+		c = _mm_min_pd(c, _mm_set_pd(r->hi[a], l->hi[a]));          /* c < hi ? c : hi */
+		__m128d d = _mm_sub_pd(pa, c);
+		d2 = _mm_add_pd(d2, _mm_mul_pd(d, d));
+	}
+	*dl = _mm_cvtsd_f64(d2);
+	*dr = _mm_cvtsd_f64(_mm_unpackhi_pd(d2, d2));
+#else
+	*dl = box_dist2(p, l);
+	*dr = box_dist2(p, l + 1);
+#endif
+}
+
+/* A lower bound of triangle_dist2: the squared distance to the
+ * triangle's plane, |n . p - n . a|, less a slack (1e-12 of |p| + |a| in
+ * the 1-norm, p1 and t->a1: no less than the 1e-12 of |p - a| this test
+ * once took, and a thousand times the rounding of either dot product) so
+ * that rounding can never make it exceed the distance triangle_dist2
+ * computes. A triangle skipped by it could not have been nearer; and as
+ * a triangle no nearer than the best changes nothing (neither the best
+ * nor the hint), the result is the same as without the test, or with any
+ * other lower bound. */
+static inline double plane_dist2(const double *p, double p1, const tri *t)
+{
+	double d = fabs(p[0] * t->n[0] + p[1] * t->n[1] + p[2] * t->n[2] - t->off);
+	d -= 1e-12 * (p1 + t->a1);
 	return d > 0.0 ? d * d : 0.0;
 }
 
@@ -415,12 +448,14 @@ static double subtree_nearest2(const bvh *b, const double *p, int at, double at_
 {
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
 	int top = 0;
+	const double p1 = fabs(p[0]) + fabs(p[1]) + fabs(p[2]);
 	for (;;) {
 		const node *n = &b->nodes[at];
 		if (at_d2 < best && n->count == 0) {
 			/* on into the nearer child; the farther one waits on the stack */
 			int l = n->first, r = n->first + 1;
-			double dl = box_dist2(p, &b->nodes[l]), dr = box_dist2(p, &b->nodes[r]);
+			double dl, dr;
+			box_pair_dist2(p, &b->nodes[l], &dl, &dr);
 			int near = dl <= dr ? l : r, far = dl <= dr ? r : l;
 			double dnear = dl <= dr ? dl : dr, dfar = dl <= dr ? dr : dl;
 			if (dfar < best)
@@ -430,7 +465,7 @@ static double subtree_nearest2(const bvh *b, const double *p, int at, double at_
 		}
 		if (at_d2 < best)
 			for (int k = n->first; k < n->first + n->count; k++) {
-				if (k == skip || plane_dist2(p, &b->tris[k]) >= best)
+				if (k == skip || plane_dist2(p, p1, &b->tris[k]) >= best)
 					continue;
 				double d = triangle_dist2(p, &b->tris[k]);
 				if (d < best)
@@ -577,6 +612,8 @@ typedef struct target {
 	pthread_mutex_t *lock;
 	const bvh *like; /* the same triangles' tree at another pose, refitted (NULL: built) */
 	const unsigned char *degen; /* its triangles' degenerate_flags (NULL: made when needed) */
+	const unsigned char *used;  /* the vertices its triangles use (NULL: marked when needed) */
+	const double *centroid;     /* its triangles' centroids as sample_at makes them (NULL: made when needed) */
 } target;
 
 static mlod_result target_tree(const target *t, const bvh **out, mlod_error *err)
@@ -623,10 +660,13 @@ static int sample_at(const mlod_posed *from, const unsigned char *used, long i, 
 /* Whether each triangle of m is degenerate (is_degenerate), into flags. */
 static void degenerate_flags(const mlod_posed *m, unsigned char *flags)
 {
+	const float *x = m->positions;
 	for (int t = 0; t < m->triangle_count; t++) {
-		tri x;
-		mesh_tri(m, t, &x);
-		flags[t] = (unsigned char)x.degenerate;
+		/* is_degenerate on the corners as mesh_tri makes them, without the copy */
+		const uint32_t *ix = m->indices + 3 * (size_t)t;
+		const float *u = x + 3 * (size_t)ix[0], *v = x + 3 * (size_t)ix[1], *w = x + 3 * (size_t)ix[2];
+		const double a[3] = { u[0], u[1], u[2] }, b[3] = { v[0], v[1], v[2] }, c[3] = { w[0], w[1], w[2] };
+		flags[t] = (unsigned char)points_degenerate(a, b, c);
 	}
 }
 
@@ -634,8 +674,8 @@ static void degenerate_flags(const mlod_posed *m, unsigned char *flags)
  * distance to its warm triangle in dist (-1: not a sample, INFINITY: no
  * warm triangle), from's vertices then its triangles; degen: onto's
  * triangles' degenerate_flags, made once per mesh rather than per sample. */
-static void bound_distances(const mlod_posed *from, const unsigned char *used, const mlod_posed *onto,
-                            const unsigned char *degen, const int *warm, double *dist)
+static void bound_distances(const mlod_posed *from, const unsigned char *used, const double *centroid,
+                            const mlod_posed *onto, const unsigned char *degen, const int *warm, double *dist)
 {
 	const float *x = onto->positions, *f = from->positions;
 	const long nv = from->vertex_count, n = nv + from->triangle_count;
@@ -648,6 +688,9 @@ static void bound_distances(const mlod_posed *from, const unsigned char *used, c
 				continue;
 			}
 			p[0] = f[3 * i], p[1] = f[3 * i + 1], p[2] = f[3 * i + 2];
+		} else if (centroid) {
+			const double *q = centroid + 3 * (size_t)(i - nv);
+			p[0] = q[0], p[1] = q[1], p[2] = q[2];
 		} else {
 			const uint32_t *ix = from->indices + 3 * (size_t)(i - nv);
 			const float *u = f + 3 * (size_t)ix[0], *v = f + 3 * (size_t)ix[1], *w = f + 3 * (size_t)ix[2];
@@ -671,12 +714,31 @@ typedef struct candidate {
 	int i;
 } candidate;
 
-static int by_bound(const void *x, const void *y)
+/* Whether u is searched before v: larger bound first, then a's samples
+ * before b's, then in the mesh's order (a total order). */
+static int before(const candidate *u, const candidate *v)
 {
-	const candidate *u = x, *v = y;
 	if (u->bound != v->bound)
-		return u->bound > v->bound ? -1 : 1;
-	return u->way != v->way ? u->way - v->way : u->i - v->i;
+		return u->bound > v->bound;
+	return u->way != v->way ? u->way < v->way : u->i < v->i;
+}
+
+/* Moves c[at] down the heap of n (the first to search at the root). */
+static void sift_down(candidate *c, long n, long at)
+{
+	candidate x = c[at];
+	for (;;) {
+		long l = 2 * at + 1;
+		if (l >= n)
+			break;
+		if (l + 1 < n && before(&c[l + 1], &c[l]))
+			l++;
+		if (!before(&c[l], &x))
+			break;
+		c[at] = c[l];
+		at = l;
+	}
+	c[at] = x;
 }
 
 /* Searches of a target before its hierarchy is built: each looks at every
@@ -723,7 +785,11 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 	const target *onto[2] = { tb, ta };
 	const int *w[2] = { warm->a, warm->b };
 	long n[2] = { (long)m[0]->vertex_count + m[0]->triangle_count, (long)m[1]->vertex_count + m[1]->triangle_count };
-	unsigned char *used[2] = { calloc((size_t)m[0]->vertex_count, 1), calloc((size_t)m[1]->vertex_count, 1) };
+	/* a kept surface's used vertices and centroids are made once per pose, for every level */
+	unsigned char *own[2] = { ta->used ? NULL : calloc((size_t)m[0]->vertex_count, 1),
+	                          tb->used ? NULL : calloc((size_t)m[1]->vertex_count, 1) };
+	const unsigned char *used[2] = { ta->used ? ta->used : own[0], tb->used ? tb->used : own[1] };
+	const double *centroid[2] = { ta->centroid, tb->centroid };
 	double *dist[2] = { malloc(sizeof(double) * (size_t)n[0]), malloc(sizeof(double) * (size_t)n[1]) };
 	unsigned char *made[2] = { NULL, NULL };
 	const unsigned char *degen[2] = { onto[0]->degen, onto[1]->degen };
@@ -738,9 +804,9 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 	}
 	long candidates = 0;
 	for (int way = 0; way < 2; way++) {
-		for (long k = 0; k < 3L * m[way]->triangle_count; k++)
-			used[way][m[way]->indices[k]] = 1;
-		bound_distances(m[way], used[way], onto[way]->mesh, degen[way], w[way], dist[way]);
+		for (long k = 0; own[way] && k < 3L * m[way]->triangle_count; k++)
+			own[way][m[way]->indices[k]] = 1;
+		bound_distances(m[way], used[way], centroid[way], onto[way]->mesh, degen[way], w[way], dist[way]);
 		for (long i = 0; i < n[way]; i++)
 			candidates += dist[way][i] > top;
 	}
@@ -753,11 +819,15 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 		for (long i = 0; i < n[way]; i++)
 			if (dist[way][i] > top)
 				c[candidates].bound = dist[way][i], c[candidates].way = way, c[candidates++].i = (int)i;
-	if (candidates > 1)
-		qsort(c, (size_t)candidates, sizeof *c, by_bound);
+	/* in before's order, taken from a heap: the search usually stops
+	 * after a few, and sorting them all cost more than the searches */
+	for (long k = candidates / 2 - 1; k >= 0; k--)
+		sift_down(c, candidates, k);
 	int searches[2] = { 0, 0 };
-	for (long k = 0; k < candidates && c[k].bound > top; k++) {
-		int way = c[k].way, i = c[k].i;
+	for (long left = candidates; left > 0 && c[0].bound > top;) {
+		int way = c[0].way, i = c[0].i;
+		c[0] = c[--left];
+		sift_down(c, left, 0);
 		double p[3], d2;
 		sample_at(m[way], used[way], i, p);
 		if ((r = target_nearest2(onto[way], &searches[way], p, w[way][i], &d2, err)) != MLOD_OK)
@@ -778,24 +848,38 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 done:
 	free(made[0]);
 	free(made[1]);
-	free(used[0]);
-	free(used[1]);
+	free(own[0]);
+	free(own[1]);
 	free(dist[0]);
 	free(dist[1]);
 	free(c);
 	return r;
 }
 
-/* Diagonal of the bounding box of the vertices a's triangles use. */
+/* Diagonal of the bounding box of the vertices a's triangles use (each
+ * once, marked first; by corner when out of memory: the same box). */
 static double diagonal(const mlod_posed *m)
 {
 	double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-	for (long i = 0; i < 3L * m->triangle_count; i++)
-		for (int a = 0; a < 3; a++) {
-			double x = m->positions[3 * (size_t)m->indices[i] + a];
-			lo[a] = x < lo[a] ? x : lo[a];
-			hi[a] = x > hi[a] ? x : hi[a];
-		}
+	unsigned char *used = calloc((size_t)m->vertex_count + 1, 1);
+	if (used) {
+		for (long i = 0; i < 3L * m->triangle_count; i++)
+			used[m->indices[i]] = 1;
+		for (int v = 0; v < m->vertex_count; v++)
+			if (used[v])
+				for (int a = 0; a < 3; a++) {
+					double x = m->positions[3 * (size_t)v + a];
+					lo[a] = x < lo[a] ? x : lo[a];
+					hi[a] = x > hi[a] ? x : hi[a];
+				}
+		free(used);
+	} else
+		for (long i = 0; i < 3L * m->triangle_count; i++)
+			for (int a = 0; a < 3; a++) {
+				double x = m->positions[3 * (size_t)m->indices[i] + a];
+				lo[a] = x < lo[a] ? x : lo[a];
+				hi[a] = x > hi[a] ? x : hi[a];
+			}
 	return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
 	            (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
@@ -806,7 +890,7 @@ static mlod_result both_ways(const target *ta, const mlod_posed *b, double diag,
 {
 	bvh tb = { 0 };
 	int b_built = 0;
-	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL, NULL };
+	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL, NULL, NULL, NULL };
 	const mlod_posed *a = ta->mesh;
 	const bvh *tree_a, *tree_b;
 	double sum = 0.0, max = 0.0;
@@ -849,7 +933,7 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	bvh ta = { 0 };
 	int built = 0;
-	const target onto_a = { a, &ta, &built, NULL, NULL, NULL };
+	const target onto_a = { a, &ta, &built, NULL, NULL, NULL, NULL, NULL };
 	r = both_ways(&onto_a, b, diag, NULL, out, err);
 	if (built)
 		bvh_free(&ta);
@@ -868,6 +952,8 @@ struct mlod_surface {
 	mlod_surface *like; /* mlod_surface_like */
 	double diag;
 	unsigned char *degen; /* its triangles' degenerate_flags, for every level's bounded measure */
+	unsigned char *used;  /* the vertices its triangles use, and */
+	double *centroid;     /* its triangles' centroids: its samples, for the same */
 };
 
 mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_error *err)
@@ -886,7 +972,8 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 	}
 	size_t pos = 3 * (size_t)m->vertex_count * sizeof *m->positions, ind = 3 * (size_t)m->triangle_count * sizeof *m->indices;
 	if (!s || !(s->mesh.positions = malloc(pos)) || !(s->mesh.indices = malloc(ind)) ||
-	    !(s->degen = malloc((size_t)m->triangle_count))) {
+	    !(s->degen = malloc((size_t)m->triangle_count)) || !(s->used = calloc((size_t)m->vertex_count, 1)) ||
+	    !(s->centroid = malloc(3 * sizeof *s->centroid * (size_t)m->triangle_count))) {
 		mlod_surface_free(s);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: out of memory");
 	}
@@ -896,8 +983,34 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 	s->mesh.triangle_count = m->triangle_count;
 	s->diag = diag;
 	degenerate_flags(&s->mesh, s->degen);
+	for (long i = 0; i < 3L * m->triangle_count; i++)
+		s->used[m->indices[i]] = 1;
+	for (int t = 0; t < m->triangle_count; t++) {
+		const uint32_t *ix = m->indices + 3 * (size_t)t;
+		const float *u = m->positions + 3 * (size_t)ix[0], *v = m->positions + 3 * (size_t)ix[1],
+		            *w = m->positions + 3 * (size_t)ix[2];
+		for (int a = 0; a < 3; a++) /* as sample_at makes it */
+			s->centroid[3 * (size_t)t + a] = ((double)u[a] + v[a] + w[a]) / 3.0;
+	}
 	*out = s;
 	return MLOD_OK;
+}
+
+const mlod_posed *mlod_surface_mesh(const mlod_surface *s)
+{
+	return &s->mesh;
+}
+
+mlod_result mlod_surface_build(mlod_surface *s, mlod_error *err)
+{
+	const bvh *like = NULL, *tree;
+	if (s->like) {
+		pthread_mutex_lock(&s->like->lock);
+		like = s->like->built ? &s->like->tree : NULL;
+		pthread_mutex_unlock(&s->like->lock);
+	}
+	const target t = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used, s->centroid };
+	return target_tree(&t, &tree, err);
 }
 
 void mlod_surface_like(mlod_surface *s, mlod_surface *like)
@@ -925,6 +1038,8 @@ void mlod_surface_free(mlod_surface *s)
 	pthread_mutex_destroy(&s->lock);
 	mlod_posed_free(&s->mesh);
 	free(s->degen);
+	free(s->used);
+	free(s->centroid);
 	free(s);
 }
 
@@ -953,6 +1068,6 @@ mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b
 		like = s->like->built ? &s->like->tree : NULL;
 		pthread_mutex_unlock(&s->like->lock);
 	}
-	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen };
+	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used, s->centroid };
 	return both_ways(&onto_a, b, a->diag, warm, out, err);
 }

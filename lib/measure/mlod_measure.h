@@ -109,6 +109,26 @@ void mlod_pose_set_bound_mean(mlod_pose_set *s, int on);
 mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *level, const mlod_pose_set *poses,
                              mlod_deviation *out, mlod_error *err);
 
+/* mlod_posed_error of count levels of one full character, into out[0 ..
+ * count): the same results, to the bit, as one call per level, with the
+ * work spread over the levels and poses (poses->threads threads: the
+ * levels' first poses, then every other pose of every level). On a
+ * failure, the first failing level and pose in that order, of those
+ * measured, is reported. */
+mlod_result mlod_posed_errors(const mlod_character *full, const mlod_character *const *levels, int count,
+                              const mlod_pose_set *poses, mlod_deviation *out, mlod_error *err);
+
+/* Keeps full posed at pose k of s (a set from mlod_pose_set_make), with
+ * its search hierarchy for pose 0, as the first mlod_posed_error measuring
+ * it would; and so declares that full does not change while s lives:
+ * mlod_posed_error with this full character (the same pointer) then takes
+ * the kept pose without posing it again. Poses may be kept in any order,
+ * on several threads at once, and while other work runs (mlod_mesh's
+ * levels keep them during the collapses); the results are the same. A
+ * pose already kept for another character stays so (and full is then
+ * posed at each call). Nothing is kept in a set made by hand. */
+mlod_result mlod_pose_set_keep(const mlod_pose_set *s, const mlod_character *full, int k, mlod_error *err);
+
 
 /* ------------------------------------------------------------------ */
 /* Levels within an error bound (bound.c)                              */

@@ -14,9 +14,11 @@
  * hierarchy (struct mlod_pose_cache): measuring every level of a character
  * builds that hierarchy once per pose. The full character is still posed
  * at every call, and the kept one used only when it is the same, byte for
- * byte. Each call measures its first pose alone, recording every sample's
- * nearest triangle in both directions, and the other poses (in parallel)
- * start their searches from those: skinning moves a sample and its nearest
+ * byte (or, kept with mlod_pose_set_keep, not posed again). Each level's
+ * first pose is measured first (mlod_posed_errors: the levels in
+ * parallel), recording every sample's nearest triangle in both
+ * directions, and the other poses (of every level, in parallel) start
+ * their searches from those: skinning moves a sample and its nearest
  * triangle together, so the first bound is nearly always the answer
  * (mlod-bgm on a 50k-triangle tubeman: 2.1 full point-triangle distances
  * and 24 nodes a query, from 5.4 and 29). The result is the same, bit for
@@ -55,7 +57,10 @@ struct mlod_pose_cache {
 	pthread_mutex_t lock;
 	int count;
 	mlod_surface **full;
+	unsigned char *linked; /* per pose: mlod_surface_like tried (pose 0's hierarchy to refit) */
 	int bound_mean; /* mlod_pose_set_bound_mean */
+	const mlod_character **owner; /* per pose: mlod_pose_set_keep's full character, kept
+	                               * there (checked): not posed again */
 };
 
 static struct mlod_pose_cache *cache_make(int count)
@@ -64,8 +69,12 @@ static struct mlod_pose_cache *cache_make(int count)
 	if (!c)
 		return NULL;
 	c->full = calloc((size_t)(count > 0 ? count : 1), sizeof *c->full);
-	if (!c->full || pthread_mutex_init(&c->lock, NULL) != 0) {
+	c->linked = calloc((size_t)(count > 0 ? count : 1), 1);
+	c->owner = calloc((size_t)(count > 0 ? count : 1), sizeof *c->owner);
+	if (!c->full || !c->linked || !c->owner || pthread_mutex_init(&c->lock, NULL) != 0) {
 		free(c->full);
+		free(c->linked);
+		free(c->owner);
 		free(c);
 		return NULL;
 	}
@@ -80,8 +89,46 @@ static void cache_free(struct mlod_pose_cache *c)
 	for (int k = 0; k < c->count; k++)
 		mlod_surface_free(c->full[k]);
 	free(c->full);
+	free(c->linked);
+	free(c->owner);
 	pthread_mutex_destroy(&c->lock);
 	free(c);
+}
+
+/* Pose k's kept full character, made from a when it has none yet (or
+ * NULL); its hierarchy, for a pose after the first, refitted from pose
+ * 0's when that pose is kept by then (tried once, under the lock, before
+ * any call uses it: so which poses refit does not depend on the order
+ * poses were kept in). */
+static mlod_result cache_keep(struct mlod_pose_cache *c, int k, const mlod_posed *a, mlod_surface **out,
+                              mlod_error *err)
+{
+	pthread_mutex_lock(&c->lock);
+	mlod_surface *s = c->full[k];
+	pthread_mutex_unlock(&c->lock);
+	*out = NULL;
+	if (!s && a) {
+		mlod_surface *made;
+		mlod_result r = mlod_surface_make(a, &made, err);
+		if (r != MLOD_OK)
+			return r;
+		pthread_mutex_lock(&c->lock);
+		if (!c->full[k])
+			c->full[k] = made, made = NULL;
+		s = c->full[k];
+		pthread_mutex_unlock(&c->lock);
+		mlod_surface_free(made); /* another call kept its own first */
+	}
+	if (s && k > 0) {
+		pthread_mutex_lock(&c->lock);
+		if (!c->linked[k] && c->full[0]) {
+			mlod_surface_like(s, c->full[0]);
+			c->linked[k] = 1;
+		}
+		pthread_mutex_unlock(&c->lock);
+	}
+	*out = s;
+	return MLOD_OK;
 }
 
 /* The kept full character at pose k when it is a, made from a when pose
@@ -91,23 +138,53 @@ static const mlod_surface *cache_get(struct mlod_pose_cache *c, int k, const mlo
 {
 	if (!c || k >= c->count)
 		return NULL;
+	mlod_surface *s;
+	cache_keep(c, k, a, &s, NULL);
+	return s && mlod_surface_is(s, a) ? s : NULL;
+}
+
+/* The kept full character at pose k without posing full, when full is
+ * the one mlod_pose_set_keep kept there; else NULL. */
+static const mlod_surface *cache_owned(struct mlod_pose_cache *c, int k, const mlod_character *full)
+{
+	if (!c || k >= c->count)
+		return NULL;
 	pthread_mutex_lock(&c->lock);
-	mlod_surface *s = c->full[k];
+	int owned = c->owner[k] == full && c->full[k];
 	pthread_mutex_unlock(&c->lock);
-	if (!s) {
-		mlod_surface *made;
-		if (mlod_surface_make(a, &made, NULL) != MLOD_OK)
-			return NULL;
+	mlod_surface *s = NULL;
+	if (owned)
+		cache_keep(c, k, NULL, &s, NULL);
+	return s;
+}
+
+mlod_result mlod_pose_set_keep(const mlod_pose_set *s, const mlod_character *full, int k, mlod_error *err)
+{
+	if (!s || !full)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pose_set_keep: NULL argument");
+	if (k < 0 || k >= s->count || full->skeleton.joint_count != s->joint_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pose_set_keep: pose %d of %d, %d joints for %d", k, s->count,
+		                 full->skeleton.joint_count, s->joint_count);
+	struct mlod_pose_cache *c = s->cache;
+	if (!c)
+		return MLOD_OK;
+	mlod_posed a = {0};
+	mlod_result r = mlod_pose_character(full, s->world + (size_t)k * (size_t)s->joint_count, &a, err);
+	mlod_surface *kept = NULL;
+	if (r == MLOD_OK)
+		r = cache_keep(c, k, &a, &kept, err);
+	if (r == MLOD_OK && mlod_surface_is(kept, &a)) { /* else kept for another: mlod_posed_error measures its own */
 		pthread_mutex_lock(&c->lock);
-		if (k > 0 && c->full[0])
-			mlod_surface_like(made, c->full[0]); /* its hierarchy refitted from pose 0's */
-		if (!c->full[k])
-			c->full[k] = made, made = NULL;
-		s = c->full[k];
+		c->owner[k] = full;
 		pthread_mutex_unlock(&c->lock);
-		mlod_surface_free(made); /* another call kept its own first */
+		/* every call's first pose searches pose 0's; the bounded poses
+		 * (mlod_pose_set_bound_mean) nearly always some sample of each
+		 * other pose: refitted from pose 0's, when that one is kept */
+		if (k == 0 || c->bound_mean)
+			r = mlod_surface_build(kept, err);
 	}
-	return mlod_surface_is(s, a) ? s : NULL;
+	mlod_posed_free(&a);
+	return r;
 }
 
 mlod_result mlod_pose_set_make(const mlod_character *c, int bind, int per_clip, int random, uint64_t seed,
@@ -221,12 +298,15 @@ static mlod_result posed_one(void *ctx, int item)
 	int k = j->first + item;
 	const mlod_mat4 *world = j->poses->world + (size_t)k * (size_t)j->poses->joint_count;
 	mlod_posed a = {0}, b = {0};
-	mlod_result r;
-	if ((r = mlod_pose_character(j->full, world, &a, &j->errs[k])) == MLOD_OK &&
-	    (r = mlod_pose_character(j->level, world, &b, &j->errs[k])) == MLOD_OK) {
-		const mlod_surface *kept = cache_get(j->poses->cache, k, &a);
+	mlod_result r = MLOD_OK;
+	/* the full character kept by mlod_pose_set_keep needs no posing */
+	const mlod_surface *kept = cache_owned(j->poses->cache, k, j->full);
+	if (!kept && (r = mlod_pose_character(j->full, world, &a, &j->errs[k])) == MLOD_OK)
+		kept = cache_get(j->poses->cache, k, &a);
+	if (r == MLOD_OK && (r = mlod_pose_character(j->level, world, &b, &j->errs[k])) == MLOD_OK) {
 		if (kept && j->warm.record) { /* the first pose, alone: the warm starts' memory */
-			j->warm.a_count = a.vertex_count + a.triangle_count;
+			const mlod_posed *m = mlod_surface_mesh(kept);
+			j->warm.a_count = m->vertex_count + m->triangle_count;
 			j->warm.b_count = b.vertex_count + b.triangle_count;
 			j->warm.a = calloc((size_t)j->warm.a_count, sizeof *j->warm.a);
 			j->warm.b = calloc((size_t)j->warm.b_count, sizeof *j->warm.b);
@@ -244,56 +324,127 @@ static mlod_result posed_one(void *ctx, int item)
 	return r;
 }
 
+/* The levels of mlod_posed_errors, in one mlod_parallel_for: item i < count
+ * is the first pose of level i (recording the warm starts); then item
+ * count + i * per + p is pose p + 1 of level i, which waits until level
+ * i's first pose is done (items are handed out in order, so every first
+ * pose has started by then: no barrier between the two kinds, and no
+ * wait that a barrier would not have). */
+typedef struct posed_batch {
+	posed_job *jobs;
+	int count, per;
+	int bound;
+	unsigned char *done;   /* per level: its first pose measured */
+	pthread_mutex_t lock;
+	pthread_cond_t cond;
+} posed_batch;
+
+static mlod_result batch_item(void *ctx, int item)
+{
+	posed_batch *b = ctx;
+	if (item < b->count) {
+		posed_job *j = &b->jobs[item];
+		mlod_result r = posed_one(j, 0);
+		pthread_mutex_lock(&b->lock);
+		j->warm.record = 0, j->first = 1, j->warm.bound = b->bound;
+		b->done[item] = r == MLOD_OK ? 1 : 2;
+		pthread_cond_broadcast(&b->cond);
+		pthread_mutex_unlock(&b->lock);
+		return r;
+	}
+	item -= b->count;
+	int i = item / b->per;
+	pthread_mutex_lock(&b->lock);
+	while (!b->done[i])
+		pthread_cond_wait(&b->cond, &b->lock);
+	int ok = b->done[i] == 1;
+	pthread_mutex_unlock(&b->lock);
+	/* a level whose first pose failed reports that failure, not its others */
+	return ok ? posed_one(&b->jobs[i], item % b->per) : MLOD_OK;
+}
+
 mlod_result mlod_posed_error(const mlod_character *full, const mlod_character *level, const mlod_pose_set *poses,
                              mlod_deviation *out, mlod_error *err)
 {
-	if (!full || !level || !poses || !out)
+	return mlod_posed_errors(full, &level, 1, poses, out, err);
+}
+
+mlod_result mlod_posed_errors(const mlod_character *full, const mlod_character *const *levels, int count,
+                              const mlod_pose_set *poses, mlod_deviation *out, mlod_error *err)
+{
+	if (!full || (count > 0 && (!levels || !out)) || !poses)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_posed_error: NULL argument");
-	memset(out, 0, sizeof *out);
-	if (poses->joint_count != full->skeleton.joint_count || level->skeleton.joint_count != full->skeleton.joint_count)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_posed_error: poses of %d joints for %d and %d joints",
-		                 poses->joint_count, full->skeleton.joint_count, level->skeleton.joint_count);
+	for (int i = 0; i < count; i++)
+		if (!levels[i])
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_posed_error: NULL argument");
+	if (count <= 0)
+		return MLOD_OK;
+	memset(out, 0, sizeof *out * (size_t)count);
+	for (int i = 0; i < count; i++)
+		if (poses->joint_count != full->skeleton.joint_count || levels[i]->skeleton.joint_count != full->skeleton.joint_count)
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_posed_error: poses of %d joints for %d and %d joints",
+			                 poses->joint_count, full->skeleton.joint_count, levels[i]->skeleton.joint_count);
 	if (poses->count <= 0)
 		return MLOD_OK;
-	posed_job j = { full, level, poses, calloc((size_t)poses->count, sizeof *j.d),
-	                calloc((size_t)poses->count, sizeof *j.errs), { 0 }, 0 };
-	if (!j.d || !j.errs) {
-		free(j.d);
-		free(j.errs);
-		return mlod_fail(err, MLOD_ERR_NOMEM, "mlod_posed_error: out of memory for %d poses", poses->count);
+	const int P = poses->count;
+	posed_job *jobs = calloc((size_t)count, sizeof *jobs);
+	mlod_deviation *d = calloc((size_t)count * (size_t)P, sizeof *d);
+	mlod_error *errs = calloc((size_t)count * (size_t)P, sizeof *errs);
+	if (!jobs || !d || !errs) {
+		free(jobs);
+		free(d);
+		free(errs);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "mlod_posed_error: out of memory for %d poses of %d levels", P, count);
 	}
-	/* The first pose alone, recording each sample's nearest triangle; the
-	 * others, in parallel, start from those (only the search's speed
-	 * depends on them, never a result). Without the memory for them, all
-	 * poses are measured cold. */
-	j.warm.record = 1;
-	mlod_result r = posed_one(&j, 0);
-	j.warm.record = 0, j.first = 1;
-	j.warm.bound = poses->cache && poses->cache->bound_mean;
-	if (r == MLOD_OK)
-		r = mlod_parallel_for(poses->count - 1, poses->threads, posed_one, &j);
+	for (int i = 0; i < count; i++) {
+		posed_job *j = &jobs[i];
+		j->full = full, j->level = levels[i], j->poses = poses;
+		j->d = d + (size_t)i * (size_t)P, j->errs = errs + (size_t)i * (size_t)P;
+		j->warm.record = 1;
+	}
+	/* Each level's first pose, recording each sample's nearest triangle;
+	 * then the other poses of every level start from those (only the
+	 * search's speed depends on them, never a result). Without the memory
+	 * for them, a level's poses are measured cold. Every item writes only
+	 * its own level and pose: the work is spread over the levels and
+	 * poses, and the results do not depend on the thread count. */
+	posed_batch b = { jobs, count, P - 1, poses->cache && poses->cache->bound_mean, calloc((size_t)count, 1),
+	                  PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER };
+	mlod_result r;
+	if (!b.done)
+		r = mlod_fail(&errs[0], MLOD_ERR_NOMEM, "mlod_posed_error: out of memory for %d levels", count);
+	else
+		r = mlod_parallel_for(count * P, poses->threads, batch_item, &b);
+	free(b.done);
+	pthread_mutex_destroy(&b.lock);
+	pthread_cond_destroy(&b.cond);
 	if (r != MLOD_OK) {
-		for (int k = 0; k < poses->count; k++)
-			if (j.errs[k].code != MLOD_OK) {
+		/* the first failure, in level order then pose order, of the items run */
+		for (long k = 0; k < (long)count * P; k++)
+			if (errs[k].code != MLOD_OK) {
 				if (err)
-					*err = j.errs[k];
+					*err = errs[k];
 				break;
 			}
-	} else {
-		/* summed in pose order, so the thread count cannot change a bit */
-		double sum = 0.0;
-		for (int k = 0; k < poses->count; k++) {
-			sum += j.d[k].mean;
-			if (j.d[k].max > out->max)
-				out->max = j.d[k].max;
-			out->scale = j.d[k].scale;
+	} else
+		for (int i = 0; i < count; i++) {
+			/* summed in pose order, so the thread count cannot change a bit */
+			double sum = 0.0;
+			for (int k = 0; k < P; k++) {
+				sum += jobs[i].d[k].mean;
+				if (jobs[i].d[k].max > out[i].max)
+					out[i].max = jobs[i].d[k].max;
+				out[i].scale = jobs[i].d[k].scale;
+			}
+			out[i].mean = sum / P;
 		}
-		out->mean = sum / poses->count;
+	for (int i = 0; i < count; i++) {
+		free(jobs[i].warm.a);
+		free(jobs[i].warm.b);
+		mlod_warm_release(&jobs[i].warm);
 	}
-	free(j.d);
-	free(j.errs);
-	free(j.warm.a);
-	free(j.warm.b);
-	mlod_warm_release(&j.warm);
+	free(jobs);
+	free(d);
+	free(errs);
 	return r;
 }

@@ -22,6 +22,14 @@ void mlod_surface_free(mlod_surface *s);
  * triangles) nothing changes. */
 void mlod_surface_like(mlod_surface *s, mlod_surface *like);
 
+/* The mesh s holds (its copy of the one it was made from). */
+const mlod_posed *mlod_surface_mesh(const mlod_surface *s);
+
+/* Makes s's hierarchy now, if no search has (under its lock), as the
+ * first search would: refitted from its like's (mlod_surface_like) when
+ * that one is built by then, else built. */
+mlod_result mlod_surface_build(mlod_surface *s, mlod_error *err);
+
 /* 1 when s holds m: the same counts, positions and indices, byte for byte. */
 int mlod_surface_is(const mlod_surface *s, const mlod_posed *m);
 

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "meshlevels.h"
+#include "bgm.h" /* bgm_seconds */
 
 /* One primitive of one instance. */
 struct mlod_mesh_part {
@@ -127,6 +128,7 @@ typedef struct part_job {
 	int *part;
 	mlod_error *errs;
 	mlod_result *result;
+	int parts;
 } part_job;
 
 static void part_job_free(part_job *j)
@@ -152,6 +154,23 @@ static mlod_result part_one(void *ctx, int k)
 	}
 	/* an unsupported primitive is skipped, not an error of the whole */
 	j->result[k] = r;
+	return MLOD_OK;
+}
+
+/* Items [0, parts) are the primitives (part_one); the last one keeps the
+ * full character posed at every measuring pose, in pose order (so that
+ * every later pose's hierarchy is refitted from pose 0's), with
+ * mlod_pose_set_keep: work the levels' measure would do first, done while
+ * the primitives collapse. A pose that cannot be kept is not an error
+ * here: the measure then poses the character itself, and reports what is
+ * wrong. */
+static mlod_result part_or_poses(void *ctx, int k)
+{
+	part_job *j = ctx;
+	if (k < j->parts)
+		return part_one(ctx, k);
+	for (int p = 0; p < j->L->measure.count; p++)
+		mlod_pose_set_keep(&j->L->measure, j->L->c, p, NULL);
 	return MLOD_OK;
 }
 
@@ -191,7 +210,7 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 	for (int i = 0; i < c->instance_count; i++)
 		n += c->meshes[c->instances[i].mesh].primitive_count;
 	part_job j = { L, min_ratio, calloc(2 * (size_t)n + 1, sizeof *j.part), calloc((size_t)n + 1, sizeof *j.errs),
-	               calloc((size_t)n + 1, sizeof *j.result) };
+	               calloc((size_t)n + 1, sizeof *j.result), n };
 	if (!j.part || !j.errs || !j.result) {
 		part_job_free(&j);
 		return nomem(err);
@@ -214,8 +233,9 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 		}
 	}
 	/* Each primitive's BGM is built and simplified on its own: in
-	 * parallel, with the results gathered in primitive order. */
-	mlod_parallel_for(n, L->opt.threads, part_one, &j);
+	 * parallel, with the results gathered in primitive order; and the
+	 * full character kept posed at each measuring pose meanwhile. */
+	mlod_parallel_for(n + 1, L->opt.threads, part_or_poses, &j);
 	for (int k = 0; k < n; k++) {
 		int i = j.part[2 * k], p = j.part[2 * k + 1];
 		const mlod_instance *in = &c->instances[i];
@@ -318,8 +338,8 @@ static void free_level(const mlod_mesh_levels *L, mlod_mesh_level *lv)
 
 /* Extracts the level at ratio (with the primitive budget, per primitive
  * the shortest prefix within ratio of its triangles; with the character
- * budget, character_prefixes) and measures it. */
-static mlod_result make_level(mlod_mesh_levels *L, mlod_mesh_level *lv, double ratio, mlod_error *err)
+ * budget, character_prefixes), not yet measured. */
+static mlod_result extract_level(mlod_mesh_levels *L, mlod_mesh_level *lv, double ratio, mlod_error *err)
 {
 	const mlod_character *c = L->c;
 	mlod_result r = MLOD_OK;
@@ -385,11 +405,30 @@ static mlod_result make_level(mlod_mesh_levels *L, mlod_mesh_level *lv, double r
 			lv->view.instances[i] = c->instances[i];
 			lv->view.instances[i].mesh = i;
 		}
-		r = mlod_posed_error(c, &lv->view, &L->measure, &lv->error, err);
 	}
 	if (r != MLOD_OK)
 		free_level(L, lv);
 	return r;
+}
+
+/* Extracts the level at ratio and measures it. */
+static mlod_result make_level(mlod_mesh_levels *L, mlod_mesh_level *lv, double ratio, mlod_error *err)
+{
+	mlod_result r = extract_level(L, lv, ratio, err);
+	if (r != MLOD_OK)
+		return r;
+	double t0 = bgm_seconds();
+	if ((r = mlod_posed_error(L->c, &lv->view, &L->measure, &lv->error, err)) != MLOD_OK)
+		free_level(L, lv);
+	L->measure_seconds += bgm_seconds() - t0;
+	return r;
+}
+
+/* Frees the levels from first on (made by a call that fails). */
+static void drop_levels(mlod_mesh_levels *L, int first)
+{
+	while (L->count > first)
+		free_level(L, &L->levels[--L->count]);
 }
 
 void mlod_mesh_levels_free(mlod_mesh_levels *L)
@@ -410,11 +449,17 @@ void mlod_mesh_levels_free(mlod_mesh_levels *L)
 
 mlod_result mlod_mesh_levels_by_ratio(mlod_mesh_levels *L, const double *ratios, int n, mlod_error *err)
 {
+	/* The levels first (which are kept depends on their triangles only),
+	 * then all of them measured at once: their poses spread over the
+	 * threads, the same results as one level after another. */
+	const int first = L->count;
 	for (int k = 0; k < n && L->count < MLOD_MESH_MAX_LEVELS; k++) {
 		mlod_mesh_level lv;
-		mlod_result r = make_level(L, &lv, ratios[k], err);
-		if (r != MLOD_OK)
+		mlod_result r = extract_level(L, &lv, ratios[k], err);
+		if (r != MLOD_OK) {
+			drop_levels(L, first);
 			return r;
+		}
 		if (L->count > 0 && lv.triangles >= L->levels[L->count - 1].triangles) {
 			note(L, "ratio %g gives no fewer triangles than %g: dropped", ratios[k], L->levels[L->count - 1].ratio);
 			free_level(L, &lv);
@@ -427,6 +472,19 @@ mlod_result mlod_mesh_levels_by_ratio(mlod_mesh_levels *L, const double *ratios,
 		}
 		L->levels[L->count++] = lv;
 	}
+	const mlod_character *views[MLOD_MESH_MAX_LEVELS];
+	mlod_deviation dev[MLOD_MESH_MAX_LEVELS];
+	for (int k = first; k < L->count; k++)
+		views[k - first] = &L->levels[k].view;
+	double t0 = bgm_seconds();
+	mlod_result r = mlod_posed_errors(L->c, views, L->count - first, &L->measure, dev, err);
+	L->measure_seconds += bgm_seconds() - t0;
+	if (r != MLOD_OK) {
+		drop_levels(L, first);
+		return r;
+	}
+	for (int k = first; k < L->count; k++)
+		L->levels[k].error = dev[k - first];
 	return MLOD_OK;
 }
 

@@ -299,6 +299,7 @@ typedef struct mlod_mesh_levels {
 	int statics;             /* of them, on no joint and no skin */
 	int triangles, vertices; /* of the input */
 	double build_seconds;
+	double measure_seconds;  /* measuring the levels' posed error (wall clock, all levels) */
 	int count;
 	mlod_mesh_level levels[MLOD_MESH_MAX_LEVELS];
 	const mlod_mesh_skeleton *skeleton; /* followed skeleton levels (mlod_mesh_levels_follow) */

@@ -18,4 +18,5 @@ L.forEach((l, k) => {
   prev = l;
 });
 if (r.options.cost !== "posed" || r.options.eligibility !== "all") throw new Error("defaults");
+if (!(r.measure_ms > 0)) throw new Error("measure_ms: " + r.measure_ms);
 '

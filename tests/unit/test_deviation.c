@@ -424,6 +424,75 @@ TEST(posed_error_bound_mean)
 	mlod_character_free(&c);
 }
 
+/* mlod_posed_errors (mlod-bgm's levels, measured together over levels and
+ * poses) after mlod_pose_set_keep (the full character kept posed, here in
+ * reverse pose order, so that pose 0 comes last): the bits of one
+ * mlod_posed_error per level on a set where nothing was kept, bounded
+ * mean on, at one and two threads; another full character on the kept set
+ * gets its own measure, not the kept one's. */
+TEST(posed_errors_batch_kept)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	mlod_pose_set kept, fresh;
+	CHECK_OK(mlod_pose_set_make(&c, 1, 4, 8, 2008, 0.6981317f, &kept, &terr));
+	mlod_pose_set_bound_mean(&kept, 1);
+	mlod_bgm_options opt = {0};
+	mlod_bgm *g;
+	CHECK_OK(mlod_bgm_build(&c, 0, 0, &opt, &g, &terr));
+	mlod_bgm_info info;
+	mlod_bgm_get_info(g, &info);
+	CHECK_OK(mlod_bgm_simplify(g, info.triangles / 30, 0, &terr));
+	const int part[3] = { 2, 10, 30 };
+	mlod_primitive q[3];
+	mlod_mesh mesh[3] = { {0}, {0}, {0} };
+	mlod_character v[3];
+	const mlod_character *views[3];
+	mlod_deviation one[3];
+	for (int k = 0; k < 3; k++) {
+		CHECK_OK(mlod_bgm_extract(g, mlod_bgm_prefix_for(g, info.triangles / part[k]), 0, &q[k], &terr));
+		mesh[k].primitive_count = 1;
+		mesh[k].primitives = &q[k];
+		v[k] = view_of(&c, &mesh[k]);
+		views[k] = &v[k];
+		/* the reference: a set of its own each, nothing kept before */
+		CHECK_OK(mlod_pose_set_make(&c, 1, 4, 8, 2008, 0.6981317f, &fresh, &terr));
+		mlod_pose_set_bound_mean(&fresh, 1);
+		CHECK_OK(mlod_posed_error(&c, &v[k], &fresh, &one[k], &terr));
+		mlod_pose_set_free(&fresh);
+	}
+	for (int k = kept.count - 1; k >= 0; k--)
+		CHECK_OK(mlod_pose_set_keep(&kept, &c, k, &terr));
+	CHECK(mlod_pose_set_keep(&kept, &c, kept.count, &terr) == MLOD_ERR_INVALID_ARG);
+	for (int threads = 1; threads <= 2; threads++) {
+		mlod_deviation all[3];
+		kept.threads = threads;
+		CHECK_OK(mlod_posed_errors(&c, views, 3, &kept, all, &terr));
+		for (int k = 0; k < 3; k++)
+			CHECK_MSG(same_deviation(&all[k], &one[k]), "%d threads, level %d: %.17g/%.17g, alone %.17g/%.17g",
+			          threads, k, all[k].mean, all[k].max, one[k].mean, one[k].max);
+		CHECK(one[0].max < one[1].max && one[1].max < one[2].max);
+	}
+	/* another full character: the poses are kept for c, so it is measured
+	 * on its own, posed at each pose and exactly, as on a set made by hand */
+	mlod_deviation other, alone;
+	mlod_pose_set hand = { kept.count, kept.joint_count, kept.world, 1, NULL };
+	CHECK_OK(mlod_pose_set_keep(&kept, &v[0], 0, &terr));
+	CHECK_OK(mlod_posed_error(&v[0], &v[2], &kept, &other, &terr));
+	CHECK_OK(mlod_posed_error(&v[0], &v[2], &hand, &alone, &terr));
+	CHECK(same_deviation(&other, &alone) && other.max > 0.0);
+	views[1] = NULL;
+	CHECK(mlod_posed_errors(&c, views, 3, &kept, &other, &terr) == MLOD_ERR_INVALID_ARG);
+	CHECK_OK(mlod_posed_errors(&c, views, 0, &kept, NULL, &terr));
+	for (int k = 0; k < 3; k++) {
+		mlod_primitive_free(&q[k]);
+		free(v[k].instances);
+	}
+	mlod_bgm_free(g);
+	mlod_pose_set_free(&kept);
+	mlod_character_free(&c);
+}
+
 /* Warm starts (surface.h) change only where each search begins: recorded
  * at one placement and used at another, or filled with nonsense, or made
  * for meshes of other sizes, the result has the same bits as without. */
@@ -559,6 +628,7 @@ int main(void)
 	RUN(bad_input);
 	RUN(posed_error_kept_full);
 	RUN(posed_error_bound_mean);
+	RUN(posed_errors_batch_kept);
 	RUN(warm_starts_same_bits);
 	RUN(bounded_degenerate_same_bits);
 	TEST_EXIT();
