@@ -285,6 +285,7 @@ struct mlod_motion {
 	memo *memo;            /* the tree's distances and residuals */
 	memo *segmemo;         /* frames level under way: segments of lines within its bound */
 	eval_scratch scratch;  /* the large arrays of the key reduction and of refine_channels */
+	int threads;           /* of the key reduction (mlod_motion_set_threads) */
 };
 
 static void line_free(line *l)
@@ -324,6 +325,12 @@ void mlod_motion_free(mlod_motion *m)
 	free(m->segmemo);
 	free(m->scratch.p);
 	free(m);
+}
+
+void mlod_motion_set_threads(mlod_motion *m, int threads)
+{
+	if (m)
+		m->threads = threads < 1 ? 1 : threads;
 }
 
 const mlod_motion_timeline *mlod_motion_timeline_info(const mlod_motion *m)
@@ -1811,8 +1818,8 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	memcpy(kept, m->kept, size);
 	memset(clip, 0, sizeof *clip);
 	double e = -1.0;
-	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, &m->scratch, err) !=
-	    MLOD_OK)
+	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, &m->scratch,
+	                  m->threads, err) != MLOD_OK)
 		return -1.0;
 	if (clip_from_kept(m, kept, clip) != 0) {
 		mlod_clip_free(clip);
@@ -1824,8 +1831,11 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	return e >= 0.0 && m->clip_end_ok ? e : level_max_error(m, clip);
 }
 
-static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
-                              mlod_motion_level *out, mlod_error *err)
+/* The keys method's next level up to its rounding: the keys kept (out's
+ * clip, method and threshold; the rest zero), which the next level builds
+ * on; *known gets the clip's level_max_error. */
+static mlod_result keys_reduce(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
+                               double *known, mlod_error *err)
 {
 	const char *name = m->orig->name ? m->orig->name : "";
 	if (target == MLOD_MOTION_THRESHOLD)
@@ -1921,10 +1931,28 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 	out->clip = best_clip;
 	free(m->kept);
 	m->kept = best;
-	r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, best_error, err);
+	*known = best_error;
+	return MLOD_OK;
+}
+
+/* The keys level's rounding and measures (level_finish); m may be any
+ * motion of the clip with the same options (the rounding reads only the
+ * setup, not the keys method's state). Frees the level on a failure. */
+static mlod_result keys_finish(mlod_motion *m, mlod_motion_target target, double value, long max_bytes, double known,
+                               mlod_motion_level *l, mlod_error *err)
+{
+	mlod_result r = level_finish(m, l, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, known, err);
 	if (r != MLOD_OK)
-		mlod_motion_level_free(out);
+		mlod_motion_level_free(l);
 	return r;
+}
+
+static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
+                              mlod_motion_level *out, mlod_error *err)
+{
+	double known = -1.0;
+	mlod_result r = keys_reduce(m, target, value, out, &known, err);
+	return r != MLOD_OK ? r : keys_finish(m, target, value, max_bytes, known, out, err);
 }
 
 mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
@@ -1933,8 +1961,8 @@ mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, ml
 	return mlod_motion_next_level_under(m, method, target, value, -1, out, err);
 }
 
-mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
-                                         double value, long max_bytes, mlod_motion_level *out, mlod_error *err)
+static mlod_result level_args(const mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
+                              mlod_error *err)
 {
 	if (!m || !out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_next_level: NULL argument");
@@ -1943,6 +1971,34 @@ mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method meth
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad level value %g", value);
 	if ((unsigned)target > MLOD_MOTION_MAX_ERROR)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad level target %d", (int)target);
+	return MLOD_OK;
+}
+
+mlod_result mlod_motion_keys_reduce(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
+                                    double *known, mlod_error *err)
+{
+	mlod_result r = level_args(m, target, value, out, err);
+	if (r == MLOD_OK && !known)
+		r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_keys_reduce: NULL argument");
+	return r != MLOD_OK ? r : keys_reduce(m, target, value, out, known, err);
+}
+
+mlod_result mlod_motion_keys_finish(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
+                                    double known, mlod_motion_level *l, mlod_error *err)
+{
+	if (!m || !l || l->method != MLOD_MOTION_KEYS)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_keys_finish: bad arguments");
+	if (l->clip.channel_count != m->common.channel_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_keys_finish: the level is not of this clip");
+	return keys_finish(m, target, value, max_bytes, known, l, err);
+}
+
+mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
+                                         double value, long max_bytes, mlod_motion_level *out, mlod_error *err)
+{
+	mlod_result r = level_args(m, target, value, out, err);
+	if (r != MLOD_OK)
+		return r;
 	switch (method) {
 	case MLOD_MOTION_FRAMES: return frames_level(m, target, value, max_bytes, out, err);
 	case MLOD_MOTION_KEYS: return keys_level(m, target, value, max_bytes, out, err);

@@ -437,9 +437,10 @@ static inline void *eval_carve(char **at, size_t n)
  * and *max_error (if not NULL) the largest point error of the result as
  * motion.c's level_max_error measures its level clip, or -1 when not
  * measured (a NaN, or samples past the clip's duration); its large arrays
- * in *scratch (NULL: its own, freed on return). */
+ * in *scratch (NULL: its own, freed on return); on up to threads threads
+ * (the same result at any count). */
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
-                          double *max_error, eval_scratch *scratch, mlod_error *err);
+                          double *max_error, eval_scratch *scratch, int threads, mlod_error *err);
 
 #endif /* MLOD_MOTION_EVAL_H */
