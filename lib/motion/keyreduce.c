@@ -43,7 +43,6 @@
  * shared buffers, in the check's own joints' columns.
  */
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -91,11 +90,6 @@ typedef struct reducer {
 	double bound;
 	int tasks, C;
 	unsigned char *related;  /* C * C: the channels' joints are one below the other (or the same) */
-	unsigned char *state;    /* per task: 0 waiting, 1 running, 2 done */
-	int first_open;          /* every task before it is done */
-	int next_lane;
-	pthread_mutex_t lock;
-	pthread_cond_t changed;
 } reducer;
 
 static int comps_of(const mlod_channel *ch)
@@ -306,49 +300,16 @@ static void run_task(reducer *R, lane *L, int t)
 		collapse_channel(R, L, c, R->bound);
 }
 
-/* May task t start: is every earlier task of a related channel done?
- * Under the lock. */
-static int task_ready(const reducer *R, int t)
-{
-	const unsigned char *rel = R->related + (size_t)(t % R->C) * (size_t)R->C;
-	for (int u = R->first_open; u < t; u++)
-		if (R->state[u] != 2 && rel[u % R->C])
-			return 0;
-	return 1;
-}
-
-/* A thread of the sweeps (lane i): takes the first task that may start,
- * until none is left to start. */
-static mlod_result lane_item(void *ctx, int i)
+static void task_item(void *ctx, int lane, int t)
 {
 	reducer *R = ctx;
-	lane *L = &R->lane[i];
-	pthread_mutex_lock(&R->lock);
-	for (;;) {
-		while (R->first_open < R->tasks && R->state[R->first_open] == 2)
-			R->first_open++;
-		int t = -1, waiting = 0;
-		for (int u = R->first_open; u < R->tasks && t < 0; u++)
-			if (R->state[u] == 0) {
-				waiting = 1;
-				if (task_ready(R, u))
-					t = u;
-			}
-		if (!waiting)
-			break;
-		if (t < 0) {
-			pthread_cond_wait(&R->changed, &R->lock);
-			continue;
-		}
-		R->state[t] = 1;
-		pthread_mutex_unlock(&R->lock);
-		run_task(R, L, t);
-		pthread_mutex_lock(&R->lock);
-		R->state[t] = 2;
-		pthread_cond_broadcast(&R->changed);
-	}
-	pthread_mutex_unlock(&R->lock);
-	return MLOD_OK;
+	run_task(R, &R->lane[lane], t);
+}
+
+static int task_conflict(void *ctx, int u, int t)
+{
+	const reducer *R = ctx;
+	return R->related[(size_t)(u % R->C) * (size_t)R->C + (size_t)(t % R->C)];
 }
 
 /* The sweeps: every task in order, or on threads lanes (the same result). */
@@ -359,30 +320,14 @@ static mlod_result run_tasks(reducer *R)
 			run_task(R, &R->lane[0], t);
 		return MLOD_OK;
 	}
-	const mlod_skeleton *s = R->s;
 	R->related = malloc((size_t)R->C * (size_t)R->C);
-	R->state = calloc((size_t)R->tasks, 1);
-	if (!R->related || !R->state)
+	if (!R->related)
 		return MLOD_ERR_NOMEM;
 	for (int a = 0; a < R->C; a++)
-		for (int b = 0; b < R->C; b++) {
-			int ja = R->common->channels[a].joint, jb = R->common->channels[b].joint, rel = 0;
-			for (int x = jb; x >= 0 && !rel; x = s->joints[x].parent)
-				rel = x == ja;
-			for (int x = ja; x >= 0 && !rel; x = s->joints[x].parent)
-				rel = x == jb;
-			R->related[(size_t)a * (size_t)R->C + (size_t)b] = (unsigned char)rel;
-		}
-	if (pthread_mutex_init(&R->lock, NULL) != 0)
-		return MLOD_ERR_NOMEM;
-	if (pthread_cond_init(&R->changed, NULL) != 0) {
-		pthread_mutex_destroy(&R->lock);
-		return MLOD_ERR_NOMEM;
-	}
-	mlod_parallel_for(R->lanes, R->lanes, lane_item, R);
-	pthread_cond_destroy(&R->changed);
-	pthread_mutex_destroy(&R->lock);
-	return MLOD_OK;
+		for (int b = 0; b < R->C; b++)
+			R->related[(size_t)a * (size_t)R->C + (size_t)b] = (unsigned char)eval_joints_related(
+				R->s, R->common->channels[a].joint, R->common->channels[b].joint);
+	return motion_run_tasks(R->tasks, R->lanes, task_conflict, task_item, R);
 }
 
 static void reducer_free(reducer *R)
@@ -394,7 +339,6 @@ static void reducer_free(reducer *R)
 	if (R->own_w0)
 		free(R->w0);
 	free(R->related);
-	free(R->state);
 	free(R->own.p); /* lc to the lanes': in the scratch */
 }
 

@@ -171,6 +171,7 @@ static void finish_item(build_ctx *b, int k)
 			made = 0;
 		else
 			b->info[base + (size_t)i] = *mlod_motion_timeline_info(m[i]);
+		mlod_motion_set_threads(m[i], b->threads);
 	}
 	/* The motion the keys levels are rounded on: a copy of another
 	 * method's when there is one. */
@@ -179,6 +180,7 @@ static void finish_item(build_ctx *b, int k)
 		b->fin_result[k] = first ? mlod_motion_create_like(first, &fin, &b->fin_error[k])
 		                         : mlod_motion_create(b->c, b->clips[k], b->opt, &fin, &b->fin_error[k]);
 		made = b->fin_result[k] == MLOD_OK;
+		mlod_motion_set_threads(fin, b->threads);
 	}
 	int frames = made ? mlod_motion_timeline_info(fin)->frames : 0;
 	for (int s = 0; s < b->spec_count && frames >= 3; s++) {

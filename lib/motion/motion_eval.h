@@ -443,4 +443,27 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
                           double *max_error, eval_scratch *scratch, int threads, mlod_error *err);
 
+/* Tasks 0..n-1 of a sequence on up to lanes threads (tasks.c): run(ctx,
+ * lane, t) runs task t with lane's own buffers (lane < lanes; one task at
+ * a time per lane); task t starts once every earlier task u with
+ * conflict(ctx, u, t) has finished, so the result is that of the tasks in
+ * order when tasks that do not conflict touch disjoint data. conflict is
+ * called under a lock and should be cheap. MLOD_ERR_NOMEM when it could
+ * not start (nothing run). */
+typedef int (*motion_conflict_fn)(void *ctx, int u, int t);
+/* Is joint a joint b, one of its ancestors or one of its descendants?
+ * (Two channels of joints that are not touch disjoint world matrices.) */
+static inline int eval_joints_related(const mlod_skeleton *s, int a, int b)
+{
+	for (int x = b; x >= 0; x = s->joints[x].parent)
+		if (x == a)
+			return 1;
+	for (int x = a; x >= 0; x = s->joints[x].parent)
+		if (x == b)
+			return 1;
+	return 0;
+}
+typedef void (*motion_task_fn)(void *ctx, int lane, int t);
+mlod_result motion_run_tasks(int n, int lanes, motion_conflict_fn conflict, motion_task_fn run, void *ctx);
+
 #endif /* MLOD_MOTION_EVAL_H */

@@ -1191,8 +1191,8 @@ TEST(keys_split_same_as_next_level)
 	/* mlod_motion_keys_reduce, then mlod_motion_keys_finish on another
 	 * motion of the clip (made by mlod_motion_create_like, as the threaded
 	 * builder does): the levels of mlod_motion_next_level; and the choice
-	 * of keys on 1, 2, 3 and 8 threads (mlod_motion_set_threads) gives the
-	 * same levels. Walk (rotations below a translated root) and the robot
+	 * of keys and the rounding's per-channel refinement on 1, 2, 3 and 8
+	 * threads (mlod_motion_set_threads) give the same levels. Walk (rotations below a translated root) and the robot
 	 * (translations and scales on several joints). */
 	const char *files[2] = { "samples/cmu_12_01_walk.bvh", "samples/RobotExpressive.glb" };
 	for (int file = 0; file < 2; file++) {
@@ -1214,6 +1214,7 @@ TEST(keys_split_same_as_next_level)
 			CHECK_OK(mlod_motion_create(&c, clip, NULL, &m, &terr));
 			CHECK_OK(mlod_motion_create_like(m, &fin, &terr));
 			mlod_motion_set_threads(m, counts[t]);
+			mlod_motion_set_threads(fin, counts[t]);
 			for (int s = 0; s < 2; s++) {
 				mlod_motion_level l;
 				double known = -2.0, bound = (s ? 0.02 : 0.004) * h;
