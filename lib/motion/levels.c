@@ -50,6 +50,11 @@ typedef struct build_ctx {
 	pthread_mutex_t lock;
 	pthread_cond_t more;
 	int *published;              /* [clip] */
+	/* The keys item's motion, once made (or not: its create_result), for
+	 * the finisher to copy; the finisher frees it once the keys item has
+	 * published every level. */
+	mlod_motion **kmotion;       /* [clip] */
+	int *made;                   /* [clip] */
 } build_ctx;
 
 #define NOT_BUILT ((mlod_result)-1)
@@ -110,6 +115,25 @@ static void publish(build_ctx *b, int k, int s)
 	pthread_mutex_unlock(&b->lock);
 }
 
+static void set_made(build_ctx *b, int k, mlod_motion *m)
+{
+	pthread_mutex_lock(&b->lock);
+	b->kmotion[k] = m;
+	b->made[k] = 1;
+	pthread_cond_broadcast(&b->more);
+	pthread_mutex_unlock(&b->lock);
+}
+
+static mlod_motion *wait_made(build_ctx *b, int k)
+{
+	pthread_mutex_lock(&b->lock);
+	while (!b->made[k])
+		pthread_cond_wait(&b->more, &b->lock);
+	mlod_motion *m = b->kmotion[k];
+	pthread_mutex_unlock(&b->lock);
+	return m;
+}
+
 static void wait_keys(build_ctx *b, int k, int s)
 {
 	pthread_mutex_lock(&b->lock);
@@ -135,6 +159,9 @@ static void keys_item(build_ctx *b, int k)
 	if (b->create_result[ci] == MLOD_OK) {
 		b->info[ci] = *mlod_motion_timeline_info(m);
 		mlod_motion_set_threads(m, b->threads);
+	}
+	set_made(b, k, m);
+	if (b->create_result[ci] == MLOD_OK) {
 		for (int s = 0; s < b->spec_count && b->info[ci].frames >= 3; s++) {
 			if (!skipped(MLOD_MOTION_KEYS, b->specs[s].target)) {
 				size_t at = chain_at(b, k, i, s);
@@ -148,8 +175,7 @@ static void keys_item(build_ctx *b, int k)
 			publish(b, k, s + 1);
 		}
 	}
-	publish(b, k, b->spec_count); /* the rest will not come */
-	mlod_motion_free(m);
+	publish(b, k, b->spec_count); /* the rest will not come; m is the finisher's to free */
 }
 
 /* The second way, item 2k + 1: clip k's levels in the order
@@ -161,24 +187,31 @@ static void finish_item(build_ctx *b, int k)
 	int n = b->method_count;
 	mlod_motion *m[2] = { NULL, NULL }, *fin = NULL;
 	size_t base = (size_t)k * (size_t)n;
-	int made = 1;
-	for (int i = 0; i < n && made; i++) {
+	/* The other method's motion and the one the keys levels are rounded
+	 * on: copies of the keys item's (mlod_motion_create_like reads only
+	 * its setup, which the keys method does not change); when that could
+	 * not be made, the other method fails as it would have. */
+	mlod_motion *keys = wait_made(b, k);
+	size_t ki = base + (size_t)b->keys;
+	int made = keys != NULL;
+	for (int i = 0; i < n; i++) {
 		if (i == b->keys)
 			continue;
-		b->create_result[base + (size_t)i] =
-			mlod_motion_create(b->c, b->clips[k], b->opt, &m[i], &b->create_error[base + (size_t)i]);
-		if (b->create_result[base + (size_t)i] != MLOD_OK)
+		size_t ci = base + (size_t)i;
+		if (!keys) {
+			b->create_result[ci] = b->create_result[ki];
+			b->create_error[ci] = b->create_error[ki];
+			continue;
+		}
+		b->create_result[ci] = mlod_motion_create_like(keys, &m[i], &b->create_error[ci]);
+		if (b->create_result[ci] != MLOD_OK)
 			made = 0;
 		else
-			b->info[base + (size_t)i] = *mlod_motion_timeline_info(m[i]);
+			b->info[ci] = *mlod_motion_timeline_info(m[i]);
 		mlod_motion_set_threads(m[i], b->threads);
 	}
-	/* The motion the keys levels are rounded on: a copy of another
-	 * method's when there is one. */
-	mlod_motion *first = m[b->keys == 0 && n == 2 ? 1 : 0];
 	if (made) {
-		b->fin_result[k] = first ? mlod_motion_create_like(first, &fin, &b->fin_error[k])
-		                         : mlod_motion_create(b->c, b->clips[k], b->opt, &fin, &b->fin_error[k]);
+		b->fin_result[k] = mlod_motion_create_like(keys, &fin, &b->fin_error[k]);
 		made = b->fin_result[k] == MLOD_OK;
 		mlod_motion_set_threads(fin, b->threads);
 	}
@@ -219,6 +252,8 @@ static void finish_item(build_ctx *b, int k)
 	for (int i = 0; i < n; i++)
 		mlod_motion_free(m[i]);
 	mlod_motion_free(fin);
+	wait_keys(b, k, b->spec_count - 1); /* the keys item is done with its motion */
+	mlod_motion_free(keys);
 }
 
 static mlod_result split_item(void *ctx, int item)
@@ -356,9 +391,11 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 	b.create_error = calloc(chains, sizeof *b.create_error);
 	b.info = calloc(chains, sizeof *b.info);
 	b.published = calloc((size_t)clip_count, sizeof *b.published);
+	b.kmotion = calloc((size_t)clip_count, sizeof *b.kmotion);
+	b.made = calloc((size_t)clip_count, sizeof *b.made);
 	mlod_result r = MLOD_OK;
 	int sync = 0;
-	if (b.published && pthread_mutex_init(&b.lock, NULL) == 0) {
+	if (b.published && b.kmotion && b.made && pthread_mutex_init(&b.lock, NULL) == 0) {
 		if (pthread_cond_init(&b.more, NULL) == 0)
 			sync = 1;
 		else
@@ -385,6 +422,8 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 	free(b.create_error);
 	free(b.info);
 	free(b.published);
+	free(b.kmotion);
+	free(b.made);
 	if (sync) {
 		pthread_cond_destroy(&b.more);
 		pthread_mutex_destroy(&b.lock);
