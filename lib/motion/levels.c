@@ -10,13 +10,15 @@
  *   choice of keys, level after level (mlod_motion_keys_reduce: a level's
  *   keys depend only on the previous level's keys), and a finisher that
  *   takes each level's keys as they come, rounds and measures them
- *   (mlod_motion_keys_finish, on a motion of its own) and builds the
- *   other method's level as mlod_motion_next_level_best does, with the
- *   keys level's bytes as its limit; the levels are then chosen as
- *   mlod_motion_next_level_best chooses. So level k's rounding and the
- *   frames method's level k overlap level k + 1's choice of keys. Items
- *   are handed out in index order and a clip's keys item comes first, so
- *   the one the finisher waits for has always started.
+ *   (mlod_motion_keys_finish, on a copy of the keys item's motion) and
+ *   builds the other method's level as mlod_motion_next_level_best does,
+ *   with the keys level's bytes as its limit; the levels are then chosen
+ *   as mlod_motion_next_level_best chooses. So level k's rounding and the
+ *   frames method's level k overlap level k + 1's choice of keys. The
+ *   choice of keys and the rounding's refinement also run on `threads`
+ *   threads each (mlod_motion_set_threads; tasks.c). Items are handed out
+ *   in index order and a clip's keys item comes first, so the one the
+ *   finisher waits for has always started.
  */
 #include <pthread.h>
 #include <stdlib.h>

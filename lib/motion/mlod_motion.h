@@ -266,9 +266,11 @@ typedef struct mlod_motion_clip_levels {
 /* The levels of clips[0..clip_count) of c, out[k] for clips[k]: for each
  * clip, mlod_motion_create with opt for each of the method_count (1 or 2)
  * methods, then for each spec in order the level
- * mlod_motion_next_level_best makes. Clips, and the methods of a clip,
- * run on up to `threads` threads; the levels do not depend on the
- * thread count. Returns MLOD_OK (each clip's outcome is in out[k]) or
+ * mlod_motion_next_level_best makes. Clips run on up to `threads`
+ * threads; with fewer clips than threads, a clip's keys method chooses
+ * its keys on threads of its own while another thread rounds and
+ * measures them and builds the other method's levels (levels.c); the
+ * levels do not depend on the thread count. Returns MLOD_OK (each clip's outcome is in out[k]) or
  * MLOD_ERR_NOMEM / MLOD_ERR_INVALID_ARG. Release out with
  * mlod_motion_clip_levels_free (levels taken over by the caller are to be
  * zeroed, or their results set to other than MLOD_OK). */
