@@ -30,6 +30,17 @@
  * samples). Last, a channel whose last value equals its first and that
  * fits that constant collapses to one key; the first and last frames of
  * every channel are thus kept exactly.
+ *
+ * Threads: a channel's reduction reads and writes only its joint's local
+ * transforms and the world matrices of its joint's subtree (and the
+ * parent's world matrices, which it only reads). Two channels whose
+ * joints are not one below the other touch disjoint parts, so their
+ * reductions commute. The sweeps' sequence of tasks (a channel at a
+ * round) then runs on several threads, each task once every earlier task
+ * of a joint above, below or the same has finished: the result is the
+ * sequence's, bit for bit, at any thread count. Each thread has its own
+ * check buffers (a lane); the subtree's world matrices of a check go to
+ * shared buffers, in the check's own joints' columns.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -40,6 +51,19 @@
 
 #define MAX_FRAME_JOINTS 1000000L /* frames * joints the caches may hold */
 #define ROUNDS 4
+#define MAX_LANES 8              /* threads of one key reduction */
+
+/* What a thread's checks need of their own. */
+typedef struct lane {
+	mlod_trs *lb[2];         /* S: the channel's joint's local transform in a check */
+	mlod_mat4 *lmb[2];       /* S: its matrix */
+	int good;                /* which buffers hold the last check that fitted */
+	const mlod_channel *good_ch; /* and of what: channel, samples */
+	int good_lo, good_hi;
+	unsigned *stamp;         /* S: the check that took the sample first */
+	unsigned stamp_now;
+	int *K;                  /* F: a channel's kept frames */
+} lane;
 
 typedef struct reducer {
 	const mlod_skeleton *s;
@@ -55,16 +79,17 @@ typedef struct reducer {
 	mlod_trs *lc;            /* S * J: current local transforms */
 	mlod_mat4 *lm;           /* S * J: their matrices */
 	mlod_mat4 *wc;           /* S * J: current world matrices */
-	mlod_mat4 *wb[2];        /* S * J: world matrices of a check (the subtree's) */
-	mlod_trs *lb[2];         /* S: the channel's joint's local transform in a check */
-	mlod_mat4 *lmb[2];       /* S: its matrix */
-	int good;                /* which buffers hold the last check that fitted */
-	const mlod_channel *good_ch; /* and of what: channel, samples */
-	int good_lo, good_hi;
+	mlod_mat4 *wb[2];        /* S * J: world matrices of a check (the subtree's; a lane's good
+	                            buffer is its own lane's good index) */
 	unsigned char *kept;
-	unsigned *stamp;         /* S: the check that took the sample first */
-	unsigned stamp_now;
-	eval_scratch own;        /* the arrays above (lc to stamp) when no scratch is given */
+	int lanes;
+	lane lane[MAX_LANES];
+	eval_scratch own;        /* the arrays above (lc to the lanes') when no scratch is given */
+	/* The tasks on threads: task t is channel t % C at round t / C + 1
+	 * (ROUNDS + 1: the collapse). */
+	double bound;
+	int tasks, C;
+	unsigned char *related;  /* C * C: the channels' joints are one below the other (or the same) */
 } reducer;
 
 static int comps_of(const mlod_channel *ch)
@@ -94,11 +119,11 @@ static int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *
 
 /* The channel's value at sample f and the subtree's world matrices with
  * it, into the spare buffers; is every joint within budget? */
-static int sample_check(reducer *R, const mlod_channel *ch, const float *va, const float *vb, float t0, float dt,
-                        eval_seg *seg, int constant, int f, double budget)
+static int sample_check(reducer *R, lane *L, const mlod_channel *ch, const float *va, const float *vb, float t0,
+                        float dt, eval_seg *seg, int constant, int f, double budget)
 {
 	const mlod_skeleton *s = R->s;
-	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch), spare = 1 - R->good;
+	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch), spare = 1 - L->good;
 	const int *sub = R->sub + R->sub_start[j];
 	int nsub = R->sub_start[j + 1] - R->sub_start[j];
 	float v[4];
@@ -117,8 +142,8 @@ static int sample_check(reducer *R, const mlod_channel *ch, const float *va, con
 		}
 	}
 	size_t base = (size_t)f * (size_t)R->J;
-	mlod_trs *l = &R->lb[spare][f];
-	mlod_mat4 *lm = &R->lmb[spare][f], *w = R->wb[spare] + base;
+	mlod_trs *l = &L->lb[spare][f];
+	mlod_mat4 *lm = &L->lmb[spare][f], *w = R->wb[spare] + base;
 	*l = R->lc[base + (size_t)j];
 	set_path(l, ch->path, v);
 	*lm = eval_from_trs(l);
@@ -144,60 +169,61 @@ static int sample_check(reducer *R, const mlod_channel *ch, const float *va, con
  * the same in any order. When every sample fits, the results become the
  * good buffers, which sweep_commit applies. */
 #define SWEEP_STRIDE 8
-static int sweep_check(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant, double budget,
-                       const int *gone, int ngone)
+static int sweep_check(reducer *R, lane *L, const mlod_channel *ch, int a, int b, int lo, int hi, int constant,
+                       double budget, const int *gone, int ngone)
 {
 	int comps = comps_of(ch);
 	eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
 	const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
 	const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
 	int stride = hi - lo + 1 >= 4 * SWEEP_STRIDE ? SWEEP_STRIDE : 1;
-	unsigned id = ++R->stamp_now;
+	unsigned id = ++L->stamp_now, *stamp = L->stamp;
 	if (id == 0) { /* wrapped: start the stamps again */
-		memset(R->stamp, 0, sizeof(unsigned) * (size_t)R->S);
-		id = R->stamp_now = 1;
+		memset(stamp, 0, sizeof(unsigned) * (size_t)R->S);
+		id = L->stamp_now = 1;
 	}
 	for (int k = ngone - 1; k >= 0; k--) {
 		int f = gone[k] * R->per;
-		R->stamp[f] = id;
-		if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+		stamp[f] = id;
+		if (!sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
 			return 0;
 	}
 	for (int f = lo; f <= hi && stride > 1; f += stride)
-		if (R->stamp[f] != id) {
-			R->stamp[f] = id;
-			if (!sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+		if (stamp[f] != id) {
+			stamp[f] = id;
+			if (!sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
 				return 0;
 		}
 	for (int f = lo; f <= hi; f++) /* the rest in order (memory order) */
-		if (R->stamp[f] != id && !sample_check(R, ch, va, vb, t0, dt, &seg, constant, f, budget))
+		if (stamp[f] != id && !sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
 			return 0;
-	R->good = 1 - R->good;
-	R->good_ch = ch, R->good_lo = lo, R->good_hi = hi;
+	L->good = 1 - L->good;
+	L->good_ch = ch, L->good_lo = lo, L->good_hi = hi;
 	return 1;
 }
 
 /* Applies the last check that fitted (channel ch at samples lo..hi). */
-static void sweep_commit(reducer *R, const mlod_channel *ch, int a, int b, int lo, int hi, int constant)
+static void sweep_commit(reducer *R, lane *L, const mlod_channel *ch, int a, int b, int lo, int hi, int constant)
 {
-	if (R->good_ch != ch || R->good_lo != lo || R->good_hi != hi)
-		sweep_check(R, ch, a, b, lo, hi, constant, HUGE_VAL, NULL, 0); /* not reached: the last fit is the one applied */
-	int j = ch->joint, g = R->good;
+	if (L->good_ch != ch || L->good_lo != lo || L->good_hi != hi)
+		sweep_check(R, L, ch, a, b, lo, hi, constant, HUGE_VAL, NULL, 0); /* not reached: the last fit is the one applied */
+	int j = ch->joint, g = L->good;
 	const int *sub = R->sub + R->sub_start[j];
 	int nsub = R->sub_start[j + 1] - R->sub_start[j];
 	for (int f = lo; f <= hi; f++) {
 		size_t base = (size_t)f * (size_t)R->J;
-		R->lc[base + (size_t)j] = R->lb[g][f];
-		R->lm[base + (size_t)j] = R->lmb[g][f];
+		R->lc[base + (size_t)j] = L->lb[g][f];
+		R->lm[base + (size_t)j] = L->lmb[g][f];
 		for (int k = 0; k < nsub; k++)
 			R->wc[base + (size_t)sub[k]] = R->wb[g][base + (size_t)sub[k]];
 	}
-	R->good_ch = NULL;
+	L->good_ch = NULL;
 }
 
 /* Removes what keys it can from one channel at one budget. */
-static void reduce_channel(reducer *R, int c, double budget, int *K)
+static void reduce_channel(reducer *R, lane *L, int c, double budget)
 {
+	int *K = L->K;
 	const mlod_channel *ch = &R->common->channels[c];
 	unsigned char *row = R->kept + (size_t)c * (size_t)R->F;
 	int nk = 0;
@@ -208,7 +234,7 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 	for (int i = 0; i + 2 < nk + 0 && i < nk - 1;) {
 		int ok = i + 1, fail = nk, step = 1, probe = i + 2;
 		while (probe < nk) {
-			if (sweep_check(R, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget, K + i + 1, probe - i - 1)) {
+			if (sweep_check(R, L, ch, K[i], K[probe], K[i] * q + 1, K[probe] * q - 1, 0, budget, K + i + 1, probe - i - 1)) {
 				ok = probe;
 				step *= 2;
 				probe = i + 1 + step;
@@ -218,20 +244,20 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 			}
 		}
 		if (fail == nk && ok < nk - 1) {
-			if (sweep_check(R, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget, K + i + 1, nk - 2 - i))
+			if (sweep_check(R, L, ch, K[i], K[nk - 1], K[i] * q + 1, K[nk - 1] * q - 1, 0, budget, K + i + 1, nk - 2 - i))
 				ok = nk - 1;
 			else
 				fail = nk - 1;
 		}
 		while (fail - ok > 1) {
 			int mid = ok + (fail - ok) / 2;
-			if (sweep_check(R, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget, K + i + 1, mid - i - 1))
+			if (sweep_check(R, L, ch, K[i], K[mid], K[i] * q + 1, K[mid] * q - 1, 0, budget, K + i + 1, mid - i - 1))
 				ok = mid;
 			else
 				fail = mid;
 		}
 		if (ok > i + 1) {
-			sweep_commit(R, ch, K[i], K[ok], K[i] * q + 1, K[ok] * q - 1, 0);
+			sweep_commit(R, L, ch, K[i], K[ok], K[i] * q + 1, K[ok] * q - 1, 0);
 			for (int k = i + 1; k < ok; k++)
 				row[K[k]] = 0;
 		}
@@ -240,7 +266,7 @@ static void reduce_channel(reducer *R, int c, double budget, int *K)
 }
 
 /* Collapses a channel to its first key when that constant fits. */
-static void collapse_channel(reducer *R, int c, double budget)
+static void collapse_channel(reducer *R, lane *L, int c, double budget)
 {
 	const mlod_channel *ch = &R->common->channels[c];
 	unsigned char *row = R->kept + (size_t)c * (size_t)R->F;
@@ -258,10 +284,50 @@ static void collapse_channel(reducer *R, int c, double budget)
 	int comps = comps_of(ch);
 	if (memcmp(ch->values, ch->values + (size_t)(R->F - 1) * (size_t)comps, sizeof(float) * (size_t)comps) != 0)
 		return;
-	if (!sweep_check(R, ch, 0, 0, 1, R->S - 1, 1, budget, NULL, 0))
+	if (!sweep_check(R, L, ch, 0, 0, 1, R->S - 1, 1, budget, NULL, 0))
 		return;
-	sweep_commit(R, ch, 0, 0, 1, R->S - 1, 1);
+	sweep_commit(R, L, ch, 0, 0, 1, R->S - 1, 1);
 	memset(row + 1, 0, (size_t)R->F - 1);
+}
+
+/* Task t of the sweeps (reducer.tasks). */
+static void run_task(reducer *R, lane *L, int t)
+{
+	int c = t % R->C, round = t / R->C + 1;
+	if (round <= ROUNDS)
+		reduce_channel(R, L, c, R->bound * round / ROUNDS);
+	else
+		collapse_channel(R, L, c, R->bound);
+}
+
+static void task_item(void *ctx, int lane, int t)
+{
+	reducer *R = ctx;
+	run_task(R, &R->lane[lane], t);
+}
+
+static int task_conflict(void *ctx, int u, int t)
+{
+	const reducer *R = ctx;
+	return R->related[(size_t)(u % R->C) * (size_t)R->C + (size_t)(t % R->C)];
+}
+
+/* The sweeps: every task in order, or on threads lanes (the same result). */
+static mlod_result run_tasks(reducer *R)
+{
+	if (R->lanes <= 1) {
+		for (int t = 0; t < R->tasks; t++)
+			run_task(R, &R->lane[0], t);
+		return MLOD_OK;
+	}
+	R->related = malloc((size_t)R->C * (size_t)R->C);
+	if (!R->related)
+		return MLOD_ERR_NOMEM;
+	for (int a = 0; a < R->C; a++)
+		for (int b = 0; b < R->C; b++)
+			R->related[(size_t)a * (size_t)R->C + (size_t)b] = (unsigned char)eval_joints_related(
+				R->s, R->common->channels[a].joint, R->common->channels[b].joint);
+	return motion_run_tasks(R->tasks, R->lanes, task_conflict, task_item, R);
 }
 
 static void reducer_free(reducer *R)
@@ -272,7 +338,8 @@ static void reducer_free(reducer *R)
 	free(R->sub);
 	if (R->own_w0)
 		free(R->w0);
-	free(R->own.p); /* lc to stamp: in the scratch */
+	free(R->related);
+	free(R->own.p); /* lc to the lanes': in the scratch */
 }
 
 static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
@@ -317,12 +384,12 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                            double point_distance, int subdivide, unsigned char *kept, mlod_error *err)
 {
-	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, NULL, err);
+	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, NULL, 1, err);
 }
 
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
-                          double *max_error, eval_scratch *scratch, mlod_error *err)
+                          double *max_error, eval_scratch *scratch, int threads, mlod_error *err)
 {
 	if (max_error)
 		*max_error = -1.0;
@@ -338,6 +405,10 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	R.per = subdivide;
 	R.S = (R.F - 1) * R.per + 1;
 	R.kept = kept;
+	R.C = common->channel_count;
+	R.tasks = (ROUNDS + 1) * R.C;
+	R.bound = bound;
+	R.lanes = threads < 1 ? 1 : threads > MAX_LANES ? MAX_LANES : threads;
 	size_t FJ = (size_t)R.S * (size_t)R.J;
 	R.times = malloc(sizeof(float) * (size_t)R.S);
 	R.radius = malloc(sizeof(double) * (size_t)R.J);
@@ -346,29 +417,34 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	R.w0 = w0 ? (mlod_mat4 *)w0 : malloc(sizeof(mlod_mat4) * FJ); /* not written when given */
 	{
 		size_t S = (size_t)R.S;
+		size_t F = (size_t)R.F;
+		size_t per_lane = 2 * eval_carve_size(sizeof(mlod_trs) * S) + 2 * eval_carve_size(sizeof(mlod_mat4) * S) +
+		                  eval_carve_size(sizeof(unsigned) * S) + eval_carve_size(sizeof(int) * F);
 		size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 4 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
-		              2 * eval_carve_size(sizeof(mlod_trs) * S) + 2 * eval_carve_size(sizeof(mlod_mat4) * S) +
-		              eval_carve_size(sizeof(unsigned) * S);
+		              (size_t)R.lanes * per_lane;
 		char *at = eval_scratch_get(scratch ? scratch : &R.own, need);
 		if (at) {
 			R.lc = eval_carve(&at, sizeof(mlod_trs) * FJ);
 			R.lm = eval_carve(&at, sizeof(mlod_mat4) * FJ);
 			R.wc = eval_carve(&at, sizeof(mlod_mat4) * FJ);
-			R.stamp = eval_carve(&at, sizeof(unsigned) * S);
-			memset(R.stamp, 0, sizeof(unsigned) * S);
-			for (int i = 0; i < 2; i++) {
+			for (int i = 0; i < 2; i++)
 				R.wb[i] = eval_carve(&at, sizeof(mlod_mat4) * FJ);
-				R.lb[i] = eval_carve(&at, sizeof(mlod_trs) * S);
-				R.lmb[i] = eval_carve(&at, sizeof(mlod_mat4) * S);
+			for (int n = 0; n < R.lanes; n++) {
+				lane *L = &R.lane[n];
+				L->stamp = eval_carve(&at, sizeof(unsigned) * S);
+				memset(L->stamp, 0, sizeof(unsigned) * S);
+				for (int i = 0; i < 2; i++) {
+					L->lb[i] = eval_carve(&at, sizeof(mlod_trs) * S);
+					L->lmb[i] = eval_carve(&at, sizeof(mlod_mat4) * S);
+				}
+				L->K = eval_carve(&at, sizeof(int) * F);
 			}
 		}
 	}
 	int *depth = malloc(sizeof(int) * (size_t)R.J);
-	int *K = malloc(sizeof(int) * (size_t)R.F);
 	int *prevk = malloc(sizeof(int) * (size_t)R.F), *nextk = malloc(sizeof(int) * (size_t)R.F);
 	int *fill = NULL;
-	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !R.lm || !R.wc || !R.stamp || !R.wb[0] || !R.wb[1] || !R.lb[0] ||
-	    !R.lb[1] || !R.lmb[0] || !R.lmb[1] || !depth || !K || !prevk || !nextk) {
+	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !depth || !prevk || !nextk) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
@@ -472,11 +548,12 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		}
 	}
 
-	for (int round = 1; round <= ROUNDS; round++)
-		for (int c = 0; c < common->channel_count; c++)
-			reduce_channel(&R, c, bound * round / ROUNDS, K);
-	for (int c = 0; c < common->channel_count; c++)
-		collapse_channel(&R, c, bound);
+	/* Rounds of reduce_channel over the channels at a growing budget, then
+	 * collapse_channel over them at the whole bound. */
+	if ((r = run_tasks(&R)) != MLOD_OK) {
+		r = mlod_fail(err, r, "out of memory");
+		goto done;
+	}
 	/* The largest point error of the result, as motion.c's
 	 * level_max_error measures the level clip of these keys: the same
 	 * sampling (the kept values are mlod_clip_sample's on
@@ -500,7 +577,6 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	}
 done:
 	free(depth);
-	free(K);
 	free(prevk);
 	free(nextk);
 	free(fill);

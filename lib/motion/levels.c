@@ -3,18 +3,22 @@
  * (mlod_motion_build_levels).
  *
  * Two ways to share the work, with the same results:
- * - one item per clip (when there are at least as many clips as threads):
- *   each level is mlod_motion_next_level_best's, whose methods after the
- *   first stop early where they cannot win;
- * - one item per clip and method (fewer clips than threads): each method
- *   builds its whole chain of levels on its own thread (a method's next
- *   level depends only on its own previous level), and the levels are
- *   then chosen as mlod_motion_next_level_best chooses. With two methods,
- *   the second's chain runs first, as there; the first's level k waits
- *   for the second's level k and takes its bytes as the limit, as there,
- *   so it stops early where it cannot win; the two chains overlap by a
- *   level. Items are handed out in index order and the second method's
- *   item comes first, so the one waited for has always started.
+ * - one item per clip (when there are at least as many clips as threads,
+ *   or no keys method): each level is mlod_motion_next_level_best's,
+ *   whose methods after the first stop early where they cannot win;
+ * - two items per clip (fewer clips than threads): the keys method's
+ *   choice of keys, level after level (mlod_motion_keys_reduce: a level's
+ *   keys depend only on the previous level's keys), and a finisher that
+ *   takes each level's keys as they come, rounds and measures them
+ *   (mlod_motion_keys_finish, on a copy of the keys item's motion) and
+ *   builds the other method's level as mlod_motion_next_level_best does,
+ *   with the keys level's bytes as its limit; the levels are then chosen
+ *   as mlod_motion_next_level_best chooses. So level k's rounding and the
+ *   frames method's level k overlap level k + 1's choice of keys. The
+ *   choice of keys and the rounding's refinement also run on `threads`
+ *   threads each (mlod_motion_set_threads; tasks.c). Items are handed out
+ *   in index order and a clip's keys item comes first, so the one the
+ *   finisher waits for has always started.
  */
 #include <pthread.h>
 #include <stdlib.h>
@@ -28,6 +32,8 @@ typedef struct build_ctx {
 	const mlod_motion_options *opt;
 	const mlod_motion_method *methods;
 	int method_count;
+	int keys;                    /* the index of the keys method (the second way) */
+	int threads;                 /* of the keys method's choice of keys (the second way) */
 	const mlod_motion_spec *specs;
 	int spec_count;
 	mlod_motion_clip_levels *out;
@@ -35,14 +41,22 @@ typedef struct build_ctx {
 	mlod_motion_level *chain;    /* [clip][method][spec] */
 	mlod_result *chain_result;   /* [clip][method][spec]; -1: not built */
 	mlod_error *chain_error;     /* [clip][method][spec] */
+	double *known;               /* [clip][spec]: the keys level's error before rounding */
 	mlod_result *create_result;  /* [clip][method] */
 	mlod_error *create_error;    /* [clip][method] */
+	mlod_result *fin_result;     /* [clip]: the finisher's own motion */
+	mlod_error *fin_error;       /* [clip] */
 	mlod_motion_timeline *info;  /* [clip][method] */
-	/* The second method's levels as they come (two methods): published
-	 * levels per clip, under lock; the first method's level waits. */
+	/* The keys levels as they are chosen: how many per clip, under lock;
+	 * the finisher waits. */
 	pthread_mutex_t lock;
 	pthread_cond_t more;
 	int *published;              /* [clip] */
+	/* The keys item's motion, once made (or not: its create_result), for
+	 * the finisher to copy; the finisher frees it once the keys item has
+	 * published every level. */
+	mlod_motion **kmotion;       /* [clip] */
+	int *made;                   /* [clip] */
 } build_ctx;
 
 #define NOT_BUILT ((mlod_result)-1)
@@ -93,7 +107,7 @@ done:
 	return MLOD_OK;
 }
 
-/* The second method's chain of clip k has levels 0..s - 1 (all: s is
+/* The keys levels of clip k up to s - 1 are chosen (all: s is
  * spec_count). */
 static void publish(build_ctx *b, int k, int s)
 {
@@ -103,51 +117,154 @@ static void publish(build_ctx *b, int k, int s)
 	pthread_mutex_unlock(&b->lock);
 }
 
-/* The byte limit of the first method's level s of clip k: the second
- * method's level's bytes when it made one, as in
- * mlod_motion_next_level_best; waits for it. */
-static long level_limit(build_ctx *b, int k, int s)
+static void set_made(build_ctx *b, int k, mlod_motion *m)
+{
+	pthread_mutex_lock(&b->lock);
+	b->kmotion[k] = m;
+	b->made[k] = 1;
+	pthread_cond_broadcast(&b->more);
+	pthread_mutex_unlock(&b->lock);
+}
+
+static mlod_motion *wait_made(build_ctx *b, int k)
+{
+	pthread_mutex_lock(&b->lock);
+	while (!b->made[k])
+		pthread_cond_wait(&b->more, &b->lock);
+	mlod_motion *m = b->kmotion[k];
+	pthread_mutex_unlock(&b->lock);
+	return m;
+}
+
+static void wait_keys(build_ctx *b, int k, int s)
 {
 	pthread_mutex_lock(&b->lock);
 	while (b->published[k] <= s)
 		pthread_cond_wait(&b->more, &b->lock);
 	pthread_mutex_unlock(&b->lock);
-	size_t at = ((size_t)k * 2 + 1) * (size_t)b->spec_count + (size_t)s;
-	return b->chain_result[at] == MLOD_OK && !b->chain[at].unfinished ? b->chain[at].bytes : -1;
 }
 
-/* The second way: one method's chain of levels of one clip; with two
- * methods, item 2k is clip k's second method, 2k + 1 its first. */
-static mlod_result method_item(void *ctx, int item)
+static size_t chain_at(const build_ctx *b, int k, int i, int s)
 {
-	build_ctx *b = ctx;
-	int n = b->method_count, k = item / n, i = n == 2 ? 1 - item % 2 : 0;
-	size_t ci = (size_t)k * (size_t)n + (size_t)i, base = ci * (size_t)b->spec_count;
+	return ((size_t)k * (size_t)b->method_count + (size_t)i) * (size_t)b->spec_count + (size_t)s;
+}
+
+/* The second way, item 2k: the keys method's choice of keys of clip k,
+ * level after level, into its chain (unfinished: not rounded, not
+ * measured). */
+static void keys_item(build_ctx *b, int k)
+{
+	int i = b->keys;
+	size_t ci = (size_t)k * (size_t)b->method_count + (size_t)i;
 	mlod_motion *m = NULL;
-	int waits = n == 2 && i == 0;
 	b->create_result[ci] = mlod_motion_create(b->c, b->clips[k], b->opt, &m, &b->create_error[ci]);
 	if (b->create_result[ci] == MLOD_OK) {
 		b->info[ci] = *mlod_motion_timeline_info(m);
+		mlod_motion_set_threads(m, b->threads);
+	}
+	set_made(b, k, m);
+	if (b->create_result[ci] == MLOD_OK) {
 		for (int s = 0; s < b->spec_count && b->info[ci].frames >= 3; s++) {
-			if (!skipped(b->methods[i], b->specs[s].target)) {
-				long limit = waits ? level_limit(b, k, s) : -1;
-				mlod_result r = mlod_motion_next_level_under(m, b->methods[i], b->specs[s].target, b->specs[s].value,
-				                                             limit, &b->chain[base + (size_t)s],
-				                                             &b->chain_error[base + (size_t)s]);
-				b->chain_result[base + (size_t)s] = r;
-				if (r != MLOD_OK && r != MLOD_ERR_LIMIT) {
-					if (n == 2 && i == 1)
-						publish(b, k, b->spec_count);
+			if (!skipped(MLOD_MOTION_KEYS, b->specs[s].target)) {
+				size_t at = chain_at(b, k, i, s);
+				mlod_result r = mlod_motion_keys_reduce(m, b->specs[s].target, b->specs[s].value, &b->chain[at],
+				                                        &b->known[(size_t)k * (size_t)b->spec_count + (size_t)s],
+				                                        &b->chain_error[at]);
+				b->chain_result[at] = r;
+				if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
 					break;
-				}
 			}
-			if (n == 2 && i == 1)
-				publish(b, k, s + 1);
+			publish(b, k, s + 1);
 		}
 	}
-	if (n == 2 && i == 1)
-		publish(b, k, b->spec_count); /* the rest will not come */
-	mlod_motion_free(m);
+	publish(b, k, b->spec_count); /* the rest will not come; m is the finisher's to free */
+}
+
+/* The second way, item 2k + 1: clip k's levels in the order
+ * mlod_motion_next_level_best makes them (the last method first, each
+ * later one limited by the bytes of the best finished level so far), the
+ * keys method's from the keys item's choice, rounded and measured here. */
+static void finish_item(build_ctx *b, int k)
+{
+	int n = b->method_count;
+	mlod_motion *m[2] = { NULL, NULL }, *fin = NULL;
+	size_t base = (size_t)k * (size_t)n;
+	/* The other method's motion and the one the keys levels are rounded
+	 * on: copies of the keys item's (mlod_motion_create_like reads only
+	 * its setup, which the keys method does not change); when that could
+	 * not be made, the other method fails as it would have. */
+	mlod_motion *keys = wait_made(b, k);
+	size_t ki = base + (size_t)b->keys;
+	int made = keys != NULL;
+	for (int i = 0; i < n; i++) {
+		if (i == b->keys)
+			continue;
+		size_t ci = base + (size_t)i;
+		if (!keys) {
+			b->create_result[ci] = b->create_result[ki];
+			b->create_error[ci] = b->create_error[ki];
+			continue;
+		}
+		b->create_result[ci] = mlod_motion_create_like(keys, &m[i], &b->create_error[ci]);
+		if (b->create_result[ci] != MLOD_OK)
+			made = 0;
+		else
+			b->info[ci] = *mlod_motion_timeline_info(m[i]);
+		mlod_motion_set_threads(m[i], b->threads);
+	}
+	if (made) {
+		b->fin_result[k] = mlod_motion_create_like(keys, &fin, &b->fin_error[k]);
+		made = b->fin_result[k] == MLOD_OK;
+		mlod_motion_set_threads(fin, b->threads);
+	}
+	int frames = made ? mlod_motion_timeline_info(fin)->frames : 0;
+	for (int s = 0; s < b->spec_count && frames >= 3; s++) {
+		const mlod_motion_spec *sp = &b->specs[s];
+		long limit = -1; /* the best finished level's bytes so far */
+		int stop = 0;
+		for (int i = n - 1; i >= 0 && !stop; i--) {
+			if (skipped(b->methods[i], sp->target))
+				continue;
+			size_t at = chain_at(b, k, i, s);
+			mlod_result r;
+			if (i == b->keys) {
+				wait_keys(b, k, s);
+				r = b->chain_result[at];
+				if (r == NOT_BUILT) { /* the keys item stopped before it */
+					stop = 1;
+					break;
+				}
+				if (r == MLOD_OK)
+					r = b->chain_result[at] =
+						mlod_motion_keys_finish(fin, sp->target, sp->value, limit,
+						                        b->known[(size_t)k * (size_t)b->spec_count + (size_t)s], &b->chain[at],
+						                        &b->chain_error[at]);
+			} else {
+				r = b->chain_result[at] = mlod_motion_next_level_under(m[i], b->methods[i], sp->target, sp->value,
+				                                                       limit, &b->chain[at], &b->chain_error[at]);
+			}
+			if (r == MLOD_OK && !b->chain[at].unfinished && (limit < 0 || b->chain[at].bytes < limit))
+				limit = b->chain[at].bytes;
+			if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
+				stop = 1; /* mlod_motion_next_level_best ends here */
+		}
+		if (stop)
+			break;
+	}
+	for (int i = 0; i < n; i++)
+		mlod_motion_free(m[i]);
+	mlod_motion_free(fin);
+	wait_keys(b, k, b->spec_count - 1); /* the keys item is done with its motion */
+	mlod_motion_free(keys);
+}
+
+static mlod_result split_item(void *ctx, int item)
+{
+	build_ctx *b = ctx;
+	if (item % 2 == 0)
+		keys_item(b, item / 2);
+	else
+		finish_item(b, item / 2);
 	return MLOD_OK;
 }
 
@@ -206,6 +323,11 @@ static void gather(build_ctx *b, int k)
 			o->error = b->create_error[base + (size_t)i];
 			return;
 		}
+	if (b->fin_result[k] != MLOD_OK) {
+		o->result = b->fin_result[k];
+		o->error = b->fin_error[k];
+		return;
+	}
 	o->timeline = b->info[base];
 	if (o->timeline.frames < 3)
 		return;
@@ -251,7 +373,12 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 	b.specs = specs;
 	b.spec_count = spec_count;
 	b.out = out;
-	if (threads <= 1 || method_count == 1 || clip_count >= threads) {
+	b.threads = threads;
+	b.keys = -1;
+	for (int i = 0; i < method_count; i++)
+		if (methods[i] == MLOD_MOTION_KEYS)
+			b.keys = i;
+	if (threads <= 1 || b.keys < 0 || clip_count >= threads) {
 		mlod_parallel_for(clip_count, threads, clip_item, &b);
 		return MLOD_OK;
 	}
@@ -259,24 +386,29 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 	b.chain = calloc(levels + 1, sizeof *b.chain);
 	b.chain_result = malloc(sizeof *b.chain_result * (levels + 1));
 	b.chain_error = calloc(levels + 1, sizeof *b.chain_error);
+	b.known = calloc((size_t)clip_count * (size_t)spec_count + 1, sizeof *b.known);
+	b.fin_result = calloc((size_t)clip_count, sizeof *b.fin_result);
+	b.fin_error = calloc((size_t)clip_count, sizeof *b.fin_error);
 	b.create_result = calloc(chains, sizeof *b.create_result);
 	b.create_error = calloc(chains, sizeof *b.create_error);
 	b.info = calloc(chains, sizeof *b.info);
 	b.published = calloc((size_t)clip_count, sizeof *b.published);
+	b.kmotion = calloc((size_t)clip_count, sizeof *b.kmotion);
+	b.made = calloc((size_t)clip_count, sizeof *b.made);
 	mlod_result r = MLOD_OK;
 	int sync = 0;
-	if (b.published && pthread_mutex_init(&b.lock, NULL) == 0) {
+	if (b.published && b.kmotion && b.made && pthread_mutex_init(&b.lock, NULL) == 0) {
 		if (pthread_cond_init(&b.more, NULL) == 0)
 			sync = 1;
 		else
 			pthread_mutex_destroy(&b.lock);
 	}
-	if (!b.chain || !b.chain_result || !b.chain_error || !b.create_result || !b.create_error || !b.info || !sync) {
+	if (!b.chain || !b.chain_result || !b.chain_error || !b.known || !b.fin_result || !b.fin_error || !b.create_result || !b.create_error || !b.info || !sync) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	} else {
 		for (size_t i = 0; i < levels; i++)
 			b.chain_result[i] = NOT_BUILT;
-		mlod_parallel_for((int)chains, threads, method_item, &b);
+		mlod_parallel_for(2 * clip_count, threads, split_item, &b);
 		for (int k = 0; k < clip_count; k++)
 			gather(&b, k);
 	}
@@ -285,10 +417,15 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 	free(b.chain);
 	free(b.chain_result);
 	free(b.chain_error);
+	free(b.known);
+	free(b.fin_result);
+	free(b.fin_error);
 	free(b.create_result);
 	free(b.create_error);
 	free(b.info);
 	free(b.published);
+	free(b.kmotion);
+	free(b.made);
 	if (sync) {
 		pthread_cond_destroy(&b.more);
 		pthread_mutex_destroy(&b.lock);

@@ -155,6 +155,10 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
  * them; first may be freed before it. */
 mlod_result mlod_motion_create_like(const mlod_motion *first, mlod_motion **out, mlod_error *err);
 void mlod_motion_free(mlod_motion *m);
+/* The keys method's choice of keys runs on up to threads threads (default
+ * 1, also for a motion made by mlod_motion_create_like); the levels are
+ * the same at any count. */
+void mlod_motion_set_threads(mlod_motion *m, int threads);
 /* The clip's common timeline. */
 const mlod_motion_timeline *mlod_motion_timeline_info(const mlod_motion *m);
 
@@ -205,6 +209,21 @@ void mlod_motion_level_free(mlod_motion_level *l);
 mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
                                          double value, long max_bytes, mlod_motion_level *out, mlod_error *err);
 
+/* mlod_motion_next_level with the keys method in two parts, for a caller
+ * that rounds and measures a level on another thread while the next
+ * level's keys are chosen: mlod_motion_keys_reduce chooses the keys (out
+ * gets the clip of the kept keys, method and threshold; *known its
+ * largest point error, or < 0 when not measured), on which m's next level
+ * builds; mlod_motion_keys_finish then rounds and measures that level
+ * with the same target, value and max_bytes as mlod_motion_next_level_under,
+ * on m or on any motion of the same clip and options (it reads only their
+ * setup), and frees it on a failure. The two give the level
+ * mlod_motion_next_level_under gives. */
+mlod_result mlod_motion_keys_reduce(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
+                                    double *known, mlod_error *err);
+mlod_result mlod_motion_keys_finish(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
+                                    double known, mlod_motion_level *l, mlod_error *err);
+
 /* The auto method's rule, in one place for mlod_motion_next_level_best
  * and the threaded builder: whether the method applies to the target (not
  * the keys method for MLOD_MOTION_THRESHOLD), and whether a level beats
@@ -247,9 +266,11 @@ typedef struct mlod_motion_clip_levels {
 /* The levels of clips[0..clip_count) of c, out[k] for clips[k]: for each
  * clip, mlod_motion_create with opt for each of the method_count (1 or 2)
  * methods, then for each spec in order the level
- * mlod_motion_next_level_best makes. Clips, and the methods of a clip,
- * run on up to `threads` threads; the levels do not depend on the
- * thread count. Returns MLOD_OK (each clip's outcome is in out[k]) or
+ * mlod_motion_next_level_best makes. Clips run on up to `threads`
+ * threads; with fewer clips than threads, a clip's keys method chooses
+ * its keys on threads of its own while another thread rounds and
+ * measures them and builds the other method's levels (levels.c); the
+ * levels do not depend on the thread count. Returns MLOD_OK (each clip's outcome is in out[k]) or
  * MLOD_ERR_NOMEM / MLOD_ERR_INVALID_ARG. Release out with
  * mlod_motion_clip_levels_free (levels taken over by the caller are to be
  * zeroed, or their results set to other than MLOD_OK). */

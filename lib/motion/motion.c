@@ -285,6 +285,7 @@ struct mlod_motion {
 	memo *memo;            /* the tree's distances and residuals */
 	memo *segmemo;         /* frames level under way: segments of lines within its bound */
 	eval_scratch scratch;  /* the large arrays of the key reduction and of refine_channels */
+	int threads;           /* of the key reduction (mlod_motion_set_threads) */
 };
 
 static void line_free(line *l)
@@ -324,6 +325,12 @@ void mlod_motion_free(mlod_motion *m)
 	free(m->segmemo);
 	free(m->scratch.p);
 	free(m);
+}
+
+void mlod_motion_set_threads(mlod_motion *m, int threads)
+{
+	if (m)
+		m->threads = threads < 1 ? 1 : threads;
 }
 
 const mlod_motion_timeline *mlod_motion_timeline_info(const mlod_motion *m)
@@ -1100,35 +1107,55 @@ static void channel_exps(const mlod_motion *m, const mlod_clip *clip, int g, con
 }
 
 /* The rounding refinement's arrays, in m->scratch (carved the same way
- * at every call, so that what one call leaves there the next finds). */
-typedef struct refine_bufs {
-	mlod_trs *L, *Lj, *Lj2;                  /* samples * joints; samples; samples */
-	mlod_mat4 *W, *T, *T2, *LM, *LMj, *LMj2; /* samples * joints (4), samples (2) */
+ * at every call, so that what one call leaves there the next finds):
+ * the level as rounded (shared), and per lane (a thread of the
+ * refinement, up to m->threads) a try's and the best fit's. */
+#define REFINE_LANES 8
+typedef struct refine_lane {
+	mlod_trs *Lj, *Lj2;                      /* samples (2) */
+	mlod_mat4 *T, *T2, *LMj, *LMj2;          /* samples * joints (2), samples (2) */
 	int *sub, *pos;                          /* joints */
+} refine_lane;
+
+typedef struct refine_bufs {
+	mlod_trs *L;                             /* samples * joints */
+	mlod_mat4 *W, *LM;                       /* samples * joints */
+	int lanes;
+	refine_lane lane[REFINE_LANES];
 } refine_bufs;
+
+static int refine_lanes(const mlod_motion *m)
+{
+	return m->threads < 1 ? 1 : m->threads > REFINE_LANES ? REFINE_LANES : m->threads;
+}
 
 static int refine_bufs_get(mlod_motion *m, refine_bufs *b)
 {
-	int F = m->samples, J = m->s->joint_count;
+	int F = m->samples, J = m->s->joint_count, lanes = refine_lanes(m);
 	size_t FJ = (size_t)F * (size_t)J;
-	size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 4 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
-	              2 * eval_carve_size(sizeof(mlod_trs) * (size_t)F) + 2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) +
-	              2 * eval_carve_size(sizeof(int) * (size_t)J);
+	size_t per_lane = 2 * eval_carve_size(sizeof(mlod_mat4) * FJ) + 2 * eval_carve_size(sizeof(mlod_trs) * (size_t)F) +
+	                  2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) + 2 * eval_carve_size(sizeof(int) * (size_t)J);
+	size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 2 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
+	              (size_t)lanes * per_lane;
 	char *at = eval_scratch_get(&m->scratch, need);
 	memset(b, 0, sizeof *b);
 	if (!at)
 		return 0;
 	b->L = eval_carve(&at, sizeof *b->L * FJ);
 	b->W = eval_carve(&at, sizeof *b->W * FJ);
-	b->T = eval_carve(&at, sizeof *b->T * FJ);
-	b->T2 = eval_carve(&at, sizeof *b->T2 * FJ);
 	b->LM = eval_carve(&at, sizeof *b->LM * FJ);
-	b->Lj = eval_carve(&at, sizeof *b->Lj * (size_t)F);
-	b->Lj2 = eval_carve(&at, sizeof *b->Lj2 * (size_t)F);
-	b->LMj = eval_carve(&at, sizeof *b->LMj * (size_t)F);
-	b->LMj2 = eval_carve(&at, sizeof *b->LMj2 * (size_t)F);
-	b->sub = eval_carve(&at, sizeof(int) * (size_t)J);
-	b->pos = eval_carve(&at, sizeof(int) * (size_t)J);
+	b->lanes = lanes;
+	for (int i = 0; i < lanes; i++) {
+		refine_lane *l = &b->lane[i];
+		l->T = eval_carve(&at, sizeof *l->T * FJ);
+		l->T2 = eval_carve(&at, sizeof *l->T2 * FJ);
+		l->Lj = eval_carve(&at, sizeof *l->Lj * (size_t)F);
+		l->Lj2 = eval_carve(&at, sizeof *l->Lj2 * (size_t)F);
+		l->LMj = eval_carve(&at, sizeof *l->LMj * (size_t)F);
+		l->LMj2 = eval_carve(&at, sizeof *l->LMj2 * (size_t)F);
+		l->sub = eval_carve(&at, sizeof(int) * (size_t)J);
+		l->pos = eval_carve(&at, sizeof(int) * (size_t)J);
+	}
 	return 1;
 }
 
@@ -1158,7 +1185,132 @@ static int round_fits(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int
  * operations as mlod_pose_world. Needs m->cache0. walked: the buffers
  * (refine_bufs) already hold the clip as rounded with g and adj at every
  * sample (level_within_keep of it fitted). Returns -1 when out of
- * memory; clip is then rounded with adj as it was. */
+ * memory; clip is then rounded with adj as it was.
+ *
+ * A channel's refinement reads and writes its joint's local transforms
+ * and the world matrices of its joint's subtree only (and reads the
+ * parent's): channels of joints that are not one below the other commute,
+ * and run on up to m->threads threads (motion_run_tasks), with the
+ * result of the channels in order. */
+typedef struct refine_ctx {
+	mlod_motion *m;
+	const mlod_clip *src;
+	mlod_clip *clip;
+	int g, stride;
+	int *adj, *e;
+	double bound;
+	refine_bufs *rb;
+} refine_ctx;
+
+/* The grid exponent of channel i for the level grid 2^g (channel_exps). */
+static int channel_exp(const mlod_motion *m, const mlod_channel *ch, int g, int adj)
+{
+	return g + adj + (ch->path == MLOD_PATH_TRANSLATION ? 0 : m->reach_exp[ch->joint]);
+}
+
+static void refine_one(void *ctx, int lane, int i)
+{
+	refine_ctx *x = ctx;
+	mlod_motion *m = x->m;
+	const mlod_skeleton *s = m->s;
+	const mlod_clip *src = x->src;
+	mlod_clip *clip = x->clip;
+	int F = m->samples, J = s->joint_count, g = x->g, stride = x->stride, *adj = x->adj, *e = x->e;
+	double bound = x->bound;
+	refine_lane *rl = &x->rb->lane[lane];
+	mlod_trs *L = x->rb->L, *Lj = rl->Lj, *Lj2 = rl->Lj2;
+	mlod_mat4 *W = x->rb->W, *T = rl->T, *T2 = rl->T2, *LM = x->rb->LM, *LMj = rl->LMj, *LMj2 = rl->LMj2;
+	int *sub = rl->sub, *pos = rl->pos;
+	const float *times = m->st;
+	mlod_channel *ch = &clip->channels[i];
+	int j = ch->joint, ns = 0, fast = ch->interp != MLOD_INTERP_CUBICSPLINE;
+	if (ch->key_count < 3)
+		return; /* its first and last keys stay exact: nothing to round */
+	for (int d = j; d < J; d++) { /* j and its descendants, parents first */
+		int a = d;
+		while (a > j)
+			a = s->joints[a].parent;
+		if (a == j)
+			pos[d] = ns, sub[ns++] = d;
+	}
+	/* The coarsest adjustment up to CHANNEL_COARSER that fits: the
+	 * largest first, then bisection (a try that does not fit usually
+	 * stops within a few samples, one that fits checks them all). The
+	 * try's local transform of j and world matrices of its subtree go
+	 * to Lj, LMj and T (ns per sample); those of the best fit so far
+	 * are kept in Lj2, LMj2, T2. */
+	int ok_adj = adj[i], bad_adj = CHANNEL_COARSER + 1, have = 0;
+	for (int want = CHANNEL_COARSER; bad_adj - ok_adj > 1; want = ok_adj + (bad_adj - ok_adj) / 2) {
+		adj[i] = want;
+		e[i] = channel_exp(m, &src->channels[i], g, adj[i]);
+		round_channel(&src->channels[i], ch, e[i], SHORTS(m));
+		int ok = 1;
+		eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+		/* Every stride-th sample first, then the rest in order. */
+		for (int pass = stride > 1 ? 0 : 1; pass < 2 && ok; pass++)
+			for (int f = 0; f < F && ok; f += pass ? 1 : stride) {
+				if (pass == 1 && stride > 1 && f % stride == 0)
+					continue;
+				mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
+				const mlod_mat4 *wf = W + (size_t)f * (size_t)J, *lmf = LM + (size_t)f * (size_t)J;
+				mlod_mat4 *w = T + (size_t)f * (size_t)ns;
+				const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J;
+				if (fast) {
+					float t = times[f], v[4];
+					if (!(t > 0.0f))
+						t = 0.0f;
+					if (t > clip->duration)
+						t = clip->duration;
+					eval_channel(ch, &seg, t, v);
+					switch (ch->path) {
+					case MLOD_PATH_TRANSLATION: l.t.x = v[0], l.t.y = v[1], l.t.z = v[2]; break;
+					case MLOD_PATH_SCALE: l.s.x = v[0], l.s.y = v[1], l.s.z = v[2]; break;
+					case MLOD_PATH_ROTATION: l.r = eval_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
+					}
+				} else {
+					mlod_channel_sample(ch, clip->duration, times[f], &l);
+				}
+				Lj[f] = l;
+				LMj[f] = eval_from_trs(&l);
+				for (int k = 0; k < ns && ok; k++) {
+					int d = sub[k], p = s->joints[d].parent;
+					const mlod_mat4 *lm = d == j ? &LMj[f] : &lmf[d];
+					/* Below j, the parent is in the subtree, before d. */
+					const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
+					w[k] = p < 0 ? mlod_mat4_mul(&s->joints[d].base, lm) : eval_mul_affine(pw, lm);
+					ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
+				}
+			}
+		if (ok) {
+			mlod_trs *tl = Lj;
+			mlod_mat4 *tm = LMj, *tt = T;
+			Lj = Lj2, LMj = LMj2, T = T2;
+			Lj2 = tl, LMj2 = tm, T2 = tt;
+			ok_adj = want, have = 1;
+		} else {
+			bad_adj = want;
+		}
+	}
+	adj[i] = ok_adj;
+	e[i] = channel_exp(m, &src->channels[i], g, adj[i]);
+	round_channel(&src->channels[i], ch, e[i], SHORTS(m));
+	if (!have)
+		return;
+	for (int f = 0; f < F; f++) {
+		mlod_mat4 *wf = W + (size_t)f * (size_t)J;
+		L[(size_t)f * (size_t)J + (size_t)j] = Lj2[f];
+		LM[(size_t)f * (size_t)J + (size_t)j] = LMj2[f];
+		for (int k = 0; k < ns; k++)
+			wf[sub[k]] = T2[(size_t)f * (size_t)ns + (size_t)k];
+	}
+}
+
+static int refine_conflict(void *ctx, int u, int t)
+{
+	const refine_ctx *x = ctx;
+	return eval_joints_related(x->m->s, x->clip->channels[u].joint, x->clip->channels[t].joint);
+}
+
 static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip, int g, int *adj, int *e,
                            double bound, const mlod_mat4 **world, int walked)
 {
@@ -1166,9 +1318,8 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	int F = m->samples, J = s->joint_count, n = clip->channel_count;
 	refine_bufs rb;
 	int got = refine_bufs_get(m, &rb);
-	mlod_trs *L = rb.L, *Lj = rb.Lj, *Lj2 = rb.Lj2;
-	mlod_mat4 *W = rb.W, *T = rb.T, *T2 = rb.T2, *LM = rb.LM, *LMj = rb.LMj, *LMj2 = rb.LMj2;
-	int *sub = rb.sub, *pos = rb.pos;
+	mlod_trs *L = rb.L;
+	mlod_mat4 *W = rb.W, *LM = rb.LM;
 	const float *times = m->st;
 	channel_exps(m, src, g, adj, e);
 	round_clip(src, clip, e, SHORTS(m));
@@ -1192,90 +1343,9 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	}
 	/* Samples every REFINE_STRIDE-th first (they are independent, and a
 	 * try that fails usually fails sooner), then the others in order. */
-	const int stride = F >= 4 * REFINE_STRIDE ? REFINE_STRIDE : 1;
-	for (int i = 0; i < n; i++) {
-		mlod_channel *ch = &clip->channels[i];
-		int j = ch->joint, ns = 0, fast = ch->interp != MLOD_INTERP_CUBICSPLINE;
-		if (ch->key_count < 3)
-			continue; /* its first and last keys stay exact: nothing to round */
-		for (int d = j; d < J; d++) { /* j and its descendants, parents first */
-			int a = d;
-			while (a > j)
-				a = s->joints[a].parent;
-			if (a == j)
-				pos[d] = ns, sub[ns++] = d;
-		}
-		/* The coarsest adjustment up to CHANNEL_COARSER that fits: the
-		 * largest first, then bisection (a try that does not fit usually
-		 * stops within a few samples, one that fits checks them all). The
-		 * try's local transform of j and world matrices of its subtree go
-		 * to Lj, LMj and T (ns per sample); those of the best fit so far
-		 * are kept in Lj2, LMj2, T2. */
-		int ok_adj = adj[i], bad_adj = CHANNEL_COARSER + 1, have = 0;
-		for (int want = CHANNEL_COARSER; bad_adj - ok_adj > 1; want = ok_adj + (bad_adj - ok_adj) / 2) {
-			adj[i] = want;
-			channel_exps(m, src, g, adj, e);
-			round_channel(&src->channels[i], ch, e[i], SHORTS(m));
-			int ok = 1;
-			eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
-			/* Every stride-th sample first, then the rest in order. */
-			for (int pass = stride > 1 ? 0 : 1; pass < 2 && ok; pass++)
-				for (int f = 0; f < F && ok; f += pass ? 1 : stride) {
-					if (pass == 1 && stride > 1 && f % stride == 0)
-						continue;
-					mlod_trs *lf = L + (size_t)f * (size_t)J, l = lf[j];
-					const mlod_mat4 *wf = W + (size_t)f * (size_t)J, *lmf = LM + (size_t)f * (size_t)J;
-					mlod_mat4 *w = T + (size_t)f * (size_t)ns;
-					const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J;
-					if (fast) {
-						float t = times[f], v[4];
-						if (!(t > 0.0f))
-							t = 0.0f;
-						if (t > clip->duration)
-							t = clip->duration;
-						eval_channel(ch, &seg, t, v);
-						switch (ch->path) {
-						case MLOD_PATH_TRANSLATION: l.t.x = v[0], l.t.y = v[1], l.t.z = v[2]; break;
-						case MLOD_PATH_SCALE: l.s.x = v[0], l.s.y = v[1], l.s.z = v[2]; break;
-						case MLOD_PATH_ROTATION: l.r = eval_normalize((mlod_quat){ v[0], v[1], v[2], v[3] }); break;
-						}
-					} else {
-						mlod_channel_sample(ch, clip->duration, times[f], &l);
-					}
-					Lj[f] = l;
-					LMj[f] = eval_from_trs(&l);
-					for (int k = 0; k < ns && ok; k++) {
-						int d = sub[k], p = s->joints[d].parent;
-						const mlod_mat4 *lm = d == j ? &LMj[f] : &lmf[d];
-						/* Below j, the parent is in the subtree, before d. */
-						const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
-						w[k] = p < 0 ? mlod_mat4_mul(&s->joints[d].base, lm) : eval_mul_affine(pw, lm);
-						ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
-					}
-				}
-			if (ok) {
-				mlod_trs *tl = Lj;
-				mlod_mat4 *tm = LMj, *tt = T;
-				Lj = Lj2, LMj = LMj2, T = T2;
-				Lj2 = tl, LMj2 = tm, T2 = tt;
-				ok_adj = want, have = 1;
-			} else {
-				bad_adj = want;
-			}
-		}
-		adj[i] = ok_adj;
-		channel_exps(m, src, g, adj, e);
-		round_channel(&src->channels[i], ch, e[i], SHORTS(m));
-		if (!have)
-			continue;
-		for (int f = 0; f < F; f++) {
-			mlod_mat4 *wf = W + (size_t)f * (size_t)J;
-			L[(size_t)f * (size_t)J + (size_t)j] = Lj2[f];
-			LM[(size_t)f * (size_t)J + (size_t)j] = LMj2[f];
-			for (int k = 0; k < ns; k++)
-				wf[sub[k]] = T2[(size_t)f * (size_t)ns + (size_t)k];
-		}
-	}
+	refine_ctx x = { m, src, clip, g, F >= 4 * REFINE_STRIDE ? REFINE_STRIDE : 1, adj, e, bound, &rb };
+	if (motion_run_tasks(n, rb.lanes, refine_conflict, refine_one, &x) != MLOD_OK)
+		return -1;
 	*world = W; /* in m->scratch: valid until its next use */
 	return 0;
 }
@@ -1811,8 +1881,8 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	memcpy(kept, m->kept, size);
 	memset(clip, 0, sizeof *clip);
 	double e = -1.0;
-	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, &m->scratch, err) !=
-	    MLOD_OK)
+	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, &m->scratch,
+	                  m->threads, err) != MLOD_OK)
 		return -1.0;
 	if (clip_from_kept(m, kept, clip) != 0) {
 		mlod_clip_free(clip);
@@ -1824,8 +1894,11 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	return e >= 0.0 && m->clip_end_ok ? e : level_max_error(m, clip);
 }
 
-static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
-                              mlod_motion_level *out, mlod_error *err)
+/* The keys method's next level up to its rounding: the keys kept (out's
+ * clip, method and threshold; the rest zero), which the next level builds
+ * on; *known gets the clip's level_max_error. */
+static mlod_result keys_reduce(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
+                               double *known, mlod_error *err)
 {
 	const char *name = m->orig->name ? m->orig->name : "";
 	if (target == MLOD_MOTION_THRESHOLD)
@@ -1921,10 +1994,28 @@ static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double 
 	out->clip = best_clip;
 	free(m->kept);
 	m->kept = best;
-	r = level_finish(m, out, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, best_error, err);
+	*known = best_error;
+	return MLOD_OK;
+}
+
+/* The keys level's rounding and measures (level_finish); m may be any
+ * motion of the clip with the same options (the rounding reads only the
+ * setup, not the keys method's state). Frees the level on a failure. */
+static mlod_result keys_finish(mlod_motion *m, mlod_motion_target target, double value, long max_bytes, double known,
+                               mlod_motion_level *l, mlod_error *err)
+{
+	mlod_result r = level_finish(m, l, target == MLOD_MOTION_MAX_ERROR ? value : -1.0, max_bytes, known, err);
 	if (r != MLOD_OK)
-		mlod_motion_level_free(out);
+		mlod_motion_level_free(l);
 	return r;
+}
+
+static mlod_result keys_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
+                              mlod_motion_level *out, mlod_error *err)
+{
+	double known = -1.0;
+	mlod_result r = keys_reduce(m, target, value, out, &known, err);
+	return r != MLOD_OK ? r : keys_finish(m, target, value, max_bytes, known, out, err);
 }
 
 mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
@@ -1933,8 +2024,8 @@ mlod_result mlod_motion_next_level(mlod_motion *m, mlod_motion_method method, ml
 	return mlod_motion_next_level_under(m, method, target, value, -1, out, err);
 }
 
-mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
-                                         double value, long max_bytes, mlod_motion_level *out, mlod_error *err)
+static mlod_result level_args(const mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
+                              mlod_error *err)
 {
 	if (!m || !out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_next_level: NULL argument");
@@ -1943,6 +2034,34 @@ mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method meth
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad level value %g", value);
 	if ((unsigned)target > MLOD_MOTION_MAX_ERROR)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "bad level target %d", (int)target);
+	return MLOD_OK;
+}
+
+mlod_result mlod_motion_keys_reduce(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
+                                    double *known, mlod_error *err)
+{
+	mlod_result r = level_args(m, target, value, out, err);
+	if (r == MLOD_OK && !known)
+		r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_keys_reduce: NULL argument");
+	return r != MLOD_OK ? r : keys_reduce(m, target, value, out, known, err);
+}
+
+mlod_result mlod_motion_keys_finish(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
+                                    double known, mlod_motion_level *l, mlod_error *err)
+{
+	if (!m || !l || l->method != MLOD_MOTION_KEYS)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_keys_finish: bad arguments");
+	if (l->clip.channel_count != m->common.channel_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_keys_finish: the level is not of this clip");
+	return keys_finish(m, target, value, max_bytes, known, l, err);
+}
+
+mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method method, mlod_motion_target target,
+                                         double value, long max_bytes, mlod_motion_level *out, mlod_error *err)
+{
+	mlod_result r = level_args(m, target, value, out, err);
+	if (r != MLOD_OK)
+		return r;
 	switch (method) {
 	case MLOD_MOTION_FRAMES: return frames_level(m, target, value, max_bytes, out, err);
 	case MLOD_MOTION_KEYS: return keys_level(m, target, value, max_bytes, out, err);

@@ -437,9 +437,33 @@ static inline void *eval_carve(char **at, size_t n)
  * and *max_error (if not NULL) the largest point error of the result as
  * motion.c's level_max_error measures its level clip, or -1 when not
  * measured (a NaN, or samples past the clip's duration); its large arrays
- * in *scratch (NULL: its own, freed on return). */
+ * in *scratch (NULL: its own, freed on return); on up to threads threads
+ * (the same result at any count). */
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
-                          double *max_error, eval_scratch *scratch, mlod_error *err);
+                          double *max_error, eval_scratch *scratch, int threads, mlod_error *err);
+
+/* Tasks 0..n-1 of a sequence on up to lanes threads (tasks.c): run(ctx,
+ * lane, t) runs task t with lane's own buffers (lane < lanes; one task at
+ * a time per lane); task t starts once every earlier task u with
+ * conflict(ctx, u, t) has finished, so the result is that of the tasks in
+ * order when tasks that do not conflict touch disjoint data. conflict is
+ * called under a lock and should be cheap. MLOD_ERR_NOMEM when it could
+ * not start (nothing run). */
+typedef int (*motion_conflict_fn)(void *ctx, int u, int t);
+/* Is joint a joint b, one of its ancestors or one of its descendants?
+ * (Two channels of joints that are not touch disjoint world matrices.) */
+static inline int eval_joints_related(const mlod_skeleton *s, int a, int b)
+{
+	for (int x = b; x >= 0; x = s->joints[x].parent)
+		if (x == a)
+			return 1;
+	for (int x = a; x >= 0; x = s->joints[x].parent)
+		if (x == b)
+			return 1;
+	return 0;
+}
+typedef void (*motion_task_fn)(void *ctx, int lane, int t);
+mlod_result motion_run_tasks(int n, int lanes, motion_conflict_fn conflict, motion_task_fn run, void *ctx);
 
 #endif /* MLOD_MOTION_EVAL_H */

@@ -1138,42 +1138,105 @@ static int same_level(const mlod_motion_level *a, const mlod_motion_level *b)
 
 TEST(build_levels_same_at_any_thread_count)
 {
-	/* One clip and two methods (each method's chain on a thread of its
-	 * own), and thresholds (the keys method skipped): the levels are
+	/* One clip and two methods (the keys method's choice of keys on
+	 * threads of its own, its rounding and the frames method's levels on
+	 * another), thresholds (the keys method skipped), the keys method
+	 * alone with bounds and with fractions of the keys, and two clips
+	 * (at 3 threads, fewer clips than threads): the levels are
 	 * mlod_motion_next_level_best's, at 1, 2 and 3 threads. */
 	mlod_character c;
 	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
 	double h = mlod_skeleton_height(&c.skeleton);
 	mlod_motion_method methods[2] = { MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS };
-	mlod_motion_spec specs[2][3] = {
+	mlod_motion_spec specs[4][3] = {
 		{ { MLOD_MOTION_MAX_ERROR, 0.002 * h }, { MLOD_MOTION_MAX_ERROR, 0.01 * h }, { MLOD_MOTION_MAX_ERROR, 0.03 * h } },
 		{ { MLOD_MOTION_THRESHOLD, 0.5 }, { MLOD_MOTION_THRESHOLD, 2.0 }, { MLOD_MOTION_THRESHOLD, 8.0 } },
+		{ { MLOD_MOTION_MAX_ERROR, 0.003 * h }, { MLOD_MOTION_MAX_ERROR, 0.01 * h }, { MLOD_MOTION_MAX_ERROR, 0.02 * h } },
+		{ { MLOD_MOTION_FRACTION, 0.5 }, { MLOD_MOTION_FRACTION, 0.2 }, { MLOD_MOTION_FRACTION, 0.05 } },
 	};
-	int clip = 0;
-	for (int set = 0; set < 2; set++) {
-		mlod_motion *m[2];
+	int clips[2] = { 0, 0 };
+	for (int set = 0; set < 4; set++) {
+		/* Sets 2 and 3: the keys method alone. */
+		const mlod_motion_method *ms = set < 2 ? methods : methods + 1;
+		int n = set < 2 ? 2 : 1, clip_count = set == 0 ? 2 : 1;
+		mlod_motion *m[2] = { NULL, NULL };
 		mlod_motion_level seq[3];
-		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m[0], &terr));
-		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m[1], &terr));
+		for (int i = 0; i < n; i++)
+			CHECK_OK(mlod_motion_create(&c, 0, NULL, &m[i], &terr));
 		for (int s = 0; s < 3; s++)
-			CHECK_OK(mlod_motion_next_level_best(m, methods, 2, specs[set][s].target, specs[set][s].value, &seq[s],
-			                                     &terr));
-		mlod_motion_free(m[0]);
-		mlod_motion_free(m[1]);
+			CHECK_OK(mlod_motion_next_level_best(m, ms, n, specs[set][s].target, specs[set][s].value, &seq[s], &terr));
+		for (int i = 0; i < n; i++)
+			mlod_motion_free(m[i]);
 		for (int threads = 1; threads <= 3; threads++) {
-			mlod_motion_clip_levels out;
-			CHECK_OK(mlod_motion_build_levels(&c, &clip, 1, NULL, methods, 2, specs[set], 3, threads, &out, &terr));
-			CHECK(out.result == MLOD_OK && out.level_count == 3);
-			for (int s = 0; s < 3; s++) {
-				CHECK(out.results[s] == MLOD_OK);
-				CHECK_MSG(same_level(&out.levels[s], &seq[s]), "set %d, level %d, %d threads", set, s, threads);
+			mlod_motion_clip_levels out[2];
+			CHECK_OK(mlod_motion_build_levels(&c, clips, clip_count, NULL, ms, n, specs[set], 3, threads, out, &terr));
+			for (int k = 0; k < clip_count; k++) {
+				CHECK(out[k].result == MLOD_OK && out[k].level_count == 3);
+				for (int s = 0; s < 3; s++) {
+					CHECK(out[k].results[s] == MLOD_OK);
+					CHECK_MSG(same_level(&out[k].levels[s], &seq[s]), "set %d, clip %d, level %d, %d threads", set, k, s,
+					          threads);
+				}
 			}
-			mlod_motion_clip_levels_free(&out, 1);
+			mlod_motion_clip_levels_free(out, clip_count);
 		}
 		for (int s = 0; s < 3; s++)
 			mlod_motion_level_free(&seq[s]);
 	}
 	mlod_character_free(&c);
+}
+
+TEST(keys_split_same_as_next_level)
+{
+	/* mlod_motion_keys_reduce, then mlod_motion_keys_finish on another
+	 * motion of the clip (made by mlod_motion_create_like, as the threaded
+	 * builder does): the levels of mlod_motion_next_level; and the choice
+	 * of keys and the rounding's per-channel refinement on 1, 2, 3 and 8
+	 * threads (mlod_motion_set_threads) give the same levels. Walk (rotations below a translated root) and the robot
+	 * (translations and scales on several joints). */
+	const char *files[2] = { "samples/cmu_12_01_walk.bvh", "samples/RobotExpressive.glb" };
+	for (int file = 0; file < 2; file++) {
+		mlod_character c;
+		CHECK(load_sample(files[file], &c) == 0);
+		double h = mlod_skeleton_height(&c.skeleton);
+		int clip = file ? 2 : 0;
+		CHECK(clip < c.clip_count);
+		mlod_motion *seq = NULL;
+		mlod_motion_level want[2];
+		CHECK_OK(mlod_motion_create(&c, clip, NULL, &seq, &terr));
+		for (int s = 0; s < 2; s++)
+			CHECK_OK(mlod_motion_next_level(seq, MLOD_MOTION_KEYS, MLOD_MOTION_MAX_ERROR, (s ? 0.02 : 0.004) * h, &want[s],
+			                                &terr));
+		mlod_motion_free(seq);
+		const int counts[4] = { 1, 2, 3, 8 };
+		for (int t = 0; t < 4; t++) {
+			mlod_motion *m = NULL, *fin = NULL;
+			CHECK_OK(mlod_motion_create(&c, clip, NULL, &m, &terr));
+			CHECK_OK(mlod_motion_create_like(m, &fin, &terr));
+			mlod_motion_set_threads(m, counts[t]);
+			mlod_motion_set_threads(fin, counts[t]);
+			for (int s = 0; s < 2; s++) {
+				mlod_motion_level l;
+				double known = -2.0, bound = (s ? 0.02 : 0.004) * h;
+				CHECK_OK(mlod_motion_keys_reduce(m, MLOD_MOTION_MAX_ERROR, bound, &l, &known, &terr));
+				CHECK(known >= 0.0 && known <= bound);
+				CHECK_OK(mlod_motion_keys_finish(fin, MLOD_MOTION_MAX_ERROR, bound, -1, known, &l, &terr));
+				CHECK_MSG(same_level(&l, &want[s]), "%s, level %d, %d threads", files[file], s, counts[t]);
+				mlod_motion_level_free(&l);
+			}
+			mlod_motion_level l;
+			double known;
+			CHECK(mlod_motion_keys_reduce(m, MLOD_MOTION_MAX_ERROR, 0.01, &l, NULL, &terr) == MLOD_ERR_INVALID_ARG);
+			CHECK(mlod_motion_keys_reduce(m, MLOD_MOTION_MAX_ERROR, -1.0, &l, &known, &terr) == MLOD_ERR_INVALID_ARG);
+			memset(&l, 0, sizeof l);
+			CHECK(mlod_motion_keys_finish(fin, MLOD_MOTION_MAX_ERROR, 0.01, -1, -1.0, &l, &terr) == MLOD_ERR_INVALID_ARG);
+			mlod_motion_free(m);
+			mlod_motion_free(fin);
+		}
+		for (int s = 0; s < 2; s++)
+			mlod_motion_level_free(&want[s]);
+		mlod_character_free(&c);
+	}
 }
 
 TEST(create_like_same_as_create)
@@ -1269,6 +1332,7 @@ int main(void)
 	RUN(precision_rounds_within_own_error);
 	RUN(fast_checks_match_exact);
 	RUN(build_levels_same_at_any_thread_count);
+	RUN(keys_split_same_as_next_level);
 	RUN(bake_report_same_at_any_thread_count);
 	RUN(create_like_same_as_create);
 	TEST_EXIT();
