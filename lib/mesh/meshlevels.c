@@ -5,6 +5,7 @@
  * posed error bound, each measured against the full character.
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -129,6 +130,7 @@ typedef struct part_job {
 	mlod_error *errs;
 	mlod_result *result;
 	int parts;
+	int defer;              /* build only: the collapses wait (chain_pending) */
 } part_job;
 
 static void part_job_free(part_job *j)
@@ -148,7 +150,7 @@ static mlod_result part_one(void *ctx, int k)
 	if (pt->triangles < 4 || in->node < 0)
 		return MLOD_OK;
 	mlod_result r = mlod_bgm_build(L->c, i, p, &L->opt, &pt->bgm, &j->errs[k]);
-	if (r == MLOD_OK) {
+	if (r == MLOD_OK && !j->defer) {
 		int target = j->min_ratio > 0.0 ? (int)ceil(j->min_ratio * pt->triangles) : 0;
 		r = mlod_bgm_simplify(pt->bgm, target, 0, &j->errs[k]);
 	}
@@ -210,7 +212,7 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 	for (int i = 0; i < c->instance_count; i++)
 		n += c->meshes[c->instances[i].mesh].primitive_count;
 	part_job j = { L, min_ratio, calloc(2 * (size_t)n + 1, sizeof *j.part), calloc((size_t)n + 1, sizeof *j.errs),
-	               calloc((size_t)n + 1, sizeof *j.result), n };
+	               calloc((size_t)n + 1, sizeof *j.result), n, 0 };
 	if (!j.part || !j.errs || !j.result) {
 		part_job_free(&j);
 		return nomem(err);
@@ -230,8 +232,12 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 			L->triangles += pt->triangles;
 			L->vertices += pr->vertex_count;
 			j.part[2 * at] = i, j.part[2 * at + 1] = p, at++;
+			j.defer += pt->triangles >= 4 && in->node >= 0;
 		}
 	}
+	/* One primitive collapses on one thread: with more, its collapses
+	 * wait for the levels, which are measured meanwhile (by_ratio). */
+	j.defer = j.defer == 1 && L->opt.threads >= 2;
 	/* Each primitive's BGM is built and simplified on its own: in
 	 * parallel, with the results gathered in primitive order; and the
 	 * full character kept posed at each measuring pose meanwhile. */
@@ -261,8 +267,12 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 		L->statics += in->skin < 0 && in->joint < 0;
 		morphs += pr->target_count > 0;
 	}
+	if (j.defer && L->simplified == 1) {
+		L->chain_pending = 1;
+		L->chain_ratio = min_ratio;
+	}
 	/* A character budget may take any primitive further than the ratio. */
-	if (L->budget == MLOD_BUDGET_CHARACTER && min_ratio > 0.0) {
+	if (L->budget == MLOD_BUDGET_CHARACTER && min_ratio > 0.0 && !j.defer) {
 		j.min_ratio = 0.0;
 		for (int k = 0; k < n; k++)
 			j.result[k] = MLOD_OK;
@@ -447,30 +457,209 @@ void mlod_mesh_levels_free(mlod_mesh_levels *L)
 	memset(L, 0, sizeof *L);
 }
 
+/* The one primitive waiting for its collapses (chain_pending). */
+static mlod_mesh_part *pending_part(const mlod_mesh_levels *L)
+{
+	for (int i = 0; i < L->c->instance_count; i++)
+		for (int p = 0; p < L->c->meshes[L->c->instances[i].mesh].primitive_count; p++)
+			if (L->parts[i][p].bgm)
+				return &L->parts[i][p];
+	return NULL;
+}
+
+/* The floor of the pending chain: init's min_ratio of the primitive's
+ * triangles (0, as far as it goes, with the character budget). */
+static int chain_floor(const mlod_mesh_levels *L, const mlod_mesh_part *pt)
+{
+	if (L->budget == MLOD_BUDGET_CHARACTER || !(L->chain_ratio > 0.0))
+		return 0;
+	return (int)ceil(L->chain_ratio * pt->triangles);
+}
+
+/* Takes the pending chain on until a level of ratio could be extracted
+ * as from the whole chain: a collapse down to its triangle target (with
+ * the character budget, what mlod_bgm_share_budget takes from the one
+ * primitive) or the chain's end. ratio 0: to the end, as init would have. */
+static mlod_result chain_to(mlod_mesh_levels *L, mlod_mesh_part *pt, double ratio, mlod_error *err)
+{
+	int floor_t = chain_floor(L, pt), t;
+	if (ratio <= 0.0)
+		t = floor_t;
+	else {
+		t = L->budget == MLOD_BUDGET_CHARACTER ? (int)ceil(ratio * (double)mlod_bgm_triangles(pt->bgm, 0))
+		                                       : (int)ceil(ratio * pt->triangles);
+		if (t < floor_t)
+			t = floor_t;
+	}
+	mlod_result r = mlod_bgm_simplify(pt->bgm, t, 0, err);
+	if (r != MLOD_OK || t <= 0)
+		return r;
+	/* simplify stops at or below t, or at the chain's end; one collapse
+	 * at a time past it if ever not (a level's prefix must be final) */
+	for (;;) {
+		int count;
+		mlod_bgm_sequence(pt->bgm, &count);
+		if (count > 0 && mlod_bgm_triangles(pt->bgm, count) <= t)
+			return MLOD_OK;
+		if ((r = mlod_bgm_simplify(pt->bgm, 0, 1, err)) != MLOD_OK)
+			return r;
+		int after;
+		mlod_bgm_sequence(pt->bgm, &after);
+		if (after == count)
+			return MLOD_OK; /* the end */
+	}
+}
+
+/* The rest of a pending chain, before anything reads it whole. */
+static mlod_result chain_finish(mlod_mesh_levels *L, mlod_error *err)
+{
+	if (!L->chain_pending)
+		return MLOD_OK;
+	L->chain_pending = 0;
+	return chain_to(L, pending_part(L), 0.0, err);
+}
+
+/* Extracts the level at ratio, after the previous ones: 1 kept (in
+ * L->levels), 0 dropped with a note, else a failure. */
+static mlod_result next_level(mlod_mesh_levels *L, double ratio, mlod_error *err)
+{
+	mlod_mesh_level lv;
+	mlod_result r = extract_level(L, &lv, ratio, err);
+	if (r != MLOD_OK)
+		return r;
+	if (L->count > 0 && lv.triangles >= L->levels[L->count - 1].triangles) {
+		note(L, "ratio %g gives no fewer triangles than %g: dropped", ratio, L->levels[L->count - 1].ratio);
+		free_level(L, &lv);
+		return MLOD_OK;
+	}
+	if (L->count == 0 && lv.triangles >= L->triangles) {
+		note(L, "ratio %g removes nothing: dropped", ratio);
+		free_level(L, &lv);
+		return MLOD_OK;
+	}
+	L->levels[L->count++] = lv;
+	return (mlod_result)1;
+}
+
+/* by_ratio with a pending chain: item 0 takes the chain from level to
+ * level and extracts each (never waiting); item 1 measures each level
+ * once it is out, on the other threads while the chain goes on, on all
+ * of them after. Each level is measured alone (mlod_posed_errors: its
+ * poses summed in order), so the bits are those of one call for all. */
+typedef struct pipe_job {
+	mlod_mesh_levels *L;
+	const double *ratios;
+	int n, first, threads;
+	int out, done;          /* levels out (L->count), the chain over */
+	pthread_mutex_t lock;
+	pthread_cond_t cond;
+	mlod_result chain_r, measure_r;
+	mlod_error chain_err, measure_err;
+	double measure_seconds;
+} pipe_job;
+
+static void pipe_chain(pipe_job *pj)
+{
+	mlod_mesh_levels *L = pj->L;
+	mlod_mesh_part *pt = pending_part(L);
+	mlod_result r = MLOD_OK;
+	for (int k = 0; r == MLOD_OK && k < pj->n && L->count < MLOD_MESH_MAX_LEVELS; k++) {
+		if ((r = chain_to(L, pt, pj->ratios[k], &pj->chain_err)) != MLOD_OK)
+			break;
+		r = next_level(L, pj->ratios[k], &pj->chain_err);
+		if (r == (mlod_result)1) {
+			r = MLOD_OK;
+			pthread_mutex_lock(&pj->lock);
+			pj->out = L->count;
+			pthread_cond_broadcast(&pj->cond);
+			pthread_mutex_unlock(&pj->lock);
+		}
+	}
+	if (r == MLOD_OK)
+		r = chain_to(L, pt, 0.0, &pj->chain_err);
+	pthread_mutex_lock(&pj->lock);
+	pj->chain_r = r;
+	pj->done = 1;
+	pthread_cond_broadcast(&pj->cond);
+	pthread_mutex_unlock(&pj->lock);
+}
+
+static void pipe_measure(pipe_job *pj)
+{
+	mlod_mesh_levels *L = pj->L;
+	int next = pj->first;
+	for (;;) {
+		pthread_mutex_lock(&pj->lock);
+		while (pj->out == next && !pj->done)
+			pthread_cond_wait(&pj->cond, &pj->lock);
+		int out = pj->out, done = pj->done;
+		pthread_mutex_unlock(&pj->lock);
+		if (out == next)
+			return; /* the chain is over (or failed) */
+		/* while the chain goes on, one level on the threads it leaves;
+		 * after it, every level out at once on all of them */
+		int count = done ? out - next : 1;
+		L->measure.threads = done ? pj->threads : pj->threads - 1;
+		const mlod_character *views[MLOD_MESH_MAX_LEVELS];
+		mlod_deviation dev[MLOD_MESH_MAX_LEVELS];
+		for (int k = 0; k < count; k++)
+			views[k] = &L->levels[next + k].view;
+		double t0 = bgm_seconds();
+		mlod_result r = mlod_posed_errors(L->c, views, count, &L->measure, dev, &pj->measure_err);
+		pj->measure_seconds += bgm_seconds() - t0;
+		if (r != MLOD_OK) {
+			pj->measure_r = r;
+			return;
+		}
+		for (int k = 0; k < count; k++)
+			L->levels[next + k].error = dev[k];
+		next += count;
+	}
+}
+
+static mlod_result pipe_item(void *ctx, int item)
+{
+	if (item == 0)
+		pipe_chain(ctx);
+	else
+		pipe_measure(ctx);
+	return MLOD_OK;
+}
+
+static mlod_result by_ratio_pipelined(mlod_mesh_levels *L, const double *ratios, int n, mlod_error *err)
+{
+	pipe_job pj = { L, ratios, n, L->count, L->measure.threads, L->count, 0, PTHREAD_MUTEX_INITIALIZER,
+	                PTHREAD_COND_INITIALIZER, MLOD_OK, MLOD_OK, { 0 }, { 0 }, 0.0 };
+	L->chain_pending = 0;
+	/* item 0 never waits: one thread alone runs both, in order */
+	mlod_parallel_for(2, 2, pipe_item, &pj);
+	L->measure.threads = pj.threads;
+	L->measure_seconds += pj.measure_seconds;
+	pthread_mutex_destroy(&pj.lock);
+	pthread_cond_destroy(&pj.cond);
+	mlod_result r = pj.chain_r != MLOD_OK ? pj.chain_r : pj.measure_r;
+	if (r != MLOD_OK) {
+		if (err)
+			*err = pj.chain_r != MLOD_OK ? pj.chain_err : pj.measure_err;
+		drop_levels(L, pj.first);
+	}
+	return r;
+}
+
 mlod_result mlod_mesh_levels_by_ratio(mlod_mesh_levels *L, const double *ratios, int n, mlod_error *err)
 {
+	if (L->chain_pending)
+		return by_ratio_pipelined(L, ratios, n, err);
 	/* The levels first (which are kept depends on their triangles only),
 	 * then all of them measured at once: their poses spread over the
 	 * threads, the same results as one level after another. */
 	const int first = L->count;
 	for (int k = 0; k < n && L->count < MLOD_MESH_MAX_LEVELS; k++) {
-		mlod_mesh_level lv;
-		mlod_result r = extract_level(L, &lv, ratios[k], err);
-		if (r != MLOD_OK) {
+		mlod_result r = next_level(L, ratios[k], err);
+		if (r != MLOD_OK && r != (mlod_result)1) {
 			drop_levels(L, first);
 			return r;
 		}
-		if (L->count > 0 && lv.triangles >= L->levels[L->count - 1].triangles) {
-			note(L, "ratio %g gives no fewer triangles than %g: dropped", ratios[k], L->levels[L->count - 1].ratio);
-			free_level(L, &lv);
-			continue;
-		}
-		if (L->count == 0 && lv.triangles >= L->triangles) {
-			note(L, "ratio %g removes nothing: dropped", ratios[k]);
-			free_level(L, &lv);
-			continue;
-		}
-		L->levels[L->count++] = lv;
 	}
 	const mlod_character *views[MLOD_MESH_MAX_LEVELS];
 	mlod_deviation dev[MLOD_MESH_MAX_LEVELS];
@@ -536,7 +725,8 @@ mlod_result mlod_mesh_levels_by_error(mlod_mesh_levels *L, double bound, mlod_er
 	for (double ratio = 0.5; ratio >= MLOD_MESH_MIN_RATIO && n < MLOD_MESH_MAX_LEVELS; ratio /= 2)
 		ratios[n++] = ratio;
 	mlod_level_search s = {ratios, n, 1.0, 0, MLOD_MESH_BISECTIONS, bound, L, search_make, search_keep, search_drop};
-	return mlod_level_search_run(&s, err);
+	mlod_result r = chain_finish(L, err);
+	return r != MLOD_OK ? r : mlod_level_search_run(&s, err);
 }
 
 void mlod_mesh_levels_totals(const mlod_mesh_levels *L, mlod_bgm_info *sum)

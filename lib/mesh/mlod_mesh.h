@@ -300,6 +300,8 @@ typedef struct mlod_mesh_levels {
 	int triangles, vertices; /* of the input */
 	double build_seconds;
 	double measure_seconds;  /* measuring the levels' posed error (wall clock, all levels) */
+	int chain_pending;       /* the one primitive's collapses wait for the levels' call */
+	double chain_ratio;      /* init's min_ratio, for them */
 	int count;
 	mlod_mesh_level levels[MLOD_MESH_MAX_LEVELS];
 	const mlod_mesh_skeleton *skeleton; /* followed skeleton levels (mlod_mesh_levels_follow) */
@@ -309,7 +311,10 @@ typedef struct mlod_mesh_levels {
 
 /* Builds the BGM of every triangle primitive of c (which must outlive L)
  * and records its collapses down to min_ratio of its triangles (0: as far
- * as they go). */
+ * as they go). With opt->threads >= 2 and one primitive to simplify, its
+ * collapses are left to mlod_mesh_levels_by_ratio or _by_error (the same
+ * sequence): by_ratio then measures each level on the other threads while
+ * the collapses go on to the next. */
 mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, const mlod_bgm_options *opt,
                                   mlod_mesh_budget budget, double min_ratio, mlod_error *err);
 void mlod_mesh_levels_free(mlod_mesh_levels *L);
