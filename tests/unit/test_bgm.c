@@ -770,6 +770,68 @@ TEST(level_errors_ordered)
 	mlod_character_free(&c);
 }
 
+/* mlod_mesh_levels at 1, 2 and 3 threads: the same levels, errors and
+ * notes to the bit. At 2 and more, one primitive's collapses wait for
+ * by_ratio, which measures each level while they go on to the next. */
+static void mesh_levels_at(const mlod_character *c, mlod_mesh_budget budget, int threads, int by_error,
+                           mlod_mesh_levels *L)
+{
+	mlod_bgm_options opt = {0};
+	opt.threads = threads;
+	double ratios[5] = {0.5, 0.25, 0.25, 0.1, 0.03};
+	CHECK_OK(mlod_mesh_levels_init(L, c, &opt, budget, by_error ? 0.0 : ratios[4], &terr));
+	CHECK_MSG(L->chain_pending == (threads >= 2), "%d threads: chain pending %d", threads, L->chain_pending);
+	if (by_error)
+		CHECK_OK(mlod_mesh_levels_by_error(L, 1.0, &terr));
+	else
+		CHECK_OK(mlod_mesh_levels_by_ratio(L, ratios, 5, &terr));
+	CHECK(!L->chain_pending);
+}
+
+TEST(mesh_levels_pipelined)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	CHECK(mlod_mesh_triangle_primitives(&c) == 1);
+	for (int v = 0; v < 3; v++) {
+		mlod_mesh_budget budget = v == 1 ? MLOD_BUDGET_PRIMITIVE : MLOD_BUDGET_CHARACTER;
+		mlod_mesh_levels one;
+		mesh_levels_at(&c, budget, 1, v == 2, &one);
+		CHECK(one.count >= 2);
+		if (v == 0)
+			CHECK_MSG(one.count == 4 && strstr(one.notes, "dropped"), "%d levels, notes %.200s", one.count, one.notes);
+		mlod_bgm_info t1;
+		mlod_mesh_levels_totals(&one, &t1);
+		for (int threads = 2; threads <= 3; threads++) {
+			mlod_mesh_levels L;
+			mesh_levels_at(&c, budget, threads, v == 2, &L);
+			CHECK_MSG(L.count == one.count, "variant %d, %d threads: %d levels, %d at one", v, threads, L.count,
+			          one.count);
+			for (int k = 0; k < L.count && k < one.count; k++) {
+				const mlod_mesh_level *a = &one.levels[k], *b = &L.levels[k];
+				CHECK_MSG(a->triangles == b->triangles && a->vertices == b->vertices && a->collapses == b->collapses &&
+				              a->error.mean == b->error.mean && a->error.max == b->error.max && a->error.max > 0.0,
+				          "variant %d, %d threads, level %d: %d triangles, error %.17g/%.17g; at one %d, %.17g/%.17g",
+				          v, threads, k, b->triangles, b->error.mean, b->error.max, a->triangles, a->error.mean,
+				          a->error.max);
+				for (int p = 0; p < a->meshes[0].primitive_count; p++) {
+					const mlod_primitive *x = &a->meshes[0].primitives[p], *y = &b->meshes[0].primitives[p];
+					CHECK(x->index_count == y->index_count && x->vertex_count == y->vertex_count);
+					CHECK(x->index_count == 0 ||
+					      memcmp(x->indices, y->indices, sizeof *x->indices * (size_t)x->index_count) == 0);
+				}
+			}
+			mlod_bgm_info t;
+			mlod_mesh_levels_totals(&L, &t);
+			CHECK(t.refused == t1.refused && t.snaps == t1.snaps && t.dropped == t1.dropped);
+			CHECK_MSG(strcmp(L.notes, one.notes) == 0, "notes %.200s; at one thread %.200s", L.notes, one.notes);
+			mlod_mesh_levels_free(&L);
+		}
+		mlod_mesh_levels_free(&one);
+	}
+	mlod_character_free(&c);
+}
+
 TEST(pose_sets)
 {
 	mlod_character c;
@@ -941,6 +1003,7 @@ int main(void)
 	RUN(rigid_and_morph);
 	RUN(deterministic);
 	RUN(level_errors_ordered);
+	RUN(mesh_levels_pipelined);
 	RUN(pose_sets);
 	RUN(remap_joints);
 	RUN(hostile_input);
