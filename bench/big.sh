@@ -8,7 +8,8 @@
 # samples/tubeman.glb) into a temporary folder, never committed. Times are
 # the CPU time (user + system, from the shell's `times`) of whole mlod-bgm
 # and mlod-pack runs at one thread (-j 1), best of RUNS (default 3), and the
-# wall-clock time of mlod-bgm -j 2 (best of RUNS). The
+# wall-clock time of mlod-bgm -j 2 (best of RUNS; its levels are measured
+# while the collapses go on). The
 # split comes from the tools' JSON reports (wall clock, of the fastest
 # run): mlod-bgm's BGM build, collapse and measuring times (the rest is
 # loading, extracting the levels and writing), mlod-pack's time per
@@ -98,7 +99,7 @@ echo "|---|---:|---|"
 awk -v t="$bgm" -v b="$build_ms" -v c="$collapse_ms" -v m="$measure_ms" 'BEGIN {
 	printf "| mlod-bgm (default levels) | %.2f | BGM build %.0f, collapses %.0f, the levels\047 posed error %.0f (the rest: loading, extracting the levels, writing) |\n", t, b, c, m }'
 awk -v t="$bgm2" 'BEGIN {
-	printf "| mlod-bgm -j 2 (default levels), wall-clock s | %.2f | the same output; two threads measure the levels |\n", t }'
+	printf "| mlod-bgm -j 2 (default levels), wall-clock s | %.2f | the same output; each level measured on the other thread while the collapses go on to the next |\n", t }'
 awk -v t="$pack" -v s="$(layer_ms skeleton)" -v m="$(layer_ms mesh)" -v o="$(layer_ms motion)" 'BEGIN {
 	printf "| mlod-pack (every layer, every level) | %.2f | skeleton %.0f, mesh %.0f, motion %.0f |\n", t, s, m, o }'
 awk -v s="$skel" -v m="$motion" -v b="$bgm" 'BEGIN {
