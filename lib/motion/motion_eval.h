@@ -411,8 +411,16 @@ typedef struct eval_scratch {
 	size_t size;
 } eval_scratch;
 
-/* At least size bytes, or NULL when out of memory (tasks.c). */
-void *eval_scratch_get(eval_scratch *sc, size_t size);
+/* At least size bytes, or NULL when out of memory. */
+static inline void *eval_scratch_get(eval_scratch *sc, size_t size)
+{
+	if (sc->size < size || !sc->p) {
+		free(sc->p);
+		sc->p = malloc(size > 0 ? size : 1);
+		sc->size = sc->p ? size : 0;
+	}
+	return sc->p;
+}
 
 /* The next n bytes of a scratch buffer, 64-byte aligned (*at moves on);
  * eval_carve_size(n) is what it takes at most. */

@@ -10,10 +10,8 @@
  * that may start; the lock orders a task's end before the start of the
  * tasks that wait for it.
  */
-#define _DEFAULT_SOURCE /* madvise */
 #include <pthread.h>
 #include <stdlib.h>
-#include <sys/mman.h>
 
 #include "motion/motion_eval.h"
 
@@ -86,29 +84,4 @@ mlod_result motion_run_tasks(int n, int lanes, motion_conflict_fn conflict, moti
 	pthread_mutex_destroy(&q.lock);
 	free(q.state);
 	return MLOD_OK;
-}
-
-/* Buffers of HUGE bytes or more start on a huge-page boundary and ask for
- * huge pages (where the system has them): the key reduction's and the
- * rounding's arrays (tens of MB on a long clip) then cost a few hundred
- * page faults instead of thousands. */
-#define HUGE ((size_t)2 << 20)
-
-void *eval_scratch_get(eval_scratch *sc, size_t size)
-{
-	if (sc->size < size || !sc->p) {
-		free(sc->p);
-		if (size >= HUGE) {
-			size_t n = (size + HUGE - 1) / HUGE * HUGE;
-			sc->p = aligned_alloc(HUGE, n);
-#ifdef MADV_HUGEPAGE
-			if (sc->p)
-				(void)madvise(sc->p, n, MADV_HUGEPAGE); /* only a hint: its failure changes nothing */
-#endif
-		} else {
-			sc->p = malloc(size > 0 ? size : 1);
-		}
-		sc->size = sc->p ? size : 0;
-	}
-	return sc->p;
 }
