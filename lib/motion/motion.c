@@ -430,8 +430,48 @@ static int reach_exps(mlod_motion *m)
 	return 0;
 }
 
+/* The clip as read at every sample (m->cache0), samples [i S / n,
+ * (i + 1) S / n) in item i, each with its own sampling state: a
+ * sample's matrices do not depend on the samples before it. */
+typedef struct cache_ctx {
+	mlod_motion *m;
+	const mlod_clip *src;
+	int n;
+	atomic_int failed;
+} cache_ctx;
+
+static mlod_result cache_item(void *ctx, int i)
+{
+	cache_ctx *x = ctx;
+	mlod_motion *m = x->m;
+	int n = m->s->joint_count, nch = x->src->channel_count;
+	eval_seg *segs = malloc(sizeof *segs * (size_t)(nch > 0 ? nch : 1));
+	mlod_trs *local = malloc(sizeof *local * (size_t)n);
+	if (!segs || !local) {
+		atomic_store(&x->failed, 1);
+	} else {
+		for (int k = 0; k < nch; k++)
+			segs[k].k = -1, segs[k].ready = 0;
+		mlod_pose_rest(m->s, local);
+		int f0 = (int)((long)i * m->samples / x->n), f1 = (int)((long)(i + 1) * m->samples / x->n);
+		for (int f = f0; f < f1; f++) {
+			eval_sample(x->src, segs, m->st[f], local);
+			eval_pose_world(m->s, local, m->cache0 + (size_t)f * (size_t)n);
+		}
+	}
+	free(segs);
+	free(local);
+	return MLOD_OK;
+}
+
 mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_motion_options *opt,
                                mlod_motion **out, mlod_error *err)
+{
+	return motion_create_on(c, clip, opt, 1, out, err);
+}
+
+mlod_result motion_create_on(const mlod_character *c, int clip, const mlod_motion_options *opt, int threads,
+                             mlod_motion **out, mlod_error *err)
 {
 	if (out)
 		*out = NULL;
@@ -522,16 +562,26 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 		/* mlod_clip_sample and mlod_pose_world, faster (motion_eval.h)
 		 * when the clip is LINEAR or STEP. */
 		int fast = eval_clip_ok(src) && src->channel_count <= nch;
-		for (int i = 0; fast && i < src->channel_count; i++)
-			m->walk_segs[i].k = -1, m->walk_segs[i].ready = 0;
-		mlod_pose_rest(s, m->walk_local);
-		for (int f = 0; f < m->samples; f++) {
-			mlod_mat4 *w = m->cache0 + (size_t)f * (size_t)n;
-			if (fast) {
-				eval_sample(src, m->walk_segs, m->st[f], m->walk_local);
-				eval_pose_world(s, m->walk_local, w);
-			} else {
-				pose_at(m, src, m->st[f], w);
+		if (fast && threads > 1) {
+			cache_ctx x;
+			x.m = m, x.src = src, x.n = threads < MLOD_MAX_THREADS ? threads : MLOD_MAX_THREADS;
+			atomic_init(&x.failed, 0);
+			if (mlod_parallel_for(x.n, x.n, cache_item, &x) != MLOD_OK || x.failed) {
+				mlod_motion_free(m);
+				return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+			}
+		} else {
+			for (int i = 0; fast && i < src->channel_count; i++)
+				m->walk_segs[i].k = -1, m->walk_segs[i].ready = 0;
+			mlod_pose_rest(s, m->walk_local);
+			for (int f = 0; f < m->samples; f++) {
+				mlod_mat4 *w = m->cache0 + (size_t)f * (size_t)n;
+				if (fast) {
+					eval_sample(src, m->walk_segs, m->st[f], m->walk_local);
+					eval_pose_world(s, m->walk_local, w);
+				} else {
+					pose_at(m, src, m->st[f], w);
+				}
 			}
 		}
 	}
