@@ -387,6 +387,94 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
 	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, NULL, 1, err);
 }
 
+/* The reduction's starting state, on up to R->lanes threads (the same
+ * floats at any count: each channel's and each sample's values are
+ * computed alone). setup_item i: the kept keys' values of channels
+ * [i C / n, (i + 1) C / n) into lc (a joint's channels set different
+ * fields), prevk and nextk the item's; frames_item i: lm and wc of
+ * samples [i S / n, (i + 1) S / n). */
+typedef struct setup_ctx {
+	reducer *R;
+	int n;
+	int *prevk, *nextk; /* n * F */
+} setup_ctx;
+
+static mlod_result setup_item(void *ctx, int i)
+{
+	setup_ctx *x = ctx;
+	reducer *R = x->R;
+	int *prevk = x->prevk + (size_t)i * (size_t)R->F, *nextk = x->nextk + (size_t)i * (size_t)R->F;
+	int c0 = (int)((long)i * R->C / x->n), c1 = (int)((long)(i + 1) * R->C / x->n);
+	for (int c = c0; c < c1; c++) {
+		const mlod_channel *ch = &R->common->channels[c];
+		const unsigned char *row = R->kept + (size_t)c * (size_t)R->F;
+		int first = -1, last = -1;
+		for (int k = 0; k < R->F; k++)
+			if (row[k]) {
+				if (first < 0)
+					first = k;
+				last = k;
+			}
+		for (int k = 0, p = -1; k < R->F; k++) /* prevk: the last kept at or before k */
+			prevk[k] = p = row[k] ? k : p;
+		for (int k = R->F - 1, n = -1; k >= 0; k--) { /* nextk: the first kept after k */
+			nextk[k] = n;
+			if (row[k])
+				n = k;
+		}
+		eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+		int seg_a = -1;
+		for (int f = 0; f < R->S; f++) {
+			float v[4];
+			int comps = comps_of(ch);
+			if (first == last || f <= first * R->per || f >= last * R->per) {
+				int k = f >= last * R->per && first != last ? last : first;
+				memcpy(v, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
+			} else {
+				/* As mlod_clip_sample computes it from the kept keys around f,
+				 * the slerp's per-segment part done once a segment. */
+				int a = prevk[f / R->per], b = nextk[f / R->per];
+				if (a != seg_a)
+					seg.ready = 0, seg_a = a;
+				const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
+				const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
+				const float u = (R->times[f] - t0) / dt;
+				if (ch->interp == MLOD_INTERP_STEP) {
+					memcpy(v, va, sizeof(float) * (size_t)comps);
+				} else if (comps == 4) {
+					mlod_quat q = eval_slerp(&seg, va, vb, u);
+					v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
+				} else {
+					for (int c = 0; c < 3; c++)
+						v[c] = va[c] + (vb[c] - va[c]) * u;
+				}
+			}
+			set_path(&R->lc[(size_t)f * (size_t)R->J + (size_t)ch->joint], ch->path, v);
+		}
+	}
+	return MLOD_OK;
+}
+
+static mlod_result frames_item(void *ctx, int i)
+{
+	setup_ctx *x = ctx;
+	reducer *R = x->R;
+	int f0 = (int)((long)i * R->S / x->n), f1 = (int)((long)(i + 1) * R->S / x->n);
+	for (int f = f0; f < f1; f++) {
+		size_t base = (size_t)f * (size_t)R->J;
+		mlod_trs *l = R->lc + base;
+		for (int j = 0; j < R->J; j++)
+			R->lm[base + (size_t)j] = eval_from_trs(&l[j]); /* mlod_mat4_from_trs, inline */
+		for (int j = 0; j < R->J; j++) {
+			int p = R->s->joints[j].parent;
+			/* mlod_mat4_mul; below a root, its affine form (the same floats) */
+			R->wc[base + (size_t)j] = p < 0 ? mlod_mat4_mul(&R->s->joints[j].base, &R->lm[base + (size_t)j])
+			                                : eval_mul_affine(&R->wc[base + (size_t)p], &R->lm[base + (size_t)j]);
+		}
+	}
+	return MLOD_OK;
+}
+
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
                           double *max_error, eval_scratch *scratch, int threads, mlod_error *err)
@@ -442,7 +530,8 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		}
 	}
 	int *depth = malloc(sizeof(int) * (size_t)R.J);
-	int *prevk = malloc(sizeof(int) * (size_t)R.F), *nextk = malloc(sizeof(int) * (size_t)R.F);
+	int *prevk = malloc(sizeof(int) * (size_t)R.F * (size_t)R.lanes);
+	int *nextk = malloc(sizeof(int) * (size_t)R.F * (size_t)R.lanes);
 	int *fill = NULL;
 	if (!R.times || !R.radius || !R.sub_start || !R.w0 || !R.lc || !depth || !prevk || !nextk) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
@@ -488,65 +577,9 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	/* The kept keys' values (those of mlod_clip_sample on the kept keys,
 	 * each sample's kept neighbours looked up), channel by channel in
 	 * order, as mlod_clip_sample sets them. */
-	for (int c = 0; c < common->channel_count; c++) {
-		const mlod_channel *ch = &common->channels[c];
-		const unsigned char *row = kept + (size_t)c * (size_t)R.F;
-		int first = -1, last = -1;
-		for (int k = 0; k < R.F; k++)
-			if (row[k]) {
-				if (first < 0)
-					first = k;
-				last = k;
-			}
-		for (int k = 0, p = -1; k < R.F; k++) /* prevk: the last kept at or before k */
-			prevk[k] = p = row[k] ? k : p;
-		for (int k = R.F - 1, n = -1; k >= 0; k--) { /* nextk: the first kept after k */
-			nextk[k] = n;
-			if (row[k])
-				n = k;
-		}
-		eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
-		int seg_a = -1;
-		for (int f = 0; f < R.S; f++) {
-			float v[4];
-			int comps = comps_of(ch);
-			if (first == last || f <= first * R.per || f >= last * R.per) {
-				int k = f >= last * R.per && first != last ? last : first;
-				memcpy(v, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
-			} else {
-				/* As mlod_clip_sample computes it from the kept keys around f,
-				 * the slerp's per-segment part done once a segment. */
-				int a = prevk[f / R.per], b = nextk[f / R.per];
-				if (a != seg_a)
-					seg.ready = 0, seg_a = a;
-				const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
-				const float t0 = R.times[a * R.per], dt = R.times[b * R.per] - t0;
-				const float u = (R.times[f] - t0) / dt;
-				if (ch->interp == MLOD_INTERP_STEP) {
-					memcpy(v, va, sizeof(float) * (size_t)comps);
-				} else if (comps == 4) {
-					mlod_quat q = eval_slerp(&seg, va, vb, u);
-					v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
-				} else {
-					for (int c = 0; c < 3; c++)
-						v[c] = va[c] + (vb[c] - va[c]) * u;
-				}
-			}
-			set_path(&R.lc[(size_t)f * (size_t)R.J + (size_t)ch->joint], ch->path, v);
-		}
-	}
-	for (int f = 0; f < R.S; f++) {
-		size_t base = (size_t)f * (size_t)R.J;
-		mlod_trs *l = R.lc + base;
-		for (int j = 0; j < R.J; j++)
-			R.lm[base + (size_t)j] = eval_from_trs(&l[j]); /* mlod_mat4_from_trs, inline */
-		for (int j = 0; j < R.J; j++) {
-			int p = s->joints[j].parent;
-			/* mlod_mat4_mul; below a root, its affine form (the same floats) */
-			R.wc[base + (size_t)j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &R.lm[base + (size_t)j])
-			                               : eval_mul_affine(&R.wc[base + (size_t)p], &R.lm[base + (size_t)j]);
-		}
-	}
+	setup_ctx sx = { &R, R.lanes, prevk, nextk };
+	mlod_parallel_for(sx.n, sx.n, setup_item, &sx);
+	mlod_parallel_for(sx.n, sx.n, frames_item, &sx);
 
 	/* Rounds of reduce_channel over the channels at a growing budget, then
 	 * collapse_channel over them at the whole bound. */

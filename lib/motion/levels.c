@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "motion/mlod_motion.h"
+#include "motion/motion_eval.h"
 
 typedef struct build_ctx {
 	const mlod_character *c;
@@ -157,7 +158,7 @@ static void keys_item(build_ctx *b, int k)
 	int i = b->keys;
 	size_t ci = (size_t)k * (size_t)b->method_count + (size_t)i;
 	mlod_motion *m = NULL;
-	b->create_result[ci] = mlod_motion_create(b->c, b->clips[k], b->opt, &m, &b->create_error[ci]);
+	b->create_result[ci] = motion_create_on(b->c, b->clips[k], b->opt, b->threads, &m, &b->create_error[ci]);
 	if (b->create_result[ci] == MLOD_OK) {
 		b->info[ci] = *mlod_motion_timeline_info(m);
 		mlod_motion_set_threads(m, b->threads);

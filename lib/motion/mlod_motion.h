@@ -151,8 +151,10 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
                                mlod_motion **out, mlod_error *err);
 /* Another motion of first's clip with first's options (for the other
  * method), its setup (common timeline, the clip as read at every sample)
- * copied instead of computed again: the same as mlod_motion_create with
- * them; first may be freed before it. */
+ * shared, read-only, instead of computed again or copied: the same as
+ * mlod_motion_create with them; first may be freed before it (the last
+ * of the motions sharing a setup to be freed frees it), and the motions
+ * may run on different threads. */
 mlod_result mlod_motion_create_like(const mlod_motion *first, mlod_motion **out, mlod_error *err);
 void mlod_motion_free(mlod_motion *m);
 /* The keys method's choice of keys runs on up to threads threads (default

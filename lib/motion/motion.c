@@ -66,6 +66,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -252,8 +253,17 @@ typedef struct line {
 	fnode *v;
 } line;
 
+/* The setup's owners: mlod_motion_create's motion and those made like it
+ * (mlod_motion_create_like) share its read-only arrays (common, st,
+ * weight, offset, euler_slot, constant, radius, reach_exp, cache0); the
+ * last one freed frees them. */
+typedef struct setup_refs {
+	atomic_int n;
+} setup_refs;
+
 struct mlod_motion {
 	const mlod_character *c;
+	setup_refs *refs;      /* NULL: the setup is this motion's alone */
 	const mlod_skeleton *s;
 	const mlod_clip *orig;
 	mlod_motion_options opt;
@@ -301,18 +311,21 @@ void mlod_motion_free(mlod_motion *m)
 {
 	if (!m)
 		return;
-	mlod_clip_free(&m->common);
-	free(m->st);
-	free(m->weight);
-	free(m->offset);
-	free(m->euler_slot);
-	free(m->constant);
-	free(m->radius);
-	free(m->reach_exp);
+	if (!m->refs || atomic_fetch_sub(&m->refs->n, 1) == 1) {
+		free(m->refs);
+		mlod_clip_free(&m->common);
+		free(m->st);
+		free(m->weight);
+		free(m->offset);
+		free(m->euler_slot);
+		free(m->constant);
+		free(m->radius);
+		free(m->reach_exp);
+		free(m->cache0);
+	}
 	free(m->local);
 	free(m->world);
 	free(m->world0);
-	free(m->cache0);
 	free(m->walk_segs);
 	free(m->walk_local);
 	line_free(&m->tree);
@@ -417,8 +430,48 @@ static int reach_exps(mlod_motion *m)
 	return 0;
 }
 
+/* The clip as read at every sample (m->cache0), samples [i S / n,
+ * (i + 1) S / n) in item i, each with its own sampling state: a
+ * sample's matrices do not depend on the samples before it. */
+typedef struct cache_ctx {
+	mlod_motion *m;
+	const mlod_clip *src;
+	int n;
+	atomic_int failed;
+} cache_ctx;
+
+static mlod_result cache_item(void *ctx, int i)
+{
+	cache_ctx *x = ctx;
+	mlod_motion *m = x->m;
+	int n = m->s->joint_count, nch = x->src->channel_count;
+	eval_seg *segs = malloc(sizeof *segs * (size_t)(nch > 0 ? nch : 1));
+	mlod_trs *local = malloc(sizeof *local * (size_t)n);
+	if (!segs || !local) {
+		atomic_store(&x->failed, 1);
+	} else {
+		for (int k = 0; k < nch; k++)
+			segs[k].k = -1, segs[k].ready = 0;
+		mlod_pose_rest(m->s, local);
+		int f0 = (int)((long)i * m->samples / x->n), f1 = (int)((long)(i + 1) * m->samples / x->n);
+		for (int f = f0; f < f1; f++) {
+			eval_sample(x->src, segs, m->st[f], local);
+			eval_pose_world(m->s, local, m->cache0 + (size_t)f * (size_t)n);
+		}
+	}
+	free(segs);
+	free(local);
+	return MLOD_OK;
+}
+
 mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_motion_options *opt,
                                mlod_motion **out, mlod_error *err)
+{
+	return motion_create_on(c, clip, opt, 1, out, err);
+}
+
+mlod_result motion_create_on(const mlod_character *c, int clip, const mlod_motion_options *opt, int threads,
+                             mlod_motion **out, mlod_error *err)
 {
 	if (out)
 		*out = NULL;
@@ -509,16 +562,26 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 		/* mlod_clip_sample and mlod_pose_world, faster (motion_eval.h)
 		 * when the clip is LINEAR or STEP. */
 		int fast = eval_clip_ok(src) && src->channel_count <= nch;
-		for (int i = 0; fast && i < src->channel_count; i++)
-			m->walk_segs[i].k = -1, m->walk_segs[i].ready = 0;
-		mlod_pose_rest(s, m->walk_local);
-		for (int f = 0; f < m->samples; f++) {
-			mlod_mat4 *w = m->cache0 + (size_t)f * (size_t)n;
-			if (fast) {
-				eval_sample(src, m->walk_segs, m->st[f], m->walk_local);
-				eval_pose_world(s, m->walk_local, w);
-			} else {
-				pose_at(m, src, m->st[f], w);
+		if (fast && threads > 1) {
+			cache_ctx x;
+			x.m = m, x.src = src, x.n = threads < MLOD_MAX_THREADS ? threads : MLOD_MAX_THREADS;
+			atomic_init(&x.failed, 0);
+			if (mlod_parallel_for(x.n, x.n, cache_item, &x) != MLOD_OK || x.failed) {
+				mlod_motion_free(m);
+				return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+			}
+		} else {
+			for (int i = 0; fast && i < src->channel_count; i++)
+				m->walk_segs[i].k = -1, m->walk_segs[i].ready = 0;
+			mlod_pose_rest(s, m->walk_local);
+			for (int f = 0; f < m->samples; f++) {
+				mlod_mat4 *w = m->cache0 + (size_t)f * (size_t)n;
+				if (fast) {
+					eval_sample(src, m->walk_segs, m->st[f], m->walk_local);
+					eval_pose_world(s, m->walk_local, w);
+				} else {
+					pose_at(m, src, m->st[f], w);
+				}
 			}
 		}
 	}
@@ -527,10 +590,12 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 	m->kept = malloc((size_t)nch * (size_t)F);
 	m->memo = calloc(1, sizeof *m->memo);
 	m->segmemo = calloc(1, sizeof *m->segmemo);
-	if (!m->kept || !m->memo || !m->segmemo) {
+	m->refs = malloc(sizeof *m->refs);
+	if (!m->kept || !m->memo || !m->segmemo || !m->refs) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
+	atomic_init(&m->refs->n, 1);
 	memset(m->kept, 1, (size_t)nch * (size_t)F);
 	*out = m;
 	return MLOD_OK;
@@ -538,26 +603,22 @@ mlod_result mlod_motion_create(const mlod_character *c, int clip, const mlod_mot
 
 static int clip_copy(const mlod_clip *src, mlod_clip *dst);
 
-/* A copy of n bytes at p, or NULL (also when p is NULL). */
-static void *dup_bytes(const void *p, size_t n)
-{
-	void *d = p ? malloc(n > 0 ? n : 1) : NULL;
-	if (d)
-		memcpy(d, p, n);
-	return d;
-}
-
 mlod_result mlod_motion_create_like(const mlod_motion *first, mlod_motion **out, mlod_error *err)
 {
 	if (out)
 		*out = NULL;
 	if (!first || !out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_create_like: NULL argument");
+	if (!first->refs)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_create_like: not a motion made by mlod_motion_create");
 	mlod_motion *m = calloc(1, sizeof *m);
 	if (!m)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	/* What mlod_motion_create computes from the character, the clip and
-	 * the options, copied; each method's state starts afresh. */
+	 * the options, shared (read-only from here on); each method's state
+	 * starts afresh. */
+	atomic_fetch_add(&first->refs->n, 1);
+	m->refs = first->refs;
 	m->c = first->c;
 	m->s = first->s;
 	m->orig = first->orig;
@@ -571,19 +632,15 @@ mlod_result mlod_motion_create_like(const mlod_motion *first, mlod_motion **out,
 	m->rot_count = first->rot_count;
 	m->clip_end_ok = first->clip_end_ok;
 	int n = first->s->joint_count, nch = first->common.channel_count, F = first->frames;
-	int bad = clip_copy(&first->common, &m->common) != 0;
-	if (!bad && !first->common.name) {
-		free(m->common.name);
-		m->common.name = NULL;
-	}
-	m->st = dup_bytes(first->st, sizeof(float) * (size_t)first->samples);
-	m->weight = dup_bytes(first->weight, sizeof(double) * (size_t)n);
-	m->offset = dup_bytes(first->offset, sizeof(int) * (size_t)nch);
-	m->euler_slot = dup_bytes(first->euler_slot, sizeof(int) * (size_t)nch);
-	m->constant = dup_bytes(first->constant, (size_t)nch);
-	m->radius = dup_bytes(first->radius, sizeof(double) * (size_t)n);
-	m->reach_exp = dup_bytes(first->reach_exp, sizeof(int) * (size_t)n);
-	m->cache0 = dup_bytes(first->cache0, sizeof(mlod_mat4) * (size_t)first->samples * (size_t)n);
+	m->common = first->common;
+	m->st = first->st;
+	m->weight = first->weight;
+	m->offset = first->offset;
+	m->euler_slot = first->euler_slot;
+	m->constant = first->constant;
+	m->radius = first->radius;
+	m->reach_exp = first->reach_exp;
+	m->cache0 = first->cache0;
 	m->local = malloc(sizeof *m->local * (size_t)n);
 	m->world = malloc(sizeof *m->world * (size_t)n);
 	m->world0 = malloc(sizeof *m->world0 * (size_t)n);
@@ -592,9 +649,7 @@ mlod_result mlod_motion_create_like(const mlod_motion *first, mlod_motion **out,
 	m->kept = malloc((size_t)nch * (size_t)F);
 	m->memo = calloc(1, sizeof *m->memo);
 	m->segmemo = calloc(1, sizeof *m->segmemo);
-	if (bad || !m->st || !m->weight || !m->offset || !m->euler_slot || !m->constant || !m->radius || !m->reach_exp ||
-	    (first->cache0 && !m->cache0) || !m->local || !m->world || !m->world0 || !m->walk_segs || !m->walk_local ||
-	    !m->kept || !m->memo || !m->segmemo) {
+	if (!m->local || !m->world || !m->world0 || !m->walk_segs || !m->walk_local || !m->kept || !m->memo || !m->segmemo) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}

@@ -411,6 +411,11 @@ typedef struct eval_scratch {
 	size_t size;
 } eval_scratch;
 
+/* mlod_motion_create, its setup (the clip as read at every sample) on up
+ * to threads threads: the same motion at any count. */
+mlod_result motion_create_on(const mlod_character *c, int clip, const mlod_motion_options *opt, int threads,
+                             mlod_motion **out, mlod_error *err);
+
 /* At least size bytes, or NULL when out of memory. */
 static inline void *eval_scratch_get(eval_scratch *sc, size_t size)
 {

@@ -1271,6 +1271,41 @@ TEST(create_like_same_as_create)
 	mlod_character_free(&c);
 }
 
+TEST(create_on_threads_same_as_create)
+{
+	/* motion_create_on: the clip as read at every sample made on 1, 2 and
+	 * 3 threads gives the same levels; and a motion made like one made
+	 * like the first, the first and the second freed before it is used
+	 * (the shared setup lives until its last motion is freed). */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	mlod_motion_level ref[2];
+	for (int threads = 1; threads <= 3; threads++) {
+		mlod_motion *m = NULL, *like = NULL, *like2 = NULL;
+		CHECK_OK(motion_create_on(&c, 0, NULL, threads, &m, &terr));
+		CHECK_OK(mlod_motion_create_like(m, &like, &terr));
+		CHECK_OK(mlod_motion_create_like(like, &like2, &terr));
+		mlod_motion_free(m);
+		mlod_motion_free(like);
+		for (int s = 0; s < 2; s++) {
+			mlod_motion_level a;
+			CHECK_OK(mlod_motion_next_level(like2, MLOD_MOTION_KEYS, MLOD_MOTION_MAX_ERROR, (s ? 0.01 : 0.002) * h, &a,
+			                                &terr));
+			if (threads == 1) {
+				ref[s] = a;
+			} else {
+				CHECK_MSG(same_level(&a, &ref[s]), "%d threads, level %d", threads, s);
+				mlod_motion_level_free(&a);
+			}
+		}
+		mlod_motion_free(like2);
+	}
+	for (int s = 0; s < 2; s++)
+		mlod_motion_level_free(&ref[s]);
+	mlod_character_free(&c);
+}
+
 TEST(bake_report_same_at_any_thread_count)
 {
 	/* mlod_motion_bake_run and its JSON report: the same text at 1 and 3
@@ -1335,5 +1370,6 @@ int main(void)
 	RUN(keys_split_same_as_next_level);
 	RUN(bake_report_same_at_any_thread_count);
 	RUN(create_like_same_as_create);
+	RUN(create_on_threads_same_as_create);
 	TEST_EXIT();
 }
