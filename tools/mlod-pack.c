@@ -180,55 +180,13 @@ static void report_json(FILE *rf, const char *input, const mlod_pack_stats *st, 
 	fprintf(rf, "\n}\n");
 }
 
-/* --info: every chunk decoded through the reader (lib/rt), so that a CRC
- * or a bound that does not hold exits 2 with the reader's message. */
+/* --info: every chunk is first decoded through the reader (lib/rt,
+ * mlod_pack_check), so that a CRC or a bound that does not hold exits 2
+ * with the reader's message. */
 typedef struct pack_totals {
 	uint64_t stored[4], raw[4];
 	uint32_t chunks[4];
 } pack_totals;
-
-static void check_chunks(const mlod_pack *p, const void *data, size_t size, const char *label)
-{
-	mlod_error err = {0};
-	mlod_pack_skeleton skel;
-	memset(&skel, 0, sizeof skel);
-	int have_skel = 0;
-	mlod_result r = MLOD_OK;
-	for (uint32_t i = 0; r == MLOD_OK && i < p->chunk_count; i++) {
-		const mlod_pack_chunk *c = &p->chunks[i];
-		if (c->type == MLOD_CHUNK_INFO) {
-			mlod_pack_info x;
-			memset(&x, 0, sizeof x);
-			r = mlod_pack_decode_info(p, data, size, &x, &err);
-			mlod_pack_info_free(&x);
-		} else if (c->type == MLOD_CHUNK_SKELETON && c->level == 0) {
-			r = mlod_pack_decode_skeleton(p, data, size, &skel, &err);
-			have_skel = r == MLOD_OK;
-		} else if (c->type == MLOD_CHUNK_SKELETON) {
-			mlod_pack_skel_level x;
-			memset(&x, 0, sizeof x);
-			r = mlod_pack_decode_skel_level(p, i, data, size, have_skel ? &skel : NULL, &x, &err);
-			mlod_pack_skel_level_free(&x);
-		} else if (c->type == MLOD_CHUNK_MESH) {
-			mlod_pack_mesh x;
-			memset(&x, 0, sizeof x);
-			r = mlod_pack_decode_mesh(p, i, data, size, have_skel ? &skel : NULL, &x, &err);
-			mlod_pack_mesh_free(&x);
-		} else if (c->type == MLOD_CHUNK_MOTION) {
-			mlod_pack_motion x;
-			memset(&x, 0, sizeof x);
-			r = mlod_pack_decode_motion(p, i, data, size, have_skel ? &skel : NULL, &x, &err);
-			mlod_pack_motion_free(&x);
-		} else if (c->type == MLOD_CHUNK_DOC) {
-			mlod_pack_doc_bytes glb;
-			r = mlod_pack_decode_doc(p, data, size, &glb, &err);
-			mlod_pack_doc_free(&glb);
-		}
-	}
-	mlod_pack_skeleton_free(&skel);
-	if (r != MLOD_OK)
-		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
-}
 
 /* The codec column: "meshopt", or "meshopt+zstd" with an entropy stage. */
 static const char *codec_column(const mlod_pack_chunk *c, char *buf, size_t n)
@@ -250,9 +208,10 @@ static int pack_info(const char *path, enum tool_report report)
 	mlod_error err = {0};
 	memset(&info, 0, sizeof info);
 	mlod_result r = mlod_pack_open(data, size, &p, &err);
+	if (r == MLOD_OK)
+		r = mlod_pack_check(&p, data, size, &err);
 	if (r != MLOD_OK)
 		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
-	check_chunks(&p, data, size, label);
 	if (p.file_size != size)
 		tool_die(EXIT_INPUT, label, "the header says %llu bytes, the file has %zu", (unsigned long long)p.file_size,
 		         size);

@@ -670,6 +670,11 @@ mlod_result mlod_pack_decode_doc(const mlod_pack *p, const void *data, size_t si
                                  mlod_error *err);
 void mlod_pack_doc_free(mlod_pack_doc_bytes *x);
 
+/* Decodes every chunk of the pack in TOC order (data: the whole file) and
+ * releases it: MLOD_OK when all decode, else the first failure, whose
+ * message names the chunk. mlod-pack --info runs it before listing. */
+mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, mlod_error *err);
+
 void mlod_pack_info_free(mlod_pack_info *x);
 void mlod_pack_skeleton_free(mlod_pack_skeleton *x);
 void mlod_pack_skel_level_free(mlod_pack_skel_level *x);

@@ -2419,3 +2419,50 @@ void mlod_pack_doc_free(mlod_pack_doc_bytes *x)
 	block_free(x->block);
 	memset(x, 0, sizeof *x);
 }
+
+/* Every chunk decoded in TOC order and released, stopping at the first
+ * failure (whose message names the chunk); unknown types are skipped. */
+mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, mlod_error *err)
+{
+	if (!p || (!data && size))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_check: NULL argument");
+	mlod_pack_skeleton skel;
+	memset(&skel, 0, sizeof skel);
+	int have_skel = 0;
+	mlod_result r = MLOD_OK;
+	for (uint32_t i = 0; r == MLOD_OK && i < p->chunk_count; i++) {
+		const mlod_pack_chunk *c = &p->chunks[i];
+		const mlod_pack_skeleton *s = have_skel ? &skel : NULL;
+		if (c->type == MLOD_CHUNK_INFO) {
+			mlod_pack_info x;
+			memset(&x, 0, sizeof x);
+			r = mlod_pack_decode_info(p, data, size, &x, err);
+			mlod_pack_info_free(&x);
+		} else if (c->type == MLOD_CHUNK_SKELETON && c->level == 0) {
+			r = mlod_pack_decode_skeleton(p, data, size, &skel, err);
+			have_skel = r == MLOD_OK;
+		} else if (c->type == MLOD_CHUNK_SKELETON) {
+			mlod_pack_skel_level x;
+			memset(&x, 0, sizeof x);
+			r = mlod_pack_decode_skel_level(p, i, data, size, s, &x, err);
+			mlod_pack_skel_level_free(&x);
+		} else if (c->type == MLOD_CHUNK_MESH) {
+			mlod_pack_mesh x;
+			memset(&x, 0, sizeof x);
+			r = mlod_pack_decode_mesh(p, i, data, size, s, &x, err);
+			mlod_pack_mesh_free(&x);
+		} else if (c->type == MLOD_CHUNK_MOTION) {
+			mlod_pack_motion x;
+			memset(&x, 0, sizeof x);
+			r = mlod_pack_decode_motion(p, i, data, size, s, &x, err);
+			mlod_pack_motion_free(&x);
+		} else if (c->type == MLOD_CHUNK_DOC) {
+			mlod_pack_doc_bytes x;
+			memset(&x, 0, sizeof x);
+			r = mlod_pack_decode_doc(p, data, size, &x, err);
+			mlod_pack_doc_free(&x);
+		}
+	}
+	mlod_pack_skeleton_free(&skel);
+	return r;
+}
