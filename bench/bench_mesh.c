@@ -9,6 +9,9 @@
  *                                 alone, best of CHAIN_RUNS runs of the
  *                                 calling thread's CPU time (steadier on a
  *                                 shared machine than medians of wall time)
+ *   bench_mesh profile FILE...    the default posed chain once per file
+ *                                 and nothing else (for callgrind:
+ *                                 --toggle-collect=mlod_levels)
  *   bench_mesh quality FILE [GLTFPACK50 GLTFPACK25 GLTFPACK10]
  *                                 posed error (mean and Hausdorff, % of the
  *                                 diagonal) at 50/25/10% of the triangles,
@@ -402,6 +405,25 @@ static void chain(int argc, char **argv)
 	       CHAIN_RUNS);
 }
 
+/* One default posed chain per file, nothing timed or printed but the
+ * triangles it kept: a run for instruction counts. */
+static void profile(int argc, char **argv)
+{
+	for (int a = 0; a < argc; a++) {
+		mlod_character c;
+		int T = load_meshed(argv[a], &c);
+		if (T == 0)
+			continue;
+		struct levelset L;
+		levelset_init(&L, &c);
+		mlod_bgm_options opt = {0};
+		mlod_levels(&c, &opt, &L, NULL);
+		printf("%s: %d triangles\n", bench_base_name(argv[a]), T);
+		levelset_free(&L);
+		mlod_character_free(&c);
+	}
+}
+
 struct method {
 	const char *name;
 	int kind; /* 0 mlod, 1 meshopt, 2 gltfpack file */
@@ -500,7 +522,7 @@ static void quality(int argc, char **argv)
 int main(int argc, char **argv)
 {
 	if (argc < 3) {
-		fprintf(stderr, "usage: bench_mesh table1|speed|chain FILE... | bench_mesh quality FILE [GP50 GP25 GP10]\n");
+		fprintf(stderr, "usage: bench_mesh table1|speed|chain|profile FILE... | bench_mesh quality FILE [GP50 GP25 GP10]\n");
 		return 1;
 	}
 	if (strcmp(argv[1], "table1") == 0)
@@ -509,6 +531,8 @@ int main(int argc, char **argv)
 		speed(argc - 2, argv + 2);
 	else if (strcmp(argv[1], "chain") == 0)
 		chain(argc - 2, argv + 2);
+	else if (strcmp(argv[1], "profile") == 0)
+		profile(argc - 2, argv + 2);
 	else if (strcmp(argv[1], "quality") == 0)
 		quality(argc - 2, argv + 2);
 	else {

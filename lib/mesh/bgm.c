@@ -797,6 +797,8 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->qsum);
 	free(g->skin);
 	free(g->opstate);
+	free(g->ftie);
+	free(g->lbmemo);
 	free(g->heap.e);
 	free(g->heap.memo);
 	free(g);

@@ -125,6 +125,15 @@ struct mlod_bgm {
 	                         * cost without opt.allow_border: once nothing else could) */
 	unsigned char *opstate; /* per face and op (collapse.c): refused when last looked at, queued */
 	int opstate_cap;
+	double *ftie;           /* per face (collapse.c): its compactness tie-break term, NaN until
+	                         * worked out (a face's nodes never change) */
+	int ftie_cap;
+	/* collapse.c: the weak queue keys' bounds by collapsed nodes (a pure
+	 * function of them: an edge or triangle whose faces died and came
+	 * back around a collapse is not worked out again); open addressing,
+	 * released with free() by mlod_bgm_free. */
+	struct bgm_lbmemo *lbmemo;
+	int lbmemo_count, lbmemo_cap;
 };
 
 /* bgm.c */

@@ -399,20 +399,30 @@ static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 	}
 }
 
+/* Face h's area times its lack of compactness, worked out once (its
+ * nodes, in its order, never change): the same arithmetic every time. */
+static double face_tie(mlod_bgm *g, int h)
+{
+	double *t = &g->ftie[h];
+	if (isnan(*t)) {
+		const bgm_face *F = &g->faces[h];
+		const double *a = g->nodes[F->n[0]].p, *b = g->nodes[F->n[1]].p, *c = g->nodes[F->n[2]].p;
+		*t = sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c));
+	}
+	return *t;
+}
+
 /* The tie-break term of a collapse: the collapsed triangle's area times
  * its lack of compactness, or for an edge the mean over its faces. */
-static double collapse_tie(const mlod_bgm *g, int f, int op, int K, const double *const P[3])
+static double collapse_tie(mlod_bgm *g, int f, int op, int K)
 {
 	if (K == 3)
-		return sqrt(area_sq(P[0], P[1], P[2])) * (1.0 - bgm_compactness(P[0], P[1], P[2]));
+		return face_tie(g, f);
 	const bgm_face *F = &g->faces[f];
 	int faces[2] = {f, F->adj[op]}, nr = faces[1] >= 0 ? 2 : 1;
 	double tie = 0.0;
-	for (int j = 0; j < nr; j++) {
-		const bgm_face *h = &g->faces[faces[j]];
-		const double *a = g->nodes[h->n[0]].p, *b = g->nodes[h->n[1]].p, *c = g->nodes[h->n[2]].p;
-		tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / nr;
-	}
+	for (int j = 0; j < nr; j++)
+		tie += face_tie(g, faces[j]) / nr;
 	return tie;
 }
 
@@ -757,13 +767,10 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	int best = -1;
 	double best_d = 0.0, tie = 0.0;
 	if (K == 3) {
-		tie = sqrt(area_sq(P[0], P[1], P[2])) * (1.0 - bgm_compactness(P[0], P[1], P[2]));
+		tie = face_tie(g, t);
 	} else {
-		for (int j = 0; j < pl->nr; j++) {
-			const bgm_face *f = &g->faces[pl->removed[j]];
-			const double *a = g->nodes[f->n[0]].p, *b = g->nodes[f->n[1]].p, *c = g->nodes[f->n[2]].p;
-			tie += sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c)) / pl->nr;
-		}
+		for (int j = 0; j < pl->nr; j++)
+			tie += face_tie(g, pl->removed[j]) / pl->nr;
 	}
 	/* The fast posed cost does not depend on the influences: rank the
 	 * candidates by it, and the first valid one is the choice (the one
@@ -911,6 +918,15 @@ static int grow_face_arrays(mlod_bgm *g)
 			b[f] = f < g->face_count && g->faces[f].death != BGM_ALIVE ? DEAD : 0;
 		g->opstate = b;
 		g->opstate_cap = g->face_cap;
+	}
+	if (g->ftie_cap < g->face_cap) {
+		double *t = realloc(g->ftie, sizeof *t * (size_t)g->face_cap);
+		if (!t)
+			return -1;
+		for (int f = g->ftie_cap; f < g->face_cap; f++)
+			t[f] = NAN;
+		g->ftie = t;
+		g->ftie_cap = g->face_cap;
 	}
 	return 0;
 }
@@ -1072,6 +1088,54 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 	return lb;
 }
 
+/* A weak key's bound before its normalising and tie-break, by the
+ * collapsed nodes in their order (c = -1 for an edge). */
+struct bgm_lbmemo {
+	int a, b, c; /* a = -1: empty */
+	double lb;
+};
+
+static unsigned lbmemo_hash(int a, int b, int c)
+{
+	unsigned h = (unsigned)a * 0x9E3779B1u;
+	h = (h ^ (h >> 15)) + (unsigned)b * 0x85EBCA77u;
+	h = (h ^ (h >> 13)) + (unsigned)c * 0xC2B2AE3Du;
+	return h ^ (h >> 16);
+}
+
+/* The slot of (a, b, c): its entry, or the empty slot where it goes. */
+static struct bgm_lbmemo *lbmemo_slot(struct bgm_lbmemo *t, int cap, int a, int b, int c)
+{
+	unsigned m = (unsigned)cap - 1u, i = lbmemo_hash(a, b, c) & m;
+	while (t[i].a >= 0 && !(t[i].a == a && t[i].b == b && t[i].c == c))
+		i = (i + 1u) & m;
+	return &t[i];
+}
+
+/* Remembers lb for (a, b, c) (nothing when out of memory: it is worked
+ * out again next time). */
+static void lbmemo_put(mlod_bgm *g, int a, int b, int c, double lb)
+{
+	if (2 * (g->lbmemo_count + 1) > g->lbmemo_cap) {
+		int cap = g->lbmemo_cap > 0 ? 2 * g->lbmemo_cap : 1024;
+		struct bgm_lbmemo *t = malloc(sizeof *t * (size_t)cap);
+		if (!t)
+			return;
+		for (int i = 0; i < cap; i++)
+			t[i].a = -1;
+		for (int i = 0; i < g->lbmemo_cap; i++)
+			if (g->lbmemo[i].a >= 0)
+				*lbmemo_slot(t, cap, g->lbmemo[i].a, g->lbmemo[i].b, g->lbmemo[i].c) = g->lbmemo[i];
+		free(g->lbmemo);
+		g->lbmemo = t;
+		g->lbmemo_cap = cap;
+	}
+	struct bgm_lbmemo *e = lbmemo_slot(g->lbmemo, g->lbmemo_cap, a, b, c);
+	if (e->a < 0)
+		g->lbmemo_count++;
+	e->a = a, e->b = b, e->c = c, e->lb = lb;
+}
+
 /* A lower bound of the cost plan() finds for operation op on face f,
  * from the quadrics alone (no patch, no validity): the least over every
  * placement plan() may try, valid or not, plus plan()'s compactness
@@ -1109,8 +1173,9 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		if (j > 0 && same)
 			same = same_influences(&g->inf[v[0]], &g->inf[v[j]]);
 	}
-	double tie = collapse_tie(g, f, op, K, P);
+	double tie = collapse_tie(g, f, op, K);
 	double lb, margin = 1.0;
+	struct bgm_lbmemo *hit;
 	if (same || g->opt.fast_cost) {
 		for (int j = 0; j < K; j++) {
 			const double *r = bgm_quadric_rest(g, v[j]);
@@ -1122,6 +1187,14 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 			lb = fmin(lb, bgm_quadric_eval(Q, P[j]));
 		if (g->opt.placement == MLOD_PLACE_OPTIMAL && bgm_quadric_solve(Q, bary, x) == 0)
 			lb = fmin(lb, bgm_quadric_eval(Q, x));
+	} else if (g->lbmemo_cap > 0 &&
+	           (hit = lbmemo_slot(g->lbmemo, g->lbmemo_cap, v[0], v[1], K == 3 ? v[2] : -1))->a >= 0) {
+		/* Worked out before for these nodes: the bound depends on nothing
+		 * else (their bind positions, quadrics and influences, and the
+		 * skin matrices, none of which changes). */
+		lb = hit->lb;
+		margin = 1.0 - 1e-9;
+		*weak = 1;
 	} else {
 		for (int j = 0; j < K; j++) {
 			const double *q = g->quadric + (size_t)v[j] * (size_t)g->pose_count * 10;
@@ -1158,6 +1231,7 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 			}
 			lb = fmax(lb, posed_min_bound(g, v, K, bary, sqrt(lmax)));
 		}
+		lbmemo_put(g, v[0], v[1], K == 3 ? v[2] : -1, lb);
 		margin = 1.0 - 1e-9; /* rounding: stay below the exact sum */
 		*weak = 1;
 	}
@@ -1262,7 +1336,7 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 	}
 	if (best == HUGE_VAL)
 		best = 0.0;
-	double tie = collapse_tie(g, f, op, K, P);
+	double tie = collapse_tie(g, f, op, K);
 	/* Along a border (two border vertices as the flags stand), plan()'s
 	 * cost is border_factor() times this: so is the bound, and such an
 	 * operation goes back at it without being planned first. */
