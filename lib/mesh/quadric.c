@@ -20,6 +20,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include "bgm.h"
 
@@ -100,6 +103,28 @@ static inline void blend(const mlod_bgm *g, int p, const mlod_influences *inf, d
 			M[i] = g->joint_count == 0 ? S[i] : (i % 5 == 0 ? 1.0 : 0.0);
 		return;
 	}
+#ifdef __SSE2__
+	/* Two entries at a time: each the same product and sum, in the same
+	 * order, as the scalar loop below (SSE2 rounds as scalar code). */
+	__m128d m0 = _mm_setzero_pd(), m1 = m0, m2 = m0, m3 = m0, m4 = m0, m5 = m0;
+	for (int k = 0; k < inf->count; k++) {
+		const float *s = S + 12 * (size_t)inf->joints[k];
+		__m128d w = _mm_set1_pd((double)inf->weights[k]);
+		__m128 a = _mm_loadu_ps(s), b = _mm_loadu_ps(s + 4), c = _mm_loadu_ps(s + 8);
+		m0 = _mm_add_pd(m0, _mm_mul_pd(w, _mm_cvtps_pd(a)));
+		m1 = _mm_add_pd(m1, _mm_mul_pd(w, _mm_cvtps_pd(_mm_movehl_ps(a, a))));
+		m2 = _mm_add_pd(m2, _mm_mul_pd(w, _mm_cvtps_pd(b)));
+		m3 = _mm_add_pd(m3, _mm_mul_pd(w, _mm_cvtps_pd(_mm_movehl_ps(b, b))));
+		m4 = _mm_add_pd(m4, _mm_mul_pd(w, _mm_cvtps_pd(c)));
+		m5 = _mm_add_pd(m5, _mm_mul_pd(w, _mm_cvtps_pd(_mm_movehl_ps(c, c))));
+	}
+	_mm_storeu_pd(M, m0);
+	_mm_storeu_pd(M + 2, m1);
+	_mm_storeu_pd(M + 4, m2);
+	_mm_storeu_pd(M + 6, m3);
+	_mm_storeu_pd(M + 8, m4);
+	_mm_storeu_pd(M + 10, m5);
+#else
 	memset(M, 0, 12 * sizeof *M);
 	for (int k = 0; k < inf->count; k++) {
 		const float *s = S + 12 * (size_t)inf->joints[k];
@@ -107,6 +132,7 @@ static inline void blend(const mlod_bgm *g, int p, const mlod_influences *inf, d
 		for (int i = 0; i < 12; i++)
 			M[i] += w * s[i];
 	}
+#endif
 }
 
 static inline void apply(const double *M, const double *x, double *y)
