@@ -955,6 +955,199 @@ static inline double max_d(double a, double b)
 	return a != a ? b : b != b ? a : a > b ? a : b;
 }
 
+/* posed_min_bound's term for pose p (not added when not above 0 or not
+ * finite; -1 when the pose gives none). */
+static inline double pose_min_bound(const mlod_bgm *g, const uint16_t *joint, int nj, const double *const qv[3], int k,
+                                    size_t p, const double *bary, double rl, double inv)
+{
+	int J = g->joint_count;
+	const float *S = g->skin + p * (size_t)J * 12;
+	double z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {0, 0, 0};
+	for (int j = 0; j < nj; j++) {
+		const float *m = S + 12 * (size_t)joint[j];
+		for (int i = 0; i < 3; i++) {
+			z[j][i] = (double)m[4 * i] * bary[0] + (double)m[4 * i + 1] * bary[1] + (double)m[4 * i + 2] * bary[2] +
+			          (double)m[4 * i + 3];
+			c[i] += z[j][i];
+		}
+	}
+	for (int i = 0; i < 3; i++)
+		c[i] *= inv;
+	double spread = 0.0, far = 0.0;
+	for (int j = 0; j < nj; j++) {
+		double d = 0.0, a = 0.0;
+		for (int i = 0; i < 3; i++) {
+			d += (z[j][i] - c[i]) * (z[j][i] - c[i]);
+			a += z[j][i] * z[j][i];
+		}
+		spread = max_d(spread, d);
+		far = max_d(far, a);
+	}
+	double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
+	double q[10];
+	const double *q0 = qv[0] + 10 * p;
+	if (k == 1) {
+		memcpy(q, q0, sizeof q);
+	} else if (k == 2) {
+		const double *q1 = qv[1] + 10 * p;
+		for (int e = 0; e < 10; e++)
+			q[e] = q0[e] + q1[e];
+	} else {
+		const double *q1 = qv[1] + 10 * p, *q2 = qv[2] + 10 * p;
+		for (int e = 0; e < 10; e++)
+			q[e] = q0[e] + q1[e] + q2[e];
+	}
+	double tr = q[0] + q[4] + q[7];
+	if (!(tr > 0.0) || !isfinite(tr))
+		return -1.0;
+	double mu = 1e-5 * tr, y[3];
+	double a = q[0] + mu, b = q[1], cc = q[2], d = q[4] + mu, e = q[5], f = q[7] + mu;
+	double det = a * (d * f - e * e) - b * (b * f - cc * e) + cc * (b * e - cc * d);
+	if (!(fabs(det) > 0.0))
+		return -1.0;
+	double r0 = -q[3] + mu * c[0], r1 = -q[6] + mu * c[1], r2 = -q[8] + mu * c[2];
+	y[0] = (r0 * (d * f - e * e) - b * (r1 * f - e * r2) + cc * (r1 * e - d * r2)) / det;
+	y[1] = (a * (r1 * f - e * r2) - r0 * (b * f - cc * e) + cc * (b * r2 - r1 * cc)) / det;
+	y[2] = (a * (d * r2 - r1 * e) - b * (b * r2 - r1 * cc) + r0 * (b * e - cc * d)) / det;
+	/* bgm_quadric_eval(q, y), written out here (the same sum) */
+	double val = q[0] * y[0] * y[0] + 2 * q[1] * y[0] * y[1] + 2 * q[2] * y[0] * y[2] + 2 * q[3] * y[0] +
+	             q[4] * y[1] * y[1] + 2 * q[5] * y[1] * y[2] + 2 * q[6] * y[1] + q[7] * y[2] * y[2] + 2 * q[8] * y[2] + q[9];
+	double dy = 0.0;
+	val = val > 0.0 ? val : 0.0;
+	for (int i = 0; i < 3; i++)
+		dy += (y[i] - c[i]) * (y[i] - c[i]);
+	val += mu * dy - mu * R * R;
+	/* Rounding: the terms of the quadric's value at a point within R of
+	 * c, far above the errors of the sums here and in plan(). */
+	double ym = max_d(max_d(fabs(c[0]), fabs(c[1])), fabs(c[2])) + R;
+	double mag = fabs(q[9]) + 2.0 * (fabs(q[3]) + fabs(q[6]) + fabs(q[8])) * ym +
+	             (fabs(q[0]) + fabs(q[4]) + fabs(q[7]) + 2.0 * (fabs(q[1]) + fabs(q[2]) + fabs(q[5]))) * ym * ym;
+	val -= 1e-12 * mag;
+	return val;
+}
+
+#ifdef __SSE2__
+/* max_d lane by lane. */
+static inline __m128d max_pd2(__m128d a, __m128d b)
+{
+	__m128d an = _mm_cmpunord_pd(a, a), bn = _mm_cmpunord_pd(b, b), gt = _mm_cmpgt_pd(a, b);
+	__m128d take_a = _mm_andnot_pd(an, _mm_or_pd(bn, gt));
+	return _mm_or_pd(_mm_and_pd(take_a, a), _mm_andnot_pd(take_a, b));
+}
+
+static inline __m128d abs_pd2(__m128d x)
+{
+	return _mm_andnot_pd(_mm_set1_pd(-0.0), x);
+}
+
+/* pose_min_bound for poses p and p + 1 (lanes 0 and 1), every step
+ * done whatever the tests: val, tr and det per pose, for the caller to
+ * test as pose_min_bound does. */
+static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int nj, const double *const qv[3], int k,
+                                   size_t p, const double *bary, double rl, double inv, double *val_out,
+                                   double *tr_out, double *det_out)
+{
+	int J = g->joint_count;
+	const float *S0 = g->skin + p * (size_t)J * 12, *S1 = S0 + (size_t)J * 12;
+	const __m128d bx = _mm_set1_pd(bary[0]), by = _mm_set1_pd(bary[1]), bz = _mm_set1_pd(bary[2]);
+	const __m128d zero = _mm_setzero_pd();
+	__m128d z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {zero, zero, zero};
+	for (int j = 0; j < nj; j++) {
+		const float *m0 = S0 + 12 * (size_t)joint[j], *m1 = S1 + 12 * (size_t)joint[j];
+		for (int i = 0; i < 3; i++) {
+			__m128 r0 = _mm_loadu_ps(m0 + 4 * i), r1 = _mm_loadu_ps(m1 + 4 * i);
+			__m128 lo = _mm_unpacklo_ps(r0, r1), hi = _mm_unpackhi_ps(r0, r1);
+			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_cvtps_pd(lo), bx), _mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(lo, lo)), by));
+			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_cvtps_pd(hi), bz)), _mm_cvtps_pd(_mm_movehl_ps(hi, hi)));
+			z[j][i] = t;
+			c[i] = _mm_add_pd(c[i], t);
+		}
+	}
+	const __m128d vinv = _mm_set1_pd(inv);
+	for (int i = 0; i < 3; i++)
+		c[i] = _mm_mul_pd(c[i], vinv);
+	__m128d spread = zero, far = zero;
+	for (int j = 0; j < nj; j++) {
+		__m128d d = zero, a = zero;
+		for (int i = 0; i < 3; i++) {
+			__m128d x = _mm_sub_pd(z[j][i], c[i]);
+			d = _mm_add_pd(d, _mm_mul_pd(x, x));
+			a = _mm_add_pd(a, _mm_mul_pd(z[j][i], z[j][i]));
+		}
+		spread = max_pd2(spread, d);
+		far = max_pd2(far, a);
+	}
+	const __m128d vrl = _mm_set1_pd(rl);
+	__m128d R = _mm_add_pd(_mm_mul_pd(_mm_add_pd(_mm_sqrt_pd(spread), vrl), _mm_set1_pd(1.0 + 1e-6)),
+	                       _mm_mul_pd(_mm_set1_pd(1e-6), _mm_add_pd(_mm_sqrt_pd(far), vrl)));
+	__m128d q[10];
+	const double *a0 = qv[0] + 10 * p;
+	if (k == 1) {
+		for (int e = 0; e < 10; e++)
+			q[e] = _mm_set_pd(a0[10 + e], a0[e]);
+	} else if (k == 2) {
+		const double *a1 = qv[1] + 10 * p;
+		for (int e = 0; e < 10; e++)
+			q[e] = _mm_add_pd(_mm_set_pd(a0[10 + e], a0[e]), _mm_set_pd(a1[10 + e], a1[e]));
+	} else {
+		const double *a1 = qv[1] + 10 * p, *a2 = qv[2] + 10 * p;
+		for (int e = 0; e < 10; e++)
+			q[e] = _mm_add_pd(_mm_add_pd(_mm_set_pd(a0[10 + e], a0[e]), _mm_set_pd(a1[10 + e], a1[e])),
+			                  _mm_set_pd(a2[10 + e], a2[e]));
+	}
+	__m128d tr = _mm_add_pd(_mm_add_pd(q[0], q[4]), q[7]);
+	__m128d mu = _mm_mul_pd(_mm_set1_pd(1e-5), tr);
+	__m128d a = _mm_add_pd(q[0], mu), b = q[1], cc = q[2], d = _mm_add_pd(q[4], mu), e = q[5], f = _mm_add_pd(q[7], mu);
+	__m128d A1 = _mm_sub_pd(_mm_mul_pd(d, f), _mm_mul_pd(e, e));
+	__m128d B1 = _mm_sub_pd(_mm_mul_pd(b, f), _mm_mul_pd(cc, e));
+	__m128d C1 = _mm_sub_pd(_mm_mul_pd(b, e), _mm_mul_pd(cc, d));
+	__m128d det = _mm_add_pd(_mm_sub_pd(_mm_mul_pd(a, A1), _mm_mul_pd(b, B1)), _mm_mul_pd(cc, C1));
+	const __m128d neg = _mm_set1_pd(-0.0);
+	__m128d r0 = _mm_add_pd(_mm_xor_pd(q[3], neg), _mm_mul_pd(mu, c[0]));
+	__m128d r1 = _mm_add_pd(_mm_xor_pd(q[6], neg), _mm_mul_pd(mu, c[1]));
+	__m128d r2 = _mm_add_pd(_mm_xor_pd(q[8], neg), _mm_mul_pd(mu, c[2]));
+	__m128d F1 = _mm_sub_pd(_mm_mul_pd(r1, f), _mm_mul_pd(e, r2));  /* r1 f - e r2 */
+	__m128d y[3];
+	y[0] = _mm_div_pd(_mm_add_pd(_mm_sub_pd(_mm_mul_pd(r0, A1), _mm_mul_pd(b, F1)),
+	                             _mm_mul_pd(cc, _mm_sub_pd(_mm_mul_pd(r1, e), _mm_mul_pd(d, r2)))),
+	                  det);
+	y[1] = _mm_div_pd(_mm_add_pd(_mm_sub_pd(_mm_mul_pd(a, F1), _mm_mul_pd(r0, B1)),
+	                             _mm_mul_pd(cc, _mm_sub_pd(_mm_mul_pd(b, r2), _mm_mul_pd(r1, cc)))),
+	                  det);
+	y[2] = _mm_div_pd(_mm_add_pd(_mm_sub_pd(_mm_mul_pd(a, _mm_sub_pd(_mm_mul_pd(d, r2), _mm_mul_pd(r1, e))),
+	                                        _mm_mul_pd(b, _mm_sub_pd(_mm_mul_pd(b, r2), _mm_mul_pd(r1, cc)))),
+	                             _mm_mul_pd(r0, C1)),
+	                  det);
+	const __m128d two = _mm_set1_pd(2.0);
+	__m128d val = _mm_mul_pd(_mm_mul_pd(q[0], y[0]), y[0]);
+	val = _mm_add_pd(val, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[1]), y[0]), y[1]));
+	val = _mm_add_pd(val, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[2]), y[0]), y[2]));
+	val = _mm_add_pd(val, _mm_mul_pd(_mm_mul_pd(two, q[3]), y[0]));
+	val = _mm_add_pd(val, _mm_mul_pd(_mm_mul_pd(q[4], y[1]), y[1]));
+	val = _mm_add_pd(val, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[5]), y[1]), y[2]));
+	val = _mm_add_pd(val, _mm_mul_pd(_mm_mul_pd(two, q[6]), y[1]));
+	val = _mm_add_pd(val, _mm_mul_pd(_mm_mul_pd(q[7], y[2]), y[2]));
+	val = _mm_add_pd(val, _mm_mul_pd(_mm_mul_pd(two, q[8]), y[2]));
+	val = _mm_add_pd(val, q[9]);
+	val = _mm_and_pd(_mm_cmpgt_pd(val, zero), val);
+	__m128d dy = zero;
+	for (int i = 0; i < 3; i++) {
+		__m128d x = _mm_sub_pd(y[i], c[i]);
+		dy = _mm_add_pd(dy, _mm_mul_pd(x, x));
+	}
+	val = _mm_add_pd(val, _mm_sub_pd(_mm_mul_pd(mu, dy), _mm_mul_pd(_mm_mul_pd(mu, R), R)));
+	__m128d ym = _mm_add_pd(max_pd2(max_pd2(abs_pd2(c[0]), abs_pd2(c[1])), abs_pd2(c[2])), R);
+	__m128d lin = _mm_add_pd(_mm_add_pd(abs_pd2(q[3]), abs_pd2(q[6])), abs_pd2(q[8]));
+	__m128d sq = _mm_add_pd(_mm_add_pd(_mm_add_pd(abs_pd2(q[0]), abs_pd2(q[4])), abs_pd2(q[7])),
+	                        _mm_mul_pd(two, _mm_add_pd(_mm_add_pd(abs_pd2(q[1]), abs_pd2(q[2])), abs_pd2(q[5]))));
+	__m128d mag = _mm_add_pd(_mm_add_pd(abs_pd2(q[9]), _mm_mul_pd(_mm_mul_pd(two, lin), ym)), _mm_mul_pd(_mm_mul_pd(sq, ym), ym));
+	val = _mm_sub_pd(val, _mm_mul_pd(_mm_set1_pd(1e-12), mag));
+	_mm_storeu_pd(val_out, val);
+	_mm_storeu_pd(tr_out, tr);
+	_mm_storeu_pd(det_out, det);
+}
+#endif
+
 /* A lower bound of the summed posed error (not normalised) of any
  * placement x within r of bary skinned with any convex combination of
  * the influences of the k vertices v: the bound for operations whose
@@ -1003,85 +1196,22 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 	for (int i = 0; i < k; i++)
 		qv[i] = g->quadric + (size_t)v[i] * P * 10;
 	double lb = 0.0, rl = r * g->skin_norm, inv = 1.0 / nj;
+	size_t p = 0;
 #ifdef __SSE2__
-	const __m128d bx = _mm_set1_pd(bary[0]), by = _mm_set1_pd(bary[1]), bz = _mm_set1_pd(bary[2]);
+	/* Two poses at a time, pose p in the low lane and p + 1 in the high
+	 * one: every lane the same products, sums and tests, in the same
+	 * order, as pose_min_bound's (SSE2 rounds as scalar code), and the
+	 * poses' terms added in pose order. */
+	for (; p + 1 < P; p += 2) {
+		double val[2], tr[2], det[2];
+		pose_min_bound2(g, joint, nj, qv, k, p, bary, rl, inv, val, tr, det);
+		for (int l = 0; l < 2; l++)
+			if (tr[l] > 0.0 && isfinite(tr[l]) && fabs(det[l]) > 0.0 && val[l] > 0.0 && isfinite(val[l]))
+				lb += val[l];
+	}
 #endif
-	for (size_t p = 0; p < P; p++) {
-		const float *S = g->skin + p * (size_t)J * 12;
-		double z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {0, 0, 0};
-		for (int j = 0; j < nj; j++) {
-			const float *m = S + 12 * (size_t)joint[j];
-#ifdef __SSE2__
-			/* Rows 0 and 1 side by side: the same products and sums, in
-			 * the same order, as row 2's (SSE2 rounds as scalar code). */
-			__m128 r0 = _mm_loadu_ps(m), r1 = _mm_loadu_ps(m + 4);
-			__m128 lo = _mm_unpacklo_ps(r0, r1), hi = _mm_unpackhi_ps(r0, r1);
-			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_cvtps_pd(lo), bx), _mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(lo, lo)), by));
-			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_cvtps_pd(hi), bz)), _mm_cvtps_pd(_mm_movehl_ps(hi, hi)));
-			_mm_storeu_pd(z[j], t);
-			z[j][2] = (double)m[8] * bary[0] + (double)m[9] * bary[1] + (double)m[10] * bary[2] + (double)m[11];
-			for (int i = 0; i < 3; i++)
-				c[i] += z[j][i];
-#else
-			for (int i = 0; i < 3; i++) {
-				z[j][i] = (double)m[4 * i] * bary[0] + (double)m[4 * i + 1] * bary[1] +
-				          (double)m[4 * i + 2] * bary[2] + (double)m[4 * i + 3];
-				c[i] += z[j][i];
-			}
-#endif
-		}
-		for (int i = 0; i < 3; i++)
-			c[i] *= inv;
-		double spread = 0.0, far = 0.0;
-		for (int j = 0; j < nj; j++) {
-			double d = 0.0, a = 0.0;
-			for (int i = 0; i < 3; i++) {
-				d += (z[j][i] - c[i]) * (z[j][i] - c[i]);
-				a += z[j][i] * z[j][i];
-			}
-			spread = max_d(spread, d);
-			far = max_d(far, a);
-		}
-		double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
-		double q[10];
-		const double *q0 = qv[0] + 10 * p;
-		if (k == 1) {
-			memcpy(q, q0, sizeof q);
-		} else if (k == 2) {
-			const double *q1 = qv[1] + 10 * p;
-			for (int e = 0; e < 10; e++)
-				q[e] = q0[e] + q1[e];
-		} else {
-			const double *q1 = qv[1] + 10 * p, *q2 = qv[2] + 10 * p;
-			for (int e = 0; e < 10; e++)
-				q[e] = q0[e] + q1[e] + q2[e];
-		}
-		double tr = q[0] + q[4] + q[7];
-		if (!(tr > 0.0) || !isfinite(tr))
-			continue;
-		double mu = 1e-5 * tr, y[3];
-		double a = q[0] + mu, b = q[1], cc = q[2], d = q[4] + mu, e = q[5], f = q[7] + mu;
-		double det = a * (d * f - e * e) - b * (b * f - cc * e) + cc * (b * e - cc * d);
-		if (!(fabs(det) > 0.0))
-			continue;
-		double r0 = -q[3] + mu * c[0], r1 = -q[6] + mu * c[1], r2 = -q[8] + mu * c[2];
-		y[0] = (r0 * (d * f - e * e) - b * (r1 * f - e * r2) + cc * (r1 * e - d * r2)) / det;
-		y[1] = (a * (r1 * f - e * r2) - r0 * (b * f - cc * e) + cc * (b * r2 - r1 * cc)) / det;
-		y[2] = (a * (d * r2 - r1 * e) - b * (b * r2 - r1 * cc) + r0 * (b * e - cc * d)) / det;
-		/* bgm_quadric_eval(q, y), written out here (the same sum) */
-		double val = q[0] * y[0] * y[0] + 2 * q[1] * y[0] * y[1] + 2 * q[2] * y[0] * y[2] + 2 * q[3] * y[0] +
-		             q[4] * y[1] * y[1] + 2 * q[5] * y[1] * y[2] + 2 * q[6] * y[1] + q[7] * y[2] * y[2] + 2 * q[8] * y[2] + q[9];
-		double dy = 0.0;
-		val = val > 0.0 ? val : 0.0;
-		for (int i = 0; i < 3; i++)
-			dy += (y[i] - c[i]) * (y[i] - c[i]);
-		val += mu * dy - mu * R * R;
-		/* Rounding: the terms of the quadric's value at a point within
-		 * R of c, far above the errors of the sums here and in plan(). */
-		double ym = max_d(max_d(fabs(c[0]), fabs(c[1])), fabs(c[2])) + R;
-		double mag = fabs(q[9]) + 2.0 * (fabs(q[3]) + fabs(q[6]) + fabs(q[8])) * ym +
-		             (fabs(q[0]) + fabs(q[4]) + fabs(q[7]) + 2.0 * (fabs(q[1]) + fabs(q[2]) + fabs(q[5]))) * ym * ym;
-		val -= 1e-12 * mag;
+	for (; p < P; p++) {
+		double val = pose_min_bound(g, joint, nj, qv, k, p, bary, rl, inv);
 		if (val > 0.0 && isfinite(val))
 			lb += val;
 	}
