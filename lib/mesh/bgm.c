@@ -796,6 +796,7 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->rquad);
 	free(g->qsum);
 	free(g->skin);
+	free(g->skin2);
 	free(g->opstate);
 	free(g->ftie);
 	free(g->lbmemo);

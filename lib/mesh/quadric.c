@@ -147,6 +147,48 @@ static inline double eval(const double *q, const double *x)
 	       q[4] * x[1] * x[1] + 2 * q[5] * x[1] * x[2] + 2 * q[6] * x[1] + q[7] * x[2] * x[2] + 2 * q[8] * x[2] + q[9];
 }
 
+#ifdef __SSE2__
+/* Two poses at a time (pair i: poses 2i and 2i + 1 in the low and high
+ * lanes), each lane the same products and sums in the same order as the
+ * one-pose functions above (SSE2 rounds as scalar code). */
+
+/* blend for both poses of pair i; inf has influences (joint_count > 0). */
+static inline void blend2(const mlod_bgm *g, size_t i, const mlod_influences *inf, __m128d *M)
+{
+	const double *S = g->skin2 + i * (size_t)g->joint_count * 24;
+	for (int e = 0; e < 12; e++)
+		M[e] = _mm_setzero_pd();
+	for (int k = 0; k < inf->count; k++) {
+		const double *s = S + 24 * (size_t)inf->joints[k];
+		__m128d w = _mm_set1_pd((double)inf->weights[k]);
+		for (int e = 0; e < 12; e++)
+			M[e] = _mm_add_pd(M[e], _mm_mul_pd(w, _mm_loadu_pd(s + 2 * e)));
+	}
+}
+
+/* q's entry e for poses 2i and 2i + 1. */
+static inline __m128d qpair(const double *q, size_t i, int e)
+{
+	return _mm_set_pd(q[20 * i + 10 + (size_t)e], q[20 * i + (size_t)e]);
+}
+
+/* eval for both poses (q: the 10 entries as pairs). */
+static inline __m128d eval2(const __m128d *q, const __m128d *x)
+{
+	const __m128d two = _mm_set1_pd(2.0);
+	__m128d v = _mm_mul_pd(_mm_mul_pd(q[0], x[0]), x[0]);
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[1]), x[0]), x[1]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[2]), x[0]), x[2]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, q[3]), x[0]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(q[4], x[1]), x[1]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[5]), x[1]), x[2]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, q[6]), x[1]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(q[7], x[2]), x[2]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, q[8]), x[2]));
+	return _mm_add_pd(v, q[9]);
+}
+#endif
+
 mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err)
 {
 	const mlod_skeleton *s = &c->skeleton;
@@ -196,6 +238,23 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 		} else {
 			to_rows(&in->offset, S);
 		}
+	}
+	/* The same matrices as doubles, two poses side by side (the two-pose
+	 * paths of bgm_quadric_error, bgm_quadric_pullback and collapse.c). */
+	if (g->joint_count > 0 && P >= 2) {
+		size_t pairs = (size_t)P / 2;
+		g->skin2 = malloc(sizeof(double) * 24 * (size_t)J * pairs);
+		if (!g->skin2) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+			goto done;
+		}
+		for (size_t i = 0; i < pairs; i++)
+			for (int k = 0; k < J; k++) {
+				const float *a = g->skin + (2 * i * (size_t)J + (size_t)k) * 12, *b = a + (size_t)J * 12;
+				double *d = g->skin2 + (i * (size_t)J + (size_t)k) * 24;
+				for (int e = 0; e < 12; e++)
+					d[2 * e] = a[e], d[2 * e + 1] = b[e];
+			}
 	}
 	/* The skin matrices the nodes use (all of them for a static mesh). */
 	unsigned char *used = calloc((size_t)J, 1);
@@ -303,7 +362,33 @@ done:
 double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
 {
 	double M[12], y[3], e = 0.0;
-	for (int p = 0; p < g->pose_count; p++) {
+	int p = 0;
+#ifdef __SSE2__
+	if (g->skin2 && inf->count > 0) {
+		/* Two poses at a time; the sum and its stop test pose by pose. */
+		const __m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
+		for (; p + 1 < g->pose_count; p += 2) {
+			__m128d Mv[12], yv[3], qv[10];
+			size_t i = (size_t)p / 2;
+			blend2(g, i, inf, Mv);
+			for (int r = 0; r < 3; r++)
+				yv[r] = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(Mv[4 * r], x0), _mm_mul_pd(Mv[4 * r + 1], x1)),
+				                              _mm_mul_pd(Mv[4 * r + 2], x2)),
+				                   Mv[4 * r + 3]);
+			for (int k = 0; k < 10; k++)
+				qv[k] = qpair(q, i, k);
+			double v[2];
+			_mm_storeu_pd(v, eval2(qv, yv));
+			e += v[0] > 0.0 ? v[0] : 0.0;
+			if (e >= stop)
+				return HUGE_VAL;
+			e += v[1] > 0.0 ? v[1] : 0.0;
+			if (e >= stop)
+				return HUGE_VAL;
+		}
+	}
+#endif
+	for (; p < g->pose_count; p++) {
 		blend(g, p, inf, M);
 		apply(M, x, y);
 		double v = eval(q + 10 * p, y);
@@ -345,7 +430,54 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 	 * T = Q [M; 0 0 0 1] and [M; 0 0 0 1]^T T (the last row's zeros left
 	 * out), written out entry by entry. */
 	double H[10] = {0};
-	for (int p = 0; p < g->pose_count; p++) {
+	int p = 0;
+#ifdef __SSE2__
+	if (g->skin2 && inf->count > 0) {
+		/* Two poses at a time, the terms added to H pose by pose. */
+		for (; p + 1 < g->pose_count; p += 2) {
+			__m128d M[12], a[10];
+			size_t i = (size_t)p / 2;
+			blend2(g, i, inf, M);
+			for (int k = 0; k < 10; k++)
+				a[k] = qpair(q, i, k);
+#define MUL(x, y) _mm_mul_pd(x, y)
+#define ADD(x, y) _mm_add_pd(x, y)
+#define DOT3(a0, m0, a1, m1, a2, m2) ADD(ADD(MUL(a0, m0), MUL(a1, m1)), MUL(a2, m2))
+			__m128d t00 = DOT3(a[0], M[0], a[1], M[4], a[2], M[8]);
+			__m128d t01 = DOT3(a[0], M[1], a[1], M[5], a[2], M[9]);
+			__m128d t02 = DOT3(a[0], M[2], a[1], M[6], a[2], M[10]);
+			__m128d t10 = DOT3(a[1], M[0], a[4], M[4], a[5], M[8]);
+			__m128d t11 = DOT3(a[1], M[1], a[4], M[5], a[5], M[9]);
+			__m128d t12 = DOT3(a[1], M[2], a[4], M[6], a[5], M[10]);
+			__m128d t20 = DOT3(a[2], M[0], a[5], M[4], a[7], M[8]);
+			__m128d t21 = DOT3(a[2], M[1], a[5], M[5], a[7], M[9]);
+			__m128d t22 = DOT3(a[2], M[2], a[5], M[6], a[7], M[10]);
+			__m128d t03 = ADD(DOT3(a[0], M[3], a[1], M[7], a[2], M[11]), a[3]);
+			__m128d t13 = ADD(DOT3(a[1], M[3], a[4], M[7], a[5], M[11]), a[6]);
+			__m128d t23 = ADD(DOT3(a[2], M[3], a[5], M[7], a[7], M[11]), a[8]);
+			__m128d t33 = ADD(DOT3(a[3], M[3], a[6], M[7], a[8], M[11]), a[9]);
+			double h[10][2];
+			_mm_storeu_pd(h[0], DOT3(M[0], t00, M[4], t10, M[8], t20));
+			_mm_storeu_pd(h[1], DOT3(M[0], t01, M[4], t11, M[8], t21));
+			_mm_storeu_pd(h[2], DOT3(M[0], t02, M[4], t12, M[8], t22));
+			_mm_storeu_pd(h[3], DOT3(M[0], t03, M[4], t13, M[8], t23));
+			_mm_storeu_pd(h[4], DOT3(M[1], t01, M[5], t11, M[9], t21));
+			_mm_storeu_pd(h[5], DOT3(M[1], t02, M[5], t12, M[9], t22));
+			_mm_storeu_pd(h[6], DOT3(M[1], t03, M[5], t13, M[9], t23));
+			_mm_storeu_pd(h[7], DOT3(M[2], t02, M[6], t12, M[10], t22));
+			_mm_storeu_pd(h[8], DOT3(M[2], t03, M[6], t13, M[10], t23));
+			_mm_storeu_pd(h[9], ADD(DOT3(M[3], t03, M[7], t13, M[11], t23), t33));
+#undef DOT3
+#undef ADD
+#undef MUL
+			for (int k = 0; k < 10; k++)
+				H[k] += h[k][0];
+			for (int k = 0; k < 10; k++)
+				H[k] += h[k][1];
+		}
+	}
+#endif
+	for (; p < g->pose_count; p++) {
 		double M[12];
 		const double *a = q + 10 * p;
 		blend(g, p, inf, M);
