@@ -1048,17 +1048,17 @@ static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int
                                    double *tr_out, double *det_out)
 {
 	int J = g->joint_count;
-	const float *S0 = g->skin + p * (size_t)J * 12, *S1 = S0 + (size_t)J * 12;
+	/* g->skin2: the skin matrices as doubles, poses p and p + 1 side by side */
+	const double *S = g->skin2 + p / 2 * (size_t)J * 24;
 	const __m128d bx = _mm_set1_pd(bary[0]), by = _mm_set1_pd(bary[1]), bz = _mm_set1_pd(bary[2]);
 	const __m128d zero = _mm_setzero_pd();
 	__m128d z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {zero, zero, zero};
 	for (int j = 0; j < nj; j++) {
-		const float *m0 = S0 + 12 * (size_t)joint[j], *m1 = S1 + 12 * (size_t)joint[j];
+		const double *m = S + 24 * (size_t)joint[j];
 		for (int i = 0; i < 3; i++) {
-			__m128 r0 = _mm_loadu_ps(m0 + 4 * i), r1 = _mm_loadu_ps(m1 + 4 * i);
-			__m128 lo = _mm_unpacklo_ps(r0, r1), hi = _mm_unpackhi_ps(r0, r1);
-			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_cvtps_pd(lo), bx), _mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(lo, lo)), by));
-			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_cvtps_pd(hi), bz)), _mm_cvtps_pd(_mm_movehl_ps(hi, hi)));
+			const double *row = m + 8 * i;
+			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(row), bx), _mm_mul_pd(_mm_loadu_pd(row + 2), by));
+			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_loadu_pd(row + 4), bz)), _mm_loadu_pd(row + 6));
 			z[j][i] = t;
 			c[i] = _mm_add_pd(c[i], t);
 		}
@@ -1074,8 +1074,10 @@ static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int
 			d = _mm_add_pd(d, _mm_mul_pd(x, x));
 			a = _mm_add_pd(a, _mm_mul_pd(z[j][i], z[j][i]));
 		}
-		spread = max_pd2(spread, d);
-		far = max_pd2(far, a);
+		/* max_d(spread, d): d is +0 or above, or NaN (then spread, never
+		 * NaN, stays, as maxpd gives its second operand) */
+		spread = _mm_max_pd(d, spread);
+		far = _mm_max_pd(a, far);
 	}
 	const __m128d vrl = _mm_set1_pd(rl);
 	__m128d R = _mm_add_pd(_mm_mul_pd(_mm_add_pd(_mm_sqrt_pd(spread), vrl), _mm_set1_pd(1.0 + 1e-6)),
@@ -1202,7 +1204,7 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 	 * one: every lane the same products, sums and tests, in the same
 	 * order, as pose_min_bound's (SSE2 rounds as scalar code), and the
 	 * poses' terms added in pose order. */
-	for (; p + 1 < P; p += 2) {
+	for (; g->skin2 && p + 1 < P; p += 2) {
 		double val[2], tr[2], det[2];
 		pose_min_bound2(g, joint, nj, qv, k, p, bary, rl, inv, val, tr, det);
 		for (int l = 0; l < 2; l++)

@@ -156,21 +156,39 @@ static inline double eval(const double *q, const double *x)
 static inline void blend2(const mlod_bgm *g, size_t i, const mlod_influences *inf, __m128d *M)
 {
 	const double *S = g->skin2 + i * (size_t)g->joint_count * 24;
-	for (int e = 0; e < 12; e++)
-		M[e] = _mm_setzero_pd();
+	/* Written out, so that the twelve sums stay in registers. */
+	__m128d m0 = _mm_setzero_pd(), m1 = m0, m2 = m0, m3 = m0, m4 = m0, m5 = m0, m6 = m0, m7 = m0, m8 = m0,
+	        m9 = m0, m10 = m0, m11 = m0;
 	for (int k = 0; k < inf->count; k++) {
 		const double *s = S + 24 * (size_t)inf->joints[k];
 		__m128d w = _mm_set1_pd((double)inf->weights[k]);
-		for (int e = 0; e < 12; e++)
-			M[e] = _mm_add_pd(M[e], _mm_mul_pd(w, _mm_loadu_pd(s + 2 * e)));
+		m0 = _mm_add_pd(m0, _mm_mul_pd(w, _mm_loadu_pd(s)));
+		m1 = _mm_add_pd(m1, _mm_mul_pd(w, _mm_loadu_pd(s + 2)));
+		m2 = _mm_add_pd(m2, _mm_mul_pd(w, _mm_loadu_pd(s + 4)));
+		m3 = _mm_add_pd(m3, _mm_mul_pd(w, _mm_loadu_pd(s + 6)));
+		m4 = _mm_add_pd(m4, _mm_mul_pd(w, _mm_loadu_pd(s + 8)));
+		m5 = _mm_add_pd(m5, _mm_mul_pd(w, _mm_loadu_pd(s + 10)));
+		m6 = _mm_add_pd(m6, _mm_mul_pd(w, _mm_loadu_pd(s + 12)));
+		m7 = _mm_add_pd(m7, _mm_mul_pd(w, _mm_loadu_pd(s + 14)));
+		m8 = _mm_add_pd(m8, _mm_mul_pd(w, _mm_loadu_pd(s + 16)));
+		m9 = _mm_add_pd(m9, _mm_mul_pd(w, _mm_loadu_pd(s + 18)));
+		m10 = _mm_add_pd(m10, _mm_mul_pd(w, _mm_loadu_pd(s + 20)));
+		m11 = _mm_add_pd(m11, _mm_mul_pd(w, _mm_loadu_pd(s + 22)));
 	}
+	M[0] = m0, M[1] = m1, M[2] = m2, M[3] = m3, M[4] = m4, M[5] = m5;
+	M[6] = m6, M[7] = m7, M[8] = m8, M[9] = m9, M[10] = m10, M[11] = m11;
 }
 
-/* q's entry e for poses 2i and 2i + 1. */
-static inline __m128d qpair(const double *q, size_t i, int e)
+/* q's ten entries for poses 2i and 2i + 1. */
+static inline void qpairs(const double *q, size_t i, __m128d *a)
 {
-	return _mm_set_pd(q[20 * i + 10 + (size_t)e], q[20 * i + (size_t)e]);
+	const double *u = q + 20 * i, *v = u + 10;
+	a[0] = _mm_set_pd(v[0], u[0]), a[1] = _mm_set_pd(v[1], u[1]), a[2] = _mm_set_pd(v[2], u[2]);
+	a[3] = _mm_set_pd(v[3], u[3]), a[4] = _mm_set_pd(v[4], u[4]), a[5] = _mm_set_pd(v[5], u[5]);
+	a[6] = _mm_set_pd(v[6], u[6]), a[7] = _mm_set_pd(v[7], u[7]), a[8] = _mm_set_pd(v[8], u[8]);
+	a[9] = _mm_set_pd(v[9], u[9]);
 }
+
 
 /* eval for both poses (q: the 10 entries as pairs). */
 static inline __m128d eval2(const __m128d *q, const __m128d *x)
@@ -371,12 +389,12 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 			__m128d Mv[12], yv[3], qv[10];
 			size_t i = (size_t)p / 2;
 			blend2(g, i, inf, Mv);
-			for (int r = 0; r < 3; r++)
-				yv[r] = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(Mv[4 * r], x0), _mm_mul_pd(Mv[4 * r + 1], x1)),
-				                              _mm_mul_pd(Mv[4 * r + 2], x2)),
-				                   Mv[4 * r + 3]);
-			for (int k = 0; k < 10; k++)
-				qv[k] = qpair(q, i, k);
+#define ROW(r) _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(Mv[4 * r], x0), _mm_mul_pd(Mv[4 * r + 1], x1)), \
+                                    _mm_mul_pd(Mv[4 * r + 2], x2)), \
+                         Mv[4 * r + 3])
+			yv[0] = ROW(0), yv[1] = ROW(1), yv[2] = ROW(2);
+#undef ROW
+			qpairs(q, i, qv);
 			double v[2];
 			_mm_storeu_pd(v, eval2(qv, yv));
 			e += v[0] > 0.0 ? v[0] : 0.0;
@@ -438,8 +456,7 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 			__m128d M[12], a[10];
 			size_t i = (size_t)p / 2;
 			blend2(g, i, inf, M);
-			for (int k = 0; k < 10; k++)
-				a[k] = qpair(q, i, k);
+			qpairs(q, i, a);
 #define MUL(x, y) _mm_mul_pd(x, y)
 #define ADD(x, y) _mm_add_pd(x, y)
 #define DOT3(a0, m0, a1, m1, a2, m2) ADD(ADD(MUL(a0, m0), MUL(a1, m1)), MUL(a2, m2))
@@ -470,10 +487,10 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 #undef DOT3
 #undef ADD
 #undef MUL
-			for (int k = 0; k < 10; k++)
-				H[k] += h[k][0];
-			for (int k = 0; k < 10; k++)
-				H[k] += h[k][1];
+			H[0] += h[0][0], H[1] += h[1][0], H[2] += h[2][0], H[3] += h[3][0], H[4] += h[4][0];
+			H[5] += h[5][0], H[6] += h[6][0], H[7] += h[7][0], H[8] += h[8][0], H[9] += h[9][0];
+			H[0] += h[0][1], H[1] += h[1][1], H[2] += h[2][1], H[3] += h[3][1], H[4] += h[4][1];
+			H[5] += h[5][1], H[6] += h[6][1], H[7] += h[7][1], H[8] += h[8][1], H[9] += h[9][1];
 		}
 	}
 #endif
