@@ -110,10 +110,9 @@ int bgm_add_node(mlod_bgm *g)
 	memset(&g->inf[n], 0, sizeof g->inf[n]);
 	if (g->lay.morph_stride > 0)
 		memset(g->morph + (size_t)n * (size_t)g->lay.morph_stride, 0, sizeof(float) * (size_t)g->lay.morph_stride);
-	if (g->pose_count > 0) {
-		memset(g->quadric + (size_t)n * (size_t)g->pose_count * 10, 0, sizeof(double) * 10 * (size_t)g->pose_count);
-		memset(g->rquad + (size_t)n * BGM_RQUAD, 0, sizeof(double) * BGM_RQUAD);
-	}
+	/* Its posed quadrics (once there are any) are the caller's to write:
+	 * the one caller after bgm_quadrics_build, collapse.c's apply(),
+	 * writes every entry and resets its pulled-back quadric. */
 	return n;
 }
 

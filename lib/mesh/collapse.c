@@ -1585,13 +1585,8 @@ static int apply(mlod_bgm *g, struct plan *pl)
 		}
 	}
 	if (g->pose_count > 0) {
-		double *q = g->quadric + (size_t)v * (size_t)g->pose_count * 10;
-		for (int k = 0; k < 10 * g->pose_count; k++) {
-			double x = 0.0;
-			for (int i = 0; i < K; i++)
-				x += g->quadric[(size_t)pl->v[i] * (size_t)g->pose_count * 10 + (size_t)k];
-			q[k] = x;
-		}
+		/* The parents' sums, each from 0 in their order (sum_quadrics). */
+		sum_quadrics(g, pl, g->quadric + (size_t)v * (size_t)g->pose_count * 10);
 		bgm_quadric_rest_reset(g, v);
 	}
 

@@ -228,7 +228,8 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	 * out. Each node's sum is made in the same order from the same 0. */
 	double *acc = malloc(sizeof(double) * 10 * (size_t)g->node_count + 1);
 	g->skin = malloc(sizeof(float) * 12 * (size_t)J * (size_t)P);
-	g->quadric = calloc((size_t)g->node_cap * (size_t)P * 10, sizeof *g->quadric);
+	/* Every node's every pose is written below (a copy or a sum). */
+	g->quadric = malloc(sizeof *g->quadric * (size_t)g->node_cap * (size_t)P * 10);
 	g->rquad = malloc(sizeof *g->rquad * (size_t)g->node_cap * BGM_RQUAD);
 	if (!mats || !rest || !local || !posed || !fn || !acc || !g->skin || !g->quadric || !g->rquad) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
