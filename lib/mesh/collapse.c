@@ -1708,10 +1708,19 @@ static int apply(mlod_bgm *g, struct plan *pl)
 
 	/* Border flags as the new faces leave them: a collapse along a border
 	 * can close a hole, leaving v-bar or a ring vertex inside. */
+	/* Each node once (v-bar is a corner of every new face, a ring vertex
+	 * of one or two): on_border reads faces, not flags. */
+	int seen[2 * MAX_PATCH + 1], ns = 0;
 	for (int j = 0; j < pl->nk; j++)
 		for (int k = 0; k < 3; k++) {
-			bgm_node *n = &g->nodes[g->faces[first + j].n[k]];
-			if (on_border(g, g->faces[first + j].n[k]))
+			int x = g->faces[first + j].n[k], dup = 0;
+			for (int i = 0; i < ns && !dup; i++)
+				dup = seen[i] == x;
+			if (dup)
+				continue;
+			seen[ns++] = x;
+			bgm_node *n = &g->nodes[x];
+			if (on_border(g, x))
 				n->flags |= BGM_BORDER;
 			else
 				n->flags &= ~BGM_BORDER;
