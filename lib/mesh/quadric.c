@@ -37,15 +37,12 @@ static void to_rows(const mlod_mat4 *m, float *out)
 			out[4 * r + c] = m->m[c * 4 + r];
 }
 
-static void plane_quadric(const double *a, const double *b, const double *c, double *q)
+/* The plane of the face with corner a and fn: its bgm_face_normal and
+ * that normal's length. */
+static void plane_quadric(const double *a, const double *fn, double *q)
 {
-	double u[3], v[3], n[3];
-	for (int i = 0; i < 3; i++)
-		u[i] = b[i] - a[i], v[i] = c[i] - a[i];
-	n[0] = u[1] * v[2] - u[2] * v[1];
-	n[1] = u[2] * v[0] - u[0] * v[2];
-	n[2] = u[0] * v[1] - u[1] * v[0];
-	double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+	double n[3] = {fn[0], fn[1], fn[2]};
+	double len = fn[3];
 	if (!(len > 0.0))
 		return;
 	double area = 0.5 * len;
@@ -319,11 +316,24 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 		for (int f = 0; f < g->face_count; f++) {
 			const bgm_face *F = &g->faces[f];
 			double q[10] = {0};
-			plane_quadric(posed + 3 * F->n[0], posed + 3 * F->n[1], posed + 3 * F->n[2], q);
+			/* Its own normal: worked out once per pose (a neighbour may have),
+			 * for its plane and its first edge. */
+			double *nf = fn + 4 * f;
+			if (nf[3] < 0.0) {
+				bgm_face_normal(posed + 3 * F->n[0], posed + 3 * F->n[1], posed + 3 * F->n[2], nf);
+				nf[3] = sqrt(dot3(nf, nf));
+			}
+			plane_quadric(posed + 3 * F->n[0], nf, q);
 			for (int i = 0; i < 3; i++) {
 				double *Q = acc + (size_t)F->n[i] * 10;
+#ifdef __SSE2__
+				/* two entries at a time, each the same sum */
+				for (int k = 0; k < 10; k += 2)
+					_mm_storeu_pd(Q + k, _mm_add_pd(_mm_loadu_pd(Q + k), _mm_loadu_pd(q + k)));
+#else
 				for (int k = 0; k < 10; k++)
 					Q[k] += q[k];
+#endif
 			}
 			/* Feature edges (borders, creases sharper than FEATURE_COS):
 			 * a plane through the edge, perpendicular to the face, keeps
@@ -337,7 +347,10 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 				const double *o = posed + 3 * F->n[(e + 2) % 3];
 				double n1[3];
 				const double *n2 = NULL;
-				bgm_face_normal(a, b, o, n1);
+				if (e == 0) /* (a, b, o) is the face's own order */
+					memcpy(n1, nf, sizeof n1);
+				else
+					bgm_face_normal(a, b, o, n1);
 				if (h >= 0) {
 					double *c = fn + 4 * h;
 					if (c[3] < 0.0) {
@@ -346,7 +359,7 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 						c[3] = sqrt(dot3(c, c));
 					}
 					n2 = c;
-					double l1 = sqrt(dot3(n1, n1)), l2 = c[3];
+					double l1 = e == 0 ? nf[3] : sqrt(dot3(n1, n1)), l2 = c[3];
 					if (!(l1 > 0.0) || !(l2 > 0.0) || dot3(n1, n2) > FEATURE_COS * l1 * l2)
 						continue;
 				}
