@@ -798,6 +798,7 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->skin2);
 	free(g->opstate);
 	free(g->ftie);
+	free(g->fgeo);
 	free(g->lbmemo);
 	free(g->heap.e);
 	free(g->heap.memo);

@@ -132,7 +132,9 @@ struct mlod_bgm {
 	int opstate_cap;
 	double *ftie;           /* per face (collapse.c): its compactness tie-break term, NaN until
 	                         * worked out (a face's nodes never change) */
-	int ftie_cap;
+	double *fgeo;           /* per face (collapse.c): bgm_face_normal, its length (NaN until
+	                         * worked out) and bgm_compactness, 5 doubles */
+	int ftie_cap;           /* of ftie and fgeo */
 	/* collapse.c: the weak queue keys' bounds by collapsed nodes (a pure
 	 * function of them: an edge or triangle whose faces died and came
 	 * back around a collapse is not worked out again); open addressing,

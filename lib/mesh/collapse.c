@@ -357,14 +357,6 @@ static void segment_weights(const double *a, const double *b, const double *x, d
 	l[0] = 1.0 - s, l[1] = s, l[2] = 0.0;
 }
 
-/* Half the squared norm of the normal: the squared area of (a, b, c). */
-static double area_sq(const double *a, const double *b, const double *c)
-{
-	double n[3];
-	bgm_face_normal(a, b, c, n);
-	return 0.25 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-}
-
 /* The collapsed vertices' posed quadrics summed per pose, as plan()
  * sums them. */
 static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
@@ -399,15 +391,30 @@ static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 	}
 }
 
-/* Face h's area times its lack of compactness, worked out once (its
- * nodes, in its order, never change): the same arithmetic every time. */
+/* Face h's bgm_face_normal (0-2), its length (3) and its compactness
+ * (4), worked out once (its nodes, in its order, never change): the
+ * same arithmetic every time. */
+static const double *face_geo(mlod_bgm *g, int h)
+{
+	double *o = g->fgeo + 5 * (size_t)h;
+	if (isnan(o[3])) {
+		const bgm_face *F = &g->faces[h];
+		const double *a = g->nodes[F->n[0]].p, *b = g->nodes[F->n[1]].p, *c = g->nodes[F->n[2]].p;
+		bgm_face_normal(a, b, c, o);
+		o[3] = sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+		o[4] = bgm_compactness(a, b, c);
+	}
+	return o;
+}
+
+/* Face h's area times its lack of compactness (sqrt(area_sq) from its
+ * normal: area_sq's arithmetic). */
 static double face_tie(mlod_bgm *g, int h)
 {
 	double *t = &g->ftie[h];
 	if (isnan(*t)) {
-		const bgm_face *F = &g->faces[h];
-		const double *a = g->nodes[F->n[0]].p, *b = g->nodes[F->n[1]].p, *c = g->nodes[F->n[2]].p;
-		*t = sqrt(area_sq(a, b, c)) * (1.0 - bgm_compactness(a, b, c));
+		const double *o = face_geo(g, h);
+		*t = sqrt(0.25 * (o[0] * o[0] + o[1] * o[1] + o[2] * o[2])) * (1.0 - o[4]);
 	}
 	return *t;
 }
@@ -753,12 +760,9 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 
 	/* The kept faces as they are, for geometry_ok. */
 	for (int i = 0; i < pl->nk; i++) {
-		const bgm_face *f = &g->faces[pl->kept[i]];
-		const double *a = g->nodes[f->n[0]].p, *b = g->nodes[f->n[1]].p, *c = g->nodes[f->n[2]].p;
-		double *no = pl->onormal[i];
-		bgm_face_normal(a, b, c, no);
-		no[3] = sqrt(no[0] * no[0] + no[1] * no[1] + no[2] * no[2]);
-		pl->oflip[i] = no[3] > 0.0 && bgm_compactness(a, b, c) >= DEGENERATE;
+		const double *o = face_geo(g, pl->kept[i]);
+		memcpy(pl->onormal[i], o, 4 * sizeof *o);
+		pl->oflip[i] = o[3] > 0.0 && o[4] >= DEGENERATE;
 	}
 	/* The cheapest valid candidate; with the compactness cost (the same
 	 * for every placement), the one nearest the barycenter. The
@@ -923,9 +927,13 @@ static int grow_face_arrays(mlod_bgm *g)
 		double *t = realloc(g->ftie, sizeof *t * (size_t)g->face_cap);
 		if (!t)
 			return -1;
-		for (int f = g->ftie_cap; f < g->face_cap; f++)
-			t[f] = NAN;
 		g->ftie = t;
+		double *o = realloc(g->fgeo, sizeof *o * 5 * (size_t)g->face_cap);
+		if (!o)
+			return -1;
+		g->fgeo = o;
+		for (int f = g->ftie_cap; f < g->face_cap; f++)
+			t[f] = o[5 * (size_t)f + 3] = NAN;
 		g->ftie_cap = g->face_cap;
 	}
 	return 0;
