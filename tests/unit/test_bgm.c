@@ -712,6 +712,130 @@ TEST(deterministic)
 	mlod_character_free(&c);
 }
 
+/* The posed cost's sums pose by pose, written here in the one-pose
+ * arithmetic of quadric.c: its two-poses-at-a-time paths must give the
+ * same bits, and stop at the same pose. */
+static void ref_blend(const mlod_bgm *g, int p, const mlod_influences *inf, double *M)
+{
+	const float *S = g->skin + (size_t)p * (size_t)g->joint_count * 12;
+	memset(M, 0, 12 * sizeof *M);
+	for (int k = 0; k < inf->count; k++) {
+		const float *s = S + 12 * (size_t)inf->joints[k];
+		double w = inf->weights[k];
+		for (int i = 0; i < 12; i++)
+			M[i] += w * s[i];
+	}
+}
+
+static double ref_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
+{
+	double M[12], y[3], e = 0.0;
+	for (int p = 0; p < g->pose_count; p++) {
+		ref_blend(g, p, inf, M);
+		for (int r = 0; r < 3; r++)
+			y[r] = M[4 * r] * x[0] + M[4 * r + 1] * x[1] + M[4 * r + 2] * x[2] + M[4 * r + 3];
+		const double *a = q + 10 * p;
+		double v = a[0] * y[0] * y[0] + 2 * a[1] * y[0] * y[1] + 2 * a[2] * y[0] * y[2] + 2 * a[3] * y[0] +
+		           a[4] * y[1] * y[1] + 2 * a[5] * y[1] * y[2] + 2 * a[6] * y[1] + a[7] * y[2] * y[2] + 2 * a[8] * y[2] + a[9];
+		e += v > 0.0 ? v : 0.0;
+		if (e >= stop)
+			return HUGE_VAL;
+	}
+	return e;
+}
+
+static void ref_pullback(const mlod_bgm *g, const double *q, const mlod_influences *inf, double *H)
+{
+	memset(H, 0, 10 * sizeof *H);
+	for (int p = 0; p < g->pose_count; p++) {
+		double M[12], T[3][4];
+		const double *a = q + 10 * p;
+		/* the packed quadric as a symmetric 4x4 */
+		double A[4][4] = {{a[0], a[1], a[2], a[3]}, {a[1], a[4], a[5], a[6]}, {a[2], a[5], a[7], a[8]}, {a[3], a[6], a[8], a[9]}};
+		ref_blend(g, p, inf, M);
+		/* T = A [M; 0 0 0 1], rows 0-2 (row 3's products are only needed for (3, 3)) */
+		for (int r = 0; r < 3; r++)
+			for (int c = 0; c < 4; c++) {
+				T[r][c] = A[r][0] * M[c] + A[r][1] * M[4 + c] + A[r][2] * M[8 + c];
+				if (c == 3)
+					T[r][c] += A[r][3];
+			}
+		double t33 = A[3][0] * M[3] + A[3][1] * M[7] + A[3][2] * M[11] + A[3][3];
+		int k = 0;
+		for (int i = 0; i < 4; i++)
+			for (int j = i; j < 4; j++) {
+				double v = M[i] * T[0][j] + M[4 + i] * T[1][j] + M[8 + i] * T[2][j];
+				if (i == 3 && j == 3)
+					v += t33;
+				H[k++] += v;
+			}
+	}
+}
+
+static void check_two_pose_sums(const mlod_character *c, int clips, int random)
+{
+	mlod_pose_set poses;
+	CHECK_OK(mlod_pose_set_make(c, 0, clips, random, 5, DEG40, &poses, &terr));
+	mlod_bgm_options opt = {0};
+	opt.poses = &poses;
+	mlod_bgm *g;
+	CHECK_OK(mlod_bgm_build(c, 0, 0, &opt, &g, &terr));
+	if (!g) {
+		mlod_pose_set_free(&poses);
+		return;
+	}
+	CHECK(g->pose_count == 1 + poses.count && g->joint_count > 0);
+	int checked = 0, stopped = 0;
+	for (int v = 0; v + 1 < g->node_count; v += 7) {
+		const double *q = g->quadric + (size_t)v * (size_t)g->pose_count * 10;
+		/* Its own influences, and Power Skinning of its and the next
+		 * node's at their midpoint (more joints). */
+		mlod_influences in[2], mixed;
+		mlod_v3 V[2];
+		for (int i = 0; i < 2; i++) {
+			const double *p = g->nodes[v + i].p;
+			V[i] = (mlod_v3){(float)p[0], (float)p[1], (float)p[2]};
+			in[i] = g->inf[v + i];
+		}
+		mlod_power_skin(V, in, 2, (mlod_v3){0.5f * (V[0].x + V[1].x), 0.5f * (V[0].y + V[1].y), 0.5f * (V[0].z + V[1].z)},
+		                &mixed);
+		const mlod_influences *ws[2] = {&g->inf[v], &mixed};
+		for (int w = 0; w < 2; w++) {
+			if (ws[w]->count == 0)
+				continue;
+			const double *p = g->nodes[v].p;
+			double x[3] = {p[0] + 0.01 * g->diagonal, p[1] - 0.02 * g->diagonal, p[2] + 0.005 * g->diagonal};
+			double want = ref_error(g, q, ws[w], x, HUGE_VAL), got = bgm_quadric_error(g, q, ws[w], x, HUGE_VAL);
+			CHECK_MSG(memcmp(&want, &got, sizeof want) == 0, "node %d: error %.17g, one pose at a time %.17g", v, got, want);
+			/* A stop inside the sum: after the same pose. */
+			double stop = 0.5 * want;
+			if (stop > 0.0) {
+				double ws_ = ref_error(g, q, ws[w], x, stop), gs = bgm_quadric_error(g, q, ws[w], x, stop);
+				CHECK(memcmp(&ws_, &gs, sizeof ws_) == 0);
+				stopped += gs == HUGE_VAL;
+			}
+			double hw[10], hg[10];
+			ref_pullback(g, q, ws[w], hw);
+			bgm_quadric_pullback(g, q, ws[w], hg);
+			CHECK_MSG(memcmp(hw, hg, sizeof hw) == 0, "node %d: pullback differs from one pose at a time", v);
+			checked++;
+		}
+	}
+	CHECK(checked > 50 && stopped > 10);
+	mlod_bgm_free(g);
+	mlod_pose_set_free(&poses);
+}
+
+TEST(two_pose_sums)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	/* An odd and an even count of poses (the bind pose is one). */
+	check_two_pose_sums(&c, 2, 2);
+	check_two_pose_sums(&c, 2, 3);
+	mlod_character_free(&c);
+}
+
 /* Level errors as mlod_posed_error reports them, recomputed pose by pose;
  * the levels are ordered. */
 TEST(level_errors_ordered)
@@ -1002,6 +1126,7 @@ int main(void)
 	RUN(border_collapses_robot);
 	RUN(rigid_and_morph);
 	RUN(deterministic);
+	RUN(two_pose_sums);
 	RUN(level_errors_ordered);
 	RUN(mesh_levels_pipelined);
 	RUN(pose_sets);
