@@ -365,6 +365,20 @@ static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 	 * loop makes it). */
 	size_t n = 10 * (size_t)g->pose_count;
 	const double *a = g->quadric + (size_t)pl->v[0] * n, *b = pl->k > 1 ? g->quadric + (size_t)pl->v[1] * n : NULL;
+#ifdef __SSE2__
+	/* Two entries at a time (n is even): each lane the sum below. */
+	if (pl->k == 2 || pl->k == 3) {
+		const double *c = pl->k == 3 ? g->quadric + (size_t)pl->v[2] * n : NULL;
+		const __m128d zero = _mm_setzero_pd();
+		for (size_t k = 0; k < n; k += 2) {
+			__m128d s = _mm_add_pd(_mm_add_pd(zero, _mm_loadu_pd(a + k)), _mm_loadu_pd(b + k));
+			if (c)
+				s = _mm_add_pd(s, _mm_loadu_pd(c + k));
+			_mm_storeu_pd(Q + k, s);
+		}
+		return;
+	}
+#endif
 	if (pl->k == 3) {
 		const double *c = g->quadric + (size_t)pl->v[2] * n;
 		for (size_t k = 0; k < n; k++) {
