@@ -220,6 +220,128 @@ static int entropy_table(const mlod_pack *p, const uint8_t *d)
 	return 0;
 }
 
+
+/* -p: each chunk's container under zstd 19 alone, and with a prefix
+ * dictionary (ZSTD_CCtx_refPrefix) of other chunks' containers, coarsest
+ * first: "deps" the chunks it already depends on (a MESH level: every
+ * coarser MESH level; a nested MOTION level: its clip's next coarser
+ * level), "deps+skel" those after the SKELETON container (every chunk but
+ * INFO and DOC already takes the decoded full skeleton), "all before" every
+ * earlier chunk (a new dependency; the bound). Bytes per chunk type, and the
+ * decode time of every chunk (best of 7). */
+static size_t zc(ZSTD_CCtx *c, uint8_t *out, size_t cap, const blob *b, const uint8_t *pre, size_t npre)
+{
+	ZSTD_CCtx_reset(c, ZSTD_reset_session_and_parameters);
+	ZSTD_CCtx_setParameter(c, ZSTD_c_compressionLevel, 19);
+	ZSTD_CCtx_setParameter(c, ZSTD_c_contentSizeFlag, 1);
+	if (npre)
+		ZSTD_CCtx_refPrefix(c, pre, npre);
+	size_t n = ZSTD_compress2(c, out, cap, b->p, b->n);
+	return ZSTD_isError(n) ? 0 : n;
+}
+
+static int is_dep(const mlod_pack *p, uint32_t c, uint32_t o, int mode)
+{
+	const mlod_pack_chunk *a = &p->chunks[c], *b = &p->chunks[o];
+	if (o >= c)
+		return 0;
+	if (mode == 3)
+		return 1;
+	if (mode == 2 && b->type == MLOD_CHUNK_SKELETON && b->level == 0 && a->type != MLOD_CHUNK_DOC)
+		return 1;
+	if (a->type == MLOD_CHUNK_MESH && b->type == MLOD_CHUNK_MESH && b->level > a->level)
+		return 1;
+	if (a->type == MLOD_CHUNK_MOTION && (a->flags & 1) && b->type == MLOD_CHUNK_MOTION && b->item == a->item &&
+	    b->level == a->level + 1)
+		return 1;
+	return 0;
+}
+
+static int prefix_table(const mlod_pack *p, const uint8_t *d)
+{
+	uint32_t nc = p->chunk_count;
+	blob *bl = calloc(nc, sizeof *bl);
+	uint8_t **own = calloc(nc, sizeof *own);
+	size_t maxn = 0, total = 0;
+	for (uint32_t c = 0; c < nc; c++) {
+		size_t cn;
+		bl[c] = (blob){container(&p->chunks[c], d, &cn, &own[c]), 0, p->chunks[c].type};
+		bl[c].n = cn;
+		maxn = cn > maxn ? cn : maxn;
+		total += cn;
+	}
+	static const uint32_t types[] = {MLOD_CHUNK_INFO, MLOD_CHUNK_SKELETON, MLOD_CHUNK_MESH, MLOD_CHUNK_MOTION,
+	                                 MLOD_CHUNK_DOC};
+	static const char *names[] = {"zstd 19 alone", "prefix: deps", "prefix: deps+skel", "prefix: all before"};
+	size_t cap = ZSTD_compressBound(maxn) + 64;
+	uint8_t *out = malloc(cap), *back = malloc(maxn + 1), *pre = malloc(total + 1);
+	uint8_t **cbuf = calloc(nc, sizeof *cbuf);
+	size_t *csz = calloc(nc, sizeof *csz), *poff = calloc(nc, sizeof *poff), *plen = calloc(nc, sizeof *plen);
+	uint8_t **pbuf = calloc(nc, sizeof *pbuf);
+	ZSTD_CCtx *cc = ZSTD_createCCtx();
+	ZSTD_DCtx *dc = ZSTD_createDCtx();
+	printf("| method | INFO | SKEL | MESH | ANIM | DOC | chunks | whole | decode ms |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+	for (int mode = 0; mode < 4; mode++) {
+		unsigned long long sum[5] = {0}, whole = p->file_size;
+		for (uint32_t c = 0; c < nc; c++) {
+			size_t np = 0;
+			if (mode)
+				for (uint32_t o = 0; o < c; o++)
+					if (is_dep(p, c, o, mode))
+						memcpy(pre + np, bl[o].p, bl[o].n), np += bl[o].n;
+			free(pbuf[c]);
+			pbuf[c] = np ? malloc(np) : NULL;
+			if (np)
+				memcpy(pbuf[c], pre, np);
+			plen[c] = np;
+			(void)poff;
+			size_t n = bl[c].type == MLOD_CHUNK_INFO ? 0 : zc(cc, out, cap, &bl[c], pre, np);
+			free(cbuf[c]);
+			cbuf[c] = NULL;
+			csz[c] = 0;
+			if (n && n < bl[c].n) {
+				cbuf[c] = malloc(n), memcpy(cbuf[c], out, n), csz[c] = n;
+			}
+			size_t now = csz[c] ? csz[c] : bl[c].n;
+			whole = whole - p->chunks[c].stored_size + now; /* alignment ignored */
+			for (int t = 0; t < 5; t++)
+				if (bl[c].type == types[t])
+					sum[t] += now;
+		}
+		double best = 1e30;
+		for (int rep = 0; rep < 7; rep++) {
+			double t0 = cpu_now();
+			for (uint32_t c = 0; c < nc; c++) {
+				if (!csz[c])
+					continue;
+				ZSTD_DCtx_reset(dc, ZSTD_reset_session_only);
+				if (plen[c])
+					ZSTD_DCtx_refPrefix(dc, pbuf[c], plen[c]);
+				size_t got = ZSTD_decompressDCtx(dc, back, bl[c].n, cbuf[c], csz[c]);
+				if (got != bl[c].n || memcmp(back, bl[c].p, got) != 0) {
+					fprintf(stderr, "pack_streams: %s: chunk %u does not come back\n", names[mode], c);
+					return 1;
+				}
+			}
+			double t = cpu_now() - t0;
+			best = t < best ? t : best;
+		}
+		unsigned long long chunks = 0;
+		for (int t = 0; t < 5; t++)
+			chunks += sum[t];
+		printf("| %s |", names[mode]);
+		for (int t = 0; t < 5; t++)
+			printf(" %llu |", sum[t]);
+		printf(" %llu | %llu | %.3f |\n", chunks, whole, 1e3 * best);
+	}
+	ZSTD_freeCCtx(cc);
+	ZSTD_freeDCtx(dc);
+	for (uint32_t c = 0; c < nc; c++)
+		free(cbuf[c]), free(own[c]), free(pbuf[c]);
+	free(own), free(cbuf), free(csz), free(poff), free(plen), free(pbuf), free(out), free(back), free(pre), free(bl);
+	return 0;
+}
+
 /* Decodes every chunk once; 0 on success. */
 static int decode_every_chunk(const mlod_pack *p, const uint8_t *d, size_t n)
 {
@@ -270,6 +392,7 @@ int main(int argc, char **argv)
 	int verbose = argc > 2 && strcmp(argv[2], "-v") == 0;
 	int entropy = argc > 2 && strcmp(argv[2], "-z") == 0;
 	int decode = argc > 2 && strcmp(argv[2], "-d") == 0;
+	int prefix = argc > 2 && strcmp(argv[2], "-p") == 0;
 	FILE *f = fopen(argv[1], "rb");
 	if (!f)
 		return perror(argv[1]), 1;
@@ -300,6 +423,12 @@ int main(int argc, char **argv)
 			printf("%s: every chunk decoded in %.3f ms CPU (best of 15): %llu stored bytes (%.1f MB/s), %llu raw "
 			       "(%.1f MB/s)\n",
 			       argv[1], 1e3 * best, stored, stored / best / 1e6, raw, raw / best / 1e6);
+		mlod_pack_close(&p);
+		free(d);
+		return rc;
+	}
+	if (prefix) {
+		int rc = prefix_table(&p, d);
 		mlod_pack_close(&p);
 		free(d);
 		return rc;

@@ -60,8 +60,10 @@
  *
  * Chunk payload: a stream container; with entropy stage MLOD_ENTROPY_ZSTD,
  * one zstd frame of it that states its size (the coded size) and nothing
- * after it (mlod(5) ENTROPY STAGE). Each chunk's stage is its own: no
- * dictionary, so every chunk still decodes from its own bytes.
+ * after it (mlod(5) ENTROPY STAGE). With MLOD_ENTROPY_ZSTD_PREFIX (format
+ * 6.0, MESH levels but the coarsest), the frame is coded with the coarser
+ * MESH levels' containers as its prefix: the chunks the level already
+ * needs, so a prefix of the file still decodes every level it holds.
  *   u32 stream_count (at most MLOD_PACK_MAX_STREAMS)
  *   stream_count stream headers of 16 bytes:
  *     0 u32  tag (MLOD_STREAM_*, a fourcc)
@@ -271,7 +273,7 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 5
+#define MLOD_PACK_MAJOR 6
 #define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32
@@ -319,6 +321,12 @@ typedef enum mlod_pack_codec {
  * are one zstd frame that says that size. INFO never has one. */
 #define MLOD_ENTROPY_NONE 0
 #define MLOD_ENTROPY_ZSTD 1
+/* Format 6.0: a MESH level but the coarsest, one zstd frame coded with a
+ * prefix (ZSTD_CCtx_refPrefix): the stream containers of every coarser
+ * MESH level, coarsest first, one after the other, as the reader has them
+ * after undoing their own stage; at most MLOD_PACK_MAX_PREFIX bytes. */
+#define MLOD_ENTROPY_ZSTD_PREFIX 2
+#define MLOD_PACK_MAX_PREFIX ((uint64_t)1 << 26)
 
 /* A stream's codec. */
 #define MLOD_SCODEC_RAW 0
@@ -690,7 +698,7 @@ int mlod_pack_find(const mlod_pack *p, uint32_t type, unsigned level, unsigned i
  * the reader: the comment named it, no declaration did. */
 const char *mlod_pack_type_name(uint32_t type);
 const char *mlod_pack_codec_name(unsigned codec);
-const char *mlod_pack_entropy_name(unsigned entropy); /* "none", "zstd" */
+const char *mlod_pack_entropy_name(unsigned entropy); /* "none", "zstd", "zstd-prefix" */
 const char *mlod_pack_layer_name(unsigned layer);
 
 #ifdef __cplusplus
