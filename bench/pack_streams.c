@@ -52,21 +52,43 @@ static void print(const tagsum *t, int nt, const char *indent)
 }
 
 /* The chunk's stream container: its bytes, or with an entropy stage
- * those bytes decoded (malloc'd into *own). */
+ * those bytes decoded (malloc'd into *own). Callers go through the
+ * chunks in TOC order from chunk 0: the MESH levels' containers are kept
+ * as the prefix of the finer ones (format 6.0, MLOD_ENTROPY_ZSTD_PREFIX). */
 static const uint8_t *container(const mlod_pack_chunk *ch, const uint8_t *d, size_t *n, uint8_t **own)
 {
+	static uint8_t *meshes;
+	static size_t nmeshes, capmeshes;
+	static const mlod_pack_chunk *last;
+	if (!last || ch <= last)
+		nmeshes = 0; /* a new pass */
+	last = ch;
 	*own = NULL;
 	*n = ch->stored_size;
-	if (ch->entropy == MLOD_ENTROPY_NONE)
-		return d + ch->offset;
-	*own = malloc(ch->coded_size + 1);
-	size_t got = *own ? ZSTD_decompress(*own, ch->coded_size, d + ch->offset, ch->stored_size) : 0;
-	if (ZSTD_isError(got) || got != ch->coded_size) {
-		fprintf(stderr, "pack_streams: a chunk's zstd frame does not decode\n");
-		exit(1);
+	const uint8_t *out = d + ch->offset;
+	if (ch->entropy != MLOD_ENTROPY_NONE) {
+		*own = malloc(ch->coded_size + 1);
+		ZSTD_DCtx *dc = ZSTD_createDCtx();
+		if (ch->entropy == MLOD_ENTROPY_ZSTD_PREFIX)
+			ZSTD_DCtx_refPrefix(dc, meshes, nmeshes);
+		size_t got = *own ? ZSTD_decompressDCtx(dc, *own, ch->coded_size, d + ch->offset, ch->stored_size) : 0;
+		ZSTD_freeDCtx(dc);
+		if (ZSTD_isError(got) || got != ch->coded_size) {
+			fprintf(stderr, "pack_streams: a chunk's zstd frame does not decode\n");
+			exit(1);
+		}
+		*n = got;
+		out = *own;
 	}
-	*n = got;
-	return *own;
+	if (ch->type == MLOD_CHUNK_MESH) {
+		if (nmeshes + *n > capmeshes) {
+			capmeshes = 2 * (nmeshes + *n);
+			meshes = realloc(meshes, capmeshes);
+		}
+		memcpy(meshes + nmeshes, out, *n);
+		nmeshes += *n;
+	}
+	return out;
 }
 
 static double cpu_now(void)
