@@ -317,8 +317,9 @@ nomem:
  * one-shot compression, one thread, the frame with its content size. */
 #define PACK_ZSTD_LEVEL 19
 
-/* prefix (format 6.0, a MESH level but the coarsest): the coarser MESH
- * levels' containers, coarsest first; the frame coded on it
+/* prefix (format 6.0): a MESH level's (but the coarsest's), the coarser
+ * MESH levels' containers, coarsest first; a skeleton level's, SKELETON's
+ * container. The frame coded on it
  * (MLOD_ENTROPY_ZSTD_PREFIX) is kept where it is smaller than the frame
  * coded alone (ties keep the frame alone, which needs nothing). */
 static mlod_result chunk_entropy(chunk *c, const uint8_t *prefix, size_t prefix_size, mlod_error *err)
@@ -2865,7 +2866,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	/* The entropy stage, after every choice above was made on the codec's
 	 * bytes (INFO has none: its size must not depend on the offsets). */
 	/* Finest first, so that the coarser MESH levels, a finer level's
-	 * prefix, are still their containers. */
+	 * prefix, and SKELETON, a skeleton level's, are still their containers. */
 	for (int i = body.n - 1; opt->entropy == MLOD_ENTROPY_ZSTD && i >= 0; i--) {
 		size_t np = 0;
 		uint8_t *pre = NULL;
@@ -2881,6 +2882,16 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 				if (body.c[j].type == MLOD_CHUNK_MESH)
 					memcpy(pre + o, body.c[j].data, body.c[j].size), o += body.c[j].size;
 		}
+		if (body.c[i].type == MLOD_CHUNK_SKELETON && body.c[i].level > 0)
+			for (int j = 0; j < i && !np; j++)
+				if (body.c[j].type == MLOD_CHUNK_SKELETON && body.c[j].level == 0) {
+					if (!(pre = malloc(body.c[j].size))) {
+						r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+						goto done;
+					}
+					memcpy(pre, body.c[j].data, body.c[j].size);
+					np = body.c[j].size;
+				}
 		r = chunk_entropy(&body.c[i], pre, np, err);
 		free(pre);
 		if (r != MLOD_OK)

@@ -400,9 +400,10 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		} else if (c->entropy == MLOD_ENTROPY_ZSTD_PREFIX && major < 6) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): codec 0x%02x: a zstd prefix stage in a %u.%u pack "
 			              "(format 6.0 added it)", i, label, e[5], major, minor);
-		} else if (c->entropy == MLOD_ENTROPY_ZSTD_PREFIX && c->type != MLOD_CHUNK_MESH) {
-			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the zstd prefix stage is for MESH levels only "
-			              "(the coarser levels are its prefix)", i, label);
+		} else if (c->entropy == MLOD_ENTROPY_ZSTD_PREFIX && c->type != MLOD_CHUNK_MESH &&
+		           !(c->type == MLOD_CHUNK_SKELETON && c->level > 0)) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the zstd prefix stage is for MESH and skeleton "
+			              "levels only (the chunks they need are its prefix)", i, label);
 		} else if (c->entropy && c->type == MLOD_CHUNK_INFO) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): INFO has no entropy stage", i, label);
 		} else if (c->entropy && (c->coded_size < 4 || c->coded_size > c->raw_size)) {
@@ -447,8 +448,16 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 	for (uint32_t i = 0; r == MLOD_OK && i < n; i++)
 		zstd |= chunks[i].entropy == MLOD_ENTROPY_ZSTD || chunks[i].entropy == MLOD_ENTROPY_ZSTD_PREFIX;
 	/* A prefix-coded MESH level needs a coarser MESH level (its prefix):
-	 * the coarsest has none. The order check put the coarser ones first. */
-	for (uint32_t i = 0, coarser = 0; r == MLOD_OK && i < n; i++) {
+	 * the coarsest has none; a skeleton level needs SKELETON. The order
+	 * check put them first. */
+	for (uint32_t i = 0, coarser = 0, full = 0; r == MLOD_OK && i < n; i++) {
+		if (chunks[i].type == MLOD_CHUNK_SKELETON && chunks[i].level == 0)
+			full = 1;
+		if (chunks[i].type == MLOD_CHUNK_SKELETON && chunks[i].entropy == MLOD_ENTROPY_ZSTD_PREFIX && !full) {
+			chunk_label(chunks[i].type, chunks[i].level, chunks[i].item, label, sizeof label);
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the zstd prefix stage without a SKELETON chunk "
+			              "before it for a prefix", i, label);
+		}
 		if (chunks[i].type != MLOD_CHUNK_MESH)
 			continue;
 		if (chunks[i].entropy == MLOD_ENTROPY_ZSTD_PREFIX && !coarser) {
@@ -631,14 +640,14 @@ static mlod_result cx_unpack(cx *x, mlod_error *err)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: the pack has no zstd decoder (not opened by mlod_pack_open)",
 		                 x->label);
 	if (c->entropy == MLOD_ENTROPY_ZSTD_PREFIX) {
-		/* Only decode_mesh gives a prefix, and open allowed the stage
-		 * only on MESH levels with a coarser one. */
+		/* Only decode_mesh and a skeleton level's decode give a prefix,
+		 * and open allowed the stage only on those levels. */
 		if (!x->prefix || !x->prefix_size)
-			return mlod_fail(err, MLOD_ERR_PARSE, "%s: coded on the coarser MESH levels' containers, which were not "
-			                 "given", x->label);
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: coded on the containers of the chunks it needs, which were "
+			                 "not given", x->label);
 		if (x->prefix_size > MLOD_PACK_MAX_PREFIX)
-			return mlod_fail(err, MLOD_ERR_PARSE, "%s: its prefix (the coarser MESH levels' containers) is %llu bytes, "
-			                 "more than the format's %llu", x->label, (unsigned long long)x->prefix_size,
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: its prefix (the containers of the chunks it needs) is %llu "
+			                 "bytes, more than the format's %llu", x->label, (unsigned long long)x->prefix_size,
 			                 (unsigned long long)MLOD_PACK_MAX_PREFIX);
 		size_t pr = ZSTD_DCtx_refPrefix(x->zd->z, x->prefix, (size_t)x->prefix_size);
 		if (ZSTD_isError(pr))
@@ -751,9 +760,10 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 	return MLOD_OK;
 }
 
-/* cx_head and cx_parse on the chunk's bytes in data (a file or a prefix). */
-static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, const void *data, size_t size, cx *x,
-                            mlod_error *err)
+/* cx_head and cx_parse on the chunk's bytes in data (a file or a prefix);
+ * prefix: for MLOD_ENTROPY_ZSTD_PREFIX, or NULL. */
+static mlod_result cx_begin_prefix(const mlod_pack *p, uint32_t index, uint32_t type, const void *data, size_t size,
+                                   const uint8_t *prefix, uint64_t prefix_size, cx *x, mlod_error *err)
 {
 	memset(x, 0, sizeof *x);
 	if (!p || (!data && size))
@@ -766,7 +776,40 @@ static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, c
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: truncated: the chunk ends at byte %llu, the data has %zu", x->label,
 		                 (unsigned long long)(c->offset + c->stored_size), size);
 	x->base = (const uint8_t *)data + c->offset;
+	x->prefix = prefix;
+	x->prefix_size = prefix_size;
 	return cx_parse(x, err);
+}
+
+static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, const void *data, size_t size, cx *x,
+                            mlod_error *err)
+{
+	return cx_begin_prefix(p, index, type, data, size, NULL, 0, x, err);
+}
+
+/* cx_begin on a skeleton level: with the prefix stage, the SKELETON
+ * chunk in data is read and checked first (its CRC, its own stage, its
+ * container), and its container is the prefix; it is freed once the
+ * level's frame is undone. */
+static mlod_result cx_begin_skel_level(const mlod_pack *p, uint32_t index, const void *data, size_t size, cx *x,
+                                       mlod_error *err)
+{
+	if (!p || index >= p->chunk_count || p->chunks[index].entropy != MLOD_ENTROPY_ZSTD_PREFIX ||
+	    p->chunks[index].type != MLOD_CHUNK_SKELETON || p->chunks[index].level == 0)
+		return cx_begin(p, index, MLOD_CHUNK_SKELETON, data, size, x, err);
+	memset(x, 0, sizeof *x);
+	int di = mlod_pack_find(p, MLOD_CHUNK_SKELETON, 0, 0);
+	if (di < 0) /* open refuses that; a caller's own TOC may not */
+		return mlod_fail(err, MLOD_ERR_PARSE, "SKELETON level %u: coded on the SKELETON chunk's container, which the "
+		                 "pack lacks", (unsigned)p->chunks[index].level);
+	cx dx;
+	mlod_result r = cx_begin(p, (uint32_t)di, MLOD_CHUNK_SKELETON, data, size, &dx, err);
+	if (r == MLOD_OK)
+		r = cx_begin_prefix(p, index, MLOD_CHUNK_SKELETON, data, size, dx.base, dx.size, x, err);
+	pk_free(&dx.alloc, dx.plain);
+	if (x->prefix)
+		x->prefix = NULL, x->prefix_size = 0;
+	return r;
 }
 
 static void cx_rewind(cx *x)
@@ -1248,7 +1291,7 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	bump b = {0};
 	stream sk, sj, sb;
 	const uint8_t *src;
-	mlod_result r = cx_begin(p, chunk, MLOD_CHUNK_SKELETON, data, size, &x, err);
+	mlod_result r = cx_begin_skel_level(p, chunk, data, size, &x, err);
 	if (r != MLOD_OK)
 		return r;
 	if (x.c->level == 0)

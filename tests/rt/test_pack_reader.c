@@ -260,7 +260,8 @@ static void restamp(uint8_t *d, size_t n)
 static int zstd_level;
 /* With zstd_level: every MESH chunk after the first (in TOC order, a
  * finer level) coded with the earlier MESH chunks' containers as its
- * prefix (MLOD_ENTROPY_ZSTD_PREFIX, format 6.0), smaller or not. */
+ * prefix (MLOD_ENTROPY_ZSTD_PREFIX, format 6.0), and every skeleton level
+ * with SKELETON's container, smaller or not. */
 static int zstd_prefix;
 /* MESH level 0's streams raw (so that its container is its raw size and
  * may take an entropy stage). */
@@ -286,7 +287,7 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 {
 	uint32_t coded[64] = {0};
 	uint8_t stage[64] = {0};
-	buf chunks[64], plain = {0}, meshes = {0};
+	buf chunks[64], plain = {0}, meshes = {0}, skel0 = {0};
 	uint32_t raw[64];
 	uint64_t off[64];
 	uint64_t at = 32 + 48 * (uint64_t)nc;
@@ -296,8 +297,9 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		if (zstd_level && c[i].type != MLOD_CHUNK_INFO && c[i].ns && !c[i].payload.n && chunks[i].n <= raw[i]) {
 			buf z = zstd_frame(&chunks[i], zstd_level);
 			stage[i] = MLOD_ENTROPY_ZSTD;
-			if (zstd_prefix && c[i].type == MLOD_CHUNK_MESH && meshes.n) {
-				const buf *pre = &meshes;
+			int skel_level = c[i].type == MLOD_CHUNK_SKELETON && c[i].level > 0 && skel0.n;
+			if (zstd_prefix && ((c[i].type == MLOD_CHUNK_MESH && meshes.n) || skel_level)) {
+				const buf *pre = skel_level ? &skel0 : &meshes;
 				buf other = {0};
 				if (wrong_prefix >= 0) {
 					uint32_t r;
@@ -323,6 +325,8 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		}
 		if (c[i].type == MLOD_CHUNK_MESH) /* its container: the finer levels' prefix */
 			put(&meshes, plain.p ? plain.p : chunks[i].p, plain.p ? plain.n : chunks[i].n);
+		if (c[i].type == MLOD_CHUNK_SKELETON && c[i].level == 0) /* the skeleton levels' prefix */
+			put(&skel0, plain.p ? plain.p : chunks[i].p, plain.p ? plain.n : chunks[i].n);
 		free(plain.p);
 		plain = (buf){0};
 		off[i] = at;
@@ -359,6 +363,7 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		free(chunks[i].p);
 	}
 	free(meshes.p);
+	free(skel0.p);
 	restamp(out.p, out.n);
 	return out;
 }
@@ -1812,11 +1817,18 @@ TEST(prefix_decodes_the_same)
 	CHECK_OK(mlod_pack_open(a.p, a.n, &pa, &terr));
 	CHECK_OK(mlod_pack_open(z.p, z.n, &pz, &terr));
 	CHECK(pz.major == 6 && pz.chunks[C_MESH0].entropy == MLOD_ENTROPY_ZSTD_PREFIX &&
+	      pz.chunks[C_SKEL1].entropy == MLOD_ENTROPY_ZSTD_PREFIX && pz.chunks[C_SKEL].entropy == MLOD_ENTROPY_ZSTD &&
 	      pz.chunks[C_MESH1].entropy == MLOD_ENTROPY_ZSTD && pz.chunks[C_MOT1].entropy == MLOD_ENTROPY_ZSTD);
 	CHECK(strcmp(mlod_pack_entropy_name(MLOD_ENTROPY_ZSTD_PREFIX), "zstd-prefix") == 0);
 	mlod_pack_skeleton sa;
 	CHECK_OK(mlod_pack_decode_skeleton(&pa, a.p, a.n, &sa, &terr));
 	int same = 1;
+	mlod_pack_skel_level la, lz;
+	CHECK_OK(mlod_pack_decode_skel_level(&pa, C_SKEL1, a.p, a.n, &sa, &la, &terr));
+	CHECK_OK(mlod_pack_decode_skel_level(&pz, C_SKEL1, z.p, z.n, &sa, &lz, &terr));
+	same &= la.kept_count == lz.kept_count && memcmp(la.kept, lz.kept, 4 * (size_t)la.kept_count) == 0;
+	mlod_pack_skel_level_free(&la);
+	mlod_pack_skel_level_free(&lz);
 	for (int k = 0; k < 3; k++) {
 		uint32_t ci = k == 2 ? C_MESH1 : C_MESH0;
 		mlod_pack_mesh ma, mz;
@@ -1898,14 +1910,26 @@ TEST(prefix_checks)
 		mlod_pack_close(&p);                                                                            \
 	} while (0)
 	/* A 5.x pack has no prefix stage (a 5.x reader refuses 6.0 whole). */
-	OPEN_FAILS(wr16(d + 4, 5), "TOC entry 5 (MESH level 0): codec 0x21: a zstd prefix stage in a 5.0 pack");
+	OPEN_FAILS(wr16(d + 4, 5), "TOC entry 2 (SKELETON level 1): codec 0x20: a zstd prefix stage in a 5.0 pack");
 	/* The coarsest level has nothing to be coded on; other types have no
 	 * prefix (their dependencies are not MESH levels). */
 	OPEN_FAILS(d[32 + 48 * C_MESH1 + 5] = 0x20, "TOC entry 3 (MESH level 1): the zstd prefix stage on the coarsest");
 	OPEN_FAILS(d[32 + 48 * C_MOT1 + 5] = 0x20, "TOC entry 4 (MOTION level 1 of clip 0): the zstd prefix stage is for "
-	                                           "MESH levels only");
-	OPEN_FAILS(d[32 + 48 * C_SKEL + 5] = 0x21, "TOC entry 1 (SKELETON): the zstd prefix stage is for MESH");
-	OPEN_FAILS(d[32 + 48 * C_DOC + 5] = 0x20, "TOC entry 7 (DOC): the zstd prefix stage is for MESH");
+	                                           "MESH and skeleton levels only");
+	OPEN_FAILS(d[32 + 48 * C_SKEL + 5] = 0x21, "TOC entry 1 (SKELETON): the zstd prefix stage is for MESH and");
+	OPEN_FAILS(d[32 + 48 * C_DOC + 5] = 0x20, "TOC entry 7 (DOC): the zstd prefix stage is for MESH and");
+	/* A skeleton level read without its prefix; with SKELETON damaged
+	 * (not re-stamped), the error names SKELETON. */
+	EDIT(d[32 + 48 * C_SKEL1 + 5] = 0x10);
+	CHECK_OK(mlod_pack_open(d, b.n, &p, &terr));
+	mlod_pack_skel_level sl;
+	CHECK_ERR(mlod_pack_decode_skel_level(&p, C_SKEL1, d, b.n, &sk, &sl, &terr), MLOD_ERR_PARSE, "SKELETON level 1: ");
+	mlod_pack_close(&p);
+	memcpy(d, b.p, b.n);
+	d[get64(d + 32 + 48 * C_SKEL + 16) + 7] ^= 1;
+	CHECK_OK(mlod_pack_open(d, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_skel_level(&p, C_SKEL1, d, b.n, &sk, &sl, &terr), MLOD_ERR_PARSE, "SKELETON: CRC mismatch");
+	mlod_pack_close(&p);
 	/* The frame read without its prefix, a damaged coarser level (named
 	 * before level 0 is read), a bomb (the frame says more than the TOC). */
 	DECODE_FAILS(e[5] = 0x11, "MESH level 0: zstd: ");
