@@ -2538,7 +2538,7 @@ int main(int argc, char **argv)
 	if (argc == 3 && (strcmp(argv[1], "--write-seed") == 0 || strcmp(argv[1], "--write-seed-zstd") == 0 ||
 	                  strcmp(argv[1], "--write-seed-prefix") == 0)) {
 		zstd_level = argv[1][12] ? 19 : 0;
-		zstd_prefix = mesh0_raw = argv[1][12] == 'p';
+		zstd_prefix = mesh0_raw = argv[1][12] && argv[1][13] == 'p';
 		buf b = make_pack(0);
 		FILE *f = fopen(argv[2], "wb");
 		int ok = f && fwrite(b.p, 1, b.n, f) == b.n;
