@@ -8,7 +8,10 @@
  * every coarser MESH level, so its load reads those chunks again through
  * the read callback, coarsest first, each into the staging buffer
  * (mlod_pack_decode_mesh_fetch): nothing is kept between loads, and the
- * coarser blocks live only in the decode's scratch. The reader allocates through the context's
+ * coarser blocks live only in the decode's scratch. A skeleton level
+ * coded on SKELETON's container (format 6.0's entropy stage 2) is staged
+ * after the SKELETON chunk, read again, and the staging buffer is sized
+ * for both. The reader allocates through the context's
  * allocator (mlod_pack_open_alloc), so every allocation of a context is
  * its allocator's.
  */
