@@ -187,6 +187,7 @@ fuzz: build/fuzz/fuzz_pack $(B)/tests/rt/test_pack_reader
 	@mkdir -p build/fuzz/corpus
 	$(B)/tests/rt/test_pack_reader --write-seed build/fuzz/corpus/seed.mlod
 	$(B)/tests/rt/test_pack_reader --write-seed-zstd build/fuzz/corpus/seed-zstd.mlod
+	$(B)/tests/rt/test_pack_reader --write-seed-prefix build/fuzz/corpus/seed-prefix.mlod
 	build/fuzz/fuzz_pack -max_total_time=$(FUZZ_TIME) -max_len=65536 $(FUZZ_ARGS) build/fuzz/corpus
 build/fuzz/fuzz_pack: tests/fuzz/fuzz_pack.c $(RT_C) lib/rt/mlod_pack.h $(sort $(wildcard lib/core/*.c)) lib/core/mlod_core.h
 	@mkdir -p $(@D)

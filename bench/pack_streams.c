@@ -52,21 +52,52 @@ static void print(const tagsum *t, int nt, const char *indent)
 }
 
 /* The chunk's stream container: its bytes, or with an entropy stage
- * those bytes decoded (malloc'd into *own). */
+ * those bytes decoded (malloc'd into *own). Callers go through the
+ * chunks in TOC order from chunk 0: the MESH levels' containers are kept
+ * as the prefix of the finer ones, SKELETON's as the skeleton levels'
+ * (format 6.0, MLOD_ENTROPY_ZSTD_PREFIX). */
 static const uint8_t *container(const mlod_pack_chunk *ch, const uint8_t *d, size_t *n, uint8_t **own)
 {
+	static uint8_t *meshes, *skel0;
+	static size_t nmeshes, capmeshes, nskel0;
+	static const mlod_pack_chunk *last;
+	if (!last || ch <= last)
+		nmeshes = 0; /* a new pass */
+	last = ch;
 	*own = NULL;
 	*n = ch->stored_size;
-	if (ch->entropy == MLOD_ENTROPY_NONE)
-		return d + ch->offset;
-	*own = malloc(ch->coded_size + 1);
-	size_t got = *own ? ZSTD_decompress(*own, ch->coded_size, d + ch->offset, ch->stored_size) : 0;
-	if (ZSTD_isError(got) || got != ch->coded_size) {
-		fprintf(stderr, "pack_streams: a chunk's zstd frame does not decode\n");
-		exit(1);
+	const uint8_t *out = d + ch->offset;
+	if (ch->entropy != MLOD_ENTROPY_NONE) {
+		*own = malloc(ch->coded_size + 1);
+		ZSTD_DCtx *dc = ZSTD_createDCtx();
+		if (ch->entropy == MLOD_ENTROPY_ZSTD_PREFIX && ch->type == MLOD_CHUNK_SKELETON)
+			ZSTD_DCtx_refPrefix(dc, skel0, nskel0);
+		else if (ch->entropy == MLOD_ENTROPY_ZSTD_PREFIX)
+			ZSTD_DCtx_refPrefix(dc, meshes, nmeshes);
+		size_t got = *own ? ZSTD_decompressDCtx(dc, *own, ch->coded_size, d + ch->offset, ch->stored_size) : 0;
+		ZSTD_freeDCtx(dc);
+		if (ZSTD_isError(got) || got != ch->coded_size) {
+			fprintf(stderr, "pack_streams: a chunk's zstd frame does not decode\n");
+			exit(1);
+		}
+		*n = got;
+		out = *own;
 	}
-	*n = got;
-	return *own;
+	if (ch->type == MLOD_CHUNK_SKELETON && ch->level == 0) {
+		free(skel0);
+		skel0 = malloc(*n + 1);
+		memcpy(skel0, out, *n);
+		nskel0 = *n;
+	}
+	if (ch->type == MLOD_CHUNK_MESH) {
+		if (nmeshes + *n > capmeshes) {
+			capmeshes = 2 * (nmeshes + *n);
+			meshes = realloc(meshes, capmeshes);
+		}
+		memcpy(meshes + nmeshes, out, *n);
+		nmeshes += *n;
+	}
+	return out;
 }
 
 static double cpu_now(void)
@@ -220,6 +251,205 @@ static int entropy_table(const mlod_pack *p, const uint8_t *d)
 	return 0;
 }
 
+
+/* -p: each chunk's container under zstd 19 alone, and with a prefix
+ * dictionary (ZSTD_CCtx_refPrefix) of other chunks' containers, coarsest
+ * first: "deps" the chunks it already depends on (a MESH level: every
+ * coarser MESH level; a nested MOTION level: its clip's next coarser
+ * level), "deps+skel" those after the SKELETON container (every chunk but
+ * INFO and DOC already takes the decoded full skeleton), "all before" every
+ * earlier chunk (a new dependency; the bound). Bytes per chunk type, and the
+ * decode time of every chunk (best of 7). */
+static size_t zc(ZSTD_CCtx *c, uint8_t *out, size_t cap, const blob *b, const uint8_t *pre, size_t npre)
+{
+	ZSTD_CCtx_reset(c, ZSTD_reset_session_and_parameters);
+	ZSTD_CCtx_setParameter(c, ZSTD_c_compressionLevel, 19);
+	ZSTD_CCtx_setParameter(c, ZSTD_c_contentSizeFlag, 1);
+	if (npre)
+		ZSTD_CCtx_refPrefix(c, pre, npre);
+	size_t n = ZSTD_compress2(c, out, cap, b->p, b->n);
+	return ZSTD_isError(n) ? 0 : n;
+}
+
+static int is_dep(const mlod_pack *p, uint32_t c, uint32_t o, int mode)
+{
+	const mlod_pack_chunk *a = &p->chunks[c], *b = &p->chunks[o];
+	if (o >= c)
+		return 0;
+	if (mode == 3)
+		return 1;
+	if (mode == 2 && b->type == MLOD_CHUNK_SKELETON && b->level == 0 && a->type != MLOD_CHUNK_DOC)
+		return 1;
+	if (a->type == MLOD_CHUNK_MESH && b->type == MLOD_CHUNK_MESH && b->level > a->level)
+		return 1;
+	if (a->type == MLOD_CHUNK_MOTION && (a->flags & 1) && b->type == MLOD_CHUNK_MOTION && b->item == a->item &&
+	    b->level == a->level + 1)
+		return 1;
+	return 0;
+}
+
+static int prefix_table(const mlod_pack *p, const uint8_t *d)
+{
+	uint32_t nc = p->chunk_count;
+	blob *bl = calloc(nc, sizeof *bl);
+	uint8_t **own = calloc(nc, sizeof *own);
+	size_t maxn = 0, total = 0;
+	for (uint32_t c = 0; c < nc; c++) {
+		size_t cn;
+		bl[c] = (blob){container(&p->chunks[c], d, &cn, &own[c]), 0, p->chunks[c].type};
+		bl[c].n = cn;
+		maxn = cn > maxn ? cn : maxn;
+		total += cn;
+	}
+	static const uint32_t types[] = {MLOD_CHUNK_INFO, MLOD_CHUNK_SKELETON, MLOD_CHUNK_MESH, MLOD_CHUNK_MOTION,
+	                                 MLOD_CHUNK_DOC};
+	static const char *names[] = {"zstd 19 alone", "prefix: deps", "prefix: deps+skel", "prefix: all before"};
+	size_t cap = ZSTD_compressBound(maxn) + 64;
+	uint8_t *out = malloc(cap), *back = malloc(maxn + 1), *pre = malloc(total + 1);
+	uint8_t **cbuf = calloc(nc, sizeof *cbuf);
+	size_t *csz = calloc(nc, sizeof *csz), *poff = calloc(nc, sizeof *poff), *plen = calloc(nc, sizeof *plen);
+	uint8_t **pbuf = calloc(nc, sizeof *pbuf);
+	ZSTD_CCtx *cc = ZSTD_createCCtx();
+	ZSTD_DCtx *dc = ZSTD_createDCtx();
+	printf("| method | INFO | SKEL | MESH | ANIM | DOC | chunks | whole | decode ms |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+	for (int mode = 0; mode < 4; mode++) {
+		unsigned long long sum[5] = {0}, whole = p->file_size;
+		for (uint32_t c = 0; c < nc; c++) {
+			size_t np = 0;
+			if (mode)
+				for (uint32_t o = 0; o < c; o++)
+					if (is_dep(p, c, o, mode))
+						memcpy(pre + np, bl[o].p, bl[o].n), np += bl[o].n;
+			free(pbuf[c]);
+			pbuf[c] = np ? malloc(np) : NULL;
+			if (np)
+				memcpy(pbuf[c], pre, np);
+			plen[c] = np;
+			(void)poff;
+			size_t n = bl[c].type == MLOD_CHUNK_INFO ? 0 : zc(cc, out, cap, &bl[c], pre, np);
+			free(cbuf[c]);
+			cbuf[c] = NULL;
+			csz[c] = 0;
+			if (n && n < bl[c].n) {
+				cbuf[c] = malloc(n), memcpy(cbuf[c], out, n), csz[c] = n;
+			}
+			size_t now = csz[c] ? csz[c] : bl[c].n;
+			whole = whole - p->chunks[c].stored_size + now; /* alignment ignored */
+			for (int t = 0; t < 5; t++)
+				if (bl[c].type == types[t])
+					sum[t] += now;
+		}
+		double best = 1e30;
+		for (int rep = 0; rep < 7; rep++) {
+			double t0 = cpu_now();
+			for (uint32_t c = 0; c < nc; c++) {
+				if (!csz[c])
+					continue;
+				ZSTD_DCtx_reset(dc, ZSTD_reset_session_only);
+				if (plen[c])
+					ZSTD_DCtx_refPrefix(dc, pbuf[c], plen[c]);
+				size_t got = ZSTD_decompressDCtx(dc, back, bl[c].n, cbuf[c], csz[c]);
+				if (got != bl[c].n || memcmp(back, bl[c].p, got) != 0) {
+					fprintf(stderr, "pack_streams: %s: chunk %u does not come back\n", names[mode], c);
+					return 1;
+				}
+			}
+			double t = cpu_now() - t0;
+			best = t < best ? t : best;
+		}
+		unsigned long long chunks = 0;
+		for (int t = 0; t < 5; t++)
+			chunks += sum[t];
+		printf("| %s |", names[mode]);
+		for (int t = 0; t < 5; t++)
+			printf(" %llu |", sum[t]);
+		printf(" %llu | %llu | %.3f |\n", chunks, whole, 1e3 * best);
+	}
+	ZSTD_freeCCtx(cc);
+	ZSTD_freeDCtx(dc);
+	for (uint32_t c = 0; c < nc; c++)
+		free(cbuf[c]), free(own[c]), free(pbuf[c]);
+	free(own), free(cbuf), free(csz), free(poff), free(plen), free(pbuf), free(out), free(back), free(pre), free(bl);
+	return 0;
+}
+
+
+/* -g: each chunk's container (format 6.0's prefix stage left aside: every
+ * chunk alone) under zstd 19 as stored; with its streams' bytes grouped
+ * by tag (a stable sort: every part's POSQ, then every NRMQ, ...; the
+ * headers first as stored); and each stream compressed on its own, kept
+ * only where smaller (per-stream entropy choice; 4 bytes a stream counted
+ * for a stored size). Bytes summed per chunk type. */
+typedef struct sref { uint32_t tag, idx; const uint8_t *p; size_t n; } sref;
+static int sref_cmp(const void *a, const void *b)
+{
+	const sref *x = a, *y = b;
+	if (x->tag != y->tag)
+		return x->tag < y->tag ? -1 : 1;
+	return x->idx < y->idx ? -1 : x->idx > y->idx;
+}
+
+static int group_table(const mlod_pack *p, const uint8_t *d)
+{
+	static const uint32_t types[] = {MLOD_CHUNK_INFO, MLOD_CHUNK_SKELETON, MLOD_CHUNK_MESH, MLOD_CHUNK_MOTION,
+	                                 MLOD_CHUNK_DOC};
+	unsigned long long sum[3][5] = {{0}};
+	for (uint32_t c = 0; c < p->chunk_count; c++) {
+		const mlod_pack_chunk *ch = &p->chunks[c];
+		size_t cn;
+		uint8_t *own;
+		const uint8_t *b = container(ch, d, &cn, &own);
+		int t = 0;
+		while (t < 5 && types[t] != ch->type)
+			t++;
+		if (t == 5 || ch->type == MLOD_CHUNK_INFO) {
+			for (int k = 0; k < 3 && t < 5; k++)
+				sum[k][t] += cn;
+			free(own);
+			continue;
+		}
+		uint32_t ns = rd32(b);
+		sref *sr = calloc(ns + 1, sizeof *sr);
+		size_t at = 4 + 16 * (size_t)ns;
+		for (uint32_t s = 0; s < ns; s++) {
+			const uint8_t *h = b + 4 + 16 * (size_t)s;
+			size_t st = rd32(h + 12);
+			sr[s] = (sref){rd32(h), s, b + at, st};
+			at += (st + 3) & ~(size_t)3;
+		}
+		size_t cap = ZSTD_compressBound(cn) + 64;
+		uint8_t *out = malloc(cap), *g = malloc(cn + 1);
+		size_t n0 = ZSTD_compress(out, cap, b, cn, 19);
+		sum[0][t] += n0 < cn ? n0 : cn;
+		qsort(sr, ns, sizeof *sr, sref_cmp);
+		size_t o = 4 + 16 * (size_t)ns;
+		memcpy(g, b, o);
+		for (uint32_t s = 0; s < ns; s++) {
+			memcpy(g + o, sr[s].p, sr[s].n);
+			o += sr[s].n;
+		}
+		size_t n1 = ZSTD_compress(out, cap, g, o, 19);
+		sum[1][t] += n1 < o ? n1 : o;
+		size_t n2 = 4 + 16 * (size_t)ns;
+		for (uint32_t s = 0; s < ns; s++) {
+			size_t z = sr[s].n ? ZSTD_compress(out, cap, sr[s].p, sr[s].n, 19) : 0;
+			n2 += 4 + (z < sr[s].n ? z : sr[s].n);
+		}
+		sum[2][t] += n2 < cn ? n2 : cn;
+		free(out), free(g), free(sr), free(own);
+	}
+	static const char *names[] = {"zstd 19 per chunk (alone)", "streams grouped by tag", "zstd 19 per stream"};
+	printf("| method | INFO | SKEL | MESH | ANIM | DOC | chunks |\n|---|---:|---:|---:|---:|---:|---:|\n");
+	for (int k = 0; k < 3; k++) {
+		unsigned long long all = 0;
+		printf("| %s |", names[k]);
+		for (int t = 0; t < 5; t++)
+			printf(" %llu |", sum[k][t]), all += sum[k][t];
+		printf(" %llu |\n", all);
+	}
+	return 0;
+}
+
 /* Decodes every chunk once; 0 on success. */
 static int decode_every_chunk(const mlod_pack *p, const uint8_t *d, size_t n)
 {
@@ -270,6 +500,8 @@ int main(int argc, char **argv)
 	int verbose = argc > 2 && strcmp(argv[2], "-v") == 0;
 	int entropy = argc > 2 && strcmp(argv[2], "-z") == 0;
 	int decode = argc > 2 && strcmp(argv[2], "-d") == 0;
+	int prefix = argc > 2 && strcmp(argv[2], "-p") == 0;
+	int group = argc > 2 && strcmp(argv[2], "-g") == 0;
 	FILE *f = fopen(argv[1], "rb");
 	if (!f)
 		return perror(argv[1]), 1;
@@ -300,6 +532,18 @@ int main(int argc, char **argv)
 			printf("%s: every chunk decoded in %.3f ms CPU (best of 15): %llu stored bytes (%.1f MB/s), %llu raw "
 			       "(%.1f MB/s)\n",
 			       argv[1], 1e3 * best, stored, stored / best / 1e6, raw, raw / best / 1e6);
+		mlod_pack_close(&p);
+		free(d);
+		return rc;
+	}
+	if (group) {
+		int rc = group_table(&p, d);
+		mlod_pack_close(&p);
+		free(d);
+		return rc;
+	}
+	if (prefix) {
+		int rc = prefix_table(&p, d);
 		mlod_pack_close(&p);
 		free(d);
 		return rc;

@@ -317,18 +317,49 @@ nomem:
  * one-shot compression, one thread, the frame with its content size. */
 #define PACK_ZSTD_LEVEL 19
 
-static mlod_result chunk_entropy(chunk *c, mlod_error *err)
+/* prefix (format 6.0): a MESH level's (but the coarsest's), the coarser
+ * MESH levels' containers, coarsest first; a skeleton level's, SKELETON's
+ * container. The frame coded on it
+ * (MLOD_ENTROPY_ZSTD_PREFIX) is kept where it is smaller than the frame
+ * coded alone (ties keep the frame alone, which needs nothing). */
+static mlod_result chunk_entropy(chunk *c, const uint8_t *prefix, size_t prefix_size, mlod_error *err)
 {
 	if (c->type == MLOD_CHUNK_INFO || c->size < 4 || c->size > c->raw)
 		return MLOD_OK;
 	size_t cap = ZSTD_compressBound(c->size);
-	uint8_t *z = malloc(cap);
+	uint8_t *z = malloc(cap), *zp = NULL;
 	if (!z)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
-	size_t n = ZSTD_compress(z, cap, c->data, c->size, PACK_ZSTD_LEVEL);
+	size_t n = ZSTD_compress(z, cap, c->data, c->size, PACK_ZSTD_LEVEL), np = 0;
 	if (ZSTD_isError(n)) {
 		free(z);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd: %s", ZSTD_getErrorName(n));
+	}
+	if (prefix_size && prefix_size <= MLOD_PACK_MAX_PREFIX) {
+		ZSTD_CCtx *cc = ZSTD_createCCtx();
+		if (!cc || !(zp = malloc(cap))) {
+			ZSTD_freeCCtx(cc);
+			free(z);
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+		}
+		np = ZSTD_CCtx_setParameter(cc, ZSTD_c_compressionLevel, PACK_ZSTD_LEVEL);
+		if (!ZSTD_isError(np))
+			np = ZSTD_CCtx_refPrefix(cc, prefix, prefix_size);
+		if (!ZSTD_isError(np))
+			np = ZSTD_compress2(cc, zp, cap, c->data, c->size);
+		ZSTD_freeCCtx(cc);
+		if (ZSTD_isError(np)) {
+			free(z);
+			free(zp);
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd with a prefix: %s", ZSTD_getErrorName(np));
+		}
+		if (np < n) {
+			free(z);
+			z = zp, n = np, zp = NULL;
+		} else {
+			np = 0;
+		}
+		free(zp);
 	}
 	if (n >= c->size) {
 		free(z);
@@ -338,7 +369,7 @@ static mlod_result chunk_entropy(chunk *c, mlod_error *err)
 	c->coded = (uint32_t)c->size;
 	c->data = z;
 	c->size = n;
-	c->entropy = MLOD_ENTROPY_ZSTD;
+	c->entropy = np ? MLOD_ENTROPY_ZSTD_PREFIX : MLOD_ENTROPY_ZSTD;
 	return MLOD_OK;
 }
 
@@ -2834,9 +2865,38 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 
 	/* The entropy stage, after every choice above was made on the codec's
 	 * bytes (INFO has none: its size must not depend on the offsets). */
-	for (int i = 0; opt->entropy == MLOD_ENTROPY_ZSTD && i < body.n; i++)
-		if ((r = chunk_entropy(&body.c[i], err)) != MLOD_OK)
+	/* Finest first, so that the coarser MESH levels, a finer level's
+	 * prefix, and SKELETON, a skeleton level's, are still their containers. */
+	for (int i = body.n - 1; opt->entropy == MLOD_ENTROPY_ZSTD && i >= 0; i--) {
+		size_t np = 0;
+		uint8_t *pre = NULL;
+		if (body.c[i].type == MLOD_CHUNK_MESH) {
+			for (int j = 0; j < i; j++)
+				if (body.c[j].type == MLOD_CHUNK_MESH)
+					np += body.c[j].size;
+			if (np && !(pre = malloc(np))) {
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+				goto done;
+			}
+			for (size_t j = 0, o = 0; (int)j < i; j++)
+				if (body.c[j].type == MLOD_CHUNK_MESH)
+					memcpy(pre + o, body.c[j].data, body.c[j].size), o += body.c[j].size;
+		}
+		if (body.c[i].type == MLOD_CHUNK_SKELETON && body.c[i].level > 0)
+			for (int j = 0; j < i && !np; j++)
+				if (body.c[j].type == MLOD_CHUNK_SKELETON && body.c[j].level == 0) {
+					if (!(pre = malloc(body.c[j].size))) {
+						r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+						goto done;
+					}
+					memcpy(pre, body.c[j].data, body.c[j].size);
+					np = body.c[j].size;
+				}
+		r = chunk_entropy(&body.c[i], pre, np, err);
+		free(pre);
+		if (r != MLOD_OK)
 			goto done;
+	}
 
 	/* INFO: its size does not depend on its values (its streams are raw). */
 	strtab names = {0};

@@ -9,7 +9,7 @@
  * and never prints or exits.
  *
  * ------------------------------------------------------------------
- * File layout (format 5.0). Everything is little-endian.
+ * File layout (format 6.0). Everything is little-endian.
  *
  *   header      32 bytes at offset 0
  *   TOC         chunk_count entries of 48 bytes, right after the header
@@ -34,7 +34,7 @@
  *   4  u8     layer (MLOD_LAYER_*)
  *   5  u8     codec: bits 0-3 the codec of the chunk's streams
  *             (MLOD_CODEC_*); bits 4-7 the entropy stage over the whole
- *             chunk (MLOD_ENTROPY_*, format 5.0; 0 before)
+ *             chunk (MLOD_ENTROPY_*, format 5.0, 2 from 6.0; 0 before)
  *   6  u16    level: 0 the finest (the input as read), larger is coarser
  *   8  u16    item: the clip for MOTION chunks, else 0
  *  10  u16    flags (MLOD_PACK_CHUNK_NESTED for a nested MOTION level, else 0)
@@ -60,8 +60,11 @@
  *
  * Chunk payload: a stream container; with entropy stage MLOD_ENTROPY_ZSTD,
  * one zstd frame of it that states its size (the coded size) and nothing
- * after it (mlod(5) ENTROPY STAGE). Each chunk's stage is its own: no
- * dictionary, so every chunk still decodes from its own bytes.
+ * after it (mlod(5) ENTROPY STAGE). With MLOD_ENTROPY_ZSTD_PREFIX (format
+ * 6.0: skeleton levels, MESH levels but the coarsest), the frame is coded
+ * with the containers of chunks the level already needs as its prefix
+ * (SKELETON's; the coarser MESH levels'), so a prefix of the file still
+ * decodes every level it holds.
  *   u32 stream_count (at most MLOD_PACK_MAX_STREAMS)
  *   stream_count stream headers of 16 bytes:
  *     0 u32  tag (MLOD_STREAM_*, a fourcc)
@@ -271,7 +274,7 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 5
+#define MLOD_PACK_MAJOR 6
 #define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32
@@ -319,6 +322,13 @@ typedef enum mlod_pack_codec {
  * are one zstd frame that says that size. INFO never has one. */
 #define MLOD_ENTROPY_NONE 0
 #define MLOD_ENTROPY_ZSTD 1
+/* Format 6.0: one zstd frame coded with a prefix (ZSTD_CCtx_refPrefix) of
+ * stream containers as the reader has them after undoing their own stage:
+ * a skeleton level's, SKELETON's; a MESH level's (not the coarsest), every
+ * coarser MESH level's, coarsest first, one after the other. Only on those
+ * chunks; at most MLOD_PACK_MAX_PREFIX bytes. */
+#define MLOD_ENTROPY_ZSTD_PREFIX 2
+#define MLOD_PACK_MAX_PREFIX ((uint64_t)1 << 26)
 
 /* A stream's codec. */
 #define MLOD_SCODEC_RAW 0
@@ -690,7 +700,7 @@ int mlod_pack_find(const mlod_pack *p, uint32_t type, unsigned level, unsigned i
  * the reader: the comment named it, no declaration did. */
 const char *mlod_pack_type_name(uint32_t type);
 const char *mlod_pack_codec_name(unsigned codec);
-const char *mlod_pack_entropy_name(unsigned entropy); /* "none", "zstd" */
+const char *mlod_pack_entropy_name(unsigned entropy); /* "none", "zstd", "zstd-prefix" */
 const char *mlod_pack_layer_name(unsigned layer);
 
 #ifdef __cplusplus

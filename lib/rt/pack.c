@@ -397,6 +397,13 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		} else if (c->entropy && major < 5) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): codec 0x%02x: an entropy stage in a %u.%u pack "
 			              "(format 5.0 added them)", i, label, e[5], major, minor);
+		} else if (c->entropy == MLOD_ENTROPY_ZSTD_PREFIX && major < 6) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): codec 0x%02x: a zstd prefix stage in a %u.%u pack "
+			              "(format 6.0 added it)", i, label, e[5], major, minor);
+		} else if (c->entropy == MLOD_ENTROPY_ZSTD_PREFIX && c->type != MLOD_CHUNK_MESH &&
+		           !(c->type == MLOD_CHUNK_SKELETON && c->level > 0)) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the zstd prefix stage is for MESH and skeleton "
+			              "levels only (the chunks they need are its prefix)", i, label);
 		} else if (c->entropy && c->type == MLOD_CHUNK_INFO) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): INFO has no entropy stage", i, label);
 		} else if (c->entropy && (c->coded_size < 4 || c->coded_size > c->raw_size)) {
@@ -439,7 +446,27 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		              (unsigned long long)file_size, n ? "last chunk" : "TOC", (unsigned long long)prev_end);
 	int zstd = 0;
 	for (uint32_t i = 0; r == MLOD_OK && i < n; i++)
-		zstd |= chunks[i].entropy == MLOD_ENTROPY_ZSTD;
+		zstd |= chunks[i].entropy == MLOD_ENTROPY_ZSTD || chunks[i].entropy == MLOD_ENTROPY_ZSTD_PREFIX;
+	/* A prefix-coded MESH level needs a coarser MESH level (its prefix):
+	 * the coarsest has none; a skeleton level needs SKELETON. The order
+	 * check put them first. */
+	for (uint32_t i = 0, coarser = 0, full = 0; r == MLOD_OK && i < n; i++) {
+		if (chunks[i].type == MLOD_CHUNK_SKELETON && chunks[i].level == 0)
+			full = 1;
+		if (chunks[i].type == MLOD_CHUNK_SKELETON && chunks[i].entropy == MLOD_ENTROPY_ZSTD_PREFIX && !full) {
+			chunk_label(chunks[i].type, chunks[i].level, chunks[i].item, label, sizeof label);
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the zstd prefix stage without a SKELETON chunk "
+			              "before it for a prefix", i, label);
+		}
+		if (chunks[i].type != MLOD_CHUNK_MESH)
+			continue;
+		if (chunks[i].entropy == MLOD_ENTROPY_ZSTD_PREFIX && !coarser) {
+			chunk_label(chunks[i].type, chunks[i].level, chunks[i].item, label, sizeof label);
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the zstd prefix stage on the coarsest MESH level, "
+			              "which has no coarser level for a prefix", i, label);
+		}
+		coarser = 1;
+	}
 	zdec *zd = NULL;
 	if (r == MLOD_OK && zstd && !(zd = zdec_new(alloc)))
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "pack TOC: out of memory for the zstd decoder");
@@ -509,6 +536,7 @@ const char *mlod_pack_entropy_name(unsigned entropy)
 	switch (entropy) {
 	case MLOD_ENTROPY_NONE: return "none";
 	case MLOD_ENTROPY_ZSTD: return "zstd";
+	case MLOD_ENTROPY_ZSTD_PREFIX: return "zstd-prefix";
 	}
 	return "unknown";
 }
@@ -541,6 +569,8 @@ typedef struct cx {
 	uint64_t size;        /* the container's bytes at base */
 	uint8_t *plain;       /* the entropy stage's output (owned) */
 	zdec *zd;             /* the pack's zstd decoder */
+	const uint8_t *prefix; /* MLOD_ENTROPY_ZSTD_PREFIX: the coarser MESH levels' */
+	uint64_t prefix_size;  /* containers, coarsest first (the caller's) */
 	uint32_t nstreams, next;
 	uint64_t cursor;      /* offset in the chunk of stream next's bytes */
 	uint64_t max_decoded; /* the largest meshopt-coded stream, decoded */
@@ -569,7 +599,7 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: Draco chunks need the Draco decoder, not built in", x->label);
 	if (c->codec != MLOD_CODEC_NONE && c->codec != MLOD_CODEC_MESHOPT)
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: unknown chunk codec %u", x->label, c->codec);
-	if (c->entropy != MLOD_ENTROPY_NONE && c->entropy != MLOD_ENTROPY_ZSTD)
+	if (c->entropy != MLOD_ENTROPY_NONE && c->entropy != MLOD_ENTROPY_ZSTD && c->entropy != MLOD_ENTROPY_ZSTD_PREFIX)
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: unknown entropy stage %u", x->label, c->entropy);
 	return MLOD_OK;
 }
@@ -609,6 +639,21 @@ static mlod_result cx_unpack(cx *x, mlod_error *err)
 	if (!x->zd)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: the pack has no zstd decoder (not opened by mlod_pack_open)",
 		                 x->label);
+	if (c->entropy == MLOD_ENTROPY_ZSTD_PREFIX) {
+		/* Only decode_mesh and a skeleton level's decode give a prefix,
+		 * and open allowed the stage only on those levels. */
+		if (!x->prefix || !x->prefix_size)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: coded on the containers of the chunks it needs, which were "
+			                 "not given", x->label);
+		if (x->prefix_size > MLOD_PACK_MAX_PREFIX)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: its prefix (the containers of the chunks it needs) is %llu "
+			                 "bytes, more than the format's %llu", x->label, (unsigned long long)x->prefix_size,
+			                 (unsigned long long)MLOD_PACK_MAX_PREFIX);
+		size_t pr = ZSTD_DCtx_refPrefix(x->zd->z, x->prefix, (size_t)x->prefix_size);
+		if (ZSTD_isError(pr))
+			return mlod_fail(err, MLOD_ERR_NOMEM, "%s: zstd prefix: %s", x->label, ZSTD_getErrorName(pr));
+	}
+	/* ZSTD_decompressDCtx uses a referenced prefix for this frame only. */
 	size_t got = ZSTD_decompressDCtx(x->zd->z, x->plain, (size_t)want, x->base, c->stored_size);
 	if (ZSTD_isError(got))
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: zstd: %s", x->label, ZSTD_getErrorName(got));
@@ -715,9 +760,10 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 	return MLOD_OK;
 }
 
-/* cx_head and cx_parse on the chunk's bytes in data (a file or a prefix). */
-static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, const void *data, size_t size, cx *x,
-                            mlod_error *err)
+/* cx_head and cx_parse on the chunk's bytes in data (a file or a prefix);
+ * prefix: for MLOD_ENTROPY_ZSTD_PREFIX, or NULL. */
+static mlod_result cx_begin_prefix(const mlod_pack *p, uint32_t index, uint32_t type, const void *data, size_t size,
+                                   const uint8_t *prefix, uint64_t prefix_size, cx *x, mlod_error *err)
 {
 	memset(x, 0, sizeof *x);
 	if (!p || (!data && size))
@@ -730,7 +776,40 @@ static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, c
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: truncated: the chunk ends at byte %llu, the data has %zu", x->label,
 		                 (unsigned long long)(c->offset + c->stored_size), size);
 	x->base = (const uint8_t *)data + c->offset;
+	x->prefix = prefix;
+	x->prefix_size = prefix_size;
 	return cx_parse(x, err);
+}
+
+static mlod_result cx_begin(const mlod_pack *p, uint32_t index, uint32_t type, const void *data, size_t size, cx *x,
+                            mlod_error *err)
+{
+	return cx_begin_prefix(p, index, type, data, size, NULL, 0, x, err);
+}
+
+/* cx_begin on a skeleton level: with the prefix stage, the SKELETON
+ * chunk in data is read and checked first (its CRC, its own stage, its
+ * container), and its container is the prefix; it is freed once the
+ * level's frame is undone. */
+static mlod_result cx_begin_skel_level(const mlod_pack *p, uint32_t index, const void *data, size_t size, cx *x,
+                                       mlod_error *err)
+{
+	if (!p || index >= p->chunk_count || p->chunks[index].entropy != MLOD_ENTROPY_ZSTD_PREFIX ||
+	    p->chunks[index].type != MLOD_CHUNK_SKELETON || p->chunks[index].level == 0)
+		return cx_begin(p, index, MLOD_CHUNK_SKELETON, data, size, x, err);
+	memset(x, 0, sizeof *x);
+	int di = mlod_pack_find(p, MLOD_CHUNK_SKELETON, 0, 0);
+	if (di < 0) /* open refuses that; a caller's own TOC may not */
+		return mlod_fail(err, MLOD_ERR_PARSE, "SKELETON level %u: coded on the SKELETON chunk's container, which the "
+		                 "pack lacks", (unsigned)p->chunks[index].level);
+	cx dx;
+	mlod_result r = cx_begin(p, (uint32_t)di, MLOD_CHUNK_SKELETON, data, size, &dx, err);
+	if (r == MLOD_OK)
+		r = cx_begin_prefix(p, index, MLOD_CHUNK_SKELETON, data, size, dx.base, dx.size, x, err);
+	pk_free(&dx.alloc, dx.plain);
+	if (x->prefix)
+		x->prefix = NULL, x->prefix_size = 0;
+	return r;
 }
 
 static void cx_rewind(cx *x)
@@ -1212,7 +1291,7 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	bump b = {0};
 	stream sk, sj, sb;
 	const uint8_t *src;
-	mlod_result r = cx_begin(p, chunk, MLOD_CHUNK_SKELETON, data, size, &x, err);
+	mlod_result r = cx_begin_skel_level(p, chunk, data, size, &x, err);
 	if (r != MLOD_OK)
 		return r;
 	if (x.c->level == 0)
@@ -1428,19 +1507,30 @@ typedef struct mesh_src {
 	void *user;
 } mesh_src;
 
-static mlod_result mesh_begin(const mesh_src *m, uint32_t index, cx *x, mlod_error *err)
+/* cx_begin on a MESH chunk from m; prefix: the coarser levels' containers
+ * (for MLOD_ENTROPY_ZSTD_PREFIX), or NULL. */
+static mlod_result mesh_begin(const mesh_src *m, uint32_t index, const uint8_t *prefix, uint64_t prefix_size, cx *x,
+                              mlod_error *err)
 {
-	if (!m->fetch)
-		return cx_begin(m->p, index, MLOD_CHUNK_MESH, m->data, m->size, x, err);
 	mlod_result r = cx_head(m->p, index, MLOD_CHUNK_MESH, x, err);
 	if (r != MLOD_OK)
 		return r;
 	const void *bytes = NULL;
-	if ((r = m->fetch(m->user, index, &bytes, err)) != MLOD_OK)
-		return r;
-	if (!bytes && x->c->stored_size)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: the fetch gave no bytes", x->label);
+	if (!m->fetch) {
+		const mlod_pack_chunk *c = x->c;
+		if (c->offset > m->size || c->stored_size > m->size - c->offset)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: truncated: the chunk ends at byte %llu, the data has %zu",
+			                 x->label, (unsigned long long)(c->offset + c->stored_size), m->size);
+		bytes = (const uint8_t *)m->data + c->offset;
+	} else {
+		if ((r = m->fetch(m->user, index, &bytes, err)) != MLOD_OK)
+			return r;
+		if (!bytes && x->c->stored_size)
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: the fetch gave no bytes", x->label);
+	}
 	x->base = bytes;
+	x->prefix = prefix;
+	x->prefix_size = prefix_size;
 	return cx_parse(x, err);
 }
 
@@ -1489,9 +1579,37 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 	if (sumraw > PACK_MAX_BLOCK)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "MESH level %u: decoding it and the coarser levels needs %llu bytes, more "
 		                 "than the reader's limit", K, (unsigned long long)sumraw);
+	/* The prefix of the finest prefix-coded level read (format 6.0): the
+	 * containers of the levels above it, coarsest first, kept as they are
+	 * read; each container's size is its TOC coded size, or its stored
+	 * size without an entropy stage (cx_parse checks both). */
+	unsigned pmin = 0; /* that level + 1; 0: no level read is prefix-coded */
+	uint64_t pcap = 0, pused = 0;
+	uint8_t *pbuf = NULL;
+	for (uint32_t l = 0; l < nlev; l++) {
+		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, top - l, 0);
+		if (ci >= 0 && p->chunks[ci].entropy == MLOD_ENTROPY_ZSTD_PREFIX)
+			pmin = top - l + 1;
+	}
+	for (unsigned L = top; pmin && L >= pmin; L--) {
+		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, L, 0);
+		if (ci >= 0)
+			pcap += p->chunks[ci].entropy ? p->chunks[ci].coded_size : p->chunks[ci].stored_size;
+		if (L == 0)
+			break;
+	}
+	if (pcap > MLOD_PACK_MAX_PREFIX)
+		return mlod_fail(err, MLOD_ERR_PARSE, "MESH level %u: its prefix (MESH levels %u to %u's containers) is %llu "
+		                 "bytes, more than the format's %llu", pmin - 1, top, pmin, (unsigned long long)pcap,
+		                 (unsigned long long)MLOD_PACK_MAX_PREFIX);
+	if (pmin && !(pbuf = pk_malloc(al, 1, (size_t)pcap + 1)))
+		return mlod_fail(err, MLOD_ERR_NOMEM, "MESH level %u: out of memory for its %llu-byte prefix", pmin - 1,
+		                 (unsigned long long)pcap);
 	blocks = pk_malloc(al, 1, (size_t)sumraw + 8);
-	if (!blocks)
+	if (!blocks) {
+		pk_free(al, pbuf);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "MESH level %u: out of memory", K);
+	}
 	for (uint32_t l = 0; l < nlev; l++) {
 		unsigned L = top - l;
 		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, L, 0);
@@ -1500,8 +1618,15 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			              "one)", K, L);
 			goto fail;
 		}
-		TRY(mesh_begin(m, (uint32_t)ci, &x, err));
+		TRY(mesh_begin(m, (uint32_t)ci, pbuf, pused, &x, err));
 		lev_open = 1;
+		if (pmin && L >= pmin) {
+			if (x.size > pcap - pused)
+				FAIL("%s: its container of %llu bytes does not fit the prefix's %llu", x.label,
+				     (unsigned long long)x.size, (unsigned long long)(pcap - pused));
+			memcpy(pbuf + pused, x.base, (size_t)x.size);
+			pused += x.size;
+		}
 		stream sp;
 		TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), l ? P : UINT64_MAX, "",
 		              "the parts of the coarsest level", err));
@@ -1911,6 +2036,7 @@ fail:
 	}
 	pk_free(al, b.base);
 	pk_free(al, blocks);
+	pk_free(al, pbuf);
 	pk_free(al, temp);
 	pk_free(al, recs0);
 	pk_free(al, blk);

@@ -8,7 +8,10 @@
  * every coarser MESH level, so its load reads those chunks again through
  * the read callback, coarsest first, each into the staging buffer
  * (mlod_pack_decode_mesh_fetch): nothing is kept between loads, and the
- * coarser blocks live only in the decode's scratch. The reader allocates through the context's
+ * coarser blocks live only in the decode's scratch. A skeleton level
+ * coded on SKELETON's container (format 6.0's entropy stage 2) is staged
+ * after the SKELETON chunk, read again, and the staging buffer is sized
+ * for both. The reader allocates through the context's
  * allocator (mlod_pack_open_alloc), so every allocation of a context is
  * its allocator's.
  */
@@ -32,19 +35,37 @@ static mlod_result chunk_bytes(mlod_rt_ctx *ctx, uint32_t chunk, const mlod_pack
 		*size = ctx->size;
 		return MLOD_OK;
 	}
-	if (c->stored_size > ctx->staging_size)
+	/* A skeleton level with the prefix stage (format 6.0) is coded on
+	 * SKELETON's container: that chunk goes first in the staging buffer. */
+	int dep = c->type == MLOD_CHUNK_SKELETON && c->level > 0 && c->entropy == MLOD_ENTROPY_ZSTD_PREFIX
+	                  ? mlod_pack_find(&ctx->pack, MLOD_CHUNK_SKELETON, 0, 0)
+	                  : -1;
+	uint64_t at = 0;
+	if (dep >= 0) {
+		const mlod_pack_chunk *d = &ctx->pack.chunks[dep];
+		if (d->stored_size > ctx->staging_size)
+			return mlod_fail(err, MLOD_ERR_PARSE, "chunk %d: %u bytes, larger than the staging buffer", dep,
+			                 d->stored_size);
+		if (ctx->read(ctx->read_user, d->offset, d->stored_size, ctx->staging) != 0)
+			return mlod_fail(err, MLOD_ERR_IO, "chunk %d: reading %u bytes at offset %llu failed", dep,
+			                 d->stored_size, (unsigned long long)d->offset);
+		at = ((uint64_t)d->stored_size + 15) & ~(uint64_t)15;
+	}
+	if (c->stored_size > ctx->staging_size || at > ctx->staging_size - c->stored_size)
 		return mlod_fail(err, MLOD_ERR_PARSE, "chunk %u: %u bytes, larger than the staging buffer", chunk,
 		                 c->stored_size);
-	if (ctx->read(ctx->read_user, c->offset, c->stored_size, ctx->staging) != 0)
+	if (ctx->read(ctx->read_user, c->offset, c->stored_size, ctx->staging + at) != 0)
 		return mlod_fail(err, MLOD_ERR_IO, "chunk %u: reading %u bytes at offset %llu failed", chunk, c->stored_size,
 		                 (unsigned long long)c->offset);
 	*shadow = ctx->pack;
 	memcpy(ctx->shadow, ctx->pack.chunks, sizeof *ctx->shadow * ctx->pack.chunk_count);
-	ctx->shadow[chunk].offset = 0;
+	ctx->shadow[chunk].offset = at;
+	if (dep >= 0)
+		ctx->shadow[dep].offset = 0;
 	shadow->chunks = ctx->shadow;
 	*pack = shadow;
 	*data = ctx->staging;
-	*size = c->stored_size;
+	*size = (size_t)at + c->stored_size;
 	return MLOD_OK;
 }
 
@@ -211,9 +232,17 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 		                 (unsigned long long)(ctx->source == SRC_MEMORY ? (uint64_t)ctx->size : ctx->file_size));
 	if (ctx->source != SRC_MEMORY) {
 		size_t big = 0;
-		for (uint32_t i = 0; i < ctx->pack.chunk_count; i++)
-			if (ctx->pack.chunks[i].type != MLOD_CHUNK_DOC && ctx->pack.chunks[i].stored_size > big)
-				big = ctx->pack.chunks[i].stored_size;
+		int cs0 = mlod_pack_find(&ctx->pack, MLOD_CHUNK_SKELETON, 0, 0);
+		size_t skel0 = cs0 >= 0 ? ((size_t)ctx->pack.chunks[cs0].stored_size + 15) & ~(size_t)15 : 0;
+		for (uint32_t i = 0; i < ctx->pack.chunk_count; i++) {
+			const mlod_pack_chunk *c = &ctx->pack.chunks[i];
+			if (c->type != MLOD_CHUNK_DOC && c->stored_size > big)
+				big = c->stored_size;
+			/* a prefix-coded skeleton level is staged after SKELETON */
+			if (c->type == MLOD_CHUNK_SKELETON && c->level > 0 && c->entropy == MLOD_ENTROPY_ZSTD_PREFIX &&
+			    skel0 + c->stored_size > big)
+				big = skel0 + c->stored_size;
+		}
 		ctx->staging_size = big;
 		ctx->staging = rt_alloc(ctx, big);
 		ctx->shadow = rt_alloc(ctx, sizeof *ctx->shadow * (ctx->pack.chunk_count + 1));

@@ -8,9 +8,14 @@
 // --doc writes the DOC chunk's glb to OUT.glb.
 // It does not decode streams: the round trip through the reader
 // (lib/rt/pack.c) is for the tests that come with it. A chunk with the
-// zstd entropy stage (format 5.0) is undone with the zstd tool first.
+// zstd entropy stage (format 5.0) is undone with the zstd tool first; one
+// with the prefix stage (format 6.0) with the chunks it needs as the tool's
+// --patch-from reference: a MESH level's coarser MESH levels' containers,
+// a skeleton level's SKELETON container.
 import { execFileSync } from 'node:child_process';
-import { readFileSync, writeFileSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 import { crc32 } from 'node:zlib';
 
 const file = process.argv[2];
@@ -21,7 +26,7 @@ const fourcc = (u) => String.fromCharCode(u & 255, (u >> 8) & 255, (u >> 16) & 2
 if (b.length < 32 || b.subarray(0, 4).toString('latin1') !== 'MLOD') die('no MLOD magic');
 const major = b.readUInt16LE(4), minor = b.readUInt16LE(6), flags = b.readUInt32LE(8), n = b.readUInt32LE(12);
 const size = Number(b.readBigUInt64LE(16));
-if (major !== 5 || minor !== 0) die(`version ${major}.${minor}`);
+if (major !== 6 || minor !== 0) die(`version ${major}.${minor}`);
 if (flags !== 0) die('flags');
 if (size !== b.length) die(`file_size ${size}, file ${b.length}`);
 if (crc32(b.subarray(0, 28)) !== b.readUInt32LE(28)) die('header CRC');
@@ -30,6 +35,8 @@ if (crc32(b.subarray(32, 32 + 48 * n)) !== b.readUInt32LE(24)) die('TOC CRC');
 
 const chunks = [];
 let end = 32 + 48 * n;
+const meshes = []; // the MESH levels' containers so far: the prefix of a finer one (entropy 2)
+let skeleton = null; // SKELETON's container: a skeleton level's prefix
 for (let i = 0; i < n; i++) {
 	const e = b.subarray(32 + 48 * i, 80 + 48 * i);
 	const c = {
@@ -40,8 +47,9 @@ for (let i = 0; i < n; i++) {
 	};
 	// flags: only ANIM's 1, nested on the clip's next coarser level (checked below)
 	if ((c.flags && (c.type !== 'ANIM' || c.flags !== 1)) || (c.coded && !c.entropy) || e.readUInt32LE(44)) die(`chunk ${i}: reserved bytes`);
-	// the entropy stage: zstd (1), never on INFO, its container at most the raw size
-	if (c.entropy > 1 || (c.entropy && (c.type === 'INFO' || c.coded < 4 || c.coded > c.raw))) die(`chunk ${i}: entropy ${c.entropy}, coded size ${c.coded}`);
+	// the entropy stage: zstd (1), or zstd on the chunks it needs (2: a MESH level but the coarsest, a skeleton level), never on INFO, its container at most the raw size
+	const skel = c.type === 'SKEL' && c.level > 0;
+	if (c.entropy > 2 || (c.entropy === 2 && !((c.type === 'MESH' && meshes.length) || (skel && skeleton))) || (c.entropy && (c.type === 'INFO' || c.coded < 4 || c.coded > c.raw))) die(`chunk ${i}: entropy ${c.entropy}, coded size ${c.coded}`);
 	if (c.offset % 16) die(`chunk ${i}: offset ${c.offset} not 16-aligned`);
 	if (c.offset < end) die(`chunk ${i}: overlaps`);
 	if (b.subarray(end, c.offset).some((x) => x !== 0)) die(`chunk ${i}: padding not zero`);
@@ -49,7 +57,19 @@ for (let i = 0; i < n; i++) {
 	end = c.offset + c.stored;
 	const stored = b.subarray(c.offset, end);
 	if (crc32(stored) !== c.crc) die(`chunk ${i} (${c.type}): CRC`);
-	const d = c.entropy ? execFileSync('zstd', ['-d', '-q', '-c'], { input: stored, maxBuffer: 1 << 30 }) : stored;
+	let d = stored;
+	if (c.entropy === 1) d = execFileSync('zstd', ['-d', '-q', '-c'], { input: stored, maxBuffer: 1 << 30 });
+	if (c.entropy === 2) {
+		const dir = mkdtempSync(join(tmpdir(), 'pack_check.'));
+		writeFileSync(join(dir, 'prefix'), skel ? skeleton : Buffer.concat(meshes));
+		try {
+			d = execFileSync('zstd', ['-d', '-q', '-c', `--patch-from=${join(dir, 'prefix')}`], { input: stored, maxBuffer: 1 << 30 });
+		} finally {
+			rmSync(dir, { recursive: true });
+		}
+	}
+	if (c.type === 'MESH') meshes.push(d);
+	if (c.type === 'SKEL' && c.level === 0) skeleton = d;
 	if (c.entropy && d.length !== c.coded) die(`chunk ${i} (${c.type}): zstd gave ${d.length} bytes, coded size ${c.coded}`);
 	c.data = d;
 	// ANIM level 0 states its error against the input clip (0 when lossless); its distance is 0

@@ -15,7 +15,7 @@ for (const k in want) if (c[k] !== want[k]) throw new Error(`${k}: ${c[k]}`);
 for (const t of ['KEPT', 'PALJ', 'PALB', 'POSQ', 'NRMQ', 'JNT8', 'WGT8', 'IDX ', 'IMAP', 'CHAN', 'STEP', 'ROTQ']) if (!c.tags.includes(t)) throw new Error('no ' + t);
 if (!c.tags.includes('TIME') && !c.tags.includes('TICK') && !c.tags.includes('TBIT')) throw new Error('no key times');
 if (JSON.stringify(c.stream_codecs) !== '[0,1,2,3]') throw new Error('stream codecs ' + c.stream_codecs);
-if (JSON.stringify(c.entropy) !== '[0,1]') throw new Error('entropy stages ' + c.entropy);
+if (JSON.stringify(c.entropy) !== '[0,1,2]') throw new Error('entropy stages ' + c.entropy);
 const levels = { skeleton: 3, mesh: 5, motion: 4 };
 for (const l in levels) if (r.layers[l].source !== 'computed' || r.layers[l].levels !== levels[l]) throw new Error(l);
 if (r.total !== fs.statSync('tubeman.mlod').size) throw new Error('report total');

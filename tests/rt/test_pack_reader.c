@@ -258,6 +258,17 @@ static void restamp(uint8_t *d, size_t n)
  * container is at most its raw size (the format's bound; MESH level 0's
  * random indices and MOTION level 0's meshopt streams code to more). */
 static int zstd_level;
+/* With zstd_level: every MESH chunk after the first (in TOC order, a
+ * finer level) coded with the earlier MESH chunks' containers as its
+ * prefix (MLOD_ENTROPY_ZSTD_PREFIX, format 6.0), and every skeleton level
+ * with SKELETON's container, smaller or not. */
+static int zstd_prefix;
+/* MESH level 0's streams raw (so that its container is its raw size and
+ * may take an entropy stage). */
+static int mesh0_raw;
+/* With zstd_prefix: code the prefix-coded chunks on this chunk's
+ * container instead of the coarser MESH levels' (a wrong prefix); -1 none. */
+static int wrong_prefix = -1;
 
 /* The zstd frame of a chunk's container. */
 static buf zstd_frame(const buf *in, int level)
@@ -275,7 +286,8 @@ static buf zstd_frame(const buf *in, int level)
 static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 {
 	uint32_t coded[64] = {0};
-	buf chunks[64];
+	uint8_t stage[64] = {0};
+	buf chunks[64], plain = {0}, meshes = {0}, skel0 = {0};
 	uint32_t raw[64];
 	uint64_t off[64];
 	uint64_t at = 32 + 48 * (uint64_t)nc;
@@ -284,10 +296,39 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		chunks[i] = chunk_bytes(&c[i], &raw[i]);
 		if (zstd_level && c[i].type != MLOD_CHUNK_INFO && c[i].ns && !c[i].payload.n && chunks[i].n <= raw[i]) {
 			buf z = zstd_frame(&chunks[i], zstd_level);
+			stage[i] = MLOD_ENTROPY_ZSTD;
+			int skel_level = c[i].type == MLOD_CHUNK_SKELETON && c[i].level > 0 && skel0.n;
+			if (zstd_prefix && ((c[i].type == MLOD_CHUNK_MESH && meshes.n) || skel_level)) {
+				const buf *pre = skel_level ? &skel0 : &meshes;
+				buf other = {0};
+				if (wrong_prefix >= 0) {
+					uint32_t r;
+					other = chunk_bytes(&c[wrong_prefix], &r);
+					pre = &other;
+				}
+				size_t cap = ZSTD_compressBound(chunks[i].n);
+				ZSTD_CCtx *cc = ZSTD_createCCtx();
+				ZSTD_CCtx_setParameter(cc, ZSTD_c_compressionLevel, zstd_level);
+				ZSTD_CCtx_refPrefix(cc, pre->p, pre->n);
+				free(z.p);
+				z.p = malloc(cap);
+				z.n = ZSTD_compress2(cc, z.p, cap, chunks[i].p, chunks[i].n);
+				if (ZSTD_isError(z.n))
+					z.n = 0;
+				ZSTD_freeCCtx(cc);
+				free(other.p);
+				stage[i] = MLOD_ENTROPY_ZSTD_PREFIX;
+			}
 			coded[i] = (uint32_t)chunks[i].n;
-			free(chunks[i].p);
+			plain = chunks[i];
 			chunks[i] = z;
 		}
+		if (c[i].type == MLOD_CHUNK_MESH) /* its container: the finer levels' prefix */
+			put(&meshes, plain.p ? plain.p : chunks[i].p, plain.p ? plain.n : chunks[i].n);
+		if (c[i].type == MLOD_CHUNK_SKELETON && c[i].level == 0) /* the skeleton levels' prefix */
+			put(&skel0, plain.p ? plain.p : chunks[i].p, plain.p ? plain.n : chunks[i].n);
+		free(plain.p);
+		plain = (buf){0};
 		off[i] = at;
 		at += chunks[i].n;
 	}
@@ -303,7 +344,7 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 	for (int i = 0; i < nc; i++) {
 		put32(&out, c[i].type);
 		put8(&out, c[i].layer);
-		put8(&out, (uint8_t)(c[i].codec | (coded[i] ? MLOD_ENTROPY_ZSTD << 4 : 0)));
+		put8(&out, (uint8_t)(c[i].codec | stage[i] << 4));
 		put16(&out, c[i].level);
 		put16(&out, c[i].item);
 		put16(&out, c[i].flags);
@@ -321,6 +362,8 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		put(&out, chunks[i].p, chunks[i].n);
 		free(chunks[i].p);
 	}
+	free(meshes.p);
+	free(skel0.p);
 	restamp(out.p, out.n);
 	return out;
 }
@@ -768,12 +811,14 @@ static int make_chunks(wchunk *c, int with_unknown)
 	/* MESH level 0: the two parts' new vertices, meshopt-coded. */
 	ch = &c[C_MESH0];
 	ch->type = MLOD_CHUNK_MESH, ch->layer = MLOD_LAYER_MESH, ch->codec = MLOD_CODEC_MESHOPT;
-	s = add_stream(ch, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), MLOD_SCODEC_MESHOPT_VERTEX);
+	const uint8_t vc0 = mesh0_raw ? MLOD_SCODEC_RAW : MLOD_SCODEC_MESHOPT_VERTEX;
+	const uint8_t ic0 = mesh0_raw ? MLOD_SCODEC_RAW : MLOD_SCODEC_MESHOPT_INDEX;
+	s = add_stream(ch, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), vc0);
 	s->count = 2;
 	part_rec(&parts_truth[0], 0, &s->data);
 	part_rec(&parts_truth[1], 1, &s->data);
-	part_streams(ch, &parts_truth[0], MLOD_SCODEC_MESHOPT_VERTEX, MLOD_SCODEC_MESHOPT_INDEX);
-	part_streams(ch, &parts_truth[1], MLOD_SCODEC_MESHOPT_VERTEX, MLOD_SCODEC_MESHOPT_INDEX);
+	part_streams(ch, &parts_truth[0], vc0, ic0);
+	part_streams(ch, &parts_truth[1], vc0, ic0);
 
 	/* MOTION level 0 of clip 0: translation (linear), rotation (ROTQ),
 	 * rotation (cubic, ROTF), scale (step); the first three share time
@@ -1396,7 +1441,7 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 6.0 is newer than this reader's 5.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 7.0 is newer than this reader's 6.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
 }
 
@@ -1431,7 +1476,7 @@ TEST(older_major_is_refused)
 	free(b.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && p.chunks == NULL, "returned %d: %s", (int)r, terr.message);
 	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
-	                               "reads 2.x to 5.x)") == 0,
+	                               "reads 2.x to 6.x)") == 0,
 	          "message: %s", terr.message);
 }
 
@@ -1669,7 +1714,7 @@ TEST(entropy_checks)
 	OPEN_FAILS(wr32(e + 12, 0), MLOD_ERR_PARSE, "TOC entry 3 (MESH level 1): coded size 0 is not 4 to its raw size");
 	OPEN_FAILS(wr16(d + 4, 4), MLOD_ERR_PARSE, "TOC entry 1 (SKELETON): codec 0x10: an entropy stage in a 4.0 pack");
 	OPEN_FAILS(d[32 + 5] = 0x10, MLOD_ERR_PARSE, "TOC entry 0 (INFO): INFO has no entropy stage");
-	DECODE_FAILS(e[5] = 0x20, MLOD_ERR_UNSUPPORTED, "MESH level 1: unknown entropy stage 2");
+	DECODE_FAILS(e[5] = 0x30, MLOD_ERR_UNSUPPORTED, "MESH level 1: unknown entropy stage 3");
 	/* The TOC says fewer bytes than the frame holds (a bomb): refused
 	 * before decoding; more: the frame does not give them. */
 	DECODE_FAILS(wr32(e + 12, coded - 1), MLOD_ERR_PARSE, "MESH level 1: the zstd frame says");
@@ -1739,6 +1784,193 @@ TEST(entropy_checks)
 	free(z.p);
 #undef OPEN_FAILS
 #undef DECODE_FAILS
+}
+
+/* Format 6.0's prefix stage: MESH level 0 (raw streams, so that its
+ * container may take a stage) coded on MESH level 1's container. */
+static buf prefix_pack(void)
+{
+	zstd_level = 19, zstd_prefix = 1, mesh0_raw = 1;
+	buf b = make_pack(0);
+	zstd_level = 0, zstd_prefix = 0, mesh0_raw = 0;
+	return b;
+}
+
+/* The prefix-coded level decodes to what the plain one does, from a
+ * whole file and through a fetch; mlod_pack_check passes; a 5.0 pack
+ * (the zstd stage alone) still reads. */
+static mlod_result fetch_from(void *user, uint32_t chunk, const void **bytes, mlod_error *err)
+{
+	const uint8_t *d = user;
+	(void)err;
+	*bytes = d + get64(d + 32 + 48 * (size_t)chunk + 16);
+	return MLOD_OK;
+}
+
+TEST(prefix_decodes_the_same)
+{
+	mesh0_raw = 1;
+	buf a = make_pack(0);
+	mesh0_raw = 0;
+	buf z = prefix_pack();
+	mlod_pack pa, pz;
+	CHECK_OK(mlod_pack_open(a.p, a.n, &pa, &terr));
+	CHECK_OK(mlod_pack_open(z.p, z.n, &pz, &terr));
+	CHECK(pz.major == 6 && pz.chunks[C_MESH0].entropy == MLOD_ENTROPY_ZSTD_PREFIX &&
+	      pz.chunks[C_SKEL1].entropy == MLOD_ENTROPY_ZSTD_PREFIX && pz.chunks[C_SKEL].entropy == MLOD_ENTROPY_ZSTD &&
+	      pz.chunks[C_MESH1].entropy == MLOD_ENTROPY_ZSTD && pz.chunks[C_MOT1].entropy == MLOD_ENTROPY_ZSTD);
+	CHECK(strcmp(mlod_pack_entropy_name(MLOD_ENTROPY_ZSTD_PREFIX), "zstd-prefix") == 0);
+	mlod_pack_skeleton sa;
+	CHECK_OK(mlod_pack_decode_skeleton(&pa, a.p, a.n, &sa, &terr));
+	int same = 1;
+	mlod_pack_skel_level la, lz;
+	CHECK_OK(mlod_pack_decode_skel_level(&pa, C_SKEL1, a.p, a.n, &sa, &la, &terr));
+	CHECK_OK(mlod_pack_decode_skel_level(&pz, C_SKEL1, z.p, z.n, &sa, &lz, &terr));
+	same &= la.kept_count == lz.kept_count && memcmp(la.kept, lz.kept, 4 * (size_t)la.kept_count) == 0;
+	mlod_pack_skel_level_free(&la);
+	mlod_pack_skel_level_free(&lz);
+	for (int k = 0; k < 3; k++) {
+		uint32_t ci = k == 2 ? C_MESH1 : C_MESH0;
+		mlod_pack_mesh ma, mz;
+		CHECK_OK(mlod_pack_decode_mesh(&pa, ci, a.p, a.n, &sa, &ma, &terr));
+		if (k == 1)
+			CHECK_OK(mlod_pack_decode_mesh_fetch(&pz, ci, fetch_from, z.p, &sa, &mz, &terr));
+		else
+			CHECK_OK(mlod_pack_decode_mesh(&pz, ci, z.p, z.n, &sa, &mz, &terr));
+		same &= ma.part_count == mz.part_count;
+		for (uint32_t i = 0; same && i < ma.part_count; i++) {
+			const mlod_pack_part *x = &ma.parts[i], *y = &mz.parts[i];
+			same = memcmp(&x->rec, &y->rec, sizeof x->rec) == 0 &&
+			       memcmp(x->positions, y->positions, 12 * (size_t)x->rec.vertex_count) == 0 &&
+			       memcmp(x->indices, y->indices, 4 * (size_t)x->rec.index_count) == 0;
+		}
+		mlod_pack_mesh_free(&ma);
+		mlod_pack_mesh_free(&mz);
+	}
+	CHECK(same);
+	CHECK_OK(mlod_pack_check(&pz, z.p, z.n, &terr));
+	/* A truncated prefix of the file that holds MESH level 1 but not level 0
+	 * still decodes level 1; level 0 is refused as truncated. */
+	size_t cut = (size_t)pz.chunks[C_MESH0].offset + pz.chunks[C_MESH0].stored_size - 1;
+	mlod_pack_mesh m;
+	CHECK_OK(mlod_pack_decode_mesh(&pz, C_MESH1, z.p, cut, &sa, &m, &terr));
+	mlod_pack_mesh_free(&m);
+	CHECK_ERR(mlod_pack_decode_mesh(&pz, C_MESH0, z.p, cut, &sa, &m, &terr), MLOD_ERR_PARSE,
+	          "MESH level 0: truncated");
+	mlod_pack_skeleton_free(&sa);
+	mlod_pack_close(&pa);
+	mlod_pack_close(&pz);
+	/* 5.0: the zstd stage alone reads; the prefix stage is refused. */
+	zstd_level = 19;
+	buf f = make_pack(0);
+	zstd_level = 0;
+	wr16(f.p + 4, 5);
+	restamp(f.p, f.n);
+	mlod_pack p5;
+	CHECK_OK(mlod_pack_open(f.p, f.n, &p5, &terr));
+	CHECK_OK(mlod_pack_check(&p5, f.p, f.n, &terr));
+	mlod_pack_close(&p5);
+	free(f.p);
+	free(a.p);
+	free(z.p);
+}
+
+/* The prefix stage's hostile cases, each naming the chunk. */
+TEST(prefix_checks)
+{
+	buf b = prefix_pack();
+	uint8_t *d = malloc(b.n);
+	mlod_pack p;
+	mlod_pack_mesh m;
+	const uint8_t *e0 = b.p + 32 + 48 * C_MESH0;
+	uint32_t coded = get32(e0 + 12);
+	CHECK(e0[5] >> 4 == MLOD_ENTROPY_ZSTD_PREFIX);
+	mlod_pack_skeleton sk;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &sk, &terr));
+	mlod_pack_close(&p);
+#define EDIT(stmt)                                                                                               \
+	do {                                                                                                    \
+		memcpy(d, b.p, b.n);                                                                            \
+		uint8_t *e = d + 32 + 48 * C_MESH0;                                                             \
+		(void)e;                                                                                        \
+		stmt;                                                                                           \
+		restamp(d, b.n);                                                                                \
+	} while (0)
+#define OPEN_FAILS(stmt, text)                                                                                   \
+	do {                                                                                                    \
+		EDIT(stmt);                                                                                     \
+		CHECK_ERR(mlod_pack_open(d, b.n, &p, &terr), MLOD_ERR_PARSE, text);                             \
+	} while (0)
+#define DECODE_FAILS(stmt, text)                                                                                 \
+	do {                                                                                                    \
+		EDIT(stmt);                                                                                     \
+		CHECK_OK(mlod_pack_open(d, b.n, &p, &terr));                                                    \
+		CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH0, d, b.n, &sk, &m, &terr), MLOD_ERR_PARSE, text);    \
+		mlod_pack_close(&p);                                                                            \
+	} while (0)
+	/* A 5.x pack has no prefix stage (a 5.x reader refuses 6.0 whole). */
+	OPEN_FAILS(wr16(d + 4, 5), "TOC entry 2 (SKELETON level 1): codec 0x20: a zstd prefix stage in a 5.0 pack");
+	/* The coarsest level has nothing to be coded on; other types have no
+	 * prefix (their dependencies are not MESH levels). */
+	OPEN_FAILS(d[32 + 48 * C_MESH1 + 5] = 0x20, "TOC entry 3 (MESH level 1): the zstd prefix stage on the coarsest");
+	OPEN_FAILS(d[32 + 48 * C_MOT1 + 5] = 0x20, "TOC entry 4 (MOTION level 1 of clip 0): the zstd prefix stage is for "
+	                                           "MESH and skeleton levels only");
+	OPEN_FAILS(d[32 + 48 * C_SKEL + 5] = 0x21, "TOC entry 1 (SKELETON): the zstd prefix stage is for MESH and");
+	OPEN_FAILS(d[32 + 48 * C_DOC + 5] = 0x20, "TOC entry 7 (DOC): the zstd prefix stage is for MESH and");
+	/* A skeleton level read without its prefix; with SKELETON damaged
+	 * (not re-stamped), the error names SKELETON. */
+	EDIT(d[32 + 48 * C_SKEL1 + 5] = 0x10);
+	CHECK_OK(mlod_pack_open(d, b.n, &p, &terr));
+	mlod_pack_skel_level sl;
+	CHECK_ERR(mlod_pack_decode_skel_level(&p, C_SKEL1, d, b.n, &sk, &sl, &terr), MLOD_ERR_PARSE, "SKELETON level 1: ");
+	mlod_pack_close(&p);
+	memcpy(d, b.p, b.n);
+	d[get64(d + 32 + 48 * C_SKEL + 16) + 7] ^= 1;
+	CHECK_OK(mlod_pack_open(d, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_skel_level(&p, C_SKEL1, d, b.n, &sk, &sl, &terr), MLOD_ERR_PARSE, "SKELETON: CRC mismatch");
+	mlod_pack_close(&p);
+	/* The frame read without its prefix, a damaged coarser level (named
+	 * before level 0 is read), a bomb (the frame says more than the TOC). */
+	DECODE_FAILS(e[5] = 0x11, "MESH level 0: zstd: ");
+	memcpy(d, b.p, b.n);
+	d[get64(d + 32 + 48 * C_MESH1 + 16) + 5] ^= 1; /* not re-stamped: the chunk's CRC */
+	CHECK_OK(mlod_pack_open(d, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH0, d, b.n, &sk, &m, &terr), MLOD_ERR_PARSE, "MESH level 1: CRC mismatch");
+	mlod_pack_close(&p);
+	DECODE_FAILS(wr32(e + 12, coded - 1), "MESH level 0: the zstd frame says");
+	/* A prefix too big: MESH level 1's TOC says a container of 96 MiB
+	 * (its raw size too, so open takes it): refused before any allocation. */
+	DECODE_FAILS((wr32(d + 32 + 48 * C_MESH1 + 12, 96u << 20), wr32(d + 32 + 48 * C_MESH1 + 28, 96u << 20)),
+	             "MESH level 0: its prefix (MESH levels 1 to 1's containers) is 100663296 bytes, more than the "
+	             "format's 67108864");
+	free(d);
+	free(b.p);
+	/* A frame coded on another chunk's container (MOTION level 1's, not a
+	 * dependency): it does not decode to a valid container; the error names
+	 * MESH level 0, never a crash. */
+	wrong_prefix = C_MOT1;
+	buf w = prefix_pack();
+	wrong_prefix = -1;
+	CHECK_OK(mlod_pack_open(w.p, w.n, &p, &terr));
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_mesh(&p, C_MESH0, w.p, w.n, &sk, &m, &terr);
+	mlod_pack_close(&p);
+	CHECK_MSG(r == MLOD_ERR_PARSE && strncmp(terr.message, "MESH level 0: ", 14) == 0, "returned %d: %s", (int)r,
+	          terr.message);
+	free(w.p);
+	mlod_pack_skeleton_free(&sk);
+#undef EDIT
+#undef OPEN_FAILS
+#undef DECODE_FAILS
+}
+
+/* Every prefix of the file again with the prefix stage. */
+TEST(every_prefix_zstd_prefix)
+{
+	zstd_level = 19, zstd_prefix = 1, mesh0_raw = 1;
+	every_prefix_of_pack();
+	zstd_level = 0, zstd_prefix = 0, mesh0_raw = 0;
 }
 
 static void every_prefix_of_pack(void)
@@ -1875,6 +2107,25 @@ TEST(mutations_zstd)
 	opened = decoded = bad = 0;
 	run_mutations(1, 10000, &opened, &decoded, &bad, why, sizeof why);
 	zstd_level = 0;
+	CHECK_MSG(!bad, "%s", why);
+	CHECK_MSG(opened > 3000 && decoded > 3000, "%d opened, %d chunks decoded", opened, decoded);
+}
+
+/* The same on a pack whose MESH level 0 is prefix-coded (format 6.0):
+ * mutated frames, prefixes and TOC entries fail with a message. */
+TEST(mutations_zstd_prefix)
+{
+	zstd_level = 19, zstd_prefix = 1, mesh0_raw = 1;
+	rng_state = 97531;
+	int opened = 0, decoded = 0, bad = 0;
+	char why[200] = "";
+	run_mutations(0, 10000, &opened, &decoded, &bad, why, sizeof why);
+	CHECK_MSG(!bad, "%s", why);
+	CHECK_MSG(opened > 1000, "only %d of 10000 opened", opened);
+	rng_state = 86420;
+	opened = decoded = bad = 0;
+	run_mutations(1, 10000, &opened, &decoded, &bad, why, sizeof why);
+	zstd_level = 0, zstd_prefix = 0, mesh0_raw = 0;
 	CHECK_MSG(!bad, "%s", why);
 	CHECK_MSG(opened > 3000 && decoded > 3000, "%d opened, %d chunks decoded", opened, decoded);
 }
@@ -2284,8 +2535,10 @@ TEST(meshopt_streams)
  * the zstd entropy stage. */
 int main(int argc, char **argv)
 {
-	if (argc == 3 && (strcmp(argv[1], "--write-seed") == 0 || strcmp(argv[1], "--write-seed-zstd") == 0)) {
+	if (argc == 3 && (strcmp(argv[1], "--write-seed") == 0 || strcmp(argv[1], "--write-seed-zstd") == 0 ||
+	                  strcmp(argv[1], "--write-seed-prefix") == 0)) {
 		zstd_level = argv[1][12] ? 19 : 0;
+		zstd_prefix = mesh0_raw = argv[1][12] && argv[1][13] == 'p';
 		buf b = make_pack(0);
 		FILE *f = fopen(argv[2], "wb");
 		int ok = f && fwrite(b.p, 1, b.n, f) == b.n;
@@ -2325,5 +2578,9 @@ int main(int argc, char **argv)
 	RUN(mutations_plain);
 	RUN(mutations_restamped);
 	RUN(mutations_zstd);
+	RUN(prefix_decodes_the_same);
+	RUN(prefix_checks);
+	RUN(every_prefix_zstd_prefix);
+	RUN(mutations_zstd_prefix);
 	return test_total_fail_ ? 1 : 0;
 }

@@ -156,13 +156,18 @@ static void fix_crcs(uint8_t *d, size_t size)
 		d[28 + k] = (uint8_t)(h >> (8 * k));
 }
 
-/* When set, write_pack puts every chunk but INFO through zstd. */
+/* When set, write_pack puts every chunk but INFO through zstd; when 2,
+ * a MESH level but the coarsest and a skeleton level are coded on the
+ * chunks they need (format 6.0's prefix stage: the coarser MESH levels'
+ * containers, SKELETON's container). */
 static int zstd_pack;
 
 static void write_pack(bytes *out)
 {
 	bytes body[32];
 	uint32_t raw[32], coded[32] = { 0 };
+	uint8_t stage[32] = { 0 };
+	bytes meshes = { 0 }, skel0 = { 0 };
 	for (int i = 0; i < nchunks; i++) {
 		memset(&body[i], 0, sizeof body[i]);
 		chunk_bytes(&chunks[i], &body[i]);
@@ -170,14 +175,31 @@ static void write_pack(bytes *out)
 		if (zstd_pack && chunks[i].type != MLOD_CHUNK_INFO) {
 			size_t cap = ZSTD_compressBound(body[i].n);
 			bytes z = { malloc(cap), 0, cap };
-			z.n = ZSTD_compress(z.d, cap, body[i].d, body[i].n, 19);
+			const bytes *pre = NULL;
+			if (zstd_pack == 2 && chunks[i].type == MLOD_CHUNK_MESH && meshes.n)
+				pre = &meshes;
+			if (zstd_pack == 2 && chunks[i].type == MLOD_CHUNK_SKELETON && chunks[i].level > 0)
+				pre = &skel0;
+			ZSTD_CCtx *cc = ZSTD_createCCtx();
+			ZSTD_CCtx_setParameter(cc, ZSTD_c_compressionLevel, 19);
+			if (pre)
+				ZSTD_CCtx_refPrefix(cc, pre->d, pre->n);
+			z.n = ZSTD_compress2(cc, z.d, cap, body[i].d, body[i].n);
+			ZSTD_freeCCtx(cc);
 			if (ZSTD_isError(z.n))
 				z.n = 0;
 			coded[i] = raw[i];
+			stage[i] = pre ? MLOD_ENTROPY_ZSTD_PREFIX : MLOD_ENTROPY_ZSTD;
+			if (chunks[i].type == MLOD_CHUNK_MESH)
+				put(&meshes, body[i].d, body[i].n);
+			if (chunks[i].type == MLOD_CHUNK_SKELETON && chunks[i].level == 0)
+				put(&skel0, body[i].d, body[i].n);
 			free(body[i].d);
 			body[i] = z;
 		}
 	}
+	free(meshes.d);
+	free(skel0.d);
 	uint64_t off = 32 + 48 * (uint64_t)nchunks, offs[32];
 	for (int i = 0; i < nchunks; i++) {
 		off = (off + 15) / 16 * 16;
@@ -191,7 +213,7 @@ static void write_pack(bytes *out)
 	for (int i = 0; i < nchunks; i++) {
 		chunk *c = &chunks[i];
 		put32(out, c->type);
-		uint8_t lc[2] = { (uint8_t)c->layer, (uint8_t)(coded[i] ? MLOD_ENTROPY_ZSTD << 4 : 0) };
+		uint8_t lc[2] = { (uint8_t)c->layer, (uint8_t)(stage[i] << 4) };
 		put(out, lc, 2);
 		put16(out, (uint16_t)c->level), put16(out, (uint16_t)c->item), put16(out, 0), put32(out, coded[i]);
 		put64(out, offs[i]);
@@ -963,6 +985,17 @@ int main(void)
 	zstd_pack = 1;
 	build_pack(&pack);
 	printf("# with the zstd entropy stage: %zu bytes\n", pack.n);
+	RUN(pack_equals_views);
+	RUN(pack_poses_as_its_decoded_views);
+	RUN(read_source_rereads_coarser_mesh);
+	RUN(pack_budget);
+	RUN(hooks_only);
+	RUN(truncated_prefixes);
+	RUN(mutations);
+	free(pack.d);
+	zstd_pack = 2;
+	build_pack(&pack);
+	printf("# with the zstd prefix stage (format 6.0): %zu bytes\n", pack.n);
 	RUN(pack_equals_views);
 	RUN(pack_poses_as_its_decoded_views);
 	RUN(read_source_rereads_coarser_mesh);
