@@ -272,7 +272,7 @@ static int pack_info(const char *path, enum tool_report report)
 		fprintf(f, "# character '%s': %u joints, %u skins, %u parts, %u clips; levels: skeleton %u, mesh %u, motion %u; "
 		        "height %.4g, diagonal %.4g\n", info.name, ir->joint_count, ir->skin_count, ir->instance_count,
 		        ir->clip_count, ir->skeleton_levels, ir->mesh_levels, ir->motion_levels, ir->height, ir->diagonal);
-		fprintf(f, "%-5s %-8s %5s  %-20s %-12s %10s %10s %11s %9s %11s\n", "type", "layer", "level", "item", "codec",
+		fprintf(f, "%-5s %-8s %5s  %-20s %-19s %10s %10s %11s %9s %11s\n", "type", "layer", "level", "item", "codec",
 		        "stored", "raw", "error", "error%", "distance");
 		for (uint32_t i = 0; i < p.chunk_count; i++) {
 			const mlod_pack_chunk *c = &p.chunks[i];
@@ -283,7 +283,7 @@ static int pack_info(const char *path, enum tool_report report)
 			else
 				snprintf(item, sizeof item, "-");
 			char cc[32];
-			fprintf(f, "%-5s %-8s %5u  %-20s %-12s %10u %10u %11.4g %8.4g%% %11.4g\n", mlod_pack_type_name(c->type),
+			fprintf(f, "%-5s %-8s %5u  %-20s %-19s %10u %10u %11.4g %8.4g%% %11.4g\n", mlod_pack_type_name(c->type),
 			        mlod_pack_layer_name(c->layer), c->level, item, codec_column(c, cc, sizeof cc), c->stored_size,
 			        c->raw_size, c->error, ref > 0.0 ? 100.0 * c->error / ref : 0.0, c->distance);
 		}
