@@ -170,6 +170,210 @@ static inline void quat_slerp(const float *a, const float *b, float t, int unit,
 	quat_blend(a, ct - d * wb, b, sign * wb, out);
 }
 
+/* ---------------------------------------------------------------- */
+/* Rotation slerps in batches                                        */
+/* ---------------------------------------------------------------- */
+
+/* A far instance's pose is mostly slerps (the tubeman's coarsest motion
+ * level: 27 animated rotation channels), each a chain of dependent
+ * double operations (the series, two square roots and divisions) that
+ * the CPU cannot overlap much one channel after the other. So the
+ * LINEAR rotation channels between two keys are gathered (up to
+ * RT_SLERP_BATCH, in the level's order) and slerped RT_SLERP_LANES at a
+ * time, one channel per lane of double vectors: per lane quat_slerp's and
+ * then quat_norm's operations, in their order, on the same doubles (IEEE
+ * per lane; no fused multiply-add: -std=c11 does not contract), so the
+ * same floats as one channel at a time. The rare lanes that take
+ * another branch of quat_slerp (nearly parallel, or more than 26
+ * degrees apart) or the identity (a zero or non-finite length) are redone
+ * for that lane alone, as quat_slerp does. */
+#define RT_SLERP_BATCH 8
+#define RT_SLERP_LANES 4
+
+typedef struct rt_slerp_batch {
+	float a[4][RT_SLERP_BATCH], b[4][RT_SLERP_BATCH]; /* the two keys, normalised, by component */
+	float t[RT_SLERP_BATCH];
+	uint32_t joint[RT_SLERP_BATCH];
+	uint32_t n;
+} rt_slerp_batch;
+
+#if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
+typedef double rt_d4 __attribute__((vector_size(32)));
+typedef float rt_f4 __attribute__((vector_size(16)));
+
+#if defined(__SSE2__) && !defined(MLOD_RT_NO_SSE2)
+#include <emmintrin.h>
+/* IEEE square roots, two lanes per instruction (as sqrt is). */
+static inline void sqrt_d4(rt_d4 *v)
+{
+	__m128d lo, hi;
+	memcpy(&lo, v, sizeof lo);
+	memcpy(&hi, (const char *)v + sizeof lo, sizeof hi);
+	lo = _mm_sqrt_pd(lo), hi = _mm_sqrt_pd(hi);
+	memcpy(v, &lo, sizeof lo);
+	memcpy((char *)v + sizeof lo, &hi, sizeof hi);
+}
+#else
+static inline void sqrt_d4(rt_d4 *v)
+{
+	for (int k = 0; k < 4; k++)
+		(*v)[k] = sqrt((*v)[k]);
+}
+#endif
+
+static inline void ld_d4(const float *p, rt_d4 *out)
+{
+	rt_f4 f;
+	memcpy(&f, p, sizeof f);
+	*out = __builtin_convertvector(f, rt_d4);
+}
+
+/* GCC on x86-64 Linux: also built for AVX2 (VEX encoding, 4 doubles per
+ * instruction; the same operations), picked at load by the CPU. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
+	!defined(MLOD_RT_NO_CLONES)
+#define RT_EVAL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RT_EVAL_CLONES
+#endif
+
+/* Lanes k0 .. k0 + 3 of the batch (all of them filled) into local[]. */
+RT_EVAL_CLONES static void slerp_lanes(const rt_slerp_batch *b, uint32_t k0, mlod_trs *local)
+{
+	rt_d4 a0, a1, a2, a3, b0, b1, b2, b3, t;
+	ld_d4(&b->a[0][k0], &a0), ld_d4(&b->a[1][k0], &a1), ld_d4(&b->a[2][k0], &a2), ld_d4(&b->a[3][k0], &a3);
+	ld_d4(&b->b[0][k0], &b0), ld_d4(&b->b[1][k0], &b1), ld_d4(&b->b[2][k0], &b2), ld_d4(&b->b[3][k0], &b3);
+	ld_d4(&b->t[k0], &t);
+	rt_d4 d = a0 * b0 + a1 * b1 + a2 * b2 + a3 * b3;
+	rt_d4 sign;
+	for (int k = 0; k < RT_SLERP_LANES; k++)
+		sign[k] = d[k] < 0.0 ? -1.0 : 1.0, d[k] = fabs(d[k]);
+	/* slerp_weights_near's series, every lane */
+	const rt_d4 y = 1.0 - d;
+	const rt_d4 x =
+	    y * (2.0 + y * (0.33333333333333331 +
+	                    y * (0.088888888888888892 +
+	                         y * (0.028571428571428571 +
+	                              y * (0.010158730158730159 +
+	                                   y * (0.0038480038480038481 +
+	                                        y * (0.0015222872365729509 +
+	                                             y * (0.0006216006216006216 +
+	                                                  y * (0.00026001594629045609 +
+	                                                       y * (0.00011084890341856287 +
+	                                                            y * (4.7986538276434138e-05 +
+	                                                                 y * 2.1037576563219316e-05)))))))))));
+	const rt_d4 z = t * t * x;
+#define RT_SINC(v)                                                                                             \
+	(1.0 + (v) * (-0.16666666666666666 +                                                                   \
+	              (v) * (0.0083333333333333332 +                                                           \
+	                     (v) * (-0.00019841269841269841 +                                                  \
+	                            (v) * (2.7557319223985893e-06 +                                            \
+	                                   (v) * (-2.505210838544172e-08 +                                     \
+	                                          (v) * (1.6059043836821613e-10 +                              \
+	                                                 (v) * (-7.6471637318198164e-13 +                      \
+	                                                        (v) * 2.8114572543455206e-15))))))))
+	const rt_d4 sx = RT_SINC(x), sz = RT_SINC(z);
+#undef RT_SINC
+	const rt_d4 ct =
+	    1.0 + z * (-0.5 +
+	               z * (0.041666666666666664 +
+	                    z * (-0.0013888888888888889 +
+	                         z * (2.4801587301587302e-05 +
+	                              z * (-2.7557319223985888e-07 +
+	                                   z * (2.08767569878681e-09 +
+	                                        z * (-1.1470745597729725e-11 +
+	                                             z * (4.7794773323873853e-14 + z * -1.5619206968586225e-16))))))));
+	rt_d4 wb = t * sz / sx;
+	rt_d4 wa = ct - d * wb;
+	wb = sign * wb;
+	/* quat_slerp's other branches, lane by lane */
+	for (int k = 0; k < RT_SLERP_LANES; k++) {
+		if (d[k] > 0.9995) {
+			wa[k] = 1.0 - t[k], wb[k] = sign[k] * t[k];
+		} else if (!(d[k] >= 0.9)) {
+			const double theta = acos(d[k]), s = sqrt(1.0 - d[k] * d[k]);
+			const double c = cos(t[k] * theta), w = sin(t[k] * theta) / s;
+			wa[k] = c - d[k] * w, wb[k] = sign[k] * w;
+		}
+	}
+	/* quat_blend */
+	const rt_d4 qx = wa * a0 + wb * b0, qy = wa * a1 + wb * b1;
+	const rt_d4 qz = wa * a2 + wb * b2, qw = wa * a3 + wb * b3;
+	rt_d4 n = qx * qx + qy * qy + qz * qz + qw * qw;
+	sqrt_d4(&n);
+	const rt_d4 r = 1.0 / n;
+	rt_f4 fx = __builtin_convertvector(qx * r, rt_f4), fy = __builtin_convertvector(qy * r, rt_f4);
+	rt_f4 fz = __builtin_convertvector(qz * r, rt_f4), fw = __builtin_convertvector(qw * r, rt_f4);
+	for (int k = 0; k < RT_SLERP_LANES; k++)
+		if (!(n[k] > 0.0))
+			fx[k] = fy[k] = fz[k] = 0.0f, fw[k] = 1.0f;
+	/* then quat_norm, as sample_channel does */
+	const rt_d4 dx = __builtin_convertvector(fx, rt_d4), dy = __builtin_convertvector(fy, rt_d4);
+	const rt_d4 dz = __builtin_convertvector(fz, rt_d4), dw = __builtin_convertvector(fw, rt_d4);
+	rt_d4 n2 = dx * dx + dy * dy + dz * dz + dw * dw;
+	sqrt_d4(&n2);
+	const rt_d4 r2 = 1.0 / n2;
+	const rt_f4 ox = __builtin_convertvector(dx * r2, rt_f4), oy = __builtin_convertvector(dy * r2, rt_f4);
+	const rt_f4 oz = __builtin_convertvector(dz * r2, rt_f4), ow = __builtin_convertvector(dw * r2, rt_f4);
+	for (int k = 0; k < RT_SLERP_LANES; k++) {
+		mlod_trs *l = &local[b->joint[k0 + (uint32_t)k]];
+		if (!(n2[k] > 0.0) || !isfinite(n2[k]))
+			l->r.x = l->r.y = l->r.z = 0.0f, l->r.w = 1.0f;
+		else
+			l->r.x = ox[k], l->r.y = oy[k], l->r.z = oz[k], l->r.w = ow[k];
+	}
+}
+#define RT_HAVE_SLERP_LANES 1
+#endif
+
+/* Slerps the batch's channels into local[] (in its order, so a joint with
+ * two rotation channels ends with the later one, as one at a time) and
+ * empties it. */
+static void slerp_flush(rt_slerp_batch *restrict b, mlod_trs *local)
+{
+	uint32_t k = 0;
+#if defined(RT_HAVE_SLERP_LANES)
+	/* A last partial group is filled with copies of the batch's last
+	 * channel: stored after it, the same floats. */
+	for (uint32_t e = b->n; e % RT_SLERP_LANES && b->n; e++) {
+		for (int c = 0; c < 4; c++)
+			b->a[c][e] = b->a[c][b->n - 1], b->b[c][e] = b->b[c][b->n - 1];
+		b->t[e] = b->t[b->n - 1], b->joint[e] = b->joint[b->n - 1];
+	}
+	for (; k < b->n; k += RT_SLERP_LANES)
+		slerp_lanes(b, k, local);
+#else
+	for (; k < b->n; k++) {
+		const float qa[4] = { b->a[0][k], b->a[1][k], b->a[2][k], b->a[3][k] };
+		const float qb[4] = { b->b[0][k], b->b[1][k], b->b[2][k], b->b[3][k] };
+		float q[4], o[4];
+		quat_slerp(qa, qb, b->t[k], 1, q);
+		quat_norm(q, o);
+		mlod_trs *l = &local[b->joint[k]];
+		l->r.x = o[0], l->r.y = o[1], l->r.z = o[2], l->r.w = o[3];
+	}
+#endif
+	b->n = 0;
+}
+
+/* Adds the LINEAR rotation channel between keys a and b at t (of joint
+ * j) to the batch, the keys normalised unless unit says they are. */
+static inline void slerp_push(rt_slerp_batch *b, const float *qa, const float *qb, float t, int unit, uint32_t j,
+                              mlod_trs *local)
+{
+	if (b->n == RT_SLERP_BATCH)
+		slerp_flush(b, local);
+	float na[4], nb[4];
+	if (!unit) {
+		quat_norm(qa, na), quat_norm(qb, nb);
+		qa = na, qb = nb;
+	}
+	const uint32_t k = b->n++;
+	for (int c = 0; c < 4; c++)
+		b->a[c][k] = qa[c], b->b[c][k] = qb[c];
+	b->t[k] = t, b->joint[k] = j;
+}
+
 /* One channel between keys p->i and p->i + 1 (LINEAR or CUBICSPLINE), as
  * lib/model/pose.c's sample_channel followed, for rotations, by
  * sample_one's normalisation. */
@@ -212,7 +416,7 @@ static void sample_channel(const mlod_pack_channel *ch, const rt_key_pos *p, int
  * channel is stored as one key) is copied here; sample_channel
  * interpolates. */
 static inline void sample_one(const mlod_pack_motion *m, uint32_t i, const uint8_t *flags, uint32_t nbits, float t,
-                              rt_key_pos *p, mlod_trs *local)
+                              rt_key_pos *p, mlod_trs *local, rt_slerp_batch *sb)
 {
 	const mlod_pack_channel *ch = &m->channels[i];
 	const uint32_t n = ch->rec.key_count;
@@ -236,11 +440,21 @@ static inline void sample_one(const mlod_pack_motion *m, uint32_t i, const uint8
 			quat_norm(key, v);
 			key = v;
 		}
+	} else if (rot && ch->rec.interp == 0) { /* LINEAR rotation: slerped in the batch */
+		const float *a = ch->values + (size_t)p->i * 4;
+		slerp_push(sb, a, a + 4, p->u, unit, ch->rec.joint, local);
+		return;
 	} else {
 		sample_channel(ch, p, comps, unit, v);
 		key = v;
 	}
 	mlod_trs *l = &local[ch->rec.joint];
+	if (rot) /* after the batch's slerps of the same joint */
+		for (uint32_t k = 0; k < sb->n; k++)
+			if (sb->joint[k] == ch->rec.joint) {
+				slerp_flush(sb, local);
+				break;
+			}
 	if (rot)
 		l->r.x = key[0], l->r.y = key[1], l->r.z = key[2], l->r.w = key[3];
 	else if (ch->rec.path == 0)
@@ -341,11 +555,14 @@ static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_r
 		if (!mu->fixed[posed[i]])
 			local[posed[i]] = ctx->rest_local[posed[i]];
 	rt_key_pos p = { NULL, 0, 0, 0, 0.0f, 0.0f };
+	rt_slerp_batch sb;
+	sb.n = 0;
 	for (uint32_t a = 0; a < mu->anim_count; a++) {
 		const uint32_t i = mu->anim[a];
 		if (needed[m->channels[i].rec.joint])
-			sample_one(m, i, flags, nbits, t, &p, local);
+			sample_one(m, i, flags, nbits, t, &p, local, &sb);
 	}
+	slerp_flush(&sb, local);
 	for (uint32_t i = 0; i < npose; i++) {
 		const uint32_t j = posed[i];
 		const float *parent = jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent;
