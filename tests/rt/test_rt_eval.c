@@ -965,8 +965,8 @@ static const char *slerp_batch_check(mlod_rt_ctx *ctx, mlod_rt_scratch *s)
 	return NULL;
 }
 
-/* The pose slerps LINEAR rotation channels in batches of up to 8, 4 per
- * double vector (rt_eval.c). 14 channels over joints 1-4, each joint's
+/* The pose slerps LINEAR rotation channels in batches of up to 8, one per
+ * lane of double vectors (rt_eval.c). 14 channels over joints 1-4, each joint's
  * last one winning: a first batch of 8 (flushed when the ninth comes:
  * out of order, its 80-degree arcs would win); a second of 4 ending
  * with a joint that a STEP rotation then sets (the batch must be
