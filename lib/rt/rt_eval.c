@@ -359,6 +359,55 @@ static void slerp_flush(rt_slerp_batch *restrict b, mlod_trs *local)
 	b->n = 0;
 }
 
+/* The local matrices' 3x3 parts of joints j[0 .. 8) (from local[]) as
+ * rt_trs_cols makes them, lane k of lm[c * 8 + k] entry c (m[0], m[1],
+ * m[2], m[4], ..., m[10]): the same doubles per lane, in the same order,
+ * so the same floats; 8 joints at a time, so that the chain of world
+ * matrices after does not wait on each joint's division. */
+#if defined(RT_HAVE_SLERP_LANES) && RT_SLERP_LANES == 8
+RT_EVAL_CLONES static void trs_lanes(const mlod_trs *local, const uint32_t *j, float *restrict lm)
+{
+	rt_f4 fx, fy, fz, fw, fsx, fsy, fsz;
+	for (int k = 0; k < 8; k++) {
+		const mlod_trs *t = &local[j[k]];
+		fx[k] = t->r.x, fy[k] = t->r.y, fz[k] = t->r.z, fw[k] = t->r.w;
+		fsx[k] = t->s.x, fsy[k] = t->s.y, fsz[k] = t->s.z;
+	}
+	const rt_d4 x = __builtin_convertvector(fx, rt_d4), y = __builtin_convertvector(fy, rt_d4);
+	const rt_d4 z = __builtin_convertvector(fz, rt_d4), w = __builtin_convertvector(fw, rt_d4);
+	const rt_d4 sx = __builtin_convertvector(fsx, rt_d4), sy = __builtin_convertvector(fsy, rt_d4);
+	const rt_d4 sz = __builtin_convertvector(fsz, rt_d4);
+	const rt_d4 n = x * x + y * y + z * z + w * w;
+	rt_d4 s = 2.0 / n;
+	for (int k = 0; k < 8; k++)
+		if (!(n[k] > 0.0))
+			s[k] = 0.0;
+	const rt_f4 m[9] = {
+		__builtin_convertvector((1 - s * (y * y + z * z)) * sx, rt_f4),
+		__builtin_convertvector(s * (x * y + w * z) * sx, rt_f4),
+		__builtin_convertvector(s * (x * z - w * y) * sx, rt_f4),
+		__builtin_convertvector(s * (x * y - w * z) * sy, rt_f4),
+		__builtin_convertvector((1 - s * (x * x + z * z)) * sy, rt_f4),
+		__builtin_convertvector(s * (y * z + w * x) * sy, rt_f4),
+		__builtin_convertvector(s * (x * z + w * y) * sz, rt_f4),
+		__builtin_convertvector(s * (y * z - w * x) * sz, rt_f4),
+		__builtin_convertvector((1 - s * (x * x + y * y)) * sz, rt_f4),
+	};
+	memcpy(lm, m, sizeof m);
+}
+#else
+static void trs_lanes(const mlod_trs *local, const uint32_t *j, float *restrict lm)
+{
+	for (int k = 0; k < 8; k++) {
+		float m[16];
+		rt_trs_cols(&local[j[k]], m);
+		static const int at[9] = { 0, 1, 2, 4, 5, 6, 8, 9, 10 };
+		for (int c = 0; c < 9; c++)
+			lm[8 * c + k] = m[at[c]];
+	}
+}
+#endif
+
 /* Adds the LINEAR rotation channel between keys a and b at t (of joint
  * j) to the batch, the keys normalised unless unit says they are. */
 static inline void slerp_push(rt_slerp_batch *b, const float *qa, const float *qb, float t, int unit, uint32_t j,
@@ -475,7 +524,8 @@ mlod_rt_scratch *mlod_rt_scratch_create(mlod_rt_ctx *ctx)
 	if (!ctx)
 		return NULL;
 	const size_t J = ctx->joint_count, P = ctx->palette_size;
-	size_t bytes = sizeof(mlod_rt_scratch) + J * sizeof(mlod_trs) + 16 * sizeof(float) * (J + P) + 64 + J * 5;
+	size_t bytes = sizeof(mlod_rt_scratch) + J * sizeof(mlod_trs) + 16 * sizeof(float) * (J + P) + 64 + J * 5 +
+	               (9 * sizeof(float) + sizeof(uint32_t)) * (J + 8);
 	mlod_rt_scratch *s = rt_alloc(ctx, bytes);
 	if (!s)
 		return NULL;
@@ -484,9 +534,11 @@ mlod_rt_scratch *mlod_rt_scratch_create(mlod_rt_ctx *ctx)
 	uintptr_t a = ((uintptr_t)(s + 1) + 15) & ~(uintptr_t)15;
 	s->world = (float *)a;
 	s->palette = s->world + 16 * J;
-	s->local = (mlod_trs *)(s->palette + 16 * P);
+	s->lm = s->palette + 16 * P;
+	s->local = (mlod_trs *)(s->lm + 9 * (J + 8));
 	s->plan_posed = (uint32_t *)(s->local + J);
-	s->plan_need = (uint8_t *)(s->plan_posed + J);
+	s->anim_joints = s->plan_posed + J;
+	s->plan_need = (uint8_t *)(s->anim_joints + J + 8);
 	return s;
 }
 
@@ -554,9 +606,12 @@ static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_r
 	const uint8_t *flags = mu->chan_flags;
 	const uint32_t nbits = 8 * ctx->chan_bytes;
 	const float t = sample_time(ctx, st);
+	uint32_t na = 0;
 	for (uint32_t i = 0; i < npose; i++)
-		if (!mu->fixed[posed[i]])
+		if (!mu->fixed[posed[i]]) {
 			local[posed[i]] = ctx->rest_local[posed[i]];
+			s->anim_joints[na++] = posed[i];
+		}
 	rt_key_pos p = { NULL, 0, 0, 0, 0.0f, 0.0f };
 	rt_slerp_batch sb;
 	sb.n = 0;
@@ -566,15 +621,24 @@ static void pose_joints(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const mlod_r
 			sample_one(m, i, flags, nbits, t, &p, local, &sb);
 	}
 	slerp_flush(&sb, local);
-	for (uint32_t i = 0; i < npose; i++) {
+	/* the animated joints' local matrices, 8 at a time (a last partial
+	 * group repeats the last joint), then the chain of world matrices */
+	for (uint32_t k = na; k % 8; k++)
+		s->anim_joints[k] = s->anim_joints[na - 1];
+	for (uint32_t k = 0; k < na; k += 8)
+		trs_lanes(local, s->anim_joints + k, s->lm + 9 * (size_t)k);
+	for (uint32_t i = 0, a = 0; i < npose; i++) {
 		const uint32_t j = posed[i];
 		const float *parent = jr[j].parent < 0 ? jr[j].base : W + 16 * (size_t)jr[j].parent;
 		const uint32_t f = mu->fixed[j];
-		if (f)
+		if (f) {
 			rt_mat_mul(parent, f == 1 ? ctx->rest_mat + 16 * (size_t)j : mu->static_mat + 16 * (size_t)(f - 2),
 			           W + 16 * (size_t)j);
-		else
-			rt_mat_mul_trs(parent, &local[j], W + 16 * (size_t)j);
+		} else {
+			const float tr[3] = { local[j].t.x, local[j].t.y, local[j].t.z };
+			rt_mat_mul_rs(parent, s->lm + 9 * (size_t)(a & ~7u) + (a & 7u), 8, tr, W + 16 * (size_t)j);
+			a++;
+		}
 	}
 }
 

@@ -85,6 +85,37 @@ static inline void rt_mat_trs(const mlod_trs *t, float *out)
 	rt_trs_cols(t, out);
 }
 
+/* parent * L for the affine L whose 3x3 part is l[0], l[stride], ...,
+ * l[8 stride] (column-major: rt_trs_cols' m[0], m[1], m[2], m[4], ...,
+ * m[10]) and translation tr: rt_mat_mul(parent, L)'s operations, so the
+ * same floats. */
+static inline void rt_mat_mul_rs(const float *restrict parent, const float *l, size_t stride, const float *tr,
+                                 float *restrict out)
+{
+#if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
+	const rt_m4 a0 = rt_m4_load(parent), a1 = rt_m4_load(parent + 4), a2 = rt_m4_load(parent + 8),
+	            a3 = rt_m4_load(parent + 12);
+	rt_m4 r0 = a0 * l[0] + a1 * l[stride] + a2 * l[2 * stride];
+	rt_m4 r1 = a0 * l[3 * stride] + a1 * l[4 * stride] + a2 * l[5 * stride];
+	rt_m4 r2 = a0 * l[6 * stride] + a1 * l[7 * stride] + a2 * l[8 * stride];
+	rt_m4 r3 = a0 * tr[0] + a1 * tr[1] + a2 * tr[2] + a3;
+	r0[3] = r1[3] = r2[3] = 0.0f, r3[3] = 1.0f;
+	memcpy(out, &r0, sizeof r0);
+	memcpy(out + 4, &r1, sizeof r1);
+	memcpy(out + 8, &r2, sizeof r2);
+	memcpy(out + 12, &r3, sizeof r3);
+#else
+	float b[16];
+	for (int c = 0; c < 3; c++)
+		for (int row = 0; row < 3; row++)
+			b[4 * c + row] = l[(size_t)(3 * c + row) * stride];
+	b[12] = tr[0], b[13] = tr[1], b[14] = tr[2];
+	b[3] = b[7] = b[11] = 0.0f;
+	b[15] = 1.0f;
+	rt_mat_mul(parent, b, out);
+#endif
+}
+
 /* parent * trs(t): rt_mat_mul(parent, rt_mat_trs(t)) in one go. */
 #if defined(__GNUC__) && !defined(MLOD_RT_NO_VECTOR_EXT)
 /* rt_trs_cols' entries kept in registers and multiplied in as rt_mat_mul
