@@ -810,6 +810,20 @@ static int rigid_unit(const float *M, float *U)
 	return 1;
 }
 
+/* The palette entries the mesh level mu reads, W[joint] times the bind
+ * matrix; built for AVX2 too where the pose is (the same floats). */
+#if defined(RT_EVAL_CLONES)
+RT_EVAL_CLONES
+#endif
+static void palette_entries(const mlod_rt_ctx *ctx, const rt_unit *su, const rt_unit *mu, const float *W,
+                            float *palette)
+{
+	for (uint32_t k = 0; k < mu->pal_used_count; k++) {
+		const uint32_t e = mu->pal_used[k];
+		rt_mat_mul(W + 16 * (size_t)entry_joint(ctx, su, e), entry_bind(ctx, su, e), palette + 16 * (size_t)e);
+	}
+}
+
 mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float *positions,
                          size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
                          uint32_t *vertex_count, mlod_error *err)
@@ -841,10 +855,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	s->posed = 2;
 	s->paletted = 0;
 	const float *W = s->world;
-	for (uint32_t k = 0; k < mu->pal_used_count; k++) {
-		const uint32_t e = mu->pal_used[k];
-		rt_mat_mul(W + 16 * (size_t)entry_joint(ctx, su, e), entry_bind(ctx, su, e), s->palette + 16 * (size_t)e);
-	}
+	palette_entries(ctx, su, mu, W, s->palette);
 	size_t base = 0;
 	float morphed[3 * RT_MORPH_RUN];
 	float M[16], U[12];
