@@ -153,6 +153,8 @@ struct mlod_rt_scratch {
 	mlod_trs *local;          /* joint_count */
 	float *world;             /* 16 per joint */
 	float *palette;           /* 16 per palette entry */
+	float *lm;                /* the pose's animated local matrices, 8 at a time by entry (rt_eval.c) */
+	uint32_t *anim_joints;    /* the pose's animated joints, in order (joint_count + 7) */
 	const rt_unit *skel_unit; /* the pose's skeleton level (NULL: level 0) */
 	int posed, paletted;      /* posed: 1 in full (mlod_rt_pose), 2 only what a mesh level needs */
 	uint32_t id;              /* the instance posed */

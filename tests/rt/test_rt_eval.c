@@ -928,12 +928,98 @@ TEST(fixed_joints_and_near_slerp)
 	CHECK(!why, "%s", why);
 }
 
+/* slerp_batches' checks: NULL, or what went wrong. */
+static const char *slerp_batch_check(mlod_rt_ctx *ctx, mlod_rt_scratch *s)
+{
+	static char why[200];
+	mlod_error e;
+	uint32_t id;
+	const float *W;
+	if (mlod_rt_instance_create(ctx, 1, 1.0f, 0, &id, &e) || force(ctx, id, 0, &e) ||
+	    mlod_rt_pose(ctx, s, id, &W, NULL, NULL, &e)) {
+		snprintf(why, sizeof why, "pose: %.120s", e.message);
+		return why;
+	}
+	/* t = 1 of keys at 0 and 4: a quarter of each joint's last arc about
+	 * z, but joint 4, whose last channel is Rx(90) (STEP) */
+	static const int parent[5] = { -1, 0, 1, 2, 1 };
+	static const double want_z[5] = { 0, 42.5, 0.005, 10, 0 }; /* degrees */
+	for (int j = 1; j < 5; j++) {
+		float L[16];
+		local_of(W, parent[j], j, L);
+		if (j == 4) {
+			if (!(NEAR(L[0], 1, 1e-6) && NEAR(L[5], 0, 1e-6) && NEAR(L[6], 1, 1e-6) && NEAR(L[9], -1, 1e-6))) {
+				snprintf(why, sizeof why, "joint 4 is not Rx(90): %.7g %.7g %.7g %.7g", L[0], L[5], L[6], L[9]);
+				return why;
+			}
+			continue;
+		}
+		const double c = cos(want_z[j] * M_PI / 180), sn = sin(want_z[j] * M_PI / 180);
+		if (!(NEAR(L[0], c, 1e-6) && NEAR(L[1], sn, 1e-6) && NEAR(L[4], -sn, 1e-6) && NEAR(L[5], c, 1e-6) &&
+		      NEAR(L[10], 1, 1e-6))) {
+			snprintf(why, sizeof why, "joint %d is not Rz(%g): %.7g %.7g %.7g %.7g", j, want_z[j], L[0], L[1],
+			         L[4], L[5]);
+			return why;
+		}
+	}
+	return NULL;
+}
+
+/* The pose slerps LINEAR rotation channels in batches of up to 8, one per
+ * lane of double vectors (rt_eval.c). 14 channels over joints 1-4, each joint's
+ * last one winning: a first batch of 8 (flushed when the ninth comes:
+ * out of order, its 80-degree arcs would win); a second of 4 ending
+ * with a joint that a STEP rotation then sets (the batch must be
+ * slerped before it); a last batch of one (a partial vector: lanes left
+ * from the batch before would set joint 4 after its STEP). The second
+ * batch holds every branch of the slerp in one vector: 170 degrees
+ * (acos), 0.02 (nearly parallel), 40 with keys of length 2 (not flagged
+ * unit) and 70 (the series); the last channel is 40 degrees against the
+ * negated key, of length 2 (the series the short way round). */
+TEST(slerp_batches)
+{
+	enum { NC = 14 };
+	static const float t04[2] = { 0, 4 };
+	static const uint32_t joint[NC] = { 1, 2, 3, 4, 1, 2, 3, 4, 1, 2, 3, 4, 4, 3 };
+	static const float arc[NC] = { 80, 80, 80, 80, 60, 60, 60, 60, 170, 0.02f, 40, 70, 0, 40 };
+	static float q[NC][8];
+	mlod_pack_channel ch[NC];
+	for (int c = 0; c < NC; c++) {
+		if (c == 12) { /* STEP Rx(90) */
+			fx_quat_x(90, q[c]), fx_quat_x(90, q[c] + 4);
+			fx_channel(&ch[c], joint[c], 1, 1, 2, t04, q[c]);
+			continue;
+		}
+		fx_quat_z(0, q[c]), fx_quat_z(arc[c], q[c] + 4);
+		for (int k = 0; k < 8; k++) {
+			if (c == 10 || c == 13)
+				q[c][k] *= 2;
+			if (c == 13 && k >= 4)
+				q[c][k] = -q[c][k];
+		}
+		fx_channel(&ch[c], joint[c], 1, 0, 2, t04, q[c]);
+	}
+	mlod_pack_motion saved[3];
+	memcpy(saved, fx_mo[1], sizeof saved);
+	for (int l = 0; l < 3; l++)
+		fx_motion(&fx_mo[1][l], ch, NC, 4);
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_all(NULL, &e);
+	mlod_rt_scratch *s = ctx ? mlod_rt_scratch_create(ctx) : NULL;
+	const char *why = s ? slerp_batch_check(ctx, s) : "open failed";
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+	memcpy(fx_mo[1], saved, sizeof saved);
+	CHECK(!why, "%s", why);
+}
+
 int main(void)
 {
 	fx_build(0);
 	RUN(sample_hand_values);
 	RUN(sample_loop_and_clamp);
 	RUN(fixed_joints_and_near_slerp);
+	RUN(slerp_batches);
 	RUN(fold_matches_full_skeleton);
 	RUN(skin_hand_lbs);
 	RUN(kernel_matches_scalar);
