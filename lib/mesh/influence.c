@@ -1,14 +1,16 @@
 /*
- * influence.c: fewer joint influences on the coarser mesh levels (beyond
- * the paper). A skinned vertex of a level loses its smallest influence
- * while the vertex, posed by linear blend skinning at every training pose,
- * stays within a budget of where its own influences put it: the budget is
- * a fraction (mlod_bgm_options.influence_budget) of the level's mean posed
- * error, measured before. The dropped weight goes where it moves the
- * vertex least: spread over the others in proportion, or all to one of
- * them. Each vertex is decided on its own, so the result is the same at
- * any thread count. Pruned levels are measured again, so their reported
- * errors are those of what is written.
+ * influence.c: fewer joint influences on the mesh levels (beyond the
+ * paper), so that far instances skin fewer. A skinned vertex of a level
+ * loses its smallest influence while the vertex, posed by linear blend
+ * skinning at every training pose, stays within a budget of where its own
+ * influences put it: the budget is a fraction
+ * (mlod_bgm_options.influence_budget) of the level's mean posed error,
+ * measured before. The dropped weight goes where it moves the vertex
+ * least: spread over the others in proportion, or all to one of them.
+ * Each vertex is decided on its own, so the result is the same at any
+ * thread count. Pruned levels are measured again, so their reported
+ * errors are those of what is written; a level whose Hausdorff error rose
+ * is tried again under a smaller budget, then left as it was.
  */
 #include <math.h>
 #include <stdio.h>
@@ -156,6 +158,13 @@ static mlod_result skin_mats(const mlod_mesh_levels *L, mlod_mat4 ***out, mlod_e
 	return MLOD_OK;
 }
 
+static int prunable(const mlod_mesh_levels *L, const mlod_mesh_level *lv, int i, int p)
+{
+	const mlod_primitive *pr = &lv->meshes[i].primitives[p];
+	return L->c->instances[i].skin >= 0 && lv->owned[i] && lv->owned[i][p] && pr->weight_set_count == 1 &&
+	       pr->weights[0] && pr->joints[0];
+}
+
 /* Prunes level lv (budget in scene units); returns the influences dropped
  * (and the vertices that lost any in *vertices). */
 static long prune_level(const mlod_mesh_levels *L, mlod_mesh_level *lv, mlod_mat4 *const *mats, double budget,
@@ -165,11 +174,9 @@ static long prune_level(const mlod_mesh_levels *L, mlod_mesh_level *lv, mlod_mat
 	long dropped = 0;
 	for (int i = 0; i < c->instance_count; i++) {
 		int s = c->instances[i].skin;
-		if (s < 0 || !lv->owned[i])
-			continue;
 		for (int p = 0; p < lv->meshes[i].primitive_count; p++) {
 			mlod_primitive *pr = &lv->meshes[i].primitives[p];
-			if (!lv->owned[i][p] || pr->weight_set_count != 1 || !pr->weights[0] || !pr->joints[0])
+			if (!prunable(L, lv, i, p))
 				continue;
 			for (int v = 0; v < pr->vertex_count; v++) {
 				int d = prune_vertex(pr, v, mats[s], c->skeleton.skins[s].joint_count, L->train.count, budget, q);
@@ -181,41 +188,126 @@ static long prune_level(const mlod_mesh_levels *L, mlod_mesh_level *lv, mlod_mat
 	return dropped;
 }
 
+/* The weights and joints of a level's skinned primitives (those
+ * prune_level may change), saved to put back. */
+typedef struct saved {
+	float *w;
+	uint16_t *j;
+} saved;
+
+/* put 0: saves lv's weights into sv (allocating); 1: puts them back. */
+static mlod_result save_level(const mlod_mesh_levels *L, mlod_mesh_level *lv, saved *sv, int put, mlod_error *err)
+{
+	size_t n = 0;
+	for (int i = 0; i < L->c->instance_count; i++)
+		for (int p = 0; p < lv->meshes[i].primitive_count; p++)
+			n += prunable(L, lv, i, p) ? 4 * (size_t)lv->meshes[i].primitives[p].vertex_count : 0;
+	if (!put) {
+		sv->w = malloc(sizeof *sv->w * (n + 1));
+		sv->j = malloc(sizeof *sv->j * (n + 1));
+		if (!sv->w || !sv->j)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	size_t at = 0;
+	for (int i = 0; i < L->c->instance_count; i++)
+		for (int p = 0; p < lv->meshes[i].primitive_count; p++) {
+			if (!prunable(L, lv, i, p))
+				continue;
+			mlod_primitive *pr = &lv->meshes[i].primitives[p];
+			size_t m = 4 * (size_t)pr->vertex_count;
+			if (put) {
+				memcpy(pr->weights[0], sv->w + at, m * sizeof *sv->w);
+				memcpy(pr->joints[0], sv->j + at, m * sizeof *sv->j);
+			} else {
+				memcpy(sv->w + at, pr->weights[0], m * sizeof *sv->w);
+				memcpy(sv->j + at, pr->joints[0], m * sizeof *sv->j);
+			}
+			at += m;
+		}
+	return MLOD_OK;
+}
+
+/* Each level is pruned under the whole budget and measured again; a level
+ * whose Hausdorff error (the one its switch distance and the pixel rule
+ * use) rose is put back and tried under half the budget, then a quarter
+ * (MLOD_INFLUENCE_TRIES budgets), and left as it was after that. */
+#define MLOD_INFLUENCE_TRIES 3
+
 mlod_result mlod_mesh_prune_influences_(mlod_mesh_levels *L, int first, mlod_error *err)
 {
 	if (!(L->opt.influence_budget > 0.0) || first >= L->count || L->train.count <= 0)
 		return MLOD_OK;
 	const mlod_skeleton *sk = &L->c->skeleton;
 	mlod_mat4 **mats = NULL;
+	saved sv[MLOD_MESH_MAX_LEVELS];
+	memset(sv, 0, sizeof sv);
+	mlod_deviation before[MLOD_MESH_MAX_LEVELS], dev[MLOD_MESH_MAX_LEVELS];
+	const mlod_character *views[MLOD_MESH_MAX_LEVELS];
+	int pending[MLOD_MESH_MAX_LEVELS], changed[MLOD_MESH_MAX_LEVELS];
+	long drops[MLOD_MESH_MAX_LEVELS], moved[MLOD_MESH_MAX_LEVELS];
+	double used[MLOD_MESH_MAX_LEVELS]; /* the budget a level was pruned under, 0: none */
 	float *q = malloc(sizeof *q * 3 * 4 * ((size_t)L->train.count + 1));
 	mlod_result r = q ? skin_mats(L, &mats, err) : mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-	const mlod_character *views[MLOD_MESH_MAX_LEVELS];
-	mlod_deviation dev[MLOD_MESH_MAX_LEVELS];
-	int changed[MLOD_MESH_MAX_LEVELS], n = 0;
-	for (int k = first; r == MLOD_OK && k < L->count; k++) {
-		mlod_mesh_level *lv = &L->levels[k];
-		double budget = L->opt.influence_budget * lv->error.mean / 100.0 * lv->error.scale;
-		long vertices = 0, dropped = prune_level(L, lv, mats, budget, q, &vertices);
-		if (dropped > 0) {
-			char text[160];
-			snprintf(text, sizeof text, "level %d: %ld influences dropped from %ld vertices (budget %.3g%% of the diagonal)",
-			         k + 1, dropped, vertices, L->opt.influence_budget * lv->error.mean);
-			mlod_mesh_note_(L, text);
+	for (int k = first; k < L->count; k++) {
+		before[k] = L->levels[k].error;
+		pending[k] = 1;
+		used[k] = 0.0;
+		if (r == MLOD_OK)
+			r = save_level(L, &L->levels[k], &sv[k], 0, err);
+	}
+	double f = L->opt.influence_budget;
+	for (int t = 0; r == MLOD_OK && t < MLOD_INFLUENCE_TRIES; t++, f /= 2) {
+		int n = 0;
+		for (int k = first; k < L->count; k++) {
+			if (!pending[k])
+				continue;
+			mlod_mesh_level *lv = &L->levels[k];
+			if (t > 0)
+				save_level(L, lv, &sv[k], 1, err);
+			double budget = f * before[k].mean / 100.0 * before[k].scale;
+			moved[k] = 0;
+			drops[k] = prune_level(L, lv, mats, budget, q, &moved[k]);
+			if (drops[k] == 0) {
+				pending[k] = 0; /* nothing within this budget, nor a smaller one */
+				continue;
+			}
 			changed[n] = k;
 			views[n++] = &lv->view;
 		}
+		if (n == 0)
+			break;
+		/* the levels' errors are those of the pruned meshes */
+		double t0 = bgm_seconds();
+		r = mlod_posed_errors(L->c, views, n, &L->measure, dev, err);
+		L->measure_seconds += bgm_seconds() - t0;
+		for (int x = 0; r == MLOD_OK && x < n; x++) {
+			int k = changed[x];
+			if (dev[x].max > before[k].max)
+				continue; /* pending: put back, tried again under less */
+			L->levels[k].error = dev[x];
+			pending[k] = 0;
+			used[k] = f;
+		}
+	}
+	for (int k = first; k < L->count; k++) {
+		char text[200];
+		if (r == MLOD_OK && pending[k]) {
+			save_level(L, &L->levels[k], &sv[k], 1, err);
+			L->levels[k].error = before[k];
+			snprintf(text, sizeof text, "level %d: influences kept (pruning raised its Hausdorff error)", k + 1);
+			mlod_mesh_note_(L, text);
+		} else if (r == MLOD_OK && used[k] > 0.0) {
+			snprintf(text, sizeof text,
+			         "level %d: %ld influences dropped from %ld vertices (budget %.3g%% of the diagonal)", k + 1,
+			         drops[k], moved[k], used[k] * before[k].mean);
+			mlod_mesh_note_(L, text);
+		}
+		free(sv[k].w);
+		free(sv[k].j);
 	}
 	for (int s = 0; mats && s < sk->skin_count; s++)
 		free(mats[s]);
 	free(mats);
 	free(q);
-	if (r != MLOD_OK || n == 0)
-		return r;
-	/* the levels' errors are those of the pruned meshes */
-	double t0 = bgm_seconds();
-	r = mlod_posed_errors(L->c, views, n, &L->measure, dev, err);
-	L->measure_seconds += bgm_seconds() - t0;
-	for (int k = 0; r == MLOD_OK && k < n; k++)
-		L->levels[changed[k]].error = dev[k];
 	return r;
 }

@@ -120,6 +120,9 @@ static void check_character(const char *path, double f)
 		          on.levels[k].error.max, d.mean, d.max);
 		if (dropped == before)
 			CHECK(off.levels[k].error.mean == on.levels[k].error.mean);
+		/* the switch distances' error never rises */
+		CHECK_MSG(on.levels[k].error.max <= off.levels[k].error.max, "level %d: Hausdorff %.9g, %.9g unpruned", k,
+		          on.levels[k].error.max, off.levels[k].error.max);
 	}
 	if (test_failed_)
 		return;
