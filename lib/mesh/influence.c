@@ -298,7 +298,7 @@ mlod_result mlod_mesh_prune_influences_(mlod_mesh_levels *L, int first, mlod_err
 			mlod_mesh_note_(L, text);
 		} else if (r == MLOD_OK && used[k] > 0.0) {
 			snprintf(text, sizeof text,
-			         "level %d: %ld influences dropped from %ld vertices (budget %.3g%% of the diagonal)", k + 1,
+			         "level %d: %ld fewer influences on %ld vertices (budget %.3g%% of the diagonal)", k + 1,
 			         drops[k], moved[k], used[k] * before[k].mean);
 			mlod_mesh_note_(L, text);
 		}

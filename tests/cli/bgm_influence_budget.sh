@@ -8,8 +8,8 @@ node -e '
 const fs = require("fs");
 const off = JSON.parse(fs.readFileSync("off.json")), on = JSON.parse(fs.readFileSync("on.json"));
 if (off.options.influence_budget !== 0 || on.options.influence_budget !== 2) throw new Error("options");
-if (/influences dropped/.test(off.notes)) throw new Error("off prunes: " + off.notes);
-const dropped = on.notes.match(/level [0-9]+: [0-9]+ influences dropped/g) || [];
+if (/fewer influences/.test(off.notes)) throw new Error("off prunes: " + off.notes);
+const dropped = on.notes.match(/level [0-9]+: [0-9]+ fewer influences/g) || [];
 if (dropped.length < 2) throw new Error("on: " + on.notes);
 if (off.levels.length !== on.levels.length) throw new Error("levels");
 on.levels.forEach((l, k) => {
