@@ -61,7 +61,8 @@ static const char usage_text[] =
 	"  -I, --influence-budget F drop influences of a level's skinned vertices\n"
 	"                           while each moves at most F times the level's mean\n"
 	"                           posed error at every training pose; the level is\n"
-	"                           measured again (default %g; 0: off; not with -e)\n"
+	"                           measured again (0, the default: off; 2 is\n"
+	"                           measured in bench/RESULTS.md; not with -e)\n"
 	"  -s, --split DIR          also write one glb per level into DIR: the input\n"
 	"                           with that level's meshes in place\n"
 	"  -j, --threads N          work on N threads (default: the processors online);\n"
@@ -292,7 +293,7 @@ int main(int argc, char **argv)
 			char list[64] = "";
 			for (size_t i = 0, n = 0; i < sizeof defaults / sizeof *defaults; i++)
 				n += (size_t)snprintf(list + n, sizeof list - n, "%s%g", i ? "," : "", defaults[i]);
-			printf(usage_text, list, MLOD_MESH_INFLUENCE_BUDGET > 0.0 ? MLOD_MESH_INFLUENCE_BUDGET : 0.0);
+			printf(usage_text, list);
 			return 0;
 		}
 		case 'V': tool_version();

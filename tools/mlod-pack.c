@@ -41,7 +41,7 @@ static const char usage_text[] =
 	"                             stays within PCT percent of the diagonal\n"
 	"      --influence-budget F   fewer influences on the levels' vertices that\n"
 	"                             move at most F times the level's mean posed\n"
-	"                             error (default %g; 0: off; not with -e)\n"
+	"                             error (0, the default: off; not with -e)\n"
 	"mesh quantisation (mlod(5) QUANTISATION):\n"
 	"      --position-bits N      positions: N bits of the part's box, 8-16\n"
 	"                             (default %d)\n"
@@ -414,8 +414,7 @@ int main(int argc, char **argv)
 			char list[64] = "";
 			for (size_t i = 0, n = 0; i < sizeof defaults / sizeof *defaults; i++)
 				n += (size_t)snprintf(list + n, sizeof list - n, "%s%g", i ? "," : "", defaults[i]);
-			printf(usage_text, list, MLOD_MESH_INFLUENCE_BUDGET > 0.0 ? MLOD_MESH_INFLUENCE_BUDGET : 0.0,
-			       MLOD_PACK_POSITION_BITS_DEFAULT, MLOD_PACK_NORMAL_BITS_DEFAULT,
+			printf(usage_text, list, MLOD_PACK_POSITION_BITS_DEFAULT, MLOD_PACK_NORMAL_BITS_DEFAULT,
 			       MLOD_PACK_UV_BITS_DEFAULT, MLOD_SKEL_MAX_ERROR_DEFAULT, MLOD_PACK_MOTION_LEVEL0_DEFAULT);
 			return 0;
 		}

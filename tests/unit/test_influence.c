@@ -145,9 +145,22 @@ TEST(budget_robot)
 	check_character("samples/RobotExpressive.glb", 1.0);
 }
 
-TEST(budget_default_robot)
+/* The default (0 in the options) is MLOD_MESH_INFLUENCE_BUDGET: off, as
+ * measured; then nothing is pruned. */
+TEST(default_budget)
 {
-	check_character("samples/RobotExpressive.glb", MLOD_MESH_INFLUENCE_BUDGET > 0.0 ? MLOD_MESH_INFLUENCE_BUDGET : 1.0);
+	if (MLOD_MESH_INFLUENCE_BUDGET > 0.0) {
+		check_character("samples/RobotExpressive.glb", MLOD_MESH_INFLUENCE_BUDGET);
+		return;
+	}
+	mlod_character c;
+	CHECK(test_load("samples/RobotExpressive.glb", &c) == 0);
+	mlod_mesh_levels L;
+	levels_with(&c, 0.0, 1, &L);
+	CHECK(L.opt.influence_budget < 0.0 && L.count >= 2);
+	CHECK_MSG(!strstr(L.notes, "fewer influences"), "%.300s", L.notes);
+	mlod_mesh_levels_free(&L);
+	mlod_character_free(&c);
 }
 
 /* The same pruned levels, errors and notes at 1 and 2 threads (at 2 the
@@ -211,7 +224,7 @@ int main(void)
 {
 	RUN(budget_tubeman);
 	RUN(budget_robot);
-	RUN(budget_default_robot);
+	RUN(default_budget);
 	RUN(deterministic_threads);
 	RUN(not_under_a_bound);
 	RUN(shared_data);
