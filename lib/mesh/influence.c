@@ -91,6 +91,10 @@ static int prune_vertex(mlod_primitive *p, int v, const mlod_mat4 *mats, int joi
 	}
 	if (o.n < 2)
 		return 0;
+	for (int k = 0; k < o.n; k++)
+		for (int m = 0; m < k; m++)
+			if (o.j[k] == o.j[m])
+				return 0; /* a joint twice: left as it is */
 	sort_infl(&o);
 	const float *pos = p->positions + 3 * (size_t)v;
 	mlod_v3 b = { pos[0], pos[1], pos[2] };
