@@ -3,7 +3,8 @@
  * paper), so that far instances skin fewer. A skinned vertex of a level
  * loses its smallest influence while the vertex, posed by linear blend
  * skinning at every training pose, stays within a budget of where its own
- * influences put it: the budget is a fraction
+ * influences put it (morph offsets not applied, as the posed error does
+ * not apply them either): the budget is a fraction
  * (mlod_bgm_options.influence_budget) of the level's mean posed error,
  * measured before. The dropped weight goes where it moves the vertex
  * least: spread over the others in proportion, or all to one of them.
