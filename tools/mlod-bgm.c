@@ -58,6 +58,11 @@ static const char usage_text[] =
 	"                           into bind space with its own weights (faster; the\n"
 	"                           new vertex's weights no longer count, some more\n"
 	"                           posed error)\n"
+	"  -I, --influence-budget F drop influences of a level's skinned vertices\n"
+	"                           while each moves at most F times the level's mean\n"
+	"                           posed error at every training pose; the level is\n"
+	"                           measured again (0, the default: off; 2 is\n"
+	"                           measured in bench/RESULTS.md; not with -e)\n"
 	"  -s, --split DIR          also write one glb per level into DIR: the input\n"
 	"                           with that level's meshes in place\n"
 	"  -j, --threads N          work on N threads (default: the processors online);\n"
@@ -155,12 +160,12 @@ static void report_table(const struct job *job)
 	       "%d border and %d non-manifold edges; %d primitives simplified; build %.1f ms\n",
 	       job->input, L->triangles, L->vertices, t.nodes, t.seam_nodes, t.eligible_nodes, t.locked_nodes,
 	       t.border_edges, t.nonmanifold_edges, L->simplified, 1e3 * L->build_seconds);
-	printf("# cost %s%s, %s collapses, budget per %s, placement %s, eligibility %s (tau %g)%s; error over %d poses (rest, clip "
-	       "frames, %d random up to 40 degrees)\n",
+	printf("# cost %s%s, %s collapses, budget per %s, placement %s, eligibility %s (tau %g)%s, influence budget %g; error "
+	       "over %d poses (rest, clip frames, %d random up to 40 degrees)\n",
 	       mlod_mesh_cost_name(L->opt.cost), L->opt.fast_cost && L->opt.cost == MLOD_COST_POSED ? " (fast)" : "",
 	       mlod_mesh_op_name(L->opt.op), mlod_mesh_budget_name(L->budget), mlod_mesh_placement_name(L->opt.placement),
 	       mlod_mesh_eligibility_name(L->opt.eligibility), L->opt.tau, L->opt.allow_border ? ", border collapses at plain cost" : "",
-	       L->measure.count, MLOD_MESH_RANDOM_POSES);
+	       L->opt.influence_budget > 0.0 ? L->opt.influence_budget : 0.0, L->measure.count, MLOD_MESH_RANDOM_POSES);
 	printf("%5s  %6s  %9s  %8s  %10s  %10s  %5s  %9s  %11s\n", "level", "ratio", "triangles", "vertices", "mean%",
 	       "max%", "caps", "build ms", "collapse ms");
 	printf("%5d  %6s  %9d  %8d  %10s  %10s  %5s  %9s  %11s\n", 0, "1", L->triangles, L->vertices, "0", "0", "-",
@@ -193,10 +198,11 @@ static void report_json(const struct job *job)
 	printf("  \"simplified_primitives\": %d,\n  \"static_primitives\": %d,\n  \"build_ms\": %.6g,\n  \"measure_ms\": %.6g,\n",
 	       L->simplified, L->statics, 1e3 * L->build_seconds, 1e3 * L->measure_seconds);
 	printf("  \"options\": {\"cost\": \"%s\", \"collapse\": \"%s\", \"budget\": \"%s\", \"placement\": \"%s\", "
-	       "\"eligibility\": \"%s\", \"tau\": %g, \"allow_border\": %s, \"fast_cost\": %s},\n",
+	       "\"eligibility\": \"%s\", \"tau\": %g, \"allow_border\": %s, \"fast_cost\": %s, \"influence_budget\": %g},\n",
 	       mlod_mesh_cost_name(L->opt.cost), mlod_mesh_op_name(L->opt.op), mlod_mesh_budget_name(L->budget),
 	       mlod_mesh_placement_name(L->opt.placement), mlod_mesh_eligibility_name(L->opt.eligibility), L->opt.tau,
-	       L->opt.allow_border ? "true" : "false", L->opt.fast_cost ? "true" : "false");
+	       L->opt.allow_border ? "true" : "false", L->opt.fast_cost ? "true" : "false",
+	       L->opt.influence_budget > 0.0 ? L->opt.influence_budget : 0.0);
 	printf("  \"measured_poses\": %d,\n  \"levels\": [\n", L->measure.count);
 	for (int k = 0; k < L->count; k++) {
 		const mlod_mesh_level *lv = &L->levels[k];
@@ -234,6 +240,7 @@ int main(int argc, char **argv)
 		{"tau", required_argument, NULL, 't'},
 		{"allow-border", no_argument, NULL, 'b'},
 		{"fast-cost", no_argument, NULL, 'F'},
+		{"influence-budget", required_argument, NULL, 'I'},
 		{"split", required_argument, NULL, 's'},
 		{"threads", required_argument, NULL, 'j'},
 		{"help", no_argument, NULL, 'h'},
@@ -258,7 +265,7 @@ int main(int argc, char **argv)
 
 	tool_name = "mlod-bgm";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:C:B:p:E:t:bFs:j:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:C:B:p:E:t:bFI:s:j:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -276,6 +283,10 @@ int main(int argc, char **argv)
 		case 't': opt.tau = tool_parse_double("--tau", optarg, 1e-6, 1e6); break;
 		case 'b': opt.allow_border = 1; break;
 		case 'F': opt.fast_cost = 1; break;
+		case 'I':
+			opt.influence_budget = tool_parse_double("--influence-budget", optarg, 0.0, 1e3);
+			opt.influence_budget = opt.influence_budget > 0.0 ? opt.influence_budget : -1.0;
+			break;
 		case 's': split = optarg; break;
 		case 'j': opt.threads = tool_parse_threads(optarg); break;
 		case 'h': {

@@ -41,6 +41,9 @@ static const char usage_text[] =
 	"                             (default %s)\n"
 	"  -e, --max-error PCT        levels down to the coarsest whose posed error\n"
 	"                             stays within PCT percent of the diagonal\n"
+	"      --influence-budget F   fewer influences on the levels' vertices that\n"
+	"                             move at most F times the level's mean posed\n"
+	"                             error (0, the default: off; not with -e)\n"
 	"mesh quantisation (mlod(5) QUANTISATION):\n"
 	"      --position-bits N      positions: N bits of the part's box, 8-16\n"
 	"                             (default %d)\n"
@@ -324,7 +327,7 @@ int main(int argc, char **argv)
 {
 	enum { OPT_CODEC = 256, OPT_ENTROPY, OPT_NAME, OPT_SKEL_ERR, OPT_MOTION_ERR, OPT_NO_SKEL, OPT_NO_MESH,
 	       OPT_NO_MOTION, OPT_INFO, OPT_JSON, OPT_POS_BITS, OPT_NRM_BITS, OPT_UV_BITS, OPT_LEVEL0_ERR,
-	       OPT_LOSSLESS_MOTION };
+	       OPT_LOSSLESS_MOTION, OPT_INFLUENCE };
 	static const struct option longopts[] = {
 		{"output", required_argument, NULL, 'o'},
 		{"report", optional_argument, NULL, 'r'},
@@ -333,6 +336,7 @@ int main(int argc, char **argv)
 		{"name", required_argument, NULL, OPT_NAME},
 		{"ratios", required_argument, NULL, 'R'},
 		{"max-error", required_argument, NULL, 'e'},
+		{"influence-budget", required_argument, NULL, OPT_INFLUENCE},
 		{"skeleton-max-error", required_argument, NULL, OPT_SKEL_ERR},
 		{"motion-max-error", required_argument, NULL, OPT_MOTION_ERR},
 		{"position-bits", required_argument, NULL, OPT_POS_BITS},
@@ -389,6 +393,10 @@ int main(int argc, char **argv)
 			ratios_given = 1;
 			break;
 		case 'e': opt.mesh_max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
+		case OPT_INFLUENCE:
+			opt.bgm.influence_budget = tool_parse_double("--influence-budget", optarg, 0.0, 1e3);
+			opt.bgm.influence_budget = opt.bgm.influence_budget > 0.0 ? opt.bgm.influence_budget : -1.0;
+			break;
 		case OPT_SKEL_ERR: opt.skel_max_error = tool_parse_double("--skeleton-max-error", optarg, 0.0, 1e6); break;
 		case OPT_MOTION_ERR: opt.motion_bound_count = parse_bounds(optarg, &opt); break;
 		case OPT_POS_BITS: opt.position_bits = parse_bits("--position-bits", optarg, MLOD_PACK_POSITION_BITS_MIN); break;

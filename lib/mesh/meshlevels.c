@@ -60,6 +60,8 @@ void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget)
 		opt->eligibility = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_ELIGIBLE_BEND : MLOD_ELIGIBLE_ALL;
 	if (!(opt->tau > 0.0))
 		opt->tau = 1.0;
+	if (opt->influence_budget == 0.0)
+		opt->influence_budget = MLOD_MESH_INFLUENCE_BUDGET > 0.0 ? MLOD_MESH_INFLUENCE_BUDGET : -1.0;
 }
 
 static int primitive_triangles(const mlod_primitive *p)
@@ -648,8 +650,11 @@ static mlod_result by_ratio_pipelined(mlod_mesh_levels *L, const double *ratios,
 
 mlod_result mlod_mesh_levels_by_ratio(mlod_mesh_levels *L, const double *ratios, int n, mlod_error *err)
 {
-	if (L->chain_pending)
-		return by_ratio_pipelined(L, ratios, n, err);
+	if (L->chain_pending) {
+		const int first = L->count;
+		mlod_result r = by_ratio_pipelined(L, ratios, n, err);
+		return r != MLOD_OK ? r : mlod_mesh_prune_influences_(L, first, err);
+	}
 	/* The levels first (which are kept depends on their triangles only),
 	 * then all of them measured at once: their poses spread over the
 	 * threads, the same results as one level after another. */
@@ -674,7 +679,7 @@ mlod_result mlod_mesh_levels_by_ratio(mlod_mesh_levels *L, const double *ratios,
 	}
 	for (int k = first; k < L->count; k++)
 		L->levels[k].error = dev[k - first];
-	return MLOD_OK;
+	return mlod_mesh_prune_influences_(L, first, err);
 }
 
 /* By error, through mlod_level_search_run: the parameter is the ratio. */
@@ -726,6 +731,8 @@ mlod_result mlod_mesh_levels_by_error(mlod_mesh_levels *L, double bound, mlod_er
 		ratios[n++] = ratio;
 	mlod_level_search s = {ratios, n, 1.0, 0, MLOD_MESH_BISECTIONS, bound, L, search_make, search_keep, search_drop};
 	mlod_result r = chain_finish(L, err);
+	if (L->opt.influence_budget > 0.0)
+		note(L, "influences not pruned under an error bound");
 	return r != MLOD_OK ? r : mlod_level_search_run(&s, err);
 }
 

@@ -10,4 +10,9 @@ void mlod_mesh_note_(mlod_mesh_levels *L, const char *text);
 /* Does instance i get levels (a node, and a primitive with a BGM)? */
 int mlod_mesh_has_levels_(const mlod_mesh_levels *L, int i);
 
+/* Influence pruning (influence.c) of levels [first, L->count), each
+ * measured before, and measured again after when anything changed
+ * (mlod_bgm_options.influence_budget, resolved: > 0 on). */
+mlod_result mlod_mesh_prune_influences_(mlod_mesh_levels *L, int first, mlod_error *err);
+
 #endif
