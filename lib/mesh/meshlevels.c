@@ -88,20 +88,12 @@ static void note(mlod_mesh_levels *L, const char *fmt, ...)
 
 static void note(mlod_mesh_levels *L, const char *fmt, ...)
 {
-	size_t n = strlen(L->notes);
-	if (n + 4 >= sizeof L->notes)
-		return;
-	if (n)
-		n += (size_t)snprintf(L->notes + n, sizeof L->notes - n, "; ");
+	char text[sizeof L->notes];
 	va_list ap;
 	va_start(ap, fmt);
-	vsnprintf(L->notes + n, sizeof L->notes - n, fmt, ap);
+	vsnprintf(text, sizeof text, fmt, ap);
 	va_end(ap);
-}
-
-void mlod_mesh_note_(mlod_mesh_levels *L, const char *text)
-{
-	note(L, "%s", text);
+	mlod_mesh_note_(L, text);
 }
 
 static mlod_result nomem(mlod_error *err)
