@@ -5,6 +5,8 @@
 #   make test-extended    also uses ../shared/data when it is present
 #   make bench            benchmarks against the peers (bench/RESULTS.md)
 #   make fuzz             libFuzzer on the pack reader (clang; not in make test)
+#   make fuzz-io          libFuzzer on BVH, glb/glTF and the stage record
+#                         (FUZZ_TARGET=bvh|gltf|record, FUZZ_TIME s each)
 #   make demo             the main job on the bundled sample
 #   make install          PREFIX=/usr/local DESTDIR= MANDIR=$(PREFIX)/share/man
 #   make config=debug|release|sanitize
