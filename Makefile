@@ -205,11 +205,12 @@ build/fuzz/fuzz_pack: tests/fuzz/fuzz_pack.c $(RT_C) lib/rt/mlod_pack.h $(sort $
 #   record  tests/fuzz/fuzz_record.c: extras.mlod of a staged glb (JSON)
 # tests/fuzz/seeds.sh writes the seeds (build/fuzz/seeds-*) from the
 # samples through the release tools; corpora grow in build/fuzz/corpus-*,
-# crashes land in build/fuzz/. A slow input (FUZZ_TIMEOUT s) or one past
-# FUZZ_RSS_MB is a finding.
+# crashes land in build/fuzz/crash-*. A slow input (FUZZ_TIMEOUT s) or one
+# past FUZZ_RSS_MB is a finding. The inputs of fixed findings
+# (tests/fuzz/regress/TARGET) are replayed first; a crash there stops.
 FUZZ_CXX ?= clang++
 FUZZ_TARGET ?= bvh gltf record
-FUZZ_TIMEOUT ?= 10
+FUZZ_TIMEOUT ?= 30
 FUZZ_RSS_MB ?= 2048
 FUZZ_IO_FLAGS := -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_IO_OBJ := $(LIB_C:%.c=build/fuzz/obj/%.o) $(LIB_CXX:%.cpp=build/fuzz/obj/%.o)
@@ -219,6 +220,11 @@ fuzz-io: fuzz-io-build
 	@set -e; for t in $(FUZZ_TARGET); do \
 		mkdir -p build/fuzz/corpus-$$t build/fuzz/crash-$$t; \
 		bin=build/fuzz/fuzz_io; max=2097152; [ $$t = record ] && bin=build/fuzz/fuzz_record; [ $$t = gltf ] || max=65536; \
+		if [ -d tests/fuzz/regress/$$t ]; then \
+			echo "fuzz-io: $$t: replaying tests/fuzz/regress/$$t"; \
+			MLOD_FUZZ_BASE=build/fuzz/stage/tiny.staged.glb $$bin tests/fuzz/regress/$$t/* > build/fuzz/regress-$$t.log 2>&1 \
+				|| { cat build/fuzz/regress-$$t.log >&2; exit 1; }; \
+		fi; \
 		echo "fuzz-io: $$t for $(FUZZ_TIME) s"; \
 		MLOD_FUZZ_BASE=build/fuzz/stage/tiny.staged.glb $$bin -max_total_time=$(FUZZ_TIME) -timeout=$(FUZZ_TIMEOUT) \
 			-rss_limit_mb=$(FUZZ_RSS_MB) -malloc_limit_mb=$(FUZZ_RSS_MB) -max_len=$$max -dict=tests/fuzz/$$t.dict \
