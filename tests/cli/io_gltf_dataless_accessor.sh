@@ -1,7 +1,8 @@
-# A 600-byte glTF whose accessors have no buffer view (glTF reads them as
+# A 400-byte glTF whose accessors have no buffer view (glTF reads them as
 # zeros) but claim a million elements each: a small input may not make
-# mlod allocate without bound (found by make fuzz-io; with 60 million
-# elements mlod-label used 5 GB and 75 s, then succeeded).
+# mlod allocate without bound (found reading the glTF reader while the
+# fuzz targets ran; they had not hit it: with 60 million elements
+# mlod-label used 5 GB and 52-75 s, then succeeded).
 cat > dataless.gltf <<'GLTF'
 {"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],
 "nodes":[{"mesh":0,"skin":0},{"name":"root"}],
