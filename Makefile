@@ -5,6 +5,8 @@
 #   make test-extended    also uses ../shared/data when it is present
 #   make bench            benchmarks against the peers (bench/RESULTS.md)
 #   make fuzz             libFuzzer on the pack reader (clang; not in make test)
+#   make fuzz-io          libFuzzer on BVH, glb/glTF and the stage record
+#                         (FUZZ_TARGET=bvh|gltf|record, FUZZ_TIME s each)
 #   make demo             the main job on the bundled sample
 #   make install          PREFIX=/usr/local DESTDIR= MANDIR=$(PREFIX)/share/man
 #   make config=debug|release|sanitize
@@ -193,6 +195,66 @@ build/fuzz/fuzz_pack: tests/fuzz/fuzz_pack.c $(RT_C) lib/rt/mlod_pack.h $(sort $
 	@mkdir -p $(@D)
 	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { echo "make fuzz needs clang with libFuzzer (Debian: clang libclang-rt-dev)" >&2; exit 1; }
 	$(FUZZ_CC) -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined $(RT_CPPFLAGS) tests/fuzz/fuzz_pack.c $(RT_C) $(sort $(wildcard lib/core/*.c)) -lmeshoptimizer -lzstd -lm -o $@
+# ----------------------------------------------------------------------
+
+# --- Bake-side input fuzzing ------------------------------------------
+# make fuzz-io: libFuzzer on what the tools read, built with clang and
+# clang++ under ASan and UBSan from the whole bake library. Targets
+# (FUZZ_TARGET, default all three in turn, FUZZ_TIME seconds each):
+#   bvh     tests/fuzz/fuzz_io.c on BVH seeds: mlod_load, then every record read
+#   gltf    the same binary on glb and glTF seeds (the samples, each stage's output)
+#   record  tests/fuzz/fuzz_record.c: extras.mlod of a staged glb (JSON)
+# tests/fuzz/seeds.sh writes the seeds (build/fuzz/seeds-*) from the
+# samples through the release tools; corpora grow in build/fuzz/corpus-*,
+# crashes land in build/fuzz/crash-*. A slow input (FUZZ_TIMEOUT s) or one
+# past FUZZ_RSS_MB is a finding. The inputs of fixed findings
+# (tests/fuzz/regress/TARGET) are replayed first; a crash there stops.
+FUZZ_CXX ?= clang++
+FUZZ_TARGET ?= bvh gltf record
+FUZZ_TIMEOUT ?= 30
+FUZZ_RSS_MB ?= 2048
+FUZZ_IO_FLAGS := -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+FUZZ_IO_OBJ := $(LIB_C:%.c=build/fuzz/obj/%.o) $(LIB_CXX:%.cpp=build/fuzz/obj/%.o)
+.PHONY: fuzz-io fuzz-io-build
+fuzz-io: fuzz-io-build
+	@for t in $(FUZZ_TARGET); do case $$t in bvh|gltf|record) ;; *) echo "FUZZ_TARGET: bvh, gltf or record, not $$t" >&2; exit 1;; esac; done
+	@set -e; for t in $(FUZZ_TARGET); do \
+		mkdir -p build/fuzz/corpus-$$t build/fuzz/crash-$$t; \
+		bin=build/fuzz/fuzz_io; max=2097152; [ $$t = record ] && bin=build/fuzz/fuzz_record; [ $$t = gltf ] || max=65536; \
+		if [ -d tests/fuzz/regress/$$t ]; then \
+			echo "fuzz-io: $$t: replaying tests/fuzz/regress/$$t"; \
+			MLOD_FUZZ_BASE=build/fuzz/stage/tiny.staged.glb $$bin tests/fuzz/regress/$$t/* > build/fuzz/regress-$$t.log 2>&1 \
+				|| { cat build/fuzz/regress-$$t.log >&2; exit 1; }; \
+		fi; \
+		echo "fuzz-io: $$t for $(FUZZ_TIME) s"; \
+		MLOD_FUZZ_BASE=build/fuzz/stage/tiny.staged.glb $$bin -max_total_time=$(FUZZ_TIME) -timeout=$(FUZZ_TIMEOUT) \
+			-rss_limit_mb=$(FUZZ_RSS_MB) -malloc_limit_mb=$(FUZZ_RSS_MB) -max_len=$$max -dict=tests/fuzz/$$t.dict \
+			-artifact_prefix=build/fuzz/crash-$$t/ $(FUZZ_ARGS) build/fuzz/corpus-$$t build/fuzz/seeds-$$t; \
+	done
+fuzz-io-build: build/fuzz/fuzz_io build/fuzz/fuzz_record build/fuzz/seeds-record/tiny.staged.json
+build/fuzz/seeds-record/tiny.staged.json: tests/fuzz/seeds.sh $(TOOLS) $(B)/tests/helpers/gen_tubeman build/fuzz/record_seed
+	tests/fuzz/seeds.sh $(BIN) $(B)/tests/helpers build/fuzz build/fuzz/record_seed
+build/fuzz/record_seed: tests/fuzz/record_seed.c $(B)/libmlod.a $(B)/libmlodrt.a
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $< $(B)/libmlod.a $(B)/libmlodrt.a $(LDFLAGS) $(LDLIBS) -o $@
+build/fuzz/fuzz_io build/fuzz/fuzz_record: build/fuzz/%: build/fuzz/obj/tests/fuzz/%.o $(FUZZ_IO_OBJ) $(RT_C:%.c=build/fuzz/obj/%.o)
+	$(FUZZ_CXX) -fsanitize=fuzzer,address,undefined $^ $(LDLIBS) -pthread -o $@
+build/fuzz/obj/tests/fuzz/%.o: tests/fuzz/%.c
+	@mkdir -p $(@D)
+	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { echo "make fuzz-io needs clang with libFuzzer (Debian: clang libclang-rt-dev)" >&2; exit 1; }
+	$(FUZZ_CC) -std=c11 -pthread $(WARN) $(FUZZ_IO_FLAGS) -fsanitize=fuzzer-no-link $(CPPFLAGS) -MMD -MP -c $< -o $@
+build/fuzz/obj/lib/core/%.o: lib/core/%.c
+	@mkdir -p $(@D)
+	$(FUZZ_CC) -std=c11 -pthread $(WARN) $(FUZZ_IO_FLAGS) -fsanitize=fuzzer-no-link $(RT_CPPFLAGS) -MMD -MP -c $< -o $@
+build/fuzz/obj/lib/rt/%.o: lib/rt/%.c
+	@mkdir -p $(@D)
+	$(FUZZ_CC) -std=c11 -pthread $(WARN) $(FUZZ_IO_FLAGS) -fsanitize=fuzzer-no-link $(RT_CPPFLAGS) -MMD -MP -c $< -o $@
+build/fuzz/obj/%.o: %.c
+	@mkdir -p $(@D)
+	$(FUZZ_CC) -std=c11 -pthread $(WARN) $(FUZZ_IO_FLAGS) -fsanitize=fuzzer-no-link $(CPPFLAGS) -MMD -MP -c $< -o $@
+build/fuzz/obj/%.o: %.cpp
+	@mkdir -p $(@D)
+	$(FUZZ_CXX) -std=c++14 -pthread -Wall -Wextra $(FUZZ_IO_FLAGS) -fsanitize=fuzzer-no-link $(CPPFLAGS) -MMD -MP -c $< -o $@
 # ----------------------------------------------------------------------
 
 -include $(shell find build -name '*.d' 2>/dev/null)

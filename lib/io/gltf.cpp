@@ -793,13 +793,77 @@ std::vector<int> node_parents(const Model &m)
 	return parent;
 }
 
-/* Checks every reference mlod may follow, so later code can index freely. */
-void check_document(const Model &m)
+/* Values of accessors without a buffer view (zeros, or a sparse
+ * substitution on zeros) cost the input nothing: together they may hold at
+ * most this many values per byte of the input and its buffers, so that a
+ * few bytes cannot make mlod allocate gigabytes. (Sparse morph targets
+ * without buffer views, one per target as exporters write them, stay far
+ * below it: their meshes' positions cost 12 bytes a vertex.) */
+const size_t dataless_values_per_byte = 16;
+
+/* Each mesh primitive and morph target decodes its accessors again, and
+ * each animation channel its sampler's: elements many references share
+ * cost the input once. Together the references may reach at most this
+ * many elements per byte of the input and its buffers, so that a long list
+ * of references to one large accessor cannot make mlod allocate gigabytes.
+ * (mlod's own levels share accessors a few times over: skeleton levels
+ * share all but the skinning of their mesh.) */
+const size_t referenced_elements_per_byte = 4;
+
+void check_references(const Model &m, size_t bytes)
+{
+	size_t budget = bytes > SIZE_MAX / referenced_elements_per_byte ? SIZE_MAX : bytes * referenced_elements_per_byte;
+	size_t total = 0;
+	auto count = [&](int accessor) -> size_t {
+		return accessor >= 0 && size_t(accessor) < m.accessors.size() ? m.accessors[size_t(accessor)].count : 0;
+	};
+	auto add = [&](size_t n, const char *what, size_t i) {
+		total += n; /* each n is below max_values * (targets + 1): no overflow before the check */
+		if (total > budget)
+			fail(MLOD_ERR_NOMEM,
+			     "%s %zu: the document refers to more than %zu accessor elements (%zu bytes of input and buffers, "
+			     "accessors counted once per reference)",
+			     what, i, budget, bytes);
+	};
+	for (size_t i = 0; i < m.meshes.size(); i++)
+		for (const tinygltf::Primitive &p : m.meshes[i].primitives) {
+			auto it = p.attributes.find("POSITION");
+			add(it == p.attributes.end() ? 0 : count(it->second) * (p.targets.size() + 1), "mesh", i);
+		}
+	for (size_t i = 0; i < m.animations.size(); i++) {
+		const tinygltf::Animation &a = m.animations[i];
+		for (const tinygltf::AnimationChannel &ch : a.channels)
+			if (ch.sampler >= 0 && size_t(ch.sampler) < a.samplers.size())
+				add(count(a.samplers[size_t(ch.sampler)].input) + count(a.samplers[size_t(ch.sampler)].output),
+				    "animation", i);
+	}
+}
+
+/* Checks every reference mlod may follow, so later code can index freely.
+ * input_size: the bytes the document was read from. */
+void check_document(const Model &m, size_t input_size)
 {
 	for (size_t v = 0; v < m.bufferViews.size(); v++)
 		check_view(m, v);
 	for (size_t a = 0; a < m.accessors.size(); a++)
 		check_accessor(m, a);
+	size_t bytes = input_size;
+	for (const tinygltf::Buffer &b : m.buffers)
+		bytes += std::min(b.data.size(), max_values);
+	size_t budget = std::min(max_values, bytes * dataless_values_per_byte), dataless = 0;
+	for (size_t a = 0; a < m.accessors.size(); a++) {
+		const tinygltf::Accessor &acc = m.accessors[a];
+		if (acc.bufferView >= 0)
+			continue;
+		/* check_accessor bounded each below max_values. */
+		dataless += acc.count * size_t(layout_of(acc).components);
+		if (dataless > budget)
+			fail(MLOD_ERR_NOMEM,
+			     "accessor %zu: %zu elements without a buffer view: accessors without one may hold %zu values "
+			     "together in %zu bytes of input and buffers",
+			     a, acc.count, budget, bytes);
+	}
+	check_references(m, bytes);
 	size_t accessors = m.accessors.size();
 	for (size_t i = 0; i < m.meshes.size(); i++) {
 		for (const tinygltf::Primitive &p : m.meshes[i].primitives) {
@@ -917,7 +981,7 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 	if (asset.version.compare(0, 2, "2.") != 0 || (!asset.minVersion.empty() && asset.minVersion != "2.0"))
 		fail(MLOD_ERR_UNSUPPORTED, "glTF version %s (minimum %s) is not supported: mlod reads glTF 2.0",
 		     asset.version.c_str(), asset.minVersion.empty() ? "none" : asset.minVersion.c_str());
-	check_document(doc.model);
+	check_document(doc.model, size);
 
 	/* The data is in memory now: the document no longer refers to files. */
 	for (tinygltf::Buffer &b : doc.model.buffers)

@@ -22,7 +22,11 @@ typedef struct mlod_gltf mlod_gltf;
 
 /* Parses .glb or .gltf bytes. base_dir resolves external URIs of a .gltf
  * (may be NULL: only data: URIs are then allowed). Draco- or
- * meshopt-compressed input is MLOD_ERR_UNSUPPORTED. */
+ * meshopt-compressed input is MLOD_ERR_UNSUPPORTED. A document that would
+ * decode far more than its bytes is MLOD_ERR_NOMEM: accessors without a
+ * buffer view may hold 16 values per byte of the input and its buffers
+ * together, and the accessors that primitives, morph targets and animation
+ * channels name (each counted once per reference) 4 elements per byte. */
 mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir,
                            mlod_gltf **out, mlod_error *err);
 void mlod_gltf_free(mlod_gltf *doc);

@@ -148,13 +148,21 @@ static int rd_number(struct rd *c, const mj *o, const char *key, int required, d
 	return 1;
 }
 
+/* Is d a whole number within [lo, hi] (both within the range of long)?
+ * The range comes first: converting a double past the range of long is
+ * undefined. */
+static int whole_in(double d, double lo, double hi)
+{
+	return d >= lo && d <= hi && d == (double)(long)d;
+}
+
 static int rd_int(struct rd *c, const mj *o, const char *key, int required, double lo, double hi, long *out)
 {
 	double d = 0.0;
 	int got = rd_number(c, o, key, required, &d);
 	if (got <= 0)
 		return got;
-	if (d != (double)(long)d || d < lo || d > hi)
+	if (!whole_in(d, lo, hi))
 		return rd_fail(c, key, "not a whole number in range");
 	*out = (long)d;
 	return 1;
@@ -192,7 +200,7 @@ static int rd_ints(struct rd *c, const mj *o, const char *key, double lo, double
 	}
 	for (int i = 0; i < v->count; i++) {
 		const mj *x = &v->items[i];
-		if (x->type != MJ_NUMBER || x->number != (double)(long)x->number || x->number < lo || x->number > hi)
+		if (x->type != MJ_NUMBER || !whole_in(x->number, lo, hi))
 			return rd_fail(c, key, "holds something other than an index in range");
 		(*items)[i] = (int)x->number;
 	}
@@ -422,7 +430,7 @@ static int read_skel_level(struct rd *c, const mj *o, int nodes, int skins, mlod
 		long from = strtol(remap->keys[i], &end, 10);
 		const mj *to = &remap->items[i];
 		if (end == remap->keys[i] || *end || from < 0 || from >= nodes || to->type != MJ_NUMBER ||
-		    to->number != (double)(long)to->number || to->number < -1 || to->number >= nodes)
+		    !whole_in(to->number, -1, nodes - 1))
 			return rd_fail(c, "remap", "holds something other than node -> node");
 		l->remap_from[i] = (int)from;
 		l->remap_to[i] = (int)to->number;

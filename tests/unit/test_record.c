@@ -303,6 +303,16 @@ TEST(old_new_and_malformed)
 		 "mesh_levels[0].triangles: not a whole number in range"},
 		{"{\"mesh_levels\":[{\"level\":1,\"ratio\":0.5,\"triangles\":1,\"vertices\":3,\"error_percent\":{}}]}",
 		 "mesh_levels[0].error_percent.max: missing"},
+		/* Numbers past the range of long (found by make fuzz-io: converting
+		 * them was undefined behaviour before the range check). */
+		{"{\"version\":1e88}", "extras.mlod.version: not a whole number in range"},
+		{"{\"version\":-1e300}", "extras.mlod.version: not a whole number in range"},
+		{"{\"skeleton_levels\":[{\"level\":1,\"threshold\":0,\"joints\":1,\"kept\":[1e88],\"skins\":[0],"
+		 "\"joint_error\":{\"max\":0,\"mean\":0},\"remap\":{}}]}",
+		 "skeleton_levels[0].kept: holds something other than an index in range"},
+		{"{\"skeleton_levels\":[{\"level\":1,\"threshold\":0,\"joints\":1,\"kept\":[0],\"skins\":[0],"
+		 "\"joint_error\":{\"max\":0,\"mean\":0},\"remap\":{\"1\":-1e88}}]}",
+		 "skeleton_levels[0].remap: holds something other than node -> node"},
 	};
 	for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
 		mlod_result r = read_scene(doc, bad[i].text, &e);
