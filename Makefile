@@ -28,10 +28,10 @@ CPPFLAGS += -Ilib -Ilib/core
 RT_CPPFLAGS := -Ilib/core -Ilib/rt
 CFLAGS_release := -O2 -g
 CFLAGS_debug := -O0 -g3
-CFLAGS_sanitize := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+CFLAGS_sanitize := -O1 -g -fsanitize=address,undefined,float-cast-overflow -fno-omit-frame-pointer -fno-sanitize-recover=undefined,float-cast-overflow
 CFLAGS += -std=c11 -pthread $(WARN) $(CFLAGS_$(config))
 CXXFLAGS += -std=c++14 -pthread -Wall -Wextra $(CFLAGS_$(config))
-LDFLAGS_sanitize := -fsanitize=address,undefined
+LDFLAGS_sanitize := -fsanitize=address,undefined,float-cast-overflow
 LDFLAGS += -pthread $(LDFLAGS_$(config))
 # meshoptimizer's codecs (the pack writer's encoder, the runtime's decoder) and
 # Draco's core mesh codec (lib/pack/draco.cpp); -ltinygltf before -ldraco;
