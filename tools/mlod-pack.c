@@ -434,9 +434,6 @@ int main(int argc, char **argv)
 			tool_usage_error("-x and --report do not go together");
 		return pack_extract(extract, output);
 	}
-	if (opt.codec == MLOD_CODEC_DRACO)
-		tool_die(EXIT_UNSUPPORTED, NULL, "--codec draco: not built yet (use meshopt or none)");
-
 	const char *path = optind < argc ? argv[optind] : NULL;
 	const char *label = tool_input_label(path);
 	char namebuf[256];
