@@ -28,6 +28,7 @@ CFLAGS_release := -O2 -g
 CFLAGS_debug := -O0 -g3
 CFLAGS_sanitize := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 CFLAGS += -std=c11 -pthread $(WARN) $(CFLAGS_$(config))
+# (MLOD_DRACO: set below; the unit tests see it to know the runtime they link)
 CXXFLAGS += -std=c++14 -pthread -Wall -Wextra $(CFLAGS_$(config))
 LDFLAGS_sanitize := -fsanitize=address,undefined
 LDFLAGS += -pthread $(LDFLAGS_$(config))
@@ -41,6 +42,7 @@ LDLIBS := -ltinygltf -lmeshoptimizer -ldraco -lzstd -lstdc++ -lm
 # lib/rt may hold; MLOD_DRACO=0 gives a runtime that refuses Draco chunks
 # as unsupported (built under build/$(config)-nodraco).
 MLOD_DRACO ?= 1
+CPPFLAGS += -DMLOD_DRACO=$(MLOD_DRACO)
 ifeq ($(MLOD_DRACO),1)
 B := build/$(config)
 else
