@@ -114,7 +114,7 @@ RT_LDLIBS := -lmeshoptimizer -ldraco -lzstd -lstdc++ -lm
 endif
 $(B)/tests/rt/%: tests/rt/%.c $(B)/libmlodrt.a
 	@mkdir -p $(@D)
-	$(CC) $(RT_CPPFLAGS) $(CFLAGS) $(LDFLAGS) $^ $(RT_LDLIBS) -o $@
+	$(CC) $(RT_CPPFLAGS) -DMLOD_DRACO=$(MLOD_DRACO) $(CFLAGS) $(LDFLAGS) $^ $(RT_LDLIBS) -o $@
 
 $(B)/%.o: %.c
 	@mkdir -p $(@D)
