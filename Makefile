@@ -30,6 +30,7 @@ CFLAGS_release := -O2 -g
 CFLAGS_debug := -O0 -g3
 CFLAGS_sanitize := -O1 -g -fsanitize=address,undefined,float-cast-overflow -fno-omit-frame-pointer -fno-sanitize-recover=undefined,float-cast-overflow
 CFLAGS += -std=c11 -pthread $(WARN) $(CFLAGS_$(config))
+# (MLOD_DRACO: set below; the unit tests see it to know the runtime they link)
 CXXFLAGS += -std=c++14 -pthread -Wall -Wextra $(CFLAGS_$(config))
 LDFLAGS_sanitize := -fsanitize=address,undefined,float-cast-overflow
 LDFLAGS += -pthread $(LDFLAGS_$(config))
@@ -38,7 +39,17 @@ LDFLAGS += -pthread $(LDFLAGS_$(config))
 # zstd (libzstd-dev), the pack's entropy stage (writer and reader).
 LDLIBS := -ltinygltf -lmeshoptimizer -ldraco -lzstd -lstdc++ -lm
 
+# MLOD_DRACO=1 (the default; libdraco-dev is in scripts/install-deps)
+# builds the runtime's Draco decode, lib/rt/rt_draco.cpp, the one C++ file
+# lib/rt may hold; MLOD_DRACO=0 gives a runtime that refuses Draco chunks
+# as unsupported (built under build/$(config)-nodraco).
+MLOD_DRACO ?= 1
+CPPFLAGS += -DMLOD_DRACO=$(MLOD_DRACO)
+ifeq ($(MLOD_DRACO),1)
 B := build/$(config)
+else
+B := build/$(config)-nodraco
+endif
 BIN := $(B)/bin
 
 LIB_PARTS := core model io measure skeleton mesh motion record pack
@@ -47,6 +58,14 @@ LIB_CXX := $(sort $(foreach p,$(LIB_PARTS),$(wildcard lib/$(p)/*.cpp)))
 LIB_OBJ := $(LIB_C:%.c=$(B)/%.o) $(LIB_CXX:%.cpp=$(B)/%.o)
 RT_C := $(sort $(wildcard lib/rt/*.c))
 RT_OBJ := $(RT_C:%.c=$(B)/%.o)
+# No C++ in lib/rt but the Draco shim.
+RT_FOREIGN := $(filter-out lib/rt/rt_draco.cpp,$(wildcard lib/rt/*.cpp lib/rt/*.cc lib/rt/*.cxx lib/rt/*.C))
+ifneq ($(RT_FOREIGN),)
+$(error lib/rt is C only but for lib/rt/rt_draco.cpp: $(RT_FOREIGN))
+endif
+ifeq ($(MLOD_DRACO),1)
+RT_OBJ += $(B)/lib/rt/rt_draco.o
+endif
 TOOL_NAMES := $(notdir $(basename $(sort $(wildcard tools/mlod-*.c))))
 TOOL_COMMON_OBJ := $(B)/tools/common.o
 TOOLS := $(TOOL_NAMES:%=$(BIN)/%)
@@ -80,16 +99,24 @@ $(B)/lib/core/%.o: lib/core/%.c
 
 $(B)/lib/rt/%.o: lib/rt/%.c
 	@mkdir -p $(@D)
-	$(CC) $(RT_CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
+	$(CC) $(RT_CPPFLAGS) -DMLOD_DRACO=$(MLOD_DRACO) $(CFLAGS) -MMD -MP -c $< -o $@
+
+# The Draco shim: the runtime's include path, Draco's core decoder only.
+$(B)/lib/rt/rt_draco.o: lib/rt/rt_draco.cpp
+	@mkdir -p $(@D)
+	$(CXX) $(RT_CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@
 
 # Runtime test programs link libmlodrt.a alone: no tinygltf, no C++, no
 # libmlod. A bake-side symbol in the runtime fails this link.
 RT_TEST_SRC := $(sort $(wildcard tests/rt/*.c))
 RT_TESTS := $(RT_TEST_SRC:tests/rt/%.c=$(B)/tests/rt/%)
 RT_LDLIBS := -lmeshoptimizer -lzstd -lm
+ifeq ($(MLOD_DRACO),1)
+RT_LDLIBS := -lmeshoptimizer -ldraco -lzstd -lstdc++ -lm
+endif
 $(B)/tests/rt/%: tests/rt/%.c $(B)/libmlodrt.a
 	@mkdir -p $(@D)
-	$(CC) $(RT_CPPFLAGS) $(CFLAGS) $(LDFLAGS) $^ $(RT_LDLIBS) -o $@
+	$(CC) $(RT_CPPFLAGS) -DMLOD_DRACO=$(MLOD_DRACO) $(CFLAGS) $(LDFLAGS) $^ $(RT_LDLIBS) -o $@
 
 $(B)/%.o: %.c
 	@mkdir -p $(@D)

@@ -28,7 +28,9 @@ static const char usage_text[] =
 	"  -r, --report[=FORMAT]      print what was packed (to stdout: with -o as\n"
 	"                             well as the pack, else instead of it); FORMAT\n"
 	"                             is table or json\n"
-	"      --codec NAME           meshopt (default) or none (draco: not built yet)\n"
+	"      --codec NAME           meshopt (default), none, or draco (MESH levels as\n"
+	"                             standalone Draco meshes: larger packs, slower\n"
+	"                             to decode; mlod(5))\n"
 	"      --entropy NAME         zstd (default): each chunk but INFO through\n"
 	"                             zstd -19 after its codec where that stores\n"
 	"                             fewer bytes (skeleton and finer mesh levels\n"
@@ -442,9 +444,6 @@ int main(int argc, char **argv)
 			tool_usage_error("-x and --report do not go together");
 		return pack_extract(extract, output);
 	}
-	if (opt.codec == MLOD_CODEC_DRACO)
-		tool_die(EXIT_UNSUPPORTED, NULL, "--codec draco: not built yet (use meshopt or none)");
-
 	const char *path = optind < argc ? argv[optind] : NULL;
 	const char *label = tool_input_label(path);
 	char namebuf[256];

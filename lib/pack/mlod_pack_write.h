@@ -65,7 +65,8 @@ extern "C" {
 /* Zero-initialised options are not the defaults: start from
  * mlod_pack_options_default. */
 typedef struct mlod_pack_options {
-	mlod_pack_codec codec;       /* NONE or MESHOPT (DRACO: MLOD_ERR_UNSUPPORTED) */
+	mlod_pack_codec codec;       /* NONE, MESHOPT or DRACO (MESH chunks as Draco
+	                              * meshes, the other chunks MESHOPT; mlod(5)) */
 	int entropy;                 /* MLOD_ENTROPY_ZSTD (the default) or _NONE: each
 	                              * chunk but INFO through zstd -19 after its codec,
 	                              * kept where it stores fewer bytes (mlod(5)) */
@@ -122,8 +123,10 @@ typedef struct mlod_pack_stats {
 
 /* Packs the character c read from doc (mlod_load of input, input_size
  * bytes, in format). *out (release with mlod_free) gets the pack. stats
- * may be NULL. Errors: MLOD_ERR_UNSUPPORTED for the draco codec,
- * MLOD_ERR_PARSE for a malformed record, what the layers return. */
+ * may be NULL. Errors: MLOD_ERR_UNSUPPORTED for a part the draco codec
+ * cannot hold (no triangles, more than 256 morph targets, or counts Draco
+ * does not give back), MLOD_ERR_PARSE for a malformed record, what the
+ * layers return. */
 mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_format format, const void *input,
                             size_t input_size, const mlod_pack_options *opt, void **out, size_t *out_size,
                             mlod_pack_stats *stats, mlod_error *err);

@@ -12,6 +12,7 @@
 #include <meshoptimizer.h>
 #include <zstd.h>
 
+#include "pack/draco.h"
 #include "pack/mlod_pack_write.h"
 #include "record/mlod_record.h"
 
@@ -316,6 +317,10 @@ nomem:
  * container is at most the raw size (the reader's bound). Deterministic:
  * one-shot compression, one thread, the frame with its content size. */
 #define PACK_ZSTD_LEVEL 19
+/* Draco's speed option (0 smallest .. 10 fastest), for encoding and decoding. */
+#ifndef MLOD_PACK_DRACO_SPEED
+#define MLOD_PACK_DRACO_SPEED 0
+#endif
 
 /* prefix (format 6.0): a MESH level's (but the coarsest's), the coarser
  * MESH levels' containers, coarsest first; a skeleton level's, SKELETON's
@@ -402,7 +407,9 @@ struct ctx {
 	const mlod_gltf *doc;
 	const mlod_character *in;
 	mlod_format format;
-	const mlod_pack_options *opt;
+	const mlod_pack_options *opt; /* codec draco: opt's copy with codec meshopt (the other chunks') */
+	int draco;                    /* --codec draco: MESH chunks are Draco meshes (draco_level) */
+	mlod_result draco_fail;       /* draco_level's failure (its message in err) */
 	mlod_pack_stats *st;
 	mlod_error *err;
 	mlod_record rec;
@@ -1521,6 +1528,92 @@ size_t mlod_pack_index_cost(const uint32_t *idx, uint32_t ni, uint32_t count0, u
 	return cost;
 }
 
+/* Codec draco (mlod(5)): level k of a part as one Draco mesh of its own
+ * (layout a: the nused vertices map[] of the part's buffer, in that
+ * numbering, and the triangles lidx), every attribute the stream's
+ * quantised integers (lossless), coded by edgebreaker; the sequential
+ * coder where edgebreaker does not give back exactly nused vertices and
+ * ni / 3 triangles (it splits non-manifold vertices and drops degenerate
+ * triangles), which the reader requires. Adds 'DRCO', then 'MTSC' with
+ * morph targets. 0 on failure (x->draco_fail and the message set, or out
+ * of memory: cb->fail). */
+static int draco_level(struct ctx *x, chunkb *cb, const struct mpart *m, const uint32_t *map, uint32_t nused,
+                       const uint32_t *lidx, uint32_t ni)
+{
+	mlod_draco_attr at[8 + MLOD_PACK_MAX_UV + 256];
+	int na = m->nattr, ok = 0;
+	if (nused == 0 || ni == 0 || na > (int)(sizeof at / sizeof at[0])) {
+		x->draco_fail = mlod_fail(x->err, MLOD_ERR_UNSUPPORTED,
+		                          "codec draco: a part of %u vertices, %u indices and %d attributes (Draco parts "
+		                          "need triangles and at most 256 morph targets)",
+		                          nused, ni, m->ntargets);
+		return 0;
+	}
+	memset(at, 0, sizeof at);
+	for (int a = 0; a < na; a++) {
+		const mattr *ma = &m->attr[a];
+		int bytes = 2, comps;
+		if (ma->size == 8)
+			comps = ma->tag == MLOD_STREAM_POSQ || ma->tag == MLOD_STREAM_MTPQ ? 3 : 4;
+		else if (ma->tag == MLOD_STREAM_COLQ || ma->tag == MLOD_STREAM_JNT8 || ma->tag == MLOD_STREAM_WGT8)
+			bytes = 1, comps = 4;
+		else
+			comps = 2;
+		at[a].kind = ma->tag == MLOD_STREAM_POSQ ? MLOD_DRACO_POSITION : MLOD_DRACO_GENERIC;
+		at[a].type = bytes == 1 ? MLOD_DRACO_U8 : MLOD_DRACO_U16;
+		at[a].components = comps;
+		uint8_t *d = malloc((size_t)nused * (size_t)(comps * bytes) + 1);
+		if (!d)
+			goto done;
+		for (uint32_t v = 0; v < nused; v++)
+			memcpy(d + (size_t)v * (size_t)(comps * bytes), m->G + (size_t)map[v] * (size_t)m->stride + ma->off,
+			       (size_t)(comps * bytes));
+		at[a].data = d;
+	}
+	for (int sequential = 0; sequential < 2 && !ok; sequential++) {
+		void *enc = NULL;
+		size_t size = 0;
+		mlod_error e2;
+		mlod_result r = mlod_draco_encode((int)nused, at, na, lidx, (int)ni, sequential, MLOD_PACK_DRACO_SPEED, &enc,
+		                                  &size, &e2);
+		if (r == MLOD_ERR_NOMEM)
+			goto done;
+		if (r != MLOD_OK)
+			continue;
+		/* What the reader checks: exactly these counts back. */
+		mlod_draco_attr back[8 + MLOD_PACK_MAX_UV + 256];
+		memcpy(back, at, sizeof(mlod_draco_attr) * (size_t)na);
+		int bv = 0, bi = 0;
+		uint32_t *bix = NULL;
+		r = mlod_draco_decode(enc, size, back, na, &bv, &bix, &bi, &e2);
+		if (r == MLOD_OK) {
+			for (int a = 0; a < na; a++)
+				mlod_free(back[a].data);
+			mlod_free(bix);
+		}
+		if (r == MLOD_OK && bv == (int)nused && bi == (int)ni) {
+			cb_add(cb, MLOD_STREAM_DRCO, (uint32_t)size, 1, enc, 0);
+			if (m->ntargets)
+				cb_add(cb, MLOD_STREAM_MTSC, (uint32_t)m->ntargets, 4, m->tscale, 0);
+			ok = 1;
+		}
+		mlod_free(enc);
+		if (r == MLOD_ERR_NOMEM)
+			goto done;
+	}
+	if (!ok)
+		x->draco_fail = mlod_fail(x->err, MLOD_ERR_UNSUPPORTED,
+		                          "codec draco: a part of %u vertices and %u triangles does not come back from Draco "
+		                          "with those counts, by edgebreaker or the sequential coder",
+		                          nused, ni / 3);
+done:
+	for (int a = 0; a < na; a++)
+		free(at[a].data);
+	if (!ok && !x->draco_fail)
+		cb->fail = 1;
+	return ok;
+}
+
 /* Level k of one part: appends its new vertices (in the order of the
  * writer's that codes the block and the indices to the fewest bytes; the
  * input order with codec none) and adds their streams, with the indices
@@ -1551,7 +1644,7 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	part_quantise(x, m, k, V);
 	uint32_t count0 = m->count;
 	int best = 0;
-	if (x->opt->codec == MLOD_CODEC_MESHOPT) {
+	if (x->opt->codec == MLOD_CODEC_MESHOPT && !x->draco) {
 		size_t best_bytes = 0;
 		/* Each vertex's class once (part_append's cls), the hash set
 		 * then as it was: the orders tried need no hashing. */
@@ -1582,6 +1675,16 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 		goto done;
 	/* The vertices the level uses: what a reader gathers from the prefix. */
 	size_t st;
+	if (x->draco) {
+		local_form(idx, ni, f.seen, f.map, &f.nused, f.lidx);
+		if (!draco_level(x, cb, m, f.map, f.nused, f.lidx, ni))
+			goto done;
+		*rec = m->rec;
+		rec->vertex_count = f.nused;
+		rec->index_count = ni;
+		ok = 1;
+		goto done;
+	}
 	if (x->opt->codec == MLOD_CODEC_MESHOPT)
 		index_bytes(idx, ni, count0, m->count, &f, &local, &st);
 	else
@@ -1629,7 +1732,12 @@ static mlod_result mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count
 	}
 	free(recs);
 	*part_count = np;
-	return cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_MESH, MLOD_LAYER_MESH, k, 0, k > 0 ? x->mesh_error[k - 1] : 0.0f,
+	if (x->draco && x->draco_fail) {
+		cb_free(&cb);
+		return x->draco_fail;
+	}
+	return cb_finish(&cb, x->draco ? MLOD_CODEC_DRACO : x->opt->codec, out, MLOD_CHUNK_MESH, MLOD_LAYER_MESH, k, 0,
+	                 k > 0 ? x->mesh_error[k - 1] : 0.0f,
 	                 x->err);
 }
 
@@ -2723,9 +2831,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_write: c, opt, out and out_size must not be NULL");
 	*out = NULL;
 	*out_size = 0;
-	if (opt->codec == MLOD_CODEC_DRACO)
-		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "the draco codec is not built yet");
-	if (opt->codec != MLOD_CODEC_NONE && opt->codec != MLOD_CODEC_MESHOPT)
+	if (opt->codec != MLOD_CODEC_NONE && opt->codec != MLOD_CODEC_MESHOPT && opt->codec != MLOD_CODEC_DRACO)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "unknown codec %d", (int)opt->codec);
 	if (opt->entropy != MLOD_ENTROPY_NONE && opt->entropy != MLOD_ENTROPY_ZSTD)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "unknown entropy stage %d", opt->entropy);
@@ -2733,7 +2839,12 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	x.doc = doc;
 	x.in = c;
 	x.format = format;
-	x.opt = opt;
+	/* Draco codes the MESH chunks; the other chunks take meshopt. */
+	mlod_pack_options mopt = *opt;
+	x.draco = opt->codec == MLOD_CODEC_DRACO;
+	if (x.draco)
+		mopt.codec = MLOD_CODEC_MESHOPT;
+	x.opt = &mopt;
 	x.st = stats ? stats : &local_stats;
 	x.err = err;
 	memset(x.st, 0, sizeof *x.st);
@@ -2870,7 +2981,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	for (int i = body.n - 1; opt->entropy == MLOD_ENTROPY_ZSTD && i >= 0; i--) {
 		size_t np = 0;
 		uint8_t *pre = NULL;
-		if (body.c[i].type == MLOD_CHUNK_MESH) {
+		if (body.c[i].type == MLOD_CHUNK_MESH && body.c[i].codec != MLOD_CODEC_DRACO) { /* Draco: standalone */
 			for (int j = 0; j < i; j++)
 				if (body.c[j].type == MLOD_CHUNK_MESH)
 					np += body.c[j].size;

@@ -360,6 +360,7 @@ typedef enum mlod_pack_codec {
 #define MLOD_STREAM_IMAP MLOD_FOURCC('I', 'M', 'A', 'P')
 #define MLOD_STREAM_MTSC MLOD_FOURCC('M', 'T', 'S', 'C')
 #define MLOD_STREAM_MTPQ MLOD_FOURCC('M', 'T', 'P', 'Q')
+#define MLOD_STREAM_DRCO MLOD_FOURCC('D', 'R', 'C', 'O') /* a part's level as one Draco mesh (codec draco) */
 #define MLOD_STREAM_CHAN MLOD_FOURCC('C', 'H', 'A', 'N')
 #define MLOD_STREAM_STEP MLOD_FOURCC('S', 'T', 'E', 'P')
 #define MLOD_STREAM_TIME MLOD_FOURCC('T', 'I', 'M', 'E')

@@ -34,6 +34,9 @@
 #include <zstd.h>
 
 #include "mlod_pack.h"
+#if MLOD_DRACO
+#include "rt_draco.h"
+#endif
 
 /* The reader's allocations, all through the pack's allocator: zeroed. */
 static void *pk_calloc(const mlod_pack_alloc *a, size_t n, size_t size)
@@ -404,6 +407,9 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		           !(c->type == MLOD_CHUNK_SKELETON && c->level > 0)) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): the zstd prefix stage is for MESH and skeleton "
 			              "levels only (the chunks they need are its prefix)", i, label);
+		} else if (c->entropy == MLOD_ENTROPY_ZSTD_PREFIX && c->codec == MLOD_CODEC_DRACO) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): a Draco chunk stands alone: no zstd prefix stage", i,
+			              label);
 		} else if (c->entropy && c->type == MLOD_CHUNK_INFO) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): INFO has no entropy stage", i, label);
 		} else if (c->entropy && (c->coded_size < 4 || c->coded_size > c->raw_size)) {
@@ -595,9 +601,13 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: chunk %u is %s, not a %s chunk", index, x->label,
 		                 mlod_pack_type_name(type));
 	}
+#if !MLOD_DRACO
 	if (c->codec == MLOD_CODEC_DRACO)
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: Draco chunks need the Draco decoder, not built in", x->label);
-	if (c->codec != MLOD_CODEC_NONE && c->codec != MLOD_CODEC_MESHOPT)
+#endif
+	if (c->codec == MLOD_CODEC_DRACO && c->type != MLOD_CHUNK_MESH) /* open refuses it; a caller's TOC may not */
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the Draco codec is for MESH chunks only", x->label);
+	if (c->codec != MLOD_CODEC_NONE && c->codec != MLOD_CODEC_MESHOPT && c->codec != MLOD_CODEC_DRACO)
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: unknown chunk codec %u", x->label, c->codec);
 	if (c->entropy != MLOD_ENTROPY_NONE && c->entropy != MLOD_ENTROPY_ZSTD && c->entropy != MLOD_ENTROPY_ZSTD_PREFIX)
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%s: unknown entropy stage %u", x->label, c->entropy);
@@ -1534,6 +1544,246 @@ static mlod_result mesh_begin(const mesh_src *m, uint32_t index, const uint8_t *
 	return cx_parse(x, err);
 }
 
+/* Dequantises a decoded part: gather holds its vertex attributes (as
+ * part_vstreams lists them) one after the other, each vertex_count
+ * elements, then its targets' 'MTPQ' elements the same way; scales the
+ * targets' (pt->targets allocated). Takes the arrays from *bp. */
+static mlod_result part_dequant(const char *label, bump *bp, mlod_pack_part *pt, uint32_t i, const uint8_t *gather,
+                                const float *scales, const mlod_pack_skeleton *skel, mlod_error *err)
+{
+	bump b = *bp;
+	struct {
+		const char *label;
+	} x = {label};
+	mlod_result r = MLOD_OK;
+	const mlod_pack_part_rec *rc = &pt->rec;
+	uint32_t V = rc->vertex_count, T = rc->target_count;
+	uint32_t size[VSTREAMS_MAX], tag[VSTREAMS_MAX];
+	int nvs = part_vstreams(rc, tag, size);
+	const uint8_t *g[VSTREAMS_MAX] = {0};
+	(void)tag;
+	{
+		size_t off = 0;
+		for (int c = 0; c < nvs; c++)
+			g[c] = gather + off, off += (size_t)V * size[c];
+	}
+	/* Dequantise. */
+	int a = 0;
+	const uint8_t *q = g[a++];
+	TAKE(pt->positions, (uint64_t)V * 12);
+	for (uint32_t v = 0; v < V; v++)
+		for (int c = 0; c < 3; c++)
+			pt->positions[3 * v + c] = rc->pos_min[c] + rd16(q + 8 * (size_t)v + 2 * c) * rc->pos_scale[c];
+	if (rc->flags & MLOD_PART_NORMALS) {
+		q = g[a++];
+		TAKE(pt->normals, (uint64_t)V * 12);
+		for (uint32_t v = 0; v < V; v++)
+			oct_decode(rdi16(q + 4 * (size_t)v), rdi16(q + 4 * (size_t)v + 2), pt->normals + 3 * (size_t)v);
+	}
+	if (rc->flags & MLOD_PART_TANGENTS) {
+		q = g[a++];
+		TAKE(pt->tangents, (uint64_t)V * 16);
+		for (uint32_t v = 0; v < V; v++) {
+			const uint8_t *e = q + 8 * (size_t)v;
+			int16_t w = rdi16(e + 4);
+			if (w != 32767 && w != -32767)
+				FAIL("%s: part %u: vertex %u: tangent handedness %d is not -32767 or 32767", x.label, i, v, w);
+			oct_decode(rdi16(e), rdi16(e + 2), pt->tangents + 4 * (size_t)v);
+			pt->tangents[4 * (size_t)v + 3] = w > 0 ? 1.0f : -1.0f;
+		}
+	}
+	for (uint32_t t = 0; t < rc->uv_sets; t++) {
+		q = g[a++];
+		TAKE(pt->uvs[t], (uint64_t)V * 8);
+		for (uint32_t v = 0; v < V; v++)
+			for (int c = 0; c < 2; c++)
+				pt->uvs[t][2 * (size_t)v + c] =
+				        rc->uv_min[t][c] + rd16(q + 4 * (size_t)v + 2 * c) * rc->uv_scale[t][c];
+	}
+	if (rc->flags & MLOD_PART_COLORS) {
+		q = g[a++];
+		TAKE(pt->colors, (uint64_t)V * 16);
+		for (size_t k = 0; k < (size_t)V * 4; k++)
+			pt->colors[k] = q[k] / 255.0f;
+	}
+	if (rc->flags & MLOD_PART_SKINNED) {
+		int j16 = (rc->flags & MLOD_PART_JOINTS16) != 0;
+		uint32_t skin_joints = skel->skins[rc->skin].joint_count;
+		q = g[a++];
+		TAKE(pt->joints, (uint64_t)V * 8);
+		for (size_t k = 0; k < (size_t)V * 4; k++) {
+			uint16_t jv = j16 ? rd16(q + 2 * k) : q[k];
+			if (jv >= skin_joints)
+				FAIL("%s: part %u: vertex %zu: joint %u is not below skin %d's %u joints", x.label, i, k / 4,
+				     jv, rc->skin, skin_joints);
+			pt->joints[k] = jv;
+		}
+		q = g[a++];
+		TAKE(pt->weights, (uint64_t)V * 16);
+		for (uint32_t v = 0; v < V; v++) {
+			const uint8_t *e = q + 4 * (size_t)v;
+			unsigned sum = (unsigned)e[0] + e[1] + e[2] + e[3];
+			if (sum != 255)
+				FAIL("%s: part %u: vertex %u: weights sum to %u, not 255", x.label, i, v, sum);
+			for (int c = 0; c < 4; c++)
+				pt->weights[4 * (size_t)v + c] = e[c] / 255.0f;
+		}
+	}
+	q = gather;
+	for (int c = 0; c < nvs; c++)
+		q += (size_t)V * size[c];
+	for (uint32_t t = 0; t < T; t++) {
+		TAKE(pt->targets[t], (uint64_t)V * 12);
+		const uint8_t *e = q + (size_t)t * V * 8;
+		for (uint32_t v = 0; v < V; v++)
+			for (int c = 0; c < 3; c++)
+				pt->targets[t][3 * (size_t)v + c] = rdi16(e + 8 * (size_t)v + 2 * c) * scales[t];
+	}
+fail:
+	*bp = b;
+	return r;
+}
+
+#if MLOD_DRACO
+/* A part's attribute in a Draco mesh (mlod(5), codec draco): the stream's
+ * element as components of 1 or 2 bytes; 'POSQ' and 'MTPQ' drop their
+ * fourth (zero) component. */
+static void draco_comp(uint32_t tag, uint32_t elsize, int *components, int *bytes)
+{
+	if (elsize == 8) {
+		*bytes = 2;
+		*components = tag == MLOD_STREAM_POSQ || tag == MLOD_STREAM_MTPQ ? 3 : 4;
+	} else if (tag == MLOD_STREAM_COLQ || tag == MLOD_STREAM_JNT8 || tag == MLOD_STREAM_WGT8) {
+		*bytes = 1, *components = 4;
+	} else {
+		*bytes = 2, *components = 2;
+	}
+}
+
+/* A MESH level of codec draco: stands alone (no coarser chunk is read).
+ * 'PART', then per part 'DRCO' (its level as one Draco mesh) and, with
+ * morph targets, 'MTSC'. */
+static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const mlod_pack_skeleton *skel,
+                                     mlod_pack_mesh *out, mlod_error *err)
+{
+	const mlod_pack *p = m->p;
+	const mlod_pack_alloc *al = &p->alloc;
+	cx x;
+	memset(&x, 0, sizeof x);
+	bump b = {0};
+	stream s, sp;
+	const uint8_t *src;
+	mlod_pack_part_rec *recs = NULL;
+	uint8_t *gather = NULL;
+	uint32_t J = skel ? skel->joint_count : 0, S = skel ? skel->skin_count : 0;
+	mlod_result r = mesh_begin(m, chunk, NULL, 0, &x, err);
+	if (r != MLOD_OK) {
+		cx_done(&x);
+		return r;
+	}
+	TRY(cx_expect(&x, &sp, MLOD_STREAM_PART, sizeof(mlod_pack_part_rec), UINT64_MAX, "", "", err));
+	if (sp.codec != MLOD_SCODEC_RAW)
+		FAIL("%s: 'PART' is not stored raw in a Draco chunk", x.label);
+	uint64_t P = sp.count; /* raw: its bytes are inside the chunk */
+	TRY(cx_load(&x, &sp, &src, err));
+	if (!(recs = pk_calloc(al, P + 1, sizeof *recs)))
+		FAIL("%s: out of memory for %llu parts", x.label, (unsigned long long)P);
+	for (uint64_t i = 0; i < P; i++)
+		memcpy(&recs[i], src + i * sizeof *recs, sizeof *recs);
+	/* The records bound every allocation before Draco decodes anything. */
+	uint64_t total = round8(P * sizeof(mlod_pack_part)), big = 8;
+	for (uint32_t i = 0; i < P; i++) {
+		const mlod_pack_part_rec *rc = &recs[i];
+		TRY(check_part_rec(&x, i, rc, J, S, err));
+		if (rc->flags & (MLOD_PART_INDEX16 | MLOD_PART_LOCAL | MLOD_PART_NEWBITS))
+			FAIL("%s: part %u: flags 0x%x: INDEX16, LOCAL and NEWBITS are not for a Draco chunk", x.label, i,
+			     rc->flags);
+		if (rc->vertex_count == 0 || rc->index_count == 0)
+			FAIL("%s: part %u: %u vertices and %u indices: a Draco part has triangles", x.label, i, rc->vertex_count,
+			     rc->index_count);
+		uint64_t V = rc->vertex_count, T = rc->target_count;
+		uint32_t f = rc->flags, tag[VSTREAMS_MAX], size[VSTREAMS_MAX];
+		int nv = part_vstreams(rc, tag, size);
+		uint64_t stride = 8 * T;
+		for (int a = 0; a < nv; a++)
+			stride += size[a];
+		total += round8(V * 12);
+		total += (f & MLOD_PART_NORMALS) ? round8(V * 12) : 0;
+		total += (f & MLOD_PART_TANGENTS) ? round8(V * 16) : 0;
+		total += (uint64_t)rc->uv_sets * round8(V * 8);
+		total += (f & MLOD_PART_COLORS) ? round8(V * 16) : 0;
+		total += (f & MLOD_PART_SKINNED) ? round8(V * 8) + round8(V * 16) : 0;
+		total += round8((uint64_t)rc->index_count * 4);
+		if (T)
+			total += round8(T * sizeof(float *)) + round8(T * 4) + T * round8(V * 12);
+		big = V * stride > big ? V * stride : big;
+		if (total > PACK_MAX_BLOCK || big > PACK_MAX_BLOCK)
+			FAIL("%s: decoded, its parts need more than the reader's limit", x.label);
+	}
+	TRY(bump_alloc(&b, &x, total, err));
+	if (!(gather = pk_malloc(al, 1, (size_t)big)))
+		FAIL("%s: out of memory", x.label);
+	mlod_pack_part *parts = bump_take(&b, P * sizeof *parts);
+	if (!parts)
+		FAIL("%s: internal block size mismatch", x.label);
+	for (uint32_t i = 0; i < P; i++) {
+		mlod_pack_part *pt = &parts[i];
+		pt->rec = recs[i];
+		const mlod_pack_part_rec *rc = &pt->rec;
+		uint32_t V = rc->vertex_count, T = rc->target_count, tag[VSTREAMS_MAX], size[VSTREAMS_MAX];
+		int nv = part_vstreams(rc, tag, size);
+		char what[32];
+		snprintf(what, sizeof what, "part %u", i);
+		TRY(cx_expect(&x, &s, MLOD_STREAM_DRCO, 1, UINT64_MAX, what, "", err));
+		if (s.codec != MLOD_SCODEC_RAW)
+			FAIL("%s: part %u: 'DRCO' is not stored raw", x.label, i);
+		stream dr = s;
+		mlod_rt_draco_attr at[VSTREAMS_MAX + 256];
+		if (T > 256)
+			FAIL("%s: part %u: %u morph targets, more than a Draco part's 256", x.label, i, T);
+		size_t off = 0;
+		for (int a = 0; a < nv + (int)T; a++) {
+			uint32_t es = a < nv ? size[a] : 8, tg = a < nv ? tag[a] : MLOD_STREAM_MTPQ;
+			draco_comp(tg, es, &at[a].components, &at[a].elsize);
+			at[a].dst = gather + off;
+			at[a].stride = es;
+			off += (size_t)V * es;
+		}
+		memset(gather, 0, off); /* the dropped fourth components */
+		TAKE(pt->indices, (uint64_t)rc->index_count * 4);
+		char msg[160];
+		if (mlod_rt_draco_decode(dr.src, dr.stored, V, rc->index_count, at, nv + (int)T, pt->indices, msg,
+		                         sizeof msg) != 0)
+			FAIL("%s: part %u: %s", x.label, i, msg);
+		float *scales = NULL;
+		if (T) {
+			TRY(cx_expect(&x, &s, MLOD_STREAM_MTSC, 4, T, what, "target count", err));
+			TRY(cx_load(&x, &s, &src, err));
+			TAKE(pt->targets, (uint64_t)T * sizeof(float *));
+			TAKE(scales, (uint64_t)T * 4);
+			memcpy(scales, src, (size_t)T * 4);
+			for (uint32_t t = 0; t < T; t++)
+				if (!(scales[t] >= 0) || !isfinite(scales[t] * 32768.0f))
+					FAIL("%s: part %u: morph target %u: scale %g is not finite and >= 0", x.label, i, t,
+					     (double)scales[t]);
+		}
+		TRY(part_dequant(x.label, &b, pt, i, gather, scales, skel, err));
+	}
+	TRY(cx_end(&x, err));
+	out->part_count = (uint32_t)P;
+	out->parts = parts;
+	out->block = b.base;
+	b.base = NULL;
+	r = MLOD_OK;
+fail:
+	cx_done(&x);
+	pk_free(al, b.base);
+	pk_free(al, recs);
+	pk_free(al, gather);
+	return r;
+}
+#endif
+
 static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pack_skeleton *skel, mlod_pack_mesh *out,
                                mlod_error *err)
 {
@@ -1547,6 +1797,10 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 	mlod_result r = cx_head(p, chunk, MLOD_CHUNK_MESH, &x, err);
 	if (r != MLOD_OK)
 		return r;
+#if MLOD_DRACO
+	if (p->chunks[chunk].codec == MLOD_CODEC_DRACO)
+		return decode_mesh_draco(m, chunk, skel, out, err);
+#endif
 	/* The chunks to read: every MESH level from the coarsest down to this
 	 * one (their blocks make the prefix this level's indices refer to). */
 	unsigned K = p->chunks[chunk].level, top = K;
@@ -1618,6 +1872,9 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			              "one)", K, L);
 			goto fail;
 		}
+		if (p->chunks[ci].codec == MLOD_CODEC_DRACO)
+			FAIL("MESH level %u: builds on MESH level %u, which is Draco-coded (a Draco level stands alone; layout "
+			     "b2 levels cannot use its vertices)", K, L);
 		TRY(mesh_begin(m, (uint32_t)ci, pbuf, pused, &x, err));
 		lev_open = 1;
 		if (pmin && L >= pmin) {
@@ -1918,7 +2175,6 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 				map[v] = lo;
 			}
 			uint64_t aoff = 0, before = 0;
-			const uint8_t *g[VSTREAMS_MAX] = {0};
 			for (int a = 0; a < nvs + (int)T; a++) {
 				uint32_t es = a < nvs ? size[a] : 8;
 				uint8_t *dst = gather + aoff;
@@ -1941,83 +2197,10 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 					else
 						memcpy(dst + (size_t)v * 8, sv, 8);
 				}
-				if (a < nvs)
-					g[a] = dst;
 				aoff += (uint64_t)V * es;
 				before += es;
 			}
-			/* Dequantise. */
-			int a = 0;
-			const uint8_t *q = g[a++];
-			TAKE(pt->positions, (uint64_t)V * 12);
-			for (uint32_t v = 0; v < V; v++)
-				for (int c = 0; c < 3; c++)
-					pt->positions[3 * v + c] = rc->pos_min[c] + rd16(q + 8 * (size_t)v + 2 * c) * rc->pos_scale[c];
-			if (rc->flags & MLOD_PART_NORMALS) {
-				q = g[a++];
-				TAKE(pt->normals, (uint64_t)V * 12);
-				for (uint32_t v = 0; v < V; v++)
-					oct_decode(rdi16(q + 4 * (size_t)v), rdi16(q + 4 * (size_t)v + 2), pt->normals + 3 * (size_t)v);
-			}
-			if (rc->flags & MLOD_PART_TANGENTS) {
-				q = g[a++];
-				TAKE(pt->tangents, (uint64_t)V * 16);
-				for (uint32_t v = 0; v < V; v++) {
-					const uint8_t *e = q + 8 * (size_t)v;
-					int16_t w = rdi16(e + 4);
-					if (w != 32767 && w != -32767)
-						FAIL("%s: part %u: vertex %u: tangent handedness %d is not -32767 or 32767", x.label, i, v, w);
-					oct_decode(rdi16(e), rdi16(e + 2), pt->tangents + 4 * (size_t)v);
-					pt->tangents[4 * (size_t)v + 3] = w > 0 ? 1.0f : -1.0f;
-				}
-			}
-			for (uint32_t t = 0; t < rc->uv_sets; t++) {
-				q = g[a++];
-				TAKE(pt->uvs[t], (uint64_t)V * 8);
-				for (uint32_t v = 0; v < V; v++)
-					for (int c = 0; c < 2; c++)
-						pt->uvs[t][2 * (size_t)v + c] =
-						        rc->uv_min[t][c] + rd16(q + 4 * (size_t)v + 2 * c) * rc->uv_scale[t][c];
-			}
-			if (rc->flags & MLOD_PART_COLORS) {
-				q = g[a++];
-				TAKE(pt->colors, (uint64_t)V * 16);
-				for (size_t k = 0; k < (size_t)V * 4; k++)
-					pt->colors[k] = q[k] / 255.0f;
-			}
-			if (rc->flags & MLOD_PART_SKINNED) {
-				int j16 = (rc->flags & MLOD_PART_JOINTS16) != 0;
-				uint32_t skin_joints = skel->skins[rc->skin].joint_count;
-				q = g[a++];
-				TAKE(pt->joints, (uint64_t)V * 8);
-				for (size_t k = 0; k < (size_t)V * 4; k++) {
-					uint16_t jv = j16 ? rd16(q + 2 * k) : q[k];
-					if (jv >= skin_joints)
-						FAIL("%s: part %u: vertex %zu: joint %u is not below skin %d's %u joints", x.label, i, k / 4,
-						     jv, rc->skin, skin_joints);
-					pt->joints[k] = jv;
-				}
-				q = g[a++];
-				TAKE(pt->weights, (uint64_t)V * 16);
-				for (uint32_t v = 0; v < V; v++) {
-					const uint8_t *e = q + 4 * (size_t)v;
-					unsigned sum = (unsigned)e[0] + e[1] + e[2] + e[3];
-					if (sum != 255)
-						FAIL("%s: part %u: vertex %u: weights sum to %u, not 255", x.label, i, v, sum);
-					for (int c = 0; c < 4; c++)
-						pt->weights[4 * (size_t)v + c] = e[c] / 255.0f;
-				}
-			}
-			q = gather;
-			for (int c = 0; c < nvs; c++)
-				q += (size_t)V * size[c];
-			for (uint32_t t = 0; t < T; t++) {
-				TAKE(pt->targets[t], (uint64_t)V * 12);
-				const uint8_t *e = q + (size_t)t * V * 8;
-				for (uint32_t v = 0; v < V; v++)
-					for (int c = 0; c < 3; c++)
-						pt->targets[t][3 * (size_t)v + c] = rdi16(e + 8 * (size_t)v + 2 * c) * scales[t];
-			}
+			TRY(part_dequant(x.label, &b, pt, i, gather, scales, skel, err));
 		}
 		TRY(cx_end(&x, err));
 		x.temp = NULL;

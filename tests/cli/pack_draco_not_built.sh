@@ -1,1 +1,0 @@
-"$BIN/mlod-pack" --codec draco -o x.mlod "$ROOT/samples/tubeman.glb"
