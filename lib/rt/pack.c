@@ -1660,6 +1660,23 @@ static void draco_comp(uint32_t tag, uint32_t elsize, int *components, int *byte
 	}
 }
 
+/* The bytes a decoded mesh level's part takes (its mlod_pack_part arrays,
+ * each rounded to 8), from its record alone. */
+static uint64_t decoded_part_bytes(const mlod_pack_part_rec *rc)
+{
+	const uint64_t V = rc->vertex_count, T = rc->target_count;
+	const uint32_t f = rc->flags;
+	uint64_t total = round8(V * 12);
+	total += (f & MLOD_PART_NORMALS) ? round8(V * 12) : 0;
+	total += (f & MLOD_PART_TANGENTS) ? round8(V * 16) : 0;
+	total += (uint64_t)rc->uv_sets * round8(V * 8);
+	total += (f & MLOD_PART_COLORS) ? round8(V * 16) : 0;
+	total += (f & MLOD_PART_SKINNED) ? round8(V * 8) + round8(V * 16) : 0;
+	total += round8((uint64_t)rc->index_count * 4);
+	if (T)
+		total += round8(T * sizeof(float *)) + round8(T * 4) + T * round8(V * 12);
+	return total;
+}
 /* A MESH level of codec draco: stands alone (no coarser chunk is read).
  * 'PART', then per part 'DRCO' (its level as one Draco mesh) and, with
  * morph targets, 'MTSC'. */
@@ -1702,20 +1719,12 @@ static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const ml
 			FAIL("%s: part %u: %u vertices and %u indices: a Draco part has triangles", x.label, i, rc->vertex_count,
 			     rc->index_count);
 		uint64_t V = rc->vertex_count, T = rc->target_count;
-		uint32_t f = rc->flags, tag[VSTREAMS_MAX], size[VSTREAMS_MAX];
+		uint32_t tag[VSTREAMS_MAX], size[VSTREAMS_MAX];
 		int nv = part_vstreams(rc, tag, size);
 		uint64_t stride = 8 * T;
 		for (int a = 0; a < nv; a++)
 			stride += size[a];
-		total += round8(V * 12);
-		total += (f & MLOD_PART_NORMALS) ? round8(V * 12) : 0;
-		total += (f & MLOD_PART_TANGENTS) ? round8(V * 16) : 0;
-		total += (uint64_t)rc->uv_sets * round8(V * 8);
-		total += (f & MLOD_PART_COLORS) ? round8(V * 16) : 0;
-		total += (f & MLOD_PART_SKINNED) ? round8(V * 8) + round8(V * 16) : 0;
-		total += round8((uint64_t)rc->index_count * 4);
-		if (T)
-			total += round8(T * sizeof(float *)) + round8(T * 4) + T * round8(V * 12);
+		total += decoded_part_bytes(rc);
 		big = V * stride > big ? V * stride : big;
 		if (total > PACK_MAX_BLOCK || big > PACK_MAX_BLOCK)
 			FAIL("%s: decoded, its parts need more than the reader's limit", x.label);
@@ -2020,16 +2029,7 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 		for (uint32_t i = 0; i < P; i++) {
 			const mlod_pack_part_rec *rc = &recs[i];
 			uint64_t V = rc->vertex_count, T = rc->target_count;
-			uint32_t f = rc->flags;
-			total += round8(V * 12);
-			total += (f & MLOD_PART_NORMALS) ? round8(V * 12) : 0;
-			total += (f & MLOD_PART_TANGENTS) ? round8(V * 16) : 0;
-			total += (uint64_t)rc->uv_sets * round8(V * 8);
-			total += (f & MLOD_PART_COLORS) ? round8(V * 16) : 0;
-			total += (f & MLOD_PART_SKINNED) ? round8(V * 8) + round8(V * 16) : 0;
-			total += round8((uint64_t)rc->index_count * 4);
-			if (T)
-				total += round8(T * sizeof(float *)) + round8(T * 4) + T * round8(V * 12);
+			total += decoded_part_bytes(rc);
 			const mblock *mb = &blk[(uint64_t)l * P + i];
 			uint64_t stride = 0;
 			uint32_t tag[VSTREAMS_MAX], size[VSTREAMS_MAX];
