@@ -722,7 +722,7 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 		free(g);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "edge collapses need the posed cost");
 	}
-	if ((unsigned)g->opt.cost > MLOD_COST_POSED || (unsigned)g->opt.placement > MLOD_PLACE_OPTIMAL ||
+	if ((unsigned)g->opt.cost > MLOD_COST_POSED || (unsigned)g->opt.placement > MLOD_PLACE_VERTEX ||
 	    (unsigned)g->opt.op > MLOD_OP_MIXED || (unsigned)g->opt.eligibility > MLOD_ELIGIBLE_ALL ||
 	    !(g->opt.tau >= 0.0) || !isfinite(g->opt.tau)) {
 		free(g);

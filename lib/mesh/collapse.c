@@ -49,7 +49,10 @@
  * more, so that the sequence ends where no valid collapse is left.
  * v-bar goes to t's barycenter (the paper) or to the posed quadric's
  * optimum (or the barycenter, or for an edge either end, when that is
- * cheaper); Power Skinning
+ * cheaper), or with MLOD_PLACE_VERTEX to the cheapest of the collapsed
+ * vertices that keeps every wedge group whole, snapped (its wedges and
+ * influences copied as they are, so coarse levels reuse its vertices);
+ * otherwise Power Skinning
  * (powerskin.c) gives its weights, the same barycentric weights as its
  * attributes give its morph target offsets.
  *
@@ -506,6 +509,18 @@ static double border_factor(const mlod_bgm *g)
 	return g->opt.allow_border ? 1.0 : BORDER_PENALTY;
 }
 
+/* Whether v-bar can be collapsed vertex s with its wedges as they are:
+ * every wedge group holds exactly one wedge of s and at most one of each
+ * other collapsed vertex. */
+static int keeps_groups(const int (*per)[3], int ngroups, int K, int s)
+{
+	for (int k = 0; k < ngroups; k++)
+		for (int o = 0; o < K; o++)
+			if ((o == s && per[k][o] != 1) || per[k][o] > 1)
+				return 0;
+	return 1;
+}
+
 /* Works out operation op on face t (its triangle collapse, or the
  * collapse of one of its edges); returns 1 when it is valid (pl holds
  * the cheapest valid placement), else 0. */
@@ -525,7 +540,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		if ((fl & (BGM_LOCKED | BGM_DEAD)) || !(fl & BGM_ELIGIBLE) || (!allow_border && (fl & BGM_BORDER)))
 			return 0;
 	}
-	int K = pl->k;
+	int K = pl->k, vertex = g->opt.placement == MLOD_PLACE_VERTEX;
 
 	/* The patch. */
 	pl->nf = pl->nr = pl->nk = 0;
@@ -659,12 +674,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		for (int s = 0; s < K; s++) {
 			if (!special[s] || (border && !(g->nodes[pl->v[s]].flags & BGM_BORDER)))
 				continue;
-			int ok = 1;
-			for (int k = 0; k < pl->ngroups && ok; k++)
-				for (int o = 0; o < K; o++)
-					if ((o == s && per[k][o] != 1) || per[k][o] > 1)
-						ok = 0;
-			if (!ok)
+			if (!keeps_groups((const int (*)[3])per, pl->ngroups, K, s))
 				continue;
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
@@ -690,14 +700,14 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 				return 0;
 		}
 		for (int s = 0; s < K; s++) {
-			if (!onb[s])
+			if (!onb[s] || (vertex && !keeps_groups((const int (*)[3])per, pl->ngroups, K, s)))
 				continue;
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
 			cand_at[nc] = s;
-			cand_snap[nc++] = -1;
+			cand_snap[nc++] = vertex ? s : -1;
 		}
-		if (K == 2 && nb == 2) {
+		if (K == 2 && nb == 2 && !vertex) {
 			memcpy(cand[nc], bary, sizeof cand[nc]);
 			cand_role[nc] = 4;
 			cand_at[nc] = -1;
@@ -727,7 +737,18 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			mm->known |= MEMO_WSUM;
 		}
 	}
-	if (!(special[0] || special[1] || special[2]) && !border) {
+	if (!(special[0] || special[1] || special[2]) && !border && vertex) {
+		/* Vertex placement: v-bar is one of the collapsed vertices, its
+		 * wedges copied whole (a snap). */
+		for (int s = 0; s < K; s++) {
+			if (!keeps_groups((const int (*)[3])per, pl->ngroups, K, s))
+				continue;
+			memcpy(cand[nc], P[s], sizeof cand[nc]);
+			cand_role[nc] = 1 + s;
+			cand_at[nc] = s;
+			cand_snap[nc++] = s;
+		}
+	} else if (!(special[0] || special[1] || special[2]) && !border) {
 		if (g->opt.placement == MLOD_PLACE_OPTIMAL && g->pose_count > 0) {
 			mlod_influences w;
 			double opt[3];
@@ -817,7 +838,11 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		if (!geometry_ok(g, pl, cand[k]))
 			continue;
 		mlod_influences w;
-		int capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+		int capped = 0;
+		if (vertex)
+			w = in3[cand_at[k]]; /* the vertex's own influences, not blended */
+		else
+			capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double cost, d = 0.0;
@@ -1461,8 +1486,11 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		role[nc] = 1 + j;
 		memcpy(cand[nc++], P[j], sizeof cand[0]);
 	}
-	role[nc] = 4;
-	memcpy(cand[nc++], bary, sizeof cand[0]);
+	int vertex = g->opt.placement == MLOD_PLACE_VERTEX;
+	if (!vertex) {
+		role[nc] = 4;
+		memcpy(cand[nc++], bary, sizeof cand[0]);
+	}
 	/* The least sum so far (the least stays the least divided by wsum):
 	 * a candidate's sum stops once it reaches it, its terms being
 	 * positive, and is then neither the least nor memoised (plan() sums
@@ -1470,7 +1498,10 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 	double best = HUGE_VAL, least = HUGE_VAL;
 	for (int k = 0; k < nc; k++) {
 		mlod_influences w;
-		mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+		if (vertex)
+			w = in3[role[k] - 1]; /* as plan() skins it */
+		else
+			mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double e;
