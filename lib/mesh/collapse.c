@@ -211,6 +211,7 @@ struct plan {
 	double onormal[MAX_PATCH][4]; /* kept[i]'s normal, then its length */
 	unsigned char oflip[MAX_PATCH]; /* kept[i] is not degenerate: it may not flip */
 	int nw, wedges[MAX_WEDGES], group[MAX_WEDGES], ngroups;
+	int src[MAX_PATCH];         /* vertex placement: the wedge of v[snap] kept[i]'s corner copies */
 	/* The chosen placement. */
 	double pos[3];
 	int snap;                   /* 0..2: v-bar at v[snap]; -1: free */
@@ -521,6 +522,41 @@ static int keeps_groups(const int (*per)[3], int ngroups, int K, int s)
 	return 1;
 }
 
+/* Vertex placement: which wedge of v[snap] each kept face's corner takes,
+ * copied whole. Its own corners keep theirs; another vertex's corner the
+ * one wedge of v[snap] in its wedge group (a texture seam: plan() made
+ * sure there is exactly one), else (normals differ only: hard edges) the
+ * wedge of v[snap] whose normal is nearest its own, the first of equals. */
+static void vertex_wedges(const mlod_bgm *g, struct plan *pl, const int *owner)
+{
+	const bgm_layout *L = &g->lay;
+	int S = L->stride, s = pl->snap;
+	for (int j = 0; j < pl->nk; j++) {
+		int w = g->faces[pl->kept[j]].w[pl->corner[j]], slot = wedge_slot(pl, w);
+		if (owner[slot] == s) {
+			pl->src[j] = w;
+			continue;
+		}
+		int in_group = -1, count = 0, nearest = -1;
+		double best = -HUGE_VAL;
+		for (int i = 0; i < pl->nw; i++) {
+			if (owner[i] != s)
+				continue;
+			if (pl->group[i] == pl->group[slot])
+				in_group = pl->wedges[i], count++;
+			double d = 0.0;
+			if (S > 0 && L->normal >= 0) {
+				const float *a = g->wedge_attr + (size_t)pl->wedges[i] * (size_t)S + L->normal;
+				const float *b = g->wedge_attr + (size_t)w * (size_t)S + L->normal;
+				d = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+			}
+			if (nearest < 0 || d > best)
+				nearest = pl->wedges[i], best = d;
+		}
+		pl->src[j] = count == 1 ? in_group : nearest;
+	}
+}
+
 /* Works out operation op on face t (its triangle collapse, or the
  * collapse of one of its edges); returns 1 when it is valid (pl holds
  * the cheapest valid placement), else 0. */
@@ -700,7 +736,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 				return 0;
 		}
 		for (int s = 0; s < K; s++) {
-			if (!onb[s] || (vertex && !keeps_groups((const int (*)[3])per, pl->ngroups, K, s)))
+			if (!onb[s])
 				continue;
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
@@ -739,10 +775,8 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	}
 	if (!(special[0] || special[1] || special[2]) && !border && vertex) {
 		/* Vertex placement: v-bar is one of the collapsed vertices, its
-		 * wedges copied whole (a snap). */
+		 * wedges copied whole (vertex_wedges). */
 		for (int s = 0; s < K; s++) {
-			if (!keeps_groups((const int (*)[3])per, pl->ngroups, K, s))
-				continue;
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
 			cand_at[nc] = s;
@@ -903,6 +937,8 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		pl->cost *= border_factor(g); /* the border moves (a lone border vertex stays put) */
 	memcpy(pl->pos, cand[best], sizeof pl->pos);
 	pl->snap = cand_snap[best];
+	if (vertex)
+		vertex_wedges(g, pl, owner);
 	if (cand_at[best] >= 0) {
 		pl->lambda[0] = pl->lambda[1] = pl->lambda[2] = 0.0;
 		pl->lambda[cand_at[best]] = 1.0;
@@ -1650,7 +1686,24 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	 * faceted); equal results share a wedge. */
 	int gw[MAX_WEDGES], cw[MAX_PATCH];
 	int S = g->lay.stride;
-	if (pl->snap >= 0) {
+	if (g->opt.placement == MLOD_PLACE_VERTEX) {
+		/* One new wedge per wedge of v[snap] taken, a copy of it. */
+		for (int j = 0; j < pl->nk; j++) {
+			int prev = -1;
+			for (int i = 0; i < j && prev < 0; i++)
+				if (pl->src[i] == pl->src[j])
+					prev = cw[i];
+			if (prev >= 0) {
+				cw[j] = prev;
+				continue;
+			}
+			if ((cw[j] = bgm_add_wedge(g, v)) < 0)
+				return -1;
+			if (S > 0)
+				memcpy(g->wedge_attr + (size_t)cw[j] * (size_t)S, g->wedge_attr + (size_t)pl->src[j] * (size_t)S,
+				       sizeof(float) * (size_t)S);
+		}
+	} else if (pl->snap >= 0) {
 		for (int k = 0; k < pl->ngroups; k++) {
 			if ((gw[k] = bgm_add_wedge(g, v)) < 0)
 				return -1;
