@@ -43,9 +43,10 @@ static const char usage_text[] =
 	"                             (default %s)\n"
 	"  -e, --max-error PCT        levels down to the coarsest whose posed error\n"
 	"                             stays within PCT percent of the diagonal\n"
-	"  -p, --placement NAME       new vertex of a collapse: optimal (default) or\n"
-	"                             vertex (one of the collapsed vertices kept\n"
-	"                             whole: fewer vertices in the shared buffer)\n"
+	"  -p, --placement NAME       new vertex of a collapse: optimal (default),\n"
+	"                             barycenter, or vertex (one of the collapsed\n"
+	"                             vertices kept whole: fewer vertices in the\n"
+	"                             shared buffer, smaller packs)\n"
 	"      --influence-budget F   fewer influences on the levels' vertices that\n"
 	"                             move at most F times the level's mean posed\n"
 	"                             error (0, the default: off; not with -e)\n"
@@ -402,10 +403,12 @@ int main(int argc, char **argv)
 		case 'p':
 			if (strcmp(optarg, "optimal") == 0)
 				opt.bgm.placement = MLOD_PLACE_OPTIMAL;
+			else if (strcmp(optarg, "barycenter") == 0)
+				opt.bgm.placement = MLOD_PLACE_BARYCENTER;
 			else if (strcmp(optarg, "vertex") == 0)
 				opt.bgm.placement = MLOD_PLACE_VERTEX;
 			else
-				tool_usage_error("--placement: unknown value '%s' (optimal or vertex)", optarg);
+				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter or vertex)", optarg);
 			break;
 		case OPT_INFLUENCE:
 			opt.bgm.influence_budget = tool_parse_double("--influence-budget", optarg, 0.0, 1e3);
