@@ -374,21 +374,23 @@ static double cpu_now(void)
 static void chain(int argc, char **argv)
 {
 	printf("| character | triangles | mlod posed (ms) | mlod posed --fast-cost (ms) | meshopt_simplify (ms) | posed / meshopt | "
-	       "fast / meshopt |\n|---|---:|---:|---:|---:|---:|---:|\n");
+	       "fast / meshopt | mlod posed -p vertex (ms) | vertex / meshopt |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
 	for (int a = 0; a < argc; a++) {
 		mlod_character c;
 		int T = load_meshed(argv[a], &c);
 		if (T == 0)
 			continue;
-		double best[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL};
+		double best[4] = {HUGE_VAL, HUGE_VAL, HUGE_VAL, HUGE_VAL};
 		for (int run = 0; run < CHAIN_RUNS; run++)
-			for (int m = 0; m < 3; m++) {
+			for (int m = 0; m < 4; m++) {
 				struct levelset L;
 				levelset_init(&L, &c);
 				mlod_bgm_options opt = {0};
 				opt.fast_cost = m == 1;
+				if (m == 3)
+					opt.placement = MLOD_PLACE_VERTEX;
 				double t0 = cpu_now();
-				if (m < 2)
+				if (m != 2)
 					mlod_levels(&c, &opt, &L, NULL);
 				else
 					meshopt_levels(&c, &L);
@@ -396,11 +398,11 @@ static void chain(int argc, char **argv)
 				best[m] = t < best[m] ? t : best[m];
 				levelset_free(&L);
 			}
-		printf("| %s | %d | %.2f | %.2f | %.2f | %.1fx | %.1fx |\n", bench_base_name(argv[a]), T, best[0], best[1], best[2],
-		       best[0] / best[2], best[1] / best[2]);
+		printf("| %s | %d | %.2f | %.2f | %.2f | %.1fx | %.1fx | %.2f | %.1fx |\n", bench_base_name(argv[a]), T, best[0], best[1],
+		       best[2], best[0] / best[2], best[1] / best[2], best[3], best[3] / best[2]);
 		mlod_character_free(&c);
 	}
-	printf("\nThe posed chain of the speed table (default, and with --fast-cost) against meshopt_simplify; best of %d "
+	printf("\nThe posed chain of the speed table (default, with --fast-cost, and with -p vertex) against meshopt_simplify; best of %d "
 	       "runs, CPU time of the calling thread.\n",
 	       CHAIN_RUNS);
 }
@@ -444,6 +446,7 @@ static void quality(int argc, char **argv)
 		{"mlod posed, optimal, bend, edge", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_BEND}},
 		{"mlod posed, optimal, literal, edge", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_OPTIMAL, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_LITERAL}},
 		{"mlod posed, barycenter, all, edge", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_BARYCENTER, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_ALL}},
+		{"mlod posed, vertex, all, edge", 0, {.cost = MLOD_COST_POSED, .placement = MLOD_PLACE_VERTEX, .op = MLOD_OP_EDGE, .eligibility = MLOD_ELIGIBLE_ALL}},
 		{"mlod compactness, barycenter, bend (paper)", 0, {.cost = MLOD_COST_COMPACTNESS, .placement = MLOD_PLACE_BARYCENTER, .eligibility = MLOD_ELIGIBLE_BEND}},
 		{"mlod compactness, barycenter, literal", 0, {.cost = MLOD_COST_COMPACTNESS, .placement = MLOD_PLACE_BARYCENTER, .eligibility = MLOD_ELIGIBLE_LITERAL}},
 		{"mlod compactness, barycenter, all", 0, {.cost = MLOD_COST_COMPACTNESS, .placement = MLOD_PLACE_BARYCENTER, .eligibility = MLOD_ELIGIBLE_ALL}},
@@ -500,19 +503,25 @@ static void quality(int argc, char **argv)
 			}
 			printf(" |\n");
 		}
-		/* Ratios of the default against the peers, where the counts match
-		 * within 1%. */
-		for (int peer = nm - 2; peer < nm; peer++) {
-			printf("| default / %s", peer == nm - 2 ? "meshopt" : "gltfpack");
-			for (int k = 0; k < 3; k++) {
-				if (!ok[0][k] || !ok[peer][k] || fabs((double)tris[0][k] - tris[peer][k]) > 0.01 * tris[peer][k] + 1)
-					printf(" | unequal | - | -");
-				else
-					printf(" | | %.2f | %.2f", res[0][set][k].mean / fmax(res[peer][set][k].mean, 1e-12),
-					       res[0][set][k].max / fmax(res[peer][set][k].max, 1e-12));
+		/* Ratios of the default and of the vertex placement against the
+		 * peers, where the counts match within 1%. */
+		int vertex_row = 0;
+		for (int m = 0; m < nm; m++)
+			if (methods[m].kind == 0 && methods[m].opt.placement == MLOD_PLACE_VERTEX)
+				vertex_row = m;
+		for (int row = 0; row < 2; row++)
+			for (int peer = nm - 2; peer < nm; peer++) {
+				int me = row ? vertex_row : 0;
+				printf("| %s / %s", row ? "vertex" : "default", peer == nm - 2 ? "meshopt" : "gltfpack");
+				for (int k = 0; k < 3; k++) {
+					if (!ok[me][k] || !ok[peer][k] || fabs((double)tris[me][k] - tris[peer][k]) > 0.01 * tris[peer][k] + 1)
+						printf(" | unequal | - | -");
+					else
+						printf(" | | %.2f | %.2f", res[me][set][k].mean / fmax(res[peer][set][k].mean, 1e-12),
+						       res[me][set][k].max / fmax(res[peer][set][k].max, 1e-12));
+				}
+				printf(" |\n");
 			}
-			printf(" |\n");
-		}
 	}
 	mlod_pose_set_free(&clip);
 	mlod_pose_set_free(&random);

@@ -48,7 +48,9 @@ static const char usage_text[] =
 	"                           primitives, cheapest collapses first; the posed\n"
 	"                           cost only, its default) or primitive (each keeps\n"
 	"                           the ratio; the default with compactness)\n"
-	"  -p, --placement NAME     new vertex: optimal (default) or barycenter\n"
+	"  -p, --placement NAME     new vertex: optimal (default), barycenter, or\n"
+	"                           vertex (one of the collapsed vertices kept whole:\n"
+	"                           coarse levels reuse level-0 vertices)\n"
 	"  -E, --eligibility NAME   vertices that may go: all, bend or literal\n"
 	"                           (default: all with the posed cost, bend otherwise)\n"
 	"  -t, --tau T              eligibility threshold factor (default 1)\n"
@@ -250,7 +252,7 @@ int main(int argc, char **argv)
 	static const char *const costs[] = {"compactness", "posed"};
 	static const char *const ops[] = {"triangle", "edge", "mixed"};
 	static const char *const budgets[] = {"character", "primitive"};
-	static const char *const placements[] = {"barycenter", "optimal"};
+	static const char *const placements[] = {"barycenter", "optimal", "vertex"};
 	static const char *const rules[] = {"literal", "bend", "all"};
 	static const double defaults[] = {MLOD_MESH_RATIOS_DEFAULT};
 	const char *output = NULL, *split = NULL;
@@ -275,7 +277,7 @@ int main(int argc, char **argv)
 		case 'C': opt.op = (mlod_collapse_op)(MLOD_OP_TRIANGLE + parse_enum("--collapse", optarg, ops, 3)); break;
 		case 'B': budget = (mlod_mesh_budget)(MLOD_BUDGET_CHARACTER + parse_enum("--budget", optarg, budgets, 2)); break;
 		case 'p':
-			opt.placement = (mlod_placement)(MLOD_PLACE_BARYCENTER + parse_enum("--placement", optarg, placements, 2));
+			opt.placement = (mlod_placement)(MLOD_PLACE_BARYCENTER + parse_enum("--placement", optarg, placements, 3));
 			break;
 		case 'E':
 			opt.eligibility = (mlod_eligibility)(MLOD_ELIGIBLE_LITERAL + parse_enum("--eligibility", optarg, rules, 3));

@@ -43,6 +43,10 @@ static const char usage_text[] =
 	"                             (default %s)\n"
 	"  -e, --max-error PCT        levels down to the coarsest whose posed error\n"
 	"                             stays within PCT percent of the diagonal\n"
+	"  -p, --placement NAME       new vertex of a collapse: optimal (default),\n"
+	"                             barycenter, or vertex (one of the collapsed\n"
+	"                             vertices kept whole: fewer vertices in the\n"
+	"                             shared buffer, smaller packs)\n"
 	"      --influence-budget F   fewer influences on the levels' vertices that\n"
 	"                             move at most F times the level's mean posed\n"
 	"                             error (0, the default: off; not with -e)\n"
@@ -338,6 +342,7 @@ int main(int argc, char **argv)
 		{"name", required_argument, NULL, OPT_NAME},
 		{"ratios", required_argument, NULL, 'R'},
 		{"max-error", required_argument, NULL, 'e'},
+		{"placement", required_argument, NULL, 'p'},
 		{"influence-budget", required_argument, NULL, OPT_INFLUENCE},
 		{"skeleton-max-error", required_argument, NULL, OPT_SKEL_ERR},
 		{"motion-max-error", required_argument, NULL, OPT_MOTION_ERR},
@@ -366,7 +371,7 @@ int main(int argc, char **argv)
 
 	tool_name = "mlod-pack";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:x:j:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, ":o:r::R:e:p:x:j:hV", longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -395,6 +400,16 @@ int main(int argc, char **argv)
 			ratios_given = 1;
 			break;
 		case 'e': opt.mesh_max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
+		case 'p':
+			if (strcmp(optarg, "optimal") == 0)
+				opt.bgm.placement = MLOD_PLACE_OPTIMAL;
+			else if (strcmp(optarg, "barycenter") == 0)
+				opt.bgm.placement = MLOD_PLACE_BARYCENTER;
+			else if (strcmp(optarg, "vertex") == 0)
+				opt.bgm.placement = MLOD_PLACE_VERTEX;
+			else
+				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter or vertex)", optarg);
+			break;
 		case OPT_INFLUENCE:
 			opt.bgm.influence_budget = tool_parse_double("--influence-budget", optarg, 0.0, 1e3);
 			opt.bgm.influence_budget = opt.bgm.influence_budget > 0.0 ? opt.bgm.influence_budget : -1.0;

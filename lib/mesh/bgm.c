@@ -302,6 +302,33 @@ static void vertex_influences(const mlod_bgm *g, int v, mlod_influences *out)
 		out->weights[i] = (float)(w[i] / sum);
 }
 
+/* Vertex placement: input vertex v's influences as it has them (its
+ * weight sets in order, trailing zero weights dropped, not merged,
+ * normalised or sorted), so that a level's vertex copied from it is
+ * written with the same joints and weights, bit for bit. */
+static void raw_influences(const mlod_bgm *g, int v, mlod_influences *out)
+{
+	const mlod_primitive *p = g->prim;
+	if (g->rigid || !g->skinned) {
+		vertex_influences(g, v, out);
+		return;
+	}
+	memset(out, 0, sizeof *out);
+	int last = 0;
+	for (int s = 0; s < p->weight_set_count && s < MLOD_MAX_SETS; s++)
+		for (int k = 0; k < 4; k++) {
+			float x = p->weights[s][4 * v + k];
+			uint16_t j = p->joints[s][4 * v + k];
+			if (!(x >= 0.0f) || j >= g->joint_count)
+				continue;
+			out->joints[out->count] = j;
+			out->weights[out->count++] = x;
+			if (x > 0.0f)
+				last = out->count;
+		}
+	out->count = last;
+}
+
 static int same_influences(const mlod_influences *a, const mlod_influences *b)
 {
 	if (a->count != b->count)
@@ -489,7 +516,10 @@ static mlod_result build(mlod_bgm *g, const mlod_character *c, const mlod_instan
 			table[slot] = v;
 			for (int i = 0; i < 3; i++)
 				g->nodes[node].p[i] = p->positions[3 * v + i];
-			g->inf[node] = vinf[v];
+			if (g->opt.placement == MLOD_PLACE_VERTEX)
+				raw_influences(g, v, &g->inf[node]);
+			else
+				g->inf[node] = vinf[v];
 			for (int i = 0; i < L->morph_stride; i++)
 				g->morph[(size_t)node * (size_t)L->morph_stride + (size_t)i] = k[3 + i];
 		}
@@ -722,7 +752,7 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 		free(g);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "edge collapses need the posed cost");
 	}
-	if ((unsigned)g->opt.cost > MLOD_COST_POSED || (unsigned)g->opt.placement > MLOD_PLACE_OPTIMAL ||
+	if ((unsigned)g->opt.cost > MLOD_COST_POSED || (unsigned)g->opt.placement > MLOD_PLACE_VERTEX ||
 	    (unsigned)g->opt.op > MLOD_OP_MIXED || (unsigned)g->opt.eligibility > MLOD_ELIGIBLE_ALL ||
 	    !(g->opt.tau >= 0.0) || !isfinite(g->opt.tau)) {
 		free(g);

@@ -49,7 +49,10 @@
  * more, so that the sequence ends where no valid collapse is left.
  * v-bar goes to t's barycenter (the paper) or to the posed quadric's
  * optimum (or the barycenter, or for an edge either end, when that is
- * cheaper); Power Skinning
+ * cheaper), or with MLOD_PLACE_VERTEX to the cheapest of the collapsed
+ * vertices that keeps every wedge group whole, snapped (its wedges and
+ * influences copied as they are, so coarse levels reuse its vertices);
+ * otherwise Power Skinning
  * (powerskin.c) gives its weights, the same barycentric weights as its
  * attributes give its morph target offsets.
  *
@@ -208,6 +211,7 @@ struct plan {
 	double onormal[MAX_PATCH][4]; /* kept[i]'s normal, then its length */
 	unsigned char oflip[MAX_PATCH]; /* kept[i] is not degenerate: it may not flip */
 	int nw, wedges[MAX_WEDGES], group[MAX_WEDGES], ngroups;
+	int src[MAX_PATCH];         /* vertex placement: the wedge of v[snap] kept[i]'s corner copies */
 	/* The chosen placement. */
 	double pos[3];
 	int snap;                   /* 0..2: v-bar at v[snap]; -1: free */
@@ -506,6 +510,53 @@ static double border_factor(const mlod_bgm *g)
 	return g->opt.allow_border ? 1.0 : BORDER_PENALTY;
 }
 
+/* Whether v-bar can be collapsed vertex s with its wedges as they are:
+ * every wedge group holds exactly one wedge of s and at most one of each
+ * other collapsed vertex. */
+static int keeps_groups(const int (*per)[3], int ngroups, int K, int s)
+{
+	for (int k = 0; k < ngroups; k++)
+		for (int o = 0; o < K; o++)
+			if ((o == s && per[k][o] != 1) || per[k][o] > 1)
+				return 0;
+	return 1;
+}
+
+/* Vertex placement: which wedge of v[snap] each kept face's corner takes,
+ * copied whole. Its own corners keep theirs; another vertex's corner the
+ * one wedge of v[snap] in its wedge group (a texture seam: plan() made
+ * sure there is exactly one), else (normals differ only: hard edges) the
+ * wedge of v[snap] whose normal is nearest its own, the first of equals. */
+static void vertex_wedges(const mlod_bgm *g, struct plan *pl, const int *owner)
+{
+	const bgm_layout *L = &g->lay;
+	int S = L->stride, s = pl->snap;
+	for (int j = 0; j < pl->nk; j++) {
+		int w = g->faces[pl->kept[j]].w[pl->corner[j]], slot = wedge_slot(pl, w);
+		if (owner[slot] == s) {
+			pl->src[j] = w;
+			continue;
+		}
+		int in_group = -1, count = 0, nearest = -1;
+		double best = -HUGE_VAL;
+		for (int i = 0; i < pl->nw; i++) {
+			if (owner[i] != s)
+				continue;
+			if (pl->group[i] == pl->group[slot])
+				in_group = pl->wedges[i], count++;
+			double d = 0.0;
+			if (S > 0 && L->normal >= 0) {
+				const float *a = g->wedge_attr + (size_t)pl->wedges[i] * (size_t)S + L->normal;
+				const float *b = g->wedge_attr + (size_t)w * (size_t)S + L->normal;
+				d = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+			}
+			if (nearest < 0 || d > best)
+				nearest = pl->wedges[i], best = d;
+		}
+		pl->src[j] = count == 1 ? in_group : nearest;
+	}
+}
+
 /* Works out operation op on face t (its triangle collapse, or the
  * collapse of one of its edges); returns 1 when it is valid (pl holds
  * the cheapest valid placement), else 0. */
@@ -525,7 +576,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		if ((fl & (BGM_LOCKED | BGM_DEAD)) || !(fl & BGM_ELIGIBLE) || (!allow_border && (fl & BGM_BORDER)))
 			return 0;
 	}
-	int K = pl->k;
+	int K = pl->k, vertex = g->opt.placement == MLOD_PLACE_VERTEX;
 
 	/* The patch. */
 	pl->nf = pl->nr = pl->nk = 0;
@@ -659,12 +710,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		for (int s = 0; s < K; s++) {
 			if (!special[s] || (border && !(g->nodes[pl->v[s]].flags & BGM_BORDER)))
 				continue;
-			int ok = 1;
-			for (int k = 0; k < pl->ngroups && ok; k++)
-				for (int o = 0; o < K; o++)
-					if ((o == s && per[k][o] != 1) || per[k][o] > 1)
-						ok = 0;
-			if (!ok)
+			if (!keeps_groups((const int (*)[3])per, pl->ngroups, K, s))
 				continue;
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
@@ -695,9 +741,9 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
 			cand_at[nc] = s;
-			cand_snap[nc++] = -1;
+			cand_snap[nc++] = vertex ? s : -1;
 		}
-		if (K == 2 && nb == 2) {
+		if (K == 2 && nb == 2 && !vertex) {
 			memcpy(cand[nc], bary, sizeof cand[nc]);
 			cand_role[nc] = 4;
 			cand_at[nc] = -1;
@@ -727,7 +773,16 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			mm->known |= MEMO_WSUM;
 		}
 	}
-	if (!(special[0] || special[1] || special[2]) && !border) {
+	if (!(special[0] || special[1] || special[2]) && !border && vertex) {
+		/* Vertex placement: v-bar is one of the collapsed vertices, its
+		 * wedges copied whole (vertex_wedges). */
+		for (int s = 0; s < K; s++) {
+			memcpy(cand[nc], P[s], sizeof cand[nc]);
+			cand_role[nc] = 1 + s;
+			cand_at[nc] = s;
+			cand_snap[nc++] = s;
+		}
+	} else if (!(special[0] || special[1] || special[2]) && !border) {
 		if (g->opt.placement == MLOD_PLACE_OPTIMAL && g->pose_count > 0) {
 			mlod_influences w;
 			double opt[3];
@@ -817,7 +872,11 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		if (!geometry_ok(g, pl, cand[k]))
 			continue;
 		mlod_influences w;
-		int capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+		int capped = 0;
+		if (vertex)
+			w = in3[cand_at[k]]; /* the vertex's own influences, not blended */
+		else
+			capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double cost, d = 0.0;
@@ -878,6 +937,8 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		pl->cost *= border_factor(g); /* the border moves (a lone border vertex stays put) */
 	memcpy(pl->pos, cand[best], sizeof pl->pos);
 	pl->snap = cand_snap[best];
+	if (vertex)
+		vertex_wedges(g, pl, owner);
 	if (cand_at[best] >= 0) {
 		pl->lambda[0] = pl->lambda[1] = pl->lambda[2] = 0.0;
 		pl->lambda[cand_at[best]] = 1.0;
@@ -1461,8 +1522,11 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		role[nc] = 1 + j;
 		memcpy(cand[nc++], P[j], sizeof cand[0]);
 	}
-	role[nc] = 4;
-	memcpy(cand[nc++], bary, sizeof cand[0]);
+	int vertex = g->opt.placement == MLOD_PLACE_VERTEX;
+	if (!vertex) {
+		role[nc] = 4;
+		memcpy(cand[nc++], bary, sizeof cand[0]);
+	}
 	/* The least sum so far (the least stays the least divided by wsum):
 	 * a candidate's sum stops once it reaches it, its terms being
 	 * positive, and is then neither the least nor memoised (plan() sums
@@ -1470,7 +1534,10 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 	double best = HUGE_VAL, least = HUGE_VAL;
 	for (int k = 0; k < nc; k++) {
 		mlod_influences w;
-		mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+		if (vertex)
+			w = in3[role[k] - 1]; /* as plan() skins it */
+		else
+			mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double e;
@@ -1619,7 +1686,24 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	 * faceted); equal results share a wedge. */
 	int gw[MAX_WEDGES], cw[MAX_PATCH];
 	int S = g->lay.stride;
-	if (pl->snap >= 0) {
+	if (g->opt.placement == MLOD_PLACE_VERTEX) {
+		/* One new wedge per wedge of v[snap] taken, a copy of it. */
+		for (int j = 0; j < pl->nk; j++) {
+			int prev = -1;
+			for (int i = 0; i < j && prev < 0; i++)
+				if (pl->src[i] == pl->src[j])
+					prev = cw[i];
+			if (prev >= 0) {
+				cw[j] = prev;
+				continue;
+			}
+			if ((cw[j] = bgm_add_wedge(g, v)) < 0)
+				return -1;
+			if (S > 0)
+				memcpy(g->wedge_attr + (size_t)cw[j] * (size_t)S, g->wedge_attr + (size_t)pl->src[j] * (size_t)S,
+				       sizeof(float) * (size_t)S);
+		}
+	} else if (pl->snap >= 0) {
 		for (int k = 0; k < pl->ngroups; k++) {
 			if ((gw[k] = bgm_add_wedge(g, v)) < 0)
 				return -1;

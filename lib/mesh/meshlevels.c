@@ -38,7 +38,7 @@ const char *mlod_mesh_budget_name(mlod_mesh_budget b)
 
 const char *mlod_mesh_placement_name(mlod_placement p)
 {
-	return p == MLOD_PLACE_BARYCENTER ? "barycenter" : "optimal";
+	return p == MLOD_PLACE_BARYCENTER ? "barycenter" : p == MLOD_PLACE_VERTEX ? "vertex" : "optimal";
 }
 
 const char *mlod_mesh_eligibility_name(mlod_eligibility e)

@@ -86,7 +86,9 @@ typedef enum mlod_mesh_cost {
 typedef enum mlod_placement {
 	MLOD_PLACE_DEFAULT = 0, /* OPTIMAL with the posed cost (measured), BARYCENTER with compactness (the paper) */
 	MLOD_PLACE_BARYCENTER,  /* the paper: the triangle's barycenter */
-	MLOD_PLACE_OPTIMAL      /* beyond the paper: the minimum of the posed quadric (or the barycenter when lower) */
+	MLOD_PLACE_OPTIMAL,     /* beyond the paper: the minimum of the posed quadric (or the barycenter when lower) */
+	MLOD_PLACE_VERTEX       /* one of the collapsed vertices, kept whole (attributes and influences as it has
+	                         * them, no Power Skinning): coarse levels reuse level-0 vertices */
 } mlod_placement;
 
 /* Which collapses run. */

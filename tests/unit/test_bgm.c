@@ -514,6 +514,71 @@ TEST(collapse_ops)
 	mlod_character_free(&c);
 }
 
+/* -p vertex: each collapse puts v-bar on one of its parents, with that
+ * parent's influences bit for bit (no Power Skinning blend), and every
+ * vertex of a prefix is an input vertex (position, joints and weights as
+ * stored; tests/cli/bgm_placement_vertex.sh checks every attribute on the
+ * written glbs). */
+static int input_vertex(const mlod_primitive *in, const mlod_primitive *q, int v)
+{
+	for (int u = 0; u < in->vertex_count; u++) {
+		if (memcmp(in->positions + 3 * (size_t)u, q->positions + 3 * (size_t)v, 3 * sizeof(float)) != 0)
+			continue;
+		int same = in->weight_set_count == q->weight_set_count;
+		for (int set = 0; set < q->weight_set_count && same; set++)
+			same = memcmp(in->joints[set] + 4 * (size_t)u, q->joints[set] + 4 * (size_t)v, 4 * sizeof(uint16_t)) == 0 &&
+			       memcmp(in->weights[set] + 4 * (size_t)u, q->weights[set] + 4 * (size_t)v, 4 * sizeof(float)) == 0;
+		if (same)
+			return 1;
+	}
+	return 0;
+}
+
+TEST(prefixes_vertex)
+{
+	const char *files[2] = {"samples/tubeman.glb", "samples/RobotExpressive.glb"};
+	mlod_bgm_options opt = {0};
+	opt.placement = MLOD_PLACE_VERTEX;
+	for (int f = 0; f < 2 && !test_failed_; f++) {
+		mlod_character c;
+		CHECK(test_load(files[f], &c) == 0);
+		for (int i = 0; i < c.instance_count && !test_failed_; i++) {
+			check_prefixes(&c, i, &opt);
+			const mlod_primitive *in = &c.meshes[c.instances[i].mesh].primitives[0];
+			mlod_bgm *g;
+			CHECK_OK(mlod_bgm_build(&c, i, 0, &opt, &g, &terr));
+			CHECK_OK(mlod_bgm_simplify(g, 0, 0, &terr));
+			int count, moved = 0;
+			const mlod_vsplit *seq = mlod_bgm_sequence(g, &count);
+			for (int r = 0; r < count; r++) {
+				const mlod_vsplit *rec = &seq[r];
+				if (rec->snapped < 0) {
+					moved++;
+					continue;
+				}
+				int parent = rec->parents[rec->snapped];
+				const mlod_influences *a = &g->inf[rec->node], *b = &g->inf[parent];
+				if (memcmp(g->nodes[rec->node].p, g->nodes[parent].p, sizeof g->nodes[parent].p) != 0 ||
+				    a->count != b->count || memcmp(a->joints, b->joints, sizeof(uint16_t) * (size_t)a->count) != 0 ||
+				    memcmp(a->weights, b->weights, sizeof(float) * (size_t)a->count) != 0)
+					moved++;
+			}
+			CHECK_MSG(count == 0 || moved == 0, "%s instance %d: %d of %d collapses not on a parent", files[f], i, moved,
+			          count);
+			int k = count / 2, fresh = 0;
+			mlod_primitive q;
+			CHECK_OK(mlod_bgm_extract(g, k, 0, &q, &terr)); /* rigid parts as stored: no weights */
+			for (int v = 0; v < q.vertex_count; v++)
+				fresh += !input_vertex(in, &q, v);
+			CHECK_MSG(fresh == 0, "%s instance %d prefix %d: %d of %d vertices not input vertices", files[f], i, k, fresh,
+			          q.vertex_count);
+			mlod_primitive_free(&q);
+			mlod_bgm_free(g);
+		}
+		mlod_character_free(&c);
+	}
+}
+
 TEST(prefixes_robot)
 {
 	/* Faceted, non-manifold parts, rigid parts and morph targets. */
@@ -1122,6 +1187,7 @@ int main(void)
 	RUN(collapse_ops);
 	RUN(prefixes_robot);
 	RUN(prefixes_fast_cost);
+	RUN(prefixes_vertex);
 	RUN(prefixes_allow_border);
 	RUN(border_collapses_robot);
 	RUN(rigid_and_morph);

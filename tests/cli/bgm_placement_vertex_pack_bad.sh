@@ -1,0 +1,1 @@
+"$BIN/mlod-pack" -p quadric -o out.mlod "$ROOT/samples/tubeman.glb"
