@@ -82,6 +82,11 @@ _Static_assert(sizeof(mlod_pack_channel_rec) == 20, "channel record is 20 bytes"
 
 /* The largest block (and temporary buffer) a decode allocates. */
 #define PACK_MAX_BLOCK ((uint64_t)1 << 30)
+/* meshopt's codecs decode at most 64 bytes per stored byte (a 16-byte
+ * group of zeros costs 2 header bits), plus a little: a stream claiming
+ * more is refused before anything is sized from it, and so is a chunk
+ * whose TOC raw size is more than this times its container. */
+#define PACK_MAX_EXPAND 64
 
 static const uint32_t crc_table[256] = {
 	0x00000000u, 0x77073096u, 0xee0e612cu, 0x990951bau, 0x076dc419u, 0x706af48fu,
@@ -415,6 +420,11 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		} else if (c->entropy && (c->coded_size < 4 || c->coded_size > c->raw_size)) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): coded size %u is not 4 to its raw size %u", i, label,
 			              c->coded_size, c->raw_size);
+		} else if ((c->codec == MLOD_CODEC_NONE || c->codec == MLOD_CODEC_MESHOPT) &&
+		           c->raw_size > (uint64_t)PACK_MAX_EXPAND * (c->entropy ? c->coded_size : c->stored_size)) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): raw size %u is more than %d times its %u-byte "
+			              "container (the stream codecs expand no more)", i, label, c->raw_size, PACK_MAX_EXPAND,
+			              c->entropy ? c->coded_size : c->stored_size);
 		} else if (!isfinite(c->error) || c->error < 0 || !isfinite(c->distance) || c->distance < 0) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): error %g and switch distance %g must be finite and >= 0",
 			              i, label, (double)c->error, (double)c->distance);
@@ -642,6 +652,10 @@ static mlod_result cx_unpack(cx *x, mlod_error *err)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame %s its %u bytes", x->label,
 		                 ZSTD_isError(frame) ? "is truncated or malformed in" : "does not end at the end of",
 		                 c->stored_size);
+	unsigned long long bound = ZSTD_decompressBound(x->base, c->stored_size);
+	if (bound == ZSTD_CONTENTSIZE_ERROR || bound < want)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame's %u bytes cannot decode to its stated %llu",
+		                 x->label, c->stored_size, (unsigned long long)want);
 	x->plain = pk_malloc(&x->alloc, 1, (size_t)want);
 	if (!x->plain)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for its %llu-byte container", x->label,
@@ -746,6 +760,10 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 			return mlod_fail(err, MLOD_ERR_PARSE,
 			                 "%s: stream %u '%s': the meshopt index codec needs a multiple of 3 elements, not %u",
 			                 x->label, i, tagn(tag).s, count);
+		if (codec != MLOD_SCODEC_RAW && decoded > (uint64_t)PACK_MAX_EXPAND * stored + PACK_MAX_EXPAND)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': %u meshopt-coded bytes cannot hold %u elements of %u bytes",
+			                 x->label, i, tagn(tag).s, stored, count, elsize);
 		if (codec == MLOD_SCODEC_RAW && stored != decoded)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': %u bytes stored for %u elements of %u bytes",
 			                 x->label, i, tagn(tag).s, stored, count, elsize);
