@@ -48,13 +48,12 @@ static void evaluate(const uint8_t *data, size_t size)
 		clips = EVAL_CLIPS;
 	if (clips == 0)
 		clips = 1;
-	uint32_t cap = mlod_rt_max_vertex_count(ctx);
-	if (cap > EVAL_VERTICES)
-		cap = EVAL_VERTICES;
-	float *pos = malloc(((size_t)cap + 1) * 3 * sizeof *pos);
-	float *nrm = malloc(((size_t)cap + 1) * 3 * sizeof *nrm);
+	/* The buffers grow to the largest level resident so far (up to
+	 * EVAL_VERTICES; mlod_rt_skin refuses a larger one). */
+	uint32_t cap = 0;
+	float *pos = NULL, *nrm = NULL;
 	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
-	if (pos && nrm && s) {
+	if (s) {
 		for (uint32_t clip = 0; clip < clips; clip++) {
 			uint32_t id;
 			if (mlod_rt_instance_create(ctx, clip, 0.25f, MLOD_RT_LOOP, &id, &e) != MLOD_OK)
@@ -66,13 +65,23 @@ static void evaluate(const uint8_t *data, size_t size)
 				float d = 10.0f;
 				mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 30, &e);
 				mlod_rt_stream(ctx, (size_t)-1, NULL, &e);
+				uint32_t want = mlod_rt_max_vertex_count(ctx);
+				want = want > EVAL_VERTICES ? EVAL_VERTICES : want;
+				if (want > cap || !pos) {
+					free(pos);
+					free(nrm);
+					pos = malloc(((size_t)want + 1) * 3 * sizeof *pos);
+					nrm = malloc(((size_t)want + 1) * 3 * sizeof *nrm);
+					cap = pos && nrm ? want : 0;
+				}
 				const float *world;
 				const uint32_t *joints;
 				uint32_t jc, pc, vc;
 				mlod_rt_pose(ctx, s, id, &world, &joints, &jc, &e);
 				const float *pal;
 				mlod_rt_palette(ctx, s, &pal, &pc, &e);
-				mlod_rt_skin(ctx, s, id, pos, 12, nrm, 12, cap, &vc, &e);
+				if (cap)
+					mlod_rt_skin(ctx, s, id, pos, 12, nrm, 12, cap, &vc, &e);
 			}
 			mlod_rt_instance_destroy(ctx, id);
 		}
