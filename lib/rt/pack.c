@@ -624,6 +624,33 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
 	return MLOD_OK;
 }
 
+/* What a zstd frame (checked whole by ZSTD_findFrameCompressedSize) can
+ * decode to at most, from its blocks rather than the size its header
+ * states: raw and RLE blocks give their size, a compressed block at most
+ * the frame's block size. 0 for a frame it cannot walk. */
+static unsigned long long zstd_bound(const uint8_t *src, size_t n)
+{
+	ZSTD_frameHeader fh;
+	size_t at = ZSTD_frameHeaderSize(src, n);
+	if (ZSTD_isError(at) || ZSTD_getFrameHeader(&fh, src, n) != 0 || fh.frameType != ZSTD_frame)
+		return 0;
+	unsigned long long bound = 0;
+	for (;;) {
+		if (n - at < 3)
+			return 0;
+		uint32_t h = (uint32_t)src[at] | (uint32_t)src[at + 1] << 8 | (uint32_t)src[at + 2] << 16;
+		uint32_t type = (h >> 1) & 3, size = h >> 3;
+		uint64_t used = type == 1 ? 1 : size;
+		at += 3;
+		if (type == 3 || used > n - at)
+			return 0;
+		at += (size_t)used;
+		bound += type == 2 ? fh.blockSizeMax : size;
+		if (h & 1)
+			return bound;
+	}
+}
+
 /* The one place that undoes an entropy stage: the chunk's stored bytes at
  * x->base (CRC checked) become its stream container in x->plain, exactly
  * the TOC's coded size (checked against the raw size at open) and nothing
@@ -652,8 +679,8 @@ static mlod_result cx_unpack(cx *x, mlod_error *err)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame %s its %u bytes", x->label,
 		                 ZSTD_isError(frame) ? "is truncated or malformed in" : "does not end at the end of",
 		                 c->stored_size);
-	unsigned long long bound = ZSTD_decompressBound(x->base, c->stored_size);
-	if (bound == ZSTD_CONTENTSIZE_ERROR || bound < want)
+	unsigned long long bound = zstd_bound(x->base, c->stored_size);
+	if (bound < want)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame's %u bytes cannot decode to its stated %llu",
 		                 x->label, c->stored_size, (unsigned long long)want);
 	x->plain = pk_malloc(&x->alloc, 1, (size_t)want);

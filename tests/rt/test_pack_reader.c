@@ -2548,6 +2548,48 @@ TEST(expansion_limits)
 	          "returned %d: %s", (int)r2, terr.message);
 }
 
+/* A zstd frame whose header states 64 MB but whose one block is a
+ * 100-byte RLE run: refused from its blocks before the container is
+ * allocated (before, the reader allocated the stated 64 MB first). */
+TEST(zstd_forged_size)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	free_chunks(c, n);
+	mlod_pack p;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	uint64_t off = p.chunks[C_MOT1].offset;
+	uint32_t stored = p.chunks[C_MOT1].stored_size;
+	mlod_pack_close(&p);
+	CHECK(stored >= 13);
+	const uint32_t said = 64u << 20;
+	uint8_t *f = b.p + off;
+	wr32(f, 0xFD2FB528u);  /* zstd magic */
+	f[4] = 0xA0;           /* single segment, 4-byte content size */
+	wr32(f + 5, said);
+	uint32_t h = 1u | 1u << 1 | 100u << 3; /* last block, RLE, 100 bytes */
+	f[9] = (uint8_t)h, f[10] = (uint8_t)(h >> 8), f[11] = (uint8_t)(h >> 16);
+	f[12] = 0;
+	uint8_t *e = b.p + 32 + 48 * C_MOT1;
+	e[5] = (uint8_t)(e[5] | MLOD_ENTROPY_ZSTD << 4);
+	wr32(e + 12, said); /* coded size */
+	wr32(e + 24, 13);   /* stored size */
+	wr32(e + 28, said); /* raw size */
+	restamp(b.p, b.n);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	mlod_pack_motion m;
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_motion(&p, C_MOT1, b.p, b.n, NULL, &m, &terr);
+	if (r == MLOD_OK)
+		mlod_pack_motion_free(&m);
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK_MSG(r == MLOD_ERR_PARSE && strstr(terr.message, "MOTION level ") &&
+	              strstr(terr.message, "the zstd frame's 13 bytes cannot decode to its stated 67108864"),
+	          "returned %d: %s", (int)r, terr.message);
+}
+
 /* The meshopt codecs' constraints, and a damaged meshopt stream. */
 TEST(meshopt_streams)
 {
@@ -2654,6 +2696,7 @@ int main(int argc, char **argv)
 	RUN(toc_checks);
 	RUN(absurd_sizes);
 	RUN(expansion_limits);
+	RUN(zstd_forged_size);
 	RUN(meshopt_streams);
 	RUN(mutations_plain);
 	RUN(mutations_restamped);
