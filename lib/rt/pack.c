@@ -420,7 +420,7 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		} else if (c->entropy && (c->coded_size < 4 || c->coded_size > c->raw_size)) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): coded size %u is not 4 to its raw size %u", i, label,
 			              c->coded_size, c->raw_size);
-		} else if ((c->codec == MLOD_CODEC_NONE || c->codec == MLOD_CODEC_MESHOPT) &&
+		} else if (c->codec <= MLOD_CODEC_DRACO &&
 		           c->raw_size > (uint64_t)PACK_MAX_EXPAND * (c->entropy ? c->coded_size : c->stored_size)) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): raw size %u is more than %d times its %u-byte "
 			              "container (the stream codecs expand no more)", i, label, c->raw_size, PACK_MAX_EXPAND,
@@ -1871,6 +1871,8 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 	 * (cx_parse checks them): two allocations for every level. */
 	for (uint32_t l = 0; l < nlev; l++) {
 		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, top - l, 0);
+		if (ci >= 0 && (r = cx_head(p, (uint32_t)ci, MLOD_CHUNK_MESH, &x, err)) != MLOD_OK)
+			return r; /* an unknown codec or entropy stage: its raw size means nothing yet */
 		uint64_t raw = ci >= 0 ? p->chunks[ci].raw_size : 0;
 		sumraw += raw;
 		maxraw = raw > maxraw ? raw : maxraw;

@@ -2590,6 +2590,51 @@ TEST(zstd_forged_size)
 	          "returned %d: %s", (int)r, terr.message);
 }
 
+/* Found by make fuzz: a MESH level of an unknown codec and entropy stage
+ * (0xf5) saying 654 MB raw, above the level decoded. The raw sizes of
+ * every level read were summed and allocated before any chunk's codec was
+ * checked; now the unknown codec is refused first (UNSUPPORTED, naming
+ * the chunk), and nothing large is allocated. */
+static size_t big_alloc;
+static void *count_malloc(void *user, size_t n)
+{
+	(void)user;
+	if (n > big_alloc)
+		big_alloc = n;
+	return malloc(n);
+}
+static void count_free(void *user, void *q)
+{
+	(void)user;
+	free(q);
+}
+
+TEST(unknown_codec_raw_size)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	free_chunks(c, n);
+	uint8_t *e = b.p + 32 + 48 * C_MESH1;
+	e[5] = 0x05;                  /* codec 5, unknown */
+	wr32(e + 28, 600u << 20);     /* raw size 600 MB */
+	restamp(b.p, b.n);
+	mlod_pack_alloc al = {count_malloc, count_free, NULL};
+	mlod_pack p;
+	CHECK_OK(mlod_pack_open_alloc(b.p, b.n, &al, &p, &terr));
+	big_alloc = 0;
+	mlod_pack_mesh m;
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_mesh(&p, C_MESH0, b.p, b.n, NULL, &m, &terr);
+	if (r == MLOD_OK)
+		mlod_pack_mesh_free(&m);
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && strstr(terr.message, "MESH level 1: unknown chunk codec 5"),
+	          "returned %d: %s", (int)r, terr.message);
+	CHECK_MSG(big_alloc < (1u << 20), "largest allocation %zu bytes", big_alloc);
+}
+
 /* The meshopt codecs' constraints, and a damaged meshopt stream. */
 TEST(meshopt_streams)
 {
@@ -2697,6 +2742,7 @@ int main(int argc, char **argv)
 	RUN(absurd_sizes);
 	RUN(expansion_limits);
 	RUN(zstd_forged_size);
+	RUN(unknown_codec_raw_size);
 	RUN(meshopt_streams);
 	RUN(mutations_plain);
 	RUN(mutations_restamped);
