@@ -1871,8 +1871,11 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 	 * (cx_parse checks them): two allocations for every level. */
 	for (uint32_t l = 0; l < nlev; l++) {
 		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, top - l, 0);
-		if (ci >= 0 && (r = cx_head(p, (uint32_t)ci, MLOD_CHUNK_MESH, &x, err)) != MLOD_OK)
-			return r; /* an unknown codec or entropy stage: its raw size means nothing yet */
+		/* An unknown codec or entropy stage: its raw size means nothing
+		 * (cx_head says which; called only then, for its message). */
+		if (ci >= 0 && (p->chunks[ci].codec > MLOD_CODEC_DRACO || p->chunks[ci].entropy > MLOD_ENTROPY_ZSTD_PREFIX) &&
+		    (r = cx_head(p, (uint32_t)ci, MLOD_CHUNK_MESH, &x, err)) != MLOD_OK)
+			return r;
 		uint64_t raw = ci >= 0 ? p->chunks[ci].raw_size : 0;
 		sumraw += raw;
 		maxraw = raw > maxraw ? raw : maxraw;
