@@ -4,7 +4,10 @@
 #   make test             unit + CLI + validator tests, then the unit tests under ASan/UBSan
 #   make test-extended    also uses ../shared/data when it is present
 #   make bench            benchmarks against the peers (bench/RESULTS.md)
-#   make fuzz             libFuzzer on the pack reader (clang; not in make test)
+#   make fuzz             libFuzzer on the pack reader (every codec, Draco
+#                         included) and one frame of the runtime at every
+#                         level (clang; not in make test)
+#   make fuzz-unpack      libFuzzer on mlod-pack -x: pack to glTF to glb
 #   make fuzz-io          libFuzzer on BVH, glb/glTF and the stage record
 #                         (FUZZ_TARGET=bvh|gltf|record, FUZZ_TIME s each)
 #   make demo             the main job on the bundled sample
@@ -203,25 +206,74 @@ $(B)/tests/test_openmesh: tests/openmesh/test_openmesh.cpp lib/mlod.h $(B)/libml
 # ----------------------------------------------------------------------
 
 # --- Pack reader fuzzing ----------------------------------------------
-# make fuzz: libFuzzer on the pack reader (tests/fuzz/fuzz_pack.c), built
-# with clang (Debian: clang, libclang-rt-dev) under ASan and UBSan from the
-# runtime's sources alone. Not part of `make test`. The corpus starts with
-# the test character's pack (test_pack_reader --write-seed) and grows in
+# make fuzz: libFuzzer on the pack reader and the runtime
+# (tests/fuzz/fuzz_pack.c: every chunk decoded, then one frame evaluated
+# at every level), built with clang (Debian: clang, libclang-rt-dev)
+# under ASan and UBSan from the runtime's sources alone, with its Draco
+# shim (clang++, -ldraco). Not part of `make test`. The corpus starts with
+# the test character's packs (test_pack_reader --write-seed*) and the tiny
+# tubeman packed by the release tools with each codec, draco included
+# (tests/fuzz/seeds.sh, build/fuzz/seeds-pack), and grows in
 # build/fuzz/corpus. FUZZ_TIME=seconds (default 60); FUZZ_ARGS passes more.
+# make fuzz-unpack: the same seeds through mlod_pack_unpack and the glb
+# writer (tests/fuzz/fuzz_unpack.c, what mlod-pack -x does), linked with
+# the bake library as fuzz-io is; corpus build/fuzz/corpus-unpack.
+# Both stop at an input slower than FUZZ_TIMEOUT s or past FUZZ_RSS_MB
+# (crashes in build/fuzz/crash-pack, crash-unpack) and first replay the
+# inputs of fixed findings (tests/fuzz/regress/pack, regress/unpack).
+# tests/fuzz/open holds inputs of findings not fixed yet (not replayed).
 FUZZ_CC ?= clang
+FUZZ_CXX ?= clang++
 FUZZ_TIME ?= 60
+FUZZ_TIMEOUT ?= 30
+FUZZ_RSS_MB ?= 2048
 FUZZ_ARGS ?=
-.PHONY: fuzz
-fuzz: build/fuzz/fuzz_pack $(B)/tests/rt/test_pack_reader
-	@mkdir -p build/fuzz/corpus
+FUZZ_IO_FLAGS := -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+FUZZ_IO_OBJ := $(LIB_C:%.c=build/fuzz/obj/%.o) $(LIB_CXX:%.cpp=build/fuzz/obj/%.o)
+FUZZ_PACK_SEEDS := build/fuzz/corpus/seed.mlod build/fuzz/seeds-pack/tiny.draco.mlod
+.PHONY: fuzz fuzz-unpack fuzz-pack-build
+fuzz: build/fuzz/fuzz_pack $(FUZZ_PACK_SEEDS)
+	@mkdir -p build/fuzz/crash-pack
+	@if [ -d tests/fuzz/regress/pack ]; then echo "fuzz: replaying tests/fuzz/regress/pack"; \
+		build/fuzz/fuzz_pack tests/fuzz/regress/pack/* > build/fuzz/regress-pack.log 2>&1 \
+			|| { cat build/fuzz/regress-pack.log >&2; exit 1; }; fi
+	build/fuzz/fuzz_pack -max_total_time=$(FUZZ_TIME) -timeout=$(FUZZ_TIMEOUT) -rss_limit_mb=$(FUZZ_RSS_MB) \
+		-malloc_limit_mb=$(FUZZ_RSS_MB) -max_len=65536 -artifact_prefix=build/fuzz/crash-pack/ $(FUZZ_ARGS) \
+		build/fuzz/corpus build/fuzz/seeds-pack
+fuzz-unpack: build/fuzz/fuzz_unpack $(FUZZ_PACK_SEEDS)
+	@mkdir -p build/fuzz/corpus-unpack build/fuzz/crash-unpack
+	@if [ -d tests/fuzz/regress/unpack ]; then echo "fuzz-unpack: replaying tests/fuzz/regress/unpack"; \
+		build/fuzz/fuzz_unpack tests/fuzz/regress/unpack/* > build/fuzz/regress-unpack.log 2>&1 \
+			|| { cat build/fuzz/regress-unpack.log >&2; exit 1; }; fi
+	build/fuzz/fuzz_unpack -max_total_time=$(FUZZ_TIME) -timeout=$(FUZZ_TIMEOUT) -rss_limit_mb=$(FUZZ_RSS_MB) \
+		-malloc_limit_mb=$(FUZZ_RSS_MB) -max_len=65536 -artifact_prefix=build/fuzz/crash-unpack/ $(FUZZ_ARGS) \
+		build/fuzz/corpus-unpack build/fuzz/corpus build/fuzz/seeds-pack
+fuzz-pack-build: build/fuzz/fuzz_pack build/fuzz/fuzz_unpack $(FUZZ_PACK_SEEDS)
+build/fuzz/corpus/seed.mlod: $(B)/tests/rt/test_pack_reader
+	@mkdir -p $(@D)
 	$(B)/tests/rt/test_pack_reader --write-seed build/fuzz/corpus/seed.mlod
 	$(B)/tests/rt/test_pack_reader --write-seed-zstd build/fuzz/corpus/seed-zstd.mlod
 	$(B)/tests/rt/test_pack_reader --write-seed-prefix build/fuzz/corpus/seed-prefix.mlod
-	build/fuzz/fuzz_pack -max_total_time=$(FUZZ_TIME) -max_len=65536 $(FUZZ_ARGS) build/fuzz/corpus
-build/fuzz/fuzz_pack: tests/fuzz/fuzz_pack.c $(RT_C) lib/rt/mlod_pack.h $(sort $(wildcard lib/core/*.c)) lib/core/mlod_core.h
+build/fuzz/seeds-pack/tiny.draco.mlod: build/fuzz/seeds-record/tiny.staged.json
+FUZZ_RT_OBJ := $(RT_C:%.c=build/fuzz/objd/%.o) build/fuzz/objd/lib/rt/rt_draco.o
+build/fuzz/fuzz_pack: build/fuzz/objd/tests/fuzz/fuzz_pack.o $(FUZZ_RT_OBJ) $(patsubst %.c,build/fuzz/obj/%.o,$(sort $(wildcard lib/core/*.c)))
+	$(FUZZ_CXX) -fsanitize=fuzzer,address,undefined $^ -lmeshoptimizer -ldraco -lzstd -lm -pthread -o $@
+build/fuzz/fuzz_unpack: build/fuzz/objd/tests/fuzz/fuzz_unpack.o $(FUZZ_IO_OBJ) $(FUZZ_RT_OBJ)
+	$(FUZZ_CXX) -fsanitize=fuzzer,address,undefined $^ $(LDLIBS) -pthread -o $@
+build/fuzz/objd/tests/fuzz/fuzz_pack.o: tests/fuzz/fuzz_pack.c
 	@mkdir -p $(@D)
 	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { echo "make fuzz needs clang with libFuzzer (Debian: clang libclang-rt-dev)" >&2; exit 1; }
-	$(FUZZ_CC) -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined $(RT_CPPFLAGS) tests/fuzz/fuzz_pack.c $(RT_C) $(sort $(wildcard lib/core/*.c)) -lmeshoptimizer -lzstd -lm -o $@
+	$(FUZZ_CC) -std=c11 -pthread $(WARN) $(FUZZ_IO_FLAGS) -fsanitize=fuzzer-no-link $(RT_CPPFLAGS) -DMLOD_DRACO=1 -MMD -MP -c $< -o $@
+build/fuzz/objd/tests/fuzz/fuzz_unpack.o: tests/fuzz/fuzz_unpack.c
+	@mkdir -p $(@D)
+	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { echo "make fuzz-unpack needs clang with libFuzzer (Debian: clang libclang-rt-dev)" >&2; exit 1; }
+	$(FUZZ_CC) -std=c11 -pthread $(WARN) $(FUZZ_IO_FLAGS) -fsanitize=fuzzer-no-link $(CPPFLAGS) $(RT_CPPFLAGS) -MMD -MP -c $< -o $@
+build/fuzz/objd/lib/rt/%.o: lib/rt/%.c
+	@mkdir -p $(@D)
+	$(FUZZ_CC) -std=c11 -pthread $(WARN) $(FUZZ_IO_FLAGS) -fsanitize=fuzzer-no-link $(RT_CPPFLAGS) -DMLOD_DRACO=1 -MMD -MP -c $< -o $@
+build/fuzz/objd/lib/rt/rt_draco.o: lib/rt/rt_draco.cpp
+	@mkdir -p $(@D)
+	$(FUZZ_CXX) -std=c++14 -pthread -Wall -Wextra $(FUZZ_IO_FLAGS) -fsanitize=fuzzer-no-link $(RT_CPPFLAGS) -DMLOD_DRACO=1 -MMD -MP -c $< -o $@
 # ----------------------------------------------------------------------
 
 # --- Bake-side input fuzzing ------------------------------------------
@@ -236,12 +288,7 @@ build/fuzz/fuzz_pack: tests/fuzz/fuzz_pack.c $(RT_C) lib/rt/mlod_pack.h $(sort $
 # crashes land in build/fuzz/crash-*. A slow input (FUZZ_TIMEOUT s) or one
 # past FUZZ_RSS_MB is a finding. The inputs of fixed findings
 # (tests/fuzz/regress/TARGET) are replayed first; a crash there stops.
-FUZZ_CXX ?= clang++
 FUZZ_TARGET ?= bvh gltf record
-FUZZ_TIMEOUT ?= 30
-FUZZ_RSS_MB ?= 2048
-FUZZ_IO_FLAGS := -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
-FUZZ_IO_OBJ := $(LIB_C:%.c=build/fuzz/obj/%.o) $(LIB_CXX:%.cpp=build/fuzz/obj/%.o)
 .PHONY: fuzz-io fuzz-io-build
 fuzz-io: fuzz-io-build
 	@for t in $(FUZZ_TARGET); do case $$t in bvh|gltf|record) ;; *) echo "FUZZ_TARGET: bvh, gltf or record, not $$t" >&2; exit 1;; esac; done

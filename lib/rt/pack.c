@@ -82,6 +82,11 @@ _Static_assert(sizeof(mlod_pack_channel_rec) == 20, "channel record is 20 bytes"
 
 /* The largest block (and temporary buffer) a decode allocates. */
 #define PACK_MAX_BLOCK ((uint64_t)1 << 30)
+/* meshopt's codecs decode at most 64 bytes per stored byte (a 16-byte
+ * group of zeros costs 2 header bits), plus a little: a stream claiming
+ * more is refused before anything is sized from it, and so is a chunk
+ * whose TOC raw size is more than this times its container. */
+#define PACK_MAX_EXPAND 64
 
 static const uint32_t crc_table[256] = {
 	0x00000000u, 0x77073096u, 0xee0e612cu, 0x990951bau, 0x076dc419u, 0x706af48fu,
@@ -415,6 +420,11 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		} else if (c->entropy && (c->coded_size < 4 || c->coded_size > c->raw_size)) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): coded size %u is not 4 to its raw size %u", i, label,
 			              c->coded_size, c->raw_size);
+		} else if (c->codec <= MLOD_CODEC_DRACO &&
+		           c->raw_size > (uint64_t)PACK_MAX_EXPAND * (c->entropy ? c->coded_size : c->stored_size)) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): raw size %u is more than %d times its %u-byte "
+			              "container (the stream codecs expand no more)", i, label, c->raw_size, PACK_MAX_EXPAND,
+			              c->entropy ? c->coded_size : c->stored_size);
 		} else if (!isfinite(c->error) || c->error < 0 || !isfinite(c->distance) || c->distance < 0) {
 			r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): error %g and switch distance %g must be finite and >= 0",
 			              i, label, (double)c->error, (double)c->distance);
@@ -614,6 +624,33 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
 	return MLOD_OK;
 }
 
+/* What a zstd frame (checked whole by ZSTD_findFrameCompressedSize) can
+ * decode to at most, from its blocks rather than the size its header
+ * states: raw and RLE blocks give their size, a compressed block at most
+ * the frame's block size. 0 for a frame it cannot walk. */
+static unsigned long long zstd_bound(const uint8_t *src, size_t n)
+{
+	ZSTD_frameHeader fh;
+	size_t at = ZSTD_frameHeaderSize(src, n);
+	if (ZSTD_isError(at) || ZSTD_getFrameHeader(&fh, src, n) != 0 || fh.frameType != ZSTD_frame)
+		return 0;
+	unsigned long long bound = 0;
+	for (;;) {
+		if (n - at < 3)
+			return 0;
+		uint32_t h = (uint32_t)src[at] | (uint32_t)src[at + 1] << 8 | (uint32_t)src[at + 2] << 16;
+		uint32_t type = (h >> 1) & 3, size = h >> 3;
+		uint64_t used = type == 1 ? 1 : size;
+		at += 3;
+		if (type == 3 || used > n - at)
+			return 0;
+		at += (size_t)used;
+		bound += type == 2 ? fh.blockSizeMax : size;
+		if (h & 1)
+			return bound;
+	}
+}
+
 /* The one place that undoes an entropy stage: the chunk's stored bytes at
  * x->base (CRC checked) become its stream container in x->plain, exactly
  * the TOC's coded size (checked against the raw size at open) and nothing
@@ -642,6 +679,10 @@ static mlod_result cx_unpack(cx *x, mlod_error *err)
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame %s its %u bytes", x->label,
 		                 ZSTD_isError(frame) ? "is truncated or malformed in" : "does not end at the end of",
 		                 c->stored_size);
+	unsigned long long bound = zstd_bound(x->base, c->stored_size);
+	if (bound < want)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: the zstd frame's %u bytes cannot decode to its stated %llu",
+		                 x->label, c->stored_size, (unsigned long long)want);
 	x->plain = pk_malloc(&x->alloc, 1, (size_t)want);
 	if (!x->plain)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "%s: out of memory for its %llu-byte container", x->label,
@@ -746,6 +787,10 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 			return mlod_fail(err, MLOD_ERR_PARSE,
 			                 "%s: stream %u '%s': the meshopt index codec needs a multiple of 3 elements, not %u",
 			                 x->label, i, tagn(tag).s, count);
+		if (codec != MLOD_SCODEC_RAW && decoded > (uint64_t)PACK_MAX_EXPAND * stored + PACK_MAX_EXPAND)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': %u meshopt-coded bytes cannot hold %u elements of %u bytes",
+			                 x->label, i, tagn(tag).s, stored, count, elsize);
 		if (codec == MLOD_SCODEC_RAW && stored != decoded)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': %u bytes stored for %u elements of %u bytes",
 			                 x->label, i, tagn(tag).s, stored, count, elsize);
@@ -1835,6 +1880,11 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 	 * (cx_parse checks them): two allocations for every level. */
 	for (uint32_t l = 0; l < nlev; l++) {
 		int ci = mlod_pack_find(p, MLOD_CHUNK_MESH, top - l, 0);
+		/* An unknown codec or entropy stage: its raw size means nothing
+		 * (cx_head says which; called only then, for its message). */
+		if (ci >= 0 && (p->chunks[ci].codec > MLOD_CODEC_DRACO || p->chunks[ci].entropy > MLOD_ENTROPY_ZSTD_PREFIX) &&
+		    (r = cx_head(p, (uint32_t)ci, MLOD_CHUNK_MESH, &x, err)) != MLOD_OK)
+			return r;
 		uint64_t raw = ci >= 0 ? p->chunks[ci].raw_size : 0;
 		sumraw += raw;
 		maxraw = raw > maxraw ? raw : maxraw;

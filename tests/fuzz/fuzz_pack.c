@@ -1,56 +1,96 @@
 /*
- * fuzz_pack.c: libFuzzer target for the pack reader (make fuzz; not part of
- * make test). Each input is opened and every chunk decoded, as the runtime
- * would: INFO, SKELETON, then each skeleton level, mesh level and motion
- * level against the decoded skeleton (or without one), and DOC.
+ * fuzz_pack.c: libFuzzer target for the pack reader and the runtime (make
+ * fuzz; not part of make test). Each input is opened and every chunk
+ * decoded, as the runtime would: INFO, SKELETON, then each skeleton level,
+ * mesh level (codec meshopt, none or draco: the fuzz build links
+ * lib/rt/rt_draco.cpp) and motion level against the decoded skeleton (or
+ * without one), and DOC. Then the runtime opens the same bytes and
+ * evaluates one frame at every level: an instance of each clip forced to
+ * level k of every layer, mlod_rt_update, mlod_rt_stream, mlod_rt_pose,
+ * mlod_rt_palette and mlod_rt_skin.
  *
- * The custom mutator re-stamps every CRC after libFuzzer's mutation on
- * half of the runs, so that mutations reach the structural checks behind
- * the CRCs instead of stopping at them.
+ * The custom mutator (fuzz_restamp.h) re-stamps the CRCs on half of the
+ * runs.
  */
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "fuzz_restamp.h"
 #include "mlod_pack.h"
+#include "mlod_rt.h"
 
-size_t LLVMFuzzerMutate(uint8_t *data, size_t size, size_t max_size);
-size_t LLVMFuzzerCustomMutator(uint8_t *data, size_t size, size_t max_size, unsigned int seed);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static uint32_t get32(const uint8_t *p)
-{
-	return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
+/* At most this many levels per layer and clips are evaluated, and skinned
+ * into at most this many vertices: a pack may list more, the runtime's
+ * answers for them are no different in kind. */
+enum { EVAL_LEVELS = 16, EVAL_CLIPS = 4, EVAL_VERTICES = 1 << 20 };
 
-static void put32(uint8_t *p, uint32_t v)
+static void evaluate(const uint8_t *data, size_t size)
 {
-	p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8), p[2] = (uint8_t)(v >> 16), p[3] = (uint8_t)(v >> 24);
-}
-
-static void restamp(uint8_t *d, size_t n)
-{
-	if (n < 32)
+	mlod_rt_config cfg = {0, 8, NULL};
+	mlod_rt_ctx *ctx = NULL;
+	mlod_error e;
+	if (mlod_rt_open_memory(data, size, &cfg, &ctx, &e) != MLOD_OK)
 		return;
-	uint64_t count = get32(d + 12), toc_end = 32 + 48 * count;
-	if (toc_end <= n) {
-		for (uint64_t i = 0; i < count; i++) {
-			uint8_t *e = d + 32 + 48 * i;
-			uint64_t off = get32(e + 16) | (uint64_t)get32(e + 20) << 32, sz = get32(e + 24);
-			if (off <= n && sz <= n - off)
-				put32(e + 32, mlod_pack_crc32(0, d + off, (size_t)sz));
-		}
-		put32(d + 24, mlod_pack_crc32(0, d + 32, (size_t)(toc_end - 32)));
+	uint32_t levels = 1;
+	for (int l = 0; l < MLOD_RT_LAYERS; l++) {
+		uint32_t n = mlod_rt_level_count(ctx, (mlod_rt_layer)l);
+		if (n > levels)
+			levels = n;
 	}
-	put32(d + 28, mlod_pack_crc32(0, d, 28));
-}
-
-size_t LLVMFuzzerCustomMutator(uint8_t *data, size_t size, size_t max_size, unsigned int seed)
-{
-	size = LLVMFuzzerMutate(data, size, max_size);
-	if (seed & 1)
-		restamp(data, size);
-	return size;
+	if (levels > EVAL_LEVELS)
+		levels = EVAL_LEVELS;
+	uint32_t clips = mlod_rt_clip_count(ctx);
+	if (clips > EVAL_CLIPS)
+		clips = EVAL_CLIPS;
+	if (clips == 0)
+		clips = 1;
+	/* The buffers grow to the largest level resident so far (up to
+	 * EVAL_VERTICES; mlod_rt_skin refuses a larger one). */
+	uint32_t cap = 0;
+	float *pos = NULL, *nrm = NULL;
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	if (s) {
+		for (uint32_t clip = 0; clip < clips; clip++) {
+			uint32_t id;
+			if (mlod_rt_instance_create(ctx, clip, 0.25f, MLOD_RT_LOOP, &id, &e) != MLOD_OK)
+				continue;
+			for (uint32_t k = levels; k-- > 0;) {
+				mlod_rt_select sel;
+				mlod_rt_select_default(&sel);
+				sel.force_level = (int)k;
+				float d = 10.0f;
+				mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 30, &e);
+				mlod_rt_stream(ctx, (size_t)-1, NULL, &e);
+				uint32_t want = mlod_rt_max_vertex_count(ctx);
+				want = want > EVAL_VERTICES ? EVAL_VERTICES : want;
+				if (want > cap || !pos) {
+					free(pos);
+					free(nrm);
+					pos = malloc(((size_t)want + 1) * 3 * sizeof *pos);
+					nrm = malloc(((size_t)want + 1) * 3 * sizeof *nrm);
+					cap = pos && nrm ? want : 0;
+				}
+				const float *world;
+				const uint32_t *joints;
+				uint32_t jc, pc, vc;
+				mlod_rt_pose(ctx, s, id, &world, &joints, &jc, &e);
+				const float *pal;
+				mlod_rt_palette(ctx, s, &pal, &pc, &e);
+				if (cap)
+					mlod_rt_skin(ctx, s, id, pos, 12, nrm, 12, cap, &vc, &e);
+			}
+			mlod_rt_instance_destroy(ctx, id);
+		}
+	}
+	if (s)
+		mlod_rt_scratch_destroy(ctx, s);
+	free(pos);
+	free(nrm);
+	mlod_rt_close(ctx);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -88,5 +128,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	mlod_pack_doc_free(&doc);
 	mlod_pack_skeleton_free(&skel);
 	mlod_pack_close(&p);
+	evaluate(data, size);
 	return 0;
 }

@@ -7,7 +7,7 @@
 # BIN holds the mlod-* tools, HELPERS gen_tubeman, RECORD_SEED is the
 # record_seed helper (release builds). Writes OUT/stage/ (each stage's glb
 # on a tiny tubeman, on RobotExpressive and on a 4-frame BVH walk),
-# OUT/seeds-bvh, OUT/seeds-gltf and OUT/seeds-record.
+# OUT/seeds-bvh, OUT/seeds-gltf, OUT/seeds-record and OUT/seeds-pack.
 set -eu
 BIN=$1 HELPERS=$2 OUT=$3 RECORD_SEED=$4
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
@@ -45,3 +45,12 @@ cp "$ROOT/samples/tubeman.glb" "$ROOT/samples/RobotExpressive.glb" $GLB "$ROOT"/
 for f in $GLB; do
 	"$RECORD_SEED" "$f" > "$OUT/seeds-record/$(basename "$f" .glb).json"
 done
+
+# Pack seeds (make fuzz, make fuzz-unpack): the tiny tubeman packed with
+# each codec (draco: MESH levels as Draco meshes) and without the entropy
+# stage; two mesh levels keep them small.
+mkdir -p "$OUT/seeds-pack"
+for c in meshopt none draco; do
+	"$BIN/mlod-pack" --codec $c -R 0.5,0.25 -o "$OUT/seeds-pack/tiny.$c.mlod" "$S/tiny.staged.glb"
+done
+"$BIN/mlod-pack" --codec draco --entropy none -R 0.5 -o "$OUT/seeds-pack/tiny.draco-raw.mlod" "$S/tiny.staged.glb"

@@ -2448,7 +2448,8 @@ TEST(absurd_sizes)
 	static wchunk c[C_COUNT + 1];
 	int n = make_chunks(c, 0);
 	/* A meshopt stream of 16 M part records (3.4 GB decoded, raw size
-	 * consistent): NOMEM before any allocation. */
+	 * consistent): refused at open (the raw size is more than meshopt
+	 * can expand the container to), before any allocation. */
 	wchunk *m = &c[C_MESH1]; /* the coarsest: it sets the part count */
 	m->codec = MLOD_CODEC_MESHOPT;
 	for (int i = 0; i < m->ns; i++)
@@ -2467,12 +2468,12 @@ TEST(absurd_sizes)
 	wr32(b.p + 32 + 48 * C_MESH1 + 28, (uint32_t)raw);
 	restamp(b.p, b.n);
 	mlod_pack_mesh mesh;
-	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
 	memset(&terr, 0, sizeof terr);
-	mlod_result r1 = mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, NULL, &mesh, &terr);
+	mlod_result r1 = mlod_pack_open(b.p, b.n, &p, &terr);
 	char m1[sizeof terr.message];
 	memcpy(m1, terr.message, sizeof m1);
-	/* The same with a raw size that does not match: PARSE. */
+	/* The same with a raw size within the limit: PARSE, from the stream
+	 * (its 201 bytes cannot hold 16 M records). */
 	wr32(b.p + 32 + 48 * C_MESH1 + 28, 1000);
 	restamp(b.p, b.n);
 	mlod_pack_close(&p);
@@ -2482,9 +2483,156 @@ TEST(absurd_sizes)
 	mlod_pack_close(&p);
 	free(b.p);
 	free_chunks(c, n);
-	CHECK_MSG(r1 == MLOD_ERR_NOMEM && strstr(m1, "MESH level 1:"), "returned %d: %s", (int)r1, m1);
-	CHECK_MSG(r2 == MLOD_ERR_PARSE && strstr(terr.message, "raw size 1000 in the TOC"), "returned %d: %s", (int)r2,
-	          terr.message);
+	CHECK_MSG(r1 == MLOD_ERR_PARSE && strstr(m1, "(MESH level 1): raw size 3355443220 is more than 64 times"),
+	          "returned %d: %s", (int)r1, m1);
+	CHECK_MSG(r2 == MLOD_ERR_PARSE && strstr(terr.message, "MESH level 1: stream 0 'PART'") &&
+	              strstr(terr.message, "cannot hold 16777216 elements"),
+	          "returned %d: %s", (int)r2, terr.message);
+}
+
+/* Found by make fuzz: a CRC-valid pack whose TOC raw size of a meshopt
+ * MESH chunk (no entropy stage) was 721 MB for 2724 stored bytes made the
+ * reader allocate that much before reading the chunk. Now open refuses a
+ * raw size past 64 times the container (meshopt's most), and a container
+ * refuses a meshopt stream whose elements its bytes cannot hold, even when
+ * the raw size agrees. */
+TEST(expansion_limits)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	wchunk *m = &c[C_MESH1];
+	m->codec = MLOD_CODEC_MESHOPT;
+	for (int i = 0; i < m->ns; i++)
+		free(m->s[i].data.p);
+	m->ns = 0;
+	wstream *s = add_stream(m, MLOD_STREAM_PART, 200, MLOD_SCODEC_MESHOPT_VERTEX);
+	s->count = 0;
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	mlod_pack p;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	uint8_t *ch = b.p + p.chunks[C_MESH1].offset;
+	uint32_t stored_size = p.chunks[C_MESH1].stored_size, raw0 = p.chunks[C_MESH1].raw_size;
+	mlod_pack_close(&p);
+	uint8_t *toc_raw = b.p + 32 + 48 * C_MESH1 + 28;
+	/* 1: the TOC's raw size alone, one byte past the limit. */
+	wr32(toc_raw, 64 * stored_size + 1);
+	restamp(b.p, b.n);
+	memset(&terr, 0, sizeof terr);
+	mlod_result r1 = mlod_pack_open(b.p, b.n, &p, &terr);
+	if (r1 == MLOD_OK)
+		mlod_pack_close(&p);
+	char m1[sizeof terr.message];
+	memcpy(m1, terr.message, sizeof m1);
+	/* 2: a stream of more elements than its bytes can hold, with the raw
+	 * size agreeing and within the limit. */
+	uint32_t stored = (uint32_t)ch[16] | (uint32_t)ch[17] << 8 | (uint32_t)ch[18] << 16 | (uint32_t)ch[19] << 24;
+	uint32_t count = (64 * stored + 64) / 200 + 1;
+	wr32(ch + 4 + 4, count);
+	uint32_t raw = 4 + 16 + (count * 200 + 3) / 4 * 4;
+	wr32(toc_raw, raw);
+	restamp(b.p, b.n);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	memset(&terr, 0, sizeof terr);
+	mlod_pack_mesh mesh;
+	mlod_result r2 = mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, NULL, &mesh, &terr);
+	if (r2 == MLOD_OK)
+		mlod_pack_mesh_free(&mesh);
+	mlod_pack_close(&p);
+	free(b.p);
+	free_chunks(c, n);
+	CHECK(raw0 <= 64 * stored_size && raw <= 64 * stored_size);
+	CHECK_MSG(r1 == MLOD_ERR_PARSE && strstr(m1, "(MESH level 1): raw size") && strstr(m1, "more than 64 times"),
+	          "returned %d: %s", (int)r1, m1);
+	CHECK_MSG(r2 == MLOD_ERR_PARSE && strstr(terr.message, "MESH level 1: stream 0 'PART'") &&
+	              strstr(terr.message, "cannot hold"),
+	          "returned %d: %s", (int)r2, terr.message);
+}
+
+/* A zstd frame whose header states 64 MB but whose one block is a
+ * 100-byte RLE run: refused from its blocks before the container is
+ * allocated (before, the reader allocated the stated 64 MB first). */
+TEST(zstd_forged_size)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	free_chunks(c, n);
+	mlod_pack p;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	uint64_t off = p.chunks[C_MOT1].offset;
+	uint32_t stored = p.chunks[C_MOT1].stored_size;
+	mlod_pack_close(&p);
+	CHECK(stored >= 13);
+	const uint32_t said = 64u << 20;
+	uint8_t *f = b.p + off;
+	wr32(f, 0xFD2FB528u);  /* zstd magic */
+	f[4] = 0xA0;           /* single segment, 4-byte content size */
+	wr32(f + 5, said);
+	uint32_t h = 1u | 1u << 1 | 100u << 3; /* last block, RLE, 100 bytes */
+	f[9] = (uint8_t)h, f[10] = (uint8_t)(h >> 8), f[11] = (uint8_t)(h >> 16);
+	f[12] = 0;
+	uint8_t *e = b.p + 32 + 48 * C_MOT1;
+	e[5] = (uint8_t)(e[5] | MLOD_ENTROPY_ZSTD << 4);
+	wr32(e + 12, said); /* coded size */
+	wr32(e + 24, 13);   /* stored size */
+	wr32(e + 28, said); /* raw size */
+	restamp(b.p, b.n);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	mlod_pack_motion m;
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_motion(&p, C_MOT1, b.p, b.n, NULL, &m, &terr);
+	if (r == MLOD_OK)
+		mlod_pack_motion_free(&m);
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK_MSG(r == MLOD_ERR_PARSE && strstr(terr.message, "MOTION level ") &&
+	              strstr(terr.message, "the zstd frame's 13 bytes cannot decode to its stated 67108864"),
+	          "returned %d: %s", (int)r, terr.message);
+}
+
+/* Found by make fuzz: a MESH level of an unknown codec and entropy stage
+ * (0xf5) saying 654 MB raw, above the level decoded. The raw sizes of
+ * every level read were summed and allocated before any chunk's codec was
+ * checked; now the unknown codec is refused first (UNSUPPORTED, naming
+ * the chunk), and nothing large is allocated. */
+static size_t big_alloc;
+static void *count_malloc(void *user, size_t n)
+{
+	(void)user;
+	if (n > big_alloc)
+		big_alloc = n;
+	return malloc(n);
+}
+static void count_free(void *user, void *q)
+{
+	(void)user;
+	free(q);
+}
+
+TEST(unknown_codec_raw_size)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0);
+	free_chunks(c, n);
+	uint8_t *e = b.p + 32 + 48 * C_MESH1;
+	e[5] = 0x05;                  /* codec 5, unknown */
+	wr32(e + 28, 600u << 20);     /* raw size 600 MB */
+	restamp(b.p, b.n);
+	mlod_pack_alloc al = {count_malloc, count_free, NULL};
+	mlod_pack p;
+	CHECK_OK(mlod_pack_open_alloc(b.p, b.n, &al, &p, &terr));
+	big_alloc = 0;
+	mlod_pack_mesh m;
+	memset(&terr, 0, sizeof terr);
+	mlod_result r = mlod_pack_decode_mesh(&p, C_MESH0, b.p, b.n, NULL, &m, &terr);
+	if (r == MLOD_OK)
+		mlod_pack_mesh_free(&m);
+	mlod_pack_close(&p);
+	free(b.p);
+	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && strstr(terr.message, "MESH level 1: unknown chunk codec 5"),
+	          "returned %d: %s", (int)r, terr.message);
+	CHECK_MSG(big_alloc < (1u << 20), "largest allocation %zu bytes", big_alloc);
 }
 
 /* The meshopt codecs' constraints, and a damaged meshopt stream. */
@@ -2592,6 +2740,9 @@ int main(int argc, char **argv)
 	RUN(structural_checks_name_the_chunk);
 	RUN(toc_checks);
 	RUN(absurd_sizes);
+	RUN(expansion_limits);
+	RUN(zstd_forged_size);
+	RUN(unknown_codec_raw_size);
 	RUN(meshopt_streams);
 	RUN(mutations_plain);
 	RUN(mutations_restamped);
