@@ -87,6 +87,12 @@ _Static_assert(sizeof(mlod_pack_channel_rec) == 20, "channel record is 20 bytes"
  * more is refused before anything is sized from it, and so is a chunk
  * whose TOC raw size is more than this times its container. */
 #define PACK_MAX_EXPAND 64
+/* A Draco MESH chunk's decoded level against its container (mlod(5)):
+ * the part records size every allocation before Draco decodes, so they
+ * may not claim more than this many times the container's bytes. The
+ * writer's levels measure up to about 16 (tubeman level 0: 22,944 bytes
+ * of container, about 365 KB decoded). */
+#define PACK_DRACO_MAX_EXPAND 1024
 
 static const uint32_t crc_table[256] = {
 	0x00000000u, 0x77073096u, 0xee0e612cu, 0x990951bau, 0x076dc419u, 0x706af48fu,
@@ -1774,6 +1780,10 @@ static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const ml
 		if (total > PACK_MAX_BLOCK || big > PACK_MAX_BLOCK)
 			FAIL("%s: decoded, its parts need more than the reader's limit", x.label);
 	}
+	if (total > (uint64_t)PACK_DRACO_MAX_EXPAND * x.size)
+		FAIL("%s: its part records say %llu decoded bytes, more than %d times its %llu-byte container (Draco "
+		     "levels expand no more)",
+		     x.label, (unsigned long long)total, PACK_DRACO_MAX_EXPAND, (unsigned long long)x.size);
 	TRY(bump_alloc(&b, &x, total, err));
 	if (!(gather = pk_malloc(al, 1, (size_t)big)))
 		FAIL("%s: out of memory", x.label);

@@ -360,6 +360,57 @@ TEST(draco_corrupt_chunk_is_an_error)
 	mlod_pack_close(&k);
 	mlod_free(pk);
 }
+
+/* A Draco chunk's part record claiming millions of vertices, CRCs valid:
+ * the reader sizes its arrays from the records before Draco decodes, so it
+ * must refuse the claim against the container (PACK_DRACO_MAX_EXPAND)
+ * instead of allocating it (make fuzz found a 7 KB pack asking 683 MB). */
+TEST(draco_part_counts_bounded)
+{
+	size_t n;
+	uint8_t *pk = make_pack("samples/tubeman.glb", MLOD_CODEC_DRACO, MLOD_ENTROPY_NONE, &n);
+	CHECK_MSG(pk, "cannot pack: %s", terr.message);
+	mlod_pack k;
+	CHECK_OK(mlod_pack_open(pk, n, &k, &terr));
+	mlod_pack_skeleton sk = {0};
+	CHECK_OK(mlod_pack_decode_skeleton(&k, pk, n, &sk, &terr));
+	uint8_t *bad = malloc(n);
+	CHECK(bad != NULL);
+	uint32_t refused = 0;
+	for (uint32_t c = 0; c < k.chunk_count; c++) {
+		const mlod_pack_chunk *ch = &k.chunks[c];
+		if (ch->type != MLOD_CHUNK_MESH)
+			continue;
+		const uint8_t *base = pk + ch->offset;
+		uint32_t ns = get32(base);
+		uint64_t cur = 4 + 16 * (uint64_t)ns;
+		CHECK(ns > 0 && get32(base + 4) == MLOD_STREAM_PART);
+		memcpy(bad, pk, n);
+		/* the first part: 4 million vertices, 4 million triangles */
+		uint8_t *rec = bad + ch->offset + cur;
+		put32(rec + offsetof(mlod_pack_part_rec, vertex_count), 4000000u);
+		put32(rec + offsetof(mlod_pack_part_rec, index_count), 12000000u);
+		uint8_t *e = bad + 32 + 48 * (size_t)c;
+		put32(e + 32, mlod_pack_crc32(0, bad + ch->offset, ch->stored_size));
+		put32(bad + 24, mlod_pack_crc32(0, bad + 32, 48 * (size_t)k.chunk_count));
+		put32(bad + 28, mlod_pack_crc32(0, bad, 28));
+		mlod_pack kb;
+		CHECK_OK(mlod_pack_open(bad, n, &kb, &terr));
+		mlod_pack_mesh m = {0};
+		mlod_result r = mlod_pack_decode_mesh(&kb, c, bad, n, &sk, &m, &terr);
+		CHECK_MSG(r == MLOD_ERR_PARSE, "level %u: result %d: %s", ch->level, r, terr.message);
+		CHECK_MSG(strstr(terr.message, "MESH level") && strstr(terr.message, "times its"), "message: %s",
+		          terr.message);
+		CHECK(m.parts == NULL && m.block == NULL);
+		mlod_pack_close(&kb);
+		refused++;
+	}
+	CHECK(refused == 5);
+	free(bad);
+	mlod_pack_skeleton_free(&sk);
+	mlod_pack_close(&k);
+	mlod_free(pk);
+}
 #endif
 
 int main(void)
@@ -371,6 +422,7 @@ int main(void)
 	RUN(draco_rt_skin_equal_tubeman);
 	RUN(draco_rt_skin_equal_robot);
 	RUN(draco_corrupt_chunk_is_an_error);
+	RUN(draco_part_counts_bounded);
 #endif
 	TEST_EXIT();
 }
