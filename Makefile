@@ -221,7 +221,6 @@ $(B)/tests/test_openmesh: tests/openmesh/test_openmesh.cpp lib/mlod.h $(B)/libml
 # Both stop at an input slower than FUZZ_TIMEOUT s or past FUZZ_RSS_MB
 # (crashes in build/fuzz/crash-pack, crash-unpack) and first replay the
 # inputs of fixed findings (tests/fuzz/regress/pack, regress/unpack).
-# tests/fuzz/open holds inputs of findings not fixed yet (not replayed).
 FUZZ_CC ?= clang
 FUZZ_CXX ?= clang++
 FUZZ_TIME ?= 60
