@@ -1595,6 +1595,28 @@ static mlod_result mesh_begin(const mesh_src *m, uint32_t index, const uint8_t *
 	return cx_parse(x, err);
 }
 
+/* A part's MTSC stream s (its target count, checked): pt->targets and
+ * *scales taken from the level's block, the scales copied and checked. */
+static mlod_result morph_scales(cx *x, bump *bp, const stream *s, mlod_pack_part *pt, uint32_t i, float **scales,
+                                mlod_error *err)
+{
+	const uint8_t *src;
+	const uint32_t T = pt->rec.target_count;
+	mlod_result r = cx_load(x, s, &src, err);
+	if (r != MLOD_OK)
+		return r;
+	pt->targets = bump_take(bp, (uint64_t)T * sizeof(float *));
+	*scales = bump_take(bp, (uint64_t)T * 4);
+	if (!pt->targets || !*scales)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: internal block size mismatch", x->label);
+	memcpy(*scales, src, (size_t)T * 4);
+	for (uint32_t t = 0; t < T; t++)
+		if (!((*scales)[t] >= 0) || !isfinite((*scales)[t] * 32768.0f))
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: part %u: morph target %u: scale %g is not finite and >= 0",
+			                 x->label, i, t, (double)(*scales)[t]);
+	return MLOD_OK;
+}
+
 /* Dequantises a decoded part: gather holds its vertex attributes (as
  * part_vstreams lists them) one after the other, each vertex_count
  * elements, then its targets' 'MTPQ' elements the same way; scales the
@@ -1822,14 +1844,7 @@ static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const ml
 		float *scales = NULL;
 		if (T) {
 			TRY(cx_expect(&x, &s, MLOD_STREAM_MTSC, 4, T, what, "target count", err));
-			TRY(cx_load(&x, &s, &src, err));
-			TAKE(pt->targets, (uint64_t)T * sizeof(float *));
-			TAKE(scales, (uint64_t)T * 4);
-			memcpy(scales, src, (size_t)T * 4);
-			for (uint32_t t = 0; t < T; t++)
-				if (!(scales[t] >= 0) || !isfinite(scales[t] * 32768.0f))
-					FAIL("%s: part %u: morph target %u: scale %g is not finite and >= 0", x.label, i, t,
-					     (double)scales[t]);
+			TRY(morph_scales(&x, &b, &s, pt, i, &scales, err));
 		}
 		TRY(part_dequant(x.label, &b, pt, i, gather, scales, skel, err));
 	}
@@ -2209,14 +2224,7 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			uint32_t T = rc->target_count;
 			if (T) {
 				cx_next(&x, &s); /* 'MTSC', checked above */
-				TRY(cx_load(&x, &s, &src, err));
-				TAKE(pt->targets, (uint64_t)T * sizeof(float *));
-				TAKE(scales, (uint64_t)T * 4);
-				memcpy(scales, src, (size_t)T * 4);
-				for (uint32_t t = 0; t < T; t++)
-					if (!(scales[t] >= 0) || !isfinite(scales[t] * 32768.0f))
-						FAIL("%s: part %u: morph target %u: scale %g is not finite and >= 0", x.label, i, t,
-						     (double)scales[t]);
+				TRY(morph_scales(&x, &b, &s, pt, i, &scales, err));
 				for (uint32_t t = 0; t < T; t++)
 					cx_next(&x, &s);
 			}
