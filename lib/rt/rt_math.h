@@ -26,6 +26,19 @@ static inline rt_m4 rt_m4_load(const float *p)
 	return v;
 }
 
+/* An affine matrix's columns stored at out, its bottom row set in the
+ * vectors, not stored over them: a matrix read back a column per load
+ * (the next joint's parent) then comes from one store each (no
+ * store-to-load forwarding stall). */
+static inline void rt_m4_store_affine(float *out, rt_m4 r0, rt_m4 r1, rt_m4 r2, rt_m4 r3)
+{
+	r0[3] = r1[3] = r2[3] = 0.0f, r3[3] = 1.0f;
+	memcpy(out, &r0, sizeof r0);
+	memcpy(out + 4, &r1, sizeof r1);
+	memcpy(out + 8, &r2, sizeof r2);
+	memcpy(out + 12, &r3, sizeof r3);
+}
+
 static inline void rt_mat_mul(const float *a, const float *b, float *out)
 {
 	const rt_m4 a0 = rt_m4_load(a), a1 = rt_m4_load(a + 4), a2 = rt_m4_load(a + 8), a3 = rt_m4_load(a + 12);
@@ -34,14 +47,7 @@ static inline void rt_mat_mul(const float *a, const float *b, float *out)
 	rt_m4 r1 = a0 * b1[0] + a1 * b1[1] + a2 * b1[2];
 	rt_m4 r2 = a0 * b2[0] + a1 * b2[1] + a2 * b2[2];
 	rt_m4 r3 = a0 * b3[0] + a1 * b3[1] + a2 * b3[2] + a3;
-	/* the bottom row set in the vectors, not stored over them: a matrix
-	 * read back a column per load (the next joint's parent) then comes
-	 * from one store each (no store-to-load forwarding stall) */
-	r0[3] = r1[3] = r2[3] = 0.0f, r3[3] = 1.0f;
-	memcpy(out, &r0, sizeof r0);
-	memcpy(out + 4, &r1, sizeof r1);
-	memcpy(out + 8, &r2, sizeof r2);
-	memcpy(out + 12, &r3, sizeof r3);
+	rt_m4_store_affine(out, r0, r1, r2, r3);
 }
 #else
 static inline void rt_mat_mul(const float *a, const float *b, float *out)
@@ -99,11 +105,7 @@ static inline void rt_mat_mul_rs(const float *restrict parent, const float *l, s
 	rt_m4 r1 = a0 * l[3 * stride] + a1 * l[4 * stride] + a2 * l[5 * stride];
 	rt_m4 r2 = a0 * l[6 * stride] + a1 * l[7 * stride] + a2 * l[8 * stride];
 	rt_m4 r3 = a0 * tr[0] + a1 * tr[1] + a2 * tr[2] + a3;
-	r0[3] = r1[3] = r2[3] = 0.0f, r3[3] = 1.0f;
-	memcpy(out, &r0, sizeof r0);
-	memcpy(out + 4, &r1, sizeof r1);
-	memcpy(out + 8, &r2, sizeof r2);
-	memcpy(out + 12, &r3, sizeof r3);
+	rt_m4_store_affine(out, r0, r1, r2, r3);
 #else
 	float b[16];
 	for (int c = 0; c < 3; c++)
@@ -143,11 +145,7 @@ static inline void rt_mat_mul_trs(const float *restrict parent, const mlod_trs *
 	rt_m4 r1 = a0 * m4 + a1 * m5 + a2 * m6;
 	rt_m4 r2 = a0 * m8 + a1 * m9 + a2 * m10;
 	rt_m4 r3 = a0 * t->t.x + a1 * t->t.y + a2 * t->t.z + a3;
-	r0[3] = r1[3] = r2[3] = 0.0f, r3[3] = 1.0f;
-	memcpy(out, &r0, sizeof r0);
-	memcpy(out + 4, &r1, sizeof r1);
-	memcpy(out + 8, &r2, sizeof r2);
-	memcpy(out + 12, &r3, sizeof r3);
+	rt_m4_store_affine(out, r0, r1, r2, r3);
 }
 #else
 static inline void rt_mat_mul_trs(const float *restrict parent, const mlod_trs *t, float *restrict out)
