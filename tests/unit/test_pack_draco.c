@@ -290,6 +290,16 @@ static uint32_t get32(const uint8_t *p)
 	return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
+/* Chunk c's CRC in the TOC, the TOC's and the header's made valid again
+ * after its stored bytes were changed in pk (a copy of k's pack). */
+static void restamp(uint8_t *pk, const mlod_pack *k, uint32_t c)
+{
+	const mlod_pack_chunk *ch = &k->chunks[c];
+	put32(pk + 32 + 48 * (size_t)c + 32, mlod_pack_crc32(0, pk + ch->offset, ch->stored_size));
+	put32(pk + 24, mlod_pack_crc32(0, pk + 32, 48 * (size_t)k->chunk_count));
+	put32(pk + 28, mlod_pack_crc32(0, pk, 28));
+}
+
 /* Bytes of the Draco streams changed (no entropy stage, so the stored
  * bytes are the container), every CRC made valid again. */
 TEST(draco_corrupt_chunk_is_an_error)
@@ -329,10 +339,7 @@ TEST(draco_corrupt_chunk_is_an_error)
 					}
 					if (t % 10 == 9) /* a truncated Draco stream: its tail zeroed */
 						memset(bad + ch->offset + cur + stored / 2, 0, stored - stored / 2);
-					uint8_t *e = bad + 32 + 48 * (size_t)c;
-					put32(e + 32, mlod_pack_crc32(0, bad + ch->offset, ch->stored_size));
-					put32(bad + 24, mlod_pack_crc32(0, bad + 32, 48 * (size_t)k.chunk_count));
-					put32(bad + 28, mlod_pack_crc32(0, bad, 28));
+					restamp(bad, &k, c);
 					mlod_pack kb;
 					CHECK_OK(mlod_pack_open(bad, n, &kb, &terr));
 					mlod_pack_mesh m = {0};
@@ -390,10 +397,7 @@ TEST(draco_part_counts_bounded)
 		uint8_t *rec = bad + ch->offset + cur;
 		put32(rec + offsetof(mlod_pack_part_rec, vertex_count), 4000000u);
 		put32(rec + offsetof(mlod_pack_part_rec, index_count), 12000000u);
-		uint8_t *e = bad + 32 + 48 * (size_t)c;
-		put32(e + 32, mlod_pack_crc32(0, bad + ch->offset, ch->stored_size));
-		put32(bad + 24, mlod_pack_crc32(0, bad + 32, 48 * (size_t)k.chunk_count));
-		put32(bad + 28, mlod_pack_crc32(0, bad, 28));
+		restamp(bad, &k, c);
 		mlod_pack kb;
 		CHECK_OK(mlod_pack_open(bad, n, &kb, &terr));
 		mlod_pack_mesh m = {0};
