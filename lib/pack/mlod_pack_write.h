@@ -98,6 +98,9 @@ typedef struct mlod_pack_options {
 	                              * morph deltas: 2^(bits-1) - 1 steps of their largest |value| */
 	int normal_bits;             /* normals, tangents: octahedral codes on a 2^bits lattice */
 	int uv_bits;                 /* UVs: 2^bits - 1 steps of the part's UV box per axis */
+	double coarse_share;         /* a vertex only coarse levels have: rounded within this share
+	                              * of their TOC error (MLOD_PACK_COARSE_SHARE; 0: level 0's
+	                              * steps for every vertex, as before format 4.x's writer) */
 } mlod_pack_options;
 
 void mlod_pack_options_default(mlod_pack_options *opt);
@@ -198,6 +201,29 @@ float mlod_pack_range_scale(float min, float max);
 /* The scale at `bits` (1 to 16): (max - min) / (2^bits - 1), so q is
  * within [0, 2^bits - 1] and |min + q * scale - v| <= scale / 2. */
 float mlod_pack_range_scale_bits(float min, float max, int bits);
+/* The same on a coarser grid of the same steps: q the multiple of 2^shift
+ * nearest (v - min) / scale (shift 0 to 15; clamped to 0 .. 65535), so
+ * |min + q * scale - v| <= 2^shift scale / 2 where that stays in range. */
+uint16_t mlod_pack_qu16_shift(float v, float min, float scale, int shift);
+
+/* Coarse levels' steps (mlod(5) QUANTISATION). A part's vertex that no
+ * finer level has with the same quantised attributes on level 0's steps,
+ * whose finest level is f >= 1, is rounded to a coarser multiple of the
+ * same grid (the reader's decode unchanged), within share times e, the
+ * smallest TOC error of levels f and coarser (e <= each of theirs):
+ * positions: the half-step vector (mesh units) times sigma, the largest
+ * singular value bound of the part's rest skinning matrices, within
+ * share e; normals: the octahedral bound within share e / (sigma l),
+ * l the median edge length of level f's triangles (the tilt that a share
+ * of the error gives a median edge), never past MLOD_PACK_NORMAL_BITS_MIN;
+ * UVs: the half-step vector within share e rho / sigma, rho the
+ * MLOD_PACK_COARSE_UV_QUANTILE quantile over level 0's edges of UV length
+ * over length (a UV error that moves the texture on the surface by at
+ * most share e, one share of a pixel at the level's switch distance,
+ * where the texture is at least that dense). Each minimum over f and the
+ * coarser levels' own bounds. */
+#define MLOD_PACK_COARSE_SHARE 0.25
+#define MLOD_PACK_COARSE_UV_QUANTILE 0.1
 
 /* Up to 4 weights (>= 0, any sum > 0) to unorm8 summing exactly to 255
  * by largest-remainder rounding: each differs from 255 w / sum by less

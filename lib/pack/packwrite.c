@@ -968,6 +968,13 @@ struct mpart {
 	uint32_t count;
 	uint32_t *slot;         /* hash set of G's vertices: id + 1, 0 empty */
 	size_t slot_cap;
+	/* Coarse levels' own steps (part_coarse; mlod(5) QUANTISATION): per
+	 * level and vertex, the finest level that has the vertex as level 0's
+	 * steps quantise it (NULL: every vertex on level 0's steps); per
+	 * level f >= 1, the steps of a vertex whose finest level is f. */
+	uint8_t *fin[MLOD_MESH_MAX_LEVELS + 1];
+	int pos_shift[MLOD_MESH_MAX_LEVELS + 1], nrm_bits[MLOD_MESH_MAX_LEVELS + 1];
+	int uv_shift[MLOD_MESH_MAX_LEVELS + 1][MLOD_PACK_MAX_UV];
 };
 
 /* The attributes a level primitive has (the part's skin, -1 none). */
@@ -1054,12 +1061,15 @@ static void part_quantise(struct ctx *x, const struct mpart *m, int k, uint8_t *
 		uint8_t *o = V + (size_t)v * (size_t)m->stride;
 		int a = 0;
 		uint16_t q[4] = {0, 0, 0, 0};
+		int f = m->fin[k] ? m->fin[k][v] : 0; /* the vertex's finest level: its steps */
 		for (int c = 0; c < 3; c++)
-			q[c] = mlod_pack_qu16(p->positions[3 * v + c], rec->pos_min[c], rec->pos_scale[c]);
+			q[c] = f ? mlod_pack_qu16_shift(p->positions[3 * v + c], rec->pos_min[c], rec->pos_scale[c],
+			                                m->pos_shift[f])
+			         : mlod_pack_qu16(p->positions[3 * v + c], rec->pos_min[c], rec->pos_scale[c]);
 		memcpy(o + m->attr[a++].off, q, 8);
 		if (p->normals) {
 			int16_t s[2];
-			mlod_pack_oct_encode_bits(p->normals + 3 * v, x->opt->normal_bits, s);
+			mlod_pack_oct_encode_bits(p->normals + 3 * v, f ? m->nrm_bits[f] : x->opt->normal_bits, s);
 			memcpy(o + m->attr[a++].off, s, 4);
 		}
 		if (p->tangents) {
@@ -1071,7 +1081,9 @@ static void part_quantise(struct ctx *x, const struct mpart *m, int k, uint8_t *
 		for (uint32_t s = 0; s < rec->uv_sets; s++) {
 			uint16_t u[2];
 			for (int c = 0; c < 2; c++)
-				u[c] = mlod_pack_qu16(p->uvs[s][2 * v + c], rec->uv_min[s][c], rec->uv_scale[s][c]);
+				u[c] = f ? mlod_pack_qu16_shift(p->uvs[s][2 * v + c], rec->uv_min[s][c], rec->uv_scale[s][c],
+				                                m->uv_shift[f][s])
+				         : mlod_pack_qu16(p->uvs[s][2 * v + c], rec->uv_min[s][c], rec->uv_scale[s][c]);
 			memcpy(o + m->attr[a++].off, u, 4);
 		}
 		if (p->color_set_count > 0) {
@@ -1121,6 +1133,219 @@ static uint64_t vhash(const uint8_t *p, int n)
 	for (int i = 0; i < n; i++)
 		h = (h ^ p[i]) * 1099511628211ull;
 	return h;
+}
+
+static double sigma_bound3(const mlod_mat4 *w);
+
+static int dbl_asc(const void *a, const void *b)
+{
+	double p = *(const double *)a, q = *(const double *)b;
+	return p < q ? -1 : p > q;
+}
+
+/* The part's skinning scale at the rest pose: the largest singular value
+ * bound (sigma_bound3) of its skin's matrices (joint world times inverse
+ * bind), or of its rigid matrix (joint world times offset, or offset). */
+static double part_sigma(const struct ctx *x, const struct mpart *m)
+{
+	const mlod_pack_part_rec *rec = &m->rec;
+	const mlod_character *c = &x->v;
+	if (m->skinned) {
+		const mlod_skin *sk = &c->skeleton.skins[rec->skin];
+		double s = 0.0;
+		for (int j = 0; j < sk->joint_count; j++) {
+			mlod_mat4 J = mlod_mat4_mul(&x->world[sk->joints[j]], &sk->inverse_bind[j]);
+			double g = sigma_bound3(&J);
+			s = g > s ? g : s;
+		}
+		return s;
+	}
+	const mlod_instance *in = &c->instances[rec->instance];
+	mlod_mat4 R = in->joint >= 0 ? mlod_mat4_mul(&x->world[in->joint], &in->offset) : in->offset;
+	return sigma_bound3(&R);
+}
+
+/* The q-th quantile (0 to 1, the lower of two) of n values, sorted in
+ * place; 0 when n is 0. */
+static double quantile(double *v, size_t n, double q)
+{
+	if (n == 0)
+		return 0.0;
+	qsort(v, n, sizeof *v, dbl_asc);
+	size_t i = (size_t)(q * (double)(n - 1));
+	return v[i];
+}
+
+/* The median length of the primitive's triangle edges (mesh units; work
+ * holds 3 per triangle). */
+static double coarse_edge(const mlod_primitive *p, double *work)
+{
+	uint32_t ni = p->index_count > 0 ? (uint32_t)p->index_count : (uint32_t)p->vertex_count;
+	size_t n = 0;
+	for (uint32_t t = 0; t + 3 <= ni; t += 3)
+		for (int e = 0; e < 3; e++) {
+			uint32_t a = p->index_count > 0 ? p->indices[t + e] : t + e;
+			uint32_t b = p->index_count > 0 ? p->indices[t + (e + 1) % 3] : t + (e + 1) % 3;
+			double d = 0.0;
+			for (int c = 0; c < 3; c++) {
+				double u = (double)p->positions[3 * a + c] - p->positions[3 * b + c];
+				d += u * u;
+			}
+			if (d > 0.0)
+				work[n++] = sqrt(d);
+		}
+	return quantile(work, n, 0.5);
+}
+
+/* The texture's density in UV units per mesh unit: the
+ * MLOD_PACK_COARSE_UV_QUANTILE quantile over the primitive's edges of UV
+ * length over length (those with both above 0). */
+static double coarse_density(const mlod_primitive *p, int set, double *work)
+{
+	uint32_t ni = p->index_count > 0 ? (uint32_t)p->index_count : (uint32_t)p->vertex_count;
+	size_t n = 0;
+	for (uint32_t t = 0; t + 3 <= ni; t += 3)
+		for (int e = 0; e < 3; e++) {
+			uint32_t a = p->index_count > 0 ? p->indices[t + e] : t + e;
+			uint32_t b = p->index_count > 0 ? p->indices[t + (e + 1) % 3] : t + (e + 1) % 3;
+			double d = 0.0, u = 0.0;
+			for (int c = 0; c < 3; c++) {
+				double w = (double)p->positions[3 * a + c] - p->positions[3 * b + c];
+				d += w * w;
+			}
+			for (int c = 0; c < 2; c++) {
+				double w = (double)p->uvs[set][2 * a + c] - p->uvs[set][2 * b + c];
+				u += w * w;
+			}
+			if (d > 0.0 && u > 0.0)
+				work[n++] = sqrt(u / d);
+		}
+	return quantile(work, n, MLOD_PACK_COARSE_UV_QUANTILE);
+}
+
+/* The largest shift (0 to 15) whose steps, scale * 2^shift per axis of
+ * n, stay within bound as a half-step vector, with every code of the
+ * range [0, qmax] still rounding within 0 .. 65535. */
+static int coarse_shift(const float *scale, const uint32_t *qmax, int n, double bound)
+{
+	int best = 0;
+	for (int sh = 1; sh <= 15; sh++) {
+		double h = 0.0;
+		int fits = 1;
+		for (int a = 0; a < n; a++) {
+			double st = ldexp((double)scale[a], sh);
+			h += st * st;
+			fits &= qmax[a] + ldexp(1.0, sh - 1) + 1.0 <= 65535.0;
+		}
+		if (!fits || !(sqrt(h) / 2.0 <= bound))
+			break;
+		best = sh;
+	}
+	return best;
+}
+
+/* Per vertex of every level, the finest level that has it on level 0's
+ * steps (the same quantised attributes), and per level f >= 1 the steps
+ * of the vertices whose finest level is f: within the writer's share of
+ * the smallest TOC error of the levels f and coarser, as mlod(5)
+ * QUANTISATION states. Nothing (every vertex on level 0's steps) with a
+ * share of 0, one level, or the Draco codec. 0, or -1 out of memory. */
+static int part_coarse(struct ctx *x, struct mpart *m, int M)
+{
+	double share = x->opt->coarse_share;
+	if (!(share > 0.0) || M < 2 || x->draco)
+		return 0;
+	size_t total = 0, most = 0;
+	for (int k = 0; k < M; k++) {
+		size_t nv = (size_t)m->lv[k]->vertex_count, ni = m->lv[k]->index_count > 0 ? (size_t)m->lv[k]->index_count : nv;
+		total += nv;
+		most = 3 * ni > most ? 3 * ni : most;
+	}
+	size_t cap = 16;
+	while (cap < 2 * total + 2)
+		cap *= 2;
+	uint8_t *K = malloc(total * (size_t)m->stride + 1);
+	uint32_t *slot = calloc(cap, sizeof *slot);
+	uint8_t *lev = malloc(total + 1);
+	double *work = malloc(sizeof *work * (most + 1));
+	int ok = K && slot && lev && work;
+	uint32_t count = 0;
+	/* Level 0's steps: the finest level of each distinct key. */
+	for (int k = 0; ok && k < M; k++) {
+		const mlod_primitive *p = m->lv[k];
+		uint8_t *V = malloc((size_t)p->vertex_count * (size_t)m->stride + 1);
+		uint8_t *fk = malloc((size_t)p->vertex_count + 1);
+		if (!V || !fk) {
+			free(V), free(fk);
+			ok = 0;
+			break;
+		}
+		part_quantise(x, m, k, V); /* level 0's steps: fin[k] is still NULL */
+		m->fin[k] = fk;
+		for (int v = 0; v < p->vertex_count; v++) {
+			const uint8_t *key = V + (size_t)v * (size_t)m->stride;
+			size_t i = vhash(key, m->stride) & (cap - 1);
+			while (slot[i] && memcmp(K + (size_t)(slot[i] - 1) * (size_t)m->stride, key, (size_t)m->stride) != 0)
+				i = (i + 1) & (cap - 1);
+			if (!slot[i]) {
+				memcpy(K + (size_t)count * (size_t)m->stride, key, (size_t)m->stride);
+				lev[count] = (uint8_t)k;
+				slot[i] = ++count;
+			}
+			m->fin[k][v] = lev[slot[i] - 1];
+		}
+		free(V);
+	}
+	/* Each level's bounds (mesh units, radians, UV units), then the
+	 * smallest of them over it and the coarser levels. */
+	double sigma = ok ? part_sigma(x, m) : 0.0;
+	double bpos[MLOD_MESH_MAX_LEVELS + 1], bnrm[MLOD_MESH_MAX_LEVELS + 1], buv[MLOD_MESH_MAX_LEVELS + 1][MLOD_PACK_MAX_UV];
+	double rho[MLOD_PACK_MAX_UV] = {0};
+	for (uint32_t s = 0; ok && s < m->rec.uv_sets; s++)
+		rho[s] = coarse_density(m->lv[0], (int)s, work);
+	for (int k = M - 1; ok && k >= 1; k--) {
+		double e = share * (double)x->mesh_error[k - 1];
+		if (!(e > 0.0) || !(sigma > 0.0) || !isfinite(e / sigma))
+			e = 0.0;
+		double edge = m->lv[k]->normals ? coarse_edge(m->lv[k], work) : 0.0;
+		bpos[k] = sigma > 0.0 ? e / sigma : 0.0;
+		bnrm[k] = edge > 0.0 && sigma > 0.0 ? e / (sigma * edge) : 0.0;
+		for (uint32_t s = 0; s < m->rec.uv_sets; s++)
+			buv[k][s] = e * rho[s] / (sigma > 0.0 ? sigma : 1.0);
+		if (k < M - 1) {
+			bpos[k] = fmin(bpos[k], bpos[k + 1]);
+			bnrm[k] = fmin(bnrm[k], bnrm[k + 1]);
+			for (uint32_t s = 0; s < m->rec.uv_sets; s++)
+				buv[k][s] = fmin(buv[k][s], buv[k + 1][s]);
+		}
+	}
+	for (int k = 1; ok && k < M; k++) {
+		uint32_t qmax[3];
+		for (int a = 0; a < 3; a++) {
+			float hi = m->rec.pos_min[a];
+			for (int j = 0; j < M; j++)
+				for (int v = 0; v < m->lv[j]->vertex_count; v++)
+					hi = fmaxf(hi, m->lv[j]->positions[3 * v + a]);
+			qmax[a] = mlod_pack_qu16(hi, m->rec.pos_min[a], m->rec.pos_scale[a]);
+		}
+		m->pos_shift[k] = coarse_shift(m->rec.pos_scale, qmax, 3, bpos[k]);
+		m->nrm_bits[k] = x->opt->normal_bits;
+		while (m->nrm_bits[k] > MLOD_PACK_NORMAL_BITS_MIN && mlod_pack_oct_bound(m->nrm_bits[k] - 1) <= bnrm[k])
+			m->nrm_bits[k]--;
+		for (uint32_t s = 0; s < m->rec.uv_sets; s++) {
+			uint32_t umax[2];
+			for (int a = 0; a < 2; a++) {
+				float hi = m->rec.uv_min[s][a];
+				for (int j = 0; j < M; j++)
+					for (int v = 0; v < m->lv[j]->vertex_count; v++)
+						hi = fmaxf(hi, m->lv[j]->uvs[s][2 * v + a]);
+				umax[a] = mlod_pack_qu16(hi, m->rec.uv_min[s][a], m->rec.uv_scale[s][a]);
+			}
+			m->uv_shift[k][s] = coarse_shift(m->rec.uv_scale[s], umax, 2, buv[k][s]);
+		}
+	}
+	free(K), free(slot), free(lev), free(work);
+	return ok ? 0 : -1;
 }
 
 /* The id of vertex key in the part's buffer, appending it when new. */
@@ -1294,6 +1519,8 @@ static void mesh_parts_free(struct ctx *x)
 	for (int i = 0; i < x->mp_count; i++) {
 		struct mpart *m = &x->mp[i];
 		free(m->tscale), free(m->attr), free(m->G), free(m->slot);
+		for (int k = 0; k <= MLOD_MESH_MAX_LEVELS; k++)
+			free(m->fin[k]);
 	}
 	free(x->mp);
 	x->mp = NULL;
@@ -1455,6 +1682,8 @@ static mlod_result mesh_parts(struct ctx *x, int M)
 				ATTR(MLOD_STREAM_MTPQ, 8);
 #undef ATTR
 			part_grid(x, pt, M);
+			if (part_coarse(x, pt, M) != 0)
+				return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 			pt->slot_cap = 16;
 			while (pt->slot_cap < 2 * total + 2)
 				pt->slot_cap *= 2;
@@ -2771,6 +3000,7 @@ void mlod_pack_options_default(mlod_pack_options *opt)
 	opt->position_bits = MLOD_PACK_POSITION_BITS_DEFAULT;
 	opt->normal_bits = MLOD_PACK_NORMAL_BITS_DEFAULT;
 	opt->uv_bits = MLOD_PACK_UV_BITS_DEFAULT;
+	opt->coarse_share = MLOD_PACK_COARSE_SHARE;
 	opt->motion_bound_count = (int)(sizeof bounds / sizeof *bounds);
 	opt->motion_level0_error = MLOD_PACK_MOTION_LEVEL0_DEFAULT;
 	opt->motion_level0_percent = 1;

@@ -128,6 +128,22 @@ uint16_t mlod_pack_qu16(float v, float min, float scale)
 	return (uint16_t)q;
 }
 
+uint16_t mlod_pack_qu16_shift(float v, float min, float scale, int shift)
+{
+	if (shift <= 0)
+		return mlod_pack_qu16(v, min, scale);
+	shift = shift > 15 ? 15 : shift;
+	if (!(scale > 0.0f))
+		return 0;
+	double step = ldexp(1.0, shift);
+	double q = floor(((double)v - (double)min) / (double)scale / step + 0.5) * step;
+	if (!(q > 0.0))
+		return 0;
+	while (q > 65535.0)
+		q -= step;
+	return (uint16_t)q;
+}
+
 void mlod_pack_weights8(const float w[4], uint8_t out[4])
 {
 	double sum = 0.0, rem[4];

@@ -735,7 +735,21 @@ static double frob3(const mlod_mat4 *m)
 	return sqrt(f);
 }
 
+/* hd_fixed > 0: that position bound (scene units through the skinning
+ * scale, as the coarse levels' check gives it) for every vertex, instead
+ * of half a step of bits of the primitive's box. */
+static double pose_bound_bits(const mlod_character *c, const mlod_mat4 *world, int bits, double hd_fixed);
 static double pose_bound(const mlod_character *c, const mlod_mat4 *world, int bits)
+{
+	return pose_bound_bits(c, world, bits, 0.0);
+}
+
+static double pose_bound_hd(const mlod_character *c, const mlod_mat4 *world, double hd_fixed)
+{
+	return pose_bound_bits(c, world, 16, hd_fixed);
+}
+
+static double pose_bound_bits(const mlod_character *c, const mlod_mat4 *world, int bits, double hd_fixed)
 {
 	double bound = 0;
 	const mlod_skeleton *sk = &c->skeleton;
@@ -756,7 +770,7 @@ static double pose_bound(const mlod_character *c, const mlod_mat4 *world, int bi
 				double step = ((double)hi - lo) / (ldexp(1.0, bits) - 1.0);
 				hd += step * step;
 			}
-			hd = sqrt(hd) / 2;
+			hd = hd_fixed > 0 ? hd_fixed : sqrt(hd) / 2;
 			for (int v = 0; v < p->vertex_count; v++) {
 				mlod_v3 pos = {p->positions[3 * v], p->positions[3 * v + 1], p->positions[3 * v + 2]};
 				if (!skin || p->weight_set_count == 0) {
@@ -846,6 +860,365 @@ static void posed_level0(const char *path)
 	free(in);
 }
 
+/* Coarse levels (mlod(5) QUANTISATION, a vertex only coarse levels
+ * have): the writer may round such a vertex, whose finest level is f,
+ * within share times the smallest TOC error of levels f and coarser.
+ * Checked here at each level k >= 1 against the level's own TOC error E
+ * (at least that smallest one), computed without the writer's code: the
+ * test makes the input's levels as mlod-pack does (mlod_mesh_levels with
+ * the defaults) and decodes MESH level k with the reader. Every decoded
+ * vertex of a part must have a vertex of the input level, and every
+ * vertex the input level's triangles use a decoded one, within
+ *   positions  half a step of the grid per axis, or share E / sigma as a
+ *              distance (sigma: the largest singular value bound, the
+ *              root of the largest absolute row sum of M^T M, of the
+ *              part's rest skinning matrices);
+ *   normals    the lattice bound at normal_bits, or share E / (sigma l),
+ *              l the median edge length of the level's triangles;
+ *   UVs        half a step per axis, or share E rho / sigma as a
+ *              distance, rho the 10% quantile over level 0's edges of UV
+ *              length over length.
+ * Then posed (the pose set of posed_level0): each level with its part
+ * attributes swapped for the decoded ones has a Hausdorff error within
+ * the input level's (measured here at the same poses) plus, over the
+ * level's vertices, s d + (2 dropped + 4 * 3/1020) r, d the larger of
+ * the two position bounds (pose_bound's terms). */
+static double gersh3(const mlod_mat4 *w)
+{
+	double g = 0.0;
+	for (int a = 0; a < 3; a++) {
+		double row = 0.0;
+		for (int b = 0; b < 3; b++) {
+			double d = 0.0;
+			for (int r = 0; r < 3; r++)
+				d += (double)w->m[4 * a + r] * w->m[4 * b + r];
+			row += fabs(d);
+		}
+		g = fmax(g, row);
+	}
+	return sqrt(g);
+}
+
+static int dcmp(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return x < y ? -1 : x > y;
+}
+
+/* Median edge length, or (set >= 0) the q quantile of UV over 3D edge
+ * length, over p's triangles. */
+static double edge_stat(const mlod_primitive *p, int set, double q)
+{
+	int ni = p->index_count ? p->index_count : p->vertex_count;
+	double *v = malloc(sizeof *v * (3 * (size_t)ni + 1));
+	size_t n = 0;
+	for (int t = 0; v && t + 3 <= ni; t += 3)
+		for (int e = 0; e < 3; e++) {
+			int a = p->index_count ? (int)p->indices[t + e] : t + e;
+			int b = p->index_count ? (int)p->indices[t + (e + 1) % 3] : t + (e + 1) % 3;
+			double d = 0, u = 0;
+			for (int c = 0; c < 3; c++)
+				d += pow((double)p->positions[3 * a + c] - p->positions[3 * b + c], 2);
+			if (set >= 0)
+				for (int c = 0; c < 2; c++)
+					u += pow((double)p->uvs[set][2 * a + c] - p->uvs[set][2 * b + c], 2);
+			if (d > 0 && (set < 0 || u > 0))
+				v[n++] = set < 0 ? sqrt(d) : sqrt(u / d);
+		}
+	double r = 0;
+	if (n) {
+		qsort(v, n, sizeof *v, dcmp);
+		r = v[(size_t)(q * (double)(n - 1))];
+	}
+	free(v);
+	return r;
+}
+
+struct cbounds {
+	double pos[3], pos_far, nrm, nrm_far, uv[MLOD_PACK_MAX_UV][2], uv_far[MLOD_PACK_MAX_UV];
+	int sets;
+};
+
+/* Whether vertex u of a is within the bounds of vertex v of b; *far set
+ * when only the coarse level's bounds hold. */
+static int within(const mlod_primitive *a, int u, const float *bp, const float *bn, float *const *buv, int v,
+                  const struct cbounds *B, int *far)
+{
+	double d2 = 0;
+	int fine = 1;
+	for (int c = 0; c < 3; c++) {
+		double d = fabs((double)a->positions[3 * u + c] - bp[3 * v + c]);
+		fine &= d <= B->pos[c];
+		d2 += d * d;
+	}
+	int f = !fine;
+	if (!fine && !(sqrt(d2) <= B->pos_far))
+		return 0;
+	if (a->normals && bn) {
+		const float *x = a->normals + 3 * u, *y = bn + 3 * v;
+		double cr[3] = {(double)x[1] * y[2] - (double)x[2] * y[1], (double)x[2] * y[0] - (double)x[0] * y[2],
+		                (double)x[0] * y[1] - (double)x[1] * y[0]};
+		double ang = atan2(sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]),
+		                   (double)x[0] * y[0] + (double)x[1] * y[1] + (double)x[2] * y[2]);
+		double lx = sqrt((double)x[0] * x[0] + (double)x[1] * x[1] + (double)x[2] * x[2]);
+		if (lx > 0.5 && ang > B->nrm) {
+			if (!(ang <= B->nrm_far))
+				return 0;
+			f = 1;
+		}
+	}
+	for (int s = 0; s < B->sets; s++) {
+		double e2 = 0;
+		int ufine = 1;
+		for (int c = 0; c < 2; c++) {
+			double d = fabs((double)a->uvs[s][2 * u + c] - buv[s][2 * v + c]);
+			ufine &= d <= B->uv[s][c];
+			e2 += d * d;
+		}
+		if (!ufine) {
+			if (!(sqrt(e2) <= B->uv_far[s]))
+				return 0;
+			f = 1;
+		}
+	}
+	*far |= f;
+	return 1;
+}
+
+/* Packs path at coarse_share write_share and checks every coarse level
+ * against check_share; returns NULL or what failed. *coarse counts the
+ * decoded vertices only the coarse bounds hold. */
+static const char *coarse_levels(const char *path, double write_share, double check_share, long *coarse, char *msg,
+                                 size_t cap)
+{
+	size_t n = 0, pack_size = 0;
+	void *in = test_read_file(path, &n), *pack = NULL;
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	mlod_pack_options opt;
+	mlod_mesh_levels ML;
+	mlod_pose_set poses = {0};
+	mlod_pack pk = {0};
+	mlod_pack_skeleton psk = {0};
+	const char *fail = NULL;
+	memset(&c, 0, sizeof c);
+	memset(&ML, 0, sizeof ML);
+	*coarse = 0;
+	mlod_pack_options_default(&opt);
+	opt.coarse_share = write_share;
+	if (!in || mlod_load(in, n, NULL, &doc, &c, &fmt, &terr) != MLOD_OK ||
+	    mlod_pack_write(doc, &c, fmt, in, n, &opt, &pack, &pack_size, NULL, &terr) != MLOD_OK ||
+	    mlod_pack_open(pack, pack_size, &pk, &terr) != MLOD_OK ||
+	    mlod_pack_decode_skeleton(&pk, pack, pack_size, &psk, &terr) != MLOD_OK) {
+		snprintf(msg, cap, "%s: load, pack or open: %s", path, terr.message);
+		fail = msg;
+		goto done;
+	}
+	/* The levels as mlod-pack makes them with its defaults. */
+	double ratios[MLOD_MESH_MAX_LEVELS];
+	memcpy(ratios, opt.ratios, sizeof ratios);
+	qsort(ratios, (size_t)opt.ratio_count, sizeof *ratios, dcmp); /* increasing: the smallest first */
+	mlod_bgm_options bo = opt.bgm;
+	mlod_mesh_budget budget = opt.budget;
+	mlod_mesh_resolve(&bo, &budget);
+	for (int i = 0; i < opt.ratio_count / 2; i++) {
+		double t = ratios[i];
+		ratios[i] = ratios[opt.ratio_count - 1 - i], ratios[opt.ratio_count - 1 - i] = t;
+	}
+	if (mlod_mesh_levels_init(&ML, &c, &bo, budget, ratios[opt.ratio_count - 1], &terr) != MLOD_OK ||
+	    mlod_mesh_levels_by_ratio(&ML, ratios, opt.ratio_count, &terr) != MLOD_OK ||
+	    mlod_pose_set_make(&c, 1, 8, 4, 7, 0.5f, &poses, &terr) != MLOD_OK) {
+		snprintf(msg, cap, "%s: levels: %s", path, terr.message);
+		fail = msg;
+		goto done;
+	}
+	mlod_mat4 *world = malloc(sizeof *world * ((size_t)c.skeleton.joint_count + 1));
+	mlod_trs *local = malloc(sizeof *local * ((size_t)c.skeleton.joint_count + 1));
+	mlod_pose_rest(&c.skeleton, local);
+	mlod_pose_world(&c.skeleton, local, world);
+	free(local);
+	for (int k = 1; !fail && k <= ML.count; k++) {
+		int ci = mlod_pack_find(&pk, MLOD_CHUNK_MESH, (unsigned)k, 0);
+		mlod_pack_mesh pm = {0};
+		if (ci < 0 || mlod_pack_decode_mesh(&pk, (uint32_t)ci, pack, pack_size, &psk, &pm, &terr) != MLOD_OK) {
+			snprintf(msg, cap, "%s: MESH level %d: %s", path, k, ci < 0 ? "missing" : terr.message);
+			fail = msg;
+			break;
+		}
+		double E = pk.chunks[ci].error, hd_max = 0;
+		mlod_mesh_level *L = &ML.levels[k - 1];
+		mlod_primitive saved[64];
+		int nsaved = 0, swapped[64][2];
+		for (uint32_t q = 0; !fail && q < pm.part_count; q++) {
+			const mlod_pack_part *pp = &pm.parts[q];
+			int i = (int)pp->rec.instance, pr = (int)pp->rec.primitive;
+			if (i >= c.instance_count || c.instances[i].node != pp->rec.node ||
+			    pr >= L->meshes[i].primitive_count) {
+				snprintf(msg, cap, "%s: level %d part %u: no input primitive", path, k, q);
+				fail = msg;
+				break;
+			}
+			mlod_primitive *A = &L->meshes[i].primitives[pr];
+			const mlod_instance *inst = &c.instances[i];
+			const mlod_primitive *A0 = &c.meshes[inst->mesh].primitives[pr];
+			double sigma = 0;
+			if (inst->skin >= 0 && A->weight_set_count > 0) {
+				const mlod_skin *sk = &c.skeleton.skins[inst->skin];
+				for (int j = 0; j < sk->joint_count; j++) {
+					mlod_mat4 J = mlod_mat4_mul(&world[sk->joints[j]], &sk->inverse_bind[j]);
+					sigma = fmax(sigma, gersh3(&J));
+				}
+			} else {
+				mlod_mat4 R = inst->joint >= 0 ? mlod_mat4_mul(&world[inst->joint], &inst->offset) : inst->offset;
+				sigma = gersh3(&R);
+			}
+			double far = sigma > 0 ? check_share * E / sigma : 0;
+			struct cbounds B = {{0}, far, oct_bound(), 0, {{0}}, {0}, (int)pp->rec.uv_sets};
+			double hd = 0;
+			for (int a = 0; a < 3; a++) {
+				B.pos[a] = pp->rec.pos_scale[a] / 2.0 * (1 + 1e-4) + 1e-6 * fabs(pp->rec.pos_min[a]);
+				hd += (double)pp->rec.pos_scale[a] * pp->rec.pos_scale[a];
+			}
+			hd_max = fmax(hd_max, fmax(sqrt(hd) / 2, far)); /* mesh units */
+			B.pos_far = far * (1 + 1e-5) + 1e-6 * sqrt(hd) * 65535;
+			double l = edge_stat(A, -1, 0.5);
+			B.nrm_far = l > 0 && sigma > 0 ? check_share * E / (sigma * l) * (1 + 1e-6) + 2e-6 : 0;
+			for (int s = 0; s < B.sets; s++) {
+				double rho = edge_stat(A0, s, 0.1), h2 = 0;
+				for (int a = 0; a < 2; a++) {
+					B.uv[s][a] = pp->rec.uv_scale[s][a] / 2.0 * (1 + 1e-4) + 1e-6 * fabs(pp->rec.uv_min[s][a]);
+					h2 += (double)pp->rec.uv_scale[s][a] * pp->rec.uv_scale[s][a];
+				}
+				B.uv_far[s] = (sigma > 0 ? far * rho : 0) * (1 + 1e-5) + 1e-6 * sqrt(h2) * 65535;
+			}
+			/* decoded -> input */
+			uint32_t nv = pp->rec.vertex_count;
+			for (uint32_t u = 0; !fail && u < nv; u++) {
+				int ok = 0, f = 0, fbest = 1;
+				mlod_primitive D = {0};
+				D.positions = pp->positions, D.normals = pp->normals;
+				for (int s = 0; s < B.sets; s++)
+					D.uvs[s] = pp->uvs[s];
+				for (int v = 0; v < A->vertex_count && !(ok && !fbest); v++) {
+					f = 0;
+					if (within(&D, (int)u, A->positions, A->normals, A->uvs, v, &B, &f))
+						ok = 1, fbest = fbest && f;
+				}
+				if (!ok) {
+					snprintf(msg, cap, "%s: level %d part %u: decoded vertex %u (%g %g %g) has no input vertex within its bounds",
+					         path, k, q, u, pp->positions[3 * u], pp->positions[3 * u + 1], pp->positions[3 * u + 2]);
+					fail = msg;
+				}
+				*coarse += ok && fbest;
+			}
+			/* input -> decoded, the vertices its triangles use */
+			int ni = A->index_count ? A->index_count : A->vertex_count;
+			unsigned char *used = calloc((size_t)A->vertex_count + 1, 1);
+			for (int t = 0; used && t < ni; t++)
+				used[A->index_count ? A->indices[t] : (uint32_t)t] = 1;
+			for (int v = 0; !fail && used && v < A->vertex_count; v++) {
+				if (!used[v])
+					continue;
+				int ok = 0, f = 0;
+				for (uint32_t u = 0; !ok && u < nv; u++) {
+					mlod_primitive D = {0};
+					D.positions = pp->positions, D.normals = pp->normals;
+					for (int s = 0; s < B.sets; s++)
+						D.uvs[s] = pp->uvs[s];
+					ok = within(&D, (int)u, A->positions, A->normals, A->uvs, v, &B, &f);
+				}
+				if (!ok) {
+					snprintf(msg, cap, "%s: level %d part %u: input vertex %d has no decoded vertex within its bounds", path,
+					         k, q, v);
+					fail = msg;
+				}
+			}
+			free(used);
+			/* swap the decoded attributes in for the posed check (a
+			 * level primitive of its own only) */
+			if (!fail && nsaved < 64 && A != A0 && (uint32_t)A->target_count == 0 && A->color_set_count == 0 &&
+			    (!A->weight_set_count || pp->weights)) {
+				saved[nsaved] = *A;
+				swapped[nsaved][0] = i, swapped[nsaved][1] = pr;
+				nsaved++;
+				A->vertex_count = (int)nv, A->positions = pp->positions, A->normals = pp->normals;
+				A->tangents = pp->tangents;
+				for (int s = 0; s < B.sets; s++)
+					A->uvs[s] = pp->uvs[s];
+				if (A->weight_set_count)
+					A->weight_set_count = 1, A->joints[0] = pp->joints, A->weights[0] = pp->weights;
+				A->index_count = (int)pp->rec.index_count, A->indices = pp->indices;
+			}
+		}
+		if (!fail) {
+			/* posed: the level as decoded against the level as input */
+			mlod_deviation dd, di;
+			double qb = 0;
+			int okp = mlod_posed_error(&c, &L->view, &poses, &dd, &terr) == MLOD_OK;
+			for (int j = nsaved - 1; j >= 0; j--)
+				L->meshes[swapped[j][0]].primitives[swapped[j][1]] = saved[j];
+			nsaved = 0;
+			okp = okp && mlod_posed_error(&c, &L->view, &poses, &di, &terr) == MLOD_OK;
+			for (int pz = 0; okp && pz < poses.count; pz++)
+				qb = fmax(qb, pose_bound_hd(&L->view, poses.world + (size_t)pz * (size_t)poses.joint_count, hd_max));
+			double got = dd.max / 100 * dd.scale, base = di.max / 100 * di.scale;
+			fprintf(stderr, "%s share %.3g (checked at %.3g) level %d: TOC error %.4g; posed max %.5g (input %.5g; %+.3f of the bound %.4g), as %% of the diagonal max %.5f (input %.5f), mean %.5f (input %.5f)\n",
+			        path, write_share, check_share, k, E, got, base, qb > 0 ? (got - base) / qb : 0.0, qb, dd.max, di.max,
+			        dd.mean, di.mean);
+			if (!okp) {
+				snprintf(msg, cap, "%s: level %d posed: %s", path, k, terr.message);
+				fail = msg;
+			} else if (got > base + qb + 1e-6 * dd.scale) {
+				snprintf(msg, cap, "%s: level %d posed error %g, input level %g + bound %g", path, k, got, base, qb);
+				fail = msg;
+			}
+		}
+		for (int j = nsaved - 1; j >= 0; j--)
+			L->meshes[swapped[j][0]].primitives[swapped[j][1]] = saved[j];
+		mlod_pack_mesh_free(&pm);
+	}
+	free(world);
+done:
+	mlod_pose_set_free(&poses);
+	mlod_mesh_levels_free(&ML);
+	mlod_pack_skeleton_free(&psk);
+	mlod_pack_close(&pk);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	mlod_free(pack);
+	free(in);
+	return fail;
+}
+
+static void coarse_sample(const char *path)
+{
+	char msg[1024];
+	long coarse = 0, none = 0;
+	nrm_bits = MLOD_PACK_NORMAL_BITS_DEFAULT;
+	const char *why = coarse_levels(path, MLOD_PACK_COARSE_SHARE, MLOD_PACK_COARSE_SHARE, &coarse, msg, sizeof msg);
+	CHECK_MSG(!why, "%.900s", why);
+	fprintf(stderr, "%s: %ld decoded vertices of levels >= 1 within the coarse bounds only\n", path, coarse);
+	CHECK_MSG(coarse > 0, "%s: no vertex rounded coarser than level 0's steps", path);
+	/* The check fails on a pack rounded within four times the share. */
+	why = coarse_levels(path, 4 * MLOD_PACK_COARSE_SHARE, MLOD_PACK_COARSE_SHARE, &coarse, msg, sizeof msg);
+	CHECK_MSG(why != NULL, "%s: a pack at 4 times the share passed the check at the share", path);
+	/* Share 0: every vertex on level 0's steps. */
+	why = coarse_levels(path, 0.0, 0.0, &none, msg, sizeof msg);
+	CHECK_MSG(!why, "%.900s", why);
+	CHECK_MSG(none == 0, "%s: share 0: %ld vertices off level 0's steps", path, none);
+}
+
+TEST(coarse_tubeman) { coarse_sample("samples/tubeman.glb"); }
+TEST(coarse_robot) { coarse_sample("samples/RobotExpressive.glb"); }
+TEST(coarse_shared_ely)
+{
+	NEED_SHARED();
+	char path[1024];
+	snprintf(path, sizeof path, "%s/Ely.glb", getenv("MLOD_SHARED_DATA"));
+	coarse_sample(path);
+}
+
 TEST(posed_tubeman) { posed_level0("samples/tubeman.glb"); }
 TEST(posed_robot) { posed_level0("samples/RobotExpressive.glb"); }
 TEST(posed_shared_ely)
@@ -885,5 +1258,8 @@ int main(void)
 	RUN(posed_tubeman);
 	RUN(posed_robot);
 	RUN(posed_shared_ely);
+	RUN(coarse_tubeman);
+	RUN(coarse_robot);
+	RUN(coarse_shared_ely);
 	TEST_EXIT();
 }
