@@ -35,7 +35,10 @@
  *       writer's form (format 3.0: the level's own numbering and its map
  *       where that codes smaller, mlod_pack_index_cost): checked against
  *       the MESH chunks mlod_pack_write makes of the same input (their
- *       streams but 'PART', same padding), the two must agree.
+ *       streams but 'PART', same padding), the two must agree (the
+ *       writer with coarse_share 0: (b) puts every vertex on level 0's
+ *       steps, where the pack rounds a vertex only coarse levels have to
+ *       coarser ones, mlod(5) QUANTISATION).
  *
  * Per input: stream bytes of (a), of (a) quantised on (b)'s grid (what
  * the grid alone changes), b1 and b2; unique vertices of (b)
@@ -799,6 +802,7 @@ static size_t packed_mesh_bytes(const char *path, int *levels)
 	mlod_pack_options opt;
 	mlod_pack_options_default(&opt);
 	opt.entropy = MLOD_ENTROPY_NONE; /* the streams as the codec stores them, read in place below */
+	opt.coarse_share = 0.0;          /* every vertex on level 0's steps, as (b) quantises them */
 	void *pack = NULL;
 	size_t pack_size = 0;
 	if (mlod_pack_write(doc, &c, mlod_detect_format(data, got), data, got, &opt, &pack, &pack_size, NULL, &err) !=

@@ -175,6 +175,31 @@ TEST(range_bits_within_half_a_step)
 		}
 }
 
+/* mlod_pack_qu16_shift: a multiple of 2^shift, within 2^shift steps / 2
+ * of the value (a 14-bit grid, so no code leaves 0 .. 65535), the same
+ * code as mlod_pack_qu16 at shift 0. */
+TEST(range_shift_within_half_a_coarse_step)
+{
+	for (int sh = 0; sh <= 15; sh++)
+		for (int c = 0; c < 5000; c++) {
+			float lo = (frand() - 0.5f) * 200.0f, ext = frand() * 10.0f, hi = lo + ext;
+			float v = c % 97 == 0 ? lo : c % 89 == 0 ? hi : lo + frand() * ext;
+			v = v > hi ? hi : v;
+			float scale = mlod_pack_range_scale_bits(lo, hi, 14);
+			uint16_t q = mlod_pack_qu16_shift(v, lo, scale, sh);
+			CHECK_MSG(q % (1u << sh) == 0, "shift %d: q %u", sh, q);
+			if (sh == 0)
+				CHECK(q == mlod_pack_qu16(v, lo, scale));
+			double back = (double)lo + (double)q * scale, step = ldexp((double)scale, sh);
+			double tol = 0.5 * step + 4.0 * 1.2e-7 * (fabs(lo) + fabs(hi));
+			if (ldexp(1.0, sh - 1) + 16384.0 <= 65535.0) /* the writer's condition for a shift */
+				CHECK_MSG(fabs(back - v) <= tol, "shift %d: v %.9g: %.9g (step %g)", sh, v, back, step);
+		}
+	/* Clamped into range: never past 65535. */
+	CHECK(mlod_pack_qu16_shift(1e9f, 0.0f, 1.0f, 4) == 65520);
+	CHECK(mlod_pack_qu16_shift(-5.0f, 0.0f, 1.0f, 4) == 0);
+}
+
 TEST(switch_distance_one_pixel)
 {
 	const double pi = 3.14159265358979323846;
@@ -1070,6 +1095,7 @@ int main(void)
 	RUN(octahedral_within_bound);
 	RUN(octahedral_bits_within_bound);
 	RUN(range_bits_within_half_a_step);
+	RUN(range_shift_within_half_a_coarse_step);
 	RUN(switch_distance_one_pixel);
 	RUN(pack_mesh_streams);
 	RUN(pack_palette_is_fold);
