@@ -20,6 +20,10 @@
  *              tubeman at 16 and at the smallest bits too),
  *              weights (the 4 largest influences, renormalised) within
  *              1/255 each
+ *   coarse     (mlod(5) QUANTISATION, coarse levels) every MESH level
+ *              k >= 1 decoded against the input's level k, vertex by
+ *              vertex and posed, within level 0's bounds or the share of
+ *              level k's TOC error (coarse_levels below)
  *
  * The writer keeps the vertex order, so vertices are compared in order.
  * The largest position error relative to its bound is printed on stderr.
