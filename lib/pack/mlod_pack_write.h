@@ -208,20 +208,18 @@ uint16_t mlod_pack_qu16_shift(float v, float min, float scale, int shift);
 
 /* Coarse levels' steps (mlod(5) QUANTISATION). A part's vertex that no
  * finer level has with the same quantised attributes on level 0's steps,
- * whose finest level is f >= 1, is rounded to a coarser multiple of the
- * same grid (the reader's decode unchanged), within share times e, the
- * smallest TOC error of levels f and coarser (e <= each of theirs):
- * positions: the half-step vector (mesh units) times sigma, the largest
- * singular value bound of the part's rest skinning matrices, within
- * share e; normals: the octahedral bound within share e / (sigma l),
- * l the median edge length of level f's triangles (the tilt that a share
- * of the error gives a median edge), never past MLOD_PACK_NORMAL_BITS_MIN;
- * UVs: the half-step vector within share e rho / sigma, rho the
- * MLOD_PACK_COARSE_UV_QUANTILE quantile over level 0's edges of UV length
- * over length (a UV error that moves the texture on the surface by at
- * most share e, one share of a pixel at the level's switch distance,
- * where the texture is at least that dense). Each minimum over f and the
- * coarser levels' own bounds. */
+ * whose finest level is f >= 1, has its position and UVs rounded to a
+ * coarser multiple of the same grid (the reader's decode unchanged),
+ * within share times e, the smallest TOC error of levels f and coarser
+ * (e <= each of theirs): positions: the half-step vector (mesh units)
+ * times sigma, the largest singular value bound of the part's rest
+ * skinning matrices, within share e; UVs: the half-step vector within
+ * share e rho / sigma, rho the MLOD_PACK_COARSE_UV_QUANTILE quantile over
+ * level 0's edges of UV length over length (a UV error that moves the
+ * texture on the surface by at most share e, one share of a pixel at the
+ * level's switch distance, where the texture is at least that dense).
+ * Each a minimum over f and the coarser levels' own bounds. Normals keep
+ * level 0's bits (fewer bits measured no smaller: mlod(5)). */
 #define MLOD_PACK_COARSE_SHARE 0.25
 #define MLOD_PACK_COARSE_UV_QUANTILE 0.1
 

@@ -971,9 +971,10 @@ struct mpart {
 	/* Coarse levels' own steps (part_coarse; mlod(5) QUANTISATION): per
 	 * level and vertex, the finest level that has the vertex as level 0's
 	 * steps quantise it (NULL: every vertex on level 0's steps); per
-	 * level f >= 1, the steps of a vertex whose finest level is f. */
+	 * level f >= 1, the position and UV shifts of a vertex whose finest
+	 * level is f. */
 	uint8_t *fin[MLOD_MESH_MAX_LEVELS + 1];
-	int pos_shift[MLOD_MESH_MAX_LEVELS + 1], nrm_bits[MLOD_MESH_MAX_LEVELS + 1];
+	int pos_shift[MLOD_MESH_MAX_LEVELS + 1];
 	int uv_shift[MLOD_MESH_MAX_LEVELS + 1][MLOD_PACK_MAX_UV];
 };
 
@@ -1069,7 +1070,7 @@ static void part_quantise(struct ctx *x, const struct mpart *m, int k, uint8_t *
 		memcpy(o + m->attr[a++].off, q, 8);
 		if (p->normals) {
 			int16_t s[2];
-			mlod_pack_oct_encode_bits(p->normals + 3 * v, f ? m->nrm_bits[f] : x->opt->normal_bits, s);
+			mlod_pack_oct_encode_bits(p->normals + 3 * v, x->opt->normal_bits, s);
 			memcpy(o + m->attr[a++].off, s, 4);
 		}
 		if (p->tangents) {
@@ -1176,27 +1177,6 @@ static double quantile(double *v, size_t n, double q)
 	return v[i];
 }
 
-/* The median length of the primitive's triangle edges (mesh units; work
- * holds 3 per triangle). */
-static double coarse_edge(const mlod_primitive *p, double *work)
-{
-	uint32_t ni = p->index_count > 0 ? (uint32_t)p->index_count : (uint32_t)p->vertex_count;
-	size_t n = 0;
-	for (uint32_t t = 0; t + 3 <= ni; t += 3)
-		for (int e = 0; e < 3; e++) {
-			uint32_t a = p->index_count > 0 ? p->indices[t + e] : t + e;
-			uint32_t b = p->index_count > 0 ? p->indices[t + (e + 1) % 3] : t + (e + 1) % 3;
-			double d = 0.0;
-			for (int c = 0; c < 3; c++) {
-				double u = (double)p->positions[3 * a + c] - p->positions[3 * b + c];
-				d += u * u;
-			}
-			if (d > 0.0)
-				work[n++] = sqrt(d);
-		}
-	return quantile(work, n, 0.5);
-}
-
 /* The texture's density in UV units per mesh unit: the
  * MLOD_PACK_COARSE_UV_QUANTILE quantile over the primitive's edges of UV
  * length over length (those with both above 0). */
@@ -1245,11 +1225,12 @@ static int coarse_shift(const float *scale, const uint32_t *qmax, int n, double 
 }
 
 /* Per vertex of every level, the finest level that has it on level 0's
- * steps (the same quantised attributes), and per level f >= 1 the steps
- * of the vertices whose finest level is f: within the writer's share of
- * the smallest TOC error of the levels f and coarser, as mlod(5)
- * QUANTISATION states. Nothing (every vertex on level 0's steps) with a
- * share of 0, one level, or the Draco codec. 0, or -1 out of memory. */
+ * steps (the same quantised attributes), and per level f >= 1 the
+ * position and UV shifts of the vertices whose finest level is f: within
+ * the writer's share of the smallest TOC error of the levels f and
+ * coarser, as mlod(5) QUANTISATION states. Nothing (every vertex on level
+ * 0's steps) with a share of 0, one level, or the Draco codec. 0, or -1
+ * out of memory. */
 static int part_coarse(struct ctx *x, struct mpart *m, int M)
 {
 	double share = x->opt->coarse_share;
@@ -1296,10 +1277,10 @@ static int part_coarse(struct ctx *x, struct mpart *m, int M)
 		}
 		free(V);
 	}
-	/* Each level's bounds (mesh units, radians, UV units), then the
+	/* Each level's bounds (mesh units, UV units), then the
 	 * smallest of them over it and the coarser levels. */
 	double sigma = ok ? part_sigma(x, m) : 0.0;
-	double bpos[MLOD_MESH_MAX_LEVELS + 1], bnrm[MLOD_MESH_MAX_LEVELS + 1], buv[MLOD_MESH_MAX_LEVELS + 1][MLOD_PACK_MAX_UV];
+	double bpos[MLOD_MESH_MAX_LEVELS + 1], buv[MLOD_MESH_MAX_LEVELS + 1][MLOD_PACK_MAX_UV];
 	double rho[MLOD_PACK_MAX_UV] = {0};
 	for (uint32_t s = 0; ok && s < m->rec.uv_sets; s++)
 		rho[s] = coarse_density(m->lv[0], (int)s, work);
@@ -1307,14 +1288,11 @@ static int part_coarse(struct ctx *x, struct mpart *m, int M)
 		double e = share * (double)x->mesh_error[k - 1];
 		if (!(e > 0.0) || !(sigma > 0.0) || !isfinite(e / sigma))
 			e = 0.0;
-		double edge = m->lv[k]->normals ? coarse_edge(m->lv[k], work) : 0.0;
 		bpos[k] = sigma > 0.0 ? e / sigma : 0.0;
-		bnrm[k] = edge > 0.0 && sigma > 0.0 ? e / (sigma * edge) : 0.0;
 		for (uint32_t s = 0; s < m->rec.uv_sets; s++)
 			buv[k][s] = e * rho[s] / (sigma > 0.0 ? sigma : 1.0);
 		if (k < M - 1) {
 			bpos[k] = fmin(bpos[k], bpos[k + 1]);
-			bnrm[k] = fmin(bnrm[k], bnrm[k + 1]);
 			for (uint32_t s = 0; s < m->rec.uv_sets; s++)
 				buv[k][s] = fmin(buv[k][s], buv[k + 1][s]);
 		}
@@ -1329,9 +1307,6 @@ static int part_coarse(struct ctx *x, struct mpart *m, int M)
 			qmax[a] = mlod_pack_qu16(hi, m->rec.pos_min[a], m->rec.pos_scale[a]);
 		}
 		m->pos_shift[k] = coarse_shift(m->rec.pos_scale, qmax, 3, bpos[k]);
-		m->nrm_bits[k] = x->opt->normal_bits;
-		while (m->nrm_bits[k] > MLOD_PACK_NORMAL_BITS_MIN && mlod_pack_oct_bound(m->nrm_bits[k] - 1) <= bnrm[k])
-			m->nrm_bits[k]--;
 		for (uint32_t s = 0; s < m->rec.uv_sets; s++) {
 			uint32_t umax[2];
 			for (int a = 0; a < 2; a++) {

@@ -877,8 +877,7 @@ static void posed_level0(const char *path)
  *              distance (sigma: the largest singular value bound, the
  *              root of the largest absolute row sum of M^T M, of the
  *              part's rest skinning matrices);
- *   normals    the lattice bound at normal_bits, or share E / (sigma l),
- *              l the median edge length of the level's triangles;
+ *   normals    the lattice bound at normal_bits (level 0's);
  *   UVs        half a step per axis, or share E rho / sigma as a
  *              distance, rho the 10% quantile over level 0's edges of UV
  *              length over length.
@@ -909,8 +908,7 @@ static int dcmp(const void *a, const void *b)
 	return x < y ? -1 : x > y;
 }
 
-/* Median edge length, or (set >= 0) the q quantile of UV over 3D edge
- * length, over p's triangles. */
+/* The q quantile of UV (set) over 3D edge length over p's triangles. */
 static double edge_stat(const mlod_primitive *p, int set, double q)
 {
 	int ni = p->index_count ? p->index_count : p->vertex_count;
@@ -923,11 +921,10 @@ static double edge_stat(const mlod_primitive *p, int set, double q)
 			double d = 0, u = 0;
 			for (int c = 0; c < 3; c++)
 				d += pow((double)p->positions[3 * a + c] - p->positions[3 * b + c], 2);
-			if (set >= 0)
-				for (int c = 0; c < 2; c++)
-					u += pow((double)p->uvs[set][2 * a + c] - p->uvs[set][2 * b + c], 2);
-			if (d > 0 && (set < 0 || u > 0))
-				v[n++] = set < 0 ? sqrt(d) : sqrt(u / d);
+			for (int c = 0; c < 2; c++)
+				u += pow((double)p->uvs[set][2 * a + c] - p->uvs[set][2 * b + c], 2);
+			if (d > 0 && u > 0)
+				v[n++] = sqrt(u / d);
 		}
 	double r = 0;
 	if (n) {
@@ -939,7 +936,7 @@ static double edge_stat(const mlod_primitive *p, int set, double q)
 }
 
 struct cbounds {
-	double pos[3], pos_far, nrm, nrm_far, uv[MLOD_PACK_MAX_UV][2], uv_far[MLOD_PACK_MAX_UV];
+	double pos[3], pos_far, nrm, uv[MLOD_PACK_MAX_UV][2], uv_far[MLOD_PACK_MAX_UV];
 	int sets;
 };
 
@@ -965,11 +962,8 @@ static int within(const mlod_primitive *a, int u, const float *bp, const float *
 		double ang = atan2(sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]),
 		                   (double)x[0] * y[0] + (double)x[1] * y[1] + (double)x[2] * y[2]);
 		double lx = sqrt((double)x[0] * x[0] + (double)x[1] * x[1] + (double)x[2] * x[2]);
-		if (lx > 0.5 && ang > B->nrm) {
-			if (!(ang <= B->nrm_far))
-				return 0;
-			f = 1;
-		}
+		if (lx > 0.5 && ang > B->nrm)
+			return 0;
 	}
 	for (int s = 0; s < B->sets; s++) {
 		double e2 = 0;
@@ -1078,7 +1072,7 @@ static const char *coarse_levels(const char *path, double write_share, double ch
 				sigma = gersh3(&R);
 			}
 			double far = sigma > 0 ? check_share * E / sigma : 0;
-			struct cbounds B = {{0}, far, oct_bound(), 0, {{0}}, {0}, (int)pp->rec.uv_sets};
+			struct cbounds B = {{0}, far, oct_bound(), {{0}}, {0}, (int)pp->rec.uv_sets};
 			double hd = 0;
 			for (int a = 0; a < 3; a++) {
 				B.pos[a] = pp->rec.pos_scale[a] / 2.0 * (1 + 1e-4) + 1e-6 * fabs(pp->rec.pos_min[a]);
@@ -1086,8 +1080,6 @@ static const char *coarse_levels(const char *path, double write_share, double ch
 			}
 			hd_max = fmax(hd_max, fmax(sqrt(hd) / 2, far)); /* mesh units */
 			B.pos_far = far * (1 + 1e-5) + 1e-6 * sqrt(hd) * 65535;
-			double l = edge_stat(A, -1, 0.5);
-			B.nrm_far = l > 0 && sigma > 0 ? check_share * E / (sigma * l) * (1 + 1e-6) + 2e-6 : 0;
 			for (int s = 0; s < B.sets; s++) {
 				double rho = edge_stat(A0, s, 0.1), h2 = 0;
 				for (int a = 0; a < 2; a++) {
