@@ -1229,12 +1229,12 @@ static int coarse_shift(const float *scale, const uint32_t *qmax, int n, double 
  * position and UV shifts of the vertices whose finest level is f: within
  * the writer's share of the smallest TOC error of the levels f and
  * coarser, as mlod(5) QUANTISATION states. Nothing (every vertex on level
- * 0's steps) with a share of 0, one level, or the Draco codec. 0, or -1
+ * 0's steps) with a share of 0 or one level. 0, or -1
  * out of memory. */
 static int part_coarse(struct ctx *x, struct mpart *m, int M)
 {
 	double share = x->opt->coarse_share;
-	if (!(share > 0.0) || M < 2 || x->draco)
+	if (!(share > 0.0) || M < 2)
 		return 0;
 	size_t total = 0, most = 0;
 	for (int k = 0; k < M; k++) {
