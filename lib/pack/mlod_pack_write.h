@@ -100,7 +100,7 @@ typedef struct mlod_pack_options {
 	int uv_bits;                 /* UVs: 2^bits - 1 steps of the part's UV box per axis */
 	double coarse_share;         /* a vertex only coarse levels have: rounded within this share
 	                              * of their TOC error (MLOD_PACK_COARSE_SHARE; 0: level 0's
-	                              * steps for every vertex, as before format 4.x's writer) */
+	                              * steps for every vertex, the writer before this rule) */
 } mlod_pack_options;
 
 void mlod_pack_options_default(mlod_pack_options *opt);
