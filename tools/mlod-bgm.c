@@ -48,9 +48,11 @@ static const char usage_text[] =
 	"                           primitives, cheapest collapses first; the posed\n"
 	"                           cost only, its default) or primitive (each keeps\n"
 	"                           the ratio; the default with compactness)\n"
-	"  -p, --placement NAME     new vertex: optimal (default), barycenter, or\n"
+	"  -p, --placement NAME     new vertex: optimal (default), barycenter,\n"
 	"                           vertex (one of the collapsed vertices kept whole:\n"
-	"                           coarse levels reuse level-0 vertices)\n"
+	"                           coarse levels reuse level-0 vertices), or\n"
+	"                           hybrid[=TAU] (the whole vertex when it costs at\n"
+	"                           most 1+TAU times the optimal; TAU default 0.5)\n"
 	"  -E, --eligibility NAME   vertices that may go: all, bend or literal\n"
 	"                           (default: all with the posed cost, bend otherwise)\n"
 	"  -t, --tau T              eligibility threshold factor (default 1)\n"
@@ -252,7 +254,6 @@ int main(int argc, char **argv)
 	static const char *const costs[] = {"compactness", "posed"};
 	static const char *const ops[] = {"triangle", "edge", "mixed"};
 	static const char *const budgets[] = {"character", "primitive"};
-	static const char *const placements[] = {"barycenter", "optimal", "vertex"};
 	static const char *const rules[] = {"literal", "bend", "all"};
 	static const double defaults[] = {MLOD_MESH_RATIOS_DEFAULT};
 	const char *output = NULL, *split = NULL;
@@ -277,7 +278,9 @@ int main(int argc, char **argv)
 		case 'C': opt.op = (mlod_collapse_op)(MLOD_OP_TRIANGLE + parse_enum("--collapse", optarg, ops, 3)); break;
 		case 'B': budget = (mlod_mesh_budget)(MLOD_BUDGET_CHARACTER + parse_enum("--budget", optarg, budgets, 2)); break;
 		case 'p':
-			opt.placement = (mlod_placement)(MLOD_PLACE_BARYCENTER + parse_enum("--placement", optarg, placements, 3));
+			if (mlod_mesh_placement_parse(optarg, &opt.placement, &opt.hybrid_factor))
+				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter, vertex, hybrid or "
+				                 "hybrid=TAU)", optarg);
 			break;
 		case 'E':
 			opt.eligibility = (mlod_eligibility)(MLOD_ELIGIBLE_LITERAL + parse_enum("--eligibility", optarg, rules, 3));

@@ -38,7 +38,31 @@ const char *mlod_mesh_budget_name(mlod_mesh_budget b)
 
 const char *mlod_mesh_placement_name(mlod_placement p)
 {
-	return p == MLOD_PLACE_BARYCENTER ? "barycenter" : p == MLOD_PLACE_VERTEX ? "vertex" : "optimal";
+	return p == MLOD_PLACE_BARYCENTER ? "barycenter"
+	       : p == MLOD_PLACE_VERTEX   ? "vertex"
+	       : p == MLOD_PLACE_HYBRID   ? "hybrid"
+	                                  : "optimal";
+}
+
+int mlod_mesh_placement_parse(const char *s, mlod_placement *p, double *factor)
+{
+	static const char *const names[] = {"barycenter", "optimal", "vertex", "hybrid"};
+	for (int i = 0; i < 4; i++)
+		if (strcmp(s, names[i]) == 0) {
+			*p = (mlod_placement)(MLOD_PLACE_BARYCENTER + i);
+			if (*p == MLOD_PLACE_HYBRID)
+				*factor = 0.0;
+			return 0;
+		}
+	if (strncmp(s, "hybrid=", 7) != 0 || !s[7])
+		return -1;
+	char *end;
+	double tau = strtod(s + 7, &end);
+	if (*end || !(tau >= 0.0) || !(tau <= 1e6))
+		return -1;
+	*p = MLOD_PLACE_HYBRID;
+	*factor = 1.0 + tau;
+	return 0;
 }
 
 const char *mlod_mesh_eligibility_name(mlod_eligibility e)
@@ -60,6 +84,8 @@ void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget)
 		opt->eligibility = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_ELIGIBLE_BEND : MLOD_ELIGIBLE_ALL;
 	if (!(opt->tau > 0.0))
 		opt->tau = 1.0;
+	if (!(opt->hybrid_factor >= 1.0))
+		opt->hybrid_factor = MLOD_MESH_HYBRID_FACTOR;
 	if (opt->influence_budget == 0.0)
 		opt->influence_budget = MLOD_MESH_INFLUENCE_BUDGET > 0.0 ? MLOD_MESH_INFLUENCE_BUDGET : -1.0;
 }
