@@ -278,7 +278,7 @@ int main(int argc, char **argv)
 		case 'C': opt.op = (mlod_collapse_op)(MLOD_OP_TRIANGLE + parse_enum("--collapse", optarg, ops, 3)); break;
 		case 'B': budget = (mlod_mesh_budget)(MLOD_BUDGET_CHARACTER + parse_enum("--budget", optarg, budgets, 2)); break;
 		case 'p':
-			if (mlod_mesh_placement_parse(optarg, &opt.placement, &opt.hybrid_factor))
+			if (mlod_mesh_placement_parse(optarg, &opt.placement, &opt.hybrid_error))
 				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter, vertex, hybrid or "
 				                 "hybrid=TAU)", optarg);
 			break;

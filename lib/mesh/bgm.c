@@ -743,7 +743,7 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 	if (g->opt.cost == MLOD_COST_DEFAULT)
 		g->opt.cost = MLOD_COST_POSED;
 	if (g->opt.placement == MLOD_PLACE_DEFAULT)
-		g->opt.placement = g->opt.cost == MLOD_COST_POSED ? MLOD_PLACE_OPTIMAL : MLOD_PLACE_BARYCENTER;
+		g->opt.placement = g->opt.cost == MLOD_COST_POSED ? MLOD_PLACE_HYBRID : MLOD_PLACE_BARYCENTER;
 	if (g->opt.eligibility == MLOD_ELIGIBLE_DEFAULT) /* as measured: see bench/RESULTS.md */
 		g->opt.eligibility = g->opt.cost == MLOD_COST_POSED ? MLOD_ELIGIBLE_ALL : MLOD_ELIGIBLE_BEND;
 	if (g->opt.op == MLOD_OP_DEFAULT)
@@ -753,15 +753,15 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "edge collapses need the posed cost");
 	}
 	if ((unsigned)g->opt.cost > MLOD_COST_POSED || (unsigned)g->opt.placement > MLOD_PLACE_HYBRID ||
-	    !(g->opt.hybrid_factor == 0.0 || (g->opt.hybrid_factor >= 1.0 && isfinite(g->opt.hybrid_factor))) ||
+	    !(g->opt.hybrid_error >= 0.0) || !isfinite(g->opt.hybrid_error) ||
 	    (unsigned)g->opt.op > MLOD_OP_MIXED || (unsigned)g->opt.eligibility > MLOD_ELIGIBLE_ALL ||
 	    !(g->opt.tau >= 0.0) || !isfinite(g->opt.tau)) {
 		free(g);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_bgm_build: bad options");
 	}
 	g->tau = g->opt.tau > 0.0 ? g->opt.tau : 1.0;
-	if (g->opt.hybrid_factor == 0.0)
-		g->opt.hybrid_factor = MLOD_MESH_HYBRID_FACTOR;
+	if (g->opt.hybrid_error == 0.0)
+		g->opt.hybrid_error = MLOD_MESH_HYBRID_ERROR;
 	g->opt.eta = NULL; /* owned copy below */
 	g->opt.poses = opt ? opt->poses : NULL;
 

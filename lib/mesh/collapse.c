@@ -53,9 +53,11 @@
  * vertices that keeps every wedge group whole, snapped (its wedges and
  * influences copied as they are, so coarse levels reuse its vertices);
  * MLOD_PLACE_HYBRID weighs both per collapse: the cheapest whole vertex
- * when its posed cost is at most hybrid_factor times the cheapest other
- * placement's, else that one (the collapse then costing what the chosen
- * placement costs); otherwise Power Skinning
+ * when its posed cost is at most the cheapest other placement's, or at
+ * most the square of hybrid_error percent of the diagonal (the cost being
+ * a mean squared distance over the patch and the poses), else that other
+ * placement (the collapse costing what the chosen placement costs);
+ * otherwise Power Skinning
  * (powerskin.c) gives its weights, the same barycentric weights as its
  * attributes give its morph target offsets.
  *
@@ -879,7 +881,10 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	 * whole vertex (family 1), tried last. */
 	int bestf[2] = {-1, -1}, capf[2] = {0, 0};
 	double costf[2] = {0.0, 0.0}, df[2] = {0.0, 0.0}, tie = 0.0;
-	double factor = hybrid ? g->opt.hybrid_factor : 1.0;
+	/* Hybrid: a whole vertex within this cost is kept (the squared share
+	 * of the diagonal: the cost is a mean squared distance). */
+	double cap = hybrid ? g->opt.hybrid_error / 100.0 * g->diagonal : 0.0;
+	cap *= cap;
 	mlod_influences inff[2];
 	if (K == 3) {
 		tie = face_tie(g, t);
@@ -933,14 +938,15 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 				goto take;
 			} else if (g->pose_count > 0) {
 				/* Stop summing once this candidate cannot beat the best of
-				 * its family (a whole vertex: nor come within the factor
-				 * of the free best): with a margin far above rounding, so
-				 * that the choice is the one the full sum makes. */
+				 * its family (a whole vertex: nor be kept, costing more
+				 * than both the free best and the cap): with a margin far
+				 * above rounding, so that the choice is the one the full
+				 * sum makes. */
 				double stop = HUGE_VAL, add = TIE_WEIGHT * tie, limit = HUGE_VAL;
 				if (bestf[fam] >= 0)
 					limit = costf[fam];
 				if (fam == 1 && bestf[0] >= 0)
-					limit = fmin(limit, factor * costf[0]);
+					limit = fmin(limit, fmax(costf[0], cap));
 				if (limit < HUGE_VAL && wsum > 0.0) {
 					double lim = limit * (g->opt.op == MLOD_OP_MIXED ? pl->nr : 1) - add;
 					if (lim > 1e-6 * add)
@@ -978,9 +984,9 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		inff[fam] = w;
 		capf[fam] = capped;
 	}
-	/* Hybrid: the whole vertex when it costs at most factor times the
-	 * free placement. */
-	int fam = bestf[1] >= 0 && (bestf[0] < 0 || costf[1] <= factor * costf[0]);
+	/* Hybrid: the whole vertex when it costs no more than the free
+	 * placement, or no more than the cap. */
+	int fam = bestf[1] >= 0 && (bestf[0] < 0 || costf[1] <= costf[0] || costf[1] <= cap);
 	int best = bestf[fam];
 	if (best < 0)
 		return 0;
