@@ -280,7 +280,7 @@ int main(int argc, char **argv)
 		case 'p':
 			if (mlod_mesh_placement_parse(optarg, &opt.placement, &opt.hybrid_error))
 				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter, vertex, hybrid or "
-				                 "hybrid=TAU)", optarg);
+				                 "hybrid=PCT, 0 < PCT <= 100)", optarg);
 			break;
 		case 'E':
 			opt.eligibility = (mlod_eligibility)(MLOD_ELIGIBLE_LITERAL + parse_enum("--eligibility", optarg, rules, 3));

@@ -402,7 +402,7 @@ int main(int argc, char **argv)
 		case 'e': opt.mesh_max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
 		case 'p':
 			if (mlod_mesh_placement_parse(optarg, &opt.bgm.placement, &opt.bgm.hybrid_error))
-				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter, vertex or hybrid[=TAU])",
+				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter, vertex or hybrid[=PCT])",
 				                 optarg);
 			break;
 		case OPT_INFLUENCE:
