@@ -529,6 +529,8 @@ static int keeps_groups(const int (*per)[3], int ngroups, int K, int s)
 	return 1;
 }
 
+static int same_influences(const mlod_influences *x, const mlod_influences *y);
+
 /* The optimal placement's candidates are tried (MLOD_PLACE_HYBRID too). */
 static int optimal_like(const mlod_bgm *g)
 {
@@ -880,6 +882,9 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	 * keeps two: the cheapest free placement (family 0) and the cheapest
 	 * whole vertex (family 1), tried last. */
 	int bestf[2] = {-1, -1}, capf[2] = {0, 0};
+	unsigned same_end = 0;
+	int geo_at[3] = {-1, -1, -1};
+	double end_e[3] = {0.0, 0.0, 0.0};
 	double costf[2] = {0.0, 0.0}, df[2] = {0.0, 0.0}, tie = 0.0;
 	/* Hybrid: a whole vertex within this cost is kept (the squared share
 	 * of the diagonal: the cost is a mean squared distance). */
@@ -916,7 +921,21 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		int k = order[kk], fam = hybrid && cand_whole[k];
 		if (ranked && bestf[0] >= 0)
 			break;
-		if (!geometry_ok(g, pl, cand[k]))
+		int at = cand_at[k];
+		if (fam == 1 && (same_end >> at & 1u) && bestf[0] >= 0) {
+			/* Its cost is known (the free end's): skip it when it cannot
+			 * be kept. */
+			double c = (wsum > 0.0 ? end_e[at] / wsum : 0.0) + TIE_WEIGHT * tie;
+			if (g->opt.op == MLOD_OP_MIXED)
+				c /= pl->nr;
+			if (c > costf[0] && c > cap)
+				continue;
+		}
+		/* A whole vertex is where a free end was: the same answer. */
+		int ok = fam == 1 && geo_at[at] >= 0 ? geo_at[at] : geometry_ok(g, pl, cand[k]);
+		if (hybrid && at >= 0 && !cand_whole[k])
+			geo_at[at] = ok;
+		if (!ok)
 			continue;
 		mlod_influences w;
 		int capped = 0;
@@ -953,7 +972,9 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 						stop = lim * wsum * (1.0 + 1e-9);
 				}
 				int role = cand_role[k];
-				if (mm && (mm->known >> role & 1u)) {
+				if (role >= 5 && (same_end >> (role - 5) & 1u)) {
+					e = end_e[role - 5];
+				} else if (mm && (mm->known >> role & 1u)) {
 					e = mm->e[role];
 				} else {
 					if (!q_ready)
@@ -965,6 +986,13 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 						mm->e[role] = e;
 						mm->known |= 1u << role;
 					}
+				}
+				/* A free end skinned with the vertex's own influences (as
+				 * Power Skinning at a vertex mostly gives) costs what
+				 * that vertex kept whole costs. */
+				if (hybrid && role >= 1 && role <= 3 && same_influences(&w, &in3[role - 1])) {
+					end_e[role - 1] = e;
+					same_end |= 1u << (role - 1);
 				}
 			}
 			cost = (wsum > 0.0 ? e / wsum : 0.0) + TIE_WEIGHT * tie;
@@ -1619,6 +1647,13 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 				continue; /* at least the least: the minimum stays */
 			mm->e[role[k]] = e;
 			mm->known |= 1u << role[k];
+		}
+		/* As plan(): a free end with the vertex's own influences costs
+		 * what the vertex kept whole costs. */
+		if (!vertex && role[k] >= 1 && role[k] <= 3 && g->opt.placement == MLOD_PLACE_HYBRID &&
+		    same_influences(&w, &in3[role[k] - 1])) {
+			mm->e[role[k] + 4] = e;
+			mm->known |= 1u << (role[k] + 4);
 		}
 		least = fmin(least, e);
 		best = fmin(best, wsum > 0.0 ? e / wsum : 0.0);
