@@ -48,9 +48,11 @@ static const char usage_text[] =
 	"                           primitives, cheapest collapses first; the posed\n"
 	"                           cost only, its default) or primitive (each keeps\n"
 	"                           the ratio; the default with compactness)\n"
-	"  -p, --placement NAME     new vertex: optimal (default), barycenter, or\n"
-	"                           vertex (one of the collapsed vertices kept whole:\n"
-	"                           coarse levels reuse level-0 vertices)\n"
+	"  -p, --placement NAME     new vertex: hybrid[=PCT] (the default: a collapsed\n"
+	"                           vertex kept whole where that costs no more than\n"
+	"                           optimal or within PCT%% of the diagonal, default\n"
+	"                           0.1), optimal, barycenter, or vertex (always one\n"
+	"                           kept whole: coarse levels reuse level-0 vertices)\n"
 	"  -E, --eligibility NAME   vertices that may go: all, bend or literal\n"
 	"                           (default: all with the posed cost, bend otherwise)\n"
 	"  -t, --tau T              eligibility threshold factor (default 1)\n"
@@ -162,11 +164,15 @@ static void report_table(const struct job *job)
 	       "%d border and %d non-manifold edges; %d primitives simplified; build %.1f ms\n",
 	       job->input, L->triangles, L->vertices, t.nodes, t.seam_nodes, t.eligible_nodes, t.locked_nodes,
 	       t.border_edges, t.nonmanifold_edges, L->simplified, 1e3 * L->build_seconds);
-	printf("# cost %s%s, %s collapses, budget per %s, placement %s, eligibility %s (tau %g)%s, influence budget %g; error "
+	char whole[48] = "";
+	if (L->opt.placement == MLOD_PLACE_HYBRID)
+		snprintf(whole, sizeof whole, " (whole within %g%%)", L->opt.hybrid_error);
+	printf("# cost %s%s, %s collapses, budget per %s, placement %s%s, eligibility %s (tau %g)%s, influence budget %g; error "
 	       "over %d poses (rest, clip frames, %d random up to 40 degrees)\n",
 	       mlod_mesh_cost_name(L->opt.cost), L->opt.fast_cost && L->opt.cost == MLOD_COST_POSED ? " (fast)" : "",
 	       mlod_mesh_op_name(L->opt.op), mlod_mesh_budget_name(L->budget), mlod_mesh_placement_name(L->opt.placement),
-	       mlod_mesh_eligibility_name(L->opt.eligibility), L->opt.tau, L->opt.allow_border ? ", border collapses at plain cost" : "",
+	       whole, mlod_mesh_eligibility_name(L->opt.eligibility), L->opt.tau,
+	       L->opt.allow_border ? ", border collapses at plain cost" : "",
 	       L->opt.influence_budget > 0.0 ? L->opt.influence_budget : 0.0, L->measure.count, MLOD_MESH_RANDOM_POSES);
 	printf("%5s  %6s  %9s  %8s  %10s  %10s  %5s  %9s  %11s\n", "level", "ratio", "triangles", "vertices", "mean%",
 	       "max%", "caps", "build ms", "collapse ms");
@@ -200,10 +206,12 @@ static void report_json(const struct job *job)
 	printf("  \"simplified_primitives\": %d,\n  \"static_primitives\": %d,\n  \"build_ms\": %.6g,\n  \"measure_ms\": %.6g,\n",
 	       L->simplified, L->statics, 1e3 * L->build_seconds, 1e3 * L->measure_seconds);
 	printf("  \"options\": {\"cost\": \"%s\", \"collapse\": \"%s\", \"budget\": \"%s\", \"placement\": \"%s\", "
-	       "\"eligibility\": \"%s\", \"tau\": %g, \"allow_border\": %s, \"fast_cost\": %s, \"influence_budget\": %g},\n",
+	       "\"hybrid_error\": %g, \"eligibility\": \"%s\", \"tau\": %g, \"allow_border\": %s, \"fast_cost\": %s, "
+	       "\"influence_budget\": %g},\n",
 	       mlod_mesh_cost_name(L->opt.cost), mlod_mesh_op_name(L->opt.op), mlod_mesh_budget_name(L->budget),
-	       mlod_mesh_placement_name(L->opt.placement), mlod_mesh_eligibility_name(L->opt.eligibility), L->opt.tau,
-	       L->opt.allow_border ? "true" : "false", L->opt.fast_cost ? "true" : "false",
+	       mlod_mesh_placement_name(L->opt.placement),
+	       L->opt.placement == MLOD_PLACE_HYBRID ? L->opt.hybrid_error : 0.0,
+	       mlod_mesh_eligibility_name(L->opt.eligibility), L->opt.tau, L->opt.allow_border ? "true" : "false", L->opt.fast_cost ? "true" : "false",
 	       L->opt.influence_budget > 0.0 ? L->opt.influence_budget : 0.0);
 	printf("  \"measured_poses\": %d,\n  \"levels\": [\n", L->measure.count);
 	for (int k = 0; k < L->count; k++) {
@@ -252,7 +260,6 @@ int main(int argc, char **argv)
 	static const char *const costs[] = {"compactness", "posed"};
 	static const char *const ops[] = {"triangle", "edge", "mixed"};
 	static const char *const budgets[] = {"character", "primitive"};
-	static const char *const placements[] = {"barycenter", "optimal", "vertex"};
 	static const char *const rules[] = {"literal", "bend", "all"};
 	static const double defaults[] = {MLOD_MESH_RATIOS_DEFAULT};
 	const char *output = NULL, *split = NULL;
@@ -277,7 +284,9 @@ int main(int argc, char **argv)
 		case 'C': opt.op = (mlod_collapse_op)(MLOD_OP_TRIANGLE + parse_enum("--collapse", optarg, ops, 3)); break;
 		case 'B': budget = (mlod_mesh_budget)(MLOD_BUDGET_CHARACTER + parse_enum("--budget", optarg, budgets, 2)); break;
 		case 'p':
-			opt.placement = (mlod_placement)(MLOD_PLACE_BARYCENTER + parse_enum("--placement", optarg, placements, 3));
+			if (mlod_mesh_placement_parse(optarg, &opt.placement, &opt.hybrid_error))
+				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter, vertex, hybrid or "
+				                 "hybrid=PCT, 0 < PCT <= 100)", optarg);
 			break;
 		case 'E':
 			opt.eligibility = (mlod_eligibility)(MLOD_ELIGIBLE_LITERAL + parse_enum("--eligibility", optarg, rules, 3));

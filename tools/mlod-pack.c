@@ -43,10 +43,10 @@ static const char usage_text[] =
 	"                             (default %s)\n"
 	"  -e, --max-error PCT        levels down to the coarsest whose posed error\n"
 	"                             stays within PCT percent of the diagonal\n"
-	"  -p, --placement NAME       new vertex of a collapse: optimal (default),\n"
+	"  -p, --placement NAME       new vertex of a collapse: hybrid[=PCT] (default;\n"
+	"                             whole within PCT%% of the diagonal, 0.1), optimal,\n"
 	"                             barycenter, or vertex (one of the collapsed\n"
-	"                             vertices kept whole: fewer vertices in the\n"
-	"                             shared buffer, smaller packs)\n"
+	"                             vertices kept whole: smaller packs)\n"
 	"      --influence-budget F   fewer influences on the levels' vertices that\n"
 	"                             move at most F times the level's mean posed\n"
 	"                             error (0, the default: off; not with -e)\n"
@@ -401,14 +401,9 @@ int main(int argc, char **argv)
 			break;
 		case 'e': opt.mesh_max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
 		case 'p':
-			if (strcmp(optarg, "optimal") == 0)
-				opt.bgm.placement = MLOD_PLACE_OPTIMAL;
-			else if (strcmp(optarg, "barycenter") == 0)
-				opt.bgm.placement = MLOD_PLACE_BARYCENTER;
-			else if (strcmp(optarg, "vertex") == 0)
-				opt.bgm.placement = MLOD_PLACE_VERTEX;
-			else
-				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter or vertex)", optarg);
+			if (mlod_mesh_placement_parse(optarg, &opt.bgm.placement, &opt.bgm.hybrid_error))
+				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter, vertex or hybrid[=PCT])",
+				                 optarg);
 			break;
 		case OPT_INFLUENCE:
 			opt.bgm.influence_budget = tool_parse_double("--influence-budget", optarg, 0.0, 1e3);

@@ -302,7 +302,7 @@ static void vertex_influences(const mlod_bgm *g, int v, mlod_influences *out)
 		out->weights[i] = (float)(w[i] / sum);
 }
 
-/* Vertex placement: input vertex v's influences as it has them (its
+/* Vertex and hybrid placement: input vertex v's influences as it has them (its
  * weight sets in order, trailing zero weights dropped, not merged,
  * normalised or sorted), so that a level's vertex copied from it is
  * written with the same joints and weights, bit for bit. */
@@ -516,7 +516,7 @@ static mlod_result build(mlod_bgm *g, const mlod_character *c, const mlod_instan
 			table[slot] = v;
 			for (int i = 0; i < 3; i++)
 				g->nodes[node].p[i] = p->positions[3 * v + i];
-			if (g->opt.placement == MLOD_PLACE_VERTEX)
+			if (g->opt.placement == MLOD_PLACE_VERTEX || g->opt.placement == MLOD_PLACE_HYBRID)
 				raw_influences(g, v, &g->inf[node]);
 			else
 				g->inf[node] = vinf[v];
@@ -678,7 +678,7 @@ static mlod_result build(mlod_bgm *g, const mlod_character *c, const mlod_instan
 	}
 
 	/* Posed quadrics, for the posed cost and the optimal placement. */
-	if (g->opt.cost == MLOD_COST_POSED || g->opt.placement == MLOD_PLACE_OPTIMAL)
+	if (g->opt.cost == MLOD_COST_POSED || g->opt.placement == MLOD_PLACE_OPTIMAL || g->opt.placement == MLOD_PLACE_HYBRID)
 		r = bgm_quadrics_build(g, c, in, err);
 
 done:
@@ -743,7 +743,7 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 	if (g->opt.cost == MLOD_COST_DEFAULT)
 		g->opt.cost = MLOD_COST_POSED;
 	if (g->opt.placement == MLOD_PLACE_DEFAULT)
-		g->opt.placement = g->opt.cost == MLOD_COST_POSED ? MLOD_PLACE_OPTIMAL : MLOD_PLACE_BARYCENTER;
+		g->opt.placement = g->opt.cost == MLOD_COST_POSED ? MLOD_PLACE_HYBRID : MLOD_PLACE_BARYCENTER;
 	if (g->opt.eligibility == MLOD_ELIGIBLE_DEFAULT) /* as measured: see bench/RESULTS.md */
 		g->opt.eligibility = g->opt.cost == MLOD_COST_POSED ? MLOD_ELIGIBLE_ALL : MLOD_ELIGIBLE_BEND;
 	if (g->opt.op == MLOD_OP_DEFAULT)
@@ -752,13 +752,16 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 		free(g);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "edge collapses need the posed cost");
 	}
-	if ((unsigned)g->opt.cost > MLOD_COST_POSED || (unsigned)g->opt.placement > MLOD_PLACE_VERTEX ||
+	if ((unsigned)g->opt.cost > MLOD_COST_POSED || (unsigned)g->opt.placement > MLOD_PLACE_HYBRID ||
+	    !(g->opt.hybrid_error >= 0.0) || !isfinite(g->opt.hybrid_error) ||
 	    (unsigned)g->opt.op > MLOD_OP_MIXED || (unsigned)g->opt.eligibility > MLOD_ELIGIBLE_ALL ||
 	    !(g->opt.tau >= 0.0) || !isfinite(g->opt.tau)) {
 		free(g);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_bgm_build: bad options");
 	}
 	g->tau = g->opt.tau > 0.0 ? g->opt.tau : 1.0;
+	if (g->opt.hybrid_error == 0.0)
+		g->opt.hybrid_error = MLOD_MESH_HYBRID_ERROR;
 	g->opt.eta = NULL; /* owned copy below */
 	g->opt.poses = opt ? opt->poses : NULL;
 

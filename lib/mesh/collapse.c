@@ -52,6 +52,11 @@
  * cheaper), or with MLOD_PLACE_VERTEX to the cheapest of the collapsed
  * vertices that keeps every wedge group whole, snapped (its wedges and
  * influences copied as they are, so coarse levels reuse its vertices);
+ * MLOD_PLACE_HYBRID weighs both per collapse: the cheapest whole vertex
+ * when its posed cost is at most the cheapest other placement's, or at
+ * most the square of hybrid_error percent of the diagonal (the cost being
+ * a mean squared distance over the patch and the poses), else that other
+ * placement (the collapse costing what the chosen placement costs);
  * otherwise Power Skinning
  * (powerskin.c) gives its weights, the same barycentric weights as its
  * attributes give its morph target offsets.
@@ -71,7 +76,7 @@
 
 #define MAX_PATCH 128       /* faces around a, b and c */
 #define MAX_WEDGES 64       /* distinct wedges of a, b and c in the patch */
-#define MAX_CANDIDATES 5
+#define MAX_CANDIDATES 8
 #define FLIP_COS 0.2        /* a re-meshed face may turn by less than ~78 degrees */
 #define DEGENERATE 1e-3     /* compactness under which a new face counts as degenerate */
 #define TIE_WEIGHT 1e-5     /* compactness tie-break of the posed cost */
@@ -110,8 +115,9 @@ struct bgm_heap_entry {
  * depends only on the collapsed vertices (quadrics, positions and
  * influences, fixed while the face lives), not on the patch, so an
  * operation back in the queue keeps it for its next bound or plan.
- * Placements by role: 0 the optimum, 1 + i vertex i, 4 the barycenter. */
-#define MEMO_ROLES 5
+ * Placements by role: 0 the optimum, 1 + i vertex i, 4 the barycenter,
+ * 5 + i vertex i kept whole (hybrid placement: its own influences). */
+#define MEMO_ROLES 8
 #define MEMO_WSUM (1u << MEMO_ROLES)
 typedef struct bgm_memo {
 	double opt[3];
@@ -122,7 +128,7 @@ typedef struct bgm_memo {
 	int next_free;
 } memo;
 
-static const memo memo_empty = {{0, 0, 0}, 0, 0, {0, 0, 0, 0, 0}, 0.0, -1};
+static const memo memo_empty = {{0, 0, 0}, 0, 0, {0}, 0.0, -1};
 
 /* A slot holding m; returns its index, or -1 when out of memory. */
 static int memo_add(struct bgm_heap *h, const memo *m)
@@ -215,6 +221,7 @@ struct plan {
 	/* The chosen placement. */
 	double pos[3];
 	int snap;                   /* 0..2: v-bar at v[snap]; -1: free */
+	int whole;                  /* v-bar is v[snap] kept whole (wedges src[], its influences) */
 	int hard[3];                /* a, b, c have hard normal edges */
 	double lambda[3];           /* attribute and morph weights of a, b, c */
 	mlod_influences inf;
@@ -522,6 +529,14 @@ static int keeps_groups(const int (*per)[3], int ngroups, int K, int s)
 	return 1;
 }
 
+static int same_influences(const mlod_influences *x, const mlod_influences *y);
+
+/* The optimal placement's candidates are tried (MLOD_PLACE_HYBRID too). */
+static int optimal_like(const mlod_bgm *g)
+{
+	return g->opt.placement == MLOD_PLACE_OPTIMAL || g->opt.placement == MLOD_PLACE_HYBRID;
+}
+
 /* Vertex placement: which wedge of v[snap] each kept face's corner takes,
  * copied whole. Its own corners keep theirs; another vertex's corner the
  * one wedge of v[snap] in its wedge group (a texture seam: plan() made
@@ -577,6 +592,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			return 0;
 	}
 	int K = pl->k, vertex = g->opt.placement == MLOD_PLACE_VERTEX;
+	int hybrid = g->opt.placement == MLOD_PLACE_HYBRID && g->opt.cost == MLOD_COST_POSED;
 
 	/* The patch. */
 	pl->nf = pl->nr = pl->nk = 0;
@@ -691,6 +707,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	/* Candidate placements. */
 	double cand[MAX_CANDIDATES][3];
 	int cand_snap[MAX_CANDIDATES], cand_role[MAX_CANDIDATES], cand_at[MAX_CANDIDATES], nc = 0;
+	int cand_whole[MAX_CANDIDATES];
 	const double *P[3] = {g->nodes[pl->v[0]].p, g->nodes[pl->v[1]].p, K == 3 ? g->nodes[pl->v[2]].p : NULL};
 	double bary[3];
 	for (int i = 0; i < 3; i++) {
@@ -715,6 +732,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
 			cand_at[nc] = s;
+			cand_whole[nc] = vertex;
 			cand_snap[nc++] = s;
 		}
 		if (nc == 0)
@@ -741,12 +759,14 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
 			cand_at[nc] = s;
+			cand_whole[nc] = vertex;
 			cand_snap[nc++] = vertex ? s : -1;
 		}
 		if (K == 2 && nb == 2 && !vertex) {
 			memcpy(cand[nc], bary, sizeof cand[nc]);
 			cand_role[nc] = 4;
 			cand_at[nc] = -1;
+			cand_whole[nc] = 0;
 			cand_snap[nc++] = -1;
 		}
 	}
@@ -780,10 +800,11 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			memcpy(cand[nc], P[s], sizeof cand[nc]);
 			cand_role[nc] = 1 + s;
 			cand_at[nc] = s;
+			cand_whole[nc] = 1;
 			cand_snap[nc++] = s;
 		}
 	} else if (!(special[0] || special[1] || special[2]) && !border) {
-		if (g->opt.placement == MLOD_PLACE_OPTIMAL && g->pose_count > 0) {
+		if (optimal_like(g) && g->pose_count > 0) {
 			mlod_influences w;
 			double opt[3];
 			int found;
@@ -808,6 +829,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 						memcpy(cand[nc], opt, sizeof cand[nc]);
 						cand_role[nc] = 0;
 						cand_at[nc] = -1;
+						cand_whole[nc] = 0;
 						cand_snap[nc++] = -1;
 					}
 				}
@@ -818,13 +840,33 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 				memcpy(cand[nc], P[s], sizeof cand[nc]);
 				cand_role[nc] = 1 + s;
 				cand_at[nc] = s;
+				cand_whole[nc] = 0;
 				cand_snap[nc++] = -1;
 			}
 		}
 		memcpy(cand[nc], bary, sizeof cand[nc]);
 		cand_role[nc] = 4;
 		cand_at[nc] = -1;
+		cand_whole[nc] = 0;
 		cand_snap[nc++] = -1;
+	}
+	if (hybrid) {
+		/* Each collapsed vertex the placements above may go to (all of
+		 * them away from seams and borders), kept whole too: last, so
+		 * that the others' least cost is known when they are tried. */
+		int n0 = nc, any = !(special[0] || special[1] || special[2]) && !border;
+		for (int s = 0; s < K; s++) {
+			int offered = any;
+			for (int i = 0; i < n0; i++)
+				offered |= cand_at[i] == s;
+			if (!offered)
+				continue;
+			memcpy(cand[nc], P[s], sizeof cand[nc]);
+			cand_role[nc] = 5 + s;
+			cand_at[nc] = s;
+			cand_whole[nc] = 1;
+			cand_snap[nc++] = s;
+		}
 	}
 
 	/* The kept faces as they are, for geometry_ok. */
@@ -836,9 +878,19 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	/* The cheapest valid candidate; with the compactness cost (the same
 	 * for every placement), the one nearest the barycenter. The
 	 * compactness tie-break of the posed cost is t's own for a triangle,
-	 * the mean over the removed faces for an edge. */
-	int best = -1;
-	double best_d = 0.0, tie = 0.0;
+	 * the mean over the removed faces for an edge. The hybrid placement
+	 * keeps two: the cheapest free placement (family 0) and the cheapest
+	 * whole vertex (family 1), tried last. */
+	int bestf[2] = {-1, -1}, capf[2] = {0, 0};
+	unsigned same_end = 0;
+	int geo_at[3] = {-1, -1, -1};
+	double end_e[3] = {0.0, 0.0, 0.0};
+	double costf[2] = {0.0, 0.0}, df[2] = {0.0, 0.0}, tie = 0.0;
+	/* Hybrid: a whole vertex within this cost is kept (the squared share
+	 * of the diagonal: the cost is a mean squared distance). */
+	double cap = hybrid ? g->opt.hybrid_error / 100.0 * g->diagonal : 0.0;
+	cap *= cap;
+	mlod_influences inff[2];
 	if (K == 3) {
 		tie = face_tie(g, t);
 	} else {
@@ -850,7 +902,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	 * the loop below would make, ties going to the earlier). */
 	int order[MAX_CANDIDATES];
 	double ckey[MAX_CANDIDATES];
-	int ranked = fast && g->opt.cost == MLOD_COST_POSED;
+	int ranked = fast && g->opt.cost == MLOD_COST_POSED && !hybrid;
 	for (int k = 0; k < nc; k++) {
 		order[k] = k;
 		if (!ranked)
@@ -866,14 +918,28 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		}
 	}
 	for (int kk = 0; kk < nc; kk++) {
-		int k = order[kk];
-		if (ranked && best >= 0)
+		int k = order[kk], fam = hybrid && cand_whole[k];
+		if (ranked && bestf[0] >= 0)
 			break;
-		if (!geometry_ok(g, pl, cand[k]))
+		int at = cand_at[k];
+		if (fam == 1 && (same_end >> at & 1u) && bestf[0] >= 0) {
+			/* Its cost is known (the free end's): skip it when it cannot
+			 * be kept. */
+			double c = (wsum > 0.0 ? end_e[at] / wsum : 0.0) + TIE_WEIGHT * tie;
+			if (g->opt.op == MLOD_OP_MIXED)
+				c /= pl->nr;
+			if (c > costf[0] && c > cap)
+				continue;
+		}
+		/* A whole vertex is where a free end was: the same answer. */
+		int ok = fam == 1 && geo_at[at] >= 0 ? geo_at[at] : geometry_ok(g, pl, cand[k]);
+		if (hybrid && at >= 0 && !cand_whole[k])
+			geo_at[at] = ok;
+		if (!ok)
 			continue;
 		mlod_influences w;
 		int capped = 0;
-		if (vertex)
+		if (cand_whole[k])
 			w = in3[cand_at[k]]; /* the vertex's own influences, not blended */
 		else
 			capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
@@ -887,20 +953,28 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			 * features count as much as large ones. */
 			double e = 0.0;
 			if (ranked) {
-				pl->cost = ckey[k];
+				cost = ckey[k];
 				goto take;
 			} else if (g->pose_count > 0) {
-				/* Stop summing once this candidate cannot beat the best:
-				 * with a margin far above rounding, so that the choice is
-				 * the one the full sum makes. */
-				double stop = HUGE_VAL, add = TIE_WEIGHT * tie;
-				if (best >= 0 && wsum > 0.0) {
-					double lim = pl->cost * (g->opt.op == MLOD_OP_MIXED ? pl->nr : 1) - add;
+				/* Stop summing once this candidate cannot beat the best of
+				 * its family (a whole vertex: nor be kept, costing more
+				 * than both the free best and the cap): with a margin far
+				 * above rounding, so that the choice is the one the full
+				 * sum makes. */
+				double stop = HUGE_VAL, add = TIE_WEIGHT * tie, limit = HUGE_VAL;
+				if (bestf[fam] >= 0)
+					limit = costf[fam];
+				if (fam == 1 && bestf[0] >= 0)
+					limit = fmin(limit, fmax(costf[0], cap));
+				if (limit < HUGE_VAL && wsum > 0.0) {
+					double lim = limit * (g->opt.op == MLOD_OP_MIXED ? pl->nr : 1) - add;
 					if (lim > 1e-6 * add)
 						stop = lim * wsum * (1.0 + 1e-9);
 				}
 				int role = cand_role[k];
-				if (mm && (mm->known >> role & 1u)) {
+				if (role >= 5 && (same_end >> (role - 5) & 1u)) {
+					e = end_e[role - 5];
+				} else if (mm && (mm->known >> role & 1u)) {
 					e = mm->e[role];
 				} else {
 					if (!q_ready)
@@ -913,31 +987,46 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 						mm->known |= 1u << role;
 					}
 				}
+				/* A free end skinned with the vertex's own influences (as
+				 * Power Skinning at a vertex mostly gives) costs what
+				 * that vertex kept whole costs. */
+				if (hybrid && role >= 1 && role <= 3 && same_influences(&w, &in3[role - 1])) {
+					end_e[role - 1] = e;
+					same_end |= 1u << (role - 1);
+				}
 			}
 			cost = (wsum > 0.0 ? e / wsum : 0.0) + TIE_WEIGHT * tie;
 			if (g->opt.op == MLOD_OP_MIXED) /* per removed face: triangles and edges compete */
 				cost /= pl->nr;
-			if (best >= 0 && !(cost < pl->cost))
+			if (bestf[fam] >= 0 && !(cost < costf[fam]))
 				continue;
 		} else {
 			cost = bgm_compactness(P[0], P[1], P[2]);
-			if (best >= 0 && !(d < best_d))
+			if (bestf[fam] >= 0 && !(d < df[fam]))
 				continue;
 		}
-		pl->cost = cost;
 	take:
-		best = k;
-		best_d = d;
-		pl->inf = w;
-		pl->capped = capped;
+		bestf[fam] = k;
+		costf[fam] = cost;
+		df[fam] = d;
+		inff[fam] = w;
+		capf[fam] = capped;
 	}
+	/* Hybrid: the whole vertex when it costs no more than the free
+	 * placement, or no more than the cap. */
+	int fam = bestf[1] >= 0 && (bestf[0] < 0 || costf[1] <= costf[0] || costf[1] <= cap);
+	int best = bestf[fam];
 	if (best < 0)
 		return 0;
+	pl->cost = costf[fam];
+	pl->inf = inff[fam];
+	pl->capped = capf[fam];
 	if (nb >= 2 && g->opt.cost == MLOD_COST_POSED)
 		pl->cost *= border_factor(g); /* the border moves (a lone border vertex stays put) */
 	memcpy(pl->pos, cand[best], sizeof pl->pos);
 	pl->snap = cand_snap[best];
-	if (vertex)
+	pl->whole = cand_whole[best];
+	if (pl->whole)
 		vertex_wedges(g, pl, owner);
 	if (cand_at[best] >= 0) {
 		pl->lambda[0] = pl->lambda[1] = pl->lambda[2] = 0.0;
@@ -1400,7 +1489,7 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		lb = bgm_quadric_eval(Q, bary);
 		for (int j = 0; j < K; j++)
 			lb = fmin(lb, bgm_quadric_eval(Q, P[j]));
-		if (g->opt.placement == MLOD_PLACE_OPTIMAL && bgm_quadric_solve(Q, bary, x) == 0)
+		if (optimal_like(g) && bgm_quadric_solve(Q, bary, x) == 0)
 			lb = fmin(lb, bgm_quadric_eval(Q, x));
 	} else if (g->lbmemo_cap > 0 &&
 	           (hit = lbmemo_slot(g->lbmemo, g->lbmemo_cap, v[0], v[1], K == 3 ? v[2] : -1))->a >= 0) {
@@ -1419,7 +1508,7 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		lb = bgm_quadric_eval(Q, bary);
 		for (int j = 0; j < K; j++)
 			lb = fmin(lb, bgm_quadric_eval(Q, P[j]));
-		if (g->opt.placement == MLOD_PLACE_OPTIMAL) {
+		if (optimal_like(g)) {
 			double lmax = 0.0, gr[3], gl = 0.0;
 			for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
 				double l = 0.0;
@@ -1501,7 +1590,7 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		mm->wsum = wsum;
 		mm->known |= MEMO_WSUM;
 	}
-	if (g->opt.placement == MLOD_PLACE_OPTIMAL) {
+	if (optimal_like(g)) {
 		mlod_influences w;
 		double opt[3];
 		if (!mm->opt_state) {
@@ -1527,6 +1616,11 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		role[nc] = 4;
 		memcpy(cand[nc++], bary, sizeof cand[0]);
 	}
+	if (g->opt.placement == MLOD_PLACE_HYBRID && g->opt.cost == MLOD_COST_POSED)
+		for (int j = 0; j < K; j++) { /* kept whole */
+			role[nc] = 5 + j;
+			memcpy(cand[nc++], P[j], sizeof cand[0]);
+		}
 	/* The least sum so far (the least stays the least divided by wsum):
 	 * a candidate's sum stops once it reaches it, its terms being
 	 * positive, and is then neither the least nor memoised (plan() sums
@@ -1536,6 +1630,8 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		mlod_influences w;
 		if (vertex)
 			w = in3[role[k] - 1]; /* as plan() skins it */
+		else if (role[k] >= 5)
+			w = in3[role[k] - 5];
 		else
 			mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
 		if (g->joint_count > 0 && w.count == 0)
@@ -1551,6 +1647,13 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 				continue; /* at least the least: the minimum stays */
 			mm->e[role[k]] = e;
 			mm->known |= 1u << role[k];
+		}
+		/* As plan(): a free end with the vertex's own influences costs
+		 * what the vertex kept whole costs. */
+		if (!vertex && role[k] >= 1 && role[k] <= 3 && g->opt.placement == MLOD_PLACE_HYBRID &&
+		    same_influences(&w, &in3[role[k] - 1])) {
+			mm->e[role[k] + 4] = e;
+			mm->known |= 1u << (role[k] + 4);
 		}
 		least = fmin(least, e);
 		best = fmin(best, wsum > 0.0 ? e / wsum : 0.0);
@@ -1686,7 +1789,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	 * faceted); equal results share a wedge. */
 	int gw[MAX_WEDGES], cw[MAX_PATCH];
 	int S = g->lay.stride;
-	if (g->opt.placement == MLOD_PLACE_VERTEX) {
+	if (pl->whole) {
 		/* One new wedge per wedge of v[snap] taken, a copy of it. */
 		for (int j = 0; j < pl->nk; j++) {
 			int prev = -1;

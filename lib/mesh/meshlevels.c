@@ -38,7 +38,31 @@ const char *mlod_mesh_budget_name(mlod_mesh_budget b)
 
 const char *mlod_mesh_placement_name(mlod_placement p)
 {
-	return p == MLOD_PLACE_BARYCENTER ? "barycenter" : p == MLOD_PLACE_VERTEX ? "vertex" : "optimal";
+	return p == MLOD_PLACE_BARYCENTER ? "barycenter"
+	       : p == MLOD_PLACE_VERTEX   ? "vertex"
+	       : p == MLOD_PLACE_HYBRID   ? "hybrid"
+	                                  : "optimal";
+}
+
+int mlod_mesh_placement_parse(const char *s, mlod_placement *p, double *error)
+{
+	static const char *const names[] = {"barycenter", "optimal", "vertex", "hybrid"};
+	for (int i = 0; i < 4; i++)
+		if (strcmp(s, names[i]) == 0) {
+			*p = (mlod_placement)(MLOD_PLACE_BARYCENTER + i);
+			if (*p == MLOD_PLACE_HYBRID)
+				*error = 0.0;
+			return 0;
+		}
+	if (strncmp(s, "hybrid=", 7) != 0 || !s[7])
+		return -1;
+	char *end;
+	double pct = strtod(s + 7, &end);
+	if (*end || !(pct > 0.0) || !(pct <= 100.0))
+		return -1;
+	*p = MLOD_PLACE_HYBRID;
+	*error = pct;
+	return 0;
 }
 
 const char *mlod_mesh_eligibility_name(mlod_eligibility e)
@@ -53,13 +77,15 @@ void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget)
 	if (budget && *budget == MLOD_BUDGET_DEFAULT) /* measured: see mlod-bgm(1) */
 		*budget = opt->cost == MLOD_COST_POSED ? MLOD_BUDGET_CHARACTER : MLOD_BUDGET_PRIMITIVE;
 	if (opt->placement == MLOD_PLACE_DEFAULT)
-		opt->placement = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_OPTIMAL;
+		opt->placement = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_HYBRID;
 	if (opt->op == MLOD_OP_DEFAULT)
 		opt->op = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_OP_TRIANGLE : MLOD_OP_EDGE;
 	if (opt->eligibility == MLOD_ELIGIBLE_DEFAULT)
 		opt->eligibility = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_ELIGIBLE_BEND : MLOD_ELIGIBLE_ALL;
 	if (!(opt->tau > 0.0))
 		opt->tau = 1.0;
+	if (!(opt->hybrid_error > 0.0))
+		opt->hybrid_error = MLOD_MESH_HYBRID_ERROR;
 	if (opt->influence_budget == 0.0)
 		opt->influence_budget = MLOD_MESH_INFLUENCE_BUDGET > 0.0 ? MLOD_MESH_INFLUENCE_BUDGET : -1.0;
 }

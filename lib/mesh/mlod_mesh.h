@@ -84,11 +84,14 @@ typedef enum mlod_mesh_cost {
  * neither tear nor smear; a collapse moving a border vertex puts v-bar on
  * a border vertex or the midpoint of a border edge. */
 typedef enum mlod_placement {
-	MLOD_PLACE_DEFAULT = 0, /* OPTIMAL with the posed cost (measured), BARYCENTER with compactness (the paper) */
+	MLOD_PLACE_DEFAULT = 0, /* HYBRID with the posed cost (measured), BARYCENTER with compactness (the paper) */
 	MLOD_PLACE_BARYCENTER,  /* the paper: the triangle's barycenter */
 	MLOD_PLACE_OPTIMAL,     /* beyond the paper: the minimum of the posed quadric (or the barycenter when lower) */
-	MLOD_PLACE_VERTEX       /* one of the collapsed vertices, kept whole (attributes and influences as it has
+	MLOD_PLACE_VERTEX,      /* one of the collapsed vertices, kept whole (attributes and influences as it has
 	                         * them, no Power Skinning): coarse levels reuse level-0 vertices */
+	MLOD_PLACE_HYBRID       /* per collapse, VERTEX's cheapest whole vertex when its posed cost is at most
+	                         * OPTIMAL's or within hybrid_error, else OPTIMAL's (posed cost only; with
+	                         * compactness it is OPTIMAL) */
 } mlod_placement;
 
 /* Which collapses run. */
@@ -107,6 +110,10 @@ typedef struct mlod_bgm_options {
 	mlod_collapse_op op;
 	mlod_eligibility eligibility;
 	double tau;                  /* 0 means 1 */
+	double hybrid_error;         /* MLOD_PLACE_HYBRID: a whole vertex is also kept when its posed cost
+	                              * (a mean squared distance over the patch and the poses) is at most
+	                              * the square of this percentage of the diagonal; 0 means
+	                              * MLOD_MESH_HYBRID_ERROR */
 	int allow_border;            /* collapses along a border rank at their plain posed cost
 	                              * (default: 50 times it), and with the compactness cost border
 	                              * collapses start at once (default: once nothing else does) */
@@ -250,6 +257,9 @@ mlod_result mlod_primitive_remap_joints(mlod_primitive *p, const int *map, int m
  * skins 3-17% fewer instructions far away at about a quarter more bake
  * time, the levels measured again). */
 #define MLOD_MESH_INFLUENCE_BUDGET 0.0
+/* MLOD_PLACE_HYBRID's default hybrid_error, in percent of the diagonal
+ * (bench/RESULTS.md, the hybrid placement's sweep). */
+#define MLOD_MESH_HYBRID_ERROR 0.1
 #define MLOD_MESH_MAX_LEVELS 16
 #define MLOD_MESH_MIN_RATIO (1.0 / 256)
 #define MLOD_MESH_BISECTIONS 6
@@ -270,6 +280,11 @@ const char *mlod_mesh_cost_name(mlod_mesh_cost c);
 const char *mlod_mesh_op_name(mlod_collapse_op op);
 const char *mlod_mesh_budget_name(mlod_mesh_budget b);
 const char *mlod_mesh_placement_name(mlod_placement p);
+/* Parses a placement name: barycenter, optimal, vertex, hybrid or
+ * hybrid=PCT (hybrid_error PCT, above 0 and at most 100); sets *p and,
+ * for hybrid, *error (0: the default). Returns 0, or -1 for anything
+ * else. */
+int mlod_mesh_placement_parse(const char *s, mlod_placement *p, double *error);
 const char *mlod_mesh_eligibility_name(mlod_eligibility e);
 
 /* Replaces the DEFAULT values with what they stand for (the cost first:
