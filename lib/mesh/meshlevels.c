@@ -77,7 +77,7 @@ void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget)
 	if (budget && *budget == MLOD_BUDGET_DEFAULT) /* measured: see mlod-bgm(1) */
 		*budget = opt->cost == MLOD_COST_POSED ? MLOD_BUDGET_CHARACTER : MLOD_BUDGET_PRIMITIVE;
 	if (opt->placement == MLOD_PLACE_DEFAULT)
-		opt->placement = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_HYBRID;
+		opt->placement = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_OPTIMAL;
 	if (opt->op == MLOD_OP_DEFAULT)
 		opt->op = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_OP_TRIANGLE : MLOD_OP_EDGE;
 	if (opt->eligibility == MLOD_ELIGIBLE_DEFAULT)

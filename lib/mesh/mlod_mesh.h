@@ -84,7 +84,7 @@ typedef enum mlod_mesh_cost {
  * neither tear nor smear; a collapse moving a border vertex puts v-bar on
  * a border vertex or the midpoint of a border edge. */
 typedef enum mlod_placement {
-	MLOD_PLACE_DEFAULT = 0, /* HYBRID with the posed cost (measured), BARYCENTER with compactness (the paper) */
+	MLOD_PLACE_DEFAULT = 0, /* OPTIMAL with the posed cost (measured), BARYCENTER with compactness (the paper) */
 	MLOD_PLACE_BARYCENTER,  /* the paper: the triangle's barycenter */
 	MLOD_PLACE_OPTIMAL,     /* beyond the paper: the minimum of the posed quadric (or the barycenter when lower) */
 	MLOD_PLACE_VERTEX,      /* one of the collapsed vertices, kept whole (attributes and influences as it has

@@ -1,15 +1,15 @@
-# -p hybrid (the default placement with the posed cost): each collapse
+# -p hybrid (opt-in; the default placement is optimal): each collapse
 # keeps its cheapest collapsed vertex whole (as -p vertex does) when that
 # costs no more than the optimal placement or stays within 0.1% of the
 # diagonal, else places v-bar optimally. So its levels hold fewer new
 # vertices (not input vertices, bit for bit in every attribute) than the
 # optimal placement's, but some: counted on the split glbs of the tubeman
 # and the robot, 0 < hybrid < optimal, and on the tubeman a larger share
-# kept whole with hybrid=1 (1% of the diagonal) than with the default. A hybrid that placed every vertex
+# kept whole with hybrid=1 (1% of the diagonal) than with hybrid. A hybrid that placed every vertex
 # optimally, or kept every one whole, fails here.
 set -e
-"$BIN/mlod-bgm" --report=json "$ROOT/samples/tubeman.glb" > r.json
-node -e 'const r = JSON.parse(require("fs").readFileSync("r.json")); if (r.options.placement !== "hybrid" || r.levels.length < 3) process.exit(1)'
+"$BIN/mlod-bgm" -p hybrid --report=json "$ROOT/samples/tubeman.glb" > r.json
+node -e 'const r = JSON.parse(require("fs").readFileSync("r.json")); if (r.options.placement !== "hybrid" || r.options.hybrid_error !== 0.1 || r.levels.length < 3) process.exit(1)'
 cat > check.js <<'JS'
 const fs = require('fs');
 const [input, ...levels] = process.argv.slice(2);
@@ -71,7 +71,7 @@ for f in tubeman RobotExpressive; do
 	done
 	mkdir "$f.default"
 	"$BIN/mlod-bgm" -s "$f.default" -o "$f.default.glb" "$ROOT/samples/$f.glb"
-	cmp "$f.default.glb" "$f.hybrid.glb" # hybrid is the default
+	cmp "$f.default.glb" "$f.optimal.glb" # optimal is the default
 	h=$(node check.js "$ROOT/samples/$f.glb" "$f.hybrid"/*.glb)
 	o=$(node check.js "$ROOT/samples/$f.glb" "$f.optimal"/*.glb)
 	w=$(node check.js "$ROOT/samples/$f.glb" "$f.hybrid=1"/*.glb)
@@ -84,10 +84,10 @@ for f in tubeman RobotExpressive; do
 	# the free placements are its vertices too: hybrid=1 keeps no more)
 	[ "$f" = RobotExpressive ] || [ "$w" -lt "$h" ]
 done
-# mlod-pack: the same placement, smaller than -p optimal; same bytes at any
-# thread count.
-"$BIN/mlod-pack" -j 1 -o a.mlod "$ROOT/samples/tubeman.glb"
-"$BIN/mlod-pack" -j 2 -o b.mlod "$ROOT/samples/tubeman.glb"
+# mlod-pack -p hybrid: the same placement, smaller than the default
+# (optimal); same bytes at any thread count.
+"$BIN/mlod-pack" -p hybrid -j 1 -o a.mlod "$ROOT/samples/tubeman.glb"
+"$BIN/mlod-pack" -p hybrid -j 2 -o b.mlod "$ROOT/samples/tubeman.glb"
 cmp a.mlod b.mlod
-"$BIN/mlod-pack" -p optimal -o o.mlod "$ROOT/samples/tubeman.glb"
+"$BIN/mlod-pack" -o o.mlod "$ROOT/samples/tubeman.glb"
 test "$(wc -c < a.mlod)" -lt "$(wc -c < o.mlod)"

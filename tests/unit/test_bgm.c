@@ -452,7 +452,7 @@ TEST(prefixes_tubeman)
 
 /* The default (posed cost) collapses edges: an edge record has two
  * parents, and its v-bar's influences are Power Skinning of those two,
- * or (the hybrid placement, the default, keeping a parent whole: *whole
+ * or (the hybrid placement, opt-in, keeping a parent whole: *whole
  * counts them) that parent's position and influences as they are.
  * MLOD_OP_MIXED lets triangles and edges compete, MLOD_OP_TRIANGLE is the
  * paper's triangle collapse only; edges need the posed cost. */
@@ -512,9 +512,12 @@ TEST(collapse_ops)
 	int edges, triangles, whole;
 	count_ops(&c, NULL, &edges, &triangles, &whole);
 	CHECK_MSG(edges > 0 && triangles == 0, "default: %d edge and %d triangle collapses", edges, triangles);
-	/* The hybrid placement keeps some vertices whole, not all. */
-	CHECK_MSG(whole > edges / 10 && whole < edges, "default: %d of %d edge collapses kept a vertex whole", whole, edges);
 	mlod_bgm_options opt = {0};
+	/* The hybrid placement keeps some vertices whole, not all. */
+	opt.placement = MLOD_PLACE_HYBRID;
+	count_ops(&c, &opt, &edges, &triangles, &whole);
+	CHECK_MSG(whole > edges / 10 && whole < edges, "hybrid: %d of %d edge collapses kept a vertex whole", whole, edges);
+	opt.placement = MLOD_PLACE_DEFAULT;
 	opt.op = MLOD_OP_MIXED;
 	count_ops(&c, &opt, &edges, &triangles, &whole);
 	CHECK_MSG(edges > 0 && triangles > 0, "mixed: %d edge and %d triangle collapses", edges, triangles);
