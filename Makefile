@@ -80,7 +80,7 @@ BENCH := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
 # Keep object files that pattern chains would treat as intermediate.
 .SECONDARY:
 
-.PHONY: all unit test test-extended bench demo install clean samples
+.PHONY: all unit rt-unit test test-extended bench demo install clean samples
 
 all: $(B)/libmlod.a $(B)/libmlodrt.a $(TOOLS)
 
@@ -151,15 +151,21 @@ $(B)/bench/pack_streams: LDLIBS += -lz
 
 unit: $(UNIT) $(HELPERS) $(RT_TESTS)
 
+# The runtime's tests alone (`make MLOD_DRACO=0 rt-unit`: the runtime built
+# without its Draco decode, which `test` runs too).
+rt-unit: $(RT_TESTS)
+
 # The whole suite: unit, CLI and validator tests on the release build, then
 # the unit tests again under AddressSanitizer and UBSan.
 test: all unit $(B)/bench/crowd
 	@$(MAKE) --no-print-directory config=sanitize unit
-	@tests/run.sh --build $(B) --sanitize-build build/sanitize
+	@$(MAKE) --no-print-directory MLOD_DRACO=0 rt-unit
+	@tests/run.sh --build $(B) --sanitize-build build/sanitize --nodraco-build build/$(config)-nodraco
 
 test-extended: all unit $(B)/bench/crowd
 	@$(MAKE) --no-print-directory config=sanitize unit
-	@tests/run.sh --build $(B) --sanitize-build build/sanitize --extended
+	@$(MAKE) --no-print-directory MLOD_DRACO=0 rt-unit
+	@tests/run.sh --build $(B) --sanitize-build build/sanitize --nodraco-build build/$(config)-nodraco --extended
 
 bench: all $(BENCH) $(HELPERS)
 	@bench/run.sh $(B)

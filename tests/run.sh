@@ -2,7 +2,8 @@
 # tests/run.sh: runs mlod's whole test suite and ends with the line
 # "N passed, N failed, N skipped".
 #
-#   tests/run.sh --build build/release [--sanitize-build build/sanitize] [--extended]
+#   tests/run.sh --build build/release [--sanitize-build build/sanitize]
+#                [--nodraco-build build/release-nodraco] [--extended]
 #
 # Stages:
 #   unit       every build/<config>/tests/test_* program and every runtime
@@ -13,6 +14,8 @@
 #              or NAME.stderr.re (below)
 #   validate   glb written by the tools, checked by the Khronos glTF validator
 #   sanitize   the unit and runtime tests again, built with ASan and UBSan
+#   nodraco    the runtime tests again, on a runtime built without its
+#              Draco decode (make MLOD_DRACO=0 rt-unit)
 # The unit tests that need ../shared/data get it whenever it is present;
 # --extended also feeds it to every CLI stage. Its absolute path is exported
 # as MLOD_SHARED_DATA. A MLOD_SHARED_DATA already set names another directory
@@ -35,13 +38,15 @@ set -u
 
 build=build/release
 san=
+nodraco=
 extended=0
 while [ $# -gt 0 ]; do
 	case $1 in
 	--build) build=$2; shift ;;
 	--sanitize-build) san=$2; shift ;;
+	--nodraco-build) nodraco=$2; shift ;;
 	--extended) extended=1 ;;
-	*) echo "usage: tests/run.sh --build DIR [--sanitize-build DIR] [--extended]" >&2; exit 1 ;;
+	*) echo "usage: tests/run.sh --build DIR [--sanitize-build DIR] [--nodraco-build DIR] [--extended]" >&2; exit 1 ;;
 	esac
 	shift
 done
@@ -106,12 +111,13 @@ stderr_matches() {
 	}' "$1" "$2"
 }
 
-# Runs the unit test programs in dir; counts their PASS/FAIL/SKIP lines.
+# Runs the unit test programs in dir (with a third argument "rt", the
+# runtime's alone); counts their PASS/FAIL/SKIP lines.
 run_unit() {
-	stage=$1 dir=$2
+	stage=$1 dir=$2 only=${3:-}
 	# A test program that was not built must not go unnoticed.
 	for src in tests/unit/test_*.c; do
-		[ -f "$src" ] || continue
+		[ -f "$src" ] && [ "$only" != rt ] || continue
 		name=$(basename "$src" .c)
 		[ -x "$dir/tests/$name" ] || fail "$stage/$name" "$dir/tests/$name was not built"
 	done
@@ -122,6 +128,7 @@ run_unit() {
 	done
 	for t in "$dir"/tests/test_* "$dir"/tests/rt/*; do
 		[ -f "$t" ] && [ -x "$t" ] || continue
+		case $only:$t in rt:*/tests/test_*) continue ;; esac
 		case $t in
 		*/tests/rt/*) name=rt/$(basename "$t") ;;
 		*) name=$(basename "$t") ;;
@@ -281,6 +288,11 @@ if [ -n "$san" ]; then
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 	export ASAN_OPTIONS UBSAN_OPTIONS
 	run_unit sanitize "$san"
+fi
+
+if [ -n "$nodraco" ]; then
+	echo "== nodraco ($nodraco)"
+	run_unit nodraco "$nodraco" rt
 fi
 
 if [ $skipped -gt 0 ]; then

@@ -1717,22 +1717,6 @@ fail:
 	return r;
 }
 
-#if MLOD_DRACO
-/* A part's attribute in a Draco mesh (mlod(5), codec draco): the stream's
- * element as components of 1 or 2 bytes; 'POSQ' and 'MTPQ' drop their
- * fourth (zero) component. */
-static void draco_comp(uint32_t tag, uint32_t elsize, int *components, int *bytes)
-{
-	if (elsize == 8) {
-		*bytes = 2;
-		*components = tag == MLOD_STREAM_POSQ || tag == MLOD_STREAM_MTPQ ? 3 : 4;
-	} else if (tag == MLOD_STREAM_COLQ || tag == MLOD_STREAM_JNT8 || tag == MLOD_STREAM_WGT8) {
-		*bytes = 1, *components = 4;
-	} else {
-		*bytes = 2, *components = 2;
-	}
-}
-
 /* The bytes a decoded mesh level's part takes (its mlod_pack_part arrays,
  * each rounded to 8), from its record alone. */
 static uint64_t decoded_part_bytes(const mlod_pack_part_rec *rc)
@@ -1750,6 +1734,23 @@ static uint64_t decoded_part_bytes(const mlod_pack_part_rec *rc)
 		total += round8(T * sizeof(float *)) + round8(T * 4) + T * round8(V * 12);
 	return total;
 }
+
+#if MLOD_DRACO
+/* A part's attribute in a Draco mesh (mlod(5), codec draco): the stream's
+ * element as components of 1 or 2 bytes; 'POSQ' and 'MTPQ' drop their
+ * fourth (zero) component. */
+static void draco_comp(uint32_t tag, uint32_t elsize, int *components, int *bytes)
+{
+	if (elsize == 8) {
+		*bytes = 2;
+		*components = tag == MLOD_STREAM_POSQ || tag == MLOD_STREAM_MTPQ ? 3 : 4;
+	} else if (tag == MLOD_STREAM_COLQ || tag == MLOD_STREAM_JNT8 || tag == MLOD_STREAM_WGT8) {
+		*bytes = 1, *components = 4;
+	} else {
+		*bytes = 2, *components = 2;
+	}
+}
+
 /* A MESH level of codec draco: stands alone (no coarser chunk is read).
  * 'PART', then per part 'DRCO' (its level as one Draco mesh) and, with
  * morph targets, 'MTSC'. */
