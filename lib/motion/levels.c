@@ -19,6 +19,13 @@
  *   threads each (mlod_motion_set_threads; tasks.c). Items are handed out
  *   in index order and a clip's keys item comes first, so the one the
  *   finisher waits for has always started.
+ * - three items per clip, the second way with the other method's levels
+ *   on a third item, when the keys method is the last one (so built
+ *   first): level k of the other method takes the limit the finisher
+ *   hands over once it has rounded keys level k, and the finisher goes
+ *   on to keys level k + 1 meanwhile. Only the third item waits on the
+ *   finisher, never the other way, so fewer threads than items only
+ *   delay it.
  */
 #include <pthread.h>
 #include <stdlib.h>
