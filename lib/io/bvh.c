@@ -17,9 +17,9 @@
  * against the bytes actually present before anything is allocated, and
  * the hierarchy is parsed without recursion. It accepts CR LF, LF or CR
  * line ends, a UTF-8 byte order mark, keywords in any case, names with
- * spaces, and braces on the line of what they open. Numbers are parsed by
- * hand, so the result does not depend on the C locale; NaN and infinities
- * are refused.
+ * spaces, and braces on the line of what they open. Numbers get the
+ * value strtod gives them in the C locale, whatever the locale (decimal.c);
+ * NaN and infinities are refused.
  *
  * Writing samples one clip at a uniform frame time. Each joint's BVH frame
  * is its rigid world frame: where the skeleton is rigid (unit scales) the
@@ -41,6 +41,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "io/decimal.h"
 #include "io/mlod_io.h"
 
 #define BVH_MAX_FRAMES 10000000       /* more frames than this is absurd */
@@ -108,88 +109,19 @@ static double pow10_exact(int e)
 
 enum { NUM_OK, NUM_SYNTAX, NUM_NONFINITE, NUM_RANGE };
 
-/* Parses a whole token as a decimal number: [+-] digits [. digits]
- * [e [+-] digits], or [+-] . digits ... Locale-independent. The value is
- * accurate to about one double ulp, far more than the float it becomes. */
+/* Parses a whole token as a decimal number (mlod_decimal_parse: strtod's
+ * value, without the locale); NUM_RANGE beyond the float range. */
 static int parse_number(const char *s, size_t len, double *out)
 {
-	size_t i = 0;
-	int neg = 0;
-	if (i < len && (s[i] == '+' || s[i] == '-'))
-		neg = s[i++] == '-';
-	/* NaN, Inf and MSVC's 1.#INF / 1.#QNAN get their own message. */
-	if (len - i >= 3) {
-		char a = (char)ascii_lower(s[i]), b = (char)ascii_lower(s[i + 1]), c = (char)ascii_lower(s[i + 2]);
-		if ((a == 'n' && b == 'a' && c == 'n') || (a == 'i' && b == 'n' && c == 'f'))
-			return NUM_NONFINITE;
-	}
-	for (size_t k = i; k < len; k++)
-		if (s[k] == '#')
-			return NUM_NONFINITE;
-
-	uint64_t mant = 0;
-	int digits = 0, any = 0;
-	long exp10 = 0;
-	while (i < len && is_digit(s[i])) {
-		any = 1;
-		if (digits < 19) {
-			mant = mant * 10 + (uint64_t)(s[i] - '0');
-			if (mant)
-				digits++;
-		} else {
-			exp10++;
-		}
-		i++;
-	}
-	if (i < len && s[i] == '.') {
-		i++;
-		while (i < len && is_digit(s[i])) {
-			any = 1;
-			if (digits < 19) {
-				mant = mant * 10 + (uint64_t)(s[i] - '0');
-				if (mant)
-					digits++;
-				exp10--;
-			}
-			i++;
-		}
-	}
-	if (!any)
-		return NUM_SYNTAX;
-	if (i < len && (s[i] == 'e' || s[i] == 'E')) {
-		i++;
-		int eneg = 0;
-		if (i < len && (s[i] == '+' || s[i] == '-'))
-			eneg = s[i++] == '-';
-		if (i >= len || !is_digit(s[i]))
-			return NUM_SYNTAX;
-		long e = 0;
-		while (i < len && is_digit(s[i])) {
-			if (e < 100000)
-				e = e * 10 + (s[i] - '0');
-			i++;
-		}
-		exp10 += eneg ? -e : e;
-	}
-	if (i != len)
-		return NUM_SYNTAX;
-
-	double v = (double)mant;
-	if (mant != 0) {
-		if (exp10 > 400)
-			return NUM_RANGE;
-		if (exp10 < -400)
-			v = 0.0;
-		else if (exp10 >= 0 && exp10 <= 22)
-			v *= pow10_exact((int)exp10);
-		else if (exp10 < 0 && exp10 >= -22)
-			v /= pow10_exact((int)-exp10);
-		else
-			v *= pow(10.0, (double)exp10);
+	double v;
+	switch (mlod_decimal_parse(s, len, &v)) {
+	case MLOD_DEC_OK: break;
+	case MLOD_DEC_NONFINITE: return NUM_NONFINITE;
+	default: return NUM_SYNTAX;
 	}
 	if (!isfinite(v) || fabs(v) > FLT_MAX)
 		return NUM_RANGE;
-	*out = neg ? -v : v;
+	*out = v;
 	return NUM_OK;
 }
 
@@ -310,6 +242,41 @@ static const char *show(const token *t, char buf[64])
 	buf[k++] = '\'';
 	buf[k] = 0;
 	return buf;
+}
+
+/* A frame value in its common form, read in one scan: [+-] digits
+ * [. digits] with at most 19 digits in all, a mantissa of at most 2^53,
+ * and a blank or the end after it. Its value is mant / 10^decimals, one
+ * exact division: mlod_decimal_parse's fast path, so the same double.
+ * Returns 1 and moves lx past it, or 0 with lx untouched (anything else
+ * goes through lex and parse_number). */
+static int frame_number(lexer *lx, double *out)
+{
+	const char *p = lx->p, *end = lx->end;
+	int neg = 0, digits = 0, decimals = 0;
+	uint64_t mant = 0;
+	if (p < end && (*p == '-' || *p == '+'))
+		neg = *p++ == '-';
+	while (p < end && is_digit(*p)) {
+		mant = mant * 10 + (uint64_t)(*p++ - '0');
+		digits++;
+	}
+	if (p < end && *p == '.') {
+		p++;
+		while (p < end && is_digit(*p)) {
+			mant = mant * 10 + (uint64_t)(*p++ - '0');
+			digits++;
+			decimals++;
+		}
+	}
+	if (digits == 0 || digits > 19 || mant > (uint64_t)1 << 53 || (p < end && !is_space((unsigned char)*p)))
+		return 0;
+	double v = (double)mant;
+	if (decimals)
+		v /= mlod_decimal_pow10[decimals];
+	*out = neg ? -v : v;
+	lx->p = p;
+	return 1;
 }
 
 /* Channel code of a channel name, or -1. */
@@ -841,6 +808,14 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 		int line = r->lx.line;
 		size_t got = 0;
 		for (;;) {
+			if (got < (size_t)vpf) {
+				double v;
+				skip_space(&r->lx, 0);
+				if (frame_number(&r->lx, &v)) {
+					vals[got++] = (float)v;
+					continue;
+				}
+			}
 			if (lex(&r->lx, &t, 0) < 0) {
 				res = fail_binary(r);
 				break;

@@ -19,6 +19,13 @@
  *   threads each (mlod_motion_set_threads; tasks.c). Items are handed out
  *   in index order and a clip's keys item comes first, so the one the
  *   finisher waits for has always started.
+ * - three items per clip, the second way with the other method's levels
+ *   on a third item, when the keys method is the last one (so built
+ *   first): level k of the other method takes the limit the finisher
+ *   hands over once it has rounded keys level k, and the finisher goes
+ *   on to keys level k + 1 meanwhile. Only the third item waits on the
+ *   finisher, never the other way, so fewer threads than items only
+ *   delay it.
  */
 #include <pthread.h>
 #include <stdlib.h>
@@ -58,6 +65,17 @@ typedef struct build_ctx {
 	 * published every level. */
 	mlod_motion **kmotion;       /* [clip] */
 	int *made;                   /* [clip] */
+	/* The third way (frames_own): the finisher hands the frames method
+	 * its motion (fmade: handed over, fmotion NULL when there is none)
+	 * and, level by level, the limit it would have given it (limit[clip]
+	 * [spec]; rounded: the levels handed over; stop: the finisher's list
+	 * ended before that level). */
+	int frames_own;
+	mlod_motion **fmotion;       /* [clip] */
+	int *fmade;                  /* [clip] */
+	long *limit;                 /* [clip][spec] */
+	int *rounded;                /* [clip] */
+	int *fin_stop;               /* [clip]: the level the finisher's list ended at, or spec_count */
 } build_ctx;
 
 #define NOT_BUILT ((mlod_result)-1)
@@ -145,6 +163,40 @@ static void wait_keys(build_ctx *b, int k, int s)
 	pthread_mutex_unlock(&b->lock);
 }
 
+/* The third way: the finisher hands over clip k's frames motion. */
+static void set_fmade(build_ctx *b, int k, mlod_motion *m)
+{
+	pthread_mutex_lock(&b->lock);
+	b->fmotion[k] = m;
+	b->fmade[k] = 1;
+	pthread_cond_broadcast(&b->more);
+	pthread_mutex_unlock(&b->lock);
+}
+
+/* The third way: the finisher is done with clip k's level s (its limit
+ * set), or its list ended at level stop. */
+static void set_rounded(build_ctx *b, int k, int s, int stop)
+{
+	pthread_mutex_lock(&b->lock);
+	b->rounded[k] = s;
+	if (stop >= 0 && stop < b->fin_stop[k])
+		b->fin_stop[k] = stop;
+	pthread_cond_broadcast(&b->more);
+	pthread_mutex_unlock(&b->lock);
+}
+
+/* Waits for the finisher's level s of clip k; 0 when its list ended
+ * before it. */
+static int wait_rounded(build_ctx *b, int k, int s)
+{
+	pthread_mutex_lock(&b->lock);
+	while (b->rounded[k] <= s && b->fin_stop[k] > s)
+		pthread_cond_wait(&b->more, &b->lock);
+	int go = b->fin_stop[k] > s;
+	pthread_mutex_unlock(&b->lock);
+	return go;
+}
+
 static size_t chain_at(const build_ctx *b, int k, int i, int s)
 {
 	return ((size_t)k * (size_t)b->method_count + (size_t)i) * (size_t)b->spec_count + (size_t)s;
@@ -219,6 +271,17 @@ static void finish_item(build_ctx *b, int k)
 		mlod_motion_set_threads(fin, b->threads);
 	}
 	int frames = made ? mlod_motion_timeline_info(fin)->frames : 0;
+	if (b->frames_own) {
+		/* The frames method (index 0, after the keys method) is the
+		 * frames item's, on its motion. */
+		int use = made && frames >= 3;
+		set_fmade(b, k, use ? m[0] : NULL);
+		if (use)
+			m[0] = NULL; /* the frames item's to free */
+		else
+			set_rounded(b, k, 0, 0);
+	}
+	int s_end = b->spec_count;
 	for (int s = 0; s < b->spec_count && frames >= 3; s++) {
 		const mlod_motion_spec *sp = &b->specs[s];
 		long limit = -1; /* the best finished level's bytes so far */
@@ -226,6 +289,12 @@ static void finish_item(build_ctx *b, int k)
 		for (int i = n - 1; i >= 0 && !stop; i--) {
 			if (skipped(b->methods[i], sp->target))
 				continue;
+			if (b->frames_own && i != b->keys) {
+				/* The frames item's, with this limit. */
+				b->limit[(size_t)k * (size_t)b->spec_count + (size_t)s] = limit;
+				set_rounded(b, k, s + 1, -1);
+				continue;
+			}
 			size_t at = chain_at(b, k, i, s);
 			mlod_result r;
 			if (i == b->keys) {
@@ -249,9 +318,15 @@ static void finish_item(build_ctx *b, int k)
 			if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
 				stop = 1; /* mlod_motion_next_level_best ends here */
 		}
-		if (stop)
+		if (stop) {
+			s_end = s;
 			break;
+		}
+		if (b->frames_own)
+			set_rounded(b, k, s + 1, -1); /* also when the frames method is skipped here */
 	}
+	if (b->frames_own)
+		set_rounded(b, k, b->rounded[k], s_end);
 	for (int i = 0; i < n; i++)
 		mlod_motion_free(m[i]);
 	mlod_motion_free(fin);
@@ -259,13 +334,46 @@ static void finish_item(build_ctx *b, int k)
 	mlod_motion_free(keys);
 }
 
+/* The third way, item 3k + 2: the frames method's levels of clip k
+ * (method 0, which mlod_motion_next_level_best builds after the keys
+ * method's), each with the limit the finisher hands over once it has
+ * rounded the keys level: the finisher goes on to the next keys level
+ * meanwhile. A frames level that fails ends its chain here, as it ends
+ * mlod_motion_next_level_best's list (gather stops at its level). */
+static void frames_item(build_ctx *b, int k)
+{
+	pthread_mutex_lock(&b->lock);
+	while (!b->fmade[k])
+		pthread_cond_wait(&b->more, &b->lock);
+	mlod_motion *m = b->fmotion[k];
+	pthread_mutex_unlock(&b->lock);
+	for (int s = 0; m && s < b->spec_count; s++) {
+		if (!wait_rounded(b, k, s))
+			break;
+		const mlod_motion_spec *sp = &b->specs[s];
+		if (skipped(b->methods[0], sp->target))
+			continue;
+		size_t at = chain_at(b, k, 0, s);
+		mlod_result r = b->chain_result[at] =
+			mlod_motion_next_level_under(m, b->methods[0], sp->target, sp->value,
+			                             b->limit[(size_t)k * (size_t)b->spec_count + (size_t)s], &b->chain[at],
+			                             &b->chain_error[at]);
+		if (r != MLOD_OK && r != MLOD_ERR_LIMIT)
+			break;
+	}
+	mlod_motion_free(m);
+}
+
 static mlod_result split_item(void *ctx, int item)
 {
 	build_ctx *b = ctx;
-	if (item % 2 == 0)
-		keys_item(b, item / 2);
+	int per = b->frames_own ? 3 : 2;
+	if (item % per == 0)
+		keys_item(b, item / per);
+	else if (item % per == 1)
+		finish_item(b, item / per);
 	else
-		finish_item(b, item / 2);
+		frames_item(b, item / per);
 	return MLOD_OK;
 }
 
@@ -396,6 +504,20 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 	b.published = calloc((size_t)clip_count, sizeof *b.published);
 	b.kmotion = calloc((size_t)clip_count, sizeof *b.kmotion);
 	b.made = calloc((size_t)clip_count, sizeof *b.made);
+	/* The third way when the keys method comes last (it is built first)
+	 * and the other one has its own item. */
+	b.frames_own = method_count == 2 && b.keys == 1;
+	int frames_ok = 1;
+	if (b.frames_own) {
+		b.fmotion = calloc((size_t)clip_count, sizeof *b.fmotion);
+		b.fmade = calloc((size_t)clip_count, sizeof *b.fmade);
+		b.limit = calloc((size_t)clip_count * (size_t)spec_count + 1, sizeof *b.limit);
+		b.rounded = calloc((size_t)clip_count, sizeof *b.rounded);
+		b.fin_stop = malloc(sizeof *b.fin_stop * (size_t)clip_count);
+		frames_ok = b.fmotion && b.fmade && b.limit && b.rounded && b.fin_stop;
+		for (int k = 0; frames_ok && k < clip_count; k++)
+			b.fin_stop[k] = spec_count;
+	}
 	mlod_result r = MLOD_OK;
 	int sync = 0;
 	if (b.published && b.kmotion && b.made && pthread_mutex_init(&b.lock, NULL) == 0) {
@@ -404,12 +526,15 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 		else
 			pthread_mutex_destroy(&b.lock);
 	}
-	if (!b.chain || !b.chain_result || !b.chain_error || !b.known || !b.fin_result || !b.fin_error || !b.create_result || !b.create_error || !b.info || !sync) {
+	if (!b.chain || !b.chain_result || !b.chain_error || !b.known || !b.fin_result || !b.fin_error || !b.create_result || !b.create_error || !b.info || !sync || !frames_ok) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	} else {
 		for (size_t i = 0; i < levels; i++)
 			b.chain_result[i] = NOT_BUILT;
-		mlod_parallel_for(2 * clip_count, threads, split_item, &b);
+		if (b.frames_own) /* one more worker per clip: the frames item waits on the finisher */
+			mlod_parallel_for(3 * clip_count, threads + clip_count, split_item, &b);
+		else
+			mlod_parallel_for(2 * clip_count, threads, split_item, &b);
 		for (int k = 0; k < clip_count; k++)
 			gather(&b, k);
 	}
@@ -427,6 +552,11 @@ mlod_result mlod_motion_build_levels(const mlod_character *c, const int *clips, 
 	free(b.published);
 	free(b.kmotion);
 	free(b.made);
+	free(b.fmotion);
+	free(b.fmade);
+	free(b.limit);
+	free(b.rounded);
+	free(b.fin_stop);
 	if (sync) {
 		pthread_cond_destroy(&b.more);
 		pthread_mutex_destroy(&b.lock);

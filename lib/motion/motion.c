@@ -783,6 +783,13 @@ typedef struct level_walk {
 	mlod_trs *local;  /* per joint: the rest pose with the animated paths set */
 } level_walk;
 
+#define REFINE_LANES 8 /* threads of the rounding's refinement and walks at most */
+static int refine_lanes(const mlod_motion *m);
+static int level_within_par(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L, mlod_mat4 *LM,
+                            mlod_mat4 *W, int lanes);
+static int level_measure_par(mlod_motion *m, const mlod_mat4 *known, double *point_error, mlod_deviation *dev,
+                             int lanes);
+
 /* Level clips have the common clip's channels: m's buffers serve. */
 static void walk_begin(mlod_motion *m, const mlod_clip *clip, level_walk *w)
 {
@@ -853,6 +860,12 @@ static int level_measure_of(mlod_motion *m, const mlod_clip *clip, const mlod_ma
 {
 	if (!m->cache0)
 		return 0;
+	int lanes = refine_lanes(m);
+	if (known && lanes > 1 && m->samples >= 64 * lanes) {
+		int r = level_measure_par(m, known, point_error, dev, lanes);
+		if (r >= 0)
+			return r;
+	}
 	const mlod_skeleton *s = m->s;
 	level_walk w;
 	walk_begin(m, clip, &w);
@@ -916,6 +929,12 @@ static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound
 	int ok = 1, stride = m->samples >= 4 * LEVEL_STRIDE ? LEVEL_STRIDE : 1;
 	if (kept)
 		*kept = keep;
+	int lanes = refine_lanes(m);
+	if (keep && m->cache0 && lanes > 1 && m->samples >= 64 * lanes) {
+		int r = level_within_par(m, clip, bound, L, LM, W, lanes);
+		if (r >= 0)
+			return r;
+	}
 	for (int pass = stride > 1 ? 0 : 1; pass < 2 && ok; pass++)
 		for (int f = 0; f < m->samples && ok; f += pass ? 1 : stride) {
 			if (pass == 1 && stride > 1 && f % stride == 0)
@@ -942,6 +961,173 @@ static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound
 				ok = eval_within(&wl[j], &w0[j], m->radius[j], bound);
 		}
 	return ok;
+}
+
+/* level_within_keep and level_measure_of (with its world matrices
+ * given) on m->threads threads, a range of samples each: every sample's
+ * floats are computed alone (its own walk state: eval_sample's floats do
+ * not depend on the samples before), so they are the serial walk's. */
+typedef struct walk_par {
+	mlod_motion *m;
+	const mlod_clip *clip;
+	double bound;
+	mlod_trs *L;
+	mlod_mat4 *LM, *W;
+	const mlod_mat4 *known;
+	int lanes;
+	atomic_int failed, oom, nan;
+	double *d;                   /* the measure: per sample, its distances in the serial order */
+	int per;                     /* distances per sample */
+	double worst[REFINE_LANES], max[REFINE_LANES];
+} walk_par;
+
+static void lane_range(const walk_par *x, int i, int *lo, int *hi)
+{
+	long S = x->m->samples;
+	*lo = (int)(S * i / x->lanes);
+	*hi = (int)(S * (i + 1) / x->lanes);
+}
+
+static mlod_result within_lane(void *ctx, int i)
+{
+	walk_par *x = ctx;
+	mlod_motion *m = x->m;
+	const mlod_skeleton *s = m->s;
+	const int J = s->joint_count;
+	int lo, hi;
+	lane_range(x, i, &lo, &hi);
+	eval_seg *segs = malloc(sizeof *segs * (size_t)(x->clip->channel_count > 0 ? x->clip->channel_count : 1));
+	mlod_trs *local = malloc(sizeof *local * (size_t)J);
+	if (!segs || !local) {
+		free(segs);
+		free(local);
+		atomic_store(&x->oom, 1);
+		return MLOD_OK;
+	}
+	for (int c = 0; c < x->clip->channel_count; c++)
+		segs[c].k = -1, segs[c].ready = 0;
+	mlod_pose_rest(s, local);
+	int ok = 1, n = hi - lo, stride = n >= 4 * LEVEL_STRIDE ? LEVEL_STRIDE : 1;
+	for (int pass = stride > 1 ? 0 : 1; pass < 2 && ok; pass++)
+		for (int f = lo; f < hi && ok; f += pass ? 1 : stride) {
+			if (pass == 1 && stride > 1 && (f - lo) % stride == 0)
+				continue;
+			if (atomic_load_explicit(&x->failed, memory_order_relaxed))
+				ok = 0;
+			size_t base = (size_t)f * (size_t)J;
+			const mlod_mat4 *w0 = m->cache0 + base;
+			mlod_trs *lf = x->L + base;
+			mlod_mat4 *lmf = x->LM + base, *wf = x->W + base;
+			eval_sample(x->clip, segs, m->st[f], local);
+			memcpy(lf, local, sizeof *lf * (size_t)J);
+			for (int j = 0; j < J; j++) {
+				int p = s->joints[j].parent;
+				lmf[j] = eval_from_trs(&lf[j]);
+				wf[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
+			}
+			for (int j = 0; j < J && ok; j++)
+				ok = eval_within(&wf[j], &w0[j], m->radius[j], x->bound);
+			if (!ok)
+				atomic_store(&x->failed, 1);
+		}
+	free(segs);
+	free(local);
+	return MLOD_OK;
+}
+
+/* level_within_keep into L, LM and W on lanes: 1 or 0, or -1 when it
+ * could not (the caller walks alone). */
+static int level_within_par(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L, mlod_mat4 *LM,
+                            mlod_mat4 *W, int lanes)
+{
+	walk_par x;
+	memset(&x, 0, sizeof x);
+	x.m = m, x.clip = clip, x.bound = bound, x.L = L, x.LM = LM, x.W = W, x.lanes = lanes;
+	atomic_init(&x.failed, 0);
+	atomic_init(&x.oom, 0);
+	atomic_init(&x.nan, 0);
+	mlod_parallel_for(lanes, lanes, within_lane, &x);
+	if (atomic_load(&x.oom))
+		return -1;
+	return !atomic_load(&x.failed);
+}
+
+static mlod_result measure_lane(void *ctx, int i)
+{
+	walk_par *x = ctx;
+	mlod_motion *m = x->m;
+	const mlod_skeleton *s = m->s;
+	const int J = s->joint_count;
+	int lo, hi;
+	lane_range(x, i, &lo, &hi);
+	double worst = 0.0, max = 0.0;
+	for (int f = lo; f < hi; f++) {
+		const mlod_mat4 *w0 = m->cache0 + (size_t)f * (size_t)J, *wl = x->known + (size_t)f * (size_t)J;
+		double *d = x->d + (size_t)f * (size_t)x->per;
+		for (int j = 0; j < J; j++) {
+			double e = eval_error_over(&wl[j], &w0[j], m->radius[j], worst);
+			if (e >= 0.0 && !(e <= worst))
+				worst = e;
+			else if (e != e) {
+				atomic_store(&x->nan, 1);
+				return MLOD_OK;
+			}
+			for (int k = 0; k < 1 + (s->joints[j].has_end_site != 0); k++) {
+				mlod_v3 o = { 0, 0, 0 };
+				if (k == 1)
+					o = s->joints[j].end_site;
+				mlod_v3 p = mlod_mat4_point(&w0[j], o), q = mlod_mat4_point(&wl[j], o);
+				double dist = mlod_v3_length(mlod_v3_sub(p, q));
+				*d++ = dist;
+				if (dist > max)
+					max = dist;
+			}
+		}
+	}
+	x->worst[i] = worst;
+	x->max[i] = max;
+	return MLOD_OK;
+}
+
+/* level_measure_of with known on lanes: the largest errors are the
+ * largest of the ranges', the sum is taken over the stored distances in
+ * the serial order. 1 or 0 as level_measure_of, -1 when it could not. */
+static int level_measure_par(mlod_motion *m, const mlod_mat4 *known, double *point_error, mlod_deviation *dev,
+                             int lanes)
+{
+	const mlod_skeleton *s = m->s;
+	walk_par x;
+	memset(&x, 0, sizeof x);
+	x.m = m, x.known = known, x.lanes = lanes;
+	atomic_init(&x.failed, 0);
+	atomic_init(&x.oom, 0);
+	atomic_init(&x.nan, 0);
+	for (int j = 0; j < s->joint_count; j++)
+		x.per += 1 + (s->joints[j].has_end_site != 0);
+	size_t count = (size_t)m->samples * (size_t)x.per;
+	x.d = malloc(sizeof *x.d * (count ? count : 1));
+	if (!x.d)
+		return -1;
+	mlod_parallel_for(lanes, lanes, measure_lane, &x);
+	if (atomic_load(&x.nan)) {
+		free(x.d);
+		return 0;
+	}
+	double worst = 0.0, max = 0.0, sum = 0.0;
+	for (int i = 0; i < lanes; i++) {
+		if (x.worst[i] > worst)
+			worst = x.worst[i];
+		if (x.max[i] > max)
+			max = x.max[i];
+	}
+	for (size_t k = 0; k < count; k++)
+		sum += x.d[k];
+	free(x.d);
+	*point_error = worst;
+	memset(dev, 0, sizeof *dev);
+	dev->max = max;
+	dev->mean = count ? sum / (double)count : 0.0;
+	return 1;
 }
 
 static int level_within(mlod_motion *m, const mlod_clip *clip, double bound)
@@ -1165,7 +1351,6 @@ static void channel_exps(const mlod_motion *m, const mlod_clip *clip, int g, con
  * at every call, so that what one call leaves there the next finds):
  * the level as rounded (shared), and per lane (a thread of the
  * refinement, up to m->threads) a try's and the best fit's. */
-#define REFINE_LANES 8
 typedef struct refine_lane {
 	mlod_trs *Lj, *Lj2;                      /* samples (2) */
 	mlod_mat4 *T, *T2, *LMj, *LMj2;          /* samples * joints (2), samples (2) */

@@ -197,7 +197,7 @@ static inline int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double ra
 
 /* mlod_motion_point_error(w, w0, radius), or -1 when a bound shows that
  * it is at most limit. */
-static inline double eval_error_over(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
+EVAL_INLINE double eval_error_over(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
 {
 	if (eval_error_bound(w, w0, radius) <= limit)
 		return -1.0;

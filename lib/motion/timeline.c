@@ -158,7 +158,20 @@ mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_opt
 	float *times = NULL, *u = NULL;
 	long n = 0;
 	int same = 1;
-	int uk = mlod_clip_key_times(clip, NULL, 0, &u, &same);
+	/* When every channel has the first one's key times (a BVH clip), the
+	 * merge of them all is the merge of the first alone: only it is
+	 * sorted. */
+	unsigned char *use = NULL;
+	int all_same = clip->channel_count > 1;
+	for (int i = 1; all_same && i < clip->channel_count; i++) {
+		const mlod_channel *a = &clip->channels[0], *b = &clip->channels[i];
+		all_same = b->key_count == a->key_count &&
+		           memcmp(b->times, a->times, sizeof(float) * (size_t)a->key_count) == 0;
+	}
+	if (all_same && (use = calloc((size_t)clip->channel_count, 1)) != NULL)
+		use[0] = 1;
+	int uk = mlod_clip_key_times(clip, use, 0, &u, &same);
+	free(use);
 	if (uk < 0)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	if (same && inf.cubic_channels == 0) {

@@ -1186,6 +1186,54 @@ TEST(build_levels_same_at_any_thread_count)
 	mlod_character_free(&c);
 }
 
+TEST(frames_item_levels_same)
+{
+	/* One clip at 2 and 3 threads: the frames method's levels on an item
+	 * of their own, each with the limit the finisher hands over after
+	 * rounding the keys level. The robot's Punch and Running have frames
+	 * levels that win (Running: all three), so a limit handed over wrong
+	 * or too early changes the chosen levels. */
+	mlod_character c;
+	CHECK(load_sample("samples/RobotExpressive.glb", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	mlod_motion_method methods[2] = { MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS };
+	mlod_motion_spec specs[3] = { { MLOD_MOTION_MAX_ERROR, 0.002 * h }, { MLOD_MOTION_MAX_ERROR, 0.01 * h },
+	                              { MLOD_MOTION_MAX_ERROR, 0.03 * h } };
+	const char *names[2] = { "Punch", "Running" };
+	int frames_won = 0;
+	for (int w = 0; w < 2; w++) {
+		int k = -1;
+		for (int i = 0; i < c.clip_count; i++)
+			if (c.clips[i].name && strcmp(c.clips[i].name, names[w]) == 0)
+				k = i;
+		CHECK_MSG(k >= 0, "no clip %s", names[w]);
+		mlod_motion *m[2] = { NULL, NULL };
+		mlod_motion_level seq[3];
+		for (int i = 0; i < 2; i++)
+			CHECK_OK(mlod_motion_create(&c, k, NULL, &m[i], &terr));
+		for (int s = 0; s < 3; s++) {
+			CHECK_OK(mlod_motion_next_level_best(m, methods, 2, specs[s].target, specs[s].value, &seq[s], &terr));
+			frames_won += seq[s].method == MLOD_MOTION_FRAMES;
+		}
+		for (int i = 0; i < 2; i++)
+			mlod_motion_free(m[i]);
+		for (int threads = 2; threads <= 3; threads++) {
+			mlod_motion_clip_levels out;
+			CHECK_OK(mlod_motion_build_levels(&c, &k, 1, NULL, methods, 2, specs, 3, threads, &out, &terr));
+			CHECK(out.result == MLOD_OK && out.level_count == 3);
+			for (int s = 0; s < 3; s++) {
+				CHECK(out.results[s] == MLOD_OK);
+				CHECK_MSG(same_level(&out.levels[s], &seq[s]), "%s, level %d, %d threads", names[w], s, threads);
+			}
+			mlod_motion_clip_levels_free(&out, 1);
+		}
+		for (int s = 0; s < 3; s++)
+			mlod_motion_level_free(&seq[s]);
+	}
+	CHECK_MSG(frames_won >= 4, "only %d frames levels won", frames_won);
+	mlod_character_free(&c);
+}
+
 TEST(keys_split_same_as_next_level)
 {
 	/* mlod_motion_keys_reduce, then mlod_motion_keys_finish on another
@@ -1367,6 +1415,7 @@ int main(void)
 	RUN(precision_rounds_within_own_error);
 	RUN(fast_checks_match_exact);
 	RUN(build_levels_same_at_any_thread_count);
+	RUN(frames_item_levels_same);
 	RUN(keys_split_same_as_next_level);
 	RUN(bake_report_same_at_any_thread_count);
 	RUN(create_like_same_as_create);
