@@ -295,6 +295,7 @@ struct mlod_motion {
 	memo *memo;            /* the tree's distances and residuals */
 	memo *segmemo;         /* frames level under way: segments of lines within its bound */
 	eval_scratch scratch;  /* the large arrays of the key reduction and of refine_channels */
+	keyreduce_state kstate; /* the last key reduction's end state */
 	int threads;           /* of the key reduction (mlod_motion_set_threads) */
 };
 
@@ -337,6 +338,7 @@ void mlod_motion_free(mlod_motion *m)
 		free(m->segmemo->slot);
 	free(m->segmemo);
 	free(m->scratch.p);
+	keyreduce_state_free(&m->kstate);
 	free(m);
 }
 
@@ -2122,7 +2124,7 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	memset(clip, 0, sizeof *clip);
 	double e = -1.0;
 	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, &m->scratch,
-	                  m->threads, err) != MLOD_OK)
+	                  &m->kstate, m->threads, err) != MLOD_OK)
 		return -1.0;
 	if (clip_from_kept(m, kept, clip) != 0) {
 		mlod_clip_free(clip);

@@ -437,16 +437,47 @@ static inline void *eval_carve(char **at, size_t n)
 	return (void *)a;
 }
 
+/* The key reduction's end state kept for the next run on the same clip
+ * (keyreduce_run): the current local transforms, their matrices and the
+ * world matrices at every sample, and the keys they were made from. A
+ * run that starts from those keys (the next level, which builds on this
+ * one's keys) takes them instead of computing them again, once it has
+ * checked that they are what its setup would compute. All zero: empty. */
+typedef struct keyreduce_state {
+	mlod_trs *lc;
+	mlod_mat4 *lm, *wc;
+	size_t fj;                /* their length */
+	unsigned char *kept;      /* the keys (channels * frames) of lc */
+	size_t nkept;
+	int valid;
+	const mlod_skeleton *s;   /* what they were made from */
+	const mlod_clip *common;
+	const mlod_mat4 *w0;
+	int per;
+} keyreduce_state;
+
+static inline void keyreduce_state_free(keyreduce_state *st)
+{
+	free(st->lc);
+	free(st->lm);
+	free(st->wc);
+	free(st->kept);
+	memset(st, 0, sizeof *st);
+}
+
 /* mlod_keyreduce, with the clip as read at the samples given (w0, samples
  * * joints world matrices as mlod_pose_world makes them; NULL: computed),
  * and *max_error (if not NULL) the largest point error of the result as
  * motion.c's level_max_error measures its level clip, or -1 when not
  * measured (a NaN, or samples past the clip's duration); its large arrays
- * in *scratch (NULL: its own, freed on return); on up to threads threads
- * (the same result at any count). */
+ * in *scratch (NULL: its own, freed on return), but for the current
+ * local transforms and matrices, which go to *state when it is given
+ * (see keyreduce_state); on up to threads threads (the same result at any
+ * count). */
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
-                          double *max_error, eval_scratch *scratch, int threads, mlod_error *err);
+                          double *max_error, eval_scratch *scratch, keyreduce_state *state, int threads,
+                          mlod_error *err);
 
 /* Tasks 0..n-1 of a sequence on up to lanes threads (tasks.c): run(ctx,
  * lane, t) runs task t with lane's own buffers (lane < lanes; one task at
