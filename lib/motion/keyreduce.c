@@ -402,8 +402,8 @@ typedef struct setup_ctx {
 /* Channel ch's path of l at sample f, from its kept keys (first and last
  * the first and last kept, a and b those around f), as mlod_clip_sample
  * computes it: seg is the slerp's per-segment part, kept while a stays. */
-static void setup_value(const reducer *R, const mlod_channel *ch, int first, int last, int a, int b, int f, eval_seg *seg,
-                        mlod_trs *l)
+EVAL_INLINE void setup_value(const reducer *R, const mlod_channel *ch, int first, int last, int a, int b, int f, eval_seg *seg,
+                            mlod_trs *l)
 {
 	float v[4];
 	int comps = comps_of(ch);
