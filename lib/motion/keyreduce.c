@@ -147,7 +147,7 @@ static int sample_check(reducer *R, lane *L, const mlod_channel *ch, const float
 	*l = R->lc[base + (size_t)j];
 	set_path(l, ch->path, v);
 	*lm = eval_from_trs(l);
-	w[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, lm) : eval_mul_affine(&R->wc[base + (size_t)p], lm);
+	w[j] = p < 0 ? eval_mul(&s->joints[j].base, lm) : eval_mul_affine(&R->wc[base + (size_t)p], lm);
 	if (!within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
 		return 0;
 	for (int k = 1; k < nsub; k++) {
@@ -478,7 +478,7 @@ static mlod_result frames_item(void *ctx, int i)
 		for (int j = 0; j < R->J; j++) {
 			int p = R->s->joints[j].parent;
 			/* mlod_mat4_mul; below a root, its affine form (the same floats) */
-			R->wc[base + (size_t)j] = p < 0 ? mlod_mat4_mul(&R->s->joints[j].base, &R->lm[base + (size_t)j])
+			R->wc[base + (size_t)j] = p < 0 ? eval_mul(&R->s->joints[j].base, &R->lm[base + (size_t)j])
 			                                : eval_mul_affine(&R->wc[base + (size_t)p], &R->lm[base + (size_t)j]);
 		}
 	}

@@ -953,7 +953,7 @@ static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound
 				for (int j = 0; j < J; j++) {
 					int p = s->joints[j].parent;
 					lmf[j] = eval_from_trs(&lf[j]);
-					wf[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
+					wf[j] = p < 0 ? eval_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
 				}
 				wl = wf;
 			} else {
@@ -1025,7 +1025,7 @@ static mlod_result within_lane(void *ctx, int i)
 			for (int j = 0; j < J; j++) {
 				int p = s->joints[j].parent;
 				lmf[j] = eval_from_trs(&lf[j]);
-				wf[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
+				wf[j] = p < 0 ? eval_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
 			}
 			for (int j = 0; j < J && ok; j++)
 				ok = eval_within(&wf[j], &w0[j], m->radius[j], x->bound);
@@ -1519,7 +1519,7 @@ static void refine_one(void *ctx, int lane, int i)
 					const mlod_mat4 *lm = d == j ? &LMj[f] : &lmf[d];
 					/* Below j, the parent is in the subtree, before d. */
 					const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
-					w[k] = p < 0 ? mlod_mat4_mul(&s->joints[d].base, lm) : eval_mul_affine(pw, lm);
+					w[k] = p < 0 ? eval_mul(&s->joints[d].base, lm) : eval_mul_affine(pw, lm);
 					ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
 				}
 			}

@@ -97,6 +97,33 @@ EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 	return r;
 }
 
+/* mlod_mat4_mul(a, b), the same floats: each entry summed from 0.0f in
+ * its order (0 + a0 b0, + a1 b1, + a2 b2, + a3 b3; the first sum keeps
+ * a -0 product's +0), a column's four rows at once where GCC's vector
+ * extension is there. For a root's base times its local matrix. */
+EVAL_INLINE mlod_mat4 eval_mul(const mlod_mat4 *a, const mlod_mat4 *b)
+{
+	mlod_mat4 r;
+#if defined(__GNUC__)
+	eval_v4 a0, a1, a2, a3;
+	memcpy(&a0, a->m, sizeof a0);
+	memcpy(&a1, a->m + 4, sizeof a1);
+	memcpy(&a2, a->m + 8, sizeof a2);
+	memcpy(&a3, a->m + 12, sizeof a3);
+	const eval_v4 zero = { 0.0f, 0.0f, 0.0f, 0.0f };
+	for (int c = 0; c < 4; c++) {
+		eval_v4 s = zero + a0 * b->m[c * 4];
+		s = s + a1 * b->m[c * 4 + 1];
+		s = s + a2 * b->m[c * 4 + 2];
+		s = s + a3 * b->m[c * 4 + 3];
+		memcpy(r.m + c * 4, &s, sizeof s);
+	}
+#else
+	r = mlod_mat4_mul(a, b);
+#endif
+	return r;
+}
+
 /* mlod_mat4_from_trs, the same operations, inline. */
 EVAL_INLINE mlod_mat4 eval_from_trs(const mlod_trs *trs)
 {
@@ -399,7 +426,7 @@ static inline void eval_pose_world(const mlod_skeleton *s, const mlod_trs *local
 	for (int i = 0; i < s->joint_count; i++) {
 		const mlod_joint *j = &s->joints[i];
 		mlod_mat4 l = eval_from_trs(&local[i]);
-		world[i] = j->parent < 0 ? mlod_mat4_mul(&j->base, &l) : eval_mul_affine(&world[j->parent], &l);
+		world[i] = j->parent < 0 ? eval_mul(&j->base, &l) : eval_mul_affine(&world[j->parent], &l);
 	}
 }
 

@@ -1460,6 +1460,26 @@ TEST(keys_state_same_as_fresh)
 	mlod_character_free(&c);
 }
 
+/* eval_mul: mlod_mat4_mul's floats, bit for bit, signed zeros included. */
+TEST(eval_mul_same_as_mat4_mul)
+{
+	const float pick[8] = { 0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 3.0e-20f, -7.25e3f, 1.0e30f };
+	unsigned x = 12345u;
+	int differ = 0;
+	for (int n = 0; n < 200000; n++) {
+		mlod_mat4 a, b;
+		for (int i = 0; i < 16; i++) {
+			x = x * 1664525u + 1013904223u;
+			a.m[i] = (x >> 29) < 3 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 1024.0f;
+			x = x * 1664525u + 1013904223u;
+			b.m[i] = (x >> 29) < 3 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 4096.0f;
+		}
+		mlod_mat4 r = eval_mul(&a, &b), q = mlod_mat4_mul(&a, &b);
+		differ += memcmp(&r, &q, sizeof r) != 0;
+	}
+	CHECK_MSG(differ == 0, "%d products differ", differ);
+}
+
 int main(void)
 {
 	RUN(levels_within_bounds_cmu);
@@ -1489,6 +1509,7 @@ int main(void)
 	RUN(keys_split_same_as_next_level);
 	RUN(bake_report_same_at_any_thread_count);
 	RUN(keys_state_same_as_fresh);
+	RUN(eval_mul_same_as_mat4_mul);
 	RUN(create_like_same_as_create);
 	RUN(create_on_threads_same_as_create);
 	TEST_EXIT();
