@@ -147,7 +147,7 @@ static int sample_check(reducer *R, lane *L, const mlod_channel *ch, const float
 	*l = R->lc[base + (size_t)j];
 	set_path(l, ch->path, v);
 	*lm = eval_from_trs(l);
-	w[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, lm) : eval_mul_affine(&R->wc[base + (size_t)p], lm);
+	w[j] = p < 0 ? eval_mul(&s->joints[j].base, lm) : eval_mul_affine(&R->wc[base + (size_t)p], lm);
 	if (!within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
 		return 0;
 	for (int k = 1; k < nsub; k++) {
@@ -384,7 +384,7 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                            double point_distance, int subdivide, unsigned char *kept, mlod_error *err)
 {
-	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, NULL, 1, err);
+	return keyreduce_run(s, original, common, bound, point_distance, subdivide, kept, NULL, NULL, NULL, NULL, 1, err);
 }
 
 /* The reduction's starting state, on up to R->lanes threads (the same
@@ -398,6 +398,36 @@ typedef struct setup_ctx {
 	int n;
 	int *prevk, *nextk; /* n * F */
 } setup_ctx;
+
+/* Channel ch's path of l at sample f, from its kept keys (first and last
+ * the first and last kept, a and b those around f), as mlod_clip_sample
+ * computes it: seg is the slerp's per-segment part, kept while a stays. */
+EVAL_INLINE void setup_value(const reducer *R, const mlod_channel *ch, int first, int last, int a, int b, int f, eval_seg *seg,
+                            mlod_trs *l)
+{
+	float v[4];
+	int comps = comps_of(ch);
+	if (first == last || f <= first * R->per || f >= last * R->per) {
+		int k = f >= last * R->per && first != last ? last : first;
+		memcpy(v, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
+	} else {
+		/* As mlod_clip_sample computes it from the kept keys around f,
+		 * the slerp's per-segment part done once a segment. */
+		const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
+		const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
+		const float u = (R->times[f] - t0) / dt;
+		if (ch->interp == MLOD_INTERP_STEP) {
+			memcpy(v, va, sizeof(float) * (size_t)comps);
+		} else if (comps == 4) {
+			mlod_quat q = eval_slerp(seg, va, vb, u);
+			v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
+		} else {
+			for (int c = 0; c < 3; c++)
+				v[c] = va[c] + (vb[c] - va[c]) * u;
+		}
+	}
+	set_path(l, ch->path, v);
+}
 
 static mlod_result setup_item(void *ctx, int i)
 {
@@ -425,31 +455,11 @@ static mlod_result setup_item(void *ctx, int i)
 		eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
 		int seg_a = -1;
 		for (int f = 0; f < R->S; f++) {
-			float v[4];
-			int comps = comps_of(ch);
-			if (first == last || f <= first * R->per || f >= last * R->per) {
-				int k = f >= last * R->per && first != last ? last : first;
-				memcpy(v, ch->values + (size_t)k * (size_t)comps, sizeof(float) * (size_t)comps);
-			} else {
-				/* As mlod_clip_sample computes it from the kept keys around f,
-				 * the slerp's per-segment part done once a segment. */
-				int a = prevk[f / R->per], b = nextk[f / R->per];
-				if (a != seg_a)
-					seg.ready = 0, seg_a = a;
-				const float *va = ch->values + (size_t)a * (size_t)comps, *vb = ch->values + (size_t)b * (size_t)comps;
-				const float t0 = R->times[a * R->per], dt = R->times[b * R->per] - t0;
-				const float u = (R->times[f] - t0) / dt;
-				if (ch->interp == MLOD_INTERP_STEP) {
-					memcpy(v, va, sizeof(float) * (size_t)comps);
-				} else if (comps == 4) {
-					mlod_quat q = eval_slerp(&seg, va, vb, u);
-					v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
-				} else {
-					for (int c = 0; c < 3; c++)
-						v[c] = va[c] + (vb[c] - va[c]) * u;
-				}
-			}
-			set_path(&R->lc[(size_t)f * (size_t)R->J + (size_t)ch->joint], ch->path, v);
+			int a = prevk[f / R->per];
+			if (a != seg_a)
+				seg.ready = 0, seg_a = a;
+			setup_value(R, ch, first, last, a, nextk[f / R->per], f, &seg,
+			            &R->lc[(size_t)f * (size_t)R->J + (size_t)ch->joint]);
 		}
 	}
 	return MLOD_OK;
@@ -468,16 +478,66 @@ static mlod_result frames_item(void *ctx, int i)
 		for (int j = 0; j < R->J; j++) {
 			int p = R->s->joints[j].parent;
 			/* mlod_mat4_mul; below a root, its affine form (the same floats) */
-			R->wc[base + (size_t)j] = p < 0 ? mlod_mat4_mul(&R->s->joints[j].base, &R->lm[base + (size_t)j])
+			R->wc[base + (size_t)j] = p < 0 ? eval_mul(&R->s->joints[j].base, &R->lm[base + (size_t)j])
 			                                : eval_mul_affine(&R->wc[base + (size_t)p], &R->lm[base + (size_t)j]);
 		}
 	}
 	return MLOD_OK;
 }
 
+/* Can the run take st's local transforms and matrices as its start? Only
+ * when they were made from the same clip, skeleton, samples and w0 and
+ * end on the keys it starts from (kept), and they are what setup_item and
+ * frames_item would compute:
+ *
+ * - a sample that the last commit covering it (sweep_commit) set, or that
+ *   no commit covered, holds the value from the kept keys around it,
+ *   computed as setup_item computes it (sample_check: the same segment
+ *   and u, a fresh slerp segment; collapse_channel: the first key), and
+ *   the keys around it are still the kept ones around it: a key that
+ *   goes makes its segment commit every sample between its neighbours;
+ * - every commit recomputes the world matrices of its joint's subtree
+ *   from the parent's, as frames_item does, so wc is the chain of lm;
+ * - but a kept key's own sample holds the value its last setup computed
+ *   with the next key then kept, which may have gone since: the slerp
+ *   at u = 0 gives the key's normalised value whatever the next key, but
+ *   for the sign of a zero, and a NaN or infinity in the next key. These
+ *   samples are computed again here and compared bit for bit. */
+static int state_fits(const reducer *R, const keyreduce_state *st, const mlod_mat4 *w0)
+{
+	size_t size = (size_t)R->C * (size_t)R->F;
+	if (!st->valid || st->s != R->s || st->common != R->common || st->w0 != w0 || !w0 || st->per != R->per ||
+	    st->nkept != size || st->fj != (size_t)R->S * (size_t)R->J || memcmp(st->kept, R->kept, size) != 0)
+		return 0;
+	for (int c = 0; c < R->C; c++) {
+		const mlod_channel *ch = &R->common->channels[c];
+		const unsigned char *row = R->kept + (size_t)c * (size_t)R->F;
+		int first = -1, last = -1;
+		for (int k = 0; k < R->F; k++)
+			if (row[k]) {
+				if (first < 0)
+					first = k;
+				last = k;
+			}
+		for (int k = first, next; k >= 0 && k <= last; k = next) {
+			for (next = k + 1; next <= last && !row[next]; next++)
+				;
+			int f = k * R->per;
+			size_t at = (size_t)f * (size_t)R->J + (size_t)ch->joint;
+			mlod_trs l = st->lc[at];
+			eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+			setup_value(R, ch, first, last, k, next <= last ? next : k, f, &seg, &l);
+			if (memcmp(&l, &st->lc[at], sizeof l) != 0)
+				return 0;
+		}
+	}
+	return 1;
+}
+
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
-                          double *max_error, eval_scratch *scratch, int threads, mlod_error *err)
+                          double *max_error, eval_scratch *scratch, keyreduce_state *state, int threads,
+                          mlod_error *err)
 {
 	if (max_error)
 		*max_error = -1.0;
@@ -508,13 +568,27 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		size_t F = (size_t)R.F;
 		size_t per_lane = 2 * eval_carve_size(sizeof(mlod_trs) * S) + 2 * eval_carve_size(sizeof(mlod_mat4) * S) +
 		                  eval_carve_size(sizeof(unsigned) * S) + eval_carve_size(sizeof(int) * F);
-		size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 4 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
-		              (size_t)R.lanes * per_lane;
+		size_t need = (state ? 0 : eval_carve_size(sizeof(mlod_trs) * FJ) + 2 * eval_carve_size(sizeof(mlod_mat4) * FJ)) +
+		              2 * eval_carve_size(sizeof(mlod_mat4) * FJ) + (size_t)R.lanes * per_lane;
 		char *at = eval_scratch_get(scratch ? scratch : &R.own, need);
-		if (at) {
-			R.lc = eval_carve(&at, sizeof(mlod_trs) * FJ);
-			R.lm = eval_carve(&at, sizeof(mlod_mat4) * FJ);
-			R.wc = eval_carve(&at, sizeof(mlod_mat4) * FJ);
+		if (state && state->fj != FJ) {
+			keyreduce_state_free(state);
+			state->lc = malloc(sizeof(mlod_trs) * FJ);
+			state->lm = malloc(sizeof(mlod_mat4) * FJ);
+			state->wc = malloc(sizeof(mlod_mat4) * FJ);
+			if (state->lc && state->lm && state->wc)
+				state->fj = FJ;
+			else
+				keyreduce_state_free(state); /* and R.lc stays NULL: out of memory */
+		}
+		if (at && (!state || state->fj == FJ)) {
+			if (state) {
+				R.lc = state->lc, R.lm = state->lm, R.wc = state->wc;
+			} else {
+				R.lc = eval_carve(&at, sizeof(mlod_trs) * FJ);
+				R.lm = eval_carve(&at, sizeof(mlod_mat4) * FJ);
+				R.wc = eval_carve(&at, sizeof(mlod_mat4) * FJ);
+			}
 			for (int i = 0; i < 2; i++)
 				R.wb[i] = eval_carve(&at, sizeof(mlod_mat4) * FJ);
 			for (int n = 0; n < R.lanes; n++) {
@@ -563,6 +637,12 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 			R.sub[R.sub_start[a] + fill[a]++] = d;
 
 	mlod_motion_sample_times(common->channels[0].times, R.F, R.per, R.times);
+	if (state) {
+		int fits = state_fits(&R, state, w0);
+		state->valid = 0; /* until this run ends */
+		if (fits)
+			goto reduce;
+	}
 	/* The clip as read, and as currently kept. */
 	for (int f = 0; f < R.S; f++) {
 		size_t base = (size_t)f * (size_t)R.J;
@@ -580,6 +660,7 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	setup_ctx sx = { &R, R.lanes, prevk, nextk };
 	mlod_parallel_for(sx.n, sx.n, setup_item, &sx);
 	mlod_parallel_for(sx.n, sx.n, frames_item, &sx);
+reduce:
 
 	/* Rounds of reduce_channel over the channels at a growing budget, then
 	 * collapse_channel over them at the whole bound. */
@@ -607,6 +688,19 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 				break;
 		}
 		*max_error = worst != worst ? -1.0 : worst;
+	}
+	if (state) {
+		size_t size = (size_t)R.C * (size_t)R.F;
+		if (state->nkept != size) {
+			free(state->kept);
+			state->kept = malloc(size);
+			state->nkept = state->kept ? size : 0;
+		}
+		if (state->kept) {
+			memcpy(state->kept, kept, size);
+			state->s = s, state->common = common, state->w0 = w0, state->per = R.per;
+			state->valid = 1;
+		}
 	}
 done:
 	free(depth);

@@ -295,6 +295,7 @@ struct mlod_motion {
 	memo *memo;            /* the tree's distances and residuals */
 	memo *segmemo;         /* frames level under way: segments of lines within its bound */
 	eval_scratch scratch;  /* the large arrays of the key reduction and of refine_channels */
+	keyreduce_state kstate; /* the last key reduction's end state */
 	int threads;           /* of the key reduction (mlod_motion_set_threads) */
 };
 
@@ -337,6 +338,7 @@ void mlod_motion_free(mlod_motion *m)
 		free(m->segmemo->slot);
 	free(m->segmemo);
 	free(m->scratch.p);
+	keyreduce_state_free(&m->kstate);
 	free(m);
 }
 
@@ -951,7 +953,7 @@ static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound
 				for (int j = 0; j < J; j++) {
 					int p = s->joints[j].parent;
 					lmf[j] = eval_from_trs(&lf[j]);
-					wf[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
+					wf[j] = p < 0 ? eval_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
 				}
 				wl = wf;
 			} else {
@@ -1023,7 +1025,7 @@ static mlod_result within_lane(void *ctx, int i)
 			for (int j = 0; j < J; j++) {
 				int p = s->joints[j].parent;
 				lmf[j] = eval_from_trs(&lf[j]);
-				wf[j] = p < 0 ? mlod_mat4_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
+				wf[j] = p < 0 ? eval_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
 			}
 			for (int j = 0; j < J && ok; j++)
 				ok = eval_within(&wf[j], &w0[j], m->radius[j], x->bound);
@@ -1517,7 +1519,7 @@ static void refine_one(void *ctx, int lane, int i)
 					const mlod_mat4 *lm = d == j ? &LMj[f] : &lmf[d];
 					/* Below j, the parent is in the subtree, before d. */
 					const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
-					w[k] = p < 0 ? mlod_mat4_mul(&s->joints[d].base, lm) : eval_mul_affine(pw, lm);
+					w[k] = p < 0 ? eval_mul(&s->joints[d].base, lm) : eval_mul_affine(pw, lm);
 					ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
 				}
 			}
@@ -2122,7 +2124,7 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 	memset(clip, 0, sizeof *clip);
 	double e = -1.0;
 	if (keyreduce_run(m->s, m->orig, &m->common, budget, point_distance(m), m->sub, kept, m->cache0, &e, &m->scratch,
-	                  m->threads, err) != MLOD_OK)
+	                  &m->kstate, m->threads, err) != MLOD_OK)
 		return -1.0;
 	if (clip_from_kept(m, kept, clip) != 0) {
 		mlod_clip_free(clip);

@@ -97,6 +97,33 @@ EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
 	return r;
 }
 
+/* mlod_mat4_mul(a, b), the same floats: each entry summed from 0.0f in
+ * its order (0 + a0 b0, + a1 b1, + a2 b2, + a3 b3; the first sum keeps
+ * a -0 product's +0), a column's four rows at once where GCC's vector
+ * extension is there. For a root's base times its local matrix. */
+EVAL_INLINE mlod_mat4 eval_mul(const mlod_mat4 *a, const mlod_mat4 *b)
+{
+	mlod_mat4 r;
+#if defined(__GNUC__)
+	eval_v4 a0, a1, a2, a3;
+	memcpy(&a0, a->m, sizeof a0);
+	memcpy(&a1, a->m + 4, sizeof a1);
+	memcpy(&a2, a->m + 8, sizeof a2);
+	memcpy(&a3, a->m + 12, sizeof a3);
+	const eval_v4 zero = { 0.0f, 0.0f, 0.0f, 0.0f };
+	for (int c = 0; c < 4; c++) {
+		eval_v4 s = zero + a0 * b->m[c * 4];
+		s = s + a1 * b->m[c * 4 + 1];
+		s = s + a2 * b->m[c * 4 + 2];
+		s = s + a3 * b->m[c * 4 + 3];
+		memcpy(r.m + c * 4, &s, sizeof s);
+	}
+#else
+	r = mlod_mat4_mul(a, b);
+#endif
+	return r;
+}
+
 /* mlod_mat4_from_trs, the same operations, inline. */
 EVAL_INLINE mlod_mat4 eval_from_trs(const mlod_trs *trs)
 {
@@ -399,7 +426,7 @@ static inline void eval_pose_world(const mlod_skeleton *s, const mlod_trs *local
 	for (int i = 0; i < s->joint_count; i++) {
 		const mlod_joint *j = &s->joints[i];
 		mlod_mat4 l = eval_from_trs(&local[i]);
-		world[i] = j->parent < 0 ? mlod_mat4_mul(&j->base, &l) : eval_mul_affine(&world[j->parent], &l);
+		world[i] = j->parent < 0 ? eval_mul(&j->base, &l) : eval_mul_affine(&world[j->parent], &l);
 	}
 }
 
@@ -437,16 +464,47 @@ static inline void *eval_carve(char **at, size_t n)
 	return (void *)a;
 }
 
+/* The key reduction's end state kept for the next run on the same clip
+ * (keyreduce_run): the current local transforms, their matrices and the
+ * world matrices at every sample, and the keys they were made from. A
+ * run that starts from those keys (the next level, which builds on this
+ * one's keys) takes them instead of computing them again, once it has
+ * checked that they are what its setup would compute. All zero: empty. */
+typedef struct keyreduce_state {
+	mlod_trs *lc;
+	mlod_mat4 *lm, *wc;
+	size_t fj;                /* their length */
+	unsigned char *kept;      /* the keys (channels * frames) of lc */
+	size_t nkept;
+	int valid;
+	const mlod_skeleton *s;   /* what they were made from */
+	const mlod_clip *common;
+	const mlod_mat4 *w0;
+	int per;
+} keyreduce_state;
+
+static inline void keyreduce_state_free(keyreduce_state *st)
+{
+	free(st->lc);
+	free(st->lm);
+	free(st->wc);
+	free(st->kept);
+	memset(st, 0, sizeof *st);
+}
+
 /* mlod_keyreduce, with the clip as read at the samples given (w0, samples
  * * joints world matrices as mlod_pose_world makes them; NULL: computed),
  * and *max_error (if not NULL) the largest point error of the result as
  * motion.c's level_max_error measures its level clip, or -1 when not
  * measured (a NaN, or samples past the clip's duration); its large arrays
- * in *scratch (NULL: its own, freed on return); on up to threads threads
- * (the same result at any count). */
+ * in *scratch (NULL: its own, freed on return), but for the current
+ * local transforms and matrices, which go to *state when it is given
+ * (see keyreduce_state); on up to threads threads (the same result at any
+ * count). */
 mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, const mlod_clip *common, double bound,
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
-                          double *max_error, eval_scratch *scratch, int threads, mlod_error *err);
+                          double *max_error, eval_scratch *scratch, keyreduce_state *state, int threads,
+                          mlod_error *err);
 
 /* Tasks 0..n-1 of a sequence on up to lanes threads (tasks.c): run(ctx,
  * lane, t) runs task t with lane's own buffers (lane < lanes; one task at

@@ -1390,6 +1390,96 @@ TEST(bake_report_same_at_any_thread_count)
 	mlod_character_free(&c);
 }
 
+/* The key reduction's end state (keyreduce_state), taken by the next run
+ * that starts from its keys: the same keys and error as a run that sets
+ * up from scratch; and a state that is not what the setup would compute
+ * at a kept key's sample is not taken. */
+TEST(keys_state_same_as_fresh)
+{
+	int F = 90, n = 6, per = 2;
+	mlod_character c = make_chain(n, F);
+	for (int j = 0; j < n; j++)
+		for (int f = 0; f < F; f++)
+			set_rot(&c.clips[0].channels[j], f,
+			        mlod_quat_axis_angle((mlod_v3){0, 0, 1}, 0.3f * sinf(0.1f * (float)(f + 7 * j))));
+	const mlod_clip *clip = &c.clips[0];
+	const mlod_skeleton *s = &c.skeleton;
+	int S = (F - 1) * per + 1;
+	size_t CF = (size_t)n * (size_t)F;
+	float *st = malloc(sizeof(float) * (size_t)S);
+	mlod_mat4 *w0 = malloc(sizeof(mlod_mat4) * (size_t)S * (size_t)n);
+	mlod_trs *l = malloc(sizeof(mlod_trs) * (size_t)n);
+	unsigned char *k1 = malloc(CF), *ka = malloc(CF), *kb = malloc(CF);
+	mlod_motion_sample_times(clip->channels[0].times, F, per, st);
+	for (int f = 0; f < S; f++) {
+		mlod_pose_rest(s, l);
+		mlod_clip_sample(clip, st[f], l);
+		mlod_pose_world(s, l, w0 + (size_t)f * (size_t)n);
+	}
+	keyreduce_state state;
+	memset(&state, 0, sizeof state);
+	double e1, ea, eb;
+	memset(k1, 1, CF);
+	CHECK_OK(keyreduce_run(s, clip, clip, 0.01, 0.1, per, k1, w0, &e1, NULL, &state, 1, &terr));
+	CHECK(state.valid);
+	memcpy(ka, k1, CF), memcpy(kb, k1, CF);
+	CHECK_OK(keyreduce_run(s, clip, clip, 0.04, 0.1, per, ka, w0, &ea, NULL, &state, 1, &terr));
+	CHECK_OK(keyreduce_run(s, clip, clip, 0.04, 0.1, per, kb, w0, &eb, NULL, NULL, 1, &terr));
+	CHECK(memcmp(ka, kb, CF) == 0);
+	CHECK(memcmp(&ea, &eb, sizeof ea) == 0);
+	int kept1 = 0, kepta = 0;
+	for (size_t i = 0; i < CF; i++)
+		kept1 += k1[i], kepta += ka[i];
+	CHECK_MSG(kepta < kept1 && kepta > n, "keys %d then %d", kept1, kepta);
+
+	/* Again from k1, then the root's state at its kept keys' samples
+	 * turned (their matrices with it): the next run must set up again. */
+	memset(k1, 1, CF);
+	CHECK_OK(keyreduce_run(s, clip, clip, 0.01, 0.1, per, k1, w0, &e1, NULL, &state, 1, &terr));
+	int turned = 0;
+	for (int key = 1; key < F - 1; key++) {
+		if (!k1[key])
+			continue;
+		size_t base = (size_t)(key * per) * (size_t)n;
+		state.lc[base].r = mlod_quat_axis_angle((mlod_v3){1, 0, 0}, 1.5f);
+		for (int j = 0; j < n; j++)
+			state.lm[base + (size_t)j] = eval_from_trs(&state.lc[base + (size_t)j]);
+		eval_pose_world(s, state.lc + base, state.wc + base);
+		turned++;
+	}
+	CHECK(turned > 0);
+	{
+		memcpy(ka, k1, CF), memcpy(kb, k1, CF);
+		CHECK_OK(keyreduce_run(s, clip, clip, 0.04, 0.1, per, ka, w0, &ea, NULL, &state, 1, &terr));
+		CHECK_OK(keyreduce_run(s, clip, clip, 0.04, 0.1, per, kb, w0, &eb, NULL, NULL, 1, &terr));
+		CHECK(memcmp(ka, kb, CF) == 0);
+		CHECK(memcmp(&ea, &eb, sizeof ea) == 0);
+	}
+	keyreduce_state_free(&state);
+	free(st), free(w0), free(l), free(k1), free(ka), free(kb);
+	mlod_character_free(&c);
+}
+
+/* eval_mul: mlod_mat4_mul's floats, bit for bit, signed zeros included. */
+TEST(eval_mul_same_as_mat4_mul)
+{
+	const float pick[8] = { 0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 3.0e-20f, -7.25e3f, 1.0e30f };
+	unsigned x = 12345u;
+	int differ = 0;
+	for (int n = 0; n < 200000; n++) {
+		mlod_mat4 a, b;
+		for (int i = 0; i < 16; i++) {
+			x = x * 1664525u + 1013904223u;
+			a.m[i] = (x >> 29) < 3 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 1024.0f;
+			x = x * 1664525u + 1013904223u;
+			b.m[i] = (x >> 29) < 3 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 4096.0f;
+		}
+		mlod_mat4 r = eval_mul(&a, &b), q = mlod_mat4_mul(&a, &b);
+		differ += memcmp(&r, &q, sizeof r) != 0;
+	}
+	CHECK_MSG(differ == 0, "%d products differ", differ);
+}
+
 int main(void)
 {
 	RUN(levels_within_bounds_cmu);
@@ -1418,6 +1508,8 @@ int main(void)
 	RUN(frames_item_levels_same);
 	RUN(keys_split_same_as_next_level);
 	RUN(bake_report_same_at_any_thread_count);
+	RUN(keys_state_same_as_fresh);
+	RUN(eval_mul_same_as_mat4_mul);
 	RUN(create_like_same_as_create);
 	RUN(create_on_threads_same_as_create);
 	TEST_EXIT();
