@@ -170,6 +170,8 @@ static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak,
 		return -1;
 	int i = h->count++;
 	struct bgm_heap_entry x = {key, face, (unsigned)op | (weak ? 4u : 0u) | (unsigned)(memo_slot + 1) << 3};
+	if (isnan(key))
+		h->unordered = 1;
 	while (i > 0) {
 		int p = (i - 1) / 4;
 		if (!entry_less(&x, &h->e[p]))
@@ -202,6 +204,44 @@ static heap_entry heap_pop(struct bgm_heap *h)
 		h->e[i] = x;
 	heap_entry top = {t.key, t.face, (int)(t.tag & 3u), (int)(t.tag >> 2 & 1u), (int)(t.tag >> 3) - 1};
 	return top;
+}
+
+/* Drops the entries of dead faces (what heap_pop's callers would drop
+ * when they come up) and rebuilds the heap from the rest. Entries are
+ * one per face and op and entry_less orders them totally (no NaN key
+ * was queued), so the live entries come out in the same order as
+ * before; a dead entry popped costs a walk down the heap, this one pass
+ * over it. */
+static void heap_purge(struct bgm_heap *h, const unsigned char *opstate, unsigned char dead)
+{
+	int n = 0;
+	for (int i = 0; i < h->count; i++) {
+		if (opstate[h->e[i].face] == dead) {
+			memo_release(h, (int)(h->e[i].tag >> 3) - 1);
+			continue;
+		}
+		h->e[n++] = h->e[i];
+	}
+	h->count = n;
+	h->dead = 0;
+	for (int s = n > 1 ? (n - 2) / 4 : -1; s >= 0; s--) {
+		struct bgm_heap_entry x = h->e[s];
+		int i = s;
+		for (;;) {
+			int c = 4 * i + 1, m = c;
+			if (c >= n)
+				break;
+			int end = c + 4 < n ? c + 4 : n;
+			for (int j = c + 1; j < end; j++)
+				if (entry_less(&h->e[j], &h->e[m]))
+					m = j;
+			if (!entry_less(&h->e[m], &x))
+				break;
+			h->e[i] = h->e[m];
+			i = m;
+		}
+		h->e[i] = x;
+	}
 }
 
 /* Everything a collapse needs, worked out by plan() and applied by
@@ -1857,6 +1897,8 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	for (int j = 0; j < pl->nf; j++) {
 		bgm_face *f = &g->faces[pl->faces[j]];
 		f->death = stamp;
+		unsigned queued = g->opstate[pl->faces[j]] >> 4;
+		g->heap.dead += (int)(queued & 1u) + (int)(queued >> 1 & 1u) + (int)(queued >> 2 & 1u) + (int)(queued >> 3 & 1u);
 		g->opstate[pl->faces[j]] = DEAD;
 		for (int k = 0; k < 3; k++)
 			bgm_inc_remove(g, f->n[k], pl->faces[j]);
@@ -1989,6 +2031,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			else if (g->record_count == g->swept)
 				break;
 			g->swept = g->record_count;
+			g->heap.dead = 0;
 			for (int f = 0; f < g->opstate_cap; f++)
 				g->opstate[f] = f < g->face_count && g->faces[f].death != BGM_ALIVE ? DEAD : 0;
 			for (int f = 0; f < g->face_count; f++)
@@ -1998,8 +2041,14 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 				}
 			continue;
 		}
+		/* Mostly dead entries: drop them at once (the same order). */
+		if (g->heap.dead > 1024 && 2 * g->heap.dead > g->heap.count && !g->heap.unordered) {
+			heap_purge(&g->heap, g->opstate, DEAD);
+			continue;
+		}
 		heap_entry e = heap_pop(&g->heap);
 		if (g->opstate[e.face] == DEAD) {
+			g->heap.dead -= g->heap.dead > 0;
 			memo_release(&g->heap, e.memo);
 			continue;
 		}
