@@ -356,22 +356,11 @@ static void barycentric(const double *a, const double *b, const double *c, const
 		l[i] = sum > 0.0 ? l[i] / sum : 1.0 / 3.0;
 }
 
-/* bgm_compactness(a, b, c) from len, the length of bgm_face_normal's
- * normal (the same arithmetic, so the same value). */
-static double compactness_of(const double *a, const double *b, const double *c, double len)
-{
-	double u[3], v[3], w[3];
-	for (int i = 0; i < 3; i++)
-		u[i] = b[i] - a[i], v[i] = c[i] - a[i], w[i] = c[i] - b[i];
-	double area = 0.5 * len;
-	double l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + w[0] * w[0] +
-	            w[1] * w[1] + w[2] * w[2];
-	if (!(l2 > 0.0))
-		return 0.0;
-	return 4.0 * sqrt(3.0) * area / l2;
-}
-
-/* Checks the re-meshed faces for flips and degeneracy with v-bar at x. */
+/* Checks the re-meshed faces for flips and degeneracy with v-bar at x.
+ * Each face's normal is bgm_face_normal's and its compactness
+ * bgm_compactness's (the same arithmetic on the same edge vectors, made
+ * once here), the compactness (a division) only for a face that does not
+ * flip: all three tests must pass. */
 static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x)
 {
 	for (int i = 0; i < pl->nk; i++) {
@@ -381,15 +370,24 @@ static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x
 			q[k] = g->nodes[f->n[k]].p;
 		q[pl->corner[i]] = x;
 		const double *no = pl->onormal[i];
-		double nn[3];
-		bgm_face_normal(q[0], q[1], q[2], nn);
+		double u[3], v[3], w[3], nn[3];
+		for (int k = 0; k < 3; k++)
+			u[k] = q[1][k] - q[0][k], v[k] = q[2][k] - q[0][k], w[k] = q[2][k] - q[1][k];
+		nn[0] = u[1] * v[2] - u[2] * v[1];
+		nn[1] = u[2] * v[0] - u[0] * v[2];
+		nn[2] = u[0] * v[1] - u[1] * v[0];
 		double lo = no[3];
 		double ln = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-		double cn = compactness_of(q[0], q[1], q[2], ln);
-		if (!(ln > 0.0) || cn < DEGENERATE)
+		if (!(ln > 0.0))
 			return 0;
 		if (lo > 0.0 && pl->oflip[i] &&
 		    !(no[0] * nn[0] + no[1] * nn[1] + no[2] * nn[2] > FLIP_COS * lo * ln))
+			return 0;
+		double area = 0.5 * ln;
+		double l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + w[0] * w[0] +
+		            w[1] * w[1] + w[2] * w[2];
+		double cn = l2 > 0.0 ? 4.0 * sqrt(3.0) * area / l2 : 0.0;
+		if (cn < DEGENERATE)
 			return 0;
 	}
 	return 1;
