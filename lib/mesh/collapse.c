@@ -119,6 +119,7 @@ struct bgm_heap_entry {
  * 5 + i vertex i kept whole (hybrid placement: its own influences). */
 #define MEMO_ROLES 8
 #define MEMO_WSUM (1u << MEMO_ROLES)
+#define MEMO_SKINNED 5        /* roles 0-4: placements Power Skinning weighs */
 typedef struct bgm_memo {
 	double opt[3];
 	int opt_state;              /* 0 not worked out, 1 found, 2 none */
@@ -126,9 +127,29 @@ typedef struct bgm_memo {
 	double e[MEMO_ROLES];
 	double wsum;
 	int next_free;
+	unsigned skinned;           /* bit r: w[r] and capped[r] are role r's Power Skinning */
+	unsigned char capped[MEMO_SKINNED];
+	mlod_influences w[MEMO_SKINNED];
 } memo;
 
-static const memo memo_empty = {{0, 0, 0}, 0, 0, {0}, 0.0, -1};
+/* mlod_power_skin of the collapsed vertices (V, in3) at x, placement
+ * role's position (the same for the operation while its face lives), as
+ * mm remembers it (when mm is not NULL). */
+static int skin_role(memo *mm, int role, const mlod_v3 *V, const mlod_influences *in3, int K, const double *x,
+                     mlod_influences *w)
+{
+	if (mm && role < MEMO_SKINNED && (mm->skinned >> role & 1u)) {
+		*w = mm->w[role];
+		return mm->capped[role];
+	}
+	int capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)x[0], (float)x[1], (float)x[2]}, w);
+	if (mm && role < MEMO_SKINNED) {
+		mm->w[role] = *w;
+		mm->capped[role] = (unsigned char)capped;
+		mm->skinned |= 1u << role;
+	}
+	return capped;
+}
 
 /* A slot holding m; returns its index, or -1 when out of memory. */
 static int memo_add(struct bgm_heap *h, const memo *m)
@@ -854,7 +875,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			} else {
 				if (!q_ready)
 					sum_quadrics(g, pl, Q), q_ready = 1;
-				mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
+				skin_role(mm, 4, V, in3, K, bary, &w);
 				found = bgm_quadric_optimum(g, Q, &w, bary, opt) == 0;
 				if (mm) {
 					mm->opt_state = found ? 1 : 2;
@@ -980,7 +1001,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		if (cand_whole[k])
 			w = in3[cand_at[k]]; /* the vertex's own influences, not blended */
 		else
-			capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+			capped = skin_role(mm, cand_role[k], V, in3, K, cand[k], &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double cost, d = 0.0;
@@ -1634,7 +1655,7 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		if (!mm->opt_state) {
 			if (!q_ready)
 				sum_quadrics(g, &pv, Q), q_ready = 1;
-			mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
+			skin_role(mm, 4, V, in3, K, bary, &w);
 			mm->opt_state = bgm_quadric_optimum(g, Q, &w, bary, mm->opt) == 0 ? 1 : 2;
 		}
 		memcpy(opt, mm->opt, sizeof opt);
@@ -1671,7 +1692,7 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		else if (role[k] >= 5)
 			w = in3[role[k] - 5];
 		else
-			mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+			skin_role(mm, role[k], V, in3, K, cand[k], &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double e;
@@ -2051,7 +2072,14 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			continue;
 		}
 		/* An operation going back keeps what its placements cost. */
-		memo local = memo_empty, *mm = e.memo >= 0 ? &g->heap.memo[e.memo] : &local;
+		memo local, *mm = e.memo >= 0 ? &g->heap.memo[e.memo] : &local;
+		if (e.memo < 0) {
+			/* Nothing known: the rest is read only once its bit says it
+			 * was written (not cleared at every pop: w[] is large). */
+			local.opt_state = 0;
+			local.known = local.skinned = 0;
+			local.next_free = -1;
+		}
 		double back = -1.0;
 		if (e.weak) {
 			double b = exact_bound(g, e.face, e.op, mm);
