@@ -300,10 +300,8 @@ static int find(int *parent, int i)
 /* Which of the collapsed vertices node n is (0 .. k-1), or -1. */
 static int owner_of(const struct plan *pl, int n)
 {
-	for (int i = 0; i < pl->k; i++)
-		if (pl->v[i] == n)
-			return i;
-	return -1;
+	/* v[2] is -1 for an edge (plan() sets it), never a node */
+	return n == pl->v[0] ? 0 : n == pl->v[1] ? 1 : n == pl->v[2] ? 2 : -1;
 }
 
 static int wedge_slot(const struct plan *pl, int w)
