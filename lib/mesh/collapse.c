@@ -2059,7 +2059,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			continue;
 		}
 		/* Mostly dead entries: drop them at once (the same order). */
-		if (g->heap.dead > 1024 && 2 * g->heap.dead > g->heap.count && !g->heap.unordered) {
+		if (g->heap.dead > 256 && 2 * g->heap.dead > g->heap.count && !g->heap.unordered) {
 			heap_purge(&g->heap, g->opstate, DEAD);
 			continue;
 		}
