@@ -377,10 +377,9 @@ static int sort_edges(struct edge_rec *edges, struct edge_rec *tmp, int ne, int 
 	return 0;
 }
 
-/* Checks a link given as directed edges from[i] -> to[i]: 1 when they
- * form one simple cycle of at least 3 edges (or one simple path when
- * path_ok), else 0. */
-int bgm_link_ok(const int *from, const int *to, int m, int path_ok)
+/* bgm_link_ok by pairs (a link too long for its table, or a negative
+ * vertex). */
+static int link_ok_slow(const int *from, const int *to, int m, int path_ok)
 {
 	if (m == 0)
 		return 1;
@@ -411,6 +410,74 @@ int bgm_link_ok(const int *from, const int *to, int m, int path_ok)
 				next = k;
 				break;
 			}
+		if (next < 0 || next == start)
+			break;
+		at = next;
+		if (++steps > m)
+			return 0;
+	}
+	if (steps != m)
+		return 0;
+	return starts == 1 || m >= 3;
+}
+
+/* Checks a link given as directed edges from[i] -> to[i]: 1 when they
+ * form one simple cycle of at least 3 edges (or one simple path when
+ * path_ok), else 0. */
+int bgm_link_ok(const int *from, const int *to, int m, int path_ok)
+{
+	if (m == 0)
+		return 1;
+	/* Each link vertex: at most one outgoing and one incoming edge (no
+	 * value twice in from[], nor in to[]), no loop. The vertices in a
+	 * small open-addressed table: where each is in from[] and in to[]. */
+	enum { BITS = 8, SIZE = 1 << BITS };
+	if (m > SIZE / 2)
+		return link_ok_slow(from, to, m, path_ok);
+	int bits = 4;
+	while ((1 << bits) < 2 * m)
+		bits++;
+	unsigned mask = (1u << bits) - 1u;
+	int key[SIZE], fi[SIZE], ti[SIZE];
+	for (unsigned i = 0; i <= mask; i++)
+		key[i] = -1;
+	for (int pass = 0; pass < 2; pass++)
+		for (int i = 0; i < m; i++) {
+			int x = pass == 0 ? from[i] : to[i];
+			if (x < 0)
+				return link_ok_slow(from, to, m, path_ok);
+			unsigned h = (((unsigned)x * 0x9E3779B1u) & 0xFFFFFFFFu) >> (32 - bits);
+			while (key[h] >= 0 && key[h] != x)
+				h = (h + 1u) & mask;
+			if (key[h] < 0)
+				key[h] = x, fi[h] = ti[h] = -1;
+			int *slot = pass == 0 ? &fi[h] : &ti[h];
+			if (*slot >= 0 || from[i] == to[i])
+				return 0;
+			*slot = i;
+		}
+	/* A start: an edge nothing comes into (the last such, as ever). */
+	int starts = 0, start = 0;
+	for (int i = 0; i < m; i++) {
+		unsigned h = (((unsigned)from[i] * 0x9E3779B1u) & 0xFFFFFFFFu) >> (32 - bits);
+		while (key[h] != from[i])
+			h = (h + 1u) & mask;
+		if (ti[h] < 0) {
+			starts++;
+			start = i;
+		}
+	}
+	if (starts > 1 || (starts == 1 && !path_ok))
+		return 0;
+	/* Walk from the start; every edge must be visited once. */
+	int at = start, steps = 1;
+	for (;;) {
+		int x = to[at], next = -1;
+		unsigned h = (((unsigned)x * 0x9E3779B1u) & 0xFFFFFFFFu) >> (32 - bits);
+		while (key[h] >= 0 && key[h] != x)
+			h = (h + 1u) & mask;
+		if (key[h] == x)
+			next = fi[h];
 		if (next < 0 || next == start)
 			break;
 		at = next;

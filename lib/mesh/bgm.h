@@ -124,6 +124,9 @@ struct mlod_bgm {
 		struct bgm_memo *memo;     /* queued operations' exact placement costs (collapse.c);
 		                            * released with free() by mlod_bgm_free */
 		int memo_count, memo_cap, memo_free;
+		int dead;                  /* entries of faces that died since (about: a purge trigger) */
+		int unordered;             /* a NaN key was queued: never purged (the order is then
+		                            * not total, and the heap's shape matters) */
 	} heap;
 	int swept;              /* collapse.c: record_count when every live face was last queued */
 	int border_phase;       /* collapse.c: border vertices may collapse (the compactness

@@ -119,6 +119,7 @@ struct bgm_heap_entry {
  * 5 + i vertex i kept whole (hybrid placement: its own influences). */
 #define MEMO_ROLES 8
 #define MEMO_WSUM (1u << MEMO_ROLES)
+#define MEMO_SKINNED 5        /* roles 0-4: placements Power Skinning weighs */
 typedef struct bgm_memo {
 	double opt[3];
 	int opt_state;              /* 0 not worked out, 1 found, 2 none */
@@ -126,9 +127,29 @@ typedef struct bgm_memo {
 	double e[MEMO_ROLES];
 	double wsum;
 	int next_free;
+	unsigned skinned;           /* bit r: w[r] and capped[r] are role r's Power Skinning */
+	unsigned char capped[MEMO_SKINNED];
+	mlod_influences w[MEMO_SKINNED];
 } memo;
 
-static const memo memo_empty = {{0, 0, 0}, 0, 0, {0}, 0.0, -1};
+/* mlod_power_skin of the collapsed vertices (V, in3) at x, placement
+ * role's position (the same for the operation while its face lives), as
+ * mm remembers it (when mm is not NULL). */
+static int skin_role(memo *mm, int role, const mlod_v3 *V, const mlod_influences *in3, int K, const double *x,
+                     mlod_influences *w)
+{
+	if (mm && role < MEMO_SKINNED && (mm->skinned >> role & 1u)) {
+		*w = mm->w[role];
+		return mm->capped[role];
+	}
+	int capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)x[0], (float)x[1], (float)x[2]}, w);
+	if (mm && role < MEMO_SKINNED) {
+		mm->w[role] = *w;
+		mm->capped[role] = (unsigned char)capped;
+		mm->skinned |= 1u << role;
+	}
+	return capped;
+}
 
 /* A slot holding m; returns its index, or -1 when out of memory. */
 static int memo_add(struct bgm_heap *h, const memo *m)
@@ -170,6 +191,8 @@ static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak,
 		return -1;
 	int i = h->count++;
 	struct bgm_heap_entry x = {key, face, (unsigned)op | (weak ? 4u : 0u) | (unsigned)(memo_slot + 1) << 3};
+	if (isnan(key))
+		h->unordered = 1;
 	while (i > 0) {
 		int p = (i - 1) / 4;
 		if (!entry_less(&x, &h->e[p]))
@@ -202,6 +225,44 @@ static heap_entry heap_pop(struct bgm_heap *h)
 		h->e[i] = x;
 	heap_entry top = {t.key, t.face, (int)(t.tag & 3u), (int)(t.tag >> 2 & 1u), (int)(t.tag >> 3) - 1};
 	return top;
+}
+
+/* Drops the entries of dead faces (what heap_pop's callers would drop
+ * when they come up) and rebuilds the heap from the rest. Entries are
+ * one per face and op and entry_less orders them totally (no NaN key
+ * was queued), so the live entries come out in the same order as
+ * before; a dead entry popped costs a walk down the heap, this one pass
+ * over it. */
+static void heap_purge(struct bgm_heap *h, const unsigned char *opstate, unsigned char dead)
+{
+	int n = 0;
+	for (int i = 0; i < h->count; i++) {
+		if (opstate[h->e[i].face] == dead) {
+			memo_release(h, (int)(h->e[i].tag >> 3) - 1);
+			continue;
+		}
+		h->e[n++] = h->e[i];
+	}
+	h->count = n;
+	h->dead = 0;
+	for (int s = n > 1 ? (n - 2) / 4 : -1; s >= 0; s--) {
+		struct bgm_heap_entry x = h->e[s];
+		int i = s;
+		for (;;) {
+			int c = 4 * i + 1, m = c;
+			if (c >= n)
+				break;
+			int end = c + 4 < n ? c + 4 : n;
+			for (int j = c + 1; j < end; j++)
+				if (entry_less(&h->e[j], &h->e[m]))
+					m = j;
+			if (!entry_less(&h->e[m], &x))
+				break;
+			h->e[i] = h->e[m];
+			i = m;
+		}
+		h->e[i] = x;
+	}
 }
 
 /* Everything a collapse needs, worked out by plan() and applied by
@@ -239,10 +300,8 @@ static int find(int *parent, int i)
 /* Which of the collapsed vertices node n is (0 .. k-1), or -1. */
 static int owner_of(const struct plan *pl, int n)
 {
-	for (int i = 0; i < pl->k; i++)
-		if (pl->v[i] == n)
-			return i;
-	return -1;
+	/* v[2] is -1 for an edge (plan() sets it), never a node */
+	return n == pl->v[0] ? 0 : n == pl->v[1] ? 1 : n == pl->v[2] ? 2 : -1;
 }
 
 static int wedge_slot(const struct plan *pl, int w)
@@ -316,22 +375,11 @@ static void barycentric(const double *a, const double *b, const double *c, const
 		l[i] = sum > 0.0 ? l[i] / sum : 1.0 / 3.0;
 }
 
-/* bgm_compactness(a, b, c) from len, the length of bgm_face_normal's
- * normal (the same arithmetic, so the same value). */
-static double compactness_of(const double *a, const double *b, const double *c, double len)
-{
-	double u[3], v[3], w[3];
-	for (int i = 0; i < 3; i++)
-		u[i] = b[i] - a[i], v[i] = c[i] - a[i], w[i] = c[i] - b[i];
-	double area = 0.5 * len;
-	double l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + w[0] * w[0] +
-	            w[1] * w[1] + w[2] * w[2];
-	if (!(l2 > 0.0))
-		return 0.0;
-	return 4.0 * sqrt(3.0) * area / l2;
-}
-
-/* Checks the re-meshed faces for flips and degeneracy with v-bar at x. */
+/* Checks the re-meshed faces for flips and degeneracy with v-bar at x.
+ * Each face's normal is bgm_face_normal's and its compactness
+ * bgm_compactness's (the same arithmetic on the same edge vectors, made
+ * once here), the compactness (a division) only for a face that does not
+ * flip: all three tests must pass. */
 static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x)
 {
 	for (int i = 0; i < pl->nk; i++) {
@@ -341,15 +389,24 @@ static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x
 			q[k] = g->nodes[f->n[k]].p;
 		q[pl->corner[i]] = x;
 		const double *no = pl->onormal[i];
-		double nn[3];
-		bgm_face_normal(q[0], q[1], q[2], nn);
+		double u[3], v[3], w[3], nn[3];
+		for (int k = 0; k < 3; k++)
+			u[k] = q[1][k] - q[0][k], v[k] = q[2][k] - q[0][k], w[k] = q[2][k] - q[1][k];
+		nn[0] = u[1] * v[2] - u[2] * v[1];
+		nn[1] = u[2] * v[0] - u[0] * v[2];
+		nn[2] = u[0] * v[1] - u[1] * v[0];
 		double lo = no[3];
 		double ln = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-		double cn = compactness_of(q[0], q[1], q[2], ln);
-		if (!(ln > 0.0) || cn < DEGENERATE)
+		if (!(ln > 0.0))
 			return 0;
 		if (lo > 0.0 && pl->oflip[i] &&
 		    !(no[0] * nn[0] + no[1] * nn[1] + no[2] * nn[2] > FLIP_COS * lo * ln))
+			return 0;
+		double area = 0.5 * ln;
+		double l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + w[0] * w[0] +
+		            w[1] * w[1] + w[2] * w[2];
+		double cn = l2 > 0.0 ? 4.0 * sqrt(3.0) * area / l2 : 0.0;
+		if (cn < DEGENERATE)
 			return 0;
 	}
 	return 1;
@@ -816,7 +873,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			} else {
 				if (!q_ready)
 					sum_quadrics(g, pl, Q), q_ready = 1;
-				mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
+				skin_role(mm, 4, V, in3, K, bary, &w);
 				found = bgm_quadric_optimum(g, Q, &w, bary, opt) == 0;
 				if (mm) {
 					mm->opt_state = found ? 1 : 2;
@@ -942,7 +999,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		if (cand_whole[k])
 			w = in3[cand_at[k]]; /* the vertex's own influences, not blended */
 		else
-			capped = mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+			capped = skin_role(mm, cand_role[k], V, in3, K, cand[k], &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double cost, d = 0.0;
@@ -1596,7 +1653,7 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		if (!mm->opt_state) {
 			if (!q_ready)
 				sum_quadrics(g, &pv, Q), q_ready = 1;
-			mlod_power_skin(V, in3, K, (mlod_v3){(float)bary[0], (float)bary[1], (float)bary[2]}, &w);
+			skin_role(mm, 4, V, in3, K, bary, &w);
 			mm->opt_state = bgm_quadric_optimum(g, Q, &w, bary, mm->opt) == 0 ? 1 : 2;
 		}
 		memcpy(opt, mm->opt, sizeof opt);
@@ -1633,7 +1690,7 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		else if (role[k] >= 5)
 			w = in3[role[k] - 5];
 		else
-			mlod_power_skin(V, in3, K, (mlod_v3){(float)cand[k][0], (float)cand[k][1], (float)cand[k][2]}, &w);
+			skin_role(mm, role[k], V, in3, K, cand[k], &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double e;
@@ -1857,6 +1914,8 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	for (int j = 0; j < pl->nf; j++) {
 		bgm_face *f = &g->faces[pl->faces[j]];
 		f->death = stamp;
+		unsigned queued = g->opstate[pl->faces[j]] >> 4;
+		g->heap.dead += (int)(queued & 1u) + (int)(queued >> 1 & 1u) + (int)(queued >> 2 & 1u) + (int)(queued >> 3 & 1u);
 		g->opstate[pl->faces[j]] = DEAD;
 		for (int k = 0; k < 3; k++)
 			bgm_inc_remove(g, f->n[k], pl->faces[j]);
@@ -1989,6 +2048,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			else if (g->record_count == g->swept)
 				break;
 			g->swept = g->record_count;
+			g->heap.dead = 0;
 			for (int f = 0; f < g->opstate_cap; f++)
 				g->opstate[f] = f < g->face_count && g->faces[f].death != BGM_ALIVE ? DEAD : 0;
 			for (int f = 0; f < g->face_count; f++)
@@ -1998,13 +2058,26 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 				}
 			continue;
 		}
+		/* Mostly dead entries: drop them at once (the same order). */
+		if (g->heap.dead > 256 && 2 * g->heap.dead > g->heap.count && !g->heap.unordered) {
+			heap_purge(&g->heap, g->opstate, DEAD);
+			continue;
+		}
 		heap_entry e = heap_pop(&g->heap);
 		if (g->opstate[e.face] == DEAD) {
+			g->heap.dead -= g->heap.dead > 0;
 			memo_release(&g->heap, e.memo);
 			continue;
 		}
 		/* An operation going back keeps what its placements cost. */
-		memo local = memo_empty, *mm = e.memo >= 0 ? &g->heap.memo[e.memo] : &local;
+		memo local, *mm = e.memo >= 0 ? &g->heap.memo[e.memo] : &local;
+		if (e.memo < 0) {
+			/* Nothing known: the rest is read only once its bit says it
+			 * was written (not cleared at every pop: w[] is large). */
+			local.opt_state = 0;
+			local.known = local.skinned = 0;
+			local.next_free = -1;
+		}
 		double back = -1.0;
 		if (e.weak) {
 			double b = exact_bound(g, e.face, e.op, mm);

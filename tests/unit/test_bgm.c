@@ -1189,6 +1189,92 @@ TEST(shared_data)
 	mlod_character_free(&c);
 }
 
+/* bgm_link_ok (a table of the link's vertices) against the definition
+ * worked out pair by pair: one simple cycle of 3 or more edges, or one
+ * simple path when paths are allowed. */
+static int link_ok_pairs(const int *from, const int *to, int m, int path_ok)
+{
+	if (m == 0)
+		return 1;
+	int starts = 0, start = 0;
+	for (int i = 0; i < m; i++) {
+		int out = 0, in = 0, in2 = 0;
+		for (int k = 0; k < m; k++) {
+			out += from[k] == from[i];
+			in += to[k] == from[i];
+			in2 += to[k] == to[i];
+		}
+		if (out > 1 || in > 1 || in2 > 1 || from[i] == to[i])
+			return 0;
+		if (in == 0)
+			starts++, start = i;
+	}
+	if (starts > 1 || (starts == 1 && !path_ok))
+		return 0;
+	int at = start, steps = 1;
+	for (;;) {
+		int next = -1;
+		for (int k = 0; k < m && next < 0; k++)
+			if (from[k] == to[at])
+				next = k;
+		if (next < 0 || next == start)
+			break;
+		at = next;
+		if (++steps > m)
+			return 0;
+	}
+	return steps == m && (starts == 1 || m >= 3);
+}
+
+TEST(link_condition)
+{
+	enum { M = 200 };
+	int from[M], to[M], ring[M + 1], agree = 0, ok = 0, total = 0;
+	uint32_t seed = 12345u;
+	for (int trial = 0; trial < 4000; trial++) {
+		seed = seed * 1664525u + 1013904223u;
+		int m = (int)(seed >> 8) % (trial < 3000 ? 16 : M) + (trial % 7 == 0 ? 0 : 1);
+		if (m > M)
+			m = M;
+		/* A fan's link (a cycle or a path over distinct vertices), then
+		 * perhaps broken: shuffled, an edge dropped, split, reversed,
+		 * a vertex repeated or a loop. */
+		for (int i = 0; i <= m; i++) {
+			seed = seed * 1664525u + 1013904223u;
+			ring[i] = (trial % 3 == 0 ? (int)(seed >> 12) % (4 * M) : 1000 + 7 * i);
+		}
+		int path = trial % 2;
+		for (int i = 0; i < m; i++) {
+			from[i] = ring[i];
+			to[i] = path ? ring[i + 1] : ring[(i + 1) % m];
+		}
+		for (int i = m - 1; i > 0; i--) {
+			seed = seed * 1664525u + 1013904223u;
+			int j = (int)(seed >> 9) % (i + 1), a = from[i], b = to[i];
+			from[i] = from[j], to[i] = to[j], from[j] = a, to[j] = b;
+		}
+		seed = seed * 1664525u + 1013904223u;
+		int how = (int)(seed >> 20) % 6, at = m > 0 ? (int)(seed >> 4) % m : 0;
+		if (m > 0 && how == 1)
+			to[at] = from[(at + 1) % m];
+		else if (m > 0 && how == 2)
+			from[at] = to[at];
+		else if (m > 0 && how == 3) {
+			int t = from[at];
+			from[at] = to[at], to[at] = t;
+		} else if (m > 1 && how == 4)
+			m--;
+		for (int p = 0; p < 2; p++) {
+			int want = link_ok_pairs(from, to, m, p), got = bgm_link_ok(from, to, m, p);
+			agree += want == got;
+			ok += got;
+			total++;
+		}
+	}
+	CHECK(agree == total);
+	CHECK(ok > total / 8 && ok < total - total / 8); /* both answers were tried */
+}
+
 int main(void)
 {
 	RUN(power_weights_equilateral);
@@ -1198,6 +1284,7 @@ int main(void)
 	RUN(eligibility_rules);
 	RUN(weight_average);
 	RUN(compactness);
+	RUN(link_condition);
 	RUN(weld_keeps_seams_closed);
 	RUN(seam_wedges);
 	RUN(prefixes_tubeman);
