@@ -761,6 +761,19 @@ done:
 	return r;
 }
 
+void mlod_bgm_options_resolve(mlod_bgm_options *opt)
+{
+	if (opt->cost == MLOD_COST_DEFAULT)
+		opt->cost = MLOD_COST_POSED;
+	/* as measured: see mlod-bgm(1) and bench/RESULTS.md */
+	if (opt->placement == MLOD_PLACE_DEFAULT)
+		opt->placement = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_OPTIMAL;
+	if (opt->op == MLOD_OP_DEFAULT)
+		opt->op = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_OP_TRIANGLE : MLOD_OP_EDGE;
+	if (opt->eligibility == MLOD_ELIGIBLE_DEFAULT)
+		opt->eligibility = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_ELIGIBLE_BEND : MLOD_ELIGIBLE_ALL;
+}
+
 mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive, const mlod_bgm_options *opt,
                            mlod_bgm **out, mlod_error *err)
 {
@@ -807,14 +820,7 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 	g->prim = p;
 	if (opt)
 		g->opt = *opt;
-	if (g->opt.cost == MLOD_COST_DEFAULT)
-		g->opt.cost = MLOD_COST_POSED;
-	if (g->opt.placement == MLOD_PLACE_DEFAULT)
-		g->opt.placement = g->opt.cost == MLOD_COST_POSED ? MLOD_PLACE_HYBRID : MLOD_PLACE_BARYCENTER;
-	if (g->opt.eligibility == MLOD_ELIGIBLE_DEFAULT) /* as measured: see bench/RESULTS.md */
-		g->opt.eligibility = g->opt.cost == MLOD_COST_POSED ? MLOD_ELIGIBLE_ALL : MLOD_ELIGIBLE_BEND;
-	if (g->opt.op == MLOD_OP_DEFAULT)
-		g->opt.op = g->opt.cost == MLOD_COST_POSED ? MLOD_OP_EDGE : MLOD_OP_TRIANGLE;
+	mlod_bgm_options_resolve(&g->opt);
 	if (g->opt.op != MLOD_OP_TRIANGLE && g->opt.cost != MLOD_COST_POSED) {
 		free(g);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "edge collapses need the posed cost");

@@ -72,16 +72,9 @@ const char *mlod_mesh_eligibility_name(mlod_eligibility e)
 
 void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget)
 {
-	if (opt->cost == MLOD_COST_DEFAULT)
-		opt->cost = MLOD_COST_POSED;
+	mlod_bgm_options_resolve(opt);
 	if (budget && *budget == MLOD_BUDGET_DEFAULT) /* measured: see mlod-bgm(1) */
 		*budget = opt->cost == MLOD_COST_POSED ? MLOD_BUDGET_CHARACTER : MLOD_BUDGET_PRIMITIVE;
-	if (opt->placement == MLOD_PLACE_DEFAULT)
-		opt->placement = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_OPTIMAL;
-	if (opt->op == MLOD_OP_DEFAULT)
-		opt->op = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_OP_TRIANGLE : MLOD_OP_EDGE;
-	if (opt->eligibility == MLOD_ELIGIBLE_DEFAULT)
-		opt->eligibility = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_ELIGIBLE_BEND : MLOD_ELIGIBLE_ALL;
 	if (!(opt->tau > 0.0))
 		opt->tau = 1.0;
 	if (!(opt->hybrid_error > 0.0))

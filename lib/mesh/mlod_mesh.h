@@ -143,6 +143,11 @@ typedef struct mlod_bgm mlod_bgm;
  * MLOD_ERR_UNSUPPORTED. */
 mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive, const mlod_bgm_options *opt,
                            mlod_bgm **out, mlod_error *err);
+/* Replaces the DEFAULT cost, placement, collapse and eligibility with what
+ * they stand for (the cost first: posed; then optimal, edge, all; with the
+ * compactness cost barycenter, triangle, bend): the one place these
+ * defaults are set, for mlod_bgm_build and mlod_mesh_resolve. */
+void mlod_bgm_options_resolve(mlod_bgm_options *opt);
 void mlod_bgm_free(mlod_bgm *g);
 
 typedef struct mlod_bgm_info {
@@ -287,8 +292,9 @@ const char *mlod_mesh_placement_name(mlod_placement p);
 int mlod_mesh_placement_parse(const char *s, mlod_placement *p, double *error);
 const char *mlod_mesh_eligibility_name(mlod_eligibility e);
 
-/* Replaces the DEFAULT values with what they stand for (the cost first:
- * posed), as the BGM and the levels use them. */
+/* Replaces the DEFAULT values with what they stand for
+ * (mlod_bgm_options_resolve, then the budget, tau, the hybrid share and
+ * the influence budget), as the BGM and the levels use them. */
 void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget);
 
 /* The triangle primitives (mode 4) of the character's instances. */
