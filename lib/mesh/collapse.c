@@ -204,10 +204,11 @@ static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak,
 	return 0;
 }
 
-static heap_entry heap_pop(struct bgm_heap *h)
+/* Puts x at slot i of the 4-ary heap or below it, moving the least
+ * child up while it is less than x. */
+static void sift_down(struct bgm_heap *h, int i, struct bgm_heap_entry x)
 {
-	struct bgm_heap_entry t = h->e[0], x = h->e[--h->count];
-	int i = 0, n = h->count;
+	const int n = h->count;
 	for (;;) {
 		int c = 4 * i + 1, m = c;
 		if (c >= n)
@@ -221,8 +222,14 @@ static heap_entry heap_pop(struct bgm_heap *h)
 		h->e[i] = h->e[m];
 		i = m;
 	}
-	if (n > 0)
-		h->e[i] = x;
+	h->e[i] = x;
+}
+
+static heap_entry heap_pop(struct bgm_heap *h)
+{
+	struct bgm_heap_entry t = h->e[0], x = h->e[--h->count];
+	if (h->count > 0)
+		sift_down(h, 0, x);
 	heap_entry top = {t.key, t.face, (int)(t.tag & 3u), (int)(t.tag >> 2 & 1u), (int)(t.tag >> 3) - 1};
 	return top;
 }
@@ -245,24 +252,8 @@ static void heap_purge(struct bgm_heap *h, const unsigned char *opstate, unsigne
 	}
 	h->count = n;
 	h->dead = 0;
-	for (int s = n > 1 ? (n - 2) / 4 : -1; s >= 0; s--) {
-		struct bgm_heap_entry x = h->e[s];
-		int i = s;
-		for (;;) {
-			int c = 4 * i + 1, m = c;
-			if (c >= n)
-				break;
-			int end = c + 4 < n ? c + 4 : n;
-			for (int j = c + 1; j < end; j++)
-				if (entry_less(&h->e[j], &h->e[m]))
-					m = j;
-			if (!entry_less(&h->e[m], &x))
-				break;
-			h->e[i] = h->e[m];
-			i = m;
-		}
-		h->e[i] = x;
-	}
+	for (int s = n > 1 ? (n - 2) / 4 : -1; s >= 0; s--)
+		sift_down(h, s, h->e[s]);
 }
 
 /* Everything a collapse needs, worked out by plan() and applied by

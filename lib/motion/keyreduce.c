@@ -402,6 +402,18 @@ typedef struct setup_ctx {
 /* Channel ch's path of l at sample f, from its kept keys (first and last
  * the first and last kept, a and b those around f), as mlod_clip_sample
  * computes it: seg is the slerp's per-segment part, kept while a stays. */
+/* The first and last kept frames of a channel's row (-1, -1: none). */
+static void kept_span(const unsigned char *row, int F, int *first, int *last)
+{
+	*first = *last = -1;
+	for (int k = 0; k < F; k++)
+		if (row[k]) {
+			if (*first < 0)
+				*first = k;
+			*last = k;
+		}
+}
+
 EVAL_INLINE void setup_value(const reducer *R, const mlod_channel *ch, int first, int last, int a, int b, int f, eval_seg *seg,
                             mlod_trs *l)
 {
@@ -438,13 +450,8 @@ static mlod_result setup_item(void *ctx, int i)
 	for (int c = c0; c < c1; c++) {
 		const mlod_channel *ch = &R->common->channels[c];
 		const unsigned char *row = R->kept + (size_t)c * (size_t)R->F;
-		int first = -1, last = -1;
-		for (int k = 0; k < R->F; k++)
-			if (row[k]) {
-				if (first < 0)
-					first = k;
-				last = k;
-			}
+		int first, last;
+		kept_span(row, R->F, &first, &last);
 		for (int k = 0, p = -1; k < R->F; k++) /* prevk: the last kept at or before k */
 			prevk[k] = p = row[k] ? k : p;
 		for (int k = R->F - 1, n = -1; k >= 0; k--) { /* nextk: the first kept after k */
@@ -512,13 +519,8 @@ static int state_fits(const reducer *R, const keyreduce_state *st, const mlod_ma
 	for (int c = 0; c < R->C; c++) {
 		const mlod_channel *ch = &R->common->channels[c];
 		const unsigned char *row = R->kept + (size_t)c * (size_t)R->F;
-		int first = -1, last = -1;
-		for (int k = 0; k < R->F; k++)
-			if (row[k]) {
-				if (first < 0)
-					first = k;
-				last = k;
-			}
+		int first, last;
+		kept_span(row, R->F, &first, &last);
 		for (int k = first, next; k >= 0 && k <= last; k = next) {
 			for (next = k + 1; next <= last && !row[next]; next++)
 				;
