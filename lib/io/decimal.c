@@ -55,7 +55,11 @@ int mlod_decimal_parse(const char *s, size_t len, double *out)
 	}
 	if (i1 == i0 && f1 == f0)
 		return MLOD_DEC_SYNTAX;
-	long e = 0;
+	/* The exponent saturates at cap: the value, at least 10^(e - len) and
+	 * below 10^(e + len), is then already beyond every double (infinite
+	 * or zero) at e = cap and at any larger e, as strtod makes it. */
+	const int64_t cap = (int64_t)(len < ((size_t)1 << 40) ? len : ((size_t)1 << 40)) + 400;
+	int64_t e = 0;
 	if (i < len && (s[i] == 'e' || s[i] == 'E')) {
 		i++;
 		int eneg = 0;
@@ -64,8 +68,7 @@ int mlod_decimal_parse(const char *s, size_t len, double *out)
 		if (i >= len || !is_digit(s[i]))
 			return MLOD_DEC_SYNTAX;
 		while (i < len && is_digit(s[i])) {
-			if (e < 100000)
-				e = e * 10 + (s[i] - '0');
+			e = e >= cap ? cap : e * 10 + (s[i] - '0');
 			i++;
 		}
 		if (eneg)
@@ -75,7 +78,7 @@ int mlod_decimal_parse(const char *s, size_t len, double *out)
 		return MLOD_DEC_SYNTAX;
 
 	/* value = (all the digits as one integer) * 10^exp10 */
-	long exp10 = e - (long)(f1 - f0);
+	int64_t exp10 = e - (int64_t)(f1 - f0);
 	/* The significant digits: from the first nonzero one. */
 	size_t n = (i1 - i0) + (f1 - f0), first = 0;
 #define DIGIT(k) (s[(k) < i1 - i0 ? i0 + (k) : f0 + ((k) - (i1 - i0))])
@@ -103,7 +106,7 @@ int mlod_decimal_parse(const char *s, size_t len, double *out)
 			size_t k = 0, keep = nsig > KEEP_DIGITS ? KEEP_DIGITS : nsig;
 			for (size_t d = 0; d < keep; d++)
 				buf[k++] = DIGIT(first + d);
-			long x = exp10 + (long)(nsig - keep);
+			int64_t x = exp10 + (int64_t)(nsig - keep);
 			if (keep < nsig) {
 				for (size_t d = first + keep; d < n; d++)
 					if (DIGIT(d) != '0') {
@@ -115,7 +118,7 @@ int mlod_decimal_parse(const char *s, size_t len, double *out)
 			buf[k++] = 'e';
 			if (x < 0)
 				buf[k++] = '-';
-			unsigned long ux = x < 0 ? 0UL - (unsigned long)x : (unsigned long)x;
+			uint64_t ux = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
 			char tmp[24];
 			size_t t = 0;
 			do {

@@ -768,6 +768,8 @@ void mlod_bgm_options_resolve(mlod_bgm_options *opt)
 	/* as measured: see mlod-bgm(1) and bench/RESULTS.md */
 	if (opt->placement == MLOD_PLACE_DEFAULT)
 		opt->placement = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_PLACE_BARYCENTER : MLOD_PLACE_OPTIMAL;
+	if (opt->placement == MLOD_PLACE_HYBRID && opt->cost == MLOD_COST_COMPACTNESS)
+		opt->placement = MLOD_PLACE_OPTIMAL; /* it weighs posed costs, which compactness has not */
 	if (opt->op == MLOD_OP_DEFAULT)
 		opt->op = opt->cost == MLOD_COST_COMPACTNESS ? MLOD_OP_TRIANGLE : MLOD_OP_EDGE;
 	if (opt->eligibility == MLOD_ELIGIBLE_DEFAULT)

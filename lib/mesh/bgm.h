@@ -127,6 +127,9 @@ struct mlod_bgm {
 		int dead;                  /* entries of faces that died since (about: a purge trigger) */
 		int unordered;             /* a NaN key was queued: never purged (the order is then
 		                            * not total, and the heap's shape matters) */
+		int no_purge;              /* never purged (set by test_bgm, which checks that a purge
+		                            * leaves the collapses as they were) */
+		int purges;                /* how many times it was */
 	} heap;
 	int swept;              /* collapse.c: record_count when every live face was last queued */
 	int border_phase;       /* collapse.c: border vertices may collapse (the compactness

@@ -252,6 +252,7 @@ static void heap_purge(struct bgm_heap *h, const unsigned char *opstate, unsigne
 	}
 	h->count = n;
 	h->dead = 0;
+	h->purges++;
 	for (int s = n > 1 ? (n - 2) / 4 : -1; s >= 0; s--)
 		sift_down(h, s, h->e[s]);
 }
@@ -2050,7 +2051,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			continue;
 		}
 		/* Mostly dead entries: drop them at once (the same order). */
-		if (g->heap.dead > 256 && 2 * g->heap.dead > g->heap.count && !g->heap.unordered) {
+		if (g->heap.dead > 256 && 2 * g->heap.dead > g->heap.count && !g->heap.unordered && !g->heap.no_purge) {
 			heap_purge(&g->heap, g->opstate, DEAD);
 			continue;
 		}

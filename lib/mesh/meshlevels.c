@@ -77,7 +77,7 @@ void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget)
 		*budget = opt->cost == MLOD_COST_POSED ? MLOD_BUDGET_CHARACTER : MLOD_BUDGET_PRIMITIVE;
 	if (!(opt->tau > 0.0))
 		opt->tau = 1.0;
-	if (!(opt->hybrid_error > 0.0))
+	if (opt->hybrid_error == 0.0) /* a negative or NaN share: mlod_bgm_build refuses it */
 		opt->hybrid_error = MLOD_MESH_HYBRID_ERROR;
 	if (opt->influence_budget == 0.0)
 		opt->influence_budget = MLOD_MESH_INFLUENCE_BUDGET > 0.0 ? MLOD_MESH_INFLUENCE_BUDGET : -1.0;

@@ -90,8 +90,11 @@ typedef enum mlod_placement {
 	MLOD_PLACE_VERTEX,      /* one of the collapsed vertices, kept whole (attributes and influences as it has
 	                         * them, no Power Skinning): coarse levels reuse level-0 vertices */
 	MLOD_PLACE_HYBRID       /* per collapse, VERTEX's cheapest whole vertex when its posed cost is at most
-	                         * OPTIMAL's or within hybrid_error, else OPTIMAL's (posed cost only; with
-	                         * compactness it is OPTIMAL) */
+	                         * OPTIMAL's or within hybrid_error, else OPTIMAL's candidates; the nodes'
+	                         * influences are read as VERTEX reads them (as stored, not merged or
+	                         * normalised), so the free placements' blends can differ from OPTIMAL's on
+	                         * inputs with two weight sets or unnormalised weights (posed cost only:
+	                         * with compactness it resolves to OPTIMAL) */
 } mlod_placement;
 
 /* Which collapses run. */

@@ -966,7 +966,7 @@ static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound
 }
 
 /* level_within_keep and level_measure_of (with its world matrices
- * given) on m->threads threads, a range of samples each: every sample's
+ * given) on refine_lanes(m) threads, a range of samples each: every sample's
  * floats are computed alone (its own walk state: eval_sample's floats do
  * not depend on the samples before), so they are the serial walk's. */
 typedef struct walk_par {

@@ -166,7 +166,7 @@ mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_opt
 	for (int i = 1; all_same && i < clip->channel_count; i++) {
 		const mlod_channel *a = &clip->channels[0], *b = &clip->channels[i];
 		all_same = b->key_count == a->key_count &&
-		           memcmp(b->times, a->times, sizeof(float) * (size_t)a->key_count) == 0;
+		           (a->key_count == 0 || memcmp(b->times, a->times, sizeof(float) * (size_t)a->key_count) == 0);
 	}
 	if (all_same && (use = calloc((size_t)clip->channel_count, 1)) != NULL)
 		use[0] = 1;

@@ -139,9 +139,8 @@ uint16_t mlod_pack_qu16_shift(float v, float min, float scale, int shift)
 	double q = floor(((double)v - (double)min) / (double)scale / step + 0.5) * step;
 	if (!(q > 0.0))
 		return 0;
-	while (q > 65535.0)
-		q -= step;
-	return (uint16_t)q;
+	const double top = floor(65535.0 / step) * step; /* the largest multiple of step in range */
+	return (uint16_t)(q > top ? top : q);
 }
 
 void mlod_pack_weights8(const float w[4], uint8_t out[4])

@@ -103,6 +103,35 @@ TEST(edge_cases)
 		double got, want;
 		CHECK_MSG(agrees(big, &got, &want), "%d digits: %.17g, strtod %.17g", n, got, want);
 	}
+	/* Tokens of about a million digits whose exponent makes up for them
+	 * (the exponent once saturated at 999,999 before the digits were
+	 * counted: 0 and inf came back for 10000 and 1). */
+	{
+		const size_t zeros = 1100000;
+		char *huge = malloc(zeros + 64);
+		CHECK(huge != NULL);
+		for (int form = 0; huge && form < 4; form++) {
+			size_t k = 0;
+			if (form == 0 || form == 2)
+				k += (size_t)sprintf(huge, "0.");
+			else
+				huge[k++] = '1';
+			memset(huge + k, '0', zeros);
+			k += zeros;
+			if (form == 0)
+				k += (size_t)sprintf(huge + k, "1e1100005");
+			else if (form == 1)
+				k += (size_t)sprintf(huge + k, "e-1100000");
+			else if (form == 2)
+				k += (size_t)sprintf(huge + k, "1e1100400");
+			else
+				k += (size_t)sprintf(huge + k, "e-1100400");
+			huge[k] = 0;
+			double got, want;
+			CHECK_MSG(agrees(huge, &got, &want), "form %d, %zu digits: %.17g, strtod %.17g", form, zeros, got, want);
+		}
+		free(huge);
+	}
 	/* Not numbers. */
 	const char *bad[] = { "", "+", "-", ".", "-.", "e5", "1e", "1e+", "1.2.3", "1x", "--1", "1 ", " 1", "0x10" };
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {

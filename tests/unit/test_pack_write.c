@@ -197,6 +197,9 @@ TEST(range_shift_within_half_a_coarse_step)
 		}
 	/* Clamped into range: never past 65535. */
 	CHECK(mlod_pack_qu16_shift(1e9f, 0.0f, 1.0f, 4) == 65520);
+	/* Far out of range (once a loop of q / step steps: a hang) and infinite. */
+	CHECK(mlod_pack_qu16_shift(1e30f, 0.0f, 1.0f, 1) == 65534);
+	CHECK(mlod_pack_qu16_shift(INFINITY, 0.0f, 1.0f, 3) == 65528);
 	CHECK(mlod_pack_qu16_shift(-5.0f, 0.0f, 1.0f, 4) == 0);
 }
 
