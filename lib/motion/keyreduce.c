@@ -642,6 +642,7 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	if (state) {
 		int fits = state_fits(&R, state, w0);
 		state->valid = 0; /* until this run ends */
+		state->reused = fits;
 		if (fits)
 			goto reduce;
 	}

@@ -477,6 +477,7 @@ typedef struct keyreduce_state {
 	unsigned char *kept;      /* the keys (channels * frames) of lc */
 	size_t nkept;
 	int valid;
+	int reused;               /* the last run took them instead of its setup */
 	const mlod_skeleton *s;   /* what they were made from */
 	const mlod_clip *common;
 	const mlod_mat4 *w0;

@@ -1394,6 +1394,51 @@ TEST(bake_report_same_at_any_thread_count)
  * that starts from its keys: the same keys and error as a run that sets
  * up from scratch; and a state that is not what the setup would compute
  * at a kept key's sample is not taken. */
+/* On the walk (a real clip, where the next level does take the state):
+ * two levels from one state give the keys and errors of fresh runs, and
+ * the second level took the state. */
+TEST(keys_state_reused_on_the_walk)
+{
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	const mlod_clip *clip = &c.clips[0];
+	const mlod_skeleton *s = &c.skeleton;
+	int n = s->joint_count, F = clip->channels[0].key_count, per = 2, S = (F - 1) * per + 1;
+	size_t CF = (size_t)clip->channel_count * (size_t)F;
+	float *st = malloc(sizeof(float) * (size_t)S);
+	mlod_mat4 *w0 = malloc(sizeof(mlod_mat4) * (size_t)S * (size_t)n);
+	mlod_trs *l = malloc(sizeof(mlod_trs) * (size_t)n);
+	unsigned char *ka = malloc(CF), *kb = malloc(CF);
+	mlod_motion_sample_times(clip->channels[0].times, F, per, st);
+	for (int f = 0; f < S; f++) {
+		mlod_pose_rest(s, l);
+		mlod_clip_sample(clip, st[f], l);
+		mlod_pose_world(s, l, w0 + (size_t)f * (size_t)n);
+	}
+	keyreduce_state state;
+	memset(&state, 0, sizeof state);
+	const double bounds[3] = {0.05, 0.2, 0.6};
+	int reused = 0;
+	memset(ka, 1, CF);
+	memset(kb, 1, CF);
+	for (int b = 0; b < 3; b++) {
+		double ea, eb;
+		CHECK_OK(keyreduce_run(s, clip, clip, bounds[b], 1.0, per, ka, w0, &ea, NULL, &state, 1, &terr));
+		reused += state.reused;
+		CHECK_OK(keyreduce_run(s, clip, clip, bounds[b], 1.0, per, kb, w0, &eb, NULL, NULL, 1, &terr));
+		CHECK_MSG(memcmp(ka, kb, CF) == 0, "bound %g: other keys with the state", bounds[b]);
+		CHECK(memcmp(&ea, &eb, sizeof ea) == 0);
+	}
+	CHECK_MSG(reused > 0, "no level took the state: the comparison says nothing");
+	keyreduce_state_free(&state);
+	free(st), free(w0), free(l), free(ka), free(kb);
+	mlod_character_free(&c);
+}
+
+/* A synthetic chain: a level that starts from the last one's state gives
+ * the keys and error of a fresh run, whether it takes the state or (as
+ * here, a kept key's sample differing from what its setup computes)
+ * refuses it; and it refuses a tampered state. */
 TEST(keys_state_same_as_fresh)
 {
 	int F = 90, n = 6, per = 2;
@@ -1451,6 +1496,7 @@ TEST(keys_state_same_as_fresh)
 	{
 		memcpy(ka, k1, CF), memcpy(kb, k1, CF);
 		CHECK_OK(keyreduce_run(s, clip, clip, 0.04, 0.1, per, ka, w0, &ea, NULL, &state, 1, &terr));
+		CHECK_MSG(!state.reused, "a tampered state was taken");
 		CHECK_OK(keyreduce_run(s, clip, clip, 0.04, 0.1, per, kb, w0, &eb, NULL, NULL, 1, &terr));
 		CHECK(memcmp(ka, kb, CF) == 0);
 		CHECK(memcmp(&ea, &eb, sizeof ea) == 0);
@@ -1508,6 +1554,7 @@ int main(void)
 	RUN(frames_item_levels_same);
 	RUN(keys_split_same_as_next_level);
 	RUN(bake_report_same_at_any_thread_count);
+	RUN(keys_state_reused_on_the_walk);
 	RUN(keys_state_same_as_fresh);
 	RUN(eval_mul_same_as_mat4_mul);
 	RUN(create_like_same_as_create);
