@@ -377,53 +377,6 @@ static int sort_edges(struct edge_rec *edges, struct edge_rec *tmp, int ne, int 
 	return 0;
 }
 
-/* bgm_link_ok by pairs (a link too long for its table, or a negative
- * vertex). */
-static int link_ok_slow(const int *from, const int *to, int m, int path_ok)
-{
-	if (m == 0)
-		return 1;
-	/* Each link vertex: at most one outgoing and one incoming edge. */
-	int starts = 0, start = 0;
-	for (int i = 0; i < m; i++) {
-		int out = 0, in = 0, in2 = 0;
-		for (int k = 0; k < m; k++) {
-			out += from[k] == from[i];
-			in += to[k] == from[i];
-			in2 += to[k] == to[i];
-		}
-		if (out > 1 || in > 1 || in2 > 1 || from[i] == to[i])
-			return 0;
-		if (in == 0) {
-			starts++;
-			start = i;
-		}
-	}
-	if (starts > 1 || (starts == 1 && !path_ok))
-		return 0;
-	/* Walk from the start; every edge must be visited once. */
-	int at = start, steps = 1;
-	for (;;) {
-		int next = -1;
-		for (int k = 0; k < m; k++)
-			if (from[k] == to[at]) {
-				next = k;
-				break;
-			}
-		if (next < 0 || next == start)
-			break;
-		at = next;
-		if (++steps > m)
-			return 0;
-	}
-	if (steps != m)
-		return 0;
-	return starts == 1 || m >= 3;
-}
-
-/* Checks a link given as directed edges from[i] -> to[i]: 1 when they
- * form one simple cycle of at least 3 edges (or one simple path when
- * path_ok), else 0. */
 int bgm_link_ok(const int *from, const int *to, int m, int path_ok)
 {
 	if (m == 0)
@@ -431,9 +384,9 @@ int bgm_link_ok(const int *from, const int *to, int m, int path_ok)
 	/* Each link vertex: at most one outgoing and one incoming edge (no
 	 * value twice in from[], nor in to[]), no loop. The vertices in a
 	 * small open-addressed table: where each is in from[] and in to[]. */
-	enum { BITS = 8, SIZE = 1 << BITS };
+	enum { BITS = 9, SIZE = 1 << BITS };
 	if (m > SIZE / 2)
-		return link_ok_slow(from, to, m, path_ok);
+		return 0; /* a link this long (callers give at most MAX_PATCH, 128): leave it alone */
 	int bits = 4;
 	while ((1 << bits) < 2 * m)
 		bits++;
@@ -445,7 +398,7 @@ int bgm_link_ok(const int *from, const int *to, int m, int path_ok)
 		for (int i = 0; i < m; i++) {
 			int x = pass == 0 ? from[i] : to[i];
 			if (x < 0)
-				return link_ok_slow(from, to, m, path_ok);
+				return 0; /* not a node */
 			unsigned h = (((unsigned)x * 0x9E3779B1u) & 0xFFFFFFFFu) >> (32 - bits);
 			while (key[h] >= 0 && key[h] != x)
 				h = (h + 1u) & mask;

@@ -157,6 +157,9 @@ int bgm_add_face(mlod_bgm *g, const int *w, int birth);
 int bgm_inc_add(mlod_bgm *g, int node, int face);
 void bgm_inc_remove(mlod_bgm *g, int node, int face);
 double bgm_seconds(void);
+/* Do the m directed edges from[i] -> to[i] (node ids) form one cycle, or
+ * with path_ok one path? A link of more than 256 edges or with a
+ * negative id is refused (0). */
 int bgm_link_ok(const int *from, const int *to, int m, int path_ok);
 double bgm_compactness(const double *a, const double *b, const double *c);
 int bgm_node_eligible(const mlod_bgm *g, const mlod_influences *inf);
