@@ -22,6 +22,12 @@
  * distances); all (the default) is alpha and pixels. It measures the CPU
  * time of one frame: the update (selection), motion sampling, pose and
  * linear blend skinning of every instance into one buffer, on one core.
+ * With --work pose it measures what a caller that skins on the GPU pays on
+ * the CPU instead: the update, motion sampling, the pose (mlod_rt_pose)
+ * and the skinning palette (mlod_rt_palette), no skinning. The paper's
+ * Figure 15 measures such a crowd of skeletons; a skeleton level saves
+ * the joints it removes that are not ancestors of kept ones (mlod_rt(3),
+ * "Skeleton levels").
  * Streaming happens between frames, outside the measured time (its cost
  * is printed apart). It prints per N one line per mode: ms per frame, the
  * speed-up over full detail, the instances per skeleton, mesh and motion
@@ -115,6 +121,9 @@ static const char usage_text[] =
 	"                        (default 1, at 1080 lines and 60 degrees)\n"
 	"      --interval TS,TE  the alpha interval of every layer (default 0,1)\n"
 	"      --hysteresis H    relative hysteresis (default 0.1)\n"
+	"      --work WORK       skin (default: motion sampling, pose and skinning)\n"
+	"                        or pose (motion sampling, pose and palette, as a\n"
+	"                        caller that skins on the GPU; the paper's Figure 15)\n"
 	"      --png FILE        writes a picture of the last measured frame, each\n"
 	"                        character coloured by its mesh level\n"
 	"      --png-count N     the crowd size pictured (one of --counts; default the\n"
@@ -329,6 +338,7 @@ typedef struct crowd {
 	float *buf;
 	uint32_t cap;
 	uint32_t n;
+	int pose_only; /* --work pose */
 } crowd;
 
 static void grow(crowd *c)
@@ -360,13 +370,33 @@ static void walk(crowd *c, float dt, float near, float far)
 	}
 }
 
-/* One measured frame: update, then pose and skin every instance. */
+/* Poses instance id and builds its palette (--work pose); *count gets the
+ * palette's matrices. */
+static mlod_result pose_one(crowd *c, uint32_t id, uint32_t *count, mlod_error *e)
+{
+	const float *palette;
+	mlod_result r = mlod_rt_pose(c->ctx, c->scratch, id, NULL, NULL, NULL, e);
+	return r != MLOD_OK ? r : mlod_rt_palette(c->ctx, c->scratch, &palette, count, e);
+}
+
+/* One measured frame: update, then pose and skin every instance (or pose
+ * it and build its palette, --work pose). *vertices counts the vertices
+ * skinned (the palette matrices built). */
 static double frame(crowd *c, const mlod_rt_select *sel, float dt, uint64_t *vertices)
 {
 	mlod_error e;
 	double t0 = cpu_seconds();
 	if (mlod_rt_update(c->ctx, sel, c->ids, c->dist, c->n, dt, &e) != MLOD_OK)
 		die(2, "%s", e.message);
+	if (c->pose_only) {
+		for (uint32_t i = 0; i < c->n; i++) {
+			uint32_t count = 0;
+			if (pose_one(c, c->ids[i], &count, &e) != MLOD_OK)
+				die(2, "%s", e.message);
+			*vertices += count;
+		}
+		return cpu_seconds() - t0;
+	}
 	for (uint32_t i = 0; i < c->n; i++) {
 		uint32_t nv = 0;
 		mlod_result r = skin_one(c, c->ids[i], &nv, &e);
@@ -1131,7 +1161,7 @@ int main(int argc, char **argv)
 	double seconds = 2, fps = 30, max_wall = 10, hyst = 0.1, height = 1.8, pixels = -1;
 	float near = 2, far = 200, ts = 0, te = 1;
 	size_t budget = 0;
-	int bench = 1, line = 0, png_w = 960, png_h = 540, png_mode = -1;
+	int bench = 1, line = 0, png_w = 960, png_h = 540, png_mode = -1, pose_only = 0;
 	unsigned long png_count = 0;
 	unsigned modes = 1u << MLOD_RT_SELECT_ALPHA | 1u << MLOD_RT_SELECT_PIXELS;
 	static const struct option longopts[] = {
@@ -1145,6 +1175,7 @@ int main(int argc, char **argv)
 		{ "png", required_argument, NULL, 'G' },      { "png-count", required_argument, NULL, 'C' },
 		{ "png-size", required_argument, NULL, 'Z' }, { "png-mode", required_argument, NULL, 'M' },
 		{ "figures", no_argument, NULL, 'g' },        { "plot", required_argument, NULL, 'p' },
+		{ "work", required_argument, NULL, 'W' },
 		{ "help", no_argument, NULL, 'h' },           { NULL, 0, NULL, 0 },
 	};
 	int ch;
@@ -1198,6 +1229,11 @@ int main(int argc, char **argv)
 			png_mode = k;
 			break;
 		}
+		case 'W':
+			if (strcmp(optarg, "skin") && strcmp(optarg, "pose"))
+				die(1, "unknown --work '%s' (skin or pose)", optarg);
+			pose_only = !strcmp(optarg, "pose");
+			break;
 		case 'S':
 			if (!strcmp(optarg, "ground") || !strcmp(optarg, "line"))
 				line = !strcmp(optarg, "line");
@@ -1252,6 +1288,7 @@ int main(int argc, char **argv)
 	mlod_error e;
 	crowd c;
 	memset(&c, 0, sizeof c);
+	c.pose_only = pose_only;
 	double t0 = cpu_seconds();
 	mlod_result r = mlod_rt_open_path(path, &cfg, &c.ctx, &e);
 	if (r != MLOD_OK)
@@ -1298,8 +1335,9 @@ int main(int argc, char **argv)
 	else
 		printf("scale 1 (scene units; the character is %.4g units tall); ", info.height);
 	printf("distances %g..%g%s spread %s\n", near, far, unit, line ? "along a line" : "over the ground");
-	printf("budget %s%zu, hysteresis %g, %g s at %g fps per measurement; modes: full",
-	       budget ? "" : "none ", budget, hyst, seconds, fps);
+	printf("budget %s%zu, hysteresis %g, %g s at %g fps per measurement; work: %s; modes: full",
+	       budget ? "" : "none ", budget, hyst, seconds, fps,
+	       pose_only ? "pose (motion sampling, pose and palette; no skinning)" : "skin (motion sampling, pose and skinning)");
 	for (int k = 0; k < MODES; k++)
 		if (modes >> k & 1) {
 			if (k == MODE_SKELETON)
@@ -1398,7 +1436,7 @@ int main(int argc, char **argv)
 	                           (bmax[2] - bmin[2]) * (bmax[2] - bmin[2]));
 	pic.near = near_u, pic.far = far_u, pic.mesh_levels = L[MLOD_RT_MESH];
 
-	printf("\n%7s %-8s %11s %8s %8s  %-s\n", "N", "mode", "ms/frame", "speedup", "Mvert/s",
+	printf("\n%7s %-8s %11s %8s %8s  %-s\n", "N", "mode", "ms/frame", "speedup", pose_only ? "Mpal/s" : "Mvert/s",
 	       "instances per level (skeleton | mesh | motion), resident bytes");
 	for (uint32_t k = 0; k < nsizes; k++) {
 		const uint32_t n = sizes[k];
