@@ -53,8 +53,6 @@
 #define ROUNDS 4
 #define MAX_LANES 8              /* threads of one key reduction */
 
-int keyreduce_one_at_a_time = 0;
-
 /* What a thread's checks need of their own. */
 typedef struct lane {
 	mlod_trs *lb[2];         /* S: the channel's joint's local transform in a check */
@@ -65,8 +63,6 @@ typedef struct lane {
 	unsigned *stamp;         /* S: the check that took the sample first */
 	unsigned stamp_now;
 	int *K;                  /* F: a channel's kept frames */
-	eval_soa4 *soa;          /* J: a block check's world matrices, per joint */
-	mlod_mat4 *junk;         /* J: where a block check's lanes outside its samples go */
 } lane;
 
 typedef struct reducer {
@@ -86,10 +82,6 @@ typedef struct reducer {
 	mlod_mat4 *wb[2];        /* S * J: world matrices of a check (the subtree's; a lane's good
 	                            buffer is its own lane's good index) */
 	unsigned char *kept;
-	int soa_ok;              /* every joint below a root has w0's last row (0, 0, 0, 1) at every
-	                            sample: checks go four samples at a time (block_check) */
-	eval_soa4 *lms, *w0s;    /* NB * J: mirrors of lm and w0 by blocks of four samples */
-	int NB;                  /* blocks: (S + 3) / 4 */
 	int lanes;
 	lane lane[MAX_LANES];
 	eval_scratch own;        /* the arrays above (lc to the lanes') when no scratch is given */
@@ -167,111 +159,6 @@ static int sample_check(reducer *R, lane *L, const mlod_channel *ch, const float
 	return 1;
 }
 
-/* Are the active lanes (act) of joint d's world matrices w (stored at
- * wm[i][d]) within budget of w0 (the block's w0s)? within's answer, lane
- * by lane: the float bound four at a time (the same doubles as
- * eval_error_bound), then mlod_motion_point_within where it cannot tell. */
-EVAL_INLINE int within4(const reducer *R, int d, const eval_soa4 *w, const eval_soa4 *w0s, mlod_mat4 *const wm[4],
-                        const int fs[4], const int act[4], double budget)
-{
-	double b[4];
-	eval_error_bound4(w, w0s, R->radius[d], b);
-	for (int i = 0; i < 4; i++)
-		if (act[i] && !(b[i] <= budget) &&
-		    !mlod_motion_point_within(&wm[i][d], &R->w0[(size_t)fs[i] * (size_t)R->J + (size_t)d], R->radius[d], budget))
-			return 0;
-	return 1;
-}
-
-/* sample_check at the samples of block blk (4 blk .. 4 blk + 3) within
- * lo..hi, four at a time (R->soa_ok): the channel's joint's matrices from
- * the current ones at each sample, its descendants' from the mirrors lms
- * and w0s. A lane outside lo..hi takes the first sample inside (the same
- * floats, for what it reads alone) and its results go to the lane's junk
- * matrices and are not looked at. Every value stored is sample_check's,
- * bit for bit; the answer is the conjunction of its answers. */
-static int block_check(reducer *R, lane *L, const mlod_channel *ch, const float *va, const float *vb, float t0,
-                       float dt, eval_seg *seg, int constant, int blk, int lo, int hi, double budget)
-{
-	const mlod_skeleton *s = R->s;
-	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch), spare = 1 - L->good;
-	const int *sub = R->sub + R->sub_start[j];
-	int nsub = R->sub_start[j + 1] - R->sub_start[j];
-	int fs[4], act[4], first = blk * 4 < lo ? lo : blk * 4;
-	mlod_mat4 *w[4];
-	const mlod_mat4 *lmv[4];
-	for (int i = 0; i < 4; i++) {
-		int f = blk * 4 + i;
-		act[i] = f >= lo && f <= hi;
-		fs[i] = f = act[i] ? f : first;
-		float v[4];
-		if (constant || ch->interp == MLOD_INTERP_STEP) {
-			memcpy(v, va, sizeof(float) * (size_t)comps);
-		} else {
-			const float u = (R->times[f] - t0) / dt;
-			if (comps == 4) {
-				mlod_quat q = eval_slerp(seg, va, vb, u);
-				v[0] = q.x, v[1] = q.y, v[2] = q.z, v[3] = q.w;
-			} else {
-				for (int c = 0; c < 3; c++)
-					v[c] = va[c] + (vb[c] - va[c]) * u;
-			}
-		}
-		size_t base = (size_t)f * (size_t)R->J;
-		mlod_trs *l = &L->lb[spare][f];
-		mlod_mat4 *lm = &L->lmb[spare][f];
-		*l = R->lc[base + (size_t)j];
-		set_path(l, ch->path, v);
-		*lm = eval_from_trs(l);
-		lmv[i] = lm;
-		w[i] = act[i] ? R->wb[spare] + base : L->junk;
-		if (p < 0) {
-			w[i][j] = eval_mul(&s->joints[j].base, lm);
-			if (act[i] && !within(R, j, &w[i][j], &R->w0[base + (size_t)j], budget))
-				return 0;
-		}
-	}
-	eval_soa4 *soa = L->soa;
-	const size_t row = (size_t)blk * (size_t)R->J;
-	if (p < 0) {
-		eval_soa4_load(&soa[j], &w[0][j], &w[1][j], &w[2][j], &w[3][j]);
-	} else {
-		eval_soa4 P, B;
-		const mlod_mat4 *wc = R->wc;
-		const size_t J = (size_t)R->J;
-		eval_soa4_load(&P, &wc[(size_t)fs[0] * J + (size_t)p], &wc[(size_t)fs[1] * J + (size_t)p],
-		               &wc[(size_t)fs[2] * J + (size_t)p], &wc[(size_t)fs[3] * J + (size_t)p]);
-		eval_soa4_load(&B, lmv[0], lmv[1], lmv[2], lmv[3]);
-		eval_mul_affine4(&soa[j], &P, &B);
-		eval_soa4_store(&soa[j], &w[0][j], &w[1][j], &w[2][j], &w[3][j]);
-		if (!within4(R, j, &soa[j], &R->w0s[row + (size_t)j], w, fs, act, budget))
-			return 0;
-	}
-	for (int k = 1; k < nsub; k++) {
-		int d = sub[k], dp = s->joints[d].parent;
-		eval_mul_affine4(&soa[d], &soa[dp], &R->lms[row + (size_t)d]);
-		eval_soa4_store(&soa[d], &w[0][d], &w[1][d], &w[2][d], &w[3][d]);
-		if (!within4(R, d, &soa[d], &R->w0s[row + (size_t)d], w, fs, act, budget))
-			return 0;
-	}
-	return 1;
-}
-
-/* The mirror of joints' matrices src (S * J) at blocks b0..b1 - 1: dst[b
- * J + j] holds samples 4 b .. 4 b + 3 (past the last sample: the last). */
-static void mirror_set(const reducer *R, eval_soa4 *dst, const mlod_mat4 *src, int b0, int b1, int j0, int j1)
-{
-	const size_t J = (size_t)R->J;
-	for (int b = b0; b < b1; b++) {
-		size_t f[4];
-		for (int i = 0; i < 4; i++)
-			f[i] = (size_t)(b * 4 + i < R->S ? b * 4 + i : R->S - 1) * J;
-		for (int j = j0; j < j1; j++)
-			eval_soa4_load(&dst[(size_t)b * J + (size_t)j], &src[f[0] + (size_t)j], &src[f[1] + (size_t)j],
-			               &src[f[2] + (size_t)j], &src[f[3] + (size_t)j]);
-	}
-}
-
 /* Checks channel ch taking, at samples lo..hi (inclusive), the values of
  * the segment between its keys at frames a and b (or a's value, constant).
  * The samples are independent (each needs only the current matrices at
@@ -295,53 +182,21 @@ static int sweep_check(reducer *R, lane *L, const mlod_channel *ch, int a, int b
 		memset(stamp, 0, sizeof(unsigned) * (size_t)R->S);
 		id = L->stamp_now = 1;
 	}
-	if (!R->soa_ok) {
-		for (int k = ngone - 1; k >= 0; k--) {
-			int f = gone[k] * R->per;
+	for (int k = ngone - 1; k >= 0; k--) {
+		int f = gone[k] * R->per;
+		stamp[f] = id;
+		if (!sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
+			return 0;
+	}
+	for (int f = lo; f <= hi && stride > 1; f += stride)
+		if (stamp[f] != id) {
 			stamp[f] = id;
 			if (!sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
 				return 0;
 		}
-		for (int f = lo; f <= hi && stride > 1; f += stride)
-			if (stamp[f] != id) {
-				stamp[f] = id;
-				if (!sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
-					return 0;
-			}
-		for (int f = lo; f <= hi; f++) /* the rest in order (memory order) */
-			if (stamp[f] != id && !sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
-				return 0;
-	} else {
-		/* The same samples, a block of four at a time (block_check):
-		 * first the last removed key's sample alone (where a check
-		 * fails, it mostly fails there), then the blocks of the other
-		 * removed keys (the last first), then the rest in order. The
-		 * answer is the same in any order; a sample checked twice is
-		 * the same floats twice. */
-		int k = ngone - 1;
-		if (k >= 0) {
-			int f = gone[k--] * R->per, blk = f / 4;
-			if (!sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
-				return 0;
-			int b0 = blk * 4 < lo ? lo : blk * 4, b1 = blk * 4 + 3 > hi ? hi : blk * 4 + 3;
-			if (b0 == b1)
-				stamp[blk] = id; /* its only sample */
-		}
-		for (; k >= 0; k--) {
-			int blk = gone[k] * R->per / 4;
-			if (stamp[blk] != id) {
-				stamp[blk] = id;
-				if (!block_check(R, L, ch, va, vb, t0, dt, &seg, constant, blk, lo, hi, budget))
-					return 0;
-			}
-		}
-		for (int blk = lo / 4; blk <= hi / 4; blk++)
-			if (stamp[blk] != id) {
-				stamp[blk] = id;
-				if (!block_check(R, L, ch, va, vb, t0, dt, &seg, constant, blk, lo, hi, budget))
-					return 0;
-			}
-	}
+	for (int f = lo; f <= hi; f++) /* the rest in order (memory order) */
+		if (stamp[f] != id && !sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
+			return 0;
 	L->good = 1 - L->good;
 	L->good_ch = ch, L->good_lo = lo, L->good_hi = hi;
 	return 1;
@@ -362,8 +217,6 @@ static void sweep_commit(reducer *R, lane *L, const mlod_channel *ch, int a, int
 		for (int k = 0; k < nsub; k++)
 			R->wc[base + (size_t)sub[k]] = R->wb[g][base + (size_t)sub[k]];
 	}
-	if (R->soa_ok)
-		mirror_set(R, R->lms, R->lm, lo / 4, hi / 4 + 1, j, j + 1);
 	L->good_ch = NULL;
 }
 
@@ -707,8 +560,6 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	R.bound = bound;
 	R.lanes = threads < 1 ? 1 : threads > MAX_LANES ? MAX_LANES : threads;
 	size_t FJ = (size_t)R.S * (size_t)R.J;
-	R.NB = (R.S + 3) / 4;
-	size_t NBJ = (size_t)R.NB * (size_t)R.J;
 	R.times = malloc(sizeof(float) * (size_t)R.S);
 	R.radius = malloc(sizeof(double) * (size_t)R.J);
 	R.sub_start = calloc((size_t)R.J + 1, sizeof(int));
@@ -718,11 +569,9 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		size_t S = (size_t)R.S;
 		size_t F = (size_t)R.F;
 		size_t per_lane = 2 * eval_carve_size(sizeof(mlod_trs) * S) + 2 * eval_carve_size(sizeof(mlod_mat4) * S) +
-		                  eval_carve_size(sizeof(unsigned) * S) + eval_carve_size(sizeof(int) * F) +
-		                  eval_carve_size(sizeof(eval_soa4) * (size_t)R.J) + eval_carve_size(sizeof(mlod_mat4) * (size_t)R.J);
+		                  eval_carve_size(sizeof(unsigned) * S) + eval_carve_size(sizeof(int) * F);
 		size_t need = (state ? 0 : eval_carve_size(sizeof(mlod_trs) * FJ) + 2 * eval_carve_size(sizeof(mlod_mat4) * FJ)) +
-		              2 * eval_carve_size(sizeof(mlod_mat4) * FJ) + (size_t)R.lanes * per_lane +
-		              2 * eval_carve_size(sizeof(eval_soa4) * NBJ);
+		              2 * eval_carve_size(sizeof(mlod_mat4) * FJ) + (size_t)R.lanes * per_lane;
 		char *at = eval_scratch_get(scratch ? scratch : &R.own, need);
 		if (state && state->fj != FJ) {
 			keyreduce_state_free(state);
@@ -744,8 +593,6 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 			}
 			for (int i = 0; i < 2; i++)
 				R.wb[i] = eval_carve(&at, sizeof(mlod_mat4) * FJ);
-			R.lms = eval_carve(&at, sizeof(eval_soa4) * NBJ);
-			R.w0s = eval_carve(&at, sizeof(eval_soa4) * NBJ);
 			for (int n = 0; n < R.lanes; n++) {
 				lane *L = &R.lane[n];
 				L->stamp = eval_carve(&at, sizeof(unsigned) * S);
@@ -755,8 +602,6 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 					L->lmb[i] = eval_carve(&at, sizeof(mlod_mat4) * S);
 				}
 				L->K = eval_carve(&at, sizeof(int) * F);
-				L->soa = eval_carve(&at, sizeof(eval_soa4) * (size_t)R.J);
-				L->junk = eval_carve(&at, sizeof(mlod_mat4) * (size_t)R.J);
 			}
 		}
 	}
@@ -819,18 +664,6 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	mlod_parallel_for(sx.n, sx.n, setup_item, &sx);
 	mlod_parallel_for(sx.n, sx.n, frames_item, &sx);
 reduce:
-	/* Four samples at a time where the last rows of w0 below the roots are
-	 * (0, 0, 0, 1), as eval_error_bound4 needs them. */
-	R.soa_ok = !keyreduce_one_at_a_time;
-	for (size_t i = 0; i < FJ && R.soa_ok; i++) {
-		const float *m = R.w0[i].m;
-		if (s->joints[i % (size_t)R.J].parent >= 0 && !(m[3] == 0.0f && m[7] == 0.0f && m[11] == 0.0f && m[15] == 1.0f))
-			R.soa_ok = 0;
-	}
-	if (R.soa_ok) {
-		mirror_set(&R, R.lms, R.lm, 0, R.NB, 0, R.J);
-		mirror_set(&R, R.w0s, R.w0, 0, R.NB, 0, R.J);
-	}
 
 	/* Rounds of reduce_channel over the channels at a growing budget, then
 	 * collapse_channel over them at the whole bound. */

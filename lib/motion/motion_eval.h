@@ -49,7 +49,6 @@
 #if defined(__GNUC__)
 typedef float eval_v4 __attribute__((vector_size(16)));
 typedef int32_t eval_v4i __attribute__((vector_size(16)));
-typedef double eval_v2d __attribute__((vector_size(16)));
 #endif
 
 EVAL_INLINE mlod_mat4 eval_mul_affine(const mlod_mat4 *a, const mlod_mat4 *b)
@@ -200,145 +199,6 @@ static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, d
 	return ((double)sqrtf(dp2) + radius * (double)sqrtf(frob)) * (1.0 + 1e-5) + 1e-18 * (1.0 + radius);
 }
 
-/* Four samples at once (the key reduction's checks, keyreduce.c): the top
- * three rows of four affine matrices, structure of arrays, m[c * 3 + r]
- * lane i holding matrix i's entry m[c * 4 + r] (row r, column c). The
- * product and the bound below run, lane by lane, the float operations of
- * eval_mul_affine and eval_error_bound in their order (no operation
- * reassociated, none contracted), so each lane's result is the one-matrix
- * form's, bit for bit; test_motion's soa4_same_as_one_at_a_time checks
- * it. With GCC's vector extension (and shuffles) the lanes are SSE
- * lanes; elsewhere a loop over the lanes calling the one-matrix forms. */
-#if defined(__GNUC__) && !defined(__clang__)
-#define EVAL_SOA4_VECTOR 1
-typedef struct eval_soa4 {
-	eval_v4 m[12];
-} eval_soa4;
-/* The 4x4 transpose of a, b, c, d (one column of four matrices) into rows. */
-#define EVAL_T4(a, b, c, d, o0, o1, o2, o3)                                                \
-	do {                                                                               \
-		const eval_v4i lo_ = { 0, 4, 1, 5 }, hi_ = { 2, 6, 3, 7 };                 \
-		const eval_v4i l2_ = { 0, 1, 4, 5 }, h2_ = { 2, 3, 6, 7 };                 \
-		eval_v4 t0_ = __builtin_shuffle(a, b, lo_), t1_ = __builtin_shuffle(c, d, lo_); \
-		eval_v4 t2_ = __builtin_shuffle(a, b, hi_), t3_ = __builtin_shuffle(c, d, hi_); \
-		o0 = __builtin_shuffle(t0_, t1_, l2_);                                     \
-		o1 = __builtin_shuffle(t0_, t1_, h2_);                                     \
-		o2 = __builtin_shuffle(t2_, t3_, l2_);                                     \
-		o3 = __builtin_shuffle(t2_, t3_, h2_);                                     \
-	} while (0)
-#else
-/* Elsewhere the four matrices as they are, each lane through the
- * one-matrix functions. */
-typedef struct eval_soa4 {
-	mlod_mat4 lane[4];
-} eval_soa4;
-#endif
-
-/* o = the top rows of m[0..3]. */
-EVAL_INLINE void eval_soa4_load(eval_soa4 *o, const mlod_mat4 *m0, const mlod_mat4 *m1, const mlod_mat4 *m2,
-                                const mlod_mat4 *m3)
-{
-#if defined(EVAL_SOA4_VECTOR)
-#pragma GCC unroll 4
-	for (int c = 0; c < 4; c++) {
-		eval_v4 a, b, d, e, unused;
-		memcpy(&a, m0->m + c * 4, sizeof a);
-		memcpy(&b, m1->m + c * 4, sizeof b);
-		memcpy(&d, m2->m + c * 4, sizeof d);
-		memcpy(&e, m3->m + c * 4, sizeof e);
-		EVAL_T4(a, b, d, e, o->m[c * 3], o->m[c * 3 + 1], o->m[c * 3 + 2], unused);
-		(void)unused;
-	}
-#else
-	o->lane[0] = *m0, o->lane[1] = *m1, o->lane[2] = *m2, o->lane[3] = *m3;
-#endif
-}
-
-/* m[0..3] = the lanes of w, the last row (0, 0, 0, 1) as eval_mul_affine
- * sets it. */
-EVAL_INLINE void eval_soa4_store(const eval_soa4 *w, mlod_mat4 *m0, mlod_mat4 *m1, mlod_mat4 *m2, mlod_mat4 *m3)
-{
-#if defined(EVAL_SOA4_VECTOR)
-	const eval_v4 zero = { 0.0f, 0.0f, 0.0f, 0.0f }, one = { 1.0f, 1.0f, 1.0f, 1.0f };
-#pragma GCC unroll 4
-	for (int c = 0; c < 4; c++) {
-		eval_v4 a, b, d, e;
-		EVAL_T4(w->m[c * 3], w->m[c * 3 + 1], w->m[c * 3 + 2], c == 3 ? one : zero, a, b, d, e);
-		memcpy(m0->m + c * 4, &a, sizeof a);
-		memcpy(m1->m + c * 4, &b, sizeof b);
-		memcpy(m2->m + c * 4, &d, sizeof d);
-		memcpy(m3->m + c * 4, &e, sizeof e);
-	}
-#else
-	/* (w's lanes are eval_mul_affine's, whose last row is (0, 0, 0, 1)) */
-	*m0 = w->lane[0], *m1 = w->lane[1], *m2 = w->lane[2], *m3 = w->lane[3];
-#endif
-}
-
-/* r = a * b lane by lane, as eval_mul_affine(a_i, b_i): entry (row, c) is
- * ((a(row, 0) b(0, c) + a(row, 1) b(1, c)) + a(row, 2) b(2, c)), plus
- * a(row, 3) in the last column. */
-EVAL_INLINE void eval_mul_affine4(eval_soa4 *r, const eval_soa4 *a, const eval_soa4 *b)
-{
-#if defined(EVAL_SOA4_VECTOR)
-#pragma GCC unroll 4
-	for (int c = 0; c < 4; c++) {
-		const eval_v4 b0 = b->m[c * 3], b1 = b->m[c * 3 + 1], b2 = b->m[c * 3 + 2];
-#pragma GCC unroll 3
-		for (int row = 0; row < 3; row++) {
-			eval_v4 s = a->m[row] * b0;
-			s = s + a->m[3 + row] * b1;
-			s = s + a->m[6 + row] * b2;
-			if (c == 3)
-				s = s + a->m[9 + row];
-			r->m[c * 3 + row] = s;
-		}
-	}
-#else
-	for (int i = 0; i < 4; i++)
-		r->lane[i] = eval_mul_affine(&a->lane[i], &b->lane[i]);
-#endif
-}
-
-/* out[i] = eval_error_bound(w_i, w0_i, radius) for matrices whose last
- * row is (0, 0, 0, 1) in both (w's always is, from eval_mul_affine; w0's
- * the caller has checked): there the last row's differences are +0, and
- * so are their squares, and adding +0 to a sum of squares gives the sum,
- * so eval_error_bound's sums ((f0 + f1) + (f2 + f3) with f3 = +0) are
- * the ones below. */
-EVAL_INLINE void eval_error_bound4(const eval_soa4 *w, const eval_soa4 *w0, double radius, double out[4])
-{
-#if defined(EVAL_SOA4_VECTOR)
-	eval_v4 d[12];
-#pragma GCC unroll 12
-	for (int k = 0; k < 12; k++)
-		d[k] = w->m[k] - w0->m[k];
-	eval_v4 f[3];
-#pragma GCC unroll 3
-	for (int row = 0; row < 3; row++)
-		f[row] = d[row] * d[row] + d[3 + row] * d[3 + row] + d[6 + row] * d[6 + row];
-	eval_v4 frob = (f[0] + f[1]) + f[2];
-	eval_v4 dp2 = (d[9] * d[9] + d[10] * d[10]) + d[11] * d[11];
-#if defined(__SSE__)
-	frob = __builtin_ia32_sqrtps(frob);
-	dp2 = __builtin_ia32_sqrtps(dp2);
-#else
-	for (int i = 0; i < 4; i++)
-		frob[i] = sqrtf(frob[i]), dp2[i] = sqrtf(dp2[i]);
-#endif
-	const eval_v2d rr = { radius, radius }, m = { 1.0 + 1e-5, 1.0 + 1e-5 };
-	const double add = 1e-18 * (1.0 + radius);
-	const eval_v2d av = { add, add };
-	eval_v2d f01 = { (double)frob[0], (double)frob[1] }, f23 = { (double)frob[2], (double)frob[3] };
-	eval_v2d p01 = { (double)dp2[0], (double)dp2[1] }, p23 = { (double)dp2[2], (double)dp2[3] };
-	eval_v2d b01 = (p01 + rr * f01) * m + av, b23 = (p23 + rr * f23) * m + av;
-	out[0] = b01[0], out[1] = b01[1], out[2] = b23[0], out[3] = b23[1];
-#else
-	for (int i = 0; i < 4; i++)
-		out[i] = eval_error_bound(&w->lane[i], &w0->lane[i], radius);
-#endif
-}
-
 /* mlod_motion_point_error(w, w0, radius) <= limit, exactly that answer,
  * its largest singular value computed only when cheaper bounds of it
  * cannot tell (pointerror.c). */
@@ -411,6 +271,10 @@ typedef struct eval_seg {
 	mlod_quat a, b;      /* the keys, normalised */
 	double sign, theta, s;
 } eval_seg;
+
+#if defined(__GNUC__)
+typedef double eval_v2d __attribute__((vector_size(16)));
+#endif
 
 /* (float)(x / n) ... for the four components: two lanes at a time where
  * GCC's vector extension is there (each lane the same IEEE division). */
@@ -642,10 +506,6 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
                           double point_distance, int subdivide, unsigned char *kept, const mlod_mat4 *w0,
                           double *max_error, eval_scratch *scratch, keyreduce_state *state, int threads,
                           mlod_error *err);
-
-/* Nonzero: keyreduce_run checks one sample at a time, never four
- * (block_check); for the tests, which compare the two. */
-extern int keyreduce_one_at_a_time;
 
 /* Tasks 0..n-1 of a sequence on up to lanes threads (tasks.c): run(ctx,
  * lane, t) runs task t with lane's own buffers (lane < lanes; one task at

@@ -1526,96 +1526,6 @@ TEST(eval_mul_same_as_mat4_mul)
 	CHECK_MSG(differ == 0, "%d products differ", differ);
 }
 
-/* The four-lane kernels (eval_soa4_load, eval_mul_affine4,
- * eval_soa4_store, eval_error_bound4): each lane's product and bound are
- * eval_mul_affine's and eval_error_bound's, bit for bit (signed zeros,
- * tiny and huge entries included). Fails if one lane differs. */
-TEST(soa4_same_as_one_at_a_time)
-{
-	const float pick[8] = { 0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 3.0e-20f, -7.25e3f, 1.0e18f };
-	unsigned x = 987654u;
-	long differ_mul = 0, differ_bound = 0;
-	for (int n = 0; n < 50000; n++) {
-		mlod_mat4 a[4], b[4], w0[4], r[4], q[4];
-		for (int i = 0; i < 4; i++) {
-			for (int k = 0; k < 16; k++) {
-				x = x * 1664525u + 1013904223u;
-				a[i].m[k] = (x >> 29) < 2 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 1024.0f;
-				x = x * 1664525u + 1013904223u;
-				b[i].m[k] = (x >> 29) < 2 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 4096.0f;
-				x = x * 1664525u + 1013904223u;
-				w0[i].m[k] = (x >> 29) < 2 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 1024.0f;
-			}
-			/* affine: the last row (0, 0, 0, 1) */
-			a[i].m[3] = a[i].m[7] = a[i].m[11] = b[i].m[3] = b[i].m[7] = b[i].m[11] = 0.0f;
-			w0[i].m[3] = w0[i].m[7] = w0[i].m[11] = 0.0f;
-			a[i].m[15] = b[i].m[15] = w0[i].m[15] = 1.0f;
-			if (n % 5 == 0)
-				w0[i] = eval_mul_affine(&a[i], &b[i]); /* near misses: equal lanes */
-			q[i] = eval_mul_affine(&a[i], &b[i]);
-		}
-		eval_soa4 A, B, W, W0;
-		eval_soa4_load(&A, &a[0], &a[1], &a[2], &a[3]);
-		eval_soa4_load(&B, &b[0], &b[1], &b[2], &b[3]);
-		eval_soa4_load(&W0, &w0[0], &w0[1], &w0[2], &w0[3]);
-		eval_mul_affine4(&W, &A, &B);
-		eval_soa4_store(&W, &r[0], &r[1], &r[2], &r[3]);
-		double radius = (n % 3) * 0.75, bd[4];
-		eval_error_bound4(&W, &W0, radius, bd);
-		for (int i = 0; i < 4; i++) {
-			differ_mul += memcmp(&r[i], &q[i], sizeof r[i]) != 0;
-			double one = eval_error_bound(&q[i], &w0[i], radius);
-			differ_bound += memcmp(&bd[i], &one, sizeof one) != 0;
-		}
-	}
-	CHECK_MSG(differ_mul == 0, "%ld lanes' products differ", differ_mul);
-	CHECK_MSG(differ_bound == 0, "%ld lanes' bounds differ", differ_bound);
-}
-
-/* keyreduce_run checking four samples at a time gives the keys and error
- * of one sample at a time (the walk at 1 and 2 samples per frame, three
- * bounds, from all keys and from the last level's; 1 and 2 threads). */
-TEST(keys_four_at_a_time_same_as_one)
-{
-	mlod_character c;
-	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
-	const mlod_clip *clip = &c.clips[0];
-	const mlod_skeleton *s = &c.skeleton;
-	for (int per = 1; per <= 2; per++) {
-		int n = s->joint_count, F = clip->channels[0].key_count, S = (F - 1) * per + 1;
-		size_t CF = (size_t)clip->channel_count * (size_t)F;
-		float *st = malloc(sizeof(float) * (size_t)S);
-		mlod_mat4 *w0 = malloc(sizeof(mlod_mat4) * (size_t)S * (size_t)n);
-		mlod_trs *l = malloc(sizeof(mlod_trs) * (size_t)n);
-		unsigned char *ka = malloc(CF), *kb = malloc(CF);
-		mlod_motion_sample_times(clip->channels[0].times, F, per, st);
-		for (int f = 0; f < S; f++) {
-			mlod_pose_rest(s, l);
-			mlod_clip_sample(clip, st[f], l);
-			mlod_pose_world(s, l, w0 + (size_t)f * (size_t)n);
-		}
-		const double bounds[3] = { 0.02, 0.2, 0.6 };
-		memset(ka, 1, CF);
-		memset(kb, 1, CF);
-		long removed = 0;
-		for (int b = 0; b < 3; b++) {
-			double ea, eb;
-			keyreduce_one_at_a_time = 0;
-			CHECK_OK(keyreduce_run(s, clip, clip, bounds[b], 1.0, per, ka, w0, &ea, NULL, NULL, 1 + b % 2, &terr));
-			keyreduce_one_at_a_time = 1;
-			CHECK_OK(keyreduce_run(s, clip, clip, bounds[b], 1.0, per, kb, w0, &eb, NULL, NULL, 1 + b % 2, &terr));
-			keyreduce_one_at_a_time = 0;
-			CHECK_MSG(memcmp(ka, kb, CF) == 0, "per %d, bound %g: other keys four at a time", per, bounds[b]);
-			CHECK(memcmp(&ea, &eb, sizeof ea) == 0);
-		}
-		for (size_t i = 0; i < CF; i++)
-			removed += !ka[i];
-		CHECK_MSG(removed > 0, "no key removed: the comparison says nothing");
-		free(st), free(w0), free(l), free(ka), free(kb);
-	}
-	mlod_character_free(&c);
-}
-
 int main(void)
 {
 	RUN(levels_within_bounds_cmu);
@@ -1647,8 +1557,6 @@ int main(void)
 	RUN(keys_state_reused_on_the_walk);
 	RUN(keys_state_same_as_fresh);
 	RUN(eval_mul_same_as_mat4_mul);
-	RUN(soa4_same_as_one_at_a_time);
-	RUN(keys_four_at_a_time_same_as_one);
 	RUN(create_like_same_as_create);
 	RUN(create_on_threads_same_as_create);
 	TEST_EXIT();
