@@ -13,6 +13,7 @@
 #define MLOD_BGM_H
 
 #include <limits.h>
+#include <stddef.h>
 
 #include "mesh/mlod_mesh.h"
 
@@ -91,8 +92,9 @@ struct mlod_bgm {
 	int *removed;
 	int removed_len, removed_cap;
 
-	/* Posed quadrics (quadric.c): pose_count poses; per node and pose 10
-	 * doubles; per pose and influence id a 3x4 skin matrix (row-major). */
+	/* Posed quadrics (quadric.c): pose_count poses; per node pose_count x
+	 * 10 doubles, laid out as bgm_qat says (poses in pairs, side by side);
+	 * per pose and influence id a 3x4 skin matrix (row-major). */
 	int pose_count;
 	double *quadric;
 	float *skin;
@@ -165,11 +167,26 @@ double bgm_compactness(const double *a, const double *b, const double *c);
 int bgm_node_eligible(const mlod_bgm *g, const mlod_influences *inf);
 
 /* quadric.c */
+/* Where entry e (0-9) of pose p is among a node's P x 10 posed quadric
+ * doubles: poses 2i and 2i + 1 side by side, entry e of pair i at
+ * 20 i + 2 e (pose 2i) and 20 i + 2 e + 1 (pose 2i + 1), so that the
+ * two-pose sums load a pair's entries straight; a last odd pose's 10
+ * entries after the pairs, in order. */
+static inline size_t bgm_qat(int P, int p, int e)
+{
+	return p < (P & ~1) ? 20 * (size_t)(p >> 1) + 2 * (size_t)e + (size_t)(p & 1) : 10 * (size_t)p + (size_t)e;
+}
+/* Pose p's 10 entries of the node quadrics q (P poses), in order. */
+static inline void bgm_quadric_get(const double *q, int P, int p, double *out)
+{
+	for (int e = 0; e < 10; e++)
+		out[e] = q[bgm_qat(P, p, e)];
+}
 /* n = (b - a) x (c - a): the face's normal times twice its area. */
 void bgm_face_normal(const double *a, const double *b, const double *c, double *n);
 mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err);
 /* The error of a node at bind position p with influences inf against
- * the quadrics q (pose_count x 10): sum over poses; HUGE_VAL as soon as
+ * the quadrics q (pose_count x 10, as bgm_qat lays them out): sum over poses; HUGE_VAL as soon as
  * the partial sum reaches stop (HUGE_VAL: never). */
 double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *p,
                          double stop);

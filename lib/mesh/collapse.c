@@ -431,9 +431,9 @@ static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 		const double *c = pl->k == 3 ? g->quadric + (size_t)pl->v[2] * n : NULL;
 		const __m128d zero = _mm_setzero_pd();
 		for (size_t k = 0; k < n; k += 2) {
-			__m128d s = _mm_add_pd(_mm_add_pd(zero, _mm_loadu_pd(a + k)), _mm_loadu_pd(b + k));
+			__m128d s = _mm_add_pd(_mm_add_pd(zero, _mm_load_pd(a + k)), _mm_load_pd(b + k));
 			if (c)
-				s = _mm_add_pd(s, _mm_loadu_pd(c + k));
+				s = _mm_add_pd(s, _mm_load_pd(c + k));
 			_mm_storeu_pd(Q + k, s);
 		}
 		return;
@@ -836,7 +836,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		sum_quadrics(g, pl, Q);
 		q_ready = 1;
 		for (int p = 0; p < g->pose_count; p++)
-			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+			wsum += Q[bgm_qat(g->pose_count, p, 0)] + Q[bgm_qat(g->pose_count, p, 4)] + Q[bgm_qat(g->pose_count, p, 7)];
 		if (mm) {
 			mm->wsum = wsum;
 			mm->known |= MEMO_WSUM;
@@ -1205,16 +1205,18 @@ static inline double pose_min_bound(const mlod_bgm *g, const uint16_t *joint, in
 		far = max_d(far, a);
 	}
 	double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
-	double q[10];
-	const double *q0 = qv[0] + 10 * p;
+	double q[10], q0[10], q1[10], q2[10];
+	int P = g->pose_count;
+	bgm_quadric_get(qv[0], P, (int)p, q0);
 	if (k == 1) {
 		memcpy(q, q0, sizeof q);
 	} else if (k == 2) {
-		const double *q1 = qv[1] + 10 * p;
+		bgm_quadric_get(qv[1], P, (int)p, q1);
 		for (int e = 0; e < 10; e++)
 			q[e] = q0[e] + q1[e];
 	} else {
-		const double *q1 = qv[1] + 10 * p, *q2 = qv[2] + 10 * p;
+		bgm_quadric_get(qv[1], P, (int)p, q1);
+		bgm_quadric_get(qv[2], P, (int)p, q2);
 		for (int e = 0; e < 10; e++)
 			q[e] = q0[e] + q1[e] + q2[e];
 	}
@@ -1278,8 +1280,8 @@ static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int
 		const double *m = S + 24 * (size_t)joint[j];
 		for (int i = 0; i < 3; i++) {
 			const double *row = m + 8 * i;
-			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(row), bx), _mm_mul_pd(_mm_loadu_pd(row + 2), by));
-			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_loadu_pd(row + 4), bz)), _mm_loadu_pd(row + 6));
+			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_load_pd(row), bx), _mm_mul_pd(_mm_load_pd(row + 2), by));
+			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_load_pd(row + 4), bz)), _mm_load_pd(row + 6));
 			z[j][i] = t;
 			c[i] = _mm_add_pd(c[i], t);
 		}
@@ -1304,19 +1306,19 @@ static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int
 	__m128d R = _mm_add_pd(_mm_mul_pd(_mm_add_pd(_mm_sqrt_pd(spread), vrl), _mm_set1_pd(1.0 + 1e-6)),
 	                       _mm_mul_pd(_mm_set1_pd(1e-6), _mm_add_pd(_mm_sqrt_pd(far), vrl)));
 	__m128d q[10];
+	/* poses p and p + 1 side by side (bgm_qat): entry e at 2 e */
 	const double *a0 = qv[0] + 10 * p;
 	if (k == 1) {
 		for (int e = 0; e < 10; e++)
-			q[e] = _mm_set_pd(a0[10 + e], a0[e]);
+			q[e] = _mm_load_pd(a0 + 2 * e);
 	} else if (k == 2) {
 		const double *a1 = qv[1] + 10 * p;
 		for (int e = 0; e < 10; e++)
-			q[e] = _mm_add_pd(_mm_set_pd(a0[10 + e], a0[e]), _mm_set_pd(a1[10 + e], a1[e]));
+			q[e] = _mm_add_pd(_mm_load_pd(a0 + 2 * e), _mm_load_pd(a1 + 2 * e));
 	} else {
 		const double *a1 = qv[1] + 10 * p, *a2 = qv[2] + 10 * p;
 		for (int e = 0; e < 10; e++)
-			q[e] = _mm_add_pd(_mm_add_pd(_mm_set_pd(a0[10 + e], a0[e]), _mm_set_pd(a1[10 + e], a1[e])),
-			                  _mm_set_pd(a2[10 + e], a2[e]));
+			q[e] = _mm_add_pd(_mm_add_pd(_mm_load_pd(a0 + 2 * e), _mm_load_pd(a1 + 2 * e)), _mm_load_pd(a2 + 2 * e));
 	}
 	__m128d tr = _mm_add_pd(_mm_add_pd(q[0], q[4]), q[7]);
 	__m128d mu = _mm_mul_pd(_mm_set1_pd(1e-5), tr);
@@ -1552,7 +1554,7 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		for (int j = 0; j < K; j++) {
 			const double *q = g->quadric + (size_t)v[j] * (size_t)g->pose_count * 10;
 			for (int k = 0; k < 10; k++)
-				Q[k] += q[k];
+				Q[k] += q[bgm_qat(g->pose_count, 0, k)]; /* the bind pose's */
 		}
 		lb = bgm_quadric_eval(Q, bary);
 		for (int j = 0; j < K; j++)
@@ -1635,7 +1637,7 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		sum_quadrics(g, &pv, Q);
 		q_ready = 1;
 		for (int p = 0; p < g->pose_count; p++)
-			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+			wsum += Q[bgm_qat(g->pose_count, p, 0)] + Q[bgm_qat(g->pose_count, p, 4)] + Q[bgm_qat(g->pose_count, p, 7)];
 		mm->wsum = wsum;
 		mm->known |= MEMO_WSUM;
 	}

@@ -18,6 +18,7 @@
  * come from mlod_bgm_options.poses (clip frames and random poses).
  */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef __SSE2__
@@ -49,11 +50,12 @@ static void plane_quadric(const double *a, const double *fn, double *q)
 	for (int i = 0; i < 3; i++)
 		n[i] /= len;
 	double d = -(n[0] * a[0] + n[1] * a[1] + n[2] * a[2]);
-	double P[4] = {n[0], n[1], n[2], d};
-	int k = 0;
-	for (int i = 0; i < 4; i++)
-		for (int j = i; j < 4; j++)
-			q[k++] += area * P[i] * P[j];
+	/* q[k] += area * P[i] * P[j] over i <= j, P = (n, d), written out */
+	double w0 = area * n[0], w1 = area * n[1], w2 = area * n[2], w3 = area * d;
+	q[0] += w0 * n[0], q[1] += w0 * n[1], q[2] += w0 * n[2], q[3] += w0 * d;
+	q[4] += w1 * n[1], q[5] += w1 * n[2], q[6] += w1 * d;
+	q[7] += w2 * n[2], q[8] += w2 * d;
+	q[9] += w3 * d;
 }
 
 static double dot3(const double *a, const double *b)
@@ -84,11 +86,13 @@ static void edge_quadric(const double *a, const double *b, const double *n, doub
 		return;
 	for (int i = 0; i < 3; i++)
 		m[i] /= len;
-	double P[4] = {m[0], m[1], m[2], -dot3(m, a)};
-	int k = 0;
-	for (int i = 0; i < 4; i++)
-		for (int j = i; j < 4; j++)
-			q[k++] += FEATURE_WEIGHT * l2 * P[i] * P[j];
+	double d = -dot3(m, a), l = FEATURE_WEIGHT * l2;
+	/* q[k] += FEATURE_WEIGHT * l2 * P[i] * P[j] over i <= j, P = (m, d), written out */
+	double w0 = l * m[0], w1 = l * m[1], w2 = l * m[2], w3 = l * d;
+	q[0] += w0 * m[0], q[1] += w0 * m[1], q[2] += w0 * m[2], q[3] += w0 * d;
+	q[4] += w1 * m[1], q[5] += w1 * m[2], q[6] += w1 * d;
+	q[7] += w2 * m[2], q[8] += w2 * d;
+	q[9] += w3 * d;
 }
 
 /* The blended 3x4 matrix of pose p for influences inf. */
@@ -147,7 +151,11 @@ static inline double eval(const double *q, const double *x)
 #ifdef __SSE2__
 /* Two poses at a time (pair i: poses 2i and 2i + 1 in the low and high
  * lanes), each lane the same products and sums in the same order as the
- * one-pose functions above (SSE2 rounds as scalar code). */
+ * one-pose functions above (SSE2 rounds as scalar code).
+ * g->skin2 and the node quadrics (g->quadric, collapse.c's g->qsum) come
+ * from malloc, so their pairs (24 and 20 doubles) are 16-byte aligned:
+ * aligned loads, which the products take as memory operands. */
+_Static_assert(_Alignof(max_align_t) >= 16, "malloc's blocks must be 16-byte aligned for the two-pose loads");
 
 /* blend for both poses of pair i; inf has influences (joint_count > 0). */
 static inline void blend2(const mlod_bgm *g, size_t i, const mlod_influences *inf, __m128d *M)
@@ -159,50 +167,57 @@ static inline void blend2(const mlod_bgm *g, size_t i, const mlod_influences *in
 	for (int k = 0; k < inf->count; k++) {
 		const double *s = S + 24 * (size_t)inf->joints[k];
 		__m128d w = _mm_set1_pd((double)inf->weights[k]);
-		m0 = _mm_add_pd(m0, _mm_mul_pd(w, _mm_loadu_pd(s)));
-		m1 = _mm_add_pd(m1, _mm_mul_pd(w, _mm_loadu_pd(s + 2)));
-		m2 = _mm_add_pd(m2, _mm_mul_pd(w, _mm_loadu_pd(s + 4)));
-		m3 = _mm_add_pd(m3, _mm_mul_pd(w, _mm_loadu_pd(s + 6)));
-		m4 = _mm_add_pd(m4, _mm_mul_pd(w, _mm_loadu_pd(s + 8)));
-		m5 = _mm_add_pd(m5, _mm_mul_pd(w, _mm_loadu_pd(s + 10)));
-		m6 = _mm_add_pd(m6, _mm_mul_pd(w, _mm_loadu_pd(s + 12)));
-		m7 = _mm_add_pd(m7, _mm_mul_pd(w, _mm_loadu_pd(s + 14)));
-		m8 = _mm_add_pd(m8, _mm_mul_pd(w, _mm_loadu_pd(s + 16)));
-		m9 = _mm_add_pd(m9, _mm_mul_pd(w, _mm_loadu_pd(s + 18)));
-		m10 = _mm_add_pd(m10, _mm_mul_pd(w, _mm_loadu_pd(s + 20)));
-		m11 = _mm_add_pd(m11, _mm_mul_pd(w, _mm_loadu_pd(s + 22)));
+		m0 = _mm_add_pd(m0, _mm_mul_pd(w, _mm_load_pd(s)));
+		m1 = _mm_add_pd(m1, _mm_mul_pd(w, _mm_load_pd(s + 2)));
+		m2 = _mm_add_pd(m2, _mm_mul_pd(w, _mm_load_pd(s + 4)));
+		m3 = _mm_add_pd(m3, _mm_mul_pd(w, _mm_load_pd(s + 6)));
+		m4 = _mm_add_pd(m4, _mm_mul_pd(w, _mm_load_pd(s + 8)));
+		m5 = _mm_add_pd(m5, _mm_mul_pd(w, _mm_load_pd(s + 10)));
+		m6 = _mm_add_pd(m6, _mm_mul_pd(w, _mm_load_pd(s + 12)));
+		m7 = _mm_add_pd(m7, _mm_mul_pd(w, _mm_load_pd(s + 14)));
+		m8 = _mm_add_pd(m8, _mm_mul_pd(w, _mm_load_pd(s + 16)));
+		m9 = _mm_add_pd(m9, _mm_mul_pd(w, _mm_load_pd(s + 18)));
+		m10 = _mm_add_pd(m10, _mm_mul_pd(w, _mm_load_pd(s + 20)));
+		m11 = _mm_add_pd(m11, _mm_mul_pd(w, _mm_load_pd(s + 22)));
 	}
 	M[0] = m0, M[1] = m1, M[2] = m2, M[3] = m3, M[4] = m4, M[5] = m5;
 	M[6] = m6, M[7] = m7, M[8] = m8, M[9] = m9, M[10] = m10, M[11] = m11;
 }
 
-/* q's ten entries for poses 2i and 2i + 1. */
-static inline void qpairs(const double *q, size_t i, __m128d *a)
-{
-	const double *u = q + 20 * i, *v = u + 10;
-	a[0] = _mm_set_pd(v[0], u[0]), a[1] = _mm_set_pd(v[1], u[1]), a[2] = _mm_set_pd(v[2], u[2]);
-	a[3] = _mm_set_pd(v[3], u[3]), a[4] = _mm_set_pd(v[4], u[4]), a[5] = _mm_set_pd(v[5], u[5]);
-	a[6] = _mm_set_pd(v[6], u[6]), a[7] = _mm_set_pd(v[7], u[7]), a[8] = _mm_set_pd(v[8], u[8]);
-	a[9] = _mm_set_pd(v[9], u[9]);
-}
+/* Entry e of the node quadrics' pair u (poses 2i and 2i + 1 side by
+ * side, bgm_qat: u = q + 20 i), loaded where it is used, so that the
+ * products take it from memory (no copy of the pair). */
+#define QP(u, e) _mm_load_pd((u) + 2 * (e))
 
-
-/* eval for both poses (q: the 10 entries as pairs). */
-static inline __m128d eval2(const __m128d *q, const __m128d *x)
+/* eval for both poses (u: the pair's entries). */
+static inline __m128d eval2(const double *u, const __m128d *x)
 {
 	const __m128d two = _mm_set1_pd(2.0);
-	__m128d v = _mm_mul_pd(_mm_mul_pd(q[0], x[0]), x[0]);
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[1]), x[0]), x[1]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[2]), x[0]), x[2]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, q[3]), x[0]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(q[4], x[1]), x[1]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[5]), x[1]), x[2]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, q[6]), x[1]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(q[7], x[2]), x[2]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, q[8]), x[2]));
-	return _mm_add_pd(v, q[9]);
+	__m128d v = _mm_mul_pd(_mm_mul_pd(QP(u, 0), x[0]), x[0]);
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, QP(u, 1)), x[0]), x[1]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, QP(u, 2)), x[0]), x[2]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, QP(u, 3)), x[0]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(QP(u, 4), x[1]), x[1]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, QP(u, 5)), x[1]), x[2]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, QP(u, 6)), x[1]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(QP(u, 7), x[2]), x[2]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, QP(u, 8)), x[2]));
+	return _mm_add_pd(v, QP(u, 9));
 }
 #endif
+
+/* Pose p's 10 entries (in order, from a) into node quadrics d (P poses),
+ * where bgm_qat puts them. */
+static inline void qput(double *d, int P, int p, const double *a)
+{
+	if (p < (P & ~1)) {
+		d += 20 * (size_t)(p >> 1) + (size_t)(p & 1);
+		for (int e = 0; e < 10; e++)
+			d[2 * e] = a[e];
+	} else {
+		memcpy(d + 10 * (size_t)p, a, 10 * sizeof *d);
+	}
+}
 
 mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err)
 {
@@ -301,9 +316,11 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 				same = q;
 		}
 		if (same >= 0) {
-			for (int v = 0; v < g->node_count; v++)
-				memcpy(g->quadric + ((size_t)v * (size_t)P + (size_t)p) * 10,
-				       g->quadric + ((size_t)v * (size_t)P + (size_t)same) * 10, 10 * sizeof *g->quadric);
+			for (int v = 0; v < g->node_count; v++) {
+				double *d = g->quadric + (size_t)v * (size_t)P * 10, a[10];
+				bgm_quadric_get(d, P, same, a);
+				qput(d, P, p, a);
+			}
 			continue;
 		}
 		for (int v = 0; v < g->node_count; v++) {
@@ -370,13 +387,19 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 				int ends[2] = {F->n[e], F->n[(e + 1) % 3]};
 				for (int i = 0; i < 2; i++) {
 					double *Q = acc + (size_t)ends[i] * 10;
+#ifdef __SSE2__
+					/* two entries at a time, each the same sum */
+					for (int k = 0; k < 10; k += 2)
+						_mm_storeu_pd(Q + k, _mm_add_pd(_mm_loadu_pd(Q + k), _mm_loadu_pd(q2 + k)));
+#else
 					for (int k = 0; k < 10; k++)
 						Q[k] += q2[k];
+#endif
 				}
 			}
 		}
 		for (int v = 0; v < g->node_count; v++)
-			memcpy(g->quadric + ((size_t)v * (size_t)P + (size_t)p) * 10, acc + (size_t)v * 10, 10 * sizeof *acc);
+			qput(g->quadric + (size_t)v * (size_t)P * 10, P, p, acc + (size_t)v * 10);
 	}
 	free(used);
 	for (int v = 0; v < g->node_count; v++)
@@ -400,7 +423,7 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 		/* Two poses at a time; the sum and its stop test pose by pose. */
 		const __m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
 		for (; p + 1 < g->pose_count; p += 2) {
-			__m128d Mv[12], yv[3], qv[10];
+			__m128d Mv[12], yv[3];
 			size_t i = (size_t)p / 2;
 			blend2(g, i, inf, Mv);
 #define ROW(r) _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(Mv[4 * r], x0), _mm_mul_pd(Mv[4 * r + 1], x1)), \
@@ -408,9 +431,8 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
                          Mv[4 * r + 3])
 			yv[0] = ROW(0), yv[1] = ROW(1), yv[2] = ROW(2);
 #undef ROW
-			qpairs(q, i, qv);
 			double v[2];
-			_mm_storeu_pd(v, eval2(qv, yv));
+			_mm_storeu_pd(v, eval2(q + 20 * i, yv));
 			e += v[0] > 0.0 ? v[0] : 0.0;
 			if (e >= stop)
 				return HUGE_VAL;
@@ -421,9 +443,11 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 	}
 #endif
 	for (; p < g->pose_count; p++) {
+		double a[10];
+		bgm_quadric_get(q, g->pose_count, p, a);
 		blend(g, p, inf, M);
 		apply(M, x, y);
-		double v = eval(q + 10 * p, y);
+		double v = eval(a, y);
 		e += v > 0.0 ? v : 0.0;
 		if (e >= stop)
 			return HUGE_VAL;
@@ -435,8 +459,9 @@ void bgm_quadric_rest_reset(mlod_bgm *g, int v)
 {
 	const double *q = g->quadric + (size_t)v * (size_t)g->pose_count * 10;
 	double *r = g->rquad + (size_t)v * BGM_RQUAD, t = 0.0;
-	for (int p = 0; p < g->pose_count; p++)
-		t += q[10 * p] + q[10 * p + 4] + q[10 * p + 7];
+	int P = g->pose_count;
+	for (int p = 0; p < P; p++)
+		t += q[bgm_qat(P, p, 0)] + q[bgm_qat(P, p, 4)] + q[bgm_qat(P, p, 7)];
 	r[0] = NAN; /* not computed yet: bgm_quadric_rest */
 	r[10] = t;
 }
@@ -466,51 +491,63 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 #ifdef __SSE2__
 	if (g->skin2 && inf->count > 0) {
 		/* Two poses at a time, the terms added to H pose by pose. */
+		__m128d Hv[5];
+		for (int j = 0; j < 5; j++)
+			Hv[j] = _mm_setzero_pd();
 		for (; p + 1 < g->pose_count; p += 2) {
-			__m128d M[12], a[10];
+			__m128d M[12];
 			size_t i = (size_t)p / 2;
 			blend2(g, i, inf, M);
-			qpairs(q, i, a);
+			const double *u = q + 20 * i;
+#define a(e) QP(u, e)
 #define MUL(x, y) _mm_mul_pd(x, y)
 #define ADD(x, y) _mm_add_pd(x, y)
 #define DOT3(a0, m0, a1, m1, a2, m2) ADD(ADD(MUL(a0, m0), MUL(a1, m1)), MUL(a2, m2))
-			__m128d t00 = DOT3(a[0], M[0], a[1], M[4], a[2], M[8]);
-			__m128d t01 = DOT3(a[0], M[1], a[1], M[5], a[2], M[9]);
-			__m128d t02 = DOT3(a[0], M[2], a[1], M[6], a[2], M[10]);
-			__m128d t10 = DOT3(a[1], M[0], a[4], M[4], a[5], M[8]);
-			__m128d t11 = DOT3(a[1], M[1], a[4], M[5], a[5], M[9]);
-			__m128d t12 = DOT3(a[1], M[2], a[4], M[6], a[5], M[10]);
-			__m128d t20 = DOT3(a[2], M[0], a[5], M[4], a[7], M[8]);
-			__m128d t21 = DOT3(a[2], M[1], a[5], M[5], a[7], M[9]);
-			__m128d t22 = DOT3(a[2], M[2], a[5], M[6], a[7], M[10]);
-			__m128d t03 = ADD(DOT3(a[0], M[3], a[1], M[7], a[2], M[11]), a[3]);
-			__m128d t13 = ADD(DOT3(a[1], M[3], a[4], M[7], a[5], M[11]), a[6]);
-			__m128d t23 = ADD(DOT3(a[2], M[3], a[5], M[7], a[7], M[11]), a[8]);
-			__m128d t33 = ADD(DOT3(a[3], M[3], a[6], M[7], a[8], M[11]), a[9]);
-			double h[10][2];
-			_mm_storeu_pd(h[0], DOT3(M[0], t00, M[4], t10, M[8], t20));
-			_mm_storeu_pd(h[1], DOT3(M[0], t01, M[4], t11, M[8], t21));
-			_mm_storeu_pd(h[2], DOT3(M[0], t02, M[4], t12, M[8], t22));
-			_mm_storeu_pd(h[3], DOT3(M[0], t03, M[4], t13, M[8], t23));
-			_mm_storeu_pd(h[4], DOT3(M[1], t01, M[5], t11, M[9], t21));
-			_mm_storeu_pd(h[5], DOT3(M[1], t02, M[5], t12, M[9], t22));
-			_mm_storeu_pd(h[6], DOT3(M[1], t03, M[5], t13, M[9], t23));
-			_mm_storeu_pd(h[7], DOT3(M[2], t02, M[6], t12, M[10], t22));
-			_mm_storeu_pd(h[8], DOT3(M[2], t03, M[6], t13, M[10], t23));
-			_mm_storeu_pd(h[9], ADD(DOT3(M[3], t03, M[7], t13, M[11], t23), t33));
+			__m128d t00 = DOT3(a(0), M[0], a(1), M[4], a(2), M[8]);
+			__m128d t01 = DOT3(a(0), M[1], a(1), M[5], a(2), M[9]);
+			__m128d t02 = DOT3(a(0), M[2], a(1), M[6], a(2), M[10]);
+			__m128d t10 = DOT3(a(1), M[0], a(4), M[4], a(5), M[8]);
+			__m128d t11 = DOT3(a(1), M[1], a(4), M[5], a(5), M[9]);
+			__m128d t12 = DOT3(a(1), M[2], a(4), M[6], a(5), M[10]);
+			__m128d t20 = DOT3(a(2), M[0], a(5), M[4], a(7), M[8]);
+			__m128d t21 = DOT3(a(2), M[1], a(5), M[5], a(7), M[9]);
+			__m128d t22 = DOT3(a(2), M[2], a(5), M[6], a(7), M[10]);
+			__m128d t03 = ADD(DOT3(a(0), M[3], a(1), M[7], a(2), M[11]), a(3));
+			__m128d t13 = ADD(DOT3(a(1), M[3], a(4), M[7], a(5), M[11]), a(6));
+			__m128d t23 = ADD(DOT3(a(2), M[3], a(5), M[7], a(7), M[11]), a(8));
+			__m128d t33 = ADD(DOT3(a(3), M[3], a(6), M[7], a(8), M[11]), a(9));
+			__m128d h0 = DOT3(M[0], t00, M[4], t10, M[8], t20);
+			__m128d h1 = DOT3(M[0], t01, M[4], t11, M[8], t21);
+			__m128d h2 = DOT3(M[0], t02, M[4], t12, M[8], t22);
+			__m128d h3 = DOT3(M[0], t03, M[4], t13, M[8], t23);
+			__m128d h4 = DOT3(M[1], t01, M[5], t11, M[9], t21);
+			__m128d h5 = DOT3(M[1], t02, M[5], t12, M[9], t22);
+			__m128d h6 = DOT3(M[1], t03, M[5], t13, M[9], t23);
+			__m128d h7 = DOT3(M[2], t02, M[6], t12, M[10], t22);
+			__m128d h8 = DOT3(M[2], t03, M[6], t13, M[10], t23);
+			__m128d h9 = ADD(DOT3(M[3], t03, M[7], t13, M[11], t23), t33);
+			/* H[e] += pose 2i's term, then += pose 2i + 1's: two entries
+			 * of H to a register (Hv[j] = H[2j], H[2j + 1]), the terms
+			 * regrouped to match (unpacklo: both entries' pose 2i terms) */
+#define ACC(j, x, y) Hv[j] = ADD(ADD(Hv[j], _mm_unpacklo_pd(x, y)), _mm_unpackhi_pd(x, y))
+			ACC(0, h0, h1);
+			ACC(1, h2, h3);
+			ACC(2, h4, h5);
+			ACC(3, h6, h7);
+			ACC(4, h8, h9);
+#undef ACC
+#undef a
 #undef DOT3
 #undef ADD
 #undef MUL
-			H[0] += h[0][0], H[1] += h[1][0], H[2] += h[2][0], H[3] += h[3][0], H[4] += h[4][0];
-			H[5] += h[5][0], H[6] += h[6][0], H[7] += h[7][0], H[8] += h[8][0], H[9] += h[9][0];
-			H[0] += h[0][1], H[1] += h[1][1], H[2] += h[2][1], H[3] += h[3][1], H[4] += h[4][1];
-			H[5] += h[5][1], H[6] += h[6][1], H[7] += h[7][1], H[8] += h[8][1], H[9] += h[9][1];
 		}
+		for (int j = 0; j < 5; j++)
+			_mm_storeu_pd(H + 2 * j, Hv[j]);
 	}
 #endif
 	for (; p < g->pose_count; p++) {
-		double M[12];
-		const double *a = q + 10 * p;
+		double M[12], a[10];
+		bgm_quadric_get(q, g->pose_count, p, a);
 		blend(g, p, inf, M);
 		double t00 = a[0] * M[0] + a[1] * M[4] + a[2] * M[8];
 		double t01 = a[0] * M[1] + a[1] * M[5] + a[2] * M[9];

@@ -862,7 +862,8 @@ static double ref_error(const mlod_bgm *g, const double *q, const mlod_influence
 		ref_blend(g, p, inf, M);
 		for (int r = 0; r < 3; r++)
 			y[r] = M[4 * r] * x[0] + M[4 * r + 1] * x[1] + M[4 * r + 2] * x[2] + M[4 * r + 3];
-		const double *a = q + 10 * p;
+		double a[10];
+		bgm_quadric_get(q, g->pose_count, p, a);
 		double v = a[0] * y[0] * y[0] + 2 * a[1] * y[0] * y[1] + 2 * a[2] * y[0] * y[2] + 2 * a[3] * y[0] +
 		           a[4] * y[1] * y[1] + 2 * a[5] * y[1] * y[2] + 2 * a[6] * y[1] + a[7] * y[2] * y[2] + 2 * a[8] * y[2] + a[9];
 		e += v > 0.0 ? v : 0.0;
@@ -876,8 +877,8 @@ static void ref_pullback(const mlod_bgm *g, const double *q, const mlod_influenc
 {
 	memset(H, 0, 10 * sizeof *H);
 	for (int p = 0; p < g->pose_count; p++) {
-		double M[12], T[3][4];
-		const double *a = q + 10 * p;
+		double M[12], T[3][4], a[10];
+		bgm_quadric_get(q, g->pose_count, p, a);
 		/* the packed quadric as a symmetric 4x4 */
 		double A[4][4] = {{a[0], a[1], a[2], a[3]}, {a[1], a[4], a[5], a[6]}, {a[2], a[5], a[7], a[8]}, {a[3], a[6], a[8], a[9]}};
 		ref_blend(g, p, inf, M);
