@@ -1275,32 +1275,34 @@ static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int
 	const double *S = g->skin2 + p / 2 * (size_t)J * 24;
 	const __m128d bx = _mm_set1_pd(bary[0]), by = _mm_set1_pd(bary[1]), bz = _mm_set1_pd(bary[2]);
 	const __m128d zero = _mm_setzero_pd();
-	__m128d z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {zero, zero, zero};
+	/* Three rows and sums in registers; |z_j|^2 and its running maximum as
+	 * the joints come (it needs no c). A square is +0 or above, or NaN, so
+	 * the sums of three squares are the ones from 0 (0 + x x = x x). */
+	__m128d z[3 * MLOD_MAX_INFLUENCES][3], c0 = zero, c1 = zero, c2 = zero, far = zero;
 	for (int j = 0; j < nj; j++) {
 		const double *m = S + 24 * (size_t)joint[j];
-		for (int i = 0; i < 3; i++) {
-			const double *row = m + 8 * i;
-			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_load_pd(row), bx), _mm_mul_pd(_mm_load_pd(row + 2), by));
-			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_load_pd(row + 4), bz)), _mm_load_pd(row + 6));
-			z[j][i] = t;
-			c[i] = _mm_add_pd(c[i], t);
-		}
+#define ROW(i) _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_load_pd(m + 8 * (i)), bx), \
+                                                _mm_mul_pd(_mm_load_pd(m + 8 * (i) + 2), by)), \
+                                     _mm_mul_pd(_mm_load_pd(m + 8 * (i) + 4), bz)), \
+                          _mm_load_pd(m + 8 * (i) + 6))
+		__m128d z0 = ROW(0), z1 = ROW(1), z2 = ROW(2);
+#undef ROW
+		z[j][0] = z0, z[j][1] = z1, z[j][2] = z2;
+		c0 = _mm_add_pd(c0, z0), c1 = _mm_add_pd(c1, z1), c2 = _mm_add_pd(c2, z2);
+		__m128d a = _mm_add_pd(_mm_add_pd(_mm_mul_pd(z0, z0), _mm_mul_pd(z1, z1)), _mm_mul_pd(z2, z2));
+		/* max_d(far, a): a is +0 or above, or NaN (then far, never NaN,
+		 * stays, as maxpd gives its second operand) */
+		far = _mm_max_pd(a, far);
 	}
 	const __m128d vinv = _mm_set1_pd(inv);
-	for (int i = 0; i < 3; i++)
-		c[i] = _mm_mul_pd(c[i], vinv);
-	__m128d spread = zero, far = zero;
+	c0 = _mm_mul_pd(c0, vinv), c1 = _mm_mul_pd(c1, vinv), c2 = _mm_mul_pd(c2, vinv);
+	__m128d c[3] = {c0, c1, c2};
+	__m128d spread = zero;
 	for (int j = 0; j < nj; j++) {
-		__m128d d = zero, a = zero;
-		for (int i = 0; i < 3; i++) {
-			__m128d x = _mm_sub_pd(z[j][i], c[i]);
-			d = _mm_add_pd(d, _mm_mul_pd(x, x));
-			a = _mm_add_pd(a, _mm_mul_pd(z[j][i], z[j][i]));
-		}
-		/* max_d(spread, d): d is +0 or above, or NaN (then spread, never
-		 * NaN, stays, as maxpd gives its second operand) */
+		__m128d x0 = _mm_sub_pd(z[j][0], c0), x1 = _mm_sub_pd(z[j][1], c1), x2 = _mm_sub_pd(z[j][2], c2);
+		__m128d d = _mm_add_pd(_mm_add_pd(_mm_mul_pd(x0, x0), _mm_mul_pd(x1, x1)), _mm_mul_pd(x2, x2));
+		/* max_d(spread, d), as far above */
 		spread = _mm_max_pd(d, spread);
-		far = _mm_max_pd(a, far);
 	}
 	const __m128d vrl = _mm_set1_pd(rl);
 	__m128d R = _mm_add_pd(_mm_mul_pd(_mm_add_pd(_mm_sqrt_pd(spread), vrl), _mm_set1_pd(1.0 + 1e-6)),
