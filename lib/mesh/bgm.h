@@ -104,9 +104,9 @@ struct mlod_bgm {
 	                         * over poses of their traces */
 	double *skin2;          /* the skin matrices as doubles, two poses side by side: per
 	                         * pair of poses (2i, 2i + 1) and influence id, 12 entries of
-	                         * 2 doubles (pose 2i, then 2i + 1); pose_count / 2 pairs (a
-	                         * last odd pose is not in it); NULL when there are none or
-	                         * for a mesh without influences */
+	                         * 2 doubles (pose 2i, then 2i + 1); pose_count / 2 pairs,
+	                         * then for a last odd pose a block with it in both lanes;
+	                         * NULL when there are none or for a mesh without influences */
 	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
 	double skin_norm;       /* collapse.c: the largest Frobenius norm of a skin matrix's
 	                         * linear part, 0 until worked out */

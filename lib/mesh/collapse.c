@@ -1267,12 +1267,13 @@ static inline __m128d abs_pd2(__m128d x)
  * done whatever the tests: val, tr and det per pose, for the caller to
  * test as pose_min_bound does. */
 static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int nj, const double *const qv[3], int k,
-                                   size_t p, const double *bary, double rl, double inv, double *val_out,
+                                   size_t i2, const double *bary, double rl, double inv, double *val_out,
                                    double *tr_out, double *det_out)
 {
 	int J = g->joint_count;
-	/* g->skin2: the skin matrices as doubles, poses p and p + 1 side by side */
-	const double *S = g->skin2 + p / 2 * (size_t)J * 24;
+	/* g->skin2: the skin matrices as doubles, poses p and p + 1 side by side
+	 * (block i2 = p / 2); qv: the k vertices' quadrics of that pair */
+	const double *S = g->skin2 + i2 * (size_t)J * 24;
 	const __m128d bx = _mm_set1_pd(bary[0]), by = _mm_set1_pd(bary[1]), bz = _mm_set1_pd(bary[2]);
 	const __m128d zero = _mm_setzero_pd();
 	/* Three rows and sums in registers; |z_j|^2 and its running maximum as
@@ -1309,16 +1310,16 @@ static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int
 	                       _mm_mul_pd(_mm_set1_pd(1e-6), _mm_add_pd(_mm_sqrt_pd(far), vrl)));
 	__m128d q[10];
 	/* poses p and p + 1 side by side (bgm_qat): entry e at 2 e */
-	const double *a0 = qv[0] + 10 * p;
+	const double *a0 = qv[0];
 	if (k == 1) {
 		for (int e = 0; e < 10; e++)
 			q[e] = _mm_load_pd(a0 + 2 * e);
 	} else if (k == 2) {
-		const double *a1 = qv[1] + 10 * p;
+		const double *a1 = qv[1];
 		for (int e = 0; e < 10; e++)
 			q[e] = _mm_add_pd(_mm_load_pd(a0 + 2 * e), _mm_load_pd(a1 + 2 * e));
 	} else {
-		const double *a1 = qv[1] + 10 * p, *a2 = qv[2] + 10 * p;
+		const double *a1 = qv[1], *a2 = qv[2];
 		for (int e = 0; e < 10; e++)
 			q[e] = _mm_add_pd(_mm_add_pd(_mm_load_pd(a0 + 2 * e), _mm_load_pd(a1 + 2 * e)), _mm_load_pd(a2 + 2 * e));
 	}
@@ -1429,12 +1430,30 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 	 * one: every lane the same products, sums and tests, in the same
 	 * order, as pose_min_bound's (SSE2 rounds as scalar code), and the
 	 * poses' terms added in pose order. */
-	for (; g->skin2 && p + 1 < P; p += 2) {
-		double val[2], tr[2], det[2];
-		pose_min_bound2(g, joint, nj, qv, k, p, bary, rl, inv, val, tr, det);
-		for (int l = 0; l < 2; l++)
-			if (tr[l] > 0.0 && isfinite(tr[l]) && fabs(det[l]) > 0.0 && val[l] > 0.0 && isfinite(val[l]))
-				lb += val[l];
+	if (g->skin2) {
+		/* A last odd pose the same way, in both lanes (its own g->skin2
+		 * block, the vertices' entries doubled in last), the low lane
+		 * taken. */
+		size_t pairs = P / 2, n = (P + 1) / 2;
+		_Alignas(16) double last[3][20];
+		const double *ql[3];
+		if (P & 1)
+			for (int i = 0; i < k; i++) {
+				for (int e = 0; e < 10; e++)
+					last[i][2 * e] = last[i][2 * e + 1] = qv[i][20 * pairs + (size_t)e];
+				ql[i] = last[i];
+			}
+		for (size_t i2 = 0; i2 < n; i2++) {
+			double val[2], tr[2], det[2];
+			const double *qp[3];
+			for (int i = 0; i < k; i++)
+				qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
+			pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv, val, tr, det);
+			for (int l = 0; l < (i2 < pairs ? 2 : 1); l++)
+				if (tr[l] > 0.0 && isfinite(tr[l]) && fabs(det[l]) > 0.0 && val[l] > 0.0 && isfinite(val[l]))
+					lb += val[l];
+		}
+		p = P;
 	}
 #endif
 	for (; p < P; p++) {

@@ -273,15 +273,16 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	/* The same matrices as doubles, two poses side by side (the two-pose
 	 * paths of bgm_quadric_error, bgm_quadric_pullback and collapse.c). */
 	if (g->joint_count > 0 && P >= 2) {
-		size_t pairs = (size_t)P / 2;
-		g->skin2 = malloc(sizeof(double) * 24 * (size_t)J * pairs);
+		/* A last odd pose has a block of its own, itself in both lanes. */
+		size_t pairs = (size_t)P / 2, blocks = ((size_t)P + 1) / 2;
+		g->skin2 = malloc(sizeof(double) * 24 * (size_t)J * blocks);
 		if (!g->skin2) {
 			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
 			goto done;
 		}
-		for (size_t i = 0; i < pairs; i++)
+		for (size_t i = 0; i < blocks; i++)
 			for (int k = 0; k < J; k++) {
-				const float *a = g->skin + (2 * i * (size_t)J + (size_t)k) * 12, *b = a + (size_t)J * 12;
+				const float *a = g->skin + (2 * i * (size_t)J + (size_t)k) * 12, *b = i < pairs ? a + (size_t)J * 12 : a;
 				double *d = g->skin2 + (i * (size_t)J + (size_t)k) * 24;
 				for (int e = 0; e < 12; e++)
 					d[2 * e] = a[e], d[2 * e + 1] = b[e];
@@ -422,24 +423,33 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 	if (g->skin2 && inf->count > 0) {
 		/* Two poses at a time; the sum and its stop test pose by pose. */
 		const __m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
-		for (; p + 1 < g->pose_count; p += 2) {
+		/* A last odd pose the same way, in both lanes (its own g->skin2
+		 * block, its entries doubled in last), the low lane taken. */
+		int P = g->pose_count, pairs = P / 2, n = (P + 1) / 2;
+		_Alignas(16) double last[20];
+		if (P & 1)
+			for (int k = 0; k < 10; k++)
+				last[2 * k] = last[2 * k + 1] = q[10 * (size_t)pairs * 2 + (size_t)k];
+		for (int i = 0; i < n; i++) {
 			__m128d Mv[12], yv[3];
-			size_t i = (size_t)p / 2;
-			blend2(g, i, inf, Mv);
+			blend2(g, (size_t)i, inf, Mv);
 #define ROW(r) _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(Mv[4 * r], x0), _mm_mul_pd(Mv[4 * r + 1], x1)), \
                                     _mm_mul_pd(Mv[4 * r + 2], x2)), \
                          Mv[4 * r + 3])
 			yv[0] = ROW(0), yv[1] = ROW(1), yv[2] = ROW(2);
 #undef ROW
 			double v[2];
-			_mm_storeu_pd(v, eval2(q + 20 * i, yv));
+			_mm_storeu_pd(v, eval2(i < pairs ? q + 20 * (size_t)i : last, yv));
 			e += v[0] > 0.0 ? v[0] : 0.0;
 			if (e >= stop)
 				return HUGE_VAL;
+			if (i == pairs)
+				break;
 			e += v[1] > 0.0 ? v[1] : 0.0;
 			if (e >= stop)
 				return HUGE_VAL;
 		}
+		return e;
 	}
 #endif
 	for (; p < g->pose_count; p++) {
@@ -491,14 +501,20 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 #ifdef __SSE2__
 	if (g->skin2 && inf->count > 0) {
 		/* Two poses at a time, the terms added to H pose by pose. */
+		/* A last odd pose the same way, in both lanes (its own g->skin2
+		 * block, its entries doubled in last), the low lane taken. */
+		int P = g->pose_count, pairs = P / 2, n = (P + 1) / 2;
+		_Alignas(16) double last[20];
+		if (P & 1)
+			for (int k = 0; k < 10; k++)
+				last[2 * k] = last[2 * k + 1] = q[10 * (size_t)pairs * 2 + (size_t)k];
 		__m128d Hv[5];
 		for (int j = 0; j < 5; j++)
 			Hv[j] = _mm_setzero_pd();
-		for (; p + 1 < g->pose_count; p += 2) {
+		for (int i = 0; i < n; i++) {
 			__m128d M[12];
-			size_t i = (size_t)p / 2;
-			blend2(g, i, inf, M);
-			const double *u = q + 20 * i;
+			blend2(g, (size_t)i, inf, M);
+			const double *u = i < pairs ? q + 20 * (size_t)i : last;
 #define a(e) QP(u, e)
 #define MUL(x, y) _mm_mul_pd(x, y)
 #define ADD(x, y) _mm_add_pd(x, y)
@@ -530,11 +546,21 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 			 * of H to a register (Hv[j] = H[2j], H[2j + 1]), the terms
 			 * regrouped to match (unpacklo: both entries' pose 2i terms) */
 #define ACC(j, x, y) Hv[j] = ADD(ADD(Hv[j], _mm_unpacklo_pd(x, y)), _mm_unpackhi_pd(x, y))
-			ACC(0, h0, h1);
-			ACC(1, h2, h3);
-			ACC(2, h4, h5);
-			ACC(3, h6, h7);
-			ACC(4, h8, h9);
+#define ACC1(j, x, y) Hv[j] = ADD(Hv[j], _mm_unpacklo_pd(x, y))
+			if (i < pairs) {
+				ACC(0, h0, h1);
+				ACC(1, h2, h3);
+				ACC(2, h4, h5);
+				ACC(3, h6, h7);
+				ACC(4, h8, h9);
+			} else {
+				ACC1(0, h0, h1);
+				ACC1(1, h2, h3);
+				ACC1(2, h4, h5);
+				ACC1(3, h6, h7);
+				ACC1(4, h8, h9);
+			}
+#undef ACC1
 #undef ACC
 #undef a
 #undef DOT3
@@ -543,6 +569,7 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 		}
 		for (int j = 0; j < 5; j++)
 			_mm_storeu_pd(H + 2 * j, Hv[j]);
+		p = P;
 	}
 #endif
 	for (; p < g->pose_count; p++) {
