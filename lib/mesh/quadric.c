@@ -219,6 +219,174 @@ static inline void qput(double *d, int P, int p, const double *a)
 	}
 }
 
+#ifdef __SSE2__
+/* bgm_face_normal for both lanes. */
+static inline void normal2(const __m128d *a, const __m128d *b, const __m128d *c, __m128d *n)
+{
+	__m128d u0 = _mm_sub_pd(b[0], a[0]), u1 = _mm_sub_pd(b[1], a[1]), u2 = _mm_sub_pd(b[2], a[2]);
+	__m128d v0 = _mm_sub_pd(c[0], a[0]), v1 = _mm_sub_pd(c[1], a[1]), v2 = _mm_sub_pd(c[2], a[2]);
+	n[0] = _mm_sub_pd(_mm_mul_pd(u1, v2), _mm_mul_pd(u2, v1));
+	n[1] = _mm_sub_pd(_mm_mul_pd(u2, v0), _mm_mul_pd(u0, v2));
+	n[2] = _mm_sub_pd(_mm_mul_pd(u0, v1), _mm_mul_pd(u1, v0));
+}
+
+static inline __m128d dot2(const __m128d *a, const __m128d *b)
+{
+	return _mm_add_pd(_mm_add_pd(_mm_mul_pd(a[0], b[0]), _mm_mul_pd(a[1], b[1])), _mm_mul_pd(a[2], b[2]));
+}
+
+/* q[k] = w_i P_j (P = (n, d), w = s P) in the lanes of keep, +0 in the
+ * others: plane_quadric's and edge_quadric's terms. */
+static inline void terms2(__m128d s, const __m128d *n, __m128d d, __m128d keep, __m128d *q)
+{
+	__m128d w0 = _mm_mul_pd(s, n[0]), w1 = _mm_mul_pd(s, n[1]), w2 = _mm_mul_pd(s, n[2]), w3 = _mm_mul_pd(s, d);
+	q[0] = _mm_and_pd(keep, _mm_mul_pd(w0, n[0])), q[1] = _mm_and_pd(keep, _mm_mul_pd(w0, n[1]));
+	q[2] = _mm_and_pd(keep, _mm_mul_pd(w0, n[2])), q[3] = _mm_and_pd(keep, _mm_mul_pd(w0, d));
+	q[4] = _mm_and_pd(keep, _mm_mul_pd(w1, n[1])), q[5] = _mm_and_pd(keep, _mm_mul_pd(w1, n[2]));
+	q[6] = _mm_and_pd(keep, _mm_mul_pd(w1, d));
+	q[7] = _mm_and_pd(keep, _mm_mul_pd(w2, n[2])), q[8] = _mm_and_pd(keep, _mm_mul_pd(w2, d));
+	q[9] = _mm_and_pd(keep, _mm_mul_pd(w3, d));
+}
+
+/* edge_quadric for both lanes, added to q in the lanes of keep (where
+ * the edge is a feature). */
+static inline void edge2(const __m128d *a, const __m128d *b, const __m128d *n, __m128d keep, __m128d *q)
+{
+	__m128d e[3] = {_mm_sub_pd(b[0], a[0]), _mm_sub_pd(b[1], a[1]), _mm_sub_pd(b[2], a[2])}, m[3];
+	m[0] = _mm_sub_pd(_mm_mul_pd(e[1], n[2]), _mm_mul_pd(e[2], n[1]));
+	m[1] = _mm_sub_pd(_mm_mul_pd(e[2], n[0]), _mm_mul_pd(e[0], n[2]));
+	m[2] = _mm_sub_pd(_mm_mul_pd(e[0], n[1]), _mm_mul_pd(e[1], n[0]));
+	__m128d len = _mm_sqrt_pd(dot2(m, m)), l2 = dot2(e, e);
+	keep = _mm_and_pd(keep, _mm_cmpgt_pd(len, _mm_setzero_pd()));
+	for (int i = 0; i < 3; i++)
+		m[i] = _mm_div_pd(m[i], len);
+	__m128d d = _mm_xor_pd(dot2(m, a), _mm_set1_pd(-0.0)), t[10];
+	terms2(_mm_mul_pd(_mm_set1_pd(FEATURE_WEIGHT), l2), m, d, keep, t);
+	for (int k = 0; k < 10; k++)
+		q[k] = _mm_add_pd(q[k], t[k]);
+}
+
+/* The quadrics of poses pa (low lane) and pb (high lane; pb = pa for a
+ * pose alone) into g->quadric: the one-pose loop of bgm_quadrics_build
+ * in two lanes, every lane the same products, sums and tests in the same
+ * order (SSE2 rounds as scalar code; a face's plane that one-pose code
+ * leaves out, a plane added as +0 instead of a -0, an edge that is no
+ * feature in a lane, add +0 there, which leaves each sum as it was: a
+ * sum from +0 is never -0). sk: 24 J doubles; posed: 3 per node; fn: 4
+ * per face; acc: 10 per node. */
+static void quadrics_pair(mlod_bgm *g, int pa, int pb, double *sk, __m128d *posed, __m128d *fn, __m128d *acc)
+{
+	int J = g->joint_count, P = g->pose_count;
+	for (int k = 0; k < J; k++) {
+		const float *a = g->skin + ((size_t)pa * (size_t)J + (size_t)k) * 12;
+		const float *b = g->skin + ((size_t)pb * (size_t)J + (size_t)k) * 12;
+		double *d = sk + (size_t)k * 24;
+		for (int e = 0; e < 12; e++)
+			d[2 * e] = a[e], d[2 * e + 1] = b[e];
+	}
+	const __m128d zero = _mm_setzero_pd();
+	for (int v = 0; v < g->node_count; v++) {
+		const mlod_influences *inf = &g->inf[v];
+		__m128d M[12];
+		if (inf->count == 0) {
+			for (int i = 0; i < 12; i++)
+				M[i] = _mm_set1_pd(i % 5 == 0 ? 1.0 : 0.0);
+		} else {
+			for (int i = 0; i < 12; i++)
+				M[i] = zero;
+			for (int k = 0; k < inf->count; k++) {
+				const double *s = sk + 24 * (size_t)inf->joints[k];
+				__m128d w = _mm_set1_pd((double)inf->weights[k]);
+				for (int i = 0; i < 12; i++)
+					M[i] = _mm_add_pd(M[i], _mm_mul_pd(w, _mm_load_pd(s + 2 * i)));
+			}
+		}
+		const double *x = g->nodes[v].p;
+		__m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
+		for (int r = 0; r < 3; r++)
+			posed[3 * v + r] = _mm_add_pd(
+			        _mm_add_pd(_mm_add_pd(_mm_mul_pd(M[4 * r], x0), _mm_mul_pd(M[4 * r + 1], x1)), _mm_mul_pd(M[4 * r + 2], x2)),
+			        M[4 * r + 3]);
+	}
+	/* Every face's normal and its length (the one-pose loop works each
+	 * out once, when first needed: the same values). */
+	for (int f = 0; f < g->face_count; f++) {
+		const bgm_face *F = &g->faces[f];
+		__m128d *n = fn + 4 * f;
+		normal2(posed + 3 * F->n[0], posed + 3 * F->n[1], posed + 3 * F->n[2], n);
+		n[3] = _mm_sqrt_pd(dot2(n, n));
+	}
+	for (size_t i = 0; i < 10 * (size_t)g->node_count; i++)
+		acc[i] = zero;
+	const __m128d all = _mm_castsi128_pd(_mm_set1_epi32(-1)), half = _mm_set1_pd(0.5);
+	const __m128d cosf = _mm_set1_pd(FEATURE_COS);
+	for (int f = 0; f < g->face_count; f++) {
+		const bgm_face *F = &g->faces[f];
+		const __m128d *nf = fn + 4 * f, *a0 = posed + 3 * F->n[0];
+		/* plane_quadric */
+		__m128d q[10], len = nf[3];
+		__m128d n[3] = {_mm_div_pd(nf[0], len), _mm_div_pd(nf[1], len), _mm_div_pd(nf[2], len)};
+		__m128d d = _mm_xor_pd(dot2(n, a0), _mm_set1_pd(-0.0));
+		terms2(_mm_mul_pd(half, len), n, d, _mm_cmpgt_pd(len, zero), q);
+		for (int i = 0; i < 3; i++) {
+			__m128d *Q = acc + (size_t)F->n[i] * 10;
+			for (int k = 0; k < 10; k++)
+				Q[k] = _mm_add_pd(Q[k], q[k]);
+		}
+		for (int e = 0; e < 3; e++) {
+			int h = F->adj[e];
+			if (h >= 0 && h < f)
+				continue; /* each interior edge once */
+			const __m128d *a = posed + 3 * F->n[e], *b = posed + 3 * F->n[(e + 1) % 3];
+			const __m128d *o = posed + 3 * F->n[(e + 2) % 3];
+			__m128d n1[3], keep = all;
+			if (e == 0)
+				n1[0] = nf[0], n1[1] = nf[1], n1[2] = nf[2];
+			else
+				normal2(a, b, o, n1);
+			const __m128d *c = NULL;
+			if (h >= 0) {
+				c = fn + 4 * h;
+				__m128d l1 = e == 0 ? nf[3] : _mm_sqrt_pd(dot2(n1, n1)), l2 = c[3];
+				keep = _mm_and_pd(_mm_cmpgt_pd(l1, zero), _mm_cmpgt_pd(l2, zero));
+				keep = _mm_andnot_pd(_mm_cmpgt_pd(dot2(n1, c), _mm_mul_pd(_mm_mul_pd(cosf, l1), l2)), keep);
+				if (_mm_movemask_pd(keep) == 0)
+					continue;
+			}
+			__m128d q2[10];
+			for (int k = 0; k < 10; k++)
+				q2[k] = zero;
+			edge2(a, b, n1, keep, q2);
+			if (c)
+				edge2(a, b, c, keep, q2);
+			int ends[2] = {F->n[e], F->n[(e + 1) % 3]};
+			for (int i = 0; i < 2; i++) {
+				__m128d *Q = acc + (size_t)ends[i] * 10;
+				for (int k = 0; k < 10; k++)
+					Q[k] = _mm_add_pd(Q[k], q2[k]);
+			}
+		}
+	}
+	/* Out: a pair (2i, 2i + 1) as it lies (bgm_qat), else lane by lane. */
+	for (int v = 0; v < g->node_count; v++) {
+		double *dst = g->quadric + (size_t)v * (size_t)P * 10;
+		const __m128d *A = acc + (size_t)v * 10;
+		if (pb == pa + 1 && (pa & 1) == 0) {
+			dst += 10 * (size_t)pa;
+			for (int k = 0; k < 10; k++)
+				_mm_store_pd(dst + 2 * k, A[k]);
+		} else {
+			double lo[10], hi[10];
+			for (int k = 0; k < 10; k++)
+				_mm_storel_pd(lo + k, A[k]), _mm_storeh_pd(hi + k, A[k]);
+			qput(dst, P, pa, lo);
+			if (pb != pa)
+				qput(dst, P, pb, hi);
+		}
+	}
+}
+#endif
+
 mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err)
 {
 	const mlod_skeleton *s = &c->skeleton;
@@ -304,26 +472,74 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	 * A pose whose used skin matrices are bit for bit an earlier pose's
 	 * (a rigid part or a joint the clip leaves still) has that pose's
 	 * quadrics, every step being the same arithmetic on the same values:
-	 * they are copied. */
+	 * they are copied (from the first such pose). */
+	int *same = malloc(sizeof(int) * (size_t)P);
+	if (!same) {
+		free(used);
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+		goto done;
+	}
 	for (int p = 0; p < P; p++) {
-		double M[12];
-		int same = -1;
-		for (int q = 0; q < p && same < 0; q++) {
+		same[p] = -1;
+		for (int q = 0; q < p && same[p] < 0; q++) {
 			const float *a = g->skin + (size_t)p * (size_t)J * 12, *b = g->skin + (size_t)q * (size_t)J * 12;
 			int eq = 1;
 			for (int j = 0; j < J && eq; j++)
 				eq = !used[j] || memcmp(a + 12 * (size_t)j, b + 12 * (size_t)j, 12 * sizeof *a) == 0;
 			if (eq)
-				same = q;
+				same[p] = q;
 		}
-		if (same >= 0) {
+	}
+	free(used);
+	int paired = 0;
+#ifdef __SSE2__
+	/* Two poses at a time (quadrics_pair): the poses to work out, in
+	 * order, two by two, a last one alone. */
+	if (g->joint_count > 0 && P >= 2) {
+		double *sk = malloc(sizeof(double) * 24 * (size_t)J);
+		__m128d *posed2 = malloc(sizeof(__m128d) * 3 * (size_t)g->node_count + 16);
+		__m128d *fn2 = malloc(sizeof(__m128d) * 4 * (size_t)g->face_count + 16);
+		__m128d *acc2 = malloc(sizeof(__m128d) * 10 * (size_t)g->node_count + 16);
+		if (sk && posed2 && fn2 && acc2) {
+			int pend = -1;
+			for (int p = 0; p < P; p++) {
+				if (same[p] >= 0)
+					continue;
+				if (pend < 0) {
+					pend = p;
+				} else {
+					quadrics_pair(g, pend, p, sk, posed2, fn2, acc2);
+					pend = -1;
+				}
+			}
+			if (pend >= 0)
+				quadrics_pair(g, pend, pend, sk, posed2, fn2, acc2);
+			paired = 1;
+		}
+		free(sk);
+		free(posed2);
+		free(fn2);
+		free(acc2);
+		if (!paired) {
+			free(same);
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+			goto done;
+		}
+	}
+#endif
+	for (int p = 0; p < P; p++) {
+		double M[12];
+		if (same[p] >= 0) {
+			/* in pose order: same[p] < p is written by now */
 			for (int v = 0; v < g->node_count; v++) {
 				double *d = g->quadric + (size_t)v * (size_t)P * 10, a[10];
-				bgm_quadric_get(d, P, same, a);
+				bgm_quadric_get(d, P, same[p], a);
 				qput(d, P, p, a);
 			}
 			continue;
 		}
+		if (paired)
+			continue;
 		for (int v = 0; v < g->node_count; v++) {
 			blend(g, p, &g->inf[v], M);
 			apply(M, g->nodes[v].p, posed + 3 * v);
@@ -402,7 +618,7 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 		for (int v = 0; v < g->node_count; v++)
 			qput(g->quadric + (size_t)v * (size_t)P * 10, P, p, acc + (size_t)v * 10);
 	}
-	free(used);
+	free(same);
 	for (int v = 0; v < g->node_count; v++)
 		bgm_quadric_rest_reset(g, v);
 done:
