@@ -158,9 +158,17 @@ static inline double eval(const double *q, const double *x)
 _Static_assert(_Alignof(max_align_t) >= 16, "malloc's blocks must be 16-byte aligned for the two-pose loads");
 
 /* blend for both poses of pair i; inf has influences (joint_count > 0). */
+static inline void blend2s(const double *S, const mlod_influences *inf, __m128d *M);
+
 static inline void blend2(const mlod_bgm *g, size_t i, const mlod_influences *inf, __m128d *M)
 {
-	const double *S = g->skin2 + i * (size_t)g->joint_count * 24;
+	blend2s(g->skin2 + i * (size_t)g->joint_count * 24, inf, M);
+}
+
+/* blend2 on the block S of two poses' skin matrices (24 doubles per
+ * influence id). */
+static inline void blend2s(const double *S, const mlod_influences *inf, __m128d *M)
+{
 	/* Written out, so that the twelve sums stay in registers. */
 	__m128d m0 = _mm_setzero_pd(), m1 = m0, m2 = m0, m3 = m0, m4 = m0, m5 = m0, m6 = m0, m7 = m0, m8 = m0,
 	        m9 = m0, m10 = m0, m11 = m0;
@@ -220,6 +228,16 @@ static inline void qput(double *d, int P, int p, const double *a)
 }
 
 #ifdef __SSE2__
+/* Q[k] += q[k], k = 0..9, written out. */
+#define ADD10(Q, q) \
+	do { \
+		(Q)[0] = _mm_add_pd((Q)[0], (q)[0]), (Q)[1] = _mm_add_pd((Q)[1], (q)[1]); \
+		(Q)[2] = _mm_add_pd((Q)[2], (q)[2]), (Q)[3] = _mm_add_pd((Q)[3], (q)[3]); \
+		(Q)[4] = _mm_add_pd((Q)[4], (q)[4]), (Q)[5] = _mm_add_pd((Q)[5], (q)[5]); \
+		(Q)[6] = _mm_add_pd((Q)[6], (q)[6]), (Q)[7] = _mm_add_pd((Q)[7], (q)[7]); \
+		(Q)[8] = _mm_add_pd((Q)[8], (q)[8]), (Q)[9] = _mm_add_pd((Q)[9], (q)[9]); \
+	} while (0)
+
 /* bgm_face_normal for both lanes. */
 static inline void normal2(const __m128d *a, const __m128d *b, const __m128d *c, __m128d *n)
 {
@@ -262,8 +280,7 @@ static inline void edge2(const __m128d *a, const __m128d *b, const __m128d *n, _
 		m[i] = _mm_div_pd(m[i], len);
 	__m128d d = _mm_xor_pd(dot2(m, a), _mm_set1_pd(-0.0)), t[10];
 	terms2(_mm_mul_pd(_mm_set1_pd(FEATURE_WEIGHT), l2), m, d, keep, t);
-	for (int k = 0; k < 10; k++)
-		q[k] = _mm_add_pd(q[k], t[k]);
+	ADD10(q, t);
 }
 
 /* The quadrics of poses pa (low lane) and pb (high lane; pb = pa for a
@@ -292,14 +309,7 @@ static void quadrics_pair(mlod_bgm *g, int pa, int pb, double *sk, __m128d *pose
 			for (int i = 0; i < 12; i++)
 				M[i] = _mm_set1_pd(i % 5 == 0 ? 1.0 : 0.0);
 		} else {
-			for (int i = 0; i < 12; i++)
-				M[i] = zero;
-			for (int k = 0; k < inf->count; k++) {
-				const double *s = sk + 24 * (size_t)inf->joints[k];
-				__m128d w = _mm_set1_pd((double)inf->weights[k]);
-				for (int i = 0; i < 12; i++)
-					M[i] = _mm_add_pd(M[i], _mm_mul_pd(w, _mm_load_pd(s + 2 * i)));
-			}
+			blend2s(sk, inf, M);
 		}
 		const double *x = g->nodes[v].p;
 		__m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
@@ -316,8 +326,7 @@ static void quadrics_pair(mlod_bgm *g, int pa, int pb, double *sk, __m128d *pose
 		normal2(posed + 3 * F->n[0], posed + 3 * F->n[1], posed + 3 * F->n[2], n);
 		n[3] = _mm_sqrt_pd(dot2(n, n));
 	}
-	for (size_t i = 0; i < 10 * (size_t)g->node_count; i++)
-		acc[i] = zero;
+	memset(acc, 0, sizeof *acc * 10 * (size_t)g->node_count); /* +0 */
 	const __m128d all = _mm_castsi128_pd(_mm_set1_epi32(-1)), half = _mm_set1_pd(0.5);
 	const __m128d cosf = _mm_set1_pd(FEATURE_COS);
 	for (int f = 0; f < g->face_count; f++) {
@@ -328,11 +337,9 @@ static void quadrics_pair(mlod_bgm *g, int pa, int pb, double *sk, __m128d *pose
 		__m128d n[3] = {_mm_div_pd(nf[0], len), _mm_div_pd(nf[1], len), _mm_div_pd(nf[2], len)};
 		__m128d d = _mm_xor_pd(dot2(n, a0), _mm_set1_pd(-0.0));
 		terms2(_mm_mul_pd(half, len), n, d, _mm_cmpgt_pd(len, zero), q);
-		for (int i = 0; i < 3; i++) {
-			__m128d *Q = acc + (size_t)F->n[i] * 10;
-			for (int k = 0; k < 10; k++)
-				Q[k] = _mm_add_pd(Q[k], q[k]);
-		}
+		ADD10(acc + (size_t)F->n[0] * 10, q);
+		ADD10(acc + (size_t)F->n[1] * 10, q);
+		ADD10(acc + (size_t)F->n[2] * 10, q);
 		for (int e = 0; e < 3; e++) {
 			int h = F->adj[e];
 			if (h >= 0 && h < f)
@@ -353,18 +360,12 @@ static void quadrics_pair(mlod_bgm *g, int pa, int pb, double *sk, __m128d *pose
 				if (_mm_movemask_pd(keep) == 0)
 					continue;
 			}
-			__m128d q2[10];
-			for (int k = 0; k < 10; k++)
-				q2[k] = zero;
+			__m128d q2[10] = {zero, zero, zero, zero, zero, zero, zero, zero, zero, zero};
 			edge2(a, b, n1, keep, q2);
 			if (c)
 				edge2(a, b, c, keep, q2);
-			int ends[2] = {F->n[e], F->n[(e + 1) % 3]};
-			for (int i = 0; i < 2; i++) {
-				__m128d *Q = acc + (size_t)ends[i] * 10;
-				for (int k = 0; k < 10; k++)
-					Q[k] = _mm_add_pd(Q[k], q2[k]);
-			}
+			ADD10(acc + (size_t)F->n[e] * 10, q2);
+			ADD10(acc + (size_t)F->n[(e + 1) % 3] * 10, q2);
 		}
 	}
 	/* Out: a pair (2i, 2i + 1) as it lies (bgm_qat), else lane by lane. */
@@ -373,8 +374,10 @@ static void quadrics_pair(mlod_bgm *g, int pa, int pb, double *sk, __m128d *pose
 		const __m128d *A = acc + (size_t)v * 10;
 		if (pb == pa + 1 && (pa & 1) == 0) {
 			dst += 10 * (size_t)pa;
-			for (int k = 0; k < 10; k++)
-				_mm_store_pd(dst + 2 * k, A[k]);
+			_mm_store_pd(dst, A[0]), _mm_store_pd(dst + 2, A[1]), _mm_store_pd(dst + 4, A[2]);
+			_mm_store_pd(dst + 6, A[3]), _mm_store_pd(dst + 8, A[4]), _mm_store_pd(dst + 10, A[5]);
+			_mm_store_pd(dst + 12, A[6]), _mm_store_pd(dst + 14, A[7]), _mm_store_pd(dst + 16, A[8]);
+			_mm_store_pd(dst + 18, A[9]);
 		} else {
 			double lo[10], hi[10];
 			for (int k = 0; k < 10; k++)
