@@ -72,7 +72,8 @@ struct mlod_bgm {
 
 	/* Nodes, wedges, faces (append-only). */
 	int node_count, node_cap;
-	int node_aux_cap;       /* capacity of inf, morph and quadric */
+	int node_aux_cap;       /* capacity of inf and morph */
+	int quadric_cap;        /* capacity (nodes) of quadric and rquad */
 	bgm_node *nodes;
 	mlod_influences *inf;   /* per node */
 	float *morph;           /* per node, lay.morph_stride floats */

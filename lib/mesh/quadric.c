@@ -17,6 +17,7 @@
  * Pose 0 is the bind pose (the rest pose for a rigid mesh); the others
  * come from mlod_bgm_options.poses (clip frames and random poses).
  */
+#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -412,8 +413,16 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	double *acc = malloc(sizeof(double) * 10 * (size_t)g->node_count + 1);
 	g->skin = malloc(sizeof(float) * 12 * (size_t)J * (size_t)P);
 	/* Every node's every pose is written below (a copy or a sum). */
-	g->quadric = malloc(sizeof *g->quadric * (size_t)g->node_cap * (size_t)P * 10);
-	g->rquad = malloc(sizeof *g->rquad * (size_t)g->node_cap * BGM_RQUAD);
+	/* Room for the nodes the collapses add (each merges two or three
+	 * live nodes into one: fewer than node_count of them), at the
+	 * capacity bgm_add_node's doubling of node_cap would reach, so that
+	 * the largest arrays are not copied over as the sequence grows. */
+	int qcap = g->node_cap;
+	while (qcap < 2 * g->node_count && qcap <= INT_MAX / 2)
+		qcap *= 2;
+	g->quadric_cap = qcap;
+	g->quadric = malloc(sizeof *g->quadric * (size_t)qcap * (size_t)P * 10);
+	g->rquad = malloc(sizeof *g->rquad * (size_t)qcap * BGM_RQUAD);
 	if (!mats || !rest || !local || !posed || !fn || !acc || !g->skin || !g->quadric || !g->rquad) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
 		goto done;
