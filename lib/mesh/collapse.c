@@ -428,13 +428,15 @@ static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 #ifdef __SSE2__
 	/* Two entries at a time (n is even): each lane the sum below. */
 	if (pl->k == 2 || pl->k == 3) {
-		const double *c = pl->k == 3 ? g->quadric + (size_t)pl->v[2] * n : NULL;
 		const __m128d zero = _mm_setzero_pd();
-		for (size_t k = 0; k < n; k += 2) {
-			__m128d s = _mm_add_pd(_mm_add_pd(zero, _mm_load_pd(a + k)), _mm_load_pd(b + k));
-			if (c)
-				s = _mm_add_pd(s, _mm_load_pd(c + k));
-			_mm_storeu_pd(Q + k, s);
+		if (pl->k == 3) {
+			const double *c = g->quadric + (size_t)pl->v[2] * n;
+			for (size_t k = 0; k < n; k += 2)
+				_mm_storeu_pd(Q + k, _mm_add_pd(_mm_add_pd(_mm_add_pd(zero, _mm_load_pd(a + k)), _mm_load_pd(b + k)),
+				                                _mm_load_pd(c + k)));
+		} else {
+			for (size_t k = 0; k < n; k += 2)
+				_mm_storeu_pd(Q + k, _mm_add_pd(_mm_add_pd(zero, _mm_load_pd(a + k)), _mm_load_pd(b + k)));
 		}
 		return;
 	}
@@ -1266,9 +1268,8 @@ static inline __m128d abs_pd2(__m128d x)
 /* pose_min_bound for poses p and p + 1 (lanes 0 and 1), every step
  * done whatever the tests: val, tr and det per pose, for the caller to
  * test as pose_min_bound does. */
-static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int nj, const double *const qv[3], int k,
-                                   size_t i2, const double *bary, double rl, double inv, double *val_out,
-                                   double *tr_out, double *det_out)
+static inline __m128d pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int nj, const double *const qv[3],
+                                      int k, size_t i2, const double *bary, double rl, double inv)
 {
 	int J = g->joint_count;
 	/* g->skin2: the skin matrices as doubles, poses p and p + 1 side by side
@@ -1316,12 +1317,14 @@ static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int
 			q[e] = _mm_load_pd(a0 + 2 * e);
 	} else if (k == 2) {
 		const double *a1 = qv[1];
-		for (int e = 0; e < 10; e++)
-			q[e] = _mm_add_pd(_mm_load_pd(a0 + 2 * e), _mm_load_pd(a1 + 2 * e));
+#define Q2(e) q[e] = _mm_add_pd(_mm_load_pd(a0 + 2 * (e)), _mm_load_pd(a1 + 2 * (e)))
+		Q2(0), Q2(1), Q2(2), Q2(3), Q2(4), Q2(5), Q2(6), Q2(7), Q2(8), Q2(9);
+#undef Q2
 	} else {
 		const double *a1 = qv[1], *a2 = qv[2];
-		for (int e = 0; e < 10; e++)
-			q[e] = _mm_add_pd(_mm_add_pd(_mm_load_pd(a0 + 2 * e), _mm_load_pd(a1 + 2 * e)), _mm_load_pd(a2 + 2 * e));
+#define Q3(e) q[e] = _mm_add_pd(_mm_add_pd(_mm_load_pd(a0 + 2 * (e)), _mm_load_pd(a1 + 2 * (e))), _mm_load_pd(a2 + 2 * (e)))
+		Q3(0), Q3(1), Q3(2), Q3(3), Q3(4), Q3(5), Q3(6), Q3(7), Q3(8), Q3(9);
+#undef Q3
 	}
 	__m128d tr = _mm_add_pd(_mm_add_pd(q[0], q[4]), q[7]);
 	__m128d mu = _mm_mul_pd(_mm_set1_pd(1e-5), tr);
@@ -1370,9 +1373,13 @@ static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int
 	                        _mm_mul_pd(two, _mm_add_pd(_mm_add_pd(abs_pd2(q[1]), abs_pd2(q[2])), abs_pd2(q[5]))));
 	__m128d mag = _mm_add_pd(_mm_add_pd(abs_pd2(q[9]), _mm_mul_pd(_mm_mul_pd(two, lin), ym)), _mm_mul_pd(_mm_mul_pd(sq, ym), ym));
 	val = _mm_sub_pd(val, _mm_mul_pd(_mm_set1_pd(1e-12), mag));
-	_mm_storeu_pd(val_out, val);
-	_mm_storeu_pd(tr_out, tr);
-	_mm_storeu_pd(det_out, det);
+	/* The caller's tests (tr > 0 and finite, |det| > 0, val > 0 and
+	 * finite) lane by lane: a lane that fails them gives +0. */
+	const __m128d inf = _mm_set1_pd(HUGE_VAL);
+	__m128d ok = _mm_and_pd(_mm_cmpgt_pd(tr, zero), _mm_cmplt_pd(tr, inf));
+	ok = _mm_and_pd(ok, _mm_cmpgt_pd(abs_pd2(det), zero));
+	ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmpgt_pd(val, zero), _mm_cmplt_pd(val, inf)));
+	return _mm_and_pd(ok, val);
 }
 #endif
 
@@ -1444,14 +1451,16 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 				ql[i] = last[i];
 			}
 		for (size_t i2 = 0; i2 < n; i2++) {
-			double val[2], tr[2], det[2];
+			double val[2];
 			const double *qp[3];
 			for (int i = 0; i < k; i++)
 				qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
-			pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv, val, tr, det);
-			for (int l = 0; l < (i2 < pairs ? 2 : 1); l++)
-				if (tr[l] > 0.0 && isfinite(tr[l]) && fabs(det[l]) > 0.0 && val[l] > 0.0 && isfinite(val[l]))
-					lb += val[l];
+			/* a pose that fails the tests gives +0, which leaves lb (from +0,
+			 * never -0) as it was */
+			_mm_storeu_pd(val, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
+			lb += val[0];
+			if (i2 < pairs)
+				lb += val[1];
 		}
 		p = P;
 	}
