@@ -382,8 +382,9 @@ static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x
 		q[pl->corner[i]] = x;
 		const double *no = pl->onormal[i];
 		double u[3], v[3], w[3], nn[3];
-		for (int k = 0; k < 3; k++)
-			u[k] = q[1][k] - q[0][k], v[k] = q[2][k] - q[0][k], w[k] = q[2][k] - q[1][k];
+		u[0] = q[1][0] - q[0][0], u[1] = q[1][1] - q[0][1], u[2] = q[1][2] - q[0][2];
+		v[0] = q[2][0] - q[0][0], v[1] = q[2][1] - q[0][1], v[2] = q[2][2] - q[0][2];
+		w[0] = q[2][0] - q[1][0], w[1] = q[2][1] - q[1][1], w[2] = q[2][2] - q[1][2];
 		nn[0] = u[1] * v[2] - u[2] * v[1];
 		nn[1] = u[2] * v[0] - u[0] * v[2];
 		nn[2] = u[0] * v[1] - u[1] * v[0];
@@ -751,7 +752,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	}
 	/* Per group, how many wedges each collapsed vertex has there. */
 	int per[MAX_WEDGES][3];
-	memset(per, 0, sizeof per);
+	memset(per, 0, sizeof per[0] * (size_t)pl->ngroups); /* the groups' rows */
 	for (int i = 0; i < pl->nw; i++)
 		per[pl->group[i]][owner[i]]++;
 
@@ -1564,8 +1565,17 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 	if (same || g->opt.fast_cost) {
 		for (int j = 0; j < K; j++) {
 			const double *r = bgm_quadric_rest(g, v[j]);
+#ifdef __SSE2__
+			/* two entries at a time, each the same sum */
+			_mm_storeu_pd(Q, _mm_add_pd(_mm_loadu_pd(Q), _mm_loadu_pd(r)));
+			_mm_storeu_pd(Q + 2, _mm_add_pd(_mm_loadu_pd(Q + 2), _mm_loadu_pd(r + 2)));
+			_mm_storeu_pd(Q + 4, _mm_add_pd(_mm_loadu_pd(Q + 4), _mm_loadu_pd(r + 4)));
+			_mm_storeu_pd(Q + 6, _mm_add_pd(_mm_loadu_pd(Q + 6), _mm_loadu_pd(r + 6)));
+			_mm_storeu_pd(Q + 8, _mm_add_pd(_mm_loadu_pd(Q + 8), _mm_loadu_pd(r + 8)));
+#else
 			for (int k = 0; k < 10; k++)
 				Q[k] += r[k];
+#endif
 		}
 		lb = bgm_quadric_eval(Q, bary);
 		for (int j = 0; j < K; j++)
@@ -1581,10 +1591,12 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		margin = 1.0 - 1e-9;
 		*weak = 1;
 	} else {
+		/* the bind pose's entries: bgm_qat(P, 0, k) = st k */
+		size_t st = bgm_qat(g->pose_count, 0, 1);
 		for (int j = 0; j < K; j++) {
 			const double *q = g->quadric + (size_t)v[j] * (size_t)g->pose_count * 10;
-			for (int k = 0; k < 10; k++)
-				Q[k] += q[bgm_qat(g->pose_count, 0, k)]; /* the bind pose's */
+			Q[0] += q[0], Q[1] += q[st], Q[2] += q[2 * st], Q[3] += q[3 * st], Q[4] += q[4 * st];
+			Q[5] += q[5 * st], Q[6] += q[6 * st], Q[7] += q[7 * st], Q[8] += q[8 * st], Q[9] += q[9 * st];
 		}
 		lb = bgm_quadric_eval(Q, bary);
 		for (int j = 0; j < K; j++)

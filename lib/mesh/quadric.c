@@ -667,13 +667,15 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 			yv[0] = ROW(0), yv[1] = ROW(1), yv[2] = ROW(2);
 #undef ROW
 			double v[2];
-			_mm_storeu_pd(v, eval2(i < pairs ? q + 20 * (size_t)i : last, yv));
-			e += v[0] > 0.0 ? v[0] : 0.0;
+			__m128d ev = eval2(i < pairs ? q + 20 * (size_t)i : last, yv);
+			/* v > 0 ? v : 0 in the lanes */
+			_mm_storeu_pd(v, _mm_and_pd(_mm_cmpgt_pd(ev, _mm_setzero_pd()), ev));
+			e += v[0];
 			if (e >= stop)
 				return HUGE_VAL;
 			if (i == pairs)
 				break;
-			e += v[1] > 0.0 ? v[1] : 0.0;
+			e += v[1];
 			if (e >= stop)
 				return HUGE_VAL;
 		}
