@@ -200,8 +200,14 @@ const double *bgm_quadric_rest(mlod_bgm *g, int v);
 /* Sets node v's trace sum and marks its pulled-back quadric for
  * computing (a new node, its quadrics summed). */
 void bgm_quadric_rest_reset(mlod_bgm *g, int v);
-/* A packed quadric's value at x, clamped at 0. */
-double bgm_quadric_eval(const double *h, const double *x);
+/* A packed quadric's value at x, clamped at 0 (inline: the queue's keys
+ * and plan() call it for every candidate). */
+static inline double bgm_quadric_eval(const double *q, const double *x)
+{
+	double v = q[0] * x[0] * x[0] + 2 * q[1] * x[0] * x[1] + 2 * q[2] * x[0] * x[2] + 2 * q[3] * x[0] +
+	           q[4] * x[1] * x[1] + 2 * q[5] * x[1] * x[2] + 2 * q[6] * x[1] + q[7] * x[2] * x[2] + 2 * q[8] * x[2] + q[9];
+	return v > 0.0 ? v : 0.0;
+}
 /* The minimiser of the packed quadric h (directions it leaves free stay
  * at x0); returns 0 and fills out, or -1. */
 int bgm_quadric_solve(const double *h, const double *x0, double *out);

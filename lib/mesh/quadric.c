@@ -833,12 +833,6 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 	memcpy(h, H, sizeof H);
 }
 
-double bgm_quadric_eval(const double *h, const double *x)
-{
-	double v = eval(h, x);
-	return v > 0.0 ? v : 0.0;
-}
-
 int bgm_quadric_solve(const double *h, const double *x0, double *out)
 {
 	/* Solve (H[0..2][0..2] + mu I) x = -H[0..2][3] + mu x0 by Cramer's
