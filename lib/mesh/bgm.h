@@ -93,21 +93,30 @@ struct mlod_bgm {
 	int *removed;
 	int removed_len, removed_cap;
 
-	/* Posed quadrics (quadric.c): pose_count poses; per node pose_count x
-	 * 10 doubles, laid out as bgm_qat says (poses in pairs, side by side);
-	 * per pose and influence id a 3x4 skin matrix (row-major). */
+	/* Posed quadrics (quadric.c): pose_count poses, of which qpose_count
+	 * are stored: a pose whose used skin matrices are bit for bit an
+	 * earlier pose's has that pose's quadrics, for every node (qmap: pose
+	 * -> stored pose, in order of first use; qpose: stored pose -> its
+	 * pose). Per node qpose_count x 10 doubles, laid out as bgm_qat says
+	 * (stored poses in pairs, side by side); a sum over poses takes each
+	 * pose's stored pose's term, in pose order. Per pose and influence id
+	 * a 3x4 skin matrix (row-major). */
 	int pose_count;
+	int qpose_count;
+	int *qmap;
+	int *qpose;
 	double *quadric;
 	float *skin;
 	double *rquad;          /* per node BGM_RQUAD doubles: its posed quadrics pulled back
 	                         * into bind space with its influences (bgm_quadric_pullback;
 	                         * NaN first until bgm_quadric_rest needs them), then the sum
 	                         * over poses of their traces */
-	double *skin2;          /* the skin matrices as doubles, two poses side by side: per
-	                         * pair of poses (2i, 2i + 1) and influence id, 12 entries of
-	                         * 2 doubles (pose 2i, then 2i + 1); pose_count / 2 pairs,
-	                         * then for a last odd pose a block with it in both lanes;
-	                         * NULL when there are none or for a mesh without influences */
+	double *skin2;          /* the skin matrices as doubles, two stored poses side by
+	                         * side: per pair of stored poses (2i, 2i + 1) and influence
+	                         * id, 12 entries of 2 doubles (2i, then 2i + 1);
+	                         * qpose_count / 2 pairs, then for a last odd one a block
+	                         * with it in both lanes; NULL when there is one pose or for
+	                         * a mesh without influences */
 	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
 	double skin_norm;       /* collapse.c: the largest Frobenius norm of a skin matrix's
 	                         * linear part, 0 until worked out */
@@ -167,12 +176,21 @@ int bgm_link_ok(const int *from, const int *to, int m, int path_ok);
 double bgm_compactness(const double *a, const double *b, const double *c);
 int bgm_node_eligible(const mlod_bgm *g, const mlod_influences *inf);
 
+/* The two-pose helpers of quadric.c and collapse.c: inlined where
+ * they are used (called from more than one place, gcc would otherwise
+ * call them, their vectors passed through memory). */
+#if defined(__GNUC__)
+#define BGM_INLINE static inline __attribute__((always_inline))
+#else
+#define BGM_INLINE static inline
+#endif
+
 /* quadric.c */
-/* Where entry e (0-9) of pose p is among a node's P x 10 posed quadric
- * doubles: poses 2i and 2i + 1 side by side, entry e of pair i at
- * 20 i + 2 e (pose 2i) and 20 i + 2 e + 1 (pose 2i + 1), so that the
- * two-pose sums load a pair's entries straight; a last odd pose's 10
- * entries after the pairs, in order. */
+/* Where entry e (0-9) of stored pose p is among a node's P x 10 posed
+ * quadric doubles (P = qpose_count): stored poses 2i and 2i + 1 side by
+ * side, entry e of pair i at 20 i + 2 e (2i) and 20 i + 2 e + 1
+ * (2i + 1), so that the two-pose sums load a pair's entries straight; a
+ * last odd one's 10 entries after the pairs, in order. */
 static inline size_t bgm_qat(int P, int p, int e)
 {
 	return p < (P & ~1) ? 20 * (size_t)(p >> 1) + 2 * (size_t)e + (size_t)(p & 1) : 10 * (size_t)p + (size_t)e;
@@ -187,7 +205,7 @@ static inline void bgm_quadric_get(const double *q, int P, int p, double *out)
 void bgm_face_normal(const double *a, const double *b, const double *c, double *n);
 mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err);
 /* The error of a node at bind position p with influences inf against
- * the quadrics q (pose_count x 10, as bgm_qat lays them out): sum over poses; HUGE_VAL as soon as
+ * the quadrics q (qpose_count x 10, as bgm_qat lays them out): sum over poses; HUGE_VAL as soon as
  * the partial sum reaches stop (HUGE_VAL: never). */
 double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *p,
                          double stop);

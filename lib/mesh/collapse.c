@@ -424,7 +424,7 @@ static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 {
 	/* Each sum from 0 in the vertices' order (the same bits whatever
 	 * loop makes it). */
-	size_t n = 10 * (size_t)g->pose_count;
+	size_t n = 10 * (size_t)g->qpose_count;
 	const double *a = g->quadric + (size_t)pl->v[0] * n, *b = pl->k > 1 ? g->quadric + (size_t)pl->v[1] * n : NULL;
 #ifdef __SSE2__
 	/* Two entries at a time (n is even): each lane the sum below. */
@@ -839,7 +839,8 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		sum_quadrics(g, pl, Q);
 		q_ready = 1;
 		for (int p = 0; p < g->pose_count; p++)
-			wsum += Q[bgm_qat(g->pose_count, p, 0)] + Q[bgm_qat(g->pose_count, p, 4)] + Q[bgm_qat(g->pose_count, p, 7)];
+			wsum += Q[bgm_qat(g->qpose_count, g->qmap[p], 0)] + Q[bgm_qat(g->qpose_count, g->qmap[p], 4)] +
+			        Q[bgm_qat(g->qpose_count, g->qmap[p], 7)];
 		if (mm) {
 			mm->wsum = wsum;
 			mm->known |= MEMO_WSUM;
@@ -1209,17 +1210,17 @@ static inline double pose_min_bound(const mlod_bgm *g, const uint16_t *joint, in
 	}
 	double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
 	double q[10], q0[10], q1[10], q2[10];
-	int P = g->pose_count;
-	bgm_quadric_get(qv[0], P, (int)p, q0);
+	int D = g->qpose_count, sp = g->qmap[p]; /* pose p's stored pose */
+	bgm_quadric_get(qv[0], D, sp, q0);
 	if (k == 1) {
 		memcpy(q, q0, sizeof q);
 	} else if (k == 2) {
-		bgm_quadric_get(qv[1], P, (int)p, q1);
+		bgm_quadric_get(qv[1], D, sp, q1);
 		for (int e = 0; e < 10; e++)
 			q[e] = q0[e] + q1[e];
 	} else {
-		bgm_quadric_get(qv[1], P, (int)p, q1);
-		bgm_quadric_get(qv[2], P, (int)p, q2);
+		bgm_quadric_get(qv[1], D, sp, q1);
+		bgm_quadric_get(qv[2], D, sp, q2);
 		for (int e = 0; e < 10; e++)
 			q[e] = q0[e] + q1[e] + q2[e];
 	}
@@ -1269,7 +1270,7 @@ static inline __m128d abs_pd2(__m128d x)
 /* pose_min_bound for poses p and p + 1 (lanes 0 and 1), every step
  * done whatever the tests: val, tr and det per pose, for the caller to
  * test as pose_min_bound does. */
-static inline __m128d pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int nj, const double *const qv[3],
+BGM_INLINE __m128d pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int nj, const double *const qv[3],
                                       int k, size_t i2, const double *bary, double rl, double inv)
 {
 	int J = g->joint_count;
@@ -1428,40 +1429,70 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 			g->skin_norm = max_d(g->skin_norm, sqrt(l));
 		}
 	}
+	size_t D = (size_t)g->qpose_count;
 	const double *qv[3];
 	for (int i = 0; i < k; i++)
-		qv[i] = g->quadric + (size_t)v[i] * P * 10;
+		qv[i] = g->quadric + (size_t)v[i] * D * 10;
 	double lb = 0.0, rl = r * g->skin_norm, inv = 1.0 / nj;
 	size_t p = 0;
 #ifdef __SSE2__
-	/* Two poses at a time, pose p in the low lane and p + 1 in the high
-	 * one: every lane the same products, sums and tests, in the same
+	/* Two stored poses at a time, 2i in the low lane and 2i + 1 in the
+	 * high one: every lane the same products, sums and tests, in the same
 	 * order, as pose_min_bound's (SSE2 rounds as scalar code), and the
 	 * poses' terms added in pose order. */
 	if (g->skin2) {
-		/* A last odd pose the same way, in both lanes (its own g->skin2
-		 * block, the vertices' entries doubled in last), the low lane
-		 * taken. */
-		size_t pairs = P / 2, n = (P + 1) / 2;
+		/* A last odd stored pose the same way, in both lanes (its own
+		 * g->skin2 block, the vertices' entries doubled in last), the low
+		 * lane taken. */
+		size_t pairs = D / 2, n = (D + 1) / 2;
 		_Alignas(16) double last[3][20];
 		const double *ql[3];
-		if (P & 1)
+		if (D & 1)
 			for (int i = 0; i < k; i++) {
 				for (int e = 0; e < 10; e++)
 					last[i][2 * e] = last[i][2 * e + 1] = qv[i][20 * pairs + (size_t)e];
 				ql[i] = last[i];
 			}
-		for (size_t i2 = 0; i2 < n; i2++) {
-			double val[2];
-			const double *qp[3];
-			for (int i = 0; i < k; i++)
-				qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
-			/* a pose that fails the tests gives +0, which leaves lb (from +0,
-			 * never -0) as it was */
-			_mm_storeu_pd(val, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
-			lb += val[0];
-			if (i2 < pairs)
-				lb += val[1];
+		/* a pose that fails the tests gives +0, which leaves lb (from +0,
+		 * never -0) as it was */
+		if (D == P) {
+			/* every pose stored, in order */
+			for (size_t i2 = 0; i2 < n; i2++) {
+				double val[2];
+				const double *qp[3];
+				for (int i = 0; i < k; i++)
+					qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
+				_mm_storeu_pd(val, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
+				lb += val[0];
+				if (i2 < pairs)
+					lb += val[1];
+			}
+		} else {
+			/* Pose p's term is its stored pose's: every stored pair's terms
+			 * first (each stored pose is some pose's), then the sum in pose
+			 * order; beyond PMB_MAX stored poses, each pose's pair again. */
+			enum { PMB_MAX = 128 };
+			double t[PMB_MAX];
+			for (size_t i2 = 0; i2 < n && 2 * n <= PMB_MAX; i2++) {
+				const double *qp[3];
+				for (int i = 0; i < k; i++)
+					qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
+				_mm_storeu_pd(t + 2 * i2, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
+			}
+			for (size_t q = 0; q < P; q++) {
+				int d = g->qmap[q];
+				if (2 * n <= PMB_MAX) {
+					lb += t[d];
+				} else {
+					size_t i2 = (size_t)d / 2;
+					double val[2];
+					const double *qp[3];
+					for (int i = 0; i < k; i++)
+						qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
+					_mm_storeu_pd(val, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
+					lb += val[d & 1];
+				}
+			}
 		}
 		p = P;
 	}
@@ -1592,9 +1623,9 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		*weak = 1;
 	} else {
 		/* the bind pose's entries: bgm_qat(P, 0, k) = st k */
-		size_t st = bgm_qat(g->pose_count, 0, 1);
+		size_t st = bgm_qat(g->qpose_count, 0, 1);
 		for (int j = 0; j < K; j++) {
-			const double *q = g->quadric + (size_t)v[j] * (size_t)g->pose_count * 10;
+			const double *q = g->quadric + (size_t)v[j] * (size_t)g->qpose_count * 10;
 			Q[0] += q[0], Q[1] += q[st], Q[2] += q[2 * st], Q[3] += q[3 * st], Q[4] += q[4 * st];
 			Q[5] += q[5 * st], Q[6] += q[6 * st], Q[7] += q[7 * st], Q[8] += q[8 * st], Q[9] += q[9 * st];
 		}
@@ -1679,7 +1710,8 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		sum_quadrics(g, &pv, Q);
 		q_ready = 1;
 		for (int p = 0; p < g->pose_count; p++)
-			wsum += Q[bgm_qat(g->pose_count, p, 0)] + Q[bgm_qat(g->pose_count, p, 4)] + Q[bgm_qat(g->pose_count, p, 7)];
+			wsum += Q[bgm_qat(g->qpose_count, g->qmap[p], 0)] + Q[bgm_qat(g->qpose_count, g->qmap[p], 4)] +
+			        Q[bgm_qat(g->qpose_count, g->qmap[p], 7)];
 		mm->wsum = wsum;
 		mm->known |= MEMO_WSUM;
 	}
@@ -1871,7 +1903,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	}
 	if (g->pose_count > 0) {
 		/* The parents' sums, each from 0 in their order (sum_quadrics). */
-		sum_quadrics(g, pl, g->quadric + (size_t)v * (size_t)g->pose_count * 10);
+		sum_quadrics(g, pl, g->quadric + (size_t)v * (size_t)g->qpose_count * 10);
 		bgm_quadric_rest_reset(g, v);
 	}
 

@@ -159,16 +159,16 @@ static inline double eval(const double *q, const double *x)
 _Static_assert(_Alignof(max_align_t) >= 16, "malloc's blocks must be 16-byte aligned for the two-pose loads");
 
 /* blend for both poses of pair i; inf has influences (joint_count > 0). */
-static inline void blend2s(const double *S, const mlod_influences *inf, __m128d *M);
+BGM_INLINE void blend2s(const double *S, const mlod_influences *inf, __m128d *M);
 
-static inline void blend2(const mlod_bgm *g, size_t i, const mlod_influences *inf, __m128d *M)
+BGM_INLINE void blend2(const mlod_bgm *g, size_t i, const mlod_influences *inf, __m128d *M)
 {
 	blend2s(g->skin2 + i * (size_t)g->joint_count * 24, inf, M);
 }
 
 /* blend2 on the block S of two poses' skin matrices (24 doubles per
  * influence id). */
-static inline void blend2s(const double *S, const mlod_influences *inf, __m128d *M)
+BGM_INLINE void blend2s(const double *S, const mlod_influences *inf, __m128d *M)
 {
 	/* Written out, so that the twelve sums stay in registers. */
 	__m128d m0 = _mm_setzero_pd(), m1 = m0, m2 = m0, m3 = m0, m4 = m0, m5 = m0, m6 = m0, m7 = m0, m8 = m0,
@@ -199,7 +199,7 @@ static inline void blend2s(const double *S, const mlod_influences *inf, __m128d 
 #define QP(u, e) _mm_load_pd((u) + 2 * (e))
 
 /* eval for both poses (u: the pair's entries). */
-static inline __m128d eval2(const double *u, const __m128d *x)
+BGM_INLINE __m128d eval2(const double *u, const __m128d *x)
 {
 	const __m128d two = _mm_set1_pd(2.0);
 	__m128d v = _mm_mul_pd(_mm_mul_pd(QP(u, 0), x[0]), x[0]);
@@ -240,7 +240,7 @@ static inline void qput(double *d, int P, int p, const double *a)
 	} while (0)
 
 /* bgm_face_normal for both lanes. */
-static inline void normal2(const __m128d *a, const __m128d *b, const __m128d *c, __m128d *n)
+BGM_INLINE void normal2(const __m128d *a, const __m128d *b, const __m128d *c, __m128d *n)
 {
 	__m128d u0 = _mm_sub_pd(b[0], a[0]), u1 = _mm_sub_pd(b[1], a[1]), u2 = _mm_sub_pd(b[2], a[2]);
 	__m128d v0 = _mm_sub_pd(c[0], a[0]), v1 = _mm_sub_pd(c[1], a[1]), v2 = _mm_sub_pd(c[2], a[2]);
@@ -249,14 +249,14 @@ static inline void normal2(const __m128d *a, const __m128d *b, const __m128d *c,
 	n[2] = _mm_sub_pd(_mm_mul_pd(u0, v1), _mm_mul_pd(u1, v0));
 }
 
-static inline __m128d dot2(const __m128d *a, const __m128d *b)
+BGM_INLINE __m128d dot2(const __m128d *a, const __m128d *b)
 {
 	return _mm_add_pd(_mm_add_pd(_mm_mul_pd(a[0], b[0]), _mm_mul_pd(a[1], b[1])), _mm_mul_pd(a[2], b[2]));
 }
 
 /* q[k] = w_i P_j (P = (n, d), w = s P) in the lanes of keep, +0 in the
  * others: plane_quadric's and edge_quadric's terms. */
-static inline void terms2(__m128d s, const __m128d *n, __m128d d, __m128d keep, __m128d *q)
+BGM_INLINE void terms2(__m128d s, const __m128d *n, __m128d d, __m128d keep, __m128d *q)
 {
 	__m128d w0 = _mm_mul_pd(s, n[0]), w1 = _mm_mul_pd(s, n[1]), w2 = _mm_mul_pd(s, n[2]), w3 = _mm_mul_pd(s, d);
 	q[0] = _mm_and_pd(keep, _mm_mul_pd(w0, n[0])), q[1] = _mm_and_pd(keep, _mm_mul_pd(w0, n[1]));
@@ -269,7 +269,7 @@ static inline void terms2(__m128d s, const __m128d *n, __m128d d, __m128d keep, 
 
 /* edge_quadric for both lanes, added to q in the lanes of keep (where
  * the edge is a feature). */
-static inline void edge2(const __m128d *a, const __m128d *b, const __m128d *n, __m128d keep, __m128d *q)
+BGM_INLINE void edge2(const __m128d *a, const __m128d *b, const __m128d *n, __m128d keep, __m128d *q)
 {
 	__m128d e[3] = {_mm_sub_pd(b[0], a[0]), _mm_sub_pd(b[1], a[1]), _mm_sub_pd(b[2], a[2])}, m[3];
 	m[0] = _mm_sub_pd(_mm_mul_pd(e[1], n[2]), _mm_mul_pd(e[2], n[1]));
@@ -284,24 +284,19 @@ static inline void edge2(const __m128d *a, const __m128d *b, const __m128d *n, _
 	ADD10(q, t);
 }
 
-/* The quadrics of poses pa (low lane) and pb (high lane; pb = pa for a
- * pose alone) into g->quadric: the one-pose loop of bgm_quadrics_build
- * in two lanes, every lane the same products, sums and tests in the same
- * order (SSE2 rounds as scalar code; a face's plane that one-pose code
- * leaves out, a plane added as +0 instead of a -0, an edge that is no
- * feature in a lane, add +0 there, which leaves each sum as it was: a
- * sum from +0 is never -0). sk: 24 J doubles; posed: 3 per node; fn: 4
+/* The quadrics of stored poses da (low lane) and db = da + 1 (high lane;
+ * db = da for a last one alone; da even) into g->quadric: the one-pose
+ * loop of bgm_quadrics_build in two lanes, every lane the same products,
+ * sums and tests in the same order (SSE2 rounds as scalar code; a
+ * face's plane that one-pose code leaves out, a plane added as +0
+ * instead of a -0, an edge that is no feature in a lane, add +0 there,
+ * which leaves each sum as it was: a sum from +0 is never -0). Their
+ * skin matrices are g->skin2's block da / 2. posed: 3 per node; fn: 4
  * per face; acc: 10 per node. */
-static void quadrics_pair(mlod_bgm *g, int pa, int pb, double *sk, __m128d *posed, __m128d *fn, __m128d *acc)
+static void quadrics_pair(mlod_bgm *g, int da, int db, __m128d *posed, __m128d *fn, __m128d *acc)
 {
-	int J = g->joint_count, P = g->pose_count;
-	for (int k = 0; k < J; k++) {
-		const float *a = g->skin + ((size_t)pa * (size_t)J + (size_t)k) * 12;
-		const float *b = g->skin + ((size_t)pb * (size_t)J + (size_t)k) * 12;
-		double *d = sk + (size_t)k * 24;
-		for (int e = 0; e < 12; e++)
-			d[2 * e] = a[e], d[2 * e + 1] = b[e];
-	}
+	int J = g->joint_count, D = g->qpose_count;
+	const double *sk = g->skin2 + (size_t)(da / 2) * (size_t)J * 24;
 	const __m128d zero = _mm_setzero_pd();
 	for (int v = 0; v < g->node_count; v++) {
 		const mlod_influences *inf = &g->inf[v];
@@ -369,23 +364,21 @@ static void quadrics_pair(mlod_bgm *g, int pa, int pb, double *sk, __m128d *pose
 			ADD10(acc + (size_t)F->n[(e + 1) % 3] * 10, q2);
 		}
 	}
-	/* Out: a pair (2i, 2i + 1) as it lies (bgm_qat), else lane by lane. */
+	/* Out: a pair (2i, 2i + 1) as it lies (bgm_qat), else the low lane. */
 	for (int v = 0; v < g->node_count; v++) {
-		double *dst = g->quadric + (size_t)v * (size_t)P * 10;
+		double *dst = g->quadric + (size_t)v * (size_t)D * 10;
 		const __m128d *A = acc + (size_t)v * 10;
-		if (pb == pa + 1 && (pa & 1) == 0) {
-			dst += 10 * (size_t)pa;
+		if (db == da + 1) {
+			dst += 10 * (size_t)da;
 			_mm_store_pd(dst, A[0]), _mm_store_pd(dst + 2, A[1]), _mm_store_pd(dst + 4, A[2]);
 			_mm_store_pd(dst + 6, A[3]), _mm_store_pd(dst + 8, A[4]), _mm_store_pd(dst + 10, A[5]);
 			_mm_store_pd(dst + 12, A[6]), _mm_store_pd(dst + 14, A[7]), _mm_store_pd(dst + 16, A[8]);
 			_mm_store_pd(dst + 18, A[9]);
 		} else {
-			double lo[10], hi[10];
+			double lo[10];
 			for (int k = 0; k < 10; k++)
-				_mm_storel_pd(lo + k, A[k]), _mm_storeh_pd(hi + k, A[k]);
-			qput(dst, P, pa, lo);
-			if (pb != pa)
-				qput(dst, P, pb, hi);
+				_mm_storel_pd(lo + k, A[k]);
+			qput(dst, D, da, lo);
 		}
 	}
 }
@@ -412,22 +405,10 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	 * out. Each node's sum is made in the same order from the same 0. */
 	double *acc = malloc(sizeof(double) * 10 * (size_t)g->node_count + 1);
 	g->skin = malloc(sizeof(float) * 12 * (size_t)J * (size_t)P);
-	/* Every node's every pose is written below (a copy or a sum). */
-	/* Room for the nodes the collapses add (each merges two or three
-	 * live nodes into one: fewer than node_count of them), at the
-	 * capacity bgm_add_node's doubling of node_cap would reach, so that
-	 * the largest arrays are not copied over as the sequence grows. */
-	int qcap = g->node_cap;
-	while (qcap < 2 * g->node_count && qcap <= INT_MAX / 2)
-		qcap *= 2;
-	g->quadric_cap = qcap;
-	g->quadric = malloc(sizeof *g->quadric * (size_t)qcap * (size_t)P * 10);
-	g->rquad = malloc(sizeof *g->rquad * (size_t)qcap * BGM_RQUAD);
-	if (!mats || !rest || !local || !posed || !fn || !acc || !g->skin || !g->quadric || !g->rquad) {
+	if (!mats || !rest || !local || !posed || !fn || !acc || !g->skin) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
 		goto done;
 	}
-	g->pose_count = P;
 	mlod_pose_rest(s, local);
 	mlod_pose_world(s, local, rest);
 	for (int p = 0; p < P; p++) {
@@ -450,27 +431,12 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			to_rows(&in->offset, S);
 		}
 	}
-	/* The same matrices as doubles, two poses side by side (the two-pose
-	 * paths of bgm_quadric_error, bgm_quadric_pullback and collapse.c). */
-	if (g->joint_count > 0 && P >= 2) {
-		/* A last odd pose has a block of its own, itself in both lanes. */
-		size_t pairs = (size_t)P / 2, blocks = ((size_t)P + 1) / 2;
-		g->skin2 = malloc(sizeof(double) * 24 * (size_t)J * blocks);
-		if (!g->skin2) {
-			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
-			goto done;
-		}
-		for (size_t i = 0; i < blocks; i++)
-			for (int k = 0; k < J; k++) {
-				const float *a = g->skin + (2 * i * (size_t)J + (size_t)k) * 12, *b = i < pairs ? a + (size_t)J * 12 : a;
-				double *d = g->skin2 + (i * (size_t)J + (size_t)k) * 24;
-				for (int e = 0; e < 12; e++)
-					d[2 * e] = a[e], d[2 * e + 1] = b[e];
-			}
-	}
 	/* The skin matrices the nodes use (all of them for a static mesh). */
 	unsigned char *used = calloc((size_t)J, 1);
-	if (!used) {
+	g->qmap = malloc(sizeof(int) * (size_t)P);
+	g->qpose = malloc(sizeof(int) * (size_t)P);
+	if (!used || !g->qmap || !g->qpose) {
+		free(used);
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
 		goto done;
 	}
@@ -480,78 +446,93 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 		for (int k = 0; k < g->inf[v].count && k < MLOD_MAX_INFLUENCES; k++)
 			if (g->inf[v].joints[k] < J)
 				used[g->inf[v].joints[k]] = 1;
-	/* Per pose: skin the nodes, then add each face's plane to its nodes.
-	 * A pose whose used skin matrices are bit for bit an earlier pose's
+	/* A pose whose used skin matrices are bit for bit an earlier pose's
 	 * (a rigid part or a joint the clip leaves still) has that pose's
-	 * quadrics, every step being the same arithmetic on the same values:
-	 * they are copied (from the first such pose). */
-	int *same = malloc(sizeof(int) * (size_t)P);
-	if (!same) {
-		free(used);
-		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
-		goto done;
-	}
+	 * quadrics, every step being the same arithmetic on the same values,
+	 * and so has every node the collapses make (their sums, their
+	 * influences among the used ones): it is not stored, qmap sends it
+	 * to the first such pose's quadrics, and the sums over poses take
+	 * that pose's terms again. */
+	int D = 0;
 	for (int p = 0; p < P; p++) {
-		same[p] = -1;
-		for (int q = 0; q < p && same[p] < 0; q++) {
+		int same = -1;
+		for (int q = 0; q < p && same < 0; q++) {
 			const float *a = g->skin + (size_t)p * (size_t)J * 12, *b = g->skin + (size_t)q * (size_t)J * 12;
 			int eq = 1;
 			for (int j = 0; j < J && eq; j++)
 				eq = !used[j] || memcmp(a + 12 * (size_t)j, b + 12 * (size_t)j, 12 * sizeof *a) == 0;
 			if (eq)
-				same[p] = q;
+				same = q;
+		}
+		if (same >= 0) {
+			g->qmap[p] = g->qmap[same];
+		} else {
+			g->qmap[p] = D;
+			g->qpose[D++] = p;
 		}
 	}
 	free(used);
+	g->pose_count = P;
+	g->qpose_count = D;
+	/* Room for the nodes the collapses add (each merges two or three
+	 * live nodes into one: fewer than node_count of them), at the
+	 * capacity bgm_add_node's doubling of node_cap would reach, so that
+	 * the largest arrays are not copied over as the sequence grows.
+	 * Every node's every stored pose is written below. */
+	int qcap = g->node_cap;
+	while (qcap < 2 * g->node_count && qcap <= INT_MAX / 2)
+		qcap *= 2;
+	g->quadric_cap = qcap;
+	g->quadric = malloc(sizeof *g->quadric * (size_t)qcap * (size_t)D * 10);
+	g->rquad = malloc(sizeof *g->rquad * (size_t)qcap * BGM_RQUAD);
+	if (!g->quadric || !g->rquad) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+		goto done;
+	}
+	/* The stored poses' matrices as doubles, two side by side (the
+	 * two-pose paths of bgm_quadric_error, bgm_quadric_pullback and
+	 * collapse.c): block i holds stored poses 2i and 2i + 1, a last odd
+	 * one a block of its own, itself in both lanes. */
+	if (g->joint_count > 0 && P >= 2) {
+		size_t pairs = (size_t)D / 2, blocks = ((size_t)D + 1) / 2;
+		g->skin2 = malloc(sizeof(double) * 24 * (size_t)J * blocks);
+		if (!g->skin2) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+			goto done;
+		}
+		for (size_t i = 0; i < blocks; i++)
+			for (int k = 0; k < J; k++) {
+				const float *a = g->skin + ((size_t)g->qpose[2 * i] * (size_t)J + (size_t)k) * 12;
+				const float *b = i < pairs ? g->skin + ((size_t)g->qpose[2 * i + 1] * (size_t)J + (size_t)k) * 12 : a;
+				double *d = g->skin2 + (i * (size_t)J + (size_t)k) * 24;
+				for (int e = 0; e < 12; e++)
+					d[2 * e] = a[e], d[2 * e + 1] = b[e];
+			}
+	}
 	int paired = 0;
 #ifdef __SSE2__
-	/* Two poses at a time (quadrics_pair): the poses to work out, in
-	 * order, two by two, a last one alone. */
+	/* Two stored poses at a time (quadrics_pair), a last one alone. */
 	if (g->joint_count > 0 && P >= 2) {
-		double *sk = malloc(sizeof(double) * 24 * (size_t)J);
 		__m128d *posed2 = malloc(sizeof(__m128d) * 3 * (size_t)g->node_count + 16);
 		__m128d *fn2 = malloc(sizeof(__m128d) * 4 * (size_t)g->face_count + 16);
 		__m128d *acc2 = malloc(sizeof(__m128d) * 10 * (size_t)g->node_count + 16);
-		if (sk && posed2 && fn2 && acc2) {
-			int pend = -1;
-			for (int p = 0; p < P; p++) {
-				if (same[p] >= 0)
-					continue;
-				if (pend < 0) {
-					pend = p;
-				} else {
-					quadrics_pair(g, pend, p, sk, posed2, fn2, acc2);
-					pend = -1;
-				}
-			}
-			if (pend >= 0)
-				quadrics_pair(g, pend, pend, sk, posed2, fn2, acc2);
+		if (posed2 && fn2 && acc2) {
+			for (int d = 0; d < D; d += 2)
+				quadrics_pair(g, d, d + 1 < D ? d + 1 : d, posed2, fn2, acc2);
 			paired = 1;
 		}
-		free(sk);
 		free(posed2);
 		free(fn2);
 		free(acc2);
 		if (!paired) {
-			free(same);
 			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
 			goto done;
 		}
 	}
 #endif
-	for (int p = 0; p < P; p++) {
+	for (int d = 0; d < D && !paired; d++) {
+		int p = g->qpose[d];
 		double M[12];
-		if (same[p] >= 0) {
-			/* in pose order: same[p] < p is written by now */
-			for (int v = 0; v < g->node_count; v++) {
-				double *d = g->quadric + (size_t)v * (size_t)P * 10, a[10];
-				bgm_quadric_get(d, P, same[p], a);
-				qput(d, P, p, a);
-			}
-			continue;
-		}
-		if (paired)
-			continue;
 		for (int v = 0; v < g->node_count; v++) {
 			blend(g, p, &g->inf[v], M);
 			apply(M, g->nodes[v].p, posed + 3 * v);
@@ -628,9 +609,8 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			}
 		}
 		for (int v = 0; v < g->node_count; v++)
-			qput(g->quadric + (size_t)v * (size_t)P * 10, P, p, acc + (size_t)v * 10);
+			qput(g->quadric + (size_t)v * (size_t)D * 10, D, d, acc + (size_t)v * 10);
 	}
-	free(same);
 	for (int v = 0; v < g->node_count; v++)
 		bgm_quadric_rest_reset(g, v);
 done:
@@ -643,48 +623,89 @@ done:
 	return r;
 }
 
-double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
-{
-	double M[12], y[3], e = 0.0;
-	int p = 0;
 #ifdef __SSE2__
-	if (g->skin2 && inf->count > 0) {
-		/* Two poses at a time; the sum and its stop test pose by pose. */
-		const __m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
-		/* A last odd pose the same way, in both lanes (its own g->skin2
-		 * block, its entries doubled in last), the low lane taken. */
-		int P = g->pose_count, pairs = P / 2, n = (P + 1) / 2;
-		_Alignas(16) double last[20];
-		if (P & 1)
-			for (int k = 0; k < 10; k++)
-				last[2 * k] = last[2 * k + 1] = q[10 * (size_t)pairs * 2 + (size_t)k];
-		for (int i = 0; i < n; i++) {
-			__m128d Mv[12], yv[3];
-			blend2(g, (size_t)i, inf, Mv);
+/* Stored poses' terms kept for the sums over poses when some poses are
+ * stored once for several (qmap): beyond this many stored poses each
+ * pose's pair is worked out again. */
+#define TERMS_MAX 128
+
+/* The two stored poses' error terms (block i: stored poses 2i and
+ * 2i + 1, u their entries, bgm_qat), each clamped at 0. */
+BGM_INLINE __m128d err_pair(const mlod_bgm *g, const double *u, const mlod_influences *inf, size_t i, __m128d x0,
+                               __m128d x1, __m128d x2)
+{
+	__m128d Mv[12], yv[3];
+	blend2(g, i, inf, Mv);
 #define ROW(r) _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(Mv[4 * r], x0), _mm_mul_pd(Mv[4 * r + 1], x1)), \
                                     _mm_mul_pd(Mv[4 * r + 2], x2)), \
                          Mv[4 * r + 3])
-			yv[0] = ROW(0), yv[1] = ROW(1), yv[2] = ROW(2);
+	yv[0] = ROW(0), yv[1] = ROW(1), yv[2] = ROW(2);
 #undef ROW
-			double v[2];
-			__m128d ev = eval2(i < pairs ? q + 20 * (size_t)i : last, yv);
-			/* v > 0 ? v : 0 in the lanes */
-			_mm_storeu_pd(v, _mm_and_pd(_mm_cmpgt_pd(ev, _mm_setzero_pd()), ev));
-			e += v[0];
-			if (e >= stop)
-				return HUGE_VAL;
-			if (i == pairs)
-				break;
-			e += v[1];
+	__m128d ev = eval2(u, yv);
+	/* v > 0 ? v : 0 in the lanes */
+	return _mm_and_pd(_mm_cmpgt_pd(ev, _mm_setzero_pd()), ev);
+}
+#endif
+
+double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
+{
+	double M[12], y[3], e = 0.0;
+	int P = g->pose_count, D = g->qpose_count;
+#ifdef __SSE2__
+	if (g->skin2 && inf->count > 0) {
+		/* Two stored poses at a time; the sum and its stop test pose by
+		 * pose. A last odd stored pose the same way, in both lanes (its
+		 * own g->skin2 block, its entries doubled in last), the low lane
+		 * taken. */
+		const __m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
+		int pairs = D / 2, n = (D + 1) / 2;
+		_Alignas(16) double last[20];
+		if (D & 1)
+			for (int k = 0; k < 10; k++)
+				last[2 * k] = last[2 * k + 1] = q[20 * (size_t)pairs + (size_t)k];
+		if (D == P) {
+			/* every pose stored, in order */
+			for (int i = 0; i < n; i++) {
+				double v[2];
+				_mm_storeu_pd(v, err_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, x0, x1, x2));
+				e += v[0];
+				if (e >= stop)
+					return HUGE_VAL;
+				if (i == pairs)
+					break;
+				e += v[1];
+				if (e >= stop)
+					return HUGE_VAL;
+			}
+			return e;
+		}
+		/* Pose p's term is its stored pose's: worked out when first
+		 * needed (a stored pose comes first at its own pose, in order). */
+		double t[TERMS_MAX];
+		int done = 0;
+		for (int p = 0; p < P; p++) {
+			int d = g->qmap[p], i = d / 2;
+			double v;
+			if (2 * n <= TERMS_MAX) {
+				for (; done <= i; done++)
+					_mm_storeu_pd(t + 2 * done, err_pair(g, done < pairs ? q + 20 * (size_t)done : last, inf, (size_t)done,
+					                                     x0, x1, x2));
+				v = t[d];
+			} else {
+				double w[2];
+				_mm_storeu_pd(w, err_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, x0, x1, x2));
+				v = w[d & 1];
+			}
+			e += v;
 			if (e >= stop)
 				return HUGE_VAL;
 		}
 		return e;
 	}
 #endif
-	for (; p < g->pose_count; p++) {
+	for (int p = 0; p < P; p++) {
 		double a[10];
-		bgm_quadric_get(q, g->pose_count, p, a);
+		bgm_quadric_get(q, D, g->qmap[p], a);
 		blend(g, p, inf, M);
 		apply(M, x, y);
 		double v = eval(a, y);
@@ -697,11 +718,13 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 
 void bgm_quadric_rest_reset(mlod_bgm *g, int v)
 {
-	const double *q = g->quadric + (size_t)v * (size_t)g->pose_count * 10;
+	int P = g->pose_count, D = g->qpose_count;
+	const double *q = g->quadric + (size_t)v * (size_t)D * 10;
 	double *r = g->rquad + (size_t)v * BGM_RQUAD, t = 0.0;
-	int P = g->pose_count;
-	for (int p = 0; p < P; p++)
-		t += q[bgm_qat(P, p, 0)] + q[bgm_qat(P, p, 4)] + q[bgm_qat(P, p, 7)];
+	for (int p = 0; p < P; p++) {
+		int d = g->qmap[p];
+		t += q[bgm_qat(D, d, 0)] + q[bgm_qat(D, d, 4)] + q[bgm_qat(D, d, 7)];
+	}
 	r[0] = NAN; /* not computed yet: bgm_quadric_rest */
 	r[10] = t;
 }
@@ -713,9 +736,51 @@ const double *bgm_quadric_rest(mlod_bgm *g, int v)
 	 * direction the planes leave free), which must not recompute it at
 	 * every use. */
 	if (isnan(r[0]))
-		bgm_quadric_pullback(g, g->quadric + (size_t)v * (size_t)g->pose_count * 10, &g->inf[v], r);
+		bgm_quadric_pullback(g, g->quadric + (size_t)v * (size_t)g->qpose_count * 10, &g->inf[v], r);
 	return r;
 }
+
+#ifdef __SSE2__
+/* The two stored poses' pullback terms h[0..9] (block i, u their
+ * entries): [M; 0 0 0 1]^T Q [M; 0 0 0 1] in the order of the one-pose
+ * loop of bgm_quadric_pullback. */
+BGM_INLINE void pull_pair(const mlod_bgm *g, const double *u, const mlod_influences *inf, size_t i, __m128d *h)
+{
+	__m128d M[12];
+	blend2(g, i, inf, M);
+#define a(e) QP(u, e)
+#define MUL(x, y) _mm_mul_pd(x, y)
+#define ADD(x, y) _mm_add_pd(x, y)
+#define DOT3(a0, m0, a1, m1, a2, m2) ADD(ADD(MUL(a0, m0), MUL(a1, m1)), MUL(a2, m2))
+	__m128d t00 = DOT3(a(0), M[0], a(1), M[4], a(2), M[8]);
+	__m128d t01 = DOT3(a(0), M[1], a(1), M[5], a(2), M[9]);
+	__m128d t02 = DOT3(a(0), M[2], a(1), M[6], a(2), M[10]);
+	__m128d t10 = DOT3(a(1), M[0], a(4), M[4], a(5), M[8]);
+	__m128d t11 = DOT3(a(1), M[1], a(4), M[5], a(5), M[9]);
+	__m128d t12 = DOT3(a(1), M[2], a(4), M[6], a(5), M[10]);
+	__m128d t20 = DOT3(a(2), M[0], a(5), M[4], a(7), M[8]);
+	__m128d t21 = DOT3(a(2), M[1], a(5), M[5], a(7), M[9]);
+	__m128d t22 = DOT3(a(2), M[2], a(5), M[6], a(7), M[10]);
+	__m128d t03 = ADD(DOT3(a(0), M[3], a(1), M[7], a(2), M[11]), a(3));
+	__m128d t13 = ADD(DOT3(a(1), M[3], a(4), M[7], a(5), M[11]), a(6));
+	__m128d t23 = ADD(DOT3(a(2), M[3], a(5), M[7], a(7), M[11]), a(8));
+	__m128d t33 = ADD(DOT3(a(3), M[3], a(6), M[7], a(8), M[11]), a(9));
+	h[0] = DOT3(M[0], t00, M[4], t10, M[8], t20);
+	h[1] = DOT3(M[0], t01, M[4], t11, M[8], t21);
+	h[2] = DOT3(M[0], t02, M[4], t12, M[8], t22);
+	h[3] = DOT3(M[0], t03, M[4], t13, M[8], t23);
+	h[4] = DOT3(M[1], t01, M[5], t11, M[9], t21);
+	h[5] = DOT3(M[1], t02, M[5], t12, M[9], t22);
+	h[6] = DOT3(M[1], t03, M[5], t13, M[9], t23);
+	h[7] = DOT3(M[2], t02, M[6], t12, M[10], t22);
+	h[8] = DOT3(M[2], t03, M[6], t13, M[10], t23);
+	h[9] = ADD(DOT3(M[3], t03, M[7], t13, M[11], t23), t33);
+#undef a
+#undef DOT3
+#undef ADD
+#undef MUL
+}
+#endif
 
 /* h (10 doubles, packed as a quadric) = sum over poses of
  * [M_p; 0 0 0 1]^T Q_p [M_p; 0 0 0 1], M_p blended for inf: the posed
@@ -727,84 +792,76 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 	 * T = Q [M; 0 0 0 1] and [M; 0 0 0 1]^T T (the last row's zeros left
 	 * out), written out entry by entry. */
 	double H[10] = {0};
-	int p = 0;
+	int P = g->pose_count, D = g->qpose_count;
 #ifdef __SSE2__
 	if (g->skin2 && inf->count > 0) {
-		/* Two poses at a time, the terms added to H pose by pose. */
-		/* A last odd pose the same way, in both lanes (its own g->skin2
-		 * block, its entries doubled in last), the low lane taken. */
-		int P = g->pose_count, pairs = P / 2, n = (P + 1) / 2;
+		/* Two stored poses at a time, the terms added to H pose by pose.
+		 * A last odd stored pose the same way, in both lanes (its own
+		 * g->skin2 block, its entries doubled in last), the low lane
+		 * taken. Two entries of H to a register (Hv[j] = H[2j],
+		 * H[2j + 1]), the terms regrouped to match. */
+		int pairs = D / 2, n = (D + 1) / 2;
 		_Alignas(16) double last[20];
-		if (P & 1)
+		if (D & 1)
 			for (int k = 0; k < 10; k++)
-				last[2 * k] = last[2 * k + 1] = q[10 * (size_t)pairs * 2 + (size_t)k];
+				last[2 * k] = last[2 * k + 1] = q[20 * (size_t)pairs + (size_t)k];
 		__m128d Hv[5];
 		for (int j = 0; j < 5; j++)
 			Hv[j] = _mm_setzero_pd();
-		for (int i = 0; i < n; i++) {
-			__m128d M[12];
-			blend2(g, (size_t)i, inf, M);
-			const double *u = i < pairs ? q + 20 * (size_t)i : last;
-#define a(e) QP(u, e)
-#define MUL(x, y) _mm_mul_pd(x, y)
-#define ADD(x, y) _mm_add_pd(x, y)
-#define DOT3(a0, m0, a1, m1, a2, m2) ADD(ADD(MUL(a0, m0), MUL(a1, m1)), MUL(a2, m2))
-			__m128d t00 = DOT3(a(0), M[0], a(1), M[4], a(2), M[8]);
-			__m128d t01 = DOT3(a(0), M[1], a(1), M[5], a(2), M[9]);
-			__m128d t02 = DOT3(a(0), M[2], a(1), M[6], a(2), M[10]);
-			__m128d t10 = DOT3(a(1), M[0], a(4), M[4], a(5), M[8]);
-			__m128d t11 = DOT3(a(1), M[1], a(4), M[5], a(5), M[9]);
-			__m128d t12 = DOT3(a(1), M[2], a(4), M[6], a(5), M[10]);
-			__m128d t20 = DOT3(a(2), M[0], a(5), M[4], a(7), M[8]);
-			__m128d t21 = DOT3(a(2), M[1], a(5), M[5], a(7), M[9]);
-			__m128d t22 = DOT3(a(2), M[2], a(5), M[6], a(7), M[10]);
-			__m128d t03 = ADD(DOT3(a(0), M[3], a(1), M[7], a(2), M[11]), a(3));
-			__m128d t13 = ADD(DOT3(a(1), M[3], a(4), M[7], a(5), M[11]), a(6));
-			__m128d t23 = ADD(DOT3(a(2), M[3], a(5), M[7], a(7), M[11]), a(8));
-			__m128d t33 = ADD(DOT3(a(3), M[3], a(6), M[7], a(8), M[11]), a(9));
-			__m128d h0 = DOT3(M[0], t00, M[4], t10, M[8], t20);
-			__m128d h1 = DOT3(M[0], t01, M[4], t11, M[8], t21);
-			__m128d h2 = DOT3(M[0], t02, M[4], t12, M[8], t22);
-			__m128d h3 = DOT3(M[0], t03, M[4], t13, M[8], t23);
-			__m128d h4 = DOT3(M[1], t01, M[5], t11, M[9], t21);
-			__m128d h5 = DOT3(M[1], t02, M[5], t12, M[9], t22);
-			__m128d h6 = DOT3(M[1], t03, M[5], t13, M[9], t23);
-			__m128d h7 = DOT3(M[2], t02, M[6], t12, M[10], t22);
-			__m128d h8 = DOT3(M[2], t03, M[6], t13, M[10], t23);
-			__m128d h9 = ADD(DOT3(M[3], t03, M[7], t13, M[11], t23), t33);
-			/* H[e] += pose 2i's term, then += pose 2i + 1's: two entries
-			 * of H to a register (Hv[j] = H[2j], H[2j + 1]), the terms
-			 * regrouped to match (unpacklo: both entries' pose 2i terms) */
-#define ACC(j, x, y) Hv[j] = ADD(ADD(Hv[j], _mm_unpacklo_pd(x, y)), _mm_unpackhi_pd(x, y))
-#define ACC1(j, x, y) Hv[j] = ADD(Hv[j], _mm_unpacklo_pd(x, y))
-			if (i < pairs) {
-				ACC(0, h0, h1);
-				ACC(1, h2, h3);
-				ACC(2, h4, h5);
-				ACC(3, h6, h7);
-				ACC(4, h8, h9);
-			} else {
-				ACC1(0, h0, h1);
-				ACC1(1, h2, h3);
-				ACC1(2, h4, h5);
-				ACC1(3, h6, h7);
-				ACC1(4, h8, h9);
-			}
+		if (D == P) {
+			/* every pose stored, in order: H[e] += pose 2i's term, then
+			 * += pose 2i + 1's (unpacklo: both entries' pose 2i terms) */
+			for (int i = 0; i < n; i++) {
+				__m128d t[10];
+				pull_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, t);
+#define ACC(j) Hv[j] = _mm_add_pd(_mm_add_pd(Hv[j], _mm_unpacklo_pd(t[2 * j], t[2 * j + 1])), \
+                                  _mm_unpackhi_pd(t[2 * j], t[2 * j + 1]))
+#define ACC1(j) Hv[j] = _mm_add_pd(Hv[j], _mm_unpacklo_pd(t[2 * j], t[2 * j + 1]))
+				if (i < pairs) {
+					ACC(0), ACC(1), ACC(2), ACC(3), ACC(4);
+				} else {
+					ACC1(0), ACC1(1), ACC1(2), ACC1(3), ACC1(4);
+				}
 #undef ACC1
 #undef ACC
-#undef a
-#undef DOT3
-#undef ADD
-#undef MUL
+			}
+		} else if (n <= TERMS_MAX / 2) {
+			/* Pose p's terms are its stored pose's: every stored pair's
+			 * terms first (each stored pose is some pose's), then the sums
+			 * in pose order. */
+			double ht[TERMS_MAX][10];
+			for (int i = 0; i < n; i++) {
+				__m128d t[10];
+				pull_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, t);
+				for (int k = 0; k < 10; k++)
+					_mm_storel_pd(&ht[2 * i][k], t[k]), _mm_storeh_pd(&ht[2 * i + 1][k], t[k]);
+			}
+			for (int p = 0; p < P; p++) {
+				const double *t = ht[g->qmap[p]];
+				for (int j = 0; j < 5; j++)
+					Hv[j] = _mm_add_pd(Hv[j], _mm_loadu_pd(t + 2 * j));
+			}
+		} else {
+			for (int p = 0; p < P; p++) {
+				int d = g->qmap[p], i = d / 2;
+				__m128d t[10];
+				double ht[10][2];
+				pull_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, t);
+				for (int k = 0; k < 10; k++)
+					_mm_storeu_pd(ht[k], t[k]);
+				for (int j = 0; j < 5; j++)
+					Hv[j] = _mm_add_pd(Hv[j], _mm_set_pd(ht[2 * j + 1][d & 1], ht[2 * j][d & 1]));
+			}
 		}
 		for (int j = 0; j < 5; j++)
 			_mm_storeu_pd(H + 2 * j, Hv[j]);
-		p = P;
+		memcpy(h, H, sizeof H);
+		return;
 	}
 #endif
-	for (; p < g->pose_count; p++) {
+	for (int p = 0; p < P; p++) {
 		double M[12], a[10];
-		bgm_quadric_get(q, g->pose_count, p, a);
+		bgm_quadric_get(q, D, g->qmap[p], a);
 		blend(g, p, inf, M);
 		double t00 = a[0] * M[0] + a[1] * M[4] + a[2] * M[8];
 		double t01 = a[0] * M[1] + a[1] * M[5] + a[2] * M[9];

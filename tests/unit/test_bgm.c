@@ -863,7 +863,7 @@ static double ref_error(const mlod_bgm *g, const double *q, const mlod_influence
 		for (int r = 0; r < 3; r++)
 			y[r] = M[4 * r] * x[0] + M[4 * r + 1] * x[1] + M[4 * r + 2] * x[2] + M[4 * r + 3];
 		double a[10];
-		bgm_quadric_get(q, g->pose_count, p, a);
+		bgm_quadric_get(q, g->qpose_count, g->qmap[p], a);
 		double v = a[0] * y[0] * y[0] + 2 * a[1] * y[0] * y[1] + 2 * a[2] * y[0] * y[2] + 2 * a[3] * y[0] +
 		           a[4] * y[1] * y[1] + 2 * a[5] * y[1] * y[2] + 2 * a[6] * y[1] + a[7] * y[2] * y[2] + 2 * a[8] * y[2] + a[9];
 		e += v > 0.0 ? v : 0.0;
@@ -878,7 +878,7 @@ static void ref_pullback(const mlod_bgm *g, const double *q, const mlod_influenc
 	memset(H, 0, 10 * sizeof *H);
 	for (int p = 0; p < g->pose_count; p++) {
 		double M[12], T[3][4], a[10];
-		bgm_quadric_get(q, g->pose_count, p, a);
+		bgm_quadric_get(q, g->qpose_count, g->qmap[p], a);
 		/* the packed quadric as a symmetric 4x4 */
 		double A[4][4] = {{a[0], a[1], a[2], a[3]}, {a[1], a[4], a[5], a[6]}, {a[2], a[5], a[7], a[8]}, {a[3], a[6], a[8], a[9]}};
 		ref_blend(g, p, inf, M);
@@ -916,7 +916,7 @@ static void check_two_pose_sums(const mlod_character *c, int clips, int random)
 	CHECK(g->pose_count == 1 + poses.count && g->joint_count > 0);
 	int checked = 0, stopped = 0;
 	for (int v = 0; v + 1 < g->node_count; v += 7) {
-		const double *q = g->quadric + (size_t)v * (size_t)g->pose_count * 10;
+		const double *q = g->quadric + (size_t)v * (size_t)g->qpose_count * 10;
 		/* Its own influences, and Power Skinning of its and the next
 		 * node's at their midpoint (more joints). */
 		mlod_influences in[2], mixed;
