@@ -1453,48 +1453,33 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 					last[i][2 * e] = last[i][2 * e + 1] = qv[i][20 * pairs + (size_t)e];
 				ql[i] = last[i];
 			}
-		/* a pose that fails the tests gives +0, which leaves lb (from +0,
-		 * never -0) as it was */
-		if (D == P) {
-			/* every pose stored, in order */
+		/* A pose that fails the tests gives +0, which leaves lb (from +0,
+		 * never -0) as it was. With every pose stored, in order, the
+		 * terms go to lb as they come; else pose p's term is its stored
+		 * pose's: every stored pair's terms first (each stored pose is
+		 * some pose's), then the sum in pose order (beyond PMB_MAX stored
+		 * poses, one pose at a time below). */
+		enum { PMB_MAX = 128 };
+		double t[PMB_MAX];
+		int all = D == P;
+		if (all || 2 * n <= PMB_MAX) {
 			for (size_t i2 = 0; i2 < n; i2++) {
 				double val[2];
 				const double *qp[3];
 				for (int i = 0; i < k; i++)
 					qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
-				_mm_storeu_pd(val, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
-				lb += val[0];
-				if (i2 < pairs)
-					lb += val[1];
-			}
-		} else {
-			/* Pose p's term is its stored pose's: every stored pair's terms
-			 * first (each stored pose is some pose's), then the sum in pose
-			 * order; beyond PMB_MAX stored poses, each pose's pair again. */
-			enum { PMB_MAX = 128 };
-			double t[PMB_MAX];
-			for (size_t i2 = 0; i2 < n && 2 * n <= PMB_MAX; i2++) {
-				const double *qp[3];
-				for (int i = 0; i < k; i++)
-					qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
-				_mm_storeu_pd(t + 2 * i2, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
-			}
-			for (size_t q = 0; q < P; q++) {
-				int d = g->qmap[q];
-				if (2 * n <= PMB_MAX) {
-					lb += t[d];
-				} else {
-					size_t i2 = (size_t)d / 2;
-					double val[2];
-					const double *qp[3];
-					for (int i = 0; i < k; i++)
-						qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
-					_mm_storeu_pd(val, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
-					lb += val[d & 1];
+				_mm_storeu_pd(all ? val : t + 2 * i2, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
+				if (all) {
+					lb += val[0];
+					if (i2 < pairs)
+						lb += val[1];
 				}
 			}
+			if (!all)
+				for (size_t q = 0; q < P; q++)
+					lb += t[g->qmap[q]];
+			p = P;
 		}
-		p = P;
 	}
 #endif
 	for (; p < P; p++) {

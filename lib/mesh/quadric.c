@@ -826,20 +826,34 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 #undef ACC
 			}
 		} else if (n <= TERMS_MAX / 2) {
-			/* Pose p's terms are its stored pose's: every stored pair's
-			 * terms first (each stored pose is some pose's), then the sums
-			 * in pose order. */
-			double ht[TERMS_MAX][10];
-			for (int i = 0; i < n; i++) {
-				__m128d t[10];
-				pull_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, t);
-				for (int k = 0; k < 10; k++)
-					_mm_storel_pd(&ht[2 * i][k], t[k]), _mm_storeh_pd(&ht[2 * i + 1][k], t[k]);
-			}
-			for (int p = 0; p < P; p++) {
-				const double *t = ht[g->qmap[p]];
-				for (int j = 0; j < 5; j++)
-					Hv[j] = _mm_add_pd(Hv[j], _mm_loadu_pd(t + 2 * j));
+			/* Pose p's terms are its stored pose's, each stored pair's
+			 * worked out when first needed (a stored pose comes first at
+			 * its own pose, in order) and kept; poses in order, two at a
+			 * time where two poses in a row are a stored pair. */
+			__m128d hb[TERMS_MAX / 2][10];
+			int done = 0;
+			for (int p = 0; p < P;) {
+				int d = g->qmap[p], i = d / 2;
+				for (; done <= i; done++)
+					pull_pair(g, done < pairs ? q + 20 * (size_t)done : last, inf, (size_t)done, hb[done]);
+				const __m128d *t = hb[i];
+#define ACC(j) Hv[j] = _mm_add_pd(_mm_add_pd(Hv[j], _mm_unpacklo_pd(t[2 * j], t[2 * j + 1])), \
+                                  _mm_unpackhi_pd(t[2 * j], t[2 * j + 1]))
+#define ACCL(j) Hv[j] = _mm_add_pd(Hv[j], _mm_unpacklo_pd(t[2 * j], t[2 * j + 1]))
+#define ACCH(j) Hv[j] = _mm_add_pd(Hv[j], _mm_unpackhi_pd(t[2 * j], t[2 * j + 1]))
+				if ((d & 1) == 0 && i < pairs && p + 1 < P && g->qmap[p + 1] == d + 1) {
+					ACC(0), ACC(1), ACC(2), ACC(3), ACC(4);
+					p += 2;
+				} else {
+					if (d & 1)
+						ACCH(0), ACCH(1), ACCH(2), ACCH(3), ACCH(4);
+					else
+						ACCL(0), ACCL(1), ACCL(2), ACCL(3), ACCL(4);
+					p++;
+				}
+#undef ACCH
+#undef ACCL
+#undef ACC
 			}
 		} else {
 			for (int p = 0; p < P; p++) {
