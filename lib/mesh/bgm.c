@@ -93,17 +93,20 @@ int bgm_add_node(mlod_bgm *g)
 				return -1;
 			g->morph = p;
 		}
-		if (g->pose_count > 0) {
-			p = realloc(g->quadric, (size_t)g->node_cap * (size_t)g->pose_count * 10 * sizeof *g->quadric);
-			if (!p)
-				return -1;
-			g->quadric = p;
-			p = realloc(g->rquad, (size_t)g->node_cap * BGM_RQUAD * sizeof *g->rquad);
-			if (!p)
-				return -1;
-			g->rquad = p;
-		}
 		g->node_aux_cap = g->node_cap;
+	}
+	/* bgm_quadrics_build makes room for every node the collapses can add:
+	 * this is for other growth. */
+	if (g->pose_count > 0 && g->quadric_cap < g->node_cap) {
+		void *p = realloc(g->quadric, (size_t)g->node_cap * (size_t)g->qpose_count * 10 * sizeof *g->quadric);
+		if (!p)
+			return -1;
+		g->quadric = p;
+		p = realloc(g->rquad, (size_t)g->node_cap * BGM_RQUAD * sizeof *g->rquad);
+		if (!p)
+			return -1;
+		g->rquad = p;
+		g->quadric_cap = g->node_cap;
 	}
 	int n = g->node_count++;
 	memset(&g->nodes[n], 0, sizeof g->nodes[n]);
@@ -853,6 +856,8 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->records);
 	free(g->removed);
 	free(g->quadric);
+	free(g->qmap);
+	free(g->qpose);
 	free(g->rquad);
 	free(g->qsum);
 	free(g->skin);

@@ -13,6 +13,7 @@
 #define MLOD_BGM_H
 
 #include <limits.h>
+#include <stddef.h>
 
 #include "mesh/mlod_mesh.h"
 
@@ -71,7 +72,8 @@ struct mlod_bgm {
 
 	/* Nodes, wedges, faces (append-only). */
 	int node_count, node_cap;
-	int node_aux_cap;       /* capacity of inf, morph and quadric */
+	int node_aux_cap;       /* capacity of inf and morph */
+	int quadric_cap;        /* capacity (nodes) of quadric and rquad */
 	bgm_node *nodes;
 	mlod_influences *inf;   /* per node */
 	float *morph;           /* per node, lay.morph_stride floats */
@@ -91,20 +93,30 @@ struct mlod_bgm {
 	int *removed;
 	int removed_len, removed_cap;
 
-	/* Posed quadrics (quadric.c): pose_count poses; per node and pose 10
-	 * doubles; per pose and influence id a 3x4 skin matrix (row-major). */
+	/* Posed quadrics (quadric.c): pose_count poses, of which qpose_count
+	 * are stored: a pose whose used skin matrices are bit for bit an
+	 * earlier pose's has that pose's quadrics, for every node (qmap: pose
+	 * -> stored pose, in order of first use; qpose: stored pose -> its
+	 * pose). Per node qpose_count x 10 doubles, laid out as bgm_qat says
+	 * (stored poses in pairs, side by side); a sum over poses takes each
+	 * pose's stored pose's term, in pose order. Per pose and influence id
+	 * a 3x4 skin matrix (row-major). */
 	int pose_count;
+	int qpose_count;
+	int *qmap;
+	int *qpose;
 	double *quadric;
 	float *skin;
 	double *rquad;          /* per node BGM_RQUAD doubles: its posed quadrics pulled back
 	                         * into bind space with its influences (bgm_quadric_pullback;
 	                         * NaN first until bgm_quadric_rest needs them), then the sum
 	                         * over poses of their traces */
-	double *skin2;          /* the skin matrices as doubles, two poses side by side: per
-	                         * pair of poses (2i, 2i + 1) and influence id, 12 entries of
-	                         * 2 doubles (pose 2i, then 2i + 1); pose_count / 2 pairs (a
-	                         * last odd pose is not in it); NULL when there are none or
-	                         * for a mesh without influences */
+	double *skin2;          /* the skin matrices as doubles, two stored poses side by
+	                         * side: per pair of stored poses (2i, 2i + 1) and influence
+	                         * id, 12 entries of 2 doubles (2i, then 2i + 1);
+	                         * qpose_count / 2 pairs, then for a last odd one a block
+	                         * with it in both lanes; NULL when there is one pose or for
+	                         * a mesh without influences */
 	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
 	double skin_norm;       /* collapse.c: the largest Frobenius norm of a skin matrix's
 	                         * linear part, 0 until worked out */
@@ -164,12 +176,36 @@ int bgm_link_ok(const int *from, const int *to, int m, int path_ok);
 double bgm_compactness(const double *a, const double *b, const double *c);
 int bgm_node_eligible(const mlod_bgm *g, const mlod_influences *inf);
 
+/* The two-pose helpers of quadric.c and collapse.c: inlined where
+ * they are used (called from more than one place, gcc would otherwise
+ * call them, their vectors passed through memory). */
+#if defined(__GNUC__)
+#define BGM_INLINE static inline __attribute__((always_inline))
+#else
+#define BGM_INLINE static inline
+#endif
+
 /* quadric.c */
+/* Where entry e (0-9) of stored pose p is among a node's P x 10 posed
+ * quadric doubles (P = qpose_count): stored poses 2i and 2i + 1 side by
+ * side, entry e of pair i at 20 i + 2 e (2i) and 20 i + 2 e + 1
+ * (2i + 1), so that the two-pose sums load a pair's entries straight; a
+ * last odd one's 10 entries after the pairs, in order. */
+static inline size_t bgm_qat(int P, int p, int e)
+{
+	return p < (P & ~1) ? 20 * (size_t)(p >> 1) + 2 * (size_t)e + (size_t)(p & 1) : 10 * (size_t)p + (size_t)e;
+}
+/* Pose p's 10 entries of the node quadrics q (P poses), in order. */
+static inline void bgm_quadric_get(const double *q, int P, int p, double *out)
+{
+	for (int e = 0; e < 10; e++)
+		out[e] = q[bgm_qat(P, p, e)];
+}
 /* n = (b - a) x (c - a): the face's normal times twice its area. */
 void bgm_face_normal(const double *a, const double *b, const double *c, double *n);
 mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err);
 /* The error of a node at bind position p with influences inf against
- * the quadrics q (pose_count x 10): sum over poses; HUGE_VAL as soon as
+ * the quadrics q (qpose_count x 10, as bgm_qat lays them out): sum over poses; HUGE_VAL as soon as
  * the partial sum reaches stop (HUGE_VAL: never). */
 double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *p,
                          double stop);
@@ -182,8 +218,14 @@ const double *bgm_quadric_rest(mlod_bgm *g, int v);
 /* Sets node v's trace sum and marks its pulled-back quadric for
  * computing (a new node, its quadrics summed). */
 void bgm_quadric_rest_reset(mlod_bgm *g, int v);
-/* A packed quadric's value at x, clamped at 0. */
-double bgm_quadric_eval(const double *h, const double *x);
+/* A packed quadric's value at x, clamped at 0 (inline: the queue's keys
+ * and plan() call it for every candidate). */
+static inline double bgm_quadric_eval(const double *q, const double *x)
+{
+	double v = q[0] * x[0] * x[0] + 2 * q[1] * x[0] * x[1] + 2 * q[2] * x[0] * x[2] + 2 * q[3] * x[0] +
+	           q[4] * x[1] * x[1] + 2 * q[5] * x[1] * x[2] + 2 * q[6] * x[1] + q[7] * x[2] * x[2] + 2 * q[8] * x[2] + q[9];
+	return v > 0.0 ? v : 0.0;
+}
 /* The minimiser of the packed quadric h (directions it leaves free stay
  * at x0); returns 0 and fills out, or -1. */
 int bgm_quadric_solve(const double *h, const double *x0, double *out);

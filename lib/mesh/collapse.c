@@ -382,8 +382,9 @@ static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x
 		q[pl->corner[i]] = x;
 		const double *no = pl->onormal[i];
 		double u[3], v[3], w[3], nn[3];
-		for (int k = 0; k < 3; k++)
-			u[k] = q[1][k] - q[0][k], v[k] = q[2][k] - q[0][k], w[k] = q[2][k] - q[1][k];
+		u[0] = q[1][0] - q[0][0], u[1] = q[1][1] - q[0][1], u[2] = q[1][2] - q[0][2];
+		v[0] = q[2][0] - q[0][0], v[1] = q[2][1] - q[0][1], v[2] = q[2][2] - q[0][2];
+		w[0] = q[2][0] - q[1][0], w[1] = q[2][1] - q[1][1], w[2] = q[2][2] - q[1][2];
 		nn[0] = u[1] * v[2] - u[2] * v[1];
 		nn[1] = u[2] * v[0] - u[0] * v[2];
 		nn[2] = u[0] * v[1] - u[1] * v[0];
@@ -423,18 +424,20 @@ static void sum_quadrics(const mlod_bgm *g, const struct plan *pl, double *Q)
 {
 	/* Each sum from 0 in the vertices' order (the same bits whatever
 	 * loop makes it). */
-	size_t n = 10 * (size_t)g->pose_count;
+	size_t n = 10 * (size_t)g->qpose_count;
 	const double *a = g->quadric + (size_t)pl->v[0] * n, *b = pl->k > 1 ? g->quadric + (size_t)pl->v[1] * n : NULL;
 #ifdef __SSE2__
 	/* Two entries at a time (n is even): each lane the sum below. */
 	if (pl->k == 2 || pl->k == 3) {
-		const double *c = pl->k == 3 ? g->quadric + (size_t)pl->v[2] * n : NULL;
 		const __m128d zero = _mm_setzero_pd();
-		for (size_t k = 0; k < n; k += 2) {
-			__m128d s = _mm_add_pd(_mm_add_pd(zero, _mm_loadu_pd(a + k)), _mm_loadu_pd(b + k));
-			if (c)
-				s = _mm_add_pd(s, _mm_loadu_pd(c + k));
-			_mm_storeu_pd(Q + k, s);
+		if (pl->k == 3) {
+			const double *c = g->quadric + (size_t)pl->v[2] * n;
+			for (size_t k = 0; k < n; k += 2)
+				_mm_storeu_pd(Q + k, _mm_add_pd(_mm_add_pd(_mm_add_pd(zero, _mm_load_pd(a + k)), _mm_load_pd(b + k)),
+				                                _mm_load_pd(c + k)));
+		} else {
+			for (size_t k = 0; k < n; k += 2)
+				_mm_storeu_pd(Q + k, _mm_add_pd(_mm_add_pd(zero, _mm_load_pd(a + k)), _mm_load_pd(b + k)));
 		}
 		return;
 	}
@@ -749,7 +752,7 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 	}
 	/* Per group, how many wedges each collapsed vertex has there. */
 	int per[MAX_WEDGES][3];
-	memset(per, 0, sizeof per);
+	memset(per, 0, sizeof per[0] * (size_t)pl->ngroups); /* the groups' rows */
 	for (int i = 0; i < pl->nw; i++)
 		per[pl->group[i]][owner[i]]++;
 
@@ -836,7 +839,8 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		sum_quadrics(g, pl, Q);
 		q_ready = 1;
 		for (int p = 0; p < g->pose_count; p++)
-			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+			wsum += Q[bgm_qat(g->qpose_count, g->qmap[p], 0)] + Q[bgm_qat(g->qpose_count, g->qmap[p], 4)] +
+			        Q[bgm_qat(g->qpose_count, g->qmap[p], 7)];
 		if (mm) {
 			mm->wsum = wsum;
 			mm->known |= MEMO_WSUM;
@@ -1205,16 +1209,18 @@ static inline double pose_min_bound(const mlod_bgm *g, const uint16_t *joint, in
 		far = max_d(far, a);
 	}
 	double R = (sqrt(spread) + rl) * (1.0 + 1e-6) + 1e-6 * (sqrt(far) + rl);
-	double q[10];
-	const double *q0 = qv[0] + 10 * p;
+	double q[10], q0[10], q1[10], q2[10];
+	int D = g->qpose_count, sp = g->qmap[p]; /* pose p's stored pose */
+	bgm_quadric_get(qv[0], D, sp, q0);
 	if (k == 1) {
 		memcpy(q, q0, sizeof q);
 	} else if (k == 2) {
-		const double *q1 = qv[1] + 10 * p;
+		bgm_quadric_get(qv[1], D, sp, q1);
 		for (int e = 0; e < 10; e++)
 			q[e] = q0[e] + q1[e];
 	} else {
-		const double *q1 = qv[1] + 10 * p, *q2 = qv[2] + 10 * p;
+		bgm_quadric_get(qv[1], D, sp, q1);
+		bgm_quadric_get(qv[2], D, sp, q2);
 		for (int e = 0; e < 10; e++)
 			q[e] = q0[e] + q1[e] + q2[e];
 	}
@@ -1264,59 +1270,63 @@ static inline __m128d abs_pd2(__m128d x)
 /* pose_min_bound for poses p and p + 1 (lanes 0 and 1), every step
  * done whatever the tests: val, tr and det per pose, for the caller to
  * test as pose_min_bound does. */
-static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int nj, const double *const qv[3], int k,
-                                   size_t p, const double *bary, double rl, double inv, double *val_out,
-                                   double *tr_out, double *det_out)
+BGM_INLINE __m128d pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int nj, const double *const qv[3],
+                                      int k, size_t i2, const double *bary, double rl, double inv)
 {
 	int J = g->joint_count;
-	/* g->skin2: the skin matrices as doubles, poses p and p + 1 side by side */
-	const double *S = g->skin2 + p / 2 * (size_t)J * 24;
+	/* g->skin2: the skin matrices as doubles, poses p and p + 1 side by side
+	 * (block i2 = p / 2); qv: the k vertices' quadrics of that pair */
+	const double *S = g->skin2 + i2 * (size_t)J * 24;
 	const __m128d bx = _mm_set1_pd(bary[0]), by = _mm_set1_pd(bary[1]), bz = _mm_set1_pd(bary[2]);
 	const __m128d zero = _mm_setzero_pd();
-	__m128d z[3 * MLOD_MAX_INFLUENCES][3], c[3] = {zero, zero, zero};
+	/* Three rows and sums in registers; |z_j|^2 and its running maximum as
+	 * the joints come (it needs no c). A square is +0 or above, or NaN, so
+	 * the sums of three squares are the ones from 0 (0 + x x = x x). */
+	__m128d z[3 * MLOD_MAX_INFLUENCES][3], c0 = zero, c1 = zero, c2 = zero, far = zero;
 	for (int j = 0; j < nj; j++) {
 		const double *m = S + 24 * (size_t)joint[j];
-		for (int i = 0; i < 3; i++) {
-			const double *row = m + 8 * i;
-			__m128d t = _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(row), bx), _mm_mul_pd(_mm_loadu_pd(row + 2), by));
-			t = _mm_add_pd(_mm_add_pd(t, _mm_mul_pd(_mm_loadu_pd(row + 4), bz)), _mm_loadu_pd(row + 6));
-			z[j][i] = t;
-			c[i] = _mm_add_pd(c[i], t);
-		}
+#define ROW(i) _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_load_pd(m + 8 * (i)), bx), \
+                                                _mm_mul_pd(_mm_load_pd(m + 8 * (i) + 2), by)), \
+                                     _mm_mul_pd(_mm_load_pd(m + 8 * (i) + 4), bz)), \
+                          _mm_load_pd(m + 8 * (i) + 6))
+		__m128d z0 = ROW(0), z1 = ROW(1), z2 = ROW(2);
+#undef ROW
+		z[j][0] = z0, z[j][1] = z1, z[j][2] = z2;
+		c0 = _mm_add_pd(c0, z0), c1 = _mm_add_pd(c1, z1), c2 = _mm_add_pd(c2, z2);
+		__m128d a = _mm_add_pd(_mm_add_pd(_mm_mul_pd(z0, z0), _mm_mul_pd(z1, z1)), _mm_mul_pd(z2, z2));
+		/* max_d(far, a): a is +0 or above, or NaN (then far, never NaN,
+		 * stays, as maxpd gives its second operand) */
+		far = _mm_max_pd(a, far);
 	}
 	const __m128d vinv = _mm_set1_pd(inv);
-	for (int i = 0; i < 3; i++)
-		c[i] = _mm_mul_pd(c[i], vinv);
-	__m128d spread = zero, far = zero;
+	c0 = _mm_mul_pd(c0, vinv), c1 = _mm_mul_pd(c1, vinv), c2 = _mm_mul_pd(c2, vinv);
+	__m128d c[3] = {c0, c1, c2};
+	__m128d spread = zero;
 	for (int j = 0; j < nj; j++) {
-		__m128d d = zero, a = zero;
-		for (int i = 0; i < 3; i++) {
-			__m128d x = _mm_sub_pd(z[j][i], c[i]);
-			d = _mm_add_pd(d, _mm_mul_pd(x, x));
-			a = _mm_add_pd(a, _mm_mul_pd(z[j][i], z[j][i]));
-		}
-		/* max_d(spread, d): d is +0 or above, or NaN (then spread, never
-		 * NaN, stays, as maxpd gives its second operand) */
+		__m128d x0 = _mm_sub_pd(z[j][0], c0), x1 = _mm_sub_pd(z[j][1], c1), x2 = _mm_sub_pd(z[j][2], c2);
+		__m128d d = _mm_add_pd(_mm_add_pd(_mm_mul_pd(x0, x0), _mm_mul_pd(x1, x1)), _mm_mul_pd(x2, x2));
+		/* max_d(spread, d), as far above */
 		spread = _mm_max_pd(d, spread);
-		far = _mm_max_pd(a, far);
 	}
 	const __m128d vrl = _mm_set1_pd(rl);
 	__m128d R = _mm_add_pd(_mm_mul_pd(_mm_add_pd(_mm_sqrt_pd(spread), vrl), _mm_set1_pd(1.0 + 1e-6)),
 	                       _mm_mul_pd(_mm_set1_pd(1e-6), _mm_add_pd(_mm_sqrt_pd(far), vrl)));
 	__m128d q[10];
-	const double *a0 = qv[0] + 10 * p;
+	/* poses p and p + 1 side by side (bgm_qat): entry e at 2 e */
+	const double *a0 = qv[0];
 	if (k == 1) {
 		for (int e = 0; e < 10; e++)
-			q[e] = _mm_set_pd(a0[10 + e], a0[e]);
+			q[e] = _mm_load_pd(a0 + 2 * e);
 	} else if (k == 2) {
-		const double *a1 = qv[1] + 10 * p;
-		for (int e = 0; e < 10; e++)
-			q[e] = _mm_add_pd(_mm_set_pd(a0[10 + e], a0[e]), _mm_set_pd(a1[10 + e], a1[e]));
+		const double *a1 = qv[1];
+#define Q2(e) q[e] = _mm_add_pd(_mm_load_pd(a0 + 2 * (e)), _mm_load_pd(a1 + 2 * (e)))
+		Q2(0), Q2(1), Q2(2), Q2(3), Q2(4), Q2(5), Q2(6), Q2(7), Q2(8), Q2(9);
+#undef Q2
 	} else {
-		const double *a1 = qv[1] + 10 * p, *a2 = qv[2] + 10 * p;
-		for (int e = 0; e < 10; e++)
-			q[e] = _mm_add_pd(_mm_add_pd(_mm_set_pd(a0[10 + e], a0[e]), _mm_set_pd(a1[10 + e], a1[e])),
-			                  _mm_set_pd(a2[10 + e], a2[e]));
+		const double *a1 = qv[1], *a2 = qv[2];
+#define Q3(e) q[e] = _mm_add_pd(_mm_add_pd(_mm_load_pd(a0 + 2 * (e)), _mm_load_pd(a1 + 2 * (e))), _mm_load_pd(a2 + 2 * (e)))
+		Q3(0), Q3(1), Q3(2), Q3(3), Q3(4), Q3(5), Q3(6), Q3(7), Q3(8), Q3(9);
+#undef Q3
 	}
 	__m128d tr = _mm_add_pd(_mm_add_pd(q[0], q[4]), q[7]);
 	__m128d mu = _mm_mul_pd(_mm_set1_pd(1e-5), tr);
@@ -1365,9 +1375,13 @@ static inline void pose_min_bound2(const mlod_bgm *g, const uint16_t *joint, int
 	                        _mm_mul_pd(two, _mm_add_pd(_mm_add_pd(abs_pd2(q[1]), abs_pd2(q[2])), abs_pd2(q[5]))));
 	__m128d mag = _mm_add_pd(_mm_add_pd(abs_pd2(q[9]), _mm_mul_pd(_mm_mul_pd(two, lin), ym)), _mm_mul_pd(_mm_mul_pd(sq, ym), ym));
 	val = _mm_sub_pd(val, _mm_mul_pd(_mm_set1_pd(1e-12), mag));
-	_mm_storeu_pd(val_out, val);
-	_mm_storeu_pd(tr_out, tr);
-	_mm_storeu_pd(det_out, det);
+	/* The caller's tests (tr > 0 and finite, |det| > 0, val > 0 and
+	 * finite) lane by lane: a lane that fails them gives +0. */
+	const __m128d inf = _mm_set1_pd(HUGE_VAL);
+	__m128d ok = _mm_and_pd(_mm_cmpgt_pd(tr, zero), _mm_cmplt_pd(tr, inf));
+	ok = _mm_and_pd(ok, _mm_cmpgt_pd(abs_pd2(det), zero));
+	ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmpgt_pd(val, zero), _mm_cmplt_pd(val, inf)));
+	return _mm_and_pd(ok, val);
 }
 #endif
 
@@ -1415,22 +1429,57 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 			g->skin_norm = max_d(g->skin_norm, sqrt(l));
 		}
 	}
+	size_t D = (size_t)g->qpose_count;
 	const double *qv[3];
 	for (int i = 0; i < k; i++)
-		qv[i] = g->quadric + (size_t)v[i] * P * 10;
+		qv[i] = g->quadric + (size_t)v[i] * D * 10;
 	double lb = 0.0, rl = r * g->skin_norm, inv = 1.0 / nj;
 	size_t p = 0;
 #ifdef __SSE2__
-	/* Two poses at a time, pose p in the low lane and p + 1 in the high
-	 * one: every lane the same products, sums and tests, in the same
+	/* Two stored poses at a time, 2i in the low lane and 2i + 1 in the
+	 * high one: every lane the same products, sums and tests, in the same
 	 * order, as pose_min_bound's (SSE2 rounds as scalar code), and the
 	 * poses' terms added in pose order. */
-	for (; g->skin2 && p + 1 < P; p += 2) {
-		double val[2], tr[2], det[2];
-		pose_min_bound2(g, joint, nj, qv, k, p, bary, rl, inv, val, tr, det);
-		for (int l = 0; l < 2; l++)
-			if (tr[l] > 0.0 && isfinite(tr[l]) && fabs(det[l]) > 0.0 && val[l] > 0.0 && isfinite(val[l]))
-				lb += val[l];
+	if (g->skin2) {
+		/* A last odd stored pose the same way, in both lanes (its own
+		 * g->skin2 block, the vertices' entries doubled in last), the low
+		 * lane taken. */
+		size_t pairs = D / 2, n = (D + 1) / 2;
+		_Alignas(16) double last[3][20];
+		const double *ql[3];
+		if (D & 1)
+			for (int i = 0; i < k; i++) {
+				for (int e = 0; e < 10; e++)
+					last[i][2 * e] = last[i][2 * e + 1] = qv[i][20 * pairs + (size_t)e];
+				ql[i] = last[i];
+			}
+		/* A pose that fails the tests gives +0, which leaves lb (from +0,
+		 * never -0) as it was. With every pose stored, in order, the
+		 * terms go to lb as they come; else pose p's term is its stored
+		 * pose's: every stored pair's terms first (each stored pose is
+		 * some pose's), then the sum in pose order (beyond PMB_MAX stored
+		 * poses, one pose at a time below). */
+		enum { PMB_MAX = 128 };
+		double t[PMB_MAX];
+		int all = D == P;
+		if (all || 2 * n <= PMB_MAX) {
+			for (size_t i2 = 0; i2 < n; i2++) {
+				double val[2];
+				const double *qp[3];
+				for (int i = 0; i < k; i++)
+					qp[i] = i2 < pairs ? qv[i] + 20 * i2 : ql[i];
+				_mm_storeu_pd(all ? val : t + 2 * i2, pose_min_bound2(g, joint, nj, qp, k, i2, bary, rl, inv));
+				if (all) {
+					lb += val[0];
+					if (i2 < pairs)
+						lb += val[1];
+				}
+			}
+			if (!all)
+				for (size_t q = 0; q < P; q++)
+					lb += t[g->qmap[q]];
+			p = P;
+		}
 	}
 #endif
 	for (; p < P; p++) {
@@ -1532,8 +1581,17 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 	if (same || g->opt.fast_cost) {
 		for (int j = 0; j < K; j++) {
 			const double *r = bgm_quadric_rest(g, v[j]);
+#ifdef __SSE2__
+			/* two entries at a time, each the same sum */
+			_mm_storeu_pd(Q, _mm_add_pd(_mm_loadu_pd(Q), _mm_loadu_pd(r)));
+			_mm_storeu_pd(Q + 2, _mm_add_pd(_mm_loadu_pd(Q + 2), _mm_loadu_pd(r + 2)));
+			_mm_storeu_pd(Q + 4, _mm_add_pd(_mm_loadu_pd(Q + 4), _mm_loadu_pd(r + 4)));
+			_mm_storeu_pd(Q + 6, _mm_add_pd(_mm_loadu_pd(Q + 6), _mm_loadu_pd(r + 6)));
+			_mm_storeu_pd(Q + 8, _mm_add_pd(_mm_loadu_pd(Q + 8), _mm_loadu_pd(r + 8)));
+#else
 			for (int k = 0; k < 10; k++)
 				Q[k] += r[k];
+#endif
 		}
 		lb = bgm_quadric_eval(Q, bary);
 		for (int j = 0; j < K; j++)
@@ -1549,10 +1607,12 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 		margin = 1.0 - 1e-9;
 		*weak = 1;
 	} else {
+		/* the bind pose's entries: bgm_qat(P, 0, k) = st k */
+		size_t st = bgm_qat(g->qpose_count, 0, 1);
 		for (int j = 0; j < K; j++) {
-			const double *q = g->quadric + (size_t)v[j] * (size_t)g->pose_count * 10;
-			for (int k = 0; k < 10; k++)
-				Q[k] += q[k];
+			const double *q = g->quadric + (size_t)v[j] * (size_t)g->qpose_count * 10;
+			Q[0] += q[0], Q[1] += q[st], Q[2] += q[2 * st], Q[3] += q[3 * st], Q[4] += q[4 * st];
+			Q[5] += q[5 * st], Q[6] += q[6 * st], Q[7] += q[7 * st], Q[8] += q[8 * st], Q[9] += q[9 * st];
 		}
 		lb = bgm_quadric_eval(Q, bary);
 		for (int j = 0; j < K; j++)
@@ -1635,7 +1695,8 @@ static double exact_bound(mlod_bgm *g, int f, int op, memo *mm)
 		sum_quadrics(g, &pv, Q);
 		q_ready = 1;
 		for (int p = 0; p < g->pose_count; p++)
-			wsum += Q[10 * p] + Q[10 * p + 4] + Q[10 * p + 7];
+			wsum += Q[bgm_qat(g->qpose_count, g->qmap[p], 0)] + Q[bgm_qat(g->qpose_count, g->qmap[p], 4)] +
+			        Q[bgm_qat(g->qpose_count, g->qmap[p], 7)];
 		mm->wsum = wsum;
 		mm->known |= MEMO_WSUM;
 	}
@@ -1827,7 +1888,7 @@ static int apply(mlod_bgm *g, struct plan *pl)
 	}
 	if (g->pose_count > 0) {
 		/* The parents' sums, each from 0 in their order (sum_quadrics). */
-		sum_quadrics(g, pl, g->quadric + (size_t)v * (size_t)g->pose_count * 10);
+		sum_quadrics(g, pl, g->quadric + (size_t)v * (size_t)g->qpose_count * 10);
 		bgm_quadric_rest_reset(g, v);
 	}
 

@@ -17,7 +17,9 @@
  * Pose 0 is the bind pose (the rest pose for a rigid mesh); the others
  * come from mlod_bgm_options.poses (clip frames and random poses).
  */
+#include <limits.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef __SSE2__
@@ -49,11 +51,12 @@ static void plane_quadric(const double *a, const double *fn, double *q)
 	for (int i = 0; i < 3; i++)
 		n[i] /= len;
 	double d = -(n[0] * a[0] + n[1] * a[1] + n[2] * a[2]);
-	double P[4] = {n[0], n[1], n[2], d};
-	int k = 0;
-	for (int i = 0; i < 4; i++)
-		for (int j = i; j < 4; j++)
-			q[k++] += area * P[i] * P[j];
+	/* q[k] += area * P[i] * P[j] over i <= j, P = (n, d), written out */
+	double w0 = area * n[0], w1 = area * n[1], w2 = area * n[2], w3 = area * d;
+	q[0] += w0 * n[0], q[1] += w0 * n[1], q[2] += w0 * n[2], q[3] += w0 * d;
+	q[4] += w1 * n[1], q[5] += w1 * n[2], q[6] += w1 * d;
+	q[7] += w2 * n[2], q[8] += w2 * d;
+	q[9] += w3 * d;
 }
 
 static double dot3(const double *a, const double *b)
@@ -84,11 +87,13 @@ static void edge_quadric(const double *a, const double *b, const double *n, doub
 		return;
 	for (int i = 0; i < 3; i++)
 		m[i] /= len;
-	double P[4] = {m[0], m[1], m[2], -dot3(m, a)};
-	int k = 0;
-	for (int i = 0; i < 4; i++)
-		for (int j = i; j < 4; j++)
-			q[k++] += FEATURE_WEIGHT * l2 * P[i] * P[j];
+	double d = -dot3(m, a), l = FEATURE_WEIGHT * l2;
+	/* q[k] += FEATURE_WEIGHT * l2 * P[i] * P[j] over i <= j, P = (m, d), written out */
+	double w0 = l * m[0], w1 = l * m[1], w2 = l * m[2], w3 = l * d;
+	q[0] += w0 * m[0], q[1] += w0 * m[1], q[2] += w0 * m[2], q[3] += w0 * d;
+	q[4] += w1 * m[1], q[5] += w1 * m[2], q[6] += w1 * d;
+	q[7] += w2 * m[2], q[8] += w2 * d;
+	q[9] += w3 * d;
 }
 
 /* The blended 3x4 matrix of pose p for influences inf. */
@@ -147,60 +152,235 @@ static inline double eval(const double *q, const double *x)
 #ifdef __SSE2__
 /* Two poses at a time (pair i: poses 2i and 2i + 1 in the low and high
  * lanes), each lane the same products and sums in the same order as the
- * one-pose functions above (SSE2 rounds as scalar code). */
+ * one-pose functions above (SSE2 rounds as scalar code).
+ * g->skin2 and the node quadrics (g->quadric, collapse.c's g->qsum) come
+ * from malloc, so their pairs (24 and 20 doubles) are 16-byte aligned:
+ * aligned loads, which the products take as memory operands. */
+_Static_assert(_Alignof(max_align_t) >= 16, "malloc's blocks must be 16-byte aligned for the two-pose loads");
 
 /* blend for both poses of pair i; inf has influences (joint_count > 0). */
-static inline void blend2(const mlod_bgm *g, size_t i, const mlod_influences *inf, __m128d *M)
+BGM_INLINE void blend2s(const double *S, const mlod_influences *inf, __m128d *M);
+
+BGM_INLINE void blend2(const mlod_bgm *g, size_t i, const mlod_influences *inf, __m128d *M)
 {
-	const double *S = g->skin2 + i * (size_t)g->joint_count * 24;
+	blend2s(g->skin2 + i * (size_t)g->joint_count * 24, inf, M);
+}
+
+/* blend2 on the block S of two poses' skin matrices (24 doubles per
+ * influence id). */
+BGM_INLINE void blend2s(const double *S, const mlod_influences *inf, __m128d *M)
+{
 	/* Written out, so that the twelve sums stay in registers. */
 	__m128d m0 = _mm_setzero_pd(), m1 = m0, m2 = m0, m3 = m0, m4 = m0, m5 = m0, m6 = m0, m7 = m0, m8 = m0,
 	        m9 = m0, m10 = m0, m11 = m0;
 	for (int k = 0; k < inf->count; k++) {
 		const double *s = S + 24 * (size_t)inf->joints[k];
 		__m128d w = _mm_set1_pd((double)inf->weights[k]);
-		m0 = _mm_add_pd(m0, _mm_mul_pd(w, _mm_loadu_pd(s)));
-		m1 = _mm_add_pd(m1, _mm_mul_pd(w, _mm_loadu_pd(s + 2)));
-		m2 = _mm_add_pd(m2, _mm_mul_pd(w, _mm_loadu_pd(s + 4)));
-		m3 = _mm_add_pd(m3, _mm_mul_pd(w, _mm_loadu_pd(s + 6)));
-		m4 = _mm_add_pd(m4, _mm_mul_pd(w, _mm_loadu_pd(s + 8)));
-		m5 = _mm_add_pd(m5, _mm_mul_pd(w, _mm_loadu_pd(s + 10)));
-		m6 = _mm_add_pd(m6, _mm_mul_pd(w, _mm_loadu_pd(s + 12)));
-		m7 = _mm_add_pd(m7, _mm_mul_pd(w, _mm_loadu_pd(s + 14)));
-		m8 = _mm_add_pd(m8, _mm_mul_pd(w, _mm_loadu_pd(s + 16)));
-		m9 = _mm_add_pd(m9, _mm_mul_pd(w, _mm_loadu_pd(s + 18)));
-		m10 = _mm_add_pd(m10, _mm_mul_pd(w, _mm_loadu_pd(s + 20)));
-		m11 = _mm_add_pd(m11, _mm_mul_pd(w, _mm_loadu_pd(s + 22)));
+		m0 = _mm_add_pd(m0, _mm_mul_pd(w, _mm_load_pd(s)));
+		m1 = _mm_add_pd(m1, _mm_mul_pd(w, _mm_load_pd(s + 2)));
+		m2 = _mm_add_pd(m2, _mm_mul_pd(w, _mm_load_pd(s + 4)));
+		m3 = _mm_add_pd(m3, _mm_mul_pd(w, _mm_load_pd(s + 6)));
+		m4 = _mm_add_pd(m4, _mm_mul_pd(w, _mm_load_pd(s + 8)));
+		m5 = _mm_add_pd(m5, _mm_mul_pd(w, _mm_load_pd(s + 10)));
+		m6 = _mm_add_pd(m6, _mm_mul_pd(w, _mm_load_pd(s + 12)));
+		m7 = _mm_add_pd(m7, _mm_mul_pd(w, _mm_load_pd(s + 14)));
+		m8 = _mm_add_pd(m8, _mm_mul_pd(w, _mm_load_pd(s + 16)));
+		m9 = _mm_add_pd(m9, _mm_mul_pd(w, _mm_load_pd(s + 18)));
+		m10 = _mm_add_pd(m10, _mm_mul_pd(w, _mm_load_pd(s + 20)));
+		m11 = _mm_add_pd(m11, _mm_mul_pd(w, _mm_load_pd(s + 22)));
 	}
 	M[0] = m0, M[1] = m1, M[2] = m2, M[3] = m3, M[4] = m4, M[5] = m5;
 	M[6] = m6, M[7] = m7, M[8] = m8, M[9] = m9, M[10] = m10, M[11] = m11;
 }
 
-/* q's ten entries for poses 2i and 2i + 1. */
-static inline void qpairs(const double *q, size_t i, __m128d *a)
-{
-	const double *u = q + 20 * i, *v = u + 10;
-	a[0] = _mm_set_pd(v[0], u[0]), a[1] = _mm_set_pd(v[1], u[1]), a[2] = _mm_set_pd(v[2], u[2]);
-	a[3] = _mm_set_pd(v[3], u[3]), a[4] = _mm_set_pd(v[4], u[4]), a[5] = _mm_set_pd(v[5], u[5]);
-	a[6] = _mm_set_pd(v[6], u[6]), a[7] = _mm_set_pd(v[7], u[7]), a[8] = _mm_set_pd(v[8], u[8]);
-	a[9] = _mm_set_pd(v[9], u[9]);
-}
+/* Entry e of the node quadrics' pair u (poses 2i and 2i + 1 side by
+ * side, bgm_qat: u = q + 20 i), loaded where it is used, so that the
+ * products take it from memory (no copy of the pair). */
+#define QP(u, e) _mm_load_pd((u) + 2 * (e))
 
-
-/* eval for both poses (q: the 10 entries as pairs). */
-static inline __m128d eval2(const __m128d *q, const __m128d *x)
+/* eval for both poses (u: the pair's entries). */
+BGM_INLINE __m128d eval2(const double *u, const __m128d *x)
 {
 	const __m128d two = _mm_set1_pd(2.0);
-	__m128d v = _mm_mul_pd(_mm_mul_pd(q[0], x[0]), x[0]);
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[1]), x[0]), x[1]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[2]), x[0]), x[2]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, q[3]), x[0]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(q[4], x[1]), x[1]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, q[5]), x[1]), x[2]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, q[6]), x[1]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(q[7], x[2]), x[2]));
-	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, q[8]), x[2]));
-	return _mm_add_pd(v, q[9]);
+	__m128d v = _mm_mul_pd(_mm_mul_pd(QP(u, 0), x[0]), x[0]);
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, QP(u, 1)), x[0]), x[1]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, QP(u, 2)), x[0]), x[2]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, QP(u, 3)), x[0]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(QP(u, 4), x[1]), x[1]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(two, QP(u, 5)), x[1]), x[2]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, QP(u, 6)), x[1]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(QP(u, 7), x[2]), x[2]));
+	v = _mm_add_pd(v, _mm_mul_pd(_mm_mul_pd(two, QP(u, 8)), x[2]));
+	return _mm_add_pd(v, QP(u, 9));
+}
+#endif
+
+/* Pose p's 10 entries (in order, from a) into node quadrics d (P poses),
+ * where bgm_qat puts them. */
+static inline void qput(double *d, int P, int p, const double *a)
+{
+	if (p < (P & ~1)) {
+		d += 20 * (size_t)(p >> 1) + (size_t)(p & 1);
+		for (int e = 0; e < 10; e++)
+			d[2 * e] = a[e];
+	} else {
+		memcpy(d + 10 * (size_t)p, a, 10 * sizeof *d);
+	}
+}
+
+#ifdef __SSE2__
+/* Q[k] += q[k], k = 0..9, written out. */
+#define ADD10(Q, q) \
+	do { \
+		(Q)[0] = _mm_add_pd((Q)[0], (q)[0]), (Q)[1] = _mm_add_pd((Q)[1], (q)[1]); \
+		(Q)[2] = _mm_add_pd((Q)[2], (q)[2]), (Q)[3] = _mm_add_pd((Q)[3], (q)[3]); \
+		(Q)[4] = _mm_add_pd((Q)[4], (q)[4]), (Q)[5] = _mm_add_pd((Q)[5], (q)[5]); \
+		(Q)[6] = _mm_add_pd((Q)[6], (q)[6]), (Q)[7] = _mm_add_pd((Q)[7], (q)[7]); \
+		(Q)[8] = _mm_add_pd((Q)[8], (q)[8]), (Q)[9] = _mm_add_pd((Q)[9], (q)[9]); \
+	} while (0)
+
+/* bgm_face_normal for both lanes. */
+BGM_INLINE void normal2(const __m128d *a, const __m128d *b, const __m128d *c, __m128d *n)
+{
+	__m128d u0 = _mm_sub_pd(b[0], a[0]), u1 = _mm_sub_pd(b[1], a[1]), u2 = _mm_sub_pd(b[2], a[2]);
+	__m128d v0 = _mm_sub_pd(c[0], a[0]), v1 = _mm_sub_pd(c[1], a[1]), v2 = _mm_sub_pd(c[2], a[2]);
+	n[0] = _mm_sub_pd(_mm_mul_pd(u1, v2), _mm_mul_pd(u2, v1));
+	n[1] = _mm_sub_pd(_mm_mul_pd(u2, v0), _mm_mul_pd(u0, v2));
+	n[2] = _mm_sub_pd(_mm_mul_pd(u0, v1), _mm_mul_pd(u1, v0));
+}
+
+BGM_INLINE __m128d dot2(const __m128d *a, const __m128d *b)
+{
+	return _mm_add_pd(_mm_add_pd(_mm_mul_pd(a[0], b[0]), _mm_mul_pd(a[1], b[1])), _mm_mul_pd(a[2], b[2]));
+}
+
+/* q[k] = w_i P_j (P = (n, d), w = s P) in the lanes of keep, +0 in the
+ * others: plane_quadric's and edge_quadric's terms. */
+BGM_INLINE void terms2(__m128d s, const __m128d *n, __m128d d, __m128d keep, __m128d *q)
+{
+	__m128d w0 = _mm_mul_pd(s, n[0]), w1 = _mm_mul_pd(s, n[1]), w2 = _mm_mul_pd(s, n[2]), w3 = _mm_mul_pd(s, d);
+	q[0] = _mm_and_pd(keep, _mm_mul_pd(w0, n[0])), q[1] = _mm_and_pd(keep, _mm_mul_pd(w0, n[1]));
+	q[2] = _mm_and_pd(keep, _mm_mul_pd(w0, n[2])), q[3] = _mm_and_pd(keep, _mm_mul_pd(w0, d));
+	q[4] = _mm_and_pd(keep, _mm_mul_pd(w1, n[1])), q[5] = _mm_and_pd(keep, _mm_mul_pd(w1, n[2]));
+	q[6] = _mm_and_pd(keep, _mm_mul_pd(w1, d));
+	q[7] = _mm_and_pd(keep, _mm_mul_pd(w2, n[2])), q[8] = _mm_and_pd(keep, _mm_mul_pd(w2, d));
+	q[9] = _mm_and_pd(keep, _mm_mul_pd(w3, d));
+}
+
+/* edge_quadric for both lanes, added to q in the lanes of keep (where
+ * the edge is a feature). */
+BGM_INLINE void edge2(const __m128d *a, const __m128d *b, const __m128d *n, __m128d keep, __m128d *q)
+{
+	__m128d e[3] = {_mm_sub_pd(b[0], a[0]), _mm_sub_pd(b[1], a[1]), _mm_sub_pd(b[2], a[2])}, m[3];
+	m[0] = _mm_sub_pd(_mm_mul_pd(e[1], n[2]), _mm_mul_pd(e[2], n[1]));
+	m[1] = _mm_sub_pd(_mm_mul_pd(e[2], n[0]), _mm_mul_pd(e[0], n[2]));
+	m[2] = _mm_sub_pd(_mm_mul_pd(e[0], n[1]), _mm_mul_pd(e[1], n[0]));
+	__m128d len = _mm_sqrt_pd(dot2(m, m)), l2 = dot2(e, e);
+	keep = _mm_and_pd(keep, _mm_cmpgt_pd(len, _mm_setzero_pd()));
+	for (int i = 0; i < 3; i++)
+		m[i] = _mm_div_pd(m[i], len);
+	__m128d d = _mm_xor_pd(dot2(m, a), _mm_set1_pd(-0.0)), t[10];
+	terms2(_mm_mul_pd(_mm_set1_pd(FEATURE_WEIGHT), l2), m, d, keep, t);
+	ADD10(q, t);
+}
+
+/* The quadrics of stored poses da (low lane) and db = da + 1 (high lane;
+ * db = da for a last one alone; da even) into g->quadric: the one-pose
+ * loop of bgm_quadrics_build in two lanes, every lane the same products,
+ * sums and tests in the same order (SSE2 rounds as scalar code; a
+ * face's plane that one-pose code leaves out, a plane added as +0
+ * instead of a -0, an edge that is no feature in a lane, add +0 there,
+ * which leaves each sum as it was: a sum from +0 is never -0). Their
+ * skin matrices are g->skin2's block da / 2. posed: 3 per node; fn: 4
+ * per face; acc: 10 per node. */
+static void quadrics_pair(mlod_bgm *g, int da, int db, __m128d *posed, __m128d *fn, __m128d *acc)
+{
+	int J = g->joint_count, D = g->qpose_count;
+	const double *sk = g->skin2 + (size_t)(da / 2) * (size_t)J * 24;
+	const __m128d zero = _mm_setzero_pd();
+	for (int v = 0; v < g->node_count; v++) {
+		const mlod_influences *inf = &g->inf[v];
+		__m128d M[12];
+		if (inf->count == 0) {
+			for (int i = 0; i < 12; i++)
+				M[i] = _mm_set1_pd(i % 5 == 0 ? 1.0 : 0.0);
+		} else {
+			blend2s(sk, inf, M);
+		}
+		const double *x = g->nodes[v].p;
+		__m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
+		for (int r = 0; r < 3; r++)
+			posed[3 * v + r] = _mm_add_pd(
+			        _mm_add_pd(_mm_add_pd(_mm_mul_pd(M[4 * r], x0), _mm_mul_pd(M[4 * r + 1], x1)), _mm_mul_pd(M[4 * r + 2], x2)),
+			        M[4 * r + 3]);
+	}
+	/* Every face's normal and its length (the one-pose loop works each
+	 * out once, when first needed: the same values). */
+	for (int f = 0; f < g->face_count; f++) {
+		const bgm_face *F = &g->faces[f];
+		__m128d *n = fn + 4 * f;
+		normal2(posed + 3 * F->n[0], posed + 3 * F->n[1], posed + 3 * F->n[2], n);
+		n[3] = _mm_sqrt_pd(dot2(n, n));
+	}
+	memset(acc, 0, sizeof *acc * 10 * (size_t)g->node_count); /* +0 */
+	const __m128d all = _mm_castsi128_pd(_mm_set1_epi32(-1)), half = _mm_set1_pd(0.5);
+	const __m128d cosf = _mm_set1_pd(FEATURE_COS);
+	for (int f = 0; f < g->face_count; f++) {
+		const bgm_face *F = &g->faces[f];
+		const __m128d *nf = fn + 4 * f, *a0 = posed + 3 * F->n[0];
+		/* plane_quadric */
+		__m128d q[10], len = nf[3];
+		__m128d n[3] = {_mm_div_pd(nf[0], len), _mm_div_pd(nf[1], len), _mm_div_pd(nf[2], len)};
+		__m128d d = _mm_xor_pd(dot2(n, a0), _mm_set1_pd(-0.0));
+		terms2(_mm_mul_pd(half, len), n, d, _mm_cmpgt_pd(len, zero), q);
+		ADD10(acc + (size_t)F->n[0] * 10, q);
+		ADD10(acc + (size_t)F->n[1] * 10, q);
+		ADD10(acc + (size_t)F->n[2] * 10, q);
+		for (int e = 0; e < 3; e++) {
+			int h = F->adj[e];
+			if (h >= 0 && h < f)
+				continue; /* each interior edge once */
+			const __m128d *a = posed + 3 * F->n[e], *b = posed + 3 * F->n[(e + 1) % 3];
+			const __m128d *o = posed + 3 * F->n[(e + 2) % 3];
+			__m128d n1[3], keep = all;
+			if (e == 0)
+				n1[0] = nf[0], n1[1] = nf[1], n1[2] = nf[2];
+			else
+				normal2(a, b, o, n1);
+			const __m128d *c = NULL;
+			if (h >= 0) {
+				c = fn + 4 * h;
+				__m128d l1 = e == 0 ? nf[3] : _mm_sqrt_pd(dot2(n1, n1)), l2 = c[3];
+				keep = _mm_and_pd(_mm_cmpgt_pd(l1, zero), _mm_cmpgt_pd(l2, zero));
+				keep = _mm_andnot_pd(_mm_cmpgt_pd(dot2(n1, c), _mm_mul_pd(_mm_mul_pd(cosf, l1), l2)), keep);
+				if (_mm_movemask_pd(keep) == 0)
+					continue;
+			}
+			__m128d q2[10] = {zero, zero, zero, zero, zero, zero, zero, zero, zero, zero};
+			edge2(a, b, n1, keep, q2);
+			if (c)
+				edge2(a, b, c, keep, q2);
+			ADD10(acc + (size_t)F->n[e] * 10, q2);
+			ADD10(acc + (size_t)F->n[(e + 1) % 3] * 10, q2);
+		}
+	}
+	/* Out: a pair (2i, 2i + 1) as it lies (bgm_qat), else the low lane. */
+	for (int v = 0; v < g->node_count; v++) {
+		double *dst = g->quadric + (size_t)v * (size_t)D * 10;
+		const __m128d *A = acc + (size_t)v * 10;
+		if (db == da + 1) {
+			dst += 10 * (size_t)da;
+			_mm_store_pd(dst, A[0]), _mm_store_pd(dst + 2, A[1]), _mm_store_pd(dst + 4, A[2]);
+			_mm_store_pd(dst + 6, A[3]), _mm_store_pd(dst + 8, A[4]), _mm_store_pd(dst + 10, A[5]);
+			_mm_store_pd(dst + 12, A[6]), _mm_store_pd(dst + 14, A[7]), _mm_store_pd(dst + 16, A[8]);
+			_mm_store_pd(dst + 18, A[9]);
+		} else {
+			double lo[10];
+			for (int k = 0; k < 10; k++)
+				_mm_storel_pd(lo + k, A[k]);
+			qput(dst, D, da, lo);
+		}
+	}
 }
 #endif
 
@@ -225,14 +405,10 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	 * out. Each node's sum is made in the same order from the same 0. */
 	double *acc = malloc(sizeof(double) * 10 * (size_t)g->node_count + 1);
 	g->skin = malloc(sizeof(float) * 12 * (size_t)J * (size_t)P);
-	/* Every node's every pose is written below (a copy or a sum). */
-	g->quadric = malloc(sizeof *g->quadric * (size_t)g->node_cap * (size_t)P * 10);
-	g->rquad = malloc(sizeof *g->rquad * (size_t)g->node_cap * BGM_RQUAD);
-	if (!mats || !rest || !local || !posed || !fn || !acc || !g->skin || !g->quadric || !g->rquad) {
+	if (!mats || !rest || !local || !posed || !fn || !acc || !g->skin) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
 		goto done;
 	}
-	g->pose_count = P;
 	mlod_pose_rest(s, local);
 	mlod_pose_world(s, local, rest);
 	for (int p = 0; p < P; p++) {
@@ -255,26 +431,12 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			to_rows(&in->offset, S);
 		}
 	}
-	/* The same matrices as doubles, two poses side by side (the two-pose
-	 * paths of bgm_quadric_error, bgm_quadric_pullback and collapse.c). */
-	if (g->joint_count > 0 && P >= 2) {
-		size_t pairs = (size_t)P / 2;
-		g->skin2 = malloc(sizeof(double) * 24 * (size_t)J * pairs);
-		if (!g->skin2) {
-			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
-			goto done;
-		}
-		for (size_t i = 0; i < pairs; i++)
-			for (int k = 0; k < J; k++) {
-				const float *a = g->skin + (2 * i * (size_t)J + (size_t)k) * 12, *b = a + (size_t)J * 12;
-				double *d = g->skin2 + (i * (size_t)J + (size_t)k) * 24;
-				for (int e = 0; e < 12; e++)
-					d[2 * e] = a[e], d[2 * e + 1] = b[e];
-			}
-	}
 	/* The skin matrices the nodes use (all of them for a static mesh). */
 	unsigned char *used = calloc((size_t)J, 1);
-	if (!used) {
+	g->qmap = malloc(sizeof(int) * (size_t)P);
+	g->qpose = malloc(sizeof(int) * (size_t)P);
+	if (!used || !g->qmap || !g->qpose) {
+		free(used);
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
 		goto done;
 	}
@@ -284,13 +446,15 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 		for (int k = 0; k < g->inf[v].count && k < MLOD_MAX_INFLUENCES; k++)
 			if (g->inf[v].joints[k] < J)
 				used[g->inf[v].joints[k]] = 1;
-	/* Per pose: skin the nodes, then add each face's plane to its nodes.
-	 * A pose whose used skin matrices are bit for bit an earlier pose's
+	/* A pose whose used skin matrices are bit for bit an earlier pose's
 	 * (a rigid part or a joint the clip leaves still) has that pose's
-	 * quadrics, every step being the same arithmetic on the same values:
-	 * they are copied. */
+	 * quadrics, every step being the same arithmetic on the same values,
+	 * and so has every node the collapses make (their sums, their
+	 * influences among the used ones): it is not stored, qmap sends it
+	 * to the first such pose's quadrics, and the sums over poses take
+	 * that pose's terms again. */
+	int D = 0;
 	for (int p = 0; p < P; p++) {
-		double M[12];
 		int same = -1;
 		for (int q = 0; q < p && same < 0; q++) {
 			const float *a = g->skin + (size_t)p * (size_t)J * 12, *b = g->skin + (size_t)q * (size_t)J * 12;
@@ -301,11 +465,74 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 				same = q;
 		}
 		if (same >= 0) {
-			for (int v = 0; v < g->node_count; v++)
-				memcpy(g->quadric + ((size_t)v * (size_t)P + (size_t)p) * 10,
-				       g->quadric + ((size_t)v * (size_t)P + (size_t)same) * 10, 10 * sizeof *g->quadric);
-			continue;
+			g->qmap[p] = g->qmap[same];
+		} else {
+			g->qmap[p] = D;
+			g->qpose[D++] = p;
 		}
+	}
+	free(used);
+	g->pose_count = P;
+	g->qpose_count = D;
+	/* Room for the nodes the collapses add (each merges two or three
+	 * live nodes into one: fewer than node_count of them), at the
+	 * capacity bgm_add_node's doubling of node_cap would reach, so that
+	 * the largest arrays are not copied over as the sequence grows.
+	 * Every node's every stored pose is written below. */
+	int qcap = g->node_cap;
+	while (qcap < 2 * g->node_count && qcap <= INT_MAX / 2)
+		qcap *= 2;
+	g->quadric_cap = qcap;
+	g->quadric = malloc(sizeof *g->quadric * (size_t)qcap * (size_t)D * 10);
+	g->rquad = malloc(sizeof *g->rquad * (size_t)qcap * BGM_RQUAD);
+	if (!g->quadric || !g->rquad) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+		goto done;
+	}
+	/* The stored poses' matrices as doubles, two side by side (the
+	 * two-pose paths of bgm_quadric_error, bgm_quadric_pullback and
+	 * collapse.c): block i holds stored poses 2i and 2i + 1, a last odd
+	 * one a block of its own, itself in both lanes. */
+	if (g->joint_count > 0 && P >= 2) {
+		size_t pairs = (size_t)D / 2, blocks = ((size_t)D + 1) / 2;
+		g->skin2 = malloc(sizeof(double) * 24 * (size_t)J * blocks);
+		if (!g->skin2) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+			goto done;
+		}
+		for (size_t i = 0; i < blocks; i++)
+			for (int k = 0; k < J; k++) {
+				const float *a = g->skin + ((size_t)g->qpose[2 * i] * (size_t)J + (size_t)k) * 12;
+				const float *b = i < pairs ? g->skin + ((size_t)g->qpose[2 * i + 1] * (size_t)J + (size_t)k) * 12 : a;
+				double *d = g->skin2 + (i * (size_t)J + (size_t)k) * 24;
+				for (int e = 0; e < 12; e++)
+					d[2 * e] = a[e], d[2 * e + 1] = b[e];
+			}
+	}
+	int paired = 0;
+#ifdef __SSE2__
+	/* Two stored poses at a time (quadrics_pair), a last one alone. */
+	if (g->joint_count > 0 && P >= 2) {
+		__m128d *posed2 = malloc(sizeof(__m128d) * 3 * (size_t)g->node_count + 16);
+		__m128d *fn2 = malloc(sizeof(__m128d) * 4 * (size_t)g->face_count + 16);
+		__m128d *acc2 = malloc(sizeof(__m128d) * 10 * (size_t)g->node_count + 16);
+		if (posed2 && fn2 && acc2) {
+			for (int d = 0; d < D; d += 2)
+				quadrics_pair(g, d, d + 1 < D ? d + 1 : d, posed2, fn2, acc2);
+			paired = 1;
+		}
+		free(posed2);
+		free(fn2);
+		free(acc2);
+		if (!paired) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+			goto done;
+		}
+	}
+#endif
+	for (int d = 0; d < D && !paired; d++) {
+		int p = g->qpose[d];
+		double M[12];
 		for (int v = 0; v < g->node_count; v++) {
 			blend(g, p, &g->inf[v], M);
 			apply(M, g->nodes[v].p, posed + 3 * v);
@@ -370,15 +597,20 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 				int ends[2] = {F->n[e], F->n[(e + 1) % 3]};
 				for (int i = 0; i < 2; i++) {
 					double *Q = acc + (size_t)ends[i] * 10;
+#ifdef __SSE2__
+					/* two entries at a time, each the same sum */
+					for (int k = 0; k < 10; k += 2)
+						_mm_storeu_pd(Q + k, _mm_add_pd(_mm_loadu_pd(Q + k), _mm_loadu_pd(q2 + k)));
+#else
 					for (int k = 0; k < 10; k++)
 						Q[k] += q2[k];
+#endif
 				}
 			}
 		}
 		for (int v = 0; v < g->node_count; v++)
-			memcpy(g->quadric + ((size_t)v * (size_t)P + (size_t)p) * 10, acc + (size_t)v * 10, 10 * sizeof *acc);
+			qput(g->quadric + (size_t)v * (size_t)D * 10, D, d, acc + (size_t)v * 10);
 	}
-	free(used);
 	for (int v = 0; v < g->node_count; v++)
 		bgm_quadric_rest_reset(g, v);
 done:
@@ -391,39 +623,92 @@ done:
 	return r;
 }
 
-double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
-{
-	double M[12], y[3], e = 0.0;
-	int p = 0;
 #ifdef __SSE2__
-	if (g->skin2 && inf->count > 0) {
-		/* Two poses at a time; the sum and its stop test pose by pose. */
-		const __m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
-		for (; p + 1 < g->pose_count; p += 2) {
-			__m128d Mv[12], yv[3], qv[10];
-			size_t i = (size_t)p / 2;
-			blend2(g, i, inf, Mv);
+/* Stored poses' terms kept for the sums over poses when some poses are
+ * stored once for several (qmap): beyond this many stored poses each
+ * pose's pair is worked out again. */
+#define TERMS_MAX 128
+
+/* The two stored poses' error terms (block i: stored poses 2i and
+ * 2i + 1, u their entries, bgm_qat), each clamped at 0. */
+BGM_INLINE __m128d err_pair(const mlod_bgm *g, const double *u, const mlod_influences *inf, size_t i, __m128d x0,
+                               __m128d x1, __m128d x2)
+{
+	__m128d Mv[12], yv[3];
+	blend2(g, i, inf, Mv);
 #define ROW(r) _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(Mv[4 * r], x0), _mm_mul_pd(Mv[4 * r + 1], x1)), \
                                     _mm_mul_pd(Mv[4 * r + 2], x2)), \
                          Mv[4 * r + 3])
-			yv[0] = ROW(0), yv[1] = ROW(1), yv[2] = ROW(2);
+	yv[0] = ROW(0), yv[1] = ROW(1), yv[2] = ROW(2);
 #undef ROW
-			qpairs(q, i, qv);
-			double v[2];
-			_mm_storeu_pd(v, eval2(qv, yv));
-			e += v[0] > 0.0 ? v[0] : 0.0;
-			if (e >= stop)
-				return HUGE_VAL;
-			e += v[1] > 0.0 ? v[1] : 0.0;
+	__m128d ev = eval2(u, yv);
+	/* v > 0 ? v : 0 in the lanes */
+	return _mm_and_pd(_mm_cmpgt_pd(ev, _mm_setzero_pd()), ev);
+}
+#endif
+
+double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
+{
+	double M[12], y[3], e = 0.0;
+	int P = g->pose_count, D = g->qpose_count;
+#ifdef __SSE2__
+	if (g->skin2 && inf->count > 0) {
+		/* Two stored poses at a time; the sum and its stop test pose by
+		 * pose. A last odd stored pose the same way, in both lanes (its
+		 * own g->skin2 block, its entries doubled in last), the low lane
+		 * taken. */
+		const __m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
+		int pairs = D / 2, n = (D + 1) / 2;
+		_Alignas(16) double last[20];
+		if (D & 1)
+			for (int k = 0; k < 10; k++)
+				last[2 * k] = last[2 * k + 1] = q[20 * (size_t)pairs + (size_t)k];
+		if (D == P) {
+			/* every pose stored, in order */
+			for (int i = 0; i < n; i++) {
+				double v[2];
+				_mm_storeu_pd(v, err_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, x0, x1, x2));
+				e += v[0];
+				if (e >= stop)
+					return HUGE_VAL;
+				if (i == pairs)
+					break;
+				e += v[1];
+				if (e >= stop)
+					return HUGE_VAL;
+			}
+			return e;
+		}
+		/* Pose p's term is its stored pose's: worked out when first
+		 * needed (a stored pose comes first at its own pose, in order). */
+		double t[TERMS_MAX];
+		int done = 0;
+		for (int p = 0; p < P; p++) {
+			int d = g->qmap[p], i = d / 2;
+			double v;
+			if (2 * n <= TERMS_MAX) {
+				for (; done <= i; done++)
+					_mm_storeu_pd(t + 2 * done, err_pair(g, done < pairs ? q + 20 * (size_t)done : last, inf, (size_t)done,
+					                                     x0, x1, x2));
+				v = t[d];
+			} else {
+				double w[2];
+				_mm_storeu_pd(w, err_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, x0, x1, x2));
+				v = w[d & 1];
+			}
+			e += v;
 			if (e >= stop)
 				return HUGE_VAL;
 		}
+		return e;
 	}
 #endif
-	for (; p < g->pose_count; p++) {
+	for (int p = 0; p < P; p++) {
+		double a[10];
+		bgm_quadric_get(q, D, g->qmap[p], a);
 		blend(g, p, inf, M);
 		apply(M, x, y);
-		double v = eval(q + 10 * p, y);
+		double v = eval(a, y);
 		e += v > 0.0 ? v : 0.0;
 		if (e >= stop)
 			return HUGE_VAL;
@@ -433,10 +718,13 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 
 void bgm_quadric_rest_reset(mlod_bgm *g, int v)
 {
-	const double *q = g->quadric + (size_t)v * (size_t)g->pose_count * 10;
+	int P = g->pose_count, D = g->qpose_count;
+	const double *q = g->quadric + (size_t)v * (size_t)D * 10;
 	double *r = g->rquad + (size_t)v * BGM_RQUAD, t = 0.0;
-	for (int p = 0; p < g->pose_count; p++)
-		t += q[10 * p] + q[10 * p + 4] + q[10 * p + 7];
+	for (int p = 0; p < P; p++) {
+		int d = g->qmap[p];
+		t += q[bgm_qat(D, d, 0)] + q[bgm_qat(D, d, 4)] + q[bgm_qat(D, d, 7)];
+	}
 	r[0] = NAN; /* not computed yet: bgm_quadric_rest */
 	r[10] = t;
 }
@@ -448,9 +736,51 @@ const double *bgm_quadric_rest(mlod_bgm *g, int v)
 	 * direction the planes leave free), which must not recompute it at
 	 * every use. */
 	if (isnan(r[0]))
-		bgm_quadric_pullback(g, g->quadric + (size_t)v * (size_t)g->pose_count * 10, &g->inf[v], r);
+		bgm_quadric_pullback(g, g->quadric + (size_t)v * (size_t)g->qpose_count * 10, &g->inf[v], r);
 	return r;
 }
+
+#ifdef __SSE2__
+/* The two stored poses' pullback terms h[0..9] (block i, u their
+ * entries): [M; 0 0 0 1]^T Q [M; 0 0 0 1] in the order of the one-pose
+ * loop of bgm_quadric_pullback. */
+BGM_INLINE void pull_pair(const mlod_bgm *g, const double *u, const mlod_influences *inf, size_t i, __m128d *h)
+{
+	__m128d M[12];
+	blend2(g, i, inf, M);
+#define a(e) QP(u, e)
+#define MUL(x, y) _mm_mul_pd(x, y)
+#define ADD(x, y) _mm_add_pd(x, y)
+#define DOT3(a0, m0, a1, m1, a2, m2) ADD(ADD(MUL(a0, m0), MUL(a1, m1)), MUL(a2, m2))
+	__m128d t00 = DOT3(a(0), M[0], a(1), M[4], a(2), M[8]);
+	__m128d t01 = DOT3(a(0), M[1], a(1), M[5], a(2), M[9]);
+	__m128d t02 = DOT3(a(0), M[2], a(1), M[6], a(2), M[10]);
+	__m128d t10 = DOT3(a(1), M[0], a(4), M[4], a(5), M[8]);
+	__m128d t11 = DOT3(a(1), M[1], a(4), M[5], a(5), M[9]);
+	__m128d t12 = DOT3(a(1), M[2], a(4), M[6], a(5), M[10]);
+	__m128d t20 = DOT3(a(2), M[0], a(5), M[4], a(7), M[8]);
+	__m128d t21 = DOT3(a(2), M[1], a(5), M[5], a(7), M[9]);
+	__m128d t22 = DOT3(a(2), M[2], a(5), M[6], a(7), M[10]);
+	__m128d t03 = ADD(DOT3(a(0), M[3], a(1), M[7], a(2), M[11]), a(3));
+	__m128d t13 = ADD(DOT3(a(1), M[3], a(4), M[7], a(5), M[11]), a(6));
+	__m128d t23 = ADD(DOT3(a(2), M[3], a(5), M[7], a(7), M[11]), a(8));
+	__m128d t33 = ADD(DOT3(a(3), M[3], a(6), M[7], a(8), M[11]), a(9));
+	h[0] = DOT3(M[0], t00, M[4], t10, M[8], t20);
+	h[1] = DOT3(M[0], t01, M[4], t11, M[8], t21);
+	h[2] = DOT3(M[0], t02, M[4], t12, M[8], t22);
+	h[3] = DOT3(M[0], t03, M[4], t13, M[8], t23);
+	h[4] = DOT3(M[1], t01, M[5], t11, M[9], t21);
+	h[5] = DOT3(M[1], t02, M[5], t12, M[9], t22);
+	h[6] = DOT3(M[1], t03, M[5], t13, M[9], t23);
+	h[7] = DOT3(M[2], t02, M[6], t12, M[10], t22);
+	h[8] = DOT3(M[2], t03, M[6], t13, M[10], t23);
+	h[9] = ADD(DOT3(M[3], t03, M[7], t13, M[11], t23), t33);
+#undef a
+#undef DOT3
+#undef ADD
+#undef MUL
+}
+#endif
 
 /* h (10 doubles, packed as a quadric) = sum over poses of
  * [M_p; 0 0 0 1]^T Q_p [M_p; 0 0 0 1], M_p blended for inf: the posed
@@ -462,55 +792,90 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 	 * T = Q [M; 0 0 0 1] and [M; 0 0 0 1]^T T (the last row's zeros left
 	 * out), written out entry by entry. */
 	double H[10] = {0};
-	int p = 0;
+	int P = g->pose_count, D = g->qpose_count;
 #ifdef __SSE2__
 	if (g->skin2 && inf->count > 0) {
-		/* Two poses at a time, the terms added to H pose by pose. */
-		for (; p + 1 < g->pose_count; p += 2) {
-			__m128d M[12], a[10];
-			size_t i = (size_t)p / 2;
-			blend2(g, i, inf, M);
-			qpairs(q, i, a);
-#define MUL(x, y) _mm_mul_pd(x, y)
-#define ADD(x, y) _mm_add_pd(x, y)
-#define DOT3(a0, m0, a1, m1, a2, m2) ADD(ADD(MUL(a0, m0), MUL(a1, m1)), MUL(a2, m2))
-			__m128d t00 = DOT3(a[0], M[0], a[1], M[4], a[2], M[8]);
-			__m128d t01 = DOT3(a[0], M[1], a[1], M[5], a[2], M[9]);
-			__m128d t02 = DOT3(a[0], M[2], a[1], M[6], a[2], M[10]);
-			__m128d t10 = DOT3(a[1], M[0], a[4], M[4], a[5], M[8]);
-			__m128d t11 = DOT3(a[1], M[1], a[4], M[5], a[5], M[9]);
-			__m128d t12 = DOT3(a[1], M[2], a[4], M[6], a[5], M[10]);
-			__m128d t20 = DOT3(a[2], M[0], a[5], M[4], a[7], M[8]);
-			__m128d t21 = DOT3(a[2], M[1], a[5], M[5], a[7], M[9]);
-			__m128d t22 = DOT3(a[2], M[2], a[5], M[6], a[7], M[10]);
-			__m128d t03 = ADD(DOT3(a[0], M[3], a[1], M[7], a[2], M[11]), a[3]);
-			__m128d t13 = ADD(DOT3(a[1], M[3], a[4], M[7], a[5], M[11]), a[6]);
-			__m128d t23 = ADD(DOT3(a[2], M[3], a[5], M[7], a[7], M[11]), a[8]);
-			__m128d t33 = ADD(DOT3(a[3], M[3], a[6], M[7], a[8], M[11]), a[9]);
-			double h[10][2];
-			_mm_storeu_pd(h[0], DOT3(M[0], t00, M[4], t10, M[8], t20));
-			_mm_storeu_pd(h[1], DOT3(M[0], t01, M[4], t11, M[8], t21));
-			_mm_storeu_pd(h[2], DOT3(M[0], t02, M[4], t12, M[8], t22));
-			_mm_storeu_pd(h[3], DOT3(M[0], t03, M[4], t13, M[8], t23));
-			_mm_storeu_pd(h[4], DOT3(M[1], t01, M[5], t11, M[9], t21));
-			_mm_storeu_pd(h[5], DOT3(M[1], t02, M[5], t12, M[9], t22));
-			_mm_storeu_pd(h[6], DOT3(M[1], t03, M[5], t13, M[9], t23));
-			_mm_storeu_pd(h[7], DOT3(M[2], t02, M[6], t12, M[10], t22));
-			_mm_storeu_pd(h[8], DOT3(M[2], t03, M[6], t13, M[10], t23));
-			_mm_storeu_pd(h[9], ADD(DOT3(M[3], t03, M[7], t13, M[11], t23), t33));
-#undef DOT3
-#undef ADD
-#undef MUL
-			H[0] += h[0][0], H[1] += h[1][0], H[2] += h[2][0], H[3] += h[3][0], H[4] += h[4][0];
-			H[5] += h[5][0], H[6] += h[6][0], H[7] += h[7][0], H[8] += h[8][0], H[9] += h[9][0];
-			H[0] += h[0][1], H[1] += h[1][1], H[2] += h[2][1], H[3] += h[3][1], H[4] += h[4][1];
-			H[5] += h[5][1], H[6] += h[6][1], H[7] += h[7][1], H[8] += h[8][1], H[9] += h[9][1];
+		/* Two stored poses at a time, the terms added to H pose by pose.
+		 * A last odd stored pose the same way, in both lanes (its own
+		 * g->skin2 block, its entries doubled in last), the low lane
+		 * taken. Two entries of H to a register (Hv[j] = H[2j],
+		 * H[2j + 1]), the terms regrouped to match. */
+		int pairs = D / 2, n = (D + 1) / 2;
+		_Alignas(16) double last[20];
+		if (D & 1)
+			for (int k = 0; k < 10; k++)
+				last[2 * k] = last[2 * k + 1] = q[20 * (size_t)pairs + (size_t)k];
+		__m128d Hv[5];
+		for (int j = 0; j < 5; j++)
+			Hv[j] = _mm_setzero_pd();
+		if (D == P) {
+			/* every pose stored, in order: H[e] += pose 2i's term, then
+			 * += pose 2i + 1's (unpacklo: both entries' pose 2i terms) */
+			for (int i = 0; i < n; i++) {
+				__m128d t[10];
+				pull_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, t);
+#define ACC(j) Hv[j] = _mm_add_pd(_mm_add_pd(Hv[j], _mm_unpacklo_pd(t[2 * j], t[2 * j + 1])), \
+                                  _mm_unpackhi_pd(t[2 * j], t[2 * j + 1]))
+#define ACC1(j) Hv[j] = _mm_add_pd(Hv[j], _mm_unpacklo_pd(t[2 * j], t[2 * j + 1]))
+				if (i < pairs) {
+					ACC(0), ACC(1), ACC(2), ACC(3), ACC(4);
+				} else {
+					ACC1(0), ACC1(1), ACC1(2), ACC1(3), ACC1(4);
+				}
+#undef ACC1
+#undef ACC
+			}
+		} else if (n <= TERMS_MAX / 2) {
+			/* Pose p's terms are its stored pose's, each stored pair's
+			 * worked out when first needed (a stored pose comes first at
+			 * its own pose, in order) and kept; poses in order, two at a
+			 * time where two poses in a row are a stored pair. */
+			__m128d hb[TERMS_MAX / 2][10];
+			int done = 0;
+			for (int p = 0; p < P;) {
+				int d = g->qmap[p], i = d / 2;
+				for (; done <= i; done++)
+					pull_pair(g, done < pairs ? q + 20 * (size_t)done : last, inf, (size_t)done, hb[done]);
+				const __m128d *t = hb[i];
+#define ACC(j) Hv[j] = _mm_add_pd(_mm_add_pd(Hv[j], _mm_unpacklo_pd(t[2 * j], t[2 * j + 1])), \
+                                  _mm_unpackhi_pd(t[2 * j], t[2 * j + 1]))
+#define ACCL(j) Hv[j] = _mm_add_pd(Hv[j], _mm_unpacklo_pd(t[2 * j], t[2 * j + 1]))
+#define ACCH(j) Hv[j] = _mm_add_pd(Hv[j], _mm_unpackhi_pd(t[2 * j], t[2 * j + 1]))
+				if ((d & 1) == 0 && i < pairs && p + 1 < P && g->qmap[p + 1] == d + 1) {
+					ACC(0), ACC(1), ACC(2), ACC(3), ACC(4);
+					p += 2;
+				} else {
+					if (d & 1)
+						ACCH(0), ACCH(1), ACCH(2), ACCH(3), ACCH(4);
+					else
+						ACCL(0), ACCL(1), ACCL(2), ACCL(3), ACCL(4);
+					p++;
+				}
+#undef ACCH
+#undef ACCL
+#undef ACC
+			}
+		} else {
+			for (int p = 0; p < P; p++) {
+				int d = g->qmap[p], i = d / 2;
+				__m128d t[10];
+				double ht[10][2];
+				pull_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, t);
+				for (int k = 0; k < 10; k++)
+					_mm_storeu_pd(ht[k], t[k]);
+				for (int j = 0; j < 5; j++)
+					Hv[j] = _mm_add_pd(Hv[j], _mm_set_pd(ht[2 * j + 1][d & 1], ht[2 * j][d & 1]));
+			}
 		}
+		for (int j = 0; j < 5; j++)
+			_mm_storeu_pd(H + 2 * j, Hv[j]);
+		memcpy(h, H, sizeof H);
+		return;
 	}
 #endif
-	for (; p < g->pose_count; p++) {
-		double M[12];
-		const double *a = q + 10 * p;
+	for (int p = 0; p < P; p++) {
+		double M[12], a[10];
+		bgm_quadric_get(q, D, g->qmap[p], a);
 		blend(g, p, inf, M);
 		double t00 = a[0] * M[0] + a[1] * M[4] + a[2] * M[8];
 		double t01 = a[0] * M[1] + a[1] * M[5] + a[2] * M[9];
@@ -537,12 +902,6 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 		H[9] += M[3] * t03 + M[7] * t13 + M[11] * t23 + t33;
 	}
 	memcpy(h, H, sizeof H);
-}
-
-double bgm_quadric_eval(const double *h, const double *x)
-{
-	double v = eval(h, x);
-	return v > 0.0 ? v : 0.0;
 }
 
 int bgm_quadric_solve(const double *h, const double *x0, double *out)
