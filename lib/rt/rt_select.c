@@ -3,6 +3,7 @@
  * TOC's distances), hysteresis and the batch update (mlod_rt.h,
  * "Selection").
  */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -120,7 +121,9 @@ static void update_one(mlod_rt_ctx *ctx, const mlod_rt_select *sel, uint32_t id,
 		                                  in->selected ? (int)st->wanted[layer] : -1);
 		st->wanted[layer] = (uint16_t)w;
 		/* a failed level's want goes to its fallback, which then loads */
-		rt_unit *u = rt_unit_get(ctx, (mlod_rt_layer)layer, rt_want_target(ctx, (mlod_rt_layer)layer, item, w), item);
+		rt_unit *u = rt_unit_get(ctx, (mlod_rt_layer)layer, w, item);
+		if (u && u->state == RT_UNIT_FAILED)
+			u = rt_unit_get(ctx, (mlod_rt_layer)layer, rt_want_target(ctx, (mlod_rt_layer)layer, item, w), item);
 		if (u) {
 			u->want_count++;
 			u->last_wanted = ctx->stamp;
@@ -139,9 +142,9 @@ mlod_result mlod_rt_update(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const ui
 	if (!isfinite(dt))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_update: dt %g is not finite", (double)dt);
 	for (size_t i = 0; i < n; i++)
-		if (!(distances[i] >= 0.0f) || isinf(distances[i]))
+		if (!(distances[i] >= 0.0f && distances[i] <= FLT_MAX)) /* NaN fails both */
 			return mlod_fail(err, MLOD_ERR_INVALID_ARG,
-			                 "mlod_rt_update: instance index %zu: distance %g is not finite and >= 0", i,
+			                 "mlod_rt_update: instance index %zu: distance %g, not finite and >= 0", i,
 			                 (double)distances[i]);
 	begin_frame(ctx);
 	for (size_t i = 0; i < n; i++)
@@ -164,7 +167,7 @@ mlod_result mlod_rt_update_positions(mlod_rt_ctx *ctx, const mlod_rt_select *sel
 		const float d = sqrtf(x * x + y * y + z * z);
 		if (!isfinite(d))
 			return mlod_fail(err, MLOD_ERR_INVALID_ARG,
-			                 "mlod_rt_update_positions: instance index %zu: distance %g is not finite", i,
+			                 "mlod_rt_update_positions: instance index %zu: distance %g, not finite", i,
 			                 (double)d);
 	}
 	begin_frame(ctx);
