@@ -48,8 +48,9 @@
  * mlod_rt_stream fails the levels that read it, and only those: its own
  * level and every level that needs it. With layout b2 (mlod(5)) a mesh
  * level reads the chunks of every coarser mesh level, so a corrupt mesh
- * chunk of level k fails mesh levels 0 .. k; a nested motion level reads
- * the clip's coarser levels it builds on. (A level whose load fails for
+ * chunk of level k fails mesh levels 0 .. k (those not resident: a
+ * resident level decoded before stays usable); a nested motion level
+ * reads the clip's coarser levels it builds on. (A level whose load fails for
  * another reason fails alone.) A failed level is marked failed
  * (mlod_rt_level_info.failed, each counted in mlod_rt_stats.failures) and
  * never tried again; an instance wanting it shows the finest resident
