@@ -45,8 +45,20 @@
  *
  * Errors. Fallible calls return an mlod_result and fill *err (when not
  * NULL) with the code and a message (mlod_core.h). A corrupt chunk met by
- * mlod_rt_stream fails that level only: it is marked failed, is never
- * tried again, and the instances keep showing coarser levels.
+ * mlod_rt_stream fails the levels that read it, and only those: its own
+ * level and every level that needs it. With layout b2 (mlod(5)) a mesh
+ * level reads the chunks of every coarser mesh level, so a corrupt mesh
+ * chunk of level k fails mesh levels 0 .. k (those not resident: a
+ * resident level decoded before stays usable); a nested motion level
+ * reads the clip's coarser levels it builds on. (A level whose load fails for
+ * another reason fails alone.) A failed level is marked failed
+ * (mlod_rt_level_info.failed, each counted in mlod_rt_stats.failures) and
+ * never tried again; an instance wanting it shows the finest resident
+ * level coarser than it (Fallback below) and its want passes to the
+ * finest coarser level not failed, which then loads (in the same
+ * mlod_rt_stream call when it fails there) and is shown. The coarsest
+ * level of each layer is decoded at open (a corrupt one fails the open),
+ * stays resident and never fails, so there always is such a level.
  *
  * ------------------------------------------------------------------
  * Levels
@@ -56,6 +68,13 @@
  * per clip (one chunk per clip and level). Each level has the pack TOC's
  * measured error (scene units) and switch distance (mlod(5)). Skeleton
  * level 0 is the full skeleton (the SKELETON chunk).
+ *
+ * Static props. A pack of a static prop (no skin, no animation: any
+ * glTF without them) has a skeleton of no joints. It opens like any
+ * other: mlod_rt_joint_count and mlod_rt_palette_size are 0, mlod_rt_pose
+ * poses no joint, mlod_rt_palette gives 0 matrices, mlod_rt_skin writes
+ * its (static) parts by their offsets, and selection and streaming work on
+ * its mesh levels as on any character's.
  *
  * Resident-level cache. Open decodes INFO, SKELETON and the coarsest level
  * of each layer (of each clip for motion); these stay resident until close.
@@ -268,6 +287,7 @@ typedef struct mlod_rt_level_info {
 	uint32_t users;       /* instances showing it at the last update */
 } mlod_rt_level_info;
 
+/* budget_bytes: the configured budget, 0 for no limit (configured 0). */
 typedef struct mlod_rt_stats {
 	size_t resident_bytes, budget_bytes, peak_resident_bytes;
 	uint32_t resident_levels, pending_levels; /* pending: wanted, not resident, not failed */
@@ -406,11 +426,17 @@ void mlod_rt_select_default(mlod_rt_select *sel);
 
 /* One frame for n instances: each instance's time advances by dt, its
  * levels are selected at distances[i] (scene units, >= 0), and wanted
- * levels are recorded for mlod_rt_stream; shown levels are resolved.
- * Ids not alive are skipped. No allocation. */
+ * levels are recorded for mlod_rt_stream (for a failed level, the finest
+ * coarser one not failed: see Errors); shown levels are resolved.
+ * Ids not alive are skipped. No allocation. MLOD_ERR_INVALID_ARG, with a
+ * message naming the index i, when distances[i] is NaN, negative or
+ * infinite (for every i < n, alive or not), and when dt is not finite
+ * (dt may be negative: time runs back); everything is checked first, so
+ * such a call changes nothing (no instance, no wanted level). */
 mlod_result mlod_rt_update(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const uint32_t *ids,
                            const float *distances, size_t n, float dt, mlod_error *err);
-/* The same with the distance from camera[3] to positions[3 * i]. */
+/* The same with the distance from camera[3] to positions[3 * i]
+ * (MLOD_ERR_INVALID_ARG naming i when it is not finite). */
 mlod_result mlod_rt_update_positions(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const float camera[3],
                                      const uint32_t *ids, const float *positions, size_t n, float dt,
                                      mlod_error *err);
@@ -438,8 +464,9 @@ mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
                          const uint32_t **joints, uint32_t *joint_count, mlod_error *err);
 /* The skinning palette of the pose last computed in s (mlod_rt_pose):
  * palette_size column-major 4x4 matrices (see "Palette"), for GPU
- * skinning. After mlod_rt_skin (which poses only what its mesh level
- * reads) it poses that instance again in full first. */
+ * skinning (0 matrices for a static prop). After mlod_rt_skin (which
+ * poses only what its mesh level reads, nothing without a mesh) it poses
+ * that instance again in full first. */
 mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const float **palette, uint32_t *count,
                             mlod_error *err);
 /* Poses the instance (as mlod_rt_pose, but only the joints that its mesh
@@ -450,7 +477,9 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
  * multiples of 4); parts without normals get (0, 0, 0). capacity is
  * the vertices the buffers hold: MLOD_ERR_LIMIT when the level needs more
  * (mlod_rt_mesh_vertex_count). *vertex_count (may be NULL) gets the
- * vertices written. */
+ * vertices written. MLOD_ERR_INVALID_ARG for an id not alive, also on a
+ * pack without a mesh (skeleton and motion only), where a live instance
+ * gets MLOD_OK and 0 vertices. */
 mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float *positions,
                          size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
                          uint32_t *vertex_count, mlod_error *err);

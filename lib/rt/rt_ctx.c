@@ -766,8 +766,10 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 	const uint32_t J = s->joint_count;
 	ctx->joint_count = J;
 	ctx->skin_count = s->skin_count;
-	if (J == 0 || !s->joints)
-		return mlod_fail(err, MLOD_ERR_PARSE, "the skeleton has no joints");
+	/* A static prop (no skin, no animation) has no joints: its instances
+	 * pose nothing and its static parts are written by their offsets. */
+	if (J && !s->joints)
+		return mlod_fail(err, MLOD_ERR_PARSE, "the skeleton's joints are missing");
 	if (s->skin_count && (!s->skins || !s->skin_joints || !s->inverse_bind))
 		return mlod_fail(err, MLOD_ERR_PARSE, "the skeleton's skins are incomplete");
 	for (uint32_t j = 0; j < J; j++)
@@ -1016,7 +1018,7 @@ void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out)
 {
 	memset(out, 0, sizeof *out);
 	out->resident_bytes = ctx->resident_bytes;
-	out->budget_bytes = ctx->budget;
+	out->budget_bytes = ctx->budget == SIZE_MAX ? 0 : ctx->budget; /* 0: no limit, as configured */
 	out->peak_resident_bytes = ctx->peak_bytes;
 	out->loads = ctx->loads;
 	out->evictions = ctx->evictions;
@@ -1058,6 +1060,117 @@ static rt_unit *next_wanted(mlod_rt_ctx *ctx)
 	return best;
 }
 
+/* ---------------------------------------------------------------- */
+/* Failed levels                                                     */
+/* ---------------------------------------------------------------- */
+
+/* 1 when the chunk's stored bytes fail its CRC, 0 when they match or
+ * cannot be read (a read error is not blamed on the chunk). Reads into
+ * the staging buffer for a read source: no allocation. */
+static int chunk_corrupt(const mlod_rt_ctx *ctx, int32_t chunk)
+{
+	if (chunk < 0 || (uint32_t)chunk >= ctx->pack.chunk_count)
+		return 0;
+	const mlod_pack_chunk *c = &ctx->pack.chunks[chunk];
+	const void *bytes;
+	if (ctx->data) { /* memory: the TOC was checked against the size at open */
+		if (c->offset > ctx->size || c->stored_size > ctx->size - c->offset)
+			return 0;
+		bytes = ctx->data + c->offset;
+	} else {
+		if (!ctx->read || !ctx->staging || c->stored_size > ctx->staging_size ||
+		    ctx->read(ctx->read_user, c->offset, c->stored_size, ctx->staging) != 0)
+			return 0;
+		bytes = ctx->staging;
+	}
+	return mlod_pack_crc32(0, bytes, c->stored_size) != c->crc;
+}
+
+/* 1 when loading unit u (level l of its layer and item) reads the chunk
+ * of unit d of the same layer and item: a MESH level reads the chunks of
+ * every coarser MESH level (layout b2, mlod(5)); a nested MOTION level
+ * reads the clip's next coarser level and what that one builds on. */
+static int unit_needs(const mlod_rt_ctx *ctx, const rt_unit *u, const rt_unit *d)
+{
+	if (u == d)
+		return 1;
+	if (u->layer != d->layer || u->item != d->item || d->level < u->level || u->chunk < 0)
+		return 0;
+	if (u->layer == MLOD_RT_MESH)
+		return 1;
+	if (u->layer != MLOD_RT_MOTION)
+		return 0;
+	for (uint32_t l = u->level; l < d->level; l++) {
+		const rt_unit *v = rt_unit_get(ctx, MLOD_RT_MOTION, l, u->item);
+		if (!v || v->chunk < 0 || !(ctx->pack.chunks[v->chunk].flags & MLOD_PACK_CHUNK_NESTED))
+			return 0;
+	}
+	return 1;
+}
+
+static void fail_unit(mlod_rt_ctx *ctx, rt_unit *u)
+{
+	if (u->state != RT_UNIT_ABSENT)
+		return; /* resident levels decoded fine and stay; failed ones stay failed */
+	u->state = RT_UNIT_FAILED;
+	ctx->failures++;
+}
+
+/* Loading u failed. u fails; and when the load read a chunk whose stored
+ * bytes fail its CRC (u's own or a coarser level's it builds on), that
+ * chunk's level fails too, with every level that needs it, so that none
+ * of them is tried again; the others stay loadable (fallbacks). */
+static void load_failed(mlod_rt_ctx *ctx, rt_unit *u)
+{
+	fail_unit(ctx, u);
+	if (!ctx->load || u->chunk < 0 || u->layer == MLOD_RT_SKELETON)
+		return;
+	const uint32_t L = ctx->levels[u->layer];
+	for (uint32_t l = u->level; l < L; l++) {
+		rt_unit *d = rt_unit_get(ctx, (mlod_rt_layer)u->layer, l, u->item);
+		if (!d || !unit_needs(ctx, u, d) || d->state == RT_UNIT_RESIDENT || !chunk_corrupt(ctx, d->chunk))
+			continue;
+		for (uint32_t k = 0; k <= l; k++) {
+			rt_unit *f = rt_unit_get(ctx, (mlod_rt_layer)u->layer, k, u->item);
+			if (f && unit_needs(ctx, f, d))
+				fail_unit(ctx, f);
+		}
+	}
+}
+
+/* The level to load for an instance that wants level w of a layer: w, or
+ * when it failed the finest coarser level that has not (the coarsest is
+ * resident from open to close and never fails). */
+uint32_t rt_want_target(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t item, uint32_t w)
+{
+	const uint32_t L = ctx->levels[layer];
+	for (uint32_t l = w; l < L; l++) {
+		const rt_unit *u = rt_unit_get(ctx, layer, l, item);
+		if (u && u->state != RT_UNIT_FAILED)
+			return l;
+	}
+	return w;
+}
+
+/* Moves the wants of failed levels to their fallbacks (rt_want_target),
+ * so that these load in the same mlod_rt_stream call. */
+static void pass_wants(mlod_rt_ctx *ctx)
+{
+	for (uint32_t i = 0; i < ctx->unit_count; i++) {
+		rt_unit *u = &ctx->units[i];
+		const uint32_t w = u->want_count & 0x7fffffffu;
+		if (u->state != RT_UNIT_FAILED || !w)
+			continue;
+		rt_unit *t = rt_unit_get(ctx, (mlod_rt_layer)u->layer,
+		                         rt_want_target(ctx, (mlod_rt_layer)u->layer, u->item, u->level), u->item);
+		u->want_count = 0;
+		if (t && t != u && t->state != RT_UNIT_FAILED) {
+			t->want_count += w;
+			t->last_wanted = u->last_wanted;
+		}
+	}
+}
+
 mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loaded, mlod_error *err)
 {
 	if (loaded)
@@ -1068,6 +1181,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 	size_t spent = 0;
 	uint32_t n = 0;
 	int changed = 0;
+	pass_wants(ctx); /* requests of failed levels */
 	while (byte_budget > 0 && spent < byte_budget) {
 		rt_unit *u = NULL;
 		/* Find the best candidate that may fit. */
@@ -1103,8 +1217,9 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 		mlod_result r = unit_load(ctx, u, &e);
 		spent += u->stored_size ? u->stored_size : 1;
 		if (r) {
-			u->state = RT_UNIT_FAILED;
-			ctx->failures++;
+			load_failed(ctx, u);
+			pass_wants(ctx);
+			changed = 1;
 			if (!first) {
 				first = r;
 				if (err)

@@ -813,11 +813,18 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: NULL argument");
 	if (pos_stride < 12 || pos_stride % 4 || (normals && (nrm_stride < 12 || nrm_stride % 4)))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: strides must be multiples of 4, at least 12");
-	if (ctx->levels[MLOD_RT_MESH] == 0)
-		return MLOD_OK;
 	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	const mlod_rt_state *st = &ctx->inst[id].st;
+	if (ctx->levels[MLOD_RT_MESH] == 0) {
+		/* No mesh: nothing to write, no joint to pose; mlod_rt_palette
+		 * then poses the instance in full, as after any skin. */
+		s->skel_unit = skel_unit(ctx, st);
+		s->id = id;
+		s->posed = 2;
+		s->paletted = 0;
+		return MLOD_OK;
+	}
 	const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MESH, st->level[MLOD_RT_MESH], 0);
 	if (!mu || mu->state != RT_UNIT_RESIDENT)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u shows no resident mesh level", id);

@@ -174,6 +174,9 @@ void *rt_alloc(const mlod_rt_ctx *ctx, size_t size);
 void rt_free(const mlod_rt_ctx *ctx, void *p);
 rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item);
 void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in);
+/* The level loaded for an instance wanting level w: w, or the finest
+ * coarser level not failed. */
+uint32_t rt_want_target(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t item, uint32_t w);
 mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err);
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
 

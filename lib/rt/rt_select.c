@@ -3,6 +3,7 @@
  * TOC's distances), hysteresis and the batch update (mlod_rt.h,
  * "Selection").
  */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -108,9 +109,7 @@ static void update_one(mlod_rt_ctx *ctx, const mlod_rt_select *sel, uint32_t id,
 				st->time += dur;
 		}
 	}
-	if (!(d >= 0.0f))
-		d = 0.0f; /* also NaN */
-	st->distance = d;
+	st->distance = d; /* finite and >= 0: checked by the caller */
 	const float span = sel->d_far - sel->d_near;
 	float a = span > 0.0f ? (d - sel->d_near) / span : (d >= sel->d_near ? 1.0f : 0.0f);
 	st->alpha = a < 0.0f ? 0.0f : a > 1.0f ? 1.0f : a;
@@ -121,7 +120,10 @@ static void update_one(mlod_rt_ctx *ctx, const mlod_rt_select *sel, uint32_t id,
 		uint32_t w = mlod_rt_select_level(ctx, sel, (mlod_rt_layer)layer, item, d,
 		                                  in->selected ? (int)st->wanted[layer] : -1);
 		st->wanted[layer] = (uint16_t)w;
+		/* a failed level's want goes to its fallback, which then loads */
 		rt_unit *u = rt_unit_get(ctx, (mlod_rt_layer)layer, w, item);
+		if (u && u->state == RT_UNIT_FAILED)
+			u = rt_unit_get(ctx, (mlod_rt_layer)layer, rt_want_target(ctx, (mlod_rt_layer)layer, item, w), item);
 		if (u) {
 			u->want_count++;
 			u->last_wanted = ctx->stamp;
@@ -136,6 +138,14 @@ mlod_result mlod_rt_update(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const ui
 {
 	if (!ctx || !sel || (n && (!ids || !distances)))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_update: NULL argument");
+	/* Everything is checked before any state changes: no partial update. */
+	if (!isfinite(dt))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_update: dt %g is not finite", (double)dt);
+	for (size_t i = 0; i < n; i++)
+		if (!(distances[i] >= 0.0f && distances[i] <= FLT_MAX)) /* NaN fails both */
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG,
+			                 "mlod_rt_update: instance index %zu: distance %g, not finite and >= 0", i,
+			                 (double)distances[i]);
 	begin_frame(ctx);
 	for (size_t i = 0; i < n; i++)
 		update_one(ctx, sel, ids[i], distances[i], dt);
@@ -148,6 +158,18 @@ mlod_result mlod_rt_update_positions(mlod_rt_ctx *ctx, const mlod_rt_select *sel
 {
 	if (!ctx || !sel || !camera || (n && (!ids || !positions)))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_update_positions: NULL argument");
+	/* Checked before any state changes, as mlod_rt_update. */
+	if (!isfinite(dt))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_update_positions: dt %g is not finite", (double)dt);
+	for (size_t i = 0; i < n; i++) {
+		const float *p = positions + 3 * i;
+		const float x = p[0] - camera[0], y = p[1] - camera[1], z = p[2] - camera[2];
+		const float d = sqrtf(x * x + y * y + z * z);
+		if (!isfinite(d))
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG,
+			                 "mlod_rt_update_positions: instance index %zu: distance %g, not finite", i,
+			                 (double)d);
+	}
 	begin_frame(ctx);
 	for (size_t i = 0; i < n; i++) {
 		const float *p = positions + 3 * i;
