@@ -75,7 +75,7 @@ static const char usage_text[] =
 	"  -V, --version            show the version\n"
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
-	"4 output failure.\n";
+	"4 output failure.\n" TOOL_OUTPUT_NOTE;
 
 /* A level as the stage record lists it. */
 static mlod_record_mesh_level level_record(const mlod_mesh_level *lv, int k)

@@ -45,7 +45,7 @@ static const char usage_text[] =
 	"stopping at the last level within --max-error.\n"
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
-	"4 output failure.\n";
+	"4 output failure.\n" TOOL_OUTPUT_NOTE;
 
 struct job {
 	const char *input;
