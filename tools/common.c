@@ -292,6 +292,26 @@ double tool_parse_double(const char *option, const char *value, double lo, doubl
 	return v;
 }
 
+int tool_parse_int(const char *option, const char *value, int lo, int hi)
+{
+	double v = tool_parse_double(option, value, lo, hi);
+	if (v != (int)v)
+		tool_usage_error("%s: '%s' is not a whole number", option, value);
+	return (int)v;
+}
+
+const char *tool_input_stem(const char *path, const char *fallback, char *buf, size_t size)
+{
+	if (is_stdio(path))
+		return fallback;
+	const char *base = strrchr(path, '/');
+	base = base ? base + 1 : path;
+	const char *dot = strrchr(base, '.');
+	size_t n = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+	snprintf(buf, size, "%.*s", (int)n, base);
+	return buf;
+}
+
 int tool_parse_threads(const char *value)
 {
 	double v = tool_parse_double("--threads", value, 1, MLOD_MAX_THREADS);

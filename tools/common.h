@@ -108,6 +108,14 @@ int tool_parse_list(const char *option, const char *value, double *out, int max,
 int tool_parse_list_percent(const char *option, const char *value, double *out, int *percent, int max, double lo,
                             double hi);
 
+/* Parses a whole number within [lo, hi]; exits 1 naming the option
+ * otherwise. */
+int tool_parse_int(const char *option, const char *value, int lo, int hi);
+
+/* The file name of path without its directory and extension ("walk" for
+ * "a/walk.bvh") in buf; fallback when path is NULL or "-". */
+const char *tool_input_stem(const char *path, const char *fallback, char *buf, size_t size);
+
 /* Parses -j/--threads: a whole number from 1 to MLOD_MAX_THREADS; exits 1
  * naming the option otherwise. The tools default to mlod_thread_count(). */
 int tool_parse_threads(const char *value);

@@ -329,6 +329,8 @@ int main(int argc, char **argv)
 		tool_usage_error("too many inputs: one file, or stdin");
 	if (ratio_count && max_error >= 0.0)
 		tool_usage_error("--ratios and --max-error do not go together");
+	if (opt.influence_budget > 0.0 && max_error >= 0.0)
+		tool_usage_error("--influence-budget and --max-error do not go together");
 	if (report != REPORT_NONE && output)
 		tool_usage_error("--report and --output do not go together");
 	if (opt.cost == MLOD_COST_COMPACTNESS && opt.op != MLOD_OP_DEFAULT && opt.op != MLOD_OP_TRIANGLE)
