@@ -187,9 +187,10 @@ static void write_in_place(const char *path, const void *data, size_t size, int 
 		tool_die(EXIT_OUTPUT, path, "write error: %s", strerror(e));
 }
 
-/* A regular file or a new path: a temporary file in the same directory,
- * then rename. what names the output in messages (the path given). */
-static void write_replace(const char *what, const char *path, const void *data, size_t size)
+/* A regular file (exists) or a new path: a temporary file in the same
+ * directory, then rename. what names the output in messages (the path
+ * given). */
+static void write_replace(const char *what, const char *path, int exists, const void *data, size_t size)
 {
 	size_t n = strlen(path) + 32;
 	char *tmp = malloc(n);
@@ -201,6 +202,8 @@ static void write_replace(const char *what, const char *path, const void *data, 
 		int e = errno;
 		free(tmp);
 		char *slash = strrchr(path, '/');
+		if (!exists) /* the file itself could not be made: the same cause */
+			tool_die(EXIT_OUTPUT, what, "cannot create: %s", strerror(e));
 		tool_die(EXIT_OUTPUT, what, "cannot create a temporary file in %.*s to replace it atomically: %s",
 		         slash ? (int)(slash == path ? 1 : slash - path) : 1, slash ? path : ".", strerror(e));
 	}
@@ -232,7 +235,7 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 	if (lstat(path, &st) != 0) {
 		if (errno != ENOENT)
 			tool_die(EXIT_OUTPUT, path, "%s", strerror(errno));
-		write_replace(path, path, data, size); /* a new file */
+		write_replace(path, path, 0, data, size); /* a new file */
 		return;
 	}
 	char *target = NULL;
@@ -245,7 +248,7 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 		/* The link's target is replaced in its own directory. */
 		if (!(target = realpath(path, NULL)))
 			tool_die(EXIT_OUTPUT, path, "cannot resolve: %s", strerror(errno));
-		write_replace(path, target, data, size);
+		write_replace(path, target, 1, data, size);
 	} else if (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode))
 		write_in_place(path, data, size, binary);
 	else

@@ -178,7 +178,7 @@ static void write_bvh(const struct job *job, const mlod_motion_bake *b, const ch
 	const mlod_clip *use = NULL;
 	if (level > 0) {
 		if (level > cl->level_count)
-			tool_die(EXIT_USAGE, NULL, "--level %d: clip %d has %d levels", level, clip, cl->level_count);
+			tool_die(EXIT_USAGE, NULL, "--level %d: clip %d's levels are 0..%d", level, clip, cl->level_count);
 		if (!cl->levels[level - 1].ok)
 			tool_die(EXIT_INPUT, job->input, "--level %d: no level within its bound", level);
 		use = &cl->levels[level - 1].l.clip;
