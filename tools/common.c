@@ -11,7 +11,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 const char *tool_name = "mlod";
@@ -171,9 +173,23 @@ static int write_all(int fd, const void *data, size_t size)
 
 /* A character device, FIFO or socket: opened and written in place (never
  * replaced); a terminal is refused for binary output, as stdout is. */
-static void write_in_place(const char *path, const void *data, size_t size, int binary)
+static void write_in_place(const char *path, const void *data, size_t size, int binary, int socket_file)
 {
-	int fd = open(path, O_WRONLY | O_NOCTTY);
+	int fd = -1;
+	if (socket_file) { /* a Unix stream socket: connected to, not opened */
+		struct sockaddr_un a = {.sun_family = AF_UNIX};
+		if (strlen(path) >= sizeof a.sun_path)
+			tool_die(EXIT_OUTPUT, path, "socket path too long");
+		strcpy(a.sun_path, path);
+		if ((fd = socket(AF_UNIX, SOCK_STREAM, 0)) >= 0 && connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
+			int e = errno;
+			close(fd);
+			fd = -1;
+			errno = e;
+		}
+	} else {
+		fd = open(path, O_WRONLY | O_NOCTTY);
+	}
 	if (fd < 0)
 		tool_die(EXIT_OUTPUT, path, "cannot open for writing: %s", strerror(errno));
 	if (binary && isatty(fd)) {
@@ -250,7 +266,7 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 			tool_die(EXIT_OUTPUT, path, "cannot resolve: %s", strerror(errno));
 		write_replace(path, target, 1, data, size);
 	} else if (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode))
-		write_in_place(path, data, size, binary);
+		write_in_place(path, data, size, binary, S_ISSOCK(st.st_mode));
 	else
 		tool_die(EXIT_OUTPUT, path, "not a regular file, character device or FIFO");
 	free(target);

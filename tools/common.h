@@ -61,8 +61,8 @@ void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_
 /* Writes bytes to path, or to stdout when path is NULL or "-". A regular
  * file or a new path is replaced atomically (a temporary file in the same
  * directory, then rename); a symbolic link is kept and the file it resolves
- * to replaced so; a character device, FIFO or socket is opened and written
- * in place. Binary output to a terminal (stdout or path) is refused (exit
+ * to replaced so; a character device or FIFO is opened and written in
+ * place, a Unix stream socket connected to and written. Binary output to a terminal (stdout or path) is refused (exit
  * 1). Exits 4 on failure. */
 void tool_write_output(const char *path, const void *data, size_t size, int binary);
 

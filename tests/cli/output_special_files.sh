@@ -1,5 +1,6 @@
 # -o on a FIFO writes into the pipe (its reader gets the same bytes as a
-# normal output) and leaves the FIFO in place; -o on a symbolic link
+# normal output) and leaves the FIFO in place, as on a Unix socket (a
+# listener gets the bytes, the socket stays); -o on a symbolic link
 # replaces the file it points to and keeps the link; a dangling link is
 # refused. Never a device: a wrong fix would destroy it.
 set -e
@@ -21,6 +22,29 @@ reader=$!
 test -p pipe.glb || { kill $reader; exit 1; }
 wait $reader
 cmp plain.mlod got.mlod
+# A Unix stream socket: connected to and written; it stays a socket.
+node - <<'JS'
+const net = require('net'), fs = require('fs'), cp = require('child_process');
+const chunks = [];
+let code = null, ended = false;
+const done = () => {
+	if (code === null || !ended) return;
+	if (code !== 0) throw new Error(`mlod-bgm exited ${code}`);
+	if (!Buffer.concat(chunks).equals(fs.readFileSync('plain.glb'))) throw new Error('the socket got other bytes');
+	if (!fs.lstatSync('sock.glb').isSocket()) throw new Error('sock.glb is no longer a socket');
+	process.exit(0);
+};
+setTimeout(() => { console.error('no connection: the socket was replaced?'); process.exit(1); }, 60000).unref();
+const srv = net.createServer((c) => {
+	c.on('data', (d) => chunks.push(d));
+	c.on('end', () => { ended = true; done(); });
+});
+srv.listen('sock.glb', () => {
+	const p = cp.spawn(`${process.env.BIN}/mlod-bgm`, ['-o', 'sock.glb', `${process.env.ROOT}/samples/tubeman.glb`],
+	                   {stdio: 'inherit'});
+	p.on('exit', (c) => { code = c; if (c !== 0) { console.error(`mlod-bgm exited ${c}`); process.exit(1); } done(); });
+});
+JS
 # A symbolic link: its target is replaced, the link stays a link.
 mkdir sub
 printf 'old' > sub/target.glb
