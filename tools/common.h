@@ -62,15 +62,15 @@ void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_
  * file or a new path is replaced atomically (a temporary file in the same
  * directory, then rename); a symbolic link is kept and the file it resolves
  * to replaced so; a character device or FIFO is opened and written in
- * place, a Unix stream socket connected to and written. Binary output to a terminal (stdout or path) is refused (exit
- * 1). Exits 4 on failure. */
+ * place, a Unix stream socket connected to and written. Binary output to
+ * a terminal (stdout or path) is refused (exit 1). Exits 4 on failure. */
 void tool_write_output(const char *path, const void *data, size_t size, int binary);
 
 /* The end of every tool's --help: how -o writes (tool_write_output). */
 #define TOOL_OUTPUT_NOTE \
 	"-o replaces a regular file atomically (through a temporary file; a\n" \
 	"symbolic link is kept and the file it names replaced); a character\n" \
-	"device, FIFO or socket is written in place, a terminal refused.\n"
+	"device, FIFO or Unix socket is written in place, a terminal refused.\n"
 
 /* Serialises doc as glb (or .gltf when path ends in ".gltf") to path or
  * stdout. Exits 4 on failure. */
