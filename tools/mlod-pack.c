@@ -112,7 +112,7 @@ static void parse_level0(const char *value, mlod_pack_options *opt)
 
 /* Level 0 is the finest motion level: its bound must be below the smallest
  * of --motion-max-error's (compared in scene units, by the height). */
-static void check_level0(const mlod_pack_options *o, const mlod_character *c, const char *label)
+static void check_level0(const mlod_pack_options *o, mlod_character *c, mlod_gltf *doc, void *bytes, const char *label)
 {
 	if (o->lossless_motion || o->no_motion_levels || c->clip_count == 0 || !(o->motion_level0_error > 0.0))
 		return;
@@ -124,11 +124,15 @@ static void check_level0(const mlod_pack_options *o, const mlod_character *c, co
 		if (first < 0 || e < e1)
 			first = b, e1 = e;
 	}
-	if (first >= 0 && e0 >= e1)
-		tool_die(EXIT_USAGE, label, "--motion-level0-error %g%s (%.4g units) is not below the first motion level's "
-		         "bound, --motion-max-error %g%s (%.4g units of a height of %.4g)", o->motion_level0_error,
-		         o->motion_level0_percent ? "%" : "", e0, o->motion_bounds[first], o->motion_percent[first] ? "%" : "",
-		         e1, h);
+	if (!(first >= 0 && e0 >= e1))
+		return;
+	free(bytes); /* the input, released before exiting (leak checkers) */
+	mlod_character_free(c);
+	mlod_gltf_free(doc);
+	tool_die(EXIT_USAGE, label, "--motion-level0-error %g%s (%.4g units) is not below the first motion level's "
+	         "bound, --motion-max-error %g%s (%.4g units of a height of %.4g)", o->motion_level0_error,
+	         o->motion_level0_percent ? "%" : "", e0, o->motion_bounds[first], o->motion_percent[first] ? "%" : "", e1,
+	         h);
 }
 
 static const char *source(const mlod_pack_layer_stats *l)
@@ -465,7 +469,7 @@ int main(int argc, char **argv)
 	size_t size = 0;
 	memset(&c, 0, sizeof c);
 	void *bytes = tool_load_keep(path, &doc, &c, &format, &size);
-	check_level0(&opt, &c, label);
+	check_level0(&opt, &c, doc, bytes, label);
 
 	mlod_pack_stats st;
 	mlod_error err = {0};
