@@ -1,15 +1,19 @@
 /* common.c: input, output and error handling shared by the mlod-* tools. */
 #define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700 /* realpath, S_ISSOCK */
 
 #include "common.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 const char *tool_name = "mlod";
@@ -150,6 +154,90 @@ void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_
 	return data;
 }
 
+/* Writes all of data to an open descriptor; 0 on success, else errno. */
+static int write_all(int fd, const void *data, size_t size)
+{
+	const char *p = data;
+	while (size > 0) {
+		ssize_t n = write(fd, p, size);
+		if (n < 0) {
+			if (errno == EINTR)
+				continue;
+			return errno;
+		}
+		p += n;
+		size -= (size_t)n;
+	}
+	return 0;
+}
+
+/* A character device, FIFO or socket: opened and written in place (never
+ * replaced); a terminal is refused for binary output, as stdout is. */
+static void write_in_place(const char *path, const void *data, size_t size, int binary, int socket_file)
+{
+	int fd = -1;
+	if (socket_file) { /* a Unix stream socket: connected to, not opened */
+		struct sockaddr_un a = {.sun_family = AF_UNIX};
+		if (strlen(path) >= sizeof a.sun_path)
+			tool_die(EXIT_OUTPUT, path, "socket path too long");
+		strcpy(a.sun_path, path);
+		if ((fd = socket(AF_UNIX, SOCK_STREAM, 0)) >= 0 && connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
+			int e = errno;
+			close(fd);
+			fd = -1;
+			errno = e;
+		}
+	} else {
+		fd = open(path, O_WRONLY | O_NOCTTY);
+	}
+	if (fd < 0)
+		tool_die(EXIT_OUTPUT, path, "cannot open for writing: %s", strerror(errno));
+	if (binary && isatty(fd)) {
+		close(fd);
+		tool_die(EXIT_USAGE, path, "refusing to write binary output to a terminal");
+	}
+	int e = write_all(fd, data, size);
+	if (close(fd) != 0 && e == 0 && errno != EINTR)
+		e = errno;
+	if (e)
+		tool_die(EXIT_OUTPUT, path, "write error: %s", strerror(e));
+}
+
+/* A regular file (exists) or a new path: a temporary file in the same
+ * directory, then rename. what names the output in messages (the path
+ * given). */
+static void write_replace(const char *what, const char *path, int exists, const void *data, size_t size)
+{
+	size_t n = strlen(path) + 32;
+	char *tmp = malloc(n);
+	if (!tmp)
+		tool_die(EXIT_OUTPUT, what, "out of memory");
+	snprintf(tmp, n, "%s.tmp.%ld", path, (long)getpid());
+	int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
+	if (fd < 0) {
+		int e = errno;
+		free(tmp);
+		char *slash = strrchr(path, '/');
+		if (!exists) /* the file itself could not be made: the same cause */
+			tool_die(EXIT_OUTPUT, what, "cannot create: %s", strerror(e));
+		tool_die(EXIT_OUTPUT, what, "cannot create a temporary file in %.*s to replace it atomically: %s",
+		         slash ? (int)(slash == path ? 1 : slash - path) : 1, slash ? path : ".", strerror(e));
+	}
+	int e = write_all(fd, data, size);
+	if (e == 0 && fsync(fd) != 0 && errno != EINVAL)
+		e = errno;
+	if (close(fd) != 0 && e == 0)
+		e = errno;
+	if (e == 0 && rename(tmp, path) != 0)
+		e = errno;
+	if (e) {
+		remove(tmp);
+		free(tmp);
+		tool_die(EXIT_OUTPUT, what, "write failed: %s", strerror(e));
+	}
+	free(tmp);
+}
+
 void tool_write_output(const char *path, const void *data, size_t size, int binary)
 {
 	if (is_stdio(path)) {
@@ -159,30 +247,29 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 			tool_die(EXIT_OUTPUT, "<stdout>", "write error: %s", strerror(errno));
 		return;
 	}
-	size_t n = strlen(path) + 32;
-	char *tmp = malloc(n);
-	if (!tmp)
-		tool_die(EXIT_OUTPUT, path, "out of memory");
-	snprintf(tmp, n, "%s.tmp.%ld", path, (long)getpid());
-	FILE *f = fopen(tmp, "wb");
-	if (!f) {
-		int e = errno;
-		free(tmp);
-		tool_die(EXIT_OUTPUT, path, "cannot create: %s", strerror(e));
+	struct stat st;
+	if (lstat(path, &st) != 0) {
+		if (errno != ENOENT)
+			tool_die(EXIT_OUTPUT, path, "%s", strerror(errno));
+		write_replace(path, path, 0, data, size); /* a new file */
+		return;
 	}
-	int ok = fwrite(data, 1, size, f) == size;
-	ok = (fflush(f) == 0) && ok;
-	ok = (fsync(fileno(f)) == 0 || errno == EINVAL) && ok;
-	int e = errno;
-	ok = (fclose(f) == 0) && ok;
-	if (!ok || rename(tmp, path) != 0) {
-		if (ok)
-			e = errno;
-		remove(tmp);
-		free(tmp);
-		tool_die(EXIT_OUTPUT, path, "write failed: %s", strerror(e));
-	}
-	free(tmp);
+	char *target = NULL;
+	/* A symbolic link stays; what it points to is written. */
+	if (S_ISLNK(st.st_mode) && stat(path, &st) != 0)
+		tool_die(EXIT_OUTPUT, path, "symbolic link to nothing that can be written (%s)", strerror(errno));
+	if (S_ISDIR(st.st_mode))
+		tool_die(EXIT_OUTPUT, path, "is a directory");
+	if (S_ISREG(st.st_mode)) {
+		/* The link's target is replaced in its own directory. */
+		if (!(target = realpath(path, NULL)))
+			tool_die(EXIT_OUTPUT, path, "cannot resolve: %s", strerror(errno));
+		write_replace(path, target, 1, data, size);
+	} else if (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode))
+		write_in_place(path, data, size, binary, S_ISSOCK(st.st_mode));
+	else
+		tool_die(EXIT_OUTPUT, path, "not a regular file, character device or FIFO");
+	free(target);
 }
 
 int tool_ends_with(const char *s, const char *suffix)
@@ -222,6 +309,26 @@ double tool_parse_double(const char *option, const char *value, double lo, doubl
 	if (v < lo || v > hi)
 		tool_usage_error("%s: %s is out of range [%g, %g]", option, value, lo, hi);
 	return v;
+}
+
+int tool_parse_int(const char *option, const char *value, int lo, int hi)
+{
+	double v = tool_parse_double(option, value, lo, hi);
+	if (v != (int)v)
+		tool_usage_error("%s: '%s' is not a whole number", option, value);
+	return (int)v;
+}
+
+const char *tool_input_stem(const char *path, const char *fallback, char *buf, size_t size)
+{
+	if (is_stdio(path))
+		return fallback;
+	const char *base = strrchr(path, '/');
+	base = base ? base + 1 : path;
+	const char *dot = strrchr(base, '.');
+	size_t n = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+	snprintf(buf, size, "%.*s", (int)n, base);
+	return buf;
 }
 
 int tool_parse_threads(const char *value)

@@ -58,10 +58,19 @@ void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format
  * with free). */
 void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format, size_t *size);
 
-/* Writes bytes to path atomically (a temporary file in the same directory,
- * then rename), or to stdout when path is NULL or "-". Binary output is
- * refused when stdout is a terminal. Exits 4 on failure. */
+/* Writes bytes to path, or to stdout when path is NULL or "-". A regular
+ * file or a new path is replaced atomically (a temporary file in the same
+ * directory, then rename); a symbolic link is kept and the file it resolves
+ * to replaced so; a character device or FIFO is opened and written in
+ * place, a Unix stream socket connected to and written. Binary output to
+ * a terminal (stdout or path) is refused (exit 1). Exits 4 on failure. */
 void tool_write_output(const char *path, const void *data, size_t size, int binary);
+
+/* The end of every tool's --help: how -o writes (tool_write_output). */
+#define TOOL_OUTPUT_NOTE \
+	"-o replaces a regular file atomically (through a temporary file; a\n" \
+	"symbolic link is kept and the file it names replaced); a character\n" \
+	"device, FIFO or Unix socket is written in place, a terminal refused.\n"
 
 /* Serialises doc as glb (or .gltf when path ends in ".gltf") to path or
  * stdout. Exits 4 on failure. */
@@ -98,6 +107,14 @@ int tool_parse_list(const char *option, const char *value, double *out, int max,
 /* The same, where a value may end in '%': percent[i] says whether value i did. */
 int tool_parse_list_percent(const char *option, const char *value, double *out, int *percent, int max, double lo,
                             double hi);
+
+/* Parses a whole number within [lo, hi]; exits 1 naming the option
+ * otherwise. */
+int tool_parse_int(const char *option, const char *value, int lo, int hi);
+
+/* The file name of path without its directory and extension ("walk" for
+ * "a/walk.bvh") in buf; fallback when path is NULL or "-". */
+const char *tool_input_stem(const char *path, const char *fallback, char *buf, size_t size);
 
 /* Parses -j/--threads: a whole number from 1 to MLOD_MAX_THREADS; exits 1
  * naming the option otherwise. The tools default to mlod_thread_count(). */

@@ -16,6 +16,7 @@
  */
 #define _GNU_SOURCE /* getopt_long */
 
+#include <errno.h>
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -67,15 +68,17 @@ static const char usage_text[] =
 	"                           posed error at every training pose; the level is\n"
 	"                           measured again (0, the default: off; 2 is\n"
 	"                           measured in bench/RESULTS.md; not with -e)\n"
-	"  -s, --split DIR          also write one glb per level into DIR: the input\n"
-	"                           with that level's meshes in place\n"
+	"  -s, --split DIR          also write one glb per level into DIR (made if\n"
+	"                           missing, not its parents): DIR/NAME.lodK.glb, the\n"
+	"                           input with that level's meshes in place; NAME is\n"
+	"                           the input's, from stdin -o's, else stdin\n"
 	"  -j, --threads N          work on N threads (default: the processors online);\n"
 	"                           the output is the same at any N\n"
 	"  -h, --help               show this help\n"
 	"  -V, --version            show the version\n"
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
-	"4 output failure.\n";
+	"4 output failure.\n" TOOL_OUTPUT_NOTE;
 
 /* A level as the stage record lists it. */
 static mlod_record_mesh_level level_record(const mlod_mesh_level *lv, int k)
@@ -124,14 +127,24 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	tool_write_gltf(output, doc);
 }
 
-/* One glb per level in dir: DIR/<input name>.lod<k>.glb. */
-static void write_split(struct job *job, const mlod_gltf *input, const char *dir, const char *input_path)
+/* One glb per level in dir (made when missing, not its parents):
+ * DIR/<name>.lod<k>.glb, name the input file's without its extension; from
+ * stdin -o's, else "stdin". */
+static void write_split(struct job *job, const mlod_gltf *input, const char *dir, const char *input_path,
+                        const char *output)
 {
 	struct stat st;
-	if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+	if (stat(dir, &st) != 0) {
+		if (errno != ENOENT || mkdir(dir, 0777) != 0)
+			tool_die(EXIT_OUTPUT, dir, "cannot create the directory: %s", strerror(errno));
+	} else if (!S_ISDIR(st.st_mode)) {
 		tool_die(EXIT_OUTPUT, dir, "not a directory");
-	const char *base = input_path && strcmp(input_path, "-") != 0 ? strrchr(input_path, '/') : NULL;
-	base = base ? base + 1 : input_path && strcmp(input_path, "-") != 0 ? input_path : "stdin";
+	}
+	const char *from = input_path && strcmp(input_path, "-") != 0 ? input_path
+	                   : output && strcmp(output, "-") != 0       ? output
+	                                                              : "stdin";
+	const char *base = strrchr(from, '/');
+	base = base ? base + 1 : from;
 	size_t blen = strlen(base);
 	const char *dot = strrchr(base, '.');
 	if (dot && dot != base)
@@ -316,6 +329,8 @@ int main(int argc, char **argv)
 		tool_usage_error("too many inputs: one file, or stdin");
 	if (ratio_count && max_error >= 0.0)
 		tool_usage_error("--ratios and --max-error do not go together");
+	if (opt.influence_budget > 0.0 && max_error >= 0.0)
+		tool_usage_error("--influence-budget and --max-error do not go together");
 	if (report != REPORT_NONE && output)
 		tool_usage_error("--report and --output do not go together");
 	if (opt.cost == MLOD_COST_COMPACTNESS && opt.op != MLOD_OP_DEFAULT && opt.op != MLOD_OP_TRIANGLE)
@@ -365,7 +380,7 @@ int main(int argc, char **argv)
 			fprintf(stderr, "%s: %s: no mesh level within --max-error %g%%\n", tool_name, job.input, max_error);
 		follow_skeleton(&job, &rec, sk);
 		if (split) /* first: write_glb changes doc */
-			write_split(&job, doc, split, input_path);
+			write_split(&job, doc, split, input_path, output);
 		if (report == REPORT_TABLE)
 			report_table(&job);
 		else if (report == REPORT_JSON)

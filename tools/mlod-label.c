@@ -37,7 +37,7 @@ static const char usage_text[] =
 	"  -V, --version          show the version\n"
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
-	"4 output failure.\n";
+	"4 output failure.\n" TOOL_OUTPUT_NOTE;
 
 struct stats {
 	double avg_neighbors, avg_depth;

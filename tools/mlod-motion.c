@@ -44,7 +44,8 @@ static const char usage_text[] =
 	"                          (default " DEFAULT_MAX_ERROR ")\n"
 	"  -t, --thresholds LIST   one level per frame distance threshold (frames method)\n"
 	"  -k, --keys LIST         one level per fraction of the keys kept (0.5,0.2)\n"
-	"      --merge MODE        frames method: remove (default) or average\n"
+	"      --merge MODE        frames method: remove (default) or average (not\n"
+	"                          with -m keys)\n"
 	"      --point-distance D  keys method: radius of the points carried by each\n"
 	"                          joint (default 0.1 for glTF, height/18 for BVH)\n"
 	"      --precision MODE    how level key values are stored, rounded within each\n"
@@ -67,7 +68,7 @@ static const char usage_text[] =
 	"  -V, --version           show the version\n"
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
-	"4 output failure.\n";
+	"4 output failure.\n" TOOL_OUTPUT_NOTE;
 
 enum method { METHOD_AUTO = -1 };
 
@@ -177,7 +178,7 @@ static void write_bvh(const struct job *job, const mlod_motion_bake *b, const ch
 	const mlod_clip *use = NULL;
 	if (level > 0) {
 		if (level > cl->level_count)
-			tool_die(EXIT_USAGE, NULL, "--level %d: clip %d has %d levels", level, clip, cl->level_count);
+			tool_die(EXIT_USAGE, NULL, "--level %d: clip %d's levels are 0..%d", level, clip, cl->level_count);
 		if (!cl->levels[level - 1].ok)
 			tool_die(EXIT_INPUT, job->input, "--level %d: no level within its bound", level);
 		use = &cl->levels[level - 1].l.clip;
@@ -217,7 +218,7 @@ int main(int argc, char **argv)
 	const char *output = NULL;
 	enum tool_report report = REPORT_NONE;
 	struct job job;
-	int level = -1, clip = 0, ch, kinds = 0, method_given = 0;
+	int level = -1, clip = 0, ch, kinds = 0, method_given = 0, merge_given = 0;
 	double point_distance = 0.0;
 	memset(&job, 0, sizeof job);
 	job.method = METHOD_AUTO;
@@ -259,6 +260,7 @@ int main(int argc, char **argv)
 				job.opt.merge = MLOD_MOTION_AVERAGE;
 			else
 				tool_usage_error("--merge: unknown mode '%s' (remove or average)", optarg);
+			merge_given = 1;
 			break;
 		case 'P': point_distance = tool_parse_double("--point-distance", optarg, 1e-12, 1e12); break;
 		case 'C': job.opt.cubic_rate = tool_parse_double("--cubic-rate", optarg, 1.0, 1e4); break;
@@ -302,6 +304,8 @@ int main(int argc, char **argv)
 			tool_usage_error("--thresholds are frame distances: they need --method frames");
 		job.method = MLOD_MOTION_FRAMES;
 	}
+	if (merge_given && job.method == MLOD_MOTION_KEYS)
+		tool_usage_error("--merge is for the frames method: not with --method keys");
 	if (job.spec_count == 0)
 		job.spec_count = parse_list("--max-error", DEFAULT_MAX_ERROR, job.specs, MLOD_MOTION_MAX_ERROR, 0.0, 1e12);
 	qsort(job.specs, (size_t)job.spec_count, sizeof *job.specs, spec_order);

@@ -64,14 +64,18 @@ static const char usage_text[] =
 	"      --motion-max-error LIST   one level per bound: E in scene units or E%%\n"
 	"                             of the skeleton height (default 0.2%%,1%%,3%%)\n"
 	"      --motion-level0-error E   level 0: the clips within E (scene units, or\n"
-	"                             E%% of the height; default %g%%), keys reduced\n"
-	"      --lossless-motion      level 0: every key of the clips as read\n"
+	"                             E%% of the height; default %g%%), keys reduced;\n"
+	"                             below the smallest --motion-max-error bound\n"
+	"      --lossless-motion      level 0: every key of the clips as read (not\n"
+	"                             with --motion-level0-error)\n"
 	"      --no-skeleton-levels, --no-mesh-levels, --no-motion-levels\n"
-	"                             pack that layer at level 0 only\n"
+	"                             pack that layer at level 0 only\n";
+static const char usage_more[] = /* printf's format ends above (ISO C's 4095-character string limit) */
 	"      --info FILE            print the pack's chunks (layer, level, clip,\n"
 	"                             codec and entropy stage, sizes, error, switch\n"
 	"                             distance) and totals;\n"
-	"                             every chunk is decoded and checked\n"
+	"                             every chunk is decoded and checked (stdout\n"
+	"                             only: not with -o)\n"
 	"      --json                 with --info: as JSON (= --report=json)\n"
 	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels,\n"
 	"                             skeleton-level skins, <clip>@lod<k> animations\n"
@@ -81,49 +85,17 @@ static const char usage_text[] =
 	"  -V, --version              show the version\n"
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
-	"4 output failure.\n";
-
-/* A bit count from min to 16. */
-static int parse_bits(const char *option, const char *value, int min)
-{
-	double v = tool_parse_double(option, value, min, 16);
-	if (v != (int)v)
-		tool_usage_error("%s: '%s' is not a whole number of bits", option, value);
-	return (int)v;
-}
-
-static const char *input_name(const char *path, char *buf, size_t size)
-{
-	if (!path || strcmp(path, "-") == 0)
-		return "";
-	const char *base = strrchr(path, '/');
-	base = base ? base + 1 : path;
-	const char *dot = strrchr(base, '.');
-	size_t n = dot && dot != base ? (size_t)(dot - base) : strlen(base);
-	snprintf(buf, size, "%.*s", (int)n, base);
-	return buf;
-}
+	"4 output failure.\n" TOOL_OUTPUT_NOTE;
 
 /* "0.2%,1%,3%" or "0.01,0.05". */
 static int parse_bounds(const char *value, mlod_pack_options *opt)
 {
-	char *copy = strdup(value), *save = NULL;
-	int n = 0;
-	if (!copy)
-		tool_die(EXIT_USAGE, NULL, "out of memory");
-	for (char *tok = strtok_r(copy, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-		if (n == MLOD_PACK_MAX_MOTION_LEVELS)
-			tool_usage_error("--motion-max-error: at most %d bounds", MLOD_PACK_MAX_MOTION_LEVELS);
-		size_t len = strlen(tok);
-		int percent = len > 0 && tok[len - 1] == '%';
-		if (percent)
-			tok[len - 1] = '\0';
-		opt->motion_bounds[n] = tool_parse_double("--motion-max-error", tok, 1e-12, percent ? 100.0 : 1e12);
-		opt->motion_percent[n++] = (unsigned char)percent;
-	}
-	free(copy);
-	if (n == 0)
-		tool_usage_error("--motion-max-error: no bound in '%s'", value);
+	int pct[MLOD_PACK_MAX_MOTION_LEVELS];
+	int n = tool_parse_list_percent("--motion-max-error", value, opt->motion_bounds, pct, MLOD_PACK_MAX_MOTION_LEVELS,
+	                                1e-12, 1e12);
+	for (int i = 0; i < n; i++)
+		if ((opt->motion_percent[i] = (unsigned char)pct[i]) && opt->motion_bounds[i] > 100.0)
+			tool_usage_error("--motion-max-error: %g%% is out of range [1e-12, 100]", opt->motion_bounds[i]);
 	return n;
 }
 
@@ -136,6 +108,31 @@ static void parse_level0(const char *value, mlod_pack_options *opt)
 	snprintf(tok, sizeof tok, "%.*s", (int)(percent ? len - 1 : len), value);
 	opt->motion_level0_error = tool_parse_double("--motion-level0-error", tok, 1e-12, percent ? 100.0 : 1e12);
 	opt->motion_level0_percent = (unsigned char)percent;
+}
+
+/* Level 0 is the finest motion level: its bound must be below the smallest
+ * of --motion-max-error's (compared in scene units, by the height). */
+static void check_level0(const mlod_pack_options *o, mlod_character *c, mlod_gltf *doc, void *bytes, const char *label)
+{
+	if (o->lossless_motion || o->no_motion_levels || c->clip_count == 0 || !(o->motion_level0_error > 0.0))
+		return;
+	double h = c->skeleton.joint_count > 0 ? mlod_skeleton_height(&c->skeleton) : 0.0, e1 = 0.0;
+	double e0 = o->motion_level0_percent ? o->motion_level0_error * h / 100.0 : o->motion_level0_error;
+	int first = -1;
+	for (int b = 0; b < o->motion_bound_count; b++) {
+		double e = o->motion_percent[b] ? o->motion_bounds[b] * h / 100.0 : o->motion_bounds[b];
+		if (first < 0 || e < e1)
+			first = b, e1 = e;
+	}
+	if (!(first >= 0 && e0 >= e1))
+		return;
+	free(bytes); /* the input, released before exiting (leak checkers) */
+	mlod_character_free(c);
+	mlod_gltf_free(doc);
+	tool_die(EXIT_USAGE, label, "--motion-level0-error %g%s (%.4g units) is not below the first motion level's "
+	         "bound, --motion-max-error %g%s (%.4g units of a height of %.4g)", o->motion_level0_error,
+	         o->motion_level0_percent ? "%" : "", e0, o->motion_bounds[first], o->motion_percent[first] ? "%" : "", e1,
+	         h);
 }
 
 static const char *source(const mlod_pack_layer_stats *l)
@@ -368,7 +365,7 @@ int main(int argc, char **argv)
 	opt.bgm.threads = mlod_thread_count();
 	const char *output = NULL, *name = NULL, *info = NULL, *extract = NULL, *codec = "meshopt";
 	enum tool_report report = REPORT_NONE;
-	int ratios_given = 0, json = 0, ch;
+	int ratios_given = 0, json = 0, level0_given = 0, ch;
 
 	tool_name = "mlod-pack";
 	opterr = 0;
@@ -412,13 +409,13 @@ int main(int argc, char **argv)
 			break;
 		case OPT_SKEL_ERR: opt.skel_max_error = tool_parse_double("--skeleton-max-error", optarg, 0.0, 1e6); break;
 		case OPT_MOTION_ERR: opt.motion_bound_count = parse_bounds(optarg, &opt); break;
-		case OPT_POS_BITS: opt.position_bits = parse_bits("--position-bits", optarg, MLOD_PACK_POSITION_BITS_MIN); break;
-		case OPT_NRM_BITS: opt.normal_bits = parse_bits("--normal-bits", optarg, MLOD_PACK_NORMAL_BITS_MIN); break;
-		case OPT_UV_BITS: opt.uv_bits = parse_bits("--uv-bits", optarg, MLOD_PACK_UV_BITS_MIN); break;
+		case OPT_POS_BITS: opt.position_bits = tool_parse_int("--position-bits", optarg, MLOD_PACK_POSITION_BITS_MIN, 16); break;
+		case OPT_NRM_BITS: opt.normal_bits = tool_parse_int("--normal-bits", optarg, MLOD_PACK_NORMAL_BITS_MIN, 16); break;
+		case OPT_UV_BITS: opt.uv_bits = tool_parse_int("--uv-bits", optarg, MLOD_PACK_UV_BITS_MIN, 16); break;
 		case OPT_NO_SKEL: opt.no_skeleton_levels = 1; break;
 		case OPT_NO_MESH: opt.no_mesh_levels = 1; break;
 		case OPT_NO_MOTION: opt.no_motion_levels = 1; break;
-		case OPT_LEVEL0_ERR: parse_level0(optarg, &opt); break;
+		case OPT_LEVEL0_ERR: parse_level0(optarg, &opt), level0_given = 1; break;
 		case OPT_LOSSLESS_MOTION: opt.lossless_motion = 1; break;
 		case OPT_INFO: info = optarg; break;
 		case 'x': extract = optarg; break;
@@ -431,6 +428,7 @@ int main(int argc, char **argv)
 				n += (size_t)snprintf(list + n, sizeof list - n, "%s%g", i ? "," : "", defaults[i]);
 			printf(usage_text, list, MLOD_PACK_POSITION_BITS_DEFAULT, MLOD_PACK_NORMAL_BITS_DEFAULT,
 			       MLOD_PACK_UV_BITS_DEFAULT, MLOD_SKEL_MAX_ERROR_DEFAULT, MLOD_PACK_MOTION_LEVEL0_DEFAULT);
+			fputs(usage_more, stdout);
 			return 0;
 		}
 		case 'V': tool_version();
@@ -442,8 +440,14 @@ int main(int argc, char **argv)
 		tool_usage_error("too many inputs: one file, or stdin");
 	if (ratios_given && opt.mesh_max_error >= 0.0)
 		tool_usage_error("--ratios and --max-error do not go together");
+	if (opt.bgm.influence_budget > 0.0 && opt.mesh_max_error >= 0.0)
+		tool_usage_error("--influence-budget and --max-error do not go together");
+	if (opt.lossless_motion && level0_given)
+		tool_usage_error("--lossless-motion and --motion-level0-error do not go together");
 	if (info && extract)
 		tool_usage_error("--info and -x do not go together");
+	if (info && output)
+		tool_usage_error("--info prints to stdout, -o does not go with it (redirect stdout)");
 	if (json && !info)
 		tool_usage_error("--json goes with --info (else use --report=json)");
 	if (info || extract) {
@@ -458,13 +462,14 @@ int main(int argc, char **argv)
 	const char *path = optind < argc ? argv[optind] : NULL;
 	const char *label = tool_input_label(path);
 	char namebuf[256];
-	opt.name = name ? name : input_name(path, namebuf, sizeof namebuf);
+	opt.name = name ? name : tool_input_stem(path, "", namebuf, sizeof namebuf);
 	mlod_gltf *doc = NULL;
 	mlod_character c;
 	mlod_format format = MLOD_FORMAT_UNKNOWN;
 	size_t size = 0;
 	memset(&c, 0, sizeof c);
 	void *bytes = tool_load_keep(path, &doc, &c, &format, &size);
+	check_level0(&opt, &c, doc, bytes, label);
 
 	mlod_pack_stats st;
 	mlod_error err = {0};

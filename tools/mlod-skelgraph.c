@@ -41,11 +41,12 @@ static const char usage_text[] =
 	"  -h, --help              show this help\n"
 	"  -V, --version           show the version\n"
 	"\n"
-	"Default levels remove 13%%, 26%% and 39%% of the joints (the paper's figure),\n"
-	"stopping at the last level within --max-error.\n"
+	"Default levels aim at removing 13%%, 26%% and 39%% of the joints (the paper's\n"
+	"figure) and stop at the last level within --max-error: fewer levels, or\n"
+	"less removed, where the bound cuts the chain (tubeman: 13%% and 23%%).\n"
 	"\n"
 	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
-	"4 output failure.\n";
+	"4 output failure.\n" TOOL_OUTPUT_NOTE;
 
 struct job {
 	const char *input;
@@ -275,7 +276,7 @@ int main(int argc, char **argv)
 		if (level < 0)
 			level = job.L.count;
 		if (level > job.L.count)
-			tool_die(EXIT_USAGE, NULL, "--level %d: there are %d levels", level, job.L.count);
+			tool_die(EXIT_USAGE, NULL, "--level %d: the levels are 0..%d", level, job.L.count);
 		write_bvh(&job, output, level, clip);
 	} else
 		write_glb(&job, doc, output);

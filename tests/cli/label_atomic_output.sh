@@ -6,11 +6,11 @@ printf 'keep me' > out.glb
 if "$BIN/mlod-label" -o out.glb empty.bvh 2>/dev/null; then exit 1; fi
 test "$(cat out.glb)" = "keep me"
 test "$(ls -A | grep -c '\.tmp\.')" -eq 0
-# A failure after the temporary file was written (the output is a
-# directory, so the rename fails) leaves no temporary file either.
+# An output that is a directory is refused before anything is written and
+# leaves no temporary file either.
 mkdir -p taken/inside
 if "$BIN/mlod-label" -o taken "$ROOT/samples/cmu_12_01_walk.bvh" 2> err.txt; then exit 1; fi
-grep -qx 'mlod-label: taken: write failed: .*' err.txt
+grep -qx 'mlod-label: taken: is a directory' err.txt
 test -d taken/inside
 test "$(ls -A | grep -c '\.tmp\.')" -eq 0
 # A good run replaces it.

@@ -9,7 +9,8 @@ while [ $i -lt 60 ]; do
 	i=$((i + 1))
 	head -c $(( (i * 6823 + 17) % size )) t.mlod > m.mlod
 	for mode in --info -x; do
-		"$BIN/mlod-pack" $mode m.mlod -o m.glb > /dev/null 2> m.err
+		o=; [ $mode = -x ] && o="-o m.glb" # --info prints to stdout only
+		"$BIN/mlod-pack" $mode m.mlod $o > /dev/null 2> m.err
 		rc=$?
 		[ $rc = 2 ] || { echo "truncated at $(wc -c < m.mlod): $mode exited $rc: $(cat m.err)" >&2; exit 9; }
 	done
@@ -18,7 +19,8 @@ while [ $i -lt 60 ]; do
 	cmp -s m.mlod t.mlod && continue
 	for mode in --info -x; do
 		rm -f m.glb
-		"$BIN/mlod-pack" $mode m.mlod -o m.glb > /dev/null 2> m.err
+		o=; [ $mode = -x ] && o="-o m.glb" # --info prints to stdout only
+		"$BIN/mlod-pack" $mode m.mlod $o > /dev/null 2> m.err
 		rc=$?
 		[ $rc = 2 ] && [ ! -e m.glb ] || { echo "byte $(( (i * 6661 + 5) % size )) changed: $mode exited $rc: $(cat m.err)" >&2; exit 9; }
 	done
