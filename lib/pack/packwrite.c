@@ -779,7 +779,8 @@ done:
 	return r;
 }
 
-/* Skeleton level k (1-based): KEPT, and the palette as fold.c's skin
+/* Skeleton level k (1-based): KEPT, and the palette binds (as PALR and
+ * PALX, format 7.0; the palette joints the reader derives) as fold.c's skin
  * transfer makes it (reduce_skin): a kept skin joint keeps its bind; a
  * removed one uses its stand-in's entry in the level skin: the stand-in's
  * own bind when the skin has it, else R(stand-in -> joint) * IBM(joint)
@@ -797,13 +798,16 @@ static mlod_result skel_level_chunk(struct ctx *x, int k, chunks *out)
 		maxsk = s->skins[i].joint_count > maxsk ? s->skins[i].joint_count : maxsk;
 	}
 	uint32_t *keptv = malloc(sizeof(uint32_t) * ((size_t)n + 1)), kc = 0;
-	uint32_t *palj = malloc(sizeof(uint32_t) * (pal + 1));
+	uint32_t *palr = malloc(sizeof(uint32_t) * (pal + 1));
 	float *palb = malloc(sizeof(float) * 16 * (pal + 1));
+	float *palx = malloc(sizeof(float) * 16 * (pal + 1));
+	float *ibmf = malloc(sizeof(float) * 16 * (pal + 1)); /* SKELETON's 'IBMS' */
+	size_t nx = 0;
 	int *lj = malloc(sizeof(int) * ((size_t)maxsk + 1));          /* the level skin's joints */
 	mlod_mat4 *lb = malloc(sizeof(mlod_mat4) * ((size_t)maxsk + 1)); /* and binds */
 	chunkb cb = {0};
 	mlod_result r = MLOD_OK;
-	if (!keptv || !palj || !palb || !lj || !lb) {
+	if (!keptv || !palr || !palb || !palx || !ibmf || !lj || !lb) {
 		r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
@@ -821,10 +825,8 @@ static mlod_result skel_level_chunk(struct ctx *x, int k, chunks *out)
 		for (int q = 0; q < sk->joint_count; q++, e++) {
 			int j = sk->joints[q];
 			mlod_mat4 bind = sk->inverse_bind[q];
-			int pj = j;
-			if (!kept[j]) {
+			if (!kept[j]) { /* its palette joint, the stand-in, the reader derives */
 				int stand = remap[j], at = -1;
-				pj = stand;
 				for (int t = 0; t < ln; t++)
 					if (lj[t] == stand)
 						at = t;
@@ -842,20 +844,45 @@ static mlod_result skel_level_chunk(struct ctx *x, int k, chunks *out)
 				}
 				bind = lb[at];
 			}
-			palj[e] = (uint32_t)pj;
 			memcpy(palb + 16 * e, bind.m, 64);
+			memcpy(ibmf + 16 * e, sk->inverse_bind[q].m, 64);
 		}
 	}
+	/* Format 7.0: each bind matrix as a reference (palr, mlod(5)): 0 for
+	 * the joint's own IBMS entry, 1 + the first IBMS entry over all skins
+	 * that holds the same bytes, else P + 1 + its index in PALX (each
+	 * matrix once, in first-use order). */
+	for (size_t i = 0, xe = 0, g = 0; i < pal; i++) {
+		const float *m = palb + 16 * i;
+		if (memcmp(m, ibmf + 16 * i, 64) == 0) {
+			palr[i] = 0;
+			continue;
+		}
+		for (g = 0; g < pal && memcmp(m, ibmf + 16 * g, 64) != 0; g++)
+			;
+		if (g < pal) {
+			palr[i] = (uint32_t)(g + 1);
+			continue;
+		}
+		for (g = 0; g < xe && memcmp(m, palx + 16 * g, 64) != 0; g++)
+			;
+		if (g == xe)
+			memcpy(palx + 16 * xe++, m, 64);
+		palr[i] = (uint32_t)(pal + 1 + g);
+		nx = xe;
+	}
 	cb_add(&cb, MLOD_STREAM_KEPT, kc, 4, keptv, 0);
-	cb_add(&cb, MLOD_STREAM_PALJ, (uint32_t)pal, 4, palj, 0);
-	cb_add(&cb, MLOD_STREAM_PALB, (uint32_t)pal, 64, palb, 0);
+	cb_add(&cb, MLOD_STREAM_PALR, (uint32_t)pal, 4, palr, 0);
+	cb_add(&cb, MLOD_STREAM_PALX, (uint32_t)nx, 64, palx, 0);
 	r = cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_SKELETON, MLOD_LAYER_SKELETON, k, 0, x->skel_error[k - 1],
 	              x->err);
 done:
 	cb_free(&cb);
 	free(keptv);
-	free(palj);
+	free(palr);
 	free(palb);
+	free(palx);
+	free(ibmf);
 	free(lj);
 	free(lb);
 	return r;

@@ -1352,6 +1352,7 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	bump b = {0};
 	stream sk, sj, sb;
 	const uint8_t *src;
+	int refs = p->major >= 7; /* 'PALR' and 'PALX'; 'PALJ' derived (format 7.0) */
 	mlod_result r = cx_begin_skel_level(p, chunk, data, size, &x, err);
 	if (r != MLOD_OK)
 		return r;
@@ -1362,16 +1363,27 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	for (uint32_t k = 0; k < skel->skin_count; k++)
 		P += skel->skins[k].joint_count;
 	TRY(cx_expect(&x, &sk, MLOD_STREAM_KEPT, 4, UINT64_MAX, "", "", err));
-	TRY(cx_expect(&x, &sj, MLOD_STREAM_PALJ, 4, P, "", "the skins' joints", err));
-	TRY(cx_expect(&x, &sb, MLOD_STREAM_PALB, 64, P, "", "the skins' joints", err));
+	if (refs) {
+		TRY(cx_expect(&x, &sj, MLOD_STREAM_PALR, 4, P, "", "the skins' joints", err));
+		TRY(cx_expect(&x, &sb, MLOD_STREAM_PALX, 64, UINT64_MAX, "", "", err));
+		if (sb.count > P)
+			FAIL("%s: %u bind matrices in 'PALX', more than the %llu skin joints", x.label, sb.count,
+			     (unsigned long long)P);
+	} else {
+		TRY(cx_expect(&x, &sj, MLOD_STREAM_PALJ, 4, P, "", "the skins' joints", err));
+		TRY(cx_expect(&x, &sb, MLOD_STREAM_PALB, 64, P, "", "the skins' joints", err));
+	}
 	TRY(cx_end(&x, err));
 	uint64_t Kc = sk.count;
 	if (Kc > J)
 		FAIL("%s: %llu kept joints of a skeleton of %llu", x.label, (unsigned long long)Kc, (unsigned long long)J);
-	/* aux: each joint's nearest kept ancestor (or itself). */
-	TRY(cx_temp(&x, J * 4, err));
+	/* aux: each joint's nearest kept ancestor (or itself); from 7.0 also
+	 * 'PALR' and each skin joint's 'IBMS' entry. */
+	TRY(cx_temp(&x, refs ? round8(J * 4) + round8(P * 4) + P * sizeof(float *) : J * 4, err));
 	TRY(bump_alloc(&b, &x, round8(Kc * 4) + round8(P * 4) + round8(P * 64), err));
 	uint32_t *kept, *palj, *nearest = (uint32_t *)x.temp;
+	uint32_t *palr = refs ? (uint32_t *)(x.temp + round8(J * 4)) : NULL;
+	const float **ibm = refs ? (const float **)(void *)(x.temp + round8(J * 4) + round8(P * 4)) : NULL;
 	float *palb;
 	TAKE(kept, Kc * 4);
 	TAKE(palj, P * 4);
@@ -1397,15 +1409,23 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 			FAIL("%s: root joint %u is not kept (every root is)", x.label, j);
 		nearest[j] = is_kept ? j : nearest[parent];
 	}
-	TRY(cx_load(&x, &sj, &src, err));
-	if (P)
-		memcpy(palj, src, P * 4);
+	if (!refs) {
+		TRY(cx_load(&x, &sj, &src, err));
+		if (P)
+			memcpy(palj, src, P * 4);
+	}
 	for (uint32_t k = 0, i = 0; k < skel->skin_count; k++)
 		for (uint32_t m = 0; m < skel->skins[k].joint_count; m++, i++) {
-			uint32_t joint = skel->skin_joints[k][m], v = palj[i];
+			uint32_t joint = skel->skin_joints[k][m];
 			if (joint >= J)
 				FAIL("%s: the given skeleton's skin %u joint %u is %u, not below its joint count", x.label, k, m,
 				     joint);
+			if (refs) {
+				palj[i] = nearest[joint];
+				ibm[i] = skel->inverse_bind[k] + 16 * (size_t)m;
+				continue;
+			}
+			uint32_t v = palj[i];
 			if (v >= J || nearest[v] != v)
 				FAIL("%s: palette entry %u (skin %u joint %u): joint %u is not a kept joint", x.label, i, k, m, v);
 			if (v != nearest[joint])
@@ -1413,9 +1433,25 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 				     "is %u",
 				     x.label, i, k, m, v, joint, nearest[joint]);
 		}
-	TRY(cx_load(&x, &sb, &src, err));
-	if (P)
-		memcpy(palb, src, P * 64);
+	if (refs) {
+		/* 0: the own IBMS entry; 1..P: IBMS entry v - 1; then 'PALX'. */
+		if (P)
+			TRY(cx_load_into(&x, &sj, (uint8_t *)palr, err));
+		TRY(cx_load(&x, &sb, &src, err));
+		for (uint64_t i = 0; i < P; i++) {
+			uint64_t v = palr[i];
+			const void *from = v == 0 ? (const void *)ibm[i] : v <= P ? (const void *)ibm[v - 1] : NULL;
+			if (!from && v - P - 1 >= sb.count)
+				FAIL("%s: palette entry %llu refers to bind matrix %llu, beyond the %llu skin joints and %u in "
+				     "'PALX'",
+				     x.label, (unsigned long long)i, (unsigned long long)v, (unsigned long long)P, sb.count);
+			memcpy(palb + 16 * i, from ? from : (const void *)(src + 64 * (v - P - 1)), 64);
+		}
+	} else {
+		TRY(cx_load(&x, &sb, &src, err));
+		if (P)
+			memcpy(palb, src, P * 64);
+	}
 	if (!all_finite(palb, (size_t)P * 16))
 		FAIL("%s: a palette bind matrix is not finite", x.label);
 	cx_done(&x);

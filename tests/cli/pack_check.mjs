@@ -6,8 +6,13 @@
 //   node tests/cli/pack_check.mjs FILE.mlod [--doc OUT.glb]
 //
 // --doc writes the DOC chunk's glb to OUT.glb.
-// It does not decode streams: the round trip through the reader
-// (lib/rt/pack.c) is for the tests that come with it. A chunk with the
+// It decodes no meshopt-coded stream: the round trip through the reader
+// (lib/rt/pack.c) is for the tests that come with it. A skeleton level's
+// palette (format 7.0: 'KEPT', 'PALR', 'PALX'; no 'PALJ', no 'PALB') is
+// checked for its streams and counts, and where 'PALR' is raw every
+// reference (0 the own 'IBMS' entry, 1..P 'IBMS' entry v - 1, above P a
+// 'PALX' matrix); "palette" in the summary counts each level's three
+// kinds (null where 'PALR' is meshopt-coded). A chunk with the
 // zstd entropy stage (format 5.0) is undone with the zstd tool first; one
 // with the prefix stage (format 6.0) with the chunks it needs as the tool's
 // --patch-from reference: a MESH level's coarser MESH levels' containers,
@@ -26,7 +31,7 @@ const fourcc = (u) => String.fromCharCode(u & 255, (u >> 8) & 255, (u >> 16) & 2
 if (b.length < 32 || b.subarray(0, 4).toString('latin1') !== 'MLOD') die('no MLOD magic');
 const major = b.readUInt16LE(4), minor = b.readUInt16LE(6), flags = b.readUInt32LE(8), n = b.readUInt32LE(12);
 const size = Number(b.readBigUInt64LE(16));
-if (major !== 6 || minor !== 0) die(`version ${major}.${minor}`);
+if (major !== 7 || minor !== 0) die(`version ${major}.${minor}`);
 if (flags !== 0) die('flags');
 if (size !== b.length) die(`file_size ${size}, file ${b.length}`);
 if (crc32(b.subarray(0, 28)) !== b.readUInt32LE(28)) die('header CRC');
@@ -103,6 +108,28 @@ for (let i = 0; i < n; i++) {
 }
 if (end !== b.length) die('bytes after the last chunk');
 
+// Skeleton levels (format 7.0): the palette as references to SKELETON's
+// 'IBMS' (P entries: its 'SKJT' count) or to the level's 'PALX'.
+const palette = [];
+if (n > 1 && chunks[1].type === 'SKEL') {
+	const sk = chunks[1].streams, P = sk.length === 5 && sk[3].tag === 'SKJT' && sk[4].tag === 'IBMS' ? sk[3].count : -1;
+	if (P < 0 || sk[4].count !== P || sk[4].size !== 64) die('SKEL streams');
+	for (const c of chunks) {
+		if (c.type !== 'SKEL' || c.level === 0) continue;
+		const [k, r, x] = c.streams, tags = c.streams.map((t) => t.tag).join(',');
+		if (tags !== 'KEPT,PALR,PALX' || k.size !== 4 || r.size !== 4 || x.size !== 64) die(`SKEL level ${c.level}: streams ${tags}`);
+		if (r.count !== P || x.count > P) die(`SKEL level ${c.level}: 'PALR' ${r.count}, 'PALX' ${x.count}, ${P} skin joints`);
+		if (r.codec !== 0) { palette.push(null); continue; }
+		const kinds = [0, 0, 0];
+		for (let e = 0; e < P; e++) {
+			const v = c.data.readUInt32LE(r.at + 4 * e);
+			if (v > P + x.count) die(`SKEL level ${c.level}: palette entry ${e} refers to ${v}, past ${P} + ${x.count}`);
+			kinds[v === 0 ? 0 : v <= P ? 1 : 2]++;
+		}
+		palette.push(kinds);
+	}
+}
+
 // Order: INFO, SKEL 0, skeleton levels coarsest first, then per level
 // coarse to fine mesh and motion, DOC last.
 const types = chunks.map((c) => c.type);
@@ -136,6 +163,7 @@ const out = {
 	stream_codecs: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.codec)))].sort(),
 	tags: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.tag)))].sort(),
 	doc: chunks[n - 1].streams[0].count,
+	palette,
 	toc: chunks.map((c) => `${c.type.trim()} ${c.level}/${c.item} ${c.crc.toString(16)}`),
 };
 for (const c of chunks) out.count[c.type.trim()] = (out.count[c.type.trim()] || 0) + 1;

@@ -665,6 +665,10 @@ static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
  * the block's, NEWBITS) in their own numbering (format 3.0), unless a
  * test sets it 0 (a format 2.0 pack). */
 static uint32_t local_flag = MLOD_PART_LOCAL;
+/* SKELETON level 1's palette as 'PALR' and 'PALX' (format 7.0), unless a
+ * test sets it 0 ('PALJ' and 'PALB', as 2.x to 6.x packs store it). */
+static int pal_refs = 1;
+static const uint32_t palj_truth[NJ] = {0, 1, 1, 1};
 
 /* The chunks of the test character, in the format's order:
  * INFO, SKELETON, SKELETON 1, MESH 1, MOTION 1/0, MESH 0, MOTION 0/0, DOC.
@@ -748,16 +752,29 @@ static int make_chunks(wchunk *c, int with_unknown)
 	s->count = 2;
 	put32(&s->data, 0);
 	put32(&s->data, 1);
-	s = add_stream(ch, MLOD_STREAM_PALJ, 4, MLOD_SCODEC_RAW);
-	s->count = NJ;
-	static const uint32_t palj[NJ] = {0, 1, 1, 1};
-	for (int j = 0; j < NJ; j++)
-		put32(&s->data, palj[j]);
-	s = add_stream(ch, MLOD_STREAM_PALB, 64, MLOD_SCODEC_RAW);
-	s->count = NJ;
-	for (int j = 0; j < NJ; j++)
+	if (pal_refs) {
+		/* Joints 0 and 1 their own IBM (0), joint 2 IBMS entry 1 (2),
+		 * joint 3 the same matrix as 'PALX' matrix 0 (NJ + 1). */
+		s = add_stream(ch, MLOD_STREAM_PALR, 4, MLOD_SCODEC_RAW);
+		s->count = NJ;
+		static const uint32_t palr[NJ] = {0, 0, 2, NJ + 1};
+		for (int j = 0; j < NJ; j++)
+			put32(&s->data, palr[j]);
+		s = add_stream(ch, MLOD_STREAM_PALX, 64, MLOD_SCODEC_RAW);
+		s->count = 1;
 		for (int k = 0; k < 16; k++)
-			putf(&s->data, ibm_truth[palj[j]][k]);
+			putf(&s->data, ibm_truth[1][k]);
+	} else {
+		s = add_stream(ch, MLOD_STREAM_PALJ, 4, MLOD_SCODEC_RAW);
+		s->count = NJ;
+		for (int j = 0; j < NJ; j++)
+			put32(&s->data, palj_truth[j]);
+		s = add_stream(ch, MLOD_STREAM_PALB, 64, MLOD_SCODEC_RAW);
+		s->count = NJ;
+		for (int j = 0; j < NJ; j++)
+			for (int k = 0; k < 16; k++)
+				putf(&s->data, ibm_truth[palj_truth[j]][k]);
+	}
 
 	/* The parts: level 0's, then level 1's from them (16 and 10 of their
 	 * vertices; part 0 with u16 indices at level 1, u32 at level 0). */
@@ -1115,8 +1132,9 @@ TEST(decode_skeleton_and_level)
 	         strcmp(s.skin_names[0], "skin") == 0 && s.joints[3].parent == 1 && s.joints[2].t[0] == 0.25f &&
 	         s.joints[3].node == 13 && s.skins[0].joint_count == NJ && s.skin_joints[0][3] == 3 &&
 	         memcmp(s.inverse_bind[0], ibm_truth, sizeof ibm_truth) == 0;
-	int lok = l.kept_count == 2 && l.kept[1] == 1 && l.palette_size == NJ && l.palette_joint[0] == 0 &&
-	          l.palette_joint[3] == 1 && memcmp(l.palette_bind + 16 * 2, ibm_truth[1], 64) == 0;
+	int lok = l.kept_count == 2 && l.kept[1] == 1 && l.palette_size == NJ;
+	for (int j = 0; lok && j < NJ; j++)
+		lok = l.palette_joint[j] == palj_truth[j] && memcmp(l.palette_bind + 16 * j, ibm_truth[palj_truth[j]], 64) == 0;
 	/* The level's chunk is not the full skeleton, and vice versa. */
 	mlod_pack_skel_level l2;
 	mlod_result r1 = mlod_pack_decode_skel_level(&p, C_SKEL, b.p, b.n, &s, &l2, &terr);
@@ -1441,7 +1459,7 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 7.0 is newer than this reader's 6.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 8.0 is newer than this reader's 7.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
 }
 
@@ -1476,7 +1494,7 @@ TEST(older_major_is_refused)
 	free(b.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && p.chunks == NULL, "returned %d: %s", (int)r, terr.message);
 	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
-	                               "reads 2.x to 6.x)") == 0,
+	                               "reads 2.x to 7.x)") == 0,
 	          "message: %s", terr.message);
 }
 
@@ -1485,7 +1503,7 @@ TEST(older_major_is_refused)
 TEST(format_2_0_reads)
 {
 	static wchunk c[C_COUNT + 1];
-	local_flag = 0;
+	local_flag = 0, pal_refs = 0;
 	int n = make_chunks(c, 0);
 	buf b = build_pack(c, n, 2, 0);
 	free_chunks(c, n);
@@ -1509,11 +1527,57 @@ TEST(format_2_0_reads)
 	mlod_pack_skeleton_free(&s);
 	mlod_pack_close(&p);
 	free(b.p);
-	local_flag = MLOD_PART_LOCAL;
+	local_flag = MLOD_PART_LOCAL, pal_refs = 1;
 	CHECK_MSG(ok, "%s", why);
 }
 
 static uint8_t *stream_data(wchunk *c, int chunk, uint32_t tag, int nth);
+
+/* Format 7.0 stores a skeleton level's palette as references ('PALR',
+ * 'PALX') and derives its joints; a 6.0 pack's 'PALJ' and 'PALB' still
+ * read, to the same palette, and a 'PALJ' entry that is not the nearest
+ * kept ancestor is still refused. A 7.0 pack with 'PALJ' and 'PALB' is
+ * refused. */
+TEST(format_6_0_palette_reads)
+{
+	static wchunk c[C_COUNT + 1];
+	pal_refs = 0;
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, 6, 0), b7 = build_pack(c, n, 7, 0);
+	wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALJ, 0) + 4 * 3, 2);
+	buf bad = build_pack(c, n, 6, 0);
+	free_chunks(c, n);
+	pal_refs = 1;
+	mlod_pack p = {0}, p7 = {0}, pb = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_skel_level l = {0}, l7 = {0}, lb = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &s, &terr));
+	CHECK_OK(mlod_pack_decode_skel_level(&p, C_SKEL1, b.p, b.n, &s, &l, &terr));
+	int ok = p.major == 6 && l.kept_count == 2 && l.palette_size == NJ;
+	for (int j = 0; ok && j < NJ; j++)
+		ok = l.palette_joint[j] == palj_truth[j] && memcmp(l.palette_bind + 16 * j, ibm_truth[palj_truth[j]], 64) == 0;
+	CHECK_OK(mlod_pack_open(b7.p, b7.n, &p7, &terr));
+	mlod_result r7 = mlod_pack_decode_skel_level(&p7, C_SKEL1, b7.p, b7.n, &s, &l7, &terr);
+	char m7[sizeof terr.message];
+	snprintf(m7, sizeof m7, "%s", terr.message);
+	CHECK_OK(mlod_pack_open(bad.p, bad.n, &pb, &terr));
+	mlod_result rb = mlod_pack_decode_skel_level(&pb, C_SKEL1, bad.p, bad.n, &s, &lb, &terr);
+	mlod_pack_skel_level_free(&l);
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_close(&p);
+	mlod_pack_close(&p7);
+	mlod_pack_close(&pb);
+	free(b.p);
+	free(b7.p);
+	free(bad.p);
+	CHECK(ok);
+	CHECK_MSG(r7 == MLOD_ERR_PARSE && strcmp(m7, "SKELETON level 1: stream 1 is 'PALJ', expected 'PALR'") == 0,
+	          "7.0 with PALJ: %d %s", (int)r7, m7);
+	CHECK_MSG(rb == MLOD_ERR_PARSE && strcmp(terr.message, "SKELETON level 1: palette entry 3 (skin 0 joint 3): joint "
+	                                                       "2 is not a kept joint") == 0,
+	          "6.0 bad PALJ: %d %s", (int)rb, terr.message);
+}
 
 /* A nested MOTION level (TOC flag MLOD_PACK_CHUNK_NESTED) builds on the
  * clip's next coarser level: the coarsest cannot be nested, and
@@ -1834,7 +1898,7 @@ TEST(prefix_decodes_the_same)
 	mlod_pack pa, pz;
 	CHECK_OK(mlod_pack_open(a.p, a.n, &pa, &terr));
 	CHECK_OK(mlod_pack_open(z.p, z.n, &pz, &terr));
-	CHECK(pz.major == 6 && pz.chunks[C_MESH0].entropy == MLOD_ENTROPY_ZSTD_PREFIX &&
+	CHECK(pz.major == MLOD_PACK_MAJOR && pz.chunks[C_MESH0].entropy == MLOD_ENTROPY_ZSTD_PREFIX &&
 	      pz.chunks[C_SKEL1].entropy == MLOD_ENTROPY_ZSTD_PREFIX && pz.chunks[C_SKEL].entropy == MLOD_ENTROPY_ZSTD &&
 	      pz.chunks[C_MESH1].entropy == MLOD_ENTROPY_ZSTD && pz.chunks[C_MOT1].entropy == MLOD_ENTROPY_ZSTD);
 	CHECK(strcmp(mlod_pack_entropy_name(MLOD_ENTROPY_ZSTD_PREFIX), "zstd-prefix") == 0);
@@ -1879,9 +1943,9 @@ TEST(prefix_decodes_the_same)
 	mlod_pack_close(&pa);
 	mlod_pack_close(&pz);
 	/* 5.0: the zstd stage alone reads; the prefix stage is refused. */
-	zstd_level = 19;
+	zstd_level = 19, pal_refs = 0;
 	buf f = make_pack(0);
-	zstd_level = 0;
+	zstd_level = 0, pal_refs = 1;
 	wr16(f.p + 4, 5);
 	restamp(f.p, f.n);
 	mlod_pack p5;
@@ -2183,7 +2247,15 @@ static void e_part_grid(wchunk *c)
 	wr32(d, 0x3f000000u);
 }
 static void e_parent(wchunk *c) { wr32(stream_data(c, C_SKEL, MLOD_STREAM_JNTS, 0) + 116 * 2, 3); }
-static void e_palj(wchunk *c) { wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALJ, 0) + 4 * 3, 2); }
+static void e_palr(wchunk *c) { wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALR, 0) + 4 * 3, NJ + 2); }
+static void e_palx_count(wchunk *c)
+{
+	wstream *x = &c[C_SKEL1].s[2];
+	x->count = NJ + 1;
+	for (int k = 0; k < 16 * NJ; k++)
+		putf(&x->data, 1.0f);
+}
+static void e_palx_nan(wchunk *c) { wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALX, 0) + 4 * 5, 0x7fc00000u); }
 static void e_weights(wchunk *c) { stream_data(c, C_MESH1, MLOD_STREAM_WGT8, 0)[4 * 5] ^= 1; }
 static void e_skin_joint(wchunk *c) { stream_data(c, C_MESH1, MLOD_STREAM_JNT8, 0)[4 * 2 + 1] = NJ; }
 static void e_uv_sets(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 40, 5); }
@@ -2303,7 +2375,9 @@ TEST(structural_checks_name_the_chunk)
 		{e_part_count, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: stream 0 'PART' has 1 elements, expected 2 (the parts of the coarsest level)"},
 		{e_part_grid, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 1: its record differs from MESH level 1's"},
 		{e_parent, C_SKEL, MLOD_ERR_PARSE, "SKELETON: joint 2: parent 3 is not -1 or an earlier joint"},
-		{e_palj, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: palette entry 3 (skin 0 joint 3): joint 2 is not a kept joint"},
+		{e_palr, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: palette entry 3 refers to bind matrix 6, beyond the 4 skin joints and 1 in 'PALX'"},
+		{e_palx_count, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: 5 bind matrices in 'PALX', more than the 4 skin joints"},
+		{e_palx_nan, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: a palette bind matrix is not finite"},
 		{e_weights, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: vertex 5: weights sum to"},
 		{e_skin_joint, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: vertex 2: joint 4 is not below skin 0's 4 joints"},
 		{e_uv_sets, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: 5 UV sets, more than 4"},
@@ -2727,6 +2801,7 @@ int main(int argc, char **argv)
 	RUN(free_accepts_zeroed);
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
+	RUN(format_6_0_palette_reads);
 	RUN(older_major_is_refused);
 	RUN(rotq_shift_decodes);
 	RUN(format_2_0_reads);

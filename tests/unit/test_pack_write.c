@@ -504,10 +504,13 @@ static void drop_skin_joint(mlod_character *c, int joint)
 
 /* The skeleton levels' palettes reproduce fold.c's skin transfer: for
  * every skin joint, the level skin that mlod_skel_level_apply makes holds
- * the joint PALJ names with the bind matrix PALB gives, and KEPT lists
- * the level's kept joints. Twice: on tubeman, whose skin has every joint
- * (a stand-in's own bind), and with a stand-in dropped from the skin
- * (R(stand-in -> joint) * IBM(joint)). */
+ * the joint the decoded palette names with the bind matrix it gives, and
+ * KEPT lists the level's kept joints. Twice: on tubeman, whose skin has
+ * every joint (a stand-in's own bind), and with a stand-in dropped from
+ * the skin (R(stand-in -> joint) * IBM(joint)). Format 7.0 stores the
+ * binds as references ('PALR'): a kept joint's is 0 (its own IBMS entry),
+ * and any whose bytes are its own IBMS entry's; else the first IBMS entry
+ * with the same bytes (1..P), else a 'PALX' matrix (above P). */
 TEST(pack_palette_is_fold)
 {
 	size_t n = 0;
@@ -552,23 +555,48 @@ TEST(pack_palette_is_fold)
 		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, NULL, &terr));
 		const mlod_skin *sk = &c.skeleton.skins[0];
 		CHECK(c.skeleton.skin_count == 1);
-		int removed_in_skin = 0;
+		int removed_in_skin = 0, explicit_total = 0;
+		mlod_pack pk;
+		mlod_pack_skeleton full;
+		CHECK_OK(mlod_pack_open(out, size, &pk, &terr));
+		CHECK_OK(mlod_pack_decode_skeleton(&pk, out, size, &full, &terr));
 		for (int k = 0; k < L.count; k++) {
 			const mlod_skel_built *b = &L.levels[k];
 			const uint8_t *ch = find_chunk(out, MLOD_CHUNK_SKELETON, k + 1);
 			CHECK_MSG(ch, "no SKEL level %d", k + 1);
-			uint32_t kc, pc, bc, es;
+			uint32_t kc, pc, xc, es;
 			uint32_t *kept = (uint32_t *)stream(ch, MLOD_STREAM_KEPT, 0, &kc, &es);
-			uint32_t *palj = (uint32_t *)stream(ch, MLOD_STREAM_PALJ, 0, &pc, &es);
-			float *palb = (float *)stream(ch, MLOD_STREAM_PALB, 0, &bc, &es);
-			CHECK(kept && palj && palb && es == 64);
-			CHECK(kc == (uint32_t)b->skel.kept_count && pc == (uint32_t)sk->joint_count && bc == pc);
+			uint32_t *palr = (uint32_t *)stream(ch, MLOD_STREAM_PALR, 0, &pc, &es);
+			float *palx = (float *)stream(ch, MLOD_STREAM_PALX, 0, &xc, &es);
+			CHECK(kept && palr && palx && es == 64 && !stream(ch, MLOD_STREAM_PALJ, 0, &es, &es));
+			CHECK(kc == (uint32_t)b->skel.kept_count && pc == (uint32_t)sk->joint_count);
+			CHECK(xc <= pc);
+			mlod_pack_skel_level lv;
+			int chunk = mlod_pack_find(&pk, MLOD_CHUNK_SKELETON, (unsigned)k + 1, 0);
+			CHECK_OK(mlod_pack_decode_skel_level(&pk, (uint32_t)chunk, out, size, &full, &lv, &terr));
+			const uint32_t *palj = lv.palette_joint;
+			const float *palb = lv.palette_bind;
+			CHECK(lv.palette_size == pc);
 			for (uint32_t i = 0; i < kc; i++)
 				CHECK(b->skel.kept[kept[i]] && (i == 0 || kept[i] > kept[i - 1]));
 			const mlod_skin *lsk = &b->c.skeleton.skins[0];
 			for (int q = 0; q < sk->joint_count; q++) {
 				int j = sk->joints[q], in_skin = 0;
 				CHECK(palj[q] == (uint32_t)b->skel.remap[j]);
+				/* a kept joint refers to its own bind; every bind to its own
+				 * IBMS entry where that holds the same bytes, else to the
+				 * first that does, else to a 'PALX' matrix */
+				const float *ibm = full.inverse_bind[0];
+				uint32_t want = 0;
+				if (memcmp(palb + 16 * q, ibm + 16 * q, 64) != 0) {
+					while (want < pc && memcmp(palb + 16 * q, ibm + 16 * want, 64) != 0)
+						want++;
+					want = want < pc ? want + 1 : pc + 1;
+				}
+				CHECK_MSG(!b->skel.kept[j] || palr[q] == 0, "level %d skin joint %d: PALR %u", k + 1, q, palr[q]);
+				CHECK_MSG(want <= pc ? palr[q] == want : palr[q] > pc && palr[q] <= pc + xc,
+				          "level %d skin joint %d: PALR %u, expected %u", k + 1, q, palr[q], want);
+				explicit_total += want > pc;
 				removed_in_skin += !b->skel.kept[j];
 				for (int t = 0; t < sk->joint_count; t++)
 					in_skin |= sk->joints[t] == (int)palj[q];
@@ -588,10 +616,14 @@ TEST(pack_palette_is_fold)
 				CHECK_MSG(found, "level %d: skin joint %d's stand-in is not in the level skin", k + 1, q);
 			}
 			free(kept);
-			free(palj);
-			free(palb);
+			free(palr);
+			free(palx);
+			mlod_pack_skel_level_free(&lv);
 		}
+		mlod_pack_skeleton_free(&full);
+		mlod_pack_close(&pk);
 		CHECK(removed_in_skin > 0); /* the rule for removed joints was exercised */
+		fprintf(stderr, "# variant %d: %d palette entries as 'PALX' matrices\n", variant, explicit_total);
 		mlod_free(out);
 		mlod_skel_levels_free(&L);
 		free(info);
@@ -995,7 +1027,7 @@ TEST(entropy_stage)
 	mlod_pack pn, pz;
 	CHECK_OK(mlod_pack_open(out[0], size[0], &pn, &terr));
 	CHECK_OK(mlod_pack_open(out[1], size[1], &pz, &terr));
-	CHECK(pn.chunk_count == pz.chunk_count && pn.major == 6 && pz.major == 6 && !pn.zstd && pz.zstd);
+	CHECK(pn.chunk_count == pz.chunk_count && pn.major == MLOD_PACK_MAJOR && pz.major == MLOD_PACK_MAJOR && !pn.zstd && pz.zstd);
 	int staged = 0, same = 1, prefixed = 0;
 	for (uint32_t i = 0; i < pz.chunk_count; i++) {
 		const mlod_pack_chunk *a = &pn.chunks[i], *z = &pz.chunks[i];
