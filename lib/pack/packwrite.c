@@ -317,6 +317,12 @@ nomem:
  * container is at most the raw size (the reader's bound). Deterministic:
  * one-shot compression, one thread, the frame with its content size. */
 #define PACK_ZSTD_LEVEL 19
+/* The block run's threshold (zstd_frame): a zstd block ends at a stream's
+ * end once this many container bytes are pending (chunk_entropy tries
+ * both runs). */
+#ifndef PACK_ZSTD_FLUSH
+#define PACK_ZSTD_FLUSH 512
+#endif
 /* Draco's speed option (0 smallest .. 10 fastest), for encoding and decoding. */
 #ifndef MLOD_PACK_DRACO_SPEED
 #define MLOD_PACK_DRACO_SPEED 0
@@ -327,55 +333,225 @@ nomem:
  * container. The frame coded on it
  * (MLOD_ENTROPY_ZSTD_PREFIX) is kept where it is smaller than the frame
  * coded alone (ties keep the frame alone, which needs nothing). */
+/* One zstd frame of the container d (n bytes) at the pack's level, with
+ * its content size, into out (cap bytes): on prefix when prefix_size > 0.
+ * With flush > 0, a zstd block ends at the end of each stream that ends
+ * at least flush bytes after the last block's end (each block has its
+ * own literal and sequence statistics: a stream's own may code it in
+ * fewer bytes than those of a block mixing it with others). */
+static size_t zstd_frame(ZSTD_CCtx *cc, uint8_t *out, size_t cap, const uint8_t *d, size_t n, const uint8_t *prefix,
+                         size_t prefix_size, size_t flush)
+{
+	ZSTD_CCtx_reset(cc, ZSTD_reset_session_and_parameters);
+	size_t z = ZSTD_CCtx_setParameter(cc, ZSTD_c_compressionLevel, PACK_ZSTD_LEVEL);
+	if (!ZSTD_isError(z))
+		z = ZSTD_CCtx_setPledgedSrcSize(cc, n);
+	if (!ZSTD_isError(z) && prefix_size)
+		z = ZSTD_CCtx_refPrefix(cc, prefix, prefix_size);
+	if (ZSTD_isError(z))
+		return z;
+	if (!flush || n < 4)
+		return ZSTD_compress2(cc, out, cap, d, n);
+	uint32_t ns = (uint32_t)d[0] | (uint32_t)d[1] << 8 | (uint32_t)d[2] << 16 | (uint32_t)d[3] << 24;
+	ZSTD_outBuffer o = {out, cap, 0};
+	size_t from = 0, to = 4 + 16 * (size_t)ns;
+	for (uint32_t i = 0; i <= ns; i++) {
+		if (i < ns) {
+			const uint8_t *h = d + 4 + 16 * (size_t)i;
+			to += (((size_t)h[12] | (size_t)h[13] << 8 | (size_t)h[14] << 16 | (size_t)h[15] << 24) + 3) & ~(size_t)3;
+		}
+		if (to > n)
+			to = n;
+		if (i < ns && to - from < flush)
+			continue;
+		ZSTD_inBuffer in = {d + from, to - from, 0};
+		ZSTD_EndDirective how = i == ns ? ZSTD_e_end : ZSTD_e_flush;
+		do {
+			z = ZSTD_compressStream2(cc, &o, &in, how);
+			if (ZSTD_isError(z))
+				return z;
+		} while (z != 0 || in.pos < in.size);
+		from = to;
+	}
+	return o.pos;
+}
+
 static mlod_result chunk_entropy(chunk *c, const uint8_t *prefix, size_t prefix_size, mlod_error *err)
 {
 	if (c->type == MLOD_CHUNK_INFO || c->size < 4 || c->size > c->raw)
 		return MLOD_OK;
-	size_t cap = ZSTD_compressBound(c->size);
-	uint8_t *z = malloc(cap), *zp = NULL;
-	if (!z)
-		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
-	size_t n = ZSTD_compress(z, cap, c->data, c->size, PACK_ZSTD_LEVEL), np = 0;
-	if (ZSTD_isError(n)) {
-		free(z);
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd: %s", ZSTD_getErrorName(n));
+	size_t cap = ZSTD_compressBound(c->size), n = c->size;
+	uint8_t *z = malloc(cap), *zt = malloc(cap);
+	ZSTD_CCtx *cc = ZSTD_createCCtx();
+	int with_prefix = 0;
+	mlod_result r = MLOD_OK;
+	if (!z || !zt || !cc) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+		goto done;
 	}
-	if (prefix_size && prefix_size <= MLOD_PACK_MAX_PREFIX) {
-		ZSTD_CCtx *cc = ZSTD_createCCtx();
-		if (!cc || !(zp = malloc(cap))) {
-			ZSTD_freeCCtx(cc);
-			free(z);
-			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+	/* alone, then on the prefix; each in one block run and with a block
+	 * per stream run (PACK_ZSTD_FLUSH); the first smallest */
+	for (int pass = 0; pass < 4; pass++) {
+		int pre = pass >= 2;
+		if (pre && !(prefix_size && prefix_size <= MLOD_PACK_MAX_PREFIX))
+			break;
+		size_t t = zstd_frame(cc, zt, cap, c->data, c->size, pre ? prefix : NULL, pre ? prefix_size : 0,
+		                      pass & 1 ? PACK_ZSTD_FLUSH : 0);
+		if (ZSTD_isError(t)) {
+			r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd%s: %s", pre ? " with a prefix" : "", ZSTD_getErrorName(t));
+			goto done;
 		}
-		np = ZSTD_CCtx_setParameter(cc, ZSTD_c_compressionLevel, PACK_ZSTD_LEVEL);
-		if (!ZSTD_isError(np))
-			np = ZSTD_CCtx_refPrefix(cc, prefix, prefix_size);
-		if (!ZSTD_isError(np))
-			np = ZSTD_compress2(cc, zp, cap, c->data, c->size);
-		ZSTD_freeCCtx(cc);
-		if (ZSTD_isError(np)) {
-			free(z);
-			free(zp);
-			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd with a prefix: %s", ZSTD_getErrorName(np));
+		if (t < n) {
+			uint8_t *swap = z;
+			z = zt, zt = swap, n = t, with_prefix = pre;
 		}
-		if (np < n) {
-			free(z);
-			z = zp, n = np, zp = NULL;
-		} else {
-			np = 0;
-		}
-		free(zp);
 	}
-	if (n >= c->size) {
-		free(z);
+	if (n < c->size) {
+		free(c->data);
+		c->coded = (uint32_t)c->size;
+		c->data = z;
+		c->size = n;
+		c->entropy = with_prefix ? MLOD_ENTROPY_ZSTD_PREFIX : MLOD_ENTROPY_ZSTD;
+		z = NULL;
+	}
+done:
+	free(z);
+	free(zt);
+	ZSTD_freeCCtx(cc);
+	return r;
+}
+
+/* The bytes of d's zstd frame alone at the pack's level, at most n (the
+ * estimate chunk_stream_choice compares forms by). cc: a reused context;
+ * scratch grows to the bound. 0 when zstd fails or out of memory. */
+static size_t zstd_bytes(ZSTD_CCtx *cc, uint8_t **scratch, size_t *cap, const uint8_t *d, size_t n)
+{
+	size_t need = ZSTD_compressBound(n);
+	if (need > *cap) {
+		uint8_t *p = realloc(*scratch, need);
+		if (!p)
+			return 0;
+		*scratch = p, *cap = need;
+	}
+	size_t z = ZSTD_compressCCtx(cc, *scratch, *cap, d, n, PACK_ZSTD_LEVEL);
+	return ZSTD_isError(z) ? 0 : z < n ? z : n;
+}
+
+/* Byte planes (MLOD_SCODEC_PLANES, _DELTA; format 7.0) of n elements of
+ * e bytes: byte j of element k at j * n + k, with delta each minus the
+ * same byte of element k - 1. */
+static void to_planes(const uint8_t *src, size_t n, size_t e, int delta, uint8_t *out)
+{
+	for (size_t j = 0; j < e; j++)
+		for (size_t k = 0; k < n; k++)
+			out[j * n + k] = (uint8_t)(src[k * e + j] - (delta && k ? src[(k - 1) * e + j] : 0));
+}
+
+/* The stream codecs by the entropy stage's bytes: cb_finish codes a
+ * stream with meshopt wherever that is smaller than the raw bytes, but
+ * zstd after it may store the raw bytes in fewer (unorm8 joints and
+ * weights, whose meshopt deltas look random to it), or the bytes in
+ * planes (format 7.0: UVs, normals, positions). Per stream of a meshopt
+ * chunk, the form whose zstd frame alone (at the pack's level) is the
+ * smallest: as cb_finish made it, raw, in byte planes, or in planes of
+ * deltas (ties in that order). The decoded values are the same. */
+static mlod_result chunk_stream_choice(chunk *c, mlod_error *err)
+{
+	if (c->type == MLOD_CHUNK_INFO || c->codec != MLOD_CODEC_MESHOPT || c->size < 4)
 		return MLOD_OK;
+	uint32_t ns = (uint32_t)c->data[0] | (uint32_t)c->data[1] << 8 | (uint32_t)c->data[2] << 16 |
+	              (uint32_t)c->data[3] << 24;
+	mlod_result r = MLOD_OK;
+	size_t cap = 0;
+	uint8_t *scratch = NULL, *raw = NULL, *form = NULL;
+	uint8_t **pick = calloc((size_t)ns + 1, sizeof *pick); /* the chosen form's bytes, NULL: as it is */
+	uint8_t *pick_codec = calloc((size_t)ns + 1, 1);
+	ZSTD_CCtx *cc = ZSTD_createCCtx();
+	buf b = {0};
+	if (!pick || !pick_codec || !cc)
+		goto nomem;
+	for (uint32_t i = 0, at = 4 + 16 * ns; i < ns; i++) {
+		const uint8_t *h = c->data + 4 + 16 * (size_t)i;
+		uint8_t scodec = h[10];
+		uint32_t count = (uint32_t)h[4] | (uint32_t)h[5] << 8 | (uint32_t)h[6] << 16 | (uint32_t)h[7] << 24;
+		size_t el = (size_t)h[8] | (size_t)h[9] << 8, bytes = (size_t)count * el;
+		size_t stored = (size_t)h[12] | (size_t)h[13] << 8 | (size_t)h[14] << 16 | (size_t)h[15] << 24;
+		const uint8_t *src = c->data + at;
+		at += (uint32_t)((stored + 3) & ~(size_t)3);
+		pick_codec[i] = scodec;
+		if (!count)
+			continue;
+		if (!(raw = malloc(bytes)) || !(form = malloc(bytes)))
+			goto nomem;
+		int rc = scodec == MLOD_SCODEC_RAW                ? (memcpy(raw, src, bytes), 0)
+		         : scodec == MLOD_SCODEC_MESHOPT_VERTEX   ? meshopt_decodeVertexBuffer(raw, count, el, src, stored)
+		         : scodec == MLOD_SCODEC_MESHOPT_SEQUENCE ? meshopt_decodeIndexSequence(raw, count, el, src, stored)
+		                                                  : meshopt_decodeIndexBuffer(raw, count, el, src, stored);
+		if (rc != 0) { /* never: the writer's own coding */
+			r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "meshopt decode of the writer's own stream failed (%d)", rc);
+			goto done;
+		}
+		size_t best = zstd_bytes(cc, &scratch, &cap, src, stored);
+		for (int f = 0; best && f < 3; f++) {
+			uint8_t codec = f == 0 ? MLOD_SCODEC_RAW : f == 1 ? MLOD_SCODEC_PLANES : MLOD_SCODEC_PLANES_DELTA;
+			if ((f == 0 && scodec == MLOD_SCODEC_RAW) || (f == 1 && el == 1))
+				continue;
+			if (f == 0)
+				memcpy(form, raw, bytes);
+			else
+				to_planes(raw, count, el, f == 2, form);
+			size_t z = zstd_bytes(cc, &scratch, &cap, form, bytes);
+			if (z && z < best) {
+				best = z;
+				free(pick[i]);
+				pick[i] = form, pick_codec[i] = codec;
+				if (!(form = malloc(bytes)))
+					goto nomem;
+			}
+		}
+		free(raw), free(form);
+		raw = form = NULL;
 	}
-	free(c->data);
-	c->coded = (uint32_t)c->size;
-	c->data = z;
-	c->size = n;
-	c->entropy = np ? MLOD_ENTROPY_ZSTD_PREFIX : MLOD_ENTROPY_ZSTD;
-	return MLOD_OK;
+	/* the container with the chosen forms */
+	buf_put(&b, c->data, 4 + 16 * (size_t)ns);
+	for (uint32_t i = 0, at = 4 + 16 * ns; i < ns; i++) {
+		uint8_t *h = c->data + 4 + 16 * (size_t)i;
+		size_t el = (size_t)h[8] | (size_t)h[9] << 8;
+		uint32_t count = (uint32_t)h[4] | (uint32_t)h[5] << 8 | (uint32_t)h[6] << 16 | (uint32_t)h[7] << 24;
+		size_t stored = (size_t)h[12] | (size_t)h[13] << 8 | (size_t)h[14] << 16 | (size_t)h[15] << 24;
+		if (pick[i]) {
+			buf_put(&b, pick[i], (size_t)count * el);
+			if (!b.fail) {
+				b.p[4 + 16 * (size_t)i + 10] = pick_codec[i];
+				put_u32(b.p + 4 + 16 * (size_t)i + 12, (uint32_t)((size_t)count * el));
+			}
+		} else {
+			buf_put(&b, c->data + at, stored);
+		}
+		buf_pad(&b, 4);
+		at += (uint32_t)((stored + 3) & ~(size_t)3);
+	}
+	if (b.fail)
+		goto nomem;
+	if (b.n <= c->raw) { /* always: no form is larger than the raw bytes */
+		free(c->data);
+		c->data = b.p, c->size = b.n;
+		b.p = NULL;
+	}
+	goto done;
+nomem:
+	r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+done:
+	for (uint32_t i = 0; pick && i < ns; i++)
+		free(pick[i]);
+	free(pick);
+	free(pick_codec);
+	free(raw);
+	free(form);
+	free(scratch);
+	free(b.p);
+	ZSTD_freeCCtx(cc);
+	return r;
 }
 
 /* A string table. */
@@ -3205,6 +3381,11 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		if ((r = cb_finish(&cb, MLOD_CODEC_NONE, &body, MLOD_CHUNK_DOC, MLOD_LAYER_NONE, 0, 0, 0.0f, err)) != MLOD_OK)
 			goto done;
 	}
+
+	/* The stream codecs by the entropy stage's bytes. */
+	for (int i = 0; opt->entropy == MLOD_ENTROPY_ZSTD && i < body.n; i++)
+		if ((r = chunk_stream_choice(&body.c[i], err)) != MLOD_OK)
+			goto done;
 
 	/* The entropy stage, after every choice above was made on the codec's
 	 * bytes (INFO has none: its size must not depend on the offsets). */

@@ -73,11 +73,12 @@
  *     4 u32  element count
  *     8 u16  element size in bytes (1..256; a multiple of 4 for the meshopt
  *            vertex codec, 2 or 4 for the index and sequence codecs)
- *    10 u8   stream codec (MLOD_SCODEC_*)
+ *    10 u8   stream codec (MLOD_SCODEC_*; 4 and 5, byte planes, format 7.0)
  *    11 u8   reserved (0)
  *    12 u32  stored byte size
  *   then the streams' bytes in order, each padded with zeros to 4 bytes.
- * A stream's decoded size is count * element size. raw size in the TOC is
+ * A stream's decoded size is count * element size, which a raw stream and
+ * one in byte planes store. raw size in the TOC is
  * 4 + 16 * stream_count + the decoded sizes, each padded to 4.
  *
  * The chunk types and their streams, in this order:
@@ -348,6 +349,12 @@ typedef enum mlod_pack_codec {
 #define MLOD_SCODEC_MESHOPT_VERTEX 1 /* meshopt_decodeVertexBuffer */
 #define MLOD_SCODEC_MESHOPT_INDEX 2  /* meshopt_decodeIndexBuffer */
 #define MLOD_SCODEC_MESHOPT_SEQUENCE 3 /* meshopt_decodeIndexSequence (format 3.0) */
+/* Format 7.0: the decoded bytes in byte planes (count * element size bytes
+ * stored, as raw): byte j of element k stored at j * count + k; with
+ * DELTA, each stored byte is that byte minus the same byte of element
+ * k - 1 (0 for k = 0), modulo 256. For the entropy stage after it. */
+#define MLOD_SCODEC_PLANES 4
+#define MLOD_SCODEC_PLANES_DELTA 5
 
 /* Stream tags. */
 #define MLOD_STREAM_INFO MLOD_FOURCC('I', 'N', 'F', 'O')

@@ -599,6 +599,7 @@ typedef struct cx {
 	uint8_t *temp;        /* aux bytes, then the decode buffer */
 	uint64_t aux;
 	mlod_pack_alloc alloc; /* the pack's */
+	uint16_t major;       /* the pack's format */
 } cx;
 
 /* Checks the chunk's TOC entry (index, type, codec). */
@@ -609,6 +610,7 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: chunk %u does not exist (the pack has %u)", index,
 		                 p->chunk_count);
 	const mlod_pack_chunk *c = &p->chunks[index];
+	x->major = p->major;
 	x->c = c;
 	x->alloc = p->alloc;
 	x->zd = p->zstd;
@@ -769,12 +771,16 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 		if (elsize < 1 || elsize > 256)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': element size %u is not 1 to 256", x->label, i,
 			                 tagn(tag).s, elsize);
-		if (codec > MLOD_SCODEC_MESHOPT_SEQUENCE)
+		if (codec > MLOD_SCODEC_PLANES_DELTA)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': unknown stream codec %u", x->label, i,
 			                 tagn(tag).s, codec);
+		if (codec >= MLOD_SCODEC_PLANES && x->major < 7)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': stream codec %u in a %u.x pack (format 7.0 added it)", x->label, i,
+			                 tagn(tag).s, codec, x->major);
 		if (codec != MLOD_SCODEC_RAW && c->codec == MLOD_CODEC_NONE)
-			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s' is meshopt-coded in a chunk of codec none",
-			                 x->label, i, tagn(tag).s);
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s' is %s in a chunk of codec none", x->label, i,
+			                 tagn(tag).s, codec >= MLOD_SCODEC_PLANES ? "in byte planes" : "meshopt-coded");
 		if (codec == MLOD_SCODEC_MESHOPT_VERTEX && elsize % 4 != 0)
 			return mlod_fail(err, MLOD_ERR_PARSE,
 			                 "%s: stream %u '%s': the meshopt vertex codec needs an element size that is a multiple of "
@@ -797,7 +803,7 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 			return mlod_fail(err, MLOD_ERR_PARSE,
 			                 "%s: stream %u '%s': %u meshopt-coded bytes cannot hold %u elements of %u bytes",
 			                 x->label, i, tagn(tag).s, stored, count, elsize);
-		if (codec == MLOD_SCODEC_RAW && stored != decoded)
+		if ((codec == MLOD_SCODEC_RAW || codec >= MLOD_SCODEC_PLANES) && stored != decoded)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': %u bytes stored for %u elements of %u bytes",
 			                 x->label, i, tagn(tag).s, stored, count, elsize);
 		if (pad4(stored) > csize - cursor)
@@ -992,6 +998,20 @@ static mlod_result cx_load_into(cx *x, const stream *s, uint8_t *dst, mlod_error
 	if (s->codec == MLOD_SCODEC_RAW) {
 		if (s->count)
 			memcpy(dst, s->src, (size_t)s->count * s->elsize);
+		return MLOD_OK;
+	}
+	if (s->codec >= MLOD_SCODEC_PLANES) { /* stored == count * elsize (cx_container) */
+		size_t n = s->count, e = s->elsize;
+		for (size_t j = 0; j < e; j++) {
+			const uint8_t *plane = s->src + j * n;
+			uint8_t acc = 0;
+			if (s->codec == MLOD_SCODEC_PLANES_DELTA)
+				for (size_t k = 0; k < n; k++)
+					dst[k * e + j] = acc = (uint8_t)(acc + plane[k]);
+			else
+				for (size_t k = 0; k < n; k++)
+					dst[k * e + j] = plane[k];
+		}
 		return MLOD_OK;
 	}
 	int rc = s->codec == MLOD_SCODEC_MESHOPT_VERTEX

@@ -207,6 +207,16 @@ static buf chunk_bytes(const wchunk *c, uint32_t *raw)
 			enc[i].n = seq ? meshopt_encodeIndexSequence(enc[i].p, bound, idx, count)
 			               : meshopt_encodeIndexBuffer(enc[i].p, bound, idx, count);
 			free(idx);
+		} else if (s->codec == MLOD_SCODEC_PLANES || s->codec == MLOD_SCODEC_PLANES_DELTA) {
+			/* byte j of element k at j * count + k (minus element k - 1's) */
+			enc[i].p = malloc(s->data.n + 1);
+			enc[i].n = s->data.n;
+			for (size_t j = 0; j < s->elsize; j++)
+				for (size_t k = 0; k < count; k++)
+					enc[i].p[j * count + k] = (uint8_t)(s->data.p[k * s->elsize + j] -
+					                                    (s->codec == MLOD_SCODEC_PLANES_DELTA && k
+					                                             ? s->data.p[(k - 1) * s->elsize + j]
+					                                             : 0));
 		} else {
 			put(&enc[i], s->data.p, s->data.n);
 		}
@@ -2710,6 +2720,94 @@ TEST(unknown_codec_raw_size)
 }
 
 /* The meshopt codecs' constraints, and a damaged meshopt stream. */
+/* Format 7.0's byte-plane stream codecs: every stream of MESH level 0,
+ * the skeleton level and a MOTION level in planes (alternately with and
+ * without deltas) decodes to what the raw streams do; a plane stream
+ * whose stored size is not its decoded size, a plane stream in a 6.0
+ * pack and one in a chunk of codec none are refused. */
+TEST(plane_streams)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	int chunks[] = {C_SKEL, C_SKEL1, C_MESH1, C_MESH0, C_MOT1, C_MOT0}, planes = 0;
+	for (int q = 0; q < 6; q++) {
+		c[chunks[q]].codec = MLOD_CODEC_MESHOPT;
+		for (int i = 0; i < c[chunks[q]].ns; i++)
+			if (c[chunks[q]].s[i].codec == MLOD_SCODEC_RAW && c[chunks[q]].s[i].count)
+				c[chunks[q]].s[i].codec = planes++ % 2 ? MLOD_SCODEC_PLANES_DELTA : MLOD_SCODEC_PLANES;
+	}
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0), b6 = build_pack(c, n, 6, 0);
+	free_chunks(c, n);
+	buf a = make_pack(0);
+	mlod_pack p, pa;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_open(a.p, a.n, &pa, &terr));
+	CHECK_OK(mlod_pack_check(&p, b.p, b.n, &terr));
+	mlod_pack_skeleton sk, ska;
+	mlod_pack_skel_level l, la;
+	mlod_pack_mesh m, ma;
+	mlod_pack_motion mo, moa;
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &sk, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&pa, a.p, a.n, &ska, &terr));
+	CHECK_OK(mlod_pack_decode_skel_level(&p, C_SKEL1, b.p, b.n, &sk, &l, &terr));
+	CHECK_OK(mlod_pack_decode_skel_level(&pa, C_SKEL1, a.p, a.n, &ska, &la, &terr));
+	int same = memcmp(sk.inverse_bind[0], ska.inverse_bind[0], 64 * NJ) == 0 &&
+	           memcmp(sk.joints, ska.joints, sizeof *sk.joints * NJ) == 0 &&
+	           memcmp(l.palette_bind, la.palette_bind, 64 * NJ) == 0 && memcmp(l.kept, la.kept, 4 * l.kept_count) == 0;
+	char why[256] = "";
+	for (int lv = 0; lv < 2; lv++) {
+		CHECK_OK(mlod_pack_decode_mesh(&p, lv ? C_MESH1 : C_MESH0, b.p, b.n, &sk, &m, &terr));
+		for (uint32_t i = 0; i < m.part_count; i++)
+			same = same && check_part(&m.parts[i], &parts_truth[2 * lv + (int)i], why, sizeof why);
+		mlod_pack_mesh_free(&m);
+		CHECK_OK(mlod_pack_decode_motion(&p, lv ? C_MOT1 : C_MOT0, b.p, b.n, &sk, &mo, &terr));
+		CHECK_OK(mlod_pack_decode_motion(&pa, lv ? C_MOT1 : C_MOT0, a.p, a.n, &ska, &moa, &terr));
+		same = same && mo.channel_count == moa.channel_count;
+		for (uint32_t i = 0; same && i < mo.channel_count; i++) {
+			uint32_t k = mo.channels[i].rec.key_count, w = mo.channels[i].rec.path == 1 ? 4 : 3;
+			same = memcmp(&mo.channels[i].rec, &moa.channels[i].rec, sizeof mo.channels[i].rec) == 0 &&
+			       memcmp(mo.channels[i].times, moa.channels[i].times, 4 * k) == 0 &&
+			       memcmp(mo.channels[i].values, moa.channels[i].values, 4 * w * k * (mo.channels[i].rec.interp == 2 ? 3 : 1)) == 0;
+		}
+		mlod_pack_motion_free(&mo);
+		mlod_pack_motion_free(&moa);
+	}
+	mlod_pack_skel_level_free(&l);
+	mlod_pack_skel_level_free(&la);
+	mlod_pack_skeleton_free(&ska);
+	CHECK_MSG(same && planes > 10, "%d plane streams: %s", planes, why);
+	/* A 6.0 pack with them: refused, naming the format that added them. */
+	mlod_pack p6;
+	CHECK_OK(mlod_pack_open(b6.p, b6.n, &p6, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p6, C_MESH1, b6.p, b6.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+	          "MESH level 1: stream 0 'PART': stream codec 4 in a 6.x pack (format 7.0 added it)");
+	mlod_pack_close(&p6);
+	/* A stored size that is not the decoded size; a chunk of codec none. */
+	uint8_t *ch = b.p + p.chunks[C_MESH1].offset, *h0 = ch + 4, save[16];
+	memcpy(save, h0, 16);
+	wr32(h0 + 12, get32(h0 + 12) - 4);
+	wr32(h0 + 16 + 12, get32(h0 + 16 + 12) + 4);
+	restamp(b.p, b.n);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+	          "MESH level 1: stream 0 'PART': 396 bytes stored for 2 elements of 200 bytes");
+	wr32(h0 + 12, get32(h0 + 12) + 4);
+	wr32(h0 + 16 + 12, get32(h0 + 16 + 12) - 4);
+	b.p[32 + 48 * C_MESH1 + 5] = (uint8_t)(b.p[32 + 48 * C_MESH1 + 5] & 0xf0);
+	restamp(b.p, b.n);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+	          "MESH level 1: stream 0 'PART' is in byte planes in a chunk of codec none");
+	mlod_pack_skeleton_free(&sk);
+	mlod_pack_close(&p);
+	mlod_pack_close(&pa);
+	free(a.p);
+	free(b.p);
+	free(b6.p);
+}
+
 TEST(meshopt_streams)
 {
 	static wchunk c[C_COUNT + 1];
@@ -2801,6 +2899,7 @@ int main(int argc, char **argv)
 	RUN(free_accepts_zeroed);
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
+	RUN(plane_streams);
 	RUN(format_6_0_palette_reads);
 	RUN(older_major_is_refused);
 	RUN(rotq_shift_decodes);
