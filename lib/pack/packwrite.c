@@ -466,9 +466,10 @@ static mlod_result chunk_stream_choice(chunk *c, mlod_error *err)
 	uint8_t *scratch = NULL, *raw = NULL, *form = NULL;
 	uint8_t **pick = calloc((size_t)ns + 1, sizeof *pick); /* the chosen form's bytes, NULL: as it is */
 	uint8_t *pick_codec = calloc((size_t)ns + 1, 1);
+	size_t *pick_size = calloc((size_t)ns + 1, sizeof *pick_size);
 	ZSTD_CCtx *cc = ZSTD_createCCtx();
 	buf b = {0};
-	if (!pick || !pick_codec || !cc)
+	if (!pick || !pick_codec || !pick_size || !cc)
 		goto nomem;
 	for (uint32_t i = 0, at = 4 + 16 * ns; i < ns; i++) {
 		const uint8_t *h = c->data + 4 + 16 * (size_t)i;
@@ -491,20 +492,29 @@ static mlod_result chunk_stream_choice(chunk *c, mlod_error *err)
 			r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "meshopt decode of the writer's own stream failed (%d)", rc);
 			goto done;
 		}
+		int sums = el == 4; /* every element's bytes sum to 255 (unorm8 weights) */
+		for (size_t k = 0; sums && k < count; k++)
+			sums = raw[4 * k] + raw[4 * k + 1] + raw[4 * k + 2] + raw[4 * k + 3] == 255;
 		size_t best = zstd_bytes(cc, &scratch, &cap, src, stored);
-		for (int f = 0; best && f < 3; f++) {
-			uint8_t codec = f == 0 ? MLOD_SCODEC_RAW : f == 1 ? MLOD_SCODEC_PLANES : MLOD_SCODEC_PLANES_DELTA;
-			if ((f == 0 && scodec == MLOD_SCODEC_RAW) || (f == 1 && el == 1))
+		for (int f = 0; best && f < 4; f++) {
+			static const uint8_t codecs[4] = {MLOD_SCODEC_RAW, MLOD_SCODEC_PLANES, MLOD_SCODEC_PLANES_DELTA,
+			                                  MLOD_SCODEC_SUM255};
+			uint8_t codec = codecs[f];
+			size_t fb = f == 3 ? 3 * (size_t)count : bytes;
+			if ((f == 0 && scodec == MLOD_SCODEC_RAW) || (f == 1 && el == 1) || (f == 3 && !sums))
 				continue;
 			if (f == 0)
 				memcpy(form, raw, bytes);
+			else if (f == 3)
+				for (size_t k = 0; k < count; k++)
+					memcpy(form + 3 * k, raw + 4 * k, 3);
 			else
 				to_planes(raw, count, el, f == 2, form);
-			size_t z = zstd_bytes(cc, &scratch, &cap, form, bytes);
+			size_t z = zstd_bytes(cc, &scratch, &cap, form, fb);
 			if (z && z < best) {
 				best = z;
 				free(pick[i]);
-				pick[i] = form, pick_codec[i] = codec;
+				pick[i] = form, pick_codec[i] = codec, pick_size[i] = fb;
 				if (!(form = malloc(bytes)))
 					goto nomem;
 			}
@@ -516,14 +526,12 @@ static mlod_result chunk_stream_choice(chunk *c, mlod_error *err)
 	buf_put(&b, c->data, 4 + 16 * (size_t)ns);
 	for (uint32_t i = 0, at = 4 + 16 * ns; i < ns; i++) {
 		uint8_t *h = c->data + 4 + 16 * (size_t)i;
-		size_t el = (size_t)h[8] | (size_t)h[9] << 8;
-		uint32_t count = (uint32_t)h[4] | (uint32_t)h[5] << 8 | (uint32_t)h[6] << 16 | (uint32_t)h[7] << 24;
 		size_t stored = (size_t)h[12] | (size_t)h[13] << 8 | (size_t)h[14] << 16 | (size_t)h[15] << 24;
 		if (pick[i]) {
-			buf_put(&b, pick[i], (size_t)count * el);
+			buf_put(&b, pick[i], pick_size[i]);
 			if (!b.fail) {
 				b.p[4 + 16 * (size_t)i + 10] = pick_codec[i];
-				put_u32(b.p + 4 + 16 * (size_t)i + 12, (uint32_t)((size_t)count * el));
+				put_u32(b.p + 4 + 16 * (size_t)i + 12, (uint32_t)pick_size[i]);
 			}
 		} else {
 			buf_put(&b, c->data + at, stored);
@@ -546,6 +554,7 @@ done:
 		free(pick[i]);
 	free(pick);
 	free(pick_codec);
+	free(pick_size);
 	free(raw);
 	free(form);
 	free(scratch);

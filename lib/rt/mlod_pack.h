@@ -73,7 +73,8 @@
  *     4 u32  element count
  *     8 u16  element size in bytes (1..256; a multiple of 4 for the meshopt
  *            vertex codec, 2 or 4 for the index and sequence codecs)
- *    10 u8   stream codec (MLOD_SCODEC_*; 4 and 5, byte planes, format 7.0)
+ *    10 u8   stream codec (MLOD_SCODEC_*; 4 and 5, byte planes, and 6,
+ *            sums to 255, format 7.0)
  *    11 u8   reserved (0)
  *    12 u32  stored byte size
  *   then the streams' bytes in order, each padded with zeros to 4 bytes.
@@ -355,6 +356,10 @@ typedef enum mlod_pack_codec {
  * k - 1 (0 for k = 0), modulo 256. For the entropy stage after it. */
 #define MLOD_SCODEC_PLANES 4
 #define MLOD_SCODEC_PLANES_DELTA 5
+/* Format 7.0: elements of 4 bytes whose bytes sum to 255 (unorm8 weights),
+ * each stored as its first three bytes (count * 3 bytes); the reader
+ * rebuilds the fourth as 255 minus their sum. */
+#define MLOD_SCODEC_SUM255 6
 
 /* Stream tags. */
 #define MLOD_STREAM_INFO MLOD_FOURCC('I', 'N', 'F', 'O')

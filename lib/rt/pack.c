@@ -771,7 +771,7 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 		if (elsize < 1 || elsize > 256)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': element size %u is not 1 to 256", x->label, i,
 			                 tagn(tag).s, elsize);
-		if (codec > MLOD_SCODEC_PLANES_DELTA)
+		if (codec > MLOD_SCODEC_SUM255)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': unknown stream codec %u", x->label, i,
 			                 tagn(tag).s, codec);
 		if (codec >= MLOD_SCODEC_PLANES && x->major < 7)
@@ -780,7 +780,17 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 			                 tagn(tag).s, codec, x->major);
 		if (codec != MLOD_SCODEC_RAW && c->codec == MLOD_CODEC_NONE)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s' is %s in a chunk of codec none", x->label, i,
-			                 tagn(tag).s, codec >= MLOD_SCODEC_PLANES ? "in byte planes" : "meshopt-coded");
+			                 tagn(tag).s,
+			                 codec == MLOD_SCODEC_SUM255 ? "stored without its sums"
+			                 : codec >= MLOD_SCODEC_PLANES ? "in byte planes"
+			                                               : "meshopt-coded");
+		if (codec == MLOD_SCODEC_SUM255 && elsize != 4)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': the sum codec needs an element size of 4, not %u", x->label, i,
+			                 tagn(tag).s, elsize);
+		if (codec == MLOD_SCODEC_SUM255 && stored != 3 * (uint64_t)count)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': %u bytes stored for %u elements of 3 bytes",
+			                 x->label, i, tagn(tag).s, stored, count);
 		if (codec == MLOD_SCODEC_MESHOPT_VERTEX && elsize % 4 != 0)
 			return mlod_fail(err, MLOD_ERR_PARSE,
 			                 "%s: stream %u '%s': the meshopt vertex codec needs an element size that is a multiple of "
@@ -803,7 +813,8 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 			return mlod_fail(err, MLOD_ERR_PARSE,
 			                 "%s: stream %u '%s': %u meshopt-coded bytes cannot hold %u elements of %u bytes",
 			                 x->label, i, tagn(tag).s, stored, count, elsize);
-		if ((codec == MLOD_SCODEC_RAW || codec >= MLOD_SCODEC_PLANES) && stored != decoded)
+		if ((codec == MLOD_SCODEC_RAW || codec == MLOD_SCODEC_PLANES || codec == MLOD_SCODEC_PLANES_DELTA) &&
+		    stored != decoded)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': %u bytes stored for %u elements of %u bytes",
 			                 x->label, i, tagn(tag).s, stored, count, elsize);
 		if (pad4(stored) > csize - cursor)
@@ -998,6 +1009,18 @@ static mlod_result cx_load_into(cx *x, const stream *s, uint8_t *dst, mlod_error
 	if (s->codec == MLOD_SCODEC_RAW) {
 		if (s->count)
 			memcpy(dst, s->src, (size_t)s->count * s->elsize);
+		return MLOD_OK;
+	}
+	if (s->codec == MLOD_SCODEC_SUM255) { /* elsize 4, stored == count * 3 (cx_container) */
+		for (size_t k = 0; k < s->count; k++) {
+			const uint8_t *e = s->src + 3 * k;
+			unsigned sum = (unsigned)e[0] + e[1] + e[2];
+			if (sum > 255)
+				return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': element %zu: its three bytes sum to %u, "
+				                 "more than 255", x->label, s->index, tagn(s->tag).s, k, sum);
+			memcpy(dst + 4 * k, e, 3);
+			dst[4 * k + 3] = (uint8_t)(255 - sum);
+		}
 		return MLOD_OK;
 	}
 	if (s->codec >= MLOD_SCODEC_PLANES) { /* stored == count * elsize (cx_container) */

@@ -15,7 +15,7 @@
 // 'PALX' matrix); "palette" in the summary counts each level's three
 // kinds (null where 'PALR' is meshopt-coded), and where 'KEPT' is, its
 // joints are checked (increasing, below the joint count). "planes" counts
-// the streams in byte planes. A chunk with the
+// the streams in byte planes, "sums" those of codec 6 (each decoded). A chunk with the
 // zstd entropy stage (format 5.0) is undone with the zstd tool first; one
 // with the prefix stage (format 6.0) with the chunks it needs as the tool's
 // --patch-from reference: a MESH level's coarser MESH levels' containers,
@@ -100,7 +100,8 @@ for (let i = 0; i < n; i++) {
 		if (st.codec === 1 && st.size % 4) die(`chunk ${i}: vertex codec on element size ${st.size}`);
 		if (st.codec === 2 && (st.size !== 2 && st.size !== 4 || st.count % 3)) die(`chunk ${i}: index codec on ${st.tag}`);
 		if (st.codec === 3 && (st.size !== 2 && st.size !== 4 || st.tag !== 'IMAP')) die(`chunk ${i}: index sequence codec on ${st.tag}`);
-		if (st.codec > 5) die(`chunk ${i}: stream codec ${st.codec}`);
+		if (st.codec === 6 && (st.size !== 4 || st.stored !== 3 * st.count)) die(`chunk ${i}: sum codec on ${st.tag}: element size ${st.size}, stored ${st.stored}`);
+		if (st.codec > 6) die(`chunk ${i}: stream codec ${st.codec}`);
 		st.at = p;
 		p += (st.stored + 3) & ~3;
 		raw += (st.count * st.size + 3) & ~3;
@@ -112,12 +113,24 @@ for (let i = 0; i < n; i++) {
 }
 if (end !== b.length) die('bytes after the last chunk');
 
-// A stream's decoded bytes where no meshopt decoder is needed: raw (0), or
+// A stream's decoded bytes where no meshopt decoder is needed: raw (0),
 // byte planes (4: byte j of element k at j * count + k; 5: the same of
-// each byte minus the element before's, modulo 256; format 7.0); else null.
+// each byte minus the element before's, modulo 256; format 7.0), or sums
+// (6: elements of 4 bytes summing to 255 as their first three; 7.0);
+// else null.
 const plain = (c, st) => {
 	const s = c.data.subarray(st.at, st.at + st.stored), n = st.count, e = st.size;
 	if (st.codec === 0) return s;
+	if (st.codec === 6) { // each element's first three bytes; the fourth 255 minus their sum
+		const out = Buffer.alloc(n * 4);
+		for (let k = 0; k < n; k++) {
+			const sum = s[3 * k] + s[3 * k + 1] + s[3 * k + 2];
+			if (sum > 255) die(`stream ${st.tag}: element ${k}: its bytes sum to ${sum}`);
+			out.set(s.subarray(3 * k, 3 * k + 3), 4 * k);
+			out[4 * k + 3] = 255 - sum;
+		}
+		return out;
+	}
 	if (st.codec !== 4 && st.codec !== 5) return null;
 	const out = Buffer.alloc(n * e);
 	for (let j = 0; j < e; j++) {
@@ -193,6 +206,8 @@ const out = {
 	doc: chunks[n - 1].streams[0].count,
 	palette,
 	planes: chunks.reduce((a, c) => a + c.streams.filter((t) => t.codec === 4 || t.codec === 5).length, 0),
+	// every weights stream stored without its sums, decoded: its count
+	sums: chunks.reduce((a, c) => a + c.streams.filter((t) => t.codec === 6 && plain(c, t)).length, 0),
 	toc: chunks.map((c) => `${c.type.trim()} ${c.level}/${c.item} ${c.crc.toString(16)}`),
 };
 for (const c of chunks) out.count[c.type.trim()] = (out.count[c.type.trim()] || 0) + 1;

@@ -207,6 +207,9 @@ static buf chunk_bytes(const wchunk *c, uint32_t *raw)
 			enc[i].n = seq ? meshopt_encodeIndexSequence(enc[i].p, bound, idx, count)
 			               : meshopt_encodeIndexBuffer(enc[i].p, bound, idx, count);
 			free(idx);
+		} else if (s->codec == MLOD_SCODEC_SUM255) { /* each element's first three bytes */
+			for (size_t k = 0; k < count; k++)
+				put(&enc[i], s->data.p + 4 * k, 3);
 		} else if (s->codec == MLOD_SCODEC_PLANES || s->codec == MLOD_SCODEC_PLANES_DELTA) {
 			/* byte j of element k at j * count + k (minus element k - 1's) */
 			enc[i].p = malloc(s->data.n + 1);
@@ -2722,18 +2725,22 @@ TEST(unknown_codec_raw_size)
 /* The meshopt codecs' constraints, and a damaged meshopt stream. */
 /* Format 7.0's byte-plane stream codecs: every stream of MESH level 0,
  * the skeleton level and a MOTION level in planes (alternately with and
- * without deltas) decodes to what the raw streams do; a plane stream
- * whose stored size is not its decoded size, a plane stream in a 6.0
- * pack and one in a chunk of codec none are refused. */
+ * without deltas; the weights without their sums, codec 6) decodes to
+ * what the raw streams do; a plane stream whose stored size is not its
+ * decoded size, a plane stream in a 6.0 pack and one in a chunk of codec
+ * none are refused, and so are weights whose three bytes pass 255 and
+ * the sum codec on elements of another size. */
 TEST(plane_streams)
 {
 	static wchunk c[C_COUNT + 1];
 	int n = make_chunks(c, 0);
-	int chunks[] = {C_SKEL, C_SKEL1, C_MESH1, C_MESH0, C_MOT1, C_MOT0}, planes = 0;
+	int chunks[] = {C_SKEL, C_SKEL1, C_MESH1, C_MESH0, C_MOT1, C_MOT0}, planes = 0, sums = 0;
 	for (int q = 0; q < 6; q++) {
 		c[chunks[q]].codec = MLOD_CODEC_MESHOPT;
 		for (int i = 0; i < c[chunks[q]].ns; i++)
-			if (c[chunks[q]].s[i].codec == MLOD_SCODEC_RAW && c[chunks[q]].s[i].count)
+			if (c[chunks[q]].s[i].tag == MLOD_STREAM_WGT8)
+				c[chunks[q]].s[i].codec = MLOD_SCODEC_SUM255, sums++;
+			else if (c[chunks[q]].s[i].codec == MLOD_SCODEC_RAW && c[chunks[q]].s[i].count)
 				c[chunks[q]].s[i].codec = planes++ % 2 ? MLOD_SCODEC_PLANES_DELTA : MLOD_SCODEC_PLANES;
 	}
 	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0), b6 = build_pack(c, n, 6, 0);
@@ -2775,7 +2782,45 @@ TEST(plane_streams)
 	mlod_pack_skel_level_free(&l);
 	mlod_pack_skel_level_free(&la);
 	mlod_pack_skeleton_free(&ska);
-	CHECK_MSG(same && planes > 10, "%d plane streams: %s", planes, why);
+	CHECK_MSG(same && planes > 10 && sums >= 2, "%d plane and %d sum streams: %s", planes, sums, why);
+	/* The weights stream of MESH level 1's part 0 (sum codec): a vertex's
+	 * three bytes summing past 255, then the codec on 'PART' (200 bytes). */
+	{
+		uint8_t *chw = b.p + p.chunks[C_MESH1].offset, *w = NULL, *hw = NULL;
+		uint32_t nsw = get32(chw);
+		size_t atw = 4 + 16 * (size_t)nsw;
+		for (uint32_t t = 0; t < nsw && !w; t++) {
+			uint8_t *ht = chw + 4 + 16 * t;
+			if (get32(ht) == MLOD_STREAM_WGT8)
+				w = chw + atw, hw = ht;
+			atw += (get32(ht + 12) + 3) & ~3u;
+		}
+		CHECK(w && hw[10] == MLOD_SCODEC_SUM255 && get32(hw + 12) == 3 * get32(hw + 4));
+		uint8_t keep = w[3 * 5];
+		w[3 * 5] = 255;
+		restamp(b.p, b.n);
+		mlod_pack_close(&p);
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+		CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+		          "'WGT8': element 5: its three bytes sum to ");
+		w[3 * 5] = keep;
+		restamp(b.p, b.n);
+		mlod_pack_close(&p);
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+		CHECK_OK(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr));
+		mlod_pack_mesh_free(&ma);
+		uint8_t *h0 = chw + 4, c0 = h0[10];
+		h0[10] = MLOD_SCODEC_SUM255;
+		restamp(b.p, b.n);
+		mlod_pack_close(&p);
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+		CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+		          "MESH level 1: stream 0 'PART': the sum codec needs an element size of 4, not 200");
+		h0[10] = c0;
+		restamp(b.p, b.n);
+		mlod_pack_close(&p);
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	}
 	/* A 6.0 pack with them: refused, naming the format that added them. */
 	mlod_pack p6;
 	CHECK_OK(mlod_pack_open(b6.p, b6.n, &p6, &terr));
