@@ -317,6 +317,16 @@ nomem:
  * container is at most the raw size (the reader's bound). Deterministic:
  * one-shot compression, one thread, the frame with its content size. */
 #define PACK_ZSTD_LEVEL 19
+/* chunk_stream_choice compares a stream's forms by their zstd frames at
+ * this level (level 19 there costs 4 times the instructions for 0.1-0.6%
+ * of the four inputs' bytes, bench/RESULTS.md), on at most
+ * PACK_CHOICE_SAMPLE of its bytes (whole elements from its first). */
+#ifndef PACK_CHOICE_LEVEL
+#define PACK_CHOICE_LEVEL 12
+#endif
+#ifndef PACK_CHOICE_SAMPLE
+#define PACK_CHOICE_SAMPLE ((size_t)1 << 14)
+#endif
 /* The block run's threshold (zstd_frame): a zstd block ends at a stream's
  * end once this many container bytes are pending (chunk_entropy tries
  * both runs). */
@@ -389,18 +399,21 @@ static mlod_result chunk_entropy(chunk *c, const uint8_t *prefix, size_t prefix_
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
 		goto done;
 	}
-	/* alone, then on the prefix; each in one block run and with a block
-	 * per stream run (PACK_ZSTD_FLUSH); the first smallest */
-	for (int pass = 0; pass < 4; pass++) {
-		int pre = pass >= 2;
-		if (pre && !(prefix_size && prefix_size <= MLOD_PACK_MAX_PREFIX))
-			break;
-		size_t t = zstd_frame(cc, zt, cap, c->data, c->size, pre ? prefix : NULL, pre ? prefix_size : 0,
-		                      pass & 1 ? PACK_ZSTD_FLUSH : 0);
+	/* alone in one block run and with a block per stream run
+	 * (PACK_ZSTD_FLUSH); then, where there is a prefix, on it with the
+	 * better of the two runs; the first smallest frame */
+	int has_prefix = prefix_size && prefix_size <= MLOD_PACK_MAX_PREFIX;
+	size_t run_flush = 0, alone_best = SIZE_MAX;
+	for (int pass = 0; pass < 2 + has_prefix; pass++) {
+		int pre = pass == 2;
+		size_t flush = pass == 1 ? PACK_ZSTD_FLUSH : pre ? run_flush : 0;
+		size_t t = zstd_frame(cc, zt, cap, c->data, c->size, pre ? prefix : NULL, pre ? prefix_size : 0, flush);
 		if (ZSTD_isError(t)) {
 			r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd%s: %s", pre ? " with a prefix" : "", ZSTD_getErrorName(t));
 			goto done;
 		}
+		if (!pre && t < alone_best)
+			alone_best = t, run_flush = flush;
 		if (t < n) {
 			uint8_t *swap = z;
 			z = zt, zt = swap, n = t, with_prefix = pre;
@@ -421,7 +434,7 @@ done:
 	return r;
 }
 
-/* The bytes of d's zstd frame alone at the pack's level, at most n (the
+/* The bytes of d's zstd frame alone at PACK_CHOICE_LEVEL, at most n (the
  * estimate chunk_stream_choice compares forms by). cc: a reused context;
  * scratch grows to the bound. 0 when zstd fails or out of memory. */
 static size_t zstd_bytes(ZSTD_CCtx *cc, uint8_t **scratch, size_t *cap, const uint8_t *d, size_t n)
@@ -433,7 +446,7 @@ static size_t zstd_bytes(ZSTD_CCtx *cc, uint8_t **scratch, size_t *cap, const ui
 			return 0;
 		*scratch = p, *cap = need;
 	}
-	size_t z = ZSTD_compressCCtx(cc, *scratch, *cap, d, n, PACK_ZSTD_LEVEL);
+	size_t z = ZSTD_compressCCtx(cc, *scratch, *cap, d, n, PACK_CHOICE_LEVEL);
 	return ZSTD_isError(z) ? 0 : z < n ? z : n;
 }
 
@@ -451,10 +464,12 @@ static void to_planes(const uint8_t *src, size_t n, size_t e, int delta, uint8_t
  * stream with meshopt wherever that is smaller than the raw bytes, but
  * zstd after it may store the raw bytes in fewer (unorm8 joints and
  * weights, whose meshopt deltas look random to it), or the bytes in
- * planes (format 7.0: UVs, normals, positions). Per stream of a meshopt
- * chunk, the form whose zstd frame alone (at the pack's level) is the
- * smallest: as cb_finish made it, raw, in byte planes, or in planes of
- * deltas (ties in that order). The decoded values are the same. */
+ * planes (format 7.0: UVs, normals, positions), or weights without their
+ * sums. Per stream of a meshopt chunk but index buffers, the form whose
+ * zstd frame alone (PACK_CHOICE_LEVEL, on the first PACK_CHOICE_SAMPLE
+ * bytes) is the smallest: as cb_finish made it, raw, in byte planes, in
+ * planes of deltas, or (elements of 4 bytes each summing to 255) without
+ * their sums (ties in that order). The decoded values are the same. */
 static mlod_result chunk_stream_choice(chunk *c, mlod_error *err)
 {
 	if (c->type == MLOD_CHUNK_INFO || c->codec != MLOD_CODEC_MESHOPT || c->size < 4)
@@ -480,7 +495,9 @@ static mlod_result chunk_stream_choice(chunk *c, mlod_error *err)
 		const uint8_t *src = c->data + at;
 		at += (uint32_t)((stored + 3) & ~(size_t)3);
 		pick_codec[i] = scodec;
-		if (!count)
+		/* index buffers stay with meshopt's index codec (raw or planes
+		 * of them never came near it) */
+		if (!count || scodec == MLOD_SCODEC_MESHOPT_INDEX)
 			continue;
 		if (!(raw = malloc(bytes)) || !(form = malloc(bytes)))
 			goto nomem;
@@ -495,7 +512,26 @@ static mlod_result chunk_stream_choice(chunk *c, mlod_error *err)
 		int sums = el == 4; /* every element's bytes sum to 255 (unorm8 weights) */
 		for (size_t k = 0; sums && k < count; k++)
 			sums = raw[4 * k] + raw[4 * k + 1] + raw[4 * k + 2] + raw[4 * k + 3] == 255;
-		size_t best = zstd_bytes(cc, &scratch, &cap, src, stored);
+		/* The forms compared on the stream's first PACK_CHOICE_SAMPLE bytes
+		 * of elements (the whole of a sequence-coded one), the codec's form
+		 * coded again on them. */
+		uint32_t en = scodec == MLOD_SCODEC_MESHOPT_SEQUENCE || bytes <= PACK_CHOICE_SAMPLE
+		                      ? count
+		                      : (uint32_t)(PACK_CHOICE_SAMPLE / el > 0 ? PACK_CHOICE_SAMPLE / el : 1);
+		size_t best;
+		if (en == count) {
+			best = zstd_bytes(cc, &scratch, &cap, src, stored);
+		} else if (scodec == MLOD_SCODEC_MESHOPT_VERTEX) {
+			size_t bound = meshopt_encodeVertexBufferBound(en, el);
+			uint8_t *sub = malloc(bound);
+			if (!sub)
+				goto nomem;
+			size_t sn = meshopt_encodeVertexBuffer(sub, bound, raw, en, el);
+			best = sn ? zstd_bytes(cc, &scratch, &cap, sub, sn) : 0;
+			free(sub);
+		} else {
+			best = zstd_bytes(cc, &scratch, &cap, raw, (size_t)en * el);
+		}
 		for (int f = 0; best && f < 4; f++) {
 			static const uint8_t codecs[4] = {MLOD_SCODEC_RAW, MLOD_SCODEC_PLANES, MLOD_SCODEC_PLANES_DELTA,
 			                                  MLOD_SCODEC_SUM255};
@@ -503,14 +539,23 @@ static mlod_result chunk_stream_choice(chunk *c, mlod_error *err)
 			size_t fb = f == 3 ? 3 * (size_t)count : bytes;
 			if ((f == 0 && scodec == MLOD_SCODEC_RAW) || (f == 1 && el == 1) || (f == 3 && !sums))
 				continue;
-			if (f == 0)
-				memcpy(form, raw, bytes);
-			else if (f == 3)
-				for (size_t k = 0; k < count; k++)
-					memcpy(form + 3 * k, raw + 4 * k, 3);
-			else
-				to_planes(raw, count, el, f == 2, form);
-			size_t z = zstd_bytes(cc, &scratch, &cap, form, fb);
+			size_t z = 0;
+			for (int whole = en == count; whole < 2; whole++) { /* the sample, then the stream */
+				uint32_t m = whole ? count : en;
+				if (f == 0)
+					memcpy(form, raw, (size_t)m * el);
+				else if (f == 3)
+					for (size_t k = 0; k < m; k++)
+						memcpy(form + 3 * k, raw + 4 * k, 3);
+				else
+					to_planes(raw, m, el, f == 2, form);
+				if (!whole)
+					z = zstd_bytes(cc, &scratch, &cap, form, f == 3 ? 3 * (size_t)m : (size_t)m * el);
+				else if (en == count)
+					z = zstd_bytes(cc, &scratch, &cap, form, fb);
+				if (!whole && !(z && z < best))
+					break; /* the sample lost: no whole form */
+			}
 			if (z && z < best) {
 				best = z;
 				free(pick[i]);
