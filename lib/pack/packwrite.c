@@ -328,11 +328,12 @@ nomem:
 #define PACK_CHOICE_SAMPLE ((size_t)1 << 14)
 #endif
 /* The block run's threshold (zstd_frame): a zstd block ends at a stream's
- * end once this many container bytes are pending (chunk_entropy tries
- * both runs). */
+ * end once this many container bytes are pending (chunk_entropy compares
+ * both runs at PACK_ZSTD_TRIAL_LEVEL). */
 #ifndef PACK_ZSTD_FLUSH
 #define PACK_ZSTD_FLUSH 512
 #endif
+#define PACK_ZSTD_TRIAL_LEVEL 3
 /* Draco's speed option (0 smallest .. 10 fastest), for encoding and decoding. */
 #ifndef MLOD_PACK_DRACO_SPEED
 #define MLOD_PACK_DRACO_SPEED 0
@@ -349,11 +350,11 @@ nomem:
  * at least flush bytes after the last block's end (each block has its
  * own literal and sequence statistics: a stream's own may code it in
  * fewer bytes than those of a block mixing it with others). */
-static size_t zstd_frame(ZSTD_CCtx *cc, uint8_t *out, size_t cap, const uint8_t *d, size_t n, const uint8_t *prefix,
-                         size_t prefix_size, size_t flush)
+static size_t zstd_frame(ZSTD_CCtx *cc, int level, uint8_t *out, size_t cap, const uint8_t *d, size_t n,
+                         const uint8_t *prefix, size_t prefix_size, size_t flush)
 {
 	ZSTD_CCtx_reset(cc, ZSTD_reset_session_and_parameters);
-	size_t z = ZSTD_CCtx_setParameter(cc, ZSTD_c_compressionLevel, PACK_ZSTD_LEVEL);
+	size_t z = ZSTD_CCtx_setParameter(cc, ZSTD_c_compressionLevel, level);
 	if (!ZSTD_isError(z))
 		z = ZSTD_CCtx_setPledgedSrcSize(cc, n);
 	if (!ZSTD_isError(z) && prefix_size)
@@ -393,32 +394,29 @@ static mlod_result chunk_entropy(chunk *c, const uint8_t *prefix, size_t prefix_
 	size_t cap = ZSTD_compressBound(c->size), n = c->size;
 	uint8_t *z = malloc(cap), *zt = malloc(cap);
 	ZSTD_CCtx *cc = ZSTD_createCCtx();
-	int with_prefix = 0;
 	mlod_result r = MLOD_OK;
 	if (!z || !zt || !cc) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
 		goto done;
 	}
-	/* alone in one block run and with a block per stream run
-	 * (PACK_ZSTD_FLUSH); then, where there is a prefix, on it with the
-	 * better of the two runs; the first smallest frame */
+	/* The block run (one as zstd splits them, or a block per stream run of
+	 * PACK_ZSTD_FLUSH bytes) that codes the container alone smaller at
+	 * PACK_ZSTD_TRIAL_LEVEL; then one frame at the pack's level with it:
+	 * on the prefix where there is one, else alone. */
 	int has_prefix = prefix_size && prefix_size <= MLOD_PACK_MAX_PREFIX;
-	size_t run_flush = 0, alone_best = SIZE_MAX;
-	for (int pass = 0; pass < 2 + has_prefix; pass++) {
-		int pre = pass == 2;
-		size_t flush = pass == 1 ? PACK_ZSTD_FLUSH : pre ? run_flush : 0;
-		size_t t = zstd_frame(cc, zt, cap, c->data, c->size, pre ? prefix : NULL, pre ? prefix_size : 0, flush);
-		if (ZSTD_isError(t)) {
-			r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd%s: %s", pre ? " with a prefix" : "", ZSTD_getErrorName(t));
-			goto done;
-		}
-		if (!pre && t < alone_best)
-			alone_best = t, run_flush = flush;
-		if (t < n) {
-			uint8_t *swap = z;
-			z = zt, zt = swap, n = t, with_prefix = pre;
-		}
+	size_t t0 = zstd_frame(cc, PACK_ZSTD_TRIAL_LEVEL, zt, cap, c->data, c->size, NULL, 0, 0);
+	size_t t1 = ZSTD_isError(t0) ? t0 : zstd_frame(cc, PACK_ZSTD_TRIAL_LEVEL, zt, cap, c->data, c->size, NULL, 0,
+	                                               PACK_ZSTD_FLUSH);
+	size_t t = ZSTD_isError(t1) ? t1
+	                            : zstd_frame(cc, PACK_ZSTD_LEVEL, z, cap, c->data, c->size, has_prefix ? prefix : NULL,
+	                                         has_prefix ? prefix_size : 0, t1 < t0 ? PACK_ZSTD_FLUSH : 0);
+	if (ZSTD_isError(t)) {
+		r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd%s: %s", has_prefix ? " with a prefix" : "",
+		              ZSTD_getErrorName(t));
+		goto done;
 	}
+	n = t < n ? t : n;
+	int with_prefix = has_prefix;
 	if (n < c->size) {
 		free(c->data);
 		c->coded = (uint32_t)c->size;

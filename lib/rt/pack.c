@@ -2879,6 +2879,28 @@ void mlod_pack_doc_free(mlod_pack_doc_bytes *x)
 
 /* Every chunk decoded in TOC order and released, stopping at the first
  * failure (whose message names the chunk); unknown types are skipped. */
+mlod_result mlod_pack_check_padding(const mlod_pack *p, const void *data, size_t size, mlod_error *err)
+{
+	if (!p || (!data && size))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_check_padding: NULL argument");
+	/* no CRC covers it: a whole file has no other bytes than the header,
+	 * the TOC, the chunks and the zero padding before each chunk */
+	const uint8_t *d = data;
+	uint64_t at = MLOD_PACK_HEADER_SIZE + (uint64_t)p->chunk_count * MLOD_PACK_TOC_ENTRY_SIZE;
+	for (uint32_t i = 0; i < p->chunk_count; i++) {
+		const mlod_pack_chunk *c = &p->chunks[i];
+		for (uint64_t b = at; b < c->offset && b < size; b++)
+			if (d[b]) {
+				char label[48];
+				chunk_label(c->type, c->level, c->item, label, sizeof label);
+				return mlod_fail(err, MLOD_ERR_PARSE, "%s: padding byte %llu before the chunk is not zero", label,
+				                 (unsigned long long)b);
+			}
+		at = c->offset + c->stored_size;
+	}
+	return MLOD_OK;
+}
+
 mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, mlod_error *err)
 {
 	if (!p || (!data && size))
@@ -2887,6 +2909,8 @@ mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, m
 	memset(&skel, 0, sizeof skel);
 	int have_skel = 0;
 	mlod_result r = MLOD_OK;
+	if ((r = mlod_pack_check_padding(p, data, size, err)) != MLOD_OK)
+		return r;
 	for (uint32_t i = 0; r == MLOD_OK && i < p->chunk_count; i++) {
 		const mlod_pack_chunk *c = &p->chunks[i];
 		const mlod_pack_skeleton *s = have_skel ? &skel : NULL;

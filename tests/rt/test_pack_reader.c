@@ -2853,6 +2853,29 @@ TEST(plane_streams)
 	free(b6.p);
 }
 
+/* The zero padding between chunks, which no CRC covers: mlod_pack_check
+ * (what mlod-pack --info and -x run first) refuses a byte set in it,
+ * naming the chunk after it. */
+TEST(padding_is_checked)
+{
+	buf b = make_pack(0);
+	mlod_pack p;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_check(&p, b.p, b.n, &terr));
+	uint32_t gap = 0;
+	for (uint32_t i = 1; i < p.chunk_count && !gap; i++)
+		if (p.chunks[i].offset > p.chunks[i - 1].offset + p.chunks[i - 1].stored_size)
+			gap = i;
+	CHECK(gap > 0);
+	uint64_t at = p.chunks[gap].offset - 1;
+	b.p[at] = 0x5a;
+	char want[128];
+	snprintf(want, sizeof want, "padding byte %llu before the chunk is not zero", (unsigned long long)at);
+	CHECK_ERR(mlod_pack_check(&p, b.p, b.n, &terr), MLOD_ERR_PARSE, want);
+	mlod_pack_close(&p);
+	free(b.p);
+}
+
 TEST(meshopt_streams)
 {
 	static wchunk c[C_COUNT + 1];
@@ -2945,6 +2968,7 @@ int main(int argc, char **argv)
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
 	RUN(plane_streams);
+	RUN(padding_is_checked);
 	RUN(format_6_0_palette_reads);
 	RUN(older_major_is_refused);
 	RUN(rotq_shift_decodes);
