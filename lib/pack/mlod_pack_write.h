@@ -13,7 +13,7 @@
  *   mesh      the MSFT_lod level nodes with a mesh level record; else
  *             mlod_mesh_levels_by_ratio (ratios) or _by_error (max_error),
  *             not following the skeleton levels: a mesh level's joints are
- *             the full skin's, and a skeleton level's palette (PALJ, PALB)
+ *             the full skin's, and a skeleton level's palette (its joints and binds)
  *             does the transfer at run time
  *   motion    the "<clip>@lod<k>" animations with a motion level record;
  *             else per clip and bound the frames and the keys methods of

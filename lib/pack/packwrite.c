@@ -317,6 +317,23 @@ nomem:
  * container is at most the raw size (the reader's bound). Deterministic:
  * one-shot compression, one thread, the frame with its content size. */
 #define PACK_ZSTD_LEVEL 19
+/* chunk_stream_choice compares a stream's forms by their zstd frames at
+ * this level (level 19 there costs 4 times the instructions for 0.1-0.6%
+ * of the four inputs' bytes, bench/RESULTS.md), on at most
+ * PACK_CHOICE_SAMPLE of its bytes (whole elements from its first). */
+#ifndef PACK_CHOICE_LEVEL
+#define PACK_CHOICE_LEVEL 12
+#endif
+#ifndef PACK_CHOICE_SAMPLE
+#define PACK_CHOICE_SAMPLE ((size_t)1 << 14)
+#endif
+/* The block run's threshold (zstd_frame): a zstd block ends at a stream's
+ * end once this many container bytes are pending (chunk_entropy compares
+ * both runs at PACK_ZSTD_TRIAL_LEVEL). */
+#ifndef PACK_ZSTD_FLUSH
+#define PACK_ZSTD_FLUSH 512
+#endif
+#define PACK_ZSTD_TRIAL_LEVEL 3
 /* Draco's speed option (0 smallest .. 10 fastest), for encoding and decoding. */
 #ifndef MLOD_PACK_DRACO_SPEED
 #define MLOD_PACK_DRACO_SPEED 0
@@ -327,55 +344,266 @@ nomem:
  * container. The frame coded on it
  * (MLOD_ENTROPY_ZSTD_PREFIX) is kept where it is smaller than the frame
  * coded alone (ties keep the frame alone, which needs nothing). */
+/* One zstd frame of the container d (n bytes) at the pack's level, with
+ * its content size, into out (cap bytes): on prefix when prefix_size > 0.
+ * With flush > 0, a zstd block ends at the end of each stream that ends
+ * at least flush bytes after the last block's end (each block has its
+ * own literal and sequence statistics: a stream's own may code it in
+ * fewer bytes than those of a block mixing it with others). */
+static size_t zstd_frame(ZSTD_CCtx *cc, int level, uint8_t *out, size_t cap, const uint8_t *d, size_t n,
+                         const uint8_t *prefix, size_t prefix_size, size_t flush)
+{
+	ZSTD_CCtx_reset(cc, ZSTD_reset_session_and_parameters);
+	size_t z = ZSTD_CCtx_setParameter(cc, ZSTD_c_compressionLevel, level);
+	if (!ZSTD_isError(z))
+		z = ZSTD_CCtx_setPledgedSrcSize(cc, n);
+	if (!ZSTD_isError(z) && prefix_size)
+		z = ZSTD_CCtx_refPrefix(cc, prefix, prefix_size);
+	if (ZSTD_isError(z))
+		return z;
+	if (!flush || n < 4)
+		return ZSTD_compress2(cc, out, cap, d, n);
+	uint32_t ns = (uint32_t)d[0] | (uint32_t)d[1] << 8 | (uint32_t)d[2] << 16 | (uint32_t)d[3] << 24;
+	ZSTD_outBuffer o = {out, cap, 0};
+	size_t from = 0, to = 4 + 16 * (size_t)ns;
+	for (uint32_t i = 0; i <= ns; i++) {
+		if (i < ns) {
+			const uint8_t *h = d + 4 + 16 * (size_t)i;
+			to += (((size_t)h[12] | (size_t)h[13] << 8 | (size_t)h[14] << 16 | (size_t)h[15] << 24) + 3) & ~(size_t)3;
+		}
+		if (to > n)
+			to = n;
+		if (i < ns && to - from < flush)
+			continue;
+		ZSTD_inBuffer in = {d + from, to - from, 0};
+		ZSTD_EndDirective how = i == ns ? ZSTD_e_end : ZSTD_e_flush;
+		do {
+			z = ZSTD_compressStream2(cc, &o, &in, how);
+			if (ZSTD_isError(z))
+				return z;
+		} while (z != 0 || in.pos < in.size);
+		from = to;
+	}
+	return o.pos;
+}
+
 static mlod_result chunk_entropy(chunk *c, const uint8_t *prefix, size_t prefix_size, mlod_error *err)
 {
 	if (c->type == MLOD_CHUNK_INFO || c->size < 4 || c->size > c->raw)
 		return MLOD_OK;
-	size_t cap = ZSTD_compressBound(c->size);
-	uint8_t *z = malloc(cap), *zp = NULL;
-	if (!z)
-		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
-	size_t n = ZSTD_compress(z, cap, c->data, c->size, PACK_ZSTD_LEVEL), np = 0;
-	if (ZSTD_isError(n)) {
-		free(z);
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd: %s", ZSTD_getErrorName(n));
+	size_t cap = ZSTD_compressBound(c->size), n = c->size;
+	uint8_t *z = malloc(cap), *zt = malloc(cap);
+	ZSTD_CCtx *cc = ZSTD_createCCtx();
+	mlod_result r = MLOD_OK;
+	if (!z || !zt || !cc) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+		goto done;
 	}
-	if (prefix_size && prefix_size <= MLOD_PACK_MAX_PREFIX) {
-		ZSTD_CCtx *cc = ZSTD_createCCtx();
-		if (!cc || !(zp = malloc(cap))) {
-			ZSTD_freeCCtx(cc);
-			free(z);
-			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
-		}
-		np = ZSTD_CCtx_setParameter(cc, ZSTD_c_compressionLevel, PACK_ZSTD_LEVEL);
-		if (!ZSTD_isError(np))
-			np = ZSTD_CCtx_refPrefix(cc, prefix, prefix_size);
-		if (!ZSTD_isError(np))
-			np = ZSTD_compress2(cc, zp, cap, c->data, c->size);
-		ZSTD_freeCCtx(cc);
-		if (ZSTD_isError(np)) {
-			free(z);
-			free(zp);
-			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd with a prefix: %s", ZSTD_getErrorName(np));
-		}
-		if (np < n) {
-			free(z);
-			z = zp, n = np, zp = NULL;
-		} else {
-			np = 0;
-		}
-		free(zp);
+	/* The block run (one as zstd splits them, or a block per stream run of
+	 * PACK_ZSTD_FLUSH bytes) that codes the container alone smaller at
+	 * PACK_ZSTD_TRIAL_LEVEL; then one frame at the pack's level with it:
+	 * on the prefix where there is one, else alone. */
+	int has_prefix = prefix_size && prefix_size <= MLOD_PACK_MAX_PREFIX;
+	size_t t0 = zstd_frame(cc, PACK_ZSTD_TRIAL_LEVEL, zt, cap, c->data, c->size, NULL, 0, 0);
+	size_t t1 = ZSTD_isError(t0) ? t0 : zstd_frame(cc, PACK_ZSTD_TRIAL_LEVEL, zt, cap, c->data, c->size, NULL, 0,
+	                                               PACK_ZSTD_FLUSH);
+	size_t t = ZSTD_isError(t1) ? t1
+	                            : zstd_frame(cc, PACK_ZSTD_LEVEL, z, cap, c->data, c->size, has_prefix ? prefix : NULL,
+	                                         has_prefix ? prefix_size : 0, t1 < t0 ? PACK_ZSTD_FLUSH : 0);
+	if (ZSTD_isError(t)) {
+		r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "zstd%s: %s", has_prefix ? " with a prefix" : "",
+		              ZSTD_getErrorName(t));
+		goto done;
 	}
-	if (n >= c->size) {
-		free(z);
+	n = t < n ? t : n;
+	int with_prefix = has_prefix;
+	if (n < c->size) {
+		free(c->data);
+		c->coded = (uint32_t)c->size;
+		c->data = z;
+		c->size = n;
+		c->entropy = with_prefix ? MLOD_ENTROPY_ZSTD_PREFIX : MLOD_ENTROPY_ZSTD;
+		z = NULL;
+	}
+done:
+	free(z);
+	free(zt);
+	ZSTD_freeCCtx(cc);
+	return r;
+}
+
+/* The bytes of d's zstd frame alone at PACK_CHOICE_LEVEL, at most n (the
+ * estimate chunk_stream_choice compares forms by). cc: a reused context;
+ * scratch grows to the bound. 0 when zstd fails or out of memory. */
+static size_t zstd_bytes(ZSTD_CCtx *cc, uint8_t **scratch, size_t *cap, const uint8_t *d, size_t n)
+{
+	size_t need = ZSTD_compressBound(n);
+	if (need > *cap) {
+		uint8_t *p = realloc(*scratch, need);
+		if (!p)
+			return 0;
+		*scratch = p, *cap = need;
+	}
+	size_t z = ZSTD_compressCCtx(cc, *scratch, *cap, d, n, PACK_CHOICE_LEVEL);
+	return ZSTD_isError(z) ? 0 : z < n ? z : n;
+}
+
+/* Byte planes (MLOD_SCODEC_PLANES, _DELTA; format 7.0) of n elements of
+ * e bytes: byte j of element k at j * n + k, with delta each minus the
+ * same byte of element k - 1. */
+static void to_planes(const uint8_t *src, size_t n, size_t e, int delta, uint8_t *out)
+{
+	for (size_t j = 0; j < e; j++)
+		for (size_t k = 0; k < n; k++)
+			out[j * n + k] = (uint8_t)(src[k * e + j] - (delta && k ? src[(k - 1) * e + j] : 0));
+}
+
+/* The stream codecs by the entropy stage's bytes: cb_finish codes a
+ * stream with meshopt wherever that is smaller than the raw bytes, but
+ * zstd after it may store the raw bytes in fewer (unorm8 joints and
+ * weights, whose meshopt deltas look random to it), or the bytes in
+ * planes (format 7.0: UVs, normals, positions), or weights without their
+ * sums. Per stream of a meshopt chunk but index buffers, the form whose
+ * zstd frame alone (PACK_CHOICE_LEVEL, on the first PACK_CHOICE_SAMPLE
+ * bytes) is the smallest: as cb_finish made it, raw, in byte planes, in
+ * planes of deltas, or (elements of 4 bytes each summing to 255) without
+ * their sums (ties in that order). The decoded values are the same. */
+static mlod_result chunk_stream_choice(chunk *c, mlod_error *err)
+{
+	if (c->type == MLOD_CHUNK_INFO || c->codec != MLOD_CODEC_MESHOPT || c->size < 4)
 		return MLOD_OK;
+	uint32_t ns = (uint32_t)c->data[0] | (uint32_t)c->data[1] << 8 | (uint32_t)c->data[2] << 16 |
+	              (uint32_t)c->data[3] << 24;
+	mlod_result r = MLOD_OK;
+	size_t cap = 0;
+	uint8_t *scratch = NULL, *raw = NULL, *form = NULL;
+	uint8_t **pick = calloc((size_t)ns + 1, sizeof *pick); /* the chosen form's bytes, NULL: as it is */
+	uint8_t *pick_codec = calloc((size_t)ns + 1, 1);
+	size_t *pick_size = calloc((size_t)ns + 1, sizeof *pick_size);
+	ZSTD_CCtx *cc = ZSTD_createCCtx();
+	buf b = {0};
+	if (!pick || !pick_codec || !pick_size || !cc)
+		goto nomem;
+	for (uint32_t i = 0, at = 4 + 16 * ns; i < ns; i++) {
+		const uint8_t *h = c->data + 4 + 16 * (size_t)i;
+		uint8_t scodec = h[10];
+		uint32_t count = (uint32_t)h[4] | (uint32_t)h[5] << 8 | (uint32_t)h[6] << 16 | (uint32_t)h[7] << 24;
+		size_t el = (size_t)h[8] | (size_t)h[9] << 8, bytes = (size_t)count * el;
+		size_t stored = (size_t)h[12] | (size_t)h[13] << 8 | (size_t)h[14] << 16 | (size_t)h[15] << 24;
+		const uint8_t *src = c->data + at;
+		at += (uint32_t)((stored + 3) & ~(size_t)3);
+		pick_codec[i] = scodec;
+		/* index buffers stay with meshopt's index codec (raw or planes
+		 * of them never came near it) */
+		if (!count || scodec == MLOD_SCODEC_MESHOPT_INDEX)
+			continue;
+		if (!(raw = malloc(bytes)) || !(form = malloc(bytes)))
+			goto nomem;
+		int rc = scodec == MLOD_SCODEC_RAW                ? (memcpy(raw, src, bytes), 0)
+		         : scodec == MLOD_SCODEC_MESHOPT_VERTEX   ? meshopt_decodeVertexBuffer(raw, count, el, src, stored)
+		         : scodec == MLOD_SCODEC_MESHOPT_SEQUENCE ? meshopt_decodeIndexSequence(raw, count, el, src, stored)
+		                                                  : meshopt_decodeIndexBuffer(raw, count, el, src, stored);
+		if (rc != 0) { /* never: the writer's own coding */
+			r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "meshopt decode of the writer's own stream failed (%d)", rc);
+			goto done;
+		}
+		int sums = el == 4; /* every element's bytes sum to 255 (unorm8 weights) */
+		for (size_t k = 0; sums && k < count; k++)
+			sums = raw[4 * k] + raw[4 * k + 1] + raw[4 * k + 2] + raw[4 * k + 3] == 255;
+		/* The forms compared on the stream's first PACK_CHOICE_SAMPLE bytes
+		 * of elements (the whole of a sequence-coded one), the codec's form
+		 * coded again on them. */
+		uint32_t en = scodec == MLOD_SCODEC_MESHOPT_SEQUENCE || bytes <= PACK_CHOICE_SAMPLE
+		                      ? count
+		                      : (uint32_t)(PACK_CHOICE_SAMPLE / el > 0 ? PACK_CHOICE_SAMPLE / el : 1);
+		size_t best;
+		if (en == count) {
+			best = zstd_bytes(cc, &scratch, &cap, src, stored);
+		} else if (scodec == MLOD_SCODEC_MESHOPT_VERTEX) {
+			size_t bound = meshopt_encodeVertexBufferBound(en, el);
+			uint8_t *sub = malloc(bound);
+			if (!sub)
+				goto nomem;
+			size_t sn = meshopt_encodeVertexBuffer(sub, bound, raw, en, el);
+			best = sn ? zstd_bytes(cc, &scratch, &cap, sub, sn) : 0;
+			free(sub);
+		} else {
+			best = zstd_bytes(cc, &scratch, &cap, raw, (size_t)en * el);
+		}
+		for (int f = 0; best && f < 4; f++) {
+			static const uint8_t codecs[4] = {MLOD_SCODEC_RAW, MLOD_SCODEC_PLANES, MLOD_SCODEC_PLANES_DELTA,
+			                                  MLOD_SCODEC_SUM255};
+			uint8_t codec = codecs[f];
+			size_t fb = f == 3 ? 3 * (size_t)count : bytes;
+			if ((f == 0 && scodec == MLOD_SCODEC_RAW) || (f == 1 && el == 1) || (f == 3 && !sums))
+				continue;
+			size_t z = 0;
+			for (int whole = en == count; whole < 2; whole++) { /* the sample, then the stream */
+				uint32_t m = whole ? count : en;
+				if (f == 0)
+					memcpy(form, raw, (size_t)m * el);
+				else if (f == 3)
+					for (size_t k = 0; k < m; k++)
+						memcpy(form + 3 * k, raw + 4 * k, 3);
+				else
+					to_planes(raw, m, el, f == 2, form);
+				if (!whole)
+					z = zstd_bytes(cc, &scratch, &cap, form, f == 3 ? 3 * (size_t)m : (size_t)m * el);
+				else if (en == count)
+					z = zstd_bytes(cc, &scratch, &cap, form, fb);
+				if (!whole && !(z && z < best))
+					break; /* the sample lost: no whole form */
+			}
+			if (z && z < best) {
+				best = z;
+				free(pick[i]);
+				pick[i] = form, pick_codec[i] = codec, pick_size[i] = fb;
+				if (!(form = malloc(bytes)))
+					goto nomem;
+			}
+		}
+		free(raw), free(form);
+		raw = form = NULL;
 	}
-	free(c->data);
-	c->coded = (uint32_t)c->size;
-	c->data = z;
-	c->size = n;
-	c->entropy = np ? MLOD_ENTROPY_ZSTD_PREFIX : MLOD_ENTROPY_ZSTD;
-	return MLOD_OK;
+	/* the container with the chosen forms */
+	buf_put(&b, c->data, 4 + 16 * (size_t)ns);
+	for (uint32_t i = 0, at = 4 + 16 * ns; i < ns; i++) {
+		uint8_t *h = c->data + 4 + 16 * (size_t)i;
+		size_t stored = (size_t)h[12] | (size_t)h[13] << 8 | (size_t)h[14] << 16 | (size_t)h[15] << 24;
+		if (pick[i]) {
+			buf_put(&b, pick[i], pick_size[i]);
+			if (!b.fail) {
+				b.p[4 + 16 * (size_t)i + 10] = pick_codec[i];
+				put_u32(b.p + 4 + 16 * (size_t)i + 12, (uint32_t)pick_size[i]);
+			}
+		} else {
+			buf_put(&b, c->data + at, stored);
+		}
+		buf_pad(&b, 4);
+		at += (uint32_t)((stored + 3) & ~(size_t)3);
+	}
+	if (b.fail)
+		goto nomem;
+	if (b.n <= c->raw) { /* always: no form is larger than the raw bytes */
+		free(c->data);
+		c->data = b.p, c->size = b.n;
+		b.p = NULL;
+	}
+	goto done;
+nomem:
+	r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
+done:
+	for (uint32_t i = 0; pick && i < ns; i++)
+		free(pick[i]);
+	free(pick);
+	free(pick_codec);
+	free(pick_size);
+	free(raw);
+	free(form);
+	free(scratch);
+	free(b.p);
+	ZSTD_freeCCtx(cc);
+	return r;
 }
 
 /* A string table. */
@@ -779,7 +1007,8 @@ done:
 	return r;
 }
 
-/* Skeleton level k (1-based): KEPT, and the palette as fold.c's skin
+/* Skeleton level k (1-based): KEPT, and the palette binds (as PALR and
+ * PALX, format 7.0; the palette joints the reader derives) as fold.c's skin
  * transfer makes it (reduce_skin): a kept skin joint keeps its bind; a
  * removed one uses its stand-in's entry in the level skin: the stand-in's
  * own bind when the skin has it, else R(stand-in -> joint) * IBM(joint)
@@ -797,13 +1026,16 @@ static mlod_result skel_level_chunk(struct ctx *x, int k, chunks *out)
 		maxsk = s->skins[i].joint_count > maxsk ? s->skins[i].joint_count : maxsk;
 	}
 	uint32_t *keptv = malloc(sizeof(uint32_t) * ((size_t)n + 1)), kc = 0;
-	uint32_t *palj = malloc(sizeof(uint32_t) * (pal + 1));
+	uint32_t *palr = malloc(sizeof(uint32_t) * (pal + 1));
 	float *palb = malloc(sizeof(float) * 16 * (pal + 1));
+	float *palx = malloc(sizeof(float) * 16 * (pal + 1));
+	float *ibmf = malloc(sizeof(float) * 16 * (pal + 1)); /* SKELETON's 'IBMS' */
+	size_t nx = 0;
 	int *lj = malloc(sizeof(int) * ((size_t)maxsk + 1));          /* the level skin's joints */
 	mlod_mat4 *lb = malloc(sizeof(mlod_mat4) * ((size_t)maxsk + 1)); /* and binds */
 	chunkb cb = {0};
 	mlod_result r = MLOD_OK;
-	if (!keptv || !palj || !palb || !lj || !lb) {
+	if (!keptv || !palr || !palb || !palx || !ibmf || !lj || !lb) {
 		r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
@@ -821,10 +1053,8 @@ static mlod_result skel_level_chunk(struct ctx *x, int k, chunks *out)
 		for (int q = 0; q < sk->joint_count; q++, e++) {
 			int j = sk->joints[q];
 			mlod_mat4 bind = sk->inverse_bind[q];
-			int pj = j;
-			if (!kept[j]) {
+			if (!kept[j]) { /* its palette joint, the stand-in, the reader derives */
 				int stand = remap[j], at = -1;
-				pj = stand;
 				for (int t = 0; t < ln; t++)
 					if (lj[t] == stand)
 						at = t;
@@ -842,20 +1072,45 @@ static mlod_result skel_level_chunk(struct ctx *x, int k, chunks *out)
 				}
 				bind = lb[at];
 			}
-			palj[e] = (uint32_t)pj;
 			memcpy(palb + 16 * e, bind.m, 64);
+			memcpy(ibmf + 16 * e, sk->inverse_bind[q].m, 64);
 		}
 	}
+	/* Format 7.0: each bind matrix as a reference (palr, mlod(5)): 0 for
+	 * the joint's own IBMS entry, 1 + the first IBMS entry over all skins
+	 * that holds the same bytes, else P + 1 + its index in PALX (each
+	 * matrix once, in first-use order). */
+	for (size_t i = 0, xe = 0, g = 0; i < pal; i++) {
+		const float *m = palb + 16 * i;
+		if (memcmp(m, ibmf + 16 * i, 64) == 0) {
+			palr[i] = 0;
+			continue;
+		}
+		for (g = 0; g < pal && memcmp(m, ibmf + 16 * g, 64) != 0; g++)
+			;
+		if (g < pal) {
+			palr[i] = (uint32_t)(g + 1);
+			continue;
+		}
+		for (g = 0; g < xe && memcmp(m, palx + 16 * g, 64) != 0; g++)
+			;
+		if (g == xe)
+			memcpy(palx + 16 * xe++, m, 64);
+		palr[i] = (uint32_t)(pal + 1 + g);
+		nx = xe;
+	}
 	cb_add(&cb, MLOD_STREAM_KEPT, kc, 4, keptv, 0);
-	cb_add(&cb, MLOD_STREAM_PALJ, (uint32_t)pal, 4, palj, 0);
-	cb_add(&cb, MLOD_STREAM_PALB, (uint32_t)pal, 64, palb, 0);
+	cb_add(&cb, MLOD_STREAM_PALR, (uint32_t)pal, 4, palr, 0);
+	cb_add(&cb, MLOD_STREAM_PALX, (uint32_t)nx, 64, palx, 0);
 	r = cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_SKELETON, MLOD_LAYER_SKELETON, k, 0, x->skel_error[k - 1],
 	              x->err);
 done:
 	cb_free(&cb);
 	free(keptv);
-	free(palj);
+	free(palr);
 	free(palb);
+	free(palx);
+	free(ibmf);
 	free(lj);
 	free(lb);
 	return r;
@@ -3178,6 +3433,11 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		if ((r = cb_finish(&cb, MLOD_CODEC_NONE, &body, MLOD_CHUNK_DOC, MLOD_LAYER_NONE, 0, 0, 0.0f, err)) != MLOD_OK)
 			goto done;
 	}
+
+	/* The stream codecs by the entropy stage's bytes. */
+	for (int i = 0; opt->entropy == MLOD_ENTROPY_ZSTD && i < body.n; i++)
+		if ((r = chunk_stream_choice(&body.c[i], err)) != MLOD_OK)
+			goto done;
 
 	/* The entropy stage, after every choice above was made on the codec's
 	 * bytes (INFO has none: its size must not depend on the offsets). */

@@ -448,6 +448,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	mlod_result r = mlod_pack_open(data, size, &p, err);
 	if (r != MLOD_OK)
 		return r;
+	if ((r = mlod_pack_check_padding(&p, data, size, err)) != MLOD_OK)
+		goto done;
 	if ((r = mlod_pack_decode_info(&p, data, size, &info, err)) != MLOD_OK)
 		goto done;
 	if (mlod_pack_find(&p, MLOD_CHUNK_SKELETON, 0, 0) >= 0) {

@@ -9,7 +9,7 @@
  * and never prints or exits.
  *
  * ------------------------------------------------------------------
- * File layout (format 6.0). Everything is little-endian.
+ * File layout (format 7.0). Everything is little-endian.
  *
  *   header      32 bytes at offset 0
  *   TOC         chunk_count entries of 48 bytes, right after the header
@@ -21,7 +21,9 @@
  *   4  u16    major version (MLOD_PACK_MAJOR); a reader refuses a newer one,
  *             and one older than MLOD_PACK_MAJOR_OLDEST (1.x: MESH layout
  *             a, no decode path); 2.x is 3.x without MLOD_PART_LOCAL,
- *             the sequence codec and 'TBIT'
+ *             the sequence codec and 'TBIT'; 2.x to 6.x store a
+ *             skeleton level's palette as 'PALJ' and 'PALB' (7.0:
+ *             'PALR' and 'PALX')
  *   6  u16    minor version; a newer minor only adds what older readers skip
  *   8  u32    flags (0; a reader ignores bits it does not know)
  *  12  u32    chunk_count (at most MLOD_PACK_MAX_CHUNKS)
@@ -71,11 +73,13 @@
  *     4 u32  element count
  *     8 u16  element size in bytes (1..256; a multiple of 4 for the meshopt
  *            vertex codec, 2 or 4 for the index and sequence codecs)
- *    10 u8   stream codec (MLOD_SCODEC_*)
+ *    10 u8   stream codec (MLOD_SCODEC_*; 4 and 5, byte planes, and 6,
+ *            sums to 255, format 7.0)
  *    11 u8   reserved (0)
  *    12 u32  stored byte size
  *   then the streams' bytes in order, each padded with zeros to 4 bytes.
- * A stream's decoded size is count * element size. raw size in the TOC is
+ * A stream's decoded size is count * element size, which a raw stream and
+ * one in byte planes store. raw size in the TOC is
  * 4 + 16 * stream_count + the decoded sizes, each padded to 4.
  *
  * The chunk types and their streams, in this order:
@@ -96,18 +100,29 @@
  *          keeps (every root is kept). A kept joint's parent at this level
  *          is its nearest kept ancestor; its local transform folds the
  *          removed joints between them (mlod(5), SKELETON LEVELS).
- *   'PALJ' u32 per skin joint (all skins in order, as 'SKJT'): the kept
- *          joint (full index) whose world matrix a vertex weighted to that
- *          skin joint follows at this level (the joint itself when kept,
- *          else its stand-in, the nearest kept ancestor)
- *   'PALB' 16 f32 per skin joint: the bind matrix to use with it (the
- *          joint's own inverse bind when kept; else the stand-in's, or
- *          R(stand-in -> joint) * IBM(joint) when the stand-in is not in
- *          that skin), so that skinning with (PALJ, PALB) equals skinning
- *          the level's transferred weights. (Writer's note: when several
- *          removed joints of one skin share a stand-in that skin lacks,
- *          all take the R * IBM of the first of them in skin order, as
- *          fold.c's skin transfer does; R is in the rest pose.)
+ *   'PALR' u32 per skin joint (all skins in order, as 'SKJT'; format
+ *          7.0): where the bind matrix to use with it comes from: 0 the
+ *          joint's own 'IBMS' entry; v in 1..P (P: the skin joints of all
+ *          skins) 'IBMS' entry v - 1, all skins in order; v > P 'PALX'
+ *          matrix v - P - 1
+ *   'PALX' 16 f32 per matrix (at most P; format 7.0): the bind matrices
+ *          no 'IBMS' entry holds
+ *   The decoded palette (mlod_pack_skel_level): per skin joint, the kept
+ *   joint (full index) whose world matrix a vertex weighted to it follows
+ *   at this level (the joint itself when kept, else its stand-in, the
+ *   nearest kept ancestor: the reader derives it), and the bind matrix
+ *   'PALR' names (the joint's own inverse bind when kept; else the
+ *   stand-in's, or R(stand-in -> joint) * IBM(joint) when the stand-in is
+ *   not in that skin), so that skinning with that palette equals skinning
+ *   the level's transferred weights. (Writer's notes: when several
+ *   removed joints of one skin share a stand-in that skin lacks, all take
+ *   the R * IBM of the first of them in skin order, as fold.c's skin
+ *   transfer does; R is in the rest pose. 'PALR' is 0 wherever the matrix
+ *   has the bytes of the joint's own 'IBMS' entry, else the first entry
+ *   that has them, else a 'PALX' matrix, each once in first-use order.)
+ *   Formats 2.0 to 6.0 stored instead 'PALJ', u32 per skin joint: the
+ *   stand-in (or the joint; the reader checks it is the nearest kept
+ *   ancestor), then 'PALB', 16 f32 per skin joint: the bind matrices.
  *
  * MESH level k (layer mesh; level 0 is the input's meshes): one part per
  *   instance and triangle primitive, in instance then primitive order, the
@@ -274,7 +289,7 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 6
+#define MLOD_PACK_MAJOR 7
 #define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32
@@ -335,6 +350,16 @@ typedef enum mlod_pack_codec {
 #define MLOD_SCODEC_MESHOPT_VERTEX 1 /* meshopt_decodeVertexBuffer */
 #define MLOD_SCODEC_MESHOPT_INDEX 2  /* meshopt_decodeIndexBuffer */
 #define MLOD_SCODEC_MESHOPT_SEQUENCE 3 /* meshopt_decodeIndexSequence (format 3.0) */
+/* Format 7.0: the decoded bytes in byte planes (count * element size bytes
+ * stored, as raw): byte j of element k stored at j * count + k; with
+ * DELTA, each stored byte is that byte minus the same byte of element
+ * k - 1 (0 for k = 0), modulo 256. For the entropy stage after it. */
+#define MLOD_SCODEC_PLANES 4
+#define MLOD_SCODEC_PLANES_DELTA 5
+/* Format 7.0: elements of 4 bytes whose bytes sum to 255 (unorm8 weights),
+ * each stored as its first three bytes (count * 3 bytes); the reader
+ * rebuilds the fourth as 255 minus their sum. */
+#define MLOD_SCODEC_SUM255 6
 
 /* Stream tags. */
 #define MLOD_STREAM_INFO MLOD_FOURCC('I', 'N', 'F', 'O')
@@ -346,6 +371,8 @@ typedef enum mlod_pack_codec {
 #define MLOD_STREAM_KEPT MLOD_FOURCC('K', 'E', 'P', 'T')
 #define MLOD_STREAM_PALJ MLOD_FOURCC('P', 'A', 'L', 'J')
 #define MLOD_STREAM_PALB MLOD_FOURCC('P', 'A', 'L', 'B')
+#define MLOD_STREAM_PALR MLOD_FOURCC('P', 'A', 'L', 'R') /* format 7.0 */
+#define MLOD_STREAM_PALX MLOD_FOURCC('P', 'A', 'L', 'X') /* format 7.0 */
 #define MLOD_STREAM_PART MLOD_FOURCC('P', 'A', 'R', 'T')
 #define MLOD_STREAM_POSQ MLOD_FOURCC('P', 'O', 'S', 'Q')
 #define MLOD_STREAM_NRMQ MLOD_FOURCC('N', 'R', 'M', 'Q')
@@ -685,6 +712,11 @@ void mlod_pack_doc_free(mlod_pack_doc_bytes *x);
  * releases it: MLOD_OK when all decode, else the first failure, whose
  * message names the chunk. mlod-pack --info runs it before listing. */
 mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, mlod_error *err);
+/* The zero padding before each chunk, which no CRC covers (data: the
+ * whole file, or a prefix: the bytes it holds): MLOD_ERR_PARSE naming the
+ * chunk after a byte that is not zero. mlod_pack_check runs it first;
+ * mlod-pack -x too. */
+mlod_result mlod_pack_check_padding(const mlod_pack *p, const void *data, size_t size, mlod_error *err);
 
 void mlod_pack_info_free(mlod_pack_info *x);
 void mlod_pack_skeleton_free(mlod_pack_skeleton *x);

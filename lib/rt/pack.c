@@ -599,6 +599,7 @@ typedef struct cx {
 	uint8_t *temp;        /* aux bytes, then the decode buffer */
 	uint64_t aux;
 	mlod_pack_alloc alloc; /* the pack's */
+	uint16_t major;       /* the pack's format */
 } cx;
 
 /* Checks the chunk's TOC entry (index, type, codec). */
@@ -609,6 +610,7 @@ static mlod_result cx_head(const mlod_pack *p, uint32_t index, uint32_t type, cx
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "pack decode: chunk %u does not exist (the pack has %u)", index,
 		                 p->chunk_count);
 	const mlod_pack_chunk *c = &p->chunks[index];
+	x->major = p->major;
 	x->c = c;
 	x->alloc = p->alloc;
 	x->zd = p->zstd;
@@ -769,12 +771,26 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 		if (elsize < 1 || elsize > 256)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': element size %u is not 1 to 256", x->label, i,
 			                 tagn(tag).s, elsize);
-		if (codec > MLOD_SCODEC_MESHOPT_SEQUENCE)
+		if (codec > MLOD_SCODEC_SUM255)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': unknown stream codec %u", x->label, i,
 			                 tagn(tag).s, codec);
+		if (codec >= MLOD_SCODEC_PLANES && x->major < 7)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': stream codec %u in a %u.x pack (format 7.0 added it)", x->label, i,
+			                 tagn(tag).s, codec, x->major);
 		if (codec != MLOD_SCODEC_RAW && c->codec == MLOD_CODEC_NONE)
-			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s' is meshopt-coded in a chunk of codec none",
-			                 x->label, i, tagn(tag).s);
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s' is %s in a chunk of codec none", x->label, i,
+			                 tagn(tag).s,
+			                 codec == MLOD_SCODEC_SUM255 ? "stored without its sums"
+			                 : codec >= MLOD_SCODEC_PLANES ? "in byte planes"
+			                                               : "meshopt-coded");
+		if (codec == MLOD_SCODEC_SUM255 && elsize != 4)
+			return mlod_fail(err, MLOD_ERR_PARSE,
+			                 "%s: stream %u '%s': the sum codec needs an element size of 4, not %u", x->label, i,
+			                 tagn(tag).s, elsize);
+		if (codec == MLOD_SCODEC_SUM255 && stored != 3 * (uint64_t)count)
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': %u bytes stored for %u elements of 3 bytes",
+			                 x->label, i, tagn(tag).s, stored, count);
 		if (codec == MLOD_SCODEC_MESHOPT_VERTEX && elsize % 4 != 0)
 			return mlod_fail(err, MLOD_ERR_PARSE,
 			                 "%s: stream %u '%s': the meshopt vertex codec needs an element size that is a multiple of "
@@ -797,7 +813,8 @@ static mlod_result cx_container(cx *x, mlod_error *err)
 			return mlod_fail(err, MLOD_ERR_PARSE,
 			                 "%s: stream %u '%s': %u meshopt-coded bytes cannot hold %u elements of %u bytes",
 			                 x->label, i, tagn(tag).s, stored, count, elsize);
-		if (codec == MLOD_SCODEC_RAW && stored != decoded)
+		if ((codec == MLOD_SCODEC_RAW || codec == MLOD_SCODEC_PLANES || codec == MLOD_SCODEC_PLANES_DELTA) &&
+		    stored != decoded)
 			return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': %u bytes stored for %u elements of %u bytes",
 			                 x->label, i, tagn(tag).s, stored, count, elsize);
 		if (pad4(stored) > csize - cursor)
@@ -992,6 +1009,32 @@ static mlod_result cx_load_into(cx *x, const stream *s, uint8_t *dst, mlod_error
 	if (s->codec == MLOD_SCODEC_RAW) {
 		if (s->count)
 			memcpy(dst, s->src, (size_t)s->count * s->elsize);
+		return MLOD_OK;
+	}
+	if (s->codec == MLOD_SCODEC_SUM255) { /* elsize 4, stored == count * 3 (cx_container) */
+		for (size_t k = 0; k < s->count; k++) {
+			const uint8_t *e = s->src + 3 * k;
+			unsigned sum = (unsigned)e[0] + e[1] + e[2];
+			if (sum > 255)
+				return mlod_fail(err, MLOD_ERR_PARSE, "%s: stream %u '%s': element %zu: its three bytes sum to %u, "
+				                 "more than 255", x->label, s->index, tagn(s->tag).s, k, sum);
+			memcpy(dst + 4 * k, e, 3);
+			dst[4 * k + 3] = (uint8_t)(255 - sum);
+		}
+		return MLOD_OK;
+	}
+	if (s->codec >= MLOD_SCODEC_PLANES) { /* stored == count * elsize (cx_container) */
+		size_t n = s->count, e = s->elsize;
+		for (size_t j = 0; j < e; j++) {
+			const uint8_t *plane = s->src + j * n;
+			uint8_t acc = 0;
+			if (s->codec == MLOD_SCODEC_PLANES_DELTA)
+				for (size_t k = 0; k < n; k++)
+					dst[k * e + j] = acc = (uint8_t)(acc + plane[k]);
+			else
+				for (size_t k = 0; k < n; k++)
+					dst[k * e + j] = plane[k];
+		}
 		return MLOD_OK;
 	}
 	int rc = s->codec == MLOD_SCODEC_MESHOPT_VERTEX
@@ -1352,6 +1395,7 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	bump b = {0};
 	stream sk, sj, sb;
 	const uint8_t *src;
+	int refs = p->major >= 7; /* 'PALR' and 'PALX'; 'PALJ' derived (format 7.0) */
 	mlod_result r = cx_begin_skel_level(p, chunk, data, size, &x, err);
 	if (r != MLOD_OK)
 		return r;
@@ -1362,16 +1406,27 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	for (uint32_t k = 0; k < skel->skin_count; k++)
 		P += skel->skins[k].joint_count;
 	TRY(cx_expect(&x, &sk, MLOD_STREAM_KEPT, 4, UINT64_MAX, "", "", err));
-	TRY(cx_expect(&x, &sj, MLOD_STREAM_PALJ, 4, P, "", "the skins' joints", err));
-	TRY(cx_expect(&x, &sb, MLOD_STREAM_PALB, 64, P, "", "the skins' joints", err));
+	if (refs) {
+		TRY(cx_expect(&x, &sj, MLOD_STREAM_PALR, 4, P, "", "the skins' joints", err));
+		TRY(cx_expect(&x, &sb, MLOD_STREAM_PALX, 64, UINT64_MAX, "", "", err));
+		if (sb.count > P)
+			FAIL("%s: %u bind matrices in 'PALX', more than the %llu skin joints", x.label, sb.count,
+			     (unsigned long long)P);
+	} else {
+		TRY(cx_expect(&x, &sj, MLOD_STREAM_PALJ, 4, P, "", "the skins' joints", err));
+		TRY(cx_expect(&x, &sb, MLOD_STREAM_PALB, 64, P, "", "the skins' joints", err));
+	}
 	TRY(cx_end(&x, err));
 	uint64_t Kc = sk.count;
 	if (Kc > J)
 		FAIL("%s: %llu kept joints of a skeleton of %llu", x.label, (unsigned long long)Kc, (unsigned long long)J);
-	/* aux: each joint's nearest kept ancestor (or itself). */
-	TRY(cx_temp(&x, J * 4, err));
+	/* aux: each joint's nearest kept ancestor (or itself); from 7.0 also
+	 * 'PALR' and each skin joint's 'IBMS' entry. */
+	TRY(cx_temp(&x, refs ? round8(J * 4) + round8(P * 4) + P * sizeof(float *) : J * 4, err));
 	TRY(bump_alloc(&b, &x, round8(Kc * 4) + round8(P * 4) + round8(P * 64), err));
 	uint32_t *kept, *palj, *nearest = (uint32_t *)x.temp;
+	uint32_t *palr = refs ? (uint32_t *)(x.temp + round8(J * 4)) : NULL;
+	const float **ibm = refs ? (const float **)(void *)(x.temp + round8(J * 4) + round8(P * 4)) : NULL;
 	float *palb;
 	TAKE(kept, Kc * 4);
 	TAKE(palj, P * 4);
@@ -1397,15 +1452,23 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 			FAIL("%s: root joint %u is not kept (every root is)", x.label, j);
 		nearest[j] = is_kept ? j : nearest[parent];
 	}
-	TRY(cx_load(&x, &sj, &src, err));
-	if (P)
-		memcpy(palj, src, P * 4);
+	if (!refs) {
+		TRY(cx_load(&x, &sj, &src, err));
+		if (P)
+			memcpy(palj, src, P * 4);
+	}
 	for (uint32_t k = 0, i = 0; k < skel->skin_count; k++)
 		for (uint32_t m = 0; m < skel->skins[k].joint_count; m++, i++) {
-			uint32_t joint = skel->skin_joints[k][m], v = palj[i];
+			uint32_t joint = skel->skin_joints[k][m];
 			if (joint >= J)
 				FAIL("%s: the given skeleton's skin %u joint %u is %u, not below its joint count", x.label, k, m,
 				     joint);
+			if (refs) {
+				palj[i] = nearest[joint];
+				ibm[i] = skel->inverse_bind[k] + 16 * (size_t)m;
+				continue;
+			}
+			uint32_t v = palj[i];
 			if (v >= J || nearest[v] != v)
 				FAIL("%s: palette entry %u (skin %u joint %u): joint %u is not a kept joint", x.label, i, k, m, v);
 			if (v != nearest[joint])
@@ -1413,9 +1476,25 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 				     "is %u",
 				     x.label, i, k, m, v, joint, nearest[joint]);
 		}
-	TRY(cx_load(&x, &sb, &src, err));
-	if (P)
-		memcpy(palb, src, P * 64);
+	if (refs) {
+		/* 0: the own IBMS entry; 1..P: IBMS entry v - 1; then 'PALX'. */
+		if (P)
+			TRY(cx_load_into(&x, &sj, (uint8_t *)palr, err));
+		TRY(cx_load(&x, &sb, &src, err));
+		for (uint64_t i = 0; i < P; i++) {
+			uint64_t v = palr[i];
+			const void *from = v == 0 ? (const void *)ibm[i] : v <= P ? (const void *)ibm[v - 1] : NULL;
+			if (!from && v - P - 1 >= sb.count)
+				FAIL("%s: palette entry %llu refers to bind matrix %llu, beyond the %llu skin joints and %u in "
+				     "'PALX'",
+				     x.label, (unsigned long long)i, (unsigned long long)v, (unsigned long long)P, sb.count);
+			memcpy(palb + 16 * i, from ? from : (const void *)(src + 64 * (v - P - 1)), 64);
+		}
+	} else {
+		TRY(cx_load(&x, &sb, &src, err));
+		if (P)
+			memcpy(palb, src, P * 64);
+	}
 	if (!all_finite(palb, (size_t)P * 16))
 		FAIL("%s: a palette bind matrix is not finite", x.label);
 	cx_done(&x);
@@ -2800,6 +2879,28 @@ void mlod_pack_doc_free(mlod_pack_doc_bytes *x)
 
 /* Every chunk decoded in TOC order and released, stopping at the first
  * failure (whose message names the chunk); unknown types are skipped. */
+mlod_result mlod_pack_check_padding(const mlod_pack *p, const void *data, size_t size, mlod_error *err)
+{
+	if (!p || (!data && size))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_check_padding: NULL argument");
+	/* no CRC covers it: a whole file has no other bytes than the header,
+	 * the TOC, the chunks and the zero padding before each chunk */
+	const uint8_t *d = data;
+	uint64_t at = MLOD_PACK_HEADER_SIZE + (uint64_t)p->chunk_count * MLOD_PACK_TOC_ENTRY_SIZE;
+	for (uint32_t i = 0; i < p->chunk_count; i++) {
+		const mlod_pack_chunk *c = &p->chunks[i];
+		for (uint64_t b = at; b < c->offset && b < size; b++)
+			if (d[b]) {
+				char label[48];
+				chunk_label(c->type, c->level, c->item, label, sizeof label);
+				return mlod_fail(err, MLOD_ERR_PARSE, "%s: padding byte %llu before the chunk is not zero", label,
+				                 (unsigned long long)b);
+			}
+		at = c->offset + c->stored_size;
+	}
+	return MLOD_OK;
+}
+
 mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, mlod_error *err)
 {
 	if (!p || (!data && size))
@@ -2808,6 +2909,8 @@ mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, m
 	memset(&skel, 0, sizeof skel);
 	int have_skel = 0;
 	mlod_result r = MLOD_OK;
+	if ((r = mlod_pack_check_padding(p, data, size, err)) != MLOD_OK)
+		return r;
 	for (uint32_t i = 0; r == MLOD_OK && i < p->chunk_count; i++) {
 		const mlod_pack_chunk *c = &p->chunks[i];
 		const mlod_pack_skeleton *s = have_skel ? &skel : NULL;

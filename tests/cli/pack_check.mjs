@@ -6,8 +6,16 @@
 //   node tests/cli/pack_check.mjs FILE.mlod [--doc OUT.glb]
 //
 // --doc writes the DOC chunk's glb to OUT.glb.
-// It does not decode streams: the round trip through the reader
-// (lib/rt/pack.c) is for the tests that come with it. A chunk with the
+// It decodes no meshopt-coded stream: the round trip through the reader
+// (lib/rt/pack.c) is for the tests that come with it. A skeleton level's
+// palette (format 7.0: 'KEPT', 'PALR', 'PALX'; no 'PALJ', no 'PALB') is
+// checked for its streams and counts, and where 'PALR' is raw or in byte
+// planes (stream codecs 4 and 5, which this script decodes) every
+// reference (0 the own 'IBMS' entry, 1..P 'IBMS' entry v - 1, above P a
+// 'PALX' matrix); "palette" in the summary counts each level's three
+// kinds (null where 'PALR' is meshopt-coded), and where 'KEPT' is, its
+// joints are checked (increasing, below the joint count). "planes" counts
+// the streams in byte planes, "sums" those of codec 6 (each decoded). A chunk with the
 // zstd entropy stage (format 5.0) is undone with the zstd tool first; one
 // with the prefix stage (format 6.0) with the chunks it needs as the tool's
 // --patch-from reference: a MESH level's coarser MESH levels' containers,
@@ -26,7 +34,7 @@ const fourcc = (u) => String.fromCharCode(u & 255, (u >> 8) & 255, (u >> 16) & 2
 if (b.length < 32 || b.subarray(0, 4).toString('latin1') !== 'MLOD') die('no MLOD magic');
 const major = b.readUInt16LE(4), minor = b.readUInt16LE(6), flags = b.readUInt32LE(8), n = b.readUInt32LE(12);
 const size = Number(b.readBigUInt64LE(16));
-if (major !== 6 || minor !== 0) die(`version ${major}.${minor}`);
+if (major !== 7 || minor !== 0) die(`version ${major}.${minor}`);
 if (flags !== 0) die('flags');
 if (size !== b.length) die(`file_size ${size}, file ${b.length}`);
 if (crc32(b.subarray(0, 28)) !== b.readUInt32LE(28)) die('header CRC');
@@ -87,11 +95,13 @@ for (let i = 0; i < n; i++) {
 		const st = { tag: fourcc(h.readUInt32LE(0)), count: h.readUInt32LE(4), size: h.readUInt16LE(8), codec: h[10], stored: h.readUInt32LE(12) };
 		if (h[11]) die(`chunk ${i}: stream ${s}: reserved`);
 		if (st.size < 1 || st.size > 256) die(`chunk ${i}: stream ${st.tag}: element size ${st.size}`);
-		if (st.codec === 0 && st.stored !== st.count * st.size) die(`chunk ${i}: raw stream ${st.tag}: stored ${st.stored}`);
+		if ((st.codec === 0 || st.codec === 4 || st.codec === 5) && st.stored !== st.count * st.size) die(`chunk ${i}: raw or plane stream ${st.tag}: stored ${st.stored}`);
+		if (st.codec && c.codec === 0) die(`chunk ${i}: stream ${st.tag} of codec ${st.codec} in a chunk of codec none`);
 		if (st.codec === 1 && st.size % 4) die(`chunk ${i}: vertex codec on element size ${st.size}`);
 		if (st.codec === 2 && (st.size !== 2 && st.size !== 4 || st.count % 3)) die(`chunk ${i}: index codec on ${st.tag}`);
 		if (st.codec === 3 && (st.size !== 2 && st.size !== 4 || st.tag !== 'IMAP')) die(`chunk ${i}: index sequence codec on ${st.tag}`);
-		if (st.codec > 3) die(`chunk ${i}: stream codec ${st.codec}`);
+		if (st.codec === 6 && (st.size !== 4 || st.stored !== 3 * st.count)) die(`chunk ${i}: sum codec on ${st.tag}: element size ${st.size}, stored ${st.stored}`);
+		if (st.codec > 6) die(`chunk ${i}: stream codec ${st.codec}`);
 		st.at = p;
 		p += (st.stored + 3) & ~3;
 		raw += (st.count * st.size + 3) & ~3;
@@ -102,6 +112,64 @@ for (let i = 0; i < n; i++) {
 	chunks.push(c);
 }
 if (end !== b.length) die('bytes after the last chunk');
+
+// A stream's decoded bytes where no meshopt decoder is needed: raw (0),
+// byte planes (4: byte j of element k at j * count + k; 5: the same of
+// each byte minus the element before's, modulo 256; format 7.0), or sums
+// (6: elements of 4 bytes summing to 255 as their first three; 7.0);
+// else null.
+const plain = (c, st) => {
+	const s = c.data.subarray(st.at, st.at + st.stored), n = st.count, e = st.size;
+	if (st.codec === 0) return s;
+	if (st.codec === 6) { // each element's first three bytes; the fourth 255 minus their sum
+		const out = Buffer.alloc(n * 4);
+		for (let k = 0; k < n; k++) {
+			const sum = s[3 * k] + s[3 * k + 1] + s[3 * k + 2];
+			if (sum > 255) die(`stream ${st.tag}: element ${k}: its bytes sum to ${sum}`);
+			out.set(s.subarray(3 * k, 3 * k + 3), 4 * k);
+			out[4 * k + 3] = 255 - sum;
+		}
+		return out;
+	}
+	if (st.codec !== 4 && st.codec !== 5) return null;
+	const out = Buffer.alloc(n * e);
+	for (let j = 0; j < e; j++) {
+		let acc = 0;
+		for (let k = 0; k < n; k++) {
+			acc = st.codec === 5 ? (acc + s[j * n + k]) & 255 : s[j * n + k];
+			out[k * e + j] = acc;
+		}
+	}
+	return out;
+};
+
+// Skeleton levels (format 7.0): the palette as references to SKELETON's
+// 'IBMS' (P entries: its 'SKJT' count) or to the level's 'PALX'.
+const palette = [];
+if (n > 1 && chunks[1].type === 'SKEL') {
+	const sk = chunks[1].streams, P = sk.length === 5 && sk[3].tag === 'SKJT' && sk[4].tag === 'IBMS' ? sk[3].count : -1;
+	if (P < 0 || sk[4].count !== P || sk[4].size !== 64) die('SKEL streams');
+	for (const c of chunks) {
+		if (c.type !== 'SKEL' || c.level === 0) continue;
+		const [k, r, x] = c.streams, tags = c.streams.map((t) => t.tag).join(',');
+		if (tags !== 'KEPT,PALR,PALX' || k.size !== 4 || r.size !== 4 || x.size !== 64) die(`SKEL level ${c.level}: streams ${tags}`);
+		if (r.count !== P || x.count > P) die(`SKEL level ${c.level}: 'PALR' ${r.count}, 'PALX' ${x.count}, ${P} skin joints`);
+		const kd = plain(c, k), J = chunks[1].streams[0].count;
+		for (let e = 0; kd && e < k.count; e++) {
+			const v = kd.readUInt32LE(4 * e);
+			if (v >= J || (e && v <= kd.readUInt32LE(4 * e - 4))) die(`SKEL level ${c.level}: kept joint ${e} is ${v}`);
+		}
+		const rd = plain(c, r);
+		if (!rd) { palette.push(null); continue; }
+		const kinds = [0, 0, 0];
+		for (let e = 0; e < P; e++) {
+			const v = rd.readUInt32LE(4 * e);
+			if (v > P + x.count) die(`SKEL level ${c.level}: palette entry ${e} refers to ${v}, past ${P} + ${x.count}`);
+			kinds[v === 0 ? 0 : v <= P ? 1 : 2]++;
+		}
+		palette.push(kinds);
+	}
+}
 
 // Order: INFO, SKEL 0, skeleton levels coarsest first, then per level
 // coarse to fine mesh and motion, DOC last.
@@ -136,6 +204,10 @@ const out = {
 	stream_codecs: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.codec)))].sort(),
 	tags: [...new Set(chunks.flatMap((c) => c.streams.map((s) => s.tag)))].sort(),
 	doc: chunks[n - 1].streams[0].count,
+	palette,
+	planes: chunks.reduce((a, c) => a + c.streams.filter((t) => t.codec === 4 || t.codec === 5).length, 0),
+	// every weights stream stored without its sums, decoded: its count
+	sums: chunks.reduce((a, c) => a + c.streams.filter((t) => t.codec === 6 && plain(c, t)).length, 0),
 	toc: chunks.map((c) => `${c.type.trim()} ${c.level}/${c.item} ${c.crc.toString(16)}`),
 };
 for (const c of chunks) out.count[c.type.trim()] = (out.count[c.type.trim()] || 0) + 1;

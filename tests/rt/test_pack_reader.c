@@ -207,6 +207,19 @@ static buf chunk_bytes(const wchunk *c, uint32_t *raw)
 			enc[i].n = seq ? meshopt_encodeIndexSequence(enc[i].p, bound, idx, count)
 			               : meshopt_encodeIndexBuffer(enc[i].p, bound, idx, count);
 			free(idx);
+		} else if (s->codec == MLOD_SCODEC_SUM255) { /* each element's first three bytes */
+			for (size_t k = 0; k < count; k++)
+				put(&enc[i], s->data.p + 4 * k, 3);
+		} else if (s->codec == MLOD_SCODEC_PLANES || s->codec == MLOD_SCODEC_PLANES_DELTA) {
+			/* byte j of element k at j * count + k (minus element k - 1's) */
+			enc[i].p = malloc(s->data.n + 1);
+			enc[i].n = s->data.n;
+			for (size_t j = 0; j < s->elsize; j++)
+				for (size_t k = 0; k < count; k++)
+					enc[i].p[j * count + k] = (uint8_t)(s->data.p[k * s->elsize + j] -
+					                                    (s->codec == MLOD_SCODEC_PLANES_DELTA && k
+					                                             ? s->data.p[(k - 1) * s->elsize + j]
+					                                             : 0));
 		} else {
 			put(&enc[i], s->data.p, s->data.n);
 		}
@@ -665,6 +678,10 @@ static void part_streams(wchunk *c, const part_truth *t, uint8_t vc, uint8_t ic)
  * the block's, NEWBITS) in their own numbering (format 3.0), unless a
  * test sets it 0 (a format 2.0 pack). */
 static uint32_t local_flag = MLOD_PART_LOCAL;
+/* SKELETON level 1's palette as 'PALR' and 'PALX' (format 7.0), unless a
+ * test sets it 0 ('PALJ' and 'PALB', as 2.x to 6.x packs store it). */
+static int pal_refs = 1;
+static const uint32_t palj_truth[NJ] = {0, 1, 1, 1};
 
 /* The chunks of the test character, in the format's order:
  * INFO, SKELETON, SKELETON 1, MESH 1, MOTION 1/0, MESH 0, MOTION 0/0, DOC.
@@ -748,16 +765,29 @@ static int make_chunks(wchunk *c, int with_unknown)
 	s->count = 2;
 	put32(&s->data, 0);
 	put32(&s->data, 1);
-	s = add_stream(ch, MLOD_STREAM_PALJ, 4, MLOD_SCODEC_RAW);
-	s->count = NJ;
-	static const uint32_t palj[NJ] = {0, 1, 1, 1};
-	for (int j = 0; j < NJ; j++)
-		put32(&s->data, palj[j]);
-	s = add_stream(ch, MLOD_STREAM_PALB, 64, MLOD_SCODEC_RAW);
-	s->count = NJ;
-	for (int j = 0; j < NJ; j++)
+	if (pal_refs) {
+		/* Joints 0 and 1 their own IBM (0), joint 2 IBMS entry 1 (2),
+		 * joint 3 the same matrix as 'PALX' matrix 0 (NJ + 1). */
+		s = add_stream(ch, MLOD_STREAM_PALR, 4, MLOD_SCODEC_RAW);
+		s->count = NJ;
+		static const uint32_t palr[NJ] = {0, 0, 2, NJ + 1};
+		for (int j = 0; j < NJ; j++)
+			put32(&s->data, palr[j]);
+		s = add_stream(ch, MLOD_STREAM_PALX, 64, MLOD_SCODEC_RAW);
+		s->count = 1;
 		for (int k = 0; k < 16; k++)
-			putf(&s->data, ibm_truth[palj[j]][k]);
+			putf(&s->data, ibm_truth[1][k]);
+	} else {
+		s = add_stream(ch, MLOD_STREAM_PALJ, 4, MLOD_SCODEC_RAW);
+		s->count = NJ;
+		for (int j = 0; j < NJ; j++)
+			put32(&s->data, palj_truth[j]);
+		s = add_stream(ch, MLOD_STREAM_PALB, 64, MLOD_SCODEC_RAW);
+		s->count = NJ;
+		for (int j = 0; j < NJ; j++)
+			for (int k = 0; k < 16; k++)
+				putf(&s->data, ibm_truth[palj_truth[j]][k]);
+	}
 
 	/* The parts: level 0's, then level 1's from them (16 and 10 of their
 	 * vertices; part 0 with u16 indices at level 1, u32 at level 0). */
@@ -1115,8 +1145,9 @@ TEST(decode_skeleton_and_level)
 	         strcmp(s.skin_names[0], "skin") == 0 && s.joints[3].parent == 1 && s.joints[2].t[0] == 0.25f &&
 	         s.joints[3].node == 13 && s.skins[0].joint_count == NJ && s.skin_joints[0][3] == 3 &&
 	         memcmp(s.inverse_bind[0], ibm_truth, sizeof ibm_truth) == 0;
-	int lok = l.kept_count == 2 && l.kept[1] == 1 && l.palette_size == NJ && l.palette_joint[0] == 0 &&
-	          l.palette_joint[3] == 1 && memcmp(l.palette_bind + 16 * 2, ibm_truth[1], 64) == 0;
+	int lok = l.kept_count == 2 && l.kept[1] == 1 && l.palette_size == NJ;
+	for (int j = 0; lok && j < NJ; j++)
+		lok = l.palette_joint[j] == palj_truth[j] && memcmp(l.palette_bind + 16 * j, ibm_truth[palj_truth[j]], 64) == 0;
 	/* The level's chunk is not the full skeleton, and vice versa. */
 	mlod_pack_skel_level l2;
 	mlod_result r1 = mlod_pack_decode_skel_level(&p, C_SKEL, b.p, b.n, &s, &l2, &terr);
@@ -1441,7 +1472,7 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 7.0 is newer than this reader's 6.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 8.0 is newer than this reader's 7.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
 }
 
@@ -1476,7 +1507,7 @@ TEST(older_major_is_refused)
 	free(b.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && p.chunks == NULL, "returned %d: %s", (int)r, terr.message);
 	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
-	                               "reads 2.x to 6.x)") == 0,
+	                               "reads 2.x to 7.x)") == 0,
 	          "message: %s", terr.message);
 }
 
@@ -1485,7 +1516,7 @@ TEST(older_major_is_refused)
 TEST(format_2_0_reads)
 {
 	static wchunk c[C_COUNT + 1];
-	local_flag = 0;
+	local_flag = 0, pal_refs = 0;
 	int n = make_chunks(c, 0);
 	buf b = build_pack(c, n, 2, 0);
 	free_chunks(c, n);
@@ -1509,11 +1540,57 @@ TEST(format_2_0_reads)
 	mlod_pack_skeleton_free(&s);
 	mlod_pack_close(&p);
 	free(b.p);
-	local_flag = MLOD_PART_LOCAL;
+	local_flag = MLOD_PART_LOCAL, pal_refs = 1;
 	CHECK_MSG(ok, "%s", why);
 }
 
 static uint8_t *stream_data(wchunk *c, int chunk, uint32_t tag, int nth);
+
+/* Format 7.0 stores a skeleton level's palette as references ('PALR',
+ * 'PALX') and derives its joints; a 6.0 pack's 'PALJ' and 'PALB' still
+ * read, to the same palette, and a 'PALJ' entry that is not the nearest
+ * kept ancestor is still refused. A 7.0 pack with 'PALJ' and 'PALB' is
+ * refused. */
+TEST(format_6_0_palette_reads)
+{
+	static wchunk c[C_COUNT + 1];
+	pal_refs = 0;
+	int n = make_chunks(c, 0);
+	buf b = build_pack(c, n, 6, 0), b7 = build_pack(c, n, 7, 0);
+	wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALJ, 0) + 4 * 3, 2);
+	buf bad = build_pack(c, n, 6, 0);
+	free_chunks(c, n);
+	pal_refs = 1;
+	mlod_pack p = {0}, p7 = {0}, pb = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_skel_level l = {0}, l7 = {0}, lb = {0};
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &s, &terr));
+	CHECK_OK(mlod_pack_decode_skel_level(&p, C_SKEL1, b.p, b.n, &s, &l, &terr));
+	int ok = p.major == 6 && l.kept_count == 2 && l.palette_size == NJ;
+	for (int j = 0; ok && j < NJ; j++)
+		ok = l.palette_joint[j] == palj_truth[j] && memcmp(l.palette_bind + 16 * j, ibm_truth[palj_truth[j]], 64) == 0;
+	CHECK_OK(mlod_pack_open(b7.p, b7.n, &p7, &terr));
+	mlod_result r7 = mlod_pack_decode_skel_level(&p7, C_SKEL1, b7.p, b7.n, &s, &l7, &terr);
+	char m7[sizeof terr.message];
+	snprintf(m7, sizeof m7, "%s", terr.message);
+	CHECK_OK(mlod_pack_open(bad.p, bad.n, &pb, &terr));
+	mlod_result rb = mlod_pack_decode_skel_level(&pb, C_SKEL1, bad.p, bad.n, &s, &lb, &terr);
+	mlod_pack_skel_level_free(&l);
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_close(&p);
+	mlod_pack_close(&p7);
+	mlod_pack_close(&pb);
+	free(b.p);
+	free(b7.p);
+	free(bad.p);
+	CHECK(ok);
+	CHECK_MSG(r7 == MLOD_ERR_PARSE && strcmp(m7, "SKELETON level 1: stream 1 is 'PALJ', expected 'PALR'") == 0,
+	          "7.0 with PALJ: %d %s", (int)r7, m7);
+	CHECK_MSG(rb == MLOD_ERR_PARSE && strcmp(terr.message, "SKELETON level 1: palette entry 3 (skin 0 joint 3): joint "
+	                                                       "2 is not a kept joint") == 0,
+	          "6.0 bad PALJ: %d %s", (int)rb, terr.message);
+}
 
 /* A nested MOTION level (TOC flag MLOD_PACK_CHUNK_NESTED) builds on the
  * clip's next coarser level: the coarsest cannot be nested, and
@@ -1834,7 +1911,7 @@ TEST(prefix_decodes_the_same)
 	mlod_pack pa, pz;
 	CHECK_OK(mlod_pack_open(a.p, a.n, &pa, &terr));
 	CHECK_OK(mlod_pack_open(z.p, z.n, &pz, &terr));
-	CHECK(pz.major == 6 && pz.chunks[C_MESH0].entropy == MLOD_ENTROPY_ZSTD_PREFIX &&
+	CHECK(pz.major == MLOD_PACK_MAJOR && pz.chunks[C_MESH0].entropy == MLOD_ENTROPY_ZSTD_PREFIX &&
 	      pz.chunks[C_SKEL1].entropy == MLOD_ENTROPY_ZSTD_PREFIX && pz.chunks[C_SKEL].entropy == MLOD_ENTROPY_ZSTD &&
 	      pz.chunks[C_MESH1].entropy == MLOD_ENTROPY_ZSTD && pz.chunks[C_MOT1].entropy == MLOD_ENTROPY_ZSTD);
 	CHECK(strcmp(mlod_pack_entropy_name(MLOD_ENTROPY_ZSTD_PREFIX), "zstd-prefix") == 0);
@@ -1879,9 +1956,9 @@ TEST(prefix_decodes_the_same)
 	mlod_pack_close(&pa);
 	mlod_pack_close(&pz);
 	/* 5.0: the zstd stage alone reads; the prefix stage is refused. */
-	zstd_level = 19;
+	zstd_level = 19, pal_refs = 0;
 	buf f = make_pack(0);
-	zstd_level = 0;
+	zstd_level = 0, pal_refs = 1;
 	wr16(f.p + 4, 5);
 	restamp(f.p, f.n);
 	mlod_pack p5;
@@ -2183,7 +2260,15 @@ static void e_part_grid(wchunk *c)
 	wr32(d, 0x3f000000u);
 }
 static void e_parent(wchunk *c) { wr32(stream_data(c, C_SKEL, MLOD_STREAM_JNTS, 0) + 116 * 2, 3); }
-static void e_palj(wchunk *c) { wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALJ, 0) + 4 * 3, 2); }
+static void e_palr(wchunk *c) { wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALR, 0) + 4 * 3, NJ + 2); }
+static void e_palx_count(wchunk *c)
+{
+	wstream *x = &c[C_SKEL1].s[2];
+	x->count = NJ + 1;
+	for (int k = 0; k < 16 * NJ; k++)
+		putf(&x->data, 1.0f);
+}
+static void e_palx_nan(wchunk *c) { wr32(stream_data(c, C_SKEL1, MLOD_STREAM_PALX, 0) + 4 * 5, 0x7fc00000u); }
 static void e_weights(wchunk *c) { stream_data(c, C_MESH1, MLOD_STREAM_WGT8, 0)[4 * 5] ^= 1; }
 static void e_skin_joint(wchunk *c) { stream_data(c, C_MESH1, MLOD_STREAM_JNT8, 0)[4 * 2 + 1] = NJ; }
 static void e_uv_sets(wchunk *c) { wr32(stream_data(c, C_MESH1, MLOD_STREAM_PART, 0) + 40, 5); }
@@ -2303,7 +2388,9 @@ TEST(structural_checks_name_the_chunk)
 		{e_part_count, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: stream 0 'PART' has 1 elements, expected 2 (the parts of the coarsest level)"},
 		{e_part_grid, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 1: its record differs from MESH level 1's"},
 		{e_parent, C_SKEL, MLOD_ERR_PARSE, "SKELETON: joint 2: parent 3 is not -1 or an earlier joint"},
-		{e_palj, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: palette entry 3 (skin 0 joint 3): joint 2 is not a kept joint"},
+		{e_palr, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: palette entry 3 refers to bind matrix 6, beyond the 4 skin joints and 1 in 'PALX'"},
+		{e_palx_count, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: 5 bind matrices in 'PALX', more than the 4 skin joints"},
+		{e_palx_nan, C_SKEL1, MLOD_ERR_PARSE, "SKELETON level 1: a palette bind matrix is not finite"},
 		{e_weights, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: vertex 5: weights sum to"},
 		{e_skin_joint, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: vertex 2: joint 4 is not below skin 0's 4 joints"},
 		{e_uv_sets, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: 5 UV sets, more than 4"},
@@ -2636,6 +2723,159 @@ TEST(unknown_codec_raw_size)
 }
 
 /* The meshopt codecs' constraints, and a damaged meshopt stream. */
+/* Format 7.0's byte-plane stream codecs: every stream of MESH level 0,
+ * the skeleton level and a MOTION level in planes (alternately with and
+ * without deltas; the weights without their sums, codec 6) decodes to
+ * what the raw streams do; a plane stream whose stored size is not its
+ * decoded size, a plane stream in a 6.0 pack and one in a chunk of codec
+ * none are refused, and so are weights whose three bytes pass 255 and
+ * the sum codec on elements of another size. */
+TEST(plane_streams)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	int chunks[] = {C_SKEL, C_SKEL1, C_MESH1, C_MESH0, C_MOT1, C_MOT0}, planes = 0, sums = 0;
+	for (int q = 0; q < 6; q++) {
+		c[chunks[q]].codec = MLOD_CODEC_MESHOPT;
+		for (int i = 0; i < c[chunks[q]].ns; i++)
+			if (c[chunks[q]].s[i].tag == MLOD_STREAM_WGT8)
+				c[chunks[q]].s[i].codec = MLOD_SCODEC_SUM255, sums++;
+			else if (c[chunks[q]].s[i].codec == MLOD_SCODEC_RAW && c[chunks[q]].s[i].count)
+				c[chunks[q]].s[i].codec = planes++ % 2 ? MLOD_SCODEC_PLANES_DELTA : MLOD_SCODEC_PLANES;
+	}
+	buf b = build_pack(c, n, MLOD_PACK_MAJOR, 0), b6 = build_pack(c, n, 6, 0);
+	free_chunks(c, n);
+	buf a = make_pack(0);
+	mlod_pack p, pa;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_open(a.p, a.n, &pa, &terr));
+	CHECK_OK(mlod_pack_check(&p, b.p, b.n, &terr));
+	mlod_pack_skeleton sk, ska;
+	mlod_pack_skel_level l, la;
+	mlod_pack_mesh m, ma;
+	mlod_pack_motion mo, moa;
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b.p, b.n, &sk, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&pa, a.p, a.n, &ska, &terr));
+	CHECK_OK(mlod_pack_decode_skel_level(&p, C_SKEL1, b.p, b.n, &sk, &l, &terr));
+	CHECK_OK(mlod_pack_decode_skel_level(&pa, C_SKEL1, a.p, a.n, &ska, &la, &terr));
+	int same = memcmp(sk.inverse_bind[0], ska.inverse_bind[0], 64 * NJ) == 0 &&
+	           memcmp(sk.joints, ska.joints, sizeof *sk.joints * NJ) == 0 &&
+	           memcmp(l.palette_bind, la.palette_bind, 64 * NJ) == 0 && memcmp(l.kept, la.kept, 4 * l.kept_count) == 0;
+	char why[256] = "";
+	for (int lv = 0; lv < 2; lv++) {
+		CHECK_OK(mlod_pack_decode_mesh(&p, lv ? C_MESH1 : C_MESH0, b.p, b.n, &sk, &m, &terr));
+		for (uint32_t i = 0; i < m.part_count; i++)
+			same = same && check_part(&m.parts[i], &parts_truth[2 * lv + (int)i], why, sizeof why);
+		mlod_pack_mesh_free(&m);
+		CHECK_OK(mlod_pack_decode_motion(&p, lv ? C_MOT1 : C_MOT0, b.p, b.n, &sk, &mo, &terr));
+		CHECK_OK(mlod_pack_decode_motion(&pa, lv ? C_MOT1 : C_MOT0, a.p, a.n, &ska, &moa, &terr));
+		same = same && mo.channel_count == moa.channel_count;
+		for (uint32_t i = 0; same && i < mo.channel_count; i++) {
+			uint32_t k = mo.channels[i].rec.key_count, w = mo.channels[i].rec.path == 1 ? 4 : 3;
+			same = memcmp(&mo.channels[i].rec, &moa.channels[i].rec, sizeof mo.channels[i].rec) == 0 &&
+			       memcmp(mo.channels[i].times, moa.channels[i].times, 4 * k) == 0 &&
+			       memcmp(mo.channels[i].values, moa.channels[i].values, 4 * w * k * (mo.channels[i].rec.interp == 2 ? 3 : 1)) == 0;
+		}
+		mlod_pack_motion_free(&mo);
+		mlod_pack_motion_free(&moa);
+	}
+	mlod_pack_skel_level_free(&l);
+	mlod_pack_skel_level_free(&la);
+	mlod_pack_skeleton_free(&ska);
+	CHECK_MSG(same && planes > 10 && sums >= 2, "%d plane and %d sum streams: %s", planes, sums, why);
+	/* The weights stream of MESH level 1's part 0 (sum codec): a vertex's
+	 * three bytes summing past 255, then the codec on 'PART' (200 bytes). */
+	{
+		uint8_t *chw = b.p + p.chunks[C_MESH1].offset, *w = NULL, *hw = NULL;
+		uint32_t nsw = get32(chw);
+		size_t atw = 4 + 16 * (size_t)nsw;
+		for (uint32_t t = 0; t < nsw && !w; t++) {
+			uint8_t *ht = chw + 4 + 16 * t;
+			if (get32(ht) == MLOD_STREAM_WGT8)
+				w = chw + atw, hw = ht;
+			atw += (get32(ht + 12) + 3) & ~3u;
+		}
+		CHECK(w && hw[10] == MLOD_SCODEC_SUM255 && get32(hw + 12) == 3 * get32(hw + 4));
+		uint8_t keep = w[3 * 5];
+		w[3 * 5] = 255;
+		restamp(b.p, b.n);
+		mlod_pack_close(&p);
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+		CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+		          "'WGT8': element 5: its three bytes sum to ");
+		w[3 * 5] = keep;
+		restamp(b.p, b.n);
+		mlod_pack_close(&p);
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+		CHECK_OK(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr));
+		mlod_pack_mesh_free(&ma);
+		uint8_t *h0 = chw + 4, c0 = h0[10];
+		h0[10] = MLOD_SCODEC_SUM255;
+		restamp(b.p, b.n);
+		mlod_pack_close(&p);
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+		CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+		          "MESH level 1: stream 0 'PART': the sum codec needs an element size of 4, not 200");
+		h0[10] = c0;
+		restamp(b.p, b.n);
+		mlod_pack_close(&p);
+		CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	}
+	/* A 6.0 pack with them: refused, naming the format that added them. */
+	mlod_pack p6;
+	CHECK_OK(mlod_pack_open(b6.p, b6.n, &p6, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p6, C_MESH1, b6.p, b6.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+	          "MESH level 1: stream 0 'PART': stream codec 4 in a 6.x pack (format 7.0 added it)");
+	mlod_pack_close(&p6);
+	/* A stored size that is not the decoded size; a chunk of codec none. */
+	uint8_t *ch = b.p + p.chunks[C_MESH1].offset, *h0 = ch + 4, save[16];
+	memcpy(save, h0, 16);
+	wr32(h0 + 12, get32(h0 + 12) - 4);
+	wr32(h0 + 16 + 12, get32(h0 + 16 + 12) + 4);
+	restamp(b.p, b.n);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+	          "MESH level 1: stream 0 'PART': 396 bytes stored for 2 elements of 200 bytes");
+	wr32(h0 + 12, get32(h0 + 12) + 4);
+	wr32(h0 + 16 + 12, get32(h0 + 16 + 12) - 4);
+	b.p[32 + 48 * C_MESH1 + 5] = (uint8_t)(b.p[32 + 48 * C_MESH1 + 5] & 0xf0);
+	restamp(b.p, b.n);
+	mlod_pack_close(&p);
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_ERR(mlod_pack_decode_mesh(&p, C_MESH1, b.p, b.n, &sk, &ma, &terr), MLOD_ERR_PARSE,
+	          "MESH level 1: stream 0 'PART' is in byte planes in a chunk of codec none");
+	mlod_pack_skeleton_free(&sk);
+	mlod_pack_close(&p);
+	mlod_pack_close(&pa);
+	free(a.p);
+	free(b.p);
+	free(b6.p);
+}
+
+/* The zero padding between chunks, which no CRC covers: mlod_pack_check
+ * (what mlod-pack --info and -x run first) refuses a byte set in it,
+ * naming the chunk after it. */
+TEST(padding_is_checked)
+{
+	buf b = make_pack(0);
+	mlod_pack p;
+	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
+	CHECK_OK(mlod_pack_check(&p, b.p, b.n, &terr));
+	uint32_t gap = 0;
+	for (uint32_t i = 1; i < p.chunk_count && !gap; i++)
+		if (p.chunks[i].offset > p.chunks[i - 1].offset + p.chunks[i - 1].stored_size)
+			gap = i;
+	CHECK(gap > 0);
+	uint64_t at = p.chunks[gap].offset - 1;
+	b.p[at] = 0x5a;
+	char want[128];
+	snprintf(want, sizeof want, "padding byte %llu before the chunk is not zero", (unsigned long long)at);
+	CHECK_ERR(mlod_pack_check(&p, b.p, b.n, &terr), MLOD_ERR_PARSE, want);
+	mlod_pack_close(&p);
+	free(b.p);
+}
+
 TEST(meshopt_streams)
 {
 	static wchunk c[C_COUNT + 1];
@@ -2727,6 +2967,9 @@ int main(int argc, char **argv)
 	RUN(free_accepts_zeroed);
 	RUN(unknown_chunks_are_skipped);
 	RUN(newer_major_is_refused);
+	RUN(plane_streams);
+	RUN(padding_is_checked);
+	RUN(format_6_0_palette_reads);
 	RUN(older_major_is_refused);
 	RUN(rotq_shift_decodes);
 	RUN(format_2_0_reads);

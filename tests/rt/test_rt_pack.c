@@ -443,13 +443,18 @@ static void build_pack(bytes *out)
 		for (uint32_t i = 0; i < sl[l]->kept_count; i++)
 			put32(b, sl[l]->kept[i]);
 		stream_end(c);
-		b = stream(c, MLOD_STREAM_PALJ, 4);
+		/* Format 7.0: each bind matrix as IBMS entry i's (0) or as the
+		 * next 'PALX' matrix (FX_J + 1 + its index); the reader derives
+		 * the palette joints. */
+		b = stream(c, MLOD_STREAM_PALR, 4);
+		uint32_t nx = 0;
 		for (uint32_t i = 0; i < FX_J; i++)
-			put32(b, sl[l]->palette_joint[i]);
+			put32(b, memcmp(sl[l]->palette_bind + 16 * i, fx_ibm_0 + 16 * i, 64) == 0 ? 0 : FX_J + 1 + nx++);
 		stream_end(c);
-		b = stream(c, MLOD_STREAM_PALB, 64);
+		b = stream(c, MLOD_STREAM_PALX, 64);
 		for (uint32_t i = 0; i < FX_J; i++)
-			put_mat(b, sl[l]->palette_bind + 16 * i);
+			if (memcmp(sl[l]->palette_bind + 16 * i, fx_ibm_0 + 16 * i, 64) != 0)
+				put_mat(b, sl[l]->palette_bind + 16 * i);
 		stream_end(c);
 	}
 	const mlod_pack_mesh *ml[3] = { &fx_mesh0, &fx_mesh1, &fx_mesh2 };

@@ -504,10 +504,13 @@ static void drop_skin_joint(mlod_character *c, int joint)
 
 /* The skeleton levels' palettes reproduce fold.c's skin transfer: for
  * every skin joint, the level skin that mlod_skel_level_apply makes holds
- * the joint PALJ names with the bind matrix PALB gives, and KEPT lists
- * the level's kept joints. Twice: on tubeman, whose skin has every joint
- * (a stand-in's own bind), and with a stand-in dropped from the skin
- * (R(stand-in -> joint) * IBM(joint)). */
+ * the joint the decoded palette names with the bind matrix it gives, and
+ * KEPT lists the level's kept joints. Twice: on tubeman, whose skin has
+ * every joint (a stand-in's own bind), and with a stand-in dropped from
+ * the skin (R(stand-in -> joint) * IBM(joint)). Format 7.0 stores the
+ * binds as references ('PALR'): a kept joint's is 0 (its own IBMS entry),
+ * and any whose bytes are its own IBMS entry's; else the first IBMS entry
+ * with the same bytes (1..P), else a 'PALX' matrix (above P). */
 TEST(pack_palette_is_fold)
 {
 	size_t n = 0;
@@ -552,23 +555,48 @@ TEST(pack_palette_is_fold)
 		CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, NULL, &terr));
 		const mlod_skin *sk = &c.skeleton.skins[0];
 		CHECK(c.skeleton.skin_count == 1);
-		int removed_in_skin = 0;
+		int removed_in_skin = 0, explicit_total = 0;
+		mlod_pack pk;
+		mlod_pack_skeleton full;
+		CHECK_OK(mlod_pack_open(out, size, &pk, &terr));
+		CHECK_OK(mlod_pack_decode_skeleton(&pk, out, size, &full, &terr));
 		for (int k = 0; k < L.count; k++) {
 			const mlod_skel_built *b = &L.levels[k];
 			const uint8_t *ch = find_chunk(out, MLOD_CHUNK_SKELETON, k + 1);
 			CHECK_MSG(ch, "no SKEL level %d", k + 1);
-			uint32_t kc, pc, bc, es;
+			uint32_t kc, pc, xc, es;
 			uint32_t *kept = (uint32_t *)stream(ch, MLOD_STREAM_KEPT, 0, &kc, &es);
-			uint32_t *palj = (uint32_t *)stream(ch, MLOD_STREAM_PALJ, 0, &pc, &es);
-			float *palb = (float *)stream(ch, MLOD_STREAM_PALB, 0, &bc, &es);
-			CHECK(kept && palj && palb && es == 64);
-			CHECK(kc == (uint32_t)b->skel.kept_count && pc == (uint32_t)sk->joint_count && bc == pc);
+			uint32_t *palr = (uint32_t *)stream(ch, MLOD_STREAM_PALR, 0, &pc, &es);
+			float *palx = (float *)stream(ch, MLOD_STREAM_PALX, 0, &xc, &es);
+			CHECK(kept && palr && palx && es == 64 && !stream(ch, MLOD_STREAM_PALJ, 0, &es, &es));
+			CHECK(kc == (uint32_t)b->skel.kept_count && pc == (uint32_t)sk->joint_count);
+			CHECK(xc <= pc);
+			mlod_pack_skel_level lv;
+			int chunk = mlod_pack_find(&pk, MLOD_CHUNK_SKELETON, (unsigned)k + 1, 0);
+			CHECK_OK(mlod_pack_decode_skel_level(&pk, (uint32_t)chunk, out, size, &full, &lv, &terr));
+			const uint32_t *palj = lv.palette_joint;
+			const float *palb = lv.palette_bind;
+			CHECK(lv.palette_size == pc);
 			for (uint32_t i = 0; i < kc; i++)
 				CHECK(b->skel.kept[kept[i]] && (i == 0 || kept[i] > kept[i - 1]));
 			const mlod_skin *lsk = &b->c.skeleton.skins[0];
 			for (int q = 0; q < sk->joint_count; q++) {
 				int j = sk->joints[q], in_skin = 0;
 				CHECK(palj[q] == (uint32_t)b->skel.remap[j]);
+				/* a kept joint refers to its own bind; every bind to its own
+				 * IBMS entry where that holds the same bytes, else to the
+				 * first that does, else to a 'PALX' matrix */
+				const float *ibm = full.inverse_bind[0];
+				uint32_t want = 0;
+				if (memcmp(palb + 16 * q, ibm + 16 * q, 64) != 0) {
+					while (want < pc && memcmp(palb + 16 * q, ibm + 16 * want, 64) != 0)
+						want++;
+					want = want < pc ? want + 1 : pc + 1;
+				}
+				CHECK_MSG(!b->skel.kept[j] || palr[q] == 0, "level %d skin joint %d: PALR %u", k + 1, q, palr[q]);
+				CHECK_MSG(want <= pc ? palr[q] == want : palr[q] > pc && palr[q] <= pc + xc,
+				          "level %d skin joint %d: PALR %u, expected %u", k + 1, q, palr[q], want);
+				explicit_total += want > pc;
 				removed_in_skin += !b->skel.kept[j];
 				for (int t = 0; t < sk->joint_count; t++)
 					in_skin |= sk->joints[t] == (int)palj[q];
@@ -588,10 +616,14 @@ TEST(pack_palette_is_fold)
 				CHECK_MSG(found, "level %d: skin joint %d's stand-in is not in the level skin", k + 1, q);
 			}
 			free(kept);
-			free(palj);
-			free(palb);
+			free(palr);
+			free(palx);
+			mlod_pack_skel_level_free(&lv);
 		}
+		mlod_pack_skeleton_free(&full);
+		mlod_pack_close(&pk);
 		CHECK(removed_in_skin > 0); /* the rule for removed joints was exercised */
+		fprintf(stderr, "# variant %d: %d palette entries as 'PALX' matrices\n", variant, explicit_total);
 		mlod_free(out);
 		mlod_skel_levels_free(&L);
 		free(info);
@@ -968,10 +1000,12 @@ static float entry_error(const uint8_t *e)
  * A smaller bound keeps more bytes. */
 /* The entropy stage (format 5.0): with zstd every chunk but INFO is a
  * zstd frame smaller than its container where it has the stage, the
- * containers are those of the pack without it (the same bytes after
- * ZSTD_decompress; INFO but its first_drawable), the pack is smaller, and
- * the same at any thread count;
- * without it no chunk has one. */
+ * containers are those of the pack without it (after ZSTD_decompress;
+ * INFO but its first_drawable) but for the stream codecs the stage chose
+ * (format 7.0: raw or byte planes where zstd stores fewer bytes; the same
+ * streams, tags, counts and element sizes, and the same glb unpacked),
+ * the pack is smaller, and the same at any thread count; without it no
+ * chunk has one. */
 TEST(entropy_stage)
 {
 	size_t n = 0;
@@ -995,8 +1029,10 @@ TEST(entropy_stage)
 	mlod_pack pn, pz;
 	CHECK_OK(mlod_pack_open(out[0], size[0], &pn, &terr));
 	CHECK_OK(mlod_pack_open(out[1], size[1], &pz, &terr));
-	CHECK(pn.chunk_count == pz.chunk_count && pn.major == 6 && pz.major == 6 && !pn.zstd && pz.zstd);
-	int staged = 0, same = 1, prefixed = 0;
+	CHECK(pn.chunk_count == pz.chunk_count && pn.major == MLOD_PACK_MAJOR && pz.major == MLOD_PACK_MAJOR && !pn.zstd && pz.zstd);
+	int staged = 0, same = 1, prefixed = 0, recoded = 0;
+	uint8_t *meshes = NULL; /* the zstd pack's MESH containers so far */
+	size_t nmeshes = 0;
 	for (uint32_t i = 0; i < pz.chunk_count; i++) {
 		const mlod_pack_chunk *a = &pn.chunks[i], *z = &pz.chunks[i];
 		CHECK(a->entropy == MLOD_ENTROPY_NONE && a->coded_size == 0);
@@ -1011,15 +1047,13 @@ TEST(entropy_stage)
 		}
 		CHECK(z->type != MLOD_CHUNK_INFO &&
 		      (z->entropy == MLOD_ENTROPY_ZSTD || (z->entropy == MLOD_ENTROPY_ZSTD_PREFIX && z->type == MLOD_CHUNK_MESH)));
-		CHECK(z->coded_size == a->stored_size && z->stored_size < z->coded_size && z->coded_size <= z->raw_size);
+		CHECK(z->stored_size < z->coded_size && z->coded_size <= z->raw_size);
 		uint8_t *back = malloc(z->coded_size), *pre = NULL;
 		size_t npre = 0;
 		if (z->entropy == MLOD_ENTROPY_ZSTD_PREFIX) { /* the coarser MESH levels' containers, coarsest first */
-			pre = malloc(size[0]);
-			for (uint32_t j = 0; j < i; j++)
-				if (pn.chunks[j].type == MLOD_CHUNK_MESH)
-					memcpy(pre + npre, (const uint8_t *)out[0] + pn.chunks[j].offset, pn.chunks[j].stored_size),
-					npre += pn.chunks[j].stored_size;
+			pre = malloc(nmeshes + 1);
+			memcpy(pre, meshes, nmeshes);
+			npre = nmeshes;
 			CHECK(npre > 0);
 			prefixed++;
 		}
@@ -1029,13 +1063,44 @@ TEST(entropy_stage)
 		size_t got = ZSTD_decompressDCtx(dc, back, z->coded_size, za, z->stored_size);
 		ZSTD_freeDCtx(dc);
 		free(pre);
-		same &= got == a->stored_size && memcmp(back, (const uint8_t *)out[0] + a->offset, got) == 0;
+		/* the same container but for stream codecs and stored sizes */
+		const uint8_t *ca = (const uint8_t *)out[0] + a->offset;
+		uint32_t ns = got >= 4 ? rd32(back) : 0;
+		int codec_diff = 0;
+		same &= got == z->coded_size && ns == rd32(ca) && 4 + 16 * (size_t)ns <= got;
+		for (uint32_t t = 0; same && t < ns; t++) {
+			const uint8_t *hz = back + 4 + 16 * t, *ha = ca + 4 + 16 * t;
+			same &= memcmp(hz, ha, 10) == 0 && hz[11] == ha[11];
+			codec_diff |= hz[10] != ha[10];
+		}
+		same &= codec_diff || (got == a->stored_size && memcmp(back, ca, got) == 0);
+		recoded += codec_diff;
+		if (z->type == MLOD_CHUNK_MESH && got == z->coded_size) {
+			meshes = realloc(meshes, nmeshes + got);
+			memcpy(meshes + nmeshes, back, got);
+			nmeshes += got;
+		}
 		free(back);
 		staged++;
 	}
 	/* every chunk but INFO is smaller through zstd on the robot */
 	CHECK_MSG(staged == (int)pz.chunk_count - 1, "%d of %u chunks with the stage", staged, pz.chunk_count);
 	CHECK(same);
+	free(meshes);
+	/* some chunks' streams recoded for the stage; the values the same */
+	CHECK_MSG(recoded > 0, "%d chunks with other stream codecs", recoded);
+	mlod_gltf *ua = NULL, *uz = NULL;
+	void *ga = NULL, *gz = NULL;
+	size_t na = 0, nz = 0;
+	CHECK_OK(mlod_pack_unpack(out[0], size[0], &ua, &terr));
+	CHECK_OK(mlod_pack_unpack(out[1], size[1], &uz, &terr));
+	CHECK_OK(mlod_gltf_write(ua, 1, &ga, &na, &terr));
+	CHECK_OK(mlod_gltf_write(uz, 1, &gz, &nz, &terr));
+	CHECK_MSG(na == nz && memcmp(ga, gz, na) == 0, "unpacked glbs of %zu and %zu bytes differ", na, nz);
+	mlod_free(ga);
+	mlod_free(gz);
+	mlod_gltf_free(ua);
+	mlod_gltf_free(uz);
 	/* format 6.0: the robot's finer MESH levels are smaller coded on the
 	 * coarser ones' containers (bench/RESULTS.md) */
 	CHECK_MSG(prefixed >= 2, "%d MESH levels with the prefix stage", prefixed);
