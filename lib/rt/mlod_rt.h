@@ -167,7 +167,10 @@
  * W_root = base * L_root.
  *
  * Palette (per skin joint, all skins in order, as the pack's 'SKJT'):
- * level 0: W[skin joint] * IBM; level k: W[PALJ] * PALB.
+ * level 0: W[skin joint] * IBM; level k: W[j] * B, with j the skin
+ * joint's stand-in at that level (itself when kept) and B the bind matrix
+ * the level gives it (the pack's palette references, mlod(5) SKELETON
+ * levels: an inverse bind of 'IBMS' or one of its own).
  *
  * Skinning writes every part of the instance's mesh level, in part order,
  * vertices concatenated: skinned parts by linear blend skinning of 4
