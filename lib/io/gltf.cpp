@@ -42,6 +42,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -100,8 +101,11 @@ template <class F> mlod_result guard(mlod_error *err, F &&body)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	} catch (const std::length_error &) {
 		return mlod_fail(err, MLOD_ERR_NOMEM, "glTF data too large");
-	} catch (const std::exception &e) {
-		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: %s", e.what());
+	} catch (const std::out_of_range &) {
+		/* (tinygltf's unchecked indices: never the library's text) */
+		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: an index or a length is out of range");
+	} catch (const std::exception &) {
+		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: the document is malformed");
 	} catch (...) {
 		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: unknown error");
 	}
@@ -2349,6 +2353,15 @@ void prune(mlod_gltf &doc, bool meshes = true)
 		}
 		m.buffers[b].data = std::move(packed);
 	}
+	/* A buffer no view uses any more goes: a kept empty one (byteLength
+	 * 0, an empty data: URI) is not glTF and does not read back. */
+	used.assign(m.buffers.size(), false);
+	for (const tinygltf::BufferView &v : m.bufferViews)
+		mark(used, v.buffer);
+	map = renumber(doc, "buffers", used);
+	keep_only(m.buffers, used);
+	for (tinygltf::BufferView &v : m.bufferViews)
+		apply(map, v.buffer);
 	/* The JSON as read follows: it brings back what tinygltf leaves out
 	 * (a zero byteOffset) and drops what it lacks. */
 	if (doc.original.is_object() && doc.original.contains("bufferViews") && doc.original["bufferViews"].is_array()) {
@@ -2783,6 +2796,79 @@ mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir, 
 		need(data != nullptr || size == 0, "mlod_gltf_read: data is NULL");
 		std::unique_ptr<mlod_gltf> doc(new mlod_gltf);
 		read_document(*doc, static_cast<const unsigned char *>(data), size, base_dir);
+		*out = doc.release();
+	});
+}
+
+mlod_result mlod_gltf_read_doc(const void *data, size_t size, mlod_gltf **out, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(out != nullptr, "mlod_gltf_read_doc: out is NULL");
+		*out = nullptr;
+		need(data != nullptr || size == 0, "mlod_gltf_read_doc: data is NULL");
+		const unsigned char *d = static_cast<const unsigned char *>(data);
+		if (size < 4 || le32(d) != glb_magic)
+			fail(MLOD_ERR_PARSE, "not a glb");
+		std::string text = glb_json(d, size);
+		json j;
+		try {
+			j = parse_json(text.data(), text.size());
+		} catch (const json::exception &) {
+			fail(MLOD_ERR_PARSE, "the glb's JSON chunk is not JSON");
+		}
+		/* The BIN chunk, when there is one (glb_json checked its length). */
+		uint32_t length = le32(d + 8);
+		size_t at = 20 + size_t(le32(d + 12));
+		std::string bin;
+		if (at + 8 <= length && le32(d + at + 4) == chunk_bin)
+			bin.assign(reinterpret_cast<const char *>(d) + at, 8 + size_t(le32(d + at)));
+		/* Emptied buffers (byteLength 0, whatever else they hold) go and the
+		 * views' buffer numbers follow; the BIN chunk goes with buffer 0. */
+		if (j.is_object() && j.contains("buffers") && j["buffers"].is_array()) {
+			json &buffers = j["buffers"];
+			std::vector<int> map(buffers.size(), -1);
+			json kept = json::array();
+			for (size_t i = 0; i < buffers.size(); i++) {
+				const json &b = buffers[i];
+				bool empty = b.is_object() && b.contains("byteLength") && b["byteLength"].is_number() &&
+				             b["byteLength"] == 0;
+				if (empty) {
+					if (i == 0)
+						bin.clear();
+					continue;
+				}
+				map[i] = int(kept.size());
+				kept.push_back(b);
+			}
+			if (j.contains("bufferViews") && j["bufferViews"].is_array())
+				for (size_t v = 0; v < j["bufferViews"].size(); v++) {
+					json &view = j["bufferViews"][v];
+					if (!view.is_object() || !view.contains("buffer") || !view["buffer"].is_number_unsigned() ||
+					    view["buffer"].get<size_t>() >= map.size())
+						continue; /* (the reader names it) */
+					int to = map[view["buffer"].get<size_t>()];
+					if (to < 0)
+						fail(MLOD_ERR_PARSE, "bufferViews[%zu]: its buffer has no bytes", v);
+					view["buffer"] = to;
+				}
+			if (kept.empty())
+				j.erase("buffers");
+			else
+				buffers = std::move(kept);
+		}
+		std::string js = j.dump();
+		js.append((4 - js.size() % 4) % 4, ' ');
+		std::string glb;
+		uint64_t total = 20 + uint64_t(js.size()) + bin.size();
+		if (total > UINT32_MAX)
+			fail(MLOD_ERR_LIMIT, "the glb would be larger than 4 GiB");
+		for (uint32_t v : {glb_magic, uint32_t(2), uint32_t(total), uint32_t(js.size()), chunk_json})
+			for (int k = 0; k < 4; k++)
+				glb += char(v >> (8 * k) & 0xFF);
+		glb += js;
+		glb += bin;
+		std::unique_ptr<mlod_gltf> doc(new mlod_gltf);
+		read_document(*doc, reinterpret_cast<const unsigned char *>(glb.data()), glb.size(), nullptr);
 		*out = doc.release();
 	});
 }

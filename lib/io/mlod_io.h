@@ -29,6 +29,11 @@ typedef struct mlod_gltf mlod_gltf;
  * channels name (each counted once per reference) 4 elements per byte. */
 mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir,
                            mlod_gltf **out, mlod_error *err);
+/* Reads a pack's DOC chunk (a glb, mlod(5)): as mlod_gltf_read without a
+ * base directory, but a buffer emptied by stripping (byteLength 0,
+ * whatever else it holds, as older mlod-pack wrote) is dropped first and
+ * the buffer views renumbered; a view on such a buffer is MLOD_ERR_PARSE. */
+mlod_result mlod_gltf_read_doc(const void *data, size_t size, mlod_gltf **out, mlod_error *err);
 void mlod_gltf_free(mlod_gltf *doc);
 
 /* Serialises the document: binary != 0 gives .glb, else .gltf JSON with

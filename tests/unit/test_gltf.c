@@ -1270,6 +1270,64 @@ TEST(bad_references)
 	                "\"nodes\":[{\"mesh\":0}]}", &err) == MLOD_OK);
 }
 
+/* A stripped document keeps no emptied buffer (byteLength 0, an empty
+ * data: URI), which no reader takes back: its glb reads again; and a DOC
+ * holding such buffers, with other members, as older packs do, reads
+ * through mlod_gltf_read_doc. */
+TEST(strip_drops_emptied_buffers)
+{
+	static const char two[] = "{\"asset\":{\"version\":\"2.0\"},"
+	                          "\"buffers\":[{\"byteLength\":44,\"uri\":\"data:application/octet-stream;base64,"
+	                          "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=\"},"
+	                          "{\"byteLength\":44,\"name\":\"second\",\"uri\":\"data:application/octet-stream;base64,"
+	                          "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=\"}],"
+	                          "\"bufferViews\":[{\"buffer\":1,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+	                          "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+	                          "\"min\":[0,0,0],\"max\":[1,1,0]},"
+	                          "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}],"
+	                          "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+	                          "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}";
+	mlod_gltf *doc = NULL, *back = NULL;
+	CHECK_OK(mlod_gltf_read(two, strlen(two), NULL, &doc, &terr));
+	if (!doc)
+		return;
+	CHECK_OK(mlod_gltf_strip_levels(doc, &terr));
+	void *glb = NULL;
+	size_t size = 0;
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &size, &terr));
+	if (glb) {
+		const char *json = (const char *)glb + 20;
+		size_t n = size >= 20 ? ((const unsigned char *)glb)[12] | ((const unsigned char *)glb)[13] << 8 : 0;
+		int empty = 0;
+		for (size_t i = 0; i + 14 <= n; i++)
+			empty |= memcmp(json + i, "\"byteLength\":0", 14) == 0;
+		CHECK_MSG(!empty, "a buffer with byteLength 0 is written: %.*s", (int)n, json);
+		CHECK_OK(mlod_gltf_read_doc(glb, size, &back, &terr));
+		mlod_gltf_free(back);
+		back = NULL;
+	}
+	mlod_free(glb);
+	mlod_gltf_free(doc);
+	/* Older DOCs: an emptied buffer 0 without a BIN chunk, one with a name
+	 * and an empty data: URI after it. */
+	static const char old_json[] = "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":0},"
+	                               "{\"byteLength\":0,\"name\":\"b\",\"uri\":\"data:application/octet-stream;base64,\"}],"
+	                               "\"nodes\":[{\"name\":\"n\"}]}";
+	size_t jn = (strlen(old_json) + 3) / 4 * 4;
+	unsigned char old[512];
+	memset(old, ' ', sizeof old);
+	uint32_t head[5] = {0x46546C67, 2, (uint32_t)(20 + jn), (uint32_t)jn, 0x4E4F534A};
+	for (int i = 0; i < 5; i++)
+		for (int k = 0; k < 4; k++)
+			old[i * 4 + k] = (unsigned char)(head[i] >> (8 * k));
+	memcpy(old + 20, old_json, strlen(old_json));
+	mlod_error err;
+	CHECK(mlod_gltf_read(old, 20 + jn, NULL, &back, &err) != MLOD_OK);
+	CHECK_OK(mlod_gltf_read_doc(old, 20 + jn, &back, &terr));
+	CHECK(back && mlod_gltf_count(back, MLOD_GLTF_NODE) == 1);
+	mlod_gltf_free(back);
+}
+
 TEST(unsupported)
 {
 	mlod_error err;
@@ -1364,6 +1422,7 @@ int main(void)
 	RUN(truncated_glb);
 	RUN(mutated_glb);
 	RUN(bad_references);
+	RUN(strip_drops_emptied_buffers);
 	RUN(unsupported);
 	RUN(external_buffer);
 	RUN(shared_data);
