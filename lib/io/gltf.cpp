@@ -2483,11 +2483,15 @@ void strip_levels(mlod_gltf &doc)
 	for (size_t n = 0; n < m.nodes.size(); n++)
 		if (m.nodes[n].extensions.count("MSFT_lod"))
 			clear_lod(doc, int(n));
-	/* Every primitive keeps its mode, material, extensions and extras. */
+	/* Every primitive keeps its mode, material, extensions and extras; one
+	 * the pack does not hold (points, lines, strips, fans: the levels are
+	 * of triangle lists) keeps its data too. */
 	json *meshes = orig_array("meshes");
 	for (size_t i = 0; i < m.meshes.size(); i++)
 		for (size_t p = 0; p < m.meshes[i].primitives.size(); p++) {
 			tinygltf::Primitive &pr = m.meshes[i].primitives[p];
+			if (pr.mode >= 0 && pr.mode != TINYGLTF_MODE_TRIANGLES)
+				continue;
 			pr.attributes.clear();
 			pr.indices = -1;
 			pr.targets.clear();
@@ -3375,6 +3379,32 @@ mlod_result mlod_gltf_add_weight_tracks(mlod_gltf *doc, int animation, const mlo
 			c.target_path = "weights";
 			a.channels.push_back(c);
 		}
+	});
+}
+
+mlod_result mlod_gltf_append_other_primitives(mlod_gltf *doc, int from, int to, int *added, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_append_other_primitives: doc is NULL");
+		Model &m = doc->model;
+		need(from >= 0 && size_t(from) < m.meshes.size() && to >= 0 && size_t(to) < m.meshes.size() && from != to,
+		     "mlod_gltf_append_other_primitives: no such meshes");
+		int n = 0;
+		std::vector<tinygltf::Primitive> src = m.meshes[size_t(from)].primitives;
+		for (size_t p = 0; p < src.size(); p++) {
+			if (src[p].mode < 0 || src[p].mode == TINYGLTF_MODE_TRIANGLES || src[p].attributes.empty())
+				continue;
+			size_t at = m.meshes[size_t(to)].primitives.size();
+			m.meshes[size_t(to)].primitives.push_back(src[p]);
+			auto e = doc->extras.find("/meshes/" + std::to_string(from) + "/primitives/" + std::to_string(p) + "/extras");
+			if (e != doc->extras.end()) {
+				json v = e->second;
+				doc->extras["/meshes/" + std::to_string(to) + "/primitives/" + std::to_string(at) + "/extras"] = v;
+			}
+			n++;
+		}
+		if (added)
+			*added = n;
 	});
 }
 

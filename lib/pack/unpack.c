@@ -571,6 +571,10 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			} else {
 				if ((r = add_parts_mesh(doc, &meshes[0], parts, count, like, NULL, 0, &s, &mesh, err)) != MLOD_OK)
 					goto done;
+				/* the DOC mesh's points, lines, strips and fans, kept whole */
+				if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) &&
+				    (r = mlod_gltf_append_other_primitives(doc, like, mesh, NULL, err)) != MLOD_OK)
+					goto done;
 				if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH))
 					mesh_map[like] = mesh;
 			}
