@@ -340,6 +340,185 @@ bool extension_supported(const std::string &name)
 	return false;
 }
 
+/* The glTF 2.0 schema's types and ranges of the properties mlod or
+ * tinygltf reads, which tinygltf leniently skips or reads as 0 (a
+ * primitives object, a byteOffset of -8): each a message naming the
+ * object ("meshes[0].primitives: not an array"). */
+struct TypeCheck {
+	enum Kind { Index, Uint, Number, String, Bool, Object, Numbers, Indices, Strings, Array, Any };
+	struct Prop {
+		const char *name;
+		Kind kind;
+		const Prop *members; /* Object: its properties; Array: its elements' (objects) */
+	};
+
+	[[noreturn]] static void bad(const std::string &at, const char *what)
+	{
+		fail(MLOD_ERR_PARSE, "%s: %s", at.c_str(), what);
+	}
+	static bool is_uint(const json &v)
+	{
+		if (v.is_number_unsigned())
+			return true;
+		if (v.is_number_integer())
+			return v.get<long long>() >= 0;
+		if (v.is_number_float()) {
+			double d = v.get<double>();
+			return d >= 0 && d <= 4294967295.0 && d == std::floor(d);
+		}
+		return false;
+	}
+	static void value(const json &v, Kind kind, const Prop *members, const std::string &at)
+	{
+		switch (kind) {
+		case Index:
+			if (!is_uint(v))
+				bad(at, "not an index (a non-negative integer)");
+			break;
+		case Uint:
+			if (!is_uint(v))
+				bad(at, "not a non-negative integer");
+			break;
+		case Number:
+			if (!v.is_number())
+				bad(at, "not a number");
+			break;
+		case String:
+			if (!v.is_string())
+				bad(at, "not a string");
+			break;
+		case Bool:
+			if (!v.is_boolean())
+				bad(at, "not a boolean");
+			break;
+		case Object:
+			object(v, members, at);
+			break;
+		case Numbers:
+		case Indices:
+		case Strings:
+		case Array:
+			if (!v.is_array())
+				bad(at, "not an array");
+			for (size_t i = 0; i < v.size(); i++)
+				value(v[i], kind == Numbers ? Number : kind == Indices ? Index : kind == Strings ? String : Object,
+				      members, at + "[" + std::to_string(i) + "]");
+			break;
+		case Any:
+			break;
+		}
+	}
+	static void object(const json &v, const Prop *members, const std::string &at)
+	{
+		if (!v.is_object())
+			bad(at, "not an object");
+		if (v.contains("name") && !v["name"].is_string())
+			bad(at + ".name", "not a string");
+		if (v.contains("extensions")) {
+			const json &e = v["extensions"];
+			if (!e.is_object())
+				bad(at + ".extensions", "not an object");
+			for (auto it = e.begin(); it != e.end(); ++it)
+				if (!it->is_object())
+					bad(at + ".extensions." + it.key(), "not an object");
+		}
+		for (const Prop *p = members; p && p->name; p++)
+			if (v.contains(p->name))
+				value(v[p->name], p->kind, p->members, at + "." + p->name);
+	}
+};
+
+void check_types(const json &j)
+{
+	using P = TypeCheck::Prop;
+	using K = TypeCheck;
+	static const P texture_info[] = {{"index", K::Index, nullptr}, {"texCoord", K::Uint, nullptr},
+	                                 {"scale", K::Number, nullptr}, {"strength", K::Number, nullptr}, {}};
+	static const P pbr[] = {{"baseColorFactor", K::Numbers, nullptr}, {"baseColorTexture", K::Object, texture_info},
+	                        {"metallicFactor", K::Number, nullptr}, {"roughnessFactor", K::Number, nullptr},
+	                        {"metallicRoughnessTexture", K::Object, texture_info}, {}};
+	static const P material[] = {{"pbrMetallicRoughness", K::Object, pbr}, {"normalTexture", K::Object, texture_info},
+	                             {"occlusionTexture", K::Object, texture_info},
+	                             {"emissiveTexture", K::Object, texture_info}, {"emissiveFactor", K::Numbers, nullptr},
+	                             {"alphaMode", K::String, nullptr}, {"alphaCutoff", K::Number, nullptr},
+	                             {"doubleSided", K::Bool, nullptr}, {}};
+	static const P none[] = {{}};
+	static const P primitive[] = {{"attributes", K::Object, none}, {"indices", K::Index, nullptr},
+	                              {"material", K::Index, nullptr}, {"mode", K::Uint, nullptr},
+	                              {"targets", K::Array, none}, {}};
+	static const P mesh[] = {{"primitives", K::Array, primitive}, {"weights", K::Numbers, nullptr}, {}};
+	static const P sparse_indices[] = {{"bufferView", K::Index, nullptr}, {"byteOffset", K::Uint, nullptr},
+	                                   {"componentType", K::Uint, nullptr}, {}};
+	static const P sparse_values[] = {{"bufferView", K::Index, nullptr}, {"byteOffset", K::Uint, nullptr}, {}};
+	static const P sparse[] = {{"count", K::Uint, nullptr}, {"indices", K::Object, sparse_indices},
+	                           {"values", K::Object, sparse_values}, {}};
+	static const P accessor[] = {{"bufferView", K::Index, nullptr}, {"byteOffset", K::Uint, nullptr},
+	                             {"componentType", K::Uint, nullptr}, {"normalized", K::Bool, nullptr},
+	                             {"count", K::Uint, nullptr}, {"type", K::String, nullptr},
+	                             {"max", K::Numbers, nullptr}, {"min", K::Numbers, nullptr},
+	                             {"sparse", K::Object, sparse}, {}};
+	static const P target[] = {{"node", K::Index, nullptr}, {"path", K::String, nullptr}, {}};
+	static const P channel[] = {{"sampler", K::Index, nullptr}, {"target", K::Object, target}, {}};
+	static const P anim_sampler[] = {{"input", K::Index, nullptr}, {"interpolation", K::String, nullptr},
+	                                 {"output", K::Index, nullptr}, {}};
+	static const P animation[] = {{"channels", K::Array, channel}, {"samplers", K::Array, anim_sampler}, {}};
+	static const P asset[] = {{"version", K::String, nullptr}, {"minVersion", K::String, nullptr},
+	                          {"generator", K::String, nullptr}, {"copyright", K::String, nullptr}, {}};
+	static const P buffer[] = {{"uri", K::String, nullptr}, {"byteLength", K::Uint, nullptr}, {}};
+	static const P view[] = {{"buffer", K::Index, nullptr}, {"byteOffset", K::Uint, nullptr},
+	                         {"byteLength", K::Uint, nullptr}, {"byteStride", K::Uint, nullptr},
+	                         {"target", K::Uint, nullptr}, {}};
+	static const P camera[] = {{"type", K::String, nullptr}, {"orthographic", K::Object, none},
+	                           {"perspective", K::Object, none}, {}};
+	static const P image[] = {{"uri", K::String, nullptr}, {"mimeType", K::String, nullptr},
+	                          {"bufferView", K::Index, nullptr}, {}};
+	static const P node[] = {{"camera", K::Index, nullptr}, {"children", K::Indices, nullptr},
+	                         {"skin", K::Index, nullptr}, {"matrix", K::Numbers, nullptr},
+	                         {"mesh", K::Index, nullptr}, {"rotation", K::Numbers, nullptr},
+	                         {"scale", K::Numbers, nullptr}, {"translation", K::Numbers, nullptr},
+	                         {"weights", K::Numbers, nullptr}, {}};
+	static const P sampler[] = {{"magFilter", K::Uint, nullptr}, {"minFilter", K::Uint, nullptr},
+	                            {"wrapS", K::Uint, nullptr}, {"wrapT", K::Uint, nullptr}, {}};
+	static const P scene[] = {{"nodes", K::Indices, nullptr}, {}};
+	static const P skin[] = {{"inverseBindMatrices", K::Index, nullptr}, {"skeleton", K::Index, nullptr},
+	                         {"joints", K::Indices, nullptr}, {}};
+	static const P texture[] = {{"sampler", K::Index, nullptr}, {"source", K::Index, nullptr}, {}};
+	static const P root[] = {{"extensionsUsed", K::Strings, nullptr}, {"extensionsRequired", K::Strings, nullptr},
+	                         {"accessors", K::Array, accessor}, {"animations", K::Array, animation},
+	                         {"asset", K::Object, asset}, {"buffers", K::Array, buffer},
+	                         {"bufferViews", K::Array, view}, {"cameras", K::Array, camera},
+	                         {"images", K::Array, image}, {"materials", K::Array, material},
+	                         {"meshes", K::Array, mesh}, {"nodes", K::Array, node},
+	                         {"samplers", K::Array, sampler}, {"scene", K::Index, nullptr},
+	                         {"scenes", K::Array, scene}, {"skins", K::Array, skin},
+	                         {"textures", K::Array, texture}, {}};
+	for (const P *p = root; p->name; p++)
+		if (j.contains(p->name))
+			TypeCheck::value(j[p->name], p->kind, p->members, p->name);
+	if (j.contains("extensions"))
+		TypeCheck::object(json::object({{"extensions", j["extensions"]}}), none, "the document");
+	/* Each primitive's attributes and morph targets: accessor indices. */
+	if (j.contains("meshes"))
+		for (size_t m = 0; m < j["meshes"].size(); m++) {
+			const json &mesh_j = j["meshes"][m];
+			if (!mesh_j.contains("primitives"))
+				continue;
+			for (size_t p = 0; p < mesh_j["primitives"].size(); p++) {
+				const json &pr = mesh_j["primitives"][p];
+				std::string at = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]";
+				if (!pr.contains("attributes"))
+					TypeCheck::bad(at, "no attributes");
+				for (auto it = pr["attributes"].begin(); it != pr["attributes"].end(); ++it)
+					TypeCheck::value(*it, K::Index, nullptr, at + ".attributes." + it.key());
+				if (pr.contains("targets"))
+					for (size_t t = 0; t < pr["targets"].size(); t++)
+						for (auto it = pr["targets"][t].begin(); it != pr["targets"][t].end(); ++it)
+							TypeCheck::value(*it, K::Index, nullptr,
+							                 at + ".targets[" + std::to_string(t) + "]." + it.key());
+			}
+		}
+}
+
 void check_required_extensions(const json &doc)
 {
 	auto it = doc.find("extensionsRequired");
@@ -961,6 +1140,7 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 	}
 	if (!j.is_object())
 		fail(MLOD_ERR_PARSE, "not glTF: the JSON is not an object");
+	check_types(j);
 	check_required_extensions(j);
 	check_buffer_uris(j, base_dir);
 

@@ -26,7 +26,11 @@ typedef struct mlod_gltf mlod_gltf;
  * decode far more than its bytes is MLOD_ERR_NOMEM: accessors without a
  * buffer view may hold 16 values per byte of the input and its buffers
  * together, and the accessors that primitives, morph targets and animation
- * channels name (each counted once per reference) 4 elements per byte. */
+ * channels name (each counted once per reference) 4 elements per byte.
+ * A property of the wrong JSON type or range for the glTF 2.0 schema (an
+ * object for an array, a negative byteOffset or index, a non-object
+ * extension) is MLOD_ERR_PARSE naming it ("meshes[0].primitives: not an
+ * array"), where tinygltf would skip it or read 0. */
 mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir,
                            mlod_gltf **out, mlod_error *err);
 /* Reads a pack's DOC chunk (a glb, mlod(5)): as mlod_gltf_read without a
