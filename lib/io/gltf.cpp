@@ -1805,21 +1805,40 @@ private:
 			     hidden);
 	}
 
+	/* A clip per animation with joint channels: one that animates morph
+	 * weights or other nodes only (a mesh without joints) has no joint
+	 * motion and stays in the document alone (a pack's DOC keeps its
+	 * morph weights channels, mlod(5)). */
 	void clips()
 	{
-		c_.clips = c_array<mlod_clip>(m_.animations.size());
-		c_.clip_count = int(m_.animations.size());
-		int not_joint = 0, weights = 0;
+		int not_joint = 0, weights = 0, outside = 0;
+		auto joint_channel = [&](const tinygltf::AnimationChannel &ch) {
+			return ch.target_path != "weights" && is_trs(ch.target_path) && ch.target_node >= 0 &&
+			       joint_of_[size_t(ch.target_node)] >= 0;
+		};
+		std::vector<size_t> with_joints;
 		for (size_t a = 0; a < m_.animations.size(); a++) {
+			bool any = false;
+			for (const tinygltf::AnimationChannel &ch : m_.animations[a].channels)
+				any = any || joint_channel(ch);
+			if (any || c_.skeleton.joint_count > 0)
+				with_joints.push_back(a);
+			else
+				outside++;
+		}
+		c_.clips = c_array<mlod_clip>(with_joints.size());
+		c_.clip_count = int(with_joints.size());
+		for (size_t q = 0; q < with_joints.size(); q++) {
+			size_t a = with_joints[q];
 			const tinygltf::Animation &anim = m_.animations[a];
-			mlod_clip &clip = c_.clips[a];
+			mlod_clip &clip = c_.clips[q];
 			clip.name = c_string(anim.name);
 			clip.gltf_index = int(a);
 			std::vector<const tinygltf::AnimationChannel *> kept;
 			for (const tinygltf::AnimationChannel &ch : anim.channels) {
 				if (ch.target_path == "weights")
 					weights++;
-				else if (!is_trs(ch.target_path) || ch.target_node < 0 || joint_of_[size_t(ch.target_node)] < 0)
+				else if (!joint_channel(ch))
 					not_joint++;
 				else
 					kept.push_back(&ch);
@@ -1837,6 +1856,10 @@ private:
 		if (weights)
 			note("%d animation channels animate morph target weights (kept in the document, outside the joint clips)",
 			     weights);
+		if (outside)
+			note("%d animations without joints to animate (morph target weights, say) are kept in the document, "
+			     "not as clips: no joint motion to reduce",
+			     outside);
 	}
 
 	void channel(size_t a, const tinygltf::AnimationChannel &src, mlod_channel &ch)
