@@ -1269,10 +1269,43 @@ void reconcile(json &out, const json &orig, bool root, bool in_extension)
 /* The document as .glb or pretty-printed .gltf bytes. */
 std::string serialize(const mlod_gltf &doc, bool binary)
 {
+	/* A glb holds the images read from files or data: URIs in its BIN
+	 * chunk, each in a buffer view of its own (a data: URI in a glb is
+	 * what the validator warns of): on a copy of the model. */
+	const Model *model = &doc.model;
+	Model with_views;
+	std::vector<std::pair<size_t, int>> moved; /* image, its new view */
+	for (size_t i = 0; binary && i < doc.model.images.size(); i++) {
+		const tinygltf::Image &im = doc.model.images[i];
+		if (im.bufferView >= 0 || im.image.empty() ||
+		    (im.mimeType.empty() ? sniff_image_type(im.image) : im.mimeType).empty())
+			continue;
+		if (moved.empty()) {
+			with_views = doc.model;
+			if (with_views.buffers.empty())
+				with_views.buffers.emplace_back();
+			model = &with_views;
+		}
+		tinygltf::Image &out = with_views.images[i];
+		std::vector<unsigned char> &b = with_views.buffers[0].data;
+		b.resize((b.size() + 3) / 4 * 4, 0);
+		tinygltf::BufferView v;
+		v.buffer = 0;
+		v.byteOffset = b.size();
+		v.byteLength = out.image.size();
+		b.insert(b.end(), out.image.begin(), out.image.end());
+		with_views.bufferViews.push_back(v);
+		if (out.mimeType.empty())
+			out.mimeType = sniff_image_type(out.image);
+		out.bufferView = int(with_views.bufferViews.size() - 1);
+		out.uri.clear();
+		out.image.clear();
+		moved.emplace_back(i, out.bufferView);
+	}
 	tinygltf::TinyGLTF writer;
 	writer.SetImageWriter(&embed_image, nullptr);
 	std::ostringstream stream;
-	if (!writer.WriteGltfSceneToStream(&doc.model, stream, !binary, binary) || !stream)
+	if (!writer.WriteGltfSceneToStream(model, stream, !binary, binary) || !stream)
 		fail(MLOD_ERR_IO, "tinygltf could not serialise the document");
 	std::string written = stream.str();
 	json j;
@@ -1287,6 +1320,14 @@ std::string serialize(const mlod_gltf &doc, bool binary)
 	fill_empty_objects(j);
 	if (!doc.original.is_null())
 		reconcile(j, doc.original, true, false);
+	for (const auto &iv : moved)
+		if (j.contains("images") && j["images"].is_array() && iv.first < j["images"].size() &&
+		    j["images"][iv.first].is_object()) {
+			json &im = j["images"][iv.first];
+			im.erase("uri");
+			im["bufferView"] = iv.second;
+			im["mimeType"] = model->images[iv.first].mimeType;
+		}
 	/* tinygltf skips animations without channels, which shifts indices. */
 	bool animations_shifted = j.contains("animations") && j["animations"].size() != doc.model.animations.size();
 	for (const auto &kv : doc.extras) {

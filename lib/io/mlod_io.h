@@ -40,8 +40,10 @@ mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir,
 mlod_result mlod_gltf_read_doc(const void *data, size_t size, mlod_gltf **out, mlod_error *err);
 void mlod_gltf_free(mlod_gltf *doc);
 
-/* Serialises the document: binary != 0 gives .glb, else .gltf JSON with
- * embedded buffers. *data is released with mlod_free. */
+/* Serialises the document: binary != 0 gives .glb (images read from
+ * files or data: URIs go into its BIN chunk, a buffer view each), else
+ * .gltf JSON with embedded buffers and images. *data is released with
+ * mlod_free. */
 mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data,
                             size_t *size, mlod_error *err);
 

@@ -5,9 +5,9 @@ M=/usr/share/assimp/models/glTF2/wrongTypes
 [ -f "$M/badArray.gltf" ] || exit 77
 check() { # file, message
 	rc=0
-	"$BIN/$tool" "$M/$1" -o out 2> err || rc=$?
+	"$BIN/$tool" "$M/$1" -o wrong.out 2> err || rc=$?
 	[ "$rc" = 2 ] || { echo "$tool $1: exit $rc, not 2" >&2; exit 1; }
-	[ ! -e out ] || { echo "$tool $1: wrote output" >&2; exit 1; }
+	[ ! -e wrong.out ] || { echo "$tool $1: wrote output" >&2; exit 1; }
 	grep -qxF "$tool: $M/$1: $2" err || { echo "$tool $1: message: $(cat err)" >&2; exit 1; }
 }
 for tool in mlod-pack mlod-label; do

@@ -301,7 +301,9 @@ TEST(gltf_text_roundtrip)
 /* ---------------------------------------------------------------- */
 
 /* Two "images" that are not valid PNGs (so decoding would fail): one in a
- * data: URI, one in a buffer view. Both must come back byte for byte. */
+ * data: URI, one in a buffer view. Both must come back byte for byte: the
+ * first, through a glb, in a buffer view of the BIN chunk (a glb holds no
+ * data: URI), and again as the same data: URI in .gltf text. */
 static const char images_gltf[] =
 	"{\"asset\":{\"version\":\"2.0\"},"
 	"\"buffers\":[{\"byteLength\":12,\"uri\":\"data:application/octet-stream;base64,iVBORwABAgMEBQYH\"}],"
@@ -318,11 +320,26 @@ TEST(images_kept)
 	CHECK_OK(read_text(images_gltf, &doc, &terr));
 	mlod_result r = reread(doc, &again);
 	char *text = gltf_text(doc), *text2 = r == MLOD_OK ? gltf_text(again) : NULL;
+	/* the glb's JSON: the first image in a view of its own */
+	void *glb = NULL;
+	size_t size = 0;
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &size, &terr));
+	const unsigned char *g = glb;
+	size_t jl = g && size >= 20 ? (size_t)g[12] | (size_t)g[13] << 8 | (size_t)g[14] << 16 | (size_t)g[15] << 24 : 0;
+	char *json = g && size >= 20 ? strndup((const char *)g + 20, jl) : NULL;
+	/* the data: URI's 16 bytes, at the view's offset 12 in the BIN chunk */
+	static const unsigned char png[16] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+	int bytes = g && size >= 20 + jl + 8 + 28 && memcmp(g + 20 + jl + 8 + 12, png, 16) == 0;
+	mlod_free(glb);
 	mlod_gltf_free(doc);
 	mlod_gltf_free(again);
-	int same = text && text2 && strcmp(text, text2) == 0;
+	int same = text && text2 && strstr(text2, "\"bufferView\": 1,\n      \"mimeType\": \"image/png\"") != NULL;
 	int uri = text && strstr(text, "\"uri\": \"data:image/png;base64,iVBORw0KGgoAAAAAAAAAAA==\"") != NULL;
 	int view = text && strstr(text, "\"bufferView\": 0,\n      \"mimeType\": \"image/png\"") != NULL;
+	int in_bin = json && !strstr(json, "data:image") && strstr(json, "{\"bufferView\":1,\"mimeType\":\"image/png\"}");
+	CHECK_MSG(in_bin, "the glb's JSON: %s", json ? json : "(none)");
+	CHECK(bytes);
+	free(json);
 	free(text);
 	free(text2);
 	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
