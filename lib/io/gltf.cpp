@@ -508,6 +508,8 @@ void check_types(const json &j)
 				std::string at = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]";
 				if (!pr.contains("attributes"))
 					TypeCheck::bad(at, "no attributes");
+				if (pr.contains("mode") && pr["mode"].get<double>() > 6)
+					TypeCheck::bad(at + ".mode", "not a primitive mode (0 to 6)");
 				for (auto it = pr["attributes"].begin(); it != pr["attributes"].end(); ++it)
 					TypeCheck::value(*it, K::Index, nullptr, at + ".attributes." + it.key());
 				if (pr.contains("targets"))

@@ -29,7 +29,7 @@ typedef struct mlod_gltf mlod_gltf;
  * channels name (each counted once per reference) 4 elements per byte.
  * A property of the wrong JSON type or range for the glTF 2.0 schema (an
  * object for an array, a negative byteOffset or index, a non-object
- * extension) is MLOD_ERR_PARSE naming it ("meshes[0].primitives: not an
+ * extension, a primitive mode past 6) is MLOD_ERR_PARSE naming it ("meshes[0].primitives: not an
  * array"), where tinygltf would skip it or read 0. */
 mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir,
                            mlod_gltf **out, mlod_error *err);

@@ -1345,6 +1345,34 @@ TEST(strip_drops_emptied_buffers)
 	mlod_gltf_free(back);
 }
 
+/* Properties of the wrong JSON type or range, which tinygltf skips or
+ * reads as 0: MLOD_ERR_PARSE naming the property. */
+TEST(wrong_types)
+{
+	static const struct {
+		const char *body, *message;
+	} cases[] = {
+		{"\"meshes\":[{\"primitives\":{\"attributes\":{}}}]}", "meshes[0].primitives: not an array"},
+		{"\"scenes\":[{\"name\":42}]}", "scenes[0].name: not a string"},
+		{"\"nodes\":[{\"mesh\":-1}]}", "nodes[0].mesh: not an index (a non-negative integer)"},
+		{"\"nodes\":[{\"translation\":[0,\"1\",0]}]}", "nodes[0].translation[1]: not a number"},
+		{"\"nodes\":[{\"extensions\":{\"KHR_x\":\"no\"}}]}", "nodes[0].extensions.KHR_x: not an object"},
+		{TRIANGLE_BUFFER "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+		 "\"accessors\":[{\"bufferView\":0,\"byteOffset\":-8,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}",
+		 "accessors[0].byteOffset: not a non-negative integer"},
+		{"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":\"0\"}}]}]}",
+		 "meshes[0].primitives[0].attributes.POSITION: not an index (a non-negative integer)"},
+		{"\"meshes\":[{\"primitives\":[{\"attributes\":{},\"mode\":9}]}]}",
+		 "meshes[0].primitives[0].mode: not a primitive mode (0 to 6)"},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+		mlod_error err = {0};
+		mlod_result r = read_body(cases[i].body, &err);
+		CHECK_MSG(r == MLOD_ERR_PARSE && strcmp(err.message, cases[i].message) == 0, "case %zu: %d \"%s\"", i,
+		          (int)r, err.message);
+	}
+}
+
 TEST(unsupported)
 {
 	mlod_error err;
@@ -1440,6 +1468,7 @@ int main(void)
 	RUN(mutated_glb);
 	RUN(bad_references);
 	RUN(strip_drops_emptied_buffers);
+	RUN(wrong_types);
 	RUN(unsupported);
 	RUN(external_buffer);
 	RUN(shared_data);
