@@ -42,6 +42,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -100,8 +101,11 @@ template <class F> mlod_result guard(mlod_error *err, F &&body)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	} catch (const std::length_error &) {
 		return mlod_fail(err, MLOD_ERR_NOMEM, "glTF data too large");
-	} catch (const std::exception &e) {
-		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: %s", e.what());
+	} catch (const std::out_of_range &) {
+		/* (tinygltf's unchecked indices: never the library's text) */
+		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: an index or a length is out of range");
+	} catch (const std::exception &) {
+		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: the document is malformed");
 	} catch (...) {
 		return mlod_fail(err, MLOD_ERR_PARSE, "glTF: unknown error");
 	}
@@ -334,6 +338,187 @@ bool extension_supported(const std::string &name)
 		if (name.compare(0, strlen(p), p) == 0)
 			return true;
 	return false;
+}
+
+/* The glTF 2.0 schema's types and ranges of the properties mlod or
+ * tinygltf reads, which tinygltf leniently skips or reads as 0 (a
+ * primitives object, a byteOffset of -8): each a message naming the
+ * object ("meshes[0].primitives: not an array"). */
+struct TypeCheck {
+	enum Kind { Index, Uint, Number, String, Bool, Object, Numbers, Indices, Strings, Array, Any };
+	struct Prop {
+		const char *name;
+		Kind kind;
+		const Prop *members; /* Object: its properties; Array: its elements' (objects) */
+	};
+
+	[[noreturn]] static void bad(const std::string &at, const char *what)
+	{
+		fail(MLOD_ERR_PARSE, "%s: %s", at.c_str(), what);
+	}
+	static bool is_uint(const json &v)
+	{
+		if (v.is_number_unsigned())
+			return true;
+		if (v.is_number_integer())
+			return v.get<long long>() >= 0;
+		if (v.is_number_float()) {
+			double d = v.get<double>();
+			return d >= 0 && d <= 4294967295.0 && d == std::floor(d);
+		}
+		return false;
+	}
+	static void value(const json &v, Kind kind, const Prop *members, const std::string &at)
+	{
+		switch (kind) {
+		case Index:
+			if (!is_uint(v))
+				bad(at, "not an index (a non-negative integer)");
+			break;
+		case Uint:
+			if (!is_uint(v))
+				bad(at, "not a non-negative integer");
+			break;
+		case Number:
+			if (!v.is_number())
+				bad(at, "not a number");
+			break;
+		case String:
+			if (!v.is_string())
+				bad(at, "not a string");
+			break;
+		case Bool:
+			if (!v.is_boolean())
+				bad(at, "not a boolean");
+			break;
+		case Object:
+			object(v, members, at);
+			break;
+		case Numbers:
+		case Indices:
+		case Strings:
+		case Array:
+			if (!v.is_array())
+				bad(at, "not an array");
+			for (size_t i = 0; i < v.size(); i++)
+				value(v[i], kind == Numbers ? Number : kind == Indices ? Index : kind == Strings ? String : Object,
+				      members, at + "[" + std::to_string(i) + "]");
+			break;
+		case Any:
+			break;
+		}
+	}
+	static void object(const json &v, const Prop *members, const std::string &at)
+	{
+		if (!v.is_object())
+			bad(at, "not an object");
+		if (v.contains("name") && !v["name"].is_string())
+			bad(at + ".name", "not a string");
+		if (v.contains("extensions")) {
+			const json &e = v["extensions"];
+			if (!e.is_object())
+				bad(at + ".extensions", "not an object");
+			for (auto it = e.begin(); it != e.end(); ++it)
+				if (!it->is_object())
+					bad(at + ".extensions." + it.key(), "not an object");
+		}
+		for (const Prop *p = members; p && p->name; p++)
+			if (v.contains(p->name))
+				value(v[p->name], p->kind, p->members, at + "." + p->name);
+	}
+};
+
+void check_types(const json &j)
+{
+	using P = TypeCheck::Prop;
+	using K = TypeCheck;
+	static const P texture_info[] = {{"index", K::Index, nullptr}, {"texCoord", K::Uint, nullptr},
+	                                 {"scale", K::Number, nullptr}, {"strength", K::Number, nullptr}, {}};
+	static const P pbr[] = {{"baseColorFactor", K::Numbers, nullptr}, {"baseColorTexture", K::Object, texture_info},
+	                        {"metallicFactor", K::Number, nullptr}, {"roughnessFactor", K::Number, nullptr},
+	                        {"metallicRoughnessTexture", K::Object, texture_info}, {}};
+	static const P material[] = {{"pbrMetallicRoughness", K::Object, pbr}, {"normalTexture", K::Object, texture_info},
+	                             {"occlusionTexture", K::Object, texture_info},
+	                             {"emissiveTexture", K::Object, texture_info}, {"emissiveFactor", K::Numbers, nullptr},
+	                             {"alphaMode", K::String, nullptr}, {"alphaCutoff", K::Number, nullptr},
+	                             {"doubleSided", K::Bool, nullptr}, {}};
+	static const P none[] = {{}};
+	static const P primitive[] = {{"attributes", K::Object, none}, {"indices", K::Index, nullptr},
+	                              {"material", K::Index, nullptr}, {"mode", K::Uint, nullptr},
+	                              {"targets", K::Array, none}, {}};
+	static const P mesh[] = {{"primitives", K::Array, primitive}, {"weights", K::Numbers, nullptr}, {}};
+	static const P sparse_indices[] = {{"bufferView", K::Index, nullptr}, {"byteOffset", K::Uint, nullptr},
+	                                   {"componentType", K::Uint, nullptr}, {}};
+	static const P sparse_values[] = {{"bufferView", K::Index, nullptr}, {"byteOffset", K::Uint, nullptr}, {}};
+	static const P sparse[] = {{"count", K::Uint, nullptr}, {"indices", K::Object, sparse_indices},
+	                           {"values", K::Object, sparse_values}, {}};
+	static const P accessor[] = {{"bufferView", K::Index, nullptr}, {"byteOffset", K::Uint, nullptr},
+	                             {"componentType", K::Uint, nullptr}, {"normalized", K::Bool, nullptr},
+	                             {"count", K::Uint, nullptr}, {"type", K::String, nullptr},
+	                             {"max", K::Numbers, nullptr}, {"min", K::Numbers, nullptr},
+	                             {"sparse", K::Object, sparse}, {}};
+	static const P target[] = {{"node", K::Index, nullptr}, {"path", K::String, nullptr}, {}};
+	static const P channel[] = {{"sampler", K::Index, nullptr}, {"target", K::Object, target}, {}};
+	static const P anim_sampler[] = {{"input", K::Index, nullptr}, {"interpolation", K::String, nullptr},
+	                                 {"output", K::Index, nullptr}, {}};
+	static const P animation[] = {{"channels", K::Array, channel}, {"samplers", K::Array, anim_sampler}, {}};
+	static const P asset[] = {{"version", K::String, nullptr}, {"minVersion", K::String, nullptr},
+	                          {"generator", K::String, nullptr}, {"copyright", K::String, nullptr}, {}};
+	static const P buffer[] = {{"uri", K::String, nullptr}, {"byteLength", K::Uint, nullptr}, {}};
+	static const P view[] = {{"buffer", K::Index, nullptr}, {"byteOffset", K::Uint, nullptr},
+	                         {"byteLength", K::Uint, nullptr}, {"byteStride", K::Uint, nullptr},
+	                         {"target", K::Uint, nullptr}, {}};
+	static const P camera[] = {{"type", K::String, nullptr}, {"orthographic", K::Object, none},
+	                           {"perspective", K::Object, none}, {}};
+	static const P image[] = {{"uri", K::String, nullptr}, {"mimeType", K::String, nullptr},
+	                          {"bufferView", K::Index, nullptr}, {}};
+	static const P node[] = {{"camera", K::Index, nullptr}, {"children", K::Indices, nullptr},
+	                         {"skin", K::Index, nullptr}, {"matrix", K::Numbers, nullptr},
+	                         {"mesh", K::Index, nullptr}, {"rotation", K::Numbers, nullptr},
+	                         {"scale", K::Numbers, nullptr}, {"translation", K::Numbers, nullptr},
+	                         {"weights", K::Numbers, nullptr}, {}};
+	static const P sampler[] = {{"magFilter", K::Uint, nullptr}, {"minFilter", K::Uint, nullptr},
+	                            {"wrapS", K::Uint, nullptr}, {"wrapT", K::Uint, nullptr}, {}};
+	static const P scene[] = {{"nodes", K::Indices, nullptr}, {}};
+	static const P skin[] = {{"inverseBindMatrices", K::Index, nullptr}, {"skeleton", K::Index, nullptr},
+	                         {"joints", K::Indices, nullptr}, {}};
+	static const P texture[] = {{"sampler", K::Index, nullptr}, {"source", K::Index, nullptr}, {}};
+	static const P root[] = {{"extensionsUsed", K::Strings, nullptr}, {"extensionsRequired", K::Strings, nullptr},
+	                         {"accessors", K::Array, accessor}, {"animations", K::Array, animation},
+	                         {"asset", K::Object, asset}, {"buffers", K::Array, buffer},
+	                         {"bufferViews", K::Array, view}, {"cameras", K::Array, camera},
+	                         {"images", K::Array, image}, {"materials", K::Array, material},
+	                         {"meshes", K::Array, mesh}, {"nodes", K::Array, node},
+	                         {"samplers", K::Array, sampler}, {"scene", K::Index, nullptr},
+	                         {"scenes", K::Array, scene}, {"skins", K::Array, skin},
+	                         {"textures", K::Array, texture}, {}};
+	for (const P *p = root; p->name; p++)
+		if (j.contains(p->name))
+			TypeCheck::value(j[p->name], p->kind, p->members, p->name);
+	if (j.contains("extensions"))
+		TypeCheck::object(json::object({{"extensions", j["extensions"]}}), none, "the document");
+	/* Each primitive's attributes and morph targets: accessor indices. */
+	if (j.contains("meshes"))
+		for (size_t m = 0; m < j["meshes"].size(); m++) {
+			const json &mesh_j = j["meshes"][m];
+			if (!mesh_j.contains("primitives"))
+				continue;
+			for (size_t p = 0; p < mesh_j["primitives"].size(); p++) {
+				const json &pr = mesh_j["primitives"][p];
+				std::string at = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]";
+				if (!pr.contains("attributes"))
+					TypeCheck::bad(at, "no attributes");
+				if (pr.contains("mode") && pr["mode"].get<double>() > 6)
+					TypeCheck::bad(at + ".mode", "not a primitive mode (0 to 6)");
+				for (auto it = pr["attributes"].begin(); it != pr["attributes"].end(); ++it)
+					TypeCheck::value(*it, K::Index, nullptr, at + ".attributes." + it.key());
+				if (pr.contains("targets"))
+					for (size_t t = 0; t < pr["targets"].size(); t++)
+						for (auto it = pr["targets"][t].begin(); it != pr["targets"][t].end(); ++it)
+							TypeCheck::value(*it, K::Index, nullptr,
+							                 at + ".targets[" + std::to_string(t) + "]." + it.key());
+			}
+		}
 }
 
 void check_required_extensions(const json &doc)
@@ -957,6 +1142,7 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 	}
 	if (!j.is_object())
 		fail(MLOD_ERR_PARSE, "not glTF: the JSON is not an object");
+	check_types(j);
 	check_required_extensions(j);
 	check_buffer_uris(j, base_dir);
 
@@ -1085,10 +1271,43 @@ void reconcile(json &out, const json &orig, bool root, bool in_extension)
 /* The document as .glb or pretty-printed .gltf bytes. */
 std::string serialize(const mlod_gltf &doc, bool binary)
 {
+	/* A glb holds the images read from files or data: URIs in its BIN
+	 * chunk, each in a buffer view of its own (a data: URI in a glb is
+	 * what the validator warns of): on a copy of the model. */
+	const Model *model = &doc.model;
+	Model with_views;
+	std::vector<std::pair<size_t, int>> moved; /* image, its new view */
+	for (size_t i = 0; binary && i < doc.model.images.size(); i++) {
+		const tinygltf::Image &im = doc.model.images[i];
+		if (im.bufferView >= 0 || im.image.empty() ||
+		    (im.mimeType.empty() ? sniff_image_type(im.image) : im.mimeType).empty())
+			continue;
+		if (moved.empty()) {
+			with_views = doc.model;
+			if (with_views.buffers.empty())
+				with_views.buffers.emplace_back();
+			model = &with_views;
+		}
+		tinygltf::Image &out = with_views.images[i];
+		std::vector<unsigned char> &b = with_views.buffers[0].data;
+		b.resize((b.size() + 3) / 4 * 4, 0);
+		tinygltf::BufferView v;
+		v.buffer = 0;
+		v.byteOffset = b.size();
+		v.byteLength = out.image.size();
+		b.insert(b.end(), out.image.begin(), out.image.end());
+		with_views.bufferViews.push_back(v);
+		if (out.mimeType.empty())
+			out.mimeType = sniff_image_type(out.image);
+		out.bufferView = int(with_views.bufferViews.size() - 1);
+		out.uri.clear();
+		out.image.clear();
+		moved.emplace_back(i, out.bufferView);
+	}
 	tinygltf::TinyGLTF writer;
 	writer.SetImageWriter(&embed_image, nullptr);
 	std::ostringstream stream;
-	if (!writer.WriteGltfSceneToStream(&doc.model, stream, !binary, binary) || !stream)
+	if (!writer.WriteGltfSceneToStream(model, stream, !binary, binary) || !stream)
 		fail(MLOD_ERR_IO, "tinygltf could not serialise the document");
 	std::string written = stream.str();
 	json j;
@@ -1103,6 +1322,14 @@ std::string serialize(const mlod_gltf &doc, bool binary)
 	fill_empty_objects(j);
 	if (!doc.original.is_null())
 		reconcile(j, doc.original, true, false);
+	for (const auto &iv : moved)
+		if (j.contains("images") && j["images"].is_array() && iv.first < j["images"].size() &&
+		    j["images"][iv.first].is_object()) {
+			json &im = j["images"][iv.first];
+			im.erase("uri");
+			im["bufferView"] = iv.second;
+			im["mimeType"] = model->images[iv.first].mimeType;
+		}
 	/* tinygltf skips animations without channels, which shifts indices. */
 	bool animations_shifted = j.contains("animations") && j["animations"].size() != doc.model.animations.size();
 	for (const auto &kv : doc.extras) {
@@ -1621,21 +1848,40 @@ private:
 			     hidden);
 	}
 
+	/* A clip per animation with joint channels: one that animates morph
+	 * weights or other nodes only (a mesh without joints) has no joint
+	 * motion and stays in the document alone (a pack's DOC keeps its
+	 * morph weights channels, mlod(5)). */
 	void clips()
 	{
-		c_.clips = c_array<mlod_clip>(m_.animations.size());
-		c_.clip_count = int(m_.animations.size());
-		int not_joint = 0, weights = 0;
+		int not_joint = 0, weights = 0, outside = 0;
+		auto joint_channel = [&](const tinygltf::AnimationChannel &ch) {
+			return ch.target_path != "weights" && is_trs(ch.target_path) && ch.target_node >= 0 &&
+			       joint_of_[size_t(ch.target_node)] >= 0;
+		};
+		std::vector<size_t> with_joints;
 		for (size_t a = 0; a < m_.animations.size(); a++) {
+			bool any = false;
+			for (const tinygltf::AnimationChannel &ch : m_.animations[a].channels)
+				any = any || joint_channel(ch);
+			if (any || c_.skeleton.joint_count > 0)
+				with_joints.push_back(a);
+			else
+				outside++;
+		}
+		c_.clips = c_array<mlod_clip>(with_joints.size());
+		c_.clip_count = int(with_joints.size());
+		for (size_t q = 0; q < with_joints.size(); q++) {
+			size_t a = with_joints[q];
 			const tinygltf::Animation &anim = m_.animations[a];
-			mlod_clip &clip = c_.clips[a];
+			mlod_clip &clip = c_.clips[q];
 			clip.name = c_string(anim.name);
 			clip.gltf_index = int(a);
 			std::vector<const tinygltf::AnimationChannel *> kept;
 			for (const tinygltf::AnimationChannel &ch : anim.channels) {
 				if (ch.target_path == "weights")
 					weights++;
-				else if (!is_trs(ch.target_path) || ch.target_node < 0 || joint_of_[size_t(ch.target_node)] < 0)
+				else if (!joint_channel(ch))
 					not_joint++;
 				else
 					kept.push_back(&ch);
@@ -1653,6 +1899,10 @@ private:
 		if (weights)
 			note("%d animation channels animate morph target weights (kept in the document, outside the joint clips)",
 			     weights);
+		if (outside)
+			note("%d animations without joints to animate (morph target weights, say) are kept in the document, "
+			     "not as clips: no joint motion to reduce",
+			     outside);
 	}
 
 	void channel(size_t a, const tinygltf::AnimationChannel &src, mlod_channel &ch)
@@ -2349,6 +2599,15 @@ void prune(mlod_gltf &doc, bool meshes = true)
 		}
 		m.buffers[b].data = std::move(packed);
 	}
+	/* A buffer no view uses any more goes: a kept empty one (byteLength
+	 * 0, an empty data: URI) is not glTF and does not read back. */
+	used.assign(m.buffers.size(), false);
+	for (const tinygltf::BufferView &v : m.bufferViews)
+		mark(used, v.buffer);
+	map = renumber(doc, "buffers", used);
+	keep_only(m.buffers, used);
+	for (tinygltf::BufferView &v : m.bufferViews)
+		apply(map, v.buffer);
 	/* The JSON as read follows: it brings back what tinygltf leaves out
 	 * (a zero byteOffset) and drops what it lacks. */
 	if (doc.original.is_object() && doc.original.contains("bufferViews") && doc.original["bufferViews"].is_array()) {
@@ -2470,11 +2729,15 @@ void strip_levels(mlod_gltf &doc)
 	for (size_t n = 0; n < m.nodes.size(); n++)
 		if (m.nodes[n].extensions.count("MSFT_lod"))
 			clear_lod(doc, int(n));
-	/* Every primitive keeps its mode, material, extensions and extras. */
+	/* Every primitive keeps its mode, material, extensions and extras; one
+	 * the pack does not hold (points, lines, strips, fans: the levels are
+	 * of triangle lists) keeps its data too. */
 	json *meshes = orig_array("meshes");
 	for (size_t i = 0; i < m.meshes.size(); i++)
 		for (size_t p = 0; p < m.meshes[i].primitives.size(); p++) {
 			tinygltf::Primitive &pr = m.meshes[i].primitives[p];
+			if (pr.mode >= 0 && pr.mode != TINYGLTF_MODE_TRIANGLES)
+				continue;
 			pr.attributes.clear();
 			pr.indices = -1;
 			pr.targets.clear();
@@ -2783,6 +3046,79 @@ mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir, 
 		need(data != nullptr || size == 0, "mlod_gltf_read: data is NULL");
 		std::unique_ptr<mlod_gltf> doc(new mlod_gltf);
 		read_document(*doc, static_cast<const unsigned char *>(data), size, base_dir);
+		*out = doc.release();
+	});
+}
+
+mlod_result mlod_gltf_read_doc(const void *data, size_t size, mlod_gltf **out, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(out != nullptr, "mlod_gltf_read_doc: out is NULL");
+		*out = nullptr;
+		need(data != nullptr || size == 0, "mlod_gltf_read_doc: data is NULL");
+		const unsigned char *d = static_cast<const unsigned char *>(data);
+		if (size < 4 || le32(d) != glb_magic)
+			fail(MLOD_ERR_PARSE, "not a glb");
+		std::string text = glb_json(d, size);
+		json j;
+		try {
+			j = parse_json(text.data(), text.size());
+		} catch (const json::exception &) {
+			fail(MLOD_ERR_PARSE, "the glb's JSON chunk is not JSON");
+		}
+		/* The BIN chunk, when there is one (glb_json checked its length). */
+		uint32_t length = le32(d + 8);
+		size_t at = 20 + size_t(le32(d + 12));
+		std::string bin;
+		if (at + 8 <= length && le32(d + at + 4) == chunk_bin)
+			bin.assign(reinterpret_cast<const char *>(d) + at, 8 + size_t(le32(d + at)));
+		/* Emptied buffers (byteLength 0, whatever else they hold) go and the
+		 * views' buffer numbers follow; the BIN chunk goes with buffer 0. */
+		if (j.is_object() && j.contains("buffers") && j["buffers"].is_array()) {
+			json &buffers = j["buffers"];
+			std::vector<int> map(buffers.size(), -1);
+			json kept = json::array();
+			for (size_t i = 0; i < buffers.size(); i++) {
+				const json &b = buffers[i];
+				bool empty = b.is_object() && b.contains("byteLength") && b["byteLength"].is_number() &&
+				             b["byteLength"] == 0;
+				if (empty) {
+					if (i == 0)
+						bin.clear();
+					continue;
+				}
+				map[i] = int(kept.size());
+				kept.push_back(b);
+			}
+			if (j.contains("bufferViews") && j["bufferViews"].is_array())
+				for (size_t v = 0; v < j["bufferViews"].size(); v++) {
+					json &view = j["bufferViews"][v];
+					if (!view.is_object() || !view.contains("buffer") || !view["buffer"].is_number_unsigned() ||
+					    view["buffer"].get<size_t>() >= map.size())
+						continue; /* (the reader names it) */
+					int to = map[view["buffer"].get<size_t>()];
+					if (to < 0)
+						fail(MLOD_ERR_PARSE, "bufferViews[%zu]: its buffer has no bytes", v);
+					view["buffer"] = to;
+				}
+			if (kept.empty())
+				j.erase("buffers");
+			else
+				buffers = std::move(kept);
+		}
+		std::string js = j.dump();
+		js.append((4 - js.size() % 4) % 4, ' ');
+		std::string glb;
+		uint64_t total = 20 + uint64_t(js.size()) + bin.size();
+		if (total > UINT32_MAX)
+			fail(MLOD_ERR_LIMIT, "the glb would be larger than 4 GiB");
+		for (uint32_t v : {glb_magic, uint32_t(2), uint32_t(total), uint32_t(js.size()), chunk_json})
+			for (int k = 0; k < 4; k++)
+				glb += char(v >> (8 * k) & 0xFF);
+		glb += js;
+		glb += bin;
+		std::unique_ptr<mlod_gltf> doc(new mlod_gltf);
+		read_document(*doc, reinterpret_cast<const unsigned char *>(glb.data()), glb.size(), nullptr);
 		*out = doc.release();
 	});
 }
@@ -3289,6 +3625,32 @@ mlod_result mlod_gltf_add_weight_tracks(mlod_gltf *doc, int animation, const mlo
 			c.target_path = "weights";
 			a.channels.push_back(c);
 		}
+	});
+}
+
+mlod_result mlod_gltf_append_other_primitives(mlod_gltf *doc, int from, int to, int *added, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc != nullptr, "mlod_gltf_append_other_primitives: doc is NULL");
+		Model &m = doc->model;
+		need(from >= 0 && size_t(from) < m.meshes.size() && to >= 0 && size_t(to) < m.meshes.size() && from != to,
+		     "mlod_gltf_append_other_primitives: no such meshes");
+		int n = 0;
+		std::vector<tinygltf::Primitive> src = m.meshes[size_t(from)].primitives;
+		for (size_t p = 0; p < src.size(); p++) {
+			if (src[p].mode < 0 || src[p].mode == TINYGLTF_MODE_TRIANGLES || src[p].attributes.empty())
+				continue;
+			size_t at = m.meshes[size_t(to)].primitives.size();
+			m.meshes[size_t(to)].primitives.push_back(src[p]);
+			auto e = doc->extras.find("/meshes/" + std::to_string(from) + "/primitives/" + std::to_string(p) + "/extras");
+			if (e != doc->extras.end()) {
+				json v = e->second;
+				doc->extras["/meshes/" + std::to_string(to) + "/primitives/" + std::to_string(at) + "/extras"] = v;
+			}
+			n++;
+		}
+		if (added)
+			*added = n;
 	});
 }
 

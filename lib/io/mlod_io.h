@@ -26,13 +26,24 @@ typedef struct mlod_gltf mlod_gltf;
  * decode far more than its bytes is MLOD_ERR_NOMEM: accessors without a
  * buffer view may hold 16 values per byte of the input and its buffers
  * together, and the accessors that primitives, morph targets and animation
- * channels name (each counted once per reference) 4 elements per byte. */
+ * channels name (each counted once per reference) 4 elements per byte.
+ * A property of the wrong JSON type or range for the glTF 2.0 schema (an
+ * object for an array, a negative byteOffset or index, a non-object
+ * extension, a primitive mode past 6) is MLOD_ERR_PARSE naming it ("meshes[0].primitives: not an
+ * array"), where tinygltf would skip it or read 0. */
 mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir,
                            mlod_gltf **out, mlod_error *err);
+/* Reads a pack's DOC chunk (a glb, mlod(5)): as mlod_gltf_read without a
+ * base directory, but a buffer emptied by stripping (byteLength 0,
+ * whatever else it holds, as older mlod-pack wrote) is dropped first and
+ * the buffer views renumbered; a view on such a buffer is MLOD_ERR_PARSE. */
+mlod_result mlod_gltf_read_doc(const void *data, size_t size, mlod_gltf **out, mlod_error *err);
 void mlod_gltf_free(mlod_gltf *doc);
 
-/* Serialises the document: binary != 0 gives .glb, else .gltf JSON with
- * embedded buffers. *data is released with mlod_free. */
+/* Serialises the document: binary != 0 gives .glb (images read from
+ * files or data: URIs go into its BIN chunk, a buffer view each), else
+ * .gltf JSON with embedded buffers and images. *data is released with
+ * mlod_free. */
 mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data,
                             size_t *size, mlod_error *err);
 
@@ -132,14 +143,15 @@ mlod_result mlod_gltf_set_node_mesh(mlod_gltf *doc, int node, int mesh, int skin
 mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out, mlod_error *err);
 
 /* Removes what a pack's levels hold (mlod(5), the DOC chunk): every
- * primitive's attributes, indices and morph targets (each keeps its mode,
- * material, extensions and extras), every animation channel but morph
+ * triangle list's attributes, indices and morph targets (each keeps its
+ * mode, material, extensions and extras; points, lines, strips and fans,
+ * which the levels do not hold, stay whole), every animation channel but morph
  * weights ones of nodes that keep a mesh (animations left without
  * channels go), MSFT_lod (level
  * nodes stay, without mesh or skin), then the accessors, buffer views and
  * bytes nothing uses. Node, mesh, skin, material, texture and image
  * indices hold; animation, accessor and buffer view indices change. The
- * result is not a valid glTF on its own (primitives without POSITION):
+ * result is not a valid glTF on its own (triangle lists without POSITION):
  * mlod-pack -x puts the levels back. A document using an extension that
  * may refer to accessors (as mlod_gltf_prune) is MLOD_ERR_UNSUPPORTED and
  * may be partly stripped: strip a copy. */
@@ -193,6 +205,13 @@ mlod_result mlod_gltf_node_lod(const mlod_gltf *doc, int node, int *ids, int max
  * KHR_texture_*, KHR_lights_punctual, KHR_mesh_quantization, EXT_texture_*,
  * MSFT_lod family) is MLOD_ERR_UNSUPPORTED and left unchanged. */
 mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err);
+
+/* Appends to mesh `to` a copy of each primitive of mesh `from` that is
+ * not a triangle list (points, lines, strips, fans) and has attributes,
+ * sharing its accessors, with its extras; *added (may be NULL) gets their
+ * number. mlod-pack -x puts them after the level-0 parts (the pack holds
+ * triangle lists only; the DOC keeps the others whole). */
+mlod_result mlod_gltf_append_other_primitives(mlod_gltf *doc, int from, int to, int *added, mlod_error *err);
 
 /* Removes MSFT_lod from node (and MSFT_screencoverage from its extras):
  * its former level nodes stay, without mesh or skin, so that node indices

@@ -376,50 +376,12 @@ static mlod_result add_clip(mlod_gltf *doc, const mlod_skeleton *s, const mlod_p
 	return r;
 }
 
-static uint32_t le32(const unsigned char *b)
-{
-	return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
-}
-
-static void put32(unsigned char *b, uint32_t v)
-{
-	b[0] = (unsigned char)v;
-	b[1] = (unsigned char)(v >> 8);
-	b[2] = (unsigned char)(v >> 16);
-	b[3] = (unsigned char)(v >> 24);
-}
-
-/* Reads the DOC's glb. A stripped document without any geometry left (a
- * BVH's, say) is a glb with a JSON chunk alone whose buffer 0 has no
- * bytes, which tinygltf refuses: it gets an empty BIN chunk (4 zero
- * bytes) first, and its empty buffer those 4 bytes. */
+/* Reads the DOC's glb (mlod_gltf_read_doc: buffers emptied by stripping,
+ * as older packs hold them, are dropped). */
 static mlod_result read_doc(const void *glb, size_t size, mlod_gltf **doc, mlod_error *err)
 {
-	const unsigned char *b = glb;
-	unsigned char *copy = NULL;
-	if (size >= 20 && memcmp(b, "glTF", 4) == 0 && le32(b + 8) == size && (size_t)le32(b + 12) + 20 == size) {
-		copy = malloc(size + 12);
-		if (!copy)
-			return nomem(err);
-		memcpy(copy, b, size);
-		/* The writer's empty buffer gets the chunk's 4 bytes (the same
-		 * JSON length). */
-		char *json = (char *)copy + 20, *end = json + le32(b + 12);
-		for (char *c = json; c + 16 <= end; c++)
-			if (memcmp(c, "{\"byteLength\":0}", 16) == 0) {
-				c[14] = '4';
-				break;
-			}
-		put32(copy + 8, (uint32_t)size + 12);
-		put32(copy + size, 4);
-		memcpy(copy + size + 4, "BIN\0", 4);
-		memset(copy + size + 8, 0, 4);
-		glb = copy;
-		size += 12;
-	}
 	mlod_error derr = {0};
-	mlod_result r = mlod_gltf_read(glb, size, NULL, doc, &derr);
-	free(copy);
+	mlod_result r = mlod_gltf_read_doc(glb, size, doc, &derr);
 	if (r != MLOD_OK)
 		return mlod_fail(err, r == MLOD_ERR_NOMEM ? r : MLOD_ERR_PARSE, "DOC: %s", derr.message);
 	return MLOD_OK;
@@ -610,6 +572,10 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 				mesh = mesh_map[like];
 			} else {
 				if ((r = add_parts_mesh(doc, &meshes[0], parts, count, like, NULL, 0, &s, &mesh, err)) != MLOD_OK)
+					goto done;
+				/* the DOC mesh's points, lines, strips and fans, kept whole */
+				if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) &&
+				    (r = mlod_gltf_append_other_primitives(doc, like, mesh, NULL, err)) != MLOD_OK)
 					goto done;
 				if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH))
 					mesh_map[like] = mesh;

@@ -301,7 +301,9 @@ TEST(gltf_text_roundtrip)
 /* ---------------------------------------------------------------- */
 
 /* Two "images" that are not valid PNGs (so decoding would fail): one in a
- * data: URI, one in a buffer view. Both must come back byte for byte. */
+ * data: URI, one in a buffer view. Both must come back byte for byte: the
+ * first, through a glb, in a buffer view of the BIN chunk (a glb holds no
+ * data: URI), and again as the same data: URI in .gltf text. */
 static const char images_gltf[] =
 	"{\"asset\":{\"version\":\"2.0\"},"
 	"\"buffers\":[{\"byteLength\":12,\"uri\":\"data:application/octet-stream;base64,iVBORwABAgMEBQYH\"}],"
@@ -318,11 +320,26 @@ TEST(images_kept)
 	CHECK_OK(read_text(images_gltf, &doc, &terr));
 	mlod_result r = reread(doc, &again);
 	char *text = gltf_text(doc), *text2 = r == MLOD_OK ? gltf_text(again) : NULL;
+	/* the glb's JSON: the first image in a view of its own */
+	void *glb = NULL;
+	size_t size = 0;
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &size, &terr));
+	const unsigned char *g = glb;
+	size_t jl = g && size >= 20 ? (size_t)g[12] | (size_t)g[13] << 8 | (size_t)g[14] << 16 | (size_t)g[15] << 24 : 0;
+	char *json = g && size >= 20 ? strndup((const char *)g + 20, jl) : NULL;
+	/* the data: URI's 16 bytes, at the view's offset 12 in the BIN chunk */
+	static const unsigned char png[16] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+	int bytes = g && size >= 20 + jl + 8 + 28 && memcmp(g + 20 + jl + 8 + 12, png, 16) == 0;
+	mlod_free(glb);
 	mlod_gltf_free(doc);
 	mlod_gltf_free(again);
-	int same = text && text2 && strcmp(text, text2) == 0;
+	int same = text && text2 && strstr(text2, "\"bufferView\": 1,\n      \"mimeType\": \"image/png\"") != NULL;
 	int uri = text && strstr(text, "\"uri\": \"data:image/png;base64,iVBORw0KGgoAAAAAAAAAAA==\"") != NULL;
 	int view = text && strstr(text, "\"bufferView\": 0,\n      \"mimeType\": \"image/png\"") != NULL;
+	int in_bin = json && !strstr(json, "data:image") && strstr(json, "{\"bufferView\":1,\"mimeType\":\"image/png\"}");
+	CHECK_MSG(in_bin, "the glb's JSON: %s", json ? json : "(none)");
+	CHECK(bytes);
+	free(json);
 	free(text);
 	free(text2);
 	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
@@ -1270,6 +1287,92 @@ TEST(bad_references)
 	                "\"nodes\":[{\"mesh\":0}]}", &err) == MLOD_OK);
 }
 
+/* A stripped document keeps no emptied buffer (byteLength 0, an empty
+ * data: URI), which no reader takes back: its glb reads again; and a DOC
+ * holding such buffers, with other members, as older packs do, reads
+ * through mlod_gltf_read_doc. */
+TEST(strip_drops_emptied_buffers)
+{
+	static const char two[] = "{\"asset\":{\"version\":\"2.0\"},"
+	                          "\"buffers\":[{\"byteLength\":44,\"uri\":\"data:application/octet-stream;base64,"
+	                          "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=\"},"
+	                          "{\"byteLength\":44,\"name\":\"second\",\"uri\":\"data:application/octet-stream;base64,"
+	                          "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=\"}],"
+	                          "\"bufferViews\":[{\"buffer\":1,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+	                          "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+	                          "\"min\":[0,0,0],\"max\":[1,1,0]},"
+	                          "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}],"
+	                          "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+	                          "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}";
+	mlod_gltf *doc = NULL, *back = NULL;
+	CHECK_OK(mlod_gltf_read(two, strlen(two), NULL, &doc, &terr));
+	if (!doc)
+		return;
+	CHECK_OK(mlod_gltf_strip_levels(doc, &terr));
+	void *glb = NULL;
+	size_t size = 0;
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &size, &terr));
+	if (glb) {
+		const char *json = (const char *)glb + 20;
+		size_t n = size >= 20 ? ((const unsigned char *)glb)[12] | ((const unsigned char *)glb)[13] << 8 : 0;
+		int empty = 0;
+		for (size_t i = 0; i + 14 <= n; i++)
+			empty |= memcmp(json + i, "\"byteLength\":0", 14) == 0;
+		CHECK_MSG(!empty, "a buffer with byteLength 0 is written: %.*s", (int)n, json);
+		CHECK_OK(mlod_gltf_read_doc(glb, size, &back, &terr));
+		mlod_gltf_free(back);
+		back = NULL;
+	}
+	mlod_free(glb);
+	mlod_gltf_free(doc);
+	/* Older DOCs: an emptied buffer 0 without a BIN chunk, one with a name
+	 * and an empty data: URI after it. */
+	static const char old_json[] = "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":0},"
+	                               "{\"byteLength\":0,\"name\":\"b\",\"uri\":\"data:application/octet-stream;base64,\"}],"
+	                               "\"nodes\":[{\"name\":\"n\"}]}";
+	size_t jn = (strlen(old_json) + 3) / 4 * 4;
+	unsigned char old[512];
+	memset(old, ' ', sizeof old);
+	uint32_t head[5] = {0x46546C67, 2, (uint32_t)(20 + jn), (uint32_t)jn, 0x4E4F534A};
+	for (int i = 0; i < 5; i++)
+		for (int k = 0; k < 4; k++)
+			old[i * 4 + k] = (unsigned char)(head[i] >> (8 * k));
+	memcpy(old + 20, old_json, strlen(old_json));
+	mlod_error err;
+	CHECK(mlod_gltf_read(old, 20 + jn, NULL, &back, &err) != MLOD_OK);
+	CHECK_OK(mlod_gltf_read_doc(old, 20 + jn, &back, &terr));
+	CHECK(back && mlod_gltf_count(back, MLOD_GLTF_NODE) == 1);
+	mlod_gltf_free(back);
+}
+
+/* Properties of the wrong JSON type or range, which tinygltf skips or
+ * reads as 0: MLOD_ERR_PARSE naming the property. */
+TEST(wrong_types)
+{
+	static const struct {
+		const char *body, *message;
+	} cases[] = {
+		{"\"meshes\":[{\"primitives\":{\"attributes\":{}}}]}", "meshes[0].primitives: not an array"},
+		{"\"scenes\":[{\"name\":42}]}", "scenes[0].name: not a string"},
+		{"\"nodes\":[{\"mesh\":-1}]}", "nodes[0].mesh: not an index (a non-negative integer)"},
+		{"\"nodes\":[{\"translation\":[0,\"1\",0]}]}", "nodes[0].translation[1]: not a number"},
+		{"\"nodes\":[{\"extensions\":{\"KHR_x\":\"no\"}}]}", "nodes[0].extensions.KHR_x: not an object"},
+		{TRIANGLE_BUFFER "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+		 "\"accessors\":[{\"bufferView\":0,\"byteOffset\":-8,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}",
+		 "accessors[0].byteOffset: not a non-negative integer"},
+		{"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":\"0\"}}]}]}",
+		 "meshes[0].primitives[0].attributes.POSITION: not an index (a non-negative integer)"},
+		{"\"meshes\":[{\"primitives\":[{\"attributes\":{},\"mode\":9}]}]}",
+		 "meshes[0].primitives[0].mode: not a primitive mode (0 to 6)"},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+		mlod_error err = {0};
+		mlod_result r = read_body(cases[i].body, &err);
+		CHECK_MSG(r == MLOD_ERR_PARSE && strcmp(err.message, cases[i].message) == 0, "case %zu: %d \"%s\"", i,
+		          (int)r, err.message);
+	}
+}
+
 TEST(unsupported)
 {
 	mlod_error err;
@@ -1364,6 +1467,8 @@ int main(void)
 	RUN(truncated_glb);
 	RUN(mutated_glb);
 	RUN(bad_references);
+	RUN(strip_drops_emptied_buffers);
+	RUN(wrong_types);
 	RUN(unsupported);
 	RUN(external_buffer);
 	RUN(shared_data);
