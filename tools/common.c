@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -238,16 +239,37 @@ static void write_replace(const char *what, const char *path, int exists, const 
 	free(tmp);
 }
 
+/* Whether st is the file open on descriptor fd (the same device and
+ * inode): -o /dev/stdout, /dev/fd/1 or /proc/self/fd/1 name the file the
+ * shell redirected to, which must be written through that descriptor (at
+ * its offset, after what the shell wrote), not replaced by name. */
+static int same_file(const struct stat *st, int fd)
+{
+	struct stat f;
+	return fstat(fd, &f) == 0 && f.st_dev == st->st_dev && f.st_ino == st->st_ino;
+}
+
 void tool_write_output(const char *path, const void *data, size_t size, int binary)
 {
-	if (is_stdio(path)) {
+	/* A reader that goes away (a FIFO, socket or pipe closed early) is an
+	 * output failure, exit 4, not a death by SIGPIPE. */
+	signal(SIGPIPE, SIG_IGN);
+	struct stat st;
+	if (!is_stdio(path) && stat(path, &st) == 0 && same_file(&st, STDERR_FILENO) && !same_file(&st, STDOUT_FILENO)) {
+		if (binary && isatty(STDERR_FILENO))
+			tool_die(EXIT_USAGE, path, "refusing to write binary output to a terminal");
+		int e = write_all(STDERR_FILENO, data, size);
+		if (e)
+			tool_die(EXIT_OUTPUT, path, "write error: %s", strerror(e));
+		return;
+	}
+	if (is_stdio(path) || (stat(path, &st) == 0 && same_file(&st, STDOUT_FILENO))) {
 		if (binary && isatty(fileno(stdout)))
 			tool_die(EXIT_USAGE, NULL, "refusing to write binary output to a terminal; redirect stdout or use -o FILE");
 		if (fwrite(data, 1, size, stdout) != size || fflush(stdout) != 0)
 			tool_die(EXIT_OUTPUT, "<stdout>", "write error: %s", strerror(errno));
 		return;
 	}
-	struct stat st;
 	if (lstat(path, &st) != 0) {
 		if (errno != ENOENT)
 			tool_die(EXIT_OUTPUT, path, "%s", strerror(errno));

@@ -70,7 +70,8 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 #define TOOL_OUTPUT_NOTE \
 	"-o replaces a regular file atomically (through a temporary file; a\n" \
 	"symbolic link is kept and the file it names replaced); a character\n" \
-	"device, FIFO or Unix socket is written in place, a terminal refused.\n"
+	"device, FIFO or Unix socket is written in place (binary output to a\n" \
+	"terminal refused); /dev/stdout goes through standard output.\n"
 
 /* Serialises doc as glb (or .gltf when path ends in ".gltf") to path or
  * stdout. Exits 4 on failure. */

@@ -341,9 +341,9 @@ nomem:
 
 /* prefix (format 6.0): a MESH level's (but the coarsest's), the coarser
  * MESH levels' containers, coarsest first; a skeleton level's, SKELETON's
- * container. The frame coded on it
- * (MLOD_ENTROPY_ZSTD_PREFIX) is kept where it is smaller than the frame
- * coded alone (ties keep the frame alone, which needs nothing). */
+ * container. Such a chunk is always coded on its prefix
+ * (MLOD_ENTROPY_ZSTD_PREFIX, chunk_entropy): no frame coded alone is
+ * tried. */
 /* One zstd frame of the container d (n bytes) at the pack's level, with
  * its content size, into out (cap bytes): on prefix when prefix_size > 0.
  * With flush > 0, a zstd block ends at the end of each stream that ends

@@ -714,8 +714,8 @@ void mlod_pack_doc_free(mlod_pack_doc_bytes *x);
 mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, mlod_error *err);
 /* The zero padding before each chunk, which no CRC covers (data: the
  * whole file, or a prefix: the bytes it holds): MLOD_ERR_PARSE naming the
- * chunk after a byte that is not zero. mlod_pack_check runs it first;
- * mlod-pack -x too. */
+ * chunk after a byte that is not zero, or bytes after the pack's end (the
+ * header's file size). mlod_pack_check runs it first; mlod-pack -x too. */
 mlod_result mlod_pack_check_padding(const mlod_pack *p, const void *data, size_t size, mlod_error *err);
 
 void mlod_pack_info_free(mlod_pack_info *x);

@@ -2898,6 +2898,9 @@ mlod_result mlod_pack_check_padding(const mlod_pack *p, const void *data, size_t
 			}
 		at = c->offset + c->stored_size;
 	}
+	if (size > p->file_size)
+		return mlod_fail(err, MLOD_ERR_PARSE, "%llu bytes after the pack's end (byte %llu), which no CRC covers",
+		                 (unsigned long long)(size - p->file_size), (unsigned long long)p->file_size);
 	return MLOD_OK;
 }
 

@@ -59,3 +59,19 @@ ln -s nowhere/x.glb dangling.glb
 if "$BIN/mlod-bgm" -o dangling.glb "$ROOT/samples/tubeman.glb" 2> err.txt; then exit 1; fi
 grep -qx 'mlod-bgm: dangling.glb: symbolic link to nothing that can be written (No such file or directory)' err.txt
 test -L dangling.glb
+# -o /dev/stdout with stdout redirected to a file: written through the
+# descriptor, after what the shell wrote there, and before what follows
+# (never the file replaced by name, which would lose HEAD and TAIL).
+{ echo HEAD; "$BIN/mlod-bgm" -o /dev/stdout "$ROOT/samples/tubeman.glb"; echo TAIL; } > mixed.out
+{ echo HEAD; cat plain.glb; echo TAIL; } > mixed.want
+cmp mixed.want mixed.out
+# A FIFO whose reader goes away early: exit 4 with a message, not SIGPIPE.
+head -c 10 pipe.glb > /dev/zero &
+reader=$!
+set +e
+"$BIN/mlod-bgm" -o pipe.glb "$ROOT/samples/tubeman.glb" 2> early.txt
+code=$?
+set -e
+wait $reader
+[ "$code" -eq 4 ] || { echo "reader gone early: exit $code, want 4" >&2; cat early.txt >&2; exit 1; }
+grep -qx 'mlod-bgm: pipe.glb: write error: Broken pipe' early.txt || { cat early.txt >&2; exit 1; }
