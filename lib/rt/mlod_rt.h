@@ -377,11 +377,14 @@ typedef struct mlod_rt_state {
 /* Takes an instance from the pool, showing clip (ignored without clips)
  * from time, at the coarsest levels until the first update.
  * MLOD_ERR_LIMIT when the pool is full, MLOD_ERR_INVALID_ARG for a clip out
- * of range. */
+ * of range or a time that is not finite. */
 mlod_result mlod_rt_instance_create(mlod_rt_ctx *ctx, uint32_t clip, float time, uint32_t flags, uint32_t *id,
                                     mlod_error *err);
 /* Returns the instance to the pool; an id not alive is ignored. */
 void mlod_rt_instance_destroy(mlod_rt_ctx *ctx, uint32_t id);
+/* Shows clip from time on a live instance (the levels stay as they are
+ * until the next update); MLOD_ERR_INVALID_ARG, nothing changed, for an id
+ * not alive, a clip out of range or a time that is not finite. */
 mlod_result mlod_rt_instance_set(mlod_rt_ctx *ctx, uint32_t id, uint32_t clip, float time, uint32_t flags,
                                  mlod_error *err);
 /* The instance's state, or NULL for an id not alive. */

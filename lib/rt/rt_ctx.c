@@ -1266,6 +1266,8 @@ mlod_result mlod_rt_instance_create(mlod_rt_ctx *ctx, uint32_t clip, float time,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_instance_create: NULL argument");
 	if (ctx->clip_count && clip >= ctx->clip_count)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "clip %u out of range (%u clips)", clip, ctx->clip_count);
+	if (!isfinite(time))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_instance_create: time %g is not finite", (double)time);
 	if (ctx->free_head >= ctx->max_instances)
 		return mlod_fail(err, MLOD_ERR_LIMIT, "the instance pool of %u is full", ctx->max_instances);
 	uint32_t i = ctx->free_head;
@@ -1313,6 +1315,8 @@ mlod_result mlod_rt_instance_set(mlod_rt_ctx *ctx, uint32_t id, uint32_t clip, f
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	if (ctx->clip_count && clip >= ctx->clip_count)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "clip %u out of range (%u clips)", clip, ctx->clip_count);
+	if (!isfinite(time))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u: time %g is not finite", id, (double)time);
 	rt_instance *in = &ctx->inst[id];
 	unuse(ctx, in);
 	in->st.clip = ctx->clip_count ? clip : 0;

@@ -495,6 +495,36 @@ TEST(update_refuses_bad_distances_and_dt)
 	mlod_rt_close(ctx);
 }
 
+/* Times that are not finite: create and set refuse them and leave the
+ * instance as it was. */
+TEST(instance_refuses_bad_times)
+{
+	fx_build(0);
+	mlod_error e = { 0 };
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_views(&fx_views, NULL, &ctx, &e), e);
+	uint32_t id;
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.5f, 0, &id, &e), e);
+	const mlod_rt_state before = *mlod_rt_instance_state(ctx, id);
+	const float bad[] = { NAN, INFINITY, -INFINITY };
+	for (int b = 0; b < 3; b++) {
+		uint32_t other = 12345;
+		e.message[0] = 0;
+		mlod_result r = mlod_rt_instance_create(ctx, 0, bad[b], 0, &other, &e);
+		CHECK(r == MLOD_ERR_INVALID_ARG && strstr(e.message, "not finite") && other == 12345,
+		      "create at %g: %d '%s'", (double)bad[b], (int)r, e.message);
+		e.message[0] = 0;
+		r = mlod_rt_instance_set(ctx, id, 0, bad[b], MLOD_RT_LOOP, &e);
+		CHECK(r == MLOD_ERR_INVALID_ARG && strstr(e.message, "not finite"), "set at %g: %d '%s'", (double)bad[b],
+		      (int)r, e.message);
+		CHECK(memcmp(mlod_rt_instance_state(ctx, id), &before, sizeof before) == 0, "set at %g: the instance changed",
+		      (double)bad[b]);
+	}
+	CHECK_OK(mlod_rt_instance_set(ctx, id, 0, 1.5f, 0, &e), e);
+	CHECK(mlod_rt_instance_state(ctx, id)->time == 1.5f, "a finite time was not taken");
+	mlod_rt_close(ctx);
+}
+
 /* ---------------------------------------------------------------- */
 /* 6. The budget in the stats                                          */
 /* ---------------------------------------------------------------- */
@@ -554,6 +584,7 @@ int main(int argc, char **argv)
 	RUN(no_mesh_views_skin_then_palette);
 	RUN(walk_pack_skin_then_palette);
 	RUN(update_refuses_bad_distances_and_dt);
+	RUN(instance_refuses_bad_times);
 	RUN(stats_budget);
 	if (tmpdir[0] && mlod_pack_bin) {
 		char cmd[600];
