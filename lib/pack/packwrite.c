@@ -391,7 +391,7 @@ static mlod_result chunk_entropy(chunk *c, const uint8_t *prefix, size_t prefix_
 {
 	if (c->type == MLOD_CHUNK_INFO || c->size < 4 || c->size > c->raw)
 		return MLOD_OK;
-	size_t cap = ZSTD_compressBound(c->size), n = c->size;
+	size_t cap = ZSTD_compressBound(c->size);
 	uint8_t *z = malloc(cap), *zt = malloc(cap);
 	ZSTD_CCtx *cc = ZSTD_createCCtx();
 	mlod_result r = MLOD_OK;
@@ -415,14 +415,12 @@ static mlod_result chunk_entropy(chunk *c, const uint8_t *prefix, size_t prefix_
 		              ZSTD_getErrorName(t));
 		goto done;
 	}
-	n = t < n ? t : n;
-	int with_prefix = has_prefix;
-	if (n < c->size) {
+	if (t < c->size) { /* else the container stays as it is */
 		free(c->data);
 		c->coded = (uint32_t)c->size;
 		c->data = z;
-		c->size = n;
-		c->entropy = with_prefix ? MLOD_ENTROPY_ZSTD_PREFIX : MLOD_ENTROPY_ZSTD;
+		c->size = t;
+		c->entropy = has_prefix ? MLOD_ENTROPY_ZSTD_PREFIX : MLOD_ENTROPY_ZSTD;
 		z = NULL;
 	}
 done:
