@@ -255,7 +255,10 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 	 * output failure, exit 4, not a death by SIGPIPE. */
 	signal(SIGPIPE, SIG_IGN);
 	struct stat st;
-	if (!is_stdio(path) && stat(path, &st) == 0 && same_file(&st, STDERR_FILENO) && !same_file(&st, STDOUT_FILENO)) {
+	int open_on = 0; /* the descriptor path names, if stdout's or stderr's */
+	if (!is_stdio(path) && stat(path, &st) == 0)
+		open_on = same_file(&st, STDOUT_FILENO) ? STDOUT_FILENO : same_file(&st, STDERR_FILENO) ? STDERR_FILENO : 0;
+	if (open_on == STDERR_FILENO) {
 		if (binary && isatty(STDERR_FILENO))
 			tool_die(EXIT_USAGE, path, "refusing to write binary output to a terminal");
 		int e = write_all(STDERR_FILENO, data, size);
@@ -263,7 +266,7 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 			tool_die(EXIT_OUTPUT, path, "write error: %s", strerror(e));
 		return;
 	}
-	if (is_stdio(path) || (stat(path, &st) == 0 && same_file(&st, STDOUT_FILENO))) {
+	if (is_stdio(path) || open_on == STDOUT_FILENO) {
 		if (binary && isatty(fileno(stdout)))
 			tool_die(EXIT_USAGE, NULL, "refusing to write binary output to a terminal; redirect stdout or use -o FILE");
 		if (fwrite(data, 1, size, stdout) != size || fflush(stdout) != 0)
