@@ -130,14 +130,23 @@ static void check_oracle(const mlod_character *c)
 }
 
 /* The oracle and the folding check on every file of ../shared/data too,
- * under make test-extended (the caller checks it is there). */
+ * under make test-extended (the caller checks it is there). The folder's
+ * contents change from machine to machine: a file of the list that is not
+ * there is named on stdout and left out; the characters, at least one of
+ * which is always there, must be. */
 static void for_shared(void (*check)(const mlod_character *))
 {
 	static const char *files[] = {"Ely.glb", "RobotExpressive.glb", "bvh_test3.bvh", "cmu_12_01_walk.bvh"};
+	static const int required[] = {1, 1, 0, 0};
 	for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
 		char path[1024];
 		mlod_character c = {0};
 		snprintf(path, sizeof path, "%.900s/%s", getenv("MLOD_SHARED_DATA"), files[i]);
+		struct stat st;
+		if (!required[i] && stat(path, &st) != 0) {
+			printf("note: %s is not in ../shared/data on this machine; left out\n", files[i]);
+			continue;
+		}
 		CHECK_MSG(test_load(path, &c) == 0, "cannot load %.300s", path);
 		check(&c);
 		mlod_character_free(&c);
