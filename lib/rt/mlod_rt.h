@@ -170,7 +170,10 @@
  * level 0: W[skin joint] * IBM; level k: W[j] * B, with j the skin
  * joint's stand-in at that level (itself when kept) and B the bind matrix
  * the level gives it (the pack's palette references, mlod(5) SKELETON
- * levels: an inverse bind of 'IBMS' or one of its own).
+ * levels: an inverse bind of 'IBMS' or one of its own). An entry with the
+ * same joint and the same bind floats as an earlier one (skins sharing
+ * joints; removed joints whose stand-in takes their weights) is copied
+ * from it instead of multiplied again: the same floats.
  *
  * Skinning writes every part of the instance's mesh level, in part order,
  * vertices concatenated: skinned parts by linear blend skinning of 4

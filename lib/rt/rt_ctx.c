@@ -295,6 +295,46 @@ static mlod_result prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_
 	return MLOD_OK;
 }
 
+/* Palette sources (rt_internal.h): the entries sorted by joint, then by
+ * their bind matrix's bytes, then by index, so that equal entries stand
+ * together with their first one leading: O(n log n), a hostile palette
+ * included. */
+typedef struct pal_key {
+	uint32_t joint, index;
+	const float *bind;
+} pal_key;
+
+static int pal_key_cmp(const void *a, const void *b)
+{
+	const pal_key *x = a, *y = b;
+	if (x->joint != y->joint)
+		return x->joint < y->joint ? -1 : 1;
+	int c = memcmp(x->bind, y->bind, 16 * sizeof(float));
+	if (c)
+		return c;
+	return x->index < y->index ? -1 : x->index > y->index;
+}
+
+mlod_result rt_palette_sources(const mlod_rt_ctx *ctx, uint32_t n, const uint32_t *joint,
+                               const float *const *bind, uint32_t *src, mlod_error *err)
+{
+	if (n == 0)
+		return MLOD_OK;
+	pal_key *k = rt_alloc(ctx, (size_t)n * sizeof *k);
+	if (!k)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "palette: out of memory");
+	for (uint32_t e = 0; e < n; e++)
+		k[e] = (pal_key){ joint[e], e, bind[e] };
+	qsort(k, n, sizeof *k, pal_key_cmp);
+	for (uint32_t i = 0, first = 0; i < n; i++) {
+		if (i && (k[i].joint != k[i - 1].joint || memcmp(k[i].bind, k[i - 1].bind, 16 * sizeof(float))))
+			first = i;
+		src[k[i].index] = k[first].index;
+	}
+	rt_free(ctx, k);
+	return MLOD_OK;
+}
+
 /* Builds the plan of a skeleton level (level >= 1) into one block. */
 static mlod_result prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_skel_level *l, mlod_error *err)
 {
@@ -305,7 +345,8 @@ static mlod_result prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_sk
 	if (l->palette_size != ctx->palette_size || (l->palette_size && (!l->palette_joint || !l->palette_bind)))
 		return mlod_fail(err, MLOD_ERR_PARSE, "skeleton level %u: palette of %u entries, the skins have %u",
 		                 u->level, l->palette_size, ctx->palette_size);
-	size_t bytes = (size_t)J * (4 + 1 + 4 + 64);
+	const size_t P = l->palette_size;
+	size_t bytes = (size_t)J * (4 + 1 + 4 + 64) + P * 4;
 	uint8_t *block = rt_alloc(ctx, bytes);
 	if (!block)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "skeleton level %u: out of memory", u->level);
@@ -313,7 +354,8 @@ static mlod_result prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_sk
 	p->rel = (float *)block;
 	p->stand = (int32_t *)(block + (size_t)J * 64);
 	p->posed = (uint32_t *)(block + (size_t)J * 68);
-	p->needed = block + (size_t)J * 72;
+	p->palette_src = (uint32_t *)(block + (size_t)J * 72);
+	p->needed = block + (size_t)J * 72 + P * 4;
 	memset(p->needed, 0, J);
 	mlod_result r = MLOD_OK;
 	for (uint32_t i = 0; i < l->kept_count; i++) {
@@ -360,6 +402,19 @@ static mlod_result prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_sk
 			continue;
 		}
 		rt_mat_mul(inv.m, ctx->rest_world + 16 * (size_t)j, rel);
+	}
+	if (P) {
+		const float **bind = rt_alloc(ctx, P * sizeof *bind);
+		if (!bind) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "skeleton level %u: out of memory", u->level);
+			goto fail;
+		}
+		for (size_t e = 0; e < P; e++)
+			bind[e] = l->palette_bind + 16 * e;
+		r = rt_palette_sources(ctx, (uint32_t)P, l->palette_joint, bind, p->palette_src, err);
+		rt_free(ctx, bind);
+		if (r != MLOD_OK)
+			goto fail;
 	}
 	p->kept_count = l->kept_count;
 	p->kept = l->kept;
@@ -805,13 +860,17 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 	ctx->palette_size = (uint32_t)pal;
 	ctx->pal_joint0 = rt_calloc(ctx, (size_t)pal + 1, sizeof *ctx->pal_joint0);
 	ctx->pal_bind0 = rt_calloc(ctx, (size_t)pal + 1, sizeof *ctx->pal_bind0);
-	if (!ctx->pal_joint0 || !ctx->pal_bind0)
+	ctx->pal_src0 = rt_calloc(ctx, (size_t)pal + 1, sizeof *ctx->pal_src0);
+	if (!ctx->pal_joint0 || !ctx->pal_bind0 || !ctx->pal_src0)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
 	for (uint32_t k = 0; k < s->skin_count; k++)
 		for (uint32_t i = 0; i < s->skins[k].joint_count; i++) {
 			ctx->pal_joint0[ctx->skin_offset[k] + i] = s->skin_joints[k][i];
 			ctx->pal_bind0[ctx->skin_offset[k] + i] = s->inverse_bind[k] + 16 * (size_t)i;
 		}
+	mlod_result pr = rt_palette_sources(ctx, (uint32_t)pal, ctx->pal_joint0, ctx->pal_bind0, ctx->pal_src0, err);
+	if (pr != MLOD_OK)
+		return pr;
 	for (uint32_t j = 0; j < J; j++) {
 		const mlod_pack_joint_rec *jr = &s->joints[j];
 		mlod_trs t = { { jr->t[0], jr->t[1], jr->t[2] },
@@ -934,6 +993,7 @@ void mlod_rt_close(mlod_rt_ctx *ctx)
 	rt_free(ctx, ctx->all_needed);
 	rt_free(ctx, ctx->pal_joint0);
 	rt_free(ctx, ctx->pal_bind0);
+	rt_free(ctx, ctx->pal_src0);
 	rt_free(ctx, ctx->clip_duration);
 	rt_free(ctx, ctx->chan_bits);
 	rt_free(ctx, ctx->inst);

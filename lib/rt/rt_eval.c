@@ -504,7 +504,7 @@ mlod_rt_scratch *mlod_rt_scratch_create(mlod_rt_ctx *ctx)
 		return NULL;
 	const size_t J = ctx->joint_count, P = ctx->palette_size;
 	size_t bytes = sizeof(mlod_rt_scratch) + J * sizeof(mlod_trs) + 16 * sizeof(float) * (J + P) + 64 + J * 5 +
-	               (9 * sizeof(float) + sizeof(uint32_t)) * (J + 8);
+	               (9 * sizeof(float) + sizeof(uint32_t)) * (J + 8) + P * sizeof(uint32_t) + 4;
 	mlod_rt_scratch *s = rt_alloc(ctx, bytes);
 	if (!s)
 		return NULL;
@@ -517,7 +517,8 @@ mlod_rt_scratch *mlod_rt_scratch_create(mlod_rt_ctx *ctx)
 	s->local = (mlod_trs *)(s->lm + 9 * (J + 8));
 	s->plan_posed = (uint32_t *)(s->local + J);
 	s->anim_joints = s->plan_posed + J;
-	s->plan_need = (uint8_t *)(s->anim_joints + J + 8);
+	s->pal_mark = s->anim_joints + J + 8;
+	s->plan_need = (uint8_t *)(s->pal_mark + P);
 	return s;
 }
 
@@ -657,6 +658,13 @@ static inline const float *entry_bind(const mlod_rt_ctx *ctx, const rt_unit *su,
 	return su ? su->plan.palette_bind + 16 * (size_t)e : ctx->pal_bind0[e];
 }
 
+/* The first entry with entry e's joint and bind (e itself when none
+ * before it): its matrix is e's, bit for bit. */
+static inline uint32_t entry_src(const mlod_rt_ctx *ctx, const rt_unit *su, uint32_t e)
+{
+	return su ? su->plan.palette_src[e] : ctx->pal_src0[e];
+}
+
 /* The skin plan of mesh level mu under skeleton level su in s: the joints
  * that its palette entries and rigid parts follow, with their ancestors
  * (removed ones too: they are folded at run time), flagged and listed in
@@ -689,8 +697,14 @@ static void skin_plan(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const rt_unit 
 static void build_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s)
 {
 	const rt_unit *su = s->skel_unit;
-	for (uint32_t e = 0; e < ctx->palette_size; e++)
-		rt_mat_mul(s->world + 16 * (size_t)entry_joint(ctx, su, e), entry_bind(ctx, su, e), s->palette + 16 * (size_t)e);
+	for (uint32_t e = 0; e < ctx->palette_size; e++) {
+		const uint32_t f = entry_src(ctx, su, e);
+		if (f != e)
+			memcpy(s->palette + 16 * (size_t)e, s->palette + 16 * (size_t)f, 16 * sizeof(float));
+		else
+			rt_mat_mul(s->world + 16 * (size_t)entry_joint(ctx, su, e), entry_bind(ctx, su, e),
+			           s->palette + 16 * (size_t)e);
+	}
 	s->paletted = 1;
 }
 
@@ -794,12 +808,20 @@ static int rigid_unit(const float *M, float *U)
 #if defined(RT_EVAL_CLONES)
 RT_EVAL_CLONES
 #endif
-static void palette_entries(const mlod_rt_ctx *ctx, const rt_unit *su, const rt_unit *mu, const float *W,
-                            float *palette)
+static void palette_entries(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const rt_unit *su, const rt_unit *mu,
+                            const float *W, float *palette)
 {
+	if (++s->pal_stamp == 0) {
+		memset(s->pal_mark, 0, ctx->palette_size * sizeof *s->pal_mark);
+		s->pal_stamp = 1;
+	}
 	for (uint32_t k = 0; k < mu->pal_used_count; k++) {
-		const uint32_t e = mu->pal_used[k];
-		rt_mat_mul(W + 16 * (size_t)entry_joint(ctx, su, e), entry_bind(ctx, su, e), palette + 16 * (size_t)e);
+		const uint32_t e = mu->pal_used[k], f = entry_src(ctx, su, e);
+		if (f != e && s->pal_mark[f] == s->pal_stamp)
+			memcpy(palette + 16 * (size_t)e, palette + 16 * (size_t)f, 16 * sizeof(float));
+		else
+			rt_mat_mul(W + 16 * (size_t)entry_joint(ctx, su, e), entry_bind(ctx, su, e), palette + 16 * (size_t)e);
+		s->pal_mark[e] = s->pal_stamp;
 	}
 }
 
@@ -841,7 +863,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	s->posed = 2;
 	s->paletted = 0;
 	const float *W = s->world;
-	palette_entries(ctx, su, mu, W, s->palette);
+	palette_entries(ctx, s, su, mu, W, s->palette);
 	size_t base = 0;
 	float morphed[3 * RT_MORPH_RUN];
 	float M[16], U[12];

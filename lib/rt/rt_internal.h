@@ -17,6 +17,7 @@ typedef struct rt_skel_plan {
 	float *rel;               /* 16 per joint: rest transform stand-in -> joint (identity when kept) */
 	const uint32_t *palette_joint;
 	const float *palette_bind;
+	uint32_t *palette_src;    /* palette_size: the first entry with the same joint and bind (rt_palette_sources) */
 } rt_skel_plan;
 
 enum { RT_UNIT_ABSENT = 0, RT_UNIT_RESIDENT = 1, RT_UNIT_FAILED = 2 };
@@ -119,6 +120,7 @@ struct mlod_rt_ctx {
 	uint8_t *all_needed;      /* joint_count ones */
 	uint32_t *pal_joint0;     /* palette_size: the joint each entry follows at level 0 */
 	const float **pal_bind0;  /* palette_size: its inverse bind matrix */
+	uint32_t *pal_src0;       /* palette_size: the first entry with the same joint and bind */
 	uint32_t levels[MLOD_RT_LAYERS];
 	uint32_t clip_count;
 	float *clip_duration;
@@ -167,6 +169,10 @@ struct mlod_rt_scratch {
 	uint32_t plan_count;
 	uint32_t *plan_posed;
 	uint8_t *plan_need;
+	/* The palette entries mlod_rt_skin made in this call: pal_mark[e] is
+	 * pal_stamp when entry e holds this pose's matrix. */
+	uint32_t *pal_mark;
+	uint32_t pal_stamp;
 };
 
 /* rt_ctx.c */
@@ -179,6 +185,12 @@ void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in);
 uint32_t rt_want_target(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t item, uint32_t w);
 mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err);
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
+/* src[e] for the n palette entries: the smallest index whose entry follows
+ * the same joint with a bind matrix of the same 16 floats (bit for bit),
+ * e itself for the first of them, so that a palette can copy the product
+ * W[joint] * bind instead of making it again. bind[e] is entry e's matrix. */
+mlod_result rt_palette_sources(const mlod_rt_ctx *ctx, uint32_t n, const uint32_t *joint,
+                               const float *const *bind, uint32_t *src, mlod_error *err);
 
 
 /* Byte counts of decoded views (from their arrays). */

@@ -1013,6 +1013,64 @@ TEST(slerp_batches)
 	CHECK(!why, "%s", why);
 }
 
+/* Palette entries that follow the same joint with the same bind matrix
+ * are copied from the first of them (rt_palette_sources) instead of
+ * multiplied again: every entry of mlod_rt_palette, and of mlod_rt_skin's
+ * entries, must still be W[joint] * bind, bit for bit, at every skeleton
+ * level, and some entries must be copies (else this tests nothing). A
+ * source pointing at another joint's entry, or at an entry the skin plan
+ * did not make, gives other floats. */
+TEST(palette_copies_equal_products)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_all(NULL, &e);
+	CHECK(ctx, "open: %s", e.message);
+	mlod_rt_scratch *s1 = mlod_rt_scratch_create(ctx), *s2 = mlod_rt_scratch_create(ctx);
+	CHECK(s1 && s2, "scratch");
+	const uint32_t P = mlod_rt_palette_size(ctx), LS = mlod_rt_level_count(ctx, MLOD_RT_SKELETON),
+	               LM = mlod_rt_level_count(ctx, MLOD_RT_MESH);
+	uint32_t id, copies = 0;
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, MLOD_RT_LOOP, &id, &e), e);
+	for (uint32_t ls = 0; ls < LS; ls++)
+		for (uint32_t lm = 0; lm < LM; lm++)
+			for (int f = 0; f < 7; f++) {
+				mlod_rt_select sel;
+				mlod_rt_select_default(&sel);
+				sel.force_level = 0;
+				float d = 1;
+				CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0713f, &e), e);
+				mlod_rt_state *st = &ctx->inst[id].st;
+				st->level[MLOD_RT_SKELETON] = (uint16_t)ls, st->level[MLOD_RT_MESH] = (uint16_t)lm;
+				const rt_unit *su = ls ? rt_unit_get(ctx, MLOD_RT_SKELETON, ls, 0) : NULL;
+				const uint32_t *joint = su ? su->plan.palette_joint : ctx->pal_joint0;
+				const uint32_t *src = su ? su->plan.palette_src : ctx->pal_src0;
+				const float *W, *Pal;
+				uint32_t n;
+				float out[3 * 16], nrm[3 * 16], ref[16];
+				CHECK_OK(mlod_rt_pose(ctx, s2, id, &W, NULL, NULL, &e), e);
+				CHECK_OK(mlod_rt_palette(ctx, s2, &Pal, NULL, &e), e);
+				for (uint32_t x = 0; x < P; x++) {
+					const float *bind = su ? su->plan.palette_bind + 16 * (size_t)x : ctx->pal_bind0[x];
+					rt_mat_mul(W + 16 * (size_t)joint[x], bind, ref);
+					CHECK(memcmp(Pal + 16 * (size_t)x, ref, 64) == 0,
+					      "skeleton %u frame %d: palette entry %u (copied from %u) is not its product", ls, f, x,
+					      src[x]);
+					copies += f == 0 && lm == 0 && src[x] != x;
+				}
+				CHECK_OK(mlod_rt_skin(ctx, s1, id, out, 12, nrm, 12, 16, &n, &e), e);
+				const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MESH, lm, 0);
+				for (uint32_t k = 0; k < mu->pal_used_count; k++) {
+					const uint32_t x = mu->pal_used[k];
+					CHECK(memcmp(s1->palette + 16 * (size_t)x, Pal + 16 * (size_t)x, 64) == 0,
+					      "skeleton %u mesh %u frame %d: mlod_rt_skin's entry %u is not its product", ls, lm, f, x);
+				}
+			}
+	CHECK(copies > 0, "no palette entry is a copy: the test checks nothing");
+	printf("# %u skeleton levels x %u mesh levels: %u palette entries copied, each its product\n", LS, LM, copies);
+	mlod_rt_scratch_destroy(ctx, s1), mlod_rt_scratch_destroy(ctx, s2);
+	mlod_rt_close(ctx);
+}
+
 int main(void)
 {
 	fx_build(0);
@@ -1029,5 +1087,7 @@ int main(void)
 	RUN(morph_targets);
 	RUN(skin_plan_matches_full_pose);
 	RUN(skin_buckets_at_load);
+	RUN(palette_copies_equal_products);
 	TEST_EXIT();
 }
+

@@ -6,7 +6,8 @@
  * resident level (the best one no finer than wanted) and saying when it
  * falls back, a corrupt level failing alone. Level costs are fixed
  * (rt_test.h, fx_build(1)): coarse levels 500 + 1000 + 2 * 700 = 2900,
- * plus the runtime's table of a skeleton level (73 bytes per joint: 365)
+ * plus the runtime's table of a skeleton level (73 bytes per joint and 4
+ * per palette entry: 365 + 20, SKEL_PLAN)
  * and its lists of a mesh level (4 bytes per palette entry and joint: 40,
  * MESH_PLAN) with its skinned parts' influence-count buckets (4 bytes per
  * part, and per skinned part 1 per vertex and 5 per run of 64: levels 0,
@@ -19,11 +20,12 @@
  */
 #include "rt_test.h"
 
+#define SKEL_PLAN (365u + 20u)
 #define MESH_PLAN 40u
 #define MESH_ORDER1 15u
 #define MESH_ORDER2 10u
 #define MOTION_PLAN(c) (4u * 5u + 4u * (c))
-#define COARSE (2900u + 365u + MESH_PLAN + MESH_ORDER2 + 2u * MOTION_PLAN(1u))
+#define COARSE (2900u + SKEL_PLAN + MESH_PLAN + MESH_ORDER2 + 2u * MOTION_PLAN(1u))
 
 static mlod_rt_ctx *open_budget(size_t budget, mlod_error *e)
 {
