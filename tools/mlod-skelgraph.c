@@ -163,7 +163,18 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	for (int i = 0; i < sc; i++)
 		full[i] = s->skins[i].gltf_index;
 	mlod_skel_levels_records(&job->L, records);
-	if (mlod_gltf_add_skel_levels(doc, &job->c, records, n, skins, &err) != MLOD_OK ||
+	/* Mesh levels already in MSFT_lod (mlod-bgm ran first) stay there. */
+	mlod_record stage;
+	if (mlod_record_read(doc, &stage, &err) != MLOD_OK)
+		tool_die(EXIT_INPUT, job->input, "%s", err.message);
+	const int mesh_levels = stage.mesh_level_count;
+	mlod_record_free(&stage);
+	if (mesh_levels > 0 && n > 0)
+		fprintf(stderr,
+		        "%s: %s: the input's %d mesh level(s) stay in MSFT_lod, weighted on the full skeleton; "
+		        "run mlod-skelgraph before mlod-bgm for mesh levels on the skeleton levels\n",
+		        tool_name, job->input, mesh_levels);
+	if (mlod_gltf_add_skel_levels(doc, &job->c, records, n, skins, mesh_levels == 0, &err) != MLOD_OK ||
 	    mlod_record_skel_levels_make(&job->c, records, n, skins, rec, &err) != MLOD_OK)
 		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
 	mlod_result r = mlod_record_write_skeleton(doc, rec, n, full, sc, &err);

@@ -157,9 +157,12 @@ mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level
  * scene listed in the original node's MSFT_lod (coverage from the
  * errors). skins (count * skin_count entries, may be NULL) receives level
  * k's glTF skin for skin s at k * skin_count + s: what the stage record
- * (mlod_record_write_skeleton) lists. */
+ * (mlod_record_write_skeleton) lists. With lod 0 no MSFT_lod is set or
+ * changed: the level nodes stay detached, for a document whose MSFT_lod
+ * already lists mesh levels (mlod-bgm ran first), which the skeleton
+ * levels must not replace. */
 mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full,
-                                      const mlod_skel_level_record *levels, int count, int *skins,
+                                      const mlod_skel_level_record *levels, int count, int *skins, int lod,
                                       mlod_error *err);
 
 /* ------------------------------------------------------------------ */

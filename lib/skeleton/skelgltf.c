@@ -8,7 +8,9 @@
  *   transferred weights (the other attributes share the original
  *   accessors), placed on a node outside the scene that uses the level's
  *   skin; the original node lists these nodes in MSFT_lod, with
- *   MSFT_screencoverage from the measured errors;
+ *   MSFT_screencoverage from the measured errors (unless the caller keeps
+ *   an MSFT_lod of mesh levels: then they stay detached, listed by the
+ *   stage record's skins only);
  * - the caller gets each level's skins, for the stage record
  *   (lib/record: extras.mlod of the scene and of each skin).
  * Played with the original animations, a level node deforms exactly like
@@ -31,7 +33,7 @@ static double level_error(const mlod_skel_level_record *r)
 }
 
 mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full,
-                                      const mlod_skel_level_record *levels, int count, int *skins_out,
+                                      const mlod_skel_level_record *levels, int count, int *skins_out, int lod,
                                       mlod_error *err)
 {
 	const mlod_skeleton *s = &full->skeleton;
@@ -88,7 +90,7 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
 		for (int k = 0; k < count; k++)
 			errors[k] = level_error(&levels[k]);
 		mlod_lod_coverage(errors, count, coverage);
-		if (count > 0 && (r = mlod_gltf_set_lod(doc, in->node, lod_nodes, count, coverage, err)) != MLOD_OK)
+		if (lod && count > 0 && (r = mlod_gltf_set_lod(doc, in->node, lod_nodes, count, coverage, err)) != MLOD_OK)
 			goto done;
 	}
 
