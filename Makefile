@@ -177,11 +177,19 @@ demo: all $(B)/bench/crowd
 samples: all $(HELPERS)
 	@scripts/gen-sample $(B)
 
+# The parts whose headers mlod.h includes (lib/PART/mlod_*.h).
+PUBLIC_PARTS := model io measure skeleton mesh motion record pack rt
+
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man3 $(DESTDIR)$(MANDIR)/man5
 	install -m 755 $(TOOLS) $(DESTDIR)$(PREFIX)/bin
 	install -m 644 $(B)/libmlod.a $(B)/libmlodrt.a $(DESTDIR)$(PREFIX)/lib
+	# the bake library's umbrella header and its part headers, in the
+	# folders it includes them from (model/mlod_model.h, ..., rt/mlod_pack.h)
 	install -m 644 lib/mlod.h $(DESTDIR)$(PREFIX)/include
+	for p in $(PUBLIC_PARTS); do \
+		install -d $(DESTDIR)$(PREFIX)/include/$$p && install -m 644 lib/$$p/mlod_*.h $(DESTDIR)$(PREFIX)/include/$$p || exit 1; \
+	done
 	# the runtime's headers: mlod_rt.h includes mlod_pack.h and mlod_core.h
 	install -m 644 lib/rt/mlod_rt.h lib/rt/mlod_pack.h lib/core/mlod_core.h $(DESTDIR)$(PREFIX)/include
 	install -m 644 man/man1/*.1 $(DESTDIR)$(MANDIR)/man1
