@@ -344,7 +344,8 @@ typedef struct crowd {
 static void grow(crowd *c)
 {
 	uint32_t need = mlod_rt_max_vertex_count(c->ctx);
-	if (need <= c->cap)
+	need = need ? need : 1; /* a buffer even without a mesh: mlod_rt_skin wants one */
+	if (c->buf && need <= c->cap)
 		return;
 	free(c->buf);
 	c->buf = malloc((size_t)need * 24);
@@ -1022,11 +1023,11 @@ static void print_hist(const uint32_t *h, uint32_t levels)
 static const char *const mode_name[MODES] = { "alpha", "pixels", "toc", "skeleton" };
 
 /* "alpha", "pixels", "toc", "skeleton", a comma list of them, or "all"
- * (alpha and pixels): a bit per mode. */
+ * (every one): a bit per mode. */
 static unsigned parse_modes(const char *s)
 {
 	if (!strcmp(s, "all"))
-		return 1u << MLOD_RT_SELECT_ALPHA | 1u << MLOD_RT_SELECT_PIXELS;
+		return (1u << MODES) - 1;
 	unsigned m = 0;
 	for (const char *p = s; *p;) {
 		size_t n = strcspn(p, ",");
@@ -1294,6 +1295,11 @@ int main(int argc, char **argv)
 	if (r != MLOD_OK)
 		die(exit_code(r), "%s", e.message);
 	double open_ms = 1000 * (cpu_seconds() - t0);
+	if (!pose_only && mlod_rt_level_count(c.ctx, MLOD_RT_MESH) == 0) {
+		/* Nothing to skin (a BVH's pack): measure the pose instead. */
+		fprintf(stderr, "crowd: %s: no mesh to skin: measuring --work pose\n", path);
+		pose_only = c.pose_only = 1;
+	}
 	size_t file_size = 0;
 	void *file = read_file(path, &file_size);
 	mlod_pack_info_rec info;
@@ -1399,7 +1405,7 @@ int main(int argc, char **argv)
 			printf(" %u", mlod_rt_mesh_vertex_count(c.ctx, k));
 		printf("\n");
 	}
-	if (bench)
+	if (bench && L[MLOD_RT_MESH] > 0)
 		skin_bench(file, file_size);
 
 	mlod_rt_select full, sel[MODES];
