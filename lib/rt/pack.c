@@ -1148,6 +1148,14 @@ static mlod_result name_at(cx *x, const char *table, uint32_t table_size, uint32
 		goto fail;                                                                                      \
 	} while (0)
 
+/* An allocation that failed: MLOD_ERR_NOMEM, so that a caller tells a low
+ * memory moment from a corrupt pack. */
+#define FAIL_NOMEM(...)                                                                                         \
+	do {                                                                                                    \
+		r = mlod_fail(err, MLOD_ERR_NOMEM, __VA_ARGS__);                                                 \
+		goto fail;                                                                                      \
+	} while (0)
+
 /* ------------------------------------------------------------------ */
 /* INFO                                                                */
 /* ------------------------------------------------------------------ */
@@ -1857,7 +1865,7 @@ static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const ml
 	uint64_t P = sp.count; /* raw: its bytes are inside the chunk */
 	TRY(cx_load(&x, &sp, &src, err));
 	if (!(recs = pk_calloc(al, P + 1, sizeof *recs)))
-		FAIL("%s: out of memory for %llu parts", x.label, (unsigned long long)P);
+		FAIL_NOMEM("%s: out of memory for %llu parts", x.label, (unsigned long long)P);
 	for (uint64_t i = 0; i < P; i++)
 		memcpy(&recs[i], src + i * sizeof *recs, sizeof *recs);
 	/* The records bound every allocation before Draco decodes anything. */
@@ -1888,7 +1896,7 @@ static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const ml
 		     x.label, (unsigned long long)total, PACK_DRACO_MAX_EXPAND, (unsigned long long)x.size);
 	TRY(bump_alloc(&b, &x, total, err));
 	if (!(gather = pk_malloc(al, 1, (size_t)big)))
-		FAIL("%s: out of memory", x.label);
+		FAIL_NOMEM("%s: out of memory", x.label);
 	mlod_pack_part *parts = bump_take(&b, P * sizeof *parts);
 	if (!parts)
 		FAIL("%s: internal block size mismatch", x.label);
@@ -2087,7 +2095,7 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			pk_free(al, temp);
 			temp_cap = 0;
 			if (!(temp = pk_malloc(al, 1, (size_t)need + 8)))
-				FAIL("%s: out of memory for %llu bytes of scratch", x.label, (unsigned long long)need);
+				FAIL_NOMEM("%s: out of memory for %llu bytes of scratch", x.label, (unsigned long long)need);
 			temp_cap = need;
 		}
 		x.temp = temp, x.aux = 0; /* the decode's scratch, shared by the levels (cx_done frees none) */

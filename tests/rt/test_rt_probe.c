@@ -6,7 +6,8 @@
  * without a mesh, mlod_rt_skin checks the instance and mlod_rt_palette
  * after it poses in full; mlod_rt_update refuses distances that are not
  * finite and >= 0 and a dt that is not finite, changing nothing; stats
- * report budget 0 for no limit.
+ * report budget 0 for no limit. A valid pack under each failing
+ * allocation in turn gives MLOD_ERR_NOMEM only (a second probe).
  *
  * The tests on packs run mlod-pack (MLOD_PACK, else build/release/bin/
  * mlod-pack from the repository's root, where tests/run.sh runs) on the
@@ -545,6 +546,71 @@ TEST(stats_budget)
 	}
 }
 
+/* ---------------------------------------------------------------- */
+/* 7. Out of memory is NOMEM                                         */
+/* ---------------------------------------------------------------- */
+
+/* An allocator that fails its fail_at-th call (1-based), and only it. */
+static unsigned long oom_calls, oom_fail_at;
+
+static void *oom_malloc(void *user, size_t size)
+{
+	(void)user;
+	if (++oom_calls == oom_fail_at)
+		return NULL;
+	return malloc(size);
+}
+
+static void oom_free(void *user, void *p)
+{
+	(void)user;
+	free(p);
+}
+
+/* A valid pack opened and streamed in full with each one allocation
+ * failing in turn: every error is MLOD_ERR_NOMEM (three mesh paths of
+ * the reader said MLOD_ERR_PARSE, "out of memory for ... bytes of
+ * scratch": a caller could not tell low memory from a corrupt pack). */
+TEST(out_of_memory_is_nomem)
+{
+	SKIP_IF_NO_PACK(out_of_memory_is_nomem);
+	char pk[512];
+	CHECK(run_pack("samples/tubeman.glb", "oom.mlod", pk, sizeof pk) == 0, "mlod-pack on the tubeman failed");
+	size_t size = 0;
+	uint8_t *data = read_all(pk, &size);
+	CHECK(data, "cannot read %s", pk);
+	const mlod_rt_allocator al = { oom_malloc, oom_free, NULL };
+	unsigned long total = 0, failures = 0;
+	for (unsigned long at = 1;; at++) {
+		mlod_rt_config cfg = { 0, 4, &al };
+		mlod_error e = { 0 };
+		mlod_rt_ctx *ctx = NULL;
+		oom_calls = 0, oom_fail_at = at;
+		mlod_result r = mlod_rt_open_memory(data, size, &cfg, &ctx, &e);
+		if (r == MLOD_OK) {
+			for (int l = 0; l < MLOD_RT_LAYERS; l++)
+				for (uint32_t k = 0; k < mlod_rt_level_count(ctx, (mlod_rt_layer)l); k++)
+					for (uint32_t item = 0; item < (l == MLOD_RT_MOTION ? mlod_rt_clip_count(ctx) : 1u); item++)
+						mlod_rt_request(ctx, (mlod_rt_layer)l, k, item, NULL);
+			r = mlod_rt_stream(ctx, SIZE_MAX, NULL, &e);
+			mlod_rt_close(ctx);
+		}
+		if (oom_calls < at) { /* no allocation failed: every one was tried */
+			CHECK(r == MLOD_OK, "no failed allocation, yet: %s", e.message);
+			total = at - 1;
+			break;
+		}
+		failures += r != MLOD_OK;
+		if (r != MLOD_OK && r != MLOD_ERR_NOMEM) {
+			free(data);
+			CHECK(0, "allocation %lu failing: code %d, %s", at, (int)r, e.message);
+		}
+	}
+	free(data);
+	CHECK(failures > 0, "no failed allocation reported an error");
+	printf("# %lu allocations, each failing in turn: %lu errors, all MLOD_ERR_NOMEM\n", total, failures);
+}
+
 int main(int argc, char **argv)
 {
 	(void)argc;
@@ -586,6 +652,7 @@ int main(int argc, char **argv)
 	RUN(update_refuses_bad_distances_and_dt);
 	RUN(instance_refuses_bad_times);
 	RUN(stats_budget);
+	RUN(out_of_memory_is_nomem);
 	if (tmpdir[0] && mlod_pack_bin) {
 		char cmd[600];
 		snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
