@@ -1935,8 +1935,9 @@ private:
 		    read_floats(m_, s.output, who + " output", ch.path == MLOD_PATH_ROTATION ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3);
 		size_t per_key = size_t(comps) * (ch.interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
 		if (values.size() != per_key * times.size())
-			fail(MLOD_ERR_PARSE, "%s: output has %zu elements for %zu keys", who.c_str(), values.size() / size_t(comps),
-			     times.size());
+			fail(MLOD_ERR_PARSE, "%s: output has %zu elements for %zu keys, not %zu (%s)", who.c_str(),
+			     values.size() / size_t(comps), times.size(), per_key / size_t(comps) * times.size(),
+			     ch.interp == MLOD_INTERP_CUBICSPLINE ? "in-tangent, value and out-tangent per key" : "one per key");
 		ch.times = c_copy(times);
 		ch.values = c_copy(values);
 		ch.key_count = int(times.size());
