@@ -287,8 +287,8 @@ typedef struct mlod_rt_level_info {
 	float error;          /* scene units */
 	float distance;       /* the TOC's switch distance */
 	uint32_t stored_size; /* bytes in the pack (0 for views) */
-	size_t bytes;         /* resident bytes, 0 when not resident; skeleton level 0
-	                         (the context's own skeleton, outside the budget) 0 */
+	size_t bytes;         /* resident bytes, 0 when not resident; 0 for skeleton level 0,
+	                         the context's own skeleton (mlod_rt_open(3)) */
 	int resident;         /* 1 when resident */
 	int failed;           /* 1 when loading it failed */
 	uint32_t users;       /* instances showing it at the last update */
