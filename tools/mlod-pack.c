@@ -37,7 +37,8 @@ static const char usage_text[] =
 	"                             also on the chunks they need, format 6.0);\n"
 	"                             none: the codec alone\n"
 	"      --name NAME            the character's name in the pack (default: the\n"
-	"                             input file's name without its extension)\n"
+	"                             name of the pack a glb of -x came from, else\n"
+	"                             the input file's name without its extension)\n"
 	"mesh levels (as mlod-bgm):\n"
 	"  -R, --ratios LIST          levels keeping these fractions of the triangles\n"
 	"                             (default %s)\n"
@@ -540,7 +541,8 @@ int main(int argc, char **argv)
 	const char *path = optind < argc ? argv[optind] : NULL;
 	const char *label = tool_input_label(path);
 	char namebuf[256];
-	opt.name = name ? name : tool_input_stem(path, "", namebuf, sizeof namebuf);
+	opt.name = name; /* else the input's record's (a glb of -x), else the file's */
+	opt.default_name = tool_input_stem(path, "", namebuf, sizeof namebuf);
 	mlod_gltf *doc = NULL;
 	mlod_character c;
 	mlod_format format = MLOD_FORMAT_UNKNOWN;
