@@ -83,7 +83,8 @@ static const char usage_text[] =
 /* A level as the stage record lists it. */
 static mlod_record_mesh_level level_record(const mlod_mesh_level *lv, int k)
 {
-	mlod_record_mesh_level r = {k + 1, lv->ratio, lv->triangles, lv->vertices, lv->error, 0.0};
+	mlod_record_mesh_level r = {.level = k + 1, .ratio = lv->ratio, .triangles = lv->triangles,
+	                            .vertices = lv->vertices, .error = lv->error};
 	return r;
 }
 

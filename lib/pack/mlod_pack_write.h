@@ -4,8 +4,12 @@
  * loaded character and writes the pack bytes.
  *
  * Levels come from the stage record when the input has them (mlod-label,
- * mlod-skelgraph, mlod-bgm and mlod-motion ran before), and are computed
- * with each layer's defaults (or the options below) when it has not:
+ * mlod-skelgraph, mlod-bgm and mlod-motion ran before, or the input is a
+ * glb of mlod_pack_unpack: then each level's error is the record's
+ * pack_error, a layer whose record lists no level stays at level 0, each
+ * clip that is a pack's motion level 0 keeps its keys and error, and the
+ * record's pack name and bounds are the INFO's), and are computed with
+ * each layer's defaults (or the options below) when it has not:
  *
  *   skeleton  the record's skeleton_levels (kept joints and remap, glTF
  *             nodes); else labels (the record's, or mlod_label_skeleton)
@@ -70,7 +74,10 @@ typedef struct mlod_pack_options {
 	int entropy;                 /* MLOD_ENTROPY_ZSTD (the default) or _NONE: each
 	                              * chunk but INFO through zstd -19 after its codec,
 	                              * kept where it stores fewer bytes (mlod(5)) */
-	const char *name;            /* the character's name in INFO; NULL: "" */
+	const char *name;            /* the character's name in INFO; NULL: the
+	                              * name in the input's record (extras.mlod.pack,
+	                              * mlod-pack -x), else default_name, else "" */
+	const char *default_name;
 	/* skeleton, when computed */
 	double skel_max_error;       /* % of the skeleton height (MLOD_SKEL_MAX_ERROR_DEFAULT) */
 	mlod_label_options label;
@@ -298,7 +305,9 @@ float mlod_pack_switch_distance(float error);
 /* Unpacks a pack (read through rt/mlod_pack.h) to a glTF document
  * (lib/pack/unpack.c): the DOC chunk with level 0 back in its nodes'
  * meshes and clips, MSFT_lod level nodes for the coarser mesh levels,
- * a skin per skeleton level and skin, "<clip>@lod<k>" animations.
+ * a skin per skeleton level and skin, "<clip>@lod<k>" animations,
+ * and the stage record (mlod-record(5) version 3) of what the pack stores
+ * of those levels, so that mlod_pack_write packs it again from them.
  * MLOD_ERR_PARSE (the reader's message, naming the chunk) for a corrupt
  * pack. Release *out with mlod_gltf_free. */
 mlod_result mlod_pack_unpack(const void *pack, size_t size, mlod_gltf **out, mlod_error *err);

@@ -625,6 +625,7 @@ struct clip_levels {
 	float error0;              /* level 0's joint position error against the input clip */
 	int count;                 /* levels >= 1 */
 	int no_shifts;             /* its rotation keys all at shift 0 (motion_shift_choice) */
+	int packed;                /* a pack's level 0 (extras.mlod.motion_level0): kept as read */
 	const mlod_clip *clip[MLOD_PACK_MAX_MOTION_LEVELS];
 	float error[MLOD_PACK_MAX_MOTION_LEVELS];
 };
@@ -702,8 +703,12 @@ static int mesh_of_gltf(const mlod_character *c, int g)
 }
 
 /* The level nodes of instance node `node`, by mesh level (1-based) into
- * nodes[]; returns the largest level found. */
-static mlod_result level_nodes(struct ctx *x, int node, int *nodes, int *max_level, double *errors)
+ * nodes[]; returns the largest level found. errors (may be NULL) gets the
+ * largest error_percent.max of each level's nodes, pack_errors the largest
+ * pack_error (-1 where none has one), and *no_error 1 when a node has
+ * neither. */
+static mlod_result level_nodes(struct ctx *x, int node, int *nodes, int *max_level, double *errors,
+                               double *pack_errors, int *no_error)
 {
 	int ids[64], count = 0;
 	*max_level = 0;
@@ -719,6 +724,10 @@ static mlod_result level_nodes(struct ctx *x, int node, int *nodes, int *max_lev
 			nodes[mn.level - 1] = ids[i];
 			if (errors && mn.error.max > errors[mn.level - 1])
 				errors[mn.level - 1] = mn.error.max;
+			if (pack_errors && mn.has_pack_error && mn.pack_error > pack_errors[mn.level - 1])
+				pack_errors[mn.level - 1] = mn.pack_error;
+			if (no_error && mn.missing_error && !mn.has_pack_error)
+				*no_error = 1;
 			*max_level = mn.level > *max_level ? mn.level : *max_level;
 		}
 	}
@@ -752,7 +761,7 @@ static mlod_result make_view(struct ctx *x)
 		}
 	for (int i = 0; i < c->instance_count; i++) {
 		int nodes[MLOD_MESH_MAX_LEVELS], max = 0;
-		if ((r = level_nodes(x, c->instances[i].node, nodes, &max, NULL)) != MLOD_OK) {
+		if ((r = level_nodes(x, c->instances[i].node, nodes, &max, NULL, NULL, NULL)) != MLOD_OK) {
 			free(level_skin);
 			return r;
 		}
@@ -853,6 +862,15 @@ static mlod_result measure(struct ctx *x)
 			}
 			any = 1;
 		}
+	/* An input unpacked from a pack (extras.mlod.pack): that pack's bounds,
+	 * which its level 0 posed again after quantisation gives back only to
+	 * within the quantisation steps (and its diagonal is the one its
+	 * errors in percent were of). */
+	if (x->rec.has_pack)
+		for (int a = 0; a < 3; a++) {
+			x->bmin[a] = (float)x->rec.pack_bounds_min[a];
+			x->bmax[a] = (float)x->rec.pack_bounds_max[a];
+		}
 	float d[3] = {x->bmax[0] - x->bmin[0], x->bmax[1] - x->bmin[1], x->bmax[2] - x->bmin[2]};
 	x->diag = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 	x->height = s->joint_count > 0 ? mlod_skeleton_height(s) : 0.0f;
@@ -870,6 +888,11 @@ static mlod_result skeleton_levels(struct ctx *x)
 	mlod_result r = MLOD_OK;
 	if (n == 0 || x->opt->no_skeleton_levels)
 		return MLOD_OK;
+	/* An empty list: an unpacked pack that had level 0 alone. */
+	if (x->rec.has_skel_levels && x->rec.skel_level_count == 0 && x->rec.has_pack) {
+		x->st->skeleton.from_input = 1;
+		return MLOD_OK;
+	}
 	if (x->rec.skel_level_count > 0) {
 		x->st->skeleton.from_input = 1;
 		for (int k = 0; k < x->rec.skel_level_count && k < MLOD_SKEL_MAX_LEVELS; k++) {
@@ -907,8 +930,16 @@ static mlod_result skeleton_levels(struct ctx *x)
 			for (int j = 0; j < n; j++) /* parents first: the nearest kept ancestor */
 				if (remap[j] < 0)
 					remap[j] = remap[s->joints[j].parent];
-			x->skel_error[k] = (float)(l->has_vertex_error ? l->vertex_error.max * x->diag / 100.0
-			                                                : l->joint_error.max);
+			/* The pack error a record from mlod-pack -x gives, else the
+			 * measured errors (version 3 may have neither). */
+			if (!l->has_pack_error && !l->has_vertex_error && l->missing_joint_error)
+				return mlod_fail(x->err, MLOD_ERR_PARSE,
+				                 "the scene's extras.mlod.skeleton_levels[%d]: no error (pack_error, "
+				                 "vertex_error_percent or joint_error)",
+				                 k);
+			x->skel_error[k] = (float)(l->has_pack_error     ? l->pack_error
+			                           : l->has_vertex_error ? l->vertex_error.max * x->diag / 100.0
+			                                                 : l->joint_error.max);
 		}
 		return MLOD_OK;
 	}
@@ -1137,10 +1168,14 @@ static mlod_result mesh_levels(struct ctx *x)
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 	for (size_t i = 0; i < MLOD_MESH_MAX_LEVELS * ((size_t)c->instance_count + 1); i++)
 		nodes[i] = -1;
-	double node_error[MLOD_MESH_MAX_LEVELS] = {0};
+	double node_error[MLOD_MESH_MAX_LEVELS] = {0}, node_pack_error[MLOD_MESH_MAX_LEVELS];
+	int no_error = 0;
+	for (int k = 0; k < MLOD_MESH_MAX_LEVELS; k++)
+		node_pack_error[k] = -1.0;
 	for (int i = 0; r == MLOD_OK && i < c->instance_count; i++) {
 		int m = 0;
-		r = level_nodes(x, c->instances[i].node, nodes + MLOD_MESH_MAX_LEVELS * i, &m, node_error);
+		r = level_nodes(x, c->instances[i].node, nodes + MLOD_MESH_MAX_LEVELS * i, &m, node_error, node_pack_error,
+		                &no_error);
 		max = m > max ? m : max;
 	}
 	if (r == MLOD_OK && max > 0) {
@@ -1154,11 +1189,25 @@ static mlod_result mesh_levels(struct ctx *x)
 			x->mesh_count = k + 1;
 			for (int i = 0; i < c->instance_count; i++)
 				x->level_node[k][i] = nodes[MLOD_MESH_MAX_LEVELS * i + k];
-			/* The scene's record, else the largest of the level nodes'. */
-			x->mesh_error[k] = (float)(node_error[k] * x->diag / 100.0);
-			for (int q = 0; q < x->rec.mesh_level_count; q++)
-				if (x->rec.mesh_levels[q].level == k + 1)
-					x->mesh_error[k] = (float)(x->rec.mesh_levels[q].error.max * x->diag / 100.0);
+			/* The scene's record, else the largest of the level nodes';
+			 * the pack error of a record from mlod-pack -x before the
+			 * measured error in percent. */
+			int scene = 0;
+			x->mesh_error[k] = (float)(node_pack_error[k] >= 0.0 ? node_pack_error[k] : node_error[k] * x->diag / 100.0);
+			for (int q = 0; q < x->rec.mesh_level_count; q++) {
+				const mlod_record_mesh_level *l = &x->rec.mesh_levels[q];
+				if (l->level != k + 1 || (l->missing_error && !l->has_pack_error))
+					continue;
+				x->mesh_error[k] = (float)(l->has_pack_error ? l->pack_error : l->error.max * x->diag / 100.0);
+				scene = 1;
+			}
+			if (!scene && no_error) {
+				r = mlod_fail(x->err, MLOD_ERR_PARSE,
+				              "mesh level %d: no error (pack_error or error_percent) in the level nodes' "
+				              "or the scene's extras.mlod",
+				              k + 1);
+				break;
+			}
 		}
 		free(nodes);
 		return r;
@@ -1166,6 +1215,11 @@ static mlod_result mesh_levels(struct ctx *x)
 	free(nodes);
 	if (r != MLOD_OK)
 		return r;
+	/* An empty list: an unpacked pack that had level 0 alone. */
+	if (x->rec.has_mesh_levels && x->rec.mesh_level_count == 0 && x->rec.has_pack) {
+		x->st->mesh.from_input = 1;
+		return MLOD_OK;
+	}
 	/* Computed, as mlod-bgm does with the same options. */
 	double ratios[MLOD_MESH_MAX_LEVELS];
 	int n = x->opt->ratio_count;
@@ -2228,11 +2282,37 @@ static mlod_result motion_level0(struct ctx *x)
 		x->clips[q].level0 = &c->clips[q];
 	double e0 = x->opt->motion_level0_percent ? x->opt->motion_level0_error * x->height / 100.0
 	                                          : x->opt->motion_level0_error;
-	if (c->clip_count == 0 || x->opt->lossless_motion || !(e0 > 0.0))
-		return MLOD_OK;
-	x->level0_owned = calloc((size_t)c->clip_count, sizeof *x->level0_owned);
-	if (!x->level0_owned)
+	/* A clip that is a pack's level 0 (mlod-pack -x: motion_level0 in its
+	 * record) keeps its keys and that pack's error: reducing it again
+	 * would stack a second error on the first. */
+	unsigned char *packed = calloc((size_t)c->clip_count + 1, 1);
+	if (!packed)
 		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	for (int q = 0; x->doc && q < c->clip_count; q++) {
+		double pe = 0.0;
+		int found = 0;
+		mlod_result rr = c->clips[q].gltf_index >= 0
+		                     ? mlod_record_read_motion0(x->doc, c->clips[q].gltf_index, &pe, &found, x->err)
+		                     : MLOD_OK;
+		if (rr != MLOD_OK) {
+			free(packed);
+			return rr;
+		}
+		if (found) {
+			packed[q] = 1;
+			x->clips[q].packed = 1;
+			x->clips[q].error0 = (float)pe;
+		}
+	}
+	if (c->clip_count == 0 || x->opt->lossless_motion || !(e0 > 0.0)) {
+		free(packed);
+		return MLOD_OK;
+	}
+	x->level0_owned = calloc((size_t)c->clip_count, sizeof *x->level0_owned);
+	if (!x->level0_owned) {
+		free(packed);
+		return mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
+	}
 	mlod_motion_options mo = {0};
 	mo.point_distance = motion_point_distance(x);
 	mo.precision = MLOD_MOTION_PRECISION_FULL; /* every level keeps the clip's own values (mlod(5) MOTION levels) */
@@ -2240,6 +2320,8 @@ static mlod_result motion_level0(struct ctx *x)
 	int kept = 0;
 	for (int q = 0; r == MLOD_OK && q < c->clip_count; q++) {
 		mlod_motion *m[2] = {NULL, NULL};
+		if (packed[q])
+			continue;
 		for (int i = 0; r == MLOD_OK && i < 2; i++)
 			r = i == 0 ? mlod_motion_create(c, q, &mo, &m[i], x->err) : mlod_motion_create_like(m[0], &m[i], x->err);
 		if (r == MLOD_OK && mlod_motion_timeline_info(m[0])->frames >= 3) {
@@ -2271,6 +2353,15 @@ static mlod_result motion_level0(struct ctx *x)
 		snprintf(text, sizeof text, "%d clip(s) keep every key at motion level 0", kept);
 		note(x, text);
 	}
+	int npacked = 0;
+	for (int q = 0; q < c->clip_count; q++)
+		npacked += packed[q];
+	if (r == MLOD_OK && npacked) {
+		char text[96];
+		snprintf(text, sizeof text, "%d clip(s) are a pack's motion level 0: kept as they are", npacked);
+		note(x, text);
+	}
+	free(packed);
 	return r;
 }
 
@@ -2299,14 +2390,20 @@ static mlod_result motion_levels(struct ctx *x)
 			if (c->clips[q].gltf_index == ml.source_animation && ml.level >= 1 &&
 			    ml.level <= MLOD_PACK_MAX_MOTION_LEVELS) {
 				struct clip_levels *cl = &x->clips[q];
+				if (!ml.has_pack_error && ml.missing_joint_error)
+					return mlod_fail(x->err, MLOD_ERR_PARSE,
+					                 "animation %d: extras.mlod: no error (pack_error or joint_error)",
+					                 x->in->clips[i].gltf_index);
 				cl->clip[ml.level - 1] = &x->in->clips[i];
-				cl->error[ml.level - 1] = (float)ml.joint_error.max;
+				cl->error[ml.level - 1] = (float)(ml.has_pack_error ? ml.pack_error : ml.joint_error.max);
 				cl->count = ml.level > cl->count ? ml.level : cl->count;
 				from_input = 1;
 			}
 	}
 	if (r != MLOD_OK)
 		return r;
+	for (int q = 0; q < c->clip_count; q++) /* an unpacked pack's clips: its levels, maybe none */
+		from_input |= x->clips[q].packed;
 	if (from_input) {
 		x->st->motion.from_input = 1;
 		for (int q = 0; q < c->clip_count; q++) /* a gap repeats the finer level */
@@ -3037,10 +3134,40 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
  * bytes with the rotation lattice shifts or without (the shifts change
  * the keys' bases and their sign choices, which can cost more than they
  * save). Sets no_shifts where they do not pay. */
+static int img_as_read(const motion_img *img, const mlod_clip *clip);
+
 static mlod_result motion_shift_choice(struct ctx *x, int A)
 {
 	for (int q = 0; q < x->v.clip_count; q++) {
 		size_t bytes[2] = {0, 0};
+		/* A pack's level 0 and its levels (an input of mlod-pack -x):
+		 * their keys are on that pack's lattices and grids already. The
+		 * shifts chosen again are kept where every level's keys go back
+		 * exactly as read (the same shifts, or coarser ones the keys
+		 * happen to sit on), else none: each level keeps the error that
+		 * pack measured, never rounded a second time. */
+		if (x->clips[q].packed) {
+			motion_img img[2] = {{0, NULL}, {0, NULL}};
+			int same = 1;
+			x->clips[q].no_shifts = 0;
+			for (int k = A - 1; same && k >= 0; k--) {
+				chunks c = {0};
+				const mlod_clip *cl = k == 0 ? x->clips[q].level0 : x->clips[q].clip[k - 1];
+				mlod_result r = motion_chunk(x, cl, k, q, k == 0 ? x->clips[q].error0 : x->clips[q].error[k - 1],
+				                             k + 1 < A ? &img[!(k & 1)] : NULL, &img[k & 1], &c);
+				for (int i = 0; i < c.n; i++)
+					free(c.c[i].data);
+				free(c.c);
+				if (r != MLOD_OK) {
+					motion_img_free(&img[0]), motion_img_free(&img[1]);
+					return r;
+				}
+				same = img_as_read(&img[k & 1], cl);
+			}
+			motion_img_free(&img[0]), motion_img_free(&img[1]);
+			x->clips[q].no_shifts = !same;
+			continue;
+		}
 		for (int pass = 0; pass < 2; pass++) {
 			motion_img img[2] = {{0, NULL}, {0, NULL}};
 			x->clips[q].no_shifts = pass;
@@ -3062,6 +3189,38 @@ static mlod_result motion_shift_choice(struct ctx *x, int A)
 		x->clips[q].no_shifts = bytes[1] <= bytes[0];
 	}
 	return MLOD_OK;
+}
+
+/* 1 when every non-cubic rotation and translation or scale key of the
+ * MOTION chunk img describes is the key of clip as read (a rotation up to
+ * its sign). */
+static int img_as_read(const motion_img *img, const mlod_clip *clip)
+{
+	for (int i = 0; i < img->n; i++) {
+		const struct img_chan *ic = &img->ch[i];
+		const mlod_channel *ch = NULL;
+		if (!ic->rot && !ic->vec)
+			continue;
+		for (int j = 0; !ch && j < clip->channel_count; j++)
+			if ((uint32_t)clip->channels[j].joint == ic->joint && (uint32_t)clip->channels[j].path == ic->path &&
+			    clip->channels[j].interp != MLOD_INTERP_CUBICSPLINE)
+				ch = &clip->channels[j];
+		if (!ch || (uint32_t)ch->key_count != ic->keys)
+			return 0;
+		for (uint32_t v = 0; ic->rot && v < ic->keys; v++) {
+			int plus = 1, minus = 1;
+			for (int c = 0; c < 4; c++) {
+				float r = (float)ic->rot[4 * v + c] / 32767.0f, w = ch->values[4 * (size_t)v + c];
+				plus &= r == w;
+				minus &= -r == w;
+			}
+			if (!plus && !minus)
+				return 0;
+		}
+		if (ic->vec && memcmp(ic->vec, ch->values, sizeof(float) * 3 * ic->keys) != 0)
+			return 0;
+	}
+	return 1;
 }
 
 /* ------------------------------------------------------------------ */
@@ -3476,7 +3635,10 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	strtab names = {0};
 	mlod_pack_info_rec info;
 	memset(&info, 0, sizeof info);
-	info.name = str_add(&names, opt->name ? opt->name : "");
+	info.name = str_add(&names, opt->name                   ? opt->name
+	                            : x.rec.has_pack            ? x.rec.pack_name
+	                            : opt->default_name         ? opt->default_name
+	                                                        : "");
 	for (int q = 0; q < x.v.clip_count; q++)
 		str_add(&names, x.v.clips[q].name);
 	if (names.b.fail) {

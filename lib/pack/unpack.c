@@ -15,6 +15,16 @@
  * (with MSFT_screencoverage; skinned level k follows skeleton level k's
  * skin, or the coarsest), and "<clip>@lod<k>" animations. The DOC's
  * emptied meshes go (mlod_gltf_prune).
+ *
+ * The stage record (mlod-record(5), version 3) says which of these are
+ * levels, with what the pack stores of them and nothing more: per
+ * skeleton level its kept joints, remap (each removed skin joint's
+ * palette joint, any other removed joint's nearest kept ancestor), skins
+ * and TOC error; per mesh level its triangles, vertices and TOC error, on
+ * the scene and on each level node; per motion level its source clip and
+ * TOC error; on each full clip its level 0's TOC error (motion_level0).
+ * mlod-pack then packs the glb again from these levels instead of making
+ * new ones.
  */
 #include <math.h>
 #include <stdio.h>
@@ -23,6 +33,7 @@
 
 #include "mlod_pack_write.h"
 #include "measure/mlod_measure.h"
+#include "record/mlod_record.h"
 
 static mlod_result nomem(mlod_error *err)
 {
@@ -100,6 +111,66 @@ static void level_skins_free(level_skins *l, int skins)
 	free(l->gltf);
 	free(l->stand);
 	memset(l, 0, sizeof *l);
+}
+
+/* Level `level`'s stage record (mlod_record_write_skeleton): the pack's
+ * kept joints and stand-ins as nodes, the level's skins and its TOC
+ * error; threshold and joint_error are left out (the pack has neither). */
+static mlod_result record_skel_level(const mlod_skeleton *s, const mlod_pack_skel_level *lv, const level_skins *ls,
+                                     int level, float error, mlod_record_skel_level *o, mlod_error *err)
+{
+	int n = s->joint_count;
+	memset(o, 0, sizeof *o);
+	o->kept = malloc(sizeof(int) * ((size_t)n + 1));
+	o->remap_from = malloc(sizeof(int) * ((size_t)n + 1));
+	o->remap_to = malloc(sizeof(int) * ((size_t)n + 1));
+	o->skins = malloc(sizeof(int) * ((size_t)s->skin_count + 1));
+	int *stand = malloc(sizeof(int) * ((size_t)n + 1));
+	if (!o->kept || !o->remap_from || !o->remap_to || !o->skins || !stand) {
+		free(stand);
+		return nomem(err);
+	}
+	unsigned char *kept = calloc((size_t)n + 1, 1);
+	if (!kept) {
+		free(stand);
+		return nomem(err);
+	}
+	for (uint32_t i = 0; i < lv->kept_count; i++)
+		if (lv->kept[i] < (uint32_t)n)
+			kept[lv->kept[i]] = 1;
+	memcpy(stand, ls->stand, sizeof(int) * (size_t)n);
+	size_t base = 0; /* a removed skin joint's stand-in is its palette joint */
+	for (int i = 0; i < s->skin_count; i++) {
+		for (int q = 0; q < s->skins[i].joint_count; q++) {
+			int j = s->skins[i].joints[q];
+			if (j >= 0 && j < n && base + (size_t)q < lv->palette_size)
+				stand[j] = (int)lv->palette_joint[base + (size_t)q];
+		}
+		base += (size_t)s->skins[i].joint_count;
+	}
+	o->level = level;
+	o->missing_threshold = 1;
+	o->missing_joint_error = 1;
+	o->has_pack_error = 1;
+	o->pack_error = error;
+	for (int j = 0; j < n; j++) {
+		int node = s->joints[j].node;
+		if (node < 0)
+			continue;
+		if (kept[j])
+			o->kept[o->kept_count++] = node;
+		else if (stand[j] >= 0 && stand[j] < n && s->joints[stand[j]].node >= 0) {
+			o->remap_from[o->remap_count] = node;
+			o->remap_to[o->remap_count++] = s->joints[stand[j]].node;
+		}
+	}
+	o->joints = (int)lv->kept_count;
+	o->skin_count = s->skin_count;
+	for (int i = 0; i < s->skin_count; i++)
+		o->skins[i] = ls->gltf[i];
+	free(stand);
+	free(kept);
+	return MLOD_OK;
 }
 
 static mlod_result add_level_skins(mlod_gltf *doc, const mlod_skeleton *s, const mlod_pack_skel_level *lv,
@@ -341,7 +412,7 @@ static mlod_result rigid_skin(mlod_gltf *doc, const mlod_skeleton *s, const worl
 
 /* A decoded motion level as a clip (pointing into it). */
 static mlod_result add_clip(mlod_gltf *doc, const mlod_skeleton *s, const mlod_pack_motion *mo, const char *name,
-                            mlod_error *err)
+                            int *index, mlod_error *err)
 {
 	mlod_clip clip = {0};
 	clip.name = (char *)name;
@@ -370,8 +441,8 @@ static mlod_result add_clip(mlod_gltf *doc, const mlod_skeleton *s, const mlod_p
 			o->short_values = lattice;
 		}
 	}
-	int index = -1;
-	mlod_result r = mlod_gltf_add_animation(doc, s, &clip, &index, err);
+	*index = -1;
+	mlod_result r = mlod_gltf_add_animation(doc, s, &clip, index, err);
 	free(clip.channels);
 	return r;
 }
@@ -400,6 +471,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	mlod_mat4 *world = NULL;
 	mlod_trs *local = NULL;
 	unsigned char *used = NULL;
+	mlod_record_skel_level *skel_rec = NULL; /* the stage record's skeleton levels */
+	mlod_record_mesh_level *mesh_rec = NULL;  /* and mesh levels */
 	uint32_t mesh_levels = 0, skel_levels = 0;
 	int have_skel = 0, node_count = 0;
 	memset(&info, 0, sizeof info);
@@ -474,7 +547,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	/* Skeleton levels: their skins. */
 	skel_levels = have_skel ? info.rec.skeleton_levels : 0;
 	ls = calloc((size_t)skel_levels + 1, sizeof *ls);
-	if (!ls) {
+	skel_rec = calloc((size_t)skel_levels + 1, sizeof *skel_rec);
+	if (!ls || !skel_rec) {
 		r = nomem(err);
 		goto done;
 	}
@@ -489,6 +563,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		if ((r = mlod_pack_decode_skel_level(&p, (uint32_t)c, data, size, &skel, &lv, err)) != MLOD_OK)
 			goto done;
 		r = add_level_skins(doc, &s, &lv, (int)k, &ls[k], err);
+		if (r == MLOD_OK)
+			r = record_skel_level(&s, &lv, &ls[k], (int)k, p.chunks[c].error, &skel_rec[k - 1], err);
 		mlod_pack_skel_level_free(&lv);
 		if (r != MLOD_OK)
 			goto done;
@@ -510,6 +586,27 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		if ((r = mlod_pack_decode_mesh(&p, (uint32_t)c, data, size, have_skel ? &skel : NULL, &meshes[k], err)) !=
 		    MLOD_OK)
 			goto done;
+	}
+	/* The record's mesh levels: what the pack stores of each. */
+	mesh_rec = calloc((size_t)mesh_levels + 1, sizeof *mesh_rec);
+	if (!mesh_rec) {
+		r = nomem(err);
+		goto done;
+	}
+	for (uint32_t k = 1; k < mesh_levels; k++) {
+		mlod_record_mesh_level *m = &mesh_rec[k - 1];
+		long tris = 0, verts = 0;
+		for (uint32_t i = 0; i < meshes[k].part_count; i++) {
+			tris += (long)meshes[k].parts[i].rec.index_count / 3;
+			verts += (long)meshes[k].parts[i].rec.vertex_count;
+		}
+		m->level = (int)k;
+		m->missing_ratio = 1;
+		m->missing_error = 1;
+		m->triangles = (int)tris;
+		m->vertices = (int)verts;
+		m->has_pack_error = 1;
+		m->pack_error = p.chunks[mlod_pack_find(&p, MLOD_CHUNK_MESH, k, 0)].error;
 	}
 	if (mesh_levels > 0) {
 		uint32_t n = meshes[0].part_count, most = 0;
@@ -622,6 +719,16 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 				snprintf(name, sizeof name, "mlod mesh level %d of node %d", k, node);
 				if ((r = mlod_gltf_add_node(doc, name, MLOD_GLTF_DETACHED, lmesh, skin, tp, &lnode, err)) != MLOD_OK)
 					goto done;
+				mlod_record_mesh_node rn;
+				memset(&rn, 0, sizeof rn);
+				rn.level = k;
+				rn.missing_ratio = 1;
+				rn.missing_error = 1;
+				rn.skeleton_level = map != NULL;
+				rn.has_pack_error = 1;
+				rn.pack_error = mesh_rec[k - 1].pack_error;
+				if ((r = mlod_record_write_mesh_node(doc, lnode, &rn, err)) != MLOD_OK)
+					goto done;
 				if (meshes[k].parts[parts[0]].rec.target_count > 0 &&
 				    (r = mlod_gltf_copy_morph_animation(doc, node, lnode, NULL, err)) != MLOD_OK)
 					goto done;
@@ -642,6 +749,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		goto done;
 	}
 	for (uint32_t c = 0; have_skel && c < info.rec.clip_count; c++) {
+		int anim0 = -1; /* the clip's level-0 animation */
 		for (uint32_t k = 0; k < info.rec.motion_levels; k++) {
 			int ch = mlod_pack_find(&p, MLOD_CHUNK_MOTION, k, c);
 			if (ch < 0) {
@@ -657,7 +765,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 				snprintf(name, sizeof name, "%s", info.clip_names[c]);
 			else
 				snprintf(name, sizeof name, "%s@lod%u", info.clip_names[c], k);
-			r = add_clip(doc, &s, &mo, name, err);
+			int anim = -1;
+			r = add_clip(doc, &s, &mo, name, &anim, err);
 			mlod_pack_motion_free(&mo);
 			int into = -1;
 			for (int a = 0; k == 0 && r == MLOD_OK && a < doc_anims; a++) {
@@ -670,12 +779,52 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 					break;
 				}
 			}
-			if (r == MLOD_OK && into >= 0)
+			if (r == MLOD_OK && into >= 0) {
 				r = mlod_gltf_merge_animation(doc, into, err);
+				anim = into;
+			}
+			/* Its record: level 0's error on the clip, a coarser level's
+			 * source clip and error on it. */
+			if (r == MLOD_OK && k == 0) {
+				anim0 = anim;
+				r = mlod_record_write_motion0(doc, anim, p.chunks[ch].error, err);
+			} else if (r == MLOD_OK) {
+				mlod_record_motion_level ml;
+				memset(&ml, 0, sizeof ml);
+				ml.level = (int)k;
+				ml.source_animation = anim0;
+				ml.missing_method = ml.missing_keys = ml.missing_joint_error = ml.missing_point_error = 1;
+				ml.has_pack_error = 1;
+				ml.pack_error = p.chunks[ch].error;
+				r = mlod_record_write_motion(doc, anim, &ml, err);
+			}
 			if (r != MLOD_OK)
 				goto done;
 		}
 	}
+
+	/* The scene's record: skeleton and mesh levels (every writer above
+	 * stamped the version). */
+	if (have_skel) { /* an empty list when the pack has level 0 alone */
+		int *full = malloc(sizeof(int) * ((size_t)s.skin_count + 1));
+		if (!full) {
+			r = nomem(err);
+			goto done;
+		}
+		for (int i = 0; i < s.skin_count; i++)
+			full[i] = s.skins[i].gltf_index >= 0 && s.skins[i].gltf_index < mlod_gltf_count(doc, MLOD_GLTF_SKIN)
+			              ? s.skins[i].gltf_index
+			              : -1;
+		r = mlod_record_write_skeleton(doc, skel_rec, skel_levels > 0 ? (int)skel_levels - 1 : 0, full, s.skin_count,
+		                               err);
+		free(full);
+		if (r != MLOD_OK)
+			goto done;
+	}
+	if (mesh_levels > 0 && (r = mlod_record_write_mesh_levels(doc, mesh_rec, (int)mesh_levels - 1, err)) != MLOD_OK)
+		goto done;
+	if ((r = mlod_record_write_pack(doc, info.name, info.rec.bounds_min, info.rec.bounds_max, err)) != MLOD_OK)
+		goto done;
 
 	/* The DOC's emptied meshes go. */
 	{
@@ -695,6 +844,10 @@ done:
 	for (uint32_t k = 0; ls && k <= skel_levels; k++)
 		level_skins_free(&ls[k], s.skin_count);
 	free(ls);
+	for (uint32_t k = 0; skel_rec && k < skel_levels; k++)
+		mlod_record_skel_level_free(&skel_rec[k]);
+	free(skel_rec);
+	free(mesh_rec);
 	free(parts);
 	free(nodes);
 	free(mesh_map);

@@ -43,8 +43,14 @@ extern "C" {
 
 /* The version this mlod writes and the newest it reads. Version 2:
  * joint_error.max_percent_height is of mlod_skeleton_height (version 1:
- * of the largest extent of the rest pose). */
-#define MLOD_RECORD_VERSION 2
+ * of the largest extent of the rest pose). Version 3: the measures a pack
+ * does not store may be absent (the missing_* flags below: the reader
+ * sets them, a writer leaves those keys out), each level may carry its
+ * pack error (pack_error, scene units: what mlod-pack -x writes), and a
+ * full clip may say it is a pack's motion level 0
+ * (mlod_record_read_motion0). A record with every key reads as it did in
+ * version 2. */
+#define MLOD_RECORD_VERSION 3
 
 /* ------------------------------------------------------------------ */
 /* Joint nodes: labels and energy (mlod-label)                         */
@@ -83,6 +89,10 @@ typedef struct mlod_record_skel_level {
 	mlod_deviation joint_error;   /* removed joints following their stand-ins: scene units (scale 0) */
 	int has_vertex_error;
 	mlod_deviation vertex_error;  /* skinned-vertex error, % of the bounding diagonal (scale 0) */
+	int missing_threshold;   /* no threshold (version 3; 0 above) */
+	int missing_joint_error; /* no joint_error (version 3; zeros above) */
+	int has_pack_error;
+	double pack_error;       /* the level's pack error (TOC), scene units */
 } mlod_record_skel_level;
 
 /* One mesh level (extras.mlod.mesh_levels[k], or mesh_level of a --split
@@ -93,7 +103,12 @@ typedef struct mlod_record_mesh_level {
 	int triangles, vertices; /* of the whole character at this level */
 	mlod_deviation error;    /* posed error, % of the bounding diagonal (scale 0) */
 	double coverage;         /* screen coverage from which the level shows
-	                          * (MSFT_screencoverage; filled by the reader) */
+	                          * (MSFT_screencoverage; filled by the reader
+	                          * from error.max: 0 when error_percent is missing) */
+	int missing_ratio;       /* no ratio (version 3; 0 above) */
+	int missing_error;       /* no error_percent (version 3; zeros above) */
+	int has_pack_error;
+	double pack_error;       /* the level's pack error (TOC), scene units */
 } mlod_record_mesh_level;
 
 /* The skins standing for one skin of the character (extras.mlod of the
@@ -107,6 +122,9 @@ typedef struct mlod_record_skin {
 /* Everything the scene and skins record. */
 typedef struct mlod_record {
 	int version;             /* as read; 1 when the file has none */
+	int has_skel_levels;     /* skeleton_levels is there (maybe empty: mlod-pack -x
+	                          * of a pack with skeleton level 0 alone) */
+	int has_mesh_levels;     /* mesh_levels is there (maybe empty) */
 	int skel_level_count;
 	mlod_record_skel_level *skel_levels;
 	int skin_count;          /* skins with a record */
@@ -115,6 +133,12 @@ typedef struct mlod_record {
 	mlod_record_mesh_level *mesh_levels;
 	int has_mesh_level;      /* a --split file: the one level it holds */
 	mlod_record_mesh_level mesh_level;
+	/* extras.mlod.pack (version 3, mlod-pack -x): the INFO fields of the
+	 * pack the file was unpacked from that its data does not give back
+	 * exactly, for packing it again. */
+	int has_pack;
+	char *pack_name;         /* the character's name */
+	double pack_bounds_min[3], pack_bounds_max[3]; /* the rest pose's bounds (INFO) */
 } mlod_record;
 
 /* Reads the scene's and the skins' records (all empty when there are
@@ -137,10 +161,15 @@ void mlod_record_skel_level_free(mlod_record_skel_level *l);
 mlod_result mlod_record_write_skeleton(mlod_gltf *doc, const mlod_record_skel_level *levels, int count,
                                        const int *full_skins, int skin_count, mlod_error *err);
 
-/* Writes extras.mlod.mesh_levels of the scene (count > 0), keeping every
- * other key. */
+/* Writes extras.mlod.mesh_levels of the scene (count 0: an empty list,
+ * the character has level 0 alone), keeping every other key. */
 mlod_result mlod_record_write_mesh_levels(mlod_gltf *doc, const mlod_record_mesh_level *levels, int count,
                                           mlod_error *err);
+
+/* Writes extras.mlod.pack of the scene: the name and bounds of the pack
+ * a file was unpacked from. */
+mlod_result mlod_record_write_pack(mlod_gltf *doc, const char *name, const float bounds_min[3],
+                                   const float bounds_max[3], mlod_error *err);
 
 /* Writes extras.mlod.mesh_level of the scene: the one level a --split
  * file holds. */
@@ -160,8 +189,14 @@ typedef struct mlod_record_mesh_node {
 	double ratio;
 	mlod_deviation error;    /* % of the bounding diagonal (scale 0) */
 	int skeleton_level;      /* its skin is a skeleton level's */
+	int missing_ratio;       /* no ratio (version 3) */
+	int missing_error;       /* no error_percent (version 3) */
+	int has_pack_error;
+	double pack_error;       /* the level's pack error (TOC), scene units */
 } mlod_record_mesh_node;
 
+/* Writes one level node's record (merging with its other keys). */
+mlod_result mlod_record_write_mesh_node(mlod_gltf *doc, int node, const mlod_record_mesh_node *n, mlod_error *err);
 /* Writes the record of every level node of lod (mlod_mesh_levels_write). */
 mlod_result mlod_record_write_mesh_nodes(mlod_gltf *doc, const mlod_mesh_levels *levels, const mlod_mesh_lod *lod,
                                          mlod_error *err);
@@ -182,6 +217,10 @@ typedef struct mlod_record_morph_weights {
 	int copied;              /* tracks kept as they are */
 } mlod_record_morph_weights;
 
+/* Up to version 2 every key but bound, grid, subdivide,
+ * vertex_error_percent_diagonal and morph_weights is required; version 3
+ * lets method with threshold, keys with source_keys and bytes,
+ * joint_error and point_error be missing (a pack stores none of them). */
 typedef struct mlod_record_motion_level {
 	int level;               /* 1 for the finest */
 	int source_animation;    /* the glTF animation it reduces */
@@ -198,6 +237,12 @@ typedef struct mlod_record_motion_level {
 	double vertex_error_percent_diagonal;
 	int has_morph_weights;
 	mlod_record_morph_weights morph_weights;
+	int missing_method;      /* no method and threshold (version 3) */
+	int missing_keys;        /* no keys, source_keys and bytes (version 3) */
+	int missing_joint_error; /* no joint_error (version 3) */
+	int missing_point_error; /* no point_error (version 3) */
+	int has_pack_error;
+	double pack_error;       /* the level's pack error (TOC), scene units */
 } mlod_record_motion_level;
 
 /* Writes the record of glTF animation `animation`, a motion level. */
@@ -206,6 +251,16 @@ mlod_result mlod_record_write_motion(mlod_gltf *doc, int animation, const mlod_r
 /* Reads it; *found is 0 when the animation has no motion level record. */
 mlod_result mlod_record_read_motion(const mlod_gltf *doc, int animation, mlod_record_motion_level *out, int *found,
                                     mlod_error *err);
+
+/* A full clip that is a pack's motion level 0 (mlod-pack -x writes it):
+ * extras.mlod.motion_level0 of its animation, an object whose pack_error
+ * is the level's joint position error against the clip the pack was made
+ * from (scene units). The packer keeps such a clip's keys as they are and
+ * takes that error. */
+mlod_result mlod_record_write_motion0(mlod_gltf *doc, int animation, double pack_error, mlod_error *err);
+/* Reads it; *found is 0 when the animation has none. */
+mlod_result mlod_record_read_motion0(const mlod_gltf *doc, int animation, double *pack_error, int *found,
+                                     mlod_error *err);
 
 /* "frames" or "keys". */
 const char *mlod_record_method_name(mlod_motion_method m);

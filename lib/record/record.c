@@ -118,6 +118,27 @@ static mlod_result stamp(mlod_gltf *doc, mlod_error *err)
 	return merge(doc, MLOD_GLTF_SCENE, -1, NULL, NULL, err);
 }
 
+/* The scene record's version (1 when it has none or it is not a whole
+ * number: mlod_record_read reports that), for the readers of other
+ * objects: a key optional since version 3 is required in older records. */
+static int doc_version(const mlod_gltf *doc)
+{
+	mj o;
+	mlod_error ignored = {0};
+	int version = 1;
+	if (mlod_gltf_count(doc, MLOD_GLTF_SCENE) == 0 || get(doc, MLOD_GLTF_SCENE, -1, &o, &ignored) != MLOD_OK)
+		return version;
+	const mj *v = mj_get(&o, "version");
+	if (v && v->type == MJ_NUMBER && v->number >= 1.0 && v->number <= 1e9 && v->number == (double)(long)v->number)
+		version = (int)v->number;
+	mj_free(&o);
+	return version;
+}
+
+/* Is a key that version 3 made optional required in a record of this
+ * version? */
+#define REQUIRED_BEFORE_3(version) ((version) < 3)
+
 /* ------------------------------------------------------------------ */
 /* Typed reading with messages                                         */
 /* ------------------------------------------------------------------ */
@@ -398,21 +419,26 @@ void mlod_record_free(mlod_record *r)
 		free(r->skins[i].levels);
 	free(r->skins);
 	free(r->mesh_levels);
+	free(r->pack_name);
 	memset(r, 0, sizeof *r);
 }
 
-static int read_skel_level(struct rd *c, const mj *o, int nodes, int skins, mlod_record_skel_level *l)
+static int read_skel_level(struct rd *c, const mj *o, int nodes, int skins, int version, mlod_record_skel_level *l)
 {
 	long level = 0, joints = 0;
 	const mj *remap;
+	int req = REQUIRED_BEFORE_3(version), got_threshold = 0, got_joint_error = 0;
 	if (o->type != MJ_OBJECT)
 		return rd_fail(c, NULL, "not an object");
-	if (rd_int(c, o, "level", 1, 1, 1e6, &level) < 0 || rd_number(c, o, "threshold", 1, &l->threshold) < 0 ||
+	if (rd_int(c, o, "level", 1, 1, 1e6, &level) < 0 || (got_threshold = rd_number(c, o, "threshold", req, &l->threshold)) < 0 ||
 	    rd_int(c, o, "joints", 1, 0, 1e9, &joints) < 0 || rd_ints(c, o, "kept", -1, nodes - 1, &l->kept, &l->kept_count) < 0 ||
 	    rd_ints(c, o, "skins", -1, skins - 1, &l->skins, &l->skin_count) < 0 ||
-	    rd_deviation(c, o, "joint_error", 1, &l->joint_error) < 0 ||
-	    (l->has_vertex_error = rd_deviation(c, o, "vertex_error_percent", 0, &l->vertex_error)) < 0)
+	    (got_joint_error = rd_deviation(c, o, "joint_error", req, &l->joint_error)) < 0 ||
+	    (l->has_vertex_error = rd_deviation(c, o, "vertex_error_percent", 0, &l->vertex_error)) < 0 ||
+	    (l->has_pack_error = rd_number(c, o, "pack_error", 0, &l->pack_error)) < 0)
 		return -1;
+	l->missing_threshold = !got_threshold;
+	l->missing_joint_error = !got_joint_error;
 	l->level = (int)level;
 	l->joints = (int)joints;
 	if (!(remap = mj_get(o, "remap")))
@@ -439,15 +465,19 @@ static int read_skel_level(struct rd *c, const mj *o, int nodes, int skins, mlod
 	return 0;
 }
 
-static int read_mesh_level(struct rd *c, const mj *o, mlod_record_mesh_level *l)
+static int read_mesh_level(struct rd *c, const mj *o, int version, mlod_record_mesh_level *l)
 {
 	long level = 0, triangles = 0, vertices = 0;
+	int req = REQUIRED_BEFORE_3(version), got_ratio = 0, got_error = 0;
 	if (o->type != MJ_OBJECT)
 		return rd_fail(c, NULL, "not an object");
-	if (rd_int(c, o, "level", 1, 1, 1e6, &level) < 0 || rd_number(c, o, "ratio", 1, &l->ratio) < 0 ||
+	if (rd_int(c, o, "level", 1, 1, 1e6, &level) < 0 || (got_ratio = rd_number(c, o, "ratio", req, &l->ratio)) < 0 ||
 	    rd_int(c, o, "triangles", 1, 0, 2e9, &triangles) < 0 || rd_int(c, o, "vertices", 1, 0, 2e9, &vertices) < 0 ||
-	    rd_deviation(c, o, "error_percent", 1, &l->error) < 0)
+	    (got_error = rd_deviation(c, o, "error_percent", req, &l->error)) < 0 ||
+	    (l->has_pack_error = rd_number(c, o, "pack_error", 0, &l->pack_error)) < 0)
 		return -1;
+	l->missing_ratio = !got_ratio;
+	l->missing_error = !got_error;
 	l->level = (int)level;
 	l->triangles = (int)triangles;
 	l->vertices = (int)vertices;
@@ -475,6 +505,7 @@ mlod_result mlod_record_read(const mlod_gltf *doc, mlod_record *out, mlod_error 
 		                MLOD_RECORD_VERSION);
 	out->version = (int)version;
 	const mj *a = mj_get(&o, "skeleton_levels");
+	out->has_skel_levels = a != NULL;
 	if (c.r == MLOD_OK && a) {
 		if (a->type != MJ_ARRAY)
 			rd_fail(&c, "skeleton_levels", "not an array");
@@ -483,11 +514,12 @@ mlod_result mlod_record_read(const mlod_gltf *doc, mlod_record *out, mlod_error 
 		for (int k = 0; c.r == MLOD_OK && k < a->count; k++) {
 			rd_at(&c, "the scene's extras.mlod.skeleton_levels[%d]", k);
 			out->skel_level_count = k + 1;
-			read_skel_level(&c, &a->items[k], nodes, skins, &out->skel_levels[k]);
+			read_skel_level(&c, &a->items[k], nodes, skins, out->version, &out->skel_levels[k]);
 		}
 	}
 	rd_at(&c, "the scene's extras.mlod");
 	a = mj_get(&o, "mesh_levels");
+	out->has_mesh_levels = a != NULL;
 	if (c.r == MLOD_OK && a) {
 		if (a->type != MJ_ARRAY)
 			rd_fail(&c, "mesh_levels", "not an array");
@@ -496,7 +528,7 @@ mlod_result mlod_record_read(const mlod_gltf *doc, mlod_record *out, mlod_error 
 		for (int k = 0; c.r == MLOD_OK && k < a->count; k++) {
 			rd_at(&c, "the scene's extras.mlod.mesh_levels[%d]", k);
 			out->mesh_level_count = k + 1;
-			read_mesh_level(&c, &a->items[k], &out->mesh_levels[k]);
+			read_mesh_level(&c, &a->items[k], out->version, &out->mesh_levels[k]);
 		}
 		if (c.r == MLOD_OK) {
 			double *errors = malloc(sizeof(double) * ((size_t)out->mesh_level_count + 1));
@@ -514,11 +546,39 @@ mlod_result mlod_record_read(const mlod_gltf *doc, mlod_record *out, mlod_error 
 			free(coverage);
 		}
 	}
+	rd_at(&c, "the scene's extras.mlod.pack");
+	a = mj_get(&o, "pack");
+	if (c.r == MLOD_OK && a) {
+		const mj *name = mj_get(a, "name"), *b = mj_get(a, "bounds");
+		const mj *lo = mj_get(b, "min"), *hi = mj_get(b, "max");
+		if (a->type != MJ_OBJECT)
+			rd_fail(&c, NULL, "not an object");
+		else if (!name || name->type != MJ_STRING)
+			rd_fail(&c, "name", "not a string");
+		else if (!b || b->type != MJ_OBJECT || !lo || !hi || lo->type != MJ_ARRAY || hi->type != MJ_ARRAY ||
+		         lo->count != 3 || hi->count != 3)
+			rd_fail(&c, "bounds", "not an object of min and max, 3 numbers each");
+		for (int i = 0; c.r == MLOD_OK && i < 3; i++) {
+			if (lo->items[i].type != MJ_NUMBER || hi->items[i].type != MJ_NUMBER ||
+			    !(lo->items[i].number <= hi->items[i].number))
+				rd_fail(&c, "bounds", "not an object of min and max, 3 numbers each");
+			out->pack_bounds_min[i] = lo->items[i].number;
+			out->pack_bounds_max[i] = hi->items[i].number;
+		}
+		if (c.r == MLOD_OK) {
+			size_t n = strlen(name->text);
+			if (!(out->pack_name = malloc(n + 1)))
+				c.r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory reading extras.mlod");
+			else
+				memcpy(out->pack_name, name->text, n + 1);
+			out->has_pack = c.r == MLOD_OK;
+		}
+	}
 	rd_at(&c, "the scene's extras.mlod");
 	a = mj_get(&o, "mesh_level");
 	if (c.r == MLOD_OK && a) {
 		rd_at(&c, "the scene's extras.mlod.mesh_level");
-		if (read_mesh_level(&c, a, &out->mesh_level) == 0) {
+		if (read_mesh_level(&c, a, out->version, &out->mesh_level) == 0) {
 			out->has_mesh_level = 1;
 			out->mesh_level.coverage = mlod_error_coverage(out->mesh_level.error.max, MLOD_COVERAGE_LINES,
 			                                               MLOD_COVERAGE_PIXELS);
@@ -584,6 +644,7 @@ mlod_result mlod_record_skel_levels_make(const mlod_character *full, const mlod_
 		o->joint_error = levels[k].joint;
 		o->has_vertex_error = levels[k].vertex.scale > 0.0;
 		o->vertex_error = levels[k].vertex;
+		/* threshold and joint_error given: missing_* 0 (memset) */
 	}
 	return MLOD_OK;
 }
@@ -597,7 +658,8 @@ mlod_result mlod_record_write_skeleton(mlod_gltf *doc, const mlod_record_skel_le
 		const mlod_record_skel_level *l = &levels[k];
 		mj o = mj_object(), remap = mj_object(), a;
 		w_int(&w, &o, "level", l->level);
-		w_num(&w, &o, "threshold", "%.9g", l->threshold);
+		if (!l->missing_threshold)
+			w_num(&w, &o, "threshold", "%.9g", l->threshold);
 		w_int(&w, &o, "joints", l->joints);
 		a = w_ints(&w, l->kept, l->kept_count);
 		w_put(&w, &o, "kept", &a);
@@ -609,9 +671,12 @@ mlod_result mlod_record_write_skeleton(mlod_gltf *doc, const mlod_record_skel_le
 		w_put(&w, &o, "remap", &remap);
 		a = w_ints(&w, l->skins, l->skin_count);
 		w_put(&w, &o, "skins", &a);
-		w_deviation(&w, &o, "joint_error", &l->joint_error);
+		if (!l->missing_joint_error)
+			w_deviation(&w, &o, "joint_error", &l->joint_error);
 		if (l->has_vertex_error)
 			w_deviation(&w, &o, "vertex_error_percent", &l->vertex_error);
+		if (l->has_pack_error)
+			w_num(&w, &o, "pack_error", "%.9g", l->pack_error);
 		w_push(&w, &list, &o);
 	}
 	if (w.failed) {
@@ -643,10 +708,14 @@ static mj mesh_level_json(struct wr *w, const mlod_record_mesh_level *l)
 {
 	mj o = mj_object();
 	w_int(w, &o, "level", l->level);
-	w_num(w, &o, "ratio", "%.6g", l->ratio);
+	if (!l->missing_ratio)
+		w_num(w, &o, "ratio", "%.6g", l->ratio);
 	w_int(w, &o, "triangles", l->triangles);
 	w_int(w, &o, "vertices", l->vertices);
-	w_deviation(w, &o, "error_percent", &l->error);
+	if (!l->missing_error)
+		w_deviation(w, &o, "error_percent", &l->error);
+	if (l->has_pack_error)
+		w_num(w, &o, "pack_error", "%.9g", l->pack_error);
 	return o;
 }
 
@@ -668,6 +737,37 @@ mlod_result mlod_record_write_mesh_levels(mlod_gltf *doc, const mlod_record_mesh
 		return MLOD_OK;
 	}
 	return merge(doc, MLOD_GLTF_SCENE, -1, "mesh_levels", &list, err);
+}
+
+mlod_result mlod_record_write_pack(mlod_gltf *doc, const char *name, const float bounds_min[3],
+                                   const float bounds_max[3], mlod_error *err)
+{
+	struct wr w = {0};
+	mj o = mj_object(), b = mj_object(), lo = mj_array(), hi = mj_array();
+	w_str(&w, &o, "name", name ? name : "");
+	for (int i = 0; i < 3; i++) {
+		mj x, y;
+		if (w.failed || mj_double(&x, "%.9g", bounds_min[i]) != 0)
+			w.failed = 1;
+		else
+			w_push(&w, &lo, &x);
+		if (w.failed || mj_double(&y, "%.9g", bounds_max[i]) != 0)
+			w.failed = 1;
+		else
+			w_push(&w, &hi, &y);
+	}
+	w_put(&w, &b, "min", &lo);
+	w_put(&w, &b, "max", &hi);
+	w_put(&w, &o, "bounds", &b);
+	if (w.failed) {
+		mj_free(&o);
+		return nomem(err);
+	}
+	if (mlod_gltf_count(doc, MLOD_GLTF_SCENE) == 0) {
+		mj_free(&o);
+		return MLOD_OK;
+	}
+	return merge(doc, MLOD_GLTF_SCENE, -1, "pack", &o, err);
 }
 
 mlod_result mlod_record_write_mesh_split(mlod_gltf *doc, const mlod_record_mesh_level *level, mlod_error *err)
@@ -698,25 +798,40 @@ void mlod_record_mesh_skeleton(const mlod_record_skel_level *l, mlod_mesh_skelet
 /* Level nodes                                                         */
 /* ------------------------------------------------------------------ */
 
+mlod_result mlod_record_write_mesh_node(mlod_gltf *doc, int node, const mlod_record_mesh_node *n, mlod_error *err)
+{
+	struct wr w = {0};
+	mj o = mj_object();
+	w_int(&w, &o, "mesh_level", n->level);
+	if (!n->missing_ratio)
+		w_num(&w, &o, "ratio", "%.6g", n->ratio);
+	if (!n->missing_error)
+		w_deviation(&w, &o, "error_percent", &n->error);
+	if (n->skeleton_level) {
+		mj t = mj_bool(1);
+		w_put(&w, &o, "skeleton_level", &t);
+	}
+	if (n->has_pack_error)
+		w_num(&w, &o, "pack_error", "%.9g", n->pack_error);
+	if (w.failed) {
+		mj_free(&o);
+		return nomem(err);
+	}
+	return merge(doc, MLOD_GLTF_NODE, node, NULL, &o, err);
+}
+
 mlod_result mlod_record_write_mesh_nodes(mlod_gltf *doc, const mlod_mesh_levels *levels, const mlod_mesh_lod *lod,
                                          mlod_error *err)
 {
 	for (int i = 0; i < lod->count; i++) {
 		const mlod_mesh_level *lv = &levels->levels[lod->level[i]];
-		struct wr w = {0};
-		mj o = mj_object();
-		w_int(&w, &o, "mesh_level", lod->level[i] + 1);
-		w_num(&w, &o, "ratio", "%.6g", lv->ratio);
-		w_deviation(&w, &o, "error_percent", &lv->error);
-		if (lod->skeleton_level[i]) {
-			mj t = mj_bool(1);
-			w_put(&w, &o, "skeleton_level", &t);
-		}
-		if (w.failed) {
-			mj_free(&o);
-			return nomem(err);
-		}
-		mlod_result r = merge(doc, MLOD_GLTF_NODE, lod->node[i], NULL, &o, err);
+		mlod_record_mesh_node n;
+		memset(&n, 0, sizeof n);
+		n.level = lod->level[i] + 1;
+		n.ratio = lv->ratio;
+		n.error = lv->error;
+		n.skeleton_level = lod->skeleton_level[i];
+		mlod_result r = mlod_record_write_mesh_node(doc, lod->node[i], &n, err);
 		if (r != MLOD_OK)
 			return r;
 	}
@@ -737,9 +852,15 @@ mlod_result mlod_record_read_mesh_node(const mlod_gltf *doc, int node, mlod_reco
 	if (mj_get(&o, "mesh_level")) {
 		rd_at(&c, "node %d: extras.mlod", node);
 		const mj *t = mj_get(&o, "skeleton_level");
-		if (rd_int(&c, &o, "mesh_level", 1, 1, 1e6, &level) > 0 && rd_number(&c, &o, "ratio", 1, &out->ratio) > 0 &&
-		    rd_deviation(&c, &o, "error_percent", 1, &out->error) > 0 && t && t->type != MJ_TRUE && t->type != MJ_FALSE)
+		int req = REQUIRED_BEFORE_3(doc_version(doc)), got_ratio = 0, got_error = 0;
+		if (rd_int(&c, &o, "mesh_level", 1, 1, 1e6, &level) > 0 &&
+		    (got_ratio = rd_number(&c, &o, "ratio", req, &out->ratio)) >= 0 &&
+		    (got_error = rd_deviation(&c, &o, "error_percent", req, &out->error)) >= 0 &&
+		    (out->has_pack_error = rd_number(&c, &o, "pack_error", 0, &out->pack_error)) >= 0 && t &&
+		    t->type != MJ_TRUE && t->type != MJ_FALSE)
 			rd_fail(&c, "skeleton_level", "not true or false");
+		out->missing_ratio = got_ratio <= 0;
+		out->missing_error = got_error <= 0;
 		out->level = (int)level;
 		out->skeleton_level = t && t->type == MJ_TRUE;
 		*found = c.r == MLOD_OK;
@@ -767,20 +888,29 @@ mlod_result mlod_record_write_motion(mlod_gltf *doc, int animation, const mlod_r
 	mj o = mj_object(), je = mj_object();
 	w_int(&w, &o, "motion_level", l->level);
 	w_int(&w, &o, "source_animation", l->source_animation);
-	w_str(&w, &o, "method", mlod_record_method_name(l->method));
-	w_num(&w, &o, "threshold", "%.9g", l->threshold);
+	if (!l->missing_method) {
+		w_str(&w, &o, "method", mlod_record_method_name(l->method));
+		w_num(&w, &o, "threshold", "%.9g", l->threshold);
+	}
 	if (l->has_bound)
 		w_num(&w, &o, "bound", "%.9g", l->bound);
-	w_int(&w, &o, "keys", l->keys);
-	w_int(&w, &o, "source_keys", l->source_keys);
-	w_int(&w, &o, "bytes", l->bytes);
+	if (!l->missing_keys) {
+		w_int(&w, &o, "keys", l->keys);
+		w_int(&w, &o, "source_keys", l->source_keys);
+		w_int(&w, &o, "bytes", l->bytes);
+	}
 	w_num(&w, &je, "max", "%.9g", l->joint_error.max);
 	w_num(&w, &je, "mean", "%.9g", l->joint_error.mean);
 	w_num(&w, &je, "max_percent_height", "%.9g", l->joint_error_max_percent_height);
-	w_put(&w, &o, "joint_error", &je);
-	w_num(&w, &o, "point_error", "%.9g", l->point_error);
-	w_num(&w, &o, "grid", "%.9g", l->grid);
-	w_int(&w, &o, "subdivide", l->subdivide);
+	if (!l->missing_joint_error)
+		w_put(&w, &o, "joint_error", &je);
+	else
+		mj_free(&je);
+	if (!l->missing_point_error) {
+		w_num(&w, &o, "point_error", "%.9g", l->point_error);
+		w_num(&w, &o, "grid", "%.9g", l->grid);
+		w_int(&w, &o, "subdivide", l->subdivide);
+	}
 	if (l->has_vertex_error)
 		w_num(&w, &o, "vertex_error_percent_diagonal", "%.9g", l->vertex_error_percent_diagonal);
 	if (l->has_morph_weights) {
@@ -796,6 +926,8 @@ mlod_result mlod_record_write_motion(mlod_gltf *doc, int animation, const mlod_r
 		w_str(&w, &x, "error_measure", MORPH_ERROR_MEASURE);
 		w_put(&w, &o, "morph_weights", &x);
 	}
+	if (l->has_pack_error)
+		w_num(&w, &o, "pack_error", "%.9g", l->pack_error);
 	if (w.failed) {
 		mj_free(&o);
 		return nomem(err);
@@ -822,22 +954,34 @@ mlod_result mlod_record_read_motion(const mlod_gltf *doc, int animation, mlod_re
 	long level = 0, source = 0, subdivide = 0;
 	const mj *method = mj_get(&o, "method"), *je = mj_get(&o, "joint_error"), *mw = mj_get(&o, "morph_weights");
 	int anims = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
+	/* Version 3: method with threshold, keys with source_keys and bytes,
+	 * joint_error and point_error may each be missing (as a group). */
+	int req = REQUIRED_BEFORE_3(doc_version(doc)), got_threshold = 0, got_keys = 0, got_je = 0, got_pe = 0;
 	if (rd_int(&c, &o, "motion_level", 1, 1, 1e6, &level) > 0 &&
 	    rd_int(&c, &o, "source_animation", 1, 0, anims - 1, &source) > 0 &&
-	    rd_number(&c, &o, "threshold", 1, &out->threshold) > 0 &&
+	    (got_threshold = rd_number(&c, &o, "threshold", req || method, &out->threshold)) >= 0 &&
 	    (out->has_bound = rd_number(&c, &o, "bound", 0, &out->bound)) >= 0 &&
-	    rd_int(&c, &o, "keys", 1, 0, 9e15, &out->keys) > 0 && rd_int(&c, &o, "source_keys", 1, 0, 9e15, &out->source_keys) > 0 &&
-	    rd_int(&c, &o, "bytes", 1, 0, 9e15, &out->bytes) > 0 && rd_deviation(&c, &o, "joint_error", 1, &out->joint_error) > 0 &&
-	    rd_number(&c, je, "max_percent_height", 0, &out->joint_error_max_percent_height) >= 0 &&
-	    rd_number(&c, &o, "point_error", 1, &out->point_error) > 0 && rd_number(&c, &o, "grid", 0, &out->grid) >= 0 &&
-	    rd_int(&c, &o, "subdivide", 0, 1, 1e6, &subdivide) >= 0 &&
+	    (got_keys = rd_int(&c, &o, "keys", req, 0, 9e15, &out->keys)) >= 0 &&
+	    rd_int(&c, &o, "source_keys", req || got_keys, 0, 9e15, &out->source_keys) >= 0 &&
+	    rd_int(&c, &o, "bytes", req || got_keys, 0, 9e15, &out->bytes) >= 0 &&
+	    (got_je = rd_deviation(&c, &o, "joint_error", req, &out->joint_error)) >= 0 &&
+	    (!je || rd_number(&c, je, "max_percent_height", 0, &out->joint_error_max_percent_height) >= 0) &&
+	    (got_pe = rd_number(&c, &o, "point_error", req, &out->point_error)) >= 0 &&
+	    rd_number(&c, &o, "grid", 0, &out->grid) >= 0 && rd_int(&c, &o, "subdivide", 0, 1, 1e6, &subdivide) >= 0 &&
 	    (out->has_vertex_error = rd_number(&c, &o, "vertex_error_percent_diagonal", 0,
-	                                       &out->vertex_error_percent_diagonal)) >= 0) {
-		if (!method || method->type != MJ_STRING ||
-		    (strcmp(method->text, "frames") != 0 && strcmp(method->text, "keys") != 0))
+	                                       &out->vertex_error_percent_diagonal)) >= 0 &&
+	    (out->has_pack_error = rd_number(&c, &o, "pack_error", 0, &out->pack_error)) >= 0) {
+		if (!method && !req)
+			out->missing_method = 1;
+		else if (!method || method->type != MJ_STRING ||
+		         (strcmp(method->text, "frames") != 0 && strcmp(method->text, "keys") != 0))
 			rd_fail(&c, "method", "not frames or keys");
 		else
 			out->method = strcmp(method->text, "keys") == 0 ? MLOD_MOTION_KEYS : MLOD_MOTION_FRAMES;
+		out->missing_keys = !got_keys;
+		out->missing_joint_error = !got_je;
+		out->missing_point_error = !got_pe;
+		(void)got_threshold;
 	}
 	if (c.r == MLOD_OK && mw) {
 		mlod_record_morph_weights *m = &out->morph_weights;
@@ -858,6 +1002,43 @@ mlod_result mlod_record_read_motion(const mlod_gltf *doc, int animation, mlod_re
 	out->source_animation = (int)source;
 	out->subdivide = (int)subdivide;
 	*found = c.r == MLOD_OK;
+	mj_free(&o);
+	return c.r;
+}
+
+mlod_result mlod_record_write_motion0(mlod_gltf *doc, int animation, double pack_error, mlod_error *err)
+{
+	struct wr w = {0};
+	mj o = mj_object(), x = mj_object();
+	w_num(&w, &x, "pack_error", "%.9g", pack_error);
+	w_put(&w, &o, "motion_level0", &x);
+	if (w.failed) {
+		mj_free(&o);
+		return nomem(err);
+	}
+	mlod_result r = merge(doc, MLOD_GLTF_ANIMATION, animation, NULL, &o, err);
+	return r == MLOD_OK ? stamp(doc, err) : r;
+}
+
+mlod_result mlod_record_read_motion0(const mlod_gltf *doc, int animation, double *pack_error, int *found,
+                                     mlod_error *err)
+{
+	mj o;
+	struct rd c = {{0}, err, MLOD_OK};
+	*found = 0;
+	*pack_error = 0.0;
+	mlod_result r = get(doc, MLOD_GLTF_ANIMATION, animation, &o, err);
+	if (r != MLOD_OK)
+		return r;
+	const mj *z = mj_get(&o, "motion_level0");
+	if (z) {
+		rd_at(&c, "animation %d: extras.mlod.motion_level0", animation);
+		if (z->type != MJ_OBJECT)
+			rd_fail(&c, NULL, "not an object");
+		else if (rd_number(&c, z, "pack_error", 1, pack_error) > 0 && !(*pack_error >= 0.0))
+			rd_fail(&c, "pack_error", "negative");
+		*found = c.r == MLOD_OK;
+	}
 	mj_free(&o);
 	return c.r;
 }

@@ -6,7 +6,8 @@
  *   mlod-skelgraph, mlod-pack   mlod_record_read_joints (joint nodes)
  *   mlod-bgm, mlod-pack         mlod_record_read (scene and skins)
  *   mlod-pack                   mlod_record_read_mesh_node (every node),
- *                               mlod_record_read_motion (every animation)
+ *                               mlod_record_read_motion and _motion0 (every
+ *                               animation)
  *   mlod-motion                 mlod_gltf_weight_tracks (every animation)
  *   mlod-bgm (lodgltf.c)        mlod_gltf_get_node_trs (every node)
  */
@@ -49,6 +50,8 @@ static void read_records(const mlod_gltf *doc, const mlod_character *c)
 		mlod_record_motion_level ml;
 		int found = 0;
 		mlod_record_read_motion(doc, a, &ml, &found, &e);
+		double pack_error = 0.0;
+		mlod_record_read_motion0(doc, a, &pack_error, &found, &e);
 		mlod_weight_track *tracks = NULL;
 		int count = 0;
 		if (mlod_gltf_weight_tracks(doc, a, &tracks, &count, &e) == MLOD_OK)

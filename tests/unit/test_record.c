@@ -160,7 +160,8 @@ TEST(stages_merge_and_version)
 
 	/* Mesh levels, then skeleton levels: both stay (the merge fix), and
 	 * the version is stamped. */
-	mlod_record_mesh_level mesh[2] = {{1, 0.5, 100, 80, {0.1, 1.5, 0}, 0}, {2, 0.25, 50, 40, {0.3, 3.0, 0}, 0}};
+	mlod_record_mesh_level mesh[2] = {{.level = 1, .ratio = 0.5, .triangles = 100, .vertices = 80, .error = {0.1, 1.5, 0}},
+	                                  {.level = 2, .ratio = 0.25, .triangles = 50, .vertices = 40, .error = {0.3, 3.0, 0}}};
 	CHECK_OK(mlod_record_write_mesh_levels(doc, mesh, 2, &terr));
 	mlod_record_skel_level skel[2] = {skel_level(1, 0, 2, 1, full), skel_level(2, 0, 3, 0, full)};
 	int fulls[1] = {full};
@@ -253,6 +254,98 @@ TEST(motion_and_node_records)
 	mlod_gltf_free(doc);
 }
 
+/* Version 3 (what mlod-pack -x writes): the measures a pack does not
+ * store may be missing, the pack errors are read, a full clip may be a
+ * pack's motion level 0; in a version 2 record the same keys are still
+ * required. */
+static mlod_result read_scene(mlod_gltf *doc, const char *text, mlod_error *err);
+
+TEST(pack_records_version3)
+{
+	mlod_gltf *doc = NULL;
+	mlod_character c = {0};
+	mlod_error e;
+	int found = 0;
+	CHECK(load("samples/tubeman.glb", &doc, &c) == 0);
+	/* Written by the writers with the missing_* flags: the keys left out. */
+	mlod_record_motion_level m = {0}, back;
+	m.level = 1;
+	m.missing_method = m.missing_keys = m.missing_joint_error = m.missing_point_error = 1;
+	m.has_pack_error = 1;
+	m.pack_error = 0.0443900004;
+	CHECK_OK(mlod_record_write_motion(doc, 0, &m, &terr));
+	char *text = NULL;
+	CHECK_OK(mlod_gltf_get_extra(doc, MLOD_GLTF_ANIMATION, 0, "mlod", &text, &terr));
+	CHECK_MSG(text && strcmp(text, "{\"motion_level\":1,\"pack_error\":0.0443900004,\"source_animation\":0}") == 0,
+	          "%s", text ? text : "(none)");
+	mlod_free(text);
+	CHECK_OK(mlod_record_read_motion(doc, 0, &back, &found, &terr));
+	CHECK(found && back.level == 1 && back.missing_method && back.missing_keys && back.missing_joint_error &&
+	      back.missing_point_error && back.has_pack_error && back.pack_error == 0.0443900004);
+	/* The same in a version 2 record is refused, naming the first key. */
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", "{\"version\":2}", &terr));
+	CHECK(mlod_record_read_motion(doc, 0, &back, &found, &e) == MLOD_ERR_PARSE);
+	CHECK_MSG(strstr(e.message, "animation 0: extras.mlod.threshold: missing"), "%s", e.message);
+	/* A version 2 record with every key reads as before (no flag set). */
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_ANIMATION, 0, "mlod",
+	                             "{\"motion_level\":1,\"source_animation\":0,\"method\":\"frames\",\"threshold\":0.5,"
+	                             "\"keys\":10,\"source_keys\":20,\"bytes\":40,\"joint_error\":{\"max\":0.1,\"mean\":0.05},"
+	                             "\"point_error\":0.1}",
+	                             &terr));
+	CHECK_OK(mlod_record_read_motion(doc, 0, &back, &found, &terr));
+	CHECK(found && !back.missing_method && !back.missing_keys && !back.missing_joint_error && !back.missing_point_error &&
+	      !back.has_pack_error && back.keys == 10 && back.joint_error.max == 0.1);
+
+	/* A level node: ratio and error_percent may be missing in version 3. */
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", "{\"version\":3}", &terr));
+	mlod_record_mesh_node n = {0}, nb;
+	n.level = 2;
+	n.missing_ratio = n.missing_error = 1;
+	n.has_pack_error = 1;
+	n.pack_error = 0.174;
+	CHECK_OK(mlod_record_write_mesh_node(doc, 1, &n, &terr));
+	CHECK_OK(mlod_record_read_mesh_node(doc, 1, &nb, &found, &terr));
+	CHECK(found && nb.level == 2 && nb.missing_ratio && nb.missing_error && nb.has_pack_error && nb.pack_error == 0.174);
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", "{\"version\":2}", &terr));
+	CHECK(mlod_record_read_mesh_node(doc, 1, &nb, &found, &e) == MLOD_ERR_PARSE);
+	CHECK_MSG(strstr(e.message, "node 1: extras.mlod.ratio: missing"), "%s", e.message);
+
+	/* Motion level 0. */
+	double pe = -1.0;
+	CHECK_OK(mlod_record_read_motion0(doc, 0, &pe, &found, &terr));
+	CHECK(!found && pe == 0.0);
+	CHECK_OK(mlod_record_write_motion0(doc, 0, 0.0111500002, &terr));
+	CHECK_OK(mlod_record_read_motion0(doc, 0, &pe, &found, &terr));
+	CHECK(found && pe == 0.0111500002);
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_ANIMATION, 0, "mlod", "{\"motion_level0\":{\"pack_error\":-1}}", &terr));
+	CHECK(mlod_record_read_motion0(doc, 0, &pe, &found, &e) == MLOD_ERR_PARSE);
+	CHECK_MSG(strstr(e.message, "animation 0: extras.mlod.motion_level0.pack_error: negative"), "%s", e.message);
+
+	/* The scene: skeleton and mesh levels with only what a pack stores. */
+	CHECK(read_scene(doc,
+	                 "{\"version\":3,\"skeleton_levels\":[{\"level\":1,\"joints\":1,\"kept\":[0],\"skins\":[0],"
+	                 "\"remap\":{},\"pack_error\":0.5}],\"mesh_levels\":[{\"level\":1,\"triangles\":1,\"vertices\":3,"
+	                 "\"pack_error\":0.25}]}",
+	                 &e) == MLOD_OK);
+	mlod_record rec;
+	CHECK_OK(mlod_record_read(doc, &rec, &terr));
+	CHECK(rec.version == 3 && rec.skel_level_count == 1 && rec.skel_levels[0].missing_threshold &&
+	      rec.skel_levels[0].missing_joint_error && rec.skel_levels[0].has_pack_error &&
+	      rec.skel_levels[0].pack_error == 0.5);
+	CHECK(rec.mesh_level_count == 1 && rec.mesh_levels[0].missing_ratio && rec.mesh_levels[0].missing_error &&
+	      rec.mesh_levels[0].has_pack_error && rec.mesh_levels[0].pack_error == 0.25 &&
+	      rec.mesh_levels[0].coverage == 0.0);
+	/* Written back: the same keys, nothing invented. */
+	CHECK_OK(mlod_record_write_mesh_levels(doc, rec.mesh_levels, 1, &terr));
+	CHECK_OK(mlod_gltf_get_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", &text, &terr));
+	CHECK_MSG(text && strstr(text, "\"mesh_levels\":[{\"level\":1,\"pack_error\":0.25,\"triangles\":1,\"vertices\":3}]"),
+	          "%s", text ? text : "(none)");
+	mlod_free(text);
+	mlod_record_free(&rec);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+}
+
 /* Sets the scene's record to text and reads it: the result, and the
  * message in err. */
 static mlod_result read_scene(mlod_gltf *doc, const char *text, mlod_error *err)
@@ -280,8 +373,9 @@ TEST(old_new_and_malformed)
 	                 &e) == MLOD_OK);
 	CHECK(read_scene(doc, "{\"version\":1}", &e) == MLOD_OK);
 	CHECK(read_scene(doc, "{\"version\":2}", &e) == MLOD_OK);
-	CHECK(read_scene(doc, "{\"version\":3}", &e) == MLOD_ERR_UNSUPPORTED);
-	CHECK_MSG(strstr(e.message, "version 3") && strstr(e.message, "up to version 2"), "%s", e.message);
+	CHECK(read_scene(doc, "{\"version\":3}", &e) == MLOD_OK);
+	CHECK(read_scene(doc, "{\"version\":4}", &e) == MLOD_ERR_UNSUPPORTED);
+	CHECK_MSG(strstr(e.message, "version 4") && strstr(e.message, "up to version 3"), "%s", e.message);
 	static const struct {
 		const char *text, *says;
 	} bad[] = {
@@ -290,6 +384,17 @@ TEST(old_new_and_malformed)
 		{"{\"version\":1.5}", "extras.mlod.version: not a whole number"},
 		{"{\"skeleton_levels\":{}}", "extras.mlod.skeleton_levels: not an array"},
 		{"{\"skeleton_levels\":[{\"level\":1}]}", "skeleton_levels[0].threshold: missing"},
+		/* Version 3: threshold, joint_error, ratio and error_percent may be
+		 * missing; the rest is required as before. */
+		{"{\"version\":3,\"skeleton_levels\":[{\"level\":1}]}", "skeleton_levels[0].joints: missing"},
+		{"{\"version\":3,\"skeleton_levels\":[{\"level\":1,\"joints\":1,\"kept\":[0],\"skins\":[0],\"remap\":{},"
+		 "\"pack_error\":\"1\"}]}",
+		 "skeleton_levels[0].pack_error: not a number"},
+		{"{\"version\":3,\"mesh_levels\":[{\"level\":1,\"triangles\":1}]}", "mesh_levels[0].vertices: missing"},
+		{"{\"version\":3,\"mesh_levels\":[{\"level\":1,\"triangles\":1,\"vertices\":3,\"error_percent\":{}}]}",
+		 "mesh_levels[0].error_percent.max: missing"},
+		{"{\"version\":2,\"mesh_levels\":[{\"level\":1,\"triangles\":1,\"vertices\":3}]}",
+		 "mesh_levels[0].ratio: missing"},
 		{"{\"skeleton_levels\":[{\"level\":1,\"threshold\":0,\"joints\":1,\"kept\":[99999],\"skins\":[0],"
 		 "\"joint_error\":{\"max\":0,\"mean\":0},\"remap\":{}}]}",
 		 "skeleton_levels[0].kept: holds something other than an index in range"},
@@ -321,7 +426,7 @@ TEST(old_new_and_malformed)
 	}
 	/* A writer does not add to a record that is not an object. */
 	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", "\"text\"", &terr));
-	mlod_record_mesh_level m = {1, 0.5, 1, 3, {0, 0, 0}, 0};
+	mlod_record_mesh_level m = {.level = 1, .ratio = 0.5, .triangles = 1, .vertices = 3};
 	CHECK(mlod_record_write_mesh_levels(doc, &m, 1, &e) == MLOD_ERR_UNSUPPORTED);
 	CHECK_MSG(strstr(e.message, "not a JSON object"), "%s", e.message);
 
@@ -355,5 +460,6 @@ int main(void)
 	RUN(stages_merge_and_version);
 	RUN(motion_and_node_records);
 	RUN(old_new_and_malformed);
+	RUN(pack_records_version3);
 	TEST_EXIT();
 }
