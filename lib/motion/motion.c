@@ -1450,7 +1450,7 @@ static int channel_exp(const mlod_motion *m, const mlod_channel *ch, int g, int 
 	return g + adj + (ch->path == MLOD_PATH_TRANSLATION ? 0 : m->reach_exp[ch->joint]);
 }
 
-static void refine_one(void *ctx, int lane, int i)
+EVAL_INLINE void refine_one_body(void *ctx, int lane, int i)
 {
 	refine_ctx *x = ctx;
 	mlod_motion *m = x->m;
@@ -1547,6 +1547,18 @@ static void refine_one(void *ctx, int lane, int i)
 	}
 }
 
+/* refine_one_body compiled twice (motion_eval.h): the same floats. */
+static void refine_one_generic(void *ctx, int lane, int i)
+{
+	refine_one_body(ctx, lane, i);
+}
+#if EVAL_HAVE_AVX2
+EVAL_TARGET_AVX2 static void refine_one_avx2(void *ctx, int lane, int i)
+{
+	refine_one_body(ctx, lane, i);
+}
+#endif
+
 static int refine_conflict(void *ctx, int u, int t)
 {
 	const refine_ctx *x = ctx;
@@ -1586,7 +1598,12 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	/* Samples every REFINE_STRIDE-th first (they are independent, and a
 	 * try that fails usually fails sooner), then the others in order. */
 	refine_ctx x = { m, src, clip, g, F >= 4 * REFINE_STRIDE ? REFINE_STRIDE : 1, adj, e, bound, &rb };
-	if (motion_run_tasks(n, rb.lanes, refine_conflict, refine_one, &x) != MLOD_OK)
+	motion_task_fn one = refine_one_generic;
+#if EVAL_HAVE_AVX2
+	if (eval_avx2())
+		one = refine_one_avx2;
+#endif
+	if (motion_run_tasks(n, rb.lanes, refine_conflict, one, &x) != MLOD_OK)
 		return -1;
 	*world = W; /* in m->scratch: valid until its next use */
 	return 0;
