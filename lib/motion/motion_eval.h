@@ -429,7 +429,7 @@ static inline int eval_clip_ok(const mlod_clip *clip)
 
 /* mlod_clip_sample(clip, t, local) for a clip eval_clip_ok accepts, with
  * one eval_seg per channel (k = -1 at first). */
-static inline void eval_sample(const mlod_clip *clip, eval_seg *segs, float t, mlod_trs *local)
+EVAL_INLINE void eval_sample(const mlod_clip *clip, eval_seg *segs, float t, mlod_trs *local)
 {
 	if (!(t > 0.0f))
 		t = 0.0f;
