@@ -115,6 +115,10 @@ EVAL_INLINE int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_m
 {
 	if (eval_error_bound(w, w0, R->radius[j]) <= budget)
 		return 1; /* the same answer as below, from a float bound */
+#if EVAL_HAVE_AVX2
+	if (R->avx2)
+		return motion_point_within_avx2(w, w0, R->radius[j], budget);
+#endif
 	return mlod_motion_point_within(w, w0, R->radius[j], budget);
 }
 

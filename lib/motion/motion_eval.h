@@ -233,6 +233,10 @@ static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, d
  * its largest singular value computed only when cheaper bounds of it
  * cannot tell (pointerror.c). */
 int eval_point_error_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit);
+#if EVAL_HAVE_AVX2
+/* mlod_motion_point_within compiled for AVX2 (pointerror.c). */
+int motion_point_within_avx2(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double budget);
+#endif
 
 /* Is mlod_motion_point_error(w, w0, radius) <= limit? Exactly that
  * answer; the exact error is computed only when the bounds cannot tell. */
