@@ -1535,7 +1535,11 @@ TEST(keys_avx2_same_as_generic)
 	 * Without AVX2 both runs take the generic copies. */
 	mlod_character c;
 	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
-	CHECK(eval_avx2() == (EVAL_HAVE_AVX2 && __builtin_cpu_supports("avx2")));
+#if EVAL_HAVE_AVX2
+	CHECK(eval_avx2() == (__builtin_cpu_supports("avx2") != 0));
+#else
+	CHECK(eval_avx2() == 0);
+#endif
 	double h = mlod_skeleton_height(&c.skeleton);
 	mlod_motion_method methods[2] = { MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS };
 	const double bounds[3] = { 0.002 * h, 0.01 * h, 0.03 * h };
