@@ -83,6 +83,7 @@ typedef struct reducer {
 	                            buffer is its own lane's good index) */
 	unsigned char *kept;
 	int lanes;
+	int avx2;                /* the AVX2 copy of the checks (eval_avx2) */
 	lane lane[MAX_LANES];
 	eval_scratch own;        /* the arrays above (lc to the lanes') when no scratch is given */
 	/* The tasks on threads: task t is channel t % C at round t / C + 1
@@ -110,16 +111,22 @@ EVAL_INLINE void set_path(mlod_trs *l, mlod_path path, const float *v)
 /* Does the joint's world matrix w stay within budget of w0? A float
  * bound of the point error decides first (the same answer); only when it
  * cannot, mlod_motion_point_within with its early exits. */
-static int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget)
+EVAL_INLINE int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget)
 {
 	if (eval_error_bound(w, w0, R->radius[j]) <= budget)
 		return 1; /* the same answer as below, from a float bound */
+#if EVAL_HAVE_AVX2
+	if (R->avx2)
+		return motion_point_within_avx2(w, w0, R->radius[j], budget);
+#endif
 	return mlod_motion_point_within(w, w0, R->radius[j], budget);
 }
 
 /* The channel's value at sample f and the subtree's world matrices with
- * it, into the spare buffers; is every joint within budget? */
-static int sample_check(reducer *R, lane *L, const mlod_channel *ch, const float *va, const float *vb, float t0,
+ * it, into the spare buffers; is every joint within budget? Compiled
+ * twice (sample_check_generic, sample_check_avx2: motion_eval.h), the
+ * same floats. */
+EVAL_INLINE int sample_check_body(reducer *R, lane *L, const mlod_channel *ch, const float *va, const float *vb, float t0,
                         float dt, eval_seg *seg, int constant, int f, double budget)
 {
 	const mlod_skeleton *s = R->s;
@@ -158,6 +165,24 @@ static int sample_check(reducer *R, lane *L, const mlod_channel *ch, const float
 	}
 	return 1;
 }
+
+#define SAMPLE_CHECK_ARGS                                                                                              \
+	reducer *R, lane *L, const mlod_channel *ch, const float *va, const float *vb, float t0, float dt, eval_seg *seg, \
+	        int constant, int f, double budget
+static int sample_check_generic(SAMPLE_CHECK_ARGS)
+{
+	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget);
+}
+#if EVAL_HAVE_AVX2
+EVAL_TARGET_AVX2 static int sample_check_avx2(SAMPLE_CHECK_ARGS)
+{
+	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget);
+}
+#define sample_check(R, ...) \
+	((R)->avx2 ? sample_check_avx2(R, __VA_ARGS__) : sample_check_generic(R, __VA_ARGS__))
+#else
+#define sample_check sample_check_generic
+#endif
 
 /* Checks channel ch taking, at samples lo..hi (inclusive), the values of
  * the segment between its keys at frames a and b (or a's value, constant).
@@ -559,6 +584,7 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 	R.tasks = (ROUNDS + 1) * R.C;
 	R.bound = bound;
 	R.lanes = threads < 1 ? 1 : threads > MAX_LANES ? MAX_LANES : threads;
+	R.avx2 = eval_avx2();
 	size_t FJ = (size_t)R.S * (size_t)R.J;
 	R.times = malloc(sizeof(float) * (size_t)R.S);
 	R.radius = malloc(sizeof(double) * (size_t)R.J);

@@ -921,8 +921,8 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
  * each sample visited leaves there the level's local transforms, their
  * matrices and its world matrices (the same floats as walk_pose and
  * eval_from_trs), and *kept is set: when the level fits, at every sample. */
-static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L, mlod_mat4 *LM,
-                             mlod_mat4 *W, int *kept)
+EVAL_INLINE int level_within_keep_body(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L,
+                                       mlod_mat4 *LM, mlod_mat4 *W, int *kept)
 {
 	level_walk w;
 	walk_begin(m, clip, &w);
@@ -965,6 +965,29 @@ static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound
 	return ok;
 }
 
+/* level_within_keep_body compiled twice (motion_eval.h): the same floats. */
+static int level_within_keep_generic(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L, mlod_mat4 *LM,
+                                     mlod_mat4 *W, int *kept)
+{
+	return level_within_keep_body(m, clip, bound, L, LM, W, kept);
+}
+#if EVAL_HAVE_AVX2
+EVAL_TARGET_AVX2 static int level_within_keep_avx2(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L,
+                                                    mlod_mat4 *LM, mlod_mat4 *W, int *kept)
+{
+	return level_within_keep_body(m, clip, bound, L, LM, W, kept);
+}
+#endif
+static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L, mlod_mat4 *LM,
+                             mlod_mat4 *W, int *kept)
+{
+#if EVAL_HAVE_AVX2
+	if (eval_avx2())
+		return level_within_keep_avx2(m, clip, bound, L, LM, W, kept);
+#endif
+	return level_within_keep_generic(m, clip, bound, L, LM, W, kept);
+}
+
 /* level_within_keep and level_measure_of (with its world matrices
  * given) on refine_lanes(m) threads, a range of samples each: every sample's
  * floats are computed alone (its own walk state: eval_sample's floats do
@@ -990,7 +1013,7 @@ static void lane_range(const walk_par *x, int i, int *lo, int *hi)
 	*hi = (int)(S * (i + 1) / x->lanes);
 }
 
-static mlod_result within_lane(void *ctx, int i)
+EVAL_INLINE mlod_result within_lane_body(void *ctx, int i)
 {
 	walk_par *x = ctx;
 	mlod_motion *m = x->m;
@@ -1037,6 +1060,18 @@ static mlod_result within_lane(void *ctx, int i)
 	return MLOD_OK;
 }
 
+/* within_lane_body compiled twice (motion_eval.h): the same floats. */
+static mlod_result within_lane_generic(void *ctx, int i)
+{
+	return within_lane_body(ctx, i);
+}
+#if EVAL_HAVE_AVX2
+EVAL_TARGET_AVX2 static mlod_result within_lane_avx2(void *ctx, int i)
+{
+	return within_lane_body(ctx, i);
+}
+#endif
+
 /* level_within_keep into L, LM and W on lanes: 1 or 0, or -1 when it
  * could not (the caller walks alone). */
 static int level_within_par(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L, mlod_mat4 *LM,
@@ -1048,7 +1083,12 @@ static int level_within_par(mlod_motion *m, const mlod_clip *clip, double bound,
 	atomic_init(&x.failed, 0);
 	atomic_init(&x.oom, 0);
 	atomic_init(&x.nan, 0);
-	mlod_parallel_for(lanes, lanes, within_lane, &x);
+	mlod_result (*lane)(void *, int) = within_lane_generic;
+#if EVAL_HAVE_AVX2
+	if (eval_avx2())
+		lane = within_lane_avx2;
+#endif
+	mlod_parallel_for(lanes, lanes, lane, &x);
 	if (atomic_load(&x.oom))
 		return -1;
 	return !atomic_load(&x.failed);
@@ -1215,7 +1255,7 @@ static double removal_bound(const mlod_motion *m, double bound)
 #define REFINE_STRIDE 8
 
 /* v rounded to the nearest multiple of 2^e. */
-static float grid_round(float v, int e)
+EVAL_INLINE float grid_round(float v, int e)
 {
 	return (float)ldexp(rint(ldexp((double)v, -e)), e);
 }
@@ -1223,7 +1263,7 @@ static float grid_round(float v, int e)
 /* Rounds a unit quaternion: its three smaller components to the grid 2^e,
  * the largest recomputed from them, so it stays unit (and the glTF
  * writer's normalisation leaves it as it is). */
-static void round_quat(float *q, int e)
+EVAL_INLINE void round_quat(float *q, int e)
 {
 	int big = 0;
 	for (int c = 1; c < 4; c++)
@@ -1247,7 +1287,7 @@ static void round_quat(float *q, int e)
  * 2^e[i] (NO_ROUNDING: as they are). The first and last key of every
  * channel stay exact. */
 /* The lattice of normalised shorts: n / 32767 as glTF readers decode it. */
-static float short_value(long n)
+EVAL_INLINE float short_value(long n)
 {
 	return (float)((double)n / 32767.0);
 }
@@ -1255,7 +1295,7 @@ static float short_value(long n)
 /* Rounds a unit quaternion onto the lattice of normalised shorts: its three
  * smaller components to multiples of step / 32767 (step a power of two),
  * the largest to the nearest lattice value that makes it unit. */
-static void round_quat_short(float *q, double step)
+EVAL_INLINE void round_quat_short(float *q, double step)
 {
 	int big = 0;
 	for (int c = 1; c < 4; c++)
@@ -1282,7 +1322,7 @@ static void round_quat_short(float *q, double step)
  * the first and last keys exact; with shorts, a rotation goes on the
  * lattice of normalised shorts instead, every key (the ends on the finest
  * lattice). */
-static void round_channel(const mlod_channel *a, mlod_channel *b, int e, int shorts)
+EVAL_INLINE void round_channel_body(const mlod_channel *a, mlod_channel *b, int e, int shorts)
 {
 	int comps = comps_of(a), n = a->key_count;
 	memcpy(b->values, a->values, sizeof(float) * (size_t)n * (size_t)comps);
@@ -1305,6 +1345,29 @@ static void round_channel(const mlod_channel *a, mlod_channel *b, int e, int sho
 			for (int c = 0; c < 3; c++)
 				v[c] = grid_round(v[c], e);
 	}
+}
+
+/* round_channel_body compiled twice (motion_eval.h): the same floats (with
+ * AVX2, rint is one instruction). */
+static void round_channel_generic(const mlod_channel *a, mlod_channel *b, int e, int shorts)
+{
+	round_channel_body(a, b, e, shorts);
+}
+#if EVAL_HAVE_AVX2
+EVAL_TARGET_AVX2 static void round_channel_avx2(const mlod_channel *a, mlod_channel *b, int e, int shorts)
+{
+	round_channel_body(a, b, e, shorts);
+}
+#endif
+static void round_channel(const mlod_channel *a, mlod_channel *b, int e, int shorts)
+{
+#if EVAL_HAVE_AVX2
+	if (eval_avx2()) {
+		round_channel_avx2(a, b, e, shorts);
+		return;
+	}
+#endif
+	round_channel_generic(a, b, e, shorts);
 }
 
 static void round_clip(const mlod_clip *src, mlod_clip *dst, const int *e, int shorts)
@@ -1450,7 +1513,7 @@ static int channel_exp(const mlod_motion *m, const mlod_channel *ch, int g, int 
 	return g + adj + (ch->path == MLOD_PATH_TRANSLATION ? 0 : m->reach_exp[ch->joint]);
 }
 
-static void refine_one(void *ctx, int lane, int i)
+EVAL_INLINE void refine_one_body(void *ctx, int lane, int i)
 {
 	refine_ctx *x = ctx;
 	mlod_motion *m = x->m;
@@ -1547,6 +1610,18 @@ static void refine_one(void *ctx, int lane, int i)
 	}
 }
 
+/* refine_one_body compiled twice (motion_eval.h): the same floats. */
+static void refine_one_generic(void *ctx, int lane, int i)
+{
+	refine_one_body(ctx, lane, i);
+}
+#if EVAL_HAVE_AVX2
+EVAL_TARGET_AVX2 static void refine_one_avx2(void *ctx, int lane, int i)
+{
+	refine_one_body(ctx, lane, i);
+}
+#endif
+
 static int refine_conflict(void *ctx, int u, int t)
 {
 	const refine_ctx *x = ctx;
@@ -1586,7 +1661,12 @@ static int refine_channels(mlod_motion *m, const mlod_clip *src, mlod_clip *clip
 	/* Samples every REFINE_STRIDE-th first (they are independent, and a
 	 * try that fails usually fails sooner), then the others in order. */
 	refine_ctx x = { m, src, clip, g, F >= 4 * REFINE_STRIDE ? REFINE_STRIDE : 1, adj, e, bound, &rb };
-	if (motion_run_tasks(n, rb.lanes, refine_conflict, refine_one, &x) != MLOD_OK)
+	motion_task_fn one = refine_one_generic;
+#if EVAL_HAVE_AVX2
+	if (eval_avx2())
+		one = refine_one_avx2;
+#endif
+	if (motion_run_tasks(n, rb.lanes, refine_conflict, one, &x) != MLOD_OK)
 		return -1;
 	*world = W; /* in m->scratch: valid until its next use */
 	return 0;

@@ -38,6 +38,36 @@
 
 #include "motion/mlod_motion.h"
 
+/* The hottest loops (the key reduction's sample checks, the rounding's
+ * per-channel tries) are compiled twice: as the rest of the library, and
+ * for x86 CPUs with AVX2 (GCC's target attribute; EVAL_TARGET_AVX2 on
+ * the second copy), chosen at run time (eval_avx2). The second copy
+ * runs the same C on the same floats: the same IEEE operations in the
+ * same order, only encoded with VEX (three-operand forms, broadcasts
+ * from memory), so fewer instructions; no fused multiply-add (AVX2 does
+ * not imply FMA, and -std=c11 does not contract). The same bytes either
+ * way (test keys_avx2_same_as_generic). */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define EVAL_HAVE_AVX2 1
+#define EVAL_TARGET_AVX2 __attribute__((target("avx2")))
+#else
+#define EVAL_HAVE_AVX2 0
+#define EVAL_TARGET_AVX2
+#endif
+
+/* For tests: nonzero makes eval_avx2 answer 0 (the generic copies run). */
+extern int motion_eval_generic_only;
+
+/* Should the AVX2 copies run? */
+static inline int eval_avx2(void)
+{
+#if EVAL_HAVE_AVX2
+	return !motion_eval_generic_only && __builtin_cpu_supports("avx2");
+#else
+	return 0;
+#endif
+}
+
 /* Margin on the Frobenius bound: the computed sigma_max is the exact one
  * times (1 + 1e-9) plus rounding far below 1e-12 relative. */
 #define EVAL_FROB_MARGIN (1.0 + 1e-6)
@@ -203,10 +233,14 @@ static inline double eval_error_bound(const mlod_mat4 *w, const mlod_mat4 *w0, d
  * its largest singular value computed only when cheaper bounds of it
  * cannot tell (pointerror.c). */
 int eval_point_error_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit);
+#if EVAL_HAVE_AVX2
+/* mlod_motion_point_within compiled for AVX2 (pointerror.c). */
+int motion_point_within_avx2(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double budget);
+#endif
 
 /* Is mlod_motion_point_error(w, w0, radius) <= limit? Exactly that
  * answer; the exact error is computed only when the bounds cannot tell. */
-static inline int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
+EVAL_INLINE int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)
 {
 	if (eval_error_bound(w, w0, radius) <= limit)
 		return 1;
@@ -311,7 +345,7 @@ static inline mlod_quat eval_blend(mlod_quat a, double wa, mlod_quat b, double w
 }
 
 /* mlod_quat_slerp(ka, kb, u) with the segment's keys ka, kb (float[4]). */
-static inline mlod_quat eval_slerp(eval_seg *sg, const float *ka, const float *kb, float u)
+EVAL_INLINE mlod_quat eval_slerp(eval_seg *sg, const float *ka, const float *kb, float u)
 {
 	if (!sg->ready) {
 		sg->a = eval_normalize((mlod_quat){ ka[0], ka[1], ka[2], ka[3] });
@@ -355,7 +389,7 @@ static inline int eval_find(const float *times, int n, int k, float t)
 /* One channel (LINEAR or STEP) at t (already clamped as mlod_clip_sample
  * clamps it) into out, comps floats, as mlod_clip_sample's sampling;
  * rotations come out as the slerp (not yet normalised). */
-static inline void eval_channel(const mlod_channel *ch, eval_seg *sg, float t, float *out)
+EVAL_INLINE void eval_channel(const mlod_channel *ch, eval_seg *sg, float t, float *out)
 {
 	const int n = ch->key_count, comps = ch->path == MLOD_PATH_ROTATION ? 4 : 3;
 	const float *v = ch->values;
@@ -399,7 +433,7 @@ static inline int eval_clip_ok(const mlod_clip *clip)
 
 /* mlod_clip_sample(clip, t, local) for a clip eval_clip_ok accepts, with
  * one eval_seg per channel (k = -1 at first). */
-static inline void eval_sample(const mlod_clip *clip, eval_seg *segs, float t, mlod_trs *local)
+EVAL_INLINE void eval_sample(const mlod_clip *clip, eval_seg *segs, float t, mlod_trs *local)
 {
 	if (!(t > 0.0f))
 		t = 0.0f;

@@ -57,7 +57,7 @@ static double sigma_max(const double a[9])
  * A' - A = A (R - I) has two equal singular values and that column lies
  * in their plane: the quotient is the largest eigenvalue). The 1e-5
  * margins cover the roundings 100 times over. */
-static int sigma_decide(const double a[9], double rad, double base, double limit)
+EVAL_INLINE int sigma_decide(const double a[9], double rad, double base, double limit)
 {
 	double b[3][3];
 	/* Written out: b[i][j] = sum over c of a[c * 3 + i] a[c * 3 + j], in
@@ -114,7 +114,7 @@ double mlod_motion_point_error(const mlod_mat4 *a, const mlod_mat4 *b, double ra
 	return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + radius * sigma_max(m);
 }
 
-int mlod_motion_point_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double budget)
+EVAL_INLINE int point_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double budget)
 {
 	double dx = (double)w->m[12] - w0->m[12], dy = (double)w->m[13] - w0->m[13], dz = (double)w->m[14] - w0->m[14];
 	double dp = sqrt(dx * dx + dy * dy + dz * dz);
@@ -131,3 +131,16 @@ int mlod_motion_point_within(const mlod_mat4 *w, const mlod_mat4 *w0, double rad
 		return 1; /* sigma_max <= Frobenius norm */
 	return sigma_decide(a, rad, 0.0, room); /* 0 + x is x */
 }
+
+int mlod_motion_point_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double budget)
+{
+	return point_within(w, w0, radius, budget);
+}
+
+#if EVAL_HAVE_AVX2
+/* mlod_motion_point_within compiled for AVX2 (motion_eval.h): the same answer. */
+EVAL_TARGET_AVX2 int motion_point_within_avx2(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double budget)
+{
+	return point_within(w, w0, radius, budget);
+}
+#endif

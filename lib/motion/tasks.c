@@ -15,6 +15,8 @@
 
 #include "motion/motion_eval.h"
 
+int motion_eval_generic_only = 0; /* motion_eval.h: for tests */
+
 typedef struct runner {
 	int n;
 	motion_conflict_fn conflict;

@@ -1526,6 +1526,47 @@ TEST(eval_mul_same_as_mat4_mul)
 	CHECK_MSG(differ == 0, "%d products differ", differ);
 }
 
+TEST(keys_avx2_same_as_generic)
+{
+	/* The hot loops' AVX2 copies (motion_eval.h: the key reduction's
+	 * sample checks, the rounding's per-channel tries and walks) against
+	 * the generic ones: the same levels, bit for bit, on the walk (both
+	 * methods, three bounds, the rounding on; one and two threads).
+	 * Without AVX2 both runs take the generic copies. */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+#if EVAL_HAVE_AVX2
+	CHECK(eval_avx2() == (__builtin_cpu_supports("avx2") != 0));
+#else
+	CHECK(eval_avx2() == 0);
+#endif
+	double h = mlod_skeleton_height(&c.skeleton);
+	mlod_motion_method methods[2] = { MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS };
+	const double bounds[3] = { 0.002 * h, 0.01 * h, 0.03 * h };
+	for (int threads = 1; threads <= 2; threads++) {
+		mlod_motion_level lv[2][3];
+		for (int generic = 0; generic < 2; generic++) {
+			motion_eval_generic_only = generic;
+			mlod_motion *m[2] = { NULL, NULL };
+			for (int i = 0; i < 2; i++) {
+				CHECK_OK(mlod_motion_create(&c, 0, NULL, &m[i], &terr));
+				mlod_motion_set_threads(m[i], threads);
+			}
+			for (int s = 0; s < 3; s++)
+				CHECK_OK(mlod_motion_next_level_best(m, methods, 2, MLOD_MOTION_MAX_ERROR, bounds[s], &lv[generic][s], &terr));
+			for (int i = 0; i < 2; i++)
+				mlod_motion_free(m[i]);
+		}
+		motion_eval_generic_only = 0;
+		for (int s = 0; s < 3; s++) {
+			CHECK_MSG(same_level(&lv[0][s], &lv[1][s]), "%d threads, level %d", threads, s);
+			mlod_motion_level_free(&lv[0][s]);
+			mlod_motion_level_free(&lv[1][s]);
+		}
+	}
+	mlod_character_free(&c);
+}
+
 int main(void)
 {
 	RUN(levels_within_bounds_cmu);
@@ -1555,6 +1596,7 @@ int main(void)
 	RUN(keys_split_same_as_next_level);
 	RUN(bake_report_same_at_any_thread_count);
 	RUN(keys_state_reused_on_the_walk);
+	RUN(keys_avx2_same_as_generic);
 	RUN(keys_state_same_as_fresh);
 	RUN(eval_mul_same_as_mat4_mul);
 	RUN(create_like_same_as_create);
