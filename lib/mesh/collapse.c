@@ -486,7 +486,7 @@ static const double *face_geo(mlod_bgm *g, int h)
 
 /* Face h's area times its lack of compactness (sqrt(area_sq) from its
  * normal: area_sq's arithmetic). */
-static double face_tie(mlod_bgm *g, int h)
+BGM_INLINE double face_tie(mlod_bgm *g, int h)
 {
 	double *t = &g->ftie[h];
 	if (isnan(*t)) {
