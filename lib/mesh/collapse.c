@@ -486,7 +486,7 @@ static const double *face_geo(mlod_bgm *g, int h)
 
 /* Face h's area times its lack of compactness (sqrt(area_sq) from its
  * normal: area_sq's arithmetic). */
-static double face_tie(mlod_bgm *g, int h)
+BGM_INLINE double face_tie(mlod_bgm *g, int h)
 {
 	double *t = &g->ftie[h];
 	if (isnan(*t)) {
@@ -498,7 +498,7 @@ static double face_tie(mlod_bgm *g, int h)
 
 /* The tie-break term of a collapse: the collapsed triangle's area times
  * its lack of compactness, or for an edge the mean over its faces. */
-static double collapse_tie(mlod_bgm *g, int f, int op, int K)
+BGM_INLINE double collapse_tie(mlod_bgm *g, int f, int op, int K)
 {
 	if (K == 3)
 		return face_tie(g, f);
@@ -512,7 +512,7 @@ static double collapse_tie(mlod_bgm *g, int f, int op, int K)
 
 /* Whether a placement stays near the collapsed vertices P[0..K-1]: at
  * most their longest edge from the barycenter (K == 2: the one edge). */
-static int near_collapsed(const double *const P[3], int K, const double bary[3], const double opt[3])
+BGM_INLINE int near_collapsed(const double *const P[3], int K, const double bary[3], const double opt[3])
 {
 	double lmax = 0.0, d = 0.0;
 	for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
@@ -1506,7 +1506,7 @@ static unsigned lbmemo_hash(int a, int b, int c)
 }
 
 /* The slot of (a, b, c): its entry, or the empty slot where it goes. */
-static struct bgm_lbmemo *lbmemo_slot(struct bgm_lbmemo *t, int cap, int a, int b, int c)
+BGM_INLINE struct bgm_lbmemo *lbmemo_slot(struct bgm_lbmemo *t, int cap, int a, int b, int c)
 {
 	unsigned m = (unsigned)cap - 1u, i = lbmemo_hash(a, b, c) & m;
 	while (t[i].a >= 0 && !(t[i].a == a && t[i].b == b && t[i].c == c))
@@ -1812,7 +1812,7 @@ static int push_op(mlod_bgm *g, int f, int op, struct plan *scratch)
 
 /* 1 when the face across edge e of face f holds a queue entry for that
  * edge. An edge has two faces and is queued from one of them. */
-static int queued_across(const mlod_bgm *g, int f, int e)
+BGM_INLINE int queued_across(const mlod_bgm *g, int f, int e)
 {
 	const bgm_face *F = &g->faces[f];
 	int across = F->adj[e];
