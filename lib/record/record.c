@@ -273,6 +273,29 @@ static void w_str(struct wr *w, mj *o, const char *key, const char *s)
 		w->failed = 1;
 }
 
+/* Ends a writer: out of memory when a step failed, else merges *value
+ * (taken over) into the object's record as merge() does. */
+static mlod_result finish(const struct wr *w, mlod_gltf *doc, mlod_gltf_kind kind, int index, const char *key,
+                          mj *value, mlod_error *err)
+{
+	if (w->failed) {
+		mj_free(value);
+		return nomem(err);
+	}
+	return merge(doc, kind, index, key, value, err);
+}
+
+/* finish() on the scene's record under key; a document without a scene
+ * has no scene record, and the value is dropped. */
+static mlod_result finish_scene(const struct wr *w, mlod_gltf *doc, const char *key, mj *value, mlod_error *err)
+{
+	if (!w->failed && mlod_gltf_count(doc, MLOD_GLTF_SCENE) == 0) {
+		mj_free(value);
+		return MLOD_OK;
+	}
+	return finish(w, doc, MLOD_GLTF_SCENE, -1, key, value, err);
+}
+
 static void w_put(struct wr *w, mj *o, const char *key, mj *v)
 {
 	if (w->failed || mj_put(o, key, v) != 0) {
@@ -329,11 +352,7 @@ mlod_result mlod_record_write_joints(mlod_gltf *doc, const mlod_character *c, co
 		w_int(&w, &o, "neighbors", info[j].neighbors);
 		w_num(&w, &o, "weight", "%.9g", info[j].weight);
 		w_num(&w, &o, "energy", "%.9g", info[j].energy);
-		if (w.failed) {
-			mj_free(&o);
-			return nomem(err);
-		}
-		mlod_result r = merge(doc, MLOD_GLTF_NODE, s->joints[j].node, NULL, &o, err);
+		mlod_result r = finish(&w, doc, MLOD_GLTF_NODE, s->joints[j].node, NULL, &o, err);
 		if (r != MLOD_OK)
 			return r;
 	}
@@ -679,11 +698,7 @@ mlod_result mlod_record_write_skeleton(mlod_gltf *doc, const mlod_record_skel_le
 			w_num(&w, &o, "pack_error", "%.9g", l->pack_error);
 		w_push(&w, &list, &o);
 	}
-	if (w.failed) {
-		mj_free(&list);
-		return nomem(err);
-	}
-	mlod_result r = merge(doc, MLOD_GLTF_SCENE, -1, "skeleton_levels", &list, err);
+	mlod_result r = finish(&w, doc, MLOD_GLTF_SCENE, -1, "skeleton_levels", &list, err);
 	for (int s = 0; r == MLOD_OK && s < skin_count; s++) {
 		if (full_skins[s] < 0)
 			continue;
@@ -695,11 +710,7 @@ mlod_result mlod_record_write_skeleton(mlod_gltf *doc, const mlod_record_skel_le
 			else
 				w_push(&w, &a, &x);
 		}
-		if (w.failed) {
-			mj_free(&a);
-			return nomem(err);
-		}
-		r = merge(doc, MLOD_GLTF_SKIN, full_skins[s], "skeleton_levels", &a, err);
+		r = finish(&w, doc, MLOD_GLTF_SKIN, full_skins[s], "skeleton_levels", &a, err);
 	}
 	return r;
 }
@@ -728,15 +739,7 @@ mlod_result mlod_record_write_mesh_levels(mlod_gltf *doc, const mlod_record_mesh
 		mj o = mesh_level_json(&w, &levels[k]);
 		w_push(&w, &list, &o);
 	}
-	if (w.failed) {
-		mj_free(&list);
-		return nomem(err);
-	}
-	if (mlod_gltf_count(doc, MLOD_GLTF_SCENE) == 0) {
-		mj_free(&list);
-		return MLOD_OK;
-	}
-	return merge(doc, MLOD_GLTF_SCENE, -1, "mesh_levels", &list, err);
+	return finish_scene(&w, doc, "mesh_levels", &list, err);
 }
 
 mlod_result mlod_record_write_pack(mlod_gltf *doc, const char *name, const float bounds_min[3],
@@ -759,30 +762,14 @@ mlod_result mlod_record_write_pack(mlod_gltf *doc, const char *name, const float
 	w_put(&w, &b, "min", &lo);
 	w_put(&w, &b, "max", &hi);
 	w_put(&w, &o, "bounds", &b);
-	if (w.failed) {
-		mj_free(&o);
-		return nomem(err);
-	}
-	if (mlod_gltf_count(doc, MLOD_GLTF_SCENE) == 0) {
-		mj_free(&o);
-		return MLOD_OK;
-	}
-	return merge(doc, MLOD_GLTF_SCENE, -1, "pack", &o, err);
+	return finish_scene(&w, doc, "pack", &o, err);
 }
 
 mlod_result mlod_record_write_mesh_split(mlod_gltf *doc, const mlod_record_mesh_level *level, mlod_error *err)
 {
 	struct wr w = {0};
 	mj o = mesh_level_json(&w, level);
-	if (w.failed) {
-		mj_free(&o);
-		return nomem(err);
-	}
-	if (mlod_gltf_count(doc, MLOD_GLTF_SCENE) == 0) {
-		mj_free(&o);
-		return MLOD_OK;
-	}
-	return merge(doc, MLOD_GLTF_SCENE, -1, "mesh_level", &o, err);
+	return finish_scene(&w, doc, "mesh_level", &o, err);
 }
 
 void mlod_record_mesh_skeleton(const mlod_record_skel_level *l, mlod_mesh_skeleton *out)
@@ -813,11 +800,7 @@ mlod_result mlod_record_write_mesh_node(mlod_gltf *doc, int node, const mlod_rec
 	}
 	if (n->has_pack_error)
 		w_num(&w, &o, "pack_error", "%.9g", n->pack_error);
-	if (w.failed) {
-		mj_free(&o);
-		return nomem(err);
-	}
-	return merge(doc, MLOD_GLTF_NODE, node, NULL, &o, err);
+	return finish(&w, doc, MLOD_GLTF_NODE, node, NULL, &o, err);
 }
 
 mlod_result mlod_record_write_mesh_nodes(mlod_gltf *doc, const mlod_mesh_levels *levels, const mlod_mesh_lod *lod,
@@ -928,11 +911,7 @@ mlod_result mlod_record_write_motion(mlod_gltf *doc, int animation, const mlod_r
 	}
 	if (l->has_pack_error)
 		w_num(&w, &o, "pack_error", "%.9g", l->pack_error);
-	if (w.failed) {
-		mj_free(&o);
-		return nomem(err);
-	}
-	mlod_result r = merge(doc, MLOD_GLTF_ANIMATION, animation, NULL, &o, err);
+	mlod_result r = finish(&w, doc, MLOD_GLTF_ANIMATION, animation, NULL, &o, err);
 	return r == MLOD_OK ? stamp(doc, err) : r;
 }
 
@@ -1012,11 +991,7 @@ mlod_result mlod_record_write_motion0(mlod_gltf *doc, int animation, double pack
 	mj o = mj_object(), x = mj_object();
 	w_num(&w, &x, "pack_error", "%.9g", pack_error);
 	w_put(&w, &o, "motion_level0", &x);
-	if (w.failed) {
-		mj_free(&o);
-		return nomem(err);
-	}
-	mlod_result r = merge(doc, MLOD_GLTF_ANIMATION, animation, NULL, &o, err);
+	mlod_result r = finish(&w, doc, MLOD_GLTF_ANIMATION, animation, NULL, &o, err);
 	return r == MLOD_OK ? stamp(doc, err) : r;
 }
 
