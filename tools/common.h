@@ -81,8 +81,22 @@ void tool_write_gltf(const char *path, const mlod_gltf *doc);
  * option when it is not a finite number within [lo, hi]. */
 double tool_parse_double(const char *option, const char *value, double lo, double hi);
 
-/* Writes s as a JSON string literal (quoted, escaped) to f. */
+/* Writes s as a JSON string literal to f: quote, backslash and control
+ * characters escaped, a byte that is not well-formed UTF-8 as U+FFFD. */
 void tool_json_string(FILE *f, const char *s);
+
+/* Writes s (a name from the input or the pack, or a note) to f for a
+ * table: \n, \t, \r, \\ and \xHH for any other control character, DEL
+ * and a byte that is not UTF-8, padded with spaces to width columns (0:
+ * none), each UTF-8 character one column, so that a name never breaks a
+ * line or a column. */
+void tool_put_name(FILE *f, const char *s, int width);
+
+/* Writes prefix, s as tool_put_name does, and a newline. */
+void tool_put_line(FILE *f, const char *prefix, const char *s);
+
+/* The columns tool_put_name takes for s, unpadded. */
+int tool_name_width(const char *s);
 
 /* Prints "tool (mlod) VERSION" to stdout and exits 0. */
 void tool_version(void)

@@ -174,9 +174,10 @@ static void report_table(const struct job *job)
 	const mlod_mesh_levels *L = &job->L;
 	mlod_bgm_info t;
 	mlod_mesh_levels_totals(L, &t);
-	printf("# %s: %d triangles, %d vertices (%d welded nodes, %d on seams, %d eligible, %d locked); "
-	       "%d border and %d non-manifold edges; %d primitives simplified; build %.1f ms\n",
-	       job->input, L->triangles, L->vertices, t.nodes, t.seam_nodes, t.eligible_nodes, t.locked_nodes,
+	fputs("# ", stdout);
+	tool_put_name(stdout, job->input, 0);
+	printf(": %d triangles, %d vertices (%d welded nodes, %d on seams, %d eligible, %d locked); "
+	       "%d border and %d non-manifold edges; %d primitives simplified; build %.1f ms\n", L->triangles, L->vertices, t.nodes, t.seam_nodes, t.eligible_nodes, t.locked_nodes,
 	       t.border_edges, t.nonmanifold_edges, L->simplified, 1e3 * L->build_seconds);
 	char whole[48] = "";
 	if (L->opt.placement == MLOD_PLACE_HYBRID)
@@ -201,9 +202,9 @@ static void report_table(const struct job *job)
 	printf("# mean%%, max%%: posed surface deviation (mean, Hausdorff) in %% of the bounding diagonal; caps: new "
 	       "vertices whose influences were cut to 4\n");
 	if (L->notes[0])
-		printf("# note: %s\n", L->notes);
+		tool_put_line(stdout, "# note: ", L->notes);
 	if (job->c.notes && *job->c.notes)
-		printf("# input: %s\n", job->c.notes);
+		tool_put_line(stdout, "# input: ", job->c.notes);
 }
 
 static void report_json(const struct job *job)

@@ -70,26 +70,29 @@ static void report_table(const char *input, const mlod_character *c, const mlod_
 	struct stats st = summarize(s, info);
 	int w = 5;
 	for (int j = 0; j < s->joint_count; j++) {
-		int n = (int)strlen(s->joints[j].name);
+		int n = tool_name_width(s->joints[j].name);
 		if (n > w)
 			w = n;
 	}
-	printf("# %s: %d joints, %d clips; hub factor %g, average neighbours %.3f, average depth %.3f\n",
-	       input, s->joint_count, c->clip_count, opt->hub_factor, st.avg_neighbors, st.avg_depth);
+	fputs("# ", stdout);
+	tool_put_name(stdout, input, 0);
+	printf(": %d joints, %d clips; hub factor %g, average neighbours %.3f, average depth %.3f\n", s->joint_count, c->clip_count, opt->hub_factor, st.avg_neighbors, st.avg_depth);
 	printf("%-*s  %-*s  %5s  %10s  %-14s  %10s\n", w, "joint", w, "parent", "depth", "neighbours",
 	       "label", "energy");
 	for (int j = 0; j < s->joint_count; j++) {
 		char label[32];
 		snprintf(label, sizeof label, "%s %s", mlod_label_symbol(info[j].label), mlod_label_name(info[j].label));
 		/* The Greek letter is 2 bytes but 1 column wide. */
-		printf("%-*s  %-*s  %5d  %10d  %-15s  %10.4f\n", w, s->joints[j].name, w, parent_name(s, j),
-		       info[j].depth, info[j].neighbors, label, info[j].energy);
+		tool_put_name(stdout, s->joints[j].name, w);
+		fputs("  ", stdout);
+		tool_put_name(stdout, parent_name(s, j), w);
+		printf("  %5d  %10d  %-15s  %10.4f\n", info[j].depth, info[j].neighbors, label, info[j].energy);
 	}
 	printf("# root %d, end-effector %d, major %d, extreme %d, minor %d\n", st.count[MLOD_LABEL_ROOT],
 	       st.count[MLOD_LABEL_END_EFFECTOR], st.count[MLOD_LABEL_MAJOR], st.count[MLOD_LABEL_EXTREME],
 	       st.count[MLOD_LABEL_MINOR]);
 	if (c->notes && *c->notes)
-		printf("# note: %s\n", c->notes);
+		tool_put_line(stdout, "# note: ", c->notes);
 }
 
 static void report_json(const char *input, const mlod_character *c, const mlod_joint_info *info,

@@ -136,79 +136,6 @@ static void check_level0(const mlod_pack_options *o, mlod_character *c, mlod_glt
 	         h);
 }
 
-/* The length of the well-formed UTF-8 sequence at p (1 to 4), or 0 for
- * a byte that does not start one (overlong forms, surrogates and code
- * points past U+10FFFF are not well formed: RFC 3629). */
-static int utf8_length(const unsigned char *p)
-{
-	unsigned c = p[0];
-	int n = c < 0x80 ? 1 : c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
-	if (n <= 1)
-		return n;
-	unsigned lo = 0x80, hi = 0xbf; /* the second byte's range */
-	if (c == 0xe0)
-		lo = 0xa0;
-	else if (c == 0xed)
-		hi = 0x9f;
-	else if (c == 0xf0)
-		lo = 0x90;
-	else if (c == 0xf4)
-		hi = 0x8f;
-	if (p[1] < lo || p[1] > hi)
-		return 0;
-	for (int i = 2; i < n; i++)
-		if (p[i] < 0x80 || p[i] > 0xbf)
-			return 0;
-	return n;
-}
-
-/* The one place that prints a name from the input or the pack (the
- * character's, a clip's, the input's, a note naming a joint or mesh):
- * as a JSON string (quote, backslash and control characters escaped, a
- * byte that is not UTF-8 as U+FFFD), or for the tables with C escapes
- * (\n, \t, \r, \\, \xHH for any other control character, DEL and a
- * byte that is not UTF-8), padded to width columns (0: none) counting
- * each UTF-8 character as one, so that a name never breaks a line or a
- * column. */
-static void put_name(FILE *f, const char *name, int json, int width)
-{
-	const unsigned char *p = (const unsigned char *)(name ? name : "");
-	int columns = 0;
-	if (json)
-		fputc('"', f);
-	while (*p) {
-		int n = utf8_length(p);
-		unsigned c = *p;
-		columns++;
-		if (n > 1) {
-			fwrite(p, 1, (size_t)n, f);
-			p += n;
-			continue;
-		}
-		p++;
-		if (n == 0 && json)
-			fputs("\\ufffd", f);
-		else if (c == '\\' || (json && c == '"'))
-			fprintf(f, "\\%c", (int)c), columns++;
-		else if (c == '\n')
-			fputs("\\n", f), columns++;
-		else if (c == '\t')
-			fputs("\\t", f), columns++;
-		else if (c == '\r')
-			fputs("\\r", f), columns++;
-		else if (json && c < 0x20)
-			fprintf(f, "\\u%04x", c), columns += 5;
-		else if (!json && (n == 0 || c < 0x20 || c == 0x7f))
-			fprintf(f, "\\x%02x", c), columns += 3;
-		else
-			fputc((int)c, f);
-	}
-	if (json)
-		fputc('"', f);
-	for (; columns < width; columns++)
-		fputc(' ', f);
-}
-
 static const char *source(const mlod_pack_layer_stats *l)
 {
 	return l->levels <= 1 ? "-" : l->from_input ? "input" : "computed";
@@ -217,7 +144,7 @@ static const char *source(const mlod_pack_layer_stats *l)
 static void report_table(FILE *rf, const char *input, const mlod_pack_stats *st, const char *codec)
 {
 	fputs("# ", rf);
-	put_name(rf, input, 0, 0);
+	tool_put_name(rf, input, 0);
 	fprintf(rf, ": %d joints, %d skins, %d parts, %d clips; height %.4g, diagonal %.4g; codec %s\n", st->joints,
 	        st->skins, st->parts, st->clips, st->height, st->diagonal, codec);
 	fprintf(rf, "%-9s %6s  %-8s  %10s  %10s  %9s  %s\n", "layer", "levels", "source", "stored", "raw", "ms",
@@ -236,17 +163,14 @@ static void report_table(FILE *rf, const char *input, const mlod_pack_stats *st,
 	fprintf(rf, "# total %llu bytes in %u chunks (info %llu, doc %llu); first drawable level: %u bytes\n",
 	        (unsigned long long)st->total, st->chunks, (unsigned long long)st->info_bytes,
 	        (unsigned long long)st->doc_bytes, st->first_drawable);
-	if (st->notes[0]) {
-		fputs("# note: ", rf);
-		put_name(rf, st->notes, 0, 0);
-		fputc('\n', rf);
-	}
+	if (st->notes[0])
+		tool_put_line(rf, "# note: ", st->notes);
 }
 
 static void report_json(FILE *rf, const char *input, const mlod_pack_stats *st, const char *codec)
 {
 	fprintf(rf, "{\n  \"input\": ");
-	put_name(rf, input, 1, 0);
+	tool_json_string(rf, input);
 	fprintf(rf, ",\n  \"codec\": \"%s\",\n  \"joints\": %d,\n  \"skins\": %d,\n  \"parts\": %d,\n  \"clips\": %d,\n",
 	        codec, st->joints, st->skins, st->parts, st->clips);
 	fprintf(rf, "  \"height\": %.9g,\n  \"diagonal\": %.9g,\n  \"layers\": {\n", st->height, st->diagonal);
@@ -264,7 +188,7 @@ static void report_json(FILE *rf, const char *input, const mlod_pack_stats *st, 
 	        (unsigned long long)st->total, st->chunks, (unsigned long long)st->info_bytes,
 	        (unsigned long long)st->doc_bytes);
 	fprintf(rf, "  \"first_drawable\": %u,\n  \"notes\": ", st->first_drawable);
-	put_name(rf, st->notes, 1, 0);
+	tool_json_string(rf, st->notes);
 	fprintf(rf, "\n}\n");
 }
 
@@ -320,10 +244,10 @@ static int pack_info(const char *path, enum tool_report report)
 	FILE *f = stdout;
 	if (report == REPORT_JSON) {
 		fprintf(f, "{\n  \"file\": ");
-		put_name(f, label, 1, 0);
+		tool_json_string(f, label);
 		fprintf(f, ",\n  \"version\": \"%u.%u\",\n  \"size\": %llu,\n  \"flags\": %u,\n  \"name\": ", p.major, p.minor,
 		        (unsigned long long)p.file_size, p.flags);
-		put_name(f, info.name, 1, 0);
+		tool_json_string(f, info.name);
 		fprintf(f, ",\n  \"joints\": %u,\n  \"skins\": %u,\n  \"parts\": %u,\n  \"clips\": %u,\n", ir->joint_count,
 		        ir->skin_count, ir->instance_count, ir->clip_count);
 		fprintf(f, "  \"skeleton_levels\": %u,\n  \"mesh_levels\": %u,\n  \"motion_levels\": %u,\n",
@@ -335,7 +259,7 @@ static int pack_info(const char *path, enum tool_report report)
 			fprintf(f, "    {\"type\": \"%s\", \"layer\": \"%s\", \"level\": %u, \"item\": %u, \"clip\": ",
 			        mlod_pack_type_name(c->type), mlod_pack_layer_name(c->layer), c->level, c->item);
 			if (c->type == MLOD_CHUNK_MOTION && c->item < ir->clip_count)
-				put_name(f, info.clip_names[c->item], 1, 0);
+				tool_json_string(f, info.clip_names[c->item]);
 			else
 				fputs("null", f);
 			fprintf(f, ", \"codec\": \"%s\", \"entropy\": \"%s\", \"offset\": %llu, \"stored\": %u, \"coded\": %u, "
@@ -354,10 +278,10 @@ static int pack_info(const char *path, enum tool_report report)
 		fprintf(f, "  \"first_drawable\": %u\n}\n", ir->first_drawable);
 	} else {
 		fputs("# ", f);
-		put_name(f, label, 0, 0);
+		tool_put_name(f, label, 0);
 		fprintf(f, ": mlod %u.%u, %llu bytes, %u chunks\n# character '", p.major, p.minor,
 		        (unsigned long long)p.file_size, p.chunk_count);
-		put_name(f, info.name, 0, 0);
+		tool_put_name(f, info.name, 0);
 		fprintf(f, "': %u joints, %u skins, %u parts, %u clips; levels: skeleton %u, mesh %u, motion %u; "
 		        "height %.4g, diagonal %.4g\n", ir->joint_count, ir->skin_count, ir->instance_count,
 		        ir->clip_count, ir->skeleton_levels, ir->mesh_levels, ir->motion_levels, ir->height, ir->diagonal);
@@ -369,7 +293,7 @@ static int pack_info(const char *path, enum tool_report report)
 			const char *item = c->type == MLOD_CHUNK_MOTION && c->item < ir->clip_count ? info.clip_names[c->item] : "-";
 			char cc[32];
 			fprintf(f, "%-5s %-8s %5u  ", mlod_pack_type_name(c->type), mlod_pack_layer_name(c->layer), c->level);
-			put_name(f, item, 0, 20);
+			tool_put_name(f, item, 20);
 			fprintf(f, " %-19s %10u %10u %11.4g %8.4g%% %11.4g\n", codec_column(c, cc, sizeof cc), c->stored_size,
 			        c->raw_size, c->error, ref > 0.0 ? 100.0 * c->error / ref : 0.0, c->distance);
 		}

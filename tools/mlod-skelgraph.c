@@ -67,7 +67,8 @@ static void removed_names(FILE *f, const struct job *job, const mlod_skel_built 
 			fputs(first ? "" : ", ", f);
 			tool_json_string(f, s->joints[j].name);
 		} else {
-			fprintf(f, "%s%s", first ? "" : " ", s->joints[j].name);
+			fputs(first ? "" : " ", f);
+			tool_put_name(f, s->joints[j].name, 0);
 		}
 		first = 0;
 	}
@@ -79,8 +80,9 @@ static void report_table(const struct job *job)
 	int minors = 0;
 	for (int j = 0; j < s->joint_count; j++)
 		minors += job->info[j].label == MLOD_LABEL_MINOR;
-	printf("# %s: %d joints (%d minor) in %d sub-chains, %d closure edges; height %.4g; %d clips; labels %s\n",
-	       job->input, s->joint_count, minors, job->L.graph.chain_count, job->L.graph.edge_count, job->L.height,
+	fputs("# ", stdout);
+	tool_put_name(stdout, job->input, 0);
+	printf(": %d joints (%d minor) in %d sub-chains, %d closure edges; height %.4g; %d clips; labels %s\n", s->joint_count, minors, job->L.graph.chain_count, job->L.graph.edge_count, job->L.height,
 	       job->c.clip_count, job->labels_from_extras ? "from extras" : "computed");
 	printf("%5s  %12s  %6s  %7s  %10s  %10s  %10s  %10s  %6s\n", "level", "threshold", "joints", "removed",
 	       "vtx max%", "vtx mean%", "jnt max%", "jnt mean%", "shear");
@@ -107,7 +109,7 @@ static void report_table(const struct job *job)
 	printf("# vtx: skinned-vertex deviation over the clips, %% of the bounding diagonal;"
 	       " jnt: removed joints following their stand-ins, %% of the height\n");
 	if (job->c.notes && *job->c.notes)
-		printf("# note: %s\n", job->c.notes);
+		tool_put_line(stdout, "# note: ", job->c.notes);
 }
 
 static void report_json(const struct job *job)
