@@ -1,5 +1,5 @@
 # mlod-pack --info and --report print the names they take from the input
-# or the pack escaped (one place, put_name): a clip and a character named
+# or the pack escaped (one place, tool_put_name in tools/common.c): a clip and a character named
 # with a quote, a backslash, a newline, a tab, control characters, DEL, a
 # non-ASCII character and a byte that is not UTF-8 keep every table line
 # whole and the columns after the name in place (\n, \t, \\, \xHH); --json
