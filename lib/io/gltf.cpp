@@ -64,6 +64,9 @@ struct mlod_gltf {
 	 * the input and those set through mlod_gltf_set_extra. They win over
 	 * the tinygltf::Value of the object, which cannot hold all of JSON. */
 	std::map<std::string, json> extras;
+	/* The roots of the scene the reader added to a document without one
+	 * (0: none added). */
+	int scene_added = 0;
 };
 
 namespace {
@@ -1122,6 +1125,47 @@ void collect_extras(const json &j, const std::string &at, std::map<std::string, 
 	}
 }
 
+/* The nodes another node's MSFT_lod names as its levels (1), as far as
+ * its ids are well formed (mlod_gltf_node_lod checks them). */
+std::vector<char> lod_level_nodes(const Model &m)
+{
+	std::vector<char> level(m.nodes.size(), 0);
+	for (const tinygltf::Node &nd : m.nodes) {
+		auto it = nd.extensions.find("MSFT_lod");
+		if (it == nd.extensions.end() || !it->second.IsObject() || !it->second.Has("ids") ||
+		    !it->second.Get("ids").IsArray())
+			continue;
+		const tinygltf::Value &ids = it->second.Get("ids");
+		for (size_t i = 0; i < ids.ArrayLen(); i++) {
+			const tinygltf::Value &e = ids.Get(int(i));
+			int id = e.IsInt() ? e.Get<int>() : e.IsNumber() ? int(e.GetNumberAsDouble()) : -1;
+			if (id >= 0 && size_t(id) < m.nodes.size())
+				level[size_t(id)] = 1;
+		}
+	}
+	return level;
+}
+
+tinygltf::Scene &default_scene(Model &m);
+
+/* A document without a scene (valid glTF: a library of nodes) gets one,
+ * the default, with every root node but MSFT_lod levels: what a viewer
+ * shows of it. The stages need it: the stage record lives in the scene's
+ * extras, and the nodes they add for levels stay out of every scene. */
+void add_scene_if_none(mlod_gltf &doc)
+{
+	Model &m = doc.model;
+	if (!m.scenes.empty() || m.nodes.empty())
+		return;
+	std::vector<int> parent = node_parents(m);
+	std::vector<char> level = lod_level_nodes(m);
+	tinygltf::Scene &scene = default_scene(m);
+	for (size_t k = 0; k < m.nodes.size(); k++)
+		if (parent[k] < 0 && !level[k])
+			scene.nodes.push_back(int(k));
+	doc.scene_added = int(scene.nodes.size());
+}
+
 void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const char *base_dir)
 {
 	if (size == 0)
@@ -1179,6 +1223,7 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 					o.erase("uri");
 	collect_extras(j, "", doc.extras);
 	doc.original = std::move(j);
+	add_scene_if_none(doc);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1431,6 +1476,9 @@ public:
 
 	void read()
 	{
+		if (doc_.scene_added)
+			note("the input has no scene: scene 0 added with its %d root node%s, for the stage record", doc_.scene_added,
+			     doc_.scene_added == 1 ? "" : "s");
 		graph();
 		skeleton();
 		skins();
@@ -1465,8 +1513,9 @@ private:
 	}
 
 	/* Parents, a parents-first order (depth-first from the roots, in file
-	 * order), rest transforms, the nodes the default scene shows (all of
-	 * them without scenes) and the nodes TRS channels animate. */
+	 * order), rest transforms, the nodes the default scene shows (without
+	 * scenes, every node but the MSFT_lod levels other nodes name, and
+	 * their children) and the nodes TRS channels animate. */
 	void graph()
 	{
 		size_t n = m_.nodes.size();
@@ -1490,10 +1539,15 @@ private:
 			world_[size_t(k)] = parent_[size_t(k)] < 0 ? local_[size_t(k)]
 			                                           : mlod_mat4_mul(&world_[size_t(parent_[size_t(k)])], &local_[size_t(k)]);
 		}
-		shown_.assign(n, m_.scenes.empty());
-		if (!m_.scenes.empty())
+		shown_.assign(n, 0);
+		if (!m_.scenes.empty()) {
 			for (int root : m_.scenes[size_t(std::max(m_.defaultScene, 0))].nodes)
 				shown_[size_t(root)] = 1;
+		} else { /* a document mlod built without a scene: every root but MSFT_lod levels */
+			std::vector<char> level = lod_level_nodes(m_);
+			for (size_t k = 0; k < n; k++)
+				shown_[k] = parent_[k] < 0 && !level[k];
+		}
 		for (int k : order_)
 			if (parent_[size_t(k)] >= 0 && shown_[size_t(parent_[size_t(k)])])
 				shown_[size_t(k)] = 1;

@@ -51,8 +51,9 @@ mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data,
  * animations. Joint nodes are the union of all skins' joints plus the nodes
  * that connect them; a document without skins (such as a BVH converted by
  * mlod_gltf_from_character) uses its animated nodes instead of skin joints.
- * Instances are the nodes with a mesh that the default scene shows (every
- * node when there is no scene). What is skipped is listed in out->notes. */
+ * Instances are the nodes with a mesh that the default scene shows (when
+ * there is no scene, every node but the MSFT_lod levels other nodes name,
+ * and their children). What is skipped is listed in out->notes. */
 mlod_result mlod_gltf_to_character(const mlod_gltf *doc, mlod_character *out,
                                    mlod_error *err);
 

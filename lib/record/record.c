@@ -698,7 +698,7 @@ mlod_result mlod_record_write_skeleton(mlod_gltf *doc, const mlod_record_skel_le
 			w_num(&w, &o, "pack_error", "%.9g", l->pack_error);
 		w_push(&w, &list, &o);
 	}
-	mlod_result r = finish(&w, doc, MLOD_GLTF_SCENE, -1, "skeleton_levels", &list, err);
+	mlod_result r = finish_scene(&w, doc, "skeleton_levels", &list, err);
 	for (int s = 0; r == MLOD_OK && s < skin_count; s++) {
 		if (full_skins[s] < 0)
 			continue;
