@@ -369,6 +369,17 @@ int main(int argc, char **argv)
 		mlod_record rec;
 		if ((r = mlod_record_read(doc, &rec, &err)) != MLOD_OK)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
+		if (rec.mesh_level_count > 0 && report == REPORT_NONE && !split) {
+			/* Levels on top of levels would leave the old ones unused: pass it through. */
+			fprintf(stderr, "%s: %s: the input already has %d mesh level%s (MSFT_lod): written unchanged; run %s on "
+			        "the input without them to bake them again\n", tool_name, job.input, rec.mesh_level_count,
+			        rec.mesh_level_count == 1 ? "" : "s", tool_name);
+			tool_write_gltf(output, doc);
+			mlod_record_free(&rec);
+			mlod_character_free(&job.c);
+			mlod_gltf_free(doc);
+			return 0;
+		}
 		mlod_mesh_skeleton *sk = calloc((size_t)rec.skel_level_count + 1, sizeof *sk);
 		if (!sk)
 			tool_die(EXIT_INPUT, job.input, "out of memory");

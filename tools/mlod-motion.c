@@ -333,6 +333,23 @@ int main(int argc, char **argv)
 			return 0;
 		}
 	}
+	int existing = 0;
+	if (doc && report == REPORT_NONE && !bvh_out) {
+		mlod_error err = {0};
+		mlod_result r = mlod_record_motion_level_count(doc, &existing, &err);
+		if (r != MLOD_OK)
+			tool_die(tool_exit_code(r), job.input, "%s", err.message);
+	}
+	if (existing > 0) {
+		/* Levels of levels would be baked from the old levels too: pass it through. */
+		fprintf(stderr, "%s: %s: the input already has %d motion level%s (<clip>@lod<k>): written unchanged; run %s "
+		        "on the input without them to bake them again\n", tool_name, job.input, existing,
+		        existing == 1 ? "" : "s", tool_name);
+		tool_write_gltf(output, doc);
+		mlod_character_free(&job.c);
+		mlod_gltf_free(doc);
+		return 0;
+	}
 	job.height = mlod_skeleton_height(&job.c.skeleton);
 	/* 10 cm: glTF is in metres; a BVH's unit is its own. */
 	job.point_distance = point_distance > 0.0 ? point_distance

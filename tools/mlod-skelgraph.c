@@ -156,36 +156,45 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 {
 	const mlod_skeleton *s = &job->c.skeleton;
 	int n = job->L.count, sc = s->skin_count;
+	mlod_error err = {0};
+	mlod_record stage;
+	mlod_result r = mlod_record_read(doc, &stage, &err);
+	if (r != MLOD_OK)
+		tool_die(tool_exit_code(r), job->input, "%s", err.message);
+	const int mesh_levels = stage.mesh_level_count, skel_levels = stage.skel_level_count;
+	mlod_record_free(&stage);
+	if (skel_levels > 0) {
+		/* Levels on top of levels would leave the old ones unused: pass it through. */
+		fprintf(stderr, "%s: %s: the input already has %d skeleton level%s: written unchanged; run %s on the input "
+		        "without them to bake them again\n", tool_name, job->input, skel_levels, skel_levels == 1 ? "" : "s",
+		        tool_name);
+		tool_write_gltf(output, doc);
+		return;
+	}
 	mlod_skel_level_record records[MLOD_SKEL_MAX_LEVELS];
 	mlod_record_skel_level rec[MLOD_SKEL_MAX_LEVELS];
 	int *skins = malloc(sizeof(int) * ((size_t)n * (size_t)sc + 1)), *full = malloc(sizeof(int) * ((size_t)sc + 1));
-	mlod_error err = {0};
 	if (!skins || !full)
 		tool_die(EXIT_OUTPUT, NULL, "out of memory");
 	for (int i = 0; i < sc; i++)
 		full[i] = s->skins[i].gltf_index;
 	mlod_skel_levels_records(&job->L, records);
 	/* Mesh levels already in MSFT_lod (mlod-bgm ran first) stay there. */
-	mlod_record stage;
-	if (mlod_record_read(doc, &stage, &err) != MLOD_OK)
-		tool_die(EXIT_INPUT, job->input, "%s", err.message);
-	const int mesh_levels = stage.mesh_level_count;
-	mlod_record_free(&stage);
 	if (mesh_levels > 0 && n > 0)
 		fprintf(stderr,
 		        "%s: %s: the input's %d mesh level(s) stay in MSFT_lod, weighted on the full skeleton; "
 		        "run mlod-skelgraph before mlod-bgm for mesh levels on the skeleton levels\n",
 		        tool_name, job->input, mesh_levels);
-	if (mlod_gltf_add_skel_levels(doc, &job->c, records, n, skins, mesh_levels == 0, &err) != MLOD_OK ||
-	    mlod_record_skel_levels_make(&job->c, records, n, skins, rec, &err) != MLOD_OK)
-		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
-	mlod_result r = mlod_record_write_skeleton(doc, rec, n, full, sc, &err);
+	if ((r = mlod_gltf_add_skel_levels(doc, &job->c, records, n, skins, mesh_levels == 0, &err)) != MLOD_OK ||
+	    (r = mlod_record_skel_levels_make(&job->c, records, n, skins, rec, &err)) != MLOD_OK)
+		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_INPUT, job->input, "%s", err.message);
+	r = mlod_record_write_skeleton(doc, rec, n, full, sc, &err);
 	for (int k = 0; k < n; k++)
 		mlod_record_skel_level_free(&rec[k]);
 	free(skins);
 	free(full);
 	if (r != MLOD_OK)
-		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_INPUT, job->input, "%s", err.message);
 	tool_write_gltf(output, doc);
 }
 

@@ -29,6 +29,18 @@
 
 #include "bgm.h"
 
+int bgm_has_triangle(const mlod_primitive *p)
+{
+	if (p->index_count == 0)
+		return p->vertex_count >= 3;
+	for (int t = 0; t + 2 < p->index_count; t += 3) {
+		const uint32_t *ix = p->indices + t;
+		if (ix[0] != ix[1] && ix[1] != ix[2] && ix[0] != ix[2])
+			return 1;
+	}
+	return 0;
+}
+
 double bgm_seconds(void)
 {
 	struct timespec ts;
@@ -771,6 +783,9 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 		if (!p->joints[s] || !p->weights[s])
 			return mlod_fail(err, MLOD_ERR_PARSE, "mesh %d primitive %d: weight set %d has no data", in->mesh,
 			                 primitive, s);
+	if (!bgm_has_triangle(p))
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "mesh %d primitive %d: every triangle repeats a corner", in->mesh,
+		                 primitive);
 
 	mlod_bgm *g = calloc(1, sizeof *g);
 	if (!g)

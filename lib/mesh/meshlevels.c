@@ -94,8 +94,10 @@ int mlod_mesh_triangle_primitives(const mlod_character *c)
 {
 	int n = 0;
 	for (int i = 0; i < c->instance_count; i++)
-		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++)
-			n += primitive_triangles(&c->meshes[c->instances[i].mesh].primitives[p]) > 0;
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
+			const mlod_primitive *pr = &c->meshes[c->instances[i].mesh].primitives[p];
+			n += primitive_triangles(pr) > 0 && bgm_has_triangle(pr);
+		}
 	return n;
 }
 
@@ -303,7 +305,7 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 	if (L->statics)
 		note(L, "%d primitive(s) of static meshes (no joint, no skin) simplified in world space", L->statics);
 	if (unsupported)
-		note(L, "%d primitive(s) that are not triangles left as they are", unsupported);
+		note(L, "%d primitive(s) that are not triangles, or whose every triangle repeats a corner, left as they are", unsupported);
 	if (morphs)
 		note(L, "%d primitive(s) with morph targets: offsets interpolated like positions", morphs);
 	return MLOD_OK;

@@ -251,6 +251,9 @@ mlod_result mlod_record_write_motion(mlod_gltf *doc, int animation, const mlod_r
 /* Reads it; *found is 0 when the animation has no motion level record. */
 mlod_result mlod_record_read_motion(const mlod_gltf *doc, int animation, mlod_record_motion_level *out, int *found,
                                     mlod_error *err);
+/* The number of animations whose record says they are motion levels
+ * (mlod-motion's <clip>@lod<k>, or mlod-pack -x's). */
+mlod_result mlod_record_motion_level_count(const mlod_gltf *doc, int *count, mlod_error *err);
 
 /* A full clip that is a pack's motion level 0 (mlod-pack -x writes it):
  * extras.mlod.motion_level0 of its animation, an object whose pack_error

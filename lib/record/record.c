@@ -985,6 +985,20 @@ mlod_result mlod_record_read_motion(const mlod_gltf *doc, int animation, mlod_re
 	return c.r;
 }
 
+mlod_result mlod_record_motion_level_count(const mlod_gltf *doc, int *count, mlod_error *err)
+{
+	*count = 0;
+	for (int a = 0; a < mlod_gltf_count(doc, MLOD_GLTF_ANIMATION); a++) {
+		mj o;
+		mlod_result r = get(doc, MLOD_GLTF_ANIMATION, a, &o, err);
+		if (r != MLOD_OK)
+			return r;
+		*count += o.type == MJ_OBJECT && mj_get(&o, "motion_level") != NULL;
+		mj_free(&o);
+	}
+	return MLOD_OK;
+}
+
 mlod_result mlod_record_write_motion0(mlod_gltf *doc, int animation, double pack_error, mlod_error *err)
 {
 	struct wr w = {0};
