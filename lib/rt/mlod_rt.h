@@ -440,8 +440,10 @@ void mlod_rt_select_default(mlod_rt_select *sel);
  * coarser one not failed: see Errors); shown levels are resolved.
  * Ids not alive are skipped. No allocation. MLOD_ERR_INVALID_ARG, with a
  * message naming the index i, when distances[i] is NaN, negative or
- * infinite (for every i < n, alive or not), and when dt is not finite
- * (dt may be negative: time runs back); everything is checked first, so
+ * infinite (for every i < n, alive or not), when dt is not finite
+ * (dt may be negative: time runs back), and for a selection whose mode is
+ * not one of the three, a float member not finite or a negative
+ * hysteresis (the message names the member); everything is checked first, so
  * such a call changes nothing (no instance, no wanted level). */
 mlod_result mlod_rt_update(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const uint32_t *ids,
                            const float *distances, size_t n, float dt, mlod_error *err);

@@ -87,6 +87,31 @@ uint32_t mlod_rt_select_level(const mlod_rt_ctx *ctx, const mlod_rt_select *sel,
 	return (uint32_t)prev;
 }
 
+/* A selection the header allows: one of the three modes, every float
+ * finite, hysteresis >= 0 (MLOD_ERR_INVALID_ARG naming the member). */
+static mlod_result select_check(const mlod_rt_select *sel, const char *fn, mlod_error *err)
+{
+	if ((unsigned)sel->mode > MLOD_RT_SELECT_TOC)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: selection mode %d is not alpha, pixels or toc", fn,
+		                 (int)sel->mode);
+	const struct { const char *name; float v; } f[] = {
+		{"d_near", sel->d_near}, {"d_far", sel->d_far}, {"fov_y", sel->fov_y}, {"lines", sel->lines},
+		{"max_pixels", sel->max_pixels}, {"hysteresis", sel->hysteresis}, {"distance_scale", sel->distance_scale},
+	};
+	for (size_t i = 0; i < sizeof f / sizeof *f; i++)
+		if (!isfinite(f[i].v))
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: selection %s %g is not finite", fn, f[i].name,
+			                 (double)f[i].v);
+	for (int l = 0; l < MLOD_RT_LAYERS; l++)
+		if (!isfinite(sel->t_start[l]) || !isfinite(sel->t_end[l]))
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: selection interval [%g, %g] of layer %d is not finite",
+			                 fn, (double)sel->t_start[l], (double)sel->t_end[l], l);
+	if (sel->hysteresis < 0.0f)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: selection hysteresis %g is negative", fn,
+		                 (double)sel->hysteresis);
+	return MLOD_OK;
+}
+
 static void begin_frame(mlod_rt_ctx *ctx)
 {
 	ctx->stamp++;
@@ -139,6 +164,8 @@ mlod_result mlod_rt_update(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const ui
 	if (!ctx || !sel || (n && (!ids || !distances)))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_update: NULL argument");
 	/* Everything is checked before any state changes: no partial update. */
+	if (select_check(sel, "mlod_rt_update", err) != MLOD_OK)
+		return MLOD_ERR_INVALID_ARG;
 	if (!isfinite(dt))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_update: dt %g is not finite", (double)dt);
 	for (size_t i = 0; i < n; i++)
@@ -159,6 +186,8 @@ mlod_result mlod_rt_update_positions(mlod_rt_ctx *ctx, const mlod_rt_select *sel
 	if (!ctx || !sel || !camera || (n && (!ids || !positions)))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_update_positions: NULL argument");
 	/* Checked before any state changes, as mlod_rt_update. */
+	if (select_check(sel, "mlod_rt_update_positions", err) != MLOD_OK)
+		return MLOD_ERR_INVALID_ARG;
 	if (!isfinite(dt))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_update_positions: dt %g is not finite", (double)dt);
 	for (size_t i = 0; i < n; i++) {

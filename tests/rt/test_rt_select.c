@@ -201,6 +201,45 @@ TEST(update_from_positions)
 	mlod_rt_close(ctx);
 }
 
+/* A selection the header does not allow (a mode out of range, a float
+ * member not finite, a negative hysteresis) is MLOD_ERR_INVALID_ARG
+ * naming the member, from both update calls, and changes nothing: the
+ * instance keeps its time and wanted levels. */
+TEST(update_bad_selection)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = open_fx(&e);
+	CHECK(ctx, "open: %s", e.message);
+	uint32_t id;
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, 0, &id, &e), e);
+	mlod_rt_select good;
+	mlod_rt_select_default(&good);
+	const float d = 120.0f, cam[3] = { 0, 0, 0 }, pos[3] = { 120.0f, 0, 0 };
+	CHECK_OK(mlod_rt_update(ctx, &good, &id, &d, 1, 0.5f, &e), e);
+	const mlod_rt_state before = *mlod_rt_instance_state(ctx, id);
+	struct { const char *what; mlod_rt_select sel; } bad[6];
+	for (int k = 0; k < 6; k++)
+		bad[k].sel = good;
+	bad[0].what = "mode 9", bad[0].sel.mode = (mlod_rt_select_mode)9;
+	bad[1].what = "d_near nan", bad[1].sel.d_near = NAN;
+	bad[2].what = "hysteresis -1 is negative", bad[2].sel.hysteresis = -1.0f;
+	bad[3].what = "d_far inf", bad[3].sel.d_far = INFINITY;
+	bad[4].what = "layer 2", bad[4].sel.t_end[2] = NAN;
+	bad[5].what = "distance_scale nan", bad[5].sel.distance_scale = NAN;
+	for (int k = 0; k < 6; k++) {
+		CHECK(mlod_rt_update(ctx, &bad[k].sel, &id, &d, 1, 0.5f, &e) == MLOD_ERR_INVALID_ARG &&
+		      strstr(e.message, bad[k].what) && strstr(e.message, "mlod_rt_update:"),
+		      "update, %s: %s", bad[k].what, e.message);
+		CHECK(mlod_rt_update_positions(ctx, &bad[k].sel, cam, &id, pos, 1, 0.5f, &e) == MLOD_ERR_INVALID_ARG &&
+		      strstr(e.message, bad[k].what) && strstr(e.message, "mlod_rt_update_positions:"),
+		      "update_positions, %s: %s", bad[k].what, e.message);
+	}
+	const mlod_rt_state *after = mlod_rt_instance_state(ctx, id);
+	CHECK(after->time == before.time && memcmp(after->wanted, before.wanted, sizeof before.wanted) == 0,
+	      "a refused update changed the instance");
+	mlod_rt_close(ctx);
+}
+
 int main(void)
 {
 	fx_build(0);
@@ -208,5 +247,6 @@ int main(void)
 	RUN(pixel_rule);
 	RUN(hysteresis_no_flicker);
 	RUN(update_from_positions);
+	RUN(update_bad_selection);
 	TEST_EXIT();
 }
