@@ -8,7 +8,8 @@
  * URIs of external buffers. tinygltf then parses the document, keeping
  * images as their encoded bytes (no decoding). Finally every cross-reference
  * is checked (node hierarchy, accessors inside buffer views inside buffers),
- * so the rest of this file can index the model without re-checking.
+ * so the rest of this file can index the model without re-checking, and no
+ * two channels of an animation may target the same node and path.
  *
  * Writing. tinygltf 2.7 serialises the model, but it drops data (empty
  * objects inside extras, accessor and buffer extensions, ...) and writes
@@ -141,6 +142,32 @@ char *c_string(const std::string &s)
 		throw std::bad_alloc();
 	memcpy(p, s.c_str(), s.size() + 1);
 	return p;
+}
+
+/* s in double quotes as in JSON (quote, backslash and control characters
+ * escaped), for a name from the file in a one-line message. */
+std::string quoted(const std::string &s)
+{
+	std::string out = "\"";
+	for (unsigned char ch : s) {
+		if (ch == '"' || ch == '\\') {
+			out += '\\';
+			out += char(ch);
+		} else if (ch < 0x20 || ch == 0x7f) {
+			char buf[8];
+			snprintf(buf, sizeof buf, "\\u%04x", ch);
+			out += buf;
+		} else {
+			out += char(ch);
+		}
+	}
+	return out + "\"";
+}
+
+/* One of the four paths glTF 2.0 defines for an animation channel. */
+bool known_path(const std::string &p)
+{
+	return p == "translation" || p == "rotation" || p == "scale" || p == "weights";
 }
 
 /* s with invalid UTF-8 replaced by U+FFFD: JSON text must be UTF-8, and
@@ -1118,11 +1145,24 @@ void check_document(const Model &m, size_t input_size)
 		fail(MLOD_ERR_PARSE, "the default scene %d does not exist", m.defaultScene);
 	for (size_t i = 0; i < m.animations.size(); i++) {
 		const tinygltf::Animation &a = m.animations[i];
-		for (const tinygltf::AnimationChannel &c : a.channels) {
+		/* Two channels of one animation may not target the same node and
+		 * path (the validator's ANIMATION_DUPLICATE_TARGETS): which one
+		 * moves the node would be up to the reader, and a pack's reader
+		 * refuses a joint with two (mlod(5)). */
+		std::map<std::pair<int, std::string>, size_t> targets;
+		for (size_t k = 0; k < a.channels.size(); k++) {
+			const tinygltf::AnimationChannel &c = a.channels[k];
 			if (c.sampler < 0)
 				fail(MLOD_ERR_PARSE, "animation %zu: sampler %d does not exist", i, c.sampler);
 			check_ref(c.sampler, a.samplers.size(), "animation %zu", i, "sampler");
 			check_ref(c.target_node, m.nodes.size(), "animation %zu", i, "target node");
+			if (c.target_node < 0)
+				continue;
+			auto seen = targets.emplace(std::make_pair(c.target_node, c.target_path), k);
+			if (!seen.second)
+				fail(MLOD_ERR_PARSE, "animation %zu %s: channels %zu and %zu both target node %d's %s", i,
+				     quoted(a.name).c_str(), seen.first->second, k, c.target_node,
+				     known_path(c.target_path) ? c.target_path.c_str() : quoted(c.target_path).c_str());
 		}
 		for (const tinygltf::AnimationSampler &s : a.samplers) {
 			if (s.input < 0 || s.output < 0)

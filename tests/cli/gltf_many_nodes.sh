@@ -1,8 +1,8 @@
 # Reading glTF is linear in the length of its arrays: a glb with 300,000
-# empty nodes more than tubeman (a 1.8 MB file) is read and written back in
+# empty nodes more than tubeman (a 1.5 MB file) is read and written back in
 # 0.5 s of CPU (measured on the 2-core test machine, loaded). The JSON depth
 # limit used to be a callback of nlohmann's parser, which rescans the
-# enclosing array at every closing object: 40,000 nodes took 3.8 s and
+# enclosing array at every closing object: 40,000 nodes took 3.8 s of CPU and
 # 300,000 did not finish in 120 s. The CPU limit below is a hang guard, not
 # a timing assertion: it is 40 times the linear reader's time, and the
 # quadratic reader needs about 200 s (ten times the limit), so no machine
