@@ -883,9 +883,13 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 	if (res != MLOD_OK)
 		return res;
 
-	/* Whole frames past the declared count (real files have them: one of
-	 * Debian's assimp test files says 3069 frames and holds 3070) are
-	 * ignored with a note, as common readers do; anything else is an error. */
+	/* One whole frame past the declared count (an off-by-one real files
+	 * have: one of Debian's assimp test files says 3069 frames and holds
+	 * 3070) is ignored with a note, as common readers do. More than one
+	 * means the count is wrong, not off by one, and which of the two the
+	 * writer meant is unknown: an error, as too few frames are, rather
+	 * than motion dropped ('Frames: 3' over 524 rows kept 3). Anything
+	 * else after the last frame is an error too. */
 	skip_space(&r->lx, 1);
 	if (r->lx.p < r->lx.end) {
 		lexer start = r->lx;
@@ -910,9 +914,13 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 			return mlod_fail(r->err, MLOD_ERR_PARSE, "line %d: extra data %s after the last of %ld frames",
 			                 t.line, show(&t, b), frames);
 		}
+		if (values / vpf > 1)
+			return mlod_fail(r->err, MLOD_ERR_PARSE,
+			                 "line %d: 'Frames: %ld' but %ld frames follow (%ld more from line %d)", frames_line,
+			                 frames, frames + values / vpf, values / vpf, first_line);
 		char note[160];
-		snprintf(note, sizeof note, "%ld %s after the %ld that 'Frames:' announces (from line %d) ignored",
-		         values / vpf, values / vpf == 1 ? "frame" : "frames", frames, first_line);
+		snprintf(note, sizeof note, "1 frame after the %ld that 'Frames:' announces (from line %d) ignored", frames,
+		         first_line);
 		c->notes = mlod_strdup(note);
 		if (!c->notes)
 			return mlod_fail(r->err, MLOD_ERR_NOMEM, "out of memory");

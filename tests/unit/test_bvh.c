@@ -510,6 +510,8 @@ static const bad_case bad_cases[] = {
 	{ HIER MOTION2 F1 "1 2 3 4 5 6 7 8", 20, "frame 2 has 8 values", 0 },
 	{ HIER MOTION2 F1 F2 "1 2 3 4 5 6 7 8\n", 21, "extra data", 0 },
 	{ HIER MOTION2 F1 F2 "\n\n}\n", 23, "extra data", 0 },
+	{ HIER MOTION2 F1 F2 F1 F2, 17, "line 17: 'Frames: 2' but 4 frames follow (2 more from line 21)", 0 },
+	{ HIER MOTION2 F1 F2 F1 F2 "1 2 3\n", 21, "extra data '0' after the last of 2 frames", 0 },
 	{ HIER MOTION2 "0 1 2 3 x 5 6 7 8\n" F2, 19, "'x' (frame 1, value 5) is not a number", 0 },
 	{ HIER MOTION2 "0 1 2 3 nan 5 6 7 8\n" F2, 19, "not a finite number", 0 },
 	{ HIER MOTION2 "0 1 2 3 NaN 5 6 7 8\n" F2, 19, "not a finite number", 0 },

@@ -1125,6 +1125,36 @@ static mlod_result try_read(const void *data, size_t size)
 	return r;
 }
 
+/* Two channels of one animation on the same node and path (the glTF
+ * validator's ANIMATION_DUPLICATE_TARGETS) are refused as the file is read,
+ * naming both (the animation's name escaped as in JSON); the same path on
+ * two nodes is fine. */
+TEST(duplicate_targets)
+{
+	static const char head[] =
+		"{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{},{}],"
+		"\"buffers\":[{\"byteLength\":16,\"uri\":\"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAAAAAA==\"}],"
+		"\"bufferViews\":[{\"buffer\":0,\"byteLength\":16}],"
+		"\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":1,\"type\":\"SCALAR\",\"min\":[0],\"max\":[0]},"
+		"{\"bufferView\":0,\"byteOffset\":4,\"componentType\":5126,\"count\":1,\"type\":\"VEC3\"}],"
+		"\"animations\":[{\"name\":\"a\\\"b\\nc\",\"samplers\":[{\"input\":0,\"output\":1}],\"channels\":["
+		"{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"scale\"}},"
+		"{\"sampler\":0,\"target\":{\"node\":1,\"path\":\"scale\"}},"
+		"{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}";
+	char text[2048];
+	mlod_gltf *doc = NULL;
+	snprintf(text, sizeof text, "%s]}]}", head);
+	mlod_result r = mlod_gltf_read(text, strlen(text), NULL, &doc, &terr);
+	CHECK_MSG(r == MLOD_OK, "%s", terr.message);
+	mlod_gltf_free(doc);
+	doc = NULL;
+	snprintf(text, sizeof text, "%s,{\"sampler\":0,\"target\":{\"node\":1,\"path\":\"scale\"}}]}]}", head);
+	r = mlod_gltf_read(text, strlen(text), NULL, &doc, &terr);
+	CHECK(r == MLOD_ERR_PARSE && doc == NULL);
+	CHECK_MSG(strcmp(terr.message, "animation 0 \"a\\\"b\\u000ac\": channels 1 and 3 both target node 1's scale") == 0,
+	          "%s", terr.message);
+}
+
 TEST(empty_and_garbage)
 {
 	CHECK(try_read("", 0) == MLOD_ERR_PARSE);
@@ -1469,6 +1499,7 @@ int main(void)
 	RUN(bad_references);
 	RUN(strip_drops_emptied_buffers);
 	RUN(wrong_types);
+	RUN(duplicate_targets);
 	RUN(unsupported);
 	RUN(external_buffer);
 	RUN(shared_data);
