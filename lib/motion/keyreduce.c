@@ -111,9 +111,9 @@ EVAL_INLINE void set_path(mlod_trs *l, mlod_path path, const float *v)
 /* Does the joint's world matrix w stay within budget of w0? A float
  * bound of the point error decides first (the same answer); only when it
  * cannot, mlod_motion_point_within with its early exits. */
-EVAL_INLINE int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget)
+EVAL_INLINE int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget, int wide)
 {
-	if (eval_error_bound(w, w0, R->radius[j]) <= budget)
+	if (eval_error_bound_w(w, w0, R->radius[j], wide) <= budget)
 		return 1; /* the same answer as below, from a float bound */
 #if EVAL_HAVE_AVX2
 	if (R->avx2)
@@ -127,7 +127,7 @@ EVAL_INLINE int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_m
  * twice (sample_check_generic, sample_check_avx2: motion_eval.h), the
  * same floats. */
 EVAL_INLINE int sample_check_body(reducer *R, lane *L, const mlod_channel *ch, const float *va, const float *vb, float t0,
-                        float dt, eval_seg *seg, int constant, int f, double budget)
+                        float dt, eval_seg *seg, int constant, int f, double budget, int wide)
 {
 	const mlod_skeleton *s = R->s;
 	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch), spare = 1 - L->good;
@@ -154,13 +154,13 @@ EVAL_INLINE int sample_check_body(reducer *R, lane *L, const mlod_channel *ch, c
 	*l = R->lc[base + (size_t)j];
 	set_path(l, ch->path, v);
 	*lm = eval_from_trs(l);
-	w[j] = p < 0 ? eval_mul(&s->joints[j].base, lm) : eval_mul_affine(&R->wc[base + (size_t)p], lm);
-	if (!within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
+	w[j] = p < 0 ? eval_mul(&s->joints[j].base, lm) : eval_mul_affine_w(&R->wc[base + (size_t)p], lm, wide);
+	if (!within(R, j, &w[j], &R->w0[base + (size_t)j], budget, wide))
 		return 0;
 	for (int k = 1; k < nsub; k++) {
 		int d = sub[k], dp = s->joints[d].parent;
-		w[d] = eval_mul_affine(&w[dp], &R->lm[base + (size_t)d]);
-		if (!within(R, d, &w[d], &R->w0[base + (size_t)d], budget))
+		w[d] = eval_mul_affine_w(&w[dp], &R->lm[base + (size_t)d], wide);
+		if (!within(R, d, &w[d], &R->w0[base + (size_t)d], budget, wide))
 			return 0;
 	}
 	return 1;
@@ -171,12 +171,12 @@ EVAL_INLINE int sample_check_body(reducer *R, lane *L, const mlod_channel *ch, c
 	        int constant, int f, double budget
 static int sample_check_generic(SAMPLE_CHECK_ARGS)
 {
-	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget);
+	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget, 0);
 }
 #if EVAL_HAVE_AVX2
 EVAL_TARGET_AVX2 static int sample_check_avx2(SAMPLE_CHECK_ARGS)
 {
-	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget);
+	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget, 1);
 }
 #define sample_check(R, ...) \
 	((R)->avx2 ? sample_check_avx2(R, __VA_ARGS__) : sample_check_generic(R, __VA_ARGS__))
