@@ -1419,7 +1419,7 @@ static void channel_exps(const mlod_motion *m, const mlod_clip *clip, int g, con
 typedef struct refine_lane {
 	mlod_trs *Lj, *Lj2;                      /* samples (2) */
 	mlod_mat4 *T, *T2, *LMj, *LMj2;          /* samples * joints (2), samples (2) */
-	int *sub, *pos;                          /* joints */
+	int *sub, *pos, *ppos;                   /* joints */
 } refine_lane;
 
 typedef struct refine_bufs {
@@ -1439,7 +1439,7 @@ static int refine_bufs_get(mlod_motion *m, refine_bufs *b)
 	int F = m->samples, J = m->s->joint_count, lanes = refine_lanes(m);
 	size_t FJ = (size_t)F * (size_t)J;
 	size_t per_lane = 2 * eval_carve_size(sizeof(mlod_mat4) * FJ) + 2 * eval_carve_size(sizeof(mlod_trs) * (size_t)F) +
-	                  2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) + 2 * eval_carve_size(sizeof(int) * (size_t)J);
+	                  2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) + 3 * eval_carve_size(sizeof(int) * (size_t)J);
 	size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 2 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
 	              (size_t)lanes * per_lane;
 	char *at = eval_scratch_get(&m->scratch, need);
@@ -1460,6 +1460,7 @@ static int refine_bufs_get(mlod_motion *m, refine_bufs *b)
 		l->LMj2 = eval_carve(&at, sizeof *l->LMj2 * (size_t)F);
 		l->sub = eval_carve(&at, sizeof(int) * (size_t)J);
 		l->pos = eval_carve(&at, sizeof(int) * (size_t)J);
+		l->ppos = eval_carve(&at, sizeof(int) * (size_t)J);
 	}
 	return 1;
 }
@@ -1525,7 +1526,7 @@ EVAL_INLINE void refine_one_body(void *ctx, int lane, int i, int wide)
 	refine_lane *rl = &x->rb->lane[lane];
 	mlod_trs *L = x->rb->L, *Lj = rl->Lj, *Lj2 = rl->Lj2;
 	mlod_mat4 *W = x->rb->W, *T = rl->T, *T2 = rl->T2, *LM = x->rb->LM, *LMj = rl->LMj, *LMj2 = rl->LMj2;
-	int *sub = rl->sub, *pos = rl->pos;
+	int *sub = rl->sub, *pos = rl->pos, *ppos = rl->ppos;
 	const float *times = m->st;
 	mlod_channel *ch = &clip->channels[i];
 	int j = ch->joint, ns = 0, fast = ch->interp != MLOD_INTERP_CUBICSPLINE;
@@ -1538,6 +1539,9 @@ EVAL_INLINE void refine_one_body(void *ctx, int lane, int i, int wide)
 		if (a == j)
 			pos[d] = ns, sub[ns++] = d;
 	}
+	for (int k = 1; k < ns; k++) /* below j, the parent is in the subtree, before */
+		ppos[k] = pos[s->joints[sub[k]].parent];
+	const int pj = s->joints[j].parent;
 	/* The coarsest adjustment up to CHANNEL_COARSER that fits: the
 	 * largest first, then bisection (a try that does not fit usually
 	 * stops within a few samples, one that fits checks them all). The
@@ -1577,12 +1581,11 @@ EVAL_INLINE void refine_one_body(void *ctx, int lane, int i, int wide)
 				}
 				Lj[f] = l;
 				LMj[f] = eval_from_trs(&l);
-				for (int k = 0; k < ns && ok; k++) {
-					int d = sub[k], p = s->joints[d].parent;
-					const mlod_mat4 *lm = d == j ? &LMj[f] : &lmf[d];
-					/* Below j, the parent is in the subtree, before d. */
-					const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
-					w[k] = p < 0 ? eval_mul(&s->joints[d].base, lm) : eval_mul_affine_w(pw, lm, wide);
+				w[0] = pj < 0 ? eval_mul(&s->joints[j].base, &LMj[f]) : eval_mul_affine_w(&wf[pj], &LMj[f], wide);
+				ok = eval_within_w(&w[0], &w0[j], m->radius[j], bound, wide);
+				for (int k = 1; k < ns && ok; k++) {
+					int d = sub[k];
+					w[k] = eval_mul_affine_w(&w[ppos[k]], &lmf[d], wide);
 					ok = eval_within_w(&w[k], &w0[d], m->radius[d], bound, wide);
 				}
 			}
