@@ -74,6 +74,7 @@ typedef struct reducer {
 	float *times;            /* S sample times */
 	double *radius;          /* per joint */
 	int *sub_start, *sub;    /* per joint: the joint and its descendants, parents first */
+	int *subp;               /* the parent of each entry of sub */
 	mlod_mat4 *w0;           /* S * J: world matrices as read */
 	int own_w0;              /* 0: the caller's */
 	mlod_trs *lc;            /* S * J: current local transforms */
@@ -111,9 +112,9 @@ EVAL_INLINE void set_path(mlod_trs *l, mlod_path path, const float *v)
 /* Does the joint's world matrix w stay within budget of w0? A float
  * bound of the point error decides first (the same answer); only when it
  * cannot, mlod_motion_point_within with its early exits. */
-EVAL_INLINE int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget)
+EVAL_INLINE int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_mat4 *w0, double budget, int wide)
 {
-	if (eval_error_bound(w, w0, R->radius[j]) <= budget)
+	if (eval_error_bound_w(w, w0, R->radius[j], wide) <= budget)
 		return 1; /* the same answer as below, from a float bound */
 #if EVAL_HAVE_AVX2
 	if (R->avx2)
@@ -127,11 +128,11 @@ EVAL_INLINE int within(const reducer *R, int j, const mlod_mat4 *w, const mlod_m
  * twice (sample_check_generic, sample_check_avx2: motion_eval.h), the
  * same floats. */
 EVAL_INLINE int sample_check_body(reducer *R, lane *L, const mlod_channel *ch, const float *va, const float *vb, float t0,
-                        float dt, eval_seg *seg, int constant, int f, double budget)
+                        float dt, eval_seg *seg, int constant, int f, double budget, int wide)
 {
 	const mlod_skeleton *s = R->s;
 	int j = ch->joint, p = s->joints[j].parent, comps = comps_of(ch), spare = 1 - L->good;
-	const int *sub = R->sub + R->sub_start[j];
+	const int *sub = R->sub + R->sub_start[j], *subp = R->subp + R->sub_start[j];
 	int nsub = R->sub_start[j + 1] - R->sub_start[j];
 	float v[4];
 	if (constant || ch->interp == MLOD_INTERP_STEP) {
@@ -154,13 +155,13 @@ EVAL_INLINE int sample_check_body(reducer *R, lane *L, const mlod_channel *ch, c
 	*l = R->lc[base + (size_t)j];
 	set_path(l, ch->path, v);
 	*lm = eval_from_trs(l);
-	w[j] = p < 0 ? eval_mul(&s->joints[j].base, lm) : eval_mul_affine(&R->wc[base + (size_t)p], lm);
-	if (!within(R, j, &w[j], &R->w0[base + (size_t)j], budget))
+	w[j] = p < 0 ? eval_mul(&s->joints[j].base, lm) : eval_mul_affine_w(&R->wc[base + (size_t)p], lm, wide);
+	if (!within(R, j, &w[j], &R->w0[base + (size_t)j], budget, wide))
 		return 0;
 	for (int k = 1; k < nsub; k++) {
-		int d = sub[k], dp = s->joints[d].parent;
-		w[d] = eval_mul_affine(&w[dp], &R->lm[base + (size_t)d]);
-		if (!within(R, d, &w[d], &R->w0[base + (size_t)d], budget))
+		int d = sub[k], dp = subp[k];
+		w[d] = eval_mul_affine_w(&w[dp], &R->lm[base + (size_t)d], wide);
+		if (!within(R, d, &w[d], &R->w0[base + (size_t)d], budget, wide))
 			return 0;
 	}
 	return 1;
@@ -171,17 +172,44 @@ EVAL_INLINE int sample_check_body(reducer *R, lane *L, const mlod_channel *ch, c
 	        int constant, int f, double budget
 static int sample_check_generic(SAMPLE_CHECK_ARGS)
 {
-	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget);
+	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget, 0);
 }
 #if EVAL_HAVE_AVX2
 EVAL_TARGET_AVX2 static int sample_check_avx2(SAMPLE_CHECK_ARGS)
 {
-	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget);
+	return sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget, 1);
 }
 #define sample_check(R, ...) \
 	((R)->avx2 ? sample_check_avx2(R, __VA_ARGS__) : sample_check_generic(R, __VA_ARGS__))
 #else
 #define sample_check sample_check_generic
+#endif
+
+/* The samples lo..hi not stamped id, in order, each as sample_check
+ * checks it but inline (most of a check's samples come here): 0 at the
+ * first that does not fit. Compiled twice as sample_check. */
+#define SAMPLE_REST_ARGS                                                                                          \
+	reducer *R, lane *L, const mlod_channel *ch, const float *va, const float *vb, float t0, float dt, eval_seg *seg, \
+	        int constant, int lo, int hi, const unsigned *stamp, unsigned id, double budget
+EVAL_INLINE int sample_rest_body(SAMPLE_REST_ARGS, int wide)
+{
+	for (int f = lo; f <= hi; f++)
+		if (stamp[f] != id && !sample_check_body(R, L, ch, va, vb, t0, dt, seg, constant, f, budget, wide))
+			return 0;
+	return 1;
+}
+static int sample_rest_generic(SAMPLE_REST_ARGS)
+{
+	return sample_rest_body(R, L, ch, va, vb, t0, dt, seg, constant, lo, hi, stamp, id, budget, 0);
+}
+#if EVAL_HAVE_AVX2
+EVAL_TARGET_AVX2 static int sample_rest_avx2(SAMPLE_REST_ARGS)
+{
+	return sample_rest_body(R, L, ch, va, vb, t0, dt, seg, constant, lo, hi, stamp, id, budget, 1);
+}
+#define sample_rest(R, ...) ((R)->avx2 ? sample_rest_avx2(R, __VA_ARGS__) : sample_rest_generic(R, __VA_ARGS__))
+#else
+#define sample_rest sample_rest_generic
 #endif
 
 /* Checks channel ch taking, at samples lo..hi (inclusive), the values of
@@ -219,9 +247,8 @@ static int sweep_check(reducer *R, lane *L, const mlod_channel *ch, int a, int b
 			if (!sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
 				return 0;
 		}
-	for (int f = lo; f <= hi; f++) /* the rest in order (memory order) */
-		if (stamp[f] != id && !sample_check(R, L, ch, va, vb, t0, dt, &seg, constant, f, budget))
-			return 0;
+	if (!sample_rest(R, L, ch, va, vb, t0, dt, &seg, constant, lo, hi, stamp, id, budget)) /* in memory order */
+		return 0;
 	L->good = 1 - L->good;
 	L->good_ch = ch, L->good_lo = lo, L->good_hi = hi;
 	return 1;
@@ -361,6 +388,7 @@ static void reducer_free(reducer *R)
 	free(R->radius);
 	free(R->sub_start);
 	free(R->sub);
+	free(R->subp);
 	if (R->own_w0)
 		free(R->w0);
 	free(R->related);
@@ -650,8 +678,9 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		total += depth[j] + 1;
 	}
 	R.sub = malloc(sizeof(int) * (size_t)total);
+	R.subp = malloc(sizeof(int) * (size_t)total);
 	fill = calloc((size_t)R.J, sizeof(int));
-	if (!R.sub || !fill) {
+	if (!R.sub || !R.subp || !fill) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
@@ -662,7 +691,7 @@ mlod_result keyreduce_run(const mlod_skeleton *s, const mlod_clip *original, con
 		R.sub_start[j + 1] += R.sub_start[j];
 	for (int d = 0; d < R.J; d++) /* d in index order: parents first in every list */
 		for (int a = d; a >= 0; a = s->joints[a].parent)
-			R.sub[R.sub_start[a] + fill[a]++] = d;
+			R.subp[R.sub_start[a] + fill[a]] = s->joints[d].parent, R.sub[R.sub_start[a] + fill[a]++] = d;
 
 	mlod_motion_sample_times(common->channels[0].times, R.F, R.per, R.times);
 	if (state) {

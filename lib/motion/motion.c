@@ -922,7 +922,7 @@ static int level_measure(mlod_motion *m, const mlod_clip *clip, double *point_er
  * matrices and its world matrices (the same floats as walk_pose and
  * eval_from_trs), and *kept is set: when the level fits, at every sample. */
 EVAL_INLINE int level_within_keep_body(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L,
-                                       mlod_mat4 *LM, mlod_mat4 *W, int *kept)
+                                       mlod_mat4 *LM, mlod_mat4 *W, int *kept, int wide)
 {
 	level_walk w;
 	walk_begin(m, clip, &w);
@@ -953,14 +953,14 @@ EVAL_INLINE int level_within_keep_body(mlod_motion *m, const mlod_clip *clip, do
 				for (int j = 0; j < J; j++) {
 					int p = s->joints[j].parent;
 					lmf[j] = eval_from_trs(&lf[j]);
-					wf[j] = p < 0 ? eval_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
+					wf[j] = p < 0 ? eval_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine_w(&wf[p], &lmf[j], wide);
 				}
 				wl = wf;
 			} else {
 				walk_pose(m, &w, f);
 			}
 			for (int j = 0; j < J && ok; j++)
-				ok = eval_within(&wl[j], &w0[j], m->radius[j], bound);
+				ok = eval_within_w(&wl[j], &w0[j], m->radius[j], bound, wide);
 		}
 	return ok;
 }
@@ -969,13 +969,13 @@ EVAL_INLINE int level_within_keep_body(mlod_motion *m, const mlod_clip *clip, do
 static int level_within_keep_generic(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L, mlod_mat4 *LM,
                                      mlod_mat4 *W, int *kept)
 {
-	return level_within_keep_body(m, clip, bound, L, LM, W, kept);
+	return level_within_keep_body(m, clip, bound, L, LM, W, kept, 0);
 }
 #if EVAL_HAVE_AVX2
 EVAL_TARGET_AVX2 static int level_within_keep_avx2(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L,
                                                     mlod_mat4 *LM, mlod_mat4 *W, int *kept)
 {
-	return level_within_keep_body(m, clip, bound, L, LM, W, kept);
+	return level_within_keep_body(m, clip, bound, L, LM, W, kept, 1);
 }
 #endif
 static int level_within_keep(mlod_motion *m, const mlod_clip *clip, double bound, mlod_trs *L, mlod_mat4 *LM,
@@ -1013,7 +1013,7 @@ static void lane_range(const walk_par *x, int i, int *lo, int *hi)
 	*hi = (int)(S * (i + 1) / x->lanes);
 }
 
-EVAL_INLINE mlod_result within_lane_body(void *ctx, int i)
+EVAL_INLINE mlod_result within_lane_body(void *ctx, int i, int wide)
 {
 	walk_par *x = ctx;
 	mlod_motion *m = x->m;
@@ -1048,10 +1048,10 @@ EVAL_INLINE mlod_result within_lane_body(void *ctx, int i)
 			for (int j = 0; j < J; j++) {
 				int p = s->joints[j].parent;
 				lmf[j] = eval_from_trs(&lf[j]);
-				wf[j] = p < 0 ? eval_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine(&wf[p], &lmf[j]);
+				wf[j] = p < 0 ? eval_mul(&s->joints[j].base, &lmf[j]) : eval_mul_affine_w(&wf[p], &lmf[j], wide);
 			}
 			for (int j = 0; j < J && ok; j++)
-				ok = eval_within(&wf[j], &w0[j], m->radius[j], x->bound);
+				ok = eval_within_w(&wf[j], &w0[j], m->radius[j], x->bound, wide);
 			if (!ok)
 				atomic_store(&x->failed, 1);
 		}
@@ -1063,12 +1063,12 @@ EVAL_INLINE mlod_result within_lane_body(void *ctx, int i)
 /* within_lane_body compiled twice (motion_eval.h): the same floats. */
 static mlod_result within_lane_generic(void *ctx, int i)
 {
-	return within_lane_body(ctx, i);
+	return within_lane_body(ctx, i, 0);
 }
 #if EVAL_HAVE_AVX2
 EVAL_TARGET_AVX2 static mlod_result within_lane_avx2(void *ctx, int i)
 {
-	return within_lane_body(ctx, i);
+	return within_lane_body(ctx, i, 1);
 }
 #endif
 
@@ -1419,7 +1419,7 @@ static void channel_exps(const mlod_motion *m, const mlod_clip *clip, int g, con
 typedef struct refine_lane {
 	mlod_trs *Lj, *Lj2;                      /* samples (2) */
 	mlod_mat4 *T, *T2, *LMj, *LMj2;          /* samples * joints (2), samples (2) */
-	int *sub, *pos;                          /* joints */
+	int *sub, *pos, *ppos;                   /* joints */
 } refine_lane;
 
 typedef struct refine_bufs {
@@ -1439,7 +1439,7 @@ static int refine_bufs_get(mlod_motion *m, refine_bufs *b)
 	int F = m->samples, J = m->s->joint_count, lanes = refine_lanes(m);
 	size_t FJ = (size_t)F * (size_t)J;
 	size_t per_lane = 2 * eval_carve_size(sizeof(mlod_mat4) * FJ) + 2 * eval_carve_size(sizeof(mlod_trs) * (size_t)F) +
-	                  2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) + 2 * eval_carve_size(sizeof(int) * (size_t)J);
+	                  2 * eval_carve_size(sizeof(mlod_mat4) * (size_t)F) + 3 * eval_carve_size(sizeof(int) * (size_t)J);
 	size_t need = eval_carve_size(sizeof(mlod_trs) * FJ) + 2 * eval_carve_size(sizeof(mlod_mat4) * FJ) +
 	              (size_t)lanes * per_lane;
 	char *at = eval_scratch_get(&m->scratch, need);
@@ -1460,6 +1460,7 @@ static int refine_bufs_get(mlod_motion *m, refine_bufs *b)
 		l->LMj2 = eval_carve(&at, sizeof *l->LMj2 * (size_t)F);
 		l->sub = eval_carve(&at, sizeof(int) * (size_t)J);
 		l->pos = eval_carve(&at, sizeof(int) * (size_t)J);
+		l->ppos = eval_carve(&at, sizeof(int) * (size_t)J);
 	}
 	return 1;
 }
@@ -1513,7 +1514,7 @@ static int channel_exp(const mlod_motion *m, const mlod_channel *ch, int g, int 
 	return g + adj + (ch->path == MLOD_PATH_TRANSLATION ? 0 : m->reach_exp[ch->joint]);
 }
 
-EVAL_INLINE void refine_one_body(void *ctx, int lane, int i)
+EVAL_INLINE void refine_one_body(void *ctx, int lane, int i, int wide)
 {
 	refine_ctx *x = ctx;
 	mlod_motion *m = x->m;
@@ -1525,7 +1526,7 @@ EVAL_INLINE void refine_one_body(void *ctx, int lane, int i)
 	refine_lane *rl = &x->rb->lane[lane];
 	mlod_trs *L = x->rb->L, *Lj = rl->Lj, *Lj2 = rl->Lj2;
 	mlod_mat4 *W = x->rb->W, *T = rl->T, *T2 = rl->T2, *LM = x->rb->LM, *LMj = rl->LMj, *LMj2 = rl->LMj2;
-	int *sub = rl->sub, *pos = rl->pos;
+	int *sub = rl->sub, *pos = rl->pos, *ppos = rl->ppos;
 	const float *times = m->st;
 	mlod_channel *ch = &clip->channels[i];
 	int j = ch->joint, ns = 0, fast = ch->interp != MLOD_INTERP_CUBICSPLINE;
@@ -1538,6 +1539,9 @@ EVAL_INLINE void refine_one_body(void *ctx, int lane, int i)
 		if (a == j)
 			pos[d] = ns, sub[ns++] = d;
 	}
+	for (int k = 1; k < ns; k++) /* below j, the parent is in the subtree, before */
+		ppos[k] = pos[s->joints[sub[k]].parent];
+	const int pj = s->joints[j].parent;
 	/* The coarsest adjustment up to CHANNEL_COARSER that fits: the
 	 * largest first, then bisection (a try that does not fit usually
 	 * stops within a few samples, one that fits checks them all). The
@@ -1577,13 +1581,12 @@ EVAL_INLINE void refine_one_body(void *ctx, int lane, int i)
 				}
 				Lj[f] = l;
 				LMj[f] = eval_from_trs(&l);
-				for (int k = 0; k < ns && ok; k++) {
-					int d = sub[k], p = s->joints[d].parent;
-					const mlod_mat4 *lm = d == j ? &LMj[f] : &lmf[d];
-					/* Below j, the parent is in the subtree, before d. */
-					const mlod_mat4 *pw = p < 0 ? NULL : d == j ? &wf[p] : &w[pos[p]];
-					w[k] = p < 0 ? eval_mul(&s->joints[d].base, lm) : eval_mul_affine(pw, lm);
-					ok = eval_within(&w[k], &w0[d], m->radius[d], bound);
+				w[0] = pj < 0 ? eval_mul(&s->joints[j].base, &LMj[f]) : eval_mul_affine_w(&wf[pj], &LMj[f], wide);
+				ok = eval_within_w(&w[0], &w0[j], m->radius[j], bound, wide);
+				for (int k = 1; k < ns && ok; k++) {
+					int d = sub[k];
+					w[k] = eval_mul_affine_w(&w[ppos[k]], &lmf[d], wide);
+					ok = eval_within_w(&w[k], &w0[d], m->radius[d], bound, wide);
 				}
 			}
 		if (ok) {
@@ -1613,12 +1616,12 @@ EVAL_INLINE void refine_one_body(void *ctx, int lane, int i)
 /* refine_one_body compiled twice (motion_eval.h): the same floats. */
 static void refine_one_generic(void *ctx, int lane, int i)
 {
-	refine_one_body(ctx, lane, i);
+	refine_one_body(ctx, lane, i, 0);
 }
 #if EVAL_HAVE_AVX2
 EVAL_TARGET_AVX2 static void refine_one_avx2(void *ctx, int lane, int i)
 {
-	refine_one_body(ctx, lane, i);
+	refine_one_body(ctx, lane, i, 1);
 }
 #endif
 

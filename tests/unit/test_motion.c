@@ -1526,6 +1526,52 @@ TEST(eval_mul_same_as_mat4_mul)
 	CHECK_MSG(differ == 0, "%d products differ", differ);
 }
 
+/* The AVX2 copies' 8-lane forms (eval_mul_affine8 through
+ * eval_mul_affine_w, and eval_error_bound_w), compiled here for AVX2 as
+ * in the copies, against the 4-lane ones: bit for bit, signed zeros,
+ * tiny and huge entries included; every column of the product (its last
+ * row too), and the bound's double. */
+#if EVAL_HAVE_AVX2
+EVAL_TARGET_AVX2 static int wide_differs(const mlod_mat4 *a, const mlod_mat4 *b, double radius)
+{
+	mlod_mat4 x = eval_mul_affine_w(a, b, 1), y = eval_mul_affine(a, b);
+	double e = eval_error_bound_w(a, b, radius, 1), f = eval_error_bound(a, b, radius);
+	return (memcmp(&x, &y, sizeof x) != 0) + 2 * (memcmp(&e, &f, sizeof e) != 0);
+}
+#endif
+
+TEST(eval_wide_same_as_narrow)
+{
+#if EVAL_HAVE_AVX2
+	if (!eval_avx2())
+		return; /* no AVX2 here: the copies that use them never run */
+	const float pick[8] = { 0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 3.0e-20f, -7.25e3f, 1.0e30f };
+	unsigned x = 54321u;
+	long products = 0, bounds = 0;
+	for (int n = 0; n < 200000; n++) {
+		mlod_mat4 a, b;
+		for (int i = 0; i < 16; i++) {
+			x = x * 1664525u + 1013904223u;
+			a.m[i] = (x >> 29) < 3 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 1024.0f;
+			x = x * 1664525u + 1013904223u;
+			b.m[i] = (x >> 29) < 3 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 4096.0f;
+		}
+		if (n % 2) /* b affine, as the local matrices are */
+			b.m[3] = b.m[7] = b.m[11] = 0.0f, b.m[15] = 1.0f;
+		if (n % 3 == 0) /* b near a, as a level's world matrix is near the original's */
+			for (int i = 0; i < 16; i++) {
+				x = x * 1664525u + 1013904223u;
+				b.m[i] = a.m[i] * (1.0f + (float)((int)(x >> 9) - (1 << 22)) * 1e-12f);
+			}
+		int d = wide_differs(&a, &b, (double)(n % 5) * 0.37);
+		products += d & 1;
+		bounds += d >> 1;
+	}
+	CHECK_MSG(products == 0, "eval_mul_affine8 differs from eval_mul_affine in %ld products", products);
+	CHECK_MSG(bounds == 0, "eval_error_bound_w's wide form differs in %ld bounds", bounds);
+#endif
+}
+
 TEST(keys_avx2_same_as_generic)
 {
 	/* The hot loops' AVX2 copies (motion_eval.h: the key reduction's
@@ -1599,6 +1645,7 @@ int main(void)
 	RUN(keys_avx2_same_as_generic);
 	RUN(keys_state_same_as_fresh);
 	RUN(eval_mul_same_as_mat4_mul);
+	RUN(eval_wide_same_as_narrow);
 	RUN(create_like_same_as_create);
 	RUN(create_on_threads_same_as_create);
 	TEST_EXIT();
