@@ -24,7 +24,11 @@
  * triangle; hierarchies are then built (or refitted from the same mesh's
  * at another pose) only when a search needs them, and the triangles'
  * degenerate flags are made once per mesh (a kept surface's once per
- * pose, for every level), not once per sample. */
+ * pose, for every level), not once per sample. A refitted hierarchy fits
+ * its boxes from the mesh and fills a leaf's triangles (corners, plane)
+ * only when a search first reaches that leaf: a bounded pose searches a
+ * few hundred samples (mlod-bgm on the 50k-triangle tubeman: 18,145
+ * searches in 48 level-poses), which reach few of its leaves. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
