@@ -255,6 +255,24 @@ static mlod_result cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uin
 	uint32_t raw = 4 + 16 * (uint32_t)cb->n;
 	if (cb->fail)
 		goto nomem;
+	/* The reader refuses a TOC error or switch distance that is not finite
+	 * and >= 0 (mlod_pack_open): coordinates near FLT_MAX (a BVH offset of
+	 * 1e25) give a motion level's error of inf. */
+	float stored_error = level > 0 || type == MLOD_CHUNK_MOTION ? error : 0.0f;
+	float distance = level > 0 ? mlod_pack_switch_distance(error) : 0.0f;
+	if (!isfinite(stored_error) || !(stored_error >= 0.0f) || !isfinite(distance)) {
+		char label[64];
+		if (type == MLOD_CHUNK_MOTION)
+			snprintf(label, sizeof label, "MOTION level %d of clip %d", level, item);
+		else
+			snprintf(label, sizeof label, "%s level %d", type == MLOD_CHUNK_MESH ? "MESH" : "SKELETON", level);
+		cb_free(cb);
+		if (!isfinite(stored_error) || !(stored_error >= 0.0f))
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: error %g is not finite and >= 0 (are the input's "
+			                 "coordinates too large?)", label, (double)stored_error);
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: error %g gives a switch distance that is not finite (are the "
+		                 "input's coordinates too large?)", label, (double)stored_error);
+	}
 	put_u32(word, (uint32_t)cb->n);
 	buf_put(&b, word, 4);
 	size_t headers = b.n;
@@ -299,8 +317,8 @@ static mlod_result cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uin
 	c->codec = type == MLOD_CHUNK_INFO || type == MLOD_CHUNK_DOC ? MLOD_CODEC_NONE : (uint8_t)codec;
 	c->level = (uint16_t)level;
 	c->item = (uint16_t)item;
-	c->error = level > 0 || type == MLOD_CHUNK_MOTION ? error : 0.0f; /* ANIM level 0: against the input clip */
-	c->distance = level > 0 ? mlod_pack_switch_distance(error) : 0.0f;
+	c->error = stored_error; /* ANIM level 0: against the input clip */
+	c->distance = distance;
 	c->data = b.p;
 	c->size = b.n;
 	c->raw = raw;
@@ -3738,6 +3756,21 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		put_u64(f.p + 16, file_size);
 		put_u32(f.p + 24, mlod_pack_crc32(0, f.p + MLOD_PACK_HEADER_SIZE, (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)n));
 		put_u32(f.p + 28, mlod_pack_crc32(0, f.p, 28));
+		/* The pack through its reader's own rules (mlod_pack_open's TOC,
+		 * mlod_pack_check's chunks): never a pack the reader refuses. */
+		mlod_pack rp;
+		mlod_error rerr = {0};
+		mlod_result rr = mlod_pack_open(f.p, f.n, &rp, &rerr);
+		if (rr == MLOD_OK) {
+			rr = mlod_pack_check(&rp, f.p, f.n, &rerr);
+			mlod_pack_close(&rp);
+		}
+		if (rr != MLOD_OK) {
+			free(f.p);
+			r = mlod_fail(err, rr == MLOD_ERR_NOMEM ? rr : MLOD_ERR_LIMIT,
+			              "the pack as written fails its reader's check: %s", rerr.message);
+			goto done;
+		}
 		*out = f.p;
 		*out_size = f.n;
 	}
