@@ -447,6 +447,36 @@ static mlod_result add_clip(mlod_gltf *doc, const mlod_skeleton *s, const mlod_p
 	return r;
 }
 
+/* Per animation of the DOC as read, whether it holds joint channels (a
+ * clip of the document's character with channels): the DOC holds the
+ * input whole (mlod(5) DOC), as a stripped DOC keeps only morph weights
+ * channels. *out is NULL when the document gives no character. */
+static mlod_result whole_animations(const mlod_gltf *doc, unsigned char **out, mlod_error *err)
+{
+	int n = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
+	mlod_character c;
+	mlod_error ignored = {0};
+	*out = NULL;
+	if (n == 0)
+		return MLOD_OK;
+	memset(&c, 0, sizeof c);
+	if (mlod_gltf_to_character(doc, &c, &ignored) != MLOD_OK) {
+		mlod_character_free(&c);
+		return MLOD_OK; /* a stripped DOC's emptied meshes */
+	}
+	unsigned char *w = calloc((size_t)n + 1, 1);
+	if (!w) {
+		mlod_character_free(&c);
+		return nomem(err);
+	}
+	for (int i = 0; i < c.clip_count; i++)
+		if (c.clips[i].channel_count > 0 && c.clips[i].gltf_index >= 0 && c.clips[i].gltf_index < n)
+			w[c.clips[i].gltf_index] = 1;
+	mlod_character_free(&c);
+	*out = w;
+	return MLOD_OK;
+}
+
 /* Reads the DOC's glb (mlod_gltf_read_doc: buffers emptied by stripping,
  * as older packs hold them, are dropped). */
 static mlod_result read_doc(const void *glb, size_t size, mlod_gltf **doc, mlod_error *err)
@@ -470,7 +500,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	int *parts = NULL, *nodes = NULL, *mesh_map = NULL, *lod_nodes = NULL;
 	mlod_mat4 *world = NULL;
 	mlod_trs *local = NULL;
-	unsigned char *used = NULL;
+	unsigned char *used = NULL, *whole = NULL;
 	mlod_record_skel_level *skel_rec = NULL; /* the stage record's skeleton levels */
 	mlod_record_mesh_level *mesh_rec = NULL;  /* and mesh levels */
 	uint32_t mesh_levels = 0, skel_levels = 0;
@@ -498,6 +528,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	r = read_doc(glb.glb, glb.size, &doc, err);
 	mlod_pack_doc_free(&glb);
 	if (r != MLOD_OK)
+		goto done;
+	if ((r = whole_animations(doc, &whole, err)) != MLOD_OK)
 		goto done;
 	if ((r = build_skeleton(have_skel ? &skel : NULL, &s, err)) != MLOD_OK)
 		goto done;
@@ -765,11 +797,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 				snprintf(name, sizeof name, "%s", info.clip_names[c]);
 			else
 				snprintf(name, sizeof name, "%s@lod%u", info.clip_names[c], k);
-			int anim = -1;
-			r = add_clip(doc, &s, &mo, name, &anim, err);
-			mlod_pack_motion_free(&mo);
-			int into = -1;
-			for (int a = 0; k == 0 && r == MLOD_OK && a < doc_anims; a++) {
+			int anim = -1, into = -1;
+			for (int a = 0; k == 0 && a < doc_anims; a++) {
 				a = mlod_gltf_find_animation(doc, name, a);
 				if (a < 0 || a >= doc_anims)
 					break;
@@ -779,10 +808,21 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 					break;
 				}
 			}
-			if (r == MLOD_OK && into >= 0) {
-				r = mlod_gltf_merge_animation(doc, into, err);
+			if (into >= 0 && whole && whole[into]) {
+				/* The DOC holds the input whole, this clip's joint
+				 * channels too: they stay as the clip (the input's keys,
+				 * within level 0's error of them), as the document's
+				 * channels cannot be taken out; merged, the level-0
+				 * channels would animate every joint twice. */
 				anim = into;
+			} else {
+				r = add_clip(doc, &s, &mo, name, &anim, err);
+				if (r == MLOD_OK && into >= 0) {
+					r = mlod_gltf_merge_animation(doc, into, err);
+					anim = into;
+				}
 			}
+			mlod_pack_motion_free(&mo);
 			/* Its record: level 0's error on the clip, a coarser level's
 			 * source clip and error on it. */
 			if (r == MLOD_OK && k == 0) {
@@ -855,6 +895,7 @@ done:
 	free(world);
 	free(local);
 	free(used);
+	free(whole);
 	skeleton_free(&s);
 	mlod_gltf_free(doc);
 	mlod_pack_skeleton_free(&skel);
