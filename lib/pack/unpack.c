@@ -545,6 +545,10 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	mlod_record_mesh_level *mesh_rec = NULL;  /* and mesh levels */
 	uint32_t mesh_levels = 0, skel_levels = 0;
 	int have_skel = 0, node_count = 0;
+	/* The chunk whose data the document is being built from: a glTF call
+	 * that refuses it as an argument (MLOD_ERR_INVALID_ARG) means a
+	 * corrupt pack, MLOD_ERR_PARSE with the chunk named (at done). */
+	char where[64] = "";
 	memset(&info, 0, sizeof info);
 	memset(&skel, 0, sizeof skel);
 	memset(&s, 0, sizeof s);
@@ -574,6 +578,20 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	if ((r = build_skeleton(have_skel ? &skel : NULL, &s, err)) != MLOD_OK)
 		goto done;
 	node_count = mlod_gltf_count(doc, MLOD_GLTF_NODE);
+	/* SKEL's glTF indices are the DOC's (it keeps node and skin indices). */
+	for (int j = 0; j < s.joint_count; j++)
+		if (s.joints[j].node >= node_count) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "SKELETON: joint %d: node %d is not one of the DOC chunk's %d nodes",
+			              j, s.joints[j].node, node_count);
+			goto done;
+		}
+	for (int i = 0; i < s.skin_count; i++)
+		if (s.skins[i].gltf_index >= mlod_gltf_count(doc, MLOD_GLTF_SKIN)) {
+			r = mlod_fail(err, MLOD_ERR_PARSE, "SKELETON: skin %d: glTF skin %d is not one of the DOC chunk's %d skins",
+			              i, s.skins[i].gltf_index, mlod_gltf_count(doc, MLOD_GLTF_SKIN));
+			goto done;
+		}
+	snprintf(where, sizeof where, "SKELETON");
 	/* The joints' nodes get back their rest TRS from SKEL, and the DOC's
 	 * skins the inverse bind matrices SKEL holds (the writer drops both
 	 * from the DOC unless they are the defaults). */
@@ -634,6 +652,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		}
 		if ((r = mlod_pack_decode_skel_level(&p, (uint32_t)c, data, size, &skel, &lv, err)) != MLOD_OK)
 			goto done;
+		snprintf(where, sizeof where, "SKELETON level %u", k);
 		r = add_level_skins(doc, &s, &lv, (int)k, &ls[k], err);
 		if (r == MLOD_OK)
 			r = record_skel_level(&s, &lv, &ls[k], (int)k, p.chunks[c].error, &skel_rec[k - 1], err);
@@ -734,6 +753,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			int count = node_parts(&meshes[0], node, parts);
 			const mlod_pack_part_rec *q0 = &meshes[0].parts[parts[0]].rec;
 			int like = q0->mesh, old_mesh = -1, old_skin = -1, mesh = -1;
+			snprintf(where, sizeof where, "MESH level 0");
 			if ((r = mlod_gltf_node_refs(doc, node, &old_mesh, &old_skin, err)) != MLOD_OK)
 				goto done;
 			/* Level 0: the node's own mesh again. */
@@ -771,6 +791,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 					goto done;
 				}
 				int skin = skin0, lmesh = -1, lnode = -1;
+				snprintf(where, sizeof where, "MESH level %d", k);
 				int **map = NULL;
 				if (q0->skin >= 0 && sl >= 1 && ls[sl].gltf && ls[sl].gltf[q0->skin] >= 0) {
 					map = ls[sl].map;
@@ -838,6 +859,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			else
 				snprintf(name, sizeof name, "%s@lod%u", info.clip_names[c], k);
 			int anim = -1, into = -1;
+			snprintf(where, sizeof where, "MOTION level %u of clip %u", k, c);
 			for (int a = 0; k == 0 && a < doc_anims; a++) {
 				a = mlod_gltf_find_animation(doc, name, a);
 				if (a < 0 || a >= doc_anims)
@@ -885,6 +907,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 
 	/* The scene's record: skeleton and mesh levels (every writer above
 	 * stamped the version). */
+	snprintf(where, sizeof where, "SKELETON");
 	if (have_skel) { /* an empty list when the pack has level 0 alone */
 		int *full = malloc(sizeof(int) * ((size_t)s.skin_count + 1));
 		if (!full) {
@@ -901,9 +924,11 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		if (r != MLOD_OK)
 			goto done;
 	}
+	snprintf(where, sizeof where, "MESH");
 	if (mesh_levels > 0 && (r = mlod_record_write_mesh_levels(doc, mesh_rec, (int)mesh_levels - 1, err)) != MLOD_OK)
 		goto done;
 	{
+		snprintf(where, sizeof where, "INFO");
 		char *name = utf8_name(info.name);
 		if (!name) {
 			r = nomem(err);
@@ -927,6 +952,11 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	*out = doc;
 	doc = NULL;
 done:
+	if (r == MLOD_ERR_INVALID_ARG && where[0] && err) {
+		char message[sizeof err->message];
+		snprintf(message, sizeof message, "%s", err->message);
+		r = mlod_fail(err, MLOD_ERR_PARSE, "%s: %s", where, message);
+	}
 	for (uint32_t k = 0; meshes && k < mesh_levels; k++)
 		mlod_pack_mesh_free(&meshes[k]);
 	free(meshes);
