@@ -528,6 +528,41 @@ static mlod_result read_doc(const void *glb, size_t size, mlod_gltf **doc, mlod_
 	return MLOD_OK;
 }
 
+/* SKELETON's glTF indices are the DOC's (which keeps node and skin
+ * indices): a joint's node and a skin's glTF skin must be there. */
+static mlod_result check_skel_indices(const mlod_pack_skeleton *k, const mlod_gltf *doc, mlod_error *err)
+{
+	int nodes = mlod_gltf_count(doc, MLOD_GLTF_NODE), skins = mlod_gltf_count(doc, MLOD_GLTF_SKIN);
+	for (uint32_t j = 0; j < k->joint_count; j++)
+		if (k->joints[j].node >= nodes)
+			return mlod_fail(err, MLOD_ERR_PARSE, "SKELETON: joint %u: node %d is not one of the DOC chunk's %d "
+			                 "nodes", j, (int)k->joints[j].node, nodes);
+	for (uint32_t i = 0; i < k->skin_count; i++)
+		if (k->skins[i].gltf_index >= skins)
+			return mlod_fail(err, MLOD_ERR_PARSE, "SKELETON: skin %u: glTF skin %d is not one of the DOC chunk's "
+			                 "%d skins", i, (int)k->skins[i].gltf_index, skins);
+	return MLOD_OK;
+}
+
+mlod_result mlod_pack_check_doc(const mlod_pack *p, const void *data, size_t size, mlod_error *err)
+{
+	mlod_pack_doc_bytes glb;
+	mlod_pack_skeleton skel;
+	mlod_gltf *doc = NULL;
+	memset(&skel, 0, sizeof skel);
+	mlod_result r = mlod_pack_decode_doc(p, data, size, &glb, err);
+	if (r != MLOD_OK)
+		return r;
+	r = read_doc(glb.glb, glb.size, &doc, err);
+	mlod_pack_doc_free(&glb);
+	if (r == MLOD_OK && mlod_pack_find(p, MLOD_CHUNK_SKELETON, 0, 0) >= 0 &&
+	    (r = mlod_pack_decode_skeleton(p, data, size, &skel, err)) == MLOD_OK)
+		r = check_skel_indices(&skel, doc, err);
+	mlod_pack_skeleton_free(&skel);
+	mlod_gltf_free(doc);
+	return r;
+}
+
 mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlod_error *err)
 {
 	mlod_pack p;
@@ -578,19 +613,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	if ((r = build_skeleton(have_skel ? &skel : NULL, &s, err)) != MLOD_OK)
 		goto done;
 	node_count = mlod_gltf_count(doc, MLOD_GLTF_NODE);
-	/* SKEL's glTF indices are the DOC's (it keeps node and skin indices). */
-	for (int j = 0; j < s.joint_count; j++)
-		if (s.joints[j].node >= node_count) {
-			r = mlod_fail(err, MLOD_ERR_PARSE, "SKELETON: joint %d: node %d is not one of the DOC chunk's %d nodes",
-			              j, s.joints[j].node, node_count);
-			goto done;
-		}
-	for (int i = 0; i < s.skin_count; i++)
-		if (s.skins[i].gltf_index >= mlod_gltf_count(doc, MLOD_GLTF_SKIN)) {
-			r = mlod_fail(err, MLOD_ERR_PARSE, "SKELETON: skin %d: glTF skin %d is not one of the DOC chunk's %d skins",
-			              i, s.skins[i].gltf_index, mlod_gltf_count(doc, MLOD_GLTF_SKIN));
-			goto done;
-		}
+	if (have_skel && (r = check_skel_indices(&skel, doc, err)) != MLOD_OK)
+		goto done;
 	snprintf(where, sizeof where, "SKELETON");
 	/* The joints' nodes get back their rest TRS from SKEL, and the DOC's
 	 * skins the inverse bind matrices SKEL holds (the writer drops both
