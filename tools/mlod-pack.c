@@ -75,7 +75,8 @@ static const char usage_more[] = /* printf's format ends above (ISO C's 4095-cha
 	"      --info FILE            print the pack's chunks (layer, level, clip,\n"
 	"                             codec and entropy stage, sizes, error, switch\n"
 	"                             distance) and totals;\n"
-	"                             every chunk is decoded and checked (stdout\n"
+	"                             every chunk is decoded and checked, the DOC\n"
+	"                             chunk's glb read as -x reads it (stdout\n"
 	"                             only: not with -o)\n"
 	"      --json                 with --info: as JSON (= --report=json)\n"
 	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels,\n"
@@ -193,8 +194,9 @@ static void report_json(FILE *rf, const char *input, const mlod_pack_stats *st, 
 }
 
 /* --info: every chunk is first decoded through the reader (lib/rt,
- * mlod_pack_check), so that a CRC or a bound that does not hold exits 2
- * with the reader's message. */
+ * mlod_pack_check), and the DOC chunk's glb read as -x reads it
+ * (mlod_pack_check_doc), so that a CRC or a bound that does not hold
+ * exits 2 with the reader's message. */
 typedef struct pack_totals {
 	uint64_t stored[4], raw[4];
 	uint32_t chunks[4];
@@ -222,6 +224,8 @@ static int pack_info(const char *path, enum tool_report report)
 	mlod_result r = mlod_pack_open(data, size, &p, &err);
 	if (r == MLOD_OK)
 		r = mlod_pack_check(&p, data, size, &err);
+	if (r == MLOD_OK)
+		r = mlod_pack_check_doc(&p, data, size, &err);
 	if (r != MLOD_OK)
 		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
 	if (p.file_size != size)

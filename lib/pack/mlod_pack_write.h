@@ -312,6 +312,12 @@ float mlod_pack_switch_distance(float error);
  * pack. Release *out with mlod_gltf_free. */
 mlod_result mlod_pack_unpack(const void *pack, size_t size, mlod_gltf **out, mlod_error *err);
 
+/* What mlod_pack_unpack checks beyond mlod_pack_check (p opened on data):
+ * the DOC chunk's glb read through the same glTF reader, and SKELETON's
+ * glTF node and skin indices against the DOC's. MLOD_ERR_PARSE naming
+ * the chunk ("DOC: ...", "SKELETON: ...") for a corrupt pack. */
+mlod_result mlod_pack_check_doc(const mlod_pack *p, const void *data, size_t size, mlod_error *err);
+
 #ifdef __cplusplus
 }
 #endif

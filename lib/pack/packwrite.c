@@ -255,6 +255,24 @@ static mlod_result cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uin
 	uint32_t raw = 4 + 16 * (uint32_t)cb->n;
 	if (cb->fail)
 		goto nomem;
+	/* The reader refuses a TOC error or switch distance that is not finite
+	 * and >= 0 (mlod_pack_open): coordinates near FLT_MAX (a BVH offset of
+	 * 1e25) give a motion level's error of inf. */
+	float stored_error = level > 0 || type == MLOD_CHUNK_MOTION ? error : 0.0f;
+	float distance = level > 0 ? mlod_pack_switch_distance(error) : 0.0f;
+	if (!isfinite(stored_error) || !(stored_error >= 0.0f) || !isfinite(distance)) {
+		char label[64];
+		if (type == MLOD_CHUNK_MOTION)
+			snprintf(label, sizeof label, "MOTION level %d of clip %d", level, item);
+		else
+			snprintf(label, sizeof label, "%s level %d", type == MLOD_CHUNK_MESH ? "MESH" : "SKELETON", level);
+		cb_free(cb);
+		if (!isfinite(stored_error) || !(stored_error >= 0.0f))
+			return mlod_fail(err, MLOD_ERR_PARSE, "%s: error %g is not finite and >= 0 (are the input's "
+			                 "coordinates too large?)", label, (double)stored_error);
+		return mlod_fail(err, MLOD_ERR_PARSE, "%s: error %g gives a switch distance that is not finite (are the "
+		                 "input's coordinates too large?)", label, (double)stored_error);
+	}
 	put_u32(word, (uint32_t)cb->n);
 	buf_put(&b, word, 4);
 	size_t headers = b.n;
@@ -299,8 +317,8 @@ static mlod_result cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uin
 	c->codec = type == MLOD_CHUNK_INFO || type == MLOD_CHUNK_DOC ? MLOD_CODEC_NONE : (uint8_t)codec;
 	c->level = (uint16_t)level;
 	c->item = (uint16_t)item;
-	c->error = level > 0 || type == MLOD_CHUNK_MOTION ? error : 0.0f; /* ANIM level 0: against the input clip */
-	c->distance = level > 0 ? mlod_pack_switch_distance(error) : 0.0f;
+	c->error = stored_error; /* ANIM level 0: against the input clip */
+	c->distance = distance;
 	c->data = b.p;
 	c->size = b.n;
 	c->raw = raw;
@@ -3224,6 +3242,311 @@ static int img_as_read(const motion_img *img, const mlod_clip *clip)
 }
 
 /* ------------------------------------------------------------------ */
+/* Attributes the pack does not store                                  */
+/* ------------------------------------------------------------------ */
+
+/* A JSON walk over the document's text, just enough to list each
+ * primitive's attribute names (lib/io decodes the attributes it knows and
+ * leaves the others; the DOC chunk drops them with the rest of level 0). */
+typedef struct jwalk {
+	const char *p, *e;
+	int depth;
+} jwalk;
+
+static void jw_ws(jwalk *w)
+{
+	while (w->p < w->e && (*w->p == ' ' || *w->p == '\t' || *w->p == '\n' || *w->p == '\r'))
+		w->p++;
+}
+
+static int jw_hex(const char *p)
+{
+	int v = 0;
+	for (int i = 0; i < 4; i++) {
+		int c = p[i], d = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10
+		                  : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+		if (d < 0)
+			return -1;
+		v = v * 16 + d;
+	}
+	return v;
+}
+
+/* A string (at its quote) into out (truncated to n - 1 bytes; \u escapes
+ * outside ASCII as '?'); 0 on malformed text. */
+static int jw_string(jwalk *w, char *out, size_t n)
+{
+	size_t k = 0;
+	if (w->p >= w->e || *w->p != '"')
+		return 0;
+	w->p++;
+	while (w->p < w->e && *w->p != '"') {
+		char c = *w->p++;
+		if (c == '\\') {
+			if (w->p >= w->e)
+				return 0;
+			c = *w->p++;
+			if (c == 'u') {
+				int v = w->e - w->p >= 4 ? jw_hex(w->p) : -1;
+				if (v < 0)
+					return 0;
+				w->p += 4;
+				c = v > 0 && v < 0x80 ? (char)v : '?';
+			} else {
+				c = c == 'n' ? '\n' : c == 't' ? '\t' : c == 'r' ? '\r' : c == 'b' ? '\b' : c == 'f' ? '\f' : c;
+			}
+		}
+		if (out && k + 1 < n)
+			out[k++] = c;
+	}
+	if (out && n)
+		out[k] = '\0';
+	if (w->p >= w->e)
+		return 0;
+	w->p++;
+	return 1;
+}
+
+/* Skips one value; 0 on malformed text or nesting over 64. */
+static int jw_skip(jwalk *w)
+{
+	jw_ws(w);
+	if (w->p >= w->e)
+		return 0;
+	char c = *w->p;
+	if (c == '"')
+		return jw_string(w, NULL, 0);
+	if (c == '{' || c == '[') {
+		char close = c == '{' ? '}' : ']';
+		if (++w->depth > 64)
+			return 0;
+		w->p++;
+		jw_ws(w);
+		if (w->p < w->e && *w->p == close) {
+			w->p++;
+			w->depth--;
+			return 1;
+		}
+		for (;;) {
+			if (c == '{') {
+				jw_ws(w);
+				if (!jw_string(w, NULL, 0))
+					return 0;
+				jw_ws(w);
+				if (w->p >= w->e || *w->p++ != ':')
+					return 0;
+			}
+			if (!jw_skip(w))
+				return 0;
+			jw_ws(w);
+			if (w->p >= w->e)
+				return 0;
+			if (*w->p == ',') {
+				w->p++;
+				continue;
+			}
+			if (*w->p++ != close)
+				return 0;
+			w->depth--;
+			return 1;
+		}
+	}
+	while (w->p < w->e && *w->p != ',' && *w->p != '}' && *w->p != ']' && *w->p != ' ' && *w->p != '\n' &&
+	       *w->p != '\r' && *w->p != '\t')
+		w->p++;
+	return 1;
+}
+
+/* At an object: calls f for each member (w at its value, which f must
+ * consume); 0 on malformed text. */
+static int jw_object(jwalk *w, int (*f)(jwalk *w, const char *key, void *arg), void *arg)
+{
+	jw_ws(w);
+	if (w->p >= w->e || *w->p != '{')
+		return jw_skip(w);
+	w->p++;
+	jw_ws(w);
+	if (w->p < w->e && *w->p == '}') {
+		w->p++;
+		return 1;
+	}
+	for (;;) {
+		char key[64];
+		jw_ws(w);
+		if (!jw_string(w, key, sizeof key))
+			return 0;
+		jw_ws(w);
+		if (w->p >= w->e || *w->p++ != ':')
+			return 0;
+		jw_ws(w);
+		if (!f(w, key, arg))
+			return 0;
+		jw_ws(w);
+		if (w->p >= w->e)
+			return 0;
+		if (*w->p == ',') {
+			w->p++;
+			continue;
+		}
+		return *w->p++ == '}';
+	}
+}
+
+/* At an array: calls f for each element with its index. */
+static int jw_array(jwalk *w, int (*f)(jwalk *w, int i, void *arg), void *arg)
+{
+	jw_ws(w);
+	if (w->p >= w->e || *w->p != '[')
+		return jw_skip(w);
+	w->p++;
+	jw_ws(w);
+	if (w->p < w->e && *w->p == ']') {
+		w->p++;
+		return 1;
+	}
+	for (int i = 0;; i++) {
+		jw_ws(w);
+		if (!f(w, i, arg))
+			return 0;
+		jw_ws(w);
+		if (w->p >= w->e)
+			return 0;
+		if (*w->p == ',') {
+			w->p++;
+			continue;
+		}
+		return *w->p++ == ']';
+	}
+}
+
+typedef struct attr_scan {
+	struct ctx *x;
+	int mesh, primitive, mode;
+	char names[16][64]; /* a primitive's unknown attributes (the first 16) */
+	int count;
+} attr_scan;
+
+/* An attribute name a part stores (mlod(5) MESH levels): POSITION,
+ * NORMAL, TANGENT, TEXCOORD_0 to TEXCOORD_3 (MLOD_PACK_MAX_UV), COLOR_0,
+ * JOINTS_n and WEIGHTS_n (the influences). */
+static int known_attribute(const char *name)
+{
+	static const char *const sets[] = {"TEXCOORD_", "COLOR_", "JOINTS_", "WEIGHTS_"};
+	static const long most[] = {MLOD_PACK_MAX_UV, 1, LONG_MAX, LONG_MAX};
+	if (!strcmp(name, "POSITION") || !strcmp(name, "NORMAL") || !strcmp(name, "TANGENT"))
+		return 1;
+	for (size_t i = 0; i < sizeof sets / sizeof *sets; i++) {
+		size_t n = strlen(sets[i]);
+		if (!strncmp(name, sets[i], n) && name[n] >= '0' && name[n] <= '9') {
+			char *d;
+			long k = strtol(name + n, &d, 10);
+			return *d == '\0' && k < most[i];
+		}
+	}
+	return 0;
+}
+
+static int scan_attribute(jwalk *w, const char *key, void *arg)
+{
+	attr_scan *a = arg;
+	if (!known_attribute(key) && a->count < 16)
+		snprintf(a->names[a->count++], sizeof a->names[0], "%s", key);
+	return jw_skip(w);
+}
+
+static int scan_primitive_member(jwalk *w, const char *key, void *arg)
+{
+	attr_scan *a = arg;
+	if (!strcmp(key, "attributes"))
+		return jw_object(w, scan_attribute, a);
+	if (!strcmp(key, "mode")) {
+		const char *start = w->p;
+		if (!jw_skip(w))
+			return 0;
+		a->mode = (int)strtol(start, NULL, 10);
+		return 1;
+	}
+	return jw_skip(w);
+}
+
+static int scan_primitive(jwalk *w, int i, void *arg)
+{
+	attr_scan *a = arg;
+	a->primitive = i;
+	a->mode = 4;
+	a->count = 0;
+	if (!jw_object(w, scan_primitive_member, a))
+		return 0;
+	for (int k = 0; a->mode == 4 && k < a->count; k++) { /* points, lines, strips, fans: the DOC keeps them */
+		char text[160];
+		snprintf(text, sizeof text, "mesh %d primitive %d: attribute %s is not stored in the pack", a->mesh,
+		         a->primitive, a->names[k]);
+		note(a->x, text);
+	}
+	return 1;
+}
+
+static int scan_mesh_member(jwalk *w, const char *key, void *arg)
+{
+	return !strcmp(key, "primitives") ? jw_array(w, scan_primitive, arg) : jw_skip(w);
+}
+
+static int scan_mesh(jwalk *w, int i, void *arg)
+{
+	((attr_scan *)arg)->mesh = i;
+	return jw_object(w, scan_mesh_member, arg);
+}
+
+static int scan_root_member(jwalk *w, const char *key, void *arg)
+{
+	return !strcmp(key, "meshes") ? jw_array(w, scan_mesh, arg) : jw_skip(w);
+}
+
+/* Notes each attribute of a triangle list that the pack does not store
+ * (_ID, any other custom or unknown name, a fifth UV set, a second
+ * colour set),
+ * from the input's JSON (a glb's JSON chunk, a .gltf's text) or the
+ * document written as glb. Text it cannot walk gives no note. */
+static mlod_result note_unstored_attributes(struct ctx *x, const mlod_gltf *doc, mlod_format format,
+                                            const void *input, size_t input_size)
+{
+	const unsigned char *in = input;
+	void *glb = NULL;
+	size_t glb_size = 0;
+	const char *json = NULL;
+	size_t n = 0;
+	if (format == MLOD_FORMAT_GLTF && input) {
+		json = input, n = input_size;
+	} else {
+		if (!(format == MLOD_FORMAT_GLB && input)) {
+			if (!doc || mlod_gltf_count(doc, MLOD_GLTF_MESH) == 0)
+				return MLOD_OK;
+			mlod_error werr = {0};
+			mlod_result r = mlod_gltf_write(doc, 1, &glb, &glb_size, &werr);
+			if (r == MLOD_ERR_NOMEM)
+				return mlod_fail(x->err, r, "%s", werr.message);
+			if (r != MLOD_OK)
+				return MLOD_OK;
+			in = glb, input_size = glb_size;
+		}
+		if (input_size >= 20 && !memcmp(in + 16, "JSON", 4)) {
+			uint32_t len = (uint32_t)in[12] | (uint32_t)in[13] << 8 | (uint32_t)in[14] << 16 | (uint32_t)in[15] << 24;
+			if (len <= input_size - 20)
+				json = (const char *)in + 20, n = len;
+		}
+	}
+	if (json) {
+		jwalk w = {json, json + n, 0};
+		attr_scan a;
+		memset(&a, 0, sizeof a);
+		a.x = x;
+		jw_object(&w, scan_root_member, &a);
+	}
+	mlod_free(glb);
+	return MLOD_OK;
+}
+
+/* ------------------------------------------------------------------ */
 /* The pack                                                            */
 /* ------------------------------------------------------------------ */
 
@@ -3468,6 +3791,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	if (doc && (r = mlod_record_read(doc, &x.rec, err)) != MLOD_OK)
 		return r;
 	if ((r = make_view(&x)) != MLOD_OK || (r = measure(&x)) != MLOD_OK)
+		goto done;
+	if (mlod_mesh_triangle_primitives(&x.v) > 0 && (r = note_unstored_attributes(&x, doc, format, input, input_size)) != MLOD_OK)
 		goto done;
 
 	/* The levels of each layer. */
@@ -3738,6 +4063,21 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		put_u64(f.p + 16, file_size);
 		put_u32(f.p + 24, mlod_pack_crc32(0, f.p + MLOD_PACK_HEADER_SIZE, (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)n));
 		put_u32(f.p + 28, mlod_pack_crc32(0, f.p, 28));
+		/* The pack through its reader's own rules (mlod_pack_open's TOC,
+		 * mlod_pack_check's chunks): never a pack the reader refuses. */
+		mlod_pack rp;
+		mlod_error rerr = {0};
+		mlod_result rr = mlod_pack_open(f.p, f.n, &rp, &rerr);
+		if (rr == MLOD_OK) {
+			rr = mlod_pack_check(&rp, f.p, f.n, &rerr);
+			mlod_pack_close(&rp);
+		}
+		if (rr != MLOD_OK) {
+			free(f.p);
+			r = mlod_fail(err, rr == MLOD_ERR_NOMEM ? rr : MLOD_ERR_LIMIT,
+			              "the pack as written fails its reader's check: %s", rerr.message);
+			goto done;
+		}
 		*out = f.p;
 		*out_size = f.n;
 	}

@@ -447,6 +447,76 @@ static mlod_result add_clip(mlod_gltf *doc, const mlod_skeleton *s, const mlod_p
 	return r;
 }
 
+/* Per animation of the DOC as read, whether it holds joint channels (a
+ * clip of the document's character with channels): the DOC holds the
+ * input whole (mlod(5) DOC), as a stripped DOC keeps only morph weights
+ * channels. *out is NULL when the document gives no character. */
+static mlod_result whole_animations(const mlod_gltf *doc, unsigned char **out, mlod_error *err)
+{
+	int n = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
+	mlod_character c;
+	mlod_error ignored = {0};
+	*out = NULL;
+	if (n == 0)
+		return MLOD_OK;
+	memset(&c, 0, sizeof c);
+	if (mlod_gltf_to_character(doc, &c, &ignored) != MLOD_OK) {
+		mlod_character_free(&c);
+		return MLOD_OK; /* a stripped DOC's emptied meshes */
+	}
+	unsigned char *w = calloc((size_t)n + 1, 1);
+	if (!w) {
+		mlod_character_free(&c);
+		return nomem(err);
+	}
+	for (int i = 0; i < c.clip_count; i++)
+		if (c.clips[i].channel_count > 0 && c.clips[i].gltf_index >= 0 && c.clips[i].gltf_index < n)
+			w[c.clips[i].gltf_index] = 1;
+	mlod_character_free(&c);
+	*out = w;
+	return MLOD_OK;
+}
+
+/* name with every byte that is not UTF-8 as U+FFFD (the rules of
+ * lib/io's names read): the record's JSON text must be UTF-8, and a
+ * pack's name is the caller's bytes (a Latin-1 file name, --name).
+ * NULL when out of memory; release with free. */
+static char *utf8_name(const char *name)
+{
+	const unsigned char *p = (const unsigned char *)(name ? name : "");
+	char *out = malloc(3 * strlen((const char *)p) + 1), *o = out;
+	if (!out)
+		return NULL;
+	while (*p) {
+		unsigned c = *p;
+		int n = c < 0x80 ? 0 : c >= 0xC2 && c <= 0xDF ? 1 : c >= 0xE0 && c <= 0xEF ? 2 : c >= 0xF0 && c <= 0xF4 ? 3 : -1;
+		int ok = n >= 0;
+		for (int k = 1; ok && k <= n; k++) {
+			unsigned lo = 0x80, hi = 0xBF;
+			if (k == 1 && c == 0xE0)
+				lo = 0xA0;
+			if (k == 1 && c == 0xED)
+				hi = 0x9F;
+			if (k == 1 && c == 0xF0)
+				lo = 0x90;
+			if (k == 1 && c == 0xF4)
+				hi = 0x8F;
+			ok = p[k] >= lo && p[k] <= hi;
+		}
+		if (ok) {
+			memcpy(o, p, (size_t)n + 1);
+			o += n + 1;
+			p += n + 1;
+		} else {
+			memcpy(o, "\xEF\xBF\xBD", 3);
+			o += 3;
+			p++;
+		}
+	}
+	*o = '\0';
+	return out;
+}
+
 /* Reads the DOC's glb (mlod_gltf_read_doc: buffers emptied by stripping,
  * as older packs hold them, are dropped). */
 static mlod_result read_doc(const void *glb, size_t size, mlod_gltf **doc, mlod_error *err)
@@ -456,6 +526,41 @@ static mlod_result read_doc(const void *glb, size_t size, mlod_gltf **doc, mlod_
 	if (r != MLOD_OK)
 		return mlod_fail(err, r == MLOD_ERR_NOMEM ? r : MLOD_ERR_PARSE, "DOC: %s", derr.message);
 	return MLOD_OK;
+}
+
+/* SKELETON's glTF indices are the DOC's (which keeps node and skin
+ * indices): a joint's node and a skin's glTF skin must be there. */
+static mlod_result check_skel_indices(const mlod_pack_skeleton *k, const mlod_gltf *doc, mlod_error *err)
+{
+	int nodes = mlod_gltf_count(doc, MLOD_GLTF_NODE), skins = mlod_gltf_count(doc, MLOD_GLTF_SKIN);
+	for (uint32_t j = 0; j < k->joint_count; j++)
+		if (k->joints[j].node >= nodes)
+			return mlod_fail(err, MLOD_ERR_PARSE, "SKELETON: joint %u: node %d is not one of the DOC chunk's %d "
+			                 "nodes", j, (int)k->joints[j].node, nodes);
+	for (uint32_t i = 0; i < k->skin_count; i++)
+		if (k->skins[i].gltf_index >= skins)
+			return mlod_fail(err, MLOD_ERR_PARSE, "SKELETON: skin %u: glTF skin %d is not one of the DOC chunk's "
+			                 "%d skins", i, (int)k->skins[i].gltf_index, skins);
+	return MLOD_OK;
+}
+
+mlod_result mlod_pack_check_doc(const mlod_pack *p, const void *data, size_t size, mlod_error *err)
+{
+	mlod_pack_doc_bytes glb;
+	mlod_pack_skeleton skel;
+	mlod_gltf *doc = NULL;
+	memset(&skel, 0, sizeof skel);
+	mlod_result r = mlod_pack_decode_doc(p, data, size, &glb, err);
+	if (r != MLOD_OK)
+		return r;
+	r = read_doc(glb.glb, glb.size, &doc, err);
+	mlod_pack_doc_free(&glb);
+	if (r == MLOD_OK && mlod_pack_find(p, MLOD_CHUNK_SKELETON, 0, 0) >= 0 &&
+	    (r = mlod_pack_decode_skeleton(p, data, size, &skel, err)) == MLOD_OK)
+		r = check_skel_indices(&skel, doc, err);
+	mlod_pack_skeleton_free(&skel);
+	mlod_gltf_free(doc);
+	return r;
 }
 
 mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlod_error *err)
@@ -470,11 +575,15 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	int *parts = NULL, *nodes = NULL, *mesh_map = NULL, *lod_nodes = NULL;
 	mlod_mat4 *world = NULL;
 	mlod_trs *local = NULL;
-	unsigned char *used = NULL;
+	unsigned char *used = NULL, *whole = NULL;
 	mlod_record_skel_level *skel_rec = NULL; /* the stage record's skeleton levels */
 	mlod_record_mesh_level *mesh_rec = NULL;  /* and mesh levels */
 	uint32_t mesh_levels = 0, skel_levels = 0;
 	int have_skel = 0, node_count = 0;
+	/* The chunk whose data the document is being built from: a glTF call
+	 * that refuses it as an argument (MLOD_ERR_INVALID_ARG) means a
+	 * corrupt pack, MLOD_ERR_PARSE with the chunk named (at done). */
+	char where[64] = "";
 	memset(&info, 0, sizeof info);
 	memset(&skel, 0, sizeof skel);
 	memset(&s, 0, sizeof s);
@@ -499,9 +608,14 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	mlod_pack_doc_free(&glb);
 	if (r != MLOD_OK)
 		goto done;
+	if ((r = whole_animations(doc, &whole, err)) != MLOD_OK)
+		goto done;
 	if ((r = build_skeleton(have_skel ? &skel : NULL, &s, err)) != MLOD_OK)
 		goto done;
 	node_count = mlod_gltf_count(doc, MLOD_GLTF_NODE);
+	if (have_skel && (r = check_skel_indices(&skel, doc, err)) != MLOD_OK)
+		goto done;
+	snprintf(where, sizeof where, "SKELETON");
 	/* The joints' nodes get back their rest TRS from SKEL, and the DOC's
 	 * skins the inverse bind matrices SKEL holds (the writer drops both
 	 * from the DOC unless they are the defaults). */
@@ -562,6 +676,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		}
 		if ((r = mlod_pack_decode_skel_level(&p, (uint32_t)c, data, size, &skel, &lv, err)) != MLOD_OK)
 			goto done;
+		snprintf(where, sizeof where, "SKELETON level %u", k);
 		r = add_level_skins(doc, &s, &lv, (int)k, &ls[k], err);
 		if (r == MLOD_OK)
 			r = record_skel_level(&s, &lv, &ls[k], (int)k, p.chunks[c].error, &skel_rec[k - 1], err);
@@ -662,6 +777,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			int count = node_parts(&meshes[0], node, parts);
 			const mlod_pack_part_rec *q0 = &meshes[0].parts[parts[0]].rec;
 			int like = q0->mesh, old_mesh = -1, old_skin = -1, mesh = -1;
+			snprintf(where, sizeof where, "MESH level 0");
 			if ((r = mlod_gltf_node_refs(doc, node, &old_mesh, &old_skin, err)) != MLOD_OK)
 				goto done;
 			/* Level 0: the node's own mesh again. */
@@ -699,6 +815,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 					goto done;
 				}
 				int skin = skin0, lmesh = -1, lnode = -1;
+				snprintf(where, sizeof where, "MESH level %d", k);
 				int **map = NULL;
 				if (q0->skin >= 0 && sl >= 1 && ls[sl].gltf && ls[sl].gltf[q0->skin] >= 0) {
 					map = ls[sl].map;
@@ -765,11 +882,9 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 				snprintf(name, sizeof name, "%s", info.clip_names[c]);
 			else
 				snprintf(name, sizeof name, "%s@lod%u", info.clip_names[c], k);
-			int anim = -1;
-			r = add_clip(doc, &s, &mo, name, &anim, err);
-			mlod_pack_motion_free(&mo);
-			int into = -1;
-			for (int a = 0; k == 0 && r == MLOD_OK && a < doc_anims; a++) {
+			int anim = -1, into = -1;
+			snprintf(where, sizeof where, "MOTION level %u of clip %u", k, c);
+			for (int a = 0; k == 0 && a < doc_anims; a++) {
 				a = mlod_gltf_find_animation(doc, name, a);
 				if (a < 0 || a >= doc_anims)
 					break;
@@ -779,10 +894,21 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 					break;
 				}
 			}
-			if (r == MLOD_OK && into >= 0) {
-				r = mlod_gltf_merge_animation(doc, into, err);
+			if (into >= 0 && whole && whole[into]) {
+				/* The DOC holds the input whole, this clip's joint
+				 * channels too: they stay as the clip (the input's keys,
+				 * within level 0's error of them), as the document's
+				 * channels cannot be taken out; merged, the level-0
+				 * channels would animate every joint twice. */
 				anim = into;
+			} else {
+				r = add_clip(doc, &s, &mo, name, &anim, err);
+				if (r == MLOD_OK && into >= 0) {
+					r = mlod_gltf_merge_animation(doc, into, err);
+					anim = into;
+				}
 			}
+			mlod_pack_motion_free(&mo);
 			/* Its record: level 0's error on the clip, a coarser level's
 			 * source clip and error on it. */
 			if (r == MLOD_OK && k == 0) {
@@ -805,6 +931,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 
 	/* The scene's record: skeleton and mesh levels (every writer above
 	 * stamped the version). */
+	snprintf(where, sizeof where, "SKELETON");
 	if (have_skel) { /* an empty list when the pack has level 0 alone */
 		int *full = malloc(sizeof(int) * ((size_t)s.skin_count + 1));
 		if (!full) {
@@ -821,10 +948,21 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		if (r != MLOD_OK)
 			goto done;
 	}
+	snprintf(where, sizeof where, "MESH");
 	if (mesh_levels > 0 && (r = mlod_record_write_mesh_levels(doc, mesh_rec, (int)mesh_levels - 1, err)) != MLOD_OK)
 		goto done;
-	if ((r = mlod_record_write_pack(doc, info.name, info.rec.bounds_min, info.rec.bounds_max, err)) != MLOD_OK)
-		goto done;
+	{
+		snprintf(where, sizeof where, "INFO");
+		char *name = utf8_name(info.name);
+		if (!name) {
+			r = nomem(err);
+			goto done;
+		}
+		r = mlod_record_write_pack(doc, name, info.rec.bounds_min, info.rec.bounds_max, err);
+		free(name);
+		if (r != MLOD_OK)
+			goto done;
+	}
 
 	/* The DOC's emptied meshes go. */
 	{
@@ -838,6 +976,11 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	*out = doc;
 	doc = NULL;
 done:
+	if (r == MLOD_ERR_INVALID_ARG && where[0] && err) {
+		char message[sizeof err->message];
+		snprintf(message, sizeof message, "%s", err->message);
+		r = mlod_fail(err, MLOD_ERR_PARSE, "%s: %s", where, message);
+	}
 	for (uint32_t k = 0; meshes && k < mesh_levels; k++)
 		mlod_pack_mesh_free(&meshes[k]);
 	free(meshes);
@@ -855,6 +998,7 @@ done:
 	free(world);
 	free(local);
 	free(used);
+	free(whole);
 	skeleton_free(&s);
 	mlod_gltf_free(doc);
 	mlod_pack_skeleton_free(&skel);
