@@ -3623,6 +3623,38 @@ mlod_result mlod_gltf_node_lod(const mlod_gltf *doc, int node, int *ids, int max
 	});
 }
 
+mlod_result mlod_gltf_primitive_attributes(const mlod_gltf *doc, int mesh, int primitive, int *mode, char ***names,
+                                           int *count, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && mode && names && count, "mlod_gltf_primitive_attributes: doc, mode, names and count must not be NULL");
+		*names = nullptr;
+		*count = 0;
+		const Model &m = doc->model;
+		if (mesh < 0 || mesh >= int(m.meshes.size()) || primitive < 0 ||
+		    primitive >= int(m.meshes[size_t(mesh)].primitives.size()))
+			fail(MLOD_ERR_INVALID_ARG, "mesh %d primitive %d does not exist", mesh, primitive);
+		const tinygltf::Primitive &p = m.meshes[size_t(mesh)].primitives[size_t(primitive)];
+		*mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+		size_t bytes = (p.attributes.size() + 1) * sizeof(char *);
+		for (const auto &kv : p.attributes)
+			bytes += kv.first.size() + 1;
+		char **out = static_cast<char **>(malloc(bytes));
+		if (!out)
+			throw std::bad_alloc();
+		char *text = reinterpret_cast<char *>(out + p.attributes.size() + 1);
+		int k = 0;
+		for (const auto &kv : p.attributes) { /* std::map: sorted by name */
+			out[k++] = text;
+			memcpy(text, kv.first.c_str(), kv.first.size() + 1);
+			text += kv.first.size() + 1;
+		}
+		out[k] = nullptr;
+		*names = out;
+		*count = k;
+	});
+}
+
 mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err)
 {
 	return guard(err, [&] {

@@ -214,6 +214,13 @@ mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err);
  * triangle lists only; the DOC keeps the others whole). */
 mlod_result mlod_gltf_append_other_primitives(mlod_gltf *doc, int from, int to, int *added, mlod_error *err);
 
+/* The names of the vertex attributes of primitive `primitive` of mesh
+ * `mesh`, sorted, and its mode (4 when the file gives none): *names is an
+ * array of *count strings and a NULL, in one block to release with
+ * mlod_free. */
+mlod_result mlod_gltf_primitive_attributes(const mlod_gltf *doc, int mesh, int primitive, int *mode, char ***names,
+                                           int *count, mlod_error *err);
+
 /* Removes MSFT_lod from node (and MSFT_screencoverage from its extras):
  * its former level nodes stay, without mesh or skin, so that node indices
  * hold. MSFT_lod leaves extensionsUsed when no node uses it any more. A

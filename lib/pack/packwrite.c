@@ -3245,187 +3245,6 @@ static int img_as_read(const motion_img *img, const mlod_clip *clip)
 /* Attributes the pack does not store                                  */
 /* ------------------------------------------------------------------ */
 
-/* A JSON walk over the document's text, just enough to list each
- * primitive's attribute names (lib/io decodes the attributes it knows and
- * leaves the others; the DOC chunk drops them with the rest of level 0). */
-typedef struct jwalk {
-	const char *p, *e;
-	int depth;
-} jwalk;
-
-static void jw_ws(jwalk *w)
-{
-	while (w->p < w->e && (*w->p == ' ' || *w->p == '\t' || *w->p == '\n' || *w->p == '\r'))
-		w->p++;
-}
-
-static int jw_hex(const char *p)
-{
-	int v = 0;
-	for (int i = 0; i < 4; i++) {
-		int c = p[i], d = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10
-		                  : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
-		if (d < 0)
-			return -1;
-		v = v * 16 + d;
-	}
-	return v;
-}
-
-/* A string (at its quote) into out (truncated to n - 1 bytes; \u escapes
- * outside ASCII as '?'); 0 on malformed text. */
-static int jw_string(jwalk *w, char *out, size_t n)
-{
-	size_t k = 0;
-	if (w->p >= w->e || *w->p != '"')
-		return 0;
-	w->p++;
-	while (w->p < w->e && *w->p != '"') {
-		char c = *w->p++;
-		if (c == '\\') {
-			if (w->p >= w->e)
-				return 0;
-			c = *w->p++;
-			if (c == 'u') {
-				int v = w->e - w->p >= 4 ? jw_hex(w->p) : -1;
-				if (v < 0)
-					return 0;
-				w->p += 4;
-				c = v > 0 && v < 0x80 ? (char)v : '?';
-			} else {
-				c = c == 'n' ? '\n' : c == 't' ? '\t' : c == 'r' ? '\r' : c == 'b' ? '\b' : c == 'f' ? '\f' : c;
-			}
-		}
-		if (out && k + 1 < n)
-			out[k++] = c;
-	}
-	if (out && n)
-		out[k] = '\0';
-	if (w->p >= w->e)
-		return 0;
-	w->p++;
-	return 1;
-}
-
-/* Skips one value; 0 on malformed text or nesting over 64. */
-static int jw_skip(jwalk *w)
-{
-	jw_ws(w);
-	if (w->p >= w->e)
-		return 0;
-	char c = *w->p;
-	if (c == '"')
-		return jw_string(w, NULL, 0);
-	if (c == '{' || c == '[') {
-		char close = c == '{' ? '}' : ']';
-		if (++w->depth > 64)
-			return 0;
-		w->p++;
-		jw_ws(w);
-		if (w->p < w->e && *w->p == close) {
-			w->p++;
-			w->depth--;
-			return 1;
-		}
-		for (;;) {
-			if (c == '{') {
-				jw_ws(w);
-				if (!jw_string(w, NULL, 0))
-					return 0;
-				jw_ws(w);
-				if (w->p >= w->e || *w->p++ != ':')
-					return 0;
-			}
-			if (!jw_skip(w))
-				return 0;
-			jw_ws(w);
-			if (w->p >= w->e)
-				return 0;
-			if (*w->p == ',') {
-				w->p++;
-				continue;
-			}
-			if (*w->p++ != close)
-				return 0;
-			w->depth--;
-			return 1;
-		}
-	}
-	while (w->p < w->e && *w->p != ',' && *w->p != '}' && *w->p != ']' && *w->p != ' ' && *w->p != '\n' &&
-	       *w->p != '\r' && *w->p != '\t')
-		w->p++;
-	return 1;
-}
-
-/* At an object: calls f for each member (w at its value, which f must
- * consume); 0 on malformed text. */
-static int jw_object(jwalk *w, int (*f)(jwalk *w, const char *key, void *arg), void *arg)
-{
-	jw_ws(w);
-	if (w->p >= w->e || *w->p != '{')
-		return jw_skip(w);
-	w->p++;
-	jw_ws(w);
-	if (w->p < w->e && *w->p == '}') {
-		w->p++;
-		return 1;
-	}
-	for (;;) {
-		char key[64];
-		jw_ws(w);
-		if (!jw_string(w, key, sizeof key))
-			return 0;
-		jw_ws(w);
-		if (w->p >= w->e || *w->p++ != ':')
-			return 0;
-		jw_ws(w);
-		if (!f(w, key, arg))
-			return 0;
-		jw_ws(w);
-		if (w->p >= w->e)
-			return 0;
-		if (*w->p == ',') {
-			w->p++;
-			continue;
-		}
-		return *w->p++ == '}';
-	}
-}
-
-/* At an array: calls f for each element with its index. */
-static int jw_array(jwalk *w, int (*f)(jwalk *w, int i, void *arg), void *arg)
-{
-	jw_ws(w);
-	if (w->p >= w->e || *w->p != '[')
-		return jw_skip(w);
-	w->p++;
-	jw_ws(w);
-	if (w->p < w->e && *w->p == ']') {
-		w->p++;
-		return 1;
-	}
-	for (int i = 0;; i++) {
-		jw_ws(w);
-		if (!f(w, i, arg))
-			return 0;
-		jw_ws(w);
-		if (w->p >= w->e)
-			return 0;
-		if (*w->p == ',') {
-			w->p++;
-			continue;
-		}
-		return *w->p++ == ']';
-	}
-}
-
-typedef struct attr_scan {
-	struct ctx *x;
-	int mesh, primitive, mode;
-	char names[16][64]; /* a primitive's unknown attributes (the first 16) */
-	int count;
-} attr_scan;
-
 /* An attribute name a part stores (mlod(5) MESH levels): POSITION,
  * NORMAL, TANGENT, TEXCOORD_0 to TEXCOORD_3 (MLOD_PACK_MAX_UV), COLOR_0,
  * JOINTS_n and WEIGHTS_n (the influences). */
@@ -3446,103 +3265,32 @@ static int known_attribute(const char *name)
 	return 0;
 }
 
-static int scan_attribute(jwalk *w, const char *key, void *arg)
-{
-	attr_scan *a = arg;
-	if (!known_attribute(key) && a->count < 16)
-		snprintf(a->names[a->count++], sizeof a->names[0], "%s", key);
-	return jw_skip(w);
-}
-
-static int scan_primitive_member(jwalk *w, const char *key, void *arg)
-{
-	attr_scan *a = arg;
-	if (!strcmp(key, "attributes"))
-		return jw_object(w, scan_attribute, a);
-	if (!strcmp(key, "mode")) {
-		const char *start = w->p;
-		if (!jw_skip(w))
-			return 0;
-		a->mode = (int)strtol(start, NULL, 10);
-		return 1;
-	}
-	return jw_skip(w);
-}
-
-static int scan_primitive(jwalk *w, int i, void *arg)
-{
-	attr_scan *a = arg;
-	a->primitive = i;
-	a->mode = 4;
-	a->count = 0;
-	if (!jw_object(w, scan_primitive_member, a))
-		return 0;
-	for (int k = 0; a->mode == 4 && k < a->count; k++) { /* points, lines, strips, fans: the DOC keeps them */
-		char text[160];
-		snprintf(text, sizeof text, "mesh %d primitive %d: attribute %s is not stored in the pack", a->mesh,
-		         a->primitive, a->names[k]);
-		note(a->x, text);
-	}
-	return 1;
-}
-
-static int scan_mesh_member(jwalk *w, const char *key, void *arg)
-{
-	return !strcmp(key, "primitives") ? jw_array(w, scan_primitive, arg) : jw_skip(w);
-}
-
-static int scan_mesh(jwalk *w, int i, void *arg)
-{
-	((attr_scan *)arg)->mesh = i;
-	return jw_object(w, scan_mesh_member, arg);
-}
-
-static int scan_root_member(jwalk *w, const char *key, void *arg)
-{
-	return !strcmp(key, "meshes") ? jw_array(w, scan_mesh, arg) : jw_skip(w);
-}
-
 /* Notes each attribute of a triangle list that the pack does not store
  * (_ID, any other custom or unknown name, a fifth UV set, a second
- * colour set),
- * from the input's JSON (a glb's JSON chunk, a .gltf's text) or the
- * document written as glb. Text it cannot walk gives no note. */
-static mlod_result note_unstored_attributes(struct ctx *x, const mlod_gltf *doc, mlod_format format,
-                                            const void *input, size_t input_size)
+ * colour set), from the document's primitives (lib/io lists them; the
+ * DOC chunk drops them with the rest of level 0). Points, lines, strips
+ * and fans stay whole in the DOC chunk: no note. */
+static mlod_result note_unstored_attributes(struct ctx *x, const mlod_gltf *doc)
 {
-	const unsigned char *in = input;
-	void *glb = NULL;
-	size_t glb_size = 0;
-	const char *json = NULL;
-	size_t n = 0;
-	if (format == MLOD_FORMAT_GLTF && input) {
-		json = input, n = input_size;
-	} else {
-		if (!(format == MLOD_FORMAT_GLB && input)) {
-			if (!doc || mlod_gltf_count(doc, MLOD_GLTF_MESH) == 0)
-				return MLOD_OK;
-			mlod_error werr = {0};
-			mlod_result r = mlod_gltf_write(doc, 1, &glb, &glb_size, &werr);
+	for (int mesh = 0; doc && mesh < mlod_gltf_count(doc, MLOD_GLTF_MESH); mesh++)
+		for (int p = 0;; p++) {
+			char **names = NULL;
+			int count = 0, mode = 4;
+			mlod_error e = {0};
+			mlod_result r = mlod_gltf_primitive_attributes(doc, mesh, p, &mode, &names, &count, &e);
 			if (r == MLOD_ERR_NOMEM)
-				return mlod_fail(x->err, r, "%s", werr.message);
-			if (r != MLOD_OK)
-				return MLOD_OK;
-			in = glb, input_size = glb_size;
+				return mlod_fail(x->err, r, "%s", e.message);
+			if (r != MLOD_OK) /* past the mesh's last primitive */
+				break;
+			for (int k = 0; mode == 4 && k < count; k++)
+				if (!known_attribute(names[k])) {
+					char text[160];
+					snprintf(text, sizeof text, "mesh %d primitive %d: attribute %.64s is not stored in the pack", mesh,
+					         p, names[k]);
+					note(x, text);
+				}
+			mlod_free(names);
 		}
-		if (input_size >= 20 && !memcmp(in + 16, "JSON", 4)) {
-			uint32_t len = (uint32_t)in[12] | (uint32_t)in[13] << 8 | (uint32_t)in[14] << 16 | (uint32_t)in[15] << 24;
-			if (len <= input_size - 20)
-				json = (const char *)in + 20, n = len;
-		}
-	}
-	if (json) {
-		jwalk w = {json, json + n, 0};
-		attr_scan a;
-		memset(&a, 0, sizeof a);
-		a.x = x;
-		jw_object(&w, scan_root_member, &a);
-	}
-	mlod_free(glb);
 	return MLOD_OK;
 }
 
@@ -3792,7 +3540,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		return r;
 	if ((r = make_view(&x)) != MLOD_OK || (r = measure(&x)) != MLOD_OK)
 		goto done;
-	if (mlod_mesh_triangle_primitives(&x.v) > 0 && (r = note_unstored_attributes(&x, doc, format, input, input_size)) != MLOD_OK)
+	if (mlod_mesh_triangle_primitives(&x.v) > 0 && (r = note_unstored_attributes(&x, doc)) != MLOD_OK)
 		goto done;
 
 	/* The levels of each layer. */
