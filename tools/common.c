@@ -364,32 +364,6 @@ int tool_parse_threads(const char *value)
 	return (int)v;
 }
 
-/* The length of the well-formed UTF-8 sequence at p (1 to 4), or 0 for
- * a byte that does not start one (overlong forms, surrogates and code
- * points past U+10FFFF are not well formed: RFC 3629). */
-static int utf8_length(const unsigned char *p)
-{
-	unsigned c = p[0];
-	int n = c < 0x80 ? 1 : c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
-	if (n <= 1)
-		return n;
-	unsigned lo = 0x80, hi = 0xbf; /* the second byte's range */
-	if (c == 0xe0)
-		lo = 0xa0;
-	else if (c == 0xed)
-		hi = 0x9f;
-	else if (c == 0xf0)
-		lo = 0x90;
-	else if (c == 0xf4)
-		hi = 0x8f;
-	if (p[1] < lo || p[1] > hi)
-		return 0;
-	for (int i = 2; i < n; i++)
-		if (p[i] < 0x80 || p[i] > 0xbf)
-			return 0;
-	return n;
-}
-
 /* The one escaper of a name from the input or the pack (the
  * character's, a clip's, a joint's, the input's, a note naming a joint or
  * mesh): as a JSON string (quote, backslash and control characters escaped, a
@@ -408,7 +382,7 @@ static int put_name(FILE *f, const char *name, int json, int width)
 	while (*p) {
 		char esc[8];
 		const char *out = esc;
-		int n = utf8_length(p), cols;
+		int n = mlod_utf8_length((const char *)p), cols;
 		unsigned c = *p;
 		size_t len;
 		if (n > 1) { /* a character, one column */

@@ -1,7 +1,8 @@
 /*
  * mlod_core.h: the common core of mlod, shared by the bake library and the
- * runtime (lib/rt): result codes and their messages, and the small math
- * (vectors, quaternions, 4x4 matrices, TRS, Euler angles) both sides use.
+ * runtime (lib/rt): result codes and their messages, UTF-8 checks, and the
+ * small math (vectors, quaternions, 4x4 matrices, TRS, Euler angles) both
+ * sides use.
  * It depends on nothing but the C library and POSIX threads (for
  * mlod_parallel_for), and nothing in it allocates but mlod_free's
  * counterpart.
@@ -60,6 +61,17 @@ mlod_result mlod_fail(mlod_error *err, mlod_result code, const char *fmt, ...)
 
 /* Releases a buffer returned by the library (glb bytes, JSON text, ...). */
 void mlod_free(void *p);
+
+/* ------------------------------------------------------------------ */
+/* Text                                                                */
+/* ------------------------------------------------------------------ */
+
+/* The length (1 to 4) of the well-formed UTF-8 sequence at s, 0 for a
+ * byte that does not start one (overlong forms, surrogates and code
+ * points past U+10FFFF are not well formed: RFC 3629), and 1 for the NUL
+ * that ends s (a sequence the NUL cuts short is not well formed). The
+ * writers of JSON text put U+FFFD for such a byte. */
+int mlod_utf8_length(const char *s);
 
 /* ------------------------------------------------------------------ */
 /* Threads                                                             */

@@ -178,26 +178,12 @@ bool known_path(const std::string &p)
 std::string utf8(const char *s)
 {
 	std::string out;
-	const unsigned char *p = reinterpret_cast<const unsigned char *>(s ? s : "");
-	while (*p) {
-		unsigned c = *p;
-		int n = c < 0x80 ? 0 : c >= 0xC2 && c <= 0xDF ? 1 : c >= 0xE0 && c <= 0xEF ? 2 : c >= 0xF0 && c <= 0xF4 ? 3 : -1;
-		bool ok = n >= 0;
-		for (int k = 1; ok && k <= n; k++) {
-			unsigned lo = 0x80, hi = 0xBF;
-			if (k == 1 && c == 0xE0) lo = 0xA0;
-			if (k == 1 && c == 0xED) hi = 0x9F;
-			if (k == 1 && c == 0xF0) lo = 0x90;
-			if (k == 1 && c == 0xF4) hi = 0x8F;
-			ok = p[k] >= lo && p[k] <= hi;
-		}
-		if (ok) {
-			out.append(reinterpret_cast<const char *>(p), size_t(n) + 1);
-			p += n + 1;
-		} else {
-			out += "\xEF\xBF\xBD";
-			p++;
-		}
+	for (const char *p = s ? s : ""; *p;) {
+		int n = mlod_utf8_length(p);
+		if (n > 0)
+			out.append(p, size_t(n)), p += n;
+		else
+			out += "\xEF\xBF\xBD", p++;
 	}
 	return out;
 }

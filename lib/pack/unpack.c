@@ -477,46 +477,6 @@ static mlod_result whole_animations(const mlod_gltf *doc, unsigned char **out, m
 	return MLOD_OK;
 }
 
-/* name with every byte that is not UTF-8 as U+FFFD (the rules of
- * lib/io's names read): the record's JSON text must be UTF-8, and a
- * pack's name is the caller's bytes (a Latin-1 file name, --name).
- * NULL when out of memory; release with free. */
-static char *utf8_name(const char *name)
-{
-	const unsigned char *p = (const unsigned char *)(name ? name : "");
-	char *out = malloc(3 * strlen((const char *)p) + 1), *o = out;
-	if (!out)
-		return NULL;
-	while (*p) {
-		unsigned c = *p;
-		int n = c < 0x80 ? 0 : c >= 0xC2 && c <= 0xDF ? 1 : c >= 0xE0 && c <= 0xEF ? 2 : c >= 0xF0 && c <= 0xF4 ? 3 : -1;
-		int ok = n >= 0;
-		for (int k = 1; ok && k <= n; k++) {
-			unsigned lo = 0x80, hi = 0xBF;
-			if (k == 1 && c == 0xE0)
-				lo = 0xA0;
-			if (k == 1 && c == 0xED)
-				hi = 0x9F;
-			if (k == 1 && c == 0xF0)
-				lo = 0x90;
-			if (k == 1 && c == 0xF4)
-				hi = 0x8F;
-			ok = p[k] >= lo && p[k] <= hi;
-		}
-		if (ok) {
-			memcpy(o, p, (size_t)n + 1);
-			o += n + 1;
-			p += n + 1;
-		} else {
-			memcpy(o, "\xEF\xBF\xBD", 3);
-			o += 3;
-			p++;
-		}
-	}
-	*o = '\0';
-	return out;
-}
-
 /* Reads the DOC's glb (mlod_gltf_read_doc: buffers emptied by stripping,
  * as older packs hold them, are dropped). */
 static mlod_result read_doc(const void *glb, size_t size, mlod_gltf **doc, mlod_error *err)
@@ -953,14 +913,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		goto done;
 	{
 		snprintf(where, sizeof where, "INFO");
-		char *name = utf8_name(info.name);
-		if (!name) {
-			r = nomem(err);
-			goto done;
-		}
-		r = mlod_record_write_pack(doc, name, info.rec.bounds_min, info.rec.bounds_max, err);
-		free(name);
-		if (r != MLOD_OK)
+		/* the record's writer puts a byte of the name that is not UTF-8 as U+FFFD */
+		if ((r = mlod_record_write_pack(doc, info.name, info.rec.bounds_min, info.rec.bounds_max, err)) != MLOD_OK)
 			goto done;
 	}
 

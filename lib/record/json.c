@@ -1,5 +1,6 @@
 /* json.c: the record module's strict JSON reader and compact writer (json.h). */
 #include "json.h"
+#include "mlod_core.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -504,8 +505,14 @@ static void put_string(struct out *o, const char *s)
 		} else if (*p < 0x20) {
 			snprintf(esc, sizeof esc, "\\u%04x", *p);
 			put(o, esc, 6);
-		} else {
+		} else if (*p < 0x80) {
 			put(o, (const char *)p, 1);
+		} else { /* JSON text is UTF-8: a byte that does not start a well-formed sequence as U+FFFD */
+			int n = mlod_utf8_length((const char *)p);
+			if (n == 0)
+				put(o, "\xEF\xBF\xBD", 3);
+			else
+				put(o, (const char *)p, (size_t)n), p += n - 1;
 		}
 	}
 	put(o, "\"", 1);
