@@ -114,29 +114,6 @@ static void parse_level0(const char *value, mlod_pack_options *opt)
 
 /* Level 0 is the finest motion level: its bound must be below the smallest
  * of --motion-max-error's (compared in scene units, by the height). */
-static void check_level0(const mlod_pack_options *o, mlod_character *c, mlod_gltf *doc, void *bytes, const char *label)
-{
-	if (o->lossless_motion || o->no_motion_levels || c->clip_count == 0 || !(o->motion_level0_error > 0.0))
-		return;
-	double h = c->skeleton.joint_count > 0 ? mlod_skeleton_height(&c->skeleton) : 0.0, e1 = 0.0;
-	double e0 = o->motion_level0_percent ? o->motion_level0_error * h / 100.0 : o->motion_level0_error;
-	int first = -1;
-	for (int b = 0; b < o->motion_bound_count; b++) {
-		double e = o->motion_percent[b] ? o->motion_bounds[b] * h / 100.0 : o->motion_bounds[b];
-		if (first < 0 || e < e1)
-			first = b, e1 = e;
-	}
-	if (!(first >= 0 && e0 >= e1))
-		return;
-	free(bytes); /* the input, released before exiting (leak checkers) */
-	mlod_character_free(c);
-	mlod_gltf_free(doc);
-	tool_die(EXIT_USAGE, label, "--motion-level0-error %g%s (%.4g units) is not below the first motion level's "
-	         "bound, --motion-max-error %g%s (%.4g units of a height of %.4g)", o->motion_level0_error,
-	         o->motion_level0_percent ? "%" : "", e0, o->motion_bounds[first], o->motion_percent[first] ? "%" : "", e1,
-	         h);
-}
-
 static const char *source(const mlod_pack_layer_stats *l)
 {
 	return l->levels <= 1 ? "-" : l->from_input ? "input" : "computed";
@@ -220,19 +197,9 @@ static int pack_info(const char *path, enum tool_report report)
 	mlod_pack p;
 	mlod_pack_info info;
 	mlod_error err = {0};
-	memset(&info, 0, sizeof info);
-	mlod_result r = mlod_pack_open(data, size, &p, &err);
-	if (r == MLOD_OK)
-		r = mlod_pack_check(&p, data, size, &err);
-	if (r == MLOD_OK)
-		r = mlod_pack_check_doc(&p, data, size, &err);
+	mlod_result r = mlod_pack_inspect(data, size, &p, &info, &err);
 	if (r != MLOD_OK)
 		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
-	if (p.file_size != size)
-		tool_die(EXIT_INPUT, label, "the header says %llu bytes, the file has %zu", (unsigned long long)p.file_size,
-		         size);
-	if ((r = mlod_pack_decode_info(&p, data, size, &info, &err)) != MLOD_OK)
-		tool_die(tool_exit_code(r), label, "%s", err.message);
 	const mlod_pack_info_rec *ir = &info.rec;
 	pack_totals t;
 	memset(&t, 0, sizeof t);
@@ -477,7 +444,6 @@ int main(int argc, char **argv)
 	size_t size = 0;
 	memset(&c, 0, sizeof c);
 	void *bytes = tool_load_keep(path, &doc, &c, &format, &size);
-	check_level0(&opt, &c, doc, bytes, label);
 
 	mlod_pack_stats st;
 	mlod_error err = {0};

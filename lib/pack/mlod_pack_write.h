@@ -318,6 +318,13 @@ mlod_result mlod_pack_unpack(const void *pack, size_t size, mlod_gltf **out, mlo
  * the chunk ("DOC: ...", "SKELETON: ...") for a corrupt pack. */
 mlod_result mlod_pack_check_doc(const mlod_pack *p, const void *data, size_t size, mlod_error *err);
 
+/* Opens a whole pack and checks everything mlod_pack_unpack would
+ * (mlod_pack_check, mlod_pack_check_doc, the header's size against size),
+ * then decodes its INFO chunk into *info: what mlod-pack --info prints.
+ * On success release with mlod_pack_info_free and mlod_pack_close; on
+ * failure nothing is left to release. */
+mlod_result mlod_pack_inspect(const void *data, size_t size, mlod_pack *p, mlod_pack_info *info, mlod_error *err);
+
 #ifdef __cplusplus
 }
 #endif

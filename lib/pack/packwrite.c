@@ -3506,6 +3506,30 @@ static uint64_t layer_bytes(const chunks *ch, int layer, int raw)
 	return n;
 }
 
+/* Level 0 is the finest motion level: its bound (motion_level0_error)
+ * must be below the smallest of the coarser levels' (motion_bounds),
+ * each in units or % of the character's height. */
+static mlod_result check_level0_bound(const mlod_pack_options *o, const mlod_character *c, mlod_error *err)
+{
+	if (o->lossless_motion || o->no_motion_levels || c->clip_count == 0 || !(o->motion_level0_error > 0.0))
+		return MLOD_OK;
+	double h = c->skeleton.joint_count > 0 ? mlod_skeleton_height(&c->skeleton) : 0.0, e1 = 0.0;
+	double e0 = o->motion_level0_percent ? o->motion_level0_error * h / 100.0 : o->motion_level0_error;
+	int first = -1;
+	for (int b = 0; b < o->motion_bound_count; b++) {
+		double e = o->motion_percent[b] ? o->motion_bounds[b] * h / 100.0 : o->motion_bounds[b];
+		if (first < 0 || e < e1)
+			first = b, e1 = e;
+	}
+	if (!(first >= 0 && e0 >= e1))
+		return MLOD_OK;
+	return mlod_fail(err, MLOD_ERR_INVALID_ARG,
+	                 "motion level 0's bound %g%s (%.4g units) is not below the first motion level's bound, "
+	                 "%g%s (%.4g units of a height of %.4g): level 0 is the finest",
+	                 o->motion_level0_error, o->motion_level0_percent ? "%" : "", e0, o->motion_bounds[first],
+	                 o->motion_percent[first] ? "%" : "", e1, h);
+}
+
 mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_format format, const void *input,
                             size_t input_size, const mlod_pack_options *opt, void **out, size_t *out_size,
                             mlod_pack_stats *stats, mlod_error *err)
@@ -3523,6 +3547,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "unknown codec %d", (int)opt->codec);
 	if (opt->entropy != MLOD_ENTROPY_NONE && opt->entropy != MLOD_ENTROPY_ZSTD)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "unknown entropy stage %d", opt->entropy);
+	if ((r = check_level0_bound(opt, c, err)) != MLOD_OK)
+		return r;
 	memset(&x, 0, sizeof x);
 	x.doc = doc;
 	x.in = c;

@@ -523,6 +523,24 @@ mlod_result mlod_pack_check_doc(const mlod_pack *p, const void *data, size_t siz
 	return r;
 }
 
+mlod_result mlod_pack_inspect(const void *data, size_t size, mlod_pack *p, mlod_pack_info *info, mlod_error *err)
+{
+	memset(info, 0, sizeof *info);
+	mlod_result r = mlod_pack_open(data, size, p, err);
+	if (r != MLOD_OK)
+		return r;
+	if ((r = mlod_pack_check(p, data, size, err)) == MLOD_OK && (r = mlod_pack_check_doc(p, data, size, err)) == MLOD_OK) {
+		if (p->file_size != size)
+			r = mlod_fail(err, MLOD_ERR_PARSE, "the header says %llu bytes, the file has %zu",
+			              (unsigned long long)p->file_size, size);
+		else
+			r = mlod_pack_decode_info(p, data, size, info, err);
+	}
+	if (r != MLOD_OK)
+		mlod_pack_close(p);
+	return r;
+}
+
 mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlod_error *err)
 {
 	mlod_pack p;
