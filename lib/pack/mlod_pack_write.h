@@ -94,7 +94,8 @@ typedef struct mlod_pack_options {
 	double point_distance;       /* 0: 0.1 for glTF, height / 18 for BVH (as mlod-motion) */
 	/* motion level 0 (computed or piped alike): the input clip within this
 	 * point error bound (keys reduced, values rounded), or as read */
-	double motion_level0_error;  /* > 0; 0: as read */
+	double motion_level0_error;  /* > 0 and below the smallest of motion_bounds (else mlod_pack_write
+	                              * is MLOD_ERR_INVALID_ARG: level 0 is the finest); 0: as read */
 	unsigned char motion_level0_percent; /* in % of the height, else scene units */
 	int lossless_motion;         /* level 0 as read whatever motion_level0_error says */
 	/* each layer can be left at level 0 alone */
