@@ -87,6 +87,23 @@ static double quat_dot(mlod_quat a, mlod_quat b)
 	return (double)a.x * b.x + (double)a.y * b.y + (double)a.z * b.z + (double)a.w * b.w;
 }
 
+double mlod_quat4_length(double x, double y, double z, double w)
+{
+	const double v[4] = { x, y, z, w };
+	double m = 0.0;
+	for (int i = 0; i < 4; i++) {
+		if (!isfinite(v[i]))
+			return NAN;
+		m = fmax(m, fabs(v[i]));
+	}
+	if (m == 0.0)
+		return 0.0;
+	double s = 0.0;
+	for (int i = 0; i < 4; i++)
+		s += (v[i] / m) * (v[i] / m);
+	return m * sqrt(s);
+}
+
 mlod_quat mlod_quat_normalize(mlod_quat q)
 {
 	double n = sqrt(quat_dot(q, q));

@@ -98,6 +98,16 @@ mlod_result mlod_parallel_for(int n, int threads, mlod_parallel_fn fn, void *ctx
 
 #define MLOD_PI 3.14159265358979323846
 
+/* The largest |length - 1| of a rotation quaternion taken as unit: the
+ * Khronos glTF validator's (ROTATION_NON_UNIT past it). The glTF reader
+ * normalises a node rotation past it, with a note; the pack reader
+ * refuses a joint's rest rotation past it. */
+#define MLOD_UNIT_QUAT_TOLERANCE 0.00769
+
+/* The length of (x, y, z, w) in double, without overflow: NaN when a
+ * component is not finite. */
+double mlod_quat4_length(double x, double y, double z, double w);
+
 /* a wrapped into (-pi, pi]: an angle difference taken the short way. */
 double mlod_wrap_angle(double a);
 

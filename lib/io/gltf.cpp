@@ -68,6 +68,11 @@ struct mlod_gltf {
 	/* The roots of the scene the reader added to a document without one
 	 * (0: none added). */
 	int scene_added = 0;
+	/* Node rotations the reader normalised (not unit within
+	 * MLOD_UNIT_QUAT_TOLERANCE), the first of them and its length. */
+	int rotations_normalised = 0;
+	int rotation_node = -1;
+	double rotation_length = 0.0;
 };
 
 namespace {
@@ -1220,6 +1225,32 @@ void add_scene_if_none(mlod_gltf &doc)
 	doc.scene_added = int(scene.nodes.size());
 }
 
+/* A node rotation further from unit length than the validator takes is
+ * normalised: the rest pose a viewer shows, and a document the tools can
+ * write valid. A rotation of length 0 has no direction: refused. */
+void normalise_node_rotations(mlod_gltf &doc)
+{
+	for (size_t i = 0; i < doc.model.nodes.size(); i++) {
+		std::vector<double> &r = doc.model.nodes[i].rotation;
+		if (r.size() != 4)
+			continue;
+		const double len = mlod_quat4_length(r[0], r[1], r[2], r[3]);
+		if (std::fabs(len - 1.0) <= MLOD_UNIT_QUAT_TOLERANCE)
+			continue;
+		if (!(len > 0.0))
+			fail(MLOD_ERR_PARSE, "node %zu: rotation (%g, %g, %g, %g) is not a quaternion of any direction", i, r[0],
+			     r[1], r[2], r[3]);
+		double m = 0.0;
+		for (double v : r)
+			m = std::max(m, std::fabs(v));
+		const double scaled = len / m; /* finite where len overflows */
+		for (double &v : r)
+			v = v / m / scaled;
+		if (doc.rotations_normalised++ == 0)
+			doc.rotation_node = int(i), doc.rotation_length = len;
+	}
+}
+
 void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const char *base_dir)
 {
 	if (size == 0)
@@ -1278,6 +1309,7 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 	collect_extras(j, "", doc.extras);
 	doc.original = std::move(j);
 	add_scene_if_none(doc);
+	normalise_node_rotations(doc);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1533,6 +1565,12 @@ public:
 		if (doc_.scene_added)
 			note("the input has no scene: scene 0 added with its %d root node%s, for the stage record", doc_.scene_added,
 			     doc_.scene_added == 1 ? "" : "s");
+		if (doc_.rotations_normalised) {
+			const tinygltf::Node &n = m_.nodes[size_t(doc_.rotation_node)];
+			note("%d node rotation%s normalised (not unit quaternions: node %d%s%s%s has length %g)",
+			     doc_.rotations_normalised, doc_.rotations_normalised == 1 ? "" : "s", doc_.rotation_node,
+			     n.name.empty() ? "" : " \"", n.name.c_str(), n.name.empty() ? "" : "\"", doc_.rotation_length);
+		}
 		graph();
 		skeleton();
 		skins();

@@ -129,7 +129,7 @@ typedef struct mlod_pack_stats {
 	uint32_t chunks, first_drawable;
 	int joints, skins, parts, clips;
 	float height, diagonal;
-	char notes[1024];            /* what was done or skipped, "; "-separated */
+	char notes[1024];            /* the reader's notes on the input, then what was done or skipped, "; "-separated */
 } mlod_pack_stats;
 
 /* Packs the character c read from doc (mlod_load of input, input_size

@@ -3562,6 +3562,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	x.st = stats ? stats : &local_stats;
 	x.err = err;
 	memset(x.st, 0, sizeof *x.st);
+	if (c->notes && *c->notes) /* the reader's, first */
+		note(&x, c->notes);
 	if (doc && (r = mlod_record_read(doc, &x.rec, err)) != MLOD_OK)
 		return r;
 	if ((r = make_view(&x)) != MLOD_OK || (r = measure(&x)) != MLOD_OK)

@@ -1326,6 +1326,10 @@ mlod_result mlod_pack_decode_skeleton(const mlod_pack *p, const void *data, size
 			FAIL("%s: joint %u: parent %d is not -1 or an earlier joint", x.label, j, jt->parent);
 		if (!all_finite(jt->t, 3) || !all_finite(jt->r, 4) || !all_finite(jt->s, 3) || !all_finite(jt->base, 16))
 			FAIL("%s: joint %u: a rest transform or base value is not finite", x.label, j);
+		const double len = mlod_quat4_length(jt->r[0], jt->r[1], jt->r[2], jt->r[3]);
+		if (!(fabs(len - 1.0) <= MLOD_UNIT_QUAT_TOLERANCE))
+			FAIL("%s: joint %u: its rest rotation has length %g, not a unit quaternion (within %g)", x.label, j, len,
+			     MLOD_UNIT_QUAT_TOLERANCE);
 		if (jt->node < -1)
 			FAIL("%s: joint %u: node %d is not -1 or a node", x.label, j, jt->node);
 		TRY(name_at(&x, names, sn.count, jt->name, &joint_names[j], what, err));
