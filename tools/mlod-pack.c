@@ -199,7 +199,7 @@ static int pack_info(const char *path, enum tool_report report)
 	mlod_error err = {0};
 	mlod_result r = mlod_pack_inspect(data, size, &p, &info, &err);
 	if (r != MLOD_OK)
-		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
+		tool_die(tool_exit_code(r), label, "%s", err.message);
 	const mlod_pack_info_rec *ir = &info.rec;
 	pack_totals t;
 	memset(&t, 0, sizeof t);
@@ -295,7 +295,7 @@ static int pack_extract(const char *path, const char *output)
 	mlod_result r = mlod_pack_unpack(data, size, &doc, &err);
 	free(data);
 	if (r != MLOD_OK)
-		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
+		tool_die(tool_exit_code(r), label, "%s", err.message);
 	tool_write_gltf(output, doc);
 	mlod_gltf_free(doc);
 	return 0;
@@ -452,7 +452,7 @@ int main(int argc, char **argv)
 	mlod_result r = mlod_pack_write(doc, &c, format, bytes, size, &opt, &pack, &pack_size, &st, &err);
 	free(bytes);
 	if (r != MLOD_OK)
-		tool_die(r == MLOD_ERR_NOMEM ? EXIT_OUTPUT : tool_exit_code(r), label, "%s", err.message);
+		tool_die(tool_exit_code(r), label, "%s", err.message);
 	if (c.clip_count == 0 && c.skeleton.joint_count > 0)
 		fprintf(stderr, "%s: %s: no animation: the pack has no motion levels\n", tool_name, label);
 	if (output || report == REPORT_NONE)
