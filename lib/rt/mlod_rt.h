@@ -82,14 +82,19 @@
  * mlod_rt_request asks for it) and decoded only inside
  * mlod_rt_stream(ctx, byte_budget). Resident bytes (the decoded levels plus
  * the runtime's per-level tables, counted from their arrays) never exceed
- * the budget, not even while a level decodes: before decoding, stream
- * makes room for an upper bound of the level's size (its size for views;
- * 4 x the TOC's raw size plus the runtime's tables for packs), evicting
- * resident levels that no instance wanted at the last update, least
- * recently wanted first; it never evicts a level that was wanted at the
- * last update nor a coarsest level. A level that cannot fit stays unloaded
- * and is tried again when room appears. (The reader's own scratch while
- * one chunk decodes is not counted.)
+ * the budget, not even while a level decodes: before a level's decoded
+ * arrays are allocated, stream makes room for them: for a pack's mesh
+ * level its exact size (the reader reads the level's part records first,
+ * and the room is what those records decode to plus the runtime's
+ * tables; remembered, so a level that does not fit is not decoded again
+ * until room appears); for other levels an upper bound, before decoding
+ * (their size for views; 4 x the TOC's raw size plus the runtime's tables
+ * for packs). Room is made by evicting resident levels that no instance
+ * wanted at the last update, least recently wanted first; it never evicts
+ * a level that was wanted at the last update nor a coarsest level. A
+ * level that cannot fit stays unloaded and is tried again when room
+ * appears. (The reader's own scratch while one chunk decodes is not
+ * counted.)
  *
  * Fallback. An instance shows, per layer, the wanted level when resident,
  * else the finest resident level coarser than the wanted one (the coarsest

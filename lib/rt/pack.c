@@ -15,7 +15,9 @@
  * coarser MESH chunk, each checked like any chunk, into scratch sized from
  * their TOC raw sizes (freed before the decode returns), then gathers the
  * vertices its indices use; its block is sized from its part records,
- * whose vertex counts the gathering must meet exactly.
+ * whose vertex counts the gathering must meet exactly (the runtime's
+ * mlod_pack_decode_mesh_reserve, pack_internal.h, is called with those
+ * records before the block is allocated).
  *
  * Byte order: the format is little-endian, and so must the host be (the
  * index codec's output and the records are read with memcpy); the
@@ -34,6 +36,7 @@
 #include <zstd.h>
 
 #include "mlod_pack.h"
+#include "pack_internal.h"
 #if MLOD_DRACO
 #include "rt_draco.h"
 #endif
@@ -1657,6 +1660,8 @@ typedef struct mesh_src {
 	size_t size;
 	mlod_pack_fetch_fn fetch;
 	void *user;
+	mlod_pack_reserve_fn reserve; /* or NULL (pack_internal.h) */
+	void *reserve_user;
 } mesh_src;
 
 /* cx_begin on a MESH chunk from m; prefix: the coarser levels' containers
@@ -1898,6 +1903,8 @@ static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const ml
 		FAIL("%s: its part records say %llu decoded bytes, more than %d times its %llu-byte container (Draco "
 		     "levels expand no more)",
 		     x.label, (unsigned long long)total, PACK_DRACO_MAX_EXPAND, (unsigned long long)x.size);
+	if (m->reserve)
+		TRY(m->reserve(m->reserve_user, recs, (uint32_t)P, err));
 	TRY(bump_alloc(&b, &x, total, err));
 	if (!(gather = pk_malloc(al, 1, (size_t)big)))
 		FAIL_NOMEM("%s: out of memory", x.label);
@@ -2214,6 +2221,10 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			FAIL("%s: its parts' prefixes (%llu vertices) are larger than the reader's limit", x.label,
 			     (unsigned long long)big_prefix);
 		}
+		if (m->reserve && (r = m->reserve(m->reserve_user, recs, (uint32_t)P, err)) != MLOD_OK) {
+			pk_free(al, recs);
+			goto fail;
+		}
 		r = bump_alloc(&b, &x, total, err);
 		work = pk_malloc(al, 1, (size_t)(8 * big_prefix + big_v + 8));
 		if (work) {
@@ -2390,7 +2401,16 @@ fail:
 mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
                                   const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err)
 {
-	mesh_src m = {p, data, size, NULL, NULL};
+	mesh_src m = {p, data, size, NULL, NULL, NULL, NULL};
+	return decode_mesh(&m, chunk, skel, out, err);
+}
+
+mlod_result mlod_pack_decode_mesh_reserve(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                          mlod_pack_fetch_fn fetch, void *fetch_user, mlod_pack_reserve_fn reserve,
+                                          void *reserve_user, const mlod_pack_skeleton *skel, mlod_pack_mesh *out,
+                                          mlod_error *err)
+{
+	mesh_src m = {p, fetch ? NULL : data, fetch ? 0 : size, fetch, fetch_user, reserve, reserve_user};
 	return decode_mesh(&m, chunk, skel, out, err);
 }
 
@@ -2402,7 +2422,7 @@ mlod_result mlod_pack_decode_mesh_fetch(const mlod_pack *p, uint32_t chunk, mlod
 			memset(out, 0, sizeof *out);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_mesh_fetch: fetch is NULL");
 	}
-	mesh_src m = {p, NULL, 0, fetch, user};
+	mesh_src m = {p, NULL, 0, fetch, user, NULL, NULL};
 	return decode_mesh(&m, chunk, skel, out, err);
 }
 

@@ -78,6 +78,30 @@ size_t rt_bytes_skel_level(const mlod_pack_skel_level *l)
 	return sizeof *l + (size_t)l->kept_count * 4 + (size_t)l->palette_size * (4 + 64);
 }
 
+/* rt_bytes_mesh of the level the pack reader decodes from these part
+ * records (its arrays follow the records' flags, UV sets and target
+ * counts exactly, lib/rt/pack.c part_dequant): the same count. */
+static size_t rt_bytes_mesh_recs(const mlod_pack_part_rec *recs, uint32_t n)
+{
+	size_t b = sizeof(mlod_pack_mesh);
+	for (uint32_t i = 0; i < n; i++) {
+		const mlod_pack_part_rec *r = &recs[i];
+		size_t v = r->vertex_count, per = 12 + 8 * (size_t)r->uv_sets;
+		if (r->flags & MLOD_PART_NORMALS)
+			per += 12;
+		if (r->flags & MLOD_PART_TANGENTS)
+			per += 16;
+		if (r->flags & MLOD_PART_COLORS)
+			per += 16;
+		if (r->flags & MLOD_PART_SKINNED)
+			per += 8 + 16;
+		b += sizeof(mlod_pack_part) + v * per + (size_t)r->index_count * 4;
+		if (r->target_count)
+			b += (size_t)r->target_count * (sizeof(float *) + v * 12);
+	}
+	return b;
+}
+
 size_t rt_bytes_mesh(const mlod_pack_mesh *m)
 {
 	size_t b = sizeof *m;
@@ -454,6 +478,16 @@ static size_t skin_order_bytes(const mlod_pack_mesh *m)
 	return b;
 }
 
+/* The bytes prepare_mesh allocates for a level of these part records. */
+static size_t mesh_plan_bytes(const mlod_rt_ctx *ctx, const mlod_pack_part_rec *recs, uint32_t n)
+{
+	size_t b = 4 * ((size_t)ctx->palette_size + ctx->joint_count) + 4 * (size_t)n;
+	for (uint32_t i = 0; i < n; i++)
+		if (recs[i].skin >= 0)
+			b += RT_SKIN_ORDER_BYTES(recs[i].vertex_count);
+	return b;
+}
+
 /* Checks a mesh level and lists what skinning it reads (u->pal_used, the
  * palette entries, and u->rigid, the joints of its rigid parts), so that
  * mlod_rt_skin poses and multiplies only those. The kernel reads a
@@ -628,6 +662,36 @@ static size_t evictable_bytes(const mlod_rt_ctx *ctx)
 	return b;
 }
 
+/* Evicts least recently wanted levels until need more bytes fit the
+ * budget; 0 when they do, -1 when they cannot (nothing is evicted then). */
+static int make_room(mlod_rt_ctx *ctx, size_t need)
+{
+	if (need > ctx->budget || ctx->resident_bytes - evictable_bytes(ctx) > ctx->budget - need)
+		return -1;
+	while (ctx->resident_bytes > ctx->budget - need) {
+		rt_unit *v = lru_victim(ctx);
+		if (!v)
+			return -1; /* unreachable: evictable_bytes counted the victims */
+		unit_release(ctx, v);
+		ctx->evictions++;
+	}
+	return 0;
+}
+
+mlod_result rt_mesh_reserve(void *user, const mlod_pack_part_rec *parts, uint32_t part_count, mlod_error *err)
+{
+	mlod_rt_ctx *ctx = user;
+	rt_unit *u = ctx->loading;
+	if (!u)
+		return MLOD_OK;
+	u->need = rt_bytes_mesh_recs(parts, part_count) + mesh_plan_bytes(ctx, parts, part_count);
+	if (!ctx->streaming || make_room(ctx, u->need) == 0)
+		return MLOD_OK;
+	ctx->refused = 1;
+	return mlod_fail(err, MLOD_ERR_LIMIT, "mesh level %u: its %zu decoded bytes do not fit the budget", u->level,
+	                 u->need);
+}
+
 /* motion_plan_bytes of a motion level's views, bounding its joints with
  * one-key channels only by the joints and by its one-key channels. */
 static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m)
@@ -641,17 +705,15 @@ static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m
 
 /* An upper bound of a unit's resident size before loading it, so that
  * room is made before decoding and resident bytes never pass the budget,
- * not even while a level decodes. Views know their size. For packs:
- * dequantising at most quadruples a stream (unorm8 weights and colours
- * become floats; positions and normals grow less), the decoded structs at
- * most double their records, and the alignment of each stream costs less
- * than 4 times its 16-byte header; plus the skeleton level's tables, or
- * the mesh level's lists and bucket tables (prepare_mesh). For a pack's
- * mesh level the bucket tables are bounded by the raw size / 4: each
- * vertex of a skinned part has at least 16 raw bytes (u16[4] position,
- * u8[4] joints and weights, mlod(5)) and costs 1 + 1/16 bytes, each part
- * a record of far more than its 8 bytes (an offset and a partial run's 4
- * counts). */
+ * not even while a level decodes. Views know their size. A pack's mesh
+ * level: its exact size once a load has read its part records (u->need),
+ * else 0, as the reader calls rt_mesh_reserve with those records before
+ * it allocates the decoded level, and room is made then. Other levels of
+ * packs: dequantising at most quadruples a stream (unorm8 weights and
+ * colours become floats; positions and normals grow less), the decoded
+ * structs at most double their records, and the alignment of each stream
+ * costs less than 4 times its 16-byte header; plus the skeleton level's
+ * tables or the motion level's. */
 static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 {
 	size_t plan = u->layer == MLOD_RT_SKELETON ? (size_t)ctx->joint_count * (4 + 1 + 4 + 64)
@@ -672,12 +734,9 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 			}
 		return 0;
 	}
-	/* A Draco MESH level is its container (mlod(5)): its decoded level
-	 * measured up to about 16 times its raw size (bench/RESULTS.md run 43),
-	 * where a layout b2 level's streams are at most about 4 times. */
-	const size_t grow = u->layer == MLOD_RT_MESH && u->chunk >= 0 && ctx->pack.chunks[u->chunk].codec == MLOD_CODEC_DRACO
-	                    ? 16 : 4;
-	size_t hint = grow * (size_t)u->raw_size + 256 + plan + (u->layer == MLOD_RT_MESH ? (size_t)u->raw_size / 4 : 0);
+	if (u->layer == MLOD_RT_MESH)
+		return u->need;
+	size_t hint = 4 * (size_t)u->raw_size + 256 + plan;
 	/* A nested motion level decodes the coarser ones it builds on (rt_pack.c
 	 * motion_load), each freed before it returns; at most two at a time,
 	 * counted here as all of them. */
@@ -1274,7 +1333,15 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 			changed = 1;
 		}
 		mlod_error e;
+		ctx->streaming = 1, ctx->refused = 0;
 		mlod_result r = unit_load(ctx, u, &e);
+		ctx->streaming = 0;
+		if (r && ctx->refused) { /* its part records say it cannot fit: it waits */
+			ctx->refused = 0;
+			u->want_count |= 0x80000000u;
+			changed = 1;
+			continue;
+		}
 		spent += u->stored_size ? u->stored_size : 1;
 		if (r) {
 			load_failed(ctx, u);

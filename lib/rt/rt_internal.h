@@ -33,6 +33,8 @@ typedef struct rt_unit {
 	uint32_t stored_size, raw_size;
 	float error, distance;
 	size_t bytes;             /* counted while resident */
+	size_t need;              /* a pack's mesh level: its resident bytes, from its part
+	                           * records (rt_mesh_reserve); 0 until a load read them */
 	uint64_t last_wanted;     /* the update stamp */
 	uint32_t want_count;      /* instances wanting it at the last update */
 	uint32_t users;           /* instances showing it */
@@ -139,6 +141,9 @@ struct mlod_rt_ctx {
 	uint64_t stamp;
 	uint64_t loads, evictions, failures;
 	uint64_t unit_gen;        /* counts loads and releases: keys the scratch's skin plan */
+	rt_unit *loading;         /* the unit ctx->load decodes (rt_mesh_reserve) */
+	int streaming;            /* inside mlod_rt_stream: rt_mesh_reserve makes room */
+	int refused;              /* rt_mesh_reserve found no room: the load is not a failure */
 	uint32_t max_vertices;
 	/* Instances. */
 	rt_instance *inst;
@@ -192,6 +197,13 @@ mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
 mlod_result rt_palette_sources(const mlod_rt_ctx *ctx, uint32_t n, const uint32_t *joint,
                                const float *const *bind, uint32_t *src, mlod_error *err);
 
+
+/* rt_ctx.c: the pack reader's reserve callback (pack_internal.h) for a
+ * mesh level's load, user the context: sets ctx->loading's need from the
+ * level's part records and, inside mlod_rt_stream, makes room for it
+ * (evicting as mlod_rt_stream does) or refuses with MLOD_ERR_LIMIT and
+ * ctx->refused set. */
+mlod_result rt_mesh_reserve(void *user, const mlod_pack_part_rec *parts, uint32_t part_count, mlod_error *err);
 
 /* Byte counts of decoded views (from their arrays). */
 size_t rt_bytes_skel_level(const mlod_pack_skel_level *l);

@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pack_internal.h"
 #include "rt_internal.h"
 
 enum { SRC_VIEWS = 0, SRC_MEMORY = 1, SRC_READ = 2 };
@@ -129,12 +130,16 @@ static mlod_result motion_load(mlod_rt_ctx *ctx, uint32_t chunk, mlod_pack_motio
 static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 {
 	if (u->layer == MLOD_RT_MESH) {
+		/* The reader calls rt_mesh_reserve with the level's part records
+		 * before it allocates the decoded level: room is made for its
+		 * exact size then. */
 		memset(&u->dec, 0, sizeof u->dec);
-		if (ctx->source == SRC_MEMORY)
-			return mlod_pack_decode_mesh(&ctx->pack, (uint32_t)u->chunk, ctx->data, ctx->size, ctx->skel,
-			                             &u->dec.mesh, err);
-		return mlod_pack_decode_mesh_fetch(&ctx->pack, (uint32_t)u->chunk, fetch_chunk, ctx, ctx->skel, &u->dec.mesh,
-		                                   err);
+		ctx->loading = u;
+		mlod_result r = mlod_pack_decode_mesh_reserve(&ctx->pack, (uint32_t)u->chunk, ctx->data, ctx->size,
+		                                              ctx->source == SRC_MEMORY ? NULL : fetch_chunk, ctx,
+		                                              rt_mesh_reserve, ctx, ctx->skel, &u->dec.mesh, err);
+		ctx->loading = NULL;
+		return r;
 	}
 	if (u->layer == MLOD_RT_MOTION) {
 		memset(&u->dec, 0, sizeof u->dec);
@@ -306,15 +311,6 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 		u->chunk = c;
 		u->stored_size = ctx->pack.chunks[c].stored_size;
 		u->raw_size = ctx->pack.chunks[c].raw_size;
-		/* A mesh level decodes its own and every coarser MESH chunk and
-		 * gathers from their blocks: its raw size, for the load's size
-		 * hint, is theirs together (a level's decoded size is at most 4
-		 * times that, as for any chunk). */
-		for (uint32_t k = u->level + 1u; u->layer == MLOD_RT_MESH && k < ctx->levels[MLOD_RT_MESH]; k++) {
-			int ck = mlod_pack_find(&ctx->pack, MLOD_CHUNK_MESH, k, 0);
-			uint64_t sum = (uint64_t)u->raw_size + (ck >= 0 ? ctx->pack.chunks[ck].raw_size : 0);
-			u->raw_size = sum > UINT32_MAX ? UINT32_MAX : (uint32_t)sum;
-		}
 		u->error = ctx->pack.chunks[c].error;
 		u->distance = ctx->pack.chunks[c].distance;
 	}

@@ -1,0 +1,227 @@
+/*
+ * test_rt_r7.c: the runtime bugs a new-user probe found (round 7, branch
+ * fixrt): a pack's mesh level loads with exactly its resident bytes free
+ * (its part records size it), and one that does not fit is not decoded
+ * again in every call.
+ *
+ * The tests on packs run mlod-pack (MLOD_PACK, else build/release/bin/
+ * mlod-pack from the repository's root, where tests/run.sh runs) on the
+ * committed samples; without mlod-pack or the samples they print SKIP.
+ * This program links libmlodrt.a alone, as every tests/rt program.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <stdint.h>
+#include <unistd.h>
+
+#include "rt_test.h"
+
+static char tmpdir[256];
+static const char *mlod_pack_bin;
+static char skip_why[512];
+
+#define SKIP_IF_NO_PACK(name)                                                                  \
+	do {                                                                                   \
+		if (!mlod_pack_bin) {                                                          \
+			printf("SKIP %s: %s\n", #name, skip_why);                              \
+			return;                                                                \
+		}                                                                              \
+	} while (0)
+
+static int file_exists(const char *p)
+{
+	return access(p, R_OK) == 0;
+}
+
+/* Runs mlod-pack on in (with options opts), writing tmpdir/out; 0 on success. */
+static int run_pack(const char *in, const char *opts, const char *out, char *path, size_t cap)
+{
+	char cmd[2048];
+	snprintf(path, cap, "%s/%s", tmpdir, out);
+	snprintf(cmd, sizeof cmd, "'%s' %s '%s' -o '%s' >/dev/null 2>'%s/pack.err'", mlod_pack_bin, opts, in, path,
+	         tmpdir);
+	return system(cmd);
+}
+
+static uint8_t *read_all(const char *path, size_t *size)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	uint8_t *d = NULL;
+	size_t n = 0, cap = 0;
+	for (;;) {
+		if (n == cap) {
+			cap = cap ? 2 * cap : 1 << 16;
+			uint8_t *t = realloc(d, cap);
+			if (!t) {
+				free(d);
+				fclose(f);
+				return NULL;
+			}
+			d = t;
+		}
+		size_t k = fread(d + n, 1, cap - n, f);
+		n += k;
+		if (k == 0)
+			break;
+	}
+	fclose(f);
+	*size = n;
+	return d;
+}
+
+/* A pack in memory read through the callback, counting the reads. */
+typedef struct mem_src {
+	const uint8_t *d;
+	size_t n;
+	unsigned long reads;
+} mem_src;
+
+static int mem_read(void *user, uint64_t offset, size_t size, void *dst)
+{
+	mem_src *m = user;
+	m->reads++;
+	if (offset > m->n || size > m->n - offset)
+		return -1;
+	memcpy(dst, m->d + offset, size);
+	return 0;
+}
+
+/* ---------------------------------------------------------------- */
+/* Issue 4: the room made for a mesh level is its size                */
+/* ---------------------------------------------------------------- */
+
+/* For each mesh level L but the coarsest: its resident bytes B (no
+ * budget); under a budget of the open's resident bytes plus B, a request
+ * for L alone loads it; plus B - 1 it does not, nothing fails, the peak
+ * stays within the budget, and a second call reads nothing (the level's
+ * size is remembered). */
+static const char *room_pass(const char *what, mem_src *m, char *msg, size_t cap)
+{
+	mlod_error e = { 0 };
+	mlod_rt_ctx *ctx = NULL;
+	if (mlod_rt_open_read(mem_read, m, m->n, NULL, &ctx, &e)) {
+		snprintf(msg, cap, "%s: open: %s", what, e.message);
+		return msg;
+	}
+	mlod_rt_stats s;
+	mlod_rt_stats_get(ctx, &s);
+	const size_t base = s.resident_bytes;
+	const uint32_t L = mlod_rt_level_count(ctx, MLOD_RT_MESH);
+	size_t bytes[64] = { 0 };
+	for (uint32_t l = 0; l + 1 < L && l < 64; l++) {
+		mlod_rt_level_info li;
+		mlod_rt_request(ctx, MLOD_RT_MESH, l, 0, NULL);
+		mlod_rt_stream(ctx, SIZE_MAX, NULL, NULL);
+		mlod_rt_level_info_get(ctx, MLOD_RT_MESH, l, 0, &li, NULL);
+		bytes[l] = li.bytes;
+	}
+	mlod_rt_close(ctx);
+	if (L < 3) {
+		snprintf(msg, cap, "%s: %u mesh levels", what, L);
+		return msg;
+	}
+	for (uint32_t l = 0; l + 1 < L && l < 64; l++)
+		for (int less = 0; less <= 1; less++) {
+			mlod_rt_config cfg = { base + bytes[l] - (size_t)less, 4, NULL };
+			if (mlod_rt_open_read(mem_read, m, m->n, &cfg, &ctx, &e)) {
+				snprintf(msg, cap, "%s: open under %zu: %s", what, cfg.budget_bytes, e.message);
+				return msg;
+			}
+			mlod_rt_level_info li;
+			uint32_t loaded = 99;
+			mlod_rt_request(ctx, MLOD_RT_MESH, l, 0, NULL);
+			mlod_result r = mlod_rt_stream(ctx, SIZE_MAX, &loaded, &e);
+			mlod_rt_level_info_get(ctx, MLOD_RT_MESH, l, 0, &li, NULL);
+			mlod_rt_stats_get(ctx, &s);
+			const char *bad = NULL;
+			if (r != MLOD_OK)
+				bad = e.message;
+			else if (less ? li.resident || loaded : !li.resident || loaded != 1)
+				bad = less ? "loaded with a byte less than its size free" : "not loaded with its size free";
+			else if (li.failed || s.failures)
+				bad = "marked failed";
+			else if (s.peak_resident_bytes > cfg.budget_bytes)
+				bad = "peak above the budget";
+			if (!bad && less) {
+				/* wanted again: its size is known, nothing is read */
+				const unsigned long before = m->reads;
+				mlod_rt_request(ctx, MLOD_RT_MESH, l, 0, NULL);
+				mlod_rt_stream(ctx, SIZE_MAX, &loaded, NULL);
+				if (m->reads != before || loaded)
+					bad = "decoded again though its size does not fit";
+			}
+			mlod_rt_close(ctx);
+			if (bad) {
+				snprintf(msg, cap, "%s mesh level %u (%zu bytes), budget %zu above the open's %zu: %s", what, l,
+				         bytes[l], bytes[l] - (size_t)less, base, bad);
+				return msg;
+			}
+		}
+	return NULL;
+}
+
+TEST(mesh_room_is_its_size)
+{
+	SKIP_IF_NO_PACK(mesh_room_is_its_size);
+	static const struct {
+		const char *in, *opts, *out;
+	} packs[] = { { "samples/tubeman.glb", "", "tubeman.mlod" },
+		      { "samples/RobotExpressive.glb", "", "robot.mlod" },
+		      { "samples/tubeman.glb", "--codec draco", "tubeman-draco.mlod" } };
+	for (size_t i = 0; i < sizeof packs / sizeof packs[0]; i++) {
+		char pk[512], msg[768];
+		CHECK(run_pack(packs[i].in, packs[i].opts, packs[i].out, pk, sizeof pk) == 0, "mlod-pack on %s failed",
+		      packs[i].in);
+		mem_src m = { NULL, 0, 0 };
+		m.d = read_all(pk, &m.n);
+		CHECK(m.d, "reading %s", pk);
+		const char *why = room_pass(packs[i].out, &m, msg, sizeof msg);
+		free((void *)m.d);
+		CHECK(!why, "%s", why);
+	}
+}
+
+int main(int argc, char **argv)
+{
+	(void)argc;
+	const char *env = getenv("MLOD_PACK");
+	static char guess[1024];
+	if (env && *env)
+		mlod_pack_bin = env;
+	else if (file_exists("build/release/bin/mlod-pack"))
+		mlod_pack_bin = "build/release/bin/mlod-pack";
+	else if (argv[0] && strlen(argv[0]) < 900) {
+		/* build/<config>/tests/rt/test_rt_r7 -> build/<config>/bin/mlod-pack */
+		snprintf(guess, sizeof guess, "%s", argv[0]);
+		char *slash = strrchr(guess, '/');
+		if (slash) {
+			snprintf(slash, sizeof guess - (size_t)(slash - guess), "/../../bin/mlod-pack");
+			if (file_exists(guess))
+				mlod_pack_bin = guess;
+		}
+	}
+	if (!mlod_pack_bin)
+		snprintf(skip_why, sizeof skip_why, "no mlod-pack (set MLOD_PACK, or run from the repository after make)");
+	else if (!file_exists("samples/RobotExpressive.glb") || !file_exists("samples/tubeman.glb")) {
+		snprintf(skip_why, sizeof skip_why, "no samples/ here (run from the repository's root)");
+		mlod_pack_bin = NULL;
+	}
+	if (mlod_pack_bin) {
+		const char *t = getenv("TMPDIR");
+		snprintf(tmpdir, sizeof tmpdir, "%s/rt_r7.XXXXXX", t && *t && strlen(t) < 200 ? t : "/tmp");
+		if (!mkdtemp(tmpdir)) {
+			snprintf(skip_why, sizeof skip_why, "mkdtemp: %s", strerror(errno));
+			mlod_pack_bin = NULL;
+		}
+	}
+	RUN(mesh_room_is_its_size);
+	if (tmpdir[0] && mlod_pack_bin) {
+		char cmd[600];
+		snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+		if (system(cmd) != 0)
+			fprintf(stderr, "could not remove %s\n", tmpdir);
+	}
+	TEST_EXIT();
+}
