@@ -1342,8 +1342,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 			changed = 1;
 			continue;
 		}
-		spent += u->stored_size ? u->stored_size : 1;
-		if (r) {
+		if (r) { /* not counted in byte_budget: the fallback loads in this call */
 			load_failed(ctx, u);
 			pass_wants(ctx);
 			changed = 1;
@@ -1368,6 +1367,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 			changed = 1;
 			continue;
 		}
+		spent += u->stored_size ? u->stored_size : 1;
 		n++;
 		changed = 1;
 	}

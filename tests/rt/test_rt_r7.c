@@ -2,7 +2,8 @@
  * test_rt_r7.c: the runtime bugs a new-user probe found (round 7, branch
  * fixrt): a pack's mesh level loads with exactly its resident bytes free
  * (its part records size it), and one that does not fit is not decoded
- * again in every call.
+ * again in every call; a failed load spends none of mlod_rt_stream's
+ * byte budget, so the fallback loads in the same call.
  *
  * The tests on packs run mlod-pack (MLOD_PACK, else build/release/bin/
  * mlod-pack from the repository's root, where tests/run.sh runs) on the
@@ -183,6 +184,58 @@ TEST(mesh_room_is_its_size)
 	}
 }
 
+/* ---------------------------------------------------------------- */
+/* Issue 6: a failed load counts nothing of byte_budget               */
+/* ---------------------------------------------------------------- */
+
+/* The robot with MESH level 1's payload corrupt (CRC stale): an instance
+ * wanting level 0 makes levels 0 and 1 fail; its want passes to level 2,
+ * which loads in the same call even with a byte budget of 1 (the failed
+ * load spent none of it) and is shown. */
+TEST(failed_load_spends_no_budget)
+{
+	SKIP_IF_NO_PACK(failed_load_spends_no_budget);
+	char pk[512];
+	CHECK(run_pack("samples/RobotExpressive.glb", "", "robot.mlod", pk, sizeof pk) == 0, "mlod-pack failed");
+	mem_src m = { NULL, 0, 0 };
+	uint8_t *d = read_all(pk, &m.n);
+	CHECK(d, "reading %s", pk);
+	m.d = d;
+	mlod_pack p;
+	mlod_error e = { 0 };
+	mlod_result r = mlod_pack_open(d, m.n, &p, &e);
+	int k = r == MLOD_OK ? mlod_pack_find(&p, MLOD_CHUNK_MESH, 1, 0) : -1;
+	uint64_t off = k >= 0 ? p.chunks[k].offset : 0;
+	uint32_t n = k >= 0 ? p.chunks[k].stored_size : 0;
+	if (r == MLOD_OK)
+		mlod_pack_close(&p);
+	if (k < 0 || n <= 64)
+		free(d);
+	CHECK(k >= 0 && n > 64, "no MESH level 1 chunk");
+	for (uint32_t i = n / 2; i < n / 2 + 8; i++)
+		d[off + i] ^= 0x5a;
+	mlod_rt_ctx *ctx = NULL;
+	r = mlod_rt_open_read(mem_read, &m, m.n, NULL, &ctx, &e);
+	if (r)
+		free(d);
+	CHECK_OK(r, e);
+	uint32_t id, loaded = 99;
+	mlod_rt_instance_create(ctx, 0, 0, 0, &id, &e);
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	sel.force_level = 0;
+	float dist = 1;
+	mlod_rt_update(ctx, &sel, &id, &dist, 1, 0, &e);
+	r = mlod_rt_stream(ctx, 1, &loaded, &e);
+	const mlod_rt_state *st = mlod_rt_instance_state(ctx, id);
+	const unsigned shown = st->level[MLOD_RT_MESH];
+	mlod_rt_close(ctx);
+	free(d);
+	CHECK(r == MLOD_ERR_PARSE, "stream: %d, want the parse error of level 1", (int)r);
+	CHECK(loaded == 1 && shown == 2, "byte budget 1: %u loaded, mesh level %u shown; want 1 and level 2", loaded,
+	      shown);
+}
+
 int main(int argc, char **argv)
 {
 	(void)argc;
@@ -217,6 +270,7 @@ int main(int argc, char **argv)
 		}
 	}
 	RUN(mesh_room_is_its_size);
+	RUN(failed_load_spends_no_budget);
 	if (tmpdir[0] && mlod_pack_bin) {
 		char cmd[600];
 		snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
