@@ -42,6 +42,11 @@ static void *rt_calloc(const mlod_rt_ctx *ctx, size_t n, size_t size)
 	return p;
 }
 
+int rt_config_bad(const mlod_rt_config *config)
+{
+	return config && config->allocator && !config->allocator->malloc != !config->allocator->free;
+}
+
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config)
 {
 	mlod_rt_allocator a = { default_malloc, default_free, NULL };
@@ -840,6 +845,7 @@ static mlod_result morph_setup(mlod_rt_ctx *ctx, mlod_error *err)
 		if (m && m->part_count > parts)
 			parts = m->part_count;
 	}
+	ctx->part_count = parts;
 	if (!parts)
 		return MLOD_OK;
 	ctx->morph_offset = rt_calloc(ctx, (size_t)parts + 1, sizeof *ctx->morph_offset);
@@ -985,6 +991,8 @@ mlod_result mlod_rt_open_views(const mlod_rt_views *v, const mlod_rt_config *con
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_views: NULL argument");
 	*out = NULL;
+	if (rt_config_bad(config))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_views: the allocator has one of malloc and free");
 	if (!v || !v->skeleton || v->skel_levels < 1 || !v->skel || (v->mesh_levels && !v->mesh) ||
 	    (v->clip_count && v->motion_levels && !v->motion) || v->skel_levels > 65535 || v->mesh_levels > 65535 ||
 	    v->motion_levels > 65535 || v->clip_count > 65535)
@@ -1135,7 +1143,11 @@ mlod_result mlod_rt_mesh_part(const mlod_rt_ctx *ctx, uint32_t level, uint32_t p
 
 void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out)
 {
+	if (!out)
+		return;
 	memset(out, 0, sizeof *out);
+	if (!ctx)
+		return;
 	out->resident_bytes = ctx->resident_bytes;
 	out->budget_bytes = ctx->budget == SIZE_MAX ? 0 : ctx->budget; /* 0: no limit, as configured */
 	out->peak_resident_bytes = ctx->peak_bytes;
@@ -1227,21 +1239,27 @@ static int unit_needs(const mlod_rt_ctx *ctx, const rt_unit *u, const rt_unit *d
 	return 1;
 }
 
-static void fail_unit(mlod_rt_ctx *ctx, rt_unit *u)
+static void fail_unit(mlod_rt_ctx *ctx, rt_unit *u, int retry)
 {
+	if (u->state == RT_UNIT_FAILED && !retry)
+		u->retry = 0; /* a corrupt chunk it reads: never again */
 	if (u->state != RT_UNIT_ABSENT)
 		return; /* resident levels decoded fine and stay; failed ones stay failed */
 	u->state = RT_UNIT_FAILED;
+	u->retry = (uint8_t)retry;
 	ctx->failures++;
 }
 
-/* Loading u failed. u fails; and when the load read a chunk whose stored
- * bytes fail its CRC (u's own or a coarser level's it builds on), that
- * chunk's level fails too, with every level that needs it, so that none
- * of them is tried again; the others stay loadable (fallbacks). */
-static void load_failed(mlod_rt_ctx *ctx, rt_unit *u)
+/* Loading u failed with r. u fails, to be tried again by the next
+ * mlod_rt_stream when r is MLOD_ERR_NOMEM or MLOD_ERR_IO (a transient
+ * cause: memory or the source), never again otherwise; and when the load
+ * read a chunk whose stored bytes fail its CRC (u's own or a coarser
+ * level's it builds on), that chunk's level fails too, with every level
+ * that needs it, so that none of them is tried again; the others stay
+ * loadable (fallbacks). */
+static void load_failed(mlod_rt_ctx *ctx, rt_unit *u, mlod_result r)
 {
-	fail_unit(ctx, u);
+	fail_unit(ctx, u, r == MLOD_ERR_NOMEM || r == MLOD_ERR_IO);
 	if (!ctx->load || u->chunk < 0 || u->layer == MLOD_RT_SKELETON)
 		return;
 	const uint32_t L = ctx->levels[u->layer];
@@ -1252,7 +1270,7 @@ static void load_failed(mlod_rt_ctx *ctx, rt_unit *u)
 		for (uint32_t k = 0; k <= l; k++) {
 			rt_unit *f = rt_unit_get(ctx, (mlod_rt_layer)u->layer, k, u->item);
 			if (f && unit_needs(ctx, f, d))
-				fail_unit(ctx, f);
+				fail_unit(ctx, f, 0);
 		}
 	}
 }
@@ -1300,6 +1318,11 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 	size_t spent = 0;
 	uint32_t n = 0;
 	int changed = 0;
+	/* Levels failed by a transient cause are tried again (their wants
+	 * stayed on them, mlod_rt_update). */
+	for (uint32_t i = 0; i < ctx->unit_count; i++)
+		if (ctx->units[i].state == RT_UNIT_FAILED && ctx->units[i].retry)
+			ctx->units[i].state = RT_UNIT_ABSENT, ctx->units[i].retry = 0;
 	pass_wants(ctx); /* requests of failed levels */
 	while (byte_budget > 0 && spent < byte_budget) {
 		rt_unit *u = NULL;
@@ -1343,7 +1366,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 			continue;
 		}
 		if (r) { /* not counted in byte_budget: the fallback loads in this call */
-			load_failed(ctx, u);
+			load_failed(ctx, u, r);
 			pass_wants(ctx);
 			changed = 1;
 			if (!first) {
@@ -1475,6 +1498,8 @@ mlod_result mlod_rt_instance_set_morph_weights(mlod_rt_ctx *ctx, uint32_t id, ui
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_instance_set_morph_weights: NULL argument");
 	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
+	if (part >= ctx->part_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "part %u out of range (%u parts)", part, ctx->part_count);
 	const uint32_t targets = mlod_rt_morph_target_count(ctx, part);
 	if (count > targets)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "part %u has %u morph targets, %u weights given", part, targets,

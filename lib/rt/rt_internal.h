@@ -28,6 +28,8 @@ typedef struct rt_unit {
 	uint8_t state;            /* RT_UNIT_* */
 	uint8_t coarse;           /* pinned: the coarsest level */
 	uint8_t owned;            /* decoded by the runtime (pack source) */
+	uint8_t retry;            /* failed by a transient cause (NOMEM, IO): the next
+	                           * mlod_rt_stream tries it again */
 	uint16_t level, item;
 	int32_t chunk;            /* TOC index, -1 for views */
 	uint32_t stored_size, raw_size;
@@ -151,6 +153,7 @@ struct mlod_rt_ctx {
 	/* Morph target weights (morph_setup): per part its targets' weights,
 	 * morph_total per instance, the instance's at morph_weights + id *
 	 * morph_total; morph_parts 0 when no part has targets. */
+	uint32_t part_count;      /* mesh parts (morph_setup): the coarsest level's, or views' most */
 	uint32_t morph_parts, morph_total;
 	uint32_t *morph_offset;   /* morph_parts + 1: first weight of each part */
 	float *morph_weights;     /* max_instances * morph_total, or NULL */
@@ -190,6 +193,8 @@ void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in);
 uint32_t rt_want_target(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t item, uint32_t w);
 mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err);
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
+/* 1 when config's allocator has one of malloc and free (both or neither). */
+int rt_config_bad(const mlod_rt_config *config);
 /* src[e] for the n palette entries: the smallest index whose entry follows
  * the same joint with a bind matrix of the same 16 floats (bit for bit),
  * e itself for the first of them, so that a palette can copy the product

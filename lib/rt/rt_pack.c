@@ -334,6 +334,8 @@ mlod_result mlod_rt_open_memory(const void *data, size_t size, const mlod_rt_con
 	if (!out || (!data && size))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_memory: NULL argument");
 	*out = NULL;
+	if (rt_config_bad(config))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_memory: the allocator has one of malloc and free");
 	mlod_rt_ctx *ctx = rt_ctx_new(config);
 	if (!ctx)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
@@ -349,6 +351,8 @@ mlod_result mlod_rt_open_read(mlod_rt_read_fn read, void *user, uint64_t file_si
 	if (!out || !read)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_read: NULL argument");
 	*out = NULL;
+	if (rt_config_bad(config))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_read: the allocator has one of malloc and free");
 	mlod_rt_ctx *ctx = rt_ctx_new(config);
 	if (!ctx)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
@@ -372,6 +376,8 @@ mlod_result mlod_rt_open_path(const char *path, const mlod_rt_config *config, ml
 	if (!out || !path)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_path: NULL argument");
 	*out = NULL;
+	if (rt_config_bad(config))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_path: the allocator has one of malloc and free");
 	FILE *f = fopen(path, "rb");
 	if (!f)
 		return mlod_fail(err, MLOD_ERR_IO, "%s: cannot open", path);

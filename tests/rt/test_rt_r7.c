@@ -3,7 +3,10 @@
  * fixrt): a pack's mesh level loads with exactly its resident bytes free
  * (its part records size it), and one that does not fit is not decoded
  * again in every call; a failed load spends none of mlod_rt_stream's
- * byte budget, so the fallback loads in the same call.
+ * byte budget, so the fallback loads in the same call; API edges:
+ * mlod_rt_stats_get on a NULL context, an allocator of one hook refused,
+ * time kept finite, a morph part out of range refused, a level failed
+ * for lack of memory tried again by the next mlod_rt_stream.
  *
  * The tests on packs run mlod-pack (MLOD_PACK, else build/release/bin/
  * mlod-pack from the repository's root, where tests/run.sh runs) on the
@@ -236,6 +239,172 @@ TEST(failed_load_spends_no_budget)
 	      shown);
 }
 
+/* ---------------------------------------------------------------- */
+/* Issue 10: API edges                                                */
+/* ---------------------------------------------------------------- */
+
+static char tube_path[512];
+static uint8_t *tube;
+static size_t tube_size;
+
+/* tubeman packed once, for the tests below; 0 when it could not be. */
+static int tube_ready(void)
+{
+	if (tube)
+		return 1;
+	if (run_pack("samples/tubeman.glb", "", "tube10.mlod", tube_path, sizeof tube_path) != 0)
+		return 0;
+	tube = read_all(tube_path, &tube_size);
+	return tube != NULL;
+}
+
+TEST(stats_of_null_context)
+{
+	mlod_rt_stats s;
+	memset(&s, 0xab, sizeof s);
+	mlod_rt_stats_get(NULL, &s);
+	CHECK(s.resident_bytes == 0 && s.loads == 0 && s.budget_bytes == 0 && s.resident_levels == 0,
+	      "mlod_rt_stats_get(NULL, &s) left bytes in s");
+	mlod_rt_stats_get(NULL, NULL);
+}
+
+static void *only_malloc(void *user, size_t size)
+{
+	(void)user;
+	return malloc(size);
+}
+
+TEST(allocator_both_or_neither)
+{
+	SKIP_IF_NO_PACK(allocator_both_or_neither);
+	CHECK(tube_ready(), "mlod-pack on tubeman failed");
+	mlod_rt_allocator half = { only_malloc, NULL, NULL };
+	mlod_rt_config cfg = { 0, 0, &half };
+	mem_src m = { tube, tube_size, 0 };
+	for (int k = 0; k < 4; k++) {
+		mlod_error e = { 0 };
+		mlod_rt_ctx *ctx = (mlod_rt_ctx *)&e; /* *out is set to NULL */
+		mlod_result r = k == 0   ? mlod_rt_open_memory(tube, tube_size, &cfg, &ctx, &e)
+		                : k == 1 ? mlod_rt_open_path(tube_path, &cfg, &ctx, &e)
+		                : k == 2 ? mlod_rt_open_read(mem_read, &m, tube_size, &cfg, &ctx, &e)
+		                         : MLOD_ERR_INVALID_ARG;
+		if (k == 3) { /* neither hook: the defaults */
+			mlod_rt_allocator other = { NULL, NULL, NULL };
+			mlod_rt_config c2 = { 0, 0, &other };
+			r = mlod_rt_open_memory(tube, tube_size, &c2, &ctx, &e);
+			CHECK(r == MLOD_OK, "an allocator of neither: %s", e.message);
+			mlod_rt_close(ctx);
+			break;
+		}
+		if (r == MLOD_OK)
+			mlod_rt_close(ctx);
+		CHECK(r == MLOD_ERR_INVALID_ARG && ctx == NULL && strstr(e.message, "allocator"),
+		      "open %d with malloc but no free: %d '%s'", k, (int)r, e.message);
+	}
+}
+
+/* A looping instance's time stays finite and wrapped whatever dt; a
+ * non-looping one's saturates at FLT_MAX. */
+TEST(time_stays_finite)
+{
+	SKIP_IF_NO_PACK(time_stays_finite);
+	CHECK(tube_ready(), "mlod-pack on tubeman failed");
+	mlod_error e = { 0 };
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_memory(tube, tube_size, NULL, &ctx, &e), e);
+	const float dur = mlod_rt_clip_duration(ctx, 0);
+	uint32_t ids[2];
+	mlod_rt_instance_create(ctx, 0, 3e38f, MLOD_RT_LOOP, &ids[0], &e);
+	mlod_rt_instance_create(ctx, 0, 3e38f, 0, &ids[1], &e);
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	float d[2] = { 1, 1 };
+	mlod_result r = MLOD_OK;
+	for (int f = 0; f < 3 && r == MLOD_OK; f++)
+		r = mlod_rt_update(ctx, &sel, ids, d, 2, 3e38f, &e);
+	const float t0 = mlod_rt_instance_state(ctx, ids[0])->time, t1 = mlod_rt_instance_state(ctx, ids[1])->time;
+	mlod_rt_close(ctx);
+	CHECK(r == MLOD_OK, "update: %s", e.message);
+	CHECK(dur > 0 && t0 >= 0 && t0 < dur, "looping: time %g after overflowing dt, want in [0, %g)", (double)t0,
+	      (double)dur);
+	CHECK(t1 == 3.4028234663852886e38f, "not looping: time %g, want FLT_MAX", (double)t1);
+}
+
+TEST(morph_part_out_of_range)
+{
+	SKIP_IF_NO_PACK(morph_part_out_of_range);
+	CHECK(tube_ready(), "mlod-pack on tubeman failed");
+	mlod_error e = { 0 };
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_memory(tube, tube_size, NULL, &ctx, &e), e);
+	uint32_t id;
+	mlod_rt_instance_create(ctx, 0, 0, 0, &id, &e);
+	const uint32_t parts = mlod_rt_mesh_part_count(ctx, mlod_rt_level_count(ctx, MLOD_RT_MESH) - 1);
+	mlod_result in = mlod_rt_instance_set_morph_weights(ctx, id, 0, NULL, 0, &e);
+	mlod_result out = mlod_rt_instance_set_morph_weights(ctx, id, parts, NULL, 0, &e);
+	mlod_rt_close(ctx);
+	CHECK(parts == 1 && in == MLOD_OK, "part 0 of %u, no weights: %d", parts, (int)in);
+	CHECK(out == MLOD_ERR_INVALID_ARG && strstr(e.message, "out of range"), "part %u of %u, no weights: %d '%s'",
+	      parts, parts, (int)out, e.message);
+}
+
+/* An allocator that fails every allocation of at least fail_at bytes
+ * while fail_at is not 0. */
+static size_t fail_at;
+static void *big_fails(void *user, size_t size)
+{
+	(void)user;
+	return fail_at && size >= fail_at ? NULL : malloc(size);
+}
+static void big_free(void *user, void *p)
+{
+	(void)user;
+	free(p);
+}
+
+/* Mesh level 0 fails for lack of memory (its 371 KB block): the
+ * instance shows level 1, loaded in the same call; with memory back, the
+ * next mlod_rt_stream tries level 0 again and it loads. A level failed
+ * by a parse error is never tried again (corrupt_chunk_fails_its_
+ * dependents_only, test_rt_probe). */
+TEST(nomem_level_tried_again)
+{
+	SKIP_IF_NO_PACK(nomem_level_tried_again);
+	CHECK(tube_ready(), "mlod-pack on tubeman failed");
+	mlod_rt_allocator a = { big_fails, big_free, NULL };
+	mlod_rt_config cfg = { 0, 4, &a };
+	mlod_error e = { 0 };
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_memory(tube, tube_size, &cfg, &ctx, &e), e);
+	uint32_t id;
+	mlod_rt_instance_create(ctx, 0, 0, 0, &id, &e);
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	sel.force_level = 0;
+	float d = 1;
+	fail_at = 300000;
+	mlod_rt_update(ctx, &sel, &id, &d, 1, 0, &e);
+	mlod_result r1 = mlod_rt_stream(ctx, SIZE_MAX, NULL, &e);
+	mlod_rt_level_info li;
+	mlod_rt_level_info_get(ctx, MLOD_RT_MESH, 0, 0, &li, NULL);
+	const unsigned shown1 = mlod_rt_instance_state(ctx, id)->level[MLOD_RT_MESH];
+	const int failed1 = li.failed;
+	fail_at = 0;
+	mlod_result r2 = MLOD_OK;
+	for (int f = 0; f < 2 && r2 == MLOD_OK; f++) {
+		mlod_rt_update(ctx, &sel, &id, &d, 1, 0, &e);
+		r2 = mlod_rt_stream(ctx, SIZE_MAX, NULL, &e);
+	}
+	mlod_rt_level_info_get(ctx, MLOD_RT_MESH, 0, 0, &li, NULL);
+	const unsigned shown2 = mlod_rt_instance_state(ctx, id)->level[MLOD_RT_MESH];
+	mlod_rt_close(ctx);
+	CHECK(r1 == MLOD_ERR_NOMEM && failed1 && shown1 == 1, "short of memory: stream %d, failed %d, shows %u; want "
+	      "NOMEM, 1, level 1", (int)r1, failed1, shown1);
+	CHECK(r2 == MLOD_OK && li.resident && !li.failed && shown2 == 0,
+	      "memory back: stream %d '%s', level 0 resident %d failed %d, shows %u", (int)r2, e.message, li.resident,
+	      li.failed, shown2);
+}
+
 int main(int argc, char **argv)
 {
 	(void)argc;
@@ -271,6 +440,12 @@ int main(int argc, char **argv)
 	}
 	RUN(mesh_room_is_its_size);
 	RUN(failed_load_spends_no_budget);
+	RUN(stats_of_null_context);
+	RUN(allocator_both_or_neither);
+	RUN(time_stays_finite);
+	RUN(morph_part_out_of_range);
+	RUN(nomem_level_tried_again);
+	free(tube);
 	if (tmpdir[0] && mlod_pack_bin) {
 		char cmd[600];
 		snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
