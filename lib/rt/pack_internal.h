@@ -24,4 +24,13 @@ mlod_result mlod_pack_decode_mesh_reserve(const mlod_pack *p, uint32_t chunk, co
                                           void *reserve_user, const mlod_pack_skeleton *skel, mlod_pack_mesh *out,
                                           mlod_error *err);
 
+/* INFO's counts against what the chunks hold (MLOD_ERR_PARSE naming
+ * INFO): its joint and skin counts against SKELETON's, its instance count
+ * against a decoded MESH level's parts (every level has the same parts).
+ * mlod_pack_check runs them; the runtime's open too. */
+mlod_result mlod_pack_info_check_skeleton(const mlod_pack_info *info, const mlod_pack_skeleton *skel,
+                                          mlod_error *err);
+mlod_result mlod_pack_info_check_mesh(const mlod_pack_info *info, const mlod_pack_mesh *mesh, unsigned level,
+                                      mlod_error *err);
+
 #endif

@@ -273,6 +273,8 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 		return r;
 	ctx->skel_owned = 1;
 	ctx->skel = &ctx->skel_dec;
+	if ((r = mlod_pack_info_check_skeleton(&ctx->info, ctx->skel, err)))
+		return r;
 	ctx->resident_bytes += sizeof ctx->info + skeleton_bytes(ctx->skel);
 	const mlod_pack_info_rec *rec = &ctx->info.rec;
 	if (rec->skeleton_levels < 1 || rec->skeleton_levels > 65535 || rec->mesh_levels > 65535 ||
@@ -314,7 +316,14 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 		u->error = ctx->pack.chunks[c].error;
 		u->distance = ctx->pack.chunks[c].distance;
 	}
-	return rt_ctx_finish_open(ctx, err);
+	if ((r = rt_ctx_finish_open(ctx, err)))
+		return r;
+	/* INFO's instance count against the coarsest mesh level, decoded now */
+	const rt_unit *cm = ctx->levels[MLOD_RT_MESH] ? rt_unit_get(ctx, MLOD_RT_MESH, ctx->levels[MLOD_RT_MESH] - 1, 0)
+	                                              : NULL;
+	if (cm && cm->mesh)
+		return mlod_pack_info_check_mesh(&ctx->info, cm->mesh, cm->level, err);
+	return MLOD_OK;
 }
 
 static mlod_result finish(mlod_rt_ctx *ctx, mlod_rt_ctx **out, mlod_error *err)

@@ -6,7 +6,8 @@
  * byte budget, so the fallback loads in the same call; API edges:
  * mlod_rt_stats_get on a NULL context, an allocator of one hook refused,
  * time kept finite, a morph part out of range refused, a level failed
- * for lack of memory tried again by the next mlod_rt_stream.
+ * for lack of memory tried again by the next mlod_rt_stream; INFO's
+ * counts checked against the chunks at open.
  *
  * The tests on packs run mlod-pack (MLOD_PACK, else build/release/bin/
  * mlod-pack from the repository's root, where tests/run.sh runs) on the
@@ -405,6 +406,75 @@ TEST(nomem_level_tried_again)
 	      li.failed, shown2);
 }
 
+/* ---------------------------------------------------------------- */
+/* Issue 5: INFO's counts against the chunks                          */
+/* ---------------------------------------------------------------- */
+
+static void wr32(uint8_t *p, uint32_t v)
+{
+	p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8), p[2] = (uint8_t)(v >> 16), p[3] = (uint8_t)(v >> 24);
+}
+
+/* A copy of tubeman's pack with the u32 at byte at of INFO's record set
+ * to v and every CRC made to match; NULL when INFO is not a plain
+ * container (the test then fails). */
+static uint8_t *info_edit(uint32_t at, uint32_t v)
+{
+	mlod_pack p;
+	mlod_error e;
+	if (mlod_pack_open(tube, tube_size, &p, &e))
+		return NULL;
+	uint8_t *d = malloc(tube_size);
+	int ci = mlod_pack_find(&p, MLOD_CHUNK_INFO, 0, 0);
+	if (!d || ci < 0 || p.chunks[ci].entropy || p.chunks[ci].stored_size < 100) {
+		mlod_pack_close(&p);
+		free(d);
+		return NULL;
+	}
+	memcpy(d, tube, tube_size);
+	const uint64_t off = p.chunks[ci].offset;
+	const uint32_t ns = d[off];
+	wr32(d + off + 4 + 16 * ns + at, v);
+	for (uint32_t i = 0; i < p.chunk_count; i++)
+		wr32(d + 32 + 48 * i + 32, mlod_pack_crc32(0, d + p.chunks[i].offset, p.chunks[i].stored_size));
+	wr32(d + 24, mlod_pack_crc32(0, d + 32, 48 * (size_t)p.chunk_count));
+	wr32(d + 28, mlod_pack_crc32(0, d, 28));
+	mlod_pack_close(&p);
+	return d;
+}
+
+/* INFO saying 1000 or 0 joints (SKELETON has 31), 2 instances (MESH has
+ * 1 part), first_drawable 0: the runtime's open refuses each, from memory
+ * and through a read callback, with MLOD_ERR_PARSE naming INFO; the pack
+ * as written opens. */
+TEST(info_counts_checked)
+{
+	SKIP_IF_NO_PACK(info_counts_checked);
+	CHECK(tube_ready(), "mlod-pack on tubeman failed");
+	static const struct {
+		uint32_t at, v;
+	} edits[] = { { 0, 1000 }, { 0, 0 }, { 24, 2 }, { 64, 0 }, { 4, 1 } };
+	for (size_t k = 0; k < sizeof edits / sizeof edits[0]; k++) {
+		uint8_t *d = info_edit(edits[k].at, edits[k].v);
+		CHECK(d, "editing INFO");
+		mem_src m = { d, tube_size, 0 };
+		for (int src = 0; src < 2; src++) {
+			mlod_error e = { 0 };
+			mlod_rt_ctx *ctx = NULL;
+			mlod_result r = src ? mlod_rt_open_read(mem_read, &m, m.n, NULL, &ctx, &e)
+			                    : mlod_rt_open_memory(d, tube_size, NULL, &ctx, &e);
+			mlod_rt_close(ctx);
+			const int valid = edits[k].at == 4; /* skin_count 1: as written */
+			if (valid ? r != MLOD_OK : (r != MLOD_ERR_PARSE || strncmp(e.message, "INFO: ", 6) != 0)) {
+				free(d);
+				CHECK(0, "INFO field at %u set to %u, %s: open gave %d '%s'", edits[k].at, edits[k].v,
+				      src ? "read" : "memory", (int)r, e.message);
+			}
+		}
+		free(d);
+	}
+}
+
 int main(int argc, char **argv)
 {
 	(void)argc;
@@ -445,6 +515,7 @@ int main(int argc, char **argv)
 	RUN(time_stays_finite);
 	RUN(morph_part_out_of_range);
 	RUN(nomem_level_tried_again);
+	RUN(info_counts_checked);
 	free(tube);
 	if (tmpdir[0] && mlod_pack_bin) {
 		char cmd[600];
