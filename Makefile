@@ -203,6 +203,14 @@ install: all
 	install -m 644 lib/rt/mlod_rt.h lib/rt/mlod_pack.h lib/core/mlod_core.h $(DESTDIR)$(PREFIX)/include
 	install -m 644 man/man1/*.1 $(DESTDIR)$(MANDIR)/man1
 	if ls man/man3/*.3 >/dev/null 2>&1; then install -m 644 man/man3/*.3 $(DESTDIR)$(MANDIR)/man3; fi
+	# a link per function a man3 page names (its NAME's .Nm lines), so that
+	# man mlod_rt_update finds mlod_rt_instance(3)
+	for p in man/man3/*.3; do \
+		[ -f "$$p" ] || continue; b=$${p##*/}; \
+		for n in $$(sed -n '/^\.Sh NAME/,/^\.Nd/s/^\.Nm \([A-Za-z0-9_]*\).*/\1/p' "$$p"); do \
+			[ "$$n.3" = "$$b" ] || ln -sf "$$b" $(DESTDIR)$(MANDIR)/man3/$$n.3 || exit 1; \
+		done; \
+	done
 	if ls man/man5/*.5 >/dev/null 2>&1; then install -m 644 man/man5/*.5 $(DESTDIR)$(MANDIR)/man5; fi
 
 clean:

@@ -77,6 +77,7 @@
  */
 #define _GNU_SOURCE /* getopt_long, clock_gettime */
 
+#include <fcntl.h>
 #include <getopt.h>
 #include <math.h>
 #include <png.h>
@@ -85,6 +86,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "rt/mlod_rt.h"
 
@@ -138,8 +140,9 @@ static const char usage_text[] =
 	"      --no-skin-bench   skip the kernel measurement\n"
 	"  -h, --help            show this help\n"
 	"\n"
-	"exit status: 0 success, 1 usage, 2 bad input, 3 unsupported input,\n"
-	"4 a picture could not be written\n";
+	"exit status: 0 success, 1 usage (also a --png or --plot FILE that is a\n"
+	"terminal), 2 bad input, 3 unsupported input, 4 a picture could not be\n"
+	"written\n";
 
 static const char *tool = "crowd";
 
@@ -691,6 +694,20 @@ static void draw_legend(unsigned char *img, int w, int h, uint32_t levels)
 								put(img, w, h, gx + (d * 4 + col3) * z + b, gy + row * z + a, frame);
 		}
 	}
+}
+
+/* A picture is binary: a path that is a terminal (/dev/tty, /dev/stdout
+ * on one) is refused up front, as the tools refuse binary output to a
+ * terminal (exit 1). A path that cannot be opened is left to write_png. */
+static void refuse_terminal(const char *path)
+{
+	int fd = path ? open(path, O_WRONLY | O_NOCTTY | O_NONBLOCK) : -1;
+	if (fd < 0)
+		return;
+	int tty = isatty(fd);
+	close(fd);
+	if (tty)
+		die(1, "%s: refusing to write binary output to a terminal", path);
 }
 
 static void write_png(const char *path, const unsigned char *img, int w, int h)
@@ -1253,6 +1270,8 @@ int main(int argc, char **argv)
 	}
 	if (optind + 1 != argc)
 		die(1, "%s", "one PACK is needed (see --help)");
+	refuse_terminal(png_path);
+	refuse_terminal(plot_path);
 	if (!(seconds > 0) || !(fps > 0) || !(far > near) || near < 0 || hyst < 0)
 		die(1, "%s", "bad --seconds, --fps, --near/--far or --hysteresis");
 	if (figures)

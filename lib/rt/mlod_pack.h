@@ -710,7 +710,10 @@ void mlod_pack_doc_free(mlod_pack_doc_bytes *x);
 
 /* Decodes every chunk of the pack in TOC order (data: the whole file) and
  * releases it: MLOD_OK when all decode, else the first failure, whose
- * message names the chunk. mlod-pack --info runs it before listing. */
+ * message names the chunk; INFO's joint, skin and instance counts must be
+ * SKELETON's and each MESH level's parts (MLOD_ERR_PARSE naming INFO;
+ * mlod_pack_decode_info checks its level counts against the TOC and its
+ * first_drawable exactly). mlod-pack --info runs it before listing. */
 mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, mlod_error *err);
 /* The zero padding before each chunk, which no CRC covers (data: the
  * whole file, or a prefix: the bytes it holds): MLOD_ERR_PARSE naming the

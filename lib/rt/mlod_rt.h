@@ -52,8 +52,11 @@
  * resident level decoded before stays usable); a nested motion level
  * reads the clip's coarser levels it builds on. (A level whose load fails for
  * another reason fails alone.) A failed level is marked failed
- * (mlod_rt_level_info.failed, each counted in mlod_rt_stats.failures) and
- * never tried again; an instance wanting it shows the finest resident
+ * (mlod_rt_level_info.failed, each failed load counted in
+ * mlod_rt_stats.failures) and never tried again, but for one that failed
+ * for lack of memory (MLOD_ERR_NOMEM) or a read error (MLOD_ERR_IO): the
+ * next mlod_rt_stream tries that one again when it is still wanted. An
+ * instance wanting a failed level shows the finest resident
  * level coarser than it (Fallback below) and its want passes to the
  * finest coarser level not failed, which then loads (in the same
  * mlod_rt_stream call when it fails there) and is shown. The coarsest
@@ -82,14 +85,19 @@
  * mlod_rt_request asks for it) and decoded only inside
  * mlod_rt_stream(ctx, byte_budget). Resident bytes (the decoded levels plus
  * the runtime's per-level tables, counted from their arrays) never exceed
- * the budget, not even while a level decodes: before decoding, stream
- * makes room for an upper bound of the level's size (its size for views;
- * 4 x the TOC's raw size plus the runtime's tables for packs), evicting
- * resident levels that no instance wanted at the last update, least
- * recently wanted first; it never evicts a level that was wanted at the
- * last update nor a coarsest level. A level that cannot fit stays unloaded
- * and is tried again when room appears. (The reader's own scratch while
- * one chunk decodes is not counted.)
+ * the budget, not even while a level decodes: before a level's decoded
+ * arrays are allocated, stream makes room for them: for a pack's mesh
+ * level its exact size (the reader reads the level's part records first,
+ * and the room is what those records decode to plus the runtime's
+ * tables; remembered, so a level that does not fit is not decoded again
+ * until room appears); for other levels an upper bound, before decoding
+ * (their size for views; 4 x the TOC's raw size plus the runtime's tables
+ * for packs). Room is made by evicting resident levels that no instance
+ * wanted at the last update, least recently wanted first; it never evicts
+ * a level that was wanted at the last update nor a coarsest level. A
+ * level that cannot fit stays unloaded and is tried again when room
+ * appears. (The reader's own scratch while one chunk decodes is not
+ * counted.)
  *
  * Fallback. An instance shows, per layer, the wanted level when resident,
  * else the finest resident level coarser than the wanted one (the coarsest
@@ -215,7 +223,8 @@ typedef enum mlod_rt_layer {
 /* ------------------------------------------------------------------ */
 
 /* User allocator: malloc(user, size) returns NULL on failure; free(user,
- * NULL) must be harmless. Both or neither. */
+ * NULL) must be harmless. Both or neither (one alone: MLOD_ERR_INVALID_ARG
+ * from every open). */
 typedef struct mlod_rt_allocator {
 	void *(*malloc)(void *user, size_t size);
 	void (*free)(void *user, void *p);
@@ -290,7 +299,8 @@ typedef struct mlod_rt_level_info {
 	size_t bytes;         /* resident bytes, 0 when not resident; 0 for skeleton level 0,
 	                         the context's own skeleton (mlod_rt_open(3)) */
 	int resident;         /* 1 when resident */
-	int failed;           /* 1 when loading it failed */
+	int failed;           /* 1 when loading it failed (NOMEM, IO: until the next
+	                         mlod_rt_stream tries it again) */
 	uint32_t users;       /* instances showing it at the last update */
 } mlod_rt_level_info;
 
@@ -298,7 +308,7 @@ typedef struct mlod_rt_level_info {
 typedef struct mlod_rt_stats {
 	size_t resident_bytes, budget_bytes, peak_resident_bytes;
 	uint32_t resident_levels, pending_levels; /* pending: wanted, not resident, not failed */
-	uint64_t loads, evictions, failures;
+	uint64_t loads, evictions, failures; /* failures: failed loads */
 } mlod_rt_stats;
 
 /* Levels of a layer, counting level 0 (motion: per clip). */
@@ -317,6 +327,7 @@ mlod_result mlod_rt_level_info_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, 
  * the largest count of any mesh level resident so far. */
 uint32_t mlod_rt_mesh_vertex_count(const mlod_rt_ctx *ctx, uint32_t level);
 uint32_t mlod_rt_max_vertex_count(const mlod_rt_ctx *ctx);
+/* All 0 for a NULL ctx; nothing for a NULL out. */
 void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out);
 
 /* A part of a resident mesh level, for drawing what mlod_rt_skin wrote:
@@ -349,7 +360,8 @@ mlod_result mlod_rt_request(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t leve
  * (ties: coarser first), until the stored bytes of the levels loaded in
  * this call reach byte_budget (a first level larger than byte_budget is
  * still loaded alone, so that every level can load; 0 loads nothing;
- * views have no stored size and count 1 byte each),
+ * views have no stored size and count 1 byte each; a level whose load
+ * fails or that does not fit counts nothing),
  * evicting as described above. Then re-resolves the instances (fallback
  * levels change to the better resident ones, and away from evicted ones).
  * *loaded (may be NULL) gets the number of levels loaded. Returns MLOD_OK,
@@ -369,7 +381,10 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 typedef struct mlod_rt_state {
 	uint32_t clip;
 	uint32_t flags;           /* MLOD_RT_LOOP */
-	float time;               /* seconds, before wrapping or clamping */
+	float time;               /* seconds: as set plus each update's dt, always finite; a
+	                           * looping instance's wrapped into [0, duration) by
+	                           * mlod_rt_update, another's saturating at +-FLT_MAX
+	                           * (sampling clamps it to [0, duration]) */
 	float distance;           /* at the last update */
 	float alpha;              /* the paper's alpha at the last update (alpha mode) */
 	uint16_t wanted[MLOD_RT_LAYERS];
@@ -404,7 +419,8 @@ const mlod_rt_state *mlod_rt_instance_state(const mlod_rt_ctx *ctx, uint32_t id)
  * stay until set again or the instance is destroyed (a new instance has
  * all weights 0: no morph). mlod_rt_skin applies them to every mesh level
  * (up to the targets that level's part has). MLOD_ERR_INVALID_ARG for an
- * id not alive, too many weights or a weight not finite. No allocation;
+ * id not alive, a part out of range (whatever count), too many weights or a
+ * weight not finite. No allocation;
  * like mlod_rt_update, not while other threads evaluate the context. */
 uint32_t mlod_rt_morph_target_count(const mlod_rt_ctx *ctx, uint32_t part);
 mlod_result mlod_rt_instance_set_morph_weights(mlod_rt_ctx *ctx, uint32_t id, uint32_t part, const float *weights,

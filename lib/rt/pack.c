@@ -15,7 +15,9 @@
  * coarser MESH chunk, each checked like any chunk, into scratch sized from
  * their TOC raw sizes (freed before the decode returns), then gathers the
  * vertices its indices use; its block is sized from its part records,
- * whose vertex counts the gathering must meet exactly.
+ * whose vertex counts the gathering must meet exactly (the runtime's
+ * mlod_pack_decode_mesh_reserve, pack_internal.h, is called with those
+ * records before the block is allocated).
  *
  * Byte order: the format is little-endian, and so must the host be (the
  * index codec's output and the records are read with memcpy); the
@@ -34,6 +36,7 @@
 #include <zstd.h>
 
 #include "mlod_pack.h"
+#include "pack_internal.h"
 #if MLOD_DRACO
 #include "rt_draco.h"
 #endif
@@ -1197,6 +1200,21 @@ mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t s
 	if (rec.first_drawable > p->file_size)
 		FAIL("%s: first_drawable %u is past the file's end (%llu)", x.label, rec.first_drawable,
 		     (unsigned long long)p->file_size);
+	/* first_drawable: where the last of INFO, SKELETON and the coarsest
+	 * level of each layer (of every clip) ends */
+	uint64_t drawable = 0;
+	for (uint32_t i = 0; i < p->chunk_count; i++) {
+		const mlod_pack_chunk *c = &p->chunks[i];
+		const int coarse = c->type == MLOD_CHUNK_INFO ||
+		                   (c->type == MLOD_CHUNK_SKELETON && (c->level == 0 || c->level + 1u == rec.skeleton_levels)) ||
+		                   (c->type == MLOD_CHUNK_MESH && c->level + 1u == rec.mesh_levels) ||
+		                   (c->type == MLOD_CHUNK_MOTION && c->level + 1u == rec.motion_levels);
+		if (coarse && c->offset + c->stored_size > drawable)
+			drawable = c->offset + c->stored_size;
+	}
+	if (rec.first_drawable != drawable)
+		FAIL("%s: first_drawable %u, but INFO, SKELETON and the coarsest levels end at byte %llu", x.label,
+		     rec.first_drawable, (unsigned long long)drawable);
 	/* The TOC holds exactly the levels INFO counts (open made them unique). */
 	uint64_t nskel = 0, nmesh = 0, nmotion = 0;
 	for (uint32_t i = 0; i < p->chunk_count; i++) {
@@ -1657,6 +1675,8 @@ typedef struct mesh_src {
 	size_t size;
 	mlod_pack_fetch_fn fetch;
 	void *user;
+	mlod_pack_reserve_fn reserve; /* or NULL (pack_internal.h) */
+	void *reserve_user;
 } mesh_src;
 
 /* cx_begin on a MESH chunk from m; prefix: the coarser levels' containers
@@ -1898,6 +1918,8 @@ static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const ml
 		FAIL("%s: its part records say %llu decoded bytes, more than %d times its %llu-byte container (Draco "
 		     "levels expand no more)",
 		     x.label, (unsigned long long)total, PACK_DRACO_MAX_EXPAND, (unsigned long long)x.size);
+	if (m->reserve)
+		TRY(m->reserve(m->reserve_user, recs, (uint32_t)P, err));
 	TRY(bump_alloc(&b, &x, total, err));
 	if (!(gather = pk_malloc(al, 1, (size_t)big)))
 		FAIL_NOMEM("%s: out of memory", x.label);
@@ -2214,6 +2236,10 @@ static mlod_result decode_mesh(const mesh_src *m, uint32_t chunk, const mlod_pac
 			FAIL("%s: its parts' prefixes (%llu vertices) are larger than the reader's limit", x.label,
 			     (unsigned long long)big_prefix);
 		}
+		if (m->reserve && (r = m->reserve(m->reserve_user, recs, (uint32_t)P, err)) != MLOD_OK) {
+			pk_free(al, recs);
+			goto fail;
+		}
 		r = bump_alloc(&b, &x, total, err);
 		work = pk_malloc(al, 1, (size_t)(8 * big_prefix + big_v + 8));
 		if (work) {
@@ -2390,7 +2416,16 @@ fail:
 mlod_result mlod_pack_decode_mesh(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
                                   const mlod_pack_skeleton *skel, mlod_pack_mesh *out, mlod_error *err)
 {
-	mesh_src m = {p, data, size, NULL, NULL};
+	mesh_src m = {p, data, size, NULL, NULL, NULL, NULL};
+	return decode_mesh(&m, chunk, skel, out, err);
+}
+
+mlod_result mlod_pack_decode_mesh_reserve(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                          mlod_pack_fetch_fn fetch, void *fetch_user, mlod_pack_reserve_fn reserve,
+                                          void *reserve_user, const mlod_pack_skeleton *skel, mlod_pack_mesh *out,
+                                          mlod_error *err)
+{
+	mesh_src m = {p, fetch ? NULL : data, fetch ? 0 : size, fetch, fetch_user, reserve, reserve_user};
 	return decode_mesh(&m, chunk, skel, out, err);
 }
 
@@ -2402,7 +2437,7 @@ mlod_result mlod_pack_decode_mesh_fetch(const mlod_pack *p, uint32_t chunk, mlod
 			memset(out, 0, sizeof *out);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_mesh_fetch: fetch is NULL");
 	}
-	mesh_src m = {p, NULL, 0, fetch, user};
+	mesh_src m = {p, NULL, 0, fetch, user, NULL, NULL};
 	return decode_mesh(&m, chunk, skel, out, err);
 }
 
@@ -2916,13 +2951,33 @@ mlod_result mlod_pack_check_padding(const mlod_pack *p, const void *data, size_t
 	return MLOD_OK;
 }
 
+mlod_result mlod_pack_info_check_skeleton(const mlod_pack_info *info, const mlod_pack_skeleton *skel,
+                                          mlod_error *err)
+{
+	if (info->rec.joint_count != skel->joint_count || info->rec.skin_count != skel->skin_count)
+		return mlod_fail(err, MLOD_ERR_PARSE, "INFO: %u joints and %u skins, but SKELETON has %u and %u",
+		                 info->rec.joint_count, info->rec.skin_count, skel->joint_count, skel->skin_count);
+	return MLOD_OK;
+}
+
+mlod_result mlod_pack_info_check_mesh(const mlod_pack_info *info, const mlod_pack_mesh *mesh, unsigned level,
+                                      mlod_error *err)
+{
+	if (info->rec.instance_count != mesh->part_count)
+		return mlod_fail(err, MLOD_ERR_PARSE, "INFO: %u instances, but MESH level %u has %u parts",
+		                 info->rec.instance_count, level, mesh->part_count);
+	return MLOD_OK;
+}
+
 mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, mlod_error *err)
 {
 	if (!p || (!data && size))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_check: NULL argument");
 	mlod_pack_skeleton skel;
 	memset(&skel, 0, sizeof skel);
-	int have_skel = 0;
+	mlod_pack_info info; /* INFO stands first (mlod_pack_open checks the order) */
+	memset(&info, 0, sizeof info);
+	int have_skel = 0, have_info = 0;
 	mlod_result r = MLOD_OK;
 	if ((r = mlod_pack_check_padding(p, data, size, err)) != MLOD_OK)
 		return r;
@@ -2930,13 +2985,14 @@ mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, m
 		const mlod_pack_chunk *c = &p->chunks[i];
 		const mlod_pack_skeleton *s = have_skel ? &skel : NULL;
 		if (c->type == MLOD_CHUNK_INFO) {
-			mlod_pack_info x;
-			memset(&x, 0, sizeof x);
-			r = mlod_pack_decode_info(p, data, size, &x, err);
-			mlod_pack_info_free(&x);
+			r = mlod_pack_decode_info(p, data, size, &info, err);
+			have_info = r == MLOD_OK;
 		} else if (c->type == MLOD_CHUNK_SKELETON && c->level == 0) {
 			r = mlod_pack_decode_skeleton(p, data, size, &skel, err);
 			have_skel = r == MLOD_OK;
+			/* INFO's counts against what the chunks hold */
+			if (have_skel && have_info)
+				r = mlod_pack_info_check_skeleton(&info, &skel, err);
 		} else if (c->type == MLOD_CHUNK_SKELETON) {
 			mlod_pack_skel_level x;
 			memset(&x, 0, sizeof x);
@@ -2946,6 +3002,8 @@ mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, m
 			mlod_pack_mesh x;
 			memset(&x, 0, sizeof x);
 			r = mlod_pack_decode_mesh(p, i, data, size, s, &x, err);
+			if (r == MLOD_OK && have_info)
+				r = mlod_pack_info_check_mesh(&info, &x, c->level, err);
 			mlod_pack_mesh_free(&x);
 		} else if (c->type == MLOD_CHUNK_MOTION) {
 			mlod_pack_motion x;
@@ -2960,5 +3018,6 @@ mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, m
 		}
 	}
 	mlod_pack_skeleton_free(&skel);
+	mlod_pack_info_free(&info);
 	return r;
 }

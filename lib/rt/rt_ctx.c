@@ -42,6 +42,11 @@ static void *rt_calloc(const mlod_rt_ctx *ctx, size_t n, size_t size)
 	return p;
 }
 
+int rt_config_bad(const mlod_rt_config *config)
+{
+	return config && config->allocator && !config->allocator->malloc != !config->allocator->free;
+}
+
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config)
 {
 	mlod_rt_allocator a = { default_malloc, default_free, NULL };
@@ -76,6 +81,30 @@ rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level
 size_t rt_bytes_skel_level(const mlod_pack_skel_level *l)
 {
 	return sizeof *l + (size_t)l->kept_count * 4 + (size_t)l->palette_size * (4 + 64);
+}
+
+/* rt_bytes_mesh of the level the pack reader decodes from these part
+ * records (its arrays follow the records' flags, UV sets and target
+ * counts exactly, lib/rt/pack.c part_dequant): the same count. */
+static size_t rt_bytes_mesh_recs(const mlod_pack_part_rec *recs, uint32_t n)
+{
+	size_t b = sizeof(mlod_pack_mesh);
+	for (uint32_t i = 0; i < n; i++) {
+		const mlod_pack_part_rec *r = &recs[i];
+		size_t v = r->vertex_count, per = 12 + 8 * (size_t)r->uv_sets;
+		if (r->flags & MLOD_PART_NORMALS)
+			per += 12;
+		if (r->flags & MLOD_PART_TANGENTS)
+			per += 16;
+		if (r->flags & MLOD_PART_COLORS)
+			per += 16;
+		if (r->flags & MLOD_PART_SKINNED)
+			per += 8 + 16;
+		b += sizeof(mlod_pack_part) + v * per + (size_t)r->index_count * 4;
+		if (r->target_count)
+			b += (size_t)r->target_count * (sizeof(float *) + v * 12);
+	}
+	return b;
 }
 
 size_t rt_bytes_mesh(const mlod_pack_mesh *m)
@@ -454,6 +483,16 @@ static size_t skin_order_bytes(const mlod_pack_mesh *m)
 	return b;
 }
 
+/* The bytes prepare_mesh allocates for a level of these part records. */
+static size_t mesh_plan_bytes(const mlod_rt_ctx *ctx, const mlod_pack_part_rec *recs, uint32_t n)
+{
+	size_t b = 4 * ((size_t)ctx->palette_size + ctx->joint_count) + 4 * (size_t)n;
+	for (uint32_t i = 0; i < n; i++)
+		if (recs[i].skin >= 0)
+			b += RT_SKIN_ORDER_BYTES(recs[i].vertex_count);
+	return b;
+}
+
 /* Checks a mesh level and lists what skinning it reads (u->pal_used, the
  * palette entries, and u->rigid, the joints of its rigid parts), so that
  * mlod_rt_skin poses and multiplies only those. The kernel reads a
@@ -628,6 +667,36 @@ static size_t evictable_bytes(const mlod_rt_ctx *ctx)
 	return b;
 }
 
+/* Evicts least recently wanted levels until need more bytes fit the
+ * budget; 0 when they do, -1 when they cannot (nothing is evicted then). */
+static int make_room(mlod_rt_ctx *ctx, size_t need)
+{
+	if (need > ctx->budget || ctx->resident_bytes - evictable_bytes(ctx) > ctx->budget - need)
+		return -1;
+	while (ctx->resident_bytes > ctx->budget - need) {
+		rt_unit *v = lru_victim(ctx);
+		if (!v)
+			return -1; /* unreachable: evictable_bytes counted the victims */
+		unit_release(ctx, v);
+		ctx->evictions++;
+	}
+	return 0;
+}
+
+mlod_result rt_mesh_reserve(void *user, const mlod_pack_part_rec *parts, uint32_t part_count, mlod_error *err)
+{
+	mlod_rt_ctx *ctx = user;
+	rt_unit *u = ctx->loading;
+	if (!u)
+		return MLOD_OK;
+	u->need = rt_bytes_mesh_recs(parts, part_count) + mesh_plan_bytes(ctx, parts, part_count);
+	if (!ctx->streaming || make_room(ctx, u->need) == 0)
+		return MLOD_OK;
+	ctx->refused = 1;
+	return mlod_fail(err, MLOD_ERR_LIMIT, "mesh level %u: its %zu decoded bytes do not fit the budget", u->level,
+	                 u->need);
+}
+
 /* motion_plan_bytes of a motion level's views, bounding its joints with
  * one-key channels only by the joints and by its one-key channels. */
 static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m)
@@ -641,17 +710,15 @@ static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m
 
 /* An upper bound of a unit's resident size before loading it, so that
  * room is made before decoding and resident bytes never pass the budget,
- * not even while a level decodes. Views know their size. For packs:
- * dequantising at most quadruples a stream (unorm8 weights and colours
- * become floats; positions and normals grow less), the decoded structs at
- * most double their records, and the alignment of each stream costs less
- * than 4 times its 16-byte header; plus the skeleton level's tables, or
- * the mesh level's lists and bucket tables (prepare_mesh). For a pack's
- * mesh level the bucket tables are bounded by the raw size / 4: each
- * vertex of a skinned part has at least 16 raw bytes (u16[4] position,
- * u8[4] joints and weights, mlod(5)) and costs 1 + 1/16 bytes, each part
- * a record of far more than its 8 bytes (an offset and a partial run's 4
- * counts). */
+ * not even while a level decodes. Views know their size. A pack's mesh
+ * level: its exact size once a load has read its part records (u->need),
+ * else 0, as the reader calls rt_mesh_reserve with those records before
+ * it allocates the decoded level, and room is made then. Other levels of
+ * packs: dequantising at most quadruples a stream (unorm8 weights and
+ * colours become floats; positions and normals grow less), the decoded
+ * structs at most double their records, and the alignment of each stream
+ * costs less than 4 times its 16-byte header; plus the skeleton level's
+ * tables or the motion level's. */
 static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 {
 	size_t plan = u->layer == MLOD_RT_SKELETON ? (size_t)ctx->joint_count * (4 + 1 + 4 + 64)
@@ -672,12 +739,9 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 			}
 		return 0;
 	}
-	/* A Draco MESH level is its container (mlod(5)): its decoded level
-	 * measured up to about 16 times its raw size (bench/RESULTS.md run 43),
-	 * where a layout b2 level's streams are at most about 4 times. */
-	const size_t grow = u->layer == MLOD_RT_MESH && u->chunk >= 0 && ctx->pack.chunks[u->chunk].codec == MLOD_CODEC_DRACO
-	                    ? 16 : 4;
-	size_t hint = grow * (size_t)u->raw_size + 256 + plan + (u->layer == MLOD_RT_MESH ? (size_t)u->raw_size / 4 : 0);
+	if (u->layer == MLOD_RT_MESH)
+		return u->need;
+	size_t hint = 4 * (size_t)u->raw_size + 256 + plan;
 	/* A nested motion level decodes the coarser ones it builds on (rt_pack.c
 	 * motion_load), each freed before it returns; at most two at a time,
 	 * counted here as all of them. */
@@ -781,6 +845,7 @@ static mlod_result morph_setup(mlod_rt_ctx *ctx, mlod_error *err)
 		if (m && m->part_count > parts)
 			parts = m->part_count;
 	}
+	ctx->part_count = parts;
 	if (!parts)
 		return MLOD_OK;
 	ctx->morph_offset = rt_calloc(ctx, (size_t)parts + 1, sizeof *ctx->morph_offset);
@@ -926,6 +991,8 @@ mlod_result mlod_rt_open_views(const mlod_rt_views *v, const mlod_rt_config *con
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_views: NULL argument");
 	*out = NULL;
+	if (rt_config_bad(config))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_views: the allocator has one of malloc and free");
 	if (!v || !v->skeleton || v->skel_levels < 1 || !v->skel || (v->mesh_levels && !v->mesh) ||
 	    (v->clip_count && v->motion_levels && !v->motion) || v->skel_levels > 65535 || v->mesh_levels > 65535 ||
 	    v->motion_levels > 65535 || v->clip_count > 65535)
@@ -1076,7 +1143,11 @@ mlod_result mlod_rt_mesh_part(const mlod_rt_ctx *ctx, uint32_t level, uint32_t p
 
 void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out)
 {
+	if (!out)
+		return;
 	memset(out, 0, sizeof *out);
+	if (!ctx)
+		return;
 	out->resident_bytes = ctx->resident_bytes;
 	out->budget_bytes = ctx->budget == SIZE_MAX ? 0 : ctx->budget; /* 0: no limit, as configured */
 	out->peak_resident_bytes = ctx->peak_bytes;
@@ -1168,21 +1239,27 @@ static int unit_needs(const mlod_rt_ctx *ctx, const rt_unit *u, const rt_unit *d
 	return 1;
 }
 
-static void fail_unit(mlod_rt_ctx *ctx, rt_unit *u)
+static void fail_unit(mlod_rt_ctx *ctx, rt_unit *u, int retry)
 {
+	if (u->state == RT_UNIT_FAILED && !retry)
+		u->retry = 0; /* a corrupt chunk it reads: never again */
 	if (u->state != RT_UNIT_ABSENT)
 		return; /* resident levels decoded fine and stay; failed ones stay failed */
 	u->state = RT_UNIT_FAILED;
+	u->retry = (uint8_t)retry;
 	ctx->failures++;
 }
 
-/* Loading u failed. u fails; and when the load read a chunk whose stored
- * bytes fail its CRC (u's own or a coarser level's it builds on), that
- * chunk's level fails too, with every level that needs it, so that none
- * of them is tried again; the others stay loadable (fallbacks). */
-static void load_failed(mlod_rt_ctx *ctx, rt_unit *u)
+/* Loading u failed with r. u fails, to be tried again by the next
+ * mlod_rt_stream when r is MLOD_ERR_NOMEM or MLOD_ERR_IO (a transient
+ * cause: memory or the source), never again otherwise; and when the load
+ * read a chunk whose stored bytes fail its CRC (u's own or a coarser
+ * level's it builds on), that chunk's level fails too, with every level
+ * that needs it, so that none of them is tried again; the others stay
+ * loadable (fallbacks). */
+static void load_failed(mlod_rt_ctx *ctx, rt_unit *u, mlod_result r)
 {
-	fail_unit(ctx, u);
+	fail_unit(ctx, u, r == MLOD_ERR_NOMEM || r == MLOD_ERR_IO);
 	if (!ctx->load || u->chunk < 0 || u->layer == MLOD_RT_SKELETON)
 		return;
 	const uint32_t L = ctx->levels[u->layer];
@@ -1193,7 +1270,7 @@ static void load_failed(mlod_rt_ctx *ctx, rt_unit *u)
 		for (uint32_t k = 0; k <= l; k++) {
 			rt_unit *f = rt_unit_get(ctx, (mlod_rt_layer)u->layer, k, u->item);
 			if (f && unit_needs(ctx, f, d))
-				fail_unit(ctx, f);
+				fail_unit(ctx, f, 0);
 		}
 	}
 }
@@ -1241,6 +1318,11 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 	size_t spent = 0;
 	uint32_t n = 0;
 	int changed = 0;
+	/* Levels failed by a transient cause are tried again (their wants
+	 * stayed on them, mlod_rt_update). */
+	for (uint32_t i = 0; i < ctx->unit_count; i++)
+		if (ctx->units[i].state == RT_UNIT_FAILED && ctx->units[i].retry)
+			ctx->units[i].state = RT_UNIT_ABSENT, ctx->units[i].retry = 0;
 	pass_wants(ctx); /* requests of failed levels */
 	while (byte_budget > 0 && spent < byte_budget) {
 		rt_unit *u = NULL;
@@ -1274,10 +1356,17 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 			changed = 1;
 		}
 		mlod_error e;
+		ctx->streaming = 1, ctx->refused = 0;
 		mlod_result r = unit_load(ctx, u, &e);
-		spent += u->stored_size ? u->stored_size : 1;
-		if (r) {
-			load_failed(ctx, u);
+		ctx->streaming = 0;
+		if (r && ctx->refused) { /* its part records say it cannot fit: it waits */
+			ctx->refused = 0;
+			u->want_count |= 0x80000000u;
+			changed = 1;
+			continue;
+		}
+		if (r) { /* not counted in byte_budget: the fallback loads in this call */
+			load_failed(ctx, u, r);
 			pass_wants(ctx);
 			changed = 1;
 			if (!first) {
@@ -1301,6 +1390,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 			changed = 1;
 			continue;
 		}
+		spent += u->stored_size ? u->stored_size : 1;
 		n++;
 		changed = 1;
 	}
@@ -1408,6 +1498,8 @@ mlod_result mlod_rt_instance_set_morph_weights(mlod_rt_ctx *ctx, uint32_t id, ui
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_instance_set_morph_weights: NULL argument");
 	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
+	if (part >= ctx->part_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "part %u out of range (%u parts)", part, ctx->part_count);
 	const uint32_t targets = mlod_rt_morph_target_count(ctx, part);
 	if (count > targets)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "part %u has %u morph targets, %u weights given", part, targets,

@@ -28,11 +28,15 @@ typedef struct rt_unit {
 	uint8_t state;            /* RT_UNIT_* */
 	uint8_t coarse;           /* pinned: the coarsest level */
 	uint8_t owned;            /* decoded by the runtime (pack source) */
+	uint8_t retry;            /* failed by a transient cause (NOMEM, IO): the next
+	                           * mlod_rt_stream tries it again */
 	uint16_t level, item;
 	int32_t chunk;            /* TOC index, -1 for views */
 	uint32_t stored_size, raw_size;
 	float error, distance;
 	size_t bytes;             /* counted while resident */
+	size_t need;              /* a pack's mesh level: its resident bytes, from its part
+	                           * records (rt_mesh_reserve); 0 until a load read them */
 	uint64_t last_wanted;     /* the update stamp */
 	uint32_t want_count;      /* instances wanting it at the last update */
 	uint32_t users;           /* instances showing it */
@@ -139,6 +143,9 @@ struct mlod_rt_ctx {
 	uint64_t stamp;
 	uint64_t loads, evictions, failures;
 	uint64_t unit_gen;        /* counts loads and releases: keys the scratch's skin plan */
+	rt_unit *loading;         /* the unit ctx->load decodes (rt_mesh_reserve) */
+	int streaming;            /* inside mlod_rt_stream: rt_mesh_reserve makes room */
+	int refused;              /* rt_mesh_reserve found no room: the load is not a failure */
 	uint32_t max_vertices;
 	/* Instances. */
 	rt_instance *inst;
@@ -146,6 +153,7 @@ struct mlod_rt_ctx {
 	/* Morph target weights (morph_setup): per part its targets' weights,
 	 * morph_total per instance, the instance's at morph_weights + id *
 	 * morph_total; morph_parts 0 when no part has targets. */
+	uint32_t part_count;      /* mesh parts (morph_setup): the coarsest level's, or views' most */
 	uint32_t morph_parts, morph_total;
 	uint32_t *morph_offset;   /* morph_parts + 1: first weight of each part */
 	float *morph_weights;     /* max_instances * morph_total, or NULL */
@@ -185,6 +193,8 @@ void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in);
 uint32_t rt_want_target(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t item, uint32_t w);
 mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err);
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
+/* 1 when config's allocator has one of malloc and free (both or neither). */
+int rt_config_bad(const mlod_rt_config *config);
 /* src[e] for the n palette entries: the smallest index whose entry follows
  * the same joint with a bind matrix of the same 16 floats (bit for bit),
  * e itself for the first of them, so that a palette can copy the product
@@ -192,6 +202,13 @@ mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
 mlod_result rt_palette_sources(const mlod_rt_ctx *ctx, uint32_t n, const uint32_t *joint,
                                const float *const *bind, uint32_t *src, mlod_error *err);
 
+
+/* rt_ctx.c: the pack reader's reserve callback (pack_internal.h) for a
+ * mesh level's load, user the context: sets ctx->loading's need from the
+ * level's part records and, inside mlod_rt_stream, makes room for it
+ * (evicting as mlod_rt_stream does) or refuses with MLOD_ERR_LIMIT and
+ * ctx->refused set. */
+mlod_result rt_mesh_reserve(void *user, const mlod_pack_part_rec *parts, uint32_t part_count, mlod_error *err);
 
 /* Byte counts of decoded views (from their arrays). */
 size_t rt_bytes_skel_level(const mlod_pack_skel_level *l);

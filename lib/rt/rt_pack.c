@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pack_internal.h"
 #include "rt_internal.h"
 
 enum { SRC_VIEWS = 0, SRC_MEMORY = 1, SRC_READ = 2 };
@@ -129,12 +130,16 @@ static mlod_result motion_load(mlod_rt_ctx *ctx, uint32_t chunk, mlod_pack_motio
 static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 {
 	if (u->layer == MLOD_RT_MESH) {
+		/* The reader calls rt_mesh_reserve with the level's part records
+		 * before it allocates the decoded level: room is made for its
+		 * exact size then. */
 		memset(&u->dec, 0, sizeof u->dec);
-		if (ctx->source == SRC_MEMORY)
-			return mlod_pack_decode_mesh(&ctx->pack, (uint32_t)u->chunk, ctx->data, ctx->size, ctx->skel,
-			                             &u->dec.mesh, err);
-		return mlod_pack_decode_mesh_fetch(&ctx->pack, (uint32_t)u->chunk, fetch_chunk, ctx, ctx->skel, &u->dec.mesh,
-		                                   err);
+		ctx->loading = u;
+		mlod_result r = mlod_pack_decode_mesh_reserve(&ctx->pack, (uint32_t)u->chunk, ctx->data, ctx->size,
+		                                              ctx->source == SRC_MEMORY ? NULL : fetch_chunk, ctx,
+		                                              rt_mesh_reserve, ctx, ctx->skel, &u->dec.mesh, err);
+		ctx->loading = NULL;
+		return r;
 	}
 	if (u->layer == MLOD_RT_MOTION) {
 		memset(&u->dec, 0, sizeof u->dec);
@@ -268,6 +273,8 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 		return r;
 	ctx->skel_owned = 1;
 	ctx->skel = &ctx->skel_dec;
+	if ((r = mlod_pack_info_check_skeleton(&ctx->info, ctx->skel, err)))
+		return r;
 	ctx->resident_bytes += sizeof ctx->info + skeleton_bytes(ctx->skel);
 	const mlod_pack_info_rec *rec = &ctx->info.rec;
 	if (rec->skeleton_levels < 1 || rec->skeleton_levels > 65535 || rec->mesh_levels > 65535 ||
@@ -306,19 +313,17 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 		u->chunk = c;
 		u->stored_size = ctx->pack.chunks[c].stored_size;
 		u->raw_size = ctx->pack.chunks[c].raw_size;
-		/* A mesh level decodes its own and every coarser MESH chunk and
-		 * gathers from their blocks: its raw size, for the load's size
-		 * hint, is theirs together (a level's decoded size is at most 4
-		 * times that, as for any chunk). */
-		for (uint32_t k = u->level + 1u; u->layer == MLOD_RT_MESH && k < ctx->levels[MLOD_RT_MESH]; k++) {
-			int ck = mlod_pack_find(&ctx->pack, MLOD_CHUNK_MESH, k, 0);
-			uint64_t sum = (uint64_t)u->raw_size + (ck >= 0 ? ctx->pack.chunks[ck].raw_size : 0);
-			u->raw_size = sum > UINT32_MAX ? UINT32_MAX : (uint32_t)sum;
-		}
 		u->error = ctx->pack.chunks[c].error;
 		u->distance = ctx->pack.chunks[c].distance;
 	}
-	return rt_ctx_finish_open(ctx, err);
+	if ((r = rt_ctx_finish_open(ctx, err)))
+		return r;
+	/* INFO's instance count against the coarsest mesh level, decoded now */
+	const rt_unit *cm = ctx->levels[MLOD_RT_MESH] ? rt_unit_get(ctx, MLOD_RT_MESH, ctx->levels[MLOD_RT_MESH] - 1, 0)
+	                                              : NULL;
+	if (cm && cm->mesh)
+		return mlod_pack_info_check_mesh(&ctx->info, cm->mesh, cm->level, err);
+	return MLOD_OK;
 }
 
 static mlod_result finish(mlod_rt_ctx *ctx, mlod_rt_ctx **out, mlod_error *err)
@@ -338,6 +343,8 @@ mlod_result mlod_rt_open_memory(const void *data, size_t size, const mlod_rt_con
 	if (!out || (!data && size))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_memory: NULL argument");
 	*out = NULL;
+	if (rt_config_bad(config))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_memory: the allocator has one of malloc and free");
 	mlod_rt_ctx *ctx = rt_ctx_new(config);
 	if (!ctx)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
@@ -353,6 +360,8 @@ mlod_result mlod_rt_open_read(mlod_rt_read_fn read, void *user, uint64_t file_si
 	if (!out || !read)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_read: NULL argument");
 	*out = NULL;
+	if (rt_config_bad(config))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_read: the allocator has one of malloc and free");
 	mlod_rt_ctx *ctx = rt_ctx_new(config);
 	if (!ctx)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
@@ -376,6 +385,8 @@ mlod_result mlod_rt_open_path(const char *path, const mlod_rt_config *config, ml
 	if (!out || !path)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_path: NULL argument");
 	*out = NULL;
+	if (rt_config_bad(config))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_path: the allocator has one of malloc and free");
 	FILE *f = fopen(path, "rb");
 	if (!f)
 		return mlod_fail(err, MLOD_ERR_IO, "%s: cannot open", path);

@@ -125,14 +125,23 @@ static void update_one(mlod_rt_ctx *ctx, const mlod_rt_select *sel, uint32_t id,
 		return;
 	rt_instance *in = &ctx->inst[id];
 	mlod_rt_state *st = &in->st;
-	st->time += dt;
-	if (st->flags & MLOD_RT_LOOP) {
-		const float dur = ctx->clip_count ? ctx->clip_duration[st->clip] : 0.0f;
-		if (dur > 0.0f && (st->time >= dur || st->time < 0.0f)) {
-			st->time = fmodf(st->time, dur);
-			if (st->time < 0.0f)
-				st->time += dur;
-		}
+	/* time stays finite: when the float sum overflows, it is made in
+	 * double, where a looping instance's wraps and another's saturates at
+	 * +-FLT_MAX (below, in float, as it always was) */
+	const float dur = ctx->clip_count ? ctx->clip_duration[st->clip] : 0.0f;
+	const int loop = (st->flags & MLOD_RT_LOOP) && dur > 0.0f;
+	if (isfinite(st->time + dt)) {
+		st->time += dt;
+	} else {
+		double t = (double)st->time + dt;
+		if (loop)
+			t = fmod(t, dur);
+		st->time = (float)(t > FLT_MAX ? FLT_MAX : t < -FLT_MAX ? -FLT_MAX : t);
+	}
+	if (loop && (st->time >= dur || st->time < 0.0f)) {
+		st->time = fmodf(st->time, dur);
+		if (st->time < 0.0f)
+			st->time += dur;
 	}
 	st->distance = d; /* finite and >= 0: checked by the caller */
 	const float span = sel->d_far - sel->d_near;
@@ -147,8 +156,14 @@ static void update_one(mlod_rt_ctx *ctx, const mlod_rt_select *sel, uint32_t id,
 		st->wanted[layer] = (uint16_t)w;
 		/* a failed level's want goes to its fallback, which then loads */
 		rt_unit *u = rt_unit_get(ctx, (mlod_rt_layer)layer, w, item);
-		if (u && u->state == RT_UNIT_FAILED)
+		if (u && u->state == RT_UNIT_FAILED) {
+			/* one to try again keeps the want too (mlod_rt_stream) */
+			if (u->retry) {
+				u->want_count++;
+				u->last_wanted = ctx->stamp;
+			}
 			u = rt_unit_get(ctx, (mlod_rt_layer)layer, rt_want_target(ctx, (mlod_rt_layer)layer, item, w), item);
+		}
 		if (u) {
 			u->want_count++;
 			u->last_wanted = ctx->stamp;

@@ -345,6 +345,37 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		off[i] = at;
 		at += chunks[i].n;
 	}
+	/* INFO's first_drawable (mlod(5)): where the last of INFO, SKELETON and
+	 * the coarsest level of each layer ends (the coarsest: the largest level
+	 * of its type here). Written into the INFO chunk's record when that says
+	 * 0 and the chunk is the encoder's plain container with the record first
+	 * (tests that set another value keep it). */
+	uint32_t top[3] = {0, 0, 0}; /* SKELETON, MESH, MOTION */
+	for (int i = 0; i < nc; i++) {
+		const int k = c[i].type == MLOD_CHUNK_SKELETON ? 0 : c[i].type == MLOD_CHUNK_MESH ? 1
+		              : c[i].type == MLOD_CHUNK_MOTION ? 2 : -1;
+		if (k >= 0 && c[i].level > top[k])
+			top[k] = c[i].level;
+	}
+	uint64_t drawable = 0;
+	for (int i = 0; i < nc; i++) {
+		const int coarse = c[i].type == MLOD_CHUNK_INFO ||
+		                   (c[i].type == MLOD_CHUNK_SKELETON && (c[i].level == 0 || c[i].level == top[0])) ||
+		                   (c[i].type == MLOD_CHUNK_MESH && c[i].level == top[1]) ||
+		                   (c[i].type == MLOD_CHUNK_MOTION && c[i].level == top[2]);
+		if (coarse && off[i] + chunks[i].n > drawable)
+			drawable = off[i] + chunks[i].n;
+	}
+	for (int i = 0; i < nc; i++) {
+		uint8_t *b = chunks[i].p;
+		if (c[i].type != MLOD_CHUNK_INFO || stage[i] || chunks[i].n < 4 + 16 + 80 || b[0] == 0 ||
+		    memcmp(b + 4, "INFO", 4) != 0)
+			continue;
+		uint8_t *fd = b + 4 + 16 * (size_t)b[0] + 64;
+		if ((size_t)(fd + 4 - b) <= chunks[i].n && !(fd[0] | fd[1] | fd[2] | fd[3]))
+			for (int k = 0; k < 4; k++)
+				fd[k] = (uint8_t)(drawable >> (8 * k));
+	}
 	buf out = {0};
 	put(&out, "MLOD", 4);
 	put16(&out, major);

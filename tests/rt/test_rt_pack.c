@@ -206,6 +206,38 @@ static void write_pack(bytes *out)
 		offs[i] = off;
 		off += body[i].n;
 	}
+	/* INFO's first_drawable (mlod(5)): where the last of INFO, SKELETON and
+	 * the coarsest level of each layer ends (the coarsest: the largest level
+	 * of its type here). Written into the INFO chunk's record when that says
+	 * 0 and the chunk is the encoder's plain container with the record first
+	 * (tests that set another value keep it). */
+	uint32_t top[3] = { 0, 0, 0 }; /* SKELETON, MESH, MOTION */
+	for (int i = 0; i < nchunks; i++) {
+		const int k = chunks[i].type == MLOD_CHUNK_SKELETON ? 0 : chunks[i].type == MLOD_CHUNK_MESH ? 1
+		              : chunks[i].type == MLOD_CHUNK_MOTION ? 2 : -1;
+		if (k >= 0 && chunks[i].level > top[k])
+			top[k] = chunks[i].level;
+	}
+	uint64_t drawable = 0;
+	for (int i = 0; i < nchunks; i++) {
+		const chunk *c = &chunks[i];
+		const int coarse = c->type == MLOD_CHUNK_INFO ||
+		                   (c->type == MLOD_CHUNK_SKELETON && (c->level == 0 || c->level == top[0])) ||
+		                   (c->type == MLOD_CHUNK_MESH && c->level == top[1]) ||
+		                   (c->type == MLOD_CHUNK_MOTION && c->level == top[2]);
+		if (coarse && offs[i] + body[i].n > drawable)
+			drawable = offs[i] + body[i].n;
+	}
+	for (int i = 0; i < nchunks; i++) {
+		uint8_t *b = body[i].d;
+		if (chunks[i].type != MLOD_CHUNK_INFO || stage[i] || body[i].n < 4 + 16 + 80 || b[0] == 0 ||
+		    memcmp(b + 4, "INFO", 4) != 0)
+			continue;
+		uint8_t *fd = b + 4 + 16 * (size_t)b[0] + 64;
+		if ((size_t)(fd + 4 - b) <= body[i].n && !(fd[0] | fd[1] | fd[2] | fd[3]))
+			for (int k = 0; k < 4; k++)
+				fd[k] = (uint8_t)(drawable >> (8 * k));
+	}
 	memset(out, 0, sizeof *out);
 	put(out, "MLOD", 4);
 	put16(out, MLOD_PACK_MAJOR), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
