@@ -1251,6 +1251,40 @@ void normalise_node_rotations(mlod_gltf &doc)
 	}
 }
 
+/* tinygltf 2.x drops an animation channel whose target has no node
+ * (KHR_animation_pointer's, which targets a JSON pointer instead): each
+ * comes back at its place, target_node -1 (the JSON as read, kept in
+ * step, gives back its target's extensions when written). */
+void restore_nodeless_channels(Model &m, const json &j)
+{
+	if (!j.contains("animations") || !j["animations"].is_array())
+		return;
+	const json &anims = j["animations"];
+	for (size_t a = 0; a < anims.size() && a < m.animations.size(); a++) {
+		const json &oa = anims[a];
+		if (!oa.is_object() || !oa.contains("channels") || !oa["channels"].is_array() ||
+		    oa["channels"].size() == m.animations[a].channels.size())
+			continue;
+		std::vector<tinygltf::AnimationChannel> &channels = m.animations[a].channels;
+		const json &oc = oa["channels"];
+		for (size_t c = 0; c < oc.size(); c++) {
+			const json &ch = oc[c];
+			if (!ch.is_object() || !ch.contains("target") || !ch["target"].is_object() ||
+			    ch["target"].contains("node") || !ch.contains("sampler") || !ch["sampler"].is_number_integer() ||
+			    !ch["target"].contains("path") || !ch["target"]["path"].is_string() || c > channels.size())
+				continue;
+			tinygltf::AnimationChannel nc;
+			nc.sampler = ch["sampler"].get<int>();
+			nc.target_node = -1;
+			nc.target_path = ch["target"]["path"].get<std::string>();
+			if (ch["target"].contains("extensions") && ch["target"]["extensions"].is_object())
+				for (auto it = ch["target"]["extensions"].begin(); it != ch["target"]["extensions"].end(); ++it)
+					nc.target_extensions[it.key()] = to_value(*it);
+			channels.insert(channels.begin() + long(c), nc);
+		}
+	}
+}
+
 void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const char *base_dir)
 {
 	if (size == 0)
@@ -1292,6 +1326,7 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 				ch = ';';
 		fail(MLOD_ERR_PARSE, "glTF: %s", error.empty() ? "tinygltf could not load the document" : error.c_str());
 	}
+	restore_nodeless_channels(doc.model, j);
 	const tinygltf::Asset &asset = doc.model.asset;
 	if (asset.version.compare(0, 2, "2.") != 0 || (!asset.minVersion.empty() && asset.minVersion != "2.0"))
 		fail(MLOD_ERR_UNSUPPORTED, "glTF version %s (minimum %s) is not supported: mlod reads glTF 2.0",
@@ -2860,10 +2895,16 @@ void clear_lod(mlod_gltf &doc, int node)
 	}
 }
 
-/* What a pack's levels hold goes (mlod_gltf_strip_levels). */
-void strip_levels(mlod_gltf &doc)
+/* What a pack's levels hold goes (mlod_gltf_strip_levels): the joint
+ * channels are the translation, rotation and scale channels of the nodes
+ * in joint_nodes. */
+void strip_levels(mlod_gltf &doc, const int *joint_nodes, int joint_count)
 {
 	Model &m = doc.model;
+	std::vector<char> joint(m.nodes.size(), 0);
+	for (int i = 0; joint_nodes && i < joint_count; i++)
+		if (joint_nodes[i] >= 0 && size_t(joint_nodes[i]) < joint.size())
+			joint[size_t(joint_nodes[i])] = 1;
 	for (const std::string &e : m.extensionsUsed)
 		if (!prune_safe(e))
 			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not stripped",
@@ -2897,7 +2938,9 @@ void strip_levels(mlod_gltf &doc)
 				o.erase("targets");
 			}
 		}
-	/* Animations keep their morph weights channels only. */
+	/* Animations keep every channel but the joint ones (the MOTION
+	 * chunks hold those): morph weights, other nodes' translation,
+	 * rotation and scale, channels without a node (KHR_animation_pointer). */
 	json *anims = orig_array("animations");
 	std::vector<bool> keep(m.animations.size(), true);
 	for (size_t a = 0; a < m.animations.size(); a++) {
@@ -2909,10 +2952,14 @@ void strip_levels(mlod_gltf &doc)
 		json ochannels = json::array(), osamplers = json::array();
 		for (size_t c = 0; c < an.channels.size(); c++) {
 			tinygltf::AnimationChannel ch = an.channels[c];
+			bool node = ch.target_node >= 0 && size_t(ch.target_node) < m.nodes.size();
+			if (ch.sampler < 0 || size_t(ch.sampler) >= an.samplers.size())
+				continue;
+			if (node && joint[size_t(ch.target_node)] &&
+			    (ch.target_path == "translation" || ch.target_path == "rotation" || ch.target_path == "scale"))
+				continue;
 			/* (weights of a node left without mesh: a level node's copy) */
-			if (ch.target_path != "weights" || ch.sampler < 0 || size_t(ch.sampler) >= an.samplers.size() ||
-			    ch.target_node < 0 || size_t(ch.target_node) >= m.nodes.size() ||
-			    m.nodes[size_t(ch.target_node)].mesh < 0)
+			if (ch.target_path == "weights" && (!node || m.nodes[size_t(ch.target_node)].mesh < 0))
 				continue;
 			if (sampler_map[size_t(ch.sampler)] < 0) {
 				sampler_map[size_t(ch.sampler)] = int(samplers.size());
@@ -3538,11 +3585,11 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
 	});
 }
 
-mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, mlod_error *err)
+mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, const int *joint_nodes, int joint_count, mlod_error *err)
 {
 	return guard(err, [&] {
-		need(doc != nullptr, "mlod_gltf_strip_levels: doc is NULL");
-		strip_levels(*doc);
+		need(doc != nullptr && (joint_nodes || joint_count == 0), "mlod_gltf_strip_levels: doc is NULL");
+		strip_levels(*doc, joint_nodes, joint_count);
 	});
 }
 

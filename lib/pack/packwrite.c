@@ -3369,7 +3369,8 @@ static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
 		r = mlod_gltf_remove_extra(copy, MLOD_GLTF_ASSET, 0, "mlod", "end_site", err);
 	if (r == MLOD_OK && parts[trs_mode] > 0)
 		r = mlod_gltf_set_extra(copy, MLOD_GLTF_ASSET, 0, "mlod", trs_marks[trs_mode], err);
-	/* The level animations (those strip_levels left: morph weights). */
+	/* The level animations (those strip_levels left: morph weights, other
+	 * nodes' channels). */
 	for (int i = 0; r == MLOD_OK && i < c->clip_count; i++) {
 		int level = 1;
 		for (int q = 0; q < x->v.clip_count; q++)
@@ -3660,8 +3661,14 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		mlod_gltf *copy = NULL;
 		mlod_error serr = {0};
 		mlod_result sr = doc ? mlod_gltf_copy(doc, &copy, &serr) : MLOD_ERR_INVALID_ARG;
+		int *joint_nodes = malloc(sizeof(int) * ((size_t)c->skeleton.joint_count + 1)), jn = 0;
+		if (!joint_nodes)
+			sr = mlod_fail(&serr, MLOD_ERR_NOMEM, "out of memory");
+		for (int j = 0; joint_nodes && j < c->skeleton.joint_count; j++)
+			joint_nodes[jn++] = c->skeleton.joints[j].node;
 		if (sr == MLOD_OK && !opt->doc_whole)
-			sr = mlod_gltf_strip_levels(copy, &serr);
+			sr = mlod_gltf_strip_levels(copy, joint_nodes, jn, &serr);
+		free(joint_nodes);
 		if (sr == MLOD_OK && !opt->doc_whole)
 			sr = doc_dedupe(&x, copy, &serr);
 		if (sr == MLOD_OK)

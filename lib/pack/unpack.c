@@ -449,8 +449,8 @@ static mlod_result add_clip(mlod_gltf *doc, const mlod_skeleton *s, const mlod_p
 
 /* Per animation of the DOC as read, whether it holds joint channels (a
  * clip of the document's character with channels): the DOC holds the
- * input whole (mlod(5) DOC), as a stripped DOC keeps only morph weights
- * channels. *out is NULL when the document gives no character. */
+ * input whole (mlod(5) DOC), as a stripped DOC keeps no joint channel.
+ * *out is NULL when the document gives no character. */
 static mlod_result whole_animations(const mlod_gltf *doc, unsigned char **out, mlod_error *err)
 {
 	int n = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
@@ -835,8 +835,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	}
 
 	/* Motion: level 0 as the clip, coarser levels as <clip>@lod<k>. A
-	 * clip whose animation the DOC kept (for its morph weights channels)
-	 * goes back into it. */
+	 * clip whose animation the DOC kept (for its other channels: morph
+	 * weights, nodes that are not joints) goes back into it. */
 	int doc_anims = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
 	used = calloc((size_t)doc_anims + 1, 1);
 	if (!used) {
