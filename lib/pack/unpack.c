@@ -477,6 +477,51 @@ static mlod_result whole_animations(const mlod_gltf *doc, unsigned char **out, m
 	return MLOD_OK;
 }
 
+/* Whether a mesh of the DOC has a triangle list without attributes (its
+ * geometry stripped: a MESH part holds it). */
+static mlod_result mesh_stripped(const mlod_gltf *doc, int mesh, int *stripped, mlod_error *err)
+{
+	*stripped = 0;
+	for (int p = 0; !*stripped; p++) {
+		char **names = NULL;
+		int count = 0, mode = 4;
+		mlod_error e = {0};
+		mlod_result r = mlod_gltf_primitive_attributes(doc, mesh, p, &mode, &names, &count, &e);
+		if (r == MLOD_ERR_NOMEM)
+			return mlod_fail(err, r, "%s", e.message);
+		if (r != MLOD_OK) /* past the mesh's last primitive */
+			break;
+		mlod_free(names);
+		*stripped = mode == 4 && count == 0;
+	}
+	return MLOD_OK;
+}
+
+/* Every DOC node whose mesh lost its geometry to the MESH chunks must be
+ * an instance node of MESH level 0's parts, which give it back: another
+ * would keep a primitive without attributes (not glTF). */
+static mlod_result check_doc_meshes(const mlod_gltf *doc, const mlod_pack_mesh *level0, mlod_error *err)
+{
+	int nodes = mlod_gltf_count(doc, MLOD_GLTF_NODE);
+	for (int n = 0; n < nodes; n++) {
+		int mesh = -1, skin = -1, stripped = 0, part = 0;
+		mlod_error ignored = {0};
+		if (mlod_gltf_node_refs(doc, n, &mesh, &skin, &ignored) != MLOD_OK || mesh < 0)
+			continue;
+		for (uint32_t i = 0; level0 && i < level0->part_count && !part; i++)
+			part = level0->parts[i].rec.node == n;
+		if (part)
+			continue;
+		mlod_result r = mesh_stripped(doc, mesh, &stripped, err);
+		if (r != MLOD_OK)
+			return r;
+		if (stripped)
+			return mlod_fail(err, MLOD_ERR_PARSE, "DOC: node %d has mesh %d, whose triangles no MESH part of "
+			                 "that node holds", n, mesh);
+	}
+	return MLOD_OK;
+}
+
 /* Reads the DOC's glb (mlod_gltf_read_doc: buffers emptied by stripping,
  * as older packs hold them, are dropped). */
 static mlod_result read_doc(const void *glb, size_t size, mlod_gltf **doc, mlod_error *err)
@@ -680,6 +725,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		    MLOD_OK)
 			goto done;
 	}
+	if ((r = check_doc_meshes(doc, mesh_levels > 0 ? &meshes[0] : NULL, err)) != MLOD_OK)
+		goto done;
 	/* The record's mesh levels: what the pack stores of each. */
 	mesh_rec = calloc((size_t)mesh_levels + 1, sizeof *mesh_rec);
 	if (!mesh_rec) {
