@@ -73,6 +73,10 @@ struct mlod_gltf {
 	int rotations_normalised = 0;
 	int rotation_node = -1;
 	double rotation_length = 0.0;
+	/* mlod_gltf_keep_indices: what goes, goes from the end of its array
+	 * only (prune, drop_animation), so that no index an unknown extension
+	 * may hold changes. */
+	bool keep_indices = false;
 };
 
 namespace {
@@ -2677,11 +2681,102 @@ template <class T> void keep_only(std::vector<T> &v, const std::vector<bool> &ke
 	v.resize(n);
 }
 
+/* The buffer views and buffers that an extension's JSON names (a
+ * "bufferView" or "buffer" member anywhere inside an "extensions"
+ * object), which prune_tail keeps whole. */
+void extension_refs(const json &j, bool inside, std::vector<bool> &views, std::vector<bool> &buffers)
+{
+	if (j.is_object()) {
+		for (auto it = j.begin(); it != j.end(); ++it) {
+			if (inside && it->is_number_integer() && it->get<long long>() >= 0) {
+				size_t i = size_t(it->get<long long>());
+				if (it.key() == "bufferView" && i < views.size())
+					views[i] = true;
+				if (it.key() == "buffer" && i < buffers.size())
+					buffers[i] = true;
+			}
+			extension_refs(*it, inside || it.key() == "extensions", views, buffers);
+		}
+	} else if (j.is_array()) {
+		for (const json &e : j)
+			extension_refs(e, inside, views, buffers);
+	}
+}
+
+/* prune for a document whose indices must hold (keep_indices): the
+ * accessors and buffer views after the last one in use go, and each
+ * buffer's bytes after its last kept view (a buffer an extension names
+ * stays whole); nothing else moves. */
+void prune_tail(mlod_gltf &doc)
+{
+	Model &m = doc.model;
+	auto mark = [](std::vector<bool> &used, int i) {
+		if (i >= 0 && size_t(i) < used.size())
+			used[size_t(i)] = true;
+	};
+	auto tail = [](std::vector<bool> &used) {
+		size_t n = used.size();
+		while (n > 0 && !used[n - 1])
+			n--;
+		for (size_t i = 0; i < used.size(); i++)
+			used[i] = i < n;
+	};
+	std::vector<bool> used(m.accessors.size(), false);
+	for (const tinygltf::Mesh &mesh : m.meshes)
+		for (const tinygltf::Primitive &p : mesh.primitives) {
+			mark(used, p.indices);
+			for (const auto &kv : p.attributes)
+				mark(used, kv.second);
+			for (const auto &t : p.targets)
+				for (const auto &kv : t)
+					mark(used, kv.second);
+		}
+	for (const tinygltf::Skin &s : m.skins)
+		mark(used, s.inverseBindMatrices);
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationSampler &s : a.samplers) {
+			mark(used, s.input);
+			mark(used, s.output);
+		}
+	tail(used);
+	renumber(doc, "accessors", used);
+	keep_only(m.accessors, used);
+
+	used.assign(m.bufferViews.size(), false);
+	std::vector<bool> named(m.buffers.size(), false);
+	extension_refs(doc.original, false, used, named);
+	for (const tinygltf::Accessor &a : m.accessors) {
+		mark(used, a.bufferView);
+		if (a.sparse.isSparse) {
+			mark(used, a.sparse.indices.bufferView);
+			mark(used, a.sparse.values.bufferView);
+		}
+	}
+	for (const tinygltf::Image &i : m.images)
+		mark(used, i.bufferView);
+	tail(used);
+	renumber(doc, "bufferViews", used);
+	keep_only(m.bufferViews, used);
+	for (size_t b = 0; b < m.buffers.size(); b++) {
+		size_t end = 0;
+		bool any = false;
+		for (const tinygltf::BufferView &v : m.bufferViews)
+			if (v.buffer == int(b))
+				any = true, end = std::max(end, size_t(v.byteOffset + v.byteLength));
+		if (any && !named[b] && end < m.buffers[b].data.size())
+			m.buffers[b].data.resize(end);
+	}
+}
+
 /* Drops the meshes no node uses, then the accessors and buffer views
  * nothing uses, and packs the buffers' bytes again. */
 void prune(mlod_gltf &doc, bool meshes = true)
 {
 	Model &m = doc.model;
+	if (doc.keep_indices) {
+		prune_tail(doc);
+		return;
+	}
 	for (const std::string &e : m.extensionsUsed)
 		if (!prune_safe(e))
 			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not pruned",
@@ -3182,6 +3277,8 @@ void drop_animation(mlod_gltf &doc, int a)
 	Model &m = doc.model;
 	if (a < 0 || size_t(a) >= m.animations.size())
 		fail(MLOD_ERR_INVALID_ARG, "animation %d does not exist", a);
+	if (doc.keep_indices && size_t(a) + 1 != m.animations.size())
+		fail(MLOD_ERR_UNSUPPORTED, "animation %d is not the last: the animations after it would be renumbered", a);
 	std::vector<bool> keep(m.animations.size(), true);
 	keep[size_t(a)] = false;
 	renumber(doc, "animations", keep);
@@ -3591,6 +3688,18 @@ mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, const int *joint_nodes, int j
 		need(doc != nullptr && (joint_nodes || joint_count == 0), "mlod_gltf_strip_levels: doc is NULL");
 		strip_levels(*doc, joint_nodes, joint_count);
 	});
+}
+
+void mlod_gltf_keep_indices(mlod_gltf *doc, int on)
+{
+	if (doc)
+		doc->keep_indices = on != 0;
+}
+
+int mlod_gltf_skin_has_inverse_binds(const mlod_gltf *doc, int skin)
+{
+	return doc && skin >= 0 && size_t(skin) < doc->model.skins.size() &&
+	       doc->model.skins[size_t(skin)].inverseBindMatrices >= 0;
 }
 
 mlod_result mlod_gltf_remove_extra(mlod_gltf *doc, mlod_gltf_kind kind, int index, const char *key,

@@ -163,6 +163,17 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
 mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, const int *joint_nodes, int joint_count, mlod_error *err);
 
 /* For a pack's DOC chunk (mlod-pack, mlod(5)): */
+/* From now on (on != 0) mlod_gltf_drop_tail, mlod_gltf_drop_animation and
+ * mlod_gltf_prune change no index that stays: a dropped animation must be
+ * the last one (else MLOD_ERR_UNSUPPORTED, the document unchanged), and
+ * only the accessors and buffer views after the last one in use go, with
+ * each buffer's bytes after its last kept view (but in a buffer an
+ * extension names); meshes stay. For a document using an extension mlod
+ * does not know, which may hold any index: the DOC chunk that keeps the
+ * input whole drops the levels the stages and mlod-pack -x append. */
+void mlod_gltf_keep_indices(mlod_gltf *doc, int on);
+/* Whether skin `skin` has inverse bind matrices (an accessor). */
+int mlod_gltf_skin_has_inverse_binds(const mlod_gltf *doc, int skin);
 /* Removes extras[key] of an object (its extras whole when nothing else is
  * left in them), but when extras[key] is an object with a member `keep`
  * (NULL: none), that member stays alone in it; nothing without the key. */

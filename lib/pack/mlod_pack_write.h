@@ -130,6 +130,7 @@ typedef struct mlod_pack_stats {
 	int joints, skins, parts, clips;
 	float height, diagonal;
 	char notes[1024];            /* the reader's notes on the input, then what was done or skipped, "; "-separated */
+	char doc_note[MLOD_ERROR_MESSAGE_SIZE + 64]; /* why DOC holds the input whole ("" when stripped), also in notes */
 } mlod_pack_stats;
 
 /* Packs the character c read from doc (mlod_load of input, input_size

@@ -3330,12 +3330,12 @@ static int listed(const int *list, int n, int g)
  * its level nodes (MSFT_lod entries, nodes with a level skin), level
  * skins and level meshes when they are the last of their kind (as the
  * stages append them; else they stay, with a note). */
-static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
+static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, int whole, mlod_error *err)
 {
 	const mlod_character *c = x->in;
 	const mlod_skeleton *s = &c->skeleton;
 	mlod_result r = MLOD_OK;
-	for (int i = 0; r == MLOD_OK && i < x->v.skeleton.skin_count; i++) {
+	for (int i = 0; r == MLOD_OK && !whole && i < x->v.skeleton.skin_count; i++) {
 		const mlod_skin *sk = &x->v.skeleton.skins[i];
 		if (sk->gltf_index >= 0 && x->v.skeleton.joint_count > 0 && !identity_binds(sk))
 			r = mlod_gltf_drop_inverse_binds(copy, sk->gltf_index, err);
@@ -3345,7 +3345,7 @@ static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
 	 * decimals (1) or their 15 significant digits (2), whichever more
 	 * parts use (the asset's extras.mlod.doc_trs says which). */
 	int parts[3] = {0, 0, 0}, nodes = mlod_gltf_count(copy, MLOD_GLTF_NODE);
-	for (int mode = 0; mode < 3; mode++)
+	for (int mode = 0; mode < 3 && !whole; mode++)
 		for (int j = 0; r == MLOD_OK && j < x->v.skeleton.joint_count; j++) {
 			const mlod_joint *q = &x->v.skeleton.joints[j];
 			int d = 0;
@@ -3370,15 +3370,25 @@ static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
 	if (r == MLOD_OK && parts[trs_mode] > 0)
 		r = mlod_gltf_set_extra(copy, MLOD_GLTF_ASSET, 0, "mlod", trs_marks[trs_mode], err);
 	/* The level animations (those strip_levels left: morph weights, other
-	 * nodes' channels). */
-	for (int i = 0; r == MLOD_OK && i < c->clip_count; i++) {
-		int level = 1;
-		for (int q = 0; q < x->v.clip_count; q++)
-			level &= x->v.clips[q].name != c->clips[i].name;
-		int a = level && c->clips[i].name ? mlod_gltf_find_animation(copy, c->clips[i].name, 0) : -1;
-		if (a >= 0)
+	 * nodes' channels); a document whose indices hold (whole), from the
+	 * last animation down while they are levels. */
+	int anims = mlod_gltf_count(copy, MLOD_GLTF_ANIMATION), dropped = 0, levels = 0;
+	for (int a = anims - 1; r == MLOD_OK && a >= 0; a--) {
+		int level = 0;
+		for (int i = 0; !level && i < c->clip_count; i++) {
+			int in_v = 0;
+			for (int q = 0; q < x->v.clip_count; q++)
+				in_v |= x->v.clips[q].name == c->clips[i].name;
+			level = !in_v && c->clips[i].name && mlod_gltf_find_animation(copy, c->clips[i].name, 0) == a;
+		}
+		levels += level;
+		if (level && (!whole || a + dropped + 1 == anims)) {
 			r = mlod_gltf_drop_animation(copy, a, err);
+			dropped++;
+		}
 	}
+	if (r == MLOD_OK && dropped < levels)
+		note(x, "the document chunk keeps some of the input's level animations: they are not its last animations");
 	if (r != MLOD_OK || !x->doc)
 		return r;
 	/* The level nodes (every MSFT_lod entry), their meshes, level skins. */
@@ -3670,26 +3680,57 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			sr = mlod_gltf_strip_levels(copy, joint_nodes, jn, &serr);
 		free(joint_nodes);
 		if (sr == MLOD_OK && !opt->doc_whole)
-			sr = doc_dedupe(&x, copy, &serr);
+			sr = doc_dedupe(&x, copy, 0, &serr);
 		if (sr == MLOD_OK)
 			sr = mlod_gltf_write(copy, 1, &glb, &glb_size, &serr);
 		mlod_gltf_free(copy);
+		copy = NULL;
+		int whole = 0;
+		if (sr == MLOD_ERR_UNSUPPORTED && doc && !opt->doc_whole) {
+			/* An extension mlod does not know may hold any index: the
+			 * document stays whole, but for what goes without moving an
+			 * index (mlod_gltf_keep_indices): the stages' records and
+			 * MSFT_lod, and the levels the stages and -x append at the
+			 * ends of the arrays, so that unpacking and packing again
+			 * gives the same document. */
+			mlod_error werr = {0};
+			mlod_result wr = mlod_gltf_copy(doc, &copy, &werr);
+			mlod_free(glb);
+			glb = NULL;
+			if (wr == MLOD_OK) {
+				mlod_gltf_keep_indices(copy, 1);
+				for (int n = 0; wr == MLOD_OK && n < mlod_gltf_count(copy, MLOD_GLTF_NODE); n++)
+					wr = mlod_gltf_clear_lod(copy, n, &werr);
+			}
+			if (wr == MLOD_OK)
+				wr = doc_dedupe(&x, copy, 1, &werr);
+			if (wr == MLOD_OK)
+				wr = mlod_gltf_write(copy, 1, &glb, &glb_size, &werr);
+			mlod_gltf_free(copy);
+			if (wr == MLOD_ERR_NOMEM) {
+				mlod_free(glb);
+				r = mlod_fail(err, wr, "%s", werr.message);
+				goto done;
+			}
+			whole = wr == MLOD_OK;
+		}
+		if (sr != MLOD_OK && (whole || (format == MLOD_FORMAT_GLB && input) || doc)) {
+			snprintf(x.st->doc_note, sizeof x.st->doc_note, "the document chunk holds the input whole: %s",
+			         serr.message);
+			note(&x, x.st->doc_note);
+		}
 		if (sr == MLOD_OK) {
 			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
 			x.st->doc_stripped = !opt->doc_whole;
+		} else if (whole) {
+			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
 		} else if (format == MLOD_FORMAT_GLB && input) {
-			char text[MLOD_ERROR_MESSAGE_SIZE + 64];
-			snprintf(text, sizeof text, "the document chunk holds the input whole: %s", serr.message);
-			note(&x, text);
 			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)input_size, 1, input, 0);
 		} else if (doc) {
 			mlod_free(glb);
 			glb = NULL;
 			if ((r = mlod_gltf_write(doc, 1, &glb, &glb_size, err)) != MLOD_OK)
 				goto done;
-			char text[MLOD_ERROR_MESSAGE_SIZE + 64];
-			snprintf(text, sizeof text, "the document chunk holds the input whole: %s", serr.message);
-			note(&x, text);
 			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
 		} else {
 			cb_add(&cb, MLOD_STREAM_GLB, 0, 1, NULL, 0);

@@ -672,7 +672,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		int identity = 1;
 		for (int j = 0; identity && j < sk->joint_count; j++)
 			identity = memcmp(&sk->inverse_bind[j], &id, sizeof id) == 0;
-		if (identity || sk->gltf_index < 0 || sk->gltf_index >= mlod_gltf_count(doc, MLOD_GLTF_SKIN))
+		if (identity || sk->gltf_index < 0 || sk->gltf_index >= mlod_gltf_count(doc, MLOD_GLTF_SKIN) ||
+		    mlod_gltf_skin_has_inverse_binds(doc, sk->gltf_index)) /* a DOC holding the input whole */
 			continue;
 		mlod_error serr = {0};
 		if (mlod_gltf_set_inverse_binds(doc, sk->gltf_index, sk->inverse_bind, sk->joint_count, &serr) != MLOD_OK) {
@@ -805,8 +806,17 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			snprintf(where, sizeof where, "MESH level 0");
 			if ((r = mlod_gltf_node_refs(doc, node, &old_mesh, &old_skin, err)) != MLOD_OK)
 				goto done;
-			/* Level 0: the node's own mesh again. */
-			if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) && mesh_map[like] >= 0) {
+			/* Level 0: the node's own mesh again; a DOC that holds the
+			 * input whole has it as read (which an extension mlod does
+			 * not know may refer to): it stays. */
+			int kept = 0;
+			if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) && like == old_mesh &&
+			    (r = mesh_stripped(doc, like, &kept, err)) != MLOD_OK)
+				goto done;
+			kept = like >= 0 && like == old_mesh && !kept;
+			if (kept) {
+				mesh = like;
+			} else if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) && mesh_map[like] >= 0) {
 				mesh = mesh_map[like];
 			} else {
 				if ((r = add_parts_mesh(doc, &meshes[0], parts, count, like, NULL, 0, &s, &mesh, err)) != MLOD_OK)
