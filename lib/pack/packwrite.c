@@ -648,6 +648,22 @@ struct clip_levels {
 	float error[MLOD_PACK_MAX_MOTION_LEVELS];
 };
 
+/* The root of skin `skin` as a skin joint index: its joint nearest the
+ * skeleton's root (the first of them). */
+static int skin_root(const mlod_skeleton *s, int skin)
+{
+	const mlod_skin *sk = &s->skins[skin];
+	int best = 0, best_depth = -1;
+	for (int q = 0; q < sk->joint_count; q++) {
+		int depth = 0, j = sk->joints[q];
+		while (j >= 0 && j < s->joint_count && depth <= s->joint_count)
+			j = s->joints[j].parent, depth++;
+		if (best_depth < 0 || depth < best_depth)
+			best = q, best_depth = depth;
+	}
+	return best;
+}
+
 struct ctx {
 	const mlod_gltf *doc;
 	const mlod_character *in;
@@ -1428,6 +1444,10 @@ static void part_quantise(struct ctx *x, const struct mpart *m, int k, uint8_t *
 			uint8_t w8[4], j8[4];
 			uint16_t j16[4];
 			mlod_pack_weights8(bw, w8);
+			if (w8[0] + w8[1] + w8[2] + w8[3] == 0) { /* no weight: the skin's root (note_unweighted) */
+				w8[0] = 255;
+				bj[0] = skin_root(&x->v.skeleton, rec->skin);
+			}
 			for (int t = 0; t < 4; t++) {
 				int jt = w8[t] ? bj[t] : 0;
 				if (jt < 0 || jt >= joints)
@@ -3294,6 +3314,50 @@ static mlod_result note_unstored_attributes(struct ctx *x, const mlod_gltf *doc)
 	return MLOD_OK;
 }
 
+/* Notes the skinned vertices whose weights are all 0 (glTF wants them to
+ * sum to 1; the validator flags them): a pack's weights sum to 255, so
+ * each goes on the skin's root joint (skin_root), which the vertex then
+ * follows. */
+static void note_unweighted(struct ctx *x)
+{
+	const mlod_character *c = x->in;
+	for (int m = 0; m < c->mesh_count; m++) {
+		int skin = -1;
+		for (int i = 0; i < c->instance_count && skin < 0; i++)
+			if (c->instances[i].mesh == m)
+				skin = c->instances[i].skin;
+		if (skin < 0 || skin >= c->skeleton.skin_count)
+			continue;
+		const mlod_mesh *mesh = &c->meshes[m];
+		for (int p = 0; p < mesh->primitive_count; p++) {
+			const mlod_primitive *pr = &mesh->primitives[p];
+			int count = 0, first = -1;
+			for (int v = 0; pr->weight_set_count > 0 && v < pr->vertex_count; v++) {
+				int any = 0;
+				for (int set = 0; set < pr->weight_set_count && !any; set++)
+					for (int i = 0; i < 4; i++)
+						any |= pr->weights[set][4 * (size_t)v + (size_t)i] > 0.0f;
+				if (!any && count++ == 0)
+					first = v;
+			}
+			if (count == 0)
+				continue;
+			const mlod_skin *sk = &c->skeleton.skins[skin];
+			int root = sk->joint_count > 0 ? sk->joints[skin_root(&c->skeleton, skin)] : -1;
+			const char *name = root >= 0 && c->skeleton.joints[root].name ? c->skeleton.joints[root].name : "";
+			char text[256];
+			int g = mesh->gltf_index >= 0 ? mesh->gltf_index : m;
+			if (count == 1)
+				snprintf(text, sizeof text, "mesh %d primitive %d: vertex %d has no weight: it follows the skin's "
+				         "root joint \"%.64s\"", g, p, first, name);
+			else
+				snprintf(text, sizeof text, "mesh %d primitive %d: %d vertices have no weight (vertex %d the first): "
+				         "they follow the skin's root joint \"%.64s\"", g, p, count, first, name);
+			note(x, text);
+		}
+	}
+}
+
 /* ------------------------------------------------------------------ */
 /* The pack                                                            */
 /* ------------------------------------------------------------------ */
@@ -3581,6 +3645,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		goto done;
 	if (mlod_mesh_triangle_primitives(&x.v) > 0 && (r = note_unstored_attributes(&x, doc)) != MLOD_OK)
 		goto done;
+	note_unweighted(&x);
 
 	/* The levels of each layer. */
 	t0 = now_seconds();
