@@ -455,6 +455,10 @@ int main(int argc, char **argv)
 		tool_die(tool_exit_code(r), label, "%s", err.message);
 	if (c.clip_count == 0 && c.skeleton.joint_count > 0)
 		fprintf(stderr, "%s: %s: no animation: the pack has no motion levels\n", tool_name, label);
+	if (st.doc_note[0]) { /* the pack is far larger than a stripped one: said, with or without --report */
+		fprintf(stderr, "%s: %s: ", tool_name, label);
+		tool_put_line(stderr, "", st.doc_note);
+	}
 	if (output || report == REPORT_NONE)
 		tool_write_output(output, pack, pack_size, 1);
 	char codec_label[48];

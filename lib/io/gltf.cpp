@@ -73,6 +73,10 @@ struct mlod_gltf {
 	int rotations_normalised = 0;
 	int rotation_node = -1;
 	double rotation_length = 0.0;
+	/* mlod_gltf_keep_indices: what goes, goes from the end of its array
+	 * only (prune, drop_animation), so that no index an unknown extension
+	 * may hold changes. */
+	bool keep_indices = false;
 };
 
 namespace {
@@ -1251,6 +1255,40 @@ void normalise_node_rotations(mlod_gltf &doc)
 	}
 }
 
+/* tinygltf 2.x drops an animation channel whose target has no node
+ * (KHR_animation_pointer's, which targets a JSON pointer instead): each
+ * comes back at its place, target_node -1 (the JSON as read, kept in
+ * step, gives back its target's extensions when written). */
+void restore_nodeless_channels(Model &m, const json &j)
+{
+	if (!j.contains("animations") || !j["animations"].is_array())
+		return;
+	const json &anims = j["animations"];
+	for (size_t a = 0; a < anims.size() && a < m.animations.size(); a++) {
+		const json &oa = anims[a];
+		if (!oa.is_object() || !oa.contains("channels") || !oa["channels"].is_array() ||
+		    oa["channels"].size() == m.animations[a].channels.size())
+			continue;
+		std::vector<tinygltf::AnimationChannel> &channels = m.animations[a].channels;
+		const json &oc = oa["channels"];
+		for (size_t c = 0; c < oc.size(); c++) {
+			const json &ch = oc[c];
+			if (!ch.is_object() || !ch.contains("target") || !ch["target"].is_object() ||
+			    ch["target"].contains("node") || !ch.contains("sampler") || !ch["sampler"].is_number_integer() ||
+			    !ch["target"].contains("path") || !ch["target"]["path"].is_string() || c > channels.size())
+				continue;
+			tinygltf::AnimationChannel nc;
+			nc.sampler = ch["sampler"].get<int>();
+			nc.target_node = -1;
+			nc.target_path = ch["target"]["path"].get<std::string>();
+			if (ch["target"].contains("extensions") && ch["target"]["extensions"].is_object())
+				for (auto it = ch["target"]["extensions"].begin(); it != ch["target"]["extensions"].end(); ++it)
+					nc.target_extensions[it.key()] = to_value(*it);
+			channels.insert(channels.begin() + long(c), nc);
+		}
+	}
+}
+
 void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const char *base_dir)
 {
 	if (size == 0)
@@ -1292,6 +1330,7 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 				ch = ';';
 		fail(MLOD_ERR_PARSE, "glTF: %s", error.empty() ? "tinygltf could not load the document" : error.c_str());
 	}
+	restore_nodeless_channels(doc.model, j);
 	const tinygltf::Asset &asset = doc.model.asset;
 	if (asset.version.compare(0, 2, "2.") != 0 || (!asset.minVersion.empty() && asset.minVersion != "2.0"))
 		fail(MLOD_ERR_UNSUPPORTED, "glTF version %s (minimum %s) is not supported: mlod reads glTF 2.0",
@@ -2642,11 +2681,102 @@ template <class T> void keep_only(std::vector<T> &v, const std::vector<bool> &ke
 	v.resize(n);
 }
 
+/* The buffer views and buffers that an extension's JSON names (a
+ * "bufferView" or "buffer" member anywhere inside an "extensions"
+ * object), which prune_tail keeps whole. */
+void extension_refs(const json &j, bool inside, std::vector<bool> &views, std::vector<bool> &buffers)
+{
+	if (j.is_object()) {
+		for (auto it = j.begin(); it != j.end(); ++it) {
+			if (inside && it->is_number_integer() && it->get<long long>() >= 0) {
+				size_t i = size_t(it->get<long long>());
+				if (it.key() == "bufferView" && i < views.size())
+					views[i] = true;
+				if (it.key() == "buffer" && i < buffers.size())
+					buffers[i] = true;
+			}
+			extension_refs(*it, inside || it.key() == "extensions", views, buffers);
+		}
+	} else if (j.is_array()) {
+		for (const json &e : j)
+			extension_refs(e, inside, views, buffers);
+	}
+}
+
+/* prune for a document whose indices must hold (keep_indices): the
+ * accessors and buffer views after the last one in use go, and each
+ * buffer's bytes after its last kept view (a buffer an extension names
+ * stays whole); nothing else moves. */
+void prune_tail(mlod_gltf &doc)
+{
+	Model &m = doc.model;
+	auto mark = [](std::vector<bool> &used, int i) {
+		if (i >= 0 && size_t(i) < used.size())
+			used[size_t(i)] = true;
+	};
+	auto tail = [](std::vector<bool> &used) {
+		size_t n = used.size();
+		while (n > 0 && !used[n - 1])
+			n--;
+		for (size_t i = 0; i < used.size(); i++)
+			used[i] = i < n;
+	};
+	std::vector<bool> used(m.accessors.size(), false);
+	for (const tinygltf::Mesh &mesh : m.meshes)
+		for (const tinygltf::Primitive &p : mesh.primitives) {
+			mark(used, p.indices);
+			for (const auto &kv : p.attributes)
+				mark(used, kv.second);
+			for (const auto &t : p.targets)
+				for (const auto &kv : t)
+					mark(used, kv.second);
+		}
+	for (const tinygltf::Skin &s : m.skins)
+		mark(used, s.inverseBindMatrices);
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationSampler &s : a.samplers) {
+			mark(used, s.input);
+			mark(used, s.output);
+		}
+	tail(used);
+	renumber(doc, "accessors", used);
+	keep_only(m.accessors, used);
+
+	used.assign(m.bufferViews.size(), false);
+	std::vector<bool> named(m.buffers.size(), false);
+	extension_refs(doc.original, false, used, named);
+	for (const tinygltf::Accessor &a : m.accessors) {
+		mark(used, a.bufferView);
+		if (a.sparse.isSparse) {
+			mark(used, a.sparse.indices.bufferView);
+			mark(used, a.sparse.values.bufferView);
+		}
+	}
+	for (const tinygltf::Image &i : m.images)
+		mark(used, i.bufferView);
+	tail(used);
+	renumber(doc, "bufferViews", used);
+	keep_only(m.bufferViews, used);
+	for (size_t b = 0; b < m.buffers.size(); b++) {
+		size_t end = 0;
+		bool any = false;
+		for (const tinygltf::BufferView &v : m.bufferViews)
+			if (v.buffer == int(b))
+				any = true, end = std::max(end, size_t(v.byteOffset + v.byteLength));
+		if (any && !named[b] && end < m.buffers[b].data.size())
+			m.buffers[b].data.resize(end);
+	}
+}
+
 /* Drops the meshes no node uses, then the accessors and buffer views
  * nothing uses, and packs the buffers' bytes again. */
 void prune(mlod_gltf &doc, bool meshes = true)
 {
 	Model &m = doc.model;
+	if (doc.keep_indices) {
+		prune_tail(doc);
+		return;
+	}
 	for (const std::string &e : m.extensionsUsed)
 		if (!prune_safe(e))
 			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not pruned",
@@ -2860,10 +2990,16 @@ void clear_lod(mlod_gltf &doc, int node)
 	}
 }
 
-/* What a pack's levels hold goes (mlod_gltf_strip_levels). */
-void strip_levels(mlod_gltf &doc)
+/* What a pack's levels hold goes (mlod_gltf_strip_levels): the joint
+ * channels are the translation, rotation and scale channels of the nodes
+ * in joint_nodes. */
+void strip_levels(mlod_gltf &doc, const int *joint_nodes, int joint_count)
 {
 	Model &m = doc.model;
+	std::vector<char> joint(m.nodes.size(), 0);
+	for (int i = 0; joint_nodes && i < joint_count; i++)
+		if (joint_nodes[i] >= 0 && size_t(joint_nodes[i]) < joint.size())
+			joint[size_t(joint_nodes[i])] = 1;
 	for (const std::string &e : m.extensionsUsed)
 		if (!prune_safe(e))
 			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not stripped",
@@ -2897,7 +3033,9 @@ void strip_levels(mlod_gltf &doc)
 				o.erase("targets");
 			}
 		}
-	/* Animations keep their morph weights channels only. */
+	/* Animations keep every channel but the joint ones (the MOTION
+	 * chunks hold those): morph weights, other nodes' translation,
+	 * rotation and scale, channels without a node (KHR_animation_pointer). */
 	json *anims = orig_array("animations");
 	std::vector<bool> keep(m.animations.size(), true);
 	for (size_t a = 0; a < m.animations.size(); a++) {
@@ -2909,10 +3047,14 @@ void strip_levels(mlod_gltf &doc)
 		json ochannels = json::array(), osamplers = json::array();
 		for (size_t c = 0; c < an.channels.size(); c++) {
 			tinygltf::AnimationChannel ch = an.channels[c];
+			bool node = ch.target_node >= 0 && size_t(ch.target_node) < m.nodes.size();
+			if (ch.sampler < 0 || size_t(ch.sampler) >= an.samplers.size())
+				continue;
+			if (node && joint[size_t(ch.target_node)] &&
+			    (ch.target_path == "translation" || ch.target_path == "rotation" || ch.target_path == "scale"))
+				continue;
 			/* (weights of a node left without mesh: a level node's copy) */
-			if (ch.target_path != "weights" || ch.sampler < 0 || size_t(ch.sampler) >= an.samplers.size() ||
-			    ch.target_node < 0 || size_t(ch.target_node) >= m.nodes.size() ||
-			    m.nodes[size_t(ch.target_node)].mesh < 0)
+			if (ch.target_path == "weights" && (!node || m.nodes[size_t(ch.target_node)].mesh < 0))
 				continue;
 			if (sampler_map[size_t(ch.sampler)] < 0) {
 				sampler_map[size_t(ch.sampler)] = int(samplers.size());
@@ -3135,6 +3277,8 @@ void drop_animation(mlod_gltf &doc, int a)
 	Model &m = doc.model;
 	if (a < 0 || size_t(a) >= m.animations.size())
 		fail(MLOD_ERR_INVALID_ARG, "animation %d does not exist", a);
+	if (doc.keep_indices && size_t(a) + 1 != m.animations.size())
+		fail(MLOD_ERR_UNSUPPORTED, "animation %d is not the last: the animations after it would be renumbered", a);
 	std::vector<bool> keep(m.animations.size(), true);
 	keep[size_t(a)] = false;
 	renumber(doc, "animations", keep);
@@ -3538,12 +3682,24 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
 	});
 }
 
-mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, mlod_error *err)
+mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, const int *joint_nodes, int joint_count, mlod_error *err)
 {
 	return guard(err, [&] {
-		need(doc != nullptr, "mlod_gltf_strip_levels: doc is NULL");
-		strip_levels(*doc);
+		need(doc != nullptr && (joint_nodes || joint_count == 0), "mlod_gltf_strip_levels: doc is NULL");
+		strip_levels(*doc, joint_nodes, joint_count);
 	});
+}
+
+void mlod_gltf_keep_indices(mlod_gltf *doc, int on)
+{
+	if (doc)
+		doc->keep_indices = on != 0;
+}
+
+int mlod_gltf_skin_has_inverse_binds(const mlod_gltf *doc, int skin)
+{
+	return doc && skin >= 0 && size_t(skin) < doc->model.skins.size() &&
+	       doc->model.skins[size_t(skin)].inverseBindMatrices >= 0;
 }
 
 mlod_result mlod_gltf_remove_extra(mlod_gltf *doc, mlod_gltf_kind kind, int index, const char *key,

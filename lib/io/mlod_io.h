@@ -146,19 +146,34 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
 /* Removes what a pack's levels hold (mlod(5), the DOC chunk): every
  * triangle list's attributes, indices and morph targets (each keeps its
  * mode, material, extensions and extras; points, lines, strips and fans,
- * which the levels do not hold, stay whole), every animation channel but morph
- * weights ones of nodes that keep a mesh (animations left without
- * channels go), MSFT_lod (level
- * nodes stay, without mesh or skin), then the accessors, buffer views and
+ * which the levels do not hold, stay whole), the joint channels (the
+ * translation, rotation and scale channels of the joint_count nodes
+ * joint_nodes lists, which a pack's MOTION chunks hold) and the morph
+ * weights channels of nodes left without a mesh (a level node's copy):
+ * other channels stay, with their samplers (a non-joint node's motion,
+ * morph weights, KHR_animation_pointer); animations left without
+ * channels go. MSFT_lod goes (level nodes stay, without mesh or skin),
+ * then the accessors, buffer views and
  * bytes nothing uses. Node, mesh, skin, material, texture and image
  * indices hold; animation, accessor and buffer view indices change. The
  * result is not a valid glTF on its own (triangle lists without POSITION):
  * mlod-pack -x puts the levels back. A document using an extension that
  * may refer to accessors (as mlod_gltf_prune) is MLOD_ERR_UNSUPPORTED and
  * may be partly stripped: strip a copy. */
-mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, mlod_error *err);
+mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, const int *joint_nodes, int joint_count, mlod_error *err);
 
 /* For a pack's DOC chunk (mlod-pack, mlod(5)): */
+/* From now on (on != 0) mlod_gltf_drop_tail, mlod_gltf_drop_animation and
+ * mlod_gltf_prune change no index that stays: a dropped animation must be
+ * the last one (else MLOD_ERR_UNSUPPORTED, the document unchanged), and
+ * only the accessors and buffer views after the last one in use go, with
+ * each buffer's bytes after its last kept view (but in a buffer an
+ * extension names); meshes stay. For a document using an extension mlod
+ * does not know, which may hold any index: the DOC chunk that keeps the
+ * input whole drops the levels the stages and mlod-pack -x append. */
+void mlod_gltf_keep_indices(mlod_gltf *doc, int on);
+/* Whether skin `skin` has inverse bind matrices (an accessor). */
+int mlod_gltf_skin_has_inverse_binds(const mlod_gltf *doc, int skin);
 /* Removes extras[key] of an object (its extras whole when nothing else is
  * left in them), but when extras[key] is an object with a member `keep`
  * (NULL: none), that member stays alone in it; nothing without the key. */

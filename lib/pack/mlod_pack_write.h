@@ -42,8 +42,11 @@
  * then the packed skins' inverse bind matrices, the joint nodes' rest TRS
  * in one number style, the stages' records and a piped input's level
  * nodes, skins, meshes and animations: mlod(5) DOC), as glb; when it
- * cannot be stripped (an extension that may refer to accessors) or with
- * doc_whole, the input glb as read, with a note.
+ * cannot be stripped (an extension that may refer to accessors), the
+ * document whole with every index as read, but for what goes without
+ * moving one (mlod_gltf_keep_indices: the records, MSFT_lod, the levels
+ * at the ends of the arrays), with a note (also in stats->doc_note); with
+ * doc_whole, the input glb as read.
  */
 #ifndef MLOD_PACK_WRITE_H
 #define MLOD_PACK_WRITE_H
@@ -130,6 +133,7 @@ typedef struct mlod_pack_stats {
 	int joints, skins, parts, clips;
 	float height, diagonal;
 	char notes[1024];            /* the reader's notes on the input, then what was done or skipped, "; "-separated */
+	char doc_note[MLOD_ERROR_MESSAGE_SIZE + 64]; /* why DOC holds the input whole ("" when stripped), also in notes */
 } mlod_pack_stats;
 
 /* Packs the character c read from doc (mlod_load of input, input_size

@@ -648,6 +648,22 @@ struct clip_levels {
 	float error[MLOD_PACK_MAX_MOTION_LEVELS];
 };
 
+/* The root of skin `skin` as a skin joint index: its joint nearest the
+ * skeleton's root (the first of them). */
+static int skin_root(const mlod_skeleton *s, int skin)
+{
+	const mlod_skin *sk = &s->skins[skin];
+	int best = 0, best_depth = -1;
+	for (int q = 0; q < sk->joint_count; q++) {
+		int depth = 0, j = sk->joints[q];
+		while (j >= 0 && j < s->joint_count && depth <= s->joint_count)
+			j = s->joints[j].parent, depth++;
+		if (best_depth < 0 || depth < best_depth)
+			best = q, best_depth = depth;
+	}
+	return best;
+}
+
 struct ctx {
 	const mlod_gltf *doc;
 	const mlod_character *in;
@@ -1428,6 +1444,10 @@ static void part_quantise(struct ctx *x, const struct mpart *m, int k, uint8_t *
 			uint8_t w8[4], j8[4];
 			uint16_t j16[4];
 			mlod_pack_weights8(bw, w8);
+			if (w8[0] + w8[1] + w8[2] + w8[3] == 0) { /* no weight: the skin's root (note_unweighted) */
+				w8[0] = 255;
+				bj[0] = skin_root(&x->v.skeleton, rec->skin);
+			}
 			for (int t = 0; t < 4; t++) {
 				int jt = w8[t] ? bj[t] : 0;
 				if (jt < 0 || jt >= joints)
@@ -3294,6 +3314,50 @@ static mlod_result note_unstored_attributes(struct ctx *x, const mlod_gltf *doc)
 	return MLOD_OK;
 }
 
+/* Notes the skinned vertices whose weights are all 0 (glTF wants them to
+ * sum to 1; the validator flags them): a pack's weights sum to 255, so
+ * each goes on the skin's root joint (skin_root), which the vertex then
+ * follows. */
+static void note_unweighted(struct ctx *x)
+{
+	const mlod_character *c = x->in;
+	for (int m = 0; m < c->mesh_count; m++) {
+		int skin = -1;
+		for (int i = 0; i < c->instance_count && skin < 0; i++)
+			if (c->instances[i].mesh == m)
+				skin = c->instances[i].skin;
+		if (skin < 0 || skin >= c->skeleton.skin_count)
+			continue;
+		const mlod_mesh *mesh = &c->meshes[m];
+		for (int p = 0; p < mesh->primitive_count; p++) {
+			const mlod_primitive *pr = &mesh->primitives[p];
+			int count = 0, first = -1;
+			for (int v = 0; pr->weight_set_count > 0 && v < pr->vertex_count; v++) {
+				int any = 0;
+				for (int set = 0; set < pr->weight_set_count && !any; set++)
+					for (int i = 0; i < 4; i++)
+						any |= pr->weights[set][4 * (size_t)v + (size_t)i] > 0.0f;
+				if (!any && count++ == 0)
+					first = v;
+			}
+			if (count == 0)
+				continue;
+			const mlod_skin *sk = &c->skeleton.skins[skin];
+			int root = sk->joint_count > 0 ? sk->joints[skin_root(&c->skeleton, skin)] : -1;
+			const char *name = root >= 0 && c->skeleton.joints[root].name ? c->skeleton.joints[root].name : "";
+			char text[256];
+			int g = mesh->gltf_index >= 0 ? mesh->gltf_index : m;
+			if (count == 1)
+				snprintf(text, sizeof text, "mesh %d primitive %d: vertex %d has no weight: it follows the skin's "
+				         "root joint \"%.64s\"", g, p, first, name);
+			else
+				snprintf(text, sizeof text, "mesh %d primitive %d: %d vertices have no weight (vertex %d the first): "
+				         "they follow the skin's root joint \"%.64s\"", g, p, count, first, name);
+			note(x, text);
+		}
+	}
+}
+
 /* ------------------------------------------------------------------ */
 /* The pack                                                            */
 /* ------------------------------------------------------------------ */
@@ -3330,12 +3394,12 @@ static int listed(const int *list, int n, int g)
  * its level nodes (MSFT_lod entries, nodes with a level skin), level
  * skins and level meshes when they are the last of their kind (as the
  * stages append them; else they stay, with a note). */
-static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
+static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, int whole, mlod_error *err)
 {
 	const mlod_character *c = x->in;
 	const mlod_skeleton *s = &c->skeleton;
 	mlod_result r = MLOD_OK;
-	for (int i = 0; r == MLOD_OK && i < x->v.skeleton.skin_count; i++) {
+	for (int i = 0; r == MLOD_OK && !whole && i < x->v.skeleton.skin_count; i++) {
 		const mlod_skin *sk = &x->v.skeleton.skins[i];
 		if (sk->gltf_index >= 0 && x->v.skeleton.joint_count > 0 && !identity_binds(sk))
 			r = mlod_gltf_drop_inverse_binds(copy, sk->gltf_index, err);
@@ -3345,7 +3409,7 @@ static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
 	 * decimals (1) or their 15 significant digits (2), whichever more
 	 * parts use (the asset's extras.mlod.doc_trs says which). */
 	int parts[3] = {0, 0, 0}, nodes = mlod_gltf_count(copy, MLOD_GLTF_NODE);
-	for (int mode = 0; mode < 3; mode++)
+	for (int mode = 0; mode < 3 && !whole; mode++)
 		for (int j = 0; r == MLOD_OK && j < x->v.skeleton.joint_count; j++) {
 			const mlod_joint *q = &x->v.skeleton.joints[j];
 			int d = 0;
@@ -3369,15 +3433,26 @@ static mlod_result doc_dedupe(struct ctx *x, mlod_gltf *copy, mlod_error *err)
 		r = mlod_gltf_remove_extra(copy, MLOD_GLTF_ASSET, 0, "mlod", "end_site", err);
 	if (r == MLOD_OK && parts[trs_mode] > 0)
 		r = mlod_gltf_set_extra(copy, MLOD_GLTF_ASSET, 0, "mlod", trs_marks[trs_mode], err);
-	/* The level animations (those strip_levels left: morph weights). */
-	for (int i = 0; r == MLOD_OK && i < c->clip_count; i++) {
-		int level = 1;
-		for (int q = 0; q < x->v.clip_count; q++)
-			level &= x->v.clips[q].name != c->clips[i].name;
-		int a = level && c->clips[i].name ? mlod_gltf_find_animation(copy, c->clips[i].name, 0) : -1;
-		if (a >= 0)
+	/* The level animations (those strip_levels left: morph weights, other
+	 * nodes' channels); a document whose indices hold (whole), from the
+	 * last animation down while they are levels. */
+	int anims = mlod_gltf_count(copy, MLOD_GLTF_ANIMATION), dropped = 0, levels = 0;
+	for (int a = anims - 1; r == MLOD_OK && a >= 0; a--) {
+		int level = 0;
+		for (int i = 0; !level && i < c->clip_count; i++) {
+			int in_v = 0;
+			for (int q = 0; q < x->v.clip_count; q++)
+				in_v |= x->v.clips[q].name == c->clips[i].name;
+			level = !in_v && c->clips[i].name && mlod_gltf_find_animation(copy, c->clips[i].name, 0) == a;
+		}
+		levels += level;
+		if (level && (!whole || a + dropped + 1 == anims)) {
 			r = mlod_gltf_drop_animation(copy, a, err);
+			dropped++;
+		}
 	}
+	if (r == MLOD_OK && dropped < levels)
+		note(x, "the document chunk keeps some of the input's level animations: they are not its last animations");
 	if (r != MLOD_OK || !x->doc)
 		return r;
 	/* The level nodes (every MSFT_lod entry), their meshes, level skins. */
@@ -3570,6 +3645,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		goto done;
 	if (mlod_mesh_triangle_primitives(&x.v) > 0 && (r = note_unstored_attributes(&x, doc)) != MLOD_OK)
 		goto done;
+	note_unweighted(&x);
 
 	/* The levels of each layer. */
 	t0 = now_seconds();
@@ -3660,29 +3736,66 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		mlod_gltf *copy = NULL;
 		mlod_error serr = {0};
 		mlod_result sr = doc ? mlod_gltf_copy(doc, &copy, &serr) : MLOD_ERR_INVALID_ARG;
+		int *joint_nodes = malloc(sizeof(int) * ((size_t)c->skeleton.joint_count + 1)), jn = 0;
+		if (!joint_nodes)
+			sr = mlod_fail(&serr, MLOD_ERR_NOMEM, "out of memory");
+		for (int j = 0; joint_nodes && j < c->skeleton.joint_count; j++)
+			joint_nodes[jn++] = c->skeleton.joints[j].node;
 		if (sr == MLOD_OK && !opt->doc_whole)
-			sr = mlod_gltf_strip_levels(copy, &serr);
+			sr = mlod_gltf_strip_levels(copy, joint_nodes, jn, &serr);
+		free(joint_nodes);
 		if (sr == MLOD_OK && !opt->doc_whole)
-			sr = doc_dedupe(&x, copy, &serr);
+			sr = doc_dedupe(&x, copy, 0, &serr);
 		if (sr == MLOD_OK)
 			sr = mlod_gltf_write(copy, 1, &glb, &glb_size, &serr);
 		mlod_gltf_free(copy);
+		copy = NULL;
+		int whole = 0;
+		if (sr == MLOD_ERR_UNSUPPORTED && doc && !opt->doc_whole) {
+			/* An extension mlod does not know may hold any index: the
+			 * document stays whole, but for what goes without moving an
+			 * index (mlod_gltf_keep_indices): the stages' records and
+			 * MSFT_lod, and the levels the stages and -x append at the
+			 * ends of the arrays, so that unpacking and packing again
+			 * gives the same document. */
+			mlod_error werr = {0};
+			mlod_result wr = mlod_gltf_copy(doc, &copy, &werr);
+			mlod_free(glb);
+			glb = NULL;
+			if (wr == MLOD_OK) {
+				mlod_gltf_keep_indices(copy, 1);
+				for (int n = 0; wr == MLOD_OK && n < mlod_gltf_count(copy, MLOD_GLTF_NODE); n++)
+					wr = mlod_gltf_clear_lod(copy, n, &werr);
+			}
+			if (wr == MLOD_OK)
+				wr = doc_dedupe(&x, copy, 1, &werr);
+			if (wr == MLOD_OK)
+				wr = mlod_gltf_write(copy, 1, &glb, &glb_size, &werr);
+			mlod_gltf_free(copy);
+			if (wr == MLOD_ERR_NOMEM) {
+				mlod_free(glb);
+				r = mlod_fail(err, wr, "%s", werr.message);
+				goto done;
+			}
+			whole = wr == MLOD_OK;
+		}
+		if (sr != MLOD_OK && (whole || (format == MLOD_FORMAT_GLB && input) || doc)) {
+			snprintf(x.st->doc_note, sizeof x.st->doc_note, "the document chunk holds the input whole: %s",
+			         serr.message);
+			note(&x, x.st->doc_note);
+		}
 		if (sr == MLOD_OK) {
 			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
 			x.st->doc_stripped = !opt->doc_whole;
+		} else if (whole) {
+			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
 		} else if (format == MLOD_FORMAT_GLB && input) {
-			char text[MLOD_ERROR_MESSAGE_SIZE + 64];
-			snprintf(text, sizeof text, "the document chunk holds the input whole: %s", serr.message);
-			note(&x, text);
 			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)input_size, 1, input, 0);
 		} else if (doc) {
 			mlod_free(glb);
 			glb = NULL;
 			if ((r = mlod_gltf_write(doc, 1, &glb, &glb_size, err)) != MLOD_OK)
 				goto done;
-			char text[MLOD_ERROR_MESSAGE_SIZE + 64];
-			snprintf(text, sizeof text, "the document chunk holds the input whole: %s", serr.message);
-			note(&x, text);
 			cb_add(&cb, MLOD_STREAM_GLB, (uint32_t)glb_size, 1, glb, 0);
 		} else {
 			cb_add(&cb, MLOD_STREAM_GLB, 0, 1, NULL, 0);

@@ -449,8 +449,8 @@ static mlod_result add_clip(mlod_gltf *doc, const mlod_skeleton *s, const mlod_p
 
 /* Per animation of the DOC as read, whether it holds joint channels (a
  * clip of the document's character with channels): the DOC holds the
- * input whole (mlod(5) DOC), as a stripped DOC keeps only morph weights
- * channels. *out is NULL when the document gives no character. */
+ * input whole (mlod(5) DOC), as a stripped DOC keeps no joint channel.
+ * *out is NULL when the document gives no character. */
 static mlod_result whole_animations(const mlod_gltf *doc, unsigned char **out, mlod_error *err)
 {
 	int n = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
@@ -474,6 +474,51 @@ static mlod_result whole_animations(const mlod_gltf *doc, unsigned char **out, m
 			w[c.clips[i].gltf_index] = 1;
 	mlod_character_free(&c);
 	*out = w;
+	return MLOD_OK;
+}
+
+/* Whether a mesh of the DOC has a triangle list without attributes (its
+ * geometry stripped: a MESH part holds it). */
+static mlod_result mesh_stripped(const mlod_gltf *doc, int mesh, int *stripped, mlod_error *err)
+{
+	*stripped = 0;
+	for (int p = 0; !*stripped; p++) {
+		char **names = NULL;
+		int count = 0, mode = 4;
+		mlod_error e = {0};
+		mlod_result r = mlod_gltf_primitive_attributes(doc, mesh, p, &mode, &names, &count, &e);
+		if (r == MLOD_ERR_NOMEM)
+			return mlod_fail(err, r, "%s", e.message);
+		if (r != MLOD_OK) /* past the mesh's last primitive */
+			break;
+		mlod_free(names);
+		*stripped = mode == 4 && count == 0;
+	}
+	return MLOD_OK;
+}
+
+/* Every DOC node whose mesh lost its geometry to the MESH chunks must be
+ * an instance node of MESH level 0's parts, which give it back: another
+ * would keep a primitive without attributes (not glTF). */
+static mlod_result check_doc_meshes(const mlod_gltf *doc, const mlod_pack_mesh *level0, mlod_error *err)
+{
+	int nodes = mlod_gltf_count(doc, MLOD_GLTF_NODE);
+	for (int n = 0; n < nodes; n++) {
+		int mesh = -1, skin = -1, stripped = 0, part = 0;
+		mlod_error ignored = {0};
+		if (mlod_gltf_node_refs(doc, n, &mesh, &skin, &ignored) != MLOD_OK || mesh < 0)
+			continue;
+		for (uint32_t i = 0; level0 && i < level0->part_count && !part; i++)
+			part = level0->parts[i].rec.node == n;
+		if (part)
+			continue;
+		mlod_result r = mesh_stripped(doc, mesh, &stripped, err);
+		if (r != MLOD_OK)
+			return r;
+		if (stripped)
+			return mlod_fail(err, MLOD_ERR_PARSE, "DOC: node %d has mesh %d, whose triangles no MESH part of "
+			                 "that node holds", n, mesh);
+	}
 	return MLOD_OK;
 }
 
@@ -627,7 +672,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		int identity = 1;
 		for (int j = 0; identity && j < sk->joint_count; j++)
 			identity = memcmp(&sk->inverse_bind[j], &id, sizeof id) == 0;
-		if (identity || sk->gltf_index < 0 || sk->gltf_index >= mlod_gltf_count(doc, MLOD_GLTF_SKIN))
+		if (identity || sk->gltf_index < 0 || sk->gltf_index >= mlod_gltf_count(doc, MLOD_GLTF_SKIN) ||
+		    mlod_gltf_skin_has_inverse_binds(doc, sk->gltf_index)) /* a DOC holding the input whole */
 			continue;
 		mlod_error serr = {0};
 		if (mlod_gltf_set_inverse_binds(doc, sk->gltf_index, sk->inverse_bind, sk->joint_count, &serr) != MLOD_OK) {
@@ -680,6 +726,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		    MLOD_OK)
 			goto done;
 	}
+	if ((r = check_doc_meshes(doc, mesh_levels > 0 ? &meshes[0] : NULL, err)) != MLOD_OK)
+		goto done;
 	/* The record's mesh levels: what the pack stores of each. */
 	mesh_rec = calloc((size_t)mesh_levels + 1, sizeof *mesh_rec);
 	if (!mesh_rec) {
@@ -758,8 +806,17 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			snprintf(where, sizeof where, "MESH level 0");
 			if ((r = mlod_gltf_node_refs(doc, node, &old_mesh, &old_skin, err)) != MLOD_OK)
 				goto done;
-			/* Level 0: the node's own mesh again. */
-			if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) && mesh_map[like] >= 0) {
+			/* Level 0: the node's own mesh again; a DOC that holds the
+			 * input whole has it as read (which an extension mlod does
+			 * not know may refer to): it stays. */
+			int kept = 0;
+			if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) && like == old_mesh &&
+			    (r = mesh_stripped(doc, like, &kept, err)) != MLOD_OK)
+				goto done;
+			kept = like >= 0 && like == old_mesh && !kept;
+			if (kept) {
+				mesh = like;
+			} else if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) && mesh_map[like] >= 0) {
 				mesh = mesh_map[like];
 			} else {
 				if ((r = add_parts_mesh(doc, &meshes[0], parts, count, like, NULL, 0, &s, &mesh, err)) != MLOD_OK)
@@ -835,8 +892,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	}
 
 	/* Motion: level 0 as the clip, coarser levels as <clip>@lod<k>. A
-	 * clip whose animation the DOC kept (for its morph weights channels)
-	 * goes back into it. */
+	 * clip whose animation the DOC kept (for its other channels: morph
+	 * weights, nodes that are not joints) goes back into it. */
 	int doc_anims = mlod_gltf_count(doc, MLOD_GLTF_ANIMATION);
 	used = calloc((size_t)doc_anims + 1, 1);
 	if (!used) {

@@ -1317,6 +1317,42 @@ TEST(bad_references)
 	                "\"nodes\":[{\"mesh\":0}]}", &err) == MLOD_OK);
 }
 
+/* A channel without a target node (KHR_animation_pointer's), which
+ * tinygltf drops as it reads, is read and written back in its place: the
+ * stages and mlod-pack -x kept 1 of these 2 channels. */
+TEST(pointer_channel_kept)
+{
+	static const char text[] =
+	    "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_animation_pointer\"],"
+	    "\"buffers\":[{\"byteLength\":16,\"uri\":\"data:application/octet-stream;base64,AAAAAAAAgD8AAAA/AACAPw==\"}],"
+	    "\"bufferViews\":[{\"buffer\":0,\"byteLength\":8},{\"buffer\":0,\"byteOffset\":8,\"byteLength\":8}],"
+	    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},"
+	    "{\"bufferView\":1,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"}],"
+	    "\"materials\":[{}],\"nodes\":[{\"name\":\"n\"}],\"scenes\":[{\"nodes\":[0]}],"
+	    "\"animations\":[{\"name\":\"a\",\"channels\":[{\"sampler\":0,\"target\":{\"path\":\"pointer\","
+	    "\"extensions\":{\"KHR_animation_pointer\":{\"pointer\":\"/materials/0/alphaCutoff\"}}}},"
+	    "{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"scale\"}}],"
+	    "\"samplers\":[{\"input\":0,\"output\":1}]}]}";
+	mlod_gltf *doc = NULL;
+	CHECK_OK(mlod_gltf_read(text, strlen(text), NULL, &doc, &terr));
+	if (!doc)
+		return;
+	void *out = NULL;
+	size_t size = 0;
+	CHECK_OK(mlod_gltf_write(doc, 0, &out, &size, &terr));
+	char *json = calloc(size + 1, 1);
+	if (json && out) {
+		memcpy(json, out, size);
+		const char *p = strstr(json, "\"pointer\": \"/materials/0/alphaCutoff\"");
+		CHECK_MSG(p != NULL, "the pointer channel is lost: %s", json);
+		CHECK(p && strstr(p, "\"path\": \"scale\"")); /* in its place, before channel 1 */
+		CHECK(!strstr(json, "\"node\": -1"));
+	}
+	free(json);
+	mlod_free(out);
+	mlod_gltf_free(doc);
+}
+
 /* A stripped document keeps no emptied buffer (byteLength 0, an empty
  * data: URI), which no reader takes back: its glb reads again; and a DOC
  * holding such buffers, with other members, as older packs do, reads
@@ -1338,7 +1374,7 @@ TEST(strip_drops_emptied_buffers)
 	CHECK_OK(mlod_gltf_read(two, strlen(two), NULL, &doc, &terr));
 	if (!doc)
 		return;
-	CHECK_OK(mlod_gltf_strip_levels(doc, &terr));
+	CHECK_OK(mlod_gltf_strip_levels(doc, NULL, 0, &terr));
 	void *glb = NULL;
 	size_t size = 0;
 	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &size, &terr));
@@ -1497,6 +1533,7 @@ int main(void)
 	RUN(truncated_glb);
 	RUN(mutated_glb);
 	RUN(bad_references);
+	RUN(pointer_channel_kept);
 	RUN(strip_drops_emptied_buffers);
 	RUN(wrong_types);
 	RUN(duplicate_targets);
