@@ -615,7 +615,9 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	mlod_result r = mlod_pack_open(data, size, &p, err);
 	if (r != MLOD_OK)
 		return r;
-	if ((r = mlod_pack_check_padding(&p, data, size, err)) != MLOD_OK)
+	/* Every chunk and INFO's counts checked first, as --info checks them
+	 * (the chunks are decoded again below: -x is not a hot path). */
+	if ((r = mlod_pack_check(&p, data, size, err)) != MLOD_OK)
 		goto done;
 	if ((r = mlod_pack_decode_info(&p, data, size, &info, err)) != MLOD_OK)
 		goto done;

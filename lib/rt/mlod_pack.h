@@ -240,12 +240,14 @@
  *   mlod-pack -x rebuilds a glb from it and the levels. (Writer's note:
  *   as mlod_gltf_strip_levels makes it: primitives keep mode, material,
  *   extensions and extras with empty attributes, no indices, no targets;
- *   animations keep their morph weights channels (those left empty go:
+ *   animations keep every channel but the joints' translation, rotation
+ *   and scale, which the MOTION chunks hold (animations left empty go:
  *   animation indices change); MSFT_lod goes, its level nodes stay
  *   without mesh or skin; node, mesh, skin and material indices hold, so
  *   'PART' node, mesh and material and 'SKIN' gltf_index refer to it. A
- *   document with an extension that may refer to accessors is stored as
- *   read, whole.)
+ *   document with an extension that may refer to accessors keeps every
+ *   index (mlod_gltf_keep_indices): only what sits at the ends of its
+ *   arrays goes, the stages' records and MSFT_lod.)
  *
  * Precisions the reader (lib/rt/pack.c) checks, added with it; they make
  * explicit what the text above implies and change no layout:
@@ -713,7 +715,7 @@ void mlod_pack_doc_free(mlod_pack_doc_bytes *x);
  * message names the chunk; INFO's joint, skin and instance counts must be
  * SKELETON's and each MESH level's parts (MLOD_ERR_PARSE naming INFO;
  * mlod_pack_decode_info checks its level counts against the TOC and its
- * first_drawable exactly). mlod-pack --info runs it before listing. */
+ * first_drawable exactly). mlod-pack --info runs it before listing, -x before unpacking. */
 mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, mlod_error *err);
 /* The zero padding before each chunk, which no CRC covers (data: the
  * whole file, or a prefix: the bytes it holds): MLOD_ERR_PARSE naming the

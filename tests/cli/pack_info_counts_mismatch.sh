@@ -29,4 +29,9 @@ for f in j1000 j0 i2 fd0; do
 	"$BIN/mlod-pack" --info $f.mlod > /dev/null
 	[ $? = 2 ] || exit 9
 done
+# -x checks the same (it unpacked each)
+for f in j1000 i2; do
+	"$BIN/mlod-pack" -x $f.mlod -o $f.glb
+	[ $? = 2 ] && [ ! -e $f.glb ] || exit 9
+done
 exit 2
