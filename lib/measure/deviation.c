@@ -178,7 +178,7 @@ static double triangle_dist2(const double *p, const tri *t)
 
 /* A triangle is degenerate when its area is negligible against its edges:
  * then the face formula would divide by (nearly) zero. */
-static int points_degenerate(const double *a, const double *b, const double *c)
+DEV_INLINE int points_degenerate(const double *a, const double *b, const double *c)
 {
 	double ab[3], ac[3];
 	sub3(b, a, ab);
@@ -496,13 +496,13 @@ static inline void leaf_ready(const bvh *b, int at)
 /* The nearest triangle in the subtree at node at (at_d2: p's squared
  * distance to its box) if nearer than best: searched nearer child first,
  * pruned by box distance, a leaf's triangle skipped when its plane is
- * already farther than the best, or when it is skip. */
-static double subtree_nearest2(const bvh *b, const double *p, int at, double at_d2, double best, int skip,
+ * already farther than the best, or when it is skip. p1: |p| in the
+ * 1-norm (plane_dist2's), made once per query by the caller. */
+static double subtree_nearest2(const bvh *b, const double *p, double p1, int at, double at_d2, double best, int skip,
                                int *hint)
 {
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
 	int top = 0;
-	const double p1 = fabs(p[0]) + fabs(p[1]) + fabs(p[2]);
 	for (;;) {
 		const node *n = &b->nodes[at];
 		if (at_d2 < best && n->count == 0) {
@@ -548,12 +548,13 @@ static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 	leaf_ready(b, b->leaf[start]);
 	double best = triangle_dist2(p, &b->tris[start]);
 	int at = b->leaf[start];
-	best = subtree_nearest2(b, p, at, 0.0, best, start, hint);
+	const double p1 = fabs(p[0]) + fabs(p[1]) + fabs(p[2]);
+	best = subtree_nearest2(b, p, p1, at, 0.0, best, start, hint);
 	for (int up = b->parent[at]; up >= 0; at = up, up = b->parent[up]) {
 		int other = at & 1 ? at + 1 : at - 1; /* children come in pairs from 1: left odd, right even */
 		double d2 = box_dist2(p, &b->nodes[other]);
 		if (d2 < best)
-			best = subtree_nearest2(b, p, other, d2, best, -1, hint);
+			best = subtree_nearest2(b, p, p1, other, d2, best, -1, hint);
 	}
 	return best;
 }
