@@ -67,7 +67,7 @@ struct mlod_bgm {
 	double tau;
 	double *eta;            /* per skeleton joint */
 	int skeleton_joints;
-	double diagonal;        /* of the bind positions */
+	double diagonal;        /* of the nodes at pose 0 (bgm_quadrics_build; 0 without quadrics) */
 	bgm_layout lay;
 
 	/* Nodes, wedges, faces (append-only). */
@@ -118,6 +118,9 @@ struct mlod_bgm {
 	                         * with it in both lanes; NULL when there is one pose or for
 	                         * a mesh without influences */
 	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
+	double pose0[12];       /* pose 0's skin matrix, every influence's (3x4, row-major) */
+	double pose0_cof[9];    /* its linear part's cofactors (row-major): n -> the posed n */
+	int pose0_mapped;       /* pose0 is not the identity (0 without quadrics) */
 	double skin_norm;       /* collapse.c: the largest Frobenius norm of a skin matrix's
 	                         * linear part, 0 until worked out */
 
@@ -232,6 +235,9 @@ static inline double bgm_quadric_eval(const double *q, const double *x)
 	           q[4] * x[1] * x[1] + 2 * q[5] * x[1] * x[2] + 2 * q[6] * x[1] + q[7] * x[2] * x[2] + 2 * q[8] * x[2] + q[9];
 	return v > 0.0 ? v : 0.0;
 }
+/* h = [M; 0 0 0 1]^T a [M; 0 0 0 1] (a, h packed quadrics, M 3x4
+ * row-major): the quadric a of posed space pulled back through M. */
+void bgm_quadric_map(const double *a, const double *M, double *h);
 /* The minimiser of the packed quadric h (directions it leaves free stay
  * at x0); returns 0 and fills out, or -1. */
 int bgm_quadric_solve(const double *h, const double *x0, double *out);

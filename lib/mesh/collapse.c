@@ -491,7 +491,16 @@ BGM_INLINE double face_tie(mlod_bgm *g, int h)
 	double *t = &g->ftie[h];
 	if (isnan(*t)) {
 		const double *o = face_geo(g, h);
-		*t = sqrt(0.25 * (o[0] * o[0] + o[1] * o[1] + o[2] * o[2])) * (1.0 - o[4]);
+		if (g->pose0_mapped) {
+			/* its area at pose 0, in the units of the posed cost */
+			const double *C = g->pose0_cof;
+			double n[3];
+			for (int i = 0; i < 3; i++)
+				n[i] = C[3 * i] * o[0] + C[3 * i + 1] * o[1] + C[3 * i + 2] * o[2];
+			*t = sqrt(0.25 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) * (1.0 - o[4]);
+		} else {
+			*t = sqrt(0.25 * (o[0] * o[0] + o[1] * o[1] + o[2] * o[2])) * (1.0 - o[4]);
+		}
 	}
 	return *t;
 }
@@ -1613,6 +1622,12 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 			const double *q = g->quadric + (size_t)v[j] * (size_t)g->qpose_count * 10;
 			Q[0] += q[0], Q[1] += q[st], Q[2] += q[2 * st], Q[3] += q[3 * st], Q[4] += q[4 * st];
 			Q[5] += q[5 * st], Q[6] += q[6 * st], Q[7] += q[7 * st], Q[8] += q[8 * st], Q[9] += q[9 * st];
+		}
+		if (g->pose0_mapped) {
+			/* pulled back through pose 0's one matrix */
+			double h[10];
+			bgm_quadric_map(Q, g->pose0, h);
+			memcpy(Q, h, sizeof h);
 		}
 		lb = bgm_quadric_eval(Q, bary);
 		for (int j = 0; j < K; j++)
