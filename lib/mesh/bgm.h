@@ -235,9 +235,6 @@ static inline double bgm_quadric_eval(const double *q, const double *x)
 	           q[4] * x[1] * x[1] + 2 * q[5] * x[1] * x[2] + 2 * q[6] * x[1] + q[7] * x[2] * x[2] + 2 * q[8] * x[2] + q[9];
 	return v > 0.0 ? v : 0.0;
 }
-/* h = [M; 0 0 0 1]^T a [M; 0 0 0 1] (a, h packed quadrics, M 3x4
- * row-major): the quadric a of posed space pulled back through M. */
-void bgm_quadric_map(const double *a, const double *M, double *h);
 /* The minimiser of the packed quadric h (directions it leaves free stay
  * at x0); returns 0 and fills out, or -1. */
 int bgm_quadric_solve(const double *h, const double *x0, double *out);

@@ -419,12 +419,18 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	/* A skinned mesh's pose 0 is its bind shape, mapped for every
 	 * influence through one matrix: the rest pose's skin matrix of the
 	 * joint with the largest weight sum (ties: the first). That is the
-	 * identity for a mesh stored in the character's space, a scale for one
-	 * stored in its own units (dequantisation folded into the inverse bind
-	 * matrices, centimetres under an armature scaled 0.01), and a rigid
-	 * motion more where the rest pose is not the bind pose (the robot),
-	 * which moves no error. The bind shape's error is then in the same
-	 * units as the other poses' and weighs as one of them. */
+	 * identity (within rounding) for a mesh stored in the character's
+	 * space whose rest pose is its bind pose, a scale for one stored in
+	 * other units (dequantisation folded into the inverse bind matrices,
+	 * centimetres under an armature scaled 0.01), and a rigid motion as
+	 * well where the rest pose is not the bind pose (the robot), which
+	 * changes no distance. Its error is then in the units of the other
+	 * poses' and weighs as one of them (with the identity, in the bind
+	 * space's units, it weighed next to nothing on the robot, stored in
+	 * 1/100 of its units, and outweighed every other pose on a
+	 * gltfpack-quantised tubeman, 625 bind units to one of its own).
+	 * One matrix for all keeps pose 0's term
+	 * independent of the influences (lower_key's bound in collapse.c). */
 	int dominant = -1;
 	if (g->skinned) {
 		double *sum = calloc((size_t)J, sizeof *sum);
@@ -436,8 +442,9 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			for (int k = 0; k < g->inf[v].count && k < MLOD_MAX_INFLUENCES; k++)
 				if (g->inf[v].joints[k] < J)
 					sum[g->inf[v].joints[k]] += g->inf[v].weights[k];
-		for (int k = 0; k < J; k++)
-			if (sum[k] > 0.0 && (dominant < 0 || sum[k] > sum[dominant]))
+		dominant = 0; /* no weights at all: every node is locked */
+		for (int k = 1; k < J; k++)
+			if (sum[k] > sum[dominant])
 				dominant = k;
 		free(sum);
 	}
@@ -447,12 +454,35 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 		if (g->skinned) {
 			mlod_skin_matrices(&s->skins[in->skin], world, mats);
 			for (int k = 0; k < J; k++)
-				to_rows(&mats[p == 0 && dominant >= 0 ? dominant : k], S + 12 * k);
+				to_rows(&mats[p == 0 ? dominant : k], S + 12 * k);
 		} else if (g->rigid) {
 			mlod_mat4 m = mlod_mat4_mul(&world[in->joint], &in->offset);
 			to_rows(&m, S);
 		} else {
 			to_rows(&in->offset, S);
+		}
+	}
+	/* A skinned mesh's pose 0 matrix within rounding of the identity (its
+	 * linear part's entries within 1e-6, its translation within 1e-6 of
+	 * the bind box's diagonal: Ely's is within 1.2e-7) is the identity,
+	 * so that a mesh stored in the character's space keeps the bind
+	 * space's numbers exactly, without a matrix to apply. */
+	if (g->skinned) {
+		double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d2 = 0.0;
+		for (int v = 0; v < g->node_count; v++)
+			for (int i = 0; i < 3; i++)
+				lo[i] = fmin(lo[i], g->nodes[v].p[i]), hi[i] = fmax(hi[i], g->nodes[v].p[i]);
+		for (int i = 0; i < 3 && g->node_count > 0; i++)
+			d2 += (hi[i] - lo[i]) * (hi[i] - lo[i]);
+		int near = 1;
+		for (int e = 0; e < 12 && near; e++) {
+			double x = g->skin[e];
+			near = e % 4 == 3 ? fabs(x) <= 1e-6 * sqrt(d2) : fabs(x - (e % 5 == 0 ? 1.0 : 0.0)) <= 1e-6;
+		}
+		if (near) {
+			mlod_mat4 id = mlod_mat4_identity();
+			for (int k = 0; k < J; k++)
+				to_rows(&id, g->skin + 12 * k);
 		}
 	}
 	/* The diagonal of the nodes' box at pose 0, in the same units as the
@@ -956,33 +986,6 @@ void bgm_quadric_pullback(const mlod_bgm *g, const double *q, const mlod_influen
 		H[9] += M[3] * t03 + M[7] * t13 + M[11] * t23 + t33;
 	}
 	memcpy(h, H, sizeof H);
-}
-
-void bgm_quadric_map(const double *a, const double *M, double *h)
-{
-	double t00 = a[0] * M[0] + a[1] * M[4] + a[2] * M[8];
-	double t01 = a[0] * M[1] + a[1] * M[5] + a[2] * M[9];
-	double t02 = a[0] * M[2] + a[1] * M[6] + a[2] * M[10];
-	double t10 = a[1] * M[0] + a[4] * M[4] + a[5] * M[8];
-	double t11 = a[1] * M[1] + a[4] * M[5] + a[5] * M[9];
-	double t12 = a[1] * M[2] + a[4] * M[6] + a[5] * M[10];
-	double t20 = a[2] * M[0] + a[5] * M[4] + a[7] * M[8];
-	double t21 = a[2] * M[1] + a[5] * M[5] + a[7] * M[9];
-	double t22 = a[2] * M[2] + a[5] * M[6] + a[7] * M[10];
-	double t03 = a[0] * M[3] + a[1] * M[7] + a[2] * M[11] + a[3];
-	double t13 = a[1] * M[3] + a[4] * M[7] + a[5] * M[11] + a[6];
-	double t23 = a[2] * M[3] + a[5] * M[7] + a[7] * M[11] + a[8];
-	double t33 = a[3] * M[3] + a[6] * M[7] + a[8] * M[11] + a[9];
-	h[0] = M[0] * t00 + M[4] * t10 + M[8] * t20;
-	h[1] = M[0] * t01 + M[4] * t11 + M[8] * t21;
-	h[2] = M[0] * t02 + M[4] * t12 + M[8] * t22;
-	h[3] = M[0] * t03 + M[4] * t13 + M[8] * t23;
-	h[4] = M[1] * t01 + M[5] * t11 + M[9] * t21;
-	h[5] = M[1] * t02 + M[5] * t12 + M[9] * t22;
-	h[6] = M[1] * t03 + M[5] * t13 + M[9] * t23;
-	h[7] = M[2] * t02 + M[6] * t12 + M[10] * t22;
-	h[8] = M[2] * t03 + M[6] * t13 + M[10] * t23;
-	h[9] = M[3] * t03 + M[7] * t13 + M[11] * t23 + t33;
 }
 
 int bgm_quadric_solve(const double *h, const double *x0, double *out)
