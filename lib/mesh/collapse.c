@@ -1568,7 +1568,7 @@ static void lbmemo_put(mlod_bgm *g, int a, int b, int c, double lb)
  * each pose's least error near where any of these placements can go,
  * whatever its weights. The fast cost (mlod_bgm_options.fast_cost) is the
  * pulled-back sum for every operation. */
-static double lower_key(mlod_bgm *g, int f, int op, int *weak)
+BGM_INLINE double lower_key(mlod_bgm *g, int f, int op, int *weak)
 {
 	const bgm_face *F = &g->faces[f];
 	int K = op == OP_TRIANGLE ? 3 : 2, v[3];
