@@ -21,7 +21,6 @@
  */
 #define _POSIX_C_SOURCE 199309L /* clock_gettime */
 
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -697,19 +696,6 @@ static mlod_result build(mlod_bgm *g, const mlod_character *c, const mlod_instan
 		g->seam_nodes += seam;
 		g->locked_nodes += (n->flags & BGM_LOCKED) != 0;
 		g->eligible_nodes += (n->flags & BGM_ELIGIBLE) && !(n->flags & BGM_LOCKED);
-	}
-
-	/* Scale. */
-	{
-		double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-		for (int v = 0; v < g->node_count; v++)
-			for (int i = 0; i < 3; i++) {
-				lo[i] = fmin(lo[i], g->nodes[v].p[i]);
-				hi[i] = fmax(hi[i], g->nodes[v].p[i]);
-			}
-		g->diagonal = g->node_count > 0 ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-		                                       (hi[2] - lo[2]) * (hi[2] - lo[2]))
-		                                 : 0.0;
 	}
 
 	/* Posed quadrics, for the posed cost and the optimal placement. */

@@ -67,7 +67,7 @@ struct mlod_bgm {
 	double tau;
 	double *eta;            /* per skeleton joint */
 	int skeleton_joints;
-	double diagonal;        /* of the bind positions */
+	double diagonal;        /* of the nodes at pose 0 (bgm_quadrics_build; 0 without quadrics) */
 	bgm_layout lay;
 
 	/* Nodes, wedges, faces (append-only). */
@@ -118,6 +118,9 @@ struct mlod_bgm {
 	                         * with it in both lanes; NULL when there is one pose or for
 	                         * a mesh without influences */
 	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
+	double pose0[12];       /* pose 0's skin matrix, every influence's (3x4, row-major) */
+	double pose0_cof[9];    /* its linear part's cofactors (row-major): n -> the posed n */
+	int pose0_mapped;       /* pose0 is not the identity (0 without quadrics) */
 	double skin_norm;       /* collapse.c: the largest Frobenius norm of a skin matrix's
 	                         * linear part, 0 until worked out */
 

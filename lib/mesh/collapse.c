@@ -491,7 +491,16 @@ BGM_INLINE double face_tie(mlod_bgm *g, int h)
 	double *t = &g->ftie[h];
 	if (isnan(*t)) {
 		const double *o = face_geo(g, h);
-		*t = sqrt(0.25 * (o[0] * o[0] + o[1] * o[1] + o[2] * o[2])) * (1.0 - o[4]);
+		if (g->pose0_mapped) {
+			/* its area at pose 0, in the units of the posed cost */
+			const double *C = g->pose0_cof;
+			double n[3];
+			for (int i = 0; i < 3; i++)
+				n[i] = C[3 * i] * o[0] + C[3 * i + 1] * o[1] + C[3 * i + 2] * o[2];
+			*t = sqrt(0.25 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) * (1.0 - o[4]);
+		} else {
+			*t = sqrt(0.25 * (o[0] * o[0] + o[1] * o[1] + o[2] * o[2])) * (1.0 - o[4]);
+		}
 	}
 	return *t;
 }
@@ -1551,7 +1560,7 @@ static void lbmemo_put(mlod_bgm *g, int a, int b, int c, double lb)
  * posed quadrics pulled back into bind space (bgm_quadric_rest), the
  * bound being then the cost itself when the cheapest placement is valid.
  * Otherwise the bound is the bind pose's term alone, which no influence
- * changes (its skin matrices are the identity, or one rigid matrix),
+ * changes (one skin matrix for every influence: quadric.c),
  * the other poses' terms not being negative; the optimal placement,
  * unknown here, lies within sqrt(lmax) of the barycenter (plan() drops
  * it beyond), where the convex quadric is at least its tangent plane at
@@ -1559,7 +1568,7 @@ static void lbmemo_put(mlod_bgm *g, int a, int b, int c, double lb)
  * each pose's least error near where any of these placements can go,
  * whatever its weights. The fast cost (mlod_bgm_options.fast_cost) is the
  * pulled-back sum for every operation. */
-static double lower_key(mlod_bgm *g, int f, int op, int *weak)
+BGM_INLINE double lower_key(mlod_bgm *g, int f, int op, int *weak)
 {
 	const bgm_face *F = &g->faces[f];
 	int K = op == OP_TRIANGLE ? 3 : 2, v[3];
@@ -1614,9 +1623,25 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 			Q[0] += q[0], Q[1] += q[st], Q[2] += q[2 * st], Q[3] += q[3 * st], Q[4] += q[4 * st];
 			Q[5] += q[5 * st], Q[6] += q[6 * st], Q[7] += q[7 * st], Q[8] += q[8 * st], Q[9] += q[9 * st];
 		}
-		lb = bgm_quadric_eval(Q, bary);
+		/* Pose 0 takes every bind position x to A x + t, one matrix
+		 * (g->pose0) whatever the influences: its term is Q(A x + t), whose
+		 * gradient in bind space is A^T times Q's there. */
+		double yb[3], yp[3][3];
+		const double *xb = bary, *xp[3] = {P[0], P[1], K == 3 ? P[2] : NULL};
+		if (g->pose0_mapped) {
+			const double *A = g->pose0;
+			for (int i = 0; i < 3; i++)
+				yb[i] = A[4 * i] * bary[0] + A[4 * i + 1] * bary[1] + A[4 * i + 2] * bary[2] + A[4 * i + 3];
+			for (int j = 0; j < K; j++) {
+				for (int i = 0; i < 3; i++)
+					yp[j][i] = A[4 * i] * P[j][0] + A[4 * i + 1] * P[j][1] + A[4 * i + 2] * P[j][2] + A[4 * i + 3];
+				xp[j] = yp[j];
+			}
+			xb = yb;
+		}
+		lb = bgm_quadric_eval(Q, xb);
 		for (int j = 0; j < K; j++)
-			lb = fmin(lb, bgm_quadric_eval(Q, P[j]));
+			lb = fmin(lb, bgm_quadric_eval(Q, xp[j]));
 		if (optimal_like(g)) {
 			double lmax = 0.0, gr[3], gl = 0.0;
 			for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
@@ -1625,12 +1650,18 @@ static double lower_key(mlod_bgm *g, int f, int op, int *weak)
 					l += (P[e][i] - P[(e + 1) % K][i]) * (P[e][i] - P[(e + 1) % K][i]);
 				lmax = fmax(lmax, l);
 			}
-			gr[0] = Q[0] * bary[0] + Q[1] * bary[1] + Q[2] * bary[2] + Q[3];
-			gr[1] = Q[1] * bary[0] + Q[4] * bary[1] + Q[5] * bary[2] + Q[6];
-			gr[2] = Q[2] * bary[0] + Q[5] * bary[1] + Q[7] * bary[2] + Q[8];
+			gr[0] = Q[0] * xb[0] + Q[1] * xb[1] + Q[2] * xb[2] + Q[3];
+			gr[1] = Q[1] * xb[0] + Q[4] * xb[1] + Q[5] * xb[2] + Q[6];
+			gr[2] = Q[2] * xb[0] + Q[5] * xb[1] + Q[7] * xb[2] + Q[8];
+			if (g->pose0_mapped) {
+				const double *A = g->pose0;
+				double w[3] = {gr[0], gr[1], gr[2]};
+				for (int i = 0; i < 3; i++)
+					gr[i] = A[i] * w[0] + A[4 + i] * w[1] + A[8 + i] * w[2];
+			}
 			for (int i = 0; i < 3; i++)
 				gl += gr[i] * gr[i];
-			double t = bgm_quadric_eval(Q, bary) - 2.0 * sqrt(gl) * sqrt(lmax) * (1.0 + 1e-9);
+			double t = bgm_quadric_eval(Q, xb) - 2.0 * sqrt(gl) * sqrt(lmax) * (1.0 + 1e-9);
 			lb = fmin(lb, t > 0.0 ? t : 0.0);
 			lb = fmax(lb, posed_min_bound(g, v, K, bary, sqrt(lmax)));
 		} else {

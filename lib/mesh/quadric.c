@@ -14,8 +14,13 @@
  * w fixed the cost is a quadric in x (sum_p M_p^T Q_p M_p), whose minimum
  * is the optimal placement.
  *
- * Pose 0 is the bind pose (the rest pose for a rigid mesh); the others
- * come from mlod_bgm_options.poses (clip frames and random poses).
+ * Pose 0 is the rest pose; the others come from mlod_bgm_options.poses
+ * (clip frames and random poses). Every pose is posed into world space,
+ * pose 0 included (a skinned mesh through the rest pose's skin matrices,
+ * not the identity): the quadrics, the costs and the bounds are then in
+ * the character's units whatever space the mesh is stored in (positions
+ * scaled into integers by KHR_mesh_quantization, centimetres under an
+ * armature scaled 0.01), and the levels do not depend on it.
  */
 #include <limits.h>
 #include <math.h>
@@ -411,25 +416,88 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	}
 	mlod_pose_rest(s, local);
 	mlod_pose_world(s, local, rest);
+	/* A skinned mesh's pose 0 is its bind shape, mapped for every
+	 * influence through one matrix: the rest pose's skin matrix of the
+	 * joint with the largest weight sum (ties: the first). That is the
+	 * identity (within rounding) for a mesh stored in the character's
+	 * space whose rest pose is its bind pose, a scale for one stored in
+	 * other units (dequantisation folded into the inverse bind matrices,
+	 * centimetres under an armature scaled 0.01), and a rigid motion as
+	 * well where the rest pose is not the bind pose (the robot), which
+	 * changes no distance. Its error is then in the units of the other
+	 * poses' and weighs as one of them (with the identity, in the bind
+	 * space's units, it weighed next to nothing on the robot, stored in
+	 * 1/100 of its units, and outweighed every other pose on a
+	 * gltfpack-quantised tubeman, 625 bind units to one of its own).
+	 * One matrix for all keeps pose 0's term
+	 * independent of the influences (lower_key's bound in collapse.c). */
+	int dominant = -1;
+	if (g->skinned) {
+		double *sum = calloc((size_t)J, sizeof *sum);
+		if (!sum) {
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+			goto done;
+		}
+		for (int v = 0; v < g->node_count; v++)
+			for (int k = 0; k < g->inf[v].count && k < MLOD_MAX_INFLUENCES; k++)
+				if (g->inf[v].joints[k] < J)
+					sum[g->inf[v].joints[k]] += g->inf[v].weights[k];
+		dominant = 0; /* no weights at all: every node is locked */
+		for (int k = 1; k < J; k++)
+			if (sum[k] > sum[dominant])
+				dominant = k;
+		free(sum);
+	}
 	for (int p = 0; p < P; p++) {
 		float *S = g->skin + (size_t)p * (size_t)J * 12;
 		const mlod_mat4 *world = p == 0 ? rest : ps->world + (size_t)(p - 1) * (size_t)s->joint_count;
 		if (g->skinned) {
-			if (p == 0) {
-				mlod_mat4 id = mlod_mat4_identity();
-				for (int k = 0; k < J; k++)
-					to_rows(&id, S + 12 * k);
-			} else {
-				mlod_skin_matrices(&s->skins[in->skin], world, mats);
-				for (int k = 0; k < J; k++)
-					to_rows(&mats[k], S + 12 * k);
-			}
+			mlod_skin_matrices(&s->skins[in->skin], world, mats);
+			for (int k = 0; k < J; k++)
+				to_rows(&mats[p == 0 ? dominant : k], S + 12 * k);
 		} else if (g->rigid) {
 			mlod_mat4 m = mlod_mat4_mul(&world[in->joint], &in->offset);
 			to_rows(&m, S);
 		} else {
 			to_rows(&in->offset, S);
 		}
+	}
+	/* A skinned mesh's pose 0 matrix within rounding of the identity (its
+	 * linear part's entries within 1e-6, its translation within 1e-6 of
+	 * the bind box's diagonal: Ely's is within 1.2e-7) is the identity,
+	 * so that a mesh stored in the character's space keeps the bind
+	 * space's numbers exactly, without a matrix to apply. */
+	if (g->skinned) {
+		double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d2 = 0.0;
+		for (int v = 0; v < g->node_count; v++)
+			for (int i = 0; i < 3; i++)
+				lo[i] = fmin(lo[i], g->nodes[v].p[i]), hi[i] = fmax(hi[i], g->nodes[v].p[i]);
+		for (int i = 0; i < 3 && g->node_count > 0; i++)
+			d2 += (hi[i] - lo[i]) * (hi[i] - lo[i]);
+		int near = 1;
+		for (int e = 0; e < 12 && near; e++) {
+			double x = g->skin[e];
+			near = e % 4 == 3 ? fabs(x) <= 1e-6 * sqrt(d2) : fabs(x - (e % 5 == 0 ? 1.0 : 0.0)) <= 1e-6;
+		}
+		if (near) {
+			mlod_mat4 id = mlod_mat4_identity();
+			for (int k = 0; k < J; k++)
+				to_rows(&id, g->skin + 12 * k);
+		}
+	}
+	/* The diagonal of the nodes' box at pose 0, in the same units as the
+	 * costs (the hybrid placement's cap). */
+	{
+		double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, M[12], y[3];
+		for (int v = 0; v < g->node_count; v++) {
+			blend(g, 0, &g->inf[v], M);
+			apply(M, g->nodes[v].p, y);
+			for (int i = 0; i < 3; i++)
+				lo[i] = fmin(lo[i], y[i]), hi[i] = fmax(hi[i], y[i]);
+		}
+		g->diagonal = g->node_count > 0 ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+		                                       (hi[2] - lo[2]) * (hi[2] - lo[2]))
+		                                 : 0.0;
 	}
 	/* The skin matrices the nodes use (all of them for a static mesh). */
 	unsigned char *used = calloc((size_t)J, 1);
@@ -470,6 +538,22 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			g->qmap[p] = D;
 			g->qpose[D++] = p;
 		}
+	}
+	/* Pose 0's one matrix (every influence's), and its linear part's
+	 * cofactors (a bind normal to a posed one), unless it is the
+	 * identity. */
+	{
+		const float *S0 = g->skin;
+		for (int e = 0; e < 12; e++) {
+			g->pose0[e] = S0[e];
+			if (g->pose0[e] != (e % 5 == 0 ? 1.0 : 0.0))
+				g->pose0_mapped = 1;
+		}
+		const double *A = g->pose0;
+		double *C = g->pose0_cof;
+		C[0] = A[5] * A[10] - A[6] * A[9], C[1] = A[6] * A[8] - A[4] * A[10], C[2] = A[4] * A[9] - A[5] * A[8];
+		C[3] = A[2] * A[9] - A[1] * A[10], C[4] = A[0] * A[10] - A[2] * A[8], C[5] = A[1] * A[8] - A[0] * A[9];
+		C[6] = A[1] * A[6] - A[2] * A[5], C[7] = A[2] * A[4] - A[0] * A[6], C[8] = A[0] * A[5] - A[1] * A[4];
 	}
 	free(used);
 	g->pose_count = P;
