@@ -380,9 +380,11 @@ int main(int argc, char **argv)
 	}
 	for (int k = 0; k < b.clip_count && report == REPORT_NONE; k++) {
 		char note[256];
-		if (mlod_motion_bake_timeline_note(&b, k, note, sizeof note))
-			fprintf(stderr, "%s: %s: clip \"%s\": %s\n", tool_name, job.input, job.c.clips[b.clips[k].index].name,
-			        note);
+		if (mlod_motion_bake_timeline_note(&b, k, note, sizeof note)) {
+			fprintf(stderr, "%s: %s: clip ", tool_name, job.input);
+			tool_json_string(stderr, job.c.clips[b.clips[k].index].name);
+			fprintf(stderr, ": %s\n", note);
+		}
 	}
 
 	if (report != REPORT_NONE) {
