@@ -37,6 +37,34 @@ static double end_site_distance(const mlod_mat4 *m, mlod_v3 e, mlod_v3 off)
 	return mlod_v3_length(mlod_v3_sub(bvh, mlod_mat4_point(m, e)));
 }
 
+/* Whether v is (1, 1, 1) to 1e-6. */
+static int unit(mlod_v3 v)
+{
+	return fabs(v.x - 1.0) <= 1e-6 && fabs(v.y - 1.0) <= 1e-6 && fabs(v.z - 1.0) <= 1e-6;
+}
+
+/* Whether any scale is not 1: a joint's rest scale, a root's base (its
+ * columns' lengths), or a scale channel of the clip. Without one every
+ * End Site is where the BVH puts it, by construction. */
+static int scaled(const mlod_character *c, int clip)
+{
+	const mlod_skeleton *s = &c->skeleton;
+	for (int j = 0; j < s->joint_count; j++) {
+		const mlod_joint *jt = &s->joints[j];
+		const float *m = jt->base.m;
+		mlod_v3 cols = { (float)sqrt((double)m[0] * m[0] + (double)m[1] * m[1] + (double)m[2] * m[2]),
+		                 (float)sqrt((double)m[4] * m[4] + (double)m[5] * m[5] + (double)m[6] * m[6]),
+		                 (float)sqrt((double)m[8] * m[8] + (double)m[9] * m[9] + (double)m[10] * m[10]) };
+		if (!unit(jt->rest.s) || (jt->parent < 0 && !unit(cols)))
+			return 1;
+	}
+	const mlod_clip *cl = &c->clips[clip];
+	for (int i = 0; i < cl->channel_count; i++)
+		if (cl->channels[i].path == MLOD_PATH_SCALE)
+			return 1;
+	return 0;
+}
+
 mlod_result mlod_skel_bvh_end_sites(const mlod_character *c, int clip, double *max, int *joint, char *note,
                                     size_t note_size, mlod_error *err)
 {
@@ -50,8 +78,8 @@ mlod_result mlod_skel_bvh_end_sites(const mlod_character *c, int clip, double *m
 	int n = s->joint_count, any = 0;
 	for (int j = 0; j < n; j++)
 		any |= s->joints[j].has_end_site;
-	if (!any || clip < 0 || clip >= c->clip_count)
-		return MLOD_OK; /* the rest pose: the OFFSETs are its places */
+	if (!any || clip < 0 || clip >= c->clip_count || !scaled(c, clip))
+		return MLOD_OK; /* the rest pose (the OFFSETs are its places), or no scale */
 	mlod_trs *local = malloc(sizeof *local * (size_t)n);
 	mlod_mat4 *world = malloc(sizeof *world * (size_t)n);
 	mlod_v3 *off = malloc(sizeof *off * (size_t)n);
