@@ -191,6 +191,14 @@ static void write_bvh(const struct job *job, const mlod_motion_bake *b, const ch
 		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_OUTPUT, output, "%s", err.message);
 	tool_write_output(output, text, size, 0);
 	mlod_free(text);
+	/* What the BVH cannot hold (of the clip as read). */
+	char note[MLOD_SKEL_BVH_NOTE_SIZE];
+	double max;
+	int joint;
+	if (mlod_skel_bvh_end_sites(&job->c, clip, &max, &joint, note, sizeof note, &err) != MLOD_OK)
+		tool_die(tool_exit_code(err.code), job->input, "%s", err.message);
+	if (note[0])
+		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, note);
 }
 
 int main(int argc, char **argv)
@@ -218,7 +226,7 @@ int main(int argc, char **argv)
 	const char *output = NULL;
 	enum tool_report report = REPORT_NONE;
 	struct job job;
-	int level = -1, clip = 0, ch, kinds = 0, method_given = 0, merge_given = 0;
+	int level = -1, clip = 0, clip_given = 0, ch, kinds = 0, method_given = 0, merge_given = 0;
 	double point_distance = 0.0;
 	memset(&job, 0, sizeof job);
 	job.method = METHOD_AUTO;
@@ -287,7 +295,7 @@ int main(int argc, char **argv)
 			break;
 		}
 		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
-		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
+		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6), clip_given = 1; break;
 		case 'j': job.threads = tool_parse_threads(optarg); break;
 		case 'h': fputs(usage_text, stdout); return 0;
 		case 'V': tool_version();
@@ -312,6 +320,8 @@ int main(int argc, char **argv)
 	int bvh_out = output && tool_ends_with(output, ".bvh");
 	if (level >= 0 && !bvh_out)
 		tool_usage_error("--level needs a .bvh output (-o out.bvh)");
+	if (clip_given && !bvh_out)
+		tool_usage_error("--clip needs a .bvh output (-o out.bvh)");
 	if (report != REPORT_NONE && output)
 		tool_usage_error("--report and --output do not go together");
 
@@ -380,9 +390,11 @@ int main(int argc, char **argv)
 	}
 	for (int k = 0; k < b.clip_count && report == REPORT_NONE; k++) {
 		char note[256];
-		if (mlod_motion_bake_timeline_note(&b, k, note, sizeof note))
-			fprintf(stderr, "%s: %s: clip \"%s\": %s\n", tool_name, job.input, job.c.clips[b.clips[k].index].name,
-			        note);
+		if (mlod_motion_bake_timeline_note(&b, k, note, sizeof note)) {
+			fprintf(stderr, "%s: %s: clip ", tool_name, job.input);
+			tool_json_string(stderr, job.c.clips[b.clips[k].index].name);
+			fprintf(stderr, ": %s\n", note);
+		}
 	}
 
 	if (report != REPORT_NONE) {

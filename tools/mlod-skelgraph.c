@@ -149,6 +149,14 @@ static void write_bvh(const struct job *job, const char *output, int level, int 
 		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_OUTPUT, output, "%s", err.message);
 	tool_write_output(output, text, size, 0);
 	mlod_free(text);
+	/* What the BVH cannot hold. */
+	char note[MLOD_SKEL_BVH_NOTE_SIZE];
+	double max;
+	int joint;
+	if (mlod_skel_bvh_end_sites(c, clip, &max, &joint, note, sizeof note, &err) != MLOD_OK)
+		tool_die(tool_exit_code(err.code), job->input, "%s", err.message);
+	if (note[0])
+		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, note);
 }
 
 /* Adds the levels and their record to the document and writes it. */
@@ -216,7 +224,7 @@ int main(int argc, char **argv)
 	const char *output = NULL;
 	enum tool_report report = REPORT_NONE;
 	double thresholds[MLOD_SKEL_MAX_LEVELS], fractions[MLOD_SKEL_MAX_LEVELS];
-	int threshold_count = 0, fraction_count = 0, level = -1, clip = 0;
+	int threshold_count = 0, fraction_count = 0, level = -1, clip = 0, clip_given = 0;
 	double max_error = MLOD_SKEL_MAX_ERROR_DEFAULT;
 	mlod_label_options lopt = {0};
 	int ch;
@@ -231,7 +239,7 @@ int main(int argc, char **argv)
 		case 'j': fraction_count = tool_parse_list("--joints", optarg, fractions, MLOD_SKEL_MAX_LEVELS, 0.0, 1.0); break;
 		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 1e6); break;
 		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MLOD_SKEL_MAX_LEVELS); break;
-		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6); break;
+		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6), clip_given = 1; break;
 		case 'H': lopt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
 		case 'h': printf(usage_text, MLOD_SKEL_MAX_ERROR_DEFAULT); return 0;
 		case 'V': tool_version();
@@ -246,6 +254,8 @@ int main(int argc, char **argv)
 	int bvh_out = output && tool_ends_with(output, ".bvh");
 	if (level >= 0 && !bvh_out)
 		tool_usage_error("--level needs a .bvh output (-o out.bvh)");
+	if (clip_given && !bvh_out)
+		tool_usage_error("--clip needs a .bvh output (-o out.bvh)");
 	if (report != REPORT_NONE && output)
 		tool_usage_error("--report and --output do not go together");
 

@@ -73,6 +73,23 @@ void mlod_free(void *p);
  * writers of JSON text put U+FFFD for such a byte. */
 int mlod_utf8_length(const char *s);
 
+/* A name from a file or a caller (NULL: "") as text that cannot break a
+ * line or move the cursor, into buf (size bytes, at least 16). With quote,
+ * for a one-line message: in double quotes, a quote, a backslash and a
+ * control character or DEL escaped as JSON escapes them (\" \\ \n \t \r
+ * \u00XX), as the tools' JSON strings (lib/io's messages quote names the
+ * same way, with \u00XX for every control character). Without, for a
+ * table column: C escapes (\\, \n, \t, \r, \xHH for any other control
+ * character and DEL), as the tools' tables write names. Either way a byte that is not UTF-8 is
+ * \xHH. A name too long for buf is cut between characters and ends in
+ * "...". Returns buf. */
+#define MLOD_NAME_TEXT_SIZE 160
+const char *mlod_name_text(const char *name, int quote, char *buf, size_t size);
+/* mlod_name_text(name, 1, ...) in a buffer that lives to the end of the
+ * enclosing block (C only: a compound literal), for a message:
+ * mlod_fail(err, code, "clip %s: ...", MLOD_QUOTED(clip->name)). */
+#define MLOD_QUOTED(name) mlod_name_text((name), 1, (char[MLOD_NAME_TEXT_SIZE]){0}, MLOD_NAME_TEXT_SIZE)
+
 /* ------------------------------------------------------------------ */
 /* Threads                                                             */
 /* ------------------------------------------------------------------ */

@@ -1,8 +1,12 @@
 /*
  * text.c: UTF-8 well-formedness, for the writers of JSON text (the stage
  * record, glTF names, the tools' reports), which must be UTF-8 while names
- * from files and callers may be Latin-1.
+ * from files and callers may be Latin-1; and names made safe to show in a
+ * message or a table (mlod_name_text).
  */
+#include <stdio.h>
+#include <string.h>
+
 #include "mlod_core.h"
 
 int mlod_utf8_length(const char *s)
@@ -27,4 +31,60 @@ int mlod_utf8_length(const char *s)
 		if (p[i] < 0x80 || p[i] > 0xbf)
 			return 0;
 	return n;
+}
+
+/* The escape of the character at p into esc (at most 7 bytes and a NUL);
+ * returns the bytes it takes from p. */
+static int name_char(const unsigned char *p, int quote, char esc[8])
+{
+	int len = mlod_utf8_length((const char *)p);
+	unsigned c = *p;
+	if (len > 1) {
+		memcpy(esc, p, (size_t)len);
+		esc[len] = '\0';
+		return len;
+	}
+	if (c == '\\' || (quote && c == '"'))
+		snprintf(esc, 8, "\\%c", (int)c);
+	else if (len == 0)
+		snprintf(esc, 8, "\\x%02x", c);
+	else if (c == '\n' || c == '\t' || c == '\r')
+		snprintf(esc, 8, "\\%c", c == '\n' ? 'n' : c == '\t' ? 't' : 'r');
+	else if (c < 0x20 || c == 0x7f)
+		snprintf(esc, 8, quote ? "\\u%04x" : "\\x%02x", c);
+	else
+		esc[0] = (char)c, esc[1] = '\0';
+	return 1;
+}
+
+const char *mlod_name_text(const char *name, int quote, char *buf, size_t size)
+{
+	const unsigned char *s = (const unsigned char *)(name ? name : "");
+	size_t n = 0, end = quote ? 2 : 0, total = 0; /* end: the quotes */
+	char esc[8];
+	if (!buf || size < 16)
+		return buf && size ? (buf[0] = '\0', buf) : "";
+	for (const unsigned char *p = s; *p;) {
+		p += name_char(p, quote, esc);
+		total += strlen(esc);
+	}
+	/* Cut: room for "..." where it stops. */
+	size_t room = size - 1 - end - (total + end + 1 > size ? 3 : 0);
+	if (quote)
+		buf[n++] = '"';
+	for (const unsigned char *p = s; *p;) {
+		p += name_char(p, quote, esc);
+		size_t e = strlen(esc);
+		if (n - (quote ? 1 : 0) + e > room) {
+			memcpy(buf + n, "...", 3);
+			n += 3;
+			break;
+		}
+		memcpy(buf + n, esc, e);
+		n += e;
+	}
+	if (quote)
+		buf[n++] = '"';
+	buf[n] = '\0';
+	return buf;
 }

@@ -460,8 +460,8 @@ static mlod_result read_channels(reader *r, mlod_joint *j, const char *desc)
 	TRY(next(r, &t));
 	int line = t.line;
 	if (t.len != 1 || !is_digit(t.s[0]) || t.s[0] > '6')
-		return mlod_fail(r->err, MLOD_ERR_PARSE, "line %d: CHANNELS of %s must be a count from 0 to 6, found %s",
-		                 t.line, desc, show(&t, b));
+		return mlod_fail(r->err, t.len == 1 && t.s[0] > '6' && t.s[0] <= '9' ? MLOD_ERR_UNSUPPORTED : MLOD_ERR_PARSE,
+		                 "line %d: CHANNELS of %s must be a count from 0 to 6, found %s", t.line, desc, show(&t, b));
 	int n = t.s[0] - '0';
 	int seen = 0;
 	for (int i = 0; i < n; i++) {

@@ -97,6 +97,18 @@ static void sb_json_string(sbuf *b, const char *s)
 	sb_printf(b, "\"");
 }
 
+/* A name in a table (mlod_name_text's C escapes), padded to width
+ * columns, a UTF-8 character one column. */
+static void sb_name(sbuf *b, const char *name, int width)
+{
+	char text[512];
+	mlod_name_text(name, 0, text, sizeof text);
+	int columns = 0;
+	for (const unsigned char *p = (const unsigned char *)text; *p; p++)
+		columns += (*p & 0xc0) != 0x80;
+	sb_printf(b, "%s%*s", text, width > columns ? width - columns : 0, "");
+}
+
 static mlod_result sb_finish(sbuf *b, char **text, mlod_error *err)
 {
 	if (b->bad || !b->p) {
@@ -164,9 +176,11 @@ static mlod_result level_extras(const mlod_character *c, const mlod_motion_bake_
 	if (c->instance_count > 0) {
 		mlod_character a = with_clip(c, &c->clips[cl->index]), b = with_clip(c, &lv->l.clip);
 		mlod_error why = { 0 };
+		char q[MLOD_NAME_TEXT_SIZE];
 		mlod_result r = mlod_vertex_deviation(&a, &b, o->vertex_samples, &lv->vertex, &why);
 		if (r != MLOD_OK)
-			return mlod_fail(err, r, "clip \"%s\": %s", c->clips[cl->index].name, why.message);
+			return mlod_fail(err, r, "clip %s: %s", mlod_name_text(c->clips[cl->index].name, 1, q, sizeof q),
+			                 why.message);
 		lv->has_vertex = 1;
 	}
 	if (cl->w_count == 0)
@@ -299,6 +313,8 @@ mlod_result mlod_motion_bake_run(const mlod_character *c, const mlod_gltf *doc, 
 	for (int k = 0; k < n && r == MLOD_OK; k++) {
 		const mlod_motion_bake_clip *cl = &out->clips[k];
 		const mlod_clip *src = &c->clips[cl->index];
+		char q[MLOD_NAME_TEXT_SIZE];
+		const char *name = mlod_name_text(src->name, 1, q, sizeof q);
 		if (w_result[k] != MLOD_OK) {
 			r = w_result[k];
 			if (err)
@@ -311,8 +327,22 @@ mlod_result mlod_motion_bake_run(const mlod_character *c, const mlod_gltf *doc, 
 				*err = built[k].error;
 			break;
 		}
+		if (src->channel_count == 0) {
+			/* A camera's or another node's animation, or morph weights
+			 * alone: mlod_gltf_add_animation writes joint channels, so
+			 * a level of it could not be written. */
+			int fail = cl->w_count == 0
+			               ? add_note(out, "clip %s animates no joint and no morph weights: nothing to reduce, no "
+			                               "levels (the animation is kept as it is)", name)
+			               : add_note(out, "clip %s animates no joint, only morph weights (%d channel%s): no levels "
+			                               "(the animation is kept as it is)", name, cl->w_count,
+			                          cl->w_count == 1 ? "" : "s");
+			if (fail != 0)
+				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+			continue;
+		}
 		if (cl->frames < 3) {
-			if (add_note(out, "clip \"%s\" has %d frame%s: nothing to reduce, no levels", src->name, cl->frames,
+			if (add_note(out, "clip %s has %d frame%s: nothing to reduce, no levels", name, cl->frames,
 			             cl->frames == 1 ? "" : "s") != 0)
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 			continue;
@@ -400,36 +430,42 @@ mlod_result mlod_motion_bake_table(const mlod_motion_bake *b, const mlod_charact
 	for (int k = 0; k < b->clip_count; k++) {
 		const mlod_motion_bake_clip *cl = &b->clips[k];
 		const char *name = c->clips[cl->index].name;
-		sb_printf(&sb, "%-16s %5d %6s %10s %7ld %6.1f%% %8ld %10s %8s %10s %8s %10s %8s\n", name, 0, "-", "-",
+		sb_name(&sb, name, 16);
+		sb_printf(&sb, " %5d %6s %10s %7ld %6.1f%% %8ld %10s %8s %10s %8s %10s %8s\n", 0, "-", "-",
 		          cl->keys, 100.0, cl->bytes, "0", "0", "0", "0", "0", c->instance_count ? "0" : "-");
 		for (int i = 0; i < cl->level_count; i++) {
 			const mlod_motion_bake_level *lv = &cl->levels[i];
 			if (!lv->ok) {
-				sb_printf(&sb, "%-16s %5d %6s (no level within %.4g)\n", name, i + 1, "-", lv->bound);
+				sb_name(&sb, name, 16);
+				sb_printf(&sb, " %5d %6s (no level within %.4g)\n", i + 1, "-", lv->bound);
 				continue;
 			}
 			char vtx[32] = "-";
 			if (lv->has_vertex)
 				snprintf(vtx, sizeof vtx, "%.4f", lv->vertex.max);
 			long keys = lv->l.keys + lv->w_keys;
-			sb_printf(&sb, "%-16s %5d %6s %10.4g %7ld %6.1f%% %8ld %10.4g %8.4f %10.4g %8.4f %10.4g %8s\n", name,
-			          i + 1, method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
+			sb_name(&sb, name, 16);
+			sb_printf(&sb, " %5d %6s %10.4g %7ld %6.1f%% %8ld %10.4g %8.4f %10.4g %8.4f %10.4g %8s\n", i + 1, method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
 			          lv->l.bytes + lv->w_bytes, lv->l.error.max, 100.0 * lv->l.error.max / height, lv->l.error.mean,
 			          100.0 * lv->l.error.mean / height, lv->l.point_error, vtx);
 		}
 	}
 	for (int k = 0; k < b->clip_count; k++) {
 		char note[256];
-		if (mlod_motion_bake_timeline_note(b, k, note, sizeof note))
-			sb_printf(&sb, "# clip %s: %s\n", c->clips[b->clips[k].index].name, note);
+		if (mlod_motion_bake_timeline_note(b, k, note, sizeof note)) {
+			sb_printf(&sb, "# clip ");
+			sb_name(&sb, c->clips[b->clips[k].index].name, 0);
+			sb_printf(&sb, ": %s\n", note);
+		}
 	}
 	for (int k = 0; k < b->clip_count; k++) {
 		const mlod_motion_bake_clip *cl = &b->clips[k];
 		if (cl->w_count == 0)
 			continue;
-		sb_printf(&sb,
-		          "# clip %s: %d morph weights channels, %ld keys; per level kept keys (vertex error bound, scene units):",
-		          c->clips[cl->index].name, cl->w_count, cl->w_keys);
+		sb_printf(&sb, "# clip ");
+		sb_name(&sb, c->clips[cl->index].name, 0);
+		sb_printf(&sb, ": %d morph weights channels, %ld keys; per level kept keys (vertex error bound, scene units):",
+		          cl->w_count, cl->w_keys);
 		for (int i = 0; i < cl->level_count; i++)
 			if (cl->levels[i].ok)
 				sb_printf(&sb, " %d: %ld (%.4g%s)", i + 1, cl->levels[i].w_keys, cl->levels[i].w_error,
@@ -527,6 +563,7 @@ mlod_result mlod_motion_bake_to_gltf(mlod_motion_bake *b, const mlod_character *
 			if (!lv->ok)
 				continue;
 			const char *base = src->name ? src->name : "";
+			char q[MLOD_NAME_TEXT_SIZE];
 			char *name = malloc(strlen(base) + 32);
 			if (!name)
 				return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
@@ -537,7 +574,7 @@ mlod_result mlod_motion_bake_to_gltf(mlod_motion_bake *b, const mlod_character *
 			mlod_error why = { 0 };
 			mlod_result r = mlod_gltf_add_animation(doc, &c->skeleton, &lv->l.clip, &index, &why);
 			if (r != MLOD_OK)
-				return mlod_fail(err, r, "clip \"%s\": %s", base, why.message);
+				return mlod_fail(err, r, "clip %s: %s", mlod_name_text(base, 1, q, sizeof q), why.message);
 			/* The level's stage record (mlod-record(5)). */
 			mlod_record_motion_level rec;
 			memset(&rec, 0, sizeof rec);
@@ -563,7 +600,7 @@ mlod_result mlod_motion_bake_to_gltf(mlod_motion_bake *b, const mlod_character *
 				                                                 lv->w_bound, lv->w_error, lv->w_copied };
 				r = mlod_gltf_add_weight_tracks(doc, index, lv->w, lv->w_count, &why);
 				if (r != MLOD_OK)
-					return mlod_fail(err, r, "clip \"%s\": %s", base, why.message);
+					return mlod_fail(err, r, "clip %s: %s", mlod_name_text(base, 1, q, sizeof q), why.message);
 			}
 			r = mlod_record_write_motion(doc, index, &rec, err);
 			if (r != MLOD_OK)

@@ -410,12 +410,13 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: no joints or no channels");
 	const mlod_channel *c0 = &common->channels[0];
 	int F = c0->key_count;
+	char q[MLOD_NAME_TEXT_SIZE];
 	if (F <= 0)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: no frames");
 	if (((double)F - 1.0) * subdivide * s->joint_count > (double)MAX_FRAME_JOINTS)
 		return mlod_fail(err, MLOD_ERR_LIMIT,
-		                 "clip \"%s\": %d frames (%d samples each) of %d joints is more than the keys method holds (%ld); split the clip",
-		                 common->name ? common->name : "", F, subdivide, s->joint_count, MAX_FRAME_JOINTS);
+		                 "clip %s: %d frames (%d samples each) of %d joints is more than the keys method holds (%ld); split the clip",
+		                 mlod_name_text(common->name, 1, q, sizeof q), F, subdivide, s->joint_count, MAX_FRAME_JOINTS);
 	for (int c = 0; c < common->channel_count; c++) {
 		const mlod_channel *ch = &common->channels[c];
 		const unsigned char *row = kept + (size_t)c * (size_t)F;

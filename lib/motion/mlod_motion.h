@@ -128,10 +128,14 @@ double mlod_motion_frame_distance(const mlod_skeleton *s, const mlod_trs *a, con
 
 /* Puts clip on its common timeline (see mlod_motion_timeline): out gets
  * one channel per channel of clip, every one keyed at every frame, LINEAR
- * or STEP, rotations normalised and sign-continuous. Release out with
- * mlod_clip_free. Bad clips (no channels, no keys, times not finite or
- * negative or not increasing, values not finite, zero quaternions) are
- * MLOD_ERR_PARSE; too many frames is MLOD_ERR_LIMIT. info may be NULL. */
+ * or STEP, rotations normalised and sign-continuous. A clip without
+ * channels (an animation of no joint: a camera's, morph weights alone)
+ * has a timeline of 0 frames; a motion of it (mlod_motion_create) has
+ * nothing to reduce, and every level of it is the clip without channels,
+ * no keys and no error. Release out with mlod_clip_free. Bad clips (no
+ * keys, times not finite or negative or not increasing, values not
+ * finite, zero quaternions) are MLOD_ERR_PARSE; too many frames is
+ * MLOD_ERR_LIMIT. info may be NULL. */
 mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_options *opt,
                                     mlod_clip *out, mlod_motion_timeline *info, mlod_error *err);
 
@@ -258,7 +262,8 @@ typedef struct mlod_motion_clip_levels {
 	mlod_error error;
 	mlod_motion_timeline timeline;
 	int level_count;          /* levels tried, in spec order: 0 for a clip of fewer than 3 frames
-	                             (nothing to reduce); a failure other than MLOD_ERR_LIMIT ends them */
+	                             (nothing to reduce, also a clip without channels: 0 frames); a
+	                             failure other than MLOD_ERR_LIMIT ends them */
 	mlod_motion_level *levels; /* level_count; those whose result is MLOD_OK are set */
 	mlod_result *results;     /* per level: MLOD_OK, MLOD_ERR_LIMIT (no method meets the target) or
 	                             the failure that ended the levels */
@@ -317,8 +322,10 @@ typedef struct mlod_motion_bake {
 	int clip_count;
 	mlod_motion_bake_clip *clips;
 	int note_count;
-	char **notes;             /* what to tell the user, in order: clips with nothing to reduce,
-	                             levels no method makes (the caller prints them) */
+	char **notes;             /* what to tell the user, in order: clips with nothing to reduce
+	                             (fewer than 3 frames, or no joint channels: kept as they are),
+	                             levels no method makes (the caller prints them); names in them
+	                             are quoted and escaped (mlod_name_text) */
 } mlod_motion_bake;
 
 typedef struct mlod_motion_bake_options {

@@ -485,10 +485,11 @@ mlod_result motion_create_on(const mlod_character *c, int clip, const mlod_motio
 	if (s->joint_count <= 0)
 		return mlod_fail(err, MLOD_ERR_PARSE, "the skeleton has no joints");
 	const mlod_clip *src = &c->clips[clip];
+	char q[MLOD_NAME_TEXT_SIZE];
 	for (int i = 0; i < src->channel_count; i++)
 		if (src->channels && (src->channels[i].joint < 0 || src->channels[i].joint >= s->joint_count))
-			return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: joint %d out of range",
-			                 src->name ? src->name : "", i, src->channels[i].joint);
+			return mlod_fail(err, MLOD_ERR_PARSE, "clip %s channel %d: joint %d out of range",
+			                 mlod_name_text(src->name, 1, q, sizeof q), i, src->channels[i].joint);
 	mlod_motion *m = calloc(1, sizeof *m);
 	if (!m)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
@@ -513,24 +514,26 @@ mlod_result motion_create_on(const mlod_character *c, int clip, const mlod_motio
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "unknown precision %d", (int)m->opt.precision);
 	}
-	if ((double)(F - 1) * m->sub + 1.0 > (double)INT_MAX / 16) {
+	if (F > 0 && (double)(F - 1) * m->sub + 1.0 > (double)INT_MAX / 16) {
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "%d frames at %d samples each are too many", F, m->sub);
 	}
-	m->samples = (F - 1) * m->sub + 1;
-	m->st = malloc(sizeof(float) * (size_t)m->samples);
+	/* A clip without joint channels has no frames and no samples: its
+	 * levels are empty (empty_level). Sizes below are at least 1. */
+	m->samples = F > 0 ? (F - 1) * m->sub + 1 : 0;
+	m->st = malloc(sizeof(float) * (size_t)(m->samples + 1));
 	m->height = mlod_skeleton_height(s);
 	if (!(m->height > 0.0))
 		m->height = 1.0;
 	m->weight = malloc(sizeof(double) * (size_t)n);
-	m->offset = malloc(sizeof(int) * (size_t)nch);
-	m->euler_slot = malloc(sizeof(int) * (size_t)nch);
-	m->constant = malloc((size_t)nch);
+	m->offset = malloc(sizeof(int) * (size_t)(nch + 1));
+	m->euler_slot = malloc(sizeof(int) * (size_t)(nch + 1));
+	m->constant = malloc((size_t)nch + 1);
 	m->local = malloc(sizeof *m->local * (size_t)n);
 	m->world = malloc(sizeof *m->world * (size_t)n);
 	m->world0 = malloc(sizeof *m->world0 * (size_t)n);
 	m->radius = malloc(sizeof(double) * (size_t)n);
-	m->walk_segs = malloc(sizeof *m->walk_segs * (size_t)nch);
+	m->walk_segs = malloc(sizeof *m->walk_segs * (size_t)(nch + 1));
 	m->walk_local = malloc(sizeof *m->walk_local * (size_t)n);
 	if (!m->st || !m->weight || !m->offset || !m->euler_slot || !m->constant || !m->local || !m->world || !m->world0 ||
 	    !m->radius || !m->walk_segs || !m->walk_local) {
@@ -538,8 +541,10 @@ mlod_result motion_create_on(const mlod_character *c, int clip, const mlod_motio
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
 	joint_weights(s, m->weight);
-	mlod_motion_sample_times(m->common.channels[0].times, F, m->sub, m->st);
-	m->clip_end_ok = m->st[m->samples - 1] <= src->duration;
+	if (F > 0) {
+		mlod_motion_sample_times(m->common.channels[0].times, F, m->sub, m->st);
+		m->clip_end_ok = m->st[m->samples - 1] <= src->duration;
+	}
 	for (int i = 0; i < nch; i++) {
 		const mlod_channel *ch = &m->common.channels[i];
 		int comps = comps_of(ch);
@@ -559,7 +564,7 @@ mlod_result motion_create_on(const mlod_character *c, int clip, const mlod_motio
 		mlod_motion_free(m);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
-	if ((double)m->samples * n <= (double)MAX_CACHED &&
+	if (m->samples > 0 && (double)m->samples * n <= (double)MAX_CACHED &&
 	    (m->cache0 = malloc(sizeof(mlod_mat4) * (size_t)m->samples * (size_t)n)) != NULL) {
 		/* mlod_clip_sample and mlod_pose_world, faster (motion_eval.h)
 		 * when the clip is LINEAR or STEP. */
@@ -589,7 +594,7 @@ mlod_result motion_create_on(const mlod_character *c, int clip, const mlod_motio
 	}
 	/* Level 0 of each method: every frame, every key (the tree's line
 	 * is made when the frames method first needs it: tree_start). */
-	m->kept = malloc((size_t)nch * (size_t)F);
+	m->kept = malloc((size_t)nch * (size_t)F + 1);
 	m->memo = calloc(1, sizeof *m->memo);
 	m->segmemo = calloc(1, sizeof *m->segmemo);
 	m->refs = malloc(sizeof *m->refs);
@@ -646,9 +651,9 @@ mlod_result mlod_motion_create_like(const mlod_motion *first, mlod_motion **out,
 	m->local = malloc(sizeof *m->local * (size_t)n);
 	m->world = malloc(sizeof *m->world * (size_t)n);
 	m->world0 = malloc(sizeof *m->world0 * (size_t)n);
-	m->walk_segs = malloc(sizeof *m->walk_segs * (size_t)nch);
+	m->walk_segs = malloc(sizeof *m->walk_segs * (size_t)(nch + 1));
 	m->walk_local = malloc(sizeof *m->walk_local * (size_t)n);
-	m->kept = malloc((size_t)nch * (size_t)F);
+	m->kept = malloc((size_t)nch * (size_t)F + 1);
 	m->memo = calloc(1, sizeof *m->memo);
 	m->segmemo = calloc(1, sizeof *m->segmemo);
 	if (!m->local || !m->world || !m->world0 || !m->walk_segs || !m->walk_local || !m->kept || !m->memo || !m->segmemo) {
@@ -677,8 +682,8 @@ static int level_clip_init(const mlod_motion *m, mlod_clip *clip)
 	clip->frame_count = m->orig->frame_count;
 	clip->gltf_index = m->orig->gltf_index;
 	clip->channel_count = m->common.channel_count;
-	clip->channels = calloc((size_t)clip->channel_count, sizeof *clip->channels);
-	return clip->name && clip->channels ? 0 : -1;
+	clip->channels = clip->channel_count > 0 ? calloc((size_t)clip->channel_count, sizeof *clip->channels) : NULL;
+	return clip->name && (clip->channels || clip->channel_count == 0) ? 0 : -1;
 }
 
 /* The clip must reach the last frame: a channel with a single key gets a
@@ -2077,7 +2082,7 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	line best = { 0, NULL };
 	double T = 0.0;
-	const char *name = m->orig->name ? m->orig->name : "";
+	char q[MLOD_NAME_TEXT_SIZE]; /* the clip's name in a message */
 	free(m->segmemo->slot);
 	memset(m->segmemo, 0, sizeof *m->segmemo);
 	if (target == MLOD_MOTION_THRESHOLD) {
@@ -2167,7 +2172,8 @@ static mlod_result frames_level(mlod_motion *m, mlod_motion_target target, doubl
 				if (!(e <= value)) {
 					line_free(&best);
 					return mlod_fail(err, MLOD_ERR_LIMIT,
-					                 "clip \"%s\": no frames level within %g: the %s already deviates by %g", name,
+					                 "clip %s: no frames level within %g: the %s already deviates by %g",
+					                 mlod_name_text(m->orig->name, 1, q, sizeof q),
 					                 value, m->info.resampled ? "resampled clip" : "previous level", e);
 				}
 			}
@@ -2225,7 +2231,7 @@ static double keys_try(mlod_motion *m, double budget, unsigned char *kept, mlod_
 static mlod_result keys_reduce(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
                                double *known, mlod_error *err)
 {
-	const char *name = m->orig->name ? m->orig->name : "";
+	char q[MLOD_NAME_TEXT_SIZE]; /* the clip's name in a message */
 	if (target == MLOD_MOTION_THRESHOLD)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "thresholds are frame distances: they need the frames method");
 	size_t size = (size_t)m->common.channel_count * (size_t)m->frames;
@@ -2262,8 +2268,8 @@ static mlod_result keys_reduce(mlod_motion *m, mlod_motion_target target, double
 			mlod_clip c0;
 			double e = keys_try(m, 0.0, kept, &c0, err);
 			mlod_clip_free(&c0);
-			r = mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": no keys level within %g: the %s already deviates by %g",
-			              name, value, m->info.resampled ? "resampled clip" : "previous level", e);
+			r = mlod_fail(err, MLOD_ERR_LIMIT, "clip %s: no keys level within %g: the %s already deviates by %g",
+			              mlod_name_text(m->orig->name, 1, q, sizeof q), value, m->info.resampled ? "resampled clip" : "previous level", e);
 		}
 	} else {
 		long target_keys = (long)floor(value * (double)mlod_clip_key_count(m->orig));
@@ -2362,12 +2368,30 @@ static mlod_result level_args(const mlod_motion *m, mlod_motion_target target, d
 	return MLOD_OK;
 }
 
+/* Every level of a clip without joint channels (no frames): the clip
+ * with no channels, no keys, no error. */
+static mlod_result empty_level(const mlod_motion *m, mlod_motion_method method, mlod_motion_level *out,
+                               mlod_error *err)
+{
+	memset(out, 0, sizeof *out);
+	if (level_clip_init(m, &out->clip) != 0) {
+		mlod_clip_free(&out->clip);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	out->method = method;
+	return MLOD_OK;
+}
+
 mlod_result mlod_motion_keys_reduce(mlod_motion *m, mlod_motion_target target, double value, mlod_motion_level *out,
                                     double *known, mlod_error *err)
 {
 	mlod_result r = level_args(m, target, value, out, err);
 	if (r == MLOD_OK && !known)
 		r = mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_keys_reduce: NULL argument");
+	if (r == MLOD_OK && m->frames == 0) {
+		*known = 0.0;
+		return empty_level(m, MLOD_MOTION_KEYS, out, err);
+	}
 	return r != MLOD_OK ? r : keys_reduce(m, target, value, out, known, err);
 }
 
@@ -2378,6 +2402,8 @@ mlod_result mlod_motion_keys_finish(mlod_motion *m, mlod_motion_target target, d
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_keys_finish: bad arguments");
 	if (l->clip.channel_count != m->common.channel_count)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_keys_finish: the level is not of this clip");
+	if (m->frames == 0)
+		return MLOD_OK; /* empty_level: nothing to round or measure */
 	return keys_finish(m, target, value, max_bytes, known, l, err);
 }
 
@@ -2387,6 +2413,8 @@ mlod_result mlod_motion_next_level_under(mlod_motion *m, mlod_motion_method meth
 	mlod_result r = level_args(m, target, value, out, err);
 	if (r != MLOD_OK)
 		return r;
+	if (m->frames == 0 && (method == MLOD_MOTION_FRAMES || method == MLOD_MOTION_KEYS))
+		return empty_level(m, method, out, err);
 	switch (method) {
 	case MLOD_MOTION_FRAMES: return frames_level(m, target, value, max_bytes, out, err);
 	case MLOD_MOTION_KEYS: return keys_level(m, target, value, max_bytes, out, err);

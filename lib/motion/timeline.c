@@ -84,40 +84,42 @@ void mlod_motion_sample_times(const float *times, int frames, int subdivide, flo
 
 static mlod_result check_clip(const mlod_clip *clip, mlod_error *err)
 {
-	const char *name = clip->name ? clip->name : "";
-	if (clip->channel_count <= 0 || !clip->channels)
-		return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\": no channels to reduce", name);
+	char q[MLOD_NAME_TEXT_SIZE];
+	const char *name = mlod_name_text(clip->name, 1, q, sizeof q);
+	if (clip->channel_count < 0 || (clip->channel_count > 0 && !clip->channels))
+		return mlod_fail(err, MLOD_ERR_PARSE, "clip %s: channel count %d without channels", name,
+		                 clip->channel_count);
 	for (int i = 0; i < clip->channel_count; i++) {
 		const mlod_channel *ch = &clip->channels[i];
 		if ((unsigned)ch->path > MLOD_PATH_SCALE || (unsigned)ch->interp > MLOD_INTERP_CUBICSPLINE)
-			return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: bad path or interpolation", name, i);
+			return mlod_fail(err, MLOD_ERR_PARSE, "clip %s channel %d: bad path or interpolation", name, i);
 		if (ch->key_count <= 0 || !ch->times || !ch->values)
-			return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: no keys", name, i);
+			return mlod_fail(err, MLOD_ERR_PARSE, "clip %s channel %d: no keys", name, i);
 		int comps = comps_of(ch), stride = comps * (ch->interp == MLOD_INTERP_CUBICSPLINE ? 3 : 1);
 		for (int k = 0; k < ch->key_count; k++) {
 			float t = ch->times[k];
 			if (!isfinite(t))
-				return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: key %d time is not finite", name, i, k);
+				return mlod_fail(err, MLOD_ERR_PARSE, "clip %s channel %d: key %d time is not finite", name, i, k);
 			if (k == 0 && t < 0.0f)
 				return mlod_fail(err, MLOD_ERR_PARSE,
-				                 "clip \"%s\" channel %d: first key time %g is negative (glTF needs times >= 0)",
+				                 "clip %s channel %d: first key time %g is negative (glTF needs times >= 0)",
 				                 name, i, (double)t);
 			if (k > 0 && !(t > ch->times[k - 1]))
 				return mlod_fail(err, MLOD_ERR_PARSE,
-				                 "clip \"%s\" channel %d: key %d time %g does not follow %g (times must increase)",
+				                 "clip %s channel %d: key %d time %g does not follow %g (times must increase)",
 				                 name, i, k, (double)t, (double)ch->times[k - 1]);
 			const float *v = ch->values + (size_t)k * (size_t)stride;
 			double len2 = 0.0;
 			for (int c = 0; c < stride; c++)
 				if (!isfinite(v[c]))
-					return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: key %d value is not finite", name,
+					return mlod_fail(err, MLOD_ERR_PARSE, "clip %s channel %d: key %d value is not finite", name,
 					                 i, k);
 			if (comps == 4) {
 				const float *q = v + (ch->interp == MLOD_INTERP_CUBICSPLINE ? 4 : 0);
 				for (int c = 0; c < 4; c++)
 					len2 += (double)q[c] * q[c];
 				if (!(len2 > 1e-12))
-					return mlod_fail(err, MLOD_ERR_PARSE, "clip \"%s\" channel %d: key %d rotation is a zero quaternion",
+					return mlod_fail(err, MLOD_ERR_PARSE, "clip %s channel %d: key %d rotation is a zero quaternion",
 					                 name, i, k);
 			}
 		}
@@ -142,6 +144,7 @@ mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_opt
                                     mlod_motion_timeline *info, mlod_error *err)
 {
 	mlod_motion_timeline inf;
+	char q[MLOD_NAME_TEXT_SIZE];
 	memset(&inf, 0, sizeof inf);
 	if (!clip || !out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_motion_common_clip: NULL argument");
@@ -149,6 +152,20 @@ mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_opt
 	mlod_result r = check_clip(clip, err);
 	if (r != MLOD_OK)
 		return r;
+	if (clip->channel_count == 0) {
+		/* No joint channels (an animation of a camera, of other nodes or
+		 * of morph weights alone): a timeline of no frames. */
+		out->name = mlod_strdup(clip->name);
+		out->duration = clip->duration;
+		out->frame_time = clip->frame_time;
+		out->frame_count = clip->frame_count;
+		out->gltf_index = clip->gltf_index;
+		if (!out->name)
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		if (info)
+			*info = inf;
+		return MLOD_OK;
+	}
 	double rate = opt && opt->cubic_rate > 0.0 ? opt->cubic_rate : DEFAULT_CUBIC_RATE;
 	for (int i = 0; i < clip->channel_count; i++)
 		if (clip->channels[i].interp == MLOD_INTERP_CUBICSPLINE)
@@ -186,8 +203,8 @@ mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_opt
 			extra += ceil(((double)u[i + 1] - u[i]) * rate - 1e-6) - 1.0;
 		if (k + extra > MAX_FRAMES) {
 			free(u);
-			return mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": resampling needs %.0f frames (at most %d)",
-			                 clip->name ? clip->name : "", k + extra, MAX_FRAMES);
+			return mlod_fail(err, MLOD_ERR_LIMIT, "clip %s: resampling needs %.0f frames (at most %d)",
+			                 mlod_name_text(clip->name, 1, q, sizeof q), k + extra, MAX_FRAMES);
 		}
 		n = k + (long)extra;
 		times = malloc(sizeof(float) * (size_t)n);
@@ -221,8 +238,8 @@ mlod_result mlod_motion_common_clip(const mlod_clip *clip, const mlod_motion_opt
 		values += (double)n * (comps_of(&clip->channels[i]) + 1);
 	if (n > MAX_FRAMES || values > MAX_VALUES) {
 		free(times);
-		return mlod_fail(err, MLOD_ERR_LIMIT, "clip \"%s\": %ld frames of %d channels is too much motion",
-		                 clip->name ? clip->name : "", n, clip->channel_count);
+		return mlod_fail(err, MLOD_ERR_LIMIT, "clip %s: %ld frames of %d channels is too much motion",
+		                 mlod_name_text(clip->name, 1, q, sizeof q), n, clip->channel_count);
 	}
 	inf.frames = (int)n;
 

@@ -216,7 +216,7 @@ static mlod_result fold_clip_joint(struct folder *f, const mlod_clip *clip, int 
 	return r;
 nomem:
 	free(times);
-	return mlod_fail(f->err, MLOD_ERR_NOMEM, "out of memory folding clip \"%s\"", clip->name);
+	return mlod_fail(f->err, MLOD_ERR_NOMEM, "out of memory folding clip %s", MLOD_QUOTED(clip->name));
 }
 
 static mlod_result fold_clip(struct folder *f, const mlod_clip *clip, mlod_clip *out)
@@ -231,7 +231,7 @@ static mlod_result fold_clip(struct folder *f, const mlod_clip *clip, mlod_clip 
 	/* At most 3 channels per kept joint besides the copied ones. */
 	out->channels = calloc((size_t)clip->channel_count + 3 * (size_t)l->kept_count + 1, sizeof(mlod_channel));
 	if (failed || !out->channels)
-		return mlod_fail(f->err, MLOD_ERR_NOMEM, "out of memory folding clip \"%s\"", clip->name);
+		return mlod_fail(f->err, MLOD_ERR_NOMEM, "out of memory folding clip %s", MLOD_QUOTED(clip->name));
 	for (int j = 0; j < s->joint_count; j++) {
 		if (!l->kept[j])
 			continue;
@@ -253,7 +253,7 @@ static mlod_result fold_clip(struct folder *f, const mlod_clip *clip, mlod_clip 
 			o->times = dup_bytes(ch->times, sizeof(float) * (size_t)ch->key_count, &failed);
 			o->values = dup_bytes(ch->values, sizeof(float) * (size_t)comps * (size_t)ch->key_count, &failed);
 			if (failed)
-				return mlod_fail(f->err, MLOD_ERR_NOMEM, "out of memory folding clip \"%s\"", clip->name);
+				return mlod_fail(f->err, MLOD_ERR_NOMEM, "out of memory folding clip %s", MLOD_QUOTED(clip->name));
 		}
 	}
 	return MLOD_OK;
@@ -272,7 +272,7 @@ static mlod_result reduce_skin(struct folder *f, const mlod_skin *sk, const mlod
 	out->joints = malloc(sizeof(int) * (size_t)(sk->joint_count ? sk->joint_count : 1));
 	out->inverse_bind = malloc(sizeof(mlod_mat4) * (size_t)(sk->joint_count ? sk->joint_count : 1));
 	if (failed || !out->joints || !out->inverse_bind)
-		return mlod_fail(f->err, MLOD_ERR_NOMEM, "out of memory reducing skin \"%s\"", sk->name);
+		return mlod_fail(f->err, MLOD_ERR_NOMEM, "out of memory reducing skin %s", MLOD_QUOTED(sk->name));
 	/* Kept joints of the skin first, in their order, with their own bind. */
 	for (int k = 0; k < sk->joint_count; k++) {
 		int j = sk->joints[k];
@@ -296,8 +296,8 @@ static mlod_result reduce_skin(struct folder *f, const mlod_skin *sk, const mlod
 		/* R(k->j) = inverse(world_k) * world_j in the rest pose. */
 		mlod_mat4 inv, rel;
 		if (mlod_mat4_invert(&world[stand], &inv) != 0)
-			return mlod_fail(f->err, MLOD_ERR_PARSE, "joint \"%s\" has a singular rest transform",
-			                 s->joints[stand].name);
+			return mlod_fail(f->err, MLOD_ERR_PARSE, "joint %s has a singular rest transform",
+			                 MLOD_QUOTED(s->joints[stand].name));
 		rel = mlod_mat4_mul(&inv, &world[j]);
 		map[k] = out->joint_count;
 		out->joints[out->joint_count] = stand;
@@ -428,8 +428,8 @@ mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level
 				continue;
 			if (skin >= 0 && skin != in->skin) {
 				r = mlod_fail(err, MLOD_ERR_UNSUPPORTED,
-				              "mesh %d \"%s\" is skinned by two different skins (%d and %d)", m,
-				              src->name ? src->name : "", skin, in->skin);
+				              "mesh %d %s is skinned by two different skins (%d and %d)", m,
+				              MLOD_QUOTED(src->name), skin, in->skin);
 				goto fail;
 			}
 			skin = in->skin;
@@ -462,8 +462,8 @@ mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level
 			if (stand != in.joint) {
 				mlod_mat4 inv, rel;
 				if (mlod_mat4_invert(&world[stand], &inv) != 0) {
-					r = mlod_fail(err, MLOD_ERR_PARSE, "joint \"%s\" has a singular rest transform",
-					              s->joints[stand].name);
+					r = mlod_fail(err, MLOD_ERR_PARSE, "joint %s has a singular rest transform",
+					              MLOD_QUOTED(s->joints[stand].name));
 					goto fail;
 				}
 				rel = mlod_mat4_mul(&inv, &world[in.joint]);

@@ -102,7 +102,7 @@ static mlod_result clip_variation(const mlod_skeleton *s, const mlod_clip *clip,
 		free(times);
 		free(pose);
 		free(prev);
-		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory sampling clip \"%s\"", clip->name);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory sampling clip %s", MLOD_QUOTED(clip->name));
 	}
 	memset(variation, 0, sizeof(double) * (size_t)jn);
 	for (int f = 0; f < frames; f++) {
@@ -142,8 +142,8 @@ mlod_result mlod_label_skeleton(const mlod_character *c, const mlod_label_option
 	for (int j = 0; j < n; j++) {
 		int p = s->joints[j].parent;
 		if (p >= j)
-			return mlod_fail(err, MLOD_ERR_PARSE, "joint %d \"%s\": parent %d does not come before it",
-			                 j, s->joints[j].name, p);
+			return mlod_fail(err, MLOD_ERR_PARSE, "joint %d %s: parent %d does not come before it",
+			                 j, MLOD_QUOTED(s->joints[j].name), p);
 		if (p >= 0) {
 			info[j].depth = info[p].depth + 1;
 			info[p].children++;

@@ -246,6 +246,24 @@ mlod_result mlod_skel_levels_default(mlod_skel_levels *L, double max_error, mlod
 void mlod_skel_levels_records(const mlod_skel_levels *L, mlod_skel_level_record *out);
 
 
+/* ------------------------------------------------------------------ */
+/* BVH output (skelbvh.c)                                              */
+/* ------------------------------------------------------------------ */
+
+/* BVH has no scale channel. mlod_bvh_write puts every joint of a clip
+ * where the character does, scales or not, but an End Site is a fixed
+ * OFFSET in its joint's frame (its place in the rest pose): where a scale
+ * changes during the clip (a glTF scale channel), or a non-uniform scale
+ * lies above a joint that turns, the End Sites below do not follow. *max
+ * gets how far the End Sites of a BVH of clip `clip` of c are from where
+ * c places them, the largest over the clip's key times (scene units; 0
+ * for clip < 0, the rest pose), *joint the joint whose End Site it is
+ * (-1: none), and note (when not NULL) what to tell the user when that is
+ * more than float rounding (1e-5 of the skeleton's extent), else "". */
+#define MLOD_SKEL_BVH_NOTE_SIZE 512
+mlod_result mlod_skel_bvh_end_sites(const mlod_character *c, int clip, double *max, int *joint, char *note,
+                                    size_t note_size, mlod_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -728,6 +728,77 @@ TEST(one_frame_clip)
 	mlod_character_free(&c);
 }
 
+TEST(clip_without_joint_channels)
+{
+	/* An animation of a camera or of morph weights alone reads as a clip
+	 * with no channels: a timeline of no frames, and every level the
+	 * empty clip (mlod_motion_common_clip failed it as MLOD_ERR_PARSE,
+	 * "no channels to reduce", so mlod-motion and mlod-pack exited 2). */
+	mlod_character c = make_chain(3, 10);
+	mlod_clip *cl = &c.clips[0];
+	for (int i = 0; i < cl->channel_count; i++) {
+		free(cl->channels[i].times);
+		free(cl->channels[i].values);
+	}
+	free(cl->channels);
+	cl->channels = NULL;
+	cl->channel_count = 0;
+	mlod_clip common;
+	mlod_motion_timeline info;
+	CHECK_OK(mlod_motion_common_clip(cl, NULL, &common, &info, &terr));
+	CHECK(info.frames == 0 && common.channel_count == 0 && strcmp(common.name, "test") == 0);
+	mlod_clip_free(&common);
+	for (int method = 0; method < 2; method++) {
+		mlod_motion *m;
+		mlod_motion_level lv;
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+		CHECK(mlod_motion_timeline_info(m)->frames == 0);
+		CHECK_OK(mlod_motion_next_level(m, (mlod_motion_method)method, MLOD_MOTION_MAX_ERROR, 0.1, &lv, &terr));
+		CHECK(lv.keys == 0 && lv.bytes == 0 && lv.error.max == 0.0 && lv.clip.channel_count == 0);
+		CHECK(strcmp(lv.clip.name, "test") == 0);
+		mlod_motion_level_free(&lv);
+		mlod_motion_free(m);
+	}
+	/* The levels of several clips: none for it, and no failure. */
+	mlod_motion_method methods[2] = {MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS};
+	mlod_motion_spec spec = {MLOD_MOTION_MAX_ERROR, 0.1};
+	int clips[1] = {0};
+	mlod_motion_clip_levels out[1];
+	CHECK_OK(mlod_motion_build_levels(&c, clips, 1, NULL, methods, 2, &spec, 1, 2, out, &terr));
+	CHECK(out[0].result == MLOD_OK && out[0].level_count == 0 && out[0].timeline.frames == 0);
+	mlod_motion_clip_levels_free(out, 1);
+	/* A channel count without channels is still refused. */
+	cl->channel_count = 2;
+	CHECK(mlod_motion_common_clip(cl, NULL, &common, NULL, &terr) == MLOD_ERR_PARSE);
+	cl->channel_count = 0;
+	mlod_character_free(&c);
+}
+
+TEST(names_escaped_in_messages)
+{
+	/* A clip name with a newline and an ANSI escape reaches stderr
+	 * through the library's messages escaped (it was printed raw). */
+	mlod_character c = make_chain(3, 10);
+	free(c.clips[0].name);
+	c.clips[0].name = strdup("w\nalk\x1b[31mRED\"");
+	c.clips[0].channels[1].times[3] = c.clips[0].channels[1].times[2];
+	mlod_clip common;
+	CHECK(mlod_motion_common_clip(&c.clips[0], NULL, &common, NULL, &terr) == MLOD_ERR_PARSE);
+	CHECK(strstr(terr.message, "clip \"w\\nalk\\u001b[31mRED\\\"\" channel 1: key 3") == terr.message);
+	/* The helper: quoted for messages, C escapes for tables, cut to fit. */
+	char b[MLOD_NAME_TEXT_SIZE];
+	CHECK(strcmp(mlod_name_text("a\tb\x7f\\", 1, b, sizeof b), "\"a\\tb\\u007f\\\\\"") == 0);
+	CHECK(strcmp(mlod_name_text("a\tb\x7f\xff\xc3\xa9", 0, b, sizeof b), "a\\tb\\x7f\\xff\xc3\xa9") == 0);
+	CHECK(strcmp(mlod_name_text(NULL, 1, b, sizeof b), "\"\"") == 0);
+	char small[16];
+	CHECK(strcmp(mlod_name_text("abcdefghijklmnopqrstuvwxyz", 1, small, sizeof small), "\"abcdefghij...\"") == 0);
+	CHECK(strcmp(mlod_name_text("\x1b\x1b\x1b\x1b", 0, small, sizeof small), "\\x1b\\x1b\\x1b...") == 0);
+	CHECK(strcmp(mlod_name_text("abcdefghijklmno", 0, small, sizeof small), "abcdefghijklmno") == 0);
+	CHECK(strcmp(mlod_name_text("abcdefghijklmnop", 0, small, sizeof small), "abcdefghijkl...") == 0);
+	CHECK(strcmp(mlod_name_text("abcdefghijklm", 1, small, sizeof small), "\"abcdefghijklm\"") == 0);
+	mlod_character_free(&c);
+}
+
 TEST(step_channels_stay_step)
 {
 	mlod_character c = make_chain(2, 30);
@@ -1631,6 +1702,8 @@ int main(void)
 	RUN(common_timeline);
 	RUN(bad_clips);
 	RUN(one_frame_clip);
+	RUN(clip_without_joint_channels);
+	RUN(names_escaped_in_messages);
 	RUN(step_channels_stay_step);
 	RUN(key_bytes);
 	RUN(precision_float_and_full);

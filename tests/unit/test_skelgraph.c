@@ -382,6 +382,97 @@ TEST(shear_is_detected)
 }
 
 /* Weight on a removed joint moves to its stand-in and merges. */
+/* The End Sites of BVH text against c's, joints matched by name, at the
+ * BVH's frames: the largest distance. */
+static double bvh_end_site_distance(const mlod_character *c, const char *text, size_t size)
+{
+	mlod_character b;
+	if (mlod_bvh_read(text, size, &b, &terr) != MLOD_OK)
+		return -1.0;
+	int n = c->skeleton.joint_count, m = b.skeleton.joint_count;
+	mlod_trs *la = malloc(sizeof *la * (size_t)n), *lb = malloc(sizeof *lb * (size_t)m);
+	mlod_mat4 *wa = malloc(sizeof *wa * (size_t)n), *wb = malloc(sizeof *wb * (size_t)m);
+	double worst = 0.0;
+	for (int f = 0; f < b.clips[0].frame_count; f++) {
+		float t = (float)f * b.clips[0].frame_time;
+		mlod_pose_rest(&c->skeleton, la);
+		mlod_clip_sample(&c->clips[0], t, la);
+		mlod_pose_world(&c->skeleton, la, wa);
+		mlod_pose_rest(&b.skeleton, lb);
+		mlod_clip_sample(&b.clips[0], t, lb);
+		mlod_pose_world(&b.skeleton, lb, wb);
+		for (int j = 0; j < m; j++)
+			for (int k = 0; k < n; k++)
+				if (b.skeleton.joints[j].has_end_site && strcmp(b.skeleton.joints[j].name, c->skeleton.joints[k].name) == 0) {
+					mlod_v3 pa = mlod_mat4_point(&wa[k], c->skeleton.joints[k].end_site);
+					mlod_v3 pb = mlod_mat4_point(&wb[j], b.skeleton.joints[j].end_site);
+					double d = mlod_v3_length(mlod_v3_sub(pa, pb));
+					worst = d > worst ? d : worst;
+				}
+	}
+	free(la);
+	free(lb);
+	free(wa);
+	free(wb);
+	mlod_character_free(&b);
+	return worst;
+}
+
+TEST(bvh_end_sites_under_scale)
+{
+	/* BVH has no scale channel: mlod_bvh_write keeps the joints in place
+	 * but not the End Sites below a scale channel's joint (tubeman with
+	 * LeftLeg scaled by 1 + 0.3 sin: 0.3051 off, written with exit 0 and
+	 * no word). mlod_skel_bvh_end_sites says how far, as the BVH read back
+	 * shows. */
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	double max = -1.0;
+	int joint = -2;
+	char note[MLOD_SKEL_BVH_NOTE_SIZE];
+	CHECK_OK(mlod_skel_bvh_end_sites(&c, 0, &max, &joint, note, sizeof note, &terr));
+	CHECK(max < 1e-4 && note[0] == '\0');
+	int leg = -1;
+	for (int j = 0; j < c.skeleton.joint_count; j++)
+		if (strcmp(c.skeleton.joints[j].name, "LeftLeg") == 0)
+			leg = j;
+	CHECK(leg >= 0);
+	mlod_clip *cl = &c.clips[0];
+	mlod_channel *chs = realloc(cl->channels, sizeof *chs * (size_t)(cl->channel_count + 1));
+	CHECK(chs);
+	cl->channels = chs;
+	const mlod_channel *first = &cl->channels[0];
+	mlod_channel *ch = &cl->channels[cl->channel_count++];
+	memset(ch, 0, sizeof *ch);
+	ch->joint = leg;
+	ch->path = MLOD_PATH_SCALE;
+	ch->interp = MLOD_INTERP_LINEAR;
+	ch->key_count = first->key_count;
+	ch->times = malloc(sizeof(float) * (size_t)ch->key_count);
+	ch->values = malloc(sizeof(float) * 3 * (size_t)ch->key_count);
+	memcpy(ch->times, first->times, sizeof(float) * (size_t)ch->key_count);
+	for (int k = 0; k < ch->key_count; k++)
+		for (int a = 0; a < 3; a++)
+			ch->values[3 * k + a] = 1.0f + 0.3f * sinf((float)k * 0.05f);
+	CHECK_OK(mlod_skel_bvh_end_sites(&c, 0, &max, &joint, note, sizeof note, &terr));
+	CHECK(joint >= 0 && strcmp(c.skeleton.joints[joint].name, "LeftToeBase") == 0);
+	CHECK_MSG(fabs(max - 0.3051) < 1e-3, "%g", max);
+	CHECK(strstr(note, "clip \"walk\": BVH has no scale channel") == note);
+	char *text = NULL;
+	size_t size = 0;
+	CHECK_OK(mlod_bvh_write(&c, 0, 0.0f, &text, &size, &terr));
+	double back = bvh_end_site_distance(&c, text, size);
+	mlod_free(text);
+	CHECK_MSG(fabs(back - max) < 1e-3 * max, "read back %g, said %g", back, max);
+	/* At the rest scale, nothing moves. */
+	for (int k = 0; k < ch->key_count; k++)
+		for (int a = 0; a < 3; a++)
+			ch->values[3 * k + a] = 1.0f;
+	CHECK_OK(mlod_skel_bvh_end_sites(&c, 0, &max, &joint, note, sizeof note, &terr));
+	CHECK(max < 1e-4 && note[0] == '\0');
+	mlod_character_free(&c);
+}
+
 TEST(skin_transfer_merges)
 {
 	int parent[] = {-1, 0, 1, 2};
@@ -471,6 +562,7 @@ int main(void)
 	RUN(folding_is_exact);
 	RUN(shear_is_detected);
 	RUN(skin_transfer_merges);
+	RUN(bvh_end_sites_under_scale);
 	RUN(vertex_deviation_is_exact);
 	RUN(shared_data);
 	TEST_EXIT();
