@@ -919,6 +919,13 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 				snprintf(name, sizeof name, "%s", info.clip_names[c]);
 			else
 				snprintf(name, sizeof name, "%s@lod%u", info.clip_names[c], k);
+			if (mo.channel_count == 0) {
+				/* A clip that animates no joint (a camera's, a morph
+				 * weights clip): its levels hold nothing to add, and its
+				 * channels stay in the document's animation. */
+				mlod_pack_motion_free(&mo);
+				continue;
+			}
 			int anim = -1, into = -1;
 			snprintf(where, sizeof where, "MOTION level %u of clip %u", k, c);
 			for (int a = 0; k == 0 && a < doc_anims; a++) {
