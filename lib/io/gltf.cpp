@@ -2703,6 +2703,51 @@ void extension_refs(const json &j, bool inside, std::vector<bool> &views, std::v
 	}
 }
 
+/* Flags index i in used (an index out of range or -1: none). */
+void mark_used(std::vector<bool> &used, int i)
+{
+	if (i >= 0 && size_t(i) < used.size())
+		used[size_t(i)] = true;
+}
+
+/* The accessors the meshes, skins and animations of m use. */
+std::vector<bool> used_accessors(const Model &m)
+{
+	std::vector<bool> used(m.accessors.size(), false);
+	for (const tinygltf::Mesh &mesh : m.meshes)
+		for (const tinygltf::Primitive &p : mesh.primitives) {
+			mark_used(used, p.indices);
+			for (const auto &kv : p.attributes)
+				mark_used(used, kv.second);
+			for (const auto &t : p.targets)
+				for (const auto &kv : t)
+					mark_used(used, kv.second);
+		}
+	for (const tinygltf::Skin &sk : m.skins)
+		mark_used(used, sk.inverseBindMatrices);
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationSampler &sa : a.samplers) {
+			mark_used(used, sa.input);
+			mark_used(used, sa.output);
+		}
+	return used;
+}
+
+/* Flags in used the buffer views the accessors (their sparse parts too)
+ * and images of m use. */
+void mark_used_views(const Model &m, std::vector<bool> &used)
+{
+	for (const tinygltf::Accessor &a : m.accessors) {
+		mark_used(used, a.bufferView);
+		if (a.sparse.isSparse) {
+			mark_used(used, a.sparse.indices.bufferView);
+			mark_used(used, a.sparse.values.bufferView);
+		}
+	}
+	for (const tinygltf::Image &i : m.images)
+		mark_used(used, i.bufferView);
+}
+
 /* prune for a document whose indices must hold (keep_indices): the
  * accessors and buffer views after the last one in use go, and each
  * buffer's bytes after its last kept view (a buffer an extension names
@@ -2710,10 +2755,6 @@ void extension_refs(const json &j, bool inside, std::vector<bool> &views, std::v
 void prune_tail(mlod_gltf &doc)
 {
 	Model &m = doc.model;
-	auto mark = [](std::vector<bool> &used, int i) {
-		if (i >= 0 && size_t(i) < used.size())
-			used[size_t(i)] = true;
-	};
 	auto tail = [](std::vector<bool> &used) {
 		size_t n = used.size();
 		while (n > 0 && !used[n - 1])
@@ -2721,23 +2762,7 @@ void prune_tail(mlod_gltf &doc)
 		for (size_t i = 0; i < used.size(); i++)
 			used[i] = i < n;
 	};
-	std::vector<bool> used(m.accessors.size(), false);
-	for (const tinygltf::Mesh &mesh : m.meshes)
-		for (const tinygltf::Primitive &p : mesh.primitives) {
-			mark(used, p.indices);
-			for (const auto &kv : p.attributes)
-				mark(used, kv.second);
-			for (const auto &t : p.targets)
-				for (const auto &kv : t)
-					mark(used, kv.second);
-		}
-	for (const tinygltf::Skin &s : m.skins)
-		mark(used, s.inverseBindMatrices);
-	for (const tinygltf::Animation &a : m.animations)
-		for (const tinygltf::AnimationSampler &s : a.samplers) {
-			mark(used, s.input);
-			mark(used, s.output);
-		}
+	std::vector<bool> used = used_accessors(m);
 	tail(used);
 	renumber(doc, "accessors", used);
 	keep_only(m.accessors, used);
@@ -2745,15 +2770,7 @@ void prune_tail(mlod_gltf &doc)
 	used.assign(m.bufferViews.size(), false);
 	std::vector<bool> named(m.buffers.size(), false);
 	extension_refs(doc.original, false, used, named);
-	for (const tinygltf::Accessor &a : m.accessors) {
-		mark(used, a.bufferView);
-		if (a.sparse.isSparse) {
-			mark(used, a.sparse.indices.bufferView);
-			mark(used, a.sparse.values.bufferView);
-		}
-	}
-	for (const tinygltf::Image &i : m.images)
-		mark(used, i.bufferView);
+	mark_used_views(m, used);
 	tail(used);
 	renumber(doc, "bufferViews", used);
 	keep_only(m.bufferViews, used);
@@ -2781,10 +2798,6 @@ void prune(mlod_gltf &doc, bool meshes = true)
 		if (!prune_safe(e))
 			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not pruned",
 			     e.c_str());
-	auto mark = [](std::vector<bool> &used, int i) {
-		if (i >= 0 && size_t(i) < used.size())
-			used[size_t(i)] = true;
-	};
 	auto apply = [](const std::vector<int> &map, int &i) {
 		if (i >= 0)
 			i = size_t(i) < map.size() ? map[size_t(i)] : -1;
@@ -2795,30 +2808,14 @@ void prune(mlod_gltf &doc, bool meshes = true)
 	if (meshes) {
 		used.assign(m.meshes.size(), false);
 		for (const tinygltf::Node &n : m.nodes)
-			mark(used, n.mesh);
+			mark_used(used, n.mesh);
 		map = renumber(doc, "meshes", used);
 		keep_only(m.meshes, used);
 		for (tinygltf::Node &n : m.nodes)
 			apply(map, n.mesh);
 	}
 
-	used.assign(m.accessors.size(), false);
-	for (const tinygltf::Mesh &mesh : m.meshes)
-		for (const tinygltf::Primitive &p : mesh.primitives) {
-			mark(used, p.indices);
-			for (const auto &kv : p.attributes)
-				mark(used, kv.second);
-			for (const auto &t : p.targets)
-				for (const auto &kv : t)
-					mark(used, kv.second);
-		}
-	for (const tinygltf::Skin &s : m.skins)
-		mark(used, s.inverseBindMatrices);
-	for (const tinygltf::Animation &a : m.animations)
-		for (const tinygltf::AnimationSampler &s : a.samplers) {
-			mark(used, s.input);
-			mark(used, s.output);
-		}
+	used = used_accessors(m);
 	map = renumber(doc, "accessors", used);
 	keep_only(m.accessors, used);
 	for (tinygltf::Mesh &mesh : m.meshes)
@@ -2839,15 +2836,7 @@ void prune(mlod_gltf &doc, bool meshes = true)
 		}
 
 	used.assign(m.bufferViews.size(), false);
-	for (const tinygltf::Accessor &a : m.accessors) {
-		mark(used, a.bufferView);
-		if (a.sparse.isSparse) {
-			mark(used, a.sparse.indices.bufferView);
-			mark(used, a.sparse.values.bufferView);
-		}
-	}
-	for (const tinygltf::Image &i : m.images)
-		mark(used, i.bufferView);
+	mark_used_views(m, used);
 	map = renumber(doc, "bufferViews", used);
 	keep_only(m.bufferViews, used);
 	for (tinygltf::Accessor &a : m.accessors) {
@@ -2880,7 +2869,7 @@ void prune(mlod_gltf &doc, bool meshes = true)
 	 * 0, an empty data: URI) is not glTF and does not read back. */
 	used.assign(m.buffers.size(), false);
 	for (const tinygltf::BufferView &v : m.bufferViews)
-		mark(used, v.buffer);
+		mark_used(used, v.buffer);
 	map = renumber(doc, "buffers", used);
 	keep_only(m.buffers, used);
 	for (tinygltf::BufferView &v : m.bufferViews)
