@@ -2,7 +2,7 @@
 # whose INFO says 1000 or 0 joints (SKELETON has 31), 2 instances (MESH
 # has 1 part) or first_drawable 0 (the CRCs made to match) is refused by
 # --info with a message naming INFO, exit 2 (a new-user probe saw them
-# pass --info, -x and the runtime; the runtime's open: test_rt_r7).
+# pass --info, -x and the runtime; the runtime's open: test_rt_edges).
 "$BIN/mlod-pack" --entropy none "$ROOT/samples/tubeman.glb" -o t.mlod 2> /dev/null || exit 9
 edit() { # field offset in INFO's record, value, output
 	python3 - t.mlod "$3" "$1" "$2" <<'PY' || exit 9

@@ -1,5 +1,5 @@
 /*
- * test_rt_r7.c: the runtime bugs a new-user probe found (round 7, branch
+ * test_rt_edges.c: the runtime's edges a new-user probe found (branch
  * fixrt): a pack's mesh level loads with exactly its resident bytes free
  * (its part records size it), and one that does not fit is not decoded
  * again in every call; a failed load spends none of mlod_rt_stream's
@@ -490,7 +490,7 @@ int main(int argc, char **argv)
 	else if (file_exists("build/release/bin/mlod-pack"))
 		mlod_pack_bin = "build/release/bin/mlod-pack";
 	else if (argv[0] && strlen(argv[0]) < 900) {
-		/* build/<config>/tests/rt/test_rt_r7 -> build/<config>/bin/mlod-pack */
+		/* build/<config>/tests/rt/test_rt_edges -> build/<config>/bin/mlod-pack */
 		snprintf(guess, sizeof guess, "%s", argv[0]);
 		char *slash = strrchr(guess, '/');
 		if (slash) {
@@ -507,7 +507,7 @@ int main(int argc, char **argv)
 	}
 	if (mlod_pack_bin) {
 		const char *t = getenv("TMPDIR");
-		snprintf(tmpdir, sizeof tmpdir, "%s/rt_r7.XXXXXX", t && *t && strlen(t) < 200 ? t : "/tmp");
+		snprintf(tmpdir, sizeof tmpdir, "%s/rt_edges.XXXXXX", t && *t && strlen(t) < 200 ? t : "/tmp");
 		if (!mkdtemp(tmpdir)) {
 			snprintf(skip_why, sizeof skip_why, "mkdtemp: %s", strerror(errno));
 			mlod_pack_bin = NULL;
