@@ -20,61 +20,8 @@
 #include <unistd.h>
 
 #include "rt_test.h"
+#include "rt_packer.h"
 
-static char tmpdir[256];
-static const char *mlod_pack_bin;
-static char skip_why[512];
-
-#define SKIP_IF_NO_PACK(name)                                                                  \
-	do {                                                                                   \
-		if (!mlod_pack_bin) {                                                          \
-			printf("SKIP %s: %s\n", #name, skip_why);                              \
-			return;                                                                \
-		}                                                                              \
-	} while (0)
-
-static int file_exists(const char *p)
-{
-	return access(p, R_OK) == 0;
-}
-
-/* Runs mlod-pack on in (with options opts), writing tmpdir/out; 0 on success. */
-static int run_pack(const char *in, const char *opts, const char *out, char *path, size_t cap)
-{
-	char cmd[2048];
-	snprintf(path, cap, "%s/%s", tmpdir, out);
-	snprintf(cmd, sizeof cmd, "'%s' %s '%s' -o '%s' >/dev/null 2>'%s/pack.err'", mlod_pack_bin, opts, in, path,
-	         tmpdir);
-	return system(cmd);
-}
-
-static uint8_t *read_all(const char *path, size_t *size)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return NULL;
-	uint8_t *d = NULL;
-	size_t n = 0, cap = 0;
-	for (;;) {
-		if (n == cap) {
-			cap = cap ? 2 * cap : 1 << 16;
-			uint8_t *t = realloc(d, cap);
-			if (!t) {
-				free(d);
-				fclose(f);
-				return NULL;
-			}
-			d = t;
-		}
-		size_t k = fread(d + n, 1, cap - n, f);
-		n += k;
-		if (k == 0)
-			break;
-	}
-	fclose(f);
-	*size = n;
-	return d;
-}
 
 /* A pack in memory read through the callback, counting the reads. */
 typedef struct mem_src {
@@ -483,36 +430,8 @@ TEST(info_counts_checked)
 int main(int argc, char **argv)
 {
 	(void)argc;
-	const char *env = getenv("MLOD_PACK");
-	static char guess[1024];
-	if (env && *env)
-		mlod_pack_bin = env;
-	else if (file_exists("build/release/bin/mlod-pack"))
-		mlod_pack_bin = "build/release/bin/mlod-pack";
-	else if (argv[0] && strlen(argv[0]) < 900) {
-		/* build/<config>/tests/rt/test_rt_edges -> build/<config>/bin/mlod-pack */
-		snprintf(guess, sizeof guess, "%s", argv[0]);
-		char *slash = strrchr(guess, '/');
-		if (slash) {
-			snprintf(slash, sizeof guess - (size_t)(slash - guess), "/../../bin/mlod-pack");
-			if (file_exists(guess))
-				mlod_pack_bin = guess;
-		}
-	}
-	if (!mlod_pack_bin)
-		snprintf(skip_why, sizeof skip_why, "no mlod-pack (set MLOD_PACK, or run from the repository after make)");
-	else if (!file_exists("samples/RobotExpressive.glb") || !file_exists("samples/tubeman.glb")) {
-		snprintf(skip_why, sizeof skip_why, "no samples/ here (run from the repository's root)");
-		mlod_pack_bin = NULL;
-	}
-	if (mlod_pack_bin) {
-		const char *t = getenv("TMPDIR");
-		snprintf(tmpdir, sizeof tmpdir, "%s/rt_edges.XXXXXX", t && *t && strlen(t) < 200 ? t : "/tmp");
-		if (!mkdtemp(tmpdir)) {
-			snprintf(skip_why, sizeof skip_why, "mkdtemp: %s", strerror(errno));
-			mlod_pack_bin = NULL;
-		}
-	}
+	static const char *const samples[] = { "samples/RobotExpressive.glb", "samples/tubeman.glb", NULL };
+	rt_packer_setup(argv[0], "rt_edges", samples);
 	RUN(mesh_room_is_its_size);
 	RUN(failed_load_spends_no_budget);
 	RUN(stats_of_null_context);
@@ -522,11 +441,6 @@ int main(int argc, char **argv)
 	RUN(nomem_level_tried_again);
 	RUN(info_counts_checked);
 	free(tube);
-	if (tmpdir[0] && mlod_pack_bin) {
-		char cmd[600];
-		snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-		if (system(cmd) != 0)
-			fprintf(stderr, "could not remove %s\n", tmpdir);
-	}
+	rt_packer_cleanup();
 	TEST_EXIT();
 }

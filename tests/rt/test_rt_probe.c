@@ -21,60 +21,7 @@
 #include <unistd.h>
 
 #include "rt_test.h"
-
-static char tmpdir[256];
-static const char *mlod_pack_bin;
-static char skip_why[512];
-
-#define SKIP_IF_NO_PACK(name)                                                                  \
-	do {                                                                                   \
-		if (!mlod_pack_bin) {                                                          \
-			printf("SKIP %s: %s\n", #name, skip_why);                              \
-			return;                                                                \
-		}                                                                              \
-	} while (0)
-
-static int file_exists(const char *p)
-{
-	return access(p, R_OK) == 0;
-}
-
-/* Runs mlod-pack on in, writing tmpdir/out; 0 on success. */
-static int run_pack(const char *in, const char *out, char *path, size_t cap)
-{
-	char cmd[2048];
-	snprintf(path, cap, "%s/%s", tmpdir, out);
-	snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' >/dev/null 2>'%s/pack.err'", mlod_pack_bin, in, path, tmpdir);
-	return system(cmd);
-}
-
-static uint8_t *read_all(const char *path, size_t *size)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return NULL;
-	uint8_t *d = NULL;
-	size_t n = 0, cap = 0;
-	for (;;) {
-		if (n == cap) {
-			cap = cap ? 2 * cap : 1 << 16;
-			uint8_t *t = realloc(d, cap);
-			if (!t) {
-				free(d);
-				fclose(f);
-				return NULL;
-			}
-			d = t;
-		}
-		size_t k = fread(d + n, 1, cap - n, f);
-		n += k;
-		if (k == 0)
-			break;
-	}
-	fclose(f);
-	*size = n;
-	return d;
-}
+#include "rt_packer.h"
 
 /* ---------------------------------------------------------------- */
 /* A static box glb, written here: 8 corners of the unit cube at the  */
@@ -193,7 +140,7 @@ TEST(static_pack_opens)
 	char glb[512], pk[512];
 	snprintf(glb, sizeof glb, "%s/box.glb", tmpdir);
 	CHECK(write_box_glb(glb) == 0, "writing %s", glb);
-	CHECK(run_pack(glb, "box.mlod", pk, sizeof pk) == 0, "mlod-pack on %s failed", glb);
+	CHECK(run_pack(glb, "", "box.mlod", pk, sizeof pk) == 0, "mlod-pack on %s failed", glb);
 	mlod_error e = { 0 };
 	mlod_rt_ctx *ctx = NULL;
 	CHECK_OK(mlod_rt_open_path(pk, NULL, &ctx, &e), e);
@@ -347,7 +294,7 @@ TEST(corrupt_chunk_fails_its_dependents_only)
 {
 	SKIP_IF_NO_PACK(corrupt_chunk_fails_its_dependents_only);
 	char pk[512];
-	CHECK(run_pack("samples/RobotExpressive.glb", "robot.mlod", pk, sizeof pk) == 0, "mlod-pack on the robot failed");
+	CHECK(run_pack("samples/RobotExpressive.glb", "", "robot.mlod", pk, sizeof pk) == 0, "mlod-pack on the robot failed");
 	robot = read_all(pk, &robot_size);
 	CHECK(robot, "reading %s", pk);
 	mlod_pack p;
@@ -426,7 +373,7 @@ TEST(walk_pack_skin_then_palette)
 {
 	SKIP_IF_NO_PACK(walk_pack_skin_then_palette);
 	char pk[512];
-	CHECK(run_pack("samples/cmu_12_01_walk.bvh", "walk.mlod", pk, sizeof pk) == 0, "mlod-pack on the walk failed");
+	CHECK(run_pack("samples/cmu_12_01_walk.bvh", "", "walk.mlod", pk, sizeof pk) == 0, "mlod-pack on the walk failed");
 	mlod_error e = { 0 };
 	mlod_rt_ctx *ctx = NULL;
 	CHECK_OK(mlod_rt_open_path(pk, NULL, &ctx, &e), e);
@@ -575,7 +522,7 @@ TEST(out_of_memory_is_nomem)
 {
 	SKIP_IF_NO_PACK(out_of_memory_is_nomem);
 	char pk[512];
-	CHECK(run_pack("samples/tubeman.glb", "oom.mlod", pk, sizeof pk) == 0, "mlod-pack on the tubeman failed");
+	CHECK(run_pack("samples/tubeman.glb", "", "oom.mlod", pk, sizeof pk) == 0, "mlod-pack on the tubeman failed");
 	size_t size = 0;
 	uint8_t *data = read_all(pk, &size);
 	CHECK(data, "cannot read %s", pk);
@@ -614,36 +561,8 @@ TEST(out_of_memory_is_nomem)
 int main(int argc, char **argv)
 {
 	(void)argc;
-	const char *env = getenv("MLOD_PACK");
-	static char guess[1024];
-	if (env && *env)
-		mlod_pack_bin = env;
-	else if (file_exists("build/release/bin/mlod-pack"))
-		mlod_pack_bin = "build/release/bin/mlod-pack";
-	else if (argv[0] && strlen(argv[0]) < 900) {
-		/* build/<config>/tests/rt/test_rt_probe -> build/<config>/bin/mlod-pack */
-		snprintf(guess, sizeof guess, "%s", argv[0]);
-		char *slash = strrchr(guess, '/');
-		if (slash) {
-			snprintf(slash, sizeof guess - (size_t)(slash - guess), "/../../bin/mlod-pack");
-			if (file_exists(guess))
-				mlod_pack_bin = guess;
-		}
-	}
-	if (!mlod_pack_bin)
-		snprintf(skip_why, sizeof skip_why, "no mlod-pack (set MLOD_PACK, or run from the repository after make)");
-	else if (!file_exists("samples/RobotExpressive.glb") || !file_exists("samples/cmu_12_01_walk.bvh")) {
-		snprintf(skip_why, sizeof skip_why, "no samples/ here (run from the repository's root)");
-		mlod_pack_bin = NULL;
-	}
-	if (mlod_pack_bin) {
-		const char *t = getenv("TMPDIR");
-		snprintf(tmpdir, sizeof tmpdir, "%s/rt_probe.XXXXXX", t && *t && strlen(t) < 200 ? t : "/tmp");
-		if (!mkdtemp(tmpdir)) {
-			snprintf(skip_why, sizeof skip_why, "mkdtemp: %s", strerror(errno));
-			mlod_pack_bin = NULL;
-		}
-	}
+	static const char *const samples[] = { "samples/RobotExpressive.glb", "samples/cmu_12_01_walk.bvh", NULL };
+	rt_packer_setup(argv[0], "rt_probe", samples);
 	RUN(static_views_open_and_skin);
 	RUN(static_pack_opens);
 	RUN(corrupt_chunk_fails_its_dependents_only);
@@ -653,11 +572,6 @@ int main(int argc, char **argv)
 	RUN(instance_refuses_bad_times);
 	RUN(stats_budget);
 	RUN(out_of_memory_is_nomem);
-	if (tmpdir[0] && mlod_pack_bin) {
-		char cmd[600];
-		snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-		if (system(cmd) != 0)
-			fprintf(stderr, "could not remove %s\n", tmpdir);
-	}
+	rt_packer_cleanup();
 	TEST_EXIT();
 }
