@@ -130,6 +130,18 @@ static char *dir_of(const char *path)
 	return d;
 }
 
+/* The reader's warnings (mlod_character.warnings: what it changed,
+ * approximated or dropped of the input), one line each on stderr, with or
+ * without a report. Their names are already quoted (no line breaks). */
+static void put_warnings(const char *path, const mlod_character *c)
+{
+	for (const char *w = c->warnings; w && *w;) {
+		size_t n = strcspn(w, "\n");
+		fprintf(stderr, "%s: %s: %.*s\n", tool_name, tool_input_label(path), (int)n, w);
+		w += n + (w[n] == '\n');
+	}
+}
+
 void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format)
 {
 	size_t size;
@@ -141,6 +153,7 @@ void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format
 	free(data);
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
+	put_warnings(path, c);
 }
 
 void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format, size_t *size)
@@ -152,6 +165,7 @@ void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_
 	free(dir);
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
+	put_warnings(path, c);
 	return data;
 }
 

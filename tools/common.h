@@ -51,7 +51,8 @@ const char *tool_input_label(const char *path);
 void *tool_read_input(const char *path, size_t *size);
 
 /* Reads and loads a glb, glTF or BVH input; exits on failure. doc may be
- * NULL. */
+ * NULL. The reader's warnings (what it changed, approximated or dropped of
+ * the input: mlod_character.warnings) go to stderr, one line each. */
 void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format);
 
 /* tool_load that also returns the input's bytes (*size of them; release

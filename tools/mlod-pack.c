@@ -455,6 +455,11 @@ int main(int argc, char **argv)
 		tool_die(tool_exit_code(r), label, "%s", err.message);
 	if (c.clip_count == 0 && c.skeleton.joint_count > 0)
 		fprintf(stderr, "%s: %s: no animation: the pack has no motion levels\n", tool_name, label);
+	for (const char *w = st.warnings; *w;) { /* what the pack does not keep, or keeps changed */
+		size_t n = strcspn(w, "\n");
+		fprintf(stderr, "%s: %s: %.*s\n", tool_name, label, (int)n, w);
+		w += n + (w[n] == '\n');
+	}
 	if (st.doc_note[0]) { /* the pack is far larger than a stripped one: said, with or without --report */
 		fprintf(stderr, "%s: %s: ", tool_name, label);
 		tool_put_line(stderr, "", st.doc_note);

@@ -922,7 +922,8 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 		snprintf(note, sizeof note, "1 frame after the %ld that 'Frames:' announces (from line %d) ignored", frames,
 		         first_line);
 		c->notes = mlod_strdup(note);
-		if (!c->notes)
+		c->warnings = mlod_strdup(note);
+		if (!c->notes || !c->warnings)
 			return mlod_fail(r->err, MLOD_ERR_NOMEM, "out of memory");
 	}
 	return MLOD_OK;

@@ -1606,9 +1606,9 @@ public:
 			     doc_.scene_added == 1 ? "" : "s");
 		if (doc_.rotations_normalised) {
 			const tinygltf::Node &n = m_.nodes[size_t(doc_.rotation_node)];
-			note("%d node rotation%s normalised (not unit quaternions: node %d%s%s%s has length %g)",
+			warn("%d node rotation%s normalised (not unit quaternions: node %d%s%s has length %g)",
 			     doc_.rotations_normalised, doc_.rotations_normalised == 1 ? "" : "s", doc_.rotation_node,
-			     n.name.empty() ? "" : " \"", n.name.c_str(), n.name.empty() ? "" : "\"", doc_.rotation_length);
+			     n.name.empty() ? "" : " ", n.name.empty() ? "" : quoted(n.name).c_str(), doc_.rotation_length);
 		}
 		graph();
 		skeleton();
@@ -1632,15 +1632,34 @@ private:
 	std::vector<char> animated_;    /* per node: a TRS channel targets it */
 	std::vector<char> shown_;       /* per node: in the default scene */
 	std::vector<std::string> notes_;
+	std::vector<std::string> warnings_; /* the notes of what was changed or dropped */
 
-	void note(const char *fmt, ...) __attribute__((format(printf, 2, 3)))
+	void vnote(bool warning, const char *fmt, va_list ap)
 	{
 		char buf[MLOD_ERROR_MESSAGE_SIZE];
+		vsnprintf(buf, sizeof buf, fmt, ap);
+		notes_.push_back(buf);
+		if (warning)
+			warnings_.push_back(buf);
+	}
+
+	/* A note for the report: what the reader read in its own way. */
+	void note(const char *fmt, ...) __attribute__((format(printf, 2, 3)))
+	{
 		va_list ap;
 		va_start(ap, fmt);
-		vsnprintf(buf, sizeof buf, fmt, ap);
+		vnote(false, fmt, ap);
 		va_end(ap);
-		notes_.push_back(buf);
+	}
+
+	/* A note the tools also print on stderr: the reader changed,
+	 * approximated or dropped something of the input. */
+	void warn(const char *fmt, ...) __attribute__((format(printf, 2, 3)))
+	{
+		va_list ap;
+		va_start(ap, fmt);
+		vnote(true, fmt, ap);
+		va_end(ap);
 	}
 
 	/* Parents, a parents-first order (depth-first from the roots, in file
@@ -1794,7 +1813,7 @@ private:
 		if (m_.skins.empty() && count > 0)
 			note("the document has no skins: its %d joints are the animated nodes and the nodes between them", count);
 		if (sheared)
-			note("%d joint nodes have a matrix that is not a TRS (shear or singular); their rest pose is approximated",
+			warn("%d joint nodes have a matrix that is not a TRS (shear or singular); their rest pose is approximated",
 			     sheared);
 		for (size_t k = 0; k < n; k++) {
 			int p = parent_[k];
@@ -1802,7 +1821,7 @@ private:
 				continue;
 			mlod_joint &j = s.joints[joint_of_[size_t(p)]];
 			if (j.has_end_site) {
-				note("joint \"%s\" has more than one End Site node; node %zu is ignored", j.name, k);
+				warn("joint %s has more than one End Site node; node %zu is ignored", quoted(j.name).c_str(), k);
 				continue;
 			}
 			j.has_end_site = 1;
@@ -1937,8 +1956,8 @@ private:
 		for (const auto &kv : p.attributes)
 			for (int s = 0; s < 4; s++)
 				if (set_index(kv.first, prefixes[s]) >= used[s])
-					note("%s: attribute %s is not decoded (sets are numbered from 0, JOINTS_n with WEIGHTS_n, "
-					     "at most %d)", who.c_str(), kv.first.c_str(), MLOD_MAX_SETS);
+					warn("%s: attribute %s is not decoded (sets are numbered from 0, JOINTS_n with WEIGHTS_n, "
+					     "at most %d)", who.c_str(), quoted(kv.first).c_str(), MLOD_MAX_SETS);
 		if (p.indices >= 0) {
 			std::vector<uint32_t> idx = read_uints(m_, p.indices, who + " indices", TINYGLTF_TYPE_SCALAR);
 			for (size_t i = 0; i < idx.size(); i++)
@@ -2128,6 +2147,14 @@ private:
 		ch.key_count = int(times.size());
 	}
 
+	static std::string lines(const std::vector<std::string> &v)
+	{
+		std::string all;
+		for (const std::string &n : v)
+			all += (all.empty() ? "" : "\n") + n;
+		return all;
+	}
+
 	void notes()
 	{
 		std::string outside;
@@ -2144,10 +2171,9 @@ private:
 			     outside.c_str(), count > 8 ? ", ..." : "", moving);
 		if (notes_.empty())
 			return;
-		std::string all;
-		for (const std::string &n : notes_)
-			all += (all.empty() ? "" : "\n") + n;
-		c_.notes = c_string(all);
+		c_.notes = c_string(lines(notes_));
+		if (!warnings_.empty())
+			c_.warnings = c_string(lines(warnings_));
 	}
 };
 

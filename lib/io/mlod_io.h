@@ -53,7 +53,8 @@ mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data,
  * mlod_gltf_from_character) uses its animated nodes instead of skin joints.
  * Instances are the nodes with a mesh that the default scene shows (when
  * there is no scene, every node but the MSFT_lod levels other nodes name,
- * and their children). What is skipped is listed in out->notes. */
+ * and their children). What is skipped is listed in out->notes, and what
+ * was changed, approximated or dropped of the input also in out->warnings. */
 mlod_result mlod_gltf_to_character(const mlod_gltf *doc, mlod_character *out,
                                    mlod_error *err);
 

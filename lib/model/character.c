@@ -69,6 +69,7 @@ void mlod_character_free(mlod_character *c)
 	}
 	free(c->clips);
 	free(c->notes);
+	free(c->warnings);
 	memset(c, 0, sizeof *c);
 }
 

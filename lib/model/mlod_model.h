@@ -145,8 +145,15 @@ typedef struct mlod_character {
 	int clip_count;
 	mlod_clip *clips;
 	/* What a reader could not represent and skipped, for the report
-	 * (e.g. "2 joint nodes outside any skin"). May be NULL. */
+	 * (e.g. "2 joint nodes outside any skin"), one note per line. May be
+	 * NULL. */
 	char *notes;
+	/* The notes of notes that a user must hear of even without a report,
+	 * because the reader changed, approximated or dropped something of
+	 * the input (a rotation normalised, an attribute not decoded, a BVH
+	 * frame ignored), one per line; the tools print them on stderr. May be
+	 * NULL. */
+	char *warnings;
 } mlod_character;
 
 /* Releases everything the character owns and zeroes it. */

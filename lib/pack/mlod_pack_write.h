@@ -133,6 +133,9 @@ typedef struct mlod_pack_stats {
 	int joints, skins, parts, clips;
 	float height, diagonal;
 	char notes[1024];            /* the reader's notes on the input, then what was done or skipped, "; "-separated */
+	char warnings[1024];         /* of those, the ones a user must hear of (what the pack does not keep or keeps
+	                                changed: an attribute not stored, an unweighted vertex moved, a motion bound
+	                                missed), one per line, names quoted; the tool prints them on stderr */
 	char doc_note[MLOD_ERROR_MESSAGE_SIZE + 64]; /* why DOC holds the input whole ("" when stripped), also in notes */
 } mlod_pack_stats;
 

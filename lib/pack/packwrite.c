@@ -712,6 +712,16 @@ static void note(struct ctx *x, const char *text)
 		snprintf(n + len, sizeof x->st->notes - len, "%s%s", len ? "; " : "", text);
 }
 
+/* A note that is also a warning (mlod_pack_stats.warnings). */
+static void warn(struct ctx *x, const char *text)
+{
+	note(x, text);
+	char *w = x->st->warnings;
+	size_t len = strlen(w);
+	if (len + strlen(text) + 2 < sizeof x->st->warnings)
+		snprintf(w + len, sizeof x->st->warnings - len, "%s%s", len ? "\n" : "", text);
+}
+
 static int joint_of_node(const mlod_skeleton *s, int node)
 {
 	for (int j = 0; j < s->joint_count; j++)
@@ -2503,7 +2513,7 @@ static mlod_result motion_levels(struct ctx *x)
 	if (missed) {
 		char text[96];
 		snprintf(text, sizeof text, "%d motion level(s) met no bound", missed);
-		note(x, text);
+		warn(x, text);
 	}
 	return r;
 }
@@ -3304,10 +3314,10 @@ static mlod_result note_unstored_attributes(struct ctx *x, const mlod_gltf *doc)
 				break;
 			for (int k = 0; mode == 4 && k < count; k++)
 				if (!known_attribute(names[k])) {
-					char text[160];
-					snprintf(text, sizeof text, "mesh %d primitive %d: attribute %.64s is not stored in the pack", mesh,
-					         p, names[k]);
-					note(x, text);
+					char text[256];
+					snprintf(text, sizeof text, "mesh %d primitive %d: attribute %s is not stored in the pack", mesh,
+					         p, MLOD_QUOTED(names[k]));
+					warn(x, text);
 				}
 			mlod_free(names);
 		}
@@ -3349,11 +3359,11 @@ static void note_unweighted(struct ctx *x)
 			int g = mesh->gltf_index >= 0 ? mesh->gltf_index : m;
 			if (count == 1)
 				snprintf(text, sizeof text, "mesh %d primitive %d: vertex %d has no weight: it follows the skin's "
-				         "root joint \"%.64s\"", g, p, first, name);
+				         "root joint %s", g, p, first, MLOD_QUOTED(name));
 			else
 				snprintf(text, sizeof text, "mesh %d primitive %d: %d vertices have no weight (vertex %d the first): "
-				         "they follow the skin's root joint \"%.64s\"", g, p, count, first, name);
-			note(x, text);
+				         "they follow the skin's root joint %s", g, p, count, first, MLOD_QUOTED(name));
+			warn(x, text);
 		}
 	}
 }

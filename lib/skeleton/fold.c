@@ -489,6 +489,11 @@ mlod_result mlod_skel_level_apply(const mlod_character *c, const mlod_skel_level
 		if (failed)
 			goto nomem;
 	}
+	if (c->warnings) {
+		out->warnings = copy_name(c->warnings, &failed);
+		if (failed)
+			goto nomem;
+	}
 	if (stats)
 		*stats = f.stats;
 	free(newidx);
