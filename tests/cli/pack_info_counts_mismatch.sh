@@ -5,21 +5,9 @@
 # pass --info, -x and the runtime; the runtime's open: test_rt_edges).
 "$BIN/mlod-pack" --entropy none "$ROOT/samples/tubeman.glb" -o t.mlod 2> /dev/null || exit 9
 edit() { # field offset in INFO's record, value, output
-	python3 - t.mlod "$3" "$1" "$2" <<'PY' || exit 9
-import struct, sys, zlib
-x = bytearray(open(sys.argv[1], 'rb').read())
-cnt = struct.unpack_from('<I', x, 12)[0]
-toc = [struct.unpack_from('<4sBBHHHIQIIIffI', x, 32 + 48 * i) for i in range(cnt)]
-for t in toc:
-    if t[0] == b'INFO':
-        ns = struct.unpack_from('<I', x, t[7])[0]
-        struct.pack_into('<I', x, t[7] + 4 + 16 * ns + int(sys.argv[3]), int(sys.argv[4]))
-for i, t in enumerate(toc):
-    struct.pack_into('<I', x, 32 + 48 * i + 32, zlib.crc32(bytes(x[t[7]:t[7] + t[8]])))
-struct.pack_into('<I', x, 24, zlib.crc32(bytes(x[32:32 + 48 * cnt])))
-struct.pack_into('<I', x, 28, zlib.crc32(bytes(x[0:28])))
-open(sys.argv[2], 'wb').write(x)
-PY
+	python3 "$ROOT/tests/pack-edit.py" t.mlod "$3" "
+e = entry(b'INFO')
+struct.pack_into('<I', x, e[7] + 4 + 16 * struct.unpack_from('<I', x, e[7])[0] + $1, $2)" || exit 9
 }
 edit 0 1000 j1000.mlod
 edit 0 0 j0.mlod
