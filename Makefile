@@ -1,6 +1,6 @@
 # mlod: multi-layer level of detail for skinned characters.
 #
-#   make                  library, runtime and tools (build/bin)
+#   make                  library, runtime and tools (build/release/bin)
 #   make test             unit + CLI + validator tests, then the unit tests under ASan/UBSan
 #   make test-extended    also uses ../shared/data when it is present
 #   make bench            benchmarks against the peers (bench/RESULTS.md)
@@ -12,6 +12,8 @@
 #                         (FUZZ_TARGET=bvh|gltf|record, FUZZ_TIME s each)
 #   make demo             the main job on the bundled sample
 #   make install          PREFIX=/usr/local DESTDIR= MANDIR=$(PREFIX)/share/man
+#                         (headers in $(PREFIX)/include/mlod; pkg-config mlod, mlodrt)
+#   make uninstall        the same variables
 #   make config=debug|release|sanitize
 #
 # Link order matters: -ltinygltf must come before -ldraco, which exports an
@@ -80,7 +82,7 @@ BENCH := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
 # Keep object files that pattern chains would treat as intermediate.
 .SECONDARY:
 
-.PHONY: all unit rt-unit test test-extended bench demo install clean samples
+.PHONY: all unit rt-unit test test-extended bench demo install uninstall clean samples
 
 all: $(B)/libmlod.a $(B)/libmlodrt.a $(TOOLS)
 
@@ -194,18 +196,39 @@ samples: all $(HELPERS)
 # The parts whose headers mlod.h includes (lib/PART/mlod_*.h).
 PUBLIC_PARTS := model io measure skeleton mesh motion record pack rt
 
+# Installed headers live in one folder of their own, $(PREFIX)/include/mlod
+# (the parts' folders, model/ to rt/, would clash with other packages'
+# in include/), which a program adds with -I: the pkg-config files
+# mlod.pc (the bake library) and mlodrt.pc (the runtime) say so, with the
+# libraries to link. mlod_rt.h and mlod_pack.h there only include
+# rt/mlod_rt.h and rt/mlod_pack.h.
+INCDIR := $(PREFIX)/include/mlod
+MLOD_VERSION := $(shell sed -n 's/^\#define MLOD_VERSION "\(.*\)"/\1/p' lib/core/mlod_core.h)
+PCDIR := $(PREFIX)/lib/pkgconfig
+ifeq ($(MLOD_DRACO),1)
+RT_LIBS := -lmlodrt -lmeshoptimizer -ldraco -lzstd -lstdc++ -lm
+else
+RT_LIBS := -lmlodrt -lmeshoptimizer -lzstd -lm
+endif
+
 install: all
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man3 $(DESTDIR)$(MANDIR)/man5
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PCDIR) $(DESTDIR)$(INCDIR) $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man3 $(DESTDIR)$(MANDIR)/man5
 	install -m 755 $(TOOLS) $(DESTDIR)$(PREFIX)/bin
 	install -m 644 $(B)/libmlod.a $(B)/libmlodrt.a $(DESTDIR)$(PREFIX)/lib
 	# the bake library's umbrella header and its part headers, in the
 	# folders it includes them from (model/mlod_model.h, ..., rt/mlod_pack.h)
-	install -m 644 lib/mlod.h $(DESTDIR)$(PREFIX)/include
+	install -m 644 lib/mlod.h lib/core/mlod_core.h $(DESTDIR)$(INCDIR)
 	for p in $(PUBLIC_PARTS); do \
-		install -d $(DESTDIR)$(PREFIX)/include/$$p && install -m 644 lib/$$p/mlod_*.h $(DESTDIR)$(PREFIX)/include/$$p || exit 1; \
+		install -d $(DESTDIR)$(INCDIR)/$$p && install -m 644 lib/$$p/mlod_*.h $(DESTDIR)$(INCDIR)/$$p || exit 1; \
 	done
-	# the runtime's headers: mlod_rt.h includes mlod_pack.h and mlod_core.h
-	install -m 644 lib/rt/mlod_rt.h lib/rt/mlod_pack.h lib/core/mlod_core.h $(DESTDIR)$(PREFIX)/include
+	# the runtime's headers by the names its man pages give
+	for h in mlod_rt.h mlod_pack.h; do \
+		printf '/* mlod: the runtime header rt/%s */\n#include "rt/%s"\n' $$h $$h > $(DESTDIR)$(INCDIR)/$$h || exit 1; \
+	done
+	printf 'prefix=%s\nincludedir=$${prefix}/include/mlod\nlibdir=$${prefix}/lib\n\nName: mlodrt\nDescription: mlod runtime: streams .mlod packs, picks levels, poses and skins crowds\nVersion: %s\nCflags: -I$${includedir}\nLibs: -L$${libdir} %s\n' \
+		'$(PREFIX)' '$(MLOD_VERSION)' '$(RT_LIBS)' > $(DESTDIR)$(PCDIR)/mlodrt.pc
+	printf 'prefix=%s\nincludedir=$${prefix}/include/mlod\nlibdir=$${prefix}/lib\n\nName: mlod\nDescription: mlod bake library: skeleton, mesh and motion levels of detail and the .mlod pack writer\nVersion: %s\nCflags: -I$${includedir}\nLibs: -L$${libdir} -lmlod -lmlodrt %s -pthread\n' \
+		'$(PREFIX)' '$(MLOD_VERSION)' '$(LDLIBS)' > $(DESTDIR)$(PCDIR)/mlod.pc
 	install -m 644 man/man1/*.1 $(DESTDIR)$(MANDIR)/man1
 	if ls man/man3/*.3 >/dev/null 2>&1; then install -m 644 man/man3/*.3 $(DESTDIR)$(MANDIR)/man3; fi
 	# a link per function a man3 page names (its NAME's .Nm lines), so that
@@ -218,8 +241,23 @@ install: all
 	done
 	if ls man/man5/*.5 >/dev/null 2>&1; then install -m 644 man/man5/*.5 $(DESTDIR)$(MANDIR)/man5; fi
 
+# Removes what install put there (the same PREFIX, DESTDIR and MANDIR).
+uninstall:
+	rm -f $(TOOL_NAMES:%=$(DESTDIR)$(PREFIX)/bin/%)
+	rm -f $(DESTDIR)$(PREFIX)/lib/libmlod.a $(DESTDIR)$(PREFIX)/lib/libmlodrt.a $(DESTDIR)$(PCDIR)/mlod.pc $(DESTDIR)$(PCDIR)/mlodrt.pc
+	rm -rf $(DESTDIR)$(INCDIR)
+	for p in man/man1/*.1 man/man5/*.5; do rm -f $(DESTDIR)$(MANDIR)/$$(basename $$(dirname $$p))/$${p##*/}; done
+	for p in man/man3/*.3; do \
+		[ -f "$$p" ] || continue; rm -f $(DESTDIR)$(MANDIR)/man3/$${p##*/}; \
+		for n in $$(sed -n '/^\.Sh NAME/,/^\.Nd/s/^\.Nm \([A-Za-z0-9_]*\).*/\1/p' "$$p"); do \
+			rm -f $(DESTDIR)$(MANDIR)/man3/$$n.3; \
+		done; \
+	done
+
+# build/deps (the OpenMesh headers scripts/install-deps unpacks) stays: the
+# tests need them and only install-deps puts them back.
 clean:
-	rm -rf build
+	rm -rf $(filter-out build/deps,$(wildcard build/*))
 
 # --- Mesh layer (issue 4) ---------------------------------------------
 # tests/openmesh/test_openmesh.cpp checks every mesh level of every sample

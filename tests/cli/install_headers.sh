@@ -1,8 +1,38 @@
-# make install puts every header mlod.h includes where it includes it
-# from: a program including mlod.h and mlod_rt.h compiles against the
-# installed tree alone (a new-user probe found model/mlod_model.h missing).
+# make install puts the headers in one folder of their own,
+# PREFIX/include/mlod (the parts' folders model/ to rt/ went straight into
+# PREFIX/include, where other packages' io/ or mesh/ would clash; a
+# new-user probe), with every header mlod.h includes where it includes it
+# from, and pkg-config files: a program including mlod.h and mlod_rt.h
+# compiles with `pkg-config --cflags mlod`, and a runtime program linked
+# with `pkg-config --libs mlodrt` alone opens a pack. make uninstall
+# removes every file install made.
 set -e
 make -s -C "$ROOT" install DESTDIR="$PWD/inst" PREFIX=/usr > /dev/null
-printf '#include <mlod.h>\n#include <mlod_rt.h>\nint main(void) { return mlod_rt_palette_size(0) != 0; }\n' > t.c
-cc -std=c11 -Wall -Wextra -Wpedantic -Werror -I inst/usr/include -c t.c -o t.o
+for d in io mesh model rt; do test ! -e "inst/usr/include/$d"; done
 test -f inst/usr/lib/libmlod.a && test -f inst/usr/lib/libmlodrt.a
+pc() { PKG_CONFIG_SYSROOT_DIR="$PWD/inst" PKG_CONFIG_PATH="$PWD/inst/usr/lib/pkgconfig" pkg-config "$@"; }
+printf '#include <mlod.h>\n#include <mlod_rt.h>\nint main(void) { return mlod_rt_palette_size(0) != 0; }\n' > t.c
+cc -std=c11 -Wall -Wextra -Wpedantic -Werror $(pc --cflags mlod) -c t.c -o t.o
+cc t.o $(pc --libs mlod) -o t
+./t
+cat > rt.c <<'C'
+#include <stdio.h>
+#include <mlod_rt.h>
+int main(int argc, char **argv)
+{
+	mlod_rt_ctx *ctx = NULL;
+	mlod_error e = {0};
+	if (argc < 2 || mlod_rt_open_path(argv[1], NULL, &ctx, &e) != MLOD_OK) {
+		fprintf(stderr, "%s\n", e.message);
+		return 1;
+	}
+	mlod_rt_close(ctx);
+	return 0;
+}
+C
+cc -std=c11 -Wall -Wextra -Wpedantic -Werror $(pc --cflags mlodrt) rt.c $(pc --libs mlodrt) -o rt
+"$BIN/mlod-pack" "$ROOT/samples/tubeman.glb" -o t.mlod
+./rt t.mlod
+make -s -C "$ROOT" uninstall DESTDIR="$PWD/inst" PREFIX=/usr > /dev/null
+left=$(find inst -type f -o -type l)
+[ -z "$left" ] || { echo "left after uninstall: $left" >&2; exit 1; }
