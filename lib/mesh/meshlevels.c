@@ -122,17 +122,37 @@ static mlod_result nomem(mlod_error *err)
 	return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 }
 
+/* The training and measuring poses. Each clip gives 2 to 8 (training)
+ * and 2 to 4 (measuring) frames, fewer per clip the more clips there are;
+ * past MLOD_MESH_MAX_POSE_CLIPS clips, that many of them, evenly spaced in
+ * file order, give 2 each, so that the poses, which each hold a posed copy
+ * of the mesh, stay bounded (100 clips made 209 measuring poses: 839 MB at
+ * 50k triangles). */
 static mlod_result make_poses(mlod_mesh_levels *L, mlod_error *err)
 {
-	int clips = L->c->clip_count > 0 ? L->c->clip_count : 1;
+	mlod_character sub = *L->c; /* a view: the same clips, or some of them */
+	mlod_clip *picked = NULL;
+	if (L->c->clip_count > MLOD_MESH_MAX_POSE_CLIPS) {
+		picked = malloc(sizeof *picked * MLOD_MESH_MAX_POSE_CLIPS);
+		if (!picked)
+			return nomem(err);
+		for (int i = 0; i < MLOD_MESH_MAX_POSE_CLIPS; i++)
+			picked[i] = L->c->clips[(long)i * L->c->clip_count / MLOD_MESH_MAX_POSE_CLIPS];
+		sub.clips = picked;
+		sub.clip_count = MLOD_MESH_MAX_POSE_CLIPS;
+		note(L, "%d clips: the posed cost and the measures take the frames of %d of them, evenly spaced",
+		     L->c->clip_count, MLOD_MESH_MAX_POSE_CLIPS);
+	}
+	int clips = sub.clip_count > 0 ? sub.clip_count : 1;
 	int per_train = 24 / clips, per_measure = 16 / clips;
 	per_train = per_train < 2 ? 2 : per_train > 8 ? 8 : per_train;
 	per_measure = per_measure < 2 ? 2 : per_measure > 4 ? 4 : per_measure; /* mlod_clip_times: 1 means all */
-	mlod_result r = mlod_pose_set_make(L->c, 0, per_train, MLOD_MESH_RANDOM_POSES, MLOD_MESH_TRAIN_SEED,
+	mlod_result r = mlod_pose_set_make(&sub, 0, per_train, MLOD_MESH_RANDOM_POSES, MLOD_MESH_TRAIN_SEED,
 	                                   MLOD_MESH_RANDOM_ANGLE, &L->train, err);
 	if (r == MLOD_OK)
-		r = mlod_pose_set_make(L->c, 1, per_measure, MLOD_MESH_RANDOM_POSES, MLOD_MESH_MEASURE_SEED,
+		r = mlod_pose_set_make(&sub, 1, per_measure, MLOD_MESH_RANDOM_POSES, MLOD_MESH_MEASURE_SEED,
 		                       MLOD_MESH_RANDOM_ANGLE, &L->measure, err);
+	free(picked);
 	return r;
 }
 

@@ -272,6 +272,10 @@ mlod_result mlod_primitive_remap_joints(mlod_primitive *p, const int *map, int m
 #define MLOD_MESH_MIN_RATIO (1.0 / 256)
 #define MLOD_MESH_BISECTIONS 6
 #define MLOD_MESH_RANDOM_POSES 8
+/* Past this many clips, the training and measuring poses come from this
+ * many of them, evenly spaced (2 frames each): a pose holds a posed copy of
+ * the mesh (about 64 bytes per triangle). */
+#define MLOD_MESH_MAX_POSE_CLIPS 16
 #define MLOD_MESH_RANDOM_ANGLE 0.69813170f /* 40 degrees */
 #define MLOD_MESH_TRAIN_SEED 1
 #define MLOD_MESH_MEASURE_SEED 2008
