@@ -347,6 +347,15 @@ mlod_result mlod_motion_bake_run(const mlod_character *c, const mlod_gltf *doc, 
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 			continue;
 		}
+		int keys = 0, frames_method = 0;
+		for (int i = 0; i < o->method_count; i++)
+			keys |= o->methods[i] == MLOD_MOTION_KEYS, frames_method |= o->methods[i] == MLOD_MOTION_FRAMES;
+		mlod_error why = { 0 };
+		if (keys && frames_method &&
+		    mlod_motion_keys_fit(c->skeleton.joint_count, cl->frames,
+		                         o->motion.subdivide > 0 ? o->motion.subdivide : MLOD_DEFAULT_SUBDIVIDE, src->name, &why) != MLOD_OK &&
+		    add_note(out, "the keys method is left out, the levels come from the frames method alone: %s", why.message) != 0)
+			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		for (int s = 0; s < built[k].level_count && r == MLOD_OK; s++) {
 			mlod_result rs = built[k].results[s];
 			size_t at = (size_t)k * (size_t)per + (size_t)s;

@@ -49,7 +49,7 @@
 #include "motion/mlod_motion.h"
 #include "motion/motion_eval.h"
 
-#define MAX_FRAME_JOINTS 1000000L /* frames * joints the caches may hold */
+#define MAX_FRAME_JOINTS MLOD_KEYREDUCE_MAX_SAMPLES /* frames * joints the caches may hold */
 #define ROUNDS 4
 #define MAX_LANES 8              /* threads of one key reduction */
 
@@ -410,13 +410,11 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: no joints or no channels");
 	const mlod_channel *c0 = &common->channels[0];
 	int F = c0->key_count;
-	char q[MLOD_NAME_TEXT_SIZE];
 	if (F <= 0)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: no frames");
-	if (((double)F - 1.0) * subdivide * s->joint_count > (double)MAX_FRAME_JOINTS)
-		return mlod_fail(err, MLOD_ERR_LIMIT,
-		                 "clip %s: %d frames (%d samples each) of %d joints is more than the keys method holds (%ld); split the clip",
-		                 mlod_name_text(common->name, 1, q, sizeof q), F, subdivide, s->joint_count, MAX_FRAME_JOINTS);
+	mlod_result fits = mlod_motion_keys_fit(s->joint_count, F, subdivide, common->name, err);
+	if (fits != MLOD_OK)
+		return fits;
 	for (int c = 0; c < common->channel_count; c++) {
 		const mlod_channel *ch = &common->channels[c];
 		const unsigned char *row = kept + (size_t)c * (size_t)F;
@@ -432,6 +430,17 @@ static mlod_result check_args(const mlod_skeleton *s, const mlod_clip *original,
 	for (int j = 0; j < s->joint_count; j++)
 		if (s->joints[j].parent >= j)
 			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_keyreduce: joint %d comes before its parent", j);
+	return MLOD_OK;
+}
+
+mlod_result mlod_motion_keys_fit(int joint_count, int frames, int subdivide, const char *name, mlod_error *err)
+{
+	char q[MLOD_NAME_TEXT_SIZE];
+	if (((double)frames - 1.0) * subdivide * joint_count > (double)MAX_FRAME_JOINTS)
+		return mlod_fail(err, MLOD_ERR_LIMIT,
+		                 "clip %s: %d frames (%d samples each) of %d joints is more than the keys method holds (%ld); "
+		                 "split the clip",
+		                 mlod_name_text(name, 1, q, sizeof q), frames, subdivide, joint_count, MAX_FRAME_JOINTS);
 	return MLOD_OK;
 }
 

@@ -423,6 +423,15 @@ mlod_result mlod_keyreduce(const mlod_skeleton *s, const mlod_clip *original, co
                            double bound, double point_distance, int subdivide, unsigned char *kept,
                            mlod_error *err);
 
+/* Whether the keys method (mlod_keyreduce) takes a clip of frames frames on
+ * its common timeline, named name, over joint_count joints at subdivide
+ * samples per interval: its caches hold every sample of every joint
+ * (about 230 bytes each), at most MLOD_KEYREDUCE_MAX_SAMPLES of them.
+ * MLOD_OK, or MLOD_ERR_LIMIT with why in err ("split the clip"); past it
+ * a clip's levels come from the frames method alone, larger. */
+#define MLOD_KEYREDUCE_MAX_SAMPLES 1000000L
+mlod_result mlod_motion_keys_fit(int joint_count, int frames, int subdivide, const char *name, mlod_error *err);
+
 
 #ifdef __cplusplus
 }

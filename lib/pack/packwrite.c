@@ -2479,9 +2479,18 @@ static mlod_result motion_levels(struct ctx *x)
 		mlod_motion *m[2] = {NULL, NULL};
 		for (int i = 0; r == MLOD_OK && i < 2; i++)
 			r = i == 0 ? mlod_motion_create(c, q, &mo, &m[i], x->err) : mlod_motion_create_like(m[0], &m[i], x->err);
+		mlod_error fit = {0};
 		if (r == MLOD_OK && mlod_motion_timeline_info(m[0])->frames < 3)
 			short_clips++;
-		else
+		else if (r == MLOD_OK && nb > 0 &&
+		         mlod_motion_keys_fit(c->skeleton.joint_count, mlod_motion_timeline_info(m[0])->frames,
+		                              MLOD_DEFAULT_SUBDIVIDE, c->clips[q].name, &fit) != MLOD_OK) {
+			char text[MLOD_ERROR_MESSAGE_SIZE + 80];
+			snprintf(text, sizeof text, "the keys method is left out, the levels come from the frames method alone: %s",
+			         fit.message);
+			warn(x, text);
+		}
+		if (r == MLOD_OK && mlod_motion_timeline_info(m[0])->frames >= 3)
 			for (int b = 0; r == MLOD_OK && b < nb; b++) {
 				static const mlod_motion_method methods[2] = {MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS};
 				mlod_motion_level best;

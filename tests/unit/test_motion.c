@@ -202,6 +202,22 @@ TEST(keys_method_beats_frames_on_cmu)
 	mlod_character_free(&c);
 }
 
+/* The keys method's limit has one owner, mlod_motion_keys_fit: 30 joints
+ * at 2 samples per interval take 16,667 frames (999,960 samples), not
+ * 16,668 (1,000,080), and the message names the clip and says to split it
+ * (the bake and the pack writer then note that the frames method alone
+ * made the levels). */
+TEST(keys_fit_limit)
+{
+	mlod_error e = { 0 };
+	CHECK(mlod_motion_keys_fit(30, 16667, 2, "walk", &e) == MLOD_OK);
+	CHECK(mlod_motion_keys_fit(30, 16668, 2, "walk", &e) == MLOD_ERR_LIMIT);
+	CHECK(strstr(e.message, "clip \"walk\": 16668 frames (2 samples each) of 30 joints") != NULL);
+	CHECK(strstr(e.message, "split the clip") != NULL);
+	CHECK(mlod_motion_keys_fit(30, 8334, 4, "walk", &e) == MLOD_OK);
+	CHECK(mlod_motion_keys_fit(30, 8335, 4, "walk", &e) == MLOD_ERR_LIMIT);
+}
+
 TEST(fraction_of_keys)
 {
 	mlod_character c;
@@ -1689,6 +1705,7 @@ int main(void)
 	RUN(levels_within_bounds_cmu);
 	RUN(levels_within_bounds_robot);
 	RUN(keys_method_beats_frames_on_cmu);
+	RUN(keys_fit_limit);
 	RUN(fraction_of_keys);
 	RUN(tree_levels_are_nested);
 	RUN(average_merge_keeps_ends);
