@@ -311,6 +311,16 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 	free(target);
 }
 
+int tool_output_is_stdout(const char *path)
+{
+	struct stat st;
+	if (is_stdio(path))
+		return 1;
+	/* /dev/null on both mixes nothing anyone reads; a terminal is refused
+	 * binary output anyway. */
+	return stat(path, &st) == 0 && !S_ISCHR(st.st_mode) && same_file(&st, STDOUT_FILENO);
+}
+
 int tool_ends_with(const char *s, const char *suffix)
 {
 	size_t a = strlen(s), b = strlen(suffix);

@@ -67,6 +67,11 @@ void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_
  * a terminal (stdout or path) is refused (exit 1). Exits 4 on failure. */
 void tool_write_output(const char *path, const void *data, size_t size, int binary);
 
+/* Whether output goes to standard output: NULL, "-", or a path naming the
+ * file open on it (/dev/stdout, /dev/fd/1, the file stdout was redirected
+ * to; not a character device such as /dev/null). */
+int tool_output_is_stdout(const char *path);
+
 /* The end of every tool's --help: how -o writes (tool_write_output). */
 #define TOOL_OUTPUT_NOTE \
 	"-o replaces a regular file atomically (through a temporary file; a\n" \

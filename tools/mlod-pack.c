@@ -25,9 +25,9 @@ static const char usage_text[] =
 	"\n"
 	"options:\n"
 	"  -o, --output FILE          write to FILE instead of stdout\n"
-	"  -r, --report[=FORMAT]      print what was packed (to stdout: with -o as\n"
-	"                             well as the pack, else instead of it); FORMAT\n"
-	"                             is table or json\n"
+	"  -r, --report[=FORMAT]      print what was packed (to stdout: with -o FILE\n"
+	"                             as well as the pack, else instead of it; not\n"
+	"                             with -o naming stdout); FORMAT is table or json\n"
 	"      --codec NAME           meshopt (default), none, or draco (MESH levels as\n"
 	"                             standalone Draco meshes: larger packs, slower\n"
 	"                             to decode; mlod(5))\n"
@@ -433,6 +433,9 @@ int main(int argc, char **argv)
 			tool_usage_error("-x and --report do not go together");
 		return pack_extract(extract, output);
 	}
+	if (report != REPORT_NONE && output && tool_output_is_stdout(output))
+		tool_usage_error("--report prints to stdout, and -o names stdout too: the pack and the report would "
+		                 "share one stream (write the pack to a file, or drop -o for the report alone)");
 	const char *path = optind < argc ? argv[optind] : NULL;
 	const char *label = tool_input_label(path);
 	char namebuf[256];
