@@ -220,25 +220,33 @@ static void write_in_place(const char *path, const void *data, size_t size, int 
 
 /* A regular file (exists) or a new path: a temporary file in the same
  * directory, then rename. what names the output in messages (the path
- * given). */
+ * given). The temporary is DIR/.mlod-XXXXXX (mkstemp): short, so that a
+ * name of NAME_MAX bytes can still be replaced. */
 static void write_replace(const char *what, const char *path, int exists, const void *data, size_t size)
 {
-	size_t n = strlen(path) + 32;
-	char *tmp = malloc(n);
+	const char *slash = strrchr(path, '/');
+	size_t dn = slash ? (size_t)(slash - path) + 1 : 0;
+	char *tmp = malloc(dn + sizeof ".mlod-XXXXXX");
 	if (!tmp)
 		tool_die(EXIT_OUTPUT, what, "out of memory");
-	snprintf(tmp, n, "%s.tmp.%ld", path, (long)getpid());
-	int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
+	memcpy(tmp, path, dn);
+	strcpy(tmp + dn, ".mlod-XXXXXX");
+	int fd = mkstemp(tmp);
 	if (fd < 0) {
 		int e = errno;
 		free(tmp);
-		char *slash = strrchr(path, '/');
 		if (!exists) /* the file itself could not be made: the same cause */
 			tool_die(EXIT_OUTPUT, what, "cannot create: %s", strerror(e));
 		tool_die(EXIT_OUTPUT, what, "cannot create a temporary file in %.*s to replace it atomically: %s",
 		         slash ? (int)(slash == path ? 1 : slash - path) : 1, slash ? path : ".", strerror(e));
 	}
-	int e = write_all(fd, data, size);
+	/* mkstemp makes it 0600: a new file gets 0666 less the umask, as
+	 * open(2) would give it. */
+	mode_t mask = umask(0);
+	umask(mask);
+	int e = fchmod(fd, 0666 & ~mask) != 0 ? errno : 0;
+	if (e == 0)
+		e = write_all(fd, data, size);
 	if (e == 0 && fsync(fd) != 0 && errno != EINVAL)
 		e = errno;
 	if (close(fd) != 0 && e == 0)
