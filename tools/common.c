@@ -218,11 +218,16 @@ static void write_in_place(const char *path, const void *data, size_t size, int 
 		tool_die(EXIT_OUTPUT, path, "write error: %s", strerror(e));
 }
 
-/* A regular file (exists) or a new path: a temporary file in the same
- * directory, then rename. what names the output in messages (the path
- * given). The temporary is DIR/.mlod-XXXXXX (mkstemp): short, so that a
- * name of NAME_MAX bytes can still be replaced. */
-static void write_replace(const char *what, const char *path, int exists, const void *data, size_t size)
+/* A regular file (old: its stat) or a new path (old NULL): a temporary
+ * file in the same directory, then rename. what names the output in
+ * messages (the path given). The temporary is DIR/.mlod-XXXXXX (mkstemp):
+ * short, so that a name of NAME_MAX bytes can still be replaced. It gets
+ * the replaced file's permission bits, owner and group (as far as the
+ * user may give them: a group the user is not in, or another owner, stays
+ * the user's), so that a private file stays private; a new file gets 0666
+ * less the umask, as open(2) would give it. Hard links to the old file
+ * keep the old contents (the rename makes a new file, as sed -i does). */
+static void write_replace(const char *what, const char *path, const struct stat *old, const void *data, size_t size)
 {
 	const char *slash = strrchr(path, '/');
 	size_t dn = slash ? (size_t)(slash - path) + 1 : 0;
@@ -235,16 +240,22 @@ static void write_replace(const char *what, const char *path, int exists, const 
 	if (fd < 0) {
 		int e = errno;
 		free(tmp);
-		if (!exists) /* the file itself could not be made: the same cause */
+		if (!old) /* the file itself could not be made: the same cause */
 			tool_die(EXIT_OUTPUT, what, "cannot create: %s", strerror(e));
 		tool_die(EXIT_OUTPUT, what, "cannot create a temporary file in %.*s to replace it atomically: %s",
 		         slash ? (int)(slash == path ? 1 : slash - path) : 1, slash ? path : ".", strerror(e));
 	}
-	/* mkstemp makes it 0600: a new file gets 0666 less the umask, as
-	 * open(2) would give it. */
-	mode_t mask = umask(0);
-	umask(mask);
-	int e = fchmod(fd, 0666 & ~mask) != 0 ? errno : 0;
+	mode_t mode = old ? old->st_mode & 07777 : 0;
+	if (!old) { /* mkstemp makes it 0600 */
+		mode_t mask = umask(0);
+		umask(mask);
+		mode = 0666 & ~mask;
+	} else if (fchown(fd, old->st_uid, old->st_gid) != 0) { /* EPERM: not the owner's to give */
+		mode &= ~(mode_t)S_ISUID; /* another owner's set-user-ID bit is not the user's */
+		if (fchown(fd, (uid_t)-1, old->st_gid) != 0)
+			mode &= ~(mode_t)S_ISGID;
+	}
+	int e = fchmod(fd, mode) != 0 ? errno : 0;
 	if (e == 0)
 		e = write_all(fd, data, size);
 	if (e == 0 && fsync(fd) != 0 && errno != EINVAL)
@@ -298,7 +309,7 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 	if (lstat(path, &st) != 0) {
 		if (errno != ENOENT)
 			tool_die(EXIT_OUTPUT, path, "%s", strerror(errno));
-		write_replace(path, path, 0, data, size); /* a new file */
+		write_replace(path, path, NULL, data, size); /* a new file */
 		return;
 	}
 	char *target = NULL;
@@ -311,7 +322,7 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 		/* The link's target is replaced in its own directory. */
 		if (!(target = realpath(path, NULL)))
 			tool_die(EXIT_OUTPUT, path, "cannot resolve: %s", strerror(errno));
-		write_replace(path, target, 1, data, size);
+		write_replace(path, target, &st, data, size);
 	} else if (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode))
 		write_in_place(path, data, size, binary, S_ISSOCK(st.st_mode));
 	else

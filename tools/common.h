@@ -74,8 +74,9 @@ int tool_output_is_stdout(const char *path);
 
 /* The end of every tool's --help: how -o writes (tool_write_output). */
 #define TOOL_OUTPUT_NOTE \
-	"-o replaces a regular file atomically (through a temporary file; a\n" \
-	"symbolic link is kept and the file it names replaced); a character\n" \
+	"-o replaces a regular file atomically (through a temporary file, its\n" \
+	"mode, owner and group kept, hard links not; a symbolic link is kept\n" \
+	"and the file it names replaced); a character\n" \
 	"device, FIFO or Unix socket is written in place (binary output to a\n" \
 	"terminal refused); /dev/stdout goes through standard output.\n"
 
