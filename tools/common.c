@@ -6,6 +6,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <getopt.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -44,6 +45,27 @@ void tool_usage_error(const char *fmt, ...)
 	va_end(ap);
 	fprintf(stderr, "\nTry '%s --help' for more information.\n", tool_name);
 	exit(EXIT_USAGE);
+}
+
+void tool_option_error(int ch, const char *shortopts, char *const *argv)
+{
+	/* A short option's letter is optopt (argv[optind - 1] is the element
+	 * before a bundle, or the bundle, or the program's name). A long
+	 * option's is 0 (unknown), or its value (a missing or unwanted value):
+	 * its element is argv[optind - 1], optind having moved past it; a
+	 * missing value's option is always the last of its element. */
+	const char *arg = argv[optind - 1];
+	int is_long = strncmp(arg, "--", 2) == 0 && arg[2] != '\0';
+	if (ch == ':') {
+		if (is_long)
+			tool_usage_error("option '%.*s' needs a value", (int)strcspn(arg, "="), arg);
+		tool_usage_error("option '-%c' needs a value", optopt);
+	}
+	if (optopt > 0 && optopt < 256 && optopt != ':' && !strchr(shortopts, optopt))
+		tool_usage_error("unknown option '-%c'", optopt);
+	if (optopt != 0 && is_long && strchr(arg, '='))
+		tool_usage_error("option '%.*s' takes no value", (int)strcspn(arg, "="), arg);
+	tool_usage_error("unknown option '%s'", arg);
 }
 
 int tool_exit_code(mlod_result r)

@@ -40,6 +40,15 @@ void tool_usage_error(const char *fmt, ...)
 #endif
 	;
 
+/* After getopt_long (opterr 0, shortopts starting with ':') returned ch,
+ * ':' or '?': prints which option was wrong ("unknown option '-k'",
+ * "option '--output' needs a value") and exits 1. */
+void tool_option_error(int ch, const char *shortopts, char *const *argv)
+#if defined(__GNUC__)
+	__attribute__((noreturn))
+#endif
+	;
+
 /* The exit code for a library result met while reading input. */
 int tool_exit_code(mlod_result r);
 

@@ -140,8 +140,9 @@ int main(int argc, char **argv)
 	int ch;
 
 	tool_name = "mlod-label";
+	static const char shortopts[] = ":o:r::hV";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -149,8 +150,7 @@ int main(int argc, char **argv)
 		case 'A': opt.max_angle = tool_parse_double("--max-angle", optarg, 1e-3, 1e6) * MLOD_PI / 180.0; break;
 		case 'h': printf(usage_text, MLOD_LABEL_HUB_FACTOR_DEFAULT, MLOD_LABEL_MAX_ANGLE_DEFAULT); return 0;
 		case 'V': tool_version();
-		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
-		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
 	if (argc - optind > 1)

@@ -233,8 +233,9 @@ int main(int argc, char **argv)
 	job.threads = mlod_thread_count();
 
 	tool_name = "mlod-motion";
+	static const char shortopts[] = ":o:r::m:e:t:k:l:c:j:hV";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::m:e:t:k:l:c:j:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -299,8 +300,7 @@ int main(int argc, char **argv)
 		case 'j': job.threads = tool_parse_threads(optarg); break;
 		case 'h': fputs(usage_text, stdout); return 0;
 		case 'V': tool_version();
-		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
-		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
 	if (argc - optind > 1)

@@ -342,8 +342,9 @@ int main(int argc, char **argv)
 	int ratios_given = 0, json = 0, level0_given = 0, ch;
 
 	tool_name = "mlod-pack";
+	static const char shortopts[] = ":o:r::R:e:p:x:j:hV";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:p:x:j:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -406,8 +407,7 @@ int main(int argc, char **argv)
 			return 0;
 		}
 		case 'V': tool_version();
-		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
-		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
 	if (argc - optind > 1)

@@ -230,8 +230,9 @@ int main(int argc, char **argv)
 	int ch;
 
 	tool_name = "mlod-skelgraph";
+	static const char shortopts[] = ":o:r::t:j:e:l:c:hV";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::t:j:e:l:c:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -243,8 +244,7 @@ int main(int argc, char **argv)
 		case 'H': lopt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
 		case 'h': printf(usage_text, MLOD_SKEL_MAX_ERROR_DEFAULT); return 0;
 		case 'V': tool_version();
-		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
-		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
 	if (argc - optind > 1)
