@@ -519,12 +519,19 @@ int tool_parse_list(const char *option, const char *value, double *out, int max,
 int tool_parse_list_percent(const char *option, const char *value, double *out, int *percent, int max, double lo,
                             double hi)
 {
+	if (!*value)
+		tool_usage_error("%s: empty list", option);
 	int n = 0;
 	char *copy = malloc(strlen(value) + 1);
 	if (!copy)
 		tool_die(EXIT_USAGE, NULL, "out of memory");
 	strcpy(copy, value);
-	for (char *tok = strtok(copy, ","); tok; tok = strtok(NULL, ",")) {
+	for (char *tok = copy, *next; tok; tok = next) {
+		next = strchr(tok, ',');
+		if (next)
+			*next++ = '\0';
+		if (!*tok) /* "0.5,,0.25", "0.5,", ",0.5": strtok skipped these */
+			tool_usage_error("%s: empty item in '%s'", option, value);
 		if (n == max)
 			tool_usage_error("%s: at most %d values", option, max);
 		size_t len = strlen(tok);
@@ -535,7 +542,24 @@ int tool_parse_list_percent(const char *option, const char *value, double *out, 
 		out[n++] = tool_parse_double(option, tok, lo, hi);
 	}
 	free(copy);
-	if (n == 0)
-		tool_usage_error("%s: empty list", option);
 	return n;
+}
+
+int tool_drop_repeats(const char *option, double *v, int *percent, int n)
+{
+	int m = 0;
+	for (int i = 0; i < n; i++) {
+		int seen = 0;
+		for (int j = 0; j < m && !seen; j++)
+			seen = v[j] == v[i] && (!percent || percent[j] == percent[i]);
+		if (seen) {
+			fprintf(stderr, "%s: %s: %g%s repeated: one level\n", tool_name, option, v[i],
+			        percent && percent[i] ? "%" : "");
+			continue;
+		}
+		if (percent)
+			percent[m] = percent[i];
+		v[m++] = v[i];
+	}
+	return m;
 }

@@ -132,12 +132,17 @@ enum tool_report tool_parse_report(const char *format);
 int tool_ends_with(const char *s, const char *suffix);
 
 /* Parses a comma-separated list of at most max numbers within [lo, hi]
- * into out; exits 1 naming the option when it is empty, too long or holds
- * something else. Returns the count. */
+ * into out; exits 1 naming the option when it or an item is empty, it is
+ * too long or holds something else. Returns the count. */
 int tool_parse_list(const char *option, const char *value, double *out, int max, double lo, double hi);
 /* The same, where a value may end in '%': percent[i] says whether value i did. */
 int tool_parse_list_percent(const char *option, const char *value, double *out, int *percent, int max, double lo,
                             double hi);
+
+/* Drops each of v[0..n) equal to an earlier one (and of the same unit:
+ * percent[i], when percent is not NULL), which would make a second,
+ * identical level, with a note on stderr; returns the count left. */
+int tool_drop_repeats(const char *option, double *v, int *percent, int n);
 
 /* Parses a whole number within [lo, hi]; exits 1 naming the option
  * otherwise. */

@@ -101,6 +101,8 @@ static int parse_list(const char *option, const char *value, struct spec *out, m
 	int pct[MAX_LEVELS] = {0};
 	int n = target == MLOD_MOTION_MAX_ERROR ? tool_parse_list_percent(option, value, v, pct, MAX_LEVELS, lo, hi)
 	                                        : tool_parse_list(option, value, v, MAX_LEVELS, lo, hi);
+	/* An equal value (in the same unit) would bake the same level twice. */
+	n = tool_drop_repeats(option, v, pct, n);
 	for (int i = 0; i < n; i++) {
 		out[i].target = target;
 		out[i].percent = target == MLOD_MOTION_MAX_ERROR && pct[i];

@@ -95,6 +95,7 @@ static int parse_bounds(const char *value, mlod_pack_options *opt)
 	int pct[MLOD_PACK_MAX_MOTION_LEVELS];
 	int n = tool_parse_list_percent("--motion-max-error", value, opt->motion_bounds, pct, MLOD_PACK_MAX_MOTION_LEVELS,
 	                                1e-12, 1e12);
+	n = tool_drop_repeats("--motion-max-error", opt->motion_bounds, pct, n); /* the same level twice */
 	for (int i = 0; i < n; i++)
 		if ((opt->motion_percent[i] = (unsigned char)pct[i]) && opt->motion_bounds[i] > 100.0)
 			tool_usage_error("--motion-max-error: %g%% is out of range [1e-12, 100]", opt->motion_bounds[i]);

@@ -224,7 +224,7 @@ int main(int argc, char **argv)
 	const char *output = NULL;
 	enum tool_report report = REPORT_NONE;
 	double thresholds[MLOD_SKEL_MAX_LEVELS], fractions[MLOD_SKEL_MAX_LEVELS];
-	int threshold_count = 0, fraction_count = 0, level = -1, clip = 0, clip_given = 0;
+	int threshold_count = -1, fraction_count = -1, level = -1, clip = 0, clip_given = 0;
 	double max_error = MLOD_SKEL_MAX_ERROR_DEFAULT;
 	mlod_label_options lopt = {0};
 	int ch;
@@ -249,8 +249,21 @@ int main(int argc, char **argv)
 	}
 	if (argc - optind > 1)
 		tool_usage_error("too many inputs: one file, or stdin");
-	if (threshold_count && fraction_count)
+	if (threshold_count >= 0 && fraction_count >= 0)
 		tool_usage_error("--thresholds and --joints do not go together");
+	/* An equal value would bake the same level twice; --joints 1 a level
+	 * that removes no joint (packed with switch distance 0). */
+	if (threshold_count > 0)
+		threshold_count = tool_drop_repeats("--thresholds", thresholds, NULL, threshold_count);
+	if (fraction_count > 0) {
+		int n = 0;
+		for (int i = 0; i < fraction_count; i++)
+			if (fractions[i] < 1.0)
+				fractions[n++] = fractions[i];
+			else
+				fprintf(stderr, "%s: --joints: 1 keeps every joint: no level\n", tool_name);
+		fraction_count = tool_drop_repeats("--joints", fractions, NULL, n);
+	}
 	int bvh_out = output && tool_ends_with(output, ".bvh");
 	if (level >= 0 && !bvh_out)
 		tool_usage_error("--level needs a .bvh output (-o out.bvh)");
@@ -283,15 +296,15 @@ int main(int argc, char **argv)
 	if ((r = mlod_skel_levels_init(&job.L, &job.c, job.info, &err)) != MLOD_OK)
 		tool_die(tool_exit_code(r), job.input, "%s", err.message);
 
-	if (threshold_count)
+	if (threshold_count >= 0)
 		r = mlod_skel_levels_thresholds(&job.L, thresholds, threshold_count, &err);
-	else if (fraction_count)
+	else if (fraction_count >= 0)
 		r = mlod_skel_levels_fractions(&job.L, fractions, fraction_count, &err);
 	else
 		r = mlod_skel_levels_default(&job.L, max_error, &err);
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), job.input, "%s", err.message);
-	if (!threshold_count && !fraction_count && job.L.count == 0 && job.L.minor_count > 0) {
+	if (threshold_count < 0 && fraction_count < 0 && job.L.count == 0 && job.L.minor_count > 0) {
 		mlod_skel_built first;
 		if ((r = mlod_skel_levels_make(&job.L, -1.0, 1, &first, &err)) != MLOD_OK)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
