@@ -36,6 +36,20 @@ void tool_die(int code, const char *what, const char *fmt, ...)
 	exit(code);
 }
 
+void tool_note(const char *what, const char *fmt, ...)
+{
+	va_list ap;
+	fprintf(stderr, "%s: ", tool_name);
+	if (what) {
+		tool_put_name(stderr, what, 0);
+		fputs(": ", stderr);
+	}
+	va_start(ap, fmt);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fputc('\n', stderr);
+}
+
 void tool_usage_error(const char *fmt, ...)
 {
 	va_list ap;

@@ -33,6 +33,14 @@ void tool_die(int code, const char *what, const char *fmt, ...)
 #endif
 	;
 
+/* Prints "tool: what: message" to stderr (what, an input's name, escaped
+ * as tool_put_name does; NULL: "tool: message") and goes on. */
+void tool_note(const char *what, const char *fmt, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 2, 3)))
+#endif
+	;
+
 /* Prints "tool: message" and a hint to run --help, then exits 1. */
 void tool_usage_error(const char *fmt, ...)
 #if defined(__GNUC__)

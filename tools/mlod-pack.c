@@ -341,6 +341,11 @@ int main(int argc, char **argv)
 	const char *output = NULL, *name = NULL, *info = NULL, *extract = NULL, *codec = "meshopt";
 	enum tool_report report = REPORT_NONE;
 	int ratios_given = 0, json = 0, level0_given = 0, ch;
+	/* The first option given that bakes (not for --info or -x), and the
+	 * first of each layer's computed levels. */
+	const char *bake = NULL, *skel_opt = NULL, *mesh_opt = NULL, *motion_opt = NULL;
+#define BAKE(name) (bake = bake ? bake : (name))
+#define LAYER(var, name) (BAKE(name), var = var ? var : (name))
 
 	tool_name = "mlod-pack";
 	static const char shortopts[] = ":o:r::R:e:p:x:j:hV";
@@ -350,6 +355,7 @@ int main(int argc, char **argv)
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
 		case OPT_CODEC:
+			BAKE("--codec");
 			if (strcmp(optarg, "meshopt") == 0)
 				opt.codec = MLOD_CODEC_MESHOPT;
 			else if (strcmp(optarg, "none") == 0)
@@ -361,6 +367,7 @@ int main(int argc, char **argv)
 			codec = optarg;
 			break;
 		case OPT_ENTROPY:
+			BAKE("--entropy");
 			if (strcmp(optarg, "zstd") == 0)
 				opt.entropy = MLOD_ENTROPY_ZSTD;
 			else if (strcmp(optarg, "none") == 0)
@@ -368,34 +375,46 @@ int main(int argc, char **argv)
 			else
 				tool_usage_error("--entropy: unknown value '%s' (zstd or none)", optarg);
 			break;
-		case OPT_NAME: name = optarg; break;
+		case OPT_NAME: name = optarg, BAKE("--name"); break;
 		case 'R':
+			LAYER(mesh_opt, "--ratios");
 			opt.ratio_count = tool_parse_list("--ratios", optarg, opt.ratios, MLOD_MESH_MAX_LEVELS, 1e-6, 1.0);
 			ratios_given = 1;
 			break;
-		case 'e': opt.mesh_max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
+		case 'e':
+			LAYER(mesh_opt, "--max-error");
+			opt.mesh_max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0);
+			break;
 		case 'p':
+			LAYER(mesh_opt, "--placement");
 			if (mlod_mesh_placement_parse(optarg, &opt.bgm.placement, &opt.bgm.hybrid_error))
 				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter, vertex or hybrid[=PCT])",
 				                 optarg);
 			break;
 		case OPT_INFLUENCE:
+			LAYER(mesh_opt, "--influence-budget");
 			opt.bgm.influence_budget = tool_parse_double("--influence-budget", optarg, 0.0, 1e3);
 			opt.bgm.influence_budget = opt.bgm.influence_budget > 0.0 ? opt.bgm.influence_budget : -1.0;
 			break;
-		case OPT_SKEL_ERR: opt.skel_max_error = tool_parse_double("--skeleton-max-error", optarg, 0.0, 1e6); break;
-		case OPT_MOTION_ERR: opt.motion_bound_count = parse_bounds(optarg, &opt); break;
-		case OPT_POS_BITS: opt.position_bits = tool_parse_int("--position-bits", optarg, MLOD_PACK_POSITION_BITS_MIN, 16); break;
-		case OPT_NRM_BITS: opt.normal_bits = tool_parse_int("--normal-bits", optarg, MLOD_PACK_NORMAL_BITS_MIN, 16); break;
-		case OPT_UV_BITS: opt.uv_bits = tool_parse_int("--uv-bits", optarg, MLOD_PACK_UV_BITS_MIN, 16); break;
-		case OPT_NO_SKEL: opt.no_skeleton_levels = 1; break;
-		case OPT_NO_MESH: opt.no_mesh_levels = 1; break;
-		case OPT_NO_MOTION: opt.no_motion_levels = 1; break;
-		case OPT_LEVEL0_ERR: parse_level0(optarg, &opt), level0_given = 1; break;
-		case OPT_LOSSLESS_MOTION: opt.lossless_motion = 1; break;
+		case OPT_SKEL_ERR:
+			LAYER(skel_opt, "--skeleton-max-error");
+			opt.skel_max_error = tool_parse_double("--skeleton-max-error", optarg, 0.0, 1e6);
+			break;
+		case OPT_MOTION_ERR:
+			LAYER(motion_opt, "--motion-max-error");
+			opt.motion_bound_count = parse_bounds(optarg, &opt);
+			break;
+		case OPT_POS_BITS: BAKE("--position-bits"), opt.position_bits = tool_parse_int("--position-bits", optarg, MLOD_PACK_POSITION_BITS_MIN, 16); break;
+		case OPT_NRM_BITS: BAKE("--normal-bits"), opt.normal_bits = tool_parse_int("--normal-bits", optarg, MLOD_PACK_NORMAL_BITS_MIN, 16); break;
+		case OPT_UV_BITS: BAKE("--uv-bits"), opt.uv_bits = tool_parse_int("--uv-bits", optarg, MLOD_PACK_UV_BITS_MIN, 16); break;
+		case OPT_NO_SKEL: opt.no_skeleton_levels = 1, BAKE("--no-skeleton-levels"); break;
+		case OPT_NO_MESH: opt.no_mesh_levels = 1, BAKE("--no-mesh-levels"); break;
+		case OPT_NO_MOTION: opt.no_motion_levels = 1, BAKE("--no-motion-levels"); break;
+		case OPT_LEVEL0_ERR: parse_level0(optarg, &opt), level0_given = 1, BAKE("--motion-level0-error"); break;
+		case OPT_LOSSLESS_MOTION: opt.lossless_motion = 1, BAKE("--lossless-motion"); break;
 		case OPT_INFO: info = optarg; break;
 		case 'x': extract = optarg; break;
-		case 'j': opt.bgm.threads = tool_parse_threads(optarg); break;
+		case 'j': opt.bgm.threads = tool_parse_threads(optarg), BAKE("--threads"); break;
 		case OPT_JSON: json = 1; break;
 		case 'h': {
 			static const double defaults[] = {MLOD_MESH_RATIOS_DEFAULT};
@@ -421,6 +440,14 @@ int main(int argc, char **argv)
 		tool_usage_error("--lossless-motion and --motion-level0-error do not go together");
 	if (info && extract)
 		tool_usage_error("--info and -x do not go together");
+	if ((info || extract) && bake)
+		tool_usage_error("%s bakes a pack: not with %s, which reads one", bake, info ? "--info" : "-x");
+	if (opt.no_skeleton_levels && skel_opt)
+		tool_usage_error("%s and --no-skeleton-levels do not go together", skel_opt);
+	if (opt.no_mesh_levels && mesh_opt)
+		tool_usage_error("%s and --no-mesh-levels do not go together", mesh_opt);
+	if (opt.no_motion_levels && motion_opt)
+		tool_usage_error("%s and --no-motion-levels do not go together", motion_opt);
 	if (info && output)
 		tool_usage_error("--info prints to stdout, -o does not go with it (redirect stdout)");
 	if (json && !info)
@@ -464,6 +491,14 @@ int main(int argc, char **argv)
 		fprintf(stderr, "%s: %s: %.*s\n", tool_name, label, (int)n, w);
 		w += n + (w[n] == '\n');
 	}
+	/* A layer option the input's own levels (mlod-skelgraph's, mlod-bgm's,
+	 * mlod-motion's) leave unused. */
+	const char *const layer_opt[3] = {skel_opt, mesh_opt, motion_opt};
+	const mlod_pack_layer_stats *const layer_st[3] = {&st.skeleton, &st.mesh, &st.motion};
+	static const char *const layer_name[3] = {"skeleton", "mesh", "motion"};
+	for (int i = 0; i < 3; i++)
+		if (layer_opt[i] && layer_st[i]->from_input)
+			tool_note(label, "%s not used: the input has its own %s levels", layer_opt[i], layer_name[i]);
 	if (st.doc_note[0]) { /* the pack is far larger than a stripped one: said, with or without --report */
 		fprintf(stderr, "%s: %s: ", tool_name, label);
 		tool_put_line(stderr, "", st.doc_note);
