@@ -417,10 +417,27 @@ double tool_parse_double(const char *option, const char *value, double lo, doubl
 
 int tool_parse_int(const char *option, const char *value, int lo, int hi)
 {
-	double v = tool_parse_double(option, value, lo, hi);
-	if (v != (int)v)
+	double v = tool_parse_double(option, value, -HUGE_VAL, HUGE_VAL);
+	if (v != floor(v)) /* before the range: 16.5 is not a whole number, whatever the range */
 		tool_usage_error("%s: '%s' is not a whole number", option, value);
+	if (v < lo || v > hi)
+		tool_usage_error("%s: %s is out of range [%d, %d]", option, value, lo, hi);
 	return (int)v;
+}
+
+double tool_parse_percent(const char *option, const char *value, double lo, double hi)
+{
+	size_t len = strlen(value);
+	if (len == 0 || value[len - 1] != '%')
+		return tool_parse_double(option, value, lo, hi);
+	char *copy = malloc(len);
+	if (!copy)
+		tool_die(EXIT_USAGE, NULL, "out of memory");
+	memcpy(copy, value, len - 1);
+	copy[len - 1] = '\0';
+	double v = tool_parse_double(option, copy, lo, hi);
+	free(copy);
+	return v;
 }
 
 const char *tool_input_stem(const char *path, const char *fallback, char *buf, size_t size)
@@ -437,10 +454,7 @@ const char *tool_input_stem(const char *path, const char *fallback, char *buf, s
 
 int tool_parse_threads(const char *value)
 {
-	double v = tool_parse_double("--threads", value, 1, MLOD_MAX_THREADS);
-	if (v != (int)v)
-		tool_usage_error("--threads: '%s' is not a whole number", value);
-	return (int)v;
+	return tool_parse_int("--threads", value, 1, MLOD_MAX_THREADS);
 }
 
 /* The one escaper of a name from the input or the pack (the

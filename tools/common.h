@@ -153,8 +153,12 @@ int tool_parse_list_percent(const char *option, const char *value, double *out, 
 int tool_drop_repeats(const char *option, double *v, int *percent, int n);
 
 /* Parses a whole number within [lo, hi]; exits 1 naming the option
- * otherwise. */
+ * otherwise ("not a whole number" before "out of range"). */
 int tool_parse_int(const char *option, const char *value, int lo, int hi);
+
+/* tool_parse_double for a value documented in percent: a trailing '%'
+ * is allowed ("1%" is 1). */
+double tool_parse_percent(const char *option, const char *value, double lo, double hi);
 
 /* The file name of path without its directory and extension ("walk" for
  * "a/walk.bvh") in buf; fallback when path is NULL or "-". */

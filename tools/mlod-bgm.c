@@ -295,7 +295,7 @@ int main(int argc, char **argv)
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
 		case 'R': ratio_count = tool_parse_list("--ratios", optarg, ratios, MLOD_MESH_MAX_LEVELS, 1e-6, 1.0); break;
-		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
+		case 'e': max_error = tool_parse_percent("--max-error", optarg, 0.0, 100.0); break;
 		case 'c': opt.cost = (mlod_mesh_cost)(MLOD_COST_COMPACTNESS + parse_enum("--cost", optarg, costs, 2)); break;
 		case 'C': opt.op = (mlod_collapse_op)(MLOD_OP_TRIANGLE + parse_enum("--collapse", optarg, ops, 3)); break;
 		case 'B': budget = (mlod_mesh_budget)(MLOD_BUDGET_CHARACTER + parse_enum("--budget", optarg, budgets, 2)); break;

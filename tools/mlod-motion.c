@@ -288,17 +288,11 @@ int main(int argc, char **argv)
 		case 'S':
 			job.opt.precision_share = tool_parse_double("--precision-share", optarg, 0.0, 1.0);
 			if (!(job.opt.precision_share > 0.0 && job.opt.precision_share < 1.0))
-				tool_usage_error("--precision-share: %s is not between 0 and 1", optarg);
+				tool_usage_error("--precision-share: %s is out of range (0, 1): above 0 and below 1", optarg);
 			break;
-		case 'D': {
-			double v = tool_parse_double("--subdivide", optarg, 1, MLOD_MAX_SUBDIVIDE);
-			if (v != floor(v))
-				tool_usage_error("--subdivide: %s is not a whole number", optarg);
-			job.opt.subdivide = (int)v;
-			break;
-		}
-		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
-		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6), clip_given = 1; break;
+		case 'D': job.opt.subdivide = tool_parse_int("--subdivide", optarg, 1, MLOD_MAX_SUBDIVIDE); break;
+		case 'l': level = tool_parse_int("--level", optarg, 0, MAX_LEVELS); break;
+		case 'c': clip = tool_parse_int("--clip", optarg, 0, 1000000), clip_given = 1; break;
 		case 'j': job.threads = tool_parse_threads(optarg); break;
 		case 'h': fputs(usage_text, stdout); return 0;
 		case 'V': tool_version();

@@ -383,7 +383,7 @@ int main(int argc, char **argv)
 			break;
 		case 'e':
 			LAYER(mesh_opt, "--max-error");
-			opt.mesh_max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0);
+			opt.mesh_max_error = tool_parse_percent("--max-error", optarg, 0.0, 100.0);
 			break;
 		case 'p':
 			LAYER(mesh_opt, "--placement");
@@ -398,7 +398,7 @@ int main(int argc, char **argv)
 			break;
 		case OPT_SKEL_ERR:
 			LAYER(skel_opt, "--skeleton-max-error");
-			opt.skel_max_error = tool_parse_double("--skeleton-max-error", optarg, 0.0, 1e6);
+			opt.skel_max_error = tool_parse_percent("--skeleton-max-error", optarg, 0.0, 1e6);
 			break;
 		case OPT_MOTION_ERR:
 			LAYER(motion_opt, "--motion-max-error");

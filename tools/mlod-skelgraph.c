@@ -238,9 +238,9 @@ int main(int argc, char **argv)
 		case 'r': report = tool_parse_report(optarg); break;
 		case 't': threshold_count = tool_parse_list("--thresholds", optarg, thresholds, MLOD_SKEL_MAX_LEVELS, 0.0, 1e9); break;
 		case 'j': fraction_count = tool_parse_list("--joints", optarg, fractions, MLOD_SKEL_MAX_LEVELS, 0.0, 1.0); break;
-		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 1e6); break;
-		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MLOD_SKEL_MAX_LEVELS); break;
-		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6), clip_given = 1; break;
+		case 'e': max_error = tool_parse_percent("--max-error", optarg, 0.0, 1e6); break;
+		case 'l': level = tool_parse_int("--level", optarg, 0, MLOD_SKEL_MAX_LEVELS); break;
+		case 'c': clip = tool_parse_int("--clip", optarg, 0, 1000000), clip_given = 1; break;
 		case 'H': lopt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
 		case 'h': printf(usage_text, MLOD_SKEL_MAX_ERROR_DEFAULT); return 0;
 		case 'V': tool_version();
