@@ -27,8 +27,10 @@ void tool_die(int code, const char *what, const char *fmt, ...)
 {
 	va_list ap;
 	fprintf(stderr, "%s: ", tool_name);
-	if (what)
-		fprintf(stderr, "%s: ", what);
+	if (what) { /* a file's name: escaped, as in the reports */
+		tool_put_name(stderr, what, 0);
+		fputs(": ", stderr);
+	}
 	va_start(ap, fmt);
 	vfprintf(stderr, fmt, ap);
 	va_end(ap);
@@ -173,7 +175,7 @@ static void put_warnings(const char *path, const mlod_character *c)
 {
 	for (const char *w = c->warnings; w && *w;) {
 		size_t n = strcspn(w, "\n");
-		fprintf(stderr, "%s: %s: %.*s\n", tool_name, tool_input_label(path), (int)n, w);
+		tool_note(tool_input_label(path), "%.*s", (int)n, w);
 		w += n + (w[n] == '\n');
 	}
 }
@@ -337,7 +339,7 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 	}
 	if (is_stdio(path) || open_on == STDOUT_FILENO) {
 		if (binary && isatty(fileno(stdout)))
-			tool_die(EXIT_USAGE, NULL, "refusing to write binary output to a terminal; redirect stdout or use -o FILE");
+			tool_die(EXIT_USAGE, "<stdout>", "refusing to write binary output to a terminal; redirect stdout or use -o FILE");
 		if (fwrite(data, 1, size, stdout) != size || fflush(stdout) != 0)
 			tool_die(EXIT_OUTPUT, "<stdout>", "write error: %s", strerror(errno));
 		return;
@@ -581,8 +583,7 @@ int tool_drop_repeats(const char *option, double *v, int *percent, int n)
 		for (int j = 0; j < m && !seen; j++)
 			seen = v[j] == v[i] && (!percent || percent[j] == percent[i]);
 		if (seen) {
-			fprintf(stderr, "%s: %s: %g%s repeated: one level\n", tool_name, option, v[i],
-			        percent && percent[i] ? "%" : "");
+			tool_note(NULL, "%s: %g%s repeated: one level", option, v[i], percent && percent[i] ? "%" : "");
 			continue;
 		}
 		if (percent)

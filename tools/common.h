@@ -25,8 +25,9 @@ enum {
 /* The tool's name for messages ("mlod-label"). Set once in main. */
 extern const char *tool_name;
 
-/* Prints "tool: what: message" to stderr and exits with code. what may be
- * NULL (then "tool: message"). */
+/* Prints "tool: what: message" to stderr and exits with code. what (a
+ * file's name) is escaped as tool_put_name does; it may be NULL (then
+ * "tool: message"). */
 void tool_die(int code, const char *what, const char *fmt, ...)
 #if defined(__GNUC__)
 	__attribute__((format(printf, 3, 4), noreturn))

@@ -362,7 +362,7 @@ int main(int argc, char **argv)
 		else if (report == REPORT_JSON)
 			report_json(&job);
 		else {
-			fprintf(stderr, "%s: %s: no triangle mesh; written unchanged\n", tool_name, job.input);
+			tool_note(job.input, "no triangle mesh; written unchanged");
 			tool_write_gltf(output, doc);
 		}
 	} else {
@@ -371,8 +371,8 @@ int main(int argc, char **argv)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
 		if (rec.mesh_level_count > 0 && report == REPORT_NONE && !split) {
 			/* Levels on top of levels would leave the old ones unused: pass it through. */
-			fprintf(stderr, "%s: %s: the input already has %d mesh level%s (MSFT_lod): written unchanged; run %s on "
-			        "the input without them to bake them again\n", tool_name, job.input, rec.mesh_level_count,
+			tool_note(job.input, "the input already has %d mesh level%s (MSFT_lod): written unchanged; run %s on "
+			        "the input without them to bake them again", rec.mesh_level_count,
 			        rec.mesh_level_count == 1 ? "" : "s", tool_name);
 			tool_write_gltf(output, doc);
 			mlod_record_free(&rec);
@@ -390,7 +390,7 @@ int main(int argc, char **argv)
 		if (r != MLOD_OK)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
 		if (max_error >= 0.0 && job.L.count == 0)
-			fprintf(stderr, "%s: %s: no mesh level within --max-error %g%%\n", tool_name, job.input, max_error);
+			tool_note(job.input, "no mesh level within --max-error %g%%", max_error);
 		follow_skeleton(&job, &rec, sk);
 		if (split) /* first: write_glb changes doc */
 			write_split(&job, doc, split, input_path, output);

@@ -165,7 +165,7 @@ int main(int argc, char **argv)
 
 	if (c.skeleton.joint_count == 0 && report == REPORT_NONE) {
 		/* A static prop: nothing to label; pass it through. */
-		fprintf(stderr, "%s: %s: no joints: nothing to label; written unchanged\n", tool_name, tool_input_label(input));
+		tool_note(tool_input_label(input), "no joints: nothing to label; written unchanged");
 		tool_write_gltf(output, doc);
 		mlod_character_free(&c);
 		mlod_gltf_free(doc);

@@ -156,7 +156,7 @@ static void bake(const struct job *job, const int *clips, int clip_count, mlod_m
 	mlod_error err = {0};
 	mlod_result r = mlod_motion_bake_run(&job->c, job->doc, clips, clip_count, &o, out, &err);
 	for (int i = 0; i < out->note_count; i++)
-		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, out->notes[i]);
+		tool_note(job->input, "%s", out->notes[i]);
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), job->input, "%s", err.message);
 }
@@ -200,7 +200,7 @@ static void write_bvh(const struct job *job, const mlod_motion_bake *b, const ch
 	if (mlod_skel_bvh_end_sites(&job->c, clip, &max, &joint, note, sizeof note, &err) != MLOD_OK)
 		tool_die(tool_exit_code(err.code), job->input, "%s", err.message);
 	if (note[0])
-		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, note);
+		tool_note(job->input, "%s", note);
 }
 
 int main(int argc, char **argv)
@@ -332,7 +332,7 @@ int main(int argc, char **argv)
 		if (bvh_out)
 			tool_die(EXIT_INPUT, job.input, "%s: no clip to write as BVH", why);
 		if (report == REPORT_NONE) {
-			fprintf(stderr, "%s: %s: %s: nothing to reduce; written unchanged\n", tool_name, job.input, why);
+			tool_note(job.input, "%s: nothing to reduce; written unchanged", why);
 			tool_write_gltf(output, doc);
 			mlod_character_free(&job.c);
 			mlod_gltf_free(doc);
@@ -348,8 +348,8 @@ int main(int argc, char **argv)
 	}
 	if (existing > 0) {
 		/* Levels of levels would be baked from the old levels too: pass it through. */
-		fprintf(stderr, "%s: %s: the input already has %d motion level%s (<clip>@lod<k>): written unchanged; run %s "
-		        "on the input without them to bake them again\n", tool_name, job.input, existing,
+		tool_note(job.input, "the input already has %d motion level%s (<clip>@lod<k>): written unchanged; run %s "
+		        "on the input without them to bake them again", existing,
 		        existing == 1 ? "" : "s", tool_name);
 		tool_write_gltf(output, doc);
 		mlod_character_free(&job.c);
@@ -387,9 +387,7 @@ int main(int argc, char **argv)
 	for (int k = 0; k < b.clip_count && report == REPORT_NONE; k++) {
 		char note[256];
 		if (mlod_motion_bake_timeline_note(&b, k, note, sizeof note)) {
-			fprintf(stderr, "%s: %s: clip ", tool_name, job.input);
-			tool_json_string(stderr, job.c.clips[b.clips[k].index].name);
-			fprintf(stderr, ": %s\n", note);
+			tool_note(job.input, "clip %s: %s", MLOD_QUOTED(job.c.clips[b.clips[k].index].name), note);
 		}
 	}
 

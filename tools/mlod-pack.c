@@ -485,10 +485,10 @@ int main(int argc, char **argv)
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), label, "%s", err.message);
 	if (c.clip_count == 0 && c.skeleton.joint_count > 0)
-		fprintf(stderr, "%s: %s: no animation: the pack has no motion levels\n", tool_name, label);
+		tool_note(label, "no animation: the pack has no motion levels");
 	for (const char *w = st.warnings; *w;) { /* what the pack does not keep, or keeps changed */
 		size_t n = strcspn(w, "\n");
-		fprintf(stderr, "%s: %s: %.*s\n", tool_name, label, (int)n, w);
+		tool_note(label, "%.*s", (int)n, w);
 		w += n + (w[n] == '\n');
 	}
 	/* A layer option the input's own levels (mlod-skelgraph's, mlod-bgm's,
@@ -500,8 +500,7 @@ int main(int argc, char **argv)
 		if (layer_opt[i] && layer_st[i]->from_input)
 			tool_note(label, "%s not used: the input has its own %s levels", layer_opt[i], layer_name[i]);
 	if (st.doc_note[0]) { /* the pack is far larger than a stripped one: said, with or without --report */
-		fprintf(stderr, "%s: %s: ", tool_name, label);
-		tool_put_line(stderr, "", st.doc_note);
+		tool_note(label, "%s", mlod_name_text(st.doc_note, 0, (char[4 * sizeof st.doc_note]){0}, 4 * sizeof st.doc_note));
 	}
 	if (output || report == REPORT_NONE)
 		tool_write_output(output, pack, pack_size, 1);

@@ -156,7 +156,7 @@ static void write_bvh(const struct job *job, const char *output, int level, int 
 	if (mlod_skel_bvh_end_sites(c, clip, &max, &joint, note, sizeof note, &err) != MLOD_OK)
 		tool_die(tool_exit_code(err.code), job->input, "%s", err.message);
 	if (note[0])
-		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, note);
+		tool_note(job->input, "%s", note);
 }
 
 /* Adds the levels and their record to the document and writes it. */
@@ -173,8 +173,8 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	mlod_record_free(&stage);
 	if (skel_levels > 0) {
 		/* Levels on top of levels would leave the old ones unused: pass it through. */
-		fprintf(stderr, "%s: %s: the input already has %d skeleton level%s: written unchanged; run %s on the input "
-		        "without them to bake them again\n", tool_name, job->input, skel_levels, skel_levels == 1 ? "" : "s",
+		tool_note(job->input, "the input already has %d skeleton level%s: written unchanged; run %s on the input "
+		        "without them to bake them again", skel_levels, skel_levels == 1 ? "" : "s",
 		        tool_name);
 		tool_write_gltf(output, doc);
 		return;
@@ -189,10 +189,8 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	mlod_skel_levels_records(&job->L, records);
 	/* Mesh levels already in MSFT_lod (mlod-bgm ran first) stay there. */
 	if (mesh_levels > 0 && n > 0)
-		fprintf(stderr,
-		        "%s: %s: the input's %d mesh level(s) stay in MSFT_lod, weighted on the full skeleton; "
-		        "run mlod-skelgraph before mlod-bgm for mesh levels on the skeleton levels\n",
-		        tool_name, job->input, mesh_levels);
+		tool_note(job->input, "the input's %d mesh level(s) stay in MSFT_lod, weighted on the full skeleton; "
+		          "run mlod-skelgraph before mlod-bgm for mesh levels on the skeleton levels", mesh_levels);
 	if ((r = mlod_gltf_add_skel_levels(doc, &job->c, records, n, skins, mesh_levels == 0, &err)) != MLOD_OK ||
 	    (r = mlod_record_skel_levels_make(&job->c, records, n, skins, rec, &err)) != MLOD_OK)
 		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_INPUT, job->input, "%s", err.message);
@@ -261,7 +259,7 @@ int main(int argc, char **argv)
 			if (fractions[i] < 1.0)
 				fractions[n++] = fractions[i];
 			else
-				fprintf(stderr, "%s: --joints: 1 keeps every joint: no level\n", tool_name);
+				tool_note(NULL, "--joints: 1 keeps every joint: no level");
 		fraction_count = tool_drop_repeats("--joints", fractions, NULL, n);
 	}
 	int bvh_out = output && tool_ends_with(output, ".bvh");
@@ -279,7 +277,7 @@ int main(int argc, char **argv)
 	tool_load(optind < argc ? argv[optind] : NULL, &doc, &job.c, NULL);
 	if (job.c.skeleton.joint_count == 0 && report == REPORT_NONE && !bvh_out) {
 		/* A static prop: no skeleton to reduce; pass it through. */
-		fprintf(stderr, "%s: %s: no joints: no skeleton levels; written unchanged\n", tool_name, job.input);
+		tool_note(job.input, "no joints: no skeleton levels; written unchanged");
 		tool_write_gltf(output, doc);
 		mlod_character_free(&job.c);
 		mlod_gltf_free(doc);
