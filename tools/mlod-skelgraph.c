@@ -54,6 +54,7 @@ struct job {
 	mlod_joint_info *info;
 	int labels_from_extras;
 	mlod_skel_levels L;
+	char notes[256]; /* what was said on stderr of the levels, for the reports */
 };
 
 static void removed_names(FILE *f, const struct job *job, const mlod_skel_built *lv, int json)
@@ -108,6 +109,8 @@ static void report_table(const struct job *job)
 	}
 	printf("# vtx: skinned-vertex deviation over the clips, %% of the bounding diagonal;"
 	       " jnt: removed joints following their stand-ins, %% of the height\n");
+	if (job->notes[0])
+		tool_put_line(stdout, "# note: ", job->notes);
 	if (job->c.notes && *job->c.notes)
 		tool_put_line(stdout, "# note: ", job->c.notes);
 }
@@ -133,7 +136,17 @@ static void report_json(const struct job *job)
 		printf("     \"shear_samples\": %d, \"weight_merges\": %d}%s\n", lv->stats.shear_samples,
 		       lv->stats.weight_merges, k + 1 < job->L.count ? "," : "");
 	}
-	printf("  ]\n}\n");
+	/* The level note and the input's notes, as one string (as the other
+	 * tools' "notes"). */
+	const char *in = job->c.notes ? job->c.notes : "";
+	char *notes = malloc(strlen(job->notes) + strlen(in) + 3);
+	if (!notes)
+		tool_die(EXIT_OUTPUT, NULL, "out of memory");
+	sprintf(notes, "%s%s%s", job->notes, job->notes[0] && in[0] ? "; " : "", in);
+	printf("  ],\n  \"notes\": ");
+	tool_json_string(stdout, notes);
+	printf("\n}\n");
+	free(notes);
 }
 
 static void write_bvh(const struct job *job, const char *output, int level, int clip)
@@ -306,8 +319,9 @@ int main(int argc, char **argv)
 		mlod_skel_built first;
 		if ((r = mlod_skel_levels_make(&job.L, -1.0, 1, &first, &err)) != MLOD_OK)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
-		fprintf(stderr, "%s: %s: no skeleton level within --max-error %g%%: removing %s alone costs %.3g%%\n",
-		        tool_name, job.input, max_error, job.c.skeleton.joints[job.L.order[0]].name, first.bound_error);
+		snprintf(job.notes, sizeof job.notes, "no skeleton level within --max-error %g%%: removing %s alone costs %.3g%%",
+		         max_error, MLOD_QUOTED(job.c.skeleton.joints[job.L.order[0]].name), first.bound_error);
+		tool_note(job.input, "%s", job.notes);
 		mlod_skel_built_free(&first);
 	}
 
