@@ -180,6 +180,17 @@ static void put_warnings(const char *path, const mlod_character *c)
 	}
 }
 
+/* Exits at a failed load, with the reader's message; a pack (mlod(5))
+ * is pointed to the mlod-pack options that read one. */
+static void load_failed(const char *path, mlod_result r, const mlod_error *err, const void *data, size_t size)
+{
+	if (size >= 4 && memcmp(data, MLOD_PACK_MAGIC, 4) == 0)
+		tool_die(EXIT_UNSUPPORTED, tool_input_label(path),
+		         "an mlod pack, not a glTF, glb or BVH file: mlod-pack --info prints it, mlod-pack -x unpacks it "
+		         "to a glb");
+	tool_die(tool_exit_code(r), tool_input_label(path), "%s", err->message);
+}
+
 void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format)
 {
 	size_t size;
@@ -190,7 +201,8 @@ void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format
 	free(dir);
 	free(data);
 	if (r != MLOD_OK)
-		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
+		load_failed(path, r, &err, data, size);
+	free(data);
 	put_warnings(path, c);
 }
 
@@ -202,7 +214,7 @@ void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_
 	mlod_result r = mlod_load(data, *size, dir, doc, c, format, &err);
 	free(dir);
 	if (r != MLOD_OK)
-		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
+		load_failed(path, r, &err, data, *size);
 	put_warnings(path, c);
 	return data;
 }

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "common.h"
 
@@ -191,10 +192,18 @@ static const char *codec_column(const mlod_pack_chunk *c, char *buf, size_t n)
 }
 
 static int pack_info(const char *path, enum tool_report report)
+/* Reads the pack of --info or -x (a file, or stdin when path is "-"). */
+static void *read_pack(const char *path, size_t *size)
+{
+	if (strcmp(path, "-") == 0 && isatty(STDIN_FILENO))
+		tool_usage_error("no input: give a pack, or pipe one into stdin");
+	return tool_read_input(path, size);
+}
+
 {
 	const char *label = tool_input_label(path);
 	size_t size = 0;
-	void *data = tool_read_input(path, &size);
+	void *data = read_pack(path, &size);
 	mlod_pack p;
 	mlod_pack_info info;
 	mlod_error err = {0};
@@ -290,7 +299,7 @@ static int pack_extract(const char *path, const char *output)
 {
 	const char *label = tool_input_label(path);
 	size_t size = 0;
-	void *data = tool_read_input(path, &size);
+	void *data = read_pack(path, &size);
 	mlod_gltf *doc = NULL;
 	mlod_error err = {0};
 	mlod_result r = mlod_pack_unpack(data, size, &doc, &err);
