@@ -83,7 +83,8 @@ static const char usage_more[] = /* printf's format ends above (ISO C's 4095-cha
 	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels,\n"
 	"                             skeleton-level skins, <clip>@lod<k> animations\n"
 	"  -j, --threads N            compute mesh levels on N threads (default: the\n"
-	"                             processors online); the same pack at any N\n"
+	"                             processors it may run on, its CPU affinity);\n"
+	"                             the same pack at any N\n"
 	"  -h, --help                 show this help\n"
 	"  -V, --version              show the version\n"
 	"\n"
@@ -191,7 +192,6 @@ static const char *codec_column(const mlod_pack_chunk *c, char *buf, size_t n)
 	return buf;
 }
 
-static int pack_info(const char *path, enum tool_report report)
 /* Reads the pack of --info or -x (a file, or stdin when path is "-"). */
 static void *read_pack(const char *path, size_t *size)
 {
@@ -200,6 +200,7 @@ static void *read_pack(const char *path, size_t *size)
 	return tool_read_input(path, size);
 }
 
+static int pack_info(const char *path, enum tool_report report)
 {
 	const char *label = tool_input_label(path);
 	size_t size = 0;
