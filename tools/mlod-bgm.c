@@ -130,9 +130,20 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	tool_write_gltf(output, doc);
 }
 
+/* Whether -o names a file whose name can stand for the input's: a
+ * regular file or a new one, not a device, FIFO or socket (-o /dev/null
+ * gave null.lod1.glb) nor standard output. */
+static int output_names_file(const char *output)
+{
+	struct stat st;
+	if (!output || strcmp(output, "-") == 0 || tool_output_is_stdout(output))
+		return 0;
+	return stat(output, &st) != 0 ? errno == ENOENT : S_ISREG(st.st_mode);
+}
+
 /* One glb per level in dir (made when missing, not its parents):
  * DIR/<name>.lod<k>.glb, name the input file's without its extension; from
- * stdin -o's, else "stdin". */
+ * stdin -o's (a regular or new file's), else "stdin". */
 static void write_split(struct job *job, const mlod_gltf *input, const char *dir, const char *input_path,
                         const char *output)
 {
@@ -144,7 +155,7 @@ static void write_split(struct job *job, const mlod_gltf *input, const char *dir
 		tool_die(EXIT_OUTPUT, dir, "not a directory");
 	}
 	const char *from = input_path && strcmp(input_path, "-") != 0 ? input_path
-	                   : output && strcmp(output, "-") != 0       ? output
+	                   : output_names_file(output)               ? output
 	                                                              : "stdin";
 	const char *base = strrchr(from, '/');
 	base = base ? base + 1 : from;
