@@ -199,7 +199,6 @@ void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format
 	mlod_error err = {0};
 	mlod_result r = mlod_load(data, size, dir, doc, c, format, &err);
 	free(dir);
-	free(data);
 	if (r != MLOD_OK)
 		load_failed(path, r, &err, data, size);
 	free(data);
