@@ -77,6 +77,7 @@
  */
 #define _GNU_SOURCE /* getopt_long, clock_gettime */
 
+#include <errno.h>
 #include <fcntl.h>
 #include <getopt.h>
 #include <math.h>
@@ -696,14 +697,30 @@ static void draw_legend(unsigned char *img, int w, int h, uint32_t levels)
 	}
 }
 
-/* A picture is binary: a path that is a terminal (/dev/tty, /dev/stdout
- * on one) is refused up front, as the tools refuse binary output to a
- * terminal (exit 1). A path that cannot be opened is left to write_png. */
-static void refuse_terminal(const char *path)
+/* A picture's path is checked up front, before seconds of measuring: a
+ * terminal (/dev/tty, /dev/stdout on one) is refused, as the tools refuse
+ * binary output to one (exit 1); a file that cannot be opened for writing,
+ * or a new one whose directory does not let it be made, exits 4 with the
+ * reason. (A FIFO without a reader yet is left to write_png.) */
+static void check_output(const char *path)
 {
-	int fd = path ? open(path, O_WRONLY | O_NOCTTY | O_NONBLOCK) : -1;
-	if (fd < 0)
+	char msg[4096];
+	if (!path)
 		return;
+	int fd = open(path, O_WRONLY | O_NOCTTY | O_NONBLOCK);
+	if (fd < 0 && errno == ENOENT) { /* a new file: its directory must take it */
+		const char *slash = strrchr(path, '/');
+		int n = slash ? (int)(slash - path) + (slash == path) : 1;
+		snprintf(msg, sizeof msg, "%.*s", n, slash ? path : ".");
+		if (access(msg, W_OK | X_OK) == 0)
+			return;
+	} else if (fd < 0 && errno == ENXIO) {
+		return;
+	}
+	if (fd < 0) {
+		snprintf(msg, sizeof msg, "%s: cannot open for writing: %s", path, strerror(errno));
+		die(4, "%s", msg);
+	}
 	int tty = isatty(fd);
 	close(fd);
 	if (tty)
@@ -713,8 +730,11 @@ static void refuse_terminal(const char *path)
 static void write_png(const char *path, const unsigned char *img, int w, int h)
 {
 	FILE *f = fopen(path, "wb");
-	if (!f)
-		die(4, "%s: cannot open for writing", path);
+	if (!f) {
+		char msg[4096];
+		snprintf(msg, sizeof msg, "%s: cannot open for writing: %s", path, strerror(errno));
+		die(4, "%s", msg);
+	}
 	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
 	png_infop info = png ? png_create_info_struct(png) : NULL;
 	if (!png || !info) {
@@ -1270,8 +1290,8 @@ int main(int argc, char **argv)
 	}
 	if (optind + 1 != argc)
 		die(1, "%s", "one PACK is needed (see --help)");
-	refuse_terminal(png_path);
-	refuse_terminal(plot_path);
+	check_output(png_path);
+	check_output(plot_path);
 	if (!(seconds > 0) || !(fps > 0) || !(far > near) || near < 0 || hyst < 0)
 		die(1, "%s", "bad --seconds, --fps, --near/--far or --hysteresis");
 	if (figures)

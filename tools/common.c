@@ -6,6 +6,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <getopt.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -26,13 +27,29 @@ void tool_die(int code, const char *what, const char *fmt, ...)
 {
 	va_list ap;
 	fprintf(stderr, "%s: ", tool_name);
-	if (what)
-		fprintf(stderr, "%s: ", what);
+	if (what) { /* a file's name: escaped, as in the reports */
+		tool_put_name(stderr, what, 0);
+		fputs(": ", stderr);
+	}
 	va_start(ap, fmt);
 	vfprintf(stderr, fmt, ap);
 	va_end(ap);
 	fputc('\n', stderr);
 	exit(code);
+}
+
+void tool_note(const char *what, const char *fmt, ...)
+{
+	va_list ap;
+	fprintf(stderr, "%s: ", tool_name);
+	if (what) {
+		tool_put_name(stderr, what, 0);
+		fputs(": ", stderr);
+	}
+	va_start(ap, fmt);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fputc('\n', stderr);
 }
 
 void tool_usage_error(const char *fmt, ...)
@@ -44,6 +61,27 @@ void tool_usage_error(const char *fmt, ...)
 	va_end(ap);
 	fprintf(stderr, "\nTry '%s --help' for more information.\n", tool_name);
 	exit(EXIT_USAGE);
+}
+
+void tool_option_error(int ch, const char *shortopts, char *const *argv)
+{
+	/* A short option's letter is optopt (argv[optind - 1] is the element
+	 * before a bundle, or the bundle, or the program's name). A long
+	 * option's is 0 (unknown), or its value (a missing or unwanted value):
+	 * its element is argv[optind - 1], optind having moved past it; a
+	 * missing value's option is always the last of its element. */
+	const char *arg = argv[optind - 1];
+	int is_long = strncmp(arg, "--", 2) == 0 && arg[2] != '\0';
+	if (ch == ':') {
+		if (is_long)
+			tool_usage_error("option '%.*s' needs a value", (int)strcspn(arg, "="), arg);
+		tool_usage_error("option '-%c' needs a value", optopt);
+	}
+	if (optopt > 0 && optopt < 256 && optopt != ':' && !strchr(shortopts, optopt))
+		tool_usage_error("unknown option '-%c'", optopt);
+	if (optopt != 0 && is_long && strchr(arg, '='))
+		tool_usage_error("option '%.*s' takes no value", (int)strcspn(arg, "="), arg);
+	tool_usage_error("unknown option '%s'", arg);
 }
 
 int tool_exit_code(mlod_result r)
@@ -137,9 +175,20 @@ static void put_warnings(const char *path, const mlod_character *c)
 {
 	for (const char *w = c->warnings; w && *w;) {
 		size_t n = strcspn(w, "\n");
-		fprintf(stderr, "%s: %s: %.*s\n", tool_name, tool_input_label(path), (int)n, w);
+		tool_note(tool_input_label(path), "%.*s", (int)n, w);
 		w += n + (w[n] == '\n');
 	}
+}
+
+/* Exits at a failed load, with the reader's message; a pack (mlod(5))
+ * is pointed to the mlod-pack options that read one. */
+static void load_failed(const char *path, mlod_result r, const mlod_error *err, const void *data, size_t size)
+{
+	if (size >= 4 && memcmp(data, MLOD_PACK_MAGIC, 4) == 0)
+		tool_die(EXIT_UNSUPPORTED, tool_input_label(path),
+		         "an mlod pack, not a glTF, glb or BVH file: mlod-pack --info prints it, mlod-pack -x unpacks it "
+		         "to a glb");
+	tool_die(tool_exit_code(r), tool_input_label(path), "%s", err->message);
 }
 
 void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format)
@@ -150,9 +199,9 @@ void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format
 	mlod_error err = {0};
 	mlod_result r = mlod_load(data, size, dir, doc, c, format, &err);
 	free(dir);
-	free(data);
 	if (r != MLOD_OK)
-		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
+		load_failed(path, r, &err, data, size);
+	free(data);
 	put_warnings(path, c);
 }
 
@@ -164,7 +213,7 @@ void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_
 	mlod_result r = mlod_load(data, *size, dir, doc, c, format, &err);
 	free(dir);
 	if (r != MLOD_OK)
-		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
+		load_failed(path, r, &err, data, *size);
 	put_warnings(path, c);
 	return data;
 }
@@ -218,27 +267,46 @@ static void write_in_place(const char *path, const void *data, size_t size, int 
 		tool_die(EXIT_OUTPUT, path, "write error: %s", strerror(e));
 }
 
-/* A regular file (exists) or a new path: a temporary file in the same
- * directory, then rename. what names the output in messages (the path
- * given). */
-static void write_replace(const char *what, const char *path, int exists, const void *data, size_t size)
+/* A regular file (old: its stat) or a new path (old NULL): a temporary
+ * file in the same directory, then rename. what names the output in
+ * messages (the path given). The temporary is DIR/.mlod-XXXXXX (mkstemp):
+ * short, so that a name of NAME_MAX bytes can still be replaced. It gets
+ * the replaced file's permission bits, owner and group (as far as the
+ * user may give them: a group the user is not in, or another owner, stays
+ * the user's), so that a private file stays private; a new file gets 0666
+ * less the umask, as open(2) would give it. Hard links to the old file
+ * keep the old contents (the rename makes a new file, as sed -i does). */
+static void write_replace(const char *what, const char *path, const struct stat *old, const void *data, size_t size)
 {
-	size_t n = strlen(path) + 32;
-	char *tmp = malloc(n);
+	const char *slash = strrchr(path, '/');
+	size_t dn = slash ? (size_t)(slash - path) + 1 : 0;
+	char *tmp = malloc(dn + sizeof ".mlod-XXXXXX");
 	if (!tmp)
 		tool_die(EXIT_OUTPUT, what, "out of memory");
-	snprintf(tmp, n, "%s.tmp.%ld", path, (long)getpid());
-	int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
+	memcpy(tmp, path, dn);
+	strcpy(tmp + dn, ".mlod-XXXXXX");
+	int fd = mkstemp(tmp);
 	if (fd < 0) {
 		int e = errno;
 		free(tmp);
-		char *slash = strrchr(path, '/');
-		if (!exists) /* the file itself could not be made: the same cause */
+		if (!old) /* the file itself could not be made: the same cause */
 			tool_die(EXIT_OUTPUT, what, "cannot create: %s", strerror(e));
 		tool_die(EXIT_OUTPUT, what, "cannot create a temporary file in %.*s to replace it atomically: %s",
 		         slash ? (int)(slash == path ? 1 : slash - path) : 1, slash ? path : ".", strerror(e));
 	}
-	int e = write_all(fd, data, size);
+	mode_t mode = old ? old->st_mode & 07777 : 0;
+	if (!old) { /* mkstemp makes it 0600 */
+		mode_t mask = umask(0);
+		umask(mask);
+		mode = 0666 & ~mask;
+	} else if (fchown(fd, old->st_uid, old->st_gid) != 0) { /* EPERM: not the owner's to give */
+		mode &= ~(mode_t)S_ISUID; /* another owner's set-user-ID bit is not the user's */
+		if (fchown(fd, (uid_t)-1, old->st_gid) != 0)
+			mode &= ~(mode_t)S_ISGID;
+	}
+	int e = fchmod(fd, mode) != 0 ? errno : 0;
+	if (e == 0)
+		e = write_all(fd, data, size);
 	if (e == 0 && fsync(fd) != 0 && errno != EINVAL)
 		e = errno;
 	if (close(fd) != 0 && e == 0)
@@ -282,7 +350,7 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 	}
 	if (is_stdio(path) || open_on == STDOUT_FILENO) {
 		if (binary && isatty(fileno(stdout)))
-			tool_die(EXIT_USAGE, NULL, "refusing to write binary output to a terminal; redirect stdout or use -o FILE");
+			tool_die(EXIT_USAGE, "<stdout>", "refusing to write binary output to a terminal; redirect stdout or use -o FILE");
 		if (fwrite(data, 1, size, stdout) != size || fflush(stdout) != 0)
 			tool_die(EXIT_OUTPUT, "<stdout>", "write error: %s", strerror(errno));
 		return;
@@ -290,7 +358,7 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 	if (lstat(path, &st) != 0) {
 		if (errno != ENOENT)
 			tool_die(EXIT_OUTPUT, path, "%s", strerror(errno));
-		write_replace(path, path, 0, data, size); /* a new file */
+		write_replace(path, path, NULL, data, size); /* a new file */
 		return;
 	}
 	char *target = NULL;
@@ -303,12 +371,22 @@ void tool_write_output(const char *path, const void *data, size_t size, int bina
 		/* The link's target is replaced in its own directory. */
 		if (!(target = realpath(path, NULL)))
 			tool_die(EXIT_OUTPUT, path, "cannot resolve: %s", strerror(errno));
-		write_replace(path, target, 1, data, size);
+		write_replace(path, target, &st, data, size);
 	} else if (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode))
 		write_in_place(path, data, size, binary, S_ISSOCK(st.st_mode));
 	else
 		tool_die(EXIT_OUTPUT, path, "not a regular file, character device or FIFO");
 	free(target);
+}
+
+int tool_output_is_stdout(const char *path)
+{
+	struct stat st;
+	if (is_stdio(path))
+		return 1;
+	/* /dev/null on both mixes nothing anyone reads; a terminal is refused
+	 * binary output anyway. */
+	return stat(path, &st) == 0 && !S_ISCHR(st.st_mode) && same_file(&st, STDOUT_FILENO);
 }
 
 int tool_ends_with(const char *s, const char *suffix)
@@ -352,10 +430,27 @@ double tool_parse_double(const char *option, const char *value, double lo, doubl
 
 int tool_parse_int(const char *option, const char *value, int lo, int hi)
 {
-	double v = tool_parse_double(option, value, lo, hi);
-	if (v != (int)v)
+	double v = tool_parse_double(option, value, -HUGE_VAL, HUGE_VAL);
+	if (v != floor(v)) /* before the range: 16.5 is not a whole number, whatever the range */
 		tool_usage_error("%s: '%s' is not a whole number", option, value);
+	if (v < lo || v > hi)
+		tool_usage_error("%s: %s is out of range [%d, %d]", option, value, lo, hi);
 	return (int)v;
+}
+
+double tool_parse_percent(const char *option, const char *value, double lo, double hi)
+{
+	size_t len = strlen(value);
+	if (len == 0 || value[len - 1] != '%')
+		return tool_parse_double(option, value, lo, hi);
+	char *copy = malloc(len);
+	if (!copy)
+		tool_die(EXIT_USAGE, NULL, "out of memory");
+	memcpy(copy, value, len - 1);
+	copy[len - 1] = '\0';
+	double v = tool_parse_double(option, copy, lo, hi);
+	free(copy);
+	return v;
 }
 
 const char *tool_input_stem(const char *path, const char *fallback, char *buf, size_t size)
@@ -372,10 +467,7 @@ const char *tool_input_stem(const char *path, const char *fallback, char *buf, s
 
 int tool_parse_threads(const char *value)
 {
-	double v = tool_parse_double("--threads", value, 1, MLOD_MAX_THREADS);
-	if (v != (int)v)
-		tool_usage_error("--threads: '%s' is not a whole number", value);
-	return (int)v;
+	return tool_parse_int("--threads", value, 1, MLOD_MAX_THREADS);
 }
 
 /* The one escaper of a name from the input or the pack (the
@@ -468,12 +560,19 @@ int tool_parse_list(const char *option, const char *value, double *out, int max,
 int tool_parse_list_percent(const char *option, const char *value, double *out, int *percent, int max, double lo,
                             double hi)
 {
+	if (!*value)
+		tool_usage_error("%s: empty list", option);
 	int n = 0;
 	char *copy = malloc(strlen(value) + 1);
 	if (!copy)
 		tool_die(EXIT_USAGE, NULL, "out of memory");
 	strcpy(copy, value);
-	for (char *tok = strtok(copy, ","); tok; tok = strtok(NULL, ",")) {
+	for (char *tok = copy, *next; tok; tok = next) {
+		next = strchr(tok, ',');
+		if (next)
+			*next++ = '\0';
+		if (!*tok) /* "0.5,,0.25", "0.5,", ",0.5": strtok skipped these */
+			tool_usage_error("%s: empty item in '%s'", option, value);
 		if (n == max)
 			tool_usage_error("%s: at most %d values", option, max);
 		size_t len = strlen(tok);
@@ -484,7 +583,23 @@ int tool_parse_list_percent(const char *option, const char *value, double *out, 
 		out[n++] = tool_parse_double(option, tok, lo, hi);
 	}
 	free(copy);
-	if (n == 0)
-		tool_usage_error("%s: empty list", option);
 	return n;
+}
+
+int tool_drop_repeats(const char *option, double *v, int *percent, int n)
+{
+	int m = 0;
+	for (int i = 0; i < n; i++) {
+		int seen = 0;
+		for (int j = 0; j < m && !seen; j++)
+			seen = v[j] == v[i] && (!percent || percent[j] == percent[i]);
+		if (seen) {
+			tool_note(NULL, "%s: %g%s repeated: one level", option, v[i], percent && percent[i] ? "%" : "");
+			continue;
+		}
+		if (percent)
+			percent[m] = percent[i];
+		v[m++] = v[i];
+	}
+	return m;
 }

@@ -25,11 +25,20 @@ enum {
 /* The tool's name for messages ("mlod-label"). Set once in main. */
 extern const char *tool_name;
 
-/* Prints "tool: what: message" to stderr and exits with code. what may be
- * NULL (then "tool: message"). */
+/* Prints "tool: what: message" to stderr and exits with code. what (a
+ * file's name) is escaped as tool_put_name does; it may be NULL (then
+ * "tool: message"). */
 void tool_die(int code, const char *what, const char *fmt, ...)
 #if defined(__GNUC__)
 	__attribute__((format(printf, 3, 4), noreturn))
+#endif
+	;
+
+/* Prints "tool: what: message" to stderr (what, an input's name, escaped
+ * as tool_put_name does; NULL: "tool: message") and goes on. */
+void tool_note(const char *what, const char *fmt, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 2, 3)))
 #endif
 	;
 
@@ -37,6 +46,15 @@ void tool_die(int code, const char *what, const char *fmt, ...)
 void tool_usage_error(const char *fmt, ...)
 #if defined(__GNUC__)
 	__attribute__((format(printf, 1, 2), noreturn))
+#endif
+	;
+
+/* After getopt_long (opterr 0, shortopts starting with ':') returned ch,
+ * ':' or '?': prints which option was wrong ("unknown option '-k'",
+ * "option '--output' needs a value") and exits 1. */
+void tool_option_error(int ch, const char *shortopts, char *const *argv)
+#if defined(__GNUC__)
+	__attribute__((noreturn))
 #endif
 	;
 
@@ -67,10 +85,16 @@ void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_
  * a terminal (stdout or path) is refused (exit 1). Exits 4 on failure. */
 void tool_write_output(const char *path, const void *data, size_t size, int binary);
 
+/* Whether output goes to standard output: NULL, "-", or a path naming the
+ * file open on it (/dev/stdout, /dev/fd/1, the file stdout was redirected
+ * to; not a character device such as /dev/null). */
+int tool_output_is_stdout(const char *path);
+
 /* The end of every tool's --help: how -o writes (tool_write_output). */
 #define TOOL_OUTPUT_NOTE \
-	"-o replaces a regular file atomically (through a temporary file; a\n" \
-	"symbolic link is kept and the file it names replaced); a character\n" \
+	"-o replaces a regular file atomically (through a temporary file, its\n" \
+	"mode, owner and group kept, hard links not; a symbolic link is kept\n" \
+	"and the file it names replaced); a character\n" \
 	"device, FIFO or Unix socket is written in place (binary output to a\n" \
 	"terminal refused); /dev/stdout goes through standard output.\n"
 
@@ -117,16 +141,25 @@ enum tool_report tool_parse_report(const char *format);
 int tool_ends_with(const char *s, const char *suffix);
 
 /* Parses a comma-separated list of at most max numbers within [lo, hi]
- * into out; exits 1 naming the option when it is empty, too long or holds
- * something else. Returns the count. */
+ * into out; exits 1 naming the option when it or an item is empty, it is
+ * too long or holds something else. Returns the count. */
 int tool_parse_list(const char *option, const char *value, double *out, int max, double lo, double hi);
 /* The same, where a value may end in '%': percent[i] says whether value i did. */
 int tool_parse_list_percent(const char *option, const char *value, double *out, int *percent, int max, double lo,
                             double hi);
 
+/* Drops each of v[0..n) equal to an earlier one (and of the same unit:
+ * percent[i], when percent is not NULL), which would make a second,
+ * identical level, with a note on stderr; returns the count left. */
+int tool_drop_repeats(const char *option, double *v, int *percent, int n);
+
 /* Parses a whole number within [lo, hi]; exits 1 naming the option
- * otherwise. */
+ * otherwise ("not a whole number" before "out of range"). */
 int tool_parse_int(const char *option, const char *value, int lo, int hi);
+
+/* tool_parse_double for a value documented in percent: a trailing '%'
+ * is allowed ("1%" is 1). */
+double tool_parse_percent(const char *option, const char *value, double lo, double hi);
 
 /* The file name of path without its directory and extension ("walk" for
  * "a/walk.bvh") in buf; fallback when path is NULL or "-". */

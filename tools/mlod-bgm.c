@@ -71,8 +71,10 @@ static const char usage_text[] =
 	"  -s, --split DIR          also write one glb per level into DIR (made if\n"
 	"                           missing, not its parents): DIR/NAME.lodK.glb, the\n"
 	"                           input with that level's meshes in place; NAME is\n"
-	"                           the input's, from stdin -o's, else stdin\n"
-	"  -j, --threads N          work on N threads (default: the processors online);\n"
+	"                           the input's, from stdin -o's (a regular file's),\n"
+	"                           else stdin\n"
+	"  -j, --threads N          work on N threads (default: the processors it may\n"
+	"                           run on, its CPU affinity);\n"
 	"                           the output is the same at any N\n"
 	"  -h, --help               show this help\n"
 	"  -V, --version            show the version\n"
@@ -128,9 +130,20 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	tool_write_gltf(output, doc);
 }
 
+/* Whether -o names a file whose name can stand for the input's: a
+ * regular file or a new one, not a device, FIFO or socket (-o /dev/null
+ * gave null.lod1.glb) nor standard output. */
+static int output_names_file(const char *output)
+{
+	struct stat st;
+	if (!output || strcmp(output, "-") == 0 || tool_output_is_stdout(output))
+		return 0;
+	return stat(output, &st) != 0 ? errno == ENOENT : S_ISREG(st.st_mode);
+}
+
 /* One glb per level in dir (made when missing, not its parents):
  * DIR/<name>.lod<k>.glb, name the input file's without its extension; from
- * stdin -o's, else "stdin". */
+ * stdin -o's (a regular or new file's), else "stdin". */
 static void write_split(struct job *job, const mlod_gltf *input, const char *dir, const char *input_path,
                         const char *output)
 {
@@ -142,7 +155,7 @@ static void write_split(struct job *job, const mlod_gltf *input, const char *dir
 		tool_die(EXIT_OUTPUT, dir, "not a directory");
 	}
 	const char *from = input_path && strcmp(input_path, "-") != 0 ? input_path
-	                   : output && strcmp(output, "-") != 0       ? output
+	                   : output_names_file(output)               ? output
 	                                                              : "stdin";
 	const char *base = strrchr(from, '/');
 	base = base ? base + 1 : from;
@@ -288,13 +301,14 @@ int main(int argc, char **argv)
 	memset(&job, 0, sizeof job);
 
 	tool_name = "mlod-bgm";
+	static const char shortopts[] = ":o:r::R:e:c:C:B:p:E:t:bFI:s:j:hV";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:c:C:B:p:E:t:bFI:s:j:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
 		case 'R': ratio_count = tool_parse_list("--ratios", optarg, ratios, MLOD_MESH_MAX_LEVELS, 1e-6, 1.0); break;
-		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
+		case 'e': max_error = tool_parse_percent("--max-error", optarg, 0.0, 100.0); break;
 		case 'c': opt.cost = (mlod_mesh_cost)(MLOD_COST_COMPACTNESS + parse_enum("--cost", optarg, costs, 2)); break;
 		case 'C': opt.op = (mlod_collapse_op)(MLOD_OP_TRIANGLE + parse_enum("--collapse", optarg, ops, 3)); break;
 		case 'B': budget = (mlod_mesh_budget)(MLOD_BUDGET_CHARACTER + parse_enum("--budget", optarg, budgets, 2)); break;
@@ -323,8 +337,7 @@ int main(int argc, char **argv)
 			return 0;
 		}
 		case 'V': tool_version();
-		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
-		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
 	if (argc - optind > 1)
@@ -362,7 +375,7 @@ int main(int argc, char **argv)
 		else if (report == REPORT_JSON)
 			report_json(&job);
 		else {
-			fprintf(stderr, "%s: %s: no triangle mesh; written unchanged\n", tool_name, job.input);
+			tool_note(job.input, "no triangle mesh; written unchanged");
 			tool_write_gltf(output, doc);
 		}
 	} else {
@@ -371,8 +384,8 @@ int main(int argc, char **argv)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
 		if (rec.mesh_level_count > 0 && report == REPORT_NONE && !split) {
 			/* Levels on top of levels would leave the old ones unused: pass it through. */
-			fprintf(stderr, "%s: %s: the input already has %d mesh level%s (MSFT_lod): written unchanged; run %s on "
-			        "the input without them to bake them again\n", tool_name, job.input, rec.mesh_level_count,
+			tool_note(job.input, "the input already has %d mesh level%s (MSFT_lod): written unchanged; run %s on "
+			        "the input without them to bake them again", rec.mesh_level_count,
 			        rec.mesh_level_count == 1 ? "" : "s", tool_name);
 			tool_write_gltf(output, doc);
 			mlod_record_free(&rec);
@@ -390,7 +403,7 @@ int main(int argc, char **argv)
 		if (r != MLOD_OK)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
 		if (max_error >= 0.0 && job.L.count == 0)
-			fprintf(stderr, "%s: %s: no mesh level within --max-error %g%%\n", tool_name, job.input, max_error);
+			tool_note(job.input, "no mesh level within --max-error %g%%", max_error);
 		follow_skeleton(&job, &rec, sk);
 		if (split) /* first: write_glb changes doc */
 			write_split(&job, doc, split, input_path, output);

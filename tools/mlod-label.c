@@ -96,13 +96,14 @@ static void report_table(const char *input, const mlod_character *c, const mlod_
 }
 
 static void report_json(const char *input, const mlod_character *c, const mlod_joint_info *info,
-                        const mlod_label_options *opt)
+                        const mlod_label_options *opt, double max_angle_degrees)
 {
 	const mlod_skeleton *s = &c->skeleton;
 	struct stats st = summarize(s, info);
 	printf("{\n  \"input\": ");
 	tool_json_string(stdout, input);
-	printf(",\n  \"hub_factor\": %.17g,\n  \"max_angle\": %.17g,\n", opt->hub_factor, opt->max_angle);
+	/* max_angle in degrees, as --max-angle took it (opt holds radians). */
+	printf(",\n  \"hub_factor\": %.17g,\n  \"max_angle\": %.17g,\n", opt->hub_factor, max_angle_degrees);
 	printf("  \"average_neighbors\": %.17g,\n  \"average_depth\": %.17g,\n", st.avg_neighbors, st.avg_depth);
 	printf("  \"clips\": %d,\n  \"notes\": ", c->clip_count);
 	tool_json_string(stdout, c->notes ? c->notes : "");
@@ -137,20 +138,24 @@ int main(int argc, char **argv)
 	const char *output = NULL;
 	enum tool_report report = REPORT_NONE;
 	mlod_label_options opt = {MLOD_LABEL_HUB_FACTOR_DEFAULT, MLOD_LABEL_MAX_ANGLE_DEFAULT * MLOD_PI / 180.0};
+	double max_angle_degrees = MLOD_LABEL_MAX_ANGLE_DEFAULT;
 	int ch;
 
 	tool_name = "mlod-label";
+	static const char shortopts[] = ":o:r::hV";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
 		case 'H': opt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
-		case 'A': opt.max_angle = tool_parse_double("--max-angle", optarg, 1e-3, 1e6) * MLOD_PI / 180.0; break;
+		case 'A':
+			max_angle_degrees = tool_parse_double("--max-angle", optarg, 1e-3, 1e6);
+			opt.max_angle = max_angle_degrees * MLOD_PI / 180.0;
+			break;
 		case 'h': printf(usage_text, MLOD_LABEL_HUB_FACTOR_DEFAULT, MLOD_LABEL_MAX_ANGLE_DEFAULT); return 0;
 		case 'V': tool_version();
-		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
-		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
 	if (argc - optind > 1)
@@ -165,7 +170,7 @@ int main(int argc, char **argv)
 
 	if (c.skeleton.joint_count == 0 && report == REPORT_NONE) {
 		/* A static prop: nothing to label; pass it through. */
-		fprintf(stderr, "%s: %s: no joints: nothing to label; written unchanged\n", tool_name, tool_input_label(input));
+		tool_note(tool_input_label(input), "no joints: nothing to label; written unchanged");
 		tool_write_gltf(output, doc);
 		mlod_character_free(&c);
 		mlod_gltf_free(doc);
@@ -182,7 +187,7 @@ int main(int argc, char **argv)
 	if (report == REPORT_TABLE) {
 		report_table(tool_input_label(input), &c, info, &opt);
 	} else if (report == REPORT_JSON) {
-		report_json(tool_input_label(input), &c, info, &opt);
+		report_json(tool_input_label(input), &c, info, &opt, max_angle_degrees);
 	} else {
 		if ((r = mlod_record_write_joints(doc, &c, info, &err)) != MLOD_OK)
 			tool_die(EXIT_OUTPUT, NULL, "%s", err.message);

@@ -62,7 +62,8 @@ static const char usage_text[] =
 	"                          default 2, the midpoints too)\n"
 	"  -l, --level K           with a .bvh output: the level to write (0 = as read)\n"
 	"  -c, --clip N            with a .bvh output: the clip to write (default 0)\n"
-	"  -j, --threads N         work on N threads (default: the processors online);\n"
+	"  -j, --threads N         work on N threads (default: the processors it may\n"
+	"                          run on, its CPU affinity);\n"
 	"                          the output is the same at any N\n"
 	"  -h, --help              show this help\n"
 	"  -V, --version           show the version\n"
@@ -101,6 +102,8 @@ static int parse_list(const char *option, const char *value, struct spec *out, m
 	int pct[MAX_LEVELS] = {0};
 	int n = target == MLOD_MOTION_MAX_ERROR ? tool_parse_list_percent(option, value, v, pct, MAX_LEVELS, lo, hi)
 	                                        : tool_parse_list(option, value, v, MAX_LEVELS, lo, hi);
+	/* An equal value (in the same unit) would bake the same level twice. */
+	n = tool_drop_repeats(option, v, pct, n);
 	for (int i = 0; i < n; i++) {
 		out[i].target = target;
 		out[i].percent = target == MLOD_MOTION_MAX_ERROR && pct[i];
@@ -154,7 +157,7 @@ static void bake(const struct job *job, const int *clips, int clip_count, mlod_m
 	mlod_error err = {0};
 	mlod_result r = mlod_motion_bake_run(&job->c, job->doc, clips, clip_count, &o, out, &err);
 	for (int i = 0; i < out->note_count; i++)
-		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, out->notes[i]);
+		tool_note(job->input, "%s", out->notes[i]);
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), job->input, "%s", err.message);
 }
@@ -198,7 +201,7 @@ static void write_bvh(const struct job *job, const mlod_motion_bake *b, const ch
 	if (mlod_skel_bvh_end_sites(&job->c, clip, &max, &joint, note, sizeof note, &err) != MLOD_OK)
 		tool_die(tool_exit_code(err.code), job->input, "%s", err.message);
 	if (note[0])
-		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, note);
+		tool_note(job->input, "%s", note);
 }
 
 int main(int argc, char **argv)
@@ -233,8 +236,9 @@ int main(int argc, char **argv)
 	job.threads = mlod_thread_count();
 
 	tool_name = "mlod-motion";
+	static const char shortopts[] = ":o:r::m:e:t:k:l:c:j:hV";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::m:e:t:k:l:c:j:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
@@ -285,22 +289,15 @@ int main(int argc, char **argv)
 		case 'S':
 			job.opt.precision_share = tool_parse_double("--precision-share", optarg, 0.0, 1.0);
 			if (!(job.opt.precision_share > 0.0 && job.opt.precision_share < 1.0))
-				tool_usage_error("--precision-share: %s is not between 0 and 1", optarg);
+				tool_usage_error("--precision-share: %s is out of range (0, 1): above 0 and below 1", optarg);
 			break;
-		case 'D': {
-			double v = tool_parse_double("--subdivide", optarg, 1, MLOD_MAX_SUBDIVIDE);
-			if (v != floor(v))
-				tool_usage_error("--subdivide: %s is not a whole number", optarg);
-			job.opt.subdivide = (int)v;
-			break;
-		}
-		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MAX_LEVELS); break;
-		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6), clip_given = 1; break;
+		case 'D': job.opt.subdivide = tool_parse_int("--subdivide", optarg, 1, MLOD_MAX_SUBDIVIDE); break;
+		case 'l': level = tool_parse_int("--level", optarg, 0, MAX_LEVELS); break;
+		case 'c': clip = tool_parse_int("--clip", optarg, 0, 1000000), clip_given = 1; break;
 		case 'j': job.threads = tool_parse_threads(optarg); break;
 		case 'h': fputs(usage_text, stdout); return 0;
 		case 'V': tool_version();
-		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
-		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
 	if (argc - optind > 1)
@@ -336,7 +333,7 @@ int main(int argc, char **argv)
 		if (bvh_out)
 			tool_die(EXIT_INPUT, job.input, "%s: no clip to write as BVH", why);
 		if (report == REPORT_NONE) {
-			fprintf(stderr, "%s: %s: %s: nothing to reduce; written unchanged\n", tool_name, job.input, why);
+			tool_note(job.input, "%s: nothing to reduce; written unchanged", why);
 			tool_write_gltf(output, doc);
 			mlod_character_free(&job.c);
 			mlod_gltf_free(doc);
@@ -352,8 +349,8 @@ int main(int argc, char **argv)
 	}
 	if (existing > 0) {
 		/* Levels of levels would be baked from the old levels too: pass it through. */
-		fprintf(stderr, "%s: %s: the input already has %d motion level%s (<clip>@lod<k>): written unchanged; run %s "
-		        "on the input without them to bake them again\n", tool_name, job.input, existing,
+		tool_note(job.input, "the input already has %d motion level%s (<clip>@lod<k>): written unchanged; run %s "
+		        "on the input without them to bake them again", existing,
 		        existing == 1 ? "" : "s", tool_name);
 		tool_write_gltf(output, doc);
 		mlod_character_free(&job.c);
@@ -391,9 +388,7 @@ int main(int argc, char **argv)
 	for (int k = 0; k < b.clip_count && report == REPORT_NONE; k++) {
 		char note[256];
 		if (mlod_motion_bake_timeline_note(&b, k, note, sizeof note)) {
-			fprintf(stderr, "%s: %s: clip ", tool_name, job.input);
-			tool_json_string(stderr, job.c.clips[b.clips[k].index].name);
-			fprintf(stderr, ": %s\n", note);
+			tool_note(job.input, "clip %s: %s", MLOD_QUOTED(job.c.clips[b.clips[k].index].name), note);
 		}
 	}
 

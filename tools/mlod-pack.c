@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "common.h"
 
@@ -25,9 +26,9 @@ static const char usage_text[] =
 	"\n"
 	"options:\n"
 	"  -o, --output FILE          write to FILE instead of stdout\n"
-	"  -r, --report[=FORMAT]      print what was packed (to stdout: with -o as\n"
-	"                             well as the pack, else instead of it); FORMAT\n"
-	"                             is table or json\n"
+	"  -r, --report[=FORMAT]      print what was packed (to stdout: with -o FILE\n"
+	"                             as well as the pack, else instead of it; not\n"
+	"                             with -o naming stdout); FORMAT is table or json\n"
 	"      --codec NAME           meshopt (default), none, or draco (MESH levels as\n"
 	"                             standalone Draco meshes: larger packs, slower\n"
 	"                             to decode; mlod(5))\n"
@@ -82,7 +83,8 @@ static const char usage_more[] = /* printf's format ends above (ISO C's 4095-cha
 	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels,\n"
 	"                             skeleton-level skins, <clip>@lod<k> animations\n"
 	"  -j, --threads N            compute mesh levels on N threads (default: the\n"
-	"                             processors online); the same pack at any N\n"
+	"                             processors it may run on, its CPU affinity);\n"
+	"                             the same pack at any N\n"
 	"  -h, --help                 show this help\n"
 	"  -V, --version              show the version\n"
 	"\n"
@@ -95,6 +97,7 @@ static int parse_bounds(const char *value, mlod_pack_options *opt)
 	int pct[MLOD_PACK_MAX_MOTION_LEVELS];
 	int n = tool_parse_list_percent("--motion-max-error", value, opt->motion_bounds, pct, MLOD_PACK_MAX_MOTION_LEVELS,
 	                                1e-12, 1e12);
+	n = tool_drop_repeats("--motion-max-error", opt->motion_bounds, pct, n); /* the same level twice */
 	for (int i = 0; i < n; i++)
 		if ((opt->motion_percent[i] = (unsigned char)pct[i]) && opt->motion_bounds[i] > 100.0)
 			tool_usage_error("--motion-max-error: %g%% is out of range [1e-12, 100]", opt->motion_bounds[i]);
@@ -189,11 +192,19 @@ static const char *codec_column(const mlod_pack_chunk *c, char *buf, size_t n)
 	return buf;
 }
 
+/* Reads the pack of --info or -x (a file, or stdin when path is "-"). */
+static void *read_pack(const char *path, size_t *size)
+{
+	if (strcmp(path, "-") == 0 && isatty(STDIN_FILENO))
+		tool_usage_error("no input: give a pack, or pipe one into stdin");
+	return tool_read_input(path, size);
+}
+
 static int pack_info(const char *path, enum tool_report report)
 {
 	const char *label = tool_input_label(path);
 	size_t size = 0;
-	void *data = tool_read_input(path, &size);
+	void *data = read_pack(path, &size);
 	mlod_pack p;
 	mlod_pack_info info;
 	mlod_error err = {0};
@@ -289,7 +300,7 @@ static int pack_extract(const char *path, const char *output)
 {
 	const char *label = tool_input_label(path);
 	size_t size = 0;
-	void *data = tool_read_input(path, &size);
+	void *data = read_pack(path, &size);
 	mlod_gltf *doc = NULL;
 	mlod_error err = {0};
 	mlod_result r = mlod_pack_unpack(data, size, &doc, &err);
@@ -340,14 +351,21 @@ int main(int argc, char **argv)
 	const char *output = NULL, *name = NULL, *info = NULL, *extract = NULL, *codec = "meshopt";
 	enum tool_report report = REPORT_NONE;
 	int ratios_given = 0, json = 0, level0_given = 0, ch;
+	/* The first option given that bakes (not for --info or -x), and the
+	 * first of each layer's computed levels. */
+	const char *bake = NULL, *skel_opt = NULL, *mesh_opt = NULL, *motion_opt = NULL;
+#define BAKE(name) (bake = bake ? bake : (name))
+#define LAYER(var, name) (BAKE(name), var = var ? var : (name))
 
 	tool_name = "mlod-pack";
+	static const char shortopts[] = ":o:r::R:e:p:x:j:hV";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::R:e:p:x:j:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
 		case OPT_CODEC:
+			BAKE("--codec");
 			if (strcmp(optarg, "meshopt") == 0)
 				opt.codec = MLOD_CODEC_MESHOPT;
 			else if (strcmp(optarg, "none") == 0)
@@ -359,6 +377,7 @@ int main(int argc, char **argv)
 			codec = optarg;
 			break;
 		case OPT_ENTROPY:
+			BAKE("--entropy");
 			if (strcmp(optarg, "zstd") == 0)
 				opt.entropy = MLOD_ENTROPY_ZSTD;
 			else if (strcmp(optarg, "none") == 0)
@@ -366,34 +385,46 @@ int main(int argc, char **argv)
 			else
 				tool_usage_error("--entropy: unknown value '%s' (zstd or none)", optarg);
 			break;
-		case OPT_NAME: name = optarg; break;
+		case OPT_NAME: name = optarg, BAKE("--name"); break;
 		case 'R':
+			LAYER(mesh_opt, "--ratios");
 			opt.ratio_count = tool_parse_list("--ratios", optarg, opt.ratios, MLOD_MESH_MAX_LEVELS, 1e-6, 1.0);
 			ratios_given = 1;
 			break;
-		case 'e': opt.mesh_max_error = tool_parse_double("--max-error", optarg, 0.0, 100.0); break;
+		case 'e':
+			LAYER(mesh_opt, "--max-error");
+			opt.mesh_max_error = tool_parse_percent("--max-error", optarg, 0.0, 100.0);
+			break;
 		case 'p':
+			LAYER(mesh_opt, "--placement");
 			if (mlod_mesh_placement_parse(optarg, &opt.bgm.placement, &opt.bgm.hybrid_error))
 				tool_usage_error("--placement: unknown value '%s' (optimal, barycenter, vertex or hybrid[=PCT])",
 				                 optarg);
 			break;
 		case OPT_INFLUENCE:
+			LAYER(mesh_opt, "--influence-budget");
 			opt.bgm.influence_budget = tool_parse_double("--influence-budget", optarg, 0.0, 1e3);
 			opt.bgm.influence_budget = opt.bgm.influence_budget > 0.0 ? opt.bgm.influence_budget : -1.0;
 			break;
-		case OPT_SKEL_ERR: opt.skel_max_error = tool_parse_double("--skeleton-max-error", optarg, 0.0, 1e6); break;
-		case OPT_MOTION_ERR: opt.motion_bound_count = parse_bounds(optarg, &opt); break;
-		case OPT_POS_BITS: opt.position_bits = tool_parse_int("--position-bits", optarg, MLOD_PACK_POSITION_BITS_MIN, 16); break;
-		case OPT_NRM_BITS: opt.normal_bits = tool_parse_int("--normal-bits", optarg, MLOD_PACK_NORMAL_BITS_MIN, 16); break;
-		case OPT_UV_BITS: opt.uv_bits = tool_parse_int("--uv-bits", optarg, MLOD_PACK_UV_BITS_MIN, 16); break;
-		case OPT_NO_SKEL: opt.no_skeleton_levels = 1; break;
-		case OPT_NO_MESH: opt.no_mesh_levels = 1; break;
-		case OPT_NO_MOTION: opt.no_motion_levels = 1; break;
-		case OPT_LEVEL0_ERR: parse_level0(optarg, &opt), level0_given = 1; break;
-		case OPT_LOSSLESS_MOTION: opt.lossless_motion = 1; break;
+		case OPT_SKEL_ERR:
+			LAYER(skel_opt, "--skeleton-max-error");
+			opt.skel_max_error = tool_parse_percent("--skeleton-max-error", optarg, 0.0, 1e6);
+			break;
+		case OPT_MOTION_ERR:
+			LAYER(motion_opt, "--motion-max-error");
+			opt.motion_bound_count = parse_bounds(optarg, &opt);
+			break;
+		case OPT_POS_BITS: BAKE("--position-bits"), opt.position_bits = tool_parse_int("--position-bits", optarg, MLOD_PACK_POSITION_BITS_MIN, 16); break;
+		case OPT_NRM_BITS: BAKE("--normal-bits"), opt.normal_bits = tool_parse_int("--normal-bits", optarg, MLOD_PACK_NORMAL_BITS_MIN, 16); break;
+		case OPT_UV_BITS: BAKE("--uv-bits"), opt.uv_bits = tool_parse_int("--uv-bits", optarg, MLOD_PACK_UV_BITS_MIN, 16); break;
+		case OPT_NO_SKEL: opt.no_skeleton_levels = 1, BAKE("--no-skeleton-levels"); break;
+		case OPT_NO_MESH: opt.no_mesh_levels = 1, BAKE("--no-mesh-levels"); break;
+		case OPT_NO_MOTION: opt.no_motion_levels = 1, BAKE("--no-motion-levels"); break;
+		case OPT_LEVEL0_ERR: parse_level0(optarg, &opt), level0_given = 1, BAKE("--motion-level0-error"); break;
+		case OPT_LOSSLESS_MOTION: opt.lossless_motion = 1, BAKE("--lossless-motion"); break;
 		case OPT_INFO: info = optarg; break;
 		case 'x': extract = optarg; break;
-		case 'j': opt.bgm.threads = tool_parse_threads(optarg); break;
+		case 'j': opt.bgm.threads = tool_parse_threads(optarg), BAKE("--threads"); break;
 		case OPT_JSON: json = 1; break;
 		case 'h': {
 			static const double defaults[] = {MLOD_MESH_RATIOS_DEFAULT};
@@ -406,8 +437,7 @@ int main(int argc, char **argv)
 			return 0;
 		}
 		case 'V': tool_version();
-		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
-		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
 	if (argc - optind > 1)
@@ -420,6 +450,14 @@ int main(int argc, char **argv)
 		tool_usage_error("--lossless-motion and --motion-level0-error do not go together");
 	if (info && extract)
 		tool_usage_error("--info and -x do not go together");
+	if ((info || extract) && bake)
+		tool_usage_error("%s bakes a pack: not with %s, which reads one", bake, info ? "--info" : "-x");
+	if (opt.no_skeleton_levels && skel_opt)
+		tool_usage_error("%s and --no-skeleton-levels do not go together", skel_opt);
+	if (opt.no_mesh_levels && mesh_opt)
+		tool_usage_error("%s and --no-mesh-levels do not go together", mesh_opt);
+	if (opt.no_motion_levels && motion_opt)
+		tool_usage_error("%s and --no-motion-levels do not go together", motion_opt);
 	if (info && output)
 		tool_usage_error("--info prints to stdout, -o does not go with it (redirect stdout)");
 	if (json && !info)
@@ -433,6 +471,9 @@ int main(int argc, char **argv)
 			tool_usage_error("-x and --report do not go together");
 		return pack_extract(extract, output);
 	}
+	if (report != REPORT_NONE && output && tool_output_is_stdout(output))
+		tool_usage_error("--report prints to stdout, and -o names stdout too: the pack and the report would "
+		                 "share one stream (write the pack to a file, or drop -o for the report alone)");
 	const char *path = optind < argc ? argv[optind] : NULL;
 	const char *label = tool_input_label(path);
 	char namebuf[256];
@@ -454,15 +495,22 @@ int main(int argc, char **argv)
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), label, "%s", err.message);
 	if (c.clip_count == 0 && c.skeleton.joint_count > 0)
-		fprintf(stderr, "%s: %s: no animation: the pack has no motion levels\n", tool_name, label);
+		tool_note(label, "no animation: the pack has no motion levels");
 	for (const char *w = st.warnings; *w;) { /* what the pack does not keep, or keeps changed */
 		size_t n = strcspn(w, "\n");
-		fprintf(stderr, "%s: %s: %.*s\n", tool_name, label, (int)n, w);
+		tool_note(label, "%.*s", (int)n, w);
 		w += n + (w[n] == '\n');
 	}
+	/* A layer option the input's own levels (mlod-skelgraph's, mlod-bgm's,
+	 * mlod-motion's) leave unused. */
+	const char *const layer_opt[3] = {skel_opt, mesh_opt, motion_opt};
+	const mlod_pack_layer_stats *const layer_st[3] = {&st.skeleton, &st.mesh, &st.motion};
+	static const char *const layer_name[3] = {"skeleton", "mesh", "motion"};
+	for (int i = 0; i < 3; i++)
+		if (layer_opt[i] && layer_st[i]->from_input)
+			tool_note(label, "%s not used: the input has its own %s levels", layer_opt[i], layer_name[i]);
 	if (st.doc_note[0]) { /* the pack is far larger than a stripped one: said, with or without --report */
-		fprintf(stderr, "%s: %s: ", tool_name, label);
-		tool_put_line(stderr, "", st.doc_note);
+		tool_note(label, "%s", mlod_name_text(st.doc_note, 0, (char[4 * sizeof st.doc_note]){0}, 4 * sizeof st.doc_note));
 	}
 	if (output || report == REPORT_NONE)
 		tool_write_output(output, pack, pack_size, 1);

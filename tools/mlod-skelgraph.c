@@ -54,6 +54,7 @@ struct job {
 	mlod_joint_info *info;
 	int labels_from_extras;
 	mlod_skel_levels L;
+	char notes[256]; /* what was said on stderr of the levels, for the reports */
 };
 
 static void removed_names(FILE *f, const struct job *job, const mlod_skel_built *lv, int json)
@@ -108,6 +109,8 @@ static void report_table(const struct job *job)
 	}
 	printf("# vtx: skinned-vertex deviation over the clips, %% of the bounding diagonal;"
 	       " jnt: removed joints following their stand-ins, %% of the height\n");
+	if (job->notes[0])
+		tool_put_line(stdout, "# note: ", job->notes);
 	if (job->c.notes && *job->c.notes)
 		tool_put_line(stdout, "# note: ", job->c.notes);
 }
@@ -133,7 +136,17 @@ static void report_json(const struct job *job)
 		printf("     \"shear_samples\": %d, \"weight_merges\": %d}%s\n", lv->stats.shear_samples,
 		       lv->stats.weight_merges, k + 1 < job->L.count ? "," : "");
 	}
-	printf("  ]\n}\n");
+	/* The level note and the input's notes, as one string (as the other
+	 * tools' "notes"). */
+	const char *in = job->c.notes ? job->c.notes : "";
+	char *notes = malloc(strlen(job->notes) + strlen(in) + 3);
+	if (!notes)
+		tool_die(EXIT_OUTPUT, NULL, "out of memory");
+	sprintf(notes, "%s%s%s", job->notes, job->notes[0] && in[0] ? "; " : "", in);
+	printf("  ],\n  \"notes\": ");
+	tool_json_string(stdout, notes);
+	printf("\n}\n");
+	free(notes);
 }
 
 static void write_bvh(const struct job *job, const char *output, int level, int clip)
@@ -156,7 +169,7 @@ static void write_bvh(const struct job *job, const char *output, int level, int 
 	if (mlod_skel_bvh_end_sites(c, clip, &max, &joint, note, sizeof note, &err) != MLOD_OK)
 		tool_die(tool_exit_code(err.code), job->input, "%s", err.message);
 	if (note[0])
-		fprintf(stderr, "%s: %s: %s\n", tool_name, job->input, note);
+		tool_note(job->input, "%s", note);
 }
 
 /* Adds the levels and their record to the document and writes it. */
@@ -173,8 +186,8 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	mlod_record_free(&stage);
 	if (skel_levels > 0) {
 		/* Levels on top of levels would leave the old ones unused: pass it through. */
-		fprintf(stderr, "%s: %s: the input already has %d skeleton level%s: written unchanged; run %s on the input "
-		        "without them to bake them again\n", tool_name, job->input, skel_levels, skel_levels == 1 ? "" : "s",
+		tool_note(job->input, "the input already has %d skeleton level%s: written unchanged; run %s on the input "
+		        "without them to bake them again", skel_levels, skel_levels == 1 ? "" : "s",
 		        tool_name);
 		tool_write_gltf(output, doc);
 		return;
@@ -189,10 +202,8 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	mlod_skel_levels_records(&job->L, records);
 	/* Mesh levels already in MSFT_lod (mlod-bgm ran first) stay there. */
 	if (mesh_levels > 0 && n > 0)
-		fprintf(stderr,
-		        "%s: %s: the input's %d mesh level(s) stay in MSFT_lod, weighted on the full skeleton; "
-		        "run mlod-skelgraph before mlod-bgm for mesh levels on the skeleton levels\n",
-		        tool_name, job->input, mesh_levels);
+		tool_note(job->input, "the input's %d mesh level(s) stay in MSFT_lod, weighted on the full skeleton; "
+		          "run mlod-skelgraph before mlod-bgm for mesh levels on the skeleton levels", mesh_levels);
 	if ((r = mlod_gltf_add_skel_levels(doc, &job->c, records, n, skins, mesh_levels == 0, &err)) != MLOD_OK ||
 	    (r = mlod_record_skel_levels_make(&job->c, records, n, skins, rec, &err)) != MLOD_OK)
 		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_INPUT, job->input, "%s", err.message);
@@ -224,33 +235,46 @@ int main(int argc, char **argv)
 	const char *output = NULL;
 	enum tool_report report = REPORT_NONE;
 	double thresholds[MLOD_SKEL_MAX_LEVELS], fractions[MLOD_SKEL_MAX_LEVELS];
-	int threshold_count = 0, fraction_count = 0, level = -1, clip = 0, clip_given = 0;
+	int threshold_count = -1, fraction_count = -1, level = -1, clip = 0, clip_given = 0;
 	double max_error = MLOD_SKEL_MAX_ERROR_DEFAULT;
 	mlod_label_options lopt = {0};
 	int ch;
 
 	tool_name = "mlod-skelgraph";
+	static const char shortopts[] = ":o:r::t:j:e:l:c:hV";
 	opterr = 0;
-	while ((ch = getopt_long(argc, argv, ":o:r::t:j:e:l:c:hV", longopts, NULL)) != -1) {
+	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
 		case 't': threshold_count = tool_parse_list("--thresholds", optarg, thresholds, MLOD_SKEL_MAX_LEVELS, 0.0, 1e9); break;
 		case 'j': fraction_count = tool_parse_list("--joints", optarg, fractions, MLOD_SKEL_MAX_LEVELS, 0.0, 1.0); break;
-		case 'e': max_error = tool_parse_double("--max-error", optarg, 0.0, 1e6); break;
-		case 'l': level = (int)tool_parse_double("--level", optarg, 0, MLOD_SKEL_MAX_LEVELS); break;
-		case 'c': clip = (int)tool_parse_double("--clip", optarg, 0, 1e6), clip_given = 1; break;
+		case 'e': max_error = tool_parse_percent("--max-error", optarg, 0.0, 1e6); break;
+		case 'l': level = tool_parse_int("--level", optarg, 0, MLOD_SKEL_MAX_LEVELS); break;
+		case 'c': clip = tool_parse_int("--clip", optarg, 0, 1000000), clip_given = 1; break;
 		case 'H': lopt.hub_factor = tool_parse_double("--hub-factor", optarg, 1e-6, 1e6); break;
 		case 'h': printf(usage_text, MLOD_SKEL_MAX_ERROR_DEFAULT); return 0;
 		case 'V': tool_version();
-		case ':': tool_usage_error("option '%s' needs a value", argv[optind - 1]);
-		default: tool_usage_error("unknown option '%s'", argv[optind - 1]);
+		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
 	if (argc - optind > 1)
 		tool_usage_error("too many inputs: one file, or stdin");
-	if (threshold_count && fraction_count)
+	if (threshold_count >= 0 && fraction_count >= 0)
 		tool_usage_error("--thresholds and --joints do not go together");
+	/* An equal value would bake the same level twice; --joints 1 a level
+	 * that removes no joint (packed with switch distance 0). */
+	if (threshold_count > 0)
+		threshold_count = tool_drop_repeats("--thresholds", thresholds, NULL, threshold_count);
+	if (fraction_count > 0) {
+		int n = 0;
+		for (int i = 0; i < fraction_count; i++)
+			if (fractions[i] < 1.0)
+				fractions[n++] = fractions[i];
+			else
+				tool_note(NULL, "--joints: 1 keeps every joint: no level");
+		fraction_count = tool_drop_repeats("--joints", fractions, NULL, n);
+	}
 	int bvh_out = output && tool_ends_with(output, ".bvh");
 	if (level >= 0 && !bvh_out)
 		tool_usage_error("--level needs a .bvh output (-o out.bvh)");
@@ -266,7 +290,7 @@ int main(int argc, char **argv)
 	tool_load(optind < argc ? argv[optind] : NULL, &doc, &job.c, NULL);
 	if (job.c.skeleton.joint_count == 0 && report == REPORT_NONE && !bvh_out) {
 		/* A static prop: no skeleton to reduce; pass it through. */
-		fprintf(stderr, "%s: %s: no joints: no skeleton levels; written unchanged\n", tool_name, job.input);
+		tool_note(job.input, "no joints: no skeleton levels; written unchanged");
 		tool_write_gltf(output, doc);
 		mlod_character_free(&job.c);
 		mlod_gltf_free(doc);
@@ -283,20 +307,21 @@ int main(int argc, char **argv)
 	if ((r = mlod_skel_levels_init(&job.L, &job.c, job.info, &err)) != MLOD_OK)
 		tool_die(tool_exit_code(r), job.input, "%s", err.message);
 
-	if (threshold_count)
+	if (threshold_count >= 0)
 		r = mlod_skel_levels_thresholds(&job.L, thresholds, threshold_count, &err);
-	else if (fraction_count)
+	else if (fraction_count >= 0)
 		r = mlod_skel_levels_fractions(&job.L, fractions, fraction_count, &err);
 	else
 		r = mlod_skel_levels_default(&job.L, max_error, &err);
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), job.input, "%s", err.message);
-	if (!threshold_count && !fraction_count && job.L.count == 0 && job.L.minor_count > 0) {
+	if (threshold_count < 0 && fraction_count < 0 && job.L.count == 0 && job.L.minor_count > 0) {
 		mlod_skel_built first;
 		if ((r = mlod_skel_levels_make(&job.L, -1.0, 1, &first, &err)) != MLOD_OK)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
-		fprintf(stderr, "%s: %s: no skeleton level within --max-error %g%%: removing %s alone costs %.3g%%\n",
-		        tool_name, job.input, max_error, job.c.skeleton.joints[job.L.order[0]].name, first.bound_error);
+		snprintf(job.notes, sizeof job.notes, "no skeleton level within --max-error %g%%: removing %s alone costs %.3g%%",
+		         max_error, MLOD_QUOTED(job.c.skeleton.joints[job.L.order[0]].name), first.bound_error);
+		tool_note(job.input, "%s", job.notes);
 		mlod_skel_built_free(&first);
 	}
 

@@ -96,7 +96,8 @@ const char *mlod_name_text(const char *name, int quote, char *buf, size_t size);
 
 #define MLOD_MAX_THREADS 64
 
-/* The number of processors online (1 when unknown), at most
+/* The number of processors this process may run on (its CPU affinity
+ * where the system tells it, else those online; 1 when unknown), at most
  * MLOD_MAX_THREADS: the tools' default for -j. */
 int mlod_thread_count(void);
 

@@ -8,6 +8,10 @@
  * order decides the result, as it would in a plain loop.
  */
 #define _POSIX_C_SOURCE 200809L
+#if defined(__linux__)
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT */
+#include <sched.h>
+#endif
 
 #include <pthread.h>
 #include <stdlib.h>
@@ -45,9 +49,19 @@ static void *worker(void *arg)
 	}
 }
 
+/* The processors this process may run on (taskset, cgroup cpusets: its
+ * CPU affinity, where the system tells it), else those online. */
 int mlod_thread_count(void)
 {
 	long n = sysconf(_SC_NPROCESSORS_ONLN);
+#if defined(__linux__) && defined(CPU_COUNT)
+	cpu_set_t set;
+	if (sched_getaffinity(0, sizeof set, &set) == 0) {
+		int a = CPU_COUNT(&set);
+		if (a >= 1 && (n < 1 || a < n))
+			n = a;
+	}
+#endif
 	return n < 1 ? 1 : n > MLOD_MAX_THREADS ? MLOD_MAX_THREADS : (int)n;
 }
 
