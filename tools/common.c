@@ -142,13 +142,13 @@ static void put_warnings(const char *path, const mlod_character *c)
 	}
 }
 
-void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format)
+void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_record_input *in)
 {
 	size_t size;
 	void *data = tool_read_input(path, &size);
 	char *dir = dir_of(path);
 	mlod_error err = {0};
-	mlod_result r = mlod_load(data, size, dir, doc, c, format, &err);
+	mlod_result r = mlod_record_load(data, size, dir, MLOD_RECORD_INPUT_CLIPS, doc, c, in, &err);
 	free(dir);
 	free(data);
 	if (r != MLOD_OK)
@@ -156,12 +156,12 @@ void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format
 	put_warnings(path, c);
 }
 
-void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format, size_t *size)
+void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_record_input *in, size_t *size)
 {
 	void *data = tool_read_input(path, size);
 	char *dir = dir_of(path);
 	mlod_error err = {0};
-	mlod_result r = mlod_load(data, *size, dir, doc, c, format, &err);
+	mlod_result r = mlod_record_load(data, *size, dir, 0, doc, c, in, &err);
 	free(dir);
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), tool_input_label(path), "%s", err.message);
