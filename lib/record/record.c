@@ -1079,6 +1079,19 @@ int mlod_record_from_bvh(const mlod_record *r, mlod_format format)
 	return format == MLOD_FORMAT_BVH || (r && r->source == MLOD_FORMAT_BVH);
 }
 
+/* Releases a clip left out (what mlod_character_free would; lib/motion's
+ * mlod_clip_free calls into this part, so not that). */
+static void clip_release(mlod_clip *clip)
+{
+	for (int ch = 0; clip->channels && ch < clip->channel_count; ch++) {
+		free(clip->channels[ch].times);
+		free(clip->channels[ch].values);
+	}
+	free(clip->channels);
+	free(clip->name);
+	memset(clip, 0, sizeof *clip);
+}
+
 /* Leaves the motion level animations out of c's clips, in order. */
 static mlod_result input_clips(const mlod_gltf *doc, mlod_character *c, int *removed, mlod_error *err)
 {
@@ -1095,7 +1108,7 @@ static mlod_result input_clips(const mlod_gltf *doc, mlod_character *c, int *rem
 			mj_free(&o);
 		}
 		if (level) {
-			mlod_clip_free(&c->clips[i]);
+			clip_release(&c->clips[i]);
 			(*removed)++;
 		} else {
 			c->clips[kept++] = c->clips[i];
