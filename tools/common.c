@@ -191,13 +191,13 @@ static void load_failed(const char *path, mlod_result r, const mlod_error *err, 
 	tool_die(tool_exit_code(r), tool_input_label(path), "%s", err->message);
 }
 
-void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format)
+void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_record_input *in)
 {
 	size_t size;
 	void *data = tool_read_input(path, &size);
 	char *dir = dir_of(path);
 	mlod_error err = {0};
-	mlod_result r = mlod_load(data, size, dir, doc, c, format, &err);
+	mlod_result r = mlod_record_load(data, size, dir, MLOD_RECORD_INPUT_CLIPS, doc, c, in, &err);
 	free(dir);
 	if (r != MLOD_OK)
 		load_failed(path, r, &err, data, size);
@@ -205,12 +205,12 @@ void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format
 	put_warnings(path, c);
 }
 
-void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format, size_t *size)
+void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_record_input *in, size_t *size)
 {
 	void *data = tool_read_input(path, size);
 	char *dir = dir_of(path);
 	mlod_error err = {0};
-	mlod_result r = mlod_load(data, *size, dir, doc, c, format, &err);
+	mlod_result r = mlod_record_load(data, *size, dir, 0, doc, c, in, &err);
 	free(dir);
 	if (r != MLOD_OK)
 		load_failed(path, r, &err, data, *size);

@@ -68,14 +68,18 @@ const char *tool_input_label(const char *path);
  * clear message when it cannot (missing, a directory, unreadable, too big). */
 void *tool_read_input(const char *path, size_t *size);
 
-/* Reads and loads a glb, glTF or BVH input; exits on failure. doc may be
- * NULL. The reader's warnings (what it changed, approximated or dropped of
- * the input: mlod_character.warnings) go to stderr, one line each. */
-void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format);
+/* Reads and loads a glb, glTF or BVH input through the stage record
+ * (mlod_record_load: a BVH's document says it is one; the clips are the
+ * input's, without the motion level animations); exits on failure. doc
+ * and in may be NULL. The reader's warnings (what it changed, approximated
+ * or dropped of the input: mlod_character.warnings) go to stderr, one line
+ * each. */
+void tool_load(const char *path, mlod_gltf **doc, mlod_character *c, mlod_record_input *in);
 
-/* tool_load that also returns the input's bytes (*size of them; release
- * with free). */
-void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_format *format, size_t *size);
+/* tool_load that keeps the motion level animations among the clips (the
+ * pack takes them as levels) and also returns the input's bytes (*size of
+ * them; release with free). */
+void *tool_load_keep(const char *path, mlod_gltf **doc, mlod_character *c, mlod_record_input *in, size_t *size);
 
 /* Writes bytes to path, or to stdout when path is NULL or "-". A regular
  * file or a new path is replaced atomically (a temporary file in the same

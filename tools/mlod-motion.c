@@ -82,7 +82,7 @@ struct spec {
 struct job {
 	const char *input;
 	const mlod_gltf *doc; /* glTF input, else NULL */
-	mlod_format format;
+	mlod_record_input in;
 	mlod_character c;
 	double height;
 	double point_distance;
@@ -324,12 +324,12 @@ int main(int argc, char **argv)
 
 	mlod_gltf *doc = NULL;
 	job.input = tool_input_label(optind < argc ? argv[optind] : NULL);
-	tool_load(optind < argc ? argv[optind] : NULL, bvh_out ? NULL : &doc, &job.c, &job.format);
+	tool_load(optind < argc ? argv[optind] : NULL, bvh_out ? NULL : &doc, &job.c, &job.in);
 	job.doc = doc;
 	if (job.c.clip_count == 0) {
 		/* Nothing to reduce (a static prop, a character without clips):
 		 * pass it through, so that a pipeline over many assets goes on. */
-		const char *why = job.format == MLOD_FORMAT_BVH ? "no animation (the BVH has 'Frames: 0')" : "no animation";
+		const char *why = job.in.format == MLOD_FORMAT_BVH ? "no animation (the BVH has 'Frames: 0')" : "no animation";
 		if (bvh_out)
 			tool_die(EXIT_INPUT, job.input, "%s: no clip to write as BVH", why);
 		if (report == REPORT_NONE) {
@@ -358,9 +358,10 @@ int main(int argc, char **argv)
 		return 0;
 	}
 	job.height = mlod_skeleton_height(&job.c.skeleton);
-	/* 10 cm: glTF is in metres; a BVH's unit is its own. */
+	/* 10 cm: glTF is in metres; a BVH's unit is its own, and so is a glb's
+	 * made from a BVH (its stage record says so). */
 	job.point_distance = point_distance > 0.0 ? point_distance
-	                                          : mlod_motion_point_distance(&job.c.skeleton, job.format != MLOD_FORMAT_BVH);
+	                                          : mlod_motion_point_distance(&job.c.skeleton, !job.in.from_bvh);
 	job.opt.point_distance = job.point_distance;
 	for (int s = 0; s < job.spec_count; s++)
 		if (job.specs[s].percent && !(job.height > 0.0) && job.c.clip_count > 0)

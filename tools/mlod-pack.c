@@ -481,16 +481,16 @@ int main(int argc, char **argv)
 	opt.default_name = tool_input_stem(path, "", namebuf, sizeof namebuf);
 	mlod_gltf *doc = NULL;
 	mlod_character c;
-	mlod_format format = MLOD_FORMAT_UNKNOWN;
+	mlod_record_input in;
 	size_t size = 0;
 	memset(&c, 0, sizeof c);
-	void *bytes = tool_load_keep(path, &doc, &c, &format, &size);
+	void *bytes = tool_load_keep(path, &doc, &c, &in, &size);
 
 	mlod_pack_stats st;
 	mlod_error err = {0};
 	void *pack = NULL;
 	size_t pack_size = 0;
-	mlod_result r = mlod_pack_write(doc, &c, format, bytes, size, &opt, &pack, &pack_size, &st, &err);
+	mlod_result r = mlod_pack_write(doc, &c, in.format, bytes, size, &opt, &pack, &pack_size, &st, &err);
 	free(bytes);
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), label, "%s", err.message);

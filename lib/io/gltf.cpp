@@ -212,13 +212,15 @@ double tidy(float f)
 }
 
 /* The glTF reader's own keys of the stage record (mlod-record(5)): a BVH
- * turned into glTF marks its End Site nodes extras.mlod.end_site = true
- * and keeps each joint's channel layout in extras.mlod_bvh.channels. The
- * reader below (is_end_site, bvh_layout) is their one reader and
- * build_document their one writer; the rest of extras.mlod belongs to
- * lib/record, above this file. */
+ * turned into glTF marks its End Site nodes extras.mlod.end_site = true,
+ * keeps each joint's channel layout in extras.mlod_bvh.channels and its
+ * clip's frame time in extras.mlod_bvh.frame_time of the animation. The
+ * reader below (is_end_site, bvh_layout, bvh_frames) is their one reader
+ * and build_document (mlod_load, load.c, for the frame time) their one
+ * writer; the rest of extras.mlod belongs to lib/record, above this
+ * file. */
 const char *const record_key = "mlod", *const record_end_site = "end_site";
-const char *const bvh_key = "mlod_bvh", *const bvh_channels = "channels";
+const char *const bvh_key = "mlod_bvh", *const bvh_channels = "channels", *const bvh_frame_time = "frame_time";
 
 /* Deeper JSON is refused: tinygltf converts it recursively. */
 const int max_json_depth = 100;
@@ -2096,6 +2098,7 @@ private:
 				channel(a, *kept[i], clip.channels[i]);
 				clip.duration = std::max(clip.duration, clip.channels[i].times[clip.channels[i].key_count - 1]);
 			}
+			bvh_frames(a, clip);
 		}
 		if (not_joint)
 			note("%d animation channels target nodes that are not joints (kept in the document, not in the clips)",
@@ -2107,6 +2110,39 @@ private:
 			note("%d animations without joints to animate (morph target weights, say) are kept in the document, "
 			     "not as clips: no joint motion to reduce",
 			     outside);
+	}
+
+	/* A BVH's clip keeps its frame time in extras.mlod_bvh.frame_time of
+	 * its animation (mlod_load writes it), so that its frames survive the
+	 * glb: the clip is sampled again (frame_time, frame_count) when every
+	 * joint channel is linear with the same key times, one key per frame
+	 * (within half a frame of k times the frame time). Else the mark is
+	 * stale (the animation was edited) and the clip is read as keys. */
+	void bvh_frames(size_t a, mlod_clip &clip) const
+	{
+		const json e = current_extras(doc_, "/animations/" + std::to_string(a) + "/extras",
+		                              m_.animations[a].extras);
+		if (!e.is_object() || !e.contains(bvh_key) || !e[bvh_key].is_object() || clip.channel_count == 0)
+			return;
+		const json &ft = e[bvh_key].contains(bvh_frame_time) ? e[bvh_key][bvh_frame_time] : json();
+		if (!ft.is_number())
+			return;
+		const float f = float(ft.get<double>());
+		const mlod_channel &first = clip.channels[0];
+		const int n = first.key_count;
+		if (!(f > 0.0f) || !std::isfinite(f) || n < 1)
+			return;
+		for (int i = 0; i < clip.channel_count; i++) {
+			const mlod_channel &ch = clip.channels[i];
+			if (ch.interp != MLOD_INTERP_LINEAR || ch.key_count != n ||
+			    std::memcmp(ch.times, first.times, sizeof(float) * size_t(n)) != 0)
+				return;
+		}
+		for (int k = 0; k < n; k++)
+			if (!(std::fabs(double(first.times[k]) - double(k) * f) <= 0.5 * f))
+				return;
+		clip.frame_time = f;
+		clip.frame_count = n;
 	}
 
 	void channel(size_t a, const tinygltf::AnimationChannel &src, mlod_channel &ch)

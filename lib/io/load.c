@@ -9,6 +9,7 @@
  * validated before it is handed out; on any failure nothing stays
  * allocated.
  */
+#include <stdio.h>
 #include <string.h>
 
 #include "io/mlod_io.h"
@@ -76,6 +77,20 @@ mlod_result mlod_load(const void *data, size_t size, const char *base_dir, mlod_
 		/* mlod_gltf_from_character makes joint i node i. */
 		for (int i = 0; r == MLOD_OK && d && i < c->skeleton.joint_count; i++)
 			c->skeleton.joints[i].node = i;
+		/* and an animation of each clip with channels: its frame time,
+		 * which glTF has no place for, goes into its
+		 * extras.mlod_bvh.frame_time (mlod-record(5)), so that the clip
+		 * read back from the glb is sampled at the same frames. */
+		for (int i = 0, a = 0; r == MLOD_OK && d && i < c->clip_count; i++) {
+			if (c->clips[i].channel_count == 0)
+				continue;
+			if (c->clips[i].frame_time > 0.0f) {
+				char mark[64];
+				snprintf(mark, sizeof mark, "{\"frame_time\":%.9g}", (double)c->clips[i].frame_time);
+				r = mlod_gltf_set_extra(d, MLOD_GLTF_ANIMATION, a, "mlod_bvh", mark, err);
+			}
+			a++;
+		}
 		break;
 	case MLOD_FORMAT_GLB:
 	case MLOD_FORMAT_GLTF:

@@ -94,7 +94,8 @@ typedef struct mlod_pack_options {
 	int motion_bound_count;      /* one level per bound on the joint position error */
 	double motion_bounds[MLOD_PACK_MAX_MOTION_LEVELS];
 	unsigned char motion_percent[MLOD_PACK_MAX_MOTION_LEVELS]; /* bound in % of the height, else scene units */
-	double point_distance;       /* 0: 0.1 for glTF, height / 18 for BVH (as mlod-motion) */
+	double point_distance;       /* 0: 0.1 for glTF, height / 18 for BVH or a glb made from one
+	                              * (mlod_record_from_bvh; as mlod-motion) */
 	/* motion level 0 (computed or piped alike): the input clip within this
 	 * point error bound (keys reduced, values rounded), or as read */
 	double motion_level0_error;  /* > 0 and below the smallest of motion_bounds (else mlod_pack_write

@@ -2312,8 +2312,10 @@ static int double_asc(const void *a, const void *b)
 
 static double motion_point_distance(const struct ctx *x)
 {
-	return x->opt->point_distance > 0.0 ? x->opt->point_distance
-	                                    : mlod_motion_point_distance(&x->v.skeleton, x->format != MLOD_FORMAT_BVH);
+	/* A BVH, or a glb made from one (its record's source): the BVH rule. */
+	return x->opt->point_distance > 0.0
+	           ? x->opt->point_distance
+	           : mlod_motion_point_distance(&x->v.skeleton, !mlod_record_from_bvh(&x->rec, x->format));
 }
 
 /* Level 0 of each clip: the clip as read, or (unless lossless_motion or a
@@ -3450,6 +3452,25 @@ static int listed(const int *list, int n, int g)
 	return 0;
 }
 
+/* The copy of the document that the DOC chunk strips. A BVH's document,
+ * which mlod_load builds in memory, is copied as the glb a stage writes of
+ * it is read (written and read back): stripped, a document that was read
+ * keeps the top-level arrays its edits empty ("accessors": [] ...), one
+ * built writes none, and the walk packed alone and after mlod-label had
+ * DOC chunks of 614 and 649 bytes. */
+static mlod_result doc_copy(const struct ctx *x, const mlod_gltf *doc, mlod_gltf **copy, mlod_error *err)
+{
+	if (x->format != MLOD_FORMAT_BVH)
+		return mlod_gltf_copy(doc, copy, err);
+	void *glb = NULL;
+	size_t size = 0;
+	mlod_result r = mlod_gltf_write(doc, 1, &glb, &size, err);
+	if (r == MLOD_OK)
+		r = mlod_gltf_read(glb, size, NULL, copy, err);
+	mlod_free(glb);
+	return r;
+}
+
 /* The stripped DOC without what the other chunks hold (mlod(5) DOC):
  * the inverse bind matrices of the packed skins (SKEL holds them; not
  * identities), the joint nodes' translation, rotation and scale that are
@@ -3800,7 +3821,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		size_t glb_size = 0;
 		mlod_gltf *copy = NULL;
 		mlod_error serr = {0};
-		mlod_result sr = doc ? mlod_gltf_copy(doc, &copy, &serr) : MLOD_ERR_INVALID_ARG;
+		mlod_result sr = doc ? doc_copy(&x, doc, &copy, &serr) : MLOD_ERR_INVALID_ARG;
 		int *joint_nodes = malloc(sizeof(int) * ((size_t)c->skeleton.joint_count + 1)), jn = 0;
 		if (!joint_nodes)
 			sr = mlod_fail(&serr, MLOD_ERR_NOMEM, "out of memory");

@@ -5,12 +5,14 @@
  * and one writer of every part:
  *
  *   joint nodes     the labels and energy of mlod-label
- *   the scene       version; skeleton_levels (mlod-skelgraph); mesh_levels,
- *                   or mesh_level in a --split file (mlod-bgm)
+ *   the scene       version; source, for a BVH's document (every stage);
+ *                   skeleton_levels (mlod-skelgraph); mesh_levels, or
+ *                   mesh_level in a --split file (mlod-bgm)
  *   skins           the skins standing for them at each skeleton level
  *   level nodes     the mesh level a node holds (mlod-bgm)
  *   animations      the motion level a "<clip>@lod<k>" animation holds
- *                   (mlod-motion)
+ *                   (mlod-motion), which the other stages do not take as
+ *                   a clip (mlod_record_load)
  *
  * Writers merge: each sets its own keys of the scene record and keeps the
  * others (a later stage never drops an earlier stage's levels), and stamps
@@ -49,8 +51,10 @@ extern "C" {
  * pack error (pack_error, scene units: what mlod-pack -x writes), and a
  * full clip may say it is a pack's motion level 0
  * (mlod_record_read_motion0). A record with every key reads as it did in
- * version 2. */
-#define MLOD_RECORD_VERSION 3
+ * version 2. Version 4: the scene may say that the document was made from
+ * a BVH file (source), whose lengths are in the file's own units; a
+ * record without it reads as version 3's. */
+#define MLOD_RECORD_VERSION 4
 
 /* ------------------------------------------------------------------ */
 /* Joint nodes: labels and energy (mlod-label)                         */
@@ -139,6 +143,9 @@ typedef struct mlod_record {
 	int has_pack;
 	char *pack_name;         /* the character's name */
 	double pack_bounds_min[3], pack_bounds_max[3]; /* the rest pose's bounds (INFO) */
+	/* extras.mlod.source (version 4): MLOD_FORMAT_BVH when the document
+	 * was made from a BVH file, else MLOD_FORMAT_UNKNOWN. */
+	mlod_format source;
 } mlod_record;
 
 /* Reads the scene's and the skins' records (all empty when there are
@@ -267,6 +274,49 @@ mlod_result mlod_record_read_motion0(const mlod_gltf *doc, int animation, double
 
 /* "frames" or "keys". */
 const char *mlod_record_method_name(mlod_motion_method m);
+
+/* ------------------------------------------------------------------ */
+/* The input: its source and the clips the stages take                 */
+/* ------------------------------------------------------------------ */
+
+/* Writes extras.mlod.source of the scene (version 4): "bvh", for a
+ * document made from a BVH file (the only source recorded; another is
+ * MLOD_ERR_INVALID_ARG). mlod_record_load writes it on a BVH's document,
+ * and the stages keep it, so that a glb of a BVH says so to the next. */
+mlod_result mlod_record_write_source(mlod_gltf *doc, mlod_format source, mlod_error *err);
+
+/* Is the character a BVH's: the input is BVH (format), or a document
+ * whose record (r, may be NULL) says it was made from one? Its lengths
+ * are then in the file's own units, and every default that assumes
+ * glTF's metres takes the BVH rule instead: the point distance is
+ * mlod_motion_point_distance(s, !mlod_record_from_bvh(r, format)). */
+int mlod_record_from_bvh(const mlod_record *r, mlod_format format);
+
+/* What mlod_record_load tells of its input. */
+typedef struct mlod_record_input {
+	mlod_format format;      /* the file's format */
+	int from_bvh;            /* mlod_record_from_bvh: a BVH, or a document made from one */
+	int level_clips;         /* motion level animations left out of the clips
+	                          * (MLOD_RECORD_INPUT_CLIPS) */
+} mlod_record_input;
+
+/* mlod_record_load leaves the motion levels (animations whose record
+ * has motion_level: mlod-motion's "<clip>@lod<k>", mlod-pack -x's) out
+ * of the character's clips, which then hold the input's clips alone:
+ * what every stage but the motion stage and the pack takes, so that the
+ * stages give the same levels in any order. The animations stay in the
+ * document, unchanged. */
+#define MLOD_RECORD_INPUT_CLIPS 1
+
+/* mlod_load through the record: loads glb, glTF or BVH bytes into a
+ * document (doc may be NULL) and a character, then writes the source of
+ * a BVH's document (mlod_record_write_source) or reads a document's
+ * (refusing a record newer than this mlod, MLOD_ERR_UNSUPPORTED, or a
+ * malformed source, MLOD_ERR_PARSE), and with MLOD_RECORD_INPUT_CLIPS in
+ * flags leaves the motion levels out of the clips. in may be NULL. On
+ * failure nothing is allocated. */
+mlod_result mlod_record_load(const void *data, size_t size, const char *base_dir, int flags, mlod_gltf **doc,
+                             mlod_character *c, mlod_record_input *in, mlod_error *err);
 
 #ifdef __cplusplus
 }

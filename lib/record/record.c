@@ -135,6 +135,15 @@ static int doc_version(const mlod_gltf *doc)
 	return version;
 }
 
+/* Is an animation's record (read with get) a motion level's? The one test
+ * of what a "<clip>@lod<k>" animation is: mlod_record_read_motion,
+ * mlod_record_motion_level_count and the clips mlod_record_load leaves
+ * out all ask it. */
+static int is_motion_level(const mj *o)
+{
+	return o->type == MJ_OBJECT && mj_get(o, "motion_level") != NULL;
+}
+
 /* Is a key that version 3 made optional required in a record of this
  * version? */
 #define REQUIRED_BEFORE_3(version) ((version) < 3)
@@ -503,6 +512,33 @@ static int read_mesh_level(struct rd *c, const mj *o, int version, mlod_record_m
 	return 0;
 }
 
+/* The scene record's version (refused when newer than this mlod's) and
+ * source (version 4): MLOD_FORMAT_BVH for "bvh", else
+ * MLOD_FORMAT_UNKNOWN. */
+static void read_scene_head(struct rd *c, const mj *o, int *version, mlod_format *source)
+{
+	long v = 1;
+	*version = 1;
+	*source = MLOD_FORMAT_UNKNOWN;
+	rd_at(c, "the scene's extras.mlod");
+	if (o->type != MJ_NULL && o->type != MJ_OBJECT)
+		rd_fail(c, NULL, "not an object");
+	if (c->r != MLOD_OK || o->type != MJ_OBJECT)
+		return;
+	if (rd_int(c, o, "version", 0, 1, 1e9, &v) > 0 && v > MLOD_RECORD_VERSION)
+		c->r = mlod_fail(c->err, MLOD_ERR_UNSUPPORTED,
+		                 "the scene's extras.mlod is version %ld: this mlod reads up to version %d", v,
+		                 MLOD_RECORD_VERSION);
+	*version = (int)v;
+	const mj *src = mj_get(o, "source");
+	if (c->r == MLOD_OK && src) {
+		if (src->type != MJ_STRING || strcmp(src->text, "bvh") != 0)
+			rd_fail(c, "source", "not \"bvh\"");
+		else
+			*source = MLOD_FORMAT_BVH;
+	}
+}
+
 mlod_result mlod_record_read(const mlod_gltf *doc, mlod_record *out, mlod_error *err)
 {
 	memset(out, 0, sizeof *out);
@@ -513,16 +549,7 @@ mlod_result mlod_record_read(const mlod_gltf *doc, mlod_record *out, mlod_error 
 	mlod_result r = MLOD_OK;
 	if (mlod_gltf_count(doc, MLOD_GLTF_SCENE) > 0 && (r = get(doc, MLOD_GLTF_SCENE, -1, &o, err)) != MLOD_OK)
 		return r;
-	rd_at(&c, "the scene's extras.mlod");
-	if (o.type != MJ_NULL && o.type != MJ_OBJECT)
-		rd_fail(&c, NULL, "not an object");
-	long version = 1;
-	if (c.r == MLOD_OK && o.type == MJ_OBJECT && rd_int(&c, &o, "version", 0, 1, 1e9, &version) > 0 &&
-	    version > MLOD_RECORD_VERSION)
-		c.r = mlod_fail(err, MLOD_ERR_UNSUPPORTED,
-		                "the scene's extras.mlod is version %ld: this mlod reads up to version %d", version,
-		                MLOD_RECORD_VERSION);
-	out->version = (int)version;
+	read_scene_head(&c, &o, &out->version, &out->source);
 	const mj *a = mj_get(&o, "skeleton_levels");
 	out->has_skel_levels = a != NULL;
 	if (c.r == MLOD_OK && a) {
@@ -925,7 +952,7 @@ mlod_result mlod_record_read_motion(const mlod_gltf *doc, int animation, mlod_re
 	mlod_result r = get(doc, MLOD_GLTF_ANIMATION, animation, &o, err);
 	if (r != MLOD_OK)
 		return r;
-	if (!mj_get(&o, "motion_level")) {
+	if (!is_motion_level(&o)) {
 		mj_free(&o);
 		return MLOD_OK;
 	}
@@ -993,7 +1020,7 @@ mlod_result mlod_record_motion_level_count(const mlod_gltf *doc, int *count, mlo
 		mlod_result r = get(doc, MLOD_GLTF_ANIMATION, a, &o, err);
 		if (r != MLOD_OK)
 			return r;
-		*count += o.type == MJ_OBJECT && mj_get(&o, "motion_level") != NULL;
+		*count += is_motion_level(&o);
 		mj_free(&o);
 	}
 	return MLOD_OK;
@@ -1030,4 +1057,107 @@ mlod_result mlod_record_read_motion0(const mlod_gltf *doc, int animation, double
 	}
 	mj_free(&o);
 	return c.r;
+}
+
+/* ------------------------------------------------------------------ */
+/* The input: its source and its clips                                 */
+/* ------------------------------------------------------------------ */
+
+mlod_result mlod_record_write_source(mlod_gltf *doc, mlod_format source, mlod_error *err)
+{
+	if (source != MLOD_FORMAT_BVH)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_record_write_source: only a BVH source is recorded");
+	struct wr w = {0};
+	mj v;
+	if (mj_string(&v, "bvh") != 0)
+		return nomem(err);
+	return finish_scene(&w, doc, "source", &v, err);
+}
+
+int mlod_record_from_bvh(const mlod_record *r, mlod_format format)
+{
+	return format == MLOD_FORMAT_BVH || (r && r->source == MLOD_FORMAT_BVH);
+}
+
+/* Releases a clip left out (what mlod_character_free would; lib/motion's
+ * mlod_clip_free calls into this part, so not that). */
+static void clip_release(mlod_clip *clip)
+{
+	for (int ch = 0; clip->channels && ch < clip->channel_count; ch++) {
+		free(clip->channels[ch].times);
+		free(clip->channels[ch].values);
+	}
+	free(clip->channels);
+	free(clip->name);
+	memset(clip, 0, sizeof *clip);
+}
+
+/* Leaves the motion level animations out of c's clips, in order. */
+static mlod_result input_clips(const mlod_gltf *doc, mlod_character *c, int *removed, mlod_error *err)
+{
+	int kept = 0;
+	*removed = 0;
+	for (int i = 0; i < c->clip_count; i++) {
+		mj o = {0};
+		int level = 0;
+		if (c->clips[i].gltf_index >= 0) {
+			mlod_result r = get(doc, MLOD_GLTF_ANIMATION, c->clips[i].gltf_index, &o, err);
+			if (r != MLOD_OK)
+				return r;
+			level = is_motion_level(&o);
+			mj_free(&o);
+		}
+		if (level) {
+			clip_release(&c->clips[i]);
+			(*removed)++;
+		} else {
+			c->clips[kept++] = c->clips[i];
+		}
+	}
+	c->clip_count = kept;
+	return MLOD_OK;
+}
+
+mlod_result mlod_record_load(const void *data, size_t size, const char *base_dir, int flags, mlod_gltf **doc,
+                             mlod_character *c, mlod_record_input *in, mlod_error *err)
+{
+	mlod_record_input local;
+	in = in ? in : &local;
+	memset(in, 0, sizeof *in);
+	if (doc)
+		*doc = NULL;
+	/* A glTF input's document is read whatever the caller wants (mlod_load
+	 * reads it anyway): its record says what the character is. */
+	int want = doc != NULL || mlod_detect_format(data, size) != MLOD_FORMAT_BVH;
+	mlod_gltf *d = NULL;
+	mlod_result r = mlod_load(data, size, base_dir, want ? &d : NULL, c, &in->format, err);
+	if (r != MLOD_OK)
+		return r;
+	in->from_bvh = in->format == MLOD_FORMAT_BVH;
+	if (d && in->format == MLOD_FORMAT_BVH) {
+		r = mlod_record_write_source(d, MLOD_FORMAT_BVH, err);
+	} else if (d) {
+		mj o = {0};
+		struct rd rc = {{0}, err, MLOD_OK};
+		int version;
+		mlod_format source = MLOD_FORMAT_UNKNOWN;
+		if (mlod_gltf_count(d, MLOD_GLTF_SCENE) > 0 && (r = get(d, MLOD_GLTF_SCENE, -1, &o, err)) == MLOD_OK) {
+			read_scene_head(&rc, &o, &version, &source);
+			r = rc.r;
+		}
+		mj_free(&o);
+		in->from_bvh = source == MLOD_FORMAT_BVH;
+	}
+	if (r == MLOD_OK && d && (flags & MLOD_RECORD_INPUT_CLIPS))
+		r = input_clips(d, c, &in->level_clips, err);
+	if (r != MLOD_OK) {
+		mlod_gltf_free(d);
+		mlod_character_free(c);
+		return r;
+	}
+	if (doc)
+		*doc = d;
+	else
+		mlod_gltf_free(d);
+	return MLOD_OK;
 }

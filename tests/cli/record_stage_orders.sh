@@ -40,7 +40,7 @@ for (const order of process.argv.slice(2)) {
 	[...order].forEach((stage, k) => {
 		const j = glb(`${order}.${k + 1}.glb`);
 		const r = rec(j.scenes[0]);
-		if (!r || r.version !== 3) throw new Error(`${order} after ${stage}: scene record version ${r && r.version}`);
+		if (!r || r.version !== 4) throw new Error(`${order} after ${stage}: scene record version ${r && r.version}`);
 		made[stage] = parts[stage](j);
 		const found = {
 			L: made.L && made.L.some((x) => x), S: made.S && made.S[0] && made.S[0].length > 0,

@@ -374,8 +374,9 @@ TEST(old_new_and_malformed)
 	CHECK(read_scene(doc, "{\"version\":1}", &e) == MLOD_OK);
 	CHECK(read_scene(doc, "{\"version\":2}", &e) == MLOD_OK);
 	CHECK(read_scene(doc, "{\"version\":3}", &e) == MLOD_OK);
-	CHECK(read_scene(doc, "{\"version\":4}", &e) == MLOD_ERR_UNSUPPORTED);
-	CHECK_MSG(strstr(e.message, "version 4") && strstr(e.message, "up to version 3"), "%s", e.message);
+	CHECK(read_scene(doc, "{\"version\":4}", &e) == MLOD_OK);
+	CHECK(read_scene(doc, "{\"version\":5}", &e) == MLOD_ERR_UNSUPPORTED);
+	CHECK_MSG(strstr(e.message, "version 5") && strstr(e.message, "up to version 4"), "%s", e.message);
 	static const struct {
 		const char *text, *says;
 	} bad[] = {
@@ -410,6 +411,9 @@ TEST(old_new_and_malformed)
 		 "mesh_levels[0].error_percent.max: missing"},
 		/* Numbers past the range of long (found by make fuzz-io: converting
 		 * them was undefined behaviour before the range check). */
+		/* Version 4: the source is "bvh" or absent. */
+		{"{\"version\":4,\"source\":\"fbx\"}", "the scene's extras.mlod.source: not \"bvh\""},
+		{"{\"version\":4,\"source\":1}", "the scene's extras.mlod.source: not \"bvh\""},
 		{"{\"version\":1e88}", "extras.mlod.version: not a whole number in range"},
 		{"{\"version\":-1e300}", "extras.mlod.version: not a whole number in range"},
 		{"{\"skeleton_levels\":[{\"level\":1,\"threshold\":0,\"joints\":1,\"kept\":[1e88],\"skins\":[0],"
@@ -452,6 +456,101 @@ TEST(old_new_and_malformed)
 	mlod_gltf_free(doc);
 }
 
+/* Loads bytes through the record (mlod_record_load). */
+static mlod_result record_load(const void *data, size_t size, int flags, mlod_gltf **doc, mlod_character *c,
+                               mlod_record_input *in, mlod_error *e)
+{
+	return mlod_record_load(data, size, NULL, flags, doc, c, in, e);
+}
+
+/* A BVH's document says it is one (extras.mlod.source, version 4) and
+ * keeps its clip's frames (extras.mlod_bvh.frame_time), so that the glb
+ * a stage writes of it reads back as the same character under the same
+ * rules; motion level animations are left out of the clips the stages
+ * take, and kept for the pack. */
+TEST(input_source_and_clips)
+{
+	size_t size;
+	void *bvh = test_read_file("samples/cmu_12_01_walk.bvh", &size);
+	CHECK(bvh != NULL);
+	if (!bvh)
+		return;
+	mlod_gltf *doc = NULL, *back = NULL;
+	mlod_character c = {0}, g = {0}, plain = {0};
+	mlod_record_input in, gin;
+	mlod_record rec;
+	mlod_error e;
+	CHECK_OK(record_load(bvh, size, MLOD_RECORD_INPUT_CLIPS, &doc, &c, &in, &terr));
+	CHECK(in.format == MLOD_FORMAT_BVH && in.from_bvh && in.level_clips == 0);
+	CHECK_OK(mlod_record_read(doc, &rec, &terr));
+	CHECK(rec.version == MLOD_RECORD_VERSION && rec.source == MLOD_FORMAT_BVH && mlod_record_from_bvh(&rec, 0));
+	mlod_record_free(&rec);
+	/* Without a document: the same character and rule. */
+	CHECK_OK(record_load(bvh, size, 0, NULL, &plain, &in, &terr));
+	CHECK(in.from_bvh && plain.clip_count == 1 && plain.clips[0].frame_time == c.clips[0].frame_time);
+	mlod_character_free(&plain);
+	/* The glb of it: a glb, from a BVH, with the BVH's frames. */
+	void *glb = NULL;
+	size_t glb_size = 0;
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &glb_size, &terr));
+	CHECK_OK(record_load(glb, glb_size, MLOD_RECORD_INPUT_CLIPS, &back, &g, &gin, &terr));
+	CHECK(gin.format == MLOD_FORMAT_GLB && gin.from_bvh);
+	CHECK(c.clip_count == 1 && g.clip_count == 1);
+	if (c.clip_count == 1 && g.clip_count == 1) {
+		const mlod_clip *a = &c.clips[0], *b = &g.clips[0];
+		CHECK(a->frame_time > 0.0f && b->frame_time == a->frame_time && b->frame_count == a->frame_count);
+		CHECK(b->duration == a->duration && b->channel_count == a->channel_count);
+		for (int i = 0; i < a->channel_count && i < b->channel_count; i++)
+			CHECK(a->channels[i].key_count == b->channels[i].key_count &&
+			      memcmp(a->channels[i].times, b->channels[i].times,
+			             sizeof(float) * (size_t)a->channels[i].key_count) == 0);
+	}
+	mlod_character_free(&g);
+	mlod_gltf_free(back);
+	/* A frame time the keys do not follow (an edited glb) is not taken. */
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_ANIMATION, 0, "mlod_bvh", "{\"frame_time\":0.5}", &terr));
+	mlod_free(glb);
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &glb_size, &terr));
+	CHECK_OK(record_load(glb, glb_size, 0, NULL, &g, NULL, &terr));
+	CHECK(g.clip_count == 1 && g.clips[0].frame_time == 0.0f && g.clips[0].frame_count == 0);
+	mlod_character_free(&g);
+	mlod_free(glb);
+	mlod_gltf_free(doc);
+	mlod_character_free(&c);
+	free(bvh);
+
+	/* The tubeman: glTF, and a motion level beside its clip. */
+	void *tube = test_read_file("samples/tubeman.glb", &size);
+	CHECK(tube != NULL);
+	if (!tube)
+		return;
+	CHECK_OK(record_load(tube, size, MLOD_RECORD_INPUT_CLIPS, &doc, &c, &in, &terr));
+	CHECK(in.format == MLOD_FORMAT_GLB && !in.from_bvh && c.clip_count == 1);
+	int anim = -1;
+	CHECK_OK(mlod_gltf_add_animation(doc, &c.skeleton, &c.clips[0], &anim, &terr));
+	mlod_record_motion_level ml = {.level = 1, .source_animation = 0, .method = MLOD_MOTION_KEYS, .threshold = 1,
+	                               .keys = 1, .source_keys = 2, .bytes = 4, .point_error = 0.1};
+	CHECK_OK(mlod_record_write_motion(doc, anim, &ml, &terr));
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &glb_size, &terr));
+	CHECK_OK(record_load(glb, glb_size, MLOD_RECORD_INPUT_CLIPS, NULL, &g, &gin, &terr));
+	CHECK(g.clip_count == 1 && gin.level_clips == 1 && g.clips[0].gltf_index == 0);
+	mlod_character_free(&g);
+	CHECK_OK(record_load(glb, glb_size, 0, NULL, &g, &gin, &terr));
+	CHECK(g.clip_count == 2 && gin.level_clips == 0 && g.clips[1].gltf_index == anim);
+	mlod_character_free(&g);
+	mlod_free(glb);
+	/* A record this mlod cannot read is refused at load. */
+	CHECK_OK(mlod_gltf_set_extra(doc, MLOD_GLTF_SCENE, -1, "mlod", "{\"version\":4,\"source\":\"fbx\"}", &terr));
+	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &glb_size, &terr));
+	CHECK(record_load(glb, glb_size, 0, NULL, &g, NULL, &e) == MLOD_ERR_PARSE);
+	CHECK_MSG(strstr(e.message, "the scene's extras.mlod.source: not \"bvh\""), "%s", e.message);
+	CHECK(g.clip_count == 0 && g.clips == NULL);
+	mlod_free(glb);
+	mlod_gltf_free(doc);
+	mlod_character_free(&c);
+	free(tube);
+}
+
 int main(void)
 {
 	RUN(json_strict);
@@ -461,5 +560,6 @@ int main(void)
 	RUN(motion_and_node_records);
 	RUN(old_new_and_malformed);
 	RUN(pack_records_version3);
+	RUN(input_source_and_clips);
 	TEST_EXIT();
 }
