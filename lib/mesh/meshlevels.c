@@ -21,6 +21,11 @@ struct mlod_mesh_part {
 	int k;                  /* the level being made: its prefix */
 };
 
+mlod_bgm *mlod_mesh_part_bgm_(const mlod_mesh_levels *L, int i, int p)
+{
+	return L->parts && L->parts[i] ? L->parts[i][p].bgm : NULL;
+}
+
 const char *mlod_mesh_cost_name(mlod_mesh_cost c)
 {
 	return c == MLOD_COST_COMPACTNESS ? "compactness" : "posed";
