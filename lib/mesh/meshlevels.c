@@ -736,6 +736,15 @@ static int search_keep(void *ctx, void *level)
 		search_drop(ctx, level);
 		return 0;
 	}
+	/* Fewer triangles at no more error: the level before is never chosen
+	 * (the runtime switches by error), so this one takes its place. */
+	mlod_mesh_level *prev = L->count > 0 ? &L->levels[L->count - 1] : NULL;
+	if (prev && lv->error.max <= prev->error.max) {
+		note(L, "the level at ratio %.4g (%d triangles) replaces the one at %.4g (%d): no more error", lv->ratio,
+		     lv->triangles, prev->ratio, prev->triangles);
+		free_level(L, prev);
+		L->count--;
+	}
 	L->levels[L->count++] = *lv;
 	free(lv);
 	return 1;
