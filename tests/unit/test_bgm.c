@@ -1466,6 +1466,30 @@ static void check_no_flips(const char *path, int *total)
 	mlod_character_free(&c);
 }
 
+/* mlod_mesh_levels_by_error: each level is coarser in error than the
+ * one before, or the runtime (which switches by error) would never pick
+ * the one before. Tubeman at 0.5%: the chain's 25% level (1944
+ * triangles) and the bisection's (1914) had the same maximum, 0.4631%. */
+TEST(error_chain_coarser)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	mlod_bgm_options opt = {0};
+	opt.threads = 1;
+	mlod_mesh_levels L;
+	CHECK_OK(mlod_mesh_levels_init(&L, &c, &opt, MLOD_BUDGET_CHARACTER, 0.0, &terr));
+	CHECK_OK(mlod_mesh_levels_by_error(&L, 0.5, &terr));
+	CHECK(L.count >= 2);
+	for (int k = 1; k < L.count; k++)
+		CHECK_MSG(L.levels[k].triangles < L.levels[k - 1].triangles &&
+		              L.levels[k].error.max > L.levels[k - 1].error.max,
+		          "level %d: %d triangles, max %.17g; level %d: %d, %.17g", k, L.levels[k].triangles,
+		          L.levels[k].error.max, k - 1, L.levels[k - 1].triangles, L.levels[k - 1].error.max);
+	CHECK_MSG(L.levels[L.count - 1].error.max <= 0.5 && strstr(L.notes, "replaces"), "notes %.300s", L.notes);
+	mlod_mesh_levels_free(&L);
+	mlod_character_free(&c);
+}
+
 TEST(no_flipped_faces)
 {
 	int total = 0;
@@ -1603,6 +1627,7 @@ int main(void)
 	RUN(extreme_scales);
 	RUN(bind_space_scale);
 	RUN(shared_data);
+	RUN(error_chain_coarser);
 	RUN(no_flipped_faces);
 	RUN(no_flipped_faces_ely);
 	TEST_EXIT();
