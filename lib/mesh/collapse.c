@@ -277,7 +277,6 @@ struct plan {
 	int corner[MAX_PATCH];      /* the corner of kept[i] that becomes v-bar */
 	double onormal[MAX_PATCH][4]; /* kept[i]'s normal, then its length */
 	double rnormal[MAX_PATCH][4]; /* kept[i]'s reference normal (face_ref), then its length */
-	double vnormal[MAX_PATCH][3]; /* the NORMAL attribute summed over kept[i]'s corners but v-bar's */
 	unsigned char oflip[MAX_PATCH]; /* kept[i] is not degenerate: it may not flip */
 	int nw, wedges[MAX_WEDGES], group[MAX_WEDGES], ngroups;
 	int src[MAX_PATCH];         /* vertex placement: the wedge of v[snap] kept[i]'s corner copies */
@@ -381,7 +380,7 @@ static void barycentric(const double *a, const double *b, const double *c, const
  * or 0 without normals): a copy of a wedge of the kept vertex or the
  * snap vertex, else interpolate_wedge's, the corner's own normal at a
  * hard edge. */
-static void vbar_normal(const mlod_bgm *g, const struct plan *pl, int j, double *n)
+static void vbar_normal(const mlod_bgm *g, const struct plan *pl, int j, double *n, double *interp)
 {
 	const bgm_layout *L = &g->lay;
 	n[0] = n[1] = n[2] = 0.0;
@@ -405,6 +404,10 @@ static void vbar_normal(const mlod_bgm *g, const struct plan *pl, int j, double 
 		n[0] = a[0], n[1] = a[1], n[2] = a[2];
 		return;
 	}
+	if (!isnan(interp[0])) { /* the same for every corner: worked out once */
+		memcpy(n, interp, 3 * sizeof *n);
+		return;
+	}
 	const bgm_face *TF = &g->faces[pl->t];
 	int tw[3] = {TF->w[0], TF->w[1], TF->w[2]};
 	if (pl->k == 2)
@@ -419,27 +422,34 @@ static void vbar_normal(const mlod_bgm *g, const struct plan *pl, int j, double 
 	int m = l[0] >= l[1] && l[0] >= l[2] ? 0 : l[1] >= l[2] ? 1 : 2;
 	for (int i = 0; i < 3; i++)
 		n[i] = len > 1e-6 ? f[i] / len : g->wedge_attr[(size_t)tw[m] * (size_t)S + (size_t)(L->normal + i)];
+	memcpy(interp, n, 3 * sizeof *n);
 }
 
 /* The chosen placement's re-meshed faces against the NORMAL attribute
  * of their corners, v-bar's as apply() will make it: a face facing more
- * than 90 degrees away from their sum is inside out where it is shaded
- * (geometry_ok checked the two other corners for every placement). */
+ * than 90 degrees away from their sum is inside out where it is shaded.
+ * (Checking the two other corners for every placement in geometry_ok as
+ * well refused more: Ely's 10% level 1.31% -> 2.47% Hausdorff.) */
 static int normals_ok(const mlod_bgm *g, const struct plan *pl)
 {
-	if (g->lay.normal < 0)
+	const bgm_layout *L = &g->lay;
+	if (L->normal < 0 || L->stride == 0)
 		return 1;
+	double interp[3] = {NAN, NAN, NAN};
 	for (int j = 0; j < pl->nk; j++) {
 		const bgm_face *f = &g->faces[pl->kept[j]];
 		const double *q[3];
 		for (int k = 0; k < 3; k++)
 			q[k] = g->nodes[f->n[k]].p;
 		q[pl->corner[j]] = pl->pos;
-		double nn[3], b[3];
+		double nn[3], s[3];
 		bgm_face_normal(q[0], q[1], q[2], nn);
-		vbar_normal(g, pl, j, b);
-		const double *vn = pl->vnormal[j];
-		if (!((vn[0] + b[0]) * nn[0] + (vn[1] + b[1]) * nn[1] + (vn[2] + b[2]) * nn[2] > 0.0))
+		vbar_normal(g, pl, j, s, interp);
+		for (int k = 1; k < 3; k++) {
+			const float *x = g->wedge_attr + (size_t)f->w[(pl->corner[j] + k) % 3] * (size_t)L->stride + L->normal;
+			s[0] += x[0], s[1] += x[1], s[2] += x[2];
+		}
+		if (!(s[0] * nn[0] + s[1] * nn[1] + s[2] * nn[2] > 0.0))
 			return 0;
 	}
 	return 1;
@@ -474,11 +484,9 @@ static int geometry_ok(const mlod_bgm *g, const struct plan *pl, const double *x
 		    !(no[0] * nn[0] + no[1] * nn[1] + no[2] * nn[2] > FLIP_COS * lo * ln))
 			return 0;
 		/* Turns add up over collapses: the reference too (the input
-		 * face this one stands for), and its vertex normals. */
-		const double *rn = pl->rnormal[i], *vn = pl->vnormal[i];
+		 * face this one stands for). */
+		const double *rn = pl->rnormal[i];
 		if (rn[3] > 0.0 && !(rn[0] * nn[0] + rn[1] * nn[1] + rn[2] * nn[2] > REF_COS * rn[3] * ln))
-			return 0;
-		if (!(vn[0] * nn[0] + vn[1] * nn[1] + vn[2] * nn[2] >= 0.0))
 			return 0;
 		double area = 0.5 * ln;
 		double l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + w[0] * w[0] +
@@ -1028,22 +1036,13 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 		}
 	}
 
-	/* The kept faces as they are, for geometry_ok: their normals, their
-	 * references, and the normals of their corners that stay. */
+	/* The kept faces as they are, for geometry_ok: their normals and
+	 * their references. */
 	for (int i = 0; i < pl->nk; i++) {
 		const double *o = face_geo(g, pl->kept[i]);
 		memcpy(pl->onormal[i], o, 4 * sizeof *o);
 		pl->oflip[i] = o[3] > 0.0 && o[4] >= DEGENERATE;
 		memcpy(pl->rnormal[i], face_ref(g, pl->kept[i]), 4 * sizeof *o);
-		double *vn = pl->vnormal[i];
-		vn[0] = vn[1] = vn[2] = 0.0;
-		if (g->lay.normal >= 0) {
-			const bgm_face *F = &g->faces[pl->kept[i]];
-			for (int k = 1; k < 3; k++) {
-				const float *x = g->wedge_attr + (size_t)F->w[(pl->corner[i] + k) % 3] * (size_t)g->lay.stride + g->lay.normal;
-				vn[0] += x[0], vn[1] += x[1], vn[2] += x[2];
-			}
-		}
 	}
 	/* The cheapest valid candidate; with the compactness cost (the same
 	 * for every placement), the one nearest the barycenter. The
