@@ -866,6 +866,7 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->opstate);
 	free(g->ftie);
 	free(g->fgeo);
+	free(g->fref);
 	free(g->lbmemo);
 	free(g->heap.e);
 	free(g->heap.memo);

@@ -155,7 +155,10 @@ struct mlod_bgm {
 	                         * worked out (a face's nodes never change) */
 	double *fgeo;           /* per face (collapse.c): bgm_face_normal, its length (NaN until
 	                         * worked out) and bgm_compactness, 5 doubles */
-	int ftie_cap;           /* of ftie and fgeo */
+	double *fref;           /* per face (collapse.c): its reference normal and that normal's
+	                         * length (NaN until worked out), 4 doubles: an input face's own,
+	                         * a new face's that of the face it replaced */
+	int ftie_cap;           /* of ftie, fgeo and fref */
 	/* collapse.c: the weak queue keys' bounds by collapsed nodes (a pure
 	 * function of them: an edge or triangle whose faces died and came
 	 * back around a collapse is not worked out again); open addressing,

@@ -21,6 +21,11 @@ struct mlod_mesh_part {
 	int k;                  /* the level being made: its prefix */
 };
 
+mlod_bgm *mlod_mesh_part_bgm_(const mlod_mesh_levels *L, int i, int p)
+{
+	return L->parts && L->parts[i] ? L->parts[i][p].bgm : NULL;
+}
+
 const char *mlod_mesh_cost_name(mlod_mesh_cost c)
 {
 	return c == MLOD_COST_COMPACTNESS ? "compactness" : "posed";
@@ -750,6 +755,15 @@ static int search_keep(void *ctx, void *level)
 	if (L->count >= MLOD_MESH_MAX_LEVELS || (L->count > 0 && lv->triangles >= L->levels[L->count - 1].triangles)) {
 		search_drop(ctx, level);
 		return 0;
+	}
+	/* Fewer triangles at no more error: the level before is never chosen
+	 * (the runtime switches by error), so this one takes its place. */
+	mlod_mesh_level *prev = L->count > 0 ? &L->levels[L->count - 1] : NULL;
+	if (prev && lv->error.max <= prev->error.max) {
+		note(L, "the level at ratio %.4g (%d triangles) replaces the one at %.4g (%d): no more error", lv->ratio,
+		     lv->triangles, prev->ratio, prev->triangles);
+		free_level(L, prev);
+		L->count--;
 	}
 	L->levels[L->count++] = *lv;
 	free(lv);

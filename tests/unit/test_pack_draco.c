@@ -92,7 +92,12 @@ static int cmp_bytes(const void *a, const void *b)
 }
 
 /* The triangles of a part as sorted records of 3 corners of w floats,
- * each starting at its smallest corner (winding kept). */
+ * each starting at its smallest corner (winding kept), except that a
+ * triangle with two corners at one position (the first 3 floats), which
+ * has no area and so no winding, has its corners sorted: Draco's
+ * edgebreaker may turn such a triangle around (the robot's coarse
+ * levels, where quantisation puts two corners of a tiny triangle on one
+ * point). */
 static float *triangles(const float *corners, const uint32_t *idx, uint32_t ni, size_t w)
 {
 	float *t = malloc(sizeof *t * (ni ? ni : 1) * w);
@@ -102,8 +107,14 @@ static float *triangles(const float *corners, const uint32_t *idx, uint32_t ni, 
 		for (int k = 1; k < 3; k++)
 			if (memcmp(c[k], c[s], w * sizeof(float)) < 0)
 				s = k;
+		int flat = memcmp(c[0], c[1], 12) == 0 || memcmp(c[1], c[2], 12) == 0 || memcmp(c[2], c[0], 12) == 0;
+		const float *o[3] = {c[s], c[(s + 1) % 3], c[(s + 2) % 3]};
+		if (flat && memcmp(o[1], o[2], w * sizeof(float)) > 0) {
+			const float *x = o[1];
+			o[1] = o[2], o[2] = x;
+		}
 		for (int k = 0; k < 3; k++)
-			memcpy(t + (3 * (size_t)f + k) * w, c[(s + k) % 3], w * sizeof(float));
+			memcpy(t + (3 * (size_t)f + k) * w, o[k], w * sizeof(float));
 	}
 	sort_width = 3 * w * sizeof(float);
 	if (t)
