@@ -2319,9 +2319,11 @@ static mlod_result mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count
 	free(recs);
 	*part_count = np;
 	if (!cb.fail && x->degenerate[k]) {
-		char text[160];
-		snprintf(text, sizeof text, "mesh level %d: %u triangles quantisation made degenerate dropped (parts left "
-		         "without a triangle: %d)", k, x->degenerate[k], x->emptied[k]);
+		char text[160], parts[64] = "";
+		if (x->emptied[k])
+			snprintf(parts, sizeof parts, " (parts left without a triangle: %d)", x->emptied[k]);
+		snprintf(text, sizeof text, "mesh level %d: %u triangles quantisation made degenerate dropped%s", k,
+		         x->degenerate[k], parts);
 		note(x, text);
 	}
 	if (x->draco && x->draco_fail) {
