@@ -692,6 +692,8 @@ struct ctx {
 	mlod_mesh_levels ML;
 	int has_ML;
 	struct mpart *mp;          /* the parts of layout b2 (mesh_parts) */
+	uint32_t degenerate[MLOD_MESH_MAX_LEVELS + 1]; /* per MESH level: triangles quantisation made degenerate */
+	int emptied[MLOD_MESH_MAX_LEVELS + 1];         /* per MESH level: parts left without a triangle */
 	int mp_count, mp_ready;
 	int **lmaps;               /* per level and instance: level_joint_map, or NULL */
 	int lmap_count;
@@ -1693,9 +1695,9 @@ static uint32_t part_vertex(struct mpart *m, const uint8_t *key)
 	return m->count - 1;
 }
 
-/* Appends level V's vertices not yet in the buffer, in order o of the
- * level's triangles (mlod_pack_vertex_order); the level's indices into
- * the buffer, or NULL when out of memory. With cls (each vertex of V: its
+/* Appends level V's vertices not yet in the buffer that its triangles in
+ * use, in order o of the triangles (mlod_pack_vertex_order); the level's
+ * indices into the buffer, or NULL when out of memory. With cls (each vertex of V: its
  * buffer id as the hash set gave it, or for a vertex the buffer lacked,
  * count + the first of its bit-identical copies in V), the same without
  * the hash set, which it leaves as it was (for trying orders). */
@@ -1707,18 +1709,24 @@ static uint32_t *part_append(struct mpart *m, const uint8_t *V, const uint32_t *
 	uint32_t *out = malloc(sizeof *out * ((size_t)ni + 1));
 	uint32_t *gid = malloc(sizeof *gid * ((size_t)nv + 1));
 	uint32_t *idx = malloc(sizeof *idx * ((size_t)ni + 1));
-	if (!remap || !inv || !out || !gid || !idx || mlod_pack_vertex_order_memo(o, in, ni, nv, positions, memo, remap, out) != 0) {
-		free(remap), free(inv), free(out), free(gid), free(idx);
+	uint8_t *used = calloc((size_t)nv + 1, 1);
+	if (!remap || !inv || !out || !gid || !idx || !used ||
+	    mlod_pack_vertex_order_memo(o, in, ni, nv, positions, memo, remap, out) != 0) {
+		free(remap), free(inv), free(out), free(gid), free(idx), free(used);
 		return NULL;
 	}
 	for (uint32_t v = 0; v < nv; v++)
 		inv[remap[v]] = v;
+	for (uint32_t t = 0; t < ni; t++) /* a vertex only dropped triangles used: not stored */
+		used[in[t]] = 1;
 	if (cls) { /* remap becomes each new class's id: UINT32_MAX until placed */
 		uint32_t count0 = m->count;
 		for (uint32_t v = 0; v < nv; v++)
 			remap[v] = UINT32_MAX;
 		for (uint32_t j = 0; j < nv; j++) {
 			uint32_t c = cls[inv[j]];
+			if (!used[inv[j]])
+				continue;
 			if (c < count0) {
 				gid[j] = c;
 				continue;
@@ -1732,11 +1740,12 @@ static uint32_t *part_append(struct mpart *m, const uint8_t *V, const uint32_t *
 		}
 	} else {
 		for (uint32_t j = 0; j < nv; j++)
-			gid[j] = part_vertex(m, V + (size_t)inv[j] * (size_t)m->stride);
+			if (used[inv[j]])
+				gid[j] = part_vertex(m, V + (size_t)inv[j] * (size_t)m->stride);
 	}
 	for (uint32_t t = 0; t < ni; t++)
 		idx[t] = gid[out[t]];
-	free(remap), free(inv), free(out), free(gid);
+	free(remap), free(inv), free(out), free(gid), free(used);
 	return idx;
 }
 
@@ -2101,6 +2110,12 @@ static int draco_level(struct ctx *x, chunkb *cb, const struct mpart *m, const u
 {
 	mlod_draco_attr at[8 + MLOD_PACK_MAX_UV + 256];
 	int na = m->nattr, ok = 0;
+	if (nused == 0 && ni == 0 && m->ntargets <= 256) { /* no triangle left: an empty 'DRCO' */
+		cb_add(cb, MLOD_STREAM_DRCO, 0, 1, NULL, 0);
+		if (m->ntargets)
+			cb_add(cb, MLOD_STREAM_MTSC, (uint32_t)m->ntargets, 4, m->tscale, 0);
+		return !cb->fail;
+	}
 	if (nused == 0 || ni == 0 || na > (int)(sizeof at / sizeof at[0])) {
 		x->draco_fail = mlod_fail(x->err, MLOD_ERR_UNSUPPORTED,
 		                          "codec draco: a part of %u vertices, %u indices and %d attributes (Draco parts "
@@ -2198,22 +2213,34 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	int ok = 0, local = 0;
 	if (!V || !in || !saved || !f.seen || !f.map || !f.lidx || !f.words || !f.old)
 		goto done;
-	for (uint32_t i = 0; i < ni; i++)
-		in[i] = p->index_count > 0 ? p->indices[i] : i;
 	part_quantise(x, m, k, V);
 	uint32_t count0 = m->count;
 	int best = 0;
+	/* Each vertex's class once (part_append's cls), the hash set then as
+	 * it was: the orders tried need no hashing. */
+	memcpy(saved, m->slot, sizeof *saved * m->slot_cap);
+	if (!(cls = malloc(sizeof *cls * ((size_t)nv + 1))))
+		goto done;
+	for (uint32_t v = 0; v < nv; v++)
+		cls[v] = part_vertex(m, V + (size_t)v * (size_t)m->stride);
+	memcpy(m->slot, saved, sizeof *saved * m->slot_cap);
+	m->count = count0;
+	/* The triangles quantisation leaves: one whose corners are two or
+	 * three times one vertex of the buffer (bit-identical quantised
+	 * attributes) is dropped; a part may keep none at a level. */
+	uint32_t kept = 0;
+	for (uint32_t t = 0; t + 3 <= ni; t += 3) {
+		uint32_t a = p->index_count > 0 ? p->indices[t] : t, b = p->index_count > 0 ? p->indices[t + 1] : t + 1,
+		         c = p->index_count > 0 ? p->indices[t + 2] : t + 2;
+		if (cls[a] == cls[b] || cls[b] == cls[c] || cls[a] == cls[c])
+			continue;
+		in[kept++] = a, in[kept++] = b, in[kept++] = c;
+	}
+	x->degenerate[k] += (ni - kept) / 3;
+	x->emptied[k] += ni > 0 && kept == 0;
+	ni = kept;
 	if (x->opt->codec == MLOD_CODEC_MESHOPT && !x->draco) {
 		size_t best_bytes = 0;
-		/* Each vertex's class once (part_append's cls), the hash set
-		 * then as it was: the orders tried need no hashing. */
-		memcpy(saved, m->slot, sizeof *saved * m->slot_cap);
-		if (!(cls = malloc(sizeof *cls * ((size_t)nv + 1))))
-			goto done;
-		for (uint32_t v = 0; v < nv; v++)
-			cls[v] = part_vertex(m, V + (size_t)v * (size_t)m->stride);
-		memcpy(m->slot, saved, sizeof *saved * m->slot_cap);
-		m->count = count0;
 		for (int o = 0; o < MLOD_PACK_ORDERS; o++) {
 			uint32_t *ix = part_append(m, V, in, ni, nv, p->positions, o, &memo, cls);
 			if (!ix)
@@ -2291,6 +2318,14 @@ static mlod_result mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count
 	}
 	free(recs);
 	*part_count = np;
+	if (!cb.fail && x->degenerate[k]) {
+		char text[160], parts[64] = "";
+		if (x->emptied[k])
+			snprintf(parts, sizeof parts, " (parts left without a triangle: %d)", x->emptied[k]);
+		snprintf(text, sizeof text, "mesh level %d: %u triangles quantisation made degenerate dropped%s", k,
+		         x->degenerate[k], parts);
+		note(x, text);
+	}
 	if (x->draco && x->draco_fail) {
 		cb_free(&cb);
 		return x->draco_fail;
@@ -3772,19 +3807,23 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		if ((r = skel_level_chunk(&x, k, &body)) != MLOD_OK)
 			goto done;
 	x.st->skeleton.seconds += now_seconds() - t0;
+	/* Rank i from the coarsest: mesh level M - 1 - i, then motion level
+	 * A - 1 - i of every clip, so that the coarsest of both layers come
+	 * first however many levels each has (mlod(5) Chunk order). */
 	int top = (M > A ? M : A) - 1;
-	for (int k = top; k >= 0; k--) {
+	for (int i = 0; i <= top; i++) {
+		int mk = M - 1 - i, k = A - 1 - i;
 		t0 = now_seconds();
-		if (k < M) {
+		if (mk >= 0) {
 			int np = 0;
-			if ((r = mesh_chunk(&x, k, &body, &np)) != MLOD_OK)
+			if ((r = mesh_chunk(&x, mk, &body, &np)) != MLOD_OK)
 				goto done;
-			if (k == 0)
+			if (mk == 0)
 				parts0 = np;
 		}
 		x.st->mesh.seconds += now_seconds() - t0;
 		t0 = now_seconds();
-		for (int q = 0; k < A && q < x.v.clip_count; q++) {
+		for (int q = 0; k >= 0 && q < x.v.clip_count; q++) {
 			const mlod_clip *cl = k == 0 ? x.clips[q].level0 : x.clips[q].clip[k - 1];
 			motion_img *mi = &x.motion_imgs[2 * q + (k & 1)], *base = k + 1 < A ? &x.motion_imgs[2 * q + !(k & 1)] : NULL;
 			if ((r = motion_chunk(&x, cl, k, q, k == 0 ? x.clips[q].error0 : x.clips[q].error[k - 1], base, mi,

@@ -318,17 +318,80 @@ static int node_parts(const mlod_pack_mesh *m, int node, int *out)
 	return n;
 }
 
-/* Adds the mesh of node's parts at one level (like glTF mesh `like`).
- * map (per skin, may be NULL) remaps skinned parts' joints. */
-static mlod_result add_parts_mesh(mlod_gltf *doc, const mlod_pack_mesh *m, const int *parts, int count, int like,
-                                  int **map, int rigid, const mlod_skeleton *s, int *out, mlod_error *err)
+/* A part without a triangle at a level (the writer drops the triangles
+ * quantisation makes degenerate, mlod(5) MESH levels): glTF has no empty
+ * primitive, so it goes out as one degenerate triangle on one vertex,
+ * which mlod-pack drops again. The vertex is the part's first at the
+ * nearest level that has one; a part with none at any level gets one
+ * made up (at its grid's origin, normal +z, joint 0 of weight 1) in lone,
+ * with *zeros its morph targets' zero deltas. */
+typedef struct lone_vertex {
+	float pos[3], nrm[3], tan[4], uv[MLOD_PACK_MAX_UV][2], col[4], w[4];
+	uint16_t j[4];
+	uint32_t idx[3];
+} lone_vertex;
+
+static mlod_result lone_primitive(const mlod_pack_mesh *meshes, int levels, int k, int part, mlod_primitive *p,
+                                  mlod_morph_target *targets, lone_vertex *lone, float **zeros, mlod_error *err)
 {
+	const mlod_pack_part *q = &meshes[k].parts[part];
+	for (int d = 1; d < levels; d++) /* the nearest level with vertices, finer first */
+		for (int e = -1; e <= 1; e += 2) {
+			int l = k + e * d;
+			if (l >= 0 && l < levels && meshes[l].parts[part].rec.vertex_count > 0) {
+				part_primitive(&meshes[l].parts[part], p, targets);
+				p->vertex_count = 1;
+				p->material = q->rec.material;
+				p->index_count = 3;
+				p->indices = lone->idx;
+				return MLOD_OK;
+			}
+		}
+	memset(lone, 0, sizeof *lone);
+	part_primitive(q, p, targets);
+	memcpy(lone->pos, q->rec.pos_min, sizeof lone->pos);
+	lone->nrm[2] = 1.0f;
+	lone->tan[0] = lone->tan[3] = 1.0f;
+	for (uint32_t t = 0; t < q->rec.uv_sets; t++) {
+		memcpy(lone->uv[t], q->rec.uv_min[t], sizeof lone->uv[t]);
+		p->uvs[t] = lone->uv[t];
+	}
+	for (int c = 0; c < 4; c++)
+		lone->col[c] = 1.0f;
+	lone->w[0] = 1.0f;
+	p->vertex_count = 1;
+	p->positions = lone->pos;
+	p->normals = q->rec.flags & MLOD_PART_NORMALS ? lone->nrm : NULL;
+	p->tangents = q->rec.flags & MLOD_PART_TANGENTS ? lone->tan : NULL;
+	p->color_set_count = q->rec.flags & MLOD_PART_COLORS ? 1 : 0;
+	p->colors[0] = p->color_set_count ? lone->col : NULL;
+	p->weight_set_count = q->rec.flags & MLOD_PART_SKINNED ? 1 : 0;
+	p->joints[0] = p->weight_set_count ? lone->j : NULL;
+	p->weights[0] = p->weight_set_count ? lone->w : NULL;
+	p->index_count = 3;
+	p->indices = lone->idx;
+	if (q->rec.target_count > 0 && !(*zeros = calloc(3, sizeof **zeros)))
+		return nomem(err);
+	for (uint32_t t = 0; t < q->rec.target_count; t++)
+		targets[t].positions = *zeros;
+	return MLOD_OK;
+}
+
+/* Adds the mesh of node's parts at level k of meshes (levels of them;
+ * like glTF mesh `like`). map (per skin, may be NULL) remaps skinned
+ * parts' joints. */
+static mlod_result add_parts_mesh(mlod_gltf *doc, const mlod_pack_mesh *meshes, int levels, int k, const int *parts,
+                                  int count, int like, int **map, int rigid, const mlod_skeleton *s, int *out,
+                                  mlod_error *err)
+{
+	const mlod_pack_mesh *m = &meshes[k];
 	mlod_primitive *prims = calloc((size_t)count + 1, sizeof *prims);
 	mlod_morph_target **targets = calloc((size_t)count + 1, sizeof *targets);
 	uint16_t **js = calloc((size_t)count + 1, sizeof *js);
-	float **ws = calloc((size_t)count + 1, sizeof *ws);
+	float **ws = calloc((size_t)count + 1, sizeof *ws), **zeros = calloc((size_t)count + 1, sizeof *zeros);
+	lone_vertex *lone = calloc((size_t)count + 1, sizeof *lone);
 	mlod_result r = MLOD_OK;
-	if (!prims || !targets || !js || !ws)
+	if (!prims || !targets || !js || !ws || !zeros || !lone)
 		r = nomem(err);
 	for (int i = 0; r == MLOD_OK && i < count; i++) {
 		const mlod_pack_part *q = &m->parts[parts[i]];
@@ -338,6 +401,10 @@ static mlod_result add_parts_mesh(mlod_gltf *doc, const mlod_pack_mesh *m, const
 			break;
 		}
 		part_primitive(q, &prims[i], targets[i]);
+		if (q->rec.index_count == 0 &&
+		    (r = lone_primitive(meshes, levels, k, parts[i], &prims[i], targets[i], &lone[i], &zeros[i], err)) !=
+		        MLOD_OK)
+			break;
 		int sk = q->rec.skin;
 		if (map && sk >= 0 && sk < s->skin_count && prims[i].weight_set_count)
 			r = remap_primitive(&prims[i], map[sk], s->skins[sk].joint_count, &js[i], &ws[i], err);
@@ -373,10 +440,14 @@ static mlod_result add_parts_mesh(mlod_gltf *doc, const mlod_pack_mesh *m, const
 			free(js[i]);
 		if (ws)
 			free(ws[i]);
+		if (zeros)
+			free(zeros[i]);
 	}
 	free(targets);
 	free(js);
 	free(ws);
+	free(zeros);
+	free(lone);
 	free(prims);
 	return r;
 }
@@ -821,7 +892,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			} else if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) && mesh_map[like] >= 0) {
 				mesh = mesh_map[like];
 			} else {
-				if ((r = add_parts_mesh(doc, &meshes[0], parts, count, like, NULL, 0, &s, &mesh, err)) != MLOD_OK)
+				if ((r = add_parts_mesh(doc, meshes, (int)mesh_levels, 0, parts, count, like, NULL, 0, &s, &mesh, err)) != MLOD_OK)
 					goto done;
 				/* the DOC mesh's points, lines, strips and fans, kept whole */
 				if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) &&
@@ -867,7 +938,8 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 					}
 					skin = rigid_index;
 				}
-				if ((r = add_parts_mesh(doc, &meshes[k], parts, count, like, map, q0->skin < 0 && q0->joint >= 0, &s, &lmesh, err)) != MLOD_OK)
+				if ((r = add_parts_mesh(doc, meshes, (int)mesh_levels, k, parts, count, like, map, q0->skin < 0 && q0->joint >= 0, &s,
+				                          &lmesh, err)) != MLOD_OK)
 					goto done;
 				char name[96];
 				snprintf(name, sizeof name, "mlod mesh level %d of node %d", k, node);

@@ -509,7 +509,7 @@ typedef struct mlod_pack_part_rec {
 	int32_t material;          /* glTF material of the input, or -1 */
 	uint32_t flags;            /* MLOD_PART_* */
 	uint32_t vertex_count;
-	uint32_t index_count;      /* a multiple of 3 */
+	uint32_t index_count;      /* a multiple of 3; 0 (and vertex_count 0): no triangle left at the level */
 	uint32_t uv_sets;          /* 0..MLOD_PACK_MAX_UV */
 	uint32_t target_count;     /* morph targets (positions only) */
 	float offset[16];          /* mlod_instance.offset */

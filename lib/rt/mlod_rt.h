@@ -334,7 +334,9 @@ void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out);
  * its vertices are first_vertex .. first_vertex + vertex_count - 1 of the
  * skinned output, its triangles index_count indices local to the part
  * (add first_vertex), pointing into the resident level: valid until that
- * level is evicted (mlod_rt_stream) or the context closes. */
+ * level is evicted (mlod_rt_stream) or the context closes. A part that
+ * quantisation left without a triangle at a level has vertex_count and
+ * index_count 0 there (mlod(5) MESH levels): nothing to draw. */
 typedef struct mlod_rt_part_info {
 	uint32_t first_vertex, vertex_count;
 	uint32_t index_count;

@@ -245,15 +245,22 @@ static int known_type(uint32_t type)
 
 /* The position of a known chunk in the format's order (strictly increasing
  * along the TOC): INFO, SKELETON, skeleton levels coarsest first, then per
- * level coarsest first the mesh level and the motion levels by clip, DOC. */
-static uint64_t order_key(const mlod_pack_chunk *c)
+ * rank from the coarsest the mesh level and the motion levels by clip, DOC.
+ * mesh_top and motion_top are the TOC's coarsest MESH and MOTION levels:
+ * MESH level L ranks mesh_top - L, MOTION level L motion_top - L (0 the
+ * coarsest of each layer). The writers before the coarsest of both layers
+ * came first ranked both from 65535 (level L with level L, the coarsest
+ * motion level after mesh level 0 when a clip has fewer levels): a TOC
+ * may follow either order. */
+static uint64_t order_key(const mlod_pack_chunk *c, unsigned mesh_top, unsigned motion_top)
 {
 	uint64_t inv = 65535u - c->level;
 	switch (c->type) {
 	case MLOD_CHUNK_INFO: return 0;
 	case MLOD_CHUNK_SKELETON: return c->level == 0 ? (uint64_t)1 << 40 : (uint64_t)2 << 40 | inv << 24;
-	case MLOD_CHUNK_MESH: return (uint64_t)3 << 40 | inv << 24;
-	case MLOD_CHUNK_MOTION: return (uint64_t)3 << 40 | inv << 24 | (uint64_t)1 << 16 | c->item;
+	case MLOD_CHUNK_MESH: return (uint64_t)3 << 40 | (uint64_t)(mesh_top - c->level) << 24;
+	case MLOD_CHUNK_MOTION:
+		return (uint64_t)3 << 40 | (uint64_t)(motion_top - c->level) << 24 | (uint64_t)1 << 16 | c->item;
 	default: return (uint64_t)4 << 40;
 	}
 }
@@ -378,10 +385,19 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		if (!chunks)
 			return mlod_fail(err, MLOD_ERR_NOMEM, "pack TOC: out of memory for %u entries", n);
 	}
-	uint64_t prev_end = toc_end, prev_key = 0;
-	int have_prev = 0;
+	uint64_t prev_end = toc_end, prev_key = 0, prev_key1 = 0;
+	int have_prev = 0, ordered = 1, ordered1 = 1; /* in order so far: by rank, by level (the older writers') */
 	mlod_result r = MLOD_OK;
 	char label[64];
+	unsigned mesh_top = 0, motion_top = 0; /* the coarsest level of each layer ranks 0 */
+	for (uint32_t i = 0; i < n; i++) {
+		const uint8_t *e = d + MLOD_PACK_HEADER_SIZE + (size_t)i * MLOD_PACK_TOC_ENTRY_SIZE;
+		unsigned lv = rd16(e + 6);
+		if (rd32(e) == MLOD_CHUNK_MESH && lv > mesh_top)
+			mesh_top = lv;
+		if (rd32(e) == MLOD_CHUNK_MOTION && lv > motion_top)
+			motion_top = lv;
+	}
 	for (uint32_t i = 0; i < n && r == MLOD_OK; i++) {
 		const uint8_t *e = d + MLOD_PACK_HEADER_SIZE + (size_t)i * MLOD_PACK_TOC_ENTRY_SIZE;
 		mlod_pack_chunk *c = &chunks[i];
@@ -442,7 +458,9 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 			                      : c->type == MLOD_CHUNK_MESH   ? MLOD_LAYER_MESH
 			                      : c->type == MLOD_CHUNK_MOTION ? MLOD_LAYER_MOTION
 			                                                     : MLOD_LAYER_NONE;
-			uint64_t key = order_key(c);
+			uint64_t key = order_key(c, mesh_top, motion_top), key1 = order_key(c, 65535u, 65535u);
+			ordered = ordered && (!have_prev || key > prev_key);
+			ordered1 = ordered1 && (!have_prev || key1 > prev_key1);
 			if (c->layer != want_layer)
 				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): layer %u, expected %u (%s)", i, label,
 				              c->layer, want_layer, mlod_pack_layer_name(want_layer));
@@ -456,12 +474,13 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 			else if (have_prev && key == prev_key)
 				r = mlod_fail(err, MLOD_ERR_PARSE, "TOC entry %u (%s): a second chunk of that type, level and item", i,
 				              label);
-			else if (have_prev && key < prev_key)
+			else if (!ordered && !ordered1)
 				r = mlod_fail(err, MLOD_ERR_PARSE,
 				              "TOC entry %u (%s) is out of order: chunks go INFO, SKELETON, skeleton levels, then mesh "
 				              "and motion levels coarsest first, DOC last",
 				              i, label);
 			prev_key = key;
+			prev_key1 = key1;
 			have_prev = 1;
 		}
 		prev_end = c->offset + c->stored_size;
@@ -1900,9 +1919,9 @@ static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const ml
 		if (rc->flags & (MLOD_PART_INDEX16 | MLOD_PART_LOCAL | MLOD_PART_NEWBITS))
 			FAIL("%s: part %u: flags 0x%x: INDEX16, LOCAL and NEWBITS are not for a Draco chunk", x.label, i,
 			     rc->flags);
-		if (rc->vertex_count == 0 || rc->index_count == 0)
-			FAIL("%s: part %u: %u vertices and %u indices: a Draco part has triangles", x.label, i, rc->vertex_count,
-			     rc->index_count);
+		if ((rc->vertex_count == 0) != (rc->index_count == 0))
+			FAIL("%s: part %u: %u vertices and %u indices: a Draco part has triangles or neither", x.label, i,
+			     rc->vertex_count, rc->index_count);
 		uint64_t V = rc->vertex_count, T = rc->target_count;
 		uint32_t tag[VSTREAMS_MAX], size[VSTREAMS_MAX];
 		int nv = part_vstreams(rc, tag, size);
@@ -1952,8 +1971,10 @@ static mlod_result decode_mesh_draco(const mesh_src *m, uint32_t chunk, const ml
 		memset(gather, 0, off); /* the dropped fourth components */
 		TAKE(pt->indices, (uint64_t)rc->index_count * 4);
 		char msg[160];
-		if (mlod_rt_draco_decode(dr.src, dr.stored, V, rc->index_count, at, nv + (int)T, pt->indices, msg,
-		                         sizeof msg) != 0)
+		if (V == 0 && dr.stored != 0) /* a part without triangles (mlod(5)) */
+			FAIL("%s: part %u: no vertices, but a %llu-byte 'DRCO'", x.label, i, (unsigned long long)dr.stored);
+		if (V > 0 && mlod_rt_draco_decode(dr.src, dr.stored, V, rc->index_count, at, nv + (int)T, pt->indices, msg,
+		                                  sizeof msg) != 0)
 			FAIL("%s: part %u: %s", x.label, i, msg);
 		float *scales = NULL;
 		if (T) {

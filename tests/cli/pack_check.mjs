@@ -171,8 +171,9 @@ if (n > 1 && chunks[1].type === 'SKEL') {
 	}
 }
 
-// Order: INFO, SKEL 0, skeleton levels coarsest first, then per level
-// coarse to fine mesh and motion, DOC last.
+// Order: INFO, SKEL 0, skeleton levels coarsest first, then per rank from
+// the coarsest (MESH level top - rank, then ANIM level top - rank of every
+// clip in clip order: the coarsest levels of both layers first), DOC last.
 const types = chunks.map((c) => c.type);
 if (types[0] !== 'INFO' || types[1] !== 'SKEL' || chunks[1].level !== 0 || types[n - 1] !== 'DOC ') die(`order: ${types.join(',')}`);
 let i = 2, last = Infinity;
@@ -180,11 +181,14 @@ for (; i < n && types[i] === 'SKEL'; i++) {
 	if (!(chunks[i].level < last) || chunks[i].level === 0) die('skeleton levels not coarsest first');
 	last = chunks[i].level;
 }
-last = Infinity;
+const top = (t) => Math.max(-1, ...chunks.filter((c) => c.type === t).map((c) => c.level));
+const meshTop = top('MESH'), animTop = top('ANIM');
+last = -Infinity;
 for (; i < n - 1; i++) {
 	if (types[i] !== 'MESH' && types[i] !== 'ANIM') die(`chunk ${i}: ${types[i]} among the levels`);
-	if (chunks[i].level > last) die(`chunk ${i}: level ${chunks[i].level} after ${last}`);
-	last = chunks[i].level;
+	const c = chunks[i], key = (c.type === 'MESH' ? meshTop - c.level : animTop - c.level) * 1e6 + (c.type === 'ANIM' ? 1 + c.item : 0);
+	if (!(key > last)) die(`chunk ${i}: ${c.type} level ${c.level} item ${c.item} out of order`);
+	last = key;
 }
 
 // INFO.

@@ -2508,6 +2508,40 @@ TEST(structural_checks_name_the_chunk)
 	}
 }
 
+/* The order of the levels with fewer motion levels than mesh levels (the
+ * test pack without MOTION level 1): the coarsest of both layers first
+ * (MESH 1, MOTION 0, MESH 0), or level with level as the writers before
+ * wrote it (MESH 1, MESH 0, MOTION 0); MOTION 0 before MESH 1 is in
+ * neither. */
+TEST(toc_order_ranks)
+{
+	static wchunk c[C_COUNT + 1];
+	int n = make_chunks(c, 0);
+	wchunk w[C_COUNT];
+	const int orders[3][C_COUNT - 1] = {
+		{C_INFO, C_SKEL, C_SKEL1, C_MESH1, C_MOT0, C_MESH0, C_DOC},
+		{C_INFO, C_SKEL, C_SKEL1, C_MESH1, C_MESH0, C_MOT0, C_DOC},
+		{C_INFO, C_SKEL, C_SKEL1, C_MOT0, C_MESH1, C_MESH0, C_DOC},
+	};
+	for (int o = 0; o < 3; o++) {
+		for (int i = 0; i < C_COUNT - 1; i++)
+			w[i] = c[orders[o][i]];
+		buf b = build_pack(w, C_COUNT - 1, MLOD_PACK_MAJOR, MLOD_PACK_MINOR);
+		mlod_pack p;
+		if (o < 2) {
+			memset(&terr, 0, sizeof terr);
+			mlod_result r = mlod_pack_open(b.p, b.n, &p, &terr);
+			CHECK_MSG(r == MLOD_OK, "order %d: %s", o, terr.message);
+			if (r == MLOD_OK)
+				mlod_pack_close(&p);
+		} else {
+			CHECK_ERR(mlod_pack_open(b.p, b.n, &p, &terr), MLOD_ERR_PARSE, "TOC entry 4 (MESH level 1) is out of order");
+		}
+		free(b.p);
+	}
+	free_chunks(c, n);
+}
+
 /* TOC and header damage, each with the CRCs re-stamped. */
 TEST(toc_checks)
 {
@@ -2531,7 +2565,8 @@ TEST(toc_checks)
 	DAMAGE(wr32(d + 12, 60000), MLOD_ERR_PARSE, "truncated pack: the TOC of 60000 chunks");
 	DAMAGE(wr32(mesh1 + 24, 0x7fffffff), MLOD_ERR_PARSE, "lie outside the file");
 	DAMAGE(mesh1[4] = MLOD_LAYER_MOTION, MLOD_ERR_PARSE, "TOC entry 3 (MESH level 1): layer 3, expected 2 (mesh)");
-	DAMAGE(mesh1[6] = 0, MLOD_ERR_PARSE, "TOC entry 4 (MOTION level 1 of clip 0) is out of order");
+	/* MESH levels 0, 0: in neither order from entry 5 (the second) on */
+	DAMAGE(mesh1[6] = 0, MLOD_ERR_PARSE, "TOC entry 5 (MESH level 0) is out of order");
 	DAMAGE((wr32(d + 32 + 48 * C_MOT0, MLOD_CHUNK_MESH), d[32 + 48 * C_MOT0 + 4] = MLOD_LAYER_MESH), MLOD_ERR_PARSE,
 	       "TOC entry 6 (MESH level 0): a second chunk of that type, level and item");
 	DAMAGE(wr32(d + 32 + 48 * C_MOT1 + 36, 0xff800000u), MLOD_ERR_PARSE, "must be finite");
@@ -3012,6 +3047,7 @@ int main(int argc, char **argv)
 	RUN(every_prefix_zstd);
 	RUN(entropy_checks);
 	RUN(structural_checks_name_the_chunk);
+	RUN(toc_order_ranks);
 	RUN(toc_checks);
 	RUN(absurd_sizes);
 	RUN(expansion_limits);

@@ -1156,6 +1156,103 @@ TEST(motion_level0_bound)
 	free(in);
 }
 
+/* Chunk order (mlod(5)): the coarsest levels of both layers first, so that
+ * first_drawable ends at them. tubeman has 5 mesh levels and 4 motion
+ * levels: MOTION level 3 comes right after MESH level 4, before MESH level
+ * 3 (the writers before placed it after MESH level 3), and first_drawable
+ * is its end. */
+TEST(pack_coarsest_first)
+{
+	size_t n = 0;
+	void *in = slurp("samples/tubeman.glb", &n);
+	CHECK(in);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	void *out = NULL;
+	size_t size = 0;
+	mlod_pack_stats st;
+	CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, &st, &terr));
+	CHECK(st.mesh.levels == 5 && st.motion.levels == 4);
+	const uint8_t *m4 = out ? find_entry(out, MLOD_CHUNK_MESH, 4) : NULL, *m3 = out ? find_entry(out, MLOD_CHUNK_MESH, 3) : NULL;
+	const uint8_t *a3 = out ? find_entry(out, MLOD_CHUNK_MOTION, 3) : NULL;
+	CHECK(m4 && m3 && a3);
+	if (m4 && m3 && a3) {
+		CHECK_MSG(a3 == m4 + 48, "MOTION level 3 is TOC entry %d, MESH level 4 %d",
+		          (int)((a3 - (const uint8_t *)out - 32) / 48), (int)((m4 - (const uint8_t *)out - 32) / 48));
+		uint64_t a3_end = rd32(a3 + 16) + (uint64_t)rd32(a3 + 24);
+		CHECK_MSG(st.first_drawable == a3_end && a3_end <= rd32(m3 + 16), "first_drawable %u, MOTION level 3 ends at "
+		          "%llu, MESH level 3 starts at %u", st.first_drawable, (unsigned long long)a3_end, rd32(m3 + 16));
+	}
+	mlod_free(out);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	free(in);
+}
+
+/* Triangles quantisation makes degenerate (mlod(5) MESH levels): in
+ * RobotExpressive's pack no decoded triangle has two equal indices (the
+ * writers before kept "3 3 3" in part 8, ShoulderR_1, at level 3, and the
+ * part as one vertex and "0 0 0" at level 4), and that part has no vertex
+ * and no triangle at level 4; the report notes the triangles dropped. */
+TEST(pack_no_degenerate_triangles)
+{
+	size_t n = 0;
+	void *in = slurp("samples/RobotExpressive.glb", &n);
+	CHECK(in);
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	CHECK_OK(mlod_load(in, n, NULL, &doc, &c, &fmt, &terr));
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	void *out = NULL;
+	size_t size = 0;
+	mlod_pack_stats st;
+	CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &out, &size, &st, &terr));
+	CHECK_MSG(strstr(st.notes, "quantisation made degenerate dropped") != NULL, "notes: %.900s", st.notes);
+	mlod_pack p;
+	mlod_pack_skeleton sk = {0};
+	long degenerate = 0, empty = 0, empty_coarsest = 0, parts = 0;
+	if (out && mlod_pack_open(out, size, &p, &terr) == MLOD_OK) {
+		CHECK_OK(mlod_pack_decode_skeleton(&p, out, size, &sk, &terr));
+		for (int k = 0; k < st.mesh.levels; k++) {
+			mlod_pack_mesh m = {0};
+			int ch = mlod_pack_find(&p, MLOD_CHUNK_MESH, (unsigned)k, 0);
+			CHECK(ch >= 0);
+			if (ch < 0 || mlod_pack_decode_mesh(&p, (uint32_t)ch, out, size, &sk, &m, &terr) != MLOD_OK) {
+				CHECK_MSG(0, "MESH level %d: %s", k, terr.message);
+				continue;
+			}
+			for (uint32_t i = 0; i < m.part_count; i++) {
+				const mlod_pack_part *q = &m.parts[i];
+				const uint32_t *x = q->indices;
+				parts++;
+				for (uint32_t t = 0; t + 2 < q->rec.index_count; t += 3)
+					degenerate += x[t] == x[t + 1] || x[t + 1] == x[t + 2] || x[t] == x[t + 2];
+				if (q->rec.index_count == 0) {
+					empty++;
+					CHECK(q->rec.vertex_count == 0);
+					empty_coarsest += k == st.mesh.levels - 1 && i == 8;
+				}
+			}
+			mlod_pack_mesh_free(&m);
+		}
+		mlod_pack_skeleton_free(&sk);
+		mlod_pack_close(&p);
+	}
+	CHECK_MSG(parts == 5 * 19 && degenerate == 0 && empty == 1 && empty_coarsest == 1,
+	          "%ld parts, %ld degenerate triangles, %ld parts without triangles (%ld part 8 at the coarsest level)", parts,
+	          degenerate, empty, empty_coarsest);
+	mlod_free(out);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	free(in);
+}
+
 int main(void)
 {
 	RUN(weights_sum_to_255);
@@ -1172,5 +1269,7 @@ int main(void)
 	RUN(nested_motion_streams_alone);
 	RUN(motion_level0_bound);
 	RUN(entropy_stage);
+	RUN(pack_coarsest_first);
+	RUN(pack_no_degenerate_triangles);
 	TEST_EXIT();
 }
