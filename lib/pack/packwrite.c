@@ -1281,8 +1281,9 @@ static mlod_result same_triangles(struct ctx *x, const mlod_mesh_levels *L, int 
  * and options (mlod-pack's own: the record holds no other) give the
  * same triangles, with their weights on the full skin and their posed
  * errors. *rebuilt 0 (and nothing kept) when the record has no ratio for
- * every level (mlod-pack -x writes none) or the rebuild gives other
- * triangles (mlod-bgm ran with options the record does not hold). */
+ * every level (mlod-pack -x writes none), the rebuild gives other
+ * triangles (mlod-bgm ran with options the record does not hold) or
+ * fails but for memory. */
 static mlod_result rebuild_levels(struct ctx *x, int *rebuilt)
 {
 	double ratios[MLOD_MESH_MAX_LEVELS];
@@ -1309,7 +1310,8 @@ static mlod_result rebuild_levels(struct ctx *x, int *rebuilt)
 	if (r != MLOD_OK || !same) {
 		mlod_mesh_levels_free(&x->ML);
 		x->has_ML = 0;
-		return r;
+		/* levels that cannot be made again are measured instead */
+		return r == MLOD_ERR_NOMEM ? r : MLOD_OK;
 	}
 	for (int k = 0; k < n; k++) {
 		x->level_mesh[k] = x->ML.levels[k].meshes;
