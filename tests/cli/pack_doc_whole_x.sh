@@ -4,7 +4,8 @@
 # instead of the pack's level-0 channels going in beside them (each joint
 # animated twice: 32 validator errors, and a pack again its reader
 # refused). The glb validates, and packed again it has the same levels:
-# every chunk's level, clip, error and switch distance.
+# every chunk's level, clip, error and switch distance (but for the coarse
+# mesh levels' errors, measured again: issue 11).
 set -e
 node "$ROOT/tests/glb-edit.mjs" "$ROOT/samples/tubeman.glb" ext.glb 'j.extensionsUsed = ["EXT_foo_unknown"];'
 "$BIN/mlod-pack" ext.glb -o ext.mlod 2> /dev/null
@@ -26,6 +27,11 @@ PY
 python3 - a.json b.json <<'PY'
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:])
-key = lambda j: [(c['type'], c['level'], c['clip'], c['error'], c['distance']) for c in j['chunks']]
+# coarse mesh levels on skeleton levels' skins are measured again (issue
+# 11): their errors and distances may grow, never shrink
+mesh = lambda c: c['type'] == 'MESH' and c['level'] > 0
+key = lambda j: [(c['type'], c['level'], c['clip']) + (() if mesh(c) else (c['error'], c['distance'])) for c in j['chunks']]
 assert key(a) == key(b), (key(a), key(b))
+for c, d in zip(a['chunks'], b['chunks']):
+    assert not mesh(c) or (d['error'] >= c['error'] and d['distance'] >= c['distance']), (c, d)
 PY

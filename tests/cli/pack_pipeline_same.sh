@@ -1,8 +1,9 @@
 # The piped stages and mlod-pack alone (mlod-pack(1) DESCRIPTION): with
-# mlod-motion --precision full and the same --name, the pipeline without
-# mlod-skelgraph gives the same pack byte for byte; with mlod-skelgraph the
-# motion chunks are still the same and the mesh chunks differ (the level
-# skins); mlod-motion's default precision gives other motion chunks.
+# mlod-motion --precision full and the same --name, the pipeline gives the
+# same pack byte for byte, with or without mlod-skelgraph (whose skeleton
+# levels mlod-bgm binds its mesh levels to: mlod-pack makes them again on
+# the full skin, issue 11); mlod-motion's default precision gives other
+# motion chunks.
 set -e
 cp "$ROOT/samples/tubeman.glb" .
 "$BIN/mlod-pack" -o direct.mlod tubeman.glb
@@ -15,10 +16,8 @@ cmp direct.mlod piped.mlod
 for f in direct full auto; do
 	"$BIN/mlod-pack" --info $f.mlod > $f.txt
 	grep '^ANIM' $f.txt | sed 's/  */ /g' > $f.anim
-	grep '^MESH' $f.txt | sed 's/  */ /g' > $f.mesh
 done
-cmp direct.anim full.anim
-if cmp -s direct.mesh full.mesh; then exit 1; fi
+cmp direct.mlod full.mlod
 if cmp -s direct.anim auto.anim; then exit 1; fi
 # The rounded levels cost motion bytes: the auto pack's are more.
 motion() { awk '$1 == "#" && $3 == "motion" { print $7 }' "$1" | tr -d ,; }
