@@ -7,7 +7,7 @@
 # 1.34, 2.08 MB; meshes 6, 11; packs 321791, 509471, 561650 bytes) and the
 # first -x held the input's mesh unused beside the rebuilt one. Now the
 # second round's glb has the first's size and counts, and the packs of
-# rounds 2 and 3 are the same bytes. Without skeleton levels: with them,
+# rounds 2 and 4 are the same bytes. Without skeleton levels: with them,
 # -x writes the coarse mesh levels on their skins, each round measures
 # them again (issue 11), and their errors and the coarse vertices' steps
 # take more rounds to settle (mlod-pack(1) BUGS).
@@ -20,9 +20,17 @@ node "$ROOT/tests/glb-edit.mjs" "$ROOT/samples/tubeman.glb" c.glb 'j.extensionsU
 "$BIN/mlod-pack" c2.glb -o c2.mlod 2> /dev/null
 "$BIN/mlod-pack" -x c2.mlod -o c3.glb
 "$BIN/mlod-pack" c3.glb -o c3.mlod 2> /dev/null
+"$BIN/mlod-pack" -x c3.mlod -o c4.glb
+"$BIN/mlod-pack" c4.glb -o c4.mlod 2> /dev/null
 node "$ROOT/tests/validate.mjs" c1.glb > /dev/null
 node "$ROOT/tests/validate.mjs" c2.glb > /dev/null
-cmp c2.mlod c3.mlod
+# From the second round the packs alternate between two vertex orders of
+# the coarsest mesh level (the writer picks its order afresh from the
+# order it reads; since the collapses keep faces right side out, tubeman's
+# coarsest level no longer settles in one): round 4 is round 2's bytes,
+# and round 3 is no larger than round 1.
+cmp c2.mlod c4.mlod
+[ "$(stat -c %s c3.mlod)" -le "$(stat -c %s c1.mlod)" ]
 python3 - c.glb c1.glb c2.glb <<'PY'
 import json, os, struct, sys
 def glb(f):
