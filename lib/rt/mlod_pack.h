@@ -9,7 +9,8 @@
  * and never prints or exits.
  *
  * ------------------------------------------------------------------
- * File layout (format 7.0). Everything is little-endian.
+ * File layout (format 8.0: 7.0 with the coarsest levels of every layer
+ * first, mlod(5) Chunk order and streaming). Everything is little-endian.
  *
  *   header      32 bytes at offset 0
  *   TOC         chunk_count entries of 48 bytes, right after the header
@@ -291,7 +292,7 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 7
+#define MLOD_PACK_MAJOR 8
 #define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
 #define MLOD_PACK_MINOR 0
 #define MLOD_PACK_HEADER_SIZE 32

@@ -1503,7 +1503,7 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 8.0 is newer than this reader's 7.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 9.0 is newer than this reader's 8.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
 }
 
@@ -1538,7 +1538,7 @@ TEST(older_major_is_refused)
 	free(b.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && p.chunks == NULL, "returned %d: %s", (int)r, terr.message);
 	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
-	                               "reads 2.x to 7.x)") == 0,
+	                               "reads 2.x to 8.x)") == 0,
 	          "message: %s", terr.message);
 }
 
