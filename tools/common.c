@@ -171,13 +171,18 @@ static char *dir_of(const char *path)
 /* The reader's warnings (mlod_character.warnings: what it changed,
  * approximated or dropped of the input), one line each on stderr, with or
  * without a report. Their names are already quoted (no line breaks). */
-static void put_warnings(const char *path, const mlod_character *c)
+void tool_note_lines(const char *what, const char *lines)
 {
-	for (const char *w = c->warnings; w && *w;) {
+	for (const char *w = lines; w && *w;) {
 		size_t n = strcspn(w, "\n");
-		tool_note(tool_input_label(path), "%.*s", (int)n, w);
+		tool_note(what, "%.*s", (int)n, w);
 		w += n + (w[n] == '\n');
 	}
+}
+
+static void put_warnings(const char *path, const mlod_character *c)
+{
+	tool_note_lines(tool_input_label(path), c->warnings);
 }
 
 /* Exits at a failed load, with the reader's message; a pack (mlod(5))

@@ -25,6 +25,10 @@ enum {
 /* The tool's name for messages ("mlod-label"). Set once in main. */
 extern const char *tool_name;
 
+/* tool_note for each line of lines ("\n"-separated; NULL or "": none):
+ * the reader's and the pack writer's warnings. */
+void tool_note_lines(const char *what, const char *lines);
+
 /* Prints "tool: what: message" to stderr and exits with code. what (a
  * file's name) is escaped as tool_put_name does; it may be NULL (then
  * "tool: message"). */

@@ -496,11 +496,7 @@ int main(int argc, char **argv)
 		tool_die(tool_exit_code(r), label, "%s", err.message);
 	if (c.clip_count == 0 && c.skeleton.joint_count > 0)
 		tool_note(label, "no animation: the pack has no motion levels");
-	for (const char *w = st.warnings; *w;) { /* what the pack does not keep, or keeps changed */
-		size_t n = strcspn(w, "\n");
-		tool_note(label, "%.*s", (int)n, w);
-		w += n + (w[n] == '\n');
-	}
+	tool_note_lines(label, st.warnings); /* what the pack does not keep, or keeps changed */
 	/* A layer option the input's own levels (mlod-skelgraph's, mlod-bgm's,
 	 * mlod-motion's) leave unused. */
 	const char *const layer_opt[3] = {skel_opt, mesh_opt, motion_opt};
