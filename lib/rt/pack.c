@@ -734,8 +734,13 @@ static mlod_result cx_unpack(cx *x, mlod_error *err)
 		if (ZSTD_isError(pr))
 			return mlod_fail(err, MLOD_ERR_NOMEM, "%s: zstd prefix: %s", x->label, ZSTD_getErrorName(pr));
 	}
-	/* ZSTD_decompressDCtx uses a referenced prefix for this frame only. */
+	/* ZSTD_decompressDCtx uses a referenced prefix for this frame only,
+	 * but keeps the dictionary object it made of it (27,352 bytes on
+	 * tubeman's mesh levels) until the next: freed here, so that the
+	 * decoder stays the size mlod_pack_decoder_bytes counted at open. */
 	size_t got = ZSTD_decompressDCtx(x->zd->z, x->plain, (size_t)want, x->base, c->stored_size);
+	if (c->entropy == MLOD_ENTROPY_ZSTD_PREFIX)
+		ZSTD_DCtx_reset(x->zd->z, ZSTD_reset_session_and_parameters);
 	if (ZSTD_isError(got))
 		return mlod_fail(err, MLOD_ERR_PARSE, "%s: zstd: %s", x->label, ZSTD_getErrorName(got));
 	if (got != want)
@@ -1076,8 +1081,17 @@ static mlod_result cx_load_into(cx *x, const stream *s, uint8_t *dst, mlod_error
 
 /* The block: one allocation carved into 8-aligned arrays, after a head
  * that records the allocator that made it (for the *_free calls). */
-enum { BLOCK_HEAD = 32 };
-_Static_assert(sizeof(mlod_pack_alloc) <= BLOCK_HEAD, "the block's head holds its allocator");
+enum { BLOCK_HEAD = 32, BLOCK_SIZE_AT = 24 };
+_Static_assert(sizeof(mlod_pack_alloc) <= BLOCK_SIZE_AT && BLOCK_SIZE_AT + sizeof(uint64_t) <= BLOCK_HEAD,
+               "the block's head holds its allocator and its size");
+
+size_t mlod_pack_block_size(const void *block)
+{
+	uint64_t n = 0;
+	if (block)
+		memcpy(&n, (const uint8_t *)block + BLOCK_SIZE_AT, sizeof n);
+	return (size_t)n;
+}
 
 static void block_free(void *block)
 {
@@ -1106,6 +1120,7 @@ static mlod_result bump_alloc(bump *b, cx *x, uint64_t total, mlod_error *err)
 	memcpy(b->base, &x->alloc, sizeof x->alloc);
 	b->used = BLOCK_HEAD;
 	b->cap = BLOCK_HEAD + total;
+	memcpy(b->base + BLOCK_SIZE_AT, &b->cap, sizeof b->cap);
 	return MLOD_OK;
 }
 

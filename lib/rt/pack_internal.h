@@ -33,4 +33,8 @@ mlod_result mlod_pack_info_check_skeleton(const mlod_pack_info *info, const mlod
 mlod_result mlod_pack_info_check_mesh(const mlod_pack_info *info, const mlod_pack_mesh *mesh, unsigned level,
                                       mlod_error *err);
 
+/* The bytes allocated for a decoded level's block (mlod_pack_motion.block
+ * and the others: one allocation each), 0 for NULL. */
+size_t mlod_pack_block_size(const void *block);
+
 #endif

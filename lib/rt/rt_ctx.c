@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pack_internal.h"
 #include "rt_internal.h"
 
 static void *default_malloc(void *user, size_t size)
@@ -59,6 +60,7 @@ mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config)
 	ctx->alloc = a;
 	ctx->budget = config && config->budget_bytes ? config->budget_bytes : SIZE_MAX;
 	ctx->max_instances = config && config->max_instances ? config->max_instances : 1024;
+	ctx->streamed = 1; /* the first update starts a frame */
 	return ctx;
 }
 
@@ -135,6 +137,10 @@ size_t rt_bytes_mesh(const mlod_pack_mesh *m)
 
 size_t rt_bytes_motion(const mlod_pack_motion *m)
 {
+	/* A decoded level's block is sized by an upper bound from its stream
+	 * headers (lib/rt/pack.c): what it holds is counted when it is all. */
+	if (m->block)
+		return sizeof *m + mlod_pack_block_size(m->block);
 	size_t b = sizeof *m;
 	for (uint32_t i = 0; i < m->channel_count; i++) {
 		const mlod_pack_channel *c = &m->channels[i];
@@ -1170,9 +1176,46 @@ mlod_result mlod_rt_request(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t leve
 	rt_unit *u = ctx ? rt_unit_get(ctx, layer, level, item) : NULL;
 	if (!u)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_request: no such level");
-	u->want_count++;
-	u->last_wanted = ctx->stamp;
+	rt_begin_frame(ctx);
+	rt_want(ctx, u, 1);
 	return MLOD_OK;
+}
+
+void rt_begin_frame(mlod_rt_ctx *ctx)
+{
+	if (!ctx->streamed)
+		return;
+	ctx->streamed = 0;
+	ctx->stamp++;
+	for (uint32_t i = 0; i < ctx->unit_count; i++)
+		ctx->units[i].want_count = 0;
+}
+
+void rt_want(mlod_rt_ctx *ctx, rt_unit *u, uint32_t n)
+{
+	const uint32_t w = u->want_count & 0x7fffffffu;
+	u->want_count = (u->want_count & 0x80000000u) | (n > 0x7fffffffu - w ? 0x7fffffffu : w + n);
+	u->last_wanted = ctx->stamp;
+}
+
+/* u cannot fit in this mlod_rt_stream call: the high bit of its want
+ * count says so (next_wanted skips it), and its wants pass to the finest
+ * coarser level of its layer and item that neither failed nor cannot fit
+ * either: one absent then loads in this call when it fits, one resident
+ * is kept from eviction. So an instance whose level never fits shows the
+ * finest level that does, not the coarsest (mlod_rt_stream(3)). */
+static void defer_want(mlod_rt_ctx *ctx, rt_unit *u)
+{
+	const uint32_t w = u->want_count & 0x7fffffffu;
+	u->want_count |= 0x80000000u;
+	for (uint32_t l = (uint32_t)u->level + 1; w && l < ctx->levels[u->layer]; l++) {
+		rt_unit *t = rt_unit_get(ctx, (mlod_rt_layer)u->layer, l, u->item);
+		if (!t || t->state == RT_UNIT_FAILED || (t->state == RT_UNIT_ABSENT && (t->want_count & 0x80000000u)))
+			continue;
+		rt_want(ctx, t, w);
+		t->last_wanted = u->last_wanted > t->last_wanted ? u->last_wanted : t->last_wanted;
+		return;
+	}
 }
 
 /* The next unit to load: most wanted, then coarser, then lower index. */
@@ -1200,8 +1243,8 @@ static rt_unit *next_wanted(mlod_rt_ctx *ctx)
  * the staging buffer for a read source: no allocation. */
 static int chunk_corrupt(const mlod_rt_ctx *ctx, int32_t chunk)
 {
-	if (chunk < 0 || (uint32_t)chunk >= ctx->pack.chunk_count)
-		return 0;
+	if (chunk < 0 || (uint32_t)chunk >= ctx->pack.chunk_count || (ctx->verified && ctx->verified[chunk]))
+		return 0; /* bytes that matched their CRC once were misread since, not corrupt */
 	const mlod_pack_chunk *c = &ctx->pack.chunks[chunk];
 	const void *bytes;
 	if (ctx->data) { /* memory: the TOC was checked against the size at open */
@@ -1259,9 +1302,10 @@ static void fail_unit(mlod_rt_ctx *ctx, rt_unit *u, int retry)
  * loadable (fallbacks). */
 static void load_failed(mlod_rt_ctx *ctx, rt_unit *u, mlod_result r)
 {
-	fail_unit(ctx, u, r == MLOD_ERR_NOMEM || r == MLOD_ERR_IO);
-	if (!ctx->load || u->chunk < 0 || u->layer == MLOD_RT_SKELETON)
-		return;
+	const int transient = r == MLOD_ERR_NOMEM || r == MLOD_ERR_IO;
+	fail_unit(ctx, u, transient);
+	if (!ctx->load || u->chunk < 0 || u->layer == MLOD_RT_SKELETON || transient)
+		return; /* a read or memory failure blames no chunk */
 	const uint32_t L = ctx->levels[u->layer];
 	for (uint32_t l = u->level; l < L; l++) {
 		rt_unit *d = rt_unit_get(ctx, (mlod_rt_layer)u->layer, l, u->item);
@@ -1302,7 +1346,7 @@ static void pass_wants(mlod_rt_ctx *ctx)
 		                         rt_want_target(ctx, (mlod_rt_layer)u->layer, u->item, u->level), u->item);
 		u->want_count = 0;
 		if (t && t != u && t->state != RT_UNIT_FAILED) {
-			t->want_count += w;
+			rt_want(ctx, t, w);
 			t->last_wanted = u->last_wanted;
 		}
 	}
@@ -1335,7 +1379,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 			if (ctx->resident_bytes + hint > ctx->budget &&
 			    ctx->resident_bytes - evictable_bytes(ctx) + hint > ctx->budget) {
 				/* cannot fit even after every eviction: skip it in this call */
-				c->want_count |= 0x80000000u;
+				defer_want(ctx, c);
 				continue;
 			}
 			u = c;
@@ -1361,7 +1405,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 		ctx->streaming = 0;
 		if (r && ctx->refused) { /* its part records say it cannot fit: it waits */
 			ctx->refused = 0;
-			u->want_count |= 0x80000000u;
+			defer_want(ctx, u);
 			changed = 1;
 			continue;
 		}
@@ -1386,7 +1430,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 		}
 		if (ctx->resident_bytes > ctx->budget) { /* larger than its hint: give it back */
 			unit_release(ctx, u);
-			u->want_count |= 0x80000000u;
+			defer_want(ctx, u);
 			changed = 1;
 			continue;
 		}
@@ -1396,6 +1440,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 	}
 	for (uint32_t i = 0; i < ctx->unit_count; i++)
 		ctx->units[i].want_count &= 0x7fffffffu;
+	ctx->streamed = 1; /* the next update starts the next frame's wants */
 	if (changed)
 		for (uint32_t i = 0; i < ctx->max_instances; i++)
 			if (ctx->inst[i].st.alive)

@@ -509,6 +509,7 @@ mlod_rt_scratch *mlod_rt_scratch_create(mlod_rt_ctx *ctx)
 	if (!s)
 		return NULL;
 	memset(s, 0, bytes);
+	s->owner = ctx;
 	/* one block: the floats on a 16-byte boundary */
 	uintptr_t a = ((uintptr_t)(s + 1) + 15) & ~(uintptr_t)15;
 	s->world = (float *)a;
@@ -627,6 +628,8 @@ mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 {
 	if (!ctx || !s)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_pose: NULL argument");
+	if (s->owner != ctx)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_pose: the scratch was made for another context");
 	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	const mlod_rt_state *st = &ctx->inst[id].st;
@@ -713,6 +716,8 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
 {
 	if (!ctx || !s)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_palette: NULL argument");
+	if (s->owner != ctx)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_palette: the scratch was made for another context");
 	if (!s->posed)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_palette: no pose in the scratch (call mlod_rt_pose)");
 	if (s->posed == 2) { /* mlod_rt_skin posed only what its mesh level reads: the whole pose */
@@ -833,6 +838,8 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		*vertex_count = 0;
 	if (!ctx || !s || !positions)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: NULL argument");
+	if (s->owner != ctx)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: the scratch was made for another context");
 	if (pos_stride < 12 || pos_stride % 4 || (normals && (nrm_stride < 12 || nrm_stride % 4)))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: strides must be multiples of 4, at least 12");
 	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)

@@ -141,12 +141,18 @@ struct mlod_rt_ctx {
 	/* Cache. */
 	size_t resident_bytes, peak_bytes;
 	uint64_t stamp;
+	int streamed;             /* mlod_rt_stream ran since the last update or request:
+	                           * the next one starts a new frame's wants (rt_begin_frame) */
 	uint64_t loads, evictions, failures;
 	uint64_t unit_gen;        /* counts loads and releases: keys the scratch's skin plan */
 	rt_unit *loading;         /* the unit ctx->load decodes (rt_mesh_reserve) */
 	int streaming;            /* inside mlod_rt_stream: rt_mesh_reserve makes room */
 	int refused;              /* rt_mesh_reserve found no room: the load is not a failure */
 	uint32_t max_vertices;
+	/* Per chunk of a read source, 1 once its bytes matched its CRC when
+	 * read (rt_pack.c read_chunk): such a chunk failing its CRC later was
+	 * misread, not corrupt. NULL for memory and views. */
+	uint8_t *verified;
 	/* Instances. */
 	rt_instance *inst;
 	uint32_t max_instances, free_head, live;
@@ -160,6 +166,7 @@ struct mlod_rt_ctx {
 };
 
 struct mlod_rt_scratch {
+	const mlod_rt_ctx *owner; /* the context it was made for (checked by every call) */
 	mlod_trs *local;          /* joint_count */
 	float *world;             /* 16 per joint */
 	float *palette;           /* 16 per palette entry */
@@ -191,6 +198,13 @@ void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in);
 /* The level loaded for an instance wanting level w: w, or the finest
  * coarser level not failed. */
 uint32_t rt_want_target(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t item, uint32_t w);
+/* A frame's wants (mlod_rt_stream(3)) are those of every update and
+ * request since the last mlod_rt_stream: the first of them after a stream
+ * (or open) clears the last frame's, later ones add to them. */
+void rt_begin_frame(mlod_rt_ctx *ctx);
+/* n more wants of u in this frame (saturating below the high bit, which
+ * mlod_rt_stream uses), stamped now for the eviction order. */
+void rt_want(mlod_rt_ctx *ctx, rt_unit *u, uint32_t n);
 mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err);
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
 /* 1 when config's allocator has one of malloc and free (both or neither). */

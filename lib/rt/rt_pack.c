@@ -25,6 +25,33 @@
 
 enum { SRC_VIEWS = 0, SRC_MEMORY = 1, SRC_READ = 2 };
 
+/* Reads chunk k's stored bytes into dst. A read source can misread (a
+ * glitch, a file rewritten under it): bytes that fail the chunk's CRC are
+ * read once more, and when they fail again though they matched when read
+ * before (ctx->verified), the read is blamed, MLOD_ERR_IO, which
+ * mlod_rt_stream tries again; else the reader reports the CRC mismatch
+ * (MLOD_ERR_PARSE: the level fails for good). */
+static mlod_result read_chunk(mlod_rt_ctx *ctx, uint32_t k, void *dst, mlod_error *err)
+{
+	const mlod_pack_chunk *c = &ctx->pack.chunks[k];
+	for (int pass = 0; pass < 2; pass++) {
+		if (ctx->read(ctx->read_user, c->offset, c->stored_size, dst) != 0)
+			return mlod_fail(err, MLOD_ERR_IO, "chunk %u: reading %u bytes at offset %llu failed", k, c->stored_size,
+			                 (unsigned long long)c->offset);
+		if (mlod_pack_crc32(0, dst, c->stored_size) == c->crc) {
+			if (ctx->verified)
+				ctx->verified[k] = 1;
+			return MLOD_OK;
+		}
+	}
+	if (ctx->verified && ctx->verified[k])
+		return mlod_fail(err, MLOD_ERR_IO,
+		                 "chunk %u (%s level %u): read twice, its bytes fail the CRC they matched when read before "
+		                 "(a read error, or a source that changed): tried again by the next mlod_rt_stream",
+		                 k, mlod_pack_type_name(c->type), (unsigned)c->level);
+	return MLOD_OK;
+}
+
 /* The chunk's bytes as (data, size) for the reader, and the pack to pass. */
 static mlod_result chunk_bytes(mlod_rt_ctx *ctx, uint32_t chunk, const mlod_pack **pack, const void **data,
                                size_t *size, mlod_pack *shadow, mlod_error *err)
@@ -47,17 +74,17 @@ static mlod_result chunk_bytes(mlod_rt_ctx *ctx, uint32_t chunk, const mlod_pack
 		if (d->stored_size > ctx->staging_size)
 			return mlod_fail(err, MLOD_ERR_PARSE, "chunk %d: %u bytes, larger than the staging buffer", dep,
 			                 d->stored_size);
-		if (ctx->read(ctx->read_user, d->offset, d->stored_size, ctx->staging) != 0)
-			return mlod_fail(err, MLOD_ERR_IO, "chunk %d: reading %u bytes at offset %llu failed", dep,
-			                 d->stored_size, (unsigned long long)d->offset);
+		mlod_result r = read_chunk(ctx, (uint32_t)dep, ctx->staging, err);
+		if (r)
+			return r;
 		at = ((uint64_t)d->stored_size + 15) & ~(uint64_t)15;
 	}
 	if (c->stored_size > ctx->staging_size || at > ctx->staging_size - c->stored_size)
 		return mlod_fail(err, MLOD_ERR_PARSE, "chunk %u: %u bytes, larger than the staging buffer", chunk,
 		                 c->stored_size);
-	if (ctx->read(ctx->read_user, c->offset, c->stored_size, ctx->staging + at) != 0)
-		return mlod_fail(err, MLOD_ERR_IO, "chunk %u: reading %u bytes at offset %llu failed", chunk, c->stored_size,
-		                 (unsigned long long)c->offset);
+	mlod_result r = read_chunk(ctx, chunk, ctx->staging + at, err);
+	if (r)
+		return r;
 	*shadow = ctx->pack;
 	memcpy(ctx->shadow, ctx->pack.chunks, sizeof *ctx->shadow * ctx->pack.chunk_count);
 	ctx->shadow[chunk].offset = at;
@@ -80,9 +107,9 @@ static mlod_result fetch_chunk(void *user, uint32_t chunk, const void **bytes, m
 	if (c->stored_size > ctx->staging_size)
 		return mlod_fail(err, MLOD_ERR_PARSE, "chunk %u: %u bytes, larger than the staging buffer", chunk,
 		                 c->stored_size);
-	if (ctx->read(ctx->read_user, c->offset, c->stored_size, ctx->staging) != 0)
-		return mlod_fail(err, MLOD_ERR_IO, "chunk %u: reading %u bytes at offset %llu failed", chunk, c->stored_size,
-		                 (unsigned long long)c->offset);
+	mlod_result r = read_chunk(ctx, chunk, ctx->staging, err);
+	if (r)
+		return r;
 	*bytes = ctx->staging;
 	return MLOD_OK;
 }
@@ -175,6 +202,7 @@ static void pack_close(mlod_rt_ctx *ctx)
 	if (ctx->pack_open)
 		mlod_pack_close(&ctx->pack);
 	rt_free(ctx, ctx->shadow);
+	rt_free(ctx, ctx->verified);
 	rt_free(ctx, ctx->staging);
 	if (ctx->file)
 		fclose(ctx->file);
@@ -251,9 +279,12 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 		ctx->staging_size = big;
 		ctx->staging = rt_alloc(ctx, big);
 		ctx->shadow = rt_alloc(ctx, sizeof *ctx->shadow * (ctx->pack.chunk_count + 1));
-		if (!ctx->staging || !ctx->shadow)
+		ctx->verified = rt_alloc(ctx, (size_t)ctx->pack.chunk_count + 1);
+		if (ctx->verified)
+			memset(ctx->verified, 0, (size_t)ctx->pack.chunk_count + 1);
+		if (!ctx->staging || !ctx->shadow || !ctx->verified)
 			return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory for a %zu-byte staging buffer", big);
-		ctx->resident_bytes += big + sizeof *ctx->shadow * ctx->pack.chunk_count;
+		ctx->resident_bytes += big + (sizeof *ctx->shadow + 1) * ctx->pack.chunk_count;
 	}
 	/* INFO and SKELETON. */
 	const mlod_pack *p;

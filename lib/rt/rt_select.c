@@ -109,14 +109,21 @@ static mlod_result select_check(const mlod_rt_select *sel, const char *fn, mlod_
 	if (sel->hysteresis < 0.0f)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: selection hysteresis %g is negative", fn,
 		                 (double)sel->hysteresis);
+	/* Settings that would put every layer at level 0 at any distance, or
+	 * turn the alpha ramp around, are refused rather than obeyed. */
+	if (sel->d_near < 0.0f || sel->d_far < sel->d_near)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: selection d_near %g, d_far %g: need 0 <= d_near <= d_far",
+		                 fn, (double)sel->d_near, (double)sel->d_far);
+	if (!(sel->fov_y > 0.0f && sel->fov_y < 3.14159265f))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: selection fov_y %g is not between 0 and pi radians", fn,
+		                 (double)sel->fov_y);
+	if (sel->lines <= 0.0f || sel->max_pixels <= 0.0f)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: selection lines %g, max_pixels %g: both must be > 0", fn,
+		                 (double)sel->lines, (double)sel->max_pixels);
+	if (sel->distance_scale < 0.0f)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: selection distance_scale %g is negative", fn,
+		                 (double)sel->distance_scale);
 	return MLOD_OK;
-}
-
-static void begin_frame(mlod_rt_ctx *ctx)
-{
-	ctx->stamp++;
-	for (uint32_t i = 0; i < ctx->unit_count; i++)
-		ctx->units[i].want_count = 0;
 }
 
 static void update_one(mlod_rt_ctx *ctx, const mlod_rt_select *sel, uint32_t id, float d, float dt)
@@ -158,16 +165,12 @@ static void update_one(mlod_rt_ctx *ctx, const mlod_rt_select *sel, uint32_t id,
 		rt_unit *u = rt_unit_get(ctx, (mlod_rt_layer)layer, w, item);
 		if (u && u->state == RT_UNIT_FAILED) {
 			/* one to try again keeps the want too (mlod_rt_stream) */
-			if (u->retry) {
-				u->want_count++;
-				u->last_wanted = ctx->stamp;
-			}
+			if (u->retry)
+				rt_want(ctx, u, 1);
 			u = rt_unit_get(ctx, (mlod_rt_layer)layer, rt_want_target(ctx, (mlod_rt_layer)layer, item, w), item);
 		}
-		if (u) {
-			u->want_count++;
-			u->last_wanted = ctx->stamp;
-		}
+		if (u)
+			rt_want(ctx, u, 1);
 	}
 	in->selected = 1;
 	rt_resolve(ctx, in);
@@ -188,7 +191,7 @@ mlod_result mlod_rt_update(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const ui
 			return mlod_fail(err, MLOD_ERR_INVALID_ARG,
 			                 "mlod_rt_update: instance index %zu: distance %g, not finite and >= 0", i,
 			                 (double)distances[i]);
-	begin_frame(ctx);
+	rt_begin_frame(ctx);
 	for (size_t i = 0; i < n; i++)
 		update_one(ctx, sel, ids[i], distances[i], dt);
 	return MLOD_OK;
@@ -214,7 +217,7 @@ mlod_result mlod_rt_update_positions(mlod_rt_ctx *ctx, const mlod_rt_select *sel
 			                 "mlod_rt_update_positions: instance index %zu: distance %g, not finite", i,
 			                 (double)d);
 	}
-	begin_frame(ctx);
+	rt_begin_frame(ctx);
 	for (size_t i = 0; i < n; i++) {
 		const float *p = positions + 3 * i;
 		const float x = p[0] - camera[0], y = p[1] - camera[1], z = p[2] - camera[2];

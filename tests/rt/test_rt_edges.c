@@ -95,14 +95,20 @@ static const char *room_pass(const char *what, mem_src *m, char *msg, size_t cap
 			const char *bad = NULL;
 			if (r != MLOD_OK)
 				bad = e.message;
-			else if (less ? li.resident || loaded : !li.resident || loaded != 1)
+			else if (less ? li.resident : !li.resident || loaded != 1)
 				bad = less ? "loaded with a byte less than its size free" : "not loaded with its size free";
+			else if (less && loaded > (l + 2 < L ? 1u : 0u))
+				bad = "more than its fallback loaded with a byte less than its size free";
+			else if (less && loaded && (mlod_rt_level_info_get(ctx, MLOD_RT_MESH, l + 1, 0, &li, NULL) != MLOD_OK ||
+			                            !li.resident))
+				bad = "a level other than its fallback (the next coarser) loaded with a byte less than its size free";
 			else if (li.failed || s.failures)
 				bad = "marked failed";
 			else if (s.peak_resident_bytes > cfg.budget_bytes)
 				bad = "peak above the budget";
 			if (!bad && less) {
-				/* wanted again: its size is known, nothing is read */
+				/* wanted again: its size is known, nothing is read (its
+				 * fallback, the next coarser level, is resident) */
 				const unsigned long before = m->reads;
 				mlod_rt_request(ctx, MLOD_RT_MESH, l, 0, NULL);
 				mlod_rt_stream(ctx, SIZE_MAX, &loaded, NULL);

@@ -217,8 +217,8 @@ TEST(update_bad_selection)
 	const float d = 120.0f, cam[3] = { 0, 0, 0 }, pos[3] = { 120.0f, 0, 0 };
 	CHECK_OK(mlod_rt_update(ctx, &good, &id, &d, 1, 0.5f, &e), e);
 	const mlod_rt_state before = *mlod_rt_instance_state(ctx, id);
-	struct { const char *what; mlod_rt_select sel; } bad[6];
-	for (int k = 0; k < 6; k++)
+	struct { const char *what; mlod_rt_select sel; } bad[12];
+	for (int k = 0; k < 12; k++)
 		bad[k].sel = good;
 	bad[0].what = "mode 9", bad[0].sel.mode = (mlod_rt_select_mode)9;
 	bad[1].what = "d_near nan", bad[1].sel.d_near = NAN;
@@ -226,7 +226,15 @@ TEST(update_bad_selection)
 	bad[3].what = "d_far inf", bad[3].sel.d_far = INFINITY;
 	bad[4].what = "layer 2", bad[4].sel.t_end[2] = NAN;
 	bad[5].what = "distance_scale nan", bad[5].sel.distance_scale = NAN;
-	for (int k = 0; k < 6; k++) {
+	/* in range: each of these put every layer at level 0 at any distance
+	 * (fov_y, lines, max_pixels) or turned the ramp into a step */
+	bad[6].what = "fov_y 0 is not between 0 and pi", bad[6].sel.fov_y = 0.0f;
+	bad[7].what = "fov_y 4 is not between 0 and pi", bad[7].sel.fov_y = 4.0f;
+	bad[8].what = "lines -1080, max_pixels 1: both must be > 0", bad[8].sel.lines = -1080.0f;
+	bad[9].what = "lines 1080, max_pixels 0: both must be > 0", bad[9].sel.max_pixels = 0.0f;
+	bad[10].what = "d_near 300, d_far 200: need 0 <= d_near <= d_far", bad[10].sel.d_near = 300.0f;
+	bad[11].what = "distance_scale -2 is negative", bad[11].sel.distance_scale = -2.0f;
+	for (int k = 0; k < 12; k++) {
 		CHECK(mlod_rt_update(ctx, &bad[k].sel, &id, &d, 1, 0.5f, &e) == MLOD_ERR_INVALID_ARG &&
 		      strstr(e.message, bad[k].what) && strstr(e.message, "mlod_rt_update:"),
 		      "update, %s: %s", bad[k].what, e.message);
