@@ -429,9 +429,9 @@ static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, c
 			if (c != big) {
 				long v = (long)e[j++] * (1L << shift);
 				v = v > 32767 ? 32767 : v < -32767 ? -32767 : v;
-				float f = (float)(v / 32767.0);
+				float f = (float)((double)v / 32767.0);
 				n[c] = (int16_t)v;
-				sum += (double)f * f;
+				sum += (double)f * (double)f;
 			}
 		n[big] = (int16_t)lrint(sqrt(sum < 1.0 ? 1.0 - sum : 0.0) * 32767.0);
 	}

@@ -29,10 +29,17 @@
  * Allocation. Every allocation of the runtime goes through the
  * configuration's allocator (malloc/free when NULL), the pack reader's too
  * (the TOC, the decoded chunks and their decoding scratch: the runtime
- * hands it the allocator, mlod_pack_open_alloc). The one exception is the
- * C library's FILE that mlod_rt_open_path opens with fopen. Memory is
+ * hands it the allocator, mlod_pack_open_alloc). The exceptions are the
+ * C library's FILE that mlod_rt_open_path opens with fopen, and Draco's
+ * decoder: a Draco-coded mesh level (mlod-pack --codec draco) is decoded
+ * by Draco's C++ code, which allocates with operator new (RobotExpressive:
+ * 2,808 allocations, 1.08 MB in all, at open; 3,596, 4.49 MB, loading two
+ * levels) and frees all of it before the call returns; the decoded level
+ * is then copied into memory from the allocator. Memory is
  * allocated only by mlod_rt_open_*, mlod_rt_scratch_create and
- * mlod_rt_stream when it loads a level. mlod_rt_update, mlod_rt_request,
+ * mlod_rt_stream when it loads or tries to load a level (a level whose
+ * reads keep failing is tried, and allocates, in every call that wants
+ * it). mlod_rt_update, mlod_rt_request,
  * mlod_rt_pose, mlod_rt_palette, mlod_rt_skin, instance creation and
  * destruction (from the pool) allocate nothing.
  *
@@ -55,7 +62,13 @@
  * (mlod_rt_level_info.failed, each failed load counted in
  * mlod_rt_stats.failures) and never tried again, but for one that failed
  * for lack of memory (MLOD_ERR_NOMEM) or a read error (MLOD_ERR_IO): the
- * next mlod_rt_stream tries that one again when it is still wanted. An
+ * next mlod_rt_stream tries that one again when it is still wanted. For a
+ * read source (mlod_rt_open_read, mlod_rt_open_path), bytes that fail
+ * their chunk's CRC are read a second time; when they fail again though
+ * that chunk matched its CRC when read before (the coarsest levels' at
+ * open, any level's once loaded), the read is blamed: MLOD_ERR_IO, naming
+ * the chunk, and tried again (a glitch, or a file rewritten under the
+ * context), so that one bad read does not fail levels for good. An
  * instance wanting a failed level shows the finest resident
  * level coarser than it (Fallback below) and its want passes to the
  * finest coarser level not failed, which then loads (in the same
@@ -84,7 +97,10 @@
  * Every other level is loaded when some instance wants it (or
  * mlod_rt_request asks for it) and decoded only inside
  * mlod_rt_stream(ctx, byte_budget). Resident bytes (the decoded levels plus
- * the runtime's per-level tables, counted from their arrays) never exceed
+ * the runtime's per-level tables, counted from their arrays; a motion
+ * level's as the block its reader allocated, sized by an upper bound from
+ * its stream headers; the pack's zstd decoder, the staging buffer and
+ * tables per chunk for a read source) never exceed
  * the budget, not even while a level decodes: before a level's decoded
  * arrays are allocated, stream makes room for them: for a pack's mesh
  * level its exact size (the reader reads the level's part records first,
@@ -93,11 +109,25 @@
  * until room appears); for other levels an upper bound, before decoding
  * (their size for views; 4 x the TOC's raw size plus the runtime's tables
  * for packs). Room is made by evicting resident levels that no instance
- * wanted at the last update, least recently wanted first; it never evicts
- * a level that was wanted at the last update nor a coarsest level. A
- * level that cannot fit stays unloaded and is tried again when room
- * appears. (The reader's own scratch while one chunk decodes is not
- * counted.)
+ * wanted in the current frame (below), least recently wanted first; it
+ * never evicts a level wanted in the current frame nor a coarsest level.
+ * A level that cannot fit stays unloaded and is tried again when room
+ * appears; meanwhile its wants pass to the finest coarser level of its
+ * layer that neither failed nor cannot fit, which loads when absent (an
+ * instance close by under a budget too small for mesh level 0 shows the
+ * finest level the budget holds, not the coarsest) and, resident, is kept
+ * from eviction. (The reader's own scratch while one chunk decodes, and
+ * the instance pool, are not counted: the memory the allocator holds
+ * between calls is the resident bytes plus what it held at open beyond
+ * them, within 256 bytes, tests/rt/test_rt_engine.c.)
+ *
+ * Frames. The wanted levels of a frame are those of every mlod_rt_update,
+ * mlod_rt_update_positions and mlod_rt_request call since the last
+ * mlod_rt_stream (or open): the first such call after a stream clears the
+ * last frame's, the later ones add to them, so a frame may update its
+ * instances in several batches (an instance in two batches counts
+ * twice). mlod_rt_stream loads for them and keeps them until the next
+ * frame starts.
  *
  * Fallback. An instance shows, per layer, the wanted level when resident,
  * else the finest resident level coarser than the wanted one (the coarsest
@@ -354,13 +384,17 @@ uint32_t mlod_rt_mesh_part_count(const mlod_rt_ctx *ctx, uint32_t level);
 mlod_result mlod_rt_mesh_part(const mlod_rt_ctx *ctx, uint32_t level, uint32_t part, mlod_rt_part_info *out,
                               mlod_error *err);
 
-/* Asks for a level as if an instance wanted it at the last update (until
- * the next update). No decoding here. */
+/* Asks for a level as if an instance wanted it in the current frame
+ * (Frames, above). No decoding here. */
 mlod_result mlod_rt_request(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item, mlod_error *err);
 
 /* Loads wanted levels, decoding on the caller's thread, most wanted first
  * (ties: coarser first), until the stored bytes of the levels loaded in
- * this call reach byte_budget (a first level larger than byte_budget is
+ * this call reach byte_budget (each level's own chunk: a mesh level also
+ * reads the chunks of every coarser mesh level, and a nested motion level
+ * those it builds on, which byte_budget does not count, so the bytes read
+ * can be larger; tubeman's mesh level 0 stores 12,339 bytes and reads
+ * 50,459; a first level larger than byte_budget is
  * still loaded alone, so that every level can load; 0 loads nothing;
  * views have no stored size and count 1 byte each; a level whose load
  * fails or that does not fit counts nothing),
@@ -460,9 +494,12 @@ void mlod_rt_select_default(mlod_rt_select *sel);
  * message naming the index i, when distances[i] is NaN, negative or
  * infinite (for every i < n, alive or not), when dt is not finite
  * (dt may be negative: time runs back), and for a selection whose mode is
- * not one of the three, a float member not finite or a negative
- * hysteresis (the message names the member); everything is checked first, so
- * such a call changes nothing (no instance, no wanted level). */
+ * not one of the three, a float member not finite, a negative
+ * hysteresis or distance_scale, d_near < 0 or d_near > d_far, fov_y not
+ * strictly between 0 and pi, or lines or max_pixels <= 0 (the message
+ * names the member); everything is checked first, so such a call changes
+ * nothing (no instance, no wanted level). The wants add to those of the
+ * frame's earlier calls (Frames). */
 mlod_result mlod_rt_update(mlod_rt_ctx *ctx, const mlod_rt_select *sel, const uint32_t *ids,
                            const float *distances, size_t n, float dt, mlod_error *err);
 /* The same with the distance from camera[3] to positions[3 * i]

@@ -1098,7 +1098,9 @@ float mlod_rt_clip_duration(const mlod_rt_ctx *ctx, uint32_t clip)
 mlod_result mlod_rt_level_info_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item,
                                    mlod_rt_level_info *out, mlod_error *err)
 {
-	const rt_unit *u = ctx && out ? rt_unit_get(ctx, layer, level, item) : NULL;
+	if (!ctx || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_level_info_get: NULL argument");
+	const rt_unit *u = rt_unit_get(ctx, layer, level, item);
 	if (!u)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "no such level");
 	out->error = u->error;

@@ -371,7 +371,7 @@ static mlod_result finish(mlod_rt_ctx *ctx, mlod_rt_ctx **out, mlod_error *err)
 mlod_result mlod_rt_open_memory(const void *data, size_t size, const mlod_rt_config *config, mlod_rt_ctx **out,
                                 mlod_error *err)
 {
-	if (!out || (!data && size))
+	if (!out || !data)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_memory: NULL argument");
 	*out = NULL;
 	if (rt_config_bad(config))

@@ -5,7 +5,8 @@
 # from, and pkg-config files: a program including mlod.h and mlod_rt.h
 # compiles with `pkg-config --cflags mlod`, and a runtime program linked
 # with `pkg-config --libs mlodrt` alone opens a pack. make uninstall
-# removes every file install made.
+# removes every file install made. The runtime's headers also compile
+# under an engine's stricter warnings.
 set -e
 make -s -C "$ROOT" install DESTDIR="$PWD/inst" PREFIX=/usr > /dev/null
 for d in io mesh model rt; do test ! -e "inst/usr/include/$d"; done
@@ -31,6 +32,12 @@ int main(int argc, char **argv)
 }
 C
 cc -std=c11 -Wall -Wextra -Wpedantic -Werror $(pc --cflags mlodrt) rt.c $(pc --libs mlodrt) -o rt
+# an engine's stricter warnings: the runtime's public headers compile
+# clean under -Wconversion -Wdouble-promotion -Werror (mlod_pack.h's inline
+# mlod_pack_rotq_key warned under both)
+printf '#include <mlod_rt.h>\n#include <mlod_pack.h>\nint main(void) { return 0; }\n' > strict.c
+cc -std=c11 -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wdouble-promotion -Werror $(pc --cflags mlodrt) \
+	-c strict.c -o strict.o
 "$BIN/mlod-pack" "$ROOT/samples/tubeman.glb" -o t.mlod
 ./rt t.mlod
 make -s -C "$ROOT" uninstall DESTDIR="$PWD/inst" PREFIX=/usr > /dev/null

@@ -5,7 +5,8 @@
  * to the finest coarser level that does; a read callback that misreads
  * once healing on the next mlod_rt_stream; the memory held between
  * frames, counted by the allocator hooks, within the resident bytes the
- * runtime reports; a scratch used with another context refused.
+ * runtime reports; a scratch used with another context refused; NULL
+ * arguments named.
  *
  * The packs come from mlod-pack on the committed samples (rt_packer.h);
  * without it the tests print SKIP. Links libmlodrt.a alone.
@@ -288,6 +289,25 @@ TEST(scratch_of_another_context)
 	mlod_rt_close(b);
 }
 
+/* NULL where the docs say MLOD_ERR_INVALID_ARG: a NULL pack of size 0
+ * (was MLOD_ERR_PARSE, "no header"), a NULL level_info (was "no such
+ * level"). */
+TEST(null_arguments_named)
+{
+	SKIP_IF_NO_PACK(null_arguments_named);
+	CHECK(packs_ready(), "mlod-pack failed");
+	mlod_error e = { 0 };
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_ERR(mlod_rt_open_memory(NULL, 0, NULL, &ctx, &e), MLOD_ERR_INVALID_ARG,
+	          "mlod_rt_open_memory: NULL argument");
+	CHECK_OK(mlod_rt_open_memory(tube, tube_size, NULL, &ctx, &e), e);
+	CHECK_ERR(mlod_rt_level_info_get(ctx, MLOD_RT_MESH, 0, 0, NULL, &e), MLOD_ERR_INVALID_ARG,
+	          "mlod_rt_level_info_get: NULL argument");
+	mlod_rt_level_info li;
+	CHECK_ERR(mlod_rt_level_info_get(ctx, MLOD_RT_MESH, 99, 0, &li, &e), MLOD_ERR_INVALID_ARG, "no such level");
+	mlod_rt_close(ctx);
+}
+
 int main(int argc, char **argv)
 {
 	(void)argc;
@@ -298,6 +318,7 @@ int main(int argc, char **argv)
 	RUN(misread_tried_again);
 	RUN(held_memory_is_counted);
 	RUN(scratch_of_another_context);
+	RUN(null_arguments_named);
 	free(robot);
 	free(tube);
 	rt_packer_cleanup();
