@@ -376,6 +376,14 @@ typedef struct mlod_rt_part_info {
 	uint32_t instance;    /* the character's mesh instance the part belongs to */
 	int32_t node;         /* its glTF node, or -1 */
 	uint32_t target_count; /* morph targets (mlod_rt_morph_target_count) */
+	/* The level's decoded arrays of this part, in the bind pose, valid
+	 * while the level stays resident: positions, normals, tangents, UV
+	 * sets, colours, joints (its skin's joints: palette entry
+	 * palette_first + joint) and weights (mlod_pack.h), so that a caller
+	 * draws it (UVs, tangents, colours) or skins it on the GPU with
+	 * mlod_rt_palette's matrices without decoding the chunk again. */
+	const mlod_pack_part *attributes;
+	uint32_t palette_first; /* a skinned part: the palette entry of its skin's joint 0 */
 } mlod_rt_part_info;
 
 /* Parts of a mesh level when resident, else 0. */

@@ -1146,6 +1146,8 @@ mlod_result mlod_rt_mesh_part(const mlod_rt_ctx *ctx, uint32_t level, uint32_t p
 	out->instance = p->rec.instance;
 	out->node = p->rec.node;
 	out->target_count = mlod_rt_morph_target_count(ctx, part);
+	out->attributes = p;
+	out->palette_first = p->rec.skin >= 0 ? ctx->skin_offset[p->rec.skin] : 0;
 	return MLOD_OK;
 }
 

@@ -6,12 +6,14 @@
  * once healing on the next mlod_rt_stream; the memory held between
  * frames, counted by the allocator hooks, within the resident bytes the
  * runtime reports; a scratch used with another context refused; NULL
- * arguments named.
+ * arguments named; a level's part attributes and the palette skinning
+ * on the GPU as mlod_rt_skin does.
  *
  * The packs come from mlod-pack on the committed samples (rt_packer.h);
  * without it the tests print SKIP. Links libmlodrt.a alone.
  */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <stdint.h>
 
 #include "rt_test.h"
@@ -308,6 +310,79 @@ TEST(null_arguments_named)
 	mlod_rt_close(ctx);
 }
 
+/* A GPU-skinning engine: a resident level's part attributes and
+ * mlod_rt_palette's matrices skin the skinned parts to what mlod_rt_skin
+ * writes (within 4e-3 scene units), with its UV sets (when the input has
+ * them; neither sample does) there to draw with. Before, mlod_rt gave neither the bind-pose
+ * arrays nor the UVs: an engine decoded the chunk a second time. */
+TEST(gpu_skinning_from_part_attributes)
+{
+	SKIP_IF_NO_PACK(gpu_skinning_from_part_attributes);
+	CHECK(packs_ready(), "mlod-pack failed");
+	const struct { const uint8_t *d; size_t n; const char *name; } packs[] = { { robot, robot_size, "robot" },
+		                                                                     { tube, tube_size, "tubeman" } };
+	for (size_t k = 0; k < 2; k++) {
+		mlod_error e = { 0 };
+		mlod_rt_ctx *ctx = NULL;
+		CHECK_OK(mlod_rt_open_memory(packs[k].d, packs[k].n, NULL, &ctx, &e), e);
+		uint32_t id;
+		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.4f, MLOD_RT_LOOP, &id, &e), e);
+		mlod_rt_select sel;
+		mlod_rt_select_default(&sel);
+		sel.force_level = 0;
+		const float d = 1.0f;
+		for (int f = 0; f < 2; f++) {
+			CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0f, &e), e);
+			CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
+		}
+		CHECK(mlod_rt_instance_state(ctx, id)->level[MLOD_RT_MESH] == 0, "%s: mesh level 0 not shown", packs[k].name);
+		const uint32_t nv = mlod_rt_mesh_vertex_count(ctx, 0);
+		float *out = malloc(sizeof(float) * 3 * (nv + 1));
+		mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+		CHECK(out && s, "memory");
+		uint32_t got = 0;
+		CHECK_OK(mlod_rt_skin(ctx, s, id, out, 12, NULL, 0, nv, &got, &e), e);
+		CHECK_OK(mlod_rt_pose(ctx, s, id, NULL, NULL, NULL, &e), e);
+		const float *pal;
+		uint32_t np;
+		CHECK_OK(mlod_rt_palette(ctx, s, &pal, &np, &e), e);
+		uint32_t skinned = 0, with_uv = 0;
+		double worst = 0.0;
+		for (uint32_t i = 0; i < mlod_rt_mesh_part_count(ctx, 0); i++) {
+			mlod_rt_part_info pi;
+			CHECK_OK(mlod_rt_mesh_part(ctx, 0, i, &pi, &e), e);
+			const mlod_pack_part *a = pi.attributes;
+			CHECK(a && a->positions && a->rec.vertex_count == pi.vertex_count, "%s part %u: no attributes",
+			      packs[k].name, i);
+			with_uv += a->uvs[0] != NULL;
+			if (pi.skin < 0 || !a->joints || !a->weights)
+				continue;
+			skinned++;
+			for (uint32_t v = 0; v < pi.vertex_count; v++) {
+				double o[3] = { 0, 0, 0 };
+				for (int q = 0; q < 4; q++) {
+					const float w = a->weights[4 * v + q];
+					const uint32_t entry = pi.palette_first + a->joints[4 * v + q];
+					CHECK(entry < np, "%s part %u: palette entry %u of %u", packs[k].name, i, entry, np);
+					const float *m = pal + 16 * (size_t)entry, *p = a->positions + 3 * (size_t)v;
+					for (int r = 0; r < 3; r++)
+						o[r] += w * ((double)m[r] * p[0] + (double)m[4 + r] * p[1] + (double)m[8 + r] * p[2] +
+						             m[12 + r]);
+				}
+				for (int r = 0; r < 3; r++) {
+					const double dv = fabs(o[r] - out[3 * (size_t)(pi.first_vertex + v) + (size_t)r]);
+					worst = dv > worst ? dv : worst;
+				}
+			}
+		}
+		CHECK(skinned > 0 && worst <= 1e-4 * 40.0, "%s: %u skinned parts, worst %g", packs[k].name, skinned, worst);
+		(void)with_uv; /* neither sample has texture coordinates */
+		mlod_rt_scratch_destroy(ctx, s);
+		free(out);
+		mlod_rt_close(ctx);
+	}
+}
+
 int main(int argc, char **argv)
 {
 	(void)argc;
@@ -319,6 +394,7 @@ int main(int argc, char **argv)
 	RUN(held_memory_is_counted);
 	RUN(scratch_of_another_context);
 	RUN(null_arguments_named);
+	RUN(gpu_skinning_from_part_attributes);
 	free(robot);
 	free(tube);
 	rt_packer_cleanup();
