@@ -98,9 +98,10 @@
  * mlod_rt_request asks for it) and decoded only inside
  * mlod_rt_stream(ctx, byte_budget). Resident bytes (the decoded levels plus
  * the runtime's per-level tables, counted from their arrays; a motion
- * level's as the block its reader allocated, sized by an upper bound from
- * its stream headers; the pack's zstd decoder, the staging buffer and
- * tables per chunk for a read source) never exceed
+ * level's as the block its reader allocated, moved to a block of its size
+ * when the upper bound it was decoded into is loose; the pack's zstd
+ * decoder, the staging buffer and tables per chunk for a read source)
+ * never exceed
  * the budget, not even while a level decodes: before a level's decoded
  * arrays are allocated, stream makes room for them: for a pack's mesh
  * level its exact size (the reader reads the level's part records first,

@@ -1124,6 +1124,16 @@ static mlod_result bump_alloc(bump *b, cx *x, uint64_t total, mlod_error *err)
 	return MLOD_OK;
 }
 
+/* p, a pointer into b's block (else returned as it is), at the same
+ * offset of nb, a copy of its used bytes. */
+static void *moved(const bump *b, uint8_t *nb, const void *p)
+{
+	/* compared as integers: the relational operators are only defined
+	 * within one object, and p may point elsewhere */
+	const uintptr_t at = (uintptr_t)p, base = (uintptr_t)b->base;
+	return p && at >= base && at - base < b->used ? nb + (at - base) : (void *)at;
+}
+
 static void *bump_take(bump *b, uint64_t bytes)
 {
 	if (round8(bytes) > b->cap - b->used)
@@ -2879,6 +2889,24 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	}
 	TRY(cx_end(&x, err));
 	cx_done(&x);
+	/* The block was sized by an upper bound ('TBIT': 32 keys a word): when
+	 * more than an eighth of it is unused, the level moves to a block of
+	 * its size (tubeman's motion level 1: 109,736 bytes before), its
+	 * pointers moved with it; without memory for that it stays. */
+	if (b.cap - b.used > b.cap / 8) {
+		uint8_t *nb = pk_malloc(&x.alloc, 1, (size_t)b.used);
+		if (nb) {
+			memcpy(nb, b.base, (size_t)b.used);
+			memcpy(nb + BLOCK_SIZE_AT, &b.used, sizeof b.used);
+			chans = moved(&b, nb, chans);
+			for (uint64_t i = 0; i < C; i++) {
+				chans[i].times = moved(&b, nb, chans[i].times);
+				chans[i].values = moved(&b, nb, chans[i].values);
+			}
+			pk_free(&x.alloc, b.base);
+			b.base = nb;
+		}
+	}
 	out->channel_count = (uint32_t)C;
 	out->channels = chans;
 	out->duration = duration;
