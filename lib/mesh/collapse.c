@@ -1086,8 +1086,15 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			order[i - 1] = x;
 		}
 	}
+	/* With the exact posed cost (not hybrid), a candidate whose error is
+	 * memoised has its geometry checked only once it is the cheapest so
+	 * far: the choice is the same as with the check first (a candidate
+	 * is taken when valid, skinned and cheaper than the best before it,
+	 * in either order). */
+	int late_geo = g->opt.cost == MLOD_COST_POSED && !ranked && !hybrid && g->pose_count > 0;
 	for (int kk = 0; kk < nc; kk++) {
 		int k = order[kk], fam = hybrid && cand_whole[k];
+		int late = late_geo && (bestf[0] >= 0 || (mm && (mm->known >> cand_role[k] & 1u)));
 		if (ranked && bestf[0] >= 0)
 			break;
 		int at = cand_at[k];
@@ -1100,12 +1107,14 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			if (c > costf[0] && c > cap)
 				continue;
 		}
-		/* A whole vertex is where a free end was: the same answer. */
-		int ok = fam == 1 && geo_at[at] >= 0 ? geo_at[at] : geometry_ok(g, pl, cand[k]);
-		if (hybrid && at >= 0 && !cand_whole[k])
-			geo_at[at] = ok;
-		if (!ok)
-			continue;
+		if (!late) {
+			/* A whole vertex is where a free end was: the same answer. */
+			int ok = fam == 1 && geo_at[at] >= 0 ? geo_at[at] : geometry_ok(g, pl, cand[k]);
+			if (hybrid && at >= 0 && !cand_whole[k])
+				geo_at[at] = ok;
+			if (!ok)
+				continue;
+		}
 		mlod_influences w;
 		int capped = 0;
 		if (cand_whole[k])
@@ -1168,6 +1177,8 @@ static int plan(mlod_bgm *g, int t, int op, int exact, struct plan *pl, memo *mm
 			if (g->opt.op == MLOD_OP_MIXED) /* per removed face: triangles and edges compete */
 				cost /= pl->nr;
 			if (bestf[fam] >= 0 && !(cost < costf[fam]))
+				continue;
+			if (late && !geometry_ok(g, pl, cand[k]))
 				continue;
 		} else {
 			cost = bgm_compactness(P[0], P[1], P[2]);
