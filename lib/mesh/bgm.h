@@ -221,6 +221,11 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
  * the partial sum reaches stop (HUGE_VAL: never). */
 double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *p,
                          double stop);
+/* bgm_quadric_error, and when it stops, the partial sum that reached stop
+ * in *reached (not NULL): the terms are +0 or above and summed in one
+ * order, so any stop at or below it stops that sum too. */
+double bgm_quadric_error_reach(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *p,
+                               double stop, double *reached);
 /* h (10 doubles) = sum over poses of M_p^T Q_p M_p, M_p the pose's skin
  * matrix blended for inf: the posed quadrics q pulled back into bind
  * space (DeCoro & Rusinkiewicz 2005), exact for a node that keeps inf. */

@@ -731,7 +731,17 @@ BGM_INLINE __m128d err_pair(const mlod_bgm *g, const double *u, const mlod_influ
 }
 #endif
 
-double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
+/* bgm_quadric_error_reach's early return: the partial sum that reached
+ * stop into *reached (when not NULL). */
+static inline double stopped(double e, double *reached)
+{
+	if (reached)
+		*reached = e;
+	return HUGE_VAL;
+}
+
+double bgm_quadric_error_reach(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop,
+                               double *reached)
 {
 	double M[12], y[3], e = 0.0;
 	int P = g->pose_count, D = g->qpose_count;
@@ -754,12 +764,12 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 				_mm_storeu_pd(v, err_pair(g, i < pairs ? q + 20 * (size_t)i : last, inf, (size_t)i, x0, x1, x2));
 				e += v[0];
 				if (e >= stop)
-					return HUGE_VAL;
+					return stopped(e, reached);
 				if (i == pairs)
 					break;
 				e += v[1];
 				if (e >= stop)
-					return HUGE_VAL;
+					return stopped(e, reached);
 			}
 			return e;
 		}
@@ -782,7 +792,7 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 			}
 			e += v;
 			if (e >= stop)
-				return HUGE_VAL;
+				return stopped(e, reached);
 		}
 		return e;
 	}
@@ -795,9 +805,14 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 		double v = eval(a, y);
 		e += v > 0.0 ? v : 0.0;
 		if (e >= stop)
-			return HUGE_VAL;
+			return stopped(e, reached);
 	}
 	return e;
+}
+
+double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
+{
+	return bgm_quadric_error_reach(g, q, inf, x, stop, NULL);
 }
 
 void bgm_quadric_rest_reset(mlod_bgm *g, int v)

@@ -874,6 +874,25 @@ static double ref_error(const mlod_bgm *g, const double *q, const mlod_influence
 	return e;
 }
 
+/* ref_error's partial sum where it stops (the whole when it does not). */
+static double ref_reached(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
+{
+	double M[12], y[3], e = 0.0;
+	for (int p = 0; p < g->pose_count; p++) {
+		ref_blend(g, p, inf, M);
+		for (int r = 0; r < 3; r++)
+			y[r] = M[4 * r] * x[0] + M[4 * r + 1] * x[1] + M[4 * r + 2] * x[2] + M[4 * r + 3];
+		double a[10];
+		bgm_quadric_get(q, g->qpose_count, g->qmap[p], a);
+		double v = a[0] * y[0] * y[0] + 2 * a[1] * y[0] * y[1] + 2 * a[2] * y[0] * y[2] + 2 * a[3] * y[0] +
+		           a[4] * y[1] * y[1] + 2 * a[5] * y[1] * y[2] + 2 * a[6] * y[1] + a[7] * y[2] * y[2] + 2 * a[8] * y[2] + a[9];
+		e += v > 0.0 ? v : 0.0;
+		if (e >= stop)
+			break;
+	}
+	return e;
+}
+
 static void ref_pullback(const mlod_bgm *g, const double *q, const mlod_influences *inf, double *H)
 {
 	memset(H, 0, 10 * sizeof *H);
@@ -943,6 +962,17 @@ static void check_two_pose_sums(const mlod_character *c, int clips, int random)
 				double ws_ = ref_error(g, q, ws[w], x, stop), gs = bgm_quadric_error(g, q, ws[w], x, stop);
 				CHECK(memcmp(&ws_, &gs, sizeof ws_) == 0);
 				stopped += gs == HUGE_VAL;
+				/* The partial sum it stopped at (one pose at a time's),
+				 * and a stop there stops it again (plan() skips such a
+				 * sum). */
+				double reached = -1.0, gr = bgm_quadric_error_reach(g, q, ws[w], x, stop, &reached);
+				CHECK(memcmp(&gr, &gs, sizeof gr) == 0);
+				if (gr == HUGE_VAL) {
+					double wr = ref_reached(g, q, ws[w], x, stop);
+					CHECK_MSG(memcmp(&wr, &reached, sizeof wr) == 0 && reached >= stop,
+					          "node %d: stopped at %.17g, one pose at a time at %.17g (stop %.17g)", v, reached, wr, stop);
+					CHECK(bgm_quadric_error(g, q, ws[w], x, reached) == HUGE_VAL);
+				}
 			}
 			double hw[10], hg[10];
 			ref_pullback(g, q, ws[w], hw);
