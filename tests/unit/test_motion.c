@@ -1223,6 +1223,39 @@ static int same_level(const mlod_motion_level *a, const mlod_motion_level *b)
 	return 1;
 }
 
+TEST(frames_level_after_threshold_level_same)
+{
+	/* The frames method keeps its tree's sum of neighbour distances (the
+	 * bisection's top) while the tree stays: after a finished level the
+	 * tree is that level's line and the sum must be made again. Motion a
+	 * reaches level 1's line by its error bound (the sum made and kept),
+	 * motion b by that level's threshold (no sum made); their level 2
+	 * must be the same. It failed with the sum kept across a finished
+	 * level. */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	mlod_motion *a, *b;
+	CHECK_OK(mlod_motion_create(&c, 0, NULL, &a, &terr));
+	CHECK_OK(mlod_motion_create(&c, 0, NULL, &b, &terr));
+	mlod_motion_level la1, lb1, la2, lb2;
+	CHECK_OK(mlod_motion_next_level(a, MLOD_MOTION_FRAMES, MLOD_MOTION_MAX_ERROR, 0.005 * h, &la1, &terr));
+	CHECK(la1.threshold > 0.0);
+	CHECK_OK(mlod_motion_next_level(b, MLOD_MOTION_FRAMES, MLOD_MOTION_THRESHOLD, la1.threshold, &lb1, &terr));
+	CHECK(lb1.keys == la1.keys);
+	CHECK_OK(mlod_motion_next_level(a, MLOD_MOTION_FRAMES, MLOD_MOTION_MAX_ERROR, 0.02 * h, &la2, &terr));
+	CHECK_OK(mlod_motion_next_level(b, MLOD_MOTION_FRAMES, MLOD_MOTION_MAX_ERROR, 0.02 * h, &lb2, &terr));
+	CHECK(la2.keys < la1.keys);
+	CHECK(same_level(&la2, &lb2));
+	mlod_motion_level_free(&la1);
+	mlod_motion_level_free(&lb1);
+	mlod_motion_level_free(&la2);
+	mlod_motion_level_free(&lb2);
+	mlod_motion_free(a);
+	mlod_motion_free(b);
+	mlod_character_free(&c);
+}
+
 TEST(build_levels_same_at_any_thread_count)
 {
 	/* One clip and two methods (the keys method's choice of keys on
@@ -1727,6 +1760,7 @@ int main(void)
 	RUN(precision_auto_shorts);
 	RUN(precision_rounds_within_own_error);
 	RUN(fast_checks_match_exact);
+	RUN(frames_level_after_threshold_level_same);
 	RUN(build_levels_same_at_any_thread_count);
 	RUN(frames_item_levels_same);
 	RUN(keys_split_same_as_next_level);
