@@ -461,6 +461,42 @@ static double dense_error(const mlod_character *c, const mlod_clip *level)
 	return r == MLOD_OK ? d.max : HUGE_VAL;
 }
 
+TEST(level_error_same_as_joint_deviation)
+{
+	/* A level's error (level_measure_of: the point distances inline,
+	 * point_gap) is mlod_joint_deviation_at's at the level's samples, bit
+	 * for bit: the keys and the frames method's, rounded. */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	const mlod_channel *ch = &c.clips[0].channels[0];
+	int n = (ch->key_count - 1) * MLOD_DEFAULT_SUBDIVIDE + 1;
+	float *st = malloc(sizeof(float) * (size_t)n);
+	CHECK(st != NULL);
+	mlod_motion_sample_times(ch->times, ch->key_count, MLOD_DEFAULT_SUBDIVIDE, st);
+	mlod_motion_method methods[2] = { MLOD_MOTION_KEYS, MLOD_MOTION_FRAMES };
+	for (int i = 0; i < 2; i++) {
+		mlod_motion *m;
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+		CHECK(mlod_motion_timeline_info(m)->frames == ch->key_count);
+		for (int k = 0; k < 2; k++) {
+			mlod_motion_level lv;
+			CHECK_OK(mlod_motion_next_level(m, methods[i], MLOD_MOTION_MAX_ERROR, (k ? 0.02 : 0.005) * h, &lv, &terr));
+			mlod_character b = c;
+			b.clips = &lv.clip;
+			mlod_deviation d = { 0, 0, 0 };
+			CHECK_OK(mlod_joint_deviation_at(&c, &b, st, n, &d, &terr));
+			CHECK_MSG(d.max == lv.error.max && d.mean == lv.error.mean && d.max > 0.0,
+			          "method %d, level %d: %.17g %.17g, measured %.17g %.17g", i, k + 1, lv.error.max,
+			          lv.error.mean, d.max, d.mean);
+			mlod_motion_level_free(&lv);
+		}
+		mlod_motion_free(m);
+	}
+	free(st);
+	mlod_character_free(&c);
+}
+
 TEST(bound_holds_between_frames)
 {
 	/* A root A with a rotation and a translation, and a child C carried
@@ -1746,6 +1782,7 @@ int main(void)
 	RUN(angle_wrap_is_not_motion);
 	RUN(points_out_from_leaves_are_kept);
 	RUN(hierarchy_error_is_bounded);
+	RUN(level_error_same_as_joint_deviation);
 	RUN(bound_holds_between_frames);
 	RUN(morph_weights_reduced_within_bound);
 	RUN(morph_target_reach_in_scene_units);
