@@ -1682,6 +1682,37 @@ TEST(eval_mul_same_as_mat4_mul)
 	CHECK_MSG(differ == 0, "%d products differ", differ);
 }
 
+/* The frames method's residuals interpolate with eval_slerp (a fresh
+ * segment) and eval_normalize where they took mlod_quat_slerp and
+ * mlod_quat_normalize: the same floats, near-parallel, opposite,
+ * unnormalised and zero keys included. */
+TEST(eval_slerp_same_as_quat_slerp)
+{
+	const float pick[8] = { 0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 3.0e-20f, -0.7071068f, 2.0f };
+	unsigned x = 777u;
+	int differ = 0;
+	for (int n = 0; n < 200000; n++) {
+		float ka[4], kb[4];
+		for (int i = 0; i < 4; i++) {
+			x = x * 1664525u + 1013904223u;
+			ka[i] = (x >> 29) < 2 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 4194304.0f;
+			x = x * 1664525u + 1013904223u;
+			/* a quarter near a (or -a): the linear blend's side */
+			kb[i] = n % 4 == 0 ? (n % 8 ? 1.0f : -1.0f) * ka[i] + (float)((int)(x >> 20) - 2048) * 1e-7f
+			      : (x >> 29) < 2 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 4194304.0f;
+		}
+		x = x * 1664525u + 1013904223u;
+		/* every float in [0, 1), small ones too (where 1 - u is not exact in floats) */
+		float u = n % 16 == 0 ? (float)(n % 32 == 0) : (float)((double)x / 4294967296.0 * ((x & 7) ? 1.0 : 1e-3));
+		eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+		mlod_quat r = eval_normalize(eval_slerp(&seg, ka, kb, u));
+		mlod_quat q = mlod_quat_normalize(mlod_quat_slerp((mlod_quat){ ka[0], ka[1], ka[2], ka[3] },
+		                                                  (mlod_quat){ kb[0], kb[1], kb[2], kb[3] }, u));
+		differ += memcmp(&r, &q, sizeof r) != 0;
+	}
+	CHECK_MSG(differ == 0, "%d slerps differ", differ);
+}
+
 /* The AVX2 copies' 8-lane forms (eval_mul_affine8 through
  * eval_mul_affine_w, and eval_error_bound_w), compiled here for AVX2 as
  * in the copies, against the 4-lane ones: bit for bit, signed zeros,
@@ -1806,6 +1837,7 @@ int main(void)
 	RUN(keys_avx2_same_as_generic);
 	RUN(keys_state_same_as_fresh);
 	RUN(eval_mul_same_as_mat4_mul);
+	RUN(eval_slerp_same_as_quat_slerp);
 	RUN(eval_wide_same_as_narrow);
 	RUN(create_like_same_as_create);
 	RUN(create_on_threads_same_as_create);
