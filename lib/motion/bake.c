@@ -88,10 +88,17 @@ static void sb_json_string(sbuf *b, const char *s)
 		case '\t': sb_printf(b, "\\t"); break;
 		case '\r': sb_printf(b, "\\r"); break;
 		default:
-			if (*p < 0x20)
+			if (*p < 0x20) {
 				sb_printf(b, "\\u%04x", *p);
-			else
+			} else if (*p < 0x80) {
 				sb_printf(b, "%c", *p);
+			} else { /* JSON text is UTF-8: a byte that does not start a well-formed sequence as U+FFFD */
+				int n = mlod_utf8_length((const char *)p);
+				if (n == 0)
+					sb_printf(b, "\xEF\xBF\xBD");
+				else
+					sb_printf(b, "%.*s", n, (const char *)p), p += n - 1;
+			}
 		}
 	}
 	sb_printf(b, "\"");
@@ -107,6 +114,21 @@ static void sb_name(sbuf *b, const char *name, int width)
 	for (const unsigned char *p = (const unsigned char *)text; *p; p++)
 		columns += (*p & 0xc0) != 0x80;
 	sb_printf(b, "%s%*s", text, width > columns ? width - columns : 0, "");
+}
+
+/* A text in a table whole, however long (sb_name cuts at 512 bytes):
+ * mlod_name_text's C escapes, into a buffer with room for every byte as
+ * \xHH. */
+static void sb_text(sbuf *b, const char *s)
+{
+	size_t size = 4 * strlen(s ? s : "") + 16;
+	char *text = malloc(size);
+	if (!text) {
+		b->bad = 1;
+		return;
+	}
+	sb_printf(b, "%s", mlod_name_text(s, 0, text, size));
+	free(text);
 }
 
 static mlod_result sb_finish(sbuf *b, char **text, mlod_error *err)
@@ -432,8 +454,9 @@ mlod_result mlod_motion_bake_table(const mlod_motion_bake *b, const mlod_charact
 {
 	sbuf sb = { NULL, 0, 0, 0 };
 	double height = info->height;
-	sb_printf(&sb, "# %s: %d joints, height %.4g, %d clips; point distance %.4g\n", info->input,
-	          c->skeleton.joint_count, height, c->clip_count, info->point_distance);
+	sb_printf(&sb, "# ");
+	sb_text(&sb, info->input);
+	sb_printf(&sb, ": %d joints, height %.4g, %d clips; point distance %.4g\n", c->skeleton.joint_count, height, c->clip_count, info->point_distance);
 	sb_printf(&sb, "%-16s %5s %6s %10s %7s %7s %8s %10s %8s %10s %8s %10s %8s\n", "clip", "level", "method",
 	          "threshold", "keys", "keys%", "bytes", "jnt max", "max%", "jnt mean", "mean%", "pt max", "vtx max%");
 	for (int k = 0; k < b->clip_count; k++) {

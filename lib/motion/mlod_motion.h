@@ -360,7 +360,9 @@ typedef struct mlod_motion_report_info {
 } mlod_motion_report_info;
 
 /* The report of a bake of c as a table or as JSON: *text, released with
- * free(). */
+ * free(). Names (info->input, the clips') in the table with
+ * mlod_name_text's C escapes; in the JSON as JSON strings, a byte that
+ * is not UTF-8 as U+FFFD. */
 mlod_result mlod_motion_bake_table(const mlod_motion_bake *b, const mlod_character *c,
                                    const mlod_motion_report_info *info, char **text, mlod_error *err);
 mlod_result mlod_motion_bake_json(const mlod_motion_bake *b, const mlod_character *c,

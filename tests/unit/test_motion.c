@@ -461,6 +461,42 @@ static double dense_error(const mlod_character *c, const mlod_clip *level)
 	return r == MLOD_OK ? d.max : HUGE_VAL;
 }
 
+TEST(level_error_same_as_joint_deviation)
+{
+	/* A level's error (level_measure_of: the point distances inline,
+	 * point_gap) is mlod_joint_deviation_at's at the level's samples, bit
+	 * for bit: the keys and the frames method's, rounded. */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	const mlod_channel *ch = &c.clips[0].channels[0];
+	int n = (ch->key_count - 1) * MLOD_DEFAULT_SUBDIVIDE + 1;
+	float *st = malloc(sizeof(float) * (size_t)n);
+	CHECK(st != NULL);
+	mlod_motion_sample_times(ch->times, ch->key_count, MLOD_DEFAULT_SUBDIVIDE, st);
+	mlod_motion_method methods[2] = { MLOD_MOTION_KEYS, MLOD_MOTION_FRAMES };
+	for (int i = 0; i < 2; i++) {
+		mlod_motion *m;
+		CHECK_OK(mlod_motion_create(&c, 0, NULL, &m, &terr));
+		CHECK(mlod_motion_timeline_info(m)->frames == ch->key_count);
+		for (int k = 0; k < 2; k++) {
+			mlod_motion_level lv;
+			CHECK_OK(mlod_motion_next_level(m, methods[i], MLOD_MOTION_MAX_ERROR, (k ? 0.02 : 0.005) * h, &lv, &terr));
+			mlod_character b = c;
+			b.clips = &lv.clip;
+			mlod_deviation d = { 0, 0, 0 };
+			CHECK_OK(mlod_joint_deviation_at(&c, &b, st, n, &d, &terr));
+			CHECK_MSG(d.max == lv.error.max && d.mean == lv.error.mean && d.max > 0.0,
+			          "method %d, level %d: %.17g %.17g, measured %.17g %.17g", i, k + 1, lv.error.max,
+			          lv.error.mean, d.max, d.mean);
+			mlod_motion_level_free(&lv);
+		}
+		mlod_motion_free(m);
+	}
+	free(st);
+	mlod_character_free(&c);
+}
+
 TEST(bound_holds_between_frames)
 {
 	/* A root A with a rotation and a translation, and a child C carried
@@ -1223,6 +1259,39 @@ static int same_level(const mlod_motion_level *a, const mlod_motion_level *b)
 	return 1;
 }
 
+TEST(frames_level_after_threshold_level_same)
+{
+	/* The frames method keeps its tree's sum of neighbour distances (the
+	 * bisection's top) while the tree stays: after a finished level the
+	 * tree is that level's line and the sum must be made again. Motion a
+	 * reaches level 1's line by its error bound (the sum made and kept),
+	 * motion b by that level's threshold (no sum made); their level 2
+	 * must be the same. It failed with the sum kept across a finished
+	 * level. */
+	mlod_character c;
+	CHECK(load_sample("samples/cmu_12_01_walk.bvh", &c) == 0);
+	double h = mlod_skeleton_height(&c.skeleton);
+	mlod_motion *a, *b;
+	CHECK_OK(mlod_motion_create(&c, 0, NULL, &a, &terr));
+	CHECK_OK(mlod_motion_create(&c, 0, NULL, &b, &terr));
+	mlod_motion_level la1, lb1, la2, lb2;
+	CHECK_OK(mlod_motion_next_level(a, MLOD_MOTION_FRAMES, MLOD_MOTION_MAX_ERROR, 0.005 * h, &la1, &terr));
+	CHECK(la1.threshold > 0.0);
+	CHECK_OK(mlod_motion_next_level(b, MLOD_MOTION_FRAMES, MLOD_MOTION_THRESHOLD, la1.threshold, &lb1, &terr));
+	CHECK(lb1.keys == la1.keys);
+	CHECK_OK(mlod_motion_next_level(a, MLOD_MOTION_FRAMES, MLOD_MOTION_MAX_ERROR, 0.02 * h, &la2, &terr));
+	CHECK_OK(mlod_motion_next_level(b, MLOD_MOTION_FRAMES, MLOD_MOTION_MAX_ERROR, 0.02 * h, &lb2, &terr));
+	CHECK(la2.keys < la1.keys);
+	CHECK(same_level(&la2, &lb2));
+	mlod_motion_level_free(&la1);
+	mlod_motion_level_free(&lb1);
+	mlod_motion_level_free(&la2);
+	mlod_motion_level_free(&lb2);
+	mlod_motion_free(a);
+	mlod_motion_free(b);
+	mlod_character_free(&c);
+}
+
 TEST(build_levels_same_at_any_thread_count)
 {
 	/* One clip and two methods (the keys method's choice of keys on
@@ -1613,6 +1682,37 @@ TEST(eval_mul_same_as_mat4_mul)
 	CHECK_MSG(differ == 0, "%d products differ", differ);
 }
 
+/* The frames method's residuals interpolate with eval_slerp (a fresh
+ * segment) and eval_normalize where they took mlod_quat_slerp and
+ * mlod_quat_normalize: the same floats, near-parallel, opposite,
+ * unnormalised and zero keys included. */
+TEST(eval_slerp_same_as_quat_slerp)
+{
+	const float pick[8] = { 0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 3.0e-20f, -0.7071068f, 2.0f };
+	unsigned x = 777u;
+	int differ = 0;
+	for (int n = 0; n < 200000; n++) {
+		float ka[4], kb[4];
+		for (int i = 0; i < 4; i++) {
+			x = x * 1664525u + 1013904223u;
+			ka[i] = (x >> 29) < 2 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 4194304.0f;
+			x = x * 1664525u + 1013904223u;
+			/* a quarter near a (or -a): the linear blend's side */
+			kb[i] = n % 4 == 0 ? (n % 8 ? 1.0f : -1.0f) * ka[i] + (float)((int)(x >> 20) - 2048) * 1e-7f
+			      : (x >> 29) < 2 ? pick[(x >> 8) & 7] : (float)((int)(x >> 9) - (1 << 22)) / 4194304.0f;
+		}
+		x = x * 1664525u + 1013904223u;
+		/* every float in [0, 1), small ones too (where 1 - u is not exact in floats) */
+		float u = n % 16 == 0 ? (float)(n % 32 == 0) : (float)((double)x / 4294967296.0 * ((x & 7) ? 1.0 : 1e-3));
+		eval_seg seg = { -1, 0, 0, { 0, 0, 0, 1 }, { 0, 0, 0, 1 }, 0.0, 0.0, 0.0 };
+		mlod_quat r = eval_normalize(eval_slerp(&seg, ka, kb, u));
+		mlod_quat q = mlod_quat_normalize(mlod_quat_slerp((mlod_quat){ ka[0], ka[1], ka[2], ka[3] },
+		                                                  (mlod_quat){ kb[0], kb[1], kb[2], kb[3] }, u));
+		differ += memcmp(&r, &q, sizeof r) != 0;
+	}
+	CHECK_MSG(differ == 0, "%d slerps differ", differ);
+}
+
 /* The AVX2 copies' 8-lane forms (eval_mul_affine8 through
  * eval_mul_affine_w, and eval_error_bound_w), compiled here for AVX2 as
  * in the copies, against the 4-lane ones: bit for bit, signed zeros,
@@ -1713,6 +1813,7 @@ int main(void)
 	RUN(angle_wrap_is_not_motion);
 	RUN(points_out_from_leaves_are_kept);
 	RUN(hierarchy_error_is_bounded);
+	RUN(level_error_same_as_joint_deviation);
 	RUN(bound_holds_between_frames);
 	RUN(morph_weights_reduced_within_bound);
 	RUN(morph_target_reach_in_scene_units);
@@ -1727,6 +1828,7 @@ int main(void)
 	RUN(precision_auto_shorts);
 	RUN(precision_rounds_within_own_error);
 	RUN(fast_checks_match_exact);
+	RUN(frames_level_after_threshold_level_same);
 	RUN(build_levels_same_at_any_thread_count);
 	RUN(frames_item_levels_same);
 	RUN(keys_split_same_as_next_level);
@@ -1735,6 +1837,7 @@ int main(void)
 	RUN(keys_avx2_same_as_generic);
 	RUN(keys_state_same_as_fresh);
 	RUN(eval_mul_same_as_mat4_mul);
+	RUN(eval_slerp_same_as_quat_slerp);
 	RUN(eval_wide_same_as_narrow);
 	RUN(create_like_same_as_create);
 	RUN(create_on_threads_same_as_create);
