@@ -180,6 +180,18 @@ void tool_note_lines(const char *what, const char *lines)
 	}
 }
 
+void tool_note_items(const char *what, const char *notes, const char *suffix)
+{
+	size_t ns = strlen(suffix);
+	for (const char *w = notes; w && *w;) {
+		const char *e = strstr(w, "; ");
+		size_t n = e ? (size_t)(e - w) : strlen(w);
+		if (n >= ns && memcmp(w + n - ns, suffix, ns) == 0)
+			tool_note(what, "%.*s", (int)n, w);
+		w += n + (e ? 2 : 0);
+	}
+}
+
 static void put_warnings(const char *path, const mlod_character *c)
 {
 	tool_note_lines(tool_input_label(path), c->warnings);

@@ -29,6 +29,11 @@ extern const char *tool_name;
  * the reader's and the pack writer's warnings. */
 void tool_note_lines(const char *what, const char *lines);
 
+/* tool_note for each item of notes ("; "-separated, as a library's notes
+ * for reports) that ends with suffix: the notes a shell user needs
+ * without --report (mlod-bgm's dropped ratios). */
+void tool_note_items(const char *what, const char *notes, const char *suffix);
+
 /* Prints "tool: what: message" to stderr and exits with code. what (a
  * file's name) is escaped as tool_put_name does; it may be NULL (then
  * "tool: message"). */

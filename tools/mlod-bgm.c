@@ -404,6 +404,8 @@ int main(int argc, char **argv)
 			tool_die(tool_exit_code(r), job.input, "%s", err.message);
 		if (max_error >= 0.0 && job.L.count == 0)
 			tool_note(job.input, "no mesh level within --max-error %g%%", max_error);
+		if (report == REPORT_NONE) /* a ratio that gives no coarser level: the report's note */
+			tool_note_items(job.input, job.L.notes, ": dropped");
 		follow_skeleton(&job, &rec, sk);
 		if (split) /* first: write_glb changes doc */
 			write_split(&job, doc, split, input_path, output);

@@ -80,7 +80,8 @@ static const char usage_more[] = /* printf's format ends above (ISO C's 4095-cha
 	"                             chunk's glb read as -x reads it (stdout\n"
 	"                             only: not with -o)\n"
 	"      --json                 with --info: as JSON (= --report=json)\n"
-	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels,\n"
+	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels (with\n"
+	"                             the pack's weights, on the full skin),\n"
 	"                             skeleton-level skins, <clip>@lod<k> animations\n"
 	"  -j, --threads N            compute mesh levels on N threads (default: the\n"
 	"                             processors it may run on, its CPU affinity);\n"
@@ -115,8 +116,7 @@ static void parse_level0(const char *value, mlod_pack_options *opt)
 	opt->motion_level0_percent = (unsigned char)percent;
 }
 
-/* Level 0 is the finest motion level: its bound must be below the smallest
- * of --motion-max-error's (compared in scene units, by the height). */
+/* The report's source column: a layer's levels from the input, or computed. */
 static const char *source(const mlod_pack_layer_stats *l)
 {
 	return l->levels <= 1 ? "-" : l->from_input ? "input" : "computed";
@@ -173,25 +173,6 @@ static void report_json(FILE *rf, const char *input, const mlod_pack_stats *st, 
 	fprintf(rf, "\n}\n");
 }
 
-/* --info: every chunk is first decoded through the reader (lib/rt,
- * mlod_pack_check), and the DOC chunk's glb read as -x reads it
- * (mlod_pack_check_doc), so that a CRC or a bound that does not hold
- * exits 2 with the reader's message. */
-typedef struct pack_totals {
-	uint64_t stored[4], raw[4];
-	uint32_t chunks[4];
-} pack_totals;
-
-/* The codec column: "meshopt", or "meshopt+zstd" with an entropy stage. */
-static const char *codec_column(const mlod_pack_chunk *c, char *buf, size_t n)
-{
-	if (c->entropy == MLOD_ENTROPY_NONE)
-		snprintf(buf, n, "%s", mlod_pack_codec_name(c->codec));
-	else
-		snprintf(buf, n, "%s+%s", mlod_pack_codec_name(c->codec), mlod_pack_entropy_name(c->entropy));
-	return buf;
-}
-
 /* Reads the pack of --info or -x (a file, or stdin when path is "-"). */
 static void *read_pack(const char *path, size_t *size)
 {
@@ -200,6 +181,10 @@ static void *read_pack(const char *path, size_t *size)
 	return tool_read_input(path, size);
 }
 
+/* --info: every chunk is first decoded through the reader (lib/rt,
+ * mlod_pack_check), and the DOC chunk's glb read as -x reads it
+ * (mlod_pack_check_doc), so that a CRC or a bound that does not hold
+ * exits 2 with the reader's message. */
 static int pack_info(const char *path, enum tool_report report)
 {
 	const char *label = tool_input_label(path);
@@ -212,17 +197,9 @@ static int pack_info(const char *path, enum tool_report report)
 	if (r != MLOD_OK)
 		tool_die(tool_exit_code(r), label, "%s", err.message);
 	const mlod_pack_info_rec *ir = &info.rec;
-	pack_totals t;
-	memset(&t, 0, sizeof t);
-	for (uint32_t i = 0; i < p.chunk_count; i++) {
-		unsigned l = p.chunks[i].layer < 4 ? p.chunks[i].layer : 0;
-		t.stored[l] += p.chunks[i].stored_size;
-		t.raw[l] += p.chunks[i].raw_size;
-		t.chunks[l]++;
-	}
-	uint64_t stored = t.stored[0] + t.stored[1] + t.stored[2] + t.stored[3];
-	uint64_t raw = t.raw[0] + t.raw[1] + t.raw[2] + t.raw[3];
-	uint64_t overhead = p.file_size - stored; /* header, TOC, padding */
+	mlod_pack_totals t;
+	mlod_pack_totals_sum(&p, &t);
+	uint64_t stored = t.all_stored, raw = t.all_raw, overhead = t.overhead;
 	FILE *f = stdout;
 	if (report == REPORT_JSON) {
 		fprintf(f, "{\n  \"file\": ");
@@ -276,7 +253,7 @@ static int pack_info(const char *path, enum tool_report report)
 			char cc[32];
 			fprintf(f, "%-5s %-8s %5u  ", mlod_pack_type_name(c->type), mlod_pack_layer_name(c->layer), c->level);
 			tool_put_name(f, item, 20);
-			fprintf(f, " %-19s %10u %10u %11.4g %8.4g%% %11.4g\n", codec_column(c, cc, sizeof cc), c->stored_size,
+			fprintf(f, " %-19s %10u %10u %11.4g %8.4g%% %11.4g\n", mlod_pack_codec_label(c, cc, sizeof cc), c->stored_size,
 			        c->raw_size, c->error, ref > 0.0 ? 100.0 * c->error / ref : 0.0, c->distance);
 		}
 		for (unsigned l = 0; l < 4; l++)
@@ -366,23 +343,13 @@ int main(int argc, char **argv)
 		case 'r': report = tool_parse_report(optarg); break;
 		case OPT_CODEC:
 			BAKE("--codec");
-			if (strcmp(optarg, "meshopt") == 0)
-				opt.codec = MLOD_CODEC_MESHOPT;
-			else if (strcmp(optarg, "none") == 0)
-				opt.codec = MLOD_CODEC_NONE;
-			else if (strcmp(optarg, "draco") == 0)
-				opt.codec = MLOD_CODEC_DRACO;
-			else
+			if (mlod_pack_codec_parse(optarg, &opt))
 				tool_usage_error("--codec: unknown value '%s' (meshopt, none or draco)", optarg);
 			codec = optarg;
 			break;
 		case OPT_ENTROPY:
 			BAKE("--entropy");
-			if (strcmp(optarg, "zstd") == 0)
-				opt.entropy = MLOD_ENTROPY_ZSTD;
-			else if (strcmp(optarg, "none") == 0)
-				opt.entropy = MLOD_ENTROPY_NONE;
-			else
+			if (mlod_pack_entropy_parse(optarg, &opt))
 				tool_usage_error("--entropy: unknown value '%s' (zstd or none)", optarg);
 			break;
 		case OPT_NAME: name = optarg, BAKE("--name"); break;

@@ -334,6 +334,27 @@ mlod_result mlod_pack_check_doc(const mlod_pack *p, const void *data, size_t siz
  * failure nothing is left to release. */
 mlod_result mlod_pack_inspect(const void *data, size_t size, mlod_pack *p, mlod_pack_info *info, mlod_error *err);
 
+/* A pack's TOC summed per layer (mlod_pack_layer, 0 to 3: none,
+ * skeleton, mesh, motion; an unknown layer counts as none), and over
+ * all: the bytes stored in chunks, their raw bytes, and the rest of the
+ * file (header, TOC, padding). What mlod-pack --info prints (packinfo.c). */
+typedef struct mlod_pack_totals {
+	uint64_t stored[4], raw[4];
+	uint32_t chunks[4];
+	uint64_t all_stored, all_raw, overhead;
+} mlod_pack_totals;
+void mlod_pack_totals_sum(const mlod_pack *p, mlod_pack_totals *t);
+
+/* A chunk's codec as --info names it: "meshopt", or "meshopt+zstd" with
+ * an entropy stage; written to buf (n bytes), which it returns. */
+const char *mlod_pack_codec_label(const mlod_pack_chunk *c, char *buf, size_t n);
+
+/* The codec (meshopt, none, draco) and entropy stage (zstd, none) of
+ * mlod-pack's --codec and --entropy into opt: 0, or -1 (opt unchanged)
+ * for another name. */
+int mlod_pack_codec_parse(const char *name, mlod_pack_options *opt);
+int mlod_pack_entropy_parse(const char *name, mlod_pack_options *opt);
+
 #ifdef __cplusplus
 }
 #endif

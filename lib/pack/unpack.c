@@ -12,9 +12,13 @@
  * becomes an animation named after the clip. Coarser levels are added as
  * mlod-skelgraph, mlod-bgm and mlod-motion write them: a skin per skeleton
  * level and skin, an MSFT_lod level node per mesh level and instance
- * (with MSFT_screencoverage; skinned level k follows skeleton level k's
- * skin, or the coarsest), and "<clip>@lod<k>" animations. The DOC's
- * emptied meshes go (mlod_gltf_prune).
+ * (with MSFT_screencoverage), and "<clip>@lod<k>" animations. A mesh
+ * level keeps the weights the pack stores, on level 0's skin (a rigid
+ * part's on a one-joint skin of its joint), not a skeleton level's as
+ * mlod-bgm after mlod-skelgraph writes it: the runtime picks skeleton and
+ * mesh levels apart, and a level on the full skin is what mlod-pack keeps
+ * as it is, with its TOC error (issue 11). The DOC's emptied meshes go
+ * (mlod_gltf_prune).
  *
  * The stage record (mlod-record(5), version 3) says which of these are
  * levels, with what the pack stores of them and nothing more: per
@@ -96,18 +100,16 @@ static void skeleton_free(mlod_skeleton *s)
 /* One skeleton level's skins: per skin, the distinct stand-ins of its
  * joints in skin order (each with the bind of the first skin joint that
  * maps to it: the writer gives every skin joint of one stand-in the same
- * bind) and the map from a skin joint to its position in that list. */
+ * bind). No mesh level is written on them (the mesh levels keep the
+ * pack's weights, on the full skin): they are the record's and a glTF
+ * viewer's skeleton levels. */
 typedef struct level_skins {
 	int *gltf;      /* per skin: the glTF skin added, or -1 */
-	int **map;      /* per skin: skin joint -> level skin joint */
 	int *stand;     /* per full joint: its stand-in at this level */
 } level_skins;
 
-static void level_skins_free(level_skins *l, int skins)
+static void level_skins_free(level_skins *l)
 {
-	for (int i = 0; l->map && i < skins; i++)
-		free(l->map[i]);
-	free(l->map);
 	free(l->gltf);
 	free(l->stand);
 	memset(l, 0, sizeof *l);
@@ -178,9 +180,8 @@ static mlod_result add_level_skins(mlod_gltf *doc, const mlod_skeleton *s, const
 {
 	memset(out, 0, sizeof *out);
 	out->gltf = malloc(sizeof(int) * ((size_t)s->skin_count + 1));
-	out->map = calloc((size_t)s->skin_count + 1, sizeof(int *));
 	out->stand = malloc(sizeof(int) * ((size_t)s->joint_count + 1));
-	if (!out->gltf || !out->map || !out->stand)
+	if (!out->gltf || !out->stand)
 		return nomem(err);
 	/* Stand-ins: a joint's nearest kept ancestor (itself when kept). */
 	unsigned char *kept = calloc((size_t)s->joint_count + 1, 1);
@@ -202,8 +203,7 @@ static mlod_result add_level_skins(mlod_gltf *doc, const mlod_skeleton *s, const
 		int n = full->joint_count, m = 0;
 		int *joints = malloc(sizeof(int) * ((size_t)n + 1));
 		mlod_mat4 *bind = malloc(sizeof(mlod_mat4) * ((size_t)n + 1));
-		out->map[i] = malloc(sizeof(int) * ((size_t)n + 1));
-		if (!joints || !bind || !out->map[i]) {
+		if (!joints || !bind) {
 			free(joints);
 			free(bind);
 			return nomem(err);
@@ -217,7 +217,6 @@ static mlod_result add_level_skins(mlod_gltf *doc, const mlod_skeleton *s, const
 				memcpy(bind[m].m, lv->palette_bind + 16 * (base + (size_t)j), sizeof(mlod_mat4));
 				m++;
 			}
-			out->map[i][j] = t;
 		}
 		base += (size_t)n;
 		char name[160];
@@ -266,46 +265,6 @@ static void part_primitive(const mlod_pack_part *q, mlod_primitive *p, mlod_morp
 		memset(&targets[t], 0, sizeof targets[t]);
 		targets[t].positions = q->targets[t];
 	}
-}
-
-/* Remaps a skinned primitive's joints through map (skin joint -> level
- * skin joint), merging the weights of influences that land on one joint
- * (glTF wants a vertex's joints with weight distinct). Allocates new
- * joints and weights arrays into *joints and *weights. */
-static mlod_result remap_primitive(mlod_primitive *p, const int *map, int map_count, uint16_t **joints,
-                                   float **weights, mlod_error *err)
-{
-	size_t n = 4 * (size_t)p->vertex_count;
-	*joints = malloc(sizeof(uint16_t) * (n + 1));
-	*weights = malloc(sizeof(float) * (n + 1));
-	if (!*joints || !*weights)
-		return nomem(err);
-	for (int v = 0; v < p->vertex_count; v++) {
-		const uint16_t *js = p->joints[0] + 4 * (size_t)v;
-		const float *ws = p->weights[0] + 4 * (size_t)v;
-		uint16_t *oj = *joints + 4 * (size_t)v;
-		float *ow = *weights + 4 * (size_t)v;
-		int m = 0;
-		for (int i = 0; i < 4; i++) {
-			if (!(ws[i] > 0.0f))
-				continue;
-			int t = js[i] < map_count ? map[js[i]] : 0, k = 0;
-			while (k < m && oj[k] != t)
-				k++;
-			if (k == m) {
-				oj[m] = (uint16_t)t;
-				ow[m++] = 0.0f;
-			}
-			ow[k] += ws[i];
-		}
-		for (; m < 4; m++) {
-			oj[m] = 0;
-			ow[m] = 0.0f;
-		}
-	}
-	p->joints[0] = *joints;
-	p->weights[0] = *weights;
-	return MLOD_OK;
 }
 
 /* The parts of a mesh level that belong to node (in part order). */
@@ -378,11 +337,11 @@ static mlod_result lone_primitive(const mlod_pack_mesh *meshes, int levels, int 
 }
 
 /* Adds the mesh of node's parts at level k of meshes (levels of them;
- * like glTF mesh `like`). map (per skin, may be NULL) remaps skinned
- * parts' joints. */
+ * like glTF mesh `like`), skinned parts with the joints and weights the
+ * pack stores (on the full skin). rigid: the parts are a rigid part's
+ * coarser level, given joint 0 of weight 1 (rigid_skin). */
 static mlod_result add_parts_mesh(mlod_gltf *doc, const mlod_pack_mesh *meshes, int levels, int k, const int *parts,
-                                  int count, int like, int **map, int rigid, const mlod_skeleton *s, int *out,
-                                  mlod_error *err)
+                                  int count, int like, int rigid, int *out, mlod_error *err)
 {
 	const mlod_pack_mesh *m = &meshes[k];
 	mlod_primitive *prims = calloc((size_t)count + 1, sizeof *prims);
@@ -405,9 +364,6 @@ static mlod_result add_parts_mesh(mlod_gltf *doc, const mlod_pack_mesh *meshes, 
 		    (r = lone_primitive(meshes, levels, k, parts[i], &prims[i], targets[i], &lone[i], &zeros[i], err)) !=
 		        MLOD_OK)
 			break;
-		int sk = q->rec.skin;
-		if (map && sk >= 0 && sk < s->skin_count && prims[i].weight_set_count)
-			r = remap_primitive(&prims[i], map[sk], s->skins[sk].joint_count, &js[i], &ws[i], err);
 		if (rigid && !prims[i].weight_set_count) {
 			/* A rigid part's level follows its one-joint skin: joint 0, weight 1. */
 			size_t nv = (size_t)prims[i].vertex_count;
@@ -452,25 +408,14 @@ static mlod_result add_parts_mesh(mlod_gltf *doc, const mlod_pack_mesh *meshes, 
 	return r;
 }
 
-/* A skin of one joint for a rigid part: world = W(stand) * bind * p, bind
- * = W(stand)^-1 W(joint) offset in the rest pose (offset itself when
- * stand is the joint). */
-typedef struct world_cache {
-	mlod_mat4 *world;
-} world_cache;
-
-static mlod_result rigid_skin(mlod_gltf *doc, const mlod_skeleton *s, const world_cache *wc, int joint,
-                              int stand, const float *offset, int *index, mlod_error *err)
+/* A skin of one joint for a rigid part's coarser levels: world = W(joint)
+ * * offset * p, the part's own joint and offset (the pack's). */
+static mlod_result rigid_skin(mlod_gltf *doc, const mlod_skeleton *s, int joint, const float *offset, int *index,
+                              mlod_error *err)
 {
-	mlod_mat4 ibm, inv;
+	mlod_mat4 ibm;
 	memcpy(ibm.m, offset, sizeof ibm.m);
-	if (stand != joint && wc && wc->world && mlod_mat4_invert(&wc->world[stand], &inv)) {
-		mlod_mat4 rel = mlod_mat4_mul(&inv, &wc->world[joint]);
-		ibm = mlod_mat4_mul(&rel, &ibm);
-	} else {
-		stand = joint;
-	}
-	int joints[1] = {stand};
+	int joints[1] = {joint};
 	mlod_skin skin = {0};
 	skin.name = "mlod rigid part";
 	skin.joint_count = 1;
@@ -667,8 +612,6 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 	level_skins *ls = NULL;
 	mlod_gltf *doc = NULL;
 	int *parts = NULL, *nodes = NULL, *mesh_map = NULL, *lod_nodes = NULL;
-	mlod_mat4 *world = NULL;
-	mlod_trs *local = NULL;
 	unsigned char *used = NULL, *whole = NULL;
 	mlod_record_skel_level *skel_rec = NULL; /* the stage record's skeleton levels */
 	mlod_record_mesh_level *mesh_rec = NULL;  /* and mesh levels */
@@ -836,18 +779,6 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 		}
 		for (int i = 0; i < mlod_gltf_count(doc, MLOD_GLTF_MESH); i++)
 			mesh_map[i] = -1;
-		/* The rest pose's world matrices (rigid parts under a stand-in). */
-		if (s.joint_count > 0) {
-			local = malloc(sizeof *local * (size_t)s.joint_count);
-			world = malloc(sizeof *world * (size_t)s.joint_count);
-			if (!local || !world) {
-				r = nomem(err);
-				goto done;
-			}
-			mlod_pose_rest(&s, local);
-			mlod_pose_world(&s, local, world);
-		}
-		world_cache wc = {world};
 		/* The instance nodes, in part order. */
 		int nn = 0;
 		for (uint32_t i = 0; i < n; i++) {
@@ -892,7 +823,7 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			} else if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) && mesh_map[like] >= 0) {
 				mesh = mesh_map[like];
 			} else {
-				if ((r = add_parts_mesh(doc, meshes, (int)mesh_levels, 0, parts, count, like, NULL, 0, &s, &mesh, err)) != MLOD_OK)
+				if ((r = add_parts_mesh(doc, meshes, (int)mesh_levels, 0, parts, count, like, 0, &mesh, err)) != MLOD_OK)
 					goto done;
 				/* the DOC mesh's points, lines, strips and fans, kept whole */
 				if (like >= 0 && like < mlod_gltf_count(doc, MLOD_GLTF_MESH) &&
@@ -914,9 +845,9 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 					continue; /* a sheared matrix: no MSFT_lod (as mlod-bgm) */
 				tp = &trs;
 			}
-			int rigid_stand = -1, rigid_index = -1;
+			int rigid_index = -1;
 			for (int k = 1; k <= lods; k++) {
-				int ck = node_parts(&meshes[k], node, parts), sl = k < (int)skel_levels ? k : (int)skel_levels - 1;
+				int ck = node_parts(&meshes[k], node, parts);
 				if (ck != count) {
 					r = mlod_fail(err, MLOD_ERR_PARSE, "MESH level %d: node %d has %d parts, level 0 %d", k, node, ck,
 					              count);
@@ -924,21 +855,18 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 				}
 				int skin = skin0, lmesh = -1, lnode = -1;
 				snprintf(where, sizeof where, "MESH level %d", k);
-				int **map = NULL;
-				if (q0->skin >= 0 && sl >= 1 && ls[sl].gltf && ls[sl].gltf[q0->skin] >= 0) {
-					map = ls[sl].map;
-					skin = ls[sl].gltf[q0->skin];
-				} else if (q0->skin < 0 && q0->joint >= 0 && q0->joint < s.joint_count) {
-					int stand = sl >= 1 && ls[sl].stand ? ls[sl].stand[q0->joint] : q0->joint;
-					if (stand != rigid_stand) {
-						rigid_stand = stand;
-						if ((r = rigid_skin(doc, &s, &wc, q0->joint, stand, q0->offset, &rigid_index, err)) !=
-						    MLOD_OK)
-							goto done;
-					}
+				/* Every level on the weights the pack stores: a skinned
+				 * part's on the full skin (level 0's), a rigid part's on
+				 * a one-joint skin of its own joint, so that the level
+				 * poses as the runtime poses it at skeleton level 0 and
+				 * mlod-pack keeps it as it is. */
+				if (q0->skin < 0 && q0->joint >= 0 && q0->joint < s.joint_count) {
+					if (rigid_index < 0 &&
+					    (r = rigid_skin(doc, &s, q0->joint, q0->offset, &rigid_index, err)) != MLOD_OK)
+						goto done;
 					skin = rigid_index;
 				}
-				if ((r = add_parts_mesh(doc, meshes, (int)mesh_levels, k, parts, count, like, map, q0->skin < 0 && q0->joint >= 0, &s,
+				if ((r = add_parts_mesh(doc, meshes, (int)mesh_levels, k, parts, count, like, q0->skin < 0 && q0->joint >= 0,
 				                          &lmesh, err)) != MLOD_OK)
 					goto done;
 				char name[96];
@@ -950,7 +878,6 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 				rn.level = k;
 				rn.missing_ratio = 1;
 				rn.missing_error = 1;
-				rn.skeleton_level = map != NULL;
 				rn.has_pack_error = 1;
 				rn.pack_error = mesh_rec[k - 1].pack_error;
 				if ((r = mlod_record_write_mesh_node(doc, lnode, &rn, err)) != MLOD_OK)
@@ -1095,7 +1022,7 @@ done:
 		mlod_pack_mesh_free(&meshes[k]);
 	free(meshes);
 	for (uint32_t k = 0; ls && k <= skel_levels; k++)
-		level_skins_free(&ls[k], s.skin_count);
+		level_skins_free(&ls[k]);
 	free(ls);
 	for (uint32_t k = 0; skel_rec && k < skel_levels; k++)
 		mlod_record_skel_level_free(&skel_rec[k]);
@@ -1105,8 +1032,6 @@ done:
 	free(nodes);
 	free(mesh_map);
 	free(lod_nodes);
-	free(world);
-	free(local);
 	free(used);
 	free(whole);
 	skeleton_free(&s);

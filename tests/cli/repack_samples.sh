@@ -4,11 +4,13 @@
 # chunk for chunk, the same type, layer, level, clip, error and switch
 # distance (only the stored bytes may differ: mlod-pack(1) BUGS), every
 # layer with levels taken from the input, each clip's level 0 kept. The
-# coarse mesh levels of a pack with skeleton levels (tubeman's) are the
-# exception: -x binds them to those levels' skins, and the packer
-# measures them again, so their errors and distances may grow, never
-# shrink. The unpacked glb, with its stage record, passes the glTF
-# validator.
+# coarse mesh levels of a pack with skeleton levels (tubeman's) too:
+# -x writes them with the weights the pack stores (the full skin), and
+# the packer keeps them with their errors. Before, -x wrote them on the
+# skeleton levels' skins and the packer measured them again: tubeman's
+# four stated 2.189, 2.153, 2.129 and 1.850 against 0.07738, 0.174,
+# 0.4604 and 1.191. The unpacked glb, with its stage record, passes the
+# glTF validator.
 set -e
 for s in tubeman.glb RobotExpressive.glb cmu_12_01_walk.bvh; do
 	n=${s%.*}
@@ -25,13 +27,7 @@ for s in tubeman.glb RobotExpressive.glb cmu_12_01_walk.bvh; do
 	done
 	cmp "$n.mlod.character" "$n.again.mlod.character"
 	cmp "$n.mlod.levels" "$n.again.mlod.levels"
-	if [ "$n" = tubeman ]; then
-		paste "$n.mlod.mesh" "$n.again.mlod.mesh" |
-			awk '{ if ($1 != $4 || $5 + 0 < $2 + 0 || $6 + 0 < $3 + 0) bad = 1; if ($5 + 0 > $2 + 0) grew++ }
-			     END { exit bad || grew != 4 }'
-	else
-		cmp "$n.mlod.mesh" "$n.again.mlod.mesh"
-	fi
+	cmp "$n.mlod.mesh" "$n.again.mlod.mesh"
 	# the layers with levels came from the input, none computed
 	if grep -q ' computed ' "$n.report.txt"; then cat "$n.report.txt" >&2; exit 1; fi
 	grep -q "are a pack's motion level 0: kept as they are" "$n.report.txt"

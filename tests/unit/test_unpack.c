@@ -1318,17 +1318,15 @@ static void repack(const char *path, int no_skel, int no_mesh, int no_motion)
 		if (at < 0)
 			continue;
 		const mlod_pack_chunk *y = &p2.chunks[at];
-		/* A coarse mesh level comes back on the skin of a skeleton level
-		 * (the weights of the joints it removes on their stand-ins): the
-		 * packer measures it again as stored, so its error may grow
-		 * (tubeman: all four), never shrink. */
-		int bound = x->type == MLOD_CHUNK_MESH && x->level > 0 && a->skeleton_levels > 1;
-		CHECK_MSG(x->layer == y->layer &&
-		              (bound ? y->error >= x->error && y->distance >= x->distance
-		                     : x->error == y->error && x->distance == y->distance),
+		/* Every level keeps its error and distance, the coarse mesh levels
+		 * of a pack with skeleton levels too: -x writes them with the
+		 * weights the pack stores (the full skin), and the packer keeps
+		 * them. Before, -x wrote them on the skeleton levels' skins, the
+		 * packer measured them again, and tubeman's four grew (issue 11). */
+		CHECK_MSG(x->layer == y->layer && x->error == y->error && x->distance == y->distance,
 		          "%s: chunk %u (type %u level %u item %u): error %.9g distance %.9g, packed again %.9g %.9g", path, i,
 		          x->type, x->level, x->item, x->error, x->distance, y->error, y->distance);
-		if (bound && y->error > x->error)
+		if (x->type == MLOD_CHUNK_MESH && y->error > x->error)
 			grew++;
 		if (x->stored_size == y->stored_size &&
 		    memcmp((const char *)pack1 + x->offset, (const char *)pack2 + y->offset, x->stored_size) == 0)
