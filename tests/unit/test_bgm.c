@@ -856,24 +856,6 @@ static void ref_blend(const mlod_bgm *g, int p, const mlod_influences *inf, doub
 	}
 }
 
-static double ref_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
-{
-	double M[12], y[3], e = 0.0;
-	for (int p = 0; p < g->pose_count; p++) {
-		ref_blend(g, p, inf, M);
-		for (int r = 0; r < 3; r++)
-			y[r] = M[4 * r] * x[0] + M[4 * r + 1] * x[1] + M[4 * r + 2] * x[2] + M[4 * r + 3];
-		double a[10];
-		bgm_quadric_get(q, g->qpose_count, g->qmap[p], a);
-		double v = a[0] * y[0] * y[0] + 2 * a[1] * y[0] * y[1] + 2 * a[2] * y[0] * y[2] + 2 * a[3] * y[0] +
-		           a[4] * y[1] * y[1] + 2 * a[5] * y[1] * y[2] + 2 * a[6] * y[1] + a[7] * y[2] * y[2] + 2 * a[8] * y[2] + a[9];
-		e += v > 0.0 ? v : 0.0;
-		if (e >= stop)
-			return HUGE_VAL;
-	}
-	return e;
-}
-
 /* ref_error's partial sum where it stops (the whole when it does not). */
 static double ref_reached(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
 {
@@ -891,6 +873,14 @@ static double ref_reached(const mlod_bgm *g, const double *q, const mlod_influen
 			break;
 	}
 	return e;
+}
+
+/* The posed error at x, one pose at a time; HUGE_VAL once the sum
+ * reaches stop. */
+static double ref_error(const mlod_bgm *g, const double *q, const mlod_influences *inf, const double *x, double stop)
+{
+	const double e = ref_reached(g, q, inf, x, stop);
+	return e >= stop ? HUGE_VAL : e;
 }
 
 static void ref_pullback(const mlod_bgm *g, const double *q, const mlod_influences *inf, double *H)
