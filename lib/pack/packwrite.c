@@ -4305,15 +4305,27 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			/* The TOC error of a level with one (not the clip as read):
 			 * the level's as the reader returns it (its keys on the
 			 * lattices and grids), when above that of the values given
-			 * (mlod(5) QUANTISATION). */
-			if (body.c[body.n - 1].error > 0.0f) {
+			 * (mlod(5) QUANTISATION), and its switch distance with it.
+			 * A pack's level 0 and its levels (mlod-pack -x) keep that
+			 * pack's errors: their keys come back as read
+			 * (motion_shift_choice), measured against its level 0. */
+			if (body.c[body.n - 1].error > 0.0f && !x.clips[q].packed) {
 				double me = img_error(&x, &x.v.clips[q], cl, mi, err);
 				if (me < 0) {
 					r = MLOD_ERR_NOMEM;
 					goto done;
 				}
-				if ((float)me > body.c[body.n - 1].error)
+				if ((float)me > body.c[body.n - 1].error) {
 					body.c[body.n - 1].error = (float)me;
+					body.c[body.n - 1].distance = k > 0 ? mlod_pack_switch_distance((float)me) : 0.0f;
+					if (!isfinite((float)me) || !isfinite(body.c[body.n - 1].distance)) {
+						r = mlod_fail(err, MLOD_ERR_PARSE,
+						              "MOTION level %d of clip %d: error %g as read back is not finite or gives a "
+						              "switch distance that is not (are the input's coordinates too large?)",
+						              k, q, me);
+						goto done;
+					}
+				}
 			}
 			x.clips[q].toc[k] = body.c[body.n - 1].error;
 			/* A reduced level 0 that stores more than the clip as read

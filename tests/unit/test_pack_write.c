@@ -1164,7 +1164,8 @@ TEST(motion_level0_bound)
  * the bake library, at the input's frames and midpoints: the point error
  * (mlod_motion_point_error, the pack's point distance) of every joint
  * within the level's TOC error, plus 1e-6 of the height for float
- * rounding, and level 0's TOC error within the default level-0 bound. The
+ * rounding, level 0's TOC error within the default level-0 bound and each
+ * switch distance the one of its TOC error. The
  * walk's level 0 before RESULTS Run 15: TOC 0.01084, measured 0.01217
  * (1.12 times). *worst gets the largest error / TOC error per level. */
 static void levels_within_toc(const char *path, int metres, double *worst)
@@ -1204,6 +1205,9 @@ static void levels_within_toc(const char *path, int metres, double *worst)
 		for (uint32_t l = 0; l < mlod_rt_level_count(ctx, MLOD_RT_MOTION); l++) {
 			mlod_rt_level_info li;
 			CHECK_OK(mlod_rt_level_info_get(ctx, MLOD_RT_MOTION, l, (uint32_t)q, &li, &terr));
+			CHECK_MSG(li.distance == (l ? mlod_pack_switch_distance(li.error) : 0.0f),
+			          "%s clip %d level %u: switch distance %g for the TOC error %g", path, q, l, (double)li.distance,
+			          (double)li.error);
 			if (l == 0)
 				CHECK_MSG(li.error <= MLOD_PACK_MOTION_LEVEL0_DEFAULT * st.height / 100.0,
 				          "%s clip %d: level 0's TOC error %g, the bound %g", path, q, (double)li.error,
