@@ -2760,48 +2760,6 @@ static mlod_result motion_level0(struct ctx *x)
 	return r;
 }
 
-/* Level 0 of clip q made again within bound (motion_shift_choice): as
- * motion_level0 makes it, or the clip as read (TOC error 0) when no
- * level meets the bound, it would not have fewer keys or bound <= 0. */
-static mlod_result level0_build(struct ctx *x, int q, double bound)
-{
-	const mlod_character *c = &x->v;
-	mlod_motion_options mo = {0};
-	mo.point_distance = motion_point_distance(x);
-	mo.precision = MLOD_MOTION_PRECISION_FULL;
-	if (x->clips[q].level0 == &x->level0_owned[q].clip)
-		mlod_motion_level_free(&x->level0_owned[q]);
-	memset(&x->level0_owned[q], 0, sizeof x->level0_owned[q]);
-	x->clips[q].level0 = &c->clips[q];
-	x->clips[q].error0 = 0.0f;
-	if (!(bound > 0.0))
-		return MLOD_OK;
-	mlod_motion *m[2] = {NULL, NULL};
-	mlod_result r = MLOD_OK;
-	for (int i = 0; r == MLOD_OK && i < 2; i++)
-		r = i == 0 ? mlod_motion_create(c, q, &mo, &m[i], x->err) : mlod_motion_create_like(m[0], &m[i], x->err);
-	if (r == MLOD_OK && mlod_motion_timeline_info(m[0])->frames >= 3) {
-		static const mlod_motion_method methods[2] = {MLOD_MOTION_FRAMES, MLOD_MOTION_KEYS};
-		mlod_motion_level best;
-		mlod_error why = {0};
-		mlod_result e = mlod_motion_next_level_best(m, methods, 2, MLOD_MOTION_MAX_ERROR, bound, &best, &why);
-		if (e == MLOD_OK && best.keys < mlod_clip_key_count(&c->clips[q])) {
-			x->level0_owned[q] = best;
-			x->clips[q].level0 = &x->level0_owned[q].clip;
-			x->clips[q].error0 = (float)best.error.max;
-		} else if (e == MLOD_OK) {
-			mlod_motion_level_free(&best);
-		} else if (e != MLOD_ERR_LIMIT) {
-			if (x->err)
-				*x->err = why;
-			r = e;
-		}
-	}
-	for (int i = 0; i < 2; i++)
-		mlod_motion_free(m[i]);
-	return r;
-}
-
 static mlod_result motion_levels(struct ctx *x)
 {
 	const mlod_character *c = &x->v;
@@ -3628,14 +3586,9 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
  * save). Sets no_shifts where they do not pay. */
 static int img_as_read(const motion_img *img, const mlod_clip *clip);
 
-static double img_error(struct ctx *x, const mlod_clip *orig, const mlod_clip *clip, const motion_img *img,
-                        mlod_error *err);
-static mlod_result level0_build(struct ctx *x, int q, double bound);
-
 /* Encodes clip q's MOTION chunks (levels A - 1 to 0) as the pack will:
- * *bytes gets their stored bytes, and *e0 (not NULL) the point error of
- * level 0 as the reader returns it against the clip as read (img_error). */
-static mlod_result motion_trial(struct ctx *x, int A, int q, size_t *bytes, double *e0)
+ * *bytes gets their stored bytes. */
+static mlod_result motion_trial(struct ctx *x, int A, int q, size_t *bytes)
 {
 	motion_img img[2] = {{0, NULL}, {0, NULL}};
 	mlod_result r = MLOD_OK;
@@ -3648,11 +3601,6 @@ static mlod_result motion_trial(struct ctx *x, int A, int q, size_t *bytes, doub
 		for (int i = 0; i < c.n; i++)
 			*bytes += c.c[i].size, free(c.c[i].data);
 		free(c.c);
-		if (r == MLOD_OK && k == 0 && e0) {
-			*e0 = img_error(x, &x->v.clips[q], cl, &img[0], x->err);
-			if (*e0 < 0)
-				r = MLOD_ERR_NOMEM;
-		}
 	}
 	motion_img_free(&img[0]), motion_img_free(&img[1]);
 	return r;
@@ -3660,8 +3608,6 @@ static mlod_result motion_trial(struct ctx *x, int A, int q, size_t *bytes, doub
 
 static mlod_result motion_shift_choice(struct ctx *x, int A)
 {
-	double e0 = x->opt->motion_level0_percent ? x->opt->motion_level0_error * x->height / 100.0
-	                                          : x->opt->motion_level0_error;
 	for (int q = 0; q < x->v.clip_count; q++) {
 		size_t bytes[2] = {0, 0};
 		/* A pack's level 0 and its levels (an input of mlod-pack -x):
@@ -3692,42 +3638,13 @@ static mlod_result motion_shift_choice(struct ctx *x, int A)
 			x->clips[q].no_shifts = !same;
 			continue;
 		}
-		/* Level 0 as the reader returns it (its keys on the lattices and
-		 * grids) within the level-0 bound e0, not only the values given:
-		 * while it measures above e0, level 0 is made again within its
-		 * bound less the excess (1.05 times it, twice that each round,
-		 * the bound at least a quarter of the one before) and the shifts
-		 * chosen again (they depend on level 0's TOC error); after 8
-		 * rounds, or when the level would not have fewer keys, level 0
-		 * is the clip as read (TOC error 0). The walk's level 0 at
-		 * 0.04854% of the height measured 0.0545% as read back; one
-		 * round (RESULTS Run 15). */
-		double bound = e0, meas = 0.0;
-		for (int round = 0;; round++) {
-			for (int pass = 0; pass < 2; pass++) {
-				x->clips[q].no_shifts = pass;
-				mlod_result r = motion_trial(x, A, q, &bytes[pass], NULL);
-				if (r != MLOD_OK)
-					return r;
-			}
-			x->clips[q].no_shifts = bytes[1] <= bytes[0];
-			if (x->opt->lossless_motion || !(e0 > 0.0) || x->clips[q].level0 == &x->v.clips[q])
-				break;
-			size_t b = 0;
-			mlod_result r = motion_trial(x, A, q, &b, &meas);
+		for (int pass = 0; pass < 2; pass++) {
+			x->clips[q].no_shifts = pass;
+			mlod_result r = motion_trial(x, A, q, &bytes[pass]);
 			if (r != MLOD_OK)
 				return r;
-			if (meas <= e0)
-				break;
-			double next = bound - ldexp(1.05, round) * (meas - e0);
-			bound = round >= 8 ? 0.0 : next > 0.25 * bound ? next : 0.25 * bound;
-			const mlod_clip *was = x->clips[q].level0;
-			if ((r = bound > 0.0 ? level0_build(x, q, bound) : level0_build(x, q, -1.0)) != MLOD_OK)
-				return r;
-			for (int k = 0; k < A - 1; k++) /* a clip with fewer levels repeats level 0 */
-				if (x->clips[q].clip[k] == was)
-					x->clips[q].clip[k] = x->clips[q].level0, x->clips[q].error[k] = x->clips[q].error0;
 		}
+		x->clips[q].no_shifts = bytes[1] <= bytes[0];
 	}
 	return MLOD_OK;
 }
@@ -3735,7 +3652,12 @@ static mlod_result motion_shift_choice(struct ctx *x, int A)
 /* The largest point error (mlod_motion_point_error, the point distance's
  * radius) of every joint of clip as the reader returns it (img: its keys
  * as the MOTION chunk holds them) against orig (the clip as read), at
- * orig's common timeline frames and midpoints; -1 when out of memory. */
+ * orig's common timeline frames and midpoints, rounded up to 8
+ * significant bits (at most 0.4% more), so that the float noise of an
+ * input read two ways (a BVH, or the glb a stage made of it, whose
+ * rotations are normalised again) gives the same TOC error (the walk's
+ * level 1: 0.044915 and 0.044910, both 0.0449219); -1 when out of
+ * memory. */
 static double img_error(struct ctx *x, const mlod_clip *orig, const mlod_clip *clip, const motion_img *img,
                         mlod_error *err)
 {
@@ -3794,6 +3716,11 @@ static double img_error(struct ctx *x, const mlod_clip *orig, const mlod_clip *c
 			if (!(e <= worst))
 				worst = isfinite(e) ? e : INFINITY;
 		}
+	}
+	if (worst > 0.0 && isfinite(worst)) {
+		int ex = 0;
+		frexp(worst, &ex);
+		worst = ldexp(ceil(ldexp(worst, 8 - ex)), ex - 8);
 	}
 done:
 	for (int i = 0; dec.channels && i < clip->channel_count; i++)
