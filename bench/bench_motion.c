@@ -34,6 +34,15 @@
  *                                        POINTERR_DEBUG=E in the environment,
  *                                        each error above E (clip, time,
  *                                        joint) goes to stderr
+ *   bench_motion rtlevels ORIG PACK      per clip and motion level of PACK
+ *                                        (made from ORIG), its TOC error and
+ *                                        the point error of the level as the
+ *                                        runtime returns it (mlod_rt_pose,
+ *                                        the level forced) against ORIG's
+ *                                        clip, every joint the level poses,
+ *                                        at ORIG's frames and midpoints (a
+ *                                        pack made with --no-skeleton-levels
+ *                                        poses every joint at every level)
  *
  * Prints Markdown tables. Times are medians of repeated runs. Clips and
  * joints of a peer's output are matched to the original by name.
@@ -49,6 +58,7 @@
 
 #include "bench.h"
 #include "mlod.h"
+#include "rt/mlod_rt.h"
 
 #define MAX_PEERS 8
 #define SPEED_RUNS 5
@@ -768,6 +778,99 @@ static int cmd_pointerr(int argc, char **argv)
 	return rc;
 }
 
+static int cmd_rtlevels(int argc, char **argv)
+{
+	mlod_character a;
+	double h, pd;
+	if (argc != 2 || load_sized(argv[0], &a, &h, &pd) != 0)
+		return 1;
+	mlod_rt_ctx *ctx = NULL;
+	mlod_error err = {0};
+	if (mlod_rt_open_path(argv[1], NULL, &ctx, &err) != MLOD_OK) {
+		fprintf(stderr, "bench_motion: %s: %s\n", argv[1], err.message);
+		mlod_character_free(&a);
+		return 1;
+	}
+	int nj = a.skeleton.joint_count, rc = 0;
+	if ((int)mlod_rt_joint_count(ctx) != nj || (int)mlod_rt_clip_count(ctx) != a.clip_count) {
+		fprintf(stderr, "bench_motion: %s: %u joints and %u clips, %s %d and %d\n", argv[1],
+		        mlod_rt_joint_count(ctx), mlod_rt_clip_count(ctx), argv[0], nj, a.clip_count);
+		mlod_rt_close(ctx);
+		mlod_character_free(&a);
+		return 1;
+	}
+	printf("%s (%s): height %.4g, point distance %.4g. Per clip and motion level: the TOC error and the point "
+	       "error of the level as mlod_rt_pose returns it against the input, at its frames and midpoints; scene "
+	       "units and %% of the height.\n\n",
+	       bench_base_name(argv[1]), bench_base_name(argv[0]), h, pd);
+	printf("| clip | level | TOC error | TOC %% | measured | measured %% | measured / TOC |\n"
+	       "|---|---:|---:|---:|---:|---:|---:|\n");
+	mlod_rt_scratch *sc = mlod_rt_scratch_create(ctx);
+	mlod_trs *la = malloc(sizeof *la * (size_t)nj);
+	mlod_mat4 *wa = malloc(sizeof *wa * (size_t)nj);
+	for (int k = 0; sc && la && wa && k < a.clip_count && rc == 0; k++) {
+		mlod_motion_options mo = {0};
+		mlod_clip common;
+		if (mlod_motion_common_clip(&a.clips[k], &mo, &common, NULL, &err) != MLOD_OK) {
+			rc = 1;
+			break;
+		}
+		int frames = common.channels[0].key_count, n = (frames - 1) * 2 + 1;
+		float *t = malloc(sizeof *t * (size_t)n);
+		mlod_motion_sample_times(common.channels[0].times, frames, 2, t);
+		for (uint32_t l = 0; t && l < mlod_rt_level_count(ctx, MLOD_RT_MOTION) && rc == 0; l++) {
+			mlod_rt_level_info li;
+			mlod_rt_select sel;
+			mlod_rt_select_default(&sel);
+			sel.force_level = (int)l;
+			uint32_t id = 0;
+			float d = 0;
+			double mx = 0;
+			if (mlod_rt_level_info_get(ctx, MLOD_RT_MOTION, l, (uint32_t)k, &li, &err) != MLOD_OK ||
+			    mlod_rt_instance_create(ctx, (uint32_t)k, 0.0f, 0, &id, &err) != MLOD_OK ||
+			    mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0f, &err) != MLOD_OK ||
+			    mlod_rt_stream(ctx, SIZE_MAX, NULL, &err) != MLOD_OK ||
+			    mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0f, &err) != MLOD_OK) {
+				rc = 1;
+				break;
+			}
+			for (int i = 0; i < n && rc == 0; i++) {
+				const float *W = NULL;
+				const uint32_t *kept = NULL;
+				uint32_t nk = 0;
+				if (mlod_rt_instance_set(ctx, id, (uint32_t)k, t[i], 0, &err) != MLOD_OK ||
+				    mlod_rt_pose(ctx, sc, id, &W, &kept, &nk, &err) != MLOD_OK) {
+					rc = 1;
+					break;
+				}
+				mlod_pose_rest(&a.skeleton, la);
+				mlod_clip_sample(&a.clips[k], t[i], la);
+				mlod_pose_world(&a.skeleton, la, wa);
+				for (uint32_t q = 0; q < nk; q++) {
+					mlod_mat4 r;
+					memcpy(r.m, W + 16 * (size_t)kept[q], sizeof r.m);
+					double e = mlod_motion_point_error(&wa[kept[q]], &r, pd);
+					mx = e > mx ? e : mx;
+				}
+			}
+			mlod_rt_instance_destroy(ctx, id);
+			printf("| %s | %u | %.6g | %.5f | %.6g | %.5f | %.4f |\n", a.clips[k].name, l, (double)li.error,
+			       100.0 * li.error / h, mx, 100.0 * mx / h, li.error > 0 ? mx / li.error : 0.0);
+		}
+		free(t);
+		mlod_clip_free(&common);
+	}
+	if (rc)
+		fprintf(stderr, "bench_motion: %s: %s\n", argv[1], err.message);
+	printf("\n");
+	free(la), free(wa);
+	if (sc)
+		mlod_rt_scratch_destroy(ctx, sc);
+	mlod_rt_close(ctx);
+	mlod_character_free(&a);
+	return rc;
+}
+
 int main(int argc, char **argv)
 {
 	if (argc >= 2 && strcmp(argv[1], "convert") == 0)
@@ -784,7 +887,9 @@ int main(int argc, char **argv)
 		return cmd_between(argc - 2, argv + 2);
 	if (argc >= 2 && strcmp(argv[1], "pointerr") == 0)
 		return cmd_pointerr(argc - 2, argv + 2);
+	if (argc >= 2 && strcmp(argv[1], "rtlevels") == 0)
+		return cmd_rtlevels(argc - 2, argv + 2);
 	fprintf(stderr, "usage: bench_motion convert IN OUT.glb | peers ORIG LABEL=FILE[@KEYS]... | precision FILE... | "
-	                "methods FILE... | speed FILE... | between FILE... | pointerr ORIG LABEL=FILE...\n");
+	                "methods FILE... | speed FILE... | between FILE... | pointerr ORIG LABEL=FILE... | rtlevels ORIG PACK\n");
 	return 1;
 }

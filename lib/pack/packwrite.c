@@ -646,6 +646,7 @@ struct clip_levels {
 	int packed;                /* a pack's level 0 (extras.mlod.motion_level0): kept as read */
 	const mlod_clip *clip[MLOD_PACK_MAX_MOTION_LEVELS];
 	float error[MLOD_PACK_MAX_MOTION_LEVELS];
+	float toc[MLOD_PACK_MAX_MOTION_LEVELS + 1]; /* per level, 0 first: its TOC error (the chunk loop) */
 };
 
 /* The root of skin `skin` as a skin joint index: its joint nearest the
@@ -3585,6 +3586,26 @@ static mlod_result motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int
  * save). Sets no_shifts where they do not pay. */
 static int img_as_read(const motion_img *img, const mlod_clip *clip);
 
+/* Encodes clip q's MOTION chunks (levels A - 1 to 0) as the pack will:
+ * *bytes gets their stored bytes. */
+static mlod_result motion_trial(struct ctx *x, int A, int q, size_t *bytes)
+{
+	motion_img img[2] = {{0, NULL}, {0, NULL}};
+	mlod_result r = MLOD_OK;
+	*bytes = 0;
+	for (int k = A - 1; r == MLOD_OK && k >= 0; k--) {
+		chunks c = {0};
+		const mlod_clip *cl = k == 0 ? x->clips[q].level0 : x->clips[q].clip[k - 1];
+		r = motion_chunk(x, cl, k, q, k == 0 ? x->clips[q].error0 : x->clips[q].error[k - 1],
+		                 k + 1 < A ? &img[!(k & 1)] : NULL, &img[k & 1], &c);
+		for (int i = 0; i < c.n; i++)
+			*bytes += c.c[i].size, free(c.c[i].data);
+		free(c.c);
+	}
+	motion_img_free(&img[0]), motion_img_free(&img[1]);
+	return r;
+}
+
 static mlod_result motion_shift_choice(struct ctx *x, int A)
 {
 	for (int q = 0; q < x->v.clip_count; q++) {
@@ -3618,26 +3639,95 @@ static mlod_result motion_shift_choice(struct ctx *x, int A)
 			continue;
 		}
 		for (int pass = 0; pass < 2; pass++) {
-			motion_img img[2] = {{0, NULL}, {0, NULL}};
 			x->clips[q].no_shifts = pass;
-			for (int k = A - 1; k >= 0; k--) {
-				chunks c = {0};
-				const mlod_clip *cl = k == 0 ? x->clips[q].level0 : x->clips[q].clip[k - 1];
-				mlod_result r = motion_chunk(x, cl, k, q, k == 0 ? x->clips[q].error0 : x->clips[q].error[k - 1],
-				                             k + 1 < A ? &img[!(k & 1)] : NULL, &img[k & 1], &c);
-				for (int i = 0; i < c.n; i++)
-					bytes[pass] += c.c[i].size, free(c.c[i].data);
-				free(c.c);
-				if (r != MLOD_OK) {
-					motion_img_free(&img[0]), motion_img_free(&img[1]);
-					return r;
-				}
-			}
-			motion_img_free(&img[0]), motion_img_free(&img[1]);
+			mlod_result r = motion_trial(x, A, q, &bytes[pass]);
+			if (r != MLOD_OK)
+				return r;
 		}
 		x->clips[q].no_shifts = bytes[1] <= bytes[0];
 	}
 	return MLOD_OK;
+}
+
+/* The largest point error (mlod_motion_point_error, the point distance's
+ * radius) of every joint of clip as the reader returns it (img: its keys
+ * as the MOTION chunk holds them) against orig (the clip as read), at
+ * orig's common timeline frames and midpoints, rounded up to 8
+ * significant bits (at most 0.4% more), so that the float noise of an
+ * input read two ways (a BVH, or the glb a stage made of it, whose
+ * rotations are normalised again) gives the same TOC error
+ * (cli/pack_bvh_stages; RESULTS Run 15); -1 when out of memory. */
+static double img_error(struct ctx *x, const mlod_clip *orig, const mlod_clip *clip, const motion_img *img,
+                        mlod_error *err)
+{
+	const mlod_skeleton *sk = &x->v.skeleton;
+	int nj = sk->joint_count;
+	if (nj <= 0 || orig->channel_count <= 0 || img->n != clip->channel_count)
+		return 0.0;
+	mlod_motion_options mo = {0};
+	mlod_clip common;
+	if (mlod_motion_common_clip(orig, &mo, &common, NULL, err) != MLOD_OK)
+		return -1.0;
+	int frames = common.channel_count > 0 ? common.channels[0].key_count : 0, n = frames > 0 ? 2 * (frames - 1) + 1 : 0;
+	mlod_clip dec = *clip;
+	dec.channels = calloc((size_t)clip->channel_count + 1, sizeof *dec.channels);
+	float *t = malloc(sizeof *t * ((size_t)n + 1));
+	mlod_trs *la = malloc(sizeof *la * (size_t)nj), *lb = malloc(sizeof *lb * (size_t)nj);
+	mlod_mat4 *wa = malloc(sizeof *wa * (size_t)nj), *wb = malloc(sizeof *wb * (size_t)nj);
+	double worst = -1.0;
+	if (!dec.channels || !t || !la || !lb || !wa || !wb) {
+		mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	worst = 0.0;
+	for (int i = 0; i < clip->channel_count && worst >= 0; i++) {
+		const struct img_chan *ic = &img->ch[i];
+		mlod_channel *d = &dec.channels[i];
+		*d = clip->channels[i];
+		d->short_values = 0;
+		d->key_count = (int)ic->keys;
+		d->times = ic->times;
+		if (ic->rot) {
+			if (!(d->values = malloc(sizeof *d->values * 4 * ic->keys)))
+				worst = -1.0;
+			for (size_t v = 0; d->values && v < 4 * (size_t)ic->keys; v++)
+				d->values[v] = (float)(ic->rot[v] / 32767.0);
+		} else if (ic->vec) {
+			d->values = ic->vec;
+		}
+	}
+	if (worst < 0) {
+		mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		goto done;
+	}
+	double pd = motion_point_distance(x);
+	if (n > 0)
+		mlod_motion_sample_times(common.channels[0].times, frames, 2, t);
+	for (int i = 0; i < n; i++) {
+		mlod_pose_rest(sk, la);
+		mlod_pose_rest(sk, lb);
+		mlod_clip_sample(orig, t[i], la);
+		mlod_clip_sample(&dec, t[i], lb);
+		mlod_pose_world(sk, la, wa);
+		mlod_pose_world(sk, lb, wb);
+		for (int j = 0; j < nj; j++) {
+			double e = mlod_motion_point_error(&wa[j], &wb[j], pd);
+			if (!(e <= worst))
+				worst = isfinite(e) ? e : INFINITY;
+		}
+	}
+	if (worst > 0.0 && isfinite(worst)) {
+		int ex = 0;
+		frexp(worst, &ex);
+		worst = ldexp(ceil(ldexp(worst, 8 - ex)), ex - 8);
+	}
+done:
+	for (int i = 0; dec.channels && i < clip->channel_count; i++)
+		if (img->ch[i].rot)
+			free(dec.channels[i].values);
+	free(dec.channels), free(t), free(la), free(lb), free(wa), free(wb);
+	mlod_clip_free(&common);
+	return worst;
 }
 
 /* 1 when every non-cubic rotation and translation or scale key of the
@@ -4138,6 +4228,32 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			if ((r = motion_chunk(&x, cl, k, q, k == 0 ? x.clips[q].error0 : x.clips[q].error[k - 1], base, mi,
 			                      &body)) != MLOD_OK)
 				goto done;
+			/* The TOC error of a level with one (not the clip as read):
+			 * the level's as the reader returns it (its keys on the
+			 * lattices and grids), when above that of the values given
+			 * (mlod(5) QUANTISATION), and its switch distance with it.
+			 * A pack's level 0 and its levels (mlod-pack -x) keep that
+			 * pack's errors: their keys come back as read
+			 * (motion_shift_choice), measured against its level 0. */
+			if (body.c[body.n - 1].error > 0.0f && !x.clips[q].packed) {
+				double me = img_error(&x, &x.v.clips[q], cl, mi, err);
+				if (me < 0) {
+					r = MLOD_ERR_NOMEM;
+					goto done;
+				}
+				if ((float)me > body.c[body.n - 1].error) {
+					body.c[body.n - 1].error = (float)me;
+					body.c[body.n - 1].distance = k > 0 ? mlod_pack_switch_distance((float)me) : 0.0f;
+					if (!isfinite((float)me) || !isfinite(body.c[body.n - 1].distance)) {
+						r = mlod_fail(err, MLOD_ERR_PARSE,
+						              "MOTION level %d of clip %d: error %g as read back is not finite or gives a "
+						              "switch distance that is not (are the input's coordinates too large?)",
+						              k, q, me);
+						goto done;
+					}
+				}
+			}
+			x.clips[q].toc[k] = body.c[body.n - 1].error;
 			/* A reduced level 0 that stores more than the clip as read
 			 * gives way to it (error 0). */
 			if (k == 0 && cl != &x.v.clips[q]) {
@@ -4145,6 +4261,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 				motion_img alt_img = {0};
 				r = motion_chunk(&x, &x.v.clips[q], 0, q, 0.0f, base, &alt_img, &alt);
 				if (r == MLOD_OK && alt.c[0].size < body.c[body.n - 1].size) {
+					x.clips[q].toc[0] = 0.0f;
 					free(body.c[body.n - 1].data);
 					body.c[body.n - 1] = alt.c[0];
 					alt.n = 0;
@@ -4417,7 +4534,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			st->mesh.errors[k] = x.mesh_error[k - 1];
 		for (int k = 0; k < A; k++)
 			for (int q = 0; q < x.v.clip_count; q++) {
-				float e = k ? x.clips[q].error[k - 1] : x.clips[q].error0;
+				float e = x.clips[q].toc[k];
 				st->motion.errors[k] = e > st->motion.errors[k] ? e : st->motion.errors[k];
 			}
 		st->skeleton.stored = layer_bytes(&body, MLOD_LAYER_SKELETON, 0);

