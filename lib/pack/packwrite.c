@@ -3656,7 +3656,7 @@ static mlod_result motion_shift_choice(struct ctx *x, int A)
  * significant bits (at most 0.4% more), so that the float noise of an
  * input read two ways (a BVH, or the glb a stage made of it, whose
  * rotations are normalised again) gives the same TOC error
- * (cli/pack_bvh_stages; RESULTS Run 15); -1 when out of memory. */
+ * (cli/pack_bvh_stages; RESULTS Run 85); -1 when out of memory. */
 static double img_error(struct ctx *x, const mlod_clip *orig, const mlod_clip *clip, const motion_img *img,
                         mlod_error *err)
 {

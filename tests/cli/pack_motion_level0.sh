@@ -1,7 +1,7 @@
 # Motion level 0 (mlod-pack(1)): by default the clip within 0.05% of the
 # height, its TOC error (the point error of its keys as read back, which
 # adds the shorts' rounding: the walk's 1.09 times the bound, RESULTS
-# Run 15) above 0 and within 1.2 times the bound, fewer bytes than --lossless-motion
+# Run 85) above 0 and within 1.2 times the bound, fewer bytes than --lossless-motion
 # (error 0); --motion-level0-error in % and in scene units (0.03, below the
 # first motion bound's 0.0447, which it must be; at 0.01% the
 # walk's reduced level 0, whose values are the clip's own, stores more than

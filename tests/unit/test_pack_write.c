@@ -1139,7 +1139,7 @@ TEST(motion_level0_bound)
 	              *q = find_entry(out[2], MLOD_CHUNK_MOTION, 0);
 	CHECK(a && b && q);
 	if (a && b && q) {
-		/* the TOC errors as read back (RESULTS Run 15): the walk's level 0
+		/* the TOC errors as read back (RESULTS Run 85): the walk's level 0
 		 * 0.0122 against its bound 0.0112 */
 		CHECK(entry_error(a) > 0 && entry_error(a) <= 1.2 * e0 && entry_error(b) == 0);
 		CHECK(entry_error(q) > 0 && entry_error(q) < entry_error(a));
@@ -1167,7 +1167,7 @@ TEST(motion_level0_bound)
  * (mlod_motion_point_error, the pack's point distance) of every joint
  * within the level's TOC error, plus 1e-6 of the height for float
  * rounding, and each switch distance the one of its TOC error. The
- * walk's level 0 before RESULTS Run 15: TOC 0.01084, measured 0.01217
+ * walk's level 0 before RESULTS Run 85: TOC 0.01084, measured 0.01217
  * (1.12 times). *worst gets the largest error / TOC error per level. */
 static void levels_within_toc(const char *path, int metres, double *worst)
 {
