@@ -23,33 +23,34 @@ const char *tool_name = "mlod";
 /* Inputs larger than this are refused rather than read into memory. */
 #define MAX_INPUT_SIZE ((size_t)2 << 30)
 
-void tool_die(int code, const char *what, const char *fmt, ...)
+/* "tool: what: message" on stderr, what (a file's name) escaped as in the
+ * reports, or left out when NULL. */
+static void vmessage(const char *what, const char *fmt, va_list ap)
 {
-	va_list ap;
 	fprintf(stderr, "%s: ", tool_name);
-	if (what) { /* a file's name: escaped, as in the reports */
+	if (what) {
 		tool_put_name(stderr, what, 0);
 		fputs(": ", stderr);
 	}
-	va_start(ap, fmt);
 	vfprintf(stderr, fmt, ap);
-	va_end(ap);
 	fputc('\n', stderr);
+}
+
+void tool_die(int code, const char *what, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	vmessage(what, fmt, ap);
+	va_end(ap);
 	exit(code);
 }
 
 void tool_note(const char *what, const char *fmt, ...)
 {
 	va_list ap;
-	fprintf(stderr, "%s: ", tool_name);
-	if (what) {
-		tool_put_name(stderr, what, 0);
-		fputs(": ", stderr);
-	}
 	va_start(ap, fmt);
-	vfprintf(stderr, fmt, ap);
+	vmessage(what, fmt, ap);
 	va_end(ap);
-	fputc('\n', stderr);
 }
 
 void tool_usage_error(const char *fmt, ...)

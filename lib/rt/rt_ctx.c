@@ -1216,8 +1216,7 @@ static void defer_want(mlod_rt_ctx *ctx, rt_unit *u)
 		rt_unit *t = rt_unit_get(ctx, (mlod_rt_layer)u->layer, l, u->item);
 		if (!t || t->state == RT_UNIT_FAILED || (t->state == RT_UNIT_ABSENT && (t->want_count & 0x80000000u)))
 			continue;
-		rt_want(ctx, t, w);
-		t->last_wanted = u->last_wanted > t->last_wanted ? u->last_wanted : t->last_wanted;
+		rt_want(ctx, t, w); /* stamped now, as u was */
 		return;
 	}
 }
