@@ -415,6 +415,65 @@ mlod_result mlod_rt_request(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t leve
 mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loaded, mlod_error *err);
 
 /* ------------------------------------------------------------------ */
+/* Names, hierarchy and bounds (mlod_rt_info(3))                       */
+/* ------------------------------------------------------------------ */
+
+/* The character as the pack's INFO gives it. Views have no INFO: name
+ * "", every number 0. */
+typedef struct mlod_rt_character {
+	const char *name;          /* valid until mlod_rt_close */
+	float bounds_min[3];       /* the rest pose of mesh level 0 (of the skeleton without
+	                            * a mesh), scene units */
+	float bounds_max[3];
+	float height;              /* the skeleton height (mlod(5)) */
+	float diagonal;            /* of the bounds */
+} mlod_rt_character;
+
+/* MLOD_ERR_INVALID_ARG for a NULL argument. */
+mlod_result mlod_rt_character_get(const mlod_rt_ctx *ctx, mlod_rt_character *out, mlod_error *err);
+
+/* A clip's name (INFO 'NAME'), valid until mlod_rt_close; "" for views;
+ * NULL for a clip out of range. mlod_rt_clip_find sets *clip to the first
+ * clip of that name (byte for byte): MLOD_ERR_INVALID_ARG with a message
+ * naming it when there is none. No allocation; both read only what open
+ * decoded. */
+const char *mlod_rt_clip_name(const mlod_rt_ctx *ctx, uint32_t clip);
+mlod_result mlod_rt_clip_find(const mlod_rt_ctx *ctx, const char *name, uint32_t *clip, mlod_error *err);
+
+/* The full skeleton (level 0: the SKELETON chunk, mlod_rt_joint_count
+ * joints, parents before children): a joint's name (valid until
+ * mlod_rt_close; "" when views give none; NULL out of range), its parent
+ * (-1 for a root, and for a joint out of range), and the first joint of a
+ * name (MLOD_ERR_INVALID_ARG naming it when none). The world matrices of
+ * mlod_rt_pose are indexed by these joints. */
+const char *mlod_rt_joint_name(const mlod_rt_ctx *ctx, uint32_t joint);
+int32_t mlod_rt_joint_parent(const mlod_rt_ctx *ctx, uint32_t joint);
+mlod_result mlod_rt_joint_find(const mlod_rt_ctx *ctx, const char *name, uint32_t *joint, mlod_error *err);
+
+/* A joint at a skeleton level (Skeleton levels, above). kept: the level
+ * keeps it; posed: mlod_rt_pose at that level computes its world matrix
+ * (kept, or a removed ancestor of a kept joint); stand_in: the joint whose
+ * world matrix it follows there (itself when kept, else its nearest kept
+ * ancestor; every root is kept); parent: its parent at the level (its
+ * nearest kept proper ancestor, -1 for a root); rest_from_stand_in: 16
+ * floats, column-major, the rest transform from the stand-in to the joint
+ * (the identity when kept), so that W[stand_in] * rest_from_stand_in
+ * places something attached to a removed joint as mlod_rt_skin places a
+ * rigid part on it. Valid while the level stays resident. Level 0 keeps
+ * every joint. MLOD_ERR_INVALID_ARG for a level or joint out of range and
+ * a skeleton level >= 1 not resident (its table is built when it
+ * loads; the coarsest always is). */
+typedef struct mlod_rt_joint_level {
+	int kept, posed;
+	uint32_t stand_in;
+	int32_t parent;
+	const float *rest_from_stand_in;
+} mlod_rt_joint_level;
+
+mlod_result mlod_rt_joint_level_get(const mlod_rt_ctx *ctx, uint32_t level, uint32_t joint, mlod_rt_joint_level *out,
+                                    mlod_error *err);
+
+/* ------------------------------------------------------------------ */
 /* Instances and selection (mlod_rt_instance(3))                       */
 /* ------------------------------------------------------------------ */
 
@@ -559,6 +618,33 @@ mlod_result mlod_rt_palette(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const fl
 mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float *positions,
                          size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
                          uint32_t *vertex_count, mlod_error *err);
+
+/* A box (min, max: scene units, the space mlod_rt_skin writes in) that
+ * holds every vertex mlod_rt_skin would write for the instance now, at
+ * its current levels, time and morph weights: for culling before
+ * skinning. It poses the instance as mlod_rt_skin does (only the joints
+ * its mesh level reads, into s: mlod_rt_palette after it poses in full)
+ * and makes the palette entries the level reads. When the mesh level
+ * loads, the runtime bounds, per palette entry, the bind-pose positions
+ * of the level's vertices weighted to it (weight > 0): their box and a
+ * ball about its centre, and their box in the joint's space (through the
+ * entry's inverse bind matrix B: a box along the bone); per rigid or
+ * static part, the box and ball of its positions. Per entry the box of
+ * its points' images is then the intersection of the image of the
+ * bind-pose box and ball under the entry's matrix P and of the joint-space
+ * box under P B^-1 (the joint's world matrix at skeleton level 0); per
+ * rigid or static part, of its box and ball under the matrix mlod_rt_skin
+ * gives it. The result is their union: a skinned vertex is a convex
+ * combination of its influences' images (weights summing to 1, as a
+ * pack's do). Morph weights widen every box and ball by the largest over
+ * the parts of sum |weight| x that target's longest delta. Each box is
+ * widened by 1e-5 of the magnitudes the kernels sum there, for their
+ * rounding. XXMEASURE Without a mesh, or for a level
+ * without vertices, the empty box: min FLT_MAX, max -FLT_MAX.
+ * MLOD_ERR_INVALID_ARG as mlod_rt_skin (min and max are then the empty
+ * box). No allocation. */
+mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float min[3], float max[3],
+                           mlod_error *err);
 
 /* The skinning kernels, for callers with their own data and for the
  * benchmark: n vertices, positions and normals 3 floats each (normals may

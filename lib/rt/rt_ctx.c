@@ -489,14 +489,191 @@ static size_t skin_order_bytes(const mlod_pack_mesh *m)
 	return b;
 }
 
+/* The bytes of a mesh level's bound tables (prepare_bounds): 13 floats
+ * per palette entry, 7 per part, one per morph target and an offset per
+ * part and one more. */
+static size_t bound_bytes(uint32_t palette_size, uint32_t parts, size_t targets)
+{
+	return 4 * (13 * (size_t)palette_size + 7 * (size_t)parts + targets + parts + 1);
+}
+
+/* The bytes prepare_mesh allocates for a decoded level. */
+static size_t mesh_tables_bytes(const mlod_rt_ctx *ctx, const mlod_pack_mesh *m)
+{
+	size_t T = 0;
+	for (uint32_t i = 0; i < m->part_count; i++)
+		T += m->parts[i].rec.target_count;
+	return 4 * ((size_t)ctx->palette_size + ctx->joint_count) + skin_order_bytes(m) +
+	       bound_bytes(ctx->palette_size, m->part_count, T);
+}
+
 /* The bytes prepare_mesh allocates for a level of these part records. */
 static size_t mesh_plan_bytes(const mlod_rt_ctx *ctx, const mlod_pack_part_rec *recs, uint32_t n)
 {
-	size_t b = 4 * ((size_t)ctx->palette_size + ctx->joint_count) + 4 * (size_t)n;
-	for (uint32_t i = 0; i < n; i++)
+	size_t b = 4 * ((size_t)ctx->palette_size + ctx->joint_count) + 4 * (size_t)n, t = 0;
+	for (uint32_t i = 0; i < n; i++) {
 		if (recs[i].skin >= 0)
 			b += RT_SKIN_ORDER_BYTES(recs[i].vertex_count);
-	return b;
+		t += recs[i].target_count;
+	}
+	return b + bound_bytes(ctx->palette_size, n, t);
+}
+
+/* x rounded up to a float; sqrt(x) rounded up. */
+static float float_up(double x)
+{
+	float f = (float)x;
+	if ((double)f < x)
+		f = nextafterf(f, INFINITY);
+	return f;
+}
+
+static float sqrt_up(double x) { return float_up(sqrt(x)); }
+
+/* Bounds accumulate per set of points: its box, then the largest squared
+ * distance from the box's middle. */
+typedef struct bound_acc {
+	double lo[3], hi[3], r2;
+	float c[3];
+} bound_acc;
+
+static void acc_init(bound_acc *a)
+{
+	for (int k = 0; k < 3; k++)
+		a->lo[k] = INFINITY, a->hi[k] = -INFINITY;
+	a->r2 = 0;
+}
+
+static void acc_box(bound_acc *a, const double *x)
+{
+	for (int k = 0; k < 3; k++)
+		a->lo[k] = fmin(a->lo[k], x[k]), a->hi[k] = fmax(a->hi[k], x[k]);
+}
+
+/* Rounds the centre to floats (after the first pass). */
+static int acc_centre(bound_acc *a)
+{
+	if (!(a->lo[0] <= a->hi[0]))
+		return 0;
+	for (int k = 0; k < 3; k++)
+		a->c[k] = (float)(0.5 * (a->lo[k] + a->hi[k]));
+	return 1;
+}
+
+static void acc_ball(bound_acc *a, const double *x)
+{
+	const double dx = x[0] - a->c[0], dy = x[1] - a->c[1], dz = x[2] - a->c[2];
+	a->r2 = fmax(a->r2, dx * dx + dy * dy + dz * dz);
+}
+
+/* out: centre, half extents (each the larger distance from the float
+ * centre to the box's sides, rounded up) and, with ball, the radius;
+ * a radius (or half extent x) of -1 for no point or one not finite. */
+static void acc_write(const bound_acc *a, int ball, float *out)
+{
+	int ok = a->lo[0] <= a->hi[0];
+	for (int k = 0; k < 3 && ok; k++) {
+		out[k] = a->c[k];
+		out[3 + k] = float_up(fmax(a->hi[k] - a->c[k], a->c[k] - a->lo[k]));
+		ok = isfinite(out[k]) && isfinite(out[3 + k]);
+	}
+	if (ball) {
+		out[6] = sqrt_up(a->r2);
+		ok = ok && isfinite(out[6]);
+	}
+	if (!ok) {
+		for (int k = 0; k < 6; k++)
+			out[k] = 0.0f;
+		out[3] = -1.0f;
+		if (ball)
+			out[6] = -1.0f;
+	}
+}
+
+/* q = B x for the affine B (column-major), in double. */
+static void affine_d(const float *B, const float *x, double *q)
+{
+	for (int k = 0; k < 3; k++)
+		q[k] = (double)B[k] * x[0] + (double)B[4 + k] * x[1] + (double)B[8 + k] * x[2] + B[12 + k];
+}
+
+/* A mesh level's bound tables (rt_internal.h, bound_entry and the
+ * others) in area (bound_bytes): two passes over the vertices, the boxes
+ * (for the centres), then the balls; acc holds 2 per palette entry. */
+static void prepare_bounds(const mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_mesh *m, float *area, bound_acc *acc)
+{
+	const uint32_t P = ctx->palette_size, n = m->part_count;
+	u->bound_entry = area;
+	u->bound_part = area + 13 * (size_t)P;
+	u->bound_morph = u->bound_part + 7 * (size_t)n;
+	size_t T = 0;
+	for (uint32_t i = 0; i < n; i++)
+		T += m->parts[i].rec.target_count;
+	u->bound_morph_at = (uint32_t *)(u->bound_morph + T);
+	for (size_t e = 0; e < 2 * (size_t)P; e++)
+		acc_init(&acc[e]);
+	for (int pass = 0; pass < 2; pass++) {
+		for (uint32_t i = 0; i < n; i++) {
+			const mlod_pack_part *p = &m->parts[i];
+			if (p->rec.skin < 0)
+				continue;
+			const uint32_t off = ctx->skin_offset[p->rec.skin];
+			for (size_t v = 0; v < p->rec.vertex_count; v++) {
+				const float *x = p->positions + 3 * v;
+				const double xd[3] = { x[0], x[1], x[2] };
+				for (int q = 0; q < 4; q++) {
+					if (!(p->weights[4 * v + q] > 0.0f))
+						continue;
+					const size_t e = off + p->joints[4 * v + q];
+					double jq[3];
+					affine_d(ctx->pal_bind0[e], x, jq);
+					if (pass == 0) {
+						acc_box(&acc[2 * e], xd);
+						acc_box(&acc[2 * e + 1], jq);
+					} else {
+						acc_ball(&acc[2 * e], xd);
+					}
+				}
+			}
+		}
+		for (uint32_t e = 0; e < P && pass == 0; e++)
+			acc_centre(&acc[2 * (size_t)e]), acc_centre(&acc[2 * (size_t)e + 1]);
+	}
+	for (uint32_t e = 0; e < P; e++) {
+		float *b = u->bound_entry + 13 * (size_t)e;
+		acc_write(&acc[2 * (size_t)e], 1, b);
+		acc_write(&acc[2 * (size_t)e + 1], 0, b + 7);
+		if (ctx->pal_bind_inv[16 * (size_t)e + 15] == 0.0f)
+			b[10] = -1.0f;
+	}
+	size_t at = 0;
+	for (uint32_t i = 0; i < n; i++) {
+		const mlod_pack_part *p = &m->parts[i];
+		bound_acc a;
+		acc_init(&a);
+		for (int pass = 0; pass < 2 && p->rec.skin < 0; pass++) {
+			for (size_t v = 0; v < p->rec.vertex_count; v++) {
+				const double xd[3] = { p->positions[3 * v], p->positions[3 * v + 1], p->positions[3 * v + 2] };
+				if (pass == 0)
+					acc_box(&a, xd);
+				else
+					acc_ball(&a, xd);
+			}
+			if (pass == 0)
+				acc_centre(&a);
+		}
+		acc_write(&a, 1, u->bound_part + 7 * (size_t)i);
+		u->bound_morph_at[i] = (uint32_t)at;
+		for (uint32_t t = 0; t < p->rec.target_count; t++) {
+			double d2 = 0;
+			const float *d = p->targets ? p->targets[t] : NULL;
+			for (size_t v = 0; d && v < p->rec.vertex_count; v++)
+				d2 = fmax(d2, (double)d[3 * v] * d[3 * v] + (double)d[3 * v + 1] * d[3 * v + 1] +
+				                  (double)d[3 * v + 2] * d[3 * v + 2]);
+			u->bound_morph[at++] = sqrt_up(d2);
+		}
+	}
+	u->bound_morph_at[n] = (uint32_t)at;
 }
 
 /* Checks a mesh level and lists what skinning it reads (u->pal_used, the
@@ -511,12 +688,18 @@ static mlod_result prepare_mesh(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_me
 	if (r)
 		return r;
 	const uint32_t P = ctx->palette_size, J = ctx->joint_count;
-	const size_t bytes = 4 * ((size_t)P + J) + skin_order_bytes(m);
-	uint32_t *block = rt_alloc(ctx, bytes ? bytes : 4);
+	size_t T = 0;
+	for (uint32_t i = 0; i < m->part_count; i++)
+		T += m->parts[i].rec.target_count;
+	const size_t bbytes = bound_bytes(P, m->part_count, T);
+	const size_t bytes = mesh_tables_bytes(ctx, m);
+	uint32_t *block = rt_alloc(ctx, bytes);
 	uint8_t *mark = rt_alloc(ctx, (P > J ? P : J) + 1);
-	if (!block || !mark) {
+	bound_acc *tmp = rt_alloc(ctx, 2 * sizeof(bound_acc) * (size_t)P + 8);
+	if (!block || !mark || !tmp) {
 		rt_free(ctx, block);
 		rt_free(ctx, mark);
+		rt_free(ctx, tmp);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "mesh level %u: out of memory", u->level);
 	}
 	memset(mark, 0, (P > J ? P : J) + 1);
@@ -550,7 +733,9 @@ static mlod_result prepare_mesh(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_me
 	rt_free(ctx, mark);
 	/* The skinned parts' influence-count buckets, once (rt_skin_order). */
 	u->skin_order_at = block + P + J;
-	u->skin_order = (uint8_t *)(u->skin_order_at + m->part_count);
+	prepare_bounds(ctx, u, m, (float *)(u->skin_order_at + m->part_count), tmp);
+	rt_free(ctx, tmp);
+	u->skin_order = (uint8_t *)(u->skin_order_at + m->part_count) + bbytes;
 	size_t at = 0;
 	for (uint32_t i = 0; i < m->part_count; i++) {
 		const mlod_pack_part *p = &m->parts[i];
@@ -583,6 +768,7 @@ static void unit_release(mlod_rt_ctx *ctx, rt_unit *u)
 	u->pal_used = u->rigid = NULL;
 	u->pal_used_count = u->rigid_count = 0;
 	u->skin_order_at = NULL, u->skin_order = NULL;
+	u->bound_entry = u->bound_part = u->bound_morph = NULL, u->bound_morph_at = NULL;
 	ctx->unit_gen++;
 	u->chan_flags = NULL;
 	u->fixed = u->anim = NULL, u->anim_count = 0, u->static_mat = NULL;
@@ -735,11 +921,11 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 		if (v && v->bytes && u->layer == MLOD_RT_MOTION)
 			return v->bytes + (v->data ? motion_plan_hint(ctx, v->data) : 0);
 		if (v && v->bytes)
-			return v->bytes + plan + (u->layer == MLOD_RT_MESH && v->data ? skin_order_bytes(v->data) : 0);
+			return v->bytes + (u->layer == MLOD_RT_MESH && v->data ? mesh_tables_bytes(ctx, v->data) : plan);
 		if (v && v->data)
 			switch (u->layer) {
 			case MLOD_RT_SKELETON: return rt_bytes_skel_level(v->data) + plan;
-			case MLOD_RT_MESH: return rt_bytes_mesh(v->data) + plan + skin_order_bytes(v->data);
+			case MLOD_RT_MESH: return rt_bytes_mesh(v->data) + mesh_tables_bytes(ctx, v->data);
 			default:
 				return rt_bytes_motion(v->data) + motion_plan_hint(ctx, v->data);
 			}
@@ -942,6 +1128,21 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 	mlod_result pr = rt_palette_sources(ctx, (uint32_t)pal, ctx->pal_joint0, ctx->pal_bind0, ctx->pal_src0, err);
 	if (pr != MLOD_OK)
 		return pr;
+	ctx->pal_bind_inv = rt_calloc(ctx, 16 * (size_t)pal + 1, sizeof *ctx->pal_bind_inv);
+	if (!ctx->pal_bind_inv)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
+	for (uint32_t e = 0; e < pal; e++) {
+		mlod_mat4 b, inv;
+		memcpy(b.m, ctx->pal_bind0[e], sizeof b.m);
+		/* affine (as skinning uses it), invertible, finite */
+		int ok = b.m[3] == 0.0f && b.m[7] == 0.0f && b.m[11] == 0.0f && b.m[15] == 1.0f &&
+		         mlod_mat4_invert(&b, &inv) == 0;
+		inv.m[3] = inv.m[7] = inv.m[11] = 0.0f, inv.m[15] = 1.0f;
+		for (int k = 0; k < 16 && ok; k++)
+			ok = isfinite(inv.m[k]) && fabsf(inv.m[k]) < 1e18f;
+		if (ok)
+			memcpy(ctx->pal_bind_inv + 16 * (size_t)e, inv.m, sizeof inv.m);
+	}
 	for (uint32_t j = 0; j < J; j++) {
 		const mlod_pack_joint_rec *jr = &s->joints[j];
 		mlod_trs t = { { jr->t[0], jr->t[1], jr->t[2] },
@@ -1066,6 +1267,7 @@ void mlod_rt_close(mlod_rt_ctx *ctx)
 	rt_free(ctx, ctx->all_needed);
 	rt_free(ctx, ctx->pal_joint0);
 	rt_free(ctx, ctx->pal_bind0);
+	rt_free(ctx, ctx->pal_bind_inv);
 	rt_free(ctx, ctx->pal_src0);
 	rt_free(ctx, ctx->clip_duration);
 	rt_free(ctx, ctx->chan_bits);
@@ -1093,6 +1295,106 @@ uint32_t mlod_rt_max_vertex_count(const mlod_rt_ctx *ctx) { return ctx ? ctx->ma
 float mlod_rt_clip_duration(const mlod_rt_ctx *ctx, uint32_t clip)
 {
 	return ctx && clip < ctx->clip_count ? ctx->clip_duration[clip] : 0.0f;
+}
+
+/* ---------------------------------------------------------------- */
+/* Names, hierarchy and the character                                */
+/* ---------------------------------------------------------------- */
+
+mlod_result mlod_rt_character_get(const mlod_rt_ctx *ctx, mlod_rt_character *out, mlod_error *err)
+{
+	if (!ctx || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_character_get: NULL argument");
+	memset(out, 0, sizeof *out);
+	out->name = "";
+	if (!ctx->info_owned)
+		return MLOD_OK; /* views: no INFO */
+	const mlod_pack_info_rec *r = &ctx->info.rec;
+	out->name = ctx->info.name ? ctx->info.name : "";
+	for (int k = 0; k < 3; k++)
+		out->bounds_min[k] = r->bounds_min[k], out->bounds_max[k] = r->bounds_max[k];
+	out->height = r->height;
+	out->diagonal = r->diagonal;
+	return MLOD_OK;
+}
+
+const char *mlod_rt_clip_name(const mlod_rt_ctx *ctx, uint32_t clip)
+{
+	if (!ctx || clip >= ctx->clip_count)
+		return NULL;
+	return ctx->info_owned && ctx->info.clip_names && ctx->info.clip_names[clip] ? ctx->info.clip_names[clip] : "";
+}
+
+mlod_result mlod_rt_clip_find(const mlod_rt_ctx *ctx, const char *name, uint32_t *clip, mlod_error *err)
+{
+	if (!ctx || !name || !clip)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_clip_find: NULL argument");
+	for (uint32_t k = 0; k < ctx->clip_count; k++)
+		if (strcmp(mlod_rt_clip_name(ctx, k), name) == 0) {
+			*clip = k;
+			return MLOD_OK;
+		}
+	return mlod_fail(err, MLOD_ERR_INVALID_ARG, "no clip named \"%.200s\" (of %u clips)", name, ctx->clip_count);
+}
+
+const char *mlod_rt_joint_name(const mlod_rt_ctx *ctx, uint32_t joint)
+{
+	if (!ctx || joint >= ctx->joint_count)
+		return NULL;
+	return ctx->skel->joint_names && ctx->skel->joint_names[joint] ? ctx->skel->joint_names[joint] : "";
+}
+
+int32_t mlod_rt_joint_parent(const mlod_rt_ctx *ctx, uint32_t joint)
+{
+	return ctx && joint < ctx->joint_count ? ctx->skel->joints[joint].parent : -1;
+}
+
+mlod_result mlod_rt_joint_find(const mlod_rt_ctx *ctx, const char *name, uint32_t *joint, mlod_error *err)
+{
+	if (!ctx || !name || !joint)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_joint_find: NULL argument");
+	for (uint32_t j = 0; j < ctx->joint_count; j++)
+		if (strcmp(mlod_rt_joint_name(ctx, j), name) == 0) {
+			*joint = j;
+			return MLOD_OK;
+		}
+	return mlod_fail(err, MLOD_ERR_INVALID_ARG, "no joint named \"%.200s\" (of %u joints)", name,
+	                 ctx->joint_count);
+}
+
+static const float rt_identity[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+
+mlod_result mlod_rt_joint_level_get(const mlod_rt_ctx *ctx, uint32_t level, uint32_t joint, mlod_rt_joint_level *out,
+                                    mlod_error *err)
+{
+	if (!ctx || !out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_joint_level_get: NULL argument");
+	if (joint >= ctx->joint_count)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "joint %u out of range (%u joints)", joint, ctx->joint_count);
+	const rt_unit *u = rt_unit_get(ctx, MLOD_RT_SKELETON, level, 0);
+	if (!u)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "skeleton level %u out of range (%u levels)", level,
+		                 ctx->levels[MLOD_RT_SKELETON]);
+	const mlod_pack_joint_rec *jr = ctx->skel->joints;
+	if (level == 0) {
+		out->kept = out->posed = 1;
+		out->stand_in = joint;
+		out->parent = jr[joint].parent;
+		out->rest_from_stand_in = rt_identity;
+		return MLOD_OK;
+	}
+	if (u->state != RT_UNIT_RESIDENT)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "skeleton level %u is not resident", level);
+	const rt_skel_plan *p = &u->plan;
+	out->kept = p->needed[joint] == 2;
+	out->posed = p->needed[joint] != 0;
+	out->stand_in = (uint32_t)p->stand[joint];
+	int32_t a = jr[joint].parent;
+	while (a >= 0 && p->needed[a] != 2)
+		a = jr[a].parent;
+	out->parent = a;
+	out->rest_from_stand_in = p->rel + 16 * (size_t)joint;
+	return MLOD_OK;
 }
 
 mlod_result mlod_rt_level_info_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item,

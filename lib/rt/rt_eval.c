@@ -4,6 +4,7 @@
  * skinning of a mesh level into the caller's buffers (mlod_rt.h,
  * "Evaluation").
  */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -942,5 +943,176 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 	}
 	if (vertex_count)
 		*vertex_count = (uint32_t)base;
+	return MLOD_OK;
+}
+
+/* ---------------------------------------------------------------- */
+/* Bounds                                                            */
+/* ---------------------------------------------------------------- */
+
+/* The relative rounding allowance of mlod_rt_bounds: the kernels sum
+ * products of floats (a blended matrix of up to 4 palette entries, then
+ * its product with a morphed position), each to within a few units in the
+ * last place (6e-8) of the magnitudes summed; 1e-5 of those magnitudes
+ * covers them more than 10 times over. */
+#define RT_BOUND_ROUND 1e-5
+
+/* The box of a set of points under the affine M (column-major), from its
+ * bounds before M: b holds the centre c, the half extents h of their box
+ * and, with r >= 0, the radius r of a ball about c that holds them. On
+ * axis i the centre is (M c)_i and the half extent the smaller of
+ * sum_j |M_ij| h_j (the box's image) and r |M's row i| (the ball's: an
+ * ellipsoid's box exactly), each a bound of the points' images, plus the
+ * rounding allowance: RT_BOUND_ROUND of the magnitudes the kernels sum
+ * there, (|M_i0| + |M_i1| + |M_i2|) (|c|_1 + |h|_1) + |M_i3|, and of
+ * extra (the other path's magnitudes, for a box made through another
+ * matrix). grow widens h and r (morph deltas). */
+static void box_image(const float *M, const float *b, double r, double grow, const double *extra, double *lo,
+                      double *hi)
+{
+	const double c[3] = { b[0], b[1], b[2] }, h[3] = { b[3] + grow, b[4] + grow, b[5] + grow };
+	const double cn = fabs(c[0]) + fabs(c[1]) + fabs(c[2]) + h[0] + h[1] + h[2];
+	for (int i = 0; i < 3; i++) {
+		const double a0 = M[i], a1 = M[4 + i], a2 = M[8 + i], t = M[12 + i];
+		const double x = a0 * c[0] + a1 * c[1] + a2 * c[2] + t;
+		double e = fabs(a0) * h[0] + fabs(a1) * h[1] + fabs(a2) * h[2];
+		if (r >= 0)
+			e = fmin(e, (r + grow) * sqrt(a0 * a0 + a1 * a1 + a2 * a2));
+		e += RT_BOUND_ROUND * ((fabs(a0) + fabs(a1) + fabs(a2)) * cn + fabs(t) + (extra ? extra[i] : 0.0));
+		lo[i] = x - e;
+		hi[i] = x + e;
+	}
+}
+
+/* The rounding magnitudes of box_image on each axis, for its extra. */
+static void box_magnitudes(const float *M, const float *b, double grow, double *out)
+{
+	const double cn = fabs(b[0]) + fabs(b[1]) + fabs(b[2]) + b[3] + b[4] + b[5] + 3 * grow;
+	for (int i = 0; i < 3; i++)
+		out[i] = (fabs(M[i]) + fabs(M[4 + i]) + fabs(M[8 + i])) * cn + fabs(M[12 + i]);
+}
+
+mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float min[3], float max[3],
+                           mlod_error *err)
+{
+	if (!ctx || !s || !min || !max)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_bounds: NULL argument");
+	for (int k = 0; k < 3; k++)
+		min[k] = FLT_MAX, max[k] = -FLT_MAX;
+	if (s->owner != ctx)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_bounds: the scratch was made for another context");
+	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
+	const mlod_rt_state *st = &ctx->inst[id].st;
+	const rt_unit *su = skel_unit(ctx, st);
+	if (ctx->levels[MLOD_RT_MESH] == 0) { /* nothing drawn: the empty box; the scratch as after mlod_rt_skin */
+		s->skel_unit = su;
+		s->id = id;
+		s->posed = 2;
+		s->paletted = 0;
+		return MLOD_OK;
+	}
+	const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MESH, st->level[MLOD_RT_MESH], 0);
+	if (!mu || mu->state != RT_UNIT_RESIDENT)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u shows no resident mesh level", id);
+	/* The pose and the palette entries mlod_rt_skin makes (the same floats). */
+	skin_plan(ctx, s, su, mu);
+	pose_joints(ctx, s, st, s->plan_posed, s->plan_count, s->plan_need);
+	s->skel_unit = su;
+	s->id = id;
+	s->posed = 2;
+	s->paletted = 0;
+	const float *W = s->world;
+	palette_entries(ctx, s, su, mu, W, s->palette);
+	/* Morph weights move a part's positions by at most sum |w_t| times
+	 * target t's longest delta: the largest such sum over the parts widens
+	 * every ball. */
+	const mlod_pack_mesh *m = mu->mesh;
+	double grow = 0;
+	for (uint32_t i = 0; i < m->part_count && i < ctx->morph_parts; i++) {
+		uint32_t k = ctx->morph_offset[i + 1] - ctx->morph_offset[i];
+		const uint32_t have = mu->bound_morph_at[i + 1] - mu->bound_morph_at[i];
+		if (have < k)
+			k = have;
+		const float *w = ctx->morph_weights + (size_t)id * ctx->morph_total + ctx->morph_offset[i];
+		const float *d = mu->bound_morph + mu->bound_morph_at[i];
+		double g = 0;
+		for (uint32_t t = 0; t < k; t++)
+			g += fabs((double)w[t]) * d[t];
+		grow = fmax(grow, g);
+	}
+	/* Skinned vertices: per palette entry, the box of its points' images
+	 * through the bind pose (the entry's matrix P on their bind-pose box and
+	 * ball) and, where the inverse bind B has an inverse, through the
+	 * joint's space (P B^-1, at level 0 the joint's world matrix, on their
+	 * box there, which follows the bone): their intersection. */
+	double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+	for (uint32_t k = 0; k < mu->pal_used_count; k++) {
+		const uint32_t e = mu->pal_used[k];
+		const float *b = mu->bound_entry + 13 * (size_t)e, *P = s->palette + 16 * (size_t)e;
+		if (!(b[6] >= 0.0f))
+			continue;
+		double l1[3], h1[3];
+		if (b[10] >= 0.0f) {
+			float M[16];
+			double l2[3], h2[3], mag1[3], mag2[3];
+			rt_mat_mul(P, ctx->pal_bind_inv + 16 * (size_t)e, M);
+			/* morphing moves a joint-space point by B's linear part times the
+			 * delta: at most B's row norm on each axis */
+			double g2[3] = { 0, 0, 0 };
+			if (grow > 0) {
+				const float *B = ctx->pal_bind0[e];
+				for (int i = 0; i < 3; i++)
+					g2[i] = grow * sqrt((double)B[i] * B[i] + (double)B[4 + i] * B[4 + i] + (double)B[8 + i] * B[8 + i]);
+			}
+			float jb[6] = { b[7], b[8], b[9], (float)(b[10] + g2[0]), (float)(b[11] + g2[1]), (float)(b[12] + g2[2]) };
+			for (int i = 0; i < 3; i++)
+				jb[3 + i] = (double)jb[3 + i] < b[10 + i] + g2[i] ? nextafterf(jb[3 + i], INFINITY) : jb[3 + i];
+			box_magnitudes(P, b, grow, mag1);
+			box_magnitudes(M, jb, 0, mag2);
+			box_image(P, b, b[6], grow, mag2, l1, h1);
+			box_image(M, jb, -1, 0, mag1, l2, h2);
+			for (int i = 0; i < 3; i++)
+				l1[i] = fmax(l1[i], l2[i]), h1[i] = fmin(h1[i], h2[i]);
+		} else {
+			box_image(P, b, b[6], grow, NULL, l1, h1);
+		}
+		for (int i = 0; i < 3; i++)
+			lo[i] = fmin(lo[i], l1[i]), hi[i] = fmax(hi[i], h1[i]);
+	}
+	/* Rigid and static parts: the matrix mlod_rt_skin makes for them. */
+	for (uint32_t i = 0; i < m->part_count; i++) {
+		const mlod_pack_part *p = &m->parts[i];
+		const float *c = mu->bound_part + 7 * (size_t)i;
+		if (p->rec.skin >= 0 || !(c[6] >= 0.0f))
+			continue;
+		float M[16];
+		if (p->rec.joint >= 0) {
+			const uint32_t j = (uint32_t)p->rec.joint;
+			if (su && su->plan.stand[j] != (int32_t)j) {
+				float t[16];
+				rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
+				rt_mat_mul(t, p->rec.offset, M);
+			} else {
+				rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
+			}
+		} else {
+			memcpy(M, p->rec.offset, sizeof M);
+		}
+		double l1[3], h1[3];
+		box_image(M, c, c[6], grow, NULL, l1, h1);
+		for (int k = 0; k < 3; k++)
+			lo[k] = fmin(lo[k], l1[k]), hi[k] = fmax(hi[k], h1[k]);
+	}
+	if (!(lo[0] <= hi[0]))
+		return MLOD_OK; /* no vertex: the empty box */
+	for (int k = 0; k < 3; k++) {
+		float a = (float)lo[k], b = (float)hi[k];
+		if ((double)a > lo[k])
+			a = nextafterf(a, -INFINITY);
+		if ((double)b < hi[k])
+			b = nextafterf(b, INFINITY);
+		min[k] = a, max[k] = b;
+	}
 	return MLOD_OK;
 }

@@ -63,6 +63,23 @@ typedef struct rt_unit {
 	 * RT_UNIT_TOL (mlod_rt_skin may then skip renormalising them), else 0. */
 	uint32_t *skin_order_at;
 	uint8_t *skin_order;
+	/* Mesh levels (prepare_mesh), for mlod_rt_bounds, in plan_block.
+	 * Per palette entry 13 floats: over the level's skinned vertices
+	 * weighted to it (weight > 0), the box of their bind-pose positions
+	 * (centre x, y, z, half extents x, y, z), the radius of the ball
+	 * about that centre that holds them (-1 when no vertex is weighted to
+	 * the entry), and the box of those positions in the entry's joint
+	 * space, by its inverse bind (centre, half extents; half extent x -1
+	 * when ctx->pal_bind_inv has none or a coordinate is not finite). Per
+	 * part 7 floats: for a rigid or static part the box and ball of its
+	 * positions (before its offset) as above, radius -1 for a skinned part
+	 * or one without vertices. Per part i, its morph targets' longest
+	 * deltas, bound_morph + bound_morph_at[i] .. bound_morph +
+	 * bound_morph_at[i + 1] - 1. */
+	float *bound_entry;       /* 13 per palette entry */
+	float *bound_part;        /* 7 per part */
+	float *bound_morph;
+	uint32_t *bound_morph_at; /* part_count + 1 */
 	uint8_t *chan_flags;      /* resident motion levels: a bit per channel (in ctx->chan_bits) */
 	/* Resident motion levels, in plan_block. Per joint (fixed): 0 when a
 	 * channel of it has more than one key (animated: sampled per frame);
@@ -124,6 +141,9 @@ struct mlod_rt_ctx {
 	uint8_t *all_needed;      /* joint_count ones */
 	uint32_t *pal_joint0;     /* palette_size: the joint each entry follows at level 0 */
 	const float **pal_bind0;  /* palette_size: its inverse bind matrix */
+	float *pal_bind_inv;      /* 16 per palette entry: the inverse of its inverse bind (the
+	                           * joint's bind-pose world matrix), or all 0 when that is
+	                           * singular or not finite (mlod_rt_bounds) */
 	uint32_t *pal_src0;       /* palette_size: the first entry with the same joint and bind */
 	uint32_t levels[MLOD_RT_LAYERS];
 	uint32_t clip_count;

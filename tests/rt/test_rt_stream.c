@@ -12,7 +12,10 @@
  * MESH_PLAN) with its skinned parts' influence-count buckets (4 bytes per
  * part, and per skinned part 1 per vertex and 5 per run of 64: levels 0,
  * 1 and 2 have 3, 2 and 1 parts, their skinned part 4, 2 and 1 vertices:
- * 21, 15 and 10 bytes; MESH_ORDER1 and MESH_ORDER2 below) and the tables
+ * 21, 15 and 10 bytes; MESH_ORDER1 and MESH_ORDER2 below) and its
+ * tables for mlod_rt_bounds (13 floats per palette entry, 7 per part, no
+ * morph target, an offset per part and one more: 296, 328 and 360 bytes
+ * for levels 2, 1 and 0, MESH_BOUND(parts)) and the tables
  * of a motion level (4 bytes per joint and per channel of a joint with a
  * channel of several keys, every one here, and 64 per joint whose channels
  * all have one key, none here: MOTION_PLAN(channels) below; clip 0's
@@ -24,8 +27,9 @@
 #define MESH_PLAN 40u
 #define MESH_ORDER1 15u
 #define MESH_ORDER2 10u
+#define MESH_BOUND(parts) (4u * (13u * 5u + 8u * (parts) + 1u))
 #define MOTION_PLAN(c) (4u * 5u + 4u * (c))
-#define COARSE (2900u + SKEL_PLAN + MESH_PLAN + MESH_ORDER2 + 2u * MOTION_PLAN(1u))
+#define COARSE (2900u + SKEL_PLAN + MESH_PLAN + MESH_ORDER2 + MESH_BOUND(1u) + 2u * MOTION_PLAN(1u))
 
 static mlod_rt_ctx *open_budget(size_t budget, mlod_error *e)
 {
@@ -167,10 +171,10 @@ static void frame(mlod_rt_ctx *ctx)
 TEST(lru_eviction)
 {
 	mlod_error e;
-	mlod_rt_ctx *ctx = open_budget(COARSE + 3500 + MESH_PLAN + MESH_ORDER1 + MOTION_PLAN(2u), &e);
+	mlod_rt_ctx *ctx = open_budget(COARSE + 3500 + MESH_PLAN + MESH_ORDER1 + MESH_BOUND(2u) + MOTION_PLAN(2u), &e);
 	CHECK(ctx, "open: %s", e.message);
 	frame(ctx);
-	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MESH, 1, 0, &e), e); /* 2000 + MESH_PLAN */
+	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MESH, 1, 0, &e), e); /* 2000 + MESH_PLAN + MESH_ORDER1 + MESH_BOUND(2) */
 	CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
 	frame(ctx);
 	CHECK_OK(mlod_rt_request(ctx, MLOD_RT_MOTION, 1, 0, &e), e); /* 1500 + MOTION_PLAN(2): exactly full */
