@@ -7,7 +7,8 @@
  * frames, counted by the allocator hooks, within the resident bytes the
  * runtime reports; a scratch used with another context refused; NULL
  * arguments named; a level's part attributes and the palette skinning
- * on the GPU as mlod_rt_skin does.
+ * on the GPU as mlod_rt_skin does; the names, hierarchy and bounds calls
+ * (mlod_rt_info(3)) allocating nothing.
  *
  * The packs come from mlod-pack on the committed samples (rt_packer.h);
  * without it the tests print SKIP. Links libmlodrt.a alone.
@@ -184,10 +185,11 @@ TEST(misread_tried_again)
 }
 
 /* Every live allocation, by size (a header before each block). */
-static size_t live, open_live;
+static size_t live, open_live, mallocs;
 static void *counting_malloc(void *user, size_t n)
 {
 	(void)user;
+	mallocs++;
 	size_t *p = malloc(n + 16);
 	if (!p)
 		return NULL;
@@ -286,6 +288,9 @@ TEST(scratch_of_another_context)
 	          "mlod_rt_palette: the scratch was made for another context");
 	CHECK_ERR(mlod_rt_skin(b, sa, id, buf, 12, NULL, 0, 16, &nv, &e), MLOD_ERR_INVALID_ARG,
 	          "mlod_rt_skin: the scratch was made for another context");
+	float mn[3], mx[3];
+	CHECK_ERR(mlod_rt_bounds(b, sa, id, mn, mx, &e), MLOD_ERR_INVALID_ARG,
+	          "mlod_rt_bounds: the scratch was made for another context");
 	mlod_rt_scratch_destroy(a, sa);
 	mlod_rt_close(a);
 	mlod_rt_close(b);
@@ -307,7 +312,88 @@ TEST(null_arguments_named)
 	          "mlod_rt_level_info_get: NULL argument");
 	mlod_rt_level_info li;
 	CHECK_ERR(mlod_rt_level_info_get(ctx, MLOD_RT_MESH, 99, 0, &li, &e), MLOD_ERR_INVALID_ARG, "no such level");
+	uint32_t k;
+	mlod_rt_joint_level jl;
+	CHECK_ERR(mlod_rt_character_get(ctx, NULL, &e), MLOD_ERR_INVALID_ARG, "mlod_rt_character_get: NULL argument");
+	CHECK_ERR(mlod_rt_clip_find(ctx, NULL, &k, &e), MLOD_ERR_INVALID_ARG, "mlod_rt_clip_find: NULL argument");
+	CHECK_ERR(mlod_rt_joint_find(ctx, "x", NULL, &e), MLOD_ERR_INVALID_ARG, "mlod_rt_joint_find: NULL argument");
+	CHECK_ERR(mlod_rt_joint_level_get(ctx, 0, 0, NULL, &e), MLOD_ERR_INVALID_ARG,
+	          "mlod_rt_joint_level_get: NULL argument");
+	/* tubeman's skeleton levels but the coarsest load when wanted */
+	CHECK(mlod_rt_level_count(ctx, MLOD_RT_SKELETON) > 2, "tubeman: %u skeleton levels",
+	      mlod_rt_level_count(ctx, MLOD_RT_SKELETON));
+	CHECK_ERR(mlod_rt_joint_level_get(ctx, 1, 0, &jl, &e), MLOD_ERR_INVALID_ARG, "skeleton level 1 is not resident");
+	CHECK_OK(mlod_rt_joint_level_get(ctx, mlod_rt_level_count(ctx, MLOD_RT_SKELETON) - 1, 0, &jl, &e), e);
+	float mn[3], mx[3];
+	CHECK_ERR(mlod_rt_bounds(ctx, NULL, 0, mn, mx, &e), MLOD_ERR_INVALID_ARG, "mlod_rt_bounds: NULL argument");
+	CHECK(mlod_rt_clip_name(NULL, 0) == NULL && mlod_rt_joint_name(NULL, 0) == NULL &&
+	          mlod_rt_joint_parent(NULL, 0) == -1,
+	      "NULL context");
 	mlod_rt_close(ctx);
+}
+
+/* An engine asks names, the hierarchy and bounds every frame: none of
+ * these calls allocates (counted by the allocator hooks), with every
+ * level resident, after they ran once. */
+TEST(info_calls_allocate_nothing)
+{
+	SKIP_IF_NO_PACK(info_calls_allocate_nothing);
+	CHECK(packs_ready(), "mlod-pack failed");
+	mlod_rt_allocator a = { counting_malloc, counting_free, NULL };
+	const struct { const uint8_t *d; size_t n; const char *name; } packs[] = { { robot, robot_size, "robot" },
+		                                                                     { tube, tube_size, "tubeman" } };
+	for (size_t p = 0; p < 2; p++) {
+		mlod_rt_config cfg = { 0, 4, &a };
+		mlod_error e = { 0 };
+		mlod_rt_ctx *ctx = NULL;
+		live = 0;
+		CHECK_OK(mlod_rt_open_memory(packs[p].d, packs[p].n, &cfg, &ctx, &e), e);
+		for (int layer = 0; layer < MLOD_RT_LAYERS; layer++)
+			for (uint32_t l = 0; l < mlod_rt_level_count(ctx, (mlod_rt_layer)layer); l++)
+				CHECK_OK(mlod_rt_request(ctx, (mlod_rt_layer)layer, l, 0, &e), e);
+		CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
+		mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+		uint32_t id;
+		CHECK(s, "scratch");
+		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.3f, MLOD_RT_LOOP, &id, &e), e);
+		mlod_rt_select sel;
+		mlod_rt_select_default(&sel);
+		const size_t before = mallocs;
+		size_t names = 0;
+		for (int round = 0; round < 2; round++)
+			for (uint32_t l = 0; l < mlod_rt_level_count(ctx, MLOD_RT_MESH); l++) {
+				sel.force_level = (int)l;
+				const float d = 1;
+				CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 0.01f, &e), e);
+				mlod_rt_character ch;
+				CHECK_OK(mlod_rt_character_get(ctx, &ch, &e), e);
+				names += strlen(ch.name);
+				for (uint32_t k = 0; k < mlod_rt_clip_count(ctx); k++) {
+					uint32_t f;
+					CHECK_OK(mlod_rt_clip_find(ctx, mlod_rt_clip_name(ctx, k), &f, &e), e);
+					names += f;
+				}
+				uint32_t none = 0;
+				CHECK(mlod_rt_clip_find(ctx, "?", &none, &e) == MLOD_ERR_INVALID_ARG, "unknown clip found");
+				for (uint32_t j = 0; j < mlod_rt_joint_count(ctx); j++) {
+					uint32_t f;
+					mlod_rt_joint_level jl;
+					CHECK_OK(mlod_rt_joint_find(ctx, mlod_rt_joint_name(ctx, j), &f, &e), e);
+					names += f + (size_t)(mlod_rt_joint_parent(ctx, j) + 1);
+					for (uint32_t sl = 0; sl < mlod_rt_level_count(ctx, MLOD_RT_SKELETON); sl++)
+						CHECK_OK(mlod_rt_joint_level_get(ctx, sl, j, &jl, &e), e);
+				}
+				float mn[3], mx[3];
+				CHECK_OK(mlod_rt_bounds(ctx, s, id, mn, mx, &e), e);
+				CHECK(mn[0] <= mx[0] && mn[1] <= mx[1] && mn[2] <= mx[2], "%s: empty box", packs[p].name);
+			}
+		CHECK(mallocs == before, "%s: %zu allocations by the names, hierarchy and bounds calls", packs[p].name,
+		      mallocs - before);
+		(void)names;
+		mlod_rt_scratch_destroy(ctx, s);
+		mlod_rt_close(ctx);
+		CHECK(live == 0, "%s: %zu bytes left after close", packs[p].name, live);
+	}
 }
 
 /* A GPU-skinning engine: a resident level's part attributes and
@@ -395,6 +481,7 @@ int main(int argc, char **argv)
 	RUN(scratch_of_another_context);
 	RUN(null_arguments_named);
 	RUN(gpu_skinning_from_part_attributes);
+	RUN(info_calls_allocate_nothing);
 	free(robot);
 	free(tube);
 	rt_packer_cleanup();

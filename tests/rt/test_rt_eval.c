@@ -1071,6 +1071,102 @@ TEST(palette_copies_equal_products)
 	mlod_rt_close(ctx);
 }
 
+/* Views (no INFO): the character's name and the clips' are "", the
+ * joints' the skeleton's; the hierarchy at each skeleton level as
+ * rt_test.h builds it (level 1 keeps 0, 2, 3: joint 1 removed but posed
+ * as 2's ancestor, joint 4 removed and not posed, both following 0, 4 at
+ * (1, 1, 0) from it); and mlod_rt_bounds around every vertex mlod_rt_skin
+ * writes (the skinned, rigid and static parts) at every pair of skeleton
+ * and mesh levels over both clips, and at levels 0 at most 0.25 beyond
+ * them on any side (measured 0.239: the vertices weighted to two joints
+ * lie inside their joints' boxes' hull, not on its corners; a box of
+ * +-FLT_MAX would pass the first check, not this one). */
+TEST(views_names_hierarchy_bounds)
+{
+	mlod_error e;
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_views(&fx_views, NULL, &ctx, &e), e);
+	CHECK(fx_load_all(ctx) == 0, "load");
+	mlod_rt_character ch;
+	CHECK_OK(mlod_rt_character_get(ctx, &ch, &e), e);
+	CHECK(strcmp(ch.name, "") == 0 && ch.diagonal == 0 && ch.bounds_max[0] == 0, "views' character");
+	CHECK(mlod_rt_clip_name(ctx, 1) && strcmp(mlod_rt_clip_name(ctx, 1), "") == 0 && !mlod_rt_clip_name(ctx, 2),
+	      "views' clip names");
+	uint32_t f = 9;
+	CHECK_OK(mlod_rt_clip_find(ctx, "", &f, &e), e);
+	CHECK(f == 0, "clip \"\" at %u", f);
+	CHECK(mlod_rt_clip_find(ctx, "Walk", &f, &e) == MLOD_ERR_INVALID_ARG && strstr(e.message, "no clip named \"Walk\""),
+	      "%s", e.message);
+	for (uint32_t j = 0; j < FX_J; j++) {
+		CHECK(strcmp(mlod_rt_joint_name(ctx, j), fx_joint_names[j]) == 0, "joint %u", j);
+		CHECK(mlod_rt_joint_parent(ctx, j) == fx_joints[j].parent, "joint %u's parent", j);
+		CHECK_OK(mlod_rt_joint_find(ctx, fx_joint_names[j], &f, &e), e);
+		CHECK(f == j, "%s found at %u", fx_joint_names[j], f);
+	}
+	CHECK(mlod_rt_joint_find(ctx, "RightHand", &f, &e) == MLOD_ERR_INVALID_ARG &&
+	          strstr(e.message, "no joint named \"RightHand\""),
+	      "%s", e.message);
+	static const struct {
+		int kept, posed;
+		uint32_t stand;
+		int32_t parent;
+	} want[3][FX_J] = { { { 1, 1, 0, -1 }, { 1, 1, 1, 0 }, { 1, 1, 2, 1 }, { 1, 1, 3, 2 }, { 1, 1, 4, 1 } },
+		            { { 1, 1, 0, -1 }, { 0, 1, 0, 0 }, { 1, 1, 2, 0 }, { 1, 1, 3, 2 }, { 0, 0, 0, 0 } },
+		            { { 1, 1, 0, -1 }, { 0, 0, 0, 0 }, { 0, 0, 0, 0 }, { 0, 0, 0, 0 }, { 0, 0, 0, 0 } } };
+	for (uint32_t l = 0; l < 3; l++)
+		for (uint32_t j = 0; j < FX_J; j++) {
+			mlod_rt_joint_level jl;
+			CHECK_OK(mlod_rt_joint_level_get(ctx, l, j, &jl, &e), e);
+			CHECK(jl.kept == want[l][j].kept && jl.posed == want[l][j].posed && jl.stand_in == want[l][j].stand &&
+			          jl.parent == want[l][j].parent,
+			      "level %u joint %u: kept %d posed %d stand-in %u parent %d", l, j, jl.kept, jl.posed, jl.stand_in,
+			      (int)jl.parent);
+		}
+	mlod_rt_joint_level jl;
+	CHECK_OK(mlod_rt_joint_level_get(ctx, 1, 4, &jl, &e), e);
+	CHECK(jl.rest_from_stand_in[12] == 1 && jl.rest_from_stand_in[13] == 1 && jl.rest_from_stand_in[14] == 0,
+	      "joint 4 from joint 0 at rest: (%g, %g, %g)", jl.rest_from_stand_in[12], jl.rest_from_stand_in[13],
+	      jl.rest_from_stand_in[14]);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	CHECK(s, "scratch");
+	uint32_t id;
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, 0, &id, &e), e);
+	uint32_t checked = 0;
+	double loose = 0;
+	for (uint32_t ls = 0; ls < 3; ls++)
+		for (uint32_t lm = 0; lm < 3; lm++)
+			for (uint32_t clip = 0; clip < 2; clip++)
+				for (int k = 0; k <= 20; k++) {
+					CHECK_OK(mlod_rt_instance_set(ctx, id, clip, 0.02f * (float)k, 0, &e), e);
+					mlod_rt_state *st = &ctx->inst[id].st;
+					st->level[MLOD_RT_SKELETON] = (uint16_t)ls, st->level[MLOD_RT_MESH] = (uint16_t)lm;
+					st->level[MLOD_RT_MOTION] = 0;
+					float out[3 * 16], mn[3], mx[3];
+					uint32_t n = 0;
+					CHECK_OK(mlod_rt_bounds(ctx, s, id, mn, mx, &e), e);
+					CHECK_OK(mlod_rt_skin(ctx, s, id, out, 12, NULL, 12, 16, &n, &e), e);
+					CHECK(n > 0, "no vertex");
+					float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+					for (uint32_t v = 0; v < n; v++)
+						for (int a = 0; a < 3; a++) {
+							const float x = out[3 * v + a];
+							CHECK(x >= mn[a] && x <= mx[a],
+							      "skeleton %u mesh %u clip %u t %g: vertex %u axis %d at %g outside [%g, %g]", ls,
+							      lm, clip, 0.02 * k, v, a, x, mn[a], mx[a]);
+							lo[a] = fminf(lo[a], x), hi[a] = fmaxf(hi[a], x);
+						}
+					if (ls == 0 && lm == 0)
+						for (int a = 0; a < 3; a++)
+							loose = fmax(loose, fmax(lo[a] - mn[a], mx[a] - hi[a]));
+					checked += n;
+				}
+	printf("# views: %u skinned vertices inside their box; at level 0 the box reaches %.3g beyond them\n", checked,
+	       loose);
+	CHECK(loose <= 0.25, "the box at level 0 reaches %g beyond the vertices", loose);
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+}
+
 int main(void)
 {
 	fx_build(0);
@@ -1088,6 +1184,7 @@ int main(void)
 	RUN(skin_plan_matches_full_pose);
 	RUN(skin_buckets_at_load);
 	RUN(palette_copies_equal_products);
+	RUN(views_names_hierarchy_bounds);
 	TEST_EXIT();
 }
 

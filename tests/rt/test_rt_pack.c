@@ -10,7 +10,10 @@
  * views'). Then every truncated prefix and
  * 10,000 mutations (half with every CRC fixed, so that the decoders' own
  * checks are reached) go through open, streaming and one frame of
- * evaluation: an error is fine, a crash or a sanitizer report is not.
+ * evaluation: an error is fine, a crash or a sanitizer report is not;
+ * every finite vertex skinned must lie in mlod_rt_bounds' box, every
+ * name read must be a string and every parent and stand-in come before
+ * its joint.
  * All of these run under a tracking allocator whose blocks come from a
  * static arena, not malloc: every block the runtime frees must be one of
  * its live blocks, none may be left at close, the decoded levels must be
@@ -833,8 +836,14 @@ TEST(hooks_only)
 	}
 }
 
-/* Open plus one frame: everything wanted streamed, every instance posed
- * and skinned, under the tracking allocator (nothing left, nothing
+/* one_frame's findings over all its runs: finite skinned coordinates
+ * outside mlod_rt_bounds' box and parents or stand-ins after their joint
+ * (parents come first), and the names' bytes read (every name a string). */
+static size_t bound_misses, name_bytes;
+
+/* Open plus one frame: everything wanted streamed, every instance
+ * bounded (mlod_rt_bounds), posed and skinned, every name and joint
+ * level read, under the tracking allocator (nothing left, nothing
  * foreign freed, checked by the callers through track_leaks). */
 static int one_frame(const void *data, size_t size, int through_read)
 {
@@ -865,10 +874,29 @@ static int one_frame(const void *data, size_t size, int through_read)
 	const uint32_t cap = mlod_rt_max_vertex_count(ctx);
 	float *buf = malloc(24 * (size_t)cap + 24);
 	for (int i = 0; i < n && s && buf; i++) {
-		uint32_t nv;
+		uint32_t nv = 0;
 		const float *P;
-		mlod_rt_skin(ctx, s, ids[i], buf, 12, buf + 3 * (size_t)cap, 12, cap, &nv, &e);
+		float mn[3], mx[3];
+		const mlod_result rb = mlod_rt_bounds(ctx, s, ids[i], mn, mx, &e);
+		if (mlod_rt_skin(ctx, s, ids[i], buf, 12, buf + 3 * (size_t)cap, 12, cap, &nv, &e) == MLOD_OK &&
+		    rb == MLOD_OK)
+			for (uint32_t v = 0; v < 3 * nv; v++) /* a finite vertex outside its box */
+				bound_misses += isfinite(buf[v]) && !(buf[v] >= mn[v % 3] && buf[v] <= mx[v % 3]);
 		mlod_rt_palette(ctx, s, &P, NULL, &e);
+	}
+	/* the names, the hierarchy and the skeleton levels' joints */
+	mlod_rt_character ch;
+	if (mlod_rt_character_get(ctx, &ch, &e) == MLOD_OK)
+		name_bytes += strlen(ch.name);
+	for (uint32_t k = 0; k < mlod_rt_clip_count(ctx); k++)
+		name_bytes += strlen(mlod_rt_clip_name(ctx, k));
+	for (uint32_t j = 0; j < mlod_rt_joint_count(ctx); j++) {
+		name_bytes += strlen(mlod_rt_joint_name(ctx, j));
+		bound_misses += mlod_rt_joint_parent(ctx, j) >= (int32_t)j;
+		mlod_rt_joint_level jl;
+		for (uint32_t l = 0; l < mlod_rt_level_count(ctx, MLOD_RT_SKELETON); l++)
+			if (mlod_rt_joint_level_get(ctx, l, j, &jl, &e) == MLOD_OK)
+				bound_misses += jl.stand_in > j || jl.parent >= (int32_t)j;
 	}
 	free(buf);
 	mlod_rt_scratch_destroy(ctx, s);
@@ -896,6 +924,7 @@ TEST(truncated_prefixes)
 TEST(mutations)
 {
 	track_reset();
+	bound_misses = name_bytes = 0;
 	uint8_t *m = malloc(pack.n);
 	unsigned seed = 99;
 	int opened = 0;
@@ -918,7 +947,10 @@ TEST(mutations)
 		opened += one_frame(m, pack.n, i % 4 == 1);
 	}
 	free(m);
-	printf("# mutations: %d of 10000 opened and ran a frame\n", opened);
+	printf("# mutations: %d of 10000 opened and ran a frame; %zu bytes of names read, %zu vertices outside "
+	       "their bound or joints out of order\n",
+	       opened, name_bytes, bound_misses);
+	CHECK(bound_misses == 0, "%zu finite vertices outside mlod_rt_bounds' box, or joints out of order", bound_misses);
 	CHECK(track_live == 0 && track_leaks == 0 && !track_bad,
 	      "%d runs left blocks or freed foreign ones (%zu live now)", track_leaks, track_live);
 	CHECK(opened > 0, "no mutated pack opened: the CRC-fixed half should reach the decoders");
