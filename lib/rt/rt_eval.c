@@ -957,39 +957,30 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
  * covers them more than 10 times over. */
 #define RT_BOUND_ROUND 1e-5
 
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+
 /* The box of a set of points under the affine M (column-major), from its
- * bounds before M: b holds the centre c, the half extents h of their box
- * and, with r >= 0, the radius r of a ball about c that holds them. On
- * axis i the centre is (M c)_i and the half extent the smaller of
- * sum_j |M_ij| h_j (the box's image) and r |M's row i| (the ball's: an
- * ellipsoid's box exactly), each a bound of the points' images, plus the
- * rounding allowance: RT_BOUND_ROUND of the magnitudes the kernels sum
- * there, (|M_i0| + |M_i1| + |M_i2|) (|c|_1 + |h|_1) + |M_i3|, and of
- * extra (the other path's magnitudes, for a box made through another
- * matrix). grow widens h and r (morph deltas). */
-static void box_image(const float *M, const float *b, double r, double grow, const double *extra, double *lo,
-                      double *hi)
+ * bounds before M: centre c, half extents h of their box and, with r >= 0,
+ * the radius of a ball about c that holds them. On axis i the centre is
+ * x_i = (M c)_i and the half extent e_i the smaller of sum_j |M_ij| h_j
+ * (the box's image) and r |M's row i| (the ball's: an ellipsoid's box
+ * exactly), each a bound of the points' images; m_i is the magnitude the
+ * kernels sum there, (|M_i0| + |M_i1| + |M_i2|) (|c|_1 + |h|_1) + |M_i3|,
+ * for the rounding allowance. */
+static inline void box_image(const float *M, const double *c, const double *h, double r, double *x, double *e,
+                             double *m)
 {
-	const double c[3] = { b[0], b[1], b[2] }, h[3] = { b[3] + grow, b[4] + grow, b[5] + grow };
 	const double cn = fabs(c[0]) + fabs(c[1]) + fabs(c[2]) + h[0] + h[1] + h[2];
 	for (int i = 0; i < 3; i++) {
 		const double a0 = M[i], a1 = M[4 + i], a2 = M[8 + i], t = M[12 + i];
-		const double x = a0 * c[0] + a1 * c[1] + a2 * c[2] + t;
-		double e = fabs(a0) * h[0] + fabs(a1) * h[1] + fabs(a2) * h[2];
+		const double f0 = fabs(a0), f1 = fabs(a1), f2 = fabs(a2);
+		x[i] = a0 * c[0] + a1 * c[1] + a2 * c[2] + t;
+		e[i] = f0 * h[0] + f1 * h[1] + f2 * h[2];
 		if (r >= 0)
-			e = fmin(e, (r + grow) * sqrt(a0 * a0 + a1 * a1 + a2 * a2));
-		e += RT_BOUND_ROUND * ((fabs(a0) + fabs(a1) + fabs(a2)) * cn + fabs(t) + (extra ? extra[i] : 0.0));
-		lo[i] = x - e;
-		hi[i] = x + e;
+			e[i] = dmin(e[i], r * sqrt(a0 * a0 + a1 * a1 + a2 * a2));
+		m[i] = (f0 + f1 + f2) * cn + fabs(t);
 	}
-}
-
-/* The rounding magnitudes of box_image on each axis, for its extra. */
-static void box_magnitudes(const float *M, const float *b, double grow, double *out)
-{
-	const double cn = fabs(b[0]) + fabs(b[1]) + fabs(b[2]) + b[3] + b[4] + b[5] + 3 * grow;
-	for (int i = 0; i < 3; i++)
-		out[i] = (fabs(M[i]) + fabs(M[4 + i]) + fabs(M[8 + i])) * cn + fabs(M[12 + i]);
 }
 
 mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float min[3], float max[3],
@@ -1039,46 +1030,47 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 		double g = 0;
 		for (uint32_t t = 0; t < k; t++)
 			g += fabs((double)w[t]) * d[t];
-		grow = fmax(grow, g);
+		grow = dmax(grow, g);
 	}
 	/* Skinned vertices: per palette entry, the box of its points' images
 	 * through the bind pose (the entry's matrix P on their bind-pose box and
 	 * ball) and, where the inverse bind B has an inverse, through the
 	 * joint's space (P B^-1, at level 0 the joint's world matrix, on their
-	 * box there, which follows the bone): their intersection. */
+	 * box there, which follows the bone): their intersection, widened by
+	 * the rounding allowance of both (the kernels compute P x). */
 	double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
 	for (uint32_t k = 0; k < mu->pal_used_count; k++) {
 		const uint32_t e = mu->pal_used[k];
 		const float *b = mu->bound_entry + 13 * (size_t)e, *P = s->palette + 16 * (size_t)e;
 		if (!(b[6] >= 0.0f))
 			continue;
-		double l1[3], h1[3];
+		const double c1[3] = { b[0], b[1], b[2] }, h1[3] = { b[3] + grow, b[4] + grow, b[5] + grow };
+		double x1[3], e1[3], m1[3];
+		box_image(P, c1, h1, b[6] + grow, x1, e1, m1);
 		if (b[10] >= 0.0f) {
 			float M[16];
-			double l2[3], h2[3], mag1[3], mag2[3];
 			rt_mat_mul(P, ctx->pal_bind_inv + 16 * (size_t)e, M);
-			/* morphing moves a joint-space point by B's linear part times the
-			 * delta: at most B's row norm on each axis */
-			double g2[3] = { 0, 0, 0 };
+			/* a morph delta d moves a joint-space point by B's linear part
+			 * times d: at most |B's row i| |d| on axis i */
+			double c2[3] = { b[7], b[8], b[9] }, h2[3] = { b[10], b[11], b[12] }, x2[3], e2[3], m2[3];
 			if (grow > 0) {
 				const float *B = ctx->pal_bind0[e];
 				for (int i = 0; i < 3; i++)
-					g2[i] = grow * sqrt((double)B[i] * B[i] + (double)B[4 + i] * B[4 + i] + (double)B[8 + i] * B[8 + i]);
+					h2[i] += grow * sqrt((double)B[i] * B[i] + (double)B[4 + i] * B[4 + i] + (double)B[8 + i] * B[8 + i]);
 			}
-			float jb[6] = { b[7], b[8], b[9], (float)(b[10] + g2[0]), (float)(b[11] + g2[1]), (float)(b[12] + g2[2]) };
-			for (int i = 0; i < 3; i++)
-				jb[3 + i] = (double)jb[3 + i] < b[10 + i] + g2[i] ? nextafterf(jb[3 + i], INFINITY) : jb[3 + i];
-			box_magnitudes(P, b, grow, mag1);
-			box_magnitudes(M, jb, 0, mag2);
-			box_image(P, b, b[6], grow, mag2, l1, h1);
-			box_image(M, jb, -1, 0, mag1, l2, h2);
-			for (int i = 0; i < 3; i++)
-				l1[i] = fmax(l1[i], l2[i]), h1[i] = fmin(h1[i], h2[i]);
+			box_image(M, c2, h2, -1, x2, e2, m2);
+			for (int i = 0; i < 3; i++) {
+				const double g = RT_BOUND_ROUND * (m1[i] + m2[i]);
+				lo[i] = dmin(lo[i], dmax(x1[i] - e1[i], x2[i] - e2[i]) - g);
+				hi[i] = dmax(hi[i], dmin(x1[i] + e1[i], x2[i] + e2[i]) + g);
+			}
 		} else {
-			box_image(P, b, b[6], grow, NULL, l1, h1);
+			for (int i = 0; i < 3; i++) {
+				const double g = RT_BOUND_ROUND * m1[i];
+				lo[i] = dmin(lo[i], x1[i] - e1[i] - g);
+				hi[i] = dmax(hi[i], x1[i] + e1[i] + g);
+			}
 		}
-		for (int i = 0; i < 3; i++)
-			lo[i] = fmin(lo[i], l1[i]), hi[i] = fmax(hi[i], h1[i]);
 	}
 	/* Rigid and static parts: the matrix mlod_rt_skin makes for them. */
 	for (uint32_t i = 0; i < m->part_count; i++) {
@@ -1099,10 +1091,13 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 		} else {
 			memcpy(M, p->rec.offset, sizeof M);
 		}
-		double l1[3], h1[3];
-		box_image(M, c, c[6], grow, NULL, l1, h1);
-		for (int k = 0; k < 3; k++)
-			lo[k] = fmin(lo[k], l1[k]), hi[k] = fmax(hi[k], h1[k]);
+		const double cc[3] = { c[0], c[1], c[2] }, hh[3] = { c[3] + grow, c[4] + grow, c[5] + grow };
+		double x[3], ex[3], mg[3];
+		box_image(M, cc, hh, c[6] + grow, x, ex, mg);
+		for (int k = 0; k < 3; k++) {
+			lo[k] = dmin(lo[k], x[k] - ex[k] - RT_BOUND_ROUND * mg[k]);
+			hi[k] = dmax(hi[k], x[k] + ex[k] + RT_BOUND_ROUND * mg[k]);
+		}
 	}
 	if (!(lo[0] <= hi[0]))
 		return MLOD_OK; /* no vertex: the empty box */
