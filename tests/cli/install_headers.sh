@@ -27,6 +27,20 @@ int main(int argc, char **argv)
 		fprintf(stderr, "%s\n", e.message);
 		return 1;
 	}
+	/* names, hierarchy and a bound through the installed header */
+	mlod_rt_character ch;
+	uint32_t clip = 0, joint = 0, id = 0;
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	float lo[3], hi[3];
+	if (!s || mlod_rt_character_get(ctx, &ch, &e) || mlod_rt_clip_find(ctx, mlod_rt_clip_name(ctx, 0), &clip, &e) ||
+	    mlod_rt_joint_find(ctx, "Hips", &joint, &e) || mlod_rt_joint_parent(ctx, joint) != -1 ||
+	    mlod_rt_instance_create(ctx, clip, 0, 0, &id, &e) || mlod_rt_bounds(ctx, s, id, lo, hi, &e) || lo[1] > hi[1]) {
+		fprintf(stderr, "%s\n", e.message);
+		return 1;
+	}
+	printf("%s: clip %s, joint %s, height %.1f\n", ch.name, mlod_rt_clip_name(ctx, clip), mlod_rt_joint_name(ctx, joint),
+	       (double)(hi[1] - lo[1]));
+	mlod_rt_scratch_destroy(ctx, s);
 	mlod_rt_close(ctx);
 	return 0;
 }
@@ -39,7 +53,8 @@ printf '#include <mlod_rt.h>\n#include <mlod_pack.h>\nint main(void) { return 0;
 cc -std=c11 -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wdouble-promotion -Werror $(pc --cflags mlodrt) \
 	-c strict.c -o strict.o
 "$BIN/mlod-pack" "$ROOT/samples/tubeman.glb" -o t.mlod
-./rt t.mlod
+./rt t.mlod > rt.out
+grep -q '^tubeman: clip walk, joint Hips' rt.out || { cat rt.out >&2; exit 1; }
 make -s -C "$ROOT" uninstall DESTDIR="$PWD/inst" PREFIX=/usr > /dev/null
 left=$(find inst -type f -o -type l)
 [ -z "$left" ] || { echo "left after uninstall: $left" >&2; exit 1; }
