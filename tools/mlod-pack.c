@@ -79,7 +79,8 @@ static const char usage_more[] = /* printf's format ends above (ISO C's 4095-cha
 	"                             every chunk is decoded and checked, the DOC\n"
 	"                             chunk's glb read as -x reads it (stdout\n"
 	"                             only: not with -o)\n"
-	"      --json                 with --info: as JSON (= --report=json)\n"
+	"      --json                 with --info: as JSON (= --report=json), with the\n"
+	"                             rest bounds and every joint's name and parent\n"
 	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels (with\n"
 	"                             the pack's weights, on the full skin),\n"
 	"                             skeleton-level skins, <clip>@lod<k> animations\n"
@@ -211,7 +212,22 @@ static int pack_info(const char *path, enum tool_report report)
 		        ir->skin_count, ir->instance_count, ir->clip_count);
 		fprintf(f, "  \"skeleton_levels\": %u,\n  \"mesh_levels\": %u,\n  \"motion_levels\": %u,\n",
 		        ir->skeleton_levels, ir->mesh_levels, ir->motion_levels);
-		fprintf(f, "  \"height\": %.9g,\n  \"diagonal\": %.9g,\n  \"chunks\": [\n", ir->height, ir->diagonal);
+		fprintf(f, "  \"height\": %.9g,\n  \"diagonal\": %.9g,\n", ir->height, ir->diagonal);
+		fprintf(f, "  \"bounds_min\": [%.9g, %.9g, %.9g],\n  \"bounds_max\": [%.9g, %.9g, %.9g],\n", ir->bounds_min[0],
+		        ir->bounds_min[1], ir->bounds_min[2], ir->bounds_max[0], ir->bounds_max[1], ir->bounds_max[2]);
+		/* the joints' names and parents, as the runtime gives them (mlod_rt_info(3)) */
+		mlod_pack_skeleton sk;
+		memset(&sk, 0, sizeof sk);
+		if ((r = mlod_pack_decode_skeleton(&p, data, size, &sk, &err)) != MLOD_OK)
+			tool_die(tool_exit_code(r), label, "%s", err.message);
+		fprintf(f, "  \"skeleton\": [");
+		for (uint32_t j = 0; j < sk.joint_count; j++) {
+			fprintf(f, "%s\n    {\"joint\": ", j ? "," : "");
+			tool_json_string(f, sk.joint_names[j]);
+			fprintf(f, ", \"parent\": %d}", (int)sk.joints[j].parent);
+		}
+		fprintf(f, "%s],\n  \"chunks\": [\n", sk.joint_count ? "\n  " : "");
+		mlod_pack_skeleton_free(&sk);
 		for (uint32_t i = 0; i < p.chunk_count; i++) {
 			const mlod_pack_chunk *c = &p.chunks[i];
 			double ref = c->layer == MLOD_LAYER_MESH ? ir->diagonal : ir->height;

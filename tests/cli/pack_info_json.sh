@@ -1,6 +1,8 @@
 # mlod-pack --info --json (and --info --report=json, the same) parses; its
 # totals equal the file size: the layers' stored bytes plus header, TOC and
-# padding, and the chunks' stored bytes sum to the layers'.
+# padding, and the chunks' stored bytes sum to the layers'; its skeleton
+# lists every joint's name and parent, and its rest bounds have INFO's
+# diagonal.
 set -e
 for s in tubeman.glb RobotExpressive.glb cmu_12_01_walk.bvh; do
 	n=${s%.*}
@@ -24,5 +26,13 @@ for (const c of j.chunks) {
 	if (c.type === 'ANIM' && typeof c.clip !== 'string') throw new Error('ANIM without a clip name');
 	if (c.level > 0 && c.type !== 'DOC' && !(c.distance >= 0 && c.error >= 0)) throw new Error('error/distance');
 }
+// the joints' names and parents (parents first) and the rest bounds, whose diagonal INFO gives
+if (j.skeleton.length !== j.joints || j.skeleton[0].parent !== -1) throw new Error('skeleton');
+j.skeleton.forEach((s, i) => {
+	if (typeof s.joint !== 'string' || !(s.parent < i)) throw new Error(`joint ${i}`);
+});
+const d = Math.hypot(...j.bounds_max.map((x, k) => x - j.bounds_min[k]));
+if (!(Math.abs(d - j.diagonal) <= 1e-4 * j.diagonal)) throw new Error(`bounds' diagonal ${d}, INFO ${j.diagonal}`);
 JS
+grep -q '"joint": "Hips", "parent": -1' tubeman.json
 done
