@@ -3,6 +3,7 @@
  * cache (loading, LRU eviction under the budget, streaming), instances and
  * the fallback rule. The pack source lives in rt_pack.c; views open here.
  */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -535,25 +536,31 @@ static float sqrt_up(double x) { return float_up(sqrt(x)); }
 typedef struct bound_acc {
 	double lo[3], hi[3], r2;
 	float c[3];
+	size_t n;
 } bound_acc;
+
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+static inline double dmax(double a, double b) { return a > b ? a : b; }
 
 static void acc_init(bound_acc *a)
 {
 	for (int k = 0; k < 3; k++)
 		a->lo[k] = INFINITY, a->hi[k] = -INFINITY;
 	a->r2 = 0;
+	a->n = 0;
 }
 
 static void acc_box(bound_acc *a, const double *x)
 {
+	a->n++;
 	for (int k = 0; k < 3; k++)
-		a->lo[k] = fmin(a->lo[k], x[k]), a->hi[k] = fmax(a->hi[k], x[k]);
+		a->lo[k] = dmin(a->lo[k], x[k]), a->hi[k] = dmax(a->hi[k], x[k]);
 }
 
 /* Rounds the centre to floats (after the first pass). */
 static int acc_centre(bound_acc *a)
 {
-	if (!(a->lo[0] <= a->hi[0]))
+	if (!a->n)
 		return 0;
 	for (int k = 0; k < 3; k++)
 		a->c[k] = (float)(0.5 * (a->lo[k] + a->hi[k]));
@@ -563,31 +570,35 @@ static int acc_centre(bound_acc *a)
 static void acc_ball(bound_acc *a, const double *x)
 {
 	const double dx = x[0] - a->c[0], dy = x[1] - a->c[1], dz = x[2] - a->c[2];
-	a->r2 = fmax(a->r2, dx * dx + dy * dy + dz * dz);
+	a->r2 = dmax(a->r2, dx * dx + dy * dy + dz * dz);
 }
 
 /* out: centre, half extents (each the larger distance from the float
- * centre to the box's sides, rounded up) and, with ball, the radius;
- * a radius (or half extent x) of -1 for no point or one not finite. */
+ * centre to the box's sides, rounded up) and, with ball, the radius. No
+ * point: half extent x (and radius) -1. A coordinate not finite (hostile
+ * views, or a huge inverse bind): with ball, centre 0 and half extents
+ * and radius FLT_MAX, a box that holds anything; without, half extent x
+ * -1 (not used). */
 static void acc_write(const bound_acc *a, int ball, float *out)
 {
-	int ok = a->lo[0] <= a->hi[0];
+	int ok = 1;
 	for (int k = 0; k < 3 && ok; k++) {
 		out[k] = a->c[k];
-		out[3 + k] = float_up(fmax(a->hi[k] - a->c[k], a->c[k] - a->lo[k]));
+		out[3 + k] = float_up(dmax(a->hi[k] - a->c[k], a->c[k] - a->lo[k]));
 		ok = isfinite(out[k]) && isfinite(out[3 + k]);
 	}
 	if (ball) {
 		out[6] = sqrt_up(a->r2);
 		ok = ok && isfinite(out[6]);
 	}
-	if (!ok) {
-		for (int k = 0; k < 6; k++)
-			out[k] = 0.0f;
+	if (a->n && ok)
+		return;
+	for (int k = 0; k < 3; k++)
+		out[k] = 0.0f, out[3 + k] = a->n && ball ? FLT_MAX : 0.0f;
+	if (!a->n || !ball)
 		out[3] = -1.0f;
-		if (ball)
-			out[6] = -1.0f;
-	}
+	if (ball)
+		out[6] = a->n ? FLT_MAX : -1.0f;
 }
 
 /* q = B x for the affine B (column-major), in double. */
@@ -625,9 +636,9 @@ static void prepare_bounds(const mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_m
 					if (!(p->weights[4 * v + q] > 0.0f))
 						continue;
 					const size_t e = off + p->joints[4 * v + q];
-					double jq[3];
-					affine_d(ctx->pal_bind0[e], x, jq);
 					if (pass == 0) {
+						double jq[3];
+						affine_d(ctx->pal_bind0[e], x, jq);
 						acc_box(&acc[2 * e], xd);
 						acc_box(&acc[2 * e + 1], jq);
 					} else {
@@ -668,7 +679,7 @@ static void prepare_bounds(const mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_m
 			double d2 = 0;
 			const float *d = p->targets ? p->targets[t] : NULL;
 			for (size_t v = 0; d && v < p->rec.vertex_count; v++)
-				d2 = fmax(d2, (double)d[3 * v] * d[3 * v] + (double)d[3 * v + 1] * d[3 * v + 1] +
+				d2 = dmax(d2, (double)d[3 * v] * d[3 * v] + (double)d[3 * v + 1] * d[3 * v + 1] +
 				                  (double)d[3 * v + 2] * d[3 * v + 2]);
 			u->bound_morph[at++] = sqrt_up(d2);
 		}
