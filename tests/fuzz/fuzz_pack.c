@@ -7,7 +7,8 @@
  * without one), and DOC. Then the runtime opens the same bytes and
  * evaluates one frame at every level: an instance of each clip forced to
  * level k of every layer, mlod_rt_update, mlod_rt_stream, mlod_rt_pose,
- * mlod_rt_palette and mlod_rt_skin.
+ * mlod_rt_palette, mlod_rt_bounds (a finite skinned vertex outside its
+ * box aborts), mlod_rt_skin and every joint's mlod_rt_joint_level_get.
  *
  * The custom mutator (fuzz_restamp.h) re-stamps the CRCs on half of the
  * runs.
@@ -80,8 +81,16 @@ static void evaluate(const uint8_t *data, size_t size)
 				mlod_rt_pose(ctx, s, id, &world, &joints, &jc, &e);
 				const float *pal;
 				mlod_rt_palette(ctx, s, &pal, &pc, &e);
-				if (cap)
-					mlod_rt_skin(ctx, s, id, pos, 12, nrm, 12, cap, &vc, &e);
+				float lo[3], hi[3];
+				const int bounded = mlod_rt_bounds(ctx, s, id, lo, hi, &e) == MLOD_OK;
+				if (cap && mlod_rt_skin(ctx, s, id, pos, 12, nrm, 12, cap, &vc, &e) == MLOD_OK && bounded)
+					for (uint32_t v = 0; v < 3 * vc; v++) /* a finite vertex outside its box: abort */
+						if (pos[v] == pos[v] && pos[v] - pos[v] == 0.0f && !(pos[v] >= lo[v % 3] && pos[v] <= hi[v % 3]))
+							abort();
+				mlod_rt_joint_level jl;
+				for (uint32_t j = 0; j < mlod_rt_joint_count(ctx); j++)
+					mlod_rt_joint_level_get(ctx, mlod_rt_instance_state(ctx, id)->level[MLOD_RT_SKELETON], j, &jl,
+					                        &e);
 			}
 			mlod_rt_instance_destroy(ctx, id);
 		}
