@@ -71,15 +71,139 @@
  * and the faces it added), so any prefix of the sequence is a valid mesh
  * and can be rebuilt, undone or redone.
  *
- * This file holds the queue's loop: which operations are queued, and
- * what happens to one when it is popped. collapse.h maps the others:
- * the heap (collapseheap.c), the lower bounds it is keyed by
- * (lowerbound.c), the plan (collapseplan.c) and its application
- * (collapseapply.c).
+ * This file holds the queue (a 4-ary heap ordered by key, then face,
+ * then op: a total order, so the operations come out in the same order
+ * whatever the heap's shape) and its loop: which operations are queued,
+ * and what happens to one when it is popped. collapse.h maps the other
+ * files: the lower bounds the queue is keyed by (lowerbound.c), the plan
+ * (collapseplan.c) and its application (collapseapply.c).
  */
 #include <stdlib.h>
 
 #include "collapse.h"
+
+/* A queued operation, as the heap hands it back. */
+typedef struct heap_entry {
+	double key;
+	int face;
+	int op;
+	int weak;   /* key is bgm_lower_key's bind-pose bound: bgm_exact_bound comes next */
+	int memo;   /* into heap.memo, or -1 */
+} heap_entry;
+
+/* As the heap stores it: 16 bytes, four children to a 64-byte line
+ * (tag: op in bits 0-1, weak in bit 2, memo + 1 above). */
+struct bgm_heap_entry {
+	double key;
+	int face;
+	unsigned tag;
+};
+
+/* A slot holding m; returns its index, or -1 when out of memory. */
+static int memo_add(struct bgm_heap *h, const bgm_memo *m)
+{
+	int i = h->memo_free;
+	if (i >= 0) {
+		h->memo_free = h->memo[i].next_free;
+	} else {
+		if (bgm_grow((void **)&h->memo, &h->memo_cap, h->memo_count + 1, sizeof *h->memo))
+			return -1;
+		i = h->memo_count++;
+	}
+	h->memo[i] = *m;
+	h->memo[i].next_free = -1;
+	return i;
+}
+
+static void memo_release(struct bgm_heap *h, int i)
+{
+	if (i < 0)
+		return;
+	h->memo[i].next_free = h->memo_free;
+	h->memo_free = i;
+}
+
+/* The queue's order: key, then face, then op (a total order, so the
+ * operations come out in the same order whatever the heap's shape). */
+static int entry_less(const struct bgm_heap_entry *a, const struct bgm_heap_entry *b)
+{
+	return a->key < b->key ||
+	       (a->key == b->key && (a->face < b->face || (a->face == b->face && (a->tag & 3u) < (b->tag & 3u))));
+}
+
+/* A 4-ary heap: half the levels of a binary one, its entries' cache
+ * misses being what a large mesh's collapses wait on. */
+static int heap_push(struct bgm_heap *h, double key, int face, int op, int weak, int memo_slot)
+{
+	if (bgm_grow((void **)&h->e, &h->cap, h->count + 1, sizeof *h->e))
+		return -1;
+	int i = h->count++;
+	struct bgm_heap_entry x = {key, face, (unsigned)op | (weak ? 4u : 0u) | (unsigned)(memo_slot + 1) << 3};
+	if (isnan(key))
+		h->unordered = 1;
+	while (i > 0) {
+		int p = (i - 1) / 4;
+		if (!entry_less(&x, &h->e[p]))
+			break;
+		h->e[i] = h->e[p];
+		i = p;
+	}
+	h->e[i] = x;
+	return 0;
+}
+
+/* Puts x at slot i of the 4-ary heap or below it, moving the least
+ * child up while it is less than x. */
+static void sift_down(struct bgm_heap *h, int i, struct bgm_heap_entry x)
+{
+	const int n = h->count;
+	for (;;) {
+		int c = 4 * i + 1, m = c;
+		if (c >= n)
+			break;
+		int end = c + 4 < n ? c + 4 : n;
+		for (int j = c + 1; j < end; j++)
+			if (entry_less(&h->e[j], &h->e[m]))
+				m = j;
+		if (!entry_less(&h->e[m], &x))
+			break;
+		h->e[i] = h->e[m];
+		i = m;
+	}
+	h->e[i] = x;
+}
+
+static heap_entry heap_pop(struct bgm_heap *h)
+{
+	struct bgm_heap_entry t = h->e[0], x = h->e[--h->count];
+	if (h->count > 0)
+		sift_down(h, 0, x);
+	heap_entry top = {t.key, t.face, (int)(t.tag & 3u), (int)(t.tag >> 2 & 1u), (int)(t.tag >> 3) - 1};
+	return top;
+}
+
+/* Drops the entries of dead faces (what heap_pop's callers would drop
+ * when they come up) and rebuilds the heap from the rest. Entries are
+ * one per face and op and entry_less orders them totally (no NaN key
+ * was queued), so the live entries come out in the same order as
+ * before; a dead entry popped costs a walk down the heap, this one pass
+ * over it. */
+static void heap_purge(struct bgm_heap *h, const unsigned char *opstate, unsigned char dead)
+{
+	int n = 0;
+	for (int i = 0; i < h->count; i++) {
+		if (opstate[h->e[i].face] == dead) {
+			memo_release(h, (int)(h->e[i].tag >> 3) - 1);
+			continue;
+		}
+		h->e[n++] = h->e[i];
+	}
+	h->count = n;
+	h->dead = 0;
+	h->purges++;
+	for (int s = n > 1 ? (n - 2) / 4 : -1; s >= 0; s--)
+		sift_down(h, s, h->e[s]);
+}
 
 /* 1 when the queue takes lower bounds of the posed cost (bgm_lower_key) and
  * plans an operation only when it is popped. */
@@ -113,7 +237,7 @@ static int push_op(mlod_bgm *g, int f, int op, bgm_plan *scratch)
 		key = bgm_compactness(g->nodes[F->n[0]].p, g->nodes[F->n[1]].p, g->nodes[F->n[2]].p);
 	}
 	g->opstate[f] |= (unsigned char)QUEUED(op);
-	return bgm_heap_push(&g->heap, key, f, op, weak, -1);
+	return heap_push(&g->heap, key, f, op, weak, -1);
 }
 
 /* 1 when the face across edge e of face f holds a queue entry for that
@@ -196,13 +320,13 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 		}
 		/* Mostly dead entries: drop them at once (the same order). */
 		if (g->heap.dead > 256 && 2 * g->heap.dead > g->heap.count && !g->heap.unordered && !g->heap.no_purge) {
-			bgm_heap_purge(&g->heap, g->opstate, DEAD);
+			heap_purge(&g->heap, g->opstate, DEAD);
 			continue;
 		}
-		bgm_heap_item e = bgm_heap_pop(&g->heap);
+		heap_entry e = heap_pop(&g->heap);
 		if (g->opstate[e.face] == DEAD) {
 			g->heap.dead -= g->heap.dead > 0;
-			bgm_memo_release(&g->heap, e.memo);
+			memo_release(&g->heap, e.memo);
 			continue;
 		}
 		/* An operation going back keeps what its placements cost. */
@@ -223,7 +347,7 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 		if (back < 0.0) {
 			g->opstate[e.face] &= (unsigned char)~QUEUED(e.op);
 			if (!bgm_plan_op(g, e.face, e.op, !g->opt.fast_cost, pl, g->opt.fast_cost ? NULL : mm)) {
-				bgm_memo_release(&g->heap, e.memo);
+				memo_release(&g->heap, e.memo);
 				g->refused++;
 				g->opstate[e.face] |= (unsigned char)BLOCKED(e.op);
 				continue;
@@ -235,17 +359,17 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 		}
 		if (back >= 0.0) {
 			int slot = e.memo;
-			if (slot < 0 && !g->opt.fast_cost && (slot = bgm_memo_add(&g->heap, &local)) < 0) {
+			if (slot < 0 && !g->opt.fast_cost && (slot = memo_add(&g->heap, &local)) < 0) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 				goto done;
 			}
-			if (bgm_heap_push(&g->heap, back, e.face, e.op, 0, slot)) {
+			if (heap_push(&g->heap, back, e.face, e.op, 0, slot)) {
 				r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");
 				goto done;
 			}
 			continue;
 		}
-		bgm_memo_release(&g->heap, e.memo);
+		memo_release(&g->heap, e.memo);
 		int first = g->face_count;
 		if (bgm_apply(g, pl)) {
 			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory simplifying");

@@ -3,15 +3,15 @@
  * BindGraphMesh they work on). The collapse sequence (mlod_bgm_simplify)
  * is made by these files, each calling only those below it:
  *
- *   collapse.c       the queue's loop: operations queued, popped, planned,
- *                    applied or put back
+ *   collapse.c       the queue, a 4-ary heap of operations, and its loop:
+ *                    operations queued, popped, planned, applied or put
+ *                    back
  *   collapseapply.c  a planned collapse applied: the patch re-meshed
  *                    around v-bar, its wedges, the record
  *   lowerbound.c     lower bounds of an operation's posed cost, the keys
  *                    the queue waits on before planning it
  *   collapseplan.c   an operation worked out: its patch, the validity
  *                    checks and the cheapest valid placement
- *   collapseheap.c   the queue: a 4-ary heap of operations
  *   collapsecost.c   what the plan and the bounds share: per-face
  *                    geometry, summed quadrics, Power Skinning by role
  *
@@ -42,15 +42,6 @@
  * mesh). No live face has every bit: an op is never both blocked and
  * queued. */
 #define DEAD 255u
-
-/* A queued operation, as the heap hands it back. */
-typedef struct bgm_heap_item {
-	double key;
-	int face;
-	int op;
-	int weak;   /* key is bgm_lower_key's bind-pose bound: bgm_exact_bound comes next */
-	int memo;   /* into heap.memo, or -1 */
-} bgm_heap_item;
 
 /* What the exact posed cost of an operation's placements came to. It
  * depends only on the collapsed vertices (quadrics, positions and
@@ -86,7 +77,7 @@ typedef struct bgm_plan {
 	int nk, kept[MAX_PATCH];    /* the others, re-meshed around v-bar */
 	int corner[MAX_PATCH];      /* the corner of kept[i] that becomes v-bar */
 	double onormal[MAX_PATCH][4]; /* kept[i]'s normal, then its length */
-	double rnormal[MAX_PATCH][4]; /* kept[i]'s reference normal (bgm_face_ref), then its length */
+	double rnormal[MAX_PATCH][4]; /* kept[i]'s reference normal (face_ref), then its length */
 	unsigned char oflip[MAX_PATCH]; /* kept[i] is not degenerate: it may not flip */
 	int nw, wedges[MAX_WEDGES], group[MAX_WEDGES], ngroups;
 	int src[MAX_PATCH];         /* vertex placement: the wedge of v[snap] kept[i]'s corner copies */
@@ -108,27 +99,12 @@ typedef struct bgm_plan {
 int bgm_face_arrays_grow(mlod_bgm *g);
 /* Face h's bgm_face_normal (0-2), its length (3) and its compactness (4). */
 const double *bgm_face_geo(mlod_bgm *g, int h);
-/* Face h's reference normal (0-2) and its length (3). */
-const double *bgm_face_ref(mlod_bgm *g, int h);
 /* The collapsed vertices' posed quadrics summed per pose into Q. */
 void bgm_sum_quadrics(const mlod_bgm *g, const bgm_plan *pl, double *Q);
 /* mlod_power_skin of the collapsed vertices at x for placement role, as
  * mm remembers it (mm may be NULL); returns whether it capped. */
 int bgm_skin_role(bgm_memo *mm, int role, const mlod_v3 *V, const mlod_influences *in3, int K, const double *x,
                   mlod_influences *w);
-int bgm_same_influences(const mlod_influences *x, const mlod_influences *y);
-
-/* collapseheap.c: the queue of operations, a 4-ary heap in the order of
- * key, face and op, and the slots of the exact costs of queued operations. */
-int bgm_heap_push(struct bgm_heap *h, double key, int face, int op, int weak, int memo_slot);
-/* The least entry (the heap not empty). */
-bgm_heap_item bgm_heap_pop(struct bgm_heap *h);
-/* Drops the entries of faces whose opstate is dead. */
-void bgm_heap_purge(struct bgm_heap *h, const unsigned char *opstate, unsigned char dead);
-/* A slot holding m; its index, or -1 when out of memory. */
-int bgm_memo_add(struct bgm_heap *h, const bgm_memo *m);
-/* Frees slot i (nothing when i < 0). */
-void bgm_memo_release(struct bgm_heap *h, int i);
 
 /* collapseplan.c: works out operation op on face t (its triangle
  * collapse, or the collapse of one of its edges); 1 when it is valid (pl

@@ -1,8 +1,9 @@
 /*
  * collapsecost.c: what the plan of a collapse (collapseplan.c) and the
  * queue's lower bounds (lowerbound.c) both price it with: each face's
- * normal, compactness and reference normal, worked out once (a face's
- * nodes never change) in per-face arrays grown with the faces; the
+ * normal and compactness, worked out once (a face's nodes never change)
+ * in per-face arrays grown with the faces (with those of the queue's
+ * state and of the reference normals, collapseplan.c); the
  * collapsed vertices' posed quadrics summed per pose; and the Power
  * Skinning (powerskin.c) of a placement by its role, remembered for the
  * operation while its face lives (bgm_memo).
@@ -30,18 +31,6 @@ const double *bgm_face_geo(mlod_bgm *g, int h)
 		o[4] = bgm_compactness(a, b, c);
 	}
 	return o;
-}
-
-/* Face h's reference normal (0-2) and its length (3): an input face's
- * own bgm_face_normal; a face a collapse made has the reference of the
- * face it replaced (the same face with its v-bar corner moved), so each
- * face keeps the orientation of the input face it descends from. */
-const double *bgm_face_ref(mlod_bgm *g, int h)
-{
-	double *r = g->fref + 4 * (size_t)h;
-	if (isnan(r[3]))
-		memcpy(r, bgm_face_geo(g, h), 4 * sizeof *r); /* only input faces: apply sets the others' */
-	return r;
 }
 
 int bgm_face_arrays_grow(mlod_bgm *g)
@@ -142,14 +131,4 @@ int bgm_skin_role(bgm_memo *mm, int role, const mlod_v3 *V, const mlod_influence
 		mm->skinned |= 1u << role;
 	}
 	return capped;
-}
-
-int bgm_same_influences(const mlod_influences *x, const mlod_influences *y)
-{
-	if (x->count != y->count)
-		return 0;
-	for (int i = 0; i < x->count; i++)
-		if (x->joints[i] != y->joints[i] || x->weights[i] != y->weights[i])
-			return 0;
-	return 1;
 }

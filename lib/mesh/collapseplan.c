@@ -24,6 +24,18 @@
                              * the robot's 10% level 5.54% -> 10.19% Hausdorff, bench/RESULTS.md) */
 #define DEGENERATE 1e-3     /* compactness under which a new face counts as degenerate */
 
+/* Face h's reference normal (0-2) and its length (3): an input face's
+ * own bgm_face_normal; a face a collapse made has the reference of the
+ * face it replaced (the same face with its v-bar corner moved), so each
+ * face keeps the orientation of the input face it descends from. */
+static const double *face_ref(mlod_bgm *g, int h)
+{
+	double *r = g->fref + 4 * (size_t)h;
+	if (isnan(r[3]))
+		memcpy(r, bgm_face_geo(g, h), 4 * sizeof *r); /* only input faces: apply sets the others' */
+	return r;
+}
+
 static int find(int *parent, int i)
 {
 	while (parent[i] != i)
@@ -628,7 +640,7 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 		const double *o = bgm_face_geo(g, pl->kept[i]);
 		memcpy(pl->onormal[i], o, 4 * sizeof *o);
 		pl->oflip[i] = o[3] > 0.0 && o[4] >= DEGENERATE;
-		memcpy(pl->rnormal[i], bgm_face_ref(g, pl->kept[i]), 4 * sizeof *o);
+		memcpy(pl->rnormal[i], face_ref(g, pl->kept[i]), 4 * sizeof *o);
 	}
 	/* The cheapest valid candidate; with the compactness cost (the same
 	 * for every placement), the one nearest the barycenter. The
