@@ -315,6 +315,134 @@ static void vertex_wedges(const mlod_bgm *g, bgm_plan *pl, const int *owner)
 	}
 }
 
+/* The patch of pl's collapsed vertices (pl->v, pl->k): its faces, those
+ * removed (two or more collapsed vertices) and those kept, each kept
+ * face's v-bar corner and the link edge opposite it (from[j] -> to[j]).
+ * 0 when the operation is refused: a patch of more than MAX_PATCH faces,
+ * a triangle whose patch has not exactly one face with all three
+ * vertices, nothing kept, or a collapsed edge with more than two faces. */
+static int plan_patch(const mlod_bgm *g, bgm_plan *pl, int *from, int *to)
+{
+	int K = pl->k;
+	pl->nf = pl->nr = pl->nk = 0;
+	for (int i = 0; i < K; i++) {
+		const bgm_node *n = &g->nodes[pl->v[i]];
+		for (int k = 0; k < n->inc_count; k++) {
+			int f = g->inc[n->inc_first + k], seen = 0;
+			for (int j = 0; j < pl->nf && !seen; j++)
+				seen = pl->faces[j] == f;
+			if (seen)
+				continue;
+			if (pl->nf == MAX_PATCH)
+				return 0;
+			pl->faces[pl->nf++] = f;
+		}
+	}
+	int all3 = 0;
+	for (int j = 0; j < pl->nf; j++) {
+		const bgm_face *f = &g->faces[pl->faces[j]];
+		int in = 0, corner = -1;
+		for (int k = 0; k < 3; k++)
+			if (owner_of(pl, f->n[k]) >= 0)
+				in++, corner = k;
+		if (in == 3)
+			all3++;
+		if (in >= 2) {
+			pl->removed[pl->nr++] = pl->faces[j];
+			continue;
+		}
+		pl->corner[pl->nk] = corner;
+		from[pl->nk] = f->n[(corner + 1) % 3];
+		to[pl->nk] = f->n[(corner + 2) % 3];
+		pl->kept[pl->nk++] = pl->faces[j];
+	}
+	if ((K == 3 && all3 != 1) || pl->nk == 0)
+		return 0;
+	/* Each collapsed edge has at most two faces (t and one across). */
+	for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
+		int x = pl->v[e], y = pl->v[(e + 1) % K], count = 0;
+		for (int j = 0; j < pl->nr; j++) {
+			const bgm_face *f = &g->faces[pl->removed[j]];
+			int hx = f->n[0] == x || f->n[1] == x || f->n[2] == x;
+			int hy = f->n[0] == y || f->n[1] == y || f->n[2] == y;
+			count += hx && hy;
+		}
+		if (count > 2)
+			return 0;
+	}
+	return 1;
+}
+
+/* The wedge groups of the patch: pl->wedges are the collapsed vertices'
+ * wedges on its faces, owner[i] the collapsed vertex wedge i is of,
+ * pl->group[i] its group (wedges joined through removed faces), and
+ * per[k][o] how many wedges collapsed vertex o has in group k. 0 when
+ * the patch has more than MAX_WEDGES of them. */
+static int plan_wedge_groups(const mlod_bgm *g, bgm_plan *pl, int *owner, int (*per)[3])
+{
+	int parent[MAX_WEDGES];
+	pl->nw = 0;
+	for (int j = 0; j < pl->nf; j++) {
+		const bgm_face *f = &g->faces[pl->faces[j]];
+		for (int k = 0; k < 3; k++) {
+			int o = owner_of(pl, f->n[k]);
+			if (o < 0 || bgm_wedge_slot(pl, f->w[k]) >= 0)
+				continue;
+			if (pl->nw == MAX_WEDGES)
+				return 0;
+			owner[pl->nw] = o;
+			parent[pl->nw] = pl->nw;
+			pl->wedges[pl->nw++] = f->w[k];
+		}
+	}
+	for (int j = 0; j < pl->nr; j++) {
+		const bgm_face *f = &g->faces[pl->removed[j]];
+		int first = -1;
+		for (int k = 0; k < 3; k++) {
+			int s = bgm_wedge_slot(pl, f->w[k]);
+			if (s < 0)
+				continue;
+			if (first < 0)
+				first = s;
+			else
+				parent[find(parent, s)] = find(parent, first);
+		}
+	}
+	pl->ngroups = 0;
+	int root_group[MAX_WEDGES];
+	for (int i = 0; i < pl->nw; i++)
+		root_group[i] = -1;
+	for (int i = 0; i < pl->nw; i++) {
+		int r = find(parent, i);
+		if (root_group[r] < 0)
+			root_group[r] = pl->ngroups++;
+		pl->group[i] = root_group[r];
+	}
+	/* Per group, how many wedges each collapsed vertex has there. */
+	memset(per, 0, sizeof per[0] * (size_t)pl->ngroups); /* the groups' rows */
+	for (int i = 0; i < pl->nw; i++)
+		per[pl->group[i]][owner[i]]++;
+	return 1;
+}
+
+/* The candidate placements of an operation: v-bar's position, its role
+ * (bgm_memo), the collapsed vertex it is at (-1: none), whether that
+ * vertex is kept whole, and the vertex v-bar snaps to (-1: free). */
+typedef struct plan_cands {
+	double x[MAX_CANDIDATES][3];
+	int role[MAX_CANDIDATES], at[MAX_CANDIDATES], whole[MAX_CANDIDATES], snap[MAX_CANDIDATES];
+	int n;
+} plan_cands;
+
+static void cand_add(plan_cands *c, const double *x, int role, int at, int whole, int snap)
+{
+	memcpy(c->x[c->n], x, sizeof c->x[c->n]);
+	c->role[c->n] = role;
+	c->at[c->n] = at;
+	c->whole[c->n] = whole;
+	c->snap[c->n++] = snap;
+}
+
 /* Where bgm_plan_op() stops summing a candidate of family fam: once it cannot
  * beat the best of its family (a whole vertex: nor be kept, costing more
  * than both the free best and the cap), with a margin far above
@@ -359,52 +487,9 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 	int hybrid = g->opt.placement == MLOD_PLACE_HYBRID && g->opt.cost == MLOD_COST_POSED;
 
 	/* The patch. */
-	pl->nf = pl->nr = pl->nk = 0;
-	for (int i = 0; i < K; i++) {
-		const bgm_node *n = &g->nodes[pl->v[i]];
-		for (int k = 0; k < n->inc_count; k++) {
-			int f = g->inc[n->inc_first + k], seen = 0;
-			for (int j = 0; j < pl->nf && !seen; j++)
-				seen = pl->faces[j] == f;
-			if (seen)
-				continue;
-			if (pl->nf == MAX_PATCH)
-				return 0;
-			pl->faces[pl->nf++] = f;
-		}
-	}
-	int from[MAX_PATCH], to[MAX_PATCH], all3 = 0;
-	for (int j = 0; j < pl->nf; j++) {
-		const bgm_face *f = &g->faces[pl->faces[j]];
-		int in = 0, corner = -1;
-		for (int k = 0; k < 3; k++)
-			if (owner_of(pl, f->n[k]) >= 0)
-				in++, corner = k;
-		if (in == 3)
-			all3++;
-		if (in >= 2) {
-			pl->removed[pl->nr++] = pl->faces[j];
-			continue;
-		}
-		pl->corner[pl->nk] = corner;
-		from[pl->nk] = f->n[(corner + 1) % 3];
-		to[pl->nk] = f->n[(corner + 2) % 3];
-		pl->kept[pl->nk++] = pl->faces[j];
-	}
-	if ((K == 3 && all3 != 1) || pl->nk == 0)
+	int from[MAX_PATCH], to[MAX_PATCH];
+	if (!plan_patch(g, pl, from, to))
 		return 0;
-	/* Each collapsed edge has at most two faces (t and one across). */
-	for (int e = 0; e < (K == 3 ? 3 : 1); e++) {
-		int x = pl->v[e], y = pl->v[(e + 1) % K], count = 0;
-		for (int j = 0; j < pl->nr; j++) {
-			const bgm_face *f = &g->faces[pl->removed[j]];
-			int hx = f->n[0] == x || f->n[1] == x || f->n[2] == x;
-			int hy = f->n[0] == y || f->n[1] == y || f->n[2] == y;
-			count += hx && hy;
-		}
-		if (count > 2)
-			return 0;
-	}
 	int border = 0, nb = 0, onb[3] = {0, 0, 0}, tex[3] = {0, 0, 0}, anytex = 0, special[3] = {0, 0, 0};
 	for (int i = 0; i < K; i++) {
 		onb[i] = (g->nodes[pl->v[i]].flags & BGM_BORDER) != 0;
@@ -424,54 +509,13 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 
 	/* Wedge groups: wedges of the collapsed vertices joined through
 	 * removed faces. */
-	int parent[MAX_WEDGES], owner[MAX_WEDGES];
-	pl->nw = 0;
-	for (int j = 0; j < pl->nf; j++) {
-		const bgm_face *f = &g->faces[pl->faces[j]];
-		for (int k = 0; k < 3; k++) {
-			int o = owner_of(pl, f->n[k]);
-			if (o < 0 || bgm_wedge_slot(pl, f->w[k]) >= 0)
-				continue;
-			if (pl->nw == MAX_WEDGES)
-				return 0;
-			owner[pl->nw] = o;
-			parent[pl->nw] = pl->nw;
-			pl->wedges[pl->nw++] = f->w[k];
-		}
-	}
-	for (int j = 0; j < pl->nr; j++) {
-		const bgm_face *f = &g->faces[pl->removed[j]];
-		int first = -1;
-		for (int k = 0; k < 3; k++) {
-			int s = bgm_wedge_slot(pl, f->w[k]);
-			if (s < 0)
-				continue;
-			if (first < 0)
-				first = s;
-			else
-				parent[find(parent, s)] = find(parent, first);
-		}
-	}
-	pl->ngroups = 0;
-	int root_group[MAX_WEDGES];
-	for (int i = 0; i < pl->nw; i++)
-		root_group[i] = -1;
-	for (int i = 0; i < pl->nw; i++) {
-		int r = find(parent, i);
-		if (root_group[r] < 0)
-			root_group[r] = pl->ngroups++;
-		pl->group[i] = root_group[r];
-	}
-	/* Per group, how many wedges each collapsed vertex has there. */
-	int per[MAX_WEDGES][3];
-	memset(per, 0, sizeof per[0] * (size_t)pl->ngroups); /* the groups' rows */
-	for (int i = 0; i < pl->nw; i++)
-		per[pl->group[i]][owner[i]]++;
+	int owner[MAX_WEDGES], per[MAX_WEDGES][3];
+	if (!plan_wedge_groups(g, pl, owner, per))
+		return 0;
 
 	/* Candidate placements. */
-	double cand[MAX_CANDIDATES][3];
-	int cand_snap[MAX_CANDIDATES], cand_role[MAX_CANDIDATES], cand_at[MAX_CANDIDATES], nc = 0;
-	int cand_whole[MAX_CANDIDATES];
+	plan_cands c;
+	c.n = 0;
 	const double *P[3] = {g->nodes[pl->v[0]].p, g->nodes[pl->v[1]].p, K == 3 ? g->nodes[pl->v[2]].p : NULL};
 	double bary[3];
 	for (int i = 0; i < 3; i++) {
@@ -493,13 +537,9 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 				continue;
 			if (!keeps_groups((const int (*)[3])per, pl->ngroups, K, s))
 				continue;
-			memcpy(cand[nc], P[s], sizeof cand[nc]);
-			cand_role[nc] = 1 + s;
-			cand_at[nc] = s;
-			cand_whole[nc] = vertex;
-			cand_snap[nc++] = s;
+			cand_add(&c, P[s], 1 + s, s, vertex, s);
 		}
-		if (nc == 0)
+		if (c.n == 0)
 			return 0;
 	} else if (border) {
 		/* The border stays where it is: v-bar goes to a border vertex,
@@ -520,18 +560,10 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 		for (int s = 0; s < K; s++) {
 			if (!onb[s])
 				continue;
-			memcpy(cand[nc], P[s], sizeof cand[nc]);
-			cand_role[nc] = 1 + s;
-			cand_at[nc] = s;
-			cand_whole[nc] = vertex;
-			cand_snap[nc++] = vertex ? s : -1;
+			cand_add(&c, P[s], 1 + s, s, vertex, vertex ? s : -1);
 		}
 		if (K == 2 && nb == 2 && !vertex) {
-			memcpy(cand[nc], bary, sizeof cand[nc]);
-			cand_role[nc] = 4;
-			cand_at[nc] = -1;
-			cand_whole[nc] = 0;
-			cand_snap[nc++] = -1;
+			cand_add(&c, bary, 4, -1, 0, -1);
 		}
 	}
 	/* The summed posed quadrics of the collapsed vertices, and their area
@@ -562,11 +594,7 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 		/* Vertex placement: v-bar is one of the collapsed vertices, its
 		 * wedges copied whole (vertex_wedges). */
 		for (int s = 0; s < K; s++) {
-			memcpy(cand[nc], P[s], sizeof cand[nc]);
-			cand_role[nc] = 1 + s;
-			cand_at[nc] = s;
-			cand_whole[nc] = 1;
-			cand_snap[nc++] = s;
+			cand_add(&c, P[s], 1 + s, s, 1, s);
 		}
 	} else if (!(special[0] || special[1] || special[2]) && !border) {
 		if (bgm_optimal_like(g) && g->pose_count > 0) {
@@ -588,49 +616,28 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 					memcpy(mm->opt, opt, sizeof opt);
 				}
 			}
-			{
-				if (found) {
-					if (bgm_near_collapsed(P, K, bary, opt)) {
-						memcpy(cand[nc], opt, sizeof cand[nc]);
-						cand_role[nc] = 0;
-						cand_at[nc] = -1;
-						cand_whole[nc] = 0;
-						cand_snap[nc++] = -1;
-					}
-				}
-			}
+			if (found && bgm_near_collapsed(P, K, bary, opt))
+				cand_add(&c, opt, 0, -1, 0, -1);
 			/* An edge may also go to either end (a half-edge collapse),
 			 * with that end's attributes. */
 			for (int s = 0; s < K && K == 2; s++) {
-				memcpy(cand[nc], P[s], sizeof cand[nc]);
-				cand_role[nc] = 1 + s;
-				cand_at[nc] = s;
-				cand_whole[nc] = 0;
-				cand_snap[nc++] = -1;
+				cand_add(&c, P[s], 1 + s, s, 0, -1);
 			}
 		}
-		memcpy(cand[nc], bary, sizeof cand[nc]);
-		cand_role[nc] = 4;
-		cand_at[nc] = -1;
-		cand_whole[nc] = 0;
-		cand_snap[nc++] = -1;
+		cand_add(&c, bary, 4, -1, 0, -1);
 	}
 	if (hybrid) {
 		/* Each collapsed vertex the placements above may go to (all of
 		 * them away from seams and borders), kept whole too: last, so
 		 * that the others' least cost is known when they are tried. */
-		int n0 = nc, any = !(special[0] || special[1] || special[2]) && !border;
+		int n0 = c.n, any = !(special[0] || special[1] || special[2]) && !border;
 		for (int s = 0; s < K; s++) {
 			int offered = any;
 			for (int i = 0; i < n0; i++)
-				offered |= cand_at[i] == s;
+				offered |= c.at[i] == s;
 			if (!offered)
 				continue;
-			memcpy(cand[nc], P[s], sizeof cand[nc]);
-			cand_role[nc] = 5 + s;
-			cand_at[nc] = s;
-			cand_whole[nc] = 1;
-			cand_snap[nc++] = s;
+			cand_add(&c, P[s], 5 + s, s, 1, s);
 		}
 	}
 
@@ -670,11 +677,11 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 	int order[MAX_CANDIDATES];
 	double ckey[MAX_CANDIDATES];
 	int ranked = fast && g->opt.cost == MLOD_COST_POSED && !hybrid;
-	for (int k = 0; k < nc; k++) {
+	for (int k = 0; k < c.n; k++) {
 		order[k] = k;
 		if (!ranked)
 			continue;
-		double e = g->pose_count > 0 ? bgm_quadric_eval(R, cand[k]) : 0.0;
+		double e = g->pose_count > 0 ? bgm_quadric_eval(R, c.x[k]) : 0.0;
 		ckey[k] = (wsum > 0.0 ? e / wsum : 0.0) + TIE_WEIGHT * tie;
 		if (g->opt.op == MLOD_OP_MIXED)
 			ckey[k] /= pl->nr;
@@ -694,18 +701,18 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 	 * instructions, RobotExpressive -2.0%, Ely -2.5% (checking late for
 	 * every candidate: the robot +0.7%, its geometry failing more). */
 	int late_geo = g->opt.cost == MLOD_COST_POSED && !ranked && !hybrid && g->pose_count > 0;
-	for (int kk = 0; kk < nc; kk++) {
-		int k = order[kk], fam = hybrid && cand_whole[k];
-		int late = late_geo && (bestf[0] >= 0 || (mm && (mm->known >> cand_role[k] & 1u)));
+	for (int kk = 0; kk < c.n; kk++) {
+		int k = order[kk], fam = hybrid && c.whole[k];
+		int late = late_geo && (bestf[0] >= 0 || (mm && (mm->known >> c.role[k] & 1u)));
 		/* A sum that stopped before (bgm_exact_bound's, or an earlier plan's)
 		 * at a partial sum the stop here does not exceed stops here too
 		 * (bgm_quadric_error_reach): not planned again. */
-		if (late_geo && mm && bestf[0] >= 0 && (mm->stopped >> cand_role[k] & 1u) && !(mm->known >> cand_role[k] & 1u) &&
-		    mm->ge[cand_role[k]] >= plan_stop(g, pl, 0, bestf, costf, cap, tie, wsum))
+		if (late_geo && mm && bestf[0] >= 0 && (mm->stopped >> c.role[k] & 1u) && !(mm->known >> c.role[k] & 1u) &&
+		    mm->ge[c.role[k]] >= plan_stop(g, pl, 0, bestf, costf, cap, tie, wsum))
 			continue;
 		if (ranked && bestf[0] >= 0)
 			break;
-		int at = cand_at[k];
+		int at = c.at[k];
 		if (fam == 1 && (same_end >> at & 1u) && bestf[0] >= 0) {
 			/* Its cost is known (the free end's): skip it when it cannot
 			 * be kept. */
@@ -717,23 +724,23 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 		}
 		if (!late) {
 			/* A whole vertex is where a free end was: the same answer. */
-			int ok = fam == 1 && geo_at[at] >= 0 ? geo_at[at] : geometry_ok(g, pl, cand[k]);
-			if (hybrid && at >= 0 && !cand_whole[k])
+			int ok = fam == 1 && geo_at[at] >= 0 ? geo_at[at] : geometry_ok(g, pl, c.x[k]);
+			if (hybrid && at >= 0 && !c.whole[k])
 				geo_at[at] = ok;
 			if (!ok)
 				continue;
 		}
 		mlod_influences w;
 		int capped = 0;
-		if (cand_whole[k])
-			w = in3[cand_at[k]]; /* the vertex's own influences, not blended */
+		if (c.whole[k])
+			w = in3[c.at[k]]; /* the vertex's own influences, not blended */
 		else
-			capped = bgm_skin_role(mm, cand_role[k], V, in3, K, cand[k], &w);
+			capped = bgm_skin_role(mm, c.role[k], V, in3, K, c.x[k], &w);
 		if (g->joint_count > 0 && w.count == 0)
 			continue;
 		double cost, d = 0.0;
 		for (int i = 0; i < 3; i++)
-			d += (cand[k][i] - bary[i]) * (cand[k][i] - bary[i]);
+			d += (c.x[k][i] - bary[i]) * (c.x[k][i] - bary[i]);
 		if (g->opt.cost == MLOD_COST_POSED) {
 			/* Area-normalised (a mean squared distance), so small
 			 * features count as much as large ones. */
@@ -743,7 +750,7 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 				goto take;
 			} else if (g->pose_count > 0) {
 				double stop = plan_stop(g, pl, fam, bestf, costf, cap, tie, wsum);
-				int role = cand_role[k];
+				int role = c.role[k];
 				if (role >= 5 && (same_end >> (role - 5) & 1u)) {
 					e = end_e[role - 5];
 				} else if (mm && (mm->known >> role & 1u)) {
@@ -752,7 +759,7 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 					if (!q_ready)
 						bgm_sum_quadrics(g, pl, Q), q_ready = 1;
 					double reached;
-					e = bgm_quadric_error_reach(g, Q, &w, cand[k], stop, &reached);
+					e = bgm_quadric_error_reach(g, Q, &w, c.x[k], stop, &reached);
 					if (e == HUGE_VAL) {
 						if (mm && role < MEMO_ROLES) {
 							mm->ge[role] = reached;
@@ -778,7 +785,7 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 				cost /= pl->nr;
 			if (bestf[fam] >= 0 && !(cost < costf[fam]))
 				continue;
-			if (late && !geometry_ok(g, pl, cand[k]))
+			if (late && !geometry_ok(g, pl, c.x[k]))
 				continue;
 		} else {
 			cost = bgm_compactness(P[0], P[1], P[2]);
@@ -803,14 +810,14 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 	pl->capped = capf[fam];
 	if (nb >= 2 && g->opt.cost == MLOD_COST_POSED)
 		pl->cost *= bgm_border_factor(g); /* the border moves (a lone border vertex stays put) */
-	memcpy(pl->pos, cand[best], sizeof pl->pos);
-	pl->snap = cand_snap[best];
-	pl->whole = cand_whole[best];
+	memcpy(pl->pos, c.x[best], sizeof pl->pos);
+	pl->snap = c.snap[best];
+	pl->whole = c.whole[best];
 	if (pl->whole)
 		vertex_wedges(g, pl, owner);
-	if (cand_at[best] >= 0) {
+	if (c.at[best] >= 0) {
 		pl->lambda[0] = pl->lambda[1] = pl->lambda[2] = 0.0;
-		pl->lambda[cand_at[best]] = 1.0;
+		pl->lambda[c.at[best]] = 1.0;
 	} else if (K == 3) {
 		barycentric(P[0], P[1], P[2], pl->pos, pl->lambda);
 	} else {
