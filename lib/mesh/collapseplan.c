@@ -704,9 +704,10 @@ int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *m
 	for (int kk = 0; kk < c.n; kk++) {
 		int k = order[kk], fam = hybrid && c.whole[k];
 		int late = late_geo && (bestf[0] >= 0 || (mm && (mm->known >> c.role[k] & 1u)));
-		/* A sum that stopped before (bgm_exact_bound's, or an earlier plan's)
-		 * at a partial sum the stop here does not exceed stops here too
-		 * (bgm_quadric_error_reach): not planned again. */
+		/* A sum that stopped before (bgm_exact_bound's, or an earlier
+		 * plan's) at a partial sum the stop here does not exceed
+		 * stops here too (bgm_quadric_error_reach): not planned
+		 * again. */
 		if (late_geo && mm && bestf[0] >= 0 && (mm->stopped >> c.role[k] & 1u) && !(mm->known >> c.role[k] & 1u) &&
 		    mm->ge[c.role[k]] >= plan_stop(g, pl, 0, bestf, costf, cap, tie, wsum))
 			continue;

@@ -523,8 +523,8 @@ double bgm_lower_key(mlod_bgm *g, int f, int op, int *weak)
 	}
 	double key = (wsum > 0.0 ? lb / wsum : 0.0) * margin + TIE_WEIGHT * tie;
 	if (!*weak) {
-		/* Along a border as the flags stand: bgm_plan_op()'s factor (bgm_exact_bound
-		 * takes it for the others). */
+		/* Along a border as the flags stand: bgm_plan_op()'s factor
+		 * (bgm_exact_bound takes it for the others). */
 		int nb = 0;
 		for (int j = 0; j < K; j++)
 			nb += (g->nodes[v[j]].flags & BGM_BORDER) != 0;
@@ -604,10 +604,10 @@ double bgm_exact_bound(mlod_bgm *g, int f, int op, bgm_memo *mm)
 			role[nc] = 5 + j;
 			memcpy(cand[nc++], P[j], sizeof cand[0]);
 		}
-	/* The least sum so far (the least stays the least divided by wsum):
-	 * a candidate's sum stops once it reaches it, its terms being
-	 * positive, and is then neither the least nor memoised (bgm_plan_op() sums
-	 * it when it needs it). */
+	/* The least sum so far (the least stays the least divided by wsum): a
+	 * candidate's sum stops once it reaches it, its terms being positive,
+	 * and is then neither the least nor memoised (bgm_plan_op() sums it
+	 * when it needs it). */
 	double best = HUGE_VAL, least = HUGE_VAL;
 	for (int k = 0; k < nc; k++) {
 		mlod_influences w;
@@ -627,8 +627,8 @@ double bgm_exact_bound(mlod_bgm *g, int f, int op, bgm_memo *mm)
 				bgm_sum_quadrics(g, &pv, Q), q_ready = 1;
 			e = bgm_quadric_error_reach(g, Q, &w, cand[k], least, &reached);
 			if (e == HUGE_VAL && least < HUGE_VAL) {
-				/* at least the least: the minimum stays; bgm_plan_op() may
-				 * skip it (plan_stop) */
+				/* at least the least: the minimum stays;
+				 * bgm_plan_op() may skip it (plan_stop) */
 				mm->ge[role[k]] = reached;
 				mm->stopped |= 1u << role[k];
 				continue;
@@ -636,8 +636,8 @@ double bgm_exact_bound(mlod_bgm *g, int f, int op, bgm_memo *mm)
 			mm->e[role[k]] = e;
 			mm->known |= 1u << role[k];
 		}
-		/* As bgm_plan_op(): a free end with the vertex's own influences costs
-		 * what the vertex kept whole costs. */
+		/* As bgm_plan_op(): a free end with the vertex's own
+		 * influences costs what the vertex kept whole costs. */
 		if (!vertex && role[k] >= 1 && role[k] <= 3 && g->opt.placement == MLOD_PLACE_HYBRID &&
 		    bgm_same_influences(&w, &in3[role[k] - 1])) {
 			mm->e[role[k] + 4] = e;
@@ -649,9 +649,10 @@ double bgm_exact_bound(mlod_bgm *g, int f, int op, bgm_memo *mm)
 	if (best == HUGE_VAL)
 		best = 0.0;
 	double tie = bgm_collapse_tie(g, f, op, K);
-	/* Along a border (two border vertices as the flags stand), bgm_plan_op()'s
-	 * cost is bgm_border_factor() times this: so is the bound, and such an
-	 * operation goes back at it without being planned first. */
+	/* Along a border (two border vertices as the flags stand),
+	 * bgm_plan_op()'s cost is bgm_border_factor() times this: so is the
+	 * bound, and such an operation goes back at it without being planned
+	 * first. */
 	int nb = 0;
 	for (int j = 0; j < K; j++)
 		nb += (g->nodes[pv.v[j]].flags & BGM_BORDER) != 0;

@@ -17,13 +17,12 @@
 
 #include "motion/motion_internal.h"
 
-/* motion_level_within for the clip c of line l (motion_clip_from_line), through the
- * segment memo: every channel of c is keyed at the line's frames (or
- * constant), so its pose at the samples from frame p up to the next frame
- * q of the line (the last sample too when q is the last frame) depends on
- * p and q alone. The bisection on the threshold tries lines that share
- * most of their segments. The memo holds one bound: motion_frames_level clears
- * it. */
+/* motion_level_within for the clip c of line l (motion_clip_from_line),
+ * through the segment memo: every channel of c is keyed at the line's frames
+ * (or constant), so its pose at the samples from frame p up to the next frame
+ * q of the line (the last sample too when q is the last frame) depends on p
+ * and q alone. The bisection on the threshold tries lines that share most of
+ * their segments. The memo holds one bound: motion_frames_level clears it. */
 static int line_within(mlod_motion *m, const motion_line *l, const mlod_clip *c, double bound)
 {
 	int usable = m->sub > 0 && c->duration >= m->common.channels[0].times[m->frames - 1] && l->n >= 2 &&

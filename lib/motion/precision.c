@@ -322,9 +322,9 @@ static int level_round(mlod_motion *m, mlod_clip *clip, double bound, double *gr
 	}
 	/* The coarsest grid from 2^(top - GRID_RANGE) to 2^top that fits,
 	 * from the top down one grid at a time: a grid that does not fit is
-	 * usually found so within a few samples (motion_level_within), one that fits
-	 * costs a whole walk, and this meets one (a bisection met about
-	 * three a level). */
+	 * usually found so within a few samples (motion_level_within), one
+	 * that fits costs a whole walk, and this meets one (a bisection met
+	 * about three a level). */
 	/* With the cache, the walk of the grid that fits stays in the
 	 * refinement's buffers, which it then starts from. */
 	refine_bufs rb;
