@@ -61,47 +61,16 @@ static int on_border(const mlod_bgm *g, int v)
 	return 0;
 }
 
-/* Applies a planned collapse; returns 0, or -1 when out of memory. */
-int bgm_apply(mlod_bgm *g, bgm_plan *pl)
+/* v-bar's wedges (v its node), cw[j] the one kept[j]'s corner takes.
+ * Snapped: one per wedge group, a copy of the snap vertex's wedge there;
+ * kept whole: a copy of each wedge of v[snap] taken. Free (no texture
+ * seam at a, b, c): the attributes interpolated inside t, except that
+ * corners of a vertex with hard normal edges keep their own normals (so
+ * faceted meshes stay faceted); equal results share a wedge. Returns 0,
+ * or -1 when out of memory. */
+static int vbar_wedges(mlod_bgm *g, const bgm_plan *pl, int v, int *cw)
 {
-	int rec = g->record_count, stamp = rec + 1;
-	if (bgm_grow((void **)&g->records, &g->record_cap, rec + 1, sizeof *g->records) ||
-	    bgm_grow((void **)&g->removed, &g->removed_cap, g->removed_len + pl->nf, sizeof *g->removed))
-		return -1;
-	int v = bgm_add_node(g);
-	if (v < 0)
-		return -1;
-	bgm_node *N = &g->nodes[v];
-	for (int i = 0; i < 3; i++)
-		N->p[i] = pl->pos[i];
-	g->inf[v] = pl->inf;
-	int fl = 0, K = pl->k;
-	for (int i = 0; i < K; i++)
-		fl |= g->nodes[pl->v[i]].flags & BGM_BORDER;
-	if (bgm_node_eligible(g, &pl->inf))
-		fl |= BGM_ELIGIBLE;
-	N->flags = fl;
-	if (g->lay.morph_stride > 0) {
-		float *m = g->morph + (size_t)v * (size_t)g->lay.morph_stride;
-		for (int k = 0; k < g->lay.morph_stride; k++) {
-			double x = 0.0;
-			for (int i = 0; i < K; i++)
-				x += pl->lambda[i] * g->morph[(size_t)pl->v[i] * (size_t)g->lay.morph_stride + (size_t)k];
-			m[k] = (float)x;
-		}
-	}
-	if (g->pose_count > 0) {
-		/* The parents' sums, each from 0 in their order (bgm_sum_quadrics). */
-		bgm_sum_quadrics(g, pl, g->quadric + (size_t)v * (size_t)g->qpose_count * 10);
-		bgm_quadric_rest_reset(g, v);
-	}
-
-	/* New wedges. Snapped: one per wedge group, a copy of the snap vertex's
-	 * wedge there. Free (no texture seam at a, b, c): the attributes
-	 * interpolated inside t, except that corners of a vertex with hard
-	 * normal edges keep their own normals (so faceted meshes stay
-	 * faceted); equal results share a wedge. */
-	int gw[MAX_WEDGES], cw[MAX_PATCH];
+	int gw[MAX_WEDGES], K = pl->k;
 	int S = g->lay.stride;
 	if (pl->whole) {
 		/* One new wedge per wedge of v[snap] taken, a copy of it. */
@@ -166,6 +135,48 @@ int bgm_apply(mlod_bgm *g, bgm_plan *pl)
 				}
 		}
 	}
+	return 0;
+}
+
+/* Applies a planned collapse; returns 0, or -1 when out of memory. */
+int bgm_apply(mlod_bgm *g, bgm_plan *pl)
+{
+	int rec = g->record_count, stamp = rec + 1;
+	if (bgm_grow((void **)&g->records, &g->record_cap, rec + 1, sizeof *g->records) ||
+	    bgm_grow((void **)&g->removed, &g->removed_cap, g->removed_len + pl->nf, sizeof *g->removed))
+		return -1;
+	int v = bgm_add_node(g);
+	if (v < 0)
+		return -1;
+	bgm_node *N = &g->nodes[v];
+	for (int i = 0; i < 3; i++)
+		N->p[i] = pl->pos[i];
+	g->inf[v] = pl->inf;
+	int fl = 0, K = pl->k;
+	for (int i = 0; i < K; i++)
+		fl |= g->nodes[pl->v[i]].flags & BGM_BORDER;
+	if (bgm_node_eligible(g, &pl->inf))
+		fl |= BGM_ELIGIBLE;
+	N->flags = fl;
+	if (g->lay.morph_stride > 0) {
+		float *m = g->morph + (size_t)v * (size_t)g->lay.morph_stride;
+		for (int k = 0; k < g->lay.morph_stride; k++) {
+			double x = 0.0;
+			for (int i = 0; i < K; i++)
+				x += pl->lambda[i] * g->morph[(size_t)pl->v[i] * (size_t)g->lay.morph_stride + (size_t)k];
+			m[k] = (float)x;
+		}
+	}
+	if (g->pose_count > 0) {
+		/* The parents' sums, each from 0 in their order (bgm_sum_quadrics). */
+		bgm_sum_quadrics(g, pl, g->quadric + (size_t)v * (size_t)g->qpose_count * 10);
+		bgm_quadric_rest_reset(g, v);
+	}
+
+	/* New wedges. */
+	int cw[MAX_PATCH];
+	if (vbar_wedges(g, pl, v, cw))
+		return -1;
 
 	/* Remove the patch. */
 	for (int j = 0; j < pl->nf; j++) {
