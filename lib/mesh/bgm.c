@@ -7,7 +7,7 @@
  * seam is not a border, and keeps each seam side's attributes as a
  * "wedge" (one per distinct glTF vertex of the node), so collapses
  * neither tear seams nor smear textures (the wedge rules are in
- * collapse.c). Vertices weld only when their influences and morph target
+ * collapseplan.c). Vertices weld only when their influences and morph target
  * offsets are equal too: welding vertices that deform differently would
  * tear the mesh when posed. Rigid meshes under a joint are skinned to it
  * with weight 1 (influence id 0); static meshes have no influences.
@@ -125,7 +125,7 @@ int bgm_add_node(mlod_bgm *g)
 	if (g->lay.morph_stride > 0)
 		memset(g->morph + (size_t)n * (size_t)g->lay.morph_stride, 0, sizeof(float) * (size_t)g->lay.morph_stride);
 	/* Its posed quadrics (once there are any) are the caller's to write:
-	 * the one caller after bgm_quadrics_build, collapse.c's apply(),
+	 * the one caller after bgm_quadrics_build, bgm_apply (collapseapply.c),
 	 * writes every entry and resets its pulled-back quadric. */
 	return n;
 }
@@ -343,16 +343,6 @@ static void raw_influences(const mlod_bgm *g, int v, mlod_influences *out)
 	out->count = last;
 }
 
-static int same_influences(const mlod_influences *a, const mlod_influences *b)
-{
-	if (a->count != b->count)
-		return 0;
-	for (int i = 0; i < a->count; i++)
-		if (a->joints[i] != b->joints[i] || a->weights[i] != b->weights[i])
-			return 0;
-	return 1;
-}
-
 /* ---------------------------------------------------------------- */
 /* Building                                                          */
 /* ---------------------------------------------------------------- */
@@ -536,7 +526,7 @@ static mlod_result build(mlod_bgm *g, const mlod_character *c, const mlod_instan
 		int node = -1;
 		while (table[slot] >= 0) {
 			int u = table[slot]; /* an input vertex that made a node */
-			if (memcmp(key + keylen * (size_t)u, k, sizeof(float) * keylen) == 0 && same_influences(&vinf[u], &vinf[v])) {
+			if (memcmp(key + keylen * (size_t)u, k, sizeof(float) * keylen) == 0 && bgm_same_influences(&vinf[u], &vinf[v])) {
 				node = vnode[u];
 				break;
 			}

@@ -1,7 +1,7 @@
 /*
  * bgm.h: the BindGraphMesh as the mesh layer's files share it (bgm.c
  * builds it, quadric.c gives its posed quadrics, collapse.c simplifies
- * it, bgmlevel.c turns prefixes into primitives). Internal: not installed,
+ * it with the files collapse.h names, bgmlevel.c turns prefixes into primitives). Internal: not installed,
  * not for tools.
  *
  * Storage is append-only, so that every prefix of the collapse sequence
@@ -117,11 +117,11 @@ struct mlod_bgm {
 	                         * qpose_count / 2 pairs, then for a last odd one a block
 	                         * with it in both lanes; NULL when there is one pose or for
 	                         * a mesh without influences */
-	double *qsum;           /* collapse.c's scratch: one plan's summed quadrics */
+	double *qsum;           /* the collapse's scratch: one plan's summed quadrics */
 	double pose0[12];       /* pose 0's skin matrix, every influence's (3x4, row-major) */
 	double pose0_cof[9];    /* its linear part's cofactors (row-major): n -> the posed n */
 	int pose0_mapped;       /* pose0 is not the identity (0 without quadrics) */
-	double skin_norm;       /* collapse.c: the largest Frobenius norm of a skin matrix's
+	double skin_norm;       /* lowerbound.c: the largest Frobenius norm of a skin matrix's
 	                         * linear part, 0 until worked out */
 
 	/* Statistics. */
@@ -131,12 +131,12 @@ struct mlod_bgm {
 	double build_seconds, collapse_seconds;
 
 	/* Collapse state (collapse.c): the queue of candidate collapses, a
-	 * binary heap of entries whose layout only collapse.c knows. */
+	 * 4-ary heap of entries whose layout only collapse.c knows. */
 	struct bgm_heap {
 		int ready;                 /* every live face was queued */
 		int count, cap;
 		struct bgm_heap_entry *e;  /* released with free() by mlod_bgm_free */
-		struct bgm_memo *memo;     /* queued operations' exact placement costs (collapse.c);
+		struct bgm_memo *memo;     /* queued operations' exact placement costs (collapse.h);
 		                            * released with free() by mlod_bgm_free */
 		int memo_count, memo_cap, memo_free;
 		int dead;                  /* entries of faces that died since (about: a purge trigger) */
@@ -149,17 +149,17 @@ struct mlod_bgm {
 	int swept;              /* collapse.c: record_count when every live face was last queued */
 	int border_phase;       /* collapse.c: border vertices may collapse (the compactness
 	                         * cost without opt.allow_border: once nothing else could) */
-	unsigned char *opstate; /* per face and op (collapse.c): refused when last looked at, queued */
+	unsigned char *opstate; /* per face and op (collapse.h): refused when last looked at, queued */
 	int opstate_cap;
-	double *ftie;           /* per face (collapse.c): its compactness tie-break term, NaN until
+	double *ftie;           /* per face (collapse.h): its compactness tie-break term, NaN until
 	                         * worked out (a face's nodes never change) */
-	double *fgeo;           /* per face (collapse.c): bgm_face_normal, its length (NaN until
+	double *fgeo;           /* per face (collapsecost.c): bgm_face_normal, its length (NaN until
 	                         * worked out) and bgm_compactness, 5 doubles */
-	double *fref;           /* per face (collapse.c): its reference normal and that normal's
+	double *fref;           /* per face (collapsecost.c): its reference normal and that normal's
 	                         * length (NaN until worked out), 4 doubles: an input face's own,
 	                         * a new face's that of the face it replaced */
 	int ftie_cap;           /* of ftie, fgeo and fref */
-	/* collapse.c: the weak queue keys' bounds by collapsed nodes (a pure
+	/* lowerbound.c: the weak queue keys' bounds by collapsed nodes (a pure
 	 * function of them: an edge or triangle whose faces died and came
 	 * back around a collapse is not worked out again); open addressing,
 	 * released with free() by mlod_bgm_free. */
@@ -187,8 +187,20 @@ int bgm_has_triangle(const mlod_primitive *p);
 int bgm_link_ok(const int *from, const int *to, int m, int path_ok);
 double bgm_compactness(const double *a, const double *b, const double *c);
 int bgm_node_eligible(const mlod_bgm *g, const mlod_influences *inf);
+/* Whether two influence lists are the same: the same joints with the
+ * same weights, in the same order (welding in bgm.c, the collapse's
+ * placements). */
+static inline int bgm_same_influences(const mlod_influences *x, const mlod_influences *y)
+{
+	if (x->count != y->count)
+		return 0;
+	for (int i = 0; i < x->count; i++)
+		if (x->joints[i] != y->joints[i] || x->weights[i] != y->weights[i])
+			return 0;
+	return 1;
+}
 
-/* The two-pose helpers of quadric.c and collapse.c: inlined where
+/* The two-pose helpers of quadric.c and the collapse files: inlined where
  * they are used (called from more than one place, gcc would otherwise
  * call them, their vectors passed through memory). */
 #if defined(__GNUC__)

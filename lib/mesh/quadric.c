@@ -158,7 +158,7 @@ static inline double eval(const double *q, const double *x)
 /* Two poses at a time (pair i: poses 2i and 2i + 1 in the low and high
  * lanes), each lane the same products and sums in the same order as the
  * one-pose functions above (SSE2 rounds as scalar code).
- * g->skin2 and the node quadrics (g->quadric, collapse.c's g->qsum) come
+ * g->skin2 and the node quadrics (g->quadric, the collapse's g->qsum) come
  * from malloc, so their pairs (24 and 20 doubles) are 16-byte aligned:
  * aligned loads, which the products take as memory operands. */
 _Static_assert(_Alignof(max_align_t) >= 16, "malloc's blocks must be 16-byte aligned for the two-pose loads");
@@ -430,7 +430,7 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	 * 1/100 of its units, and outweighed every other pose on a
 	 * gltfpack-quantised tubeman, 625 bind units to one of its own).
 	 * One matrix for all keeps pose 0's term
-	 * independent of the influences (lower_key's bound in collapse.c). */
+	 * independent of the influences (bgm_lower_key's bound in lowerbound.c). */
 	int dominant = -1;
 	if (g->skinned) {
 		double *sum = calloc((size_t)J, sizeof *sum);
@@ -575,7 +575,7 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	}
 	/* The stored poses' matrices as doubles, two side by side (the
 	 * two-pose paths of bgm_quadric_error, bgm_quadric_pullback and
-	 * collapse.c): block i holds stored poses 2i and 2i + 1, a last odd
+	 * lowerbound.c): block i holds stored poses 2i and 2i + 1, a last odd
 	 * one a block of its own, itself in both lanes. */
 	if (g->joint_count > 0 && P >= 2) {
 		size_t pairs = (size_t)D / 2, blocks = ((size_t)D + 1) / 2;

@@ -2,7 +2,7 @@
  * keyreduce.c: per-channel key reduction under a hierarchical error bound.
  *
  * Beyond the paper (whose motion layer, 4.3, removes whole frames; see
- * motion.c): each animated channel of each joint keeps only the keys it
+ * motiontree.c): each animated channel of each joint keeps only the keys it
  * needs, in the manner of ozz-animation's keyframe optimizer and of ACL's
  * "virtual vertex" error (Frechette, "Animation Compression Library").
  * The error of a joint at a frame is the point error (pointerror.c)
@@ -736,8 +736,8 @@ reduce:
 		r = mlod_fail(err, r, "out of memory");
 		goto done;
 	}
-	/* The largest point error of the result, as motion.c's
-	 * level_max_error measures the level clip of these keys: the same
+	/* The largest point error of the result, as levelerror.c's
+	 * motion_level_max_error measures the level clip of these keys: the same
 	 * sampling (the kept values are mlod_clip_sample's on
 	 * those keys) and kinematics, when no sample time is past the clip's
 	 * duration (mlod_clip_sample would clamp it). */

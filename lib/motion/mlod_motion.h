@@ -1,15 +1,20 @@
 /*
  * mlod_motion.h: the motion layer (paper 4.3): the common timeline
  * (timeline.c), the point error both methods answer to (pointerror.c), the
- * multiresolution motion tree and the levels (motion.c), per-channel key
- * reduction under a hierarchical error bound (keyreduce.c), morph
- * target weight tracks (morphweights.c), the levels of many clips on
- * threads (levels.c), and a character's levels as mlod-motion makes and
- * writes them (bake.c). Files call one way: bake.c calls levels.c and
- * morphweights.c, levels.c calls motion.c, which calls keyreduce.c; both
- * call pointerror.c and timeline.c. motion_eval.h
- * (internal) holds the inline fast forms of sampling, kinematics and the
- * point error check that motion.c and keyreduce.c measure with.
+ * motion object (motion.c) and its levels (nextlevel.c): the
+ * multiresolution motion tree (motiontree.c, the frames method of
+ * framesmethod.c) and per-channel key reduction under a hierarchical
+ * error bound (keyreduce.c, the keys method of keysmethod.c), their
+ * values rounded (precision.c), morph target weight tracks
+ * (morphweights.c), the levels of many clips on threads (levels.c), and
+ * a character's levels as mlod-motion makes and writes them (bake.c).
+ * Files call one way: bake.c calls levels.c and morphweights.c, levels.c
+ * calls motion.c and nextlevel.c, which calls the two methods;
+ * keysmethod.c calls keyreduce.c; all call pointerror.c and timeline.c.
+ * motion_internal.h (internal) maps the files of the levels;
+ * motion_eval.h (internal) holds the inline fast forms of sampling,
+ * kinematics and the point error check that they and keyreduce.c
+ * measure with.
  */
 #ifndef MLOD_MOTION_H
 #define MLOD_MOTION_H

@@ -620,7 +620,7 @@ static inline void keyreduce_state_free(keyreduce_state *st)
 /* mlod_keyreduce, with the clip as read at the samples given (w0, samples
  * * joints world matrices as mlod_pose_world makes them; NULL: computed),
  * and *max_error (if not NULL) the largest point error of the result as
- * motion.c's level_max_error measures its level clip, or -1 when not
+ * levelerror.c's motion_level_max_error measures its level clip, or -1 when not
  * measured (a NaN, or samples past the clip's duration); its large arrays
  * in *scratch (NULL: its own, freed on return), but for the current
  * local transforms and matrices, which go to *state when it is given

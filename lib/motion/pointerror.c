@@ -1,6 +1,6 @@
 /*
  * pointerror.c: the point error, the bound both motion methods answer to
- * (the frames method of motion.c and the key reduction of keyreduce.c):
+ * (the frames method of framesmethod.c and the key reduction of keyreduce.c):
  *
  *     |o' - o| + r * sigma_max(A' - A)
  *

@@ -5,7 +5,7 @@
  * mlod_clip_key_times, with CUBICSPLINE intervals subdivided to at least
  * cubic_rate frames per second), the sample times between frames where
  * bounds are checked, and the keys and bytes a clip stores. motion.c,
- * keyreduce.c and morphweights.c build on it.
+ * the methods, keyreduce.c and morphweights.c build on it.
  */
 #include <math.h>
 #include <stdlib.h>
