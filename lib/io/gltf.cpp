@@ -2450,8 +2450,10 @@ int add_animation(Model &m, const mlod_clip &clip, const std::vector<int> &nodes
 		 * single precision (its squared length within 1e-6 of 1, as
 		 * mlod_quat_normalize's are) is written as given: normalising it
 		 * again moves some keys by a last bit, and not to a fixed point
-		 * (0.2% of the walk's keys cycle), so a BVH read directly and the
-		 * glb a stage makes of it would differ (cli/pack_bvh_stages). */
+		 * (31 of the walk's 16,244 keys cycle), so the keys read back
+		 * would depend on how many times they were written (a BVH read
+		 * directly against the glb a stage makes of it:
+		 * cli/pack_bvh_stages; the BVH reader normalises once more). */
 		if (ch.path == MLOD_PATH_ROTATION) {
 			size_t first = ch.interp == MLOD_INTERP_CUBICSPLINE ? 4 : 0;
 			for (size_t k = 0; k < keys; k++) {

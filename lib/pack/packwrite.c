@@ -651,6 +651,7 @@ struct clip_levels {
 	 * 0: none (the clip as read, a pack's levels, an input's without). */
 	double bound0, bound[MLOD_PACK_MAX_MOTION_LEVELS];
 	mlod_motion_level remade[MLOD_PACK_MAX_MOTION_LEVELS + 1]; /* 0 first: the levels made again */
+	int chain_remade;          /* levels 1 to count are remade[1] to remade[count] */
 	/* rotq_shifts' last answer (the shifts follow the clip and emin only) */
 	int *shift, *tgrid, has_shift;
 	double shift_emin;
@@ -3709,9 +3710,10 @@ static mlod_result levels_remake(struct ctx *x, int q, int A, int chains, double
 		cl->level0 = l0 ? &cl->remade[0].clip : &c->clips[q];
 		cl->error0 = l0 ? (float)cl->remade[0].error.max : 0.0f;
 	}
-	for (int k = 0; k < A - 1; k++) {
+	cl->chain_remade |= (chains & 2) != 0;
+	for (int k = 0; k < A - 1; k++) { /* repeats point at the finer level again (it may be new) */
 		const mlod_motion_level *l = &cl->remade[k + 1];
-		if (k < cl->count && !(chains & 2)) {
+		if (k < cl->count && !cl->chain_remade) {
 			continue;
 		} else if (k < cl->count && l->clip.channels) {
 			cl->clip[k] = &l->clip;

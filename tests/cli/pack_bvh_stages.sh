@@ -6,11 +6,13 @@
 # and skeleton levels fold and measure the clip at its frames. The glb was
 # taken as glTF: 34,441 bytes after mlod-label against 37,606 alone.
 # The same at any motion level-0 bound: the glb holds the rotation keys
-# as the BVH read gives them (a glb write normalises only keys not unit
-# to single precision). It normalised every key again, moving 84 of the
-# walk's 16,244 by a last bit, and the packs differed at level-0 bounds
-# other than the default (0.0100097656, 0.0105 and 0.009 scene units)
-# and with --lossless-motion (RESULTS Run 85).
+# as the BVH read gives them (the BVH reader normalises each key once
+# more, as a glb write did; a glb write normalises only keys not unit to
+# single precision). The glb held every key normalised once more than
+# the BVH read, 84 of the walk's 16,244 a last bit apart, and the packs
+# differed at level-0 bounds other than the default (0.0100097656,
+# 0.0105 and 0.009 scene units) and with --lossless-motion (RESULTS
+# Run 85).
 set -e
 W="$ROOT/samples/cmu_12_01_walk.bvh"
 "$BIN/mlod-pack" -o direct.mlod < "$W"
