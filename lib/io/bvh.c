@@ -860,7 +860,15 @@ static mlod_result read_motion(reader *r, mlod_character *c)
 			if (anim[j].tv)
 				memcpy(anim[j].tv + 3 * f, pos, sizeof pos);
 			if (anim[j].rv) {
-				mlod_quat q = mlod_quat_from_euler(jt->euler, ang);
+				/* Normalised once more, as a glb write normalised every
+				 * rotation key until it kept those unit to single
+				 * precision as given (mlod_gltf_from_character): the glb
+				 * a stage makes of the BVH holds these very keys, so the
+				 * two reads give the same pack at any motion bound
+				 * (cli/pack_bvh_stages; 84 of the walk's 16,244 keys
+				 * moved by a last bit), and that glb, tubeman.glb
+				 * included, is what it was. */
+				mlod_quat q = mlod_quat_normalize(mlod_quat_from_euler(jt->euler, ang));
 				if (f > 0) {
 					const float *p = anim[j].rv + 4 * (f - 1);
 					if (p[0] * q.x + p[1] * q.y + p[2] * q.z + p[3] * q.w < 0.0f) {

@@ -2446,10 +2446,21 @@ int add_animation(Model &m, const mlod_clip &clip, const std::vector<int> &nodes
 		for (size_t k = 1; k < keys; k++)
 			if (!(times[k] > times[k - 1]))
 				fail(MLOD_ERR_INVALID_ARG, "clip \"%s\" channel %d: key times do not increase", out.name.c_str(), i);
-		if (ch.path == MLOD_PATH_ROTATION) { /* unit quaternions; cubic tangents stay as they are */
+		/* Unit quaternions; cubic tangents stay as they are. A key unit to
+		 * single precision (its squared length within 1e-6 of 1, as
+		 * mlod_quat_normalize's are) is written as given: normalising it
+		 * again moves some keys by a last bit, and not to a fixed point
+		 * (31 of the walk's 16,244 keys cycle), so the keys read back
+		 * would depend on how many times they were written (a BVH read
+		 * directly against the glb a stage makes of it:
+		 * cli/pack_bvh_stages; the BVH reader normalises once more). */
+		if (ch.path == MLOD_PATH_ROTATION) {
 			size_t first = ch.interp == MLOD_INTERP_CUBICSPLINE ? 4 : 0;
 			for (size_t k = 0; k < keys; k++) {
 				float *q = &values[k * per_key + first];
+				double n2 = double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3];
+				if (std::fabs(n2 - 1.0) <= 1e-6)
+					continue;
 				mlod_quat n = mlod_quat_normalize(mlod_quat{q[0], q[1], q[2], q[3]});
 				q[0] = n.x, q[1] = n.y, q[2] = n.z, q[3] = n.w;
 			}

@@ -1139,20 +1139,31 @@ TEST(motion_level0_bound)
 	              *q = find_entry(out[2], MLOD_CHUNK_MOTION, 0);
 	CHECK(a && b && q);
 	if (a && b && q) {
-		/* the TOC errors as read back (RESULTS Run 85): the walk's level 0
-		 * 0.0122 against its bound 0.0112 */
-		CHECK(entry_error(a) > 0 && entry_error(a) <= 1.2 * e0 && entry_error(b) == 0);
-		CHECK(entry_error(q) > 0 && entry_error(q) < entry_error(a));
+		/* the TOC errors as read back within the bound (RESULTS Run 15):
+		 * before, the walk's level 0 stated 0.0122 against its bound
+		 * 0.0112; at a quarter of the bound level 0 is the clip as read
+		 * (the reduced level, made again until it held, stored more) */
+		CHECK_MSG(entry_error(a) > 0 && entry_error(a) <= e0, "level 0: TOC error %g, bound %g",
+		          (double)entry_error(a), e0);
+		CHECK(entry_error(b) == 0);
+		CHECK(entry_error(q) >= 0 && entry_error(q) <= e0 / 4 && entry_error(q) < entry_error(a));
 		CHECK(st[0].motion.errors[0] == entry_error(a));
 		CHECK(rd32(a + 28) < rd32(b + 28) && rd32(a + 28) < rd32(q + 28));
 	}
 	CHECK(st[0].motion.levels == 4 && st[1].motion.levels == 4);
-	for (int k = 1; k < 4; k++) {
-		const uint8_t *x = find_entry(out[0], MLOD_CHUNK_MOTION, k), *y = find_entry(out[1], MLOD_CHUNK_MOTION, k);
-		/* the same keys; the TOC errors as read back, on lattices that
-		 * differ (a level 0 of error 0 keeps the finest) */
-		CHECK(x && y && rd32(x + 28) == rd32(y + 28) && entry_error(x) > 0 && entry_error(y) > 0);
-	}
+	static const double bounds[3] = {MLOD_PACK_MOTION_BOUNDS_DEFAULT};
+	for (int k = 1; k < 4; k++)
+		for (int v = 0; v < 3; v++) {
+			/* every coarser level within its bound as read back (before:
+			 * the walk's 0.2023%, 1.006% and 3.009% of the height against
+			 * 0.2%, 1% and 3%), whatever level 0 gets */
+			const uint8_t *x = find_entry(out[v], MLOD_CHUNK_MOTION, k);
+			double bk = bounds[k - 1] * st[v].height / 100.0;
+			CHECK(x);
+			if (x)
+				CHECK_MSG(entry_error(x) > 0 && entry_error(x) <= bk, "pack %d level %d: TOC error %g, bound %g", v,
+				          k, (double)entry_error(x), bk);
+		}
 	for (int v = 0; v < 3; v++)
 		mlod_free(out[v]);
 	mlod_character_free(&c);
