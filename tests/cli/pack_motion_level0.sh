@@ -7,7 +7,7 @@
 # own, stores more than the clip as read, which it then keeps: error 0,
 # the lossless bytes); every coarser level within its bound (0.2%, 1%
 # and 3%) as read back whatever level 0 gets, the walk's and CMU 01_01's
-# (before RESULTS Run 15: the walk's level 0 at 1.09 times its bound,
+# (before RESULTS Run 89: the walk's level 0 at 1.09 times its bound,
 # its levels 1 to 3 at 0.2023%, 1.006% and 3.009%, 01_01's at 0.0550%,
 # 0.2045%, 1.0019% and 3.0097%); --report=json's level0_error is the
 # TOC's; piped (mlod-motion --precision full) and direct packs agree with

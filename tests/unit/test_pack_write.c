@@ -1139,7 +1139,7 @@ TEST(motion_level0_bound)
 	              *q = find_entry(out[2], MLOD_CHUNK_MOTION, 0);
 	CHECK(a && b && q);
 	if (a && b && q) {
-		/* the TOC errors as read back within the bound (RESULTS Run 15):
+		/* the TOC errors as read back within the bound (RESULTS Run 89):
 		 * before, the walk's level 0 stated 0.0122 against its bound
 		 * 0.0112; at a quarter of the bound level 0 is the clip as read
 		 * (the reduced level, made again until it held, stored more) */
