@@ -809,6 +809,27 @@ static int rigid_unit(const float *M, float *U)
 	return 1;
 }
 
+/* The matrix of a rigid or static part (p->rec.skin < 0): its joint's
+ * world matrix in W (through the stand-in's and the rest transform from
+ * it when the skeleton level su removed the joint) times its offset; a
+ * static part's offset alone. mlod_rt_skin and mlod_rt_bounds both take
+ * it from here, so a bound holds the floats the skin writes. */
+static void rigid_matrix(const rt_unit *su, const float *W, const mlod_pack_part *p, float *M)
+{
+	if (p->rec.joint < 0) {
+		memcpy(M, p->rec.offset, 16 * sizeof(float));
+		return;
+	}
+	const uint32_t j = (uint32_t)p->rec.joint;
+	if (su && su->plan.stand[j] != (int32_t)j) {
+		float t[16];
+		rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
+		rt_mat_mul(t, p->rec.offset, M);
+	} else {
+		rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
+	}
+}
+
 /* The palette entries the mesh level mu reads, W[joint] times the bind
  * matrix; built for AVX2 too where the pose is (the same floats). */
 #if defined(RT_EVAL_CLONES)
@@ -890,18 +911,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		 * levels have 15 rigid parts on 12 joints). */
 		if (!skinned && !(m_ok && p->rec.joint == m_joint &&
 		                  (m_off == p->rec.offset || memcmp(m_off, p->rec.offset, sizeof M) == 0))) {
-			if (p->rec.joint >= 0) {
-				const uint32_t j = (uint32_t)p->rec.joint;
-				if (su && su->plan.stand[j] != (int32_t)j) {
-					float t[16];
-					rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
-					rt_mat_mul(t, p->rec.offset, M);
-				} else {
-					rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
-				}
-			} else {
-				memcpy(M, p->rec.offset, sizeof M);
-			}
+			rigid_matrix(su, W, p, M);
 			m_ok = 1, m_joint = p->rec.joint, m_off = p->rec.offset, m_unit = -1;
 		}
 		/* Rigid and static parts with unit normals: skip renormalising
@@ -1079,18 +1089,7 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 		if (p->rec.skin >= 0 || !(c[6] >= 0.0f))
 			continue;
 		float M[16];
-		if (p->rec.joint >= 0) {
-			const uint32_t j = (uint32_t)p->rec.joint;
-			if (su && su->plan.stand[j] != (int32_t)j) {
-				float t[16];
-				rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
-				rt_mat_mul(t, p->rec.offset, M);
-			} else {
-				rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
-			}
-		} else {
-			memcpy(M, p->rec.offset, sizeof M);
-		}
+		rigid_matrix(su, W, p, M);
 		const double cc[3] = { c[0], c[1], c[2] }, hh[3] = { c[3] + grow, c[4] + grow, c[5] + grow };
 		double x[3], ex[3], mg[3];
 		box_image(M, cc, hh, c[6] + grow, x, ex, mg);
