@@ -852,6 +852,40 @@ static void palette_entries(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const rt
 	}
 }
 
+/* What mlod_rt_skin and mlod_rt_bounds share, for a live instance id:
+ * poses only what its mesh level reads (the joints its palette entries
+ * and rigid parts follow, with their ancestors) into s->world, makes
+ * those palette entries in s->palette, and stamps the scratch as posed
+ * for id (so mlod_rt_palette then poses in full). *su and *mu: the
+ * skeleton and mesh levels shown. Without a mesh, nothing is posed and
+ * *mu is NULL. MLOD_ERR_INVALID_ARG when the mesh level shown is not
+ * resident, MLOD_ERR_LIMIT when it has more vertices than capacity. */
+static mlod_result pose_mesh_level(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, uint32_t capacity,
+                                   const rt_unit **su, const rt_unit **mu, mlod_error *err)
+{
+	const mlod_rt_state *st = &ctx->inst[id].st;
+	*su = skel_unit(ctx, st);
+	*mu = NULL;
+	if (ctx->levels[MLOD_RT_MESH] > 0) {
+		const rt_unit *m = rt_unit_get(ctx, MLOD_RT_MESH, st->level[MLOD_RT_MESH], 0);
+		if (!m || m->state != RT_UNIT_RESIDENT)
+			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u shows no resident mesh level", id);
+		if (m->vertex_count > capacity)
+			return mlod_fail(err, MLOD_ERR_LIMIT, "mesh level %u has %u vertices, the buffers hold %u", m->level,
+			                 m->vertex_count, capacity);
+		skin_plan(ctx, s, *su, m);
+		pose_joints(ctx, s, st, s->plan_posed, s->plan_count, s->plan_need);
+		*mu = m;
+	}
+	s->skel_unit = *su;
+	s->id = id;
+	s->posed = 2;
+	s->paletted = 0;
+	if (*mu)
+		palette_entries(ctx, s, *su, *mu, s->world, s->palette);
+	return MLOD_OK;
+}
+
 mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float *positions,
                          size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
                          uint32_t *vertex_count, mlod_error *err)
@@ -866,33 +900,11 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: strides must be multiples of 4, at least 12");
 	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
-	const mlod_rt_state *st = &ctx->inst[id].st;
-	if (ctx->levels[MLOD_RT_MESH] == 0) {
-		/* No mesh: nothing to write, no joint to pose; mlod_rt_palette
-		 * then poses the instance in full, as after any skin. */
-		s->skel_unit = skel_unit(ctx, st);
-		s->id = id;
-		s->posed = 2;
-		s->paletted = 0;
-		return MLOD_OK;
-	}
-	const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MESH, st->level[MLOD_RT_MESH], 0);
-	if (!mu || mu->state != RT_UNIT_RESIDENT)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u shows no resident mesh level", id);
-	if (mu->vertex_count > capacity)
-		return mlod_fail(err, MLOD_ERR_LIMIT, "mesh level %u has %u vertices, the buffers hold %u", mu->level,
-		                 mu->vertex_count, capacity);
-	/* Only what the mesh level reads: the joints its palette entries and
-	 * rigid parts follow (with their ancestors), and those entries. */
-	const rt_unit *su = skel_unit(ctx, st);
-	skin_plan(ctx, s, su, mu);
-	pose_joints(ctx, s, st, s->plan_posed, s->plan_count, s->plan_need);
-	s->skel_unit = su;
-	s->id = id;
-	s->posed = 2;
-	s->paletted = 0;
+	const rt_unit *su, *mu;
+	mlod_result r = pose_mesh_level(ctx, s, id, capacity, &su, &mu, err);
+	if (r != MLOD_OK || !mu)
+		return r;
 	const float *W = s->world;
-	palette_entries(ctx, s, su, mu, W, s->palette);
 	size_t base = 0;
 	float morphed[3 * RT_MORPH_RUN];
 	float M[16], U[12];
@@ -1004,27 +1016,13 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_bounds: the scratch was made for another context");
 	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
-	const mlod_rt_state *st = &ctx->inst[id].st;
-	const rt_unit *su = skel_unit(ctx, st);
-	if (ctx->levels[MLOD_RT_MESH] == 0) { /* nothing drawn: the empty box; the scratch as after mlod_rt_skin */
-		s->skel_unit = su;
-		s->id = id;
-		s->posed = 2;
-		s->paletted = 0;
-		return MLOD_OK;
-	}
-	const rt_unit *mu = rt_unit_get(ctx, MLOD_RT_MESH, st->level[MLOD_RT_MESH], 0);
-	if (!mu || mu->state != RT_UNIT_RESIDENT)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u shows no resident mesh level", id);
-	/* The pose and the palette entries mlod_rt_skin makes (the same floats). */
-	skin_plan(ctx, s, su, mu);
-	pose_joints(ctx, s, st, s->plan_posed, s->plan_count, s->plan_need);
-	s->skel_unit = su;
-	s->id = id;
-	s->posed = 2;
-	s->paletted = 0;
+	/* The pose and the palette entries mlod_rt_skin makes (the same
+	 * floats); without a mesh, the empty box. */
+	const rt_unit *su, *mu;
+	mlod_result r = pose_mesh_level(ctx, s, id, UINT32_MAX, &su, &mu, err);
+	if (r != MLOD_OK || !mu)
+		return r;
 	const float *W = s->world;
-	palette_entries(ctx, s, su, mu, W, s->palette);
 	/* Morph weights move a part's positions by at most sum |w_t| times
 	 * target t's longest delta: the largest such sum over the parts widens
 	 * every ball. */
