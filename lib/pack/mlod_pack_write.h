@@ -68,6 +68,12 @@ extern "C" {
  * the finest default level's, below gltfpack -cc's own error on every
  * sample clip (bench_motion pointerr; mlod-pack(1)). */
 #define MLOD_PACK_MOTION_LEVEL0_DEFAULT 0.05
+/* The rounds in which mlod_pack_write makes a clip's levels again while
+ * one measures above its bound as the reader returns its keys (each round
+ * that level's bound less 1.05 times the excess, twice that each round, at
+ * least a quarter of the bound before); after them a level 0 still above
+ * its bound is the clip as read (mlod-pack(1)). */
+#define MLOD_PACK_HOLD_ROUNDS 8
 
 /* Zero-initialised options are not the defaults: start from
  * mlod_pack_options_default. */

@@ -129,13 +129,29 @@ static mlod_result motion_shifts_pick(struct ctx *x, int A, int q, double *toc)
 	return MLOD_OK;
 }
 
+/* A level above its bound (0: none), its TOC error toc. */
+static int above(double bound, double toc)
+{
+	return bound > 0.0 && toc > bound;
+}
+
+/* A level's bound in the round after round `round` (motion_hold): its
+ * bound in this one, used, less 1.05 times its TOC error's excess over
+ * bound, twice that each round, and at least a quarter of used. */
+static double tighter_bound(double used, double bound, double toc, int round)
+{
+	double next = used - ldexp(1.05, round) * (toc - bound);
+	return next > 0.25 * used ? next : 0.25 * used;
+}
+
 /* Every level of clip q with a bound (clip_levels.bound0 and bound)
  * holds it as the reader returns its keys (its TOC error): while one
  * measures above its bound, the levels are made again (levels_remake),
  * that level's within its bound less 1.05 times the excess (twice that
  * each round, at least a quarter of the bound before), and the shifts
- * chosen again (they follow the smallest TOC error). After 8 rounds a
- * level 0 still above its bound is the clip as read (TOC error 0). */
+ * chosen again (they follow the smallest TOC error). After
+ * MLOD_PACK_HOLD_ROUNDS rounds a level 0 still above its bound is the clip
+ * as read (TOC error 0). */
 static mlod_result motion_hold(struct ctx *x, int A, int q)
 {
 	struct clip_levels *cl = &x->clips[q];
@@ -145,28 +161,22 @@ static mlod_result motion_hold(struct ctx *x, int A, int q)
 		b[k] = cl->bound[k], hold |= k < cl->count && b[k] > 0.0;
 	mlod_result r = motion_shifts_pick(x, A, q, hold ? toc : NULL);
 	for (int round = 0; r == MLOD_OK && hold; round++) {
-		int over = cl->bound0 > 0.0 && toc[0] > cl->bound0;
+		int over = above(cl->bound0, toc[0]);
 		for (int k = 0; k < cl->count && k < A - 1; k++)
-			over |= cl->bound[k] > 0.0 && toc[k + 1] > cl->bound[k];
+			over |= above(cl->bound[k], toc[k + 1]);
 		if (!over)
 			break;
 		int chains = 0;
-		if (round == 8) {
-			if (!(cl->bound0 > 0.0 && toc[0] > cl->bound0))
+		if (round == MLOD_PACK_HOLD_ROUNDS) {
+			if (!above(cl->bound0, toc[0]))
 				break;
 			b0 = 0.0, hold = 0, chains = 1;
 		} else {
-			if (cl->bound0 > 0.0 && toc[0] > cl->bound0) {
-				double next = b0 - ldexp(1.05, round) * (toc[0] - cl->bound0);
-				b0 = next > 0.25 * b0 ? next : 0.25 * b0;
-				chains |= 1;
-			}
+			if (above(cl->bound0, toc[0]))
+				b0 = tighter_bound(b0, cl->bound0, toc[0], round), chains |= 1;
 			for (int k = 0; k < cl->count && k < A - 1; k++)
-				if (cl->bound[k] > 0.0 && toc[k + 1] > cl->bound[k]) {
-					double next = b[k] - ldexp(1.05, round) * (toc[k + 1] - cl->bound[k]);
-					b[k] = next > 0.25 * b[k] ? next : 0.25 * b[k];
-					chains |= 2;
-				}
+				if (above(cl->bound[k], toc[k + 1]))
+					b[k] = tighter_bound(b[k], cl->bound[k], toc[k + 1], round), chains |= 2;
 		}
 		if ((r = levels_remake(x, q, A, chains, b0, b)) == MLOD_OK)
 			r = motion_shifts_pick(x, A, q, hold ? toc : NULL);
