@@ -488,80 +488,26 @@ int tool_parse_threads(const char *value)
 	return tool_parse_int("--threads", value, 1, MLOD_MAX_THREADS);
 }
 
-/* The one escaper of a name from the input or the pack (the
- * character's, a clip's, a joint's, the input's, a note naming a joint or
- * mesh): as a JSON string (quote, backslash and control characters escaped, a
- * byte that is not UTF-8 as U+FFFD), or for the tables with C escapes
- * (\n, \t, \r, \\, \xHH for any other control character, DEL and a
- * byte that is not UTF-8), padded to width columns (0: none) counting
- * each UTF-8 character as one, so that a name never breaks a line or a
- * column. With f NULL it writes nothing; it returns the table form's
- * columns. */
-static int put_name(FILE *f, const char *name, int json, int width)
-{
-	const unsigned char *p = (const unsigned char *)(name ? name : "");
-	int columns = 0;
-	if (json && f)
-		fputc('"', f);
-	while (*p) {
-		char esc[8];
-		const char *out = esc;
-		int n = mlod_utf8_length((const char *)p), cols;
-		unsigned c = *p;
-		size_t len;
-		if (n > 1) { /* a character, one column */
-			out = (const char *)p;
-			len = (size_t)n;
-			cols = 1;
-			p += n;
-		} else {
-			p++;
-			if (n == 0 && json)
-				snprintf(esc, sizeof esc, "\\ufffd");
-			else if (c == '\\' || (json && c == '"'))
-				snprintf(esc, sizeof esc, "\\%c", (int)c);
-			else if (c == '\n' || c == '\t' || c == '\r')
-				snprintf(esc, sizeof esc, "\\%c", c == '\n' ? 'n' : c == '\t' ? 't' : 'r');
-			else if (json && c < 0x20)
-				snprintf(esc, sizeof esc, "\\u%04x", c);
-			else if (!json && (n == 0 || c < 0x20 || c == 0x7f))
-				snprintf(esc, sizeof esc, "\\x%02x", c);
-			else
-				esc[0] = (char)c, esc[1] = '\0';
-			len = strlen(esc);
-			cols = (int)len;
-		}
-		if (f)
-			fwrite(out, 1, len, f);
-		columns += cols;
-	}
-	if (json && f)
-		fputc('"', f);
-	for (; f && columns < width; columns++)
-		fputc(' ', f);
-	return columns;
-}
-
 void tool_json_string(FILE *f, const char *s)
 {
-	put_name(f, s, 1, 0);
+	mlod_name_put(f, s, 1, 0);
 }
 
 void tool_put_name(FILE *f, const char *s, int width)
 {
-	put_name(f, s, 0, width);
+	mlod_name_put(f, s, 0, width);
 }
 
 void tool_put_line(FILE *f, const char *prefix, const char *s)
 {
 	fputs(prefix, f);
-	put_name(f, s, 0, 0);
+	mlod_name_put(f, s, 0, 0);
 	fputc('\n', f);
 }
 
 int tool_name_width(const char *s)
 {
-	return put_name(NULL, s, 0, 0);
+	return mlod_name_put(NULL, s, 0, 0);
 }
 
 void tool_version(void)

@@ -20,6 +20,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -89,6 +90,18 @@ const char *mlod_name_text(const char *name, int quote, char *buf, size_t size);
  * enclosing block (C only: a compound literal), for a message:
  * mlod_fail(err, code, "clip %s: ...", MLOD_QUOTED(clip->name)). */
 #define MLOD_QUOTED(name) mlod_name_text((name), 1, (char[MLOD_NAME_TEXT_SIZE]){0}, MLOD_NAME_TEXT_SIZE)
+
+/* The one escaper of a name from the input or the pack (the character's,
+ * a clip's, a joint's, the input's, a note naming a joint or mesh) written
+ * to f whole, for the tools' output and mlod_pack_print_info's: with json,
+ * as a JSON string (in double quotes; quote, backslash and control
+ * characters escaped, a byte that is not UTF-8 as \ufffd); else for a
+ * table with C escapes (\n, \t, \r, \\, \xHH for any other control
+ * character, DEL and a byte that is not UTF-8), padded to width columns
+ * (0: none) counting each UTF-8 character as one, so that a name never
+ * breaks a line or a column. With f NULL it writes nothing. Returns the
+ * table form's columns (unpadded). */
+int mlod_name_put(FILE *f, const char *name, int json, int width);
 
 /* ------------------------------------------------------------------ */
 /* Threads                                                             */

@@ -88,3 +88,49 @@ const char *mlod_name_text(const char *name, int quote, char *buf, size_t size)
 	buf[n] = '\0';
 	return buf;
 }
+
+/* The tools' tables and JSON and lib/pack's --info text (mlod_core.h). */
+int mlod_name_put(FILE *f, const char *name, int json, int width)
+{
+	const unsigned char *p = (const unsigned char *)(name ? name : "");
+	int columns = 0;
+	if (json && f)
+		fputc('"', f);
+	while (*p) {
+		char esc[8];
+		const char *out = esc;
+		int n = mlod_utf8_length((const char *)p), cols;
+		unsigned c = *p;
+		size_t len;
+		if (n > 1) { /* a character, one column */
+			out = (const char *)p;
+			len = (size_t)n;
+			cols = 1;
+			p += n;
+		} else {
+			p++;
+			if (n == 0 && json)
+				snprintf(esc, sizeof esc, "\\ufffd");
+			else if (c == '\\' || (json && c == '"'))
+				snprintf(esc, sizeof esc, "\\%c", (int)c);
+			else if (c == '\n' || c == '\t' || c == '\r')
+				snprintf(esc, sizeof esc, "\\%c", c == '\n' ? 'n' : c == '\t' ? 't' : 'r');
+			else if (json && c < 0x20)
+				snprintf(esc, sizeof esc, "\\u%04x", c);
+			else if (!json && (n == 0 || c < 0x20 || c == 0x7f))
+				snprintf(esc, sizeof esc, "\\x%02x", c);
+			else
+				esc[0] = (char)c, esc[1] = '\0';
+			len = strlen(esc);
+			cols = (int)len;
+		}
+		if (f)
+			fwrite(out, 1, len, f);
+		columns += cols;
+	}
+	if (json && f)
+		fputc('"', f);
+	for (; f && columns < width; columns++)
+		fputc(' ', f);
+	return columns;
+}

@@ -51,6 +51,8 @@
 #ifndef MLOD_PACK_WRITE_H
 #define MLOD_PACK_WRITE_H
 
+#include <stdio.h>
+
 #include "rt/mlod_pack.h"
 #include "io/mlod_io.h"
 #include "mesh/mlod_mesh.h"
@@ -360,6 +362,26 @@ const char *mlod_pack_codec_label(const mlod_pack_chunk *c, char *buf, size_t n)
  * for another name. */
 int mlod_pack_codec_parse(const char *name, mlod_pack_options *opt);
 int mlod_pack_entropy_parse(const char *name, mlod_pack_options *opt);
+
+/* The text forms of mlod-pack's --info and --report (packinfo.c): the
+ * table, or JSON laid out one member a line (mlod-pack(1)). Names are
+ * escaped by mlod_name_put. Both write to f, which the caller flushes and
+ * checks. */
+typedef enum mlod_pack_text { MLOD_PACK_TEXT_TABLE, MLOD_PACK_TEXT_JSON } mlod_pack_text;
+
+/* --info: the pack data (size bytes), opened and checked as
+ * mlod_pack_inspect does, its header, INFO and every chunk's TOC entry,
+ * and the layers' totals; as JSON also its rest bounds and every joint's
+ * name and parent (SKELETON decoded). label names the pack in the output.
+ * Errors: mlod_pack_inspect's (nothing written), the SKELETON chunk's
+ * (MLOD_ERR_PARSE, the JSON written up to the skeleton). */
+mlod_result mlod_pack_print_info(FILE *f, const char *label, const void *data, size_t size, mlod_pack_text form,
+                                 mlod_error *err);
+
+/* --report: what mlod_pack_write packed (st) of input, with codec the
+ * codec's name as the report gives it ("meshopt+zstd"). */
+void mlod_pack_print_stats(FILE *f, const char *input, const mlod_pack_stats *st, const char *codec,
+                           mlod_pack_text form);
 
 #ifdef __cplusplus
 }
