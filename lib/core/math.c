@@ -472,6 +472,23 @@ mlod_v3 mlod_mat4_vector(const mlod_mat4 *m, mlod_v3 v)
 	return r;
 }
 
+/* Gershgorin on M^T M (mlod_core.h). */
+double mlod_mat4_sigma_bound(const mlod_mat4 *w)
+{
+	double g = 0.0;
+	for (int a = 0; a < 3; a++) {
+		double row = 0.0;
+		for (int b = 0; b < 3; b++) {
+			double d = 0.0;
+			for (int r = 0; r < 3; r++)
+				d += (double)w->m[4 * a + r] * w->m[4 * b + r];
+			row += fabs(d);
+		}
+		g = row > g ? row : g;
+	}
+	return sqrt(g);
+}
+
 mlod_trs mlod_trs_identity(void)
 {
 	mlod_trs t = { { 0, 0, 0 }, { 0, 0, 0, 1 }, { 1, 1, 1 } };

@@ -203,6 +203,10 @@ int mlod_mat4_to_trs(const mlod_mat4 *m, mlod_trs *out, float tol);
 int mlod_mat4_invert(const mlod_mat4 *m, mlod_mat4 *out);
 mlod_v3 mlod_mat4_point(const mlod_mat4 *m, mlod_v3 p);  /* m * (p, 1) */
 mlod_v3 mlod_mat4_vector(const mlod_mat4 *m, mlod_v3 v); /* m * (v, 0) */
+/* An upper bound of the largest singular value of w's 3x3 part M: the
+ * square root of the largest absolute row sum of M^T M (Gershgorin),
+ * exact for a rotation times a uniform scale. */
+double mlod_mat4_sigma_bound(const mlod_mat4 *w);
 mlod_trs mlod_trs_identity(void);
 
 

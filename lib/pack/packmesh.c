@@ -63,15 +63,18 @@ static uint32_t prim_signature(const mlod_primitive *p, int skin)
  * wider than 65535 such steps takes the union's 16-bit steps. Morph
  * deltas: the largest |delta| of any level. bench/bench_layout makes the
  * same grid (mlod_pack_b2_grid). */
-static void part_grid(struct ctx *x, struct mpart *m, int M)
+/* part_grid's axes of the positions (set -1) or of UV set `set`, at bits
+ * of level 0's box: min and scale per axis. */
+static void part_axes(const struct mpart *m, int M, int set, int bits, float *min, float *scale)
 {
-	const mlod_primitive *p0 = m->lv[0];
+	const int n = set < 0 ? 3 : 2;
 	float mn[3], mx[3], mn0[3], mx0[3];
 	for (int k = 0; k < M; k++) {
 		const mlod_primitive *p = m->lv[k];
+		const float *d = set < 0 ? p->positions : p->uvs[set];
 		for (int v = 0; v < p->vertex_count; v++)
-			for (int a = 0; a < 3; a++) {
-				float f = p->positions[3 * v + a];
+			for (int a = 0; a < n; a++) {
+				float f = d[n * v + a];
 				int first = k == 0 && v == 0;
 				if (first || f < mn[a])
 					mn[a] = f;
@@ -81,36 +84,19 @@ static void part_grid(struct ctx *x, struct mpart *m, int M)
 					mn0[a] = first || f < mn0[a] ? f : mn0[a], mx0[a] = first || f > mx0[a] ? f : mx0[a];
 			}
 	}
-	for (int a = 0; a < 3; a++) {
-		float s0 = mlod_pack_range_scale_bits(mn0[a], mx0[a], x->opt->position_bits);
+	for (int a = 0; a < n; a++) {
+		float s0 = mlod_pack_range_scale_bits(mn0[a], mx0[a], bits);
 		float s16 = mlod_pack_range_scale_bits(mn[a], mx[a], 16);
-		m->rec.pos_min[a] = mn[a];
-		m->rec.pos_scale[a] = s0 > s16 ? s0 : s16;
+		min[a] = mn[a];
+		scale[a] = s0 > s16 ? s0 : s16;
 	}
-	for (int s = 0; s < (int)m->rec.uv_sets; s++) {
-		float umn[2], umx[2], umn0[2], umx0[2];
-		for (int k = 0; k < M; k++) {
-			const mlod_primitive *p = m->lv[k];
-			for (int v = 0; v < p->vertex_count; v++)
-				for (int a = 0; a < 2; a++) {
-					float f = p->uvs[s][2 * v + a];
-					int first = k == 0 && v == 0;
-					if (first || f < umn[a])
-						umn[a] = f;
-					if (first || f > umx[a])
-						umx[a] = f;
-					if (k == 0)
-						umn0[a] = first || f < umn0[a] ? f : umn0[a],
-						umx0[a] = first || f > umx0[a] ? f : umx0[a];
-				}
-		}
-		for (int a = 0; a < 2; a++) {
-			float s0 = mlod_pack_range_scale_bits(umn0[a], umx0[a], x->opt->uv_bits);
-			float s16 = mlod_pack_range_scale_bits(umn[a], umx[a], 16);
-			m->rec.uv_min[s][a] = umn[a];
-			m->rec.uv_scale[s][a] = s0 > s16 ? s0 : s16;
-		}
-	}
+}
+
+static void part_grid(struct ctx *x, struct mpart *m, int M)
+{
+	part_axes(m, M, -1, x->opt->position_bits, m->rec.pos_min, m->rec.pos_scale);
+	for (int s = 0; s < (int)m->rec.uv_sets; s++)
+		part_axes(m, M, s, x->opt->uv_bits, m->rec.uv_min[s], m->rec.uv_scale[s]);
 	for (int t = 0; t < m->ntargets; t++) {
 		float mt = 0.0f;
 		for (int k = 0; k < M; k++) {
@@ -120,7 +106,6 @@ static void part_grid(struct ctx *x, struct mpart *m, int M)
 		}
 		m->tscale[t] = mt > 0.0f ? (float)(mt / (ldexp(1.0, x->opt->position_bits - 1) - 1.0)) : 0.0f;
 	}
-	(void)p0;
 }
 
 /* Level k's vertices quantised on the part's grid into V (interleaved). */
@@ -219,8 +204,9 @@ static int dbl_asc(const void *a, const void *b)
 }
 
 /* The part's skinning scale at the rest pose: the largest singular value
- * bound (sigma_bound3) of its skin's matrices (joint world times inverse
- * bind), or of its rigid matrix (joint world times offset, or offset). */
+ * bound (mlod_mat4_sigma_bound) of its skin's matrices (joint world times
+ * inverse bind), or of its rigid matrix (joint world times offset, or
+ * offset). */
 static double part_sigma(const struct ctx *x, const struct mpart *m)
 {
 	const mlod_pack_part_rec *rec = &m->rec;
@@ -230,14 +216,14 @@ static double part_sigma(const struct ctx *x, const struct mpart *m)
 		double s = 0.0;
 		for (int j = 0; j < sk->joint_count; j++) {
 			mlod_mat4 J = mlod_mat4_mul(&x->world[sk->joints[j]], &sk->inverse_bind[j]);
-			double g = pack_sigma_bound3(&J);
+			double g = mlod_mat4_sigma_bound(&J);
 			s = g > s ? g : s;
 		}
 		return s;
 	}
 	const mlod_instance *in = &c->instances[rec->instance];
 	mlod_mat4 R = in->joint >= 0 ? mlod_mat4_mul(&x->world[in->joint], &in->offset) : in->offset;
-	return pack_sigma_bound3(&R);
+	return mlod_mat4_sigma_bound(&R);
 }
 
 /* The q-th quantile (0 to 1, the lower of two) of n values, sorted in

@@ -485,25 +485,6 @@ double mlod_pack_rotq_angle(int shift)
 	return 2.0 * asin(h < 1.0 ? h : 1.0) * (1.0 + 1e-9);
 }
 
-/* An upper bound of the largest singular value of w's 3x3 part M: the
- * square root of the largest absolute row sum of M^T M (Gershgorin),
- * exact for a rotation times a uniform scale. */
-double pack_sigma_bound3(const mlod_mat4 *w)
-{
-	double g = 0.0;
-	for (int a = 0; a < 3; a++) {
-		double row = 0.0;
-		for (int b = 0; b < 3; b++) {
-			double d = 0.0;
-			for (int r = 0; r < 3; r++)
-				d += (double)w->m[4 * a + r] * w->m[4 * b + r];
-			row += fabs(d);
-		}
-		g = row > g ? row : g;
-	}
-	return sqrt(g);
-}
-
 /* Joint j's rounding error bound in rotq_shifts: over its ancestors a,
  * j first, ra[a] reach(a, j) where a has a rotation lattice, and ta[a]
  * where its translations are on a grid (0 when exact). */
@@ -590,9 +571,9 @@ static mlod_result rotq_shifts(struct ctx *x, const mlod_clip *orig, const mlod_
 		mlod_clip_sample(orig, t[i], loc);
 		mlod_pose_world(sk, loc, w);
 		for (int j = 0; j < nj; j++) {
-			double rad = pd * pack_sigma_bound3(&w[j]);
+			double rad = pd * mlod_mat4_sigma_bound(&w[j]);
 			int pa = sk->joints[j].parent;
-			double sp = pack_sigma_bound3(pa < 0 ? &sk->joints[j].base : &w[pa]);
+			double sp = mlod_mat4_sigma_bound(pa < 0 ? &sk->joints[j].base : &w[pa]);
 			if (!(sp <= ps[j]))
 				ps[j] = isfinite(sp) ? sp : INFINITY;
 			for (int g = j; g >= 0; g = sk->joints[g].parent) {

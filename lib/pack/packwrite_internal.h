@@ -280,7 +280,6 @@ typedef struct motion_img {
 double pack_motion_point_distance(const struct ctx *x);
 mlod_result pack_motion_levels(struct ctx *x);
 void pack_motion_img_free(motion_img *m);
-double pack_sigma_bound3(const mlod_mat4 *w);
 mlod_result pack_motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int item, float error,
                               const motion_img *base, motion_img *img, chunks *out);
 

@@ -891,9 +891,9 @@ static void posed_level0(const char *path)
  * vertex of a part must have a vertex of the input level, and every
  * vertex the input level's triangles use a decoded one, within
  *   positions  half a step of the grid per axis, or share E / sigma as a
- *              distance (sigma: the largest singular value bound, the
- *              root of the largest absolute row sum of M^T M, of the
- *              part's rest skinning matrices);
+ *              distance (sigma: the largest singular value bound,
+ *              lib/core's mlod_mat4_sigma_bound, of the part's rest
+ *              skinning matrices);
  *   normals    the lattice bound at normal_bits (level 0's);
  *   UVs        half a step per axis, or share E rho / sigma as a
  *              distance, rho the 10% quantile over level 0's edges of UV
@@ -903,22 +903,6 @@ static void posed_level0(const char *path)
  * the input level's (measured here at the same poses) plus, over the
  * level's vertices, s d + (2 dropped + 4 * 3/1020) r, d the larger of
  * the two position bounds (pose_bound's terms). */
-static double gersh3(const mlod_mat4 *w)
-{
-	double g = 0.0;
-	for (int a = 0; a < 3; a++) {
-		double row = 0.0;
-		for (int b = 0; b < 3; b++) {
-			double d = 0.0;
-			for (int r = 0; r < 3; r++)
-				d += (double)w->m[4 * a + r] * w->m[4 * b + r];
-			row += fabs(d);
-		}
-		g = fmax(g, row);
-	}
-	return sqrt(g);
-}
-
 static int dcmp(const void *a, const void *b)
 {
 	double x = *(const double *)a, y = *(const double *)b;
@@ -1082,11 +1066,11 @@ static const char *coarse_levels(const char *path, double write_share, double ch
 				const mlod_skin *sk = &c.skeleton.skins[inst->skin];
 				for (int j = 0; j < sk->joint_count; j++) {
 					mlod_mat4 J = mlod_mat4_mul(&world[sk->joints[j]], &sk->inverse_bind[j]);
-					sigma = fmax(sigma, gersh3(&J));
+					sigma = fmax(sigma, mlod_mat4_sigma_bound(&J));
 				}
 			} else {
 				mlod_mat4 R = inst->joint >= 0 ? mlod_mat4_mul(&world[inst->joint], &inst->offset) : inst->offset;
-				sigma = gersh3(&R);
+				sigma = mlod_mat4_sigma_bound(&R);
 			}
 			double far = sigma > 0 ? check_share * E / sigma : 0;
 			struct cbounds B = {{0}, far, oct_bound(), {{0}}, {0}, (int)pp->rec.uv_sets};
