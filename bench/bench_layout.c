@@ -90,7 +90,7 @@ static double cpu_now(void)
 }
 
 /* ------------------------------------------------------------------ */
-/* Quantisation, as lib/pack/packwrite.c's add_part_streams            */
+/* Quantisation, as lib/pack/packmesh.c's part_quantise               */
 /* ------------------------------------------------------------------ */
 
 /* The interleaved quantised vertex: attribute a at off[a], size[a] bytes. */
@@ -544,7 +544,7 @@ static uint32_t *append_level(vset *set, uint8_t *G, uint32_t *count, const uint
 	return idx;
 }
 
-/* (b)'s grid for every level of a part, the writer's (lib/pack/packwrite.c
+/* (b)'s grid for every level of a part, the writer's (lib/pack/packmesh.c
  * part_grid): level 0's steps from the corner of the union of the levels'
  * boxes, or the union's 16-bit steps where the union is wider than 65535
  * of level 0's; morph deltas: the largest |delta| of any level. */

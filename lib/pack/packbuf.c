@@ -8,23 +8,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <meshoptimizer.h>
 #include <zstd.h>
 
 #include "pack/packwrite_internal.h"
-
-/* ------------------------------------------------------------------ */
-/* Bytes                                                               */
-/* ------------------------------------------------------------------ */
-
-double pack_now_seconds(void)
-{
-	struct timespec ts;
-	timespec_get(&ts, TIME_UTC);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ------------------------------------------------------------------ */
 /* Chunks and their streams                                            */

@@ -7,8 +7,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "pack/packwrite_internal.h"
+
+static double now_seconds(void)
+{
+	struct timespec ts;
+	timespec_get(&ts, TIME_UTC);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 void mlod_pack_options_default(mlod_pack_options *opt)
 {
@@ -143,15 +151,15 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	pack_note_unweighted(&x);
 
 	/* The levels of each layer. */
-	t0 = pack_now_seconds();
+	t0 = now_seconds();
 	if ((r = pack_skeleton_levels(&x)) != MLOD_OK)
 		goto done;
-	x.st->skeleton.seconds = pack_now_seconds() - t0;
-	t0 = pack_now_seconds();
+	x.st->skeleton.seconds = now_seconds() - t0;
+	t0 = now_seconds();
 	if ((r = pack_mesh_levels(&x)) != MLOD_OK)
 		goto done;
-	x.st->mesh.seconds = pack_now_seconds() - t0;
-	t0 = pack_now_seconds();
+	x.st->mesh.seconds = now_seconds() - t0;
+	t0 = now_seconds();
 	if ((r = pack_motion_levels(&x)) != MLOD_OK)
 		goto done;
 	int A = 0; /* motion levels counting level 0 */
@@ -164,7 +172,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 		}
 	if ((r = pack_motion_shift_choice(&x, A)) != MLOD_OK)
 		goto done;
-	x.st->motion.seconds = pack_now_seconds() - t0;
+	x.st->motion.seconds = now_seconds() - t0;
 	if (!(x.motion_imgs = calloc(2 * (size_t)x.v.clip_count + 1, sizeof *x.motion_imgs))) {
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
@@ -174,20 +182,20 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	int S = 1 + x.skel_count;
 	int M = mlod_mesh_triangle_primitives(&x.v) > 0 ? 1 + x.mesh_count : 0;
 	int parts0 = 0;
-	t0 = pack_now_seconds();
+	t0 = now_seconds();
 	if ((r = pack_skeleton_chunk(&x, &body)) != MLOD_OK)
 		goto done;
 	for (int k = S - 1; k >= 1; k--)
 		if ((r = pack_skel_level_chunk(&x, k, &body)) != MLOD_OK)
 			goto done;
-	x.st->skeleton.seconds += pack_now_seconds() - t0;
+	x.st->skeleton.seconds += now_seconds() - t0;
 	/* Rank i from the coarsest: mesh level M - 1 - i, then motion level
 	 * A - 1 - i of every clip, so that the coarsest of both layers come
 	 * first however many levels each has (mlod(5) Chunk order). */
 	int top = (M > A ? M : A) - 1;
 	for (int i = 0; i <= top; i++) {
 		int mk = M - 1 - i, k = A - 1 - i;
-		t0 = pack_now_seconds();
+		t0 = now_seconds();
 		if (mk >= 0) {
 			int np = 0;
 			if ((r = pack_mesh_chunk(&x, mk, &body, &np)) != MLOD_OK)
@@ -195,8 +203,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			if (mk == 0)
 				parts0 = np;
 		}
-		x.st->mesh.seconds += pack_now_seconds() - t0;
-		t0 = pack_now_seconds();
+		x.st->mesh.seconds += now_seconds() - t0;
+		t0 = now_seconds();
 		for (int q = 0; k >= 0 && q < x.v.clip_count; q++) {
 			const mlod_clip *cl = k == 0 ? x.clips[q].level0 : x.clips[q].clip[k - 1];
 			motion_img *mi = &x.motion_imgs[2 * q + (k & 1)], *base = k + 1 < A ? &x.motion_imgs[2 * q + !(k & 1)] : NULL;
@@ -251,7 +259,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 					goto done;
 			}
 		}
-		x.st->motion.seconds += pack_now_seconds() - t0;
+		x.st->motion.seconds += now_seconds() - t0;
 	}
 	/* DOC: the input without what the levels hold (mlod_gltf_strip_levels),
 	 * or as read when it cannot be stripped. */

@@ -3,7 +3,8 @@
  * is the public API). What its files share: the byte buffer and the
  * chunks, the character as packed (struct ctx), the MOTION chunk as the
  * reader returns it, and the functions one file calls in another
- * (prefixed pack_; every other function stays static in its file).
+ * (prefixed pack_; every other function stays static in its file). A
+ * function's comment stays at its definition.
  *
  * The files, each a layer of the writer, in the order the pack is made:
  *
@@ -39,9 +40,12 @@
 #include "record/mlod_record.h"
 
 /* ------------------------------------------------------------------ */
-/* Bytes (packbuf.c)                                                   */
+/* Bytes                                                               */
 /* ------------------------------------------------------------------ */
 
+/* A growing byte buffer; after a failed allocation fail is set and every
+ * later write does nothing, so that the writer checks it after a run of
+ * writes. */
 typedef struct buf {
 	uint8_t *p;
 	size_t n, cap;
@@ -151,7 +155,6 @@ typedef struct chunks {
 	int n, cap;
 } chunks;
 
-double pack_now_seconds(void);
 void pack_cb_add(chunkb *cb, uint32_t tag, uint32_t count, uint16_t size, const void *data, int index);
 void pack_cb_free(chunkb *cb);
 size_t pack_stream_coded_bytes(const stream *s);
@@ -264,6 +267,7 @@ int *pack_level_joint_map(const mlod_skeleton *s, const mlod_skin *lsk, const ml
 mlod_result pack_mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count);
 
 /* packmotion.c */
+
 /* A MOTION chunk as the reader returns it, for the next finer level to
  * build on: per channel its key times and, for non-cubic rotations, its
  * keys as lattice integers (mlod_pack_rotq_key). */
