@@ -6,22 +6,23 @@
  * (prefixed pack_; every other function stays static in its file). A
  * function's comment stays at its definition.
  *
- * The files, each a layer of the writer, in the order the pack is made:
+ * The files, each a layer of the writer, each calling only files below it
+ * (scripts/check-call-cycles):
  *
  *   packwrite.c    mlod_pack_write: the layers' levels, then their chunks
  *                  coarsest first, the INFO and DOC chunks, the TOC
- *   packchar.c     the character as packed: the view of the input, its
- *                  rest measures, notes and warnings, the attributes the
- *                  pack does not store
- *   packskel.c     skeleton levels and SKELETON chunks
- *   packbound.c    mesh levels: the input's bound to skeleton levels, or
- *                  computed
- *   packmesh.c     MESH chunks (layout b2, or Draco meshes)
- *   packmotion.c   motion levels and MOTION chunks (the rotation lattice)
  *   motionhold.c   motion levels held to their bounds as read back, the
  *                  lattice shifts kept where they pay, a chunk's error as
  *                  read back
+ *   packmotion.c   motion levels and MOTION chunks (the rotation lattice)
+ *   packskel.c     skeleton levels and SKELETON chunks
  *   packdoc.c      the document the DOC chunk keeps
+ *   packbound.c    mesh levels: the input's bound to skeleton levels, or
+ *                  computed
+ *   packmesh.c     MESH chunks (layout b2, or Draco meshes)
+ *   packchar.c     the character as packed: the view of the input, its
+ *                  rest measures, notes and warnings, the attributes the
+ *                  pack does not store
  *   packbuf.c      bytes, a chunk's streams and container, the entropy
  *                  stage
  *
