@@ -504,7 +504,12 @@ typedef struct mlod_rt_state {
  * of range or a time that is not finite. */
 mlod_result mlod_rt_instance_create(mlod_rt_ctx *ctx, uint32_t clip, float time, uint32_t flags, uint32_t *id,
                                     mlod_error *err);
-/* Returns the instance to the pool; an id not alive is ignored. */
+/* Returns the instance to the pool; an id not alive is ignored. An id is
+ * a handle (the slot's index and its generation), not an index: once its
+ * instance is destroyed, it names nothing, even after the pool gives the
+ * slot to a new instance, until the slot's generation wraps after
+ * 2^(32 - bits) destroys, bits being the fewest (at least 1) that hold
+ * max_instances - 1 (2^22 for the default pool of 1024). */
 void mlod_rt_instance_destroy(mlod_rt_ctx *ctx, uint32_t id);
 /* Shows clip from time on a live instance (the levels stay as they are
  * until the next update); MLOD_ERR_INVALID_ARG, nothing changed, for an id

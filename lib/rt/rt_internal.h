@@ -105,6 +105,7 @@ typedef void (*rt_close_fn)(struct mlod_rt_ctx *ctx);
 typedef struct rt_instance {
 	mlod_rt_state st;
 	uint32_t next_free;
+	uint32_t gen;             /* the slot's generation: one more per destroy (rt_slot_id) */
 	int selected;             /* 0 until the first update: no hysteresis then */
 } rt_instance;
 
@@ -176,8 +177,12 @@ struct mlod_rt_ctx {
 	/* Instances. */
 	rt_instance *inst;
 	uint32_t max_instances, free_head, live;
+	/* An id is the slot's index in its low slot_bits bits and the slot's
+	 * generation above them (rt_slot_id); slot_bits 32 leaves no
+	 * generation (a pool of more than 2^31). */
+	uint32_t slot_bits;
 	/* Morph target weights (morph_setup): per part its targets' weights,
-	 * morph_total per instance, the instance's at morph_weights + id *
+	 * morph_total per instance, the instance's at morph_weights + slot *
 	 * morph_total; morph_parts 0 when no part has targets. */
 	uint32_t part_count;      /* mesh parts (morph_setup): the coarsest level's, or views' most */
 	uint32_t morph_parts, morph_total;
@@ -285,5 +290,27 @@ void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals,
 /* rt_math.h: the affine helpers rt_mat_mul (a * b), rt_mat_trs
  * (mlod_mat4_from_trs) and rt_mat_mul_trs (parent * rt_mat_trs(t)). */
 #include "rt_math.h"
+
+/* The id of slot i as it is now: its index and its generation. */
+static inline uint32_t rt_slot_id(const mlod_rt_ctx *ctx, uint32_t i)
+{
+	return ctx->slot_bits >= 32 ? i : ctx->inst[i].gen << ctx->slot_bits | i;
+}
+
+/* The slot an id names (its index in inst), whether alive or not. */
+static inline uint32_t rt_slot(const mlod_rt_ctx *ctx, uint32_t id)
+{
+	return ctx->slot_bits >= 32 ? id : id & ((1u << ctx->slot_bits) - 1u);
+}
+
+/* The live instance id names, or NULL: a slot out of range, not alive, or
+ * alive with another generation (id outlived its instance). */
+static inline rt_instance *rt_live(const mlod_rt_ctx *ctx, uint32_t id)
+{
+	const uint32_t i = rt_slot(ctx, id);
+	if (i >= ctx->max_instances || !ctx->inst[i].st.alive || rt_slot_id(ctx, i) != id)
+		return NULL;
+	return &ctx->inst[i];
+}
 
 #endif
