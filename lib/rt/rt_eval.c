@@ -873,14 +873,23 @@ static mlod_result pose_mesh_level(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, u
 		if (m->vertex_count > capacity)
 			return mlod_fail(err, MLOD_ERR_LIMIT, "mesh level %u has %u vertices, the buffers hold %u", m->level,
 			                 m->vertex_count, capacity);
+		*mu = m;
+		/* The pose and palette entries of the call before, when they are
+		 * of this instance as it still is (a cull's mlod_rt_bounds, then
+		 * mlod_rt_skin): the same floats, made once. */
+		if (s->posed == 2 && s->id == id && s->pose_unit_gen == ctx->unit_gen && s->skel_unit == *su && s->pose_mesh == m &&
+		    s->pose_time == st->time && s->pose_clip == st->clip &&
+		    s->pose_motion_level == st->level[MLOD_RT_MOTION])
+			return MLOD_OK;
 		skin_plan(ctx, s, *su, m);
 		pose_joints(ctx, s, st, s->plan_posed, s->plan_count, s->plan_need);
-		*mu = m;
 	}
 	s->skel_unit = *su;
 	s->id = id;
 	s->posed = 2;
 	s->paletted = 0;
+	s->pose_unit_gen = ctx->unit_gen, s->pose_mesh = *mu;
+	s->pose_time = st->time, s->pose_clip = st->clip, s->pose_motion_level = st->level[MLOD_RT_MOTION];
 	if (*mu)
 		palette_entries(ctx, s, *su, *mu, s->world, s->palette);
 	return MLOD_OK;

@@ -200,6 +200,15 @@ struct mlod_rt_scratch {
 	const rt_unit *skel_unit; /* the pose's skeleton level (NULL: level 0) */
 	int posed, paletted;      /* posed: 1 in full (mlod_rt_pose), 2 only what a mesh level needs */
 	uint32_t id;              /* the instance posed */
+	/* Everything a pose of a mesh level (posed 2) depends on besides id
+	 * (whose generation changes with its instance) and skel_unit: the
+	 * resident levels (unit_gen), the mesh level, the clip, its level and
+	 * the time. mlod_rt_skin after mlod_rt_bounds of the same instance,
+	 * nothing of these changed, takes the pose as it is (pose_mesh_level). */
+	uint64_t pose_unit_gen;
+	const rt_unit *pose_mesh;
+	float pose_time;
+	uint32_t pose_clip, pose_motion_level;
 	/* The skin plan (mlod_rt_skin): the joints that the mesh level mesh
 	 * under the skeleton level skel needs posed (need: a flag per joint;
 	 * posed: their list, increasing), valid while ctx->unit_gen is gen. */
