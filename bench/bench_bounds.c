@@ -9,10 +9,11 @@
  * Per pack: every level resident; INSTANCES instances (default 64) over
  * the clips at times spread over each clip, every layer at level 0 (the
  * costliest); ROUNDS rounds (default 200) of each call on every instance
- * (mlod_rt_bounds, mlod_rt_skin with normals, mlod_rt_pose), timed per
- * round: the median ns per instance and the CPU seconds of all rounds.
+ * (mlod_rt_bounds, mlod_rt_skin with normals, mlod_rt_pose, and a cull's
+ * mlod_rt_bounds then mlod_rt_skin of each instance), timed per round:
+ * the median ns per instance and the CPU seconds of all rounds.
  * Under callgrind (valgrind --tool=callgrind), the inclusive instruction
- * counts of the three functions over the calls made give the cost per
+ * counts of the functions over the calls made give the cost per
  * call independent of the load (callgrind_annotate --inclusive=yes).
  * Tightness: each clip at 25 times, at mesh levels 0 and the coarsest
  * (skeleton and motion at the same level, clamped): the box's volume and
@@ -110,9 +111,9 @@ static int one_pack(const char *path, int rounds, uint32_t ninst)
 	}
 	printf("\n");
 	/* cost */
-	const char *names[3] = { "mlod_rt_bounds", "mlod_rt_skin", "mlod_rt_pose" };
+	const char *names[4] = { "mlod_rt_bounds", "mlod_rt_skin", "mlod_rt_pose", "bounds+skin" };
 	double *t = malloc(sizeof(double) * (size_t)rounds);
-	for (int op = 0; op < 3; op++) {
+	for (int op = 0; op < 4; op++) {
 		const double c0 = cpu_now();
 		for (int r = 0; r < rounds; r++) {
 			const double w0 = bench_now();
@@ -123,8 +124,12 @@ static int one_pack(const char *path, int rounds, uint32_t ninst)
 					mlod_rt_bounds(ctx, s, ids[i], mn, mx, NULL);
 				else if (op == 1)
 					mlod_rt_skin(ctx, s, ids[i], pos, 12, nrm, 12, nv, &n, NULL);
-				else
+				else if (op == 2)
 					mlod_rt_pose(ctx, s, ids[i], NULL, NULL, NULL, NULL);
+				else { /* a cull: the box, then the skin of the same instance */
+					mlod_rt_bounds(ctx, s, ids[i], mn, mx, NULL);
+					mlod_rt_skin(ctx, s, ids[i], pos, 12, nrm, 12, nv, &n, NULL);
+				}
 			}
 			t[r] = (bench_now() - w0) / ninst;
 		}

@@ -504,7 +504,12 @@ typedef struct mlod_rt_state {
  * of range or a time that is not finite. */
 mlod_result mlod_rt_instance_create(mlod_rt_ctx *ctx, uint32_t clip, float time, uint32_t flags, uint32_t *id,
                                     mlod_error *err);
-/* Returns the instance to the pool; an id not alive is ignored. */
+/* Returns the instance to the pool; an id not alive is ignored. An id is
+ * a handle (the slot's index and its generation), not an index: once its
+ * instance is destroyed, it names nothing, even after the pool gives the
+ * slot to a new instance, until the slot's generation wraps after
+ * 2^(32 - bits) destroys, bits being the fewest (at least 1) that hold
+ * max_instances - 1 (2^22 for the default pool of 1024). */
 void mlod_rt_instance_destroy(mlod_rt_ctx *ctx, uint32_t id);
 /* Shows clip from time on a live instance (the levels stay as they are
  * until the next update); MLOD_ERR_INVALID_ARG, nothing changed, for an id
@@ -644,7 +649,10 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
  * is 1.37 times the skinned vertices' box's at the median on tubeman,
  * 1.21 on RobotExpressive, 1.001 on Ely; a call costs 34,800, 41,800 and
  * 16,900 instructions against mlod_rt_skin's 254,400, 180,300 and
- * 298,200. Without a mesh, or for a level
+ * 298,200. mlod_rt_skin right after it, with the same scratch and
+ * instance and nothing changed between (the instance's time, clip and
+ * levels, the resident levels), takes its pose and palette entries as
+ * they are instead of making them again. Without a mesh, or for a level
  * without vertices, the empty box: min FLT_MAX, max -FLT_MAX.
  * MLOD_ERR_INVALID_ARG as mlod_rt_skin (min and max are then the empty
  * box). No allocation. */

@@ -1170,6 +1170,9 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 	for (uint32_t i = 0; i < ctx->max_instances; i++)
 		ctx->inst[i].next_free = i + 1;
 	ctx->free_head = 0;
+	ctx->slot_bits = 1;
+	while (ctx->slot_bits < 32 && (ctx->max_instances - 1) >> ctx->slot_bits)
+		ctx->slot_bits++;
 
 	/* The coarse levels, pinned. */
 	for (uint32_t i = 0; i < ctx->unit_count; i++) {
@@ -1803,32 +1806,36 @@ mlod_result mlod_rt_instance_create(mlod_rt_ctx *ctx, uint32_t clip, float time,
 			u->users++;
 	}
 	ctx->live++;
-	*id = i;
+	*id = rt_slot_id(ctx, i);
 	return MLOD_OK;
 }
 
 void mlod_rt_instance_destroy(mlod_rt_ctx *ctx, uint32_t id)
 {
-	if (!ctx || id >= ctx->max_instances || !ctx->inst[id].st.alive)
+	rt_instance *in = ctx ? rt_live(ctx, id) : NULL;
+	if (!in)
 		return;
-	rt_instance *in = &ctx->inst[id];
 	unuse(ctx, in);
 	in->st.alive = 0;
+	/* The slot's next id differs from every id it gave before, until the
+	 * generation wraps (2^(32 - slot_bits) destroys of this slot). */
+	if (ctx->slot_bits < 32)
+		in->gen = (in->gen + 1) & ((1u << (32 - ctx->slot_bits)) - 1u);
 	in->next_free = ctx->free_head;
-	ctx->free_head = id;
+	ctx->free_head = (uint32_t)(in - ctx->inst);
 	ctx->live--;
 }
 
 mlod_result mlod_rt_instance_set(mlod_rt_ctx *ctx, uint32_t id, uint32_t clip, float time, uint32_t flags,
                                  mlod_error *err)
 {
-	if (!ctx || id >= ctx->max_instances || !ctx->inst[id].st.alive)
+	rt_instance *in = ctx ? rt_live(ctx, id) : NULL;
+	if (!in)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	if (ctx->clip_count && clip >= ctx->clip_count)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "clip %u out of range (%u clips)", clip, ctx->clip_count);
 	if (!isfinite(time))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u: time %g is not finite", id, (double)time);
-	rt_instance *in = &ctx->inst[id];
 	unuse(ctx, in);
 	in->st.clip = ctx->clip_count ? clip : 0;
 	in->st.time = time;
@@ -1857,7 +1864,8 @@ mlod_result mlod_rt_instance_set_morph_weights(mlod_rt_ctx *ctx, uint32_t id, ui
 {
 	if (!ctx || (!weights && count))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_instance_set_morph_weights: NULL argument");
-	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+	const rt_instance *in = rt_live(ctx, id);
+	if (!in)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	if (part >= ctx->part_count)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "part %u out of range (%u parts)", part, ctx->part_count);
@@ -1870,7 +1878,7 @@ mlod_result mlod_rt_instance_set_morph_weights(mlod_rt_ctx *ctx, uint32_t id, ui
 			return mlod_fail(err, MLOD_ERR_INVALID_ARG, "part %u: morph weight %u is not finite", part, t);
 	if (!targets)
 		return MLOD_OK;
-	float *w = ctx->morph_weights + (size_t)id * ctx->morph_total + ctx->morph_offset[part];
+	float *w = ctx->morph_weights + (size_t)(in - ctx->inst) * ctx->morph_total + ctx->morph_offset[part];
 	for (uint32_t t = 0; t < targets; t++)
 		w[t] = t < count ? weights[t] : 0.0f;
 	return MLOD_OK;
@@ -1878,7 +1886,6 @@ mlod_result mlod_rt_instance_set_morph_weights(mlod_rt_ctx *ctx, uint32_t id, ui
 
 const mlod_rt_state *mlod_rt_instance_state(const mlod_rt_ctx *ctx, uint32_t id)
 {
-	if (!ctx || id >= ctx->max_instances || !ctx->inst[id].st.alive)
-		return NULL;
-	return &ctx->inst[id].st;
+	const rt_instance *in = ctx ? rt_live(ctx, id) : NULL;
+	return in ? &in->st : NULL;
 }

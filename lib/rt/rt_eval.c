@@ -631,9 +631,9 @@ mlod_result mlod_rt_pose(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_pose: NULL argument");
 	if (s->owner != ctx)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_pose: the scratch was made for another context");
-	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+	if (!rt_live(ctx, id))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
-	const mlod_rt_state *st = &ctx->inst[id].st;
+	const mlod_rt_state *st = &ctx->inst[rt_slot(ctx, id)].st;
 	const rt_unit *su = skel_unit(ctx, st);
 	pose_joints(ctx, s, st, su ? su->plan.posed : ctx->all_joints, su ? su->plan.posed_count : ctx->joint_count,
 	            su ? su->plan.needed : ctx->all_needed);
@@ -754,7 +754,7 @@ static const float *part_morph(const mlod_rt_ctx *ctx, uint32_t id, uint32_t i, 
 	uint32_t k = ctx->morph_offset[i + 1] - ctx->morph_offset[i];
 	if (p->rec.target_count < k)
 		k = p->rec.target_count;
-	const float *w = ctx->morph_weights + (size_t)id * ctx->morph_total + ctx->morph_offset[i];
+	const float *w = ctx->morph_weights + (size_t)rt_slot(ctx, id) * ctx->morph_total + ctx->morph_offset[i];
 	for (uint32_t t = 0; t < k; t++)
 		if (w[t] != 0.0f && p->targets[t]) {
 			*nt = k;
@@ -863,7 +863,7 @@ static void palette_entries(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, const rt
 static mlod_result pose_mesh_level(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, uint32_t capacity,
                                    const rt_unit **su, const rt_unit **mu, mlod_error *err)
 {
-	const mlod_rt_state *st = &ctx->inst[id].st;
+	const mlod_rt_state *st = &ctx->inst[rt_slot(ctx, id)].st;
 	*su = skel_unit(ctx, st);
 	*mu = NULL;
 	if (ctx->levels[MLOD_RT_MESH] > 0) {
@@ -873,14 +873,23 @@ static mlod_result pose_mesh_level(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, u
 		if (m->vertex_count > capacity)
 			return mlod_fail(err, MLOD_ERR_LIMIT, "mesh level %u has %u vertices, the buffers hold %u", m->level,
 			                 m->vertex_count, capacity);
+		*mu = m;
+		/* The pose and palette entries of the call before, when they are
+		 * of this instance as it still is (a cull's mlod_rt_bounds, then
+		 * mlod_rt_skin): the same floats, made once. */
+		if (s->posed == 2 && s->id == id && s->pose_unit_gen == ctx->unit_gen && s->skel_unit == *su && s->pose_mesh == m &&
+		    s->pose_time == st->time && s->pose_clip == st->clip &&
+		    s->pose_motion_level == st->level[MLOD_RT_MOTION])
+			return MLOD_OK;
 		skin_plan(ctx, s, *su, m);
 		pose_joints(ctx, s, st, s->plan_posed, s->plan_count, s->plan_need);
-		*mu = m;
 	}
 	s->skel_unit = *su;
 	s->id = id;
 	s->posed = 2;
 	s->paletted = 0;
+	s->pose_unit_gen = ctx->unit_gen, s->pose_mesh = *mu;
+	s->pose_time = st->time, s->pose_clip = st->clip, s->pose_motion_level = st->level[MLOD_RT_MOTION];
 	if (*mu)
 		palette_entries(ctx, s, *su, *mu, s->world, s->palette);
 	return MLOD_OK;
@@ -898,7 +907,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: the scratch was made for another context");
 	if (pos_stride < 12 || pos_stride % 4 || (normals && (nrm_stride < 12 || nrm_stride % 4)))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin: strides must be multiples of 4, at least 12");
-	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+	if (!rt_live(ctx, id))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	const rt_unit *su, *mu;
 	mlod_result r = pose_mesh_level(ctx, s, id, capacity, &su, &mu, err);
@@ -1014,7 +1023,7 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 		min[k] = FLT_MAX, max[k] = -FLT_MAX;
 	if (s->owner != ctx)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_bounds: the scratch was made for another context");
-	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+	if (!rt_live(ctx, id))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
 	/* The pose and the palette entries mlod_rt_skin makes (the same
 	 * floats); without a mesh, the empty box. */
@@ -1033,7 +1042,7 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 		const uint32_t have = mu->bound_morph_at[i + 1] - mu->bound_morph_at[i];
 		if (have < k)
 			k = have;
-		const float *w = ctx->morph_weights + (size_t)id * ctx->morph_total + ctx->morph_offset[i];
+		const float *w = ctx->morph_weights + (size_t)rt_slot(ctx, id) * ctx->morph_total + ctx->morph_offset[i];
 		const float *d = mu->bound_morph + mu->bound_morph_at[i];
 		double g = 0;
 		for (uint32_t t = 0; t < k; t++)

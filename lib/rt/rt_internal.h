@@ -105,6 +105,7 @@ typedef void (*rt_close_fn)(struct mlod_rt_ctx *ctx);
 typedef struct rt_instance {
 	mlod_rt_state st;
 	uint32_t next_free;
+	uint32_t gen;             /* the slot's generation: one more per destroy (rt_slot_id) */
 	int selected;             /* 0 until the first update: no hysteresis then */
 } rt_instance;
 
@@ -176,8 +177,12 @@ struct mlod_rt_ctx {
 	/* Instances. */
 	rt_instance *inst;
 	uint32_t max_instances, free_head, live;
+	/* An id is the slot's index in its low slot_bits bits and the slot's
+	 * generation above them (rt_slot_id); slot_bits 32 leaves no
+	 * generation (a pool of more than 2^31). */
+	uint32_t slot_bits;
 	/* Morph target weights (morph_setup): per part its targets' weights,
-	 * morph_total per instance, the instance's at morph_weights + id *
+	 * morph_total per instance, the instance's at morph_weights + slot *
 	 * morph_total; morph_parts 0 when no part has targets. */
 	uint32_t part_count;      /* mesh parts (morph_setup): the coarsest level's, or views' most */
 	uint32_t morph_parts, morph_total;
@@ -195,6 +200,15 @@ struct mlod_rt_scratch {
 	const rt_unit *skel_unit; /* the pose's skeleton level (NULL: level 0) */
 	int posed, paletted;      /* posed: 1 in full (mlod_rt_pose), 2 only what a mesh level needs */
 	uint32_t id;              /* the instance posed */
+	/* Everything a pose of a mesh level (posed 2) depends on besides id
+	 * (whose generation changes with its instance) and skel_unit: the
+	 * resident levels (unit_gen), the mesh level, the clip, its level and
+	 * the time. mlod_rt_skin after mlod_rt_bounds of the same instance,
+	 * nothing of these changed, takes the pose as it is (pose_mesh_level). */
+	uint64_t pose_unit_gen;
+	const rt_unit *pose_mesh;
+	float pose_time;
+	uint32_t pose_clip, pose_motion_level;
 	/* The skin plan (mlod_rt_skin): the joints that the mesh level mesh
 	 * under the skeleton level skel needs posed (need: a flag per joint;
 	 * posed: their list, increasing), valid while ctx->unit_gen is gen. */
@@ -285,5 +299,27 @@ void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals,
 /* rt_math.h: the affine helpers rt_mat_mul (a * b), rt_mat_trs
  * (mlod_mat4_from_trs) and rt_mat_mul_trs (parent * rt_mat_trs(t)). */
 #include "rt_math.h"
+
+/* The id of slot i as it is now: its index and its generation. */
+static inline uint32_t rt_slot_id(const mlod_rt_ctx *ctx, uint32_t i)
+{
+	return ctx->slot_bits >= 32 ? i : ctx->inst[i].gen << ctx->slot_bits | i;
+}
+
+/* The slot an id names (its index in inst), whether alive or not. */
+static inline uint32_t rt_slot(const mlod_rt_ctx *ctx, uint32_t id)
+{
+	return ctx->slot_bits >= 32 ? id : id & ((1u << ctx->slot_bits) - 1u);
+}
+
+/* The live instance id names, or NULL: a slot out of range, not alive, or
+ * alive with another generation (id outlived its instance). */
+static inline rt_instance *rt_live(const mlod_rt_ctx *ctx, uint32_t id)
+{
+	const uint32_t i = rt_slot(ctx, id);
+	if (i >= ctx->max_instances || !ctx->inst[i].st.alive || rt_slot_id(ctx, i) != id)
+		return NULL;
+	return &ctx->inst[i];
+}
 
 #endif

@@ -128,9 +128,9 @@ static mlod_result select_check(const mlod_rt_select *sel, const char *fn, mlod_
 
 static void update_one(mlod_rt_ctx *ctx, const mlod_rt_select *sel, uint32_t id, float d, float dt)
 {
-	if (id >= ctx->max_instances || !ctx->inst[id].st.alive)
+	rt_instance *in = rt_live(ctx, id);
+	if (!in)
 		return;
-	rt_instance *in = &ctx->inst[id];
 	mlod_rt_state *st = &in->st;
 	/* time stays finite: when the float sum overflows, it is made in
 	 * double, where a looping instance's wraps and another's saturates at

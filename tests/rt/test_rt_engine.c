@@ -8,7 +8,9 @@
  * runtime reports; a scratch used with another context refused; NULL
  * arguments named; a level's part attributes and the palette skinning
  * on the GPU as mlod_rt_skin does; the names, hierarchy and bounds calls
- * (mlod_rt_info(3)) allocating nothing.
+ * (mlod_rt_info(3)) allocating nothing; an id kept past its instance's
+ * destroy refused; mlod_rt_skin after mlod_rt_bounds posing once, with the
+ * floats of a fresh scratch.
  *
  * The packs come from mlod-pack on the committed samples (rt_packer.h);
  * without it the tests print SKIP. Links libmlodrt.a alone.
@@ -16,6 +18,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "rt_test.h"
 #include "rt_packer.h"
@@ -296,6 +300,119 @@ TEST(scratch_of_another_context)
 	mlod_rt_close(b);
 }
 
+/* An id kept past its instance's destroy names nothing, even once the
+ * pool has given its slot to a new instance (before, ids had no
+ * generation: the old id reached the new instance, and a destroy through
+ * it took that instance away). */
+TEST(stale_id_refused)
+{
+	SKIP_IF_NO_PACK(stale_id_refused);
+	CHECK(packs_ready(), "mlod-pack failed");
+	mlod_error e = { 0 };
+	mlod_rt_config cfg = { .max_instances = 2 };
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_memory(robot, robot_size, &cfg, &ctx, &e), e);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	CHECK(s, "scratch");
+	uint32_t old, now, other;
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, 0, &old, &e), e);
+	CHECK_OK(mlod_rt_instance_create(ctx, 1, 0, 0, &other, &e), e);
+	mlod_rt_instance_destroy(ctx, old);
+	CHECK_OK(mlod_rt_instance_create(ctx, 2, 0.5f, 0, &now, &e), e);
+	CHECK(now != old && now != other, "ids %#x %#x %#x", old, other, now);
+	CHECK(mlod_rt_instance_state(ctx, old) == NULL, "the old id %#x names an instance", old);
+	CHECK_ERR(mlod_rt_instance_set(ctx, old, 0, 0, 0, &e), MLOD_ERR_INVALID_ARG, "is not alive");
+	float buf[3 * 8000], mn[3], mx[3], w = 1.0f;
+	uint32_t nv = 0;
+	CHECK_ERR(mlod_rt_pose(ctx, s, old, NULL, NULL, NULL, &e), MLOD_ERR_INVALID_ARG, "is not alive");
+	CHECK_ERR(mlod_rt_skin(ctx, s, old, buf, 12, NULL, 0, 8000, &nv, &e), MLOD_ERR_INVALID_ARG, "is not alive");
+	CHECK_ERR(mlod_rt_bounds(ctx, s, old, mn, mx, &e), MLOD_ERR_INVALID_ARG, "is not alive");
+	CHECK_ERR(mlod_rt_instance_set_morph_weights(ctx, old, 0, &w, 1, &e), MLOD_ERR_INVALID_ARG, "is not alive");
+	/* an update through the old id leaves the new instance as it was */
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	const float d = 50.0f;
+	CHECK_OK(mlod_rt_update(ctx, &sel, &old, &d, 1, 0.25f, &e), e);
+	const mlod_rt_state *st = mlod_rt_instance_state(ctx, now);
+	CHECK(st && st->clip == 2 && st->time == 0.5f && st->distance == 0.0f, "the new instance moved");
+	/* a destroy through it leaves the new instance alive */
+	mlod_rt_instance_destroy(ctx, old);
+	CHECK(mlod_rt_instance_state(ctx, now) != NULL, "destroying the old id took the new instance");
+	CHECK_OK(mlod_rt_skin(ctx, s, now, buf, 12, NULL, 0, 8000, &nv, &e), e);
+	/* one slot reused 1,000 times gives 1,000 different ids */
+	uint32_t seen[1000];
+	int repeats = 0;
+	for (int k = 0; k < 1000; k++) {
+		mlod_rt_instance_destroy(ctx, now);
+		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, 0, &now, &e), e);
+		for (int j = 0; j < k; j++)
+			repeats += seen[j] == now || now == old || now == other;
+		seen[k] = now;
+	}
+	CHECK(repeats == 0, "%d ids given twice", repeats);
+	CHECK(mlod_rt_instance_state(ctx, other) != NULL, "the other instance is gone");
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+}
+
+/* Skinned n vertices (positions and normals) of id on a fresh scratch. */
+static int skin_fresh(mlod_rt_ctx *ctx, uint32_t id, float *pos, float *nrm, uint32_t cap, uint32_t *n)
+{
+	mlod_error e = { 0 };
+	mlod_rt_scratch *f = mlod_rt_scratch_create(ctx);
+	const int ok = f && mlod_rt_skin(ctx, f, id, pos, 12, nrm, 12, cap, n, &e) == MLOD_OK;
+	mlod_rt_scratch_destroy(ctx, f);
+	return ok;
+}
+
+/* A cull's mlod_rt_bounds then mlod_rt_skin of the same instance poses
+ * once; the skin is float for float a fresh scratch's, and a change
+ * between the two (an update, a new clip or time, another instance, a
+ * stream) is never missed. */
+TEST(skin_after_bounds_same_floats)
+{
+	SKIP_IF_NO_PACK(skin_after_bounds_same_floats);
+	CHECK(packs_ready(), "mlod-pack failed");
+	mlod_error e = { 0 };
+	mlod_rt_ctx *ctx = NULL;
+	CHECK_OK(mlod_rt_open_memory(tube, tube_size, NULL, &ctx, &e), e);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	CHECK(s, "scratch");
+	uint32_t a, b;
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.2f, MLOD_RT_LOOP, &a, &e), e);
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.9f, MLOD_RT_LOOP, &b, &e), e);
+	const mlod_rt_select sel = pixels();
+	const uint32_t ids[2] = { a, b };
+	const float ds[2] = { 1.0f, 1.0f };
+	CHECK_OK(mlod_rt_update(ctx, &sel, ids, ds, 2, 0, &e), e);
+	CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
+	const uint32_t cap = mlod_rt_max_vertex_count(ctx);
+	float *p = malloc(4 * 3 * sizeof(float) * cap), *n = p + 3 * cap, *fp = n + 3 * cap, *fn = fp + 3 * cap;
+	CHECK(p && cap, "buffers");
+	float mn[3], mx[3], before = 0;
+	uint32_t c = 0, fc = 0;
+	for (int step = 0; step < 6; step++) {
+		uint32_t id = step == 3 ? b : a;
+		CHECK_OK(mlod_rt_bounds(ctx, s, a, mn, mx, &e), e);
+		if (step == 1)
+			CHECK_OK(mlod_rt_update(ctx, &sel, &a, &ds[0], 1, 0.25f, &e), e);
+		if (step == 2)
+			CHECK_OK(mlod_rt_instance_set(ctx, a, 1 % mlod_rt_clip_count(ctx), 0.6f, MLOD_RT_LOOP, &e), e);
+		if (step == 4)
+			CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
+		CHECK_OK(mlod_rt_skin(ctx, s, id, p, 12, n, 12, cap, &c, &e), e);
+		CHECK(skin_fresh(ctx, id, fp, fn, cap, &fc), "fresh skin");
+		CHECK(c == fc && !memcmp(p, fp, 12 * (size_t)c) && !memcmp(n, fn, 12 * (size_t)c),
+		      "step %d: the skin after bounds is not a fresh scratch's", step);
+		if (step == 1)
+			CHECK(p[0] != before, "step 1: the update did not move the skin");
+		before = p[0];
+	}
+	free(p);
+	mlod_rt_scratch_destroy(ctx, s);
+	mlod_rt_close(ctx);
+}
+
 /* NULL where the docs say MLOD_ERR_INVALID_ARG: a NULL pack of size 0
  * (was MLOD_ERR_PARSE, "no header"), a NULL level_info (was "no such
  * level"). */
@@ -479,6 +596,8 @@ int main(int argc, char **argv)
 	RUN(misread_tried_again);
 	RUN(held_memory_is_counted);
 	RUN(scratch_of_another_context);
+	RUN(stale_id_refused);
+	RUN(skin_after_bounds_same_floats);
 	RUN(null_arguments_named);
 	RUN(gpu_skinning_from_part_attributes);
 	RUN(info_calls_allocate_nothing);

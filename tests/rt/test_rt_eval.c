@@ -675,7 +675,10 @@ TEST(morph_targets)
 		mlod_rt_instance_destroy(ctx, id);
 		uint32_t again;
 		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.7f, MLOD_RT_LOOP, &again, &e), e);
-		CHECK(again == id, "the pool gave slot %u, not %u", again, id);
+		/* the pool reuses the slot (last freed, first taken) under a new
+		 * generation: the old id names nothing now */
+		CHECK(again != id, "the pool gave the destroyed id %#x again", id);
+		CHECK(mlod_rt_instance_state(ctx, id) == NULL, "the destroyed id %#x still names an instance", id);
 		CHECK_OK(force(ctx, again, level, &e), e);
 		CHECK_OK(mlod_rt_skin(ctx, s, again, mp, 12, mn, 12, 7, &mc, &e), e);
 		CHECK(fx_maxdiff(zp, mp, 3 * (int)rc) == 0, "level %d: a new instance kept the old weights", level);
@@ -710,7 +713,7 @@ TEST(skin_plan_matches_full_pose)
 				sel.force_level = 0;
 				float d = 1;
 				CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0913f, &e), e);
-				mlod_rt_state *st = &ctx->inst[id].st; /* the levels under test */
+				mlod_rt_state *st = &rt_live(ctx, id)->st; /* the levels under test */
 				st->level[MLOD_RT_SKELETON] = (uint16_t)ls, st->level[MLOD_RT_MESH] = (uint16_t)lm;
 				st->level[MLOD_RT_MOTION] = (uint16_t)(f % 3);
 				uint32_t n = 0;
@@ -1039,7 +1042,7 @@ TEST(palette_copies_equal_products)
 				sel.force_level = 0;
 				float d = 1;
 				CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 0.0713f, &e), e);
-				mlod_rt_state *st = &ctx->inst[id].st;
+				mlod_rt_state *st = &rt_live(ctx, id)->st;
 				st->level[MLOD_RT_SKELETON] = (uint16_t)ls, st->level[MLOD_RT_MESH] = (uint16_t)lm;
 				const rt_unit *su = ls ? rt_unit_get(ctx, MLOD_RT_SKELETON, ls, 0) : NULL;
 				const uint32_t *joint = su ? su->plan.palette_joint : ctx->pal_joint0;
@@ -1138,7 +1141,7 @@ TEST(views_names_hierarchy_bounds)
 			for (uint32_t clip = 0; clip < 2; clip++)
 				for (int k = 0; k <= 20; k++) {
 					CHECK_OK(mlod_rt_instance_set(ctx, id, clip, 0.02f * (float)k, 0, &e), e);
-					mlod_rt_state *st = &ctx->inst[id].st;
+					mlod_rt_state *st = &rt_live(ctx, id)->st;
 					st->level[MLOD_RT_SKELETON] = (uint16_t)ls, st->level[MLOD_RT_MESH] = (uint16_t)lm;
 					st->level[MLOD_RT_MOTION] = 0;
 					float out[3 * 16], mn[3], mx[3];
