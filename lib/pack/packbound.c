@@ -302,7 +302,7 @@ static mlod_result bound_levels(struct ctx *x)
 	int ratios = x->rec.mesh_level_count == x->mesh_count;
 	for (int k = 0; ratios && k < x->mesh_count; k++)
 		ratios = !x->rec.mesh_levels[k].missing_ratio;
-	char text[400];
+	char text[800];
 	snprintf(text, sizeof text,
 	         "mesh level%s %s of the input %s on skeleton levels' skins (the weights of the joints those levels "
 	         "remove moved to their stand-ins): %s",

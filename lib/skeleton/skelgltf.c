@@ -75,7 +75,8 @@ mlod_result mlod_gltf_add_skel_levels(mlod_gltf *doc, const mlod_character *full
 	 * instance node. */
 	for (int i = 0; i < full->instance_count; i++) {
 		const mlod_instance *in = &full->instances[i];
-		if (in->skin < 0 || in->node < 0 || mesh_index[in->mesh] < 0) /* level 1's mesh */
+		/* level 1's mesh (none without levels: mesh_index holds nothing) */
+		if (count <= 0 || in->skin < 0 || in->node < 0 || mesh_index[in->mesh] < 0)
 			continue;
 		for (int k = 0; k < count; k++) {
 			char name[64];

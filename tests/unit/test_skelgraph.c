@@ -473,6 +473,28 @@ TEST(bvh_end_sites_under_scale)
 	mlod_character_free(&c);
 }
 
+/* Writing no skeleton level (none within the bound, as on the robot at
+ * the default 2%) touches no level's mesh: before, the instance loop read
+ * mesh_index, allocated for one int, at every mesh (ASan: heap overflow
+ * in mlod_gltf_add_skel_levels on samples/RobotExpressive.glb). */
+TEST(no_levels_written)
+{
+	size_t size;
+	void *bytes = test_read_file("samples/RobotExpressive.glb", &size);
+	CHECK_MSG(bytes, "samples/RobotExpressive.glb: cannot read");
+	mlod_error e = {0};
+	mlod_gltf *doc = NULL;
+	mlod_character c = {0};
+	CHECK_MSG(mlod_gltf_read(bytes, size, NULL, &doc, &e) == MLOD_OK && mlod_gltf_to_character(doc, &c, &e) == MLOD_OK,
+	      "%s", e.message);
+	CHECK_MSG(c.mesh_count > 1 && c.instance_count > 1, "the robot has %d meshes", c.mesh_count);
+	int skins[1];
+	CHECK_MSG(mlod_gltf_add_skel_levels(doc, &c, NULL, 0, skins, 1, &e) == MLOD_OK, "%s", e.message);
+	mlod_character_free(&c);
+	mlod_gltf_free(doc);
+	free(bytes);
+}
+
 TEST(skin_transfer_merges)
 {
 	int parent[] = {-1, 0, 1, 2};
@@ -562,6 +584,7 @@ int main(void)
 	RUN(folding_is_exact);
 	RUN(shear_is_detected);
 	RUN(skin_transfer_merges);
+	RUN(no_levels_written);
 	RUN(bvh_end_sites_under_scale);
 	RUN(vertex_deviation_is_exact);
 	RUN(shared_data);
