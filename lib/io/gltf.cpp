@@ -3055,7 +3055,7 @@ void clear_lod(mlod_gltf &doc, int node)
 /* What a pack's levels hold goes (mlod_gltf_strip_levels): the joint
  * channels are the translation, rotation and scale channels of the nodes
  * in joint_nodes. */
-void strip_levels(mlod_gltf &doc, const int *joint_nodes, int joint_count)
+void strip_levels(mlod_gltf &doc, const int *joint_nodes, int joint_count, const unsigned char *strip_mesh)
 {
 	Model &m = doc.model;
 	std::vector<char> joint(m.nodes.size(), 0);
@@ -3079,7 +3079,7 @@ void strip_levels(mlod_gltf &doc, const int *joint_nodes, int joint_count)
 	 * of triangle lists) keeps its data too. */
 	json *meshes = orig_array("meshes");
 	for (size_t i = 0; i < m.meshes.size(); i++)
-		for (size_t p = 0; p < m.meshes[i].primitives.size(); p++) {
+		for (size_t p = 0; (!strip_mesh || strip_mesh[i]) && p < m.meshes[i].primitives.size(); p++) {
 			tinygltf::Primitive &pr = m.meshes[i].primitives[p];
 			if (pr.mode >= 0 && pr.mode != TINYGLTF_MODE_TRIANGLES)
 				continue;
@@ -3744,11 +3744,12 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
 	});
 }
 
-mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, const int *joint_nodes, int joint_count, mlod_error *err)
+mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, const int *joint_nodes, int joint_count,
+                                   const unsigned char *strip_mesh, mlod_error *err)
 {
 	return guard(err, [&] {
 		need(doc != nullptr && (joint_nodes || joint_count == 0), "mlod_gltf_strip_levels: doc is NULL");
-		strip_levels(*doc, joint_nodes, joint_count);
+		strip_levels(*doc, joint_nodes, joint_count, strip_mesh);
 	});
 }
 

@@ -160,8 +160,12 @@ mlod_result mlod_gltf_get_node_trs(const mlod_gltf *doc, int node, mlod_trs *out
  * result is not a valid glTF on its own (triangle lists without POSITION):
  * mlod-pack -x puts the levels back. A document using an extension that
  * may refer to accessors (as mlod_gltf_prune) is MLOD_ERR_UNSUPPORTED and
- * may be partly stripped: strip a copy. */
-mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, const int *joint_nodes, int joint_count, mlod_error *err);
+ * may be partly stripped: strip a copy. strip_mesh (NULL: every mesh)
+ * holds a flag per mesh of the document: the triangle lists of a mesh
+ * whose flag is 0 stay whole (a mesh the levels do not hold: outside the
+ * default scene, or used by no node). */
+mlod_result mlod_gltf_strip_levels(mlod_gltf *doc, const int *joint_nodes, int joint_count,
+                                   const unsigned char *strip_mesh, mlod_error *err);
 
 /* For a pack's DOC chunk (mlod-pack, mlod(5)): */
 /* From now on (on != 0) mlod_gltf_drop_tail, mlod_gltf_drop_animation and

@@ -54,6 +54,114 @@ mlod_result pack_doc_copy(const struct ctx *x, const mlod_gltf *doc, mlod_gltf *
 	return r;
 }
 
+/* A piped input's level nodes (every MSFT_lod entry of x->doc, and the
+ * nodes a level skin skins: mlod-skelgraph's), their meshes and the level
+ * skins, each listed once; ln and lm hold a node count, ls a skin count. */
+static void level_refs(const struct ctx *x, int *ln, int *nln_out, int *lm, int *nlm_out, int *ls, int *nls_out)
+{
+	const mlod_skeleton *s = &x->in->skeleton;
+	const int nn = mlod_gltf_count(x->doc, MLOD_GLTF_NODE);
+	int nln = 0, nlm = 0, nls = 0;
+	for (int n = 0; n < nn; n++) {
+		int ids[64], count = 0;
+		mlod_error ignored = {0};
+		if (mlod_gltf_node_lod(x->doc, n, ids, 64, &count, &ignored) != MLOD_OK)
+			continue;
+		for (int i = 0; i < count && i < 64; i++) {
+			int mesh = -1, skin = -1;
+			if (ids[i] == n || listed(ln, nln, ids[i]))
+				continue;
+			ln[nln++] = ids[i];
+			if (mlod_gltf_node_refs(x->doc, ids[i], &mesh, &skin, &ignored) == MLOD_OK && mesh >= 0 &&
+			    !listed(lm, nlm, mesh))
+				lm[nlm++] = mesh;
+		}
+	}
+	for (int i = 0; i < s->skin_count; i++)
+		if (x->view_skin[i] < 0 && s->skins[i].gltf_index >= 0)
+			ls[nls++] = s->skins[i].gltf_index;
+	/* and the nodes a level skin skins (mlod-skelgraph's skeleton level
+	 * nodes), with their meshes */
+	for (int n = 0; nls > 0 && n < nn; n++) {
+		int mesh = -1, skin = -1;
+		mlod_error ignored = {0};
+		if (mlod_gltf_node_refs(x->doc, n, &mesh, &skin, &ignored) != MLOD_OK || !listed(ls, nls, skin))
+			continue;
+		if (!listed(ln, nln, n))
+			ln[nln++] = n;
+		if (mesh >= 0 && !listed(lm, nlm, mesh))
+			lm[nlm++] = mesh;
+	}
+	*nln_out = nln, *nlm_out = nlm, *nls_out = nls;
+}
+
+/* Which meshes of doc (a copy of x->doc, its indices the same, or a
+ * BVH's document) the DOC chunk
+ * strips (mlod_gltf_strip_levels): a flag per mesh, 1 for a mesh an
+ * instance of the character holds (its levels give it back) or a piped input's level
+ * mesh (the levels replace it); any other mesh (outside the default
+ * scene, or used by no node) keeps its triangle lists whole, with a note
+ * when it has any. *flags is malloc'd. */
+mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned char **flags, mlod_error *err)
+{
+	const mlod_character *c = x->in;
+	const int nm = mlod_gltf_count(doc, MLOD_GLTF_MESH);
+	unsigned char *f = calloc((size_t)nm + 1, 1);
+	if (!f)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	for (int i = 0; i < c->instance_count; i++) {
+		const int m = c->instances[i].mesh;
+		if (m >= 0 && m < c->mesh_count && c->meshes[m].gltf_index >= 0 && c->meshes[m].gltf_index < nm)
+			f[c->meshes[m].gltf_index] = 1;
+	}
+	if (x->doc) {
+		const int nn = mlod_gltf_count(doc, MLOD_GLTF_NODE);
+		int *ln = malloc(sizeof(int) * ((size_t)nn + 1)), *lm = malloc(sizeof(int) * ((size_t)nn + 1));
+		int *ls = malloc(sizeof(int) * ((size_t)c->skeleton.skin_count + 1)), nln = 0, nlm = 0, nls = 0;
+		if (!ln || !lm || !ls) {
+			free(ln), free(lm), free(ls), free(f);
+			return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+		}
+		level_refs(x, ln, &nln, lm, &nlm, ls, &nls);
+		for (int i = 0; i < nlm; i++)
+			if (lm[i] >= 0 && lm[i] < nm)
+				f[lm[i]] = 1;
+		free(ln), free(lm), free(ls);
+	}
+	char list[200] = "";
+	int whole = 0;
+	for (int m = 0; m < nm; m++) {
+		int triangles = 0;
+		for (int p = 0; !f[m] && !triangles; p++) {
+			char **names = NULL;
+			int count = 0, mode = 4;
+			mlod_error e = {0};
+			mlod_result r = mlod_gltf_primitive_attributes(doc, m, p, &mode, &names, &count, &e);
+			if (r == MLOD_ERR_NOMEM) {
+				free(f);
+				return mlod_fail(err, r, "%s", e.message);
+			}
+			if (r != MLOD_OK) /* past the mesh's last primitive */
+				break;
+			mlod_free(names);
+			triangles = mode == 4;
+		}
+		if (triangles && whole++ < 12) {
+			const size_t len = strlen(list);
+			snprintf(list + len, sizeof list - len, "%s%d", len ? ", " : "", m);
+		}
+	}
+	if (whole) {
+		char text[320];
+		snprintf(text, sizeof text, "mesh%s %s%s %s in no node of the default scene: the document chunk keeps %s "
+		         "whole, without levels", whole > 1 ? "es" : "", list, whole > 12 ? ", ..." : "",
+		         whole > 1 ? "are" : "is", whole > 1 ? "them" : "it");
+		pack_warn(x, text);
+	}
+	*flags = f;
+	return MLOD_OK;
+}
+
 /* The stripped DOC without what the other chunks hold (mlod(5) DOC):
  * the inverse bind matrices of the packed skins (SKEL holds them; not
  * identities), the joint nodes' translation, rotation and scale that are
@@ -133,36 +241,7 @@ mlod_result pack_doc_dedupe(struct ctx *x, mlod_gltf *copy, int whole, mlod_erro
 		free(ln), free(lm), free(ls);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 	}
-	for (int n = 0; r == MLOD_OK && n < nn; n++) {
-		int ids[64], count = 0;
-		mlod_error ignored = {0};
-		if (mlod_gltf_node_lod(x->doc, n, ids, 64, &count, &ignored) != MLOD_OK)
-			continue;
-		for (int i = 0; i < count && i < 64; i++) {
-			int mesh = -1, skin = -1;
-			if (ids[i] == n || listed(ln, nln, ids[i]))
-				continue;
-			ln[nln++] = ids[i];
-			if (mlod_gltf_node_refs(x->doc, ids[i], &mesh, &skin, &ignored) == MLOD_OK && mesh >= 0 &&
-			    !listed(lm, nlm, mesh))
-				lm[nlm++] = mesh;
-		}
-	}
-	for (int i = 0; i < s->skin_count; i++)
-		if (x->view_skin[i] < 0 && s->skins[i].gltf_index >= 0)
-			ls[nls++] = s->skins[i].gltf_index;
-	/* and the nodes a level skin skins (mlod-skelgraph's skeleton level
-	 * nodes), with their meshes */
-	for (int n = 0; nls > 0 && n < nn; n++) {
-		int mesh = -1, skin = -1;
-		mlod_error ignored = {0};
-		if (mlod_gltf_node_refs(x->doc, n, &mesh, &skin, &ignored) != MLOD_OK || !listed(ls, nls, skin))
-			continue;
-		if (!listed(ln, nln, n))
-			ln[nln++] = n;
-		if (mesh >= 0 && !listed(lm, nlm, mesh))
-			lm[nlm++] = mesh;
-	}
+	level_refs(x, ln, &nln, lm, &nlm, ls, &nls);
 	/* Each kind from its first level one on, when all of those are. */
 	int from[3] = {nn, ns, nm}, *lists[3] = {ln, ls, lm}, counts[3] = {nln, nls, nlm}, totals[3] = {nn, ns, nm};
 	for (int k = 0; k < 3; k++) {

@@ -275,8 +275,10 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			sr = mlod_fail(&serr, MLOD_ERR_NOMEM, "out of memory");
 		for (int j = 0; joint_nodes && j < c->skeleton.joint_count; j++)
 			joint_nodes[jn++] = c->skeleton.joints[j].node;
-		if (sr == MLOD_OK && !opt->doc_whole)
-			sr = mlod_gltf_strip_levels(copy, joint_nodes, jn, &serr);
+		unsigned char *strip = NULL;
+		if (sr == MLOD_OK && !opt->doc_whole && (sr = pack_doc_strip_flags(&x, copy, &strip, &serr)) == MLOD_OK)
+			sr = mlod_gltf_strip_levels(copy, joint_nodes, jn, strip, &serr);
+		free(strip);
 		free(joint_nodes);
 		if (sr == MLOD_OK && !opt->doc_whole)
 			sr = pack_doc_dedupe(&x, copy, 0, &serr);

@@ -295,5 +295,6 @@ double pack_img_error(struct ctx *x, int q, const mlod_clip *clip, const motion_
 /* packdoc.c */
 mlod_result pack_doc_copy(const struct ctx *x, const mlod_gltf *doc, mlod_gltf **copy, mlod_error *err);
 mlod_result pack_doc_dedupe(struct ctx *x, mlod_gltf *copy, int whole, mlod_error *err);
+mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned char **flags, mlod_error *err);
 
 #endif

@@ -240,7 +240,8 @@
  *   skins and everything else the input carried. The runtime skips it;
  *   mlod-pack -x rebuilds a glb from it and the levels. (Writer's note:
  *   as mlod_gltf_strip_levels makes it: primitives keep mode, material,
- *   extensions and extras with empty attributes, no indices, no targets;
+ *   extensions and extras with empty attributes, no indices, no targets,
+ *   but for meshes no node of the default scene shows, which stay whole;
  *   animations keep every channel but the joints' translation, rotation
  *   and scale, which the MOTION chunks hold (animations left empty go:
  *   animation indices change); MSFT_lod goes, its level nodes stay

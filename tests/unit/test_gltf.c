@@ -1374,7 +1374,7 @@ TEST(strip_drops_emptied_buffers)
 	CHECK_OK(mlod_gltf_read(two, strlen(two), NULL, &doc, &terr));
 	if (!doc)
 		return;
-	CHECK_OK(mlod_gltf_strip_levels(doc, NULL, 0, &terr));
+	CHECK_OK(mlod_gltf_strip_levels(doc, NULL, 0, NULL, &terr));
 	void *glb = NULL;
 	size_t size = 0;
 	CHECK_OK(mlod_gltf_write(doc, 1, &glb, &size, &terr));
