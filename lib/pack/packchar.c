@@ -276,7 +276,9 @@ static int known_attribute(const char *name)
 /* Notes each attribute of a triangle list that the pack does not store
  * (_ID, any other custom or unknown name, a fifth UV set, a second
  * colour set), from the document's primitives (lib/io lists them; the
- * DOC chunk drops them with the rest of level 0). Points, lines, strips
+ * DOC chunk drops them with the rest of level 0), then morph target
+ * normal and tangent deltas and influences past a vertex's 4 largest,
+ * from the character's parts. Points, lines, strips
  * and fans stay whole in the DOC chunk: no note. */
 mlod_result pack_note_unstored_attributes(struct ctx *x, const mlod_gltf *doc)
 {
@@ -299,6 +301,48 @@ mlod_result pack_note_unstored_attributes(struct ctx *x, const mlod_gltf *doc)
 				}
 			mlod_free(names);
 		}
+	/* What the character's own parts carry that a MESH part does not:
+	 * morph target normal and tangent deltas, influences past the 4
+	 * largest of a vertex. */
+	const mlod_character *c = x->in;
+	for (int m = 0; m < c->mesh_count; m++) {
+		int shown = 0;
+		for (int i = 0; i < c->instance_count && !shown; i++)
+			shown = c->instances[i].mesh == m;
+		for (int p = 0; shown && p < c->meshes[m].primitive_count; p++) {
+			const mlod_primitive *pr = &c->meshes[m].primitives[p];
+			int nt = 0, past = 0;
+			for (int t = 0; t < pr->target_count; t++)
+				nt |= (pr->targets[t].normals ? 1 : 0) | (pr->targets[t].tangents ? 2 : 0);
+			for (int v = 0; pr->weight_set_count > 1 && v < pr->vertex_count && !past; v++) {
+				int distinct = 0; /* joints with weight, each counted once */
+				for (int s = 0; s < pr->weight_set_count; s++)
+					for (int i = 0; i < 4; i++) {
+						const size_t a = 4 * (size_t)v + (size_t)i;
+						int seen = !(pr->weights[s][a] > 0.0f);
+						for (int s2 = 0; s2 <= s && !seen; s2++)
+							for (int i2 = 0; i2 < (s2 == s ? i : 4) && !seen; i2++) {
+								const size_t b = 4 * (size_t)v + (size_t)i2;
+								seen = pr->weights[s2][b] > 0.0f && pr->joints[s2][b] == pr->joints[s][a];
+							}
+						distinct += !seen;
+					}
+				past = distinct > 4;
+			}
+			char text[256];
+			if (nt) {
+				snprintf(text, sizeof text, "mesh %d primitive %d: morph target %s deltas are not stored in the pack "
+				         "(position deltas only)", c->meshes[m].gltf_index, p,
+				         nt == 3 ? "normal and tangent" : nt == 1 ? "normal" : "tangent");
+				pack_warn(x, text);
+			}
+			if (past) {
+				snprintf(text, sizeof text, "mesh %d primitive %d: influences past the 4 largest of a vertex are "
+				         "dropped (the 4 kept are scaled to sum to 1)", c->meshes[m].gltf_index, p);
+				pack_warn(x, text);
+			}
+		}
+	}
 	return MLOD_OK;
 }
 
