@@ -1127,10 +1127,18 @@ void check_document(const Model &m, size_t input_size)
 	}
 	node_parents(m);
 	for (size_t i = 0; i < m.skins.size(); i++) {
-		for (int j : m.skins[i].joints) {
+		/* A node listed twice (the validator's DUPLICATE_ELEMENTS) would
+		 * make two joints of one node, each skinning with its own bind. */
+		std::map<int, size_t> listed;
+		for (size_t k = 0; k < m.skins[i].joints.size(); k++) {
+			const int j = m.skins[i].joints[k];
 			if (j < 0)
 				fail(MLOD_ERR_PARSE, "skin %zu: joint node %d does not exist", i, j);
 			check_ref(j, m.nodes.size(), "skin %zu", i, "joint node");
+			auto seen = listed.emplace(j, k);
+			if (!seen.second)
+				fail(MLOD_ERR_PARSE, "skin %zu %s: joints %zu and %zu are both node %d", i,
+				     quoted(m.skins[i].name).c_str(), seen.first->second, k, j);
 		}
 		check_ref(m.skins[i].skeleton, m.nodes.size(), "skin %zu", i, "skeleton node");
 		check_ref(m.skins[i].inverseBindMatrices, accessors, "skin %zu", i, "inverseBindMatrices accessor");
