@@ -28,13 +28,29 @@
 
 #include "bgm.h"
 
+/* Whether corners a, b, c (vertex indices) make a triangle of nonzero
+ * area. */
+static int has_area(const float *pos, uint32_t a, uint32_t b, uint32_t c)
+{
+	const float *A = pos + 3 * (size_t)a, *B = pos + 3 * (size_t)b, *C = pos + 3 * (size_t)c;
+	const double u[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]}, v[3] = {C[0] - A[0], C[1] - A[1], C[2] - A[2]};
+	const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+	return n[0] != 0.0 || n[1] != 0.0 || n[2] != 0.0;
+}
+
 int bgm_has_triangle(const mlod_primitive *p)
 {
-	if (p->index_count == 0)
-		return p->vertex_count >= 3;
+	if (p->index_count == 0) {
+		for (int t = 0; t + 2 < p->vertex_count; t += 3)
+			if (!p->positions || has_area(p->positions, (uint32_t)t, (uint32_t)t + 1, (uint32_t)t + 2))
+				return 1;
+		return 0;
+	}
 	for (int t = 0; t + 2 < p->index_count; t += 3) {
 		const uint32_t *ix = p->indices + t;
-		if (ix[0] != ix[1] && ix[1] != ix[2] && ix[0] != ix[2])
+		if (ix[0] != ix[1] && ix[1] != ix[2] && ix[0] != ix[2] &&
+		    (!p->positions || (ix[0] < (uint32_t)p->vertex_count && ix[1] < (uint32_t)p->vertex_count &&
+		                       ix[2] < (uint32_t)p->vertex_count && has_area(p->positions, ix[0], ix[1], ix[2]))))
 			return 1;
 	}
 	return 0;
@@ -760,7 +776,7 @@ mlod_result mlod_bgm_build(const mlod_character *c, int instance, int primitive,
 			return mlod_fail(err, MLOD_ERR_PARSE, "mesh %d primitive %d: weight set %d has no data", in->mesh,
 			                 primitive, s);
 	if (!bgm_has_triangle(p))
-		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "mesh %d primitive %d: every triangle repeats a corner", in->mesh,
+		return mlod_fail(err, MLOD_ERR_UNSUPPORTED, "mesh %d primitive %d: no triangle has an area", in->mesh,
 		                 primitive);
 
 	mlod_bgm *g = calloc(1, sizeof *g);

@@ -177,9 +177,9 @@ void bgm_inc_remove(mlod_bgm *g, int node, int face);
 double bgm_seconds(void);
 
 /* Whether a triangles primitive has a triangle with three distinct
- * corners: one whose corners all repeat (indices all zero, say) has no
- * surface to simplify or measure, and mlod_bgm_build refuses it as
- * unsupported. */
+ * corners and a nonzero area: one without (indices all zero, or every
+ * position the same point, say) has no surface to simplify or measure,
+ * and mlod_bgm_build refuses it as unsupported. */
 int bgm_has_triangle(const mlod_primitive *p);
 /* Do the m directed edges from[i] -> to[i] (node ids) form one cycle, or
  * with path_ok one path? A link of more than 256 edges or with a

@@ -95,6 +95,14 @@ static int primitive_triangles(const mlod_primitive *p)
 	return (p->index_count > 0 ? p->index_count : p->vertex_count) / 3;
 }
 
+int mlod_mesh_has_surface(const mlod_mesh *m)
+{
+	for (int p = 0; p < m->primitive_count; p++)
+		if (primitive_triangles(&m->primitives[p]) > 0 && bgm_has_triangle(&m->primitives[p]))
+			return 1;
+	return 0;
+}
+
 int mlod_mesh_triangle_primitives(const mlod_character *c)
 {
 	int n = 0;
@@ -330,7 +338,8 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 	if (L->statics)
 		note(L, "%d primitive(s) of static meshes (no joint, no skin) simplified in world space", L->statics);
 	if (unsupported)
-		note(L, "%d primitive(s) that are not triangles, or whose every triangle repeats a corner, left as they are", unsupported);
+		note(L, "%d primitive(s) that are not triangles, or whose every triangle repeats a corner or has no area, left "
+		     "as they are", unsupported);
 	if (morphs)
 		note(L, "%d primitive(s) with morph targets: offsets interpolated like positions", morphs);
 	return MLOD_OK;

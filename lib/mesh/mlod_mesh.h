@@ -306,6 +306,10 @@ void mlod_mesh_resolve(mlod_bgm_options *opt, mlod_mesh_budget *budget);
 
 /* The triangle primitives (mode 4) of the character's instances. */
 int mlod_mesh_triangle_primitives(const mlod_character *c);
+/* Whether a mesh has a triangle list with a triangle of three distinct
+ * corners and a nonzero area: one the mesh layer simplifies (the others
+ * are left as they are). */
+int mlod_mesh_has_surface(const mlod_mesh *m);
 
 /* One level of the whole character. */
 typedef struct mlod_mesh_level {

@@ -98,7 +98,8 @@ static void level_refs(const struct ctx *x, int *ln, int *nln_out, int *lm, int 
 /* Which meshes of doc (a copy of x->doc, its indices the same, or a
  * BVH's document) the DOC chunk
  * strips (mlod_gltf_strip_levels): a flag per mesh, 1 for a mesh an
- * instance of the character holds (its levels give it back) or a piped input's level
+ * instance of the character holds with a surface (mlod_mesh_has_surface:
+ * else no MESH part gives it back) (its levels give it back) or a piped input's level
  * mesh (the levels replace it); any other mesh (outside the default
  * scene, or used by no node) keeps its triangle lists whole, with a note
  * when it has any. *flags is malloc'd. */
@@ -112,7 +113,7 @@ mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned c
 	for (int i = 0; i < c->instance_count; i++) {
 		const int m = c->instances[i].mesh;
 		if (m >= 0 && m < c->mesh_count && c->meshes[m].gltf_index >= 0 && c->meshes[m].gltf_index < nm)
-			f[c->meshes[m].gltf_index] = 1;
+			f[c->meshes[m].gltf_index] = mlod_mesh_has_surface(&c->meshes[m]) ? 1 : 2;
 	}
 	if (x->doc) {
 		const int nn = mlod_gltf_count(doc, MLOD_GLTF_NODE);
@@ -146,7 +147,9 @@ mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned c
 			mlod_free(names);
 			triangles = mode == 4;
 		}
-		if (triangles && whole++ < 12) {
+		if (f[m] == 2) /* shown, but no surface: whole, as the mesh layer leaves it */
+			f[m] = 0;
+		else if (triangles && whole++ < 12) {
 			const size_t len = strlen(list);
 			snprintf(list + len, sizeof list - len, "%s%d", len ? ", " : "", m);
 		}
