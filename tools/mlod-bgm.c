@@ -119,13 +119,16 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	mlod_error err = {0};
 	mlod_mesh_lod lod;
 	mlod_record_mesh_level rec[MLOD_MESH_MAX_LEVELS];
-	if (mlod_mesh_levels_write(&job->L, doc, &lod, &err) != MLOD_OK)
-		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+	/* Adding the levels to the document in memory: its failure is the
+	 * input's (or memory's), not the output file's, nor a usage error. */
+	mlod_result r = mlod_mesh_levels_write(&job->L, doc, &lod, &err);
+	if (r != MLOD_OK)
+		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_INPUT, job->input, "%s", err.message);
 	for (int k = 0; k < job->L.count; k++)
 		rec[k] = level_record(&job->L.levels[k], k);
-	if (mlod_record_write_mesh_nodes(doc, &job->L, &lod, &err) != MLOD_OK ||
-	    (job->L.count > 0 && mlod_record_write_mesh_levels(doc, rec, job->L.count, &err) != MLOD_OK))
-		tool_die(EXIT_OUTPUT, NULL, "%s", err.message);
+	if ((r = mlod_record_write_mesh_nodes(doc, &job->L, &lod, &err)) != MLOD_OK ||
+	    (job->L.count > 0 && (r = mlod_record_write_mesh_levels(doc, rec, job->L.count, &err)) != MLOD_OK))
+		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_INPUT, job->input, "%s", err.message);
 	mlod_mesh_lod_free(&lod);
 	tool_write_gltf(output, doc);
 }
