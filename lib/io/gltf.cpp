@@ -666,6 +666,29 @@ void check_buffer_uris(const json &doc, const char *base_dir)
 	}
 }
 
+/* An external image is embedded in what mlod writes, so it must be read
+ * as a buffer is: from below base_dir. One elsewhere would leave the
+ * written glb a relative URI that no longer points at it: refused, as
+ * such a buffer is. Without a base directory (standard input, a pack's
+ * DOC chunk), or when the file is missing, an image keeps its URI. */
+void check_image_uris(const json &doc, const char *base_dir)
+{
+	auto images = doc.find("images");
+	if (images == doc.end() || !images->is_array())
+		return;
+	for (size_t i = 0; i < images->size(); i++) {
+		const json &im = (*images)[i];
+		if (!im.is_object() || !im.contains("uri") || !im["uri"].is_string())
+			continue;
+		std::string uri = im["uri"].get<std::string>();
+		if (uri.compare(0, 5, "data:") == 0)
+			continue;
+		if (base_dir && !stays_inside(url_decode(uri)))
+			fail(MLOD_ERR_UNSUPPORTED, "image %zu: URI \"%s\" is not a file below the base directory", i,
+			     uri.c_str());
+	}
+}
+
 /* ------------------------------------------------------------------ */
 /* Reading: tinygltf callbacks                                         */
 /* ------------------------------------------------------------------ */
@@ -1322,6 +1345,7 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 	check_types(j);
 	check_required_extensions(j);
 	check_buffer_uris(j, base_dir);
+	check_image_uris(j, base_dir);
 
 	tinygltf::TinyGLTF loader;
 	FileAccess access{base_dir != nullptr, base_dir ? join_path(base_dir, "") : ""};
