@@ -611,6 +611,23 @@ std::string url_decode(const std::string &s)
 	return out;
 }
 
+/* text with every byte outside printable ASCII as \xNN: a JSON parser's
+ * message quotes what it last read, which may be any bytes of the file. */
+std::string printable(const char *text)
+{
+	std::string out;
+	for (const unsigned char *c = reinterpret_cast<const unsigned char *>(text); *c; c++) {
+		if (*c >= 0x20 && *c < 0x7f) {
+			out += char(*c);
+		} else {
+			char hex[8];
+			snprintf(hex, sizeof hex, "\\x%02x", unsigned(*c));
+			out += hex;
+		}
+	}
+	return out;
+}
+
 /* Is path a plain relative path that stays below the base directory (no
  * scheme, not absolute, no ".." segment)? Other URIs are not opened, so a
  * hostile file cannot make mlod embed arbitrary local files. */
@@ -1338,7 +1355,8 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 			j = parse_json(reinterpret_cast<const char *>(data), size);
 		}
 	} catch (const json::exception &e) {
-		fail(MLOD_ERR_PARSE, "%s: %s", binary ? "glb JSON chunk" : "not glTF (neither glb nor JSON)", e.what());
+		fail(MLOD_ERR_PARSE, "%s: %s", binary ? "glb JSON chunk" : "not glTF (neither glb nor JSON)",
+		     printable(e.what()).c_str());
 	}
 	if (!j.is_object())
 		fail(MLOD_ERR_PARSE, "not glTF: the JSON is not an object");
@@ -3586,7 +3604,7 @@ mlod_result mlod_gltf_set_extra(mlod_gltf *doc, mlod_gltf_kind kind, int index, 
 		try {
 			v = parse_json(text, strlen(text));
 		} catch (const json::exception &e) {
-			fail(MLOD_ERR_INVALID_ARG, "extras \"%s\": not JSON: %s", key, e.what());
+			fail(MLOD_ERR_INVALID_ARG, "extras \"%s\": not JSON: %s", key, printable(e.what()).c_str());
 		} catch (const Failure &f) {
 			fail(MLOD_ERR_INVALID_ARG, "extras \"%s\": %s", key, f.message.c_str());
 		}
