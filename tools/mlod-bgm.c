@@ -124,6 +124,7 @@ static void write_glb(struct job *job, mlod_gltf *doc, const char *output)
 	mlod_result r = mlod_mesh_levels_write(&job->L, doc, &lod, &err);
 	if (r != MLOD_OK)
 		tool_die(r == MLOD_ERR_UNSUPPORTED ? EXIT_UNSUPPORTED : EXIT_INPUT, job->input, "%s", err.message);
+	tool_note_items(job->input, job->L.notes, "stay outside the level list"); /* the input's own MSFT_lod */
 	for (int k = 0; k < job->L.count; k++)
 		rec[k] = level_record(&job->L.levels[k], k);
 	if ((r = mlod_record_write_mesh_nodes(doc, &job->L, &lod, &err)) != MLOD_OK ||

@@ -335,7 +335,7 @@ int main(int argc, char **argv)
 		tool_die(tool_exit_code(r), label, "%s", err.message);
 	if (c.clip_count == 0 && c.skeleton.joint_count > 0)
 		tool_note(label, "no animation: the pack has no motion levels");
-	if (in.format != MLOD_FORMAT_BVH && st.mesh.levels == 0)
+	if (c.mesh_count > 0 && st.mesh.levels == 0)
 		tool_note(label, "no triangle mesh in the default scene: the pack has no mesh levels");
 	tool_note_lines(label, st.warnings); /* what the pack does not keep, or keeps changed */
 	/* A layer option the input's own levels (mlod-skelgraph's, mlod-bgm's,

@@ -262,6 +262,26 @@ mlod_result mlod_mesh_levels_write(mlod_mesh_levels *L, mlod_gltf *doc, mlod_mes
 			out->skeleton_level[out->count++] = sk && skin >= 0;
 			lod_nodes[k] = node;
 		}
+		/* A node that has MSFT_lod levels of its own (not a stage's: an
+		 * input with mesh levels passes through, and mlod-skelgraph's
+		 * skeleton levels are followed, L->skeleton_count) gets mlod's
+		 * instead; its own level nodes stay in the document, outside the
+		 * list. */
+		int own[8], own_count = 0;
+		mlod_error ignored = {0};
+		if (r == MLOD_OK && L->skeleton_count == 0 &&
+		    mlod_gltf_node_lod(doc, in->node, own, 8, &own_count, &ignored) == MLOD_OK &&
+		    own_count > 0) {
+			char text[200];
+			int at = snprintf(text, sizeof text, "node %d: its own MSFT_lod levels (node", in->node);
+			for (int k = 0; k < own_count && k < 8 && at > 0 && (size_t)at < sizeof text; k++)
+				at += snprintf(text + at, sizeof text - (size_t)at, "%s %d", k ? "," : (own_count > 1 ? "s" : ""),
+				               own[k]);
+			if (at > 0 && (size_t)at < sizeof text)
+				snprintf(text + at, sizeof text - (size_t)at, ") are replaced by mlod's: those nodes stay outside "
+				         "the level list");
+			mlod_mesh_note_(L, text);
+		}
 		if (r == MLOD_OK)
 			r = mlod_gltf_set_lod(doc, in->node, lod_nodes, L->count, coverage, err);
 	}

@@ -100,9 +100,9 @@ static void level_refs(const struct ctx *x, int *ln, int *nln_out, int *lm, int 
  * strips (mlod_gltf_strip_levels): a flag per mesh, 1 for a mesh an
  * instance of the character holds with a surface (mlod_mesh_has_surface:
  * else no MESH part gives it back) (its levels give it back) or a piped input's level
- * mesh (the levels replace it); any other mesh (outside the default
- * scene, or used by no node) keeps its triangle lists whole, with a note
- * when it has any. *flags is malloc'd. */
+ * mesh (the levels replace it), or a mesh no node uses; any other mesh
+ * (on a node outside the default scene) keeps its triangle lists whole,
+ * with a warning when it has any. *flags is malloc'd. */
 mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned char **flags, mlod_error *err)
 {
 	const mlod_character *c = x->in;
@@ -127,8 +127,38 @@ mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned c
 		for (int i = 0; i < nlm; i++)
 			if (lm[i] >= 0 && lm[i] < nm)
 				f[lm[i]] = 1;
+		/* MSFT_lod levels without a stage record of levels are the
+		 * input's own: the DOC chunk keeps MSFT_lod of no node
+		 * (mlod_gltf_strip_levels), so they go; said, not silent. */
+		if (nln > 0 && x->rec.mesh_level_count == 0 && x->rec.skel_level_count == 0) {
+			char text[200];
+			int at = snprintf(text, sizeof text, "the input's own MSFT_lod level node%s", nln > 1 ? "s" : "");
+			for (int i = 0; i < nln && i < 8 && at > 0 && (size_t)at < sizeof text; i++)
+				at += snprintf(text + at, sizeof text - (size_t)at, "%s %d", i ? "," : "", ln[i]);
+			if (at > 0 && (size_t)at < sizeof text)
+				snprintf(text + at, sizeof text - (size_t)at, "%s %s not kept: the pack's levels replace %s",
+				         nln > 8 ? ", ..." : "", nln > 1 ? "are" : "is", nln > 1 ? "them" : "it");
+			pack_warn(x, text);
+		}
 		free(ln), free(lm), free(ls);
 	}
+	/* A mesh no node uses goes as the others do (-x writes no such mesh):
+	 * no bytes kept for it. */
+	unsigned char *used = calloc((size_t)nm + 1, 1);
+	if (!used) {
+		free(f);
+		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
+	}
+	for (int n = 0; n < mlod_gltf_count(doc, MLOD_GLTF_NODE); n++) {
+		int mesh = -1, skin = -1;
+		mlod_error ignored = {0};
+		if (mlod_gltf_node_refs(doc, n, &mesh, &skin, &ignored) == MLOD_OK && mesh >= 0 && mesh < nm)
+			used[mesh] = 1;
+	}
+	for (int m = 0; m < nm; m++)
+		if (!used[m])
+			f[m] = 1;
+	free(used);
 	char list[200] = "";
 	int whole = 0;
 	for (int m = 0; m < nm; m++) {
@@ -156,7 +186,7 @@ mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned c
 	}
 	if (whole) {
 		char text[320];
-		snprintf(text, sizeof text, "mesh%s %s%s %s in no node of the default scene: the document chunk keeps %s "
+		snprintf(text, sizeof text, "mesh%s %s%s %s on no node of the default scene: the document chunk keeps %s "
 		         "whole, without levels", whole > 1 ? "es" : "", list, whole > 12 ? ", ..." : "",
 		         whole > 1 ? "are" : "is", whole > 1 ? "them" : "it");
 		pack_warn(x, text);

@@ -241,7 +241,8 @@
  *   mlod-pack -x rebuilds a glb from it and the levels. (Writer's note:
  *   as mlod_gltf_strip_levels makes it: primitives keep mode, material,
  *   extensions and extras with empty attributes, no indices, no targets,
- *   but for meshes no node of the default scene shows, which stay whole;
+ *   but for meshes on nodes the default scene does not show, which stay
+ *   whole;
  *   animations keep every channel but the joints' translation, rotation
  *   and scale, which the MOTION chunks hold (animations left empty go:
  *   animation indices change); MSFT_lod goes, its level nodes stay
