@@ -174,6 +174,12 @@ static inline tagname tagn(uint32_t tag)
 /* The chunk's name in messages: "MESH level 2", "MOTION level 1 of clip 0". */
 void pk_chunk_label(uint32_t type, unsigned level, unsigned item, char *buf, size_t n);
 
+/* The start of a decode of the pack's one chunk of a type (INFO,
+ * SKELETON): out (out_size bytes) zeroed, then the pack and the chunk's
+ * index (*ci) found; fn names the call in messages (rd_open.c). */
+mlod_result pk_find_one(const mlod_pack *p, uint32_t type, void *out, size_t out_size, const char *fn, int *ci,
+                        mlod_error *err);
+
 /* The pack's zstd decoder (rd_stream.c), made by open when a chunk has an
  * entropy stage. */
 typedef struct zdec zdec;
@@ -275,15 +281,17 @@ _Static_assert(sizeof(mlod_pack_alloc) <= BLOCK_SIZE_AT && BLOCK_SIZE_AT + sizeo
                "the block's head holds its allocator and its size");
 
 /* pk_bump_alloc makes a block (total bytes after its head), bump_take
- * carves it, pk_block_free frees it by the allocator its head records
- * (rd_stream.c). */
+ * carves it; pk_block_release frees it by the allocator its head records
+ * and zeroes the struct that held it (the *_free calls); pk_undo is a
+ * decode's failure: x done, b's block freed, r returned (rd_stream.c). */
 typedef struct bump {
 	uint8_t *base;
 	uint64_t used, cap;
 } bump;
 
 mlod_result pk_bump_alloc(bump *b, cx *x, uint64_t total, mlod_error *err);
-void pk_block_free(void *block);
+void pk_block_release(void *block, void *owner, size_t owner_size);
+mlod_result pk_undo(cx *x, bump *b, mlod_result r);
 
 /* p, a pointer into b's block (else returned as it is), at the same
  * offset of nb, a copy of its used bytes. */

@@ -17,19 +17,15 @@
 mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t size, mlod_pack_info *out,
                                   mlod_error *err)
 {
-	if (!out)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_info: out is NULL");
-	memset(out, 0, sizeof *out);
-	if (!p)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_info: the pack is NULL");
-	int ci = mlod_pack_find(p, MLOD_CHUNK_INFO, 0, 0);
-	if (ci < 0)
-		return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no INFO chunk");
+	int ci;
+	mlod_result r = pk_find_one(p, MLOD_CHUNK_INFO, out, sizeof *out, "mlod_pack_decode_info", &ci, err);
+	if (r != MLOD_OK)
+		return r;
 	cx x;
 	bump b = {0};
 	stream s_info, s_name;
 	const uint8_t *src;
-	mlod_result r = pk_cx_begin(p, (uint32_t)ci, MLOD_CHUNK_INFO, data, size, &x, err);
+	r = pk_cx_begin(p, (uint32_t)ci, MLOD_CHUNK_INFO, data, size, &x, err);
 	if (r != MLOD_OK)
 		return r;
 	TRY(pk_cx_expect(&x, &s_info, MLOD_STREAM_INFO, sizeof(mlod_pack_info_rec), 1, "", "one record", err));
@@ -119,17 +115,13 @@ mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t s
 	out->block = b.base;
 	return MLOD_OK;
 fail:
-	pk_cx_done(&x);
-	pk_free(&x.alloc, b.base);
-	return r;
+	return pk_undo(&x, &b, r);
 }
 
 void mlod_pack_info_free(mlod_pack_info *x)
 {
-	if (!x)
-		return;
-	pk_block_free(x->block);
-	memset(x, 0, sizeof *x);
+	if (x)
+		pk_block_release(x->block, x, sizeof *x);
 }
 
 /* ------------------------------------------------------------------ */
@@ -208,10 +200,8 @@ mlod_result mlod_pack_decode_doc(const mlod_pack *p, const void *data, size_t si
 
 void mlod_pack_doc_free(mlod_pack_doc_bytes *x)
 {
-	if (!x)
-		return;
-	pk_block_free(x->block);
-	memset(x, 0, sizeof *x);
+	if (x)
+		pk_block_release(x->block, x, sizeof *x);
 }
 
 /* Every chunk decoded in TOC order and released, stopping at the first

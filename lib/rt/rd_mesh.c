@@ -910,8 +910,6 @@ mlod_result mlod_pack_decode_mesh_fetch(const mlod_pack *p, uint32_t chunk, mlod
 
 void mlod_pack_mesh_free(mlod_pack_mesh *x)
 {
-	if (!x)
-		return;
-	pk_block_free(x->block);
-	memset(x, 0, sizeof *x);
+	if (x)
+		pk_block_release(x->block, x, sizeof *x);
 }

@@ -428,15 +428,11 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	out->block = b.base;
 	return MLOD_OK;
 fail:
-	pk_cx_done(&x);
-	pk_free(&x.alloc, b.base);
-	return r;
+	return pk_undo(&x, &b, r);
 }
 
 void mlod_pack_motion_free(mlod_pack_motion *x)
 {
-	if (!x)
-		return;
-	pk_block_free(x->block);
-	memset(x, 0, sizeof *x);
+	if (x)
+		pk_block_release(x->block, x, sizeof *x);
 }

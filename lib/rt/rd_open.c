@@ -384,6 +384,23 @@ int mlod_pack_find(const mlod_pack *p, uint32_t type, unsigned level, unsigned i
 	return -1;
 }
 
+mlod_result pk_find_one(const mlod_pack *p, uint32_t type, void *out, size_t out_size, const char *fn, int *ci,
+                        mlod_error *err)
+{
+	if (!out)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: out is NULL", fn);
+	memset(out, 0, out_size);
+	if (!p)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "%s: the pack is NULL", fn);
+	*ci = mlod_pack_find(p, type, 0, 0);
+	if (*ci < 0) {
+		char label[64];
+		pk_chunk_label(type, 0, 0, label, sizeof label);
+		return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no %s chunk", label);
+	}
+	return MLOD_OK;
+}
+
 const char *mlod_pack_type_name(uint32_t type)
 {
 	switch (type) {

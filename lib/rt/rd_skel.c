@@ -16,19 +16,15 @@
 mlod_result mlod_pack_decode_skeleton(const mlod_pack *p, const void *data, size_t size, mlod_pack_skeleton *out,
                                       mlod_error *err)
 {
-	if (!out)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_skeleton: out is NULL");
-	memset(out, 0, sizeof *out);
-	if (!p)
-		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_skeleton: the pack is NULL");
-	int ci = mlod_pack_find(p, MLOD_CHUNK_SKELETON, 0, 0);
-	if (ci < 0)
-		return mlod_fail(err, MLOD_ERR_PARSE, "the pack has no SKELETON chunk");
+	int ci;
+	mlod_result r = pk_find_one(p, MLOD_CHUNK_SKELETON, out, sizeof *out, "mlod_pack_decode_skeleton", &ci, err);
+	if (r != MLOD_OK)
+		return r;
 	cx x;
 	bump b = {0};
 	stream sj, sn, ss, sk, si;
 	const uint8_t *src;
-	mlod_result r = pk_cx_begin(p, (uint32_t)ci, MLOD_CHUNK_SKELETON, data, size, &x, err);
+	r = pk_cx_begin(p, (uint32_t)ci, MLOD_CHUNK_SKELETON, data, size, &x, err);
 	if (r != MLOD_OK)
 		return r;
 	TRY(pk_cx_expect(&x, &sj, MLOD_STREAM_JNTS, sizeof(mlod_pack_joint_rec), UINT64_MAX, "", "", err));
@@ -124,17 +120,13 @@ mlod_result mlod_pack_decode_skeleton(const mlod_pack *p, const void *data, size
 	out->block = b.base;
 	return MLOD_OK;
 fail:
-	pk_cx_done(&x);
-	pk_free(&x.alloc, b.base);
-	return r;
+	return pk_undo(&x, &b, r);
 }
 
 void mlod_pack_skeleton_free(mlod_pack_skeleton *x)
 {
-	if (!x)
-		return;
-	pk_block_free(x->block);
-	memset(x, 0, sizeof *x);
+	if (x)
+		pk_block_release(x->block, x, sizeof *x);
 }
 
 /* ------------------------------------------------------------------ */
@@ -264,15 +256,11 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	out->block = b.base;
 	return MLOD_OK;
 fail:
-	pk_cx_done(&x);
-	pk_free(&x.alloc, b.base);
-	return r;
+	return pk_undo(&x, &b, r);
 }
 
 void mlod_pack_skel_level_free(mlod_pack_skel_level *x)
 {
-	if (!x)
-		return;
-	pk_block_free(x->block);
-	memset(x, 0, sizeof *x);
+	if (x)
+		pk_block_release(x->block, x, sizeof *x);
 }

@@ -505,13 +505,27 @@ size_t mlod_pack_block_size(const void *block)
 	return (size_t)n;
 }
 
-void pk_block_free(void *block)
+/* A block freed by the allocator its head records. */
+static void block_free(void *block)
 {
 	if (!block)
 		return;
 	mlod_pack_alloc a;
 	memcpy(&a, block, sizeof a);
 	pk_free(&a, block);
+}
+
+void pk_block_release(void *block, void *owner, size_t owner_size)
+{
+	block_free(block);
+	memset(owner, 0, owner_size);
+}
+
+mlod_result pk_undo(cx *x, bump *b, mlod_result r)
+{
+	pk_cx_done(x);
+	pk_free(&x->alloc, b->base);
+	return r;
 }
 
 mlod_result pk_bump_alloc(bump *b, cx *x, uint64_t total, mlod_error *err)
