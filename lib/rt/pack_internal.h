@@ -180,11 +180,17 @@ void pk_chunk_label(uint32_t type, unsigned level, unsigned item, char *buf, siz
 mlod_result pk_find_one(const mlod_pack *p, uint32_t type, void *out, size_t out_size, const char *fn, int *ci,
                         mlod_error *err);
 
-/* The pack's zstd decoder (rd_stream.c), made by open when a chunk has an
- * entropy stage. */
-typedef struct zdec zdec;
-zdec *pk_zdec_new(const mlod_pack_alloc *alloc);
-void pk_zdec_free(const mlod_pack_alloc *alloc, zdec *d);
+/* zstd's decoder context, one per opened pack (its set-up costs about as
+ * much as decoding a small chunk, so the decodes share it), made by open
+ * (rd_open.c) with the pack's allocator when a chunk has an entropy stage:
+ * a block holding a copy of the allocator (zstd's hooks point to it, so
+ * the pack struct may be copied) and the context, which rd_stream.c
+ * decodes with (struct ZSTD_DCtx_s: zstd.h's ZSTD_DCtx, not included
+ * here). */
+typedef struct zdec {
+	mlod_pack_alloc a;
+	struct ZSTD_DCtx_s *z;
+} zdec;
 
 typedef struct stream {
 	uint32_t index, tag, count, elsize, codec, stored;

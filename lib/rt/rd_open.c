@@ -8,6 +8,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* ZSTD_createDCtx_advanced (the allocator hooks) is in zstd's advanced
+ * API; libzstd exports it. */
+#define ZSTD_STATIC_LINKING_ONLY
+#include <zstd.h>
+
 #define MLOD_PACK_READER /* pack_internal.h: the reader's own part */
 #include "pack_internal.h"
 
@@ -153,6 +158,56 @@ static uint64_t order_key(const mlod_pack_chunk *c, unsigned mesh_top, unsigned 
 		return (uint64_t)3 << 40 | (uint64_t)(motion_top - c->level) << 24 | (uint64_t)1 << 16 | c->item;
 	default: return (uint64_t)4 << 40;
 	}
+}
+
+/* ------------------------------------------------------------------ */
+/* The entropy stage's decoder, made at open                           */
+/* ------------------------------------------------------------------ */
+
+static void *zs_alloc(void *user, size_t size)
+{
+	const mlod_pack_alloc *a = user;
+	return a->malloc(a->user, size);
+}
+
+static void zs_free(void *user, void *p)
+{
+	const mlod_pack_alloc *a = user;
+	if (p)
+		a->free(a->user, p);
+}
+
+static zdec *zdec_new(const mlod_pack_alloc *alloc)
+{
+	zdec *d = pk_calloc(alloc, 1, sizeof *d);
+	if (!d)
+		return NULL;
+	if (alloc && alloc->malloc && alloc->free) {
+		d->a = *alloc;
+		ZSTD_customMem mem = {zs_alloc, zs_free, &d->a};
+		d->z = ZSTD_createDCtx_advanced(mem);
+	} else {
+		d->z = ZSTD_createDCtx();
+	}
+	if (!d->z) {
+		pk_free(alloc, d);
+		return NULL;
+	}
+	return d;
+}
+
+static void zdec_free(const mlod_pack_alloc *alloc, zdec *d)
+{
+	if (!d)
+		return;
+	ZSTD_freeDCtx(d->z);
+	pk_free(alloc, d);
+}
+
+size_t mlod_pack_decoder_bytes(const mlod_pack *p)
+{
+	const zdec *d = p ? p->zstd : NULL;
+	return d ? sizeof *d + ZSTD_sizeof_DCtx(d->z) : 0;
 }
 
 /* ------------------------------------------------------------------ */
@@ -343,7 +398,7 @@ mlod_result mlod_pack_open_alloc(const void *data, size_t size, const mlod_pack_
 		coarser = 1;
 	}
 	zdec *zd = NULL;
-	if (r == MLOD_OK && zstd && !(zd = pk_zdec_new(alloc)))
+	if (r == MLOD_OK && zstd && !(zd = zdec_new(alloc)))
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "pack TOC: out of memory for the zstd decoder");
 	if (r != MLOD_OK) {
 		pk_free(alloc, chunks);
@@ -368,7 +423,7 @@ void mlod_pack_close(mlod_pack *p)
 	if (!p)
 		return;
 	pk_free(&p->alloc, p->chunks);
-	pk_zdec_free(&p->alloc, p->zstd);
+	zdec_free(&p->alloc, p->zstd);
 	memset(p, 0, sizeof *p);
 }
 

@@ -1,7 +1,8 @@
 /*
  * rd_stream.c: a chunk's bytes to its streams: the CRC, the entropy
- * stage's decoder (zstd), the stream container and its streams' codecs,
- * and the block a decode carves its arrays from.
+ * stage (zstd, with the pack's decoder made in rd_open.c), the stream
+ * container and its streams' codecs, and the block a decode carves its
+ * arrays from.
  */
 #include <math.h>
 #include <stdio.h>
@@ -10,72 +11,12 @@
 
 #include <meshoptimizer.h>
 
-/* ZSTD_createDCtx_advanced (the allocator hooks) is in zstd's advanced
- * API; libzstd exports it. */
+/* ZSTD_DCtx_refPrefix is in zstd's advanced API; libzstd exports it. */
 #define ZSTD_STATIC_LINKING_ONLY
 #include <zstd.h>
 
 #define MLOD_PACK_READER /* pack_internal.h: the reader's own part */
 #include "pack_internal.h"
-
-/* ------------------------------------------------------------------ */
-/* The entropy stage's decoder                                         */
-/* ------------------------------------------------------------------ */
-
-/* zstd's decoder context, one per opened pack (its set-up costs about as
- * much as decoding a small chunk, so the decodes share it), made with the
- * pack's allocator: a block holding a copy of the allocator (zstd's hooks
- * point to it, so the pack struct may be copied) and the context. */
-typedef struct zdec {
-	mlod_pack_alloc a;
-	ZSTD_DCtx *z;
-} zdec;
-
-static void *zs_alloc(void *user, size_t size)
-{
-	const mlod_pack_alloc *a = user;
-	return a->malloc(a->user, size);
-}
-
-static void zs_free(void *user, void *p)
-{
-	const mlod_pack_alloc *a = user;
-	if (p)
-		a->free(a->user, p);
-}
-
-zdec *pk_zdec_new(const mlod_pack_alloc *alloc)
-{
-	zdec *d = pk_calloc(alloc, 1, sizeof *d);
-	if (!d)
-		return NULL;
-	if (alloc && alloc->malloc && alloc->free) {
-		d->a = *alloc;
-		ZSTD_customMem mem = {zs_alloc, zs_free, &d->a};
-		d->z = ZSTD_createDCtx_advanced(mem);
-	} else {
-		d->z = ZSTD_createDCtx();
-	}
-	if (!d->z) {
-		pk_free(alloc, d);
-		return NULL;
-	}
-	return d;
-}
-
-void pk_zdec_free(const mlod_pack_alloc *alloc, zdec *d)
-{
-	if (!d)
-		return;
-	ZSTD_freeDCtx(d->z);
-	pk_free(alloc, d);
-}
-
-size_t mlod_pack_decoder_bytes(const mlod_pack *p)
-{
-	const zdec *d = p ? p->zstd : NULL;
-	return d ? sizeof *d + ZSTD_sizeof_DCtx(d->z) : 0;
-}
 
 /* ------------------------------------------------------------------ */
 /* A chunk's stream container                                          */
