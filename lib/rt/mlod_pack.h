@@ -252,7 +252,7 @@
  *   index (mlod_gltf_keep_indices): only what sits at the ends of its
  *   arrays goes, the stages' records and MSFT_lod.)
  *
- * Precisions the reader (lib/rt/pack.c) checks, added with it; they make
+ * Precisions the reader (lib/rt/rd_*.c) checks, added with it; they make
  * explicit what the text above implies and change no layout:
  * - file_size is exactly the last chunk's end (the TOC's end without
  *   chunks): no bytes after the last chunk.

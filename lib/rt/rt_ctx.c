@@ -88,7 +88,7 @@ size_t rt_bytes_skel_level(const mlod_pack_skel_level *l)
 
 /* rt_bytes_mesh of the level the pack reader decodes from these part
  * records (its arrays follow the records' flags, UV sets and target
- * counts exactly, lib/rt/pack.c part_dequant): the same count. */
+ * counts exactly, lib/rt/rd_mesh.c part_dequant): the same count. */
 static size_t rt_bytes_mesh_recs(const mlod_pack_part_rec *recs, uint32_t n)
 {
 	size_t b = sizeof(mlod_pack_mesh);
@@ -139,7 +139,7 @@ size_t rt_bytes_mesh(const mlod_pack_mesh *m)
 size_t rt_bytes_motion(const mlod_pack_motion *m)
 {
 	/* A decoded level's block is sized by an upper bound from its stream
-	 * headers (lib/rt/pack.c): what it holds is counted when it is all. */
+	 * headers (lib/rt/rd_motion.c): what it holds is counted when it is all. */
 	if (m->block)
 		return sizeof *m + mlod_pack_block_size(m->block);
 	size_t b = sizeof *m;

@@ -1,7 +1,7 @@
 /*
  * rt_pack.c: the pack source of the runtime: mlod_rt_open_memory, _path
  * and _read, and the loader that decodes one level through the pack reader
- * (lib/rt/pack.c) inside mlod_rt_stream. Sources other than memory read a
+ * (lib/rt/rd_*.c) inside mlod_rt_stream. Sources other than memory read a
  * chunk into a staging buffer (allocated at open, the size of the largest
  * chunk) and decode it through a copy of the TOC whose entry for that
  * chunk says offset 0; a MESH level (layout b2) needs the vertex blocks of

@@ -7,7 +7,7 @@
 //
 // --doc writes the DOC chunk's glb to OUT.glb.
 // It decodes no meshopt-coded stream: the round trip through the reader
-// (lib/rt/pack.c) is for the tests that come with it. A skeleton level's
+// (lib/rt/rd_*.c) is for the tests that come with it. A skeleton level's
 // palette (format 7.0: 'KEPT', 'PALR', 'PALX'; no 'PALJ', no 'PALB') is
 // checked for its streams and counts, and where 'PALR' is raw or in byte
 // planes (stream codecs 4 and 5, which this script decodes) every

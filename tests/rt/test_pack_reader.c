@@ -1,5 +1,5 @@
 /*
- * test_pack_reader.c: the pack reader (lib/rt/pack.c) against packs built
+ * test_pack_reader.c: the pack reader (lib/rt/rd_*.c) against packs built
  * here, byte by byte, by a small test-local encoder (the writer, lib/pack,
  * is another part). Links libmlodrt.a alone (+ meshoptimizer for the
  * codecs and libm), which also proves the runtime boundary.

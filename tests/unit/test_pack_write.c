@@ -6,7 +6,7 @@
  *
  * The pack is checked at the stream level here (header, TOC and CRC; the
  * MESH level 0 streams decoded with meshoptimizer's decoder), with no
- * dependency on the reader (lib/rt/pack.c). When the reader lands, the
+ * dependency on the reader (lib/rt/rd_*.c). When the reader lands, the
  * round trip through mlod_pack_decode_* belongs beside pack_mesh_streams.
  */
 #include "test.h"
