@@ -297,9 +297,12 @@ static int ticks_fit(const float *const *arr, const int *cnt, int n, double step
  * candidates: 1 / the nearest whole frame rate to the smallest key
  * interval d; the smallest positive key time (a clip sampled as
  * (float)(k * step)); the largest time over its whole number of d; d.
- * The first that gives every time back exactly wins; else the first
- * within MLOD_PACK_TICK_TOLERANCE (times summed frame by frame in f32). */
-static double time_step(const float *const *arr, const int *cnt, int n, uint32_t *max_tick)
+ * The first that gives every time back exactly wins; else, unless exact,
+ * the first within MLOD_PACK_TICK_TOLERANCE (times summed frame by frame
+ * in f32). A chunk with a STEP channel asks for exact times: a STEP
+ * channel jumps at its key times, so a key read back a hair late gives
+ * the key before at the key's own time (the whole step's error there). */
+static double time_step(const float *const *arr, const int *cnt, int n, int exact, uint32_t *max_tick)
 {
 	double d = 0, first = 0, last = 0;
 	for (int a = 0; a < n; a++)
@@ -316,7 +319,7 @@ static double time_step(const float *const *arr, const int *cnt, int n, uint32_t
 	double fps = floor(1.0 / d + 0.5), frames = floor(last / d + 0.5);
 	double cand[5] = {fps >= 1 && fps <= 100000 ? 1.0 / fps : 0, first, frames >= 1 ? last / frames : 0,
 	                  frames >= 1 ? (double)(float)(last / frames) : 0, d};
-	for (int pass = 0; pass < 2; pass++)
+	for (int pass = 0; pass < (exact ? 1 : 2); pass++)
 		for (int i = 0; i < 5; i++)
 			if (cand[i] > 0 && ticks_fit(arr, cnt, n, cand[i], pass ? MLOD_PACK_TICK_TOLERANCE : 0, max_tick))
 				return cand[i];
@@ -747,7 +750,10 @@ mlod_result pack_motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int i
 		ta[i] = (int)recs[i].time;
 	free(recs);
 	uint32_t max_tick = 0;
-	double step = time_step(arr, cnt, na, &max_tick);
+	int steps = 0;
+	for (int i = 0; i < img->n; i++)
+		steps |= img->ch[i].interp == MLOD_INTERP_STEP;
+	double step = time_step(arr, cnt, na, steps, &max_tick);
 	pack_cb_add(&cb, MLOD_STREAM_STEP, 1, 8, &step, 0);
 	/* The key times: one stream, the arrays one after the other; f32, or
 	 * ticks, each array's first then each next minus the one before (the
