@@ -102,6 +102,9 @@ const char *mlod_name_text(const char *name, int quote, char *buf, size_t size);
  * breaks a line or a column. With f NULL it writes nothing. Returns the
  * table form's columns (unpadded). */
 int mlod_name_put(FILE *f, const char *name, int json, int width);
+/* Appends "v0, v1, ..." (the first `most` of the n values, then ", ..."
+ * when there are more) to the string in buf, within size bytes. */
+void mlod_int_list(char *buf, size_t size, const int *v, int n, int most);
 
 /* ------------------------------------------------------------------ */
 /* Threads                                                             */

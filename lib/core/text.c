@@ -134,3 +134,14 @@ int mlod_name_put(FILE *f, const char *name, int json, int width)
 		fputc(' ', f);
 	return columns;
 }
+
+void mlod_int_list(char *buf, size_t size, const int *v, int n, int most)
+{
+	size_t at = strlen(buf);
+	for (int i = 0; i < n && i < most && at < size; i++) {
+		int k = snprintf(buf + at, size - at, "%s%d", i ? ", " : "", v[i]);
+		at = k < 0 ? size : at + (size_t)k;
+	}
+	if (n > most && at < size)
+		snprintf(buf + at, size - at, ", ...");
+}

@@ -272,14 +272,10 @@ mlod_result mlod_mesh_levels_write(mlod_mesh_levels *L, mlod_gltf *doc, mlod_mes
 		if (r == MLOD_OK && L->skeleton_count == 0 &&
 		    mlod_gltf_node_lod(doc, in->node, own, 8, &own_count, &ignored) == MLOD_OK &&
 		    own_count > 0) {
-			char text[200];
-			int at = snprintf(text, sizeof text, "node %d: its own MSFT_lod levels (node", in->node);
-			for (int k = 0; k < own_count && k < 8 && at > 0 && (size_t)at < sizeof text; k++)
-				at += snprintf(text + at, sizeof text - (size_t)at, "%s %d", k ? "," : (own_count > 1 ? "s" : ""),
-				               own[k]);
-			if (at > 0 && (size_t)at < sizeof text)
-				snprintf(text + at, sizeof text - (size_t)at, ") are replaced by mlod's: those nodes stay outside "
-				         "the level list");
+			char list[80] = "", text[200];
+			mlod_int_list(list, sizeof list, own, own_count, 8);
+			snprintf(text, sizeof text, "node %d: its own MSFT_lod levels (node%s %s) are replaced by mlod's: those "
+			         "nodes stay outside the level list", in->node, own_count > 1 ? "s" : "", list);
 			mlod_mesh_note_(L, text);
 		}
 		if (r == MLOD_OK)

@@ -96,13 +96,14 @@ static void level_refs(const struct ctx *x, int *ln, int *nln_out, int *lm, int 
 }
 
 /* Which meshes of doc (a copy of x->doc, its indices the same, or a
- * BVH's document) the DOC chunk
- * strips (mlod_gltf_strip_levels): a flag per mesh, 1 for a mesh an
- * instance of the character holds with a surface (mlod_mesh_has_surface:
- * else no MESH part gives it back) (its levels give it back) or a piped input's level
- * mesh (the levels replace it), or a mesh no node uses; any other mesh
- * (on a node outside the default scene) keeps its triangle lists whole,
- * with a warning when it has any. *flags is malloc'd. */
+ * BVH's document) the DOC chunk strips (mlod_gltf_strip_levels): a flag
+ * per mesh, 1 for a mesh an instance of the character holds with a
+ * surface (mlod_mesh_has_surface; its MESH parts give it back, where a
+ * mesh without one has no part), a piped input's level mesh (the levels
+ * replace it) or a mesh no node uses (-x writes none); any other mesh
+ * (on a node outside the default scene, or shown without a surface)
+ * keeps its triangle lists whole, with a warning for the former.
+ * *flags is malloc'd. */
 mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned char **flags, mlod_error *err)
 {
 	const mlod_character *c = x->in;
@@ -131,13 +132,10 @@ mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned c
 		 * input's own: the DOC chunk keeps MSFT_lod of no node
 		 * (mlod_gltf_strip_levels), so they go; said, not silent. */
 		if (nln > 0 && x->rec.mesh_level_count == 0 && x->rec.skel_level_count == 0) {
-			char text[200];
-			int at = snprintf(text, sizeof text, "the input's own MSFT_lod level node%s", nln > 1 ? "s" : "");
-			for (int i = 0; i < nln && i < 8 && at > 0 && (size_t)at < sizeof text; i++)
-				at += snprintf(text + at, sizeof text - (size_t)at, "%s %d", i ? "," : "", ln[i]);
-			if (at > 0 && (size_t)at < sizeof text)
-				snprintf(text + at, sizeof text - (size_t)at, "%s %s not kept: the pack's levels replace %s",
-				         nln > 8 ? ", ..." : "", nln > 1 ? "are" : "is", nln > 1 ? "them" : "it");
+			char list[80] = "", text[200];
+			mlod_int_list(list, sizeof list, ln, nln, 8);
+			snprintf(text, sizeof text, "the input's own MSFT_lod level node%s %s %s not kept: the pack's levels "
+			         "replace %s", nln > 1 ? "s" : "", list, nln > 1 ? "are" : "is", nln > 1 ? "them" : "it");
 			pack_warn(x, text);
 		}
 		free(ln), free(lm), free(ls);
@@ -159,8 +157,7 @@ mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned c
 		if (!used[m])
 			f[m] = 1;
 	free(used);
-	char list[200] = "";
-	int whole = 0;
+	int whole = 0, first[12];
 	for (int m = 0; m < nm; m++) {
 		int triangles = 0;
 		for (int p = 0; !f[m] && !triangles; p++) {
@@ -179,16 +176,15 @@ mlod_result pack_doc_strip_flags(struct ctx *x, const mlod_gltf *doc, unsigned c
 		}
 		if (f[m] == 2) /* shown, but no surface: whole, as the mesh layer leaves it */
 			f[m] = 0;
-		else if (triangles && whole++ < 12) {
-			const size_t len = strlen(list);
-			snprintf(list + len, sizeof list - len, "%s%d", len ? ", " : "", m);
-		}
+		else if (triangles && whole++ < 12)
+			first[whole - 1] = m;
 	}
 	if (whole) {
-		char text[320];
-		snprintf(text, sizeof text, "mesh%s %s%s %s on no node of the default scene: the document chunk keeps %s "
-		         "whole, without levels", whole > 1 ? "es" : "", list, whole > 12 ? ", ..." : "",
-		         whole > 1 ? "are" : "is", whole > 1 ? "them" : "it");
+		char list[120] = "", text[320];
+		mlod_int_list(list, sizeof list, first, whole, 12);
+		snprintf(text, sizeof text, "mesh%s %s %s on no node of the default scene: the document chunk keeps %s "
+		         "whole, without levels", whole > 1 ? "es" : "", list, whole > 1 ? "are" : "is",
+		         whole > 1 ? "them" : "it");
 		pack_warn(x, text);
 	}
 	*flags = f;
