@@ -18,3 +18,11 @@ for (const c of anim) {
 	if (c.level > 0 && !(c.raw < anim[c.level - 1].raw)) throw new Error("level " + c.level + " not smaller than level " + (c.level - 1));
 	if (c.level > 0 && !(c.error_percent > 0)) throw new Error("level " + c.level + ": error 0, the clip as read");
 }' || exit 1
+# mlod-motion --precision full piped into mlod-pack gives the pack
+# mlod-pack makes itself, byte for byte, as for LINEAR clips (README):
+# the same levels, so the same bytes. The glb keeps the input's name (the
+# character's name comes from it).
+mkdir piped || exit 1
+"$BIN/mlod-motion" --precision full -o piped/step.glb step.glb || exit 1
+(cd piped && "$BIN/mlod-pack" -o ../piped.mlod step.glb) || exit 1
+cmp step.mlod piped.mlod || { echo "piped --precision full pack differs from the direct one"; exit 1; }
