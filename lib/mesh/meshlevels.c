@@ -311,6 +311,7 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 		mlod_bgm_info info;
 		mlod_bgm_get_info(pt->bgm, &info);
 		L->build_seconds += info.build_seconds;
+		L->degenerate += info.dropped;
 		L->simplified++;
 		L->statics += in->skin < 0 && in->joint < 0;
 		morphs += pr->target_count > 0;
@@ -342,6 +343,8 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 		     "as they are", unsupported);
 	if (morphs)
 		note(L, "%d primitive(s) with morph targets: offsets interpolated like positions", morphs);
+	if (L->degenerate)
+		note(L, "%d triangle(s) with two corners at one position (no area) left out of the levels", L->degenerate);
 	return MLOD_OK;
 }
 
@@ -581,7 +584,7 @@ static mlod_result next_level(mlod_mesh_levels *L, double ratio, mlod_error *err
 		free_level(L, &lv);
 		return MLOD_OK;
 	}
-	if (L->count == 0 && lv.triangles >= L->triangles) {
+	if (L->count == 0 && lv.triangles >= L->triangles - L->degenerate) {
 		note(L, "ratio %g removes nothing: dropped", ratio);
 		free_level(L, &lv);
 		return MLOD_OK;

@@ -346,6 +346,7 @@ typedef struct mlod_mesh_levels {
 	int simplified;          /* primitives with a BGM */
 	int statics;             /* of them, on no joint and no skin */
 	int triangles, vertices; /* of the input */
+	int degenerate;          /* input triangles with two corners at one position, in no level */
 	double build_seconds;
 	double measure_seconds;  /* measuring the levels' posed error (wall clock, all levels) */
 	int chain_pending;       /* the one primitive's collapses wait for the levels' call */

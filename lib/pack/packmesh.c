@@ -935,16 +935,21 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	m->count = count0;
 	/* The triangles quantisation leaves: one whose corners are two or
 	 * three times one vertex of the buffer (bit-identical quantised
-	 * attributes) is dropped; a part may keep none at a level. */
-	uint32_t kept = 0;
+	 * attributes) is dropped, as is one repeating an index of its own
+	 * (the input's: counted apart); a part may keep none at a level. */
+	uint32_t kept = 0, repeated = x->repeated[k];
 	for (uint32_t t = 0; t + 3 <= ni; t += 3) {
 		uint32_t a = p->index_count > 0 ? p->indices[t] : t, b = p->index_count > 0 ? p->indices[t + 1] : t + 1,
 		         c = p->index_count > 0 ? p->indices[t + 2] : t + 2;
+		if (a == b || b == c || a == c) {
+			x->repeated[k]++;
+			continue;
+		}
 		if (cls[a] == cls[b] || cls[b] == cls[c] || cls[a] == cls[c])
 			continue;
 		in[kept++] = a, in[kept++] = b, in[kept++] = c;
 	}
-	x->degenerate[k] += (ni - kept) / 3;
+	x->degenerate[k] += (ni - kept) / 3 - (x->repeated[k] - repeated);
 	x->emptied[k] += ni > 0 && kept == 0;
 	ni = kept;
 	if (x->opt->codec == MLOD_CODEC_MESHOPT && !x->draco) {
@@ -1027,6 +1032,12 @@ mlod_result pack_mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count)
 	}
 	free(recs);
 	*part_count = np;
+	if (!cb.fail && x->repeated[k]) { /* the input's own, which draw nothing */
+		char text[128];
+		snprintf(text, sizeof text, "mesh level %d: %u triangles that repeat a vertex (no area) not stored", k,
+		         x->repeated[k]);
+		pack_note(x, text);
+	}
 	if (!cb.fail && x->degenerate[k]) {
 		char text[160], parts[64] = "";
 		if (x->emptied[k])
