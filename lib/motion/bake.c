@@ -594,7 +594,11 @@ mlod_result mlod_motion_bake_to_gltf(mlod_motion_bake *b, const mlod_character *
 			mlod_motion_bake_level *lv = &cl->levels[i];
 			if (!lv->ok)
 				continue;
-			const char *base = src->name ? src->name : "";
+			/* An unnamed clip's levels are named as three.js names
+			 * the clip itself: animation_<its glTF index>. */
+			char unnamed[32];
+			snprintf(unnamed, sizeof unnamed, "animation_%d", src->gltf_index >= 0 ? src->gltf_index : cl->index);
+			const char *base = src->name && src->name[0] ? src->name : unnamed;
 			char q[MLOD_NAME_TEXT_SIZE];
 			char *name = malloc(strlen(base) + 32);
 			if (!name)

@@ -916,8 +916,10 @@ mlod_result mlod_pack_unpack(const void *data, size_t size, mlod_gltf **out, mlo
 			char name[512];
 			if (k == 0)
 				snprintf(name, sizeof name, "%s", info.clip_names[c]);
-			else
+			else if (info.clip_names[c][0])
 				snprintf(name, sizeof name, "%s@lod%u", info.clip_names[c], k);
+			else /* an unnamed clip's levels: animation_<its index>, as mlod-motion names them */
+				snprintf(name, sizeof name, "animation_%d@lod%u", anim0, k);
 			if (mo.channel_count == 0) {
 				/* A clip that animates no joint (a camera's, a morph
 				 * weights clip): its levels hold nothing to add, and its
