@@ -747,10 +747,7 @@ reduce:
 			size_t base = (size_t)f * (size_t)R.J;
 			for (int j = 0; j < R.J; j++) {
 				double e = eval_error_over(&R.wc[base + (size_t)j], &R.w0[base + (size_t)j], R.radius[j], worst);
-				if (e >= 0.0 && !(e <= worst))
-					worst = e;
-				else if (e != e)
-					worst = e; /* NaN counts as the worst */
+				worst = eval_worst(worst, e);
 			}
 			if (!(worst <= HUGE_VAL))
 				break;

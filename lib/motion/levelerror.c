@@ -274,10 +274,7 @@ double motion_level_max_error(mlod_motion *m, const mlod_clip *clip)
 		walk_pose(m, &w, f);
 		for (int j = 0; j < m->s->joint_count; j++) {
 			double e = eval_error_over(&m->world[j], &w0[j], m->radius[j], worst);
-			if (e >= 0.0 && !(e <= worst))
-				worst = e;
-			else if (e != e)
-				worst = e; /* NaN counts as the worst */
+			worst = eval_worst(worst, e);
 		}
 		if (!(worst <= HUGE_VAL))
 			break;

@@ -33,6 +33,7 @@
 
 #include "motion/mlod_motion.h"
 #include "motion/motion_eval.h"
+#include "motion/motion_internal.h"
 
 typedef struct build_ctx {
 	const mlod_character *c;
@@ -402,21 +403,10 @@ static mlod_result choose(build_ctx *b, int k, int s, mlod_motion_level *out, ml
 				*err = b->chain_error[at];
 			return r;
 		}
-		if (mlod_motion_level_wins(l, out, ok)) {
-			if (ok)
-				mlod_motion_level_free(out);
-			*out = *l;
-			memset(l, 0, sizeof *l);
-			ok = 1;
-		}
+		if (motion_best_take(out, &ok, l))
+			memset(l, 0, sizeof *l); /* taken over */
 	}
-	if (ok)
-		return MLOD_OK;
-	if (limited < 0)
-		return mlod_fail(err, MLOD_ERR_LIMIT, "no method makes a level for this target");
-	if (err)
-		*err = why;
-	return MLOD_ERR_LIMIT;
+	return motion_best_end(ok, limited, &why, err);
 }
 
 /* Gathers clip k from its chains, in the order the first way meets

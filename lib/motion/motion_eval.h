@@ -346,6 +346,15 @@ EVAL_INLINE int eval_within(const mlod_mat4 *w, const mlod_mat4 *w0, double radi
 	return eval_within_w(w, w0, radius, limit, 0);
 }
 
+/* The worst of a running maximum and an error from eval_error_over (-1:
+ * within it); a NaN is the worst and stays so. */
+EVAL_INLINE double eval_worst(double worst, double e)
+{
+	if (worst != worst || e != e)
+		return worst != worst ? worst : e;
+	return e > worst ? e : worst;
+}
+
 /* mlod_motion_point_error(w, w0, radius), or -1 when a bound shows that
  * it is at most limit. */
 EVAL_INLINE double eval_error_over(const mlod_mat4 *w, const mlod_mat4 *w0, double radius, double limit)

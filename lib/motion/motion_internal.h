@@ -264,6 +264,17 @@ long motion_line_keys(const mlod_motion *m, const motion_line *l);
 /* ---------------------------------------------------------------- */
 
 /* The frames method's next level. */
+/* The auto method's pick over the methods' levels, for
+ * mlod_motion_next_level_best and the threaded builder (levels.c):
+ * motion_best_take moves *l into *best when it wins
+ * (mlod_motion_level_wins; the level it beats is freed) and returns 1,
+ * else leaves *l to the caller and returns 0; motion_best_end ends the
+ * pick: MLOD_OK with a level, else MLOD_ERR_LIMIT with the reason of the
+ * earliest method that hit its limit (why, limited >= 0) or, when none
+ * applied, its own. */
+int motion_best_take(mlod_motion_level *best, int *have, mlod_motion_level *l);
+mlod_result motion_best_end(int have, int limited, const mlod_error *why, mlod_error *err);
+
 mlod_result motion_frames_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
                                 mlod_motion_level *out, mlod_error *err);
 /* The keys method's next level up to its rounding (*known: the clip's

@@ -95,6 +95,28 @@ int mlod_motion_level_wins(const mlod_motion_level *l, const mlod_motion_level *
 	       (!have || l->bytes < best->bytes || (l->bytes == best->bytes && !(best->error.max < l->error.max)));
 }
 
+int motion_best_take(mlod_motion_level *best, int *have, mlod_motion_level *l)
+{
+	if (!mlod_motion_level_wins(l, best, *have))
+		return 0;
+	if (*have)
+		mlod_motion_level_free(best);
+	*best = *l;
+	*have = 1;
+	return 1;
+}
+
+mlod_result motion_best_end(int have, int limited, const mlod_error *why, mlod_error *err)
+{
+	if (have)
+		return MLOD_OK;
+	if (limited < 0)
+		return mlod_fail(err, MLOD_ERR_LIMIT, "no method makes a level for this target");
+	if (err)
+		*err = *why;
+	return MLOD_ERR_LIMIT;
+}
+
 mlod_result mlod_motion_next_level_best(mlod_motion *const *m, const mlod_motion_method *methods, int n,
                                         mlod_motion_target target, double value, mlod_motion_level *out,
                                         mlod_error *err)
@@ -121,20 +143,8 @@ mlod_result mlod_motion_next_level_best(mlod_motion *const *m, const mlod_motion
 				*err = e;
 			return r;
 		}
-		if (mlod_motion_level_wins(&l, out, ok)) {
-			if (ok)
-				mlod_motion_level_free(out);
-			*out = l;
-			ok = 1;
-		} else {
+		if (!motion_best_take(out, &ok, &l))
 			mlod_motion_level_free(&l);
-		}
 	}
-	if (ok)
-		return MLOD_OK;
-	if (limited < 0)
-		return mlod_fail(err, MLOD_ERR_LIMIT, "no method makes a level for this target");
-	if (err)
-		*err = why;
-	return MLOD_ERR_LIMIT;
+	return motion_best_end(ok, limited, &why, err);
 }
