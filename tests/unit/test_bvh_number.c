@@ -1,5 +1,5 @@
 /* test_bvh_number.c: the BVH reader's numbers (lib/io/decimal.c and the
- * frame lines' one-scan path in bvh.c) against strtod in the C locale. */
+ * frame lines' one-scan path in bvhread.c) against strtod in the C locale. */
 #include "test.h"
 
 #include <stdint.h>
