@@ -341,16 +341,24 @@ typedef struct crowd {
 	float *dist, *speed, *azimuth; /* scene units, scene units per second, radians */
 	float *buf;
 	uint32_t cap;
+	uint32_t cap0;    /* cap after open (grow's first call) */
+	uint32_t regrows; /* reallocations after that: 0 for a pack of format 8.1 on */
 	uint32_t n;
 	int pose_only; /* --work pose */
 } crowd;
 
+/* The skinning buffers: sized once, right after open, from
+ * mlod_rt_max_vertex_count, the largest mesh level the pack can stream in
+ * (format 8.1, mlod(5) INFO). A pack of format 8.0 or older states none:
+ * the count is then the largest resident level's, and the buffers grow
+ * when a larger level loads (the calls after open, counted in regrows). */
 static void grow(crowd *c)
 {
 	uint32_t need = mlod_rt_max_vertex_count(c->ctx);
 	need = need ? need : 1; /* a buffer even without a mesh: mlod_rt_skin wants one */
 	if (c->buf && need <= c->cap)
 		return;
+	c->regrows += c->buf != NULL;
 	free(c->buf);
 	c->buf = malloc((size_t)need * 24);
 	if (!c->buf)
@@ -1360,6 +1368,7 @@ int main(int argc, char **argv)
 	if (!c.scratch || !c.ids || !c.dist || !c.speed || !c.azimuth)
 		die(2, "%s", "out of memory");
 	grow(&c);
+	c.cap0 = c.cap;
 
 	const uint32_t clips = mlod_rt_clip_count(c.ctx);
 	uint32_t L[MLOD_RT_LAYERS];
@@ -1443,6 +1452,11 @@ int main(int argc, char **argv)
 		for (uint32_t k = 0; k < L[MLOD_RT_MESH]; k++)
 			printf(" %u", mlod_rt_mesh_vertex_count(c.ctx, k));
 		printf("\n");
+		if (c.regrows == 0)
+			printf("skinning buffers: %u vertices, sized once at open (mlod_rt_max_vertex_count)\n", c.cap0);
+		else
+			printf("skinning buffers: %u vertices at open, %u once every level loaded (a pack before format 8.1 "
+			       "states no largest level)\n", c.cap0, c.cap);
 	}
 	if (bench && L[MLOD_RT_MESH] > 0)
 		skin_bench(file, file_size);

@@ -194,7 +194,11 @@ static mlod_result info_json(FILE *f, const char *label, const void *data, size_
 	fprintf(f, "  },\n  \"stored\": %llu,\n  \"raw\": %llu,\n  \"overhead\": %llu,\n  \"total\": %llu,\n",
 	        (unsigned long long)stored, (unsigned long long)raw, (unsigned long long)overhead,
 	        (unsigned long long)(stored + overhead));
-	fprintf(f, "  \"first_drawable\": %u\n}\n", ir->first_drawable);
+	fprintf(f, "  \"first_drawable\": %u,\n  \"max_vertex_count\": ", ir->first_drawable);
+	if (info->has_max_vertices)
+		fprintf(f, "%u\n}\n", ir->max_vertex_count);
+	else
+		fputs("null\n}\n", f); /* not stated before format 8.1 */
 	return MLOD_OK;
 }
 
@@ -229,6 +233,10 @@ static void info_table(FILE *f, const char *label, const mlod_pack *p, const mlo
 	        (unsigned long long)(stored + overhead), (unsigned long long)stored, (unsigned long long)raw,
 	        (unsigned long long)overhead);
 	fprintf(f, "# first drawable level: %u bytes\n", ir->first_drawable);
+	if (info->has_max_vertices)
+		fprintf(f, "# largest mesh level: %u vertices\n", ir->max_vertex_count);
+	else
+		fprintf(f, "# largest mesh level: not stated (format %u.%u, before 8.1)\n", p->major, p->minor);
 }
 
 /* Every chunk is first decoded through the reader (lib/rt,

@@ -1025,6 +1025,12 @@ mlod_result pack_mesh_chunk(struct ctx *x, int k, chunks *out, int *part_count)
 		if (!part_level(x, &cb, &x->mp[i], k, &recs[i]))
 			cb.fail = 1;
 	if (!cb.fail) {
+		/* the level's vertices as a reader decodes them: its records' */
+		uint64_t nv = 0;
+		for (int i = 0; i < np; i++)
+			nv += recs[i].vertex_count;
+		if (nv > x->max_vertices)
+			x->max_vertices = nv;
 		free(cb.s[0].data);
 		cb.s[0].data = (uint8_t *)recs;
 		cb.s[0].count = (uint32_t)np;

@@ -404,6 +404,13 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	info.clip_count = (uint32_t)x.v.clip_count;
 	info.motion_levels = (uint32_t)A;
 	info.instance_count = (uint32_t)parts0;
+	if (x.max_vertices > UINT32_MAX / 2) { /* the runtime's limit of a level's vertices */
+		free(names.b.p);
+		r = mlod_fail(err, MLOD_ERR_LIMIT, "a mesh level of %llu vertices: more than a pack holds (%u)",
+		              (unsigned long long)x.max_vertices, UINT32_MAX / 2);
+		goto done;
+	}
+	info.max_vertex_count = (uint32_t)x.max_vertices;
 	for (int a = 0; a < 3; a++) {
 		info.bounds_min[a] = x.bmin[a];
 		info.bounds_max[a] = x.bmax[a];

@@ -225,6 +225,7 @@ struct ctx {
 	struct mpart *mp;          /* the parts of layout b2 (mesh_parts) */
 	uint32_t degenerate[MLOD_MESH_MAX_LEVELS + 1]; /* per MESH level: triangles quantisation made degenerate */
 	uint32_t repeated[MLOD_MESH_MAX_LEVELS + 1];   /* per MESH level: triangles repeating a vertex (the input's) */
+	uint64_t max_vertices; /* INFO's max_vertex_count: the most vertices (sum over its part records) of a MESH level */
 	int emptied[MLOD_MESH_MAX_LEVELS + 1];         /* per MESH level: parts left without a triangle */
 	int mp_count, mp_ready;
 	int **lmaps;               /* per level and instance: level_joint_map, or NULL */

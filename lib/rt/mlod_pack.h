@@ -9,8 +9,9 @@
  * and never prints or exits.
  *
  * ------------------------------------------------------------------
- * File layout (format 8.0: 7.0 with the coarsest levels of every layer
- * first, mlod(5) Chunk order and streaming). Everything is little-endian.
+ * File layout (format 8.1: 7.0 with the coarsest levels of every layer
+ * first, mlod(5) Chunk order and streaming; 8.1 adds INFO's
+ * max_vertex_count in bytes 8.0 reserved). Everything is little-endian.
  *
  *   header      32 bytes at offset 0
  *   TOC         chunk_count entries of 48 bytes, right after the header
@@ -88,6 +89,15 @@
  * INFO (layer none, once): stream 'INFO', one element of
  *   sizeof(mlod_pack_info_rec) bytes; stream 'NAME', the string table
  *   (u8, NUL-separated, UTF-8): the character's and the clips' names.
+ *   max_vertex_count (format 8.1, record bytes 68-71) is the largest sum
+ *   of a MESH level's part records' vertex counts; the reader checks it
+ *   against the TOC at decode (at most what the MESH chunks' raw sizes
+ *   can hold: a level's vertices are among its indices, 2 bytes each at
+ *   least, and among the 'POSQ' elements of it and the coarser levels, 8
+ *   bytes each; a Draco level's at most 1024 times its
+ *   container over 12 bytes of positions), every MESH level against it
+ *   (the runtime before it allocates the level), and mlod_pack_check
+ *   that the largest level has exactly it.
  *
  * SKELETON (layer skeleton, level 0, once): the full skeleton.
  *   'JNTS' joint records (mlod_pack_joint_rec), parents before children
@@ -296,7 +306,7 @@ extern "C" {
 #define MLOD_PACK_MAGIC "MLOD"
 #define MLOD_PACK_MAJOR 8
 #define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
-#define MLOD_PACK_MINOR 0
+#define MLOD_PACK_MINOR 1 /* 8.1: INFO's max_vertex_count */
 #define MLOD_PACK_HEADER_SIZE 32
 #define MLOD_PACK_TOC_ENTRY_SIZE 48
 #define MLOD_PACK_ALIGN 16
@@ -473,8 +483,22 @@ typedef struct mlod_pack_info_rec {
 	                            * skeleton, mesh and motion levels (INFO,
 	                            * SKELETON, and the coarsest level of each
 	                            * layer, of every clip for motion) */
-	uint32_t reserved[3];
+	uint32_t max_vertex_count; /* format 8.1: the most vertices of any mesh
+	                            * level, all parts (the sum of its part
+	                            * records' vertex counts: what
+	                            * mlod_rt_mesh_vertex_count gives for it),
+	                            * 0 without meshes; reserved (0) before 8.1,
+	                            * and a reader gives 0 for an older pack
+	                            * (mlod_pack_has_max_vertices) */
+	uint32_t reserved[2];
 } mlod_pack_info_rec;
+
+/* 1 when the pack's INFO has max_vertex_count (format 8.1 and later). */
+#define MLOD_PACK_MINOR_MAX_VERTICES 1
+static inline int mlod_pack_version_has_max_vertices(unsigned major, unsigned minor)
+{
+	return major > 8 || (major == 8 && minor >= MLOD_PACK_MINOR_MAX_VERTICES);
+}
 
 /* SKELETON 'JNTS'. */
 typedef struct mlod_pack_joint_rec {
@@ -601,7 +625,8 @@ uint32_t mlod_pack_crc32(uint32_t crc, const void *data, size_t size);
  * that allocator. */
 
 typedef struct mlod_pack_info {
-	mlod_pack_info_rec rec;
+	mlod_pack_info_rec rec;    /* max_vertex_count 0 in a pack older than 8.1 */
+	int has_max_vertices;      /* 1 when the pack states rec.max_vertex_count (format 8.1 on) */
 	const char *name;          /* the character's */
 	const char **clip_names;   /* clip_count */
 	void *block;

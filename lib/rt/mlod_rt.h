@@ -356,7 +356,21 @@ float mlod_rt_clip_duration(const mlod_rt_ctx *ctx, uint32_t clip);
 mlod_result mlod_rt_level_info_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item,
                                    mlod_rt_level_info *out, mlod_error *err);
 /* Vertices the mesh level writes (all parts) when resident, else 0; and
- * the largest count of any mesh level resident so far. */
+ * the largest count of any mesh level: the vertices the caller's skinning
+ * buffers need for every level, known from open on, before any streaming,
+ * for a pack of format 8.1 or later (INFO's max_vertex_count, mlod(5))
+ * and for views (their largest level). Open refuses a pack whose value
+ * is more than its MESH chunks can hold (a level's vertices are among its
+ * indices, 2 raw bytes each at least, and among the 'POSQ' elements of it
+ * and the coarser levels, 8 raw bytes each: at most half its chunk's TOC
+ * raw size and an eighth of the raw sizes of it and the coarser MESH
+ * chunks, so that positions and normals (24 bytes a vertex) sized from
+ * it take at most 3 times the MESH chunks' raw bytes; a Draco level at
+ * most 1024 / 12 vertices per byte of its container), and a level of more
+ * vertices than it fails its load (MLOD_ERR_PARSE naming the level,
+ * before it is allocated), so mlod_rt_skin never wants more. For an older pack
+ * (format 8.0 and before, which leave it 0) it is the largest count of
+ * any mesh level resident so far, and grows as finer levels load. */
 uint32_t mlod_rt_mesh_vertex_count(const mlod_rt_ctx *ctx, uint32_t level);
 uint32_t mlod_rt_max_vertex_count(const mlod_rt_ctx *ctx);
 /* All 0 for a NULL ctx; nothing for a NULL out. */

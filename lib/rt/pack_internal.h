@@ -26,12 +26,20 @@ mlod_result mlod_pack_decode_mesh_reserve(const mlod_pack *p, uint32_t chunk, co
 
 /* INFO's counts against what the chunks hold (MLOD_ERR_PARSE naming
  * INFO): its joint and skin counts against SKELETON's, its instance count
- * against a decoded MESH level's parts (every level has the same parts).
+ * against a decoded MESH level's parts (every level has the same parts)
+ * and its max_vertex_count against the level's vertices.
  * mlod_pack_check runs them; the runtime's open too. */
 mlod_result mlod_pack_info_check_skeleton(const mlod_pack_info *info, const mlod_pack_skeleton *skel,
                                           mlod_error *err);
 mlod_result mlod_pack_info_check_mesh(const mlod_pack_info *info, const mlod_pack_mesh *mesh, unsigned level,
                                       mlod_error *err);
+/* A MESH level's vertices (the sum of its part records' vertex counts)
+ * against INFO's max_vertex_count (format 8.1; nothing to check before):
+ * MLOD_ERR_PARSE naming the level when they are more. The runtime runs it
+ * with the part records before it allocates the level;
+ * mlod_pack_info_check_mesh with the decoded level. */
+mlod_result mlod_pack_info_check_vertices(const mlod_pack_info *info, uint64_t vertices, unsigned level,
+                                          mlod_error *err);
 
 /* The bytes allocated for a decoded level's block (mlod_pack_motion.block
  * and the others: one allocation each), 0 for NULL. */

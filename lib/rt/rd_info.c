@@ -14,6 +14,31 @@
 /* INFO                                                                */
 /* ------------------------------------------------------------------ */
 
+/* The most vertices a MESH level of this TOC can have, over its levels
+ * (INFO's max_vertex_count is at most this; at most UINT32_MAX / 2, the
+ * runtime's limit). A layout b2 level's vertices are the prefix vertices
+ * its indices use: at most its index count, each index at least 2 decoded
+ * bytes of its raw size, and at most the prefix's vertices, each 8 bytes
+ * of 'POSQ' in it or a coarser level (the MESH chunks stand coarsest
+ * first: the sum of the raw sizes so far). A Draco level's part records
+ * claim at most PACK_DRACO_MAX_EXPAND times its container decoded
+ * (rd_mesh.c), at least 12 bytes of positions per vertex; its raw size is
+ * its container's. */
+static uint64_t info_max_vertices_bound(const mlod_pack *p)
+{
+	uint64_t best = 0, prefix = 0;
+	for (uint32_t i = 0; i < p->chunk_count; i++) {
+		const mlod_pack_chunk *c = &p->chunks[i];
+		if (c->type != MLOD_CHUNK_MESH)
+			continue;
+		prefix += c->raw_size;
+		uint64_t v = c->codec == MLOD_CODEC_DRACO ? (uint64_t)PACK_DRACO_MAX_EXPAND * c->raw_size / 12
+		                                          : (c->raw_size / 2 < prefix / 8 ? c->raw_size / 2 : prefix / 8);
+		best = v > best ? v : best;
+	}
+	return best < UINT32_MAX / 2 ? best : UINT32_MAX / 2;
+}
+
 mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t size, mlod_pack_info *out,
                                   mlod_error *err)
 {
@@ -44,6 +69,16 @@ mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t s
 	if ((rec.motion_levels == 0) != (rec.clip_count == 0))
 		FAIL("%s: %u motion levels with %u clips (0 motion levels means no clips)", x.label, rec.motion_levels,
 		     rec.clip_count);
+	/* max_vertex_count (format 8.1; reserved bytes before, which a reader
+	 * ignores): at most what the MESH chunks can hold, so that a caller
+	 * sizing its skinning buffers from it at open never sizes more than
+	 * the file's raw bytes allow; each level is checked against it as it
+	 * decodes (mlod_pack_info_check_mesh, the runtime's rt_mesh_reserve). */
+	if (!mlod_pack_version_has_max_vertices(p->major, p->minor))
+		rec.max_vertex_count = 0;
+	else if (rec.max_vertex_count > info_max_vertices_bound(p))
+		FAIL("%s: max_vertex_count %u is more than its %u MESH levels can hold (%llu vertices at most)", x.label,
+		     rec.max_vertex_count, rec.mesh_levels, (unsigned long long)info_max_vertices_bound(p));
 	if (rec.first_drawable > p->file_size)
 		FAIL("%s: first_drawable %u is past the file's end (%llu)", x.label, rec.first_drawable,
 		     (unsigned long long)p->file_size);
@@ -110,6 +145,7 @@ mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t s
 	}
 	pk_cx_done(&x);
 	out->rec = rec;
+	out->has_max_vertices = mlod_pack_version_has_max_vertices(p->major, p->minor);
 	out->name = name;
 	out->clip_names = clip_names;
 	out->block = b.base;
@@ -246,6 +282,19 @@ mlod_result mlod_pack_info_check_mesh(const mlod_pack_info *info, const mlod_pac
 	if (info->rec.instance_count != mesh->part_count)
 		return mlod_fail(err, MLOD_ERR_PARSE, "INFO: %u instances, but MESH level %u has %u parts",
 		                 info->rec.instance_count, level, mesh->part_count);
+	uint64_t v = 0;
+	for (uint32_t i = 0; i < mesh->part_count; i++)
+		v += mesh->parts[i].rec.vertex_count;
+	return mlod_pack_info_check_vertices(info, v, level, err);
+}
+
+mlod_result mlod_pack_info_check_vertices(const mlod_pack_info *info, uint64_t vertices, unsigned level,
+                                          mlod_error *err)
+{
+	if (info->has_max_vertices && vertices > info->rec.max_vertex_count)
+		return mlod_fail(err, MLOD_ERR_PARSE,
+		                 "MESH level %u: %llu vertices, more than INFO's max_vertex_count %u (the largest level's)",
+		                 level, (unsigned long long)vertices, info->rec.max_vertex_count);
 	return MLOD_OK;
 }
 
@@ -258,6 +307,7 @@ mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, m
 	mlod_pack_info info; /* INFO stands first (mlod_pack_open checks the order) */
 	memset(&info, 0, sizeof info);
 	int have_skel = 0, have_info = 0;
+	uint64_t max_vertices = 0; /* of the MESH levels so far */
 	mlod_result r = MLOD_OK;
 	if ((r = mlod_pack_check_padding(p, data, size, err)) != MLOD_OK)
 		return r;
@@ -284,6 +334,10 @@ mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, m
 			r = mlod_pack_decode_mesh(p, i, data, size, s, &x, err);
 			if (r == MLOD_OK && have_info)
 				r = mlod_pack_info_check_mesh(&info, &x, c->level, err);
+			uint64_t v = 0;
+			for (uint32_t k = 0; r == MLOD_OK && k < x.part_count; k++)
+				v += x.parts[k].rec.vertex_count;
+			max_vertices = v > max_vertices ? v : max_vertices;
 			mlod_pack_mesh_free(&x);
 		} else if (c->type == MLOD_CHUNK_MOTION) {
 			mlod_pack_motion x;
@@ -297,6 +351,11 @@ mlod_result mlod_pack_check(const mlod_pack *p, const void *data, size_t size, m
 			mlod_pack_doc_free(&x);
 		}
 	}
+	/* INFO's max_vertex_count is exactly the largest level's (each level
+	 * was checked not to pass it) */
+	if (r == MLOD_OK && have_info && info.has_max_vertices && max_vertices != info.rec.max_vertex_count)
+		r = mlod_fail(err, MLOD_ERR_PARSE, "INFO: max_vertex_count %u, but the largest MESH level has %llu vertices",
+		              info.rec.max_vertex_count, (unsigned long long)max_vertices);
 	mlod_pack_skeleton_free(&skel);
 	mlod_pack_info_free(&info);
 	return r;

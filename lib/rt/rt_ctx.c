@@ -892,6 +892,15 @@ mlod_result rt_mesh_reserve(void *user, const mlod_pack_part_rec *parts, uint32_
 	rt_unit *u = ctx->loading;
 	if (!u)
 		return MLOD_OK;
+	/* A level of more vertices than INFO says the largest has would
+	 * overflow the buffers callers sized from mlod_rt_max_vertex_count:
+	 * the pack is corrupt (checked before the level is allocated). */
+	uint64_t vertices = 0;
+	for (uint32_t i = 0; i < part_count; i++)
+		vertices += parts[i].vertex_count;
+	mlod_result r = mlod_pack_info_check_vertices(&ctx->info, vertices, u->level, err);
+	if (r != MLOD_OK)
+		return r;
 	u->need = rt_bytes_mesh_recs(parts, part_count) + mesh_plan_bytes(ctx, parts, part_count);
 	if (!ctx->streaming || make_room(ctx, u->need) == 0)
 		return MLOD_OK;
@@ -1253,6 +1262,14 @@ mlod_result mlod_rt_open_views(const mlod_rt_views *v, const mlod_rt_config *con
 		u->view = vl;
 		u->error = u->level ? vl->error : 0.0f;
 		u->distance = u->level ? vl->distance : 0.0f;
+		/* Views hold every level from open on: mlod_rt_max_vertex_count
+		 * is their largest (a level check_mesh would refuse counts none) */
+		const mlod_pack_mesh *m = u->layer == MLOD_RT_MESH ? vl->data : NULL;
+		uint64_t nv = 0;
+		for (uint32_t k = 0; m && m->parts && k < m->part_count; k++)
+			nv += m->parts[k].rec.vertex_count;
+		if (nv > ctx->max_vertices && nv <= UINT32_MAX / 2)
+			ctx->max_vertices = (uint32_t)nv;
 	}
 	mlod_result r = rt_ctx_finish_open(ctx, err);
 	if (r) {

@@ -169,7 +169,9 @@ struct mlod_rt_ctx {
 	rt_unit *loading;         /* the unit ctx->load decodes (rt_mesh_reserve) */
 	int streaming;            /* inside mlod_rt_stream: rt_mesh_reserve makes room */
 	int refused;              /* rt_mesh_reserve found no room: the load is not a failure */
-	uint32_t max_vertices;
+	uint32_t max_vertices;    /* mlod_rt_max_vertex_count: INFO's max_vertex_count from open on
+	                           * (a pack of format 8.1 on) or the views' largest mesh level;
+	                           * else (older packs) the largest mesh level resident so far */
 	/* Per chunk of a read source, 1 once its bytes matched its CRC when
 	 * read (rt_pack.c read_chunk): such a chunk failing its CRC later was
 	 * misread, not corrupt. NULL for memory and views. */

@@ -299,6 +299,9 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 	    (r = mlod_pack_decode_info(p, data, size, &ctx->info, err)))
 		return r;
 	ctx->info_owned = 1;
+	/* Known at open from format 8.1 on (mlod_rt_max_vertex_count); an
+	 * older pack's grows as its levels load. */
+	ctx->max_vertices = ctx->info.rec.max_vertex_count;
 	if ((r = chunk_bytes(ctx, (uint32_t)cs, &p, &data, &size, &shadow, err)) ||
 	    (r = mlod_pack_decode_skeleton(p, data, size, &ctx->skel_dec, err)))
 		return r;

@@ -34,7 +34,7 @@ const fourcc = (u) => String.fromCharCode(u & 255, (u >> 8) & 255, (u >> 16) & 2
 if (b.length < 32 || b.subarray(0, 4).toString('latin1') !== 'MLOD') die('no MLOD magic');
 const major = b.readUInt16LE(4), minor = b.readUInt16LE(6), flags = b.readUInt32LE(8), n = b.readUInt32LE(12);
 const size = Number(b.readBigUInt64LE(16));
-if (major !== 8 || minor !== 0) die(`version ${major}.${minor}`);
+if (major !== 8 || minor !== 1) die(`version ${major}.${minor}`);
 if (flags !== 0) die('flags');
 if (size !== b.length) die(`file_size ${size}, file ${b.length}`);
 if (crc32(b.subarray(0, 28)) !== b.readUInt32LE(28)) die('header CRC');
@@ -202,6 +202,7 @@ const out = {
 	joints: u(0), skins: u(1), skeleton_levels: u(2), mesh_levels: u(3), clips: u(4), motion_levels: u(5), parts: u(6),
 	name: names[0], clip_names: names.slice(1, 1 + u(4)),
 	bounds_min: [f(8), f(9), f(10)], bounds_max: [f(11), f(12), f(13)], height: f(14), diagonal: f(15), first_drawable: u(16),
+	max_vertex_count: u(17), // format 8.1: the largest mesh level's vertices
 	count: {},
 	codecs: [...new Set(chunks.map((c) => c.codec))].sort(),
 	entropy: [...new Set(chunks.map((c) => c.entropy))].sort(),
@@ -218,6 +219,7 @@ for (const c of chunks) out.count[c.type.trim()] = (out.count[c.type.trim()] || 
 if (out.count.SKEL !== out.skeleton_levels) die('SKEL chunks and INFO skeleton_levels');
 if ((out.count.MESH || 0) !== out.mesh_levels) die('MESH chunks and INFO mesh_levels');
 if ((out.count.ANIM || 0) !== out.clips * out.motion_levels) die('ANIM chunks and INFO clips x motion_levels');
+if ((out.mesh_levels === 0 && out.max_vertex_count !== 0) || u(18) || u(19)) die('INFO max_vertex_count or reserved bytes');
 if (out.first_drawable > b.length || out.first_drawable < chunks[1].offset + chunks[1].stored) die('first_drawable');
 // Every coarsest level lies within first_drawable.
 for (const c of chunks) {

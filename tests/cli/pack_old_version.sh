@@ -1,4 +1,4 @@
-# A format 1.0 pack (the major version of a new pack set back to 1, the
+# A format 1.0 pack (the version of a new pack set back to 1.0, the
 # header CRC made again): --info and -x refuse it with what to do, exit 3
 # (unsupported), and write nothing. Format 2.0 changed the MESH layout;
 # there is no 1.x decode.
@@ -7,6 +7,7 @@ node - <<'JS' || exit 9
 const fs = require('fs');
 const b = fs.readFileSync('t.mlod');
 b.writeUInt16LE(1, 4);
+b.writeUInt16LE(0, 6);
 let c = 0xffffffff;
 for (let i = 0; i < 28; i++) {
 	c ^= b[i];

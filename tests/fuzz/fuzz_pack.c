@@ -9,6 +9,11 @@
  * level k of every layer, mlod_rt_update, mlod_rt_stream, mlod_rt_pose,
  * mlod_rt_palette, mlod_rt_bounds (a finite skinned vertex outside its
  * box aborts), mlod_rt_skin and every joint's mlod_rt_joint_level_get.
+ * A pack of format 8.1 or later states its largest mesh level's vertex
+ * count (INFO's max_vertex_count): the skinning buffers are sized from it
+ * once, at open, and a resident level of more vertices, a count that
+ * changes after open or an mlod_rt_skin asking for more aborts; an older
+ * pack's buffers grow as its levels load.
  *
  * The custom mutator (fuzz_restamp.h) re-stamps the CRCs on half of the
  * runs.
@@ -29,7 +34,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
  * answers for them are no different in kind. */
 enum { EVAL_LEVELS = 16, EVAL_CLIPS = 4, EVAL_VERTICES = 1 << 20 };
 
-static void evaluate(const uint8_t *data, size_t size)
+static void evaluate(const uint8_t *data, size_t size, int stated)
 {
 	mlod_rt_config cfg = {0, 8, NULL};
 	mlod_rt_ctx *ctx = NULL;
@@ -49,10 +54,12 @@ static void evaluate(const uint8_t *data, size_t size)
 		clips = EVAL_CLIPS;
 	if (clips == 0)
 		clips = 1;
-	/* The buffers grow to the largest level resident so far (up to
-	 * EVAL_VERTICES; mlod_rt_skin refuses a larger one). */
+	/* The buffers: sized once at open from the count the pack states, else
+	 * grown to the largest level resident so far (up to EVAL_VERTICES;
+	 * mlod_rt_skin refuses a larger one). */
 	uint32_t cap = 0;
 	float *pos = NULL, *nrm = NULL;
+	const uint32_t at_open = mlod_rt_max_vertex_count(ctx);
 	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
 	if (s) {
 		for (uint32_t clip = 0; clip < clips; clip++) {
@@ -67,7 +74,14 @@ static void evaluate(const uint8_t *data, size_t size)
 				mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 30, &e);
 				mlod_rt_stream(ctx, (size_t)-1, NULL, &e);
 				uint32_t want = mlod_rt_max_vertex_count(ctx);
+				if (stated && want != at_open) /* known at open, never changed */
+					abort();
+				for (uint32_t m = 0; stated && m < mlod_rt_level_count(ctx, MLOD_RT_MESH); m++)
+					if (mlod_rt_mesh_vertex_count(ctx, m) > at_open) /* a level past what INFO states */
+						abort();
 				want = want > EVAL_VERTICES ? EVAL_VERTICES : want;
+				if (stated && pos && want > cap) /* sized at open: never grown */
+					abort();
 				if (want > cap || !pos) {
 					free(pos);
 					free(nrm);
@@ -83,10 +97,13 @@ static void evaluate(const uint8_t *data, size_t size)
 				mlod_rt_palette(ctx, s, &pal, &pc, &e);
 				float lo[3], hi[3];
 				const int bounded = mlod_rt_bounds(ctx, s, id, lo, hi, &e) == MLOD_OK;
-				if (cap && mlod_rt_skin(ctx, s, id, pos, 12, nrm, 12, cap, &vc, &e) == MLOD_OK && bounded)
+				const mlod_result sr = cap ? mlod_rt_skin(ctx, s, id, pos, 12, nrm, 12, cap, &vc, &e) : MLOD_ERR_LIMIT;
+				if (sr == MLOD_OK && bounded)
 					for (uint32_t v = 0; v < 3 * vc; v++) /* a finite vertex outside its box: abort */
 						if (pos[v] == pos[v] && pos[v] - pos[v] == 0.0f && !(pos[v] >= lo[v % 3] && pos[v] <= hi[v % 3]))
 							abort();
+				if (sr == MLOD_ERR_LIMIT && stated && cap && at_open <= EVAL_VERTICES) /* more than INFO states */
+					abort();
 				mlod_rt_joint_level jl;
 				for (uint32_t j = 0; j < mlod_rt_joint_count(ctx); j++)
 					mlod_rt_joint_level_get(ctx, mlod_rt_instance_state(ctx, id)->level[MLOD_RT_SKELETON], j, &jl,
@@ -136,7 +153,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	mlod_pack_decode_doc(&p, data, size, &doc, &e); /* also with the entropy stage */
 	mlod_pack_doc_free(&doc);
 	mlod_pack_skeleton_free(&skel);
+	const int stated = mlod_pack_version_has_max_vertices(p.major, p.minor);
 	mlod_pack_close(&p);
-	evaluate(data, size);
+	evaluate(data, size, stated);
 	return 0;
 }

@@ -366,6 +366,19 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		if (coarse && off[i] + chunks[i].n > drawable)
 			drawable = off[i] + chunks[i].n;
 	}
+	/* INFO's max_vertex_count (format 8.1): the most vertices of a MESH
+	 * level, the sum of its 'PART' records' vertex counts; written the
+	 * same way (when 0, in a pack of 8.1 or later). */
+	uint32_t maxv = 0;
+	for (int i = 0; i < nc; i++)
+		for (int k = 0; c[i].type == MLOD_CHUNK_MESH && k < c[i].ns; k++)
+			if (c[i].s[k].tag == MLOD_STREAM_PART && c[i].s[k].elsize == sizeof(mlod_pack_part_rec)) {
+				uint32_t v = 0;
+				for (uint32_t r = 0; r < c[i].s[k].count && (r + 1) * sizeof(mlod_pack_part_rec) <= c[i].s[k].data.n; r++)
+					v += get32(c[i].s[k].data.p + r * sizeof(mlod_pack_part_rec) +
+					           offsetof(mlod_pack_part_rec, vertex_count));
+				maxv = v > maxv ? v : maxv;
+			}
 	for (int i = 0; i < nc; i++) {
 		uint8_t *b = chunks[i].p;
 		if (c[i].type != MLOD_CHUNK_INFO || stage[i] || chunks[i].n < 4 + 16 + 80 || b[0] == 0 ||
@@ -375,6 +388,10 @@ static buf build_pack(const wchunk *c, int nc, uint16_t major, uint16_t minor)
 		if ((size_t)(fd + 4 - b) <= chunks[i].n && !(fd[0] | fd[1] | fd[2] | fd[3]))
 			for (int k = 0; k < 4; k++)
 				fd[k] = (uint8_t)(drawable >> (8 * k));
+		uint8_t *mv = fd + 4;
+		if (mlod_pack_version_has_max_vertices(major, minor) && (size_t)(mv + 4 - b) <= chunks[i].n &&
+		    !(mv[0] | mv[1] | mv[2] | mv[3]))
+			wr32(mv, maxv);
 	}
 	buf out = {0};
 	put(&out, "MLOD", 4);
@@ -1112,7 +1129,7 @@ TEST(open_reads_header_and_toc)
 	buf b = make_pack(0);
 	mlod_pack p;
 	CHECK_OK(mlod_pack_open(b.p, b.n, &p, &terr));
-	int ok = p.major == MLOD_PACK_MAJOR && p.minor == 0 && p.chunk_count == C_COUNT && p.file_size == b.n &&
+	int ok = p.major == MLOD_PACK_MAJOR && p.minor == MLOD_PACK_MINOR && p.chunk_count == C_COUNT && p.file_size == b.n &&
 	         p.chunks[C_MESH0].type == MLOD_CHUNK_MESH && p.chunks[C_MESH0].codec == MLOD_CODEC_MESHOPT &&
 	         p.chunks[C_MESH1].level == 1 && p.chunks[C_MESH1].error == 0.01f &&
 	         p.chunks[C_MESH1].distance == 9.35f && p.chunks[C_MESH1].offset % 16 == 0;
@@ -1838,7 +1855,8 @@ TEST(entropy_checks)
 	} while (0)
 	OPEN_FAILS(wr32(e + 12, raw + 1), MLOD_ERR_PARSE, "TOC entry 3 (MESH level 1): coded size");
 	OPEN_FAILS(wr32(e + 12, 0), MLOD_ERR_PARSE, "TOC entry 3 (MESH level 1): coded size 0 is not 4 to its raw size");
-	OPEN_FAILS(wr16(d + 4, 4), MLOD_ERR_PARSE, "TOC entry 1 (SKELETON): codec 0x10: an entropy stage in a 4.0 pack");
+	OPEN_FAILS((wr16(d + 4, 4), wr16(d + 6, 0)), MLOD_ERR_PARSE,
+	           "TOC entry 1 (SKELETON): codec 0x10: an entropy stage in a 4.0 pack");
 	OPEN_FAILS(d[32 + 5] = 0x10, MLOD_ERR_PARSE, "TOC entry 0 (INFO): INFO has no entropy stage");
 	DECODE_FAILS(e[5] = 0x30, MLOD_ERR_UNSUPPORTED, "MESH level 1: unknown entropy stage 3");
 	/* The TOC says fewer bytes than the frame holds (a bomb): refused
@@ -2036,7 +2054,8 @@ TEST(prefix_checks)
 		mlod_pack_close(&p);                                                                            \
 	} while (0)
 	/* A 5.x pack has no prefix stage (a 5.x reader refuses 6.0 whole). */
-	OPEN_FAILS(wr16(d + 4, 5), "TOC entry 2 (SKELETON level 1): codec 0x20: a zstd prefix stage in a 5.0 pack");
+	OPEN_FAILS((wr16(d + 4, 5), wr16(d + 6, 0)),
+	           "TOC entry 2 (SKELETON level 1): codec 0x20: a zstd prefix stage in a 5.0 pack");
 	/* The coarsest level has nothing to be coded on; other types have no
 	 * prefix (their dependencies are not MESH levels). */
 	OPEN_FAILS(d[32 + 48 * C_MESH1 + 5] = 0x20, "TOC entry 3 (MESH level 1): the zstd prefix stage on the coarsest");

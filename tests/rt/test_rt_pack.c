@@ -867,12 +867,14 @@ static int one_frame(const void *data, size_t size, int through_read)
 		if (mlod_rt_instance_create(ctx, mlod_rt_clip_count(ctx) ? (uint32_t)i % mlod_rt_clip_count(ctx) : 0,
 		                            0.4f * (float)i, MLOD_RT_LOOP, &ids[n], &e) == MLOD_OK)
 			n++;
+	/* sized at open, before any level streams in (format 8.1: INFO's
+	 * max_vertex_count) */
+	const uint32_t cap = mlod_rt_max_vertex_count(ctx);
+	float *buf = malloc(24 * (size_t)cap + 24);
 	mlod_rt_select sel;
 	mlod_rt_select_default(&sel);
 	mlod_rt_update(ctx, &sel, ids, d, (size_t)n, 0.1f, &e);
 	mlod_rt_stream(ctx, SIZE_MAX, NULL, &e);
-	const uint32_t cap = mlod_rt_max_vertex_count(ctx);
-	float *buf = malloc(24 * (size_t)cap + 24);
 	for (int i = 0; i < n && s && buf; i++) {
 		uint32_t nv = 0;
 		const float *P;

@@ -226,13 +226,14 @@ static void rt_skin_equal(const char *path)
 	float *out[2][2];
 	for (int k = 0; k < 2; k++) {
 		CHECK_OK(mlod_rt_open_memory(pk[k], n[k], NULL, &ctx[k], &terr));
+		/* sized at open for every level (INFO's max_vertex_count) */
+		uint32_t nv = mlod_rt_max_vertex_count(ctx[k]);
+		out[k][0] = malloc((size_t)nv * 12 + 12), out[k][1] = malloc((size_t)nv * 12 + 12);
 		for (uint32_t l = 0; l < mlod_rt_level_count(ctx[k], MLOD_RT_MESH); l++)
 			CHECK_OK(mlod_rt_request(ctx[k], MLOD_RT_MESH, l, 0, &terr));
 		CHECK_OK(mlod_rt_stream(ctx[k], SIZE_MAX, NULL, &terr));
 		sc[k] = mlod_rt_scratch_create(ctx[k]);
 		CHECK(sc[k] != NULL);
-		uint32_t nv = mlod_rt_max_vertex_count(ctx[k]);
-		out[k][0] = malloc((size_t)nv * 12 + 12), out[k][1] = malloc((size_t)nv * 12 + 12);
 	}
 	uint32_t L = mlod_rt_level_count(ctx[0], MLOD_RT_MESH), compared = 0;
 	CHECK(L == mlod_rt_level_count(ctx[1], MLOD_RT_MESH) && L >= 2);
