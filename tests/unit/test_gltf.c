@@ -1,5 +1,5 @@
 /*
- * test_gltf.c: the glTF shim (lib/io/gltf.cpp): reading the sample, lossless
+ * test_gltf.c: the glTF shim (lib/io/gltf_*.cpp): reading the sample, lossless
  * round trips, extras, the add_* calls, character <-> glTF, and hostile
  * input (empty, truncated, garbage, bad references, cycles, mutations).
  * With MLOD_SHARED_DATA set, every .glb there is round-tripped too.
