@@ -136,28 +136,6 @@ template <class T> static void keep_only(std::vector<T> &v, const std::vector<bo
 	v.resize(n);
 }
 
-/* The buffer views and buffers that an extension's JSON names (a
- * "bufferView" or "buffer" member anywhere inside an "extensions"
- * object), which prune_tail keeps whole. */
-static void extension_refs(const json &j, bool inside, std::vector<bool> &views, std::vector<bool> &buffers)
-{
-	if (j.is_object()) {
-		for (auto it = j.begin(); it != j.end(); ++it) {
-			if (inside && it->is_number_integer() && it->get<long long>() >= 0) {
-				size_t i = size_t(it->get<long long>());
-				if (it.key() == "bufferView" && i < views.size())
-					views[i] = true;
-				if (it.key() == "buffer" && i < buffers.size())
-					buffers[i] = true;
-			}
-			extension_refs(*it, inside || it.key() == "extensions", views, buffers);
-		}
-	} else if (j.is_array()) {
-		for (const json &e : j)
-			extension_refs(e, inside, views, buffers);
-	}
-}
-
 /* Flags index i in used (an index out of range or -1: none). */
 static void mark_used(std::vector<bool> &used, int i)
 {

@@ -37,8 +37,10 @@
  * defaults the input left out. The JSON it writes is therefore reconciled
  * with the JSON as read: objects that came from the input keep exactly
  * their keys, plus those mlod adds, and extras come from an exact copy.
- * Buffer 0 becomes the glb's BIN chunk; other buffers and images that were
- * not in a buffer view are embedded as data: URIs, bytes unchanged.
+ * A glb's BIN chunk holds every buffer (buffers 1.. appended to buffer 0,
+ * unless their indices matter beyond the buffer views) and every image
+ * that was not in a buffer view (in a view of its own); a .gltf embeds
+ * buffers and such images as data: URIs, bytes unchanged.
  *
  * Character model. mlod_gltf_to_character decodes skins, meshes (every
  * accessor layout: normalised integers, strides, sparse) and animations
@@ -241,6 +243,7 @@ std::string dump_json(const json &j, int indent);
 std::string pointer_token(const std::string &key);
 Value to_value(const json &j);
 json current_extras(const mlod_gltf &doc, const std::string &pointer, const Value &value);
+void extension_refs(const json &j, bool inside, std::vector<bool> &views, std::vector<bool> &buffers);
 mlod_trs node_trs(const tinygltf::Node &n);
 mlod_mat4 node_matrix(const tinygltf::Node &n);
 bool is_identity(const mlod_mat4 &m);

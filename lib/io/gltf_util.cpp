@@ -215,6 +215,29 @@ Value to_value(const json &j)
 	}
 }
 
+/* The buffer views and buffers that an extension's JSON names (a
+ * "bufferView" or "buffer" member anywhere inside an "extensions"
+ * object), which prune_tail keeps whole and a glb
+ * does not merge. */
+void extension_refs(const json &j, bool inside, std::vector<bool> &views, std::vector<bool> &buffers)
+{
+	if (j.is_object()) {
+		for (auto it = j.begin(); it != j.end(); ++it) {
+			if (inside && it->is_number_integer() && it->get<long long>() >= 0) {
+				size_t i = size_t(it->get<long long>());
+				if (it.key() == "bufferView" && i < views.size())
+					views[i] = true;
+				if (it.key() == "buffer" && i < buffers.size())
+					buffers[i] = true;
+			}
+			extension_refs(*it, inside || it.key() == "extensions", views, buffers);
+		}
+	} else if (j.is_array()) {
+		for (const json &e : j)
+			extension_refs(e, inside, views, buffers);
+	}
+}
+
 /* The extras of an object: the exact copy at pointer if there is one,
  * else its Value. */
 json current_extras(const mlod_gltf &doc, const std::string &pointer, const Value &value)

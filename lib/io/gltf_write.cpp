@@ -95,38 +95,89 @@ static void reconcile(json &out, const json &orig, bool root, bool in_extension)
 	}
 }
 
+/* Can a glb's BIN chunk hold buffers 1.. too? Only when their indices
+ * matter to nothing but the buffer views: no extension names a buffer
+ * (EXT_meshopt_compression's views do), and none of them has a URI (mlod
+ * embeds what it reads: none has), extensions or extras of its own. */
+static bool buffers_mergeable(const mlod_gltf &doc)
+{
+	const Model &m = doc.model;
+	if (m.buffers.size() < 2 || !m.buffers[0].uri.empty())
+		return false;
+	for (size_t k = 1; k < m.buffers.size(); k++) {
+		const tinygltf::Buffer &b = m.buffers[k];
+		if (!b.uri.empty() || !b.extensions.empty() || b.extras.Type() != tinygltf::NULL_TYPE ||
+		    doc.extras.count("/buffers/" + std::to_string(k) + "/extras"))
+			return false;
+	}
+	const json &o = doc.original;
+	if (o.is_object() && o.contains("buffers") && o["buffers"].is_array())
+		for (size_t k = 1; k < o["buffers"].size(); k++)
+			if (o["buffers"][k].is_object() && (o["buffers"][k].contains("extensions") || o["buffers"][k].contains("extras")))
+				return false;
+	std::vector<bool> views(m.bufferViews.size(), false), named(m.buffers.size(), false);
+	extension_refs(o, false, views, named);
+	return std::find(named.begin(), named.end(), true) == named.end();
+}
+
 /* The document as .glb or pretty-printed .gltf bytes. */
 std::string serialize(const mlod_gltf &doc, bool binary)
 {
+	/* A glb has one BIN chunk: buffers 1.. join buffer 0 there, each at a
+	 * 4-byte aligned offset (every component type's alignment), rather
+	 * than as base64 data: URIs, a third larger and slower to load; their
+	 * views follow them. On a copy of the model. */
+	const Model *model = &doc.model;
+	Model copy;
+	const bool merged = binary && buffers_mergeable(doc);
+	std::vector<size_t> rebased; /* the views of merged buffers */
+	if (merged) {
+		copy = doc.model;
+		model = &copy;
+		std::vector<unsigned char> &b = copy.buffers[0].data;
+		std::vector<size_t> base(copy.buffers.size(), 0);
+		for (size_t k = 1; k < copy.buffers.size(); k++) {
+			b.resize((b.size() + 3) / 4 * 4, 0);
+			base[k] = b.size();
+			b.insert(b.end(), copy.buffers[k].data.begin(), copy.buffers[k].data.end());
+		}
+		copy.buffers.resize(1);
+		for (size_t v = 0; v < copy.bufferViews.size(); v++) {
+			tinygltf::BufferView &view = copy.bufferViews[v];
+			if (view.buffer < 1)
+				continue;
+			view.byteOffset += base[size_t(view.buffer)];
+			view.buffer = 0;
+			rebased.push_back(v);
+		}
+	}
 	/* A glb holds the images read from files or data: URIs in its BIN
 	 * chunk, each in a buffer view of its own (a data: URI in a glb is
 	 * what the validator warns of): on a copy of the model. */
-	const Model *model = &doc.model;
-	Model with_views;
 	std::vector<std::pair<size_t, int>> moved; /* image, its new view */
 	for (size_t i = 0; binary && i < doc.model.images.size(); i++) {
 		const tinygltf::Image &im = doc.model.images[i];
 		if (im.bufferView >= 0 || im.image.empty() ||
 		    (im.mimeType.empty() ? sniff_image_type(im.image) : im.mimeType).empty())
 			continue;
-		if (moved.empty()) {
-			with_views = doc.model;
-			if (with_views.buffers.empty())
-				with_views.buffers.emplace_back();
-			model = &with_views;
+		if (model != &copy) {
+			copy = doc.model;
+			model = &copy;
 		}
-		tinygltf::Image &out = with_views.images[i];
-		std::vector<unsigned char> &b = with_views.buffers[0].data;
+		if (copy.buffers.empty())
+			copy.buffers.emplace_back();
+		tinygltf::Image &out = copy.images[i];
+		std::vector<unsigned char> &b = copy.buffers[0].data;
 		b.resize((b.size() + 3) / 4 * 4, 0);
 		tinygltf::BufferView v;
 		v.buffer = 0;
 		v.byteOffset = b.size();
 		v.byteLength = out.image.size();
 		b.insert(b.end(), out.image.begin(), out.image.end());
-		with_views.bufferViews.push_back(v);
+		copy.bufferViews.push_back(v);
 		if (out.mimeType.empty())
 			out.mimeType = sniff_image_type(out.image);
-		out.bufferView = int(with_views.bufferViews.size() - 1);
+		out.bufferView = int(copy.bufferViews.size() - 1);
 		out.uri.clear();
 		out.image.clear();
 		moved.emplace_back(i, out.bufferView);
@@ -149,6 +200,23 @@ std::string serialize(const mlod_gltf &doc, bool binary)
 	fill_empty_objects(j);
 	if (!doc.original.is_null())
 		reconcile(j, doc.original, true, false);
+	if (merged) {
+		/* Merged buffers: reconcile passes over an array shorter than the
+		 * input's, so buffer 0 is reconciled here, and a view that the
+		 * input gave no byteOffset gets its new one back. */
+		const json &o = doc.original;
+		if (o.is_object() && o.contains("buffers") && o["buffers"].is_array() && !o["buffers"].empty() &&
+		    j.contains("buffers") && j["buffers"].is_array() && !j["buffers"].empty())
+			reconcile(j["buffers"][0], o["buffers"][0], false, false);
+		for (size_t v : rebased) {
+			if (!j.contains("bufferViews") || v >= j["bufferViews"].size() || !j["bufferViews"][v].is_object())
+				continue;
+			json &view = j["bufferViews"][v];
+			view["buffer"] = 0;
+			if (model->bufferViews[v].byteOffset)
+				view["byteOffset"] = model->bufferViews[v].byteOffset;
+		}
+	}
 	for (const auto &iv : moved)
 		if (j.contains("images") && j["images"].is_array() && iv.first < j["images"].size() &&
 		    j["images"][iv.first].is_object()) {
