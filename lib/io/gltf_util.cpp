@@ -90,7 +90,8 @@ double tidy(float f)
 	return double(f);
 }
 
-/* Deeper JSON is refused: tinygltf converts it recursively. */
+/* Deeper JSON is refused: tinygltf converts it recursively. It is valid
+ * JSON that mlod does not handle, so MLOD_ERR_UNSUPPORTED (exit 3). */
 const int max_json_depth = 100;
 
 /* nlohmann's DOM builder with the depth limit, as a SAX handler. The limit
@@ -107,7 +108,7 @@ struct depth_limited_dom : nlohmann::detail::json_sax_dom_parser<json> {
 	void check() const
 	{
 		if (depth > max_json_depth)
-			fail(MLOD_ERR_PARSE, "JSON nested deeper than %d levels", max_json_depth);
+			fail(MLOD_ERR_UNSUPPORTED, "JSON nested deeper than %d levels", max_json_depth);
 	}
 	bool null() { check(); return base::null(); }
 	bool boolean(bool v) { check(); return base::boolean(v); }
