@@ -1,6 +1,6 @@
 /*
- * gltf_accessor.cpp: accessors: layouts, checks and decoding (normalised integers,
- * strides, sparse) (gltf_internal.hpp).
+ * gltf_accessor.cpp: accessors: layouts, checks and decoding (normalised
+ * integers, strides, sparse) (gltf_internal.hpp).
  */
 #include "io/gltf_internal.hpp"
 

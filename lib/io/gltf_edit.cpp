@@ -1,6 +1,6 @@
 /*
- * gltf_edit.cpp: editing a document: extras, level meshes in place, pruning,
- * dropping and restoring what a pack keeps (gltf_internal.hpp).
+ * gltf_edit.cpp: editing a document: extras, level meshes in place,
+ * pruning, dropping and restoring what a pack keeps (gltf_internal.hpp).
  */
 #include "io/gltf_internal.hpp"
 

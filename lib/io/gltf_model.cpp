@@ -665,8 +665,8 @@ static int append_view(Model &m, const void *data, size_t size, int target)
 
 /* Appends an accessor over count elements of comps components at data.
  * With min_max, records the per-component bounds (floats only). */
-static int append_accessor(Model &m, const void *data, size_t count, int component_type, int type, int comps, int target,
-                    bool min_max)
+static int append_accessor(Model &m, const void *data, size_t count, int component_type, int type, int comps,
+                           int target, bool min_max)
 {
 	size_t bytes = count * size_t(comps) * component_size(component_type);
 	tinygltf::Accessor a;

@@ -1,6 +1,7 @@
 /*
- * gltf_read.cpp: reading: tinygltf with mlod's file and image callbacks, then
- * what the reader adds (the exact extras, a scene, unit rotations) (gltf_internal.hpp).
+ * gltf_read.cpp: reading: tinygltf with mlod's file and image callbacks,
+ * then what the reader adds (the exact extras, a scene, unit rotations);
+ * a pack's DOC chunk (gltf_internal.hpp).
  */
 #include <sys/stat.h>
 #include <fstream>
@@ -68,7 +69,7 @@ static bool refuse_write(std::string *err, const std::string &, const std::vecto
  * their address without checking the view against the buffer, so that is
  * checked here (user is the model being loaded). */
 static bool keep_image_bytes(tinygltf::Image *image, const int index, std::string *err, std::string *, int, int,
-                      const unsigned char *bytes, int size, void *user)
+                             const unsigned char *bytes, int size, void *user)
 {
 	if (image->bufferView >= 0) {
 		const Model &m = *static_cast<const Model *>(user);

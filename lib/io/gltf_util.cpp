@@ -1,6 +1,6 @@
 /*
- * gltf_util.cpp: errors, C allocation, strings, JSON (the depth-limited parser,
- * tinygltf Values) and node transforms (gltf_internal.hpp).
+ * gltf_util.cpp: errors, C allocation, strings, JSON (the depth-limited
+ * parser, tinygltf Values) and node transforms (gltf_internal.hpp).
  */
 #include <cstdarg>
 

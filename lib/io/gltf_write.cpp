@@ -1,6 +1,6 @@
 /*
- * gltf_write.cpp: writing: tinygltf's JSON reconciled with the input's, as .glb
- * or .gltf bytes (gltf_internal.hpp).
+ * gltf_write.cpp: writing: tinygltf's JSON reconciled with the input's,
+ * as .glb or .gltf bytes (gltf_internal.hpp).
  */
 #include <sstream>
 
@@ -43,7 +43,8 @@ static std::string sniff_image_type(const std::vector<unsigned char> &b)
 /* tinygltf's image writer: embeds the bytes as they were read in a data:
  * URI. Images that were never loaded (an external file that was missing)
  * keep their URI. Not called for images in a buffer view. */
-static bool embed_image(const std::string *, const std::string *, const tinygltf::Image *image, bool, std::string *uri, void *)
+static bool embed_image(const std::string *, const std::string *, const tinygltf::Image *image, bool,
+                        std::string *uri, void *)
 {
 	if (image->image.empty())
 		return false;
@@ -113,7 +114,8 @@ static bool buffers_mergeable(const mlod_gltf &doc)
 	const json &o = doc.original;
 	if (o.is_object() && o.contains("buffers") && o["buffers"].is_array())
 		for (size_t k = 1; k < o["buffers"].size(); k++)
-			if (o["buffers"][k].is_object() && (o["buffers"][k].contains("extensions") || o["buffers"][k].contains("extras")))
+			if (o["buffers"][k].is_object() &&
+			    (o["buffers"][k].contains("extensions") || o["buffers"][k].contains("extras")))
 				return false;
 	std::vector<bool> views(m.bufferViews.size(), false), named(m.buffers.size(), false);
 	extension_refs(o, false, views, named);
