@@ -1,5 +1,5 @@
 /*
- * test_gltf.c: the glTF shim (lib/io/gltf.cpp): reading the sample, lossless
+ * test_gltf.c: the glTF shim (lib/io/gltf_*.cpp): reading the sample, lossless
  * round trips, extras, the add_* calls, character <-> glTF, and hostile
  * input (empty, truncated, garbage, bad references, cycles, mutations).
  * With MLOD_SHARED_DATA set, every .glb there is round-tripped too.
@@ -1177,7 +1177,8 @@ TEST(empty_and_garbage)
 	CHECK(mlod_gltf_to_character(NULL, NULL, NULL) == MLOD_ERR_INVALID_ARG);
 	CHECK(mlod_gltf_write(NULL, 1, NULL, NULL, NULL) == MLOD_ERR_INVALID_ARG);
 	mlod_gltf_free(NULL);
-	/* Too deep for tinygltf's recursive conversion. */
+	/* Too deep for tinygltf's recursive conversion: valid JSON that mlod
+	 * does not handle (unsupported, exit 3), not malformed input. */
 	char deep[1200] = "{\"asset\":{\"version\":\"2.0\"},\"extras\":";
 	size_t n = strlen(deep);
 	for (int i = 0; i < 500; i++)
@@ -1185,7 +1186,9 @@ TEST(empty_and_garbage)
 	for (int i = 0; i < 500; i++)
 		deep[n++] = ']';
 	deep[n++] = '}';
-	CHECK(try_read(deep, n) == MLOD_ERR_PARSE);
+	CHECK(try_read(deep, n) == MLOD_ERR_UNSUPPORTED);
+	CHECK(mlod_gltf_read(deep, n, NULL, &doc, &terr) == MLOD_ERR_UNSUPPORTED && doc == NULL);
+	CHECK_MSG(strcmp(terr.message, "JSON nested deeper than 100 levels") == 0, "%s", terr.message);
 }
 
 TEST(truncated_glb)

@@ -1,0 +1,741 @@
+/*
+ * gltf_edit.cpp: editing a document: extras, level meshes in place,
+ * pruning, dropping and restoring what a pack keeps (gltf_internal.hpp).
+ */
+#include "io/gltf_internal.hpp"
+
+namespace mlod_gltf_internal {
+
+/* ------------------------------------------------------------------ */
+/* Extras                                                              */
+/* ------------------------------------------------------------------ */
+
+/* Sets extras[key] of an object, keeping its other keys. */
+void set_extra(mlod_gltf &doc, mlod_gltf_kind kind, int index, const std::string &key, const json &v)
+{
+	std::string pointer;
+	Value *value = extras_slot(doc, kind, index, &pointer);
+	json e = current_extras(doc, pointer, *value);
+	if (e.is_null())
+		e = json::object();
+	if (!e.is_object())
+		fail(MLOD_ERR_UNSUPPORTED, "%s is not a JSON object: mlod does not add keys to it", pointer.c_str());
+	e[key] = v;
+	*value = to_value(e);
+	doc.extras[pointer] = std::move(e);
+}
+
+/* The glTF node of every joint of s (-1 when it has none). */
+std::vector<int> joint_nodes(const mlod_skeleton *s)
+{
+	std::vector<int> nodes;
+	for (int i = 0; i < s->joint_count; i++)
+		nodes.push_back(s->joints[i].node);
+	return nodes;
+}
+
+/* ------------------------------------------------------------------ */
+/* Editing a read document: level meshes in place, pruning             */
+/* ------------------------------------------------------------------ */
+
+/* Appends a mesh with mesh's primitives that takes the name, default
+ * morph weights, extensions and extras of glTF mesh `like` (and of its
+ * primitives, by position); returns its index. */
+int add_mesh_like(mlod_gltf &doc, int like, const mlod_mesh &mesh)
+{
+	Model &m = doc.model;
+	if (like < 0 || size_t(like) >= m.meshes.size())
+		fail(MLOD_ERR_INVALID_ARG, "mesh %d does not exist", like);
+	int index = add_mesh(m, mesh);
+	const tinygltf::Mesh &src = m.meshes[size_t(like)];
+	tinygltf::Mesh &dst = m.meshes[size_t(index)];
+	size_t prims = std::min(src.primitives.size(), dst.primitives.size());
+	bool same_targets = true;
+	for (size_t p = 0; p < dst.primitives.size(); p++)
+		same_targets = same_targets && dst.primitives[p].targets.size() == src.weights.size();
+	dst.name = src.name;
+	if (same_targets)
+		dst.weights = src.weights;
+	dst.extensions = src.extensions;
+	dst.extras = src.extras;
+	for (size_t p = 0; p < prims; p++) {
+		/* Not Draco's: it points at the full mesh's compressed data (a
+		 * file that lists Draco as used but not required gets here). */
+		dst.primitives[p].extensions = src.primitives[p].extensions;
+		dst.primitives[p].extensions.erase("KHR_draco_mesh_compression");
+		dst.primitives[p].extras = src.primitives[p].extras;
+	}
+	std::string from = "/meshes/" + std::to_string(like) + "/", to = "/meshes/" + std::to_string(index) + "/";
+	std::map<std::string, json> copied;
+	for (auto it = doc.extras.lower_bound(from); it != doc.extras.end() && it->first.compare(0, from.size(), from) == 0;
+	     ++it) {
+		std::string rest = it->first.substr(from.size());
+		unsigned long p = 0;
+		if (rest == "extras" || (sscanf(rest.c_str(), "primitives/%lu/extras", &p) == 1 && p < prims &&
+		                         rest == "primitives/" + std::to_string(p) + "/extras"))
+			copied[to + rest] = it->second;
+	}
+	doc.extras.insert(copied.begin(), copied.end());
+	return index;
+}
+
+/* Extensions that refer to no mesh, accessor or buffer view, so that
+ * pruning (which renumbers those) leaves them right. */
+static bool prune_safe(const std::string &name)
+{
+	static const char *const prefixes[] = {"KHR_materials_", "KHR_texture_", "KHR_lights_punctual",
+	                                       "KHR_mesh_quantization", "KHR_xmp", "EXT_texture_", "MSFT_lod",
+	                                       "MSFT_texture_dds"};
+	for (const char *p : prefixes)
+		if (name.compare(0, strlen(p), p) == 0)
+			return true;
+	return false;
+}
+
+/* Drops the elements of array `name` that keep says go, from the JSON as
+ * read and from the exact extras (later ones renumbered). Returns the
+ * old -> new index map (-1: dropped). The caller drops them from the model. */
+static std::vector<int> renumber(mlod_gltf &doc, const std::string &name, const std::vector<bool> &keep)
+{
+	std::vector<int> map(keep.size(), -1);
+	int n = 0;
+	for (size_t i = 0; i < keep.size(); i++)
+		if (keep[i])
+			map[i] = n++;
+	if (doc.original.is_object() && doc.original.contains(name) && doc.original[name].is_array()) {
+		json kept = json::array();
+		const json &a = doc.original[name];
+		for (size_t i = 0; i < a.size(); i++)
+			if (i >= keep.size() || keep[i])
+				kept.push_back(a[i]);
+		doc.original[name] = std::move(kept);
+	}
+	std::string prefix = "/" + name + "/";
+	std::map<std::string, json> moved;
+	for (auto it = doc.extras.lower_bound(prefix);
+	     it != doc.extras.end() && it->first.compare(0, prefix.size(), prefix) == 0;) {
+		size_t slash = it->first.find('/', prefix.size());
+		size_t i = size_t(std::stoul(it->first.substr(prefix.size(), slash - prefix.size())));
+		if (i < map.size() && map[i] >= 0)
+			moved[prefix + std::to_string(map[i]) + it->first.substr(slash)] = std::move(it->second);
+		it = doc.extras.erase(it);
+	}
+	doc.extras.insert(moved.begin(), moved.end());
+	return map;
+}
+
+template <class T> static void keep_only(std::vector<T> &v, const std::vector<bool> &keep)
+{
+	size_t n = 0;
+	for (size_t i = 0; i < v.size(); i++)
+		if (keep[i]) {
+			if (n != i) /* never move an element onto itself */
+				v[n] = std::move(v[i]);
+			n++;
+		}
+	v.resize(n);
+}
+
+/* Flags index i in used (an index out of range or -1: none). */
+static void mark_used(std::vector<bool> &used, int i)
+{
+	if (i >= 0 && size_t(i) < used.size())
+		used[size_t(i)] = true;
+}
+
+/* The accessors the meshes, skins and animations of m use. */
+static std::vector<bool> used_accessors(const Model &m)
+{
+	std::vector<bool> used(m.accessors.size(), false);
+	for (const tinygltf::Mesh &mesh : m.meshes)
+		for (const tinygltf::Primitive &p : mesh.primitives) {
+			mark_used(used, p.indices);
+			for (const auto &kv : p.attributes)
+				mark_used(used, kv.second);
+			for (const auto &t : p.targets)
+				for (const auto &kv : t)
+					mark_used(used, kv.second);
+		}
+	for (const tinygltf::Skin &sk : m.skins)
+		mark_used(used, sk.inverseBindMatrices);
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationSampler &sa : a.samplers) {
+			mark_used(used, sa.input);
+			mark_used(used, sa.output);
+		}
+	return used;
+}
+
+/* Flags in used the buffer views the accessors (their sparse parts too)
+ * and images of m use. */
+static void mark_used_views(const Model &m, std::vector<bool> &used)
+{
+	for (const tinygltf::Accessor &a : m.accessors) {
+		mark_used(used, a.bufferView);
+		if (a.sparse.isSparse) {
+			mark_used(used, a.sparse.indices.bufferView);
+			mark_used(used, a.sparse.values.bufferView);
+		}
+	}
+	for (const tinygltf::Image &i : m.images)
+		mark_used(used, i.bufferView);
+}
+
+/* prune for a document whose indices must hold (keep_indices): the
+ * accessors and buffer views after the last one in use go, and each
+ * buffer's bytes after its last kept view (a buffer an extension names
+ * stays whole); nothing else moves. */
+static void prune_tail(mlod_gltf &doc)
+{
+	Model &m = doc.model;
+	auto tail = [](std::vector<bool> &used) {
+		size_t n = used.size();
+		while (n > 0 && !used[n - 1])
+			n--;
+		for (size_t i = 0; i < used.size(); i++)
+			used[i] = i < n;
+	};
+	std::vector<bool> used = used_accessors(m);
+	tail(used);
+	renumber(doc, "accessors", used);
+	keep_only(m.accessors, used);
+
+	used.assign(m.bufferViews.size(), false);
+	std::vector<bool> named(m.buffers.size(), false);
+	extension_refs(doc.original, false, used, named);
+	mark_used_views(m, used);
+	tail(used);
+	renumber(doc, "bufferViews", used);
+	keep_only(m.bufferViews, used);
+	for (size_t b = 0; b < m.buffers.size(); b++) {
+		size_t end = 0;
+		bool any = false;
+		for (const tinygltf::BufferView &v : m.bufferViews)
+			if (v.buffer == int(b))
+				any = true, end = std::max(end, size_t(v.byteOffset + v.byteLength));
+		if (any && !named[b] && end < m.buffers[b].data.size())
+			m.buffers[b].data.resize(end);
+	}
+}
+
+/* Drops the meshes no node uses, then the accessors and buffer views
+ * nothing uses, and packs the buffers' bytes again. */
+void prune(mlod_gltf &doc, bool meshes)
+{
+	Model &m = doc.model;
+	if (doc.keep_indices) {
+		prune_tail(doc);
+		return;
+	}
+	for (const std::string &e : m.extensionsUsed)
+		if (!prune_safe(e))
+			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not pruned",
+			     e.c_str());
+	auto apply = [](const std::vector<int> &map, int &i) {
+		if (i >= 0)
+			i = size_t(i) < map.size() ? map[size_t(i)] : -1;
+	};
+
+	std::vector<bool> used(m.meshes.size(), true);
+	std::vector<int> map;
+	if (meshes) {
+		used.assign(m.meshes.size(), false);
+		for (const tinygltf::Node &n : m.nodes)
+			mark_used(used, n.mesh);
+		map = renumber(doc, "meshes", used);
+		keep_only(m.meshes, used);
+		for (tinygltf::Node &n : m.nodes)
+			apply(map, n.mesh);
+	}
+
+	used = used_accessors(m);
+	map = renumber(doc, "accessors", used);
+	keep_only(m.accessors, used);
+	for (tinygltf::Mesh &mesh : m.meshes)
+		for (tinygltf::Primitive &p : mesh.primitives) {
+			apply(map, p.indices);
+			for (auto &kv : p.attributes)
+				apply(map, kv.second);
+			for (auto &t : p.targets)
+				for (auto &kv : t)
+					apply(map, kv.second);
+		}
+	for (tinygltf::Skin &s : m.skins)
+		apply(map, s.inverseBindMatrices);
+	for (tinygltf::Animation &a : m.animations)
+		for (tinygltf::AnimationSampler &s : a.samplers) {
+			apply(map, s.input);
+			apply(map, s.output);
+		}
+
+	used.assign(m.bufferViews.size(), false);
+	mark_used_views(m, used);
+	map = renumber(doc, "bufferViews", used);
+	keep_only(m.bufferViews, used);
+	for (tinygltf::Accessor &a : m.accessors) {
+		apply(map, a.bufferView);
+		if (a.sparse.isSparse) {
+			apply(map, a.sparse.indices.bufferView);
+			apply(map, a.sparse.values.bufferView);
+		}
+	}
+	for (tinygltf::Image &i : m.images)
+		apply(map, i.bufferView);
+
+	/* Each buffer keeps its views' bytes only, in view order, 4-byte aligned. */
+	for (size_t b = 0; b < m.buffers.size(); b++) {
+		std::vector<unsigned char> packed;
+		for (tinygltf::BufferView &v : m.bufferViews) {
+			if (v.buffer != int(b))
+				continue;
+			const std::vector<unsigned char> &data = m.buffers[b].data;
+			if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset)
+				fail(MLOD_ERR_PARSE, "a buffer view lies outside buffer %zu", b);
+			packed.resize((packed.size() + 3) / 4 * 4, 0);
+			size_t at = packed.size();
+			packed.insert(packed.end(), data.begin() + long(v.byteOffset), data.begin() + long(v.byteOffset + v.byteLength));
+			v.byteOffset = at;
+		}
+		m.buffers[b].data = std::move(packed);
+	}
+	/* A buffer no view uses any more goes: a kept empty one (byteLength
+	 * 0, an empty data: URI) is not glTF and does not read back. */
+	used.assign(m.buffers.size(), false);
+	for (const tinygltf::BufferView &v : m.bufferViews)
+		mark_used(used, v.buffer);
+	map = renumber(doc, "buffers", used);
+	keep_only(m.buffers, used);
+	for (tinygltf::BufferView &v : m.bufferViews)
+		apply(map, v.buffer);
+	/* The JSON as read follows: it brings back what tinygltf leaves out
+	 * (a zero byteOffset) and drops what it lacks. */
+	if (doc.original.is_object() && doc.original.contains("bufferViews") && doc.original["bufferViews"].is_array()) {
+		json &views = doc.original["bufferViews"];
+		for (size_t i = 0; i < views.size() && i < m.bufferViews.size(); i++)
+			if (views[i].is_object())
+				views[i]["byteOffset"] = m.bufferViews[i].byteOffset;
+	}
+}
+
+/* Gives node `to` the default morph weights of node `from` and, in every
+ * animation, a copy of each channel animating from's weights. Returns the
+ * channels added. */
+int copy_morph_animation(Model &m, int from, int to)
+{
+	if (from < 0 || size_t(from) >= m.nodes.size() || to < 0 || size_t(to) >= m.nodes.size())
+		fail(MLOD_ERR_INVALID_ARG, "node %d or %d does not exist", from, to);
+	m.nodes[size_t(to)].weights = m.nodes[size_t(from)].weights;
+	int added = 0;
+	for (tinygltf::Animation &a : m.animations) {
+		size_t n = a.channels.size();
+		for (size_t c = 0; c < n; c++)
+			if (a.channels[c].target_node == from && a.channels[c].target_path == "weights") {
+				tinygltf::AnimationChannel copy = a.channels[c];
+				copy.target_node = to;
+				a.channels.push_back(copy);
+				added++;
+			}
+	}
+	return added;
+}
+
+/* Removes MSFT_lod from node and MSFT_screencoverage from its extras; its
+ * former level nodes lose their mesh and skin (they stay, empty, so that
+ * node indices hold). MSFT_lod leaves extensionsUsed when no node uses it
+ * any more. The JSON as read follows. */
+void clear_lod(mlod_gltf &doc, int node)
+{
+	Model &m = doc.model;
+	if (node < 0 || size_t(node) >= m.nodes.size())
+		fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+	tinygltf::Node &n = m.nodes[size_t(node)];
+	auto lod = n.extensions.find("MSFT_lod");
+	if (lod == n.extensions.end())
+		return;
+	const Value ids = lod->second.Get("ids"); /* a copy: the extension goes below */
+	for (size_t i = 0; ids.IsArray() && i < ids.ArrayLen(); i++) {
+		int id = ids.Get(int(i)).IsInt() ? ids.Get(int(i)).Get<int>() : -1;
+		if (id >= 0 && size_t(id) < m.nodes.size() && id != node) {
+			m.nodes[size_t(id)].mesh = -1;
+			m.nodes[size_t(id)].skin = -1;
+		}
+	}
+	n.extensions.erase(lod);
+	std::string pointer = "/nodes/" + std::to_string(node) + "/extras";
+	json e = current_extras(doc, pointer, n.extras);
+	if (e.is_object() && e.contains("MSFT_screencoverage")) {
+		e.erase("MSFT_screencoverage");
+		n.extras = e.empty() ? Value() : to_value(e);
+		if (e.empty())
+			doc.extras.erase(pointer);
+		else
+			doc.extras[pointer] = e;
+	}
+	bool used = false;
+	for (const tinygltf::Node &other : m.nodes)
+		used = used || other.extensions.count("MSFT_lod") > 0;
+	if (!used)
+		m.extensionsUsed.erase(std::remove(m.extensionsUsed.begin(), m.extensionsUsed.end(), "MSFT_lod"),
+		                       m.extensionsUsed.end());
+
+	json &orig = doc.original;
+	if (!orig.is_object())
+		return;
+	if (orig.contains("nodes") && orig["nodes"].is_array()) {
+		json &nodes = orig["nodes"];
+		if (ids.IsArray())
+			for (size_t i = 0; i < ids.ArrayLen(); i++) {
+				int id = ids.Get(int(i)).IsInt() ? ids.Get(int(i)).Get<int>() : -1;
+				if (id >= 0 && size_t(id) < nodes.size() && nodes[size_t(id)].is_object()) {
+					nodes[size_t(id)].erase("mesh");
+					nodes[size_t(id)].erase("skin");
+				}
+			}
+		if (size_t(node) < nodes.size() && nodes[size_t(node)].is_object()) {
+			json &o = nodes[size_t(node)];
+			if (o.contains("extensions") && o["extensions"].is_object()) {
+				o["extensions"].erase("MSFT_lod");
+				if (o["extensions"].empty())
+					o.erase("extensions");
+			}
+		}
+	}
+	if (!used && orig.contains("extensionsUsed") && orig["extensionsUsed"].is_array()) {
+		json kept = json::array();
+		for (const json &e2 : orig["extensionsUsed"])
+			if (e2 != "MSFT_lod")
+				kept.push_back(e2);
+		if (kept.empty())
+			orig.erase("extensionsUsed");
+		else
+			orig["extensionsUsed"] = kept;
+	}
+}
+
+/* What a pack's levels hold goes (mlod_gltf_strip_levels): the joint
+ * channels are the translation, rotation and scale channels of the nodes
+ * in joint_nodes. */
+void strip_levels(mlod_gltf &doc, const int *joint_nodes, int joint_count, const unsigned char *strip_mesh)
+{
+	Model &m = doc.model;
+	std::vector<char> joint(m.nodes.size(), 0);
+	for (int i = 0; joint_nodes && i < joint_count; i++)
+		if (joint_nodes[i] >= 0 && size_t(joint_nodes[i]) < joint.size())
+			joint[size_t(joint_nodes[i])] = 1;
+	for (const std::string &e : m.extensionsUsed)
+		if (!prune_safe(e))
+			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not stripped",
+			     e.c_str());
+	json &orig = doc.original;
+	auto orig_array = [&](const char *name) -> json * {
+		return orig.is_object() && orig.contains(name) && orig[name].is_array() ? &orig[name] : nullptr;
+	};
+	/* MSFT_lod: the level nodes stay, without mesh or skin. */
+	for (size_t n = 0; n < m.nodes.size(); n++)
+		if (m.nodes[n].extensions.count("MSFT_lod"))
+			clear_lod(doc, int(n));
+	/* Every primitive keeps its mode, material, extensions and extras; one
+	 * the pack does not hold (points, lines, strips, fans: the levels are
+	 * of triangle lists) keeps its data too. */
+	json *meshes = orig_array("meshes");
+	for (size_t i = 0; i < m.meshes.size(); i++)
+		for (size_t p = 0; (!strip_mesh || strip_mesh[i]) && p < m.meshes[i].primitives.size(); p++) {
+			tinygltf::Primitive &pr = m.meshes[i].primitives[p];
+			if (pr.mode >= 0 && pr.mode != TINYGLTF_MODE_TRIANGLES)
+				continue;
+			pr.attributes.clear();
+			pr.indices = -1;
+			pr.targets.clear();
+			if (meshes && i < meshes->size() && (*meshes)[i].is_object() && (*meshes)[i].contains("primitives") &&
+			    (*meshes)[i]["primitives"].is_array() && p < (*meshes)[i]["primitives"].size() &&
+			    (*meshes)[i]["primitives"][p].is_object()) {
+				json &o = (*meshes)[i]["primitives"][p];
+				o["attributes"] = json::object();
+				o.erase("indices");
+				o.erase("targets");
+			}
+		}
+	/* Animations keep every channel but the joint ones (the MOTION
+	 * chunks hold those): morph weights, other nodes' translation,
+	 * rotation and scale, channels without a node (KHR_animation_pointer). */
+	json *anims = orig_array("animations");
+	std::vector<bool> keep(m.animations.size(), true);
+	for (size_t a = 0; a < m.animations.size(); a++) {
+		tinygltf::Animation &an = m.animations[a];
+		json *oa = anims && a < anims->size() && (*anims)[a].is_object() ? &(*anims)[a] : nullptr;
+		std::vector<tinygltf::AnimationChannel> channels;
+		std::vector<int> sampler_map(an.samplers.size(), -1);
+		std::vector<tinygltf::AnimationSampler> samplers;
+		json ochannels = json::array(), osamplers = json::array();
+		for (size_t c = 0; c < an.channels.size(); c++) {
+			tinygltf::AnimationChannel ch = an.channels[c];
+			bool node = ch.target_node >= 0 && size_t(ch.target_node) < m.nodes.size();
+			if (ch.sampler < 0 || size_t(ch.sampler) >= an.samplers.size())
+				continue;
+			if (node && joint[size_t(ch.target_node)] &&
+			    (ch.target_path == "translation" || ch.target_path == "rotation" || ch.target_path == "scale"))
+				continue;
+			/* (weights of a node left without mesh: a level node's copy) */
+			if (ch.target_path == "weights" && (!node || m.nodes[size_t(ch.target_node)].mesh < 0))
+				continue;
+			if (sampler_map[size_t(ch.sampler)] < 0) {
+				sampler_map[size_t(ch.sampler)] = int(samplers.size());
+				samplers.push_back(an.samplers[size_t(ch.sampler)]);
+				if (oa && oa->contains("samplers") && (*oa)["samplers"].is_array() &&
+				    size_t(ch.sampler) < (*oa)["samplers"].size())
+					osamplers.push_back((*oa)["samplers"][size_t(ch.sampler)]);
+			}
+			if (oa && oa->contains("channels") && (*oa)["channels"].is_array() && c < (*oa)["channels"].size()) {
+				json oc = (*oa)["channels"][c];
+				oc["sampler"] = sampler_map[size_t(ch.sampler)];
+				ochannels.push_back(oc);
+			}
+			ch.sampler = sampler_map[size_t(ch.sampler)];
+			channels.push_back(ch);
+		}
+		an.channels = std::move(channels);
+		an.samplers = std::move(samplers);
+		if (oa) {
+			(*oa)["channels"] = std::move(ochannels);
+			(*oa)["samplers"] = std::move(osamplers);
+		}
+		keep[a] = !an.channels.empty();
+	}
+	renumber(doc, "animations", keep);
+	keep_only(m.animations, keep);
+	/* The accessors, views and bytes nothing uses any more go. */
+	prune(doc, false);
+}
+
+/* The JSON object as read of element i of top-level array name (nullptr
+ * when there is none). */
+static json *orig_element(mlod_gltf &doc, const char *name, int i)
+{
+	json &o = doc.original;
+	if (i < 0 || !o.is_object() || !o.contains(name) || !o[name].is_array() || size_t(i) >= o[name].size() ||
+	    !o[name][size_t(i)].is_object())
+		return nullptr;
+	return &o[name][size_t(i)];
+}
+
+/* Removes key from an object's extras (the whole extras when it empties),
+ * but for member `keep` of an object extras[key] (none when empty). */
+void remove_extra(mlod_gltf &doc, mlod_gltf_kind kind, int index, const std::string &key, const std::string &keep)
+{
+	std::string pointer;
+	Value *value = extras_slot(doc, kind, index, &pointer);
+	json e = current_extras(doc, pointer, *value);
+	if (!e.is_object() || !e.contains(key))
+		return;
+	json &v = e[key];
+	if (!keep.empty() && v.is_object() && v.contains(keep)) {
+		if (v.size() == 1)
+			return;
+		json kept = json::object();
+		kept[keep] = v[keep];
+		v = std::move(kept);
+	} else {
+		e.erase(key);
+	}
+	*value = e.empty() ? Value() : to_value(e);
+	if (e.empty())
+		doc.extras.erase(pointer);
+	else
+		doc.extras[pointer] = e;
+}
+
+/* Drops nodes from `nodes` on, skins from `skins` on, meshes from `meshes`
+ * on, after checking that nothing kept refers to them. */
+void drop_tail(mlod_gltf &doc, int nodes, int skins, int meshes)
+{
+	Model &m = doc.model;
+	nodes = std::max(0, std::min(nodes, int(m.nodes.size())));
+	skins = std::max(0, std::min(skins, int(m.skins.size())));
+	meshes = std::max(0, std::min(meshes, int(m.meshes.size())));
+	auto gone = [](int i, int from) { return i >= from; };
+	for (int n = 0; n < nodes; n++) {
+		const tinygltf::Node &nd = m.nodes[size_t(n)];
+		if (gone(nd.mesh, meshes) || gone(nd.skin, skins))
+			fail(MLOD_ERR_UNSUPPORTED, "node %d uses a mesh or skin that would go", n);
+		for (int c : nd.children)
+			if (gone(c, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "node %d has a child that would go", n);
+		if (nd.extensions.count("MSFT_lod"))
+			fail(MLOD_ERR_UNSUPPORTED, "node %d keeps MSFT_lod", n);
+	}
+	for (int k = 0; k < skins; k++) {
+		const tinygltf::Skin &sk = m.skins[size_t(k)];
+		if (gone(sk.skeleton, nodes))
+			fail(MLOD_ERR_UNSUPPORTED, "skin %d's skeleton would go", k);
+		for (int j : sk.joints)
+			if (gone(j, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "skin %d has a joint that would go", k);
+	}
+	for (const tinygltf::Scene &sc : m.scenes)
+		for (int n : sc.nodes)
+			if (gone(n, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "a scene lists a node that would go");
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationChannel &c : a.channels)
+			if (gone(c.target_node, nodes))
+				fail(MLOD_ERR_UNSUPPORTED, "animation \"%s\" targets a node that would go", a.name.c_str());
+	auto tail = [](size_t size, int from) {
+		std::vector<bool> keep(size, true);
+		for (size_t i = size_t(from); i < size; i++)
+			keep[i] = false;
+		return keep;
+	};
+	std::vector<bool> keep = tail(m.nodes.size(), nodes);
+	renumber(doc, "nodes", keep);
+	keep_only(m.nodes, keep);
+	keep = tail(m.skins.size(), skins);
+	renumber(doc, "skins", keep);
+	keep_only(m.skins, keep);
+	keep = tail(m.meshes.size(), meshes);
+	renumber(doc, "meshes", keep);
+	keep_only(m.meshes, keep);
+	prune(doc, false);
+}
+
+/* A node's rest TRS parts that hold the default (identity) values. */
+static bool trs_default(const mlod_trs &t, int part)
+{
+	if (part == 0)
+		return t.t.x == 0.0f && t.t.y == 0.0f && t.t.z == 0.0f;
+	if (part == 1)
+		return t.r.x == 0.0f && t.r.y == 0.0f && t.r.z == 0.0f && t.r.w == 1.0f;
+	return t.s.x == 1.0f && t.s.y == 1.0f && t.s.z == 1.0f;
+}
+
+/* The double a node's number is for f32 value f: f itself (mode 0), the
+ * shortest decimal that reads as f (mode 1), or f to 15 significant digits
+ * (mode 2, as some exporters write). */
+static double trs_number(float f, int mode)
+{
+	if (mode == 0 || !std::isfinite(f))
+		return f;
+	char buf[64];
+	if (mode == 2) {
+		snprintf(buf, sizeof buf, "%.15g", double(f));
+		return strtod(buf, nullptr);
+	}
+	for (int p = 1; p <= 9; p++) {
+		snprintf(buf, sizeof buf, "%.*g", p, double(f));
+		double d = strtod(buf, nullptr);
+		if (float(d) == f)
+			return d;
+	}
+	return f;
+}
+
+static void trs_values(const mlod_trs &t, int part, int mode, std::vector<double> &v)
+{
+	if (part == 0)
+		v = {trs_number(t.t.x, mode), trs_number(t.t.y, mode), trs_number(t.t.z, mode)};
+	else if (part == 1)
+		v = {trs_number(t.r.x, mode), trs_number(t.r.y, mode), trs_number(t.r.z, mode), trs_number(t.r.w, mode)};
+	else
+		v = {trs_number(t.s.x, mode), trs_number(t.s.y, mode), trs_number(t.s.z, mode)};
+}
+
+const char *const trs_keys[3] = {"translation", "rotation", "scale"};
+
+static std::vector<double> &trs_member(tinygltf::Node &n, int part)
+{
+	return part == 0 ? n.translation : part == 1 ? n.rotation : n.scale;
+}
+
+/* Drops (with apply; else only counts) the translation, rotation and
+ * scale of node `node` that are exactly trs_values of rest in mode and
+ * not the default; returns them as bits 1, 2, 4. A node with a matrix
+ * keeps it. */
+int drop_node_trs(mlod_gltf &doc, int node, const mlod_trs &rest, int mode, bool apply)
+{
+	Model &m = doc.model;
+	if (node < 0 || size_t(node) >= m.nodes.size())
+		fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+	tinygltf::Node &n = m.nodes[size_t(node)];
+	if (!n.matrix.empty())
+		return 0;
+	int dropped = 0;
+	for (int part = 0; part < 3; part++) {
+		std::vector<double> &have = trs_member(n, part), want;
+		trs_values(rest, part, mode, want);
+		if (have != want || trs_default(rest, part))
+			continue;
+		dropped |= 1 << part;
+		if (!apply)
+			continue;
+		have.clear();
+		if (json *o = orig_element(doc, "nodes", node))
+			o->erase(trs_keys[part]);
+	}
+	return dropped;
+}
+
+/* Gives node `node` (without a matrix) each of rest's translation,
+ * rotation and scale it lacks that is not the default. */
+void fill_node_trs(mlod_gltf &doc, int node, const mlod_trs &rest, int mode)
+{
+	Model &m = doc.model;
+	if (node < 0 || size_t(node) >= m.nodes.size())
+		fail(MLOD_ERR_INVALID_ARG, "node %d does not exist", node);
+	tinygltf::Node &n = m.nodes[size_t(node)];
+	if (!n.matrix.empty())
+		return;
+	for (int part = 0; part < 3; part++) {
+		std::vector<double> &have = trs_member(n, part);
+		if (!have.empty() || trs_default(rest, part))
+			continue;
+		trs_values(rest, part, mode, have);
+		if (json *o = orig_element(doc, "nodes", node))
+			(*o)[trs_keys[part]] = have;
+	}
+}
+
+/* Drops animation a. */
+void drop_animation(mlod_gltf &doc, int a)
+{
+	Model &m = doc.model;
+	if (a < 0 || size_t(a) >= m.animations.size())
+		fail(MLOD_ERR_INVALID_ARG, "animation %d does not exist", a);
+	if (doc.keep_indices && size_t(a) + 1 != m.animations.size())
+		fail(MLOD_ERR_UNSUPPORTED, "animation %d is not the last: the animations after it would be renumbered", a);
+	std::vector<bool> keep(m.animations.size(), true);
+	keep[size_t(a)] = false;
+	renumber(doc, "animations", keep);
+	keep_only(m.animations, keep);
+	prune(doc, false);
+}
+
+/* Drops skin k's inverse bind matrices (their bytes go). */
+void drop_inverse_binds(mlod_gltf &doc, int k)
+{
+	Model &m = doc.model;
+	if (k < 0 || size_t(k) >= m.skins.size())
+		fail(MLOD_ERR_INVALID_ARG, "skin %d does not exist", k);
+	m.skins[size_t(k)].inverseBindMatrices = -1;
+	if (json *o = orig_element(doc, "skins", k))
+		o->erase("inverseBindMatrices");
+	prune(doc, false);
+}
+
+/* Gives skin k the inverse bind matrices (a new accessor). */
+void set_inverse_binds(mlod_gltf &doc, int k, const mlod_mat4 *ibm, int count)
+{
+	Model &m = doc.model;
+	if (k < 0 || size_t(k) >= m.skins.size())
+		fail(MLOD_ERR_INVALID_ARG, "skin %d does not exist", k);
+	if (count != int(m.skins[size_t(k)].joints.size()))
+		fail(MLOD_ERR_INVALID_ARG, "skin %d has %zu joints, not %d", k, m.skins[size_t(k)].joints.size(), count);
+	std::vector<float> v(16 * size_t(count));
+	for (int j = 0; j < count; j++)
+		memcpy(&v[16 * size_t(j)], ibm[j].m, sizeof(float[16]));
+	check_finite(v.data(), v.size(), "inverse bind matrices");
+	int a = append_floats(m, v.data(), size_t(count), 16, 0);
+	m.skins[size_t(k)].inverseBindMatrices = a;
+	if (json *o = orig_element(doc, "skins", k))
+		(*o)["inverseBindMatrices"] = a;
+}
+
+} /* namespace mlod_gltf_internal */
