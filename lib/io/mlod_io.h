@@ -1,6 +1,7 @@
 /*
- * mlod_io.h: input and output: glTF through a C shim over tinygltf (the only
- * C++ of the bake side), BVH read and write, and format detection.
+ * mlod_io.h: input and output: glTF through a C shim over tinygltf (C++,
+ * lib/io/gltf_*.cpp; the bake side's other C++ is lib/pack's Draco shim),
+ * BVH read and write, and format detection.
  */
 #ifndef MLOD_IO_H
 #define MLOD_IO_H
