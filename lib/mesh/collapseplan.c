@@ -15,6 +15,7 @@
  * (collapsecost.c); a candidate's sum stops once it cannot win.
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "collapse.h"
@@ -227,6 +228,139 @@ static int geometry_ok(const mlod_bgm *g, const bgm_plan *pl, const double *x)
 			return 0;
 	}
 	return 1;
+}
+
+/* Squared distance from p to triangle (a, b, c) (Ericson 5.1.5). */
+static double point_tri2(const double *p, const double *a, const double *b, const double *c)
+{
+	double ab[3], ac[3], ap[3], q[3];
+	for (int i = 0; i < 3; i++)
+		ab[i] = b[i] - a[i], ac[i] = c[i] - a[i], ap[i] = p[i] - a[i];
+	double d1 = ab[0] * ap[0] + ab[1] * ap[1] + ab[2] * ap[2], d2 = ac[0] * ap[0] + ac[1] * ap[1] + ac[2] * ap[2];
+	double bp[3], cp[3];
+	for (int i = 0; i < 3; i++)
+		bp[i] = p[i] - b[i], cp[i] = p[i] - c[i];
+	double d3 = ab[0] * bp[0] + ab[1] * bp[1] + ab[2] * bp[2], d4 = ac[0] * bp[0] + ac[1] * bp[1] + ac[2] * bp[2];
+	double d5 = ab[0] * cp[0] + ab[1] * cp[1] + ab[2] * cp[2], d6 = ac[0] * cp[0] + ac[1] * cp[1] + ac[2] * cp[2];
+	double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+	if (d1 <= 0.0 && d2 <= 0.0) {
+		memcpy(q, a, sizeof q);
+	} else if (d3 >= 0.0 && d4 <= d3) {
+		memcpy(q, b, sizeof q);
+	} else if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+		double v = d1 / (d1 - d3);
+		for (int i = 0; i < 3; i++)
+			q[i] = a[i] + v * ab[i];
+	} else if (d6 >= 0.0 && d5 <= d6) {
+		memcpy(q, c, sizeof q);
+	} else if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+		double w = d2 / (d2 - d6);
+		for (int i = 0; i < 3; i++)
+			q[i] = a[i] + w * ac[i];
+	} else if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+		double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+		for (int i = 0; i < 3; i++)
+			q[i] = b[i] + w * (c[i] - b[i]);
+	} else {
+		double den = 1.0 / (va + vb + vc), v = vb * den, w = vc * den;
+		for (int i = 0; i < 3; i++)
+			q[i] = a[i] + ab[i] * v + ac[i] * w;
+	}
+	return (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
+}
+
+/* Node n's positions at the stored poses (bgm_quadrics_build's qpose),
+ * kept in g->gap_pos (a node's bind position and influences never
+ * change); NULL when out of memory. The pointer lasts until the next
+ * call. */
+static const double *posed_node(mlod_bgm *g, int n)
+{
+	size_t P = (size_t)g->qpose_count;
+	if (n >= g->gap_cap) {
+		int cap = g->node_cap > n ? g->node_cap : n + 1;
+		double *q = realloc(g->gap_pos, sizeof *q * 3 * P * (size_t)cap);
+		if (!q)
+			return NULL;
+		for (size_t i = 3 * P * (size_t)g->gap_cap; i < 3 * P * (size_t)cap; i += 3 * P)
+			q[i] = NAN;
+		g->gap_pos = q;
+		g->gap_cap = cap;
+	}
+	double *o = g->gap_pos + 3 * P * (size_t)n;
+	if (isnan(o[0]))
+		for (size_t k = 0; k < P; k++)
+			bgm_pose_point(g, g->qpose[k], &g->inf[n], g->nodes[n].p, o + 3 * k);
+	return o;
+}
+
+/* The largest squared distance, over the poses (the bind pose when there
+ * are none), of a collapsed vertex from the re-meshed patch (its kept
+ * faces, v-bar at the plan's place with its influences), times
+ * GAP_WEIGHT. The posed quadrics price a collapse by a mean over the
+ * patch's area, which a vertex standing off a small area (a seam vertex
+ * snapped across a thin strap, the crease of a bent joint) barely moves;
+ * this is the one-sided Hausdorff distance of that step. Poses whose
+ * skin matrices repeat an earlier one's (qmap) give the same distances
+ * and are skipped. */
+double bgm_plan_gap(mlod_bgm *g, const bgm_plan *pl)
+{
+	double worst = 0.0;
+	int S = g->pose_count > 0 ? g->qpose_count : 1;
+	/* The patch's nodes at every stored pose, looked up once (the
+	 * lookups may move g->gap_pos: pointers taken after). */
+	int ids[3 + 2 * MAX_PATCH], nid = 0;
+	for (int j = 0; j < pl->k; j++)
+		ids[nid++] = pl->v[j];
+	for (int i = 0; i < pl->nk; i++) {
+		const bgm_face *f = &g->faces[pl->kept[i]];
+		for (int k = 1; k < 3; k++)
+			ids[nid++] = f->n[(pl->corner[i] + k) % 3];
+	}
+	const double *at[3 + 2 * MAX_PATCH];
+	if (g->pose_count > 0) {
+		for (int i = 0; i < nid; i++)
+			if (!posed_node(g, ids[i]))
+				return 0.0; /* out of memory: no gap */
+		for (int i = 0; i < nid; i++)
+			at[i] = g->gap_pos + 3 * (size_t)g->qpose_count * (size_t)ids[i];
+	} else {
+		for (int i = 0; i < nid; i++)
+			at[i] = g->nodes[ids[i]].p;
+	}
+	for (int s = 0; s < S; s++) {
+		double X[3];
+		if (g->pose_count > 0)
+			bgm_pose_point(g, g->qpose[s], &pl->inf, pl->pos, X);
+		else
+			memcpy(X, pl->pos, sizeof X);
+		const double *vp[3];
+		double best[3];
+		int open = 0;
+		for (int j = 0; j < pl->k; j++) {
+			vp[j] = at[j] + 3 * s;
+			/* X is on the patch: a vertex no farther from it than the
+			 * largest so far cannot raise it */
+			double m = (vp[j][0] - X[0]) * (vp[j][0] - X[0]) + (vp[j][1] - X[1]) * (vp[j][1] - X[1]) +
+			           (vp[j][2] - X[2]) * (vp[j][2] - X[2]);
+			best[j] = m;
+			open |= m > worst;
+		}
+		for (int i = 0; i < pl->nk && open; i++) {
+			const double *q1 = at[pl->k + 2 * i] + 3 * s, *q2 = at[pl->k + 2 * i + 1] + 3 * s;
+			open = 0;
+			for (int j = 0; j < pl->k; j++) {
+				if (best[j] <= worst)
+					continue;
+				double d = point_tri2(vp[j], X, q1, q2);
+				best[j] = d < best[j] ? d : best[j];
+				open |= best[j] > worst;
+			}
+		}
+		for (int j = 0; j < pl->k; j++)
+			if (best[j] > worst)
+				worst = best[j];
+	}
+	return GAP_WEIGHT * worst;
 }
 
 /* The weights of x projected onto segment (a, b), clamped into it. */
