@@ -867,7 +867,6 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->qpose);
 	free(g->rquad);
 	free(g->qsum);
-	free(g->gap_pos);
 	free(g->skin);
 	free(g->skin2);
 	free(g->opstate);

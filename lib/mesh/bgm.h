@@ -118,9 +118,6 @@ struct mlod_bgm {
 	                         * with it in both lanes; NULL when there is one pose or for
 	                         * a mesh without influences */
 	double *qsum;           /* the collapse's scratch: one plan's summed quadrics */
-	double *gap_pos;        /* bgm_plan_gap: per node its position at each stored pose
-	                         * (qpose_count x 3, NaN first until needed), gap_cap nodes */
-	int gap_cap;
 	double pose0[12];       /* pose 0's skin matrix, every influence's (3x4, row-major) */
 	double pose0_cof[9];    /* its linear part's cofactors (row-major): n -> the posed n */
 	int pose0_mapped;       /* pose0 is not the identity (0 without quadrics) */
@@ -260,7 +257,6 @@ static inline double bgm_quadric_eval(const double *q, const double *x)
 }
 /* The minimiser of the packed quadric h (directions it leaves free stay
  * at x0); returns 0 and fills out, or -1. */
-void bgm_pose_point(const mlod_bgm *g, int p, const mlod_influences *inf, const double *x, double *y);
 int bgm_quadric_solve(const double *h, const double *x0, double *out);
 /* The bind position minimising that error with inf fixed (directions the
  * quadric leaves free stay at x0); returns 0 and fills out, or -1. */

@@ -232,7 +232,7 @@ static int push_op(mlod_bgm *g, int f, int op, bgm_plan *scratch)
 			g->opstate[f] |= (unsigned char)BLOCKED(op);
 			return 0;
 		}
-		key = scratch->cost + bgm_plan_gap(g, scratch);
+		key = scratch->cost;
 	} else {
 		key = bgm_compactness(g->nodes[F->n[0]].p, g->nodes[F->n[1]].p, g->nodes[F->n[2]].p);
 	}
@@ -352,11 +352,6 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 				g->opstate[e.face] |= (unsigned char)BLOCKED(e.op);
 				continue;
 			}
-			/* The largest posed gap is worked out only for a plan
-			 * that would otherwise go now (a dearer one goes back at
-			 * its cost without it, still a lower bound). */
-			if (g->opt.cost == MLOD_COST_POSED && !(pl->cost > e.key * (1.0 + 1e-9) + 1e-300))
-				pl->cost += bgm_plan_gap(g, pl);
 			if (g->opt.cost == MLOD_COST_POSED && pl->cost > e.key * (1.0 + 1e-9) + 1e-300) {
 				g->opstate[e.face] |= (unsigned char)QUEUED(e.op);
 				back = pl->cost;

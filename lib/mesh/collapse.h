@@ -29,8 +29,6 @@
 #define MAX_WEDGES 64       /* distinct wedges of a, b and c in the patch */
 #define MAX_CANDIDATES 8
 #define TIE_WEIGHT 1e-5     /* compactness tie-break of the posed cost */
-#define GAP_WEIGHT 0.07    /* posed cost: weight of a collapse's largest posed gap (collapseplan.c;
-                             * measured: bench/RESULTS.md, Ely's Hausdorff error) */
 #define BORDER_PENALTY 50.0 /* posed cost factor of a collapse along a border (measured:
                              * bench/RESULTS.md, the mesh layer's floor) */
 
@@ -113,11 +111,6 @@ int bgm_skin_role(bgm_memo *mm, int role, const mlod_v3 *V, const mlod_influence
  * holds the cheapest valid placement), else 0. With exact, the posed
  * cost of each placement with its own weights, through mm (may be NULL). */
 int bgm_plan_op(mlod_bgm *g, int t, int op, int exact, bgm_plan *pl, bgm_memo *mm);
-/* What a valid plan's collapse adds to its cost with the posed cost:
- * GAP_WEIGHT times the largest squared distance, over the poses, of a
- * collapsed vertex from the re-meshed patch (never negative, so the
- * queue's lower bounds of the plan's cost bound the sum too). */
-double bgm_plan_gap(mlod_bgm *g, const bgm_plan *pl);
 
 /* lowerbound.c: lower bounds of bgm_plan_op's cost, from the quadrics
  * alone: a queue key (*weak: a bind-pose bound, bgm_exact_bound comes

@@ -148,13 +148,6 @@ static inline void apply(const double *M, const double *x, double *y)
 		y[r] = M[4 * r] * x[0] + M[4 * r + 1] * x[1] + M[4 * r + 2] * x[2] + M[4 * r + 3];
 }
 
-void bgm_pose_point(const mlod_bgm *g, int p, const mlod_influences *inf, const double *x, double *y)
-{
-	double M[12];
-	blend(g, p, inf, M);
-	apply(M, x, y);
-}
-
 static inline double eval(const double *q, const double *x)
 {
 	return q[0] * x[0] * x[0] + 2 * q[1] * x[0] * x[1] + 2 * q[2] * x[0] * x[2] + 2 * q[3] * x[0] +
