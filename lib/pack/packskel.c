@@ -87,6 +87,17 @@ mlod_result pack_skeleton_levels(struct ctx *x)
 		r = mlod_skel_levels_init(&L, &x->v, info, x->err);
 	if (r == MLOD_OK)
 		r = mlod_skel_levels_default(&L, x->opt->skel_max_error, x->err);
+	if (r == MLOD_ERR_UNSUPPORTED) {
+		/* A character the skeleton layer cannot reduce (a mesh skinned
+		 * by two skins): the other layers still pack, the skeleton at
+		 * level 0 alone, with a warning (mlod-skelgraph refuses it). */
+		char text[MLOD_ERROR_MESSAGE_SIZE + 64];
+		snprintf(text, sizeof text, "no skeleton levels: %s", x->err ? x->err->message : "unsupported character");
+		pack_warn(x, text);
+		mlod_skel_levels_free(&L);
+		memset(&L, 0, sizeof L);
+		r = MLOD_OK;
+	}
 	for (int k = 0; r == MLOD_OK && k < L.count; k++) {
 		const mlod_skel_built *b = &L.levels[k];
 		x->kept[k] = malloc((size_t)n);
