@@ -18,7 +18,8 @@ extern "C" {
 
 /* An opaque glTF document. Everything mlod does not change (materials,
  * textures, cameras, extras, extensions, names, animations, skins) is kept
- * as read and written back unchanged. */
+ * as read and written back unchanged; a glb joins the buffers into one
+ * (mlod_gltf_write: the names of the buffers past the first go). */
 typedef struct mlod_gltf mlod_gltf;
 
 /* Parses .glb or .gltf bytes. base_dir resolves external URIs of a .gltf
@@ -31,7 +32,8 @@ typedef struct mlod_gltf mlod_gltf;
  * A property of the wrong JSON type or range for the glTF 2.0 schema (an
  * object for an array, a negative byteOffset or index, a non-object
  * extension, a primitive mode past 6) is MLOD_ERR_PARSE naming it ("meshes[0].primitives: not an
- * array"), where tinygltf would skip it or read 0. */
+ * array"), where tinygltf would skip it or read 0. JSON nested deeper than
+ * 100 levels is MLOD_ERR_UNSUPPORTED (valid JSON, beyond what mlod reads). */
 mlod_result mlod_gltf_read(const void *data, size_t size, const char *base_dir,
                            mlod_gltf **out, mlod_error *err);
 /* Reads a pack's DOC chunk (a glb, mlod(5)): as mlod_gltf_read without a

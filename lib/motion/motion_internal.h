@@ -260,10 +260,9 @@ double motion_line_distance(const mlod_motion *m, const motion_line *l);
 long motion_line_keys(const mlod_motion *m, const motion_line *l);
 
 /* ---------------------------------------------------------------- */
-/* framesmethod.c, keysmethod.c                                      */
+/* nextlevel.c, framesmethod.c, keysmethod.c                         */
 /* ---------------------------------------------------------------- */
 
-/* The frames method's next level. */
 /* The auto method's pick over the methods' levels, for
  * mlod_motion_next_level_best and the threaded builder (levels.c):
  * motion_best_take moves *l into *best when it wins
@@ -275,6 +274,7 @@ long motion_line_keys(const mlod_motion *m, const motion_line *l);
 int motion_best_take(mlod_motion_level *best, int *have, mlod_motion_level *l);
 mlod_result motion_best_end(int have, int limited, const mlod_error *why, mlod_error *err);
 
+/* The frames method's next level. */
 mlod_result motion_frames_level(mlod_motion *m, mlod_motion_target target, double value, long max_bytes,
                                 mlod_motion_level *out, mlod_error *err);
 /* The keys method's next level up to its rounding (*known: the clip's

@@ -626,10 +626,11 @@ uint32_t mlod_pack_crc32(uint32_t crc, const void *data, size_t size);
 
 typedef struct mlod_pack_info {
 	mlod_pack_info_rec rec;    /* max_vertex_count 0 in a pack older than 8.1 */
-	int has_max_vertices;      /* 1 when the pack states rec.max_vertex_count (format 8.1 on) */
 	const char *name;          /* the character's */
 	const char **clip_names;   /* clip_count */
 	void *block;
+	int has_max_vertices;      /* 1 when the pack states rec.max_vertex_count (format 8.1 on);
+	                            * last, so the members before it keep their offsets */
 } mlod_pack_info;
 
 typedef struct mlod_pack_skeleton {

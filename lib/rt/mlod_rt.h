@@ -368,7 +368,12 @@ mlod_result mlod_rt_level_info_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, 
  * it take at most 3 times the MESH chunks' raw bytes; a Draco level at
  * most 1024 / 12 vertices per byte of its container), and a level of more
  * vertices than it fails its load (MLOD_ERR_PARSE naming the level,
- * before it is allocated), so mlod_rt_skin never wants more. For an older pack
+ * before it is allocated), so mlod_rt_skin never wants more. The raw
+ * sizes are the TOC's claims, checked only as each chunk decodes (a zstd
+ * frame has no fixed expansion limit): a hostile pack can claim raw sizes
+ * it does not hold and a count up to 2^31 - 1 with them (its levels then
+ * fail their loads), so a caller that opens untrusted packs caps the
+ * buffers it sizes from this at a limit of its own. For an older pack
  * (format 8.0 and before, which leave it 0) it is the largest count of
  * any mesh level resident so far, and grows as finer levels load. */
 uint32_t mlod_rt_mesh_vertex_count(const mlod_rt_ctx *ctx, uint32_t level);

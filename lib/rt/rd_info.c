@@ -70,10 +70,12 @@ mlod_result mlod_pack_decode_info(const mlod_pack *p, const void *data, size_t s
 		FAIL("%s: %u motion levels with %u clips (0 motion levels means no clips)", x.label, rec.motion_levels,
 		     rec.clip_count);
 	/* max_vertex_count (format 8.1; reserved bytes before, which a reader
-	 * ignores): at most what the MESH chunks can hold, so that a caller
-	 * sizing its skinning buffers from it at open never sizes more than
-	 * the file's raw bytes allow; each level is checked against it as it
-	 * decodes (mlod_pack_info_check_mesh, the runtime's rt_mesh_reserve). */
+	 * ignores): at most what the MESH chunks' TOC raw sizes can hold, so
+	 * that a caller sizing its skinning buffers from it at open never
+	 * sizes more than those sizes allow (claims until each chunk decodes:
+	 * mlod_rt.h says what that leaves a caller of untrusted packs); each
+	 * level is checked against it as it decodes (mlod_pack_info_check_mesh,
+	 * the runtime's rt_mesh_reserve). */
 	if (!mlod_pack_version_has_max_vertices(p->major, p->minor))
 		rec.max_vertex_count = 0;
 	else if (rec.max_vertex_count > info_max_vertices_bound(p))
