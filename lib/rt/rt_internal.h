@@ -227,14 +227,13 @@ struct mlod_rt_scratch {
 };
 
 /* rt_ctx.c: allocation through the context's allocator (rt_calloc: n
- * zeroed elements, NULL on overflow), an empty context, and a unit. */
+ * zeroed elements, NULL on overflow) and an empty context. */
 void *rt_alloc(const mlod_rt_ctx *ctx, size_t size);
 void rt_free(const mlod_rt_ctx *ctx, void *p);
 void *rt_calloc(const mlod_rt_ctx *ctx, size_t n, size_t size);
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
 /* 1 when config's allocator has one of malloc and free (both or neither). */
 int rt_config_bad(const mlod_rt_config *config);
-rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item);
 
 /* rt_prepare.c: a level just made resident (u->skel, u->mesh or
  * u->motion set), checked, with the runtime's tables of it built in
@@ -325,6 +324,21 @@ void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals,
 /* rt_math.h: the affine helpers rt_mat_mul (a * b), rt_mat_trs
  * (mlod_mat4_from_trs) and rt_mat_mul_trs (parent * rt_mat_trs(t)). */
 #include "rt_math.h"
+
+/* Level level of a layer (and clip item of the motion layer), or NULL out
+ * of range. Inline: every update resolves each instance's levels by it
+ * (rt_resolve), and a pose looks up its levels. */
+static inline rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item)
+{
+	if ((unsigned)layer >= MLOD_RT_LAYERS || level >= ctx->levels[layer])
+		return NULL;
+	if (layer == MLOD_RT_MOTION) {
+		if (item >= ctx->clip_count)
+			return NULL;
+		return &ctx->units[ctx->unit_base[layer] + item * ctx->levels[layer] + level];
+	}
+	return &ctx->units[ctx->unit_base[layer] + level];
+}
 
 /* The id of slot i as it is now: its index and its generation. */
 static inline uint32_t rt_slot_id(const mlod_rt_ctx *ctx, uint32_t i)
