@@ -1,11 +1,11 @@
 /*
  * rt_ctx.c: the context's groundwork: allocation through the caller's
- * allocator and an empty context (a unit by layer, level and item is
- * rt_unit_get, inline in rt_internal.h). The rest of the context:
- * rt_prepare.c (checking and preparing a loaded level), rt_load.c (the
- * resident-level cache), rt_instance.c (instances and the fallback rule),
- * rt_open.c (opening views, the common part of every open, closing) and
- * rt_query.c; the pack source is rt_pack.c.
+ * allocator, an empty context, and a unit by layer, level and item
+ * (rt_unit_get; rt_unit_at, inline in rt_internal.h). The rest of the
+ * context: rt_prepare.c (checking and preparing a loaded level),
+ * rt_load.c (the resident-level cache), rt_instance.c (instances and the
+ * fallback rule), rt_open.c (opening views, the common part of every
+ * open, closing) and rt_query.c; the pack source is rt_pack.c.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -64,4 +64,9 @@ mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config)
 	ctx->max_instances = config && config->max_instances ? config->max_instances : 1024;
 	ctx->streamed = 1; /* the first update starts a frame */
 	return ctx;
+}
+
+rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item)
+{
+	return rt_unit_at(ctx, layer, level, item);
 }

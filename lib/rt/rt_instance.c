@@ -16,13 +16,13 @@ static uint16_t resolve_layer(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint3
 {
 	const uint32_t L = ctx->levels[layer];
 	for (uint32_t l = wanted; l < L; l++) {
-		const rt_unit *u = rt_unit_get(ctx, layer, l, item);
+		const rt_unit *u = rt_unit_at(ctx, layer, l, item);
 		if (u && u->state == RT_UNIT_RESIDENT)
 			return (uint16_t)l;
 	}
 	/* Unreachable while the coarsest stays resident; any resident one. */
 	for (uint32_t l = wanted; l-- > 0;) {
-		const rt_unit *u = rt_unit_get(ctx, layer, l, item);
+		const rt_unit *u = rt_unit_at(ctx, layer, l, item);
 		if (u && u->state == RT_UNIT_RESIDENT)
 			return (uint16_t)l;
 	}
@@ -39,9 +39,9 @@ void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in)
 			continue;
 		}
 		uint32_t item = layer == MLOD_RT_MOTION ? st->clip : 0;
-		rt_unit *old = rt_unit_get(ctx, (mlod_rt_layer)layer, st->level[layer], item);
+		rt_unit *old = rt_unit_at(ctx, (mlod_rt_layer)layer, st->level[layer], item);
 		uint16_t l = resolve_layer(ctx, (mlod_rt_layer)layer, item, st->wanted[layer]);
-		rt_unit *now = rt_unit_get(ctx, (mlod_rt_layer)layer, l, item);
+		rt_unit *now = rt_unit_at(ctx, (mlod_rt_layer)layer, l, item);
 		if (old != now) {
 			if (old && old->users)
 				old->users--;
@@ -60,8 +60,8 @@ static void unuse(mlod_rt_ctx *ctx, rt_instance *in)
 	for (int layer = 0; layer < MLOD_RT_LAYERS; layer++) {
 		if (!ctx->levels[layer])
 			continue;
-		rt_unit *u = rt_unit_get(ctx, (mlod_rt_layer)layer, in->st.level[layer],
-		                         layer == MLOD_RT_MOTION ? in->st.clip : 0);
+		rt_unit *u = rt_unit_at(ctx, (mlod_rt_layer)layer, in->st.level[layer],
+		                        layer == MLOD_RT_MOTION ? in->st.clip : 0);
 		if (u && u->users)
 			u->users--;
 	}
@@ -97,8 +97,8 @@ mlod_result mlod_rt_instance_create(mlod_rt_ctx *ctx, uint32_t clip, float time,
 		uint16_t c = (uint16_t)(ctx->levels[layer] ? ctx->levels[layer] - 1 : 0);
 		in->st.wanted[layer] = c;
 		in->st.level[layer] = c;
-		rt_unit *u = ctx->levels[layer] ? rt_unit_get(ctx, (mlod_rt_layer)layer, c,
-		                                              layer == MLOD_RT_MOTION ? in->st.clip : 0)
+		rt_unit *u = ctx->levels[layer] ? rt_unit_at(ctx, (mlod_rt_layer)layer, c,
+		                                             layer == MLOD_RT_MOTION ? in->st.clip : 0)
 		                                : NULL;
 		if (u)
 			u->users++;
@@ -140,8 +140,8 @@ mlod_result mlod_rt_instance_set(mlod_rt_ctx *ctx, uint32_t id, uint32_t clip, f
 	in->st.flags = flags;
 	/* The shown motion level now counts for the new clip. */
 	for (int layer = 0; layer < MLOD_RT_LAYERS; layer++) {
-		rt_unit *u = ctx->levels[layer] ? rt_unit_get(ctx, (mlod_rt_layer)layer, in->st.level[layer],
-		                                              layer == MLOD_RT_MOTION ? in->st.clip : 0)
+		rt_unit *u = ctx->levels[layer] ? rt_unit_at(ctx, (mlod_rt_layer)layer, in->st.level[layer],
+		                                             layer == MLOD_RT_MOTION ? in->st.clip : 0)
 		                                : NULL;
 		if (u)
 			u->users++;

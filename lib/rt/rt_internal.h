@@ -227,11 +227,13 @@ struct mlod_rt_scratch {
 };
 
 /* rt_ctx.c: allocation through the context's allocator (rt_calloc: n
- * zeroed elements, NULL on overflow) and an empty context. */
+ * zeroed elements, NULL on overflow), an empty context, and a unit
+ * (rt_unit_at below). */
 void *rt_alloc(const mlod_rt_ctx *ctx, size_t size);
 void rt_free(const mlod_rt_ctx *ctx, void *p);
 void *rt_calloc(const mlod_rt_ctx *ctx, size_t n, size_t size);
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
+rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item);
 /* 1 when config's allocator has one of malloc and free (both or neither). */
 int rt_config_bad(const mlod_rt_config *config);
 
@@ -326,9 +328,13 @@ void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals,
 #include "rt_math.h"
 
 /* Level level of a layer (and clip item of the motion layer), or NULL out
- * of range. Inline: every update resolves each instance's levels by it
- * (rt_resolve), and a pose looks up its levels. */
-static inline rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item)
+ * of range: rt_unit_get (rt_ctx.c), and the same inline, rt_unit_at, for
+ * rt_instance.c and rt_load.c, whose loops look levels up for every
+ * instance at every update (resolve_layer, rt_want_target): they were one
+ * file with rt_unit_get, which the compiler inlined there. The other
+ * files call rt_unit_get, as they did: inlined into rt_eval.c, it made
+ * mlod_rt_pose 0.4% costlier under callgrind (bench_bounds, Run 15). */
+static inline rt_unit *rt_unit_at(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item)
 {
 	if ((unsigned)layer >= MLOD_RT_LAYERS || level >= ctx->levels[layer])
 		return NULL;

@@ -281,7 +281,7 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 	 * motion_load), each freed before it returns; at most two at a time,
 	 * counted here as all of them. */
 	for (const rt_unit *v = u; v && v->chunk >= 0 && (ctx->pack.chunks[v->chunk].flags & MLOD_PACK_CHUNK_NESTED);) {
-		if (!(v = rt_unit_get(ctx, MLOD_RT_MOTION, (uint32_t)v->level + 1, v->item)))
+		if (!(v = rt_unit_at(ctx, MLOD_RT_MOTION, (uint32_t)v->level + 1, v->item)))
 			break;
 		hint += 4 * (size_t)v->raw_size + 256;
 	}
@@ -298,7 +298,7 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 
 mlod_result mlod_rt_request(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item, mlod_error *err)
 {
-	rt_unit *u = ctx ? rt_unit_get(ctx, layer, level, item) : NULL;
+	rt_unit *u = ctx ? rt_unit_at(ctx, layer, level, item) : NULL;
 	if (!u)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_request: no such level");
 	rt_begin_frame(ctx);
@@ -334,7 +334,7 @@ static void defer_want(mlod_rt_ctx *ctx, rt_unit *u)
 	const uint32_t w = u->want_count & 0x7fffffffu;
 	u->want_count |= 0x80000000u;
 	for (uint32_t l = (uint32_t)u->level + 1; w && l < ctx->levels[u->layer]; l++) {
-		rt_unit *t = rt_unit_get(ctx, (mlod_rt_layer)u->layer, l, u->item);
+		rt_unit *t = rt_unit_at(ctx, (mlod_rt_layer)u->layer, l, u->item);
 		if (!t || t->state == RT_UNIT_FAILED || (t->state == RT_UNIT_ABSENT && (t->want_count & 0x80000000u)))
 			continue;
 		rt_want(ctx, t, w); /* stamped now, as u was */
@@ -399,7 +399,7 @@ static int unit_needs(const mlod_rt_ctx *ctx, const rt_unit *u, const rt_unit *d
 	if (u->layer != MLOD_RT_MOTION)
 		return 0;
 	for (uint32_t l = u->level; l < d->level; l++) {
-		const rt_unit *v = rt_unit_get(ctx, MLOD_RT_MOTION, l, u->item);
+		const rt_unit *v = rt_unit_at(ctx, MLOD_RT_MOTION, l, u->item);
 		if (!v || v->chunk < 0 || !(ctx->pack.chunks[v->chunk].flags & MLOD_PACK_CHUNK_NESTED))
 			return 0;
 	}
@@ -432,11 +432,11 @@ static void load_failed(mlod_rt_ctx *ctx, rt_unit *u, mlod_result r)
 		return; /* a read or memory failure blames no chunk */
 	const uint32_t L = ctx->levels[u->layer];
 	for (uint32_t l = u->level; l < L; l++) {
-		rt_unit *d = rt_unit_get(ctx, (mlod_rt_layer)u->layer, l, u->item);
+		rt_unit *d = rt_unit_at(ctx, (mlod_rt_layer)u->layer, l, u->item);
 		if (!d || !unit_needs(ctx, u, d) || d->state == RT_UNIT_RESIDENT || !chunk_corrupt(ctx, d->chunk))
 			continue;
 		for (uint32_t k = 0; k <= l; k++) {
-			rt_unit *f = rt_unit_get(ctx, (mlod_rt_layer)u->layer, k, u->item);
+			rt_unit *f = rt_unit_at(ctx, (mlod_rt_layer)u->layer, k, u->item);
 			if (f && unit_needs(ctx, f, d))
 				fail_unit(ctx, f, 0);
 		}
@@ -450,7 +450,7 @@ uint32_t rt_want_target(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t it
 {
 	const uint32_t L = ctx->levels[layer];
 	for (uint32_t l = w; l < L; l++) {
-		const rt_unit *u = rt_unit_get(ctx, layer, l, item);
+		const rt_unit *u = rt_unit_at(ctx, layer, l, item);
 		if (u && u->state != RT_UNIT_FAILED)
 			return l;
 	}
@@ -466,8 +466,8 @@ static void pass_wants(mlod_rt_ctx *ctx)
 		const uint32_t w = u->want_count & 0x7fffffffu;
 		if (u->state != RT_UNIT_FAILED || !w)
 			continue;
-		rt_unit *t = rt_unit_get(ctx, (mlod_rt_layer)u->layer,
-		                         rt_want_target(ctx, (mlod_rt_layer)u->layer, u->item, u->level), u->item);
+		rt_unit *t = rt_unit_at(ctx, (mlod_rt_layer)u->layer,
+		                        rt_want_target(ctx, (mlod_rt_layer)u->layer, u->item, u->level), u->item);
 		u->want_count = 0;
 		if (t && t != u && t->state != RT_UNIT_FAILED) {
 			rt_want(ctx, t, w);
