@@ -784,7 +784,7 @@ static void morph_range(const mlod_pack_part *p, const float *w, uint32_t nt, si
  * M n normalised. The Gram matrix of M's columns, over s^2 = its first
  * entry, differs from the identity by at most RT_UNIT_TOL in every entry
  * (0 in the first), so its eigenvalues lie within 1 +- 3 RT_UNIT_TOL and
- * | U n | within 1 +- 2 RT_UNIT_TOL of | n |, which prepare_mesh checked to
+ * | U n | within 1 +- 2 RT_UNIT_TOL of | n |, which rt_prepare_mesh checked to
  * be within RT_UNIT_TOL of 1: U n is M n normalised to within
  * 3 RT_UNIT_TOL of its length (and float rounding), in the same
  * direction. Returns 1 and U = M / s (the first three columns) when so,

@@ -52,7 +52,7 @@ typedef struct rt_unit {
 	const mlod_pack_mesh *mesh;
 	const mlod_pack_motion *motion;
 	rt_skel_plan plan;        /* skeleton levels >= 1 */
-	/* Mesh levels (prepare_mesh): the palette entries its skinned vertices
+	/* Mesh levels (rt_prepare_mesh): the palette entries its skinned vertices
 	 * read (every influence the kernel blends, up to the last non-zero
 	 * weight), increasing, and the joints its rigid parts follow. */
 	uint32_t pal_used_count, rigid_count;
@@ -63,7 +63,7 @@ typedef struct rt_unit {
 	 * RT_UNIT_TOL (mlod_rt_skin may then skip renormalising them), else 0. */
 	uint32_t *skin_order_at;
 	uint8_t *skin_order;
-	/* Mesh levels (prepare_mesh), for mlod_rt_bounds, in plan_block.
+	/* Mesh levels (rt_prepare_mesh), for mlod_rt_bounds, in plan_block.
 	 * Per palette entry 13 floats: over the level's skinned vertices
 	 * weighted to it (weight > 0), the box of their bind-pose positions
 	 * (centre x, y, z, half extents x, y, z), the radius of the ball
@@ -226,11 +226,41 @@ struct mlod_rt_scratch {
 	uint32_t pal_stamp;
 };
 
-/* rt_ctx.c */
+/* rt_ctx.c: allocation through the context's allocator (rt_calloc: n
+ * zeroed elements, NULL on overflow), an empty context, and a unit
+ * (rt_unit_at below). */
 void *rt_alloc(const mlod_rt_ctx *ctx, size_t size);
 void rt_free(const mlod_rt_ctx *ctx, void *p);
+void *rt_calloc(const mlod_rt_ctx *ctx, size_t n, size_t size);
+mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
 rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item);
-void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in);
+/* 1 when config's allocator has one of malloc and free (both or neither). */
+int rt_config_bad(const mlod_rt_config *config);
+
+/* rt_prepare.c: a level just made resident (u->skel, u->mesh or
+ * u->motion set), checked, with the runtime's tables of it built in
+ * u->plan_block (rt_unit above); on failure the caller releases it. */
+mlod_result rt_prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_skel_level *l, mlod_error *err);
+mlod_result rt_prepare_mesh(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_mesh *m, mlod_error *err);
+mlod_result rt_prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_motion *m, mlod_error *err);
+/* The bytes of those tables: a motion level's of J joints, A channels of
+ * animated joints and S joints with one-key channels only; a decoded mesh
+ * level's; a mesh level's from its part records (before it decodes). */
+size_t rt_motion_plan_bytes(uint32_t J, uint32_t A, uint32_t S);
+size_t rt_mesh_tables_bytes(const mlod_rt_ctx *ctx, const mlod_pack_mesh *m);
+size_t rt_mesh_plan_bytes(const mlod_rt_ctx *ctx, const mlod_pack_part_rec *recs, uint32_t n);
+/* src[e] for the n palette entries: the smallest index whose entry follows
+ * the same joint with a bind matrix of the same 16 floats (bit for bit),
+ * e itself for the first of them, so that a palette can copy the product
+ * W[joint] * bind instead of making it again. bind[e] is entry e's matrix. */
+mlod_result rt_palette_sources(const mlod_rt_ctx *ctx, uint32_t n, const uint32_t *joint,
+                               const float *const *bind, uint32_t *src, mlod_error *err);
+
+/* rt_load.c: the resident-level cache. rt_unit_load loads u (not
+ * resident): on success it is resident and counted; rt_unit_release
+ * gives a resident unit's data back (others are left as they are). */
+mlod_result rt_unit_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err);
+void rt_unit_release(mlod_rt_ctx *ctx, rt_unit *u);
 /* The level loaded for an instance wanting level w: w, or the finest
  * coarser level not failed. */
 uint32_t rt_want_target(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t item, uint32_t w);
@@ -241,29 +271,24 @@ void rt_begin_frame(mlod_rt_ctx *ctx);
 /* n more wants of u in this frame (saturating below the high bit, which
  * mlod_rt_stream uses), stamped now for the eviction order. */
 void rt_want(mlod_rt_ctx *ctx, rt_unit *u, uint32_t n);
-mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err);
-mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
-/* 1 when config's allocator has one of malloc and free (both or neither). */
-int rt_config_bad(const mlod_rt_config *config);
-/* src[e] for the n palette entries: the smallest index whose entry follows
- * the same joint with a bind matrix of the same 16 floats (bit for bit),
- * e itself for the first of them, so that a palette can copy the product
- * W[joint] * bind instead of making it again. bind[e] is entry e's matrix. */
-mlod_result rt_palette_sources(const mlod_rt_ctx *ctx, uint32_t n, const uint32_t *joint,
-                               const float *const *bind, uint32_t *src, mlod_error *err);
-
-
-/* rt_ctx.c: the pack reader's reserve callback (pack_internal.h) for a
- * mesh level's load, user the context: sets ctx->loading's need from the
- * level's part records and, inside mlod_rt_stream, makes room for it
- * (evicting as mlod_rt_stream does) or refuses with MLOD_ERR_LIMIT and
- * ctx->refused set. */
+/* The pack reader's reserve callback (pack_internal.h) for a mesh level's
+ * load, user the context: sets ctx->loading's need from the level's part
+ * records and, inside mlod_rt_stream, makes room for it (evicting as
+ * mlod_rt_stream does) or refuses with MLOD_ERR_LIMIT and ctx->refused
+ * set. */
 mlod_result rt_mesh_reserve(void *user, const mlod_pack_part_rec *parts, uint32_t part_count, mlod_error *err);
-
 /* Byte counts of decoded views (from their arrays). */
 size_t rt_bytes_skel_level(const mlod_pack_skel_level *l);
 size_t rt_bytes_mesh(const mlod_pack_mesh *m);
 size_t rt_bytes_motion(const mlod_pack_motion *m);
+
+/* rt_instance.c: an instance's shown levels resolved from its wanted ones
+ * and the resident levels (the fallback rule), with the users counts. */
+void rt_resolve(mlod_rt_ctx *ctx, rt_instance *in);
+
+/* rt_open.c: the common part of every open, once the source has set the
+ * skeleton, the levels and the units: on failure the caller closes. */
+mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err);
 
 /* rt_skin.c: the vertices of a rigid or static part (or a stretch of
  * them) by the affine M: the point M p and the normal M n normalised (nrm
@@ -277,7 +302,7 @@ size_t rt_bytes_motion(const mlod_pack_motion *m);
 void rt_transform(size_t n, const float *pos, const float *nrm, const float *M, const float *U, float *out_pos,
                   size_t ps, float *out_nrm, size_t ns);
 
-/* rt_skin.c: the influence-count buckets of a skinned part (prepare_mesh
+/* rt_skin.c: the influence-count buckets of a skinned part (rt_prepare_mesh
  * builds them when a mesh level loads, so mlod_rt_skin_lbs's per-run
  * bucketing is not redone every frame). For n vertices in runs of
  * RT_SKIN_RUN, order holds RT_SKIN_ORDER_BYTES(n) bytes: first n, per run
@@ -301,6 +326,25 @@ void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals,
 /* rt_math.h: the affine helpers rt_mat_mul (a * b), rt_mat_trs
  * (mlod_mat4_from_trs) and rt_mat_mul_trs (parent * rt_mat_trs(t)). */
 #include "rt_math.h"
+
+/* Level level of a layer (and clip item of the motion layer), or NULL out
+ * of range: rt_unit_get (rt_ctx.c), and the same inline, rt_unit_at, for
+ * rt_instance.c and rt_load.c, whose loops look levels up for every
+ * instance at every update (resolve_layer, rt_want_target): they were one
+ * file with rt_unit_get, which the compiler inlined there. The other
+ * files call rt_unit_get, as they did: inlined into rt_eval.c, it made
+ * mlod_rt_pose 0.4% costlier under callgrind (bench_bounds, Run 15). */
+static inline rt_unit *rt_unit_at(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item)
+{
+	if ((unsigned)layer >= MLOD_RT_LAYERS || level >= ctx->levels[layer])
+		return NULL;
+	if (layer == MLOD_RT_MOTION) {
+		if (item >= ctx->clip_count)
+			return NULL;
+		return &ctx->units[ctx->unit_base[layer] + item * ctx->levels[layer] + level];
+	}
+	return &ctx->units[ctx->unit_base[layer] + level];
+}
 
 /* The id of slot i as it is now: its index and its generation. */
 static inline uint32_t rt_slot_id(const mlod_rt_ctx *ctx, uint32_t i)

@@ -1,6 +1,6 @@
 /*
  * rt_math.h: the runtime's affine matrix helpers (4x4 column-major, bottom
- * row 0 0 0 1), used both when a pack opens (rt_ctx.c: rest poses) and
+ * row 0 0 0 1), used both when a pack opens (rt_open.c: rest poses) and
  * every frame (rt_eval.c), inline: a pose makes a few per joint.
  * Included by rt_internal.h.
  */

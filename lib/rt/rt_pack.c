@@ -118,7 +118,7 @@ static mlod_result fetch_chunk(void *user, uint32_t chunk, const void **bytes, m
  * builds on the clip's next coarser level, as the reader returns it: the
  * chain of levels it builds on is decoded here, from the first that is
  * not nested, and freed again (a resident level's keys may have been
- * normalised: prepare_motion). */
+ * normalised: rt_prepare_motion). */
 static mlod_result motion_load(mlod_rt_ctx *ctx, uint32_t chunk, mlod_pack_motion *out, mlod_error *err)
 {
 	const mlod_pack_chunk *c = &ctx->pack.chunks[chunk];

@@ -16,7 +16,7 @@
  * at a time (SSE2: transposed, one square root and one division per 4
  * vertices, stored as rt_transform stores), 8 at a time where the CPU has
  * AVX (checked at run time; lane for lane the same operations). mlod_rt_skin does not bucket
- * every frame: prepare_mesh (rt_ctx.c) keeps each skinned part's buckets
+ * every frame: rt_prepare_mesh (rt_prepare.c) keeps each skinned part's buckets
  * from rt_skin_order, and rt_skin_lbs_ordered is the same loop given them.
  * It is written with the GCC/Clang vector extension; SSE2 intrinsics (the
  * x86-64 baseline) only for the bucketing mask and the normalisation (inlined
