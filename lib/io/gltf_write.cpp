@@ -122,13 +122,23 @@ static bool buffers_mergeable(const mlod_gltf &doc)
 	return std::find(named.begin(), named.end(), true) == named.end();
 }
 
+/* Appends bytes to a glb's BIN buffer at the next 4-byte aligned offset
+ * (every component type's alignment), which it returns. */
+static size_t append_aligned(std::vector<unsigned char> &bin, const std::vector<unsigned char> &bytes)
+{
+	bin.resize((bin.size() + 3) / 4 * 4, 0);
+	size_t at = bin.size();
+	bin.insert(bin.end(), bytes.begin(), bytes.end());
+	return at;
+}
+
 /* The document as .glb or pretty-printed .gltf bytes. */
 std::string serialize(const mlod_gltf &doc, bool binary)
 {
-	/* A glb has one BIN chunk: buffers 1.. join buffer 0 there, each at a
-	 * 4-byte aligned offset (every component type's alignment), rather
-	 * than as base64 data: URIs, a third larger and slower to load; their
-	 * views follow them. On a copy of the model. */
+	/* A glb has one BIN chunk: buffers 1.. join buffer 0 there
+	 * (append_aligned), rather than as base64 data: URIs, a third larger
+	 * and slower to load; their views follow them. On a copy of the
+	 * model. */
 	const Model *model = &doc.model;
 	Model copy;
 	const bool merged = binary && buffers_mergeable(doc);
@@ -136,13 +146,9 @@ std::string serialize(const mlod_gltf &doc, bool binary)
 	if (merged) {
 		copy = doc.model;
 		model = &copy;
-		std::vector<unsigned char> &b = copy.buffers[0].data;
 		std::vector<size_t> base(copy.buffers.size(), 0);
-		for (size_t k = 1; k < copy.buffers.size(); k++) {
-			b.resize((b.size() + 3) / 4 * 4, 0);
-			base[k] = b.size();
-			b.insert(b.end(), copy.buffers[k].data.begin(), copy.buffers[k].data.end());
-		}
+		for (size_t k = 1; k < copy.buffers.size(); k++)
+			base[k] = append_aligned(copy.buffers[0].data, copy.buffers[k].data);
 		copy.buffers.resize(1);
 		for (size_t v = 0; v < copy.bufferViews.size(); v++) {
 			tinygltf::BufferView &view = copy.bufferViews[v];
@@ -169,13 +175,10 @@ std::string serialize(const mlod_gltf &doc, bool binary)
 		if (copy.buffers.empty())
 			copy.buffers.emplace_back();
 		tinygltf::Image &out = copy.images[i];
-		std::vector<unsigned char> &b = copy.buffers[0].data;
-		b.resize((b.size() + 3) / 4 * 4, 0);
 		tinygltf::BufferView v;
 		v.buffer = 0;
-		v.byteOffset = b.size();
+		v.byteOffset = append_aligned(copy.buffers[0].data, out.image);
 		v.byteLength = out.image.size();
-		b.insert(b.end(), out.image.begin(), out.image.end());
 		copy.bufferViews.push_back(v);
 		if (out.mimeType.empty())
 			out.mimeType = sniff_image_type(out.image);
