@@ -937,19 +937,20 @@ static int part_level(struct ctx *x, chunkb *cb, struct mpart *m, int k, mlod_pa
 	 * three times one vertex of the buffer (bit-identical quantised
 	 * attributes) is dropped, as is one repeating an index of its own
 	 * (the input's: counted apart); a part may keep none at a level. */
-	uint32_t kept = 0, repeated = x->repeated[k];
+	uint32_t kept = 0, repeated = 0;
 	for (uint32_t t = 0; t + 3 <= ni; t += 3) {
 		uint32_t a = p->index_count > 0 ? p->indices[t] : t, b = p->index_count > 0 ? p->indices[t + 1] : t + 1,
 		         c = p->index_count > 0 ? p->indices[t + 2] : t + 2;
 		if (a == b || b == c || a == c) {
-			x->repeated[k]++;
+			repeated++;
 			continue;
 		}
 		if (cls[a] == cls[b] || cls[b] == cls[c] || cls[a] == cls[c])
 			continue;
 		in[kept++] = a, in[kept++] = b, in[kept++] = c;
 	}
-	x->degenerate[k] += (ni - kept) / 3 - (x->repeated[k] - repeated);
+	x->repeated[k] += repeated;
+	x->degenerate[k] += (ni - kept) / 3 - repeated;
 	x->emptied[k] += ni > 0 && kept == 0;
 	ni = kept;
 	if (x->opt->codec == MLOD_CODEC_MESHOPT && !x->draco) {
