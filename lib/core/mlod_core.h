@@ -2,10 +2,11 @@
  * mlod_core.h: the common core of mlod, shared by the bake library and the
  * runtime (lib/rt): result codes and their messages, UTF-8 checks, and the
  * small math (vectors, quaternions, 4x4 matrices, TRS, Euler angles) both
- * sides use.
+ * sides use, and the one growable byte buffer (mlod_buf) the writers of
+ * text and bytes build their output in.
  * It depends on nothing but the C library and POSIX threads (for
- * mlod_parallel_for), and nothing in it allocates but mlod_free's
- * counterpart.
+ * mlod_parallel_for), and nothing in it allocates but mlod_buf and
+ * mlod_free's counterpart.
  *
  * Conventions (every part of mlod follows them)
  * - Every fallible call returns an mlod_result and, when err is not NULL,
@@ -18,9 +19,11 @@
 #ifndef MLOD_CORE_H
 #define MLOD_CORE_H
 
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <string.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -62,6 +65,86 @@ mlod_result mlod_fail(mlod_error *err, mlod_result code, const char *fmt, ...)
 
 /* Releases a buffer returned by the library (glb bytes, JSON text, ...). */
 void mlod_free(void *p);
+
+/* ------------------------------------------------------------------ */
+/* Byte buffer                                                         */
+/* ------------------------------------------------------------------ */
+
+/* A growable byte buffer, for output built piece by piece (BVH text, JSON,
+ * a report, a pack's chunks). Zeroed (MLOD_BUF_INIT or mlod_buf_init) it
+ * is empty and holds no memory. A failed growth (out of memory, or a size
+ * past SIZE_MAX) sets status, frees nothing and makes every later append
+ * do nothing, so a writer appends a run and checks once, at the end
+ * (mlod_buf_take). While data is not NULL, data[size] is a NUL, so text
+ * appended is a C string as it stands. The appends return status. */
+typedef struct mlod_buf {
+	unsigned char *data; /* the bytes (malloc'd), NULL until the first growth */
+	size_t size;         /* bytes appended */
+	size_t cap;          /* bytes allocated: at least size + 1 once data is not NULL */
+	mlod_result status;  /* MLOD_OK, or why an append failed (MLOD_ERR_NOMEM) */
+} mlod_buf;
+
+#define MLOD_BUF_INIT { NULL, 0, 0, MLOD_OK }
+
+void mlod_buf_init(mlod_buf *b);
+/* Makes room for extra more bytes (and the NUL after them), growing the
+ * allocation at least twofold; MLOD_ERR_NOMEM when size + extra overflows
+ * or the allocation fails. */
+mlod_result mlod_buf_grow(mlod_buf *b, size_t extra);
+
+/* mlod_buf_grow when the room is not there already (inline, for the
+ * appends of a few bytes that writers make per number or character). */
+static inline mlod_result mlod_buf_reserve(mlod_buf *b, size_t extra)
+{
+	if (b->status == MLOD_OK && extra < b->cap - b->size)
+		return MLOD_OK;
+	return mlod_buf_grow(b, extra);
+}
+
+/* Appends n bytes of d (d may be NULL when n is 0). */
+static inline mlod_result mlod_buf_append(mlod_buf *b, const void *d, size_t n)
+{
+	if (mlod_buf_reserve(b, n) != MLOD_OK)
+		return b->status;
+	if (n)
+		memcpy(b->data + b->size, d, n);
+	b->size += n;
+	b->data[b->size] = 0;
+	return MLOD_OK;
+}
+
+/* Appends the string s without its NUL. */
+static inline mlod_result mlod_buf_append_str(mlod_buf *b, const char *s)
+{
+	return mlod_buf_append(b, s, strlen(s));
+}
+
+static inline mlod_result mlod_buf_append_char(mlod_buf *b, char c)
+{
+	return mlod_buf_append(b, &c, 1);
+}
+
+/* Appends n zero bytes. */
+mlod_result mlod_buf_append_zeros(mlod_buf *b, size_t n);
+
+/* Appends printf-style text (vsnprintf's, so the C locale's numbers in the
+ * tools); an encoding error sets status to MLOD_ERR_INVALID_ARG. */
+mlod_result mlod_buf_printf(mlod_buf *b, const char *fmt, ...)
+#if defined(__GNUC__)
+	__attribute__((format(printf, 2, 3)))
+#endif
+	;
+mlod_result mlod_buf_vprintf(mlod_buf *b, const char *fmt, va_list ap);
+
+/* Hands the bytes over: *data (for mlod_free; an empty buffer gives a
+ * malloc'd ""), and *size when size is not NULL, and leaves b empty. When
+ * an append failed, frees the bytes, sets *data to NULL and fails with
+ * status and "out of memory writing <what>" ("out of memory" when what is
+ * NULL). */
+mlod_result mlod_buf_take(mlod_buf *b, char **data, size_t *size, const char *what, mlod_error *err);
+
+/* Frees the bytes and leaves b empty (status MLOD_OK). */
+void mlod_buf_free(mlod_buf *b);
 
 /* ------------------------------------------------------------------ */
 /* Text                                                                */

@@ -28,43 +28,6 @@
 /* Writer                                                              */
 /* ================================================================== */
 
-typedef struct strbuf {
-	char *s;
-	size_t len, cap;
-	int oom;
-} strbuf;
-
-static void sb_put(strbuf *b, const char *s, size_t n)
-{
-	if (b->oom)
-		return;
-	if (b->len + n + 1 > b->cap) {
-		size_t cap = b->cap ? b->cap : 4096;
-		while (cap < b->len + n + 1)
-			cap *= 2;
-		char *p = realloc(b->s, cap);
-		if (!p) {
-			b->oom = 1;
-			return;
-		}
-		b->s = p;
-		b->cap = cap;
-	}
-	memcpy(b->s + b->len, s, n);
-	b->len += n;
-	b->s[b->len] = 0;
-}
-
-static void sb_puts(strbuf *b, const char *s)
-{
-	sb_put(b, s, strlen(s));
-}
-
-static void sb_char(strbuf *b, char c)
-{
-	sb_put(b, &c, 1);
-}
-
 /* Decimal digits of v into buf (no sign); returns the length. */
 static size_t utoa(unsigned long long v, char *buf)
 {
@@ -289,7 +252,7 @@ typedef struct writer {
 	/* Output. */
 	int *order;          /* joints in file order (depth first) */
 	double *prev;        /* last frame's Euler angles, 3 per joint */
-	strbuf b;
+	mlod_buf b;
 } writer;
 
 static int unit_scale(mlod_v3 s)
@@ -413,7 +376,7 @@ static void writer_free(writer *w)
 	free(w->q);
 	free(w->order);
 	free(w->prev);
-	free(w->b.s);
+	mlod_buf_free(&w->b);
 }
 
 /* Each joint's layout as the character gives it (or the default), and the
@@ -516,39 +479,39 @@ static mlod_result writer_widen(writer *w, mlod_error *err)
 }
 
 /* A joint name safe for BVH: no blanks, braces or control bytes. */
-static void put_name(strbuf *b, const char *name, int index)
+static void put_name(mlod_buf *b, const char *name, int index)
 {
 	if (!name || !*name) {
 		char num[24];
 		num[utoa((unsigned long long)index, num)] = 0;
-		sb_puts(b, "joint");
-		sb_puts(b, num);
+		mlod_buf_append_str(b, "joint");
+		mlod_buf_append_str(b, num);
 		return;
 	}
 	for (const char *p = name; *p; p++) {
 		unsigned char c = (unsigned char)*p;
-		sb_char(b, c <= 0x20 || c == 0x7f || c == '{' || c == '}' ? '_' : (char)c);
+		mlod_buf_append_char(b, c <= 0x20 || c == 0x7f || c == '{' || c == '}' ? '_' : (char)c);
 	}
 }
 
-static void put_indent(strbuf *b, int depth)
+static void put_indent(mlod_buf *b, int depth)
 {
 	for (int i = 0; i < depth && i < 64; i++)
-		sb_char(b, '\t');
+		mlod_buf_append_char(b, '\t');
 }
 
-static void put_offset(strbuf *b, int depth, mlod_v3 v)
+static void put_offset(mlod_buf *b, int depth, mlod_v3 v)
 {
 	char num[64];
 	float c[3] = { v.x, v.y, v.z };
 	put_indent(b, depth);
-	sb_puts(b, "OFFSET");
+	mlod_buf_append_str(b, "OFFSET");
 	for (int i = 0; i < 3; i++) {
 		format_float_exact(c[i], num);
-		sb_char(b, ' ');
-		sb_puts(b, num);
+		mlod_buf_append_char(b, ' ');
+		mlod_buf_append_str(b, num);
 	}
-	sb_char(b, '\n');
+	mlod_buf_append_char(b, '\n');
 }
 
 /* Opens joint j at the given depth: name, brace, OFFSET, CHANNELS. */
@@ -556,39 +519,39 @@ static void put_joint_head(writer *w, int j, int depth)
 {
 	const mlod_joint *jt = &w->c->skeleton.joints[j];
 	const layout *l = &w->lay[j];
-	strbuf *b = &w->b;
+	mlod_buf *b = &w->b;
 	put_indent(b, depth);
-	sb_puts(b, jt->parent < 0 ? "ROOT " : "JOINT ");
+	mlod_buf_append_str(b, jt->parent < 0 ? "ROOT " : "JOINT ");
 	put_name(b, jt->name, j);
-	sb_char(b, '\n');
+	mlod_buf_append_char(b, '\n');
 	put_indent(b, depth);
-	sb_puts(b, "{\n");
+	mlod_buf_append_str(b, "{\n");
 	put_offset(b, depth + 1, w->offset[j]);
 	put_indent(b, depth + 1);
-	sb_puts(b, "CHANNELS ");
-	sb_char(b, (char)('0' + l->n));
+	mlod_buf_append_str(b, "CHANNELS ");
+	mlod_buf_append_char(b, (char)('0' + l->n));
 	for (int k = 0; k < l->n; k++) {
-		sb_char(b, ' ');
-		sb_puts(b, bvh_channel_names[l->ch[k]]);
+		mlod_buf_append_char(b, ' ');
+		mlod_buf_append_str(b, bvh_channel_names[l->ch[k]]);
 	}
-	sb_char(b, '\n');
+	mlod_buf_append_char(b, '\n');
 }
 
 /* Closes joint j: its End Site, then the brace. */
 static void put_joint_tail(writer *w, int j, int depth)
 {
-	strbuf *b = &w->b;
+	mlod_buf *b = &w->b;
 	if (w->c->skeleton.joints[j].has_end_site) {
 		put_indent(b, depth + 1);
-		sb_puts(b, "End Site\n");
+		mlod_buf_append_str(b, "End Site\n");
 		put_indent(b, depth + 1);
-		sb_puts(b, "{\n");
+		mlod_buf_append_str(b, "{\n");
 		put_offset(b, depth + 2, w->end[j]);
 		put_indent(b, depth + 1);
-		sb_puts(b, "}\n");
+		mlod_buf_append_str(b, "}\n");
 	}
 	put_indent(b, depth);
-	sb_puts(b, "}\n");
+	mlod_buf_append_str(b, "}\n");
 }
 
 /* The HIERARCHY, depth first without recursion; fills w->order. */
@@ -615,7 +578,7 @@ static mlod_result write_hierarchy(writer *w, mlod_error *err)
 			first_child[p] = j;
 		}
 	}
-	sb_puts(&w->b, "HIERARCHY\n");
+	mlod_buf_append_str(&w->b, "HIERARCHY\n");
 	int count = 0;
 	for (int root = 0; root < w->n; root++) {
 		if (s->joints[root].parent >= 0)
@@ -651,16 +614,16 @@ static mlod_result write_hierarchy(writer *w, mlod_error *err)
  * shortest decimal of their float, angles to 1e-5 degree (2e-7 radian). */
 static void write_motion(writer *w)
 {
-	strbuf *b = &w->b;
+	mlod_buf *b = &w->b;
 	char num[64];
-	sb_puts(b, "MOTION\nFrames: ");
+	mlod_buf_append_str(b, "MOTION\nFrames: ");
 	num[utoa((unsigned long long)w->frames, num)] = 0;
-	sb_puts(b, num);
-	sb_puts(b, "\nFrame Time: ");
+	mlod_buf_append_str(b, num);
+	mlod_buf_append_str(b, "\nFrame Time: ");
 	format_float_exact((float)w->ft, num);
-	sb_puts(b, num);
-	sb_char(b, '\n');
-	for (long f = 0; f < w->frames && !b->oom; f++) {
+	mlod_buf_append_str(b, num);
+	mlod_buf_append_char(b, '\n');
+	for (long f = 0; f < w->frames && b->status == MLOD_OK; f++) {
 		pose_frame(w, f);
 		int sep = 0;
 		for (int i = 0; i < w->n; i++) {
@@ -679,12 +642,12 @@ static void write_motion(writer *w)
 				else
 					format_number(ang[code - MLOD_BVH_XROT] * (180.0 / MLOD_PI), 5, num);
 				if (sep)
-					sb_char(b, ' ');
+					mlod_buf_append_char(b, ' ');
 				sep = 1;
-				sb_puts(b, num);
+				mlod_buf_append_str(b, num);
 			}
 		}
-		sb_char(b, '\n');
+		mlod_buf_append_char(b, '\n');
 	}
 }
 
@@ -752,14 +715,8 @@ mlod_result mlod_bvh_write(const mlod_character *c, int clip, float frame_time, 
 		res = write_hierarchy(&w, err);
 	if (res == MLOD_OK)
 		write_motion(&w);
-	if (res == MLOD_OK && w.b.oom)
-		res = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing BVH");
-	if (res == MLOD_OK) {
-		*text = w.b.s;
-		if (size)
-			*size = w.b.len;
-		w.b.s = NULL;
-	}
+	if (res == MLOD_OK)
+		res = mlod_buf_take(&w.b, text, size, "BVH", err);
 	writer_free(&w);
 	return res;
 }

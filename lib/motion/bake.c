@@ -38,113 +38,58 @@ static const char *target_name(mlod_motion_target t)
 /* Text                                                                */
 /* ------------------------------------------------------------------ */
 
-typedef struct sbuf {
-	char *p;
-	size_t n, cap;
-	int bad;
-} sbuf;
-
-#if defined(__GNUC__)
-__attribute__((format(printf, 2, 3)))
-#endif
-static void sb_printf(sbuf *b, const char *fmt, ...)
+static void sb_json_string(mlod_buf *b, const char *s)
 {
-	if (b->bad)
-		return;
-	va_list ap;
-	va_start(ap, fmt);
-	int need = vsnprintf(NULL, 0, fmt, ap);
-	va_end(ap);
-	if (need < 0) {
-		b->bad = 1;
-		return;
-	}
-	if (b->n + (size_t)need + 1 > b->cap) {
-		size_t cap = b->cap ? b->cap : 1024;
-		while (cap < b->n + (size_t)need + 1)
-			cap *= 2;
-		char *p = realloc(b->p, cap);
-		if (!p) {
-			b->bad = 1;
-			return;
-		}
-		b->p = p;
-		b->cap = cap;
-	}
-	va_start(ap, fmt);
-	vsnprintf(b->p + b->n, b->cap - b->n, fmt, ap);
-	va_end(ap);
-	b->n += (size_t)need;
-}
-
-static void sb_json_string(sbuf *b, const char *s)
-{
-	sb_printf(b, "\"");
+	mlod_buf_printf(b, "\"");
 	for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
 		switch (*p) {
-		case '"': sb_printf(b, "\\\""); break;
-		case '\\': sb_printf(b, "\\\\"); break;
-		case '\n': sb_printf(b, "\\n"); break;
-		case '\t': sb_printf(b, "\\t"); break;
-		case '\r': sb_printf(b, "\\r"); break;
+		case '"': mlod_buf_printf(b, "\\\""); break;
+		case '\\': mlod_buf_printf(b, "\\\\"); break;
+		case '\n': mlod_buf_printf(b, "\\n"); break;
+		case '\t': mlod_buf_printf(b, "\\t"); break;
+		case '\r': mlod_buf_printf(b, "\\r"); break;
 		default:
 			if (*p < 0x20) {
-				sb_printf(b, "\\u%04x", *p);
+				mlod_buf_printf(b, "\\u%04x", *p);
 			} else if (*p < 0x80) {
-				sb_printf(b, "%c", *p);
+				mlod_buf_printf(b, "%c", *p);
 			} else { /* JSON text is UTF-8: a byte that does not start a well-formed sequence as U+FFFD */
 				int n = mlod_utf8_length((const char *)p);
 				if (n == 0)
-					sb_printf(b, "\xEF\xBF\xBD");
+					mlod_buf_printf(b, "\xEF\xBF\xBD");
 				else
-					sb_printf(b, "%.*s", n, (const char *)p), p += n - 1;
+					mlod_buf_printf(b, "%.*s", n, (const char *)p), p += n - 1;
 			}
 		}
 	}
-	sb_printf(b, "\"");
+	mlod_buf_printf(b, "\"");
 }
 
 /* A name in a table (mlod_name_text's C escapes), padded to width
  * columns, a UTF-8 character one column. */
-static void sb_name(sbuf *b, const char *name, int width)
+static void sb_name(mlod_buf *b, const char *name, int width)
 {
 	char text[512];
 	mlod_name_text(name, 0, text, sizeof text);
 	int columns = 0;
 	for (const unsigned char *p = (const unsigned char *)text; *p; p++)
 		columns += (*p & 0xc0) != 0x80;
-	sb_printf(b, "%s%*s", text, width > columns ? width - columns : 0, "");
+	mlod_buf_printf(b, "%s%*s", text, width > columns ? width - columns : 0, "");
 }
 
 /* A text in a table whole, however long (sb_name cuts at 512 bytes):
  * mlod_name_text's C escapes, into a buffer with room for every byte as
  * \xHH. */
-static void sb_text(sbuf *b, const char *s)
+static void sb_text(mlod_buf *b, const char *s)
 {
 	size_t size = 4 * strlen(s ? s : "") + 16;
 	char *text = malloc(size);
 	if (!text) {
-		b->bad = 1;
+		b->status = MLOD_ERR_NOMEM;
 		return;
 	}
-	sb_printf(b, "%s", mlod_name_text(s, 0, text, size));
+	mlod_buf_printf(b, "%s", mlod_name_text(s, 0, text, size));
 	free(text);
-}
-
-static mlod_result sb_finish(sbuf *b, char **text, mlod_error *err)
-{
-	if (b->bad || !b->p) {
-		free(b->p);
-		*text = NULL;
-		if (!b->bad && (b->p = malloc(1)) != NULL) { /* nothing written: an empty text */
-			b->p[0] = '\0';
-			*text = b->p;
-			return MLOD_OK;
-		}
-		return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
-	}
-	*text = b->p;
-	return MLOD_OK;
 }
 
 static int add_note(mlod_motion_bake *b, const char *fmt, ...)
@@ -452,24 +397,24 @@ int mlod_motion_bake_timeline_note(const mlod_motion_bake *b, int k, char *buf, 
 mlod_result mlod_motion_bake_table(const mlod_motion_bake *b, const mlod_character *c,
                                    const mlod_motion_report_info *info, char **text, mlod_error *err)
 {
-	sbuf sb = { NULL, 0, 0, 0 };
+	mlod_buf sb = MLOD_BUF_INIT;
 	double height = info->height;
-	sb_printf(&sb, "# ");
+	mlod_buf_printf(&sb, "# ");
 	sb_text(&sb, info->input);
-	sb_printf(&sb, ": %d joints, height %.4g, %d clips; point distance %.4g\n", c->skeleton.joint_count, height, c->clip_count, info->point_distance);
-	sb_printf(&sb, "%-16s %5s %6s %10s %7s %7s %8s %10s %8s %10s %8s %10s %8s\n", "clip", "level", "method",
+	mlod_buf_printf(&sb, ": %d joints, height %.4g, %d clips; point distance %.4g\n", c->skeleton.joint_count, height, c->clip_count, info->point_distance);
+	mlod_buf_printf(&sb, "%-16s %5s %6s %10s %7s %7s %8s %10s %8s %10s %8s %10s %8s\n", "clip", "level", "method",
 	          "threshold", "keys", "keys%", "bytes", "jnt max", "max%", "jnt mean", "mean%", "pt max", "vtx max%");
 	for (int k = 0; k < b->clip_count; k++) {
 		const mlod_motion_bake_clip *cl = &b->clips[k];
 		const char *name = c->clips[cl->index].name;
 		sb_name(&sb, name, 16);
-		sb_printf(&sb, " %5d %6s %10s %7ld %6.1f%% %8ld %10s %8s %10s %8s %10s %8s\n", 0, "-", "-",
+		mlod_buf_printf(&sb, " %5d %6s %10s %7ld %6.1f%% %8ld %10s %8s %10s %8s %10s %8s\n", 0, "-", "-",
 		          cl->keys, 100.0, cl->bytes, "0", "0", "0", "0", "0", c->instance_count ? "0" : "-");
 		for (int i = 0; i < cl->level_count; i++) {
 			const mlod_motion_bake_level *lv = &cl->levels[i];
 			if (!lv->ok) {
 				sb_name(&sb, name, 16);
-				sb_printf(&sb, " %5d %6s (no level within %.4g)\n", i + 1, "-", lv->bound);
+				mlod_buf_printf(&sb, " %5d %6s (no level within %.4g)\n", i + 1, "-", lv->bound);
 				continue;
 			}
 			char vtx[32] = "-";
@@ -477,7 +422,7 @@ mlod_result mlod_motion_bake_table(const mlod_motion_bake *b, const mlod_charact
 				snprintf(vtx, sizeof vtx, "%.4f", lv->vertex.max);
 			long keys = lv->l.keys + lv->w_keys;
 			sb_name(&sb, name, 16);
-			sb_printf(&sb, " %5d %6s %10.4g %7ld %6.1f%% %8ld %10.4g %8.4f %10.4g %8.4f %10.4g %8s\n", i + 1, method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
+			mlod_buf_printf(&sb, " %5d %6s %10.4g %7ld %6.1f%% %8ld %10.4g %8.4f %10.4g %8.4f %10.4g %8s\n", i + 1, method_name(lv->l.method), lv->l.threshold, keys, 100.0 * (double)keys / (double)cl->keys,
 			          lv->l.bytes + lv->w_bytes, lv->l.error.max, 100.0 * lv->l.error.max / height, lv->l.error.mean,
 			          100.0 * lv->l.error.mean / height, lv->l.point_error, vtx);
 		}
@@ -485,76 +430,76 @@ mlod_result mlod_motion_bake_table(const mlod_motion_bake *b, const mlod_charact
 	for (int k = 0; k < b->clip_count; k++) {
 		char note[256];
 		if (mlod_motion_bake_timeline_note(b, k, note, sizeof note)) {
-			sb_printf(&sb, "# clip ");
+			mlod_buf_printf(&sb, "# clip ");
 			sb_name(&sb, c->clips[b->clips[k].index].name, 0);
-			sb_printf(&sb, ": %s\n", note);
+			mlod_buf_printf(&sb, ": %s\n", note);
 		}
 	}
 	for (int k = 0; k < b->clip_count; k++) {
 		const mlod_motion_bake_clip *cl = &b->clips[k];
 		if (cl->w_count == 0)
 			continue;
-		sb_printf(&sb, "# clip ");
+		mlod_buf_printf(&sb, "# clip ");
 		sb_name(&sb, c->clips[cl->index].name, 0);
-		sb_printf(&sb, ": %d morph weights channels, %ld keys; per level kept keys (vertex error bound, scene units):",
+		mlod_buf_printf(&sb, ": %d morph weights channels, %ld keys; per level kept keys (vertex error bound, scene units):",
 		          cl->w_count, cl->w_keys);
 		for (int i = 0; i < cl->level_count; i++)
 			if (cl->levels[i].ok)
-				sb_printf(&sb, " %d: %ld (%.4g%s)", i + 1, cl->levels[i].w_keys, cl->levels[i].w_error,
+				mlod_buf_printf(&sb, " %d: %ld (%.4g%s)", i + 1, cl->levels[i].w_keys, cl->levels[i].w_error,
 				          cl->levels[i].w_copied ? ", some copied" : "");
-		sb_printf(&sb, "\n");
+		mlod_buf_printf(&sb, "\n");
 	}
-	sb_printf(&sb, "# threshold: frame distance (frames) or error budget in scene units (keys); jnt: world joint\n"
+	mlod_buf_printf(&sb, "# threshold: frame distance (frames) or error budget in scene units (keys); jnt: world joint\n"
 	               "# position error against the clip as read, scene units and %% of the height; pt: point error (joint\n"
 	               "# origins and points within the point distance), scene units; vtx: skinned-vertex error, %% of the\n"
 	               "# bounding diagonal\n");
 	int sub = info->subdivide;
 	if (sub == 1)
-		sb_printf(&sb, "# jnt and pt measured at the frames of each clip's common timeline (--subdivide 1)\n");
+		mlod_buf_printf(&sb, "# jnt and pt measured at the frames of each clip's common timeline (--subdivide 1)\n");
 	else
-		sb_printf(&sb,
+		mlod_buf_printf(&sb,
 		          "# jnt and pt measured at the frames of each clip's common timeline and %d time%s between each two "
 		          "(--subdivide %d)\n",
 		          sub - 1, sub == 2 ? "" : "s", sub);
 	if (info->precision != MLOD_MOTION_PRECISION_FULL)
-		sb_printf(&sb, "# key values rounded within each level's bound (--precision %s)\n",
+		mlod_buf_printf(&sb, "# key values rounded within each level's bound (--precision %s)\n",
 		          info->precision == MLOD_MOTION_PRECISION_AUTO ? "auto" : "float");
 	if (c->notes && *c->notes)
-		sb_printf(&sb, "# note: %s\n", c->notes);
-	return sb_finish(&sb, text, err);
+		mlod_buf_printf(&sb, "# note: %s\n", c->notes);
+	return mlod_buf_take(&sb, text, NULL, NULL, err);
 }
 
 mlod_result mlod_motion_bake_json(const mlod_motion_bake *b, const mlod_character *c,
                                   const mlod_motion_report_info *info, char **text, mlod_error *err)
 {
-	sbuf sb = { NULL, 0, 0, 0 };
+	mlod_buf sb = MLOD_BUF_INIT;
 	double height = info->height;
-	sb_printf(&sb, "{\n  \"input\": ");
+	mlod_buf_printf(&sb, "{\n  \"input\": ");
 	sb_json_string(&sb, info->input);
-	sb_printf(&sb, ",\n  \"joints\": %d,\n  \"height\": %.9g,\n  \"point_distance\": %.9g,\n  \"subdivide\": %d,\n  \"clips\": [\n",
+	mlod_buf_printf(&sb, ",\n  \"joints\": %d,\n  \"height\": %.9g,\n  \"point_distance\": %.9g,\n  \"subdivide\": %d,\n  \"clips\": [\n",
 	          c->skeleton.joint_count, height, info->point_distance, info->subdivide);
 	for (int k = 0; k < b->clip_count; k++) {
 		const mlod_motion_bake_clip *cl = &b->clips[k];
-		sb_printf(&sb, "    {\"name\": ");
+		mlod_buf_printf(&sb, "    {\"name\": ");
 		sb_json_string(&sb, c->clips[cl->index].name);
-		sb_printf(&sb,
+		mlod_buf_printf(&sb,
 		          ", \"index\": %d, \"duration\": %.9g, \"frames\": %d, \"resampled\": %s, "
 		          "\"mismatched_channels\": %d, \"cubic_channels\": %d, \"keys\": %ld, \"bytes\": %ld,\n     \"levels\": [",
 		          cl->index, (double)c->clips[cl->index].duration, cl->frames, cl->timeline.resampled ? "true" : "false",
 		          cl->timeline.mismatched_channels, cl->timeline.cubic_channels, cl->keys, cl->bytes);
 		for (int i = 0; i < cl->level_count; i++) {
 			const mlod_motion_bake_level *lv = &cl->levels[i];
-			sb_printf(&sb, "%s\n       {\"level\": %d, \"target\": \"%s\", \"value\": %.9g, ", i ? "," : "", i + 1,
+			mlod_buf_printf(&sb, "%s\n       {\"level\": %d, \"target\": \"%s\", \"value\": %.9g, ", i ? "," : "", i + 1,
 			          target_name(lv->target), lv->value);
 			if (lv->bound >= 0.0)
-				sb_printf(&sb, "\"bound\": %.9g, \"bound_percent_height\": %.9g, ", lv->bound,
+				mlod_buf_printf(&sb, "\"bound\": %.9g, \"bound_percent_height\": %.9g, ", lv->bound,
 				          100.0 * lv->bound / height);
 			if (!lv->ok) {
-				sb_printf(&sb, "\"ok\": false}");
+				mlod_buf_printf(&sb, "\"ok\": false}");
 				continue;
 			}
 			long keys = lv->l.keys + lv->w_keys;
-			sb_printf(&sb,
+			mlod_buf_printf(&sb,
 			          "\"ok\": true, \"method\": \"%s\", \"threshold\": %.9g, \"keys\": %ld, \"keys_percent\": %.6g, "
 			          "\"bytes\": %ld,\n        \"joint_error\": {\"max\": %.9g, \"mean\": %.9g, \"max_percent_height\": %.9g, "
 			          "\"mean_percent_height\": %.9g},\n        \"point_error\": %.9g, \"grid\": %.9g",
@@ -562,22 +507,22 @@ mlod_result mlod_motion_bake_json(const mlod_motion_bake *b, const mlod_characte
 			          lv->l.bytes + lv->w_bytes, lv->l.error.max, lv->l.error.mean, 100.0 * lv->l.error.max / height,
 			          100.0 * lv->l.error.mean / height, lv->l.point_error, lv->l.grid);
 			if (lv->has_vertex)
-				sb_printf(&sb,
+				mlod_buf_printf(&sb,
 				          ",\n        \"vertex_error\": {\"max\": %.9g, \"max_percent_diagonal\": %.9g, "
 				          "\"mean_percent_diagonal\": %.9g}",
 				          lv->vertex.max * lv->vertex.scale / 100.0, lv->vertex.max, lv->vertex.mean);
 			if (lv->w_count)
-				sb_printf(&sb,
+				mlod_buf_printf(&sb,
 				          ",\n        \"morph_weights\": {\"channels\": %d, \"keys\": %ld, \"source_keys\": %ld, \"bytes\": %ld, "
 				          "\"bound\": %.9g, \"error\": %.9g, \"copied\": %d, \"error_measure\": \"sum over targets of "
 				          "|weight error| times the target's largest vertex offset in the rest pose, scene units\"}",
 				          lv->w_count, lv->w_keys, cl->w_keys, lv->w_bytes, lv->w_bound, lv->w_error, lv->w_copied);
-			sb_printf(&sb, "}");
+			mlod_buf_printf(&sb, "}");
 		}
-		sb_printf(&sb, "]}%s\n", k + 1 < b->clip_count ? "," : "");
+		mlod_buf_printf(&sb, "]}%s\n", k + 1 < b->clip_count ? "," : "");
 	}
-	sb_printf(&sb, "  ]\n}\n");
-	return sb_finish(&sb, text, err);
+	mlod_buf_printf(&sb, "  ]\n}\n");
+	return mlod_buf_take(&sb, text, NULL, NULL, err);
 }
 
 /* ------------------------------------------------------------------ */

@@ -1,8 +1,8 @@
 /*
- * packbuf.c: the pack writer's bytes and chunks: a growing byte buffer,
- * a chunk's streams and their container (meshopt codecs), the entropy
- * stage (zstd) and a stream's form chosen by its zstd bytes, the string
- * table (packwrite_internal.h).
+ * packbuf.c: the pack writer's chunks: a chunk's streams and their
+ * container (meshopt codecs, built in an mlod_buf), the entropy stage
+ * (zstd) and a stream's form chosen by its zstd bytes, the string table
+ * (packwrite_internal.h).
  */
 #include <math.h>
 #include <stdio.h>
@@ -137,7 +137,7 @@ size_t pack_cb_coded_bytes(const chunkb *cb, int from)
 mlod_result pack_cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uint32_t type, int layer, int level,
                            int item, float error, mlod_error *err)
 {
-	buf b = {0};
+	mlod_buf b = MLOD_BUF_INIT;
 	uint8_t word[4];
 	uint32_t raw = 4 + 16 * (uint32_t)cb->n;
 	if (cb->fail)
@@ -161,9 +161,9 @@ mlod_result pack_cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uint3
 		                 "input's coordinates too large?)", label, (double)stored_error);
 	}
 	put_u32(word, (uint32_t)cb->n);
-	buf_put(&b, word, 4);
-	size_t headers = b.n;
-	buf_zeros(&b, 16 * (size_t)cb->n);
+	mlod_buf_append(&b, word, 4);
+	size_t headers = b.size;
+	mlod_buf_append_zeros(&b, 16 * (size_t)cb->n);
 	for (int i = 0; i < cb->n; i++) {
 		stream *s = &cb->s[i];
 		size_t bytes = (size_t)s->count * s->size;
@@ -181,13 +181,13 @@ mlod_result pack_cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uint3
 		put_u16(h + 8, s->size);
 		h[10] = scodec;
 		put_u32(h + 12, (uint32_t)stored);
-		if (!b.fail)
-			memcpy(b.p + headers + 16 * (size_t)i, h, 16);
-		buf_put(&b, data, stored);
+		if (b.status == MLOD_OK)
+			memcpy(b.data + headers + 16 * (size_t)i, h, 16);
+		mlod_buf_append(&b, data, stored);
 		buf_pad(&b, 4);
 		free(enc);
 	}
-	if (b.fail)
+	if (b.status != MLOD_OK)
 		goto nomem;
 	if (out->n == out->cap) {
 		int cap = out->cap ? 2 * out->cap : 32;
@@ -206,13 +206,13 @@ mlod_result pack_cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uint3
 	c->item = (uint16_t)item;
 	c->error = stored_error; /* ANIM level 0: against the input clip */
 	c->distance = distance;
-	c->data = b.p;
-	c->size = b.n;
+	c->data = b.data;
+	c->size = b.size;
 	c->raw = raw;
 	pack_cb_free(cb);
 	return MLOD_OK;
 nomem:
-	free(b.p);
+	mlod_buf_free(&b);
 	pack_cb_free(cb);
 	return mlod_fail(err, MLOD_ERR_NOMEM, "out of memory writing the pack");
 }
@@ -391,7 +391,7 @@ mlod_result pack_chunk_stream_choice(chunk *c, mlod_error *err)
 	uint8_t *pick_codec = calloc((size_t)ns + 1, 1);
 	size_t *pick_size = calloc((size_t)ns + 1, sizeof *pick_size);
 	ZSTD_CCtx *cc = ZSTD_createCCtx();
-	buf b = {0};
+	mlod_buf b = MLOD_BUF_INIT;
 	if (!pick || !pick_codec || !pick_size || !cc)
 		goto nomem;
 	for (uint32_t i = 0, at = 4 + 16 * ns; i < ns; i++) {
@@ -476,28 +476,28 @@ mlod_result pack_chunk_stream_choice(chunk *c, mlod_error *err)
 		raw = form = NULL;
 	}
 	/* the container with the chosen forms */
-	buf_put(&b, c->data, 4 + 16 * (size_t)ns);
+	mlod_buf_append(&b, c->data, 4 + 16 * (size_t)ns);
 	for (uint32_t i = 0, at = 4 + 16 * ns; i < ns; i++) {
 		uint8_t *h = c->data + 4 + 16 * (size_t)i;
 		size_t stored = (size_t)h[12] | (size_t)h[13] << 8 | (size_t)h[14] << 16 | (size_t)h[15] << 24;
 		if (pick[i]) {
-			buf_put(&b, pick[i], pick_size[i]);
-			if (!b.fail) {
-				b.p[4 + 16 * (size_t)i + 10] = pick_codec[i];
-				put_u32(b.p + 4 + 16 * (size_t)i + 12, (uint32_t)pick_size[i]);
+			mlod_buf_append(&b, pick[i], pick_size[i]);
+			if (b.status == MLOD_OK) {
+				b.data[4 + 16 * (size_t)i + 10] = pick_codec[i];
+				put_u32(b.data + 4 + 16 * (size_t)i + 12, (uint32_t)pick_size[i]);
 			}
 		} else {
-			buf_put(&b, c->data + at, stored);
+			mlod_buf_append(&b, c->data + at, stored);
 		}
 		buf_pad(&b, 4);
 		at += (uint32_t)((stored + 3) & ~(size_t)3);
 	}
-	if (b.fail)
+	if (b.status != MLOD_OK)
 		goto nomem;
-	if (b.n <= c->raw) { /* always: no form is larger than the raw bytes */
+	if (b.size <= c->raw) { /* always: no form is larger than the raw bytes */
 		free(c->data);
-		c->data = b.p, c->size = b.n;
-		b.p = NULL;
+		c->data = b.data, c->size = b.size;
+		b = (mlod_buf)MLOD_BUF_INIT;
 	}
 	goto done;
 nomem:
@@ -511,14 +511,14 @@ done:
 	free(raw);
 	free(form);
 	free(scratch);
-	free(b.p);
+	mlod_buf_free(&b);
 	ZSTD_freeCCtx(cc);
 	return r;
 }
 
-uint32_t pack_str_add(strtab *t, const char *s)
+uint32_t pack_str_add(mlod_buf *t, const char *s)
 {
-	uint32_t off = (uint32_t)t->b.n;
-	buf_put(&t->b, s ? s : "", strlen(s ? s : "") + 1);
+	uint32_t off = (uint32_t)t->size;
+	mlod_buf_append(t, s ? s : "", strlen(s ? s : "") + 1);
 	return off;
 }

@@ -122,7 +122,7 @@ mlod_result pack_skeleton_chunk(struct ctx *x, chunks *out)
 {
 	const mlod_skeleton *s = &x->v.skeleton;
 	chunkb cb = {0};
-	strtab names = {0};
+	mlod_buf names = MLOD_BUF_INIT;
 	int n = s->joint_count;
 	mlod_pack_joint_rec *j = calloc((size_t)n + 1, sizeof *j);
 	mlod_pack_skin_rec *sk = calloc((size_t)s->skin_count + 1, sizeof *sk);
@@ -157,19 +157,19 @@ mlod_result pack_skeleton_chunk(struct ctx *x, chunks *out)
 			memcpy(ibms + 16 * e, k->inverse_bind[q].m, 64);
 		}
 	}
-	if (names.b.fail) {
+	if (names.status != MLOD_OK) {
 		r = mlod_fail(x->err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
 	pack_cb_add(&cb, MLOD_STREAM_JNTS, (uint32_t)n, sizeof *j, j, 0);
-	pack_cb_add(&cb, MLOD_STREAM_NAME, (uint32_t)names.b.n, 1, names.b.p, 0);
+	pack_cb_add(&cb, MLOD_STREAM_NAME, (uint32_t)names.size, 1, names.data, 0);
 	pack_cb_add(&cb, MLOD_STREAM_SKIN, (uint32_t)s->skin_count, sizeof *sk, sk, 0);
 	pack_cb_add(&cb, MLOD_STREAM_SKJT, (uint32_t)pal, 4, skjt, 0);
 	pack_cb_add(&cb, MLOD_STREAM_IBMS, (uint32_t)pal, 64, ibms, 0);
 	r = pack_cb_finish(&cb, x->opt->codec, out, MLOD_CHUNK_SKELETON, MLOD_LAYER_SKELETON, 0, 0, 0.0f, x->err);
 done:
 	pack_cb_free(&cb);
-	free(names.b.p);
+	mlod_buf_free(&names);
 	free(j);
 	free(sk);
 	free(skjt);

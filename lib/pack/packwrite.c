@@ -383,7 +383,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	}
 
 	/* INFO: its size does not depend on its values (its streams are raw). */
-	strtab names = {0};
+	mlod_buf names = MLOD_BUF_INIT;
 	mlod_pack_info_rec info;
 	memset(&info, 0, sizeof info);
 	info.name = pack_str_add(&names, opt->name                   ? opt->name
@@ -392,8 +392,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	                                                             : "");
 	for (int q = 0; q < x.v.clip_count; q++)
 		pack_str_add(&names, x.v.clips[q].name);
-	if (names.b.fail) {
-		free(names.b.p);
+	if (names.status != MLOD_OK) {
+		mlod_buf_free(&names);
 		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 		goto done;
 	}
@@ -405,7 +405,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	info.motion_levels = (uint32_t)A;
 	info.instance_count = (uint32_t)parts0;
 	if (x.max_vertices > UINT32_MAX / 2) { /* the runtime's limit of a level's vertices */
-		free(names.b.p);
+		mlod_buf_free(&names);
 		r = mlod_fail(err, MLOD_ERR_LIMIT, "a mesh level of %llu vertices: more than a pack holds (%u)",
 		              (unsigned long long)x.max_vertices, UINT32_MAX / 2);
 		goto done;
@@ -417,7 +417,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	}
 	info.height = x.height;
 	info.diagonal = x.diag;
-	size_t info_size = 4 + 2 * 16 + ((sizeof info + 3) & ~(size_t)3) + ((names.b.n + 3) & ~(size_t)3);
+	size_t info_size = 4 + 2 * 16 + ((sizeof info + 3) & ~(size_t)3) + ((names.size + 3) & ~(size_t)3);
 	/* Offsets. */
 	uint64_t off = MLOD_PACK_HEADER_SIZE + (uint64_t)MLOD_PACK_TOC_ENTRY_SIZE * (uint64_t)(body.n + 1);
 	off = (off + 15) & ~(uint64_t)15;
@@ -438,7 +438,7 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	}
 	uint64_t file_size = off;
 	if (file_size > UINT32_MAX || body.n + 1 > MLOD_PACK_MAX_CHUNKS) {
-		free(names.b.p);
+		mlod_buf_free(&names);
 		r = mlod_fail(err, MLOD_ERR_LIMIT, "the pack would be larger than 4 GiB");
 		goto done;
 	}
@@ -446,8 +446,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	{
 		chunkb cb = {0};
 		pack_cb_add(&cb, MLOD_STREAM_INFO, 1, sizeof info, &info, 0);
-		pack_cb_add(&cb, MLOD_STREAM_NAME, (uint32_t)names.b.n, 1, names.b.p, 0);
-		free(names.b.p);
+		pack_cb_add(&cb, MLOD_STREAM_NAME, (uint32_t)names.size, 1, names.data, 0);
+		mlod_buf_free(&names);
 		if ((r = pack_cb_finish(&cb, MLOD_CODEC_NONE, &head, MLOD_CHUNK_INFO, MLOD_LAYER_NONE, 0, 0, 0.0f, err)) !=
 		    MLOD_OK)
 			goto done;
@@ -456,19 +456,19 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 
 	/* Header, TOC, chunks. */
 	{
-		buf f = {0};
+		mlod_buf f = MLOD_BUF_INIT;
 		int n = body.n + 1;
-		buf_zeros(&f, MLOD_PACK_HEADER_SIZE + (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)n);
-		if (f.fail) {
+		mlod_buf_append_zeros(&f, MLOD_PACK_HEADER_SIZE + (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)n);
+		if (f.status != MLOD_OK) {
 			r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory");
 			goto done;
 		}
 		for (int i = 0; i < n; i++) {
 			chunk *ch = i == 0 ? &head.c[0] : &body.c[i - 1];
 			buf_pad(&f, MLOD_PACK_ALIGN);
-			if (f.fail || f.n != ch->offset)
+			if (f.status != MLOD_OK || f.size != ch->offset)
 				break;
-			uint8_t *e = f.p + MLOD_PACK_HEADER_SIZE + (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)i;
+			uint8_t *e = f.data + MLOD_PACK_HEADER_SIZE + (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)i;
 			put_u32(e, ch->type);
 			e[4] = ch->layer;
 			e[5] = (uint8_t)(ch->codec | ch->entropy << 4);
@@ -482,38 +482,39 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 			put_u32(e + 32, mlod_pack_crc32(0, ch->data, ch->size));
 			put_f32(e + 36, ch->error);
 			put_f32(e + 40, ch->distance);
-			buf_put(&f, ch->data, ch->size);
+			mlod_buf_append(&f, ch->data, ch->size);
 		}
-		if (f.fail || f.n != file_size) {
-			free(f.p);
-			r = mlod_fail(err, f.fail ? MLOD_ERR_NOMEM : MLOD_ERR_INVALID_ARG, "writing the pack: layout mismatch");
+		if (f.status != MLOD_OK || f.size != file_size) {
+			r = mlod_fail(err, f.status != MLOD_OK ? MLOD_ERR_NOMEM : MLOD_ERR_INVALID_ARG,
+			              "writing the pack: layout mismatch");
+			mlod_buf_free(&f);
 			goto done;
 		}
-		memcpy(f.p, MLOD_PACK_MAGIC, 4);
-		put_u16(f.p + 4, MLOD_PACK_MAJOR);
-		put_u16(f.p + 6, MLOD_PACK_MINOR);
-		put_u32(f.p + 8, 0);
-		put_u32(f.p + 12, (uint32_t)n);
-		put_u64(f.p + 16, file_size);
-		put_u32(f.p + 24, mlod_pack_crc32(0, f.p + MLOD_PACK_HEADER_SIZE, (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)n));
-		put_u32(f.p + 28, mlod_pack_crc32(0, f.p, 28));
+		memcpy(f.data, MLOD_PACK_MAGIC, 4);
+		put_u16(f.data + 4, MLOD_PACK_MAJOR);
+		put_u16(f.data + 6, MLOD_PACK_MINOR);
+		put_u32(f.data + 8, 0);
+		put_u32(f.data + 12, (uint32_t)n);
+		put_u64(f.data + 16, file_size);
+		put_u32(f.data + 24, mlod_pack_crc32(0, f.data + MLOD_PACK_HEADER_SIZE, (size_t)MLOD_PACK_TOC_ENTRY_SIZE * (size_t)n));
+		put_u32(f.data + 28, mlod_pack_crc32(0, f.data, 28));
 		/* The pack through its reader's own rules (mlod_pack_open's TOC,
 		 * mlod_pack_check's chunks): never a pack the reader refuses. */
 		mlod_pack rp;
 		mlod_error rerr = {0};
-		mlod_result rr = mlod_pack_open(f.p, f.n, &rp, &rerr);
+		mlod_result rr = mlod_pack_open(f.data, f.size, &rp, &rerr);
 		if (rr == MLOD_OK) {
-			rr = mlod_pack_check(&rp, f.p, f.n, &rerr);
+			rr = mlod_pack_check(&rp, f.data, f.size, &rerr);
 			mlod_pack_close(&rp);
 		}
 		if (rr != MLOD_OK) {
-			free(f.p);
+			mlod_buf_free(&f);
 			r = mlod_fail(err, rr == MLOD_ERR_NOMEM ? rr : MLOD_ERR_LIMIT,
 			              "the pack as written fails its reader's check: %s", rerr.message);
 			goto done;
 		}
-		*out = f.p;
-		*out_size = f.n;
+		*out = f.data;
+		*out_size = f.size;
 	}
 
 	/* Stats. */

@@ -1,7 +1,7 @@
 /*
  * packwrite_internal.h: internal to lib/pack's writer (mlod_pack_write.h
- * is the public API). What its files share: the byte buffer and the
- * chunks, the character as packed (struct ctx), the MOTION chunk as the
+ * is the public API). What its files share: the aligned append and the
+ * little-endian writers on the byte buffer (mlod_buf), the chunks, the character as packed (struct ctx), the MOTION chunk as the
  * reader returns it, and the functions one file calls in another
  * (prefixed pack_; every other function stays static in its file). A
  * function's comment stays at its definition.
@@ -26,8 +26,9 @@
  *   packbuf.c      bytes, a chunk's streams and container, the entropy
  *                  stage
  *
- * The byte buffer's small writers are static inline here, so that they
- * stay inlined where they were (the build is -O2 without LTO).
+ * The small writers are static inline here (as mlod_buf's appends are in
+ * mlod_core.h), so that they stay inlined where they were (the build is
+ * -O2 without LTO).
  */
 #ifndef MLOD_PACKWRITE_INTERNAL_H
 #define MLOD_PACKWRITE_INTERNAL_H
@@ -44,53 +45,12 @@
 /* Bytes                                                               */
 /* ------------------------------------------------------------------ */
 
-/* A growing byte buffer; after a failed allocation fail is set and every
- * later write does nothing, so that the writer checks it after a run of
- * writes. */
-typedef struct buf {
-	uint8_t *p;
-	size_t n, cap;
-	int fail;
-} buf;
-
-static inline void buf_reserve(buf *b, size_t extra)
+/* The pack's aligned appends, on the library's byte buffer (mlod_buf,
+ * mlod_core.h): zeros up to the next multiple of align. */
+static inline void buf_pad(mlod_buf *b, size_t align)
 {
-	if (b->fail || b->n + extra <= b->cap)
-		return;
-	size_t cap = b->cap ? b->cap : 256;
-	while (cap < b->n + extra)
-		cap *= 2;
-	uint8_t *p = realloc(b->p, cap);
-	if (!p) {
-		b->fail = 1;
-		return;
-	}
-	b->p = p;
-	b->cap = cap;
-}
-
-static inline void buf_put(buf *b, const void *d, size_t n)
-{
-	buf_reserve(b, n);
-	if (b->fail || n == 0)
-		return;
-	memcpy(b->p + b->n, d, n);
-	b->n += n;
-}
-
-static inline void buf_zeros(buf *b, size_t n)
-{
-	buf_reserve(b, n);
-	if (b->fail)
-		return;
-	memset(b->p + b->n, 0, n);
-	b->n += n;
-}
-
-static inline void buf_pad(buf *b, size_t align)
-{
-	if (b->n % align)
-		buf_zeros(b, align - b->n % align);
+	if (b->size % align)
+		mlod_buf_append_zeros(b, align - b->size % align);
 }
 
 static inline void put_u16(uint8_t *p, uint16_t v)
@@ -117,11 +77,6 @@ static inline void put_f32(uint8_t *p, float f)
 	memcpy(&u, &f, 4);
 	put_u32(p, u);
 }
-
-/* A string table. */
-typedef struct strtab {
-	buf b;
-} strtab;
 
 /* ------------------------------------------------------------------ */
 /* Chunks and their streams (packbuf.c)                                */
@@ -164,7 +119,7 @@ mlod_result pack_cb_finish(chunkb *cb, mlod_pack_codec codec, chunks *out, uint3
                            int item, float error, mlod_error *err);
 mlod_result pack_chunk_entropy(chunk *c, const uint8_t *prefix, size_t prefix_size, mlod_error *err);
 mlod_result pack_chunk_stream_choice(chunk *c, mlod_error *err);
-uint32_t pack_str_add(strtab *t, const char *s);
+uint32_t pack_str_add(mlod_buf *t, const char *s);
 
 /* ------------------------------------------------------------------ */
 /* The character as packed (packchar.c)                                */

@@ -464,94 +464,65 @@ int mj_string(mj *out, const char *s)
 /* Writing                                                             */
 /* ------------------------------------------------------------------ */
 
-struct out {
-	char *s;
-	size_t len, cap;
-	int failed;
-};
-
-static void put(struct out *o, const char *s, size_t n)
+static void put_string(mlod_buf *o, const char *s)
 {
-	if (o->failed)
-		return;
-	if (o->len + n + 1 > o->cap) {
-		size_t cap = (o->cap + n + 1) * 2;
-		char *p = realloc(o->s, cap);
-		if (!p) {
-			o->failed = 1;
-			return;
-		}
-		o->s = p;
-		o->cap = cap;
-	}
-	memcpy(o->s + o->len, s, n);
-	o->len += n;
-	o->s[o->len] = '\0';
-}
-
-static void put_string(struct out *o, const char *s)
-{
-	put(o, "\"", 1);
+	mlod_buf_append(o, "\"", 1);
 	for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
 		char esc[8];
 		if (*p == '"' || *p == '\\') {
 			esc[0] = '\\';
 			esc[1] = (char)*p;
-			put(o, esc, 2);
+			mlod_buf_append(o, esc, 2);
 		} else if (*p == '\n' || *p == '\t' || *p == '\r' || *p == '\b' || *p == '\f') {
 			esc[0] = '\\';
 			esc[1] = *p == '\n' ? 'n' : *p == '\t' ? 't' : *p == '\r' ? 'r' : *p == '\b' ? 'b' : 'f';
-			put(o, esc, 2);
+			mlod_buf_append(o, esc, 2);
 		} else if (*p < 0x20) {
 			snprintf(esc, sizeof esc, "\\u%04x", *p);
-			put(o, esc, 6);
+			mlod_buf_append(o, esc, 6);
 		} else if (*p < 0x80) {
-			put(o, (const char *)p, 1);
+			mlod_buf_append(o, (const char *)p, 1);
 		} else { /* JSON text is UTF-8: a byte that does not start a well-formed sequence as U+FFFD */
 			int n = mlod_utf8_length((const char *)p);
 			if (n == 0)
-				put(o, "\xEF\xBF\xBD", 3);
+				mlod_buf_append(o, "\xEF\xBF\xBD", 3);
 			else
-				put(o, (const char *)p, (size_t)n), p += n - 1;
+				mlod_buf_append(o, (const char *)p, (size_t)n), p += n - 1;
 		}
 	}
-	put(o, "\"", 1);
+	mlod_buf_append(o, "\"", 1);
 }
 
-static void write_value(struct out *o, const mj *v)
+static void write_value(mlod_buf *o, const mj *v)
 {
 	switch (v->type) {
-	case MJ_NULL: put(o, "null", 4); break;
-	case MJ_TRUE: put(o, "true", 4); break;
-	case MJ_FALSE: put(o, "false", 5); break;
-	case MJ_NUMBER: put(o, v->text, strlen(v->text)); break;
+	case MJ_NULL: mlod_buf_append(o, "null", 4); break;
+	case MJ_TRUE: mlod_buf_append(o, "true", 4); break;
+	case MJ_FALSE: mlod_buf_append(o, "false", 5); break;
+	case MJ_NUMBER: mlod_buf_append(o, v->text, strlen(v->text)); break;
 	case MJ_STRING: put_string(o, v->text); break;
 	case MJ_ARRAY:
 	case MJ_OBJECT:
-		put(o, v->type == MJ_OBJECT ? "{" : "[", 1);
+		mlod_buf_append(o, v->type == MJ_OBJECT ? "{" : "[", 1);
 		for (int i = 0; i < v->count; i++) {
 			if (i)
-				put(o, ",", 1);
+				mlod_buf_append(o, ",", 1);
 			if (v->type == MJ_OBJECT) {
 				put_string(o, v->keys[i]);
-				put(o, ":", 1);
+				mlod_buf_append(o, ":", 1);
 			}
 			write_value(o, &v->items[i]);
 		}
-		put(o, v->type == MJ_OBJECT ? "}" : "]", 1);
+		mlod_buf_append(o, v->type == MJ_OBJECT ? "}" : "]", 1);
 		break;
 	}
 }
 
+/* Into an mlod_buf (mlod_core.h), which ignores the writes after a failed
+ * growth: checked once, at the end. */
 int mj_write(const mj *v, char **text)
 {
-	struct out o = {0};
+	mlod_buf o = MLOD_BUF_INIT;
 	write_value(&o, v);
-	if (o.failed || !o.s) {
-		free(o.s);
-		*text = NULL;
-		return -1;
-	}
-	*text = o.s;
-	return 0;
+	return mlod_buf_take(&o, text, NULL, NULL, NULL) == MLOD_OK ? 0 : -1;
 }
