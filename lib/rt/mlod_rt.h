@@ -134,7 +134,10 @@
  * Fallback. An instance shows, per layer, the wanted level when resident,
  * else the finest resident level coarser than the wanted one (the coarsest
  * is always resident, so there always is one), and flags the layer in
- * mlod_rt_state.fallback.
+ * mlod_rt_state.fallback. Why is the wanted level's mlod_rt_level_info
+ * (the motion layer's for the instance's clip): failed (its load failed),
+ * no_room (the last mlod_rt_stream found no room for it within the
+ * budget), else it waits for an mlod_rt_stream with byte budget left.
  *
  * ------------------------------------------------------------------
  * Selection (mlod_rt_select)
@@ -334,6 +337,12 @@ typedef struct mlod_rt_level_info {
 	int failed;           /* 1 when loading it failed (NOMEM, IO: until the next
 	                         mlod_rt_stream tries it again) */
 	uint32_t users;       /* instances showing it at the last update */
+	int no_room;          /* 1 when the last mlod_rt_stream wanted it but found no
+	                         room for it within budget_bytes, even after evicting
+	                         every level the frame does not want: it stays
+	                         unloaded and its wants passed to a coarser level
+	                         (Resident-level cache, above); 0 once that call
+	                         loaded it or did not reach it */
 } mlod_rt_level_info;
 
 /* budget_bytes: the configured budget, 0 for no limit (configured 0). */
