@@ -121,7 +121,16 @@
  * from eviction. (The reader's own scratch while one chunk decodes, and
  * the instance pool, are not counted: the memory the allocator holds
  * between calls is the resident bytes plus what it held at open beyond
- * them, within 256 bytes, tests/rt/test_rt_engine.c.)
+ * them, to a few hundred bytes either way, not exactly: a pack's mesh
+ * level's block holds a 32-byte head and its arrays' 8-byte alignment
+ * beyond its count (net 8 to 92 bytes a level on tubeman and
+ * RobotExpressive; 272 for RobotExpressive's four finer levels), and a
+ * level's count includes its descriptor, which the context holds from
+ * open (32 bytes a motion level: RobotExpressive streaming its 14 clips
+ * under a budget held up to 936 bytes less than it counted), measured
+ * with counting allocator hooks, bench/RESULTS.md Run 15;
+ * tests/rt/test_rt_engine.c checks a crowd's frames hold at most 256
+ * bytes beyond the count.)
  *
  * Frames. The wanted levels of a frame are those of every mlod_rt_update,
  * mlod_rt_update_positions and mlod_rt_request call since the last
