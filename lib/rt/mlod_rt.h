@@ -601,8 +601,11 @@ void mlod_rt_select_default(mlod_rt_select *sel);
  * levels are selected at distances[i] (scene units, >= 0), and wanted
  * levels are recorded for mlod_rt_stream (for a failed level, the finest
  * coarser one not failed: see Errors); shown levels are resolved.
- * Ids not alive are skipped. No allocation. MLOD_ERR_INVALID_ARG, with a
- * message naming the index i, when distances[i] is NaN, negative or
+ * Ids not alive are skipped. No allocation. MLOD_ERR_INVALID_ARG for a
+ * NULL ctx or sel (there is no default selection: mlod_rt_select_default
+ * fills one), or NULL ids or distances with n > 0 (with n 0 they may be
+ * NULL: the call then only starts the frame); with a message naming the
+ * index i, when distances[i] is NaN, negative or
  * infinite (for every i < n, alive or not), when dt is not finite
  * (dt may be negative: time runs back), and for a selection whose mode is
  * not one of the three, a float member not finite, a negative
