@@ -255,6 +255,9 @@ extern "C" {
 typedef struct mlod_rt_ctx mlod_rt_ctx;
 typedef struct mlod_rt_scratch mlod_rt_scratch;
 
+/* The runtime's layers, from 0. Not the pack's MLOD_LAYER_* of a TOC entry
+ * (mlod_pack.h), which count from 1 (MLOD_LAYER_MESH is 2, MLOD_RT_MESH 1):
+ * a caller reading the TOC with mlod_pack(3) compares with those. */
 typedef enum mlod_rt_layer {
 	MLOD_RT_SKELETON = 0,
 	MLOD_RT_MESH = 1,
