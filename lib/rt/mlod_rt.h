@@ -121,7 +121,16 @@
  * from eviction. (The reader's own scratch while one chunk decodes, and
  * the instance pool, are not counted: the memory the allocator holds
  * between calls is the resident bytes plus what it held at open beyond
- * them, within 256 bytes, tests/rt/test_rt_engine.c.)
+ * them, to a few hundred bytes either way, not exactly: a pack's mesh
+ * level's block holds a 32-byte head and its arrays' 8-byte alignment
+ * beyond its count (net 8 to 92 bytes a level on tubeman and
+ * RobotExpressive; 272 for RobotExpressive's four finer levels), and a
+ * level's count includes its descriptor, which the context holds from
+ * open (32 bytes a motion level: RobotExpressive streaming its 14 clips
+ * under a budget held up to 936 bytes less than it counted), measured
+ * with counting allocator hooks, bench/RESULTS.md Run 15;
+ * tests/rt/test_rt_engine.c checks a crowd's frames hold at most 256
+ * bytes beyond the count.)
  *
  * Frames. The wanted levels of a frame are those of every mlod_rt_update,
  * mlod_rt_update_positions and mlod_rt_request call since the last
@@ -134,7 +143,10 @@
  * Fallback. An instance shows, per layer, the wanted level when resident,
  * else the finest resident level coarser than the wanted one (the coarsest
  * is always resident, so there always is one), and flags the layer in
- * mlod_rt_state.fallback.
+ * mlod_rt_state.fallback. Why is the wanted level's mlod_rt_level_info
+ * (the motion layer's for the instance's clip): failed (its load failed),
+ * no_room (the last mlod_rt_stream found no room for it within the
+ * budget), else it waits for an mlod_rt_stream with byte budget left.
  *
  * ------------------------------------------------------------------
  * Selection (mlod_rt_select)
@@ -243,6 +255,9 @@ extern "C" {
 typedef struct mlod_rt_ctx mlod_rt_ctx;
 typedef struct mlod_rt_scratch mlod_rt_scratch;
 
+/* The runtime's layers, from 0. Not the pack's MLOD_LAYER_* of a TOC entry
+ * (mlod_pack.h), which count from 1 (MLOD_LAYER_MESH is 2, MLOD_RT_MESH 1):
+ * a caller reading the TOC with mlod_pack(3) compares with those. */
 typedef enum mlod_rt_layer {
 	MLOD_RT_SKELETON = 0,
 	MLOD_RT_MESH = 1,
@@ -334,6 +349,12 @@ typedef struct mlod_rt_level_info {
 	int failed;           /* 1 when loading it failed (NOMEM, IO: until the next
 	                         mlod_rt_stream tries it again) */
 	uint32_t users;       /* instances showing it at the last update */
+	int no_room;          /* 1 when the last mlod_rt_stream wanted it but found no
+	                         room for it within budget_bytes, even after evicting
+	                         every level the frame does not want: it stays
+	                         unloaded and its wants passed to a coarser level
+	                         (Resident-level cache, above); 0 once that call
+	                         loaded it or did not reach it */
 } mlod_rt_level_info;
 
 /* budget_bytes: the configured budget, 0 for no limit (configured 0). */
@@ -583,8 +604,11 @@ void mlod_rt_select_default(mlod_rt_select *sel);
  * levels are selected at distances[i] (scene units, >= 0), and wanted
  * levels are recorded for mlod_rt_stream (for a failed level, the finest
  * coarser one not failed: see Errors); shown levels are resolved.
- * Ids not alive are skipped. No allocation. MLOD_ERR_INVALID_ARG, with a
- * message naming the index i, when distances[i] is NaN, negative or
+ * Ids not alive are skipped. No allocation. MLOD_ERR_INVALID_ARG for a
+ * NULL ctx or sel (there is no default selection: mlod_rt_select_default
+ * fills one), or NULL ids or distances with n > 0 (with n 0 they may be
+ * NULL: the call then only starts the frame); with a message naming the
+ * index i, when distances[i] is NaN, negative or
  * infinite (for every i < n, alive or not), when dt is not finite
  * (dt may be negative: time runs back), and for a selection whose mode is
  * not one of the three, a float member not finite, a negative

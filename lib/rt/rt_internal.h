@@ -30,6 +30,8 @@ typedef struct rt_unit {
 	uint8_t owned;            /* decoded by the runtime (pack source) */
 	uint8_t retry;            /* failed by a transient cause (NOMEM, IO): the next
 	                           * mlod_rt_stream tries it again */
+	uint8_t no_room;          /* the last mlod_rt_stream found no room for it in the
+	                           * budget (defer_want): mlod_rt_level_info.no_room */
 	uint16_t level, item;
 	int32_t chunk;            /* TOC index, -1 for views */
 	uint32_t stored_size, raw_size;

@@ -333,6 +333,7 @@ static void defer_want(mlod_rt_ctx *ctx, rt_unit *u)
 {
 	const uint32_t w = u->want_count & 0x7fffffffu;
 	u->want_count |= 0x80000000u;
+	u->no_room = 1; /* until the next mlod_rt_stream: the caller can tell why */
 	for (uint32_t l = (uint32_t)u->level + 1; w && l < ctx->levels[u->layer]; l++) {
 		rt_unit *t = rt_unit_at(ctx, (mlod_rt_layer)u->layer, l, u->item);
 		if (!t || t->state == RT_UNIT_FAILED || (t->state == RT_UNIT_ABSENT && (t->want_count & 0x80000000u)))
@@ -488,9 +489,11 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 	int changed = 0;
 	/* Levels failed by a transient cause are tried again (their wants
 	 * stayed on them, mlod_rt_update). */
-	for (uint32_t i = 0; i < ctx->unit_count; i++)
+	for (uint32_t i = 0; i < ctx->unit_count; i++) {
 		if (ctx->units[i].state == RT_UNIT_FAILED && ctx->units[i].retry)
 			ctx->units[i].state = RT_UNIT_ABSENT, ctx->units[i].retry = 0;
+		ctx->units[i].no_room = 0; /* said of the last call only */
+	}
 	pass_wants(ctx); /* requests of failed levels */
 	while (byte_budget > 0 && spent < byte_budget) {
 		rt_unit *u = NULL;

@@ -142,6 +142,7 @@ mlod_result mlod_rt_level_info_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, 
 	out->resident = u->state == RT_UNIT_RESIDENT;
 	out->failed = u->state == RT_UNIT_FAILED;
 	out->users = u->users;
+	out->no_room = u->no_room;
 	return MLOD_OK;
 }
 

@@ -128,6 +128,61 @@ TEST(fallback_the_finest_that_fits)
 	mlod_rt_close(ctx);
 }
 
+
+/* Why an instance falls back (a probe of issue 12 could not tell): under
+ * the 400,000-byte budget above, the mesh levels finer than the one shown
+ * say no_room after mlod_rt_stream, the one shown does not; a frame whose
+ * mlod_rt_stream has no byte budget left for the wanted level (here 0:
+ * it loads nothing) leaves it waiting, neither failed nor no_room, which
+ * is what a stream budget too small per frame shows. Before, the three
+ * causes (no room, failed, not streamed yet) looked alike but for failed. */
+TEST(fallback_says_why)
+{
+	SKIP_IF_NO_PACK(fallback_says_why);
+	CHECK(packs_ready(), "mlod-pack failed");
+	mlod_error e = { 0 };
+	mlod_rt_ctx *ctx = NULL;
+	mlod_rt_config cfg = { 400000, 16, NULL };
+	CHECK_OK(mlod_rt_open_memory(robot, robot_size, &cfg, &ctx, &e), e);
+	uint32_t id;
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, MLOD_RT_LOOP, &id, &e), e);
+	const mlod_rt_select sel = pixels();
+	const float d = 3.0f;
+	for (int f = 0; f < 5; f++) {
+		CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 60, &e), e);
+		CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
+	}
+	const mlod_rt_state *st = mlod_rt_instance_state(ctx, id);
+	const uint32_t shown = st->level[MLOD_RT_MESH];
+	CHECK(st->wanted[MLOD_RT_MESH] == 0 && shown > 0 && (st->fallback & (1u << MLOD_RT_MESH)),
+	      "mesh wanted %u, shown %u, fallback 0x%x", st->wanted[MLOD_RT_MESH], shown, st->fallback);
+	for (uint32_t l = 0; l <= shown; l++) {
+		mlod_rt_level_info li;
+		CHECK_OK(mlod_rt_level_info_get(ctx, MLOD_RT_MESH, l, 0, &li, &e), e);
+		CHECK(li.no_room == (l < shown) && !li.failed && li.resident == (l == shown),
+		      "mesh level %u (shown %u): no_room %d, failed %d, resident %d", l, shown, li.no_room, li.failed,
+		      li.resident);
+	}
+	/* the next call says only what it found: byte_budget 0 reaches no level */
+	CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 60, &e), e);
+	CHECK_OK(mlod_rt_stream(ctx, 0, NULL, &e), e);
+	mlod_rt_level_info li;
+	CHECK_OK(mlod_rt_level_info_get(ctx, MLOD_RT_MESH, 0, 0, &li, &e), e);
+	CHECK(!li.no_room && !li.resident && !li.failed, "after a stream of 0 bytes: no_room %d", li.no_room);
+	mlod_rt_close(ctx);
+
+	/* no budget, a stream of 0 bytes: the wanted level waits, for no lack of room */
+	CHECK_OK(mlod_rt_open_memory(robot, robot_size, NULL, &ctx, &e), e);
+	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, MLOD_RT_LOOP, &id, &e), e);
+	CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 60, &e), e);
+	CHECK_OK(mlod_rt_stream(ctx, 0, NULL, &e), e);
+	st = mlod_rt_instance_state(ctx, id);
+	CHECK_OK(mlod_rt_level_info_get(ctx, MLOD_RT_MESH, st->wanted[MLOD_RT_MESH], 0, &li, &e), e);
+	CHECK((st->fallback & (1u << MLOD_RT_MESH)) && !li.resident && !li.failed && !li.no_room,
+	      "waiting level: fallback 0x%x resident %d failed %d no_room %d", st->fallback, li.resident, li.failed,
+	      li.no_room);
+	mlod_rt_close(ctx);
+}
 /* A read callback that returns damaged bytes during one mlod_rt_stream
  * call only. The coarsest mesh level's chunk, read fine at open, now
  * fails its CRC twice: the read is blamed (MLOD_ERR_IO, naming that
@@ -593,6 +648,7 @@ int main(int argc, char **argv)
 	rt_packer_setup(argv[0], "rt_engine", samples);
 	RUN(wants_of_every_batch);
 	RUN(fallback_the_finest_that_fits);
+	RUN(fallback_says_why);
 	RUN(misread_tried_again);
 	RUN(held_memory_is_counted);
 	RUN(scratch_of_another_context);
