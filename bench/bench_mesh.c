@@ -47,86 +47,11 @@ static int load(const char *path, mlod_character *c)
 }
 
 /* Poses for the posed cost, as mlod-bgm makes them. */
-static void train_poses(const mlod_character *c0, mlod_pose_set *out)
+static void train_poses(const mlod_character *c, mlod_pose_set *out)
 {
-	mlod_character sub = *c0;
-	static mlod_clip picked[64];
-	int maxc = getenv("PROTO_MAXCLIPS") ? atoi(getenv("PROTO_MAXCLIPS")) : 16;
-	if (c0->clip_count > maxc && maxc <= 64) {
-		for (int i = 0; i < maxc; i++)
-			picked[i] = c0->clips[(long)i * c0->clip_count / maxc];
-		sub.clips = picked;
-		sub.clip_count = maxc;
-	}
-	const mlod_character *c = &sub;
 	int clips = c->clip_count > 0 ? c->clip_count : 1, per = 24 / clips;
-	int pmax = getenv("PROTO_PER_MAX") ? atoi(getenv("PROTO_PER_MAX")) : 8, pmin = getenv("PROTO_PER_MIN") ? atoi(getenv("PROTO_PER_MIN")) : 2;
-	int nr = getenv("PROTO_RANDOM") ? atoi(getenv("PROTO_RANDOM")) : MLOD_MESH_RANDOM_POSES;
-	per = per < pmin ? pmin : per > pmax ? pmax : per;
-	mlod_pose_set_make(c, 0, per, nr, getenv("PROTO_SEED") ? (uint64_t)atoll(getenv("PROTO_SEED")) : MLOD_MESH_TRAIN_SEED, MLOD_MESH_RANDOM_ANGLE, out, NULL);
-	int pool = getenv("PROTO_POOL") ? atoi(getenv("PROTO_POOL")) : 0;
-	if (pool > nr && nr > 0) {
-		/* farthest-point pick of nr of pool random poses, from the clip frames and the rest pose */
-		mlod_pose_set big = {0};
-		mlod_pose_set_make(c, 1, per, pool, getenv("PROTO_SEED") ? (uint64_t)atoll(getenv("PROTO_SEED")) : MLOD_MESH_TRAIN_SEED, MLOD_MESH_RANDOM_ANGLE, &big, NULL);
-		int J = big.joint_count, fixed = big.count - pool;
-		double ext = 0.0;
-		for (int j = 0; j < J; j++)
-			for (int i = 12; i < 15; i++)
-				ext = fmax(ext, fabs(big.world[j].m[i]));
-		ext = ext > 0.0 ? ext : 1.0;
-		double *mind = malloc(sizeof(double) * (size_t)pool);
-		for (int k = 0; k < pool; k++)
-			mind[k] = HUGE_VAL;
-		int *pick = malloc(sizeof(int) * (size_t)nr);
-		int chosen = -1;
-		for (int t = 0; t < fixed + nr; t++) {
-			int from = t < fixed ? t : chosen;
-			const mlod_mat4 *A = big.world + (size_t)from * (size_t)J;
-			for (int k = 0; k < pool; k++) {
-				const mlod_mat4 *B = big.world + (size_t)(fixed + k) * (size_t)J;
-				double d = 0.0;
-				for (int j = 0; j < J; j++)
-					for (int i = 0; i < 15; i++) {
-						if (i % 4 == 3)
-							continue;
-						double e = (double)A[j].m[i] - B[j].m[i];
-						if (i >= 12)
-							e /= ext;
-						d += e * e;
-					}
-				mind[k] = fmin(mind[k], d);
-			}
-			if (t >= fixed - 1 && t - fixed + 1 < nr) {
-				int best = 0;
-				for (int k = 1; k < pool; k++)
-					if (mind[k] > mind[best])
-						best = k;
-				pick[t - fixed + 1] = best;
-				chosen = fixed + best;
-			}
-		}
-		/* out: its clip frames (no rest pose) then the picks */
-		int first = out->count - nr;
-		for (int i = 0; i < nr; i++)
-			memcpy(out->world + (size_t)J * (size_t)(first + i), big.world + (size_t)J * (size_t)(fixed + pick[i]), sizeof(mlod_mat4) * (size_t)J);
-		free(mind);
-		free(pick);
-		mlod_pose_set_free(&big);
-	}
-	int dup = getenv("PROTO_DUP") ? atoi(getenv("PROTO_DUP")) : 1;
-	if (dup > 1 && nr > 0) {
-		int J = out->joint_count, n0 = out->count, first = n0 - nr;
-		mlod_mat4 *w = malloc(sizeof *w * (size_t)J * (size_t)(first + nr * dup));
-		memcpy(w, out->world, sizeof *w * (size_t)J * (size_t)first);
-		for (int i = 0; i < nr; i++)
-			for (int d = 0; d < dup; d++)
-				memcpy(w + (size_t)J * (size_t)(first + i * dup + d), out->world + (size_t)J * (size_t)(first + i), sizeof *w * (size_t)J);
-		mlod_pose_set_free(out);
-		out->world = w;
-		out->joint_count = J;
-		out->count = first + nr * dup;
-	}
+	per = per < 2 ? 2 : per > 8 ? 8 : per;
+	mlod_pose_set_make(c, 0, per, MLOD_MESH_RANDOM_POSES, MLOD_MESH_TRAIN_SEED, MLOD_MESH_RANDOM_ANGLE, out, NULL);
 }
 
 /* ---------------------------------------------------------------- */
@@ -572,8 +497,6 @@ static void quality(int argc, char **argv)
 		{"gltfpack 1.3 -si R -se 1 -noq", 2, {0}},
 	};
 	int nm = (int)(sizeof methods / sizeof *methods);
-	if (getenv("PROTO_DEFAULT_ONLY"))
-		nm = 1;
 	mlod_pose_set clip = {0}, random = {0};
 	mlod_pose_set_make(&c, 0, 16, 0, 0, 0.0f, &clip, NULL);
 	mlod_pose_set_make(&c, 0, 0, MLOD_MESH_RANDOM_POSES, MLOD_MESH_MEASURE_SEED, MLOD_MESH_RANDOM_ANGLE, &random, NULL);
@@ -619,7 +542,7 @@ static void quality(int argc, char **argv)
 				if (!ok[m][k])
 					printf(" | - | - | -");
 				else
-					printf(getenv("PROTO_DEFAULT_ONLY") ? " | %d | %.6f | %.4f" : " | %d | %.4f | %.3f", tris[m][k], res[m][set][k].mean, res[m][set][k].max);
+					printf(" | %d | %.4f | %.3f", tris[m][k], res[m][set][k].mean, res[m][set][k].max);
 			}
 			printf(" |\n");
 		}

@@ -160,7 +160,7 @@ static mlod_result make_poses(mlod_mesh_levels *L, mlod_error *err)
 	int per_train = 24 / clips, per_measure = 16 / clips;
 	per_train = per_train < 2 ? 2 : per_train > 8 ? 8 : per_train;
 	per_measure = per_measure < 2 ? 2 : per_measure > 4 ? 4 : per_measure; /* mlod_clip_times: 1 means all */
-	mlod_result r = mlod_pose_set_make(&sub, 0, per_train, getenv("PROTO_RANDOM") ? atoi(getenv("PROTO_RANDOM")) : MLOD_MESH_RANDOM_POSES, MLOD_MESH_TRAIN_SEED,
+	mlod_result r = mlod_pose_set_make(&sub, 0, per_train, MLOD_MESH_RANDOM_POSES, MLOD_MESH_TRAIN_SEED,
 	                                   MLOD_MESH_RANDOM_ANGLE, &L->train, err);
 	if (r == MLOD_OK)
 		r = mlod_pose_set_make(&sub, 1, per_measure, MLOD_MESH_RANDOM_POSES, MLOD_MESH_MEASURE_SEED,

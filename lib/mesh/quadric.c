@@ -389,93 +389,6 @@ static void quadrics_pair(mlod_bgm *g, int da, int db, __m128d *posed, __m128d *
 }
 #endif
 
-#include <stdio.h>
-static double near_tol(void)
-{
-	const char *e = getenv("MLOD_NEAR_TOL");
-	return e ? atof(e) : 0.0;
-}
-
-/* PROTOTYPE: near-duplicate training poses. Pose p (1 <= p < P) whose
- * every node moves by at most tol from an earlier kept pose q's position
- * (bounded per used joint j: ||A_p - A_q||_F R_j + |S_p c_j - S_q c_j|,
- * c_j, R_j the centre and radius of j's nodes in bind space) takes q's
- * skin matrices: the exact-duplicate rule below then stores it once and
- * counts it at q's terms (q weighs as the poses it stands for). */
-static int near_poses(mlod_bgm *g, int P, int J, const unsigned char *used, double tol)
-{
-	double *cr = calloc((size_t)J * 4, sizeof *cr);
-	double *lo = malloc(sizeof(double) * 6 * (size_t)J);
-	int *rep = malloc(sizeof(int) * (size_t)P);
-	if (!cr || !lo || !rep) {
-		free(cr), free(lo), free(rep);
-		return -1;
-	}
-	for (int j = 0; j < J; j++)
-		for (int i = 0; i < 3; i++)
-			lo[6 * j + i] = HUGE_VAL, lo[6 * j + 3 + i] = -HUGE_VAL;
-	/* each joint's nodes' box: centre of the box, radius from it */
-	for (int v = 0; v < g->node_count; v++) {
-		int n = g->joint_count == 0 ? 1 : g->inf[v].count;
-		for (int k = 0; k < n && k < MLOD_MAX_INFLUENCES; k++) {
-			int j = g->joint_count == 0 ? 0 : g->inf[v].joints[k];
-			if (j >= J || (g->joint_count > 0 && !(g->inf[v].weights[k] > 0.0f)))
-				continue;
-			for (int i = 0; i < 3; i++)
-				lo[6 * j + i] = fmin(lo[6 * j + i], g->nodes[v].p[i]), lo[6 * j + 3 + i] = fmax(lo[6 * j + 3 + i], g->nodes[v].p[i]);
-		}
-	}
-	for (int j = 0; j < J; j++) {
-		if (!(lo[6 * j] <= lo[6 * j + 3]))
-			continue;
-		double r2 = 0.0;
-		for (int i = 0; i < 3; i++) {
-			cr[4 * j + i] = 0.5 * (lo[6 * j + i] + lo[6 * j + 3 + i]);
-			double h = 0.5 * (lo[6 * j + 3 + i] - lo[6 * j + i]);
-			r2 += h * h;
-		}
-		cr[4 * j + 3] = sqrt(r2);
-	}
-	int reps = 0, merged = 0;
-	for (int p = 1; p < P; p++) {
-		const float *a = g->skin + (size_t)p * (size_t)J * 12;
-		int best = -1;
-		double bd = HUGE_VAL;
-		for (int t = 0; t < reps; t++) {
-			const float *b = g->skin + (size_t)rep[t] * (size_t)J * 12;
-			double d = 0.0;
-			for (int j = 0; j < J && d < bd; j++) {
-				if (!used[j] || !(lo[6 * j] <= lo[6 * j + 3]))
-					continue;
-				const float *x = a + 12 * j, *y = b + 12 * j;
-				double f = 0.0, m = 0.0;
-				for (int i = 0; i < 3; i++) {
-					double e = (double)x[4 * i + 3] - y[4 * i + 3];
-					for (int k = 0; k < 3; k++) {
-						double dd = (double)x[4 * i + k] - y[4 * i + k];
-						f += dd * dd;
-						e += dd * cr[4 * j + k];
-					}
-					m += e * e;
-				}
-				d = fmax(d, sqrt(f) * cr[4 * j + 3] + sqrt(m));
-			}
-			if (d < bd)
-				bd = d, best = rep[t];
-		}
-		if (best >= 0 && bd <= tol) {
-			memcpy(g->skin + (size_t)p * (size_t)J * 12, g->skin + (size_t)best * (size_t)J * 12, sizeof(float) * 12 * (size_t)J);
-			merged++;
-		} else {
-			rep[reps++] = p;
-		}
-	}
-	if (getenv("MLOD_NEAR_DEBUG"))
-		fprintf(stderr, "near_poses: %d poses, %d merged, %d nodes\n", P, merged, g->node_count);
-	free(cr), free(lo), free(rep);
-	return 0;
-}
-
 mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_instance *in, mlod_error *err)
 {
 	const mlod_skeleton *s = &c->skeleton;
@@ -601,11 +514,6 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 		for (int k = 0; k < g->inf[v].count && k < MLOD_MAX_INFLUENCES; k++)
 			if (g->inf[v].joints[k] < J)
 				used[g->inf[v].joints[k]] = 1;
-	if (P > 2 && near_tol() > 0.0 && near_poses(g, P, J, used, near_tol() * g->diagonal) != 0) {
-		free(used);
-		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
-		goto done;
-	}
 	/* A pose whose used skin matrices are bit for bit an earlier pose's
 	 * (a rigid part or a joint the clip leaves still) has that pose's
 	 * quadrics, every step being the same arithmetic on the same values,
@@ -650,8 +558,6 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	free(used);
 	g->pose_count = P;
 	g->qpose_count = D;
-	if (getenv("MLOD_NEAR_DEBUG"))
-		fprintf(stderr, "stored: P %d D %d nodes %d\n", P, D, g->node_count);
 	/* Room for the nodes the collapses add (each merges two or three
 	 * live nodes into one: fewer than node_count of them), at the
 	 * capacity bgm_add_node's doubling of node_cap would reach, so that
