@@ -57,8 +57,11 @@ void mlod_primitive_fix_weights(mlod_primitive *p, int root, mlod_weight_fix *fi
 	fix->unweighted = fix->rescaled = 0;
 	fix->first_unweighted = fix->first_rescaled = -1;
 	fix->first_sum = 0.0f;
-	if (!p || p->weight_set_count <= 0)
+	if (!p || p->weight_set_count <= 0 || p->weight_set_count > MLOD_MAX_SETS)
 		return;
+	for (int s = 0; s < p->weight_set_count; s++)
+		if (!p->joints[s] || !p->weights[s]) /* mlod_character_validate refuses it */
+			return;
 	for (int v = 0; v < p->vertex_count; v++) {
 		int nonzero;
 		float sum = vertex_sum(p, v, &nonzero);
