@@ -79,9 +79,48 @@ int add_mesh_like(mlod_gltf &doc, int like, const mlod_mesh &mesh)
 	return index;
 }
 
-/* Extensions that refer to no mesh, accessor or buffer view, so that
- * pruning (which renumbers those) leaves them right. */
-static bool prune_safe(const std::string &name)
+/* The node, mesh, ... index a JSON pointer ("/nodes/3/rotation") names
+ * in top-level array `array` ("nodes"), or -1. */
+static long pointer_index(const std::string &pointer, const char *array)
+{
+	std::string head = std::string("/") + array + "/";
+	if (pointer.compare(0, head.size(), head) != 0)
+		return -1;
+	const char *digits = pointer.c_str() + head.size();
+	char *end = nullptr;
+	errno = 0;
+	long i = isdigit((unsigned char)*digits) ? strtol(digits, &end, 10) : -1;
+	return i >= 0 && errno == 0 && (*end == '/' || *end == '\0') ? i : -1;
+}
+
+/* The JSON pointers of the KHR_animation_pointer channels of m. */
+static std::vector<std::string> animation_pointers(const Model &m)
+{
+	std::vector<std::string> pointers;
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationChannel &c : a.channels) {
+			auto it = c.target_extensions.find("KHR_animation_pointer");
+			if (it == c.target_extensions.end())
+				continue;
+			const Value &v = it->second;
+			pointers.push_back(v.IsObject() && v.Has("pointer") && v.Get("pointer").IsString()
+			                       ? v.Get("pointer").Get<std::string>()
+			                       : std::string());
+		}
+	return pointers;
+}
+
+/* Whether the document's extension `name` refers to no mesh, accessor or
+ * buffer view, so that pruning and stripping (which renumber those; the
+ * meshes only when meshes_move) leave it right. By name: the families
+ * that refer to materials, textures, images, samplers or lights only, or
+ * to nothing (KHR_node_visibility: a boolean; EXT_materials_bump, which
+ * three.js's exporter writes: a factor and a texture). By its content:
+ * KHR_animation_pointer, whose channels are core animation channels (their
+ * samplers' accessors are renumbered with the others), when each pointer
+ * names a property of a node, material, camera or KHR_lights_punctual
+ * light, whose indices hold, or of a mesh when meshes do not move. */
+static bool prune_safe(const Model &m, const std::string &name, bool meshes_move)
 {
 	static const char *const prefixes[] = {"KHR_materials_", "KHR_texture_", "KHR_lights_punctual",
 	                                       "KHR_mesh_quantization", "KHR_xmp", "EXT_texture_", "MSFT_lod",
@@ -89,7 +128,16 @@ static bool prune_safe(const std::string &name)
 	for (const char *p : prefixes)
 		if (name.compare(0, strlen(p), p) == 0)
 			return true;
-	return false;
+	if (name == "KHR_node_visibility" || name == "EXT_materials_bump")
+		return true;
+	if (name != "KHR_animation_pointer")
+		return false;
+	for (const std::string &p : animation_pointers(m))
+		if (pointer_index(p, "nodes") < 0 && pointer_index(p, "materials") < 0 && pointer_index(p, "cameras") < 0 &&
+		    pointer_index(p, "extensions/KHR_lights_punctual/lights") < 0 &&
+		    (meshes_move || pointer_index(p, "meshes") < 0))
+			return false;
+	return true;
 }
 
 /* Drops the elements of array `name` that keep says go, from the JSON as
@@ -228,7 +276,7 @@ void prune(mlod_gltf &doc, bool meshes)
 		return;
 	}
 	for (const std::string &e : m.extensionsUsed)
-		if (!prune_safe(e))
+		if (!prune_safe(m, e, meshes))
 			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not pruned",
 			     e.c_str());
 	auto apply = [](const std::vector<int> &map, int &i) {
@@ -423,7 +471,7 @@ void strip_levels(mlod_gltf &doc, const int *joint_nodes, int joint_count, const
 		if (joint_nodes[i] >= 0 && size_t(joint_nodes[i]) < joint.size())
 			joint[size_t(joint_nodes[i])] = 1;
 	for (const std::string &e : m.extensionsUsed)
-		if (!prune_safe(e))
+		if (!prune_safe(m, e, false))
 			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not stripped",
 			     e.c_str());
 	json &orig = doc.original;
@@ -579,6 +627,10 @@ void drop_tail(mlod_gltf &doc, int nodes, int skins, int meshes)
 		for (const tinygltf::AnimationChannel &c : a.channels)
 			if (gone(c.target_node, nodes))
 				fail(MLOD_ERR_UNSUPPORTED, "animation \"%s\" targets a node that would go", a.name.c_str());
+	for (const std::string &p : animation_pointers(m))
+		if (gone(int(std::min(pointer_index(p, "nodes"), long(INT_MAX))), nodes) ||
+		    gone(int(std::min(pointer_index(p, "meshes"), long(INT_MAX))), meshes))
+			fail(MLOD_ERR_UNSUPPORTED, "an animation pointer (KHR_animation_pointer) names a node or mesh that would go");
 	auto tail = [](size_t size, int from) {
 		std::vector<bool> keep(size, true);
 		for (size_t i = size_t(from); i < size; i++)

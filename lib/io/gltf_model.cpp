@@ -36,6 +36,7 @@ public:
 		skins();
 		meshes();
 		instances();
+		weights();
 		clips();
 		notes();
 	}
@@ -471,6 +472,46 @@ private:
 		if (hidden)
 			note("%d nodes with a mesh are not in the default scene (MSFT_lod levels, say): they are not instances",
 			     hidden);
+	}
+
+	/* Skin weights glTF does not allow, made valid by mlod's one rule
+	 * (mlod_primitive_fix_weights): the primitives of each mesh a skinned
+	 * node uses, with the skin of its first instance (else of the first
+	 * such node: an MSFT_lod level), so that every level a tool writes
+	 * from them is valid; the input's own accessors stay as they are. */
+	void weights()
+	{
+		for (int m = 0; m < c_.mesh_count; m++) {
+			int skin = -1;
+			for (int i = 0; i < c_.instance_count && skin < 0; i++)
+				if (c_.instances[i].mesh == m)
+					skin = c_.instances[i].skin;
+			for (size_t k = 0; k < m_.nodes.size() && skin < 0; k++)
+				if (m_.nodes[k].mesh == m)
+					skin = m_.nodes[k].skin;
+			if (skin < 0 || skin >= c_.skeleton.skin_count)
+				continue;
+			int root = mlod_skin_root(&c_.skeleton, skin);
+			const mlod_skin &sk = c_.skeleton.skins[skin];
+			std::string name = root >= 0 ? quoted(c_.skeleton.joints[sk.joints[root]].name) : "\"\"";
+			for (int p = 0; p < c_.meshes[m].primitive_count; p++) {
+				mlod_weight_fix fix;
+				mlod_primitive_fix_weights(&c_.meshes[m].primitives[p], root, &fix);
+				/* The pack's words for the same rule (mlod-pack(1)). */
+				if (fix.unweighted == 1)
+					warn("mesh %d primitive %d: vertex %d has no weight: it follows the skin's root joint %s", m, p,
+					     fix.first_unweighted, name.c_str());
+				else if (fix.unweighted > 1)
+					warn("mesh %d primitive %d: %d vertices have no weight (vertex %d the first): they follow the "
+					     "skin's root joint %s", m, p, fix.unweighted, fix.first_unweighted, name.c_str());
+				if (fix.rescaled == 1)
+					warn("mesh %d primitive %d: the weights of vertex %d sum to %.9g, not 1: scaled to 1", m, p,
+					     fix.first_rescaled, double(fix.first_sum));
+				else if (fix.rescaled > 1)
+					warn("mesh %d primitive %d: the weights of %d vertices do not sum to 1 (vertex %d the first: %.9g): "
+					     "scaled to 1", m, p, fix.rescaled, fix.first_rescaled, double(fix.first_sum));
+			}
+		}
 	}
 
 	/* A clip per animation with joint channels: one that animates morph

@@ -226,8 +226,12 @@ mlod_result mlod_gltf_node_lod(const mlod_gltf *doc, int node, int *ids, int max
  * nothing uses, and packs the buffers again: indices of meshes, accessors
  * and buffer views change, every other index stays. A document using an
  * extension that may refer to those (beyond the KHR_materials_*,
- * KHR_texture_*, KHR_lights_punctual, KHR_mesh_quantization, EXT_texture_*,
- * MSFT_lod family) is MLOD_ERR_UNSUPPORTED and left unchanged. */
+ * KHR_texture_*, KHR_lights_punctual, KHR_mesh_quantization, KHR_xmp*,
+ * EXT_texture_*, MSFT_lod, MSFT_texture_dds family, KHR_node_visibility and
+ * EXT_materials_bump; KHR_animation_pointer is known when every pointer
+ * names a node, material, camera or KHR_lights_punctual light, or a mesh
+ * where mesh indices hold, as in mlod_gltf_strip_levels) is
+ * MLOD_ERR_UNSUPPORTED and left unchanged. */
 mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err);
 
 /* Appends to mesh `to` a copy of each primitive of mesh `from` that is

@@ -2,7 +2,8 @@
  * mlod_model.h: the character model: skeleton, skins, meshes, instances and
  * clips as every reader produces them and every layer consumes them, with
  * pose evaluation and linear blend skinning (pose.c), lifetime, invariants
- * and the skeleton height (character.c), and clip timelines (keytimes.c).
+ * and the skeleton height (character.c), clip timelines (keytimes.c) and
+ * the rule for skin weights glTF does not allow (weights.c).
  *
  * - Objects the library allocates are released with the matching *_free
  *   call, which accepts NULL. Plain buffers it returns are released with
@@ -186,6 +187,39 @@ float mlod_skeleton_height(const mlod_skeleton *s);
  * the test character's proportions, never shown as a percentage. */
 float mlod_skeleton_extent(const mlod_skeleton *s);
 
+/* Skin weights glTF does not allow (weights.c). glTF wants every skinned
+ * vertex's weights to sum to 1, and the Khronos validator fails a file
+ * whose sum is off by more than 2e-7 per non-zero weight
+ * (ACCESSOR_WEIGHTS_NON_NORMALIZED), all-zero weights included. The one
+ * rule of mlod for them, which the glTF reader applies to the primitives
+ * of every mesh a skinned node uses (so every level a tool writes has
+ * valid weights, and every measure moves the vertices as the pack and
+ * the runtime do), with a warning per primitive:
+ * - a vertex whose weights are all 0 gets weight 1 on the skin's root
+ *   joint (mlod_skin_root), which it then follows; its other influences
+ *   become joint 0 at weight 0;
+ * - a vertex whose weights sum to something else is scaled to sum to 1
+ *   (which changes no pose: skinning divides by the sum).
+ * A vertex with a negative or non-finite weight is left as it is (the
+ * character then fails mlod_character_validate). */
+typedef struct mlod_weight_fix {
+	int unweighted;        /* vertices that had no weight */
+	int first_unweighted;  /* the first of them, or -1 */
+	int rescaled;          /* vertices whose weights were scaled to sum to 1 */
+	int first_rescaled;    /* the first of them, or -1 */
+	float first_sum;       /* its weights' sum before */
+} mlod_weight_fix;
+
+/* The root of skin `skin` as a skin joint index: of its joints, the
+ * nearest the skeleton's root (the first of them at that depth); -1 for a
+ * skin without joints or out of range. */
+int mlod_skin_root(const mlod_skeleton *s, int skin);
+
+/* Applies the rule to p, whose vertices a skin with skin joint `root`
+ * (mlod_skin_root; -1: all-zero vertices are left as they are) deforms,
+ * and counts what it changed into *fix. */
+void mlod_primitive_fix_weights(mlod_primitive *p, int root, mlod_weight_fix *fix);
+
 /* A malloc'ed copy of s ("" for NULL), or NULL when out of memory. */
 char *mlod_strdup(const char *s);
 
@@ -223,7 +257,7 @@ void mlod_skin_matrices(const mlod_skin *skin, const mlod_mat4 *world, mlod_mat4
 /* Linear blend skinning of a primitive's positions (3 * vertex_count floats
  * into out) and, when out_normals is not NULL and the primitive has
  * normals, of its normals. Vertices whose weights sum to 0 stay at their
- * bind position. */
+ * bind position (the glTF reader leaves none: mlod_primitive_fix_weights). */
 void mlod_skin_primitive(const mlod_primitive *p, const mlod_mat4 *skin_mats,
                          float *out_positions, float *out_normals);
 /* The position mlod_skin_primitive gives vertex v, bit for bit. */

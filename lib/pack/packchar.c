@@ -16,22 +16,6 @@
 /* The character as packed                                             */
 /* ------------------------------------------------------------------ */
 
-/* The root of skin `skin` as a skin joint index: its joint nearest the
- * skeleton's root (the first of them). */
-int pack_skin_root(const mlod_skeleton *s, int skin)
-{
-	const mlod_skin *sk = &s->skins[skin];
-	int best = 0, best_depth = -1;
-	for (int q = 0; q < sk->joint_count; q++) {
-		int depth = 0, j = sk->joints[q];
-		while (j >= 0 && j < s->joint_count && depth <= s->joint_count)
-			j = s->joints[j].parent, depth++;
-		if (best_depth < 0 || depth < best_depth)
-			best = q, best_depth = depth;
-	}
-	return best;
-}
-
 void pack_note(struct ctx *x, const char *text)
 {
 	char *n = x->st->notes;
@@ -348,8 +332,10 @@ mlod_result pack_note_unstored_attributes(struct ctx *x, const mlod_gltf *doc)
 
 /* Notes the skinned vertices whose weights are all 0 (glTF wants them to
  * sum to 1; the validator flags them): a pack's weights sum to 255, so
- * each goes on the skin's root joint (skin_root), which the vertex then
- * follows. */
+ * each goes on the skin's root joint (mlod_skin_root), which the vertex
+ * then follows, the rule of mlod_primitive_fix_weights. The glTF reader
+ * leaves none (it applies that rule, with its own warning, in the same
+ * words): this is for a character built otherwise. */
 void pack_note_unweighted(struct ctx *x)
 {
 	const mlod_character *c = x->in;
@@ -375,7 +361,7 @@ void pack_note_unweighted(struct ctx *x)
 			if (count == 0)
 				continue;
 			const mlod_skin *sk = &c->skeleton.skins[skin];
-			int root = sk->joint_count > 0 ? sk->joints[pack_skin_root(&c->skeleton, skin)] : -1;
+			int root = sk->joint_count > 0 ? sk->joints[mlod_skin_root(&c->skeleton, skin)] : -1;
 			const char *name = root >= 0 && c->skeleton.joints[root].name ? c->skeleton.joints[root].name : "";
 			char text[256];
 			int g = mesh->gltf_index >= 0 ? mesh->gltf_index : m;

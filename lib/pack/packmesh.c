@@ -162,7 +162,7 @@ static void part_quantise(struct ctx *x, const struct mpart *m, int k, uint8_t *
 			mlod_pack_weights8(bw, w8);
 			if (w8[0] + w8[1] + w8[2] + w8[3] == 0) { /* no weight: the skin's root (note_unweighted) */
 				w8[0] = 255;
-				bj[0] = pack_skin_root(&x->v.skeleton, rec->skin);
+				bj[0] = mlod_skin_root(&x->v.skeleton, rec->skin);
 			}
 			for (int t = 0; t < 4; t++) {
 				int jt = w8[t] ? bj[t] : 0;

@@ -194,7 +194,6 @@ struct ctx {
 	int motion_count;          /* levels >= 1, over all clips */
 };
 
-int pack_skin_root(const mlod_skeleton *s, int skin);
 void pack_note(struct ctx *x, const char *text);
 void pack_warn(struct ctx *x, const char *text);
 int pack_joint_of_node(const mlod_skeleton *s, int node);

@@ -498,6 +498,55 @@ TEST(pose_character_skinned_and_rigid)
 	mlod_character_free(&c);
 }
 
+TEST(fix_weights_rule)
+{
+	/* Two sets, five vertices: v0 valid (untouched, bit for bit), v1 all 0
+	 * (on the root, joint 2 here, alone), v2 summing to 0.5 over both sets
+	 * (scaled), v3 with a negative weight (left: validate refuses it), v4
+	 * 1e-7 over 1 with one weight (within the validator's 2e-7: kept). */
+	float w0[20] = { 0.25f, 0.75f, 0, 0, 0, 0, 0, 0, 0.1f, 0.1f, 0, 0, -1, 0, 0, 0, 1.0000001f, 0, 0, 0 };
+	float w1[20] = { 0, 0, 0, 0, 0, 0, 0, 0, 0.1f, 0.2f, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
+	uint16_t j0[20] = { 0, 1, 0, 0, 1, 1, 1, 1, 0, 1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0 };
+	uint16_t j1[20] = { 0, 0, 0, 0, 2, 2, 2, 2, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
+	float keep0[20], keep1[20];
+	memcpy(keep0, w0, sizeof w0), memcpy(keep1, w1, sizeof w1);
+	float pos[15] = { 0 };
+	mlod_primitive p = { 0 };
+	p.vertex_count = 5;
+	p.positions = pos;
+	p.weight_set_count = 2;
+	p.joints[0] = j0, p.joints[1] = j1, p.weights[0] = w0, p.weights[1] = w1;
+	mlod_weight_fix fix;
+	mlod_primitive_fix_weights(&p, 2, &fix);
+	CHECK(fix.unweighted == 1 && fix.first_unweighted == 1);
+	CHECK(fix.rescaled == 1 && fix.first_rescaled == 2);
+	CHECK_NEAR(fix.first_sum, 0.5, 1e-6);
+	CHECK(memcmp(w0, keep0, 4 * sizeof(float)) == 0 && memcmp(w0 + 12, keep0 + 12, 8 * sizeof(float)) == 0);
+	CHECK(j0[4] == 2 && w0[4] == 1.0f);
+	for (int i = 1; i < 4; i++)
+		CHECK(j0[4 + i] == 0 && w0[4 + i] == 0.0f);
+	for (int i = 0; i < 4; i++)
+		CHECK(j1[4 + i] == 0 && w1[4 + i] == 0.0f);
+	float sum = 0.0f;
+	for (int i = 0; i < 4; i++)
+		sum += w0[8 + i], sum += w1[8 + i];
+	CHECK_NEAR(sum, 1.0, 4e-7);
+	CHECK_NEAR(w1[9], 0.4, 1e-6);
+	/* no root: a vertex without weight stays so */
+	w0[4] = 0.0f;
+	mlod_primitive_fix_weights(&p, -1, &fix);
+	CHECK(fix.unweighted == 0 && fix.rescaled == 0 && w0[4] == 0.0f);
+
+	/* the skin's root: of its joints, the one nearest the skeleton's root */
+	mlod_character c;
+	build_chain(&c);
+	CHECK(mlod_skin_root(&c.skeleton, 0) == 0);
+	c.skeleton.skins[0].joints[0] = 2, c.skeleton.skins[0].joints[2] = 0;
+	CHECK(mlod_skin_root(&c.skeleton, 0) == 2);
+	CHECK(mlod_skin_root(&c.skeleton, 1) == -1);
+	mlod_character_free(&c);
+}
+
 int main(void)
 {
 	RUN(validate_accepts_and_free_zeroes);
@@ -512,5 +561,6 @@ int main(void)
 	RUN(linear_blend_skinning);
 	RUN(skinning_uses_every_weight_set);
 	RUN(pose_character_skinned_and_rigid);
+	RUN(fix_weights_rule);
 	TEST_EXIT();
 }
