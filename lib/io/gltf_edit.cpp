@@ -111,16 +111,18 @@ static std::vector<std::string> animation_pointers(const Model &m)
 }
 
 /* Whether the document's extension `name` refers to no mesh, accessor or
- * buffer view, so that pruning and stripping (which renumber those; the
- * meshes only when meshes_move) leave it right. By name: the families
+ * buffer view, so that pruning and stripping (which renumber those) leave
+ * it right. By name: the families
  * that refer to materials, textures, images, samplers or lights only, or
  * to nothing (KHR_node_visibility: a boolean; EXT_materials_bump, which
  * three.js's exporter writes: a factor and a texture). By its content:
  * KHR_animation_pointer, whose channels are core animation channels (their
  * samplers' accessors are renumbered with the others), when each pointer
  * names a property of a node, material, camera or KHR_lights_punctual
- * light, whose indices hold, or of a mesh when meshes do not move. */
-static bool prune_safe(const Model &m, const std::string &name, bool meshes_move)
+ * light, whose indices hold. Not of a mesh: mlod-pack -x puts level 0 in
+ * a new mesh and leaves the old one an empty shell that such a pointer
+ * would still name. */
+static bool prune_safe(const Model &m, const std::string &name)
 {
 	static const char *const prefixes[] = {"KHR_materials_", "KHR_texture_", "KHR_lights_punctual",
 	                                       "KHR_mesh_quantization", "KHR_xmp", "EXT_texture_", "MSFT_lod",
@@ -134,8 +136,7 @@ static bool prune_safe(const Model &m, const std::string &name, bool meshes_move
 		return false;
 	for (const std::string &p : animation_pointers(m))
 		if (pointer_index(p, "nodes") < 0 && pointer_index(p, "materials") < 0 && pointer_index(p, "cameras") < 0 &&
-		    pointer_index(p, "extensions/KHR_lights_punctual/lights") < 0 &&
-		    (meshes_move || pointer_index(p, "meshes") < 0))
+		    pointer_index(p, "extensions/KHR_lights_punctual/lights") < 0)
 			return false;
 	return true;
 }
@@ -276,7 +277,7 @@ void prune(mlod_gltf &doc, bool meshes)
 		return;
 	}
 	for (const std::string &e : m.extensionsUsed)
-		if (!prune_safe(m, e, meshes))
+		if (!prune_safe(m, e))
 			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not pruned",
 			     e.c_str());
 	auto apply = [](const std::vector<int> &map, int &i) {
@@ -471,7 +472,7 @@ void strip_levels(mlod_gltf &doc, const int *joint_nodes, int joint_count, const
 		if (joint_nodes[i] >= 0 && size_t(joint_nodes[i]) < joint.size())
 			joint[size_t(joint_nodes[i])] = 1;
 	for (const std::string &e : m.extensionsUsed)
-		if (!prune_safe(m, e, false))
+		if (!prune_safe(m, e))
 			fail(MLOD_ERR_UNSUPPORTED, "extension %s may refer to meshes or accessors: the document is not stripped",
 			     e.c_str());
 	json &orig = doc.original;

@@ -476,29 +476,46 @@ private:
 
 	/* Skin weights glTF does not allow, made valid by mlod's one rule
 	 * (mlod_primitive_fix_weights): the primitives of each mesh a skinned
-	 * node uses, with the skin of its first instance (else of the first
-	 * such node: an MSFT_lod level), so that every level a tool writes
-	 * from them is valid; the input's own accessors stay as they are. */
+	 * node uses (an instance, or a node outside the scene: an MSFT_lod
+	 * level), so that every level a tool writes from them is valid; the
+	 * input's own accessors stay as they are. An all-zero vertex goes on
+	 * the skin's root, a skin joint index; a mesh whose skins have their
+	 * roots at different indices keeps such vertices as they are, with a
+	 * warning (mlod-pack then puts each on its own part's skin's root). */
 	void weights()
 	{
 		for (int m = 0; m < c_.mesh_count; m++) {
-			int skin = -1;
-			for (int i = 0; i < c_.instance_count && skin < 0; i++)
+			int skin = -1, root = -1;
+			bool agree = true;
+			auto use = [&](int s) {
+				if (s < 0 || s >= c_.skeleton.skin_count)
+					return;
+				int r = mlod_skin_root(&c_.skeleton, s);
+				if (skin < 0)
+					skin = s, root = r;
+				else if (r != root)
+					agree = false;
+			};
+			for (int i = 0; i < c_.instance_count; i++)
 				if (c_.instances[i].mesh == m)
-					skin = c_.instances[i].skin;
-			for (size_t k = 0; k < m_.nodes.size() && skin < 0; k++)
+					use(c_.instances[i].skin);
+			for (size_t k = 0; k < m_.nodes.size(); k++)
 				if (m_.nodes[k].mesh == m)
-					skin = m_.nodes[k].skin;
-			if (skin < 0 || skin >= c_.skeleton.skin_count)
+					use(m_.nodes[k].skin);
+			if (skin < 0)
 				continue;
-			int root = mlod_skin_root(&c_.skeleton, skin);
 			const mlod_skin &sk = c_.skeleton.skins[skin];
 			std::string name = root >= 0 ? quoted(c_.skeleton.joints[sk.joints[root]].name) : "\"\"";
 			for (int p = 0; p < c_.meshes[m].primitive_count; p++) {
 				mlod_weight_fix fix;
-				mlod_primitive_fix_weights(&c_.meshes[m].primitives[p], root, &fix);
+				const bool rule = agree && root >= 0;
+				mlod_primitive_fix_weights(&c_.meshes[m].primitives[p], rule ? root : -1, &fix);
+				if (!rule && fix.unweighted > 0)
+					warn("mesh %d primitive %d: %d vertices have no weight (vertex %d the first), and the skins that "
+					     "use the mesh have no common root joint: they stay without weight", m, p, fix.unweighted,
+					     fix.first_unweighted);
 				/* The pack's words for the same rule (mlod-pack(1)). */
-				if (fix.unweighted == 1)
+				else if (fix.unweighted == 1)
 					warn("mesh %d primitive %d: vertex %d has no weight: it follows the skin's root joint %s", m, p,
 					     fix.first_unweighted, name.c_str());
 				else if (fix.unweighted > 1)

@@ -229,8 +229,7 @@ mlod_result mlod_gltf_node_lod(const mlod_gltf *doc, int node, int *ids, int max
  * KHR_texture_*, KHR_lights_punctual, KHR_mesh_quantization, KHR_xmp*,
  * EXT_texture_*, MSFT_lod, MSFT_texture_dds family, KHR_node_visibility and
  * EXT_materials_bump; KHR_animation_pointer is known when every pointer
- * names a node, material, camera or KHR_lights_punctual light, or a mesh
- * where mesh indices hold, as in mlod_gltf_strip_levels) is
+ * names a node, material, camera or KHR_lights_punctual light) is
  * MLOD_ERR_UNSUPPORTED and left unchanged. */
 mlod_result mlod_gltf_prune(mlod_gltf *doc, mlod_error *err);
 

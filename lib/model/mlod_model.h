@@ -203,7 +203,7 @@ float mlod_skeleton_extent(const mlod_skeleton *s);
  * A vertex with a negative or non-finite weight is left as it is (the
  * character then fails mlod_character_validate). */
 typedef struct mlod_weight_fix {
-	int unweighted;        /* vertices that had no weight */
+	int unweighted;        /* vertices that had no weight (on root, unless -1) */
 	int first_unweighted;  /* the first of them, or -1 */
 	int rescaled;          /* vertices whose weights were scaled to sum to 1 */
 	int first_rescaled;    /* the first of them, or -1 */
@@ -216,8 +216,8 @@ typedef struct mlod_weight_fix {
 int mlod_skin_root(const mlod_skeleton *s, int skin);
 
 /* Applies the rule to p, whose vertices a skin with skin joint `root`
- * (mlod_skin_root; -1: all-zero vertices are left as they are) deforms,
- * and counts what it changed into *fix. */
+ * (mlod_skin_root; -1: all-zero vertices are counted but left as they
+ * are) deforms, and counts what it found into *fix. */
 void mlod_primitive_fix_weights(mlod_primitive *p, int root, mlod_weight_fix *fix);
 
 /* A malloc'ed copy of s ("" for NULL), or NULL when out of memory. */

@@ -68,6 +68,8 @@ void mlod_primitive_fix_weights(mlod_primitive *p, int root, mlod_weight_fix *fi
 		if (sum < 0.0f || (nonzero > 0 && sum_ok(sum, nonzero)))
 			continue;
 		if (nonzero == 0) {
+			if (fix->unweighted++ == 0)
+				fix->first_unweighted = v;
 			if (root < 0)
 				continue;
 			for (int s = 0; s < p->weight_set_count; s++)
@@ -75,8 +77,6 @@ void mlod_primitive_fix_weights(mlod_primitive *p, int root, mlod_weight_fix *fi
 					p->joints[s][4 * (size_t)v + (size_t)i] = 0;
 			p->joints[0][4 * (size_t)v] = (uint16_t)root;
 			p->weights[0][4 * (size_t)v] = 1.0f;
-			if (fix->unweighted++ == 0)
-				fix->first_unweighted = v;
 			continue;
 		}
 		if (fix->rescaled++ == 0)

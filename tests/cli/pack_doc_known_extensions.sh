@@ -3,12 +3,13 @@
 # (tubeman: about 321,700 bytes against 85,515). Three more are known now:
 # EXT_materials_bump (three.js's exporter writes it: a factor and a
 # texture), KHR_node_visibility (a boolean) and KHR_animation_pointer when
-# each pointer names a node, material, camera, light, or a mesh where
-# mesh indices hold (its channels are core channels, their samplers
-# renumbered as any): each gives a stripped DOC without the note, and -x
-# gives back the extension, a valid glb, and a pointer channel's keys
-# exactly. A pointer into an unknown extension's data keeps the document
-# whole, as before.
+# each pointer names a node, material, camera or light (its channels are
+# core channels, their samplers renumbered as any): each gives a stripped
+# DOC without the note, and -x gives back the extension, a valid glb, and
+# a pointer channel's keys exactly. A pointer into an unknown extension's
+# data keeps the document whole, as before, and so does a pointer to a
+# mesh: -x puts level 0 in a new mesh, and the pointer named the old one,
+# left empty (the validator's EMPTY_ENTITY).
 set -e
 T="$ROOT/samples/tubeman.glb"
 node "$ROOT/tests/glb-edit.mjs" "$T" bump.glb \
@@ -23,6 +24,7 @@ j.extensionsUsed = ["KHR_animation_pointer"];'
 }
 pointer ptr.glb /materials/0/pbrMetallicRoughness/baseColorFactor
 pointer foo.glb /extensions/EXT_foo/things/0/color
+pointer mesh.glb /meshes/0/weights
 # The keys of the pointer channel of a glb's first animation.
 keys() {
 	node -e '
@@ -53,6 +55,10 @@ if (JSON.stringify(doc("bump-x.glb").materials[0].extensions) !== "{\"EXT_materi
 if (JSON.stringify(doc("vis-x.glb").nodes[0].extensions) !== "{\"KHR_node_visibility\":{\"visible\":true}}") throw new Error("visibility");
 '
 [ "$(keys ptr.glb)" = "$(keys ptr-x.glb)" ]
-"$BIN/mlod-pack" -o foo.mlod foo.glb 2> foo.err
-grep -qxF "mlod-pack: foo.glb: the document chunk holds the input whole: extension KHR_animation_pointer may refer to meshes or accessors: the document is not stripped" foo.err
-[ "$(wc -c < foo.mlod)" -gt 300000 ]
+for f in foo mesh; do
+	"$BIN/mlod-pack" -o $f.mlod $f.glb 2> $f.err
+	grep -qxF "mlod-pack: $f.glb: the document chunk holds the input whole: extension KHR_animation_pointer may refer to meshes or accessors: the document is not stripped" $f.err
+	[ "$(wc -c < $f.mlod)" -gt 300000 ]
+	"$BIN/mlod-pack" -x $f.mlod -o $f-x.glb
+	node "$ROOT/tests/validate.mjs" $f-x.glb > /dev/null
+done

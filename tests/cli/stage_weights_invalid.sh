@@ -9,7 +9,10 @@
 # on stderr in every tool; the input's own accessors (level 0 of the
 # stages' outputs) are written as they are, so the validator finds the
 # input's 106 errors there and none elsewhere, and a pack unpacks to a
-# glb without error.
+# glb without error. A mesh that two skins with their roots at different
+# entries of their joint lists use cannot name one root for both: its
+# vertices without weight stay so, with a warning (they went on the
+# first skin's entry, another joint of the second skin).
 set -e
 node -e '
 const fs = require("fs");
@@ -63,3 +66,14 @@ for (let m = 1; m < j.meshes.length; m++) {
 expect mlod-pack | cmp - pack.err
 "$BIN/mlod-pack" -x bad.mlod -o x.glb
 [ "$(errors x.glb)" = "0 0" ]
+# The same mesh on a second node, with a second skin whose joint list is
+# the first's turned by one (its root at entry 1, not 0).
+node "$ROOT/tests/glb-edit.mjs" bad.glb two.glb '
+const n = j.nodes.findIndex((x) => x.mesh === 0), s = j.skins[j.nodes[n].skin];
+const joints = s.joints.slice(1).concat(s.joints.slice(0, 1));
+j.skins.push(Object.assign({}, s, { joints, name: "turned" }));
+j.nodes.push({ name: "second", mesh: 0, skin: j.skins.length - 1 });
+j.scenes[j.scene || 0].nodes.push(j.nodes.length - 1);'
+"$BIN/mlod-label" -o two-label.glb two.glb 2> two.err
+grep -qxF 'mlod-label: two.glb: mesh 0 primitive 0: 51 vertices have no weight (vertex 0 the first), and the skins that use the mesh have no common root joint: they stay without weight' two.err
+! grep -q "follow the skin's root joint" two.err

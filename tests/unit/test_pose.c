@@ -532,10 +532,10 @@ TEST(fix_weights_rule)
 		sum += w0[8 + i], sum += w1[8 + i];
 	CHECK_NEAR(sum, 1.0, 4e-7);
 	CHECK_NEAR(w1[9], 0.4, 1e-6);
-	/* no root: a vertex without weight stays so */
+	/* no root: a vertex without weight stays so, counted */
 	w0[4] = 0.0f;
 	mlod_primitive_fix_weights(&p, -1, &fix);
-	CHECK(fix.unweighted == 0 && fix.rescaled == 0 && w0[4] == 0.0f);
+	CHECK(fix.unweighted == 1 && fix.first_unweighted == 1 && fix.rescaled == 0 && w0[4] == 0.0f);
 
 	/* the skin's root: of its joints, the one nearest the skeleton's root */
 	mlod_character c;
