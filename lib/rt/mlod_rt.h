@@ -293,8 +293,8 @@ typedef int (*mlod_rt_read_fn)(void *user, uint64_t offset, size_t size, void *d
  * and unchanged until mlod_rt_close. config may be NULL (defaults).
  * Errors: MLOD_ERR_INVALID_ARG, MLOD_ERR_PARSE / MLOD_ERR_UNSUPPORTED from
  * the reader (malformed or newer pack, a corrupt coarse chunk),
- * MLOD_ERR_LIMIT when the coarse levels alone exceed the budget,
- * MLOD_ERR_NOMEM. */
+ * MLOD_ERR_LIMIT when the coarse levels alone exceed the budget (the
+ * budget they need: mlod_rt_open_memory_bytes, below), MLOD_ERR_NOMEM. */
 mlod_result mlod_rt_open_memory(const void *data, size_t size, const mlod_rt_config *config, mlod_rt_ctx **out,
                                 mlod_error *err);
 /* Opens a pack file; the file stays open until mlod_rt_close and is read
@@ -304,6 +304,24 @@ mlod_result mlod_rt_open_path(const char *path, const mlod_rt_config *config, ml
  * stay valid until mlod_rt_close. Adds MLOD_ERR_IO when read fails. */
 mlod_result mlod_rt_open_read(mlod_rt_read_fn read, void *user, uint64_t file_size, const mlod_rt_config *config,
                               mlod_rt_ctx **out, mlod_error *err);
+
+/* The budget an open needs: *bytes is the least budget_bytes with which
+ * the same open (the same source kind: a _path or _read open also holds
+ * the staging buffer, memory does not) succeeds, the resident bytes it
+ * pins (INFO, SKELETON, the coarsest level of each layer and clip, their
+ * tables, the zstd decoder); mlod_rt_stats.open_bytes of the context
+ * that open makes. Costs an open: it opens the pack with no budget
+ * through config's allocator (config's budget_bytes is ignored; NULL:
+ * defaults) and closes it, so *bytes is exact, not a bound from the TOC
+ * (whose sizes are claims until the chunks decode). A caller adds the
+ * room it wants for finer levels (mlod_rt_level_info.bytes once loaded).
+ * Errors: the open's, never MLOD_ERR_LIMIT for the budget; *bytes is 0
+ * on failure. */
+mlod_result mlod_rt_open_memory_bytes(const void *data, size_t size, const mlod_rt_config *config, size_t *bytes,
+                                      mlod_error *err);
+mlod_result mlod_rt_open_path_bytes(const char *path, const mlod_rt_config *config, size_t *bytes, mlod_error *err);
+mlod_result mlod_rt_open_read_bytes(mlod_rt_read_fn read, void *user, uint64_t file_size,
+                                    const mlod_rt_config *config, size_t *bytes, mlod_error *err);
 
 /* Decoded views built by the caller (tests, or a host that decodes
  * itself). Everything is borrowed and must outlive the context. The levels
@@ -357,11 +375,16 @@ typedef struct mlod_rt_level_info {
 	                         loaded it or did not reach it */
 } mlod_rt_level_info;
 
-/* budget_bytes: the configured budget, 0 for no limit (configured 0). */
+/* budget_bytes: the configured budget, 0 for no limit (configured 0).
+ * open_bytes: the resident bytes open pinned (the coarsest levels and the
+ * rest open holds resident until close): the least budget_bytes that
+ * opens this pack from this kind of source (mlod_rt_open_memory_bytes);
+ * budget_bytes - open_bytes is the room finer levels stream into. */
 typedef struct mlod_rt_stats {
 	size_t resident_bytes, budget_bytes, peak_resident_bytes;
 	uint32_t resident_levels, pending_levels; /* pending: wanted, not resident, not failed */
 	uint64_t loads, evictions, failures; /* failures: failed loads */
+	size_t open_bytes;                   /* last: the members before keep their offsets */
 } mlod_rt_stats;
 
 /* Levels of a layer, counting level 0 (motion: per clip). */
