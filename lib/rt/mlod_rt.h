@@ -99,27 +99,32 @@
  * mlod_rt_request asks for it) and decoded only inside
  * mlod_rt_stream(ctx, byte_budget). Resident bytes (the decoded levels plus
  * the runtime's per-level tables, counted from their arrays; a motion
- * level's as the block its reader allocated, moved to a block of its size
- * when the upper bound it was decoded into is loose; the pack's zstd
+ * level's as the block its reader allocated, sized exactly from its
+ * channel records; the pack's zstd
  * decoder, the staging buffer and tables per chunk for a read source)
  * never exceed
  * the budget, not even while a level decodes: before a level's decoded
- * arrays are allocated, stream makes room for them: for a pack's mesh
- * level its exact size (the reader reads the level's part records first,
- * and the room is what those records decode to plus the runtime's
- * tables; remembered, so a level that does not fit is not decoded again
- * until room appears); for other levels an upper bound, before decoding
+ * arrays are allocated, stream makes room for them: for a pack's mesh or
+ * motion level its exact size (the reader reads the level's part or
+ * channel records first, and the room is what those records decode to
+ * plus the runtime's tables; records claiming more than the level's
+ * streams hold size nothing and fail the level, MLOD_ERR_PARSE;
+ * remembered, so a level that does not fit is not decoded again until
+ * room appears); for skeleton levels an upper bound, before decoding
  * (their size for views; 4 x the TOC's raw size plus the runtime's tables
- * for packs). Room is made by evicting resident levels that no instance
- * wanted in the current frame (below), least recently wanted first; it
+ * for packs). The budget an open needs: mlod_rt_open_memory_bytes and
+ * mlod_rt_stats.open_bytes. Room is made by evicting resident levels that
+ * no instance wanted in the current frame (below), least recently wanted
+ * first; it
  * never evicts a level wanted in the current frame nor a coarsest level.
  * A level that cannot fit stays unloaded and is tried again when room
  * appears; meanwhile its wants pass to the finest coarser level of its
  * layer that neither failed nor cannot fit, which loads when absent (an
  * instance close by under a budget too small for mesh level 0 shows the
  * finest level the budget holds, not the coarsest) and, resident, is kept
- * from eviction. (The reader's own scratch while one chunk decodes, and
- * the instance pool, are not counted: the memory the allocator holds
+ * from eviction. (The reader's own scratch while one chunk decodes, a
+ * nested motion level's coarser levels decoded and freed inside its load,
+ * and the instance pool, are not counted: the memory the allocator holds
  * between calls is the resident bytes plus what it held at open beyond
  * them, to a few hundred bytes either way, not exactly: a pack's mesh
  * level's block holds a 32-byte head and its arrays' 8-byte alignment
@@ -127,7 +132,7 @@
  * RobotExpressive; 272 for RobotExpressive's four finer levels), and a
  * level's count includes its descriptor, which the context holds from
  * open (32 bytes a motion level: RobotExpressive streaming its 14 clips
- * under a budget held up to 936 bytes less than it counted), measured
+ * under a budget held up to 584 bytes less than it counted), measured
  * with counting allocator hooks, bench/RESULTS.md Run 15;
  * tests/rt/test_rt_engine.c checks a crowd's frames hold at most 256
  * bytes beyond the count.)
