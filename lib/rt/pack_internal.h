@@ -80,7 +80,9 @@ size_t mlod_pack_block_size(const void *block);
  * uint64_t, so no product or sum can wrap. A decode sizes its one
  * allocation (the block) from the stream headers, whose decoded sizes add
  * up to the TOC's raw size, and refuses one above PACK_MAX_BLOCK before
- * allocating. Meshopt-coded streams are decoded into a temporary buffer
+ * allocating (a MOTION level sizes it exactly from its channel records,
+ * once they are checked, when they are within that bound, and calls
+ * mlod_pack_decode_motion_reserve's reserve with that size first). Meshopt-coded streams are decoded into a temporary buffer
  * (freed before the decode returns); raw streams are read in place.
  * Every allocation is the pack's allocator's (mlod_pack_open_alloc; malloc
  * by default), and a block starts with that allocator, for *_free.
