@@ -99,27 +99,32 @@
  * mlod_rt_request asks for it) and decoded only inside
  * mlod_rt_stream(ctx, byte_budget). Resident bytes (the decoded levels plus
  * the runtime's per-level tables, counted from their arrays; a motion
- * level's as the block its reader allocated, moved to a block of its size
- * when the upper bound it was decoded into is loose; the pack's zstd
+ * level's as the block its reader allocated, sized exactly from its
+ * channel records; the pack's zstd
  * decoder, the staging buffer and tables per chunk for a read source)
  * never exceed
  * the budget, not even while a level decodes: before a level's decoded
- * arrays are allocated, stream makes room for them: for a pack's mesh
- * level its exact size (the reader reads the level's part records first,
- * and the room is what those records decode to plus the runtime's
- * tables; remembered, so a level that does not fit is not decoded again
- * until room appears); for other levels an upper bound, before decoding
+ * arrays are allocated, stream makes room for them: for a pack's mesh or
+ * motion level its exact size (the reader reads the level's part or
+ * channel records first, and the room is what those records decode to
+ * plus the runtime's tables; records claiming more than the level's
+ * streams hold size nothing and fail the level, MLOD_ERR_PARSE;
+ * remembered, so a level that does not fit is not decoded again until
+ * room appears); for skeleton levels an upper bound, before decoding
  * (their size for views; 4 x the TOC's raw size plus the runtime's tables
- * for packs). Room is made by evicting resident levels that no instance
- * wanted in the current frame (below), least recently wanted first; it
+ * for packs). The budget an open needs: mlod_rt_open_memory_bytes and
+ * mlod_rt_stats.open_bytes. Room is made by evicting resident levels that
+ * no instance wanted in the current frame (below), least recently wanted
+ * first; it
  * never evicts a level wanted in the current frame nor a coarsest level.
  * A level that cannot fit stays unloaded and is tried again when room
  * appears; meanwhile its wants pass to the finest coarser level of its
  * layer that neither failed nor cannot fit, which loads when absent (an
  * instance close by under a budget too small for mesh level 0 shows the
  * finest level the budget holds, not the coarsest) and, resident, is kept
- * from eviction. (The reader's own scratch while one chunk decodes, and
- * the instance pool, are not counted: the memory the allocator holds
+ * from eviction. (The reader's own scratch while one chunk decodes, a
+ * nested motion level's coarser levels decoded and freed inside its load,
+ * and the instance pool, are not counted: the memory the allocator holds
  * between calls is the resident bytes plus what it held at open beyond
  * them, to a few hundred bytes either way, not exactly: a pack's mesh
  * level's block holds a 32-byte head and its arrays' 8-byte alignment
@@ -127,7 +132,7 @@
  * RobotExpressive; 272 for RobotExpressive's four finer levels), and a
  * level's count includes its descriptor, which the context holds from
  * open (32 bytes a motion level: RobotExpressive streaming its 14 clips
- * under a budget held up to 936 bytes less than it counted), measured
+ * under a budget held up to 584 bytes less than it counted), measured
  * with counting allocator hooks, bench/RESULTS.md Run 15;
  * tests/rt/test_rt_engine.c checks a crowd's frames hold at most 256
  * bytes beyond the count.)
@@ -293,8 +298,8 @@ typedef int (*mlod_rt_read_fn)(void *user, uint64_t offset, size_t size, void *d
  * and unchanged until mlod_rt_close. config may be NULL (defaults).
  * Errors: MLOD_ERR_INVALID_ARG, MLOD_ERR_PARSE / MLOD_ERR_UNSUPPORTED from
  * the reader (malformed or newer pack, a corrupt coarse chunk),
- * MLOD_ERR_LIMIT when the coarse levels alone exceed the budget,
- * MLOD_ERR_NOMEM. */
+ * MLOD_ERR_LIMIT when the coarse levels alone exceed the budget (the
+ * budget they need: mlod_rt_open_memory_bytes, below), MLOD_ERR_NOMEM. */
 mlod_result mlod_rt_open_memory(const void *data, size_t size, const mlod_rt_config *config, mlod_rt_ctx **out,
                                 mlod_error *err);
 /* Opens a pack file; the file stays open until mlod_rt_close and is read
@@ -304,6 +309,24 @@ mlod_result mlod_rt_open_path(const char *path, const mlod_rt_config *config, ml
  * stay valid until mlod_rt_close. Adds MLOD_ERR_IO when read fails. */
 mlod_result mlod_rt_open_read(mlod_rt_read_fn read, void *user, uint64_t file_size, const mlod_rt_config *config,
                               mlod_rt_ctx **out, mlod_error *err);
+
+/* The budget an open needs: *bytes is the least budget_bytes with which
+ * the same open (the same source kind: a _path or _read open also holds
+ * the staging buffer, memory does not) succeeds, the resident bytes it
+ * pins (INFO, SKELETON, the coarsest level of each layer and clip, their
+ * tables, the zstd decoder); mlod_rt_stats.open_bytes of the context
+ * that open makes. Costs an open: it opens the pack with no budget
+ * through config's allocator (config's budget_bytes is ignored; NULL:
+ * defaults) and closes it, so *bytes is exact, not a bound from the TOC
+ * (whose sizes are claims until the chunks decode). A caller adds the
+ * room it wants for finer levels (mlod_rt_level_info.bytes once loaded).
+ * Errors: the open's, never MLOD_ERR_LIMIT for the budget; *bytes is 0
+ * on failure. */
+mlod_result mlod_rt_open_memory_bytes(const void *data, size_t size, const mlod_rt_config *config, size_t *bytes,
+                                      mlod_error *err);
+mlod_result mlod_rt_open_path_bytes(const char *path, const mlod_rt_config *config, size_t *bytes, mlod_error *err);
+mlod_result mlod_rt_open_read_bytes(mlod_rt_read_fn read, void *user, uint64_t file_size,
+                                    const mlod_rt_config *config, size_t *bytes, mlod_error *err);
 
 /* Decoded views built by the caller (tests, or a host that decodes
  * itself). Everything is borrowed and must outlive the context. The levels
@@ -357,11 +380,16 @@ typedef struct mlod_rt_level_info {
 	                         loaded it or did not reach it */
 } mlod_rt_level_info;
 
-/* budget_bytes: the configured budget, 0 for no limit (configured 0). */
+/* budget_bytes: the configured budget, 0 for no limit (configured 0).
+ * open_bytes: the resident bytes open pinned (the coarsest levels and the
+ * rest open holds resident until close): the least budget_bytes that
+ * opens this pack from this kind of source (mlod_rt_open_memory_bytes);
+ * budget_bytes - open_bytes is the room finer levels stream into. */
 typedef struct mlod_rt_stats {
 	size_t resident_bytes, budget_bytes, peak_resident_bytes;
 	uint32_t resident_levels, pending_levels; /* pending: wanted, not resident, not failed */
 	uint64_t loads, evictions, failures; /* failures: failed loads */
+	size_t open_bytes;                   /* last: the members before keep their offsets */
 } mlod_rt_stats;
 
 /* Levels of a layer, counting level 0 (motion: per clip). */

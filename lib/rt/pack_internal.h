@@ -24,6 +24,22 @@ mlod_result mlod_pack_decode_mesh_reserve(const mlod_pack *p, uint32_t chunk, co
                                           void *reserve_user, const mlod_pack_skeleton *skel, mlod_pack_mesh *out,
                                           mlod_error *err);
 
+/* Called by mlod_pack_decode_motion_reserve once the level's channel
+ * records are read and checked (a nested level's base already decoded:
+ * the caller's), before the decoded level's one block is allocated: the
+ * records (key counts, paths, interpolations, time arrays) give its
+ * arrays exactly, and block_bytes is that block's size, its head included
+ * (mlod_pack_block_size of the level once decoded). A result other than
+ * MLOD_OK stops the decode with that result, before that allocation. */
+typedef mlod_result (*mlod_pack_motion_reserve_fn)(void *user, const mlod_pack_channel_rec *channels,
+                                                   uint32_t channel_count, uint64_t block_bytes, mlod_error *err);
+
+/* mlod_pack_decode_motion_on, calling reserve (may be NULL) as above. */
+mlod_result mlod_pack_decode_motion_reserve(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                            const mlod_pack_skeleton *skel, const mlod_pack_motion *base,
+                                            mlod_pack_motion_reserve_fn reserve, void *reserve_user,
+                                            mlod_pack_motion *out, mlod_error *err);
+
 /* INFO's counts against what the chunks hold (MLOD_ERR_PARSE naming
  * INFO): its joint and skin counts against SKELETON's, its instance count
  * against a decoded MESH level's parts (every level has the same parts)
@@ -64,7 +80,9 @@ size_t mlod_pack_block_size(const void *block);
  * uint64_t, so no product or sum can wrap. A decode sizes its one
  * allocation (the block) from the stream headers, whose decoded sizes add
  * up to the TOC's raw size, and refuses one above PACK_MAX_BLOCK before
- * allocating. Meshopt-coded streams are decoded into a temporary buffer
+ * allocating (a MOTION level sizes it exactly from its channel records,
+ * once they are checked, when they are within that bound, and calls
+ * mlod_pack_decode_motion_reserve's reserve with that size first). Meshopt-coded streams are decoded into a temporary buffer
  * (freed before the decode returns); raw streams are read in place.
  * Every allocation is the pack's allocator's (mlod_pack_open_alloc; malloc
  * by default), and a block starts with that allocator, for *_free.

@@ -102,6 +102,14 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
                                        const mlod_pack_skeleton *skel, const mlod_pack_motion *base,
                                        mlod_pack_motion *out, mlod_error *err)
 {
+	return mlod_pack_decode_motion_reserve(p, chunk, data, size, skel, base, NULL, NULL, out, err);
+}
+
+mlod_result mlod_pack_decode_motion_reserve(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                            const mlod_pack_skeleton *skel, const mlod_pack_motion *base,
+                                            mlod_pack_motion_reserve_fn reserve, void *reserve_user,
+                                            mlod_pack_motion *out, mlod_error *err)
+{
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_motion: out is NULL");
 	memset(out, 0, sizeof *out);
@@ -121,9 +129,11 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	stream sc, sstep;
 	TRY(pk_cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
 	TRY(pk_cx_expect(&x, &sstep, MLOD_STREAM_STEP, 8, 1, "", "one step", err));
-	/* each channel's values are taken on their own: up to 8 bytes of
-	 * rounding each */
-	uint64_t C = sc.count, total = round8(C * sizeof(mlod_pack_channel)) + 8 * C;
+	/* An upper bound of the block from the stream headers alone: what
+	 * the channel records may claim (below) before the block is sized
+	 * from them. Each channel's values are taken on their own: up to 8
+	 * bytes of rounding each. */
+	uint64_t C = sc.count, bound = round8(C * sizeof(mlod_pack_channel)) + 8 * C;
 	while (cx_next(&x, &s)) {
 		/* 'TBIT': each key but an array's first takes a bit at least */
 		uint64_t per = s.tag == MLOD_STREAM_TBIT                                 ? 4 * 32
@@ -133,26 +143,25 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 		                                                                          : 0;
 		if (!per)
 			FAIL("%s: stream %u is '%s', not a motion stream", x.label, s.index, tagn(s.tag).s);
-		total += round8(per * s.count);
+		bound += round8(per * s.count);
 	}
-	/* the time arrays: a pointer and a count per array, at most one per
-	 * channel */
-	total += round8(C * sizeof(float *)) + round8(C * 4);
 	cx_rewind(&x);
-	/* aux: one byte per joint and path, to find a second channel. */
-	TRY(pk_cx_temp(&x, (uint64_t)J * 3, err));
-	TRY(pk_bump_alloc(&b, &x, total, err));
+	/* Scratch: one byte per joint and path (to find a second channel),
+	 * the channel records, and each time array's key count and keys, so
+	 * that the records are checked and the block sized from them before
+	 * it is allocated. */
+	const uint64_t a_seen = round8((uint64_t)J * 3), a_recs = round8(C * sizeof(mlod_pack_channel_rec)),
+	               a_count = round8(C * 4);
+	TRY(pk_cx_temp(&x, a_seen + a_recs + a_count + C * sizeof(float *), err));
 	uint8_t *seen = x.temp;
+	mlod_pack_channel_rec *recs = x.temp ? (mlod_pack_channel_rec *)(void *)(x.temp + a_seen) : NULL;
+	uint32_t *tcount = x.temp ? (uint32_t *)(void *)(x.temp + a_seen + a_recs) : NULL;
+	const float **tarr = x.temp ? (const float **)(void *)(x.temp + a_seen + a_recs + a_count) : NULL;
 	mlod_pack_channel *chans;
-	const float **tarr;
-	uint32_t *tcount;
-	TAKE(chans, C * sizeof *chans);
-	TAKE(tarr, C * sizeof *tarr);
-	TAKE(tcount, C * sizeof *tcount);
 	TRY(pk_cx_expect(&x, &sc, MLOD_STREAM_CHAN, sizeof(mlod_pack_channel_rec), UINT64_MAX, "", "", err));
 	TRY(pk_cx_load(&x, &sc, &src, err));
-	for (uint64_t i = 0; i < C; i++)
-		memcpy(&chans[i].rec, src + i * sizeof(mlod_pack_channel_rec), sizeof(mlod_pack_channel_rec));
+	if (C)
+		memcpy(recs, src, (size_t)C * sizeof *recs);
 	TRY(pk_cx_expect(&x, &sstep, MLOD_STREAM_STEP, 8, 1, "", "one step", err));
 	TRY(pk_cx_load(&x, &sstep, &src, err));
 	double step;
@@ -164,10 +173,11 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 		FAIL("%s: step %g is not finite and >= 0", x.label, step);
 	float duration = 0;
 	static const char *const path_names[3] = {"translation", "rotation", "scale"};
-	/* The channels; the time arrays' counts, in first-use order. */
-	uint64_t T = 0, nt = 0, nq = 0, nf = 0, nv = 0;
+	/* The channels; the time arrays' counts, in first-use order; the
+	 * values' bytes, each channel's array on its own. */
+	uint64_t T = 0, nt = 0, nq = 0, nf = 0, nv = 0, vbytes = 0;
 	for (uint32_t i = 0; i < C; i++) {
-		const mlod_pack_channel_rec *rc = &chans[i].rec;
+		const mlod_pack_channel_rec *rc = &recs[i];
 		uint32_t K = rc->key_count;
 		if (rc->joint >= J)
 			FAIL("%s: channel %u: joint %u is not below the skeleton's %u joints", x.label, i, rc->joint, J);
@@ -196,6 +206,7 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 			nf += 3 * (uint64_t)K;
 		else
 			nv += m * K;
+		vbytes += round8((rc->path == 1 ? 16 : 12) * m * K);
 	}
 	/* The key times: one stream, the arrays one after the other. */
 	if (!cx_next(&x, &s))
@@ -211,6 +222,19 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 		     tagn(s.tag).s, s.count, s.tag == MLOD_STREAM_TBIT ? "at least " : "",
 		     (unsigned long long)(s.tag == MLOD_STREAM_TBIT ? T : nt),
 		     s.tag == MLOD_STREAM_TBIT ? "first ticks" : "keys");
+	/* The block, exactly: the channels, the key times, the values. A pack
+	 * whose streams hold them is within the bound (each value and time an
+	 * element of its stream, a 'TBIT' element 32 keys at most), so records
+	 * claiming more are corrupt: they size nothing, the block is the
+	 * bound's (as a pack's claims cannot make it larger than its streams),
+	 * and the decode fails below where a stream falls short, saying which. */
+	const uint64_t total = round8(C * sizeof(mlod_pack_channel)) + round8(nt * 4) + vbytes;
+	if (reserve && total <= bound)
+		TRY(reserve(reserve_user, recs, (uint32_t)C, BLOCK_HEAD + total, err));
+	TRY(pk_bump_alloc(&b, &x, total <= bound ? total : bound, err));
+	TAKE(chans, C * sizeof *chans);
+	for (uint64_t i = 0; i < C; i++)
+		chans[i].rec = recs[i];
 	TRY(pk_cx_load(&x, &s, &src, err));
 	float *all;
 	TAKE(all, nt * 4);
@@ -404,24 +428,6 @@ mlod_result mlod_pack_decode_motion_on(const mlod_pack *p, uint32_t chunk, const
 	}
 	TRY(pk_cx_end(&x, err));
 	pk_cx_done(&x);
-	/* The block was sized by an upper bound ('TBIT': 32 keys a word): when
-	 * more than an eighth of it is unused, the level moves to a block of
-	 * its size (tubeman's motion level 1: 109,736 bytes before), its
-	 * pointers moved with it; without memory for that it stays. */
-	if (b.cap - b.used > b.cap / 8) {
-		uint8_t *nb = pk_malloc(&x.alloc, 1, (size_t)b.used);
-		if (nb) {
-			memcpy(nb, b.base, (size_t)b.used);
-			memcpy(nb + BLOCK_SIZE_AT, &b.used, sizeof b.used);
-			chans = moved(&b, nb, chans);
-			for (uint64_t i = 0; i < C; i++) {
-				chans[i].times = moved(&b, nb, chans[i].times);
-				chans[i].values = moved(&b, nb, chans[i].values);
-			}
-			pk_free(&x.alloc, b.base);
-			b.base = nb;
-		}
-	}
 	out->channel_count = (uint32_t)C;
 	out->channels = chans;
 	out->duration = duration;

@@ -37,8 +37,9 @@ typedef struct rt_unit {
 	uint32_t stored_size, raw_size;
 	float error, distance;
 	size_t bytes;             /* counted while resident */
-	size_t need;              /* a pack's mesh level: its resident bytes, from its part
-	                           * records (rt_mesh_reserve); 0 until a load read them */
+	size_t need;              /* a pack's mesh or motion level: its resident bytes, from its
+	                           * part or channel records (rt_mesh_reserve,
+	                           * rt_motion_reserve); 0 until a load read them */
 	uint64_t last_wanted;     /* the update stamp */
 	uint32_t want_count;      /* instances wanting it at the last update */
 	uint32_t users;           /* instances showing it */
@@ -163,6 +164,7 @@ struct mlod_rt_ctx {
 	uint32_t unit_base[MLOD_RT_LAYERS];
 	/* Cache. */
 	size_t resident_bytes, peak_bytes;
+	size_t open_bytes;        /* resident_bytes when open had loaded what it pins */
 	uint64_t stamp;
 	int streamed;             /* mlod_rt_stream ran since the last update or request:
 	                           * the next one starts a new frame's wants (rt_begin_frame) */
@@ -279,6 +281,10 @@ void rt_want(mlod_rt_ctx *ctx, rt_unit *u, uint32_t n);
  * mlod_rt_stream does) or refuses with MLOD_ERR_LIMIT and ctx->refused
  * set. */
 mlod_result rt_mesh_reserve(void *user, const mlod_pack_part_rec *parts, uint32_t part_count, mlod_error *err);
+/* The same for a motion level's load (its channel records and its block's
+ * size, mlod_pack_motion_reserve_fn). */
+mlod_result rt_motion_reserve(void *user, const mlod_pack_channel_rec *channels, uint32_t channel_count,
+                              uint64_t block_bytes, mlod_error *err);
 /* Byte counts of decoded views (from their arrays). */
 size_t rt_bytes_skel_level(const mlod_pack_skel_level *l);
 size_t rt_bytes_mesh(const mlod_pack_mesh *m);

@@ -71,8 +71,8 @@ size_t rt_bytes_mesh(const mlod_pack_mesh *m)
 
 size_t rt_bytes_motion(const mlod_pack_motion *m)
 {
-	/* A decoded level's block is sized by an upper bound from its stream
-	 * headers (lib/rt/rd_motion.c): what it holds is counted when it is all. */
+	/* A decoded level's block is sized exactly from its channel records
+	 * (lib/rt/rd_motion.c), its head included: counted as allocated. */
 	if (m->block)
 		return sizeof *m + mlod_pack_block_size(m->block);
 	size_t b = sizeof *m;
@@ -232,6 +232,53 @@ mlod_result rt_mesh_reserve(void *user, const mlod_pack_part_rec *parts, uint32_
 	                 u->need);
 }
 
+/* rt_prepare_motion's tables for a level of these channel records
+ * (checked by the reader: joints below the skeleton's), counted as it
+ * counts them: A, the channels of joints with a channel of more than one
+ * key, and S, the joints whose channels all have one key. SIZE_MAX when
+ * its flags cannot be allocated. */
+static size_t motion_plan_recs(mlod_rt_ctx *ctx, const mlod_pack_channel_rec *c, uint32_t n)
+{
+	const uint32_t J = ctx->joint_count;
+	/* [j]: has a channel (2 once counted); [J + j]: one of more than one key */
+	uint8_t *mark = rt_calloc(ctx, (size_t)J + 1, 2);
+	if (!mark)
+		return SIZE_MAX;
+	uint32_t A = 0, S = 0;
+	for (uint32_t i = 0; i < n; i++)
+		if (c[i].joint < J) {
+			mark[c[i].joint] = 1;
+			if (c[i].key_count > 1)
+				mark[J + c[i].joint] = 1;
+		}
+	for (uint32_t i = 0; i < n; i++)
+		if (c[i].joint < J) {
+			A += mark[J + c[i].joint];
+			if (mark[c[i].joint] == 1)
+				S += !mark[J + c[i].joint], mark[c[i].joint] = 2;
+		}
+	rt_free(ctx, mark);
+	return rt_motion_plan_bytes(J, A, S);
+}
+
+mlod_result rt_motion_reserve(void *user, const mlod_pack_channel_rec *channels, uint32_t channel_count,
+                              uint64_t block_bytes, mlod_error *err)
+{
+	mlod_rt_ctx *ctx = user;
+	rt_unit *u = ctx->loading;
+	if (!u)
+		return MLOD_OK;
+	const size_t plan = motion_plan_recs(ctx, channels, channel_count);
+	if (plan == SIZE_MAX || block_bytes > SIZE_MAX - sizeof(mlod_pack_motion) - plan)
+		return mlod_fail(err, MLOD_ERR_NOMEM, "motion level %u of clip %u: out of memory", u->level, u->item);
+	u->need = sizeof(mlod_pack_motion) + (size_t)block_bytes + plan;
+	if (!ctx->streaming || make_room(ctx, u->need) == 0)
+		return MLOD_OK;
+	ctx->refused = 1;
+	return mlod_fail(err, MLOD_ERR_LIMIT, "motion level %u of clip %u: its %zu decoded bytes do not fit the budget",
+	                 u->level, u->item, u->need);
+}
+
 /* rt_motion_plan_bytes of a motion level's views, bounding its joints with
  * one-key channels only by the joints and by its one-key channels. */
 static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m)
@@ -245,15 +292,17 @@ static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m
 
 /* An upper bound of a unit's resident size before loading it, so that
  * room is made before decoding and resident bytes never pass the budget,
- * not even while a level decodes. Views know their size. A pack's mesh
- * level: its exact size once a load has read its part records (u->need),
- * else 0, as the reader calls rt_mesh_reserve with those records before
- * it allocates the decoded level, and room is made then. Other levels of
- * packs: dequantising at most quadruples a stream (unorm8 weights and
- * colours become floats; positions and normals grow less), the decoded
- * structs at most double their records, and the alignment of each stream
- * costs less than 4 times its 16-byte header; plus the skeleton level's
- * tables or the motion level's. */
+ * not even while a level decodes. Views know their size. A pack's mesh or
+ * motion level: its exact size once a load has read its part or channel
+ * records (u->need), else 0, as the reader calls rt_mesh_reserve or
+ * rt_motion_reserve with those records before it allocates the decoded
+ * level, and room is made then (a nested motion level's coarser levels,
+ * decoded and freed inside its load, are the reader's scratch, not
+ * counted, as a mesh level's coarser vertex blocks are). Skeleton levels
+ * of packs: dequantising at most quadruples a stream, the decoded structs
+ * at most double their records, and the alignment of each stream costs
+ * less than 4 times its 16-byte header; plus the skeleton level's
+ * tables. */
 static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 {
 	size_t plan = u->layer == MLOD_RT_SKELETON ? (size_t)ctx->joint_count * (4 + 1 + 4 + 64)
@@ -274,22 +323,9 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 			}
 		return 0;
 	}
-	if (u->layer == MLOD_RT_MESH)
+	if (u->layer != MLOD_RT_SKELETON)
 		return u->need;
-	size_t hint = 4 * (size_t)u->raw_size + 256 + plan;
-	/* A nested motion level decodes the coarser ones it builds on (rt_pack.c
-	 * motion_load), each freed before it returns; at most two at a time,
-	 * counted here as all of them. */
-	for (const rt_unit *v = u; v && v->chunk >= 0 && (ctx->pack.chunks[v->chunk].flags & MLOD_PACK_CHUNK_NESTED);) {
-		if (!(v = rt_unit_at(ctx, MLOD_RT_MOTION, (uint32_t)v->level + 1, v->item)))
-			break;
-		hint += 4 * (size_t)v->raw_size + 256;
-	}
-	/* A motion level's tables: its channels (decoded, counted in the hint
-	 * so far at sizeof(mlod_pack_channel) each) are at most hint / that. */
-	if (u->layer == MLOD_RT_MOTION)
-		hint += rt_motion_plan_bytes(ctx->joint_count, 0, ctx->joint_count) + 4 * (hint / sizeof(mlod_pack_channel));
-	return hint;
+	return 4 * (size_t)u->raw_size + 256 + plan;
 }
 
 /* ---------------------------------------------------------------- */

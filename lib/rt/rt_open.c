@@ -189,6 +189,7 @@ mlod_result rt_ctx_finish_open(mlod_rt_ctx *ctx, mlod_error *err)
 	mlod_result mr = morph_setup(ctx, err);
 	if (mr)
 		return mr;
+	ctx->open_bytes = ctx->resident_bytes; /* mlod_rt_stats.open_bytes, mlod_rt_open_*_bytes */
 	if (ctx->resident_bytes > ctx->budget)
 		return mlod_fail(err, MLOD_ERR_LIMIT,
 		                 "the coarse levels need %zu bytes, more than the budget of %zu bytes",

@@ -118,7 +118,9 @@ static mlod_result fetch_chunk(void *user, uint32_t chunk, const void **bytes, m
  * builds on the clip's next coarser level, as the reader returns it: the
  * chain of levels it builds on is decoded here, from the first that is
  * not nested, and freed again (a resident level's keys may have been
- * normalised: rt_prepare_motion). */
+ * normalised: rt_prepare_motion). The level itself is decoded last, with
+ * rt_motion_reserve, which makes room for it before its block is
+ * allocated. */
 static mlod_result motion_load(mlod_rt_ctx *ctx, uint32_t chunk, mlod_pack_motion *out, mlod_error *err)
 {
 	const mlod_pack_chunk *c = &ctx->pack.chunks[chunk];
@@ -145,7 +147,8 @@ static mlod_result motion_load(mlod_rt_ctx *ctx, uint32_t chunk, mlod_pack_motio
 		mlod_pack shadow;
 		mlod_pack_motion *dst = l == c->level ? out : &tmp[l & 1];
 		if ((r = chunk_bytes(ctx, (uint32_t)k, &p, &data, &size, &shadow, err)) == MLOD_OK)
-			r = mlod_pack_decode_motion_on(p, (uint32_t)k, data, size, ctx->skel, base, dst, err);
+			r = mlod_pack_decode_motion_reserve(p, (uint32_t)k, data, size, ctx->skel, base,
+			                                    l == c->level ? rt_motion_reserve : NULL, ctx, dst, err);
 		mlod_pack_motion_free(&tmp[!(l & 1)]);
 		base = dst;
 	}
@@ -169,8 +172,13 @@ static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 		return r;
 	}
 	if (u->layer == MLOD_RT_MOTION) {
+		/* The same for a motion level's channel records (the coarser
+		 * levels it builds on, decoded first, are scratch). */
 		memset(&u->dec, 0, sizeof u->dec);
-		return motion_load(ctx, (uint32_t)u->chunk, &u->dec.motion, err);
+		ctx->loading = u;
+		mlod_result r = motion_load(ctx, (uint32_t)u->chunk, &u->dec.motion, err);
+		ctx->loading = NULL;
+		return r;
 	}
 	const mlod_pack *p;
 	const void *data;
@@ -455,4 +463,64 @@ mlod_result mlod_rt_open_path(const char *path, const mlod_rt_config *config, ml
 	}
 	*out = ctx;
 	return MLOD_OK;
+}
+
+/* ---------------------------------------------------------------- */
+/* The budget an open needs                                          */
+/* ---------------------------------------------------------------- */
+
+/* config with no budget (a copy; the defaults for NULL). */
+static mlod_rt_config unlimited(const mlod_rt_config *config)
+{
+	mlod_rt_config c = { 0, 0, NULL };
+	if (config)
+		c = *config;
+	c.budget_bytes = 0;
+	return c;
+}
+
+/* The opened ctx's open_bytes into *bytes, and ctx closed (r: the open's
+ * result, taken before ctx is read: an argument's order is unspecified). */
+static mlod_result open_bytes(mlod_result r, mlod_rt_ctx *ctx, size_t *bytes)
+{
+	if (r == MLOD_OK) {
+		*bytes = ctx->open_bytes;
+		mlod_rt_close(ctx);
+	}
+	return r;
+}
+
+mlod_result mlod_rt_open_memory_bytes(const void *data, size_t size, const mlod_rt_config *config, size_t *bytes,
+                                      mlod_error *err)
+{
+	if (!bytes)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_memory_bytes: NULL argument");
+	*bytes = 0;
+	const mlod_rt_config c = unlimited(config);
+	mlod_rt_ctx *ctx = NULL;
+	const mlod_result r = mlod_rt_open_memory(data, size, &c, &ctx, err);
+	return open_bytes(r, ctx, bytes);
+}
+
+mlod_result mlod_rt_open_path_bytes(const char *path, const mlod_rt_config *config, size_t *bytes, mlod_error *err)
+{
+	if (!bytes)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_path_bytes: NULL argument");
+	*bytes = 0;
+	const mlod_rt_config c = unlimited(config);
+	mlod_rt_ctx *ctx = NULL;
+	const mlod_result r = mlod_rt_open_path(path, &c, &ctx, err);
+	return open_bytes(r, ctx, bytes);
+}
+
+mlod_result mlod_rt_open_read_bytes(mlod_rt_read_fn read, void *user, uint64_t file_size,
+                                    const mlod_rt_config *config, size_t *bytes, mlod_error *err)
+{
+	if (!bytes)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_open_read_bytes: NULL argument");
+	*bytes = 0;
+	const mlod_rt_config c = unlimited(config);
+	mlod_rt_ctx *ctx = NULL;
+	const mlod_result r = mlod_rt_open_read(read, user, file_size, &c, &ctx, err);
+	return open_bytes(r, ctx, bytes);
 }

@@ -194,6 +194,7 @@ void mlod_rt_stats_get(const mlod_rt_ctx *ctx, mlod_rt_stats *out)
 	out->resident_bytes = ctx->resident_bytes;
 	out->budget_bytes = ctx->budget == SIZE_MAX ? 0 : ctx->budget; /* 0: no limit, as configured */
 	out->peak_resident_bytes = ctx->peak_bytes;
+	out->open_bytes = ctx->open_bytes;
 	out->loads = ctx->loads;
 	out->evictions = ctx->evictions;
 	out->failures = ctx->failures;
