@@ -133,7 +133,7 @@
  * level's count includes its descriptor, which the context holds from
  * open (32 bytes a motion level: RobotExpressive streaming its 14 clips
  * under a budget held up to 584 bytes less than it counted), measured
- * with counting allocator hooks, bench/RESULTS.md Run 15;
+ * with counting allocator hooks, bench/RESULTS.md Runs 104 and 107;
  * tests/rt/test_rt_engine.c checks a crowd's frames hold at most 256
  * bytes beyond the count.)
  *
@@ -374,7 +374,10 @@ typedef struct mlod_rt_level_info {
 	uint32_t users;       /* instances showing it at the last update */
 	int no_room;          /* 1 when the last mlod_rt_stream wanted it but found no
 	                         room for it within budget_bytes, even after evicting
-	                         every level the frame does not want: it stays
+	                         every level the frame does not want (the room a
+	                         mesh or motion level decodes to, exactly; for a
+	                         skeleton level, an upper bound from its raw
+	                         size, so it may say so of one that would fit): it stays
 	                         unloaded and its wants passed to a coarser level
 	                         (Resident-level cache, above); 0 once that call
 	                         loaded it or did not reach it */

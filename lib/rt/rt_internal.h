@@ -341,7 +341,7 @@ void rt_skin_lbs_ordered(size_t n, const float *positions, const float *normals,
  * instance at every update (resolve_layer, rt_want_target): they were one
  * file with rt_unit_get, which the compiler inlined there. The other
  * files call rt_unit_get, as they did: inlined into rt_eval.c, it made
- * mlod_rt_pose 0.4% costlier under callgrind (bench_bounds, Run 15). */
+ * mlod_rt_pose 0.4% costlier under callgrind (bench_bounds, Run 101). */
 static inline rt_unit *rt_unit_at(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item)
 {
 	if ((unsigned)layer >= MLOD_RT_LAYERS || level >= ctx->levels[layer])

@@ -16,6 +16,7 @@
 #define RT_TEST_H
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,6 +58,43 @@ static char t_msg_[1024];
 #define M_PI 3.14159265358979323846
 #endif
 #define NEAR(a, b, tol) (fabs((double)(a) - (double)(b)) <= (tol))
+
+/* Allocator hooks (mlod_rt_allocator, user = an rt_counter) that count
+ * the bytes and blocks they hold and can be told to fail: held is what
+ * is live, mallocs every allocation asked for, fail_after the
+ * allocations left before the hooks return NULL (-1: never). */
+typedef struct rt_counter {
+	size_t held;
+	size_t mallocs;
+	long fail_after;
+} rt_counter;
+typedef struct rt_counter_head {
+	size_t size;
+	max_align_t pad; /* the block after it aligned as malloc's */
+} rt_counter_head;
+static inline void *rt_counter_malloc(void *user, size_t size)
+{
+	rt_counter *c = user;
+	c->mallocs++;
+	if (c->fail_after == 0)
+		return NULL;
+	if (c->fail_after > 0)
+		c->fail_after--;
+	rt_counter_head *h = malloc(sizeof *h + size);
+	if (!h)
+		return NULL;
+	h->size = size;
+	c->held += size;
+	return h + 1;
+}
+static inline void rt_counter_free(void *user, void *p)
+{
+	if (!p)
+		return;
+	rt_counter_head *h = (rt_counter_head *)p - 1;
+	((rt_counter *)user)->held -= h->size;
+	free(h);
+}
 
 /* ---------------------------------------------------------------- */
 /* The hand-built character                                          */

@@ -86,6 +86,24 @@ TEST(wants_of_every_batch)
 	mlod_rt_close(ctx);
 }
 
+/* The robot opened under a 400,000-byte budget, which cannot hold mesh
+ * level 0, and one instance at 3 units streamed for 5 frames by pixels
+ * (the two fallback tests below). */
+static void robot_near_under_budget(mlod_rt_ctx **ctx, uint32_t *id)
+{
+	CHECK(packs_ready(), "mlod-pack failed");
+	mlod_error e = { 0 };
+	mlod_rt_config cfg = { 400000, 16, NULL };
+	CHECK_OK(mlod_rt_open_memory(robot, robot_size, &cfg, ctx, &e), e);
+	CHECK_OK(mlod_rt_instance_create(*ctx, 0, 0, MLOD_RT_LOOP, id, &e), e);
+	const mlod_rt_select sel = pixels();
+	const float d = 3.0f;
+	for (int f = 0; f < 5; f++) {
+		CHECK_OK(mlod_rt_update(*ctx, &sel, id, &d, 1, 1.0f / 60, &e), e);
+		CHECK_OK(mlod_rt_stream(*ctx, SIZE_MAX, NULL, &e), e);
+	}
+}
+
 /* A budget that cannot hold mesh level 0 (robot: 400,000 bytes) with an
  * instance at 3 units: level 0 and 1 never fit, level 2 does and is
  * shown, where before the instance showed the coarsest level (4, 27% of
@@ -93,19 +111,12 @@ TEST(wants_of_every_batch)
 TEST(fallback_the_finest_that_fits)
 {
 	SKIP_IF_NO_PACK(fallback_the_finest_that_fits);
-	CHECK(packs_ready(), "mlod-pack failed");
 	mlod_error e = { 0 };
 	mlod_rt_ctx *ctx = NULL;
-	mlod_rt_config cfg = { 400000, 16, NULL };
-	CHECK_OK(mlod_rt_open_memory(robot, robot_size, &cfg, &ctx, &e), e);
 	uint32_t id;
-	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, MLOD_RT_LOOP, &id, &e), e);
-	const mlod_rt_select sel = pixels();
-	const float d = 3.0f;
-	for (int f = 0; f < 5; f++) {
-		CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 60, &e), e);
-		CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
-	}
+	robot_near_under_budget(&ctx, &id);
+	if (t_failed_)
+		return;
 	const mlod_rt_state *st = mlod_rt_instance_state(ctx, id);
 	const uint32_t L = mlod_rt_level_count(ctx, MLOD_RT_MESH);
 	uint32_t finest = L - 1; /* the finest resident level, which must be the one shown */
@@ -139,19 +150,12 @@ TEST(fallback_the_finest_that_fits)
 TEST(fallback_says_why)
 {
 	SKIP_IF_NO_PACK(fallback_says_why);
-	CHECK(packs_ready(), "mlod-pack failed");
 	mlod_error e = { 0 };
 	mlod_rt_ctx *ctx = NULL;
-	mlod_rt_config cfg = { 400000, 16, NULL };
-	CHECK_OK(mlod_rt_open_memory(robot, robot_size, &cfg, &ctx, &e), e);
 	uint32_t id;
-	CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, MLOD_RT_LOOP, &id, &e), e);
-	const mlod_rt_select sel = pixels();
-	const float d = 3.0f;
-	for (int f = 0; f < 5; f++) {
-		CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 60, &e), e);
-		CHECK_OK(mlod_rt_stream(ctx, SIZE_MAX, NULL, &e), e);
-	}
+	robot_near_under_budget(&ctx, &id);
+	if (t_failed_)
+		return;
 	const mlod_rt_state *st = mlod_rt_instance_state(ctx, id);
 	const uint32_t shown = st->level[MLOD_RT_MESH];
 	CHECK(st->wanted[MLOD_RT_MESH] == 0 && shown > 0 && (st->fallback & (1u << MLOD_RT_MESH)),
@@ -164,6 +168,8 @@ TEST(fallback_says_why)
 		      li.resident);
 	}
 	/* the next call says only what it found: byte_budget 0 reaches no level */
+	const mlod_rt_select sel = pixels();
+	const float d = 3.0f;
 	CHECK_OK(mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 60, &e), e);
 	CHECK_OK(mlod_rt_stream(ctx, 0, NULL, &e), e);
 	mlod_rt_level_info li;
@@ -243,29 +249,9 @@ TEST(misread_tried_again)
 	mlod_rt_close(ctx);
 }
 
-/* Every live allocation, by size (a header before each block). */
-static size_t live, open_live, mallocs;
-static void *counting_malloc(void *user, size_t n)
-{
-	(void)user;
-	mallocs++;
-	size_t *p = malloc(n + 16);
-	if (!p)
-		return NULL;
-	p[0] = n;
-	live += n;
-	return (char *)p + 16;
-}
-
-static void counting_free(void *user, void *q)
-{
-	(void)user;
-	if (!q)
-		return;
-	size_t *p = (size_t *)((char *)q - 16);
-	live -= p[0];
-	free(p);
-}
+/* What the hooks hold (rt_test.h's counting allocator). */
+static rt_counter cnt = { 0, 0, -1 };
+static size_t open_live;
 
 /* Under budgets from tight to ample, 32 instances walking through every
  * distance: after each mlod_rt_stream, what the hooks hold beyond what
@@ -278,7 +264,7 @@ TEST(held_memory_is_counted)
 {
 	SKIP_IF_NO_PACK(held_memory_is_counted);
 	CHECK(packs_ready(), "mlod-pack failed");
-	mlod_rt_allocator a = { counting_malloc, counting_free, NULL };
+	mlod_rt_allocator a = { rt_counter_malloc, rt_counter_free, &cnt };
 	const struct { const uint8_t *d; size_t n; const char *name; } packs[] = { { robot, robot_size, "robot" },
 		                                                                     { tube, tube_size, "tubeman" } };
 	const size_t budgets[] = { 300000, 500000, 0 };
@@ -287,11 +273,11 @@ TEST(held_memory_is_counted)
 			mlod_rt_config cfg = { budgets[b], 32, &a };
 			mlod_error e = { 0 };
 			mlod_rt_ctx *ctx = NULL;
-			live = 0;
+			cnt.held = 0;
 			CHECK_OK(mlod_rt_open_memory(packs[p].d, packs[p].n, &cfg, &ctx, &e), e);
 			mlod_rt_stats s;
 			mlod_rt_stats_get(ctx, &s);
-			open_live = live - s.resident_bytes; /* the instance pool and what else is not a level */
+			open_live = cnt.held - s.resident_bytes; /* the instance pool and what else is not a level */
 			uint32_t ids[32];
 			float d[32];
 			const uint32_t clips = mlod_rt_clip_count(ctx) ? mlod_rt_clip_count(ctx) : 1;
@@ -305,16 +291,16 @@ TEST(held_memory_is_counted)
 				CHECK_OK(mlod_rt_update(ctx, &sel, ids, d, 32, 1.0f / 60, &e), e);
 				mlod_rt_stream(ctx, 32768, NULL, &e);
 				mlod_rt_stats_get(ctx, &s);
-				const long over = (long)(live - open_live) - (long)s.resident_bytes;
+				const long over = (long)(cnt.held - open_live) - (long)s.resident_bytes;
 				worst = over > worst ? over : worst;
 				if (budgets[b])
-					CHECK(live - open_live <= budgets[b] + 256, "%s, budget %zu, frame %d: %zu held", packs[p].name,
-					      budgets[b], f, live - open_live);
+					CHECK(cnt.held - open_live <= budgets[b] + 256, "%s, budget %zu, frame %d: %zu held", packs[p].name,
+					      budgets[b], f, cnt.held - open_live);
 			}
 			CHECK(worst <= 256, "%s, budget %zu: %ld bytes held beyond the resident bytes reported", packs[p].name,
 			      budgets[b], worst);
 			mlod_rt_close(ctx);
-			CHECK(live == 0, "%s: %zu bytes left after close", packs[p].name, live);
+			CHECK(cnt.held == 0, "%s: %zu bytes left after close", packs[p].name, cnt.held);
 		}
 }
 
@@ -511,14 +497,14 @@ TEST(info_calls_allocate_nothing)
 {
 	SKIP_IF_NO_PACK(info_calls_allocate_nothing);
 	CHECK(packs_ready(), "mlod-pack failed");
-	mlod_rt_allocator a = { counting_malloc, counting_free, NULL };
+	mlod_rt_allocator a = { rt_counter_malloc, rt_counter_free, &cnt };
 	const struct { const uint8_t *d; size_t n; const char *name; } packs[] = { { robot, robot_size, "robot" },
 		                                                                     { tube, tube_size, "tubeman" } };
 	for (size_t p = 0; p < 2; p++) {
 		mlod_rt_config cfg = { 0, 4, &a };
 		mlod_error e = { 0 };
 		mlod_rt_ctx *ctx = NULL;
-		live = 0;
+		cnt.held = 0;
 		CHECK_OK(mlod_rt_open_memory(packs[p].d, packs[p].n, &cfg, &ctx, &e), e);
 		for (int layer = 0; layer < MLOD_RT_LAYERS; layer++)
 			for (uint32_t l = 0; l < mlod_rt_level_count(ctx, (mlod_rt_layer)layer); l++)
@@ -530,7 +516,7 @@ TEST(info_calls_allocate_nothing)
 		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0.3f, MLOD_RT_LOOP, &id, &e), e);
 		mlod_rt_select sel;
 		mlod_rt_select_default(&sel);
-		const size_t before = mallocs;
+		const size_t before = cnt.mallocs;
 		size_t names = 0;
 		for (int round = 0; round < 2; round++)
 			for (uint32_t l = 0; l < mlod_rt_level_count(ctx, MLOD_RT_MESH); l++) {
@@ -559,12 +545,12 @@ TEST(info_calls_allocate_nothing)
 				CHECK_OK(mlod_rt_bounds(ctx, s, id, mn, mx, &e), e);
 				CHECK(mn[0] <= mx[0] && mn[1] <= mx[1] && mn[2] <= mx[2], "%s: empty box", packs[p].name);
 			}
-		CHECK(mallocs == before, "%s: %zu allocations by the names, hierarchy and bounds calls", packs[p].name,
-		      mallocs - before);
+		CHECK(cnt.mallocs == before, "%s: %zu allocations by the names, hierarchy and bounds calls", packs[p].name,
+		      cnt.mallocs - before);
 		(void)names;
 		mlod_rt_scratch_destroy(ctx, s);
 		mlod_rt_close(ctx);
-		CHECK(live == 0, "%s: %zu bytes left after close", packs[p].name, live);
+		CHECK(cnt.held == 0, "%s: %zu bytes left after close", packs[p].name, cnt.held);
 	}
 }
 

@@ -55,38 +55,6 @@ static int packs_ready(void)
 	return 1;
 }
 
-/* Allocator hooks that count what they hold and can fail. */
-typedef struct counter {
-	size_t held;
-	long fail_after; /* allocations left before failing; -1: never */
-} counter;
-typedef struct head {
-	size_t size;
-	max_align_t pad;
-} head;
-static void *c_malloc(void *user, size_t size)
-{
-	counter *c = user;
-	if (c->fail_after == 0)
-		return NULL;
-	if (c->fail_after > 0)
-		c->fail_after--;
-	head *h = malloc(sizeof *h + size);
-	if (!h)
-		return NULL;
-	h->size = size;
-	c->held += size;
-	return h + 1;
-}
-static void c_free(void *user, void *p)
-{
-	if (!p)
-		return;
-	head *h = (head *)p - 1;
-	((counter *)user)->held -= h->size;
-	free(h);
-}
-
 /* Read callbacks over memory, with a switch that makes them fail. */
 typedef struct source {
 	const uint8_t *data;
@@ -134,13 +102,13 @@ TEST(open_three_ways_and_their_errors)
 		CHECK_CODE(mlod_rt_open_read(s_read, &s, k->size, NULL, &ctx, &e), MLOD_ERR_IO);
 		s.fail = 0;
 		CHECK_CODE(mlod_rt_open_read(s_read, &s, k->size - 100, NULL, &ctx, &e), MLOD_ERR_PARSE);
-		mlod_rt_allocator half = { c_malloc, NULL, NULL };
+		mlod_rt_allocator half = { rt_counter_malloc, NULL, NULL };
 		cfg.budget_bytes = 0, cfg.allocator = &half;
 		CHECK_CODE(mlod_rt_open_memory(k->data, k->size, &cfg, &ctx, &e), MLOD_ERR_INVALID_ARG);
 		/* every allocation of open failing in turn: NOMEM, nothing held */
 		for (long f = 0;; f++) {
-			counter c = { 0, f };
-			mlod_rt_allocator a = { c_malloc, c_free, &c };
+			rt_counter c = { 0, 0, f };
+			mlod_rt_allocator a = { rt_counter_malloc, rt_counter_free, &c };
 			cfg.allocator = &a;
 			mlod_result r = mlod_rt_open_memory(k->data, k->size, &cfg, &ctx, &e);
 			if (r == MLOD_OK) {
@@ -156,7 +124,7 @@ TEST(open_three_ways_and_their_errors)
 }
 
 /* The frames of one context: see the file's comment. */
-static void crowd(mlod_rt_ctx *ctx, counter *cnt, size_t budget, const char *what)
+static void crowd(mlod_rt_ctx *ctx, rt_counter *cnt, size_t budget, const char *what)
 {
 	mlod_error e = { 0 };
 	const uint32_t clips = mlod_rt_clip_count(ctx);
@@ -279,8 +247,8 @@ TEST(crowd_from_memory_and_read_callbacks)
 		/* room for some finer levels, not all (tubeman: mesh level 0 never fits) */
 		const size_t budget = st.resident_bytes + st.resident_bytes / 2 + 200000;
 		for (int way = 0; way < 2; way++) {
-			counter c = { 0, -1 };
-			mlod_rt_allocator a = { c_malloc, c_free, &c };
+			rt_counter c = { 0, 0, -1 };
+			mlod_rt_allocator a = { rt_counter_malloc, rt_counter_free, &c };
 			mlod_rt_config cfg = { budget, N, &a };
 			source s = { k->data, k->size, 0 };
 			ctx = NULL;
