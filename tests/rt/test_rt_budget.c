@@ -18,6 +18,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "rt_test.h"
 #include "rt_packer.h"
@@ -80,58 +81,103 @@ static void load_one(mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint
 	CHECK_OK(mlod_rt_level_info_get(ctx, layer, level, item, li, &e), e);
 }
 
+/* Every finer level of pack k (skeleton levels but 0 and the coarsest,
+ * mesh levels, motion levels of the first three clips) from memory and
+ * through read callbacks: its resident bytes loaded alone without a
+ * budget, then under exactly what open pinned plus those bytes (it loads,
+ * never passing the budget, not even while it decodes: the peak) and one
+ * byte less (no room). *checked counts the budgets. */
+static void levels_in_their_size(const struct pk *k, int *checked)
+{
+	for (int how = 0; how < 2; how++) {
+		mlod_error e = { 0 };
+		mlod_rt_ctx *ctx = NULL;
+		source src;
+		CHECK_OK(open_how(k, how, &src, 0, &ctx, &e), e);
+		mlod_rt_stats st;
+		mlod_rt_stats_get(ctx, &st);
+		const size_t at_open = st.open_bytes;
+		CHECK(at_open == st.resident_bytes, "%s: open_bytes %zu, resident %zu after open", k->file, at_open,
+		      st.resident_bytes);
+		const uint32_t clips = mlod_rt_clip_count(ctx), sl = mlod_rt_level_count(ctx, MLOD_RT_SKELETON),
+		               ml = mlod_rt_level_count(ctx, MLOD_RT_MESH), tl = mlod_rt_level_count(ctx, MLOD_RT_MOTION);
+		mlod_rt_close(ctx);
+		for (int layer = MLOD_RT_SKELETON; layer <= MLOD_RT_MOTION; layer++) {
+			const uint32_t L = layer == MLOD_RT_SKELETON ? sl : layer == MLOD_RT_MESH ? ml : tl,
+			               items = layer == MLOD_RT_MOTION ? clips : 1;
+			/* skeleton level 0 is the context's own, resident from open */
+			for (uint32_t item = 0; item < items && item < 3; item++)
+				for (uint32_t l = layer == MLOD_RT_SKELETON; l + 1 < L; l++) {
+					/* its resident bytes, loaded alone without a budget */
+					CHECK_OK(open_how(k, how, &src, 0, &ctx, &e), e);
+					mlod_rt_level_info li, lb;
+					load_one(ctx, (mlod_rt_layer)layer, l, item, &li);
+					mlod_rt_close(ctx);
+					CHECK(li.resident && li.bytes > 0, "%s: layer %d level %u item %u did not load", k->file,
+					      layer, l, item);
+					/* exactly that room admits it; one byte less does not */
+					for (int less = 0; less < 2; less++) {
+						CHECK_OK(open_how(k, how, &src, at_open + li.bytes - (size_t)less, &ctx, &e), e);
+						load_one(ctx, (mlod_rt_layer)layer, l, item, &lb);
+						mlod_rt_stats_get(ctx, &st);
+						CHECK(lb.resident == !less && lb.no_room == less && !lb.failed,
+						      "%s (%s): layer %d level %u item %u (%zu bytes) under %zu: resident %d, "
+						      "no_room %d, failed %d",
+						      k->file, how ? "read" : "memory", layer, l, item, li.bytes,
+						      at_open + li.bytes - (size_t)less, lb.resident, lb.no_room, lb.failed);
+						CHECK(lb.bytes == (less ? 0 : li.bytes) && st.resident_bytes <= st.budget_bytes &&
+						              st.peak_resident_bytes <= st.budget_bytes,
+						      "%s (%s): layer %d level %u: %zu bytes, %zu before; resident %zu, peak %zu, "
+						      "budget %zu",
+						      k->file, how ? "read" : "memory", layer, l, lb.bytes, li.bytes, st.resident_bytes,
+						      st.peak_resident_bytes, st.budget_bytes);
+						mlod_rt_close(ctx);
+						(*checked)++;
+					}
+				}
+		}
+	}
+}
+
 TEST(level_loads_in_its_size)
 {
 	SKIP_IF_NO_PACK(level_loads_in_its_size);
 	CHECK(packs_ready(), "mlod-pack failed");
 	int checked = 0;
-	for (size_t p = 0; p < PACKS; p++)
-		for (int how = 0; how < 2; how++) {
-			const struct pk *k = &packs[p];
-			mlod_error e = { 0 };
-			mlod_rt_ctx *ctx = NULL;
-			source src;
-			CHECK_OK(open_how(k, how, &src, 0, &ctx, &e), e);
-			mlod_rt_stats st;
-			mlod_rt_stats_get(ctx, &st);
-			const size_t at_open = st.open_bytes;
-			CHECK(at_open == st.resident_bytes, "%s: open_bytes %zu, resident %zu after open", k->file, at_open,
-			      st.resident_bytes);
-			const uint32_t clips = mlod_rt_clip_count(ctx), ml = mlod_rt_level_count(ctx, MLOD_RT_MESH),
-			               tl = mlod_rt_level_count(ctx, MLOD_RT_MOTION);
-			mlod_rt_close(ctx);
-			for (int layer = MLOD_RT_MESH; layer <= MLOD_RT_MOTION; layer++) {
-				const uint32_t L = layer == MLOD_RT_MESH ? ml : tl, items = layer == MLOD_RT_MESH ? 1 : clips;
-				for (uint32_t item = 0; item < items && item < 3; item++)
-					for (uint32_t l = 0; l + 1 < L; l++) {
-						/* its resident bytes, loaded alone without a budget */
-						CHECK_OK(open_how(k, how, &src, 0, &ctx, &e), e);
-						mlod_rt_level_info li, lb;
-						load_one(ctx, (mlod_rt_layer)layer, l, item, &li);
-						mlod_rt_close(ctx);
-						CHECK(li.resident && li.bytes > 0, "%s: layer %d level %u item %u did not load", k->file,
-						      layer, l, item);
-						/* exactly that room admits it; one byte less does not */
-						for (int less = 0; less < 2; less++) {
-							CHECK_OK(open_how(k, how, &src, at_open + li.bytes - (size_t)less, &ctx, &e), e);
-							load_one(ctx, (mlod_rt_layer)layer, l, item, &lb);
-							mlod_rt_stats_get(ctx, &st);
-							CHECK(lb.resident == !less && lb.no_room == less && !lb.failed,
-							      "%s (%s): layer %d level %u item %u (%zu bytes) under %zu: resident %d, "
-							      "no_room %d, failed %d",
-							      k->file, how ? "read" : "memory", layer, l, item, li.bytes,
-							      at_open + li.bytes - (size_t)less, lb.resident, lb.no_room, lb.failed);
-							CHECK(lb.bytes == (less ? 0 : li.bytes) && st.resident_bytes <= st.budget_bytes,
-							      "%s: layer %d level %u: %zu bytes, %zu before; resident %zu, budget %zu",
-							      k->file, layer, l, lb.bytes, li.bytes, st.resident_bytes, st.budget_bytes);
-							mlod_rt_close(ctx);
-							checked++;
-						}
-					}
-			}
-		}
+	for (size_t p = 0; p < PACKS && !t_failed_; p++)
+		levels_in_their_size(&packs[p], &checked);
+	if (t_failed_)
+		return;
 	printf("# %d budgets, each exactly a level's size or a byte less\n", checked);
 	CHECK(checked > 0, "no finer level");
+}
+
+/* The same on ../shared/data's Ely (skeleton levels 1 and 2 between 0 and
+ * the coarsest, four finer mesh levels), when MLOD_SHARED_DATA names it. */
+TEST(ely_levels_load_in_their_size)
+{
+	SKIP_IF_NO_PACK(ely_levels_load_in_their_size);
+	const char *dir = getenv("MLOD_SHARED_DATA");
+	struct stat sb;
+	if (!dir || !*dir || stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) {
+		printf("SKIP ely_levels_load_in_their_size: needs ../shared/data: MLOD_SHARED_DATA %s\n",
+		       dir && *dir ? "is not a directory" : "is not set (make test-extended sets it when ../shared/data exists)");
+		return;
+	}
+	char sample[600];
+	snprintf(sample, sizeof sample, "%.500s/Ely.glb", dir);
+	struct pk ely = { sample, "", "bud-ely.mlod", "", NULL, 0 };
+	CHECK(run_pack(ely.sample, ely.opts, ely.file, ely.path, sizeof ely.path) == 0 &&
+	              (ely.data = read_all(ely.path, &ely.size)) != NULL,
+	      "mlod-pack %s failed", sample);
+	int checked = 0;
+	levels_in_their_size(&ely, &checked);
+	free(ely.data);
+	if (t_failed_)
+		return;
+	printf("# Ely: %d budgets, each exactly a level's size or a byte less\n", checked);
+	/* 2 skeleton and 4 mesh levels, 2 sources, 2 budgets each */
+	CHECK(checked == 24, "%d budgets on Ely, not 24", checked);
 }
 
 /* The raw tubeman pack with its motion level 1 of clip 0's first
@@ -269,6 +315,7 @@ int main(int argc, char **argv)
 		                               "samples/cmu_12_01_walk.bvh", NULL };
 	rt_packer_setup(argv[0], "rt_budget", samples);
 	RUN(level_loads_in_its_size);
+	RUN(ely_levels_load_in_their_size);
 	RUN(hostile_motion_claims_fail_the_level);
 	RUN(open_bytes_is_the_least_budget);
 	for (size_t p = 0; p < PACKS; p++)
