@@ -40,6 +40,22 @@ mlod_result mlod_pack_decode_motion_reserve(const mlod_pack *p, uint32_t chunk, 
                                             mlod_pack_motion_reserve_fn reserve, void *reserve_user,
                                             mlod_pack_motion *out, mlod_error *err);
 
+/* Called by mlod_pack_decode_skel_level_reserve once the level's records
+ * are read and checked (its kept joints; its palette's joints, or from
+ * format 7.0 its bind matrix references), before the decoded level's one
+ * block is allocated: kept_count and palette_size give its arrays exactly
+ * (mlod_pack_skel_level), and block_bytes is that block's size, its head
+ * included (mlod_pack_block_size of the level once decoded). A result
+ * other than MLOD_OK stops the decode with that result, before that
+ * allocation. */
+typedef mlod_result (*mlod_pack_skel_reserve_fn)(void *user, uint32_t kept_count, uint32_t palette_size,
+                                                 uint64_t block_bytes, mlod_error *err);
+
+/* mlod_pack_decode_skel_level, calling reserve (may be NULL) as above. */
+mlod_result mlod_pack_decode_skel_level_reserve(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                                const mlod_pack_skeleton *skel, mlod_pack_skel_reserve_fn reserve,
+                                                void *reserve_user, mlod_pack_skel_level *out, mlod_error *err);
+
 /* INFO's counts against what the chunks hold (MLOD_ERR_PARSE naming
  * INFO): its joint and skin counts against SKELETON's, its instance count
  * against a decoded MESH level's parts (every level has the same parts)
@@ -82,7 +98,10 @@ size_t mlod_pack_block_size(const void *block);
  * up to the TOC's raw size, and refuses one above PACK_MAX_BLOCK before
  * allocating (a MOTION level sizes it exactly from its channel records,
  * once they are checked, when they are within that bound, and calls
- * mlod_pack_decode_motion_reserve's reserve with that size first). Meshopt-coded streams are decoded into a temporary buffer
+ * mlod_pack_decode_motion_reserve's reserve with that size first; a
+ * skeleton level from its kept count and the skeleton's palette, once its
+ * records are checked, calling mlod_pack_decode_skel_level_reserve's
+ * reserve first). Meshopt-coded streams are decoded into a temporary buffer
  * (freed before the decode returns); raw streams are read in place.
  * Every allocation is the pack's allocator's (mlod_pack_open_alloc; malloc
  * by default), and a block starts with that allocator, for *_free.

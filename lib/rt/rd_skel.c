@@ -136,6 +136,13 @@ void mlod_pack_skeleton_free(mlod_pack_skeleton *x)
 mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
                                         const mlod_pack_skeleton *skel, mlod_pack_skel_level *out, mlod_error *err)
 {
+	return mlod_pack_decode_skel_level_reserve(p, chunk, data, size, skel, NULL, NULL, out, err);
+}
+
+mlod_result mlod_pack_decode_skel_level_reserve(const mlod_pack *p, uint32_t chunk, const void *data, size_t size,
+                                                const mlod_pack_skeleton *skel, mlod_pack_skel_reserve_fn reserve,
+                                                void *reserve_user, mlod_pack_skel_level *out, mlod_error *err)
+{
 	if (!out)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_pack_decode_skel_level: out is NULL");
 	memset(out, 0, sizeof *out);
@@ -170,29 +177,30 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	uint64_t Kc = sk.count;
 	if (Kc > J)
 		FAIL("%s: %llu kept joints of a skeleton of %llu", x.label, (unsigned long long)Kc, (unsigned long long)J);
-	/* aux: each joint's nearest kept ancestor (or itself); from 7.0 also
-	 * 'PALR' and each skin joint's 'IBMS' entry. */
-	TRY(pk_cx_temp(&x, refs ? round8(J * 4) + round8(P * 4) + P * sizeof(float *) : J * 4, err));
-	TRY(pk_bump_alloc(&b, &x, round8(Kc * 4) + round8(P * 4) + round8(P * 64), err));
-	uint32_t *kept, *palj, *nearest = (uint32_t *)x.temp;
-	uint32_t *palr = refs ? (uint32_t *)(x.temp + round8(J * 4)) : NULL;
-	const float **ibm = refs ? (const float **)(void *)(x.temp + round8(J * 4) + round8(P * 4)) : NULL;
-	float *palb;
-	TAKE(kept, Kc * 4);
-	TAKE(palj, P * 4);
-	TAKE(palb, P * 64);
+	/* Scratch: the kept joints and the palette's joints (the records,
+	 * read and checked before the block is sized and allocated), each
+	 * joint's nearest kept ancestor (or itself); from 7.0 also 'PALR' and
+	 * each skin joint's 'IBMS' entry. */
+	const uint64_t a_kept = round8(Kc * 4), a_near = round8(J * 4), a_palj = round8(P * 4),
+	               a_palr = refs ? round8(P * 4) : 0;
+	TRY(pk_cx_temp(&x, a_kept + a_near + a_palj + a_palr + (refs ? P * sizeof(float *) : 0), err));
+	uint32_t *rkept = x.temp ? (uint32_t *)(void *)x.temp : NULL;
+	uint32_t *nearest = x.temp ? (uint32_t *)(void *)(x.temp + a_kept) : NULL;
+	uint32_t *rpalj = x.temp ? (uint32_t *)(void *)(x.temp + a_kept + a_near) : NULL;
+	uint32_t *palr = refs && x.temp ? (uint32_t *)(void *)(x.temp + a_kept + a_near + a_palj) : NULL;
+	const float **ibm = refs && x.temp ? (const float **)(void *)(x.temp + a_kept + a_near + a_palj + a_palr) : NULL;
 	TRY(pk_cx_load(&x, &sk, &src, err));
 	if (Kc)
-		memcpy(kept, src, Kc * 4);
+		memcpy(rkept, src, Kc * 4);
 	for (uint64_t i = 0; i < Kc; i++) {
-		if (kept[i] >= J)
-			FAIL("%s: kept joint %llu is %u, not below the joint count %llu", x.label, (unsigned long long)i, kept[i],
-			     (unsigned long long)J);
-		if (i > 0 && kept[i] <= kept[i - 1])
-			FAIL("%s: kept joints are not increasing (%u after %u)", x.label, kept[i], kept[i - 1]);
+		if (rkept[i] >= J)
+			FAIL("%s: kept joint %llu is %u, not below the joint count %llu", x.label, (unsigned long long)i,
+			     rkept[i], (unsigned long long)J);
+		if (i > 0 && rkept[i] <= rkept[i - 1])
+			FAIL("%s: kept joints are not increasing (%u after %u)", x.label, rkept[i], rkept[i - 1]);
 	}
 	for (uint32_t j = 0, ki = 0; j < J; j++) {
-		int is_kept = ki < Kc && kept[ki] == j;
+		int is_kept = ki < Kc && rkept[ki] == j;
 		if (is_kept)
 			ki++;
 		int32_t parent = skel->joints[j].parent;
@@ -205,7 +213,7 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 	if (!refs) {
 		TRY(pk_cx_load(&x, &sj, &src, err));
 		if (P)
-			memcpy(palj, src, P * 4);
+			memcpy(rpalj, src, P * 4);
 	}
 	for (uint32_t k = 0, i = 0; k < skel->skin_count; k++)
 		for (uint32_t m = 0; m < skel->skins[k].joint_count; m++, i++) {
@@ -214,11 +222,11 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 				FAIL("%s: the given skeleton's skin %u joint %u is %u, not below its joint count", x.label, k, m,
 				     joint);
 			if (refs) {
-				palj[i] = nearest[joint];
+				rpalj[i] = nearest[joint];
 				ibm[i] = skel->inverse_bind[k] + 16 * (size_t)m;
 				continue;
 			}
-			uint32_t v = palj[i];
+			uint32_t v = rpalj[i];
 			if (v >= J || nearest[v] != v)
 				FAIL("%s: palette entry %u (skin %u joint %u): joint %u is not a kept joint", x.label, i, k, m, v);
 			if (v != nearest[joint])
@@ -226,24 +234,41 @@ mlod_result mlod_pack_decode_skel_level(const mlod_pack *p, uint32_t chunk, cons
 				     "is %u",
 				     x.label, i, k, m, v, joint, nearest[joint]);
 		}
+	/* 0: the own IBMS entry; 1..P: IBMS entry v - 1; then 'PALX'. */
+	if (refs && P) {
+		TRY(pk_cx_load_into(&x, &sj, (uint8_t *)palr, err));
+		for (uint64_t i = 0; i < P; i++)
+			if (palr[i] > P && palr[i] - P - 1 >= sb.count)
+				FAIL("%s: palette entry %llu refers to bind matrix %u, beyond the %llu skin joints and %u in "
+				     "'PALX'",
+				     x.label, (unsigned long long)i, palr[i], (unsigned long long)P, sb.count);
+	}
+	/* The block, exactly, from the checked counts: nothing a stream claims
+	 * beyond them sizes it (the kept count is at most the joints', the
+	 * palette the skeleton's). */
+	const uint64_t total = round8(Kc * 4) + round8(P * 4) + round8(P * 64);
+	if (reserve)
+		TRY(reserve(reserve_user, (uint32_t)Kc, (uint32_t)P, BLOCK_HEAD + total, err));
+	TRY(pk_bump_alloc(&b, &x, total, err));
+	uint32_t *kept, *palj;
+	float *palb;
+	TAKE(kept, Kc * 4);
+	TAKE(palj, P * 4);
+	TAKE(palb, P * 64);
+	if (Kc)
+		memcpy(kept, rkept, Kc * 4);
+	if (P)
+		memcpy(palj, rpalj, P * 4);
+	TRY(pk_cx_load(&x, &sb, &src, err));
 	if (refs) {
-		/* 0: the own IBMS entry; 1..P: IBMS entry v - 1; then 'PALX'. */
-		if (P)
-			TRY(pk_cx_load_into(&x, &sj, (uint8_t *)palr, err));
-		TRY(pk_cx_load(&x, &sb, &src, err));
 		for (uint64_t i = 0; i < P; i++) {
 			uint64_t v = palr[i];
-			const void *from = v == 0 ? (const void *)ibm[i] : v <= P ? (const void *)ibm[v - 1] : NULL;
-			if (!from && v - P - 1 >= sb.count)
-				FAIL("%s: palette entry %llu refers to bind matrix %llu, beyond the %llu skin joints and %u in "
-				     "'PALX'",
-				     x.label, (unsigned long long)i, (unsigned long long)v, (unsigned long long)P, sb.count);
-			memcpy(palb + 16 * i, from ? from : (const void *)(src + 64 * (v - P - 1)), 64);
+			const void *from = v == 0 ? (const void *)ibm[i] : v <= P ? (const void *)ibm[v - 1]
+			                                                          : (const void *)(src + 64 * (v - P - 1));
+			memcpy(palb + 16 * i, from, 64);
 		}
-	} else {
-		TRY(pk_cx_load(&x, &sb, &src, err));
-		if (P)
-			memcpy(palb, src, P * 64);
+	} else if (P) {
+		memcpy(palb, src, P * 64);
 	}
 	if (!all_finite(palb, (size_t)P * 16))
 		FAIL("%s: a palette bind matrix is not finite", x.label);

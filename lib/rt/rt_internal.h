@@ -37,9 +37,10 @@ typedef struct rt_unit {
 	uint32_t stored_size, raw_size;
 	float error, distance;
 	size_t bytes;             /* counted while resident */
-	size_t need;              /* a pack's mesh or motion level: its resident bytes, from its
-	                           * part or channel records (rt_mesh_reserve,
-	                           * rt_motion_reserve); 0 until a load read them */
+	size_t need;              /* a pack's level: its resident bytes, from its part, channel
+	                           * or kept-joint records (rt_mesh_reserve,
+	                           * rt_motion_reserve, rt_skel_reserve); 0 until a
+	                           * load read them */
 	uint64_t last_wanted;     /* the update stamp */
 	uint32_t want_count;      /* instances wanting it at the last update */
 	uint32_t users;           /* instances showing it */
@@ -247,9 +248,11 @@ int rt_config_bad(const mlod_rt_config *config);
 mlod_result rt_prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_skel_level *l, mlod_error *err);
 mlod_result rt_prepare_mesh(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_mesh *m, mlod_error *err);
 mlod_result rt_prepare_motion(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_motion *m, mlod_error *err);
-/* The bytes of those tables: a motion level's of J joints, A channels of
- * animated joints and S joints with one-key channels only; a decoded mesh
- * level's; a mesh level's from its part records (before it decodes). */
+/* The bytes of those tables: a skeleton level's of J joints and a palette
+ * of P entries; a motion level's of J joints, A channels of animated
+ * joints and S joints with one-key channels only; a decoded mesh level's;
+ * a mesh level's from its part records (before it decodes). */
+size_t rt_skel_plan_bytes(uint32_t J, uint32_t P);
 size_t rt_motion_plan_bytes(uint32_t J, uint32_t A, uint32_t S);
 size_t rt_mesh_tables_bytes(const mlod_rt_ctx *ctx, const mlod_pack_mesh *m);
 size_t rt_mesh_plan_bytes(const mlod_rt_ctx *ctx, const mlod_pack_part_rec *recs, uint32_t n);
@@ -285,6 +288,10 @@ mlod_result rt_mesh_reserve(void *user, const mlod_pack_part_rec *parts, uint32_
  * size, mlod_pack_motion_reserve_fn). */
 mlod_result rt_motion_reserve(void *user, const mlod_pack_channel_rec *channels, uint32_t channel_count,
                               uint64_t block_bytes, mlod_error *err);
+/* The same for a skeleton level's load (its kept joints and palette
+ * entries, checked; mlod_pack_skel_reserve_fn). */
+mlod_result rt_skel_reserve(void *user, uint32_t kept_count, uint32_t palette_size, uint64_t block_bytes,
+                            mlod_error *err);
 /* Byte counts of decoded views (from their arrays). */
 size_t rt_bytes_skel_level(const mlod_pack_skel_level *l);
 size_t rt_bytes_mesh(const mlod_pack_mesh *m);

@@ -14,9 +14,16 @@
 /* Byte counts                                                       */
 /* ---------------------------------------------------------------- */
 
+/* A skeleton level of these counts (its kept joints; its palette's joints
+ * and bind matrices). */
+static size_t rt_bytes_skel_counts(uint32_t kept_count, uint32_t palette_size)
+{
+	return sizeof(mlod_pack_skel_level) + (size_t)kept_count * 4 + (size_t)palette_size * (4 + 64);
+}
+
 size_t rt_bytes_skel_level(const mlod_pack_skel_level *l)
 {
-	return sizeof *l + (size_t)l->kept_count * 4 + (size_t)l->palette_size * (4 + 64);
+	return rt_bytes_skel_counts(l->kept_count, l->palette_size);
 }
 
 /* rt_bytes_mesh of the level the pack reader decodes from these part
@@ -279,6 +286,22 @@ mlod_result rt_motion_reserve(void *user, const mlod_pack_channel_rec *channels,
 	                 u->level, u->item, u->need);
 }
 
+mlod_result rt_skel_reserve(void *user, uint32_t kept_count, uint32_t palette_size, uint64_t block_bytes,
+                            mlod_error *err)
+{
+	mlod_rt_ctx *ctx = user;
+	rt_unit *u = ctx->loading;
+	(void)block_bytes; /* counted from its arrays, as a mesh level is (rt_bytes_skel_level) */
+	if (!u)
+		return MLOD_OK;
+	u->need = rt_bytes_skel_counts(kept_count, palette_size) + rt_skel_plan_bytes(ctx->joint_count, palette_size);
+	if (!ctx->streaming || make_room(ctx, u->need) == 0)
+		return MLOD_OK;
+	ctx->refused = 1;
+	return mlod_fail(err, MLOD_ERR_LIMIT, "skeleton level %u: its %zu decoded bytes do not fit the budget", u->level,
+	                 u->need);
+}
+
 /* rt_motion_plan_bytes of a motion level's views, bounding its joints with
  * one-key channels only by the joints and by its one-key channels. */
 static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m)
@@ -290,22 +313,18 @@ static size_t motion_plan_hint(const mlod_rt_ctx *ctx, const mlod_pack_motion *m
 	return rt_motion_plan_bytes(J, C, S < J ? S : J);
 }
 
-/* An upper bound of a unit's resident size before loading it, so that
- * room is made before decoding and resident bytes never pass the budget,
- * not even while a level decodes. Views know their size. A pack's mesh or
- * motion level: its exact size once a load has read its part or channel
- * records (u->need), else 0, as the reader calls rt_mesh_reserve or
- * rt_motion_reserve with those records before it allocates the decoded
+/* A unit's resident size before loading it, so that room is made before
+ * decoding and resident bytes never pass the budget, not even while a
+ * level decodes. Views know their size. A pack's level: its exact size
+ * once a load has read its part, channel or kept-joint records (u->need),
+ * else 0, as the reader calls rt_mesh_reserve, rt_motion_reserve or
+ * rt_skel_reserve with those records before it allocates the decoded
  * level, and room is made then (a nested motion level's coarser levels,
  * decoded and freed inside its load, are the reader's scratch, not
- * counted, as a mesh level's coarser vertex blocks are). Skeleton levels
- * of packs: dequantising at most quadruples a stream, the decoded structs
- * at most double their records, and the alignment of each stream costs
- * less than 4 times its 16-byte header; plus the skeleton level's
- * tables. */
+ * counted, as a mesh level's coarser vertex blocks are). */
 static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 {
-	size_t plan = u->layer == MLOD_RT_SKELETON ? (size_t)ctx->joint_count * (4 + 1 + 4 + 64)
+	size_t plan = u->layer == MLOD_RT_SKELETON ? rt_skel_plan_bytes(ctx->joint_count, ctx->palette_size)
 	              : u->layer == MLOD_RT_MESH   ? 4 * ((size_t)ctx->palette_size + ctx->joint_count)
 	                                           : 0;
 	if (!ctx->load) {
@@ -323,9 +342,7 @@ static size_t size_hint(const mlod_rt_ctx *ctx, const rt_unit *u)
 			}
 		return 0;
 	}
-	if (u->layer != MLOD_RT_SKELETON)
-		return u->need;
-	return 4 * (size_t)u->raw_size + 256 + plan;
+	return u->need;
 }
 
 /* ---------------------------------------------------------------- */
@@ -566,7 +583,7 @@ mlod_result mlod_rt_stream(mlod_rt_ctx *ctx, size_t byte_budget, uint32_t *loade
 		ctx->streaming = 1, ctx->refused = 0;
 		mlod_result r = rt_unit_load(ctx, u, &e);
 		ctx->streaming = 0;
-		if (r && ctx->refused) { /* its part records say it cannot fit: it waits */
+		if (r && ctx->refused) { /* its records say it cannot fit: it waits */
 			ctx->refused = 0;
 			defer_want(ctx, u);
 			changed = 1;

@@ -180,6 +180,7 @@ static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 		ctx->loading = NULL;
 		return r;
 	}
+	/* And a skeleton level's kept joints and palette (rt_skel_reserve). */
 	const mlod_pack *p;
 	const void *data;
 	size_t size;
@@ -188,7 +189,11 @@ static mlod_result pack_load(mlod_rt_ctx *ctx, rt_unit *u, mlod_error *err)
 	if (r)
 		return r;
 	memset(&u->dec, 0, sizeof u->dec);
-	return mlod_pack_decode_skel_level(p, (uint32_t)u->chunk, data, size, ctx->skel, &u->dec.skel, err);
+	ctx->loading = u;
+	r = mlod_pack_decode_skel_level_reserve(p, (uint32_t)u->chunk, data, size, ctx->skel, rt_skel_reserve, ctx,
+	                                        &u->dec.skel, err);
+	ctx->loading = NULL;
+	return r;
 }
 
 static void pack_unload(mlod_rt_ctx *ctx, rt_unit *u)

@@ -231,6 +231,13 @@ mlod_result rt_palette_sources(const mlod_rt_ctx *ctx, uint32_t n, const uint32_
 	return MLOD_OK;
 }
 
+/* The plan of a skeleton level (rt_prepare_skel): per joint a matrix, a
+ * stand-in, a posed entry and a flag; per palette entry its source. */
+size_t rt_skel_plan_bytes(uint32_t J, uint32_t P)
+{
+	return (size_t)J * (4 + 1 + 4 + 64) + (size_t)P * 4;
+}
+
 /* Builds the plan of a skeleton level (level >= 1) into one block. */
 mlod_result rt_prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_skel_level *l, mlod_error *err)
 {
@@ -242,7 +249,7 @@ mlod_result rt_prepare_skel(mlod_rt_ctx *ctx, rt_unit *u, const mlod_pack_skel_l
 		return mlod_fail(err, MLOD_ERR_PARSE, "skeleton level %u: palette of %u entries, the skins have %u",
 		                 u->level, l->palette_size, ctx->palette_size);
 	const size_t P = l->palette_size;
-	size_t bytes = (size_t)J * (4 + 1 + 4 + 64) + P * 4;
+	const size_t bytes = rt_skel_plan_bytes(J, (uint32_t)P);
 	uint8_t *block = rt_alloc(ctx, bytes);
 	if (!block)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "skeleton level %u: out of memory", u->level);

@@ -261,6 +261,113 @@ TEST(hostile_motion_claims_fail_the_level)
 	}
 }
 
+/* Fixes the CRCs of pack d (size n) after chunk c of p changed: the
+ * chunk's, then the TOC's and the header's over it. */
+static void fix_crcs(uint8_t *d, const mlod_pack *p, int c)
+{
+	uint8_t *e = d + 32 + 48 * (size_t)c;
+	uint32_t v = mlod_pack_crc32(0, d + p->chunks[c].offset, p->chunks[c].stored_size);
+	memcpy(e + 32, &v, 4);
+	v = mlod_pack_crc32(0, d + 32, (size_t)p->chunk_count * 48);
+	memcpy(d + 24, &v, 4);
+	v = mlod_pack_crc32(0, d, 28);
+	memcpy(d + 28, &v, 4);
+}
+
+/* The raw tubeman pack with its skeleton level 1 edited, CRCs fixed
+ * (NULL when its streams are not the raw 'KEPT', 'PALR', 'PALX'): what 0,
+ * its last kept joint the joint count (no such joint); 1, the 'KEPT'
+ * stream's header claiming a kept joint more than it stores; 2, a 'PALR'
+ * entry naming a bind matrix beyond the skin joints and 'PALX'; 3, the
+ * TOC's raw size of the chunk 4 bytes more than its streams decode to. */
+static uint8_t *skel_edited(int what)
+{
+	const struct pk *k = &packs[RAW];
+	mlod_error e = { 0 };
+	mlod_pack p;
+	if (mlod_pack_open(k->data, k->size, &p, &e) != MLOD_OK)
+		return NULL;
+	const int c = mlod_pack_find(&p, MLOD_CHUNK_SKELETON, 1, 0);
+	uint8_t *d = NULL;
+	if (c >= 0 && p.chunks[c].entropy == MLOD_ENTROPY_NONE && (d = malloc(k->size))) {
+		memcpy(d, k->data, k->size);
+		uint8_t *b = d + p.chunks[c].offset, *h = b + 4;
+		uint32_t n, tag[3], count[3], joints = 0;
+		memcpy(&n, b, 4);
+		for (int i = 0; i < 3 && (uint32_t)i < n; i++) {
+			memcpy(&tag[i], h + 16 * i, 4);
+			memcpy(&count[i], h + 16 * i + 4, 4);
+		}
+		mlod_pack_skeleton sk;
+		if (mlod_pack_decode_skeleton(&p, k->data, k->size, &sk, &e) == MLOD_OK) {
+			joints = sk.joint_count;
+			mlod_pack_skeleton_free(&sk);
+		}
+		if (n != 3 || tag[0] != MLOD_STREAM_KEPT || tag[1] != MLOD_STREAM_PALR || tag[2] != MLOD_STREAM_PALX ||
+		    h[10] != MLOD_SCODEC_RAW || h[16 + 10] != MLOD_SCODEC_RAW || !joints || !count[0] || !count[1]) {
+			free(d);
+			d = NULL;
+		} else {
+			uint8_t *kept = b + 4 + 16 * 3, *palr = kept + 4 * (size_t)count[0]; /* 4-byte records: no padding */
+			uint32_t v;
+			switch (what) {
+			case 0: memcpy(kept + 4 * ((size_t)count[0] - 1), &joints, 4); break;
+			case 1: v = count[0] + 1, memcpy(h + 4, &v, 4); break;
+			case 2: v = count[1] + count[2] + 1, memcpy(palr, &v, 4); break;
+			default:
+				v = p.chunks[c].raw_size + 4;
+				memcpy(d + 32 + 48 * (size_t)c + 28, &v, 4);
+				break;
+			}
+			fix_crcs(d, &p, c);
+		}
+	}
+	mlod_pack_close(&p);
+	return d;
+}
+
+TEST(hostile_skeleton_claims_fail_the_level)
+{
+	SKIP_IF_NO_PACK(hostile_skeleton_claims_fail_the_level);
+	CHECK(packs_ready(), "mlod-pack failed");
+	const struct pk *k = &packs[RAW];
+	/* room for the level's true size and more; no room at all (the records
+	 * are checked before room is asked: they fail it, not the budget) */
+	for (int what = 0; what < 4; what++)
+		for (int how = 0; how < 4; how++) {
+			const int read = how & 1;
+			const size_t extra = how & 2 ? 0 : 20000;
+			uint8_t *d = skel_edited(what);
+			CHECK(d, "no raw 'KEPT', 'PALR', 'PALX' streams in skeleton level 1");
+			const struct pk ed = { k->sample, k->opts, k->file, "", d, k->size };
+			mlod_error e = { 0 };
+			mlod_rt_ctx *ctx = NULL;
+			source src;
+			size_t need = 0;
+			CHECK_OK(mlod_rt_open_memory_bytes(d, k->size, NULL, &need, &e), e);
+			if (read)
+				CHECK_OK(mlod_rt_open_read_bytes(s_read, &(source){ d, k->size }, k->size, NULL, &need, &e), e);
+			CHECK_OK(open_how(&ed, read, &src, need + extra, &ctx, &e), e);
+			CHECK_OK(mlod_rt_request(ctx, MLOD_RT_SKELETON, 1, 0, &e), e);
+			mlod_result r = mlod_rt_stream(ctx, SIZE_MAX, NULL, &e);
+			CHECK(r == MLOD_ERR_PARSE, "edit %d (%s, %zu bytes of room): %s: %s", what, read ? "read" : "memory",
+			      extra, mlod_strerror(r), e.message);
+			mlod_rt_level_info li;
+			CHECK_OK(mlod_rt_level_info_get(ctx, MLOD_RT_SKELETON, 1, 0, &li, &e), e);
+			mlod_rt_stats st;
+			mlod_rt_stats_get(ctx, &st);
+			CHECK(li.failed && !li.resident && !li.no_room && st.resident_bytes <= st.budget_bytes &&
+			              st.peak_resident_bytes <= st.budget_bytes,
+			      "edit %d: failed %d, resident %d, no_room %d; resident bytes %zu, peak %zu, budget %zu", what,
+			      li.failed, li.resident, li.no_room, st.resident_bytes, st.peak_resident_bytes, st.budget_bytes);
+			/* its wants passed to the coarsest, resident from open */
+			CHECK_OK(mlod_rt_level_info_get(ctx, MLOD_RT_SKELETON, 2, 0, &li, &e), e);
+			CHECK(li.resident, "skeleton level 2 not resident in place of the failed level 1");
+			mlod_rt_close(ctx);
+			free(d);
+		}
+}
+
 TEST(open_bytes_is_the_least_budget)
 {
 	SKIP_IF_NO_PACK(open_bytes_is_the_least_budget);
@@ -317,6 +424,7 @@ int main(int argc, char **argv)
 	RUN(level_loads_in_its_size);
 	RUN(ely_levels_load_in_their_size);
 	RUN(hostile_motion_claims_fail_the_level);
+	RUN(hostile_skeleton_claims_fail_the_level);
 	RUN(open_bytes_is_the_least_budget);
 	for (size_t p = 0; p < PACKS; p++)
 		free(packs[p].data);
