@@ -104,15 +104,14 @@
  * decoder, the staging buffer and tables per chunk for a read source)
  * never exceed
  * the budget, not even while a level decodes: before a level's decoded
- * arrays are allocated, stream makes room for them: for a pack's mesh or
- * motion level its exact size (the reader reads the level's part or
- * channel records first, and the room is what those records decode to
- * plus the runtime's tables; records claiming more than the level's
- * streams hold size nothing and fail the level, MLOD_ERR_PARSE;
- * remembered, so a level that does not fit is not decoded again until
- * room appears); for skeleton levels an upper bound, before decoding
- * (their size for views; 4 x the TOC's raw size plus the runtime's tables
- * for packs). The budget an open needs: mlod_rt_open_memory_bytes and
+ * arrays are allocated, stream makes room for them: for a pack's level
+ * its exact size (the reader reads the level's part, channel or
+ * kept-joint and palette records first, and the room is what those
+ * records decode to plus the runtime's tables; records claiming more
+ * than the level's streams hold, or joints and bind matrices it lacks,
+ * size nothing and fail the level, MLOD_ERR_PARSE; remembered, so a level that does not fit is not
+ * decoded again until room appears); for views their size. The budget an
+ * open needs: mlod_rt_open_memory_bytes and
  * mlod_rt_stats.open_bytes. Room is made by evicting resident levels that
  * no instance wanted in the current frame (below), least recently wanted
  * first; it
@@ -375,9 +374,7 @@ typedef struct mlod_rt_level_info {
 	int no_room;          /* 1 when the last mlod_rt_stream wanted it but found no
 	                         room for it within budget_bytes, even after evicting
 	                         every level the frame does not want (the room a
-	                         mesh or motion level decodes to, exactly; for a
-	                         skeleton level, an upper bound from its raw
-	                         size, so it may say so of one that would fit): it stays
+	                         level decodes to, exactly): it stays
 	                         unloaded and its wants passed to a coarser level
 	                         (Resident-level cache, above); 0 once that call
 	                         loaded it or did not reach it */

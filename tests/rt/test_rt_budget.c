@@ -5,9 +5,17 @@
  * room it asks before decoding is its size from its channel records, as
  * a mesh level's is from its part records; it was 4 x the TOC's raw size
  * of it and of every level it nests on); the same for every finer mesh
- * level; from memory and through read callbacks. A motion level whose
- * channel records claim more keys than its streams hold (CRCs fixed)
- * fails that level alone, within the budget (its fallback loads). mlod_rt_open_*_bytes give
+ * level and every skeleton level between 0 and the coarsest (from its
+ * kept joints and palette; it was 4 x its raw size plus tables, less than
+ * tubeman's and Ely's levels decode to, more than the BVH walk's), with
+ * the peak resident bytes within the budget; from memory and through
+ * read callbacks; Ely too when MLOD_SHARED_DATA names ../shared/data. A
+ * motion level whose channel records claim more keys than its streams
+ * hold (CRCs fixed) fails that level alone, within the budget (its
+ * fallback loads); so does a skeleton level whose records name a joint
+ * or bind matrix it lacks, or whose 'KEPT' header or TOC raw size claims
+ * more than it holds, even with no room at all (its records are checked
+ * before room is asked). mlod_rt_open_*_bytes give
  * the least budget that opens (that budget opens, one byte less is
  * MLOD_ERR_LIMIT), equal to mlod_rt_stats.open_bytes, for each source.
  *
