@@ -718,15 +718,17 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
  * widened by 1e-5 of the magnitudes the kernels sum there, for their
  * rounding. Measured at mesh level 0 (mlod_rt_info(3)): the box's volume
  * is 1.37 times the skinned vertices' box's at the median on tubeman,
- * 1.21 on RobotExpressive, 1.001 on Ely; a call costs 34,800, 41,800 and
- * 16,900 instructions against mlod_rt_skin's 254,400, 180,300 and
+ * 1.21 on RobotExpressive, 1.001 on Ely; a call costs 35,700, 44,200 and
+ * 17,500 instructions against mlod_rt_skin's 254,400, 180,300 and
  * 298,200. mlod_rt_skin right after it, with the same scratch and
  * instance and nothing changed between (the instance's time, clip and
  * levels, the resident levels), takes its pose and palette entries as
  * they are instead of making them again. Without a mesh, or for a level
- * without vertices, the empty box: min FLT_MAX, max -FLT_MAX.
- * MLOD_ERR_INVALID_ARG as mlod_rt_skin (min and max are then the empty
- * box). No allocation. */
+ * without vertices, the empty box: min FLT_MAX, max -FLT_MAX. When a
+ * bound comes to NaN (a pose or palette that is not finite, which only a
+ * hostile pack gives), all of space: min -infinity, max +infinity, which
+ * no cull drops. MLOD_ERR_INVALID_ARG as mlod_rt_skin (min and max are
+ * then the empty box). No allocation. */
 mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float min[3], float max[3],
                            mlod_error *err);
 

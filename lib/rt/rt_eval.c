@@ -991,6 +991,16 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 static inline double dmin(double a, double b) { return a < b ? a : b; }
 static inline double dmax(double a, double b) { return a > b ? a : b; }
 
+/* Takes [a, b] into the box's axis i, adding both to *probe: a NaN,
+ * which dmin and dmax would let a later bound wash out, stays there (as
+ * do infinities of both signs, a box that is all of space anyway). */
+static inline void widen(double *lo, double *hi, int i, double a, double b, double *probe)
+{
+	*probe += a + b;
+	lo[i] = dmin(lo[i], a);
+	hi[i] = dmax(hi[i], b);
+}
+
 /* The box of a set of points under the affine M (column-major), from its
  * bounds before M: centre c, half extents h of their box and, with r >= 0,
  * the radius of a ball about c that holds them. On axis i the centre is
@@ -1056,6 +1066,7 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 	 * box there, which follows the bone): their intersection, widened by
 	 * the rounding allowance of both (the kernels compute P x). */
 	double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+	double probe = 0; /* NaN once a bound came to NaN: a pose or palette not finite */
 	for (uint32_t k = 0; k < mu->pal_used_count; k++) {
 		const uint32_t e = mu->pal_used[k];
 		const float *b = mu->bound_entry + 13 * (size_t)e, *P = s->palette + 16 * (size_t)e;
@@ -1078,14 +1089,14 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 			box_image(M, c2, h2, -1, x2, e2, m2);
 			for (int i = 0; i < 3; i++) {
 				const double g = RT_BOUND_ROUND * (m1[i] + m2[i]);
-				lo[i] = dmin(lo[i], dmax(x1[i] - e1[i], x2[i] - e2[i]) - g);
-				hi[i] = dmax(hi[i], dmin(x1[i] + e1[i], x2[i] + e2[i]) + g);
+				const double a1 = x1[i] - e1[i], b1 = x1[i] + e1[i];
+				probe += a1 + b1; /* dmax and dmin drop a NaN of their first operand */
+				widen(lo, hi, i, dmax(a1, x2[i] - e2[i]) - g, dmin(b1, x2[i] + e2[i]) + g, &probe);
 			}
 		} else {
 			for (int i = 0; i < 3; i++) {
 				const double g = RT_BOUND_ROUND * m1[i];
-				lo[i] = dmin(lo[i], x1[i] - e1[i] - g);
-				hi[i] = dmax(hi[i], x1[i] + e1[i] + g);
+				widen(lo, hi, i, x1[i] - e1[i] - g, x1[i] + e1[i] + g, &probe);
 			}
 		}
 	}
@@ -1100,10 +1111,13 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 		const double cc[3] = { c[0], c[1], c[2] }, hh[3] = { c[3] + grow, c[4] + grow, c[5] + grow };
 		double x[3], ex[3], mg[3];
 		box_image(M, cc, hh, c[6] + grow, x, ex, mg);
-		for (int k = 0; k < 3; k++) {
-			lo[k] = dmin(lo[k], x[k] - ex[k] - RT_BOUND_ROUND * mg[k]);
-			hi[k] = dmax(hi[k], x[k] + ex[k] + RT_BOUND_ROUND * mg[k]);
-		}
+		for (int k = 0; k < 3; k++)
+			widen(lo, hi, k, x[k] - ex[k] - RT_BOUND_ROUND * mg[k], x[k] + ex[k] + RT_BOUND_ROUND * mg[k], &probe);
+	}
+	if (isnan(probe)) { /* the kernels' outputs are not bounded: all of space, which no cull drops */
+		for (int k = 0; k < 3; k++)
+			min[k] = -INFINITY, max[k] = INFINITY;
+		return MLOD_OK;
 	}
 	if (!(lo[0] <= hi[0]))
 		return MLOD_OK; /* no vertex: the empty box */

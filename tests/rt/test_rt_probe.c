@@ -558,6 +558,53 @@ TEST(out_of_memory_is_nomem)
 	printf("# %lu allocations, each failing in turn: %lu errors, all MLOD_ERR_NOMEM\n", total, failures);
 }
 
+/* A fuzzed pack (tests/fuzz/regress/pack/bounds-nan-bound.mlod: one byte
+ * of a tubeman pack's SKELETON changed, CRCs made right) poses some
+ * palette entries to huge matrices whose bound comes to NaN: the NaN was
+ * washed out by the next entry's bound, so mlod_rt_bounds gave the empty
+ * box while mlod_rt_skin wrote finite vertices (-1.4e20) outside it. Now
+ * such a bound is all of space, and every finite skinned vertex of every
+ * forced level lies in the box. */
+TEST(bounds_hold_a_hostile_pose)
+{
+	size_t size = 0;
+	uint8_t *data = read_all("tests/fuzz/regress/pack/bounds-nan-bound.mlod", &size);
+	CHECK(data, "cannot read tests/fuzz/regress/pack/bounds-nan-bound.mlod (run from the repository's root)");
+	mlod_error e = { 0 };
+	mlod_rt_ctx *ctx = NULL;
+	mlod_result r = mlod_rt_open_memory(data, size, NULL, &ctx, &e);
+	if (r != MLOD_OK)
+		free(data);
+	CHECK_OK(r, e);
+	const uint32_t cap = mlod_rt_max_vertex_count(ctx), levels = mlod_rt_level_count(ctx, MLOD_RT_MESH);
+	float *pos = malloc(((size_t)cap + 1) * 3 * sizeof *pos);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	uint32_t id, outside = 0, checked = 0;
+	int ok = pos && s && mlod_rt_instance_create(ctx, 0, 0.25f, MLOD_RT_LOOP, &id, &e) == MLOD_OK;
+	for (uint32_t k = levels; ok && k-- > 0;) {
+		mlod_rt_select sel;
+		mlod_rt_select_default(&sel);
+		sel.force_level = (int)k;
+		const float d = 10.0f;
+		float lo[3], hi[3];
+		uint32_t vc = 0;
+		ok = mlod_rt_update(ctx, &sel, &id, &d, 1, 1.0f / 30, &e) == MLOD_OK;
+		(void)mlod_rt_stream(ctx, SIZE_MAX, NULL, &e); /* a corrupt level fails: a coarser one stands in */
+		ok = ok && mlod_rt_bounds(ctx, s, id, lo, hi, &e) == MLOD_OK &&
+		     mlod_rt_skin(ctx, s, id, pos, 12, NULL, 0, cap, &vc, &e) == MLOD_OK;
+		for (uint32_t v = 0; ok && v < 3 * vc; v++)
+			if (isfinite(pos[v]))
+				checked++, outside += !(pos[v] >= lo[v % 3] && pos[v] <= hi[v % 3]);
+	}
+	if (s)
+		mlod_rt_scratch_destroy(ctx, s);
+	free(pos);
+	mlod_rt_close(ctx);
+	free(data);
+	CHECK(ok, "%s", e.message);
+	CHECK(checked > 0 && outside == 0, "%u of %u finite coordinates outside their box", outside, checked);
+}
+
 int main(int argc, char **argv)
 {
 	(void)argc;
@@ -572,6 +619,7 @@ int main(int argc, char **argv)
 	RUN(instance_refuses_bad_times);
 	RUN(stats_budget);
 	RUN(out_of_memory_is_nomem);
+	RUN(bounds_hold_a_hostile_pose);
 	rt_packer_cleanup();
 	TEST_EXIT();
 }
