@@ -970,7 +970,7 @@ static bool put_attribute(mlod_gltf &doc, int mesh, int p, const std::string &na
  * shorts (every set of the primitive in one such type) must sum to
  * exactly 255 or 65535: each changed vertex's weights are rounded by
  * largest remainder, over all its sets, and c takes the values the
- * reader reads back from those (within half a step of the rule's);
+ * reader reads back from those (less than a step from the rule's);
  * other weight types become floats. Joints keep their type unless the
  * root joint does not fit (unsigned bytes past 255: unsigned shorts).
  * An accessor is written in place (its bytes, bounds kept true) when it
