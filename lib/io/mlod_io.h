@@ -338,6 +338,8 @@ mlod_format mlod_detect_format(const void *data, size_t size);
 
 /* Loads glb, glTF or BVH bytes into a document and a character. BVH gets a
  * document made with mlod_gltf_from_character, so every tool writes glb.
+ * A glTF document is read with mlod_gltf_to_character_fix: it holds the
+ * skin weights the reader made valid, as the character does.
  * doc may be NULL when only the character is wanted. On failure nothing
  * is allocated. */
 mlod_result mlod_load(const void *data, size_t size, const char *base_dir,
