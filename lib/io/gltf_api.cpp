@@ -80,6 +80,25 @@ mlod_result mlod_gltf_to_character(const mlod_gltf *doc, mlod_character *out, ml
 	});
 }
 
+mlod_result mlod_gltf_to_character_fix(mlod_gltf *doc, mlod_character *out, mlod_error *err)
+{
+	return guard(err, [&] {
+		need(doc && out, "mlod_gltf_to_character_fix: doc and out must not be NULL");
+		memset(out, 0, sizeof *out);
+		mlod_character c;
+		memset(&c, 0, sizeof c);
+		try {
+			std::vector<std::pair<int, int>> fixed;
+			read_character(*doc, c, &fixed);
+			set_skin_weights(*doc, c, fixed);
+		} catch (...) {
+			mlod_character_free(&c);
+			throw;
+		}
+		*out = c;
+	});
+}
+
 mlod_result mlod_gltf_from_character(const mlod_character *c, mlod_gltf **out, mlod_error *err)
 {
 	return guard(err, [&] {

@@ -791,4 +791,300 @@ void set_inverse_binds(mlod_gltf &doc, int k, const mlod_mat4 *ibm, int count)
 		(*o)["inverseBindMatrices"] = a;
 }
 
+/* ------------------------------------------------------------------ */
+/* Skin weights the reader made valid, into the document               */
+/* ------------------------------------------------------------------ */
+
+/* How many times m refers to each accessor (as used_accessors). */
+static std::vector<int> accessor_refs(const Model &m)
+{
+	std::vector<int> refs(m.accessors.size(), 0);
+	auto count = [&](int i) {
+		if (i >= 0 && size_t(i) < refs.size())
+			refs[size_t(i)]++;
+	};
+	for (const tinygltf::Mesh &mesh : m.meshes)
+		for (const tinygltf::Primitive &p : mesh.primitives) {
+			count(p.indices);
+			for (const auto &kv : p.attributes)
+				count(kv.second);
+			for (const auto &t : p.targets)
+				for (const auto &kv : t)
+					count(kv.second);
+		}
+	for (const tinygltf::Skin &sk : m.skins)
+		count(sk.inverseBindMatrices);
+	for (const tinygltf::Animation &a : m.animations)
+		for (const tinygltf::AnimationSampler &sa : a.samplers) {
+			count(sa.input);
+			count(sa.output);
+		}
+	return refs;
+}
+
+static bool skin_attribute(const std::string &name)
+{
+	return name.compare(0, 7, "JOINTS_") == 0 || name.compare(0, 8, "WEIGHTS_") == 0;
+}
+
+/* Whether the bytes of accessor i's elements are its own, so that writing
+ * them changes nothing else: it has a buffer view (that no extension
+ * names) and no sparse part, and no other accessor, sparse part or image
+ * reads any of them (accessors interleaved in one strided view each read
+ * their own bytes of every stride). */
+static bool owns_bytes(const mlod_gltf &doc, size_t i)
+{
+	const Model &m = doc.model;
+	const tinygltf::Accessor &a = m.accessors[i];
+	if (a.bufferView < 0 || a.sparse.isSparse || a.count == 0)
+		return false;
+	std::vector<bool> named(m.bufferViews.size(), false), buffers(m.buffers.size(), false);
+	extension_refs(doc.original, false, named, buffers);
+	const tinygltf::BufferView &v = m.bufferViews[size_t(a.bufferView)];
+	if (named[size_t(a.bufferView)] || buffers[size_t(v.buffer)])
+		return false;
+	const Layout l = layout_of(a);
+	const size_t stride = v.byteStride ? v.byteStride : l.element;
+	const size_t begin = v.byteOffset + a.byteOffset, end = begin + (a.count - 1) * stride + l.element;
+	/* Does [from, to) of view `view` meet [begin, end)? */
+	auto meets = [&](int view, size_t from, size_t to) {
+		if (view < 0 || size_t(view) >= m.bufferViews.size())
+			return false;
+		const tinygltf::BufferView &w = m.bufferViews[size_t(view)];
+		return w.buffer == v.buffer && w.byteOffset + from < end && begin < w.byteOffset + to;
+	};
+	for (size_t k = 0; k < m.accessors.size(); k++) {
+		const tinygltf::Accessor &b = m.accessors[k];
+		if (k == i || b.count == 0)
+			continue;
+		const Layout lb = layout_of(b);
+		if (b.sparse.isSparse) {
+			const auto &s = b.sparse;
+			size_t n = size_t(std::max(s.count, 0));
+			if (meets(s.indices.bufferView, size_t(s.indices.byteOffset),
+			          size_t(s.indices.byteOffset) + n * component_size(s.indices.componentType)) ||
+			    meets(s.values.bufferView, size_t(s.values.byteOffset), size_t(s.values.byteOffset) + n * lb.element))
+				return false;
+		}
+		if (b.bufferView < 0)
+			continue;
+		const tinygltf::BufferView &w = m.bufferViews[size_t(b.bufferView)];
+		size_t sb = w.byteStride ? w.byteStride : lb.element;
+		if (!meets(b.bufferView, b.byteOffset, b.byteOffset + (b.count - 1) * sb + lb.element))
+			continue;
+		if (b.bufferView == a.bufferView && v.byteStride) {
+			/* interleaved: each reads a window of every stride */
+			size_t s = v.byteStride, ra = a.byteOffset % s, rb = b.byteOffset % s;
+			if ((rb + s - ra) % s >= l.element && (ra + s - rb) % s >= lb.element)
+				continue;
+		}
+		return false;
+	}
+	for (const tinygltf::Image &im : m.images)
+		if (im.bufferView >= 0 && size_t(im.bufferView) < m.bufferViews.size() &&
+		    meets(im.bufferView, 0, m.bufferViews[size_t(im.bufferView)].byteLength))
+			return false;
+	return true;
+}
+
+/* One component of type `type` (an unsigned integer or a float) at p,
+ * little-endian. */
+static void put_component(unsigned char *p, int type, double value)
+{
+	uint32_t bits;
+	size_t size = component_size(type);
+	if (type == TINYGLTF_COMPONENT_TYPE_FLOAT) {
+		float f = float(value);
+		memcpy(&bits, &f, 4);
+	} else {
+		bits = uint32_t(value);
+	}
+	for (size_t k = 0; k < size; k++)
+		p[k] = uint8_t(bits >> (8 * k));
+}
+
+/* Gives attribute `name` of primitive p of mesh `mesh` the VEC4 values
+ * raw (stored values: integers, or floats) in component type `type`:
+ * in place when the accessor it names has that type, owns its bytes and
+ * no one else refers to it (refs and mine: every reference, and those of
+ * the primitives being rewritten; written: accessors already rewritten
+ * in place), else as a new accessor (normalized as `normalized`). Returns
+ * whether the old accessor was left without reference. */
+static bool put_attribute(mlod_gltf &doc, int mesh, int p, const std::string &name, const std::vector<double> &raw,
+                          int type, bool normalized, std::vector<int> &refs, std::vector<int> &mine,
+                          std::vector<char> &written)
+{
+	Model &m = doc.model;
+	int &index = m.meshes[size_t(mesh)].primitives[size_t(p)].attributes.at(name);
+	tinygltf::Accessor &a = m.accessors[size_t(index)];
+	size_t n = raw.size() / 4;
+	if (a.componentType == type && a.type == TINYGLTF_TYPE_VEC4 && a.count == n && !written[size_t(index)] &&
+	    refs[size_t(index)] == mine[size_t(index)] && owns_bytes(doc, size_t(index))) {
+		Layout l = layout_of(a);
+		const tinygltf::BufferView &v = m.bufferViews[size_t(a.bufferView)];
+		size_t stride = v.byteStride ? v.byteStride : l.element;
+		unsigned char *base = m.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
+		for (size_t e = 0; e < n; e++)
+			for (int c = 0; c < 4; c++)
+				put_component(base + e * stride + l.offset(c), type, raw[4 * e + size_t(c)]);
+		/* Bounds the input gave stay true (stored values, as glTF's). */
+		if (a.minValues.size() == 4 && a.maxValues.size() == 4)
+			for (int c = 0; c < 4; c++) {
+				a.minValues[size_t(c)] = a.maxValues[size_t(c)] = raw[size_t(c)];
+				for (size_t e = 1; e < n; e++) {
+					a.minValues[size_t(c)] = std::min(a.minValues[size_t(c)], raw[4 * e + size_t(c)]);
+					a.maxValues[size_t(c)] = std::max(a.maxValues[size_t(c)], raw[4 * e + size_t(c)]);
+				}
+			}
+		written[size_t(index)] = 1;
+		return false;
+	}
+	std::vector<unsigned char> bytes(raw.size() * component_size(type));
+	for (size_t k = 0; k < raw.size(); k++)
+		put_component(&bytes[k * component_size(type)], type, raw[k]);
+	int old = index;
+	int added = append_accessor(m, bytes.data(), n, type, TINYGLTF_TYPE_VEC4, 4, TINYGLTF_TARGET_ARRAY_BUFFER, false);
+	m.accessors[size_t(added)].normalized = normalized;
+	/* (`index` and `a` may not outlive append_accessor) */
+	m.meshes[size_t(mesh)].primitives[size_t(p)].attributes[name] = added;
+	refs.push_back(1);
+	mine.push_back(1);
+	written.push_back(1);
+	json &o = doc.original;
+	if (o.is_object() && o.contains("meshes") && o["meshes"].is_array() && size_t(mesh) < o["meshes"].size()) {
+		json &om = o["meshes"][size_t(mesh)];
+		if (om.is_object() && om.contains("primitives") && om["primitives"].is_array() &&
+		    size_t(p) < om["primitives"].size() && om["primitives"][size_t(p)].is_object() &&
+		    om["primitives"][size_t(p)].contains("attributes") && om["primitives"][size_t(p)]["attributes"].is_object())
+			om["primitives"][size_t(p)]["attributes"][name] = added;
+	}
+	return --refs[size_t(old)] == 0;
+}
+
+/* Writes into the document the skin weights the reader changed by mlod's
+ * rule (read_character's fixed: mesh, primitive), so that level 0 of
+ * what a tool writes passes the validator as its levels do: each
+ * JOINTS_n and WEIGHTS_n accessor whose values the rule changed gets c's
+ * values, in its own component type where that can hold them. Float
+ * weights take c's floats as they are. Normalised unsigned bytes or
+ * shorts (every set of the primitive in one such type) must sum to
+ * exactly 255 or 65535: each changed vertex's weights are rounded by
+ * largest remainder, over all its sets, and c takes the values the
+ * reader reads back from those (less than a step from the rule's);
+ * other weight types become floats. Joints keep their type unless the
+ * root joint does not fit (unsigned bytes past 255: unsigned shorts).
+ * An accessor is written in place (its bytes, bounds kept true) when it
+ * owns its bytes, keeps its type and only the primitives rewritten here
+ * refer to it; otherwise the primitive gets a new accessor, and the old
+ * data goes (prune) when nothing else uses it and the document may be
+ * pruned. Valid weights: nothing changes. */
+void set_skin_weights(mlod_gltf &doc, mlod_character &c, const std::vector<std::pair<int, int>> &fixed)
+{
+	if (fixed.empty())
+		return;
+	Model &m = doc.model;
+	std::vector<int> refs = accessor_refs(m), mine(m.accessors.size(), 0);
+	for (const auto &mp : fixed)
+		for (const auto &kv : m.meshes[size_t(mp.first)].primitives[size_t(mp.second)].attributes)
+			if (skin_attribute(kv.first))
+				mine[size_t(kv.second)]++;
+	std::vector<char> written(m.accessors.size(), 0);
+	bool orphans = false;
+	for (const auto &mp : fixed) {
+		const int mesh = mp.first, p = mp.second;
+		mlod_primitive &pr = c.meshes[mesh].primitives[p];
+		const size_t n = size_t(pr.vertex_count);
+		const int sets = pr.weight_set_count;
+		const size_t ns = size_t(sets);
+		std::vector<std::string> wn(ns), jn(ns);
+		std::vector<std::vector<float>> have_w(ns);
+		std::vector<std::vector<uint32_t>> have_j(ns);
+		int wtype = -1;
+		bool wnorm = false, one_type = true;
+		for (int k = 0; k < sets; k++) {
+			wn[size_t(k)] = "WEIGHTS_" + std::to_string(k);
+			jn[size_t(k)] = "JOINTS_" + std::to_string(k);
+			const auto &attrs = m.meshes[size_t(mesh)].primitives[size_t(p)].attributes;
+			int wa = attrs.at(wn[size_t(k)]), ja = attrs.at(jn[size_t(k)]);
+			have_w[size_t(k)] = read_floats(m, wa, wn[size_t(k)], TINYGLTF_TYPE_VEC4);
+			have_j[size_t(k)] = read_uints(m, ja, jn[size_t(k)], TINYGLTF_TYPE_VEC4);
+			const tinygltf::Accessor &a = m.accessors[size_t(wa)];
+			if (k == 0)
+				wtype = a.componentType, wnorm = a.normalized;
+			one_type = one_type && a.componentType == wtype && a.normalized == wnorm;
+		}
+		double scale = 0.0; /* stored value of weight 1; 0: floats */
+		if (one_type && wnorm && wtype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE)
+			scale = 255.0;
+		else if (one_type && wnorm && wtype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)
+			scale = 65535.0;
+		if (scale > 0.0) {
+			/* Largest remainder over the vertex's weights, ties to the
+			 * first: the stored values sum to exactly `scale`. */
+			std::vector<double> x(4 * size_t(sets));
+			std::vector<size_t> order(x.size());
+			for (size_t v = 0; v < n; v++) {
+				bool changed = false;
+				double total = 0.0;
+				for (int k = 0; k < sets; k++)
+					for (size_t i = 0; i < 4; i++) {
+						float w = pr.weights[k][4 * v + i];
+						changed = changed || memcmp(&w, &have_w[size_t(k)][4 * v + i], sizeof w) != 0;
+						total += w;
+					}
+				if (!changed || !(total > 0.0))
+					continue;
+				double left = scale;
+				for (size_t i = 0; i < x.size(); i++) {
+					x[i] = double(pr.weights[i / 4][4 * v + i % 4]) / total * scale;
+					left -= std::floor(x[i]);
+					order[i] = i;
+				}
+				std::stable_sort(order.begin(), order.end(),
+				                 [&](size_t a, size_t b) { return x[a] - std::floor(x[a]) > x[b] - std::floor(x[b]); });
+				for (size_t r = 0; r < x.size(); r++) {
+					double q = std::floor(x[order[r]]) + (double(r) < left ? 1.0 : 0.0);
+					/* as the reader reads it (gltf_accessor.cpp) */
+					pr.weights[order[r] / 4][4 * v + order[r] % 4] = float(q / scale);
+				}
+			}
+		}
+		for (int k = 0; k < sets; k++) {
+			if (memcmp(pr.weights[k], have_w[size_t(k)].data(), 4 * n * sizeof(float)) != 0) {
+				std::vector<double> raw(4 * n);
+				for (size_t i = 0; i < raw.size(); i++)
+					raw[i] = scale > 0.0 ? std::round(double(pr.weights[k][i]) * scale) : double(pr.weights[k][i]);
+				orphans |= put_attribute(doc, mesh, p, wn[size_t(k)], raw,
+				                         scale > 0.0 ? wtype : int(TINYGLTF_COMPONENT_TYPE_FLOAT), scale > 0.0, refs,
+				                         mine, written);
+			}
+			bool same = true;
+			uint32_t most = 0;
+			std::vector<double> raw(4 * n);
+			for (size_t i = 0; i < raw.size(); i++) {
+				same = same && pr.joints[k][i] == have_j[size_t(k)][i];
+				most = std::max(most, uint32_t(pr.joints[k][i]));
+				raw[i] = pr.joints[k][i];
+			}
+			if (same)
+				continue;
+			int jtype = m.accessors[size_t(m.meshes[size_t(mesh)].primitives[size_t(p)].attributes.at(jn[size_t(k)]))]
+			                .componentType;
+			if (jtype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && most > 0xFF)
+				jtype = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+			orphans |= put_attribute(doc, mesh, p, jn[size_t(k)], raw, jtype, false, refs, mine, written);
+		}
+	}
+	if (!orphans)
+		return;
+	bool safe = doc.keep_indices;
+	if (!safe) {
+		safe = true;
+		for (const std::string &e : m.extensionsUsed)
+			safe = safe && prune_safe(m, e);
+	}
+	if (safe)
+		prune(doc, false);
+}
+
 } /* namespace mlod_gltf_internal */

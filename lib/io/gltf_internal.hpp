@@ -279,9 +279,11 @@ std::vector<uint32_t> read_uints(const Model &m, int i, const std::string &what,
 std::string serialize(const mlod_gltf &doc, bool binary);
 
 /* In gltf_model.cpp: glTF -> character */
-void read_character(const mlod_gltf &doc, mlod_character &c);
+void read_character(const mlod_gltf &doc, mlod_character &c, std::vector<std::pair<int, int>> *fixed = nullptr);
 
 /* In gltf_model.cpp: character -> glTF */
+int append_accessor(Model &m, const void *data, size_t count, int component_type, int type, int comps, int target,
+                    bool min_max);
 int append_floats(Model &m, const float *v, size_t count, int comps, int target, bool min_max = false);
 void check_finite(const float *v, size_t n, const char *what);
 int add_mesh(Model &m, const mlod_mesh &mesh);
@@ -306,6 +308,7 @@ void fill_node_trs(mlod_gltf &doc, int node, const mlod_trs &rest, int mode);
 void drop_animation(mlod_gltf &doc, int a);
 void drop_inverse_binds(mlod_gltf &doc, int k);
 void set_inverse_binds(mlod_gltf &doc, int k, const mlod_mat4 *ibm, int count);
+void set_skin_weights(mlod_gltf &doc, mlod_character &c, const std::vector<std::pair<int, int>> &fixed);
 
 } /* namespace mlod_gltf_internal */
 

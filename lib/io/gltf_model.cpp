@@ -18,7 +18,10 @@ namespace {
 /* Builds an mlod_character from a document; every method may throw. */
 class CharacterReader {
 public:
-	CharacterReader(const mlod_gltf &doc, mlod_character &c) : doc_(doc), m_(doc.model), c_(c) {}
+	CharacterReader(const mlod_gltf &doc, mlod_character &c, std::vector<std::pair<int, int>> *fixed)
+	    : doc_(doc), m_(doc.model), c_(c), fixed_(fixed)
+	{
+	}
 
 	void read()
 	{
@@ -45,6 +48,7 @@ private:
 	const mlod_gltf &doc_;
 	const Model &m_;
 	mlod_character &c_;
+	std::vector<std::pair<int, int>> *fixed_; /* the (mesh, primitive) pairs weights() changed; may be null */
 	std::vector<int> parent_;       /* per node */
 	std::vector<int> order_;        /* nodes, parents first */
 	std::vector<mlod_mat4> local_;  /* per node */
@@ -477,8 +481,9 @@ private:
 	/* Skin weights glTF does not allow, made valid by mlod's one rule
 	 * (mlod_primitive_fix_weights): the primitives of each mesh a skinned
 	 * node uses (an instance, or a node outside the scene: an MSFT_lod
-	 * level), so that every level a tool writes from them is valid; the
-	 * input's own accessors stay as they are. An all-zero vertex goes on
+	 * level), so that every level a tool writes from them is valid (the
+	 * primitives changed go into fixed_, for set_skin_weights to write
+	 * into the document's own accessors). An all-zero vertex goes on
 	 * the skin's root, a skin joint index; a mesh whose skins have their
 	 * roots at different indices keeps such vertices as they are, with a
 	 * warning (mlod-pack then puts each on its own part's skin's root). */
@@ -510,6 +515,8 @@ private:
 				mlod_weight_fix fix;
 				const bool rule = agree && root >= 0;
 				mlod_primitive_fix_weights(&c_.meshes[m].primitives[p], rule ? root : -1, &fix);
+				if (fixed_ && ((rule && fix.unweighted > 0) || fix.rescaled > 0))
+					fixed_->emplace_back(m, p);
 				if (!rule && fix.unweighted > 0)
 					warn("mesh %d primitive %d: %d vertices have no weight (vertex %d the first), and the skins that "
 					     "use the mesh have no common root joint: they stay without weight", m, p, fix.unweighted,
@@ -692,10 +699,11 @@ private:
 
 } /* namespace */
 
-/* Fills c from doc (may throw). */
-void read_character(const mlod_gltf &doc, mlod_character &c)
+/* Fills c from doc (may throw); fixed (may be null) gets the (mesh,
+ * primitive) pairs whose skin weights mlod's rule changed. */
+void read_character(const mlod_gltf &doc, mlod_character &c, std::vector<std::pair<int, int>> *fixed)
 {
-	CharacterReader(doc, c).read();
+	CharacterReader(doc, c, fixed).read();
 }
 
 /* ------------------------------------------------------------------ */
@@ -723,8 +731,8 @@ static int append_view(Model &m, const void *data, size_t size, int target)
 
 /* Appends an accessor over count elements of comps components at data.
  * With min_max, records the per-component bounds (floats only). */
-static int append_accessor(Model &m, const void *data, size_t count, int component_type, int type, int comps,
-                           int target, bool min_max)
+int append_accessor(Model &m, const void *data, size_t count, int component_type, int type, int comps, int target,
+                    bool min_max)
 {
 	size_t bytes = count * size_t(comps) * component_size(component_type);
 	tinygltf::Accessor a;

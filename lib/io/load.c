@@ -95,8 +95,11 @@ mlod_result mlod_load(const void *data, size_t size, const char *base_dir, mlod_
 	case MLOD_FORMAT_GLB:
 	case MLOD_FORMAT_GLTF:
 		r = mlod_gltf_read(data, size, base_dir, &d, err);
+		/* A document the caller keeps (to write back) takes the skin
+		 * weights the reader makes valid: level 0 of every tool's output
+		 * passes the validator as its levels do. */
 		if (r == MLOD_OK)
-			r = mlod_gltf_to_character(d, c, err);
+			r = doc ? mlod_gltf_to_character_fix(d, c, err) : mlod_gltf_to_character(d, c, err);
 		if (r == MLOD_OK)
 			r = mlod_character_validate(c, err);
 		break;

@@ -60,6 +60,25 @@ mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data,
  * was changed, approximated or dropped of the input also in out->warnings. */
 mlod_result mlod_gltf_to_character(const mlod_gltf *doc, mlod_character *out,
                                    mlod_error *err);
+/* mlod_gltf_to_character for a document that will be written back (what
+ * mlod_load does): the reader's rule for skin weights glTF does not allow
+ * (mlod_primitive_fix_weights) then holds in the document too. Each
+ * JOINTS_n and WEIGHTS_n accessor whose values the rule changed gets the
+ * character's values, in its own component type where that can hold
+ * them: floats stay floats, bit for bit; normalised unsigned bytes or
+ * shorts (every set of the primitive in that one type) keep it, each
+ * changed vertex's weights rounded by largest remainder to sum to
+ * exactly 255 or 65535, and the character takes the values read back
+ * from those; other weight types become floats, and joints stored as
+ * unsigned bytes become unsigned shorts when the skin's root joint is
+ * past 255. An accessor that only such primitives use and whose bytes
+ * are its own (no sparse part, no other accessor or image on them) is
+ * overwritten in place, its min and max kept true; otherwise the
+ * primitive gets a new accessor, and the old data goes when nothing uses
+ * it (as mlod_gltf_prune, but for a document it would refuse). Nothing
+ * changes in a document whose weights are valid. On failure doc may be
+ * partly changed. */
+mlod_result mlod_gltf_to_character_fix(mlod_gltf *doc, mlod_character *out, mlod_error *err);
 
 /* Builds a new document from a character: nodes for joints (joint i is
  * node i; End Sites become child nodes marked extras.mlod.end_site),
@@ -319,6 +338,8 @@ mlod_format mlod_detect_format(const void *data, size_t size);
 
 /* Loads glb, glTF or BVH bytes into a document and a character. BVH gets a
  * document made with mlod_gltf_from_character, so every tool writes glb.
+ * A glTF document is read with mlod_gltf_to_character_fix: it holds the
+ * skin weights the reader made valid, as the character does.
  * doc may be NULL when only the character is wanted. On failure nothing
  * is allocated. */
 mlod_result mlod_load(const void *data, size_t size, const char *base_dir,
