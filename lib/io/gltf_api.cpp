@@ -63,20 +63,31 @@ mlod_result mlod_gltf_write(const mlod_gltf *doc, int binary, void **data, size_
 	});
 }
 
+/* The character of doc into *out (zeroed first, freed on failure); with
+ * fix (doc itself), the skin weights the reader made valid are written
+ * back into it (mlod_gltf_to_character_fix). */
+static void to_character(const mlod_gltf &doc, mlod_gltf *fix, mlod_character *out)
+{
+	memset(out, 0, sizeof *out);
+	mlod_character c;
+	memset(&c, 0, sizeof c);
+	try {
+		std::vector<std::pair<int, int>> fixed;
+		read_character(doc, c, fix ? &fixed : nullptr);
+		if (fix)
+			set_skin_weights(*fix, c, fixed);
+	} catch (...) {
+		mlod_character_free(&c);
+		throw;
+	}
+	*out = c;
+}
+
 mlod_result mlod_gltf_to_character(const mlod_gltf *doc, mlod_character *out, mlod_error *err)
 {
 	return guard(err, [&] {
 		need(doc && out, "mlod_gltf_to_character: doc and out must not be NULL");
-		memset(out, 0, sizeof *out);
-		mlod_character c;
-		memset(&c, 0, sizeof c);
-		try {
-			read_character(*doc, c);
-		} catch (...) {
-			mlod_character_free(&c);
-			throw;
-		}
-		*out = c;
+		to_character(*doc, nullptr, out);
 	});
 }
 
@@ -84,18 +95,7 @@ mlod_result mlod_gltf_to_character_fix(mlod_gltf *doc, mlod_character *out, mlod
 {
 	return guard(err, [&] {
 		need(doc && out, "mlod_gltf_to_character_fix: doc and out must not be NULL");
-		memset(out, 0, sizeof *out);
-		mlod_character c;
-		memset(&c, 0, sizeof c);
-		try {
-			std::vector<std::pair<int, int>> fixed;
-			read_character(*doc, c, &fixed);
-			set_skin_weights(*doc, c, fixed);
-		} catch (...) {
-			mlod_character_free(&c);
-			throw;
-		}
-		*out = c;
+		to_character(*doc, doc, out);
 	});
 }
 
