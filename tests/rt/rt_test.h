@@ -17,6 +17,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,6 +59,25 @@ static char t_msg_[1024];
 #define M_PI 3.14159265358979323846
 #endif
 #define NEAR(a, b, tol) (fabs((double)(a) - (double)(b)) <= (tol))
+
+/* Read callbacks (mlod_rt_read, user = an rt_mem_source) over a pack in
+ * memory: they count their calls, and fail (-1) while fail is set or for
+ * a range past the end. */
+typedef struct rt_mem_source {
+	const uint8_t *data;
+	size_t size;
+	int fail;
+	unsigned long reads;
+} rt_mem_source;
+static inline int rt_mem_read(void *user, uint64_t offset, size_t size, void *dst)
+{
+	rt_mem_source *m = user;
+	m->reads++;
+	if (m->fail || offset > m->size || size > m->size - offset)
+		return -1;
+	memcpy(dst, m->data + offset, size);
+	return 0;
+}
 
 /* Allocator hooks (mlod_rt_allocator, user = an rt_counter) that count
  * the bytes and blocks they hold and can be told to fail: held is what

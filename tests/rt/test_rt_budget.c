@@ -56,26 +56,13 @@ static int packs_ready(void)
 	return 1;
 }
 
-typedef struct source {
-	const uint8_t *data;
-	size_t size;
-} source;
-static int s_read(void *user, uint64_t off, size_t size, void *dst)
-{
-	const source *s = user;
-	if (off > s->size || size > s->size - off)
-		return -1;
-	memcpy(dst, s->data + off, size);
-	return 0;
-}
-
 /* Opens pack k from memory (how 0) or read callbacks (how 1). */
-static mlod_result open_how(const struct pk *k, int how, source *src, size_t budget, mlod_rt_ctx **ctx,
+static mlod_result open_how(const struct pk *k, int how, rt_mem_source *src, size_t budget, mlod_rt_ctx **ctx,
                             mlod_error *e)
 {
 	mlod_rt_config cfg = { budget, 4, NULL };
-	src->data = k->data, src->size = k->size;
-	return how ? mlod_rt_open_read(s_read, src, k->size, &cfg, ctx, e)
+	*src = (rt_mem_source){ k->data, k->size, 0, 0 };
+	return how ? mlod_rt_open_read(rt_mem_read, src, k->size, &cfg, ctx, e)
 	           : mlod_rt_open_memory(k->data, k->size, &cfg, ctx, e);
 }
 
@@ -100,7 +87,7 @@ static void levels_in_their_size(const struct pk *k, int *checked)
 	for (int how = 0; how < 2; how++) {
 		mlod_error e = { 0 };
 		mlod_rt_ctx *ctx = NULL;
-		source src;
+		rt_mem_source src;
 		CHECK_OK(open_how(k, how, &src, 0, &ctx, &e), e);
 		mlod_rt_stats st;
 		mlod_rt_stats_get(ctx, &st);
@@ -350,11 +337,11 @@ TEST(hostile_skeleton_claims_fail_the_level)
 			const struct pk ed = { k->sample, k->opts, k->file, "", d, k->size };
 			mlod_error e = { 0 };
 			mlod_rt_ctx *ctx = NULL;
-			source src;
+			rt_mem_source src;
 			size_t need = 0;
 			CHECK_OK(mlod_rt_open_memory_bytes(d, k->size, NULL, &need, &e), e);
 			if (read)
-				CHECK_OK(mlod_rt_open_read_bytes(s_read, &(source){ d, k->size }, k->size, NULL, &need, &e), e);
+				CHECK_OK(mlod_rt_open_read_bytes(rt_mem_read, &(rt_mem_source){ d, k->size, 0, 0 }, k->size, NULL, &need, &e), e);
 			CHECK_OK(open_how(&ed, read, &src, need + extra, &ctx, &e), e);
 			CHECK_OK(mlod_rt_request(ctx, MLOD_RT_SKELETON, 1, 0, &e), e);
 			mlod_result r = mlod_rt_stream(ctx, SIZE_MAX, NULL, &e);
@@ -384,11 +371,11 @@ TEST(open_bytes_is_the_least_budget)
 		const struct pk *k = &packs[p];
 		mlod_error e = { 0 };
 		size_t need[3] = { 0, 0, 0 };
-		source src = { k->data, k->size };
+		rt_mem_source src = { k->data, k->size, 0, 0 };
 		mlod_rt_config big = { 1, 4, NULL }; /* its budget is ignored */
 		CHECK_OK(mlod_rt_open_memory_bytes(k->data, k->size, &big, &need[0], &e), e);
 		CHECK_OK(mlod_rt_open_path_bytes(k->path, NULL, &need[1], &e), e);
-		CHECK_OK(mlod_rt_open_read_bytes(s_read, &src, k->size, NULL, &need[2], &e), e);
+		CHECK_OK(mlod_rt_open_read_bytes(rt_mem_read, &src, k->size, NULL, &need[2], &e), e);
 		CHECK(need[0] > 0 && need[1] > need[0] && need[1] == need[2],
 		      "%s: memory %zu, path %zu, read %zu (the staging buffer beyond memory's)", k->file, need[0], need[1],
 		      need[2]);
@@ -398,7 +385,7 @@ TEST(open_bytes_is_the_least_budget)
 				mlod_rt_ctx *ctx = NULL;
 				mlod_result r = how == 0   ? mlod_rt_open_memory(k->data, k->size, &cfg, &ctx, &e)
 				                : how == 1 ? mlod_rt_open_path(k->path, &cfg, &ctx, &e)
-				                           : mlod_rt_open_read(s_read, &src, k->size, &cfg, &ctx, &e);
+				                           : mlod_rt_open_read(rt_mem_read, &src, k->size, &cfg, &ctx, &e);
 				CHECK(r == (less ? MLOD_ERR_LIMIT : MLOD_OK), "%s, open %d under %zu: %s: %s", k->file, how,
 				      cfg.budget_bytes, mlod_strerror(r), e.message);
 				if (r == MLOD_OK) {

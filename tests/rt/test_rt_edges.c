@@ -23,37 +23,11 @@
 #include "rt_packer.h"
 
 
-/* A pack in memory read through the callback, counting the reads. */
-typedef struct mem_src {
-	const uint8_t *d;
-	size_t n;
-	unsigned long reads;
-} mem_src;
-
-static int mem_read(void *user, uint64_t offset, size_t size, void *dst)
-{
-	mem_src *m = user;
-	m->reads++;
-	if (offset > m->n || size > m->n - offset)
-		return -1;
-	memcpy(dst, m->d + offset, size);
-	return 0;
-}
-
-/* ---------------------------------------------------------------- */
-/* Issue 4: the room made for a mesh level is its size                */
-/* ---------------------------------------------------------------- */
-
-/* For each mesh level L but the coarsest: its resident bytes B (no
- * budget); under a budget of the open's resident bytes plus B, a request
- * for L alone loads it; plus B - 1 it does not, nothing fails, the peak
- * stays within the budget, and a second call reads nothing (the level's
- * size is remembered). */
-static const char *room_pass(const char *what, mem_src *m, char *msg, size_t cap)
+static const char *room_pass(const char *what, rt_mem_source *m, char *msg, size_t cap)
 {
 	mlod_error e = { 0 };
 	mlod_rt_ctx *ctx = NULL;
-	mlod_result r0 = mlod_rt_open_read(mem_read, m, m->n, NULL, &ctx, &e);
+	mlod_result r0 = mlod_rt_open_read(rt_mem_read, m, m->size, NULL, &ctx, &e);
 	if (r0 == MLOD_ERR_UNSUPPORTED && strstr(what, "draco")) {
 		printf("# %s: %s (a runtime built with MLOD_DRACO=0): not measured\n", what, e.message);
 		return NULL;
@@ -82,7 +56,7 @@ static const char *room_pass(const char *what, mem_src *m, char *msg, size_t cap
 	for (uint32_t l = 0; l + 1 < L && l < 64; l++)
 		for (int less = 0; less <= 1; less++) {
 			mlod_rt_config cfg = { base + bytes[l] - (size_t)less, 4, NULL };
-			if (mlod_rt_open_read(mem_read, m, m->n, &cfg, &ctx, &e)) {
+			if (mlod_rt_open_read(rt_mem_read, m, m->size, &cfg, &ctx, &e)) {
 				snprintf(msg, cap, "%s: open under %zu: %s", what, cfg.budget_bytes, e.message);
 				return msg;
 			}
@@ -137,11 +111,11 @@ TEST(mesh_room_is_its_size)
 		char pk[512], msg[768];
 		CHECK(run_pack(packs[i].in, packs[i].opts, packs[i].out, pk, sizeof pk) == 0, "mlod-pack on %s failed",
 		      packs[i].in);
-		mem_src m = { NULL, 0, 0 };
-		m.d = read_all(pk, &m.n);
-		CHECK(m.d, "reading %s", pk);
+		rt_mem_source m = { NULL, 0, 0, 0 };
+		m.data = read_all(pk, &m.size);
+		CHECK(m.data, "reading %s", pk);
 		const char *why = room_pass(packs[i].out, &m, msg, sizeof msg);
-		free((void *)m.d);
+		free((void *)m.data);
 		CHECK(!why, "%s", why);
 	}
 }
@@ -159,13 +133,13 @@ TEST(failed_load_spends_no_budget)
 	SKIP_IF_NO_PACK(failed_load_spends_no_budget);
 	char pk[512];
 	CHECK(run_pack("samples/RobotExpressive.glb", "", "robot.mlod", pk, sizeof pk) == 0, "mlod-pack failed");
-	mem_src m = { NULL, 0, 0 };
-	uint8_t *d = read_all(pk, &m.n);
+	rt_mem_source m = { NULL, 0, 0, 0 };
+	uint8_t *d = read_all(pk, &m.size);
 	CHECK(d, "reading %s", pk);
-	m.d = d;
+	m.data = d;
 	mlod_pack p;
 	mlod_error e = { 0 };
-	mlod_result r = mlod_pack_open(d, m.n, &p, &e);
+	mlod_result r = mlod_pack_open(d, m.size, &p, &e);
 	int k = r == MLOD_OK ? mlod_pack_find(&p, MLOD_CHUNK_MESH, 1, 0) : -1;
 	uint64_t off = k >= 0 ? p.chunks[k].offset : 0;
 	uint32_t n = k >= 0 ? p.chunks[k].stored_size : 0;
@@ -177,7 +151,7 @@ TEST(failed_load_spends_no_budget)
 	for (uint32_t i = n / 2; i < n / 2 + 8; i++)
 		d[off + i] ^= 0x5a;
 	mlod_rt_ctx *ctx = NULL;
-	r = mlod_rt_open_read(mem_read, &m, m.n, NULL, &ctx, &e);
+	r = mlod_rt_open_read(rt_mem_read, &m, m.size, NULL, &ctx, &e);
 	if (r)
 		free(d);
 	CHECK_OK(r, e);
@@ -239,13 +213,13 @@ TEST(allocator_both_or_neither)
 	CHECK(tube_ready(), "mlod-pack on tubeman failed");
 	mlod_rt_allocator half = { only_malloc, NULL, NULL };
 	mlod_rt_config cfg = { 0, 0, &half };
-	mem_src m = { tube, tube_size, 0 };
+	rt_mem_source m = { tube, tube_size, 0, 0 };
 	for (int k = 0; k < 4; k++) {
 		mlod_error e = { 0 };
 		mlod_rt_ctx *ctx = (mlod_rt_ctx *)&e; /* *out is set to NULL */
 		mlod_result r = k == 0   ? mlod_rt_open_memory(tube, tube_size, &cfg, &ctx, &e)
 		                : k == 1 ? mlod_rt_open_path(tube_path, &cfg, &ctx, &e)
-		                : k == 2 ? mlod_rt_open_read(mem_read, &m, tube_size, &cfg, &ctx, &e)
+		                : k == 2 ? mlod_rt_open_read(rt_mem_read, &m, tube_size, &cfg, &ctx, &e)
 		                         : MLOD_ERR_INVALID_ARG;
 		if (k == 3) { /* neither hook: the defaults */
 			mlod_rt_allocator other = { NULL, NULL, NULL };
@@ -415,11 +389,11 @@ TEST(info_counts_checked)
 	for (size_t k = 0; k < sizeof edits / sizeof edits[0]; k++) {
 		uint8_t *d = info_edit(edits[k].at, edits[k].v);
 		CHECK(d, "editing INFO");
-		mem_src m = { d, tube_size, 0 };
+		rt_mem_source m = { d, tube_size, 0, 0 };
 		for (int src = 0; src < 2; src++) {
 			mlod_error e = { 0 };
 			mlod_rt_ctx *ctx = NULL;
-			mlod_result r = src ? mlod_rt_open_read(mem_read, &m, m.n, NULL, &ctx, &e)
+			mlod_result r = src ? mlod_rt_open_read(rt_mem_read, &m, m.size, NULL, &ctx, &e)
 			                    : mlod_rt_open_memory(d, tube_size, NULL, &ctx, &e);
 			mlod_rt_close(ctx);
 			const int valid = edits[k].at == 4; /* skin_count 1: as written */

@@ -55,21 +55,6 @@ static int packs_ready(void)
 	return 1;
 }
 
-/* Read callbacks over memory, with a switch that makes them fail. */
-typedef struct source {
-	const uint8_t *data;
-	size_t size;
-	int fail;
-} source;
-static int s_read(void *user, uint64_t off, size_t size, void *dst)
-{
-	const source *s = user;
-	if (s->fail || off > s->size || size > s->size - off)
-		return -1;
-	memcpy(dst, s->data + off, size);
-	return 0;
-}
-
 /* expr fails with code (the message is not checked here: the docs name codes). */
 #define CHECK_CODE(expr, code)                                                                     \
 	do {                                                                                       \
@@ -98,10 +83,10 @@ TEST(open_three_ways_and_their_errors)
 		CHECK_CODE(mlod_rt_open_memory(k->data, k->size / 2, NULL, &ctx, &e), MLOD_ERR_PARSE);
 		CHECK_CODE(mlod_rt_open_memory(NULL, k->size, NULL, &ctx, &e), MLOD_ERR_INVALID_ARG);
 		CHECK_CODE(mlod_rt_open_path("/nonexistent/x.mlod", NULL, &ctx, &e), MLOD_ERR_IO);
-		source s = { k->data, k->size, 1 };
-		CHECK_CODE(mlod_rt_open_read(s_read, &s, k->size, NULL, &ctx, &e), MLOD_ERR_IO);
+		rt_mem_source s = { k->data, k->size, 1, 0 };
+		CHECK_CODE(mlod_rt_open_read(rt_mem_read, &s, k->size, NULL, &ctx, &e), MLOD_ERR_IO);
 		s.fail = 0;
-		CHECK_CODE(mlod_rt_open_read(s_read, &s, k->size - 100, NULL, &ctx, &e), MLOD_ERR_PARSE);
+		CHECK_CODE(mlod_rt_open_read(rt_mem_read, &s, k->size - 100, NULL, &ctx, &e), MLOD_ERR_PARSE);
 		mlod_rt_allocator half = { rt_counter_malloc, NULL, NULL };
 		cfg.budget_bytes = 0, cfg.allocator = &half;
 		CHECK_CODE(mlod_rt_open_memory(k->data, k->size, &cfg, &ctx, &e), MLOD_ERR_INVALID_ARG);
@@ -250,12 +235,12 @@ TEST(crowd_from_memory_and_read_callbacks)
 			rt_counter c = { 0, 0, -1 };
 			mlod_rt_allocator a = { rt_counter_malloc, rt_counter_free, &c };
 			mlod_rt_config cfg = { budget, N, &a };
-			source s = { k->data, k->size, 0 };
+			rt_mem_source s = { k->data, k->size, 0, 0 };
 			ctx = NULL;
 			if (way == 0)
 				CHECK_OK(mlod_rt_open_memory(k->data, k->size, &cfg, &ctx, &e), e);
 			else
-				CHECK_OK(mlod_rt_open_read(s_read, &s, k->size, &cfg, &ctx, &e), e);
+				CHECK_OK(mlod_rt_open_read(rt_mem_read, &s, k->size, &cfg, &ctx, &e), e);
 			crowd(ctx, &c, budget, k->file);
 			mlod_rt_close(ctx);
 			if (t_failed_)
@@ -322,9 +307,9 @@ TEST(read_error_tried_again)
 	for (size_t p = 0; p < 2; p++) {
 		const struct pk *k = &packs[p];
 		mlod_error e = { 0 };
-		source s = { k->data, k->size, 0 };
+		rt_mem_source s = { k->data, k->size, 0, 0 };
 		mlod_rt_ctx *ctx = NULL;
-		CHECK_OK(mlod_rt_open_read(s_read, &s, k->size, NULL, &ctx, &e), e);
+		CHECK_OK(mlod_rt_open_read(rt_mem_read, &s, k->size, NULL, &ctx, &e), e);
 		uint32_t id;
 		CHECK_OK(mlod_rt_instance_create(ctx, 0, 0, 0, &id, &e), e);
 		mlod_rt_select sel;

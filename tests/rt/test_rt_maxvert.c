@@ -24,20 +24,6 @@ static void wr32(uint8_t *p, uint32_t v)
 		p[k] = (uint8_t)(v >> (8 * k));
 }
 
-typedef struct mem_src {
-	const uint8_t *d;
-	size_t n;
-} mem_src;
-
-static int mem_read(void *user, uint64_t offset, size_t size, void *dst)
-{
-	mem_src *m = user;
-	if (offset > m->n || size > m->n - offset)
-		return -1;
-	memcpy(dst, m->d + offset, size);
-	return 0;
-}
-
 /* A pack as mlod-pack wrote it (read into memory), or NULL. */
 typedef struct packed {
 	const char *what;
@@ -141,10 +127,10 @@ static void load_all(mlod_rt_ctx *ctx, uint32_t *max, uint32_t *stated, uint32_t
 }
 
 /* Opens d from memory (src 0) or through a read callback (src 1). */
-static mlod_result open_src(int src, const uint8_t *d, size_t n, mem_src *m, mlod_rt_ctx **ctx, mlod_error *e)
+static mlod_result open_src(int src, const uint8_t *d, size_t n, rt_mem_source *m, mlod_rt_ctx **ctx, mlod_error *e)
 {
-	m->d = d, m->n = n;
-	return src ? mlod_rt_open_read(mem_read, m, n, NULL, ctx, e) : mlod_rt_open_memory(d, n, NULL, ctx, e);
+	*m = (rt_mem_source){ d, n, 0, 0 };
+	return src ? mlod_rt_open_read(rt_mem_read, m, n, NULL, ctx, e) : mlod_rt_open_memory(d, n, NULL, ctx, e);
 }
 
 /* The value at open is the largest level's, and stays it as every level
@@ -157,7 +143,7 @@ TEST(known_at_open)
 		for (int src = 0; src < 2; src++) {
 			mlod_error e = { 0 };
 			mlod_rt_ctx *ctx = NULL;
-			mem_src m;
+			rt_mem_source m;
 			CHECK_OK(open_src(src, packs[i].d, packs[i].n, &m, &ctx, &e), e);
 			const uint32_t at_open = mlod_rt_max_vertex_count(ctx);
 			const uint32_t L = mlod_rt_level_count(ctx, MLOD_RT_MESH);
@@ -216,7 +202,7 @@ TEST(smaller_fails_the_level)
 			uint8_t *d = edited(&packs[i], more ? max + 1 : max - 1, -1);
 			CHECK(d, "editing %s", packs[i].what);
 			for (int src = 0; src < 2; src++) {
-				mem_src m;
+				rt_mem_source m;
 				ctx = NULL;
 				mlod_result r = open_src(src, d, packs[i].n, &m, &ctx, &e);
 				if (r != MLOD_OK) {
@@ -311,7 +297,7 @@ TEST(hostile_value_refused)
 			for (int src = 0; src < 2; src++) {
 				mlod_error e = { 0 };
 				mlod_rt_ctx *ctx = NULL;
-				mem_src m;
+				rt_mem_source m;
 				mlod_result r = open_src(src, d, packs[i].n, &m, &ctx, &e);
 				const uint32_t got = ctx ? mlod_rt_max_vertex_count(ctx) : 0;
 				mlod_rt_close(ctx);
@@ -344,7 +330,7 @@ TEST(previous_minor_opens)
 			for (int src = 0; src < 2; src++) {
 				mlod_error e = { 0 };
 				mlod_rt_ctx *ctx = NULL;
-				mem_src m;
+				rt_mem_source m;
 				mlod_result r = open_src(src, d, packs[i].n, &m, &ctx, &e);
 				if (r != MLOD_OK) {
 					if (v)
