@@ -66,6 +66,21 @@ mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config)
 	return ctx;
 }
 
+int rt_units_make(mlod_rt_ctx *ctx, uint32_t skel_levels, uint32_t mesh_levels, uint32_t clip_count,
+                  uint32_t motion_levels)
+{
+	ctx->levels[MLOD_RT_SKELETON] = skel_levels;
+	ctx->levels[MLOD_RT_MESH] = mesh_levels;
+	ctx->clip_count = motion_levels ? clip_count : 0;
+	ctx->levels[MLOD_RT_MOTION] = ctx->clip_count ? motion_levels : 0;
+	ctx->unit_count = ctx->levels[0] + ctx->levels[1] + ctx->clip_count * ctx->levels[2];
+	ctx->unit_base[0] = 0;
+	ctx->unit_base[1] = ctx->levels[0];
+	ctx->unit_base[2] = ctx->levels[0] + ctx->levels[1];
+	ctx->units = rt_calloc(ctx, ctx->unit_count, sizeof *ctx->units);
+	return ctx->units ? 0 : -1;
+}
+
 rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item)
 {
 	return rt_unit_at(ctx, layer, level, item);

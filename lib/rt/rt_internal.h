@@ -238,6 +238,13 @@ void *rt_alloc(const mlod_rt_ctx *ctx, size_t size);
 void rt_free(const mlod_rt_ctx *ctx, void *p);
 void *rt_calloc(const mlod_rt_ctx *ctx, size_t n, size_t size);
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config);
+/* Lays out ctx's levels and units (a pack's and views' opens alike): the
+ * level counts per layer (no motion levels without clips, no clips
+ * without motion levels), unit_count, unit_base, and the units zeroed;
+ * -1 when they cannot be allocated. The counts are checked (at most
+ * 65,535 each) by the caller. */
+int rt_units_make(mlod_rt_ctx *ctx, uint32_t skel_levels, uint32_t mesh_levels, uint32_t clip_count,
+                  uint32_t motion_levels);
 rt_unit *rt_unit_get(const mlod_rt_ctx *ctx, mlod_rt_layer layer, uint32_t level, uint32_t item);
 /* 1 when config's allocator has one of malloc and free (both or neither). */
 int rt_config_bad(const mlod_rt_config *config);

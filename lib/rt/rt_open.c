@@ -214,16 +214,7 @@ mlod_result mlod_rt_open_views(const mlod_rt_views *v, const mlod_rt_config *con
 	if (!ctx)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
 	ctx->skel = v->skeleton;
-	ctx->levels[MLOD_RT_SKELETON] = v->skel_levels;
-	ctx->levels[MLOD_RT_MESH] = v->mesh_levels;
-	ctx->clip_count = v->motion_levels ? v->clip_count : 0;
-	ctx->levels[MLOD_RT_MOTION] = ctx->clip_count ? v->motion_levels : 0;
-	ctx->unit_count = ctx->levels[0] + ctx->levels[1] + ctx->clip_count * ctx->levels[2];
-	ctx->unit_base[0] = 0;
-	ctx->unit_base[1] = ctx->levels[0];
-	ctx->unit_base[2] = ctx->levels[0] + ctx->levels[1];
-	ctx->units = rt_calloc(ctx, ctx->unit_count, sizeof *ctx->units);
-	if (!ctx->units) {
+	if (rt_units_make(ctx, v->skel_levels, v->mesh_levels, v->clip_count, v->motion_levels)) {
 		mlod_rt_close(ctx);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
 	}

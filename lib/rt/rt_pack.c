@@ -327,18 +327,8 @@ static mlod_result pack_open(mlod_rt_ctx *ctx, mlod_error *err)
 	if (rec->skeleton_levels < 1 || rec->skeleton_levels > 65535 || rec->mesh_levels > 65535 ||
 	    rec->motion_levels > 65535 || rec->clip_count > 65535)
 		return mlod_fail(err, MLOD_ERR_PARSE, "INFO: level counts out of range");
-	ctx->levels[MLOD_RT_SKELETON] = rec->skeleton_levels;
-	ctx->levels[MLOD_RT_MESH] = rec->mesh_levels;
-	ctx->clip_count = rec->motion_levels ? rec->clip_count : 0;
-	ctx->levels[MLOD_RT_MOTION] = ctx->clip_count ? rec->motion_levels : 0;
-	ctx->unit_count = ctx->levels[0] + ctx->levels[1] + ctx->clip_count * ctx->levels[2];
-	ctx->unit_base[0] = 0;
-	ctx->unit_base[1] = ctx->levels[0];
-	ctx->unit_base[2] = ctx->levels[0] + ctx->levels[1];
-	ctx->units = rt_alloc(ctx, sizeof *ctx->units * ctx->unit_count);
-	if (!ctx->units)
+	if (rt_units_make(ctx, rec->skeleton_levels, rec->mesh_levels, rec->clip_count, rec->motion_levels))
 		return mlod_fail(err, MLOD_ERR_NOMEM, "opening: out of memory");
-	memset(ctx->units, 0, sizeof *ctx->units * ctx->unit_count);
 	for (uint32_t i = 0; i < ctx->unit_count; i++) {
 		rt_unit *u = &ctx->units[i];
 		uint32_t type;
