@@ -515,7 +515,7 @@ private:
 				mlod_weight_fix fix;
 				const bool rule = agree && root >= 0;
 				mlod_primitive_fix_weights(&c_.meshes[m].primitives[p], rule ? root : -1, &fix);
-				if (fixed_ && ((rule && fix.unweighted > 0) || fix.rescaled > 0))
+				if (fixed_ && ((rule && fix.unweighted > 0) || fix.rescaled > 0 || fix.merged > 0))
 					fixed_->emplace_back(m, p);
 				if (!rule && fix.unweighted > 0)
 					warn("mesh %d primitive %d: %d vertices have no weight (vertex %d the first), and the skins that "
@@ -528,6 +528,12 @@ private:
 				else if (fix.unweighted > 1)
 					warn("mesh %d primitive %d: %d vertices have no weight (vertex %d the first): they follow the "
 					     "skin's root joint %s", m, p, fix.unweighted, fix.first_unweighted, name.c_str());
+				if (fix.merged == 1)
+					warn("mesh %d primitive %d: vertex %d names one joint in two influences: merged into one", m, p,
+					     fix.first_merged);
+				else if (fix.merged > 1)
+					warn("mesh %d primitive %d: %d vertices name one joint in two influences (vertex %d the first): "
+					     "merged into one", m, p, fix.merged, fix.first_merged);
 				if (fix.rescaled == 1)
 					warn("mesh %d primitive %d: the weights of vertex %d sum to %.9g, not 1: scaled to 1", m, p,
 					     fix.first_rescaled, double(fix.first_sum));

@@ -199,7 +199,11 @@ float mlod_skeleton_extent(const mlod_skeleton *s);
  *   joint (mlod_skin_root), which it then follows; its other influences
  *   become joint 0 at weight 0;
  * - a vertex whose weights sum to something else is scaled to sum to 1
- *   (which changes no pose: skinning divides by the sum).
+ *   (which changes no pose: skinning divides by the sum);
+ * - a vertex that names one joint in two influences or more, each with a
+ *   non-zero weight, keeps the first of them with their summed weight,
+ *   the others becoming joint 0 at weight 0 (which changes no pose either;
+ *   merged first, so the sum is then checked as above).
  * A vertex with a negative or non-finite weight is left as it is (the
  * character then fails mlod_character_validate). */
 typedef struct mlod_weight_fix {
@@ -208,6 +212,8 @@ typedef struct mlod_weight_fix {
 	int rescaled;          /* vertices whose weights were scaled to sum to 1 */
 	int first_rescaled;    /* the first of them, or -1 */
 	float first_sum;       /* its weights' sum before */
+	int merged;            /* vertices whose repeated joints were merged */
+	int first_merged;      /* the first of them, or -1 */
 } mlod_weight_fix;
 
 /* The root of skin `skin` as a skin joint index: of its joints, the

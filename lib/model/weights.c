@@ -45,6 +45,36 @@ static float vertex_sum(const mlod_primitive *p, int v, int *nonzero)
 	return sum;
 }
 
+/* Merges the influences of vertex v that name one joint twice or more
+ * with non-zero weights (the validator's ACCESSOR_JOINTS_INDEX_DUPLICATE)
+ * into the first of them, in the order vertex_sum reads them: its weight
+ * takes theirs, and each later one becomes joint 0 at weight 0. Changes
+ * no pose: skinning sums the influences of a joint however many slots
+ * hold them. Returns whether it merged any. A negative or non-finite
+ * weight is left for mlod_character_validate. */
+static int merge_repeats(mlod_primitive *p, int v)
+{
+	const int n = 4 * p->weight_set_count;
+	int merged = 0;
+	for (int a = 0; a < n; a++) {
+		float *wa = &p->weights[a % p->weight_set_count][4 * (size_t)v + (size_t)(a / p->weight_set_count)];
+		if (!(*wa > 0.0f) || !isfinite(*wa))
+			continue;
+		uint16_t ja = p->joints[a % p->weight_set_count][4 * (size_t)v + (size_t)(a / p->weight_set_count)];
+		for (int b = a + 1; b < n; b++) {
+			const size_t at = 4 * (size_t)v + (size_t)(b / p->weight_set_count);
+			float *wb = &p->weights[b % p->weight_set_count][at];
+			uint16_t *jb = &p->joints[b % p->weight_set_count][at];
+			if (*jb != ja || !(*wb > 0.0f) || !isfinite(*wb))
+				continue;
+			*wa += *wb;
+			*wb = 0.0f, *jb = 0;
+			merged = 1;
+		}
+	}
+	return merged;
+}
+
 /* Whether the validator takes the sum: within 2e-7 of 1 per non-zero
  * weight (its ACCESSOR_WEIGHTS_NON_NORMALIZED tolerance). */
 static int sum_ok(float sum, int nonzero)
@@ -54,8 +84,8 @@ static int sum_ok(float sum, int nonzero)
 
 void mlod_primitive_fix_weights(mlod_primitive *p, int root, mlod_weight_fix *fix)
 {
-	fix->unweighted = fix->rescaled = 0;
-	fix->first_unweighted = fix->first_rescaled = -1;
+	fix->unweighted = fix->rescaled = fix->merged = 0;
+	fix->first_unweighted = fix->first_rescaled = fix->first_merged = -1;
 	fix->first_sum = 0.0f;
 	if (!p || p->weight_set_count <= 0 || p->weight_set_count > MLOD_MAX_SETS)
 		return;
@@ -63,6 +93,8 @@ void mlod_primitive_fix_weights(mlod_primitive *p, int root, mlod_weight_fix *fi
 		if (!p->joints[s] || !p->weights[s]) /* mlod_character_validate refuses it */
 			return;
 	for (int v = 0; v < p->vertex_count; v++) {
+		if (merge_repeats(p, v) && fix->merged++ == 0)
+			fix->first_merged = v;
 		int nonzero;
 		float sum = vertex_sum(p, v, &nonzero);
 		if (sum < 0.0f || (nonzero > 0 && sum_ok(sum, nonzero)))

@@ -507,7 +507,7 @@ TEST(fix_weights_rule)
 	float w0[20] = { 0.25f, 0.75f, 0, 0, 0, 0, 0, 0, 0.1f, 0.1f, 0, 0, -1, 0, 0, 0, 1.0000001f, 0, 0, 0 };
 	float w1[20] = { 0, 0, 0, 0, 0, 0, 0, 0, 0.1f, 0.2f, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
 	uint16_t j0[20] = { 0, 1, 0, 0, 1, 1, 1, 1, 0, 1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0 };
-	uint16_t j1[20] = { 0, 0, 0, 0, 2, 2, 2, 2, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
+	uint16_t j1[20] = { 0, 0, 0, 0, 2, 2, 2, 2, 2, 3, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 };
 	float keep0[20], keep1[20];
 	memcpy(keep0, w0, sizeof w0), memcpy(keep1, w1, sizeof w1);
 	float pos[15] = { 0 };
@@ -520,6 +520,7 @@ TEST(fix_weights_rule)
 	mlod_primitive_fix_weights(&p, 2, &fix);
 	CHECK(fix.unweighted == 1 && fix.first_unweighted == 1);
 	CHECK(fix.rescaled == 1 && fix.first_rescaled == 2);
+	CHECK(fix.merged == 0 && fix.first_merged == -1);
 	CHECK_NEAR(fix.first_sum, 0.5, 1e-6);
 	CHECK(memcmp(w0, keep0, 4 * sizeof(float)) == 0 && memcmp(w0 + 12, keep0 + 12, 8 * sizeof(float)) == 0);
 	CHECK(j0[4] == 2 && w0[4] == 1.0f);
@@ -536,6 +537,33 @@ TEST(fix_weights_rule)
 	w0[4] = 0.0f;
 	mlod_primitive_fix_weights(&p, -1, &fix);
 	CHECK(fix.unweighted == 1 && fix.first_unweighted == 1 && fix.rescaled == 0 && w0[4] == 0.0f);
+
+	/* A joint named twice with non-zero weights (the validator's
+	 * ACCESSOR_JOINTS_INDEX_DUPLICATE): v0 names joint 5 in set 1's
+	 * first influence and in set 0's second (read first: set 1's), v1 joint 4 three times and
+	 * once more at weight 0 (not a repeat: left), v2 joint 6 twice at
+	 * weights summing to 0.5 (merged, then scaled). In the order the
+	 * validator reads them (influence by influence, set by set), the first
+	 * keeps the sum; the others become joint 0 at weight 0. */
+	float d0[12] = { 0.5f, 0.25f, 0, 0, 0.25f, 0.25f, 0, 0, 0.2f, 0, 0, 0 };
+	float d1[12] = { 0.25f, 0, 0, 0, 0.25f, 0.25f, 0, 0, 0.3f, 0, 0, 0 };
+	uint16_t dj0[12] = { 1, 5, 0, 0, 4, 4, 0, 4, 6, 0, 0, 0 };
+	uint16_t dj1[12] = { 5, 0, 0, 0, 4, 1, 0, 0, 6, 0, 0, 0 };
+	mlod_primitive q = { 0 };
+	q.vertex_count = 3;
+	q.positions = pos;
+	q.weight_set_count = 2;
+	q.joints[0] = dj0, q.joints[1] = dj1, q.weights[0] = d0, q.weights[1] = d1;
+	mlod_primitive_fix_weights(&q, 0, &fix);
+	CHECK(fix.merged == 3 && fix.first_merged == 0);
+	CHECK(fix.unweighted == 0 && fix.rescaled == 1 && fix.first_rescaled == 2);
+	CHECK(dj1[0] == 5 && d1[0] == 0.5f && dj0[1] == 0 && d0[1] == 0.0f && dj0[0] == 1 && d0[0] == 0.5f);
+	CHECK(dj0[4] == 4 && d0[4] == 0.75f && dj1[4] == 0 && d1[4] == 0.0f && dj0[5] == 0 && d0[5] == 0.0f);
+	CHECK(dj0[7] == 4 && d0[7] == 0.0f && dj1[5] == 1 && d1[5] == 0.25f);
+	CHECK(dj0[8] == 6 && d0[8] == 1.0f && dj1[8] == 0 && d1[8] == 0.0f);
+	/* nothing left to merge: a second pass changes nothing */
+	mlod_primitive_fix_weights(&q, 0, &fix);
+	CHECK(fix.merged == 0 && fix.rescaled == 0 && fix.unweighted == 0);
 
 	/* the skin's root: of its joints, the one nearest the skeleton's root */
 	mlod_character c;
