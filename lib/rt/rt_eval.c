@@ -1131,3 +1131,191 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 	}
 	return MLOD_OK;
 }
+
+/* ---------------------------------------------------------------- */
+/* Skinning only when the shown vertices went stale                  */
+/* ---------------------------------------------------------------- */
+
+/* The caller's record of the last skin of one instance
+ * (mlod_rt_stale_size): this head, then 12 floats per palette entry (the
+ * 3x4 affine part of the matrix the skin used: columns 0 .. 3, rows 0 .. 2),
+ * 12 per part (a rigid or static part's matrix), the instance's morph
+ * weights. All zero (valid 0): never skinned. */
+typedef struct rt_stale_head {
+	uint32_t valid;           /* RT_STALE_VALID once it holds a skin */
+	uint32_t id;              /* the instance skinned (its generation too) */
+	uint32_t skel_level, mesh_level, clip;
+	uint32_t palette_size, part_count, morph_total; /* the layout, for a record of another context */
+} rt_stale_head;
+
+#define RT_STALE_VALID 0x6d6c7331u
+
+size_t mlod_rt_stale_size(const mlod_rt_ctx *ctx)
+{
+	if (!ctx)
+		return 0;
+	return sizeof(rt_stale_head) + 48 * ((size_t)ctx->palette_size + ctx->part_count) + 4 * (size_t)ctx->morph_total;
+}
+
+static inline void affine12(const float *M, float *out)
+{
+	for (int c = 0; c < 4; c++)
+		out[3 * c] = M[4 * c], out[3 * c + 1] = M[4 * c + 1], out[3 * c + 2] = M[4 * c + 2];
+}
+
+/* How far a point of a set bounded by centre c (3), half extents h (3)
+ * and ball radius r about c, each grown by g, moves from the affine A0 (12
+ * floats, affine12) to M (column-major 4x4): with D = M - A0 (linear part
+ * L, translation t) a point x moves by D x = (L c + t) + L (x - c), at
+ * most |L c + t| plus the smaller of ||L||_F (r + g) (the Frobenius norm
+ * bounds the spectral one) and |(sum_j |L_ij| (h_j + g))_i| (the box's);
+ * plus the rounding of both skins (RT_BOUND_ROUND of the magnitudes the
+ * kernels sum, as mlod_rt_bounds allows, for each matrix, times sqrt 3
+ * over the axes). 0 when the matrices are the same floats (the kernels
+ * then write the same floats). NaN when any is not finite. */
+static double stale_move(const float *A0, const float *M, const float *c, const float *h, double r, double g)
+{
+	float A1[12];
+	affine12(M, A1);
+	if (memcmp(A0, A1, sizeof A1) == 0)
+		return 0.0;
+	const double cn = fabs(c[0]) + fabs(c[1]) + fabs(c[2]) + h[0] + h[1] + h[2] + 3 * g;
+	double u2 = 0, v2 = 0, f2 = 0, mag = 0;
+	for (int i = 0; i < 3; i++) {
+		double u = (double)A1[9 + i] - A0[9 + i], v = 0, m0 = fabs(A0[9 + i]), m1 = fabs(A1[9 + i]);
+		for (int j = 0; j < 3; j++) {
+			const double l = (double)A1[3 * j + i] - A0[3 * j + i];
+			u += l * c[j];
+			v += fabs(l) * (h[j] + g);
+			f2 += l * l;
+			m0 += fabs(A0[3 * j + i]) * cn, m1 += fabs(A1[3 * j + i]) * cn;
+		}
+		u2 += u * u, v2 += v * v;
+		mag = dmax(mag, m0 + m1);
+		mag += 0 * (m0 + m1); /* a NaN of either stays */
+	}
+	const double ball = sqrt(f2) * (r + g), box = sqrt(v2);
+	return sqrt(u2) + dmin(ball, box) + 0 * (ball + box) + RT_BOUND_ROUND * 1.7320508075688772 * mag;
+}
+
+mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const mlod_rt_select *sel,
+                               float max_stale_pixels, void *record, float *positions, size_t pos_stride,
+                               float *normals, size_t nrm_stride, uint32_t capacity, uint32_t *vertex_count,
+                               int *skinned, float *stale_pixels, mlod_error *err)
+{
+	if (vertex_count)
+		*vertex_count = 0;
+	if (skinned)
+		*skinned = 0;
+	if (stale_pixels)
+		*stale_pixels = 0;
+	if (!ctx || !s || !sel || !record || !positions)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: NULL argument");
+	if (s->owner != ctx)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: the scratch was made for another context");
+	if (pos_stride < 12 || pos_stride % 4 || (normals && (nrm_stride < 12 || nrm_stride % 4)))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: strides must be multiples of 4, at least 12");
+	if (!(sel->fov_y > 0.0f && sel->fov_y < 3.14159265f) || !(sel->lines > 0.0f) || !isfinite(sel->lines))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: fov_y must lie in (0, pi), lines be > 0");
+	if (!(max_stale_pixels >= 0.0f) || !isfinite(max_stale_pixels))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: max_stale_pixels must be finite, >= 0");
+	const rt_instance *in = rt_live(ctx, id);
+	if (!in)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
+	const mlod_rt_state *st = &in->st;
+	const rt_unit *su, *mu;
+	mlod_result r = pose_mesh_level(ctx, s, id, capacity, &su, &mu, err);
+	if (r != MLOD_OK)
+		return r;
+	if (!mu) /* no mesh: nothing to keep */
+		return mlod_rt_skin(ctx, s, id, positions, pos_stride, normals, nrm_stride, capacity, vertex_count, err);
+	rt_stale_head *hd = record;
+	float *rec_pal = (float *)(hd + 1), *rec_part = rec_pal + 12 * (size_t)ctx->palette_size;
+	float *rec_morph = rec_part + 12 * (size_t)ctx->part_count;
+	const mlod_pack_mesh *m = mu->mesh;
+	const uint32_t skel_level = su ? su->level : 0;
+	const float *mw = ctx->morph_total ? ctx->morph_weights + (size_t)rt_slot(ctx, id) * ctx->morph_total : NULL;
+	/* Anything but the pose changed since the kept skin: skin. */
+	int need = hd->valid != RT_STALE_VALID || hd->id != id || hd->skel_level != skel_level ||
+	           hd->mesh_level != mu->level || hd->clip != st->clip || hd->palette_size != ctx->palette_size ||
+	           hd->part_count != ctx->part_count || hd->morph_total != ctx->morph_total ||
+	           m->part_count > ctx->part_count || (mw && memcmp(rec_morph, mw, 4 * (size_t)ctx->morph_total) != 0);
+	if (!need) {
+		/* The distance a vertex may have moved for max_stale_pixels at the
+		 * instance's distance: D pixels = D lines / (2 d tan(fov_y / 2)). */
+		const double px = (double)sel->lines / (2.0 * (double)st->distance * tan(0.5 * (double)sel->fov_y));
+		const double lim = (double)max_stale_pixels / px; /* d = 0: px infinite, lim 0 */
+		double grow = 0; /* morph weights (unchanged): as mlod_rt_bounds widens the balls */
+		for (uint32_t i = 0; i < m->part_count && i < ctx->morph_parts; i++) {
+			uint32_t k = ctx->morph_offset[i + 1] - ctx->morph_offset[i];
+			const uint32_t have = mu->bound_morph_at[i + 1] - mu->bound_morph_at[i];
+			if (have < k)
+				k = have;
+			const float *w = mw + ctx->morph_offset[i], *d = mu->bound_morph + mu->bound_morph_at[i];
+			double g = 0;
+			for (uint32_t t = 0; t < k; t++)
+				g += fabs((double)w[t]) * d[t];
+			grow = dmax(grow, g);
+		}
+		/* A skinned vertex is a convex combination of its entries' images:
+		 * it moved at most the most any of its entries' points moved. An
+		 * entry no vertex weighs (b[6] < 0) still multiplies: a matrix
+		 * not finite there makes the output NaN, so it must skin. */
+		double most = 0;
+		for (uint32_t k = 0; k < mu->pal_used_count && !need; k++) {
+			const uint32_t e = mu->pal_used[k];
+			const float *b = mu->bound_entry + 13 * (size_t)e;
+			const double mv = b[6] >= 0.0f ? stale_move(rec_pal + 12 * (size_t)e, s->palette + 16 * (size_t)e, b,
+			                                            b + 3, b[6], grow)
+			                               : 0 * stale_move(rec_pal + 12 * (size_t)e, s->palette + 16 * (size_t)e,
+			                                                b, b, 0, 0);
+			need = !(mv <= lim);
+			most = dmax(most, mv);
+		}
+		for (uint32_t i = 0; i < m->part_count && !need; i++) {
+			const mlod_pack_part *p = &m->parts[i];
+			const float *c = mu->bound_part + 7 * (size_t)i;
+			if (p->rec.skin >= 0 || !(c[6] >= 0.0f))
+				continue;
+			float M[16];
+			rigid_matrix(su, s->world, p, M);
+			const double mv = stale_move(rec_part + 12 * (size_t)i, M, c, c + 3, c[6], grow);
+			need = !(mv <= lim);
+			most = dmax(most, mv);
+		}
+		if (!need) {
+			if (vertex_count)
+				*vertex_count = mu->vertex_count;
+			if (stale_pixels)
+				*stale_pixels = (float)(most * px);
+			return MLOD_OK;
+		}
+	}
+	/* Skin (the pose and palette entries above, as they are) and keep
+	 * what it used. */
+	r = mlod_rt_skin(ctx, s, id, positions, pos_stride, normals, nrm_stride, capacity, vertex_count, err);
+	if (r != MLOD_OK) {
+		hd->valid = 0;
+		return r;
+	}
+	for (uint32_t k = 0; k < mu->pal_used_count; k++) {
+		const uint32_t e = mu->pal_used[k];
+		affine12(s->palette + 16 * (size_t)e, rec_pal + 12 * (size_t)e);
+	}
+	for (uint32_t i = 0; i < m->part_count && i < ctx->part_count; i++) { /* more parts: never kept (need) */
+		const mlod_pack_part *p = &m->parts[i];
+		if (p->rec.skin >= 0)
+			continue;
+		float M[16];
+		rigid_matrix(su, s->world, p, M);
+		affine12(M, rec_part + 12 * (size_t)i);
+	}
+	if (mw)
+		memcpy(rec_morph, mw, 4 * (size_t)ctx->morph_total);
+	hd->valid = RT_STALE_VALID, hd->id = id, hd->skel_level = skel_level, hd->mesh_level = mu->level;
+	hd->clip = st->clip, hd->palette_size = ctx->palette_size, hd->part_count = ctx->part_count;
+	hd->morph_total = ctx->morph_total;
+	if (skinned)
+		*skinned = 1;
+	return MLOD_OK;
+}
