@@ -1137,15 +1137,19 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 /* ---------------------------------------------------------------- */
 
 /* The caller's record of the last skin of one instance
- * (mlod_rt_stale_size): this head, then 12 floats per palette entry (the
- * 3x4 affine part of the matrix the skin used: columns 0 .. 3, rows 0 .. 2),
- * 12 per part (a rigid or static part's matrix), the instance's morph
- * weights. All zero (valid 0): never skinned. */
+ * (mlod_rt_stale_size): this head, then 12 floats per joint (the 3x4
+ * affine part of the world matrix the skin used, columns 0 .. 3, rows
+ * 0 .. 2; valid at the joints the skin posed), then the instance's morph
+ * weights. The palette entries and rigid parts' matrices of that skin are
+ * made again from them by the same products (rt_mat_mul, rigid_matrix):
+ * the same floats, in fewer bytes than a palette (RobotExpressive: 43
+ * joints, 172 palette entries). All zero (valid 0): never skinned. */
 typedef struct rt_stale_head {
 	uint32_t valid;           /* RT_STALE_VALID once it holds a skin */
 	uint32_t id;              /* the instance skinned (its generation too) */
 	uint32_t skel_level, mesh_level, clip;
-	uint32_t palette_size, part_count, morph_total; /* the layout, for a record of another context */
+	uint32_t joint_count, morph_total; /* the layout, for a record of another context */
+	uint32_t pad;
 } rt_stale_head;
 
 #define RT_STALE_VALID 0x6d6c7331u
@@ -1154,48 +1158,62 @@ size_t mlod_rt_stale_size(const mlod_rt_ctx *ctx)
 {
 	if (!ctx)
 		return 0;
-	return sizeof(rt_stale_head) + 48 * ((size_t)ctx->palette_size + ctx->part_count) + 4 * (size_t)ctx->morph_total;
+	return sizeof(rt_stale_head) + 48 * (size_t)ctx->joint_count + 4 * (size_t)ctx->morph_total;
 }
 
-static inline void affine12(const float *M, float *out)
+/* A kept world matrix (12 floats) as the 16 rt_mat_mul reads. */
+static inline void affine16(const float *w, float *M)
 {
 	for (int c = 0; c < 4; c++)
-		out[3 * c] = M[4 * c], out[3 * c + 1] = M[4 * c + 1], out[3 * c + 2] = M[4 * c + 2];
+		M[4 * c] = w[3 * c], M[4 * c + 1] = w[3 * c + 1], M[4 * c + 2] = w[3 * c + 2], M[4 * c + 3] = 0.0f;
+	M[15] = 1.0f;
 }
 
 /* How far a point of a set bounded by centre c (3), half extents h (3)
- * and ball radius r about c, each grown by g, moves from the affine A0 (12
- * floats, affine12) to M (column-major 4x4): with D = M - A0 (linear part
- * L, translation t) a point x moves by D x = (L c + t) + L (x - c), at
- * most |L c + t| plus the smaller of ||L||_F (r + g) (the Frobenius norm
- * bounds the spectral one) and |(sum_j |L_ij| (h_j + g))_i| (the box's);
- * plus the rounding of both skins (RT_BOUND_ROUND of the magnitudes the
- * kernels sum, as mlod_rt_bounds allows, for each matrix, times sqrt 3
- * over the axes). 0 when the matrices are the same floats (the kernels
- * then write the same floats). NaN when any is not finite. */
-static double stale_move(const float *A0, const float *M, const float *c, const float *h, double r, double g)
+ * and ball radius r about c, each grown by g, moves from the affine M0 to
+ * M1 (column-major 4x4): with D = M1 - M0 (linear part L, translation t) a
+ * point x moves by D x = (L c + t) + L (x - c), at most |L c + t| plus the
+ * smaller of ||L||_F (r + g) (the Frobenius norm bounds the spectral one)
+ * and |(sum_j |L_ij| (h_j + g))_i| (the box's); plus the rounding of both
+ * skins (RT_BOUND_ROUND of the magnitudes the kernels sum, as
+ * mlod_rt_bounds allows, for each matrix, times sqrt 3 over the axes). 0
+ * when the matrices are the same finite floats (the kernels then write
+ * the same floats). NaN when any is not finite. */
+static double stale_move(const float *M0, const float *M1, const float *c, const float *h, double r, double g)
 {
-	float A1[12];
-	affine12(M, A1);
-	if (memcmp(A0, A1, sizeof A1) == 0)
-		return 0.0;
 	const double cn = fabs(c[0]) + fabs(c[1]) + fabs(c[2]) + h[0] + h[1] + h[2] + 3 * g;
 	double u2 = 0, v2 = 0, f2 = 0, mag = 0;
 	for (int i = 0; i < 3; i++) {
-		double u = (double)A1[9 + i] - A0[9 + i], v = 0, m0 = fabs(A0[9 + i]), m1 = fabs(A1[9 + i]);
+		double u = (double)M1[12 + i] - M0[12 + i], v = 0, m0 = fabs(M0[12 + i]), m1 = fabs(M1[12 + i]);
 		for (int j = 0; j < 3; j++) {
-			const double l = (double)A1[3 * j + i] - A0[3 * j + i];
+			const double l = (double)M1[4 * j + i] - M0[4 * j + i];
 			u += l * c[j];
 			v += fabs(l) * (h[j] + g);
 			f2 += l * l;
-			m0 += fabs(A0[3 * j + i]) * cn, m1 += fabs(A1[3 * j + i]) * cn;
+			m0 += fabs(M0[4 * j + i]) * cn, m1 += fabs(M1[4 * j + i]) * cn;
 		}
 		u2 += u * u, v2 += v * v;
-		mag = dmax(mag, m0 + m1);
-		mag += 0 * (m0 + m1); /* a NaN of either stays */
+		mag = dmax(mag, m0 + m1) + 0 * (m0 + m1); /* a NaN of either stays */
 	}
+	if (u2 == 0 && f2 == 0) /* the same matrix (finite: NaN compares false): the same floats out */
+		return 0.0;
 	const double ball = sqrt(f2) * (r + g), box = sqrt(v2);
 	return sqrt(u2) + dmin(ball, box) + 0 * (ball + box) + RT_BOUND_ROUND * 1.7320508075688772 * mag;
+}
+
+/* rigid_matrix of a rigid part (joint >= 0) given Wj, the world matrix
+ * of its joint, or of its stand-in when su removed the joint: the same
+ * products, so the same floats. */
+static void rigid_matrix_at(const rt_unit *su, const float *Wj, const mlod_pack_part *p, float *M)
+{
+	const uint32_t j = (uint32_t)p->rec.joint;
+	if (su && su->plan.stand[j] != (int32_t)j) {
+		float t[16];
+		rt_mat_mul(Wj, su->plan.rel + 16 * (size_t)j, t);
+		rt_mat_mul(t, p->rec.offset, M);
+	} else {
+		rt_mat_mul(Wj, p->rec.offset, M);
+	}
 }
 
 mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const mlod_rt_select *sel,
@@ -1230,16 +1248,15 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 	if (!mu) /* no mesh: nothing to keep */
 		return mlod_rt_skin(ctx, s, id, positions, pos_stride, normals, nrm_stride, capacity, vertex_count, err);
 	rt_stale_head *hd = record;
-	float *rec_pal = (float *)(hd + 1), *rec_part = rec_pal + 12 * (size_t)ctx->palette_size;
-	float *rec_morph = rec_part + 12 * (size_t)ctx->part_count;
+	float *rec_world = (float *)(hd + 1), *rec_morph = rec_world + 12 * (size_t)ctx->joint_count;
 	const mlod_pack_mesh *m = mu->mesh;
 	const uint32_t skel_level = su ? su->level : 0;
 	const float *mw = ctx->morph_total ? ctx->morph_weights + (size_t)rt_slot(ctx, id) * ctx->morph_total : NULL;
 	/* Anything but the pose changed since the kept skin: skin. */
 	int need = hd->valid != RT_STALE_VALID || hd->id != id || hd->skel_level != skel_level ||
-	           hd->mesh_level != mu->level || hd->clip != st->clip || hd->palette_size != ctx->palette_size ||
-	           hd->part_count != ctx->part_count || hd->morph_total != ctx->morph_total ||
-	           m->part_count > ctx->part_count || (mw && memcmp(rec_morph, mw, 4 * (size_t)ctx->morph_total) != 0);
+	           hd->mesh_level != mu->level || hd->clip != st->clip || hd->joint_count != ctx->joint_count ||
+	           hd->morph_total != ctx->morph_total ||
+	           (mw && memcmp(rec_morph, mw, 4 * (size_t)ctx->morph_total) != 0);
 	if (!need) {
 		/* The distance a vertex may have moved for max_stale_pixels at the
 		 * instance's distance: D pixels = D lines / (2 d tan(fov_y / 2)). */
@@ -1262,24 +1279,29 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 		 * entry no vertex weighs (b[6] < 0) still multiplies: a matrix
 		 * not finite there makes the output NaN, so it must skin. */
 		double most = 0;
+		float W0[16], P0[16];
 		for (uint32_t k = 0; k < mu->pal_used_count && !need; k++) {
 			const uint32_t e = mu->pal_used[k];
 			const float *b = mu->bound_entry + 13 * (size_t)e;
-			const double mv = b[6] >= 0.0f ? stale_move(rec_pal + 12 * (size_t)e, s->palette + 16 * (size_t)e, b,
-			                                            b + 3, b[6], grow)
-			                               : 0 * stale_move(rec_pal + 12 * (size_t)e, s->palette + 16 * (size_t)e,
-			                                                b, b, 0, 0);
+			affine16(rec_world + 12 * (size_t)entry_joint(ctx, su, e), W0);
+			rt_mat_mul(W0, entry_bind(ctx, su, e), P0);
+			const double mv = b[6] >= 0.0f ? stale_move(P0, s->palette + 16 * (size_t)e, b, b + 3, b[6], grow)
+			                               : 0 * stale_move(P0, s->palette + 16 * (size_t)e, b, b, 0, 0);
 			need = !(mv <= lim);
 			most = dmax(most, mv);
 		}
+		/* Rigid and static parts: their matrices, then and now. */
 		for (uint32_t i = 0; i < m->part_count && !need; i++) {
 			const mlod_pack_part *p = &m->parts[i];
 			const float *c = mu->bound_part + 7 * (size_t)i;
-			if (p->rec.skin >= 0 || !(c[6] >= 0.0f))
-				continue;
-			float M[16];
-			rigid_matrix(su, s->world, p, M);
-			const double mv = stale_move(rec_part + 12 * (size_t)i, M, c, c + 3, c[6], grow);
+			if (p->rec.skin >= 0 || p->rec.joint < 0 || !(c[6] >= 0.0f))
+				continue; /* a static part does not move */
+			const uint32_t j = (uint32_t)p->rec.joint, sj = su ? (uint32_t)su->plan.stand[j] : j;
+			float M0[16], M1[16];
+			affine16(rec_world + 12 * (size_t)sj, W0);
+			rigid_matrix_at(su, s->world + 16 * (size_t)sj, p, M1);
+			rigid_matrix_at(su, W0, p, M0);
+			const double mv = stale_move(M0, M1, c, c + 3, c[6], grow);
 			need = !(mv <= lim);
 			most = dmax(most, mv);
 		}
@@ -1292,29 +1314,23 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 		}
 	}
 	/* Skin (the pose and palette entries above, as they are) and keep
-	 * what it used. */
+	 * the world matrices it used. */
 	r = mlod_rt_skin(ctx, s, id, positions, pos_stride, normals, nrm_stride, capacity, vertex_count, err);
 	if (r != MLOD_OK) {
 		hd->valid = 0;
 		return r;
 	}
-	for (uint32_t k = 0; k < mu->pal_used_count; k++) {
-		const uint32_t e = mu->pal_used[k];
-		affine12(s->palette + 16 * (size_t)e, rec_pal + 12 * (size_t)e);
-	}
-	for (uint32_t i = 0; i < m->part_count && i < ctx->part_count; i++) { /* more parts: never kept (need) */
-		const mlod_pack_part *p = &m->parts[i];
-		if (p->rec.skin >= 0)
-			continue;
-		float M[16];
-		rigid_matrix(su, s->world, p, M);
-		affine12(M, rec_part + 12 * (size_t)i);
+	for (uint32_t k = 0; k < s->plan_count; k++) {
+		const uint32_t j = s->plan_posed[k];
+		const float *w = s->world + 16 * (size_t)j;
+		float *o = rec_world + 12 * (size_t)j;
+		for (int c = 0; c < 4; c++)
+			o[3 * c] = w[4 * c], o[3 * c + 1] = w[4 * c + 1], o[3 * c + 2] = w[4 * c + 2];
 	}
 	if (mw)
 		memcpy(rec_morph, mw, 4 * (size_t)ctx->morph_total);
 	hd->valid = RT_STALE_VALID, hd->id = id, hd->skel_level = skel_level, hd->mesh_level = mu->level;
-	hd->clip = st->clip, hd->palette_size = ctx->palette_size, hd->part_count = ctx->part_count;
-	hd->morph_total = ctx->morph_total;
+	hd->clip = st->clip, hd->joint_count = ctx->joint_count, hd->morph_total = ctx->morph_total, hd->pad = 0;
 	if (skinned)
 		*skinned = 1;
 	return MLOD_OK;
