@@ -1149,7 +1149,7 @@ typedef struct rt_stale_head {
 	uint32_t id;              /* the instance skinned (its generation too) */
 	uint32_t skel_level, mesh_level, clip;
 	uint32_t joint_count, morph_total; /* the layout, for a record of another context */
-	uint32_t pad;
+	uint32_t hint;            /* the item whose bound went over at the last check */
 } rt_stale_head;
 
 #define RT_STALE_VALID 0x6d6c7331u
@@ -1169,37 +1169,68 @@ static inline void affine16(const float *w, float *M)
 	M[15] = 1.0f;
 }
 
+/* The change from the affine M0 to M1 (column-major 4x4), in double: D =
+ * M1 - M0, its linear part l (l[3 j + i] = row i, column j) and
+ * translation t; f2 = ||l||_F^2; per row i the magnitudes the kernels sum
+ * with either matrix, a[i] = sum_j (|M0_ij| + |M1_ij|) and b[i] = |M0_i3|
+ * + |M1_i3| (for the rounding allowance); same: 1 when D is 0 and finite. */
+typedef struct rt_stale_delta {
+	double l[9], t[3], a[3], b[3], f2;
+	int same;
+} rt_stale_delta;
+
+static void stale_delta(const float *M0, const float *M1, rt_stale_delta *d)
+{
+	double f2 = 0, z = 0;
+	for (int i = 0; i < 3; i++) {
+		d->t[i] = (double)M1[12 + i] - M0[12 + i];
+		d->b[i] = fabs((double)M0[12 + i]) + fabs((double)M1[12 + i]);
+		z += d->t[i] * d->t[i];
+		double a = 0;
+		for (int j = 0; j < 3; j++) {
+			const double l = (double)M1[4 * j + i] - M0[4 * j + i];
+			d->l[3 * j + i] = l;
+			f2 += l * l;
+			a += fabs((double)M0[4 * j + i]) + fabs((double)M1[4 * j + i]);
+		}
+		d->a[i] = a;
+	}
+	d->f2 = f2;
+	d->same = z == 0 && f2 == 0; /* NaN compares false */
+}
+
 /* How far a point of a set bounded by centre c (3), half extents h (3)
- * and ball radius r about c, each grown by g, moves from the affine M0 to
- * M1 (column-major 4x4): with D = M1 - M0 (linear part L, translation t) a
- * point x moves by D x = (L c + t) + L (x - c), at most |L c + t| plus the
- * smaller of ||L||_F (r + g) (the Frobenius norm bounds the spectral one)
- * and |(sum_j |L_ij| (h_j + g))_i| (the box's); plus the rounding of both
+ * and ball radius r about c, each grown by g, moves under the change d: a
+ * point x moves by D x = (l c + t) + l (x - c), at most |l c + t| plus the
+ * smaller of ||l||_F (r + g) (the Frobenius norm bounds the spectral one)
+ * and |(sum_j |l_ij| (h_j + g))_i| (the box's); plus the rounding of both
  * skins (RT_BOUND_ROUND of the magnitudes the kernels sum, as
  * mlod_rt_bounds allows, for each matrix, times sqrt 3 over the axes). 0
  * when the matrices are the same finite floats (the kernels then write
  * the same floats). NaN when any is not finite. */
-static double stale_move(const float *M0, const float *M1, const float *c, const float *h, double r, double g)
+static double stale_move(const rt_stale_delta *d, const float *c, const float *h, double r, double g)
 {
-	const double cn = fabs(c[0]) + fabs(c[1]) + fabs(c[2]) + h[0] + h[1] + h[2] + 3 * g;
-	double u2 = 0, v2 = 0, f2 = 0, mag = 0;
-	for (int i = 0; i < 3; i++) {
-		double u = (double)M1[12 + i] - M0[12 + i], v = 0, m0 = fabs(M0[12 + i]), m1 = fabs(M1[12 + i]);
-		for (int j = 0; j < 3; j++) {
-			const double l = (double)M1[4 * j + i] - M0[4 * j + i];
-			u += l * c[j];
-			v += fabs(l) * (h[j] + g);
-			f2 += l * l;
-			m0 += fabs(M0[4 * j + i]) * cn, m1 += fabs(M1[4 * j + i]) * cn;
-		}
-		u2 += u * u, v2 += v * v;
-		mag = dmax(mag, m0 + m1) + 0 * (m0 + m1); /* a NaN of either stays */
-	}
-	if (u2 == 0 && f2 == 0) /* the same matrix (finite: NaN compares false): the same floats out */
+	if (d->same)
 		return 0.0;
-	const double ball = sqrt(f2) * (r + g), box = sqrt(v2);
+	const double cn = fabs(c[0]) + fabs(c[1]) + fabs(c[2]) + h[0] + h[1] + h[2] + 3 * g;
+	const double h0 = h[0] + g, h1 = h[1] + g, h2 = h[2] + g;
+	double u2 = 0, v2 = 0, mag = 0;
+	for (int i = 0; i < 3; i++) {
+		const double *l = d->l + i;
+		const double u = d->t[i] + l[0] * c[0] + l[3] * c[1] + l[6] * c[2];
+		const double v = fabs(l[0]) * h0 + fabs(l[3]) * h1 + fabs(l[6]) * h2;
+		const double m = d->a[i] * cn + d->b[i];
+		u2 += u * u, v2 += v * v;
+		mag = dmax(mag, m) + 0 * m; /* a NaN stays */
+	}
+	const double ball = sqrt(d->f2) * (r + g), box = sqrt(v2);
 	return sqrt(u2) + dmin(ball, box) + 0 * (ball + box) + RT_BOUND_ROUND * 1.7320508075688772 * mag;
 }
+
+/* Entries sharing a joint and a bind matrix (entry_src: skins sharing
+ * joints) share their change: kept on the stack for the last few sources
+ * met, by source index modulo RT_STALE_SLOTS. */
+#define RT_STALE_SLOTS 16
 
 /* rigid_matrix of a rigid part (joint >= 0) given Wj, the world matrix
  * of its joint, or of its stand-in when su removed the joint: the same
@@ -1278,32 +1309,54 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 		 * it moved at most the most any of its entries' points moved. An
 		 * entry no vertex weighs (b[6] < 0) still multiplies: a matrix
 		 * not finite there makes the output NaN, so it must skin. */
+		/* Items: the level's palette entries (k < pal_used_count), then
+		 * its parts (rigid ones move with their matrix; static and
+		 * skinned ones are skipped here). The item that went over last
+		 * time (hd->hint) first: a moving instance mostly goes over on
+		 * the same limb, so its skin is decided after one item. */
 		double most = 0;
-		float W0[16], P0[16];
-		for (uint32_t k = 0; k < mu->pal_used_count && !need; k++) {
-			const uint32_t e = mu->pal_used[k];
-			const float *b = mu->bound_entry + 13 * (size_t)e;
-			affine16(rec_world + 12 * (size_t)entry_joint(ctx, su, e), W0);
-			rt_mat_mul(W0, entry_bind(ctx, su, e), P0);
-			const double mv = b[6] >= 0.0f ? stale_move(P0, s->palette + 16 * (size_t)e, b, b + 3, b[6], grow)
-			                               : 0 * stale_move(P0, s->palette + 16 * (size_t)e, b, b, 0, 0);
+		rt_stale_delta cache[RT_STALE_SLOTS];
+		uint32_t tag[RT_STALE_SLOTS];
+		for (int k = 0; k < RT_STALE_SLOTS; k++)
+			tag[k] = UINT32_MAX;
+		const uint32_t items = mu->pal_used_count + m->part_count;
+		const uint32_t first = hd->hint < items ? hd->hint : 0;
+		for (uint32_t n = 0; n < items && !need; n++) {
+			const uint32_t k = n == 0 ? first : n <= first ? n - 1 : n;
+			double mv = 0;
+			if (k < mu->pal_used_count) {
+				const uint32_t e = mu->pal_used[k], f = entry_src(ctx, su, e), slot = f % RT_STALE_SLOTS;
+				const float *b = mu->bound_entry + 13 * (size_t)e;
+				rt_stale_delta *d = &cache[slot];
+				if (tag[slot] != f) {
+					/* the matrix this entry had at the kept skin: the
+					 * same product as then (rt_mat_mul of the same floats) */
+					float W0[16], P0[16];
+					affine16(rec_world + 12 * (size_t)entry_joint(ctx, su, e), W0);
+					rt_mat_mul(W0, entry_bind(ctx, su, e), P0);
+					stale_delta(P0, s->palette + 16 * (size_t)e, d);
+					tag[slot] = f;
+				}
+				mv = b[6] >= 0.0f ? stale_move(d, b, b + 3, b[6], grow) : 0 * stale_move(d, b, b, 0, 0);
+			} else {
+				const uint32_t i = k - mu->pal_used_count;
+				const mlod_pack_part *p = &m->parts[i];
+				const float *c = mu->bound_part + 7 * (size_t)i;
+				if (p->rec.skin >= 0 || p->rec.joint < 0 || !(c[6] >= 0.0f))
+					continue; /* a static part does not move */
+				const uint32_t j = (uint32_t)p->rec.joint, sj = su ? (uint32_t)su->plan.stand[j] : j;
+				float W0[16], M0[16], M1[16];
+				affine16(rec_world + 12 * (size_t)sj, W0);
+				rigid_matrix_at(su, s->world + 16 * (size_t)sj, p, M1);
+				rigid_matrix_at(su, W0, p, M0);
+				rt_stale_delta d;
+				stale_delta(M0, M1, &d);
+				mv = stale_move(&d, c, c + 3, c[6], grow);
+			}
 			need = !(mv <= lim);
 			most = dmax(most, mv);
-		}
-		/* Rigid and static parts: their matrices, then and now. */
-		for (uint32_t i = 0; i < m->part_count && !need; i++) {
-			const mlod_pack_part *p = &m->parts[i];
-			const float *c = mu->bound_part + 7 * (size_t)i;
-			if (p->rec.skin >= 0 || p->rec.joint < 0 || !(c[6] >= 0.0f))
-				continue; /* a static part does not move */
-			const uint32_t j = (uint32_t)p->rec.joint, sj = su ? (uint32_t)su->plan.stand[j] : j;
-			float M0[16], M1[16];
-			affine16(rec_world + 12 * (size_t)sj, W0);
-			rigid_matrix_at(su, s->world + 16 * (size_t)sj, p, M1);
-			rigid_matrix_at(su, W0, p, M0);
-			const double mv = stale_move(M0, M1, c, c + 3, c[6], grow);
-			need = !(mv <= lim);
-			most = dmax(most, mv);
+			if (need)
+				hd->hint = k;
 		}
 		if (!need) {
 			if (vertex_count)
@@ -1330,7 +1383,7 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 	if (mw)
 		memcpy(rec_morph, mw, 4 * (size_t)ctx->morph_total);
 	hd->valid = RT_STALE_VALID, hd->id = id, hd->skel_level = skel_level, hd->mesh_level = mu->level;
-	hd->clip = st->clip, hd->joint_count = ctx->joint_count, hd->morph_total = ctx->morph_total, hd->pad = 0;
+	hd->clip = st->clip, hd->joint_count = ctx->joint_count, hd->morph_total = ctx->morph_total;
 	if (skinned)
 		*skinned = 1;
 	return MLOD_OK;
