@@ -410,6 +410,9 @@ static mlod_result pose_one(crowd *c, uint32_t id, uint32_t *count, mlod_error *
 /* One measured frame: update, then pose and skin every instance (or pose
  * it and build its palette, --work pose). *vertices counts the vertices
  * skinned (the palette matrices built). */
+#if defined(__GNUC__)
+__attribute__((noinline)) /* a function of its own, for callgrind --toggle-collect=frame */
+#endif
 static double frame(crowd *c, const mlod_rt_select *sel, float dt, uint64_t *vertices)
 {
 	mlod_error e;
