@@ -28,6 +28,18 @@
  * Figure 15 measures such a crowd of skeletons; a skeleton level saves
  * the joints it removes that are not ancestors of kept ones (mlod_rt(3),
  * "Skeleton levels").
+ * The stale and split modes (--mode) select by pixels and skin with
+ * mlod_rt_skin_stale: each instance is skinned again only when the
+ * vertices it kept are provably more than a staleness in pixels off
+ * (mlod_rt_eval(3)); stale selects at --pixels P and allows --stale-pixels
+ * Q (default 1: 2 px from level 0 in all), split at P / 2 and P / 2 (the
+ * pixel rule's P in all). Their frames time the update, motion sampling,
+ * pose, the bound and the skins it asks for (into the one buffer, as the
+ * other modes: a caller drawing them keeps a buffer per instance, which
+ * the time does not depend on); each instance's record (mlod_rt_stale_size
+ * bytes) is zeroed before the mode's first frame, which therefore skins
+ * every instance. Their lines end with the fraction of calls that skinned.
+ * The frame's dt is 1 / --fps (default 1/30 s): the gain depends on it.
  * Streaming happens between frames, outside the measured time (its cost
  * is printed apart). It prints per N one line per mode: ms per frame, the
  * speed-up over full detail, the instances per skeleton, mesh and motion

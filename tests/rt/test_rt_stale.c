@@ -124,8 +124,6 @@ static void stale_path(const uint8_t *data, size_t size, float q, path_stats *ps
 					ps->morph_changes += !level_changed && !clip_changed && (int)i == morph_set;
 				}
 			}
-			if (getenv("STALE_DEBUG"))
-				printf("i %u f %d d %g lvl %u sk %d\n", i, f, (double)st->distance, st->level[1], skinned);
 			if (skinned) {
 				for (int l = 0; l < MLOD_RT_LAYERS; l++)
 					last_level[i][l] = st->level[l];
