@@ -775,7 +775,8 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
  * mlod_rt_skin, and MLOD_ERR_INVALID_ARG for a NULL sel or record, fov_y
  * not in (0, pi), lines not > 0 or max_stale_pixels negative or not finite
  * (nothing written then); after a skin that fails the record is marked
- * empty. No allocation. The errors add: a mesh level selected within p
+ * empty. No allocation (the check keeps the changes of up to 16 palette
+ * sources on the stack, about 2.6 KB). The errors add: a mesh level selected within p
  * pixels of level 0 (MLOD_RT_SELECT_PIXELS) shown with a stale pose within
  * q pixels of now is within p + q pixels of level 0 now (0.5 + 0.5 keeps
  * the pixel rule's 1 pixel). Like mlod_rt_skin it only reads the context;
