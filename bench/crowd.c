@@ -28,6 +28,18 @@
  * Figure 15 measures such a crowd of skeletons; a skeleton level saves
  * the joints it removes that are not ancestors of kept ones (mlod_rt(3),
  * "Skeleton levels").
+ * The stale and split modes (--mode) select by pixels and skin with
+ * mlod_rt_skin_stale: each instance is skinned again only when the
+ * vertices it kept are provably more than a staleness in pixels off
+ * (mlod_rt_eval(3)); stale selects at --pixels P and allows --stale-pixels
+ * Q (default 1: 2 px from level 0 in all), split at P / 2 and P / 2 (the
+ * pixel rule's P in all). Their frames time the update, motion sampling,
+ * pose, the bound and the skins it asks for (into the one buffer, as the
+ * other modes: a caller drawing them keeps a buffer per instance, which
+ * the time does not depend on); each instance's record (mlod_rt_stale_size
+ * bytes) is zeroed before the mode's first frame, which therefore skins
+ * every instance. Their lines end with the fraction of calls that skinned.
+ * The frame's dt is 1 / --fps (default 1/30 s): the gain depends on it.
  * Streaming happens between frames, outside the measured time (its cost
  * is printed apart). It prints per N one line per mode: ms per frame, the
  * speed-up over full detail, the instances per skeleton, mesh and motion
@@ -118,10 +130,15 @@ static const char usage_text[] =
 	"                        (the paper's), pixels (projected error), toc (the\n"
 	"                        pack's switch distances), skeleton (alpha on the\n"
 	"                        skeleton layer alone, mesh and motion at level 0),\n"
-	"                        a comma list of them, or all (default: alpha and\n"
-	"                        pixels)\n"
+	"                        stale (pixels, and each instance skinned again only\n"
+	"                        when its kept vertices are more than --stale-pixels\n"
+	"                        off: mlod_rt_skin_stale), split (the same with P/2\n"
+	"                        for each, P in all), a comma list of them, or all\n"
+	"                        (default: alpha and pixels)\n"
 	"      --pixels P        pixels mode: the largest projected error in pixels\n"
 	"                        (default 1, at 1080 lines and 60 degrees)\n"
+	"      --stale-pixels Q  stale mode: the largest staleness in pixels (default\n"
+	"                        1; the selection's P adds to it)\n"
 	"      --interval TS,TE  the alpha interval of every layer (default 0,1)\n"
 	"      --hysteresis H    relative hysteresis (default 0.1)\n"
 	"      --work WORK       skin (default: motion sampling, pose and skinning)\n"
@@ -131,7 +148,8 @@ static const char usage_text[] =
 	"                        character coloured by its mesh level\n"
 	"      --png-count N     the crowd size pictured (one of --counts; default the\n"
 	"                        largest)\n"
-	"      --png-mode MODE   the rule pictured (default the first measured)\n"
+	"      --png-mode MODE   the rule pictured (default the first measured; stale\n"
+	"                        and split are drawn from fresh skins)\n"
 	"      --png-size WxH    the picture's size (default 960x540)\n"
 	"      --figures         also prints the paper's Figures 15 and 16 as data:\n"
 	"                        frames per second against N for full detail, the\n"
@@ -345,6 +363,15 @@ typedef struct crowd {
 	uint32_t regrows; /* reallocations after that: 0 for a pack of format 8.1 on */
 	uint32_t n;
 	int pose_only; /* --work pose */
+	/* stale and split modes: skin_stale >= 0 is the staleness allowed
+	 * (pixels), each instance's record at rec + i * rec_size (the caller's
+	 * memory, mlod_rt_stale_size), stale_sel the view it is measured in;
+	 * calls and skins count mlod_rt_skin_stale's calls and re-skins. */
+	float skin_stale;
+	uint8_t *rec;
+	size_t rec_size;
+	const mlod_rt_select *stale_sel;
+	uint64_t calls, skins;
 } crowd;
 
 /* The skinning buffers: sized once, right after open, from
@@ -395,6 +422,9 @@ static mlod_result pose_one(crowd *c, uint32_t id, uint32_t *count, mlod_error *
 /* One measured frame: update, then pose and skin every instance (or pose
  * it and build its palette, --work pose). *vertices counts the vertices
  * skinned (the palette matrices built). */
+#if defined(__GNUC__)
+__attribute__((noinline)) /* a function of its own, for callgrind --toggle-collect=frame */
+#endif
 static double frame(crowd *c, const mlod_rt_select *sel, float dt, uint64_t *vertices)
 {
 	mlod_error e;
@@ -407,6 +437,32 @@ static double frame(crowd *c, const mlod_rt_select *sel, float dt, uint64_t *ver
 			if (pose_one(c, c->ids[i], &count, &e) != MLOD_OK)
 				die(2, "%s", e.message);
 			*vertices += count;
+		}
+		return cpu_seconds() - t0;
+	}
+	if (c->skin_stale >= 0) {
+		/* Every instance's skin goes to the one buffer, as in the other
+		 * modes (the time is the same: a caller drawing them keeps a buffer
+		 * per instance, N x vertices x 24 bytes, which this does not
+		 * allocate); the records are per instance. */
+		for (uint32_t i = 0; i < c->n; i++) {
+			uint32_t nv = 0;
+			int skinned = 0;
+			mlod_result r = mlod_rt_skin_stale(c->ctx, c->scratch, c->ids[i], c->stale_sel, c->skin_stale,
+			                                   c->rec + (size_t)i * c->rec_size, c->buf, 12,
+			                                   c->buf + 3 * (size_t)c->cap, 12, c->cap, &nv, &skinned, NULL, &e);
+			if (r == MLOD_ERR_LIMIT) {
+				t0 -= cpu_seconds();
+				grow(c);
+				t0 += cpu_seconds();
+				r = mlod_rt_skin_stale(c->ctx, c->scratch, c->ids[i], c->stale_sel, c->skin_stale,
+				                       c->rec + (size_t)i * c->rec_size, c->buf, 12, c->buf + 3 * (size_t)c->cap,
+				                       12, c->cap, &nv, &skinned, NULL, &e);
+			}
+			if (r != MLOD_OK)
+				die(2, "%s", e.message);
+			c->calls++, c->skins += (uint64_t)skinned;
+			*vertices += skinned ? nv : 0;
 		}
 		return cpu_seconds() - t0;
 	}
@@ -1015,16 +1071,21 @@ typedef struct result {
 	uint32_t hist[MLOD_RT_LAYERS][16];
 	uint32_t fallbacks;
 	size_t resident;
+	double reskin; /* stale and split: the fraction of calls that skinned; -1 otherwise */
 } result;
 
 /* Runs the walk under sel; the histogram is the last measured frame's, and
  * so is the picture when pic is not NULL (drawn outside the measured time,
  * before any more streaming). */
 static result run_mode(crowd *c, const mlod_rt_select *sel, double seconds, double fps, double max_wall, float near,
-                       float far, picture *pic)
+                       float far, picture *pic, float stale)
 {
 	result res;
 	memset(&res, 0, sizeof res);
+	res.reskin = -1;
+	c->skin_stale = stale, c->stale_sel = sel, c->calls = c->skins = 0;
+	if (stale >= 0) /* every instance never skinned (not measured) */
+		memset(c->rec, 0, (size_t)c->n * c->rec_size);
 	const float dt = (float)(1.0 / fps);
 	const int frames = (int)(seconds * fps + 0.5) > 0 ? (int)(seconds * fps + 0.5) : 1;
 	settle(c, sel);
@@ -1040,6 +1101,9 @@ static result run_mode(crowd *c, const mlod_rt_select *sel, double seconds, doub
 		grow(c);
 	}
 	res.ms = 1000.0 * total / res.frames;
+	if (stale >= 0)
+		res.reskin = c->calls ? (double)c->skins / (double)c->calls : 0;
+	c->skin_stale = -1;
 	for (uint32_t i = 0; i < c->n; i++) {
 		const mlod_rt_state *st = mlod_rt_instance_state(c->ctx, c->ids[i]);
 		for (int l = 0; l < MLOD_RT_LAYERS; l++)
@@ -1063,9 +1127,11 @@ static void print_hist(const uint32_t *h, uint32_t levels)
 /* The LoD modes measured besides full detail: the runtime's rules
  * (mlod_rt_select_mode), then skeleton (the paper's Figure 15: the alpha
  * rule on the skeleton layer alone, mesh and motion at level 0). */
-#define MODES 4
+#define MODES 6
 #define MODE_SKELETON 3
-static const char *const mode_name[MODES] = { "alpha", "pixels", "toc", "skeleton" };
+#define MODE_STALE 4 /* pixels at P, staleness Q (mlod_rt_skin_stale) */
+#define MODE_SPLIT 5 /* pixels at P / 2, staleness P / 2 */
+static const char *const mode_name[MODES] = { "alpha", "pixels", "toc", "skeleton", "stale", "split" };
 
 /* "alpha", "pixels", "toc", "skeleton", a comma list of them, or "all"
  * (every one): a bit per mode. */
@@ -1081,11 +1147,11 @@ static unsigned parse_modes(const char *s)
 			if (strlen(mode_name[k]) == n && !strncmp(p, mode_name[k], n))
 				break;
 		if (k == MODES || n == 0)
-			die(1, "unknown --mode '%s' (alpha, pixels, toc, skeleton, a comma list of them, or all)", s);
+			die(1, "unknown --mode '%s' (alpha, pixels, toc, skeleton, stale, split, a comma list of them, or all)", s);
 		m |= 1u << k;
 		p += n;
 		if (*p == ',' && *++p == '\0')
-			die(1, "unknown --mode '%s' (alpha, pixels, toc, skeleton, a comma list of them, or all)", s);
+			die(1, "unknown --mode '%s' (alpha, pixels, toc, skeleton, stale, split, a comma list of them, or all)", s);
 	}
 	return m;
 }
@@ -1105,6 +1171,8 @@ static void print_figures(crowd *c, const uint32_t *L, float near, float far, co
 		{ 40, 90, 200 },  /* pixels: blue */
 		{ 150, 60, 170 }, /* toc: purple */
 		{ 235, 140, 20 }, /* skeleton: orange */
+		{ 20, 170, 190 }, /* stale: cyan */
+		{ 110, 110, 110 }, /* split: grey */
 		{ 200, 30, 30 },  /* full: red */
 	};
 	panel p15, p16;
@@ -1118,6 +1186,8 @@ static void print_figures(crowd *c, const uint32_t *L, float near, float far, co
 	order[ns++] = MODE_SKELETON;
 	for (int m = 0; m < 3; m++)
 		order[ns++] = m;
+	order[ns++] = MODE_STALE;
+	order[ns++] = MODE_SPLIT;
 	printf("\nfigure 15 (the crowd's frame rate against N: frames per second of CPU time, one core)\n%7s", "N");
 	for (int i = 0; i < ns; i++)
 		if (order[i] == MODES || (modes >> order[i] & 1)) {
@@ -1204,7 +1274,7 @@ int main(int argc, char **argv)
 {
 	const char *counts = "1,10,50,250,1000,10000", *png_path = NULL, *plot_path = NULL;
 	int figures = 0;
-	double seconds = 2, fps = 30, max_wall = 10, hyst = 0.1, height = 1.8, pixels = -1;
+	double seconds = 2, fps = 30, max_wall = 10, hyst = 0.1, height = 1.8, pixels = -1, stale_px = 1;
 	float near = 2, far = 200, ts = 0, te = 1;
 	size_t budget = 0;
 	int bench = 1, line = 0, png_w = 960, png_h = 540, png_mode = -1, pose_only = 0;
@@ -1221,7 +1291,7 @@ int main(int argc, char **argv)
 		{ "png", required_argument, NULL, 'G' },      { "png-count", required_argument, NULL, 'C' },
 		{ "png-size", required_argument, NULL, 'Z' }, { "png-mode", required_argument, NULL, 'M' },
 		{ "figures", no_argument, NULL, 'g' },        { "plot", required_argument, NULL, 'p' },
-		{ "work", required_argument, NULL, 'W' },
+		{ "work", required_argument, NULL, 'W' },     { "stale-pixels", required_argument, NULL, 'Q' },
 		{ "help", no_argument, NULL, 'h' },           { NULL, 0, NULL, 0 },
 	};
 	int ch;
@@ -1242,6 +1312,13 @@ int main(int argc, char **argv)
 			height = strtod(optarg, &end);
 			if (end == optarg || *end || !isfinite(height) || height < 0)
 				die(1, "bad --height '%s' (the character's height in metres, or 0 for scene units)", optarg);
+			break;
+		}
+		case 'Q': {
+			char *end;
+			stale_px = strtod(optarg, &end);
+			if (end == optarg || *end || !isfinite(stale_px) || !(stale_px >= 0))
+				die(1, "bad --stale-pixels '%s' (a staleness in pixels, >= 0)", optarg);
 			break;
 		}
 		case 'P': {
@@ -1365,7 +1442,12 @@ int main(int argc, char **argv)
 	c.dist = malloc(sizeof *c.dist * maxn);
 	c.speed = malloc(sizeof *c.speed * maxn);
 	c.azimuth = malloc(sizeof *c.azimuth * maxn);
-	if (!c.scratch || !c.ids || !c.dist || !c.speed || !c.azimuth)
+	c.skin_stale = -1;
+	c.rec_size = mlod_rt_stale_size(c.ctx);
+	if (modes & (1u << MODE_STALE | 1u << MODE_SPLIT))
+		c.rec = malloc(c.rec_size * maxn);
+	if (!c.scratch || !c.ids || !c.dist || !c.speed || !c.azimuth ||
+	    (modes & (1u << MODE_STALE | 1u << MODE_SPLIT) && !c.rec))
 		die(2, "%s", "out of memory");
 	grow(&c);
 	c.cap0 = c.cap;
@@ -1401,10 +1483,18 @@ int main(int argc, char **argv)
 			else if (k == MLOD_RT_SELECT_PIXELS)
 				printf(", pixels (%g px at %g lines, fov %g deg)", lod.max_pixels, lod.lines,
 				       lod.fov_y * 180.0 / 3.14159265358979323846);
-			else
+			else if (k == MLOD_RT_SELECT_TOC)
 				printf(", toc (the pack's switch distances)");
+			else if (k == MODE_STALE)
+				printf(", stale (pixels at %g px, skinned again when over %g px stale)", lod.max_pixels, stale_px);
+			else
+				printf(", split (pixels at %g px, skinned again when over %g px stale)", 0.5 * lod.max_pixels,
+				       0.5 * lod.max_pixels);
 		}
 	printf("\n");
+	if (modes & (1u << MODE_STALE | 1u << MODE_SPLIT))
+		printf("stale and split: a record of %zu bytes per instance (mlod_rt_stale_size: 48 per joint, 4 per "
+		       "morph weight, 32); frame dt %g s\n", c.rec_size, 1.0 / fps);
 	/* Open to the first frame (one instance, the coarse levels open gave),
 	 * then the decoding of every other level. */
 	float bmin[3], bmax[3];
@@ -1477,6 +1567,12 @@ int main(int argc, char **argv)
 	for (int l = 0; l < MLOD_RT_LAYERS; l++)
 		if (l != MLOD_RT_SKELETON)
 			sel[MODE_SKELETON].t_start[l] = sel[MODE_SKELETON].t_end[l] = 2.0f;
+	/* stale: the pixel rule and a staleness of stale_px; split: half of
+	 * --pixels for each, so that the sum is the pixel rule's */
+	sel[MODE_STALE] = sel[MLOD_RT_SELECT_PIXELS];
+	sel[MODE_SPLIT] = sel[MLOD_RT_SELECT_PIXELS];
+	sel[MODE_SPLIT].max_pixels = 0.5f * lod.max_pixels;
+	const float stale_of[MODES] = { -1, -1, -1, -1, (float)stale_px, 0.5f * lod.max_pixels };
 	/* Figure 15's data: frames per second (CPU, one core) per N and mode
 	 * (full last). */
 	double fig15[32][MODES + 1];
@@ -1516,14 +1612,14 @@ int main(int argc, char **argv)
 		memcpy(d0, c.dist, sizeof *d0 * n);
 		memcpy(s0, c.speed, sizeof *s0 * n);
 		result res[MODES + 1];
-		res[MODES] = run_mode(&c, &full, seconds, fps, max_wall, near_u, far_u, NULL);
+		res[MODES] = run_mode(&c, &full, seconds, fps, max_wall, near_u, far_u, NULL, -1);
 		for (int m = 0; m < MODES; m++) {
 			if (!(modes >> m & 1))
 				continue;
 			memcpy(c.dist, d0, sizeof *d0 * n); /* the same walk for every mode */
 			memcpy(c.speed, s0, sizeof *s0 * n);
 			res[m] = run_mode(&c, &sel[m], seconds, fps, max_wall, near_u, far_u,
-			                  png_path && n == png_count && m == png_mode && !pic.done ? &pic : NULL);
+			                  png_path && n == png_count && m == png_mode && !pic.done ? &pic : NULL, stale_of[m]);
 		}
 		free(d0), free(s0);
 		const int want = (int)(seconds * fps + 0.5);
@@ -1545,6 +1641,8 @@ int main(int argc, char **argv)
 			printf(" |");
 			print_hist(b->hist[2], L[2]);
 			printf("  %zu B", b->resident);
+			if (b->reskin >= 0)
+				printf("  reskinned %.1f%%", 100 * b->reskin);
 			if (b->fallbacks)
 				printf("  (fallbacks %u)", b->fallbacks);
 			if (b->frames < want)
@@ -1569,6 +1667,6 @@ int main(int argc, char **argv)
 	}
 	mlod_rt_scratch_destroy(c.ctx, c.scratch);
 	mlod_rt_close(c.ctx);
-	free(c.ids), free(c.dist), free(c.speed), free(c.azimuth), free(c.buf), free(file);
+	free(c.ids), free(c.dist), free(c.speed), free(c.azimuth), free(c.buf), free(c.rec), free(file);
 	return 0;
 }

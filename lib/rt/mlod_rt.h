@@ -40,13 +40,13 @@
  * mlod_rt_stream when it loads or tries to load a level (a level whose
  * reads keep failing is tried, and allocates, in every call that wants
  * it). mlod_rt_update, mlod_rt_request,
- * mlod_rt_pose, mlod_rt_palette, mlod_rt_skin, mlod_rt_bounds, the names
- * and hierarchy calls, instance creation and
+ * mlod_rt_pose, mlod_rt_palette, mlod_rt_skin, mlod_rt_skin_stale,
+ * mlod_rt_bounds, the names and hierarchy calls, instance creation and
  * destruction (from the pool) allocate nothing.
  *
  * Threading. A context is not locked. Decoding happens only inside
  * mlod_rt_stream, on the caller's thread; nothing runs in the background.
- * mlod_rt_pose, mlod_rt_palette, mlod_rt_skin and mlod_rt_bounds only read the context, so
+ * mlod_rt_pose, mlod_rt_palette, mlod_rt_skin, mlod_rt_skin_stale and mlod_rt_bounds only read the context, so
  * several threads may evaluate different instances at once, each with its
  * own scratch, as long as no thread calls mlod_rt_update, mlod_rt_stream,
  * mlod_rt_request or creates, destroys or changes an instance meanwhile.
@@ -731,6 +731,62 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
  * then the empty box). No allocation. */
 mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, float min[3], float max[3],
                            mlod_error *err);
+
+/* Skinning only when the vertices shown went stale. A CPU-skinning
+ * caller that keeps each instance's skinned vertices in buffers of its own
+ * (the ones it draws) poses every instance every frame and skins one again
+ * only when the vertices it kept are provably more than max_stale_pixels
+ * off where mlod_rt_skin would put them now. The caller keeps, per
+ * instance, a record of mlod_rt_stale_size(ctx) bytes (4-byte aligned, its
+ * own memory: the runtime allocates nothing for it), all zero for "never
+ * skinned" (zero it again whenever its buffers no longer hold that
+ * instance's last skin): 32 bytes, then 48 per joint of the full skeleton
+ * (the 3x4 affine part of each world matrix the kept skin used), then 4 per
+ * morph weight (mlod_rt_morph_target_count summed over the parts).
+ * mlod_rt_skin_stale poses the instance as mlod_rt_skin does (only what
+ * its mesh level reads) and makes the palette entries; then, when the
+ * record holds a skin of the same instance id, at the same skeleton and
+ * mesh levels shown, the same clip and the same morph weights (bit for
+ * bit), it bounds how far any vertex moved since: a skinned vertex is a
+ * convex combination of its palette entries' images, so with P0 an entry's
+ * matrix then (made again from the kept world matrix by the same product:
+ * the same floats) and P1 now, L0 and L1 their 3x3 linear parts, c, r and h
+ * the centre, radius and half extents of the bind-pose ball and box of the
+ * vertices weighted to the entry (mlod_rt_bounds' tables), grown by g for
+ * the morph weights as there, every vertex moved at most
+ *     max_e |P1 c_e - P0 c_e| + min(||L1 - L0||_F (r_e + g),
+ *                                   | (sum_j |(L1 - L0)_ij| (h_j + g))_i |)
+ * (the Frobenius norm bounds the spectral norm), the same for each rigid
+ * part's matrix and ball, plus the rounding of both skins (1e-5 of the
+ * magnitudes the kernels sum, each matrix, as mlod_rt_bounds allows); an
+ * entry whose matrix did not change adds 0 (the kernels then write the
+ * same floats). That is exact, whatever the clip does between. At the
+ * instance's distance d at the last update (mlod_rt_update), a move D is
+ * D lines / (2 d tan(fov_y / 2)) pixels (sel's fov_y and lines; nothing
+ * else of sel is read). When that is at most max_stale_pixels, nothing is
+ * written (*skinned 0, *stale_pixels the bound in pixels, *vertex_count
+ * the level's vertices, which the buffers still hold); otherwise (a bound
+ * over it, or NaN, which only a hostile pack gives; d 0 with a pose that
+ * moved; the record empty or of another instance, level, clip or weights)
+ * it skins into the buffers as mlod_rt_skin (*skinned 1, *stale_pixels 0)
+ * and keeps this skin's world matrices and weights in the record. The
+ * motion level may change without a skin: the bound is on the matrices.
+ * Without a mesh it is mlod_rt_skin. Errors and arguments as
+ * mlod_rt_skin, and MLOD_ERR_INVALID_ARG for a NULL sel or record, fov_y
+ * not in (0, pi), lines not > 0 or max_stale_pixels negative or not finite
+ * (nothing written then); after a skin that fails the record is marked
+ * empty. No allocation (the check keeps the changes of up to 16 palette
+ * sources on the stack, about 2.6 KB). The errors add: a mesh level selected within p
+ * pixels of level 0 (MLOD_RT_SELECT_PIXELS) shown with a stale pose within
+ * q pixels of now is within p + q pixels of level 0 now (0.5 + 0.5 keeps
+ * the pixel rule's 1 pixel). Like mlod_rt_skin it only reads the context;
+ * a record is one instance's, used by one thread at a time. Measured:
+ * mlod_rt_eval(3), bench/RESULTS.md Run 15. */
+size_t mlod_rt_stale_size(const mlod_rt_ctx *ctx);
+mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const mlod_rt_select *sel,
+                               float max_stale_pixels, void *record, float *positions, size_t pos_stride,
+                               float *normals, size_t nrm_stride, uint32_t capacity, uint32_t *vertex_count,
+                               int *skinned, float *stale_pixels, mlod_error *err);
 
 /* The skinning kernels, for callers with their own data and for the
  * benchmark: n vertices, positions and normals 3 floats each (normals may

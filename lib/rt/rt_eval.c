@@ -1131,3 +1131,260 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 	}
 	return MLOD_OK;
 }
+
+/* ---------------------------------------------------------------- */
+/* Skinning only when the shown vertices went stale                  */
+/* ---------------------------------------------------------------- */
+
+/* The caller's record of the last skin of one instance
+ * (mlod_rt_stale_size): this head, then 12 floats per joint (the 3x4
+ * affine part of the world matrix the skin used, columns 0 .. 3, rows
+ * 0 .. 2; valid at the joints the skin posed), then the instance's morph
+ * weights. The palette entries and rigid parts' matrices of that skin are
+ * made again from them by the same products (rt_mat_mul, rigid_matrix):
+ * the same floats, in fewer bytes than a palette (RobotExpressive: 43
+ * joints, 172 palette entries). All zero (valid 0): never skinned. */
+typedef struct rt_stale_head {
+	uint32_t valid;           /* RT_STALE_VALID once it holds a skin */
+	uint32_t id;              /* the instance skinned (its generation too) */
+	uint32_t skel_level, mesh_level, clip;
+	uint32_t joint_count, morph_total; /* the layout, for a record of another context */
+	uint32_t hint;            /* the item whose bound went over at the last check */
+} rt_stale_head;
+
+#define RT_STALE_VALID 0x6d6c7331u
+
+size_t mlod_rt_stale_size(const mlod_rt_ctx *ctx)
+{
+	if (!ctx)
+		return 0;
+	return sizeof(rt_stale_head) + 48 * (size_t)ctx->joint_count + 4 * (size_t)ctx->morph_total;
+}
+
+/* A kept world matrix (12 floats) as the 16 rt_mat_mul reads. */
+static inline void affine16(const float *w, float *M)
+{
+	for (int c = 0; c < 4; c++)
+		M[4 * c] = w[3 * c], M[4 * c + 1] = w[3 * c + 1], M[4 * c + 2] = w[3 * c + 2], M[4 * c + 3] = 0.0f;
+	M[15] = 1.0f;
+}
+
+/* The change from the affine M0 to M1 (column-major 4x4), in double: D =
+ * M1 - M0, its linear part l (l[3 j + i] = row i, column j) and
+ * translation t; f2 = ||l||_F^2; per row i the magnitudes the kernels sum
+ * with either matrix, a[i] = sum_j (|M0_ij| + |M1_ij|) and b[i] = |M0_i3|
+ * + |M1_i3| (for the rounding allowance); same: 1 when D is 0 and finite. */
+typedef struct rt_stale_delta {
+	double l[9], t[3], a[3], b[3], f2;
+	int same;
+} rt_stale_delta;
+
+static void stale_delta(const float *M0, const float *M1, rt_stale_delta *d)
+{
+	double f2 = 0, z = 0;
+	for (int i = 0; i < 3; i++) {
+		d->t[i] = (double)M1[12 + i] - M0[12 + i];
+		d->b[i] = fabs((double)M0[12 + i]) + fabs((double)M1[12 + i]);
+		z += d->t[i] * d->t[i];
+		double a = 0;
+		for (int j = 0; j < 3; j++) {
+			const double l = (double)M1[4 * j + i] - M0[4 * j + i];
+			d->l[3 * j + i] = l;
+			f2 += l * l;
+			a += fabs((double)M0[4 * j + i]) + fabs((double)M1[4 * j + i]);
+		}
+		d->a[i] = a;
+	}
+	d->f2 = f2;
+	d->same = z == 0 && f2 == 0; /* NaN compares false */
+}
+
+/* How far a point of a set bounded by centre c (3), half extents h (3)
+ * and ball radius r about c, each grown by g, moves under the change d: a
+ * point x moves by D x = (l c + t) + l (x - c), at most |l c + t| plus the
+ * smaller of ||l||_F (r + g) (the Frobenius norm bounds the spectral one)
+ * and |(sum_j |l_ij| (h_j + g))_i| (the box's); plus the rounding of both
+ * skins (RT_BOUND_ROUND of the magnitudes the kernels sum, as
+ * mlod_rt_bounds allows, for each matrix, times sqrt 3 over the axes). 0
+ * when the matrices are the same finite floats (the kernels then write
+ * the same floats). NaN when any is not finite. */
+static double stale_move(const rt_stale_delta *d, const float *c, const float *h, double r, double g)
+{
+	if (d->same)
+		return 0.0;
+	const double cn = fabs(c[0]) + fabs(c[1]) + fabs(c[2]) + h[0] + h[1] + h[2] + 3 * g;
+	const double h0 = h[0] + g, h1 = h[1] + g, h2 = h[2] + g;
+	double u2 = 0, v2 = 0, mag = 0;
+	for (int i = 0; i < 3; i++) {
+		const double *l = d->l + i;
+		const double u = d->t[i] + l[0] * c[0] + l[3] * c[1] + l[6] * c[2];
+		const double v = fabs(l[0]) * h0 + fabs(l[3]) * h1 + fabs(l[6]) * h2;
+		const double m = d->a[i] * cn + d->b[i];
+		u2 += u * u, v2 += v * v;
+		mag = dmax(mag, m) + 0 * m; /* a NaN stays */
+	}
+	const double ball = sqrt(d->f2) * (r + g), box = sqrt(v2);
+	return sqrt(u2) + dmin(ball, box) + 0 * (ball + box) + RT_BOUND_ROUND * 1.7320508075688772 * mag;
+}
+
+/* Entries sharing a joint and a bind matrix (entry_src: skins sharing
+ * joints) share their change: kept on the stack for the last few sources
+ * met, by source index modulo RT_STALE_SLOTS. */
+#define RT_STALE_SLOTS 16
+
+/* rigid_matrix of a rigid part (joint >= 0) given Wj, the world matrix
+ * of its joint, or of its stand-in when su removed the joint: the same
+ * products, so the same floats. */
+static void rigid_matrix_at(const rt_unit *su, const float *Wj, const mlod_pack_part *p, float *M)
+{
+	const uint32_t j = (uint32_t)p->rec.joint;
+	if (su && su->plan.stand[j] != (int32_t)j) {
+		float t[16];
+		rt_mat_mul(Wj, su->plan.rel + 16 * (size_t)j, t);
+		rt_mat_mul(t, p->rec.offset, M);
+	} else {
+		rt_mat_mul(Wj, p->rec.offset, M);
+	}
+}
+
+mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const mlod_rt_select *sel,
+                               float max_stale_pixels, void *record, float *positions, size_t pos_stride,
+                               float *normals, size_t nrm_stride, uint32_t capacity, uint32_t *vertex_count,
+                               int *skinned, float *stale_pixels, mlod_error *err)
+{
+	if (vertex_count)
+		*vertex_count = 0;
+	if (skinned)
+		*skinned = 0;
+	if (stale_pixels)
+		*stale_pixels = 0;
+	if (!ctx || !s || !sel || !record || !positions)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: NULL argument");
+	if (s->owner != ctx)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: the scratch was made for another context");
+	if (pos_stride < 12 || pos_stride % 4 || (normals && (nrm_stride < 12 || nrm_stride % 4)))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: strides must be multiples of 4, at least 12");
+	if (!(sel->fov_y > 0.0f && sel->fov_y < 3.14159265f) || !(sel->lines > 0.0f) || !isfinite(sel->lines))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: fov_y must lie in (0, pi), lines be > 0");
+	if (!(max_stale_pixels >= 0.0f) || !isfinite(max_stale_pixels))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: max_stale_pixels must be finite, >= 0");
+	const rt_instance *in = rt_live(ctx, id);
+	if (!in)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
+	const mlod_rt_state *st = &in->st;
+	const rt_unit *su, *mu;
+	mlod_result r = pose_mesh_level(ctx, s, id, capacity, &su, &mu, err);
+	if (r != MLOD_OK)
+		return r;
+	if (!mu) /* no mesh: nothing to keep */
+		return mlod_rt_skin(ctx, s, id, positions, pos_stride, normals, nrm_stride, capacity, vertex_count, err);
+	rt_stale_head *hd = record;
+	float *rec_world = (float *)(hd + 1), *rec_morph = rec_world + 12 * (size_t)ctx->joint_count;
+	const mlod_pack_mesh *m = mu->mesh;
+	const uint32_t skel_level = su ? su->level : 0;
+	const float *mw = ctx->morph_total ? ctx->morph_weights + (size_t)rt_slot(ctx, id) * ctx->morph_total : NULL;
+	/* Anything but the pose changed since the kept skin: skin. */
+	int need = hd->valid != RT_STALE_VALID || hd->id != id || hd->skel_level != skel_level ||
+	           hd->mesh_level != mu->level || hd->clip != st->clip || hd->joint_count != ctx->joint_count ||
+	           hd->morph_total != ctx->morph_total ||
+	           (mw && memcmp(rec_morph, mw, 4 * (size_t)ctx->morph_total) != 0);
+	if (!need) {
+		/* The distance a vertex may have moved for max_stale_pixels at the
+		 * instance's distance: D pixels = D lines / (2 d tan(fov_y / 2)). */
+		const double px = (double)sel->lines / (2.0 * (double)st->distance * tan(0.5 * (double)sel->fov_y));
+		const double lim = (double)max_stale_pixels / px; /* d = 0: px infinite, lim 0 */
+		double grow = 0; /* morph weights (unchanged): as mlod_rt_bounds widens the balls */
+		for (uint32_t i = 0; i < m->part_count && i < ctx->morph_parts; i++) {
+			uint32_t k = ctx->morph_offset[i + 1] - ctx->morph_offset[i];
+			const uint32_t have = mu->bound_morph_at[i + 1] - mu->bound_morph_at[i];
+			if (have < k)
+				k = have;
+			const float *w = mw + ctx->morph_offset[i], *d = mu->bound_morph + mu->bound_morph_at[i];
+			double g = 0;
+			for (uint32_t t = 0; t < k; t++)
+				g += fabs((double)w[t]) * d[t];
+			grow = dmax(grow, g);
+		}
+		/* A skinned vertex is a convex combination of its entries' images:
+		 * it moved at most the most any of its entries' points moved. An
+		 * entry no vertex weighs (b[6] < 0) still multiplies: a matrix
+		 * not finite there makes the output NaN, so it must skin. */
+		/* Items: the level's palette entries (k < pal_used_count), then
+		 * its parts (rigid ones move with their matrix; static and
+		 * skinned ones are skipped here). The item that went over last
+		 * time (hd->hint) first: a moving instance mostly goes over on
+		 * the same limb, so its skin is decided after one item. */
+		double most = 0;
+		rt_stale_delta cache[RT_STALE_SLOTS];
+		uint32_t tag[RT_STALE_SLOTS];
+		for (int k = 0; k < RT_STALE_SLOTS; k++)
+			tag[k] = UINT32_MAX;
+		const uint32_t items = mu->pal_used_count + m->part_count;
+		const uint32_t first = hd->hint < items ? hd->hint : 0;
+		for (uint32_t n = 0; n < items && !need; n++) {
+			const uint32_t k = n == 0 ? first : n <= first ? n - 1 : n;
+			double mv = 0;
+			if (k < mu->pal_used_count) {
+				const uint32_t e = mu->pal_used[k], f = entry_src(ctx, su, e), slot = f % RT_STALE_SLOTS;
+				const float *b = mu->bound_entry + 13 * (size_t)e;
+				rt_stale_delta *d = &cache[slot];
+				if (tag[slot] != f) {
+					/* the matrix this entry had at the kept skin: the
+					 * same product as then (rt_mat_mul of the same floats) */
+					float W0[16], P0[16];
+					affine16(rec_world + 12 * (size_t)entry_joint(ctx, su, e), W0);
+					rt_mat_mul(W0, entry_bind(ctx, su, e), P0);
+					stale_delta(P0, s->palette + 16 * (size_t)e, d);
+					tag[slot] = f;
+				}
+				mv = b[6] >= 0.0f ? stale_move(d, b, b + 3, b[6], grow) : 0 * stale_move(d, b, b, 0, 0);
+			} else {
+				const uint32_t i = k - mu->pal_used_count;
+				const mlod_pack_part *p = &m->parts[i];
+				const float *c = mu->bound_part + 7 * (size_t)i;
+				if (p->rec.skin >= 0 || p->rec.joint < 0 || !(c[6] >= 0.0f))
+					continue; /* a static part does not move */
+				const uint32_t j = (uint32_t)p->rec.joint, sj = su ? (uint32_t)su->plan.stand[j] : j;
+				float W0[16], M0[16], M1[16];
+				affine16(rec_world + 12 * (size_t)sj, W0);
+				rigid_matrix_at(su, s->world + 16 * (size_t)sj, p, M1);
+				rigid_matrix_at(su, W0, p, M0);
+				rt_stale_delta d;
+				stale_delta(M0, M1, &d);
+				mv = stale_move(&d, c, c + 3, c[6], grow);
+			}
+			need = !(mv <= lim);
+			most = dmax(most, mv);
+			if (need)
+				hd->hint = k;
+		}
+		if (!need) {
+			if (vertex_count)
+				*vertex_count = mu->vertex_count;
+			if (stale_pixels)
+				*stale_pixels = (float)(most * px);
+			return MLOD_OK;
+		}
+	}
+	/* Skin (the pose and palette entries above, as they are) and keep
+	 * the world matrices it used. */
+	r = mlod_rt_skin(ctx, s, id, positions, pos_stride, normals, nrm_stride, capacity, vertex_count, err);
+	if (r != MLOD_OK) {
+		hd->valid = 0;
+		return r;
+	}
+	for (uint32_t k = 0; k < s->plan_count; k++) {
+		const uint32_t j = s->plan_posed[k];
+		const float *w = s->world + 16 * (size_t)j;
+		float *o = rec_world + 12 * (size_t)j;
+		for (int c = 0; c < 4; c++)
+			o[3 * c] = w[4 * c], o[3 * c + 1] = w[4 * c + 1], o[3 * c + 2] = w[4 * c + 2];
+	}
+	if (mw)
+		memcpy(rec_morph, mw, 4 * (size_t)ctx->morph_total);
+	hd->valid = RT_STALE_VALID, hd->id = id, hd->skel_level = skel_level, hd->mesh_level = mu->level;
+	hd->clip = st->clip, hd->joint_count = ctx->joint_count, hd->morph_total = ctx->morph_total;
+	if (skinned)
+		*skinned = 1;
+	return MLOD_OK;
+}
