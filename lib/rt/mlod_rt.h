@@ -781,7 +781,7 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
  * q pixels of now is within p + q pixels of level 0 now (0.5 + 0.5 keeps
  * the pixel rule's 1 pixel). Like mlod_rt_skin it only reads the context;
  * a record is one instance's, used by one thread at a time. Measured:
- * mlod_rt_eval(3), bench/RESULTS.md Run 15. */
+ * mlod_rt_eval(3), bench/RESULTS.md Run 112. */
 size_t mlod_rt_stale_size(const mlod_rt_ctx *ctx);
 mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const mlod_rt_select *sel,
                                float max_stale_pixels, void *record, float *positions, size_t pos_stride,
