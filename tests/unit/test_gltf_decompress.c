@@ -2,7 +2,8 @@
  * test_gltf_decompress.c: meshopt-compressed glTF input
  * (lib/io/gltf_decompress.cpp): a triangle whose positions and indices are
  * EXT_meshopt_compression / KHR_meshopt_compression buffer views, encoded
- * here with meshoptimizer's own encoders, reads as the plain triangle; then
+ * here with meshoptimizer's own encoders (indices with the index codec and
+ * the sequence codec), reads as the plain triangle; then
  * hostile variants (truncated, garbled, huge counts, bad strides, unknown
  * modes, filters and codec versions) are refused with the right code.
  * Draco input is covered by the CLI tests (tests/cli/pack_draco_input.sh),
@@ -15,15 +16,19 @@
 static const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
 static const unsigned indices[3] = {0, 1, 2};
 
-/* The compressed bytes: vertices at 0, indices at index_at. */
+/* The compressed bytes: vertices at 0, indices at index_at (the index
+ * codec: mode TRIANGLES) and at sequence_at (the sequence codec: mode
+ * INDICES). */
 static unsigned char encoded[512];
-static size_t vertex_bytes, index_at, index_bytes;
+static size_t vertex_bytes, index_at, index_bytes, sequence_at, sequence_bytes;
 
 static void encode(void)
 {
 	vertex_bytes = meshopt_encodeVertexBuffer(encoded, sizeof encoded, positions, 3, 12);
 	index_at = (vertex_bytes + 3) / 4 * 4;
 	index_bytes = meshopt_encodeIndexBuffer(encoded + index_at, sizeof encoded - index_at, indices, 3);
+	sequence_at = (index_at + index_bytes + 3) / 4 * 4;
+	sequence_bytes = meshopt_encodeIndexSequence(encoded + sequence_at, sizeof encoded - sequence_at, indices, 3);
 }
 
 static void base64(const unsigned char *d, size_t n, char *out)
@@ -50,7 +55,7 @@ static mlod_result read_triangle(const char *ext, const char *vertex_ext, const 
 	static char text[8192], data[1024], vdef[256], idef[256];
 	if (!bytes) {
 		bytes = encoded;
-		nbytes = index_at + index_bytes;
+		nbytes = sequence_at + sequence_bytes;
 	}
 	base64(bytes, nbytes, data);
 	snprintf(vdef, sizeof vdef, "\"byteLength\":%zu,\"byteStride\":12,\"count\":3,\"mode\":\"ATTRIBUTES\"", vertex_bytes);
@@ -77,11 +82,15 @@ static mlod_result read_triangle(const char *ext, const char *vertex_ext, const 
 
 TEST(plain_triangle)
 {
-	for (int k = 0; k < 2; k++) {
+	char sequence[256];
+	snprintf(sequence, sizeof sequence,
+	         "\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":2,\"count\":3,\"mode\":\"INDICES\"", sequence_at,
+	         sequence_bytes);
+	for (int k = 0; k < 3; k++) {
 		mlod_character c = {0};
 		mlod_error err = {0};
-		const char *ext = k ? "KHR_meshopt_compression" : "EXT_meshopt_compression";
-		mlod_result r = read_triangle(ext, NULL, NULL, NULL, 0, &c, &err);
+		const char *ext = k == 1 ? "KHR_meshopt_compression" : "EXT_meshopt_compression";
+		mlod_result r = read_triangle(ext, NULL, k == 2 ? sequence : NULL, NULL, 0, &c, &err);
 		CHECK_MSG(r == MLOD_OK, "%s: %d %s", ext, (int)r, err.message);
 		if (r == MLOD_OK) {
 			const mlod_primitive *p = c.mesh_count == 1 && c.meshes[0].primitive_count == 1 ? c.meshes[0].primitives : NULL;
@@ -119,15 +128,15 @@ TEST(hostile)
 	refused(NULL, ix, NULL, 0, MLOD_ERR_PARSE, "the compressed index data is malformed or truncated");
 	/* Past the end of the buffer. */
 	snprintf(v, sizeof v, "\"byteOffset\":8,\"byteLength\":%zu,\"byteStride\":12,\"count\":3,\"mode\":\"ATTRIBUTES\"",
-	         index_at + index_bytes);
+	         sequence_at + sequence_bytes);
 	refused(v, NULL, NULL, 0, MLOD_ERR_PARSE, "lie past the end of buffer 0");
 	/* Garbled headers: a newer codec version, and no meshopt stream. */
 	unsigned char copy[512];
 	memcpy(copy, encoded, sizeof copy);
 	copy[0] = 0xA1;
-	refused(NULL, NULL, copy, index_at + index_bytes, MLOD_ERR_UNSUPPORTED, "vertex codec version 1");
+	refused(NULL, NULL, copy, sequence_at + sequence_bytes, MLOD_ERR_UNSUPPORTED, "vertex codec version 1");
 	copy[0] = 0x17;
-	refused(NULL, NULL, copy, index_at + index_bytes, MLOD_ERR_PARSE, "malformed or truncated");
+	refused(NULL, NULL, copy, sequence_at + sequence_bytes, MLOD_ERR_PARSE, "malformed or truncated");
 	/* Sizes: count and stride against the view, a count no stream of
 	 * this length decodes to, strides the decoder would assert on. */
 	refused("\"byteLength\":8,\"byteStride\":12,\"count\":4,\"mode\":\"ATTRIBUTES\"", NULL, NULL, 0, MLOD_ERR_PARSE,
