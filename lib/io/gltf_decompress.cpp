@@ -74,6 +74,8 @@ static std::string base64_decode(const std::string &s, size_t from, const std::s
 	return out;
 }
 
+static size_t member(const json &e, const char *key, long long def, const std::string &at);
+
 const std::string &Buffers::get(size_t i, const std::string &what)
 {
 	if (i >= loaded.size())
@@ -82,9 +84,7 @@ const std::string &Buffers::get(size_t i, const std::string &what)
 		return *loaded[i];
 	const json &b = list[i];
 	std::string at = "buffers[" + std::to_string(i) + "]";
-	if (!b.contains("byteLength"))
-		fail(MLOD_ERR_PARSE, "%s: no byteLength", at.c_str());
-	size_t length = b["byteLength"].get<size_t>();
+	size_t length = member(b, "byteLength", -1, at);
 	std::string data;
 	if (!b.contains("uri")) {
 		for (const char *name : meshopt_names)
@@ -360,9 +360,8 @@ static void decode_draco(json &j, json &prim, const std::string &at, Buffers &bu
 	if (found == decoded.end()) {
 		const json &view = views[v];
 		std::string vat = "bufferViews[" + std::to_string(v) + "]";
-		size_t buffer = view.contains("buffer") ? view["buffer"].get<size_t>() : size_t(-1);
-		size_t offset = view.contains("byteOffset") ? view["byteOffset"].get<size_t>() : 0;
-		size_t length = view.contains("byteLength") ? view["byteLength"].get<size_t>() : 0;
+		size_t buffer = member(view, "buffer", -1, vat), offset = member(view, "byteOffset", 0, vat);
+		size_t length = member(view, "byteLength", -1, vat);
 		if (extension(view, meshopt_names[0]) || extension(view, meshopt_names[1]))
 			fail(MLOD_ERR_UNSUPPORTED, "%s: Draco data in a meshopt-compressed buffer view", vat.c_str());
 		const unsigned char *src = slice(buffers, buffer, offset, length, vat);
@@ -543,8 +542,7 @@ bool decompress(json &j, const unsigned char *data, bool binary, const char *bas
 	for (size_t v = 0; v < views.size(); v++) {
 		json &view = j["bufferViews"][v];
 		std::string at = "bufferViews[" + std::to_string(v) + "]";
-		size_t length = view["byteLength"].get<size_t>();
-		size_t offset = view.contains("byteOffset") ? view["byteOffset"].get<size_t>() : 0;
+		size_t length = member(view, "byteLength", -1, at), offset = member(view, "byteOffset", 0, at);
 		const char *codec = nullptr;
 		for (const char *name : meshopt_names)
 			if (extension(view, name))
@@ -559,7 +557,7 @@ bool decompress(json &j, const unsigned char *data, bool binary, const char *bas
 			length = 0;
 			bytes = "";
 		} else {
-			bytes = slice(buffers, view["buffer"].get<size_t>(), offset, length, at);
+			bytes = slice(buffers, member(view, "buffer", -1, at), offset, length, at);
 		}
 		view["buffer"] = 0;
 		view["byteOffset"] = append(bin, bytes, length);
@@ -583,15 +581,19 @@ bool decompress(json &j, const unsigned char *data, bool binary, const char *bas
 	if (std::find(draco_view.begin(), draco_view.end(), true) != draco_view.end()) {
 		std::vector<bool> used(j["bufferViews"].size(), false), ignored(buffer_list.size(), false);
 		extension_refs(j, false, used, ignored);
+		auto use = [&](const json &o) {
+			if (o.is_object() && o.contains("bufferView") && o["bufferView"].is_number_unsigned() &&
+			    o["bufferView"].get<size_t>() < used.size())
+				used[o["bufferView"].get<size_t>()] = true;
+		};
 		for (const char *list : {"accessors", "images"})
 			if (j.contains(list))
 				for (const json &o : j[list]) {
-					if (o.contains("bufferView"))
-						used[o["bufferView"].get<size_t>()] = true;
+					use(o);
 					if (o.contains("sparse"))
 						for (const char *part : {"indices", "values"})
-							if (o["sparse"].contains(part) && o["sparse"][part].contains("bufferView"))
-								used[o["sparse"][part]["bufferView"].get<size_t>()] = true;
+							if (o["sparse"].contains(part))
+								use(o["sparse"][part]);
 				}
 		std::vector<long long> map(used.size(), -1);
 		json kept = json::array();
