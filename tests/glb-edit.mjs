@@ -4,7 +4,8 @@
 //   node tests/glb-edit.mjs in.glb out.glb 'BODY'
 //
 // BODY is JavaScript run with `j`, the parsed JSON chunk, to change in
-// place; the BIN chunk is copied as it is.
+// place, and `bin`, the BIN chunk's bytes (a Buffer; empty without one),
+// whose bytes may be changed in place (not its length).
 import { readFileSync, writeFileSync } from 'node:fs';
 
 const [src, dst, body] = process.argv.slice(2);
@@ -12,7 +13,8 @@ const b = readFileSync(src);
 if (b.readUInt32LE(0) !== 0x46546c67) throw new Error(`${src}: not a glb`);
 const jl = b.readUInt32LE(12);
 const j = JSON.parse(b.subarray(20, 20 + jl).toString('utf8'));
-new Function('j', body)(j);
+const binStart = 20 + jl + 8 <= b.length ? 20 + jl + 8 : b.length;
+new Function('j', 'bin', body)(j, b.subarray(binStart));
 let text = Buffer.from(JSON.stringify(j));
 text = Buffer.concat([text, Buffer.alloc((4 - (text.length % 4)) % 4, 0x20)]);
 const bin = b.subarray(20 + jl), head = Buffer.alloc(20);

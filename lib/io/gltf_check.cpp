@@ -45,11 +45,14 @@ std::string glb_json(const unsigned char *d, size_t size)
 }
 
 /* Required extensions that only touch what mlod passes through unchanged
- * (materials, textures, lights) or that the accessor decoder handles. */
+ * (materials, textures, lights), that the accessor decoder handles, or
+ * that gltf_decompress.cpp removes before tinygltf reads the document
+ * (meshopt and Draco compression). */
 static bool extension_supported(const std::string &name)
 {
 	static const char *const prefixes[] = {"KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_punctual",
-	                                       "KHR_mesh_quantization", "MSFT_texture_dds"};
+	                                       "KHR_mesh_quantization", "MSFT_texture_dds", "EXT_meshopt_compression",
+	                                       "KHR_meshopt_compression", "KHR_draco_mesh_compression"};
 	for (const char *p : prefixes)
 		if (name.compare(0, strlen(p), p) == 0)
 			return true;
@@ -246,19 +249,13 @@ void check_required_extensions(const json &doc)
 		if (!e.is_string())
 			continue;
 		std::string name = e.get<std::string>();
-		if (name == "KHR_draco_mesh_compression")
-			fail(MLOD_ERR_UNSUPPORTED, "the file requires KHR_draco_mesh_compression: Draco-compressed meshes "
-			                           "cannot be decoded (decompress it first, e.g. with gltf-transform)");
-		if (name == "EXT_meshopt_compression" || name == "KHR_meshopt_compression")
-			fail(MLOD_ERR_UNSUPPORTED, "the file requires %s: meshopt-compressed buffers cannot be decoded "
-			                           "(decompress it first, e.g. with gltf-transform)", name.c_str());
 		if (!extension_supported(name))
 			fail(MLOD_ERR_UNSUPPORTED, "the file requires the extension %s, which mlod does not support", name.c_str());
 	}
 }
 
 /* %XX decoding, as tinygltf does before opening a URI. */
-static std::string url_decode(const std::string &s)
+std::string url_decode(const std::string &s)
 {
 	std::string out;
 	for (size_t i = 0; i < s.size(); i++) {

@@ -15,6 +15,8 @@
  *                       keeps
  *   gltf_read.cpp       reading: tinygltf with mlod's file callbacks, then
  *                       what the reader adds (a scene, unit rotations)
+ *   gltf_decompress.cpp meshopt and Draco compression made plain before
+ *                       tinygltf reads the document
  *   gltf_model.cpp      glTF -> character (mlod_gltf_to_character), and
  *                       character -> glTF: meshes, skins, animations, nodes
  *   gltf_write.cpp      writing: tinygltf's JSON reconciled with the input's
@@ -25,8 +27,11 @@
  *
  * Reading. mlod_gltf_read checks what tinygltf does not before handing it
  * the bytes: the glb container's length fields, the JSON syntax and nesting
- * depth, required extensions mlod cannot decode (Draco, meshopt), and the
- * URIs of external buffers. tinygltf then parses the document, keeping
+ * depth, required extensions mlod cannot read, and the URIs of external
+ * buffers. A document using EXT_/KHR_meshopt_compression or
+ * KHR_draco_mesh_compression is rewritten into a plain glb (one buffer,
+ * every compressed buffer view and Draco primitive decoded), since the
+ * Debian tinygltf knows neither. tinygltf then parses the document, keeping
  * images as their encoded bytes (no decoding). Finally every cross-reference
  * is checked (node hierarchy, accessors inside buffer views inside buffers),
  * so the rest of the shim can index the model without re-checking, and no
@@ -259,9 +264,13 @@ bool stays_inside(const std::string &path);
 std::string join_path(const std::string &dir, const std::string &file);
 void check_buffer_uris(const json &doc, const char *base_dir);
 void check_image_uris(const json &doc, const char *base_dir);
+std::string url_decode(const std::string &s);
 std::vector<int> node_parents(const Model &m);
 void check_document(const Model &m, size_t input_size);
 std::vector<char> lod_level_nodes(const Model &m);
+
+/* In gltf_decompress.cpp */
+bool decompress(json &j, const unsigned char *data, bool binary, const char *base_dir, std::string &out);
 
 /* In gltf_read.cpp */
 void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const char *base_dir);

@@ -211,6 +211,13 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 	check_required_extensions(j);
 	check_buffer_uris(j, base_dir);
 	check_image_uris(j, base_dir);
+	/* Compressed meshes: tinygltf reads the plain glb made of them. */
+	std::string plain;
+	if (decompress(j, data, binary, base_dir, plain)) {
+		data = reinterpret_cast<const unsigned char *>(plain.data());
+		size = plain.size();
+		binary = true;
+	}
 
 	tinygltf::TinyGLTF loader;
 	FileAccess access{base_dir != nullptr, base_dir ? join_path(base_dir, "") : ""};

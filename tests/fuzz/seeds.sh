@@ -45,6 +45,18 @@ cp "$ROOT/samples/tubeman.glb" "$ROOT/samples/RobotExpressive.glb" $GLB "$ROOT"/
 for f in $GLB; do
 	"$RECORD_SEED" "$f" > "$OUT/seeds-record/$(basename "$f" .glb).json"
 done
+# Compressed input (lib/io/gltf_decompress.cpp): the tiny tubeman through
+# gltfpack -c and -cc (meshopt, -cc with its filters) and gltf-transform's
+# Draco, where tests/node has them (scripts/install-deps).
+NB=$ROOT/tests/node/node_modules/.bin
+cp "$ROOT/tests/data/meshopt.glb" "$OUT/seeds-gltf/"
+if [ -x "$NB/gltfpack" ]; then
+	"$NB/gltfpack" -i "$S/tiny.glb" -o "$OUT/seeds-gltf/tiny.meshopt.glb" -c > /dev/null
+	"$NB/gltfpack" -i "$S/tiny.glb" -o "$OUT/seeds-gltf/tiny.meshopt-cc.glb" -cc > /dev/null
+fi
+if [ -x "$NB/gltf-transform" ]; then
+	"$NB/gltf-transform" draco "$S/tiny.glb" "$OUT/seeds-gltf/tiny.draco.glb" > /dev/null 2>&1
+fi
 
 # Pack seeds (make fuzz, make fuzz-unpack): the tiny tubeman packed with
 # each codec (draco: MESH levels as Draco meshes) and without the entropy

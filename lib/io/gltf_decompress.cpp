@@ -1,0 +1,663 @@
+/*
+ * gltf_decompress.cpp: compressed glTF made plain before tinygltf reads it
+ * (gltf_internal.hpp). The Debian tinygltf knows neither
+ * EXT_meshopt_compression / KHR_meshopt_compression (buffer views) nor
+ * KHR_draco_mesh_compression (primitives), so the reader rewrites such a
+ * document into a plain glb: every buffer view's bytes, decoded where
+ * compressed, go into one new buffer, each Draco primitive's attributes
+ * and indices into new buffer views of it, and the extensions leave
+ * extensionsUsed / extensionsRequired. Only Draco's core decoder is used
+ * (never its glTF I/O, which carries its own tinygltf: deps.md).
+ */
+#include <fstream>
+
+#include <draco/compression/decode.h>
+#include <meshoptimizer.h>
+
+#include "io/gltf_internal.hpp"
+
+namespace mlod_gltf_internal {
+
+static const char *const meshopt_names[] = {"EXT_meshopt_compression", "KHR_meshopt_compression"};
+static const char *const draco_name = "KHR_draco_mesh_compression";
+
+/* A meshopt stream never decodes to more than this many times its length
+ * plus a little: the vertex codec's densest block spends 2 bits on 16 zero
+ * bytes (64x), an index triangle takes at least a byte (12 bytes out), a
+ * sequence index a byte (4 out). A declared size past it is hostile, and
+ * is refused before anything is allocated. */
+const size_t meshopt_max_ratio = 64, meshopt_slack = 4096;
+
+/* The document's buffers, loaded when a view first needs one. */
+struct Buffers {
+	const json &list;
+	const unsigned char *glb_bin; /* the glb's BIN chunk, or null */
+	size_t glb_bin_size;
+	const char *base_dir;
+	std::vector<std::unique_ptr<std::string>> loaded;
+
+	Buffers(const json &j, const unsigned char *bin, size_t bin_size, const char *dir)
+	    : list(j), glb_bin(bin), glb_bin_size(bin_size), base_dir(dir), loaded(j.is_array() ? j.size() : 0)
+	{
+	}
+
+	/* The bytes of buffer i ("what" names who asks). */
+	const std::string &get(size_t i, const std::string &what);
+};
+
+static std::string base64_decode(const std::string &s, size_t from, const std::string &what)
+{
+	static signed char table[256];
+	if (!table['B']) {
+		memset(table, -1, sizeof table);
+		const char *a = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+		for (int k = 0; a[k]; k++)
+			table[(unsigned char)a[k]] = (signed char)k;
+	}
+	std::string out;
+	out.reserve((s.size() - from) / 4 * 3);
+	unsigned acc = 0;
+	int bits = 0;
+	for (size_t i = from; i < s.size(); i++) {
+		unsigned char c = (unsigned char)s[i];
+		if (c == '=')
+			break;
+		if (table[c] < 0)
+			fail(MLOD_ERR_PARSE, "%s: the data: URI is not base64 (byte %zu)", what.c_str(), i);
+		acc = acc << 6 | unsigned(table[c]);
+		bits += 6;
+		if (bits >= 8) {
+			bits -= 8;
+			out += char(acc >> bits & 0xFF);
+		}
+	}
+	return out;
+}
+
+static size_t member(const json &e, const char *key, long long def, const std::string &at);
+
+const std::string &Buffers::get(size_t i, const std::string &what)
+{
+	if (i >= loaded.size())
+		fail(MLOD_ERR_PARSE, "%s: buffer %zu does not exist (the document has %zu)", what.c_str(), i, loaded.size());
+	if (loaded[i])
+		return *loaded[i];
+	const json &b = list[i];
+	std::string at = "buffers[" + std::to_string(i) + "]";
+	size_t length = member(b, "byteLength", -1, at);
+	std::string data;
+	if (!b.contains("uri")) {
+		for (const char *name : meshopt_names)
+			if (b.contains("extensions") && b["extensions"].is_object() && b["extensions"].contains(name))
+				fail(MLOD_ERR_PARSE, "%s: %s uses %s's fallback buffer, which has no data", what.c_str(), at.c_str(),
+				     name);
+		if (i != 0 || !glb_bin)
+			fail(MLOD_ERR_PARSE, "%s: %s has neither a URI nor a glb BIN chunk", what.c_str(), at.c_str());
+		data.assign(reinterpret_cast<const char *>(glb_bin), glb_bin_size);
+	} else {
+		std::string uri = b["uri"].get<std::string>();
+		if (uri.compare(0, 5, "data:") == 0) {
+			size_t comma = uri.find(',');
+			if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos)
+				fail(MLOD_ERR_UNSUPPORTED, "%s: a data: URI that is not base64", at.c_str());
+			data = base64_decode(uri, comma + 1, at);
+		} else {
+			/* check_buffer_uris allowed it: a file below base_dir */
+			if (!base_dir)
+				fail(MLOD_ERR_PARSE, "%s: an external file without a directory to read it from", at.c_str());
+			std::ifstream f(join_path(base_dir, url_decode(uri)), std::ios::binary | std::ios::ate);
+			std::streamoff size = f.tellg();
+			if (!f || size < 0 || uint64_t(size) > UINT32_MAX)
+				fail(MLOD_ERR_IO, "%s: cannot read %s", at.c_str(), mlod_gltf_internal::quoted(uri).c_str());
+			data.resize(size_t(size));
+			f.seekg(0);
+			if (size > 0 && !f.read(&data[0], size))
+				fail(MLOD_ERR_IO, "%s: cannot read %s", at.c_str(), mlod_gltf_internal::quoted(uri).c_str());
+		}
+	}
+	if (data.size() < length)
+		fail(MLOD_ERR_PARSE, "%s: byteLength %zu, but the data has %zu bytes", at.c_str(), length, data.size());
+	data.resize(length);
+	loaded[i].reset(new std::string(std::move(data)));
+	return *loaded[i];
+}
+
+/* The extension object of name on o, or null. */
+static const json *extension(const json &o, const char *name)
+{
+	if (!o.is_object() || !o.contains("extensions") || !o["extensions"].is_object())
+		return nullptr;
+	auto it = o["extensions"].find(name);
+	return it == o["extensions"].end() ? nullptr : &*it;
+}
+
+static void erase_extension(json &o, const char *name)
+{
+	o["extensions"].erase(name);
+	if (o["extensions"].empty())
+		o.erase("extensions");
+}
+
+/* A non-negative integer member of an extension object, or def when
+ * absent (def < 0: required). */
+static size_t member(const json &e, const char *key, long long def, const std::string &at)
+{
+	if (!e.contains(key)) {
+		if (def < 0)
+			fail(MLOD_ERR_PARSE, "%s: no %s", at.c_str(), key);
+		return size_t(def);
+	}
+	const json &v = e[key];
+	if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<unsigned long long>() > UINT32_MAX)
+		fail(MLOD_ERR_PARSE, "%s.%s: not an integer from 0 to 2^32-1", at.c_str(), key);
+	return v.get<size_t>();
+}
+
+static std::string string_member(const json &e, const char *key, const char *def, const std::string &at)
+{
+	if (!e.contains(key))
+		return def;
+	if (!e[key].is_string())
+		fail(MLOD_ERR_PARSE, "%s.%s: not a string", at.c_str(), key);
+	return e[key].get<std::string>();
+}
+
+/* The bytes [offset, offset + length) of buffer "buffer", checked. */
+static const unsigned char *slice(Buffers &buffers, size_t buffer, size_t offset, size_t length, const std::string &at)
+{
+	const std::string &b = buffers.get(buffer, at);
+	if (offset > b.size() || length > b.size() - offset)
+		fail(MLOD_ERR_PARSE, "%s: bytes %zu to %zu lie past the end of buffer %zu (%zu bytes)", at.c_str(), offset,
+		     offset + length, buffer, b.size());
+	return reinterpret_cast<const unsigned char *>(b.data()) + offset;
+}
+
+/* Explains a meshopt decoder's refusal: an unknown codec version is
+ * unsupported, anything else malformed. header: the high nibble the
+ * stream must start with; newest: the last version 0.18 decodes. */
+[[noreturn]] static void meshopt_refused(const unsigned char *src, size_t length, unsigned header, unsigned newest,
+                                         const char *codec, const std::string &at)
+{
+	if (length > 0 && (src[0] & 0xF0) == header && (src[0] & 0x0F) > newest)
+		fail(MLOD_ERR_UNSUPPORTED, "%s: %s codec version %u: mlod's meshoptimizer 0.18 decodes versions up to %u",
+		     at.c_str(), codec, src[0] & 0x0Fu, newest);
+	fail(MLOD_ERR_PARSE, "%s: the compressed %s data is malformed or truncated", at.c_str(), codec);
+}
+
+/* Decodes a meshopt-compressed buffer view (extension object e of name)
+ * into its plain bytes. */
+static std::string decode_meshopt(Buffers &buffers, const json &e, const char *name, size_t view_length,
+                                  const std::string &view_at)
+{
+	std::string at = view_at + ".extensions." + name;
+	if (!e.is_object())
+		fail(MLOD_ERR_PARSE, "%s: not an object", at.c_str());
+	size_t buffer = member(e, "buffer", -1, at), offset = member(e, "byteOffset", 0, at);
+	size_t length = member(e, "byteLength", -1, at), stride = member(e, "byteStride", -1, at);
+	size_t count = member(e, "count", -1, at);
+	std::string mode = string_member(e, "mode", "", at), filter = string_member(e, "filter", "NONE", at);
+	if (mode != "ATTRIBUTES" && mode != "TRIANGLES" && mode != "INDICES")
+		fail(MLOD_ERR_UNSUPPORTED, "%s: mode %s: mlod decodes ATTRIBUTES, TRIANGLES and INDICES", at.c_str(),
+		     mlod_gltf_internal::quoted(mode).c_str());
+	if (filter != "NONE" && filter != "OCTAHEDRAL" && filter != "QUATERNION" && filter != "EXPONENTIAL")
+		fail(MLOD_ERR_UNSUPPORTED, "%s: filter %s: mlod decodes NONE, OCTAHEDRAL, QUATERNION and EXPONENTIAL",
+		     at.c_str(), mlod_gltf_internal::quoted(filter).c_str());
+	if (mode != "ATTRIBUTES" && filter != "NONE")
+		fail(MLOD_ERR_PARSE, "%s: filter %s on mode %s (filters apply to ATTRIBUTES only)", at.c_str(),
+		     filter.c_str(), mode.c_str());
+	/* The decoders assert on these: checked first. */
+	if (mode == "ATTRIBUTES" ? stride == 0 || stride > 256 || stride % 4 != 0 : stride != 2 && stride != 4)
+		fail(MLOD_ERR_PARSE, "%s: byteStride %zu is not valid for mode %s", at.c_str(), stride, mode.c_str());
+	if (mode == "TRIANGLES" && count % 3 != 0)
+		fail(MLOD_ERR_PARSE, "%s: count %zu of mode TRIANGLES is not a multiple of 3", at.c_str(), count);
+	if ((filter == "OCTAHEDRAL" && stride != 4 && stride != 8) || (filter == "QUATERNION" && stride != 8))
+		fail(MLOD_ERR_PARSE, "%s: byteStride %zu is not valid for filter %s", at.c_str(), stride, filter.c_str());
+	uint64_t size = uint64_t(count) * stride;
+	if (size != view_length)
+		fail(MLOD_ERR_PARSE, "%s: count %zu times byteStride %zu is %llu bytes, but the buffer view has %zu",
+		     at.c_str(), count, stride, (unsigned long long)size, view_length);
+	if (size > uint64_t(length) * meshopt_max_ratio + meshopt_slack)
+		fail(MLOD_ERR_PARSE, "%s: %llu bytes cannot be the decoding of %zu compressed bytes", at.c_str(),
+		     (unsigned long long)size, length);
+	const unsigned char *src = slice(buffers, buffer, offset, length, at);
+	std::string out(size_t(size), '\0');
+	void *dst = &out[0];
+	if (mode == "ATTRIBUTES") {
+		if (meshopt_decodeVertexBuffer(dst, count, stride, src, length) != 0)
+			meshopt_refused(src, length, 0xA0, 0, "vertex", at);
+		if (filter == "OCTAHEDRAL")
+			meshopt_decodeFilterOct(dst, count, stride);
+		else if (filter == "QUATERNION")
+			meshopt_decodeFilterQuat(dst, count, stride);
+		else if (filter == "EXPONENTIAL")
+			meshopt_decodeFilterExp(dst, count, stride);
+	} else if (mode == "TRIANGLES") {
+		if (meshopt_decodeIndexBuffer(dst, count, stride, src, length) != 0)
+			meshopt_refused(src, length, 0xE0, 1, "index", at);
+	} else {
+		if (meshopt_decodeIndexSequence(dst, count, stride, src, length) != 0)
+			meshopt_refused(src, length, 0xD0, 0, "index sequence", at);
+	}
+	return out;
+}
+
+/* Appends bytes to the new buffer on a 4-byte boundary; returns where. */
+static size_t append(std::string &bin, const void *data, size_t size)
+{
+	bin.append((4 - bin.size() % 4) % 4, '\0');
+	if (uint64_t(bin.size()) + size > UINT32_MAX - 4096)
+		fail(MLOD_ERR_LIMIT, "the decompressed buffers would be larger than 4 GiB");
+	size_t at = bin.size();
+	bin.append(static_cast<const char *>(data), size);
+	return at;
+}
+
+static int type_components(const std::string &type)
+{
+	if (type == "SCALAR")
+		return 1;
+	if (type.size() == 4 && type.compare(0, 3, "VEC") == 0 && type[3] >= '2' && type[3] <= '4')
+		return type[3] - '0';
+	return 0;
+}
+
+/* Writes the values of a Draco attribute, one element per point, as the
+ * accessor's component type. */
+template <class T>
+static void convert_points(const draco::PointAttribute &attr, size_t points, int comps, size_t stride, char *out,
+                           const std::string &at)
+{
+	T v[4];
+	for (size_t p = 0; p < points; p++) {
+		if (!attr.ConvertValue<T>(attr.mapped_index(draco::PointIndex(uint32_t(p))), int8_t(comps), v))
+			fail(MLOD_ERR_PARSE, "%s: Draco cannot convert point %zu's value", at.c_str(), p);
+		memcpy(out + p * stride, v, sizeof(T) * size_t(comps));
+	}
+}
+
+/* The min and max of an accessor decoded from Draco: those of its
+ * decoded values, which the dequantisation moved off the file's (a
+ * validator compares them exactly). */
+static void set_bounds(json &acc, const std::string &data, size_t count, int comps, int ct, size_t stride)
+{
+	json lo = json::array(), hi = json::array();
+	for (int c = 0; c < comps; c++) {
+		double mn = 0, mx = 0;
+		for (size_t e = 0; e < count; e++) {
+			const char *p = data.data() + e * stride + size_t(c) * component_size(ct);
+			double v;
+			switch (ct) {
+			case 5120: v = *reinterpret_cast<const int8_t *>(p); break;
+			case 5121: v = *reinterpret_cast<const uint8_t *>(p); break;
+			case 5122: { int16_t x; memcpy(&x, p, 2); v = x; } break;
+			case 5123: { uint16_t x; memcpy(&x, p, 2); v = x; } break;
+			case 5125: { uint32_t x; memcpy(&x, p, 4); v = x; } break;
+			default: { float x; memcpy(&x, p, 4); v = x; } break;
+			}
+			if (e == 0 || v < mn)
+				mn = v;
+			if (e == 0 || v > mx)
+				mx = v;
+		}
+		if (ct == 5126) {
+			lo.push_back(mn);
+			hi.push_back(mx);
+		} else {
+			lo.push_back((long long)mn);
+			hi.push_back((long long)mx);
+		}
+	}
+	if (count == 0)
+		return;
+	acc["min"] = lo;
+	acc["max"] = hi;
+}
+
+/* One decoded Draco buffer view: the mesh, and the accessors already
+ * written from it. */
+struct DracoView {
+	std::unique_ptr<draco::Mesh> mesh;
+};
+
+/* Rewrites a Draco primitive: its indices and mapped attributes get new
+ * buffer views in bin, decoded from the extension's buffer view (views
+ * are the document's views as read; decoded caches their meshes;
+ * written maps an accessor to the Draco view it was written from). */
+static void decode_draco(json &j, json &prim, const std::string &at, Buffers &buffers, const json &views,
+                         std::map<size_t, DracoView> &decoded, std::map<size_t, size_t> &written, std::string &bin)
+{
+	const json &e = *extension(prim, draco_name);
+	std::string eat = at + ".extensions." + draco_name;
+	if (!e.is_object())
+		fail(MLOD_ERR_PARSE, "%s: not an object", eat.c_str());
+	if (prim.contains("mode") && prim["mode"].get<int>() != 4)
+		fail(MLOD_ERR_UNSUPPORTED, "%s: mode %d: mlod decodes Draco triangles (mode 4) only", at.c_str(),
+		     prim["mode"].get<int>());
+	if (!prim.contains("indices"))
+		fail(MLOD_ERR_UNSUPPORTED, "%s: a Draco primitive without indices", at.c_str());
+	size_t v = member(e, "bufferView", -1, eat);
+	if (!views.is_array() || v >= views.size())
+		fail(MLOD_ERR_PARSE, "%s.bufferView %zu does not exist", eat.c_str(), v);
+	if (!e.contains("attributes") || !e["attributes"].is_object())
+		fail(MLOD_ERR_PARSE, "%s: no attributes object", eat.c_str());
+	json &accessors = j["accessors"];
+	size_t n_acc = accessors.is_array() ? accessors.size() : 0;
+	/* The accessors' sizes bound what is decoded, checked before Draco
+	 * allocates anything past its input. */
+	auto accessor = [&](size_t a, const std::string &what) -> json & {
+		if (a >= n_acc)
+			fail(MLOD_ERR_PARSE, "%s: accessor %zu does not exist", what.c_str(), a);
+		json &acc = accessors[a];
+		if (!acc.contains("count") || !acc.contains("componentType") || !acc.contains("type"))
+			fail(MLOD_ERR_PARSE, "%s: accessor %zu lacks count, componentType or type", what.c_str(), a);
+		if (acc.contains("sparse"))
+			fail(MLOD_ERR_UNSUPPORTED, "%s: accessor %zu is sparse", what.c_str(), a);
+		return acc;
+	};
+	size_t ia = prim["indices"].get<size_t>();
+	json &iacc = accessor(ia, at + ".indices");
+	auto found = decoded.find(v);
+	if (found == decoded.end()) {
+		const json &view = views[v];
+		std::string vat = "bufferViews[" + std::to_string(v) + "]";
+		size_t buffer = member(view, "buffer", -1, vat), offset = member(view, "byteOffset", 0, vat);
+		size_t length = member(view, "byteLength", -1, vat);
+		if (extension(view, meshopt_names[0]) || extension(view, meshopt_names[1]))
+			fail(MLOD_ERR_UNSUPPORTED, "%s: Draco data in a meshopt-compressed buffer view", vat.c_str());
+		const unsigned char *src = slice(buffers, buffer, offset, length, vat);
+		draco::DecoderBuffer db;
+		db.Init(reinterpret_cast<const char *>(src), length);
+		auto type = draco::Decoder::GetEncodedGeometryType(&db);
+		if (!type.ok())
+			fail(MLOD_ERR_PARSE, "%s: not Draco data (%s)", vat.c_str(), printable(type.status().error_msg()).c_str());
+		if (type.value() != draco::TRIANGULAR_MESH)
+			fail(MLOD_ERR_UNSUPPORTED, "%s: a Draco point cloud, not a triangle mesh", vat.c_str());
+		draco::Decoder decoder;
+		auto mesh = decoder.DecodeMeshFromBuffer(&db);
+		if (!mesh.ok())
+			fail(MLOD_ERR_PARSE, "%s: Draco cannot decode it: %s", vat.c_str(),
+			     printable(mesh.status().error_msg()).c_str());
+		found = decoded.emplace(v, DracoView{std::move(mesh).value()}).first;
+	}
+	const draco::Mesh &mesh = *found->second.mesh;
+	size_t points = mesh.num_points(), faces = mesh.num_faces();
+	auto claim = [&](size_t a, const std::string &what) {
+		auto w = written.find(a);
+		if (w != written.end()) {
+			if (w->second != v)
+				fail(MLOD_ERR_PARSE, "%s: accessor %zu is decoded from two Draco buffer views (%zu and %zu)",
+				     what.c_str(), a, w->second, v);
+			return false;
+		}
+		written[a] = v;
+		return true;
+	};
+	auto set_view = [&](json &acc, size_t offset, size_t length, size_t stride, int target) {
+		json nv = json::object({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}, {"target", target}});
+		if (stride)
+			nv["byteStride"] = stride;
+		j["bufferViews"].push_back(nv);
+		acc["bufferView"] = j["bufferViews"].size() - 1;
+		acc.erase("byteOffset");
+	};
+	/* Indices: three per face, as the accessor's component type. */
+	if (claim(ia, at + ".indices")) {
+		size_t count = iacc["count"].get<size_t>();
+		int ct = iacc["componentType"].get<int>();
+		if (iacc["type"] != "SCALAR" || (ct != 5121 && ct != 5123 && ct != 5125))
+			fail(MLOD_ERR_PARSE, "%s: indices accessor %zu is not SCALAR of unsigned integers", at.c_str(), ia);
+		if (count != faces * 3)
+			fail(MLOD_ERR_PARSE, "%s: indices accessor %zu has count %zu, the Draco mesh %zu faces (%zu indices)",
+			     at.c_str(), ia, count, faces, faces * 3);
+		size_t cs = component_size(ct), limit = ct == 5121 ? 0xFF : ct == 5123 ? 0xFFFF : 0xFFFFFFFF;
+		std::string out(count * cs, '\0');
+		for (draco::FaceIndex f(0); f < mesh.num_faces(); ++f)
+			for (int k = 0; k < 3; k++) {
+				uint32_t idx = mesh.face(f)[k].value();
+				if (idx >= points || idx > limit)
+					fail(MLOD_ERR_PARSE, "%s: Draco index %u does not fit %zu points and accessor %zu", at.c_str(),
+					     idx, points, ia);
+				memcpy(&out[(size_t(f.value()) * 3 + size_t(k)) * cs], &idx, cs); /* little-endian */
+			}
+		size_t off = append(bin, out.data(), out.size());
+		set_view(iacc, off, out.size(), 0, 34963);
+	}
+	const json &attrs = prim["attributes"];
+	for (auto it = e["attributes"].begin(); it != e["attributes"].end(); ++it) {
+		std::string what = eat + ".attributes." + it.key();
+		if (!it->is_number_integer() || it->get<long long>() < 0 || it->get<long long>() > INT32_MAX)
+			fail(MLOD_ERR_PARSE, "%s: not a Draco attribute id", what.c_str());
+		if (!attrs.contains(it.key()))
+			fail(MLOD_ERR_PARSE, "%s: the primitive has no attribute %s", what.c_str(), it.key().c_str());
+		size_t a = attrs[it.key()].get<size_t>();
+		json &acc = accessor(a, what);
+		const draco::PointAttribute *attr = mesh.GetAttributeByUniqueId(it->get<uint32_t>());
+		if (!attr)
+			fail(MLOD_ERR_PARSE, "%s: the Draco mesh has no attribute %lld", what.c_str(), it->get<long long>());
+		if (!claim(a, what))
+			continue;
+		size_t count = acc["count"].get<size_t>();
+		int ct = acc["componentType"].get<int>(), comps = type_components(acc["type"].get<std::string>());
+		if (!comps)
+			fail(MLOD_ERR_UNSUPPORTED, "%s: accessor %zu of type %s from Draco", what.c_str(), a,
+			     acc["type"].get<std::string>().c_str());
+		if (count != points)
+			fail(MLOD_ERR_PARSE, "%s: accessor %zu has count %zu, the Draco mesh %zu points", what.c_str(), a, count,
+			     points);
+		if (attr->num_components() != comps)
+			fail(MLOD_ERR_PARSE, "%s: accessor %zu has %d components, the Draco attribute %d", what.c_str(), a, comps,
+			     int(attr->num_components()));
+		size_t cs = component_size(ct);
+		if (!cs)
+			fail(MLOD_ERR_PARSE, "%s: accessor %zu has component type %d", what.c_str(), a, ct);
+		if (count > max_values / size_t(comps))
+			fail(MLOD_ERR_LIMIT, "%s: accessor %zu has %zu elements, more than mlod decodes", what.c_str(), a, count);
+		size_t element = cs * size_t(comps), stride = (element + 3) / 4 * 4;
+		std::string out(count * stride, '\0');
+		switch (ct) {
+		case 5120: convert_points<int8_t>(*attr, count, comps, stride, &out[0], what); break;
+		case 5121: convert_points<uint8_t>(*attr, count, comps, stride, &out[0], what); break;
+		case 5122: convert_points<int16_t>(*attr, count, comps, stride, &out[0], what); break;
+		case 5123: convert_points<uint16_t>(*attr, count, comps, stride, &out[0], what); break;
+		case 5125: convert_points<uint32_t>(*attr, count, comps, stride, &out[0], what); break;
+		default: convert_points<float>(*attr, count, comps, stride, &out[0], what); break;
+		}
+		size_t off = append(bin, out.data(), out.size());
+		set_view(acc, off, out.size(), stride == element ? 0 : stride, 34962);
+		if (acc.contains("min") || acc.contains("max"))
+			set_bounds(acc, out, count, comps, ct, stride);
+	}
+	erase_extension(prim, draco_name);
+}
+
+/* Renumbers the buffer views j refers to after views were removed: those
+ * of accessors (sparse too) and images, and, as extension_refs finds
+ * them, any "bufferView" inside an extension; never inside extras. */
+static void remap_views(json &j, bool inside, const std::vector<long long> &map)
+{
+	if (j.is_object()) {
+		for (auto it = j.begin(); it != j.end(); ++it) {
+			if (it.key() == "extras")
+				continue;
+			if (inside && it.key() == "bufferView" && it->is_number_unsigned() && it->get<size_t>() < map.size())
+				*it = map[it->get<size_t>()];
+			else
+				remap_views(*it, inside || it.key() == "extensions" || it.key() == "accessors" ||
+				                     it.key() == "images",
+				            map);
+		}
+	} else if (j.is_array()) {
+		for (json &e : j)
+			remap_views(e, inside, map);
+	}
+}
+
+static bool names_compression(const json &j)
+{
+	for (const char *list : {"extensionsUsed", "extensionsRequired"})
+		if (j.contains(list))
+			for (const json &e : j[list])
+				for (const char *n : {meshopt_names[0], meshopt_names[1], draco_name})
+					if (e == n)
+						return true;
+	return false;
+}
+
+/* If the document j (read from data; binary: a glb) uses meshopt
+ * or Draco compression, rewrites j into a plain document whose one buffer
+ * is the glb's BIN chunk, and returns that glb in out; else returns
+ * false and leaves j alone. */
+bool decompress(json &j, const unsigned char *data, bool binary, const char *base_dir, std::string &out)
+{
+	if (!names_compression(j))
+		return false;
+	/* The BIN chunk (glb_json checked the container). */
+	const unsigned char *bin_chunk = nullptr;
+	size_t bin_size = 0;
+	if (binary) {
+		size_t at = 20 + size_t(le32(data + 12)), length = le32(data + 8);
+		if (at + 8 <= length && le32(data + at + 4) == chunk_bin) {
+			bin_chunk = data + at + 8;
+			bin_size = le32(data + at);
+		}
+	}
+	static const json none = json::array();
+	const json &buffer_list = j.contains("buffers") ? j["buffers"] : none;
+	Buffers buffers(buffer_list, bin_chunk, bin_size, base_dir);
+	json views = j.contains("bufferViews") ? j["bufferViews"] : json::array();
+	std::string bin;
+
+	/* Draco's data is read from the views as they are; its views then
+	 * carry nothing else and stay empty. */
+	std::vector<bool> draco_view(views.size(), false);
+	if (j.contains("meshes"))
+		for (const json &mesh : j["meshes"])
+			if (mesh.contains("primitives"))
+				for (const json &p : mesh["primitives"])
+					if (const json *e = extension(p, draco_name))
+						if (e->is_object() && e->contains("bufferView") && (*e)["bufferView"].is_number_unsigned() &&
+						    (*e)["bufferView"].get<size_t>() < views.size())
+							draco_view[(*e)["bufferView"].get<size_t>()] = true;
+
+	for (size_t v = 0; v < views.size(); v++) {
+		json &view = j["bufferViews"][v];
+		std::string at = "bufferViews[" + std::to_string(v) + "]";
+		size_t length = member(view, "byteLength", -1, at), offset = member(view, "byteOffset", 0, at);
+		const char *codec = nullptr;
+		for (const char *name : meshopt_names)
+			if (extension(view, name))
+				codec = name;
+		std::string decoded;
+		const void *bytes;
+		if (codec) {
+			decoded = decode_meshopt(buffers, *extension(view, codec), codec, length, at);
+			bytes = decoded.data();
+			erase_extension(view, codec);
+		} else if (draco_view[v]) {
+			length = 0;
+			bytes = "";
+		} else {
+			bytes = slice(buffers, member(view, "buffer", -1, at), offset, length, at);
+		}
+		view["buffer"] = 0;
+		view["byteOffset"] = append(bin, bytes, length);
+		view["byteLength"] = length;
+	}
+
+	std::map<size_t, DracoView> decoded;
+	std::map<size_t, size_t> written;
+	if (j.contains("meshes"))
+		for (size_t m = 0; m < j["meshes"].size(); m++) {
+			json &mesh = j["meshes"][m];
+			if (mesh.contains("primitives"))
+				for (size_t p = 0; p < mesh["primitives"].size(); p++)
+					if (extension(mesh["primitives"][p], draco_name))
+						decode_draco(j, mesh["primitives"][p],
+						             "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]",
+						             buffers, views, decoded, written, bin);
+		}
+	/* Empty Draco views (glTF wants byteLength >= 1) go, and the indices
+	 * of the views after them follow. */
+	if (std::find(draco_view.begin(), draco_view.end(), true) != draco_view.end()) {
+		std::vector<bool> used(j["bufferViews"].size(), false), ignored(buffer_list.size(), false);
+		extension_refs(j, false, used, ignored);
+		auto use = [&](const json &o) {
+			if (o.is_object() && o.contains("bufferView") && o["bufferView"].is_number_unsigned() &&
+			    o["bufferView"].get<size_t>() < used.size())
+				used[o["bufferView"].get<size_t>()] = true;
+		};
+		for (const char *list : {"accessors", "images"})
+			if (j.contains(list))
+				for (const json &o : j[list]) {
+					use(o);
+					if (o.contains("sparse"))
+						for (const char *part : {"indices", "values"})
+							if (o["sparse"].contains(part))
+								use(o["sparse"][part]);
+				}
+		std::vector<long long> map(used.size(), -1);
+		json kept = json::array();
+		for (size_t v = 0; v < used.size(); v++) {
+			if (v < draco_view.size() && draco_view[v] && !used[v])
+				continue;
+			map[v] = (long long)kept.size();
+			kept.push_back(j["bufferViews"][v]);
+		}
+		j["bufferViews"] = kept;
+		remap_views(j, false, map);
+	}
+
+	/* One buffer now: the BIN chunk. An extension that names a buffer
+	 * would name the wrong one. */
+	std::vector<bool> ignored(j["bufferViews"].size(), false), named(buffer_list.size(), false);
+	extension_refs(j, false, ignored, named);
+	if (std::find(named.begin(), named.end(), true) != named.end())
+		fail(MLOD_ERR_UNSUPPORTED, "an extension refers to a buffer directly: mlod cannot decompress this file");
+	json buffer = buffer_list.size() ? buffer_list[0] : json::object();
+	buffer.erase("uri");
+	for (const char *name : meshopt_names)
+		if (extension(buffer, name))
+			erase_extension(buffer, name);
+	buffer["byteLength"] = bin.size();
+	if (bin.empty())
+		j.erase("buffers");
+	else
+		j["buffers"] = json::array({buffer});
+	if (j["bufferViews"].empty())
+		j.erase("bufferViews");
+	for (const char *list : {"extensionsUsed", "extensionsRequired"})
+		if (j.contains(list)) {
+			json kept = json::array();
+			for (const json &e : j[list])
+				if (e != meshopt_names[0] && e != meshopt_names[1] && e != draco_name)
+					kept.push_back(e);
+			if (kept.empty())
+				j.erase(list);
+			else
+				j[list] = kept;
+		}
+
+	std::string js = dump_json(j, -1);
+	js.append((4 - js.size() % 4) % 4, ' ');
+	bin.append((4 - bin.size() % 4) % 4, '\0');
+	uint64_t total = 20 + uint64_t(js.size()) + (bin.empty() ? 0 : 8 + bin.size());
+	if (total > UINT32_MAX)
+		fail(MLOD_ERR_LIMIT, "the decompressed glb would be larger than 4 GiB");
+	out.clear();
+	out.reserve(size_t(total));
+	auto put = [&](uint32_t v) {
+		for (int k = 0; k < 4; k++)
+			out += char(v >> (8 * k) & 0xFF);
+	};
+	for (uint32_t v : {glb_magic, uint32_t(2), uint32_t(total), uint32_t(js.size()), chunk_json})
+		put(v);
+	out += js;
+	if (!bin.empty()) {
+		put(uint32_t(bin.size()));
+		put(chunk_bin);
+		out += bin;
+	}
+	return true;
+}
+
+} /* namespace mlod_gltf_internal */
