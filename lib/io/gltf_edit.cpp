@@ -230,6 +230,109 @@ static void mark_used_views(const Model &m, std::vector<bool> &used)
 		mark_used(used, i.bufferView);
 }
 
+/* Trims each buffer view that only plain accessors read (no image, no
+ * sparse part, no extension names it) to the bytes they read: the ranges
+ * of accessors that went (a view holding every clip's keys, as
+ * gltf-transform writes them, of which a pack's DOC chunk keeps one morph
+ * weights channel) go, and the accessors left move down with their
+ * bytes. Each range keeps its offset modulo 4, so every accessor keeps
+ * its alignment; a range that overlaps another (interleaved attributes)
+ * is merged with it. Views whose accessors read all their bytes are left
+ * as they are. */
+static void trim_views(mlod_gltf &doc)
+{
+	Model &m = doc.model;
+	const size_t nv = m.bufferViews.size();
+	std::vector<bool> fixed(nv, false);
+	std::vector<bool> named(m.buffers.size(), false);
+	extension_refs(doc.original, false, fixed, named);
+	for (const tinygltf::Accessor &a : m.accessors)
+		if (a.sparse.isSparse) {
+			mark_used(fixed, a.bufferView);
+			mark_used(fixed, a.sparse.indices.bufferView);
+			mark_used(fixed, a.sparse.values.bufferView);
+		}
+	for (const tinygltf::Image &i : m.images)
+		mark_used(fixed, i.bufferView);
+	std::vector<std::vector<std::pair<size_t, size_t>>> ranges(nv);
+	for (const tinygltf::Accessor &a : m.accessors) {
+		if (a.bufferView < 0 || size_t(a.bufferView) >= nv || fixed[size_t(a.bufferView)])
+			continue;
+		const tinygltf::BufferView &v = m.bufferViews[size_t(a.bufferView)];
+		const Layout l = layout_of(a);
+		const size_t stride = v.byteStride ? v.byteStride : l.element;
+		size_t end = a.byteOffset;
+		if (a.count > 0) {
+			/* (the reader checked that every accessor fits its view) */
+			end += stride * (a.count - 1) + l.element;
+		}
+		if (end > v.byteLength) {
+			fixed[size_t(a.bufferView)] = true; /* not ours to move */
+			continue;
+		}
+		if (end > a.byteOffset)
+			ranges[size_t(a.bufferView)].emplace_back(a.byteOffset, end);
+	}
+	json *acc = nullptr, *views = nullptr;
+	if (doc.original.is_object() && doc.original.contains("accessors") && doc.original["accessors"].is_array())
+		acc = &doc.original["accessors"];
+	if (doc.original.is_object() && doc.original.contains("bufferViews") && doc.original["bufferViews"].is_array())
+		views = &doc.original["bufferViews"];
+	for (size_t vi = 0; vi < nv; vi++) {
+		auto &r = ranges[vi];
+		if (fixed[vi] || r.empty())
+			continue;
+		tinygltf::BufferView &v = m.bufferViews[vi];
+		if (v.buffer < 0 || size_t(v.buffer) >= m.buffers.size() || named[size_t(v.buffer)])
+			continue;
+		std::vector<unsigned char> &data = m.buffers[size_t(v.buffer)].data;
+		if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset)
+			fail(MLOD_ERR_PARSE, "buffer view %zu lies outside buffer %d", vi, v.buffer);
+		std::sort(r.begin(), r.end());
+		std::vector<std::pair<size_t, size_t>> merged;
+		size_t kept = 0;
+		for (const auto &x : r)
+			if (!merged.empty() && x.first <= merged.back().second)
+				merged.back().second = std::max(merged.back().second, x.second);
+			else
+				merged.push_back(x);
+		for (const auto &x : merged)
+			kept += x.second - x.first;
+		if (kept + 4 * merged.size() >= v.byteLength)
+			continue;
+		/* Each merged range's new start, congruent to its old one mod 4. */
+		std::vector<size_t> to(merged.size());
+		std::vector<unsigned char> bytes;
+		for (size_t k = 0; k < merged.size(); k++) {
+			size_t at = bytes.size();
+			at += (merged[k].first - at % 4 + 4) % 4;
+			to[k] = at;
+			bytes.resize(at, 0);
+			bytes.insert(bytes.end(), data.begin() + long(v.byteOffset + merged[k].first),
+			             data.begin() + long(v.byteOffset + merged[k].second));
+		}
+		for (size_t ai = 0; ai < m.accessors.size(); ai++) {
+			tinygltf::Accessor &a = m.accessors[ai];
+			if (a.bufferView != int(vi))
+				continue;
+			size_t k = size_t(std::upper_bound(merged.begin(), merged.end(), std::make_pair(a.byteOffset, SIZE_MAX)) -
+			                  merged.begin());
+			/* an accessor of count 0 may sit past every range: it reads nothing */
+			a.byteOffset = k == 0 ? 0 : to[k - 1] + (a.byteOffset - merged[k - 1].first);
+			if (a.count == 0 && k > 0 && a.byteOffset > bytes.size())
+				a.byteOffset = bytes.size();
+			if (acc && ai < acc->size() && (*acc)[ai].is_object())
+				(*acc)[ai]["byteOffset"] = a.byteOffset;
+		}
+		/* The view's bytes now lie at its start; those after stay in the
+		 * buffer until prune packs it. */
+		std::copy(bytes.begin(), bytes.end(), data.begin() + long(v.byteOffset));
+		v.byteLength = bytes.size();
+		if (views && vi < views->size() && (*views)[vi].is_object())
+			(*views)[vi]["byteLength"] = v.byteLength;
+	}
+}
+
 /* prune for a document whose indices must hold (keep_indices): the
  * accessors and buffer views after the last one in use go, and each
  * buffer's bytes after its last kept view (a buffer an extension names
@@ -317,6 +420,7 @@ void prune(mlod_gltf &doc, bool meshes)
 			apply(map, s.output);
 		}
 
+	trim_views(doc);
 	used.assign(m.bufferViews.size(), false);
 	mark_used_views(m, used);
 	map = renumber(doc, "bufferViews", used);
