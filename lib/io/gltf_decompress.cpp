@@ -4,9 +4,11 @@
  * EXT_meshopt_compression / KHR_meshopt_compression (buffer views) nor
  * KHR_draco_mesh_compression (primitives), so the reader rewrites such a
  * document into a plain glb: every buffer view's bytes, decoded where
- * compressed, go into one new buffer, each Draco primitive's attributes
- * and indices into new buffer views of it, and the extensions leave
- * extensionsUsed / extensionsRequired. Only Draco's core decoder is used
+ * compressed, go into one new buffer (overlapping plain views copied
+ * once, views with one meshopt source decoded once, the decoded bytes
+ * within a budget of the input's: spend), each Draco primitive's
+ * attributes and indices into new buffer views of it, and the extensions
+ * leave extensionsUsed / extensionsRequired. Only Draco's core decoder is used
  * (never its glTF I/O, which carries its own tinygltf: deps.md).
  */
 #include <fstream>
@@ -749,7 +751,9 @@ bool decompress(json &j, const unsigned char *data, bool binary, const char *bas
 	}
 
 	/* One buffer now: the BIN chunk. An extension that names a buffer
-	 * would name the wrong one. */
+	 * would name the wrong one. It keeps buffer 0's name, extras and
+	 * other extensions; the other buffers' go (documented in
+	 * mlod-label(1): keeping them would take keeping their buffers). */
 	std::vector<bool> ignored(j["bufferViews"].size(), false), named(buffer_list.size(), false);
 	extension_refs(j, false, ignored, named);
 	if (std::find(named.begin(), named.end(), true) != named.end())
