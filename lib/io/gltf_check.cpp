@@ -311,9 +311,28 @@ std::string join_path(const std::string &dir, const std::string &file)
 	return dir.back() == '/' ? dir + file : dir + "/" + file;
 }
 
+/* Whether buffer b is a meshopt fallback (extension object with
+ * "fallback": true) in a document that names the extension: its data
+ * only serves readers without the extension, and mlod decodes it
+ * (gltf_decompress.cpp), so the file may well be absent (gltfpack -cf). */
+static bool meshopt_fallback(const json &doc, const json &b)
+{
+	if (!b.contains("extensions") || !b["extensions"].is_object() || !doc.contains("extensionsUsed") ||
+	    !doc["extensionsUsed"].is_array())
+		return false;
+	for (const char *name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
+		auto e = b["extensions"].find(name);
+		if (e != b["extensions"].end() && e->is_object() && e->contains("fallback") && (*e)["fallback"] == true)
+			for (const json &used : doc["extensionsUsed"])
+				if (used == name)
+					return true;
+	}
+	return false;
+}
+
 /* External buffers must be readable files under base_dir; data: URIs must
- * be of a type tinygltf decodes. Images are not checked: one that cannot
- * be read keeps its URI. */
+ * be of a type tinygltf decodes. A meshopt fallback buffer is not
+ * checked, nor are images: one that cannot be read keeps its URI. */
 void check_buffer_uris(const json &doc, const char *base_dir)
 {
 	auto buffers = doc.find("buffers");
@@ -321,7 +340,7 @@ void check_buffer_uris(const json &doc, const char *base_dir)
 		return;
 	for (size_t i = 0; i < buffers->size(); i++) {
 		const json &b = (*buffers)[i];
-		if (!b.is_object() || !b.contains("uri") || !b["uri"].is_string())
+		if (!b.is_object() || !b.contains("uri") || !b["uri"].is_string() || meshopt_fallback(doc, b))
 			continue;
 		std::string uri = b["uri"].get<std::string>();
 		if (uri.compare(0, 5, "data:") == 0) {

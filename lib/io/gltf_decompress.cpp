@@ -4,12 +4,15 @@
  * EXT_meshopt_compression / KHR_meshopt_compression (buffer views) nor
  * KHR_draco_mesh_compression (primitives), so the reader rewrites such a
  * document into a plain glb: every buffer view's bytes, decoded where
- * compressed, go into one new buffer, each Draco primitive's attributes
- * and indices into new buffer views of it, and the extensions leave
- * extensionsUsed / extensionsRequired. Only Draco's core decoder is used
+ * compressed, go into one new buffer (overlapping plain views copied
+ * once, views with one meshopt source decoded once, the decoded bytes
+ * within a budget of the input's: spend), each Draco primitive's
+ * attributes and indices into new buffer views of it, and the extensions
+ * leave extensionsUsed / extensionsRequired. Only Draco's core decoder is used
  * (never its glTF I/O, which carries its own tinygltf: deps.md).
  */
 #include <fstream>
+#include <tuple>
 
 #include <draco/compression/decode.h>
 #include <meshoptimizer.h>
@@ -35,9 +38,11 @@ struct Buffers {
 	size_t glb_bin_size;
 	const char *base_dir;
 	std::vector<std::unique_ptr<std::string>> loaded;
+	uint64_t input; /* the glb's length (0 for JSON), plus each buffer read from a URI */
 
-	Buffers(const json &j, const unsigned char *bin, size_t bin_size, const char *dir)
-	    : list(j), glb_bin(bin), glb_bin_size(bin_size), base_dir(dir), loaded(j.is_array() ? j.size() : 0)
+	Buffers(const json &j, const unsigned char *bin, size_t bin_size, const char *dir, size_t glb_size)
+	    : list(j), glb_bin(bin), glb_bin_size(bin_size), base_dir(dir), loaded(j.is_array() ? j.size() : 0),
+	      input(glb_size)
 	{
 	}
 
@@ -101,6 +106,7 @@ const std::string &Buffers::get(size_t i, const std::string &what)
 			if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos)
 				fail(MLOD_ERR_UNSUPPORTED, "%s: a data: URI that is not base64", at.c_str());
 			data = base64_decode(uri, comma + 1, at);
+			input += data.size();
 		} else {
 			/* check_buffer_uris allowed it: a file below base_dir */
 			if (!base_dir)
@@ -113,6 +119,7 @@ const std::string &Buffers::get(size_t i, const std::string &what)
 			f.seekg(0);
 			if (size > 0 && !f.read(&data[0], size))
 				fail(MLOD_ERR_IO, "%s: cannot read %s", at.c_str(), mlod_gltf_internal::quoted(uri).c_str());
+			input += data.size();
 		}
 	}
 	if (data.size() < length)
@@ -184,18 +191,33 @@ static const unsigned char *slice(Buffers &buffers, size_t buffer, size_t offset
 	fail(MLOD_ERR_PARSE, "%s: the compressed %s data is malformed or truncated", at.c_str(), codec);
 }
 
-/* Decodes a meshopt-compressed buffer view (extension object e of name)
- * into its plain bytes. */
-static std::string decode_meshopt(Buffers &buffers, const json &e, const char *name, size_t view_length,
-                                  const std::string &view_at)
+/* A meshopt-compressed buffer view's source: what decoding it depends on.
+ * Views with equal sources decode to the same bytes, once. */
+struct MeshoptSource {
+	size_t buffer, offset, length, stride, count;
+	std::string mode, filter;
+	bool operator<(const MeshoptSource &o) const
+	{
+		return std::tie(buffer, offset, length, stride, count, mode, filter) <
+		       std::tie(o.buffer, o.offset, o.length, o.stride, o.count, o.mode, o.filter);
+	}
+};
+
+/* Reads and checks the meshopt extension object e of name on a buffer
+ * view (view_stride: the view's own byteStride, 0 without one). */
+static MeshoptSource meshopt_source(const json &e, const char *name, size_t view_length, size_t view_stride,
+                                    const std::string &view_at)
 {
 	std::string at = view_at + ".extensions." + name;
 	if (!e.is_object())
 		fail(MLOD_ERR_PARSE, "%s: not an object", at.c_str());
-	size_t buffer = member(e, "buffer", -1, at), offset = member(e, "byteOffset", 0, at);
-	size_t length = member(e, "byteLength", -1, at), stride = member(e, "byteStride", -1, at);
-	size_t count = member(e, "count", -1, at);
-	std::string mode = string_member(e, "mode", "", at), filter = string_member(e, "filter", "NONE", at);
+	MeshoptSource s;
+	s.buffer = member(e, "buffer", -1, at), s.offset = member(e, "byteOffset", 0, at);
+	s.length = member(e, "byteLength", -1, at), s.stride = member(e, "byteStride", -1, at);
+	s.count = member(e, "count", -1, at);
+	s.mode = string_member(e, "mode", "", at), s.filter = string_member(e, "filter", "NONE", at);
+	const std::string &mode = s.mode, &filter = s.filter;
+	size_t stride = s.stride, count = s.count, length = s.length;
 	if (mode != "ATTRIBUTES" && mode != "TRIANGLES" && mode != "INDICES")
 		fail(MLOD_ERR_UNSUPPORTED, "%s: mode %s: mlod decodes ATTRIBUTES, TRIANGLES and INDICES", at.c_str(),
 		     mlod_gltf_internal::quoted(mode).c_str());
@@ -208,6 +230,11 @@ static std::string decode_meshopt(Buffers &buffers, const json &e, const char *n
 	/* The decoders assert on these: checked first. */
 	if (mode == "ATTRIBUTES" ? stride == 0 || stride > 256 || stride % 4 != 0 : stride != 2 && stride != 4)
 		fail(MLOD_ERR_PARSE, "%s: byteStride %zu is not valid for mode %s", at.c_str(), stride, mode.c_str());
+	/* The decoded elements lie byteStride apart: a view that says
+	 * otherwise would read them in another layout. */
+	if (view_stride && view_stride != stride)
+		fail(MLOD_ERR_PARSE, "%s: byteStride %zu, but the buffer view's byteStride is %zu", at.c_str(), stride,
+		     view_stride);
 	if (mode == "TRIANGLES" && count % 3 != 0)
 		fail(MLOD_ERR_PARSE, "%s: count %zu of mode TRIANGLES is not a multiple of 3", at.c_str(), count);
 	if ((filter == "OCTAHEDRAL" && stride != 4 && stride != 8) || (filter == "QUATERNION" && stride != 8))
@@ -219,37 +246,65 @@ static std::string decode_meshopt(Buffers &buffers, const json &e, const char *n
 	if (size > uint64_t(length) * meshopt_max_ratio + meshopt_slack)
 		fail(MLOD_ERR_PARSE, "%s: %llu bytes cannot be the decoding of %zu compressed bytes", at.c_str(),
 		     (unsigned long long)size, length);
-	const unsigned char *src = slice(buffers, buffer, offset, length, at);
-	std::string out(size_t(size), '\0');
-	void *dst = &out[0];
-	if (mode == "ATTRIBUTES") {
-		if (meshopt_decodeVertexBuffer(dst, count, stride, src, length) != 0)
-			meshopt_refused(src, length, 0xA0, 0, "vertex", at);
-		if (filter == "OCTAHEDRAL")
-			meshopt_decodeFilterOct(dst, count, stride);
-		else if (filter == "QUATERNION")
-			meshopt_decodeFilterQuat(dst, count, stride);
-		else if (filter == "EXPONENTIAL")
-			meshopt_decodeFilterExp(dst, count, stride);
-	} else if (mode == "TRIANGLES") {
-		if (meshopt_decodeIndexBuffer(dst, count, stride, src, length) != 0)
-			meshopt_refused(src, length, 0xE0, 1, "index", at);
-	} else {
-		if (meshopt_decodeIndexSequence(dst, count, stride, src, length) != 0)
-			meshopt_refused(src, length, 0xD0, 0, "index sequence", at);
-	}
-	return out;
+	return s;
 }
 
-/* Appends bytes to the new buffer on a 4-byte boundary; returns where. */
+/* Decodes a meshopt source (checked by meshopt_source) into dst, its
+ * count * stride bytes. */
+static void decode_meshopt(Buffers &buffers, const MeshoptSource &s, void *dst, const std::string &at)
+{
+	const unsigned char *src = slice(buffers, s.buffer, s.offset, s.length, at);
+	if (s.mode == "ATTRIBUTES") {
+		if (meshopt_decodeVertexBuffer(dst, s.count, s.stride, src, s.length) != 0)
+			meshopt_refused(src, s.length, 0xA0, 0, "vertex", at);
+		if (s.filter == "OCTAHEDRAL")
+			meshopt_decodeFilterOct(dst, s.count, s.stride);
+		else if (s.filter == "QUATERNION")
+			meshopt_decodeFilterQuat(dst, s.count, s.stride);
+		else if (s.filter == "EXPONENTIAL")
+			meshopt_decodeFilterExp(dst, s.count, s.stride);
+	} else if (s.mode == "TRIANGLES") {
+		if (meshopt_decodeIndexBuffer(dst, s.count, s.stride, src, s.length) != 0)
+			meshopt_refused(src, s.length, 0xE0, 1, "index", at);
+	} else {
+		if (meshopt_decodeIndexSequence(dst, s.count, s.stride, src, s.length) != 0)
+			meshopt_refused(src, s.length, 0xD0, 0, "index sequence", at);
+	}
+}
+
+/* Appends bytes (null: zeros) to the new buffer on a 4-byte boundary;
+ * returns where. */
 static size_t append(std::string &bin, const void *data, size_t size)
 {
 	bin.append((4 - bin.size() % 4) % 4, '\0');
 	if (uint64_t(bin.size()) + size > UINT32_MAX - 4096)
 		fail(MLOD_ERR_LIMIT, "the decompressed buffers would be larger than 4 GiB");
 	size_t at = bin.size();
-	bin.append(static_cast<const char *>(data), size);
+	if (data)
+		bin.append(static_cast<const char *>(data), size);
+	else
+		bin.append(size, '\0');
 	return at;
+}
+
+/* Decoded bytes (meshopt's and Draco's, every view and primitive
+ * together) may reach this many per byte of input (the glb, and the
+ * buffers read from URIs), plus decoded_slack: one meshopt stream never
+ * passes 64 to 1 (meshopt_max_ratio), but many streams over the same
+ * compressed bytes, or many Draco primitives, could otherwise make a small
+ * file allocate gigabytes. Checked before each allocation. */
+const uint64_t decoded_per_input_byte = 64, decoded_slack = uint64_t(1) << 20;
+
+static void spend(const Buffers &buffers, uint64_t &total, uint64_t size, const std::string &at)
+{
+	uint64_t budget = buffers.input * decoded_per_input_byte + decoded_slack;
+	if (total + size > budget)
+		fail(MLOD_ERR_LIMIT,
+		     "%s: the decompressed data would pass %llu bytes: mlod decodes at most %llu times the %llu bytes of "
+		     "input and buffers, plus 1 MiB",
+		     at.c_str(), (unsigned long long)budget, (unsigned long long)decoded_per_input_byte,
+		     (unsigned long long)buffers.input);
+	total += size;
 }
 
 static int type_components(const std::string &type)
@@ -324,7 +379,8 @@ struct DracoView {
  * are the document's views as read; decoded caches their meshes;
  * written maps an accessor to the Draco view it was written from). */
 static void decode_draco(json &j, json &prim, const std::string &at, Buffers &buffers, const json &views,
-                         std::map<size_t, DracoView> &decoded, std::map<size_t, size_t> &written, std::string &bin)
+                         std::map<size_t, DracoView> &decoded, std::map<size_t, size_t> &written, std::string &bin,
+                         uint64_t &total)
 {
 	const json &e = *extension(prim, draco_name);
 	std::string eat = at + ".extensions." + draco_name;
@@ -342,8 +398,10 @@ static void decode_draco(json &j, json &prim, const std::string &at, Buffers &bu
 		fail(MLOD_ERR_PARSE, "%s: no attributes object", eat.c_str());
 	json &accessors = j["accessors"];
 	size_t n_acc = accessors.is_array() ? accessors.size() : 0;
-	/* The accessors' sizes bound what is decoded, checked before Draco
-	 * allocates anything past its input. */
+	/* The accessors are checked before Draco decodes anything: their
+	 * counts bound what mlod writes (below max_values each, and within
+	 * the decoded budget: spend). What Draco's decoder allocates for its
+	 * own mesh only its own checks against its input bound. */
 	auto accessor = [&](size_t a, const std::string &what) -> json & {
 		if (a >= n_acc)
 			fail(MLOD_ERR_PARSE, "%s: accessor %zu does not exist", what.c_str(), a);
@@ -356,6 +414,33 @@ static void decode_draco(json &j, json &prim, const std::string &at, Buffers &bu
 	};
 	size_t ia = prim["indices"].get<size_t>();
 	json &iacc = accessor(ia, at + ".indices");
+	{
+		int ct = iacc["componentType"].get<int>();
+		if (iacc["type"] != "SCALAR" || (ct != 5121 && ct != 5123 && ct != 5125))
+			fail(MLOD_ERR_PARSE, "%s: indices accessor %zu is not SCALAR of unsigned integers", at.c_str(), ia);
+		if (iacc["count"].get<size_t>() > max_values)
+			fail(MLOD_ERR_LIMIT, "%s: indices accessor %zu has %zu elements, more than mlod decodes", at.c_str(), ia,
+			     iacc["count"].get<size_t>());
+	}
+	const json &attrs = prim["attributes"];
+	for (auto it = e["attributes"].begin(); it != e["attributes"].end(); ++it) {
+		std::string what = eat + ".attributes." + it.key();
+		if (!it->is_number_integer() || it->get<long long>() < 0 || it->get<long long>() > INT32_MAX)
+			fail(MLOD_ERR_PARSE, "%s: not a Draco attribute id", what.c_str());
+		if (!attrs.contains(it.key()))
+			fail(MLOD_ERR_PARSE, "%s: the primitive has no attribute %s", what.c_str(), it.key().c_str());
+		size_t a = attrs[it.key()].get<size_t>();
+		json &acc = accessor(a, what);
+		size_t count = acc["count"].get<size_t>();
+		int ct = acc["componentType"].get<int>(), comps = type_components(acc["type"].get<std::string>());
+		if (!comps)
+			fail(MLOD_ERR_UNSUPPORTED, "%s: accessor %zu of type %s from Draco", what.c_str(), a,
+			     acc["type"].get<std::string>().c_str());
+		if (!component_size(ct))
+			fail(MLOD_ERR_PARSE, "%s: accessor %zu has component type %d", what.c_str(), a, ct);
+		if (count > max_values / size_t(comps))
+			fail(MLOD_ERR_LIMIT, "%s: accessor %zu has %zu elements, more than mlod decodes", what.c_str(), a, count);
+	}
 	auto found = decoded.find(v);
 	if (found == decoded.end()) {
 		const json &view = views[v];
@@ -404,12 +489,11 @@ static void decode_draco(json &j, json &prim, const std::string &at, Buffers &bu
 	if (claim(ia, at + ".indices")) {
 		size_t count = iacc["count"].get<size_t>();
 		int ct = iacc["componentType"].get<int>();
-		if (iacc["type"] != "SCALAR" || (ct != 5121 && ct != 5123 && ct != 5125))
-			fail(MLOD_ERR_PARSE, "%s: indices accessor %zu is not SCALAR of unsigned integers", at.c_str(), ia);
 		if (count != faces * 3)
 			fail(MLOD_ERR_PARSE, "%s: indices accessor %zu has count %zu, the Draco mesh %zu faces (%zu indices)",
 			     at.c_str(), ia, count, faces, faces * 3);
 		size_t cs = component_size(ct), limit = ct == 5121 ? 0xFF : ct == 5123 ? 0xFFFF : 0xFFFFFFFF;
+		spend(buffers, total, uint64_t(count) * cs, at + ".indices");
 		std::string out(count * cs, '\0');
 		for (draco::FaceIndex f(0); f < mesh.num_faces(); ++f)
 			for (int k = 0; k < 3; k++) {
@@ -422,15 +506,10 @@ static void decode_draco(json &j, json &prim, const std::string &at, Buffers &bu
 		size_t off = append(bin, out.data(), out.size());
 		set_view(iacc, off, out.size(), 0, 34963);
 	}
-	const json &attrs = prim["attributes"];
 	for (auto it = e["attributes"].begin(); it != e["attributes"].end(); ++it) {
 		std::string what = eat + ".attributes." + it.key();
-		if (!it->is_number_integer() || it->get<long long>() < 0 || it->get<long long>() > INT32_MAX)
-			fail(MLOD_ERR_PARSE, "%s: not a Draco attribute id", what.c_str());
-		if (!attrs.contains(it.key()))
-			fail(MLOD_ERR_PARSE, "%s: the primitive has no attribute %s", what.c_str(), it.key().c_str());
 		size_t a = attrs[it.key()].get<size_t>();
-		json &acc = accessor(a, what);
+		json &acc = accessors[a]; /* checked above */
 		const draco::PointAttribute *attr = mesh.GetAttributeByUniqueId(it->get<uint32_t>());
 		if (!attr)
 			fail(MLOD_ERR_PARSE, "%s: the Draco mesh has no attribute %lld", what.c_str(), it->get<long long>());
@@ -438,9 +517,6 @@ static void decode_draco(json &j, json &prim, const std::string &at, Buffers &bu
 			continue;
 		size_t count = acc["count"].get<size_t>();
 		int ct = acc["componentType"].get<int>(), comps = type_components(acc["type"].get<std::string>());
-		if (!comps)
-			fail(MLOD_ERR_UNSUPPORTED, "%s: accessor %zu of type %s from Draco", what.c_str(), a,
-			     acc["type"].get<std::string>().c_str());
 		if (count != points)
 			fail(MLOD_ERR_PARSE, "%s: accessor %zu has count %zu, the Draco mesh %zu points", what.c_str(), a, count,
 			     points);
@@ -448,11 +524,8 @@ static void decode_draco(json &j, json &prim, const std::string &at, Buffers &bu
 			fail(MLOD_ERR_PARSE, "%s: accessor %zu has %d components, the Draco attribute %d", what.c_str(), a, comps,
 			     int(attr->num_components()));
 		size_t cs = component_size(ct);
-		if (!cs)
-			fail(MLOD_ERR_PARSE, "%s: accessor %zu has component type %d", what.c_str(), a, ct);
-		if (count > max_values / size_t(comps))
-			fail(MLOD_ERR_LIMIT, "%s: accessor %zu has %zu elements, more than mlod decodes", what.c_str(), a, count);
 		size_t element = cs * size_t(comps), stride = (element + 3) / 4 * 4;
+		spend(buffers, total, uint64_t(count) * stride, what);
 		std::string out(count * stride, '\0');
 		switch (ct) {
 		case 5120: convert_points<int8_t>(*attr, count, comps, stride, &out[0], what); break;
@@ -492,6 +565,28 @@ static void remap_views(json &j, bool inside, const std::vector<long long> &map)
 	}
 }
 
+/* Marks the buffer views that accessors (sparse too), images and
+ * extensions name. */
+static void mark_view_users(const json &j, std::vector<bool> &used)
+{
+	std::vector<bool> ignored(j.contains("buffers") && j["buffers"].is_array() ? j["buffers"].size() : 0, false);
+	extension_refs(j, false, used, ignored);
+	auto use = [&](const json &o) {
+		if (o.is_object() && o.contains("bufferView") && o["bufferView"].is_number_unsigned() &&
+		    o["bufferView"].get<size_t>() < used.size())
+			used[o["bufferView"].get<size_t>()] = true;
+	};
+	for (const char *list : {"accessors", "images"})
+		if (j.contains(list) && j[list].is_array())
+			for (const json &o : j[list]) {
+				use(o);
+				if (o.is_object() && o.contains("sparse") && o["sparse"].is_object())
+					for (const char *part : {"indices", "values"})
+						if (o["sparse"].contains(part))
+							use(o["sparse"][part]);
+			}
+}
+
 static bool names_compression(const json &j)
 {
 	for (const char *list : {"extensionsUsed", "extensionsRequired"})
@@ -523,44 +618,106 @@ bool decompress(json &j, const unsigned char *data, bool binary, const char *bas
 	}
 	static const json none = json::array();
 	const json &buffer_list = j.contains("buffers") ? j["buffers"] : none;
-	Buffers buffers(buffer_list, bin_chunk, bin_size, base_dir);
+	Buffers buffers(buffer_list, bin_chunk, bin_size, base_dir, binary ? le32(data + 8) : 0);
 	json views = j.contains("bufferViews") ? j["bufferViews"] : json::array();
 	std::string bin;
+	uint64_t spent = 0; /* decoded bytes so far (spend) */
 
-	/* Draco's data is read from the views as they are; its views then
-	 * carry nothing else and stay empty. */
-	std::vector<bool> draco_view(views.size(), false);
+	/* Draco's data is read from the views as they are; a view that only
+	 * Draco extensions name then carries nothing and stays empty (one an
+	 * accessor, an image or another extension also names keeps its bytes). */
+	std::vector<bool> draco_view(views.size(), false), other_use(views.size(), false);
+	std::vector<json *> draco_exts;
 	if (j.contains("meshes"))
-		for (const json &mesh : j["meshes"])
+		for (json &mesh : j["meshes"])
 			if (mesh.contains("primitives"))
-				for (const json &p : mesh["primitives"])
-					if (const json *e = extension(p, draco_name))
-						if (e->is_object() && e->contains("bufferView") && (*e)["bufferView"].is_number_unsigned() &&
-						    (*e)["bufferView"].get<size_t>() < views.size())
-							draco_view[(*e)["bufferView"].get<size_t>()] = true;
+				for (json &p : mesh["primitives"])
+					if (extension(p, draco_name)) {
+						json &e = p["extensions"][draco_name];
+						draco_exts.push_back(&e);
+						if (e.is_object() && e.contains("bufferView") && e["bufferView"].is_number_unsigned() &&
+						    e["bufferView"].get<size_t>() < views.size())
+							draco_view[e["bufferView"].get<size_t>()] = true;
+					}
+	if (!draco_exts.empty()) {
+		/* The Draco extensions step aside (null) while the others are read. */
+		std::vector<json> held(draco_exts.size());
+		for (size_t k = 0; k < draco_exts.size(); k++)
+			std::swap(held[k], *draco_exts[k]);
+		mark_view_users(j, other_use);
+		for (size_t k = 0; k < draco_exts.size(); k++)
+			std::swap(held[k], *draco_exts[k]);
+	}
 
+	/* Plain views: each run of overlapping views in a buffer is copied
+	 * once, from its first view's 4-byte boundary, and the views rebased
+	 * onto the copy; meshopt views with the same source share one
+	 * decoding. So no byte is copied or decoded twice. */
+	struct Plain {
+		size_t buffer, begin, end, view;
+		bool operator<(const Plain &o) const { return std::tie(buffer, begin, end) < std::tie(o.buffer, o.begin, o.end); }
+	};
+	std::vector<Plain> plain;
+	std::vector<const char *> codec(views.size(), nullptr);
 	for (size_t v = 0; v < views.size(); v++) {
 		json &view = j["bufferViews"][v];
 		std::string at = "bufferViews[" + std::to_string(v) + "]";
 		size_t length = member(view, "byteLength", -1, at), offset = member(view, "byteOffset", 0, at);
-		const char *codec = nullptr;
 		for (const char *name : meshopt_names)
 			if (extension(view, name))
-				codec = name;
-		std::string decoded;
-		const void *bytes;
-		if (codec) {
-			decoded = decode_meshopt(buffers, *extension(view, codec), codec, length, at);
-			bytes = decoded.data();
-			erase_extension(view, codec);
-		} else if (draco_view[v]) {
+				codec[v] = name;
+		if (!codec[v] && !(draco_view[v] && !other_use[v])) {
+			size_t buffer = member(view, "buffer", -1, at);
+			slice(buffers, buffer, offset, length, at);
+			plain.push_back(Plain{buffer, offset, offset + length, v});
+		}
+	}
+	/* run[v]: the first (lowest) member of v's run, in plain's order. */
+	std::sort(plain.begin(), plain.end());
+	std::vector<size_t> run(views.size(), SIZE_MAX), run_end(plain.size());
+	for (size_t k = 0, first = 0; k < plain.size(); k++) {
+		if (k == 0 || plain[k].buffer != plain[first].buffer || plain[k].begin >= run_end[first])
+			first = k, run_end[k] = plain[k].end;
+		else
+			run_end[first] = std::max(run_end[first], plain[k].end);
+		run[plain[k].view] = first;
+	}
+	std::vector<size_t> run_at(plain.size(), SIZE_MAX); /* where a run's copy starts in bin */
+	std::map<MeshoptSource, size_t> meshopt_at;
+	for (size_t v = 0; v < views.size(); v++) {
+		json &view = j["bufferViews"][v];
+		std::string at = "bufferViews[" + std::to_string(v) + "]";
+		size_t length = member(view, "byteLength", -1, at), offset = member(view, "byteOffset", 0, at);
+		size_t placed;
+		if (codec[v]) {
+			std::string eat = at + ".extensions." + codec[v];
+			size_t view_stride = view.contains("byteStride") ? member(view, "byteStride", 0, at) : 0;
+			MeshoptSource s = meshopt_source(*extension(view, codec[v]), codec[v], length, view_stride, at);
+			auto found = meshopt_at.find(s);
+			if (found != meshopt_at.end()) {
+				placed = found->second;
+			} else {
+				slice(buffers, s.buffer, s.offset, s.length, eat); /* loads the buffer for spend's count */
+				spend(buffers, spent, length, eat);
+				placed = append(bin, nullptr, length);
+				decode_meshopt(buffers, s, &bin[placed], eat);
+				meshopt_at.emplace(s, placed);
+			}
+			erase_extension(view, codec[v]);
+		} else if (run[v] == SIZE_MAX) {
+			/* a view only Draco names: emptied, removed below */
 			length = 0;
-			bytes = "";
+			placed = append(bin, nullptr, 0);
 		} else {
-			bytes = slice(buffers, member(view, "buffer", -1, at), offset, length, at);
+			const Plain &first = plain[run[v]];
+			size_t from = first.begin / 4 * 4;
+			if (run_at[run[v]] == SIZE_MAX)
+				run_at[run[v]] =
+				    append(bin, slice(buffers, first.buffer, from, run_end[run[v]] - from, at), run_end[run[v]] - from);
+			placed = run_at[run[v]] + (offset - from);
 		}
 		view["buffer"] = 0;
-		view["byteOffset"] = append(bin, bytes, length);
+		view["byteOffset"] = placed;
 		view["byteLength"] = length;
 	}
 
@@ -574,27 +731,13 @@ bool decompress(json &j, const unsigned char *data, bool binary, const char *bas
 					if (extension(mesh["primitives"][p], draco_name))
 						decode_draco(j, mesh["primitives"][p],
 						             "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]",
-						             buffers, views, decoded, written, bin);
+						             buffers, views, decoded, written, bin, spent);
 		}
 	/* Empty Draco views (glTF wants byteLength >= 1) go, and the indices
 	 * of the views after them follow. */
 	if (std::find(draco_view.begin(), draco_view.end(), true) != draco_view.end()) {
-		std::vector<bool> used(j["bufferViews"].size(), false), ignored(buffer_list.size(), false);
-		extension_refs(j, false, used, ignored);
-		auto use = [&](const json &o) {
-			if (o.is_object() && o.contains("bufferView") && o["bufferView"].is_number_unsigned() &&
-			    o["bufferView"].get<size_t>() < used.size())
-				used[o["bufferView"].get<size_t>()] = true;
-		};
-		for (const char *list : {"accessors", "images"})
-			if (j.contains(list))
-				for (const json &o : j[list]) {
-					use(o);
-					if (o.contains("sparse"))
-						for (const char *part : {"indices", "values"})
-							if (o["sparse"].contains(part))
-								use(o["sparse"][part]);
-				}
+		std::vector<bool> used(j["bufferViews"].size(), false);
+		mark_view_users(j, used);
 		std::vector<long long> map(used.size(), -1);
 		json kept = json::array();
 		for (size_t v = 0; v < used.size(); v++) {
@@ -608,7 +751,9 @@ bool decompress(json &j, const unsigned char *data, bool binary, const char *bas
 	}
 
 	/* One buffer now: the BIN chunk. An extension that names a buffer
-	 * would name the wrong one. */
+	 * would name the wrong one. It keeps buffer 0's name, extras and
+	 * other extensions; the other buffers' go (documented in
+	 * mlod-label(1): keeping them would take keeping their buffers). */
 	std::vector<bool> ignored(j["bufferViews"].size(), false), named(buffer_list.size(), false);
 	extension_refs(j, false, ignored, named);
 	if (std::find(named.begin(), named.end(), true) != named.end())

@@ -4,8 +4,9 @@
  * EXT_meshopt_compression / KHR_meshopt_compression buffer views, encoded
  * here with meshoptimizer's own encoders (indices with the index codec and
  * the sequence codec), reads as the plain triangle; then
- * hostile variants (truncated, garbled, huge counts, bad strides, unknown
- * modes, filters and codec versions) are refused with the right code.
+ * hostile variants (truncated, garbled, huge counts, bad strides, a stride
+ * the view contradicts, unknown modes, filters and codec versions) are
+ * refused with the right code.
  * Draco input is covered by the CLI tests (tests/cli/pack_draco_input.sh),
  * which make it with gltf-transform.
  */
@@ -143,11 +144,15 @@ TEST(hostile)
 	        "count 4 times byteStride 12 is 48 bytes, but the buffer view has 36");
 	refused("\"byteLength\":8,\"byteStride\":6,\"count\":6,\"mode\":\"ATTRIBUTES\"", NULL, NULL, 0, MLOD_ERR_PARSE,
 	        "byteStride 6 is not valid for mode ATTRIBUTES");
-	refused("\"byteLength\":8,\"byteStride\":4,\"count\":4000000000,\"mode\":\"ATTRIBUTES\"", NULL, NULL, 0,
+	refused("\"byteLength\":8,\"byteStride\":12,\"count\":4000000000,\"mode\":\"ATTRIBUTES\"", NULL, NULL, 0,
 	        MLOD_ERR_PARSE, "but the buffer view has 36");
 	refused("\"byteLength\":8,\"byteStride\":-4,\"count\":9,\"mode\":\"ATTRIBUTES\"", NULL, NULL, 0, MLOD_ERR_PARSE,
 	        "byteStride: not an integer");
 	refused("\"byteLength\":8,\"count\":9,\"mode\":\"ATTRIBUTES\"", NULL, NULL, 0, MLOD_ERR_PARSE, "no byteStride");
+	/* A stride the view's own byteStride (12) contradicts: the decoded
+	 * elements would be read in another layout. */
+	refused("\"byteLength\":8,\"byteStride\":4,\"count\":9,\"mode\":\"ATTRIBUTES\"", NULL, NULL, 0, MLOD_ERR_PARSE,
+	        "byteStride 4, but the buffer view's byteStride is 12");
 	snprintf(ix, sizeof ix, "\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":2,\"count\":2,\"mode\":\"TRIANGLES\"",
 	         index_at, index_bytes);
 	refused(NULL, ix, NULL, 0, MLOD_ERR_PARSE, "count 2 of mode TRIANGLES is not a multiple of 3");
