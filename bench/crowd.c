@@ -449,15 +449,15 @@ static double frame(crowd *c, const mlod_rt_select *sel, float dt, uint64_t *ver
 			uint32_t nv = 0;
 			int skinned = 0;
 			mlod_result r = mlod_rt_skin_stale(c->ctx, c->scratch, c->ids[i], c->stale_sel, c->skin_stale,
-			                                   c->rec + (size_t)i * c->rec_size, c->buf, 12,
+			                                   c->rec + (size_t)i * c->rec_size, c->rec_size, c->buf, 12,
 			                                   c->buf + 3 * (size_t)c->cap, 12, c->cap, &nv, &skinned, NULL, &e);
 			if (r == MLOD_ERR_LIMIT) {
 				t0 -= cpu_seconds();
 				grow(c);
 				t0 += cpu_seconds();
 				r = mlod_rt_skin_stale(c->ctx, c->scratch, c->ids[i], c->stale_sel, c->skin_stale,
-				                       c->rec + (size_t)i * c->rec_size, c->buf, 12, c->buf + 3 * (size_t)c->cap,
-				                       12, c->cap, &nv, &skinned, NULL, &e);
+				                       c->rec + (size_t)i * c->rec_size, c->rec_size, c->buf, 12,
+				                       c->buf + 3 * (size_t)c->cap, 12, c->cap, &nv, &skinned, NULL, &e);
 			}
 			if (r != MLOD_OK)
 				die(2, "%s", e.message);

@@ -738,11 +738,15 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
  * only when the vertices it kept are provably more than max_stale_pixels
  * off where mlod_rt_skin would put them now. The caller keeps, per
  * instance, a record of mlod_rt_stale_size(ctx) bytes (4-byte aligned, its
- * own memory: the runtime allocates nothing for it), all zero for "never
- * skinned" (zero it again whenever its buffers no longer hold that
- * instance's last skin): 32 bytes, then 48 per joint of the full skeleton
+ * own memory: the runtime allocates nothing for it; record_size its
+ * size), all zero for "never skinned" (zero it again whenever its buffers
+ * no longer hold that instance's last skin): 32 bytes, then 48 per joint of the full skeleton
  * (the 3x4 affine part of each world matrix the kept skin used), then 4 per
- * morph weight (mlod_rt_morph_target_count summed over the parts).
+ * morph weight (mlod_rt_morph_target_count summed over the parts). The
+ * record names the context that wrote it (a count of the opens in the
+ * process): a record written through another context, of another pack or
+ * another open of the same one, holds no skin for this one (it skins), so
+ * a record means nothing outside the process that wrote it.
  * mlod_rt_skin_stale poses the instance as mlod_rt_skin does (only what
  * its mesh level reads) and makes the palette entries; then, when the
  * record holds a skin of the same instance id, at the same skeleton and
@@ -765,17 +769,18 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
  * D lines / (2 d tan(fov_y / 2)) pixels (sel's fov_y and lines; nothing
  * else of sel is read). When that is at most max_stale_pixels, nothing is
  * written (*skinned 0, *stale_pixels the bound in pixels, *vertex_count
- * the level's vertices, which the buffers still hold); otherwise (a bound
- * over it, or NaN, which only a hostile pack gives; d 0 with a pose that
- * moved; the record empty or of another instance, level, clip or weights)
- * it skins into the buffers as mlod_rt_skin (*skinned 1, *stale_pixels 0)
+ * the level's vertices, which the buffers still hold); at d 0 only a pose
+ * that did not move at all keeps (every bound 0: *stale_pixels 0).
+ * Otherwise (a bound over it, or NaN, which only a hostile pack gives; d 0
+ * with a pose that moved; the record empty or of another context,
+ * instance, level, clip or weights) it skins into the buffers as mlod_rt_skin (*skinned 1, *stale_pixels 0)
  * and keeps this skin's world matrices and weights in the record. The
  * motion level may change without a skin: the bound is on the matrices.
  * Without a mesh it is mlod_rt_skin. Errors and arguments as
  * mlod_rt_skin, and MLOD_ERR_INVALID_ARG for a NULL sel or record, fov_y
- * not in (0, pi), lines not > 0 or max_stale_pixels negative or not finite
- * (nothing written then); after a skin that fails the record is marked
- * empty. No allocation (the check keeps the changes of up to 16 palette
+ * not in (0, pi), lines not > 0, max_stale_pixels negative or not finite,
+ * or record_size below mlod_rt_stale_size(ctx) (nothing written then);
+ * after a skin that fails the record is marked empty. No allocation (the check keeps the changes of up to 16 palette
  * sources on the stack, about 2.6 KB). The errors add: a mesh level selected within p
  * pixels of level 0 (MLOD_RT_SELECT_PIXELS) shown with a stale pose within
  * q pixels of now is within p + q pixels of level 0 now (0.5 + 0.5 keeps
@@ -784,9 +789,9 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
  * mlod_rt_eval(3), bench/RESULTS.md Run 112. */
 size_t mlod_rt_stale_size(const mlod_rt_ctx *ctx);
 mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const mlod_rt_select *sel,
-                               float max_stale_pixels, void *record, float *positions, size_t pos_stride,
-                               float *normals, size_t nrm_stride, uint32_t capacity, uint32_t *vertex_count,
-                               int *skinned, float *stale_pixels, mlod_error *err);
+                               float max_stale_pixels, void *record, size_t record_size, float *positions,
+                               size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
+                               uint32_t *vertex_count, int *skinned, float *stale_pixels, mlod_error *err);
 
 /* The skinning kernels, for callers with their own data and for the
  * benchmark: n vertices, positions and normals 3 floats each (normals may

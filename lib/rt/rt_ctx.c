@@ -7,6 +7,7 @@
  * fallback rule), rt_open.c (opening views, the common part of every
  * open, closing) and rt_query.c; the pack source is rt_pack.c.
  */
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -50,6 +51,12 @@ int rt_config_bad(const mlod_rt_config *config)
 	return config && config->allocator && !config->allocator->malloc != !config->allocator->free;
 }
 
+/* The contexts opened in the process so far: each takes the next count
+ * as its open_tag, so a record of mlod_rt_skin_stale written by another
+ * context (another pack, or another open of the same one, which may
+ * reuse the same memory) never passes for this one's. */
+static _Atomic uint64_t rt_opened;
+
 mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config)
 {
 	mlod_rt_allocator a = { default_malloc, default_free, NULL };
@@ -60,6 +67,7 @@ mlod_rt_ctx *rt_ctx_new(const mlod_rt_config *config)
 		return NULL;
 	memset(ctx, 0, sizeof *ctx);
 	ctx->alloc = a;
+	ctx->open_tag = atomic_fetch_add(&rt_opened, 1) + 1;
 	ctx->budget = config && config->budget_bytes ? config->budget_bytes : SIZE_MAX;
 	ctx->max_instances = config && config->max_instances ? config->max_instances : 1024;
 	ctx->streamed = 1; /* the first update starts a frame */

@@ -809,12 +809,21 @@ static int rigid_unit(const float *M, float *U)
 	return 1;
 }
 
-/* The matrix of a rigid or static part (p->rec.skin < 0): its joint's
- * world matrix in W (through the stand-in's and the rest transform from
- * it when the skeleton level su removed the joint) times its offset; a
- * static part's offset alone. mlod_rt_skin and mlod_rt_bounds both take
- * it from here, so a bound holds the floats the skin writes. */
-static void rigid_matrix(const rt_unit *su, const float *W, const mlod_pack_part *p, float *M)
+/* The joint whose world matrix a rigid part (p->rec.joint >= 0) reads:
+ * its own, or its stand-in's when the skeleton level su removed it. */
+static inline uint32_t rigid_joint(const rt_unit *su, const mlod_pack_part *p)
+{
+	const uint32_t j = (uint32_t)p->rec.joint;
+	return su ? (uint32_t)su->plan.stand[j] : j;
+}
+
+/* The matrix of a rigid or static part (p->rec.skin < 0): Wj, the world
+ * matrix of rigid_joint (through the stand-in's rest transform to the
+ * joint when su removed it), times its offset; a static part's offset
+ * alone (Wj not read). mlod_rt_skin, mlod_rt_bounds and
+ * mlod_rt_skin_stale (with a kept Wj) all take it from here, so a bound
+ * holds the floats the skin writes. */
+static void rigid_matrix(const rt_unit *su, const float *Wj, const mlod_pack_part *p, float *M)
 {
 	if (p->rec.joint < 0) {
 		memcpy(M, p->rec.offset, 16 * sizeof(float));
@@ -823,11 +832,18 @@ static void rigid_matrix(const rt_unit *su, const float *W, const mlod_pack_part
 	const uint32_t j = (uint32_t)p->rec.joint;
 	if (su && su->plan.stand[j] != (int32_t)j) {
 		float t[16];
-		rt_mat_mul(W + 16 * (size_t)su->plan.stand[j], su->plan.rel + 16 * (size_t)j, t);
+		rt_mat_mul(Wj, su->plan.rel + 16 * (size_t)j, t);
 		rt_mat_mul(t, p->rec.offset, M);
 	} else {
-		rt_mat_mul(W + 16 * (size_t)j, p->rec.offset, M);
+		rt_mat_mul(Wj, p->rec.offset, M);
 	}
+}
+
+/* Wj for rigid_matrix in the world matrices W (W itself for a static
+ * part, which does not read it). */
+static inline const float *rigid_world(const rt_unit *su, const float *W, const mlod_pack_part *p)
+{
+	return p->rec.joint < 0 ? W : W + 16 * (size_t)rigid_joint(su, p);
 }
 
 /* The palette entries the mesh level mu reads, W[joint] times the bind
@@ -932,7 +948,7 @@ mlod_result mlod_rt_skin(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id
 		 * levels have 15 rigid parts on 12 joints). */
 		if (!skinned && !(m_ok && p->rec.joint == m_joint &&
 		                  (m_off == p->rec.offset || memcmp(m_off, p->rec.offset, sizeof M) == 0))) {
-			rigid_matrix(su, W, p, M);
+			rigid_matrix(su, rigid_world(su, W, p), p, M);
 			m_ok = 1, m_joint = p->rec.joint, m_off = p->rec.offset, m_unit = -1;
 		}
 		/* Rigid and static parts with unit normals: skip renormalising
@@ -1107,7 +1123,7 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 		if (p->rec.skin >= 0 || !(c[6] >= 0.0f))
 			continue;
 		float M[16];
-		rigid_matrix(su, W, p, M);
+		rigid_matrix(su, rigid_world(su, W, p), p, M);
 		const double cc[3] = { c[0], c[1], c[2] }, hh[3] = { c[3] + grow, c[4] + grow, c[5] + grow };
 		double x[3], ex[3], mg[3];
 		box_image(M, cc, hh, c[6] + grow, x, ex, mg);
@@ -1143,12 +1159,15 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
  * weights. The palette entries and rigid parts' matrices of that skin are
  * made again from them by the same products (rt_mat_mul, rigid_matrix):
  * the same floats, in fewer bytes than a palette (RobotExpressive: 43
- * joints, 172 palette entries). All zero (valid 0): never skinned. */
+ * joints, 172 palette entries). All zero (valid 0): never skinned. The
+ * context that wrote it is named by its open_tag: a record of another
+ * context (another pack, or another open of the same pack: the same
+ * layout, other instances) holds no skin of this one's. */
 typedef struct rt_stale_head {
 	uint32_t valid;           /* RT_STALE_VALID once it holds a skin */
 	uint32_t id;              /* the instance skinned (its generation too) */
 	uint32_t skel_level, mesh_level, clip;
-	uint32_t joint_count, morph_total; /* the layout, for a record of another context */
+	uint32_t tag_lo, tag_hi;  /* the writer's open_tag (two halves: the record is 4-byte aligned) */
 	uint32_t hint;            /* the item whose bound went over at the last check */
 } rt_stale_head;
 
@@ -1232,25 +1251,10 @@ static double stale_move(const rt_stale_delta *d, const float *c, const float *h
  * met, by source index modulo RT_STALE_SLOTS. */
 #define RT_STALE_SLOTS 16
 
-/* rigid_matrix of a rigid part (joint >= 0) given Wj, the world matrix
- * of its joint, or of its stand-in when su removed the joint: the same
- * products, so the same floats. */
-static void rigid_matrix_at(const rt_unit *su, const float *Wj, const mlod_pack_part *p, float *M)
-{
-	const uint32_t j = (uint32_t)p->rec.joint;
-	if (su && su->plan.stand[j] != (int32_t)j) {
-		float t[16];
-		rt_mat_mul(Wj, su->plan.rel + 16 * (size_t)j, t);
-		rt_mat_mul(t, p->rec.offset, M);
-	} else {
-		rt_mat_mul(Wj, p->rec.offset, M);
-	}
-}
-
 mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t id, const mlod_rt_select *sel,
-                               float max_stale_pixels, void *record, float *positions, size_t pos_stride,
-                               float *normals, size_t nrm_stride, uint32_t capacity, uint32_t *vertex_count,
-                               int *skinned, float *stale_pixels, mlod_error *err)
+                               float max_stale_pixels, void *record, size_t record_size, float *positions,
+                               size_t pos_stride, float *normals, size_t nrm_stride, uint32_t capacity,
+                               uint32_t *vertex_count, int *skinned, float *stale_pixels, mlod_error *err)
 {
 	if (vertex_count)
 		*vertex_count = 0;
@@ -1268,6 +1272,10 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: fov_y must lie in (0, pi), lines be > 0");
 	if (!(max_stale_pixels >= 0.0f) || !isfinite(max_stale_pixels))
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_rt_skin_stale: max_stale_pixels must be finite, >= 0");
+	if (record_size < mlod_rt_stale_size(ctx))
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG,
+		                 "mlod_rt_skin_stale: a record of %zu bytes, this context's take %zu (mlod_rt_stale_size)",
+		                 record_size, mlod_rt_stale_size(ctx));
 	const rt_instance *in = rt_live(ctx, id);
 	if (!in)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "instance %u is not alive", id);
@@ -1284,9 +1292,9 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 	const uint32_t skel_level = su ? su->level : 0;
 	const float *mw = ctx->morph_total ? ctx->morph_weights + (size_t)rt_slot(ctx, id) * ctx->morph_total : NULL;
 	/* Anything but the pose changed since the kept skin: skin. */
-	int need = hd->valid != RT_STALE_VALID || hd->id != id || hd->skel_level != skel_level ||
-	           hd->mesh_level != mu->level || hd->clip != st->clip || hd->joint_count != ctx->joint_count ||
-	           hd->morph_total != ctx->morph_total ||
+	const uint32_t tag_lo = (uint32_t)ctx->open_tag, tag_hi = (uint32_t)(ctx->open_tag >> 32);
+	int need = hd->valid != RT_STALE_VALID || hd->tag_lo != tag_lo || hd->tag_hi != tag_hi || hd->id != id ||
+	           hd->skel_level != skel_level || hd->mesh_level != mu->level || hd->clip != st->clip ||
 	           (mw && memcmp(rec_morph, mw, 4 * (size_t)ctx->morph_total) != 0);
 	if (!need) {
 		/* The distance a vertex may have moved for max_stale_pixels at the
@@ -1344,11 +1352,11 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 				const float *c = mu->bound_part + 7 * (size_t)i;
 				if (p->rec.skin >= 0 || p->rec.joint < 0 || !(c[6] >= 0.0f))
 					continue; /* a static part does not move */
-				const uint32_t j = (uint32_t)p->rec.joint, sj = su ? (uint32_t)su->plan.stand[j] : j;
+				const uint32_t sj = rigid_joint(su, p);
 				float W0[16], M0[16], M1[16];
 				affine16(rec_world + 12 * (size_t)sj, W0);
-				rigid_matrix_at(su, s->world + 16 * (size_t)sj, p, M1);
-				rigid_matrix_at(su, W0, p, M0);
+				rigid_matrix(su, s->world + 16 * (size_t)sj, p, M1);
+				rigid_matrix(su, W0, p, M0);
 				rt_stale_delta d;
 				stale_delta(M0, M1, &d);
 				mv = stale_move(&d, c, c + 3, c[6], grow);
@@ -1361,8 +1369,10 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 		if (!need) {
 			if (vertex_count)
 				*vertex_count = mu->vertex_count;
+			/* at d 0 (px infinite) only a pose that did not move
+			 * at all gets here: 0, not 0 times infinity */
 			if (stale_pixels)
-				*stale_pixels = (float)(most * px);
+				*stale_pixels = most > 0 ? (float)(most * px) : 0.0f;
 			return MLOD_OK;
 		}
 	}
@@ -1383,7 +1393,7 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 	if (mw)
 		memcpy(rec_morph, mw, 4 * (size_t)ctx->morph_total);
 	hd->valid = RT_STALE_VALID, hd->id = id, hd->skel_level = skel_level, hd->mesh_level = mu->level;
-	hd->clip = st->clip, hd->joint_count = ctx->joint_count, hd->morph_total = ctx->morph_total;
+	hd->clip = st->clip, hd->tag_lo = tag_lo, hd->tag_hi = tag_hi;
 	if (skinned)
 		*skinned = 1;
 	return MLOD_OK;

@@ -116,6 +116,8 @@ typedef struct rt_instance {
 struct mlod_rt_ctx {
 	mlod_rt_allocator alloc;
 	size_t budget;
+	uint64_t open_tag;        /* this open's, one per context in the process, never 0:
+	                           * mlod_rt_skin_stale's records name it (rt_ctx_new) */
 	rt_load_fn load;
 	rt_unload_fn unload;
 	rt_close_fn close_source;

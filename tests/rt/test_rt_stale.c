@@ -107,7 +107,7 @@ static void stale_path(const uint8_t *data, size_t size, float q, path_stats *ps
 			int skinned = -1;
 			float bound_px = -1;
 			float *kb = kept + (size_t)i * cap * 3;
-			ok = mlod_rt_skin_stale(ctx, s, ids[i], &sel, q, rec + i * rec_size, kb, 12, NULL, 0, cap, &vc,
+			ok = mlod_rt_skin_stale(ctx, s, ids[i], &sel, q, rec + i * rec_size, rec_size, kb, 12, NULL, 0, cap, &vc,
 			                        &skinned, &bound_px, &e) == MLOD_OK;
 			if (!ok)
 				break;
@@ -265,7 +265,8 @@ TEST(morph_weights_force_a_skin)
 	}
 	const uint32_t cap = mlod_rt_max_vertex_count(ctx);
 	float *buf = malloc((size_t)cap * 12);
-	void *rec = calloc(1, mlod_rt_stale_size(ctx));
+	const size_t rs = mlod_rt_stale_size(ctx);
+	void *rec = calloc(1, rs);
 	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
 	uint32_t id;
 	int sk[4] = { -1, -1, -1, -1 };
@@ -275,11 +276,11 @@ TEST(morph_weights_force_a_skin)
 	int ok = buf && rec && s && mlod_rt_instance_create(ctx, 0, 0.1f, 0, &id, &e) == MLOD_OK &&
 	         mlod_rt_update(ctx, &sel, &id, &d, 1, 0, &e) == MLOD_OK;
 	/* dt 0: the pose stays; only the weights change */
-	ok = ok && mlod_rt_skin_stale(ctx, s, id, &sel, 1, rec, buf, 12, NULL, 0, cap, NULL, &sk[0], NULL, &e) == MLOD_OK;
-	ok = ok && mlod_rt_skin_stale(ctx, s, id, &sel, 1, rec, buf, 12, NULL, 0, cap, NULL, &sk[1], NULL, &e) == MLOD_OK;
+	ok = ok && mlod_rt_skin_stale(ctx, s, id, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk[0], NULL, &e) == MLOD_OK;
+	ok = ok && mlod_rt_skin_stale(ctx, s, id, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk[1], NULL, &e) == MLOD_OK;
 	ok = ok && mlod_rt_instance_set_morph_weights(ctx, id, part, &w1, 1, &e) == MLOD_OK;
-	ok = ok && mlod_rt_skin_stale(ctx, s, id, &sel, 1, rec, buf, 12, NULL, 0, cap, NULL, &sk[2], NULL, &e) == MLOD_OK;
-	ok = ok && mlod_rt_skin_stale(ctx, s, id, &sel, 1, rec, buf, 12, NULL, 0, cap, NULL, &sk[3], NULL, &e) == MLOD_OK;
+	ok = ok && mlod_rt_skin_stale(ctx, s, id, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk[2], NULL, &e) == MLOD_OK;
+	ok = ok && mlod_rt_skin_stale(ctx, s, id, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk[3], NULL, &e) == MLOD_OK;
 	if (s)
 		mlod_rt_scratch_destroy(ctx, s);
 	mlod_rt_close(ctx);
@@ -331,7 +332,7 @@ TEST(no_allocation_per_frame)
 		ok = mlod_rt_update(ctx, &sel, ids, dist, N, 1.0f / 30, &e) == MLOD_OK;
 		for (uint32_t i = 0; ok && i < N; i++) {
 			int sk = 0;
-			ok = mlod_rt_skin_stale(ctx, s, ids[i], &sel, 1, rec + i * rs, buf, 12, buf + 3 * (size_t)cap, 12, cap,
+			ok = mlod_rt_skin_stale(ctx, s, ids[i], &sel, 1, rec + i * rs, rs, buf, 12, buf + 3 * (size_t)cap, 12, cap,
 			                        NULL, &sk, NULL, &e) == MLOD_OK;
 			skinned += (unsigned long)sk, calls++;
 		}
@@ -372,7 +373,8 @@ TEST(hostile_packs_never_skip_a_nan)
 		const uint32_t cap = mlod_rt_max_vertex_count(ctx) < (1u << 20) ? mlod_rt_max_vertex_count(ctx) : (1u << 20);
 		const uint32_t levels = mlod_rt_level_count(ctx, MLOD_RT_MESH);
 		float *pos = malloc(((size_t)cap + 1) * 3 * sizeof *pos);
-		void *rec = calloc(1, mlod_rt_stale_size(ctx) + 4);
+		const size_t rs = mlod_rt_stale_size(ctx) + 4;
+		void *rec = calloc(1, rs);
 		mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
 		uint32_t id;
 		int ok = pos && rec && s && mlod_rt_instance_create(ctx, 0, 0.25f, MLOD_RT_LOOP, &id, &e) == MLOD_OK;
@@ -388,7 +390,7 @@ TEST(hostile_packs_never_skip_a_nan)
 				int sk = -1;
 				ok = mlod_rt_update(ctx, &sel, &id, &d, 1, f % 2 ? 1.0f / 30 : 0, &e) == MLOD_OK &&
 				     mlod_rt_bounds(ctx, s, id, lo, hi, &e) == MLOD_OK;
-				mlod_result r = ok ? mlod_rt_skin_stale(ctx, s, id, &sel, 1000, rec, pos, 12, NULL, 0, cap, NULL,
+				mlod_result r = ok ? mlod_rt_skin_stale(ctx, s, id, &sel, 1000, rec, rs, pos, 12, NULL, 0, cap, NULL,
 				                                        &sk, NULL, &e)
 				                   : MLOD_OK;
 				if (r == MLOD_ERR_LIMIT || r == MLOD_ERR_INVALID_ARG)
@@ -427,6 +429,7 @@ TEST(arguments)
 	const uint32_t cap = mlod_rt_max_vertex_count(ctx);
 	float buf[3 * 64];
 	uint8_t rec[4096];
+	const size_t rs = mlod_rt_stale_size(ctx);
 	uint32_t a, b;
 	mlod_rt_select sel;
 	mlod_rt_select_default(&sel);
@@ -438,28 +441,135 @@ TEST(arguments)
 	         mlod_rt_instance_create(ctx, 0, 0, 0, &b, &e) == MLOD_OK;
 	const uint32_t ids[2] = { a, b };
 	ok = ok && mlod_rt_update(ctx, &sel, ids, d, 2, 0, &e) == MLOD_OK;
-	ok = ok && mlod_rt_skin_stale(ctx, s, a, &sel, 1, rec, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e) == MLOD_OK &&
+	ok = ok && mlod_rt_skin_stale(ctx, s, a, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e) == MLOD_OK &&
 	     sk == 1;
-	ok = ok && mlod_rt_skin_stale(ctx, s, a, &sel, 1, rec, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e) == MLOD_OK &&
+	ok = ok && mlod_rt_skin_stale(ctx, s, a, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e) == MLOD_OK &&
 	     sk == 0;
 	/* the same record for another instance at the same pose: skins */
-	ok = ok && mlod_rt_skin_stale(ctx, s, b, &sel, 1, rec, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e) == MLOD_OK &&
+	ok = ok && mlod_rt_skin_stale(ctx, s, b, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e) == MLOD_OK &&
 	     sk == 1;
+	/* distance 0, the pose unchanged: keeps, and the bound in pixels is
+	 * 0 (not 0 times an infinite scale, NaN) */
+	const float d0[2] = { 0, 0 };
+	float px = -1;
+	int sk0 = -1;
+	ok = ok && mlod_rt_update(ctx, &sel, ids, d0, 2, 0, &e) == MLOD_OK && /* may switch levels: skins */
+	     mlod_rt_skin_stale(ctx, s, b, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk0, &px, &e) == MLOD_OK &&
+	     mlod_rt_skin_stale(ctx, s, b, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk0, &px, &e) == MLOD_OK;
+	const int kept_at_0 = sk0 == 0 && px == 0.0f;
 	mlod_rt_select bad = sel;
 	bad.fov_y = 0;
-	mlod_result r1 = mlod_rt_skin_stale(ctx, s, b, &bad, 1, rec, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
-	mlod_result r2 = mlod_rt_skin_stale(ctx, s, b, &sel, -1, rec, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
-	mlod_result r3 = mlod_rt_skin_stale(ctx, s, b, &sel, NAN, rec, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
-	mlod_result r4 = mlod_rt_skin_stale(ctx, s, b, NULL, 1, rec, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
-	mlod_result r5 = mlod_rt_skin_stale(ctx, s, b, &sel, 1, NULL, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
+	mlod_result r1 = mlod_rt_skin_stale(ctx, s, b, &bad, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
+	mlod_result r2 = mlod_rt_skin_stale(ctx, s, b, &sel, -1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
+	mlod_result r3 = mlod_rt_skin_stale(ctx, s, b, &sel, NAN, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
+	mlod_result r4 = mlod_rt_skin_stale(ctx, s, b, NULL, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
+	mlod_result r5 = mlod_rt_skin_stale(ctx, s, b, &sel, 1, NULL, rs, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e);
+	/* a record one byte short: refused, saying so, and nothing written */
+	uint8_t before[4096];
+	memcpy(before, rec, sizeof rec);
+	mlod_error e6 = { 0 };
+	mlod_result r6 = mlod_rt_skin_stale(ctx, s, b, &sel, 1, rec, rs - 1, buf, 12, NULL, 0, cap, NULL, &sk, NULL, &e6);
+	const int untouched = memcmp(before, rec, sizeof rec) == 0;
 	if (s)
 		mlod_rt_scratch_destroy(ctx, s);
 	mlod_rt_close(ctx);
 	CHECK(ok, "skins 1 0 1 expected: %s", e.message);
+	CHECK(kept_at_0, "at distance 0 with the pose unchanged: skinned %d, %g pixels (want 0, 0)", sk0, (double)px);
 	CHECK(r1 == MLOD_ERR_INVALID_ARG && r2 == MLOD_ERR_INVALID_ARG && r3 == MLOD_ERR_INVALID_ARG &&
 	              r4 == MLOD_ERR_INVALID_ARG && r5 == MLOD_ERR_INVALID_ARG,
 	      "bad arguments accepted: %d %d %d %d %d", (int)r1, (int)r2, (int)r3, (int)r4, (int)r5);
+	CHECK(r6 == MLOD_ERR_INVALID_ARG && strstr(e6.message, "mlod_rt_stale_size") && untouched,
+	      "a record too small: %d, \"%s\", record %s", (int)r6, e6.message, untouched ? "untouched" : "written");
+	printf("# a record too small: %s\n", e6.message);
 	CHECK(mlod_rt_stale_size(NULL) == 0, "a size for no context");
+}
+
+/* One instance each in several contexts, at the same id, state and
+ * distance (dt 0: the pose stays), sharing one record: a record written
+ * through one context holds no skin for another, whether another open of
+ * the same pack (alive at once, or opened after the first closed, which
+ * may reuse its memory) or another pack. */
+static uint32_t the_id; /* the one instance's, the same in each context */
+
+static int skin_with(mlod_rt_ctx *ctx, void *rec, size_t rs, float *buf, int *sk, mlod_error *e)
+{
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	mlod_rt_scratch *s = mlod_rt_scratch_create(ctx);
+	const uint32_t cap = mlod_rt_max_vertex_count(ctx);
+	int ok = s != NULL;
+	*sk = -1;
+	ok = ok && mlod_rt_skin_stale(ctx, s, the_id, &sel, 1, rec, rs, buf, 12, NULL, 0, cap, NULL, sk, NULL, e) == MLOD_OK;
+	if (s)
+		mlod_rt_scratch_destroy(ctx, s);
+	return ok;
+}
+
+static mlod_rt_ctx *open_one(const uint8_t *data, size_t size, mlod_error *e)
+{
+	mlod_rt_ctx *ctx = NULL;
+	uint32_t id = UINT32_MAX;
+	const float d = 10;
+	mlod_rt_select sel;
+	mlod_rt_select_default(&sel);
+	if (mlod_rt_open_memory(data, size, NULL, &ctx, e) != MLOD_OK)
+		return NULL;
+	if (mlod_rt_instance_create(ctx, 0, 0.25f, MLOD_RT_LOOP, &id, e) != MLOD_OK ||
+	    mlod_rt_update(ctx, &sel, &id, &d, 1, 0, e) != MLOD_OK) {
+		mlod_rt_close(ctx);
+		return NULL;
+	}
+	if (the_id == UINT32_MAX)
+		the_id = id;
+	if (id != the_id) {
+		snprintf(e->message, sizeof e->message, "instance ids %u and %u in two fresh contexts", the_id, id);
+		mlod_rt_close(ctx);
+		return NULL;
+	}
+	return ctx;
+}
+
+TEST(record_of_another_context_skins)
+{
+	SKIP_IF_NO_PACK(record_of_another_context_skins);
+	size_t rsize = 0, tsize = 0;
+	uint8_t *robot = pack_sample("samples/RobotExpressive.glb", "stale-robot-c.mlod", &rsize);
+	uint8_t *tube = pack_sample("samples/tubeman.glb", "stale-tube-c.mlod", &tsize);
+	CHECK(robot && tube, "mlod-pack failed");
+	mlod_error e = { 0 };
+	the_id = UINT32_MAX;
+	mlod_rt_ctx *a = open_one(robot, rsize, &e), *b = open_one(robot, rsize, &e), *t = open_one(tube, tsize, &e);
+	int ok = a && b && t;
+	const size_t ra = ok ? mlod_rt_stale_size(a) : 0, rt = ok ? mlod_rt_stale_size(t) : 0;
+	const size_t rs = ra > rt ? ra : rt;
+	uint32_t cap = 0;
+	if (ok) {
+		cap = mlod_rt_max_vertex_count(a);
+		if (mlod_rt_max_vertex_count(t) > cap)
+			cap = mlod_rt_max_vertex_count(t);
+	}
+	void *rec = calloc(1, rs + 1);
+	float *buf = malloc((size_t)cap * 12 + 12);
+	ok = ok && rec && buf && ra == mlod_rt_stale_size(b);
+	int sk[8] = { -1, -1, -1, -1, -1, -1, -1, -1 };
+	ok = ok && skin_with(a, rec, ra, buf, &sk[0], &e) && skin_with(a, rec, ra, buf, &sk[1], &e); /* 1 0 */
+	ok = ok && skin_with(b, rec, ra, buf, &sk[2], &e) && skin_with(b, rec, ra, buf, &sk[3], &e); /* 1 0 */
+	ok = ok && skin_with(a, rec, ra, buf, &sk[4], &e);                                            /* 1 */
+	ok = ok && skin_with(t, rec, rt, buf, &sk[5], &e) && skin_with(t, rec, rt, buf, &sk[6], &e); /* 1 0 */
+	/* a closes; a new open of the same pack (often at a's address) with a's record */
+	ok = ok && skin_with(a, rec, ra, buf, &sk[7], &e);
+	mlod_rt_close(a);
+	a = ok ? open_one(robot, rsize, &e) : NULL;
+	int sk_new = -1;
+	ok = ok && a && skin_with(a, rec, ra, buf, &sk_new, &e);
+	mlod_rt_close(a), mlod_rt_close(b), mlod_rt_close(t);
+	free(rec), free(buf), free(robot), free(tube);
+	CHECK(ok, "%s", e.message);
+	CHECK(sk[0] == 1 && sk[1] == 0 && sk[2] == 1 && sk[3] == 0 && sk[4] == 1 && sk[5] == 1 && sk[6] == 0 &&
+	              sk[7] == 1 && sk_new == 1,
+	      "skinned %d %d | %d %d | %d | %d %d | %d | %d: want 1 0 | 1 0 | 1 | 1 0 | 1 | 1", sk[0], sk[1], sk[2],
+	      sk[3], sk[4], sk[5], sk[6], sk[7], sk_new);
+	printf("# one record through two opens of the robot, the tubeman and a new open: skinned at each change\n");
 }
 
 int main(int argc, char **argv)
@@ -472,6 +582,7 @@ int main(int argc, char **argv)
 	RUN_S(ely_stale_vertices_within_the_bound);
 	RUN_S(morph_weights_force_a_skin);
 	RUN(no_allocation_per_frame);
+	RUN(record_of_another_context_skins);
 	RUN(hostile_packs_never_skip_a_nan);
 	rt_packer_cleanup();
 	TEST_EXIT();
