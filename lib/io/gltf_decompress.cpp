@@ -11,7 +11,6 @@
  * leave extensionsUsed / extensionsRequired. Only Draco's core decoder is used
  * (never its glTF I/O, which carries its own tinygltf: deps.md).
  */
-#include <fstream>
 #include <tuple>
 
 #include <draco/compression/decode.h>
@@ -37,7 +36,7 @@ struct Buffers {
 	const unsigned char *glb_bin; /* the glb's BIN chunk, or null */
 	size_t glb_bin_size;
 	const char *base_dir;
-	std::vector<std::unique_ptr<std::string>> loaded;
+	std::vector<std::unique_ptr<std::vector<unsigned char>>> loaded;
 	uint64_t input; /* the glb's length (0 for JSON), plus each buffer read from a URI */
 
 	Buffers(const json &j, const unsigned char *bin, size_t bin_size, const char *dir, size_t glb_size)
@@ -47,10 +46,10 @@ struct Buffers {
 	}
 
 	/* The bytes of buffer i ("what" names who asks). */
-	const std::string &get(size_t i, const std::string &what);
+	const std::vector<unsigned char> &get(size_t i, const std::string &what);
 };
 
-static std::string base64_decode(const std::string &s, size_t from, const std::string &what)
+static std::vector<unsigned char> base64_decode(const std::string &s, size_t from, const std::string &what)
 {
 	static signed char table[256];
 	if (!table['B']) {
@@ -59,7 +58,7 @@ static std::string base64_decode(const std::string &s, size_t from, const std::s
 		for (int k = 0; a[k]; k++)
 			table[(unsigned char)a[k]] = (signed char)k;
 	}
-	std::string out;
+	std::vector<unsigned char> out;
 	out.reserve((s.size() - from) / 4 * 3);
 	unsigned acc = 0;
 	int bits = 0;
@@ -73,7 +72,7 @@ static std::string base64_decode(const std::string &s, size_t from, const std::s
 		bits += 6;
 		if (bits >= 8) {
 			bits -= 8;
-			out += char(acc >> bits & 0xFF);
+			out.push_back((unsigned char)(acc >> bits & 0xFF));
 		}
 	}
 	return out;
@@ -81,7 +80,7 @@ static std::string base64_decode(const std::string &s, size_t from, const std::s
 
 static size_t member(const json &e, const char *key, long long def, const std::string &at);
 
-const std::string &Buffers::get(size_t i, const std::string &what)
+const std::vector<unsigned char> &Buffers::get(size_t i, const std::string &what)
 {
 	if (i >= loaded.size())
 		fail(MLOD_ERR_PARSE, "%s: buffer %zu does not exist (the document has %zu)", what.c_str(), i, loaded.size());
@@ -90,7 +89,7 @@ const std::string &Buffers::get(size_t i, const std::string &what)
 	const json &b = list[i];
 	std::string at = "buffers[" + std::to_string(i) + "]";
 	size_t length = member(b, "byteLength", -1, at);
-	std::string data;
+	std::vector<unsigned char> data;
 	if (!b.contains("uri")) {
 		for (const char *name : meshopt_names)
 			if (b.contains("extensions") && b["extensions"].is_object() && b["extensions"].contains(name))
@@ -98,7 +97,7 @@ const std::string &Buffers::get(size_t i, const std::string &what)
 				     name);
 		if (i != 0 || !glb_bin)
 			fail(MLOD_ERR_PARSE, "%s: %s has neither a URI nor a glb BIN chunk", what.c_str(), at.c_str());
-		data.assign(reinterpret_cast<const char *>(glb_bin), glb_bin_size);
+		data.assign(glb_bin, glb_bin + glb_bin_size);
 	} else {
 		std::string uri = b["uri"].get<std::string>();
 		if (uri.compare(0, 5, "data:") == 0) {
@@ -111,21 +110,17 @@ const std::string &Buffers::get(size_t i, const std::string &what)
 			/* check_buffer_uris allowed it: a file below base_dir */
 			if (!base_dir)
 				fail(MLOD_ERR_PARSE, "%s: an external file without a directory to read it from", at.c_str());
-			std::ifstream f(join_path(base_dir, url_decode(uri)), std::ios::binary | std::ios::ate);
-			std::streamoff size = f.tellg();
-			if (!f || size < 0 || uint64_t(size) > UINT32_MAX)
-				fail(MLOD_ERR_IO, "%s: cannot read %s", at.c_str(), mlod_gltf_internal::quoted(uri).c_str());
-			data.resize(size_t(size));
-			f.seekg(0);
-			if (size > 0 && !f.read(&data[0], size))
-				fail(MLOD_ERR_IO, "%s: cannot read %s", at.c_str(), mlod_gltf_internal::quoted(uri).c_str());
+			std::string why;
+			if (!read_file(join_path(base_dir, url_decode(uri)), data, &why))
+				fail(MLOD_ERR_IO, "%s: cannot read %s: %s", at.c_str(), mlod_gltf_internal::quoted(uri).c_str(),
+				     why.c_str());
 			input += data.size();
 		}
 	}
 	if (data.size() < length)
 		fail(MLOD_ERR_PARSE, "%s: byteLength %zu, but the data has %zu bytes", at.c_str(), length, data.size());
 	data.resize(length);
-	loaded[i].reset(new std::string(std::move(data)));
+	loaded[i].reset(new std::vector<unsigned char>(std::move(data)));
 	return *loaded[i];
 }
 
@@ -172,11 +167,11 @@ static std::string string_member(const json &e, const char *key, const char *def
 /* The bytes [offset, offset + length) of buffer "buffer", checked. */
 static const unsigned char *slice(Buffers &buffers, size_t buffer, size_t offset, size_t length, const std::string &at)
 {
-	const std::string &b = buffers.get(buffer, at);
+	const std::vector<unsigned char> &b = buffers.get(buffer, at);
 	if (offset > b.size() || length > b.size() - offset)
 		fail(MLOD_ERR_PARSE, "%s: bytes %zu to %zu lie past the end of buffer %zu (%zu bytes)", at.c_str(), offset,
 		     offset + length, buffer, b.size());
-	return reinterpret_cast<const unsigned char *>(b.data()) + offset;
+	return b.data() + offset;
 }
 
 /* Explains a meshopt decoder's refusal: an unknown codec version is
@@ -368,18 +363,12 @@ static void set_bounds(json &acc, const std::string &data, size_t count, int com
 	acc["max"] = hi;
 }
 
-/* One decoded Draco buffer view: the mesh, and the accessors already
- * written from it. */
-struct DracoView {
-	std::unique_ptr<draco::Mesh> mesh;
-};
-
 /* Rewrites a Draco primitive: its indices and mapped attributes get new
  * buffer views in bin, decoded from the extension's buffer view (views
- * are the document's views as read; decoded caches their meshes;
+ * are the document's views as read; decoded caches their meshes, by view;
  * written maps an accessor to the Draco view it was written from). */
 static void decode_draco(json &j, json &prim, const std::string &at, Buffers &buffers, const json &views,
-                         std::map<size_t, DracoView> &decoded, std::map<size_t, size_t> &written, std::string &bin,
+                         std::map<size_t, std::unique_ptr<draco::Mesh>> &decoded, std::map<size_t, size_t> &written, std::string &bin,
                          uint64_t &total)
 {
 	const json &e = *extension(prim, draco_name);
@@ -462,9 +451,9 @@ static void decode_draco(json &j, json &prim, const std::string &at, Buffers &bu
 		if (!mesh.ok())
 			fail(MLOD_ERR_PARSE, "%s: Draco cannot decode it: %s", vat.c_str(),
 			     printable(mesh.status().error_msg()).c_str());
-		found = decoded.emplace(v, DracoView{std::move(mesh).value()}).first;
+		found = decoded.emplace(v, std::move(mesh).value()).first;
 	}
-	const draco::Mesh &mesh = *found->second.mesh;
+	const draco::Mesh &mesh = *found->second;
 	size_t points = mesh.num_points(), faces = mesh.num_faces();
 	auto claim = [&](size_t a, const std::string &what) {
 		auto w = written.find(a);
@@ -721,7 +710,7 @@ bool decompress(json &j, const unsigned char *data, bool binary, const char *bas
 		view["byteLength"] = length;
 	}
 
-	std::map<size_t, DracoView> decoded;
+	std::map<size_t, std::unique_ptr<draco::Mesh>> decoded;
 	std::map<size_t, size_t> written;
 	if (j.contains("meshes"))
 		for (size_t m = 0; m < j["meshes"].size(); m++) {
@@ -782,26 +771,16 @@ bool decompress(json &j, const unsigned char *data, bool binary, const char *bas
 				j[list] = kept;
 		}
 
-	std::string js = dump_json(j, -1);
-	js.append((4 - js.size() % 4) % 4, ' ');
-	bin.append((4 - bin.size() % 4) % 4, '\0');
-	uint64_t total = 20 + uint64_t(js.size()) + (bin.empty() ? 0 : 8 + bin.size());
-	if (total > UINT32_MAX)
-		fail(MLOD_ERR_LIMIT, "the decompressed glb would be larger than 4 GiB");
-	out.clear();
-	out.reserve(size_t(total));
-	auto put = [&](uint32_t v) {
-		for (int k = 0; k < 4; k++)
-			out += char(v >> (8 * k) & 0xFF);
-	};
-	for (uint32_t v : {glb_magic, uint32_t(2), uint32_t(total), uint32_t(js.size()), chunk_json})
-		put(v);
-	out += js;
+	std::string chunk;
 	if (!bin.empty()) {
-		put(uint32_t(bin.size()));
-		put(chunk_bin);
-		out += bin;
+		bin.append((4 - bin.size() % 4) % 4, '\0');
+		for (uint32_t v : {uint32_t(bin.size()), chunk_bin})
+			for (int k = 0; k < 4; k++)
+				chunk += char(v >> (8 * k) & 0xFF);
+		chunk += bin;
+		std::string().swap(bin);
 	}
+	out = glb_bytes(j, chunk);
 	return true;
 }
 

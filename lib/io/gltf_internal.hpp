@@ -245,6 +245,12 @@ double tidy(float f);
 json parse_json(const char *text, size_t size);
 json parse_written_json(const char *text, size_t size);
 std::string dump_json(const json &j, int indent);
+/* A glb of JSON j (compact, padded) and bin_chunk, the BIN chunk with its
+ * header and padding (empty: none); MLOD_ERR_LIMIT past 4 GiB. */
+std::string glb_bytes(const json &j, const std::string &bin_chunk);
+/* The bytes of the file at path into out, or false with why ("cannot
+ * open", "larger than 4 GiB", "read error"). */
+bool read_file(const std::string &path, std::vector<unsigned char> &out, std::string *why);
 std::string pointer_token(const std::string &key);
 Value to_value(const json &j);
 json current_extras(const mlod_gltf &doc, const std::string &pointer, const Value &value);

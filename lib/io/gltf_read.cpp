@@ -43,19 +43,7 @@ static bool read_whole_file(std::vector<unsigned char> *out, std::string *err, c
 		*err = "not readable";
 		return false;
 	}
-	std::ifstream f(path, std::ios::binary | std::ios::ate);
-	std::streamoff size = f.tellg();
-	if (!f || size < 0 || uint64_t(size) > UINT32_MAX) {
-		*err = f ? "larger than 4 GiB" : "cannot open";
-		return false;
-	}
-	out->resize(size_t(size));
-	f.seekg(0);
-	if (size > 0 && !f.read(reinterpret_cast<char *>(out->data()), size)) {
-		*err = "read error";
-		return false;
-	}
-	return true;
+	return read_file(path, *out, err);
 }
 
 static bool refuse_write(std::string *err, const std::string &, const std::vector<unsigned char> &, void *)
@@ -310,17 +298,7 @@ void read_pack_document(mlod_gltf &doc, const unsigned char *d, size_t size)
 		else
 			buffers = std::move(kept);
 	}
-	std::string js = dump_json(j, -1);
-	js.append((4 - js.size() % 4) % 4, ' ');
-	std::string glb;
-	uint64_t total = 20 + uint64_t(js.size()) + bin.size();
-	if (total > UINT32_MAX)
-		fail(MLOD_ERR_LIMIT, "the glb would be larger than 4 GiB");
-	for (uint32_t v : {glb_magic, uint32_t(2), uint32_t(total), uint32_t(js.size()), chunk_json})
-		for (int k = 0; k < 4; k++)
-			glb += char(v >> (8 * k) & 0xFF);
-	glb += js;
-	glb += bin;
+	std::string glb = glb_bytes(j, bin);
 	read_document(doc, reinterpret_cast<const unsigned char *>(glb.data()), glb.size(), nullptr);
 }
 

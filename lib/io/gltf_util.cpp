@@ -146,6 +146,40 @@ std::string dump_json(const json &j, int indent)
 	return j.dump(indent);
 }
 
+std::string glb_bytes(const json &j, const std::string &bin_chunk)
+{
+	std::string text = dump_json(j, -1);
+	text.append((4 - text.size() % 4) % 4, ' ');
+	uint64_t total = 20 + uint64_t(text.size()) + bin_chunk.size();
+	if (total > UINT32_MAX)
+		fail(MLOD_ERR_LIMIT, "the glb would be larger than 4 GiB");
+	std::string out;
+	out.reserve(size_t(total));
+	for (uint32_t v : {glb_magic, uint32_t(2), uint32_t(total), uint32_t(text.size()), chunk_json})
+		for (int k = 0; k < 4; k++)
+			out += char(v >> (8 * k) & 0xFF);
+	out += text;
+	out += bin_chunk;
+	return out;
+}
+
+bool read_file(const std::string &path, std::vector<unsigned char> &out, std::string *why)
+{
+	std::ifstream f(path, std::ios::binary | std::ios::ate);
+	std::streamoff size = f.tellg();
+	if (!f || size < 0 || uint64_t(size) > UINT32_MAX) {
+		*why = f ? "larger than 4 GiB" : "cannot open";
+		return false;
+	}
+	out.resize(size_t(size));
+	f.seekg(0);
+	if (size > 0 && !f.read(reinterpret_cast<char *>(out.data()), size)) {
+		*why = "read error";
+		return false;
+	}
+	return true;
+}
+
 std::string pointer_token(const std::string &key)
 {
 	std::string t;

@@ -242,19 +242,7 @@ std::string serialize(const mlod_gltf &doc, bool binary)
 	if (!binary)
 		return dump_json(j, 2) + "\n";
 
-	std::string text = dump_json(j, -1);
-	text.append((4 - text.size() % 4) % 4, ' ');
-	uint64_t total = 20 + uint64_t(text.size()) + bin_chunk.size();
-	if (total > UINT32_MAX)
-		fail(MLOD_ERR_LIMIT, "the glb would be larger than 4 GiB");
-	std::string out;
-	out.reserve(size_t(total));
-	for (uint32_t v : {glb_magic, uint32_t(2), uint32_t(total), uint32_t(text.size()), chunk_json})
-		for (int k = 0; k < 4; k++)
-			out += char(v >> (8 * k) & 0xFF);
-	out += text;
-	out += bin_chunk;
-	return out;
+	return glb_bytes(j, bin_chunk);
 }
 
 } /* namespace mlod_gltf_internal */
