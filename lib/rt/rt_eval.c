@@ -1017,6 +1017,29 @@ static inline void widen(double *lo, double *hi, int i, double a, double b, doub
 	hi[i] = dmax(hi[i], b);
 }
 
+/* How far instance id's morph weights move a part's positions at most at
+ * mesh level mu: sum |w_t| times target t's longest delta, the largest
+ * such sum over the parts, which widens every ball (mlod_rt_bounds,
+ * mlod_rt_skin_stale). */
+static double morph_growth(const mlod_rt_ctx *ctx, const rt_unit *mu, uint32_t id)
+{
+	const mlod_pack_mesh *m = mu->mesh;
+	double grow = 0;
+	for (uint32_t i = 0; i < m->part_count && i < ctx->morph_parts; i++) {
+		uint32_t k = ctx->morph_offset[i + 1] - ctx->morph_offset[i];
+		const uint32_t have = mu->bound_morph_at[i + 1] - mu->bound_morph_at[i];
+		if (have < k)
+			k = have;
+		const float *w = ctx->morph_weights + (size_t)rt_slot(ctx, id) * ctx->morph_total + ctx->morph_offset[i];
+		const float *d = mu->bound_morph + mu->bound_morph_at[i];
+		double g = 0;
+		for (uint32_t t = 0; t < k; t++)
+			g += fabs((double)w[t]) * d[t];
+		grow = dmax(grow, g);
+	}
+	return grow;
+}
+
 /* The box of a set of points under the affine M (column-major), from its
  * bounds before M: centre c, half extents h of their box and, with r >= 0,
  * the radius of a ball about c that holds them. On axis i the centre is
@@ -1058,23 +1081,8 @@ mlod_result mlod_rt_bounds(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint32_t 
 	if (r != MLOD_OK || !mu)
 		return r;
 	const float *W = s->world;
-	/* Morph weights move a part's positions by at most sum |w_t| times
-	 * target t's longest delta: the largest such sum over the parts widens
-	 * every ball. */
 	const mlod_pack_mesh *m = mu->mesh;
-	double grow = 0;
-	for (uint32_t i = 0; i < m->part_count && i < ctx->morph_parts; i++) {
-		uint32_t k = ctx->morph_offset[i + 1] - ctx->morph_offset[i];
-		const uint32_t have = mu->bound_morph_at[i + 1] - mu->bound_morph_at[i];
-		if (have < k)
-			k = have;
-		const float *w = ctx->morph_weights + (size_t)rt_slot(ctx, id) * ctx->morph_total + ctx->morph_offset[i];
-		const float *d = mu->bound_morph + mu->bound_morph_at[i];
-		double g = 0;
-		for (uint32_t t = 0; t < k; t++)
-			g += fabs((double)w[t]) * d[t];
-		grow = dmax(grow, g);
-	}
+	const double grow = morph_growth(ctx, mu, id);
 	/* Skinned vertices: per palette entry, the box of its points' images
 	 * through the bind pose (the entry's matrix P on their bind-pose box and
 	 * ball) and, where the inverse bind B has an inverse, through the
@@ -1301,18 +1309,7 @@ mlod_result mlod_rt_skin_stale(const mlod_rt_ctx *ctx, mlod_rt_scratch *s, uint3
 		 * instance's distance: D pixels = D lines / (2 d tan(fov_y / 2)). */
 		const double px = (double)sel->lines / (2.0 * (double)st->distance * tan(0.5 * (double)sel->fov_y));
 		const double lim = (double)max_stale_pixels / px; /* d = 0: px infinite, lim 0 */
-		double grow = 0; /* morph weights (unchanged): as mlod_rt_bounds widens the balls */
-		for (uint32_t i = 0; i < m->part_count && i < ctx->morph_parts; i++) {
-			uint32_t k = ctx->morph_offset[i + 1] - ctx->morph_offset[i];
-			const uint32_t have = mu->bound_morph_at[i + 1] - mu->bound_morph_at[i];
-			if (have < k)
-				k = have;
-			const float *w = mw + ctx->morph_offset[i], *d = mu->bound_morph + mu->bound_morph_at[i];
-			double g = 0;
-			for (uint32_t t = 0; t < k; t++)
-				g += fabs((double)w[t]) * d[t];
-			grow = dmax(grow, g);
-		}
+		const double grow = morph_growth(ctx, mu, id); /* the weights are unchanged */
 		/* A skinned vertex is a convex combination of its entries' images:
 		 * it moved at most the most any of its entries' points moved. An
 		 * entry no vertex weighs (b[6] < 0) still multiplies: a matrix
