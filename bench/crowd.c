@@ -936,15 +936,17 @@ static void line(canvas *C, double x0, double y0, double x1, double y1, const un
 	}
 }
 
-/* One panel: up to 5 series of n points (x[k], y[k][s]; y <= 0: none),
- * in the box (bx, by, bw, bh) of the canvas, log or linear axes. */
+/* One panel: up to PANEL_SERIES series of n points (x[k], y[k][s]; y <= 0:
+ * none), in the box (bx, by, bw, bh) of the canvas, log or linear axes.
+ * Figure 15 draws full detail and every mode (MODES + 1, checked below). */
+#define PANEL_SERIES 8
 typedef struct panel {
 	const char *title, *xlabel, *ylabel;
 	int logx, logy;
 	int n, series;
-	double x[32], y[32][5];
-	const char *name[5];
-	const unsigned char *colour[5];
+	double x[32], y[32][PANEL_SERIES];
+	const char *name[PANEL_SERIES];
+	const unsigned char *colour[PANEL_SERIES];
 	const char *point_label[32]; /* written beside the first series' points, or NULL */
 } panel;
 
@@ -1132,6 +1134,7 @@ static void print_hist(const uint32_t *h, uint32_t levels)
 #define MODE_STALE 4 /* pixels at P, staleness Q (mlod_rt_skin_stale) */
 #define MODE_SPLIT 5 /* pixels at P / 2, staleness P / 2 */
 static const char *const mode_name[MODES] = { "alpha", "pixels", "toc", "skeleton", "stale", "split" };
+_Static_assert(MODES + 1 <= PANEL_SERIES, "figure 15's panel holds full detail and every mode");
 
 /* "alpha", "pixels", "toc", "skeleton", a comma list of them, or "all"
  * (every one): a bit per mode. */
