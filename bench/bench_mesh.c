@@ -506,8 +506,6 @@ static void quality(int argc, char **argv)
 	int tris[16][3], ok[16][3];
 	memset(ok, 0, sizeof ok);
 	for (int m = 0; m < nm; m++) {
-		if (getenv("Q_DEFAULT_ONLY") && ((m >= 1 && m <= 10) || (atoi(getenv("Q_DEFAULT_ONLY")) == 2 && m > 0)))
-			continue;
 		if (methods[m].kind == 2) {
 			for (int k = 0; k < 3; k++) {
 				mlod_character g;
@@ -544,7 +542,7 @@ static void quality(int argc, char **argv)
 				if (!ok[m][k])
 					printf(" | - | - | -");
 				else
-					printf(getenv("Q_DEFAULT_ONLY") ? " | %d | %.6f | %.5f" : " | %d | %.4f | %.3f", tris[m][k], res[m][set][k].mean, res[m][set][k].max);
+					printf(" | %d | %.4f | %.3f", tris[m][k], res[m][set][k].mean, res[m][set][k].max);
 			}
 			printf(" |\n");
 		}

@@ -288,8 +288,6 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 		goto done;
 	}
 	if (!g->heap.ready) {
-		extern double bgm_exp_last_pop; /* PROTOTYPE (lowerbound.c) */
-		bgm_exp_last_pop = HUGE_VAL;
 		g->heap.ready = 1;
 		g->swept = g->record_count;
 		g->heap.memo_free = -1;
@@ -326,10 +324,6 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 			continue;
 		}
 		heap_entry e = heap_pop(&g->heap);
-		{
-			extern double bgm_exp_last_pop; /* PROTOTYPE (lowerbound.c) */
-			bgm_exp_last_pop = e.key;
-		}
 		if (g->opstate[e.face] == DEAD) {
 			g->heap.dead -= g->heap.dead > 0;
 			memo_release(&g->heap, e.memo);

@@ -410,36 +410,6 @@ static void lbmemo_put(mlod_bgm *g, int a, int b, int c, double lb)
  * each pose's least error near where any of these placements can go,
  * whatever its weights. The fast cost (mlod_bgm_options.fast_cost) is the
  * pulled-back sum for every operation. */
-/* PROTOTYPE (branch chain): the pulled-back cost as a queue key. */
-double bgm_exp_last_pop = HUGE_VAL;
-
-static double exp_knob(const char *name)
-{
-	static double est = -1.0, h = -1.0; /* read once (a prototype: not thread-safe, unset is 0) */
-	double *k = name[8] == '_' ? &h : &est;
-	if (*k < 0.0) {
-		const char *e = getenv(name);
-		*k = e ? atof(e) : 0.0;
-	}
-	return *k;
-}
-
-static double fast_estimate(mlod_bgm *g, const int *v, int K, const double *const P[3], const double *bary)
-{
-	double Q[10] = {0}, x[3];
-	for (int j = 0; j < K; j++) {
-		const double *r = bgm_quadric_rest(g, v[j]);
-		for (int k = 0; k < 10; k++)
-			Q[k] += r[k];
-	}
-	double lb = bgm_quadric_eval(Q, bary);
-	for (int j = 0; j < K; j++)
-		lb = fmin(lb, bgm_quadric_eval(Q, P[j]));
-	if (bgm_quadric_solve(Q, bary, x) == 0)
-		lb = fmin(lb, bgm_quadric_eval(Q, x));
-	return lb > 0.0 ? lb : 0.0;
-}
-
 double bgm_lower_key(mlod_bgm *g, int f, int op, int *weak)
 {
 	const bgm_face *F = &g->faces[f];
@@ -535,16 +505,7 @@ double bgm_lower_key(mlod_bgm *g, int f, int op, int *weak)
 				gl += gr[i] * gr[i];
 			double t = bgm_quadric_eval(Q, xb) - 2.0 * sqrt(gl) * sqrt(lmax) * (1.0 + 1e-9);
 			lb = fmin(lb, t > 0.0 ? t : 0.0);
-			/* PROTOTYPE (branch chain, measured and left out): MLOD_EST=s
-			 * keys the operation at s times the pulled-back cost instead of
-			 * posed_min_bound; with MLOD_EST_H=h only where that cost over
-			 * wsum is above h times the key last popped. */
-			double est = exp_knob("MLOD_EST") > 0.0 ? fast_estimate(g, v, K, P, bary) : 0.0;
-			double h = exp_knob("MLOD_EST_H");
-			if (est > 0.0 && (h <= 0.0 || (wsum > 0.0 ? est / wsum : 0.0) > h * bgm_exp_last_pop))
-				lb = fmax(lb, (h > 0.0 ? 1.0 : exp_knob("MLOD_EST")) * est);
-			else
-				lb = fmax(lb, posed_min_bound(g, v, K, bary, sqrt(lmax)));
+			lb = fmax(lb, posed_min_bound(g, v, K, bary, sqrt(lmax)));
 		} else {
 			/* Barycenter and vertices: within the longest edge too. */
 			double lmax = 0.0;
