@@ -671,7 +671,6 @@ typedef struct target {
 	const bvh *like; /* the same triangles' tree at another pose, refitted (NULL: built) */
 	const unsigned char *degen; /* its triangles' degenerate_flags (NULL: made when needed) */
 	const unsigned char *used;  /* the vertices its triangles use (NULL: marked when needed) */
-	const double *centroid;     /* its triangles' centroids as sample_at makes them (NULL: made when needed) */
 } target;
 
 static mlod_result target_tree(const target *t, const bvh **out, mlod_error *err)
@@ -734,8 +733,7 @@ static void degenerate_flags(const mlod_posed *m, unsigned char *flags)
  * triangles' degenerate_flags, made once per mesh rather than per sample.
  * Returns how many exceed top (the candidates to search), counted as
  * they are made rather than in a pass of their own. */
-static long bound_distances(const mlod_posed *from, const unsigned char *used, const double *centroid,
-                            const mlod_posed *onto, const unsigned char *degen, const int *warm, double top,
+static long bound_distances(const mlod_posed *from, const unsigned char *used, const mlod_posed *onto, const unsigned char *degen, const int *warm, double top,
                             double *dist)
 {
 	long above = 0;
@@ -750,9 +748,6 @@ static long bound_distances(const mlod_posed *from, const unsigned char *used, c
 				continue;
 			}
 			p[0] = f[3 * i], p[1] = f[3 * i + 1], p[2] = f[3 * i + 2];
-		} else if (centroid) {
-			const double *q = centroid + 3 * (size_t)(i - nv);
-			p[0] = q[0], p[1] = q[1], p[2] = q[2];
 		} else {
 			const uint32_t *ix = from->indices + 3 * (size_t)(i - nv);
 			const float *u = f + 3 * (size_t)ix[0], *v = f + 3 * (size_t)ix[1], *w = f + 3 * (size_t)ix[2];
@@ -849,11 +844,10 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 	const target *onto[2] = { tb, ta };
 	const int *w[2] = { warm->a, warm->b };
 	long n[2] = { (long)m[0]->vertex_count + m[0]->triangle_count, (long)m[1]->vertex_count + m[1]->triangle_count };
-	/* a kept surface's used vertices and centroids are made once per pose, for every level */
+	/* a kept surface's used vertices are marked once per pose, for every level */
 	unsigned char *own[2] = { ta->used ? NULL : calloc((size_t)m[0]->vertex_count, 1),
 	                          tb->used ? NULL : calloc((size_t)m[1]->vertex_count, 1) };
 	const unsigned char *used[2] = { ta->used ? ta->used : own[0], tb->used ? tb->used : own[1] };
-	const double *centroid[2] = { ta->centroid, tb->centroid };
 	double *dist[2] = { malloc(sizeof(double) * (size_t)n[0]), malloc(sizeof(double) * (size_t)n[1]) };
 	unsigned char *made[2] = { NULL, NULL };
 	const unsigned char *degen[2] = { onto[0]->degen, onto[1]->degen };
@@ -870,7 +864,7 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 	for (int way = 0; way < 2; way++) {
 		for (long k = 0; own[way] && k < 3L * m[way]->triangle_count; k++)
 			own[way][m[way]->indices[k]] = 1;
-		candidates += bound_distances(m[way], used[way], centroid[way], onto[way]->mesh, degen[way], w[way], top,
+		candidates += bound_distances(m[way], used[way], onto[way]->mesh, degen[way], w[way], top,
 		                              dist[way]);
 	}
 	if (candidates > 0 && !(c = malloc(sizeof *c * (size_t)candidates))) {
@@ -953,7 +947,7 @@ static mlod_result both_ways(const target *ta, const mlod_posed *b, double diag,
 {
 	bvh tb = { 0 };
 	int b_built = 0;
-	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL, NULL, NULL, NULL };
+	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL, NULL, NULL };
 	const mlod_posed *a = ta->mesh;
 	const bvh *tree_a, *tree_b;
 	double sum = 0.0, max = 0.0;
@@ -996,7 +990,7 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	bvh ta = { 0 };
 	int built = 0;
-	const target onto_a = { a, &ta, &built, NULL, NULL, NULL, NULL, NULL };
+	const target onto_a = { a, &ta, &built, NULL, NULL, NULL, NULL };
 	r = both_ways(&onto_a, b, diag, NULL, out, err);
 	if (built)
 		bvh_free(&ta);
@@ -1015,11 +1009,17 @@ struct mlod_surface {
 	mlod_surface *like; /* mlod_surface_like */
 	double diag;
 	unsigned char *degen; /* its triangles' degenerate_flags, for every level's bounded measure */
-	unsigned char *used;  /* the vertices its triangles use, and */
-	double *centroid;     /* its triangles' centroids: its samples, for the same */
+	unsigned char *used;  /* the vertices its triangles use, for the same */
+	int borrowed;         /* mesh.indices are those of the surface it was made like */
 };
 
 mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_error *err)
+{
+	return mlod_surface_make_like(m, NULL, out, err);
+}
+
+mlod_result mlod_surface_make_like(const mlod_posed *m, const mlod_surface *like, mlod_surface **out,
+                                   mlod_error *err)
 {
 	mlod_result r;
 	*out = NULL;
@@ -1034,27 +1034,24 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 		s = NULL;
 	}
 	size_t pos = 3 * (size_t)m->vertex_count * sizeof *m->positions, ind = 3 * (size_t)m->triangle_count * sizeof *m->indices;
-	if (!s || !(s->mesh.positions = malloc(pos)) || !(s->mesh.indices = malloc(ind)) ||
-	    !(s->degen = malloc((size_t)m->triangle_count)) || !(s->used = calloc((size_t)m->vertex_count, 1)) ||
-	    !(s->centroid = malloc(3 * sizeof *s->centroid * (size_t)m->triangle_count))) {
+	if (s && like && like->mesh.triangle_count == m->triangle_count && !memcmp(like->mesh.indices, m->indices, ind)) {
+		s->mesh.indices = like->mesh.indices; /* the same mesh at another pose: one copy of its triangles */
+		s->borrowed = 1;
+	}
+	if (!s || !(s->mesh.positions = malloc(pos)) || (!s->borrowed && !(s->mesh.indices = malloc(ind))) ||
+	    !(s->degen = malloc((size_t)m->triangle_count)) || !(s->used = calloc((size_t)m->vertex_count, 1))) {
 		mlod_surface_free(s);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: out of memory");
 	}
 	memcpy(s->mesh.positions, m->positions, pos);
-	memcpy(s->mesh.indices, m->indices, ind);
+	if (!s->borrowed)
+		memcpy(s->mesh.indices, m->indices, ind);
 	s->mesh.vertex_count = m->vertex_count;
 	s->mesh.triangle_count = m->triangle_count;
 	s->diag = diag;
 	degenerate_flags(&s->mesh, s->degen);
 	for (long i = 0; i < 3L * m->triangle_count; i++)
 		s->used[m->indices[i]] = 1;
-	for (int t = 0; t < m->triangle_count; t++) {
-		const uint32_t *ix = m->indices + 3 * (size_t)t;
-		const float *u = m->positions + 3 * (size_t)ix[0], *v = m->positions + 3 * (size_t)ix[1],
-		            *w = m->positions + 3 * (size_t)ix[2];
-		for (int a = 0; a < 3; a++) /* as sample_at makes it */
-			s->centroid[3 * (size_t)t + a] = ((double)u[a] + v[a] + w[a]) / 3.0;
-	}
 	*out = s;
 	return MLOD_OK;
 }
@@ -1072,7 +1069,7 @@ mlod_result mlod_surface_build(mlod_surface *s, mlod_error *err)
 		like = s->like->built ? &s->like->tree : NULL;
 		pthread_mutex_unlock(&s->like->lock);
 	}
-	const target t = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used, s->centroid };
+	const target t = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used };
 	return target_tree(&t, &tree, err);
 }
 
@@ -1099,10 +1096,11 @@ void mlod_surface_free(mlod_surface *s)
 	if (s->built)
 		bvh_free(&s->tree);
 	pthread_mutex_destroy(&s->lock);
+	if (s->borrowed)
+		s->mesh.indices = NULL;
 	mlod_posed_free(&s->mesh);
 	free(s->degen);
 	free(s->used);
-	free(s->centroid);
 	free(s);
 }
 
@@ -1131,6 +1129,6 @@ mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b
 		like = s->like->built ? &s->like->tree : NULL;
 		pthread_mutex_unlock(&s->like->lock);
 	}
-	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used, s->centroid };
+	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used };
 	return both_ways(&onto_a, b, a->diag, warm, out, err);
 }
