@@ -25,10 +25,11 @@
  * at another pose) only when a search needs them, and the triangles'
  * degenerate flags are made once per mesh (a kept surface's once per
  * pose, for every level), not once per sample. A refitted hierarchy fits
- * its boxes from the mesh and fills a leaf's triangles (corners, plane)
- * only when a search first reaches that leaf: a bounded pose searches a
- * few hundred samples (mlod-bgm on the 50k-triangle tubeman: 18,145
- * searches in 48 level-poses), which reach few of its leaves. */
+ * its boxes from the mesh and keeps no triangles: a search makes a leaf's
+ * (corners, plane) from the mesh each time it reaches that leaf. A bounded
+ * pose searches a few hundred samples (mlod-bgm on the 50k-triangle
+ * tubeman: 18,145 searches in 48 level-poses), which reach few of its
+ * leaves, and kept triangles cost 120 bytes each per pose. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -76,14 +77,24 @@ struct mlod_bvh {
 	int *leaf;   /* the leaf holding each place of tris */
 	int tri_count;
 	int borrowed; /* order, place, parent and leaf belong to the tree this one was refitted from */
-	/* A refitted tree fills its leaves' triangles when a search first
-	 * reaches them (leaf_ready): a few hundred searches of a pose then
-	 * fill a few of its leaves, not all. filled: per node, 1 once its
-	 * triangles are (NULL: all are, as built); mesh: the positions they
-	 * come from; lock: held while filling, when searches share the tree. */
-	atomic_uchar *filled;
+	/* A refitted tree (tris NULL) makes a leaf's triangles from mesh
+	 * when a search first reaches it (leaf_tris), into blocks of its own
+	 * (leaf_tri: per node, NULL until then), under lock when searches
+	 * share the tree. A bounded pose searches a few hundred samples,
+	 * which reach a few of its leaves (mlod-bgm on the 207k-triangle
+	 * tubeman: 1.6-6.9% of them): room for all, as a built tree has,
+	 * would cost 120 bytes a triangle a pose. */
 	const mlod_posed *mesh;
+	_Atomic(tri *) *leaf_tri;
+	struct tri_block *blocks;
 	pthread_mutex_t *lock;
+};
+
+#define TRI_BLOCK 1024 /* triangles of a refitted tree's block */
+struct tri_block {
+	struct tri_block *next;
+	int used;
+	tri t[];
 };
 typedef struct mlod_bvh bvh;
 
@@ -330,19 +341,18 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 }
 
 /* The triangles of m in the tree's leaf order, with their normals. */
-static void fill_tri(const mlod_posed *m, bvh *out, int k);
+static void fill_tri(const mlod_posed *m, int face, tri *t);
 
 static void fill_tris(const mlod_posed *m, bvh *out)
 {
 	for (int k = 0; k < out->tri_count; k++)
-		fill_tri(m, out, k);
+		fill_tri(m, out->order[k], &out->tris[k]);
 }
 
-/* Place k of out's triangles, from m, with its normal. */
-static void fill_tri(const mlod_posed *m, bvh *out, int k)
+/* Triangle face of m into t, with its normal. */
+static void fill_tri(const mlod_posed *m, int face, tri *t)
 {
-	const uint32_t *ix = m->indices + 3 * (size_t)out->order[k];
-	tri *t = &out->tris[k];
+	const uint32_t *ix = m->indices + 3 * (size_t)face;
 	for (int a = 0; a < 3; a++) {
 		t->a[a] = m->positions[3 * (size_t)ix[0] + a];
 		t->b[a] = m->positions[3 * (size_t)ix[1] + a];
@@ -369,10 +379,9 @@ static mlod_result bvh_refit(const bvh *from, const mlod_posed *m, pthread_mutex
 {
 	memset(out, 0, sizeof *out);
 	out->nodes = malloc((size_t)from->node_count * sizeof *out->nodes);
-	out->tris = malloc((size_t)from->tri_count * sizeof *out->tris);
-	out->filled = calloc((size_t)from->node_count, sizeof *out->filled);
+	out->leaf_tri = calloc((size_t)from->node_count, sizeof *out->leaf_tri);
 	out->borrowed = 1;
-	if (!out->nodes || !out->tris || !out->filled)
+	if (!out->nodes || !out->leaf_tri)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", from->tri_count);
 	out->node_count = from->node_count;
 	out->tri_count = from->tri_count;
@@ -412,7 +421,12 @@ static void bvh_free(bvh *b)
 {
 	free(b->nodes);
 	free(b->tris);
-	free(b->filled);
+	free(b->leaf_tri);
+	while (b->blocks) {
+		struct tri_block *next = b->blocks->next;
+		free(b->blocks);
+		b->blocks = next;
+	}
 	if (!b->borrowed) {
 		free(b->order);
 		free(b->place);
@@ -474,23 +488,44 @@ static inline double plane_dist2(const double *p, double p1, const tri *t)
 	return d > 0.0 ? d * d : 0.0;
 }
 
-/* Makes sure the triangles of leaf at are filled (a refitted tree's
- * are filled when first searched): under the tree's lock when it has
- * one, each leaf once. */
-static inline void leaf_ready(const bvh *b, int at)
+/* A refitted tree's leaf at, its triangles made from its mesh (as a
+ * built tree's are) into its blocks, each leaf once; into buf (LEAF_SIZE
+ * of them), not kept, when there is no memory for a block. */
+static const tri *leaf_fill(const bvh *b, int at, tri *buf)
 {
-	if (!b->filled || atomic_load_explicit(&b->filled[at], memory_order_acquire))
-		return;
+	bvh *w = (bvh *)b; /* only the blocks and leaf_tri change, under the lock */
+	const node *n = &b->nodes[at];
 	if (b->lock)
 		pthread_mutex_lock(b->lock);
-	if (!atomic_load_explicit(&b->filled[at], memory_order_relaxed)) {
-		const node *n = &b->nodes[at];
-		for (int k = n->first; k < n->first + n->count; k++)
-			fill_tri(b->mesh, (bvh *)b, k); /* only its triangles change, this once */
-		atomic_store_explicit(&b->filled[at], 1, memory_order_release);
+	tri *t = atomic_load_explicit(&b->leaf_tri[at], memory_order_relaxed);
+	if (!t) {
+		struct tri_block *k = b->blocks;
+		if (!k || k->used + n->count > TRI_BLOCK) {
+			k = malloc(sizeof *k + TRI_BLOCK * sizeof k->t[0]);
+			if (k)
+				k->next = b->blocks, k->used = 0, w->blocks = k;
+		}
+		t = k ? k->t + k->used : buf;
+		for (int i = 0; i < n->count; i++)
+			fill_tri(b->mesh, b->order[n->first + i], &t[i]);
+		if (k) {
+			k->used += n->count;
+			atomic_store_explicit(&w->leaf_tri[at], t, memory_order_release);
+		}
 	}
 	if (b->lock)
 		pthread_mutex_unlock(b->lock);
+	return t;
+}
+
+/* The triangles of leaf at, place k at [k - its first]: a built tree's
+ * own, a refitted tree's made when first needed (leaf_fill). */
+static inline const tri *leaf_tris(const bvh *b, int at, tri *buf)
+{
+	if (b->tris)
+		return b->tris + b->nodes[at].first;
+	const tri *t = atomic_load_explicit(&b->leaf_tri[at], memory_order_acquire);
+	return t ? t : leaf_fill(b, at, buf);
 }
 
 /* The nearest triangle in the subtree at node at (at_d2: p's squared
@@ -502,6 +537,7 @@ static double subtree_nearest2(const bvh *b, const double *p, double p1, int at,
                                int *hint)
 {
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
+	tri buf[LEAF_SIZE];
 	int top = 0;
 	for (;;) {
 		const node *n = &b->nodes[at];
@@ -517,16 +553,16 @@ static double subtree_nearest2(const bvh *b, const double *p, double p1, int at,
 			at = near, at_d2 = dnear;
 			continue;
 		}
-		if (at_d2 < best)
-			leaf_ready(b, at);
-		if (at_d2 < best)
-			for (int k = n->first; k < n->first + n->count; k++) {
-				if (k == skip || plane_dist2(p, p1, &b->tris[k]) >= best)
+		if (at_d2 < best) {
+			const tri *t = leaf_tris(b, at, buf);
+			for (int i = 0, k = n->first; i < n->count; i++, k++) {
+				if (k == skip || plane_dist2(p, p1, &t[i]) >= best)
 					continue;
-				double d = triangle_dist2(p, &b->tris[k]);
+				double d = triangle_dist2(p, &t[i]);
 				if (d < best)
 					best = d, *hint = k;
 			}
+		}
 		if (top == 0)
 			return best;
 		--top;
@@ -545,9 +581,9 @@ static double subtree_nearest2(const bvh *b, const double *p, double p1, int at,
 static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 {
 	const int start = *hint; /* measured here, so skipped in its leaf */
-	leaf_ready(b, b->leaf[start]);
-	double best = triangle_dist2(p, &b->tris[start]);
 	int at = b->leaf[start];
+	tri buf[LEAF_SIZE];
+	double best = triangle_dist2(p, &leaf_tris(b, at, buf)[start - b->nodes[at].first]);
 	const double p1 = fabs(p[0]) + fabs(p[1]) + fabs(p[2]);
 	best = subtree_nearest2(b, p, p1, at, 0.0, best, start, hint);
 	for (int up = b->parent[at]; up >= 0; at = up, up = b->parent[up]) {
