@@ -25,10 +25,11 @@
  * at another pose) only when a search needs them, and the triangles'
  * degenerate flags are made once per mesh (a kept surface's once per
  * pose, for every level), not once per sample. A refitted hierarchy fits
- * its boxes from the mesh and fills a leaf's triangles (corners, plane)
- * only when a search first reaches that leaf: a bounded pose searches a
- * few hundred samples (mlod-bgm on the 50k-triangle tubeman: 18,145
- * searches in 48 level-poses), which reach few of its leaves. */
+ * its boxes from the mesh and keeps no triangles: a search makes a leaf's
+ * (corners, plane) from the mesh each time it reaches that leaf. A bounded
+ * pose searches a few hundred samples (mlod-bgm on the 50k-triangle
+ * tubeman: 18,145 searches in 48 level-poses), which reach few of its
+ * leaves, and kept triangles cost 120 bytes each per pose. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -76,14 +77,24 @@ struct mlod_bvh {
 	int *leaf;   /* the leaf holding each place of tris */
 	int tri_count;
 	int borrowed; /* order, place, parent and leaf belong to the tree this one was refitted from */
-	/* A refitted tree fills its leaves' triangles when a search first
-	 * reaches them (leaf_ready): a few hundred searches of a pose then
-	 * fill a few of its leaves, not all. filled: per node, 1 once its
-	 * triangles are (NULL: all are, as built); mesh: the positions they
-	 * come from; lock: held while filling, when searches share the tree. */
-	atomic_uchar *filled;
+	/* A refitted tree (tris NULL) makes a leaf's triangles from mesh
+	 * when a search first reaches it (leaf_tris), into blocks of its own
+	 * (leaf_tri: per node, NULL until then), under lock when searches
+	 * share the tree. A bounded pose searches a few hundred samples,
+	 * which reach a few of its leaves (mlod-bgm on the 207k-triangle
+	 * tubeman: 1.6-6.9% of them): room for all, as a built tree has,
+	 * would cost 120 bytes a triangle a pose. */
 	const mlod_posed *mesh;
+	_Atomic(tri *) *leaf_tri;
+	struct tri_block *blocks;
 	pthread_mutex_t *lock;
+};
+
+#define TRI_BLOCK 1024 /* triangles of a refitted tree's block */
+struct tri_block {
+	struct tri_block *next;
+	int used;
+	tri t[];
 };
 typedef struct mlod_bvh bvh;
 
@@ -330,19 +341,18 @@ static mlod_result bvh_build(const mlod_posed *m, bvh *out, mlod_error *err)
 }
 
 /* The triangles of m in the tree's leaf order, with their normals. */
-static void fill_tri(const mlod_posed *m, bvh *out, int k);
+static void fill_tri(const mlod_posed *m, int face, tri *t);
 
 static void fill_tris(const mlod_posed *m, bvh *out)
 {
 	for (int k = 0; k < out->tri_count; k++)
-		fill_tri(m, out, k);
+		fill_tri(m, out->order[k], &out->tris[k]);
 }
 
-/* Place k of out's triangles, from m, with its normal. */
-static void fill_tri(const mlod_posed *m, bvh *out, int k)
+/* Triangle face of m into t, with its normal. */
+static void fill_tri(const mlod_posed *m, int face, tri *t)
 {
-	const uint32_t *ix = m->indices + 3 * (size_t)out->order[k];
-	tri *t = &out->tris[k];
+	const uint32_t *ix = m->indices + 3 * (size_t)face;
 	for (int a = 0; a < 3; a++) {
 		t->a[a] = m->positions[3 * (size_t)ix[0] + a];
 		t->b[a] = m->positions[3 * (size_t)ix[1] + a];
@@ -369,10 +379,9 @@ static mlod_result bvh_refit(const bvh *from, const mlod_posed *m, pthread_mutex
 {
 	memset(out, 0, sizeof *out);
 	out->nodes = malloc((size_t)from->node_count * sizeof *out->nodes);
-	out->tris = malloc((size_t)from->tri_count * sizeof *out->tris);
-	out->filled = calloc((size_t)from->node_count, sizeof *out->filled);
+	out->leaf_tri = calloc((size_t)from->node_count, sizeof *out->leaf_tri);
 	out->borrowed = 1;
-	if (!out->nodes || !out->tris || !out->filled)
+	if (!out->nodes || !out->leaf_tri)
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: cannot allocate a hierarchy of %d triangles", from->tri_count);
 	out->node_count = from->node_count;
 	out->tri_count = from->tri_count;
@@ -412,7 +421,12 @@ static void bvh_free(bvh *b)
 {
 	free(b->nodes);
 	free(b->tris);
-	free(b->filled);
+	free(b->leaf_tri);
+	while (b->blocks) {
+		struct tri_block *next = b->blocks->next;
+		free(b->blocks);
+		b->blocks = next;
+	}
 	if (!b->borrowed) {
 		free(b->order);
 		free(b->place);
@@ -474,23 +488,44 @@ static inline double plane_dist2(const double *p, double p1, const tri *t)
 	return d > 0.0 ? d * d : 0.0;
 }
 
-/* Makes sure the triangles of leaf at are filled (a refitted tree's
- * are filled when first searched): under the tree's lock when it has
- * one, each leaf once. */
-static inline void leaf_ready(const bvh *b, int at)
+/* A refitted tree's leaf at, its triangles made from its mesh (as a
+ * built tree's are) into its blocks, each leaf once; into buf (LEAF_SIZE
+ * of them), not kept, when there is no memory for a block. */
+static const tri *leaf_fill(const bvh *b, int at, tri *buf)
 {
-	if (!b->filled || atomic_load_explicit(&b->filled[at], memory_order_acquire))
-		return;
+	bvh *w = (bvh *)b; /* only the blocks and leaf_tri change, under the lock */
+	const node *n = &b->nodes[at];
 	if (b->lock)
 		pthread_mutex_lock(b->lock);
-	if (!atomic_load_explicit(&b->filled[at], memory_order_relaxed)) {
-		const node *n = &b->nodes[at];
-		for (int k = n->first; k < n->first + n->count; k++)
-			fill_tri(b->mesh, (bvh *)b, k); /* only its triangles change, this once */
-		atomic_store_explicit(&b->filled[at], 1, memory_order_release);
+	tri *t = atomic_load_explicit(&b->leaf_tri[at], memory_order_relaxed);
+	if (!t) {
+		struct tri_block *k = b->blocks;
+		if (!k || k->used + n->count > TRI_BLOCK) {
+			k = malloc(sizeof *k + TRI_BLOCK * sizeof k->t[0]);
+			if (k)
+				k->next = b->blocks, k->used = 0, w->blocks = k;
+		}
+		t = k ? k->t + k->used : buf;
+		for (int i = 0; i < n->count; i++)
+			fill_tri(b->mesh, b->order[n->first + i], &t[i]);
+		if (k) {
+			k->used += n->count;
+			atomic_store_explicit(&w->leaf_tri[at], t, memory_order_release);
+		}
 	}
 	if (b->lock)
 		pthread_mutex_unlock(b->lock);
+	return t;
+}
+
+/* The triangles of leaf at, place k at [k - its first]: a built tree's
+ * own, a refitted tree's made when first needed (leaf_fill). */
+static inline const tri *leaf_tris(const bvh *b, int at, tri *buf)
+{
+	if (b->tris)
+		return b->tris + b->nodes[at].first;
+	const tri *t = atomic_load_explicit(&b->leaf_tri[at], memory_order_acquire);
+	return t ? t : leaf_fill(b, at, buf);
 }
 
 /* The nearest triangle in the subtree at node at (at_d2: p's squared
@@ -502,6 +537,7 @@ static double subtree_nearest2(const bvh *b, const double *p, double p1, int at,
                                int *hint)
 {
 	struct { int node; double d2; } stack[MAX_DEPTH + 1];
+	tri buf[LEAF_SIZE];
 	int top = 0;
 	for (;;) {
 		const node *n = &b->nodes[at];
@@ -517,16 +553,16 @@ static double subtree_nearest2(const bvh *b, const double *p, double p1, int at,
 			at = near, at_d2 = dnear;
 			continue;
 		}
-		if (at_d2 < best)
-			leaf_ready(b, at);
-		if (at_d2 < best)
-			for (int k = n->first; k < n->first + n->count; k++) {
-				if (k == skip || plane_dist2(p, p1, &b->tris[k]) >= best)
+		if (at_d2 < best) {
+			const tri *t = leaf_tris(b, at, buf);
+			for (int i = 0, k = n->first; i < n->count; i++, k++) {
+				if (k == skip || plane_dist2(p, p1, &t[i]) >= best)
 					continue;
-				double d = triangle_dist2(p, &b->tris[k]);
+				double d = triangle_dist2(p, &t[i]);
 				if (d < best)
 					best = d, *hint = k;
 			}
+		}
 		if (top == 0)
 			return best;
 		--top;
@@ -545,9 +581,9 @@ static double subtree_nearest2(const bvh *b, const double *p, double p1, int at,
 static double bvh_nearest2(const bvh *b, const double *p, int *hint)
 {
 	const int start = *hint; /* measured here, so skipped in its leaf */
-	leaf_ready(b, b->leaf[start]);
-	double best = triangle_dist2(p, &b->tris[start]);
 	int at = b->leaf[start];
+	tri buf[LEAF_SIZE];
+	double best = triangle_dist2(p, &leaf_tris(b, at, buf)[start - b->nodes[at].first]);
 	const double p1 = fabs(p[0]) + fabs(p[1]) + fabs(p[2]);
 	best = subtree_nearest2(b, p, p1, at, 0.0, best, start, hint);
 	for (int up = b->parent[at]; up >= 0; at = up, up = b->parent[up]) {
@@ -671,7 +707,6 @@ typedef struct target {
 	const bvh *like; /* the same triangles' tree at another pose, refitted (NULL: built) */
 	const unsigned char *degen; /* its triangles' degenerate_flags (NULL: made when needed) */
 	const unsigned char *used;  /* the vertices its triangles use (NULL: marked when needed) */
-	const double *centroid;     /* its triangles' centroids as sample_at makes them (NULL: made when needed) */
 } target;
 
 static mlod_result target_tree(const target *t, const bvh **out, mlod_error *err)
@@ -734,8 +769,7 @@ static void degenerate_flags(const mlod_posed *m, unsigned char *flags)
  * triangles' degenerate_flags, made once per mesh rather than per sample.
  * Returns how many exceed top (the candidates to search), counted as
  * they are made rather than in a pass of their own. */
-static long bound_distances(const mlod_posed *from, const unsigned char *used, const double *centroid,
-                            const mlod_posed *onto, const unsigned char *degen, const int *warm, double top,
+static long bound_distances(const mlod_posed *from, const unsigned char *used, const mlod_posed *onto, const unsigned char *degen, const int *warm, double top,
                             double *dist)
 {
 	long above = 0;
@@ -750,9 +784,6 @@ static long bound_distances(const mlod_posed *from, const unsigned char *used, c
 				continue;
 			}
 			p[0] = f[3 * i], p[1] = f[3 * i + 1], p[2] = f[3 * i + 2];
-		} else if (centroid) {
-			const double *q = centroid + 3 * (size_t)(i - nv);
-			p[0] = q[0], p[1] = q[1], p[2] = q[2];
 		} else {
 			const uint32_t *ix = from->indices + 3 * (size_t)(i - nv);
 			const float *u = f + 3 * (size_t)ix[0], *v = f + 3 * (size_t)ix[1], *w = f + 3 * (size_t)ix[2];
@@ -849,11 +880,10 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 	const target *onto[2] = { tb, ta };
 	const int *w[2] = { warm->a, warm->b };
 	long n[2] = { (long)m[0]->vertex_count + m[0]->triangle_count, (long)m[1]->vertex_count + m[1]->triangle_count };
-	/* a kept surface's used vertices and centroids are made once per pose, for every level */
+	/* a kept surface's used vertices are marked once per pose, for every level */
 	unsigned char *own[2] = { ta->used ? NULL : calloc((size_t)m[0]->vertex_count, 1),
 	                          tb->used ? NULL : calloc((size_t)m[1]->vertex_count, 1) };
 	const unsigned char *used[2] = { ta->used ? ta->used : own[0], tb->used ? tb->used : own[1] };
-	const double *centroid[2] = { ta->centroid, tb->centroid };
 	double *dist[2] = { malloc(sizeof(double) * (size_t)n[0]), malloc(sizeof(double) * (size_t)n[1]) };
 	unsigned char *made[2] = { NULL, NULL };
 	const unsigned char *degen[2] = { onto[0]->degen, onto[1]->degen };
@@ -870,7 +900,7 @@ static mlod_result measure_bound(const target *ta, const target *tb, const mlod_
 	for (int way = 0; way < 2; way++) {
 		for (long k = 0; own[way] && k < 3L * m[way]->triangle_count; k++)
 			own[way][m[way]->indices[k]] = 1;
-		candidates += bound_distances(m[way], used[way], centroid[way], onto[way]->mesh, degen[way], w[way], top,
+		candidates += bound_distances(m[way], used[way], onto[way]->mesh, degen[way], w[way], top,
 		                              dist[way]);
 	}
 	if (candidates > 0 && !(c = malloc(sizeof *c * (size_t)candidates))) {
@@ -953,7 +983,7 @@ static mlod_result both_ways(const target *ta, const mlod_posed *b, double diag,
 {
 	bvh tb = { 0 };
 	int b_built = 0;
-	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL, NULL, NULL, NULL };
+	const target onto_b = { b, &tb, &b_built, NULL, warm && !warm->record ? warm->b_tree : NULL, NULL, NULL };
 	const mlod_posed *a = ta->mesh;
 	const bvh *tree_a, *tree_b;
 	double sum = 0.0, max = 0.0;
@@ -996,7 +1026,7 @@ mlod_result mlod_surface_deviation(const mlod_posed *a, const mlod_posed *b,
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "deviation: mesh a has no extent (all its vertices coincide)");
 	bvh ta = { 0 };
 	int built = 0;
-	const target onto_a = { a, &ta, &built, NULL, NULL, NULL, NULL, NULL };
+	const target onto_a = { a, &ta, &built, NULL, NULL, NULL, NULL };
 	r = both_ways(&onto_a, b, diag, NULL, out, err);
 	if (built)
 		bvh_free(&ta);
@@ -1015,11 +1045,17 @@ struct mlod_surface {
 	mlod_surface *like; /* mlod_surface_like */
 	double diag;
 	unsigned char *degen; /* its triangles' degenerate_flags, for every level's bounded measure */
-	unsigned char *used;  /* the vertices its triangles use, and */
-	double *centroid;     /* its triangles' centroids: its samples, for the same */
+	unsigned char *used;  /* the vertices its triangles use, for the same */
+	int borrowed;         /* mesh.indices are those of the surface it was made like */
 };
 
 mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_error *err)
+{
+	return mlod_surface_make_like(m, NULL, out, err);
+}
+
+mlod_result mlod_surface_make_like(const mlod_posed *m, const mlod_surface *like, mlod_surface **out,
+                                   mlod_error *err)
 {
 	mlod_result r;
 	*out = NULL;
@@ -1034,27 +1070,24 @@ mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_erro
 		s = NULL;
 	}
 	size_t pos = 3 * (size_t)m->vertex_count * sizeof *m->positions, ind = 3 * (size_t)m->triangle_count * sizeof *m->indices;
-	if (!s || !(s->mesh.positions = malloc(pos)) || !(s->mesh.indices = malloc(ind)) ||
-	    !(s->degen = malloc((size_t)m->triangle_count)) || !(s->used = calloc((size_t)m->vertex_count, 1)) ||
-	    !(s->centroid = malloc(3 * sizeof *s->centroid * (size_t)m->triangle_count))) {
+	if (s && like && like->mesh.triangle_count == m->triangle_count && !memcmp(like->mesh.indices, m->indices, ind)) {
+		s->mesh.indices = like->mesh.indices; /* the same mesh at another pose: one copy of its triangles */
+		s->borrowed = 1;
+	}
+	if (!s || !(s->mesh.positions = malloc(pos)) || (!s->borrowed && !(s->mesh.indices = malloc(ind))) ||
+	    !(s->degen = malloc((size_t)m->triangle_count)) || !(s->used = calloc((size_t)m->vertex_count, 1))) {
 		mlod_surface_free(s);
 		return mlod_fail(err, MLOD_ERR_NOMEM, "deviation: out of memory");
 	}
 	memcpy(s->mesh.positions, m->positions, pos);
-	memcpy(s->mesh.indices, m->indices, ind);
+	if (!s->borrowed)
+		memcpy(s->mesh.indices, m->indices, ind);
 	s->mesh.vertex_count = m->vertex_count;
 	s->mesh.triangle_count = m->triangle_count;
 	s->diag = diag;
 	degenerate_flags(&s->mesh, s->degen);
 	for (long i = 0; i < 3L * m->triangle_count; i++)
 		s->used[m->indices[i]] = 1;
-	for (int t = 0; t < m->triangle_count; t++) {
-		const uint32_t *ix = m->indices + 3 * (size_t)t;
-		const float *u = m->positions + 3 * (size_t)ix[0], *v = m->positions + 3 * (size_t)ix[1],
-		            *w = m->positions + 3 * (size_t)ix[2];
-		for (int a = 0; a < 3; a++) /* as sample_at makes it */
-			s->centroid[3 * (size_t)t + a] = ((double)u[a] + v[a] + w[a]) / 3.0;
-	}
 	*out = s;
 	return MLOD_OK;
 }
@@ -1072,7 +1105,7 @@ mlod_result mlod_surface_build(mlod_surface *s, mlod_error *err)
 		like = s->like->built ? &s->like->tree : NULL;
 		pthread_mutex_unlock(&s->like->lock);
 	}
-	const target t = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used, s->centroid };
+	const target t = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used };
 	return target_tree(&t, &tree, err);
 }
 
@@ -1099,10 +1132,11 @@ void mlod_surface_free(mlod_surface *s)
 	if (s->built)
 		bvh_free(&s->tree);
 	pthread_mutex_destroy(&s->lock);
+	if (s->borrowed)
+		s->mesh.indices = NULL;
 	mlod_posed_free(&s->mesh);
 	free(s->degen);
 	free(s->used);
-	free(s->centroid);
 	free(s);
 }
 
@@ -1131,6 +1165,6 @@ mlod_result mlod_surface_deviation_to(const mlod_surface *a, const mlod_posed *b
 		like = s->like->built ? &s->like->tree : NULL;
 		pthread_mutex_unlock(&s->like->lock);
 	}
-	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used, s->centroid };
+	const target onto_a = { &s->mesh, &s->tree, &s->built, &s->lock, like, s->degen, s->used };
 	return both_ways(&onto_a, b, a->diag, warm, out, err);
 }

@@ -129,6 +129,11 @@ mlod_result mlod_posed_errors(const mlod_character *full, const mlod_character *
  * posed at each call). Nothing is kept in a set made by hand. */
 mlod_result mlod_pose_set_keep(const mlod_pose_set *s, const mlod_character *full, int k, mlod_error *err);
 
+/* Frees what s keeps (the posed full characters and their hierarchies,
+ * those of mlod_pose_set_keep too): a later mlod_posed_error poses and
+ * keeps them again, with the same results. Not while another call uses s. */
+void mlod_pose_set_forget(const mlod_pose_set *s);
+
 
 /* ------------------------------------------------------------------ */
 /* Levels within an error bound (bound.c)                              */

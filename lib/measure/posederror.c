@@ -82,12 +82,23 @@ static struct mlod_pose_cache *cache_make(int count)
 	return c;
 }
 
+/* Frees the kept full characters, the last pose first (the others share
+ * pose 0's triangles and refit its hierarchy), and what was known of them. */
+static void cache_clear(struct mlod_pose_cache *c)
+{
+	for (int k = c->count - 1; k >= 0; k--) {
+		mlod_surface_free(c->full[k]);
+		c->full[k] = NULL;
+		c->linked[k] = 0;
+		c->owner[k] = NULL;
+	}
+}
+
 static void cache_free(struct mlod_pose_cache *c)
 {
 	if (!c)
 		return;
-	for (int k = 0; k < c->count; k++)
-		mlod_surface_free(c->full[k]);
+	cache_clear(c);
 	free(c->full);
 	free(c->linked);
 	free(c->owner);
@@ -104,12 +115,14 @@ static mlod_result cache_keep(struct mlod_pose_cache *c, int k, const mlod_posed
                               mlod_error *err)
 {
 	pthread_mutex_lock(&c->lock);
-	mlod_surface *s = c->full[k];
+	mlod_surface *s = c->full[k], *first = c->full[0];
 	pthread_mutex_unlock(&c->lock);
 	*out = NULL;
 	if (!s && a) {
+		/* after the first pose, its triangles shared when they are a's
+		 * (pose 0 is freed last) */
 		mlod_surface *made;
-		mlod_result r = mlod_surface_make(a, &made, err);
+		mlod_result r = mlod_surface_make_like(a, k > 0 ? first : NULL, &made, err);
 		if (r != MLOD_OK)
 			return r;
 		pthread_mutex_lock(&c->lock);
@@ -265,6 +278,12 @@ done:
 	if (r != MLOD_OK)
 		mlod_pose_set_free(out);
 	return r;
+}
+
+void mlod_pose_set_forget(const mlod_pose_set *s)
+{
+	if (s && s->cache)
+		cache_clear(s->cache);
 }
 
 void mlod_pose_set_bound_mean(mlod_pose_set *s, int on)

@@ -14,6 +14,12 @@ typedef struct mlod_surface mlod_surface;
 /* A copy of m with its hierarchy; fails, with the message
  * mlod_surface_deviation gives for such a mesh a, when m cannot be one. */
 mlod_result mlod_surface_make(const mlod_posed *m, mlod_surface **out, mlod_error *err);
+/* The same; when like (NULL: none) holds m's triangles, byte for byte,
+ * the copy shares like's instead of copying them: like must then outlive
+ * it (the same mesh at another pose: a pose set's kept full character,
+ * whose triangles every pose has). */
+mlod_result mlod_surface_make_like(const mlod_posed *m, const mlod_surface *like, mlod_surface **out,
+                                   mlod_error *err);
 void mlod_surface_free(mlod_surface *s);
 
 /* s's hierarchy, when a search needs it, is then like's refitted to s's

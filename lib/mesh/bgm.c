@@ -879,6 +879,38 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g);
 }
 
+void bgm_release_collapse_state(mlod_bgm *g)
+{
+	if (!g)
+		return;
+	free(g->quadric);
+	free(g->qmap);
+	free(g->qpose);
+	free(g->rquad);
+	free(g->qsum);
+	free(g->skin);
+	free(g->skin2);
+	free(g->opstate);
+	free(g->ftie);
+	free(g->fgeo);
+	free(g->fref);
+	free(g->lbmemo);
+	free(g->heap.e);
+	free(g->heap.memo);
+	g->quadric = g->rquad = g->qsum = g->skin2 = NULL;
+	g->qmap = g->qpose = NULL;
+	g->skin = NULL;
+	g->opstate = NULL;
+	g->ftie = g->fgeo = g->fref = NULL;
+	g->lbmemo = NULL;
+	g->heap.e = NULL;
+	g->heap.memo = NULL;
+	g->quadric_cap = g->opstate_cap = g->ftie_cap = 0;
+	g->lbmemo_count = g->lbmemo_cap = 0;
+	g->heap.count = g->heap.cap = 0;
+	g->heap.memo_count = g->heap.memo_cap = g->heap.memo_free = 0;
+}
+
 void mlod_bgm_get_info(const mlod_bgm *g, mlod_bgm_info *out)
 {
 	memset(out, 0, sizeof *out);

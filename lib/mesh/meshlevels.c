@@ -199,8 +199,14 @@ static mlod_result part_one(void *ctx, int k)
 		return MLOD_OK;
 	mlod_result r = mlod_bgm_build(L->c, i, p, &L->opt, &pt->bgm, &j->errs[k]);
 	if (r == MLOD_OK && !j->defer) {
-		int target = j->min_ratio > 0.0 ? (int)ceil(j->min_ratio * pt->triangles) : 0;
+		/* A character budget may take any primitive further than the
+		 * ratio: its chain goes as far as it goes (the same collapses as
+		 * stopping at the ratio and going on after). Either way the chain
+		 * is then final, and what only the collapses use is freed. */
+		int target = j->min_ratio > 0.0 && L->budget != MLOD_BUDGET_CHARACTER ? (int)ceil(j->min_ratio * pt->triangles)
+		                                                                      : 0;
 		r = mlod_bgm_simplify(pt->bgm, target, 0, &j->errs[k]);
+		bgm_release_collapse_state(pt->bgm);
 	}
 	/* an unsupported primitive is skipped, not an error of the whole */
 	j->result[k] = r;
@@ -221,16 +227,6 @@ static mlod_result part_or_poses(void *ctx, int k)
 		return part_one(ctx, k);
 	for (int p = 0; p < j->L->measure.count; p++)
 		mlod_pose_set_keep(&j->L->measure, j->L->c, p, NULL);
-	return MLOD_OK;
-}
-
-/* A part simplified as far as it goes (the character budget). */
-static mlod_result part_further(void *ctx, int k)
-{
-	part_job *j = ctx;
-	mlod_mesh_part *pt = &j->L->parts[j->part[2 * k]][j->part[2 * k + 1]];
-	if (pt->bgm)
-		j->result[k] = mlod_bgm_simplify(pt->bgm, 0, 0, &j->errs[k]);
 	return MLOD_OK;
 }
 
@@ -319,21 +315,6 @@ mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, 
 	if (j.defer && L->simplified == 1) {
 		L->chain_pending = 1;
 		L->chain_ratio = min_ratio;
-	}
-	/* A character budget may take any primitive further than the ratio. */
-	if (L->budget == MLOD_BUDGET_CHARACTER && min_ratio > 0.0 && !j.defer) {
-		j.min_ratio = 0.0;
-		for (int k = 0; k < n; k++)
-			j.result[k] = MLOD_OK;
-		mlod_parallel_for(n, L->opt.threads, part_further, &j);
-		for (int k = 0; k < n; k++)
-			if (j.result[k] != MLOD_OK) {
-				if (err)
-					*err = j.errs[k];
-				r = j.result[k];
-				part_job_free(&j);
-				return r;
-			}
 	}
 	part_job_free(&j);
 	if (L->statics)
@@ -568,7 +549,10 @@ static mlod_result chain_finish(mlod_mesh_levels *L, mlod_error *err)
 	if (!L->chain_pending)
 		return MLOD_OK;
 	L->chain_pending = 0;
-	return chain_to(L, pending_part(L), 0.0, err);
+	mlod_mesh_part *pt = pending_part(L);
+	mlod_result r = chain_to(L, pt, 0.0, err);
+	bgm_release_collapse_state(pt->bgm); /* the chain is final */
+	return r;
 }
 
 /* Extracts the level at ratio, after the previous ones: 1 kept (in
@@ -629,6 +613,7 @@ static void pipe_chain(pipe_job *pj)
 	}
 	if (r == MLOD_OK)
 		r = chain_to(L, pt, 0.0, &pj->chain_err);
+	bgm_release_collapse_state(pt->bgm); /* the chain is final */
 	pthread_mutex_lock(&pj->lock);
 	pj->chain_r = r;
 	pj->done = 1;
@@ -698,7 +683,22 @@ static mlod_result by_ratio_pipelined(mlod_mesh_levels *L, const double *ratios,
 	return r;
 }
 
+/* The levels are measured: the full character posed at every measuring
+ * pose is let go (a later call poses it again, with the same results). */
+static mlod_result measured(mlod_mesh_levels *L, mlod_result r)
+{
+	mlod_pose_set_forget(&L->measure);
+	return r;
+}
+
+static mlod_result by_ratio(mlod_mesh_levels *L, const double *ratios, int n, mlod_error *err);
+
 mlod_result mlod_mesh_levels_by_ratio(mlod_mesh_levels *L, const double *ratios, int n, mlod_error *err)
+{
+	return measured(L, by_ratio(L, ratios, n, err));
+}
+
+static mlod_result by_ratio(mlod_mesh_levels *L, const double *ratios, int n, mlod_error *err)
 {
 	if (L->chain_pending) {
 		const int first = L->count;
@@ -792,7 +792,7 @@ mlod_result mlod_mesh_levels_by_error(mlod_mesh_levels *L, double bound, mlod_er
 	mlod_result r = chain_finish(L, err);
 	if (L->opt.influence_budget > 0.0)
 		note(L, "influences not pruned under an error bound");
-	return r != MLOD_OK ? r : mlod_level_search_run(&s, err);
+	return measured(L, r != MLOD_OK ? r : mlod_level_search_run(&s, err));
 }
 
 void mlod_mesh_levels_totals(const mlod_mesh_levels *L, mlod_bgm_info *sum)

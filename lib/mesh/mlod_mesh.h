@@ -359,11 +359,15 @@ typedef struct mlod_mesh_levels {
 } mlod_mesh_levels;
 
 /* Builds the BGM of every triangle primitive of c (which must outlive L)
- * and records its collapses down to min_ratio of its triangles (0: as far
- * as they go). With opt->threads >= 2 and one primitive to simplify, its
- * collapses are left to mlod_mesh_levels_by_ratio or _by_error (the same
- * sequence): by_ratio then measures each level on the other threads while
- * the collapses go on to the next. */
+ * and records its collapses down to min_ratio of its triangles (0, or the
+ * character budget: as far as they go). With opt->threads >= 2 and one
+ * primitive to simplify, its collapses are left to
+ * mlod_mesh_levels_by_ratio or _by_error (the same sequence): by_ratio
+ * then measures each level on the other threads while the collapses go on
+ * to the next. Once a primitive's collapses are over, what only they use
+ * (its posed quadrics, queue and cost caches) is freed; and once
+ * by_ratio or by_error has measured the levels, so is the full character
+ * posed at every measuring pose (a later call poses it again). */
 mlod_result mlod_mesh_levels_init(mlod_mesh_levels *L, const mlod_character *c, const mlod_bgm_options *opt,
                                   mlod_mesh_budget budget, double min_ratio, mlod_error *err);
 void mlod_mesh_levels_free(mlod_mesh_levels *L);

@@ -1129,6 +1129,15 @@ static void mesh_levels_at(const mlod_character *c, mlod_mesh_budget budget, int
 	else
 		CHECK_OK(mlod_mesh_levels_by_ratio(L, ratios, 5, &terr));
 	CHECK(!L->chain_pending);
+	/* the chains are final: what only the collapses use is freed */
+	for (int i = 0; i < c->instance_count; i++)
+		for (int p = 0; p < c->meshes[c->instances[i].mesh].primitive_count; p++) {
+			const mlod_bgm *g = mlod_mesh_part_bgm_(L, i, p);
+			CHECK_MSG(!g || (!g->quadric && !g->rquad && !g->skin && !g->heap.e && !g->heap.memo && !g->opstate &&
+			                 !g->ftie && !g->fgeo && !g->fref && !g->lbmemo),
+			          "%d threads, budget %d: instance %d primitive %d still holds its collapse state", threads,
+			          (int)budget, i, p);
+		}
 }
 
 TEST(mesh_levels_pipelined)

@@ -428,8 +428,9 @@ TEST(posed_error_bound_mean)
  * poses) after mlod_pose_set_keep (the full character kept posed, here in
  * reverse pose order, so that pose 0 comes last): the bits of one
  * mlod_posed_error per level on a set where nothing was kept, bounded
- * mean on, at one and two threads; another full character on the kept set
- * gets its own measure, not the kept one's. */
+ * mean on, at one and two threads, and again after mlod_pose_set_forget;
+ * another full character on the kept set gets its own measure, not the
+ * kept one's. */
 TEST(posed_errors_batch_kept)
 {
 	mlod_character c;
@@ -473,6 +474,22 @@ TEST(posed_errors_batch_kept)
 			          threads, k, all[k].mean, all[k].max, one[k].mean, one[k].max);
 		CHECK(one[0].max < one[1].max && one[1].max < one[2].max);
 	}
+	/* forgotten (mlod_pose_set_forget, as mlod_mesh_levels does once its
+	 * levels are measured): posed and kept again by the next call, the
+	 * later poses sharing pose 0's triangles, with the same bits */
+	for (int threads = 1; threads <= 2; threads++) {
+		mlod_deviation all[3];
+		mlod_pose_set_forget(&kept);
+		kept.threads = threads;
+		CHECK_OK(mlod_posed_errors(&c, views, 3, &kept, all, &terr));
+		CHECK_OK(mlod_posed_errors(&c, views, 3, &kept, all, &terr)); /* and from what that call kept */
+		for (int k = 0; k < 3; k++)
+			CHECK_MSG(same_deviation(&all[k], &one[k]), "forgotten, %d threads, level %d: %.17g/%.17g, alone %.17g/%.17g",
+			          threads, k, all[k].mean, all[k].max, one[k].mean, one[k].max);
+	}
+	mlod_pose_set_forget(&kept);
+	for (int k = kept.count - 1; k >= 0; k--)
+		CHECK_OK(mlod_pose_set_keep(&kept, &c, k, &terr));
 	/* another full character: the poses are kept for c, so it is measured
 	 * on its own, posed at each pose and exactly, as on a set made by hand */
 	mlod_deviation other, alone;
