@@ -122,18 +122,14 @@ int bgm_add_node(mlod_bgm *g)
 		}
 		g->node_aux_cap = g->node_cap;
 	}
-	/* bgm_quadrics_build makes room for every node the collapses can add:
-	 * this is for other growth. */
-	if (g->pose_count > 0 && g->quadric_cap < g->node_cap) {
-		void *p = realloc(g->quadric, (size_t)g->node_cap * (size_t)g->qpose_count * 10 * sizeof *g->quadric);
+	/* A node made after bgm_quadrics_build (by a collapse) needs only
+	 * its row's index: it reuses a parent's row (bgm_apply). */
+	if (g->qslot && g->qslot_cap < g->node_cap) {
+		void *p = realloc(g->qslot, (size_t)g->node_cap * sizeof *g->qslot);
 		if (!p)
 			return -1;
-		g->quadric = p;
-		p = realloc(g->rquad, (size_t)g->node_cap * BGM_RQUAD * sizeof *g->rquad);
-		if (!p)
-			return -1;
-		g->rquad = p;
-		g->quadric_cap = g->node_cap;
+		g->qslot = p;
+		g->qslot_cap = g->node_cap;
 	}
 	int n = g->node_count++;
 	memset(&g->nodes[n], 0, sizeof g->nodes[n]);
@@ -864,6 +860,7 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->removed);
 	free(g->quadric);
 	free(g->qmap);
+	free(g->qslot);
 	free(g->qpose);
 	free(g->rquad);
 	free(g->qsum);
@@ -885,6 +882,7 @@ void bgm_release_collapse_state(mlod_bgm *g)
 		return;
 	free(g->quadric);
 	free(g->qmap);
+	free(g->qslot);
 	free(g->qpose);
 	free(g->rquad);
 	free(g->qsum);
@@ -898,7 +896,7 @@ void bgm_release_collapse_state(mlod_bgm *g)
 	free(g->heap.e);
 	free(g->heap.memo);
 	g->quadric = g->rquad = g->qsum = g->skin2 = NULL;
-	g->qmap = g->qpose = NULL;
+	g->qmap = g->qpose = g->qslot = NULL;
 	g->skin = NULL;
 	g->opstate = NULL;
 	g->ftie = g->fgeo = g->fref = NULL;

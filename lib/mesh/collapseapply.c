@@ -168,8 +168,11 @@ int bgm_apply(mlod_bgm *g, bgm_plan *pl)
 		}
 	}
 	if (g->pose_count > 0) {
-		/* The parents' sums, each from 0 in their order (bgm_sum_quadrics). */
-		bgm_sum_quadrics(g, pl, g->quadric + (size_t)v * (size_t)g->qpose_count * 10);
+		/* The parents' sums, each from 0 in their order (bgm_sum_quadrics),
+		 * into the first parent's row, which dies with it below: the sum
+		 * reads each entry of it before writing that entry. */
+		g->qslot[v] = g->qslot[pl->v[0]];
+		bgm_sum_quadrics(g, pl, g->quadric + (size_t)g->qslot[v] * (size_t)g->qpose_count * 10);
 		bgm_quadric_rest_reset(g, v);
 	}
 

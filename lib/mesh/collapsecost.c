@@ -71,13 +71,13 @@ void bgm_sum_quadrics(const mlod_bgm *g, const bgm_plan *pl, double *Q)
 	/* Each sum from 0 in the vertices' order (the same bits whatever
 	 * loop makes it). */
 	size_t n = 10 * (size_t)g->qpose_count;
-	const double *a = g->quadric + (size_t)pl->v[0] * n, *b = pl->k > 1 ? g->quadric + (size_t)pl->v[1] * n : NULL;
+	const double *a = g->quadric + (size_t)g->qslot[pl->v[0]] * n, *b = pl->k > 1 ? g->quadric + (size_t)g->qslot[pl->v[1]] * n : NULL;
 #ifdef __SSE2__
 	/* Two entries at a time (n is even): each lane the sum below. */
 	if (pl->k == 2 || pl->k == 3) {
 		const __m128d zero = _mm_setzero_pd();
 		if (pl->k == 3) {
-			const double *c = g->quadric + (size_t)pl->v[2] * n;
+			const double *c = g->quadric + (size_t)g->qslot[pl->v[2]] * n;
 			for (size_t k = 0; k < n; k += 2)
 				_mm_storeu_pd(Q + k, _mm_add_pd(_mm_add_pd(_mm_add_pd(zero, _mm_load_pd(a + k)), _mm_load_pd(b + k)),
 				                                _mm_load_pd(c + k)));
@@ -89,7 +89,7 @@ void bgm_sum_quadrics(const mlod_bgm *g, const bgm_plan *pl, double *Q)
 	}
 #endif
 	if (pl->k == 3) {
-		const double *c = g->quadric + (size_t)pl->v[2] * n;
+		const double *c = g->quadric + (size_t)g->qslot[pl->v[2]] * n;
 		for (size_t k = 0; k < n; k++) {
 			double s = 0.0;
 			s += a[k];
@@ -108,7 +108,7 @@ void bgm_sum_quadrics(const mlod_bgm *g, const bgm_plan *pl, double *Q)
 		for (size_t k = 0; k < n; k++) {
 			double s = 0.0;
 			for (int j = 0; j < pl->k; j++)
-				s += g->quadric[(size_t)pl->v[j] * n + k];
+				s += g->quadric[(size_t)g->qslot[pl->v[j]] * n + k];
 			Q[k] = s;
 		}
 	}

@@ -283,7 +283,7 @@ static double posed_min_bound(mlod_bgm *g, const int *v, int k, const double *ba
 	size_t D = (size_t)g->qpose_count;
 	const double *qv[3];
 	for (int i = 0; i < k; i++)
-		qv[i] = g->quadric + (size_t)v[i] * D * 10;
+		qv[i] = g->quadric + (size_t)g->qslot[v[i]] * D * 10;
 	double lb = 0.0, rl = r * g->skin_norm, inv = 1.0 / nj;
 	size_t p = 0;
 #ifdef __SSE2__
@@ -422,7 +422,7 @@ double bgm_lower_key(mlod_bgm *g, int f, int op, int *weak)
 		P[j] = g->nodes[v[j]].p;
 		for (int i = 0; i < 3; i++)
 			bary[i] += P[j][i] / K;
-		wsum += g->rquad[(size_t)v[j] * BGM_RQUAD + 10];
+		wsum += g->rquad[(size_t)g->qslot[v[j]] * BGM_RQUAD + 10];
 		if (j > 0 && same)
 			same = bgm_same_influences(&g->inf[v[0]], &g->inf[v[j]]);
 	}
@@ -461,7 +461,7 @@ double bgm_lower_key(mlod_bgm *g, int f, int op, int *weak)
 		/* the bind pose's entries: bgm_qat(P, 0, k) = st k */
 		size_t st = bgm_qat(g->qpose_count, 0, 1);
 		for (int j = 0; j < K; j++) {
-			const double *q = g->quadric + (size_t)v[j] * (size_t)g->qpose_count * 10;
+			const double *q = g->quadric + (size_t)g->qslot[v[j]] * (size_t)g->qpose_count * 10;
 			Q[0] += q[0], Q[1] += q[st], Q[2] += q[2 * st], Q[3] += q[3 * st], Q[4] += q[4 * st];
 			Q[5] += q[5 * st], Q[6] += q[6 * st], Q[7] += q[7 * st], Q[8] += q[8 * st], Q[9] += q[9 * st];
 		}

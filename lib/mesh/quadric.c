@@ -371,7 +371,7 @@ static void quadrics_pair(mlod_bgm *g, int da, int db, __m128d *posed, __m128d *
 	}
 	/* Out: a pair (2i, 2i + 1) as it lies (bgm_qat), else the low lane. */
 	for (int v = 0; v < g->node_count; v++) {
-		double *dst = g->quadric + (size_t)v * (size_t)D * 10;
+		double *dst = g->quadric + (size_t)g->qslot[v] * (size_t)D * 10;
 		const __m128d *A = acc + (size_t)v * 10;
 		if (db == da + 1) {
 			dst += 10 * (size_t)da;
@@ -558,15 +558,19 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 	free(used);
 	g->pose_count = P;
 	g->qpose_count = D;
-	/* Room for the nodes the collapses add (each merges two or three
-	 * live nodes into one: fewer than node_count of them), at the
-	 * capacity bgm_add_node's doubling of node_cap would reach, so that
-	 * the largest arrays are not copied over as the sequence grows.
-	 * Every node's every stored pose is written below. */
-	int qcap = g->node_cap;
-	while (qcap < 2 * g->node_count && qcap <= INT_MAX / 2)
-		qcap *= 2;
+	/* One row per node; the nodes the collapses add reuse their parents'
+	 * rows (qslot, bgm_apply), so the rows never grow. Every node's
+	 * every stored pose is written below. */
+	int qcap = g->node_count;
 	g->quadric_cap = qcap;
+	g->qslot = malloc(sizeof *g->qslot * (size_t)g->node_cap);
+	if (!g->qslot) {
+		r = mlod_fail(err, MLOD_ERR_NOMEM, "out of memory building posed quadrics");
+		goto done;
+	}
+	g->qslot_cap = g->node_cap;
+	for (int v = 0; v < g->node_count; v++)
+		g->qslot[v] = v;
 	g->quadric = malloc(sizeof *g->quadric * (size_t)qcap * (size_t)D * 10);
 	g->rquad = malloc(sizeof *g->rquad * (size_t)qcap * BGM_RQUAD);
 	if (!g->quadric || !g->rquad) {
@@ -693,7 +697,7 @@ mlod_result bgm_quadrics_build(mlod_bgm *g, const mlod_character *c, const mlod_
 			}
 		}
 		for (int v = 0; v < g->node_count; v++)
-			qput(g->quadric + (size_t)v * (size_t)D * 10, D, d, acc + (size_t)v * 10);
+			qput(g->quadric + (size_t)g->qslot[v] * (size_t)D * 10, D, d, acc + (size_t)v * 10);
 	}
 	for (int v = 0; v < g->node_count; v++)
 		bgm_quadric_rest_reset(g, v);
@@ -818,8 +822,8 @@ double bgm_quadric_error(const mlod_bgm *g, const double *q, const mlod_influenc
 void bgm_quadric_rest_reset(mlod_bgm *g, int v)
 {
 	int P = g->pose_count, D = g->qpose_count;
-	const double *q = g->quadric + (size_t)v * (size_t)D * 10;
-	double *r = g->rquad + (size_t)v * BGM_RQUAD, t = 0.0;
+	const double *q = g->quadric + (size_t)g->qslot[v] * (size_t)D * 10;
+	double *r = g->rquad + (size_t)g->qslot[v] * BGM_RQUAD, t = 0.0;
 	for (int p = 0; p < P; p++) {
 		int d = g->qmap[p];
 		t += q[bgm_qat(D, d, 0)] + q[bgm_qat(D, d, 4)] + q[bgm_qat(D, d, 7)];
@@ -830,12 +834,12 @@ void bgm_quadric_rest_reset(mlod_bgm *g, int v)
 
 const double *bgm_quadric_rest(mlod_bgm *g, int v)
 {
-	double *r = g->rquad + (size_t)v * BGM_RQUAD;
+	double *r = g->rquad + (size_t)g->qslot[v] * BGM_RQUAD;
 	/* NaN marks it unknown: a computed r[0] may round below 0 (a
 	 * direction the planes leave free), which must not recompute it at
 	 * every use. */
 	if (isnan(r[0]))
-		bgm_quadric_pullback(g, g->quadric + (size_t)v * (size_t)g->qpose_count * 10, &g->inf[v], r);
+		bgm_quadric_pullback(g, g->quadric + (size_t)g->qslot[v] * (size_t)g->qpose_count * 10, &g->inf[v], r);
 	return r;
 }
 
