@@ -858,21 +858,7 @@ void mlod_bgm_free(mlod_bgm *g)
 	free(g->inc);
 	free(g->records);
 	free(g->removed);
-	free(g->quadric);
-	free(g->qmap);
-	free(g->qslot);
-	free(g->qpose);
-	free(g->rquad);
-	free(g->qsum);
-	free(g->skin);
-	free(g->skin2);
-	free(g->opstate);
-	free(g->ftie);
-	free(g->fgeo);
-	free(g->fref);
-	free(g->lbmemo);
-	free(g->heap.e);
-	free(g->heap.memo);
+	bgm_release_collapse_state(g);
 	free(g);
 }
 
