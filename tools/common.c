@@ -505,6 +505,21 @@ void tool_put_line(FILE *f, const char *prefix, const char *s)
 	fputc('\n', f);
 }
 
+void tool_put_lines(FILE *f, const char *prefix, const char *s)
+{
+	for (const char *w = s; w && *w;) {
+		size_t n = strcspn(w, "\n");
+		char *line = malloc(n + 1);
+		if (!line)
+			tool_die(EXIT_OUTPUT, NULL, "out of memory");
+		memcpy(line, w, n);
+		line[n] = 0;
+		tool_put_line(f, prefix, line);
+		free(line);
+		w += n + (w[n] == '\n');
+	}
+}
+
 int tool_name_width(const char *s)
 {
 	return mlod_name_put(NULL, s, 0, 0);

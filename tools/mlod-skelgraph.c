@@ -112,7 +112,7 @@ static void report_table(const struct job *job)
 	if (job->notes[0])
 		tool_put_line(stdout, "# note: ", job->notes);
 	if (job->c.notes && *job->c.notes)
-		tool_put_line(stdout, "# note: ", job->c.notes);
+		tool_put_lines(stdout, "# note: ", job->c.notes);
 }
 
 static void report_json(const struct job *job)
