@@ -337,6 +337,8 @@ int main(int argc, char **argv)
 		tool_note(label, "no animation: the pack has no motion levels");
 	if (c.mesh_count > 0 && st.mesh.levels == 0)
 		tool_note(label, "no triangle mesh in the default scene: the pack has no mesh levels");
+	else if (c.mesh_count == 0 && c.skeleton.joint_count == 0) /* as the stages' "nothing to" notes */
+		tool_note(label, "no joints and no mesh: nothing to pack; the pack holds the document alone");
 	tool_note_lines(label, st.warnings); /* what the pack does not keep, or keeps changed */
 	/* A layer option the input's own levels (mlod-skelgraph's, mlod-bgm's,
 	 * mlod-motion's) leave unused. */
