@@ -101,6 +101,10 @@ struct mlod_gltf {
 	int rotations_normalised = 0;
 	int rotation_node = -1;
 	double rotation_length = 0.0;
+	/* External images the reader could not read (a missing file, or no
+	 * directory to find them in): "image I: \"URI\" ...why", one each. The
+	 * output keeps their URIs; the character reader warns of them. */
+	std::vector<std::string> unread_images;
 	/* mlod_gltf_keep_indices: what goes, goes from the end of its array
 	 * only (prune, drop_animation), so that no index an unknown extension
 	 * may hold changes. */

@@ -34,6 +34,9 @@ public:
 			     doc_.rotations_normalised, doc_.rotations_normalised == 1 ? "" : "s", doc_.rotation_node,
 			     n.name.empty() ? "" : " ", n.name.empty() ? "" : quoted(n.name).c_str(), doc_.rotation_length);
 		}
+		for (const std::string &u : doc_.unread_images)
+			warn("%s: the output keeps its URI, which points at no image unless the file sits beside the output",
+			     u.c_str());
 		graph();
 		skeleton();
 		skins();
