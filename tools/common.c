@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <getopt.h>
+#include <float.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -434,22 +435,33 @@ void tool_write_gltf(const char *path, const mlod_gltf *doc)
 	mlod_free(data);
 }
 
-double tool_parse_double(const char *option, const char *value, double lo, double hi)
+/* value as a double: dies if it is not a number, or too close to 0 for
+ * a double; a number too large for one (1e400) is returned as infinity,
+ * which the callers' ranges refuse as out of range. */
+static double parse_number(const char *option, const char *value)
 {
 	char *end = NULL;
 	errno = 0;
 	double v = strtod(value, &end);
-	if (end == value || *end != '\0' || errno == ERANGE || !isfinite(v))
+	if (end == value || *end != '\0' || isnan(v))
 		tool_usage_error("%s: '%s' is not a number", option, value);
-	if (v < lo || v > hi)
+	if (errno == ERANGE && fabs(v) <= DBL_MIN) /* underflow: a number, but none a double holds */
+		tool_usage_error("%s: %s is out of range (too close to 0 for a double)", option, value);
+	return errno == ERANGE ? copysign(HUGE_VAL, v) : v;
+}
+
+double tool_parse_double(const char *option, const char *value, double lo, double hi)
+{
+	double v = parse_number(option, value);
+	if (isinf(v) || v < lo || v > hi)
 		tool_usage_error("%s: %s is out of range [%g, %g]", option, value, lo, hi);
 	return v;
 }
 
 int tool_parse_int(const char *option, const char *value, int lo, int hi)
 {
-	double v = tool_parse_double(option, value, -HUGE_VAL, HUGE_VAL);
-	if (v != floor(v)) /* before the range: 16.5 is not a whole number, whatever the range */
+	double v = parse_number(option, value);
+	if (isfinite(v) && v != floor(v)) /* before the range: 16.5 is not a whole number, whatever the range */
 		tool_usage_error("%s: '%s' is not a whole number", option, value);
 	if (v < lo || v > hi)
 		tool_usage_error("%s: %s is out of range [%d, %d]", option, value, lo, hi);
@@ -503,6 +515,21 @@ void tool_put_line(FILE *f, const char *prefix, const char *s)
 	fputs(prefix, f);
 	mlod_name_put(f, s, 0, 0);
 	fputc('\n', f);
+}
+
+void tool_put_lines(FILE *f, const char *prefix, const char *s)
+{
+	for (const char *w = s; w && *w;) {
+		size_t n = strcspn(w, "\n");
+		char *line = malloc(n + 1);
+		if (!line)
+			tool_die(EXIT_OUTPUT, NULL, "out of memory");
+		memcpy(line, w, n);
+		line[n] = 0;
+		tool_put_line(f, prefix, line);
+		free(line);
+		w += n + (w[n] == '\n');
+	}
 }
 
 int tool_name_width(const char *s)

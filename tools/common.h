@@ -133,6 +133,10 @@ void tool_put_name(FILE *f, const char *s, int width);
 /* Writes prefix, s as tool_put_name does, and a newline. */
 void tool_put_line(FILE *f, const char *prefix, const char *s);
 
+/* tool_put_line for each line of s (the reader's notes, one a line): one
+ * prefixed line each, so that no note shows as a literal \n. */
+void tool_put_lines(FILE *f, const char *prefix, const char *s);
+
 /* The columns tool_put_name takes for s, unpadded. */
 int tool_name_width(const char *s);
 

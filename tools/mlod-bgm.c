@@ -221,7 +221,7 @@ static void report_table(const struct job *job)
 	if (L->notes[0])
 		tool_put_line(stdout, "# note: ", L->notes);
 	if (job->c.notes && *job->c.notes)
-		tool_put_line(stdout, "# input: ", job->c.notes);
+		tool_put_lines(stdout, "# input: ", job->c.notes);
 }
 
 static void report_json(const struct job *job)

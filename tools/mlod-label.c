@@ -92,7 +92,7 @@ static void report_table(const char *input, const mlod_character *c, const mlod_
 	       st.count[MLOD_LABEL_END_EFFECTOR], st.count[MLOD_LABEL_MAJOR], st.count[MLOD_LABEL_EXTREME],
 	       st.count[MLOD_LABEL_MINOR]);
 	if (c->notes && *c->notes)
-		tool_put_line(stdout, "# note: ", c->notes);
+		tool_put_lines(stdout, "# note: ", c->notes);
 }
 
 static void report_json(const char *input, const mlod_character *c, const mlod_joint_info *info,

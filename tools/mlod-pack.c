@@ -16,8 +16,8 @@
 
 static const char usage_text[] =
 	"usage: mlod-pack [options] [input]\n"
-	"       mlod-pack --info FILE [--json]\n"
-	"       mlod-pack -x FILE [-o out.glb]\n"
+	"       mlod-pack --info [--json] [FILE]\n"
+	"       mlod-pack -x [-o out.glb] [FILE]\n"
 	"\n"
 	"Bakes the skeleton, mesh and motion levels of a character into one .mlod\n"
 	"pack (mlod(5)), coarse levels first. Input is glb, glTF or BVH; levels left\n"
@@ -73,15 +73,18 @@ static const char usage_text[] =
 	"      --no-skeleton-levels, --no-mesh-levels, --no-motion-levels\n"
 	"                             pack that layer at level 0 only\n";
 static const char usage_more[] = /* printf's format ends above (ISO C's 4095-character string limit) */
-	"      --info FILE            print the pack's chunks (layer, level, clip,\n"
+	"      --info [FILE]          print the pack's chunks (layer, level, clip,\n"
 	"                             codec and entropy stage, sizes, error, switch\n"
 	"                             distance) and totals;\n"
 	"                             every chunk is decoded and checked, the DOC\n"
 	"                             chunk's glb read as -x reads it (stdout\n"
-	"                             only: not with -o)\n"
+	"                             only: not with -o). FILE, for --info and -x:\n"
+	"                             the operand, in any order with the other\n"
+	"                             options, or the value (--info=FILE, -xFILE);\n"
+	"                             stdin without one\n"
 	"      --json                 with --info: as JSON (= --report=json), with the\n"
 	"                             rest bounds and every joint's name and parent\n"
-	"  -x, --extract FILE         unpack FILE to a glb: MSFT_lod mesh levels (with\n"
+	"  -x, --extract [FILE]       unpack FILE to a glb: MSFT_lod mesh levels (with\n"
 	"                             the pack's weights, on the full skin),\n"
 	"                             skeleton-level skins, <clip>@lod<k> animations\n"
 	"  -j, --threads N            compute mesh levels on N threads (default: the\n"
@@ -186,9 +189,9 @@ int main(int argc, char **argv)
 		{"no-motion-levels", no_argument, NULL, OPT_NO_MOTION},
 		{"motion-level0-error", required_argument, NULL, OPT_LEVEL0_ERR},
 		{"lossless-motion", no_argument, NULL, OPT_LOSSLESS_MOTION},
-		{"info", required_argument, NULL, OPT_INFO},
+		{"info", optional_argument, NULL, OPT_INFO},
 		{"json", no_argument, NULL, OPT_JSON},
-		{"extract", required_argument, NULL, 'x'},
+		{"extract", optional_argument, NULL, 'x'},
 		{"threads", required_argument, NULL, 'j'},
 		{"help", no_argument, NULL, 'h'},
 		{"version", no_argument, NULL, 'V'},
@@ -207,7 +210,7 @@ int main(int argc, char **argv)
 #define LAYER(var, name) (BAKE(name), var = var ? var : (name))
 
 	tool_name = "mlod-pack";
-	static const char shortopts[] = ":o:r::R:e:p:x:j:hV";
+	static const char shortopts[] = ":o:r::R:e:p:x::j:hV";
 	opterr = 0;
 	while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
 		switch (ch) {
@@ -261,8 +264,11 @@ int main(int argc, char **argv)
 		case OPT_NO_MOTION: opt.no_motion_levels = 1, BAKE("--no-motion-levels"); break;
 		case OPT_LEVEL0_ERR: parse_level0(optarg, &opt), level0_given = 1, BAKE("--motion-level0-error"); break;
 		case OPT_LOSSLESS_MOTION: opt.lossless_motion = 1, BAKE("--lossless-motion"); break;
-		case OPT_INFO: info = optarg; break;
-		case 'x': extract = optarg; break;
+		/* The pack as the option's value (--info=FILE, -xFILE) or as the
+		 * operand (--info FILE, -x FILE, in any order with --json, -o):
+		 * "" until the operand is known. */
+		case OPT_INFO: info = optarg ? optarg : ""; break;
+		case 'x': extract = optarg ? optarg : ""; break;
 		case 'j': opt.bgm.threads = tool_parse_threads(optarg), BAKE("--threads"); break;
 		case OPT_JSON: json = 1; break;
 		case 'h': {
@@ -302,8 +308,12 @@ int main(int argc, char **argv)
 	if (json && !info)
 		tool_usage_error("--json goes with --info (else use --report=json)");
 	if (info || extract) {
-		if (optind < argc)
-			tool_usage_error("%s takes its pack as the option's value", info ? "--info" : "-x");
+		const char **pack = info ? &info : &extract;
+		if (**pack && optind < argc)
+			tool_usage_error("%s names its pack '%s', and so does the operand '%s': give one", info ? "--info" : "-x",
+			                 *pack, argv[optind]);
+		if (!**pack)
+			*pack = optind < argc ? argv[optind] : "-"; /* no pack named: stdin */
 		if (info)
 			return pack_info(info, json ? REPORT_JSON : report);
 		if (report != REPORT_NONE)
@@ -337,6 +347,8 @@ int main(int argc, char **argv)
 		tool_note(label, "no animation: the pack has no motion levels");
 	if (c.mesh_count > 0 && st.mesh.levels == 0)
 		tool_note(label, "no triangle mesh in the default scene: the pack has no mesh levels");
+	else if (c.mesh_count == 0 && c.skeleton.joint_count == 0) /* as the stages' "nothing to" notes */
+		tool_note(label, "no joints and no mesh: nothing to pack; the pack holds the document alone");
 	tool_note_lines(label, st.warnings); /* what the pack does not keep, or keeps changed */
 	/* A layer option the input's own levels (mlod-skelgraph's, mlod-bgm's,
 	 * mlod-motion's) leave unused. */

@@ -31,7 +31,9 @@ static const char usage_text[] =
 	"                          the level chosen by --level as BVH\n"
 	"  -r, --report[=FORMAT]   print the levels instead; FORMAT is table or json\n"
 	"  -t, --thresholds LIST   levels at these energy thresholds (E1,E2,...)\n"
-	"  -j, --joints LIST       levels keeping these fractions of the joints (0.8,0.6)\n"
+	"  -j, --joints LIST       levels keeping these fractions of the joints (0.8,0.6);\n"
+	"                          not threads, as -j is in mlod-bgm, mlod-motion and\n"
+	"                          mlod-pack: mlod-skelgraph runs on one thread\n"
 	"  -e, --max-error PCT     default levels stop before the error exceeds PCT\n"
 	"                          percent of the skeleton height, the rest-pose\n"
 	"                          joints' extent along +Y (default %g)\n"
@@ -112,7 +114,7 @@ static void report_table(const struct job *job)
 	if (job->notes[0])
 		tool_put_line(stdout, "# note: ", job->notes);
 	if (job->c.notes && *job->c.notes)
-		tool_put_line(stdout, "# note: ", job->c.notes);
+		tool_put_lines(stdout, "# note: ", job->c.notes);
 }
 
 static void report_json(const struct job *job)
@@ -248,7 +250,13 @@ int main(int argc, char **argv)
 		case 'o': output = optarg; break;
 		case 'r': report = tool_parse_report(optarg); break;
 		case 't': threshold_count = tool_parse_list("--thresholds", optarg, thresholds, MLOD_SKEL_MAX_LEVELS, 0.0, 1e9); break;
-		case 'j': fraction_count = tool_parse_list("--joints", optarg, fractions, MLOD_SKEL_MAX_LEVELS, 0.0, 1.0); break;
+		case 'j':
+			/* "-j 2", as the other tools' --threads: said plainly. */
+			if (strspn(optarg, "0123456789") == strlen(optarg) && atoi(optarg) > 1)
+				tool_usage_error("--joints: %s is out of range [0, 1]: -j here keeps fractions of the joints, "
+				                 "not threads (mlod-skelgraph runs on one thread)", optarg);
+			fraction_count = tool_parse_list("--joints", optarg, fractions, MLOD_SKEL_MAX_LEVELS, 0.0, 1.0);
+			break;
 		case 'e': max_error = tool_parse_percent("--max-error", optarg, 0.0, 1e6); break;
 		case 'l': level = tool_parse_int("--level", optarg, 0, MLOD_SKEL_MAX_LEVELS); break;
 		case 'c': clip = tool_parse_int("--clip", optarg, 0, 1000000), clip_given = 1; break;

@@ -84,6 +84,10 @@
 
 #include "io/mlod_io.h"
 
+/* The deepest node hierarchy the character reader takes (levels from a
+ * root, the root one), as deep as the BVH reader's (BVH_MAX_DEPTH). */
+#define MLOD_MAX_NODE_DEPTH 1000
+
 struct mlod_gltf {
 	tinygltf::Model model;
 	/* The JSON as read (without URIs), to write back what tinygltf drops;
@@ -101,6 +105,10 @@ struct mlod_gltf {
 	int rotations_normalised = 0;
 	int rotation_node = -1;
 	double rotation_length = 0.0;
+	/* External images the reader could not read (a missing file, or no
+	 * directory to find them in): "image I: \"URI\" ...why", one each. The
+	 * output keeps their URIs; the character reader warns of them. */
+	std::vector<std::string> unread_images;
 	/* mlod_gltf_keep_indices: what goes, goes from the end of its array
 	 * only (prune, drop_animation), so that no index an unknown extension
 	 * may hold changes. */

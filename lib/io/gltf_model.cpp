@@ -34,6 +34,9 @@ public:
 			     doc_.rotations_normalised, doc_.rotations_normalised == 1 ? "" : "s", doc_.rotation_node,
 			     n.name.empty() ? "" : " ", n.name.empty() ? "" : quoted(n.name).c_str(), doc_.rotation_length);
 		}
+		for (const std::string &u : doc_.unread_images)
+			warn("%s: the output keeps its URI, which points at no image unless the file sits beside the output",
+			     u.c_str());
 		graph();
 		skeleton();
 		skins();
@@ -107,6 +110,21 @@ private:
 			const std::vector<int> &ch = m_.nodes[size_t(k)].children;
 			for (size_t i = ch.size(); i-- > 0;)
 				stack.push_back(ch[i]);
+		}
+		/* Depth, once per node (parents first). The stages after the
+		 * reader walk joints to their roots (the rest box, the skeletal
+		 * graph's closure edges, the motion checks over descendants): a
+		 * hierarchy deeper than a BVH may be is refused, as the BVH
+		 * reader refuses one. */
+		std::vector<int> depth(n, 0);
+		for (int k : order_) {
+			int p = parent_[size_t(k)];
+			depth[size_t(k)] = p < 0 ? 0 : depth[size_t(p)] + 1;
+			if (depth[size_t(k)] >= MLOD_MAX_NODE_DEPTH)
+				fail(MLOD_ERR_UNSUPPORTED, "node %d%s%s is %d levels deep: mlod reads node hierarchies at most %d levels "
+				     "deep", k, m_.nodes[size_t(k)].name.empty() ? "" : " ",
+				     m_.nodes[size_t(k)].name.empty() ? "" : quoted(m_.nodes[size_t(k)].name).c_str(), depth[size_t(k)] + 1,
+				     MLOD_MAX_NODE_DEPTH);
 		}
 		local_.resize(n);
 		world_.resize(n);
@@ -196,18 +214,23 @@ private:
 				in_skin_[size_t(j)] = 1;
 		const std::vector<char> &seeds = m_.skins.empty() ? animated_ : in_skin_;
 		std::vector<char> is_joint(seeds);
+		/* Nodes with no joint above them: a walk up stops there too, so
+		 * that each node is walked through once (linear in the nodes, not
+		 * seeds times depth). */
+		std::vector<char> no_joint_above(n, 0);
+		std::vector<int> between;
 		for (size_t j = 0; j < n; j++) {
 			if (!seeds[j])
 				continue;
-			std::vector<int> between;
+			between.clear();
 			int k = parent_[j];
-			while (k >= 0 && !is_joint[size_t(k)]) {
+			while (k >= 0 && !is_joint[size_t(k)] && !no_joint_above[size_t(k)]) {
 				between.push_back(k);
 				k = parent_[size_t(k)];
 			}
-			if (k >= 0)
-				for (int b : between)
-					is_joint[size_t(b)] = 1;
+			bool joint_above = k >= 0 && is_joint[size_t(k)];
+			for (int b : between)
+				(joint_above ? is_joint : no_joint_above)[size_t(b)] = 1;
 		}
 		joint_of_.assign(n, -1);
 		int count = 0;
@@ -260,6 +283,12 @@ private:
 		mlod_skeleton &s = c_.skeleton;
 		s.skins = c_array<mlod_skin>(m_.skins.size());
 		s.skin_count = int(m_.skins.size());
+		/* Each joint's root, once (the joints are parents first): walking
+		 * each joint up to it took time quadratic in the depth. */
+		std::vector<int> root(size_t(s.joint_count));
+		for (int j = 0; j < s.joint_count; j++)
+			root[size_t(j)] = s.joints[j].parent >= 0 ? root[size_t(s.joints[j].parent)] : j;
+		std::vector<int> skin_of_root(size_t(s.joint_count), -1); /* the last skin that counted the root */
 		for (size_t i = 0; i < m_.skins.size(); i++) {
 			const tinygltf::Skin &src = m_.skins[i];
 			mlod_skin &k = s.skins[i];
@@ -276,20 +305,20 @@ private:
 				if (ibm.size() < 16 * n)
 					fail(MLOD_ERR_PARSE, "skin %zu: %zu inverse bind matrices for %zu joints", i, ibm.size() / 16, n);
 			}
-			std::vector<int> roots;
+			size_t roots = 0;
 			for (size_t j = 0; j < n; j++) {
 				k.joints[j] = joint_of_[size_t(src.joints[j])];
 				k.inverse_bind[j] = mlod_mat4_identity();
 				if (!ibm.empty())
 					memcpy(k.inverse_bind[j].m, &ibm[16 * j], sizeof(float[16]));
-				int r = k.joints[j];
-				while (s.joints[r].parent >= 0)
-					r = s.joints[r].parent;
-				if (std::find(roots.begin(), roots.end(), r) == roots.end())
-					roots.push_back(r);
+				int r = root[size_t(k.joints[j])];
+				if (skin_of_root[size_t(r)] != int(i)) {
+					skin_of_root[size_t(r)] = int(i);
+					roots++;
+				}
 			}
-			if (roots.size() > 1)
-				note("skin %zu \"%s\": its joints have no common root (%zu separate hierarchies)", i, k.name, roots.size());
+			if (roots > 1)
+				note("skin %zu \"%s\": its joints have no common root (%zu separate hierarchies)", i, k.name, roots);
 		}
 	}
 

@@ -75,6 +75,28 @@ static bool keep_image_bytes(tinygltf::Image *image, const int index, std::strin
 	return true;
 }
 
+/* The external images tinygltf could not read (it keeps their URIs and
+ * no bytes): named in doc.unread_images, for a warning. */
+static void note_unread_images(mlod_gltf &doc, const char *base_dir)
+{
+	const std::vector<tinygltf::Image> &images = doc.model.images;
+	for (size_t i = 0; i < images.size(); i++) {
+		const tinygltf::Image &im = images[i];
+		if (im.bufferView >= 0 || !im.image.empty() || im.uri.empty() || im.uri.compare(0, 5, "data:") == 0)
+			continue;
+		std::string why;
+		if (!base_dir) {
+			why = "is an external file, and standard input has no directory to find it in";
+		} else {
+			struct stat st;
+			std::string path = join_path(base_dir, url_decode(im.uri));
+			why = stat(path.c_str(), &st) != 0 ? std::string("cannot be read: ") + strerror(errno)
+			                                    : std::string("could not be read");
+		}
+		doc.unread_images.push_back("image " + std::to_string(i) + ": " + quoted(im.uri) + " " + why);
+	}
+}
+
 /* ------------------------------------------------------------------ */
 /* Reading: the document                                               */
 /* ------------------------------------------------------------------ */
@@ -230,6 +252,7 @@ void read_document(mlod_gltf &doc, const unsigned char *data, size_t size, const
 		fail(MLOD_ERR_UNSUPPORTED, "glTF version %s (minimum %s) is not supported: mlod reads glTF 2.0",
 		     asset.version.c_str(), asset.minVersion.empty() ? "none" : asset.minVersion.c_str());
 	check_document(doc.model, size);
+	note_unread_images(doc, base_dir);
 
 	/* The data is in memory now: the document no longer refers to files. */
 	for (tinygltf::Buffer &b : doc.model.buffers)
