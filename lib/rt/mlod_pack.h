@@ -304,9 +304,9 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 8
+#define MLOD_PACK_MAJOR 9
 #define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
-#define MLOD_PACK_MINOR 1 /* 8.1: INFO's max_vertex_count */
+#define MLOD_PACK_MINOR 0 /* 9.0: predicted ROTQ keys; 8.1: INFO's max_vertex_count */
 #define MLOD_PACK_HEADER_SIZE 32
 #define MLOD_PACK_TOC_ENTRY_SIZE 48
 #define MLOD_PACK_ALIGN 16
@@ -454,6 +454,34 @@ static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, c
 		for (int c = 0; dot < 0 && c < 4; c++)
 			n[c] = (int16_t)-n[c];
 	}
+}
+/* Format 9.0: what a 'ROTQ' key's three stored components are taken
+ * from. e[3] as stored (index i = e[3] & 3, shift = e[3] >> 2), prev the
+ * channel's key before as returned, next (or NULL) the channel's next key
+ * that has a base key, as mlod_pack_rotq_key returns it without a key
+ * before (prev NULL), and f = (t - t_prev) / (t_next - t_prev) in double
+ * from the keys' f32 times. The prediction p = prev + (s next - prev) * f
+ * (s = -1 when next's dot product with prev is negative, else 1; p = prev
+ * without next), negated when p[i] < 0; pred[j] = lrint(p[c] / 2^shift)
+ * for the three components c but i, in index order. The stored e[j] is
+ * the key's minus pred[j], wrapped to 16 bits. A channel's first key
+ * stores its components as they are. The writer and the reader share it. */
+static inline void mlod_pack_rotq_predict(const int16_t e3, const int16_t prev[4], const int16_t *next, double f,
+                                          int16_t pred[3])
+{
+	int big = e3 & 3, shift = (e3 >> 2) & 15;
+	double p[4];
+	int64_t dot = 0;
+	for (int c = 0; next && c < 4; c++)
+		dot += (int64_t)prev[c] * next[c];
+	for (int c = 0; c < 4; c++)
+		p[c] = next ? prev[c] + ((dot < 0 ? -(double)next[c] : (double)next[c]) - prev[c]) * f : (double)prev[c];
+	int neg = p[big] < 0;
+	for (int c = 0, j = 0; c < 4; c++)
+		if (c != big) {
+			double v = ldexp(neg ? -p[c] : p[c], -shift);
+			pred[j++] = (int16_t)(v > 32767.0 ? 32767 : v < -32767.0 ? -32767 : lrint(v));
+		}
 }
 #define MLOD_STREAM_ROTF MLOD_FOURCC('R', 'O', 'T', 'F')
 #define MLOD_STREAM_VEC3 MLOD_FOURCC('V', 'E', 'C', '3')
