@@ -484,7 +484,8 @@ static void rotq_encode_on(const float *r, const int16_t *bn, int16_t *out, int 
 
 /* Format 9.0 (mlod(5) ROTQ): each 'ROTQ' key but a channel's first as
  * its difference to mlod_pack_rotq_predict's prediction, from the key
- * before as returned and the channel's next key on a base key. q and qd
+ * before as returned and the channel's next key on a base key,
+ * zigzagged (mlod_pack_zigzag16). q and qd
  * hold the 'ROTQ' and 'ROTD' elements as pack_motion_chunk made them,
  * img the keys as returned; in the same order, q's elements change. */
 static void rotq_residuals(const mlod_clip *clip, const motion_img *img, const motion_img *base, int16_t *q,
@@ -520,7 +521,7 @@ static void rotq_residuals(const mlod_clip *clip, const motion_img *img, const m
 			}
 			mlod_pack_rotq_predict(e[3], ic->rot + 4 * (v - 1), w < keys ? nx : NULL, f, pred);
 			for (int j = 0; j < 3; j++)
-				e[j] = (int16_t)(uint16_t)((uint16_t)e[j] - (uint16_t)pred[j]);
+				e[j] = mlod_pack_zigzag16((int16_t)(uint16_t)((uint16_t)e[j] - (uint16_t)pred[j]));
 		}
 	}
 }
@@ -973,8 +974,11 @@ mlod_result pack_motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int i
 			}
 		}
 	}
-	if (!cb.fail)
+	if (!cb.fail) { /* format 9.0: ROTQ's predicted, then ROTD's zigzagged */
 		rotq_residuals(clip, img, base, q, qd);
+		for (size_t c = 0; c < 4 * at_d; c++)
+			qd[c] = mlod_pack_zigzag16(qd[c]);
+	}
 	free(shift);
 	free(tgrid);
 	pack_cb_add(&cb, MLOD_STREAM_ROTQ, (uint32_t)at_a, 8, q, 0);

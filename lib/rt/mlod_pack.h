@@ -455,6 +455,18 @@ static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, c
 			n[c] = (int16_t)-n[c];
 	}
 }
+/* Format 9.0: a 16-bit difference d as stored (zigzag: small magnitudes
+ * of either sign to small numbers, 0 -1 1 -2 to 0 1 2 3), and back. */
+static inline int16_t mlod_pack_zigzag16(int16_t d)
+{
+	return (int16_t)(uint16_t)((uint16_t)((uint16_t)d << 1) ^ (uint16_t)(d < 0 ? 0xFFFFu : 0u));
+}
+static inline int16_t mlod_pack_unzigzag16(int16_t z)
+{
+	uint16_t u = (uint16_t)z;
+	return (int16_t)(uint16_t)((uint16_t)(u >> 1) ^ (uint16_t)(u & 1 ? 0xFFFFu : 0u));
+}
+
 /* Format 9.0: what a 'ROTQ' key's three stored components are taken
  * from. e[3] as stored (index i = e[3] & 3, shift = e[3] >> 2), prev the
  * channel's key before as returned, next (or NULL) the channel's next key
@@ -464,8 +476,9 @@ static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, c
  * (s = -1 when next's dot product with prev is negative, else 1; p = prev
  * without next), negated when p[i] < 0; pred[j] = lrint(p[c] / 2^shift)
  * for the three components c but i, in index order. The stored e[j] is
- * the key's minus pred[j], wrapped to 16 bits. A channel's first key
- * stores its components as they are. The writer and the reader share it. */
+ * the key's minus pred[j], wrapped to 16 bits and zigzagged
+ * (mlod_pack_zigzag16). A channel's first key stores its components as
+ * they are. The writer and the reader share it. */
 static inline void mlod_pack_rotq_predict(const int16_t e3, const int16_t prev[4], const int16_t *next, double f,
                                           int16_t pred[3])
 {

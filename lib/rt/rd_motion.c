@@ -343,6 +343,9 @@ mlod_result mlod_pack_decode_motion_reserve(const mlod_pack *p, uint32_t chunk, 
 			for (int c = 0; c < 4; c++)
 				el[c] = rdi16(e + 2 * c);
 			int64_t at = base_key(bc, ch->times[k], &from);
+			if (at >= 0 && p->major >= 9) /* format 9.0: 'ROTD' zigzagged */
+				for (int c = 0; c < 4; c++)
+					el[c] = mlod_pack_unzigzag16(el[c]);
 			if (at >= 0)
 				for (int c = 0; c < 4; c++)
 					bn[c] = (int16_t)lrint((double)bc->values[4 * at + c] * 32767.0);
@@ -351,7 +354,8 @@ mlod_result mlod_pack_decode_motion_reserve(const mlod_pack *p, uint32_t chunk, 
 				     k, el[3]);
 			if (at < 0 && k > 0 && p->major >= 9) {
 				/* the stored components are the differences to
-				 * the prediction (mlod_pack_rotq_predict) */
+				 * the prediction (mlod_pack_rotq_predict),
+				 * zigzagged */
 				if (w <= k)
 					for (w = k + 1, at_w = -1; w < ch->rec.key_count &&
 					                           (at_w = base_key(bc, ch->times[w], &from_w)) < 0;
@@ -363,7 +367,7 @@ mlod_result mlod_pack_decode_motion_reserve(const mlod_pack *p, uint32_t chunk, 
 					const uint8_t *ew = (const uint8_t *)(ch->values + 4 * (size_t)w);
 					int16_t elw[4], bw[4];
 					for (int c = 0; c < 4; c++) {
-						elw[c] = rdi16(ew + 2 * c);
+						elw[c] = mlod_pack_unzigzag16(rdi16(ew + 2 * c));
 						bw[c] = (int16_t)lrint((double)bc->values[4 * at_w + c] * 32767.0);
 					}
 					mlod_pack_rotq_key(elw, bw, NULL, nx);
@@ -372,7 +376,7 @@ mlod_result mlod_pack_decode_motion_reserve(const mlod_pack *p, uint32_t chunk, 
 				}
 				mlod_pack_rotq_predict(el[3], prev, w < ch->rec.key_count ? nx : NULL, f, pred);
 				for (int c = 0; c < 3; c++)
-					el[c] = (int16_t)(uint16_t)((uint16_t)el[c] + (uint16_t)pred[c]);
+					el[c] = (int16_t)(uint16_t)((uint16_t)mlod_pack_unzigzag16(el[c]) + (uint16_t)pred[c]);
 			}
 			if (at < 0)
 				for (int c = 0; c < 3; c++)
