@@ -25,7 +25,9 @@
  *             a, no decode path); 2.x is 3.x without MLOD_PART_LOCAL,
  *             the sequence codec and 'TBIT'; 2.x to 6.x store a
  *             skeleton level's palette as 'PALJ' and 'PALB' (7.0:
- *             'PALR' and 'PALX')
+ *             'PALR' and 'PALX'); 2.x to 8.x store 'ROTQ' keys as they
+ *             are and 'ROTD' differences not zigzagged (9.0: predicted,
+ *             zigzagged)
  *   6  u16    minor version; a newer minor only adds what older readers skip
  *   8  u32    flags (0; a reader ignores bits it does not know)
  *  12  u32    chunk_count (at most MLOD_PACK_MAX_CHUNKS)
@@ -220,8 +222,15 @@
  *          element is i, 0..3); the reader rebuilds component i as
  *          lrint(sqrt(max(0, 1 - s)) * 32767) / 32767, s the sum of the
  *          others' squares (each the f32 nearest q / 32767, summed in f64);
+ *          Format 9.0: every key but a channel's first stores, instead
+ *          of its three components, each one's difference to its
+ *          prediction (mlod_pack_rotq_predict: from the channel's key
+ *          before and its next key with a base key), wrapped to 16 bits
+ *          and zigzagged (mlod_pack_zigzag16); the element's i + 4 *
+ *          shift as before;
  *   'ROTD' i16[4] per key of every non-cubic rotation with a base key: its
- *          lattice integers minus the base key's, wrapped to 16 bits;
+ *          lattice integers minus the base key's, wrapped to 16 bits
+ *          (format 9.0: then zigzagged);
  *          after either, a key is negated when its dot product with the
  *          channel's key before is negative (q and -q are one rotation)
  *          (mlod_pack_rotq_key). (Format 1.0 stored the four components.)
