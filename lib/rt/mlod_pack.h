@@ -499,9 +499,10 @@ static inline void mlod_pack_rotq_predict(const int16_t e3, const int16_t prev[4
 	for (int c = 0; c < 4; c++)
 		p[c] = next ? prev[c] + ((dot < 0 ? -(double)next[c] : (double)next[c]) - prev[c]) * f : (double)prev[c];
 	int neg = p[big] < 0;
+	const double scale = 1.0 / (double)(1 << shift); /* exact: v is p[c] / 2^shift */
 	for (int c = 0, j = 0; c < 4; c++)
 		if (c != big) {
-			double v = ldexp(neg ? -p[c] : p[c], -shift);
+			double v = (neg ? -p[c] : p[c]) * scale;
 			pred[j++] = (int16_t)(v > 32767.0 ? 32767 : v < -32767.0 ? -32767 : lrint(v));
 		}
 }
