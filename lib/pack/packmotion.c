@@ -482,6 +482,50 @@ static void rotq_encode_on(const float *r, const int16_t *bn, int16_t *out, int 
 		out[c] = (int16_t)(uint16_t)((uint16_t)(dot < 0 ? -t[c] : t[c]) - (uint16_t)bn[c]);
 }
 
+/* Format 9.0 (mlod(5) ROTQ): each 'ROTQ' key but a channel's first as
+ * its difference to mlod_pack_rotq_predict's prediction, from the key
+ * before as returned and the channel's next key on a base key,
+ * zigzagged (mlod_pack_zigzag16). q and qd
+ * hold the 'ROTQ' and 'ROTD' elements as pack_motion_chunk made them,
+ * img the keys as returned; in the same order, q's elements change. */
+static void rotq_residuals(const mlod_clip *clip, const motion_img *img, const motion_img *base, int16_t *q,
+                           const int16_t *qd)
+{
+	size_t at_a = 0, at_d = 0;
+	for (int i = 0; i < clip->channel_count; i++) {
+		const mlod_channel *ch = &clip->channels[i];
+		if (ch->path != MLOD_PATH_ROTATION || ch->interp == MLOD_INTERP_CUBICSPLINE)
+			continue;
+		const struct img_chan *ic = &img->ch[i];
+		const struct img_chan *bc = img_channel(base, ic->joint);
+		uint32_t keys = ic->keys, w = 0; /* w: the next key after v on a base key, keys if none */
+		long bw = -1;
+		for (uint32_t v = 0; v < keys; v++) {
+			long b = img_key(bc, ic->times[v]);
+			if (b >= 0) {
+				at_d++;
+				continue;
+			}
+			int16_t *e = q + 4 * at_a++;
+			if (v == 0)
+				continue;
+			if (w <= v)
+				for (w = v + 1, bw = -1; w < keys && (bw = img_key(bc, ic->times[w])) < 0; w++)
+					;
+			int16_t nx[4], pred[3];
+			double f = 0.0;
+			if (w < keys) {
+				mlod_pack_rotq_key(qd + 4 * at_d, bc->rot + 4 * bw, NULL, nx);
+				f = ((double)ic->times[v] - (double)ic->times[v - 1]) /
+				    ((double)ic->times[w] - (double)ic->times[v - 1]);
+			}
+			mlod_pack_rotq_predict(e[3], ic->rot + 4 * (v - 1), w < keys ? nx : NULL, f, pred);
+			for (int j = 0; j < 3; j++)
+				e[j] = mlod_pack_zigzag16((int16_t)(uint16_t)((uint16_t)e[j] - (uint16_t)pred[j]));
+		}
+	}
+}
+
 double mlod_pack_rotq_angle(int shift)
 {
 	double h = sqrt(19.0) * ldexp(1.0, shift) / 65534.0;
@@ -929,6 +973,11 @@ mlod_result pack_motion_chunk(struct ctx *x, const mlod_clip *clip, int k, int i
 					at_v++;
 			}
 		}
+	}
+	if (!cb.fail) { /* format 9.0: ROTQ's predicted, then ROTD's zigzagged */
+		rotq_residuals(clip, img, base, q, qd);
+		for (size_t c = 0; c < 4 * at_d; c++)
+			qd[c] = mlod_pack_zigzag16(qd[c]);
 	}
 	free(shift);
 	free(tgrid);

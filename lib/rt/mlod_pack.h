@@ -25,7 +25,9 @@
  *             a, no decode path); 2.x is 3.x without MLOD_PART_LOCAL,
  *             the sequence codec and 'TBIT'; 2.x to 6.x store a
  *             skeleton level's palette as 'PALJ' and 'PALB' (7.0:
- *             'PALR' and 'PALX')
+ *             'PALR' and 'PALX'); 2.x to 8.x store 'ROTQ' keys as they
+ *             are and 'ROTD' differences not zigzagged (9.0: predicted,
+ *             zigzagged)
  *   6  u16    minor version; a newer minor only adds what older readers skip
  *   8  u32    flags (0; a reader ignores bits it does not know)
  *  12  u32    chunk_count (at most MLOD_PACK_MAX_CHUNKS)
@@ -220,8 +222,15 @@
  *          element is i, 0..3); the reader rebuilds component i as
  *          lrint(sqrt(max(0, 1 - s)) * 32767) / 32767, s the sum of the
  *          others' squares (each the f32 nearest q / 32767, summed in f64);
+ *          Format 9.0: every key but a channel's first stores, instead
+ *          of its three components, each one's difference to its
+ *          prediction (mlod_pack_rotq_predict: from the channel's key
+ *          before and its next key with a base key), wrapped to 16 bits
+ *          and zigzagged (mlod_pack_zigzag16); the element's i + 4 *
+ *          shift as before;
  *   'ROTD' i16[4] per key of every non-cubic rotation with a base key: its
- *          lattice integers minus the base key's, wrapped to 16 bits;
+ *          lattice integers minus the base key's, wrapped to 16 bits
+ *          (format 9.0: then zigzagged);
  *          after either, a key is negated when its dot product with the
  *          channel's key before is negative (q and -q are one rotation)
  *          (mlod_pack_rotq_key). (Format 1.0 stored the four components.)
@@ -304,9 +313,9 @@ extern "C" {
 #endif
 
 #define MLOD_PACK_MAGIC "MLOD"
-#define MLOD_PACK_MAJOR 8
+#define MLOD_PACK_MAJOR 9
 #define MLOD_PACK_MAJOR_OLDEST 2 /* the oldest major this reader reads */
-#define MLOD_PACK_MINOR 1 /* 8.1: INFO's max_vertex_count */
+#define MLOD_PACK_MINOR 0 /* 9.0: predicted ROTQ keys; 8.1: INFO's max_vertex_count */
 #define MLOD_PACK_HEADER_SIZE 32
 #define MLOD_PACK_TOC_ENTRY_SIZE 48
 #define MLOD_PACK_ALIGN 16
@@ -454,6 +463,48 @@ static inline void mlod_pack_rotq_key(const int16_t e[4], const int16_t *base, c
 		for (int c = 0; dot < 0 && c < 4; c++)
 			n[c] = (int16_t)-n[c];
 	}
+}
+/* Format 9.0: a 16-bit difference d as stored (zigzag: small magnitudes
+ * of either sign to small numbers, 0 -1 1 -2 to 0 1 2 3), and back. */
+static inline int16_t mlod_pack_zigzag16(int16_t d)
+{
+	return (int16_t)(uint16_t)((uint16_t)((uint16_t)d << 1) ^ (uint16_t)(d < 0 ? 0xFFFFu : 0u));
+}
+static inline int16_t mlod_pack_unzigzag16(int16_t z)
+{
+	uint16_t u = (uint16_t)z;
+	return (int16_t)(uint16_t)((uint16_t)(u >> 1) ^ (uint16_t)(u & 1 ? 0xFFFFu : 0u));
+}
+
+/* Format 9.0: what a 'ROTQ' key's three stored components are taken
+ * from. e[3] as stored (index i = e[3] & 3, shift = e[3] >> 2), prev the
+ * channel's key before as returned, next (or NULL) the channel's next key
+ * that has a base key, as mlod_pack_rotq_key returns it without a key
+ * before (prev NULL), and f = (t - t_prev) / (t_next - t_prev) in double
+ * from the keys' f32 times. The prediction p = prev + (s next - prev) * f
+ * (s = -1 when next's dot product with prev is negative, else 1; p = prev
+ * without next), negated when p[i] < 0; pred[j] = lrint(p[c] / 2^shift)
+ * for the three components c but i, in index order. The stored e[j] is
+ * the key's minus pred[j], wrapped to 16 bits and zigzagged
+ * (mlod_pack_zigzag16). A channel's first key stores its components as
+ * they are. The writer and the reader share it. */
+static inline void mlod_pack_rotq_predict(const int16_t e3, const int16_t prev[4], const int16_t *next, double f,
+                                          int16_t pred[3])
+{
+	int big = e3 & 3, shift = (e3 >> 2) & 15;
+	double p[4];
+	int64_t dot = 0;
+	for (int c = 0; next && c < 4; c++)
+		dot += (int64_t)prev[c] * next[c];
+	for (int c = 0; c < 4; c++)
+		p[c] = next ? prev[c] + ((dot < 0 ? -(double)next[c] : (double)next[c]) - prev[c]) * f : (double)prev[c];
+	int neg = p[big] < 0;
+	const double scale = 1.0 / (double)(1 << shift); /* exact: v is p[c] / 2^shift */
+	for (int c = 0, j = 0; c < 4; c++)
+		if (c != big) {
+			double v = (neg ? -p[c] : p[c]) * scale;
+			pred[j++] = (int16_t)(v > 32767.0 ? 32767 : v < -32767.0 ? -32767 : lrint(v));
+		}
 }
 #define MLOD_STREAM_ROTF MLOD_FOURCC('R', 'O', 'T', 'F')
 #define MLOD_STREAM_VEC3 MLOD_FOURCC('V', 'E', 'C', '3')

@@ -334,21 +334,53 @@ mlod_result mlod_pack_decode_motion_reserve(const mlod_pack *p, uint32_t chunk, 
 		if (ch->rec.path != 1 || ch->rec.interp == 2)
 			continue;
 		const mlod_pack_channel *bc = base_channel(base, ch->rec.joint);
-		int16_t n[4], prev[4], bn[4];
-		uint32_t from = 0;
+		int16_t n[4], prev[4], bn[4], nx[4];
+		uint32_t from = 0, from_w = 0, w = 0; /* w: the next key after k on a base key (format 9.0) */
+		int64_t at_w = -1;
 		for (uint32_t k = 0; k < ch->rec.key_count; k++) {
 			const uint8_t *e = (const uint8_t *)(ch->values + 4 * (size_t)k);
 			int16_t el[4];
 			for (int c = 0; c < 4; c++)
 				el[c] = rdi16(e + 2 * c);
 			int64_t at = base_key(bc, ch->times[k], &from);
+			if (at >= 0 && p->major >= 9) /* format 9.0: 'ROTD' zigzagged */
+				for (int c = 0; c < 4; c++)
+					el[c] = mlod_pack_unzigzag16(el[c]);
 			if (at >= 0)
 				for (int c = 0; c < 4; c++)
 					bn[c] = (int16_t)lrint((double)bc->values[4 * at + c] * 32767.0);
 			else if (el[3] < 0 || el[3] > (p->major >= 4 ? 4 * MLOD_PACK_ROTQ_SHIFT_MAX + 3 : 3))
 				FAIL("%s: channel %u: rotation key %u: component index and shift %d out of range", x.label, i,
 				     k, el[3]);
-			else
+			if (at < 0 && k > 0 && p->major >= 9) {
+				/* the stored components are the differences to
+				 * the prediction (mlod_pack_rotq_predict),
+				 * zigzagged */
+				if (w <= k) { /* the next one, and its key (nx) */
+					for (w = k + 1, at_w = -1; w < ch->rec.key_count &&
+					                           (at_w = base_key(bc, ch->times[w], &from_w)) < 0;
+					     w++)
+						;
+					if (w < ch->rec.key_count) {
+						const uint8_t *ew = (const uint8_t *)(ch->values + 4 * (size_t)w);
+						int16_t elw[4], bw[4];
+						for (int c = 0; c < 4; c++) {
+							elw[c] = mlod_pack_unzigzag16(rdi16(ew + 2 * c));
+							bw[c] = (int16_t)lrint((double)bc->values[4 * at_w + c] * 32767.0);
+						}
+						mlod_pack_rotq_key(elw, bw, NULL, nx);
+					}
+				}
+				int16_t pred[3];
+				double f = 0.0;
+				if (w < ch->rec.key_count)
+					f = ((double)ch->times[k] - (double)ch->times[k - 1]) /
+					    ((double)ch->times[w] - (double)ch->times[k - 1]);
+				mlod_pack_rotq_predict(el[3], prev, w < ch->rec.key_count ? nx : NULL, f, pred);
+				for (int c = 0; c < 3; c++)
+					el[c] = (int16_t)(uint16_t)((uint16_t)mlod_pack_unzigzag16(el[c]) + (uint16_t)pred[c]);
+			}
+			if (at < 0)
 				for (int c = 0; c < 3; c++)
 					if (el[c] > (32767 >> (el[3] >> 2)) || el[c] < -(32767 >> (el[3] >> 2)))
 						FAIL("%s: channel %u: rotation key %u: component %d past the lattice", x.label, i,

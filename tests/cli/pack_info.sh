@@ -7,7 +7,7 @@ for s in tubeman.glb RobotExpressive.glb cmu_12_01_walk.bvh; do
 	"$BIN/mlod-pack" "$ROOT/samples/$s" -o "$n.mlod" 2> /dev/null
 	"$BIN/mlod-pack" --info "$n.mlod" > "$n.txt"
 	size=$(wc -c < "$n.mlod" | tr -d ' ')
-	grep -q "^# $n.mlod: mlod 8\.1, $size bytes, [0-9]* chunks$" "$n.txt"
+	grep -q "^# $n.mlod: mlod 9\.0, $size bytes, [0-9]* chunks$" "$n.txt"
 	grep -q "^INFO  none " "$n.txt"
 	# the codec column names the entropy stage: INFO has none, DOC zstd
 	grep -q "^INFO  none         0  -  *none  " "$n.txt"

@@ -459,6 +459,7 @@ static float time_truth[NK];
 static float vec_truth[NK * 3][3];
 static float rot_truth[NK * 3][4];
 static int16_t rotq_truth[NK][4], rotq_enc[NK][4];
+static int rotq_v9 = 1; /* make_chunks' 'ROTQ' as format 9.0 codes it (0: 2.0 to 8.x) */
 
 static const int32_t parents[NJ] = {-1, 0, 1, 1};
 
@@ -953,9 +954,22 @@ static int make_chunks(wchunk *c, int with_unknown)
 	/* the values: ROTQ (channel 1), ROTF (channel 2), VEC3 (channels 0, 3) */
 	s = add_stream(ch, MLOD_STREAM_ROTQ, 8, MLOD_SCODEC_MESHOPT_VERTEX);
 	s->count = NK;
-	for (int k = 0; k < NK; k++)
+	for (int k = 0; k < NK; k++) {
+		int16_t e[4];
+		memcpy(e, rotq_enc[k], sizeof e);
+		/* format 9.0: every key but the first as its three components
+		 * minus the key before's (as returned; negated where its
+		 * component at the index is negative: no key of a base level
+		 * here), zigzagged: 0 -1 1 -2 as 0 1 2 3 */
+		for (int a = 0, j = 0, big = e[3] & 3; rotq_v9 && k > 0 && a < 4; a++)
+			if (a != big) {
+				int sign = rotq_truth[k - 1][big] < 0 ? -1 : 1;
+				long d = (int16_t)(uint16_t)((long)e[j] - sign * (long)rotq_truth[k - 1][a]); /* wrapped */
+				e[j++] = (int16_t)(uint16_t)(d >= 0 ? 2 * d : -2 * d - 1);
+			}
 		for (int a = 0; a < 4; a++)
-			put16(&s->data, (uint16_t)rotq_enc[k][a]);
+			put16(&s->data, (uint16_t)e[a]);
+	}
 	add_stream(ch, MLOD_STREAM_ROTD, 8, MLOD_SCODEC_MESHOPT_VERTEX);
 	s = add_stream(ch, MLOD_STREAM_ROTF, 16, MLOD_SCODEC_RAW);
 	s->count = NK * 3;
@@ -1520,7 +1534,7 @@ TEST(newer_major_is_refused)
 	free(b.p);
 	free(m.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED, "returned %d: %s", (int)r, msg);
-	CHECK_MSG(strcmp(msg, "pack format 9.0 is newer than this reader's 8.x") == 0, "message: %s", msg);
+	CHECK_MSG(strcmp(msg, "pack format 10.0 is newer than this reader's 9.x") == 0, "message: %s", msg);
 	CHECK(r2 == MLOD_OK && minor == 7);
 }
 
@@ -1541,6 +1555,42 @@ TEST(rotq_shift_decodes)
 	CHECK(memcmp(n, m, sizeof n) == 0);
 }
 
+/* Format 9.0 stores a 'ROTQ' key but a channel's first as the zigzagged
+ * difference to its prediction; an 8.x pack's keys, as they are, still
+ * read to the same keys, and the same bytes read as 9.0 do not. */
+TEST(format_8_rotq_reads)
+{
+	static wchunk c[C_COUNT + 1];
+	rotq_v9 = 0;
+	int n = make_chunks(c, 0);
+	buf b8 = build_pack(c, n, 8, 1), b9 = build_pack(c, n, 9, 0);
+	free_chunks(c, n);
+	rotq_v9 = 1;
+	mlod_pack p = {0}, p9 = {0};
+	mlod_pack_skeleton s = {0};
+	mlod_pack_motion m = {0}, m9 = {0};
+	CHECK_OK(mlod_pack_open(b8.p, b8.n, &p, &terr));
+	CHECK_OK(mlod_pack_decode_skeleton(&p, b8.p, b8.n, &s, &terr));
+	CHECK_OK(mlod_pack_decode_motion(&p, C_MOT0, b8.p, b8.n, &s, &m, &terr));
+	CHECK_OK(mlod_pack_open(b9.p, b9.n, &p9, &terr));
+	mlod_result r9 = mlod_pack_decode_motion(&p9, C_MOT0, b9.p, b9.n, &s, &m9, &terr);
+	int ok = p.major == 8 && m.channel_count == 4, differs = r9 != MLOD_OK;
+	for (int k = 0; ok && k < NK; k++)
+		for (int a = 0; ok && a < 4; a++) {
+			ok = m.channels[1].values[4 * k + a] == (float)(rotq_truth[k][a] / 32767.0);
+			differs |= r9 == MLOD_OK && m9.channels[1].values[4 * k + a] != m.channels[1].values[4 * k + a];
+		}
+	mlod_pack_motion_free(&m);
+	mlod_pack_motion_free(&m9);
+	mlod_pack_skeleton_free(&s);
+	mlod_pack_close(&p);
+	mlod_pack_close(&p9);
+	free(b8.p);
+	free(b9.p);
+	CHECK(ok);
+	CHECK(differs);
+}
+
 /* Format 2.0 changed the MESH layout (b2) and the MOTION streams: a 1.x
  * pack is refused whole, with what to do; there is no 1.x decode. */
 TEST(older_major_is_refused)
@@ -1555,7 +1605,7 @@ TEST(older_major_is_refused)
 	free(b.p);
 	CHECK_MSG(r == MLOD_ERR_UNSUPPORTED && p.chunks == NULL, "returned %d: %s", (int)r, terr.message);
 	CHECK_MSG(strcmp(terr.message, "mlod 1.0 pack: made by an older mlod-pack; pack the input again (this reader "
-	                               "reads 2.x to 8.x)") == 0,
+	                               "reads 2.x to 9.x)") == 0,
 	          "message: %s", terr.message);
 }
 
@@ -2400,10 +2450,11 @@ static void e_rotq_index(wchunk *c)
 {
 	wr16(stream_data(c, C_MOT0, MLOD_STREAM_ROTQ, 0) + 8 * 2 + 6, 4 * MLOD_PACK_ROTQ_SHIFT_MAX + 4);
 }
-/* Format 4.0: key 2 at shift 8 (index 0), its first component 200 past 32767 >> 8. */
+/* Format 4.0: key 0 (stored as it is in 9.0 too) at shift 8 (index 0),
+ * its first component 200 past 32767 >> 8. */
 static void e_rotq_past(wchunk *c)
 {
-	uint8_t *d = stream_data(c, C_MOT0, MLOD_STREAM_ROTQ, 0) + 8 * 2;
+	uint8_t *d = stream_data(c, C_MOT0, MLOD_STREAM_ROTQ, 0);
 	wr16(d, 200);
 	wr16(d + 6, 4 * 8);
 }
@@ -2470,7 +2521,7 @@ TEST(structural_checks_name_the_chunk)
 		{e_no_skin, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: skinned, but without a skin"},
 		{e_rotq_cubic, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: stream 3 'ROTQ' has 5 elements, expected 0 (rotation keys without a base key)"},
 		{e_rotq_index, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 2: component index and shift 36 out of range"},
-		{e_rotq_past, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 2: component 200 past the lattice"},
+		{e_rotq_past, C_MOT0, MLOD_ERR_PARSE, "MOTION level 0 of clip 0: channel 1: rotation key 0: component 200 past the lattice"},
 		{e_part_flags, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: unknown flags 0x100"},
 		{e_newbits_alone, C_MESH1, MLOD_ERR_PARSE, "MESH level 1: part 0: NEWBITS without LOCAL"},
 		{e_imap_past, C_MESH0, MLOD_ERR_PARSE, "MESH level 0: part 1: vertex 0 maps to 24, past its prefix of 24 vertices (MESH levels 1 to 0)"},
@@ -3057,6 +3108,7 @@ int main(int argc, char **argv)
 	RUN(format_6_0_palette_reads);
 	RUN(older_major_is_refused);
 	RUN(rotq_shift_decodes);
+	RUN(format_8_rotq_reads);
 	RUN(format_2_0_reads);
 	RUN(motion_tick_bits);
 	RUN(nested_motion_needs_its_base);

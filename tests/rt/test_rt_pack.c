@@ -243,7 +243,9 @@ static void write_pack(bytes *out)
 	}
 	memset(out, 0, sizeof *out);
 	put(out, "MLOD", 4);
-	put16(out, MLOD_PACK_MAJOR), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
+	/* format 8.0, the layout this builder writes: its 'ROTQ' keys as they are
+	 * (9.0 predicts them), no max_vertex_count (8.1) */
+	put16(out, 8), put16(out, 0), put32(out, 0), put32(out, (uint32_t)nchunks), put64(out, off);
 	put32(out, 0), put32(out, 0); /* CRCs below */
 	for (int i = 0; i < nchunks; i++) {
 		chunk *c = &chunks[i];
