@@ -140,8 +140,15 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	x.st = stats ? stats : &local_stats;
 	x.err = err;
 	memset(x.st, 0, sizeof *x.st);
-	if (c->notes && *c->notes) /* the reader's, first */
-		pack_note(&x, c->notes);
+	/* The reader's notes first, one note per line of them. */
+	for (const char *n = c->notes; n && *n;) {
+		size_t len = strcspn(n, "\n");
+		char line[512];
+		snprintf(line, sizeof line, "%.*s", (int)(len < sizeof line ? len : sizeof line - 1), n);
+		if (*line)
+			pack_note(&x, line);
+		n += len + (n[len] == '\n');
+	}
 	if (doc && (r = mlod_record_read(doc, &x.rec, err)) != MLOD_OK)
 		return r;
 	if ((r = pack_make_view(&x)) != MLOD_OK || (r = pack_measure(&x)) != MLOD_OK)

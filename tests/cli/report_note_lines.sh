@@ -1,6 +1,7 @@
-# The reader's notes (one a line) come out of mlod-label's, mlod-skelgraph's
-# and mlod-bgm's table reports one "# note:" or "# input:" line each, not
-# joined by a literal "\n" (as they were). Two notes here: a mesh node
+# The reader's notes (one a line) come out of mlod-label's, mlod-skelgraph's,
+# mlod-bgm's and mlod-motion's table reports one "# note:" or "# input:" line
+# each, not joined by a literal "\n" (as they were), and mlod-pack's note
+# line has them as notes of their own ("; " between). Two notes here: a mesh node
 # outside the default scene, and joints without a skin.
 python3 - <<'PY' || exit 1
 import base64, json, struct
@@ -30,11 +31,16 @@ json.dump({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 2]}
                          {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}]},
           open("two.gltf", "w"))
 PY
-for t in label:note skelgraph:note bgm:input; do
+for t in label:note skelgraph:note bgm:input motion:note; do
 	tool=${t%:*} prefix=${t#*:}
 	"$BIN/mlod-$tool" --report two.gltf > $tool.txt 2> /dev/null || { echo "mlod-$tool failed" >&2; exit 1; }
 	grep -q '\\n' $tool.txt && { echo "mlod-$tool: a literal \\n" >&2; cat $tool.txt >&2; exit 1; }
 	grep -q "^# $prefix: 1 nodes with a mesh are not in the default scene" $tool.txt &&
 		grep -q "^# $prefix: the document has no skins" $tool.txt || { cat $tool.txt >&2; exit 1; }
 done
+"$BIN/mlod-pack" --report two.gltf -o two.mlod > pack.txt 2> /dev/null || { echo "mlod-pack failed" >&2; exit 1; }
+grep -q '\\n' pack.txt && { echo "mlod-pack: a literal \\n" >&2; cat pack.txt >&2; exit 1; }
+grep -Eq '^# note: (.*; )?1 nodes with a mesh are not in the default scene[^;]*: they are not instances(;|$)' pack.txt &&
+	grep -Eq '^# note: (.*; )?the document has no skins: its 1 joints are[^;]*(;|$)' pack.txt ||
+	{ cat pack.txt >&2; exit 1; }
 exit 0
