@@ -11,7 +11,6 @@
 #include "model/mlod_model.h"
 
 #define BVH_MAX_FRAMES 10000000       /* more frames than this is absurd */
-#define BVH_MAX_DEPTH 1000            /* deeper nesting than this is nonsense */
 #define BVH_MAX_JOINTS (1 << 20)
 #define BVH_MAX_WRITE_VALUES 200000000 /* values a written BVH may hold */
 

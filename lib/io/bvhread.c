@@ -293,7 +293,7 @@ typedef struct reader {
 	mlod_error *err;
 	mlod_joint *joints;
 	int count, cap;
-	open_joint stack[BVH_MAX_DEPTH];
+	open_joint stack[MLOD_MAX_HIERARCHY_DEPTH];
 	int depth;
 } reader;
 
@@ -397,9 +397,9 @@ static mlod_result read_name(reader *r, const char *kind, char **out)
 static mlod_result begin_joint(reader *r, int parent, const char *kind)
 {
 	char b[64], d[160];
-	if (r->depth >= BVH_MAX_DEPTH)
-		return mlod_fail(r->err, MLOD_ERR_PARSE, "line %d: joints nested deeper than %d levels",
-		                 r->lx.line, BVH_MAX_DEPTH);
+	if (r->depth >= MLOD_MAX_HIERARCHY_DEPTH)
+		return mlod_fail(r->err, MLOD_ERR_UNSUPPORTED, "line %d: joints nested deeper than %d levels",
+		                 r->lx.line, MLOD_MAX_HIERARCHY_DEPTH);
 	if (r->count >= BVH_MAX_JOINTS)
 		return mlod_fail(r->err, MLOD_ERR_NOMEM, "line %d: more than %d joints", r->lx.line,
 		                 BVH_MAX_JOINTS);

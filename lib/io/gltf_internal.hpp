@@ -84,10 +84,6 @@
 
 #include "io/mlod_io.h"
 
-/* The deepest node hierarchy the character reader takes (levels from a
- * root, the root one), as deep as the BVH reader's (BVH_MAX_DEPTH). */
-#define MLOD_MAX_NODE_DEPTH 1000
-
 struct mlod_gltf {
 	tinygltf::Model model;
 	/* The JSON as read (without URIs), to write back what tinygltf drops;

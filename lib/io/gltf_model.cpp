@@ -120,11 +120,11 @@ private:
 		for (int k : order_) {
 			int p = parent_[size_t(k)];
 			depth[size_t(k)] = p < 0 ? 0 : depth[size_t(p)] + 1;
-			if (depth[size_t(k)] >= MLOD_MAX_NODE_DEPTH)
+			if (depth[size_t(k)] >= MLOD_MAX_HIERARCHY_DEPTH)
 				fail(MLOD_ERR_UNSUPPORTED, "node %d%s%s is %d levels deep: mlod reads node hierarchies at most %d levels "
 				     "deep", k, m_.nodes[size_t(k)].name.empty() ? "" : " ",
 				     m_.nodes[size_t(k)].name.empty() ? "" : quoted(m_.nodes[size_t(k)].name).c_str(), depth[size_t(k)] + 1,
-				     MLOD_MAX_NODE_DEPTH);
+				     MLOD_MAX_HIERARCHY_DEPTH);
 		}
 		local_.resize(n);
 		world_.resize(n);

@@ -8,6 +8,12 @@
 
 #include "model/mlod_model.h"
 
+/* The deepest hierarchy the readers take, in levels from a root (the root
+ * one): glTF nodes and BVH joints. The later stages walk joints to their
+ * roots, so deeper input is MLOD_ERR_UNSUPPORTED (exit 3), with the line
+ * (BVH) or node (glTF) too deep in the message. */
+#define MLOD_MAX_HIERARCHY_DEPTH 1000
+
 #ifdef __cplusplus
 extern "C" {
 #endif
