@@ -481,29 +481,38 @@ static inline int16_t mlod_pack_unzigzag16(int16_t z)
  * channel's key before as returned, next (or NULL) the channel's next key
  * that has a base key, as mlod_pack_rotq_key returns it without a key
  * before (prev NULL), and f = (t - t_prev) / (t_next - t_prev) in double
- * from the keys' f32 times. The prediction p = prev + (s next - prev) * f
- * (s = -1 when next's dot product with prev is negative, else 1; p = prev
- * without next), negated when p[i] < 0; pred[j] = lrint(p[c] / 2^shift)
- * for the three components c but i, in index order. The stored e[j] is
- * the key's minus pred[j], wrapped to 16 bits and zigzagged
- * (mlod_pack_zigzag16). A channel's first key stores its components as
- * they are. The writer and the reader share it. */
+ * from the keys' f32 times (a subtraction and a division: IEEE double
+ * rounds them alike everywhere). The prediction is in integers, so that
+ * every compiler and flag set (fused multiply-adds) gets the same bits:
+ * F = lrint(f * 65536) (0..65536), P[c] = prev[c] * 65536 + (s next[c] -
+ * prev[c]) * F in int64 (s = -1 when next's dot product with prev is
+ * negative, else 1; P[c] = prev[c] * 65536 without next), negated when
+ * P[i] < 0; pred[j] = P[c] / 2^(16 + shift) rounded half away from zero,
+ * within +-32767, for the three components c but i, in index order. The
+ * stored e[j] is the key's minus pred[j], wrapped to 16 bits and
+ * zigzagged (mlod_pack_zigzag16). A channel's first key stores its
+ * components as they are. The writer and the reader share it. */
 static inline void mlod_pack_rotq_predict(const int16_t e3, const int16_t prev[4], const int16_t *next, double f,
                                           int16_t pred[3])
 {
 	int big = e3 & 3, shift = (e3 >> 2) & 15;
-	double p[4];
-	int64_t dot = 0;
+	int64_t P[4], dot = 0;
+	const int64_t F = next && f > 0.0 ? (f < 1.0 ? (int64_t)lrint(f * 16777216.0) : 16777216) : 0;
 	for (int c = 0; next && c < 4; c++)
 		dot += (int64_t)prev[c] * next[c];
-	for (int c = 0; c < 4; c++)
-		p[c] = next ? prev[c] + ((dot < 0 ? -(double)next[c] : (double)next[c]) - prev[c]) * f : (double)prev[c];
-	int neg = p[big] < 0;
-	const double scale = 1.0 / (double)(1 << shift); /* exact: v is p[c] / 2^shift */
+	for (int c = 0; c < 4; c++) {
+		const int64_t n = next ? (dot < 0 ? -(int64_t)next[c] : (int64_t)next[c]) : prev[c];
+		P[c] = (int64_t)prev[c] * 16777216 + (n - prev[c]) * F;
+	}
+	const int neg = P[big] < 0;
+	const int64_t D = (int64_t)1 << (24 + shift);
 	for (int c = 0, j = 0; c < 4; c++)
 		if (c != big) {
-			double v = (neg ? -p[c] : p[c]) * scale;
-			pred[j++] = (int16_t)(v > 32767.0 ? 32767 : v < -32767.0 ? -32767 : lrint(v));
+			const int64_t v = neg ? -P[c] : P[c], a = v < 0 ? -v : v;
+			int64_t r = (a + D / 2) / D;
+			if (r > 32767)
+				r = 32767;
+			pred[j++] = (int16_t)(v < 0 ? -r : r);
 		}
 }
 #define MLOD_STREAM_ROTF MLOD_FOURCC('R', 'O', 'T', 'F')

@@ -1558,6 +1558,31 @@ TEST(rotq_shift_decodes)
 /* Format 9.0 stores a 'ROTQ' key but a channel's first as the zigzagged
  * difference to its prediction; an 8.x pack's keys, as they are, still
  * read to the same keys, and the same bytes read as 9.0 do not. */
+/* Format 9.0's ROTQ prediction is integer arithmetic after F = lrint(f
+ * 2^24), so that every compiler and flag set (fused multiply-adds) reads
+ * the same keys: exact values, ties half away from zero (lrint's ties to
+ * even gave 0 for both halves below), the dot product's sign, the big
+ * component's sign, a shift, and no next key. */
+TEST(rotq_predict_integers)
+{
+	int16_t pred[3];
+	const int16_t a[4] = { 100, 200, 300, 32000 }, b[4] = { 102, 204, 306, 32000 };
+	mlod_pack_rotq_predict(3, a, b, 0.5, pred);
+	CHECK_MSG(pred[0] == 101 && pred[1] == 202 && pred[2] == 303, "%d %d %d", pred[0], pred[1], pred[2]);
+	const int16_t z[4] = { 0, 0, 0, 32767 }, h[4] = { 1, -1, 3, 32767 };
+	mlod_pack_rotq_predict(3, z, h, 0.5, pred);
+	CHECK_MSG(pred[0] == 1 && pred[1] == -1 && pred[2] == 2, "ties: %d %d %d", pred[0], pred[1], pred[2]);
+	const int16_t t[4] = { 3000, 0, 0, 32000 };
+	mlod_pack_rotq_predict(3, z, t, 1.0 / 3.0, pred); /* 3000 * 5592405 / 2^24 = 999.99994 */
+	CHECK_MSG(pred[0] == 1000 && pred[1] == 0 && pred[2] == 0, "thirds: %d %d %d", pred[0], pred[1], pred[2]);
+	const int16_t n[4] = { -400, 0, 0, -32000 }; /* dot < 0: the prediction runs to -n */
+	mlod_pack_rotq_predict(3, a, n, 1.0, pred);
+	CHECK_MSG(pred[0] == 400 && pred[1] == 0 && pred[2] == 0, "dot: %d %d %d", pred[0], pred[1], pred[2]);
+	const int16_t m[4] = { 800, -400, 40, -32000 }; /* big component negative: negated, then / 2^2 */
+	mlod_pack_rotq_predict(3 + 4 * 2, m, NULL, 0.0, pred);
+	CHECK_MSG(pred[0] == -200 && pred[1] == 100 && pred[2] == -10, "shift: %d %d %d", pred[0], pred[1], pred[2]);
+}
+
 TEST(format_8_rotq_reads)
 {
 	static wchunk c[C_COUNT + 1];
@@ -3108,6 +3133,7 @@ int main(int argc, char **argv)
 	RUN(format_6_0_palette_reads);
 	RUN(older_major_is_refused);
 	RUN(rotq_shift_decodes);
+	RUN(rotq_predict_integers);
 	RUN(format_8_rotq_reads);
 	RUN(format_2_0_reads);
 	RUN(motion_tick_bits);
