@@ -7,7 +7,6 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <getopt.h>
-#include <float.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -435,9 +434,10 @@ void tool_write_gltf(const char *path, const mlod_gltf *doc)
 	mlod_free(data);
 }
 
-/* value as a double: dies if it is not a number, or too close to 0 for
- * a double; a number too large for one (1e400) is returned as infinity,
- * which the callers' ranges refuse as out of range. */
+/* value as a double: dies if it is not a number, or so close to 0 that
+ * no double holds it (1e-400; a subnormal such as 1e-310 is a double); a
+ * number too large for one (1e400) is returned as infinity (strtod's
+ * HUGE_VAL), which the callers' ranges refuse as out of range. */
 static double parse_number(const char *option, const char *value)
 {
 	char *end = NULL;
@@ -445,9 +445,9 @@ static double parse_number(const char *option, const char *value)
 	double v = strtod(value, &end);
 	if (end == value || *end != '\0' || isnan(v))
 		tool_usage_error("%s: '%s' is not a number", option, value);
-	if (errno == ERANGE && fabs(v) <= DBL_MIN) /* underflow: a number, but none a double holds */
+	if (errno == ERANGE && v == 0.0) /* underflow to 0: a number, but none a double holds */
 		tool_usage_error("%s: %s is out of range (too close to 0 for a double)", option, value);
-	return errno == ERANGE ? copysign(HUGE_VAL, v) : v;
+	return v;
 }
 
 double tool_parse_double(const char *option, const char *value, double lo, double hi)

@@ -285,6 +285,8 @@ int main(int argc, char **argv)
 		default: tool_option_error(ch, shortopts, argv);
 		}
 	}
+	if (info && extract)
+		tool_usage_error("--info and -x do not go together");
 	if (argc - optind > 1)
 		tool_usage_error("too many inputs: one file, or stdin");
 	if (ratios_given && opt.mesh_max_error >= 0.0)
@@ -293,8 +295,6 @@ int main(int argc, char **argv)
 		tool_usage_error("--influence-budget and --max-error do not go together");
 	if (opt.lossless_motion && level0_given)
 		tool_usage_error("--lossless-motion and --motion-level0-error do not go together");
-	if (info && extract)
-		tool_usage_error("--info and -x do not go together");
 	if ((info || extract) && bake)
 		tool_usage_error("%s bakes a pack: not with %s, which reads one", bake, info ? "--info" : "-x");
 	if (opt.no_skeleton_levels && skel_opt)

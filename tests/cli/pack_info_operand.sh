@@ -19,3 +19,4 @@ cmp a.txt b.txt
 "$BIN/mlod-pack" --extract=w.mlod -o d.glb
 cmp a.glb b.glb && cmp a.glb c.glb && cmp a.glb d.glb
 ! "$BIN/mlod-pack" --info=w.mlod w.mlod
+! "$BIN/mlod-pack" --info w.mlod -x w.mlod
