@@ -889,7 +889,8 @@ void bgm_release_collapse_state(mlod_bgm *g)
 	g->lbmemo = NULL;
 	g->heap.e = NULL;
 	g->heap.memo = NULL;
-	g->quadric_cap = g->opstate_cap = g->ftie_cap = 0;
+	g->quadric_cap = g->opstate_cap = g->ftie_cap = g->qslot_cap = 0;
+	g->released = 1;
 	g->lbmemo_count = g->lbmemo_cap = 0;
 	g->heap.count = g->heap.cap = 0;
 	g->heap.memo_count = g->heap.memo_cap = g->heap.memo_free = 0;

@@ -111,6 +111,7 @@ struct mlod_bgm {
 	 * row per node ever made: bench/RESULTS.md Run 118). */
 	int *qslot;
 	int qslot_cap;          /* capacity (nodes) of qslot */
+	int released;           /* bgm_release_collapse_state ran: no more collapses */
 	int *qpose;
 	double *quadric;
 	float *skin;

@@ -278,6 +278,8 @@ mlod_result mlod_bgm_simplify(mlod_bgm *g, int target, int max_collapses, mlod_e
 {
 	if (!g)
 		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_bgm_simplify: NULL");
+	if (g->released)
+		return mlod_fail(err, MLOD_ERR_INVALID_ARG, "mlod_bgm_simplify: the collapse state was released (the chain is final)");
 	double t0 = bgm_seconds();
 	mlod_result r = MLOD_OK;
 	bgm_plan *pl = malloc(sizeof *pl), *scratch = malloc(sizeof *scratch);

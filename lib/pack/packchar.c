@@ -16,12 +16,17 @@
 /* The character as packed                                             */
 /* ------------------------------------------------------------------ */
 
-void pack_note(struct ctx *x, const char *text)
+void pack_note_n(struct ctx *x, const char *text, size_t tlen)
 {
 	char *n = x->st->notes;
 	size_t len = strlen(n);
-	if (len + strlen(text) + 3 < sizeof x->st->notes)
-		snprintf(n + len, sizeof x->st->notes - len, "%s%s", len ? "; " : "", text);
+	if (len + tlen + 3 < sizeof x->st->notes && tlen <= INT_MAX)
+		snprintf(n + len, sizeof x->st->notes - len, "%s%.*s", len ? "; " : "", (int)tlen, text);
+}
+
+void pack_note(struct ctx *x, const char *text)
+{
+	pack_note_n(x, text, strlen(text));
 }
 
 /* A note that is also a warning (mlod_pack_stats.warnings). */

@@ -143,10 +143,8 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	/* The reader's notes first, one note per line of them. */
 	for (const char *n = c->notes; n && *n;) {
 		size_t len = strcspn(n, "\n");
-		char line[512];
-		snprintf(line, sizeof line, "%.*s", (int)(len < sizeof line ? len : sizeof line - 1), n);
-		if (*line)
-			pack_note(&x, line);
+		if (len > 0)
+			pack_note_n(&x, n, len);
 		n += len + (n[len] == '\n');
 	}
 	if (doc && (r = mlod_record_read(doc, &x.rec, err)) != MLOD_OK)

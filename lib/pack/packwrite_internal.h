@@ -195,6 +195,8 @@ struct ctx {
 };
 
 void pack_note(struct ctx *x, const char *text);
+/* The first len bytes of text as a note. */
+void pack_note_n(struct ctx *x, const char *text, size_t len);
 void pack_warn(struct ctx *x, const char *text);
 int pack_joint_of_node(const mlod_skeleton *s, int node);
 int pack_skin_of_gltf(const mlod_skeleton *s, int g);

@@ -319,6 +319,25 @@ TEST(weld_keeps_seams_closed)
 	mlod_character_free(&c);
 }
 
+/* Once its collapse state is released (the chain is final), a BGM
+ * refuses more collapses with a message instead of reading the freed
+ * quadric rows (a review found nothing guarding it but a comment). */
+TEST(released_refuses_simplify)
+{
+	mlod_character c;
+	CHECK(test_load("samples/tubeman.glb", &c) == 0);
+	mlod_bgm *g;
+	CHECK_OK(mlod_bgm_build(&c, 0, 0, NULL, &g, &terr));
+	mlod_bgm_info info;
+	mlod_bgm_get_info(g, &info);
+	CHECK_OK(mlod_bgm_simplify(g, info.triangles / 2, 0, &terr));
+	bgm_release_collapse_state(g);
+	mlod_result r = mlod_bgm_simplify(g, info.triangles / 4, 0, &terr);
+	mlod_bgm_free(g);
+	mlod_character_free(&c);
+	CHECK_MSG(r == MLOD_ERR_INVALID_ARG && strstr(terr.message, "released"), "%d: %s", (int)r, terr.message);
+}
+
 /* Every wedge a collapse made: a free v-bar's parents had one texture
  * value each and the wedge's UV lies in their range; a snapped v-bar
  * reproduces a UV of the vertex it snapped onto exactly. */
@@ -1650,6 +1669,7 @@ int main(void)
 	RUN(stored_poses);
 	RUN(level_errors_ordered);
 	RUN(mesh_levels_pipelined);
+	RUN(released_refuses_simplify);
 	RUN(pose_sets);
 	RUN(remap_joints);
 	RUN(hostile_input);
