@@ -174,11 +174,9 @@ static char *dir_of(const char *path)
  * without a report. Their names are already quoted (no line breaks). */
 void tool_note_lines(const char *what, const char *lines)
 {
-	for (const char *w = lines; w && *w;) {
-		size_t n = strcspn(w, "\n");
-		tool_note(what, "%.*s", (int)n, w);
-		w += n + (w[n] == '\n');
-	}
+	size_t n;
+	for (const char *w = lines, *l; (l = mlod_next_line(&w, &n));)
+		tool_note(what, "%.*s", (int)n, l);
 }
 
 void tool_note_items(const char *what, const char *notes, const char *suffix)
@@ -519,16 +517,17 @@ void tool_put_line(FILE *f, const char *prefix, const char *s)
 
 void tool_put_lines(FILE *f, const char *prefix, const char *s)
 {
-	for (const char *w = s; w && *w;) {
-		size_t n = strcspn(w, "\n");
+	size_t n;
+	for (const char *w = s, *l; (l = mlod_next_line(&w, &n));) {
+		if (n == 0) /* as the library's reports: no empty note */
+			continue;
 		char *line = malloc(n + 1);
 		if (!line)
 			tool_die(EXIT_OUTPUT, NULL, "out of memory");
-		memcpy(line, w, n);
+		memcpy(line, l, n);
 		line[n] = 0;
 		tool_put_line(f, prefix, line);
 		free(line);
-		w += n + (w[n] == '\n');
 	}
 }
 

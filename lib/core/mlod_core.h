@@ -168,6 +168,12 @@ int mlod_utf8_length(const char *s);
  * \xHH. A name too long for buf is cut between characters and ends in
  * "...". Returns buf. */
 #define MLOD_NAME_TEXT_SIZE 160
+
+/* Text of lines (the reader's notes and warnings: one a line), line by
+ * line: the line at *at (up to its '\n' or the end, without the '\n') as
+ * its start and *len; *at moves past it. NULL once *at is NULL or at the
+ * end. for (const char *w = text, *l; (l = mlod_next_line(&w, &n));) */
+const char *mlod_next_line(const char **at, size_t *len);
 const char *mlod_name_text(const char *name, int quote, char *buf, size_t size);
 /* mlod_name_text(name, 1, ...) in a buffer that lives to the end of the
  * enclosing block (C only: a compound literal), for a message:

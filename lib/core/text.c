@@ -145,3 +145,14 @@ void mlod_int_list(char *buf, size_t size, const int *v, int n, int most)
 	if (n > most && at < size)
 		snprintf(buf + at, size - at, ", ...");
 }
+
+const char *mlod_next_line(const char **at, size_t *len)
+{
+	const char *w = *at;
+	if (!w || !*w)
+		return NULL;
+	size_t n = strcspn(w, "\n");
+	*len = n;
+	*at = w + n + (w[n] == '\n');
+	return w;
+}

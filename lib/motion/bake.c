@@ -464,12 +464,10 @@ mlod_result mlod_motion_bake_table(const mlod_motion_bake *b, const mlod_charact
 	if (info->precision != MLOD_MOTION_PRECISION_FULL)
 		mlod_buf_printf(&sb, "# key values rounded within each level's bound (--precision %s)\n",
 		          info->precision == MLOD_MOTION_PRECISION_AUTO ? "auto" : "float");
-	for (const char *n = c->notes; n && *n;) { /* one "# note:" line per line of the reader's notes */
-		int len = (int)strcspn(n, "\n");
+	size_t len; /* one "# note:" line per line of the reader's notes */
+	for (const char *w = c->notes, *l; (l = mlod_next_line(&w, &len));)
 		if (len > 0)
-			mlod_buf_printf(&sb, "# note: %.*s\n", len, n);
-		n += len + (n[len] == '\n');
-	}
+			mlod_buf_printf(&sb, "# note: %.*s\n", (int)len, l);
 	return mlod_buf_take(&sb, text, NULL, NULL, err);
 }
 

@@ -141,12 +141,10 @@ mlod_result mlod_pack_write(const mlod_gltf *doc, const mlod_character *c, mlod_
 	x.err = err;
 	memset(x.st, 0, sizeof *x.st);
 	/* The reader's notes first, one note per line of them. */
-	for (const char *n = c->notes; n && *n;) {
-		size_t len = strcspn(n, "\n");
+	size_t len;
+	for (const char *w = c->notes, *l; (l = mlod_next_line(&w, &len));)
 		if (len > 0)
-			pack_note_n(&x, n, len);
-		n += len + (n[len] == '\n');
-	}
+			pack_note_n(&x, l, len);
 	if (doc && (r = mlod_record_read(doc, &x.rec, err)) != MLOD_OK)
 		return r;
 	if ((r = pack_make_view(&x)) != MLOD_OK || (r = pack_measure(&x)) != MLOD_OK)

@@ -107,6 +107,28 @@ TEST(printf_append)
 }
 
 /* Nothing appended: an empty text, not NULL. */
+/* mlod_next_line, the one splitter of the reader's notes into lines:
+ * each line without its '\n', an empty line between two '\n's, no line
+ * after a final '\n', none at all for NULL or "". */
+TEST(next_line)
+{
+	const char *w = "a\n\nbc\n", *l;
+	size_t n = 99;
+	char got[64] = "";
+	int count = 0;
+	while ((l = mlod_next_line(&w, &n)) && count < 8) {
+		snprintf(got + strlen(got), sizeof got - strlen(got), "[%.*s]", (int)n, l);
+		count++;
+	}
+	CHECK_MSG(count == 3 && strcmp(got, "[a][][bc]") == 0, "%d lines: %s", count, got);
+	w = "x";
+	CHECK(mlod_next_line(&w, &n) && n == 1 && *w == '\0' && !mlod_next_line(&w, &n));
+	w = NULL;
+	CHECK(!mlod_next_line(&w, &n));
+	w = "";
+	CHECK(!mlod_next_line(&w, &n));
+}
+
 TEST(take_empty)
 {
 	mlod_buf b = MLOD_BUF_INIT;
@@ -123,5 +145,6 @@ int main(void)
 	RUN(overflow);
 	RUN(printf_append);
 	RUN(take_empty);
+	RUN(next_line);
 	TEST_EXIT();
 }
